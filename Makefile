@@ -1,0 +1,122 @@
+# obscura: one entry point.
+#
+#   make          build/libobscura.a and build/obscura
+#   make deps     install the Debian packages the build and tests need
+#   make demo     run the bundled example (no daemon)
+#   make test     unit + end-to-end tests, then the same under ASan/UBSan
+#   make bench    benchmarks (bench/RESULTS.md)
+#
+# BUILD selects the output folder, so the sanitizer build lives beside the
+# normal one: make BUILD=build/asan SAN=1.
+
+BUILD ?= build
+SAN ?= 0
+DEBUG ?= 0
+
+CC ?= cc
+PKGS := OpenEXR egl osmesa libpng libcjson
+# Only OpenEXR's C core library is used (openexr.h), not the C++ one.
+EXR_CFLAGS := $(shell pkg-config --cflags OpenEXR 2>/dev/null)
+PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson 2>/dev/null) $(EXR_CFLAGS)
+PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson 2>/dev/null) -lz -lm -lpthread
+
+CFLAGS ?= -O2 -g
+CFLAGS += -std=c11 -D_DEFAULT_SOURCE -Wall -Wextra -Wshadow -Wstrict-prototypes \
+          -Wno-missing-field-initializers -fno-strict-aliasing
+CPPFLAGS += -Icore -I$(BUILD)/gen
+ifeq ($(SAN),1)
+CFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+LDFLAGS += -fsanitize=address,undefined
+endif
+ifeq ($(DEBUG),1)
+CPPFLAGS += -DOBS_DEBUG=1
+endif
+
+CORE_SRC := $(wildcard core/*.c core/gl/*.c)
+CORE_OBJ := $(CORE_SRC:%.c=$(BUILD)/obj/%.o)
+SHADERS := $(wildcard core/shaders/*.glsl)
+SHADER_HDR := $(BUILD)/gen/obs_shaders.h
+
+CLI_SRC := $(wildcard clients/*.c)
+CLI_OBJ := $(CLI_SRC:%.c=$(BUILD)/obj/%.o)
+
+UNIT_SRC := $(wildcard tests/unit/*/test_*.c)
+UNIT_BIN := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+
+LIB := $(BUILD)/libobscura.a
+CLI := $(BUILD)/obscura
+
+.PHONY: all deps demo test check unit e2e test-asan headers bench clean
+.DEFAULT_GOAL := all
+
+all: $(LIB) $(CLI)
+
+# ---- dependencies -------------------------------------------------------
+deps:
+	@tools/deps.sh
+
+
+# ---- build --------------------------------------------------------------
+$(SHADER_HDR): $(SHADERS) tools/embed_shaders.sh
+	@mkdir -p $(dir $@)
+	tools/embed_shaders.sh $(SHADERS) > $@.tmp && mv $@.tmp $@
+
+$(BUILD)/obj/%.o: %.c | $(SHADER_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) -MMD -MP -c $< -o $@
+
+$(LIB): $(CORE_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(CLI): $(CLI_OBJ) $(LIB)
+	$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(PKG_LIBS)
+
+$(BUILD)/tests/%: tests/unit/%.c $(LIB) tests/unit/testutil.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS) -lcmocka
+
+-include $(CORE_OBJ:.o=.d) $(CLI_OBJ:.o=.d)
+
+# ---- demo ---------------------------------------------------------------
+demo: deps all
+	@mkdir -p out
+	$(CLI) info
+	$(CLI) ao tests/data/room_small.exr --camera tests/data/room_small.camera.json \
+	    --output both -o out/room_small.exr
+	$(CLI) ao tests/data/room_small.exr --camera tests/data/room_small.camera.json \
+	    --output ao -o out/room_small_ao.png
+	$(CLI) ao tests/data/room_small.exr --camera tests/data/room_small.camera.json \
+	    --output composite -o out/room_small_composite.png
+	@echo "demo: wrote out/room_small.exr (AO.Y + R,G,B,A), out/room_small_ao.png, out/room_small_composite.png"
+
+# ---- tests --------------------------------------------------------------
+# make test = the whole suite, then the same suite under ASan/UBSan.
+test: deps
+	$(MAKE) check
+	$(MAKE) check BUILD=build/asan SAN=1
+
+check: all headers unit e2e
+
+unit: $(UNIT_BIN)
+	@tests/run_unit.sh $(UNIT_BIN)
+
+e2e: $(CLI)
+	@OBSCURA=$(CLI) tests/e2e/run.sh
+
+# Every public header compiles alone, as C and as C++.
+headers:
+	@mkdir -p $(BUILD)/headers
+	@for h in core/obscura.h core/status.h core/params.h core/io.h core/metrics.h; do \
+	  echo "#include \"$$h\"" > $(BUILD)/headers/t.c; \
+	  $(CC) -I. -Wall -Wextra -Werror -std=c99 -c $(BUILD)/headers/t.c -o /dev/null || exit 1; \
+	  cp $(BUILD)/headers/t.c $(BUILD)/headers/t.cpp; \
+	  c++ -I. -Wall -Wextra -Werror -c $(BUILD)/headers/t.cpp -o /dev/null || exit 1; \
+	done
+	@echo "headers: each public header compiles alone as C and C++"
+
+bench: deps all
+	@bench/run.sh
+
+clean:
+	rm -rf build out

@@ -1,0 +1,646 @@
+/* obscura: the command-line client.  Runs the AO chain in-process.
+ *
+ *   obscura ao IN.exr -o OUT.(exr|png) [options] [parameters]
+ *   obscura compare TRUTH.exr CANDIDATE.exr [--channel-a CH] [--channel-b CH] ...
+ *   obscura info [--backend B]
+ *   obscura params [--markdown]
+ *
+ * Exit codes: 0 ok, 1 failure (GL, I/O), 2 usage, 3 bad input. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "io.h"
+#include "metrics.h"
+#include "obscura.h"
+
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_BADINPUT = 3 };
+
+static int verbosity = OBS_LOG_INFO;
+
+static void log_cb(void *user, obs_log_level level, const char *msg)
+{
+    static const char *const names[] = {"error", "warning", "info", "debug"};
+    (void)user;
+    if ((int)level <= verbosity)
+        fprintf(stderr, "obscura: %s: %s\n", names[level], msg);
+}
+
+static void die_usage(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "obscura: ");
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n(run 'obscura help' for usage)\n");
+    va_end(ap);
+    exit(EXIT_USAGE);
+}
+
+/* Exit code for a failed status: bad input is permanent (3). */
+static int status_exit(obs_status s)
+{
+    switch (s) {
+    case OBS_BAD_FILE:
+    case OBS_UNSUPPORTED:
+    case OBS_MISSING_CHANNEL:
+    case OBS_TOO_LARGE:
+    case OBS_NO_CAMERA:
+    case OBS_INVALID_ARGUMENT: return EXIT_BADINPUT;
+    default: return EXIT_FAIL;
+    }
+}
+
+static int fail(obs_status s, const char *what, const char *err)
+{
+    fprintf(stderr, "obscura: %s: %s (%s)\n", what, err && *err ? err : obs_status_message(s),
+            obs_status_name(s));
+    return status_exit(s);
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+/* ---- options ------------------------------------------------------------- */
+
+/* Options of the client itself; the AO parameters come from the one
+ * parameter table (obs_param_*), so they are not listed here. */
+typedef struct cli_opt {
+    const char *name; /* without "--" */
+    const char *arg;  /* NULL: a switch */
+    const char *doc;
+} cli_opt;
+
+static const cli_opt ao_opts[] = {
+    {"o", "FILE", "output file; .exr or .png (also --output-file)"},
+    {"output", "ao|composite|both", "what to write (default ao)"},
+    {"format", "exr|png", "output format (default: from the file name)"},
+    {"float", NULL, "EXR: 32-bit float channels (default half)"},
+    {"png-bits", "8|16", "PNG bit depth (default 8)"},
+    {"camera", "FILE", "camera JSON (width, height, fov_y_deg, world_to_camera, projection)"},
+    {"preset", "auto|blender|generic", "channel-name preset (default auto)"},
+    {"depth", "CH", "depth channel name"},
+    {"normal", "X,Y,Z", "normal channel names"},
+    {"color", "R,G,B[,A]", "colour channel names"},
+    {"max-size", "N", "largest accepted width or height (default 16384)"},
+    {"backend", "B", "auto|egl-device|egl-surfaceless|osmesa (or OBSCURA_BACKEND)"},
+    {"cpu", NULL, "run the CPU twin instead of OpenGL (slow; for reference)"},
+    {"debug-gl", NULL, "install the KHR_debug callback and log GL messages"},
+    {"quiet", NULL, "only warnings and errors (-q)"},
+    {"verbose", NULL, "debug messages too (-v)"},
+    {NULL, NULL, NULL}};
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "obscura %s: ambient occlusion for G-buffer EXRs (VAO on OpenGL)\n\n"
+            "usage:\n"
+            "  obscura ao IN.exr -o OUT.(exr|png) [options] [parameters]\n"
+            "  obscura compare TRUTH.exr CANDIDATE.exr [--channel-a CH] [--channel-b CH]\n"
+            "                  [--mask auto|none|CH] [--diff OUT.png] [--json]\n"
+            "  obscura info [--backend B]\n"
+            "  obscura params [--markdown]\n\n"
+            "ao options:\n",
+            OBS_VERSION);
+    for (const cli_opt *o = ao_opts; o->name; o++) {
+        char left[48];
+        snprintf(left, sizeof left, "%s%s %s", o->name[1] ? "--" : "-", o->name,
+                 o->arg ? o->arg : "");
+        fprintf(f, "  %-30s %s\n", left, o->doc);
+    }
+    fprintf(f, "\nparameters (the one parameter table; 'obscura params' for details):\n");
+    for (int i = 0; i < obs_param_count(); i++) {
+        const obs_param_info *pi = obs_param_at(i);
+        char flag[48], range[64] = "";
+        snprintf(flag, sizeof flag, "--%s", pi->name);
+        for (char *c = flag; *c; c++)
+            if (*c == '_')
+                *c = '-';
+        if (pi->type == OBS_PARAM_FLOAT || pi->type == OBS_PARAM_INT)
+            snprintf(range, sizeof range, " [%g..%g]", pi->min, pi->max);
+        else if (pi->type == OBS_PARAM_ENUM)
+            snprintf(range, sizeof range, " {%s}", pi->choices);
+        fprintf(f, "  %-30s %s (default %s%s)\n", flag, pi->doc, pi->def, range);
+    }
+    fprintf(f, "\nexit codes: 0 ok, 1 failure, 2 usage, 3 bad input\n");
+}
+
+/* Splits "a,b,c" into at most n names (pointers into a copy kept in buf). */
+static int split_names(const char *s, char *buf, size_t len, const char **out, int n)
+{
+    snprintf(buf, len, "%s", s);
+    int k = 0;
+    for (char *tok = strtok(buf, ","); tok && k < n; tok = strtok(NULL, ","))
+        out[k++] = tok;
+    return k;
+}
+
+typedef struct ao_args {
+    const char *in, *out, *camera, *format, *backend;
+    unsigned outputs;
+    int float_exr, png_bits, cpu, debug_gl;
+    long max_size;
+    obs_channel_map map;
+    char normal_buf[256], color_buf[256];
+    obs_params params;
+} ao_args;
+
+/* Matches "--name VALUE" or "--name=VALUE"; returns the value or NULL. */
+static const char *opt_value(int argc, char **argv, int *i, const char *name)
+{
+    const char *a = argv[*i];
+    size_t n = strlen(name);
+    if (a[0] != '-')
+        return NULL;
+    a += a[1] == '-' ? 2 : 1;
+    if (strncmp(a, name, n) != 0)
+        return NULL;
+    if (a[n] == '=')
+        return a + n + 1;
+    if (a[n] != '\0')
+        return NULL;
+    if (*i + 1 >= argc)
+        die_usage("option --%s needs a value", name);
+    return argv[++*i];
+}
+
+static int is_switch(const char *arg, const char *name)
+{
+    return arg[0] == '-' && arg[1] == '-' && strcmp(arg + 2, name) == 0;
+}
+
+static void parse_ao(int argc, char **argv, ao_args *a)
+{
+    const char *v;
+    memset(a, 0, sizeof *a);
+    a->outputs = OBS_OUTPUT_AO;
+    a->png_bits = 8;
+    for (int i = 0; i < argc; i++) {
+        const char *arg = argv[i];
+        if (arg[0] != '-' || arg[1] == '\0') {
+            if (a->in)
+                die_usage("more than one input file ('%s' and '%s')", a->in, arg);
+            a->in = arg;
+        } else if ((v = opt_value(argc, argv, &i, "o")) || (v = opt_value(argc, argv, &i, "output-file"))) {
+            a->out = v;
+        } else if ((v = opt_value(argc, argv, &i, "output"))) {
+            if (!strcmp(v, "ao"))
+                a->outputs = OBS_OUTPUT_AO;
+            else if (!strcmp(v, "composite"))
+                a->outputs = OBS_OUTPUT_COMPOSITE;
+            else if (!strcmp(v, "both"))
+                a->outputs = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE;
+            else
+                die_usage("--output: '%s' is not one of ao|composite|both", v);
+        } else if ((v = opt_value(argc, argv, &i, "format"))) {
+            if (strcmp(v, "exr") && strcmp(v, "png"))
+                die_usage("--format: '%s' is not one of exr|png", v);
+            a->format = v;
+        } else if (is_switch(arg, "float")) {
+            a->float_exr = 1;
+        } else if ((v = opt_value(argc, argv, &i, "png-bits"))) {
+            a->png_bits = atoi(v);
+            if (a->png_bits != 8 && a->png_bits != 16)
+                die_usage("--png-bits: '%s' is not 8 or 16", v);
+        } else if ((v = opt_value(argc, argv, &i, "camera"))) {
+            a->camera = v;
+        } else if ((v = opt_value(argc, argv, &i, "preset"))) {
+            a->map.preset = v;
+        } else if ((v = opt_value(argc, argv, &i, "depth"))) {
+            a->map.depth = v;
+        } else if ((v = opt_value(argc, argv, &i, "normal"))) {
+            if (split_names(v, a->normal_buf, sizeof a->normal_buf, a->map.normal, 3) != 3)
+                die_usage("--normal needs three channel names X,Y,Z");
+        } else if ((v = opt_value(argc, argv, &i, "color"))) {
+            int k = split_names(v, a->color_buf, sizeof a->color_buf, a->map.color, 4);
+            if (k != 3 && k != 4)
+                die_usage("--color needs three or four channel names R,G,B[,A]");
+        } else if ((v = opt_value(argc, argv, &i, "max-size"))) {
+            a->max_size = strtol(v, NULL, 10);
+            if (a->max_size < 1 || a->max_size > 1 << 20)
+                die_usage("--max-size: '%s' is not in [1, 1048576]", v);
+        } else if ((v = opt_value(argc, argv, &i, "backend"))) {
+            a->backend = v;
+        } else if (is_switch(arg, "cpu")) {
+            a->cpu = 1;
+        } else if (is_switch(arg, "debug-gl")) {
+            a->debug_gl = 1;
+        } else if (is_switch(arg, "quiet") || !strcmp(arg, "-q")) {
+            verbosity = OBS_LOG_WARN;
+        } else if (is_switch(arg, "verbose") || !strcmp(arg, "-v")) {
+            verbosity = OBS_LOG_DEBUG;
+        } else if (arg[1] == '-') {
+            /* a parameter of the table: --name VALUE or --name=VALUE */
+            char name[64];
+            const char *eq = strchr(arg + 2, '=');
+            size_t n = eq ? (size_t)(eq - arg - 2) : strlen(arg + 2);
+            snprintf(name, sizeof name, "%.*s", (int)n, arg + 2);
+            if (!obs_param_find(name))
+                die_usage("unknown option '%s'", arg);
+            if (!eq && i + 1 >= argc)
+                die_usage("parameter --%s needs a value", name);
+            char err[OBS_ERR_LEN];
+            if (obs_param_set(&a->params, name, eq ? eq + 1 : argv[++i], err) != OBS_OK)
+                die_usage("%s", err);
+        } else {
+            die_usage("unknown option '%s'", arg);
+        }
+    }
+    if (!a->in)
+        die_usage("ao: no input file");
+    if (!a->out)
+        die_usage("ao: no output file (-o FILE)");
+    if (!a->format) {
+        const char *dot = strrchr(a->out, '.');
+        if (dot && !strcmp(dot, ".png"))
+            a->format = "png";
+        else if (dot && !strcmp(dot, ".exr"))
+            a->format = "exr";
+        else
+            die_usage("cannot tell the format of '%s': use .exr or .png, or --format", a->out);
+    }
+}
+
+/* "dir/out.png" + "ao" -> "dir/out.ao.png" */
+static void suffixed(const char *path, const char *suffix, char *buf, size_t len)
+{
+    const char *dot = strrchr(path, '.');
+    const char *slash = strrchr(path, '/');
+    if (!dot || (slash && dot < slash))
+        dot = path + strlen(path);
+    snprintf(buf, len, "%.*s.%s%s", (int)(dot - path), path, suffix, dot);
+}
+
+static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs_camera *cam,
+                                char err[OBS_ERR_LEN])
+{
+    static const char *const ao_names[] = {"AO.Y"};
+    static const char *const rgba_names[] = {"R", "G", "B", "A"};
+    obs_status s = OBS_OK;
+    if (!strcmp(a->format, "exr")) {
+        obs_exr_layer layers[2];
+        int n = 0;
+        if (r->ao.data)
+            layers[n++] = (obs_exr_layer){&r->ao, ao_names};
+        if (r->composite.data)
+            layers[n++] = (obs_exr_layer){&r->composite, rgba_names};
+        s = obs_exr_write(a->out, layers, n, a->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
+        if (s == OBS_OK)
+            fprintf(stderr, "obscura: wrote %s\n", a->out);
+        return s;
+    }
+    int both = r->ao.data && r->composite.data;
+    char path[4096];
+    if (r->ao.data) {
+        if (both)
+            suffixed(a->out, "ao", path, sizeof path);
+        else
+            snprintf(path, sizeof path, "%s", a->out);
+        s = obs_png_write(path, &r->ao, a->png_bits, 0, err);
+        if (s != OBS_OK)
+            return s;
+        fprintf(stderr, "obscura: wrote %s\n", path);
+    }
+    if (r->composite.data) {
+        if (both)
+            suffixed(a->out, "composite", path, sizeof path);
+        else
+            snprintf(path, sizeof path, "%s", a->out);
+        s = obs_png_write(path, &r->composite, a->png_bits, 1, err);
+        if (s == OBS_OK)
+            fprintf(stderr, "obscura: wrote %s\n", path);
+    }
+    return s;
+}
+
+static obs_status backend_from_args(const char *name, obs_backend *b)
+{
+    if (!name)
+        name = getenv("OBSCURA_BACKEND");
+    if (!name || !*name) {
+        *b = OBS_BACKEND_AUTO;
+        return OBS_OK;
+    }
+    if (obs_backend_parse(name, b) != OBS_OK)
+        die_usage("backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", name);
+    return OBS_OK;
+}
+
+static int cmd_ao(int argc, char **argv)
+{
+    ao_args a;
+    char err[OBS_ERR_LEN] = "";
+    obs_gbuffer_file gf = {0};
+    obs_result res = {0};
+    obs_ctx *ctx = NULL;
+    obs_status s;
+    int rc = EXIT_OK;
+
+    parse_ao(argc, argv, &a);
+    obs_limits lim = {0};
+    if (a.max_size)
+        lim.max_width = lim.max_height = (int)a.max_size;
+
+    double t0 = now_ms();
+    s = obs_gbuffer_read_exr(a.in, &a.map, &lim, &gf, err);
+    if (s != OBS_OK)
+        return fail(s, a.in, err);
+    double t_read = now_ms() - t0;
+    const obs_exr_info *info = &gf.info;
+    if (verbosity >= OBS_LOG_INFO) {
+        fprintf(stderr, "obscura: info: %s: %dx%d, preset %s, depth %s, normals %s, colour %s\n",
+                a.in, gf.gb.width, gf.gb.height, info->preset, info->depth,
+                info->normal[0][0] ? info->normal[0] : "(none)",
+                info->color[0][0] ? info->color[0] : "(none)");
+    }
+    if (a.camera) {
+        int cw = 0, ch = 0;
+        s = obs_camera_read_json(a.camera, &gf.gb.camera, &cw, &ch, err);
+        if (s != OBS_OK) {
+            rc = fail(s, a.camera, err);
+            goto done;
+        }
+        int dw = gf.gb.display_width > 0 ? gf.gb.display_width : gf.gb.width;
+        int dh = gf.gb.display_height > 0 ? gf.gb.display_height : gf.gb.height;
+        if (cw > 0 && ch > 0 && fabs((double)cw / ch - (double)dw / dh) > 1e-3)
+            fprintf(stderr, "obscura: warning: camera %s is %dx%d but the image is %dx%d (aspect differs)\n",
+                    a.camera, cw, ch, dw, dh);
+    }
+
+    t0 = now_ms();
+    if (a.cpu) {
+        s = obs_run_cpu(&gf.gb, &a.params, a.outputs, &res, err);
+    } else {
+        obs_ctx_desc desc = {.debug = a.debug_gl, .log = log_cb};
+        backend_from_args(a.backend, &desc.backend);
+        s = obs_ctx_create(&desc, &ctx, err);
+        if (s != OBS_OK) {
+            rc = fail(s, "OpenGL", err);
+            goto done;
+        }
+        if (verbosity >= OBS_LOG_DEBUG)
+            fprintf(stderr, "obscura: debug: context created in %.1f ms\n", now_ms() - t0);
+        t0 = now_ms();
+        s = obs_run(ctx, &gf.gb, &a.params, a.outputs, &res, err);
+    }
+    if (s != OBS_OK) {
+        rc = fail(s, a.in, err);
+        goto done;
+    }
+    double t_run = now_ms() - t0;
+
+    t0 = now_ms();
+    s = write_outputs(&a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, err);
+    if (s != OBS_OK) {
+        rc = fail(s, a.out, err);
+        goto done;
+    }
+    if (verbosity >= OBS_LOG_INFO) {
+        obs_params p;
+        obs_ctx_info ci = {0};
+        obs_params_resolve(&a.params, &p);
+        if (ctx)
+            obs_ctx_get_info(ctx, &ci);
+        fprintf(stderr, "obscura: info: %dx%d, radius %g, %d samples, %s: read %.1f ms, AO %.1f ms, write %.1f ms\n",
+                gf.gb.width, gf.gb.height, p.radius, p.samples,
+                a.cpu ? "cpu" : obs_backend_name(ci.backend), t_read, t_run,
+                now_ms() - t0);
+    }
+
+done:
+    obs_result_free(&res);
+    obs_ctx_destroy(ctx);
+    obs_gbuffer_free(&gf);
+    return rc;
+}
+
+static int cmd_info(int argc, char **argv)
+{
+    const char *backend = NULL;
+    for (int i = 0; i < argc; i++) {
+        const char *v = opt_value(argc, argv, &i, "backend");
+        if (!v)
+            die_usage("info: unknown argument '%s'", argv[i]);
+        backend = v;
+    }
+    obs_ctx_desc desc = {.log = log_cb};
+    char err[OBS_ERR_LEN] = "";
+    obs_ctx *ctx;
+    backend_from_args(backend, &desc.backend);
+    verbosity = OBS_LOG_WARN;
+    obs_status s = obs_ctx_create(&desc, &ctx, err);
+    if (s != OBS_OK)
+        return fail(s, "OpenGL", err);
+    obs_ctx_info info;
+    obs_ctx_get_info(ctx, &info);
+    printf("obscura %s\nbackend: %s\nGL version: %s\nGL vendor: %s\nGL renderer: %s\n", OBS_VERSION,
+           obs_backend_name(info.backend), info.gl_version, info.gl_vendor, info.gl_renderer);
+    obs_ctx_destroy(ctx);
+    return EXIT_OK;
+}
+
+static int cmd_params(int argc, char **argv)
+{
+    int markdown = argc > 0 && !strcmp(argv[0], "--markdown");
+    if (markdown)
+        printf("| parameter | type | default | range | meaning |\n|---|---|---|---|---|\n");
+    for (int i = 0; i < obs_param_count(); i++) {
+        const obs_param_info *pi = obs_param_at(i);
+        static const char *const types[] = {"float", "int", "enum", "16 floats"};
+        char range[96] = "";
+        if (pi->type == OBS_PARAM_FLOAT || pi->type == OBS_PARAM_INT)
+            snprintf(range, sizeof range, "%g .. %g", pi->min, pi->max);
+        else if (pi->type == OBS_PARAM_ENUM)
+            snprintf(range, sizeof range, "%s", pi->choices);
+        char flag[48];
+        snprintf(flag, sizeof flag, "--%s", pi->name);
+        for (char *c = flag; *c; c++)
+            if (*c == '_')
+                *c = '-';
+        if (markdown)
+            printf("| `%s` | %s | %s | %s | %s |\n", flag, types[pi->type], pi->def, range, pi->doc);
+        else
+            printf("%-18s %-9s default %-8s %-20s %s\n", flag, types[pi->type], pi->def, range, pi->doc);
+    }
+    return EXIT_OK;
+}
+
+/* The depth channel of a G-buffer EXR, for the geometry mask. */
+static int load_mask(const char *path, const char *channel, const obs_image *like,
+                     unsigned char **mask, char err[OBS_ERR_LEN])
+{
+    obs_image d = {0};
+    obs_status s;
+    if (channel) {
+        s = obs_exr_read_channel(path, channel, NULL, &d, err);
+    } else {
+        obs_gbuffer_file gf = {0};
+        s = obs_gbuffer_read_exr(path, NULL, NULL, &gf, err);
+        if (s == OBS_OK) {
+            s = obs_exr_read_channel(path, gf.info.depth, NULL, &d, err);
+            obs_gbuffer_free(&gf);
+        }
+    }
+    if (s != OBS_OK)
+        return -1;
+    if (d.width != like->width || d.height != like->height) {
+        snprintf(err, OBS_ERR_LEN, "mask %dx%d does not match the image %dx%d", d.width, d.height,
+                 like->width, like->height);
+        obs_image_free(&d);
+        return -1;
+    }
+    size_t n = (size_t)d.width * d.height;
+    *mask = malloc(n);
+    if (!*mask) {
+        obs_image_free(&d);
+        snprintf(err, OBS_ERR_LEN, "out of memory");
+        return -1;
+    }
+    for (size_t i = 0; i < n; i++)
+        (*mask)[i] = isfinite(d.data[i]) && d.data[i] > 0.0f && d.data[i] < 1e9f;
+    obs_image_free(&d);
+    return 0;
+}
+
+/* First channel of the list that the file has. */
+static const char *pick_channel(const char *path, const char *const *cands, char *buf, size_t len,
+                                char err[OBS_ERR_LEN])
+{
+    char **names = NULL;
+    if (obs_exr_list_channels(path, &names, err) != OBS_OK)
+        return NULL;
+    const char *found = NULL;
+    for (int c = 0; cands[c] && !found; c++)
+        for (char **n = names; *n && !found; n++)
+            if (!strcmp(*n, cands[c])) {
+                snprintf(buf, len, "%s", *n);
+                found = buf;
+            }
+    if (!found)
+        snprintf(err, OBS_ERR_LEN, "none of the usual AO channels (AO.Y, Y, ViewLayer.AO.R, A, R) is in %s; use --channel-a/--channel-b", path);
+    obs_strv_free(names);
+    return found;
+}
+
+static int cmd_compare(int argc, char **argv)
+{
+    static const char *const ao_cands[] = {"AO.Y", "Y", "ViewLayer.AO.R", "A", "R", NULL};
+    const char *pa = NULL, *pb = NULL, *cha = NULL, *chb = NULL, *mask_opt = "auto", *diff = NULL;
+    int json = 0;
+    for (int i = 0; i < argc; i++) {
+        const char *v;
+        if ((v = opt_value(argc, argv, &i, "channel-a")))
+            cha = v;
+        else if ((v = opt_value(argc, argv, &i, "channel-b")))
+            chb = v;
+        else if ((v = opt_value(argc, argv, &i, "mask")))
+            mask_opt = v;
+        else if ((v = opt_value(argc, argv, &i, "diff")))
+            diff = v;
+        else if (is_switch(argv[i], "json"))
+            json = 1;
+        else if (argv[i][0] == '-')
+            die_usage("compare: unknown option '%s'", argv[i]);
+        else if (!pa)
+            pa = argv[i];
+        else if (!pb)
+            pb = argv[i];
+        else
+            die_usage("compare: more than two files");
+    }
+    if (!pa || !pb)
+        die_usage("compare: needs two files, TRUTH and CANDIDATE");
+
+    char err[OBS_ERR_LEN] = "", bufa[128], bufb[128];
+    obs_image a = {0}, b = {0};
+    unsigned char *mask = NULL;
+    obs_status s;
+    int rc = EXIT_OK;
+    if (!cha && !(cha = pick_channel(pa, ao_cands, bufa, sizeof bufa, err)))
+        return fail(OBS_MISSING_CHANNEL, pa, err);
+    if (!chb && !(chb = pick_channel(pb, ao_cands, bufb, sizeof bufb, err)))
+        return fail(OBS_MISSING_CHANNEL, pb, err);
+    if ((s = obs_exr_read_channel(pa, cha, NULL, &a, err)) != OBS_OK)
+        return fail(s, pa, err);
+    if ((s = obs_exr_read_channel(pb, chb, NULL, &b, err)) != OBS_OK) {
+        rc = fail(s, pb, err);
+        goto done;
+    }
+    if (strcmp(mask_opt, "none") != 0) {
+        /* auto: the depth channel of TRUTH (else CANDIDATE) selects geometry */
+        const char *mch = strcmp(mask_opt, "auto") ? mask_opt : NULL;
+        if (load_mask(pa, mch, &a, &mask, err) != 0) {
+            char err2[OBS_ERR_LEN];
+            if (mch || load_mask(pb, NULL, &a, &mask, err2) != 0) {
+                if (mch) {
+                    rc = fail(OBS_MISSING_CHANNEL, "--mask", err);
+                    goto done;
+                }
+                mask = NULL; /* no depth anywhere: compare every pixel */
+            }
+        }
+    }
+    obs_metrics m;
+    s = obs_metrics_compute(&a, &b, mask, &m, err);
+    if (s != OBS_OK) {
+        rc = fail(s, "compare", err);
+        goto done;
+    }
+    if (json)
+        printf("{\"mse\": %.6f, \"mae\": %.5f, \"psnr\": %.2f, \"ssim\": %.4f, \"corr\": %.4f, "
+               "\"bias\": %.5f, \"pixels\": %lld}\n",
+               m.mse, m.mae, m.psnr, m.ssim, m.corr, m.bias, m.count);
+    else
+        printf("%s (%s) vs %s (%s), %lld pixels%s\n  MSE %.6f  PSNR %.2f dB  SSIM %.4f  MAE %.5f  "
+               "corr %.4f  bias %+.5f\n",
+               pa, cha, pb, chb, m.count, mask ? " with geometry" : "", m.mse, m.psnr, m.ssim, m.mae,
+               m.corr, m.bias);
+    if (diff) {
+        obs_image d = {0};
+        s = obs_metrics_diff_image(&a, &b, &d, err);
+        if (s == OBS_OK)
+            s = obs_png_write(diff, &d, 8, 0, err);
+        obs_image_free(&d);
+        if (s != OBS_OK)
+            rc = fail(s, diff, err);
+    }
+done:
+    free(mask);
+    obs_image_free(&a);
+    obs_image_free(&b);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "ao"))
+        return cmd_ao(argc - 2, argv + 2);
+    if (!strcmp(cmd, "compare"))
+        return cmd_compare(argc - 2, argv + 2);
+    if (!strcmp(cmd, "info"))
+        return cmd_info(argc - 2, argv + 2);
+    if (!strcmp(cmd, "params"))
+        return cmd_params(argc - 2, argv + 2);
+    if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
+        usage(stdout);
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "version") || !strcmp(cmd, "--version")) {
+        printf("obscura %s\n", OBS_VERSION);
+        return EXIT_OK;
+    }
+    die_usage("unknown command '%s'", cmd);
+    return EXIT_USAGE;
+}

@@ -1,0 +1,143 @@
+/* Frame setup: which camera, which normals, which samples. */
+#include <math.h>
+#include <string.h>
+
+#include "frame.h"
+#include "io.h"
+
+obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p, obs_camera *out,
+                               char err[OBS_ERR_LEN])
+{
+    obs_camera cam = gb->camera;
+    int dw = gb->display_width > 0 ? gb->display_width : gb->width;
+    int dh = gb->display_height > 0 ? gb->display_height : gb->height;
+
+    if (p->fov_y > 0.0f) {
+        obs_camera fov;
+        obs_camera_from_fov(p->fov_y, (float)dw / (float)dh, p->near, p->far, &fov);
+        memcpy(cam.projection, fov.projection, sizeof cam.projection);
+        cam.has_projection = 1;
+        cam.source = OBS_CAMERA_PARAMS;
+    }
+    if (p->has_world_to_camera) {
+        memcpy(cam.world_to_camera, p->world_to_camera, sizeof cam.world_to_camera);
+        cam.has_world_to_camera = 1;
+    }
+    if (!cam.has_world_to_camera)
+        obs__mat4_identity(cam.world_to_camera);
+    if (!cam.has_projection)
+        return obs__fail(err, OBS_NO_CAMERA,
+                         "no camera: the G-buffer has no worldToCamera/worldToNDC header "
+                         "attributes; give a camera JSON (--camera) or a field of view (--fov-y)");
+    *out = cam;
+    return OBS_OK;
+}
+
+/* Inverse transpose of the upper 3x3 of m: the matrix that carries normals
+ * the way m carries points. */
+static int normal_matrix(const float m[16], float out[9])
+{
+    float a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], f = m[6], g = m[8], h = m[9],
+          i = m[10];
+    float det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
+    if (!isfinite(det) || fabsf(det) < 1e-12f)
+        return -1;
+    /* (M^-1)^T = cofactor matrix / det */
+    out[0] = (e * i - f * h) / det;
+    out[1] = -(d * i - f * g) / det;
+    out[2] = (d * h - e * g) / det;
+    out[3] = -(b * i - c * h) / det;
+    out[4] = (a * i - c * g) / det;
+    out[5] = -(a * h - b * g) / det;
+    out[6] = (b * f - c * e) / det;
+    out[7] = -(a * f - c * d) / det;
+    out[8] = (a * e - b * d) / det;
+    return 0;
+}
+
+obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *p,
+                            obs__frame *f, char err[OBS_ERR_LEN])
+{
+    obs_camera cam;
+    obs_status s = obs__gbuffer_validate(gb, err);
+    if (s != OBS_OK)
+        return s;
+    s = obs_params_check(p, err);
+    if (s != OBS_OK)
+        return s;
+    s = obs__camera_resolve(gb, p, &cam, err);
+    if (s != OBS_OK)
+        return s;
+
+    memset(f, 0, sizeof *f);
+    f->width = gb->width;
+    f->height = gb->height;
+    f->viewport[0] = (float)gb->display_x;
+    f->viewport[1] = (float)gb->display_y;
+    f->viewport[2] = (float)(gb->display_width > 0 ? gb->display_width : gb->width);
+    f->viewport[3] = (float)(gb->display_height > 0 ? gb->display_height : gb->height);
+    memcpy(f->proj, cam.projection, sizeof f->proj);
+    f->depth_mode = p->depth_mode;
+    f->radius = p->radius / p->unit_scale;
+    f->samples = p->samples;
+    f->sample_xy = obs__samples(p->samples);
+    for (int k = 0; k < 9; k++)
+        obs__pixel_rotation(k / 3, k % 3, &f->rot[k][0], &f->rot[k][1]);
+
+    static const float identity3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    memcpy(f->normal_matrix, identity3, sizeof identity3);
+    if (!gb->normal.data) {
+        f->reconstruct_normals = 1;
+        obs__log(log_ctx, OBS_LOG_INFO, "no normal channel: reconstructing normals from depth");
+    } else if (p->normal_space == OBS_NORMALS_WORLD) {
+        if (!cam.has_world_to_camera) {
+            f->reconstruct_normals = 1;
+            obs__log(log_ctx, OBS_LOG_WARN,
+                     "normals are world-space but the camera has no world_to_camera "
+                     "(give --camera or --world-to-camera): reconstructing normals from depth");
+        } else if (normal_matrix(cam.world_to_camera, f->normal_matrix) != 0) {
+            return obs__fail(err, OBS_NO_CAMERA, "world_to_camera is singular");
+        }
+    }
+    return OBS_OK;
+}
+
+obs_status obs__gbuffer_validate(const obs_gbuffer *gb, char err[OBS_ERR_LEN])
+{
+    static const struct {
+        const char *name;
+        size_t off;
+        int channels;
+        int required;
+    } planes[] = {
+        {"depth", offsetof(obs_gbuffer, depth), 1, 1},
+        {"normal", offsetof(obs_gbuffer, normal), 3, 0},
+        {"color", offsetof(obs_gbuffer, color), 4, 0},
+    };
+    if (!gb)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no G-buffer");
+    obs_status s = obs_check_size(NULL, gb->width, gb->height, err);
+    if (s != OBS_OK)
+        return s;
+    if (gb->display_width < 0 || gb->display_height < 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "negative display window size");
+    for (size_t i = 0; i < sizeof planes / sizeof planes[0]; i++) {
+        const obs_plane *pl = (const obs_plane *)((const char *)gb + planes[i].off);
+        if (!pl->data) {
+            if (planes[i].required)
+                return obs__fail(err, OBS_MISSING_CHANNEL, "G-buffer has no %s plane",
+                                 planes[i].name);
+            continue;
+        }
+        if (pl->channels != planes[i].channels)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s plane has %d channels, expected %d",
+                             planes[i].name, pl->channels, planes[i].channels);
+        size_t row = (size_t)gb->width * (size_t)pl->channels * sizeof(float);
+        if (pl->row_stride != 0 && (pl->row_stride < row || pl->row_stride % (pl->channels * sizeof(float))))
+            return obs__fail(err, OBS_INVALID_ARGUMENT,
+                             "%s plane row stride %zu is smaller than a row (%zu bytes) or not a "
+                             "whole number of pixels",
+                             planes[i].name, pl->row_stride, row);
+    }
+    return OBS_OK;
+}

@@ -1,0 +1,51 @@
+/* One frame's resolved setup, shared by the GL passes (as uniforms) and by
+ * their CPU twin, plus the twin's per-pixel functions.  Each function here
+ * has a GLSL counterpart of the same name in core/shaders/common.glsl (or
+ * the pass shader named beside it); tests compare the two. */
+#ifndef OBSCURA_FRAME_H
+#define OBSCURA_FRAME_H
+
+#include "internal.h"
+
+/* Raw depth at or beyond this (Blender writes 1e10 for the sky), non-finite
+ * or <= 0 is background: no geometry, AO 1, never an occluder. */
+#define OBS__SKY_DEPTH 1e9f
+
+typedef struct obs__frame {
+    int width, height;
+    float viewport[4];      /* display_x, display_y, display_width, display_height */
+    float proj[16];         /* view -> clip, row-major */
+    float normal_matrix[9]; /* input normal -> view normal, row-major 3x3 */
+    int reconstruct_normals;/* 1: no usable normals, derive them from depth */
+    int depth_mode;         /* OBS_DEPTH_PLANAR/RADIAL/NDC */
+    float radius;           /* R in depth units: radius / unit_scale */
+    int samples;
+    const float *sample_xy; /* samples * (x, y) on the unit disk */
+    float rot[9][2];        /* (cos, sin) of the 3x3 tile's rotations */
+} obs__frame;
+
+/* Resolves camera, parameters and normal handling for one frame. */
+obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *resolved,
+                            obs__frame *f, char err[OBS_ERR_LEN]);
+
+/* ---- per-pixel twins (GLSL: common.glsl, prep.frag, vao.frag) ----------- */
+
+/* Pixel centre (x, y) of the planes -> NDC of the display window. */
+void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2]);
+
+/* View-space position of the point seen at pixel (x, y): the prep pass.
+ * out = (x, y, z, d) with d the planar depth; (0,0,0,0) for background. */
+void obs__prep_position(const obs__frame *f, float raw_depth, int x, int y, float out[4]);
+
+/* View-space unit normal of pixel (x, y) from the input normal (or, with
+ * reconstruct_normals, from the neighbouring positions in `pos`, 4 floats
+ * per pixel as obs__prep_position writes them). */
+void obs__prep_normal(const obs__frame *f, const float *pos, const float *in_normal, int x, int y,
+                      float out[3]);
+
+/* Volumetric AO of the point p with normal n at pixel (x, y), eq 1 and 2
+ * of VAO++ section 3; `pos` is the prep pass's position plane. */
+float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                     const float n[3]);
+
+#endif

@@ -1,0 +1,31 @@
+/* The GL backends (EGL device, EGL surfaceless, OSMesa).  No GL headers
+ * here: OSMesa's own header brings the legacy gl.h, which must not meet
+ * glcorearb.h in one translation unit. */
+#ifndef OBSCURA_GL_BACKEND_H
+#define OBSCURA_GL_BACKEND_H
+
+#include "internal.h"
+
+typedef void (*obs__glproc)(void);
+typedef obs__glproc (*obs__getproc_fn)(const char *name);
+
+/* ---- backends ---------------------------------------------------------- */
+
+typedef struct obs__backend_state {
+    void *egl_display;
+    void *egl_context;
+    void *osmesa;
+    unsigned char *osmesa_buf;
+} obs__backend_state;
+
+obs_status obs__egl_create(int debug, int device, obs__backend_state *st,
+                           obs__getproc_fn *getproc, char err[OBS_ERR_LEN]);
+void obs__egl_destroy(obs__backend_state *st);
+obs_status obs__egl_make_current(obs__backend_state *st);
+
+obs_status obs__osmesa_create(obs__backend_state *st,
+                              obs__getproc_fn *getproc, char err[OBS_ERR_LEN]);
+void obs__osmesa_destroy(obs__backend_state *st);
+obs_status obs__osmesa_make_current(obs__backend_state *st);
+
+#endif

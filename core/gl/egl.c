@@ -1,0 +1,162 @@
+/* EGL backends: the device platform (a real GPU, EGL_EXT_platform_device)
+ * and Mesa's surfaceless platform (EGL_MESA_platform_surfaceless).  Both
+ * make an OpenGL 4.3+ core context current with no surface. */
+#include <string.h>
+
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+
+#include "backend.h"
+
+static int has_ext(const char *exts, const char *name)
+{
+    size_t n = strlen(name);
+    for (const char *p = exts; p && (p = strstr(p, name)) != NULL; p += n)
+        if ((p == exts || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0'))
+            return 1;
+    return 0;
+}
+
+static obs__glproc egl_getproc(const char *name)
+{
+    return (obs__glproc)eglGetProcAddress(name);
+}
+
+/* The first device that is not Mesa's software rasteriser: the device
+ * backend is for real GPUs; llvmpipe is reached through surfaceless. */
+static EGLDisplay device_display(char err[OBS_ERR_LEN])
+{
+    const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    if (!has_ext(client, "EGL_EXT_platform_device") || !has_ext(client, "EGL_EXT_device_enumeration")) {
+        obs__fail(err, OBS_GL_UNAVAILABLE, "egl-device: EGL_EXT_platform_device is not available");
+        return EGL_NO_DISPLAY;
+    }
+    PFNEGLQUERYDEVICESEXTPROC query_devices =
+        (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
+    PFNEGLQUERYDEVICESTRINGEXTPROC query_string =
+        (PFNEGLQUERYDEVICESTRINGEXTPROC)eglGetProcAddress("eglQueryDeviceStringEXT");
+    PFNEGLGETPLATFORMDISPLAYEXTPROC get_display =
+        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+    if (!query_devices || !query_string || !get_display) {
+        obs__fail(err, OBS_GL_UNAVAILABLE, "egl-device: device enumeration entry points missing");
+        return EGL_NO_DISPLAY;
+    }
+    EGLDeviceEXT devs[16];
+    EGLint n = 0;
+    if (!query_devices(16, devs, &n) || n <= 0) {
+        obs__fail(err, OBS_GL_UNAVAILABLE, "egl-device: no EGL devices");
+        return EGL_NO_DISPLAY;
+    }
+    for (EGLint i = 0; i < n; i++) {
+        const char *exts = query_string(devs[i], EGL_EXTENSIONS);
+        if (has_ext(exts, "EGL_MESA_device_software"))
+            continue;
+        EGLDisplay d = get_display(EGL_PLATFORM_DEVICE_EXT, devs[i], NULL);
+        if (d != EGL_NO_DISPLAY)
+            return d;
+    }
+    obs__fail(err, OBS_GL_UNAVAILABLE, "egl-device: no hardware EGL device among %d device(s)", (int)n);
+    return EGL_NO_DISPLAY;
+}
+
+static EGLDisplay surfaceless_display(char err[OBS_ERR_LEN])
+{
+    const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    if (!has_ext(client, "EGL_MESA_platform_surfaceless")) {
+        obs__fail(err, OBS_GL_UNAVAILABLE,
+                  "egl-surfaceless: EGL_MESA_platform_surfaceless is not available");
+        return EGL_NO_DISPLAY;
+    }
+    PFNEGLGETPLATFORMDISPLAYEXTPROC get_display =
+        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+    EGLDisplay d = get_display ? get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL)
+                               : EGL_NO_DISPLAY;
+    if (d == EGL_NO_DISPLAY)
+        obs__fail(err, OBS_GL_UNAVAILABLE, "egl-surfaceless: no display (EGL error 0x%x)",
+                  (unsigned)eglGetError());
+    return d;
+}
+
+obs_status obs__egl_create(int debug, int device, obs__backend_state *st,
+                           obs__getproc_fn *getproc, char err[OBS_ERR_LEN])
+{
+    const char *who = device ? "egl-device" : "egl-surfaceless";
+    EGLDisplay dpy = device ? device_display(err) : surfaceless_display(err);
+    EGLContext gc = EGL_NO_CONTEXT;
+    EGLint major = 0, minor = 0;
+    obs_status s;
+
+    if (dpy == EGL_NO_DISPLAY)
+        return OBS_GL_UNAVAILABLE;
+    if (!eglInitialize(dpy, &major, &minor)) {
+        s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: eglInitialize failed (0x%x)", who,
+                      (unsigned)eglGetError());
+        goto fail;
+    }
+    const char *exts = eglQueryString(dpy, EGL_EXTENSIONS);
+    if (!has_ext(exts, "EGL_KHR_surfaceless_context")) {
+        s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: EGL_KHR_surfaceless_context missing", who);
+        goto fail;
+    }
+    if (!eglBindAPI(EGL_OPENGL_API)) {
+        s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: desktop OpenGL is not supported", who);
+        goto fail;
+    }
+    EGLConfig cfg = NULL;
+    if (!has_ext(exts, "EGL_KHR_no_config_context")) {
+        const EGLint cattr[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+        EGLint ncfg = 0;
+        if (!eglChooseConfig(dpy, cattr, &cfg, 1, &ncfg) || ncfg < 1) {
+            s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: no OpenGL config", who);
+            goto fail;
+        }
+    }
+    const EGLint attr[] = {
+        EGL_CONTEXT_MAJOR_VERSION, 4,
+        EGL_CONTEXT_MINOR_VERSION, 3,
+        EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+        EGL_CONTEXT_OPENGL_DEBUG, debug ? EGL_TRUE : EGL_FALSE,
+        EGL_NONE};
+    gc = eglCreateContext(dpy, cfg ? cfg : (EGLConfig)0, EGL_NO_CONTEXT, attr);
+    if (gc == EGL_NO_CONTEXT) {
+        s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: no OpenGL 4.3 core context (0x%x)", who,
+                      (unsigned)eglGetError());
+        goto fail;
+    }
+    if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, gc)) {
+        s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: eglMakeCurrent failed (0x%x)", who,
+                      (unsigned)eglGetError());
+        goto fail;
+    }
+    st->egl_display = dpy;
+    st->egl_context = gc;
+    *getproc = egl_getproc;
+    return OBS_OK;
+
+fail:
+    if (gc != EGL_NO_CONTEXT)
+        eglDestroyContext(dpy, gc);
+    eglTerminate(dpy);
+    return s;
+}
+
+obs_status obs__egl_make_current(obs__backend_state *st)
+{
+    if (eglGetCurrentContext() == (EGLContext)st->egl_context)
+        return OBS_OK;
+    return eglMakeCurrent(st->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, st->egl_context)
+               ? OBS_OK
+               : OBS_GL_ERROR;
+}
+
+void obs__egl_destroy(obs__backend_state *st)
+{
+    if (!st->egl_display)
+        return;
+    eglMakeCurrent(st->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (st->egl_context)
+        eglDestroyContext(st->egl_display, st->egl_context);
+    eglTerminate(st->egl_display);
+    eglReleaseThread();
+    st->egl_display = st->egl_context = NULL;
+}

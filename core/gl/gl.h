@@ -1,0 +1,182 @@
+/* Internal GL layer: the function table, the context struct, helpers.
+ *
+ * GL entry points are loaded through the backend's GetProcAddress into a
+ * table, never linked directly: libOSMesa and libglvnd both export gl*
+ * symbols, and only the loaded table is sure to reach the context that is
+ * current.  Code calls glFoo(...) as usual; the macros below route the call
+ * through the calling thread's current table. */
+#ifndef OBSCURA_GL_H
+#define OBSCURA_GL_H
+
+#include <GL/glcorearb.h>
+
+#include "internal.h"
+#include "gl/backend.h"
+
+#define OBS__GL_FUNCS(X)                                                       \
+    X(PFNGLGETSTRINGPROC, GetString)                                           \
+    X(PFNGLGETINTEGERVPROC, GetIntegerv)                                       \
+    X(PFNGLGETERRORPROC, GetError)                                             \
+    X(PFNGLENABLEPROC, Enable)                                                 \
+    X(PFNGLDISABLEPROC, Disable)                                               \
+    X(PFNGLFINISHPROC, Finish)                                                 \
+    X(PFNGLVIEWPORTPROC, Viewport)                                             \
+    X(PFNGLCREATESHADERPROC, CreateShader)                                     \
+    X(PFNGLSHADERSOURCEPROC, ShaderSource)                                     \
+    X(PFNGLCOMPILESHADERPROC, CompileShader)                                   \
+    X(PFNGLGETSHADERIVPROC, GetShaderiv)                                       \
+    X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog)                             \
+    X(PFNGLDELETESHADERPROC, DeleteShader)                                     \
+    X(PFNGLCREATEPROGRAMPROC, CreateProgram)                                   \
+    X(PFNGLATTACHSHADERPROC, AttachShader)                                     \
+    X(PFNGLLINKPROGRAMPROC, LinkProgram)                                       \
+    X(PFNGLGETPROGRAMIVPROC, GetProgramiv)                                     \
+    X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog)                           \
+    X(PFNGLDELETEPROGRAMPROC, DeleteProgram)                                   \
+    X(PFNGLUSEPROGRAMPROC, UseProgram)                                         \
+    X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                         \
+    X(PFNGLUNIFORM1IPROC, Uniform1i)                                           \
+    X(PFNGLUNIFORM1FPROC, Uniform1f)                                           \
+    X(PFNGLUNIFORM2IPROC, Uniform2i)                                           \
+    X(PFNGLUNIFORM2FVPROC, Uniform2fv)                                         \
+    X(PFNGLUNIFORM4FVPROC, Uniform4fv)                                         \
+    X(PFNGLUNIFORMMATRIX3FVPROC, UniformMatrix3fv)                             \
+    X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                             \
+    X(PFNGLGENTEXTURESPROC, GenTextures)                                       \
+    X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                 \
+    X(PFNGLBINDTEXTUREPROC, BindTexture)                                       \
+    X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                                   \
+    X(PFNGLTEXSTORAGE2DPROC, TexStorage2D)                                     \
+    X(PFNGLTEXSUBIMAGE2DPROC, TexSubImage2D)                                   \
+    X(PFNGLTEXPARAMETERIPROC, TexParameteri)                                   \
+    X(PFNGLPIXELSTOREIPROC, PixelStorei)                                       \
+    X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers)                               \
+    X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)                         \
+    X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)                               \
+    X(PFNGLFRAMEBUFFERTEXTURE2DPROC, FramebufferTexture2D)                     \
+    X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, CheckFramebufferStatus)                 \
+    X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                               \
+    X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)                         \
+    X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                               \
+    X(PFNGLDRAWARRAYSPROC, DrawArrays)                                         \
+    X(PFNGLREADBUFFERPROC, ReadBuffer)                                         \
+    X(PFNGLDRAWBUFFERSPROC, DrawBuffers)                                       \
+    X(PFNGLREADPIXELSPROC, ReadPixels)                                         \
+    X(PFNGLGENQUERIESPROC, GenQueries)                                         \
+    X(PFNGLDELETEQUERIESPROC, DeleteQueries)                                   \
+    X(PFNGLQUERYCOUNTERPROC, QueryCounter)                                     \
+    X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)
+
+/* Optional entry points (may be NULL). */
+#define OBS__GL_FUNCS_OPT(X) X(PFNGLDEBUGMESSAGECALLBACKPROC, DebugMessageCallback)
+
+typedef struct obs__gl {
+#define OBS__GL_FIELD(type, name) type name;
+    OBS__GL_FUNCS(OBS__GL_FIELD)
+    OBS__GL_FUNCS_OPT(OBS__GL_FIELD)
+#undef OBS__GL_FIELD
+} obs__gl;
+
+/* The table of the context current on this thread. */
+extern _Thread_local const obs__gl *obs__glp;
+
+#define glGetString obs__glp->GetString
+#define glGetIntegerv obs__glp->GetIntegerv
+#define glGetError obs__glp->GetError
+#define glEnable obs__glp->Enable
+#define glDisable obs__glp->Disable
+#define glFinish obs__glp->Finish
+#define glViewport obs__glp->Viewport
+#define glCreateShader obs__glp->CreateShader
+#define glShaderSource obs__glp->ShaderSource
+#define glCompileShader obs__glp->CompileShader
+#define glGetShaderiv obs__glp->GetShaderiv
+#define glGetShaderInfoLog obs__glp->GetShaderInfoLog
+#define glDeleteShader obs__glp->DeleteShader
+#define glCreateProgram obs__glp->CreateProgram
+#define glAttachShader obs__glp->AttachShader
+#define glLinkProgram obs__glp->LinkProgram
+#define glGetProgramiv obs__glp->GetProgramiv
+#define glGetProgramInfoLog obs__glp->GetProgramInfoLog
+#define glDeleteProgram obs__glp->DeleteProgram
+#define glUseProgram obs__glp->UseProgram
+#define glGetUniformLocation obs__glp->GetUniformLocation
+#define glUniform1i obs__glp->Uniform1i
+#define glUniform1f obs__glp->Uniform1f
+#define glUniform2i obs__glp->Uniform2i
+#define glUniform2fv obs__glp->Uniform2fv
+#define glUniform4fv obs__glp->Uniform4fv
+#define glUniformMatrix3fv obs__glp->UniformMatrix3fv
+#define glUniformMatrix4fv obs__glp->UniformMatrix4fv
+#define glGenTextures obs__glp->GenTextures
+#define glDeleteTextures obs__glp->DeleteTextures
+#define glBindTexture obs__glp->BindTexture
+#define glActiveTexture obs__glp->ActiveTexture
+#define glTexStorage2D obs__glp->TexStorage2D
+#define glTexSubImage2D obs__glp->TexSubImage2D
+#define glTexParameteri obs__glp->TexParameteri
+#define glPixelStorei obs__glp->PixelStorei
+#define glGenFramebuffers obs__glp->GenFramebuffers
+#define glDeleteFramebuffers obs__glp->DeleteFramebuffers
+#define glBindFramebuffer obs__glp->BindFramebuffer
+#define glFramebufferTexture2D obs__glp->FramebufferTexture2D
+#define glCheckFramebufferStatus obs__glp->CheckFramebufferStatus
+#define glGenVertexArrays obs__glp->GenVertexArrays
+#define glDeleteVertexArrays obs__glp->DeleteVertexArrays
+#define glBindVertexArray obs__glp->BindVertexArray
+#define glDrawArrays obs__glp->DrawArrays
+#define glReadBuffer obs__glp->ReadBuffer
+#define glDrawBuffers obs__glp->DrawBuffers
+#define glReadPixels obs__glp->ReadPixels
+#define glGenQueries obs__glp->GenQueries
+#define glDeleteQueries obs__glp->DeleteQueries
+#define glQueryCounter obs__glp->QueryCounter
+#define glGetQueryObjectui64v obs__glp->GetQueryObjectui64v
+
+/* Loads every entry point; fails naming the first one missing. */
+obs_status obs__gl_load(obs__gl *gl, obs__getproc_fn getproc, char err[OBS_ERR_LEN]);
+
+/* Compiles and links a program from a vertex and a fragment source (the
+ * fragment source is the concatenation of `frag_parts`).  A compile or
+ * link failure is OBS_GL_SHADER with the shader's name and info log. */
+obs_status obs__gl_program(const char *name, const char *vert, const char *const *frag_parts,
+                           int frag_count, GLuint *out, char err[OBS_ERR_LEN]);
+
+/* Drains glGetError; returns OBS_GL_ERROR naming `where` if any. */
+obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
+
+/* ---- the per-resolution frame resources and programs -------------------- */
+
+typedef struct obs__programs {
+    GLuint prep, vao, composite;
+} obs__programs;
+
+typedef struct obs__targets {
+    int width, height;          /* 0: none allocated yet */
+    GLuint tex_depth, tex_normal, tex_color;  /* inputs */
+    GLuint tex_viewpos, tex_vnormal;          /* prep outputs */
+    GLuint tex_ao, tex_composite;             /* results */
+    GLuint fbo_prep, fbo_ao, fbo_composite;
+} obs__targets;
+
+struct obs_ctx {
+    obs_backend backend;
+    obs__backend_state st;
+    obs__gl gl;
+    int debug;
+    obs_log_fn log;
+    void *log_user;
+    char version[128], vendor[128], renderer[256];
+    GLuint vao;  /* empty vertex array for the full-screen triangle */
+    obs__programs prog;
+    obs__targets tg;
+    unsigned long gl_objects_created; /* textures + framebuffers, for tests */
+};
+
+/* Deletes the per-resolution textures, framebuffers and programs. */
+void obs__frame_release(obs_ctx *ctx);
+
+/* Makes the context current on the calling thread (and its table). */
+obs_status obs__ctx_bind(obs_ctx *ctx, char err[OBS_ERR_LEN]);
+
+#endif

@@ -1,0 +1,67 @@
+/* Shader programs: compile and link, failures carry the info log. */
+#include <stdio.h>
+#include <string.h>
+
+#include "gl.h"
+
+static obs_status compile(const char *name, GLenum type, const char *const *parts, int count,
+                          GLuint *out, char err[OBS_ERR_LEN])
+{
+    GLuint sh = glCreateShader(type);
+    GLint ok = 0;
+    glShaderSource(sh, count, parts, NULL);
+    glCompileShader(sh);
+    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[OBS_ERR_LEN - 64] = "";
+        glGetShaderInfoLog(sh, (GLsizei)sizeof log, NULL, log);
+        glDeleteShader(sh);
+        return obs__fail(err, OBS_GL_SHADER, "shader %s (%s) failed to compile: %s", name,
+                         type == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
+    }
+    *out = sh;
+    return OBS_OK;
+}
+
+obs_status obs__gl_program(const char *name, const char *vert, const char *const *frag_parts,
+                           int frag_count, GLuint *out, char err[OBS_ERR_LEN])
+{
+    GLuint vs = 0, fs = 0, prog = 0;
+    GLint ok = 0;
+    obs_status s = compile(name, GL_VERTEX_SHADER, &vert, 1, &vs, err);
+    if (s != OBS_OK)
+        goto fail;
+    s = compile(name, GL_FRAGMENT_SHADER, frag_parts, frag_count, &fs, err);
+    if (s != OBS_OK)
+        goto fail;
+    prog = glCreateProgram();
+    glAttachShader(prog, vs);
+    glAttachShader(prog, fs);
+    glLinkProgram(prog);
+    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[OBS_ERR_LEN - 64] = "";
+        glGetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
+        s = obs__fail(err, OBS_GL_SHADER, "program %s failed to link: %s", name, log);
+        glDeleteProgram(prog);
+        goto fail;
+    }
+    *out = prog;
+fail:
+    if (vs)
+        glDeleteShader(vs);
+    if (fs)
+        glDeleteShader(fs);
+    return s;
+}
+
+obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN])
+{
+    GLenum e, first = GL_NO_ERROR;
+    while ((e = glGetError()) != GL_NO_ERROR)
+        if (first == GL_NO_ERROR)
+            first = e;
+    if (first == GL_NO_ERROR)
+        return OBS_OK;
+    return obs__fail(err, OBS_GL_ERROR, "OpenGL error 0x%04x in %s", (unsigned)first, where);
+}

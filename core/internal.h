@@ -1,0 +1,65 @@
+/* Internal cross-file helpers of libobscura (obs__ prefix).  Not installed. */
+#ifndef OBSCURA_INTERNAL_H
+#define OBSCURA_INTERNAL_H
+
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "obscura.h"
+
+#if defined(__GNUC__)
+#define OBS__PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define OBS__PRINTF(a, b)
+#endif
+
+/* Writes a formatted message into err (if non-NULL) and returns s. */
+obs_status obs__fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
+    OBS__PRINTF(3, 4);
+
+/* Overflow-checked size arithmetic: 0 on success, -1 when the product does
+ * not fit in size_t (then *out is left alone). */
+int obs__size_mul(size_t a, size_t b, size_t *out);
+int obs__size_mul3(size_t a, size_t b, size_t c, size_t *out);
+
+/* Bytes of one plane's row (stride or packed) and pointer to pixel (x, y). */
+size_t obs__plane_stride(const obs_plane *p, int width);
+const float *obs__plane_px(const obs_plane *p, int width, int x, int y);
+
+/* Checks a G-buffer's sizes and planes before anything runs; the message
+ * names the offending plane. */
+obs_status obs__gbuffer_validate(const obs_gbuffer *gb, char err[OBS_ERR_LEN]);
+
+/* 4x4 row-major matrices, column-vector convention. */
+void obs__mat4_identity(float m[16]);
+void obs__mat4_mul(const float a[16], const float b[16], float out[16]);
+int obs__mat4_invert(const float m[16], float out[16]); /* -1 if singular */
+void obs__mat4_transpose(const float m[16], float out[16]);
+/* out = m * (x, y, z, w) */
+void obs__mat4_apply(const float m[16], const float v[4], float out[4]);
+
+/* The camera a frame is computed with: the G-buffer's camera, overridden
+ * by parameters (fov_y, world_to_camera) where they are set.  Fails with
+ * NO_CAMERA when neither gives a projection. */
+obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p,
+                               obs_camera *out, char err[OBS_ERR_LEN]);
+
+/* Sample sets on the unit disk, generated once with a fixed seed.
+ * Returns n (x, y) pairs, n in [2, OBS__MAX_SAMPLES]. */
+#define OBS__MAX_SAMPLES 32
+const float *obs__samples(int n);
+
+/* Per-pixel rotation of the sample set: 3x3 tile of 9 uniform angles
+ * (VAO++ section 4.5), computed from pixel coordinates. */
+void obs__pixel_rotation(int x, int y, float *cos_a, float *sin_a);
+
+/* Allocates the images of a result for `outputs` (OBS_OUTPUT_* bits). */
+obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs,
+                             char err[OBS_ERR_LEN]);
+
+/* Reports through a context's log callback (no-op without one). */
+void obs__log(obs_ctx *ctx, obs_log_level level, const char *fmt, ...)
+    OBS__PRINTF(3, 4);
+
+#endif

@@ -1,0 +1,267 @@
+/* The parameter table: metadata, parsing, defaults, range checks. */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+#define OBS__STR(x) #x
+#define OBS__DEF_FLOAT(d) OBS__STR(d)
+#define OBS__DEF_INT(d) OBS__STR(d)
+#define OBS__DEF_ENUM(d) d
+#define OBS__DEF_MAT4(d) "unset"
+
+static const obs_param_info table[] = {
+#define X(name, type, def, lo, hi, choices, doc)                                   \
+    {#name, OBS_PARAM_##type, OBS__DEF_##type(def), lo, hi, choices, doc,         \
+     offsetof(obs_params, name)},
+    OBS_PARAM_TABLE(X)
+#undef X
+};
+
+#define TABLE_LEN ((int)(sizeof table / sizeof table[0]))
+
+int obs_param_count(void) { return TABLE_LEN; }
+
+const obs_param_info *obs_param_at(int i)
+{
+    return i >= 0 && i < TABLE_LEN ? &table[i] : NULL;
+}
+
+/* Compares names treating '-' and '_' as the same character. */
+static int name_eq(const char *a, const char *b)
+{
+    for (; *a && *b; a++, b++) {
+        char ca = *a == '-' ? '_' : *a, cb = *b == '-' ? '_' : *b;
+        if (ca != cb)
+            return 0;
+    }
+    return *a == *b;
+}
+
+const obs_param_info *obs_param_find(const char *name)
+{
+    for (int i = 0; name && i < TABLE_LEN; i++)
+        if (name_eq(table[i].name, name))
+            return &table[i];
+    return NULL;
+}
+
+/* Index (1-based) of `value` in the '|'-separated list, 0 if absent. */
+static int choice_index(const char *choices, const char *value)
+{
+    size_t vlen = strlen(value);
+    int idx = 1;
+    for (const char *p = choices; *p; idx++) {
+        const char *end = strchr(p, '|');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        if (len == vlen && strncmp(p, value, len) == 0)
+            return idx;
+        if (!end)
+            break;
+        p = end + 1;
+    }
+    return 0;
+}
+
+/* Writes choice number idx (1-based) into buf. */
+static void choice_name(const char *choices, int idx, char *buf, size_t len)
+{
+    const char *p = choices;
+    for (int i = 1; i < idx && p; i++) {
+        p = strchr(p, '|');
+        if (p)
+            p++;
+    }
+    if (!p || idx < 1) {
+        snprintf(buf, len, "?");
+        return;
+    }
+    const char *end = strchr(p, '|');
+    int n = end ? (int)(end - p) : (int)strlen(p);
+    snprintf(buf, len, "%.*s", n, p);
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || errno == ERANGE || !isfinite(v))
+        return -1;
+    while (isspace((unsigned char)*end))
+        end++;
+    if (*end)
+        return -1;
+    *out = v;
+    return 0;
+}
+
+static obs_status range_error(const obs_param_info *pi, const char *value, char err[OBS_ERR_LEN])
+{
+    if (pi->type == OBS_PARAM_INT)
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "parameter %s: '%s' is not an integer in [%g, %g]", pi->name,
+                         value, pi->min, pi->max);
+    return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not a number in [%g, %g]",
+                     pi->name, value, pi->min, pi->max);
+}
+
+obs_status obs_param_set(obs_params *p, const char *name, const char *value,
+                         char err[OBS_ERR_LEN])
+{
+    const obs_param_info *pi = obs_param_find(name);
+    if (!pi)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown parameter '%s'", name ? name : "");
+    if (!value)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s needs a value", pi->name);
+    char *field = (char *)p + pi->offset;
+    double v;
+
+    switch (pi->type) {
+    case OBS_PARAM_FLOAT:
+        if (parse_double(value, &v) != 0 || v < pi->min || v > pi->max)
+            return range_error(pi, value, err);
+        *(float *)field = (float)v;
+        return OBS_OK;
+    case OBS_PARAM_INT:
+        if (parse_double(value, &v) != 0 || v != floor(v) || v < pi->min || v > pi->max)
+            return range_error(pi, value, err);
+        *(int *)field = (int)v;
+        return OBS_OK;
+    case OBS_PARAM_ENUM: {
+        int idx = choice_index(pi->choices, value);
+        if (!idx)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s",
+                             pi->name, value, pi->choices);
+        *(int *)field = idx;
+        return OBS_OK;
+    }
+    case OBS_PARAM_MAT4: {
+        /* 16 numbers separated by commas and/or spaces. */
+        float m[16];
+        const char *s = value;
+        for (int i = 0; i < 16; i++) {
+            char *end;
+            while (isspace((unsigned char)*s) || *s == ',')
+                s++;
+            errno = 0;
+            double d = strtod(s, &end);
+            if (end == s || errno == ERANGE || !isfinite(d))
+                return obs__fail(err, OBS_INVALID_ARGUMENT,
+                                 "parameter %s: expected 16 numbers, number %d is missing or invalid",
+                                 pi->name, i + 1);
+            m[i] = (float)d;
+            s = end;
+        }
+        while (isspace((unsigned char)*s) || *s == ',')
+            s++;
+        if (*s)
+            return obs__fail(err, OBS_INVALID_ARGUMENT,
+                             "parameter %s: expected 16 numbers, found more", pi->name);
+        memcpy(field, m, sizeof m);
+        if (pi->offset == offsetof(obs_params, world_to_camera))
+            p->has_world_to_camera = 1;
+        return OBS_OK;
+    }
+    }
+    return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s has an unknown type", pi->name);
+}
+
+void obs_param_format(const obs_params *p, const obs_param_info *pi, char *buf, size_t len)
+{
+    const char *field = (const char *)p + pi->offset;
+    switch (pi->type) {
+    case OBS_PARAM_FLOAT: snprintf(buf, len, "%g", *(const float *)field); break;
+    case OBS_PARAM_INT: snprintf(buf, len, "%d", *(const int *)field); break;
+    case OBS_PARAM_ENUM: choice_name(pi->choices, *(const int *)field, buf, len); break;
+    case OBS_PARAM_MAT4: {
+        const float *m = (const float *)field;
+        size_t off = 0;
+        buf[0] = '\0';
+        for (int i = 0; i < 16 && off < len; i++)
+            off += (size_t)snprintf(buf + off, len - off, i ? ",%g" : "%g", m[i]);
+        break;
+    }
+    }
+}
+
+void obs_params_resolve(const obs_params *in, obs_params *out)
+{
+    obs_params r;
+    if (in)
+        r = *in;
+    else
+        memset(&r, 0, sizeof r);
+    for (int i = 0; i < TABLE_LEN; i++) {
+        const obs_param_info *pi = &table[i];
+        char *field = (char *)&r + pi->offset;
+        switch (pi->type) {
+        case OBS_PARAM_FLOAT:
+            if (*(float *)field == 0.0f)
+                *(float *)field = (float)strtod(pi->def, NULL);
+            break;
+        case OBS_PARAM_INT:
+            if (*(int *)field == 0)
+                *(int *)field = (int)strtol(pi->def, NULL, 10);
+            break;
+        case OBS_PARAM_ENUM:
+            if (*(int *)field == 0)
+                *(int *)field = choice_index(pi->choices, pi->def);
+            break;
+        case OBS_PARAM_MAT4:
+            break; /* unset stays unset: has_world_to_camera says */
+        }
+    }
+    *out = r;
+}
+
+obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN])
+{
+    for (int i = 0; i < TABLE_LEN; i++) {
+        const obs_param_info *pi = &table[i];
+        const char *field = (const char *)p + pi->offset;
+        char text[64];
+        switch (pi->type) {
+        case OBS_PARAM_FLOAT: {
+            float v = *(const float *)field;
+            if (!isfinite(v) || v < pi->min || v > pi->max) {
+                snprintf(text, sizeof text, "%g", v);
+                return range_error(pi, text, err);
+            }
+            break;
+        }
+        case OBS_PARAM_INT: {
+            int v = *(const int *)field;
+            if (v < pi->min || v > pi->max) {
+                snprintf(text, sizeof text, "%d", v);
+                return range_error(pi, text, err);
+            }
+            break;
+        }
+        case OBS_PARAM_ENUM: {
+            int v = *(const int *)field;
+            int n = 1;
+            for (const char *c = pi->choices; *c; c++)
+                n += *c == '|';
+            if (v < 1 || v > n)
+                return obs__fail(err, OBS_INVALID_ARGUMENT,
+                                 "parameter %s: value %d is not one of %s", pi->name, v,
+                                 pi->choices);
+            break;
+        }
+        case OBS_PARAM_MAT4: {
+            const float *m = (const float *)field;
+            for (int k = 0; k < 16; k++)
+                if (!isfinite(m[k]))
+                    return obs__fail(err, OBS_INVALID_ARGUMENT,
+                                     "parameter %s: element %d is not finite", pi->name, k + 1);
+            break;
+        }
+        }
+    }
+    return OBS_OK;
+}

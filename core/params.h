@@ -1,0 +1,116 @@
+/* The one parameter table.
+ *
+ * Every tunable of the AO chain is declared once, here: name, type,
+ * default, range, choices and a one-line doc.  The CLI flags and help, the
+ * README's parameter list and (later) the HTTP and binary protocols are all
+ * generated from this table.  A zero-initialised obs_params means "all
+ * defaults"; obs_params_resolve() applies them in one place.
+ */
+#ifndef OBSCURA_PARAMS_H
+#define OBSCURA_PARAMS_H
+
+#include <stddef.h>
+
+#include "status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Enumerated parameter values.  0 always means "default". */
+typedef enum obs_depth_mode {
+    OBS_DEPTH_DEFAULT,
+    OBS_DEPTH_PLANAR, /* distance along the camera axis (Blender's Depth.Z) */
+    OBS_DEPTH_RADIAL, /* distance from the camera centre */
+    OBS_DEPTH_NDC     /* OpenGL depth-buffer value in [0,1] */
+} obs_depth_mode;
+
+typedef enum obs_normal_space {
+    OBS_NORMALS_DEFAULT,
+    OBS_NORMALS_WORLD,  /* world space: rotated by world_to_camera */
+    OBS_NORMALS_CAMERA  /* view space, camera looking down -Z */
+} obs_normal_space;
+
+/* X(name, type, default, min, max, choices, doc)
+ * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4.
+ * For ENUM the default is the choice's name; for MAT4 it is unused. */
+#define OBS_PARAM_TABLE(X)                                                     \
+    X(radius, FLOAT, 0.5, 1e-4, 1e4, NULL,                                     \
+      "AO radius R in world units: hemisphere radius of the occlusion "        \
+      "test; VAO's tangent sphere has radius R/2")                             \
+    X(samples, INT, 16, 2, 32, NULL,                                           \
+      "line samples per pixel on the tangent sphere's disk")                   \
+    X(depth_mode, ENUM, "planar", 0, 0, "planar|radial|ndc",                   \
+      "what the depth channel holds: distance along the camera axis, "         \
+      "distance from the camera, or a [0,1] OpenGL depth-buffer value")        \
+    X(normal_space, ENUM, "world", 0, 0, "world|camera",                       \
+      "space of the normal channel (world normals need world_to_camera)")      \
+    X(unit_scale, FLOAT, 1.0, 1e-6, 1e6, NULL,                                 \
+      "depth values are multiplied by this to reach the units of radius")      \
+    X(fov_y, FLOAT, 0.0, 0.0, 179.0, NULL,                                     \
+      "vertical field of view in degrees (0: take the camera from the EXR "    \
+      "header or camera JSON)")                                                \
+    X(near, FLOAT, 0.1, 1e-6, 1e9, NULL,                                       \
+      "near clip distance, used with fov_y (ndc depth is linearised with it)") \
+    X(far, FLOAT, 1000.0, 1e-6, 1e12, NULL,                                    \
+      "far clip distance, used with fov_y")                                    \
+    X(world_to_camera, MAT4, 0, 0, 0, NULL,                                    \
+      "16 numbers, row-major, column-vector convention: world to camera "      \
+      "(-Z forward); overrides the file's camera rotation")
+
+#define OBS__PDECL_FLOAT(n) float n;
+#define OBS__PDECL_INT(n) int n;
+#define OBS__PDECL_ENUM(n) int n;
+#define OBS__PDECL_MAT4(n) float n[16];
+
+typedef struct obs_params {
+#define OBS__PDECL(name, type, def, lo, hi, choices, doc) OBS__PDECL_##type(name)
+    OBS_PARAM_TABLE(OBS__PDECL)
+#undef OBS__PDECL
+    int has_world_to_camera; /* set by obs_param_set for world_to_camera */
+} obs_params;
+
+typedef enum obs_param_type {
+    OBS_PARAM_FLOAT,
+    OBS_PARAM_INT,
+    OBS_PARAM_ENUM,
+    OBS_PARAM_MAT4
+} obs_param_type;
+
+typedef struct obs_param_info {
+    const char *name;     /* snake_case; flags use the same name with '-' */
+    obs_param_type type;
+    const char *def;      /* default as text, for help and docs */
+    double min, max;      /* FLOAT and INT only */
+    const char *choices;  /* ENUM only: "a|b|c" */
+    const char *doc;
+    size_t offset;        /* offsetof(obs_params, name) */
+} obs_param_info;
+
+int obs_param_count(void);
+/* NULL when i is out of range. */
+const obs_param_info *obs_param_at(int i);
+/* Finds a parameter by name; '-' and '_' are interchangeable. */
+const obs_param_info *obs_param_find(const char *name);
+
+/* Parses `value` for the parameter `name` into p, checking its range.
+ * Errors name the parameter and the allowed values. */
+obs_status obs_param_set(obs_params *p, const char *name, const char *value,
+                         char err[OBS_ERR_LEN]);
+
+/* Writes the value of parameter `pi` in p as text (the resolved value). */
+void obs_param_format(const obs_params *p, const obs_param_info *pi, char *buf,
+                      size_t len);
+
+/* out = in with every zero field replaced by its default. */
+void obs_params_resolve(const obs_params *in, obs_params *out);
+
+/* Checks every field of a resolved struct against the table's ranges;
+ * the message names the first field out of range. */
+obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,237 @@
+/* obs_run: uploads a G-buffer, runs the passes on the GL context, reads the
+ * results back.  Textures and framebuffers are allocated once per
+ * resolution and reused for every frame of that size. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "frame.h"
+#include "gl/gl.h"
+#include "obs_shaders.h"
+
+static const char glsl_version[] = "#version 430 core\n";
+
+static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
+{
+    if (ctx->prog.prep)
+        return OBS_OK;
+    const char *prep[] = {glsl_version, obs__shader_common, obs__shader_prep_frag};
+    const char *vao[] = {glsl_version, obs__shader_common, obs__shader_vao_frag};
+    const char *comp[] = {glsl_version, obs__shader_composite_frag};
+    obs_status s = obs__gl_program("prep", obs__shader_fullscreen_vert, prep, 3, &ctx->prog.prep, err);
+    if (s == OBS_OK)
+        s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 3, &ctx->prog.vao, err);
+    if (s == OBS_OK)
+        s = obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2, &ctx->prog.composite,
+                            err);
+    return s;
+}
+
+static GLuint make_texture(obs_ctx *ctx, GLenum format, int w, int h)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    ctx->gl_objects_created++;
+    return t;
+}
+
+static obs_status make_fbo(obs_ctx *ctx, GLuint *fbo, const GLuint *tex, int count,
+                           const char *name, char err[OBS_ERR_LEN])
+{
+    static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glGenFramebuffers(1, fbo);
+    ctx->gl_objects_created++;
+    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+    for (int i = 0; i < count; i++)
+        glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, tex[i], 0);
+    glDrawBuffers(count, bufs);
+    GLenum st = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (st != GL_FRAMEBUFFER_COMPLETE)
+        return obs__fail(err, OBS_GL_ERROR, "framebuffer %s incomplete (0x%04x)", name, (unsigned)st);
+    return OBS_OK;
+}
+
+void obs__frame_release(obs_ctx *ctx)
+{
+    obs__targets *t = &ctx->tg;
+    GLuint tex[] = {t->tex_depth, t->tex_normal, t->tex_color, t->tex_viewpos,
+                    t->tex_vnormal, t->tex_ao, t->tex_composite};
+    GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_composite};
+    glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
+    glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
+    memset(t, 0, sizeof *t);
+    if (ctx->prog.prep)
+        glDeleteProgram(ctx->prog.prep);
+    if (ctx->prog.vao)
+        glDeleteProgram(ctx->prog.vao);
+    if (ctx->prog.composite)
+        glDeleteProgram(ctx->prog.composite);
+    memset(&ctx->prog, 0, sizeof ctx->prog);
+}
+
+static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LEN])
+{
+    obs__targets *t = &ctx->tg;
+    if (t->width == w && t->height == h)
+        return OBS_OK;
+    if (t->width) {
+        /* a new resolution: drop the old set, keep the programs */
+        obs__programs keep = ctx->prog;
+        memset(&ctx->prog, 0, sizeof ctx->prog);
+        obs__frame_release(ctx);
+        ctx->prog = keep;
+    }
+    t->tex_depth = make_texture(ctx, GL_R32F, w, h);
+    t->tex_normal = make_texture(ctx, GL_RGB32F, w, h);
+    t->tex_color = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_viewpos = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_vnormal = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_ao = make_texture(ctx, GL_R32F, w, h);
+    t->tex_composite = make_texture(ctx, GL_RGBA32F, w, h);
+    GLuint prep[] = {t->tex_viewpos, t->tex_vnormal};
+    obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 2, "prep", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_ao, &t->tex_ao, 1, "ao", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_composite, &t->tex_composite, 1, "composite", err);
+    if (s == OBS_OK)
+        s = obs__gl_check("allocating frame targets", err);
+    if (s != OBS_OK) {
+        obs__programs keep = ctx->prog;
+        memset(&ctx->prog, 0, sizeof ctx->prog);
+        obs__frame_release(ctx);
+        ctx->prog = keep;
+        return s;
+    }
+    t->width = w;
+    t->height = h;
+    obs__log(ctx, OBS_LOG_DEBUG, "allocated frame targets for %dx%d", w, h);
+    return OBS_OK;
+}
+
+static void upload(GLuint tex, const obs_plane *p, int w, int h, GLenum format)
+{
+    size_t px_bytes = (size_t)p->channels * sizeof(float);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, (GLint)(obs__plane_stride(p, w) / px_bytes));
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, GL_FLOAT, p->data);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+}
+
+static void bind_tex(GLuint prog, const char *name, int unit, GLuint tex)
+{
+    glActiveTexture(GL_TEXTURE0 + (GLenum)unit);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glUniform1i(glGetUniformLocation(prog, name), unit);
+}
+
+/* Uniforms of common.glsl. */
+static void set_common(GLuint prog, const obs__frame *f)
+{
+    glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_TRUE, f->proj);
+    glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
+    glUniform1i(glGetUniformLocation(prog, "u_depth_mode"), f->depth_mode);
+    glUniform2i(glGetUniformLocation(prog, "u_size"), f->width, f->height);
+}
+
+static void draw(obs_ctx *ctx, GLuint fbo, int w, int h)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, w, h);
+    glBindVertexArray(ctx->vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+static void read_back(GLuint fbo, int w, int h, GLenum format, float *dst)
+{
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, format, GL_FLOAT, dst);
+}
+
+obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                   obs_result *out, char err[OBS_ERR_LEN])
+{
+    obs_params p;
+    obs__frame f;
+    obs_status s;
+
+    memset(out, 0, sizeof *out);
+    if (!ctx)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
+    if (!(outputs & (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE)))
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no output requested");
+    obs_params_resolve(params, &p);
+    s = obs__frame_setup(ctx, gb, &p, &f, err);
+    if (s != OBS_OK)
+        return s;
+    s = obs__ctx_bind(ctx, err);
+    if (s != OBS_OK)
+        return s;
+    s = build_programs(ctx, err);
+    if (s != OBS_OK)
+        return s;
+    s = ensure_targets(ctx, f.width, f.height, err);
+    if (s != OBS_OK)
+        return s;
+    s = obs__alloc_result(out, f.width, f.height, outputs, err);
+    if (s != OBS_OK)
+        return s;
+
+    obs__targets *t = &ctx->tg;
+    int w = f.width, h = f.height;
+    upload(t->tex_depth, &gb->depth, w, h, GL_RED);
+    if (!f.reconstruct_normals)
+        upload(t->tex_normal, &gb->normal, w, h, GL_RGB);
+    int has_color = gb->color.data != NULL && (outputs & OBS_OUTPUT_COMPOSITE);
+    if (has_color)
+        upload(t->tex_color, &gb->color, w, h, GL_RGBA);
+
+    /* prep pass */
+    GLuint prog = ctx->prog.prep;
+    glUseProgram(prog);
+    set_common(prog, &f);
+    bind_tex(prog, "u_depth", 0, t->tex_depth);
+    bind_tex(prog, "u_normal", 1, t->tex_normal);
+    glUniform1i(glGetUniformLocation(prog, "u_reconstruct"), f.reconstruct_normals);
+    glUniformMatrix3fv(glGetUniformLocation(prog, "u_normal_matrix"), 1, GL_TRUE, f.normal_matrix);
+    draw(ctx, t->fbo_prep, w, h);
+
+    /* AO pass */
+    prog = ctx->prog.vao;
+    glUseProgram(prog);
+    set_common(prog, &f);
+    bind_tex(prog, "u_pos", 0, t->tex_viewpos);
+    bind_tex(prog, "u_vnormal", 1, t->tex_vnormal);
+    glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
+    glUniform1i(glGetUniformLocation(prog, "u_count"), f.samples);
+    glUniform2fv(glGetUniformLocation(prog, "u_samples"), f.samples, f.sample_xy);
+    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f.rot[0][0]);
+    draw(ctx, t->fbo_ao, w, h);
+
+    if (outputs & OBS_OUTPUT_COMPOSITE) {
+        prog = ctx->prog.composite;
+        glUseProgram(prog);
+        bind_tex(prog, "u_ao", 0, t->tex_ao);
+        bind_tex(prog, "u_color", 1, t->tex_color);
+        glUniform1i(glGetUniformLocation(prog, "u_has_color"), has_color);
+        draw(ctx, t->fbo_composite, w, h);
+        read_back(t->fbo_composite, w, h, GL_RGBA, out->composite.data);
+    }
+    if (outputs & OBS_OUTPUT_AO)
+        read_back(t->fbo_ao, w, h, GL_RED, out->ao.data);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glUseProgram(0);
+
+    s = obs__gl_check("running the AO passes", err);
+    if (s != OBS_OK)
+        obs_result_free(out);
+    return s;
+}

@@ -1,0 +1,62 @@
+// Shared by the passes (prepended to each fragment shader).  Each function
+// has a C twin of the same name in core/vao_cpu.c.
+//
+// Pixel (x, y) is row y from the top, as the planes are uploaded: texel
+// row y of every texture is image row y, so gl_FragCoord.xy (row 0 first)
+// indexes the planes directly.
+
+uniform mat4 u_proj;        // view -> clip
+uniform vec4 u_viewport;    // display x, y, width, height of the planes
+uniform int u_depth_mode;   // 1 planar, 2 radial, 3 ndc (obs_depth_mode)
+
+const float SKY_DEPTH = 1e9;
+const float FAR_AWAY = 1e30;
+
+#define PM(r, c) u_proj[c][r]
+
+vec2 px_ndc(ivec2 p)
+{
+    return vec2((float(p.x) + 0.5 + u_viewport.x) / u_viewport.z * 2.0 - 1.0,
+                1.0 - (float(p.y) + 0.5 + u_viewport.y) / u_viewport.w * 2.0);
+}
+
+// The point seen at ndc with planar depth d is origin + d * dir, dir.z = -1.
+void view_ray(vec2 ndc, out vec3 origin, out vec3 dir)
+{
+    float nx = ndc.x, ny = ndc.y;
+    float a = PM(0, 0) - nx * PM(3, 0), b = PM(0, 1) - nx * PM(3, 1);
+    float c = PM(1, 0) - ny * PM(3, 0), d = PM(1, 1) - ny * PM(3, 1);
+    float b0x = nx * PM(3, 3) - PM(0, 3), b0y = ny * PM(3, 3) - PM(1, 3);
+    float b1x = nx * PM(3, 2) - PM(0, 2), b1y = ny * PM(3, 2) - PM(1, 2);
+    float inv = 1.0 / (a * d - b * c);
+    origin = vec3((d * b0x - b * b0y) * inv, (a * b0y - c * b0x) * inv, 0.0);
+    dir = vec3(-(d * b1x - b * b1y) * inv, -(a * b1y - c * b1x) * inv, -1.0);
+}
+
+// Planar depth from the raw value; 0 for background.
+float linear_depth(float raw, vec3 dir)
+{
+    if (!(raw > 0.0) || raw >= SKY_DEPTH)
+        return 0.0;
+    if (u_depth_mode == 2)
+        return raw / sqrt(dir.x * dir.x + dir.y * dir.y + dir.z * dir.z);
+    if (u_depth_mode == 3) {
+        if (raw >= 1.0)
+            return 0.0;
+        float zn = 2.0 * raw - 1.0;
+        float z = (PM(2, 3) - zn * PM(3, 3)) / (zn * PM(3, 2) - PM(2, 2));
+        return -z > 0.0 ? -z : 0.0;
+    }
+    return raw;
+}
+
+// View-space position and planar depth; vec4(0) for background.
+vec4 prep_position(float raw, ivec2 p)
+{
+    vec3 o, dir;
+    view_ray(px_ndc(p), o, dir);
+    float d = linear_depth(raw, dir);
+    if (d <= 0.0 || isinf(d) || isnan(d))
+        return vec4(0.0);
+    return vec4(o.x + d * dir.x, o.y + d * dir.y, -d, d);
+}

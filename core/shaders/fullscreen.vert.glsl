@@ -1,0 +1,8 @@
+#version 430 core
+// One triangle that covers the viewport; every pass is a fragment shader
+// over the frame's pixels.
+void main()
+{
+    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}

@@ -1,0 +1,68 @@
+// Prep pass: view-space position (xyz, planar depth in w) and view-space
+// unit normal of every pixel.  C twin: obs__prep_position/_normal.
+
+uniform sampler2D u_depth;       // raw depth
+uniform sampler2D u_normal;      // input normals (when given)
+uniform int u_reconstruct;       // 1: derive normals from depth
+uniform mat3 u_normal_matrix;    // input normal -> view normal
+uniform ivec2 u_size;
+
+layout(location = 0) out vec4 o_pos;
+layout(location = 1) out vec4 o_normal;
+
+vec4 position_at(ivec2 p)
+{
+    return prep_position(texelFetch(u_depth, p, 0).r, p);
+}
+
+// Difference towards the neighbour along step whose depth is closer to the
+// centre's, so that edges do not bend the normal.
+bool neighbour_delta(ivec2 p, vec4 c, ivec2 step, out vec3 delta)
+{
+    bool found = false;
+    float best_dz = 0.0;
+    delta = vec3(0.0);
+    for (int s = -1; s <= 1; s += 2) {
+        ivec2 q = p + s * step;
+        if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
+            continue;
+        vec4 n = position_at(q);
+        if (n.w <= 0.0)
+            continue;
+        float dz = abs(n.w - c.w);
+        if (!found || dz < best_dz) {
+            found = true;
+            best_dz = dz;
+            delta = float(s) * (n.xyz - c.xyz);
+        }
+    }
+    return found;
+}
+
+vec3 normalize_safe(vec3 v)
+{
+    float l = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    return l > 0.0 ? v / l : v;
+}
+
+void main()
+{
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec4 c = position_at(p);
+    o_pos = c;
+    vec3 n;
+    if (u_reconstruct == 0) {
+        n = normalize_safe(u_normal_matrix * texelFetch(u_normal, p, 0).xyz);
+    } else {
+        vec3 dx, dy;
+        n = vec3(0.0);
+        if (neighbour_delta(p, c, ivec2(1, 0), dx) && neighbour_delta(p, c, ivec2(0, 1), dy))
+            n = cross(dx, dy);
+        if (n == vec3(0.0))
+            n = -c.xyz;             // isolated pixel: face the camera
+        else if (dot(n, c.xyz) > 0.0)
+            n = -n;                 // a visible surface faces the camera
+        n = normalize_safe(n);
+    }
+    o_normal = vec4(n, 0.0);
+}

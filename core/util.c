@@ -1,0 +1,152 @@
+/* Small shared helpers: error messages, checked sizes, 4x4 matrices. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+obs_status obs__fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
+{
+    if (err) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, OBS_ERR_LEN, fmt, ap);
+        va_end(ap);
+    }
+    return s;
+}
+
+int obs__size_mul(size_t a, size_t b, size_t *out)
+{
+    if (a != 0 && b > SIZE_MAX / a)
+        return -1;
+    *out = a * b;
+    return 0;
+}
+
+int obs__size_mul3(size_t a, size_t b, size_t c, size_t *out)
+{
+    size_t ab;
+    if (obs__size_mul(a, b, &ab) != 0)
+        return -1;
+    return obs__size_mul(ab, c, out);
+}
+
+obs_status obs_check_size(const obs_limits *lim, int64_t width, int64_t height,
+                          char err[OBS_ERR_LEN])
+{
+    int64_t max_w = lim && lim->max_width > 0 ? lim->max_width : 16384;
+    int64_t max_h = lim && lim->max_height > 0 ? lim->max_height : 16384;
+    uint64_t max_px = lim && lim->max_pixels > 0 ? lim->max_pixels
+                                                 : (uint64_t)max_w * (uint64_t)max_h;
+    if (width <= 0 || height <= 0)
+        return obs__fail(err, OBS_BAD_FILE, "image size %lldx%lld is empty or negative",
+                         (long long)width, (long long)height);
+    if (width > max_w || height > max_h)
+        return obs__fail(err, OBS_TOO_LARGE, "image size %lldx%lld exceeds the limit %lldx%lld",
+                         (long long)width, (long long)height, (long long)max_w,
+                         (long long)max_h);
+    if ((uint64_t)width * (uint64_t)height > max_px)
+        return obs__fail(err, OBS_TOO_LARGE, "image of %llu pixels exceeds the limit of %llu pixels",
+                         (unsigned long long)((uint64_t)width * (uint64_t)height),
+                         (unsigned long long)max_px);
+    return OBS_OK;
+}
+
+void obs_image_free(obs_image *img)
+{
+    if (!img)
+        return;
+    free(img->data);
+    memset(img, 0, sizeof *img);
+}
+
+size_t obs__plane_stride(const obs_plane *p, int width)
+{
+    return p->row_stride ? p->row_stride : (size_t)width * (size_t)p->channels * sizeof(float);
+}
+
+const float *obs__plane_px(const obs_plane *p, int width, int x, int y)
+{
+    const char *row = (const char *)p->data + (size_t)y * obs__plane_stride(p, width);
+    return (const float *)row + (size_t)x * (size_t)p->channels;
+}
+
+/* ---- 4x4 matrices, row-major, column-vector convention ------------------ */
+
+void obs__mat4_identity(float m[16])
+{
+    memset(m, 0, 16 * sizeof(float));
+    m[0] = m[5] = m[10] = m[15] = 1.0f;
+}
+
+void obs__mat4_mul(const float a[16], const float b[16], float out[16])
+{
+    float r[16];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double s = 0.0;
+            for (int k = 0; k < 4; k++)
+                s += (double)a[i * 4 + k] * b[k * 4 + j];
+            r[i * 4 + j] = (float)s;
+        }
+    memcpy(out, r, sizeof r);
+}
+
+void obs__mat4_transpose(const float m[16], float out[16])
+{
+    float r[16];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            r[j * 4 + i] = m[i * 4 + j];
+    memcpy(out, r, sizeof r);
+}
+
+void obs__mat4_apply(const float m[16], const float v[4], float out[4])
+{
+    float r[4];
+    for (int i = 0; i < 4; i++)
+        r[i] = m[i * 4 + 0] * v[0] + m[i * 4 + 1] * v[1] + m[i * 4 + 2] * v[2] +
+               m[i * 4 + 3] * v[3];
+    memcpy(out, r, sizeof r);
+}
+
+/* Gauss-Jordan elimination with partial pivoting, in double. */
+int obs__mat4_invert(const float m[16], float out[16])
+{
+    double a[4][8];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            a[i][j] = m[i * 4 + j];
+            a[i][j + 4] = (i == j);
+        }
+    for (int c = 0; c < 4; c++) {
+        int piv = c;
+        for (int r = c + 1; r < 4; r++)
+            if (fabs(a[r][c]) > fabs(a[piv][c]))
+                piv = r;
+        if (fabs(a[piv][c]) < 1e-12)
+            return -1;
+        if (piv != c)
+            for (int j = 0; j < 8; j++) {
+                double t = a[c][j];
+                a[c][j] = a[piv][j];
+                a[piv][j] = t;
+            }
+        double inv = 1.0 / a[c][c];
+        for (int j = 0; j < 8; j++)
+            a[c][j] *= inv;
+        for (int r = 0; r < 4; r++) {
+            if (r == c)
+                continue;
+            double f = a[r][c];
+            for (int j = 0; j < 8; j++)
+                a[r][j] -= f * a[c][j];
+        }
+    }
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            out[i * 4 + j] = (float)a[i][j + 4];
+    return 0;
+}

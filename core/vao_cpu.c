@@ -1,0 +1,295 @@
+/* The CPU twin of the GL passes: the same math, pixel by pixel, in C.
+ * Each function mirrors the GLSL function of the same role; keep them in
+ * step (tests/unit/core/test_gl_twin.c compares their outputs). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "frame.h"
+
+/* GLSL: px_ndc() in common.glsl */
+void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2])
+{
+    ndc[0] = ((float)x + 0.5f + f->viewport[0]) / f->viewport[2] * 2.0f - 1.0f;
+    ndc[1] = 1.0f - ((float)y + 0.5f + f->viewport[1]) / f->viewport[3] * 2.0f;
+}
+
+/* GLSL: view_ray() in common.glsl.  The point seen at NDC (nx, ny) with
+ * planar depth d is origin + d * dir (dir.z = -1): the projection solved
+ * for view x, y as a 2x2 system that is affine in view z. */
+static void view_ray(const float *P, const float ndc[2], float origin[3], float dir[3])
+{
+    float nx = ndc[0], ny = ndc[1];
+    float a = P[0] - nx * P[12], b = P[1] - nx * P[13];
+    float c = P[4] - ny * P[12], d = P[5] - ny * P[13];
+    float b0x = nx * P[15] - P[3], b0y = ny * P[15] - P[7];
+    float b1x = nx * P[14] - P[2], b1y = ny * P[14] - P[6];
+    float inv = 1.0f / (a * d - b * c);
+    origin[0] = (d * b0x - b * b0y) * inv;
+    origin[1] = (a * b0y - c * b0x) * inv;
+    origin[2] = 0.0f;
+    dir[0] = -(d * b1x - b * b1y) * inv;
+    dir[1] = -(a * b1y - c * b1x) * inv;
+    dir[2] = -1.0f;
+}
+
+/* GLSL: linear_depth() in common.glsl.  Planar depth from the raw value,
+ * 0 for background. */
+static float linear_depth(const obs__frame *f, float raw, const float dir[3])
+{
+    if (!(raw > 0.0f) || raw >= OBS__SKY_DEPTH) /* also catches NaN */
+        return 0.0f;
+    if (f->depth_mode == OBS_DEPTH_RADIAL)
+        return raw / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    if (f->depth_mode == OBS_DEPTH_NDC) {
+        if (raw >= 1.0f)
+            return 0.0f;
+        /* z_ndc = (P22 z + P23) / (P32 z + P33), solved for view z. */
+        const float *P = f->proj;
+        float zn = 2.0f * raw - 1.0f;
+        float z = (P[11] - zn * P[15]) / (zn * P[14] - P[10]);
+        return -z > 0.0f ? -z : 0.0f;
+    }
+    return raw;
+}
+
+void obs__prep_position(const obs__frame *f, float raw_depth, int x, int y, float out[4])
+{
+    float ndc[2], o[3], dir[3];
+    obs__px_ndc(f, x, y, ndc);
+    view_ray(f->proj, ndc, o, dir);
+    float d = linear_depth(f, raw_depth, dir);
+    if (d <= 0.0f || !isfinite(d)) {
+        out[0] = out[1] = out[2] = out[3] = 0.0f;
+        return;
+    }
+    out[0] = o[0] + d * dir[0];
+    out[1] = o[1] + d * dir[1];
+    out[2] = -d;
+    out[3] = d;
+}
+
+static void normalize3(float v[3])
+{
+    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (l > 0.0f) {
+        v[0] /= l;
+        v[1] /= l;
+        v[2] /= l;
+    }
+}
+
+/* GLSL: neighbour_delta() in prep.frag.glsl.  The difference towards the
+ * neighbour (along +x or +y) whose depth is closer to the centre's, so
+ * that edges do not bend the normal; 0 if neither neighbour is geometry. */
+static int neighbour_delta(const obs__frame *f, const float *pos, int x, int y, int dx, int dy,
+                           float out[3])
+{
+    const float *c = pos + 4 * ((size_t)y * (size_t)f->width + (size_t)x);
+    const float *best = NULL;
+    float best_dz = 0.0f, sign = 1.0f;
+    for (int s = -1; s <= 1; s += 2) {
+        int nx = x + s * dx, ny = y + s * dy;
+        if (nx < 0 || ny < 0 || nx >= f->width || ny >= f->height)
+            continue;
+        const float *q = pos + 4 * ((size_t)ny * (size_t)f->width + (size_t)nx);
+        if (q[3] <= 0.0f)
+            continue;
+        float dz = fabsf(q[3] - c[3]);
+        if (!best || dz < best_dz) {
+            best = q;
+            best_dz = dz;
+            sign = (float)s;
+        }
+    }
+    if (!best)
+        return 0;
+    for (int k = 0; k < 3; k++)
+        out[k] = sign * (best[k] - c[k]);
+    return 1;
+}
+
+void obs__prep_normal(const obs__frame *f, const float *pos, const float *in_normal, int x, int y,
+                      float out[3])
+{
+    const float *p = pos + 4 * ((size_t)y * (size_t)f->width + (size_t)x);
+    if (!f->reconstruct_normals) {
+        const float *m = f->normal_matrix;
+        for (int k = 0; k < 3; k++)
+            out[k] = m[3 * k] * in_normal[0] + m[3 * k + 1] * in_normal[1] +
+                     m[3 * k + 2] * in_normal[2];
+        normalize3(out);
+        return;
+    }
+    float ddx[3], ddy[3];
+    if (neighbour_delta(f, pos, x, y, 1, 0, ddx) && neighbour_delta(f, pos, x, y, 0, 1, ddy)) {
+        out[0] = ddx[1] * ddy[2] - ddx[2] * ddy[1];
+        out[1] = ddx[2] * ddy[0] - ddx[0] * ddy[2];
+        out[2] = ddx[0] * ddy[1] - ddx[1] * ddy[0];
+    } else {
+        out[0] = out[1] = out[2] = 0.0f;
+    }
+    if (out[0] == 0.0f && out[1] == 0.0f && out[2] == 0.0f) {
+        /* isolated pixel: face the camera */
+        out[0] = -p[0];
+        out[1] = -p[1];
+        out[2] = -p[2];
+    } else if (out[0] * p[0] + out[1] * p[1] + out[2] * p[2] > 0.0f) {
+        /* a visible surface faces the camera */
+        out[0] = -out[0];
+        out[1] = -out[1];
+        out[2] = -out[2];
+    }
+    normalize3(out);
+}
+
+/* GLSL: vao.frag.glsl */
+float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                     const float n[3])
+{
+    const float *P = f->proj;
+    const float R = f->radius, r = 0.5f * f->radius;
+    /* Centre of the tangent sphere of radius R/2, moved along the normal. */
+    float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
+    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    float open = 0.0f, F = 0.0f;
+
+    for (int i = 0; i < f->samples; i++) {
+        float sx = f->sample_xy[2 * i], sy = f->sample_xy[2 * i + 1];
+        float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
+        float h = r * l; /* half length of the pipe through the sphere */
+        F += R * l;      /* eq 2: F = R * sum sqrt(1 - x^2 - y^2) */
+
+        /* Sample on the disk through the centre, perpendicular to view Z. */
+        float s[3] = {c[0] + r * (rot[0] * sx - rot[1] * sy), c[1] + r * (rot[1] * sx + rot[0] * sy),
+                      c[2]};
+        float cw = P[12] * s[0] + P[13] * s[1] + P[14] * s[2] + P[15];
+        float zs = INFINITY; /* scene depth at the sample's pixel */
+        if (cw > 0.0f) {
+            float cx = P[0] * s[0] + P[1] * s[1] + P[2] * s[2] + P[3];
+            float cy = P[4] * s[0] + P[5] * s[1] + P[6] * s[2] + P[7];
+            float u = (cx / cw * 0.5f + 0.5f) * f->viewport[2] - f->viewport[0];
+            float v = (0.5f - cy / cw * 0.5f) * f->viewport[3] - f->viewport[1];
+            float fu = floorf(u), fv = floorf(v);
+            if (fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height) {
+                float d = pos[4 * ((size_t)fv * (size_t)f->width + (size_t)fu) + 3];
+                if (d > 0.0f)
+                    zs = d;
+            }
+        }
+        /* Unoccluded length of the pipe (cases A, B, C of section 3):
+         * the pipe spans depths [-c.z - h, -c.z + h]. */
+        float front = -c[2] - h;
+        open += fminf(fmaxf(zs - front, 0.0f), 2.0f * h);
+    }
+    return F > 0.0f ? open / F : 1.0f; /* eq 1: V = (1/F) sum dz_i */
+}
+
+static obs_status alloc_image(obs_image *img, int w, int h, int channels, char err[OBS_ERR_LEN])
+{
+    size_t n;
+    if (obs__size_mul3((size_t)w, (size_t)h, (size_t)channels * sizeof(float), &n) != 0)
+        return obs__fail(err, OBS_TOO_LARGE, "image %dx%dx%d overflows", w, h, channels);
+    img->data = malloc(n);
+    if (!img->data)
+        return obs__fail(err, OBS_NO_MEMORY, "out of memory for a %dx%d image", w, h);
+    img->width = w;
+    img->height = h;
+    img->channels = channels;
+    return OBS_OK;
+}
+
+obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs, char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    obs_status s = OBS_OK;
+    if (outputs & OBS_OUTPUT_AO)
+        s = alloc_image(&out->ao, w, h, 1, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_COMPOSITE))
+        s = alloc_image(&out->composite, w, h, 4, err);
+    if (s != OBS_OK)
+        obs_result_free(out);
+    return s;
+}
+
+void obs_result_free(obs_result *r)
+{
+    if (!r)
+        return;
+    obs_image_free(&r->ao);
+    obs_image_free(&r->composite);
+}
+
+/* GLSL: composite.frag.glsl.  Colour x AO; grey AO when there is no colour. */
+static void composite_pixel(const float *color, float ao, float out[4])
+{
+    if (!color) {
+        out[0] = out[1] = out[2] = ao;
+        out[3] = 1.0f;
+        return;
+    }
+    out[0] = color[0] * ao;
+    out[1] = color[1] * ao;
+    out[2] = color[2] * ao;
+    out[3] = color[3];
+}
+
+obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                       obs_result *out, char err[OBS_ERR_LEN])
+{
+    obs_params p;
+    obs__frame f;
+    float *pos = NULL, *nrm = NULL;
+    obs_status s;
+
+    memset(out, 0, sizeof *out);
+    if (!(outputs & (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE)))
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no output requested");
+    obs_params_resolve(params, &p);
+    s = obs__frame_setup(NULL, gb, &p, &f, err);
+    if (s != OBS_OK)
+        return s;
+
+    size_t npx = (size_t)f.width * (size_t)f.height;
+    pos = malloc(npx * 4 * sizeof(float));
+    nrm = malloc(npx * 3 * sizeof(float));
+    if (!pos || !nrm) {
+        s = obs__fail(err, OBS_NO_MEMORY, "out of memory for a %dx%d frame", f.width, f.height);
+        goto fail;
+    }
+    s = obs__alloc_result(out, f.width, f.height, outputs, err);
+    if (s != OBS_OK)
+        goto fail;
+
+    /* prep pass */
+    for (int y = 0; y < f.height; y++)
+        for (int x = 0; x < f.width; x++)
+            obs__prep_position(&f, *obs__plane_px(&gb->depth, f.width, x, y), x, y,
+                               pos + 4 * ((size_t)y * f.width + x));
+    for (int y = 0; y < f.height; y++)
+        for (int x = 0; x < f.width; x++) {
+            const float *in = gb->normal.data ? obs__plane_px(&gb->normal, f.width, x, y) : NULL;
+            obs__prep_normal(&f, pos, in, x, y, nrm + 3 * ((size_t)y * f.width + x));
+        }
+    /* AO pass and composite */
+    for (int y = 0; y < f.height; y++)
+        for (int x = 0; x < f.width; x++) {
+            size_t i = (size_t)y * f.width + x;
+            float ao = pos[4 * i + 3] > 0.0f ? obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i)
+                                             : 1.0f;
+            if (out->ao.data)
+                out->ao.data[i] = ao;
+            if (out->composite.data)
+                composite_pixel(gb->color.data ? obs__plane_px(&gb->color, f.width, x, y) : NULL,
+                                ao, out->composite.data + 4 * i);
+        }
+    free(pos);
+    free(nrm);
+    return OBS_OK;
+
+fail:
+    free(pos);
+    free(nrm);
+    obs_result_free(out);
+    return s;
+}

@@ -1,0 +1,127 @@
+/* The parameter table: lookup, parsing, ranges, defaults. */
+#include "testutil.h"
+
+#include "obscura.h"
+
+static void test_zero_means_defaults(void **state)
+{
+    (void)state;
+    obs_params in = {0}, p;
+    char err[OBS_ERR_LEN];
+    obs_params_resolve(&in, &p);
+    assert_float_equal(p.radius, 0.5f, 0.0f);
+    assert_int_equal(p.samples, 16);
+    assert_int_equal(p.depth_mode, OBS_DEPTH_PLANAR);
+    assert_int_equal(p.normal_space, OBS_NORMALS_WORLD);
+    assert_float_equal(p.unit_scale, 1.0f, 0.0f);
+    assert_float_equal(p.fov_y, 0.0f, 0.0f);
+    assert_int_equal(p.has_world_to_camera, 0);
+    assert_int_equal(obs_params_check(&p, err), OBS_OK);
+    /* NULL is the same as zeroed */
+    obs_params q;
+    obs_params_resolve(NULL, &q);
+    assert_memory_equal(&p, &q, sizeof p);
+}
+
+static void test_set_and_format(void **state)
+{
+    (void)state;
+    obs_params p = {0};
+    char err[OBS_ERR_LEN], buf[256];
+    assert_int_equal(obs_param_set(&p, "radius", "0.25", err), OBS_OK);
+    assert_float_equal(p.radius, 0.25f, 0.0f);
+    assert_int_equal(obs_param_set(&p, "samples", "8", err), OBS_OK);
+    assert_int_equal(p.samples, 8);
+    /* flags spell names with '-' */
+    assert_int_equal(obs_param_set(&p, "depth-mode", "radial", err), OBS_OK);
+    assert_int_equal(p.depth_mode, OBS_DEPTH_RADIAL);
+    assert_int_equal(obs_param_set(&p, "normal_space", "camera", err), OBS_OK);
+    assert_int_equal(p.normal_space, OBS_NORMALS_CAMERA);
+    obs_param_format(&p, obs_param_find("depth_mode"), buf, sizeof buf);
+    assert_string_equal(buf, "radial");
+    obs_param_format(&p, obs_param_find("samples"), buf, sizeof buf);
+    assert_string_equal(buf, "8");
+
+    assert_int_equal(obs_param_set(&p, "world-to-camera", "1,0,0,0, 0,1,0,0, 0,0,1,-5, 0,0,0,1", err),
+                     OBS_OK);
+    assert_int_equal(p.has_world_to_camera, 1);
+    assert_float_equal(p.world_to_camera[11], -5.0f, 0.0f);
+}
+
+static void test_errors_name_the_parameter(void **state)
+{
+    (void)state;
+    obs_params p = {0};
+    char err[OBS_ERR_LEN];
+    assert_int_equal(obs_param_set(&p, "samples", "64", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "samples"));
+    assert_non_null(strstr(err, "[2, 32]"));
+    assert_int_equal(obs_param_set(&p, "samples", "3.5", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_param_set(&p, "radius", "abc", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "radius"));
+    assert_int_equal(obs_param_set(&p, "radius", "-1", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_param_set(&p, "radius", "nan", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_param_set(&p, "radius", "1e999", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_param_set(&p, "depth_mode", "linear", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "planar|radial|ndc"));
+    assert_int_equal(obs_param_set(&p, "nope", "1", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "nope"));
+    assert_int_equal(obs_param_set(&p, "world_to_camera", "1,2,3", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_param_set(&p, "world_to_camera", "1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17", err),
+                     OBS_INVALID_ARGUMENT);
+    /* nothing was changed by the failed calls */
+    obs_params zero = {0};
+    assert_memory_equal(&p, &zero, sizeof p);
+
+    /* a struct filled by hand is checked field by field */
+    obs_params q;
+    obs_params_resolve(NULL, &q);
+    q.samples = 40;
+    assert_int_equal(obs_params_check(&q, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "samples"));
+    obs_params_resolve(NULL, &q);
+    q.depth_mode = 7;
+    assert_int_equal(obs_params_check(&q, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "depth_mode"));
+}
+
+static void test_table_is_complete(void **state)
+{
+    (void)state;
+    assert_true(obs_param_count() >= 9);
+    for (int i = 0; i < obs_param_count(); i++) {
+        const obs_param_info *pi = obs_param_at(i);
+        assert_non_null(pi->name);
+        assert_non_null(pi->doc);
+        assert_true(strlen(pi->doc) > 10);
+        assert_ptr_equal(obs_param_find(pi->name), pi);
+        if (pi->type == OBS_PARAM_ENUM)
+            assert_non_null(pi->choices);
+        if (pi->type == OBS_PARAM_FLOAT || pi->type == OBS_PARAM_INT)
+            assert_true(pi->min <= pi->max);
+    }
+    assert_null(obs_param_at(-1));
+    assert_null(obs_param_at(obs_param_count()));
+}
+
+static void test_status_names(void **state)
+{
+    (void)state;
+    assert_string_equal(obs_status_name(OBS_OK), "OK");
+    assert_string_equal(obs_status_name(OBS_MISSING_CHANNEL), "MISSING_CHANNEL");
+    assert_string_equal(obs_status_name((obs_status)999), "UNKNOWN");
+    for (int s = 0; s < OBS_STATUS_COUNT; s++)
+        assert_true(strlen(obs_status_message((obs_status)s)) > 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_zero_means_defaults),
+        cmocka_unit_test(test_set_and_format),
+        cmocka_unit_test(test_errors_name_the_parameter),
+        cmocka_unit_test(test_table_is_complete),
+        cmocka_unit_test(test_status_names),
+    };
+    return cmocka_run_group_tests_name("params", tests, NULL, NULL);
+}

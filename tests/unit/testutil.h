@@ -1,0 +1,40 @@
+/* Shared bits of the cmocka unit tests.  Tests run from the repository
+ * root (make unit does that), so data paths are relative to it. */
+#ifndef OBS_TESTUTIL_H
+#define OBS_TESTUTIL_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <cmocka.h>
+
+/* Small copies of real inputs, committed in the repository. */
+#define TESTDATA "tests/data"
+
+/* The larger shared data set; tests that use it skip when it is absent. */
+static inline const char *obs_test_shared(void)
+{
+    const char *s = getenv("OBSCURA_SHARED_DATA");
+    return s && *s ? s : "../shared/data";
+}
+
+static inline int obs_test_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+/* Where tests may write files (created by run_unit.sh). */
+static inline const char *obs_test_tmp(void)
+{
+    const char *s = getenv("OBSCURA_TEST_TMP");
+    return s && *s ? s : "/tmp";
+}
+
+#endif

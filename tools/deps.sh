@@ -1,0 +1,29 @@
+#!/bin/sh
+# Installs the Debian packages obscura's build and tests need, when any is
+# missing.  As root: apt-get.  Otherwise: prints the exact command.
+set -eu
+
+PKGS="build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libosmesa6-dev \
+libopenexr-dev libpng-dev libcjson-dev libcmocka-dev zlib1g-dev"
+
+missing=""
+for p in $PKGS; do
+    st=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+    case "$st" in
+        *"install ok installed"*) ;;
+        *) missing="$missing $p" ;;
+    esac
+done
+
+[ -z "$missing" ] && exit 0
+
+echo "deps: missing Debian packages:$missing"
+if [ "$(id -u)" -eq 0 ]; then
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -q
+    # shellcheck disable=SC2086
+    apt-get install -y -q --no-install-recommends $missing
+else
+    echo "deps: run as root:  apt-get install -y$missing" >&2
+    exit 1
+fi
