@@ -27,6 +27,8 @@ CPPFLAGS += -Icore -I$(BUILD)/gen
 ifeq ($(SAN),1)
 CFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 LDFLAGS += -fsanitize=address,undefined
+export LSAN_OPTIONS := suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0
+export UBSAN_OPTIONS := print_stacktrace=1:halt_on_error=1
 endif
 ifeq ($(DEBUG),1)
 CPPFLAGS += -DOBS_DEBUG=1
@@ -46,7 +48,7 @@ UNIT_BIN := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 LIB := $(BUILD)/libobscura.a
 CLI := $(BUILD)/obscura
 
-.PHONY: all deps demo test check unit e2e test-asan headers bench clean
+.PHONY: all deps demo demo-run test check unit e2e headers bench clean
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI)
@@ -79,7 +81,12 @@ $(BUILD)/tests/%: tests/unit/%.c $(LIB) tests/unit/testutil.h
 -include $(CORE_OBJ:.o=.d) $(CLI_OBJ:.o=.d)
 
 # ---- demo ---------------------------------------------------------------
-demo: deps all
+# The packages may only now have been installed: build in a fresh make, so
+# that pkg-config is asked again.
+demo: deps
+	@$(MAKE) --no-print-directory demo-run
+
+demo-run: all
 	@mkdir -p out
 	$(CLI) info
 	$(CLI) ao tests/data/room_small.exr --camera tests/data/room_small.camera.json \
@@ -115,7 +122,8 @@ headers:
 	done
 	@echo "headers: each public header compiles alone as C and C++"
 
-bench: deps all
+bench: deps
+	@$(MAKE) --no-print-directory all
 	@bench/run.sh
 
 clean:

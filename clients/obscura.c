@@ -61,6 +61,13 @@ static int fail(obs_status s, const char *what, const char *err)
     return status_exit(s);
 }
 
+/* A file that cannot be read is bad input too: retrying will not help. */
+static int input_fail(obs_status s, const char *what, const char *err)
+{
+    int rc = fail(s, what, err);
+    return s == OBS_IO ? EXIT_BADINPUT : rc;
+}
+
 static double now_ms(void)
 {
     struct timespec ts;
@@ -351,7 +358,7 @@ static int cmd_ao(int argc, char **argv)
     double t0 = now_ms();
     s = obs_gbuffer_read_exr(a.in, &a.map, &lim, &gf, err);
     if (s != OBS_OK)
-        return fail(s, a.in, err);
+        return input_fail(s, a.in, err);
     double t_read = now_ms() - t0;
     const obs_exr_info *info = &gf.info;
     if (verbosity >= OBS_LOG_INFO) {
@@ -364,7 +371,7 @@ static int cmd_ao(int argc, char **argv)
         int cw = 0, ch = 0;
         s = obs_camera_read_json(a.camera, &gf.gb.camera, &cw, &ch, err);
         if (s != OBS_OK) {
-            rc = fail(s, a.camera, err);
+            rc = input_fail(s, a.camera, err);
             goto done;
         }
         int dw = gf.gb.display_width > 0 ? gf.gb.display_width : gf.gb.width;

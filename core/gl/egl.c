@@ -136,7 +136,6 @@ obs_status obs__egl_create(int debug, int device, obs__backend_state *st,
 fail:
     if (gc != EGL_NO_CONTEXT)
         eglDestroyContext(dpy, gc);
-    eglTerminate(dpy);
     return s;
 }
 
@@ -156,7 +155,9 @@ void obs__egl_destroy(obs__backend_state *st)
     eglMakeCurrent(st->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (st->egl_context)
         eglDestroyContext(st->egl_display, st->egl_context);
-    eglTerminate(st->egl_display);
+    /* No eglTerminate: the display is per process and cheap to keep, and
+     * terminating it unloads Mesa's driver, which leaks its JIT state on
+     * every unload.  A context created later reuses the display. */
     eglReleaseThread();
     st->egl_display = st->egl_context = NULL;
 }

@@ -54,8 +54,13 @@ obs_status obs__osmesa_make_current(obs__backend_state *st)
 
 void obs__osmesa_destroy(obs__backend_state *st)
 {
-    if (st->osmesa)
+    if (st->osmesa) {
+        /* unbind first: a context destroyed while current keeps its
+         * framebuffer alive */
+        if (OSMesaGetCurrentContext() == (OSMesaContext)st->osmesa)
+            OSMesaMakeCurrent(NULL, NULL, 0, 0, 0);
         OSMesaDestroyContext((OSMesaContext)st->osmesa);
+    }
     free(st->osmesa_buf);
     st->osmesa = NULL;
     st->osmesa_buf = NULL;

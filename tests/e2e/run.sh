@@ -1,0 +1,139 @@
+#!/bin/sh
+# End-to-end tests of the obscura CLI: drives the real binary on real
+# G-buffers and checks its files, messages and exit codes.
+#
+#   OBSCURA=build/obscura tests/e2e/run.sh
+#
+# Uses tests/data always, and ../shared/data (OBSCURA_SHARED_DATA) when it
+# exists.  Prints one line per check; exits 1 if any check failed.
+set -u
+OBSCURA=${OBSCURA:-build/obscura}
+SHARED=${OBSCURA_SHARED_DATA:-../shared/data}
+DATA=tests/data
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+pass=0
+failed=0
+
+ok() { pass=$((pass + 1)); echo "  ok   $*"; }
+bad() { failed=$((failed + 1)); echo "  FAIL $*"; }
+
+# expect CODE DESCRIPTION -- command...: runs it, checks the exit code.
+expect() {
+    code=$1; what=$2; shift 3
+    "$@" >"$T/out" 2>"$T/err"
+    rc=$?
+    if [ "$rc" -eq "$code" ]; then ok "$what"; else
+        bad "$what (exit $rc, expected $code)"; sed 's/^/       /' "$T/err" | tail -5; fi
+}
+
+# stderr of the last command contains TEXT
+said() {
+    if grep -q -- "$1" "$T/err" "$T/out"; then ok "message: $1"; else
+        bad "message '$1' missing"; sed 's/^/       /' "$T/err" | tail -5; fi
+}
+
+# value of KEY in the JSON line of the last compare
+json() { sed -n "s/.*\"$1\": \([-0-9.e+]*\).*/\1/p" "$T/out"; }
+
+# AO of SCENE (stem) against the Cycles AO pass in the same file;
+# correlation must exceed 0.6.
+fidelity() {
+    stem=$1; name=$(basename "$stem")
+    expect 0 "ao $name" -- "$OBSCURA" ao "$stem.exr" --camera "$stem.camera.json" -o "$T/$name.exr"
+    expect 0 "ao $name as PNG" -- "$OBSCURA" ao "$stem.exr" --camera "$stem.camera.json" -o "$T/$name.png" -q
+    expect 0 "compare $name" -- "$OBSCURA" compare "$stem.exr" "$T/$name.exr" \
+        --channel-a ViewLayer.AO.R --channel-b AO.Y --json
+    corr=$(json corr); mse=$(json mse); ssim=$(json ssim)
+    echo "       $name vs Cycles AO: corr $corr, MSE $mse, SSIM $ssim"
+    if awk "BEGIN { exit !($corr > 0.6) }"; then ok "$name correlation $corr > 0.6"; else
+        bad "$name correlation $corr <= 0.6"; fi
+    mkdir -p out/e2e 2>/dev/null && cp "$T/$name.png" "out/e2e/${name}_ao.png" 2>/dev/null
+}
+
+echo "e2e: $OBSCURA"
+
+echo "-- info and usage"
+expect 0 "info" -- "$OBSCURA" info
+said "GL renderer"
+for b in egl-surfaceless osmesa; do
+    expect 0 "info --backend $b" -- "$OBSCURA" info --backend $b
+    said "backend: $b"
+done
+OBSCURA_BACKEND=osmesa expect 0 "OBSCURA_BACKEND=osmesa" -- "$OBSCURA" info
+said "backend: osmesa"
+expect 2 "unknown backend" -- "$OBSCURA" info --backend vulkan
+said "not one of"
+expect 0 "help" -- "$OBSCURA" help
+said "--radius"
+expect 2 "no arguments" -- "$OBSCURA"
+expect 2 "unknown command" -- "$OBSCURA" frobnicate
+expect 2 "no output file" -- "$OBSCURA" ao "$DATA/room_small.exr"
+said "no output file"
+expect 2 "parameter out of range" -- "$OBSCURA" ao "$DATA/room_small.exr" -o "$T/x.exr" --samples 64
+said "samples"
+expect 2 "unknown option" -- "$OBSCURA" ao "$DATA/room_small.exr" -o "$T/x.exr" --no-such-flag 1
+expect 2 "unknown output format" -- "$OBSCURA" ao "$DATA/room_small.exr" -o "$T/x.tif"
+
+echo "-- fidelity against the Cycles AO pass (small scenes, tests/data)"
+fidelity "$DATA/room_small"
+fidelity "$DATA/yard_small"
+if [ -d "$SHARED/blender" ]; then
+    echo "-- fidelity, full-size scenes ($SHARED/blender)"
+    fidelity "$SHARED/blender/room"
+    fidelity "$SHARED/blender/yard"
+else
+    echo "  skip full-size scenes: $SHARED/blender not found"
+fi
+
+echo "-- outputs"
+R="$DATA/room_small.exr"
+C="$DATA/room_small.camera.json"
+expect 0 "both to EXR" -- "$OBSCURA" ao "$R" --camera "$C" --output both -o "$T/both.exr" --float
+expect 0 "EXR has AO.Y and RGBA" -- "$OBSCURA" compare "$T/both.exr" "$T/both.exr" --channel-a AO.Y --channel-b R --mask none
+expect 0 "composite PNG 16-bit" -- "$OBSCURA" ao "$R" --camera "$C" --output composite --png-bits 16 -o "$T/c16.png"
+expect 0 "both to PNG" -- "$OBSCURA" ao "$R" --camera "$C" --output both -o "$T/pair.png"
+if [ -s "$T/pair.ao.png" ] && [ -s "$T/pair.composite.png" ]; then ok "both to PNG wrote two files"; else bad "both to PNG files missing"; fi
+expect 0 "CPU twin" -- "$OBSCURA" ao "$R" --camera "$C" --cpu -o "$T/cpu.exr" --float
+expect 0 "GL float" -- "$OBSCURA" ao "$R" --camera "$C" -o "$T/gl.exr" --float
+expect 0 "compare GL with CPU twin" -- "$OBSCURA" compare "$T/cpu.exr" "$T/gl.exr" --mask none --json
+mae=$(json mae)
+if awk "BEGIN { exit !($mae < 0.001) }"; then ok "GL vs CPU MAE $mae < 1e-3"; else bad "GL vs CPU MAE $mae"; fi
+expect 0 "osmesa backend" -- "$OBSCURA" ao "$R" --camera "$C" --backend osmesa -o "$T/osm.exr" --float
+expect 0 "compare osmesa with egl" -- "$OBSCURA" compare "$T/gl.exr" "$T/osm.exr" --mask none --json
+mae=$(json mae)
+if awk "BEGIN { exit !($mae < 1e-5) }"; then ok "osmesa vs egl-surfaceless MAE $mae < 1e-5"; else bad "osmesa vs egl MAE $mae"; fi
+
+echo "-- cameras and channel maps"
+expect 0 "preset + fov only (normals reconstructed)" -- "$OBSCURA" ao "$R" --preset blender --fov-y 50 -o "$T/fov.png" --output composite
+said "reconstructing normals"
+expect 3 "no camera at all" -- "$OBSCURA" ao "$R" -o "$T/x.exr"
+said "--fov-y"
+expect 0 "explicit channels" -- "$OBSCURA" ao "$R" --camera "$C" --depth ViewLayer.Depth.Z \
+    --normal ViewLayer.Normal.X,ViewLayer.Normal.Y,ViewLayer.Normal.Z --color ViewLayer.Combined.R,ViewLayer.Combined.G,ViewLayer.Combined.B -o "$T/x.exr"
+expect 3 "missing channel named" -- "$OBSCURA" ao "$R" --camera "$C" --depth Nope.Z -o "$T/x.exr"
+said "Nope.Z"
+expect 3 "generic preset on a Blender file" -- "$OBSCURA" ao "$R" --camera "$C" --preset generic -o "$T/x.exr"
+expect 3 "size limit" -- "$OBSCURA" ao "$R" --camera "$C" --max-size 100 -o "$T/x.exr"
+said "limit"
+expect 3 "missing input" -- "$OBSCURA" ao "$T/nope.exr" --camera "$C" -o "$T/x.exr"
+expect 1 "unwritable output" -- "$OBSCURA" ao "$R" --camera "$C" -o "$T/no/such/dir/x.exr"
+expect 3 "not an EXR" -- "$OBSCURA" ao "$C" --camera "$C" -o "$T/x.exr"
+printf '{"width": 3}' > "$T/badcam.json"
+expect 3 "bad camera JSON" -- "$OBSCURA" ao "$R" --camera "$T/badcam.json" -o "$T/x.exr"
+
+echo "-- damaged EXRs: a clear error, never a crash"
+n=0; crashed=0
+for f in "$DATA"/damaged/* ; do
+    case "$f" in *.rst) continue ;; esac
+    n=$((n + 1))
+    "$OBSCURA" ao "$f" --fov-y 50 -o "$T/d.exr" >"$T/out" 2>"$T/err"
+    rc=$?
+    if [ "$rc" -ne 3 ] && [ "$rc" -ne 0 ]; then
+        crashed=$((crashed + 1)); echo "       $f: exit $rc"; tail -3 "$T/err"
+    fi
+done
+if [ "$crashed" -eq 0 ]; then ok "$n damaged files: each rejected with exit 3 (or read)"; else bad "$crashed of $n damaged files crashed"; fi
+
+echo "e2e: $pass passed, $failed failed"
+[ "$failed" -eq 0 ]

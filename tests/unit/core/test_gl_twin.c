@@ -1,0 +1,206 @@
+/* The GL passes against their CPU twin on real input, EGL surfaceless
+ * against OSMesa, resource reuse across frames, and shader failures. */
+#include <math.h>
+
+#include "testutil.h"
+
+#include "gl/gl.h"
+#include "io.h"
+
+static const char *const scenes[] = {TESTDATA "/room_small", TESTDATA "/yard_small"};
+
+static void load(const char *stem, obs_gbuffer_file *gf)
+{
+    char path[512], err[OBS_ERR_LEN] = "";
+    snprintf(path, sizeof path, "%s.exr", stem);
+    if (obs_gbuffer_read_exr(path, NULL, NULL, gf, err) != OBS_OK)
+        fail_msg("%s: %s", path, err);
+    snprintf(path, sizeof path, "%s.camera.json", stem);
+    if (obs_camera_read_json(path, &gf->gb.camera, NULL, NULL, err) != OBS_OK)
+        fail_msg("%s: %s", path, err);
+}
+
+static obs_ctx *make_ctx(obs_backend b)
+{
+    obs_ctx *ctx = NULL;
+    char err[OBS_ERR_LEN] = "";
+    obs_ctx_desc d = {.backend = b};
+    if (obs_ctx_create(&d, &ctx, err) != OBS_OK)
+        fail_msg("%s: %s", obs_backend_name(b), err);
+    return ctx;
+}
+
+/* Mean |a - b| and the fraction of pixels differing by more than 1e-3. */
+static void diff(const obs_image *a, const obs_image *b, double *mean, double *frac)
+{
+    size_t n = (size_t)a->width * a->height * a->channels, big = 0;
+    double sum = 0;
+    assert_int_equal(a->width, b->width);
+    assert_int_equal(a->height, b->height);
+    for (size_t i = 0; i < n; i++) {
+        double d = fabs((double)a->data[i] - b->data[i]);
+        sum += d;
+        big += d > 1e-3;
+    }
+    *mean = sum / n;
+    *frac = (double)big / n;
+}
+
+/* GL and CPU do the same float arithmetic, but a sample that lands within
+ * rounding of a pixel border may read the neighbouring pixel's depth on
+ * one side and not the other, changing that pixel's AO by up to one
+ * sample's weight (~1/n).  So: the mean difference is tiny and few pixels
+ * differ at all (bounds: mean < 1e-3, fewer than 2 % of pixels > 1e-3). */
+static void test_gl_matches_cpu(void **state)
+{
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_EGL_SURFACELESS);
+    (void)state;
+    for (size_t s = 0; s < sizeof scenes / sizeof scenes[0]; s++) {
+        obs_gbuffer_file gf = {0};
+        obs_result gl, cpu;
+        char err[OBS_ERR_LEN] = "";
+        load(scenes[s], &gf);
+        unsigned out = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE;
+        assert_int_equal(obs_run(ctx, &gf.gb, NULL, out, &gl, err), OBS_OK);
+        assert_int_equal(obs_run_cpu(&gf.gb, NULL, out, &cpu, err), OBS_OK);
+        double mean, frac, cmean, cfrac;
+        diff(&gl.ao, &cpu.ao, &mean, &frac);
+        diff(&gl.composite, &cpu.composite, &cmean, &cfrac);
+        print_message("%s: GL vs CPU AO: mean |diff| %.2e, %.3f %% of pixels > 1e-3; composite mean %.2e\n",
+                      scenes[s], mean, 100 * frac, cmean);
+        assert_true(mean < 1e-3);
+        assert_true(frac < 0.02);
+        assert_true(cmean < 1e-3);
+        obs_result_free(&gl);
+        obs_result_free(&cpu);
+        obs_gbuffer_free(&gf);
+    }
+    obs_ctx_destroy(ctx);
+}
+
+/* Frames of one size reuse textures and framebuffers; a new size
+ * allocates once more; results do not depend on what ran before. */
+static void test_resources_reused(void **state)
+{
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_AUTO);
+    obs_gbuffer_file room = {0}, yard = {0};
+    obs_result a, b;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    load(scenes[0], &room);
+    load(scenes[1], &yard);
+    assert_int_equal(obs_run(ctx, &room.gb, NULL, OBS_OUTPUT_AO, &a, err), OBS_OK);
+    unsigned long after_first = ctx->gl_objects_created;
+    assert_true(after_first > 0);
+    obs_result_free(&a);
+    assert_int_equal(obs_run(ctx, &yard.gb, NULL, OBS_OUTPUT_AO, &a, err), OBS_OK);
+    assert_int_equal(ctx->gl_objects_created, after_first); /* same size: nothing new */
+    assert_int_equal(obs_run(ctx, &room.gb, NULL, OBS_OUTPUT_AO, &b, err), OBS_OK);
+    obs_result_free(&b);
+
+    /* a smaller frame: one new set of targets */
+    obs_gbuffer half = room.gb;
+    half.width = room.gb.width / 2;
+    half.height = room.gb.height / 2;
+    half.display_width = room.gb.width;
+    half.display_height = room.gb.height;
+    half.depth.row_stride = (size_t)room.gb.width * sizeof(float);
+    half.normal.row_stride = (size_t)room.gb.width * 3 * sizeof(float);
+    half.color.row_stride = (size_t)room.gb.width * 4 * sizeof(float);
+    assert_int_equal(obs_run(ctx, &half, NULL, OBS_OUTPUT_AO, &b, err), OBS_OK);
+    assert_int_equal(ctx->gl_objects_created, 2 * after_first);
+    /* the top-left quarter as a sub-window gives the same AO as the CPU
+     * twin on the same sub-window (strides and display offsets honoured) */
+    obs_result c;
+    assert_int_equal(obs_run_cpu(&half, NULL, OBS_OUTPUT_AO, &c, err), OBS_OK);
+    double mean, frac;
+    diff(&b.ao, &c.ao, &mean, &frac);
+    assert_true(mean < 1e-3);
+    obs_result_free(&b);
+    obs_result_free(&c);
+
+    /* the yard frame again: identical to its first run */
+    assert_int_equal(obs_run(ctx, &yard.gb, NULL, OBS_OUTPUT_AO, &b, err), OBS_OK);
+    assert_memory_equal(a.ao.data, b.ao.data, sizeof(float) * a.ao.width * a.ao.height);
+    obs_result_free(&a);
+    obs_result_free(&b);
+    obs_gbuffer_free(&room);
+    obs_gbuffer_free(&yard);
+    obs_ctx_destroy(ctx);
+}
+
+/* A shader that does not compile is a status carrying the info log. */
+static void test_shader_failure_is_a_status(void **state)
+{
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_AUTO);
+    char err[OBS_ERR_LEN] = "";
+    GLuint prog = 0;
+    (void)state;
+    assert_int_equal(obs__ctx_bind(ctx, err), OBS_OK);
+    const char *vert = "#version 430 core\nvoid main() { gl_Position = vec4(0.0); }\n";
+    const char *frag[] = {"#version 430 core\nout vec4 o;\nvoid main() { o = undefined_thing; }\n"};
+    assert_int_equal(obs__gl_program("broken", vert, frag, 1, &prog, err), OBS_GL_SHADER);
+    print_message("shader failure: %s\n", err);
+    assert_non_null(strstr(err, "broken"));
+    assert_non_null(strstr(err, "undefined_thing"));
+    assert_int_equal(prog, 0);
+    obs_ctx_destroy(ctx);
+}
+
+/* Bad G-buffers and parameters are refused before any GL work. */
+static void test_bad_input(void **state)
+{
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_AUTO);
+    obs_gbuffer_file gf = {0};
+    obs_result r;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    load(scenes[0], &gf);
+
+    obs_gbuffer g = gf.gb;
+    g.depth.data = NULL;
+    assert_int_equal(obs_run(ctx, &g, NULL, OBS_OUTPUT_AO, &r, err), OBS_MISSING_CHANNEL);
+    assert_non_null(strstr(err, "depth"));
+    g = gf.gb;
+    g.normal.channels = 4;
+    assert_int_equal(obs_run(ctx, &g, NULL, OBS_OUTPUT_AO, &r, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "normal"));
+    g = gf.gb;
+    g.width = 0;
+    assert_int_equal(obs_run(ctx, &g, NULL, OBS_OUTPUT_AO, &r, err), OBS_BAD_FILE);
+    g = gf.gb;
+    g.width = 20000;
+    assert_int_equal(obs_run(ctx, &g, NULL, OBS_OUTPUT_AO, &r, err), OBS_TOO_LARGE);
+    g = gf.gb;
+    g.depth.row_stride = 4;
+    assert_int_equal(obs_run(ctx, &g, NULL, OBS_OUTPUT_AO, &r, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "stride"));
+    g = gf.gb;
+    memset(&g.camera, 0, sizeof g.camera);
+    assert_int_equal(obs_run(ctx, &g, NULL, OBS_OUTPUT_AO, &r, err), OBS_NO_CAMERA);
+    assert_non_null(strstr(err, "--fov-y"));
+
+    obs_params p;
+    obs_params_resolve(NULL, &p);
+    p.samples = 33;
+    assert_int_equal(obs_run(ctx, &gf.gb, &p, OBS_OUTPUT_AO, &r, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "samples"));
+    assert_int_equal(obs_run(ctx, &gf.gb, NULL, 0, &r, err), OBS_INVALID_ARGUMENT);
+
+    /* and the context still works afterwards */
+    assert_int_equal(obs_run(ctx, &gf.gb, NULL, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    obs_result_free(&r);
+    obs_gbuffer_free(&gf);
+    obs_ctx_destroy(ctx);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_gl_matches_cpu),
+        cmocka_unit_test(test_resources_reused),
+        cmocka_unit_test(test_shader_failure_is_a_status),
+        cmocka_unit_test(test_bad_input),
+    };
+    return cmocka_run_group_tests_name("gl_twin", tests, NULL, NULL);
+}
