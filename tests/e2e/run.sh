@@ -60,6 +60,13 @@ for b in egl-surfaceless osmesa; do
     expect 0 "info --backend $b" -- "$OBSCURA" info --backend $b
     said "backend: $b"
 done
+# egl-device needs a real GPU: it works, or says why not (exit 1)
+"$OBSCURA" info --backend egl-device >"$T/out" 2>"$T/err"
+case $? in
+    0) ok "egl-device: $(grep renderer "$T/out")" ;;
+    1) if grep -q "egl-device" "$T/err"; then ok "egl-device unavailable, said why: $(cat "$T/err")"; else bad "egl-device failed silently"; fi ;;
+    *) bad "egl-device crashed" ;;
+esac
 OBSCURA_BACKEND=osmesa expect 0 "OBSCURA_BACKEND=osmesa" -- "$OBSCURA" info
 said "backend: osmesa"
 expect 2 "unknown backend" -- "$OBSCURA" info --backend vulkan
