@@ -5,6 +5,7 @@
 #   make demo     run the bundled example (no daemon)
 #   make test     unit + end-to-end tests, then the same under ASan/UBSan
 #   make bench    benchmarks (bench/RESULTS.md)
+#   make readme   regenerate README.md's parameter table
 #
 # BUILD selects the output folder, so the sanitizer build lives beside the
 # normal one: make BUILD=build/asan SAN=1.
@@ -47,11 +48,16 @@ UNIT_BIN := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
 LIB := $(BUILD)/libobscura.a
 CLI := $(BUILD)/obscura
+BENCH := $(BUILD)/frame_bench
 
-.PHONY: all deps demo demo-run test check unit e2e headers bench clean
+# The daemon and the wire protocol bring their own rules; they add their
+# binaries to `all` and their e2e prerequisites to E2E_DEPS.
+-include protocol/protocol.mk daemon/daemon.mk
+
+.PHONY: all deps demo demo-run test check unit e2e headers readme readme-check bench clean
 .DEFAULT_GOAL := all
 
-all: $(LIB) $(CLI)
+all: $(LIB) $(CLI) $(EXTRA_BINS)
 
 # ---- dependencies -------------------------------------------------------
 deps:
@@ -74,11 +80,16 @@ $(LIB): $(CORE_OBJ)
 $(CLI): $(CLI_OBJ) $(LIB)
 	$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(PKG_LIBS)
 
-$(BUILD)/tests/%: tests/unit/%.c $(LIB) tests/unit/testutil.h
+$(BENCH): bench/frame_bench.c $(LIB)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
+# PROTO_LIB and EXTRA_LIBS come from protocol.mk / daemon.mk when present.
+$(BUILD)/tests/%: tests/unit/%.c $(PROTO_LIB) $(LIB) tests/unit/testutil.h
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS) -lcmocka
+	$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) $(EXTRA_LIBS) -lcmocka
 
 -include $(CORE_OBJ:.o=.d) $(CLI_OBJ:.o=.d)
+
 
 # ---- demo ---------------------------------------------------------------
 # The packages may only now have been installed: build in a fresh make, so
@@ -103,13 +114,23 @@ test: deps
 	$(MAKE) check
 	$(MAKE) check BUILD=build/asan SAN=1
 
-check: all headers unit e2e
+check: all headers unit e2e readme-check
+
+# The README's parameter table is generated from the parameter table.
+readme: $(CLI)
+	tools/readme_params.sh $(CLI) README.md
+
+readme-check: $(CLI)
+	@tools/readme_params.sh --check $(CLI) README.md && echo "readme: parameter table up to date"
 
 unit: $(UNIT_BIN)
 	@tests/run_unit.sh $(UNIT_BIN)
 
-e2e: $(CLI)
-	@OBSCURA=$(CLI) tests/e2e/run.sh
+# Every tests/e2e/*.sh runs with the binaries' paths in the environment.
+E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)
+
+e2e: $(CLI) $(E2E_DEPS)
+	@set -e; for t in tests/e2e/*.sh; do $(E2E_ENV) $$t; done
 
 # Every public header compiles alone, as C and as C++.
 headers:
@@ -123,8 +144,8 @@ headers:
 	@echo "headers: each public header compiles alone as C and C++"
 
 bench: deps
-	@$(MAKE) --no-print-directory all
-	@bench/run.sh
+	@$(MAKE) --no-print-directory all $(BENCH)
+	@BUILD=$(BUILD) bench/run.sh
 
 clean:
 	rm -rf build out

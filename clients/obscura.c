@@ -56,8 +56,11 @@ static int status_exit(obs_status s)
 
 static int fail(obs_status s, const char *what, const char *err)
 {
-    fprintf(stderr, "obscura: %s: %s (%s)\n", what, err && *err ? err : obs_status_message(s),
-            obs_status_name(s));
+    const char *msg = err && *err ? err : obs_status_message(s);
+    if (strncmp(msg, what, strlen(what)) == 0) /* the message names it already */
+        fprintf(stderr, "obscura: %s (%s)\n", msg, obs_status_name(s));
+    else
+        fprintf(stderr, "obscura: %s: %s (%s)\n", what, msg, obs_status_name(s));
     return status_exit(s);
 }
 
@@ -466,6 +469,10 @@ static int cmd_params(int argc, char **argv)
             snprintf(range, sizeof range, "%g .. %g", pi->min, pi->max);
         else if (pi->type == OBS_PARAM_ENUM)
             snprintf(range, sizeof range, "%s", pi->choices);
+        if (markdown) /* '|' would end a Markdown table cell */
+            for (char *c = range; *c; c++)
+                if (*c == '|')
+                    *c = '/';
         char flag[48];
         snprintf(flag, sizeof flag, "--%s", pi->name);
         for (char *c = flag; *c; c++)

@@ -1,0 +1,158 @@
+/* Frame timing: one context, many frames, medians.
+ *
+ *   frame_bench [--backend B] [--frames N] G-BUFFER.exr CAMERA.json...
+ *
+ * For each G-buffer (and a 1920x1080 nearest-neighbour upscale of it):
+ * the first frame (shaders compiled, targets allocated), the median of N
+ * warm frames at 8/16/32 samples, and the CPU twin at 16 samples, all in
+ * one run so the ratios are comparable.  Output is a Markdown table. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "io.h"
+#include "obscura.h"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+static int cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median_run(obs_ctx *ctx, const obs_gbuffer *gb, int samples, int frames, int cpu)
+{
+    double t[64];
+    char err[OBS_ERR_LEN];
+    obs_params p = {0};
+    p.samples = samples;
+    if (frames > 64)
+        frames = 64;
+    for (int i = 0; i < frames; i++) {
+        obs_result r;
+        double t0 = now_ms();
+        obs_status s = cpu ? obs_run_cpu(gb, &p, OBS_OUTPUT_AO, &r, err)
+                           : obs_run(ctx, gb, &p, OBS_OUTPUT_AO, &r, err);
+        t[i] = now_ms() - t0;
+        if (s != OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            exit(1);
+        }
+        obs_result_free(&r);
+    }
+    qsort(t, (size_t)frames, sizeof t[0], cmp);
+    return t[frames / 2];
+}
+
+/* Nearest-neighbour upscale of every plane to w x h (same camera). */
+static float *upscale(const obs_plane *p, int sw, int sh, int w, int h)
+{
+    if (!p->data)
+        return NULL;
+    float *out = malloc(sizeof(float) * (size_t)w * h * p->channels);
+    size_t stride = p->row_stride ? p->row_stride : sizeof(float) * (size_t)sw * p->channels;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float *src = (const float *)((const char *)p->data + (size_t)(y * sh / h) * stride) +
+                               (size_t)(x * sw / w) * p->channels;
+            memcpy(out + ((size_t)y * w + x) * p->channels, src, sizeof(float) * p->channels);
+        }
+    return out;
+}
+
+static void bench(obs_ctx *ctx, const char *name, const obs_gbuffer *gb, int frames, int with_cpu)
+{
+    char err[OBS_ERR_LEN];
+    obs_result r;
+    double t0 = now_ms();
+    if (obs_run(ctx, gb, NULL, OBS_OUTPUT_AO, &r, err) != OBS_OK) {
+        fprintf(stderr, "frame_bench: %s\n", err);
+        exit(1);
+    }
+    double first = now_ms() - t0;
+    obs_result_free(&r);
+    double m8 = median_run(ctx, gb, 8, frames, 0);
+    double m16 = median_run(ctx, gb, 16, frames, 0);
+    double m32 = median_run(ctx, gb, 32, frames, 0);
+    printf("| %s | %dx%d | %.1f | %.1f | %.1f | %.1f |", name, gb->width, gb->height, first, m8, m16,
+           m32);
+    if (with_cpu) {
+        double c16 = median_run(ctx, gb, 16, 3, 1);
+        printf(" %.1f (%.1fx) |\n", c16, c16 / m16);
+    } else {
+        printf(" - |\n");
+    }
+    fflush(stdout);
+}
+
+int main(int argc, char **argv)
+{
+    obs_ctx_desc desc = {0};
+    int frames = 15;
+    int i = 1;
+    for (; i < argc && argv[i][0] == '-'; i++) {
+        if (!strcmp(argv[i], "--backend") && i + 1 < argc)
+            obs_backend_parse(argv[++i], &desc.backend);
+        else if (!strcmp(argv[i], "--frames") && i + 1 < argc)
+            frames = atoi(argv[++i]);
+    }
+    if (argc - i < 2 || (argc - i) % 2) {
+        fprintf(stderr, "usage: frame_bench [--backend B] [--frames N] GBUFFER.exr CAMERA.json...\n");
+        return 2;
+    }
+    char err[OBS_ERR_LEN];
+    obs_ctx *ctx;
+    double t0 = now_ms();
+    if (obs_ctx_create(&desc, &ctx, err) != OBS_OK) {
+        fprintf(stderr, "frame_bench: %s\n", err);
+        return 1;
+    }
+    double t_ctx = now_ms() - t0;
+    obs_ctx_info info;
+    obs_ctx_get_info(ctx, &info);
+    printf("backend %s, %s, %s; context created in %.1f ms; median of %d warm frames "
+           "(upload + passes + readback of AO)\n\n",
+           obs_backend_name(info.backend), info.gl_version, info.gl_renderer, t_ctx, frames);
+    printf("| G-buffer | size | first frame ms (16 samples, compiles shaders) | 8 samples ms | 16 samples ms | "
+           "32 samples ms | CPU twin 16 samples ms (x GL) |\n|---|---|---|---|---|---|---|\n");
+    for (; i + 1 < argc; i += 2) {
+        obs_gbuffer_file gf = {0};
+        if (obs_gbuffer_read_exr(argv[i], NULL, NULL, &gf, err) != OBS_OK ||
+            obs_camera_read_json(argv[i + 1], &gf.gb.camera, NULL, NULL, err) != OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            return 1;
+        }
+        const char *base = strrchr(argv[i], '/') ? strrchr(argv[i], '/') + 1 : argv[i];
+        bench(ctx, base, &gf.gb, frames, 1);
+
+        /* the same frame at 1920x1080 */
+        obs_gbuffer big = gf.gb;
+        int w = 1920, h = 1080;
+        float *d = upscale(&gf.gb.depth, gf.gb.width, gf.gb.height, w, h);
+        float *n = upscale(&gf.gb.normal, gf.gb.width, gf.gb.height, w, h);
+        float *c = upscale(&gf.gb.color, gf.gb.width, gf.gb.height, w, h);
+        big.width = w;
+        big.height = h;
+        big.display_width = big.display_height = 0;
+        big.display_x = big.display_y = 0;
+        big.depth = (obs_plane){d, 1, 0};
+        big.normal = (obs_plane){n, 3, 0};
+        big.color = (obs_plane){c, 4, 0};
+        char name[256];
+        snprintf(name, sizeof name, "%s upscaled", base);
+        bench(ctx, name, &big, frames, 0);
+        free(d);
+        free(n);
+        free(c);
+        obs_gbuffer_free(&gf);
+    }
+    obs_ctx_destroy(ctx);
+    return 0;
+}

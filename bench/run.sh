@@ -1,0 +1,17 @@
+#!/bin/sh
+# make bench: frame timings on this machine.  Reads the full-size scenes
+# from ../shared/data when present, else the small copies in tests/data.
+set -eu
+BUILD=${BUILD:-build}
+SHARED=${OBSCURA_SHARED_DATA:-../shared/data}
+if [ -d "$SHARED/blender" ]; then
+    set -- "$SHARED/blender/room.exr" "$SHARED/blender/room.camera.json" \
+           "$SHARED/blender/yard.exr" "$SHARED/blender/yard.camera.json"
+else
+    echo "bench: $SHARED/blender not found; using the small scenes in tests/data" >&2
+    set -- tests/data/room_small.exr tests/data/room_small.camera.json \
+           tests/data/yard_small.exr tests/data/yard_small.camera.json
+fi
+echo "## $(date -u +%Y-%m-%d) $(uname -m), $(nproc) cores"
+echo
+"$BUILD/frame_bench" "$@"
