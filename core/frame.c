@@ -81,6 +81,11 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     f->radius = p->radius / p->unit_scale;
     f->samples = p->samples;
     f->sample_xy = obs__samples(p->samples);
+    f->range_check = p->range_check == OBS_ON;
+    f->range_u = p->range_u;
+    f->blur_radius = p->blur == OBS_ON ? p->blur_radius : 0;
+    for (int k = 0; k <= f->blur_radius; k++) /* section 4.6: Gaussian kernel */
+        f->blur_w[k] = expf(-(float)(k * k) / (2.0f * p->blur_sigma * p->blur_sigma));
     for (int k = 0; k < 9; k++)
         obs__pixel_rotation(k / 3, k % 3, &f->rot[k][0], &f->rot[k][1]);
 

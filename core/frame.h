@@ -11,6 +11,10 @@
  * or <= 0 is background: no geometry, AO 1, never an occluder. */
 #define OBS__SKY_DEPTH 1e9f
 
+/* Largest blur_radius of the parameter table (uniform array size - 1 in
+ * blur.frag.glsl). */
+#define OBS__MAX_BLUR 16
+
 typedef struct obs__frame {
     int width, height;
     float viewport[4];      /* display_x, display_y, display_width, display_height */
@@ -22,6 +26,10 @@ typedef struct obs__frame {
     int samples;
     const float *sample_xy; /* samples * (x, y) on the unit disk */
     float rot[9][2];        /* (cos, sin) of the 3x3 tile's rotations */
+    int range_check;        /* 1: depth range check (section 4.4, eq 4) */
+    float range_u;          /* u of eq 4 */
+    int blur_radius;        /* low-pass filter half-width (section 4.6); 0: off */
+    float blur_w[OBS__MAX_BLUR + 1]; /* Gaussian weight of offset 0..blur_radius */
 } obs__frame;
 
 /* Resolves camera, parameters and normal handling for one frame. */
@@ -47,5 +55,15 @@ void obs__prep_normal(const obs__frame *f, const float *pos, const float *in_nor
  * of VAO++ section 3; `pos` is the prep pass's position plane. */
 float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                      const float n[3]);
+
+/* Low-pass filter, VAO++ section 4.6 (GLSL: blur.frag.glsl): one pass of
+ * the depth-aware cross-bilateral Gaussian along (dx, dy) at pixel (x, y)
+ * of the AO plane `ao`; `pos` gives each pixel's view depth (w). */
+float obs__blur_pixel(const obs__frame *f, const float *pos, const float *ao, int x, int y, int dx,
+                      int dy);
+
+/* Both passes over the whole plane, horizontal then vertical, in place in
+ * `ao`; `tmp` holds width * height floats. */
+void obs__blur(const obs__frame *f, const float *pos, float *ao, float *tmp);
 
 #endif

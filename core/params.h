@@ -25,6 +25,12 @@ typedef enum obs_depth_mode {
     OBS_DEPTH_NDC     /* OpenGL depth-buffer value in [0,1] */
 } obs_depth_mode;
 
+typedef enum obs_switch {
+    OBS_SWITCH_DEFAULT,
+    OBS_ON,
+    OBS_OFF
+} obs_switch;
+
 typedef enum obs_normal_space {
     OBS_NORMALS_DEFAULT,
     OBS_NORMALS_WORLD,  /* world space: rotated by world_to_camera */
@@ -56,7 +62,26 @@ typedef enum obs_normal_space {
       "far clip distance, used with fov_y")                                    \
     X(world_to_camera, MAT4, 0, 0, 0, NULL,                                    \
       "16 numbers, row-major, column-vector convention: world to camera "      \
-      "(-Z forward); overrides the file's camera rotation")
+      "(-Z forward); overrides the file's camera rotation")                    \
+    X(range_check, ENUM, "on", 0, 0, "on|off",                                 \
+      "depth range check (VAO++ 4.4, eq 4): a pipe hidden behind a surface "   \
+      "counts as occluded only by the falloff s(d) = u / max(u, d/radius), "   \
+      "d its distance behind that surface; off: occluders are infinitely "     \
+      "thick")                                                                 \
+    X(range_u, FLOAT, 0.03, 1e-4, 1.0, NULL,                                   \
+      "u of the depth range check's falloff (eq 4): occluders are taken as "   \
+      "fully thick up to u * radius behind the visible surface")               \
+    X(blur, ENUM, "on", 0, 0, "on|off",                                        \
+      "low-pass filter (VAO++ 4.6): depth-aware cross-bilateral Gaussian "     \
+      "blur of the AO, a horizontal then a vertical pass; neighbours whose "   \
+      "view depth differs from the centre's by more than radius are left out") \
+    X(blur_radius, INT, 2, 1, 16, NULL,                                        \
+      "blur kernel half-width in pixels (the kernel is 2 * blur_radius + 1 "   \
+      "taps per pass)")                                                        \
+    X(blur_sigma, FLOAT, 1.25, 0.1, 64.0, NULL,                                \
+      "standard deviation of the blur's Gaussian in pixels; with the default " \
+      "radius 2, sigma 1.25 nulls the period-3 pattern of the 3x3 rotation "   \
+      "tile (exp(-1/2s^2) + exp(-4/2s^2) = 1)")
 
 #define OBS__PDECL_FLOAT(n) float n;
 #define OBS__PDECL_INT(n) int n;

@@ -16,10 +16,13 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
         return OBS_OK;
     const char *prep[] = {glsl_version, obs__shader_common, obs__shader_prep_frag};
     const char *vao[] = {glsl_version, obs__shader_common, obs__shader_vao_frag};
+    const char *blur[] = {glsl_version, obs__shader_common, obs__shader_blur_frag};
     const char *comp[] = {glsl_version, obs__shader_composite_frag};
     obs_status s = obs__gl_program("prep", obs__shader_fullscreen_vert, prep, 3, &ctx->prog.prep, err);
     if (s == OBS_OK)
         s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 3, &ctx->prog.vao, err);
+    if (s == OBS_OK)
+        s = obs__gl_program("blur", obs__shader_fullscreen_vert, blur, 3, &ctx->prog.blur, err);
     if (s == OBS_OK)
         s = obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2, &ctx->prog.composite,
                             err);
@@ -60,8 +63,8 @@ void obs__frame_release(obs_ctx *ctx)
 {
     obs__targets *t = &ctx->tg;
     GLuint tex[] = {t->tex_depth, t->tex_normal, t->tex_color, t->tex_viewpos,
-                    t->tex_vnormal, t->tex_ao, t->tex_composite};
-    GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_composite};
+                    t->tex_vnormal, t->tex_ao, t->tex_composite, t->tex_blur};
+    GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite};
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
     memset(t, 0, sizeof *t);
@@ -69,6 +72,8 @@ void obs__frame_release(obs_ctx *ctx)
         glDeleteProgram(ctx->prog.prep);
     if (ctx->prog.vao)
         glDeleteProgram(ctx->prog.vao);
+    if (ctx->prog.blur)
+        glDeleteProgram(ctx->prog.blur);
     if (ctx->prog.composite)
         glDeleteProgram(ctx->prog.composite);
     memset(&ctx->prog, 0, sizeof ctx->prog);
@@ -93,10 +98,13 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     t->tex_vnormal = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_ao = make_texture(ctx, GL_R32F, w, h);
     t->tex_composite = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_blur = make_texture(ctx, GL_R32F, w, h);
     GLuint prep[] = {t->tex_viewpos, t->tex_vnormal};
     obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 2, "prep", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_ao, &t->tex_ao, 1, "ao", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_blur, &t->tex_blur, 1, "blur", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_composite, &t->tex_composite, 1, "composite", err);
     if (s == OBS_OK)
@@ -214,7 +222,26 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     glUniform1i(glGetUniformLocation(prog, "u_count"), f.samples);
     glUniform2fv(glGetUniformLocation(prog, "u_samples"), f.samples, f.sample_xy);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f.rot[0][0]);
+    glUniform1i(glGetUniformLocation(prog, "u_range_check"), f.range_check);
+    glUniform1f(glGetUniformLocation(prog, "u_range_u"), f.range_u);
     draw(ctx, t->fbo_ao, w, h);
+
+    /* low-pass filter (section 4.6): ao -> blur along x -> ao along y */
+    if (f.blur_radius > 0) {
+        prog = ctx->prog.blur;
+        glUseProgram(prog);
+        set_common(prog, &f);
+        bind_tex(prog, "u_pos", 1, t->tex_viewpos);
+        glUniform1i(glGetUniformLocation(prog, "u_blur_radius"), f.blur_radius);
+        glUniform1fv(glGetUniformLocation(prog, "u_blur_w"), f.blur_radius + 1, f.blur_w);
+        glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
+        bind_tex(prog, "u_ao", 0, t->tex_ao);
+        glUniform2i(glGetUniformLocation(prog, "u_dir"), 1, 0);
+        draw(ctx, t->fbo_blur, w, h);
+        bind_tex(prog, "u_ao", 0, t->tex_blur);
+        glUniform2i(glGetUniformLocation(prog, "u_dir"), 0, 1);
+        draw(ctx, t->fbo_ao, w, h);
+    }
 
     if (outputs & OBS_OUTPUT_COMPOSITE) {
         prog = ctx->prog.composite;

@@ -180,7 +180,19 @@ float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const 
         /* Unoccluded length of the pipe (cases A, B, C of section 3):
          * the pipe spans depths [-c.z - h, -c.z + h]. */
         float front = -c[2] - h;
-        open += fminf(fmaxf(zs - front, 0.0f), 2.0f * h);
+        float dz = fminf(fmaxf(zs - front, 0.0f), 2.0f * h);
+        if (f->range_check && zs < front) {
+            /* Case C with the depth range check, section 4.4, eq 4: the
+             * pipe lies d behind the visible surface; the occluder is
+             * thick only by the falloff s(d) = u / max(u, d / radius), so
+             * the pipe's weight 2h counts as occluded times s(d).  d is
+             * taken from the pipe's near end, so s = 1 where case C meets
+             * case A (zs = front) and the two join without a step. */
+            float d = front - zs;
+            float sd = f->range_u / fmaxf(f->range_u, d / R);
+            dz = 2.0f * h * (1.0f - sd);
+        }
+        open += dz;
     }
     return F > 0.0f ? open / F : 1.0f; /* eq 1: V = (1/F) sum dz_i */
 }
@@ -239,7 +251,7 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
 {
     obs_params p;
     obs__frame f;
-    float *pos = NULL, *nrm = NULL;
+    float *pos = NULL, *nrm = NULL, *ao = NULL, *tmp = NULL;
     obs_status s;
 
     memset(out, 0, sizeof *out);
@@ -253,7 +265,9 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
     size_t npx = (size_t)f.width * (size_t)f.height;
     pos = malloc(npx * 4 * sizeof(float));
     nrm = malloc(npx * 3 * sizeof(float));
-    if (!pos || !nrm) {
+    ao = malloc(npx * sizeof(float));
+    tmp = malloc(npx * sizeof(float));
+    if (!pos || !nrm || !ao || !tmp) {
         s = obs__fail(err, OBS_NO_MEMORY, "out of memory for a %dx%d frame", f.width, f.height);
         goto fail;
     }
@@ -271,25 +285,35 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
             const float *in = gb->normal.data ? obs__plane_px(&gb->normal, f.width, x, y) : NULL;
             obs__prep_normal(&f, pos, in, x, y, nrm + 3 * ((size_t)y * f.width + x));
         }
-    /* AO pass and composite */
+    /* AO pass */
     for (int y = 0; y < f.height; y++)
         for (int x = 0; x < f.width; x++) {
             size_t i = (size_t)y * f.width + x;
-            float ao = pos[4 * i + 3] > 0.0f ? obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i)
-                                             : 1.0f;
-            if (out->ao.data)
-                out->ao.data[i] = ao;
-            if (out->composite.data)
-                composite_pixel(gb->color.data ? obs__plane_px(&gb->color, f.width, x, y) : NULL,
-                                ao, out->composite.data + 4 * i);
+            ao[i] = pos[4 * i + 3] > 0.0f ? obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i)
+                                          : 1.0f;
         }
+    /* low-pass filter (section 4.6), then composite */
+    obs__blur(&f, pos, ao, tmp);
+    if (out->ao.data)
+        memcpy(out->ao.data, ao, npx * sizeof(float));
+    if (out->composite.data)
+        for (int y = 0; y < f.height; y++)
+            for (int x = 0; x < f.width; x++) {
+                size_t i = (size_t)y * f.width + x;
+                composite_pixel(gb->color.data ? obs__plane_px(&gb->color, f.width, x, y) : NULL,
+                                ao[i], out->composite.data + 4 * i);
+            }
     free(pos);
     free(nrm);
+    free(ao);
+    free(tmp);
     return OBS_OK;
 
 fail:
     free(pos);
     free(nrm);
+    free(ao);
+    free(tmp);
     obs_result_free(out);
     return s;
 }

@@ -38,6 +38,7 @@
     X(PFNGLUNIFORM1IPROC, Uniform1i)                                           \
     X(PFNGLUNIFORM1FPROC, Uniform1f)                                           \
     X(PFNGLUNIFORM2IPROC, Uniform2i)                                           \
+    X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                         \
     X(PFNGLUNIFORM2FVPROC, Uniform2fv)                                         \
     X(PFNGLUNIFORM4FVPROC, Uniform4fv)                                         \
     X(PFNGLUNIFORMMATRIX3FVPROC, UniformMatrix3fv)                             \
@@ -104,6 +105,7 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glUniform1i obs__glp->Uniform1i
 #define glUniform1f obs__glp->Uniform1f
 #define glUniform2i obs__glp->Uniform2i
+#define glUniform1fv obs__glp->Uniform1fv
 #define glUniform2fv obs__glp->Uniform2fv
 #define glUniform4fv obs__glp->Uniform4fv
 #define glUniformMatrix3fv obs__glp->UniformMatrix3fv
@@ -148,7 +150,7 @@ obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 /* ---- the per-resolution frame resources and programs -------------------- */
 
 typedef struct obs__programs {
-    GLuint prep, vao, composite;
+    GLuint prep, vao, blur, composite;
 } obs__programs;
 
 typedef struct obs__targets {
@@ -156,7 +158,8 @@ typedef struct obs__targets {
     GLuint tex_depth, tex_normal, tex_color;  /* inputs */
     GLuint tex_viewpos, tex_vnormal;          /* prep outputs */
     GLuint tex_ao, tex_composite;             /* results */
-    GLuint fbo_prep, fbo_ao, fbo_composite;
+    GLuint tex_blur;                          /* between the two blur passes */
+    GLuint fbo_prep, fbo_ao, fbo_blur, fbo_composite;
 } obs__targets;
 
 struct obs_ctx {

@@ -10,6 +10,8 @@ uniform float u_radius;          // R, in depth units
 uniform int u_count;             // samples
 uniform vec2 u_samples[32];      // unit disk
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
+uniform int u_range_check;       // 1: depth range check (section 4.4, eq 4)
+uniform float u_range_u;         // u of eq 4
 
 out float o_ao;
 
@@ -50,7 +52,17 @@ void main()
         }
         // Unoccluded length of the pipe (cases A, B, C of section 3).
         float front = -c.z - h;
-        open += min(max(zs - front, 0.0), 2.0 * h);
+        float dz = min(max(zs - front, 0.0), 2.0 * h);
+        if (u_range_check != 0 && zs < front) {
+            // Case C with the depth range check, section 4.4, eq 4:
+            // s(d) = u / max(u, d / radius), d behind the visible surface,
+            // measured from the pipe's near end (s = 1 where case C meets
+            // case A); the occluded weight 2h is multiplied by s(d).
+            float d = front - zs;
+            float sd = u_range_u / max(u_range_u, d / R);
+            dz = 2.0 * h * (1.0 - sd);
+        }
+        open += dz;
     }
     o_ao = F > 0.0 ? open / F : 1.0;   // eq 1: V = (1/F) sum dz_i
 }

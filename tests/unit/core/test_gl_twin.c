@@ -61,18 +61,34 @@ static void test_gl_matches_cpu(void **state)
         char err[OBS_ERR_LEN] = "";
         load(scenes[s], &gf);
         unsigned out = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE;
-        assert_int_equal(obs_run(ctx, &gf.gb, NULL, out, &gl, err), OBS_OK);
-        assert_int_equal(obs_run_cpu(&gf.gb, NULL, out, &cpu, err), OBS_OK);
-        double mean, frac, cmean, cfrac;
-        diff(&gl.ao, &cpu.ao, &mean, &frac);
-        diff(&gl.composite, &cpu.composite, &cmean, &cfrac);
-        print_message("%s: GL vs CPU AO: mean |diff| %.2e, %.3f %% of pixels > 1e-3; composite mean %.2e\n",
-                      scenes[s], mean, 100 * frac, cmean);
-        assert_true(mean < 1e-3);
-        assert_true(frac < 0.02);
-        assert_true(cmean < 1e-3);
-        obs_result_free(&gl);
-        obs_result_free(&cpu);
+        /* the defaults (range check and 5-tap blur on), then a wide blur
+         * with the range check off, then no blur */
+        static const char *const variants[][2][2] = {
+            {{NULL, NULL}, {NULL, NULL}},
+            {{"blur_radius", "7"}, {"range_check", "off"}},
+            {{"blur", "off"}, {NULL, NULL}},
+        };
+        for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
+            obs_params p = {0};
+            for (int k = 0; k < 2; k++)
+                if (variants[v][k][0])
+                    assert_int_equal(obs_param_set(&p, variants[v][k][0], variants[v][k][1], err),
+                                     OBS_OK);
+            assert_int_equal(obs_run(ctx, &gf.gb, &p, out, &gl, err), OBS_OK);
+            assert_int_equal(obs_run_cpu(&gf.gb, &p, out, &cpu, err), OBS_OK);
+            double mean, frac, cmean, cfrac;
+            diff(&gl.ao, &cpu.ao, &mean, &frac);
+            diff(&gl.composite, &cpu.composite, &cmean, &cfrac);
+            print_message("%s (%s %s): GL vs CPU AO: mean |diff| %.2e, %.3f %% of pixels > 1e-3; "
+                          "composite mean %.2e\n",
+                          scenes[s], variants[v][0][0] ? variants[v][0][0] : "defaults",
+                          variants[v][0][1] ? variants[v][0][1] : "", mean, 100 * frac, cmean);
+            assert_true(mean < 1e-3);
+            assert_true(frac < 0.02);
+            assert_true(cmean < 1e-3);
+            obs_result_free(&gl);
+            obs_result_free(&cpu);
+        }
         obs_gbuffer_free(&gf);
     }
     obs_ctx_destroy(ctx);

@@ -97,6 +97,8 @@ static obs_params camera_normals(int samples)
     obs_params p = {0};
     char err[OBS_ERR_LEN];
     obs_param_set(&p, "normal_space", "camera", err);
+    /* the VAO estimate itself, not the low-pass filter (test_blur.c) */
+    obs_param_set(&p, "blur", "off", err);
     p.samples = samples;
     return p;
 }
@@ -279,6 +281,63 @@ static void test_corner_scene(void **state)
     free(s);
 }
 
+/* Depth range check (section 4.4, eq 4), in closed form: P on a plane
+ * facing an orthographic camera, with a surface D in front of it covering
+ * every sample (a foreground object).  Each pipe i spans depths
+ * [dc - h_i, dc + h_i] around the sphere centre dc = z_P - R/2, so it lies
+ * d_i = D - R/2 - h_i behind the surface (case C).  Without the check every
+ * pipe is closed: V = 0.  With it, pipe i is occluded by s(d_i) of its
+ * length: V = sum 2 h_i (1 - s(d_i)) / F, s(d) = u / max(u, d / R). */
+static void test_range_check_closed_form(void **state)
+{
+    scene *s = malloc(sizeof *s);
+    (void)state;
+    float P[16];
+    ortho(P, 2.0f, 1.5f);
+    plane front = {{0, 0, 1}, -4.0f}; /* the occluder, at depth 4 */
+    render(s, P, &front, 1);
+    const float n_cam[3] = {0, 0, 1};
+
+    for (int pass = 0; pass < 3; pass++) {
+        obs_params p = camera_normals(16), rp;
+        char err[OBS_ERR_LEN];
+        p.radius = 0.5f;
+        if (pass == 1)
+            obs_param_set(&p, "range_check", "off", err);
+        if (pass == 2)
+            p.range_u = 0.2f;
+        obs__frame f;
+        obs_params_resolve(&p, &rp);
+        assert_int_equal(obs__frame_setup(NULL, &s->gb, &rp, &f, err), OBS_OK);
+        float *pos = malloc(sizeof(float) * 4 * W * H);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++)
+                obs__prep_position(&f, s->depth[y * W + x], x, y, pos + 4 * (y * W + x));
+        const float R = f.radius, u = f.range_u;
+        for (int k = 0; k < 4; k++) {
+            float D = 0.51f + 0.3f * k; /* > R/2 + max h = R: every pipe is behind */
+            double open = 0, F = 0;
+            for (int i = 0; i < f.samples; i++) {
+                float sx = f.sample_xy[2 * i], sy = f.sample_xy[2 * i + 1];
+                float l = sqrtf(1 - sx * sx - sy * sy), h = 0.5f * R * l;
+                float d = D - 0.5f * R - h;
+                F += R * l; /* eq 2 */
+                float sd = u / fmaxf(u, d / R); /* eq 4 */
+                open += f.range_check ? 2 * h * (1 - sd) : 0.0;
+            }
+            const float pt[3] = {0.0f, 0.0f, -4.0f - D};
+            float v = obs__vao_pixel(&f, pos, W / 2, H / 2, pt, n_cam);
+            assert_float_equal(v, (float)(open / F), 1e-5f);
+            if (pass == 1)
+                assert_float_equal(v, 0.0f, 0.0f);
+            else
+                assert_true(v > 0.0f);
+        }
+        free(pos);
+    }
+    free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -287,6 +346,7 @@ int main(void)
         cmocka_unit_test(test_open_plane_tilted_perspective),
         cmocka_unit_test(test_inner_corner),
         cmocka_unit_test(test_corner_scene),
+        cmocka_unit_test(test_range_check_closed_form),
     };
     return cmocka_run_group_tests_name("vao_math", tests, NULL, NULL);
 }
