@@ -6,6 +6,7 @@
 #   make test     unit + end-to-end tests, then the same under ASan/UBSan
 #   make bench    benchmarks (bench/RESULTS.md)
 #   make readme   regenerate README.md's parameter table
+#   make samples  regenerate core/sample_tables.c (VAO++ 4.5 sample sets)
 #
 # BUILD selects the output folder, so the sanitizer build lives beside the
 # normal one: make BUILD=build/asan SAN=1.
@@ -54,7 +55,7 @@ BENCH := $(BUILD)/frame_bench
 # binaries to `all` and their e2e prerequisites to E2E_DEPS.
 -include protocol/protocol.mk daemon/daemon.mk
 
-.PHONY: all deps demo demo-run test check unit e2e headers readme readme-check bench clean
+.PHONY: all deps demo demo-run test check unit e2e headers readme readme-check samples bench clean
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI) $(EXTRA_BINS)
@@ -119,6 +120,11 @@ check: all headers unit e2e readme-check
 # The README's parameter table is generated from the parameter table.
 readme: $(CLI)
 	tools/readme_params.sh $(CLI) README.md
+
+# The sample sets are the generator's output, checked in as C source
+# (tests/unit/core/test_samples.c fails when they are stale).
+samples: $(CLI)
+	$(CLI) samples --c > core/sample_tables.c.tmp && mv core/sample_tables.c.tmp core/sample_tables.c
 
 readme-check: $(CLI)
 	@tools/readme_params.sh --check $(CLI) README.md && echo "readme: parameter table up to date"

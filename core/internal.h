@@ -45,10 +45,27 @@ void obs__mat4_apply(const float m[16], const float v[4], float out[4]);
 obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p,
                                obs_camera *out, char err[OBS_ERR_LEN]);
 
-/* Sample sets on the unit disk, generated once with a fixed seed.
- * Returns n (x, y) pairs, n in [2, OBS__MAX_SAMPLES]. */
+/* Sample sets on the unit disk (VAO++ section 4.5), n = 2, 4, 8, 16, 32:
+ * the checked-in output of the generator in samples_gen.c
+ * (core/sample_tables.c).  All five sets lie one after the other in one
+ * table of OBS__SAMPLE_TABLE_LEN (x, y) pairs, the set of n starting at
+ * pair n - 2: the layout of the shader's single uniform array (4.1). */
 #define OBS__MAX_SAMPLES 32
+#define OBS__SAMPLE_TABLE_LEN 62 /* 2 + 4 + 8 + 16 + 32 */
+extern const float obs__sample_table[OBS__SAMPLE_TABLE_LEN][2];
+/* n (x, y) pairs of the table; NULL unless n is 2, 4, 8, 16 or 32. */
 const float *obs__samples(int n);
+
+/* The generator behind the table, stopped at a stage (for the tests):
+ * VAOPP is the whole of section 4.5 (= obs_samples_generate); POISSON the
+ * rotation-aware Poisson-disk set alone, in the order its points were
+ * placed; PLAIN a Poisson-disk set by the same method blind to the 9
+ * rotations, in placing order (the rotation-unaware comparison). */
+enum { OBS__SAMPLES_VAOPP, OBS__SAMPLES_POISSON, OBS__SAMPLES_PLAIN };
+obs_status obs__samples_generate_ex(int n, int mode, float *xy);
+/* Smallest distance between two of the n samples, or with rotations 1
+ * between two points of the union of the set's 9 tile rotations. */
+double obs__samples_min_distance(const float *xy, int n, int rotations);
 
 /* Per-pixel rotation of the sample set: 3x3 tile of 9 uniform angles
  * (VAO++ section 4.5), computed from pixel coordinates. */

@@ -100,8 +100,28 @@ static int parse_double(const char *s, double *out)
     return 0;
 }
 
+/* INT parameters with choices take only the listed numbers. */
+static int int_allowed(const obs_param_info *pi, int v)
+{
+    if (!pi->choices)
+        return 1;
+    for (const char *c = pi->choices; *c;) {
+        char *end;
+        long n = strtol(c, &end, 10);
+        if (end == c)
+            return 0;
+        if (n == v)
+            return 1;
+        c = *end == '|' ? end + 1 : end;
+    }
+    return 0;
+}
+
 static obs_status range_error(const obs_param_info *pi, const char *value, char err[OBS_ERR_LEN])
 {
+    if (pi->type == OBS_PARAM_INT && pi->choices)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s",
+                         pi->name, value, pi->choices);
     if (pi->type == OBS_PARAM_INT)
         return obs__fail(err, OBS_INVALID_ARGUMENT,
                          "parameter %s: '%s' is not an integer in [%g, %g]", pi->name,
@@ -128,7 +148,8 @@ obs_status obs_param_set(obs_params *p, const char *name, const char *value,
         *(float *)field = (float)v;
         return OBS_OK;
     case OBS_PARAM_INT:
-        if (parse_double(value, &v) != 0 || v != floor(v) || v < pi->min || v > pi->max)
+        if (parse_double(value, &v) != 0 || v != floor(v) || v < pi->min || v > pi->max ||
+            !int_allowed(pi, (int)v))
             return range_error(pi, value, err);
         *(int *)field = (int)v;
         return OBS_OK;
@@ -236,7 +257,7 @@ obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN])
         }
         case OBS_PARAM_INT: {
             int v = *(const int *)field;
-            if (v < pi->min || v > pi->max) {
+            if (v < pi->min || v > pi->max || !int_allowed(pi, v)) {
                 snprintf(text, sizeof text, "%d", v);
                 return range_error(pi, text, err);
             }

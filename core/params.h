@@ -39,13 +39,18 @@ typedef enum obs_normal_space {
 
 /* X(name, type, default, min, max, choices, doc)
  * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4.
+ * An INT with choices takes only the listed numbers (within min..max). 
  * For ENUM the default is the choice's name; for MAT4 it is unused. */
 #define OBS_PARAM_TABLE(X)                                                     \
     X(radius, FLOAT, 0.5, 1e-4, 1e4, NULL,                                     \
       "AO radius R in world units: hemisphere radius of the occlusion "        \
       "test; VAO's tangent sphere has radius R/2")                             \
-    X(samples, INT, 16, 2, 32, NULL,                                           \
-      "line samples per pixel on the tangent sphere's disk")                   \
+    X(samples, INT, 16, 2, 32, "2|4|8|16|32",                                  \
+      "line samples per pixel on the tangent sphere's disk; the sets of "     \
+      "VAO++ 4.5 (rotation-aware Poisson disk, best rotation permutation, "    \
+      "z-order) exist for 2, 4, 8, 16 and 32 only, other counts are "          \
+      "refused: the first n of a larger z-ordered set would cover one part "   \
+      "of the disk")                                                           \
     X(depth_mode, ENUM, "planar", 0, 0, "planar|radial|ndc",                   \
       "what the depth channel holds: distance along the camera axis, "         \
       "distance from the camera, or a [0,1] OpenGL depth-buffer value")        \

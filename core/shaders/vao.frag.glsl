@@ -8,7 +8,7 @@ uniform sampler2D u_vnormal;     // prep: view normal
 uniform ivec2 u_size;
 uniform float u_radius;          // R, in depth units
 uniform int u_count;             // samples
-uniform vec2 u_samples[32];      // unit disk
+uniform vec2 u_samples[32];      // unit disk: a set of section 4.5 (core/sample_tables.c)
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
 uniform int u_range_check;       // 1: depth range check (section 4.4, eq 4)
 uniform float u_range_u;         // u of eq 4

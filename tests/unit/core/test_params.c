@@ -55,7 +55,7 @@ static void test_errors_name_the_parameter(void **state)
     char err[OBS_ERR_LEN];
     assert_int_equal(obs_param_set(&p, "samples", "64", err), OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "samples"));
-    assert_non_null(strstr(err, "[2, 32]"));
+    assert_non_null(strstr(err, "2|4|8|16|32")); /* the sizes of section 4.5 */
     assert_int_equal(obs_param_set(&p, "samples", "3.5", err), OBS_INVALID_ARGUMENT);
     assert_int_equal(obs_param_set(&p, "radius", "abc", err), OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "radius"));
