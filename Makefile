@@ -141,7 +141,7 @@ e2e: $(CLI) $(E2E_DEPS)
 # Every public header compiles alone, as C and as C++.
 headers:
 	@mkdir -p $(BUILD)/headers
-	@for h in core/obscura.h core/status.h core/params.h core/io.h core/metrics.h; do \
+	@for h in core/obscura.h core/status.h core/params.h core/io.h core/metrics.h protocol/http.h; do \
 	  echo "#include \"$$h\"" > $(BUILD)/headers/t.c; \
 	  $(CC) -I. -Wall -Wextra -Werror -std=c99 -c $(BUILD)/headers/t.c -o /dev/null || exit 1; \
 	  cp $(BUILD)/headers/t.c $(BUILD)/headers/t.cpp; \

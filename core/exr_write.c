@@ -1,6 +1,7 @@
 /* EXR output through OpenEXR's C API: one scanline part, ZIP, half or
  * float, each layer's channels under the names the caller gives. */
 #include <limits.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "exr_internal.h"
@@ -99,8 +100,25 @@ static void bind_channels(exr_encode_pipeline_t *enc, const obs_exr_layer *layer
     }
 }
 
-obs_status obs_exr_write(const char *path, const obs_exr_layer *layers, int layer_count,
-                         obs_exr_pixel pixel, const obs_camera *cam, char err[OBS_ERR_LEN])
+/* The in-memory stream: OpenEXR writes at offsets (the chunk table last,
+ * back near the start), so the buffer is addressed, not appended. */
+static int64_t mem_write(exr_const_context_t ctxt, void *user, const void *buf, uint64_t sz,
+                         uint64_t offset, exr_stream_error_func_ptr_t error_cb)
+{
+    if (obs__membuf_write(user, offset, buf, (size_t)sz) != 0) {
+        if (error_cb)
+            error_cb(ctxt, EXR_ERR_OUT_OF_MEMORY, "out of memory for %llu bytes at %llu",
+                     (unsigned long long)sz, (unsigned long long)offset);
+        return -1;
+    }
+    return (int64_t)sz;
+}
+
+/* Writes to `path`, or into `mem` when it is non-NULL (`path` then only
+ * names the output in messages). */
+static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_layer *layers,
+                            int layer_count, obs_exr_pixel pixel, const obs_camera *cam,
+                            char err[OBS_ERR_LEN])
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
@@ -125,7 +143,12 @@ obs_status obs_exr_write(const char *path, const obs_exr_layer *layers, int laye
     obs__exr_msg_reset();
     /* A temporary file renamed at the end: a failed write leaves no
      * half-written EXR behind for the next step of a render farm. */
-    if ((rv = exr_start_write(&ctx, path, EXR_INTERMEDIATE_TEMP_FILE, &init)) != EXR_ERR_SUCCESS)
+    if (mem) {
+        init.user_data = mem;
+        init.write_fn = mem_write;
+    }
+    if ((rv = exr_start_write(&ctx, path, mem ? EXR_WRITE_FILE_DIRECTLY : EXR_INTERMEDIATE_TEMP_FILE,
+                              &init)) != EXR_ERR_SUCCESS)
         goto fail;
     what = "writing the header";
     if ((rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part)) != EXR_ERR_SUCCESS ||
@@ -174,4 +197,24 @@ fail:
         st = rv == EXR_ERR_INVALID_ARGUMENT || rv == EXR_ERR_NAME_TOO_LONG ? OBS_INVALID_ARGUMENT : OBS_IO;
     const char *msg = obs__exr_msg()[0] ? obs__exr_msg() : exr_get_default_error_message(rv);
     return obs__fail(err, st, "%s: %s: %s", path, what, msg);
+}
+
+obs_status obs_exr_write(const char *path, const obs_exr_layer *layers, int layer_count,
+                         obs_exr_pixel pixel, const obs_camera *cam, char err[OBS_ERR_LEN])
+{
+    return write_exr(path, NULL, layers, layer_count, pixel, cam, err);
+}
+
+obs_status obs_exr_write_mem(const obs_exr_layer *layers, int layer_count, obs_exr_pixel pixel,
+                             const obs_camera *cam, obs_bytes *out, char err[OBS_ERR_LEN])
+{
+    obs__membuf mem = {0};
+    if (!out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_write_mem: no output");
+    *out = (obs_bytes){0};
+    obs_status st = write_exr("(memory)", &mem, layers, layer_count, pixel, cam, err);
+    if (st == OBS_OK)
+        obs__membuf_take(&mem, out);
+    free(mem.data);
+    return st;
 }

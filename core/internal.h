@@ -79,4 +79,15 @@ obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs,
 void obs__log(obs_ctx *ctx, obs_log_level level, const char *fmt, ...)
     OBS__PRINTF(3, 4);
 
+/* A growable byte buffer (core/bytes.c) behind obs_*_write_mem. */
+typedef struct obs__membuf {
+    unsigned char *data;
+    size_t size, cap;
+} obs__membuf;
+/* Writes len bytes at offset, growing the buffer; -1 when out of memory. */
+int obs__membuf_write(obs__membuf *m, uint64_t offset, const void *data, size_t len);
+/* Moves the bytes into *out (the buffer is left empty). */
+struct obs_bytes;
+void obs__membuf_take(obs__membuf *m, struct obs_bytes *out);
+
 #endif

@@ -109,6 +109,28 @@ obs_status obs_exr_write(const char *path, const obs_exr_layer *layers,
 obs_status obs_png_write(const char *path, const obs_image *img, int bits,
                          int srgb, char err[OBS_ERR_LEN]);
 
+/* ---- in-memory output (the daemon answers with these) ------------------ */
+
+/* Bytes owned by the library.  Caller frees with obs_bytes_free(). */
+typedef struct obs_bytes {
+    unsigned char *data; /* malloc'd; free() also releases it */
+    size_t size;
+} obs_bytes;
+
+/* Frees the bytes and zeroes the struct; NULL-safe. */
+void obs_bytes_free(obs_bytes *b);
+
+/* obs_exr_write() into memory: the same file, byte for byte.  On success
+ * *out holds the EXR; caller frees with obs_bytes_free(). */
+obs_status obs_exr_write_mem(const obs_exr_layer *layers, int layer_count,
+                             obs_exr_pixel pixel, const obs_camera *cam,
+                             obs_bytes *out, char err[OBS_ERR_LEN]);
+
+/* obs_png_write() into memory: the same file, byte for byte.  On success
+ * *out holds the PNG; caller frees with obs_bytes_free(). */
+obs_status obs_png_write_mem(const obs_image *img, int bits, int srgb,
+                             obs_bytes *out, char err[OBS_ERR_LEN]);
+
 /* ---- camera ------------------------------------------------------------ */
 
 /* Reads a camera JSON (width, height, fov_y_deg, near, far,

@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "internal.h"
+#include "io.h"
 
 /* libpng states the cause of an error in a warning just before it. */
 typedef struct png_msgs {
@@ -58,8 +59,23 @@ static void convert_row(const float *src, unsigned char *dst, int width, int cha
     }
 }
 
-obs_status obs_png_write(const char *path, const obs_image *img, int bits, int srgb,
-                         char err[OBS_ERR_LEN])
+/* libpng's write callbacks for the in-memory stream. */
+static void mem_write(png_structp png, png_bytep data, size_t len)
+{
+    obs__membuf *m = png_get_io_ptr(png);
+    if (obs__membuf_write(m, m->size, data, len) != 0)
+        png_error(png, "out of memory");
+}
+
+static void mem_flush(png_structp png)
+{
+    (void)png;
+}
+
+/* Writes to `path`, or into `mem` when it is non-NULL (`path` then only
+ * names the output in messages). */
+static obs_status write_png(const char *path, obs__membuf *mem, const obs_image *img, int bits,
+                            int srgb, char err[OBS_ERR_LEN])
 {
     png_msgs msgs = {"", ""};
     char *const msg = msgs.error; /* what obs__fail() fills on our own errors */
@@ -84,7 +100,7 @@ obs_status obs_png_write(const char *path, const obs_image *img, int bits, int s
     if (obs__size_mul3((size_t)img->width, (size_t)img->channels, (size_t)bits / 8, &rowbytes) != 0 ||
         !(row = malloc(rowbytes)))
         return obs__fail(err, OBS_NO_MEMORY, "%s: row of %d pixels", path, img->width);
-    if (!(fp = fopen(path, "wb"))) {
+    if (!mem && !(fp = fopen(path, "wb"))) {
         st = obs__fail(msg, OBS_IO, "cannot create: %s", strerror(errno));
         goto fail;
     }
@@ -98,7 +114,10 @@ obs_status obs_png_write(const char *path, const obs_image *img, int bits, int s
         goto fail;
     }
     static const int types[] = {0, PNG_COLOR_TYPE_GRAY, 0, PNG_COLOR_TYPE_RGB, PNG_COLOR_TYPE_RGB_ALPHA};
-    png_init_io(png, fp);
+    if (mem)
+        png_set_write_fn(png, mem, mem_write, mem_flush);
+    else
+        png_init_io(png, fp);
     png_set_IHDR(png, info, (png_uint_32)img->width, (png_uint_32)img->height, bits,
                  types[img->channels], PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
@@ -122,4 +141,24 @@ fail:
     if (fp && stat(path, &sb) == 0 && S_ISREG(sb.st_mode))
         remove(path);
     return obs__fail(err, st, "%s: %s", path, msg);
+}
+
+obs_status obs_png_write(const char *path, const obs_image *img, int bits, int srgb,
+                         char err[OBS_ERR_LEN])
+{
+    return write_png(path, NULL, img, bits, srgb, err);
+}
+
+obs_status obs_png_write_mem(const obs_image *img, int bits, int srgb, obs_bytes *out,
+                             char err[OBS_ERR_LEN])
+{
+    obs__membuf mem = {0};
+    if (!out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_png_write_mem: no output");
+    *out = (obs_bytes){0};
+    obs_status st = write_png("(memory)", &mem, img, bits, srgb, err);
+    if (st == OBS_OK)
+        obs__membuf_take(&mem, out);
+    free(mem.data);
+    return st;
 }

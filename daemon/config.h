@@ -1,0 +1,107 @@
+/* obscurad's configuration: one table of options (Redis static_configs
+ * style).  A config file holds `name value` lines; every line is also a
+ * flag (--name value or --name=value), and flags override the file.
+ * `obscurad --help` is generated from the table. */
+#ifndef OBSD_CONFIG_H
+#define OBSD_CONFIG_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "status.h"
+
+#define OBSD_STR_LEN 256
+
+/* X(name, type, min, max, default, doc)
+ * type: STRING (max = longest length), INT, SIZE (bytes; k/m/g suffixes,
+ * powers of 1024), ENUM (choices in the doc's braces are checked against
+ * the `choices` column of obsd_enum_choices()). */
+#define OBSD_CONFIG_TABLE(X)                                                   \
+    X(http, STRING, 0, OBSD_STR_LEN - 1, "127.0.0.1:8420",                     \
+      "HTTP listen address HOST:PORT (IPv4; port 0 picks a free port; "        \
+      "empty: no HTTP)")                                                       \
+    X(socket, STRING, 0, OBSD_STR_LEN - 1, "",                                 \
+      "binary protocol on this Unix socket path (not implemented yet)")       \
+    X(tcp, STRING, 0, OBSD_STR_LEN - 1, "",                                    \
+      "binary protocol on this TCP HOST:PORT (not implemented yet)")          \
+    X(queue, INT, 1, 1024, "8",                                                \
+      "frames that may wait for the GL worker; more are answered 503")         \
+    X(threads, INT, 1, 64, "4",                                                \
+      "HTTP threads (they read, decode and encode; one GL thread runs)")       \
+    X(max_pixels, SIZE, 1, 1073741824, "33554432",                             \
+      "largest accepted width x height of a G-buffer (413 above)")             \
+    X(max_body, SIZE, 1024, 17179869184, "1g",                                 \
+      "largest accepted request body in bytes (413 above, before reading)")    \
+    X(timeout, INT, 0, 86400, "60",                                            \
+      "seconds a connection may stay idle (0: no limit)")                      \
+    X(token_file, STRING, 0, OBSD_STR_LEN - 1, "",                             \
+      "file holding a bearer token; when set, /v1/* and /metrics need "        \
+      "'Authorization: Bearer TOKEN'")                                         \
+    X(backend, ENUM, 0, 0, "auto",                                             \
+      "GL backend: auto|egl-device|egl-surfaceless|osmesa (default: "          \
+      "OBSCURA_BACKEND, else auto)")                                           \
+    X(log_level, ENUM, 0, 0, "info",                                           \
+      "error|warn|info|debug; info logs one line per request")
+
+typedef enum obsd_opt_type {
+    OBSD_OPT_STRING,
+    OBSD_OPT_INT,
+    OBSD_OPT_SIZE,
+    OBSD_OPT_ENUM
+} obsd_opt_type;
+
+typedef struct obsd_config {
+#define OBSD__FIELD_STRING(n) char n[OBSD_STR_LEN];
+#define OBSD__FIELD_INT(n) int n;
+#define OBSD__FIELD_SIZE(n) int64_t n;
+#define OBSD__FIELD_ENUM(n) int n;
+#define OBSD__FIELD(name, type, lo, hi, def, doc) OBSD__FIELD_##type(name)
+    OBSD_CONFIG_TABLE(OBSD__FIELD)
+#undef OBSD__FIELD
+    /* which options were given explicitly (file or flag), by table index */
+    unsigned char set[32];
+} obsd_config;
+
+typedef struct obsd_opt_info {
+    const char *name;
+    obsd_opt_type type;
+    int64_t min, max;
+    const char *def;
+    const char *choices; /* ENUM only: "a|b|c"; the value is the index */
+    const char *doc;
+    size_t offset;
+} obsd_opt_info;
+
+int obsd_opt_count(void);
+const obsd_opt_info *obsd_opt_at(int i);
+/* By name; '-' and '_' are interchangeable.  NULL when unknown. */
+const obsd_opt_info *obsd_opt_find(const char *name);
+
+/* Every option at its default. */
+void obsd_config_defaults(obsd_config *c);
+
+/* Sets one option from text, checking type and range; the message names
+ * the option and what it accepts. */
+obs_status obsd_config_set(obsd_config *c, const char *name, const char *value,
+                           char err[OBS_ERR_LEN]);
+
+/* Reads `name value` lines (# comments, blank lines); the message names
+ * the file and line. */
+obs_status obsd_config_load(obsd_config *c, const char *path, char err[OBS_ERR_LEN]);
+
+/* Parses argv[1..]: --config FILE is read first, then every other flag
+ * overrides it.  *help is set by --help / -h.  Returns OBS_OK or
+ * OBS_INVALID_ARGUMENT / OBS_IO with a message. */
+obs_status obsd_config_args(obsd_config *c, int argc, char **argv, int *help,
+                            char err[OBS_ERR_LEN]);
+
+/* --help text, generated from the table. */
+void obsd_config_help(FILE *f);
+
+/* The current value of an option as text (for logs and tests). */
+void obsd_config_format(const obsd_config *c, const obsd_opt_info *o, char *buf, size_t len);
+
+/* Index values of the ENUM options. */
+enum { OBSD_LOG_ERROR, OBSD_LOG_WARN, OBSD_LOG_INFO, OBSD_LOG_DEBUG };
+
+#endif

@@ -1,0 +1,184 @@
+/* obscurad: keeps one GL context alive and serves AO frames over HTTP.
+ *
+ *   obscurad [--config FILE] [--http 127.0.0.1:8420] [--queue 8] ...
+ *
+ * Threads: main (signals, start and drain), the GL worker (the only one
+ * that touches GL), libmicrohttpd's pool (parse, decode, encode).
+ * SIGTERM/SIGINT: stop accepting, finish every queued and running frame,
+ * answer it, exit 0; a second SIGINT exits at once.
+ * Exit codes: 0 ok, 1 failure (GL, listen), 2 usage. */
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "config.h"
+#include "gl_worker.h"
+#include "http_server.h"
+#include "log.h"
+#include "stats.h"
+
+static volatile sig_atomic_t stop_requested;
+static volatile sig_atomic_t interrupts;
+
+/* Only sets flags: the main loop acts on them. */
+static void on_signal(int sig)
+{
+    if (sig == SIGINT)
+        interrupts = interrupts + 1;
+    stop_requested = 1;
+}
+
+static int install_signals(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    if (sigaction(SIGTERM, &sa, NULL) != 0 || sigaction(SIGINT, &sa, NULL) != 0)
+        return -1;
+    sa.sa_handler = SIG_IGN;
+    return sigaction(SIGPIPE, &sa, NULL);
+}
+
+/* Blocks or unblocks SIGTERM/SIGINT on the calling thread; threads made
+ * while blocked inherit it, so the signals reach the main thread. */
+static void mask_signals(int how)
+{
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGTERM);
+    sigaddset(&set, SIGINT);
+    pthread_sigmask(how, &set, NULL);
+}
+
+static int read_token(const char *path, char *buf, size_t len)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        obsd_log(OBSD_LOG_ERROR, "--token-file %s: %s", path, strerror(errno));
+        return -1;
+    }
+    size_t n = fread(buf, 1, len - 1, f);
+    int more = fgetc(f) != EOF;
+    fclose(f);
+    buf[n] = '\0';
+    while (n && (buf[n - 1] == '\n' || buf[n - 1] == '\r' || buf[n - 1] == ' ' || buf[n - 1] == '\t'))
+        buf[--n] = '\0';
+    if (more || n == 0 || strpbrk(buf, "\r\n")) {
+        obsd_log(OBSD_LOG_ERROR, "--token-file %s: expected one line of 1 to %zu characters", path, len - 2);
+        return -1;
+    }
+    return 0;
+}
+
+static void sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL); /* a signal cuts it short, which is what we want */
+}
+
+int main(int argc, char **argv)
+{
+    obsd_config cfg;
+    char err[OBS_ERR_LEN] = "", token[512] = "";
+    int help = 0;
+
+    obsd_config_defaults(&cfg);
+    obs_status s = obsd_config_args(&cfg, argc, argv, &help, err);
+    if (s != OBS_OK) {
+        fprintf(stderr, "obscurad: %s\n(run 'obscurad --help' for usage)\n", err);
+        return 2;
+    }
+    if (help) {
+        obsd_config_help(stdout);
+        return 0;
+    }
+    obsd_log_set_level(cfg.log_level);
+    if (cfg.socket[0] || cfg.tcp[0]) {
+        obsd_log(OBSD_LOG_ERROR, "--socket/--tcp: the binary protocol is not implemented yet; use --http");
+        return 2;
+    }
+    if (!cfg.http[0]) {
+        obsd_log(OBSD_LOG_ERROR, "no listener: --http is empty");
+        return 2;
+    }
+    if (cfg.token_file[0] && read_token(cfg.token_file, token, sizeof token) != 0)
+        return 2;
+
+    obs_ctx_desc desc = {.log = obsd_log_core};
+    const obsd_opt_info *bo = obsd_opt_find("backend");
+    const char *env = getenv("OBSCURA_BACKEND");
+    char bname[32];
+    obsd_config_format(&cfg, bo, bname, sizeof bname);
+    if (!cfg.set[bo - obsd_opt_at(0)] && env && *env)
+        snprintf(bname, sizeof bname, "%s", env);
+    if (obs_backend_parse(bname, &desc.backend) != OBS_OK) {
+        obsd_log(OBSD_LOG_ERROR, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
+        return 2;
+    }
+    if (install_signals() != 0) {
+        obsd_log(OBSD_LOG_ERROR, "cannot install signal handlers: %s", strerror(errno));
+        return 1;
+    }
+
+    obsd_queue queue;
+    obsd_gl_worker gl;
+    obsd_http *http = NULL;
+    if (obsd_queue_init(&queue, cfg.queue) != 0) {
+        obsd_log(OBSD_LOG_ERROR, "out of memory");
+        return 1;
+    }
+    obsd_stats_init();
+    mask_signals(SIG_BLOCK);
+    s = obsd_gl_start(&gl, &queue, &desc, err);
+    if (s != OBS_OK) {
+        obsd_log(OBSD_LOG_ERROR, "OpenGL: %s (%s)", err, obs_status_name(s));
+        obsd_queue_destroy(&queue);
+        return 1;
+    }
+    obsd_log(OBSD_LOG_INFO, "GL context: backend %s, %s, %s (created in %.0f ms)", gl.backend,
+             gl.gl_renderer, gl.gl_version, gl.create_ms);
+    s = obsd_http_start(&cfg, token, &queue, &gl, &http, err);
+    mask_signals(SIG_UNBLOCK);
+    if (s != OBS_OK) {
+        obsd_log(OBSD_LOG_ERROR, "%s", err);
+        obsd_gl_stop(&gl);
+        obsd_queue_destroy(&queue);
+        return 1;
+    }
+    {
+        char host[OBSD_STR_LEN];
+        snprintf(host, sizeof host, "%s", cfg.http);
+        char *colon = strrchr(host, ':');
+        if (colon)
+            *colon = '\0';
+        obsd_log(OBSD_LOG_INFO, "listening on http://%s:%d (queue %d, %d threads, max %lld pixels, "
+                 "max body %lld bytes%s)", host, obsd_http_port(http), cfg.queue, cfg.threads,
+                 (long long)cfg.max_pixels, (long long)cfg.max_body, token[0] ? ", token required" : "");
+    }
+
+    while (!stop_requested)
+        sleep_ms(200);
+
+    /* Drain: no new connections; every frame taken is finished and
+     * answered before the server stops. */
+    obsd_log(OBSD_LOG_INFO, "stopping: finishing %d request(s) under way (SIGINT again to quit now)",
+             obsd_http_in_flight(http));
+    obsd_http_quiesce(http);
+    while (obsd_http_in_flight(http) > 0) {
+        if (interrupts >= 2) {
+            obsd_log(OBSD_LOG_WARN, "second SIGINT: exiting now");
+            _exit(130);
+        }
+        sleep_ms(20);
+    }
+    obsd_http_stop(http);
+    obsd_gl_stop(&gl);
+    obsd_queue_destroy(&queue);
+    obsd_log(OBSD_LOG_INFO, "stopped");
+    return 0;
+}

@@ -1,0 +1,200 @@
+/* Counters and histograms behind GET /metrics (Prometheus text 0.0.4). */
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "stats.h"
+
+static const char *const route_paths[OBSD_ROUTE_COUNT] = {
+    "/v1/ao", "/v1/params", "/v1/info", "/healthz", "/readyz", "/metrics", "other"};
+static const char *const stage_names[OBSD_STAGE_COUNT] = {"queue", "decode", "gl", "encode", "total"};
+/* The statuses the daemon answers; anything else counts as the last. */
+static const int codes[] = {200, 400, 401, 404, 405, 413, 415, 422, 500, 503, 0};
+#define NCODES ((int)(sizeof codes / sizeof codes[0]))
+/* Histogram bucket upper bounds in milliseconds (+Inf implied). */
+static const double buckets[] = {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000};
+#define NBUCKETS ((int)(sizeof buckets / sizeof buckets[0]))
+/* Frames by pixel count: up to 640x480, 1920x1080, 3840x2160, larger. */
+static const char *const res_names[] = {"sd", "hd", "uhd", "larger"};
+static const int64_t res_max[] = {640 * 480, 1920 * 1080, 3840 * 2160, INT64_MAX};
+#define NRES 4
+
+static struct {
+    pthread_mutex_t lock;
+    uint64_t requests[OBSD_ROUTE_COUNT][NCODES];
+    uint64_t bytes_in, bytes_out;
+    uint64_t hist[OBSD_STAGE_COUNT][NBUCKETS + 1];
+    double sum[OBSD_STAGE_COUNT];
+    uint64_t count[OBSD_STAGE_COUNT];
+    uint64_t frames[NRES];
+} st = {PTHREAD_MUTEX_INITIALIZER};
+
+const char *obsd_route_path(obsd_route r)
+{
+    return r >= 0 && r < OBSD_ROUTE_COUNT ? route_paths[r] : "other";
+}
+
+obsd_route obsd_route_of(const char *path)
+{
+    for (int r = 0; r < OBSD_ROUTE_OTHER; r++)
+        if (path && !strcmp(path, route_paths[r]))
+            return (obsd_route)r;
+    return OBSD_ROUTE_OTHER;
+}
+
+void obsd_stats_init(void)
+{
+    pthread_mutex_lock(&st.lock);
+    memset(st.requests, 0, sizeof st.requests);
+    memset(st.hist, 0, sizeof st.hist);
+    memset(st.sum, 0, sizeof st.sum);
+    memset(st.count, 0, sizeof st.count);
+    memset(st.frames, 0, sizeof st.frames);
+    st.bytes_in = st.bytes_out = 0;
+    pthread_mutex_unlock(&st.lock);
+}
+
+void obsd_stats_request(obsd_route route, int http_status, uint64_t bytes_in, uint64_t bytes_out)
+{
+    int c = 0;
+    while (c < NCODES - 1 && codes[c] != http_status)
+        c++;
+    if (route < 0 || route >= OBSD_ROUTE_COUNT)
+        route = OBSD_ROUTE_OTHER;
+    pthread_mutex_lock(&st.lock);
+    st.requests[route][c]++;
+    st.bytes_in += bytes_in;
+    st.bytes_out += bytes_out;
+    pthread_mutex_unlock(&st.lock);
+}
+
+void obsd_stats_stage(obsd_stage stage, double ms)
+{
+    if (stage < 0 || stage >= OBSD_STAGE_COUNT || !(ms >= 0.0))
+        return;
+    int b = 0;
+    while (b < NBUCKETS && ms > buckets[b])
+        b++;
+    pthread_mutex_lock(&st.lock);
+    st.hist[stage][b]++;
+    st.sum[stage] += ms / 1e3;
+    st.count[stage]++;
+    pthread_mutex_unlock(&st.lock);
+}
+
+void obsd_stats_frame(int64_t width, int64_t height)
+{
+    int64_t px = width * height;
+    int r = 0;
+    while (r < NRES - 1 && px > res_max[r])
+        r++;
+    pthread_mutex_lock(&st.lock);
+    st.frames[r]++;
+    pthread_mutex_unlock(&st.lock);
+}
+
+typedef struct sbuf {
+    char *p;
+    size_t len, cap;
+    int failed;
+} sbuf;
+
+static void put(sbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void put(sbuf *b, const char *fmt, ...)
+{
+    for (int tries = 0; tries < 2 && !b->failed; tries++) {
+        va_list ap;
+        va_start(ap, fmt);
+        int n = vsnprintf(b->p + b->len, b->cap - b->len, fmt, ap);
+        va_end(ap);
+        if (n < 0) {
+            b->failed = 1;
+            return;
+        }
+        if ((size_t)n < b->cap - b->len) {
+            b->len += (size_t)n;
+            return;
+        }
+        size_t cap = (b->cap + (size_t)n) * 2;
+        char *p = realloc(b->p, cap);
+        if (!p) {
+            b->failed = 1;
+            return;
+        }
+        b->p = p;
+        b->cap = cap;
+    }
+}
+
+char *obsd_stats_text(const obsd_gauges *g, size_t *len)
+{
+    sbuf b = {malloc(8192), 0, 8192, 0};
+    if (!b.p)
+        return NULL;
+    b.p[0] = '\0';
+    pthread_mutex_lock(&st.lock);
+    put(&b, "# HELP obscurad_requests_total HTTP requests answered, by route and status.\n"
+            "# TYPE obscurad_requests_total counter\n");
+    for (int r = 0; r < OBSD_ROUTE_COUNT; r++)
+        for (int c = 0; c < NCODES; c++)
+            if (st.requests[r][c])
+                put(&b, "obscurad_requests_total{route=\"%s\",code=\"%s%d\"} %llu\n", route_paths[r],
+                    codes[c] ? "" : "other", codes[c] ? codes[c] : 0,
+                    (unsigned long long)st.requests[r][c]);
+    put(&b, "# HELP obscurad_stage_seconds Latency of each stage of a frame "
+            "(queue wait, EXR decode, GL run, encode, total).\n"
+            "# TYPE obscurad_stage_seconds histogram\n");
+    for (int s = 0; s < OBSD_STAGE_COUNT; s++) {
+        uint64_t cum = 0;
+        for (int k = 0; k <= NBUCKETS; k++) {
+            cum += st.hist[s][k];
+            if (k < NBUCKETS)
+                put(&b, "obscurad_stage_seconds_bucket{stage=\"%s\",le=\"%g\"} %llu\n", stage_names[s],
+                    buckets[k] / 1e3, (unsigned long long)cum);
+            else
+                put(&b, "obscurad_stage_seconds_bucket{stage=\"%s\",le=\"+Inf\"} %llu\n", stage_names[s],
+                    (unsigned long long)cum);
+        }
+        put(&b, "obscurad_stage_seconds_sum{stage=\"%s\"} %.6f\n", stage_names[s], st.sum[s]);
+        put(&b, "obscurad_stage_seconds_count{stage=\"%s\"} %llu\n", stage_names[s],
+            (unsigned long long)st.count[s]);
+    }
+    put(&b, "# HELP obscurad_frames_total Frames computed, by resolution class "
+            "(sd <= 640x480 < hd <= 1920x1080 < uhd <= 3840x2160 < larger).\n"
+            "# TYPE obscurad_frames_total counter\n");
+    for (int r = 0; r < NRES; r++)
+        put(&b, "obscurad_frames_total{class=\"%s\"} %llu\n", res_names[r], (unsigned long long)st.frames[r]);
+    put(&b, "# HELP obscurad_bytes_received_total Request body bytes received.\n"
+            "# TYPE obscurad_bytes_received_total counter\n"
+            "obscurad_bytes_received_total %llu\n"
+            "# HELP obscurad_bytes_sent_total Response body bytes sent.\n"
+            "# TYPE obscurad_bytes_sent_total counter\n"
+            "obscurad_bytes_sent_total %llu\n",
+        (unsigned long long)st.bytes_in, (unsigned long long)st.bytes_out);
+    pthread_mutex_unlock(&st.lock);
+    put(&b, "# HELP obscurad_queue_depth Frames waiting for the GL worker.\n"
+            "# TYPE obscurad_queue_depth gauge\n"
+            "obscurad_queue_depth %d\n"
+            "# HELP obscurad_queue_capacity Frames that may wait (--queue).\n"
+            "# TYPE obscurad_queue_capacity gauge\n"
+            "obscurad_queue_capacity %d\n"
+            "# HELP obscurad_gl_busy 1 while the GL worker runs a frame.\n"
+            "# TYPE obscurad_gl_busy gauge\n"
+            "obscurad_gl_busy %d\n"
+            "# HELP obscurad_in_flight HTTP requests being served.\n"
+            "# TYPE obscurad_in_flight gauge\n"
+            "obscurad_in_flight %d\n"
+            "# HELP obscurad_gl_up 1 while the GL context is alive.\n"
+            "# TYPE obscurad_gl_up gauge\n"
+            "obscurad_gl_up %d\n",
+        g->queue_depth, g->queue_capacity, g->gl_running, g->in_flight, g->gl_alive);
+    if (b.failed) {
+        free(b.p);
+        return NULL;
+    }
+    if (len)
+        *len = b.len;
+    return b.p;
+}

@@ -1,0 +1,177 @@
+/* HTTP request parsing, status mapping and JSON bodies (protocol/http.c). */
+#include "testutil.h"
+
+#include <cjson/cJSON.h>
+
+#include "../../../protocol/http.h"
+
+static void test_defaults(void **state)
+{
+    (void)state;
+    obs_http_request r;
+    obs_http_request_init(&r);
+    assert_int_equal(r.outputs, OBS_OUTPUT_AO);
+    assert_int_equal(r.format, OBS_HTTP_EXR);
+    assert_int_equal(r.png_bits, 8);
+    assert_int_equal(r.float_exr, 0);
+    assert_null(r.map.preset);
+    assert_null(r.map.depth);
+    assert_int_equal(obs_http_request_check(&r, NULL), OBS_OK);
+}
+
+static void test_table_params(void **state)
+{
+    (void)state;
+    obs_http_request r;
+    char err[OBS_ERR_LEN] = "";
+    obs_http_request_init(&r);
+    assert_int_equal(obs_http_request_set(&r, "radius", "0.25", err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "fov-y", "50", err), OBS_OK); /* '-' or '_' */
+    assert_int_equal(obs_http_request_set(&r, "depth_mode", "radial", err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "world_to_camera", "1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1", err), OBS_OK);
+    assert_true(r.params.radius == 0.25f);
+    assert_true(r.params.fov_y == 50.0f);
+    assert_int_equal(r.params.depth_mode, OBS_DEPTH_RADIAL);
+    assert_int_equal(r.params.has_world_to_camera, 1);
+}
+
+static void test_bad_params(void **state)
+{
+    (void)state;
+    obs_http_request r;
+    char err[OBS_ERR_LEN] = "";
+    obs_http_request_init(&r);
+    assert_int_equal(obs_http_request_set(&r, "samples", "64", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "samples"));
+    assert_int_equal(obs_http_request_set(&r, "radius", "abc", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "radius"));
+    assert_int_equal(obs_http_request_set(&r, "frobnicate", "1", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "frobnicate"));
+    assert_int_equal(obs_http_request_set(&r, "output", "all", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "ao|composite|both"));
+    assert_int_equal(obs_http_request_set(&r, "format", "tiff", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_http_request_set(&r, "png_bits", "12", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_http_request_set(&r, "preset", "maya", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_http_request_set(&r, "normal", "N.X,N.Y", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_http_request_set(&r, "normal", "N.X,,N.Z", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_http_request_set(&r, "color", "R,G,B,A,X", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_http_request_set(&r, "depth", "", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_http_request_set(&r, "", "1", err), OBS_INVALID_ARGUMENT);
+    char longname[200];
+    memset(longname, 'x', sizeof longname - 1);
+    longname[sizeof longname - 1] = '\0';
+    assert_int_equal(obs_http_request_set(&r, "depth", longname, err), OBS_INVALID_ARGUMENT);
+    /* nothing half-set: still the defaults */
+    assert_int_equal(r.outputs, OBS_OUTPUT_AO);
+    assert_null(r.map.depth);
+}
+
+static void test_options(void **state)
+{
+    (void)state;
+    obs_http_request r;
+    char err[OBS_ERR_LEN] = "";
+    obs_http_request_init(&r);
+    assert_int_equal(obs_http_request_set(&r, "output", "both", err), OBS_OK);
+    assert_int_equal(r.outputs, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "format", "png", err), OBS_OK);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "one output"));
+    assert_int_equal(obs_http_request_set(&r, "output", "composite", err), OBS_OK);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "png-bits", "16", err), OBS_OK);
+    assert_int_equal(r.png_bits, 16);
+    assert_int_equal(obs_http_request_set(&r, "float", "1", err), OBS_OK);
+    assert_int_equal(r.float_exr, 1);
+    assert_int_equal(obs_http_request_set(&r, "preset", "blender", err), OBS_OK);
+    assert_string_equal(r.map.preset, "blender");
+    assert_int_equal(obs_http_request_set(&r, "depth", "Z", err), OBS_OK);
+    assert_string_equal(r.map.depth, "Z");
+    assert_int_equal(obs_http_request_set(&r, "normal", "N.X,N.Y,N.Z", err), OBS_OK);
+    assert_string_equal(r.map.normal[2], "N.Z");
+    assert_int_equal(obs_http_request_set(&r, "color", "R,G,B", err), OBS_OK);
+    assert_string_equal(r.map.color[2], "B");
+    assert_null(r.map.color[3]);
+    assert_int_equal(obs_http_request_set(&r, "color", "R,G,B,A", err), OBS_OK);
+    assert_string_equal(r.map.color[3], "A");
+}
+
+static void test_status_map(void **state)
+{
+    (void)state;
+    const char *code;
+    assert_int_equal(obs_http_status_of(OBS_INVALID_ARGUMENT, &code), 400);
+    assert_int_equal(obs_http_status_of(OBS_TOO_LARGE, &code), 413);
+    assert_int_equal(obs_http_status_of(OBS_UNSUPPORTED, &code), 415);
+    assert_int_equal(obs_http_status_of(OBS_MISSING_CHANNEL, &code), 422);
+    assert_string_equal(code, "missing_channel");
+    assert_int_equal(obs_http_status_of(OBS_NO_CAMERA, &code), 422);
+    assert_string_equal(code, "no_camera");
+    assert_int_equal(obs_http_status_of(OBS_BAD_FILE, &code), 422);
+    assert_string_equal(code, "bad_file");
+    assert_int_equal(obs_http_status_of(OBS_GL_ERROR, &code), 500);
+    assert_int_equal(obs_http_status_of(OBS_GL_SHADER, NULL), 500);
+    for (int s = 0; s < OBS_STATUS_COUNT; s++) {
+        int h = obs_http_status_of((obs_status)s, &code);
+        assert_true(h >= 200 && h < 600);
+        assert_non_null(code);
+    }
+}
+
+static void test_json(void **state)
+{
+    (void)state;
+    char *e = obs_http_error_json("bad_parameter", "parameter \"samples\": 64 is out of range");
+    cJSON *j = cJSON_Parse(e);
+    assert_non_null(j);
+    cJSON *err = cJSON_GetObjectItem(j, "error");
+    assert_string_equal(cJSON_GetObjectItem(err, "code")->valuestring, "bad_parameter");
+    assert_non_null(strstr(cJSON_GetObjectItem(err, "message")->valuestring, "\"samples\""));
+    cJSON_Delete(j);
+    free(e);
+
+    char *p = obs_http_params_json();
+    j = cJSON_Parse(p);
+    assert_non_null(j);
+    cJSON *params = cJSON_GetObjectItem(j, "params");
+    assert_int_equal(cJSON_GetArraySize(params), obs_param_count());
+    for (int i = 0; i < obs_param_count(); i++) {
+        cJSON *o = cJSON_GetArrayItem(params, i);
+        const obs_param_info *pi = obs_param_at(i);
+        assert_string_equal(cJSON_GetObjectItem(o, "name")->valuestring, pi->name);
+        assert_non_null(cJSON_GetObjectItem(o, "doc"));
+        assert_non_null(cJSON_GetObjectItem(o, "default"));
+        if (pi->type == OBS_PARAM_FLOAT || pi->type == OBS_PARAM_INT)
+            assert_true(cJSON_GetObjectItem(o, "max")->valuedouble == pi->max);
+        if (pi->type == OBS_PARAM_ENUM)
+            assert_true(cJSON_GetArraySize(cJSON_GetObjectItem(o, "choices")) >= 2);
+    }
+    assert_true(cJSON_GetArraySize(cJSON_GetObjectItem(j, "options")) >= 5);
+    cJSON_Delete(j);
+    free(p);
+}
+
+static void test_bearer(void **state)
+{
+    (void)state;
+    assert_true(obs_http_bearer_ok("Bearer abc", "abc"));
+    assert_false(obs_http_bearer_ok("Bearer abd", "abc"));
+    assert_false(obs_http_bearer_ok("Bearer ab", "abc"));
+    assert_false(obs_http_bearer_ok("Bearer abcd", "abc"));
+    assert_false(obs_http_bearer_ok("Bearer ", "abc"));
+    assert_false(obs_http_bearer_ok("Basic abc", "abc"));
+    assert_false(obs_http_bearer_ok(NULL, "abc"));
+    assert_false(obs_http_bearer_ok("Bearer ", ""));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_defaults),   cmocka_unit_test(test_table_params),
+        cmocka_unit_test(test_bad_params), cmocka_unit_test(test_options),
+        cmocka_unit_test(test_status_map), cmocka_unit_test(test_json),
+        cmocka_unit_test(test_bearer),
+    };
+    return cmocka_run_group_tests_name("protocol_http", tests, NULL, NULL);
+}
