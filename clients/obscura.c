@@ -91,7 +91,9 @@ typedef struct cli_opt {
 
 static const cli_opt ao_opts[] = {
     {"o", "FILE", "output file; .exr or .png (also --output-file)"},
-    {"output", "ao|composite|both", "what to write (default ao)"},
+    {"output", "ao|composite|both|samples",
+     "what to write (default ao); a comma list combines them; samples: the sample count "
+     "of each pixel (adaptive sampling, VAO++ 4.1; EXR channel Samples.Y, PNG count/32)"},
     {"format", "exr|png", "output format (default: from the file name)"},
     {"float", NULL, "EXR: 32-bit float channels (default half)"},
     {"png-bits", "8|16", "PNG bit depth (default 8)"},
@@ -205,14 +207,24 @@ static void parse_ao(int argc, char **argv, ao_args *a)
         } else if ((v = opt_value(argc, argv, &i, "o")) || (v = opt_value(argc, argv, &i, "output-file"))) {
             a->out = v;
         } else if ((v = opt_value(argc, argv, &i, "output"))) {
-            if (!strcmp(v, "ao"))
-                a->outputs = OBS_OUTPUT_AO;
-            else if (!strcmp(v, "composite"))
-                a->outputs = OBS_OUTPUT_COMPOSITE;
-            else if (!strcmp(v, "both"))
-                a->outputs = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE;
-            else
-                die_usage("--output: '%s' is not one of ao|composite|both", v);
+            char buf[256];
+            const char *names[4];
+            int k = split_names(v, buf, sizeof buf, names, 4);
+            a->outputs = 0;
+            for (int j = 0; j < k; j++) {
+                if (!strcmp(names[j], "ao"))
+                    a->outputs |= OBS_OUTPUT_AO;
+                else if (!strcmp(names[j], "composite"))
+                    a->outputs |= OBS_OUTPUT_COMPOSITE;
+                else if (!strcmp(names[j], "both"))
+                    a->outputs |= OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE;
+                else if (!strcmp(names[j], "samples"))
+                    a->outputs |= OBS_OUTPUT_SAMPLE_COUNT;
+                else
+                    die_usage("--output: '%s' is not one of ao|composite|both|samples", names[j]);
+            }
+            if (!a->outputs)
+                die_usage("--output: '%s' names no output", v);
         } else if ((v = opt_value(argc, argv, &i, "format"))) {
             if (strcmp(v, "exr") && strcmp(v, "png"))
                 die_usage("--format: '%s' is not one of exr|png", v);
@@ -292,42 +304,70 @@ static void suffixed(const char *path, const char *suffix, char *buf, size_t len
     snprintf(buf, len, "%.*s.%s%s", (int)(dot - path), path, suffix, dot);
 }
 
+/* The sample count as an image of count / 32 (PNG holds [0, 1]). */
+static obs_status count_scaled(const obs_image *count, obs_image *out)
+{
+    size_t n = (size_t)count->width * count->height;
+    out->data = malloc(n * sizeof(float));
+    if (!out->data)
+        return OBS_NO_MEMORY;
+    out->width = count->width;
+    out->height = count->height;
+    out->channels = 1;
+    for (size_t i = 0; i < n; i++)
+        out->data[i] = count->data[i] / 32.0f;
+    return OBS_OK;
+}
+
 static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs_camera *cam,
                                 char err[OBS_ERR_LEN])
 {
     static const char *const ao_names[] = {"AO.Y"};
     static const char *const rgba_names[] = {"R", "G", "B", "A"};
+    static const char *const count_names[] = {"Samples.Y"};
     obs_status s = OBS_OK;
     if (!strcmp(a->format, "exr")) {
-        obs_exr_layer layers[2];
+        obs_exr_layer layers[3];
         int n = 0;
         if (r->ao.data)
             layers[n++] = (obs_exr_layer){&r->ao, ao_names};
         if (r->composite.data)
             layers[n++] = (obs_exr_layer){&r->composite, rgba_names};
+        if (r->sample_count.data)
+            layers[n++] = (obs_exr_layer){&r->sample_count, count_names};
         s = obs_exr_write(a->out, layers, n, a->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
         if (s == OBS_OK)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
         return s;
     }
-    int both = r->ao.data && r->composite.data;
-    char path[4096];
-    if (r->ao.data) {
-        if (both)
-            suffixed(a->out, "ao", path, sizeof path);
+    /* PNG: one file per output; NAME.ao.png, NAME.composite.png,
+     * NAME.samples.png when there are several */
+    const struct {
+        const obs_image *img;
+        const char *suffix;
+        int srgb;
+    } files[] = {{&r->ao, "ao", 0}, {&r->composite, "composite", 1}, {&r->sample_count, "samples", 0}};
+    int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data;
+    for (size_t k = 0; k < sizeof files / sizeof files[0] && s == OBS_OK; k++) {
+        char path[4096];
+        obs_image scaled = {0};
+        const obs_image *img = files[k].img;
+        if (!img->data)
+            continue;
+        if (count > 1)
+            suffixed(a->out, files[k].suffix, path, sizeof path);
         else
             snprintf(path, sizeof path, "%s", a->out);
-        s = obs_png_write(path, &r->ao, a->png_bits, 0, err);
-        if (s != OBS_OK)
-            return s;
-        fprintf(stderr, "obscura: wrote %s\n", path);
-    }
-    if (r->composite.data) {
-        if (both)
-            suffixed(a->out, "composite", path, sizeof path);
-        else
-            snprintf(path, sizeof path, "%s", a->out);
-        s = obs_png_write(path, &r->composite, a->png_bits, 1, err);
+        if (img == &r->sample_count) {
+            s = count_scaled(img, &scaled);
+            if (s != OBS_OK) {
+                snprintf(err, OBS_ERR_LEN, "out of memory for the sample-count image");
+                return s;
+            }
+            img = &scaled;
+        }
+        s = obs_png_write(path, img, a->png_bits, files[k].srgb, err);
+        obs_image_free(&scaled);
         if (s == OBS_OK)
             fprintf(stderr, "obscura: wrote %s\n", path);
     }

@@ -81,6 +81,12 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     f->radius = p->radius / p->unit_scale;
     f->samples = p->samples;
     f->sample_xy = obs__samples(p->samples);
+    f->sample_table = &obs__sample_table[0][0];
+    /* Section 4.1: the area ratio against the disk of diameter D0 (a
+     * fraction of the height) is D^2 / D0^2 with D^2 = r^2 |det J| vw / vh
+     * (see obs__adaptive_count); the constant part is folded here. */
+    f->adaptive = p->adaptive == OBS_ON;
+    f->adaptive_k = f->viewport[2] / (f->viewport[3] * p->adaptive_diameter * p->adaptive_diameter);
     f->range_check = p->range_check == OBS_ON;
     f->range_u = p->range_u;
     f->blur_radius = p->blur == OBS_ON ? p->blur_radius : 0;

@@ -11,6 +11,9 @@
  * or <= 0 is background: no geometry, AO 1, never an occluder. */
 #define OBS__SKY_DEPTH 1e9f
 
+/* Every OBS_OUTPUT_* bit. */
+#define OBS__OUTPUTS_ALL (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT)
+
 /* Largest blur_radius of the parameter table (uniform array size - 1 in
  * blur.frag.glsl). */
 #define OBS__MAX_BLUR 16
@@ -23,8 +26,11 @@ typedef struct obs__frame {
     int reconstruct_normals;/* 1: no usable normals, derive them from depth */
     int depth_mode;         /* OBS_DEPTH_PLANAR/RADIAL/NDC */
     float radius;           /* R in depth units: radius / unit_scale */
-    int samples;
+    int samples;            /* the count of the parameter: adaptive sampling's maximum */
     const float *sample_xy; /* samples * (x, y) on the unit disk */
+    const float *sample_table; /* all sets, 62 (x, y) pairs: the set of n at pair n - 2 */
+    int adaptive;           /* 1: adaptive sampling (section 4.1) */
+    float adaptive_k;       /* vw / (vh * D0^2): disk area ratio = r^2 |det J| * adaptive_k */
     float rot[9][2];        /* (cos, sin) of the 3x3 tile's rotations */
     int range_check;        /* 1: depth range check (section 4.4, eq 4) */
     float range_u;          /* u of eq 4 */
@@ -51,10 +57,16 @@ void obs__prep_position(const obs__frame *f, float raw_depth, int x, int y, floa
 void obs__prep_normal(const obs__frame *f, const float *pos, const float *in_normal, int x, int y,
                       float out[3]);
 
+/* Adaptive sampling, VAO++ section 4.1 (GLSL: adaptive_count() in
+ * vao.frag.glsl): the sample count for a tangent sphere centred at the
+ * view-space point c, from the screen area of its disk of radius R/2. */
+int obs__adaptive_count(const obs__frame *f, const float c[3]);
+
 /* Volumetric AO of the point p with normal n at pixel (x, y), eq 1 and 2
- * of VAO++ section 3; `pos` is the prep pass's position plane. */
+ * of VAO++ section 3; `pos` is the prep pass's position plane.  The count
+ * of samples taken goes to *count when count is not NULL. */
 float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                     const float n[3]);
+                     const float n[3], int *count);
 
 /* Low-pass filter, VAO++ section 4.6 (GLSL: blur.frag.glsl): one pass of
  * the depth-aware cross-bilateral Gaussian along (dx, dy) at pixel (x, y)

@@ -51,6 +51,17 @@ typedef enum obs_normal_space {
       "z-order) exist for 2, 4, 8, 16 and 32 only, other counts are "          \
       "refused: the first n of a larger z-ordered set would cover one part "   \
       "of the disk")                                                           \
+    X(adaptive, ENUM, "on", 0, 0, "on|off",                                    \
+      "adaptive sampling (VAO++ 4.1): each pixel takes the sample set whose "  \
+      "size fits the area of its tangent sphere's disk projected on the "      \
+      "screen: 2 samples up to twice the area of a disk of diameter "          \
+      "adaptive_diameter, doubling with every doubling of the area, at most "  \
+      "samples; off: every pixel takes samples")                               \
+    X(adaptive_diameter, FLOAT, 0.01, 1e-4, 1.0, NULL,                         \
+      "projected disk diameter, as a fraction of the image height, at which "  \
+      "adaptive sampling uses its minimum of 2 samples (4x this diameter "     \
+      "takes 32); 0.01 is 4.8 px at 480 px, where the 3x3 rotation tile's "    \
+      "9 x 2 sample positions are as many as the pixels the disk covers")      \
     X(depth_mode, ENUM, "planar", 0, 0, "planar|radial|ndc",                   \
       "what the depth channel holds: distance along the camera axis, "         \
       "distance from the camera, or a [0,1] OpenGL depth-buffer value")        \

@@ -62,9 +62,9 @@ static obs_status make_fbo(obs_ctx *ctx, GLuint *fbo, const GLuint *tex, int cou
 void obs__frame_release(obs_ctx *ctx)
 {
     obs__targets *t = &ctx->tg;
-    GLuint tex[] = {t->tex_depth, t->tex_normal, t->tex_color, t->tex_viewpos,
-                    t->tex_vnormal, t->tex_ao, t->tex_composite, t->tex_blur};
-    GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite};
+    GLuint tex[] = {t->tex_depth, t->tex_normal,    t->tex_color, t->tex_viewpos, t->tex_vnormal,
+                    t->tex_ao,    t->tex_composite, t->tex_blur,  t->tex_count};
+    GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao};
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
     memset(t, 0, sizeof *t);
@@ -99,8 +99,12 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     t->tex_ao = make_texture(ctx, GL_R32F, w, h);
     t->tex_composite = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_blur = make_texture(ctx, GL_R32F, w, h);
+    t->tex_count = make_texture(ctx, GL_R32F, w, h);
     GLuint prep[] = {t->tex_viewpos, t->tex_vnormal};
+    GLuint vao[] = {t->tex_ao, t->tex_count};
     obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 2, "prep", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_vao, vao, 2, "vao", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_ao, &t->tex_ao, 1, "ao", err);
     if (s == OBS_OK)
@@ -156,10 +160,10 @@ static void draw(obs_ctx *ctx, GLuint fbo, int w, int h)
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-static void read_back(GLuint fbo, int w, int h, GLenum format, float *dst)
+static void read_back(GLuint fbo, GLenum attachment, int w, int h, GLenum format, float *dst)
 {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadBuffer(attachment);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, w, h, format, GL_FLOAT, dst);
 }
@@ -174,7 +178,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     memset(out, 0, sizeof *out);
     if (!ctx)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
-    if (!(outputs & (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE)))
+    if (!(outputs & OBS__OUTPUTS_ALL))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no output requested");
     obs_params_resolve(params, &p);
     s = obs__frame_setup(ctx, gb, &p, &f, err);
@@ -220,11 +224,19 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     bind_tex(prog, "u_vnormal", 1, t->tex_vnormal);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
     glUniform1i(glGetUniformLocation(prog, "u_count"), f.samples);
-    glUniform2fv(glGetUniformLocation(prog, "u_samples"), f.samples, f.sample_xy);
+    /* section 4.1: all sets in one uniform array, picked by offset */
+    glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS__SAMPLE_TABLE_LEN, f.sample_table);
+    glUniform1i(glGetUniformLocation(prog, "u_adaptive"), f.adaptive);
+    glUniform1f(glGetUniformLocation(prog, "u_adaptive_k"), f.adaptive_k);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f.rot[0][0]);
     glUniform1i(glGetUniformLocation(prog, "u_range_check"), f.range_check);
     glUniform1f(glGetUniformLocation(prog, "u_range_u"), f.range_u);
-    draw(ctx, t->fbo_ao, w, h);
+    /* the sample count goes to its texture only when asked for */
+    const GLenum vao_bufs[] = {GL_COLOR_ATTACHMENT0,
+                               (outputs & OBS_OUTPUT_SAMPLE_COUNT) ? GL_COLOR_ATTACHMENT1 : GL_NONE};
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_vao);
+    glDrawBuffers(2, vao_bufs);
+    draw(ctx, t->fbo_vao, w, h);
 
     /* low-pass filter (section 4.6): ao -> blur along x -> ao along y */
     if (f.blur_radius > 0) {
@@ -250,10 +262,12 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         bind_tex(prog, "u_color", 1, t->tex_color);
         glUniform1i(glGetUniformLocation(prog, "u_has_color"), has_color);
         draw(ctx, t->fbo_composite, w, h);
-        read_back(t->fbo_composite, w, h, GL_RGBA, out->composite.data);
+        read_back(t->fbo_composite, GL_COLOR_ATTACHMENT0, w, h, GL_RGBA, out->composite.data);
     }
     if (outputs & OBS_OUTPUT_AO)
-        read_back(t->fbo_ao, w, h, GL_RED, out->ao.data);
+        read_back(t->fbo_ao, GL_COLOR_ATTACHMENT0, w, h, GL_RED, out->ao.data);
+    if (outputs & OBS_OUTPUT_SAMPLE_COUNT)
+        read_back(t->fbo_vao, GL_COLOR_ATTACHMENT1, w, h, GL_RED, out->sample_count.data);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
 

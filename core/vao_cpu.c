@@ -143,9 +143,44 @@ void obs__prep_normal(const obs__frame *f, const float *pos, const float *in_nor
     normalize3(out);
 }
 
+/* GLSL: adaptive_count() in vao.frag.glsl.  Section 4.1: "double the
+ * number of samples every time surface area of the sampling disc
+ * doubles", 2 samples for a disk of diameter D0 (adaptive_diameter, a
+ * fraction of the image height).
+ *
+ * The disk is c + (dx, dy, 0), |(dx, dy)| <= r = R/2.  Its NDC image has
+ * the Jacobian J = d(ndc)/d(dx, dy) at c,
+ *   J = [[P00 w - X P30, P01 w - X P31], [P10 w - Y P30, P11 w - Y P31]] / w^2
+ * with (X, Y, w) = the clip coordinates of c; its area is pi r^2 |det J|
+ * (exact when P30 = P31 = 0, i.e. for every perspective or orthographic
+ * camera: the map is then affine at fixed view z).  In pixels that is
+ * times (vw/2)(vh/2); the diameter D of the disk of the same area, as a
+ * fraction of vh, has D^2 = r^2 |det J| vw / vh, and the area ratio is
+ * q = D^2 / D0^2 = r^2 |det J| * adaptive_k.  The count is 2 for q < 2,
+ * 4 for 2 <= q < 4, ..., capped at the samples parameter; a centre
+ * behind the camera takes the maximum. */
+int obs__adaptive_count(const obs__frame *f, const float c[3])
+{
+    const float *P = f->proj;
+    float w = P[12] * c[0] + P[13] * c[1] + P[14] * c[2] + P[15];
+    if (!(w > 0.0f))
+        return f->samples;
+    float X = P[0] * c[0] + P[1] * c[1] + P[2] * c[2] + P[3];
+    float Y = P[4] * c[0] + P[5] * c[1] + P[6] * c[2] + P[7];
+    float w2 = w * w;
+    float j00 = (P[0] * w - X * P[12]) / w2, j01 = (P[1] * w - X * P[13]) / w2;
+    float j10 = (P[4] * w - Y * P[12]) / w2, j11 = (P[5] * w - Y * P[13]) / w2;
+    float r = 0.5f * f->radius;
+    float q = r * r * fabsf(j00 * j11 - j01 * j10) * f->adaptive_k;
+    int n = 2;
+    while (n < f->samples && q >= (float)n)
+        n *= 2;
+    return n;
+}
+
 /* GLSL: vao.frag.glsl */
 float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                     const float n[3])
+                     const float n[3], int *count)
 {
     const float *P = f->proj;
     const float R = f->radius, r = 0.5f * f->radius;
@@ -153,9 +188,19 @@ float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const 
     float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
     const float *rot = f->rot[3 * (x % 3) + (y % 3)];
     float open = 0.0f, F = 0.0f;
+    /* Section 4.1: the set of the pixel's count, found in the one table of
+     * all sets by its offset (the shader's single uniform array). */
+    int ns = f->samples;
+    const float *xy = f->sample_xy;
+    if (f->adaptive) {
+        ns = obs__adaptive_count(f, c);
+        xy = f->sample_table + 2 * (ns - 2);
+    }
+    if (count)
+        *count = ns;
 
-    for (int i = 0; i < f->samples; i++) {
-        float sx = f->sample_xy[2 * i], sy = f->sample_xy[2 * i + 1];
+    for (int i = 0; i < ns; i++) {
+        float sx = xy[2 * i], sy = xy[2 * i + 1];
         float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
         float h = r * l; /* half length of the pipe through the sphere */
         F += R * l;      /* eq 2: F = R * sum sqrt(1 - x^2 - y^2) */
@@ -219,6 +264,8 @@ obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs, ch
         s = alloc_image(&out->ao, w, h, 1, err);
     if (s == OBS_OK && (outputs & OBS_OUTPUT_COMPOSITE))
         s = alloc_image(&out->composite, w, h, 4, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_SAMPLE_COUNT))
+        s = alloc_image(&out->sample_count, w, h, 1, err);
     if (s != OBS_OK)
         obs_result_free(out);
     return s;
@@ -230,6 +277,7 @@ void obs_result_free(obs_result *r)
         return;
     obs_image_free(&r->ao);
     obs_image_free(&r->composite);
+    obs_image_free(&r->sample_count);
 }
 
 /* GLSL: composite.frag.glsl.  Colour x AO; grey AO when there is no colour. */
@@ -255,7 +303,7 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
     obs_status s;
 
     memset(out, 0, sizeof *out);
-    if (!(outputs & (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE)))
+    if (!(outputs & OBS__OUTPUTS_ALL))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no output requested");
     obs_params_resolve(params, &p);
     s = obs__frame_setup(NULL, gb, &p, &f, err);
@@ -286,11 +334,16 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
             obs__prep_normal(&f, pos, in, x, y, nrm + 3 * ((size_t)y * f.width + x));
         }
     /* AO pass */
+    float *count = out->sample_count.data;
     for (int y = 0; y < f.height; y++)
         for (int x = 0; x < f.width; x++) {
             size_t i = (size_t)y * f.width + x;
-            ao[i] = pos[4 * i + 3] > 0.0f ? obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i)
-                                          : 1.0f;
+            int n = 0;
+            ao[i] = pos[4 * i + 3] > 0.0f
+                        ? obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, &n)
+                        : 1.0f;
+            if (count)
+                count[i] = (float)n;
         }
     /* low-pass filter (section 4.6), then composite */
     obs__blur(&f, pos, ao, tmp);

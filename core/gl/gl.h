@@ -159,7 +159,9 @@ typedef struct obs__targets {
     GLuint tex_viewpos, tex_vnormal;          /* prep outputs */
     GLuint tex_ao, tex_composite;             /* results */
     GLuint tex_blur;                          /* between the two blur passes */
+    GLuint tex_count;                         /* debug: samples per pixel (4.1) */
     GLuint fbo_prep, fbo_ao, fbo_blur, fbo_composite;
+    GLuint fbo_vao;                           /* AO pass: tex_ao + tex_count */
 } obs__targets;
 
 struct obs_ctx {

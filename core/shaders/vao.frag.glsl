@@ -7,13 +7,46 @@ uniform sampler2D u_pos;         // prep: view position, planar depth in w
 uniform sampler2D u_vnormal;     // prep: view normal
 uniform ivec2 u_size;
 uniform float u_radius;          // R, in depth units
-uniform int u_count;             // samples
-uniform vec2 u_samples[32];      // unit disk: a set of section 4.5 (core/sample_tables.c)
+uniform int u_count;             // samples (with adaptive sampling: the most)
+uniform vec2 u_samples[62];      // all sets of section 4.5 (core/sample_tables.c), the
+                                 // set of n from n - 2: the single array of section 4.1
+uniform int u_adaptive;          // 1: adaptive sampling (section 4.1)
+uniform float u_adaptive_k;      // vw / (vh * D0^2), see adaptive_count
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
 uniform int u_range_check;       // 1: depth range check (section 4.4, eq 4)
 uniform float u_range_u;         // u of eq 4
 
-out float o_ao;
+layout(location = 0) out float o_ao;
+layout(location = 1) out float o_count; // samples taken (debug output)
+
+// Adaptive sampling, section 4.1: "double the number of samples every time
+// surface area of the sampling disc doubles", 2 samples for a disk of
+// diameter D0 (a fraction of the image height).  The disk c + (dx, dy, 0),
+// |(dx, dy)| <= r, has in NDC the Jacobian at c
+//   J = [[P00 w - X P30, P01 w - X P31], [P10 w - Y P30, P11 w - Y P31]] / w^2,
+// (X, Y, w) the clip coordinates of c, and the area pi r^2 |det J| (exact
+// for perspective and orthographic cameras: affine at fixed view z).  The
+// diameter D of the disk of that area in pixels, as a fraction of vh, has
+// D^2 = r^2 |det J| vw / vh; the area ratio q = D^2 / D0^2.  Count: 2 for
+// q < 2, 4 for 2 <= q < 4, ..., at most u_count.  C twin:
+// obs__adaptive_count.
+int adaptive_count(vec3 c)
+{
+    float w = PM(3, 0) * c.x + PM(3, 1) * c.y + PM(3, 2) * c.z + PM(3, 3);
+    if (!(w > 0.0))
+        return u_count;
+    float X = PM(0, 0) * c.x + PM(0, 1) * c.y + PM(0, 2) * c.z + PM(0, 3);
+    float Y = PM(1, 0) * c.x + PM(1, 1) * c.y + PM(1, 2) * c.z + PM(1, 3);
+    float w2 = w * w;
+    float j00 = (PM(0, 0) * w - X * PM(3, 0)) / w2, j01 = (PM(0, 1) * w - X * PM(3, 1)) / w2;
+    float j10 = (PM(1, 0) * w - Y * PM(3, 0)) / w2, j11 = (PM(1, 1) * w - Y * PM(3, 1)) / w2;
+    float r = 0.5 * u_radius;
+    float q = r * r * abs(j00 * j11 - j01 * j10) * u_adaptive_k;
+    int n = 2;
+    while (n < u_count && q >= float(n))
+        n *= 2;
+    return n;
+}
 
 void main()
 {
@@ -21,6 +54,7 @@ void main()
     vec4 p = texelFetch(u_pos, px, 0);
     if (p.w <= 0.0) {
         o_ao = 1.0;
+        o_count = 0.0;
         return;
     }
     vec3 n = texelFetch(u_vnormal, px, 0).xyz;
@@ -28,9 +62,13 @@ void main()
     vec3 c = p.xyz + n * r;     // tangent sphere centre
     vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
     float open = 0.0, F = 0.0;
+    // Section 4.1: the pixel's set, by its offset in the one array of sets.
+    int ns = u_adaptive != 0 ? adaptive_count(c) : u_count;
+    int off = ns - 2;
+    o_count = float(ns);
 
-    for (int i = 0; i < u_count; i++) {
-        float sx = u_samples[i].x, sy = u_samples[i].y;
+    for (int i = 0; i < ns; i++) {
+        float sx = u_samples[off + i].x, sy = u_samples[off + i].y;
         float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
         float h = r * l;        // half length of the pipe through the sphere
         F += R * l;             // eq 2: F = R * sum sqrt(1 - x^2 - y^2)

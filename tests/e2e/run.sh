@@ -101,6 +101,13 @@ expect 0 "EXR has AO.Y and RGBA" -- "$OBSCURA" compare "$T/both.exr" "$T/both.ex
 expect 0 "composite PNG 16-bit" -- "$OBSCURA" ao "$R" --camera "$C" --output composite --png-bits 16 -o "$T/c16.png"
 expect 0 "both to PNG" -- "$OBSCURA" ao "$R" --camera "$C" --output both -o "$T/pair.png"
 if [ -s "$T/pair.ao.png" ] && [ -s "$T/pair.composite.png" ]; then ok "both to PNG wrote two files"; else bad "both to PNG files missing"; fi
+# the per-pixel sample count of adaptive sampling (VAO++ 4.1), a debug output
+expect 0 "AO and sample count to EXR" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,samples -o "$T/count.exr" --adaptive-diameter 0.04
+expect 0 "EXR has AO.Y and Samples.Y" -- "$OBSCURA" compare "$T/count.exr" "$T/count.exr" --channel-a AO.Y --channel-b Samples.Y --mask none
+expect 0 "sample count to PNG with the AO" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,samples -o "$T/count.png"
+if [ -s "$T/count.ao.png" ] && [ -s "$T/count.samples.png" ]; then ok "ao,samples to PNG wrote two files"; else bad "ao,samples PNG files missing"; fi
+expect 2 "unknown output" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,depth -o "$T/x.exr"
+said "not one of ao|composite|both|samples"
 expect 0 "CPU twin" -- "$OBSCURA" ao "$R" --camera "$C" --cpu -o "$T/cpu.exr" --float
 expect 0 "GL float" -- "$OBSCURA" ao "$R" --camera "$C" -o "$T/gl.exr" --float
 expect 0 "compare GL with CPU twin" -- "$OBSCURA" compare "$T/cpu.exr" "$T/gl.exr" --mask none --json

@@ -60,13 +60,17 @@ static void test_gl_matches_cpu(void **state)
         obs_result gl, cpu;
         char err[OBS_ERR_LEN] = "";
         load(scenes[s], &gf);
-        unsigned out = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE;
-        /* the defaults (range check and 5-tap blur on), then a wide blur
-         * with the range check off, then no blur */
+        unsigned out = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT;
+        /* the defaults (range check, 5-tap blur, adaptive sampling on),
+         * then a wide blur with the range check off, then no blur, then
+         * adaptive sampling with a diameter that spreads the counts over
+         * 2..32, then a fixed count */
         static const char *const variants[][2][2] = {
             {{NULL, NULL}, {NULL, NULL}},
             {{"blur_radius", "7"}, {"range_check", "off"}},
             {{"blur", "off"}, {NULL, NULL}},
+            {{"adaptive_diameter", "0.04"}, {"samples", "32"}},
+            {{"adaptive", "off"}, {NULL, NULL}},
         };
         for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
             obs_params p = {0};
@@ -76,16 +80,22 @@ static void test_gl_matches_cpu(void **state)
                                      OBS_OK);
             assert_int_equal(obs_run(ctx, &gf.gb, &p, out, &gl, err), OBS_OK);
             assert_int_equal(obs_run_cpu(&gf.gb, &p, out, &cpu, err), OBS_OK);
-            double mean, frac, cmean, cfrac;
+            double mean, frac, cmean, cfrac, nmean, nfrac;
             diff(&gl.ao, &cpu.ao, &mean, &frac);
             diff(&gl.composite, &cpu.composite, &cmean, &cfrac);
+            /* the sample count (section 4.1) compares the disk's area
+             * with powers of two: only a pixel within rounding of one
+             * may differ */
+            diff(&gl.sample_count, &cpu.sample_count, &nmean, &nfrac);
             print_message("%s (%s %s): GL vs CPU AO: mean |diff| %.2e, %.3f %% of pixels > 1e-3; "
-                          "composite mean %.2e\n",
+                          "composite mean %.2e; sample counts differ at %.3f %% of pixels\n",
                           scenes[s], variants[v][0][0] ? variants[v][0][0] : "defaults",
-                          variants[v][0][1] ? variants[v][0][1] : "", mean, 100 * frac, cmean);
+                          variants[v][0][1] ? variants[v][0][1] : "", mean, 100 * frac, cmean,
+                          100 * nfrac);
             assert_true(mean < 1e-3);
             assert_true(frac < 0.02);
             assert_true(cmean < 1e-3);
+            assert_true(nfrac < 1e-3);
             obs_result_free(&gl);
             obs_result_free(&cpu);
         }

@@ -175,6 +175,7 @@ static float *frame_ao(const obs_gbuffer *gb, int n, const float *xy)
     assert_int_equal(obs__frame_setup(NULL, gb, &rp, &f, err), OBS_OK);
     f.samples = n; /* the twin takes any count; the parameter only 2..32 */
     f.sample_xy = xy;
+    f.adaptive = 0; /* this set at every pixel: no adaptive choice (4.1) */
     size_t npx = (size_t)f.width * f.height;
     float *pos = malloc(npx * 4 * sizeof(float)), *nrm = malloc(npx * 3 * sizeof(float));
     float *ao = malloc(npx * sizeof(float)), *tmp = malloc(npx * sizeof(float));
@@ -189,8 +190,9 @@ static float *frame_ao(const obs_gbuffer *gb, int n, const float *xy)
     for (int y = 0; y < f.height; y++)
         for (int x = 0; x < f.width; x++) {
             size_t i = (size_t)y * f.width + x;
-            ao[i] = pos[4 * i + 3] > 0.0f ? obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i)
-                                          : 1.0f;
+            ao[i] = pos[4 * i + 3] > 0.0f
+                        ? obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, NULL)
+                        : 1.0f;
         }
     obs__blur(&f, pos, ao, tmp);
     free(pos);

@@ -262,9 +262,9 @@ static void test_inner_corner(void **state)
         for (int k = 0; k < 9; k++) { /* every rotation of the 3x3 tile */
             int x = W / 2 + k / 3, y = H / 2 + k % 3;
             const float corner[3] = {0.0f, -0.5f, -5.0f};
-            assert_float_equal(obs__vao_pixel(&f, pos, x, y, corner, floor_n), 0.5f, 1e-5f);
+            assert_float_equal(obs__vao_pixel(&f, pos, x, y, corner, floor_n, NULL), 0.5f, 1e-5f);
             const float near[3] = {0.0f, -0.5f, -5.0f + e};
-            assert_float_equal(obs__vao_pixel(&f, pos, x, y, near, floor_n),
+            assert_float_equal(obs__vao_pixel(&f, pos, x, y, near, floor_n, NULL),
                                (float)(0.5 + n * e / F), 1e-5f);
         }
         free(pos);
@@ -365,7 +365,7 @@ static void test_range_check_closed_form(void **state)
                 open += f.range_check ? 2 * h * (1 - sd) : 0.0;
             }
             const float pt[3] = {0.0f, 0.0f, -4.0f - D};
-            float v = obs__vao_pixel(&f, pos, W / 2, H / 2, pt, n_cam);
+            float v = obs__vao_pixel(&f, pos, W / 2, H / 2, pt, n_cam, NULL);
             assert_float_equal(v, (float)(open / F), 1e-5f);
             if (pass == 1)
                 assert_float_equal(v, 0.0f, 0.0f);
