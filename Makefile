@@ -78,8 +78,11 @@ $(LIB): $(CORE_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(CLI): $(CLI_OBJ) $(LIB)
-	$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) $(PKG_LIBS)
+# The CLI is also a client of obscurad (clients/remote.c): it links the
+# protocol library.
+$(BUILD)/obj/clients/%.o: CPPFLAGS += -Iprotocol
+$(CLI): $(CLI_OBJ) $(PROTO_LIB) $(LIB)
+	$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(PROTO_LIB) $(LIB) $(PKG_LIBS)
 
 $(BENCH): bench/frame_bench.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
@@ -141,7 +144,7 @@ e2e: $(CLI) $(E2E_DEPS)
 # Every public header compiles alone, as C and as C++.
 headers:
 	@mkdir -p $(BUILD)/headers
-	@for h in core/obscura.h core/status.h core/params.h core/io.h core/metrics.h protocol/http.h; do \
+	@for h in core/obscura.h core/status.h core/params.h core/io.h core/metrics.h protocol/http.h protocol/binary.h; do \
 	  echo "#include \"$$h\"" > $(BUILD)/headers/t.c; \
 	  $(CC) -I. -Wall -Wextra -Werror -std=c99 -c $(BUILD)/headers/t.c -o /dev/null || exit 1; \
 	  cp $(BUILD)/headers/t.c $(BUILD)/headers/t.cpp; \

@@ -17,6 +17,7 @@
 #include "io.h"
 #include "metrics.h"
 #include "obscura.h"
+#include "remote.h"
 
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_BADINPUT = 3 };
 
@@ -105,6 +106,7 @@ static const cli_opt ao_opts[] = {
     {"max-size", "N", "largest accepted width or height (default 16384)"},
     {"backend", "B", "auto|egl-device|egl-surfaceless|osmesa (or OBSCURA_BACKEND)"},
     {"cpu", NULL, "run the CPU twin instead of OpenGL (slow; for reference)"},
+    {"server", "URL", "run on obscurad: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT"},
     {"debug-gl", NULL, "install the KHR_debug callback and log GL messages"},
     {"quiet", NULL, "only warnings and errors (-q)"},
     {"verbose", NULL, "debug messages too (-v)"},
@@ -145,7 +147,7 @@ static void usage(FILE *f)
             snprintf(range, sizeof range, " {%s}", pi->choices);
         fprintf(f, "  %-30s %s (default %s%s)\n", flag, pi->doc, pi->def, range);
     }
-    fprintf(f, "\nexit codes: 0 ok, 1 failure, 2 usage, 3 bad input\n");
+    fprintf(f, "\nexit codes: 0 ok, 1 failure, 2 usage, 3 bad input, 4 server unreachable or busy\n");
 }
 
 /* Splits "a,b,c" into at most n names (pointers into a copy kept in buf). */
@@ -396,7 +398,9 @@ static int cmd_ao(int argc, char **argv)
     obs_ctx *ctx = NULL;
     obs_status s;
     int rc = EXIT_OK;
+    const char *server = NULL;
 
+    argc = cli_remote_take_server(argc, argv, &server);
     parse_ao(argc, argv, &a);
     obs_limits lim = {0};
     if (a.max_size)
@@ -431,6 +435,9 @@ static int cmd_ao(int argc, char **argv)
     t0 = now_ms();
     if (a.cpu) {
         s = obs_run_cpu(&gf.gb, &a.params, a.outputs, &res, err);
+    } else if (server) { /* clients/remote.c prints its own errors */
+        if ((rc = cli_remote_run(server, argc, argv, a.in, &gf.gb, a.outputs, &res)) != EXIT_OK)
+            goto done;
     } else {
         obs_ctx_desc desc = {.debug = a.debug_gl, .log = log_cb};
         backend_from_args(a.backend, &desc.backend);

@@ -285,7 +285,7 @@ void obsd_config_format(const obsd_config *c, const obsd_opt_info *o, char *buf,
 void obsd_config_help(FILE *f)
 {
     static const char *const args[] = {"STRING", "N", "SIZE", "CHOICE"}; /* SIZE takes k, m, g */
-    fprintf(f, "obscurad %s: the obscura daemon (one GL context, frames over HTTP)\n\n"
+    fprintf(f, "obscurad %s: the obscura daemon (one GL context, frames over HTTP and the binary protocol)\n\n"
                "usage: obscurad [--config FILE] [--OPTION VALUE]...\n\n"
                "Every option is also a config-file line 'name value' (# comments);\n"
                "flags override the file.\n\n"

@@ -21,13 +21,16 @@
       "HTTP listen address HOST:PORT (IPv4; port 0 picks a free port; "        \
       "empty: no HTTP)")                                                       \
     X(socket, STRING, 0, OBSD_STR_LEN - 1, "",                                 \
-      "binary protocol on this Unix socket path (not implemented yet)")       \
+      "binary protocol (protocol/PROTOCOL.md) on this Unix socket path "      \
+      "(empty: none)")       \
     X(tcp, STRING, 0, OBSD_STR_LEN - 1, "",                                    \
-      "binary protocol on this TCP HOST:PORT (not implemented yet)")          \
+      "binary protocol on this TCP [HOST:]PORT (host 127.0.0.1 unless "       \
+      "given; port 0 picks a free port; empty: none)")          \
     X(queue, INT, 1, 1024, "8",                                                \
       "frames that may wait for the GL worker; more are answered 503")         \
     X(threads, INT, 1, 64, "4",                                                \
-      "HTTP threads (they read, decode and encode; one GL thread runs)")       \
+      "HTTP threads (they read, decode and encode; one GL thread runs; the "  \
+      "binary protocol has a thread per connection)")       \
     X(max_pixels, SIZE, 1, 1073741824, "33554432",                             \
       "largest accepted width x height of a G-buffer (413 above)")             \
     X(max_body, SIZE, 1024, 17179869184, "1g",                                 \

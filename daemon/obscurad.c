@@ -1,9 +1,12 @@
-/* obscurad: keeps one GL context alive and serves AO frames over HTTP.
+/* obscurad: keeps one GL context alive and serves AO frames over HTTP and
+ * the binary protocol (Unix socket, TCP).
  *
- *   obscurad [--config FILE] [--http 127.0.0.1:8420] [--queue 8] ...
+ *   obscurad [--config FILE] [--http 127.0.0.1:8420] [--socket PATH]
+ *            [--tcp HOST:PORT] [--queue 8] ...
  *
  * Threads: main (signals, start and drain), the GL worker (the only one
- * that touches GL), libmicrohttpd's pool (parse, decode, encode).
+ * that touches GL), libmicrohttpd's pool and the binary protocol's
+ * connection threads (parse, decode, encode).
  * SIGTERM/SIGINT: stop accepting, finish every queued and running frame,
  * answer it, exit 0; a second SIGINT exits at once.
  * Exit codes: 0 ok, 1 failure (GL, listen), 2 usage. */
@@ -16,6 +19,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "binary_server.h"
 #include "gl_worker.h"
 #include "http_server.h"
 #include "log.h"
@@ -98,12 +102,8 @@ int main(int argc, char **argv)
         return 0;
     }
     obsd_log_set_level(cfg.log_level);
-    if (cfg.socket[0] || cfg.tcp[0]) {
-        obsd_log(OBSD_LOG_ERROR, "--socket/--tcp: the binary protocol is not implemented yet; use --http");
-        return 2;
-    }
-    if (!cfg.http[0]) {
-        obsd_log(OBSD_LOG_ERROR, "no listener: --http is empty");
+    if (!cfg.http[0] && !cfg.socket[0] && !cfg.tcp[0]) {
+        obsd_log(OBSD_LOG_ERROR, "no listener: --http, --socket and --tcp are all empty");
         return 2;
     }
     if (cfg.token_file[0] && read_token(cfg.token_file, token, sizeof token) != 0)
@@ -128,6 +128,7 @@ int main(int argc, char **argv)
     obsd_queue queue;
     obsd_gl_worker gl;
     obsd_http *http = NULL;
+    obsd_bin *bin = NULL;
     if (obsd_queue_init(&queue, cfg.queue) != 0) {
         obsd_log(OBSD_LOG_ERROR, "out of memory");
         return 1;
@@ -142,15 +143,30 @@ int main(int argc, char **argv)
     }
     obsd_log(OBSD_LOG_INFO, "GL context: backend %s, %s, %s (created in %.0f ms)", gl.backend,
              gl.gl_renderer, gl.gl_version, gl.create_ms);
-    s = obsd_http_start(&cfg, token, &queue, &gl, &http, err);
+    s = cfg.http[0] ? obsd_http_start(&cfg, token, &queue, &gl, &http, err) : OBS_OK;
+    if (s == OBS_OK && (cfg.socket[0] || cfg.tcp[0]))
+        s = obsd_bin_start(&cfg, token, &queue, &gl, &bin, err);
     mask_signals(SIG_UNBLOCK);
     if (s != OBS_OK) {
         obsd_log(OBSD_LOG_ERROR, "%s", err);
+        if (http) {
+            obsd_http_quiesce(http);
+            obsd_http_stop(http);
+        }
         obsd_gl_stop(&gl);
         obsd_queue_destroy(&queue);
         return 1;
     }
-    {
+    if (cfg.socket[0])
+        obsd_log(OBSD_LOG_INFO, "binary protocol on unix:%s", cfg.socket);
+    if (cfg.tcp[0]) {
+        char host[OBSD_STR_LEN] = "127.0.0.1";
+        const char *colon = strrchr(cfg.tcp, ':');
+        if (colon && colon > cfg.tcp)
+            snprintf(host, sizeof host, "%.*s", (int)(colon - cfg.tcp), cfg.tcp);
+        obsd_log(OBSD_LOG_INFO, "binary protocol on tcp://%s:%d", host, obsd_bin_tcp_port(bin));
+    }
+    if (http) {
         char host[OBSD_STR_LEN];
         snprintf(host, sizeof host, "%s", cfg.http);
         char *colon = strrchr(host, ':');
@@ -166,10 +182,12 @@ int main(int argc, char **argv)
 
     /* Drain: no new connections; every frame taken is finished and
      * answered before the server stops. */
-    obsd_log(OBSD_LOG_INFO, "stopping: finishing %d request(s) under way (SIGINT again to quit now)",
-             obsd_http_in_flight(http));
-    obsd_http_quiesce(http);
-    while (obsd_http_in_flight(http) > 0) {
+    obsd_log(OBSD_LOG_INFO, "stopping: finishing %d request(s) and %d binary connection(s) under way "
+             "(SIGINT again to quit now)", http ? obsd_http_in_flight(http) : 0, obsd_bin_in_flight(bin));
+    if (http)
+        obsd_http_quiesce(http);
+    obsd_bin_quiesce(bin);
+    while ((http && obsd_http_in_flight(http) > 0) || obsd_bin_in_flight(bin) > 0) {
         if (interrupts >= 2) {
             obsd_log(OBSD_LOG_WARN, "second SIGINT: exiting now");
             _exit(130);
@@ -177,6 +195,7 @@ int main(int argc, char **argv)
         sleep_ms(20);
     }
     obsd_http_stop(http);
+    obsd_bin_stop(bin);
     obsd_gl_stop(&gl);
     obsd_queue_destroy(&queue);
     obsd_log(OBSD_LOG_INFO, "stopped");

@@ -8,7 +8,7 @@
 #include "stats.h"
 
 static const char *const route_paths[OBSD_ROUTE_COUNT] = {
-    "/v1/ao", "/v1/params", "/v1/info", "/healthz", "/readyz", "/metrics", "other"};
+    "/v1/ao", "/v1/params", "/v1/info", "/healthz", "/readyz", "/metrics", "binary", "other"};
 static const char *const stage_names[OBSD_STAGE_COUNT] = {"queue", "decode", "gl", "encode", "total"};
 /* The statuses the daemon answers; anything else counts as the last. */
 static const int codes[] = {200, 400, 401, 404, 405, 413, 415, 422, 500, 503, 0};

@@ -13,6 +13,7 @@ typedef enum obsd_route {
     OBSD_ROUTE_HEALTHZ,
     OBSD_ROUTE_READYZ,
     OBSD_ROUTE_METRICS,
+    OBSD_ROUTE_BINARY, /* the binary protocol (socket / TCP), not a URL */
     OBSD_ROUTE_OTHER,
     OBSD_ROUTE_COUNT
 } obsd_route;

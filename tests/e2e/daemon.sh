@@ -78,8 +78,8 @@ echo "-- options"
 check "--help lists every option" "grep -q -- '--max-body' '$T/help' && grep -q -- '--token-file' '$T/help' && grep -q -- '--log-level' '$T/help'"
 "$OBSCURAD" --queue 0 >"$T/q0" 2>&1
 check "--queue 0 refused with exit 2, naming it" "[ $? -eq 2 ] && grep -q 'queue' '$T/q0'"
-"$OBSCURAD" --socket "$T/s.sock" >"$T/sock" 2>&1
-check "--socket: exit 2, not implemented yet" "[ $? -eq 2 ] && grep -q 'not implemented' '$T/sock'"
+"$OBSCURAD" --http '' >"$T/nolisten" 2>&1
+check "no listener at all: exit 2" "[ $? -eq 2 ] && grep -q 'no listener' '$T/nolisten'"
 printf 'queue 3\n# a comment\nlog_level debug\nbogus 1\n' > "$T/bad.conf"
 "$OBSCURAD" --config "$T/bad.conf" >"$T/conf" 2>&1
 check "config file error names file and line" "[ $? -eq 2 ] && grep -q 'bad.conf:4' '$T/conf'"

@@ -1,0 +1,555 @@
+/* The remote client of `obscura ao --server URL` (see remote.h): a
+ * minimal HTTP/1.1 POST (Connection: close) and the binary protocol,
+ * both over plain sockets. */
+#include "remote.h"
+
+#include <errno.h>
+#include <math.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <sys/un.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "binary.h"
+#include "io.h"
+
+enum { RC_OK = 0, RC_FAIL = 1, RC_USAGE = 2, RC_BADINPUT = 3, RC_UNAVAILABLE = 4 };
+
+#define ATTEMPTS 5         /* tries when unreachable or busy */
+#define MAX_WAIT_S 5       /* the longest Retry-After honoured */
+#define IO_TIMEOUT_S 300   /* send / receive timeout per call */
+#define MAX_ANSWER (4ull << 30)
+
+typedef enum { PROTO_HTTP, PROTO_UNIX, PROTO_TCP } proto;
+
+typedef struct server_addr {
+    proto kind;
+    char host[256], port[16], path[108];
+} server_addr;
+
+int cli_remote_take_server(int argc, char **argv, const char **server)
+{
+    int n = 0;
+    *server = NULL;
+    for (int i = 0; i < argc; i++) {
+        if (!strcmp(argv[i], "--server") && i + 1 < argc) {
+            *server = argv[++i];
+        } else if (!strncmp(argv[i], "--server=", 9)) {
+            *server = argv[i] + 9;
+        } else {
+            argv[n++] = argv[i];
+        }
+    }
+    return n;
+}
+
+static int parse_server(const char *url, server_addr *a)
+{
+    memset(a, 0, sizeof *a);
+    const char *rest;
+    if (!strncmp(url, "unix:", 5)) {
+        a->kind = PROTO_UNIX;
+        rest = url + 5;
+        if (!strncmp(rest, "//", 2))
+            rest += 2;
+        if (!*rest || strlen(rest) >= sizeof a->path)
+            return -1;
+        snprintf(a->path, sizeof a->path, "%s", rest);
+        return 0;
+    }
+    if (!strncmp(url, "http://", 7)) {
+        a->kind = PROTO_HTTP;
+        rest = url + 7;
+    } else if (!strncmp(url, "tcp://", 6)) {
+        a->kind = PROTO_TCP;
+        rest = url + 6;
+    } else {
+        return -1;
+    }
+    const char *colon = strrchr(rest, ':');
+    size_t hl = colon ? (size_t)(colon - rest) : 0;
+    if (!colon || hl == 0 || hl >= sizeof a->host)
+        return -1;
+    memcpy(a->host, rest, hl);
+    const char *p = colon + 1;
+    size_t pl = strcspn(p, "/");
+    if (pl == 0 || pl >= sizeof a->port || strspn(p, "0123456789") != pl || (p[pl] && strcmp(p + pl, "/")))
+        return -1;
+    memcpy(a->port, p, pl);
+    return 0;
+}
+
+static void set_timeouts(int fd)
+{
+    struct timeval tv = {IO_TIMEOUT_S, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
+}
+
+/* -1 when the server cannot be reached (retryable). */
+static int connect_to(const server_addr *a, char *why, size_t why_len)
+{
+    if (a->kind == PROTO_UNIX) {
+        struct sockaddr_un sa = {.sun_family = AF_UNIX};
+        snprintf(sa.sun_path, sizeof sa.sun_path, "%s", a->path);
+        int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+        if (fd >= 0 && connect(fd, (struct sockaddr *)&sa, sizeof sa) == 0) {
+            set_timeouts(fd);
+            return fd;
+        }
+        snprintf(why, why_len, "unix:%s: %s", a->path, strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    struct addrinfo hints = {.ai_family = AF_UNSPEC, .ai_socktype = SOCK_STREAM}, *res = NULL;
+    int gai = getaddrinfo(a->host, a->port, &hints, &res);
+    if (gai != 0) {
+        snprintf(why, why_len, "%s:%s: %s", a->host, a->port, gai_strerror(gai));
+        return -1;
+    }
+    int fd = -1;
+    for (struct addrinfo *ai = res; ai && fd < 0; ai = ai->ai_next) {
+        fd = socket(ai->ai_family, ai->ai_socktype | SOCK_CLOEXEC, ai->ai_protocol);
+        if (fd >= 0 && connect(fd, ai->ai_addr, ai->ai_addrlen) != 0) {
+            snprintf(why, why_len, "%s:%s: %s", a->host, a->port, strerror(errno));
+            close(fd);
+            fd = -1;
+        }
+    }
+    freeaddrinfo(res);
+    if (fd >= 0) {
+        int one = 1;
+        setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+        set_timeouts(fd);
+    }
+    return fd;
+}
+
+static int send_all(int fd, const void *buf, size_t len)
+{
+    for (size_t put = 0; put < len;) {
+        ssize_t n = send(fd, (const char *)buf + put, len - put, MSG_NOSIGNAL);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return -1;
+        put += (size_t)n;
+    }
+    return 0;
+}
+
+static int recv_all(int fd, void *buf, size_t len)
+{
+    for (size_t got = 0; got < len;) {
+        ssize_t n = recv(fd, (char *)buf + got, len - got, 0);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return -1;
+        got += (size_t)n;
+    }
+    return 0;
+}
+
+/* ---- the parameters to forward ------------------------------------------- */
+
+typedef struct pairs {
+    obs_bin_param p[OBS_BIN_MAX_PARAMS];
+    int n;
+} pairs;
+
+static void add(pairs *ps, const char *name, const char *value)
+{
+    if (ps->n < OBS_BIN_MAX_PARAMS)
+        ps->p[ps->n++] = (obs_bin_param){name, value};
+}
+
+static int has(const pairs *ps, const char *name)
+{
+    for (int i = 0; i < ps->n; i++)
+        if (!strcmp(ps->p[i].name, name))
+            return 1;
+    return 0;
+}
+
+/* The table's parameters as given (parse_ao has checked them), and with
+ * `map_too` the channel-map options.  Names keep their spelling ('-' or
+ * '_'), which both protocols accept; leading "--" is dropped. */
+static void collect(int argc, char **argv, int map_too, pairs *ps, char names[][OBS_BIN_MAX_NAME + 1])
+{
+    static const char *const map_opts[] = {"preset", "depth", "normal", "color", NULL};
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (strncmp(a, "--", 2) != 0)
+            continue;
+        const char *eq = strchr(a + 2, '=');
+        size_t n = eq ? (size_t)(eq - a - 2) : strlen(a + 2);
+        if (n == 0 || n > OBS_BIN_MAX_NAME)
+            continue;
+        char *name = names[ps->n];
+        snprintf(name, OBS_BIN_MAX_NAME + 1, "%.*s", (int)n, a + 2);
+        int is_map = 0;
+        for (int k = 0; map_opts[k]; k++)
+            is_map |= !strcmp(name, map_opts[k]);
+        int is_param = obs_param_find(name) != NULL;
+        if (!is_param && !(map_too && is_map))
+            continue; /* a client option (its value, if any, is no "--" word) */
+        const char *value = eq ? eq + 1 : (i + 1 < argc ? argv[++i] : "");
+        add(ps, name, value);
+    }
+}
+
+static const char *outputs_name(unsigned outputs)
+{
+    switch (outputs) {
+    case OBS_OUTPUT_AO: return "ao";
+    case OBS_OUTPUT_COMPOSITE: return "composite";
+    case OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE: return "both";
+    default: return NULL;
+    }
+}
+
+/* Exit code for a server's answer other than 200. */
+static int answer_rc(int status)
+{
+    if (status == 503)
+        return RC_UNAVAILABLE;
+    return status >= 400 && status < 500 ? RC_BADINPUT : RC_FAIL;
+}
+
+static int copy_image(const float *src, size_t stride_floats, int w, int h, int ch, obs_image *out)
+{
+    size_t row = (size_t)w * ch;
+    out->data = malloc(row * h * sizeof(float));
+    if (!out->data)
+        return -1;
+    out->width = w;
+    out->height = h;
+    out->channels = ch;
+    for (int y = 0; y < h; y++)
+        memcpy(out->data + row * y, src + stride_floats * y, row * sizeof(float));
+    return 0;
+}
+
+/* ---- binary protocol ------------------------------------------------------ */
+
+/* One attempt.  Returns 0 and fills res on 200; otherwise the status
+ * (503 and -1 for "unreachable" are retried by the caller). */
+static int binary_once(const server_addr *a, const obs_bytes *frame, obs_result *res, int *retry_after,
+                       char *msg, size_t msg_len)
+{
+    int fd = connect_to(a, msg, msg_len);
+    if (fd < 0)
+        return -1;
+    unsigned char hdr[OBS_BIN_HEADER_LEN];
+    unsigned char *payload = NULL;
+    obs_bin_header h;
+    obs_bin_response r = {0};
+    char err[OBS_ERR_LEN];
+    int rc = -1;
+    if (send_all(fd, frame->data, frame->size) != 0 || recv_all(fd, hdr, sizeof hdr) != 0) {
+        snprintf(msg, msg_len, "connection lost: %s", strerror(errno));
+        goto done;
+    }
+    if (obs_bin_header_parse(hdr, &h, MAX_ANSWER, err) != OBS_OK || h.kind != OBS_BIN_RESPONSE) {
+        snprintf(msg, msg_len, "not an obscurad answer: %s", err);
+        rc = 500;
+        goto done;
+    }
+    if (!(payload = malloc(h.length ? (size_t)h.length : 1)) || recv_all(fd, payload, (size_t)h.length) != 0) {
+        snprintf(msg, msg_len, "answer cut short");
+        goto done;
+    }
+    if (obs_bin_response_decode(payload, (size_t)h.length, NULL, &r, err) != OBS_OK) {
+        snprintf(msg, msg_len, "bad answer: %s", err);
+        rc = 500;
+        goto done;
+    }
+    if (r.status != 200) {
+        snprintf(msg, msg_len, "%.63s: %.500s", r.code, r.message);
+        *retry_after = r.retry_after;
+        rc = r.status;
+        goto done;
+    }
+    for (int i = 0; i < r.image_count; i++) {
+        /* take the images over: they are ours */
+        if (r.images[i].output == OBS_OUTPUT_AO && !res->ao.data)
+            res->ao = r.images[i].image, r.images[i].image = (obs_image){0};
+        else if (r.images[i].output == OBS_OUTPUT_COMPOSITE && !res->composite.data)
+            res->composite = r.images[i].image, r.images[i].image = (obs_image){0};
+    }
+    rc = 0;
+done:
+    obs_bin_response_free(&r);
+    free(payload);
+    close(fd);
+    return rc;
+}
+
+/* ---- HTTP ----------------------------------------------------------------- */
+
+static void url_encode(const char *s, char *out, size_t len)
+{
+    static const char hex[] = "0123456789ABCDEF";
+    size_t o = 0;
+    for (; *s && o + 4 < len; s++) {
+        unsigned char c = (unsigned char)*s;
+        if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+            strchr("-_.~,", c)) {
+            out[o++] = (char)c;
+        } else {
+            out[o++] = '%';
+            out[o++] = hex[c >> 4];
+            out[o++] = hex[c & 15];
+        }
+    }
+    out[o] = '\0';
+}
+
+static unsigned char *read_file(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    unsigned char *buf = NULL;
+    long n;
+    if (!f)
+        return NULL;
+    if (fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0 &&
+        (buf = malloc((size_t)n)) && fread(buf, 1, (size_t)n, f) == (size_t)n) {
+        *len = (size_t)n;
+    } else {
+        free(buf);
+        buf = NULL;
+    }
+    fclose(f);
+    return buf;
+}
+
+/* The answer's EXR (float, AO.Y and/or R,G,B,A) back into images. */
+static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs, obs_result *res,
+                         char *msg, size_t msg_len)
+{
+    obs_channel_map map = {.preset = "generic", .depth = (outputs & OBS_OUTPUT_AO) ? "AO.Y" : "R"};
+    if (outputs & OBS_OUTPUT_COMPOSITE) {
+        static const char *const rgba[] = {"R", "G", "B", "A"};
+        for (int c = 0; c < 4; c++)
+            map.color[c] = rgba[c];
+    }
+    obs_gbuffer_file gf = {0};
+    char err[OBS_ERR_LEN];
+    if (obs_gbuffer_read_exr_mem(body, len, &map, NULL, &gf, err) != OBS_OK) {
+        snprintf(msg, msg_len, "cannot read the answer's EXR: %s", err);
+        return -1;
+    }
+    const obs_gbuffer *g = &gf.gb;
+    int rc = 0;
+    if (outputs & OBS_OUTPUT_AO)
+        rc |= copy_image(g->depth.data, g->depth.row_stride ? g->depth.row_stride / 4 : (size_t)g->width,
+                         g->width, g->height, 1, &res->ao);
+    if (outputs & OBS_OUTPUT_COMPOSITE)
+        rc |= copy_image(g->color.data, g->color.row_stride ? g->color.row_stride / 4 : (size_t)g->width * 4,
+                         g->width, g->height, 4, &res->composite);
+    obs_gbuffer_free(&gf);
+    if (rc)
+        snprintf(msg, msg_len, "out of memory");
+    return rc ? -1 : 0;
+}
+
+static int http_once(const server_addr *a, const char *query, const unsigned char *body, size_t body_len,
+                     unsigned outputs, obs_result *res, int *retry_after, char *msg, size_t msg_len)
+{
+    int fd = connect_to(a, msg, msg_len);
+    if (fd < 0)
+        return -1;
+    const char *token = getenv("OBSCURA_TOKEN");
+    size_t hcap = strlen(query) + 1024;
+    char *head = malloc(hcap);
+    unsigned char *ans = NULL;
+    size_t alen = 0, acap = 0;
+    int rc = -1;
+    if (!head)
+        goto done;
+    snprintf(head, hcap, "POST /v1/ao?%s HTTP/1.1\r\nHost: %s:%s\r\nContent-Type: image/x-exr\r\n"
+             "Content-Length: %zu\r\nConnection: close\r\n%s%s%s\r\n", query, a->host, a->port, body_len,
+             token && *token ? "Authorization: Bearer " : "", token && *token ? token : "",
+             token && *token ? "\r\n" : "");
+    /* a 413 or 401 may come before the body is read; the answer counts */
+    int sent = send_all(fd, head, strlen(head)) == 0 && send_all(fd, body, body_len) == 0;
+    for (;;) {
+        if (alen == acap) {
+            acap = acap ? acap * 2 : 1 << 16;
+            unsigned char *p = acap <= MAX_ANSWER ? realloc(ans, acap) : NULL;
+            if (!p)
+                goto done;
+            ans = p;
+        }
+        ssize_t n = recv(fd, ans + alen, acap - alen, 0);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            break;
+        alen += (size_t)n;
+    }
+    const unsigned char *end = NULL;
+    for (size_t i = 0; i + 4 <= alen; i++)
+        if (!memcmp(ans + i, "\r\n\r\n", 4)) {
+            end = ans + i;
+            break;
+        }
+    int status = 0;
+    if (!end || sscanf((const char *)ans, "HTTP/1.%*d %d", &status) != 1) {
+        snprintf(msg, msg_len, "%s", sent ? "no HTTP answer" : "connection lost while sending");
+        goto done;
+    }
+    const unsigned char *payload = end + 4;
+    size_t plen = alen - (size_t)(payload - ans);
+    if (status != 200) {
+        /* {"error": {"code": "...", "message": "..."}}: show the message */
+        char text[1024];
+        snprintf(text, sizeof text, "%.*s", (int)(plen < 1000 ? plen : 1000), (const char *)payload);
+        const char *m = strstr(text, "\"message\":\"");
+        snprintf(msg, msg_len, "HTTP %d: %.600s", status, m ? m + 11 : text);
+        size_t ml = strlen(msg);
+        if (ml >= 2 && !strcmp(msg + ml - 2, "}}"))
+            msg[ml - 3] = '\0';
+        for (const unsigned char *h = ans; h < end; h++)
+            if (!strncasecmp((const char *)h, "\nRetry-After:", 13))
+                *retry_after = atoi((const char *)h + 13);
+        rc = status;
+        goto done;
+    }
+    rc = exr_to_result(payload, plen, outputs, res, msg, msg_len) == 0 ? 0 : 500;
+done:
+    free(head);
+    free(ans);
+    close(fd);
+    return rc;
+}
+
+/* The camera the CLI chose, as query parameters, when it came from a
+ * camera JSON (HTTP carries no projection matrix; fov_y, near and far
+ * rebuild it). */
+static void camera_params(const obs_gbuffer *gb, pairs *ps, char *buf, size_t len)
+{
+    const obs_camera *c = &gb->camera;
+    if (c->source != OBS_CAMERA_JSON || has(ps, "fov_y") || has(ps, "fov-y"))
+        return;
+    const float *p = c->projection;
+    double fov = 2.0 * atan(1.0 / p[5]) * 180.0 / M_PI;
+    double near_z = p[11] / (p[10] - 1.0), far_z = p[11] / (p[10] + 1.0);
+    char *w2c = buf + 96;
+    snprintf(buf, 32, "%.9g", fov);
+    snprintf(buf + 32, 32, "%.9g", near_z);
+    snprintf(buf + 64, 32, "%.9g", far_z);
+    add(ps, "fov_y", buf);
+    add(ps, "near", buf + 32);
+    add(ps, "far", buf + 64);
+    if (c->has_world_to_camera && !has(ps, "world_to_camera") && !has(ps, "world-to-camera")) {
+        size_t o = 0;
+        for (int k = 0; k < 16 && o < len - 96; k++)
+            o += (size_t)snprintf(w2c + o, len - 96 - o, "%s%.9g", k ? "," : "", c->world_to_camera[k]);
+        add(ps, "world_to_camera", w2c);
+    }
+}
+
+/* ---- the run -------------------------------------------------------------- */
+
+static void sleep_s(int s)
+{
+    struct timespec ts = {s, 0};
+    nanosleep(&ts, NULL);
+}
+
+int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
+                   const obs_gbuffer *gb, unsigned outputs, obs_result *out)
+{
+    server_addr a;
+    static pairs ps;
+    static char names[OBS_BIN_MAX_PARAMS][OBS_BIN_MAX_NAME + 1];
+    char msg[OBS_ERR_LEN + 128] = "", cam[1024];
+    const char *oname = outputs_name(outputs);
+    memset(out, 0, sizeof *out);
+    ps.n = 0;
+    if (parse_server(server, &a) != 0) {
+        fprintf(stderr, "obscura: --server '%s' is not http://HOST:PORT, unix:/PATH or tcp://HOST:PORT\n",
+                server);
+        return RC_USAGE;
+    }
+    if (!oname) {
+        fprintf(stderr, "obscura: --server: the daemon answers ao, composite or both, not this --output\n");
+        return RC_USAGE;
+    }
+    collect(argc, argv, a.kind == PROTO_HTTP, &ps, names);
+    add(&ps, "output", oname);
+
+    obs_bytes frame = {0};
+    unsigned char *body = NULL;
+    size_t body_len = 0;
+    char *query = NULL;
+    const char *token = getenv("OBSCURA_TOKEN");
+    char err[OBS_ERR_LEN];
+    if (a.kind == PROTO_HTTP) {
+        add(&ps, "format", "exr");
+        add(&ps, "float", "1");
+        camera_params(gb, &ps, cam, sizeof cam);
+        if (!(body = read_file(in_path, &body_len))) {
+            fprintf(stderr, "obscura: %s: cannot read it to send\n", in_path);
+            return RC_BADINPUT;
+        }
+        size_t qcap = 1;
+        for (int i = 0; i < ps.n; i++)
+            qcap += strlen(ps.p[i].name) + 3 * strlen(ps.p[i].value) + 2;
+        if (!(query = malloc(qcap))) {
+            free(body);
+            return RC_FAIL;
+        }
+        size_t o = 0;
+        for (int i = 0; i < ps.n; i++) {
+            char v[3 * OBS_BIN_MAX_VALUE + 1];
+            url_encode(ps.p[i].value, v, sizeof v);
+            o += (size_t)snprintf(query + o, qcap - o, "%s%s=%s", i ? "&" : "", ps.p[i].name, v);
+        }
+    } else {
+        add(&ps, "format", "raw");
+        if (token && *token)
+            add(&ps, "token", token);
+        obs_bin_request_desc d = {.id = 1, .params = ps.p, .param_count = ps.n, .gb = gb};
+        if (obs_bin_request_encode(&d, &frame, err) != OBS_OK) {
+            fprintf(stderr, "obscura: cannot encode the request: %s\n", err);
+            return RC_FAIL;
+        }
+    }
+
+    int rc = -1;
+    for (int attempt = 1; attempt <= ATTEMPTS; attempt++) {
+        int wait = 1;
+        obs_result_free(out);
+        rc = a.kind == PROTO_HTTP ? http_once(&a, query, body, body_len, outputs, out, &wait, msg, sizeof msg)
+                                  : binary_once(&a, &frame, out, &wait, msg, sizeof msg);
+        if ((rc != -1 && rc != 503) || attempt == ATTEMPTS)
+            break;
+        wait = wait < 1 ? 1 : wait > MAX_WAIT_S ? MAX_WAIT_S : wait;
+        fprintf(stderr, "obscura: %s: %s; retrying in %d s (%d of %d)\n", server,
+                rc == -1 ? msg : "busy (503)", wait, attempt, ATTEMPTS - 1);
+        sleep_s(wait);
+    }
+    free(query);
+    free(body);
+    obs_bytes_free(&frame);
+    if (rc == 0)
+        return RC_OK;
+    obs_result_free(out);
+    if (rc == -1) {
+        fprintf(stderr, "obscura: %s: unreachable: %s\n", server, msg);
+        return RC_UNAVAILABLE;
+    }
+    fprintf(stderr, "obscura: %s: %s%s\n", server, msg, rc == 503 ? " (still busy after retries)" : "");
+    return answer_rc(rc);
+}

@@ -1,0 +1,32 @@
+/* obscura ao --server URL: the AO chain run by obscurad instead of
+ * in-process.  The CLI reads and decodes its input as always, this runs
+ * the frame remotely and hands back the same obs_result, so the CLI
+ * writes the same files.
+ *
+ *   unix:/path, tcp://host:port   the binary protocol (protocol/PROTOCOL.md),
+ *                                 raw float32 planes both ways
+ *   http://host:port              POST /v1/ao with the input EXR, the
+ *                                 answer asked as a float EXR
+ *
+ * OBSCURA_TOKEN, when set, is sent as the bearer token. */
+#ifndef OBSCURA_CLIENT_REMOTE_H
+#define OBSCURA_CLIENT_REMOTE_H
+
+#include "obscura.h"
+
+/* Takes "--server URL" / "--server=URL" out of argv[0..argc-1] (argv is
+ * compacted); returns the new argc.  *server is NULL when absent. */
+int cli_remote_take_server(int argc, char **argv, const char **server);
+
+/* Runs the frame on the daemon at `server`.  argv are the ao arguments
+ * (the parameters of the table are forwarded by name); in_path is the
+ * input EXR (sent as is over HTTP); gb its decoded G-buffer with the
+ * camera the CLI chose (sent as planes over the binary protocol).
+ * Prints its own message on failure.  Returns an exit code: 0 ok, 1
+ * failure, 2 usage, 3 bad input (the server said 4xx other than 503), 4
+ * server unreachable or busy (after bounded retries with Retry-After).
+ * On 0 the caller frees *out with obs_result_free(). */
+int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
+                   const obs_gbuffer *gb, unsigned outputs, obs_result *out);
+
+#endif

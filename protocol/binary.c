@@ -1,0 +1,633 @@
+/* The binary protocol: frame headers, requests and responses (see
+ * protocol/PROTOCOL.md).  Little-endian on the wire; the reader is a
+ * bounds-checked cursor, the writer counts first and fills second, so a
+ * frame is allocated once, at its exact size. */
+#include "binary.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "the binary protocol copies float32 planes as they are: little-endian hosts only"
+#endif
+
+#define RAW_HEADER_LEN 160 /* width .. projection, see PROTOCOL.md */
+
+static obs_status fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static obs_status fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    if (err)
+        vsnprintf(err, OBS_ERR_LEN, fmt, ap);
+    va_end(ap);
+    return s;
+}
+
+/* a * b * c without overflow; 0 on overflow. */
+static int mul3(uint64_t a, uint64_t b, uint64_t c, uint64_t *out)
+{
+    if ((b && a > UINT64_MAX / b) || (c && a * b > UINT64_MAX / c))
+        return 0;
+    *out = a * b * c;
+    return 1;
+}
+
+/* ---- writer: counts when p is NULL ---------------------------------------- */
+
+typedef struct writer {
+    unsigned char *p;
+    size_t n;
+} writer;
+
+static void put(writer *w, const void *src, size_t len)
+{
+    if (w->p && len)
+        memcpy(w->p + w->n, src, len);
+    w->n += len;
+}
+
+static void put_u8(writer *w, unsigned v)
+{
+    unsigned char b = (unsigned char)v;
+    put(w, &b, 1);
+}
+
+static void put_u16(writer *w, unsigned v)
+{
+    unsigned char b[2] = {(unsigned char)v, (unsigned char)(v >> 8)};
+    put(w, b, 2);
+}
+
+static void put_u32(writer *w, uint32_t v)
+{
+    unsigned char b[4];
+    for (int i = 0; i < 4; i++)
+        b[i] = (unsigned char)(v >> (8 * i));
+    put(w, b, 4);
+}
+
+static void put_u64(writer *w, uint64_t v)
+{
+    unsigned char b[8];
+    for (int i = 0; i < 8; i++)
+        b[i] = (unsigned char)(v >> (8 * i));
+    put(w, b, 8);
+}
+
+/* Zero bytes up to the next multiple of 8 of the payload offset. */
+static void put_pad8(writer *w, size_t payload_start)
+{
+    static const unsigned char zero[8];
+    put(w, zero, (8 - (w->n - payload_start) % 8) % 8);
+}
+
+/* A plane of w x h pixels, `ch` floats each, tightly packed on the wire. */
+static void put_plane(writer *w, const obs_plane *pl, int width, int height, int ch)
+{
+    size_t row = (size_t)width * (size_t)ch * sizeof(float);
+    size_t stride = pl->row_stride ? pl->row_stride : row;
+    if (!w->p) {
+        w->n += row * (size_t)height;
+        return;
+    }
+    if (stride == row) {
+        put(w, pl->data, row * (size_t)height);
+        return;
+    }
+    for (int y = 0; y < height; y++)
+        put(w, (const unsigned char *)pl->data + (size_t)y * stride, row);
+}
+
+/* ---- reader ---------------------------------------------------------------- */
+
+typedef struct reader {
+    const unsigned char *p;
+    size_t n, off;
+    const char *what; /* "request" or "response", for messages */
+} reader;
+
+static int have(const reader *r, uint64_t len) { return len <= r->n - r->off; }
+
+static int get(reader *r, void *dst, size_t len)
+{
+    if (!have(r, len))
+        return 0;
+    memcpy(dst, r->p + r->off, len);
+    r->off += len;
+    return 1;
+}
+
+static int get_u8(reader *r, unsigned *v)
+{
+    unsigned char b;
+    if (!get(r, &b, 1))
+        return 0;
+    *v = b;
+    return 1;
+}
+
+static int get_u16(reader *r, unsigned *v)
+{
+    unsigned char b[2];
+    if (!get(r, b, 2))
+        return 0;
+    *v = (unsigned)b[0] | (unsigned)b[1] << 8;
+    return 1;
+}
+
+static int get_u32(reader *r, uint32_t *v)
+{
+    unsigned char b[4];
+    if (!get(r, b, 4))
+        return 0;
+    *v = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+    return 1;
+}
+
+static int get_u64(reader *r, uint64_t *v)
+{
+    unsigned char b[8];
+    if (!get(r, b, 8))
+        return 0;
+    *v = 0;
+    for (int i = 7; i >= 0; i--)
+        *v = *v << 8 | b[i];
+    return 1;
+}
+
+static int get_pad8(reader *r)
+{
+    size_t pad = (8 - r->off % 8) % 8;
+    if (!have(r, pad))
+        return 0;
+    for (size_t i = 0; i < pad; i++)
+        if (r->p[r->off + i] != 0)
+            return 0;
+    r->off += pad;
+    return 1;
+}
+
+static obs_status truncated(const reader *r, const char *field, char err[OBS_ERR_LEN])
+{
+    return fail(err, OBS_BAD_FILE, "malformed %s: %s at byte %zu of a %zu-byte payload "
+                "(truncated or corrupt)", r->what, field, r->off, r->n);
+}
+
+/* ---- header ---------------------------------------------------------------- */
+
+void obs_bin_header_write(unsigned char *out, obs_bin_kind kind, uint64_t id, uint64_t length)
+{
+    writer w = {out, 0};
+    put(&w, OBS_BIN_MAGIC, 4);
+    put_u16(&w, OBS_BIN_VERSION);
+    put_u16(&w, (unsigned)kind);
+    put_u64(&w, id);
+    put_u64(&w, length);
+}
+
+obs_status obs_bin_header_parse(const unsigned char *in, obs_bin_header *h, uint64_t max_payload,
+                                char err[OBS_ERR_LEN])
+{
+    reader r = {in, OBS_BIN_HEADER_LEN, 4, "header"};
+    unsigned version, kind;
+    memset(h, 0, sizeof *h);
+    if (memcmp(in, OBS_BIN_MAGIC, 4) != 0)
+        return fail(err, OBS_BAD_FILE, "not an obscura binary-protocol frame (magic is not '%s')",
+                    OBS_BIN_MAGIC);
+    get_u16(&r, &version);
+    get_u16(&r, &kind);
+    get_u64(&r, &h->id);
+    get_u64(&r, &h->length);
+    if (version != OBS_BIN_VERSION)
+        return fail(err, OBS_UNSUPPORTED, "protocol version %u is not supported (this is version %d)",
+                    version, OBS_BIN_VERSION);
+    if (kind != OBS_BIN_REQUEST && kind != OBS_BIN_RESPONSE)
+        return fail(err, OBS_BAD_FILE, "frame kind %u is neither request (1) nor response (2)", kind);
+    h->kind = (obs_bin_kind)kind;
+    if (h->length > max_payload)
+        return fail(err, OBS_TOO_LARGE, "frame payload of %llu bytes is over the limit of %llu bytes",
+                    (unsigned long long)h->length, (unsigned long long)max_payload);
+    return OBS_OK;
+}
+
+/* ---- requests -------------------------------------------------------------- */
+
+static obs_status check_gbuffer(const obs_gbuffer *gb, char err[OBS_ERR_LEN])
+{
+    if (!gb->depth.data || gb->width <= 0 || gb->height <= 0)
+        return fail(err, OBS_INVALID_ARGUMENT, "raw G-buffer: depth plane and a size are required");
+    if (gb->depth.channels != 1 || (gb->normal.data && gb->normal.channels != 3) ||
+        (gb->color.data && gb->color.channels != 4))
+        return fail(err, OBS_INVALID_ARGUMENT, "raw G-buffer: planes must be depth 1, normal 3, "
+                    "colour 4 channels");
+    return OBS_OK;
+}
+
+static void write_request(writer *w, const obs_bin_request_desc *d, uint64_t payload_len)
+{
+    unsigned char hdr[OBS_BIN_HEADER_LEN];
+    obs_bin_header_write(hdr, OBS_BIN_REQUEST, d->id, payload_len);
+    put(w, hdr, sizeof hdr);
+    size_t start = w->n;
+    put_u32(w, (uint32_t)d->param_count);
+    for (int i = 0; i < d->param_count; i++) {
+        size_t nl = strlen(d->params[i].name), vl = strlen(d->params[i].value);
+        put_u16(w, (unsigned)nl);
+        put(w, d->params[i].name, nl);
+        put_u32(w, (uint32_t)vl);
+        put(w, d->params[i].value, vl);
+    }
+    if (d->exr) {
+        put_u8(w, OBS_BIN_EXR);
+        put_pad8(w, start);
+        put_u64(w, d->exr_len);
+        put(w, d->exr, d->exr_len);
+        return;
+    }
+    const obs_gbuffer *gb = d->gb;
+    const obs_camera *cam = &gb->camera;
+    uint32_t flags = (gb->normal.data ? OBS_BIN_HAS_NORMAL : 0) | (gb->color.data ? OBS_BIN_HAS_COLOR : 0) |
+                     (cam->has_world_to_camera ? OBS_BIN_HAS_WORLD_TO_CAMERA : 0) |
+                     (cam->has_projection ? OBS_BIN_HAS_PROJECTION : 0);
+    put_u8(w, OBS_BIN_RAW);
+    put_pad8(w, start);
+    put_u32(w, (uint32_t)gb->width);
+    put_u32(w, (uint32_t)gb->height);
+    put_u32(w, (uint32_t)gb->display_x);
+    put_u32(w, (uint32_t)gb->display_y);
+    put_u32(w, (uint32_t)gb->display_width);
+    put_u32(w, (uint32_t)gb->display_height);
+    put_u32(w, flags);
+    put_u32(w, 0);
+    put(w, cam->world_to_camera, sizeof cam->world_to_camera);
+    put(w, cam->projection, sizeof cam->projection);
+    put_plane(w, &gb->depth, gb->width, gb->height, 1);
+    if (gb->normal.data)
+        put_plane(w, &gb->normal, gb->width, gb->height, 3);
+    if (gb->color.data)
+        put_plane(w, &gb->color, gb->width, gb->height, 4);
+}
+
+obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out, char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    if (!!d->gb == !!d->exr)
+        return fail(err, OBS_INVALID_ARGUMENT, "a request carries either raw planes or an EXR");
+    if (d->param_count < 0 || d->param_count > OBS_BIN_MAX_PARAMS)
+        return fail(err, OBS_INVALID_ARGUMENT, "at most %d parameters", OBS_BIN_MAX_PARAMS);
+    for (int i = 0; i < d->param_count; i++) {
+        size_t nl = strlen(d->params[i].name), vl = strlen(d->params[i].value);
+        if (nl == 0 || nl > OBS_BIN_MAX_NAME || vl > OBS_BIN_MAX_VALUE)
+            return fail(err, OBS_INVALID_ARGUMENT, "parameter '%.64s': name of 1 to %d bytes and "
+                        "value of at most %d bytes", d->params[i].name, OBS_BIN_MAX_NAME, OBS_BIN_MAX_VALUE);
+    }
+    if (d->gb) {
+        obs_status s = check_gbuffer(d->gb, err);
+        if (s != OBS_OK)
+            return s;
+    }
+    writer w = {NULL, 0};
+    write_request(&w, d, 0);
+    if (!(w.p = malloc(w.n)))
+        return fail(err, OBS_NO_MEMORY, "no memory for a %zu-byte request", w.n);
+    size_t total = w.n;
+    w.n = 0;
+    write_request(&w, d, total - OBS_BIN_HEADER_LEN);
+    out->data = w.p;
+    out->size = total;
+    return OBS_OK;
+}
+
+/* Sets one name=value pair of a request. */
+static obs_status request_param(obs_bin_request *q, const char *name, const char *value,
+                                char err[OBS_ERR_LEN])
+{
+    if (!strcmp(name, "token")) {
+        size_t n = strlen(value);
+        if (n >= sizeof q->token)
+            return fail(err, OBS_INVALID_ARGUMENT, "parameter token: longer than %zu bytes",
+                        sizeof q->token - 1);
+        memcpy(q->token, value, n + 1);
+        return OBS_OK;
+    }
+    if (!strcmp(name, "format") && !strcmp(value, "raw")) {
+        q->raw_out = 1;
+        return OBS_OK;
+    }
+    if (!strcmp(name, "format"))
+        q->raw_out = 0;
+    return obs_http_request_set(&q->hr, name, value, err);
+}
+
+/* A plane of `ch` floats per pixel at the reader's offset: points into
+ * the payload when aligned, else into dst (a copy). */
+static const float *take_plane(reader *r, uint64_t bytes, float *dst)
+{
+    const unsigned char *src = r->p + r->off;
+    r->off += (size_t)bytes;
+    if (((uintptr_t)src & 3u) == 0)
+        return (const float *)(const void *)src;
+    memcpy(dst, src, (size_t)bytes);
+    return dst;
+}
+
+static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *q, char err[OBS_ERR_LEN])
+{
+    uint32_t width, height, dx, dy, dw, dh, flags, reserved;
+    if (!have(r, RAW_HEADER_LEN))
+        return truncated(r, "raw G-buffer header", err);
+    get_u32(r, &width);
+    get_u32(r, &height);
+    get_u32(r, &dx);
+    get_u32(r, &dy);
+    get_u32(r, &dw);
+    get_u32(r, &dh);
+    get_u32(r, &flags);
+    get_u32(r, &reserved);
+    if (flags & ~0xfu || reserved)
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: unknown flags 0x%x or reserved field set", flags);
+    obs_status s = obs_check_size(lim, width, height, err);
+    if (s != OBS_OK)
+        return s;
+    if ((int32_t)dw < 0 || (int32_t)dh < 0 || dw > (1u << 20) || dh > (1u << 20))
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: display window %u x %u is not a size", dw, dh);
+    obs_gbuffer *gb = &q->gf.gb;
+    obs_camera *cam = &gb->camera;
+    get(r, cam->world_to_camera, sizeof cam->world_to_camera);
+    get(r, cam->projection, sizeof cam->projection);
+    cam->has_world_to_camera = !!(flags & OBS_BIN_HAS_WORLD_TO_CAMERA);
+    cam->has_projection = !!(flags & OBS_BIN_HAS_PROJECTION);
+    cam->source = cam->has_projection ? OBS_CAMERA_PARAMS : OBS_CAMERA_NONE;
+
+    /* Exactly the planes the flags announce, and nothing after them. */
+    uint64_t px = (uint64_t)width * height, channels = 1, bytes = 0;
+    channels += (flags & OBS_BIN_HAS_NORMAL) ? 3 : 0;
+    channels += (flags & OBS_BIN_HAS_COLOR) ? 4 : 0;
+    if (!mul3(px, channels, sizeof(float), &bytes) || bytes != r->n - r->off)
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: %u x %u with %llu channels needs %llu bytes of "
+                    "planes, the frame holds %zu", width, height, (unsigned long long)channels,
+                    (unsigned long long)bytes, r->n - r->off);
+    if (((uintptr_t)(r->p + r->off) & 3u) != 0 && !(q->gf.storage = malloc((size_t)bytes)))
+        return fail(err, OBS_NO_MEMORY, "no memory for %llu bytes of planes", (unsigned long long)bytes);
+    float *copy = q->gf.storage;
+    gb->width = (int)width;
+    gb->height = (int)height;
+    gb->display_x = (int32_t)dx;
+    gb->display_y = (int32_t)dy;
+    gb->display_width = (int)dw;
+    gb->display_height = (int)dh;
+    gb->depth = (obs_plane){take_plane(r, px * 4, copy), 1, 0};
+    if (flags & OBS_BIN_HAS_NORMAL)
+        gb->normal = (obs_plane){take_plane(r, px * 12, copy ? copy + px : NULL), 3, 0};
+    if (flags & OBS_BIN_HAS_COLOR)
+        gb->color = (obs_plane){take_plane(r, px * 16, copy ? copy + px * (channels - 4) : NULL), 4, 0};
+    return OBS_OK;
+}
+
+obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, const obs_limits *lim,
+                                  obs_bin_request *out, char err[OBS_ERR_LEN])
+{
+    reader r = {payload, len, 0, "request"};
+    uint32_t count;
+    unsigned body;
+    obs_status s;
+    memset(out, 0, sizeof *out);
+    obs_http_request_init(&out->hr);
+    if (!get_u32(&r, &count))
+        return truncated(&r, "parameter count", err);
+    if (count > OBS_BIN_MAX_PARAMS)
+        return fail(err, OBS_BAD_FILE, "malformed request: %u parameters (at most %d)", count,
+                    OBS_BIN_MAX_PARAMS);
+    for (uint32_t i = 0; i < count; i++) {
+        char name[OBS_BIN_MAX_NAME + 1], value[OBS_BIN_MAX_VALUE + 1];
+        unsigned nl;
+        uint32_t vl;
+        if (!get_u16(&r, &nl))
+            return truncated(&r, "parameter name length", err);
+        if (nl == 0 || nl > OBS_BIN_MAX_NAME)
+            return fail(err, OBS_BAD_FILE, "malformed request: parameter %u has a name of %u bytes "
+                        "(1 to %d)", i, nl, OBS_BIN_MAX_NAME);
+        if (!get(&r, name, nl))
+            return truncated(&r, "parameter name", err);
+        name[nl] = '\0';
+        if (!get_u32(&r, &vl))
+            return truncated(&r, "parameter value length", err);
+        if (vl > OBS_BIN_MAX_VALUE)
+            return fail(err, OBS_BAD_FILE, "malformed request: parameter '%.64s' has a value of %u "
+                        "bytes (at most %d)", name, vl, OBS_BIN_MAX_VALUE);
+        if (!get(&r, value, vl))
+            return truncated(&r, "parameter value", err);
+        value[vl] = '\0';
+        if (memchr(name, 0, nl) || memchr(value, 0, vl))
+            return fail(err, OBS_BAD_FILE, "malformed request: a NUL byte in parameter %u", i);
+        if ((s = request_param(out, name, value, err)) != OBS_OK)
+            return s;
+    }
+    if ((s = obs_http_request_check(&out->hr, err)) != OBS_OK)
+        return s;
+    if (out->raw_out && out->hr.format != OBS_HTTP_EXR)
+        return fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
+    if (!get_u8(&r, &body))
+        return truncated(&r, "G-buffer kind", err);
+    if (!get_pad8(&r))
+        return truncated(&r, "padding", err);
+    if (body == OBS_BIN_EXR) {
+        uint64_t n;
+        if (!get_u64(&r, &n))
+            return truncated(&r, "EXR length", err);
+        if (n != r.n - r.off)
+            return fail(err, OBS_BAD_FILE, "malformed request: EXR of %llu bytes, the frame holds %zu",
+                        (unsigned long long)n, r.n - r.off);
+        if (n == 0)
+            return fail(err, OBS_BAD_FILE, "malformed request: empty EXR");
+        out->body = OBS_BIN_EXR;
+        out->exr = r.p + r.off;
+        out->exr_len = (size_t)n;
+        return OBS_OK;
+    }
+    if (body != OBS_BIN_RAW)
+        return fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is neither EXR (1) nor "
+                    "raw (2)", body);
+    out->body = OBS_BIN_RAW;
+    s = decode_raw(&r, lim, out, err);
+    if (s != OBS_OK)
+        obs_bin_request_free(out);
+    return s;
+}
+
+void obs_bin_request_free(obs_bin_request *q)
+{
+    if (!q)
+        return;
+    free(q->gf.storage);
+    memset(&q->gf, 0, sizeof q->gf);
+    q->exr = NULL;
+    q->exr_len = 0;
+}
+
+/* ---- responses ------------------------------------------------------------- */
+
+static void write_response(writer *w, const obs_bin_response_desc *d, uint64_t payload_len)
+{
+    unsigned char hdr[OBS_BIN_HEADER_LEN];
+    obs_bin_header_write(hdr, OBS_BIN_RESPONSE, d->id, payload_len);
+    put(w, hdr, sizeof hdr);
+    size_t start = w->n;
+    const char *code = d->code ? d->code : "";
+    const char *msg = d->message ? d->message : "";
+    size_t cl = strnlen(code, 63), ml = strnlen(msg, OBS_BIN_MAX_MESSAGE);
+    put_u16(w, (unsigned)d->status);
+    put_u16(w, (unsigned)d->retry_after);
+    put_u16(w, (unsigned)cl);
+    put(w, code, cl);
+    put_u32(w, (uint32_t)ml);
+    put(w, msg, ml);
+    put_u8(w, d->body);
+    put_pad8(w, start);
+    if (d->body == OBS_BIN_EXR || d->body == OBS_BIN_PNG) {
+        put_u64(w, d->blob_len);
+        put(w, d->blob, d->blob_len);
+    } else if (d->body == OBS_BIN_RAW) {
+        put_u32(w, (uint32_t)d->image_count);
+        for (int i = 0; i < d->image_count; i++) {
+            const obs_image *im = &d->images[i].image;
+            put_u32(w, d->images[i].output);
+            put_u32(w, (uint32_t)im->width);
+            put_u32(w, (uint32_t)im->height);
+            put_u32(w, (uint32_t)im->channels);
+            put(w, im->data, (size_t)im->width * im->height * im->channels * sizeof(float));
+        }
+    }
+}
+
+obs_status obs_bin_response_encode(const obs_bin_response_desc *d, obs_bytes *out, char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    if (d->status < 100 || d->status > 599 || d->retry_after < 0 || d->retry_after > 65535)
+        return fail(err, OBS_INVALID_ARGUMENT, "response status %d or retry-after %d out of range",
+                    d->status, d->retry_after);
+    if (d->body == OBS_BIN_RAW) {
+        if (d->image_count < 1 || d->image_count > OBS_BIN_MAX_IMAGES)
+            return fail(err, OBS_INVALID_ARGUMENT, "1 to %d raw images", OBS_BIN_MAX_IMAGES);
+        for (int i = 0; i < d->image_count; i++) {
+            const obs_image *im = &d->images[i].image;
+            if (!im->data || im->width <= 0 || im->height <= 0 || im->channels < 1 || im->channels > 4)
+                return fail(err, OBS_INVALID_ARGUMENT, "raw image %d is empty or has %d channels", i,
+                            im->channels);
+        }
+    }
+    writer w = {NULL, 0};
+    write_response(&w, d, 0);
+    if (!(w.p = malloc(w.n)))
+        return fail(err, OBS_NO_MEMORY, "no memory for a %zu-byte response", w.n);
+    size_t total = w.n;
+    w.n = 0;
+    write_response(&w, d, total - OBS_BIN_HEADER_LEN);
+    out->data = w.p;
+    out->size = total;
+    return OBS_OK;
+}
+
+obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, const obs_limits *lim,
+                                   obs_bin_response *out, char err[OBS_ERR_LEN])
+{
+    reader r = {payload, len, 0, "response"};
+    unsigned status, retry, cl, body;
+    uint32_t ml;
+    obs_status s = OBS_OK;
+    memset(out, 0, sizeof *out);
+    if (!get_u16(&r, &status) || !get_u16(&r, &retry) || !get_u16(&r, &cl))
+        return truncated(&r, "status", err);
+    if (cl >= sizeof out->code)
+        return fail(err, OBS_BAD_FILE, "malformed response: code of %u bytes", cl);
+    if (!get(&r, out->code, cl))
+        return truncated(&r, "code", err);
+    if (!get_u32(&r, &ml))
+        return truncated(&r, "message length", err);
+    if (ml > OBS_BIN_MAX_MESSAGE)
+        return fail(err, OBS_BAD_FILE, "malformed response: message of %u bytes", ml);
+    if (!get(&r, out->message, ml))
+        return truncated(&r, "message", err);
+    if (!get_u8(&r, &body) || !get_pad8(&r))
+        return truncated(&r, "body kind", err);
+    out->status = (int)status;
+    out->retry_after = (int)retry;
+    out->body = (obs_bin_body)body;
+    switch (body) {
+    case OBS_BIN_NONE:
+        break;
+    case OBS_BIN_EXR:
+    case OBS_BIN_PNG: {
+        uint64_t n;
+        if (!get_u64(&r, &n))
+            return truncated(&r, "file length", err);
+        if (!have(&r, n))
+            return truncated(&r, "file", err);
+        out->blob = r.p + r.off;
+        out->blob_len = (size_t)n;
+        r.off += (size_t)n;
+        break;
+    }
+    case OBS_BIN_RAW: {
+        uint32_t count;
+        if (!get_u32(&r, &count))
+            return truncated(&r, "image count", err);
+        if (count < 1 || count > OBS_BIN_MAX_IMAGES)
+            return fail(err, OBS_BAD_FILE, "malformed response: %u images (1 to %d)", count,
+                        OBS_BIN_MAX_IMAGES);
+        for (uint32_t i = 0; i < count; i++) {
+            uint32_t output, w, h, c;
+            uint64_t bytes = 0;
+            if (!get_u32(&r, &output) || !get_u32(&r, &w) || !get_u32(&r, &h) || !get_u32(&r, &c)) {
+                s = truncated(&r, "image header", err);
+                goto fail;
+            }
+            if (c < 1 || c > 4) {
+                s = fail(err, OBS_BAD_FILE, "malformed response: image %u has %u channels", i, c);
+                goto fail;
+            }
+            if ((s = obs_check_size(lim, w, h, err)) != OBS_OK)
+                goto fail;
+            if (!mul3((uint64_t)w * h, c, sizeof(float), &bytes) || !have(&r, bytes)) {
+                s = truncated(&r, "image pixels", err);
+                goto fail;
+            }
+            obs_image *im = &out->images[i].image;
+            if (!(im->data = malloc((size_t)bytes))) {
+                s = fail(err, OBS_NO_MEMORY, "no memory for a %u x %u image", w, h);
+                goto fail;
+            }
+            get(&r, im->data, (size_t)bytes);
+            im->width = (int)w;
+            im->height = (int)h;
+            im->channels = (int)c;
+            out->images[i].output = output;
+            out->image_count = (int)i + 1;
+        }
+        break;
+    }
+    default:
+        return fail(err, OBS_BAD_FILE, "malformed response: body kind %u", body);
+    }
+    if (r.off != r.n) {
+        s = fail(err, OBS_BAD_FILE, "malformed response: %zu bytes after the body", r.n - r.off);
+        goto fail;
+    }
+    return OBS_OK;
+fail:
+    obs_bin_response_free(out);
+    return s;
+}
+
+void obs_bin_response_free(obs_bin_response *r)
+{
+    if (!r)
+        return;
+    for (int i = 0; i < r->image_count; i++)
+        obs_image_free(&r->images[i].image);
+    r->image_count = 0;
+}

@@ -1,0 +1,166 @@
+/* The binary protocol of obscurad: length-prefixed frames on a stream
+ * socket (Unix or TCP).  Encoding and decoding only; no sockets, no GL.
+ * The wire format, byte by byte, is in protocol/PROTOCOL.md.
+ *
+ *   frame    = header (OBS_BIN_HEADER_LEN bytes) + payload (header.length)
+ *   request  = parameters (name=value strings) + outputs + a G-buffer,
+ *              either an EXR file or raw float32 planes and a camera
+ *   response = status + code + message, then nothing, an EXR/PNG file or
+ *              raw float32 planes
+ *
+ * Every size read from the wire is checked (overflow, the limits the
+ * caller passes, the bytes actually present) before anything is
+ * allocated or read; a decoder never reads past the buffer it was given. */
+#ifndef OBSCURA_PROTOCOL_BINARY_H
+#define OBSCURA_PROTOCOL_BINARY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "http.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define OBS_BIN_MAGIC "OBSP"
+#define OBS_BIN_VERSION 1
+#define OBS_BIN_HEADER_LEN 24
+#define OBS_BIN_MAX_PARAMS 256
+#define OBS_BIN_MAX_NAME 64
+#define OBS_BIN_MAX_VALUE 4096
+#define OBS_BIN_MAX_MESSAGE 4096
+
+typedef enum obs_bin_kind {
+    OBS_BIN_REQUEST = 1,
+    OBS_BIN_RESPONSE = 2
+} obs_bin_kind;
+
+/* The G-buffer of a request, and the body of a response. */
+typedef enum obs_bin_body {
+    OBS_BIN_NONE = 0, /* responses only: an error */
+    OBS_BIN_EXR = 1,  /* an OpenEXR file */
+    OBS_BIN_RAW = 2,  /* float32 planes */
+    OBS_BIN_PNG = 3   /* responses only: a PNG file */
+} obs_bin_body;
+
+/* Raw G-buffer flags. */
+enum {
+    OBS_BIN_HAS_NORMAL = 1,
+    OBS_BIN_HAS_COLOR = 2,
+    OBS_BIN_HAS_WORLD_TO_CAMERA = 4,
+    OBS_BIN_HAS_PROJECTION = 8
+};
+
+typedef struct obs_bin_header {
+    obs_bin_kind kind;
+    uint64_t id;     /* chosen by the client, echoed in the response */
+    uint64_t length; /* payload bytes that follow the header */
+} obs_bin_header;
+
+/* Writes a header into out[OBS_BIN_HEADER_LEN]. */
+void obs_bin_header_write(unsigned char *out, obs_bin_kind kind, uint64_t id, uint64_t length);
+
+/* Parses a header: magic, version, kind, and length <= max_payload.
+ * OBS_BAD_FILE for a bad magic/version/kind, OBS_TOO_LARGE for a length
+ * over the limit (h->length is set then, so the caller can say how big). */
+obs_status obs_bin_header_parse(const unsigned char *in, obs_bin_header *h, uint64_t max_payload,
+                                char err[OBS_ERR_LEN]);
+
+/* ---- requests ------------------------------------------------------------ */
+
+/* One name=value pair; names are the parameter table's plus the request
+ * options of protocol/http.h (output, format, float, png_bits, preset,
+ * depth, normal, color), format=raw, and token. */
+typedef struct obs_bin_param {
+    const char *name;
+    const char *value;
+} obs_bin_param;
+
+/* What a client sends.  gb: raw planes (tightly packed or strided); exr:
+ * an EXR file.  Exactly one of them is set. */
+typedef struct obs_bin_request_desc {
+    uint64_t id;
+    const obs_bin_param *params;
+    int param_count;
+    const obs_gbuffer *gb;
+    const void *exr;
+    size_t exr_len;
+} obs_bin_request_desc;
+
+/* Encodes a whole request frame (header + payload).  Caller frees with
+ * obs_bytes_free(). */
+obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out,
+                                  char err[OBS_ERR_LEN]);
+
+/* A decoded request.  With body RAW, gf.gb's planes point into the
+ * payload when it is 4-byte aligned (else into gf.storage, a copy); with
+ * EXR, exr/exr_len point into the payload.  Either way the payload must
+ * outlive the request.  Free with obs_bin_request_free(). */
+typedef struct obs_bin_request {
+    obs_http_request hr; /* parameters and response options */
+    int raw_out;         /* format=raw: answer with float32 planes */
+    char token[512];     /* token=..., "" when absent */
+    obs_bin_body body;   /* EXR or RAW */
+    const unsigned char *exr;
+    size_t exr_len;
+    obs_gbuffer_file gf; /* RAW */
+} obs_bin_request;
+
+/* Decodes a request payload (the bytes after the header).  Sizes are
+ * checked against `lim` before any allocation.  Statuses: OBS_BAD_FILE
+ * (malformed, truncated, trailing bytes), OBS_INVALID_ARGUMENT (a bad
+ * parameter, named), OBS_TOO_LARGE, OBS_NO_MEMORY. */
+obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, const obs_limits *lim,
+                                  obs_bin_request *out, char err[OBS_ERR_LEN]);
+void obs_bin_request_free(obs_bin_request *r);
+
+/* ---- responses ----------------------------------------------------------- */
+
+/* One raw output image: which output (OBS_OUTPUT_* bit) and its pixels. */
+typedef struct obs_bin_image {
+    unsigned output;
+    obs_image image; /* decoded: owned, free with obs_image_free() */
+} obs_bin_image;
+
+#define OBS_BIN_MAX_IMAGES 8
+
+typedef struct obs_bin_response_desc {
+    uint64_t id;
+    int status;        /* HTTP-like: 200, 400, 401, 413, 415, 422, 500, 503 */
+    int retry_after;   /* seconds, with 503; 0 otherwise */
+    const char *code;  /* "ok", "bad_parameter", ... (as protocol/http.h) */
+    const char *message;
+    obs_bin_body body; /* NONE, EXR, PNG or RAW */
+    const void *blob;  /* EXR or PNG */
+    size_t blob_len;
+    const obs_bin_image *images; /* RAW */
+    int image_count;
+} obs_bin_response_desc;
+
+/* Encodes a whole response frame.  Caller frees with obs_bytes_free(). */
+obs_status obs_bin_response_encode(const obs_bin_response_desc *d, obs_bytes *out,
+                                   char err[OBS_ERR_LEN]);
+
+typedef struct obs_bin_response {
+    int status, retry_after;
+    char code[64];
+    char message[OBS_BIN_MAX_MESSAGE + 1];
+    obs_bin_body body;
+    const unsigned char *blob; /* EXR/PNG: points into the payload */
+    size_t blob_len;
+    obs_bin_image images[OBS_BIN_MAX_IMAGES]; /* RAW: copies, owned */
+    int image_count;
+} obs_bin_response;
+
+/* Decodes a response payload; raw images are checked against `lim` and
+ * copied out.  Free with obs_bin_response_free(). */
+obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, const obs_limits *lim,
+                                   obs_bin_response *out, char err[OBS_ERR_LEN]);
+void obs_bin_response_free(obs_bin_response *r);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,352 @@
+/* The binary protocol's encoder and decoder (protocol/binary.c): round
+ * trips, every truncation of a valid frame, oversized sizes refused before
+ * allocation, garbage. */
+#include "testutil.h"
+
+#include "../../../protocol/binary.h"
+
+#define W 7
+#define H 5
+
+static float depth[W * H], normal[W * H * 3], color[W * H * 4];
+
+static void fill_gbuffer(obs_gbuffer *gb)
+{
+    for (int i = 0; i < W * H; i++) {
+        depth[i] = 1.0f + (float)i * 0.25f;
+        for (int c = 0; c < 3; c++)
+            normal[i * 3 + c] = (float)(i + c) / 100.0f;
+        for (int c = 0; c < 4; c++)
+            color[i * 4 + c] = (float)(i * 4 + c) / 7.0f;
+    }
+    memset(gb, 0, sizeof *gb);
+    gb->width = W;
+    gb->height = H;
+    gb->display_x = 1;
+    gb->display_y = 2;
+    gb->display_width = 10;
+    gb->display_height = 8;
+    gb->depth = (obs_plane){depth, 1, 0};
+    gb->normal = (obs_plane){normal, 3, 0};
+    gb->color = (obs_plane){color, 4, 0};
+    for (int k = 0; k < 16; k++) {
+        gb->camera.world_to_camera[k] = (float)k;
+        gb->camera.projection[k] = (float)-k;
+    }
+    gb->camera.has_world_to_camera = 1;
+    gb->camera.has_projection = 1;
+}
+
+static const obs_bin_param params[] = {
+    {"radius", "0.25"}, {"samples", "8"}, {"output", "both"}, {"format", "raw"}, {"token", "t0k"}};
+
+static obs_bytes encode_raw_request(void)
+{
+    obs_gbuffer gb;
+    obs_bytes out;
+    char err[OBS_ERR_LEN] = "";
+    fill_gbuffer(&gb);
+    obs_bin_request_desc d = {.id = 42, .params = params, .param_count = 5, .gb = &gb};
+    assert_int_equal(obs_bin_request_encode(&d, &out, err), OBS_OK);
+    return out;
+}
+
+/* Decodes a whole frame (header + payload) from a fresh, exactly sized
+ * heap copy, so that ASan sees any read past the end. */
+static obs_status decode_frame(const unsigned char *frame, size_t len, obs_bin_request *q,
+                               char err[OBS_ERR_LEN])
+{
+    obs_bin_header h;
+    if (len < OBS_BIN_HEADER_LEN)
+        return OBS_BAD_FILE;
+    obs_status s = obs_bin_header_parse(frame, &h, 1u << 30, err);
+    if (s != OBS_OK)
+        return s;
+    if (h.length != len - OBS_BIN_HEADER_LEN)
+        return OBS_BAD_FILE; /* the stream would wait for more */
+    size_t n = len - OBS_BIN_HEADER_LEN;
+    unsigned char *copy = malloc(n ? n : 1);
+    memcpy(copy, frame + OBS_BIN_HEADER_LEN, n);
+    s = obs_bin_request_decode(copy, n, NULL, q, err);
+    obs_bin_request_free(q);
+    free(copy);
+    return s;
+}
+
+static void test_raw_round_trip(void **state)
+{
+    (void)state;
+    obs_bytes f = encode_raw_request();
+    obs_bin_header h;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_bin_header_parse(f.data, &h, f.size, err), OBS_OK);
+    assert_int_equal(h.kind, OBS_BIN_REQUEST);
+    assert_true(h.id == 42);
+    assert_true(h.length == f.size - OBS_BIN_HEADER_LEN);
+
+    obs_bin_request q;
+    const unsigned char *payload = f.data + OBS_BIN_HEADER_LEN; /* malloc + 24: aligned */
+    assert_int_equal(obs_bin_request_decode(payload, (size_t)h.length, NULL, &q, err), OBS_OK);
+    assert_int_equal(q.body, OBS_BIN_RAW);
+    assert_int_equal(q.raw_out, 1);
+    assert_string_equal(q.token, "t0k");
+    assert_true(q.hr.params.radius == 0.25f);
+    assert_int_equal(q.hr.params.samples, 8);
+    assert_int_equal(q.hr.outputs, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE);
+    const obs_gbuffer *gb = &q.gf.gb;
+    assert_int_equal(gb->width, W);
+    assert_int_equal(gb->height, H);
+    assert_int_equal(gb->display_x, 1);
+    assert_int_equal(gb->display_y, 2);
+    assert_int_equal(gb->display_width, 10);
+    assert_int_equal(gb->display_height, 8);
+    assert_null(q.gf.storage); /* zero copy: planes point into the payload */
+    assert_memory_equal(gb->depth.data, depth, sizeof depth);
+    assert_memory_equal(gb->normal.data, normal, sizeof normal);
+    assert_memory_equal(gb->color.data, color, sizeof color);
+    assert_true(gb->camera.has_world_to_camera && gb->camera.has_projection);
+    assert_true(gb->camera.world_to_camera[15] == 15.0f && gb->camera.projection[3] == -3.0f);
+    obs_bin_request_free(&q);
+
+    /* a misaligned payload is copied, not read as floats in place */
+    unsigned char *odd = malloc((size_t)h.length + 1);
+    memcpy(odd + 1, payload, (size_t)h.length);
+    assert_int_equal(obs_bin_request_decode(odd + 1, (size_t)h.length, NULL, &q, err), OBS_OK);
+    assert_non_null(q.gf.storage);
+    assert_memory_equal(q.gf.gb.color.data, color, sizeof color);
+    assert_memory_equal(q.gf.gb.normal.data, normal, sizeof normal);
+    obs_bin_request_free(&q);
+    free(odd);
+    obs_bytes_free(&f);
+}
+
+static void test_exr_round_trip(void **state)
+{
+    (void)state;
+    static const unsigned char exr[] = {0x76, 0x2f, 0x31, 0x01, 9, 9, 9};
+    obs_bin_param p[] = {{"format", "png"}, {"output", "composite"}, {"png_bits", "16"}};
+    obs_bin_request_desc d = {.id = 7, .params = p, .param_count = 3, .exr = exr, .exr_len = sizeof exr};
+    obs_bytes f;
+    obs_bin_request q;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_bin_request_encode(&d, &f, err), OBS_OK);
+    assert_int_equal(obs_bin_request_decode(f.data + OBS_BIN_HEADER_LEN, f.size - OBS_BIN_HEADER_LEN,
+                                            NULL, &q, err), OBS_OK);
+    assert_int_equal(q.body, OBS_BIN_EXR);
+    assert_int_equal(q.raw_out, 0);
+    assert_int_equal(q.hr.format, OBS_HTTP_PNG);
+    assert_int_equal(q.hr.png_bits, 16);
+    assert_int_equal(q.exr_len, sizeof exr);
+    assert_memory_equal(q.exr, exr, sizeof exr);
+    obs_bin_request_free(&q);
+    obs_bytes_free(&f);
+}
+
+static void test_response_round_trip(void **state)
+{
+    (void)state;
+    float ao[W * H], rgba[W * H * 4];
+    for (int i = 0; i < W * H; i++)
+        ao[i] = (float)i / (W * H);
+    memcpy(rgba, color, sizeof rgba);
+    obs_bin_image im[2] = {{OBS_OUTPUT_AO, {W, H, 1, ao}}, {OBS_OUTPUT_COMPOSITE, {W, H, 4, rgba}}};
+    obs_bin_response_desc d = {.id = 9, .status = 200, .code = "ok", .message = "",
+                               .body = OBS_BIN_RAW, .images = im, .image_count = 2};
+    obs_bytes f;
+    obs_bin_response r;
+    obs_bin_header h;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_bin_response_encode(&d, &f, err), OBS_OK);
+    assert_int_equal(obs_bin_header_parse(f.data, &h, f.size, err), OBS_OK);
+    assert_int_equal(h.kind, OBS_BIN_RESPONSE);
+    assert_true(h.id == 9);
+    assert_int_equal(obs_bin_response_decode(f.data + OBS_BIN_HEADER_LEN, (size_t)h.length, NULL, &r, err),
+                     OBS_OK);
+    assert_int_equal(r.status, 200);
+    assert_int_equal(r.image_count, 2);
+    assert_int_equal(r.images[1].output, OBS_OUTPUT_COMPOSITE);
+    assert_int_equal(r.images[1].image.channels, 4);
+    assert_memory_equal(r.images[0].image.data, ao, sizeof ao);
+    assert_memory_equal(r.images[1].image.data, rgba, sizeof rgba);
+    obs_bin_response_free(&r);
+    /* every truncation of the payload is refused, never read past */
+    for (size_t n = 0; n < (size_t)h.length; n++) {
+        unsigned char *copy = malloc(n ? n : 1);
+        memcpy(copy, f.data + OBS_BIN_HEADER_LEN, n);
+        assert_int_not_equal(obs_bin_response_decode(copy, n, NULL, &r, err), OBS_OK);
+        assert_int_equal(r.image_count, 0);
+        free(copy);
+    }
+    obs_bytes_free(&f);
+
+    /* an error: status, retry-after, code and message */
+    obs_bin_response_desc e = {.id = 3, .status = 503, .retry_after = 1, .code = "queue_full",
+                               .message = "the frame queue is full; retry later"};
+    assert_int_equal(obs_bin_response_encode(&e, &f, err), OBS_OK);
+    assert_int_equal(obs_bin_response_decode(f.data + OBS_BIN_HEADER_LEN, f.size - OBS_BIN_HEADER_LEN,
+                                             NULL, &r, err), OBS_OK);
+    assert_int_equal(r.status, 503);
+    assert_int_equal(r.retry_after, 1);
+    assert_string_equal(r.code, "queue_full");
+    assert_string_equal(r.message, "the frame queue is full; retry later");
+    assert_int_equal(r.body, OBS_BIN_NONE);
+    obs_bytes_free(&f);
+}
+
+static void test_every_truncation(void **state)
+{
+    (void)state;
+    obs_bytes f = encode_raw_request();
+    char err[OBS_ERR_LEN];
+    obs_bin_request q;
+    for (size_t n = 0; n < f.size; n++) {
+        err[0] = '\0';
+        assert_int_not_equal(decode_frame(f.data, n, &q, err), OBS_OK);
+        /* and the payload alone, cut at n, with the header's length left
+         * as it was: the decoder sees fewer bytes than the frame says */
+        if (n >= OBS_BIN_HEADER_LEN) {
+            size_t m = n - OBS_BIN_HEADER_LEN;
+            unsigned char *copy = malloc(m ? m : 1);
+            memcpy(copy, f.data + OBS_BIN_HEADER_LEN, m);
+            assert_int_not_equal(obs_bin_request_decode(copy, m, NULL, &q, err), OBS_OK);
+            assert_true(err[0] != '\0');
+            assert_null(q.gf.storage);
+            free(copy);
+        }
+    }
+    assert_int_equal(decode_frame(f.data, f.size, &q, err), OBS_OK);
+    obs_bytes_free(&f);
+}
+
+/* Writes a little-endian u32 at p. */
+static void le32(unsigned char *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++)
+        p[i] = (unsigned char)(v >> (8 * i));
+}
+
+static void test_oversized(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+    obs_bin_header h;
+    unsigned char hdr[OBS_BIN_HEADER_LEN];
+    /* a payload length over the limit: refused from the header alone */
+    obs_bin_header_write(hdr, OBS_BIN_REQUEST, 1, UINT64_MAX);
+    assert_int_equal(obs_bin_header_parse(hdr, &h, 1u << 20, err), OBS_TOO_LARGE);
+    assert_non_null(strstr(err, "over the limit"));
+
+    /* planes claiming 65535 x 65535 (and 2^32-1 squared, which overflows
+     * 32 bits): refused by the size check, nothing allocated */
+    obs_bytes f = encode_raw_request();
+    unsigned char *payload = f.data + OBS_BIN_HEADER_LEN;
+    size_t len = f.size - OBS_BIN_HEADER_LEN;
+    /* the raw header starts 8-aligned after the parameters: find width */
+    size_t off = 0;
+    for (size_t i = 0; i + 8 <= len; i += 8)
+        if (payload[i] == W && payload[i + 1] == 0 && payload[i + 4] == H && payload[i + 5] == 0) {
+            off = i;
+            break;
+        }
+    assert_true(off > 0);
+    obs_bin_request q;
+    obs_limits lim = {.max_pixels = 10000};
+    const uint32_t sizes[][2] = {{65535, 65535}, {0xffffffffu, 0xffffffffu}, {0, 5}, {20000, 1}, {200, 100}};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        le32(payload + off, sizes[k][0]);
+        le32(payload + off + 4, sizes[k][1]);
+        obs_status s = obs_bin_request_decode(payload, len, &lim, &q, err);
+        assert_int_not_equal(s, OBS_OK);
+        assert_null(q.gf.storage);
+    }
+    le32(payload + off, 200);
+    le32(payload + off + 4, 100);
+    assert_int_equal(obs_bin_request_decode(payload, len, &lim, &q, err), OBS_TOO_LARGE);
+    /* within the limits but more pixels than the frame holds */
+    le32(payload + off, W + 1);
+    le32(payload + off + 4, H);
+    assert_int_equal(obs_bin_request_decode(payload, len, &lim, &q, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "holds"));
+    obs_bytes_free(&f);
+
+    /* an EXR length past the frame */
+    static const unsigned char exr[] = {1, 2, 3, 4};
+    obs_bin_request_desc d = {.id = 1, .exr = exr, .exr_len = sizeof exr};
+    assert_int_equal(obs_bin_request_encode(&d, &f, err), OBS_OK);
+    unsigned char *lenp = f.data + f.size - sizeof exr - 8;
+    le32(lenp, 0xffffffffu);
+    assert_int_equal(obs_bin_request_decode(f.data + OBS_BIN_HEADER_LEN, f.size - OBS_BIN_HEADER_LEN,
+                                            NULL, &q, err), OBS_BAD_FILE);
+    obs_bytes_free(&f);
+}
+
+static void test_garbage(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+    obs_bin_header h;
+    obs_bin_request q;
+    unsigned char hdr[OBS_BIN_HEADER_LEN];
+    /* an HTTP request on the socket */
+    memcpy(hdr, "GET / HTTP/1.1\r\nHost: x\r\n", OBS_BIN_HEADER_LEN);
+    assert_int_equal(obs_bin_header_parse(hdr, &h, 1u << 20, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "magic"));
+    obs_bin_header_write(hdr, OBS_BIN_REQUEST, 1, 10);
+    hdr[4] = 2; /* version 2 */
+    assert_int_equal(obs_bin_header_parse(hdr, &h, 1u << 20, err), OBS_UNSUPPORTED);
+    obs_bin_header_write(hdr, (obs_bin_kind)3, 1, 10);
+    assert_int_equal(obs_bin_header_parse(hdr, &h, 1u << 20, err), OBS_BAD_FILE);
+
+    /* pseudo-random payloads: never accepted as a frame, never a crash */
+    uint32_t x = 12345;
+    for (int round = 0; round < 2000; round++) {
+        size_t n = (size_t)(round % 300);
+        unsigned char *buf = malloc(n ? n : 1);
+        for (size_t i = 0; i < n; i++) {
+            x = x * 1664525u + 1013904223u;
+            buf[i] = (unsigned char)(x >> 24);
+        }
+        if (n >= 4 && round % 3 == 0)
+            le32(buf, (uint32_t)(round % 4)); /* a plausible parameter count */
+        obs_status s = obs_bin_request_decode(buf, n, NULL, &q, err);
+        if (s == OBS_OK)
+            obs_bin_request_free(&q);
+        obs_bin_response r;
+        if (obs_bin_response_decode(buf, n, NULL, &r, err) == OBS_OK)
+            obs_bin_response_free(&r);
+        free(buf);
+    }
+
+    /* a bad parameter is named, a NUL in a name is malformed */
+    obs_bin_param bad[] = {{"samples", "64"}};
+    obs_bytes f;
+    static const unsigned char exr[] = {1};
+    obs_bin_request_desc d = {.id = 1, .params = bad, .param_count = 1, .exr = exr, .exr_len = 1};
+    assert_int_equal(obs_bin_request_encode(&d, &f, err), OBS_OK);
+    assert_int_equal(obs_bin_request_decode(f.data + OBS_BIN_HEADER_LEN, f.size - OBS_BIN_HEADER_LEN,
+                                            NULL, &q, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "samples"));
+    f.data[OBS_BIN_HEADER_LEN + 7] = 0; /* inside "samples" */
+    assert_int_equal(obs_bin_request_decode(f.data + OBS_BIN_HEADER_LEN, f.size - OBS_BIN_HEADER_LEN,
+                                            NULL, &q, err), OBS_BAD_FILE);
+    obs_bytes_free(&f);
+    /* trailing bytes after a raw G-buffer */
+    obs_bytes g = encode_raw_request();
+    unsigned char *longer = malloc(g.size + 4);
+    memcpy(longer, g.data, g.size);
+    memset(longer + g.size, 0, 4);
+    assert_int_equal(obs_bin_request_decode(longer + OBS_BIN_HEADER_LEN, g.size + 4 - OBS_BIN_HEADER_LEN,
+                                            NULL, &q, err), OBS_BAD_FILE);
+    free(longer);
+    obs_bytes_free(&g);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_raw_round_trip),      cmocka_unit_test(test_exr_round_trip),
+        cmocka_unit_test(test_response_round_trip), cmocka_unit_test(test_every_truncation),
+        cmocka_unit_test(test_oversized),           cmocka_unit_test(test_garbage),
+    };
+    return cmocka_run_group_tests_name("protocol_binary", tests, NULL, NULL);
+}
