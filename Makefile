@@ -139,7 +139,7 @@ unit: $(UNIT_BIN)
 E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)
 
 e2e: $(CLI) $(E2E_DEPS)
-	@set -e; for t in tests/e2e/*.sh; do $(E2E_ENV) $$t; done
+	@rc=0; for t in tests/e2e/*.sh; do $(E2E_ENV) $$t || rc=1; done; exit $$rc
 
 # Every public header compiles alone, as C and as C++.
 headers:
