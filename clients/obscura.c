@@ -531,9 +531,15 @@ static int cmd_params(int argc, char **argv)
         for (char *c = flag; *c; c++)
             if (*c == '_')
                 *c = '-';
-        if (markdown)
-            printf("| `%s` | %s | %s | %s | %s |\n", flag, types[pi->type], pi->def, range, pi->doc);
-        else
+        if (markdown) {
+            printf("| `%s` | %s | %s | %s | ", flag, types[pi->type], pi->def, range);
+            for (const char *c = pi->doc; *c; c++) { /* a bare '|' would end the cell */
+                if (*c == '|')
+                    putchar('\\');
+                putchar(*c);
+            }
+            printf(" |\n");
+        } else
             printf("%-18s %-9s default %-8s %-20s %s\n", flag, types[pi->type], pi->def, range, pi->doc);
     }
     return EXIT_OK;
