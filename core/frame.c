@@ -89,6 +89,13 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     f->adaptive_k = f->viewport[2] / (f->viewport[3] * p->adaptive_diameter * p->adaptive_diameter);
     f->range_check = p->range_check == OBS_ON;
     f->range_u = p->range_u;
+    /* Section 4.2: the pre-pass texture has one texel per 8 x 8 block. */
+    f->culling = p->culling == OBS_CULLING_GREEDY ? 1 : p->culling == OBS_CULLING_CAREFUL ? 2 : 0;
+    f->cull_threshold = 1.0f - p->culling_epsilon;
+    f->cull_w = (f->width + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK;
+    f->cull_h = (f->height + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK;
+    f->cull_scale[0] = 1.0f / (float)(OBS__CULL_BLOCK * f->cull_w);
+    f->cull_scale[1] = 1.0f / (float)(OBS__CULL_BLOCK * f->cull_h);
     f->blur_radius = p->blur == OBS_ON ? p->blur_radius : 0;
     for (int k = 0; k <= f->blur_radius; k++) /* section 4.6: Gaussian kernel */
         f->blur_w[k] = expf(-(float)(k * k) / (2.0f * p->blur_sigma * p->blur_sigma));

@@ -12,7 +12,16 @@
 #define OBS__SKY_DEPTH 1e9f
 
 /* Every OBS_OUTPUT_* bit. */
-#define OBS__OUTPUTS_ALL (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT)
+#define OBS__OUTPUTS_ALL                                                                           \
+    (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK)
+
+/* Culling pre-pass (VAO++ section 4.2): one low-resolution texel per
+ * OBS__CULL_BLOCK x OBS__CULL_BLOCK pixels ("1/8 resolution"), always
+ * OBS__CULL_SAMPLES samples; a culling candidate of the careful variant
+ * takes at most OBS__CULL_CAREFUL samples. */
+#define OBS__CULL_BLOCK 8
+#define OBS__CULL_SAMPLES 8
+#define OBS__CULL_CAREFUL 4
 
 /* Largest blur_radius of the parameter table (uniform array size - 1 in
  * blur.frag.glsl). */
@@ -34,6 +43,10 @@ typedef struct obs__frame {
     float rot[9][2];        /* (cos, sin) of the 3x3 tile's rotations */
     int range_check;        /* 1: depth range check (section 4.4, eq 4) */
     float range_u;          /* u of eq 4 */
+    int culling;            /* section 4.2: 0 off, 1 greedy, 2 careful */
+    float cull_threshold;   /* an estimate below this shows occlusion: 1 - culling_epsilon */
+    int cull_w, cull_h;     /* the low-resolution texture: ceil(width / 8) x ceil(height / 8) */
+    float cull_scale[2];    /* 1 / (8 cull_w), 1 / (8 cull_h): pixel corner -> texture coordinate */
     int blur_radius;        /* low-pass filter half-width (section 4.6); 0: off */
     float blur_w[OBS__MAX_BLUR + 1]; /* Gaussian weight of offset 0..blur_radius */
 } obs__frame;
@@ -67,6 +80,29 @@ int obs__adaptive_count(const obs__frame *f, const float c[3]);
  * of samples taken goes to *count when count is not NULL. */
 float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                      const float n[3], int *count);
+
+/* The sample count pixel (x, y) takes without culling: the samples
+ * parameter, or the adaptive count (section 4.1) of its tangent sphere. */
+int obs__vao_count(const obs__frame *f, const float p[3], const float n[3]);
+
+/* The volumetric AO estimator of obs__vao_pixel with an explicit set:
+ * the ns samples at xy (GLSL: vao_estimate() in vao.glsl). */
+float obs__vao_estimate(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                        const float n[3], int ns, const float *xy);
+
+/* Culling pre-pass, VAO++ section 4.2 (GLSL: cull.frag.glsl), CPU twin
+ * in cull_cpu.c.  The low-resolution AO: texel (i, j) of cull_w x cull_h
+ * (written to est) is the 8-sample AO of the pixel at the block's centre,
+ * (min(8i + 4, width - 1), min(8j + 4, height - 1)); 1 for background. */
+void obs__cull_prepass(const obs__frame *f, const float *pos, const float *nrm, float *est);
+
+/* GL_LINEAR fetch of the low-resolution AO at the full-resolution
+ * position (px, py) (pixel corners are integers), clamped to the edge. */
+float obs__cull_fetch(const obs__frame *f, const float *est, int px, int py);
+
+/* 1 when none of the four corners of pixel (x, y) shows occlusion: the
+ * pixel is a culling candidate (GLSL: cull_candidate() in vao.frag.glsl). */
+int obs__cull_candidate(const obs__frame *f, const float *est, int x, int y);
 
 /* Low-pass filter, VAO++ section 4.6 (GLSL: blur.frag.glsl): one pass of
  * the depth-aware cross-bilateral Gaussian along (dx, dy) at pixel (x, y)

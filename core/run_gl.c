@@ -15,12 +15,15 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
     if (ctx->prog.prep)
         return OBS_OK;
     const char *prep[] = {glsl_version, obs__shader_common, obs__shader_prep_frag};
-    const char *vao[] = {glsl_version, obs__shader_common, obs__shader_vao_frag};
+    const char *vao[] = {glsl_version, obs__shader_common, obs__shader_vao, obs__shader_vao_frag};
+    const char *cull[] = {glsl_version, obs__shader_common, obs__shader_vao, obs__shader_cull_frag};
     const char *blur[] = {glsl_version, obs__shader_common, obs__shader_blur_frag};
     const char *comp[] = {glsl_version, obs__shader_composite_frag};
     obs_status s = obs__gl_program("prep", obs__shader_fullscreen_vert, prep, 3, &ctx->prog.prep, err);
     if (s == OBS_OK)
-        s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 3, &ctx->prog.vao, err);
+        s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 4, &ctx->prog.vao, err);
+    if (s == OBS_OK)
+        s = obs__gl_program("cull", obs__shader_fullscreen_vert, cull, 4, &ctx->prog.cull, err);
     if (s == OBS_OK)
         s = obs__gl_program("blur", obs__shader_fullscreen_vert, blur, 3, &ctx->prog.blur, err);
     if (s == OBS_OK)
@@ -46,7 +49,8 @@ static GLuint make_texture(obs_ctx *ctx, GLenum format, int w, int h)
 static obs_status make_fbo(obs_ctx *ctx, GLuint *fbo, const GLuint *tex, int count,
                            const char *name, char err[OBS_ERR_LEN])
 {
-    static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1,
+                                  GL_COLOR_ATTACHMENT2};
     glGenFramebuffers(1, fbo);
     ctx->gl_objects_created++;
     glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
@@ -63,8 +67,9 @@ void obs__frame_release(obs_ctx *ctx)
 {
     obs__targets *t = &ctx->tg;
     GLuint tex[] = {t->tex_depth, t->tex_normal,    t->tex_color, t->tex_viewpos, t->tex_vnormal,
-                    t->tex_ao,    t->tex_composite, t->tex_blur,  t->tex_count};
-    GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao};
+                    t->tex_ao,    t->tex_composite, t->tex_blur,  t->tex_count,
+                    t->tex_cull,  t->tex_cullmask};
+    GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao, t->fbo_cull};
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
     memset(t, 0, sizeof *t);
@@ -72,6 +77,8 @@ void obs__frame_release(obs_ctx *ctx)
         glDeleteProgram(ctx->prog.prep);
     if (ctx->prog.vao)
         glDeleteProgram(ctx->prog.vao);
+    if (ctx->prog.cull)
+        glDeleteProgram(ctx->prog.cull);
     if (ctx->prog.blur)
         glDeleteProgram(ctx->prog.blur);
     if (ctx->prog.composite)
@@ -100,11 +107,20 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     t->tex_composite = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_blur = make_texture(ctx, GL_R32F, w, h);
     t->tex_count = make_texture(ctx, GL_R32F, w, h);
+    t->tex_cullmask = make_texture(ctx, GL_R32F, w, h);
+    /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block, read
+     * with linear filtering (R32F filters in desktop GL). */
+    t->tex_cull = make_texture(ctx, GL_R32F, (w + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK,
+                               (h + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     GLuint prep[] = {t->tex_viewpos, t->tex_vnormal};
-    GLuint vao[] = {t->tex_ao, t->tex_count};
+    GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask};
     obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 2, "prep", err);
     if (s == OBS_OK)
-        s = make_fbo(ctx, &t->fbo_vao, vao, 2, "vao", err);
+        s = make_fbo(ctx, &t->fbo_vao, vao, 3, "vao", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_cull, &t->tex_cull, 1, "cull", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_ao, &t->tex_ao, 1, "ao", err);
     if (s == OBS_OK)
@@ -150,6 +166,19 @@ static void set_common(GLuint prog, const obs__frame *f)
     glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
     glUniform1i(glGetUniformLocation(prog, "u_depth_mode"), f->depth_mode);
     glUniform2i(glGetUniformLocation(prog, "u_size"), f->width, f->height);
+}
+
+/* Uniforms of vao.glsl, the estimator of the AO pass and the pre-pass. */
+static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
+{
+    bind_tex(prog, "u_pos", 0, t->tex_viewpos);
+    bind_tex(prog, "u_vnormal", 1, t->tex_vnormal);
+    glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
+    /* section 4.1: all sets in one uniform array, picked by offset */
+    glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS__SAMPLE_TABLE_LEN, f->sample_table);
+    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
+    glUniform1i(glGetUniformLocation(prog, "u_range_check"), f->range_check);
+    glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
 }
 
 static void draw(obs_ctx *ctx, GLuint fbo, int w, int h)
@@ -216,26 +245,35 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     glUniformMatrix3fv(glGetUniformLocation(prog, "u_normal_matrix"), 1, GL_TRUE, f.normal_matrix);
     draw(ctx, t->fbo_prep, w, h);
 
+    /* culling pre-pass (section 4.2): 8-sample AO at 1/8 resolution */
+    if (f.culling) {
+        prog = ctx->prog.cull;
+        glUseProgram(prog);
+        set_common(prog, &f);
+        set_vao(prog, &f, t);
+        draw(ctx, t->fbo_cull, f.cull_w, f.cull_h);
+    }
+
     /* AO pass */
     prog = ctx->prog.vao;
     glUseProgram(prog);
     set_common(prog, &f);
-    bind_tex(prog, "u_pos", 0, t->tex_viewpos);
-    bind_tex(prog, "u_vnormal", 1, t->tex_vnormal);
-    glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
+    set_vao(prog, &f, t);
     glUniform1i(glGetUniformLocation(prog, "u_count"), f.samples);
-    /* section 4.1: all sets in one uniform array, picked by offset */
-    glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS__SAMPLE_TABLE_LEN, f.sample_table);
     glUniform1i(glGetUniformLocation(prog, "u_adaptive"), f.adaptive);
     glUniform1f(glGetUniformLocation(prog, "u_adaptive_k"), f.adaptive_k);
-    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f.rot[0][0]);
-    glUniform1i(glGetUniformLocation(prog, "u_range_check"), f.range_check);
-    glUniform1f(glGetUniformLocation(prog, "u_range_u"), f.range_u);
-    /* the sample count goes to its texture only when asked for */
-    const GLenum vao_bufs[] = {GL_COLOR_ATTACHMENT0,
-                               (outputs & OBS_OUTPUT_SAMPLE_COUNT) ? GL_COLOR_ATTACHMENT1 : GL_NONE};
+    /* section 4.2: the pre-pass result, read at the pixel corners */
+    glUniform1i(glGetUniformLocation(prog, "u_culling"), f.culling);
+    bind_tex(prog, "u_cull", 2, t->tex_cull);
+    glUniform2fv(glGetUniformLocation(prog, "u_cull_scale"), 1, f.cull_scale);
+    glUniform1f(glGetUniformLocation(prog, "u_cull_threshold"), f.cull_threshold);
+    /* the debug outputs go to their textures only when asked for */
+    const GLenum vao_bufs[] = {
+        GL_COLOR_ATTACHMENT0,
+        (outputs & OBS_OUTPUT_SAMPLE_COUNT) ? GL_COLOR_ATTACHMENT1 : GL_NONE,
+        (outputs & OBS_OUTPUT_CULL_MASK) ? GL_COLOR_ATTACHMENT2 : GL_NONE};
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_vao);
-    glDrawBuffers(2, vao_bufs);
+    glDrawBuffers(3, vao_bufs);
     draw(ctx, t->fbo_vao, w, h);
 
     /* low-pass filter (section 4.6): ao -> blur along x -> ao along y */
@@ -268,6 +306,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         read_back(t->fbo_ao, GL_COLOR_ATTACHMENT0, w, h, GL_RED, out->ao.data);
     if (outputs & OBS_OUTPUT_SAMPLE_COUNT)
         read_back(t->fbo_vao, GL_COLOR_ATTACHMENT1, w, h, GL_RED, out->sample_count.data);
+    if (outputs & OBS_OUTPUT_CULL_MASK)
+        read_back(t->fbo_vao, GL_COLOR_ATTACHMENT2, w, h, GL_RED, out->cull_mask.data);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
 

@@ -178,9 +178,31 @@ int obs__adaptive_count(const obs__frame *f, const float c[3])
     return n;
 }
 
-/* GLSL: vao.frag.glsl */
+/* GLSL: the count in main() of vao.frag.glsl */
+int obs__vao_count(const obs__frame *f, const float p[3], const float n[3])
+{
+    if (!f->adaptive)
+        return f->samples;
+    const float r = 0.5f * f->radius;
+    const float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
+    return obs__adaptive_count(f, c);
+}
+
 float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                      const float n[3], int *count)
+{
+    /* Section 4.1: the set of the pixel's count, found in the one table of
+     * all sets by its offset (the shader's single uniform array). */
+    int ns = obs__vao_count(f, p, n);
+    if (count)
+        *count = ns;
+    const float *xy = f->adaptive ? f->sample_table + 2 * (ns - 2) : f->sample_xy;
+    return obs__vao_estimate(f, pos, x, y, p, n, ns, xy);
+}
+
+/* GLSL: vao_estimate() in vao.glsl */
+float obs__vao_estimate(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                        const float n[3], int ns, const float *xy)
 {
     const float *P = f->proj;
     const float R = f->radius, r = 0.5f * f->radius;
@@ -188,16 +210,6 @@ float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const 
     float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
     const float *rot = f->rot[3 * (x % 3) + (y % 3)];
     float open = 0.0f, F = 0.0f;
-    /* Section 4.1: the set of the pixel's count, found in the one table of
-     * all sets by its offset (the shader's single uniform array). */
-    int ns = f->samples;
-    const float *xy = f->sample_xy;
-    if (f->adaptive) {
-        ns = obs__adaptive_count(f, c);
-        xy = f->sample_table + 2 * (ns - 2);
-    }
-    if (count)
-        *count = ns;
 
     for (int i = 0; i < ns; i++) {
         float sx = xy[2 * i], sy = xy[2 * i + 1];
@@ -266,6 +278,8 @@ obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs, ch
         s = alloc_image(&out->composite, w, h, 4, err);
     if (s == OBS_OK && (outputs & OBS_OUTPUT_SAMPLE_COUNT))
         s = alloc_image(&out->sample_count, w, h, 1, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_CULL_MASK))
+        s = alloc_image(&out->cull_mask, w, h, 1, err);
     if (s != OBS_OK)
         obs_result_free(out);
     return s;
@@ -278,6 +292,7 @@ void obs_result_free(obs_result *r)
     obs_image_free(&r->ao);
     obs_image_free(&r->composite);
     obs_image_free(&r->sample_count);
+    obs_image_free(&r->cull_mask);
 }
 
 /* GLSL: composite.frag.glsl.  Colour x AO; grey AO when there is no colour. */
@@ -299,7 +314,7 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
 {
     obs_params p;
     obs__frame f;
-    float *pos = NULL, *nrm = NULL, *ao = NULL, *tmp = NULL;
+    float *pos = NULL, *nrm = NULL, *ao = NULL, *tmp = NULL, *est = NULL;
     obs_status s;
 
     memset(out, 0, sizeof *out);
@@ -315,7 +330,8 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
     nrm = malloc(npx * 3 * sizeof(float));
     ao = malloc(npx * sizeof(float));
     tmp = malloc(npx * sizeof(float));
-    if (!pos || !nrm || !ao || !tmp) {
+    est = malloc((size_t)f.cull_w * (size_t)f.cull_h * sizeof(float));
+    if (!pos || !nrm || !ao || !tmp || !est) {
         s = obs__fail(err, OBS_NO_MEMORY, "out of memory for a %dx%d frame", f.width, f.height);
         goto fail;
     }
@@ -333,17 +349,33 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
             const float *in = gb->normal.data ? obs__plane_px(&gb->normal, f.width, x, y) : NULL;
             obs__prep_normal(&f, pos, in, x, y, nrm + 3 * ((size_t)y * f.width + x));
         }
+    /* culling pre-pass (section 4.2) */
+    if (f.culling)
+        obs__cull_prepass(&f, pos, nrm, est);
     /* AO pass */
-    float *count = out->sample_count.data;
+    float *count = out->sample_count.data, *mask = out->cull_mask.data;
     for (int y = 0; y < f.height; y++)
         for (int x = 0; x < f.width; x++) {
             size_t i = (size_t)y * f.width + x;
-            int n = 0;
-            ao[i] = pos[4 * i + 3] > 0.0f
-                        ? obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, &n)
-                        : 1.0f;
+            int n = 0, culled = 0;
+            ao[i] = 1.0f;
+            if (pos[4 * i + 3] > 0.0f) {
+                /* Section 4.2: a culling candidate gets AO 1 (greedy) or
+                 * at most the 4-sample set (careful). */
+                culled = f.culling && obs__cull_candidate(&f, est, x, y);
+                if (!culled) {
+                    ao[i] = obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, &n);
+                } else if (f.culling == 2) {
+                    n = obs__vao_count(&f, pos + 4 * i, nrm + 3 * i);
+                    n = n < OBS__CULL_CAREFUL ? n : OBS__CULL_CAREFUL;
+                    ao[i] = obs__vao_estimate(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, n,
+                                              f.sample_table + 2 * (n - 2));
+                }
+            }
             if (count)
                 count[i] = (float)n;
+            if (mask)
+                mask[i] = (float)culled;
         }
     /* low-pass filter (section 4.6), then composite */
     obs__blur(&f, pos, ao, tmp);
@@ -360,6 +392,7 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
     free(nrm);
     free(ao);
     free(tmp);
+    free(est);
     return OBS_OK;
 
 fail:
@@ -367,6 +400,7 @@ fail:
     free(nrm);
     free(ao);
     free(tmp);
+    free(est);
     obs_result_free(out);
     return s;
 }

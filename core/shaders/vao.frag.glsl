@@ -1,23 +1,19 @@
-// Volumetric ambient occlusion (VAO++ section 3, after Szirmay-Kalos et
-// al.): the fraction of a tangent sphere of radius R/2, moved along the
-// normal, that is not behind the depth buffer, estimated with line samples
-// (pipes along view Z) through a disk.  C twin: obs__vao_pixel.
+// AO pass: the volumetric AO of every pixel (the estimator is in
+// vao.glsl), with the sample count of adaptive sampling (section 4.1) and
+// the culling test of the pre-pass (section 4.2).  C twin: obs_run_cpu's
+// AO loop (obs__vao_count, obs__cull_candidate, obs__vao_estimate).
 
-uniform sampler2D u_pos;         // prep: view position, planar depth in w
-uniform sampler2D u_vnormal;     // prep: view normal
-uniform ivec2 u_size;
-uniform float u_radius;          // R, in depth units
 uniform int u_count;             // samples (with adaptive sampling: the most)
-uniform vec2 u_samples[62];      // all sets of section 4.5 (core/sample_tables.c), the
-                                 // set of n from n - 2: the single array of section 4.1
 uniform int u_adaptive;          // 1: adaptive sampling (section 4.1)
 uniform float u_adaptive_k;      // vw / (vh * D0^2), see adaptive_count
-uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
-uniform int u_range_check;       // 1: depth range check (section 4.4, eq 4)
-uniform float u_range_u;         // u of eq 4
+uniform int u_culling;           // section 4.2: 0 off, 1 greedy, 2 careful
+uniform sampler2D u_cull;        // the pre-pass's 1/8-resolution AO, GL_LINEAR
+uniform vec2 u_cull_scale;       // 1 / (8 * its size): pixel corner -> texture coordinate
+uniform float u_cull_threshold;  // an estimate below this shows occlusion
 
 layout(location = 0) out float o_ao;
 layout(location = 1) out float o_count; // samples taken (debug output)
+layout(location = 2) out float o_cull;  // 1: culling candidate (debug output)
 
 // Adaptive sampling, section 4.1: "double the number of samples every time
 // surface area of the sampling disc doubles", 2 samples for a disk of
@@ -48,59 +44,44 @@ int adaptive_count(vec3 c)
     return n;
 }
 
+
+// Culling pre-pass, section 4.2: "Checking for estimated occlusion in the
+// second pass is done via four texel fetches from downsized AO texture in
+// given pixel corners.  Texture interpolation mode is set to linear ...
+// When at least one of these pixels exhibits occlusion, we calculate full
+// AO - otherwise the pixel is a candidate for culling."  A corner (x, y)
+// lies at texel coordinate x / 8 - 0.5: the bilinear weights are multiples
+// of 1/8.  C twin: obs__cull_candidate, obs__cull_fetch (cull_cpu.c).
+bool cull_candidate(ivec2 px)
+{
+    for (int k = 0; k < 4; k++) {
+        vec2 corner = vec2(px + ivec2(k & 1, k >> 1));
+        if (texture(u_cull, corner * u_cull_scale).r < u_cull_threshold)
+            return false;
+    }
+    return true;
+}
+
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 p = texelFetch(u_pos, px, 0);
+    o_cull = 0.0;
     if (p.w <= 0.0) {
         o_ao = 1.0;
         o_count = 0.0;
         return;
     }
     vec3 n = texelFetch(u_vnormal, px, 0).xyz;
-    float R = u_radius, r = 0.5 * u_radius;
-    vec3 c = p.xyz + n * r;     // tangent sphere centre
-    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
-    float open = 0.0, F = 0.0;
     // Section 4.1: the pixel's set, by its offset in the one array of sets.
-    int ns = u_adaptive != 0 ? adaptive_count(c) : u_count;
-    int off = ns - 2;
-    o_count = float(ns);
-
-    for (int i = 0; i < ns; i++) {
-        float sx = u_samples[off + i].x, sy = u_samples[off + i].y;
-        float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
-        float h = r * l;        // half length of the pipe through the sphere
-        F += R * l;             // eq 2: F = R * sum sqrt(1 - x^2 - y^2)
-
-        vec3 s = vec3(c.x + r * (rot.x * sx - rot.y * sy), c.y + r * (rot.y * sx + rot.x * sy), c.z);
-        float cw = PM(3, 0) * s.x + PM(3, 1) * s.y + PM(3, 2) * s.z + PM(3, 3);
-        float zs = FAR_AWAY;    // scene depth at the sample's pixel
-        if (cw > 0.0) {
-            float cx = PM(0, 0) * s.x + PM(0, 1) * s.y + PM(0, 2) * s.z + PM(0, 3);
-            float cy = PM(1, 0) * s.x + PM(1, 1) * s.y + PM(1, 2) * s.z + PM(1, 3);
-            float u = (cx / cw * 0.5 + 0.5) * u_viewport.z - u_viewport.x;
-            float v = (0.5 - cy / cw * 0.5) * u_viewport.w - u_viewport.y;
-            float fu = floor(u), fv = floor(v);
-            if (fu >= 0.0 && fv >= 0.0 && fu < float(u_size.x) && fv < float(u_size.y)) {
-                float d = texelFetch(u_pos, ivec2(int(fu), int(fv)), 0).w;
-                if (d > 0.0)
-                    zs = d;
-            }
-        }
-        // Unoccluded length of the pipe (cases A, B, C of section 3).
-        float front = -c.z - h;
-        float dz = min(max(zs - front, 0.0), 2.0 * h);
-        if (u_range_check != 0 && zs < front) {
-            // Case C with the depth range check, section 4.4, eq 4:
-            // s(d) = u / max(u, d / radius), d behind the visible surface,
-            // measured from the pipe's near end (s = 1 where case C meets
-            // case A); the occluded weight 2h is multiplied by s(d).
-            float d = front - zs;
-            float sd = u_range_u / max(u_range_u, d / R);
-            dz = 2.0 * h * (1.0 - sd);
-        }
-        open += dz;
+    int ns = u_adaptive != 0 ? adaptive_count(p.xyz + n * (0.5 * u_radius)) : u_count;
+    // Section 4.2: a culling candidate gets AO 1 (greedy) or at most the
+    // 4-sample set (careful: "calculates occlusion with 4 samples in areas
+    // where no AO is estimated"; never more than the pixel would take).
+    if (u_culling != 0 && cull_candidate(px)) {
+        o_cull = 1.0;
+        ns = u_culling == 1 ? 0 : min(ns, 4);
     }
-    o_ao = F > 0.0 ? open / F : 1.0;   // eq 1: V = (1/F) sum dz_i
+    o_count = float(ns);
+    o_ao = ns > 0 ? vao_estimate(px, p, n, ns) : 1.0;
 }

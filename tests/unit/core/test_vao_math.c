@@ -99,6 +99,8 @@ static obs_params camera_normals(int samples)
     obs_param_set(&p, "normal_space", "camera", err);
     /* the VAO estimate itself, not the low-pass filter (test_blur.c) */
     obs_param_set(&p, "blur", "off", err);
+    /* every pixel with its own count, none culled (4.2: test_culling.c) */
+    obs_param_set(&p, "culling", "off", err);
     p.samples = samples;
     return p;
 }

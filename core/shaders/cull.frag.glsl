@@ -1,0 +1,17 @@
+// Culling pre-pass (VAO++ section 4.2): "We first calculate AO in a lower
+// resolution texture (we use 1/8 resolution of the final image) to
+// estimate areas where AO occurs ... We also always use 8 samples for this
+// pass."  Texel (i, j) is the 8-sample AO (vao.glsl, range check included,
+// no adaptive sampling) of the 8 x 8 block's centre pixel (8i + 4, 8j + 4),
+// clamped into a partial last block; 1 for background.  The AO pass reads
+// it with GL_LINEAR at the pixel corners (cull_candidate in vao.frag.glsl).
+// C twin: obs__cull_prepass (cull_cpu.c).
+
+out float o_est;
+
+void main()
+{
+    ivec2 px = min(ivec2(gl_FragCoord.xy) * 8 + 4, u_size - 1);
+    vec4 p = texelFetch(u_pos, px, 0);
+    o_est = p.w > 0.0 ? vao_estimate(px, p, texelFetch(u_vnormal, px, 0).xyz, 8) : 1.0;
+}
