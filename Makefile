@@ -53,7 +53,7 @@ BENCH := $(BUILD)/frame_bench
 
 # The daemon and the wire protocol bring their own rules; they add their
 # binaries to `all` and their e2e prerequisites to E2E_DEPS.
--include protocol/protocol.mk daemon/daemon.mk
+-include protocol/protocol.mk daemon/daemon.mk clients/clients.mk
 
 .PHONY: all deps demo demo-run test check unit e2e headers readme readme-check samples bench clean
 .DEFAULT_GOAL := all

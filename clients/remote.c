@@ -527,17 +527,20 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
         }
     }
 
-    int rc = -1;
-    for (int attempt = 1; attempt <= ATTEMPTS; attempt++) {
+    int rc = -1, attempts = ATTEMPTS;
+    const char *env = getenv("OBSCURA_RETRIES");
+    if (env && *env)
+        attempts = 1 + (atoi(env) < 0 ? 0 : atoi(env) > 100 ? 100 : atoi(env));
+    for (int attempt = 1; attempt <= attempts; attempt++) {
         int wait = 1;
         obs_result_free(out);
         rc = a.kind == PROTO_HTTP ? http_once(&a, query, body, body_len, outputs, out, &wait, msg, sizeof msg)
                                   : binary_once(&a, &frame, out, &wait, msg, sizeof msg);
-        if ((rc != -1 && rc != 503) || attempt == ATTEMPTS)
+        if ((rc != -1 && rc != 503) || attempt == attempts)
             break;
         wait = wait < 1 ? 1 : wait > MAX_WAIT_S ? MAX_WAIT_S : wait;
         fprintf(stderr, "obscura: %s: %s; retrying in %d s (%d of %d)\n", server,
-                rc == -1 ? msg : "busy (503)", wait, attempt, ATTEMPTS - 1);
+                rc == -1 ? msg : "busy (503)", wait, attempt, attempts - 1);
         sleep_s(wait);
     }
     free(query);

@@ -8,7 +8,9 @@
  *   http://host:port              POST /v1/ao with the input EXR, the
  *                                 answer asked as a float EXR
  *
- * OBSCURA_TOKEN, when set, is sent as the bearer token. */
+ * OBSCURA_TOKEN, when set, is sent as the bearer token.  OBSCURA_RETRIES
+ * (0..100, default 4) is how often an unreachable or busy server is tried
+ * again. */
 #ifndef OBSCURA_CLIENT_REMOTE_H
 #define OBSCURA_CLIENT_REMOTE_H
 
