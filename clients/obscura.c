@@ -5,6 +5,7 @@
  *   obscura info [--backend B]
  *   obscura params [--markdown]
  *   obscura samples [--c]
+ *   obscura batch IN.####.exr --frames 1-100x2 -o OUT.####.exr [--server URL] [--jobs N] [--strict] ...
  *
  * Exit codes: 0 ok, 1 failure (GL, I/O), 2 usage, 3 bad input. */
 #include <math.h>
@@ -14,6 +15,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "batch.h"
 #include "io.h"
 #include "metrics.h"
 #include "obscura.h"
@@ -22,6 +24,10 @@
 enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_BADINPUT = 3 };
 
 static int verbosity = OBS_LOG_INFO;
+
+/* obscura batch runs cmd_ao once per frame and keeps one context. */
+static int keep_ctx;
+static obs_ctx *kept_ctx;
 
 static void log_cb(void *user, obs_log_level level, const char *msg)
 {
@@ -92,9 +98,10 @@ typedef struct cli_opt {
 
 static const cli_opt ao_opts[] = {
     {"o", "FILE", "output file; .exr or .png (also --output-file)"},
-    {"output", "ao|composite|both|samples",
+    {"output", "ao|composite|both|samples|bleed",
      "what to write (default ao); a comma list combines them; samples: the sample count "
-     "of each pixel (adaptive sampling, VAO++ 4.1; EXR channel Samples.Y, PNG count/32)"},
+     "of each pixel (adaptive sampling, VAO++ 4.1; EXR channel Samples.Y, PNG count/32); "
+     "bleed: the colour-bleed term (VAO++ 4.7, --bleeding; EXR channels Bleed.R/G/B)"},
     {"format", "exr|png", "output format (default: from the file name)"},
     {"float", NULL, "EXR: 32-bit float channels (default half)"},
     {"png-bits", "8|16", "PNG bit depth (default 8)"},
@@ -122,7 +129,10 @@ static void usage(FILE *f)
             "                  [--mask auto|none|CH] [--diff OUT.png] [--json]\n"
             "  obscura info [--backend B]\n"
             "  obscura params [--markdown]\n"
-            "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as core/sample_tables.c\n\n"
+            "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as core/sample_tables.c\n"
+            "  obscura batch IN.####.exr --frames SPEC -o OUT.####.exr [--server URL] [--jobs N]\n"
+            "                [--strict] [ao options]   a frame sequence; SPEC 1-100, 1-100x2, 1,5,9;\n"
+            "                #### or %%04d is the frame; missing inputs are skipped (--strict: exit 3)\n\n"
             "ao options:\n",
             OBS_VERSION);
     for (const cli_opt *o = ao_opts; o->name; o++) {
@@ -222,8 +232,10 @@ static void parse_ao(int argc, char **argv, ao_args *a)
                     a->outputs |= OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE;
                 else if (!strcmp(names[j], "samples"))
                     a->outputs |= OBS_OUTPUT_SAMPLE_COUNT;
+                else if (!strcmp(names[j], "bleed"))
+                    a->outputs |= OBS_OUTPUT_BLEED;
                 else
-                    die_usage("--output: '%s' is not one of ao|composite|both|samples", names[j]);
+                    die_usage("--output: '%s' is not one of ao|composite|both|samples|bleed", names[j]);
             }
             if (!a->outputs)
                 die_usage("--output: '%s' names no output", v);
@@ -327,9 +339,10 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
     static const char *const ao_names[] = {"AO.Y"};
     static const char *const rgba_names[] = {"R", "G", "B", "A"};
     static const char *const count_names[] = {"Samples.Y"};
+    static const char *const bleed_names[] = {"Bleed.R", "Bleed.G", "Bleed.B"};
     obs_status s = OBS_OK;
     if (!strcmp(a->format, "exr")) {
-        obs_exr_layer layers[3];
+        obs_exr_layer layers[4];
         int n = 0;
         if (r->ao.data)
             layers[n++] = (obs_exr_layer){&r->ao, ao_names};
@@ -337,19 +350,24 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
             layers[n++] = (obs_exr_layer){&r->composite, rgba_names};
         if (r->sample_count.data)
             layers[n++] = (obs_exr_layer){&r->sample_count, count_names};
+        if (r->bleed.data)
+            layers[n++] = (obs_exr_layer){&r->bleed, bleed_names};
         s = obs_exr_write(a->out, layers, n, a->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
-        if (s == OBS_OK)
+        if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
         return s;
     }
     /* PNG: one file per output; NAME.ao.png, NAME.composite.png,
-     * NAME.samples.png when there are several */
+     * NAME.samples.png, NAME.bleed.png when there are several */
     const struct {
         const obs_image *img;
         const char *suffix;
         int srgb;
-    } files[] = {{&r->ao, "ao", 0}, {&r->composite, "composite", 1}, {&r->sample_count, "samples", 0}};
-    int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data;
+    } files[] = {{&r->ao, "ao", 0},
+                 {&r->composite, "composite", 1},
+                 {&r->sample_count, "samples", 0},
+                 {&r->bleed, "bleed", 1}};
+    int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data + !!r->bleed.data;
     for (size_t k = 0; k < sizeof files / sizeof files[0] && s == OBS_OK; k++) {
         char path[4096];
         obs_image scaled = {0};
@@ -370,7 +388,7 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
         }
         s = obs_png_write(path, img, a->png_bits, files[k].srgb, err);
         obs_image_free(&scaled);
-        if (s == OBS_OK)
+        if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", path);
     }
     return s;
@@ -441,7 +459,7 @@ static int cmd_ao(int argc, char **argv)
     } else {
         obs_ctx_desc desc = {.debug = a.debug_gl, .log = log_cb};
         backend_from_args(a.backend, &desc.backend);
-        s = obs_ctx_create(&desc, &ctx, err);
+        s = kept_ctx ? (ctx = kept_ctx, OBS_OK) : obs_ctx_create(&desc, &ctx, err);
         if (s != OBS_OK) {
             rc = fail(s, "OpenGL", err);
             goto done;
@@ -477,9 +495,33 @@ static int cmd_ao(int argc, char **argv)
 
 done:
     obs_result_free(&res);
-    obs_ctx_destroy(ctx);
+    if (keep_ctx)
+        kept_ctx = ctx;
+    else
+        obs_ctx_destroy(ctx);
     obs_gbuffer_free(&gf);
     return rc;
+}
+
+/* The hooks of obscura batch (clients/batch.c). */
+static void batch_check(int argc, char **argv)
+{
+    ao_args a;
+    const char *server;
+    argc = cli_remote_take_server(argc, argv, &server);
+    parse_ao(argc, argv, &a);
+}
+
+static int batch_ao(int argc, char **argv)
+{
+    keep_ctx = 1;
+    return cmd_ao(argc, argv);
+}
+
+static void batch_finish(void)
+{
+    obs_ctx_destroy(kept_ctx);
+    kept_ctx = NULL;
 }
 
 static int cmd_info(int argc, char **argv)
@@ -748,6 +790,10 @@ int main(int argc, char **argv)
         return cmd_params(argc - 2, argv + 2);
     if (!strcmp(cmd, "samples"))
         return cmd_samples(argc - 2, argv + 2);
+    if (!strcmp(cmd, "batch")) {
+        static const cli_batch_ops ops = {batch_check, batch_ao, batch_finish};
+        return cli_batch(argc - 2, argv + 2, &ops);
+    }
     if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
         usage(stdout);
         return EXIT_OK;

@@ -102,6 +102,24 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     for (int k = 0; k < 9; k++)
         obs__pixel_rotation(k / 3, k % 3, &f->rot[k][0], &f->rot[k][1]);
 
+    /* Sections 4.3 and 4.7 read the colour plane; without one they are off. */
+    f->luminance = p->luminance == OBS_LUMINANCE_LUM ? 1 : p->luminance == OBS_LUMINANCE_VALUE ? 2 : 0;
+    f->lum_threshold = p->lum_threshold;
+    f->lum_width = p->lum_width;
+    f->lum_sigma = p->lum_sigma;
+    f->bleed_step = p->bleeding == OBS_BLEEDING_FULL   ? 1
+                    : p->bleeding == OBS_BLEEDING_HALF ? 2
+                    : p->bleeding == OBS_BLEEDING_QUARTER ? 4
+                                                          : 0;
+    if (!gb->color.data && f->luminance) {
+        f->luminance = 0;
+        obs__log(log_ctx, OBS_LOG_INFO, "no colour channel: luminance sensitivity is off");
+    }
+    if (!gb->color.data && f->bleed_step) {
+        f->bleed_step = 0;
+        obs__log(log_ctx, OBS_LOG_INFO, "no colour channel: colour bleeding is off");
+    }
+
     static const float identity3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     memcpy(f->normal_matrix, identity3, sizeof identity3);
     if (!gb->normal.data) {

@@ -13,7 +13,8 @@
 
 /* Every OBS_OUTPUT_* bit. */
 #define OBS__OUTPUTS_ALL                                                                           \
-    (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK)
+    (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |        \
+     OBS_OUTPUT_BLEED)
 
 /* Culling pre-pass (VAO++ section 4.2): one low-resolution texel per
  * OBS__CULL_BLOCK x OBS__CULL_BLOCK pixels ("1/8 resolution"), always
@@ -49,6 +50,9 @@ typedef struct obs__frame {
     float cull_scale[2];    /* 1 / (8 cull_w), 1 / (8 cull_h): pixel corner -> texture coordinate */
     int blur_radius;        /* low-pass filter half-width (section 4.6); 0: off */
     float blur_w[OBS__MAX_BLUR + 1]; /* Gaussian weight of offset 0..blur_radius */
+    int luminance;          /* section 4.3, eq 3: 0 off, 1 Rec. 709 luminance, 2 HSV V */
+    float lum_threshold, lum_width, lum_sigma; /* threshold, width, sigma of eq 3 */
+    int bleed_step;         /* section 4.7, eq 5: 0 off, else every bleed_step-th sample */
 } obs__frame;
 
 /* Resolves camera, parameters and normal handling for one frame. */
@@ -103,6 +107,25 @@ float obs__cull_fetch(const obs__frame *f, const float *est, int px, int py);
 /* 1 when none of the four corners of pixel (x, y) shows occlusion: the
  * pixel is a culling candidate (GLSL: cull_candidate() in vao.frag.glsl). */
 int obs__cull_candidate(const obs__frame *f, const float *est, int x, int y);
+
+/* The estimator of obs__vao_estimate that also gathers colour bleeding
+ * (VAO++ section 4.7, eq 5; GLSL: vao_estimate() in vao.glsl): with
+ * f->bleed_step > 0, bleed gets the mean over every bleed_step-th sample
+ * of white mixed towards the colour at the sample's pixel by c(x); else
+ * (1, 1, 1).  col: 4 floats (RGBA) per pixel; NULL: no bleeding. */
+float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *col, int x,
+                              int y, const float p[3], const float n[3], int ns, const float *xy,
+                              float bleed[3]);
+
+/* Eq 5 of VAO++ section 4.7 (GLSL: bleed_weight() in vao.glsl): the
+ * indirect contribution c(x) of the surface point x to the point p with
+ * normal n, for the AO radius R. */
+float obs__bleed_weight(const float x[3], const float p[3], const float n[3], float R);
+
+/* Luminance sensitivity, VAO++ section 4.3, eq 3 (GLSL:
+ * luminance_ao() in luminance.frag.glsl): the AO of a pixel of colour
+ * rgb after the correction; f->luminance must be non-zero. */
+float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3]);
 
 /* Low-pass filter, VAO++ section 4.6 (GLSL: blur.frag.glsl): one pass of
  * the depth-aware cross-bilateral Gaussian along (dx, dy) at pixel (x, y)

@@ -144,13 +144,16 @@ void obs_ctx_get_info(const obs_ctx *ctx, obs_ctx_info *info);
 
 enum {
     OBS_OUTPUT_AO = 1,          /* one channel, 1 = unoccluded */
-    OBS_OUTPUT_COMPOSITE = 2,   /* RGBA: colour x AO */
+    OBS_OUTPUT_COMPOSITE = 2,   /* RGBA: colour x AO (x bleed with bleeding) */
     OBS_OUTPUT_SAMPLE_COUNT = 4, /* debug: one channel, the samples each pixel
                                     took (VAO++ 4.1); 0 for background and
                                     for greedily culled pixels (4.2) */
-    OBS_OUTPUT_CULL_MASK = 8     /* debug: one channel, 1 where the culling
+    OBS_OUTPUT_CULL_MASK = 8,    /* debug: one channel, 1 where the culling
                                     pre-pass (VAO++ 4.2) made the pixel a
                                     culling candidate, else 0 */
+    OBS_OUTPUT_BLEED = 16        /* RGB: the colour-bleed term (VAO++ 4.7),
+                                    (1,1,1) where there is none or bleeding
+                                    is off */
 };
 
 typedef struct obs_result {
@@ -158,6 +161,7 @@ typedef struct obs_result {
     obs_image composite;    /* filled when OBS_OUTPUT_COMPOSITE was asked */
     obs_image sample_count; /* filled when OBS_OUTPUT_SAMPLE_COUNT was asked */
     obs_image cull_mask;    /* filled when OBS_OUTPUT_CULL_MASK was asked */
+    obs_image bleed;        /* filled when OBS_OUTPUT_BLEED was asked */
 } obs_result;
 
 /* Runs the AO chain on the context's thread.  `params` may be NULL or

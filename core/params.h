@@ -39,6 +39,23 @@ typedef enum obs_culling {
     OBS_CULLING_CAREFUL  /* culling candidates take the 4-sample set */
 } obs_culling;
 
+/* Luminance sensitivity, VAO++ section 4.3 (parameter `luminance`). */
+typedef enum obs_luminance {
+    OBS_LUMINANCE_DEFAULT,
+    OBS_LUMINANCE_OFF,
+    OBS_LUMINANCE_LUM,   /* Rec. 709 luminance of the colour */
+    OBS_LUMINANCE_VALUE  /* HSV V: max(r, g, b) */
+} obs_luminance;
+
+/* Colour bleeding, VAO++ section 4.7 (parameter `bleeding`). */
+typedef enum obs_bleeding {
+    OBS_BLEEDING_DEFAULT,
+    OBS_BLEEDING_OFF,
+    OBS_BLEEDING_FULL,    /* every sample */
+    OBS_BLEEDING_HALF,    /* every second sample */
+    OBS_BLEEDING_QUARTER  /* every fourth sample */
+} obs_bleeding;
+
 typedef enum obs_normal_space {
     OBS_NORMALS_DEFAULT,
     OBS_NORMALS_WORLD,  /* world space: rotated by world_to_camera */
@@ -115,7 +132,31 @@ typedef enum obs_normal_space {
     X(blur_sigma, FLOAT, 1.25, 0.1, 64.0, NULL,                                \
       "standard deviation of the blur's Gaussian in pixels; with the default " \
       "radius 2, sigma 1.25 nulls the period-3 pattern of the 3x3 rotation "   \
-      "tile (exp(-1/2s^2) + exp(-4/2s^2) = 1)")
+      "tile (exp(-1/2s^2) + exp(-4/2s^2) = 1)")                                 \
+    X(luminance, ENUM, "off", 0, 0, "off|lum|value",                           \
+      "luminance sensitivity (VAO++ 4.3, eq 3): suppress the occlusion of "    \
+      "bright pixels of the G-buffer colour, after the blur: occlusion 1 - AO "\
+      "times (1 - min(1, max(0, lum - threshold + width)) / (2 width))^sigma, "\
+      "lum the Rec. 709 luminance (lum) or HSV V = max(r, g, b) (value); "     \
+      "off without a colour plane")                                            \
+    X(lum_threshold, FLOAT, 0.5, 1e-4, 1e4, NULL,                               \
+      "threshold of eq 3: the middle of the ramp from full to no occlusion "   \
+      "(paper's Figure 9: 0.5)")                                               \
+    X(lum_width, FLOAT, 0.3, 1e-3, 1e4, NULL,                                  \
+      "width of eq 3: occlusion is untouched up to lum = threshold - width "   \
+      "and gone from threshold + width (paper's Figure 9: 0.3); eq 3 as "      \
+      "printed clamps lum - threshold + width at 1 before dividing by "        \
+      "2 width, so above 0.5 some occlusion always stays")                     \
+    X(lum_sigma, FLOAT, 1.0, 0.01, 100.0, NULL,                                \
+      "sigma of eq 3, the ramp's linearity: 1 a straight ramp, above 1 "       \
+      "occlusion falls off sooner, below 1 later")                             \
+    X(bleeding, ENUM, "off", 0, 0, "off|full|half|quarter",                    \
+      "colour bleeding (VAO++ 4.7, eq 5): the bleed term averages, over "      \
+      "every sample (full), every second (half) or every fourth (quarter), "   \
+      "white mixed towards the colour at the sample's pixel by c(x) = "        \
+      "max(0, (x-p).n / |x-p|) max(0, 1 - |x-p|/radius)^2, x the surface "     \
+      "point seen there; the composite is multiplied by it; off without a "    \
+      "colour plane")
 
 #define OBS__PDECL_FLOAT(n) float n;
 #define OBS__PDECL_INT(n) int n;

@@ -19,6 +19,7 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
     const char *cull[] = {glsl_version, obs__shader_common, obs__shader_vao, obs__shader_cull_frag};
     const char *blur[] = {glsl_version, obs__shader_common, obs__shader_blur_frag};
     const char *comp[] = {glsl_version, obs__shader_composite_frag};
+    const char *lum[] = {glsl_version, obs__shader_luminance_frag};
     obs_status s = obs__gl_program("prep", obs__shader_fullscreen_vert, prep, 3, &ctx->prog.prep, err);
     if (s == OBS_OK)
         s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 4, &ctx->prog.vao, err);
@@ -28,6 +29,9 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
         s = obs__gl_program("blur", obs__shader_fullscreen_vert, blur, 3, &ctx->prog.blur, err);
     if (s == OBS_OK)
         s = obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2, &ctx->prog.composite,
+                            err);
+    if (s == OBS_OK)
+        s = obs__gl_program("luminance", obs__shader_fullscreen_vert, lum, 2, &ctx->prog.luminance,
                             err);
     return s;
 }
@@ -50,7 +54,7 @@ static obs_status make_fbo(obs_ctx *ctx, GLuint *fbo, const GLuint *tex, int cou
                            const char *name, char err[OBS_ERR_LEN])
 {
     static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1,
-                                  GL_COLOR_ATTACHMENT2};
+                                  GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
     glGenFramebuffers(1, fbo);
     ctx->gl_objects_created++;
     glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
@@ -68,7 +72,7 @@ void obs__frame_release(obs_ctx *ctx)
     obs__targets *t = &ctx->tg;
     GLuint tex[] = {t->tex_depth, t->tex_normal,    t->tex_color, t->tex_viewpos, t->tex_vnormal,
                     t->tex_ao,    t->tex_composite, t->tex_blur,  t->tex_count,
-                    t->tex_cull,  t->tex_cullmask};
+                    t->tex_cull,  t->tex_cullmask, t->tex_bleed};
     GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao, t->fbo_cull};
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
@@ -83,6 +87,8 @@ void obs__frame_release(obs_ctx *ctx)
         glDeleteProgram(ctx->prog.blur);
     if (ctx->prog.composite)
         glDeleteProgram(ctx->prog.composite);
+    if (ctx->prog.luminance)
+        glDeleteProgram(ctx->prog.luminance);
     memset(&ctx->prog, 0, sizeof ctx->prog);
 }
 
@@ -108,6 +114,7 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     t->tex_blur = make_texture(ctx, GL_R32F, w, h);
     t->tex_count = make_texture(ctx, GL_R32F, w, h);
     t->tex_cullmask = make_texture(ctx, GL_R32F, w, h);
+    t->tex_bleed = make_texture(ctx, GL_RGBA32F, w, h);
     /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block, read
      * with linear filtering (R32F filters in desktop GL). */
     t->tex_cull = make_texture(ctx, GL_R32F, (w + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK,
@@ -115,10 +122,10 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     GLuint prep[] = {t->tex_viewpos, t->tex_vnormal};
-    GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask};
+    GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask, t->tex_bleed};
     obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 2, "prep", err);
     if (s == OBS_OK)
-        s = make_fbo(ctx, &t->fbo_vao, vao, 3, "vao", err);
+        s = make_fbo(ctx, &t->fbo_vao, vao, 4, "vao", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_cull, &t->tex_cull, 1, "cull", err);
     if (s == OBS_OK)
@@ -231,7 +238,9 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     upload(t->tex_depth, &gb->depth, w, h, GL_RED);
     if (!f.reconstruct_normals)
         upload(t->tex_normal, &gb->normal, w, h, GL_RGB);
-    int has_color = gb->color.data != NULL && (outputs & OBS_OUTPUT_COMPOSITE);
+    /* colour: for the composite, luminance sensitivity (4.3), bleeding (4.7) */
+    int has_color = gb->color.data != NULL &&
+                    ((outputs & OBS_OUTPUT_COMPOSITE) || f.luminance || f.bleed_step);
     if (has_color)
         upload(t->tex_color, &gb->color, w, h, GL_RGBA);
 
@@ -267,13 +276,17 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     bind_tex(prog, "u_cull", 2, t->tex_cull);
     glUniform2fv(glGetUniformLocation(prog, "u_cull_scale"), 1, f.cull_scale);
     glUniform1f(glGetUniformLocation(prog, "u_cull_threshold"), f.cull_threshold);
+    /* section 4.7: colour bleeding reads the colour at the samples */
+    glUniform1i(glGetUniformLocation(prog, "u_bleed_step"), f.bleed_step);
+    bind_tex(prog, "u_color", 3, t->tex_color);
     /* the debug outputs go to their textures only when asked for */
     const GLenum vao_bufs[] = {
         GL_COLOR_ATTACHMENT0,
         (outputs & OBS_OUTPUT_SAMPLE_COUNT) ? GL_COLOR_ATTACHMENT1 : GL_NONE,
-        (outputs & OBS_OUTPUT_CULL_MASK) ? GL_COLOR_ATTACHMENT2 : GL_NONE};
+        (outputs & OBS_OUTPUT_CULL_MASK) ? GL_COLOR_ATTACHMENT2 : GL_NONE,
+        f.bleed_step ? GL_COLOR_ATTACHMENT3 : GL_NONE};
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_vao);
-    glDrawBuffers(3, vao_bufs);
+    glDrawBuffers(4, vao_bufs);
     draw(ctx, t->fbo_vao, w, h);
 
     /* low-pass filter (section 4.6): ao -> blur along x -> ao along y */
@@ -293,21 +306,47 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         draw(ctx, t->fbo_ao, w, h);
     }
 
-    if (outputs & OBS_OUTPUT_COMPOSITE) {
-        prog = ctx->prog.composite;
+    /* luminance sensitivity (section 4.3, eq 3), after the blur (see
+     * luminance.frag.glsl): ao -> tex_blur, free once the blur is done */
+    GLuint ao_tex = t->tex_ao, ao_fbo = t->fbo_ao;
+    if (f.luminance) {
+        prog = ctx->prog.luminance;
         glUseProgram(prog);
         bind_tex(prog, "u_ao", 0, t->tex_ao);
         bind_tex(prog, "u_color", 1, t->tex_color);
+        glUniform1i(glGetUniformLocation(prog, "u_luminance"), f.luminance);
+        glUniform1f(glGetUniformLocation(prog, "u_lum_threshold"), f.lum_threshold);
+        glUniform1f(glGetUniformLocation(prog, "u_lum_width"), f.lum_width);
+        glUniform1f(glGetUniformLocation(prog, "u_lum_sigma"), f.lum_sigma);
+        draw(ctx, t->fbo_blur, w, h);
+        ao_tex = t->tex_blur;
+        ao_fbo = t->fbo_blur;
+    }
+
+    if (outputs & OBS_OUTPUT_COMPOSITE) {
+        prog = ctx->prog.composite;
+        glUseProgram(prog);
+        bind_tex(prog, "u_ao", 0, ao_tex);
+        bind_tex(prog, "u_color", 1, t->tex_color);
+        bind_tex(prog, "u_bleed", 2, t->tex_bleed);
         glUniform1i(glGetUniformLocation(prog, "u_has_color"), has_color);
+        glUniform1i(glGetUniformLocation(prog, "u_has_bleed"), f.bleed_step > 0);
         draw(ctx, t->fbo_composite, w, h);
         read_back(t->fbo_composite, GL_COLOR_ATTACHMENT0, w, h, GL_RGBA, out->composite.data);
     }
     if (outputs & OBS_OUTPUT_AO)
-        read_back(t->fbo_ao, GL_COLOR_ATTACHMENT0, w, h, GL_RED, out->ao.data);
+        read_back(ao_fbo, GL_COLOR_ATTACHMENT0, w, h, GL_RED, out->ao.data);
     if (outputs & OBS_OUTPUT_SAMPLE_COUNT)
         read_back(t->fbo_vao, GL_COLOR_ATTACHMENT1, w, h, GL_RED, out->sample_count.data);
     if (outputs & OBS_OUTPUT_CULL_MASK)
         read_back(t->fbo_vao, GL_COLOR_ATTACHMENT2, w, h, GL_RED, out->cull_mask.data);
+    if (outputs & OBS_OUTPUT_BLEED) {
+        if (f.bleed_step)
+            read_back(t->fbo_vao, GL_COLOR_ATTACHMENT3, w, h, GL_RGB, out->bleed.data);
+        else /* bleeding off: the neutral term, no GL work */
+            for (size_t i = 0; i < (size_t)w * h * 3; i++)
+                out->bleed.data[i] = 1.0f;
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
 

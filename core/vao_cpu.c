@@ -200,9 +200,18 @@ float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const 
     return obs__vao_estimate(f, pos, x, y, p, n, ns, xy);
 }
 
-/* GLSL: vao_estimate() in vao.glsl */
+/* GLSL: vao_estimate() in vao.glsl, without colour bleeding */
 float obs__vao_estimate(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                         const float n[3], int ns, const float *xy)
+{
+    float bleed[3];
+    return obs__vao_estimate_bleed(f, pos, NULL, x, y, p, n, ns, xy, bleed);
+}
+
+/* GLSL: vao_estimate() in vao.glsl */
+float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *col, int x,
+                              int y, const float p[3], const float n[3], int ns, const float *xy,
+                              float bleed[3])
 {
     const float *P = f->proj;
     const float R = f->radius, r = 0.5f * f->radius;
@@ -210,8 +219,14 @@ float obs__vao_estimate(const obs__frame *f, const float *pos, int x, int y, con
     float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
     const float *rot = f->rot[3 * (x % 3) + (y % 3)];
     float open = 0.0f, F = 0.0f;
+    float acc[3] = {0.0f, 0.0f, 0.0f}, taken = 0.0f; /* section 4.7 */
 
     for (int i = 0; i < ns; i++) {
+        /* Section 4.7: "every second or fourth sample"; the sets are
+         * z-ordered, so those still cover the disk evenly. */
+        int bleeds = col && f->bleed_step > 0 && i % f->bleed_step == 0;
+        float c5 = 0.0f; /* eq 5's c(x); 0 (white) without a surface there */
+        const float *cx5 = NULL;
         float sx = xy[2 * i], sy = xy[2 * i + 1];
         float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
         float h = r * l; /* half length of the pipe through the sphere */
@@ -229,10 +244,23 @@ float obs__vao_estimate(const obs__frame *f, const float *pos, int x, int y, con
             float v = (0.5f - cy / cw * 0.5f) * f->viewport[3] - f->viewport[1];
             float fu = floorf(u), fv = floorf(v);
             if (fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height) {
-                float d = pos[4 * ((size_t)fv * (size_t)f->width + (size_t)fu) + 3];
-                if (d > 0.0f)
+                size_t k = (size_t)fv * (size_t)f->width + (size_t)fu;
+                float d = pos[4 * k + 3];
+                if (d > 0.0f) {
                     zs = d;
+                    if (bleeds) { /* eq 5 with x the surface point at the sample's pixel */
+                        c5 = obs__bleed_weight(pos + 4 * k, p, n, R);
+                        cx5 = col + 4 * k;
+                    }
+                }
             }
+        }
+        if (bleeds) {
+            /* "We use c(x) to linearly interpolate between the white
+             * color and the sampled color." */
+            for (int j = 0; j < 3; j++)
+                acc[j] += cx5 ? 1.0f + c5 * (cx5[j] - 1.0f) : 1.0f;
+            taken += 1.0f;
         }
         /* Unoccluded length of the pipe (cases A, B, C of section 3):
          * the pipe spans depths [-c.z - h, -c.z + h]. */
@@ -251,6 +279,8 @@ float obs__vao_estimate(const obs__frame *f, const float *pos, int x, int y, con
         }
         open += dz;
     }
+    for (int j = 0; j < 3; j++)
+        bleed[j] = taken > 0.0f ? acc[j] / taken : 1.0f;
     return F > 0.0f ? open / F : 1.0f; /* eq 1: V = (1/F) sum dz_i */
 }
 
@@ -280,6 +310,8 @@ obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs, ch
         s = alloc_image(&out->sample_count, w, h, 1, err);
     if (s == OBS_OK && (outputs & OBS_OUTPUT_CULL_MASK))
         s = alloc_image(&out->cull_mask, w, h, 1, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_BLEED))
+        s = alloc_image(&out->bleed, w, h, 3, err);
     if (s != OBS_OK)
         obs_result_free(out);
     return s;
@@ -293,19 +325,22 @@ void obs_result_free(obs_result *r)
     obs_image_free(&r->composite);
     obs_image_free(&r->sample_count);
     obs_image_free(&r->cull_mask);
+    obs_image_free(&r->bleed);
 }
 
-/* GLSL: composite.frag.glsl.  Colour x AO; grey AO when there is no colour. */
-static void composite_pixel(const float *color, float ao, float out[4])
+/* GLSL: composite.frag.glsl.  Section 5: "applied to resulting image
+ * simply by multiplication by occlusion values": colour x AO, and x the
+ * bleed term (section 4.7) when bleeding is on; grey AO when there is no
+ * colour. */
+static void composite_pixel(const float *color, float ao, const float *bleed, float out[4])
 {
     if (!color) {
         out[0] = out[1] = out[2] = ao;
         out[3] = 1.0f;
         return;
     }
-    out[0] = color[0] * ao;
-    out[1] = color[1] * ao;
-    out[2] = color[2] * ao;
+    for (int k = 0; k < 3; k++)
+        out[k] = bleed ? color[k] * ao * bleed[k] : color[k] * ao;
     out[3] = color[3];
 }
 
@@ -314,7 +349,8 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
 {
     obs_params p;
     obs__frame f;
-    float *pos = NULL, *nrm = NULL, *ao = NULL, *tmp = NULL, *est = NULL;
+    float *pos = NULL, *nrm = NULL, *ao = NULL, *tmp = NULL, *est = NULL, *col = NULL,
+          *bleed = NULL;
     obs_status s;
 
     memset(out, 0, sizeof *out);
@@ -331,7 +367,11 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
     ao = malloc(npx * sizeof(float));
     tmp = malloc(npx * sizeof(float));
     est = malloc((size_t)f.cull_w * (size_t)f.cull_h * sizeof(float));
-    if (!pos || !nrm || !ao || !tmp || !est) {
+    /* colour, packed RGBA, for sections 4.3 and 4.7; the bleed term */
+    if (f.luminance || f.bleed_step)
+        col = malloc(npx * 4 * sizeof(float));
+    bleed = malloc(npx * 3 * sizeof(float));
+    if (!pos || !nrm || !ao || !tmp || !est || !bleed || ((f.luminance || f.bleed_step) && !col)) {
         s = obs__fail(err, OBS_NO_MEMORY, "out of memory for a %dx%d frame", f.width, f.height);
         goto fail;
     }
@@ -349,6 +389,11 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
             const float *in = gb->normal.data ? obs__plane_px(&gb->normal, f.width, x, y) : NULL;
             obs__prep_normal(&f, pos, in, x, y, nrm + 3 * ((size_t)y * f.width + x));
         }
+    if (col)
+        for (int y = 0; y < f.height; y++)
+            for (int x = 0; x < f.width; x++)
+                memcpy(col + 4 * ((size_t)y * f.width + x), obs__plane_px(&gb->color, f.width, x, y),
+                       4 * sizeof(float));
     /* culling pre-pass (section 4.2) */
     if (f.culling)
         obs__cull_prepass(&f, pos, nrm, est);
@@ -358,18 +403,24 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
         for (int x = 0; x < f.width; x++) {
             size_t i = (size_t)y * f.width + x;
             int n = 0, culled = 0;
+            float *b = bleed + 3 * i;
             ao[i] = 1.0f;
+            b[0] = b[1] = b[2] = 1.0f;
             if (pos[4 * i + 3] > 0.0f) {
                 /* Section 4.2: a culling candidate gets AO 1 (greedy) or
                  * at most the 4-sample set (careful). */
                 culled = f.culling && obs__cull_candidate(&f, est, x, y);
                 if (!culled) {
-                    ao[i] = obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, &n);
+                    /* section 4.1: the set of the pixel's count */
+                    n = obs__vao_count(&f, pos + 4 * i, nrm + 3 * i);
+                    const float *xy = f.adaptive ? f.sample_table + 2 * (n - 2) : f.sample_xy;
+                    ao[i] = obs__vao_estimate_bleed(&f, pos, col, x, y, pos + 4 * i, nrm + 3 * i,
+                                                    n, xy, b);
                 } else if (f.culling == 2) {
                     n = obs__vao_count(&f, pos + 4 * i, nrm + 3 * i);
                     n = n < OBS__CULL_CAREFUL ? n : OBS__CULL_CAREFUL;
-                    ao[i] = obs__vao_estimate(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, n,
-                                              f.sample_table + 2 * (n - 2));
+                    ao[i] = obs__vao_estimate_bleed(&f, pos, col, x, y, pos + 4 * i, nrm + 3 * i,
+                                                    n, f.sample_table + 2 * (n - 2), b);
                 }
             }
             if (count)
@@ -379,20 +430,31 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
         }
     /* low-pass filter (section 4.6), then composite */
     obs__blur(&f, pos, ao, tmp);
+    /* luminance sensitivity (section 4.3, eq 3), after the blur: the
+     * blur is depth-aware only and would carry a bright pixel's
+     * suppression onto its dark neighbours (and their occlusion onto it) */
+    if (f.luminance)
+        for (size_t i = 0; i < npx; i++)
+            ao[i] = obs__luminance_ao(&f, ao[i], col + 4 * i);
     if (out->ao.data)
         memcpy(out->ao.data, ao, npx * sizeof(float));
+    if (out->bleed.data)
+        memcpy(out->bleed.data, bleed, npx * 3 * sizeof(float));
     if (out->composite.data)
         for (int y = 0; y < f.height; y++)
             for (int x = 0; x < f.width; x++) {
                 size_t i = (size_t)y * f.width + x;
                 composite_pixel(gb->color.data ? obs__plane_px(&gb->color, f.width, x, y) : NULL,
-                                ao[i], out->composite.data + 4 * i);
+                                ao[i], f.bleed_step ? bleed + 3 * i : NULL,
+                                out->composite.data + 4 * i);
             }
     free(pos);
     free(nrm);
     free(ao);
     free(tmp);
     free(est);
+    free(col);
+    free(bleed);
     return OBS_OK;
 
 fail:
@@ -401,6 +463,8 @@ fail:
     free(ao);
     free(tmp);
     free(est);
+    free(col);
+    free(bleed);
     obs_result_free(out);
     return s;
 }

@@ -150,7 +150,7 @@ obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 /* ---- the per-resolution frame resources and programs -------------------- */
 
 typedef struct obs__programs {
-    GLuint prep, vao, cull, blur, composite;
+    GLuint prep, vao, cull, blur, composite, luminance;
 } obs__programs;
 
 typedef struct obs__targets {
@@ -162,8 +162,9 @@ typedef struct obs__targets {
     GLuint tex_count;                         /* debug: samples per pixel (4.1) */
     GLuint tex_cull;                          /* culling pre-pass AO, 1/8 size (4.2) */
     GLuint tex_cullmask;                      /* debug: culling candidates (4.2) */
+    GLuint tex_bleed;                         /* colour-bleed term (4.7), RGBA */
     GLuint fbo_prep, fbo_ao, fbo_blur, fbo_composite;
-    GLuint fbo_vao;                           /* AO pass: tex_ao + tex_count + tex_cullmask */
+    GLuint fbo_vao;                           /* AO pass: tex_ao + tex_count + tex_cullmask + tex_bleed */
     GLuint fbo_cull;                          /* culling pre-pass: tex_cull */
 } obs__targets;
 

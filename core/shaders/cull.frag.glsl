@@ -13,5 +13,6 @@ void main()
 {
     ivec2 px = min(ivec2(gl_FragCoord.xy) * 8 + 4, u_size - 1);
     vec4 p = texelFetch(u_pos, px, 0);
-    o_est = p.w > 0.0 ? vao_estimate(px, p, texelFetch(u_vnormal, px, 0).xyz, 8) : 1.0;
+    vec3 unused;                // no colour bleeding in the pre-pass
+    o_est = p.w > 0.0 ? vao_estimate(px, p, texelFetch(u_vnormal, px, 0).xyz, 8, 0, unused) : 1.0;
 }

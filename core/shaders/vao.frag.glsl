@@ -10,10 +10,12 @@ uniform int u_culling;           // section 4.2: 0 off, 1 greedy, 2 careful
 uniform sampler2D u_cull;        // the pre-pass's 1/8-resolution AO, GL_LINEAR
 uniform vec2 u_cull_scale;       // 1 / (8 * its size): pixel corner -> texture coordinate
 uniform float u_cull_threshold;  // an estimate below this shows occlusion
+uniform int u_bleed_step;        // section 4.7: 0 off, else every u_bleed_step-th sample
 
 layout(location = 0) out float o_ao;
 layout(location = 1) out float o_count; // samples taken (debug output)
 layout(location = 2) out float o_cull;  // 1: culling candidate (debug output)
+layout(location = 3) out vec4 o_bleed;  // section 4.7: the colour-bleed term
 
 // Adaptive sampling, section 4.1: "double the number of samples every time
 // surface area of the sampling disc doubles", 2 samples for a disk of
@@ -67,6 +69,7 @@ void main()
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 p = texelFetch(u_pos, px, 0);
     o_cull = 0.0;
+    o_bleed = vec4(1.0);
     if (p.w <= 0.0) {
         o_ao = 1.0;
         o_count = 0.0;
@@ -83,5 +86,7 @@ void main()
         ns = u_culling == 1 ? 0 : min(ns, 4);
     }
     o_count = float(ns);
-    o_ao = ns > 0 ? vao_estimate(px, p, n, ns) : 1.0;
+    vec3 bleed = vec3(1.0);
+    o_ao = ns > 0 ? vao_estimate(px, p, n, ns, u_bleed_step, bleed) : 1.0;
+    o_bleed = vec4(bleed, 1.0);
 }

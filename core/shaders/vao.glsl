@@ -14,17 +14,46 @@ uniform vec2 u_samples[62];      // all sets of section 4.5 (core/sample_tables.
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
 uniform int u_range_check;       // 1: depth range check (section 4.4, eq 4)
 uniform float u_range_u;         // u of eq 4
+uniform sampler2D u_color;       // G-buffer colour (section 4.7)
+
+// Colour bleeding, section 4.7, eq 5:
+//   c(x) = max(0, (x - p).n / |x - p|) (1 - |x - p| / radius)^2,
+// x the view-space point the depth buffer holds at the sample's pixel (the
+// paper uses the samples "regardless of whether they lie on the surface").
+// As printed the falloff grows again past 2 radius; it is clamped at 0
+// from |x - p| = radius on.  x = p gives 0.  C twin: obs__bleed_weight.
+float bleed_weight(vec3 x, vec3 p, vec3 n, float R)
+{
+    float dx = x.x - p.x, dy = x.y - p.y, dz = x.z - p.z;
+    float len = sqrt(dx * dx + dy * dy + dz * dz);
+    if (!(len > 0.0))
+        return 0.0;
+    float cosv = (dx * n.x + dy * n.y + dz * n.z) / len;
+    float fall = max(0.0, 1.0 - len / R);
+    return max(0.0, cosv) * fall * fall;
+}
 
 // The AO of the point p (xyz; w: planar depth) with normal n at pixel px
-// from the ns samples of the set at u_samples[ns - 2].
-float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns)
+// from the ns samples of the set at u_samples[ns - 2].  With bleed_step >
+// 0, bleed gets the colour-bleed term of section 4.7: the mean over every
+// bleed_step-th sample of white mixed towards the colour at the sample's
+// pixel by eq 5's c(x); else vec3(1).  C twin: obs__vao_estimate_bleed.
+float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bleed)
 {
     float R = u_radius, r = 0.5 * u_radius;
     vec3 c = p.xyz + n * r;     // tangent sphere centre
     vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
     float open = 0.0, F = 0.0;
     int off = ns - 2;
+    vec3 acc = vec3(0.0);
+    float taken = 0.0;
     for (int i = 0; i < ns; i++) {
+        // Section 4.7: "every second or fourth sample"; the sets are
+        // z-ordered, so those still cover the disk evenly.
+        bool bleeds = bleed_step > 0 && i % bleed_step == 0;
+        float c5 = 0.0;         // eq 5's c(x); 0 (white) without a surface there
+        bool hit = false;
+        ivec2 q = ivec2(0);
         float sx = u_samples[off + i].x, sy = u_samples[off + i].y;
         float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
         float h = r * l;        // half length of the pipe through the sphere
@@ -40,10 +69,25 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns)
             float v = (0.5 - cy / cw * 0.5) * u_viewport.w - u_viewport.y;
             float fu = floor(u), fv = floor(v);
             if (fu >= 0.0 && fv >= 0.0 && fu < float(u_size.x) && fv < float(u_size.y)) {
-                float d = texelFetch(u_pos, ivec2(int(fu), int(fv)), 0).w;
-                if (d > 0.0)
-                    zs = d;
+                q = ivec2(int(fu), int(fv));
+                vec4 xs = texelFetch(u_pos, q, 0);
+                if (xs.w > 0.0) {
+                    zs = xs.w;
+                    if (bleeds) {   // eq 5, x the surface point at the sample's pixel
+                        c5 = bleed_weight(xs.xyz, p.xyz, n, R);
+                        hit = true;
+                    }
+                }
             }
+        }
+        if (bleeds) {
+            // "We use c(x) to linearly interpolate between the white color
+            // and the sampled color."
+            vec3 col = hit ? texelFetch(u_color, q, 0).rgb : vec3(1.0);
+            acc += hit ? vec3(1.0 + c5 * (col.r - 1.0), 1.0 + c5 * (col.g - 1.0),
+                              1.0 + c5 * (col.b - 1.0))
+                       : vec3(1.0);
+            taken += 1.0;
         }
         // Unoccluded length of the pipe (cases A, B, C of section 3).
         float front = -c.z - h;
@@ -59,5 +103,6 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns)
         }
         open += dz;
     }
+    bleed = taken > 0.0 ? acc / taken : vec3(1.0);
     return F > 0.0 ? open / F : 1.0;   // eq 1: V = (1/F) sum dz_i
 }

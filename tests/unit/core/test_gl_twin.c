@@ -61,12 +61,15 @@ static void test_gl_matches_cpu(void **state)
         char err[OBS_ERR_LEN] = "";
         load(scenes[s], &gf);
         unsigned out = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT |
-                       OBS_OUTPUT_CULL_MASK;
+                       OBS_OUTPUT_CULL_MASK | OBS_OUTPUT_BLEED;
         /* the defaults (range check, 5-tap blur, adaptive sampling on),
          * then a wide blur with the range check off, then no blur, then
          * adaptive sampling with a diameter that spreads the counts over
          * 2..32, then a fixed count, then the greedy culling pre-pass
-         * (section 4.2; the defaults use careful) and none */
+         * (section 4.2; the defaults use careful) and none, then
+         * luminance sensitivity (section 4.3) with luminance and with
+         * HSV V, then colour bleeding (section 4.7) with every sample and
+         * every fourth, the latter with luminance sensitivity too */
         static const char *const variants[][2][2] = {
             {{NULL, NULL}, {NULL, NULL}},
             {{"blur_radius", "7"}, {"range_check", "off"}},
@@ -75,6 +78,10 @@ static void test_gl_matches_cpu(void **state)
             {{"adaptive", "off"}, {NULL, NULL}},
             {{"culling", "greedy"}, {"blur", "off"}},
             {{"culling", "off"}, {NULL, NULL}},
+            {{"luminance", "lum"}, {"lum_sigma", "2"}},
+            {{"luminance", "value"}, {"lum_threshold", "0.3"}},
+            {{"bleeding", "full"}, {NULL, NULL}},
+            {{"bleeding", "quarter"}, {"luminance", "lum"}},
         };
         for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
             obs_params p = {0};
@@ -98,17 +105,23 @@ static void test_gl_matches_cpu(void **state)
              * rounding above could move a decision */
             double mmean, mfrac;
             diff(&gl.cull_mask, &cpu.cull_mask, &mmean, &mfrac);
+            /* the bleed term (section 4.7): the same samples, so the same
+             * border rounding as the AO */
+            double bmean, bfrac;
+            diff(&gl.bleed, &cpu.bleed, &bmean, &bfrac);
             print_message("%s (%s %s): GL vs CPU AO: mean |diff| %.2e, %.3f %% of pixels > 1e-3; "
                           "composite mean %.2e; sample counts differ at %.3f %% of pixels, "
-                          "culling mask at %.3f %%\n",
+                          "culling mask at %.3f %%; bleed mean %.2e, %.3f %% > 1e-3\n",
                           scenes[s], variants[v][0][0] ? variants[v][0][0] : "defaults",
                           variants[v][0][1] ? variants[v][0][1] : "", mean, 100 * frac, cmean,
-                          100 * nfrac, 100 * mfrac);
+                          100 * nfrac, 100 * mfrac, bmean, 100 * bfrac);
             assert_true(mean < 1e-3);
             assert_true(frac < 0.02);
             assert_true(cmean < 1e-3);
             assert_true(nfrac < 1e-3);
             assert_true(mfrac < 1e-3);
+            assert_true(bmean < 1e-3);
+            assert_true(bfrac < 0.02);
             obs_result_free(&gl);
             obs_result_free(&cpu);
         }
