@@ -336,22 +336,10 @@ static obs_status count_scaled(const obs_image *count, obs_image *out)
 static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs_camera *cam,
                                 char err[OBS_ERR_LEN])
 {
-    static const char *const ao_names[] = {"AO.Y"};
-    static const char *const rgba_names[] = {"R", "G", "B", "A"};
-    static const char *const count_names[] = {"Samples.Y"};
-    static const char *const bleed_names[] = {"Bleed.R", "Bleed.G", "Bleed.B"};
     obs_status s = OBS_OK;
     if (!strcmp(a->format, "exr")) {
-        obs_exr_layer layers[4];
-        int n = 0;
-        if (r->ao.data)
-            layers[n++] = (obs_exr_layer){&r->ao, ao_names};
-        if (r->composite.data)
-            layers[n++] = (obs_exr_layer){&r->composite, rgba_names};
-        if (r->sample_count.data)
-            layers[n++] = (obs_exr_layer){&r->sample_count, count_names};
-        if (r->bleed.data)
-            layers[n++] = (obs_exr_layer){&r->bleed, bleed_names};
+        obs_exr_layer layers[OBS_RESULT_LAYERS];
+        int n = obs_result_exr_layers(r, layers);
         s = obs_exr_write(a->out, layers, n, a->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);

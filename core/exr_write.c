@@ -218,3 +218,21 @@ obs_status obs_exr_write_mem(const obs_exr_layer *layers, int layer_count, obs_e
     free(mem.data);
     return st;
 }
+
+int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_LAYERS])
+{
+    static const char *const ao[] = {"AO.Y"};
+    static const char *const rgba[] = {"R", "G", "B", "A"};
+    static const char *const count[] = {"Samples.Y"};
+    static const char *const bleed[] = {"Bleed.R", "Bleed.G", "Bleed.B"};
+    int n = 0;
+    if (r->ao.data)
+        layers[n++] = (obs_exr_layer){&r->ao, ao};
+    if (r->composite.data)
+        layers[n++] = (obs_exr_layer){&r->composite, rgba};
+    if (r->sample_count.data)
+        layers[n++] = (obs_exr_layer){&r->sample_count, count};
+    if (r->bleed.data)
+        layers[n++] = (obs_exr_layer){&r->bleed, bleed};
+    return n;
+}

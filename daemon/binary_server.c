@@ -251,14 +251,8 @@ static int run_frame(frame *f, obs_bin_request *q)
         d.images = images;
         d.image_count = n;
     } else if (q->hr.format == OBS_HTTP_EXR) {
-        static const char *const ao_names[] = {"AO.Y"};
-        static const char *const rgba_names[] = {"R", "G", "B", "A"};
-        obs_exr_layer layers[2];
-        int n = 0;
-        if (res->ao.data)
-            layers[n++] = (obs_exr_layer){&res->ao, ao_names};
-        if (res->composite.data)
-            layers[n++] = (obs_exr_layer){&res->composite, rgba_names};
+        obs_exr_layer layers[OBS_RESULT_LAYERS];
+        int n = obs_result_exr_layers(res, layers);
         s = obs_exr_write_mem(layers, n, q->hr.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF,
                               gb->camera.has_projection ? &gb->camera : NULL, &blob, err);
         d.body = OBS_BIN_EXR;

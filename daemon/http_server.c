@@ -377,14 +377,8 @@ static enum MHD_Result ao_finish(req *r)
     const char *type;
     const obs_result *res = &job->result;
     if (r->hr.format == OBS_HTTP_EXR) {
-        static const char *const ao_names[] = {"AO.Y"};
-        static const char *const rgba_names[] = {"R", "G", "B", "A"};
-        obs_exr_layer layers[2];
-        int n = 0;
-        if (res->ao.data)
-            layers[n++] = (obs_exr_layer){&res->ao, ao_names};
-        if (res->composite.data)
-            layers[n++] = (obs_exr_layer){&res->composite, rgba_names};
+        obs_exr_layer layers[OBS_RESULT_LAYERS];
+        int n = obs_result_exr_layers(res, layers);
         const obs_camera *cam = r->gf.gb.camera.has_projection ? &r->gf.gb.camera : NULL;
         s = obs_exr_write_mem(layers, n, r->hr.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, &out, err);
         type = "image/x-exr";

@@ -1,50 +1,9 @@
-/* The GL passes against their CPU twin on real input, EGL surfaceless
- * against OSMesa, resource reuse across frames, and shader failures. */
-#include <math.h>
-
-#include "testutil.h"
+/* The GL passes against their CPU twin on real input, resource reuse
+ * across frames, shader failures, bad input.  (EGL against OSMesa:
+ * test_backends.c.) */
+#include "gl_testutil.h"
 
 #include "gl/gl.h"
-#include "io.h"
-
-static const char *const scenes[] = {TESTDATA "/room_small", TESTDATA "/yard_small"};
-
-static void load(const char *stem, obs_gbuffer_file *gf)
-{
-    char path[512], err[OBS_ERR_LEN] = "";
-    snprintf(path, sizeof path, "%s.exr", stem);
-    if (obs_gbuffer_read_exr(path, NULL, NULL, gf, err) != OBS_OK)
-        fail_msg("%s: %s", path, err);
-    snprintf(path, sizeof path, "%s.camera.json", stem);
-    if (obs_camera_read_json(path, &gf->gb.camera, NULL, NULL, err) != OBS_OK)
-        fail_msg("%s: %s", path, err);
-}
-
-static obs_ctx *make_ctx(obs_backend b)
-{
-    obs_ctx *ctx = NULL;
-    char err[OBS_ERR_LEN] = "";
-    obs_ctx_desc d = {.backend = b};
-    if (obs_ctx_create(&d, &ctx, err) != OBS_OK)
-        fail_msg("%s: %s", obs_backend_name(b), err);
-    return ctx;
-}
-
-/* Mean |a - b| and the fraction of pixels differing by more than 1e-3. */
-static void diff(const obs_image *a, const obs_image *b, double *mean, double *frac)
-{
-    size_t n = (size_t)a->width * a->height * a->channels, big = 0;
-    double sum = 0;
-    assert_int_equal(a->width, b->width);
-    assert_int_equal(a->height, b->height);
-    for (size_t i = 0; i < n; i++) {
-        double d = fabs((double)a->data[i] - b->data[i]);
-        sum += d;
-        big += d > 1e-3;
-    }
-    *mean = sum / n;
-    *frac = (double)big / n;
-}
 
 /* GL and CPU do the same float arithmetic, but a sample that lands within
  * rounding of a pixel border may read the neighbouring pixel's depth on
