@@ -224,6 +224,7 @@ int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_L
     static const char *const ao[] = {"AO.Y"};
     static const char *const rgba[] = {"R", "G", "B", "A"};
     static const char *const count[] = {"Samples.Y"};
+    static const char *const cull[] = {"Cull.Y"};
     static const char *const bleed[] = {"Bleed.R", "Bleed.G", "Bleed.B"};
     int n = 0;
     if (r->ao.data)
@@ -232,6 +233,8 @@ int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_L
         layers[n++] = (obs_exr_layer){&r->composite, rgba};
     if (r->sample_count.data)
         layers[n++] = (obs_exr_layer){&r->sample_count, count};
+    if (r->cull_mask.data)
+        layers[n++] = (obs_exr_layer){&r->cull_mask, cull};
     if (r->bleed.data)
         layers[n++] = (obs_exr_layer){&r->bleed, bleed};
     return n;

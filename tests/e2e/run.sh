@@ -106,6 +106,16 @@ expect 0 "AO and sample count to EXR" -- "$OBSCURA" ao "$R" --camera "$C" --outp
 expect 0 "EXR has AO.Y and Samples.Y" -- "$OBSCURA" compare "$T/count.exr" "$T/count.exr" --channel-a AO.Y --channel-b Samples.Y --mask none
 expect 0 "sample count to PNG with the AO" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,samples -o "$T/count.png"
 if [ -s "$T/count.ao.png" ] && [ -s "$T/count.samples.png" ]; then ok "ao,samples to PNG wrote two files"; else bad "ao,samples PNG files missing"; fi
+# the culling mask (VAO++ 4.2) and the colour-bleed term (4.7), GL and CPU twin
+expect 0 "culling mask and bleed to EXR" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,cull,bleed --bleeding full -o "$T/cb.exr" --float
+expect 0 "culling mask and bleed, CPU twin" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,cull,bleed --bleeding full -o "$T/cb_cpu.exr" --float --cpu
+for ch in Cull.Y Bleed.G; do
+    expect 0 "$ch: GL vs CPU twin" -- "$OBSCURA" compare "$T/cb_cpu.exr" "$T/cb.exr" --channel-a $ch --channel-b $ch --mask none --json
+    mae=$(json mae)
+    if awk "BEGIN { exit !($mae < 1e-4) }"; then ok "$ch GL vs CPU MAE $mae"; else bad "$ch GL vs CPU MAE $mae"; fi
+done
+expect 0 "cull mask to PNG with the AO" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,cull -o "$T/cm.png"
+if [ -s "$T/cm.ao.png" ] && [ -s "$T/cm.cull.png" ]; then ok "ao,cull to PNG wrote two files"; else bad "ao,cull PNG files missing"; fi
 expect 2 "unknown output" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,depth -o "$T/x.exr"
 said "not one of ao|composite|both|samples"
 expect 0 "CPU twin" -- "$OBSCURA" ao "$R" --camera "$C" --cpu -o "$T/cpu.exr" --float
