@@ -78,7 +78,13 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     f->viewport[3] = (float)(gb->display_height > 0 ? gb->display_height : gb->height);
     memcpy(f->proj, cam.projection, sizeof f->proj);
     f->depth_mode = p->depth_mode;
-    f->radius = p->radius / p->unit_scale;
+    /* The radius parameter is the ray-traced AO distance D (the reach of
+     * Cycles' AO pass); the VAO kernel width R of eq 1 is k * D, so the
+     * tangent sphere has radius k * D / 2.  k = OBS__RADIUS_K (frame.h),
+     * chosen in bench/QUALITY.md "How --radius maps to the AO distance".
+     * Everything downstream (eq 2's F, eq 4's falloff, the blur's depth
+     * threshold, eq 5) takes this R, the paper's "kernel radius". */
+    f->radius = OBS__RADIUS_K * p->radius / p->unit_scale;
     f->samples = p->samples;
     f->sample_xy = obs__samples(p->samples);
     f->sample_table = &obs__sample_table[0][0];

@@ -28,6 +28,18 @@
  * blur.frag.glsl). */
 #define OBS__MAX_BLUR 16
 
+/* k of R = k * D: the paper's kernel width R (hemisphere radius; the
+ * tangent sphere has radius R/2) for the ray-traced AO distance D that the
+ * radius parameter gives.  k = 1: the tangent sphere of radius D/2 is the
+ * largest sphere inside the ray tracer's hemisphere of radius D that
+ * touches p, so both measure occluders within D of p along the normal
+ * (same support).  The crease-integral mapping k = 64/(9 pi) was examined
+ * and not adopted: it matches a floor-wall crease but not a slab (k = 4/3)
+ * and made yard.exr markedly worse (bench/QUALITY.md, "How --radius maps
+ * to the AO distance"; tools/radius_mapping.py).  Applied in one place,
+ * obs__frame_setup (frame.c). */
+#define OBS__RADIUS_K 1.0f
+
 typedef struct obs__frame {
     int width, height;
     float viewport[4];      /* display_x, display_y, display_width, display_height */
@@ -35,7 +47,7 @@ typedef struct obs__frame {
     float normal_matrix[9]; /* input normal -> view normal, row-major 3x3 */
     int reconstruct_normals;/* 1: no usable normals, derive them from depth */
     int depth_mode;         /* OBS_DEPTH_PLANAR/RADIAL/NDC */
-    float radius;           /* R in depth units: radius / unit_scale */
+    float radius;           /* R, the kernel width, in depth units: OBS__RADIUS_K * radius / unit_scale */
     int samples;            /* the count of the parameter: adaptive sampling's maximum */
     const float *sample_xy; /* samples * (x, y) on the unit disk */
     const float *sample_table; /* all sets, 62 (x, y) pairs: the set of n at pair n - 2 */

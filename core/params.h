@@ -68,8 +68,10 @@ typedef enum obs_normal_space {
  * For ENUM the default is the choice's name; for MAT4 it is unused. */
 #define OBS_PARAM_TABLE(X)                                                     \
     X(radius, FLOAT, 0.5, 1e-4, 1e4, NULL,                                     \
-      "AO radius R in world units: hemisphere radius of the occlusion "        \
-      "test; VAO's tangent sphere has radius R/2")                             \
+      "AO distance D in world units, as in a ray tracer's AO (the fraction "  \
+      "of cosine-weighted rays unblocked within D, Cycles' AO pass); VAO's "   \
+      "kernel width R = D: its tangent sphere (radius D/2) is the largest "    \
+      "sphere inside that hemisphere (bench/QUALITY.md); R below is this")     \
     X(samples, INT, 16, 2, 32, "2|4|8|16|32",                                  \
       "line samples per pixel on the tangent sphere's disk; the sets of "     \
       "VAO++ 4.5 (rotation-aware Poisson disk, best rotation permutation, "    \
@@ -116,16 +118,16 @@ typedef enum obs_normal_space {
       "(-Z forward); overrides the file's camera rotation")                    \
     X(range_check, ENUM, "on", 0, 0, "on|off",                                 \
       "depth range check (VAO++ 4.4, eq 4): a pipe hidden behind a surface "   \
-      "counts as occluded only by the falloff s(d) = u / max(u, d/radius), "   \
+      "counts as occluded only by the falloff s(d) = u / max(u, d/R), "      \
       "d its distance behind that surface; off: occluders are infinitely "     \
       "thick")                                                                 \
     X(range_u, FLOAT, 0.03, 1e-4, 1.0, NULL,                                   \
       "u of the depth range check's falloff (eq 4): occluders are taken as "   \
-      "fully thick up to u * radius behind the visible surface")               \
+      "fully thick up to u * R behind the visible surface")                    \
     X(blur, ENUM, "on", 0, 0, "on|off",                                        \
       "low-pass filter (VAO++ 4.6): depth-aware cross-bilateral Gaussian "     \
       "blur of the AO, a horizontal then a vertical pass; neighbours whose "   \
-      "view depth differs from the centre's by more than radius are left out") \
+      "view depth differs from the centre's by more than R are left out")      \
     X(blur_radius, INT, 2, 1, 16, NULL,                                        \
       "blur kernel half-width in pixels (the kernel is 2 * blur_radius + 1 "   \
       "taps per pass)")                                                        \
@@ -154,7 +156,7 @@ typedef enum obs_normal_space {
       "colour bleeding (VAO++ 4.7, eq 5): the bleed term averages, over "      \
       "every sample (full), every second (half) or every fourth (quarter), "   \
       "white mixed towards the colour at the sample's pixel by c(x) = "        \
-      "max(0, (x-p).n / |x-p|) max(0, 1 - |x-p|/radius)^2, x the surface "     \
+      "max(0, (x-p).n / |x-p|) max(0, 1 - |x-p|/R)^2, x the surface "          \
       "point seen there; the composite is multiplied by it; off without a "    \
       "colour plane")
 

@@ -38,6 +38,7 @@ static void run(const obs_gbuffer *gb, const char *bleeding, unsigned outputs, o
 {
     obs_params p = {0};
     char err[OBS_ERR_LEN] = "";
+    p.radius = 0.5f / OBS__RADIUS_K; /* the kernel width R = 0.5 these expectations were built for: radius is the AO distance D, R = OBS__RADIUS_K * D (frame.h) */
     assert_int_equal(obs_param_set(&p, "normal_space", "camera", err), OBS_OK);
     assert_int_equal(obs_param_set(&p, "bleeding", bleeding, err), OBS_OK);
     if (obs_run_cpu(gb, &p, outputs, r, err) != OBS_OK)
@@ -124,6 +125,7 @@ static void test_room_small(void **state)
     obs_params p = {0};
     char err[OBS_ERR_LEN] = "";
     (void)state;
+    p.radius = 0.5f / OBS__RADIUS_K; /* R = 0.5, as measured below (see run()) */
     if (obs_gbuffer_read_exr(TESTDATA "/room_small.exr", NULL, NULL, &gf, err) != OBS_OK ||
         obs_camera_read_json(TESTDATA "/room_small.camera.json", &gf.gb.camera, NULL, NULL, err) !=
             OBS_OK)

@@ -342,7 +342,9 @@ static void test_range_check_closed_form(void **state)
     for (int pass = 0; pass < 3; pass++) {
         obs_params p = camera_normals(16), rp;
         char err[OBS_ERR_LEN];
-        p.radius = 0.5f;
+        /* R = 0.5 (the occluder depths below are chosen for it): radius is
+         * the AO distance D, R = OBS__RADIUS_K * D (frame.h) */
+        p.radius = 0.5f / OBS__RADIUS_K;
         if (pass == 1)
             obs_param_set(&p, "range_check", "off", err);
         if (pass == 2)
