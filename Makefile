@@ -50,10 +50,14 @@ UNIT_BIN := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 LIB := $(BUILD)/libobscura.a
 CLI := $(BUILD)/obscura
 BENCH := $(BUILD)/frame_bench
+# Developer tool: a G-buffer EXR upscaled to WxH (tests/e2e/load.sh, bench).
+UPSCALE := $(BUILD)/exr_upscale
+DAEMON_BENCH := $(BUILD)/daemon_bench
 
 # The daemon and the wire protocol bring their own rules; they add their
 # binaries to `all` and their e2e prerequisites to E2E_DEPS.
 -include protocol/protocol.mk daemon/daemon.mk clients/clients.mk
+E2E_DEPS += $(UPSCALE)
 
 .PHONY: all deps demo demo-run test check unit e2e headers readme readme-check samples bench clean
 .DEFAULT_GOAL := all
@@ -86,6 +90,13 @@ $(CLI): $(CLI_OBJ) $(PROTO_LIB) $(LIB)
 
 $(BENCH): bench/frame_bench.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
+$(UPSCALE): tools/exr_upscale.c $(LIB)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
+# The daemon bench is a client: the CLI's remote code and the protocol.
+$(DAEMON_BENCH): bench/daemon_bench.c $(BUILD)/obj/clients/remote.o $(PROTO_LIB) $(LIB)
+	$(CC) $(CPPFLAGS) -Iclients -Iprotocol $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(BUILD)/obj/clients/remote.o $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 # PROTO_LIB and EXTRA_LIBS come from protocol.mk / daemon.mk when present.
 $(BUILD)/tests/%: tests/unit/%.c $(PROTO_LIB) $(LIB) tests/unit/testutil.h $(wildcard tests/unit/core/*.h)
@@ -153,7 +164,7 @@ headers:
 	@echo "headers: each public header compiles alone as C and C++"
 
 bench: deps
-	@$(MAKE) --no-print-directory all $(BENCH)
+	@$(MAKE) --no-print-directory all $(BENCH) $(UPSCALE) $(DAEMON_BENCH)
 	@BUILD=$(BUILD) bench/run.sh
 
 clean:

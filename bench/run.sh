@@ -15,3 +15,6 @@ fi
 echo "## $(date -u +%Y-%m-%d) $(uname -m), $(nproc) cores"
 echo
 "$BUILD/frame_bench" "$@"
+echo
+# the daemon: round trip vs in-process, concurrent clients (1920x1080)
+BUILD="$BUILD" bench/daemon_bench.sh "$1" "$2"
