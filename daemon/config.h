@@ -44,7 +44,9 @@
       "GL backend: auto|egl-device|egl-surfaceless|osmesa (default: "          \
       "OBSCURA_BACKEND, else auto)")                                           \
     X(log_level, ENUM, 0, 0, "info",                                           \
-      "error|warn|info|debug; info logs one line per request")
+      "error|warn|info|debug; info logs one line per request")                \
+    X(fail_gl_after, INT, 0, 1000000000, "0",                                  \
+      "testing: report a GL failure on frame N (0: never)")
 
 typedef enum obsd_opt_type {
     OBSD_OPT_STRING,

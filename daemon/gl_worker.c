@@ -1,8 +1,56 @@
-/* The GL worker thread: creates the context, runs jobs, destroys it. */
+/* The GL worker thread: creates the context, runs jobs, recreates the
+ * context after a GL failure, destroys it. */
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 #include "gl_worker.h"
+#include "config.h"
+#include "log.h"
+
+#define BACKOFF_FIRST_MS 100
+#define BACKOFF_MAX_MS 5000
+
+static void sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+/* Destroys the context and creates a new one with the same options,
+ * retrying with backoff until it exists or the worker is stopped.
+ * Returns the new context, or NULL when stopped before one existed. */
+static obs_ctx *recreate(obsd_gl_worker *w, obs_ctx *ctx, obs_status why, const char *msg)
+{
+    atomic_store(&w->alive, 0);
+    obsd_log(OBSD_LOG_WARN, "GL failure (%s: %s): destroying and recreating the GL context",
+             obs_status_name(why), msg && *msg ? msg : obs_status_message(why));
+    obs_ctx_destroy(ctx);
+    ctx = NULL;
+    int backoff = BACKOFF_FIRST_MS;
+    for (int attempt = 1;; attempt++) {
+        char err[OBS_ERR_LEN] = "";
+        double t0 = obsd_now_ms();
+        obs_status s = obs_ctx_create(&w->desc, &ctx, err);
+        if (s == OBS_OK) {
+            atomic_fetch_add(&w->recreations, 1);
+            atomic_store(&w->alive, 1);
+            obsd_log(OBSD_LOG_WARN, "GL context recreated (attempt %d, %.0f ms)", attempt,
+                     obsd_now_ms() - t0);
+            return ctx;
+        }
+        ctx = NULL;
+        obsd_log(OBSD_LOG_WARN, "GL context recreation failed (attempt %d): %s (%s); retrying in %d ms",
+                 attempt, err, obs_status_name(s), backoff);
+        /* Sleep in slices so that a stop is noticed soon. */
+        for (int slept = 0; slept < backoff; slept += 50) {
+            if (atomic_load(&w->stopping))
+                return NULL;
+            sleep_ms(50);
+        }
+        backoff = backoff * 2 > BACKOFF_MAX_MS ? BACKOFF_MAX_MS : backoff * 2;
+    }
+}
 
 static void *worker_main(void *arg)
 {
@@ -22,7 +70,7 @@ static void *worker_main(void *arg)
         snprintf(w->gl_vendor, sizeof w->gl_vendor, "%s", info.gl_vendor ? info.gl_vendor : "");
         snprintf(w->gl_renderer, sizeof w->gl_renderer, "%s", info.gl_renderer ? info.gl_renderer : "");
         w->create_ms = obsd_now_ms() - t0;
-        w->alive = 1;
+        atomic_store(&w->alive, 1);
     } else {
         snprintf(w->err, sizeof w->err, "%s", err);
     }
@@ -33,24 +81,46 @@ static void *worker_main(void *arg)
         return NULL;
 
     obsd_job *job;
+    long frame = 0;
     while ((job = obsd_queue_pop(w->queue)) != NULL) {
+        frame++;
         job->t_started = obsd_now_ms();
         job->err[0] = '\0';
-        job->status = obs_run(ctx, job->gb, job->params, job->outputs, &job->result, job->err);
+        if (!ctx) {
+            /* Stopped while the context could not be recreated. */
+            job->status = OBS_GL_UNAVAILABLE;
+            snprintf(job->err, OBS_ERR_LEN, "the GL context was lost and could not be recreated");
+        } else if (w->fail_after > 0 && frame == w->fail_after) {
+            job->status = OBS_GL_ERROR;
+            snprintf(job->err, OBS_ERR_LEN, "injected GL failure on frame %ld (--fail-gl-after)", frame);
+        } else {
+            job->status = obs_run(ctx, job->gb, job->params, job->outputs, &job->result, job->err);
+        }
         job->t_finished = obsd_now_ms();
+        obs_status st = job->status;
+        char msg[OBS_ERR_LEN];
+        snprintf(msg, sizeof msg, "%s", job->err);
         obsd_queue_done(w->queue);
         job->done(job, job->user); /* the job is not ours after this */
+        if (ctx && (st == OBS_GL_ERROR || st == OBS_GL_UNAVAILABLE))
+            ctx = recreate(w, ctx, st, msg);
     }
-    obs_ctx_destroy(ctx);
+    atomic_store(&w->alive, 0);
+    if (ctx)
+        obs_ctx_destroy(ctx);
     return NULL;
 }
 
 obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *desc,
-                         char err[OBS_ERR_LEN])
+                         int fail_after, char err[OBS_ERR_LEN])
 {
     memset(w, 0, sizeof *w);
     w->queue = q;
     w->desc = *desc;
+    w->fail_after = fail_after;
+    atomic_init(&w->alive, 0);
+    atomic_init(&w->recreations, 0);
+    atomic_init(&w->stopping, 0);
     pthread_mutex_init(&w->lock, NULL);
     pthread_cond_init(&w->ready, NULL);
     if (pthread_create(&w->thread, NULL, worker_main, w) != 0) {
@@ -65,15 +135,18 @@ obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *d
     if (s != OBS_OK) {
         pthread_join(w->thread, NULL);
         snprintf(err, OBS_ERR_LEN, "%s", w->err);
+    } else {
+        w->running = 1;
     }
     return s;
 }
 
 void obsd_gl_stop(obsd_gl_worker *w)
 {
-    if (!w->alive)
+    if (!w->running)
         return;
+    atomic_store(&w->stopping, 1);
     obsd_queue_close(w->queue);
     pthread_join(w->thread, NULL);
-    w->alive = 0;
+    w->running = 0;
 }

@@ -1,8 +1,14 @@
 /* The GL worker: the one thread that owns the GL context, for the whole
  * life of the process.  It takes jobs from the queue, runs obs_run and
- * hands each back through its `done` callback. */
+ * hands each back through its `done` callback.  When a frame fails with
+ * OBS_GL_ERROR or OBS_GL_UNAVAILABLE (a lost context), that frame is
+ * answered with the failure, then the worker destroys the context and
+ * creates a new one with the same options (retrying with backoff) before
+ * it takes the next frame; `alive` is 0 meanwhile. */
 #ifndef OBSD_GL_WORKER_H
 #define OBSD_GL_WORKER_H
+
+#include <stdatomic.h>
 
 #include "job.h"
 
@@ -10,10 +16,15 @@ typedef struct obsd_gl_worker {
     pthread_t thread;
     obsd_queue *queue;
     obs_ctx_desc desc;
-    /* set once the context exists (read-only afterwards) */
+    int fail_after; /* testing: frame number treated as a GL failure (0: none) */
+    /* set once the first context exists (read-only afterwards; a
+     * recreated context uses the same options) */
     char backend[32], gl_version[128], gl_vendor[128], gl_renderer[256];
     double create_ms;
-    int alive; /* the context exists and the thread runs */
+    atomic_int alive;              /* a context exists */
+    atomic_ullong recreations;     /* contexts recreated after a GL failure */
+    atomic_int stopping;           /* obsd_gl_stop() was called */
+    int running;                   /* the thread runs (main thread only) */
     /* start-up handshake */
     pthread_mutex_t lock;
     pthread_cond_t ready;
@@ -23,9 +34,11 @@ typedef struct obsd_gl_worker {
 } obsd_gl_worker;
 
 /* Starts the thread and waits until it has created the context; on
- * failure the thread has ended and err says why. */
+ * failure the thread has ended and err says why.  fail_after: testing
+ * (--fail-gl-after), frame N is failed with OBS_GL_ERROR without running
+ * it, as if the context were lost; 0: never. */
 obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *desc,
-                         char err[OBS_ERR_LEN]);
+                         int fail_after, char err[OBS_ERR_LEN]);
 
 /* Closes the queue, lets the worker finish every queued job, joins it
  * (the context is destroyed on the worker thread). */

@@ -155,7 +155,8 @@ static void gauges(obsd_http *h, obsd_gauges *g)
     g->queue_capacity = h->cfg->queue;
     g->gl_running = running;
     g->in_flight = atomic_load(&h->in_flight);
-    g->gl_alive = h->gl->alive;
+    g->gl_alive = atomic_load(&h->gl->alive);
+    g->gl_recreations = (unsigned long long)atomic_load(&h->gl->recreations);
 }
 
 static enum MHD_Result get_info(req *r)

@@ -188,8 +188,12 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
             "obscurad_in_flight %d\n"
             "# HELP obscurad_gl_up 1 while the GL context is alive.\n"
             "# TYPE obscurad_gl_up gauge\n"
-            "obscurad_gl_up %d\n",
-        g->queue_depth, g->queue_capacity, g->gl_running, g->in_flight, g->gl_alive);
+            "obscurad_gl_up %d\n"
+            "# HELP obscurad_gl_context_recreations_total GL contexts recreated after a GL failure.\n"
+            "# TYPE obscurad_gl_context_recreations_total counter\n"
+            "obscurad_gl_context_recreations_total %llu\n",
+        g->queue_depth, g->queue_capacity, g->gl_running, g->in_flight, g->gl_alive,
+        g->gl_recreations);
     if (b.failed) {
         free(b.p);
         return NULL;

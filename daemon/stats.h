@@ -43,6 +43,7 @@ void obsd_stats_frame(int64_t width, int64_t height);
 /* Gauges sampled when the text is made. */
 typedef struct obsd_gauges {
     int queue_depth, queue_capacity, gl_running, in_flight, gl_alive;
+    unsigned long long gl_recreations; /* GL contexts recreated after a failure */
 } obsd_gauges;
 
 /* The Prometheus text exposition; caller frees with free(). */

@@ -1,0 +1,103 @@
+#!/bin/sh
+# End-to-end test of obscurad's GL failure recovery: the daemon is started
+# with --fail-gl-after 2, so that frame 2 is treated as a lost GL context.
+# Frame 1 is 200, frame 2 is a 500 JSON error, the context is recreated,
+# frame 3 is 200 with the same AO as frame 1, /metrics counts one
+# recreation, /readyz is 200 again and SIGTERM exits 0.
+#
+#   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/recover.sh
+#
+# Loopback only; the daemon is killed on exit; every wait is bounded.
+set -u
+OBSCURAD=${OBSCURAD:-build/obscurad}
+DATA=tests/data
+R="$DATA/room_small.exr"
+T=$(mktemp -d)
+PIDS=""
+cleanup() {
+    for p in $PIDS; do kill -KILL "$p" 2>/dev/null; done
+    rm -rf "$T"
+}
+trap cleanup EXIT
+trap 'exit 1' INT TERM
+pass=0
+failed=0
+ok() { pass=$((pass + 1)); echo "  ok   $*"; }
+bad() { failed=$((failed + 1)); echo "  FAIL $*"; }
+check() { if eval "$2"; then ok "$1"; else bad "$1"; fi; }
+
+if ! command -v curl >/dev/null 2>&1; then
+    echo "recover e2e: curl not found (make deps)"; exit 1
+fi
+CURL="curl -s --max-time 60"
+
+# start NAME ARGS...: starts obscurad on a free port (port 0; the port is
+# read from its log), sets PID_NAME and PORT_NAME.
+start() {
+    name=$1; shift
+    : > "$T/$name.log"
+    "$OBSCURAD" --http 127.0.0.1:0 "$@" 2>"$T/$name.log" &
+    pid=$!
+    PIDS="$PIDS $pid"
+    port=""
+    i=0
+    while [ $i -lt 300 ] && [ -z "$port" ]; do
+        port=$(sed -n 's/.*listening on http:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$T/$name.log")
+        kill -0 "$pid" 2>/dev/null || break
+        [ -z "$port" ] && sleep 0.1
+        i=$((i + 1))
+    done
+    eval "PID_$name=$pid; PORT_$name=$port"
+    if [ -n "$port" ]; then ok "$name: obscurad started on 127.0.0.1:$port"; else
+        bad "$name: obscurad did not start"; sed 's/^/       /' "$T/$name.log" | tail -5; exit 1; fi
+}
+
+# post PORT QUERY FILE OUT [curl args]: prints the HTTP status
+post() {
+    p=$1 q=$2 f=$3 o=$4; shift 4
+    $CURL -o "$o" -D "$o.h" -w '%{http_code}' -H 'Content-Type: image/x-exr' \
+        --data-binary @"$f" "$@" "http://127.0.0.1:$p/v1/ao?$q"
+}
+# get PORT PATH OUT [curl args]: prints the HTTP status
+get() {
+    p=$1 path=$2 o=$3; shift 3
+    $CURL -o "$o" -D "$o.h" -w '%{http_code}' "$@" "http://127.0.0.1:$p$path"
+}
+# error_is FILE CODE: the body is our JSON error with that code
+error_is() { grep -q "\"code\":\"$2\"" "$1"; }
+
+CAM="fov_y=50&near=0.05&far=100"
+
+echo "e2e recover: $OBSCURAD"
+"$OBSCURAD" --help >"$T/help" 2>&1
+check "--help lists --fail-gl-after" "grep -q -- '--fail-gl-after' '$T/help'"
+
+start A --fail-gl-after 2 --queue 4 --threads 2
+A=$PORT_A
+
+c1=$(post $A "$CAM" "$R" "$T/f1.exr")
+check "frame 1: 200" "[ '$c1' = 200 ]"
+c2=$(post $A "$CAM" "$R" "$T/f2.json")
+check "frame 2: 500 JSON gl_error naming the injected failure" "[ '$c2' = 500 ] && grep -qi 'Content-Type: application/json' $T/f2.json.h && error_is $T/f2.json gl_error && grep -q 'injected' $T/f2.json"
+c3=$(post $A "$CAM" "$R" "$T/f3.exr")
+check "frame 3: 200 after recovery" "[ '$c3' = 200 ]"
+check "frame 3: same AO as frame 1" "cmp -s $T/f1.exr $T/f3.exr"
+
+get $A /metrics "$T/m" >/dev/null
+n=$(sed -n 's/^obscurad_gl_context_recreations_total //p' "$T/m")
+check "metrics: one GL context recreation (${n:-?})" "[ '${n:-}' = 1 ]"
+check "metrics: GL up, one 500 on /v1/ao" "grep -q '^obscurad_gl_up 1' $T/m && grep -q 'route=\"/v1/ao\",code=\"500\"} 1' $T/m"
+check "GET /readyz 200 after recovery" "[ \$(get $A /readyz $T/g) = 200 ]"
+check "GET /healthz 200" "[ \$(get $A /healthz $T/g) = 200 ]"
+check "log: a warning names the recreation" "grep -qi 'recreat' $T/A.log"
+
+kill -TERM "$PID_A"
+k=0
+while [ $k -lt 300 ] && kill -0 "$PID_A" 2>/dev/null; do sleep 0.1; k=$((k + 1)); done
+wait "$PID_A"; rc=$?
+check "SIGTERM: exit $rc (0)" "[ $rc -eq 0 ]"
+if [ $failed -ne 0 ]; then
+    echo "  --- log A (tail)"; tail -8 "$T/A.log" | sed 's/^/       /'
+fi
+echo "e2e recover: $pass passed, $failed failed"
+[ "$failed" -eq 0 ]
