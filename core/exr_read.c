@@ -5,10 +5,13 @@
  * every library failure becomes a status with the library's message. */
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "exr_internal.h"
 #include "internal.h"
@@ -21,6 +24,9 @@
 /* A decoded chunk is held whole by the library; the header decides its
  * size, so a damaged header could ask for gigabytes from a tiny file. */
 #define MAX_CHUNK_BYTES ((uint64_t)1 << 30)
+
+/* Upper bound on obs_limits.threads. */
+#define OBS_MAX_DECODE_THREADS 64
 
 /* ---- OpenEXR messages --------------------------------------------------- */
 
@@ -341,58 +347,136 @@ static obs_status decode_chunk(exr_const_context_t ctx, int part, const part_geo
     return OBS_OK;
 }
 
-/* Decodes level 0 of a part into the targets, chunk by chunk. */
-static obs_status decode_part(exr_const_context_t ctx, int part, const part_geom *g,
-                              const target *t, int nt, char err[OBS_ERR_LEN])
+/* Level 0 of a part, decoded by a few threads at once.  OpenEXR's C API
+ * lets many threads read and decode chunks of one context concurrently
+ * (openexr_context.h, openexr_decode.h), each with its own decode
+ * pipeline; mem_read() reads at explicit offsets, so it is safe too.
+ * Chunks are handed out in file order from a counter, and on failure the
+ * error of the lowest failing chunk is kept: every chunk before it was
+ * handed out before it and is finished, so the result is the one a single
+ * thread gives, whatever the timing. */
+typedef struct part_job {
+    exr_const_context_t ctx;
+    int part;
+    const part_geom *g;
+    const target *t;
+    int nt;
+    int32_t lines;        /* scanlines per chunk (scanline parts) */
+    uint32_t tw, th;      /* tile size (tiled parts) */
+    int64_t ntx, chunks;  /* tiles across; chunks in all */
+    _Atomic int64_t next; /* next chunk to hand out */
+    atomic_int stop;      /* set on the first failure: hand out no more */
+    pthread_mutex_t lock; /* guards the three below */
+    int64_t failed;       /* lowest failing chunk (chunks = none) */
+    obs_status st;
+    char err[OBS_ERR_LEN];
+} part_job;
+
+static obs_status decode_nth(part_job *j, int64_t i, decoder *d, char err[OBS_ERR_LEN])
 {
-    decoder d = {EXR_DECODE_PIPELINE_INITIALIZER};
+    const part_geom *g = j->g;
     exr_chunk_info_t ci;
     exr_result_t rv;
-    obs_status st = OBS_OK;
 
     if (!g->tiled) {
-        int32_t lines = 0;
-        if ((rv = exr_get_scanlines_per_chunk(ctx, part, &lines)) != EXR_ERR_SUCCESS || lines < 1) {
-            st = obs__exr_fail(err, rv ? rv : EXR_ERR_INVALID_ATTR, "scanlines per chunk");
-            goto fail;
-        }
-        for (int64_t y = g->dw.min.y; y <= g->dw.max.y; y += lines) {
-            if ((rv = exr_read_scanline_chunk_info(ctx, part, (int)y, &ci)) != EXR_ERR_SUCCESS) {
-                st = obs__exr_fail(err, rv, "reading a scanline chunk");
-                goto fail;
+        int64_t y = g->dw.min.y + i * j->lines;
+        if ((rv = exr_read_scanline_chunk_info(j->ctx, j->part, (int)y, &ci)) != EXR_ERR_SUCCESS)
+            return obs__exr_fail(err, rv, "reading a scanline chunk");
+        return decode_chunk(j->ctx, j->part, g, &ci, (int64_t)ci.start_x - g->dw.min.x,
+                            (int64_t)ci.start_y - g->dw.min.y, j->t, j->nt, d, err);
+    }
+    int64_t tx = i % j->ntx, ty = i / j->ntx;
+    if ((rv = exr_read_tile_chunk_info(j->ctx, j->part, (int)tx, (int)ty, 0, 0, &ci)) != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, "reading a tile");
+    return decode_chunk(j->ctx, j->part, g, &ci, tx * j->tw, ty * j->th, j->t, j->nt, d, err);
+}
+
+static void *decode_worker(void *arg)
+{
+    part_job *j = arg;
+    decoder d = {EXR_DECODE_PIPELINE_INITIALIZER};
+    char err[OBS_ERR_LEN] = "";
+
+    obs__exr_msg_reset(); /* the library's messages are per thread */
+    while (!atomic_load(&j->stop)) {
+        int64_t i = atomic_fetch_add(&j->next, 1);
+        if (i >= j->chunks)
+            break;
+        obs_status st = decode_nth(j, i, &d, err);
+        if (st != OBS_OK) {
+            pthread_mutex_lock(&j->lock);
+            if (i < j->failed) {
+                j->failed = i;
+                j->st = st;
+                memcpy(j->err, err, sizeof err);
             }
-            st = decode_chunk(ctx, part, g, &ci, (int64_t)ci.start_x - g->dw.min.x,
-                              (int64_t)ci.start_y - g->dw.min.y, t, nt, &d, err);
-            if (st != OBS_OK)
-                goto fail;
+            pthread_mutex_unlock(&j->lock);
+            atomic_store(&j->stop, 1);
+            break;
         }
+    }
+    if (d.started)
+        exr_decoding_destroy(j->ctx, &d.dec);
+    free(d.scratch);
+    return NULL;
+}
+
+/* Decode threads for a part of `chunks` chunks: the configured count
+ * (0 = CPUs online, up to 8), but no more than one for every 4 chunks. */
+static int decode_threads(const obs_limits *lim, int64_t chunks)
+{
+    long n = lim && lim->threads > 0 ? lim->threads : 0;
+    if (n <= 0) {
+        n = sysconf(_SC_NPROCESSORS_ONLN);
+        n = n < 1 ? 1 : n > 8 ? 8 : n;
+    }
+    if (n > OBS_MAX_DECODE_THREADS)
+        n = OBS_MAX_DECODE_THREADS;
+    if (n > chunks / 4)
+        n = (long)(chunks / 4);
+    return n < 1 ? 1 : (int)n;
+}
+
+/* Decodes level 0 of a part into the targets. */
+static obs_status decode_part(exr_const_context_t ctx, int part, const part_geom *g,
+                              const target *t, int nt, const obs_limits *lim,
+                              char err[OBS_ERR_LEN])
+{
+    part_job j = {.ctx = ctx, .part = part, .g = g, .t = t, .nt = nt, .st = OBS_OK};
+    pthread_t tid[OBS_MAX_DECODE_THREADS];
+    int started = 0;
+    exr_result_t rv;
+
+    if (!g->tiled) {
+        if ((rv = exr_get_scanlines_per_chunk(ctx, part, &j.lines)) != EXR_ERR_SUCCESS || j.lines < 1)
+            return obs__exr_fail(err, rv ? rv : EXR_ERR_INVALID_ATTR, "scanlines per chunk");
+        j.chunks = ((int64_t)g->height + j.lines - 1) / j.lines;
     } else {
-        uint32_t tw = 0, th = 0;
         exr_tile_level_mode_t level;
         exr_tile_round_mode_t round;
-        rv = exr_get_tile_descriptor(ctx, part, &tw, &th, &level, &round);
-        if (rv != EXR_ERR_SUCCESS || tw == 0 || th == 0) {
-            st = obs__exr_fail(err, rv ? rv : EXR_ERR_INVALID_ATTR, "tile description");
-            goto fail;
-        }
-        int64_t ntx = ((int64_t)g->width + tw - 1) / tw, nty = ((int64_t)g->height + th - 1) / th;
-        for (int64_t ty = 0; ty < nty; ty++)
-            for (int64_t tx = 0; tx < ntx; tx++) {
-                rv = exr_read_tile_chunk_info(ctx, part, (int)tx, (int)ty, 0, 0, &ci);
-                if (rv != EXR_ERR_SUCCESS) {
-                    st = obs__exr_fail(err, rv, "reading a tile");
-                    goto fail;
-                }
-                st = decode_chunk(ctx, part, g, &ci, tx * tw, ty * th, t, nt, &d, err);
-                if (st != OBS_OK)
-                    goto fail;
-            }
+        rv = exr_get_tile_descriptor(ctx, part, &j.tw, &j.th, &level, &round);
+        if (rv != EXR_ERR_SUCCESS || j.tw == 0 || j.th == 0)
+            return obs__exr_fail(err, rv ? rv : EXR_ERR_INVALID_ATTR, "tile description");
+        j.ntx = ((int64_t)g->width + j.tw - 1) / j.tw;
+        j.chunks = j.ntx * (((int64_t)g->height + j.th - 1) / j.th);
     }
-fail:
-    if (d.started)
-        exr_decoding_destroy(ctx, &d.dec);
-    free(d.scratch);
-    return st;
+    j.failed = j.chunks;
+    atomic_init(&j.next, 0);
+    atomic_init(&j.stop, 0);
+    if (pthread_mutex_init(&j.lock, NULL) != 0)
+        return obs__fail(err, OBS_NO_MEMORY, "decode lock");
+
+    /* This thread decodes too; threads that fail to start are not needed. */
+    int threads = decode_threads(lim, j.chunks);
+    while (started < threads - 1 && pthread_create(&tid[started], NULL, decode_worker, &j) == 0)
+        started++;
+    decode_worker(&j);
+    for (int i = 0; i < started; i++)
+        pthread_join(tid[i], NULL);
+    pthread_mutex_destroy(&j.lock);
+    if (j.st != OBS_OK)
+        memcpy(err, j.err, OBS_ERR_LEN);
+    return j.st;
 }
 
 /* ---- camera ------------------------------------------------------------- */
@@ -579,7 +663,7 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     if (has_c && m.color[3] < 0) /* colour without alpha is opaque */
         for (size_t i = 0; i < px; i++)
             color[i * 4 + 3] = 1.0f;
-    if ((st = decode_part(ctx, part, &g, t, nt, err)) != OBS_OK)
+    if ((st = decode_part(ctx, part, &g, t, nt, lim, err)) != OBS_OK)
         goto fail;
 
     obs_gbuffer *gb = &out->gb;
@@ -716,7 +800,7 @@ obs_status obs_exr_read_channel(const char *path, const char *channel, const obs
         goto fail;
     }
     target t = {channel, out->data, 1};
-    if ((st = decode_part(ctx, found, &g, &t, 1, sub)) != OBS_OK)
+    if ((st = decode_part(ctx, found, &g, &t, 1, lim, sub)) != OBS_OK)
         goto fail;
     out->width = g.width;
     out->height = g.height;

@@ -55,7 +55,9 @@ typedef struct obs_gbuffer_file {
  * compression OpenEXR's C API decodes).  Honours the data window: the
  * G-buffer covers the data window.  The camera comes from the header's
  * worldToCamera/worldToNDC attributes when present.  Every size is checked
- * against `lim` (NULL = defaults) before anything is allocated. */
+ * against `lim` (NULL = defaults) before anything is allocated.  The
+ * chunks of the part are decoded by lim->threads threads (see
+ * obs_limits); the result does not depend on the count. */
 obs_status obs_gbuffer_read_exr(const char *path, const obs_channel_map *map,
                                 const obs_limits *lim, obs_gbuffer_file *out,
                                 char err[OBS_ERR_LEN]);

@@ -95,6 +95,8 @@ typedef struct obs_limits {
     int max_width;      /* 0 -> 16384 */
     int max_height;     /* 0 -> 16384 */
     uint64_t max_pixels; /* 0 -> max_width * max_height */
+    int threads;        /* EXR decode threads; 0 -> CPUs online, up to 8 (at
+                           most 64, and one for every 4 chunks of a part) */
 } obs_limits;
 
 /* Checks width x height against the limits (zeroed limits = defaults). */

@@ -708,6 +708,116 @@ static void test_beachball(void **state)
     obs_gbuffer_free(&f);
 }
 
+/* ---- parallel decoding --------------------------------------------------- */
+
+static size_t storage_bytes(const obs_gbuffer_file *f)
+{
+    size_t per = 1 + (f->gb.normal.data ? 3 : 0) + (f->gb.color.data ? 4 : 0);
+    return (size_t)f->gb.width * (size_t)f->gb.height * per * sizeof(float);
+}
+
+/* The same file read with one decode thread and with `threads`: same
+ * status, message, planes and info. */
+static void same_with_threads(const char *path, const unsigned char *buf, size_t len,
+                              const obs_channel_map *map, int threads)
+{
+    obs_limits one = {.threads = 1}, many = {.threads = threads};
+    obs_gbuffer_file a, b;
+    char ea[OBS_ERR_LEN] = "", eb[OBS_ERR_LEN] = "";
+    obs_status sa = buf ? obs_gbuffer_read_exr_mem(buf, len, map, &one, &a, ea)
+                        : obs_gbuffer_read_exr(path, map, &one, &a, ea);
+    obs_status sb = buf ? obs_gbuffer_read_exr_mem(buf, len, map, &many, &b, eb)
+                        : obs_gbuffer_read_exr(path, map, &many, &b, eb);
+    if (sa != sb || strcmp(ea, eb) != 0)
+        fail_msg("%s (%zu bytes): 1 thread: %s (%s); %d threads: %s (%s)", path, len,
+                 obs_status_name(sa), ea, threads, obs_status_name(sb), eb);
+    if (sa == OBS_OK) {
+        assert_int_equal(a.gb.width, b.gb.width);
+        assert_int_equal(a.gb.height, b.gb.height);
+        assert_int_equal(storage_bytes(&a), storage_bytes(&b));
+        assert_memory_equal(a.storage, b.storage, storage_bytes(&a));
+        assert_memory_equal(&a.info, &b.info, sizeof a.info);
+    }
+    obs_gbuffer_free(&a);
+    obs_gbuffer_free(&b);
+}
+
+static void test_threads_blender(void **state)
+{
+    (void)state;
+    const char *files[] = {TESTDATA "/room_small.exr", TESTDATA "/yard_small.exr"};
+    for (int i = 0; i < 2; i++) {
+        size_t len;
+        unsigned char *buf = slurp(files[i], &len);
+        for (int n = 2; n <= 8; n *= 2) {
+            same_with_threads(files[i], NULL, 0, NULL, n);
+            same_with_threads(files[i], buf, len, NULL, n);
+        }
+        /* damage: cut short, every decoder count reports the same chunk */
+        for (int k = 1; k < 8; k++)
+            same_with_threads(files[i], buf, len * (size_t)k / 8, NULL, 4);
+        /* one compressed chunk overwritten in the middle */
+        memset(buf + len / 2, 0x5a, 64);
+        same_with_threads(files[i], buf, len, NULL, 4);
+        free(buf);
+    }
+}
+
+static void test_threads_synth(void **state)
+{
+    (void)state;
+    const char *tiled = tmp_path("tiled_threads.exr");
+    tpart p = simple_part(50, 37, EXR_COMPRESSION_ZIP);
+    p.tiled = 1;
+    p.tw = 8;
+    p.th = 8; /* 7 x 5 tiles */
+    add_ch(&p, "B", EXR_PIXEL_HALF);
+    add_ch(&p, "G", EXR_PIXEL_FLOAT);
+    add_ch(&p, "R", EXR_PIXEL_FLOAT);
+    add_ch(&p, "Z", EXR_PIXEL_FLOAT);
+    write_synth(tiled, &p, 1, NULL, NULL);
+    same_with_threads(tiled, NULL, 0, NULL, 4);
+    same_with_threads(tiled, NULL, 0, NULL, 64);
+
+    const char *multi = tmp_path("multipart_threads.exr");
+    tpart mp[2] = {simple_part(24, 40, EXR_COMPRESSION_ZIP), simple_part(24, 40, EXR_COMPRESSION_ZIPS)};
+    mp[0].name = "beauty";
+    add_ch(&mp[0], "B", EXR_PIXEL_HALF);
+    add_ch(&mp[0], "G", EXR_PIXEL_HALF);
+    add_ch(&mp[0], "R", EXR_PIXEL_HALF);
+    mp[1].name = "gbuffer"; /* one scanline a chunk: 40 chunks */
+    add_ch(&mp[1], "N.X", EXR_PIXEL_FLOAT);
+    add_ch(&mp[1], "N.Y", EXR_PIXEL_FLOAT);
+    add_ch(&mp[1], "N.Z", EXR_PIXEL_FLOAT);
+    add_ch(&mp[1], "Z", EXR_PIXEL_FLOAT);
+    write_synth(multi, mp, 2, NULL, NULL);
+    same_with_threads(multi, NULL, 0, NULL, 4);
+
+    /* and the values are right with many threads */
+    obs_limits many = {.threads = 8};
+    obs_gbuffer_file f;
+    char err[OBS_ERR_LEN] = "";
+    if (obs_gbuffer_read_exr(tiled, NULL, &many, &f, err) != OBS_OK)
+        fail_msg("%s", err);
+    check_plane(&f.gb, &f.gb.depth, 0, "Z", 0, 0);
+    check_plane(&f.gb, &f.gb.color, 0, "R", 0, 0);
+    check_plane(&f.gb, &f.gb.color, 2, "B", 0, 0);
+    obs_gbuffer_free(&f);
+    if (obs_gbuffer_read_exr(multi, NULL, &many, &f, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_int_equal(f.info.part, 1);
+    check_plane(&f.gb, &f.gb.depth, 0, "Z", 0, 0);
+    check_plane(&f.gb, &f.gb.normal, 1, "N.Y", 0, 0);
+    obs_gbuffer_free(&f);
+    obs_image img;
+    if (obs_exr_read_channel(multi, "N.Z", &many, &img, err) != OBS_OK)
+        fail_msg("%s", err);
+    for (int y = 0; y < 40; y++)
+        for (int x = 0; x < 24; x++)
+            assert_true(img.data[y * 24 + x] == tval("N.Z", x, y));
+    obs_image_free(&img);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -727,6 +837,8 @@ int main(void)
         cmocka_unit_test(test_deep_unsupported),
         cmocka_unit_test(test_camera_from_header),
         cmocka_unit_test(test_beachball),
+        cmocka_unit_test(test_threads_blender),
+        cmocka_unit_test(test_threads_synth),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
