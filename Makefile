@@ -5,7 +5,7 @@
 #   make demo     run the bundled example (no daemon)
 #   make test     unit + end-to-end tests, then the same under ASan/UBSan
 #   make bench    benchmarks (bench/RESULTS.md)
-#   make readme   regenerate README.md's parameter table
+#   make readme   regenerate README.md's parameter and daemon option tables
 #   make samples  regenerate core/sample_tables.c (VAO++ 4.5 sample sets)
 #
 # BUILD selects the output folder, so the sanitizer build lives beside the
@@ -132,16 +132,16 @@ test: deps
 check: all headers unit e2e readme-check
 
 # The README's parameter table is generated from the parameter table.
-readme: $(CLI)
-	tools/readme_params.sh $(CLI) README.md
+readme: $(CLI) $(BUILD)/obscurad
+	tools/readme_params.sh $(CLI) $(BUILD)/obscurad README.md
 
 # The sample sets are the generator's output, checked in as C source
 # (tests/unit/core/test_samples.c fails when they are stale).
 samples: $(CLI)
 	$(CLI) samples --c > core/sample_tables.c.tmp && mv core/sample_tables.c.tmp core/sample_tables.c
 
-readme-check: $(CLI)
-	@tools/readme_params.sh --check $(CLI) README.md && echo "readme: parameter table up to date"
+readme-check: $(CLI) $(BUILD)/obscurad
+	@tools/readme_params.sh --check $(CLI) $(BUILD)/obscurad README.md && echo "readme: generated tables up to date"
 
 unit: $(UNIT_BIN)
 	@tests/run_unit.sh $(UNIT_BIN)

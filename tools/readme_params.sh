@@ -1,23 +1,27 @@
 #!/bin/sh
-# Writes the parameter table (from `obscura params --markdown`) into
-# README.md between the params:begin and params:end markers.
-#   tools/readme_params.sh [OBSCURA] [README]     (make readme)
+# Writes the generated blocks of README.md:
+#   params:begin .. params:end     `obscura params --markdown` (the parameter table)
+#   obscurad:begin .. obscurad:end `obscurad --help` (the daemon's option table)
+#   tools/readme_params.sh [--check] OBSCURA OBSCURAD [README]     (make readme)
 # With --check, exits 1 when README.md is out of date instead.
 set -eu
 check=0
 [ "${1:-}" = "--check" ] && { check=1; shift; }
 OBSCURA=${1:-build/obscura}
-README=${2:-README.md}
+OBSCURAD=${2:-build/obscurad}
+README=${3:-README.md}
 tmp=$(mktemp)
-trap 'rm -f "$tmp" "$tmp.new"' EXIT
+trap 'rm -f "$tmp" "$tmp.d" "$tmp.new"' EXIT
 "$OBSCURA" params --markdown > "$tmp"
-awk -v table="$tmp" '
+{ echo '```'; "$OBSCURAD" --help | sed -n '/^options:/,$p'; echo '```'; } > "$tmp.d"
+awk -v table="$tmp" -v daemon="$tmp.d" '
     /<!-- params:begin -->/ { print; while ((getline l < table) > 0) print l; skip = 1; next }
-    /<!-- params:end -->/ { skip = 0 }
+    /<!-- obscurad:begin -->/ { print; while ((getline l < daemon) > 0) print l; skip = 1; next }
+    /<!-- (params|obscurad):end -->/ { skip = 0 }
     !skip { print }' "$README" > "$tmp.new"
 if [ "$check" -eq 1 ]; then
     if cmp -s "$README" "$tmp.new"; then exit 0; fi
-    echo "README.md's parameter table is out of date: run 'make readme'" >&2
+    echo "README.md's generated tables are out of date: run 'make readme'" >&2
     diff "$README" "$tmp.new" >&2 || true
     exit 1
 fi
