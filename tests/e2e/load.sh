@@ -1,8 +1,8 @@
 #!/bin/sh
 # Concurrency test of obscurad: 16 concurrent `obscura batch --server`
 # clients x 10 frames each (HTTP, Unix socket and TCP mixed), mixed sizes
-# (tests/data/room_small.exr, 320x240, and one frame in 16 a 1920x1080
-# nearest upscale of it made here with exr_upscale), against a daemon with a small --queue.
+# (tests/data/room_small.exr upscaled to 640x480, and one frame in 16 a
+# 1920x1080 upscale, both made here with exr_upscale), against a daemon with a small --queue.
 # Every frame must come back, byte-identical to the in-process output
 # (else `obscura compare --mask none` MAE < 1e-6); the full queue must have
 # been answered 503 and retried by the CLI.
@@ -43,7 +43,7 @@ case "$BUILD" in
     echo "e2e load: ASan build ($BUILD): scaled down to $CLIENTS clients x $FRAMES frames" ;;
 esac
 NBIG=$(( CLIENTS * FRAMES / BIG_EVERY ))
-echo "e2e load: $CLIENTS concurrent clients x $FRAMES frames ($NBIG frames 1920x1080, the rest 320x240), --queue $QUEUE"
+echo "e2e load: $CLIENTS concurrent clients x $FRAMES frames ($NBIG frames 1920x1080, the rest 640x480), --queue $QUEUE"
 
 W2C=$(tr -d ' \n' < "$DATA/room_small.camera.json" |
     sed 's/.*"world_to_camera":\[\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\]\].*/\1,\2,\3,\4/')
@@ -51,10 +51,12 @@ W2C=$(tr -d ' \n' < "$DATA/room_small.camera.json" |
 CAM_CLI="--fov-y 50 --near 0.05 --far 100 --world-to-camera $W2C --samples 4"
 
 # the inputs: frame.0001..N of each size (links), and their in-process AO
-if ! "$UPSCALE" "$R" 1920x1080 "$T/big.exr" 2>"$T/err"; then
-    bad "exr_upscale 1920x1080"; cat "$T/err"; exit 1; fi
+if ! "$UPSCALE" "$R" 1920x1080 "$T/big.exr" 2>"$T/err" ||
+   ! "$UPSCALE" "$R" 640x480 "$T/mid.exr" 2>"$T/err"; then
+    bad "exr_upscale 1920x1080 and 640x480"; cat "$T/err"; exit 1; fi
+R="$T/mid.exr"
 # client c's frame f (links) is 1920x1080 when (c * FRAMES + f) mod BIG_EVERY
-# is 0, else 320x240: every client sees both sizes
+# is 0, else 640x480: every client sees both sizes
 c=0
 while [ $c -lt "$CLIENTS" ]; do
     mkdir -p "$T/in$c"
@@ -73,7 +75,7 @@ done
 # shellcheck disable=SC2086
 "$OBSCURA" ao "$R" $CAM_CLI -o "$T/ref_small.exr" -q 2>/dev/null &&
     "$OBSCURA" ao "$T/big.exr" $CAM_CLI -o "$T/ref_big.exr" -q 2>/dev/null
-check "in-process references (320x240 and 1920x1080)" "[ -s '$T/ref_small.exr' ] && [ -s '$T/ref_big.exr' ]"
+check "in-process references (640x480 and 1920x1080)" "[ -s '$T/ref_small.exr' ] && [ -s '$T/ref_big.exr' ]"
 
 SOCK="$T/obscurad.sock"
 "$OBSCURAD" --http 127.0.0.1:0 --socket "$SOCK" --tcp 127.0.0.1:0 --queue $QUEUE 2>"$T/d.log" &
