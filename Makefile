@@ -5,6 +5,7 @@
 #   make demo     run the bundled example (no daemon)
 #   make test     unit + end-to-end tests, then the same under ASan/UBSan
 #   make bench    benchmarks (bench/RESULTS.md)
+#   make fuzz     libFuzzer target of the binary protocol (clang; tests/fuzz/fuzz.mk)
 #   make readme   regenerate README.md's parameter and daemon option tables
 #   make samples  regenerate core/sample_tables.c (VAO++ 4.5 sample sets)
 #
@@ -56,7 +57,7 @@ DAEMON_BENCH := $(BUILD)/daemon_bench
 
 # The daemon and the wire protocol bring their own rules; they add their
 # binaries to `all` and their e2e prerequisites to E2E_DEPS.
--include protocol/protocol.mk daemon/daemon.mk clients/clients.mk
+-include protocol/protocol.mk daemon/daemon.mk clients/clients.mk tests/fuzz/fuzz.mk
 E2E_DEPS += $(UPSCALE)
 
 .PHONY: all deps demo demo-run test check unit e2e headers readme readme-check samples bench clean

@@ -335,9 +335,50 @@ static const float *take_plane(reader *r, uint64_t bytes, float *dst)
     return dst;
 }
 
+/* IEEE-754 binary16 -> binary32, exactly: every half is a float.
+ * Subnormal halves become normal floats; inf stays inf; a NaN keeps its
+ * sign and payload (shifted into the float's top mantissa bits). */
+float obs_bin_half_to_float(uint16_t h)
+{
+    uint32_t sign = (uint32_t)(h & 0x8000u) << 16, exp = (h >> 10) & 0x1fu, man = h & 0x3ffu, bits;
+    if (exp == 0x1f)
+        bits = sign | 0x7f800000u | man << 13;
+    else if (exp)
+        bits = sign | (exp + 112) << 23 | man << 13;
+    else if (!man)
+        bits = sign;
+    else {
+        /* man * 2^-24: normalise so the leading 1 lands on bit 10. */
+        exp = 113;
+        while (!(man & 0x400u)) {
+            man <<= 1;
+            exp--;
+        }
+        bits = sign | exp << 23 | (man & 0x3ffu) << 13;
+    }
+    float f;
+    memcpy(&f, &bits, sizeof f);
+    return f;
+}
+
+/* Float16 planes: converted into q->gf.storage, depth then normal then
+ * colour, `channels` floats per pixel in all. */
+static obs_status take_half_planes(reader *r, uint64_t px, uint64_t channels, obs_bin_request *q,
+                                   char err[OBS_ERR_LEN])
+{
+    size_t n = (size_t)(px * channels);
+    if (!(q->gf.storage = malloc(n * sizeof(float))))
+        return fail(err, OBS_NO_MEMORY, "no memory for %zu float16 values", n);
+    const unsigned char *src = r->p + r->off;
+    for (size_t i = 0; i < n; i++)
+        q->gf.storage[i] = obs_bin_half_to_float((uint16_t)(src[2 * i] | src[2 * i + 1] << 8));
+    r->off += n * 2;
+    return OBS_OK;
+}
+
 static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *q, char err[OBS_ERR_LEN])
 {
-    uint32_t width, height, dx, dy, dw, dh, flags, reserved;
+    uint32_t width, height, dx, dy, dw, dh, flags, type;
     if (!have(r, RAW_HEADER_LEN))
         return truncated(r, "raw G-buffer header", err);
     get_u32(r, &width);
@@ -347,9 +388,12 @@ static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *
     get_u32(r, &dw);
     get_u32(r, &dh);
     get_u32(r, &flags);
-    get_u32(r, &reserved);
-    if (flags & ~0xfu || reserved)
-        return fail(err, OBS_BAD_FILE, "raw G-buffer: unknown flags 0x%x or reserved field set", flags);
+    get_u32(r, &type);
+    if (flags & ~0xfu)
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: unknown flags 0x%x", flags);
+    if (type != OBS_BIN_F32 && type != OBS_BIN_F16)
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: plane type %u is neither float32 (0) nor "
+                    "float16 (1)", type);
     obs_status s = obs_check_size(lim, width, height, err);
     if (s != OBS_OK)
         return s;
@@ -365,21 +409,35 @@ static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *
 
     /* Exactly the planes the flags announce, and nothing after them. */
     uint64_t px = (uint64_t)width * height, channels = 1, bytes = 0;
+    uint64_t value_size = type == OBS_BIN_F16 ? 2 : sizeof(float);
     channels += (flags & OBS_BIN_HAS_NORMAL) ? 3 : 0;
     channels += (flags & OBS_BIN_HAS_COLOR) ? 4 : 0;
-    if (!mul3(px, channels, sizeof(float), &bytes) || bytes != r->n - r->off)
-        return fail(err, OBS_BAD_FILE, "raw G-buffer: %u x %u with %llu channels needs %llu bytes of "
-                    "planes, the frame holds %zu", width, height, (unsigned long long)channels,
-                    (unsigned long long)bytes, r->n - r->off);
-    if (((uintptr_t)(r->p + r->off) & 3u) != 0 && !(q->gf.storage = malloc((size_t)bytes)))
-        return fail(err, OBS_NO_MEMORY, "no memory for %llu bytes of planes", (unsigned long long)bytes);
-    float *copy = q->gf.storage;
+    if (!mul3(px, channels, value_size, &bytes) || bytes != r->n - r->off)
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: %u x %u with %llu %s channels needs %llu bytes "
+                    "of planes, the frame holds %zu", width, height, (unsigned long long)channels,
+                    type == OBS_BIN_F16 ? "float16" : "float32", (unsigned long long)bytes,
+                    r->n - r->off);
     gb->width = (int)width;
     gb->height = (int)height;
     gb->display_x = (int32_t)dx;
     gb->display_y = (int32_t)dy;
     gb->display_width = (int)dw;
     gb->display_height = (int)dh;
+    if (type == OBS_BIN_F16) {
+        obs_status hs = take_half_planes(r, px, channels, q, err);
+        if (hs != OBS_OK)
+            return hs;
+        float *f = q->gf.storage;
+        gb->depth = (obs_plane){f, 1, 0};
+        if (flags & OBS_BIN_HAS_NORMAL)
+            gb->normal = (obs_plane){f + px, 3, 0};
+        if (flags & OBS_BIN_HAS_COLOR)
+            gb->color = (obs_plane){f + px * (channels - 4), 4, 0};
+        return OBS_OK;
+    }
+    if (((uintptr_t)(r->p + r->off) & 3u) != 0 && !(q->gf.storage = malloc((size_t)bytes)))
+        return fail(err, OBS_NO_MEMORY, "no memory for %llu bytes of planes", (unsigned long long)bytes);
+    float *copy = q->gf.storage;
     gb->depth = (obs_plane){take_plane(r, px * 4, copy), 1, 0};
     if (flags & OBS_BIN_HAS_NORMAL)
         gb->normal = (obs_plane){take_plane(r, px * 12, copy ? copy + px : NULL), 3, 0};

@@ -4,7 +4,7 @@
  *
  *   frame    = header (OBS_BIN_HEADER_LEN bytes) + payload (header.length)
  *   request  = parameters (name=value strings) + outputs + a G-buffer,
- *              either an EXR file or raw float32 planes and a camera
+ *              either an EXR file or raw float32/float16 planes and a camera
  *   response = status + code + message, then nothing, an EXR/PNG file or
  *              raw float32 planes
  *
@@ -40,7 +40,7 @@ typedef enum obs_bin_kind {
 typedef enum obs_bin_body {
     OBS_BIN_NONE = 0, /* responses only: an error */
     OBS_BIN_EXR = 1,  /* an OpenEXR file */
-    OBS_BIN_RAW = 2,  /* float32 planes */
+    OBS_BIN_RAW = 2,  /* float32 planes (requests: or float16) */
     OBS_BIN_PNG = 3   /* responses only: a PNG file */
 } obs_bin_body;
 
@@ -51,6 +51,17 @@ enum {
     OBS_BIN_HAS_WORLD_TO_CAMERA = 4,
     OBS_BIN_HAS_PROJECTION = 8
 };
+
+/* Raw G-buffer plane types (the field after the flags).  Requests only:
+ * float16 planes are converted to float32 by the decoder; responses and
+ * the encoder use float32. */
+enum {
+    OBS_BIN_F32 = 0,
+    OBS_BIN_F16 = 1
+};
+
+/* IEEE-754 half -> float, exact (subnormals, inf, NaN included). */
+float obs_bin_half_to_float(uint16_t h);
 
 typedef struct obs_bin_header {
     obs_bin_kind kind;
@@ -93,8 +104,9 @@ typedef struct obs_bin_request_desc {
 obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out,
                                   char err[OBS_ERR_LEN]);
 
-/* A decoded request.  With body RAW, gf.gb's planes point into the
- * payload when it is 4-byte aligned (else into gf.storage, a copy); with
+/* A decoded request.  With body RAW, gf.gb's float32 planes point into
+ * the payload when it is 4-byte aligned (else into gf.storage, a copy);
+ * float16 planes are converted into gf.storage; with
  * EXR, exr/exr_len point into the payload.  Either way the payload must
  * outlive the request.  Free with obs_bin_request_free(). */
 typedef struct obs_bin_request {

@@ -3,6 +3,8 @@
  * allocation, garbage. */
 #include "testutil.h"
 
+#include <math.h>
+
 #include "../../../protocol/binary.h"
 
 #define W 7
@@ -341,12 +343,139 @@ static void test_garbage(void **state)
     obs_bytes_free(&g);
 }
 
+static uint32_t float_bits(float f)
+{
+    uint32_t b;
+    memcpy(&b, &f, sizeof b);
+    return b;
+}
+
+/* half -> float against known bit patterns */
+static void test_half_to_float(void **state)
+{
+    (void)state;
+    static const struct {
+        uint16_t h;
+        uint32_t f;
+    } cases[] = {
+        {0x0000, 0x00000000}, /* +0 */
+        {0x8000, 0x80000000}, /* -0 */
+        {0x3c00, 0x3f800000}, /* 1 */
+        {0xbc00, 0xbf800000}, /* -1 */
+        {0x4000, 0x40000000}, /* 2 */
+        {0x3555, 0x3eaaa000}, /* 0.333251953125 */
+        {0x7bff, 0x477fe000}, /* 65504, largest finite */
+        {0x0400, 0x38800000}, /* 2^-14, smallest normal */
+        {0x0001, 0x33800000}, /* 2^-24, smallest subnormal */
+        {0x8001, 0xb3800000}, /* -2^-24 */
+        {0x0002, 0x34000000}, /* 2^-23 */
+        {0x0003, 0x34400000}, /* 3 * 2^-24 */
+        {0x0200, 0x38000000}, /* 2^-15 */
+        {0x03ff, 0x387fc000}, /* largest subnormal, 1023 * 2^-24 */
+        {0x7c00, 0x7f800000}, /* +inf */
+        {0xfc00, 0xff800000}, /* -inf */
+        {0x7e00, 0x7fc00000}, /* quiet NaN */
+        {0x7c01, 0x7f802000}, /* signalling NaN, payload kept */
+        {0xfe00, 0xffc00000}, /* negative NaN */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        float f = obs_bin_half_to_float(cases[i].h);
+        if (float_bits(f) != cases[i].f)
+            fail_msg("half 0x%04x: float bits 0x%08x, expected 0x%08x", cases[i].h, float_bits(f),
+                     cases[i].f);
+    }
+    assert_true(obs_bin_half_to_float(0x0001) == 5.9604644775390625e-8f);
+    assert_true(isnan(obs_bin_half_to_float(0x7fff)) && isinf(obs_bin_half_to_float(0x7c00)));
+    /* every half: finite ones scale back to their integer mantissa exactly */
+    for (uint32_t h = 0; h < 0x10000; h++) {
+        float f = obs_bin_half_to_float((uint16_t)h);
+        unsigned e = (h >> 10) & 0x1f, m = h & 0x3ff;
+        if (e == 0x1f) {
+            assert_true(m ? isnan(f) : isinf(f));
+            continue;
+        }
+        double v = e ? ldexp(1024 + m, (int)e - 25) : ldexp(m, -24);
+        if (h & 0x8000)
+            v = -v;
+        if ((double)f != v || !!signbit(f) != !!(h & 0x8000))
+            fail_msg("half 0x%04x: %a, expected %a", h, (double)f, v);
+    }
+}
+
+/* The raw request of encode_raw_request() with float16 planes: value k
+ * (depth, then normal, then colour) is the half 0x3c00 + k = 1 + k/1024. */
+static obs_bytes encode_f16_request(void)
+{
+    obs_bytes f32 = encode_raw_request();
+    size_t values = (size_t)W * H * 8, raw = f32.size - values * 4 - 160;
+    obs_bytes f = {malloc(raw + 160 + values * 2), raw + 160 + values * 2};
+    memcpy(f.data, f32.data, raw + 160);
+    le32(f.data + raw + 28, 1); /* plane type float16 */
+    for (size_t k = 0; k < values; k++) {
+        f.data[raw + 160 + 2 * k] = (unsigned char)(0x3c00 + k);
+        f.data[raw + 160 + 2 * k + 1] = (unsigned char)((0x3c00 + k) >> 8);
+    }
+    obs_bin_header_write(f.data, OBS_BIN_REQUEST, 42, f.size - OBS_BIN_HEADER_LEN);
+    obs_bytes_free(&f32);
+    return f;
+}
+
+static void test_f16_planes(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+    obs_bytes f = encode_f16_request();
+    obs_bin_request q;
+    size_t n = f.size - OBS_BIN_HEADER_LEN, px = (size_t)W * H;
+    for (int shift = 0; shift < 2; shift++) { /* aligned and not */
+        unsigned char *copy = malloc(n + 1);
+        memcpy(copy + shift, f.data + OBS_BIN_HEADER_LEN, n);
+        assert_int_equal(obs_bin_request_decode(copy + shift, n, NULL, &q, err), OBS_OK);
+        const obs_gbuffer *gb = &q.gf.gb;
+        assert_int_equal(gb->width, W);
+        assert_int_equal(gb->height, H);
+        assert_int_equal(gb->display_width, 10);
+        assert_non_null(q.gf.storage);
+        assert_true(gb->camera.world_to_camera[15] == 15.0f);
+        for (size_t k = 0; k < px * 8; k++) {
+            float v = k < px ? gb->depth.data[k]
+                    : k < px * 4 ? gb->normal.data[k - px] : gb->color.data[k - px * 4];
+            if (v != 1.0f + (float)k / 1024.0f)
+                fail_msg("value %zu: %g", k, (double)v);
+        }
+        assert_int_equal(gb->normal.channels, 3);
+        assert_int_equal(gb->color.channels, 4);
+        obs_bin_request_free(&q);
+        free(copy);
+    }
+    /* every truncation: refused, never read past */
+    for (size_t len = OBS_BIN_HEADER_LEN; len < f.size; len++) {
+        unsigned char *cut = malloc(len);
+        memcpy(cut, f.data, len);
+        obs_bin_header_write(cut, OBS_BIN_REQUEST, 42, len - OBS_BIN_HEADER_LEN);
+        assert_int_not_equal(decode_frame(cut, len, &q, err), OBS_OK);
+        free(cut);
+    }
+    /* float32-sized planes with type float16, and an unknown type */
+    obs_bytes g = encode_raw_request();
+    size_t raw = g.size - px * 8 * 4 - 160;
+    le32(g.data + raw + 28, 1);
+    assert_int_equal(decode_frame(g.data, g.size, &q, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "float16"));
+    le32(g.data + raw + 28, 2);
+    assert_int_equal(decode_frame(g.data, g.size, &q, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "plane type 2"));
+    obs_bytes_free(&g);
+    obs_bytes_free(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_raw_round_trip),      cmocka_unit_test(test_exr_round_trip),
         cmocka_unit_test(test_response_round_trip), cmocka_unit_test(test_every_truncation),
         cmocka_unit_test(test_oversized),           cmocka_unit_test(test_garbage),
+        cmocka_unit_test(test_half_to_float),       cmocka_unit_test(test_f16_planes),
     };
     return cmocka_run_group_tests_name("protocol_binary", tests, NULL, NULL);
 }

@@ -1,0 +1,39 @@
+# tests/fuzz/: libFuzzer targets, built with clang (-fsanitize=fuzzer,
+# address,undefined).  Included by the top Makefile; not part of `all`.
+#
+#   make fuzz        build $(BUILD)/fuzz/fuzz_binary and refresh the seed
+#                    corpus tests/fuzz/corpus/binary
+#   $(BUILD)/fuzz/fuzz_binary -max_total_time=60 NEW_DIR tests/fuzz/corpus/binary
+#
+# The protocol sources and the few core files they need are compiled here,
+# with clang and the fuzzer's sanitizers, not taken from $(BUILD)/obj.
+FUZZ_CC ?= clang
+FUZZ_DIR := $(BUILD)/fuzz
+FUZZ_CFLAGS := -O1 -g -std=c11 -D_DEFAULT_SOURCE -Wall -Wextra -fno-omit-frame-pointer \
+               -fsanitize=address,undefined -fno-sanitize-recover=undefined
+FUZZ_CPPFLAGS := -Icore -Iprotocol $(shell pkg-config --cflags libcjson OpenEXR 2>/dev/null)
+FUZZ_LIBS := $(shell pkg-config --libs libcjson 2>/dev/null) -lm
+FUZZ_SRC := protocol/binary.c protocol/http.c core/status.c core/util.c core/params.c \
+            core/bytes.c core/channel_map.c
+FUZZ_HDR := $(wildcard protocol/*.h core/*.h)
+
+.PHONY: fuzz fuzz-check
+fuzz: fuzz-check $(FUZZ_DIR)/fuzz_binary $(FUZZ_DIR)/corpus.stamp
+
+fuzz-check:
+	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { \
+	  echo "make fuzz: '$(FUZZ_CC)' not found; the fuzz targets need clang with libFuzzer" \
+	       "(apt-get install clang, or make fuzz FUZZ_CC=/path/to/clang)" >&2; exit 1; }
+
+$(FUZZ_DIR)/fuzz_binary: tests/fuzz/fuzz_binary.c $(FUZZ_SRC) $(FUZZ_HDR) | fuzz-check
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SRC) -o $@ $(FUZZ_LIBS)
+
+$(FUZZ_DIR)/gen_corpus: tests/fuzz/gen_corpus.c $(FUZZ_SRC) $(FUZZ_HDR) | fuzz-check
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CPPFLAGS) $(FUZZ_CFLAGS) $< $(FUZZ_SRC) -o $@ $(FUZZ_LIBS)
+
+$(FUZZ_DIR)/corpus.stamp: $(FUZZ_DIR)/gen_corpus
+	@mkdir -p tests/fuzz/corpus/binary
+	$(FUZZ_DIR)/gen_corpus tests/fuzz/corpus/binary
+	@touch $@
