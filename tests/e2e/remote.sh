@@ -132,6 +132,31 @@ if command -v python3 >/dev/null 2>&1; then
     st=$(python3 -c 'import struct,sys; p=struct.pack("<I",1)+struct.pack("<H",7)+b"samples"+struct.pack("<I",2)+b"64"+b"\x01"+b"\0"*3+struct.pack("<Q",1)+b"x"; sys.stdout.buffer.write(b"OBSP"+struct.pack("<HHQQ",1,1,8,len(p))+p)' |
         python3 "$T/frame.py" "unix:$SOCK")
     check "a bad parameter: 400 ($st)" "[ '$st' = 400 ]"
+    # pipelining: three requests sent before any answer is read come back
+    # in order (ids 11, 12, 13), each answered 200
+    cat > "$T/pipe.py" <<'EOF2'
+import socket, struct, sys
+req = open(sys.argv[2], "rb").read()
+s = socket.socket(socket.AF_UNIX); s.connect(sys.argv[1]); s.settimeout(20)
+s.sendall(b"".join(req[:8] + struct.pack("<Q", i) + req[16:] for i in (11, 12, 13)))
+buf, out = b"", []
+try:
+    while len(out) < 3:
+        b = s.recv(65536)
+        if not b: break
+        buf += b
+        while len(buf) >= 24:
+            n, = struct.unpack_from("<Q", buf, 16)
+            if len(buf) < 24 + n: break
+            fid, = struct.unpack_from("<Q", buf, 8)
+            st, = struct.unpack_from("<H", buf, 24)
+            out.append("%d:%d" % (fid, st)); buf = buf[24 + n:]
+except socket.timeout:
+    out.append("timeout")
+print(",".join(out))
+EOF2
+    st=$(python3 "$T/pipe.py" "$SOCK" tests/fuzz/corpus/binary/request_raw_depth)
+    check "three pipelined requests answered in order: $st" "[ '$st' = '11:200,12:200,13:200' ]"
 else
     echo "  skip bad-frame checks: no python3"
 fi
