@@ -14,19 +14,8 @@ OBSCURAD=${OBSCURAD:-build/obscurad}
 DATA=tests/data
 R="$(pwd)/$DATA/room_small.exr"
 CAMF="$DATA/room_small.camera.json"
-T=$(mktemp -d)
+. tests/e2e/lib/common.sh
 PID=""
-cleanup() {
-    [ -n "$PID" ] && kill -KILL "$PID" 2>/dev/null
-    rm -rf "$T"
-}
-trap cleanup EXIT
-trap 'exit 1' INT TERM
-pass=0
-failed=0
-ok() { pass=$((pass + 1)); echo "  ok   $*"; }
-bad() { failed=$((failed + 1)); echo "  FAIL $*"; }
-check() { if eval "$2"; then ok "$1"; else bad "$1"; fi; }
 
 echo "e2e batch: $OBSCURA"
 mkdir -p "$T/shot"

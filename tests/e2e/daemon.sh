@@ -12,59 +12,11 @@ OBSCURA=${OBSCURA:-build/obscura}
 OBSCURAD=${OBSCURAD:-build/obscurad}
 DATA=tests/data
 R="$DATA/room_small.exr"
-T=$(mktemp -d)
-PIDS=""
-cleanup() {
-    for p in $PIDS; do kill -KILL "$p" 2>/dev/null; done
-    rm -rf "$T"
-}
-trap cleanup EXIT
-trap 'exit 1' INT TERM
-pass=0
-failed=0
-ok() { pass=$((pass + 1)); echo "  ok   $*"; }
-bad() { failed=$((failed + 1)); echo "  FAIL $*"; }
-check() { if eval "$2"; then ok "$1"; else bad "$1"; fi; }
+. tests/e2e/lib/common.sh
 
 if ! command -v curl >/dev/null 2>&1; then
     echo "daemon e2e: curl not found (make deps)"; exit 1
 fi
-CURL="curl -s --max-time 60"
-
-# start NAME ARGS...: starts obscurad on a free port (port 0; the port is
-# read from its log), sets PID_NAME and PORT_NAME.
-start() {
-    name=$1; shift
-    : > "$T/$name.log"
-    "$OBSCURAD" --http 127.0.0.1:0 "$@" 2>"$T/$name.log" &
-    pid=$!
-    PIDS="$PIDS $pid"
-    port=""
-    i=0
-    while [ $i -lt 300 ] && [ -z "$port" ]; do
-        port=$(sed -n 's/.*listening on http:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$T/$name.log")
-        kill -0 "$pid" 2>/dev/null || break
-        [ -z "$port" ] && sleep 0.1
-        i=$((i + 1))
-    done
-    eval "PID_$name=$pid; PORT_$name=$port"
-    if [ -n "$port" ]; then ok "$name: obscurad started on 127.0.0.1:$port"; else
-        bad "$name: obscurad did not start"; sed 's/^/       /' "$T/$name.log" | tail -5; exit 1; fi
-}
-
-# post PORT QUERY FILE OUT [curl args]: prints the HTTP status
-post() {
-    p=$1 q=$2 f=$3 o=$4; shift 4
-    $CURL -o "$o" -D "$o.h" -w '%{http_code}' -H 'Content-Type: image/x-exr' \
-        --data-binary @"$f" "$@" "http://127.0.0.1:$p/v1/ao?$q"
-}
-# get PORT PATH OUT [curl args]: prints the HTTP status
-get() {
-    p=$1 path=$2 o=$3; shift 3
-    $CURL -o "$o" -D "$o.h" -w '%{http_code}' "$@" "http://127.0.0.1:$p$path"
-}
-# error_is FILE CODE: the body is our JSON error with that code
-error_is() { grep -q "\"code\":\"$2\"" "$1"; }
 
 # The camera as query parameters: fov_y 50 and the JSON's world_to_camera.
 W2C=$(tr -d ' \n' < "$DATA/room_small.camera.json" |

@@ -19,21 +19,9 @@ BUILD=${BUILD:-build}
 UPSCALE="$BUILD/exr_upscale"
 DATA=tests/data
 R="$(pwd)/$DATA/room_small.exr"
-T=$(mktemp -d)
-PID=""
+. tests/e2e/lib/common.sh
 CPIDS=""
-cleanup() {
-    for p in $CPIDS; do kill -KILL "$p" 2>/dev/null; done
-    [ -n "$PID" ] && kill -KILL "$PID" 2>/dev/null
-    rm -rf "$T"
-}
-trap cleanup EXIT
-trap 'exit 1' INT TERM
-pass=0
-failed=0
-ok() { pass=$((pass + 1)); echo "  ok   $*"; }
-bad() { failed=$((failed + 1)); echo "  FAIL $*"; }
-check() { if eval "$2"; then ok "$1"; else bad "$1"; fi; }
+PID=""
 CURL="curl -s --max-time 30"
 
 CLIENTS=16 FRAMES=10 BIG_EVERY=16 QUEUE=3 DEADLINE=50
