@@ -98,11 +98,13 @@ typedef struct cli_opt {
 
 static const cli_opt ao_opts[] = {
     {"o", "FILE", "output file; .exr or .png (also --output-file)"},
-    {"output", "ao|composite|both|samples|cull|bleed",
+    {"output", "ao|composite|both|samples|cull|bleed|luminance",
      "what to write (default ao); a comma list combines them; samples: the sample count "
      "of each pixel (adaptive sampling, VAO++ 4.1; EXR channel Samples.Y, PNG count/32); "
      "cull: 1 where the culling pre-pass culled the pixel (VAO++ 4.2; EXR channel Cull.Y); "
-     "bleed: the colour-bleed term (VAO++ 4.7, --bleeding; EXR channels Bleed.R/G/B)"},
+     "bleed: the colour-bleed term (VAO++ 4.7, --bleeding; EXR channels Bleed.R/G/B); "
+     "luminance: the factor of VAO++ eq 3 (4.3, --luminance), 1 keeps the occlusion, 0 "
+     "removes it (EXR channel Luminance.Y)"},
     {"format", "exr|png", "output format (default: from the file name)"},
     {"float", NULL, "EXR: 32-bit float channels (default half)"},
     {"png-bits", "8|16", "PNG bit depth (default 8)"},
@@ -221,8 +223,8 @@ static void parse_ao(int argc, char **argv, ao_args *a)
             a->out = v;
         } else if ((v = opt_value(argc, argv, &i, "output"))) {
             char buf[256];
-            const char *names[6];
-            int k = split_names(v, buf, sizeof buf, names, 6);
+            const char *names[8];
+            int k = split_names(v, buf, sizeof buf, names, 8);
             a->outputs = 0;
             for (int j = 0; j < k; j++) {
                 if (!strcmp(names[j], "ao"))
@@ -237,8 +239,11 @@ static void parse_ao(int argc, char **argv, ao_args *a)
                     a->outputs |= OBS_OUTPUT_CULL_MASK;
                 else if (!strcmp(names[j], "bleed"))
                     a->outputs |= OBS_OUTPUT_BLEED;
+                else if (!strcmp(names[j], "luminance"))
+                    a->outputs |= OBS_OUTPUT_LUMINANCE;
                 else
-                    die_usage("--output: '%s' is not one of ao|composite|both|samples|cull|bleed",
+                    die_usage("--output: '%s' is not one of "
+                              "ao|composite|both|samples|cull|bleed|luminance",
                               names[j]);
             }
             if (!a->outputs)
@@ -350,7 +355,8 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
         return s;
     }
     /* PNG: one file per output; NAME.ao.png, NAME.composite.png,
-     * NAME.samples.png, NAME.cull.png, NAME.bleed.png when there are several */
+     * NAME.samples.png, NAME.cull.png, NAME.bleed.png, NAME.luminance.png
+     * when there are several */
     const struct {
         const obs_image *img;
         const char *suffix;
@@ -359,9 +365,10 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
                  {&r->composite, "composite", 1},
                  {&r->sample_count, "samples", 0},
                  {&r->cull_mask, "cull", 0},
-                 {&r->bleed, "bleed", 1}};
+                 {&r->bleed, "bleed", 1},
+                 {&r->luminance, "luminance", 0}};
     int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data + !!r->cull_mask.data +
-                !!r->bleed.data;
+                !!r->bleed.data + !!r->luminance.data;
     for (size_t k = 0; k < sizeof files / sizeof files[0] && s == OBS_OK; k++) {
         char path[4096];
         obs_image scaled = {0};

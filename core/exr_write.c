@@ -226,6 +226,7 @@ int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_L
     static const char *const count[] = {"Samples.Y"};
     static const char *const cull[] = {"Cull.Y"};
     static const char *const bleed[] = {"Bleed.R", "Bleed.G", "Bleed.B"};
+    static const char *const lum[] = {"Luminance.Y"};
     int n = 0;
     if (r->ao.data)
         layers[n++] = (obs_exr_layer){&r->ao, ao};
@@ -237,5 +238,7 @@ int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_L
         layers[n++] = (obs_exr_layer){&r->cull_mask, cull};
     if (r->bleed.data)
         layers[n++] = (obs_exr_layer){&r->bleed, bleed};
+    if (r->luminance.data)
+        layers[n++] = (obs_exr_layer){&r->luminance, lum};
     return n;
 }

@@ -14,7 +14,7 @@
 /* Every OBS_OUTPUT_* bit. */
 #define OBS__OUTPUTS_ALL                                                                           \
     (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |        \
-     OBS_OUTPUT_BLEED)
+     OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE)
 
 /* Culling pre-pass (VAO++ section 4.2): one low-resolution texel per
  * OBS__CULL_BLOCK x OBS__CULL_BLOCK pixels ("1/8 resolution"), always
@@ -135,8 +135,11 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
 float obs__bleed_weight(const float x[3], const float p[3], const float n[3], float R);
 
 /* Luminance sensitivity, VAO++ section 4.3, eq 3 (GLSL:
- * luminance_ao() in luminance.frag.glsl): the AO of a pixel of colour
- * rgb after the correction; f->luminance must be non-zero. */
+ * luminance_factor() in luminance.frag.glsl): the factor of eq 3 for a
+ * pixel of colour rgb, 1 keeps its occlusion, 0 removes it; and the AO
+ * after the correction, 1 - (1 - ao) * factor.  f->luminance must be
+ * non-zero. */
+float obs__luminance_factor(const obs__frame *f, const float rgb[3]);
 float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3]);
 
 /* Low-pass filter, VAO++ section 4.6 (GLSL: blur.frag.glsl): one pass of

@@ -102,7 +102,7 @@ typedef struct obs_exr_layer {
  * AO.Y; R,G,B,A (composite); Samples.Y (sample count); Cull.Y (culling
  * mask); Bleed.R,G,B.  Fills `layers` with the images the result holds;
  * returns how many. */
-#define OBS_RESULT_LAYERS 5
+#define OBS_RESULT_LAYERS 6
 int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_LAYERS]);
 
 /* Writes a scanline EXR (ZIP compression) holding every layer's channels;

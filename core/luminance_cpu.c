@@ -6,7 +6,7 @@
 
 #include "frame.h"
 
-float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3])
+float obs__luminance_factor(const obs__frame *f, const float rgb[3])
 {
     /* lum(x): Rec. 709 luminance, or "the V component of the HSV color
      * model" (max of r, g, b), "less dependent on the hue". */
@@ -21,6 +21,10 @@ float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3])
      * our AO, 1 = unoccluded, is corrected as 1 - (1 - AO) * factor. */
     float t = fminf(1.0f, fmaxf(0.0f, lum - f->lum_threshold + f->lum_width));
     float base = 1.0f - t / (2.0f * f->lum_width);
-    float k = base > 0.0f ? powf(base, f->lum_sigma) : 0.0f;
-    return 1.0f - (1.0f - ao) * k;
+    return base > 0.0f ? powf(base, f->lum_sigma) : 0.0f;
+}
+
+float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3])
+{
+    return 1.0f - (1.0f - ao) * obs__luminance_factor(f, rgb);
 }

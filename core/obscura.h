@@ -153,9 +153,13 @@ enum {
     OBS_OUTPUT_CULL_MASK = 8,    /* debug: one channel, 1 where the culling
                                     pre-pass (VAO++ 4.2) made the pixel a
                                     culling candidate, else 0 */
-    OBS_OUTPUT_BLEED = 16        /* RGB: the colour-bleed term (VAO++ 4.7),
+    OBS_OUTPUT_BLEED = 16,       /* RGB: the colour-bleed term (VAO++ 4.7),
                                     (1,1,1) where there is none or bleeding
                                     is off */
+    OBS_OUTPUT_LUMINANCE = 32    /* debug: one channel, the luminance-
+                                    sensitivity factor of VAO++ eq 3 (4.3):
+                                    1 keeps the pixel's occlusion, 0 removes
+                                    it; 1 everywhere when it is off */
 };
 
 typedef struct obs_result {
@@ -164,6 +168,7 @@ typedef struct obs_result {
     obs_image sample_count; /* filled when OBS_OUTPUT_SAMPLE_COUNT was asked */
     obs_image cull_mask;    /* filled when OBS_OUTPUT_CULL_MASK was asked */
     obs_image bleed;        /* filled when OBS_OUTPUT_BLEED was asked */
+    obs_image luminance;    /* filled when OBS_OUTPUT_LUMINANCE was asked */
 } obs_result;
 
 /* Runs the AO chain on the context's thread.  `params` may be NULL or
@@ -179,6 +184,40 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params,
                        unsigned outputs, obs_result *out, char err[OBS_ERR_LEN]);
 
 void obs_result_free(obs_result *r);
+
+/* ---- per-pass GPU timings ---------------------------------------------- */
+
+/* The passes of obs_run, in order.  UPLOAD and READBACK are the texture
+ * transfers of the G-buffer and of the results. */
+typedef enum obs_pass {
+    OBS_PASS_UPLOAD,
+    OBS_PASS_PREP,
+    OBS_PASS_CULL,
+    OBS_PASS_AO,
+    OBS_PASS_BLUR,
+    OBS_PASS_LUMINANCE,
+    OBS_PASS_COMPOSITE,
+    OBS_PASS_READBACK,
+    OBS_PASS_COUNT
+} obs_pass;
+
+/* "upload", "prep", "cull", "ao", "blur", "luminance", "composite",
+ * "readback". */
+const char *obs_pass_name(obs_pass p);
+
+typedef struct obs_pass_times {
+    double ms[OBS_PASS_COUNT]; /* GL time of each pass; -1: it did not run */
+    double total_ms;           /* sum of the passes that ran */
+} obs_pass_times;
+
+/* Turns per-pass timing on or off for the following obs_run calls: each
+ * pass is bracketed by a GL_TIME_ELAPSED query (GL 3.3 timer queries),
+ * read back when the frame ends.  Off by default: reading the queries
+ * waits for the GPU. */
+obs_status obs_ctx_set_timing(obs_ctx *ctx, int on, char err[OBS_ERR_LEN]);
+
+/* The times of the last obs_run with timing on; 0 when there is none. */
+int obs_ctx_last_times(const obs_ctx *ctx, obs_pass_times *out);
 
 /* ---- sample sets --------------------------------------------------------- */
 

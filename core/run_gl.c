@@ -72,7 +72,7 @@ void obs__frame_release(obs_ctx *ctx)
     obs__targets *t = &ctx->tg;
     GLuint tex[] = {t->tex_depth, t->tex_normal,    t->tex_color, t->tex_viewpos, t->tex_vnormal,
                     t->tex_ao,    t->tex_composite, t->tex_blur,  t->tex_count,
-                    t->tex_cull,  t->tex_cullmask, t->tex_bleed};
+                    t->tex_cull,  t->tex_cullmask, t->tex_bleed, t->tex_lumfactor};
     GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao, t->fbo_cull};
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
@@ -115,6 +115,7 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     t->tex_count = make_texture(ctx, GL_R32F, w, h);
     t->tex_cullmask = make_texture(ctx, GL_R32F, w, h);
     t->tex_bleed = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_lumfactor = make_texture(ctx, GL_R32F, w, h);
     /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block, read
      * with linear filtering (R32F filters in desktop GL). */
     t->tex_cull = make_texture(ctx, GL_R32F, (w + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK,
@@ -123,6 +124,7 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     GLuint prep[] = {t->tex_viewpos, t->tex_vnormal};
     GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask, t->tex_bleed};
+    GLuint blur[] = {t->tex_blur, t->tex_lumfactor};
     obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 2, "prep", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_vao, vao, 4, "vao", err);
@@ -131,7 +133,7 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_ao, &t->tex_ao, 1, "ao", err);
     if (s == OBS_OK)
-        s = make_fbo(ctx, &t->fbo_blur, &t->tex_blur, 1, "blur", err);
+        s = make_fbo(ctx, &t->fbo_blur, blur, 2, "blur", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_composite, &t->tex_composite, 1, "composite", err);
     if (s == OBS_OK)
@@ -204,9 +206,77 @@ static void read_back(GLuint fbo, GLenum attachment, int w, int h, GLenum format
     glReadPixels(0, 0, w, h, format, GL_FLOAT, dst);
 }
 
+/* ---- per-pass timings (GL_TIME_ELAPSED queries) ------------------------ */
+
+const char *obs_pass_name(obs_pass p)
+{
+    static const char *const names[OBS_PASS_COUNT] = {
+        "upload", "prep", "cull", "ao", "blur", "luminance", "composite", "readback"};
+    return (unsigned)p < OBS_PASS_COUNT ? names[p] : "unknown";
+}
+
+obs_status obs_ctx_set_timing(obs_ctx *ctx, int on, char err[OBS_ERR_LEN])
+{
+    if (!ctx)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
+    obs_status s = obs__ctx_bind(ctx, err);
+    if (s != OBS_OK)
+        return s;
+    if (on && !ctx->queries[0])
+        glGenQueries(OBS_PASS_COUNT, ctx->queries);
+    ctx->timing = on != 0;
+    ctx->times_valid = 0;
+    return obs__gl_check("creating timer queries", err);
+}
+
+int obs_ctx_last_times(const obs_ctx *ctx, obs_pass_times *out)
+{
+    if (!ctx || !ctx->times_valid)
+        return 0;
+    *out = ctx->times;
+    return 1;
+}
+
+/* Brackets one pass; passes never nest (GL allows one active
+ * GL_TIME_ELAPSED query). */
+static void pass_begin(obs_ctx *ctx, obs_pass p, unsigned *ran)
+{
+    if (!ctx->timing)
+        return;
+    glBeginQuery(GL_TIME_ELAPSED, ctx->queries[p]);
+    *ran |= 1u << p;
+}
+
+static void pass_end(obs_ctx *ctx)
+{
+    if (ctx->timing)
+        glEndQuery(GL_TIME_ELAPSED);
+}
+
+/* Waits for the queries of the passes in `ran` (the frame has been read
+ * back, so the GPU is done with them anyway). */
+static void collect_times(obs_ctx *ctx, unsigned ran)
+{
+    if (!ctx->timing)
+        return;
+    obs_pass_times *t = &ctx->times;
+    t->total_ms = 0.0;
+    for (int p = 0; p < OBS_PASS_COUNT; p++) {
+        t->ms[p] = -1.0;
+        if (!(ran & (1u << p)))
+            continue;
+        GLuint64 ns = 0;
+        glGetQueryObjectui64v(ctx->queries[p], GL_QUERY_RESULT, &ns);
+        t->ms[p] = (double)ns / 1e6;
+        t->total_ms += t->ms[p];
+    }
+    ctx->times_valid = 1;
+}
+
 obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                    obs_result *out, char err[OBS_ERR_LEN])
 {
+    unsigned ran = 0; /* passes timed in this frame */
     obs_params p;
     obs__frame f;
     obs_status s;
@@ -235,6 +305,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
 
     obs__targets *t = &ctx->tg;
     int w = f.width, h = f.height;
+    pass_begin(ctx, OBS_PASS_UPLOAD, &ran);
     upload(t->tex_depth, &gb->depth, w, h, GL_RED);
     if (!f.reconstruct_normals)
         upload(t->tex_normal, &gb->normal, w, h, GL_RGB);
@@ -243,8 +314,10 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
                     ((outputs & OBS_OUTPUT_COMPOSITE) || f.luminance || f.bleed_step);
     if (has_color)
         upload(t->tex_color, &gb->color, w, h, GL_RGBA);
+    pass_end(ctx);
 
     /* prep pass */
+    pass_begin(ctx, OBS_PASS_PREP, &ran);
     GLuint prog = ctx->prog.prep;
     glUseProgram(prog);
     set_common(prog, &f);
@@ -253,17 +326,21 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     glUniform1i(glGetUniformLocation(prog, "u_reconstruct"), f.reconstruct_normals);
     glUniformMatrix3fv(glGetUniformLocation(prog, "u_normal_matrix"), 1, GL_TRUE, f.normal_matrix);
     draw(ctx, t->fbo_prep, w, h);
+    pass_end(ctx);
 
     /* culling pre-pass (section 4.2): 8-sample AO at 1/8 resolution */
     if (f.culling) {
+        pass_begin(ctx, OBS_PASS_CULL, &ran);
         prog = ctx->prog.cull;
         glUseProgram(prog);
         set_common(prog, &f);
         set_vao(prog, &f, t);
         draw(ctx, t->fbo_cull, f.cull_w, f.cull_h);
+        pass_end(ctx);
     }
 
     /* AO pass */
+    pass_begin(ctx, OBS_PASS_AO, &ran);
     prog = ctx->prog.vao;
     glUseProgram(prog);
     set_common(prog, &f);
@@ -288,9 +365,11 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_vao);
     glDrawBuffers(4, vao_bufs);
     draw(ctx, t->fbo_vao, w, h);
+    pass_end(ctx);
 
     /* low-pass filter (section 4.6): ao -> blur along x -> ao along y */
     if (f.blur_radius > 0) {
+        pass_begin(ctx, OBS_PASS_BLUR, &ran);
         prog = ctx->prog.blur;
         glUseProgram(prog);
         set_common(prog, &f);
@@ -300,16 +379,21 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
         bind_tex(prog, "u_ao", 0, t->tex_ao);
         glUniform2i(glGetUniformLocation(prog, "u_dir"), 1, 0);
+        const GLenum blur_bufs[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+        glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_blur);
+        glDrawBuffers(2, blur_bufs);
         draw(ctx, t->fbo_blur, w, h);
         bind_tex(prog, "u_ao", 0, t->tex_blur);
         glUniform2i(glGetUniformLocation(prog, "u_dir"), 0, 1);
         draw(ctx, t->fbo_ao, w, h);
+        pass_end(ctx);
     }
 
     /* luminance sensitivity (section 4.3, eq 3), after the blur (see
      * luminance.frag.glsl): ao -> tex_blur, free once the blur is done */
     GLuint ao_tex = t->tex_ao, ao_fbo = t->fbo_ao;
     if (f.luminance) {
+        pass_begin(ctx, OBS_PASS_LUMINANCE, &ran);
         prog = ctx->prog.luminance;
         glUseProgram(prog);
         bind_tex(prog, "u_ao", 0, t->tex_ao);
@@ -318,12 +402,19 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         glUniform1f(glGetUniformLocation(prog, "u_lum_threshold"), f.lum_threshold);
         glUniform1f(glGetUniformLocation(prog, "u_lum_width"), f.lum_width);
         glUniform1f(glGetUniformLocation(prog, "u_lum_sigma"), f.lum_sigma);
+        const GLenum lum_bufs[] = {
+            GL_COLOR_ATTACHMENT0,
+            (outputs & OBS_OUTPUT_LUMINANCE) ? GL_COLOR_ATTACHMENT1 : GL_NONE};
+        glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_blur);
+        glDrawBuffers(2, lum_bufs);
         draw(ctx, t->fbo_blur, w, h);
         ao_tex = t->tex_blur;
         ao_fbo = t->fbo_blur;
+        pass_end(ctx);
     }
 
     if (outputs & OBS_OUTPUT_COMPOSITE) {
+        pass_begin(ctx, OBS_PASS_COMPOSITE, &ran);
         prog = ctx->prog.composite;
         glUseProgram(prog);
         bind_tex(prog, "u_ao", 0, ao_tex);
@@ -332,8 +423,11 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         glUniform1i(glGetUniformLocation(prog, "u_has_color"), has_color);
         glUniform1i(glGetUniformLocation(prog, "u_has_bleed"), f.bleed_step > 0);
         draw(ctx, t->fbo_composite, w, h);
-        read_back(t->fbo_composite, GL_COLOR_ATTACHMENT0, w, h, GL_RGBA, out->composite.data);
+        pass_end(ctx);
     }
+    pass_begin(ctx, OBS_PASS_READBACK, &ran);
+    if (outputs & OBS_OUTPUT_COMPOSITE)
+        read_back(t->fbo_composite, GL_COLOR_ATTACHMENT0, w, h, GL_RGBA, out->composite.data);
     if (outputs & OBS_OUTPUT_AO)
         read_back(ao_fbo, GL_COLOR_ATTACHMENT0, w, h, GL_RED, out->ao.data);
     if (outputs & OBS_OUTPUT_SAMPLE_COUNT)
@@ -347,8 +441,17 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
             for (size_t i = 0; i < (size_t)w * h * 3; i++)
                 out->bleed.data[i] = 1.0f;
     }
+    if (outputs & OBS_OUTPUT_LUMINANCE) {
+        if (f.luminance)
+            read_back(t->fbo_blur, GL_COLOR_ATTACHMENT1, w, h, GL_RED, out->luminance.data);
+        else /* off: the factor is 1, no GL work */
+            for (size_t i = 0; i < (size_t)w * h; i++)
+                out->luminance.data[i] = 1.0f;
+    }
+    pass_end(ctx);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
+    collect_times(ctx, ran);
 
     s = obs__gl_check("running the AO passes", err);
     if (s != OBS_OK)

@@ -310,6 +310,8 @@ obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs, ch
         s = alloc_image(&out->sample_count, w, h, 1, err);
     if (s == OBS_OK && (outputs & OBS_OUTPUT_CULL_MASK))
         s = alloc_image(&out->cull_mask, w, h, 1, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_LUMINANCE))
+        s = alloc_image(&out->luminance, w, h, 1, err);
     if (s == OBS_OK && (outputs & OBS_OUTPUT_BLEED))
         s = alloc_image(&out->bleed, w, h, 3, err);
     if (s != OBS_OK)
@@ -325,6 +327,7 @@ void obs_result_free(obs_result *r)
     obs_image_free(&r->composite);
     obs_image_free(&r->sample_count);
     obs_image_free(&r->cull_mask);
+    obs_image_free(&r->luminance);
     obs_image_free(&r->bleed);
 }
 
@@ -433,6 +436,8 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
     /* luminance sensitivity (section 4.3, eq 3), after the blur: the
      * blur is depth-aware only and would carry a bright pixel's
      * suppression onto its dark neighbours (and their occlusion onto it) */
+    for (size_t i = 0; out->luminance.data && i < npx; i++)
+        out->luminance.data[i] = f.luminance ? obs__luminance_factor(&f, col + 4 * i) : 1.0f;
     if (f.luminance)
         for (size_t i = 0; i < npx; i++)
             ao[i] = obs__luminance_ao(&f, ao[i], col + 4 * i);

@@ -192,6 +192,8 @@ void obs_ctx_destroy(obs_ctx *ctx)
     if (obs__ctx_bind(ctx, NULL) == OBS_OK) {
         obs__frame_release(ctx);
         glDeleteVertexArrays(1, &ctx->vao);
+        if (ctx->queries[0])
+            glDeleteQueries(OBS_PASS_COUNT, ctx->queries);
     }
     if (ctx->backend == OBS_BACKEND_OSMESA)
         obs__osmesa_destroy(&ctx->st);

@@ -66,6 +66,8 @@
     X(PFNGLGENQUERIESPROC, GenQueries)                                         \
     X(PFNGLDELETEQUERIESPROC, DeleteQueries)                                   \
     X(PFNGLQUERYCOUNTERPROC, QueryCounter)                                     \
+    X(PFNGLBEGINQUERYPROC, BeginQuery)                                         \
+    X(PFNGLENDQUERYPROC, EndQuery)                                             \
     X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)
 
 /* Optional entry points (may be NULL). */
@@ -133,6 +135,8 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glGenQueries obs__glp->GenQueries
 #define glDeleteQueries obs__glp->DeleteQueries
 #define glQueryCounter obs__glp->QueryCounter
+#define glBeginQuery obs__glp->BeginQuery
+#define glEndQuery obs__glp->EndQuery
 #define glGetQueryObjectui64v obs__glp->GetQueryObjectui64v
 
 /* Loads every entry point; fails naming the first one missing. */
@@ -163,7 +167,9 @@ typedef struct obs__targets {
     GLuint tex_cull;                          /* culling pre-pass AO, 1/8 size (4.2) */
     GLuint tex_cullmask;                      /* debug: culling candidates (4.2) */
     GLuint tex_bleed;                         /* colour-bleed term (4.7), RGBA */
-    GLuint fbo_prep, fbo_ao, fbo_blur, fbo_composite;
+    GLuint tex_lumfactor;                     /* debug: factor of eq 3 (4.3) */
+    GLuint fbo_prep, fbo_ao, fbo_composite;
+    GLuint fbo_blur;                          /* tex_blur + tex_lumfactor */
     GLuint fbo_vao;                           /* AO pass: tex_ao + tex_count + tex_cullmask + tex_bleed */
     GLuint fbo_cull;                          /* culling pre-pass: tex_cull */
 } obs__targets;
@@ -180,6 +186,10 @@ struct obs_ctx {
     obs__programs prog;
     obs__targets tg;
     unsigned long gl_objects_created; /* textures + framebuffers, for tests */
+    int timing;                          /* obs_ctx_set_timing */
+    GLuint queries[OBS_PASS_COUNT];      /* GL_TIME_ELAPSED, one per pass */
+    int times_valid;
+    obs_pass_times times;                /* of the last timed frame */
 };
 
 /* Deletes the per-resolution textures, framebuffers and programs. */

@@ -140,6 +140,52 @@ static void test_resources_reused(void **state)
     obs_ctx_destroy(ctx);
 }
 
+/* Per-pass timings: each pass that ran has a time, the others -1; no
+ * times before a timed frame or with timing off.  (Times are read, never
+ * bounded: speed is measured by make bench.) */
+static void test_pass_times(void **state)
+{
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_AUTO);
+    obs_gbuffer_file gf = {0};
+    obs_pass_times t;
+    obs_result r;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    load(scenes[0], &gf);
+    assert_int_equal(obs_run(ctx, &gf.gb, NULL, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    obs_result_free(&r);
+    assert_false(obs_ctx_last_times(ctx, &t));
+    assert_int_equal(obs_ctx_set_timing(ctx, 1, err), OBS_OK);
+    obs_params p = {0};
+    assert_int_equal(obs_param_set(&p, "culling", "off", err), OBS_OK);
+    assert_int_equal(obs_run(ctx, &gf.gb, &p, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE, &r, err),
+                     OBS_OK);
+    obs_result_free(&r);
+    assert_true(obs_ctx_last_times(ctx, &t));
+    double sum = 0.0;
+    for (int k = 0; k < OBS_PASS_COUNT; k++) {
+        print_message("%-10s %8.3f ms\n", obs_pass_name((obs_pass)k), t.ms[k]);
+        if (t.ms[k] >= 0.0)
+            sum += t.ms[k];
+    }
+    assert_true(t.ms[OBS_PASS_CULL] == -1.0);      /* culling off */
+    assert_true(t.ms[OBS_PASS_LUMINANCE] == -1.0); /* off by default */
+    assert_true(t.ms[OBS_PASS_AO] > 0.0);
+    assert_true(t.ms[OBS_PASS_PREP] >= 0.0 && t.ms[OBS_PASS_BLUR] >= 0.0 &&
+                t.ms[OBS_PASS_COMPOSITE] >= 0.0 && t.ms[OBS_PASS_READBACK] >= 0.0);
+    assert_true(fabs(sum - t.total_ms) < 1e-9);
+    /* the default chain runs the culling pre-pass */
+    assert_int_equal(obs_run(ctx, &gf.gb, NULL, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    obs_result_free(&r);
+    assert_true(obs_ctx_last_times(ctx, &t));
+    assert_true(t.ms[OBS_PASS_CULL] >= 0.0 && t.ms[OBS_PASS_COMPOSITE] == -1.0);
+    assert_int_equal(obs_ctx_set_timing(ctx, 0, err), OBS_OK);
+    assert_false(obs_ctx_last_times(ctx, &t));
+    assert_string_equal(obs_pass_name(OBS_PASS_COUNT), "unknown");
+    obs_gbuffer_free(&gf);
+    obs_ctx_destroy(ctx);
+}
+
 /* A shader that does not compile is a status carrying the info log. */
 static void test_shader_failure_is_a_status(void **state)
 {
@@ -210,6 +256,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gl_matches_cpu),
         cmocka_unit_test(test_resources_reused),
+        cmocka_unit_test(test_pass_times),
         cmocka_unit_test(test_shader_failure_is_a_status),
         cmocka_unit_test(test_bad_input),
     };

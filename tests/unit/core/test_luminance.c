@@ -4,7 +4,7 @@
  * input. */
 #include <math.h>
 
-#include "testutil.h"
+#include "gl_testutil.h"
 
 #include "frame.h"
 #include "io.h"
@@ -119,11 +119,59 @@ static void test_bright_pixel_less_occlusion(void **state)
     obs_result_free(&nocol);
 }
 
+/* The debug output (OBS_OUTPUT_LUMINANCE) on real input: the factor of
+ * eq 3 per pixel, from the GL pass and from the CPU twin; it explains the
+ * whole change of the AO, ao_on = 1 - (1 - ao_off) * factor, pixel by
+ * pixel; it is 1 everywhere when the term is off. */
+static void test_debug_output(void **state)
+{
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_AUTO);
+    obs_gbuffer_file gf = {0};
+    obs_result off, on, cpu;
+    char err[OBS_ERR_LEN] = "";
+    unsigned out = OBS_OUTPUT_AO | OBS_OUTPUT_LUMINANCE;
+    (void)state;
+    load(scenes[0], &gf);
+    obs_params p = {0};
+    assert_int_equal(obs_run(ctx, &gf.gb, &p, out, &off, err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "luminance", "lum", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "lum_threshold", "0.8", err), OBS_OK);
+    assert_int_equal(obs_run(ctx, &gf.gb, &p, out, &on, err), OBS_OK);
+    assert_int_equal(obs_run_cpu(&gf.gb, &p, out, &cpu, err), OBS_OK);
+    size_t n = (size_t)off.ao.width * off.ao.height, partial = 0, changed = 0;
+    double worst = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        float k = on.luminance.data[i];
+        assert_true(off.luminance.data[i] == 1.0f);
+        assert_true(k >= 0.0f && k <= 1.0f);
+        partial += k > 0.01f && k < 0.99f;
+        changed += on.ao.data[i] != off.ao.data[i];
+        double want = 1.0 - (1.0 - off.ao.data[i]) * k;
+        worst = fmax(worst, fabs(want - on.ao.data[i]));
+    }
+    double mean, frac;
+    diff(&on.luminance, &cpu.luminance, &mean, &frac);
+    print_message("room_small, threshold 0.8: factor strictly between 0 and 1 at %.1f %% of "
+                  "pixels, AO changed at %.1f %%; worst |ao_on - (1 - (1 - ao_off) k)| %.2e; "
+                  "GL vs CPU factor: mean |diff| %.2e\n",
+                  100.0 * partial / n, 100.0 * changed / n, worst, mean);
+    assert_true(partial > n / 20); /* the term does act on this scene */
+    assert_true(changed > n / 20);
+    assert_true(worst < 1e-5);
+    assert_true(mean < 1e-6);
+    obs_result_free(&off);
+    obs_result_free(&on);
+    obs_result_free(&cpu);
+    obs_gbuffer_free(&gf);
+    obs_ctx_destroy(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_eq3_table),
         cmocka_unit_test(test_bright_pixel_less_occlusion),
+        cmocka_unit_test(test_debug_output),
     };
     return cmocka_run_group_tests_name("luminance", tests, NULL, NULL);
 }
