@@ -51,6 +51,8 @@ UNIT_BIN := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 LIB := $(BUILD)/libobscura.a
 CLI := $(BUILD)/obscura
 BENCH := $(BUILD)/frame_bench
+# VAO++ Table 1: the extensions timed with GL timer queries.
+EXT_BENCH := $(BUILD)/extensions_bench
 # Developer tool: a G-buffer EXR upscaled to WxH (tests/e2e/load.sh, bench).
 UPSCALE := $(BUILD)/exr_upscale
 DAEMON_BENCH := $(BUILD)/daemon_bench
@@ -90,6 +92,9 @@ $(CLI): $(CLI_OBJ) $(PROTO_LIB) $(LIB)
 	$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(PROTO_LIB) $(LIB) $(PKG_LIBS)
 
 $(BENCH): bench/frame_bench.c $(LIB)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
+$(EXT_BENCH): bench/extensions_bench.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 $(UPSCALE): tools/exr_upscale.c $(LIB)
@@ -165,7 +170,7 @@ headers:
 	@echo "headers: each public header compiles alone as C and C++"
 
 bench: deps
-	@$(MAKE) --no-print-directory all $(BENCH) $(UPSCALE) $(DAEMON_BENCH)
+	@$(MAKE) --no-print-directory all $(BENCH) $(EXT_BENCH) $(UPSCALE) $(DAEMON_BENCH)
 	@BUILD=$(BUILD) bench/run.sh
 
 clean:

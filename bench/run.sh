@@ -16,5 +16,9 @@ echo "## $(date -u +%Y-%m-%d) $(uname -m), $(nproc) cores"
 echo
 "$BUILD/frame_bench" "$@"
 echo
+# VAO++ Table 1: the extensions at 2..32 samples, 1080p and 4K, GL timer
+# queries (bench/extensions_bench.c); the first G-buffer, scaled
+"$BUILD/extensions_bench" "$1" "$2"
+echo
 # the daemon: round trip vs in-process, concurrent clients (1920x1080)
 BUILD="$BUILD" bench/daemon_bench.sh "$1" "$2"
