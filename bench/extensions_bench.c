@@ -3,7 +3,8 @@
  * samples and two resolutions, timed on the GL timeline.
  *
  *   extensions_bench [--backend B] [--frames N] [--frames-4k N]
- *                    [--sizes WxH,...] G-BUFFER.exr [CAMERA.json]
+ *                    [--sizes WxH,...] [--set NAME=VALUE]... G-BUFFER.exr
+ *                    [CAMERA.json]
  *
  * The G-buffer is scaled (nearest neighbour, same camera) to each size
  * unless it already has that size.  Per cell: the median over N frames of
@@ -14,6 +15,9 @@
  * ratios are to VAO in the same run.  The depth range check and the blur
  * stay on in every column (they are quality extensions, not timed by
  * Table 1), so every column is the same chain with one switch changed.
+ * --set gives every variant a parameter of the table (adaptive_diameter,
+ * say: adaptive sampling picks counts by the disk's size on screen, so
+ * whether it saves anything depends on the scene and on that value).
  * Output: Markdown. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -60,9 +64,15 @@ static void set(obs_params *p, const char *name, const char *value)
         die(name, err);
 }
 
+enum { MAX_SETS = 8 };
+static const char *set_name[MAX_SETS], *set_value[MAX_SETS];
+static int nsets;
+
 static obs_params variant_params(int v, int samples)
 {
     obs_params p = {0};
+    for (int i = 0; i < nsets; i++)
+        set(&p, set_name[i], set_value[i]);
     char n[16];
     snprintf(n, sizeof n, "%d", samples);
     set(&p, "samples", n);
@@ -91,7 +101,28 @@ static float *scale_plane(const obs_plane *p, int sw, int sh, int w, int h)
 
 typedef struct cell {
     double effect, chain_gl, wall; /* medians, ms */
+    double mean_samples;           /* per pixel with geometry */
 } cell;
+
+/* Mean sample count over the pixels that took samples (VAO++ 4.1's
+ * debug output). */
+static double mean_samples(obs_ctx *ctx, const obs_gbuffer *gb, int v, int samples)
+{
+    char err[OBS_ERR_LEN];
+    obs_params p = variant_params(v, samples);
+    obs_result r;
+    if (obs_run(ctx, gb, &p, OBS_OUTPUT_SAMPLE_COUNT, &r, err) != OBS_OK)
+        die("obs_run", err);
+    double sum = 0.0;
+    size_t n = 0;
+    for (size_t i = 0; i < (size_t)r.sample_count.width * r.sample_count.height; i++)
+        if (r.sample_count.data[i] > 0.0f) {
+            sum += r.sample_count.data[i];
+            n++;
+        }
+    obs_result_free(&r);
+    return n ? sum / n : 0.0;
+}
 
 /* One frame of variant v; returns its times. */
 static void frame(obs_ctx *ctx, const obs_gbuffer *gb, int v, int samples, double *effect,
@@ -123,7 +154,8 @@ static void measure(obs_ctx *ctx, const obs_gbuffer *gb, int frames, cell out[CO
             for (int v = 0; v < VARIANTS; v++)
                 frame(ctx, gb, v, counts[c], &e[v][i], &g[v][i], &w[v][i]);
         for (int v = 0; v < VARIANTS; v++)
-            out[c][v] = (cell){median(e[v], frames), median(g[v], frames), median(w[v], frames)};
+            out[c][v] = (cell){median(e[v], frames), median(g[v], frames), median(w[v], frames),
+                               mean_samples(ctx, gb, v, counts[c])};
         fprintf(stderr, "extensions_bench: %dx%d, %d samples done\n", gb->width, gb->height,
                 counts[c]);
     }
@@ -139,8 +171,9 @@ static void print_table(int w, int h, int frames, cell t[COUNTS][VARIANTS])
         printf(" %s effect |", variant_name[v]);
     for (int v = 0; v < VARIANTS; v++)
         printf(" %s chain GL / wall |", variant_name[v]);
+    printf(" mean samples/pixel +adaptive, VAO++ |");
     printf("\n|---|");
-    for (int v = 0; v < 2 * VARIANTS; v++)
+    for (int v = 0; v < 2 * VARIANTS + 1; v++)
         printf("---|");
     printf("\n");
     for (int c = 0; c < COUNTS; c++) {
@@ -153,7 +186,7 @@ static void print_table(int w, int h, int frames, cell t[COUNTS][VARIANTS])
         }
         for (int v = 0; v < VARIANTS; v++)
             printf(" %.1f / %.1f |", t[c][v].chain_gl, t[c][v].wall);
-        printf("\n");
+        printf(" %.1f, %.1f |\n", t[c][1].mean_samples, t[c][3].mean_samples);
     }
     printf("\n");
     fflush(stdout);
@@ -164,11 +197,12 @@ static void print_passes(obs_ctx *ctx, const obs_gbuffer *gb, int frames)
 {
     char err[OBS_ERR_LEN];
     double ms[OBS_PASS_COUNT][MAX_FRAMES], wall[MAX_FRAMES];
+    obs_params vpp = variant_params(3, 16);
     for (int i = -1; i < frames; i++) {
         obs_result r;
         obs_pass_times t;
         double t0 = now_ms();
-        if (obs_run(ctx, gb, NULL, OBS_OUTPUT_AO, &r, err) != OBS_OK)
+        if (obs_run(ctx, gb, &vpp, OBS_OUTPUT_AO, &r, err) != OBS_OK)
             die("obs_run", err);
         double wt = now_ms() - t0;
         obs_result_free(&r);
@@ -178,7 +212,7 @@ static void print_passes(obs_ctx *ctx, const obs_gbuffer *gb, int frames)
             ms[p][i] = t.ms[p];
         wall[i] = wt;
     }
-    printf("Default chain (VAO++, 16 samples, range check, blur) at %dx%d, per pass, median of "
+    printf("VAO++ chain (16 samples, range check, blur; --set values) at %dx%d, per pass, median of "
            "%d frames:\n\n| pass | GL ms |\n|---|---|\n",
            gb->width, gb->height, frames);
     for (int p = 0; p < OBS_PASS_COUNT; p++) {
@@ -215,6 +249,13 @@ int main(int argc, char **argv)
                 nsizes++;
                 s = *end == ',' ? end + 1 : end;
             }
+        } else if (!strcmp(argv[i], "--set") && i + 1 < argc && nsets < MAX_SETS) {
+            char *eq = strchr(argv[++i], '=');
+            if (!eq)
+                die("--set", "expected NAME=VALUE");
+            *eq = '\0';
+            set_name[nsets] = argv[i];
+            set_value[nsets++] = eq + 1;
         } else {
             die(argv[i], "unknown option");
         }
@@ -239,9 +280,12 @@ int main(int argc, char **argv)
         die("timer queries", err);
     obs_ctx_info info;
     obs_ctx_get_info(ctx, &info);
-    printf("Renderer: %s, %s (backend %s). Input: %s (%dx%d), nearest-neighbour scaled.\n\n",
+    printf("Renderer: %s, %s (backend %s). Input: %s (%dx%d), nearest-neighbour scaled.",
            info.gl_renderer, info.gl_version, obs_backend_name(info.backend), argv[i],
            gf.gb.width, gf.gb.height);
+    for (int k = 0; k < nsets; k++)
+        printf(" %s%s = %s", k ? "," : " Every variant:", set_name[k], set_value[k]);
+    printf("\n\n");
 
     for (int s = 0; s < nsizes; s++) {
         int w = sizes[s][0], h = sizes[s][1];
