@@ -126,6 +126,25 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
         obs__log(log_ctx, OBS_LOG_INFO, "no colour channel: colour bleeding is off");
     }
 
+    /* The comparison methods (parameter method); their AO runs in place
+     * of the VAO estimator, the rest of the chain is shared. */
+    f->method = p->method;
+    f->hs_count = p->hemisphere_samples;
+    f->hs_bias = p->hemisphere_bias * f->radius;
+    obs__hemisphere_kernel(f->hs_count, &f->hs_kernel[0][0]);
+    f->angle_pairs = p->angle_pairs;
+    obs__angle_pattern(f->angle_pairs, &f->angle_xy[0][0]);
+    f->angle_acos = p->angle_acos;
+    f->hbao_dirs = p->hbao_directions;
+    f->hbao_steps = p->hbao_steps;
+    for (int d = 0; d < f->hbao_dirs; d++) { /* HBAO: Nd directions over 2 pi */
+        double a = 2.0 * M_PI * d / f->hbao_dirs;
+        f->hbao_dir[d][0] = (float)cos(a);
+        f->hbao_dir[d][1] = (float)sin(a);
+    }
+    f->hbao_bias_cs[0] = (float)cos(p->hbao_angle_bias * M_PI / 180.0);
+    f->hbao_bias_cs[1] = (float)sin(p->hbao_angle_bias * M_PI / 180.0);
+
     static const float identity3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     memcpy(f->normal_matrix, identity3, sizeof identity3);
     if (!gb->normal.data) {
@@ -182,4 +201,23 @@ obs_status obs__gbuffer_validate(const obs_gbuffer *gb, char err[OBS_ERR_LEN])
                              planes[i].name, pl->row_stride, row);
     }
     return OBS_OK;
+}
+
+/* GLSL: view_to_px() in method.glsl; the projection of vao_estimate. */
+int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy)
+{
+    const float *P = f->proj;
+    float cw = P[12] * s[0] + P[13] * s[1] + P[14] * s[2] + P[15];
+    if (!(cw > 0.0f))
+        return 0;
+    float cx = P[0] * s[0] + P[1] * s[1] + P[2] * s[2] + P[3];
+    float cy = P[4] * s[0] + P[5] * s[1] + P[6] * s[2] + P[7];
+    float u = (cx / cw * 0.5f + 0.5f) * f->viewport[2] - f->viewport[0];
+    float v = (0.5f - cy / cw * 0.5f) * f->viewport[3] - f->viewport[1];
+    float fu = floorf(u), fv = floorf(v);
+    if (!(fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height))
+        return 0;
+    *qx = (int)fu;
+    *qy = (int)fv;
+    return 1;
 }

@@ -40,6 +40,12 @@
  * obs__frame_setup (frame.c). */
 #define OBS__RADIUS_K 1.0f
 
+/* Largest counts of the comparison methods' parameters (uniform array
+ * sizes in hemisphere.glsl, angle.glsl, hbao.glsl). */
+#define OBS__MAX_HEMISPHERE 64
+#define OBS__MAX_PAIRS 16
+#define OBS__MAX_DIRECTIONS 32
+
 typedef struct obs__frame {
     int width, height;
     float viewport[4];      /* display_x, display_y, display_width, display_height */
@@ -65,6 +71,21 @@ typedef struct obs__frame {
     int luminance;          /* section 4.3, eq 3: 0 off, 1 Rec. 709 luminance, 2 HSV V */
     float lum_threshold, lum_width, lum_sigma; /* threshold, width, sigma of eq 3 */
     int bleed_step;         /* section 4.7, eq 5: 0 off, else every bleed_step-th sample */
+    int method;             /* OBS_METHOD_*: which estimator the AO pass runs */
+    /* method hemisphere (hemisphere_cpu.c): the kernel, unit hemisphere
+     * around +z, scaled by radius at use */
+    int hs_count;
+    float hs_bias;          /* in depth units: hemisphere_bias * R */
+    float hs_kernel[OBS__MAX_HEMISPHERE][3];
+    /* method angle (angle_cpu.c): pair i's offset on the unit disk (its
+     * partner is the negation); the arc cosine used (OBS_ACOS_*) */
+    int angle_pairs;
+    float angle_xy[OBS__MAX_PAIRS][2];
+    int angle_acos;
+    /* method hbao (hbao_cpu.c): directions (unit, view xy), steps, bias */
+    int hbao_dirs, hbao_steps;
+    float hbao_dir[OBS__MAX_DIRECTIONS][2];
+    float hbao_bias_cs[2];  /* cos, sin of the angle bias */
 } obs__frame;
 
 /* Resolves camera, parameters and normal handling for one frame. */
@@ -147,6 +168,49 @@ float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3]);
  * of the AO plane `ao`; `pos` gives each pixel's view depth (w). */
 float obs__blur_pixel(const obs__frame *f, const float *pos, const float *ao, int x, int y, int dx,
                       int dy);
+
+/* ---- comparison methods (parameter `method`) ----------------------------- */
+
+/* The pixel whose planes hold the view-space point s: 1 and (qx, qy) when s
+ * projects into the image in front of the camera, else 0 (GLSL:
+ * view_to_px() in method.glsl). */
+int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy);
+
+/* The unit-hemisphere kernel of n samples (n <= OBS__MAX_HEMISPHERE),
+ * 3 floats each, around +z (hemisphere_cpu.c). */
+void obs__hemisphere_kernel(int n, float *out);
+
+/* Normal-oriented hemisphere SSAO of the point p (xyz; planar depth in
+ * p[3] is not needed) with normal n at pixel (x, y); `pos` is the prep
+ * pass's position plane (GLSL: hemisphere.glsl). */
+float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                            const float n[3]);
+
+/* The pair offsets of the angle-based method on the unit disk, 2 floats
+ * per pair (angle_cpu.c). */
+void obs__angle_pattern(int pairs, float *out);
+
+/* The arc cosine of the angle-based method: mode OBS_ACOS_QUADRATIC,
+ * _LINEAR or _EXACT; x is clamped to [-1, 1] (GLSL: acos_mode() in
+ * angle.glsl). */
+float obs__acos_mode(int mode, float x);
+
+/* Angle-based paired-sample SSAO of the point p (xyzw, w the planar
+ * depth) with normal n at pixel (x, y) (GLSL: angle.glsl). */
+float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[4],
+                       const float n[3]);
+
+/* Horizon-based AO of the point p with normal n at pixel (x, y), marched
+ * from that pixel (GLSL: hbao.glsl).  The count of depth samples read
+ * goes to *count when count is not NULL. */
+float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                      const float n[3], int *count);
+
+/* The AO of pixel (x, y) by the frame's method other than vaopp/vao
+ * (position and normal from the planes); *count: samples taken (GLSL:
+ * main() of method.frag.glsl). */
+float obs__method_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                        int *count);
 
 /* Both passes over the whole plane, horizontal then vertical, in place in
  * `ao`; `tmp` holds width * height floats. */

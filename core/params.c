@@ -210,6 +210,76 @@ void obs_param_format(const obs_params *p, const obs_param_info *pi, char *buf, 
     }
 }
 
+/* Which methods a parameter belongs to (bits 1 << obs_method); the
+ * parameters not listed belong to every method.  A value that agrees
+ * with what the method fixes (adaptive off with method vao) is no
+ * conflict. */
+#define M(m) (1u << OBS_METHOD_##m)
+static const struct {
+    size_t offset;
+    unsigned methods;
+    int allowed; /* the one value every other method accepts; 0: none */
+    const char *why;
+} method_params[] = {
+    {offsetof(obs_params, samples), M(VAOPP) | M(VAO), 0,
+     "the VAO sample sets; hemisphere takes hemisphere_samples, angle angle_pairs, hbao "
+     "hbao_directions and hbao_steps"},
+    {offsetof(obs_params, adaptive), M(VAOPP), OBS_OFF, "adaptive sampling is VAO++'s (4.1)"},
+    {offsetof(obs_params, adaptive_diameter), M(VAOPP), 0, "adaptive sampling is VAO++'s (4.1)"},
+    {offsetof(obs_params, culling), M(VAOPP), OBS_CULLING_OFF,
+     "the culling pre-pass is VAO++'s (4.2)"},
+    {offsetof(obs_params, culling_epsilon), M(VAOPP), 0, "the culling pre-pass is VAO++'s (4.2)"},
+    {offsetof(obs_params, range_check), M(VAOPP), OBS_OFF,
+     "the depth range check is VAO++'s (4.4, eq 4)"},
+    {offsetof(obs_params, range_u), M(VAOPP), 0, "the depth range check is VAO++'s (4.4, eq 4)"},
+    {offsetof(obs_params, bleeding), M(VAOPP) | M(VAO), OBS_BLEEDING_OFF,
+     "colour bleeding (4.7) gathers the colour at the VAO samples"},
+    {offsetof(obs_params, hemisphere_samples), M(HEMISPHERE), 0, "it is method hemisphere's"},
+    {offsetof(obs_params, hemisphere_bias), M(HEMISPHERE), 0, "it is method hemisphere's"},
+    {offsetof(obs_params, angle_pairs), M(ANGLE), 0, "it is method angle's"},
+    {offsetof(obs_params, angle_acos), M(ANGLE), 0, "it is method angle's"},
+    {offsetof(obs_params, hbao_directions), M(HBAO), 0, "it is method hbao's"},
+    {offsetof(obs_params, hbao_steps), M(HBAO), 0, "it is method hbao's"},
+    {offsetof(obs_params, hbao_angle_bias), M(HBAO), 0, "it is method hbao's"},
+};
+#undef M
+
+/* 1 + the table index of the first parameter in `in` (given: non-zero)
+ * that does not apply to `method`; 0 if none. */
+static int method_conflict(const obs_params *in, int method)
+{
+    if (!in || method < OBS_METHOD_VAOPP || method > OBS_METHOD_HBAO)
+        return 0;
+    for (size_t k = 0; k < sizeof method_params / sizeof method_params[0]; k++) {
+        if (method_params[k].methods & (1u << method))
+            continue;
+        const char *field = (const char *)in + method_params[k].offset;
+        int given = 0, agrees = 0;
+        for (int i = 0; i < TABLE_LEN; i++) {
+            if (table[i].offset != method_params[k].offset)
+                continue;
+            if (table[i].type == OBS_PARAM_FLOAT) {
+                given = *(const float *)field != 0.0f;
+            } else {
+                int v = *(const int *)field;
+                given = v != 0;
+                agrees = method_params[k].allowed && v == method_params[k].allowed;
+            }
+            if (given && !agrees)
+                return i + 1;
+        }
+    }
+    return 0;
+}
+
+static const char *method_why(size_t offset)
+{
+    for (size_t k = 0; k < sizeof method_params / sizeof method_params[0]; k++)
+        if (method_params[k].offset == offset)
+            return method_params[k].why;
+    return "";
+}
+
 void obs_params_resolve(const obs_params *in, obs_params *out)
 {
     obs_params r;
@@ -237,11 +307,38 @@ void obs_params_resolve(const obs_params *in, obs_params *out)
             break; /* unset stays unset: has_world_to_camera says */
         }
     }
+    /* A struct resolved before keeps its verdict: its fields are no
+     * longer what a request gave. */
+    if (!in || in->method_conflict == 0) {
+        int c = method_conflict(in, r.method);
+        r.method_conflict = c ? c : -1;
+    }
+    /* What the method fixes: adaptive sampling (4.1), culling (4.2) and
+     * the depth range check (4.4) are VAO++'s; plain VAO (section 3) and
+     * the other methods run without them.  Bleeding (4.7) gathers the
+     * colour at the VAO samples: VAO and VAO++ only. */
+    if (r.method != OBS_METHOD_VAOPP) {
+        r.adaptive = OBS_OFF;
+        r.culling = OBS_CULLING_OFF;
+        r.range_check = OBS_OFF;
+    }
+    if (r.method != OBS_METHOD_VAOPP && r.method != OBS_METHOD_VAO)
+        r.bleeding = OBS_BLEEDING_OFF;
     *out = r;
 }
 
 obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN])
 {
+    if (p->method_conflict > 0 && p->method_conflict <= TABLE_LEN) {
+        const obs_param_info *pi = &table[p->method_conflict - 1];
+        const obs_param_info *mi = obs_param_find("method");
+        char method[32];
+        obs_param_format(p, mi, method, sizeof method);
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "parameter %s does not apply to method %s: %s; leave it unset "
+                         "or pick a method it belongs to",
+                         pi->name, method, method_why(pi->offset));
+    }
     for (int i = 0; i < TABLE_LEN; i++) {
         const obs_param_info *pi = &table[i];
         const char *field = (const char *)p + pi->offset;

@@ -56,6 +56,24 @@ typedef enum obs_bleeding {
     OBS_BLEEDING_QUARTER  /* every fourth sample */
 } obs_bleeding;
 
+/* The AO method (parameter `method`). */
+typedef enum obs_method {
+    OBS_METHOD_DEFAULT,
+    OBS_METHOD_VAOPP,      /* VAO++: the whole chain */
+    OBS_METHOD_VAO,        /* plain VAO: no adaptive sampling, culling, range check */
+    OBS_METHOD_HEMISPHERE, /* normal-oriented hemisphere SSAO (hemisphere_cpu.c) */
+    OBS_METHOD_ANGLE,      /* angle-based paired-sample SSAO (angle_cpu.c) */
+    OBS_METHOD_HBAO        /* horizon-based AO (hbao_cpu.c) */
+} obs_method;
+
+/* The arc cosine of the angle-based method (parameter `angle_acos`). */
+typedef enum obs_acos {
+    OBS_ACOS_DEFAULT,
+    OBS_ACOS_QUADRATIC, /* pi (1 - sign(x) x^2) / 2 */
+    OBS_ACOS_LINEAR,    /* pi (1 - x) / 2 */
+    OBS_ACOS_EXACT      /* acos(x) */
+} obs_acos;
+
 typedef enum obs_normal_space {
     OBS_NORMALS_DEFAULT,
     OBS_NORMALS_WORLD,  /* world space: rotated by world_to_camera */
@@ -67,6 +85,13 @@ typedef enum obs_normal_space {
  * An INT with choices takes only the listed numbers (within min..max). 
  * For ENUM the default is the choice's name; for MAT4 it is unused. */
 #define OBS_PARAM_TABLE(X)                                                     \
+    X(method, ENUM, "vaopp", 0, 0, "vaopp|vao|hemisphere|angle|hbao",          \
+      "AO method: vaopp (the VAO++ chain), vao (plain VAO, VAO++ section 3: "  \
+      "adaptive, culling and range_check off), hemisphere (normal-oriented "   \
+      "hemisphere SSAO), angle (angle-based paired-sample SSAO), hbao "        \
+      "(horizon-based AO); every method shares the input, blur, luminance "    \
+      "and composite; the others have no adaptive sampling, culling, range "   \
+      "check or bleeding; a parameter of another method is refused")           \
     X(radius, FLOAT, 0.5, 1e-4, 1e4, NULL,                                     \
       "AO distance D in world units, as in a ray tracer's AO (the fraction "  \
       "of cosine-weighted rays unblocked within D, Cycles' AO pass); VAO's "   \
@@ -158,7 +183,32 @@ typedef enum obs_normal_space {
       "white mixed towards the colour at the sample's pixel by c(x) = "        \
       "max(0, (x-p).n / |x-p|) max(0, 1 - |x-p|/R)^2, x the surface "          \
       "point seen there; the composite is multiplied by it; off without a "    \
-      "colour plane")
+      "colour plane")                                                          \
+    X(hemisphere_samples, INT, 10, 1, 64, NULL,                                \
+      "method hemisphere: samples in the normal-oriented hemisphere of "       \
+      "radius D; Unity's post-processing stack (VAO++ Table 2) takes 3, 6, "   \
+      "10 (its default, Medium) and 16")                                       \
+    X(hemisphere_bias, FLOAT, 0.05, 1e-6, 1.0, NULL,                           \
+      "method hemisphere: a sample is occluded when the surface at its pixel " \
+      "lies more than hemisphere_bias * D in front of it (self-occlusion "     \
+      "guard; 0.025 at radius 0.5 in the common kernel tutorials)")            \
+    X(angle_pairs, INT, 6, 1, 16, NULL,                                        \
+      "method angle: sample pairs per pixel, each pair two opposite points "   \
+      "of a disk of radius D (6 in the angle-based SSAO article)")              \
+    X(angle_acos, ENUM, "quadratic", 0, 0, "quadratic|linear|exact",           \
+      "method angle: the arc cosine of the pair angles: the article's "        \
+      "quadratic pi (1 - sign(x) x^2) / 2 (max error 9.47 degrees), its "      \
+      "linear pi (1 - x) / 2 (18.95 degrees), or exact acos")                  \
+    X(hbao_directions, INT, 8, 1, 32, NULL,                                    \
+      "method hbao: screen-space directions per pixel, Nd of HBAO (8 in "      \
+      "NVIDIA's HBAO sample)")                                                 \
+    X(hbao_steps, INT, 6, 1, 32, NULL,                                         \
+      "method hbao: ray-marching steps per direction, Ns of HBAO (6 in "       \
+      "NVIDIA's HBAO sample), spread over the projected radius D / (Ns + 1) "  \
+      "apart")                                                                 \
+    X(hbao_angle_bias, FLOAT, 30.0, 1e-6, 89.0, NULL,                          \
+      "method hbao: angle bias in degrees added to the tangent angle t(theta) "\
+      "against the self-occlusion of tessellated surfaces")
 
 #define OBS__PDECL_FLOAT(n) float n;
 #define OBS__PDECL_INT(n) int n;
@@ -170,6 +220,11 @@ typedef struct obs_params {
     OBS_PARAM_TABLE(OBS__PDECL)
 #undef OBS__PDECL
     int has_world_to_camera; /* set by obs_param_set for world_to_camera */
+    /* Set by obs_params_resolve: 1 + the table index of the first
+     * parameter the request gave that does not apply to its method
+     * (obs_params_check refuses it, naming it); -1: none; 0: not resolved
+     * yet.  Resolving a resolved struct again keeps it. */
+    int method_conflict;
 } obs_params;
 
 typedef enum obs_param_type {
@@ -204,7 +259,13 @@ obs_status obs_param_set(obs_params *p, const char *name, const char *value,
 void obs_param_format(const obs_params *p, const obs_param_info *pi, char *buf,
                       size_t len);
 
-/* out = in with every zero field replaced by its default. */
+/* out = in with every zero field replaced by its default, then the
+ * settings the method fixes: methods other than vaopp have adaptive
+ * sampling, culling and the depth range check off (VAO++ features), and
+ * methods hemisphere, angle and hbao have bleeding off too (it gathers the
+ * colour at the VAO samples).  A parameter that in gave (non-zero) and
+ * that the method does not use or fixes otherwise is recorded in
+ * out->method_conflict; obs_params_check then refuses it. */
 void obs_params_resolve(const obs_params *in, obs_params *out);
 
 /* Checks every field of a resolved struct against the table's ranges;

@@ -36,6 +36,20 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
     return s;
 }
 
+/* The AO program of a comparison method (parameter method), built on its
+ * first use: common.glsl, method.glsl, the method's file, method.frag. */
+static obs_status build_method_program(obs_ctx *ctx, int method, char err[OBS_ERR_LEN])
+{
+    static const char *const names[3] = {"hemisphere", "angle", "hbao"};
+    const char *const files[3] = {obs__shader_hemisphere, obs__shader_angle, obs__shader_hbao};
+    int k = method - OBS_METHOD_HEMISPHERE;
+    if (k < 0 || k > 2 || ctx->prog.method[k])
+        return OBS_OK;
+    const char *src[] = {glsl_version, obs__shader_common, obs__shader_method, files[k],
+                         obs__shader_method_frag};
+    return obs__gl_program(names[k], obs__shader_fullscreen_vert, src, 5, &ctx->prog.method[k], err);
+}
+
 static GLuint make_texture(obs_ctx *ctx, GLenum format, int w, int h)
 {
     GLuint t;
@@ -89,6 +103,9 @@ void obs__frame_release(obs_ctx *ctx)
         glDeleteProgram(ctx->prog.composite);
     if (ctx->prog.luminance)
         glDeleteProgram(ctx->prog.luminance);
+    for (int k = 0; k < 3; k++)
+        if (ctx->prog.method[k])
+            glDeleteProgram(ctx->prog.method[k]);
     memset(&ctx->prog, 0, sizeof ctx->prog);
 }
 
@@ -188,6 +205,36 @@ static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
     glUniform1i(glGetUniformLocation(prog, "u_range_check"), f->range_check);
     glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
+}
+
+/* Selects the AO program of a comparison method (hemisphere, angle,
+ * hbao; built by build_method_program) and sets its uniforms: method.glsl's
+ * and the method's own. */
+static GLuint use_method_program(obs_ctx *ctx, const obs__frame *f, const obs__targets *t)
+{
+    GLuint prog = ctx->prog.method[f->method - OBS_METHOD_HEMISPHERE];
+    glUseProgram(prog);
+    set_common(prog, f);
+    bind_tex(prog, "u_pos", 0, t->tex_viewpos);
+    bind_tex(prog, "u_vnormal", 1, t->tex_vnormal);
+    glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
+    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
+    if (f->method == OBS_METHOD_HEMISPHERE) {
+        glUniform1i(glGetUniformLocation(prog, "u_hs_count"), f->hs_count);
+        glUniform1f(glGetUniformLocation(prog, "u_hs_bias"), f->hs_bias);
+        glUniform1fv(glGetUniformLocation(prog, "u_hs_kernel"), 3 * f->hs_count,
+                     &f->hs_kernel[0][0]);
+    } else if (f->method == OBS_METHOD_ANGLE) {
+        glUniform1i(glGetUniformLocation(prog, "u_angle_pairs"), f->angle_pairs);
+        glUniform2fv(glGetUniformLocation(prog, "u_angle_xy"), f->angle_pairs, &f->angle_xy[0][0]);
+        glUniform1i(glGetUniformLocation(prog, "u_angle_acos"), f->angle_acos);
+    } else {
+        glUniform1i(glGetUniformLocation(prog, "u_hbao_dirs"), f->hbao_dirs);
+        glUniform1i(glGetUniformLocation(prog, "u_hbao_steps"), f->hbao_steps);
+        glUniform2fv(glGetUniformLocation(prog, "u_hbao_dir"), f->hbao_dirs, &f->hbao_dir[0][0]);
+        glUniform2fv(glGetUniformLocation(prog, "u_hbao_bias_cs"), 1, f->hbao_bias_cs);
+    }
+    return prog;
 }
 
 static void draw(obs_ctx *ctx, GLuint fbo, int w, int h)
@@ -294,6 +341,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     if (s != OBS_OK)
         return s;
     s = build_programs(ctx, err);
+    if (s == OBS_OK)
+        s = build_method_program(ctx, f.method, err);
     if (s != OBS_OK)
         return s;
     s = ensure_targets(ctx, f.width, f.height, err);
@@ -341,21 +390,25 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
 
     /* AO pass */
     pass_begin(ctx, OBS_PASS_AO, &ran);
-    prog = ctx->prog.vao;
-    glUseProgram(prog);
-    set_common(prog, &f);
-    set_vao(prog, &f, t);
-    glUniform1i(glGetUniformLocation(prog, "u_count"), f.samples);
-    glUniform1i(glGetUniformLocation(prog, "u_adaptive"), f.adaptive);
-    glUniform1f(glGetUniformLocation(prog, "u_adaptive_k"), f.adaptive_k);
-    /* section 4.2: the pre-pass result, read at the pixel corners */
-    glUniform1i(glGetUniformLocation(prog, "u_culling"), f.culling);
-    bind_tex(prog, "u_cull", 2, t->tex_cull);
-    glUniform2fv(glGetUniformLocation(prog, "u_cull_scale"), 1, f.cull_scale);
-    glUniform1f(glGetUniformLocation(prog, "u_cull_threshold"), f.cull_threshold);
-    /* section 4.7: colour bleeding reads the colour at the samples */
-    glUniform1i(glGetUniformLocation(prog, "u_bleed_step"), f.bleed_step);
-    bind_tex(prog, "u_color", 3, t->tex_color);
+    if (f.method > OBS_METHOD_VAO) { /* a comparison method in place of VAO */
+        prog = use_method_program(ctx, &f, t);
+    } else {
+        prog = ctx->prog.vao;
+        glUseProgram(prog);
+        set_common(prog, &f);
+        set_vao(prog, &f, t);
+        glUniform1i(glGetUniformLocation(prog, "u_count"), f.samples);
+        glUniform1i(glGetUniformLocation(prog, "u_adaptive"), f.adaptive);
+        glUniform1f(glGetUniformLocation(prog, "u_adaptive_k"), f.adaptive_k);
+        /* section 4.2: the pre-pass result, read at the pixel corners */
+        glUniform1i(glGetUniformLocation(prog, "u_culling"), f.culling);
+        bind_tex(prog, "u_cull", 2, t->tex_cull);
+        glUniform2fv(glGetUniformLocation(prog, "u_cull_scale"), 1, f.cull_scale);
+        glUniform1f(glGetUniformLocation(prog, "u_cull_threshold"), f.cull_threshold);
+        /* section 4.7: colour bleeding reads the colour at the samples */
+        glUniform1i(glGetUniformLocation(prog, "u_bleed_step"), f.bleed_step);
+        bind_tex(prog, "u_color", 3, t->tex_color);
+    }
     /* the debug outputs go to their textures only when asked for */
     const GLenum vao_bufs[] = {
         GL_COLOR_ATTACHMENT0,

@@ -409,7 +409,10 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
             float *b = bleed + 3 * i;
             ao[i] = 1.0f;
             b[0] = b[1] = b[2] = 1.0f;
-            if (pos[4 * i + 3] > 0.0f) {
+            if (f.method > OBS_METHOD_VAO) {
+                /* a comparison method in place of the VAO estimator */
+                ao[i] = obs__method_pixel(&f, pos, nrm, x, y, &n);
+            } else if (pos[4 * i + 3] > 0.0f) {
                 /* Section 4.2: a culling candidate gets AO 1 (greedy) or
                  * at most the 4-sample set (careful). */
                 culled = f.culling && obs__cull_candidate(&f, est, x, y);

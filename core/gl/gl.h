@@ -155,6 +155,7 @@ obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 
 typedef struct obs__programs {
     GLuint prep, vao, cull, blur, composite, luminance;
+    GLuint method[3]; /* parameter method: hemisphere, angle, hbao (built on first use) */
 } obs__programs;
 
 typedef struct obs__targets {

@@ -1,0 +1,68 @@
+// Method hbao: horizon-based ambient occlusion (Bavoil, Sainz, Dimitrov,
+// SIGGRAPH 2008):
+//   AO = 1 - 1/(2 pi) Int (sin h(theta) - sin t(theta)) W(theta) dtheta,
+// per-sample attenuation W(r) = 1 - r^2 / R^2.  C twin: obs__hbao_pixel
+// (hbao_cpu.c), which documents the method.
+
+uniform int u_hbao_dirs;         // Nd
+uniform int u_hbao_steps;        // Ns
+uniform vec2 u_hbao_dir[32];     // unit directions over 2 pi (view xy)
+uniform vec2 u_hbao_bias_cs;     // cos, sin of the angle bias
+
+// R projected at p in pixels; 0 behind the camera.
+float radius_px(vec3 p)
+{
+    float w = PM(3, 0) * p.x + PM(3, 1) * p.y + PM(3, 2) * p.z + PM(3, 3);
+    if (!(w > 0.0))
+        return 0.0;
+    float X = PM(0, 0) * p.x + PM(0, 1) * p.y + PM(0, 2) * p.z + PM(0, 3);
+    float Y = PM(1, 0) * p.x + PM(1, 1) * p.y + PM(1, 2) * p.z + PM(1, 3);
+    float w2 = w * w;
+    float j00 = (PM(0, 0) * w - X * PM(3, 0)) / w2, j01 = (PM(0, 1) * w - X * PM(3, 1)) / w2;
+    float j10 = (PM(1, 0) * w - Y * PM(3, 0)) / w2, j11 = (PM(1, 1) * w - Y * PM(3, 1)) / w2;
+    return u_radius * sqrt(abs(j00 * j11 - j01 * j10) * u_viewport.z * u_viewport.w * 0.25);
+}
+
+float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
+{
+    float R = u_radius, R2 = R * R;
+    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
+    float rpx = radius_px(p.xyz);
+    count = 0;
+    if (!(rpx >= 1.0))
+        return 1.0;                       // the kernel reaches no other pixel
+    int ns = min(u_hbao_steps, int(rpx));
+    float stp = rpx / float(ns + 1);
+    float ao = 0.0;
+    for (int d = 0; d < u_hbao_dirs; d++) {
+        vec2 e = u_hbao_dir[d];
+        float dx = rot.x * e.x - rot.y * e.y, dy = rot.y * e.x + rot.x * e.y;
+        // t(theta) + angle bias, by its sine and cosine
+        float nd = n.x * dx + n.y * dy, nz = max(n.z, 0.0);
+        float l = sqrt(nd * nd + nz * nz);
+        float st = l > 0.0 ? -nd / l : 0.0, ct = l > 0.0 ? nz / l : 1.0;
+        float sin_h = st * u_hbao_bias_cs.x + ct * u_hbao_bias_cs.y;
+        if (ct * u_hbao_bias_cs.x - st * u_hbao_bias_cs.y < 0.0)
+            sin_h = 1.0;
+        for (int j = 1; j <= ns; j++) {
+            ivec2 q = px + ivec2(int(floor(dx * stp * float(j) + 0.5)),
+                                 int(floor(-dy * stp * float(j) + 0.5)));
+            if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
+                break;
+            count++;
+            vec4 xq = texelFetch(u_pos, q, 0);
+            if (!(xq.w > 0.0))
+                continue;
+            vec3 v = xq.xyz - p.xyz;
+            float r2 = v.x * v.x + v.y * v.y + v.z * v.z;
+            if (!(r2 < R2) || !(r2 > 0.0))
+                continue;
+            float sin_s = v.z / sqrt(r2);
+            if (sin_s > sin_h) {
+                ao += (1.0 - r2 / R2) * (sin_s - sin_h);   // W(r_i) (sin h_i - sin h_(i-1))
+                sin_h = sin_s;
+            }
+        }
+    }
+    return max(0.0, 1.0 - ao / float(u_hbao_dirs));
+}

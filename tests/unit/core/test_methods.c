@@ -1,0 +1,545 @@
+/* The comparison methods (parameter method: hemisphere, angle, hbao; vao
+ * is VAO++ with its extensions off): each estimator's CPU twin on
+ * analytic scenes (open plane -> 1, corner -> the value derived below),
+ * the angle-based method's arc cosine approximations against the errors
+ * the article states, the GL passes against the CPU twin on the real
+ * G-buffers, and the parameter rules of the methods. */
+#include <math.h>
+
+#include "gl_testutil.h"
+
+#include "frame.h"
+
+/* Odd sizes: with an orthographic camera of pixel size PX the centre of
+ * pixel (CX, CY) is the view axis, x = y = 0. */
+#define W 97
+#define H 73
+#define PX 0.02f
+#define CX 48
+#define CY 36
+
+typedef struct scene {
+    float depth[W * H];
+    float normal[W * H * 3];
+    obs_gbuffer gb;
+} scene;
+
+static void ortho(float P[16])
+{
+    const float n = 0.1f, f = 100.0f;
+    memset(P, 0, 16 * sizeof(float));
+    P[0] = 1.0f / (0.5f * W * PX);
+    P[5] = 1.0f / (0.5f * H * PX);
+    P[10] = -2.0f / (f - n);
+    P[11] = -(f + n) / (f - n);
+    P[15] = 1.0f;
+}
+
+static void perspective(float P[16], float fov_y_deg)
+{
+    const float n = 0.1f, f = 100.0f, t = 1.0f / tanf(fov_y_deg * (float)M_PI / 360.0f);
+    memset(P, 0, 16 * sizeof(float));
+    P[0] = t * H / W;
+    P[5] = t;
+    P[10] = -(f + n) / (f - n);
+    P[11] = -2.0f * f * n / (f - n);
+    P[14] = -1.0f;
+}
+
+typedef struct plane {
+    float n[3], c; /* n . p = c */
+} plane;
+
+/* Each pixel sees the nearest plane (the first one on a tie). */
+static void render(scene *s, const float P[16], const plane *pl, int count)
+{
+    memset(s, 0, sizeof *s);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            float nx = (x + 0.5f) / W * 2 - 1, ny = 1 - (y + 0.5f) / H * 2;
+            float o[3] = {0, 0, 0}, d[3] = {0, 0, -1}, best = 1e10f;
+            if (P[14] == 0.0f) {
+                o[0] = nx / P[0];
+                o[1] = ny / P[5];
+            } else {
+                d[0] = nx / P[0];
+                d[1] = ny / P[5];
+            }
+            const float *bn = NULL;
+            for (int k = 0; k < count; k++) {
+                float den = pl[k].n[0] * d[0] + pl[k].n[1] * d[1] + pl[k].n[2] * d[2];
+                if (fabsf(den) < 1e-9f)
+                    continue;
+                float t = (pl[k].c - (pl[k].n[0] * o[0] + pl[k].n[1] * o[1] + pl[k].n[2] * o[2])) /
+                          den;
+                if (t > 0 && t < best) {
+                    best = t;
+                    bn = pl[k].n;
+                }
+            }
+            s->depth[y * W + x] = best; /* d.z = -1: t is the planar depth */
+            if (bn)
+                memcpy(&s->normal[3 * (y * W + x)], bn, 3 * sizeof(float));
+        }
+    s->gb.width = W;
+    s->gb.height = H;
+    s->gb.depth = (obs_plane){s->depth, 1, 0};
+    s->gb.normal = (obs_plane){s->normal, 3, 0};
+    memcpy(s->gb.camera.projection, P, 16 * sizeof(float));
+    obs__mat4_identity(s->gb.camera.world_to_camera);
+    s->gb.camera.has_projection = 1;
+    s->gb.camera.has_world_to_camera = 1;
+}
+
+/* Parameters of one method on camera-space normals, without the blur
+ * (the estimator itself). */
+static obs_params method_params(const char *method)
+{
+    obs_params p = {0};
+    char err[OBS_ERR_LEN];
+    assert_int_equal(obs_param_set(&p, "method", method, err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "normal_space", "camera", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "blur", "off", err), OBS_OK);
+    return p;
+}
+
+/* The frame and the prep pass's planes of a scene. */
+static void setup(const scene *s, const obs_params *p, obs__frame *f, float **pos, float **nrm)
+{
+    obs_params rp;
+    char err[OBS_ERR_LEN] = "";
+    obs_params_resolve(p, &rp);
+    if (obs__frame_setup(NULL, &s->gb, &rp, f, err) != OBS_OK)
+        fail_msg("frame setup: %s", err);
+    *pos = malloc(sizeof(float) * 4 * W * H);
+    *nrm = malloc(sizeof(float) * 3 * W * H);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            obs__prep_position(f, s->depth[y * W + x], x, y, *pos + 4 * (y * W + x));
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            obs__prep_normal(f, *pos, s->normal + 3 * (y * W + x), x, y, *nrm + 3 * (y * W + x));
+}
+
+static const char *const methods[] = {"hemisphere", "angle", "hbao"};
+
+/* ---- open plane -> 1 ------------------------------------------------------ */
+
+/* An open plane occludes nothing.  hemisphere: every kernel point lies
+ * above the plane, so the surface at its pixel is behind it (up to half a
+ * pixel of slope, far inside the bias).  angle: both points of a pair lie
+ * in the plane, perpendicular to n: theta_l + theta_r = pi, AO 1.  hbao:
+ * every sample lies in the tangent plane, below t(theta) + bias.  Checked
+ * on a plane tilted 31 degrees (orthographic) and one facing a perspective
+ * camera, through the whole CPU chain. */
+static void test_open_plane(void **state)
+{
+    (void)state;
+    scene *s = malloc(sizeof *s);
+    float P[16];
+    for (int cam = 0; cam < 2; cam++) {
+        plane pl;
+        if (cam == 0) {
+            float l = sqrtf(1 + 0.36f);
+            pl = (plane){{0, 0.6f / l, 1 / l}, -5.0f / l};
+            ortho(P);
+        } else {
+            pl = (plane){{0, 0, 1}, -5.0f};
+            perspective(P, 60.0f);
+        }
+        render(s, P, &pl, 1);
+        for (size_t m = 0; m < sizeof methods / sizeof methods[0]; m++) {
+            obs_params p = method_params(methods[m]);
+            p.radius = 0.4f;
+            obs_result r;
+            char err[OBS_ERR_LEN] = "";
+            assert_int_equal(obs_run_cpu(&s->gb, &p, OBS_OUTPUT_AO, &r, err), OBS_OK);
+            float mn = 1;
+            for (int i = 0; i < W * H; i++) {
+                assert_true(r.ao.data[i] <= 1.0f + 1e-6f);
+                mn = fminf(mn, r.ao.data[i]);
+            }
+            print_message("open plane (%s), %-10s: min AO %.6f\n", cam ? "perspective" : "ortho",
+                          methods[m], mn);
+            assert_true(mn > 1.0f - 1e-5f);
+            obs_result_free(&r);
+        }
+    }
+    free(s);
+}
+
+/* ---- hemisphere: floor meets wall ----------------------------------------- */
+
+/* The inner corner of test_vao_math.c: P on the floor (normal +Y) where it
+ * meets a wall facing the orthographic camera.  The tangent frame of +Y
+ * (Duff et al.) is t1 = +X, t2 = -Z, so kernel point k (rotated by the
+ * tile's (c, s): k'y = s kx + c ky) lies at view depth z_P + R k'y; the
+ * wall, at P's depth, is in front of it by R k'y, and the range check
+ * gives 1 (|z_P - z_wall| = 0).  So
+ *   AO = 1 - #{i : R k'y_i >= bias} / n,
+ * the samples behind the wall's plane; over a kernel symmetric about the
+ * wall plane that is 1/2 (the floor-wall corner's cosine-weighted value). */
+static void test_hemisphere_corner(void **state)
+{
+    (void)state;
+    scene *s = malloc(sizeof *s);
+    float P[16];
+    ortho(P);
+    plane wall = {{0, 0, 1}, -5.0f};
+    render(s, P, &wall, 1);
+    const int counts[] = {3, 6, 10, 16, 64};
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++) {
+        obs_params p = method_params("hemisphere");
+        p.hemisphere_samples = counts[c];
+        obs__frame f;
+        float *pos, *nrm;
+        setup(s, &p, &f, &pos, &nrm);
+        const float floor_n[3] = {0, 1, 0}, pt[3] = {0.0f, -0.3f, -5.0f};
+        double mean = 0;
+        for (int k = 0; k < 9; k++) { /* every rotation of the 3x3 tile */
+            int x = CX + k / 3, y = CY + k % 3;
+            const float *rot = f.rot[3 * (x % 3) + (y % 3)];
+            int behind = 0;
+            for (int i = 0; i < f.hs_count; i++) {
+                float ky = rot[1] * f.hs_kernel[i][0] + rot[0] * f.hs_kernel[i][1];
+                behind += f.radius * ky >= f.hs_bias;
+            }
+            float ao = obs__hemisphere_pixel(&f, pos, x, y, pt, floor_n);
+            assert_float_equal(ao, 1.0f - (float)behind / (float)f.hs_count, 1e-6f);
+            mean += ao / 9;
+        }
+        print_message("hemisphere corner, %2d samples: mean AO over the tile %.4f\n", counts[c],
+                      mean);
+        assert_true(mean > 0.3 && mean < 0.7);
+        free(pos);
+        free(nrm);
+    }
+    free(s);
+}
+
+/* ---- angle and hbao: a 90-degree valley ------------------------------------ */
+
+/* Two planes meeting at 90 degrees along the view y axis, rising towards
+ * the orthographic camera on both sides: z = -5 + |x|; plane B (x > 0)
+ * has the normal nB = (-1, 0, 1)/sqrt 2, plane A (x < 0) nA = (1, 0, 1)/sqrt 2.
+ * P is the crease point on the view axis, pixel (CX, CY), with nB (B is
+ * listed first and wins the tie).  The true AO there is 1/2, as at the
+ * floor-wall corner. */
+static void valley(scene *s)
+{
+    float P[16];
+    const float r2 = sqrtf(0.5f);
+    ortho(P);
+    plane pl[2] = {{{-r2, 0, r2}, -5.0f * r2}, {{r2, 0, r2}, -5.0f * r2}};
+    render(s, P, pl, 2);
+}
+
+/* angle.  A pair point at offset v = x - P from P: on plane B, v is in
+ * P's tangent plane, theta = pi/2; on plane A, v = (vx, vy, -vx) and
+ *   cos theta = nB . v / |v| = sqrt 2 |vx| / sqrt(2 vx^2 + vy^2).
+ * A pair (o, -o) puts one point on each side (or both on the crease
+ * column, theta = pi/2 twice), so its AO is
+ *   min((pi/2 + theta_A) / pi, 1) = 1/2 + theta_A / pi,
+ * 1/2 for a pair across the crease, 1 for one along it.  No point is far:
+ * |depth difference| = |vx| <= R.  The points are the pixel centres the
+ * samples P +- o fall in.  Over all pair directions this averages
+ * 1/2 + (1/pi^2) Int acos(sqrt 2 |cos a| / sqrt(1 + cos^2 a)) da. */
+static void test_angle_valley(void **state)
+{
+    (void)state;
+    scene *s = malloc(sizeof *s);
+    valley(s);
+    const char *const modes[] = {"quadratic", "linear", "exact"};
+    const float nB[3] = {-sqrtf(0.5f), 0, sqrtf(0.5f)};
+    for (int md = 0; md < 3; md++)
+        for (int pairs = 2; pairs <= 16; pairs *= 2) {
+            obs_params p = method_params("angle");
+            char err[OBS_ERR_LEN];
+            assert_int_equal(obs_param_set(&p, "angle_acos", modes[md], err), OBS_OK);
+            p.angle_pairs = pairs;
+            p.radius = 0.4f; /* 20 pixels */
+            obs__frame f;
+            float *pos, *nrm;
+            setup(s, &p, &f, &pos, &nrm);
+            const float *pt = pos + 4 * (CY * W + CX);
+            assert_float_equal(pt[0], 0.0f, 1e-6f);
+            double expect = 0;
+            for (int i = 0; i < f.angle_pairs; i++) {
+                /* tile rotation of (CX, CY) is 0: offset R * pattern */
+                float ox = f.radius * f.angle_xy[i][0], oy = f.radius * f.angle_xy[i][1];
+                double th = M_PI / 2;
+                for (int sg = -1; sg <= 1; sg += 2) {
+                    int qx = (int)floorf((sg * ox) / PX + 0.5f * W);
+                    int qy = (int)floorf(0.5f * H - (sg * oy) / PX);
+                    float vx = (qx + 0.5f - 0.5f * W) * PX, vy = (0.5f * H - qy - 0.5f) * PX;
+                    if (vx < 0)
+                        th = obs__acos_mode(f.angle_acos,
+                                            sqrtf(2.0f) * fabsf(vx) / sqrtf(2 * vx * vx + vy * vy));
+                }
+                expect += fmin(0.5 + th / M_PI, 1.0) / f.angle_pairs;
+            }
+            float ao = obs__angle_pixel(&f, pos, CX, CY, pt, nB);
+            if (pairs == 16)
+                print_message("angle valley (%s acos), %2d pairs: AO %.4f, derived %.4f\n",
+                              modes[md], pairs, ao, expect);
+            /* exact acos is steep near 1: the float rounding of cos shows */
+            assert_float_equal(ao, (float)expect, md == 2 ? 1e-4f : 1e-5f);
+            free(pos);
+            free(nrm);
+        }
+    free(s);
+}
+
+/* hbao.  Directions 0, 45, ..., 315 degrees (tile rotation 0 at P's
+ * pixel), steps of R_px / (Ns + 1) pixels rounded to the nearest pixel,
+ * so the 180-degree ray visits (-k, 0), the 135- and 225-degree rays
+ * (-k', -+k') with k = round(step), k' = round(step / sqrt 2).
+ * Towards B (0, 45, 315 degrees) and along the crease (90, 270) every
+ * sample lies in P's tangent plane: elevation = t(theta) < t + bias, no
+ * AO.  Towards A every sample has the same elevation h (a plane through
+ * P): 180: v = k PX (-1, 0, 1), sin h = 1/sqrt 2, r1^2 = 2 k^2 PX^2;
+ * 135/225: v = k' PX (-1, +-1, 1), sin h = 1/sqrt 3, r1^2 = 3 k'^2 PX^2,
+ * and only the first sample raises the horizon above t + bias:
+ *   AO = 1 - 1/8 sum_{180, 135, 225} W(r1) (sin h - sin(t + bias)),
+ * W(r) = 1 - r^2/R^2, t = atan(-(nB . D) / nB.z): -45 degrees at 180,
+ * -35.26 at 135 and 225.  (Without bias and attenuation, with directions
+ * dense, the integral gives exactly 1/2.) */
+static void test_hbao_valley(void **state)
+{
+    (void)state;
+    scene *s = malloc(sizeof *s);
+    valley(s);
+    const float nB[3] = {-sqrtf(0.5f), 0, sqrtf(0.5f)};
+    const char *const biases[] = {"30", "0.001", "10"};
+    for (int b = 0; b < 3; b++) {
+        obs_params p = method_params("hbao");
+        char err[OBS_ERR_LEN];
+        assert_int_equal(obs_param_set(&p, "hbao_angle_bias", biases[b], err), OBS_OK);
+        p.radius = 0.5f; /* R_px = 25 */
+        obs__frame f;
+        float *pos, *nrm;
+        setup(s, &p, &f, &pos, &nrm);
+        const float *pt = pos + 4 * (CY * W + CX);
+        const double R = f.radius, bias = atof(biases[b]) * M_PI / 180;
+        const double step = (R / PX) / (f.hbao_steps + 1);
+        const double k = floor(step + 0.5), k2 = floor(step * sqrt(0.5) + 0.5);
+        const double W180 = 1 - 2 * k * k * PX * PX / (R * R);
+        const double W135 = 1 - 3 * k2 * k2 * PX * PX / (R * R);
+        const double t180 = -M_PI / 4, t135 = -atan(sqrt(0.5));
+        double sum = W180 * (sqrt(0.5) - sin(t180 + bias)) +
+                     2 * W135 * (sqrt(1.0 / 3) - sin(t135 + bias));
+        double expect = 1 - sum / 8;
+        int count;
+        float ao = obs__hbao_pixel(&f, pos, CX, CY, pt, nB, &count);
+        print_message("hbao valley, bias %s degrees: AO %.5f, derived %.5f (%d samples)\n",
+                      biases[b], ao, expect, count);
+        assert_float_equal(ao, (float)expect, 1e-5f);
+        assert_int_equal(count, 8 * 6);
+        free(pos);
+        free(nrm);
+    }
+    free(s);
+}
+
+/* ---- the article's arc cosine approximations ------------------------------- */
+
+/* "the maximum error between the two functions is around 18.946 degrees"
+ * (linear) and "around 9.473 degrees" (quadratic). */
+static void test_acos_errors(void **state)
+{
+    (void)state;
+    double worst[4] = {0, 0, 0, 0};
+    for (int i = 0; i <= 200000; i++) {
+        float x = (float)(i / 100000.0 - 1.0);
+        for (int m = OBS_ACOS_QUADRATIC; m <= OBS_ACOS_EXACT; m++)
+            worst[m] = fmax(worst[m], fabs(obs__acos_mode(m, x) - acos((double)x)) * 180 / M_PI);
+    }
+    print_message("acos: max error linear %.3f, quadratic %.3f, exact %.5f degrees\n",
+                  worst[OBS_ACOS_LINEAR], worst[OBS_ACOS_QUADRATIC], worst[OBS_ACOS_EXACT]);
+    assert_float_equal(worst[OBS_ACOS_LINEAR], 18.946, 0.01);
+    assert_float_equal(worst[OBS_ACOS_QUADRATIC], 9.473, 0.01);
+    assert_true(worst[OBS_ACOS_EXACT] < 1e-3);
+    /* out of range inputs are clamped, not NaN */
+    assert_float_equal(obs__acos_mode(OBS_ACOS_EXACT, 1.5f), 0.0f, 0.0f);
+    assert_float_equal(obs__acos_mode(OBS_ACOS_QUADRATIC, -2.0f), (float)M_PI, 1e-6f);
+}
+
+/* ---- parameters ------------------------------------------------------------ */
+
+static void expect_refused(const char *method, const char *name, const char *value)
+{
+    obs_params p = {0}, r;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_param_set(&p, "method", method, err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, name, value, err), OBS_OK);
+    obs_params_resolve(&p, &r);
+    assert_int_equal(obs_params_check(&r, err), OBS_INVALID_ARGUMENT);
+    print_message("method %s, %s %s: %s\n", method, name, value, err);
+    assert_non_null(strstr(err, name));
+    assert_non_null(strstr(err, method));
+}
+
+static void expect_accepted(const char *method, const char *name, const char *value)
+{
+    obs_params p = {0}, r;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_param_set(&p, "method", method, err), OBS_OK);
+    if (name)
+        assert_int_equal(obs_param_set(&p, name, value, err), OBS_OK);
+    obs_params_resolve(&p, &r);
+    if (obs_params_check(&r, err) != OBS_OK)
+        fail_msg("method %s, %s %s: %s", method, name ? name : "", value ? value : "", err);
+}
+
+static void test_method_params(void **state)
+{
+    (void)state;
+    obs_params p = {0}, r;
+    char err[OBS_ERR_LEN] = "";
+    /* the default is VAO++ with its extensions */
+    obs_params_resolve(&p, &r);
+    assert_int_equal(r.method, OBS_METHOD_VAOPP);
+    assert_int_equal(r.adaptive, OBS_ON);
+    assert_int_equal(r.culling, OBS_CULLING_CAREFUL);
+    assert_int_equal(r.range_check, OBS_ON);
+    /* method vao fixes them off; the others also bleeding */
+    assert_int_equal(obs_param_set(&p, "method", "vao", err), OBS_OK);
+    obs_params_resolve(&p, &r);
+    assert_int_equal(r.adaptive, OBS_OFF);
+    assert_int_equal(r.culling, OBS_CULLING_OFF);
+    assert_int_equal(r.range_check, OBS_OFF);
+    assert_int_equal(obs_params_check(&r, err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "method", "hbao", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "bleeding", "off", err), OBS_OK);
+    obs_params_resolve(&p, &r);
+    assert_int_equal(r.bleeding, OBS_BLEEDING_OFF);
+    assert_int_equal(r.hbao_directions, 8);
+    assert_int_equal(r.hbao_steps, 6);
+    assert_int_equal(r.hemisphere_samples, 10);
+    assert_int_equal(r.angle_pairs, 6);
+    assert_int_equal(r.angle_acos, OBS_ACOS_QUADRATIC);
+    /* a resolved struct resolves again to itself, without conflicts */
+    obs_params r2;
+    obs_params_resolve(&r, &r2);
+    assert_memory_equal(&r, &r2, sizeof r);
+    assert_int_equal(obs_params_check(&r2, err), OBS_OK);
+
+    /* a value that contradicts the method, or a parameter it does not use,
+     * is refused by name */
+    expect_refused("vao", "adaptive", "on");
+    expect_refused("vao", "culling", "greedy");
+    expect_refused("vao", "range_check", "on");
+    expect_refused("vao", "range_u", "0.1");
+    expect_refused("hemisphere", "samples", "16");
+    expect_refused("angle", "bleeding", "full");
+    expect_refused("hbao", "adaptive_diameter", "0.02");
+    expect_refused("vaopp", "hbao_steps", "4");
+    expect_refused("hbao", "hemisphere_samples", "6");
+    expect_refused("hemisphere", "angle_acos", "exact");
+    /* agreeing values and the shared chain are fine */
+    expect_accepted("vao", "adaptive", "off");
+    expect_accepted("vao", "samples", "32");
+    expect_accepted("vao", "bleeding", "full");
+    expect_accepted("hbao", "culling", "off");
+    expect_accepted("hbao", "luminance", "lum");
+    expect_accepted("angle", "blur_radius", "4");
+    expect_accepted("hemisphere", "hemisphere_samples", "3");
+    expect_accepted("angle", "angle_pairs", "16");
+    expect_accepted("hbao", "hbao_directions", "32");
+    /* ranges of the method parameters */
+    assert_int_equal(obs_param_set(&p, "hbao_steps", "0", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "hbao_steps"));
+    assert_int_equal(obs_param_set(&p, "angle_pairs", "17", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_param_set(&p, "hemisphere_samples", "65", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_param_set(&p, "method", "ssao", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "vaopp|vao|hemisphere|angle|hbao"));
+    /* and the run itself refuses, naming it */
+    scene *s = malloc(sizeof *s);
+    valley(s);
+    obs_params q = {0};
+    obs_result res;
+    assert_int_equal(obs_param_set(&q, "method", "angle", err), OBS_OK);
+    assert_int_equal(obs_param_set(&q, "samples", "8", err), OBS_OK);
+    assert_int_equal(obs_run_cpu(&s->gb, &q, OBS_OUTPUT_AO, &res, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "samples"));
+    free(s);
+}
+
+/* ---- GL against the CPU twin on real input --------------------------------- */
+
+/* As in test_gl_twin.c: a sample within rounding of a pixel border may
+ * read the neighbour on one side only, so the mean difference is tiny and
+ * few pixels differ (mean < 1e-3, under 2 % of pixels > 1e-3); the sample
+ * counts (hbao: the samples inside the image) match. */
+static void test_gl_matches_cpu(void **state)
+{
+    (void)state;
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_EGL_SURFACELESS);
+    static const char *const variants[][3][2] = {
+        {{"method", "vao"}, {NULL, NULL}, {NULL, NULL}},
+        {{"method", "hemisphere"}, {NULL, NULL}, {NULL, NULL}},
+        {{"method", "hemisphere"}, {"hemisphere_samples", "3"}, {"blur", "off"}},
+        {{"method", "hemisphere"}, {"hemisphere_samples", "16"}, {"luminance", "lum"}},
+        {{"method", "angle"}, {NULL, NULL}, {NULL, NULL}},
+        {{"method", "angle"}, {"angle_acos", "exact"}, {"blur", "off"}},
+        {{"method", "angle"}, {"angle_acos", "linear"}, {"angle_pairs", "16"}},
+        {{"method", "hbao"}, {NULL, NULL}, {NULL, NULL}},
+        {{"method", "hbao"}, {"hbao_directions", "4"}, {"blur", "off"}},
+        {{"method", "hbao"}, {"hbao_steps", "16"}, {"hbao_angle_bias", "10"}},
+    };
+    for (size_t sc = 0; sc < sizeof scenes / sizeof scenes[0]; sc++) {
+        obs_gbuffer_file gf = {0};
+        load(scenes[sc], &gf);
+        for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
+            obs_params p = {0};
+            obs_result gl, cpu;
+            char err[OBS_ERR_LEN] = "";
+            for (int k = 0; k < 3; k++)
+                if (variants[v][k][0])
+                    assert_int_equal(obs_param_set(&p, variants[v][k][0], variants[v][k][1], err),
+                                     OBS_OK);
+            unsigned out = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT |
+                           OBS_OUTPUT_CULL_MASK | OBS_OUTPUT_BLEED;
+            if (obs_run(ctx, &gf.gb, &p, out, &gl, err) != OBS_OK)
+                fail_msg("GL: %s", err);
+            assert_int_equal(obs_run_cpu(&gf.gb, &p, out, &cpu, err), OBS_OK);
+            double mean, frac, cmean, cfrac, nmean, nfrac, mmean, mfrac;
+            diff(&gl.ao, &cpu.ao, &mean, &frac);
+            diff(&gl.composite, &cpu.composite, &cmean, &cfrac);
+            diff(&gl.sample_count, &cpu.sample_count, &nmean, &nfrac);
+            diff(&gl.cull_mask, &cpu.cull_mask, &mmean, &mfrac);
+            double ao_mean = 0;
+            for (int i = 0; i < gl.ao.width * gl.ao.height; i++)
+                ao_mean += gl.ao.data[i] / (gl.ao.width * gl.ao.height);
+            print_message("%s (%s %s %s): GL vs CPU AO mean |diff| %.2e, %.3f %% > 1e-3; mean AO "
+                          "%.4f; counts differ at %.3f %%\n",
+                          scenes[sc], variants[v][0][1], variants[v][1][0] ? variants[v][1][0] : "",
+                          variants[v][1][1] ? variants[v][1][1] : "", mean, 100 * frac, ao_mean,
+                          100 * nfrac);
+            assert_true(mean < 1e-3);
+            assert_true(frac < 0.02);
+            assert_true(cmean < 1e-3);
+            assert_true(nfrac < 1e-3);
+            assert_true(mmean == 0.0);
+            assert_true(ao_mean > 0.3 && ao_mean <= 1.0);
+            obs_result_free(&gl);
+            obs_result_free(&cpu);
+        }
+        obs_gbuffer_free(&gf);
+    }
+    obs_ctx_destroy(ctx);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_open_plane),
+        cmocka_unit_test(test_hemisphere_corner),
+        cmocka_unit_test(test_angle_valley),
+        cmocka_unit_test(test_hbao_valley),
+        cmocka_unit_test(test_acos_errors),
+        cmocka_unit_test(test_method_params),
+        cmocka_unit_test(test_gl_matches_cpu),
+    };
+    return cmocka_run_group_tests_name("methods", tests, NULL, NULL);
+}
