@@ -5,6 +5,7 @@
  *   extensions_bench [--backend B] [--frames N] [--frames-4k N]
  *                    [--sizes WxH,...] [--set NAME=VALUE]... G-BUFFER.exr
  *                    [CAMERA.json]
+ *   extensions_bench --methods [same options]   (Table 2 instead)
  *
  * The G-buffer is scaled (nearest neighbour, same camera) to each size
  * unless it already has that size.  Per cell: the median over N frames of
@@ -18,6 +19,11 @@
  * --set gives every variant a parameter of the table (adaptive_diameter,
  * say: adaptive sampling picks counts by the disk's size on screen, so
  * whether it saves anything depends on the scene and on that value).
+ * --methods prints the structure of Table 2 instead: VAO++ at 2, 4, 8,
+ * 16 samples against the other methods of --method at matching levels
+ * (hemisphere 3, 6, 10, 16 samples as Table 2's Unity SSAO; angle and
+ * hbao at the same number of depth samples: n/2 pairs, directions x steps
+ * = n), the same effect time, ratios VAO++ / method.
  * Output: Markdown. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -161,6 +167,84 @@ static void measure(obs_ctx *ctx, const obs_gbuffer *gb, int frames, cell out[CO
     }
 }
 
+/* ---- Table 2: the methods at four quality levels ------------------------ */
+
+enum { LEVELS = 4, METHODS = 4 };
+/* per level: vaopp samples, hemisphere samples, angle pairs, hbao dirs, hbao steps */
+static const int level[LEVELS][5] = {
+    {2, 3, 1, 2, 1}, {4, 6, 2, 4, 1}, {8, 10, 4, 4, 2}, {16, 16, 8, 4, 4}};
+
+static obs_params method_params(int m, int l)
+{
+    obs_params p = {0};
+    char a[16], b[16];
+    for (int i = 0; i < nsets; i++)
+        set(&p, set_name[i], set_value[i]);
+    if (m == 0) {
+        snprintf(a, sizeof a, "%d", level[l][0]);
+        set(&p, "samples", a);
+    } else if (m == 1) {
+        set(&p, "method", "hemisphere");
+        snprintf(a, sizeof a, "%d", level[l][1]);
+        set(&p, "hemisphere_samples", a);
+    } else if (m == 2) {
+        set(&p, "method", "angle");
+        snprintf(a, sizeof a, "%d", level[l][2]);
+        set(&p, "angle_pairs", a);
+    } else {
+        set(&p, "method", "hbao");
+        snprintf(a, sizeof a, "%d", level[l][3]);
+        snprintf(b, sizeof b, "%d", level[l][4]);
+        set(&p, "hbao_directions", a);
+        set(&p, "hbao_steps", b);
+    }
+    return p;
+}
+
+static double effect_of(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *p)
+{
+    char err[OBS_ERR_LEN];
+    obs_result r;
+    obs_pass_times t;
+    if (obs_run(ctx, gb, p, OBS_OUTPUT_AO, &r, err) != OBS_OK)
+        die("obs_run", err);
+    obs_result_free(&r);
+    if (!obs_ctx_last_times(ctx, &t))
+        die("timer queries", "no times after a timed frame");
+    return t.ms[OBS_PASS_AO] + (t.ms[OBS_PASS_CULL] > 0 ? t.ms[OBS_PASS_CULL] : 0);
+}
+
+static void methods_table(obs_ctx *ctx, const obs_gbuffer *gb, int frames)
+{
+    printf("%dx%d, median of %d frames, effect GL ms (culling pre-pass + AO pass); in "
+           "brackets VAO++ / method.\n\n| level | VAO++ | hemisphere | angle | hbao |\n"
+           "|---|---|---|---|---|\n",
+           gb->width, gb->height, frames);
+    for (int l = 0; l < LEVELS; l++) {
+        double t[METHODS][MAX_FRAMES], med[METHODS];
+        obs_params p[METHODS];
+        for (int m = 0; m < METHODS; m++) {
+            p[m] = method_params(m, l);
+            effect_of(ctx, gb, &p[m]); /* warm-up: programs, caches */
+        }
+        for (int i = 0; i < frames; i++)
+            for (int m = 0; m < METHODS; m++)
+                t[m][i] = effect_of(ctx, gb, &p[m]);
+        for (int m = 0; m < METHODS; m++)
+            med[m] = median(t[m], frames);
+        printf("| %d |", l + 1);
+        printf(" %d samples: %.1f |", level[l][0], med[0]);
+        printf(" %d samples: %.1f (%.0f %%) |", level[l][1], med[1], 100.0 * med[0] / med[1]);
+        printf(" %d pairs: %.1f (%.0f %%) |", level[l][2], med[2], 100.0 * med[0] / med[2]);
+        printf(" %dx%d: %.1f (%.0f %%) |\n", level[l][3], level[l][4], med[3],
+               100.0 * med[0] / med[3]);
+        fflush(stdout);
+        fprintf(stderr, "extensions_bench: %dx%d, methods level %d done\n", gb->width,
+                gb->height, l + 1);
+    }
+    printf("\n");
+}
+
 static void print_table(int w, int h, int frames, cell t[COUNTS][VARIANTS])
 {
     printf("%dx%d, median of %d frames. Effect = GL time of the culling pre-pass + AO pass "
@@ -229,9 +313,11 @@ int main(int argc, char **argv)
     obs_ctx_desc desc = {0};
     int frames = 5, frames_big = 3;
     int sizes[MAX_SIZES][2] = {{1920, 1080}, {3840, 2160}}, nsizes = 2;
-    int i = 1;
+    int i = 1, methods = 0;
     for (; i < argc && argv[i][0] == '-'; i++) {
-        if (!strcmp(argv[i], "--backend") && i + 1 < argc) {
+        if (!strcmp(argv[i], "--methods")) {
+            methods = 1;
+        } else if (!strcmp(argv[i], "--backend") && i + 1 < argc) {
             if (obs_backend_parse(argv[++i], &desc.backend) != OBS_OK)
                 die("--backend", "unknown backend");
         } else if (!strcmp(argv[i], "--frames") && i + 1 < argc) {
@@ -262,8 +348,9 @@ int main(int argc, char **argv)
     }
     if (argc - i < 1 || argc - i > 2 || frames < 1 || frames >= MAX_FRAMES || frames_big < 1 ||
         frames_big >= MAX_FRAMES) {
-        fprintf(stderr, "usage: extensions_bench [--backend B] [--frames N] [--frames-4k N] "
-                        "[--sizes WxH,...] GBUFFER.exr [CAMERA.json]\n");
+        fprintf(stderr, "usage: extensions_bench [--methods] [--backend B] [--frames N] "
+                        "[--frames-4k N] [--sizes WxH,...] [--set NAME=VALUE]... GBUFFER.exr "
+                        "[CAMERA.json]\n");
         return 2;
     }
     char err[OBS_ERR_LEN];
@@ -300,10 +387,14 @@ int main(int argc, char **argv)
         big.normal = (obs_plane){n, gf.gb.normal.channels, 0};
         big.color = (obs_plane){c, gf.gb.color.channels, 0};
         int nf = (long long)w * h > 4000000 ? frames_big : frames;
-        cell t[COUNTS][VARIANTS];
-        measure(ctx, &big, nf, t);
-        print_table(w, h, nf, t);
-        print_passes(ctx, &big, nf);
+        if (methods) {
+            methods_table(ctx, &big, nf);
+        } else {
+            cell t[COUNTS][VARIANTS];
+            measure(ctx, &big, nf, t);
+            print_table(w, h, nf, t);
+            print_passes(ctx, &big, nf);
+        }
         free(d);
         free(n);
         free(c);

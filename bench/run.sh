@@ -20,5 +20,8 @@ echo
 # queries (bench/extensions_bench.c); the first G-buffer, scaled
 "$BUILD/extensions_bench" "$1" "$2"
 echo
+# VAO++ Table 2: the other methods of --method at matching levels, 1080p
+"$BUILD/extensions_bench" --methods --sizes 1920x1080 "$1" "$2"
+echo
 # the daemon: round trip vs in-process, concurrent clients (1920x1080)
 BUILD="$BUILD" bench/daemon_bench.sh "$1" "$2"
