@@ -230,7 +230,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         float sx = xy[2 * i], sy = xy[2 * i + 1];
         float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
         float h = r * l; /* half length of the pipe through the sphere */
-        F += R * l;      /* eq 2: F = R * sum sqrt(1 - x^2 - y^2) */
+        int seen = 0;    /* the sample's pixel is on the planes */
 
         /* Sample on the disk through the centre, perpendicular to view Z. */
         float s[3] = {c[0] + r * (rot[0] * sx - rot[1] * sy), c[1] + r * (rot[1] * sx + rot[0] * sy),
@@ -245,6 +245,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
             float fu = floorf(u), fv = floorf(v);
             if (fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height) {
                 size_t k = (size_t)fv * (size_t)f->width + (size_t)fu;
+                seen = 1;
                 float d = pos[4 * k + 3];
                 if (d > 0.0f) {
                     zs = d;
@@ -277,7 +278,15 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
             float sd = f->range_u / fmaxf(f->range_u, d / R);
             dz = 2.0f * h * (1.0f - sd);
         }
-        open += dz;
+        /* A sample off the planes (or behind the camera) says nothing
+         * about the scene: it is left out of eq 1's sum and of F alike, so
+         * V is estimated from the part of the disk that is seen, instead
+         * of counting the unseen part as open (which lightened contact
+         * shadows near the image border). */
+        if (seen) {
+            open += dz;
+            F += R * l; /* eq 2: F = R * sum sqrt(1 - x^2 - y^2) */
+        }
     }
     for (int j = 0; j < 3; j++)
         bleed[j] = taken > 0.0f ? acc[j] / taken : 1.0f;

@@ -57,7 +57,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
         float sx = u_samples[off + i].x, sy = u_samples[off + i].y;
         float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
         float h = r * l;        // half length of the pipe through the sphere
-        F += R * l;             // eq 2: F = R * sum sqrt(1 - x^2 - y^2)
+        bool seen = false;      // the sample's pixel is on the planes
 
         vec3 s = vec3(c.x + r * (rot.x * sx - rot.y * sy), c.y + r * (rot.y * sx + rot.x * sy), c.z);
         float cw = PM(3, 0) * s.x + PM(3, 1) * s.y + PM(3, 2) * s.z + PM(3, 3);
@@ -70,6 +70,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             float fu = floor(u), fv = floor(v);
             if (fu >= 0.0 && fv >= 0.0 && fu < float(u_size.x) && fv < float(u_size.y)) {
                 q = ivec2(int(fu), int(fv));
+                seen = true;
                 vec4 xs = texelFetch(u_pos, q, 0);
                 if (xs.w > 0.0) {
                     zs = xs.w;
@@ -101,7 +102,13 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             float sd = u_range_u / max(u_range_u, d / R);
             dz = 2.0 * h * (1.0 - sd);
         }
-        open += dz;
+        // A sample off the planes (or behind the camera) is left out of
+        // eq 1's sum and of F alike: V comes from the part of the disk
+        // that is seen (C twin: the same comment).
+        if (seen) {
+            open += dz;
+            F += R * l;         // eq 2: F = R * sum sqrt(1 - x^2 - y^2)
+        }
     }
     bleed = taken > 0.0 ? acc / taken : vec3(1.0);
     return F > 0.0 ? open / F : 1.0;   // eq 1: V = (1/F) sum dz_i
