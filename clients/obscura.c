@@ -488,10 +488,20 @@ static int cmd_ao(int argc, char **argv)
         obs_params_resolve(&a.params, &p);
         if (ctx)
             obs_ctx_get_info(ctx, &ci);
-        fprintf(stderr, "obscura: info: %dx%d, radius %g, %d samples, %s: read %.1f ms, AO %.1f ms, write %.1f ms\n",
-                gf.gb.width, gf.gb.height, p.radius, p.samples,
-                a.cpu ? "cpu" : obs_backend_name(ci.backend), t_read, t_run,
-                now_ms() - t0);
+        char how[64]; /* the method and its sample counts */
+        if (p.method == OBS_METHOD_HEMISPHERE)
+            snprintf(how, sizeof how, "hemisphere, %d samples", p.hemisphere_samples);
+        else if (p.method == OBS_METHOD_ANGLE)
+            snprintf(how, sizeof how, "angle, %d pairs", p.angle_pairs);
+        else if (p.method == OBS_METHOD_HBAO)
+            snprintf(how, sizeof how, "hbao, %d directions x %d steps", p.hbao_directions,
+                     p.hbao_steps);
+        else
+            snprintf(how, sizeof how, "%s, %d samples", p.method == OBS_METHOD_VAO ? "vao" : "vaopp",
+                     p.samples);
+        fprintf(stderr, "obscura: info: %dx%d, radius %g, %s, %s: read %.1f ms, AO %.1f ms, write %.1f ms\n",
+                gf.gb.width, gf.gb.height, p.radius, how,
+                a.cpu ? "cpu" : obs_backend_name(ci.backend), t_read, t_run, now_ms() - t0);
     }
 
 done:
