@@ -5,6 +5,7 @@
 #   make demo     run the bundled example (no daemon)
 #   make test     unit + end-to-end tests, then the same under ASan/UBSan
 #   make bench    benchmarks (bench/RESULTS.md)
+#   make quality  AO against ray-traced ground truth (bench/QUALITY.md)
 #   make fuzz     libFuzzer target of the binary protocol (clang; tests/fuzz/fuzz.mk)
 #   make readme   regenerate README.md's parameter and daemon option tables
 #   make samples  regenerate core/sample_tables.c (VAO++ 4.5 sample sets)
@@ -22,6 +23,11 @@ PKGS := OpenEXR egl osmesa libpng libcjson
 EXR_CFLAGS := $(shell pkg-config --cflags OpenEXR 2>/dev/null)
 PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson 2>/dev/null) $(EXR_CFLAGS)
 PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson 2>/dev/null) -lz -lm -lpthread
+# Scene loading (core/scene.c: assimp) and the ray-traced reference
+# (core/reference.c: Embree 3, no .pc file) live in libobscura.a too; as
+# static members they are linked only into binaries that call them, and
+# --as-needed keeps the shared libraries out of the others (the daemon).
+PKG_LIBS += -Wl,--push-state,--as-needed $(shell pkg-config --libs assimp 2>/dev/null) -lembree3 -Wl,--pop-state
 
 CFLAGS ?= -O2 -g
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -Wall -Wextra -Wshadow -Wstrict-prototypes \
@@ -55,6 +61,8 @@ BENCH := $(BUILD)/frame_bench
 EXT_BENCH := $(BUILD)/extensions_bench
 # Developer tool: a G-buffer EXR upscaled to WxH (tests/e2e/load.sh, bench).
 UPSCALE := $(BUILD)/exr_upscale
+# Developer tool of make quality: EXR channels side by side in one PNG.
+QSTRIP := $(BUILD)/quality_strip
 DAEMON_BENCH := $(BUILD)/daemon_bench
 
 # The daemon and the wire protocol bring their own rules; they add their
@@ -62,7 +70,7 @@ DAEMON_BENCH := $(BUILD)/daemon_bench
 -include protocol/protocol.mk daemon/daemon.mk clients/clients.mk tests/fuzz/fuzz.mk
 E2E_DEPS += $(UPSCALE)
 
-.PHONY: all deps demo demo-run test check unit e2e headers readme readme-check samples bench clean
+.PHONY: all deps demo demo-run test check unit e2e headers readme readme-check samples bench quality clean
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI) $(EXTRA_BINS)
@@ -98,6 +106,9 @@ $(EXT_BENCH): bench/extensions_bench.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 $(UPSCALE): tools/exr_upscale.c $(LIB)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
+$(QSTRIP): tools/quality_strip.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 # The daemon bench is a client: the CLI's remote code and the protocol.
@@ -161,7 +172,7 @@ e2e: $(CLI) $(E2E_DEPS)
 # Every public header compiles alone, as C and as C++.
 headers:
 	@mkdir -p $(BUILD)/headers
-	@for h in core/obscura.h core/status.h core/params.h core/io.h core/metrics.h protocol/http.h protocol/binary.h; do \
+	@for h in core/obscura.h core/status.h core/params.h core/io.h core/metrics.h core/scene.h core/reference.h protocol/http.h protocol/binary.h; do \
 	  echo "#include \"$$h\"" > $(BUILD)/headers/t.c; \
 	  $(CC) -I. -Wall -Wextra -Werror -std=c99 -c $(BUILD)/headers/t.c -o /dev/null || exit 1; \
 	  cp $(BUILD)/headers/t.c $(BUILD)/headers/t.cpp; \
@@ -172,6 +183,13 @@ headers:
 bench: deps
 	@$(MAKE) --no-print-directory all $(BENCH) $(EXT_BENCH) $(UPSCALE) $(DAEMON_BENCH)
 	@BUILD=$(BUILD) bench/run.sh
+
+# Quality against ground truth (bench/QUALITY.md, bench/quality/*.png): every
+# method of bench/quality.sh's table on the Blender scenes of
+# $(OBSCURA_SHARED_DATA) (default ../shared/data).
+quality: deps
+	@$(MAKE) --no-print-directory all $(QSTRIP)
+	@BUILD=$(BUILD) bench/quality.sh
 
 clean:
 	rm -rf build out

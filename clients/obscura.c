@@ -5,17 +5,22 @@
  *   obscura info [--backend B]
  *   obscura params [--markdown]
  *   obscura samples [--c]
+ *   obscura gbuffer SCENE -o OUT.exr --camera CAM.json   (clients/ground.c)
+ *   obscura reference SCENE -o REF.exr --camera CAM.json (clients/ground.c)
  *   obscura batch IN.####.exr --frames 1-100x2 -o OUT.####.exr [--server URL] [--jobs N] [--strict] ...
  *
  * Exit codes: 0 ok, 1 failure (GL, I/O), 2 usage, 3 bad input. */
+#include <cjson/cJSON.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 
 #include "batch.h"
+#include "ground.h"
 #include "io.h"
 #include "metrics.h"
 #include "obscura.h"
@@ -129,15 +134,20 @@ static void usage(FILE *f)
             "usage:\n"
             "  obscura ao IN.exr -o OUT.(exr|png) [options] [parameters]\n"
             "  obscura compare TRUTH.exr CANDIDATE.exr [--channel-a CH] [--channel-b CH]\n"
-            "                  [--mask auto|none|CH] [--diff OUT.png] [--json]\n"
+            "                  [--mask auto|none|CH] [--diff OUT.(png|exr)] [--json]\n"
+            "                  metrics: MSE, PSNR, SSIM, MAE, corr, bias over the mask's pixels;\n"
+            "                  --mask auto: where TRUTH's (else CANDIDATE's) depth channel has\n"
+            "                  geometry (0 < Z < 1e9); none: every pixel; CH: where channel CH of\n"
+            "                  TRUTH is a depth with geometry\n"
             "  obscura info [--backend B]\n"
             "  obscura params [--markdown]\n"
             "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as core/sample_tables.c\n"
             "  obscura batch IN.####.exr --frames SPEC -o OUT.####.exr [--server URL] [--jobs N]\n"
             "                [--strict] [ao options]   a frame sequence; SPEC 1-100, 1-100x2, 1,5,9;\n"
-            "                #### or %%04d is the frame; missing inputs are skipped (--strict: exit 3)\n\n"
-            "ao options:\n",
+            "                #### or %%04d is the frame; missing inputs are skipped (--strict: exit 3)\n",
             OBS_VERSION);
+    cli_ground_usage(f);
+    fprintf(f, "\nao options:\n");
     for (const cli_opt *o = ao_opts; o->name; o++) {
         char left[48];
         snprintf(left, sizeof left, "%s%s %s", o->name[1] ? "--" : "-", o->name,
@@ -695,6 +705,63 @@ static const char *pick_channel(const char *path, const char *const *cands, char
     return found;
 }
 
+/* The --json line of compare: one object on one line, "key": value, built
+ * with cJSON (names are escaped; NaN becomes null). */
+static void print_compare_json(const char *pa, const char *cha, const char *pb, const char *chb,
+                               const char *mask, const obs_metrics *m)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "truth", pa);
+    cJSON_AddStringToObject(o, "channel_a", cha);
+    cJSON_AddStringToObject(o, "candidate", pb);
+    cJSON_AddStringToObject(o, "channel_b", chb);
+    cJSON_AddStringToObject(o, "mask", mask);
+    cJSON_AddNumberToObject(o, "mse", m->mse);
+    cJSON_AddNumberToObject(o, "mae", m->mae);
+    cJSON_AddNumberToObject(o, "psnr", m->psnr);
+    cJSON_AddNumberToObject(o, "ssim", m->ssim);
+    cJSON_AddNumberToObject(o, "corr", m->corr);
+    cJSON_AddNumberToObject(o, "bias", m->bias);
+    cJSON_AddNumberToObject(o, "pixels", (double)m->count);
+    const cJSON *c;
+    const char *sep = "{";
+    cJSON_ArrayForEach(c, o) {
+        cJSON *key = cJSON_CreateString(c->string);
+        char *v = cJSON_PrintUnformatted(c), *k = key ? cJSON_PrintUnformatted(key) : NULL;
+        printf("%s%s: %s", sep, k ? k : "\"\"", v ? v : "null");
+        cJSON_free(v);
+        cJSON_free(k);
+        cJSON_Delete(key);
+        sep = ", ";
+    }
+    printf("}\n");
+    cJSON_Delete(o);
+}
+
+/* compare --diff: PNG, the RGB map of obs_metrics_diff_image(); EXR, the
+ * same map as R,G,B plus the signed difference (candidate - truth, of the
+ * clamped values) as Diff.Y. */
+static obs_status write_diff(const char *path, const obs_image *a, const obs_image *b,
+                             const obs_image *map, char err[OBS_ERR_LEN])
+{
+    size_t n = strlen(path);
+    if (n < 4 || strcasecmp(path + n - 4, ".exr") != 0)
+        return obs_png_write(path, map, 8, 0, err);
+    size_t px = (size_t)a->width * a->height;
+    obs_image d = {a->width, a->height, 1, malloc(px * sizeof(float))};
+    if (!d.data) {
+        snprintf(err, OBS_ERR_LEN, "out of memory for the difference image");
+        return OBS_NO_MEMORY;
+    }
+    for (size_t i = 0; i < px; i++)
+        d.data[i] = fminf(fmaxf(b->data[i], 0.0f), 1.0f) - fminf(fmaxf(a->data[i], 0.0f), 1.0f);
+    static const char *const rgb[] = {"R", "G", "B"}, *const dy[] = {"Diff.Y"};
+    const obs_exr_layer layers[] = {{map, rgb}, {&d, dy}};
+    obs_status s = obs_exr_write(path, layers, 2, OBS_EXR_FLOAT, NULL, err);
+    obs_image_free(&d);
+    return s;
+}
+
 static int cmd_compare(int argc, char **argv)
 {
     static const char *const ao_cands[] = {"AO.Y", "Y", "ViewLayer.AO.R", "A", "R", NULL};
@@ -760,9 +827,7 @@ static int cmd_compare(int argc, char **argv)
         goto done;
     }
     if (json)
-        printf("{\"mse\": %.6f, \"mae\": %.5f, \"psnr\": %.2f, \"ssim\": %.4f, \"corr\": %.4f, "
-               "\"bias\": %.5f, \"pixels\": %lld}\n",
-               m.mse, m.mae, m.psnr, m.ssim, m.corr, m.bias, m.count);
+        print_compare_json(pa, cha, pb, chb, mask ? mask_opt : "none", &m);
     else
         printf("%s (%s) vs %s (%s), %lld pixels%s\n  MSE %.6f  PSNR %.2f dB  SSIM %.4f  MAE %.5f  "
                "corr %.4f  bias %+.5f\n",
@@ -772,7 +837,7 @@ static int cmd_compare(int argc, char **argv)
         obs_image d = {0};
         s = obs_metrics_diff_image(&a, &b, &d, err);
         if (s == OBS_OK)
-            s = obs_png_write(diff, &d, 8, 0, err);
+            s = write_diff(diff, &a, &b, &d, err);
         obs_image_free(&d);
         if (s != OBS_OK)
             rc = fail(s, diff, err);
@@ -801,6 +866,10 @@ int main(int argc, char **argv)
         return cmd_params(argc - 2, argv + 2);
     if (!strcmp(cmd, "samples"))
         return cmd_samples(argc - 2, argv + 2);
+    if (!strcmp(cmd, "gbuffer"))
+        return cli_gbuffer(argc - 2, argv + 2);
+    if (!strcmp(cmd, "reference"))
+        return cli_reference(argc - 2, argv + 2);
     if (!strcmp(cmd, "batch")) {
         static const cli_batch_ops ops = {batch_check, batch_ao, batch_finish};
         return cli_batch(argc - 2, argv + 2, &ops);

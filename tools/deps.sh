@@ -4,7 +4,8 @@
 set -eu
 
 PKGS="build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libosmesa6-dev \
-libopenexr-dev libpng-dev libcjson-dev libcmocka-dev zlib1g-dev libmicrohttpd-dev curl"
+libopenexr-dev libpng-dev libcjson-dev libcmocka-dev zlib1g-dev libmicrohttpd-dev curl \
+libassimp-dev libembree-dev"
 
 missing=""
 for p in $PKGS; do

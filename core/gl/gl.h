@@ -68,7 +68,16 @@
     X(PFNGLQUERYCOUNTERPROC, QueryCounter)                                     \
     X(PFNGLBEGINQUERYPROC, BeginQuery)                                         \
     X(PFNGLENDQUERYPROC, EndQuery)                                             \
-    X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)
+    X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)                       \
+    /* meshes (raster_gl.c) */                                                 \
+    X(PFNGLGENBUFFERSPROC, GenBuffers)                                         \
+    X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                                   \
+    X(PFNGLBINDBUFFERPROC, BindBuffer)                                         \
+    X(PFNGLBUFFERDATAPROC, BufferData)                                         \
+    X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)                       \
+    X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)               \
+    X(PFNGLDRAWELEMENTSPROC, DrawElements)                                     \
+    X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv)
 
 /* Optional entry points (may be NULL). */
 #define OBS__GL_FUNCS_OPT(X) X(PFNGLDEBUGMESSAGECALLBACKPROC, DebugMessageCallback)
@@ -138,6 +147,14 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glBeginQuery obs__glp->BeginQuery
 #define glEndQuery obs__glp->EndQuery
 #define glGetQueryObjectui64v obs__glp->GetQueryObjectui64v
+#define glGenBuffers obs__glp->GenBuffers
+#define glDeleteBuffers obs__glp->DeleteBuffers
+#define glBindBuffer obs__glp->BindBuffer
+#define glBufferData obs__glp->BufferData
+#define glVertexAttribPointer obs__glp->VertexAttribPointer
+#define glEnableVertexAttribArray obs__glp->EnableVertexAttribArray
+#define glDrawElements obs__glp->DrawElements
+#define glClearBufferfv obs__glp->ClearBufferfv
 
 /* Loads every entry point; fails naming the first one missing. */
 obs_status obs__gl_load(obs__gl *gl, obs__getproc_fn getproc, char err[OBS_ERR_LEN]);

@@ -1,0 +1,416 @@
+/* The ground-truth commands: a G-buffer rasterised from a mesh
+ * (obscura gbuffer) and the ray-traced AO reference (obscura reference).
+ * Both take the scene as a mesh file (anything assimp reads) in world
+ * space and the camera as a camera JSON. */
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "ground.h"
+#include "io.h"
+#include "obscura.h"
+#include "reference.h"
+#include "scene.h"
+
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_BADINPUT = 3 };
+
+void cli_ground_usage(FILE *f)
+{
+    fprintf(f,
+            "  obscura gbuffer SCENE -o OUT.exr --camera CAM.json [--width W] [--height H]\n"
+            "                  [--backend B]    rasterise a mesh (OBJ, PLY, glTF/GLB, OFF, ...)\n"
+            "                  into a G-buffer EXR: Z, N (world), Ncam, P, R,G,B (albedo), A\n"
+            "  obscura reference SCENE -o REF.(exr|png) --camera CAM.json [--distance D]\n"
+            "                  [--spp N] [--seed N] [--threads N] [--width W] [--height H]\n"
+            "                  [--gbuffer G.exr]   ray-traced AO (Embree): AO.Y and Z\n");
+}
+
+static void die_usage(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "obscura: %s: ", cmd);
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n(run 'obscura help' for usage)\n");
+    va_end(ap);
+    exit(EXIT_USAGE);
+}
+
+/* Bad input (a file that is damaged, missing or not a mesh) is exit 3;
+ * GL and memory failures exit 1. */
+static int fail(obs_status s, const char *what, const char *err)
+{
+    const char *msg = err && *err ? err : obs_status_message(s);
+    if (strncmp(msg, what, strlen(what)) == 0)
+        fprintf(stderr, "obscura: %s (%s)\n", msg, obs_status_name(s));
+    else
+        fprintf(stderr, "obscura: %s: %s (%s)\n", what, msg, obs_status_name(s));
+    switch (s) {
+    case OBS_IO:
+    case OBS_BAD_FILE:
+    case OBS_UNSUPPORTED:
+    case OBS_MISSING_CHANNEL:
+    case OBS_TOO_LARGE:
+    case OBS_NO_CAMERA:
+    case OBS_INVALID_ARGUMENT: return EXIT_BADINPUT;
+    default: return EXIT_FAIL;
+    }
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
+}
+
+/* The options both commands share. */
+typedef struct ground_args {
+    const char *cmd, *scene, *out, *camera, *backend, *gbuffer;
+    long width, height, spp, threads;
+    unsigned long long seed;
+    double distance;
+    int quiet, verbose;
+} ground_args;
+
+/* "--name VALUE" or "--name=VALUE"; NULL when argv[*i] is not --name. */
+static const char *opt_value(const ground_args *a, int argc, char **argv, int *i, const char *name)
+{
+    const char *s = argv[*i];
+    size_t n = strlen(name);
+    if (s[0] != '-')
+        return NULL;
+    s += s[1] == '-' ? 2 : 1;
+    if (strncmp(s, name, n) != 0 || (s[n] != '=' && s[n] != '\0'))
+        return NULL;
+    if (s[n] == '=')
+        return s + n + 1;
+    if (*i + 1 >= argc)
+        die_usage(a->cmd, "option --%s needs a value", name);
+    return argv[++*i];
+}
+
+static long parse_long(const ground_args *a, const char *name, const char *v, long lo, long hi)
+{
+    char *end;
+    errno = 0;
+    long x = strtol(v, &end, 10);
+    if (errno || end == v || *end || x < lo || x > hi)
+        die_usage(a->cmd, "--%s '%s': expected an integer from %ld to %ld", name, v, lo, hi);
+    return x;
+}
+
+static void parse(ground_args *a, int argc, char **argv, int reference)
+{
+    for (int i = 0; i < argc; i++) {
+        const char *v;
+        if ((v = opt_value(a, argc, argv, &i, "o")) || (v = opt_value(a, argc, argv, &i, "output")))
+            a->out = v;
+        else if ((v = opt_value(a, argc, argv, &i, "camera")))
+            a->camera = v;
+        else if ((v = opt_value(a, argc, argv, &i, "width")))
+            a->width = parse_long(a, "width", v, 1, 16384);
+        else if ((v = opt_value(a, argc, argv, &i, "height")))
+            a->height = parse_long(a, "height", v, 1, 16384);
+        else if (!reference && (v = opt_value(a, argc, argv, &i, "backend")))
+            a->backend = v;
+        else if (reference && (v = opt_value(a, argc, argv, &i, "spp")))
+            a->spp = parse_long(a, "spp", v, 1, 1 << 20);
+        else if (reference && (v = opt_value(a, argc, argv, &i, "threads")))
+            a->threads = parse_long(a, "threads", v, 1, 64);
+        else if (reference && (v = opt_value(a, argc, argv, &i, "seed")))
+            a->seed = (unsigned long long)parse_long(a, "seed", v, 0, 0x7fffffffL);
+        else if (reference && (v = opt_value(a, argc, argv, &i, "gbuffer")))
+            a->gbuffer = v;
+        else if (reference && (v = opt_value(a, argc, argv, &i, "distance"))) {
+            char *end;
+            a->distance = strtod(v, &end);
+            if (end == v || *end || !(a->distance > 0) || !isfinite(a->distance))
+                die_usage(a->cmd, "--distance '%s': expected a positive length", v);
+        } else if (!strcmp(argv[i], "-q") || !strcmp(argv[i], "--quiet"))
+            a->quiet = 1;
+        else if (!strcmp(argv[i], "-v") || !strcmp(argv[i], "--verbose"))
+            a->verbose = 1;
+        else if (argv[i][0] == '-' && argv[i][1])
+            die_usage(a->cmd, "unknown option '%s'", argv[i]);
+        else if (!a->scene)
+            a->scene = argv[i];
+        else
+            die_usage(a->cmd, "more than one scene ('%s', '%s')", a->scene, argv[i]);
+    }
+    if (!a->scene)
+        die_usage(a->cmd, "no scene file");
+    if (!a->out)
+        die_usage(a->cmd, "no output file (-o OUT)");
+    if (!a->camera && !(reference && a->gbuffer))
+        die_usage(a->cmd, "no camera (--camera CAM.json)");
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcasecmp(s + n - m, suffix) == 0;
+}
+
+/* The camera JSON and the image size: the flags, else the JSON's. */
+static int load_camera(const ground_args *a, obs_camera *cam, int *w, int *h)
+{
+    char err[OBS_ERR_LEN] = "";
+    int cw = 0, ch = 0;
+    obs_status s = obs_camera_read_json(a->camera, cam, &cw, &ch, err);
+    if (s != OBS_OK)
+        return fail(s == OBS_IO ? OBS_IO : s, a->camera, err);
+    if (!cam->has_projection)
+        return fail(OBS_NO_CAMERA, a->camera, "the camera has no projection (fov_y_deg or projection)");
+    *w = a->width ? (int)a->width : cw;
+    *h = a->height ? (int)a->height : ch;
+    if (*w <= 0 || *h <= 0)
+        die_usage(a->cmd, "%s gives no image size: use --width and --height", a->camera);
+    if (cw > 0 && ch > 0 && fabs((double)cw / ch - (double)*w / *h) > 1e-3)
+        fprintf(stderr, "obscura: warning: camera %s is %dx%d, the image %dx%d (aspect differs)\n",
+                a->camera, cw, ch, *w, *h);
+    return EXIT_OK;
+}
+
+static void log_cb(void *user, obs_log_level level, const char *msg)
+{
+    static const char *const names[] = {"error", "warning", "info", "debug"};
+    const ground_args *a = user;
+    int verbosity = a->quiet ? OBS_LOG_WARN : a->verbose ? OBS_LOG_DEBUG : OBS_LOG_WARN;
+    if ((int)level <= verbosity)
+        fprintf(stderr, "obscura: %s: %s\n", names[level], msg);
+}
+
+static int load_scene(const ground_args *a, obs_scene *scene)
+{
+    char err[OBS_ERR_LEN] = "";
+    double t0 = now_s();
+    obs_status s = obs_scene_load(a->scene, scene, err);
+    if (s != OBS_OK)
+        return fail(s, a->scene, err);
+    if (!a->quiet)
+        fprintf(stderr, "obscura: info: %s: %zu triangles, %zu vertices%s (%.2f s)\n", a->scene,
+                scene->triangle_count, scene->vertex_count, scene->albedo ? ", albedo" : "",
+                now_s() - t0);
+    return EXIT_OK;
+}
+
+/* ---- obscura gbuffer ------------------------------------------------------ */
+
+int cli_gbuffer(int argc, char **argv)
+{
+    ground_args a = {.cmd = "gbuffer"};
+    parse(&a, argc, argv, 0);
+    if (!ends_with(a.out, ".exr"))
+        die_usage(a.cmd, "%s: the G-buffer is written as .exr", a.out);
+
+    obs_camera cam;
+    obs_scene scene = {0};
+    obs_raster r = {0};
+    obs_ctx *ctx = NULL;
+    char err[OBS_ERR_LEN] = "";
+    int w, h, rc;
+    obs_status s;
+    if ((rc = load_camera(&a, &cam, &w, &h)) != EXIT_OK)
+        return rc;
+    if ((rc = load_scene(&a, &scene)) != EXIT_OK)
+        return rc;
+
+    obs_ctx_desc desc = {.log = log_cb, .log_user = &a};
+    const char *bname = a.backend ? a.backend : getenv("OBSCURA_BACKEND");
+    if (bname && *bname && obs_backend_parse(bname, &desc.backend) != OBS_OK)
+        die_usage(a.cmd, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
+    double t0 = now_s();
+    if ((s = obs_ctx_create(&desc, &ctx, err)) != OBS_OK) {
+        rc = fail(s, "OpenGL", err);
+        goto done;
+    }
+    if ((s = obs_raster_gbuffer(ctx, &scene, &cam, w, h, &r, err)) != OBS_OK) {
+        rc = fail(s, a.scene, err);
+        goto done;
+    }
+    double t_raster = now_s() - t0;
+
+    static const char *const n_z[] = {"Z"}, *const n_n[] = {"N.X", "N.Y", "N.Z"},
+                             *const n_nc[] = {"Ncam.X", "Ncam.Y", "Ncam.Z"},
+                             *const n_p[] = {"P.X", "P.Y", "P.Z"}, *const n_c[] = {"R", "G", "B", "A"},
+                             *const n_a[] = {"A"};
+    /* Without albedo only the coverage (A) of the colour image is kept. */
+    obs_image alpha = {0};
+    if (!r.has_albedo) {
+        size_t n = (size_t)w * h;
+        if (!(alpha.data = malloc(n * sizeof(float)))) {
+            rc = fail(OBS_NO_MEMORY, a.out, NULL);
+            goto done;
+        }
+        alpha.width = w;
+        alpha.height = h;
+        alpha.channels = 1;
+        for (size_t i = 0; i < n; i++)
+            alpha.data[i] = r.color.data[4 * i + 3];
+    }
+    const obs_exr_layer layers[] = {{&r.depth, n_z},       {&r.normal, n_n},
+                                    {&r.normal_cam, n_nc}, {&r.position, n_p},
+                                    r.has_albedo ? (obs_exr_layer){&r.color, n_c}
+                                                 : (obs_exr_layer){&alpha, n_a}};
+    /* Float: the sky depth (1e10) and world positions do not fit a half. */
+    s = obs_exr_write(a.out, layers, 5, OBS_EXR_FLOAT, &cam, err);
+    obs_image_free(&alpha);
+    if (s != OBS_OK) {
+        rc = fail(s, a.out, err);
+        goto done;
+    }
+    if (!a.quiet) {
+        obs_ctx_info ci;
+        obs_ctx_get_info(ctx, &ci);
+        fprintf(stderr, "obscura: info: wrote %s: %dx%d, %s, rasterised in %.2f s\n", a.out, w, h,
+                obs_backend_name(ci.backend), t_raster);
+    }
+
+done:
+    obs_raster_free(&r);
+    obs_ctx_destroy(ctx);
+    obs_scene_free(&scene);
+    return rc;
+}
+
+/* ---- obscura reference ----------------------------------------------------- */
+
+static void progress_cb(void *user, int done, int total)
+{
+    int *last = user;
+    int pct = (int)(100.0 * done / total);
+    if (pct != *last) {
+        *last = pct;
+        fprintf(stderr, "\robscura: reference: %3d%% (%d/%d rows)", pct, done, total);
+        if (done == total)
+            fputc('\n', stderr);
+    }
+}
+
+/* Reads the first channel triple of `cands` (each 3 names) that the file
+ * has into one 3-channel image. */
+static obs_status read_triple(const char *path, const char *const cands[][3], int ncand,
+                              obs_image *out, char err[OBS_ERR_LEN])
+{
+    obs_status s = OBS_MISSING_CHANNEL;
+    for (int c = 0; c < ncand; c++) {
+        obs_image ch[3] = {{0}};
+        s = OBS_OK;
+        for (int k = 0; k < 3 && s == OBS_OK; k++)
+            s = obs_exr_read_channel(path, cands[c][k], NULL, &ch[k], err);
+        if (s == OBS_OK) {
+            size_t n = (size_t)ch[0].width * ch[0].height;
+            out->width = ch[0].width;
+            out->height = ch[0].height;
+            out->channels = 3;
+            out->data = malloc(n * 3 * sizeof(float));
+            if (!out->data)
+                s = OBS_NO_MEMORY;
+            for (size_t i = 0; out->data && i < n; i++)
+                for (int k = 0; k < 3; k++)
+                    out->data[3 * i + k] = ch[k].data[i];
+        }
+        for (int k = 0; k < 3; k++)
+            obs_image_free(&ch[k]);
+        if (s == OBS_OK)
+            return OBS_OK;
+    }
+    snprintf(err, OBS_ERR_LEN, "no %s channels (looked for %s/%s/%s%s%s)", cands[0][0],
+             cands[0][0], cands[0][1], cands[0][2], ncand > 1 ? " and " : "",
+             ncand > 1 ? cands[1][0] : "");
+    return s == OBS_NO_MEMORY ? s : OBS_MISSING_CHANNEL;
+}
+
+int cli_reference(int argc, char **argv)
+{
+    static const char *const pos_cands[][3] = {{"P.X", "P.Y", "P.Z"},
+                                               {"ViewLayer.Position.X", "ViewLayer.Position.Y",
+                                                "ViewLayer.Position.Z"}};
+    static const char *const nrm_cands[][3] = {{"N.X", "N.Y", "N.Z"},
+                                               {"ViewLayer.Normal.X", "ViewLayer.Normal.Y",
+                                                "ViewLayer.Normal.Z"}};
+    ground_args a = {.cmd = "reference", .distance = 0.5};
+    parse(&a, argc, argv, 1);
+    int png = ends_with(a.out, ".png");
+    if (!png && !ends_with(a.out, ".exr"))
+        die_usage(a.cmd, "%s: the reference is written as .exr or .png", a.out);
+
+    obs_camera cam = {0};
+    obs_scene scene = {0};
+    obs_image pos = {0}, nrm = {0}, ao = {0}, depth = {0};
+    char err[OBS_ERR_LEN] = "";
+    int w = 0, h = 0, rc = EXIT_OK;
+    obs_status s;
+
+    if (a.camera && (rc = load_camera(&a, &cam, &w, &h)) != EXIT_OK)
+        return rc;
+    if (a.gbuffer) {
+        /* The points of a G-buffer: ours (P, N) or Blender's; the camera
+         * from its header unless --camera gives one. */
+        if (!a.camera) {
+            obs_gbuffer_file gf = {0};
+            if ((s = obs_gbuffer_read_exr(a.gbuffer, NULL, NULL, &gf, err)) != OBS_OK)
+                return fail(s == OBS_IO ? OBS_IO : s, a.gbuffer, err);
+            cam = gf.gb.camera;
+            obs_gbuffer_free(&gf);
+            if (!cam.has_projection)
+                return fail(OBS_NO_CAMERA, a.gbuffer,
+                            "no worldToCamera/worldToNDC in the header: use --camera");
+        }
+        if ((s = read_triple(a.gbuffer, pos_cands, 2, &pos, err)) != OBS_OK ||
+            (s = read_triple(a.gbuffer, nrm_cands, 2, &nrm, err)) != OBS_OK) {
+            rc = fail(s, a.gbuffer, err);
+            goto done;
+        }
+        w = pos.width;
+        h = pos.height;
+    }
+    if ((rc = load_scene(&a, &scene)) != EXIT_OK)
+        goto done;
+
+    int last = -1;
+    obs_reference_view view = {.camera = &cam, .width = w, .height = h,
+                               .position = a.gbuffer ? &pos : NULL,
+                               .normal = a.gbuffer ? &nrm : NULL};
+    obs_reference_desc desc = {.distance = (float)a.distance, .spp = (int)a.spp,
+                               .seed = a.seed, .threads = (int)a.threads};
+    if (!a.quiet && isatty(STDERR_FILENO)) {
+        desc.progress = progress_cb;
+        desc.progress_user = &last;
+    }
+    double t0 = now_s();
+    if ((s = obs_reference_render(&scene, &view, &desc, &ao, &depth, err)) != OBS_OK) {
+        rc = fail(s, a.scene, err);
+        goto done;
+    }
+    double t = now_s() - t0;
+
+    if (png) {
+        s = obs_png_write(a.out, &ao, 8, 0, err);
+    } else {
+        static const char *const n_ao[] = {"AO.Y"}, *const n_z[] = {"Z"};
+        const obs_exr_layer layers[] = {{&ao, n_ao}, {&depth, n_z}};
+        s = obs_exr_write(a.out, layers, 2, OBS_EXR_FLOAT, &cam, err);
+    }
+    if (s != OBS_OK) {
+        rc = fail(s, a.out, err);
+        goto done;
+    }
+    if (!a.quiet)
+        fprintf(stderr, "obscura: info: wrote %s: %dx%d, distance %g, %ld spp, seed %llu, %.2f s\n",
+                a.out, w, h, a.distance, a.spp ? a.spp : 256L, a.seed, t);
+
+done:
+    obs_image_free(&ao);
+    obs_image_free(&depth);
+    obs_image_free(&pos);
+    obs_image_free(&nrm);
+    obs_scene_free(&scene);
+    return rc;
+}

@@ -1,0 +1,111 @@
+#!/bin/sh
+# End-to-end tests of the ground-truth commands: `obscura gbuffer` and
+# `obscura reference` on a mesh written here (and on the Blender room of
+# ../shared/data when present), `obscura ao` on the G-buffer with no camera
+# flag (the camera comes from the EXR header), `obscura compare --json
+# --diff`, and clear errors for bad input.
+#
+#   OBSCURA=build/obscura tests/e2e/ground.sh
+set -u
+OBSCURA=${OBSCURA:-build/obscura}
+SHARED=${OBSCURA_SHARED_DATA:-../shared/data}
+. tests/e2e/lib/common.sh
+
+# expect CODE DESCRIPTION -- command...: runs it, checks the exit code
+expect() {
+    code=$1; what=$2; shift 3
+    "$@" >"$T/out" 2>"$T/err"
+    rc=$?
+    if [ "$rc" -eq "$code" ]; then ok "$what"; else
+        bad "$what (exit $rc, expected $code)"; sed 's/^/       /' "$T/err" | tail -5; fi
+}
+said() {
+    if grep -q -- "$1" "$T/err" "$T/out"; then ok "message: $1"; else
+        bad "message '$1' missing"; sed 's/^/       /' "$T/err" | tail -5; fi
+}
+json() { sed -n "s/.*\"$1\": \([-0-9.e+]*\).*/\1/p" "$T/out"; }
+
+echo "e2e ground: $OBSCURA"
+# a floor, a wall and a box on the floor; a camera looking at the corner
+cat >"$T/corner.obj" <<'OBJ'
+v -2 -2 0
+v 2 -2 0
+v 2 2 0
+v -2 2 0
+v -2 2 0
+v 2 2 0
+v 2 2 2
+v -2 2 2
+v -0.3 0.8 0
+v 0.3 0.8 0
+v 0.3 0.8 0.5
+v -0.3 0.8 0.5
+f 1 2 3 4
+f 5 6 7 8
+f 9 10 11 12
+OBJ
+cat >"$T/corner.camera.json" <<'CAM'
+{"width": 160, "height": 120, "fov_y_deg": 50, "near": 0.05, "far": 100,
+ "world_to_camera": [[1, 0, 0, 0], [0, 0.5547002, 0.8320503, -1.6641006],
+                     [0, -0.8320503, 0.5547002, -4.4376016], [0, 0, 0, 1]]}
+CAM
+C="$T/corner.camera.json"
+
+echo "-- gbuffer"
+expect 0 "gbuffer corner.obj" -- "$OBSCURA" gbuffer "$T/corner.obj" --camera "$C" -o "$T/gb.exr"
+expect 0 "G-buffer has Z, N, Ncam, P, A" -- "$OBSCURA" compare "$T/gb.exr" "$T/gb.exr" \
+    --channel-a Ncam.Z --channel-b A --mask none
+expect 0 "ao on the G-buffer, camera from its header" -- "$OBSCURA" ao "$T/gb.exr" -o "$T/ao.exr"
+expect 0 "gbuffer --width/--height" -- "$OBSCURA" gbuffer "$T/corner.obj" --camera "$C" \
+    --width 80 --height 60 -o "$T/gb_half.exr" -q
+
+echo "-- reference"
+expect 0 "reference corner.obj" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" \
+    -o "$T/ref.exr" --spp 32 --threads 2
+expect 0 "reference from the G-buffer's points" -- "$OBSCURA" reference "$T/corner.obj" \
+    --gbuffer "$T/gb.exr" -o "$T/ref_gb.exr" --spp 32
+expect 0 "reference as PNG" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" -o "$T/ref.png" --spp 4 -q
+expect 0 "compare reference and ao --json --diff" -- "$OBSCURA" compare "$T/ref.exr" "$T/ao.exr" \
+    --json --diff "$T/diff.exr"
+mae=$(json mae); pixels=$(json pixels)
+check "compare JSON has mae ($mae) and pixels ($pixels)" "[ -n '$mae' ] && [ '$pixels' -gt 1000 ]"
+check "the diff EXR was written" "[ -s '$T/diff.exr' ]"
+expect 0 "camera rays and G-buffer points agree" -- "$OBSCURA" compare "$T/ref.exr" "$T/ref_gb.exr" --json
+mae=$(json mae)
+check "camera rays vs G-buffer points: MAE $mae < 0.05" "awk 'BEGIN { exit !($mae < 0.05) }'"
+
+echo "-- bad input"
+expect 3 "missing scene" -- "$OBSCURA" gbuffer "$T/none.obj" --camera "$C" -o "$T/x.exr"
+said "none.obj: cannot open"
+printf 'ply\nnot a mesh at all\n' >"$T/junk.ply"
+expect 3 "unreadable mesh" -- "$OBSCURA" reference "$T/junk.ply" --camera "$C" -o "$T/x.exr"
+said "junk.ply"
+printf 'v 0 0 0\nv 1 0 0\nl 1 2\n' >"$T/lines.obj"
+expect 3 "empty scene" -- "$OBSCURA" gbuffer "$T/lines.obj" --camera "$C" -o "$T/x.exr"
+said "no triangles"
+printf '{"fov_y_deg": 500}' >"$T/bad.json"
+expect 3 "bad camera" -- "$OBSCURA" gbuffer "$T/corner.obj" --camera "$T/bad.json" -o "$T/x.exr"
+said "fov_y_deg"
+expect 3 "missing camera file" -- "$OBSCURA" reference "$T/corner.obj" --camera "$T/nocam.json" -o "$T/x.exr"
+said "nocam.json"
+expect 2 "no camera" -- "$OBSCURA" gbuffer "$T/corner.obj" -o "$T/x.exr"
+expect 2 "gbuffer writes EXR only" -- "$OBSCURA" gbuffer "$T/corner.obj" --camera "$C" -o "$T/x.png"
+expect 2 "bad --spp" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" -o "$T/x.exr" --spp 0
+expect 2 "bad --distance" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" -o "$T/x.exr" --distance -1
+expect 3 "G-buffer without positions" -- "$OBSCURA" reference "$T/corner.obj" --gbuffer "$T/ao.exr" \
+    --camera "$C" -o "$T/x.exr"
+said "no P.X channels"
+
+B="$SHARED/blender"
+if [ -f "$B/room.obj" ]; then
+    echo "-- Blender room (shared data)"
+    expect 0 "gbuffer room.obj" -- "$OBSCURA" gbuffer "$B/room.obj" --camera "$B/room.camera.json" -o "$T/room_gb.exr"
+    expect 0 "ao on the rasterised room" -- "$OBSCURA" ao "$T/room_gb.exr" -o "$T/room_ao.exr"
+    expect 0 "compare with Cycles AO" -- "$OBSCURA" compare "$B/room.exr" "$T/room_ao.exr" \
+        --channel-a ViewLayer.AO.R --json
+    corr=$(json corr)
+    check "rasterised room vs Cycles AO: corr $corr > 0.6" "awk 'BEGIN { exit !($corr > 0.6) }'"
+fi
+
+echo "e2e ground: $pass passed, $failed failed"
+[ "$failed" -eq 0 ]
