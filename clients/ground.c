@@ -171,9 +171,18 @@ static int load_camera(const ground_args *a, obs_camera *cam, int *w, int *h)
     *h = a->height ? (int)a->height : ch;
     if (*w <= 0 || *h <= 0)
         die_usage(a->cmd, "%s gives no image size: use --width and --height", a->camera);
-    if (cw > 0 && ch > 0 && fabs((double)cw / ch - (double)*w / *h) > 1e-3)
-        fprintf(stderr, "obscura: warning: camera %s is %dx%d, the image %dx%d (aspect differs)\n",
-                a->camera, cw, ch, *w, *h);
+    if (cw > 0 && ch > 0 && fabs((double)cw / ch - (double)*w / *h) > 1e-3) {
+        /* Another aspect: a centred perspective keeps its vertical field
+         * of view and widens or narrows horizontally (x scale = y scale /
+         * aspect); any other projection is used as it is, stretched. */
+        if (obs_camera_fit_aspect(cam, *w, *h)) {
+            fprintf(stderr, "obscura: camera %s is %dx%d; rendering %dx%d with its vertical field "
+                            "of view\n", a->camera, cw, ch, *w, *h);
+        } else {
+            fprintf(stderr, "obscura: warning: camera %s is %dx%d, the image %dx%d (aspect "
+                            "differs; the projection is stretched)\n", a->camera, cw, ch, *w, *h);
+        }
+    }
     return EXIT_OK;
 }
 

@@ -16,6 +16,19 @@
 #define DEFAULT_NEAR 0.1
 #define DEFAULT_FAR 1000.0
 
+int obs_camera_fit_aspect(obs_camera *cam, int width, int height)
+{
+    float *P = cam->projection; /* row-major */
+    if (width <= 0 || height <= 0 || P[14] != -1.0f || P[15] != 0.0f || P[1] != 0.0f ||
+        P[2] != 0.0f || P[4] != 0.0f || P[6] != 0.0f)
+        return 0;
+    float x = P[5] * (float)height / (float)width;
+    if (x == P[0])
+        return 0;
+    P[0] = x;
+    return 1;
+}
+
 void obs_camera_from_fov(float fov_y_deg, float aspect, float near_z, float far_z, obs_camera *cam)
 {
     const double f = 1.0 / tan(fov_y_deg * 3.14159265358979323846 / 360.0);

@@ -154,6 +154,13 @@ obs_status obs_camera_read_json(const char *path, obs_camera *cam, int *width,
 void obs_camera_from_fov(float fov_y_deg, float aspect, float near_z,
                          float far_z, obs_camera *cam);
 
+/* Fits a centred perspective projection to an image of width x height:
+ * the vertical field of view stays, the horizontal one follows the aspect
+ * (x scale = y scale * height / width).  Returns 1 when it changed the
+ * projection, 0 when the projection is not a centred perspective (an
+ * off-centre or orthographic one is left as it is) or already fits. */
+int obs_camera_fit_aspect(obs_camera *cam, int width, int height);
+
 #ifdef __cplusplus
 }
 #endif

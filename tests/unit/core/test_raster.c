@@ -180,6 +180,47 @@ static void test_conventions(void **state)
     obs_scene_free(&scene);
 }
 
+/* Another aspect (obs_camera_fit_aspect, used by `obscura gbuffer
+ * --width --height`): twice as wide with the same vertical field of view,
+ * the middle W columns see exactly what the W x H image sees. */
+static void test_fit_aspect(void **state)
+{
+    (void)state;
+    obs_scene scene;
+    obs_camera cam, wide;
+    obs_raster a, b;
+    char err[OBS_ERR_LEN] = "";
+    load_test_scene(&scene);
+    look_at_camera(&cam);
+    wide = cam;
+    assert_int_equal(obs_camera_fit_aspect(&wide, W, H), 0); /* already fits */
+    assert_int_equal(obs_camera_fit_aspect(&wide, 2 * W, H), 1);
+    assert_float_equal(wide.projection[0], cam.projection[0] / 2, 1e-6);
+    assert_float_equal(wide.projection[5], cam.projection[5], 0);
+    if (obs_raster_gbuffer(ctx, &scene, &cam, W, H, &a, err) != OBS_OK ||
+        obs_raster_gbuffer(ctx, &scene, &wide, 2 * W, H, &b, err) != OBS_OK)
+        fail_msg("%s", err);
+    int same = 0, covered = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            float da = a.depth.data[(size_t)y * W + x];
+            float db = b.depth.data[(size_t)y * 2 * W + x + W / 2];
+            covered += da < OBS_SKY_DEPTH;
+            same += fabsf(da - db) <= 1e-4f * da;
+        }
+    print_message("fit aspect: %d of %d pixels equal (%d with geometry)\n", same, W * H, covered);
+    assert_true(covered > W * H / 4);
+    assert_true(same >= W * H - W * H / 1000); /* a rasterisation tie may differ */
+    /* an off-centre projection is left alone */
+    obs_camera off = cam;
+    off.projection[2] = 0.1f;
+    assert_int_equal(obs_camera_fit_aspect(&off, 2 * W, H), 0);
+    assert_float_equal(off.projection[0], cam.projection[0], 0);
+    obs_raster_free(&a);
+    obs_raster_free(&b);
+    obs_scene_free(&scene);
+}
+
 /* A triangle seen from its back gets its normal flipped towards the
  * camera; albedo from a material; OFF, PLY and glTF. */
 static void test_backface_albedo_formats(void **state)
@@ -369,6 +410,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_conventions),
+        cmocka_unit_test(test_fit_aspect),
         cmocka_unit_test(test_backface_albedo_formats),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_blender_room),
