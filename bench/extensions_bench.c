@@ -367,7 +367,7 @@ int main(int argc, char **argv)
         die("timer queries", err);
     obs_ctx_info info;
     obs_ctx_get_info(ctx, &info);
-    printf("Renderer: %s, %s (backend %s). Input: %s (%dx%d), nearest-neighbour scaled.",
+    printf("Renderer: %s, %s (backend %s). Input: %s (%dx%d), nearest-neighbour scaled to each size unless it has it.",
            info.gl_renderer, info.gl_version, obs_backend_name(info.backend), argv[i],
            gf.gb.width, gf.gb.height);
     for (int k = 0; k < nsets; k++)

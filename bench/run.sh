@@ -17,11 +17,26 @@ echo
 "$BUILD/frame_bench" "$@"
 echo
 # VAO++ Table 1: the extensions at 2..32 samples, 1080p and 4K, GL timer
-# queries (bench/extensions_bench.c); the first G-buffer, scaled
-"$BUILD/extensions_bench" "$1" "$2"
-echo
-# VAO++ Table 2: the other methods of --method at matching levels, 1080p
-"$BUILD/extensions_bench" --methods --sizes 1920x1080 "$1" "$2"
+# queries (bench/extensions_bench.c).  G-buffers rendered at those sizes
+# from the scene's mesh (obscura gbuffer, same camera, same vertical field
+# of view) when it is there, else the first G-buffer scaled.
+OBJ=${1%.exr}.obj
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+if [ -f "$OBJ" ]; then
+    for size in 1920x1080 3840x2160; do
+        "$BUILD/obscura" gbuffer "$OBJ" --camera "$2" --width "${size%x*}" --height "${size#*x}" \
+            -o "$TMP/$size.exr" -q
+        "$BUILD/extensions_bench" --sizes "$size" "$TMP/$size.exr"
+        echo
+    done
+    # VAO++ Table 2: the other methods of --method at matching levels, 1080p
+    "$BUILD/extensions_bench" --methods --sizes 1920x1080 "$TMP/1920x1080.exr"
+else
+    "$BUILD/extensions_bench" "$1" "$2"
+    echo
+    "$BUILD/extensions_bench" --methods --sizes 1920x1080 "$1" "$2"
+fi
 echo
 # the daemon: round trip vs in-process, concurrent clients (1920x1080)
 BUILD="$BUILD" bench/daemon_bench.sh "$1" "$2"
