@@ -282,12 +282,36 @@ static void progress(int tty, int done, int total, double t0, int frame, int rc,
         fputc('\n', stderr);
 }
 
-/* One worker: frames from the shared counter until none are left. */
+int cli_batch_rotate(const char *list, int k, char *buf, size_t len)
+{
+    int n = 1;
+    for (const char *p = list; *p; p++)
+        n += *p == ',';
+    k = ((k % n) + n) % n;
+    const char *start = list;
+    for (int i = 0; i < k; i++)
+        start = strchr(start, ',') + 1;
+    size_t total = strlen(list);
+    if (total >= len)
+        return -1;
+    /* "c,d" + "," + "a,b" */
+    size_t tail = strlen(start);
+    memcpy(buf, start, tail);
+    if (k > 0) {
+        buf[tail] = ',';
+        memcpy(buf + tail + 1, list, (size_t)(start - list) - 1);
+    }
+    buf[total] = '\0';
+    return 0;
+}
+
+/* One worker: frames from the shared counter until none are left.  With
+ * a list of servers, frame i starts at server i (round robin). */
 static void worker(int fd, shared *sh, const int *todo, int ntodo, const char *in, const char *out,
-                   char **extra, int nextra, const cli_batch_ops *ops)
+                   char **extra, int nextra, int server_at, const cli_batch_ops *ops)
 {
     char **av = malloc((size_t)(nextra + 4) * sizeof *av);
-    char inp[PATH_MAX], outp[PATH_MAX];
+    char inp[PATH_MAX], outp[PATH_MAX], servers[4096];
     for (;;) {
         int i = __atomic_fetch_add(&sh->next, 1, __ATOMIC_SEQ_CST);
         if (i >= ntodo || __atomic_load_n(&sh->stop, __ATOMIC_SEQ_CST))
@@ -303,6 +327,8 @@ static void worker(int fd, shared *sh, const int *todo, int ntodo, const char *i
             for (int k = 0; k < nextra; k++)
                 av[n++] = extra[k];
             av[n] = NULL;
+            if (server_at >= 0 && cli_batch_rotate(extra[server_at], i, servers, sizeof servers) == 0)
+                av[3 + server_at] = servers;
             r.rc = ops->ao(n, av);
         }
         r.seconds = now_s() - t0;
@@ -404,8 +430,10 @@ int cli_batch(int argc, char **argv, const cli_batch_ops *ops)
                                "context (for parallel frames run obscurad and pass --server)");
         goto done;
     }
+    int server_at = -1;
     if (server) {
         extra[nextra++] = "--server";
+        server_at = nextra;
         extra[nextra++] = (char *)server;
     }
     if (!quiet_given)
@@ -482,7 +510,7 @@ int cli_batch(int argc, char **argv, const cli_batch_ops *ops)
             break;
         if (p == 0) {
             close(fds[0]);
-            worker(fds[1], sh, todo, ntodo, in, out, extra, nextra, ops);
+            worker(fds[1], sh, todo, ntodo, in, out, extra, nextra, server_at, ops);
             close(fds[1]);
             free(extra);
             free(frames);

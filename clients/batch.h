@@ -32,6 +32,11 @@ int cli_batch_check_pattern(const char *pattern, char *err, size_t err_len);
  * pattern is not valid. */
 int cli_batch_expand(const char *pattern, int frame, char *buf, size_t len);
 
+/* The comma-separated list rotated to start at its k-th entry (modulo
+ * its length): ("a,b,c", 1) -> "b,c,a".  Returns 0, or -1 when it does
+ * not fit in buf. */
+int cli_batch_rotate(const char *list, int k, char *buf, size_t len);
+
 typedef struct cli_batch_ops {
     /* Validates `obscura ao` arguments (exits 2 on a usage error). */
     void (*check)(int argc, char **argv);

@@ -121,7 +121,10 @@ static const cli_opt ao_opts[] = {
     {"max-size", "N", "largest accepted width or height (default 16384)"},
     {"backend", "B", "auto|egl-device|egl-surfaceless|osmesa (or OBSCURA_BACKEND)"},
     {"cpu", NULL, "run the CPU twin instead of OpenGL (slow; for reference)"},
-    {"server", "URL", "run on obscurad: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT"},
+    {"server", "URL[,URL...]", "run on obscurad: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT; a "
+     "comma list spreads frames over several (the next one when one is busy or down)"},
+    {"stream", "NAME", "with an http:// --server: post the frame to the daemon's stream NAME too "
+     "(the preview page at the daemon's / shows it)"},
     {"debug-gl", NULL, "install the KHR_debug callback and log GL messages"},
     {"quiet", NULL, "only warnings and errors (-q)"},
     {"verbose", NULL, "debug messages too (-v)"},

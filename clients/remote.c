@@ -34,18 +34,37 @@ typedef struct server_addr {
     char host[256], port[16], path[108];
 } server_addr;
 
+static const char *stream_name; /* --stream NAME: post to /v1/streams/NAME/frames */
+
+static int stream_name_ok(const char *s)
+{
+    size_t n = strlen(s);
+    return n >= 1 && n <= 64 && strspn(s, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-") == n;
+}
+
 int cli_remote_take_server(int argc, char **argv, const char **server)
 {
     int n = 0;
     *server = NULL;
+    stream_name = NULL;
     for (int i = 0; i < argc; i++) {
         if (!strcmp(argv[i], "--server") && i + 1 < argc) {
             *server = argv[++i];
         } else if (!strncmp(argv[i], "--server=", 9)) {
             *server = argv[i] + 9;
+        } else if (!strcmp(argv[i], "--stream") && i + 1 < argc) {
+            stream_name = argv[++i];
+        } else if (!strncmp(argv[i], "--stream=", 9)) {
+            stream_name = argv[i] + 9;
         } else {
             argv[n++] = argv[i];
         }
+    }
+    if (stream_name && (!*server || !stream_name_ok(stream_name))) {
+        fprintf(stderr, "obscura: --stream '%s': %s\n(run 'obscura help' for usage)\n", stream_name,
+                !*server ? "needs --server http://HOST:PORT (streams live in obscurad)"
+                         : "a stream name is 1 to 64 characters of A-Z a-z 0-9 . _ -");
+        exit(RC_USAGE);
     }
     return n;
 }
@@ -376,8 +395,11 @@ static int http_once(const server_addr *a, const char *query, const unsigned cha
     int rc = -1;
     if (!head)
         goto done;
-    snprintf(head, hcap, "POST /v1/ao?%s HTTP/1.1\r\nHost: %s:%s\r\nContent-Type: image/x-exr\r\n"
-             "Content-Length: %zu\r\nConnection: close\r\n%s%s%s\r\n", query, a->host, a->port, body_len,
+    char path[96] = "/v1/ao";
+    if (stream_name)
+        snprintf(path, sizeof path, "/v1/streams/%s/frames", stream_name);
+    snprintf(head, hcap, "POST %s?%s HTTP/1.1\r\nHost: %s:%s\r\nContent-Type: image/x-exr\r\n"
+             "Content-Length: %zu\r\nConnection: close\r\n%s%s%s\r\n", path, query, a->host, a->port, body_len,
              token && *token ? "Authorization: Bearer " : "", token && *token ? token : "",
              token && *token ? "\r\n" : "");
     /* a 413 or 401 may come before the body is read; the answer counts */
@@ -467,27 +489,93 @@ static void sleep_s(int s)
     nanosleep(&ts, NULL);
 }
 
+static double mono_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
+}
+
+/* Servers this process found unreachable are passed over for a while
+ * (a batch worker runs many frames), unless every server is. */
+#define DOWN_FOR_S 30.0
+static struct {
+    char url[256];
+    double until;
+} down[CLI_REMOTE_MAX_SERVERS];
+
+static double down_until(const char *url)
+{
+    for (int i = 0; i < CLI_REMOTE_MAX_SERVERS; i++)
+        if (!strcmp(down[i].url, url))
+            return down[i].until;
+    return 0;
+}
+
+static void mark_down(const char *url, double until)
+{
+    int slot = 0;
+    for (int i = 0; i < CLI_REMOTE_MAX_SERVERS; i++) {
+        if (!strcmp(down[i].url, url) || !down[i].url[0]) {
+            slot = i;
+            break;
+        }
+        if (down[i].until < down[slot].until)
+            slot = i;
+    }
+    snprintf(down[slot].url, sizeof down[slot].url, "%s", url);
+    down[slot].until = until;
+}
+
+int cli_remote_split(const char *list, char urls[][256], int max)
+{
+    int n = 0;
+    for (const char *p = list;; p++) {
+        size_t len = strcspn(p, ",");
+        if (len == 0 || len >= 256 || n == max)
+            return -1;
+        memcpy(urls[n], p, len);
+        urls[n][len] = '\0';
+        n++;
+        p += len;
+        if (!*p)
+            return n;
+    }
+}
+
 int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
                    const obs_gbuffer *gb, unsigned outputs, obs_result *out)
 {
-    server_addr a;
-    static pairs ps;
-    static char names[OBS_BIN_MAX_PARAMS][OBS_BIN_MAX_NAME + 1];
+    static server_addr addrs[CLI_REMOTE_MAX_SERVERS];
+    static char urls[CLI_REMOTE_MAX_SERVERS][256];
+    static pairs ps, pb; /* the HTTP and the binary parameters */
+    static char names[OBS_BIN_MAX_PARAMS][OBS_BIN_MAX_NAME + 1], names_b[OBS_BIN_MAX_PARAMS][OBS_BIN_MAX_NAME + 1];
     char msg[OBS_ERR_LEN + 128] = "", cam[1024];
     const char *oname = outputs_name(outputs);
+    int nserv = cli_remote_split(server, urls, CLI_REMOTE_MAX_SERVERS), any_http = 0, any_bin = 0;
     memset(out, 0, sizeof *out);
-    ps.n = 0;
-    if (parse_server(server, &a) != 0) {
-        fprintf(stderr, "obscura: --server '%s' is not http://HOST:PORT, unix:/PATH or tcp://HOST:PORT\n",
-                server);
+    ps.n = pb.n = 0;
+    for (int k = 0; k < nserv; k++) {
+        if (parse_server(urls[k], &addrs[k]) != 0) {
+            nserv = -1;
+            break;
+        }
+        any_http |= addrs[k].kind == PROTO_HTTP;
+        any_bin |= addrs[k].kind != PROTO_HTTP;
+    }
+    if (nserv < 1) {
+        fprintf(stderr, "obscura: --server '%s' is not http://HOST:PORT, unix:/PATH or tcp://HOST:PORT "
+                "(or a comma-separated list of up to %d of them)\n", server, CLI_REMOTE_MAX_SERVERS);
+        return RC_USAGE;
+    }
+    if (stream_name && any_bin) {
+        fprintf(stderr, "obscura: --stream needs http:// servers (streams are an HTTP feature)\n");
         return RC_USAGE;
     }
     if (!oname) {
         fprintf(stderr, "obscura: --server: the daemon answers ao, composite or both, not this --output\n");
         return RC_USAGE;
     }
-    collect(argc, argv, a.kind == PROTO_HTTP, &ps, names);
-    add(&ps, "output", oname);
 
     obs_bytes frame = {0};
     unsigned char *body = NULL;
@@ -495,7 +583,10 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
     char *query = NULL;
     const char *token = getenv("OBSCURA_TOKEN");
     char err[OBS_ERR_LEN];
-    if (a.kind == PROTO_HTTP) {
+    int rc = RC_FAIL;
+    if (any_http) {
+        collect(argc, argv, 1, &ps, names);
+        add(&ps, "output", oname);
         add(&ps, "format", "exr");
         add(&ps, "float", "1");
         camera_params(gb, &ps, cam, sizeof cam);
@@ -506,43 +597,66 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
         size_t qcap = 1;
         for (int i = 0; i < ps.n; i++)
             qcap += strlen(ps.p[i].name) + 3 * strlen(ps.p[i].value) + 2;
-        if (!(query = malloc(qcap))) {
-            free(body);
-            return RC_FAIL;
-        }
+        if (!(query = malloc(qcap)))
+            goto fail;
         size_t o = 0;
         for (int i = 0; i < ps.n; i++) {
             char v[3 * OBS_BIN_MAX_VALUE + 1];
             url_encode(ps.p[i].value, v, sizeof v);
             o += (size_t)snprintf(query + o, qcap - o, "%s%s=%s", i ? "&" : "", ps.p[i].name, v);
         }
-    } else {
-        add(&ps, "format", "raw");
+    }
+    if (any_bin) {
+        collect(argc, argv, 0, &pb, names_b);
+        add(&pb, "output", oname);
+        add(&pb, "format", "raw");
         if (token && *token)
-            add(&ps, "token", token);
-        obs_bin_request_desc d = {.id = 1, .params = ps.p, .param_count = ps.n, .gb = gb};
+            add(&pb, "token", token);
+        obs_bin_request_desc d = {.id = 1, .params = pb.p, .param_count = pb.n, .gb = gb};
         if (obs_bin_request_encode(&d, &frame, err) != OBS_OK) {
             fprintf(stderr, "obscura: cannot encode the request: %s\n", err);
-            return RC_FAIL;
+            goto fail;
         }
     }
 
-    int rc = -1, attempts = ATTEMPTS;
+    /* Each round tries the servers in the order given (obscura batch
+     * rotates the list frame by frame), passing over one found down
+     * lately; a busy (503) or unreachable server hands the frame to the
+     * next.  When every server failed, wait and go round again. */
+    int attempts = ATTEMPTS, last = -1, k_last = 0;
     const char *env = getenv("OBSCURA_RETRIES");
     if (env && *env)
         attempts = 1 + (atoi(env) < 0 ? 0 : atoi(env) > 100 ? 100 : atoi(env));
-    for (int attempt = 1; attempt <= attempts; attempt++) {
-        int wait = 1;
-        obs_result_free(out);
-        rc = a.kind == PROTO_HTTP ? http_once(&a, query, body, body_len, outputs, out, &wait, msg, sizeof msg)
-                                  : binary_once(&a, &frame, out, &wait, msg, sizeof msg);
-        if ((rc != -1 && rc != 503) || attempt == attempts)
+    for (int round = 1; round <= attempts; round++) {
+        int wait = 1, tried = 0;
+        double now = mono_s();
+        for (int pass = 0; pass < 2 && !tried; pass++) /* pass 1: every server, if all are down */
+            for (int k = 0; k < nserv; k++) {
+                if (pass == 0 && nserv > 1 && down_until(urls[k]) > now)
+                    continue;
+                tried++;
+                obs_result_free(out);
+                last = addrs[k].kind == PROTO_HTTP
+                           ? http_once(&addrs[k], query, body, body_len, outputs, out, &wait, msg, sizeof msg)
+                           : binary_once(&addrs[k], &frame, out, &wait, msg, sizeof msg);
+                k_last = k;
+                if (last != -1 && last != 503)
+                    goto answered;
+                if (last == -1)
+                    mark_down(urls[k], mono_s() + DOWN_FOR_S);
+                if (nserv > 1)
+                    fprintf(stderr, "obscura: %s: %s; trying the next server\n", urls[k],
+                            last == -1 ? msg : "busy (503)");
+            }
+        if (round == attempts)
             break;
         wait = wait < 1 ? 1 : wait > MAX_WAIT_S ? MAX_WAIT_S : wait;
         fprintf(stderr, "obscura: %s: %s; retrying in %d s (%d of %d)\n", server,
-                rc == -1 ? msg : "busy (503)", wait, attempt, attempts - 1);
+                last == -1 ? msg : "busy (503)", wait, round, attempts - 1);
         sleep_s(wait);
     }
+answered:
+    rc = last;
     free(query);
     free(body);
     obs_bytes_free(&frame);
@@ -550,9 +664,14 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
         return RC_OK;
     obs_result_free(out);
     if (rc == -1) {
-        fprintf(stderr, "obscura: %s: unreachable: %s\n", server, msg);
+        fprintf(stderr, "obscura: %s: unreachable: %s\n", nserv > 1 ? server : urls[k_last], msg);
         return RC_UNAVAILABLE;
     }
-    fprintf(stderr, "obscura: %s: %s%s\n", server, msg, rc == 503 ? " (still busy after retries)" : "");
+    fprintf(stderr, "obscura: %s: %s%s\n", urls[k_last], msg, rc == 503 ? " (still busy after retries)" : "");
     return answer_rc(rc);
+fail:
+    free(query);
+    free(body);
+    obs_bytes_free(&frame);
+    return RC_FAIL;
 }

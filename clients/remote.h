@@ -8,16 +8,27 @@
  *   http://host:port              POST /v1/ao with the input EXR, the
  *                                 answer asked as a float EXR
  *
+ * URL may be a comma-separated list of servers: a frame goes to the
+ * first, and to the next when one is busy (503) or unreachable; a server
+ * found unreachable is passed over for 30 s (`obscura batch` rotates the
+ * list frame by frame, so frames are spread round robin).  With
+ * `--stream NAME` (HTTP only) the frame is posted to the daemon's stream
+ * NAME (POST /v1/streams/NAME/frames) for the preview page.
+ *
  * OBSCURA_TOKEN, when set, is sent as the bearer token.  OBSCURA_RETRIES
- * (0..100, default 4) is how often an unreachable or busy server is tried
- * again. */
+ * (0..100, default 4) is how often the servers, all unreachable or busy,
+ * are tried again. */
 #ifndef OBSCURA_CLIENT_REMOTE_H
 #define OBSCURA_CLIENT_REMOTE_H
 
 #include "obscura.h"
 
-/* Takes "--server URL" / "--server=URL" out of argv[0..argc-1] (argv is
- * compacted); returns the new argc.  *server is NULL when absent. */
+#define CLI_REMOTE_MAX_SERVERS 16
+
+/* Takes "--server URL" / "--server=URL" and "--stream NAME" out of
+ * argv[0..argc-1] (argv is compacted); returns the new argc.  *server is
+ * NULL when absent.  A --stream without --server, or with a bad name, is
+ * a usage error: it prints why and exits 2. */
 int cli_remote_take_server(int argc, char **argv, const char **server);
 
 /* Runs the frame on the daemon at `server`.  argv are the ao arguments
@@ -28,6 +39,11 @@ int cli_remote_take_server(int argc, char **argv, const char **server);
  * failure, 2 usage, 3 bad input (the server said 4xx other than 503), 4
  * server unreachable or busy (after bounded retries with Retry-After).
  * On 0 the caller frees *out with obs_result_free(). */
+/* Splits a comma-separated server list into urls (each < 256 bytes);
+ * returns how many, or -1 when an entry is empty or too long or there
+ * are more than max. */
+int cli_remote_split(const char *list, char urls[][256], int max);
+
 int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
                    const obs_gbuffer *gb, unsigned outputs, obs_result *out);
 

@@ -40,6 +40,15 @@
     X(token_file, STRING, 0, OBSD_STR_LEN - 1, "",                             \
       "file holding a bearer token; when set, /v1/* and /metrics need "        \
       "'Authorization: Bearer TOKEN'")                                         \
+    X(streams, INT, 0, 1024, "16",                                             \
+      "streams of frames kept for the preview page (POST /v1/streams/NAME/"   \
+      "frames); a new one beyond drops the least recently posted-to (0: "      \
+      "streams off)")                                                          \
+    X(stream_frames, INT, 1, 1024, "8",                                        \
+      "frames kept per stream (the oldest is dropped)")                        \
+    X(stream_memory, SIZE, 1048576, 17179869184, "256m",                       \
+      "memory a stream's frames may hold (input EXR, AO, composite, colour); " \
+      "the oldest are dropped beyond it, the newest is always kept")          \
     X(backend, ENUM, 0, 0, "auto",                                             \
       "GL backend: auto|egl-device|egl-surfaceless|osmesa (default: "          \
       "OBSCURA_BACKEND, else auto)")                                           \

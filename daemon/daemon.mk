@@ -16,6 +16,14 @@ E2E_DEPS += $(OBSCURAD)
 
 $(BUILD)/obj/daemon/%.o: CPPFLAGS += -Iprotocol
 
+# The preview page (daemon/preview) is embedded into the daemon.
+PAGE_FILES := $(sort $(wildcard daemon/preview/*))
+PAGE_HDR := $(BUILD)/gen/obsd_page.h
+$(PAGE_HDR): $(PAGE_FILES) tools/embed_files.sh
+	@mkdir -p $(dir $@)
+	tools/embed_files.sh $(PAGE_FILES) > $@.tmp && mv $@.tmp $@
+$(BUILD)/obj/daemon/http_page.o: $(PAGE_HDR)
+
 $(DAEMON_LIB): $(filter-out $(DAEMON_MAIN),$(DAEMON_OBJ))
 	@rm -f $@
 	ar rcs $@ $^

@@ -1,5 +1,7 @@
 /* The HTTP API of obscurad: routes, limits, the frame path.
  *
+ * (/v1/streams is in http_streams.c, the page in http_page.c.)
+ *
  *   first call    route, method, token, query parameters, Content-Length
  *                 (413 before any of the body is read)
  *   body calls    append, 413 when it grows over --max-body
@@ -8,9 +10,8 @@
  *   resumed       the GL worker is done: encode here, answer */
 #include <arpa/inet.h>
 #include <errno.h>
-#include <microhttpd.h>
+#include <math.h>
 #include <netinet/in.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,56 +20,10 @@
 
 #include <cjson/cJSON.h>
 
-#include "http.h"
-#include "http_server.h"
-#include "io.h"
+#include "http_internal.h"
 #include "log.h"
-#include "stats.h"
 
-struct obsd_http {
-    struct MHD_Daemon *mhd;
-    const obsd_config *cfg;
-    const char *token;
-    obsd_queue *queue;
-    obsd_gl_worker *gl;
-    int port;
-    MHD_socket listen_fd;
-    atomic_int in_flight;
-    atomic_int draining;
-    atomic_uint_fast64_t next_id;
-};
-
-typedef enum req_state {
-    REQ_NEW,
-    REQ_BODY,     /* reading the body of POST /v1/ao */
-    REQ_QUEUED,   /* suspended; the GL worker has the job */
-    REQ_REFUSED,  /* suspended and resumed at once: the queue was full */
-    REQ_ANSWERED
-} req_state;
-
-typedef struct req {
-    obsd_http *srv;
-    struct MHD_Connection *conn;
-    uint64_t id;
-    obsd_route route;
-    req_state state;
-    char method[8];
-    char peer[64];
-    double t0;
-    /* POST /v1/ao */
-    unsigned char *body;
-    size_t len, cap;
-    int too_big;
-    size_t discarded;    /* bytes thrown away after too_big */
-    int before_drain;    /* started before SIGTERM: finished in the drain */
-    obs_http_request hr;
-    obs_gbuffer_file gf;
-    obsd_job job;
-    double ms_decode, ms_queue, ms_gl, ms_encode;
-    /* answer */
-    int status;
-    size_t bytes_out;
-} req;
+typedef obsd__req req;
 
 /* ---- answers --------------------------------------------------------- */
 
@@ -79,13 +34,12 @@ static void log_request(const req *r, const char *note)
     obsd_log(OBSD_LOG_INFO,
              "req=%llu peer=%s %s %s status=%d in=%zu out=%zu queue=%.1f decode=%.1f gl=%.1f "
              "encode=%.1f total=%.1f ms%s%s",
-             (unsigned long long)r->id, r->peer, r->method, obsd_route_path(r->route), r->status,
+             (unsigned long long)r->id, r->peer, r->method, r->path, r->status,
              r->len + r->discarded, r->bytes_out, r->ms_queue, r->ms_decode, r->ms_gl, r->ms_encode,
              obsd_now_ms() - r->t0, note && *note ? " " : "", note ? note : "");
 }
 
-/* Queues `resp` (taking it) with status; logs and counts the request. */
-static enum MHD_Result answer(req *r, int status, struct MHD_Response *resp, size_t body_len,
+enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size_t body_len,
                               const char *note)
 {
     if (!resp)
@@ -97,13 +51,13 @@ static enum MHD_Result answer(req *r, int status, struct MHD_Response *resp, siz
     enum MHD_Result rc = MHD_queue_response(r->conn, (unsigned)status, resp);
     MHD_destroy_response(resp);
     obsd_stats_request(r->route, status, r->len + r->discarded, body_len);
-    if (r->route == OBSD_ROUTE_AO)
+    if (r->route == OBSD_ROUTE_AO || r->op == STREAM_POST)
         obsd_stats_stage(OBSD_STAGE_TOTAL, obsd_now_ms() - r->t0);
     log_request(r, rc == MHD_YES ? note : "(could not queue the answer)");
     return rc;
 }
 
-static enum MHD_Result answer_text(req *r, int status, const char *type, char *text, size_t len,
+enum MHD_Result obsd__answer_text(req *r, int status, const char *type, char *text, size_t len,
                                    const char *note)
 {
     struct MHD_Response *resp =
@@ -113,11 +67,10 @@ static enum MHD_Result answer_text(req *r, int status, const char *type, char *t
         return MHD_NO;
     }
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, type);
-    return answer(r, status, resp, len, note);
+    return obsd__answer(r, status, resp, len, note);
 }
 
-/* The JSON error body; `extra` adds one header (name, value) when set. */
-static enum MHD_Result answer_error(req *r, int status, const char *code, const char *msg,
+enum MHD_Result obsd__answer_error(req *r, int status, const char *code, const char *msg,
                                     const char *hname, const char *hvalue)
 {
     char *body = obs_http_error_json(code, msg);
@@ -134,14 +87,14 @@ static enum MHD_Result answer_error(req *r, int status, const char *code, const 
         MHD_add_response_header(resp, hname, hvalue);
     char note[OBS_ERR_LEN + 32];
     snprintf(note, sizeof note, "error=%s: %s", code, msg);
-    return answer(r, status, resp, len, note);
+    return obsd__answer(r, status, resp, len, note);
 }
 
-static enum MHD_Result answer_status(req *r, obs_status s, const char *msg)
+enum MHD_Result obsd__answer_status(req *r, obs_status s, const char *msg)
 {
     const char *code;
     int http = obs_http_status_of(s, &code);
-    return answer_error(r, http, code, msg && *msg ? msg : obs_status_message(s),
+    return obsd__answer_error(r, http, code, msg && *msg ? msg : obs_status_message(s),
                         http == 503 ? MHD_HTTP_HEADER_RETRY_AFTER : NULL, "1");
 }
 
@@ -157,6 +110,7 @@ static void gauges(obsd_http *h, obsd_gauges *g)
     g->in_flight = atomic_load(&h->in_flight);
     g->gl_alive = atomic_load(&h->gl->alive);
     g->gl_recreations = (unsigned long long)atomic_load(&h->gl->recreations);
+    obsd_streams_gauges(h->streams, &g->streams, &g->stream_frames, &g->stream_bytes, &g->sse_subscribers);
 }
 
 static enum MHD_Result get_info(req *r)
@@ -176,7 +130,7 @@ static enum MHD_Result get_info(req *r)
     cJSON_AddNumberToObject(o, "max_body", (double)h->cfg->max_body);
     char *text = cJSON_Print(o);
     cJSON_Delete(o);
-    return text ? answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
+    return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
 }
 
 static enum MHD_Result get_route(req *r)
@@ -185,13 +139,13 @@ static enum MHD_Result get_route(req *r)
     switch (r->route) {
     case OBSD_ROUTE_PARAMS: {
         char *text = obs_http_params_json();
-        return text ? answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
+        return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
     }
     case OBSD_ROUTE_INFO:
         return get_info(r);
     case OBSD_ROUTE_HEALTHZ: {
         char *text = strdup("ok\n");
-        return text ? answer_text(r, 200, "text/plain", text, 3, NULL) : MHD_NO;
+        return text ? obsd__answer_text(r, 200, "text/plain", text, 3, NULL) : MHD_NO;
     }
     case OBSD_ROUTE_READYZ: {
         obsd_gauges g;
@@ -202,38 +156,106 @@ static enum MHD_Result get_route(req *r)
                           : atomic_load(&h->draining) ? "shutting down"
                           : full ? "queue full" : NULL;
         if (why)
-            return answer_error(r, 503, "not_ready", why, MHD_HTTP_HEADER_RETRY_AFTER, "1");
+            return obsd__answer_error(r, 503, "not_ready", why, MHD_HTTP_HEADER_RETRY_AFTER, "1");
         char *text = strdup("ready\n");
-        return text ? answer_text(r, 200, "text/plain", text, 6, NULL) : MHD_NO;
+        return text ? obsd__answer_text(r, 200, "text/plain", text, 6, NULL) : MHD_NO;
     }
     case OBSD_ROUTE_METRICS: {
         obsd_gauges g;
         size_t len = 0;
         gauges(h, &g);
         char *text = obsd_stats_text(&g, &len);
-        return text ? answer_text(r, 200, "text/plain; version=0.0.4", text, len, NULL) : MHD_NO;
+        return text ? obsd__answer_text(r, 200, "text/plain; version=0.0.4", text, len, NULL) : MHD_NO;
     }
     default:
-        return answer_error(r, 404, "not_found", "no such route", NULL, NULL);
+        return obsd__answer_error(r, 404, "not_found", "no such route", NULL, NULL);
     }
 }
 
-/* ---- POST /v1/ao ----------------------------------------------------- */
+/* ---- frames: POST /v1/ao and the streams' frames ---------------------- */
 
 typedef struct arg_ctx {
-    obs_http_request *hr;
+    req *r;
     obs_status status;
     char err[OBS_ERR_LEN];
 } arg_ctx;
 
+static int record_pair(req *r, const char *key, const char *value)
+{
+    size_t kl = strlen(key) + 1, vl = strlen(value) + 1;
+    if (r->query_len + kl + vl > r->query_cap) {
+        size_t cap = (r->query_cap ? r->query_cap * 2 : 256) + kl + vl;
+        char *p = realloc(r->query, cap);
+        if (!p)
+            return -1;
+        r->query = p;
+        r->query_cap = cap;
+    }
+    memcpy(r->query + r->query_len, key, kl);
+    memcpy(r->query + r->query_len + kl, value, vl);
+    r->query_len += kl + vl;
+    return 0;
+}
+
+static int name_is(const char *name, const char *want)
+{
+    for (; *name && *want; name++, want++)
+        if ((*name == '-' ? '_' : *name) != *want)
+            return 0;
+    return *name == *want;
+}
+
 static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
 {
     arg_ctx *a = cls;
+    req *r = a->r;
     (void)kind;
     if (a->status != OBS_OK)
         return MHD_NO;
-    a->status = obs_http_request_set(a->hr, key, value, a->err);
+    if (!value)
+        value = "";
+    if (r->op == STREAM_FRAME) {
+        /* a stored frame: the view options, and anything else re-runs it */
+        if (name_is(key, "exposure")) {
+            char *end;
+            double ev = strtod(value, &end);
+            if (end == value || *end || !(ev >= -20.0 && ev <= 20.0)) {
+                snprintf(a->err, OBS_ERR_LEN, "parameter exposure: '%.100s' is not a number in [-20, 20] "
+                         "(stops)", value);
+                a->status = OBS_INVALID_ARGUMENT;
+                return MHD_NO;
+            }
+            r->exposure = ev;
+            return MHD_YES;
+        }
+        if (name_is(key, "output") && !strcmp(value, "color")) {
+            r->want_color = 1;
+            return MHD_YES;
+        }
+        if (name_is(key, "output"))
+            r->want_color = 0;
+        else if (!name_is(key, "format") && !name_is(key, "float") && !name_is(key, "png_bits"))
+            r->rerun = 1;
+    }
+    a->status = obs_http_request_set(&r->hr, key, value, a->err);
+    if (a->status == OBS_OK && r->record_query && record_pair(r, key, value) != 0) {
+        snprintf(a->err, OBS_ERR_LEN, "no memory for the query");
+        a->status = OBS_NO_MEMORY;
+    }
     return a->status == OBS_OK ? MHD_YES : MHD_NO;
+}
+
+int obsd__parse_query(req *r, enum MHD_Result *rc)
+{
+    arg_ctx a = {r, OBS_OK, ""};
+    MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
+    if (a.status == OBS_OK)
+        a.status = obs_http_request_check(&r->hr, a.err);
+    if (a.status == OBS_OK)
+        return 1;
+    *rc = a.status == OBS_INVALID_ARGUMENT ? obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL)
+                                           : obsd__answer_status(r, a.status, a.err);
+    return 0;
 }
 
 /* Called on the GL worker thread: give the connection back to MHD. */
@@ -244,24 +266,21 @@ static void job_done(obsd_job *job, void *user)
     MHD_resume_connection(r->conn);
 }
 
-static enum MHD_Result ao_start(req *r)
+enum MHD_Result obsd__frame_start(req *r)
 {
     obsd_http *h = r->srv;
     const char *v;
+    enum MHD_Result rc;
     r->before_drain = !atomic_load(&h->draining);
     if (!r->before_drain)
-        return answer_error(r, 503, "shutting_down", "the daemon is shutting down",
+        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
                             MHD_HTTP_HEADER_RETRY_AFTER, "5");
-    arg_ctx a = {&r->hr, OBS_OK, ""};
     obs_http_request_init(&r->hr);
-    MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
-    if (a.status == OBS_OK)
-        a.status = obs_http_request_check(&r->hr, a.err);
-    if (a.status != OBS_OK)
-        return answer_error(r, 400, "bad_parameter", a.err, NULL, NULL);
+    if (!obsd__parse_query(r, &rc))
+        return rc;
     v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
     if (v && strncmp(v, "image/x-exr", 11) != 0 && strncmp(v, "application/octet-stream", 24) != 0)
-        return answer_error(r, 415, "unsupported_media_type",
+        return obsd__answer_error(r, 415, "unsupported_media_type",
                             "the body must be a G-buffer EXR (Content-Type: image/x-exr)", NULL, NULL);
     v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
     if (v) {
@@ -272,18 +291,18 @@ static enum MHD_Result ao_start(req *r)
             char msg[160];
             snprintf(msg, sizeof msg, "body of %s bytes is over the limit of %lld bytes (--max-body)",
                      v, (long long)h->cfg->max_body);
-            return answer_error(r, 413, "body_too_large", msg, NULL, NULL);
+            return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
         }
         /* Sized by the claim, which is within the limit; grows if it lied. */
         r->cap = n ? (size_t)n : 0;
         if (r->cap && !(r->body = malloc(r->cap)))
-            return answer_status(r, OBS_NO_MEMORY, "no memory for the body");
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the body");
     }
     /* Refuse early when the queue is already full: no need for the body. */
     int full;
     obsd_queue_stats(h->queue, NULL, NULL, &full);
     if (full)
-        return answer_error(r, 503, "queue_full", "the frame queue is full; retry later",
+        return obsd__answer_error(r, 503, "queue_full", "the frame queue is full; retry later",
                             MHD_HTTP_HEADER_RETRY_AFTER, "1");
     r->state = REQ_BODY;
     return MHD_YES;
@@ -308,8 +327,9 @@ static enum MHD_Result ao_body(req *r, const char *data, size_t *size)
         }
         r->discarded += n;
         if (r->discarded > max) {
-            obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s POST /v1/ao: body over twice --max-body, "
-                     "connection closed", (unsigned long long)r->id, r->peer);
+            obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: body over twice --max-body, "
+                     "connection closed", (unsigned long long)r->id, r->peer, r->method,
+                     obsd_route_path(r->route));
             return MHD_NO;
         }
         return MHD_YES;
@@ -320,7 +340,7 @@ static enum MHD_Result ao_body(req *r, const char *data, size_t *size)
             cap = cap > max / 2 ? max : cap * 2;
         unsigned char *p = realloc(r->body, cap);
         if (!p)
-            return answer_status(r, OBS_NO_MEMORY, "no memory for the body");
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the body");
         r->body = p;
         r->cap = cap;
     }
@@ -329,25 +349,19 @@ static enum MHD_Result ao_body(req *r, const char *data, size_t *size)
     return MHD_YES;
 }
 
-static enum MHD_Result ao_run(req *r)
+enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len, unsigned outputs)
 {
     obsd_http *h = r->srv;
     char err[OBS_ERR_LEN] = "";
     obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
-    if (r->len == 0)
-        return answer_error(r, 400, "empty_body", "POST /v1/ao needs a G-buffer EXR as its body",
-                            NULL, NULL);
     double t0 = obsd_now_ms();
-    obs_status s = obs_gbuffer_read_exr_mem(r->body, r->len, &r->hr.map, &lim, &r->gf, err);
+    obs_status s = obs_gbuffer_read_exr_mem(body, len, &r->hr.map, &lim, &r->gf, err);
     r->ms_decode = obsd_now_ms() - t0;
     obsd_stats_stage(OBSD_STAGE_DECODE, r->ms_decode);
-    free(r->body);
-    r->body = NULL;
-    r->cap = 0;
     if (s != OBS_OK)
-        return answer_status(r, s, err);
+        return obsd__answer_status(r, s, err);
 
-    r->job = (obsd_job){.gb = &r->gf.gb, .params = &r->hr.params, .outputs = r->hr.outputs,
+    r->job = (obsd_job){.gb = &r->gf.gb, .params = &r->hr.params, .outputs = outputs,
                         .done = job_done, .user = r};
     /* Suspend before queueing: the worker may finish and resume at once. */
     r->state = REQ_QUEUED;
@@ -359,52 +373,114 @@ static enum MHD_Result ao_run(req *r)
     return MHD_YES;
 }
 
-/* Called again once the GL worker resumed the connection. */
-static enum MHD_Result ao_finish(req *r)
+static enum MHD_Result ao_run(req *r)
+{
+    if (r->len == 0) {
+        char msg[128];
+        snprintf(msg, sizeof msg, "%s %s needs a G-buffer EXR as its body", r->method,
+                 r->op == STREAM_POST ? "/v1/streams/NAME/frames" : "/v1/ao");
+        return obsd__answer_error(r, 400, "empty_body", msg, NULL, NULL);
+    }
+    if (r->op == STREAM_POST) /* the body is kept with the frame: re-runs decode it again */
+        return obsd__queue_frame(r, r->body, r->len, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE);
+    enum MHD_Result rc = obsd__queue_frame(r, r->body, r->len, r->hr.outputs);
+    free(r->body);
+    r->body = NULL;
+    r->cap = 0;
+    return rc;
+}
+
+void obsd__job_timings(req *r)
 {
     obsd_job *job = &r->job;
-    char err[OBS_ERR_LEN] = "";
     r->ms_queue = job->t_started - job->t_queued;
     r->ms_gl = job->t_finished - job->t_started;
     obsd_stats_stage(OBSD_STAGE_QUEUE, r->ms_queue);
     obsd_stats_stage(OBSD_STAGE_GL, r->ms_gl);
-    if (job->status != OBS_OK)
-        return answer_status(r, job->status, job->err);
-    obsd_stats_frame(r->gf.gb.width, r->gf.gb.height);
+    if (job->status == OBS_OK)
+        obsd_stats_frame(r->gf.gb.width, r->gf.gb.height);
+}
 
+/* A copy of a colour image with its RGB times 2^ev (alpha kept). */
+static int expose(const obs_image *src, double ev, obs_image *out)
+{
+    size_t n = (size_t)src->width * (size_t)src->height;
+    float k = (float)pow(2.0, ev);
+    *out = *src;
+    if (!(out->data = malloc(n * (size_t)src->channels * sizeof(float))))
+        return -1;
+    for (size_t i = 0; i < n * (size_t)src->channels; i++)
+        out->data[i] = (src->channels == 4 && i % 4 == 3) ? src->data[i] : src->data[i] * k;
+    return 0;
+}
+
+enum MHD_Result obsd__answer_images(req *r, const obs_image *ao, const obs_image *composite,
+                                    const obs_image *color, const obs_camera *cam, int timing,
+                                    const char *extra_name, const char *extra_value)
+{
+    char err[OBS_ERR_LEN] = "";
     double t0 = obsd_now_ms();
     obs_bytes out = {0};
     obs_status s;
     const char *type;
-    const obs_result *res = &job->result;
     if (r->hr.format == OBS_HTTP_EXR) {
+        obs_result tmp = {0};
         obs_exr_layer layers[OBS_RESULT_LAYERS];
-        int n = obs_result_exr_layers(res, layers);
-        const obs_camera *cam = r->gf.gb.camera.has_projection ? &r->gf.gb.camera : NULL;
+        if (ao)
+            tmp.ao = *ao;
+        if (composite || color)
+            tmp.composite = composite ? *composite : *color;
+        int n = obs_result_exr_layers(&tmp, layers);
         s = obs_exr_write_mem(layers, n, r->hr.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, &out, err);
         type = "image/x-exr";
     } else {
-        const obs_image *img = res->ao.data ? &res->ao : &res->composite;
-        s = obs_png_write_mem(img, r->hr.png_bits, img == &res->composite, &out, err);
+        const obs_image *img = ao ? ao : composite ? composite : color;
+        obs_image exposed = {0};
+        if (img != ao && r->exposure != 0.0) {
+            if (expose(img, r->exposure, &exposed) != 0)
+                return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the image");
+            img = &exposed;
+        }
+        s = obs_png_write_mem(img, r->hr.png_bits, img != ao, &out, err);
+        obs_image_free(&exposed);
         type = "image/png";
     }
     r->ms_encode = obsd_now_ms() - t0;
     obsd_stats_stage(OBSD_STAGE_ENCODE, r->ms_encode);
-    obs_result_free(&job->result);
     if (s != OBS_OK)
-        return answer_error(r, 500, "encode_failed", err, NULL, NULL);
+        return obsd__answer_error(r, 500, "encode_failed", err, NULL, NULL);
 
     struct MHD_Response *resp = MHD_create_response_from_buffer(out.size, out.data, MHD_RESPMEM_MUST_FREE);
     if (!resp) {
         obs_bytes_free(&out);
         return MHD_NO;
     }
-    char timing[192];
-    snprintf(timing, sizeof timing, "queue;dur=%.2f, decode;dur=%.2f, gl;dur=%.2f, encode;dur=%.2f",
-             r->ms_queue, r->ms_decode, r->ms_gl, r->ms_encode);
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, type);
-    MHD_add_response_header(resp, "Server-Timing", timing);
-    return answer(r, 200, resp, out.size, NULL);
+    if (timing) {
+        char t[192];
+        snprintf(t, sizeof t, "queue;dur=%.2f, decode;dur=%.2f, gl;dur=%.2f, encode;dur=%.2f",
+                 r->ms_queue, r->ms_decode, r->ms_gl, r->ms_encode);
+        MHD_add_response_header(resp, "Server-Timing", t);
+    }
+    if (extra_name)
+        MHD_add_response_header(resp, extra_name, extra_value);
+    return obsd__answer(r, 200, resp, out.size, NULL);
+}
+
+/* Called again once the GL worker resumed the connection. */
+static enum MHD_Result ao_finish(req *r)
+{
+    obsd_job *job = &r->job;
+    obsd__job_timings(r);
+    if (job->status != OBS_OK)
+        return obsd__answer_status(r, job->status, job->err);
+    const obs_result *res = &job->result;
+    const obs_camera *cam = r->gf.gb.camera.has_projection ? &r->gf.gb.camera : NULL;
+    enum MHD_Result rc = obsd__answer_images(r, res->ao.data ? &res->ao : NULL,
+                                             res->composite.data ? &res->composite : NULL, NULL, cam, 1,
+                                             NULL, NULL);
+    obs_result_free(&job->result);
+    return rc;
 }
 
 /* ---- dispatch -------------------------------------------------------- */
@@ -439,26 +515,35 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         r->t0 = obsd_now_ms();
         r->route = obsd_route_of(url);
         snprintf(r->method, sizeof r->method, "%s", method);
+        snprintf(r->path, sizeof r->path, "%s", url);
+        for (char *c = r->path; *c; c++)
+            if ((unsigned char)*c < 0x21 || (unsigned char)*c > 0x7e)
+                *c = '?';
         peer_name(conn, r->peer, sizeof r->peer);
 
+        if (r->route == OBSD_ROUTE_PAGE) /* the page is static: no token */
+            return obsd__page(r, url);
         if (r->route == OBSD_ROUTE_OTHER)
-            return answer_error(r, 404, "not_found", "no such route (try GET /v1/params)", NULL, NULL);
+            return obsd__answer_error(r, 404, "not_found", "no such route (try GET /v1/params)", NULL, NULL);
         const char *allowed = r->route == OBSD_ROUTE_AO ? "POST" : "GET";
-        if (strcmp(method, allowed) != 0 && !(r->route != OBSD_ROUTE_AO && !strcmp(method, "HEAD"))) {
+        if (r->route != OBSD_ROUTE_STREAMS && strcmp(method, allowed) != 0 &&
+            !(r->route != OBSD_ROUTE_AO && !strcmp(method, "HEAD"))) {
             char msg[64];
             snprintf(msg, sizeof msg, "%s takes %s", obsd_route_path(r->route), allowed);
-            return answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, allowed);
+            return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, allowed);
         }
         /* Probes stay open; the API and the metrics need the token. */
         if (h->token && r->route != OBSD_ROUTE_HEALTHZ && r->route != OBSD_ROUTE_READYZ &&
             !obs_http_bearer_ok(MHD_lookup_connection_value(conn, MHD_HEADER_KIND,
                                                             MHD_HTTP_HEADER_AUTHORIZATION),
                                 h->token))
-            return answer_error(r, 401, "unauthorized", "missing or wrong bearer token",
+            return obsd__answer_error(r, 401, "unauthorized", "missing or wrong bearer token",
                                 MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"obscurad\"");
+        if (r->route == OBSD_ROUTE_STREAMS)
+            return obsd__streams_start(r, url);
         if (r->route != OBSD_ROUTE_AO)
             return get_route(r);
-        return ao_start(r);
+        return obsd__frame_start(r);
     }
     switch (r->state) {
     case REQ_BODY:
@@ -468,13 +553,13 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
             char msg[160];
             snprintf(msg, sizeof msg, "body is over the limit of %lld bytes (--max-body)",
                      (long long)h->cfg->max_body);
-            return answer_error(r, 413, "body_too_large", msg, NULL, NULL);
+            return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
         }
         return ao_run(r);
     case REQ_QUEUED:
-        return ao_finish(r);
+        return r->route == OBSD_ROUTE_STREAMS ? obsd__streams_finish(r) : ao_finish(r);
     case REQ_REFUSED:
-        return answer_error(r, 503, atomic_load(&h->draining) ? "shutting_down" : "queue_full",
+        return obsd__answer_error(r, 503, atomic_load(&h->draining) ? "shutting_down" : "queue_full",
                             "the frame queue is full; retry later", MHD_HTTP_HEADER_RETRY_AFTER, "1");
     default:
         /* Answered already; discard what else the client sends. */
@@ -494,6 +579,7 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
     if (why != MHD_REQUEST_TERMINATED_COMPLETED_OK && r->state != REQ_ANSWERED)
         obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s ended without an answer (reason %d)",
                  (unsigned long long)r->id, r->peer, r->method, obsd_route_path(r->route), (int)why);
+    obsd__streams_done(r);
     free(r->body);
     obs_result_free(&r->job.result);
     obs_gbuffer_free(&r->gf);
@@ -550,6 +636,10 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
     h->queue = q;
     h->gl = gl;
     h->listen_fd = MHD_INVALID_SOCKET;
+    if (!(h->streams = obsd_streams_new(cfg->streams, cfg->stream_frames, cfg->stream_memory))) {
+        free(h);
+        return OBS_NO_MEMORY;
+    }
     atomic_init(&h->in_flight, 0);
     atomic_init(&h->draining, 0);
     atomic_init(&h->next_id, 0);
@@ -565,6 +655,7 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
     if (!h->mhd) {
         snprintf(err, OBS_ERR_LEN, "cannot listen on %s (in use, or not an address of this host?)",
                  cfg->http);
+        obsd_streams_free(h->streams);
         free(h);
         return OBS_IO;
     }
@@ -579,11 +670,18 @@ int obsd_http_port(const obsd_http *h) { return h->port; }
 void obsd_http_quiesce(obsd_http *h)
 {
     atomic_store(&h->draining, 1);
+    obsd_streams_end_all(h->streams); /* event streams end, so that the drain ends */
     if (h->listen_fd == MHD_INVALID_SOCKET)
         h->listen_fd = MHD_quiesce_daemon(h->mhd);
 }
 
 int obsd_http_in_flight(obsd_http *h) { return atomic_load(&h->in_flight); }
+
+void obsd_http_tick(obsd_http *h)
+{
+    if (h)
+        obsd_streams_tick(h->streams, obsd_now_ms());
+}
 
 void obsd_http_stop(obsd_http *h)
 {
@@ -593,5 +691,6 @@ void obsd_http_stop(obsd_http *h)
     /* MHD hands the quiesced socket to us, to close after the stop. */
     if (h->listen_fd != MHD_INVALID_SOCKET)
         close(h->listen_fd);
+    obsd_streams_free(h->streams);
     free(h);
 }

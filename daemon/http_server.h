@@ -16,10 +16,12 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
 /* The port it listens on (useful with port 0). */
 int obsd_http_port(const obsd_http *h);
 /* Stops accepting connections; requests under way go on.  New frames on
- * open connections are answered 503. */
+ * open connections are answered 503; event streams (SSE) end. */
 void obsd_http_quiesce(obsd_http *h);
 /* Requests between their first byte and their answer being sent. */
 int obsd_http_in_flight(obsd_http *h);
+/* Wakes event streams whose keep-alive is due; call a few times a second. */
+void obsd_http_tick(obsd_http *h);
 /* Closes every connection and frees the server; call when in_flight is 0. */
 void obsd_http_stop(obsd_http *h);
 

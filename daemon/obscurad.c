@@ -177,8 +177,10 @@ int main(int argc, char **argv)
                  (long long)cfg.max_pixels, (long long)cfg.max_body, token[0] ? ", token required" : "");
     }
 
-    while (!stop_requested)
+    while (!stop_requested) {
         sleep_ms(200);
+        obsd_http_tick(http); /* event streams' keep-alives */
+    }
 
     /* Drain: no new connections; every frame taken is finished and
      * answered before the server stops. */

@@ -8,7 +8,8 @@
 #include "stats.h"
 
 static const char *const route_paths[OBSD_ROUTE_COUNT] = {
-    "/v1/ao", "/v1/params", "/v1/info", "/healthz", "/readyz", "/metrics", "binary", "other"};
+    "/v1/ao", "/v1/params", "/v1/info", "/healthz", "/readyz", "/metrics", "/v1/streams", "/",
+    "binary", "other"};
 static const char *const stage_names[OBSD_STAGE_COUNT] = {"queue", "decode", "gl", "encode", "total"};
 /* The statuses the daemon answers; anything else counts as the last. */
 static const int codes[] = {200, 400, 401, 404, 405, 413, 415, 422, 500, 503, 0};
@@ -38,9 +39,13 @@ const char *obsd_route_path(obsd_route r)
 
 obsd_route obsd_route_of(const char *path)
 {
-    for (int r = 0; r < OBSD_ROUTE_OTHER; r++)
+    for (int r = 0; r < OBSD_ROUTE_BINARY; r++)
         if (path && !strcmp(path, route_paths[r]))
             return (obsd_route)r;
+    if (path && !strncmp(path, "/v1/streams/", 12))
+        return OBSD_ROUTE_STREAMS;
+    if (path && !strncmp(path, "/preview/", 9))
+        return OBSD_ROUTE_PAGE;
     return OBSD_ROUTE_OTHER;
 }
 
@@ -194,6 +199,19 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
             "obscurad_gl_context_recreations_total %llu\n",
         g->queue_depth, g->queue_capacity, g->gl_running, g->in_flight, g->gl_alive,
         g->gl_recreations);
+    put(&b, "# HELP obscurad_streams Streams of frames kept for the preview page.\n"
+            "# TYPE obscurad_streams gauge\n"
+            "obscurad_streams %d\n"
+            "# HELP obscurad_stream_frames Frames kept over all streams.\n"
+            "# TYPE obscurad_stream_frames gauge\n"
+            "obscurad_stream_frames %d\n"
+            "# HELP obscurad_stream_bytes Memory held by the kept frames.\n"
+            "# TYPE obscurad_stream_bytes gauge\n"
+            "obscurad_stream_bytes %llu\n"
+            "# HELP obscurad_event_subscribers Open event streams (GET /v1/streams/NAME/events).\n"
+            "# TYPE obscurad_event_subscribers gauge\n"
+            "obscurad_event_subscribers %d\n",
+        g->streams, g->stream_frames, (unsigned long long)g->stream_bytes, g->sse_subscribers);
     if (b.failed) {
         free(b.p);
         return NULL;

@@ -13,6 +13,8 @@ typedef enum obsd_route {
     OBSD_ROUTE_HEALTHZ,
     OBSD_ROUTE_READYZ,
     OBSD_ROUTE_METRICS,
+    OBSD_ROUTE_STREAMS, /* /v1/streams and everything under it */
+    OBSD_ROUTE_PAGE,    /* the preview page: / and /preview/... */
     OBSD_ROUTE_BINARY, /* the binary protocol (socket / TCP), not a URL */
     OBSD_ROUTE_OTHER,
     OBSD_ROUTE_COUNT
@@ -29,7 +31,8 @@ typedef enum obsd_stage {
 
 /* "/v1/ao", ... ; "other" for OBSD_ROUTE_OTHER. */
 const char *obsd_route_path(obsd_route r);
-/* The route of a URL path (exact match), OBSD_ROUTE_OTHER if none. */
+/* The route of a URL path (exact match; /v1/streams/... and /preview/...
+ * by prefix), OBSD_ROUTE_OTHER if none. */
 obsd_route obsd_route_of(const char *path);
 
 void obsd_stats_init(void);
@@ -44,6 +47,8 @@ void obsd_stats_frame(int64_t width, int64_t height);
 typedef struct obsd_gauges {
     int queue_depth, queue_capacity, gl_running, in_flight, gl_alive;
     unsigned long long gl_recreations; /* GL contexts recreated after a failure */
+    int streams, stream_frames, sse_subscribers;
+    uint64_t stream_bytes;
 } obsd_gauges;
 
 /* The Prometheus text exposition; caller frees with free(). */

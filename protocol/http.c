@@ -220,7 +220,8 @@ char *obs_http_params_json(void)
         } else {
             cJSON_AddStringToObject(o, "default", pi->def);
         }
-        if (pi->type == OBS_PARAM_ENUM && pi->choices)
+        /* an int with choices takes only those numbers (samples: 2|4|8|16|32) */
+        if ((pi->type == OBS_PARAM_ENUM || pi->type == OBS_PARAM_INT) && pi->choices)
             cJSON_AddItemToObject(o, "choices", choices_array(pi->choices));
         cJSON_AddStringToObject(o, "doc", pi->doc);
     }

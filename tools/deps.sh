@@ -6,6 +6,13 @@ set -eu
 PKGS="build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libosmesa6-dev \
 libopenexr-dev libpng-dev libcjson-dev libcmocka-dev zlib1g-dev libmicrohttpd-dev curl \
 libassimp-dev libembree-dev"
+# Only for the tests: the preview page in a real browser (Chromium; node
+# and npm fetch playwright-core), the deploy checks (systemd-analyze,
+# PyYAML).  `deps.sh --build` leaves them out (deploy/container).
+if [ "${1:-}" != "--build" ]; then
+    PKGS="$PKGS chromium nodejs python3-yaml systemd"
+    command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
+fi
 
 missing=""
 for p in $PKGS; do

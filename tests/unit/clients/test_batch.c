@@ -101,12 +101,33 @@ static void test_patterns(void **state)
     assert_string_equal(buf, "ao.0001.exr");
 }
 
+/* A server list rotated frame by frame: round robin over the daemons. */
+static void test_rotate(void **state)
+{
+    (void)state;
+    char buf[64];
+    assert_int_equal(cli_batch_rotate("a,b,c", 0, buf, sizeof buf), 0);
+    assert_string_equal(buf, "a,b,c");
+    assert_int_equal(cli_batch_rotate("a,b,c", 1, buf, sizeof buf), 0);
+    assert_string_equal(buf, "b,c,a");
+    assert_int_equal(cli_batch_rotate("a,b,c", 5, buf, sizeof buf), 0);
+    assert_string_equal(buf, "c,a,b");
+    assert_int_equal(cli_batch_rotate("http://h:1,unix:/s", 3, buf, sizeof buf), 0);
+    assert_string_equal(buf, "unix:/s,http://h:1");
+    assert_int_equal(cli_batch_rotate("only", 7, buf, sizeof buf), 0);
+    assert_string_equal(buf, "only");
+    assert_int_equal(cli_batch_rotate("a,b,c", 1, buf, 5), -1); /* never past the buffer */
+    assert_int_equal(cli_batch_rotate("a,b,c", 1, buf, 6), 0);
+    assert_string_equal(buf, "b,c,a");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_bad_frames),
         cmocka_unit_test(test_patterns),
+        cmocka_unit_test(test_rotate),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

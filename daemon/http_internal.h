@@ -1,0 +1,128 @@
+/* Shared by the parts of obscurad's HTTP server: http_server.c (the
+ * server, /v1/ao and the GET routes), http_streams.c (/v1/streams) and
+ * http_page.c (the preview page).  Not a public header. */
+#ifndef OBSD_HTTP_INTERNAL_H
+#define OBSD_HTTP_INTERNAL_H
+
+#include <microhttpd.h>
+#include <stdatomic.h>
+
+#include "http.h"
+#include "http_server.h"
+#include "io.h"
+#include "stats.h"
+#include "stream_store.h"
+
+struct obsd_http {
+    struct MHD_Daemon *mhd;
+    const obsd_config *cfg;
+    const char *token;
+    obsd_queue *queue;
+    obsd_gl_worker *gl;
+    obsd_streams *streams;
+    int port;
+    MHD_socket listen_fd;
+    atomic_int in_flight;
+    atomic_int draining;
+    atomic_uint_fast64_t next_id;
+};
+
+typedef enum obsd__req_state {
+    REQ_NEW,
+    REQ_BODY,     /* reading the body of a frame (POST /v1/ao, a stream's frames) */
+    REQ_QUEUED,   /* suspended; the GL worker has the job */
+    REQ_REFUSED,  /* suspended and resumed at once: the queue was full */
+    REQ_EVENTS,   /* answering with Server-Sent Events */
+    REQ_ANSWERED
+} obsd__req_state;
+
+/* What a /v1/streams request does. */
+typedef enum obsd__stream_op {
+    STREAM_NONE,
+    STREAM_LIST,      /* GET /v1/streams */
+    STREAM_INFO,      /* GET /v1/streams/NAME */
+    STREAM_POST,      /* POST /v1/streams/NAME/frames */
+    STREAM_FRAME,     /* GET /v1/streams/NAME/frames/N */
+    STREAM_EVENTS     /* GET /v1/streams/NAME/events */
+} obsd__stream_op;
+
+typedef struct obsd__req {
+    obsd_http *srv;
+    struct MHD_Connection *conn;
+    uint64_t id;
+    obsd_route route;
+    obsd__req_state state;
+    char method[8];
+    char peer[64];
+    char path[128];      /* the URL's path, for the log */
+    double t0;
+    /* a frame's body */
+    unsigned char *body;
+    size_t len, cap;
+    int too_big;
+    size_t discarded;    /* bytes thrown away after too_big */
+    int before_drain;    /* started before SIGTERM: finished in the drain */
+    obs_http_request hr;
+    obs_gbuffer_file gf;
+    obsd_job job;
+    double ms_decode, ms_queue, ms_gl, ms_encode;
+    /* /v1/streams */
+    obsd__stream_op op;
+    char stream[OBSD_STREAM_NAME_LEN + 1];
+    char *query;         /* the query as "name\0value\0" pairs (recorded for a posted frame) */
+    size_t query_len, query_cap;
+    int record_query;
+    int query_failed;
+    obsd_frame *frame;   /* GET .../frames/N: the stored frame (a reference) */
+    int want_color;      /* output=color */
+    int rerun;           /* GET .../frames/N with parameters: run the frame again */
+    double exposure;     /* stops applied to colour PNGs */
+    obsd_sub sub;        /* GET .../events */
+    int subscribed;
+    char event[512];
+    int event_len, event_off;
+    /* answer */
+    int status;
+    size_t bytes_out;
+} obsd__req;
+
+/* Queues `resp` (taking it) with status; logs and counts the request. */
+enum MHD_Result obsd__answer(obsd__req *r, int status, struct MHD_Response *resp, size_t body_len,
+                             const char *note);
+/* A body of `len` bytes that the answer frees. */
+enum MHD_Result obsd__answer_text(obsd__req *r, int status, const char *type, char *text, size_t len,
+                                  const char *note);
+/* The JSON error; one extra header (name, value) when hname is set. */
+enum MHD_Result obsd__answer_error(obsd__req *r, int status, const char *code, const char *msg,
+                                   const char *hname, const char *hvalue);
+/* The error of a core status (503 with Retry-After). */
+enum MHD_Result obsd__answer_status(obsd__req *r, obs_status s, const char *msg);
+
+/* The start of a frame's request: query, Content-Type, Content-Length,
+ * a full queue; then the body is read (REQ_BODY). */
+enum MHD_Result obsd__frame_start(obsd__req *r);
+/* The request's query parameters into r->hr (recorded into r->query
+ * when r->record_query); 400 answered on a bad one (returns 0, *rc set). */
+int obsd__parse_query(obsd__req *r, enum MHD_Result *rc);
+/* Decodes `body` with r->hr's channel map, queues the frame (outputs)
+ * and suspends the connection; answers the error itself. */
+enum MHD_Result obsd__queue_frame(obsd__req *r, const unsigned char *body, size_t len, unsigned outputs);
+/* The stages of a finished job into r and the metrics. */
+void obsd__job_timings(obsd__req *r);
+/* Answers with images as r->hr asks (format, outputs, float, png_bits):
+ * ao / composite / colour, any may be NULL when not asked for.  With
+ * `timing`, a Server-Timing header. */
+enum MHD_Result obsd__answer_images(obsd__req *r, const obs_image *ao, const obs_image *composite,
+                                    const obs_image *color, const obs_camera *cam, int timing,
+                                    const char *extra_name, const char *extra_value);
+
+/* /v1/streams: the first call of a request (token checked); the call
+ * after the GL worker resumed it; the end of a request. */
+enum MHD_Result obsd__streams_start(obsd__req *r, const char *url);
+enum MHD_Result obsd__streams_finish(obsd__req *r);
+void obsd__streams_done(obsd__req *r);
+
+/* GET / and /preview/...: the embedded page. */
+enum MHD_Result obsd__page(obsd__req *r, const char *url);
+
+#endif

@@ -1,0 +1,342 @@
+/* /v1/streams: frames posted to named streams, kept for the preview page
+ * (daemon/stream_store.c), fetched again or re-run with other
+ * parameters, and announced to subscribers as Server-Sent Events.
+ *
+ *   GET  /v1/streams                    the streams (JSON)
+ *   GET  /v1/streams/NAME               one stream and its kept frames (JSON)
+ *   POST /v1/streams/NAME/frames        a frame, as POST /v1/ao; kept
+ *   GET  /v1/streams/NAME/frames/N      a kept frame (N or "latest"):
+ *                                       output=ao|composite|color, format,
+ *                                       exposure; other parameters re-run it
+ *   GET  /v1/streams/NAME/events        text/event-stream: `frame` events
+ *
+ * An event stream is a suspended connection: the content reader parks it
+ * when there is nothing to send and the store wakes it (new frame, keep-
+ * alive, shutdown), so it holds no thread while it waits. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "http_internal.h"
+#include "log.h"
+
+typedef obsd__req req;
+
+/* Splits the path after /v1/streams into r->op and r->stream; 0 when it
+ * is no route (404), -1 when the name is not valid. */
+static int parse_path(req *r, const char *url, uint64_t *seq, int *latest)
+{
+    const char *p = url + strlen("/v1/streams");
+    if (!*p || !strcmp(p, "/")) {
+        r->op = STREAM_LIST;
+        return 1;
+    }
+    p++; /* the '/' */
+    size_t n = strcspn(p, "/");
+    if (n > OBSD_STREAM_NAME_LEN)
+        return -1;
+    memcpy(r->stream, p, n);
+    r->stream[n] = '\0';
+    if (!obsd_stream_name_ok(r->stream))
+        return -1;
+    p += n;
+    if (!*p) {
+        r->op = STREAM_INFO;
+        return 1;
+    }
+    if (!strcmp(p, "/events")) {
+        r->op = STREAM_EVENTS;
+        return 1;
+    }
+    if (!strcmp(p, "/frames")) {
+        r->op = STREAM_POST;
+        return 1;
+    }
+    if (!strncmp(p, "/frames/", 8)) {
+        const char *s = p + 8;
+        r->op = STREAM_FRAME;
+        if (!strcmp(s, "latest")) {
+            *latest = 1;
+            return 1;
+        }
+        char *end;
+        unsigned long long v = strtoull(s, &end, 10);
+        if (*s >= '0' && *s <= '9' && !*end && v > 0) {
+            *seq = v;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* ---- Server-Sent Events ----------------------------------------------- */
+
+static void sub_park(void *arg)
+{
+    req *r = arg;
+    MHD_suspend_connection(r->conn);
+}
+
+static void sub_wake(void *arg)
+{
+    req *r = arg;
+    MHD_resume_connection(r->conn);
+}
+
+static ssize_t sse_reader(void *cls, uint64_t pos, char *buf, size_t max)
+{
+    req *r = cls;
+    (void)pos;
+    if (r->event_off >= r->event_len) {
+        int n = obsd_streams_next_event(r->srv->streams, &r->sub, r->event, sizeof r->event, obsd_now_ms());
+        if (n < 0)
+            return MHD_CONTENT_READER_END_OF_STREAM;
+        if (n == 0)
+            return 0; /* parked: the connection is suspended until woken */
+        r->event_len = n;
+        r->event_off = 0;
+    }
+    size_t k = (size_t)(r->event_len - r->event_off);
+    if (k > max)
+        k = max;
+    memcpy(buf, r->event + r->event_off, k);
+    r->event_off += (int)k;
+    return (ssize_t)k;
+}
+
+static enum MHD_Result events(req *r)
+{
+    obsd_http *h = r->srv;
+    if (atomic_load(&h->draining))
+        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
+                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    r->sub = (obsd_sub){.park = sub_park, .wake = sub_wake, .arg = r};
+    if (obsd_streams_subscribe(h->streams, r->stream, &r->sub, obsd_now_ms()) != 0) {
+        char msg[192];
+        snprintf(msg, sizeof msg, "too many event subscribers (at most %d), or no stream '%s' and no room "
+                 "for a new one (--streams)", OBSD_STREAM_MAX_SUBS, r->stream);
+        return obsd__answer_error(r, 503, "too_many_subscribers", msg, MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    }
+    r->subscribed = 1;
+    struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 1024, sse_reader, r, NULL);
+    if (!resp)
+        return MHD_NO;
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "text/event-stream");
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
+    MHD_add_response_header(resp, "X-Accel-Buffering", "no");
+    r->state = REQ_EVENTS;
+    return obsd__answer(r, 200, resp, 0, "event stream opened");
+}
+
+/* ---- frames ------------------------------------------------------------ */
+
+/* The stored frame's parameters first (its camera, its channel map), so
+ * that the request's own override them; its output and format do not
+ * carry over. */
+static void apply_stored(req *r, const obsd_frame *f)
+{
+    char err[OBS_ERR_LEN];
+    for (size_t k = 0; k + 1 < f->query_len;) {
+        const char *key = f->query + k, *val = key + strlen(key) + 1;
+        (void)obs_http_request_set(&r->hr, key, val, err); /* they were valid when posted */
+        k = (size_t)(val - f->query) + strlen(val) + 1;
+    }
+    r->hr.outputs = OBS_OUTPUT_AO;
+    r->hr.format = OBS_HTTP_EXR;
+    r->hr.float_exr = 0;
+    r->hr.png_bits = 8;
+}
+
+static enum MHD_Result get_frame(req *r, uint64_t seq)
+{
+    obsd_http *h = r->srv;
+    int found = 0;
+    enum MHD_Result rc;
+    char msg[320];
+    r->frame = obsd_streams_get(h->streams, r->stream, seq, &found);
+    if (!r->frame) {
+        if (found && seq)
+            snprintf(msg, sizeof msg, "stream '%s' has no frame %llu (GET /v1/streams/%s lists the kept ones)",
+                     r->stream, (unsigned long long)seq, r->stream);
+        else
+            snprintf(msg, sizeof msg, found ? "stream '%s' has no frame yet" : "no stream '%s'", r->stream);
+        return obsd__answer_error(r, 404, "not_found", msg, NULL, NULL);
+    }
+    obs_http_request_init(&r->hr);
+    apply_stored(r, r->frame);
+    if (!obsd__parse_query(r, &rc))
+        return rc;
+    const obsd_frame *f = r->frame;
+    char num[32];
+    snprintf(num, sizeof num, "%llu", (unsigned long long)f->seq);
+    if (r->want_color) {
+        if (!f->color.data)
+            return obsd__answer_error(r, 404, "no_color", "the frame's G-buffer has no colour plane", NULL,
+                                      NULL);
+        return obsd__answer_images(r, NULL, NULL, &f->color, NULL, 0, "X-Obscura-Frame", num);
+    }
+    if (!r->rerun)
+        return obsd__answer_images(r, (r->hr.outputs & OBS_OUTPUT_AO) ? &f->ao : NULL,
+                                   (r->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &f->composite : NULL, NULL,
+                                   f->camera.has_projection ? &f->camera : NULL, 0, "X-Obscura-Frame", num);
+    /* other parameters: the frame runs again (not kept) */
+    r->before_drain = !atomic_load(&h->draining);
+    if (!r->before_drain)
+        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
+                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    int full;
+    obsd_queue_stats(h->queue, NULL, NULL, &full);
+    if (full)
+        return obsd__answer_error(r, 503, "queue_full", "the frame queue is full; retry later",
+                                  MHD_HTTP_HEADER_RETRY_AFTER, "1");
+    return obsd__queue_frame(r, f->body, f->body_len, r->hr.outputs);
+}
+
+enum MHD_Result obsd__streams_start(req *r, const char *url)
+{
+    obsd_http *h = r->srv;
+    uint64_t seq = 0;
+    int latest = 0;
+    int ok = parse_path(r, url, &seq, &latest);
+    if (ok < 0)
+        return obsd__answer_error(r, 400, "bad_stream_name",
+                                  "a stream name is 1 to 64 characters of A-Z a-z 0-9 . _ -", NULL, NULL);
+    if (ok == 0)
+        return obsd__answer_error(r, 404, "not_found",
+                                  "no such route (GET /v1/streams, GET|POST /v1/streams/NAME/frames[/N], "
+                                  "GET /v1/streams/NAME/events)", NULL, NULL);
+    if (h->cfg->streams < 1)
+        return obsd__answer_error(r, 404, "streams_off", "streams are off (--streams 0)", NULL, NULL);
+    const char *allowed = r->op == STREAM_POST ? "POST" : "GET";
+    if (strcmp(r->method, allowed) != 0 && !(r->op != STREAM_POST && !strcmp(r->method, "HEAD"))) {
+        char msg[96];
+        snprintf(msg, sizeof msg, "this /v1/streams route takes %s", allowed);
+        return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, allowed);
+    }
+    switch (r->op) {
+    case STREAM_LIST: {
+        char *text = obsd_streams_list_json(h->streams);
+        return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
+    }
+    case STREAM_INFO: {
+        int found;
+        char *text = obsd_streams_stream_json(h->streams, r->stream, &found);
+        if (!found) {
+            char msg[96];
+            snprintf(msg, sizeof msg, "no stream '%s'", r->stream);
+            return obsd__answer_error(r, 404, "not_found", msg, NULL, NULL);
+        }
+        return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
+    }
+    case STREAM_POST:
+        r->record_query = 1;
+        return obsd__frame_start(r);
+    case STREAM_FRAME:
+        return get_frame(r, latest ? 0 : seq);
+    case STREAM_EVENTS:
+        return events(r);
+    default:
+        return obsd__answer_error(r, 404, "not_found", "no such route", NULL, NULL);
+    }
+}
+
+/* The G-buffer's colour as an RGBA image (alpha 1 when it has none). */
+static int copy_color(const obs_gbuffer *gb, obs_image *out)
+{
+    const obs_plane *p = &gb->color;
+    if (!p->data || p->channels < 3)
+        return 0;
+    size_t w = (size_t)gb->width, hgt = (size_t)gb->height;
+    size_t stride = p->row_stride ? p->row_stride / sizeof(float) : w * (size_t)p->channels;
+    if (!(out->data = malloc(w * hgt * 4 * sizeof(float))))
+        return -1;
+    out->width = gb->width;
+    out->height = gb->height;
+    out->channels = 4;
+    for (size_t y = 0; y < hgt; y++)
+        for (size_t x = 0; x < w; x++) {
+            const float *s = p->data + y * stride + x * (size_t)p->channels;
+            float *d = out->data + (y * w + x) * 4;
+            d[0] = s[0];
+            d[1] = s[1];
+            d[2] = s[2];
+            d[3] = p->channels >= 4 ? s[3] : 1.0f;
+        }
+    return 0;
+}
+
+/* POST .../frames, the GL worker done: keep the frame, answer like /v1/ao. */
+static enum MHD_Result post_finish(req *r)
+{
+    obsd_http *h = r->srv;
+    obsd_job *job = &r->job;
+    obs_result *res = &job->result;
+    obsd_frame *f = obsd_frame_new();
+    if (!f || copy_color(&r->gf.gb, &f->color) != 0) {
+        obsd_frame_release(f);
+        return obsd__answer_status(r, OBS_NO_MEMORY, "no memory to keep the frame");
+    }
+    f->width = r->gf.gb.width;
+    f->height = r->gf.gb.height;
+    f->body = r->body;
+    f->body_len = r->len;
+    r->body = NULL;
+    r->cap = 0;
+    f->query = r->query;
+    f->query_len = r->query_len;
+    r->query = NULL;
+    r->query_len = r->query_cap = 0;
+    f->ao = res->ao;
+    f->composite = res->composite;
+    res->ao = (obs_image){0};
+    res->composite = (obs_image){0};
+    obs_result_free(res);
+    f->camera = r->gf.gb.camera;
+    f->ms_queue = r->ms_queue;
+    f->ms_decode = r->ms_decode;
+    f->ms_gl = r->ms_gl;
+    atomic_fetch_add(&f->refs, 1); /* ours, to answer with */
+    uint64_t seq = obsd_streams_add(h->streams, r->stream, f);
+    if (!seq) {
+        obsd_frame_release(f);
+        return obsd__answer_status(r, OBS_NO_MEMORY, "no memory to keep the frame");
+    }
+    char num[32];
+    snprintf(num, sizeof num, "%llu", (unsigned long long)seq);
+    r->frame = f; /* released when the request ends */
+    return obsd__answer_images(r, (r->hr.outputs & OBS_OUTPUT_AO) ? &f->ao : NULL,
+                               (r->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &f->composite : NULL, NULL,
+                               f->camera.has_projection ? &f->camera : NULL, 1, "X-Obscura-Frame", num);
+}
+
+enum MHD_Result obsd__streams_finish(req *r)
+{
+    obsd_job *job = &r->job;
+    obsd__job_timings(r);
+    if (job->status != OBS_OK)
+        return obsd__answer_status(r, job->status, job->err);
+    if (r->op == STREAM_POST)
+        return post_finish(r);
+    /* a re-run of a kept frame */
+    const obs_result *res = &job->result;
+    char num[32];
+    snprintf(num, sizeof num, "%llu", (unsigned long long)r->frame->seq);
+    enum MHD_Result rc = obsd__answer_images(r, res->ao.data ? &res->ao : NULL,
+                                             res->composite.data ? &res->composite : NULL, NULL,
+                                             r->gf.gb.camera.has_projection ? &r->gf.gb.camera : NULL, 1,
+                                             "X-Obscura-Frame", num);
+    obs_result_free(&job->result);
+    return rc;
+}
+
+void obsd__streams_done(req *r)
+{
+    if (r->subscribed) {
+        obsd_streams_unsubscribe(r->srv->streams, &r->sub);
+        r->subscribed = 0;
+    }
+    obsd_frame_release(r->frame);
+    r->frame = NULL;
+    free(r->query);
+    r->query = NULL;
+}
