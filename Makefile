@@ -70,7 +70,7 @@ DAEMON_BENCH := $(BUILD)/daemon_bench
 -include protocol/protocol.mk daemon/daemon.mk clients/clients.mk tests/fuzz/fuzz.mk
 E2E_DEPS += $(UPSCALE)
 
-.PHONY: all deps demo demo-run test check unit e2e headers readme readme-check samples bench quality clean
+.PHONY: all deps demo demo-run test check unit e2e headers readme readme-check samples bench quality clean deep-fixture
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI) $(EXTRA_BINS)
@@ -107,6 +107,19 @@ $(EXT_BENCH): bench/extensions_bench.c $(LIB)
 
 $(UPSCALE): tools/exr_upscale.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
+# Deep input: OITAO Table I structure (bench/RESULTS.md, "Deep input").
+DEEP_BENCH := $(BUILD)/deep_bench
+$(DEEP_BENCH): bench/deep_bench.c $(LIB)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
+# The deep test fixture, written with OpenEXR's C++ deep API (the C API of
+# 3.1 cannot write deep data); its output tests/data/deep_small.exr is
+# committed, so only this target needs the C++ library.
+deep-fixture:
+	@mkdir -p $(BUILD)
+	c++ -O1 -std=c++14 $$(pkg-config --cflags OpenEXR) tools/deep_fixture.cpp -o $(BUILD)/deep_fixture $$(pkg-config --libs OpenEXR)
+	$(BUILD)/deep_fixture tests/data/deep_small.exr
 
 $(QSTRIP): tools/quality_strip.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
@@ -172,7 +185,7 @@ e2e: $(CLI) $(E2E_DEPS)
 # Every public header compiles alone, as C and as C++.
 headers:
 	@mkdir -p $(BUILD)/headers
-	@for h in core/obscura.h core/status.h core/params.h core/io.h core/metrics.h core/scene.h core/reference.h protocol/http.h protocol/binary.h; do \
+	@for h in core/obscura.h core/status.h core/params.h core/io.h core/deep.h core/metrics.h core/scene.h core/reference.h protocol/http.h protocol/binary.h; do \
 	  echo "#include \"$$h\"" > $(BUILD)/headers/t.c; \
 	  $(CC) -I. -Wall -Wextra -Werror -std=c99 -c $(BUILD)/headers/t.c -o /dev/null || exit 1; \
 	  cp $(BUILD)/headers/t.c $(BUILD)/headers/t.cpp; \

@@ -20,6 +20,7 @@
 #include <time.h>
 
 #include "batch.h"
+#include "deep.h"
 #include "ground.h"
 #include "io.h"
 #include "metrics.h"
@@ -421,6 +422,99 @@ static obs_status backend_from_args(const char *name, obs_backend *b)
     return OBS_OK;
 }
 
+/* Deep input (core/deep.h): multi-layer AO of OITAO over the compressed
+ * A-buffer.  Outputs: AO.Y, the per-node AO blended by alpha; AOFront.Y,
+ * the front node's AO; R,G,B,A, the front-to-back composite times AO.Y
+ * (premultiplied).  PNG: NAME.ao.png, NAME.front.png, NAME.composite.png. */
+static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server)
+{
+    char err[OBS_ERR_LEN] = "";
+    obs_deep_image d;
+    obs_deep_result r = {0};
+    obs_ctx *ctx = NULL;
+    obs_status s;
+    int rc = EXIT_OK;
+
+    if (server)
+        die_usage("ao: deep input runs in-process only (no --server)");
+    if (a->camera)
+        die_usage("ao: deep input takes the camera from the EXR header or --fov-y");
+    double t0 = now_ms();
+    if ((s = obs_deep_read_exr(a->in, lim, &d, err)) != OBS_OK)
+        return input_fail(s, a->in, err);
+    double t_read = now_ms() - t0;
+    t0 = now_ms();
+    if (a->cpu) {
+        s = obs_deep_run_cpu(&d, &a->params, &r, err);
+    } else {
+        obs_ctx_desc desc = {.debug = a->debug_gl, .log = log_cb};
+        backend_from_args(a->backend, &desc.backend);
+        if ((s = obs_ctx_create(&desc, &ctx, err)) != OBS_OK) {
+            rc = fail(s, "OpenGL", err);
+            goto done;
+        }
+        s = obs_deep_run(ctx, &d, &a->params, &r, err);
+    }
+    if (s != OBS_OK) {
+        rc = fail(s, a->in, err);
+        goto done;
+    }
+    double t_run = now_ms() - t0;
+    const obs_camera *cam = d.camera.has_projection ? &d.camera : NULL;
+    int want_ao = (a->outputs & OBS_OUTPUT_AO) != 0, want_comp = (a->outputs & OBS_OUTPUT_COMPOSITE) != 0;
+    if (!strcmp(a->format, "exr")) {
+        static const char *const ao_n[] = {"AO.Y"}, *const front_n[] = {"AOFront.Y"};
+        static const char *const rgba_n[] = {"R", "G", "B", "A"};
+        obs_exr_layer layers[3];
+        int n = 0;
+        if (want_ao) {
+            layers[n++] = (obs_exr_layer){&r.ao_blend, ao_n};
+            layers[n++] = (obs_exr_layer){&r.ao_front, front_n};
+        }
+        if (want_comp)
+            layers[n++] = (obs_exr_layer){&r.composite, rgba_n};
+        s = obs_exr_write(a->out, layers, n, a->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
+        if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
+            fprintf(stderr, "obscura: wrote %s\n", a->out);
+    } else {
+        const struct {
+            const obs_image *img;
+            const char *suffix;
+            int on, srgb;
+        } files[] = {{&r.ao_blend, "ao", want_ao, 0},
+                     {&r.ao_front, "front", want_ao, 0},
+                     {&r.composite, "composite", want_comp, 1}};
+        for (size_t k = 0; k < 3 && s == OBS_OK; k++) {
+            char path[4096];
+            if (!files[k].on)
+                continue;
+            suffixed(a->out, files[k].suffix, path, sizeof path);
+            s = obs_png_write(path, files[k].img, a->png_bits, files[k].srgb, err);
+            if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
+                fprintf(stderr, "obscura: wrote %s\n", path);
+        }
+    }
+    if (s != OBS_OK) {
+        rc = fail(s, a->out, err);
+        goto done;
+    }
+    if (verbosity >= OBS_LOG_INFO) {
+        obs_params p;
+        obs_params_resolve(&a->params, &p);
+        fprintf(stderr, "obscura: info: deep %dx%d, %llu samples, %s, %d nodes%s, %s hulls, "
+                "radius %g, %d samples: read %.1f ms, AO %.1f ms\n",
+                d.width, d.height, (unsigned long long)d.offset[(size_t)d.width * d.height],
+                p.deep_mode == OBS_DEEP_SINGLE ? "single-layer" : "multi-layer", p.deep_layers,
+                p.deep_front_half == OBS_ON ? " (front half kept)" : "",
+                p.deep_hull == OBS_DEEP_THIN ? "thin" : "solid", p.radius, p.samples, t_read, t_run);
+    }
+done:
+    obs_deep_result_free(&r);
+    obs_ctx_destroy(ctx);
+    obs_deep_free(&d);
+    return rc;
+}
+
 static int cmd_ao(int argc, char **argv)
 {
     ao_args a;
@@ -438,6 +532,9 @@ static int cmd_ao(int argc, char **argv)
     if (a.max_size)
         lim.max_width = lim.max_height = (int)a.max_size;
 
+    int deep = 0;
+    if (obs_exr_is_deep(a.in, &deep, err) == OBS_OK && deep)
+        return cmd_ao_deep(&a, &lim, server);
     double t0 = now_ms();
     s = obs_gbuffer_read_exr(a.in, &a.map, &lim, &gf, err);
     if (s != OBS_OK)

@@ -46,4 +46,8 @@ obs_status obs__exr_status(exr_result_t rv);
 obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv,
                          const char *what);
 
+/* The camera of a part's header (worldToCamera / worldToNDC) in obscura's
+ * conventions; zeroed when the header has none (exr_read.c). */
+void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam);
+
 #endif

@@ -553,7 +553,7 @@ static void camera_from_exr(const float wtc[16], const float *ndc, obs_camera *c
     cam->has_projection = 1;
 }
 
-static void read_camera(exr_const_context_t ctx, int part, obs_camera *cam)
+void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam)
 {
     float wtc[16], ndc[16];
     memset(cam, 0, sizeof *cam);
@@ -676,7 +676,7 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     gb->depth = (obs_plane){depth, 1, 0};
     gb->normal = (obs_plane){normal, has_n ? 3 : 0, 0};
     gb->color = (obs_plane){color, has_c ? 4 : 0, 0};
-    read_camera(ctx, part, &gb->camera);
+    obs__exr_read_camera(ctx, part, &gb->camera);
 
     obs_exr_info *info = &out->info;
     info->part = part;

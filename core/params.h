@@ -208,7 +208,23 @@ typedef enum obs_normal_space {
       "apart")                                                                 \
     X(hbao_angle_bias, FLOAT, 30.0, 1e-6, 89.0, NULL,                          \
       "method hbao: angle bias in degrees added to the tangent angle t(theta) "\
-      "against the self-occlusion of tessellated surfaces")
+      "against the self-occlusion of tessellated surfaces")                   \
+    X(deep_mode, ENUM, "multi", 0, 0, "multi|single",                          \
+      "deep input: multi (OITAO Algorithm 1: each sample is occluded by every "\
+      "compressed node at its pixel, the largest occlusion counts) or single " \
+      "(the front node alone, as a flat depth buffer would)")                  \
+    X(deep_layers, INT, 4, 1, 8, NULL,                                         \
+      "deep input: nodes m kept per pixel by the list compression of OITAO "   \
+      "III-B (eq 5 drops the node of least alpha (1 - z), z the depth "        \
+      "normalised over the image)")                                           \
+    X(deep_front_half, ENUM, "off", 0, 0, "on|off",                            \
+      "deep input: eq 5 searches the back half of the list only, keeping the " \
+      "m/2 front nodes (OITAO V-A, Fig. 6 column C)")                          \
+    X(deep_hull, ENUM, "solid", 0, 0, "solid|thin",                            \
+      "deep input: transparent surfaces as solid volumes (OITAO eq 1: "        \
+      "occluders and receivers weighted by alpha) or thin hulls (eqs 2-4: "    \
+      "exterior and interior AO mixed by W(p), alpha or 1 - alpha on back "    \
+      "faces)")
 
 #define OBS__PDECL_FLOAT(n) float n;
 #define OBS__PDECL_INT(n) int n;

@@ -77,7 +77,10 @@
     X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)                       \
     X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)               \
     X(PFNGLDRAWELEMENTSPROC, DrawElements)                                     \
-    X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv)
+    X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv)                                   \
+    /* deep input's node planes (deep_gl.c) */                                 \
+    X(PFNGLTEXSTORAGE3DPROC, TexStorage3D)                                     \
+    X(PFNGLTEXSUBIMAGE3DPROC, TexSubImage3D)
 
 /* Optional entry points (may be NULL). */
 #define OBS__GL_FUNCS_OPT(X) X(PFNGLDEBUGMESSAGECALLBACKPROC, DebugMessageCallback)
@@ -155,6 +158,8 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glEnableVertexAttribArray obs__glp->EnableVertexAttribArray
 #define glDrawElements obs__glp->DrawElements
 #define glClearBufferfv obs__glp->ClearBufferfv
+#define glTexStorage3D obs__glp->TexStorage3D
+#define glTexSubImage3D obs__glp->TexSubImage3D
 
 /* Loads every entry point; fails naming the first one missing. */
 obs_status obs__gl_load(obs__gl *gl, obs__getproc_fn getproc, char err[OBS_ERR_LEN]);

@@ -1,0 +1,116 @@
+// Multi-layer, opacity-based AO of deep input (OITAO, Bauer et al.): each
+// pixel's compressed list (section III-B) is a column of the 2D array
+// textures, node k in layer k.  For every node: VAO++'s volumetric AO
+// (section 3) whose line samples are occluded by every node at their
+// pixel, the largest occlusion counting (OITAO Algorithm 1), weighted by
+// opacity (eq 1, or eqs 2-4 for thin hulls); the nodes' AO blended front
+// to back by alpha (section III, the separated scheme).  C twin:
+// core/deep_cpu.c (same function names).
+
+uniform sampler2DArray u_lpos;  // node view position xyz, planar depth w (0: empty)
+uniform sampler2DArray u_lnrm;  // node view normal xyz, alpha w
+uniform int u_m;                // nodes per pixel
+uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node 0 only
+uniform int u_thin;             // 1: thin hulls (eqs 2-4); 0: solid volumes (eq 1)
+uniform ivec2 u_size;
+uniform float u_radius;         // R, in depth units
+uniform int u_ns;               // line samples
+uniform vec2 u_samples[32];     // the set of section 4.5
+uniform vec2 u_rot[9];          // (cos, sin) of the 3x3 tile's rotations
+uniform int u_range_check;      // 1: depth range check (VAO++ 4.4, eq 4)
+uniform float u_range_u;        // u of eq 4
+
+layout(location = 0) out vec4 o_ao; // (front node's AO, blended AO, 0, 1)
+
+// The length of the pipe [front, front + 2h] hidden by a node at planar
+// depth zs: VAO++ section 3's cases with the node as the depth buffer, eq
+// 4's falloff when it lies in front.  interior: a node in front of the
+// pipe is on a thin hull's exterior side (eqs 2-4) and hides nothing.
+float node_occlusion(float zs, float front, float h, bool interior)
+{
+    if (!(zs > 0.0))
+        return 0.0;
+    float dz = min(max(zs - front, 0.0), 2.0 * h);
+    if (zs < front) {
+        if (interior)
+            return 0.0;
+        if (u_range_check != 0) {
+            float d = front - zs;
+            float sd = u_range_u / max(u_range_u, d / u_radius);
+            dz = 2.0 * h * (1.0 - sd);
+        }
+    }
+    return 2.0 * h - dz;
+}
+
+// VAO++ eqs 1-2 for the tangent sphere at p along n; each sample's
+// occlusion is the largest over the nodes at its pixel (Algorithm 1, line
+// 9), each node's weighted by its alpha (eq 1's alpha_omega).
+float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
+{
+    float R = u_radius, r = 0.5 * u_radius;
+    vec3 c = p + n * r;
+    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
+    int layers = u_multi != 0 ? u_m : 1;
+    float open = 0.0, F = 0.0;
+    for (int i = 0; i < u_ns; i++) {
+        float sx = u_samples[i].x, sy = u_samples[i].y;
+        float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
+        float h = r * l;
+        vec3 s = vec3(c.x + r * (rot.x * sx - rot.y * sy), c.y + r * (rot.y * sx + rot.x * sy), c.z);
+        float cw = PM(3, 0) * s.x + PM(3, 1) * s.y + PM(3, 2) * s.z + PM(3, 3);
+        if (!(cw > 0.0))
+            continue;
+        float cx = PM(0, 0) * s.x + PM(0, 1) * s.y + PM(0, 2) * s.z + PM(0, 3);
+        float cy = PM(1, 0) * s.x + PM(1, 1) * s.y + PM(1, 2) * s.z + PM(1, 3);
+        float u = (cx / cw * 0.5 + 0.5) * u_viewport.z - u_viewport.x;
+        float v = (0.5 - cy / cw * 0.5) * u_viewport.w - u_viewport.y;
+        float fu = floor(u), fv = floor(v);
+        if (!(fu >= 0.0 && fv >= 0.0 && fu < float(u_size.x) && fv < float(u_size.y)))
+            continue;
+        ivec2 q = ivec2(int(fu), int(fv));
+        float front = -c.z - h, occ = 0.0;
+        for (int k = 0; k < layers; k++) {
+            float zs = texelFetch(u_lpos, ivec3(q, k), 0).w;
+            float a = texelFetch(u_lnrm, ivec3(q, k), 0).w;
+            occ = max(occ, a * node_occlusion(zs, front, h, interior));
+        }
+        open += 2.0 * h - occ;
+        F += R * l;
+    }
+    return F > 0.0 ? open / F : 1.0;
+}
+
+// OITAO eq 1 (solid) or eqs 2-4 (thin hull) for node k at px.
+float node_ao(ivec2 px, int k)
+{
+    vec4 p = texelFetch(u_lpos, ivec3(px, k), 0);
+    vec4 n = texelFetch(u_lnrm, ivec3(px, k), 0);
+    if (!(p.w > 0.0))
+        return 1.0;
+    float ve = sphere_ao(px, p.xyz, n.xyz, false);
+    if (u_thin == 0)
+        return 1.0 - n.w * (1.0 - ve);              // eq 1: alpha_p
+    float vi = sphere_ao(px, p.xyz, -n.xyz, true);
+    float facing = -(p.x * n.x + p.y * n.y + p.z * n.z);
+    float W = facing >= 0.0 ? n.w : 1.0 - n.w;      // eq 3
+    return W * ve + (1.0 - W) * vi;                 // eq 4
+}
+
+void main()
+{
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    float T = 1.0, acc = 0.0, front = 1.0;
+    for (int k = 0; k < u_m; k++) {
+        vec4 p = texelFetch(u_lpos, ivec3(px, k), 0);
+        if (!(p.w > 0.0))
+            break;
+        float a = texelFetch(u_lnrm, ivec3(px, k), 0).w;
+        float ao = node_ao(px, k);
+        if (k == 0)
+            front = ao;
+        acc += T * a * ao;   // "over", front to back
+        T *= 1.0 - a;
+    }
+    o_ao = vec4(front, acc + T, 0.0, 1.0);
+}

@@ -1,0 +1,527 @@
+/* Deep input: the deep scanline reader (fixture written by
+ * tools/deep_fixture.cpp, damaged files), the list compression of OITAO
+ * III-B (eq 5 against a hand-computed case), multi-layer AO (a hidden
+ * occluder seen only in a deeper layer), opacity (eqs 1-4), the GL pass
+ * against its CPU twin, and the three deep EXRs of OpenEXR's
+ * LowResLeftView set when ../shared is present. */
+#include "testutil.h"
+
+#include <dirent.h>
+#include <math.h>
+
+#include "deep.h"
+
+#define FIXTURE TESTDATA "/deep_small.exr"
+
+static unsigned char *slurp(const char *path, size_t *len)
+{
+    FILE *fp = fopen(path, "rb");
+    assert_non_null(fp);
+    assert_int_equal(fseek(fp, 0, SEEK_END), 0);
+    long n = ftell(fp);
+    assert_true(n >= 0);
+    rewind(fp);
+    unsigned char *buf = malloc((size_t)n + 1);
+    assert_int_equal(fread(buf, 1, (size_t)n, fp), (size_t)n);
+    fclose(fp);
+    *len = (size_t)n;
+    return buf;
+}
+
+static const float *px_samples(const obs_deep_image *d, int x, int y, int *n)
+{
+    size_t i = (size_t)y * d->width + x;
+    *n = (int)(d->offset[i + 1] - d->offset[i]);
+    return d->samples + d->offset[i] * OBS_DEEP_CH;
+}
+
+/* ---- reader ----------------------------------------------------------------- */
+
+/* The fixture's layout (tools/deep_fixture.cpp), sorted front to back. */
+static void test_read_fixture(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    int deep = 0;
+    assert_int_equal(obs_exr_is_deep(FIXTURE, &deep, err), OBS_OK);
+    assert_int_equal(deep, 1);
+    if (obs_deep_read_exr(FIXTURE, NULL, &d, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_int_equal(d.width, 48);
+    assert_int_equal(d.height, 32);
+    assert_true(d.has_zback && d.has_alpha && d.has_color && !d.has_normal);
+    assert_true(d.camera.has_projection);
+    assert_int_equal((int)d.offset[48 * 32], 1536 + 640 + 256 + 10);
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 48; x++) {
+            int n, want = 1 + (x >= 16 && y >= 12) + (x >= 8 && x < 24 && y >= 8 && y < 24) +
+                          (x == 0 && y == 0) * 10;
+            const float *s = px_samples(&d, x, y, &n);
+            assert_int_equal(n, want);
+            for (int k = 1; k < n; k++) /* sorted */
+                assert_true(s[k * OBS_DEEP_CH] >= s[(k - 1) * OBS_DEEP_CH]);
+            const float *back = s + (n - 1) * OBS_DEEP_CH;
+            assert_float_equal(back[OBS_DEEP_Z], 8.0f, 1e-6);
+            assert_float_equal(back[OBS_DEEP_B], 0.6f, 1e-3);
+            assert_float_equal(back[OBS_DEEP_ZBACK], 8.0f, 1e-6);
+            if (x >= 8 && x < 24 && y >= 8 && y < 24 && !(x == 0 && y == 0)) {
+                assert_float_equal(s[OBS_DEEP_Z], 4.0f, 1e-6);
+                assert_float_equal(s[OBS_DEEP_A], 0.5f, 1e-3);
+                assert_float_equal(s[OBS_DEEP_R], 0.5f, 1e-3);
+            }
+        }
+    int n;
+    const float *s = px_samples(&d, 0, 0, &n);
+    for (int k = 0; k < 10; k++)
+        assert_float_equal(s[k * OBS_DEEP_CH], 1.0f + 0.1f * (float)k, 1e-5);
+
+    /* the same from memory */
+    size_t len;
+    unsigned char *buf = slurp(FIXTURE, &len);
+    obs_deep_image m;
+    assert_int_equal(obs_deep_read_exr_mem(buf, len, NULL, &m, err), OBS_OK);
+    assert_int_equal(memcmp(m.offset, d.offset, (48 * 32 + 1) * sizeof *d.offset), 0);
+    assert_int_equal(memcmp(m.samples, d.samples, d.offset[48 * 32] * OBS_DEEP_CH * sizeof(float)), 0);
+    obs_deep_free(&m);
+    free(buf);
+    obs_deep_free(&d);
+
+    /* a flat file is no deep input */
+    assert_int_equal(obs_exr_is_deep(TESTDATA "/room_small.exr", &deep, err), OBS_OK);
+    assert_int_equal(deep, 0);
+    assert_int_equal(obs_deep_read_exr(TESTDATA "/room_small.exr", NULL, &d, err), OBS_UNSUPPORTED);
+    assert_non_null(strstr(err, "no deep part"));
+}
+
+/* The size limits apply before anything is allocated. */
+static void test_read_limits(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    obs_limits lim = {.max_width = 32};
+    assert_int_equal(obs_deep_read_exr(FIXTURE, &lim, &d, err), OBS_TOO_LARGE);
+    assert_true(err[0] != '\0');
+    assert_null(d.samples);
+}
+
+static void check_status(const char *what, obs_status st, const char *err)
+{
+    if (st != OBS_OK && err[0] == '\0')
+        fail_msg("%s: failed (%s) without a message", what, obs_status_name(st));
+    if (st != OBS_OK && st != OBS_BAD_FILE && st != OBS_UNSUPPORTED && st != OBS_MISSING_CHANNEL &&
+        st != OBS_TOO_LARGE && st != OBS_NO_MEMORY && st != OBS_IO)
+        fail_msg("%s: unexpected status %s (%s)", what, obs_status_name(st), err);
+}
+
+static void read_any(const char *what, const unsigned char *buf, size_t len, int *ok)
+{
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    obs_status st = obs_deep_read_exr_mem(buf, len, NULL, &d, err);
+    check_status(what, st, err);
+    if (st == OBS_OK) {
+        size_t npx = (size_t)d.width * d.height;
+        for (size_t i = 0; i < npx; i++)
+            assert_true(d.offset[i + 1] >= d.offset[i]);
+        (*ok)++;
+    } else {
+        assert_null(d.samples);
+    }
+    obs_deep_free(&d);
+}
+
+/* The fixture cut short at every length and with bytes of its chunks
+ * (count tables, sample data) overwritten: a status, never a crash. */
+static void test_read_damaged_fixture(void **state)
+{
+    (void)state;
+    size_t len;
+    unsigned char *buf = slurp(FIXTURE, &len);
+    unsigned char *bad = malloc(len);
+    int ok = 0;
+    char what[64];
+    for (size_t cut = 0; cut < len; cut += cut < 600 ? 7 : 97) {
+        snprintf(what, sizeof what, "fixture cut at %zu", cut);
+        read_any(what, buf, cut ? cut : 1, &ok);
+    }
+    assert_int_equal(ok, 0);
+    unsigned seed = 12345;
+    for (int t = 0; t < 300; t++) {
+        memcpy(bad, buf, len);
+        for (int k = 0; k < 4; k++) {
+            seed = seed * 1103515245u + 12345u;
+            size_t at = 300 + (seed >> 8) % (len - 300);
+            seed = seed * 1103515245u + 12345u;
+            bad[at] = (unsigned char)(seed >> 16);
+        }
+        snprintf(what, sizeof what, "fixture damaged, trial %d", t);
+        read_any(what, bad, len, &ok);
+    }
+    free(bad);
+    free(buf);
+}
+
+static void run_dir(const char *dir, int *files)
+{
+    DIR *dp = opendir(dir);
+    struct dirent *e;
+    if (!dp)
+        return;
+    while ((e = readdir(dp))) {
+        char path[1024];
+        if (e->d_name[0] == '.' || strstr(e->d_name, ".rst"))
+            continue;
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        obs_deep_image d;
+        char err[OBS_ERR_LEN] = "";
+        obs_status st = obs_deep_read_exr(path, NULL, &d, err);
+        check_status(path, st, err);
+        obs_deep_free(&d);
+        size_t len;
+        unsigned char *buf = slurp(path, &len);
+        int ok = 0;
+        if (len > 0)
+            read_any(path, buf, len, &ok);
+        free(buf);
+        (*files)++;
+    }
+    closedir(dp);
+}
+
+/* OpenEXR's damaged files (fuzzer cases, several deep): rejected with a
+ * message or read, never a crash, hang or leak. */
+static void test_read_damaged_files(void **state)
+{
+    (void)state;
+    char dir[512];
+    int files = 0;
+    run_dir(TESTDATA "/damaged", &files);
+    assert_true(files > 10);
+    snprintf(dir, sizeof dir, "%s/openexr-images/Damaged", obs_test_shared());
+    run_dir(dir, &files);
+}
+
+/* ---- list compression (OITAO III-B, eq 5) --------------------------------- */
+
+static void sample(float *s, float z, float a)
+{
+    memset(s, 0, OBS_DEEP_CH * sizeof(float));
+    s[OBS_DEEP_Z] = s[OBS_DEEP_ZBACK] = z;
+    s[OBS_DEEP_A] = a;
+}
+
+/* m = 2, z already in [0, 1], inserted out of order:
+ *   z 0.6 a 0.5 -> a (1 - z) = 0.20
+ *   z 0.1 a 0.1 ->             0.09
+ *   z 0.5 a 0.9 ->             0.45
+ * After the third insertion the array is [0.1, 0.5, 0.6]; eq 5 over all
+ * three drops 0.1 (0.09), keeping [0.5, 0.6]; over the back half (j >=
+ * m / 2 = 1) it drops 0.6 (0.20 < 0.45), keeping [0.1, 0.5]. */
+static void test_compress_eq5(void **state)
+{
+    (void)state;
+    float in[3 * OBS_DEEP_CH], out[OBS_DEEP_MAX_LAYERS * OBS_DEEP_CH];
+    sample(in, 0.6f, 0.5f);
+    sample(in + OBS_DEEP_CH, 0.1f, 0.1f);
+    sample(in + 2 * OBS_DEEP_CH, 0.5f, 0.9f);
+    assert_int_equal(obs_deep_compress_list(in, 3, 2, 0, 0.0f, 1.0f, out), 2);
+    assert_float_equal(out[OBS_DEEP_Z], 0.5f, 0);
+    assert_float_equal(out[OBS_DEEP_CH + OBS_DEEP_Z], 0.6f, 0);
+    assert_int_equal(obs_deep_compress_list(in, 3, 2, 1, 0.0f, 1.0f, out), 2);
+    assert_float_equal(out[OBS_DEEP_Z], 0.1f, 0);
+    assert_float_equal(out[OBS_DEEP_CH + OBS_DEEP_Z], 0.5f, 0);
+    /* fewer samples than nodes: kept, sorted */
+    assert_int_equal(obs_deep_compress_list(in, 2, 4, 0, 0.0f, 1.0f, out), 2);
+    assert_float_equal(out[OBS_DEEP_Z], 0.1f, 0);
+
+    /* m = 4, depths normalised over 2..12 (z = (Z - 2) / 10):
+     *   Z 2 a .2 -> .20, 4 a 1 -> .80, 7 a .1 -> .05, 9 a .6 -> .18,
+     *   12 a 1 -> 0 (dropped on the 5th insertion), 5 a .4 -> .28; the
+     *   6th leaves [2, 4, 5, 7, 9], where 7 (.05) goes: [2, 4, 5, 9]. */
+    float in6[6 * OBS_DEEP_CH];
+    const float Z[6] = {2, 4, 7, 9, 12, 5}, A[6] = {.2f, 1, .1f, .6f, 1, .4f};
+    for (int k = 0; k < 6; k++)
+        sample(in6 + k * OBS_DEEP_CH, Z[k], A[k]);
+    assert_int_equal(obs_deep_compress_list(in6, 6, 4, 0, 2.0f, 12.0f, out), 4);
+    const float want[4] = {2, 4, 5, 9};
+    for (int k = 0; k < 4; k++)
+        assert_float_equal(out[k * OBS_DEEP_CH + OBS_DEEP_Z], want[k], 0);
+
+    /* the fixture's pixel (0, 0): ten samples of alpha 0.3 at Z 1 .. 1.9
+     * and the opaque wall at 8, the image's farthest depth: z = 1 there,
+     * so eq 5 gives the wall 0 and drops it whatever its alpha; of the
+     * others, a (1 - z) falls with depth: m = 4 keeps Z 1 .. 1.3 */
+    obs_deep_image d;
+    obs_deep_layers l;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_deep_read_exr(FIXTURE, NULL, &d, err), OBS_OK);
+    assert_int_equal(obs_deep_compress(&d, 4, 0, &l, err), OBS_OK);
+    assert_float_equal(l.zmin, 1.0f, 1e-6);
+    assert_float_equal(l.zmax, 8.0f, 1e-6);
+    assert_int_equal(l.count[0], 4);
+    size_t npx = 48 * 32;
+    const float keep[4] = {1.0f, 1.1f, 1.2f, 1.3f};
+    for (int k = 0; k < 4; k++)
+        assert_float_equal(l.node[(size_t)k * npx * OBS_DEEP_CH + OBS_DEEP_Z], keep[k], 1e-5);
+    obs_deep_layers_free(&l);
+    obs_deep_free(&d);
+}
+
+/* ---- multi-layer AO ------------------------------------------------------ */
+
+/* A synthetic A-buffer: w x h, up to 3 samples per pixel. */
+
+static void synth_init(obs_deep_image *d, int w, int h)
+{
+    memset(d, 0, sizeof *d);
+    d->width = w;
+    d->height = h;
+    d->offset = calloc((size_t)w * h + 1, sizeof *d->offset);
+    d->samples = calloc((size_t)w * h * 3, OBS_DEEP_CH * sizeof(float));
+    d->has_alpha = 1;
+    d->has_color = 1;
+}
+
+static void synth_add(obs_deep_image *d, int x, int y, float z, float a)
+{
+    /* pixels are filled in order: each call appends to the last pixel */
+    size_t i = (size_t)y * d->width + x;
+    float *s = d->samples + d->offset[i + 1] * OBS_DEEP_CH;
+    sample(s, z, a);
+    s[OBS_DEEP_R] = s[OBS_DEEP_G] = s[OBS_DEEP_B] = 0.5f * a;
+    d->offset[i + 1]++;
+}
+
+static void synth_next(obs_deep_image *d, int x, int y)
+{
+    size_t i = (size_t)y * d->width + x;
+    d->offset[i + 1] = d->offset[i];
+}
+
+/* A wall at depth 10 everywhere; right of column 16 something near the
+ * camera (depth 3, far in front of the wall) and, hidden behind it, a box
+ * face at depth `hidden` with alpha `ha` (0: none). */
+static void scene(obs_deep_image *d, float hidden, float ha)
+{
+    synth_init(d, 32, 32);
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++) {
+            synth_next(d, x, y);
+            if (x >= 16) {
+                synth_add(d, x, y, 3.0f, 1.0f);
+                if (ha > 0.0f)
+                    synth_add(d, x, y, hidden, ha);
+            }
+            synth_add(d, x, y, 10.0f, 1.0f);
+        }
+}
+
+static obs_params deep_params(int mode)
+{
+    obs_params p = {0};
+    char err[OBS_ERR_LEN];
+    assert_int_equal(obs_param_set(&p, "fov_y", "40", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "radius", "1", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "deep_mode", mode == OBS_DEEP_SINGLE ? "single" : "multi", err),
+                     OBS_OK);
+    return p;
+}
+
+static float ao_at(const obs_deep_image *d, const obs_params *p, int x, int y, float *blend)
+{
+    obs_deep_result r;
+    char err[OBS_ERR_LEN] = "";
+    if (obs_deep_run_cpu(d, p, &r, err) != OBS_OK)
+        fail_msg("%s", err);
+    float v = r.ao_front.data[y * d->width + x];
+    if (blend)
+        *blend = r.ao_blend.data[y * d->width + x];
+    obs_deep_result_free(&r);
+    return v;
+}
+
+/* The wall pixel beside the near object: its tangent sphere (radius 0.5,
+ * depths 9..10) reaches the box face at 9.3, hidden behind the near
+ * object.  Single-layer sees only the near object, 6.5 in front of the
+ * pipes (the range check's falloff leaves almost nothing); multi-layer
+ * finds the box in the second node. */
+static void test_hidden_occluder(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    scene(&d, 9.3f, 1.0f);
+    obs_params single = deep_params(OBS_DEEP_SINGLE), multi = deep_params(OBS_DEEP_MULTI);
+    float s = ao_at(&d, &single, 15, 16, NULL);
+    float m = ao_at(&d, &multi, 15, 16, NULL);
+    print_message("hidden occluder: AO single %.4f, multi %.4f\n", s, m);
+    assert_true(s > 0.97f);
+    assert_true(m < s - 0.1f);
+    /* far from the edge both agree on an open wall */
+    assert_float_equal(ao_at(&d, &single, 4, 16, NULL), 1.0f, 1e-4);
+    assert_float_equal(ao_at(&d, &multi, 4, 16, NULL), 1.0f, 1e-4);
+    obs_deep_free(&d);
+
+    /* without the hidden box, multi-layer equals single-layer there */
+    scene(&d, 0.0f, 0.0f);
+    assert_float_equal(ao_at(&d, &multi, 15, 16, NULL), s, 1e-5);
+    obs_deep_free(&d);
+
+    /* eq 1: a half-transparent box occludes (about) half as much */
+    scene(&d, 9.3f, 0.5f);
+    float half = ao_at(&d, &multi, 15, 16, NULL);
+    print_message("alpha 0.5 box: AO %.4f\n", half);
+    assert_float_equal(1.0f - half, 0.5f * (1.0f - m), 0.02f);
+    obs_deep_free(&d);
+}
+
+/* The blend of OITAO III's separated scheme and eq 1's receiver alpha: a
+ * pane of alpha a over a wall gives a AO_pane + (1 - a) AO_wall; with
+ * thin hulls the front face weighs exterior AO by alpha (eqs 2-4). */
+static void test_blend_and_hull(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    obs_params p = deep_params(OBS_DEEP_MULTI);
+    char err[OBS_ERR_LEN];
+    float blend;
+    /* a pane of alpha 0.4 at 9.8 over the wall at 10, everywhere */
+    synth_init(&d, 24, 24);
+    for (int y = 0; y < 24; y++)
+        for (int x = 0; x < 24; x++) {
+            synth_next(&d, x, y);
+            synth_add(&d, x, y, 9.8f, 0.4f);
+            synth_add(&d, x, y, 10.0f, 1.0f);
+        }
+    obs_deep_result r;
+    assert_int_equal(obs_deep_run_cpu(&d, &p, &r, err), OBS_OK);
+    size_t c = 12 * 24 + 12;
+    /* the pane is open (nothing in its sphere): AO 1 */
+    assert_float_equal(r.ao_front.data[c], 1.0f, 1e-5);
+    /* the wall, 0.2 behind the pane, sees it in its sphere; eq 1 weights the
+     * pane's occlusion by its 0.4 */
+    blend = r.ao_blend.data[c];
+    assert_true(blend < 1.0f && blend > 0.6f);
+    /* composite: over of (0.2, 0.2, 0.2, 0.4) and (0.5, 0.5, 0.5, 1) */
+    float want = (0.2f + 0.6f * 0.5f) * blend;
+    assert_float_equal(r.composite.data[4 * c], want, 1e-5);
+    assert_float_equal(r.composite.data[4 * c + 3], 1.0f, 1e-6);
+    obs_deep_result_free(&r);
+    assert_int_equal(obs_param_set(&p, "deep_hull", "thin", err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(&d, &p, &r, err), OBS_OK);
+    /* the pane's interior sphere (behind it) holds the wall: W = 0.4 of
+     * the open exterior, 0.6 of the occluded interior */
+    assert_true(r.ao_front.data[c] < 0.9f);
+    obs_deep_result_free(&r);
+    obs_deep_free(&d);
+}
+
+/* ---- GL against the CPU twin ------------------------------------------------ */
+
+static void compare_gl(obs_ctx *ctx, const obs_deep_image *d, const obs_params *p, const char *what)
+{
+    obs_deep_result g, c;
+    char err[OBS_ERR_LEN] = "";
+    if (obs_deep_run(ctx, d, p, &g, err) != OBS_OK)
+        fail_msg("%s: GL: %s", what, err);
+    assert_int_equal(obs_deep_run_cpu(d, p, &c, err), OBS_OK);
+    size_t n = (size_t)d->width * d->height;
+    double worst = 0.0, sum = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double e = fmax(fabs(g.ao_front.data[i] - c.ao_front.data[i]),
+                        fabs(g.ao_blend.data[i] - c.ao_blend.data[i]));
+        worst = fmax(worst, e);
+        sum += e;
+    }
+    print_message("%s: GL vs CPU max |diff| %.2e, mean %.2e\n", what, worst, sum / (double)n);
+    assert_true(worst < 2e-3);
+    assert_true(sum / (double)n < 1e-5);
+    obs_deep_result_free(&g);
+    obs_deep_result_free(&c);
+}
+
+static void test_gl_twin(void **state)
+{
+    (void)state;
+    obs_ctx *ctx = NULL;
+    obs_ctx_desc desc = {0};
+    char err[OBS_ERR_LEN] = "";
+    if (obs_ctx_create(&desc, &ctx, err) != OBS_OK) {
+        print_message("no GL context (%s): skipped\n", err);
+        skip();
+    }
+    obs_deep_image d;
+    scene(&d, 9.8f, 0.7f);
+    obs_params p = deep_params(OBS_DEEP_MULTI);
+    compare_gl(ctx, &d, &p, "hidden occluder, multi");
+    p = deep_params(OBS_DEEP_SINGLE);
+    compare_gl(ctx, &d, &p, "hidden occluder, single");
+    obs_deep_free(&d);
+    assert_int_equal(obs_deep_read_exr(FIXTURE, NULL, &d, err), OBS_OK);
+    p = (obs_params){0};
+    assert_int_equal(obs_param_set(&p, "radius", "1", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "fixture, solid");
+    assert_int_equal(obs_param_set(&p, "deep_hull", "thin", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "deep_front_half", "on", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "fixture, thin, m = 2, front half");
+    obs_deep_free(&d);
+    obs_ctx_destroy(ctx);
+}
+
+/* ---- real deep EXRs (../shared) ---------------------------------------------- */
+
+static void test_real_files(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"Balls", "Leaves", "Trunks"};
+    int found = 0;
+    for (int k = 0; k < 3; k++) {
+        char path[512], err[OBS_ERR_LEN] = "";
+        snprintf(path, sizeof path, "%s/openexr-images/v2/LowResLeftView/%s.exr", obs_test_shared(),
+                 names[k]);
+        if (!obs_test_exists(path))
+            continue;
+        found++;
+        obs_deep_image d;
+        if (obs_deep_read_exr(path, NULL, &d, err) != OBS_OK)
+            fail_msg("%s", err);
+        assert_true(d.offset[(size_t)d.width * d.height] > 10000);
+        obs_params p = {0};
+        assert_int_equal(obs_param_set(&p, "fov_y", "40", err), OBS_OK);
+        assert_int_equal(obs_param_set(&p, "radius", "20", err), OBS_OK);
+        assert_int_equal(obs_param_set(&p, "samples", "8", err), OBS_OK);
+        obs_deep_result r;
+        if (obs_deep_run_cpu(&d, &p, &r, err) != OBS_OK)
+            fail_msg("%s: %s", path, err);
+        size_t n = (size_t)d.width * d.height;
+        double mean = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            assert_true(r.ao_blend.data[i] >= 0.0f && r.ao_blend.data[i] <= 1.0f + 1e-5f);
+            mean += r.ao_blend.data[i];
+        }
+        print_message("%s: %dx%d, %llu samples, mean blended AO %.4f\n", names[k], d.width, d.height,
+                      (unsigned long long)d.offset[n], mean / (double)n);
+        obs_deep_result_free(&r);
+        obs_deep_free(&d);
+    }
+    if (!found)
+        skip();
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_read_fixture),
+        cmocka_unit_test(test_read_limits),
+        cmocka_unit_test(test_read_damaged_fixture),
+        cmocka_unit_test(test_read_damaged_files),
+        cmocka_unit_test(test_compress_eq5),
+        cmocka_unit_test(test_hidden_occluder),
+        cmocka_unit_test(test_blend_and_hull),
+        cmocka_unit_test(test_gl_twin),
+        cmocka_unit_test(test_real_files),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
