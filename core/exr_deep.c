@@ -13,61 +13,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "deep.h"
 #include "exr_internal.h"
 #include "internal.h"
 
-typedef struct mem_src {
-    const unsigned char *buf;
-    size_t len;
-} mem_src;
-
-static int64_t mem_read(exr_const_context_t ctxt, void *user, void *buffer, uint64_t sz,
-                        uint64_t offset, exr_stream_error_func_ptr_t error_cb)
-{
-    const mem_src *m = user;
-    (void)ctxt;
-    (void)error_cb;
-    if (offset >= m->len)
-        return 0;
-    uint64_t n = m->len - offset < sz ? m->len - offset : sz;
-    memcpy(buffer, m->buf + offset, (size_t)n);
-    return (int64_t)n;
-}
-
-static int64_t mem_size(exr_const_context_t ctxt, void *user)
-{
-    (void)ctxt;
-    return (int64_t)((const mem_src *)user)->len;
-}
-
-static obs_status open_exr(const char *path, const mem_src *mem, exr_context_t *ctx,
-                           int64_t *size, char err[OBS_ERR_LEN])
-{
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    struct stat st;
-    init.error_handler_fn = obs__exr_error_handler;
-    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
-    if (mem) {
-        init.user_data = (void *)mem;
-        init.read_fn = mem_read;
-        init.size_fn = mem_size;
-    }
-    *ctx = NULL;
-    *size = mem ? (int64_t)mem->len
-            : stat(path, &st) == 0 && S_ISREG(st.st_mode) ? (int64_t)st.st_size : -1;
-    obs__exr_msg_reset();
-    exr_result_t rv = exr_start_read(ctx, mem ? "<memory>" : path, &init);
-    if (rv != EXR_ERR_SUCCESS) {
-        exr_finish(ctx);
-        *ctx = NULL;
-        return obs__exr_fail(err, rv, "not a readable OpenEXR file");
-    }
-    obs__exr_msg_reset();
-    return OBS_OK;
-}
+typedef obs__exr_mem mem_src;
 
 /* The first deep part, or -1; *tiled says whether it is deep tiled. */
 static int first_deep_part(exr_const_context_t ctx, int *tiled)
@@ -96,7 +47,7 @@ obs_status obs_exr_is_deep(const char *path, int *deep, char err[OBS_ERR_LEN])
     if (!path || !deep)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_is_deep: NULL argument");
     *deep = 0;
-    if ((st = open_exr(path, NULL, &ctx, &size, sub)) != OBS_OK)
+    if ((st = obs__exr_open(path, NULL, &ctx, &size, sub)) != OBS_OK)
         return obs__fail(err, st, "%s: %s", path, sub);
     *deep = first_deep_part(ctx, &tiled) >= 0;
     exr_finish(&ctx);
@@ -476,7 +427,7 @@ static obs_status read_any(const char *label, const char *path, const mem_src *m
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
     memset(out, 0, sizeof *out);
-    if ((st = open_exr(path, mem, &ctx, &size, sub)) == OBS_OK)
+    if ((st = obs__exr_open(path, mem, &ctx, &size, sub)) == OBS_OK)
         st = read_deep(ctx, size, lim, out, sub);
     if (ctx)
         exr_finish(&ctx);

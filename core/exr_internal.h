@@ -50,4 +50,16 @@ obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv,
  * conventions; zeroed when the header has none (exr_read.c). */
 void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam);
 
+/* A file in memory, read through OpenEXR's custom-stream callbacks. */
+typedef struct obs__exr_mem {
+    const unsigned char *buf;
+    size_t len;
+} obs__exr_mem;
+
+/* Opens a file (mem == NULL) or a memory buffer for reading, chunk table
+ * reconstruction off (a damaged table is an error); *size receives the
+ * byte count when known (else -1).  Shared by exr_read.c and exr_deep.c. */
+obs_status obs__exr_open(const char *path, const obs__exr_mem *mem, exr_context_t *ctx,
+                         int64_t *size, char err[OBS_ERR_LEN]);
+
 #endif

@@ -77,10 +77,7 @@ obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv, const char *wha
 
 /* ---- opening ------------------------------------------------------------ */
 
-typedef struct mem_src {
-    const unsigned char *buf;
-    size_t len;
-} mem_src;
+typedef obs__exr_mem mem_src;
 
 static int64_t mem_read(exr_const_context_t ctxt, void *user, void *buffer, uint64_t sz,
                         uint64_t offset, exr_stream_error_func_ptr_t error_cb)
@@ -101,9 +98,7 @@ static int64_t mem_size(exr_const_context_t ctxt, void *user)
     return (int64_t)((const mem_src *)user)->len;
 }
 
-/* Opens a file (mem == NULL) or a memory buffer; *size receives the byte
- * count when known (else -1). */
-static obs_status open_exr(const char *path, const mem_src *mem, exr_context_t *ctx,
+obs_status obs__exr_open(const char *path, const mem_src *mem, exr_context_t *ctx,
                            int64_t *size, char err[OBS_ERR_LEN])
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -708,7 +703,7 @@ static obs_status read_any(const char *label, const char *path, const mem_src *m
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
     memset(out, 0, sizeof *out);
-    if ((st = open_exr(path, mem, &ctx, &size, sub)) != OBS_OK)
+    if ((st = obs__exr_open(path, mem, &ctx, &size, sub)) != OBS_OK)
         goto fail;
     st = read_gbuffer(ctx, size, map, lim, out, sub);
 fail:
@@ -765,7 +760,7 @@ obs_status obs_exr_read_channel(const char *path, const char *channel, const obs
     if (!path || !channel || !out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_read_channel: NULL argument");
     memset(out, 0, sizeof *out);
-    if ((st = open_exr(path, NULL, &ctx, &size, sub)) != OBS_OK)
+    if ((st = obs__exr_open(path, NULL, &ctx, &size, sub)) != OBS_OK)
         goto fail;
     if ((rv = exr_get_count(ctx, &parts)) != EXR_ERR_SUCCESS) {
         st = obs__exr_fail(sub, rv, "part count");
@@ -830,7 +825,7 @@ obs_status obs_exr_list_channels(const char *path, char ***names_out, char err[O
     if (!path || !names_out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_list_channels: NULL argument");
     *names_out = NULL;
-    if ((st = open_exr(path, NULL, &ctx, &size, sub)) != OBS_OK)
+    if ((st = obs__exr_open(path, NULL, &ctx, &size, sub)) != OBS_OK)
         goto fail;
     if ((st = part_names(ctx, 0, &names, &n, sub)) != OBS_OK)
         goto fail;
