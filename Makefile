@@ -194,7 +194,7 @@ headers:
 	@echo "headers: each public header compiles alone as C and C++"
 
 bench: deps
-	@$(MAKE) --no-print-directory all $(BENCH) $(EXT_BENCH) $(UPSCALE) $(DAEMON_BENCH)
+	@$(MAKE) --no-print-directory all $(BENCH) $(EXT_BENCH) $(UPSCALE) $(DAEMON_BENCH) $(DEEP_BENCH)
 	@BUILD=$(BUILD) bench/run.sh
 
 # Quality against ground truth (bench/QUALITY.md, bench/quality/*.png): every

@@ -1,9 +1,13 @@
-/* deep_bench: OITAO (Bauer et al.) Table I structure for obscura's deep
- * input: list compression to m = 2, 4, 8 nodes against the uncompressed
- * lists, time per stage and the AO error, on the three deep EXRs of
- * OpenEXR's LowResLeftView set merged into one A-buffer (Balls, Leaves,
- * Trunks: their flat composite is composited.exr).  Writes the AO PNGs of
- * bench/deep/ and a Markdown table on stdout.
+/* deep_bench: OITAO (Bauer et al.) Table I for obscura's deep input: list
+ * compression to m = 2, 4, 8 nodes against the uncompressed lists, time
+ * per stage and the AO error, on the three deep EXRs of OpenEXR's
+ * LowResLeftView set merged into one A-buffer (Balls, Leaves, Trunks:
+ * their flat composite is composited.exr).  Stages: the compression
+ * (eq 5, CPU, timed alone), the upload of the node planes, the AO pass and
+ * the read-back (obs_ctx_set_timing: core/deep_gl.c times them between
+ * glFinish calls), and the
+ * rest of the run on the CPU (node prep, composite).  Writes the AO PNGs
+ * of bench/deep/ and a Markdown table on stdout.
  *
  *   deep_bench DIR OUTDIR [--cpu]
  *
@@ -109,8 +113,13 @@ int main(int argc, char **argv)
         cpu = 1;
     }
     obs_ctx_info ci = {0};
-    if (ctx)
+    if (ctx) {
         obs_ctx_get_info(ctx, &ci);
+        if (obs_ctx_set_timing(ctx, 1, err) != OBS_OK) {
+            fprintf(stderr, "timer queries: %s\n", err);
+            return 1;
+        }
+    }
 
     /* AO PNGs of each file alone, then the merged scene below */
     for (int k = 0; k < 3; k++) {
@@ -151,6 +160,7 @@ int main(int argc, char **argv)
         printf("|---");
     printf("|\n");
     double t_comp[16], t_ao[16], mean_err[16], max_err[16], frac[16];
+    obs_pass_times gl[16];
     for (int k = 0; k < nv; k++) {
         obs_params p = {0};
         obs_deep_layers l;
@@ -182,7 +192,12 @@ int main(int argc, char **argv)
                 fprintf(stderr, "%s: %s\n", v[k].label, err);
                 return 1;
             }
-            t_ao[k] = t < t_ao[k] ? t : t_ao[k];
+            if (t < t_ao[k]) {
+                t_ao[k] = t;
+                if (!ctx || !obs_ctx_last_times(ctx, &gl[k]))
+                    for (int q = 0; q < OBS_PASS_COUNT; q++)
+                        gl[k].ms[q] = 0.0;
+            }
             if (rep == 0) {
                 if (k == 0) {
                     ref = r.ao_blend;
@@ -216,9 +231,24 @@ int main(int argc, char **argv)
     printf("| compression (ms, CPU) |");
     for (int k = 0; k < nv; k++)
         printf(" %.1f |", t_comp[k]);
-    printf("\n| whole run: compression + node prep + AO + composite (ms) |");
+    static const struct {
+        obs_pass pass;
+        const char *label;
+    } stages[] = {{OBS_PASS_UPLOAD, "upload of the m node planes (ms, GL, glFinish to glFinish)"},
+                  {OBS_PASS_AO, "AO pass (ms, GL, glFinish to glFinish)"},
+                  {OBS_PASS_READBACK, "read-back (ms, GL, glFinish to glFinish)"}};
+    for (int q = 0; q < 3; q++) {
+        printf("\n| %s |", stages[q].label);
+        for (int k = 0; k < nv; k++)
+            printf(" %.1f |", gl[k].ms[stages[q].pass]);
+    }
+    printf("\n| node prep, composite, the rest (ms, CPU: whole run minus the above) |");
     for (int k = 0; k < nv; k++)
-        printf(" %.0f |", t_ao[k]);
+        printf(" %.0f |", t_ao[k] - t_comp[k] - gl[k].ms[OBS_PASS_UPLOAD] - gl[k].ms[OBS_PASS_AO] -
+                              gl[k].ms[OBS_PASS_READBACK]);
+    printf("\n| **whole run** (ms, wall clock) |");
+    for (int k = 0; k < nv; k++)
+        printf(" **%.0f** |", t_ao[k]);
     printf("\n| mean abs. AO error vs uncompressed |");
     for (int k = 0; k < nv; k++)
         printf(" %.5f |", mean_err[k]);

@@ -40,3 +40,14 @@ fi
 echo
 # the daemon: round trip vs in-process, concurrent clients (1920x1080)
 BUILD="$BUILD" bench/daemon_bench.sh "$1" "$2"
+echo
+# OITAO Table I: deep input's list compression, m = 2, 4, 8 against the
+# uncompressed lists (bench/deep_bench.c), on OpenEXR's LowResLeftView deep
+# images when present; the AO PNGs go to bench/deep/.
+DEEP=$SHARED/openexr-images/v2/LowResLeftView
+if [ -f "$DEEP/Balls.exr" ]; then
+    mkdir -p bench/deep
+    "$BUILD/deep_bench" "$DEEP" bench/deep
+else
+    echo "bench: $DEEP not found; deep input (OITAO Table I) skipped" >&2
+fi

@@ -426,7 +426,7 @@ static obs_status backend_from_args(const char *name, obs_backend *b)
  * A-buffer.  Outputs: AO.Y, the per-node AO blended by alpha; AOFront.Y,
  * the front node's AO; R,G,B,A, the front-to-back composite times AO.Y
  * (premultiplied).  PNG: NAME.ao.png, NAME.front.png, NAME.composite.png. */
-static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server)
+static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server, int argc, char **argv)
 {
     char err[OBS_ERR_LEN] = "";
     obs_deep_image d;
@@ -435,8 +435,6 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     obs_status s;
     int rc = EXIT_OK;
 
-    if (server)
-        die_usage("ao: deep input runs in-process only (no --server)");
     if (a->camera)
         die_usage("ao: deep input takes the camera from the EXR header or --fov-y");
     double t0 = now_ms();
@@ -446,6 +444,9 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     t0 = now_ms();
     if (a->cpu) {
         s = obs_deep_run_cpu(&d, &a->params, &r, err);
+    } else if (server) { /* clients/remote.c prints its own errors */
+        if ((rc = cli_remote_run_deep(server, argc, argv, a->in, &d, a->outputs, &r)) != EXIT_OK)
+            goto done;
     } else {
         obs_ctx_desc desc = {.debug = a->debug_gl, .log = log_cb};
         backend_from_args(a->backend, &desc.backend);
@@ -463,16 +464,8 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     const obs_camera *cam = d.camera.has_projection ? &d.camera : NULL;
     int want_ao = (a->outputs & OBS_OUTPUT_AO) != 0, want_comp = (a->outputs & OBS_OUTPUT_COMPOSITE) != 0;
     if (!strcmp(a->format, "exr")) {
-        static const char *const ao_n[] = {"AO.Y"}, *const front_n[] = {"AOFront.Y"};
-        static const char *const rgba_n[] = {"R", "G", "B", "A"};
         obs_exr_layer layers[3];
-        int n = 0;
-        if (want_ao) {
-            layers[n++] = (obs_exr_layer){&r.ao_blend, ao_n};
-            layers[n++] = (obs_exr_layer){&r.ao_front, front_n};
-        }
-        if (want_comp)
-            layers[n++] = (obs_exr_layer){&r.composite, rgba_n};
+        int n = obs_deep_result_exr_layers(&r, a->outputs, layers);
         s = obs_exr_write(a->out, layers, n, a->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
@@ -534,7 +527,7 @@ static int cmd_ao(int argc, char **argv)
 
     int deep = 0;
     if (obs_exr_is_deep(a.in, &deep, err) == OBS_OK && deep)
-        return cmd_ao_deep(&a, &lim, server);
+        return cmd_ao_deep(&a, &lim, server, argc, argv);
     double t0 = now_ms();
     s = obs_gbuffer_read_exr(a.in, &a.map, &lim, &gf, err);
     if (s != OBS_OK)

@@ -258,11 +258,36 @@ static int copy_image(const float *src, size_t stride_floats, int w, int h, int 
     return 0;
 }
 
+/* What an answer fills: a flat frame's result, or deep input's. */
+typedef struct answer {
+    obs_result *flat;
+    obs_deep_result *deep;
+} answer;
+
+static void answer_free(answer *a)
+{
+    if (a->flat)
+        obs_result_free(a->flat);
+    if (a->deep)
+        obs_deep_result_free(a->deep);
+}
+
+/* Where a raw image of the answer goes (NULL: not one asked for). */
+static obs_image *answer_slot(answer *a, unsigned output)
+{
+    if (a->deep)
+        return output == OBS_OUTPUT_AO ? &a->deep->ao_blend
+               : output == OBS_BIN_OUTPUT_AO_FRONT ? &a->deep->ao_front
+               : output == OBS_OUTPUT_COMPOSITE ? &a->deep->composite : NULL;
+    return output == OBS_OUTPUT_AO ? &a->flat->ao
+           : output == OBS_OUTPUT_COMPOSITE ? &a->flat->composite : NULL;
+}
+
 /* ---- binary protocol ------------------------------------------------------ */
 
 /* One attempt.  Returns 0 and fills res on 200; otherwise the status
  * (503 and -1 for "unreachable" are retried by the caller). */
-static int binary_once(const server_addr *a, const obs_bytes *frame, obs_result *res, int *retry_after,
+static int binary_once(const server_addr *a, const obs_bytes *frame, answer *res, int *retry_after,
                        char *msg, size_t msg_len)
 {
     int fd = connect_to(a, msg, msg_len);
@@ -300,10 +325,9 @@ static int binary_once(const server_addr *a, const obs_bytes *frame, obs_result 
     }
     for (int i = 0; i < r.image_count; i++) {
         /* take the images over: they are ours */
-        if (r.images[i].output == OBS_OUTPUT_AO && !res->ao.data)
-            res->ao = r.images[i].image, r.images[i].image = (obs_image){0};
-        else if (r.images[i].output == OBS_OUTPUT_COMPOSITE && !res->composite.data)
-            res->composite = r.images[i].image, r.images[i].image = (obs_image){0};
+        obs_image *slot = answer_slot(res, r.images[i].output);
+        if (slot && !slot->data)
+            *slot = r.images[i].image, r.images[i].image = (obs_image){0};
     }
     rc = 0;
 done:
@@ -351,12 +375,13 @@ static unsigned char *read_file(const char *path, size_t *len)
     return buf;
 }
 
-/* The answer's EXR (float, AO.Y and/or R,G,B,A) back into images. */
-static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs, obs_result *res,
-                         char *msg, size_t msg_len)
+/* One channel (`ao`, read as the depth) and/or R,G,B,A of the answer's
+ * float EXR into images. */
+static int exr_images(const unsigned char *body, size_t len, const char *ao, obs_image *ao_out,
+                      obs_image *rgba_out, char *msg, size_t msg_len)
 {
-    obs_channel_map map = {.preset = "generic", .depth = (outputs & OBS_OUTPUT_AO) ? "AO.Y" : "R"};
-    if (outputs & OBS_OUTPUT_COMPOSITE) {
+    obs_channel_map map = {.preset = "generic", .depth = ao ? ao : "R"};
+    if (rgba_out) {
         static const char *const rgba[] = {"R", "G", "B", "A"};
         for (int c = 0; c < 4; c++)
             map.color[c] = rgba[c];
@@ -369,20 +394,35 @@ static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs
     }
     const obs_gbuffer *g = &gf.gb;
     int rc = 0;
-    if (outputs & OBS_OUTPUT_AO)
+    if (ao)
         rc |= copy_image(g->depth.data, g->depth.row_stride ? g->depth.row_stride / 4 : (size_t)g->width,
-                         g->width, g->height, 1, &res->ao);
-    if (outputs & OBS_OUTPUT_COMPOSITE)
+                         g->width, g->height, 1, ao_out);
+    if (rgba_out)
         rc |= copy_image(g->color.data, g->color.row_stride ? g->color.row_stride / 4 : (size_t)g->width * 4,
-                         g->width, g->height, 4, &res->composite);
+                         g->width, g->height, 4, rgba_out);
     obs_gbuffer_free(&gf);
     if (rc)
         snprintf(msg, msg_len, "out of memory");
     return rc ? -1 : 0;
 }
 
+/* The answer's EXR (float; AO.Y, deep input's AOFront.Y, R,G,B,A) back
+ * into images. */
+static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs, answer *res,
+                         char *msg, size_t msg_len)
+{
+    int ao = (outputs & OBS_OUTPUT_AO) != 0, comp = (outputs & OBS_OUTPUT_COMPOSITE) != 0;
+    if (!res->deep)
+        return exr_images(body, len, ao ? "AO.Y" : NULL, &res->flat->ao, comp ? &res->flat->composite : NULL,
+                          msg, msg_len);
+    obs_deep_result *d = res->deep;
+    if (exr_images(body, len, ao ? "AO.Y" : NULL, &d->ao_blend, comp ? &d->composite : NULL, msg, msg_len))
+        return -1;
+    return ao ? exr_images(body, len, "AOFront.Y", &d->ao_front, NULL, msg, msg_len) : 0;
+}
+
 static int http_once(const server_addr *a, const char *query, const unsigned char *body, size_t body_len,
-                     unsigned outputs, obs_result *res, int *retry_after, char *msg, size_t msg_len)
+                     unsigned outputs, answer *res, int *retry_after, char *msg, size_t msg_len)
 {
     int fd = connect_to(a, msg, msg_len);
     if (fd < 0)
@@ -460,6 +500,8 @@ done:
  * rebuild it). */
 static void camera_params(const obs_gbuffer *gb, pairs *ps, char *buf, size_t len)
 {
+    if (!gb)
+        return; /* deep input: the camera is the EXR's, or the parameters' */
     const obs_camera *c = &gb->camera;
     if (c->source != OBS_CAMERA_JSON || has(ps, "fov_y") || has(ps, "fov-y"))
         return;
@@ -523,7 +565,7 @@ static void mark_down(const char *url, double until)
         if (down[i].until < down[slot].until)
             slot = i;
     }
-    snprintf(down[slot].url, sizeof down[slot].url, "%s", url);
+    snprintf(down[slot].url, sizeof down[slot].url, "%.255s", url);
     down[slot].until = until;
 }
 
@@ -543,8 +585,9 @@ int cli_remote_split(const char *list, char urls[][256], int max)
     }
 }
 
-int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
-                   const obs_gbuffer *gb, unsigned outputs, obs_result *out)
+/* The frame (gb or deep) on the servers; the answer into `out`. */
+static int run_remote(const char *server, int argc, char **argv, const char *in_path, const obs_gbuffer *gb,
+                      const obs_deep_image *deep, unsigned outputs, answer *out)
 {
     static server_addr addrs[CLI_REMOTE_MAX_SERVERS];
     static char urls[CLI_REMOTE_MAX_SERVERS][256];
@@ -553,7 +596,10 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
     char msg[OBS_ERR_LEN + 128] = "", cam[1024];
     const char *oname = outputs_name(outputs);
     int nserv = cli_remote_split(server, urls, CLI_REMOTE_MAX_SERVERS), any_http = 0, any_bin = 0;
-    memset(out, 0, sizeof *out);
+    if (out->flat)
+        memset(out->flat, 0, sizeof *out->flat);
+    if (out->deep)
+        memset(out->deep, 0, sizeof *out->deep);
     ps.n = pb.n = 0;
     for (int k = 0; k < nserv; k++) {
         if (parse_server(urls[k], &addrs[k]) != 0) {
@@ -566,6 +612,10 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
     if (nserv < 1) {
         fprintf(stderr, "obscura: --server '%s' is not http://HOST:PORT, unix:/PATH or tcp://HOST:PORT "
                 "(or a comma-separated list of up to %d of them)\n", server, CLI_REMOTE_MAX_SERVERS);
+        return RC_USAGE;
+    }
+    if (stream_name && deep) {
+        fprintf(stderr, "obscura: --stream: streams keep flat frames, not deep input\n");
         return RC_USAGE;
     }
     if (stream_name && any_bin) {
@@ -612,7 +662,7 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
         add(&pb, "format", "raw");
         if (token && *token)
             add(&pb, "token", token);
-        obs_bin_request_desc d = {.id = 1, .params = pb.p, .param_count = pb.n, .gb = gb};
+        obs_bin_request_desc d = {.id = 1, .params = pb.p, .param_count = pb.n, .gb = gb, .deep = deep};
         if (obs_bin_request_encode(&d, &frame, err) != OBS_OK) {
             fprintf(stderr, "obscura: cannot encode the request: %s\n", err);
             goto fail;
@@ -635,7 +685,7 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
                 if (pass == 0 && nserv > 1 && down_until(urls[k]) > now)
                     continue;
                 tried++;
-                obs_result_free(out);
+                answer_free(out);
                 last = addrs[k].kind == PROTO_HTTP
                            ? http_once(&addrs[k], query, body, body_len, outputs, out, &wait, msg, sizeof msg)
                            : binary_once(&addrs[k], &frame, out, &wait, msg, sizeof msg);
@@ -662,7 +712,7 @@ answered:
     obs_bytes_free(&frame);
     if (rc == 0)
         return RC_OK;
-    obs_result_free(out);
+    answer_free(out);
     if (rc == -1) {
         fprintf(stderr, "obscura: %s: unreachable: %s\n", nserv > 1 ? server : urls[k_last], msg);
         return RC_UNAVAILABLE;
@@ -674,4 +724,18 @@ fail:
     free(body);
     obs_bytes_free(&frame);
     return RC_FAIL;
+}
+
+int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
+                   const obs_gbuffer *gb, unsigned outputs, obs_result *out)
+{
+    answer a = {out, NULL};
+    return run_remote(server, argc, argv, in_path, gb, NULL, outputs, &a);
+}
+
+int cli_remote_run_deep(const char *server, int argc, char **argv, const char *in_path,
+                        const obs_deep_image *deep, unsigned outputs, obs_deep_result *out)
+{
+    answer a = {NULL, out};
+    return run_remote(server, argc, argv, in_path, NULL, deep, outputs, &a);
 }

@@ -4,7 +4,8 @@
  * writes the same files.
  *
  *   unix:/path, tcp://host:port   the binary protocol (protocol/PROTOCOL.md),
- *                                 raw float32 planes both ways
+ *                                 raw float32 planes both ways (deep input:
+ *                                 a deep G-buffer, counts and samples)
  *   http://host:port              POST /v1/ao with the input EXR, the
  *                                 answer asked as a float EXR
  *
@@ -21,6 +22,7 @@
 #ifndef OBSCURA_CLIENT_REMOTE_H
 #define OBSCURA_CLIENT_REMOTE_H
 
+#include "deep.h"
 #include "obscura.h"
 
 #define CLI_REMOTE_MAX_SERVERS 16
@@ -39,12 +41,20 @@ int cli_remote_take_server(int argc, char **argv, const char **server);
  * failure, 2 usage, 3 bad input (the server said 4xx other than 503), 4
  * server unreachable or busy (after bounded retries with Retry-After).
  * On 0 the caller frees *out with obs_result_free(). */
+int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
+                   const obs_gbuffer *gb, unsigned outputs, obs_result *out);
+
+/* The same for deep input: over the binary protocol the A-buffer goes as
+ * a deep G-buffer (per-pixel counts and samples), over HTTP the deep EXR
+ * as it is; the answer is the deep chain's result (AO.Y, AOFront.Y, the
+ * composite, as `outputs` asks).  On 0 the caller frees *out with
+ * obs_deep_result_free(). */
+int cli_remote_run_deep(const char *server, int argc, char **argv, const char *in_path,
+                        const obs_deep_image *deep, unsigned outputs, obs_deep_result *out);
+
 /* Splits a comma-separated server list into urls (each < 256 bytes);
  * returns how many, or -1 when an entry is empty or too long or there
  * are more than max. */
 int cli_remote_split(const char *list, char urls[][256], int max);
-
-int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
-                   const obs_gbuffer *gb, unsigned outputs, obs_result *out);
 
 #endif

@@ -14,6 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "io.h"
 #include "obscura.h"
 
 #ifdef __cplusplus
@@ -56,6 +57,8 @@ typedef struct obs_deep_image {
 /* 1 when the file's first deep part is deep data (scanline or tiled),
  * 0 when it has none; an unreadable file is an error. */
 obs_status obs_exr_is_deep(const char *path, int *deep, char err[OBS_ERR_LEN]);
+/* The same for an EXR in memory (a request body). */
+obs_status obs_exr_is_deep_mem(const void *buf, size_t len, int *deep, char err[OBS_ERR_LEN]);
 
 /* Reads the first deep scanline part of an EXR: a pass over the sample
  * count tables (checked: non-negative, cumulative per scanline, within
@@ -120,6 +123,12 @@ typedef struct obs_deep_result {
 } obs_deep_result;
 
 void obs_deep_result_free(obs_deep_result *r);
+
+/* The result's images as EXR layers, as `obscura ao`, the daemon and its
+ * clients write them: with OBS_OUTPUT_AO in `outputs`, AO.Y (ao_blend)
+ * and AOFront.Y (ao_front); with OBS_OUTPUT_COMPOSITE, R,G,B,A.  Returns
+ * how many (images the result does not hold are left out). */
+int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_exr_layer layers[3]);
 
 /* Multi-layer AO of the deep image on the CPU: compression to the
  * parameters' deep_layers nodes, then OITAO Algorithm 1 with VAO++'s

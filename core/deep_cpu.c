@@ -27,6 +27,20 @@ void obs_deep_result_free(obs_deep_result *r)
     obs_image_free(&r->composite);
 }
 
+int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_exr_layer layers[3])
+{
+    static const char *const ao[] = {"AO.Y"}, *const front[] = {"AOFront.Y"};
+    static const char *const rgba[] = {"R", "G", "B", "A"};
+    int n = 0;
+    if ((outputs & OBS_OUTPUT_AO) && r->ao_blend.data)
+        layers[n++] = (obs_exr_layer){&r->ao_blend, ao};
+    if ((outputs & OBS_OUTPUT_AO) && r->ao_front.data)
+        layers[n++] = (obs_exr_layer){&r->ao_front, front};
+    if ((outputs & OBS_OUTPUT_COMPOSITE) && r->composite.data)
+        layers[n++] = (obs_exr_layer){&r->composite, rgba};
+    return n;
+}
+
 static obs_status alloc_img(obs_image *img, int w, int h, int c, char err[OBS_ERR_LEN])
 {
     size_t n;

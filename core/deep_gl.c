@@ -3,38 +3,144 @@
  * (deep_cpu.c: view position, normal, alpha), uploaded as two 2D array
  * textures of m layers (RGBA32F: position + planar depth, normal +
  * alpha) and one fragment pass (core/shaders/deep.frag.glsl) writes the
- * front node's AO and the blended AO.  The resources live for one call:
- * deep input is a file-at-a-time path, not the daemon's frame loop. */
+ * front node's AO and the blended AO.
+ *
+ * The program is built once per context; the array textures, the output
+ * texture and its framebuffer are kept for the next frame of the same
+ * size and node count (the daemon runs deep frames back to back), as the
+ * flat chain keeps its targets (run_gl.c).
+ *
+ * With obs_ctx_set_timing the upload, the AO pass and the read-back
+ * (OBS_PASS_UPLOAD, OBS_PASS_AO, OBS_PASS_READBACK) are timed on the host
+ * between glFinish calls, not with GL_TIME_ELAPSED queries: Mesa's
+ * llvmpipe ends a query that no draw follows at its next flush, so with
+ * the node textures of the last frame reused the AO pass's whole cost
+ * was reported as the upload's.  Finishing each stage costs a GPU its
+ * overlap, which timing mode gives up anyway (it waits for the results). */
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "deep_internal.h"
 #include "gl/gl.h"
 #include "obs_shaders.h"
 
-static GLuint array_texture(int w, int h, int m, const float *data)
+static GLuint array_texture(obs_ctx *ctx, int w, int h, int m)
 {
     GLuint t;
     glGenTextures(1, &t);
+    ctx->gl_objects_created++;
     glBindTexture(GL_TEXTURE_2D_ARRAY, t);
     glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, w, h, m);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+static void upload_layers(GLuint tex, int w, int h, int m, const float *data)
+{
+    glBindTexture(GL_TEXTURE_2D_ARRAY, tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
     glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, m, GL_RGBA, GL_FLOAT, data);
-    return t;
+}
+
+/* Drops the size-dependent objects; the program stays unless `all`. */
+static void release(obs_ctx *ctx, int all)
+{
+    obs__deep_targets *t = &ctx->deep;
+    GLuint tex[] = {t->tex_pos, t->tex_nrm, t->tex_out};
+    glDeleteTextures(3, tex);
+    if (t->fbo)
+        glDeleteFramebuffers(1, &t->fbo);
+    GLuint prog = t->prog;
+    memset(t, 0, sizeof *t);
+    if (all && prog)
+        glDeleteProgram(prog);
+    else
+        t->prog = prog;
+}
+
+void obs__deep_release(obs_ctx *ctx) { release(ctx, 1); }
+
+/* The program, and the targets for w x h with m nodes: kept from the last
+ * frame when they match. */
+static obs_status ensure_deep(obs_ctx *ctx, int w, int h, int m, char err[OBS_ERR_LEN])
+{
+    static const char glsl_version[] = "#version 430 core\n";
+    obs__deep_targets *t = &ctx->deep;
+    obs_status s;
+    if (!t->prog) {
+        const char *src[] = {glsl_version, obs__shader_common, obs__shader_deep_frag};
+        if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, 3, &t->prog, err)) != OBS_OK) {
+            t->prog = 0;
+            return s;
+        }
+    }
+    if (t->width == w && t->height == h && t->m == m)
+        return OBS_OK;
+    release(ctx, 0);
+    t->tex_pos = array_texture(ctx, w, h, m);
+    t->tex_nrm = array_texture(ctx, w, h, m);
+    glGenTextures(1, &t->tex_out);
+    ctx->gl_objects_created++;
+    glBindTexture(GL_TEXTURE_2D, t->tex_out);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
+    glGenFramebuffers(1, &t->fbo);
+    ctx->gl_objects_created++;
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->tex_out, 0);
+    GLenum buf = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &buf);
+    GLenum st = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    s = st == GL_FRAMEBUFFER_COMPLETE
+            ? obs__gl_check("allocating deep targets", err)
+            : obs__fail(err, OBS_GL_ERROR, "deep AO framebuffer incomplete (0x%04x)", (unsigned)st);
+    if (s != OBS_OK) {
+        release(ctx, 0);
+        return s;
+    }
+    t->width = w;
+    t->height = h;
+    t->m = m;
+    obs__log(ctx, OBS_LOG_DEBUG, "allocated deep targets for %dx%d, %d nodes", w, h, m);
+    return OBS_OK;
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+/* Starts stage p when timing is on: the GL work queued before it is done
+ * first. */
+static void stage_begin(obs_ctx *ctx, double *t0)
+{
+    if (!ctx->timing)
+        return;
+    glFinish();
+    *t0 = now_ms();
+}
+
+static void stage_end(obs_ctx *ctx, obs_pass p, double t0, obs_pass_times *t)
+{
+    if (!ctx->timing)
+        return;
+    glFinish();
+    t->ms[p] = now_ms() - t0;
 }
 
 obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
                         obs_deep_result *out, char err[OBS_ERR_LEN])
 {
-    static const char glsl_version[] = "#version 430 core\n";
     obs__deep_frame df;
-    GLuint prog = 0, tex[3] = {0, 0, 0}, fbo = 0;
     float *rgba = NULL;
+    obs_pass_times times;
+    double t0 = 0.0;
     obs_status s;
 
     if (!ctx || !out)
@@ -42,6 +148,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     memset(out, 0, sizeof *out);
     if ((s = obs__ctx_bind(ctx, err)) != OBS_OK)
         return s;
+    ctx->times_valid = 0;
     if ((s = obs__deep_frame_setup(d, params, &df, err)) != OBS_OK)
         return s;
     const obs__frame *f = &df.f;
@@ -52,25 +159,20 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
         s = obs__fail(err, OBS_NO_MEMORY, "deep AO read-back of %dx%d", w, h);
         goto fail;
     }
-    const char *src[] = {glsl_version, obs__shader_common, obs__shader_deep_frag};
-    if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, 3, &prog, err)) != OBS_OK)
+    if ((s = ensure_deep(ctx, w, h, df.m, err)) != OBS_OK)
         goto fail;
+    const obs__deep_targets *t = &ctx->deep;
+    const GLuint prog = t->prog;
+    for (int p = 0; p < OBS_PASS_COUNT; p++)
+        times.ms[p] = -1.0;
 
-    tex[0] = array_texture(w, h, df.m, df.pos);
-    tex[1] = array_texture(w, h, df.m, df.nrm);
-    glGenTextures(1, &tex[2]);
-    glBindTexture(GL_TEXTURE_2D, tex[2]);
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
-    glGenFramebuffers(1, &fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex[2], 0);
-    GLenum buf = GL_COLOR_ATTACHMENT0;
-    glDrawBuffers(1, &buf);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-        s = obs__fail(err, OBS_GL_ERROR, "deep AO framebuffer incomplete");
-        goto fail;
-    }
+    stage_begin(ctx, &t0);
+    upload_layers(t->tex_pos, w, h, df.m, df.pos);
+    upload_layers(t->tex_nrm, w, h, df.m, df.nrm);
+    stage_end(ctx, OBS_PASS_UPLOAD, t0, &times);
 
+    stage_begin(ctx, &t0);
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
     glUseProgram(prog);
     glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_TRUE, f->proj);
     glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
@@ -86,33 +188,37 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform1i(glGetUniformLocation(prog, "u_multi"), df.multi);
     glUniform1i(glGetUniformLocation(prog, "u_thin"), df.thin);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, tex[0]);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, t->tex_pos);
     glUniform1i(glGetUniformLocation(prog, "u_lpos"), 0);
     glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, tex[1]);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, t->tex_nrm);
     glUniform1i(glGetUniformLocation(prog, "u_lnrm"), 1);
     glViewport(0, 0, w, h);
     glBindVertexArray(ctx->vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    stage_end(ctx, OBS_PASS_AO, t0, &times);
+
+    stage_begin(ctx, &t0);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba);
+    stage_end(ctx, OBS_PASS_READBACK, t0, &times);
     glActiveTexture(GL_TEXTURE0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if ((s = obs__gl_check("deep AO pass", err)) != OBS_OK)
         goto fail;
+    if (ctx->timing) {
+        times.total_ms = times.ms[OBS_PASS_UPLOAD] + times.ms[OBS_PASS_AO] + times.ms[OBS_PASS_READBACK];
+        ctx->times = times;
+        ctx->times_valid = 1;
+    }
     for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
         out->ao_front.data[i] = rgba[4 * i];
         out->ao_blend.data[i] = rgba[4 * i + 1];
     }
     obs__deep_composite(d, out);
 fail:
-    if (fbo) {
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        glDeleteFramebuffers(1, &fbo);
-    }
-    glDeleteTextures(3, tex);
-    if (prog)
-        glDeleteProgram(prog);
     free(rgba);
     obs__deep_frame_free(&df);
     if (s != OBS_OK)

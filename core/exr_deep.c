@@ -54,6 +54,27 @@ obs_status obs_exr_is_deep(const char *path, int *deep, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
+obs_status obs_exr_is_deep_mem(const void *buf, size_t len, int *deep, char err[OBS_ERR_LEN])
+{
+    char sub[OBS_ERR_LEN] = "";
+    exr_context_t ctx = NULL;
+    mem_src mem = {buf, len};
+    int64_t size;
+    int tiled = 0;
+    obs_status st;
+
+    if (!deep)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_is_deep_mem: NULL argument");
+    *deep = 0;
+    if (!buf || len == 0)
+        return obs__fail(err, OBS_BAD_FILE, "EXR in memory: empty buffer");
+    if ((st = obs__exr_open(NULL, &mem, &ctx, &size, sub)) != OBS_OK)
+        return obs__fail(err, st, "EXR in memory: %s", sub);
+    *deep = first_deep_part(ctx, &tiled) >= 0;
+    exr_finish(&ctx);
+    return OBS_OK;
+}
+
 /* ---- channels ------------------------------------------------------------- */
 
 /* Channel index of each sample value (OBS_DEEP_*), -1 where absent. */

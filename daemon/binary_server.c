@@ -193,6 +193,44 @@ static void job_done(obsd_job *job, void *user)
     pthread_mutex_unlock(&c->lock);
 }
 
+/* Encodes the answer of a finished job as the request asks: raw float32
+ * images, an EXR or a PNG.  Deep input answers AO.Y (the blended AO),
+ * AOFront.Y (raw output OBS_BIN_OUTPUT_AO_FRONT) and the composite. */
+static obs_status encode_answer(const obs_bin_request *q, const obsd_job *job, const obs_camera *cam,
+                                obs_bin_response_desc *d, obs_bin_image images[3], obs_bytes *blob,
+                                char err[OBS_ERR_LEN])
+{
+    const obs_result *res = &job->result;
+    const obs_deep_result *dr = &job->deep_result;
+    const int deep = job->deep != NULL, want_ao = (q->hr.outputs & OBS_OUTPUT_AO) != 0;
+    const obs_image *ao = deep ? (want_ao ? &dr->ao_blend : NULL) : (res->ao.data ? &res->ao : NULL);
+    const obs_image *front = deep && want_ao ? &dr->ao_front : NULL;
+    const obs_image *comp = deep ? ((q->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &dr->composite : NULL)
+                                 : (res->composite.data ? &res->composite : NULL);
+    if (q->raw_out) {
+        int n = 0;
+        if (ao)
+            images[n++] = (obs_bin_image){OBS_OUTPUT_AO, *ao};
+        if (front)
+            images[n++] = (obs_bin_image){OBS_BIN_OUTPUT_AO_FRONT, *front};
+        if (comp)
+            images[n++] = (obs_bin_image){OBS_OUTPUT_COMPOSITE, *comp};
+        d->body = OBS_BIN_RAW;
+        d->images = images;
+        d->image_count = n;
+        return OBS_OK;
+    }
+    if (q->hr.format == OBS_HTTP_EXR) {
+        obs_exr_layer layers[OBS_RESULT_LAYERS];
+        int n = deep ? obs_deep_result_exr_layers(dr, q->hr.outputs, layers) : obs_result_exr_layers(res, layers);
+        d->body = OBS_BIN_EXR;
+        return obs_exr_write_mem(layers, n, q->hr.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, blob, err);
+    }
+    const obs_image *img = ao ? ao : comp;
+    d->body = OBS_BIN_PNG;
+    return obs_png_write_mem(img, q->hr.png_bits, img == comp, blob, err);
+}
+
 /* Runs a decoded request through the queue and answers it. */
 static int run_frame(frame *f, obs_bin_request *q)
 {
@@ -200,24 +238,34 @@ static int run_frame(frame *f, obs_bin_request *q)
     obsd_bin *b = c->srv;
     obs_limits lim = {.max_pixels = (uint64_t)b->cfg->max_pixels};
     obs_gbuffer_file exr = {0};
+    obs_deep_image deep_exr = {0};
     const obs_gbuffer *gb = &q->gf.gb;
+    const obs_deep_image *deep = q->body == OBS_BIN_DEEP ? &q->deep : NULL;
     char err[OBS_ERR_LEN] = "";
     int rc;
 
     if (q->body == OBS_BIN_EXR) {
+        /* a deep EXR runs the deep chain, as on POST /v1/ao */
+        int is_deep = 0;
         double t0 = obsd_now_ms();
-        obs_status s = obs_gbuffer_read_exr_mem(q->exr, q->exr_len, &q->hr.map, &lim, &exr, err);
+        obs_status s = obs_exr_is_deep_mem(q->exr, q->exr_len, &is_deep, err);
+        if (s == OBS_OK && is_deep)
+            s = obs_deep_read_exr_mem(q->exr, q->exr_len, &lim, &deep_exr, err);
+        else if (s == OBS_OK)
+            s = obs_gbuffer_read_exr_mem(q->exr, q->exr_len, &q->hr.map, &lim, &exr, err);
         f->ms_decode = obsd_now_ms() - t0;
         obsd_stats_stage(OBSD_STAGE_DECODE, f->ms_decode);
         if (s != OBS_OK)
             return send_status(f, s, err);
         gb = &exr.gb;
+        deep = is_deep ? &deep_exr : NULL;
     }
-    obsd_job job = {.gb = gb, .params = &q->hr.params, .outputs = q->hr.outputs, .done = job_done,
-                    .user = c};
+    obsd_job job = {.gb = deep ? NULL : gb, .deep = deep, .params = &q->hr.params,
+                    .outputs = q->hr.outputs, .done = job_done, .user = c};
     c->done = 0;
     if (obsd_queue_push(b->queue, &job) != 0) {
         obs_gbuffer_free(&exr);
+        obs_deep_free(&deep_exr);
         return send_error(f, 503, atomic_load(&b->draining) ? "shutting_down" : "queue_full",
                           "the frame queue is full; retry later");
     }
@@ -233,34 +281,14 @@ static int run_frame(frame *f, obs_bin_request *q)
         rc = send_status(f, job.status, job.err);
         goto done;
     }
-    obsd_stats_frame(gb->width, gb->height);
+    obsd_stats_frame(deep ? deep->width : gb->width, deep ? deep->height : gb->height);
 
     double t0 = obsd_now_ms();
-    const obs_result *res = &job.result;
+    const obs_camera *cam = deep ? &deep->camera : &gb->camera;
     obs_bin_response_desc d = {.id = f->id, .status = 200, .code = "ok", .message = ""};
-    obs_bin_image images[2];
+    obs_bin_image images[3];
     obs_bytes blob = {0};
-    obs_status s = OBS_OK;
-    if (q->raw_out) {
-        int n = 0;
-        if (res->ao.data)
-            images[n++] = (obs_bin_image){OBS_OUTPUT_AO, res->ao};
-        if (res->composite.data)
-            images[n++] = (obs_bin_image){OBS_OUTPUT_COMPOSITE, res->composite};
-        d.body = OBS_BIN_RAW;
-        d.images = images;
-        d.image_count = n;
-    } else if (q->hr.format == OBS_HTTP_EXR) {
-        obs_exr_layer layers[OBS_RESULT_LAYERS];
-        int n = obs_result_exr_layers(res, layers);
-        s = obs_exr_write_mem(layers, n, q->hr.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF,
-                              gb->camera.has_projection ? &gb->camera : NULL, &blob, err);
-        d.body = OBS_BIN_EXR;
-    } else {
-        const obs_image *img = res->ao.data ? &res->ao : &res->composite;
-        s = obs_png_write_mem(img, q->hr.png_bits, img == &res->composite, &blob, err);
-        d.body = OBS_BIN_PNG;
-    }
+    obs_status s = encode_answer(q, &job, cam->has_projection ? cam : NULL, &d, images, &blob, err);
     d.blob = blob.data;
     d.blob_len = blob.size;
     if (s != OBS_OK) {
@@ -274,7 +302,9 @@ static int run_frame(frame *f, obs_bin_request *q)
     obs_bytes_free(&blob);
 done:
     obs_result_free(&job.result);
+    obs_deep_result_free(&job.deep_result);
     obs_gbuffer_free(&exr);
+    obs_deep_free(&deep_exr);
     return rc;
 }
 

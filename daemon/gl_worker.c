@@ -93,6 +93,8 @@ static void *worker_main(void *arg)
         } else if (w->fail_after > 0 && frame == w->fail_after) {
             job->status = OBS_GL_ERROR;
             snprintf(job->err, OBS_ERR_LEN, "injected GL failure on frame %ld (--fail-gl-after)", frame);
+        } else if (job->deep) {
+            job->status = obs_deep_run(ctx, job->deep, job->params, &job->deep_result, job->err);
         } else {
             job->status = obs_run(ctx, job->gb, job->params, job->outputs, &job->result, job->err);
         }

@@ -1,6 +1,7 @@
 /* The GL worker: the one thread that owns the GL context, for the whole
- * life of the process.  It takes jobs from the queue, runs obs_run and
- * hands each back through its `done` callback.  When a frame fails with
+ * life of the process.  It takes jobs from the queue, runs obs_run (or
+ * obs_deep_run for deep input) and hands each back through its `done`
+ * callback.  When a frame fails with
  * OBS_GL_ERROR or OBS_GL_UNAVAILABLE (a lost context), that frame is
  * answered with the failure, then the worker destroys the context and
  * creates a new one with the same options (retrying with backoff) before

@@ -64,6 +64,7 @@ typedef struct obsd__req {
     int before_drain;    /* started before SIGTERM: finished in the drain */
     obs_http_request hr;
     obs_gbuffer_file gf;
+    obs_deep_image deep; /* a deep EXR body (POST /v1/ao) */
     obsd_job job;
     double ms_decode, ms_queue, ms_gl, ms_encode;
     /* /v1/streams */
@@ -104,8 +105,9 @@ enum MHD_Result obsd__frame_start(obsd__req *r);
 /* The request's query parameters into r->hr (recorded into r->query
  * when r->record_query); 400 answered on a bad one (returns 0, *rc set). */
 int obsd__parse_query(obsd__req *r, enum MHD_Result *rc);
-/* Decodes `body` with r->hr's channel map, queues the frame (outputs)
- * and suspends the connection; answers the error itself. */
+/* Decodes `body` with r->hr's channel map (a deep EXR into r->deep, on
+ * POST /v1/ao only), queues the frame (outputs) and suspends the
+ * connection; answers the error itself. */
 enum MHD_Result obsd__queue_frame(obsd__req *r, const unsigned char *body, size_t len, unsigned outputs);
 /* The stages of a finished job into r and the metrics. */
 void obsd__job_timings(obsd__req *r);

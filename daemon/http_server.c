@@ -355,14 +355,23 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     char err[OBS_ERR_LEN] = "";
     obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
     double t0 = obsd_now_ms();
-    obs_status s = obs_gbuffer_read_exr_mem(body, len, &r->hr.map, &lim, &r->gf, err);
+    /* A deep EXR runs the multi-layer chain (core/deep.h), on /v1/ao only:
+     * streams keep flat frames. */
+    int deep = 0;
+    obs_status s = obs_exr_is_deep_mem(body, len, &deep, err);
+    if (s == OBS_OK && deep && r->op == STREAM_POST)
+        s = OBS_UNSUPPORTED, snprintf(err, sizeof err, "deep EXR input runs on POST /v1/ao, not in streams");
+    else if (s == OBS_OK && deep)
+        s = obs_deep_read_exr_mem(body, len, &lim, &r->deep, err);
+    else if (s == OBS_OK)
+        s = obs_gbuffer_read_exr_mem(body, len, &r->hr.map, &lim, &r->gf, err);
     r->ms_decode = obsd_now_ms() - t0;
     obsd_stats_stage(OBSD_STAGE_DECODE, r->ms_decode);
     if (s != OBS_OK)
         return obsd__answer_status(r, s, err);
 
-    r->job = (obsd_job){.gb = &r->gf.gb, .params = &r->hr.params, .outputs = outputs,
-                        .done = job_done, .user = r};
+    r->job = (obsd_job){.gb = deep ? NULL : &r->gf.gb, .deep = deep ? &r->deep : NULL,
+                        .params = &r->hr.params, .outputs = outputs, .done = job_done, .user = r};
     /* Suspend before queueing: the worker may finish and resume at once. */
     r->state = REQ_QUEUED;
     MHD_suspend_connection(r->conn);
@@ -397,7 +406,9 @@ void obsd__job_timings(req *r)
     r->ms_gl = job->t_finished - job->t_started;
     obsd_stats_stage(OBSD_STAGE_QUEUE, r->ms_queue);
     obsd_stats_stage(OBSD_STAGE_GL, r->ms_gl);
-    if (job->status == OBS_OK)
+    if (job->status == OBS_OK && job->deep)
+        obsd_stats_frame(job->deep->width, job->deep->height);
+    else if (job->status == OBS_OK)
         obsd_stats_frame(r->gf.gb.width, r->gf.gb.height);
 }
 
@@ -413,6 +424,9 @@ static int expose(const obs_image *src, double ev, obs_image *out)
         out->data[i] = (src->channels == 4 && i % 4 == 3) ? src->data[i] : src->data[i] * k;
     return 0;
 }
+
+static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, int timing,
+                                    const char *extra_name, const char *extra_value);
 
 enum MHD_Result obsd__answer_images(req *r, const obs_image *ao, const obs_image *composite,
                                     const obs_image *color, const obs_camera *cam, int timing,
@@ -449,10 +463,17 @@ enum MHD_Result obsd__answer_images(req *r, const obs_image *ao, const obs_image
     obsd_stats_stage(OBSD_STAGE_ENCODE, r->ms_encode);
     if (s != OBS_OK)
         return obsd__answer_error(r, 500, "encode_failed", err, NULL, NULL);
+    return answer_bytes(r, &out, type, timing, extra_name, extra_value);
+}
 
-    struct MHD_Response *resp = MHD_create_response_from_buffer(out.size, out.data, MHD_RESPMEM_MUST_FREE);
+/* Answers 200 with an encoded image (taking `out`), the Server-Timing
+ * header with `timing`, and one extra header when extra_name is set. */
+static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, int timing,
+                                    const char *extra_name, const char *extra_value)
+{
+    struct MHD_Response *resp = MHD_create_response_from_buffer(out->size, out->data, MHD_RESPMEM_MUST_FREE);
     if (!resp) {
-        obs_bytes_free(&out);
+        obs_bytes_free(out);
         return MHD_NO;
     }
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, type);
@@ -464,7 +485,35 @@ enum MHD_Result obsd__answer_images(req *r, const obs_image *ao, const obs_image
     }
     if (extra_name)
         MHD_add_response_header(resp, extra_name, extra_value);
-    return obsd__answer(r, 200, resp, out.size, NULL);
+    return obsd__answer(r, 200, resp, out->size, NULL);
+}
+
+/* The answer of deep input: an EXR of AO.Y, AOFront.Y and R,G,B,A as
+ * `obscura ao` writes it, or a PNG of the blended AO or the composite. */
+static enum MHD_Result answer_deep(req *r)
+{
+    const obs_deep_result *dr = &r->job.deep_result;
+    const obs_camera *cam = r->deep.camera.has_projection ? &r->deep.camera : NULL;
+    char err[OBS_ERR_LEN] = "";
+    double t0 = obsd_now_ms();
+    obs_bytes out = {0};
+    obs_status s;
+    const char *type;
+    if (r->hr.format == OBS_HTTP_EXR) {
+        obs_exr_layer layers[3];
+        int n = obs_deep_result_exr_layers(dr, r->hr.outputs, layers);
+        s = obs_exr_write_mem(layers, n, r->hr.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, &out, err);
+        type = "image/x-exr";
+    } else {
+        int comp = !(r->hr.outputs & OBS_OUTPUT_AO);
+        s = obs_png_write_mem(comp ? &dr->composite : &dr->ao_blend, r->hr.png_bits, comp, &out, err);
+        type = "image/png";
+    }
+    r->ms_encode = obsd_now_ms() - t0;
+    obsd_stats_stage(OBSD_STAGE_ENCODE, r->ms_encode);
+    if (s != OBS_OK)
+        return obsd__answer_error(r, 500, "encode_failed", err, NULL, NULL);
+    return answer_bytes(r, &out, type, 1, NULL, NULL);
 }
 
 /* Called again once the GL worker resumed the connection. */
@@ -474,6 +523,11 @@ static enum MHD_Result ao_finish(req *r)
     obsd__job_timings(r);
     if (job->status != OBS_OK)
         return obsd__answer_status(r, job->status, job->err);
+    if (job->deep) {
+        enum MHD_Result rc = answer_deep(r);
+        obs_deep_result_free(&job->deep_result);
+        return rc;
+    }
     const obs_result *res = &job->result;
     const obs_camera *cam = r->gf.gb.camera.has_projection ? &r->gf.gb.camera : NULL;
     enum MHD_Result rc = obsd__answer_images(r, res->ao.data ? &res->ao : NULL,
@@ -582,7 +636,9 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
     obsd__streams_done(r);
     free(r->body);
     obs_result_free(&r->job.result);
+    obs_deep_result_free(&r->job.deep_result);
     obs_gbuffer_free(&r->gf);
+    obs_deep_free(&r->deep);
     free(r);
     *con_cls = NULL;
     atomic_fetch_sub(&h->in_flight, 1);

@@ -5,16 +5,22 @@
 
 #include <pthread.h>
 
+#include "deep.h"
 #include "obscura.h"
 
 typedef struct obsd_job obsd_job;
 struct obsd_job {
-    /* in: owned by the submitter, valid until `done` runs */
+    /* in: owned by the submitter, valid until `done` runs; either a flat
+     * G-buffer (gb, the VAO++ chain) or a deep one (deep, the multi-layer
+     * chain of core/deep.h) */
     const obs_gbuffer *gb;
+    const obs_deep_image *deep;
     const obs_params *params;
     unsigned outputs;
-    /* out: filled by the GL worker before `done` */
+    /* out: filled by the GL worker before `done` (result for gb,
+     * deep_result for deep) */
     obs_result result;
+    obs_deep_result deep_result;
     obs_status status;
     char err[OBS_ERR_LEN];
     double t_queued, t_started, t_finished; /* obsd_now_ms() */

@@ -4,6 +4,7 @@
  * frame is allocated once, at its exact size. */
 #include "binary.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,7 +14,10 @@
 #error "the binary protocol copies float32 planes as they are: little-endian hosts only"
 #endif
 
-#define RAW_HEADER_LEN 160 /* width .. projection, see PROTOCOL.md */
+#define RAW_HEADER_LEN 160  /* width .. projection, see PROTOCOL.md */
+#define DEEP_HEADER_LEN 176 /* width .. projection of a deep G-buffer */
+#define DEEP_FLAGS (OBS_BIN_DEEP_ZBACK | OBS_BIN_DEEP_ALPHA | OBS_BIN_HAS_WORLD_TO_CAMERA | \
+                    OBS_BIN_HAS_PROJECTION | OBS_BIN_DEEP_COLOR | OBS_BIN_DEEP_NORMAL)
 
 static obs_status fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
@@ -227,6 +231,52 @@ static obs_status check_gbuffer(const obs_gbuffer *gb, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
+/* A deep image the encoder can send: sizes within the decoder's limits,
+ * each pixel's samples sorted front to back. */
+static obs_status check_deep(const obs_deep_image *d, char err[OBS_ERR_LEN])
+{
+    if (!d->offset || d->width <= 0 || d->height <= 0)
+        return fail(err, OBS_INVALID_ARGUMENT, "deep G-buffer: offsets and a size are required");
+    size_t npx = (size_t)d->width * (size_t)d->height;
+    if (d->offset[0] != 0 || d->offset[npx] > OBS_DEEP_MAX_SAMPLES || (d->offset[npx] && !d->samples))
+        return fail(err, OBS_INVALID_ARGUMENT, "deep G-buffer: %llu samples (at most %llu)",
+                    (unsigned long long)d->offset[npx], (unsigned long long)OBS_DEEP_MAX_SAMPLES);
+    for (size_t i = 0; i < npx; i++)
+        if (d->offset[i + 1] < d->offset[i] || d->offset[i + 1] - d->offset[i] > OBS_DEEP_MAX_PER_PIXEL)
+            return fail(err, OBS_INVALID_ARGUMENT, "deep G-buffer: pixel %zu holds a bad sample count", i);
+    return OBS_OK;
+}
+
+static void write_deep(writer *w, const obs_deep_image *d)
+{
+    const obs_camera *cam = &d->camera;
+    size_t npx = (size_t)d->width * (size_t)d->height;
+    uint32_t flags = (d->has_zback ? OBS_BIN_DEEP_ZBACK : 0) | (d->has_alpha ? OBS_BIN_DEEP_ALPHA : 0) |
+                     (cam->has_world_to_camera ? OBS_BIN_HAS_WORLD_TO_CAMERA : 0) |
+                     (cam->has_projection ? OBS_BIN_HAS_PROJECTION : 0) |
+                     (d->has_color ? OBS_BIN_DEEP_COLOR : 0) | (d->has_normal ? OBS_BIN_DEEP_NORMAL : 0);
+    put_u32(w, (uint32_t)d->width);
+    put_u32(w, (uint32_t)d->height);
+    put_u32(w, (uint32_t)d->display_x);
+    put_u32(w, (uint32_t)d->display_y);
+    put_u32(w, (uint32_t)d->display_width);
+    put_u32(w, (uint32_t)d->display_height);
+    put_u32(w, flags);
+    put_u32(w, OBS_DEEP_CH);
+    put_u32(w, OBS_BIN_F32);
+    put_u32(w, 0);
+    put_u64(w, d->offset[npx]);
+    put(w, cam->world_to_camera, sizeof cam->world_to_camera);
+    put(w, cam->projection, sizeof cam->projection);
+    if (!w->p) {
+        w->n += npx * 4 + (size_t)d->offset[npx] * OBS_DEEP_CH * sizeof(float);
+        return;
+    }
+    for (size_t i = 0; i < npx; i++)
+        put_u32(w, (uint32_t)(d->offset[i + 1] - d->offset[i]));
+    put(w, d->samples, (size_t)d->offset[npx] * OBS_DEEP_CH * sizeof(float));
+}
+
 static void write_request(writer *w, const obs_bin_request_desc *d, uint64_t payload_len)
 {
     unsigned char hdr[OBS_BIN_HEADER_LEN];
@@ -246,6 +296,12 @@ static void write_request(writer *w, const obs_bin_request_desc *d, uint64_t pay
         put_pad8(w, start);
         put_u64(w, d->exr_len);
         put(w, d->exr, d->exr_len);
+        return;
+    }
+    if (d->deep) {
+        put_u8(w, OBS_BIN_DEEP);
+        put_pad8(w, start);
+        write_deep(w, d->deep);
         return;
     }
     const obs_gbuffer *gb = d->gb;
@@ -275,8 +331,9 @@ static void write_request(writer *w, const obs_bin_request_desc *d, uint64_t pay
 obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
-    if (!!d->gb == !!d->exr)
-        return fail(err, OBS_INVALID_ARGUMENT, "a request carries either raw planes or an EXR");
+    if (!!d->gb + !!d->exr + !!d->deep != 1)
+        return fail(err, OBS_INVALID_ARGUMENT, "a request carries one of raw planes, an EXR or a "
+                    "deep G-buffer");
     if (d->param_count < 0 || d->param_count > OBS_BIN_MAX_PARAMS)
         return fail(err, OBS_INVALID_ARGUMENT, "at most %d parameters", OBS_BIN_MAX_PARAMS);
     for (int i = 0; i < d->param_count; i++) {
@@ -285,11 +342,9 @@ obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out,
             return fail(err, OBS_INVALID_ARGUMENT, "parameter '%.64s': name of 1 to %d bytes and "
                         "value of at most %d bytes", d->params[i].name, OBS_BIN_MAX_NAME, OBS_BIN_MAX_VALUE);
     }
-    if (d->gb) {
-        obs_status s = check_gbuffer(d->gb, err);
-        if (s != OBS_OK)
-            return s;
-    }
+    obs_status s = d->gb ? check_gbuffer(d->gb, err) : d->deep ? check_deep(d->deep, err) : OBS_OK;
+    if (s != OBS_OK)
+        return s;
     writer w = {NULL, 0};
     write_request(&w, d, 0);
     if (!(w.p = malloc(w.n)))
@@ -446,6 +501,112 @@ static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *
     return OBS_OK;
 }
 
+/* Z as the deep reader sorts it: NaN after everything. */
+static float sort_key(float z) { return z != z ? INFINITY : z; }
+
+/* A deep G-buffer (PROTOCOL.md, "Deep G-buffer"): every size is checked
+ * before anything is allocated: the window against the limits, the
+ * sample total against OBS_DEEP_MAX_SAMPLES, the counts' and samples'
+ * bytes against the rest of the payload, then each count against
+ * OBS_DEEP_MAX_PER_PIXEL and their sum against the total. */
+static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request *q, char err[OBS_ERR_LEN])
+{
+    uint32_t width, height, dx, dy, dw, dh, flags, values, type, reserved;
+    uint64_t total;
+    if (!have(r, DEEP_HEADER_LEN))
+        return truncated(r, "deep G-buffer header", err);
+    get_u32(r, &width);
+    get_u32(r, &height);
+    get_u32(r, &dx);
+    get_u32(r, &dy);
+    get_u32(r, &dw);
+    get_u32(r, &dh);
+    get_u32(r, &flags);
+    get_u32(r, &values);
+    get_u32(r, &type);
+    get_u32(r, &reserved);
+    get_u64(r, &total);
+    if (flags & ~(uint32_t)DEEP_FLAGS)
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: unknown flags 0x%x", flags);
+    if (values != OBS_DEEP_CH)
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: %u values per sample; the layout has %d "
+                    "(Z, ZBack, R, G, B, A, N.X, N.Y, N.Z)", values, OBS_DEEP_CH);
+    if (type != OBS_BIN_F32 || reserved != 0)
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: sample type %u (only float32, 0) or reserved "
+                    "field %u (0)", type, reserved);
+    obs_status s = obs_check_size(lim, width, height, err);
+    if (s != OBS_OK)
+        return s;
+    if ((int32_t)dw < 0 || (int32_t)dh < 0 || dw > (1u << 20) || dh > (1u << 20))
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: display window %u x %u is not a size", dw, dh);
+    if (total > OBS_DEEP_MAX_SAMPLES)
+        return fail(err, OBS_TOO_LARGE, "deep G-buffer: %llu samples, over the limit of %llu",
+                    (unsigned long long)total, (unsigned long long)OBS_DEEP_MAX_SAMPLES);
+    /* width x height within the limits, total < 2^25: no overflow below */
+    uint64_t npx = (uint64_t)width * height, sample_bytes = total * OBS_DEEP_CH * sizeof(float);
+    obs_camera *cam = &q->deep.camera;
+    get(r, cam->world_to_camera, sizeof cam->world_to_camera);
+    get(r, cam->projection, sizeof cam->projection);
+    if (npx * 4 + sample_bytes != r->n - r->off)
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: %u x %u counts and %llu samples need %llu bytes, "
+                    "the frame holds %zu", width, height, (unsigned long long)total,
+                    (unsigned long long)(npx * 4 + sample_bytes), r->n - r->off);
+    const unsigned char *cp = r->p + r->off;
+    uint64_t sum = 0;
+    for (uint64_t i = 0; i < npx; i++) {
+        uint32_t c = (uint32_t)cp[4 * i] | (uint32_t)cp[4 * i + 1] << 8 | (uint32_t)cp[4 * i + 2] << 16 |
+                     (uint32_t)cp[4 * i + 3] << 24;
+        if (c > OBS_DEEP_MAX_PER_PIXEL)
+            return fail(err, OBS_TOO_LARGE, "deep G-buffer: pixel (%llu, %llu) holds %u samples, over the "
+                        "limit of %d", (unsigned long long)(i % width), (unsigned long long)(i / width), c,
+                        OBS_DEEP_MAX_PER_PIXEL);
+        sum += c;
+    }
+    if (sum != total)
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: the pixels' counts sum to %llu samples, the "
+                    "header says %llu", (unsigned long long)sum, (unsigned long long)total);
+    obs_deep_image *d = &q->deep;
+    if (!(d->offset = malloc((size_t)(npx + 1) * sizeof *d->offset)))
+        return fail(err, OBS_NO_MEMORY, "no memory for the offsets of %u x %u pixels", width, height);
+    d->offset[0] = 0;
+    for (uint64_t i = 0; i < npx; i++)
+        d->offset[i + 1] = d->offset[i] + ((uint32_t)cp[4 * i] | (uint32_t)cp[4 * i + 1] << 8 |
+                                           (uint32_t)cp[4 * i + 2] << 16 | (uint32_t)cp[4 * i + 3] << 24);
+    r->off += (size_t)npx * 4;
+    if (total && ((uintptr_t)(r->p + r->off) & 3u) != 0) {
+        if (!(q->gf.storage = malloc((size_t)sample_bytes)))
+            return fail(err, OBS_NO_MEMORY, "no memory for %llu deep samples", (unsigned long long)total);
+        memcpy(q->gf.storage, r->p + r->off, (size_t)sample_bytes);
+        d->samples = q->gf.storage;
+    } else {
+        /* read-only use: the core takes the image as const */
+        d->samples = total ? (float *)(uintptr_t)(r->p + r->off) : NULL;
+    }
+    r->off += (size_t)sample_bytes;
+    /* front to back, as the deep reader leaves them (core/exr_deep.c) */
+    for (uint64_t i = 0; i < npx; i++)
+        for (uint64_t k = d->offset[i] + 1; k < d->offset[i + 1]; k++)
+            if (sort_key(d->samples[(k - 1) * OBS_DEEP_CH + OBS_DEEP_Z]) >
+                sort_key(d->samples[k * OBS_DEEP_CH + OBS_DEEP_Z]))
+                return fail(err, OBS_BAD_FILE, "deep G-buffer: the samples of pixel (%llu, %llu) are not "
+                            "sorted by Z, front to back", (unsigned long long)(i % width),
+                            (unsigned long long)(i / width));
+    d->width = (int)width;
+    d->height = (int)height;
+    d->display_x = (int32_t)dx;
+    d->display_y = (int32_t)dy;
+    d->display_width = dw ? (int)dw : (int)width;
+    d->display_height = dh ? (int)dh : (int)height;
+    d->has_zback = !!(flags & OBS_BIN_DEEP_ZBACK);
+    d->has_alpha = !!(flags & OBS_BIN_DEEP_ALPHA);
+    d->has_color = !!(flags & OBS_BIN_DEEP_COLOR);
+    d->has_normal = !!(flags & OBS_BIN_DEEP_NORMAL);
+    cam->has_world_to_camera = !!(flags & OBS_BIN_HAS_WORLD_TO_CAMERA);
+    cam->has_projection = !!(flags & OBS_BIN_HAS_PROJECTION);
+    cam->source = cam->has_projection ? OBS_CAMERA_PARAMS : OBS_CAMERA_NONE;
+    return OBS_OK;
+}
+
 obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, const obs_limits *lim,
                                   obs_bin_request *out, char err[OBS_ERR_LEN])
 {
@@ -507,9 +668,16 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
         out->exr_len = (size_t)n;
         return OBS_OK;
     }
+    if (body == OBS_BIN_DEEP) {
+        out->body = OBS_BIN_DEEP;
+        s = decode_deep(&r, lim, out, err);
+        if (s != OBS_OK)
+            obs_bin_request_free(out);
+        return s;
+    }
     if (body != OBS_BIN_RAW)
-        return fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is neither EXR (1) nor "
-                    "raw (2)", body);
+        return fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is not EXR (1), raw (2) "
+                    "or deep (4)", body);
     out->body = OBS_BIN_RAW;
     s = decode_raw(&r, lim, out, err);
     if (s != OBS_OK)
@@ -523,6 +691,8 @@ void obs_bin_request_free(obs_bin_request *q)
         return;
     free(q->gf.storage);
     memset(&q->gf, 0, sizeof q->gf);
+    free(q->deep.offset);
+    memset(&q->deep, 0, sizeof q->deep);
     q->exr = NULL;
     q->exr_len = 0;
 }

@@ -3,8 +3,10 @@
  * The wire format, byte by byte, is in protocol/PROTOCOL.md.
  *
  *   frame    = header (OBS_BIN_HEADER_LEN bytes) + payload (header.length)
- *   request  = parameters (name=value strings) + outputs + a G-buffer,
- *              either an EXR file or raw float32/float16 planes and a camera
+ *   request  = parameters (name=value strings) + outputs + a G-buffer:
+ *              an EXR file (flat or deep), raw float32/float16 planes and a
+ *              camera, or a deep (layered) A-buffer: per-pixel sample
+ *              counts and the packed samples
  *   response = status + code + message, then nothing, an EXR/PNG file or
  *              raw float32 planes
  *
@@ -18,6 +20,7 @@
 #include <stdint.h>
 
 #include "http.h"
+#include "../core/deep.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -41,7 +44,8 @@ typedef enum obs_bin_body {
     OBS_BIN_NONE = 0, /* responses only: an error */
     OBS_BIN_EXR = 1,  /* an OpenEXR file */
     OBS_BIN_RAW = 2,  /* float32 planes (requests: or float16) */
-    OBS_BIN_PNG = 3   /* responses only: a PNG file */
+    OBS_BIN_PNG = 3,  /* responses only: a PNG file */
+    OBS_BIN_DEEP = 4  /* requests only: a deep (layered) A-buffer */
 } obs_bin_body;
 
 /* Raw G-buffer flags. */
@@ -51,6 +55,20 @@ enum {
     OBS_BIN_HAS_WORLD_TO_CAMERA = 4,
     OBS_BIN_HAS_PROJECTION = 8
 };
+
+/* Deep G-buffer flags: which of a sample's values the renderer wrote
+ * (the others are filled as the deep EXR reader fills them), and the
+ * camera (the same bits as the raw G-buffer's). */
+enum {
+    OBS_BIN_DEEP_ZBACK = 1,
+    OBS_BIN_DEEP_ALPHA = 2,
+    OBS_BIN_DEEP_COLOR = 16,
+    OBS_BIN_DEEP_NORMAL = 32
+};
+
+/* The `output` of a raw response image that holds the front node's AO of
+ * deep input (its AO.Y, blended over the nodes, is OBS_OUTPUT_AO). */
+#define OBS_BIN_OUTPUT_AO_FRONT 256u
 
 /* Raw G-buffer plane types (the field after the flags).  Requests only:
  * float16 planes are converted to float32 by the decoder; responses and
@@ -89,7 +107,8 @@ typedef struct obs_bin_param {
 } obs_bin_param;
 
 /* What a client sends.  gb: raw planes (tightly packed or strided); exr:
- * an EXR file.  Exactly one of them is set. */
+ * an EXR file; deep: an A-buffer (each pixel's samples sorted by Z, front
+ * to back, as obs_deep_read_exr gives them).  Exactly one of them is set. */
 typedef struct obs_bin_request_desc {
     uint64_t id;
     const obs_bin_param *params;
@@ -97,6 +116,7 @@ typedef struct obs_bin_request_desc {
     const obs_gbuffer *gb;
     const void *exr;
     size_t exr_len;
+    const obs_deep_image *deep;
 } obs_bin_request_desc;
 
 /* Encodes a whole request frame (header + payload).  Caller frees with
@@ -107,16 +127,20 @@ obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out,
 /* A decoded request.  With body RAW, gf.gb's float32 planes point into
  * the payload when it is 4-byte aligned (else into gf.storage, a copy);
  * float16 planes are converted into gf.storage; with
- * EXR, exr/exr_len point into the payload.  Either way the payload must
- * outlive the request.  Free with obs_bin_request_free(). */
+ * EXR, exr/exr_len point into the payload; with DEEP, deep.offset is
+ * owned and deep.samples points into the payload when it is 4-byte
+ * aligned (else into gf.storage, a copy).  The deep image is read-only
+ * (never pass it to obs_deep_free).  Either way the payload must outlive
+ * the request.  Free with obs_bin_request_free(). */
 typedef struct obs_bin_request {
     obs_http_request hr; /* parameters and response options */
     int raw_out;         /* format=raw: answer with float32 planes */
     char token[512];     /* token=..., "" when absent */
-    obs_bin_body body;   /* EXR or RAW */
+    obs_bin_body body;   /* EXR, RAW or DEEP */
     const unsigned char *exr;
     size_t exr_len;
     obs_gbuffer_file gf; /* RAW */
+    obs_deep_image deep; /* DEEP */
 } obs_bin_request;
 
 /* Decodes a request payload (the bytes after the header).  Sizes are

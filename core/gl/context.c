@@ -191,6 +191,7 @@ void obs_ctx_destroy(obs_ctx *ctx)
         return;
     if (obs__ctx_bind(ctx, NULL) == OBS_OK) {
         obs__frame_release(ctx);
+        obs__deep_release(ctx);
         glDeleteVertexArrays(1, &ctx->vao);
         if (ctx->queries[0])
             glDeleteQueries(OBS_PASS_COUNT, ctx->queries);

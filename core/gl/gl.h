@@ -197,6 +197,15 @@ typedef struct obs__targets {
     GLuint fbo_cull;                          /* culling pre-pass: tex_cull */
 } obs__targets;
 
+/* Deep input's pass (deep_gl.c): its program, and the node planes and
+ * the output target of one size and node count. */
+typedef struct obs__deep_targets {
+    GLuint prog;                 /* built on first use, kept */
+    int width, height, m;        /* 0: none allocated yet */
+    GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
+    GLuint tex_out, fbo;         /* AO of the front node and the blend */
+} obs__deep_targets;
+
 struct obs_ctx {
     obs_backend backend;
     obs__backend_state st;
@@ -208,6 +217,7 @@ struct obs_ctx {
     GLuint vao;  /* empty vertex array for the full-screen triangle */
     obs__programs prog;
     obs__targets tg;
+    obs__deep_targets deep;
     unsigned long gl_objects_created; /* textures + framebuffers, for tests */
     int timing;                          /* obs_ctx_set_timing */
     GLuint queries[OBS_PASS_COUNT];      /* GL_TIME_ELAPSED, one per pass */
@@ -217,6 +227,9 @@ struct obs_ctx {
 
 /* Deletes the per-resolution textures, framebuffers and programs. */
 void obs__frame_release(obs_ctx *ctx);
+
+/* Deletes deep input's program, textures and framebuffer. */
+void obs__deep_release(obs_ctx *ctx);
 
 /* Makes the context current on the calling thread (and its table). */
 obs_status obs__ctx_bind(obs_ctx *ctx, char err[OBS_ERR_LEN]);

@@ -1,6 +1,6 @@
 /* libFuzzer target for the binary protocol's decoders (protocol/binary.c).
  *
- * Every input is decoded as a request payload and as a response payload,
+ * Every input (raw, EXR and deep G-buffers) is decoded as a request payload and as a response payload,
  * from an exactly sized heap copy (ASan sees any read past the end), once
  * 8-aligned and once at an odd address (the raw planes' copy path); a
  * frame header is parsed from the first 24 bytes when there are that many.
@@ -35,6 +35,16 @@ static void decode_all(const unsigned char *p, size_t n)
             if (gb->color.data)
                 for (size_t i = 0; i < px * 4; i++)
                     sink += gb->color.data[i];
+            (void)sink;
+        } else if (q.body == OBS_BIN_DEEP) {
+            /* every offset and every sample value, as the deep chain reads them */
+            const obs_deep_image *d = &q.deep;
+            size_t px = (size_t)d->width * (size_t)d->height;
+            volatile float sink = 0;
+            for (size_t i = 0; i < px; i++)
+                for (uint64_t k = d->offset[i]; k < d->offset[i + 1]; k++)
+                    for (int c = 0; c < OBS_DEEP_CH; c++)
+                        sink += d->samples[k * OBS_DEEP_CH + c];
             (void)sink;
         } else if (q.body == OBS_BIN_EXR) {
             volatile unsigned char s = q.exr[0] ^ q.exr[q.exr_len - 1];

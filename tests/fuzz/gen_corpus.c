@@ -92,6 +92,18 @@ int main(int argc, char **argv)
                                .exr_len = sizeof exr};
     rc |= save_bytes(dir, "request_exr", &b, obs_bin_request_encode(&d, &b, err));
 
+    /* a deep (layered) G-buffer, 2 x 2: counts 2, 0, 1, 3, a camera */
+    static const uint64_t offset[5] = {0, 2, 2, 3, 6};
+    float samples[6 * OBS_DEEP_CH];
+    for (int k = 0; k < 6 * OBS_DEEP_CH; k++)
+        samples[k] = k % OBS_DEEP_CH == OBS_DEEP_Z ? 1.0f + (float)k : 0.5f;
+    obs_deep_image deep = {.width = 2, .height = 2, .display_width = 2, .display_height = 2,
+                           .offset = (uint64_t *)offset, .samples = samples, .has_alpha = 1,
+                           .has_color = 1, .camera = full.camera};
+    obs_bin_param dp[] = {{"deep_layers", "2"}, {"format", "raw"}, {"output", "both"}};
+    d = (obs_bin_request_desc){.id = 11, .params = dp, .param_count = 3, .deep = &deep};
+    rc |= save_bytes(dir, "request_deep", &b, obs_bin_request_encode(&d, &b, err));
+
     /* responses: an error, a PNG, raw images */
     obs_bin_response_desc r = {.id = 7, .status = 503, .retry_after = 1, .code = "queue_full",
                                .message = "the queue is full"};

@@ -10,6 +10,7 @@
 #include <math.h>
 
 #include "deep.h"
+#include "gl/gl.h"
 
 #define FIXTURE TESTDATA "/deep_small.exr"
 
@@ -470,6 +471,57 @@ static void test_gl_twin(void **state)
     obs_ctx_destroy(ctx);
 }
 
+/* The deep pass keeps its program and targets: a second frame of the same
+ * size and node count creates no GL objects and gives the same AO; another
+ * node count makes one new set.  With timing on, the upload, the AO pass
+ * and the read-back have GL times. */
+static void test_gl_resources_reused(void **state)
+{
+    (void)state;
+    obs_ctx *ctx = NULL;
+    obs_ctx_desc desc = {0};
+    char err[OBS_ERR_LEN] = "";
+    if (obs_ctx_create(&desc, &ctx, err) != OBS_OK) {
+        print_message("no GL context (%s): skipped\n", err);
+        skip();
+    }
+    obs_deep_image d;
+    obs_deep_result a, b;
+    obs_params p = {0};
+    assert_int_equal(obs_deep_read_exr(FIXTURE, NULL, &d, err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "radius", "1", err), OBS_OK);
+    unsigned long before = ctx->gl_objects_created;
+    assert_int_equal(obs_deep_run(ctx, &d, &p, &a, err), OBS_OK);
+    unsigned long first = ctx->gl_objects_created - before;
+    assert_int_equal(first, 4); /* two node arrays, the output, its framebuffer */
+    assert_int_equal(obs_deep_run(ctx, &d, &p, &b, err), OBS_OK);
+    assert_int_equal(ctx->gl_objects_created - before, first);
+    size_t n = (size_t)d.width * d.height * sizeof(float);
+    assert_memory_equal(a.ao_blend.data, b.ao_blend.data, n);
+    assert_memory_equal(a.ao_front.data, b.ao_front.data, n);
+    obs_deep_result_free(&b);
+
+    assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
+    assert_int_equal(obs_deep_run(ctx, &d, &p, &b, err), OBS_OK);
+    assert_int_equal(ctx->gl_objects_created - before, 2 * first);
+    obs_deep_result_free(&b);
+    assert_int_equal(obs_param_set(&p, "deep_layers", "4", err), OBS_OK);
+
+    obs_pass_times t;
+    assert_int_equal(obs_ctx_set_timing(ctx, 1, err), OBS_OK);
+    assert_int_equal(obs_ctx_last_times(ctx, &t), 0);
+    assert_int_equal(obs_deep_run(ctx, &d, &p, &b, err), OBS_OK);
+    assert_int_equal(ctx->gl_objects_created - before, 3 * first);
+    assert_memory_equal(a.ao_blend.data, b.ao_blend.data, n);
+    assert_int_equal(obs_ctx_last_times(ctx, &t), 1);
+    assert_true(t.ms[OBS_PASS_UPLOAD] >= 0.0 && t.ms[OBS_PASS_AO] >= 0.0 && t.ms[OBS_PASS_READBACK] >= 0.0);
+    assert_true(t.ms[OBS_PASS_PREP] < 0.0 && t.ms[OBS_PASS_BLUR] < 0.0);
+    obs_deep_result_free(&a);
+    obs_deep_result_free(&b);
+    obs_deep_free(&d);
+    obs_ctx_destroy(ctx);
+}
+
 /* ---- real deep EXRs (../shared) ---------------------------------------------- */
 
 static void test_real_files(void **state)
@@ -521,6 +573,7 @@ int main(void)
         cmocka_unit_test(test_hidden_occluder),
         cmocka_unit_test(test_blend_and_hull),
         cmocka_unit_test(test_gl_twin),
+        cmocka_unit_test(test_gl_resources_reused),
         cmocka_unit_test(test_real_files),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -469,6 +469,219 @@ static void test_f16_planes(void **state)
     obs_bytes_free(&f);
 }
 
+/* ---- deep (layered) G-buffers ---------------------------------------------- */
+
+#define DW 3
+#define DH 2
+/* samples per pixel: 2, 0, 1, 3, 1, 0 (7 in all) */
+static const uint64_t deep_offset[DW * DH + 1] = {0, 2, 2, 3, 6, 7, 7};
+static float deep_samples[7 * OBS_DEEP_CH];
+
+static void fill_deep(obs_deep_image *d)
+{
+    for (int s = 0; s < 7; s++)
+        for (int c = 0; c < OBS_DEEP_CH; c++)
+            deep_samples[s * OBS_DEEP_CH + c] = c == OBS_DEEP_Z ? 1.0f + (float)s : (float)(s * 10 + c) / 64.0f;
+    memset(d, 0, sizeof *d);
+    d->width = DW;
+    d->height = DH;
+    d->display_x = -1;
+    d->display_y = 2;
+    d->display_width = 8;
+    d->display_height = 4;
+    d->offset = (uint64_t *)deep_offset;
+    d->samples = deep_samples;
+    d->has_zback = d->has_alpha = d->has_color = 1;
+    for (int k = 0; k < 16; k++)
+        d->camera.projection[k] = (float)k / 3.0f;
+    d->camera.has_projection = 1;
+}
+
+/* A deep request with no parameters: the deep header starts at payload
+ * byte 8 (count, kind, padding). */
+#define DEEP_AT (OBS_BIN_HEADER_LEN + 8)
+static obs_bytes encode_deep_request(void)
+{
+    obs_deep_image d;
+    obs_bytes out;
+    char err[OBS_ERR_LEN] = "";
+    fill_deep(&d);
+    obs_bin_request_desc desc = {.id = 5, .deep = &d};
+    assert_int_equal(obs_bin_request_encode(&desc, &out, err), OBS_OK);
+    assert_int_equal(out.size, DEEP_AT + 176 + DW * DH * 4 + 7 * OBS_DEEP_CH * 4);
+    return out;
+}
+
+static obs_status decode_payload(const obs_bytes *f, const obs_limits *lim, obs_bin_request *q,
+                                 char err[OBS_ERR_LEN])
+{
+    size_t n = f->size - OBS_BIN_HEADER_LEN;
+    unsigned char *copy = malloc(n);
+    memcpy(copy, f->data + OBS_BIN_HEADER_LEN, n);
+    err[0] = '\0';
+    obs_status s = obs_bin_request_decode(copy, n, lim, q, err);
+    if (s != OBS_OK) {
+        assert_true(err[0] != '\0');
+        assert_null(q->deep.offset); /* nothing kept on failure */
+        assert_null(q->gf.storage);
+    }
+    obs_bin_request_free(q);
+    free(copy);
+    return s;
+}
+
+static void test_deep_round_trip(void **state)
+{
+    (void)state;
+    obs_bytes f = encode_deep_request();
+    char err[OBS_ERR_LEN] = "";
+    obs_bin_request q;
+    obs_bin_header h;
+    assert_int_equal(obs_bin_header_parse(f.data, &h, 1u << 20, err), OBS_OK);
+    assert_int_equal(h.length, f.size - OBS_BIN_HEADER_LEN);
+    /* aligned (samples used in place) and at an odd address (copied) */
+    for (int odd = 0; odd < 2; odd++) {
+        size_t n = f.size - OBS_BIN_HEADER_LEN;
+        unsigned char *buf = malloc(n + 1);
+        memcpy(buf + odd, f.data + OBS_BIN_HEADER_LEN, n);
+        if (obs_bin_request_decode(buf + odd, n, NULL, &q, err) != OBS_OK)
+            fail_msg("%s", err);
+        assert_int_equal(q.body, OBS_BIN_DEEP);
+        const obs_deep_image *d = &q.deep;
+        assert_int_equal(d->width, DW);
+        assert_int_equal(d->height, DH);
+        assert_int_equal(d->display_x, -1);
+        assert_int_equal(d->display_y, 2);
+        assert_int_equal(d->display_width, 8);
+        assert_int_equal(d->display_height, 4);
+        assert_true(d->has_zback && d->has_alpha && d->has_color && !d->has_normal);
+        assert_true(d->camera.has_projection && !d->camera.has_world_to_camera);
+        for (int k = 0; k < 16; k++)
+            assert_true(d->camera.projection[k] == (float)k / 3.0f);
+        assert_memory_equal(d->offset, deep_offset, sizeof deep_offset);
+        assert_memory_equal(d->samples, deep_samples, sizeof deep_samples);
+        assert_true(odd ? q.gf.storage != NULL : q.gf.storage == NULL);
+        obs_bin_request_free(&q);
+        free(buf);
+    }
+    obs_bytes_free(&f);
+}
+
+static void test_deep_truncated(void **state)
+{
+    (void)state;
+    obs_bytes f = encode_deep_request();
+    char err[OBS_ERR_LEN];
+    obs_bin_request q;
+    for (size_t n = OBS_BIN_HEADER_LEN; n < f.size; n++) {
+        size_t m = n - OBS_BIN_HEADER_LEN;
+        unsigned char *copy = malloc(m ? m : 1);
+        memcpy(copy, f.data + OBS_BIN_HEADER_LEN, m);
+        err[0] = '\0';
+        assert_int_equal(obs_bin_request_decode(copy, m, NULL, &q, err), OBS_BAD_FILE);
+        assert_true(err[0] != '\0');
+        assert_null(q.deep.offset);
+        assert_null(q.gf.storage);
+        free(copy);
+    }
+    /* a cut inside the header names it; a cut in the samples, the sizes */
+    f.size = DEEP_AT + 100;
+    assert_int_equal(decode_payload(&f, NULL, &q, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "deep G-buffer header"));
+    f.size = DEEP_AT + 176 + DW * DH * 4 + 10;
+    assert_int_equal(decode_payload(&f, NULL, &q, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "the frame holds"));
+    obs_bytes_free(&f);
+}
+
+static void test_deep_bad_counts(void **state)
+{
+    (void)state;
+    obs_bytes f = encode_deep_request();
+    char err[OBS_ERR_LEN];
+    obs_bin_request q;
+    unsigned char *counts = f.data + DEEP_AT + 176;
+    /* counts that do not sum to the total (bytes still add up) */
+    le32(counts, 1);
+    le32(counts + 4, 1);
+    assert_int_equal(decode_payload(&f, NULL, &q, err), OBS_OK);
+    le32(counts + 4, 2);
+    assert_int_equal(decode_payload(&f, NULL, &q, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "sum to 8 samples, the header says 7"));
+    /* a count that would wrap a 32-bit sum */
+    le32(counts, 0xffffffffu);
+    assert_int_equal(decode_payload(&f, NULL, &q, err), OBS_TOO_LARGE);
+    assert_non_null(strstr(err, "pixel (0, 0) holds 4294967295 samples"));
+    le32(counts, 2);
+    le32(counts + 4, 0);
+    /* samples out of order in pixel (0, 1), samples 3..5: Z 4, 5, 6 -> 4, 7, 6 */
+    float z = 7.0f;
+    memcpy(f.data + f.size - (7 - 4) * OBS_DEEP_CH * 4 + OBS_DEEP_Z * 4, &z, 4);
+    assert_int_equal(decode_payload(&f, NULL, &q, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "pixel (0, 1) are not sorted"));
+    obs_bytes_free(&f);
+}
+
+static void test_deep_bad_sizes(void **state)
+{
+    (void)state;
+    obs_bytes f = encode_deep_request();
+    char err[OBS_ERR_LEN];
+    obs_bin_request q;
+    unsigned char *hd = f.data + DEEP_AT;
+    obs_limits lim = {.max_pixels = 10000};
+    /* too many samples: refused from the total before anything else */
+    le32(hd + 40, 0);
+    le32(hd + 44, 1); /* 2^32 */
+    assert_int_equal(decode_payload(&f, &lim, &q, err), OBS_TOO_LARGE);
+    assert_non_null(strstr(err, "4294967296 samples, over the limit"));
+    le32(hd + 44, 0);
+    le32(hd + 40, (uint32_t)OBS_DEEP_MAX_SAMPLES + 1);
+    assert_int_equal(decode_payload(&f, &lim, &q, err), OBS_TOO_LARGE);
+    /* a total the frame's bytes do not hold */
+    le32(hd + 40, 8);
+    assert_int_equal(decode_payload(&f, &lim, &q, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "need"));
+    le32(hd + 40, 7);
+    /* a window over the limits, of no pixels, or bigger than the frame */
+    const uint32_t sizes[][3] = {{65535, 65535, OBS_TOO_LARGE}, {0xffffffffu, 0xffffffffu, OBS_TOO_LARGE},
+                                 {0, 2, 0}, {200, 100, OBS_TOO_LARGE}, {DW + 1, DH, OBS_BAD_FILE}};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        le32(hd, sizes[k][0]);
+        le32(hd + 4, sizes[k][1]);
+        obs_status s = decode_payload(&f, &lim, &q, err);
+        assert_int_not_equal(s, OBS_OK);
+        if (sizes[k][2])
+            assert_int_equal(s, (obs_status)sizes[k][2]);
+    }
+    le32(hd, DW);
+    le32(hd + 4, DH);
+    assert_int_equal(decode_payload(&f, &lim, &q, err), OBS_OK);
+    /* values per sample, sample type, reserved, flags */
+    const size_t field[] = {28, 32, 36, 24};
+    const uint32_t value[] = {8, 1, 1, 0x100};
+    const char *const says[] = {"8 values per sample", "sample type 1", "reserved", "unknown flags"};
+    for (int k = 0; k < 4; k++) {
+        uint32_t keep = (uint32_t)hd[field[k]] | (uint32_t)hd[field[k] + 1] << 8;
+        le32(hd + field[k], value[k]);
+        assert_int_equal(decode_payload(&f, &lim, &q, err), OBS_BAD_FILE);
+        assert_non_null(strstr(err, says[k]));
+        le32(hd + field[k], keep);
+    }
+    assert_int_equal(decode_payload(&f, &lim, &q, err), OBS_OK);
+    /* the encoder refuses what the decoder would */
+    obs_deep_image d;
+    fill_deep(&d);
+    uint64_t bad[DW * DH + 1];
+    memcpy(bad, deep_offset, sizeof bad);
+    bad[2] = 1; /* decreasing */
+    d.offset = bad;
+    obs_bin_request_desc desc = {.id = 1, .deep = &d};
+    obs_bytes g;
+    assert_int_equal(obs_bin_request_encode(&desc, &g, err), OBS_INVALID_ARGUMENT);
+    obs_bytes_free(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -476,6 +689,8 @@ int main(void)
         cmocka_unit_test(test_response_round_trip), cmocka_unit_test(test_every_truncation),
         cmocka_unit_test(test_oversized),           cmocka_unit_test(test_garbage),
         cmocka_unit_test(test_half_to_float),       cmocka_unit_test(test_f16_planes),
+        cmocka_unit_test(test_deep_round_trip),     cmocka_unit_test(test_deep_truncated),
+        cmocka_unit_test(test_deep_bad_counts),     cmocka_unit_test(test_deep_bad_sizes),
     };
     return cmocka_run_group_tests_name("protocol_binary", tests, NULL, NULL);
 }
