@@ -19,7 +19,8 @@ DEBUG ?= 0
 
 CC ?= cc
 PKGS := OpenEXR egl osmesa libpng libcjson
-# Only OpenEXR's C core library is used (openexr.h), not the C++ one.
+# OpenEXR's C core library (openexr.h) reads and writes; its C++ library
+# only writes deep files (core/exr_deep_write.cpp, see below).
 EXR_CFLAGS := $(shell pkg-config --cflags OpenEXR 2>/dev/null)
 PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson 2>/dev/null) $(EXR_CFLAGS)
 PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson 2>/dev/null) -lz -lm -lpthread
@@ -28,6 +29,13 @@ PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjs
 # static members they are linked only into binaries that call them, and
 # --as-needed keeps the shared libraries out of the others (the daemon).
 PKG_LIBS += -Wl,--push-state,--as-needed $(shell pkg-config --libs assimp 2>/dev/null) -lembree3 -Wl,--pop-state
+# The deep EXR writer (core/exr_deep_write.cpp, OpenEXR's C++ deep API; the
+# C API of 3.1 cannot write deep data): the same arrangement, so only the
+# binaries that write deep files (the CLI, tests) need the C++ libraries.
+PKG_LIBS += -Wl,--push-state,--as-needed $(shell pkg-config --libs OpenEXR 2>/dev/null) -lstdc++ -Wl,--pop-state
+CXX ?= c++
+CXXFLAGS ?= -O2 -g
+CXXFLAGS += -std=c++14 -Wall -Wextra -Wshadow -fno-strict-aliasing
 
 CFLAGS ?= -O2 -g
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -Wall -Wextra -Wshadow -Wstrict-prototypes \
@@ -35,6 +43,7 @@ CFLAGS += -std=c11 -D_DEFAULT_SOURCE -Wall -Wextra -Wshadow -Wstrict-prototypes 
 CPPFLAGS += -Icore -I$(BUILD)/gen
 ifeq ($(SAN),1)
 CFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+CXXFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 LDFLAGS += -fsanitize=address,undefined
 export LSAN_OPTIONS := suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0
 export UBSAN_OPTIONS := print_stacktrace=1:halt_on_error=1
@@ -44,7 +53,8 @@ CPPFLAGS += -DOBS_DEBUG=1
 endif
 
 CORE_SRC := $(wildcard core/*.c core/gl/*.c)
-CORE_OBJ := $(CORE_SRC:%.c=$(BUILD)/obj/%.o)
+CORE_CXX_SRC := $(wildcard core/*.cpp)
+CORE_OBJ := $(CORE_SRC:%.c=$(BUILD)/obj/%.o) $(CORE_CXX_SRC:%.cpp=$(BUILD)/obj/%.o)
 SHADERS := $(wildcard core/shaders/*.glsl)
 SHADER_HDR := $(BUILD)/gen/obs_shaders.h
 
@@ -88,6 +98,10 @@ $(SHADER_HDR): $(SHADERS) tools/embed_shaders.sh
 $(BUILD)/obj/%.o: %.c | $(SHADER_HDR)
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/obj/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CPPFLAGS) $(CXXFLAGS) $(EXR_CFLAGS) -MMD -MP -c $< -o $@
 
 $(LIB): $(CORE_OBJ)
 	@rm -f $@

@@ -11,6 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "deep.h"
 #include "ground.h"
 #include "io.h"
 #include "obscura.h"
@@ -25,9 +26,14 @@ void cli_ground_usage(FILE *f)
             "  obscura gbuffer SCENE -o OUT.exr --camera CAM.json [--width W] [--height H]\n"
             "                  [--backend B]    rasterise a mesh (OBJ, PLY, glTF/GLB, OFF, ...)\n"
             "                  into a G-buffer EXR: Z, N (world), Ncam, P, R,G,B (albedo), A\n"
+            "                  [--deep] [--alpha [NAME=]A]...   every fragment into a deep\n"
+            "                  EXR (A-buffer): Z, A, R,G,B, N (world); opacity from the\n"
+            "                  materials or --alpha (all meshes, or those matching NAME)\n"
             "  obscura reference SCENE -o REF.(exr|png) --camera CAM.json [--distance D]\n"
             "                  [--spp N] [--seed N] [--threads N] [--width W] [--height H]\n"
-            "                  [--gbuffer G.exr]   ray-traced AO (Embree): AO.Y and Z\n");
+            "                  [--gbuffer G.exr] [--alpha [NAME=]A]...\n"
+            "                  ray-traced AO (Embree): AO.Y and Z; transparent surfaces\n"
+            "                  attenuate rays, transparent layers blend by alpha\n");
 }
 
 static void die_usage(const char *cmd, const char *fmt, ...)
@@ -75,7 +81,10 @@ typedef struct ground_args {
     long width, height, spp, threads;
     unsigned long long seed;
     double distance;
-    int quiet, verbose;
+    int quiet, verbose, deep;
+#define MAX_ALPHA_SPECS 64
+    const char *alpha[MAX_ALPHA_SPECS]; /* --alpha specs, in order */
+    int nalpha;
 } ground_args;
 
 /* "--name VALUE" or "--name=VALUE"; NULL when argv[*i] is not --name. */
@@ -119,6 +128,19 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
             a->height = parse_long(a, "height", v, 1, 16384);
         else if (!reference && (v = opt_value(a, argc, argv, &i, "backend")))
             a->backend = v;
+        else if (!reference && !strcmp(argv[i], "--deep"))
+            a->deep = 1;
+        else if ((v = opt_value(a, argc, argv, &i, "alpha"))) {
+            /* A or NAME=A, A in [0, 1]; the name is matched on loading. */
+            const char *eq = strrchr(v, '='), *num = eq ? eq + 1 : v;
+            char *end;
+            double x = strtod(num, &end);
+            if (end == num || *end || !(x >= 0.0 && x <= 1.0) || eq == v)
+                die_usage(a->cmd, "--alpha '%s': expected A or NAME=A, A from 0 to 1", v);
+            if (a->nalpha == MAX_ALPHA_SPECS)
+                die_usage(a->cmd, "more than %d --alpha options", MAX_ALPHA_SPECS);
+            a->alpha[a->nalpha++] = v;
+        }
         else if (reference && (v = opt_value(a, argc, argv, &i, "spp")))
             a->spp = parse_long(a, "spp", v, 1, 1 << 20);
         else if (reference && (v = opt_value(a, argc, argv, &i, "threads")))
@@ -149,6 +171,8 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
         die_usage(a->cmd, "no output file (-o OUT)");
     if (!a->camera && !(reference && a->gbuffer))
         die_usage(a->cmd, "no camera (--camera CAM.json)");
+    if (!reference && a->nalpha && !a->deep)
+        die_usage(a->cmd, "--alpha needs --deep (the flat G-buffer is the front surface only)");
 }
 
 static int ends_with(const char *s, const char *suffix)
@@ -202,14 +226,52 @@ static int load_scene(const ground_args *a, obs_scene *scene)
     obs_status s = obs_scene_load(a->scene, scene, err);
     if (s != OBS_OK)
         return fail(s, a->scene, err);
+    for (int k = 0; k < a->nalpha; k++)
+        if ((s = obs_scene_set_opacity(scene, a->alpha[k], err)) != OBS_OK) {
+            obs_scene_free(scene);
+            return fail(s, a->scene, err);
+        }
     if (!a->quiet)
-        fprintf(stderr, "obscura: info: %s: %zu triangles, %zu vertices%s (%.2f s)\n", a->scene,
+        fprintf(stderr, "obscura: info: %s: %zu triangles, %zu vertices%s%s (%.2f s)\n", a->scene,
                 scene->triangle_count, scene->vertex_count, scene->albedo ? ", albedo" : "",
-                now_s() - t0);
+                scene->opacity ? ", opacity" : "", now_s() - t0);
     return EXIT_OK;
 }
 
 /* ---- obscura gbuffer ------------------------------------------------------ */
+
+/* gbuffer --deep: the A-buffer (obs_raster_deep) as a deep EXR. */
+static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene,
+                      const obs_camera *cam, int w, int h, double t0)
+{
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    obs_status s = obs_raster_deep(ctx, scene, cam, w, h, &d, err);
+    if (s != OBS_OK)
+        return fail(s, a->scene, err);
+    double t_raster = now_s() - t0;
+    if ((s = obs_deep_write_exr(a->out, &d, err)) != OBS_OK) {
+        obs_deep_free(&d);
+        return fail(s, a->out, err);
+    }
+    if (!a->quiet) {
+        size_t npx = (size_t)w * h, covered = 0;
+        uint64_t most = 0;
+        for (size_t i = 0; i < npx; i++) {
+            uint64_t n = d.offset[i + 1] - d.offset[i];
+            covered += n > 0;
+            most = n > most ? n : most;
+        }
+        obs_ctx_info ci;
+        obs_ctx_get_info(ctx, &ci);
+        fprintf(stderr, "obscura: info: wrote %s: %dx%d deep, %llu samples (%zu pixels covered, "
+                        "at most %llu per pixel), %s, rasterised in %.2f s\n",
+                a->out, w, h, (unsigned long long)d.offset[npx], covered,
+                (unsigned long long)most, obs_backend_name(ci.backend), t_raster);
+    }
+    obs_deep_free(&d);
+    return EXIT_OK;
+}
 
 int cli_gbuffer(int argc, char **argv)
 {
@@ -237,6 +299,10 @@ int cli_gbuffer(int argc, char **argv)
     double t0 = now_s();
     if ((s = obs_ctx_create(&desc, &ctx, err)) != OBS_OK) {
         rc = fail(s, "OpenGL", err);
+        goto done;
+    }
+    if (a.deep) {
+        rc = write_deep(&a, ctx, &scene, &cam, w, h, t0);
         goto done;
     }
     if ((s = obs_raster_gbuffer(ctx, &scene, &cam, w, h, &r, err)) != OBS_OK) {

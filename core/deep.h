@@ -74,6 +74,14 @@ obs_status obs_deep_read_exr_mem(const void *buf, size_t len, const obs_limits *
 /* Frees and zeroes; NULL-safe. */
 void obs_deep_free(obs_deep_image *d);
 
+/* Writes a deep scanline EXR (ZIPS, float channels): Z always, ZBack, A,
+ * R, G, B and N.X/N.Y/N.Z as d->has_* say (the names obs_deep_read_exr()
+ * reads), the camera as worldToCamera/worldToNDC when d->camera has one.
+ * Samples are written in their order (front to back).  Through OpenEXR's
+ * C++ library (core/exr_deep_write.cpp).  Fails with OBS_IO when the
+ * file cannot be written. */
+obs_status obs_deep_write_exr(const char *path, const obs_deep_image *d, char err[OBS_ERR_LEN]);
+
 /* Values of the parameters deep_mode and deep_hull (params.h). */
 enum { OBS_DEEP_MULTI = 1, OBS_DEEP_SINGLE = 2 };
 enum { OBS_DEEP_SOLID = 1, OBS_DEEP_THIN = 2 };

@@ -46,6 +46,11 @@ obs_status obs__exr_status(exr_result_t rv);
 obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv,
                          const char *what);
 
+/* The worldToCamera and worldToNDC attributes (row-major, OpenEXR's
+ * row-vector convention) of a camera (exr_write.c); the deep writer
+ * (exr_deep_write.cpp, C++) declares it itself. */
+void obs__exr_camera_matrices(const obs_camera *cam, float wtc[16], float ndc[16]);
+
 /* The camera of a part's header (worldToCamera / worldToNDC) in obscura's
  * conventions; zeroed when the header has none (exr_read.c). */
 void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam);

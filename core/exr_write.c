@@ -54,19 +54,14 @@ static obs_status check_layers(const obs_exr_layer *layers, int count, int *long
  *   worldToCamera = (F W)^T
  *   q = (x_clip + w_clip)/2, (w_clip - y_clip)/2, z_clip, w_clip  (rows of Q)
  *   worldToNDC = (Q W)^T */
-static exr_result_t write_camera(exr_context_t ctx, int part, const obs_camera *cam)
+void obs__exr_camera_matrices(const obs_camera *cam, float wtc[16], float ndc[16])
 {
     static const float F[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1};
-    exr_attr_m44f_t wtc, ndc;
     float fw[16], q[16], qw[16];
     const float *p = cam->projection;
-    exr_result_t rv;
 
     obs__mat4_mul(F, cam->world_to_camera, fw);
-    obs__mat4_transpose(fw, wtc.m);
-    if ((rv = exr_attr_set_m44f(ctx, part, "worldToCamera", &wtc)) != EXR_ERR_SUCCESS ||
-        !cam->has_projection)
-        return rv;
+    obs__mat4_transpose(fw, wtc);
     for (int j = 0; j < 4; j++) {
         q[0 + j] = 0.5f * (p[0 + j] + p[12 + j]);
         q[4 + j] = 0.5f * (p[12 + j] - p[4 + j]);
@@ -74,7 +69,18 @@ static exr_result_t write_camera(exr_context_t ctx, int part, const obs_camera *
         q[12 + j] = p[12 + j];
     }
     obs__mat4_mul(q, cam->world_to_camera, qw);
-    obs__mat4_transpose(qw, ndc.m);
+    obs__mat4_transpose(qw, ndc);
+}
+
+static exr_result_t write_camera(exr_context_t ctx, int part, const obs_camera *cam)
+{
+    exr_attr_m44f_t wtc, ndc;
+    exr_result_t rv;
+
+    obs__exr_camera_matrices(cam, wtc.m, ndc.m);
+    if ((rv = exr_attr_set_m44f(ctx, part, "worldToCamera", &wtc)) != EXR_ERR_SUCCESS ||
+        !cam->has_projection)
+        return rv;
     return exr_attr_set_m44f(ctx, part, "worldToNDC", &ndc);
 }
 

@@ -8,6 +8,7 @@
 
 #include "gl/gl.h"
 #include "obs_shaders.h"
+#include "raster_internal.h"
 #include "scene.h"
 
 enum { T_DEPTH, T_NORMAL, T_NORMAL_CAM, T_POSITION, T_COLOR, T_COUNT };
@@ -80,7 +81,7 @@ static void read_target(int attachment, obs_image *img, float *rgba)
     }
 }
 
-static GLuint upload(GLenum target, const void *data, size_t bytes)
+GLuint obs__gl_buffer(GLenum target, const void *data, size_t bytes)
 {
     GLuint b = 0;
     glGenBuffers(1, &b);
@@ -89,8 +90,31 @@ static GLuint upload(GLenum target, const void *data, size_t bytes)
     return b;
 }
 
-/* Camera uniforms, in double precision on the CPU. */
-static obs_status set_camera(GLuint prog, const obs_camera *cam, char err[OBS_ERR_LEN])
+void obs__raster_upload_mesh(const obs_scene *scene, GLuint *vao, GLuint vbo[3], GLuint *ibo)
+{
+    const size_t vbytes = scene->vertex_count * 3 * sizeof(float);
+    glGenVertexArrays(1, vao);
+    glBindVertexArray(*vao);
+    const float *attrs[3] = {scene->positions, scene->normals, scene->albedo};
+    for (GLuint a = 0; a < 3; a++) {
+        if (!attrs[a])
+            continue;
+        vbo[a] = obs__gl_buffer(GL_ARRAY_BUFFER, attrs[a], vbytes);
+        glVertexAttribPointer(a, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+        glEnableVertexAttribArray(a);
+    }
+    *ibo = obs__gl_buffer(GL_ELEMENT_ARRAY_BUFFER, scene->indices,
+                          scene->triangle_count * 3 * sizeof(uint32_t));
+}
+
+void obs__raster_set_scene(GLuint prog, const obs_scene *scene)
+{
+    glUseProgram(prog);
+    glUniform1i(glGetUniformLocation(prog, "u_has_normals"), scene->normals != NULL);
+    glUniform1i(glGetUniformLocation(prog, "u_has_albedo"), scene->albedo != NULL);
+}
+
+obs_status obs__raster_set_camera(GLuint prog, const obs_camera *cam, char err[OBS_ERR_LEN])
 {
     float clip[16], inv[16], nm[9], eye[4];
     obs__mat4_mul(cam->projection, cam->world_to_camera, clip);
@@ -123,7 +147,8 @@ static obs_status set_camera(GLuint prog, const obs_camera *cam, char err[OBS_ER
 obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
                               int width, int height, obs_raster *out, char err[OBS_ERR_LEN])
 {
-    static const char *const frag[] = {"#version 430 core\n", obs__shader_raster_frag};
+    static const char *const frag[] = {"#version 430 core\n", obs__shader_raster_common,
+                                       obs__shader_raster_frag};
     raster_gl g = {0};
     float *rgba = NULL;
     obs_status s;
@@ -159,12 +184,11 @@ obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_ca
         goto fail;
     }
 
-    if ((s = obs__gl_program("raster", obs__shader_raster_vert, frag, 2, &g.prog, err)) != OBS_OK)
+    if ((s = obs__gl_program("raster", obs__shader_raster_vert, frag, 3, &g.prog, err)) != OBS_OK)
         goto fail;
-    if ((s = set_camera(g.prog, cam, err)) != OBS_OK)
+    if ((s = obs__raster_set_camera(g.prog, cam, err)) != OBS_OK)
         goto fail;
-    glUniform1i(glGetUniformLocation(g.prog, "u_has_normals"), scene->normals != NULL);
-    glUniform1i(glGetUniformLocation(g.prog, "u_has_albedo"), scene->albedo != NULL);
+    obs__raster_set_scene(g.prog, scene);
 
     /* Targets: float planes and a 32-bit float depth buffer. */
     static const GLenum formats[T_COUNT] = {GL_R32F, GL_RGBA32F, GL_RGBA32F, GL_RGBA32F,
@@ -192,20 +216,7 @@ obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_ca
         goto fail;
     }
 
-    /* The mesh. */
-    const size_t vbytes = scene->vertex_count * 3 * sizeof(float);
-    glGenVertexArrays(1, &g.vao);
-    glBindVertexArray(g.vao);
-    const float *attrs[3] = {scene->positions, scene->normals, scene->albedo};
-    for (GLuint a = 0; a < 3; a++) {
-        if (!attrs[a])
-            continue;
-        g.vbo[a] = upload(GL_ARRAY_BUFFER, attrs[a], vbytes);
-        glVertexAttribPointer(a, 3, GL_FLOAT, GL_FALSE, 0, NULL);
-        glEnableVertexAttribArray(a);
-    }
-    g.ibo = upload(GL_ELEMENT_ARRAY_BUFFER, scene->indices,
-                   scene->triangle_count * 3 * sizeof(uint32_t));
+    obs__raster_upload_mesh(scene, &g.vao, g.vbo, &g.ibo);
 
     const float sky[4] = {OBS_SKY_DEPTH, 0, 0, 0}, zero[4] = {0, 0, 0, 0}, far_z = 1.0f;
     glClearBufferfv(GL_COLOR, T_DEPTH, sky);

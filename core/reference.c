@@ -17,6 +17,8 @@
 #define MAX_SPP (1 << 20)
 #define MAX_THREADS 64
 #define PI_F 3.14159265358979f
+/* Surfaces one ray may cross in a scene with opacities. */
+#define MAX_CROSSINGS 256
 
 /* ---- random numbers: PCG32 (O'Neill 2014, pcg32_random_r) --------------- */
 
@@ -149,6 +151,50 @@ static void camera_ray(const job *j, int x, int y, float o[3], float d[3])
     normalize3(d);
 }
 
+/* The surface point of a hit of the ray o + t d, its shading normal n and
+ * geometric normal ng, both facing the ray's origin.  0 for a degenerate
+ * triangle. */
+static int hit_point(const job *j, const float o[3], const float d[3], const struct RTCRayHit *rh,
+                     float p[3], float n[3], float ng[3])
+{
+    for (int k = 0; k < 3; k++)
+        p[k] = o[k] + rh->ray.tfar * d[k];
+    ng[0] = rh->hit.Ng_x;
+    ng[1] = rh->hit.Ng_y;
+    ng[2] = rh->hit.Ng_z;
+    if (normalize3(ng) != 0)
+        return 0; /* a degenerate triangle */
+    /* Seen from the back: both normals flip, as a path tracer's do. */
+    float flip = dot3(ng, d) > 0.0f ? -1.0f : 1.0f;
+    for (int k = 0; k < 3; k++)
+        ng[k] *= flip;
+    memcpy(n, ng, 3 * sizeof(float));
+    const obs_scene *s = j->scene;
+    if (s->normals) {
+        const uint32_t *tri = s->indices + 3 * (size_t)rh->hit.primID;
+        float w[3] = {1.0f - rh->hit.u - rh->hit.v, rh->hit.u, rh->hit.v}, sn[3] = {0, 0, 0};
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 3; k++)
+                sn[k] += w[c] * s->normals[3 * (size_t)tri[c] + k];
+        if (normalize3(sn) == 0)
+            for (int k = 0; k < 3; k++)
+                n[k] = flip * sn[k];
+    }
+    return 1;
+}
+
+/* The closest hit of o + t d with tnear < t < tfar; 0 when none. */
+static int intersect(const job *j, struct RTCIntersectContext *ictx, const float o[3],
+                     const float d[3], float tnear, float tfar, struct RTCRayHit *rh)
+{
+    init_ray(&rh->ray, o, d, tfar);
+    rh->ray.tnear = tnear;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(j->rtc, ictx, rh);
+    return rh->hit.geomID != RTC_INVALID_GEOMETRY_ID;
+}
+
 /* The surface point of pixel (x, y), its shading normal n and geometric
  * normal ng, both facing the viewer.  0 when there is none. */
 static int surface_point(const job *j, struct RTCIntersectContext *ictx, int x, int y,
@@ -177,62 +223,107 @@ static int surface_point(const job *j, struct RTCIntersectContext *ictx, int x, 
     float o[3], d[3];
     camera_ray(j, x, y, o, d);
     struct RTCRayHit rh;
-    init_ray(&rh.ray, o, d, INFINITY);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(j->rtc, ictx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+    if (!intersect(j, ictx, o, d, 0.0f, INFINITY, &rh))
         return 0;
-    for (int k = 0; k < 3; k++)
-        p[k] = o[k] + rh.ray.tfar * d[k];
-    ng[0] = rh.hit.Ng_x;
-    ng[1] = rh.hit.Ng_y;
-    ng[2] = rh.hit.Ng_z;
-    if (normalize3(ng) != 0)
-        return 0; /* a degenerate triangle */
-    /* Seen from the back: both normals flip, as a path tracer's do. */
-    float flip = dot3(ng, d) > 0.0f ? -1.0f : 1.0f;
-    for (int k = 0; k < 3; k++)
-        ng[k] *= flip;
-    memcpy(n, ng, 3 * sizeof(float));
-    const obs_scene *s = j->scene;
-    if (s->normals) {
-        const uint32_t *tri = s->indices + 3 * (size_t)rh.hit.primID;
-        float w[3] = {1.0f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v}, sn[3] = {0, 0, 0};
-        for (int c = 0; c < 3; c++)
-            for (int k = 0; k < 3; k++)
-                sn[k] += w[c] * s->normals[3 * (size_t)tri[c] + k];
-        if (normalize3(sn) == 0)
-            for (int k = 0; k < 3; k++)
-                n[k] = flip * sn[k];
-    }
-    return 1;
+    return hit_point(j, o, d, &rh, p, n, ng);
 }
 
-/* Fraction of the cosine-weighted rays from p that travel the distance
- * without a hit (reference.h). */
+/* How far past a hit the next search starts, and an AO ray's origin is
+ * lifted off its surface: scales with the coordinates (float spacing). */
+static float surface_eps(const float p[3])
+{
+    return 1e-4f * fmaxf(1.0f, fmaxf(fabsf(p[0]), fmaxf(fabsf(p[1]), fabsf(p[2]))));
+}
+
+/* Transmittance of the segment o + t d, 0 < t < tfar (reference.h): 0 or
+ * 1 for an opaque scene; with opacities, the product of (1 - alpha) over
+ * the surfaces it crosses, found by searching again just past each hit
+ * (at most MAX_CROSSINGS; a segment crossing more counts as blocked). */
+static float transmittance(const job *j, struct RTCIntersectContext *ictx, const float o[3],
+                           const float d[3], float tfar)
+{
+    const float *opacity = j->scene->opacity;
+    if (!opacity) {
+        struct RTCRay r;
+        init_ray(&r, o, d, tfar);
+        rtcOccluded1(j->rtc, ictx, &r);
+        return r.tfar >= 0.0f ? 1.0f : 0.0f; /* Embree sets tfar to -inf on a hit */
+    }
+    float T = 1.0f, tnear = 0.0f;
+    for (int k = 0; k < MAX_CROSSINGS; k++) {
+        struct RTCRayHit rh;
+        if (!intersect(j, ictx, o, d, tnear, tfar, &rh))
+            return T;
+        float a = opacity[rh.hit.primID];
+        if (a >= 1.0f)
+            return 0.0f;
+        T *= 1.0f - fmaxf(a, 0.0f);
+        float p[3] = {o[0] + rh.ray.tfar * d[0], o[1] + rh.ray.tfar * d[1],
+                      o[2] + rh.ray.tfar * d[2]};
+        tnear = rh.ray.tfar + surface_eps(p);
+    }
+    return 0.0f;
+}
+
+/* The cosine-weighted average of the transmittance of rays from p over
+ * the distance (reference.h): the fraction of unblocked rays for an
+ * opaque scene. */
 static float ao_at(const job *j, struct RTCIntersectContext *ictx, pcg32 *rng, const float p[3],
                    const float n[3], const float ng[3])
 {
     float t[3], b[3], o[3], d[3];
-    /* Leave the surface along its own normal, by an amount that scales
-     * with the coordinates (float spacing). */
-    float scale = fmaxf(1.0f, fmaxf(fabsf(p[0]), fmaxf(fabsf(p[1]), fabsf(p[2]))));
+    /* Leave the surface along its own normal. */
+    float eps = surface_eps(p);
     for (int k = 0; k < 3; k++)
-        o[k] = p[k] + ng[k] * 1e-4f * scale;
+        o[k] = p[k] + ng[k] * eps;
     onb(n, t, b);
-    int open = 0;
+    float open = 0.0f;
     for (int i = 0; i < j->desc.spp; i++) {
         float u1 = uniform01(rng), u2 = uniform01(rng);
         cosine_dir(n, t, b, u1, u2, d);
         if (dot3(d, ng) <= 0.0f)
             continue; /* below the surface: no light comes from there */
-        struct RTCRay r;
-        init_ray(&r, o, d, j->desc.distance);
-        rtcOccluded1(j->rtc, ictx, &r);
-        open += r.tfar >= 0.0f; /* Embree sets tfar to -inf on a hit */
+        open += transmittance(j, ictx, o, d, j->desc.distance);
     }
-    return (float)open / (float)j->desc.spp;
+    return open / (float)j->desc.spp;
+}
+
+static float planar_depth(const job *j, const float p[3])
+{
+    const float *w = j->view->camera->world_to_camera;
+    return -(w[8] * p[0] + w[9] * p[1] + w[10] * p[2] + w[11]);
+}
+
+/* A pixel of a scene with opacities (reference.h): every surface the
+ * camera ray crosses (at most MAX_CROSSINGS) is a layer; its AO is
+ * 1 - alpha (1 - V), V its ray-traced visibility with attenuated rays
+ * (OITAO eq 1, the receiver's alpha_p), and the layers are blended front
+ * to back by alpha onto AO 1 (OITAO III, the separated scheme), as
+ * core/deep_cpu.c blends its nodes.  Layers of alpha 0 are skipped.
+ * *depth: the front layer's planar depth, OBS_SKY_DEPTH when none. */
+static float layered_ao(const job *j, struct RTCIntersectContext *ictx, pcg32 *rng, int x, int y,
+                        float *depth)
+{
+    float o[3], d[3], T = 1.0f, acc = 0.0f, tnear = 0.0f;
+    camera_ray(j, x, y, o, d);
+    *depth = OBS_SKY_DEPTH;
+    for (int k = 0; k < MAX_CROSSINGS && T > 0.0f; k++) {
+        struct RTCRayHit rh;
+        float p[3], n[3], ng[3];
+        if (!intersect(j, ictx, o, d, tnear, INFINITY, &rh))
+            break;
+        int ok = hit_point(j, o, d, &rh, p, n, ng);
+        float a = fminf(fmaxf(j->scene->opacity[rh.hit.primID], 0.0f), 1.0f);
+        tnear = rh.ray.tfar + surface_eps(p);
+        if (!ok || !(a > 0.0f))
+            continue;
+        if (*depth == OBS_SKY_DEPTH)
+            *depth = planar_depth(j, p);
+        float v = ao_at(j, ictx, rng, p, n, ng);
+        acc += T * a * (1.0f - a * (1.0f - v));
+        T *= 1.0f - a;
+    }
+    return acc + T;
 }
 
 static void *worker(void *arg)
@@ -247,6 +338,13 @@ static void *worker(void *arg)
             float p[3], n[3], ng[3];
             pcg32 rng;
             pcg32_seed(&rng, j->desc.seed, i);
+            if (j->scene->opacity && !j->view->position) {
+                float z;
+                j->ao[i] = layered_ao(j, &ictx, &rng, x, y, &z);
+                if (j->depth)
+                    j->depth[i] = z;
+                continue;
+            }
             if (!surface_point(j, &ictx, x, y, p, n, ng)) {
                 j->ao[i] = 1.0f;
                 if (j->depth)
@@ -254,10 +352,8 @@ static void *worker(void *arg)
                 continue;
             }
             j->ao[i] = ao_at(j, &ictx, &rng, p, n, ng);
-            if (j->depth) {
-                const float *w = j->view->camera->world_to_camera;
-                j->depth[i] = -(w[8] * p[0] + w[9] * p[1] + w[10] * p[2] + w[11]);
-            }
+            if (j->depth)
+                j->depth[i] = planar_depth(j, p);
         }
         pthread_mutex_lock(&j->progress_lock);
         j->rows_done++;

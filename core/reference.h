@@ -9,7 +9,21 @@
  * hitting anything (any face, front or back), else 0.  Estimated by Monte
  * Carlo with cosine-weighted directions (pdf cos/pi, so the estimate is
  * the fraction of unblocked rays); a direction below the triangle's own
- * plane counts as blocked.  No GL here; safe to call from any thread. */
+ * plane counts as blocked.  No GL here; safe to call from any thread.
+ *
+ * Transparency (a scene with opacity, scene.h): V becomes the ray's
+ * transmittance over D, the product of (1 - alpha) of every surface it
+ * crosses (an opaque one: 0), so a ray within D of a surface of opacity
+ * alpha is blocked by alpha.  The primary ray of a pixel crosses layers
+ * k = 0, 1, ... (front to back, alpha_k > 0); each gets the AO of OITAO
+ * eq 1 with the integral ray traced,
+ *   AO_k = 1 - alpha_k (1 - V_k),  V_k = 1/pi integral T(p_k, w, D) cos dw,
+ * and the pixel is their front-to-back alpha blend onto AO 1 (OITAO III,
+ * the separated scheme: what core/deep_cpu.c computes from the A-buffer),
+ *   AO = sum_k alpha_k AO_k prod_{j<k} (1 - alpha_j) + prod_k (1 - alpha_k).
+ * An opaque front surface gives the definition above.  G-buffer points
+ * (obs_reference_view.position) are taken as opaque; only their rays are
+ * attenuated. */
 #ifndef OBSCURA_REFERENCE_H
 #define OBSCURA_REFERENCE_H
 
@@ -49,8 +63,8 @@ typedef struct obs_reference_view {
 } obs_reference_view;
 
 /* The AO estimate (1 channel, 1 = unoccluded, 1 where nothing is hit)
- * and, when depth is non-NULL, the planar view depth of the points
- * (OBS_SKY_DEPTH where there is none).  Caller frees both with
+ * and, when depth is non-NULL, the planar view depth of the points (the
+ * front layer's with opacities; OBS_SKY_DEPTH where there is none).  Caller frees both with
  * obs_image_free(). */
 obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view *view,
                                 const obs_reference_desc *desc, obs_image *ao,

@@ -21,11 +21,22 @@ extern "C" {
  * chain takes depth >= 1e9 as sky). */
 #define OBS_SKY_DEPTH 1e10f
 
+/* One mesh of a scene file: its names (assimp's mesh name, and the name
+ * of the first node that holds it; either may be "") and its run of
+ * triangles. */
+typedef struct obs_scene_mesh {
+    char *name, *node;
+    size_t first_triangle, triangle_count;
+} obs_scene_mesh;
+
 /* An indexed triangle mesh in world space.  Arrays are malloc'd;
  * obs_scene_free() releases them.  normals and albedo may be NULL:
  * without normals the rasteriser uses each triangle's geometric normal;
  * albedo is per vertex, linear RGB, present only when some material of
- * the file has a diffuse or base colour. */
+ * the file has a diffuse or base colour.  opacity is per triangle, in
+ * [0, 1], present only when some material is not opaque (assimp's
+ * AI_MATKEY_OPACITY, glTF's base colour alpha with alphaMode BLEND) or
+ * obs_scene_set_opacity() set one; NULL means opaque. */
 typedef struct obs_scene {
     size_t vertex_count;
     float *positions;    /* 3 per vertex */
@@ -33,6 +44,9 @@ typedef struct obs_scene {
     float *albedo;       /* 3 per vertex, or NULL */
     size_t triangle_count;
     uint32_t *indices;   /* 3 per triangle, each < vertex_count */
+    float *opacity;      /* 1 per triangle, or NULL (opaque) */
+    size_t mesh_count;   /* the file's meshes, in triangle order; 0 for */
+    obs_scene_mesh *meshes; /* a scene built in memory */
     float bounds_min[3]; /* filled by obs_scene_check() */
     float bounds_max[3];
 } obs_scene;
@@ -50,6 +64,14 @@ obs_status obs_scene_check(obs_scene *s, char err[OBS_ERR_LEN]);
 
 /* Frees the arrays and zeroes *s; NULL-safe. */
 void obs_scene_free(obs_scene *s);
+
+/* Sets the opacity of meshes from a spec: "A" (every triangle) or
+ * "NAME=A" (the meshes whose name or node name matches the fnmatch(3)
+ * pattern NAME),
+ * A a number in [0, 1].  Specs apply in order, a later one overriding.
+ * Fails with OBS_INVALID_ARGUMENT on a malformed spec or a pattern no
+ * mesh matches (the message lists the mesh names), OBS_NO_MEMORY. */
+obs_status obs_scene_set_opacity(obs_scene *s, const char *spec, char err[OBS_ERR_LEN]);
 
 /* A G-buffer rasterised from a scene, one sample per pixel at the pixel
  * centre.  Background pixels: depth OBS_SKY_DEPTH, everything else 0. */
@@ -72,6 +94,23 @@ obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_ca
 
 /* Frees the images and zeroes *r; NULL-safe. */
 void obs_raster_free(obs_raster *r);
+
+struct obs_deep_image; /* deep.h */
+
+/* Rasterises the scene into an A-buffer: every fragment at every pixel
+ * centre, depth test off, kept in per-pixel linked lists on the GPU (GL
+ * 4.3 shader storage buffers and an atomic counter: OITAO section IV-A,
+ * the PPLL of Yang et al.), read back and sorted front to back.  Each
+ * sample: Z (planar view depth; ZBack = Z), A (the triangle's opacity;
+ * fragments of opacity 0 are left out), R, G, B (albedo premultiplied by
+ * A; has_color only when the scene has albedo) and the world-space
+ * shading normal facing the camera (N, as obs_raster's).
+ * A node pool too small for the frame is grown to the fragment count and
+ * the scene drawn again; more than OBS_DEEP_MAX_SAMPLES fragments, or
+ * more than OBS_DEEP_MAX_PER_PIXEL at one pixel, is OBS_TOO_LARGE.  The
+ * camera is copied into out->camera.  Caller frees with obs_deep_free(). */
+obs_status obs_raster_deep(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam, int width,
+                           int height, struct obs_deep_image *out, char err[OBS_ERR_LEN]);
 
 #ifdef __cplusplus
 }

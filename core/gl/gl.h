@@ -80,7 +80,11 @@
     X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv)                                   \
     /* deep input's node planes (deep_gl.c) */                                 \
     X(PFNGLTEXSTORAGE3DPROC, TexStorage3D)                                     \
-    X(PFNGLTEXSUBIMAGE3DPROC, TexSubImage3D)
+    X(PFNGLTEXSUBIMAGE3DPROC, TexSubImage3D)                                   \
+    /* the A-buffer rasteriser's linked lists (raster_deep_gl.c) */            \
+    X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                                 \
+    X(PFNGLGETBUFFERSUBDATAPROC, GetBufferSubData)                             \
+    X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)
 
 /* Optional entry points (may be NULL). */
 #define OBS__GL_FUNCS_OPT(X) X(PFNGLDEBUGMESSAGECALLBACKPROC, DebugMessageCallback)
@@ -160,6 +164,9 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glClearBufferfv obs__glp->ClearBufferfv
 #define glTexStorage3D obs__glp->TexStorage3D
 #define glTexSubImage3D obs__glp->TexSubImage3D
+#define glBindBufferBase obs__glp->BindBufferBase
+#define glGetBufferSubData obs__glp->GetBufferSubData
+#define glMemoryBarrier obs__glp->MemoryBarrier
 
 /* Loads every entry point; fails naming the first one missing. */
 obs_status obs__gl_load(obs__gl *gl, obs__getproc_fn getproc, char err[OBS_ERR_LEN]);

@@ -1,9 +1,10 @@
 #!/bin/sh
 # End-to-end tests of the ground-truth commands: `obscura gbuffer` and
-# `obscura reference` on a mesh written here (and on the Blender room of
-# ../shared/data when present), `obscura ao` on the G-buffer with no camera
-# flag (the camera comes from the EXR header), `obscura compare --json
-# --diff`, and clear errors for bad input.
+# `obscura reference` on meshes written here (flat, and deep with a
+# transparent pane: `gbuffer --deep`, `reference --alpha`) and on the
+# Blender room of ../shared/data when present, `obscura ao` on the
+# G-buffer with no camera flag (the camera comes from the EXR header),
+# `obscura compare --json --diff`, and clear errors for bad input.
 #
 #   OBSCURA=build/obscura tests/e2e/ground.sh
 set -u
@@ -73,6 +74,66 @@ check "the diff EXR was written" "[ -s '$T/diff.exr' ]"
 expect 0 "camera rays and G-buffer points agree" -- "$OBSCURA" compare "$T/ref.exr" "$T/ref_gb.exr" --json
 mae=$(json mae)
 check "camera rays vs G-buffer points: MAE $mae < 0.05" "awk 'BEGIN { exit !($mae < 0.05) }'"
+
+echo "-- deep: gbuffer --deep, reference --alpha"
+# a floor, a wall, a box and a pane in front of it (named objects)
+cat >"$T/pane.obj" <<'OBJ'
+o floor
+v -3 -3 0
+v 3 -3 0
+v 3 2 0
+v -3 2 0
+f 1 2 3 4
+o wall
+v -3 2 0
+v 3 2 0
+v 3 2 2
+v -3 2 2
+f 5 6 7 8
+o box
+v -0.4 0.25 0
+v 0.3 0.25 0
+v 0.3 0.8 0
+v -0.4 0.8 0
+v -0.4 0.25 0.6
+v 0.3 0.25 0.6
+v 0.3 0.8 0.6
+v -0.4 0.8 0.6
+f 9 10 14 13
+f 10 11 15 14
+f 11 12 16 15
+f 12 9 13 16
+f 13 14 15 16
+o pane
+v -1 0 0
+v 1 0 0
+v 1 0 0.9
+v -1 0 0.9
+f 17 18 19 20
+OBJ
+expect 0 "gbuffer --deep --alpha pane=0.5" -- "$OBSCURA" gbuffer "$T/pane.obj" --camera "$C" \
+    --deep --alpha pane=0.5 -o "$T/deep.exr"
+said "deep, [0-9]* samples"
+expect 0 "ao on the deep G-buffer (multi-layer)" -- "$OBSCURA" ao "$T/deep.exr" -o "$T/multi.exr" -q
+expect 0 "ao on the deep G-buffer (single-layer)" -- "$OBSCURA" ao "$T/deep.exr" \
+    --deep-mode single -o "$T/single.exr" -q
+expect 0 "reference --alpha pane=0.5" -- "$OBSCURA" reference "$T/pane.obj" --camera "$C" \
+    --alpha pane=0.5 -o "$T/ref_alpha.exr" --spp 32 --threads 2 -q
+expect 0 "compare multi-layer" -- "$OBSCURA" compare "$T/ref_alpha.exr" "$T/multi.exr" --json
+mse_multi=$(json mse)
+expect 0 "compare single-layer" -- "$OBSCURA" compare "$T/ref_alpha.exr" "$T/single.exr" --json
+mse_single=$(json mse)
+check "multi-layer MSE $mse_multi < single-layer MSE $mse_single" \
+    "awk 'BEGIN { exit !($mse_multi < $mse_single) }'"
+expect 2 "--alpha needs --deep" -- "$OBSCURA" gbuffer "$T/pane.obj" --camera "$C" --alpha 0.5 -o "$T/x.exr"
+expect 2 "--alpha out of range" -- "$OBSCURA" gbuffer "$T/pane.obj" --camera "$C" --deep \
+    --alpha pane=1.5 -o "$T/x.exr"
+said "expected A or NAME=A"
+expect 2 "--alpha without a number" -- "$OBSCURA" reference "$T/pane.obj" --camera "$C" \
+    --alpha pane= -o "$T/x.exr"
+expect 3 "--alpha naming no mesh" -- "$OBSCURA" gbuffer "$T/pane.obj" --camera "$C" --deep \
+    --alpha sofa=0.5 -o "$T/x.exr"
+said "no mesh is named 'sofa'"
 
 echo "-- bad input"
 expect 3 "missing scene" -- "$OBSCURA" gbuffer "$T/none.obj" --camera "$C" -o "$T/x.exr"
