@@ -495,11 +495,13 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         obs_params p;
         obs_params_resolve(&a->params, &p);
         fprintf(stderr, "obscura: info: deep %dx%d, %llu samples, %s, %d nodes%s, %s hulls, "
-                "radius %g, %d samples: read %.1f ms, AO %.1f ms\n",
+                "radius %g, %d %ssamples: read %.1f ms, AO %.1f ms\n",
                 d.width, d.height, (unsigned long long)d.offset[(size_t)d.width * d.height],
                 p.deep_mode == OBS_DEEP_SINGLE ? "single-layer" : "multi-layer", p.deep_layers,
                 p.deep_front_half == OBS_ON ? " (front half kept)" : "",
-                p.deep_hull == OBS_DEEP_THIN ? "thin" : "solid", p.radius, p.samples, t_read, t_run);
+                p.deep_hull == OBS_DEEP_THIN ? "thin" : "solid", p.radius,
+                p.method == OBS_METHOD_HEMISPHERE ? p.hemisphere_samples : p.samples,
+                p.method == OBS_METHOD_HEMISPHERE ? "hemisphere " : "", t_read, t_run);
     }
 done:
     obs_deep_result_free(&r);

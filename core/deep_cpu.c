@@ -10,6 +10,9 @@
  * occluder by its alpha and the receiver's occlusion by its own (solid
  * volumes); for thin hulls eqs 2-4 mix the exterior AO (sphere on the
  * normal's side) and the interior AO (sphere on the other side) by W(p).
+ * With method hemisphere the per-node occlusion is instead that of the
+ * normal-oriented hemisphere kernel's point samples (hemisphere_cpu.c),
+ * each against every node, the largest counting (hemisphere_ao() below).
  * The AO of each node is blended front to back by alpha into one 2D AO
  * (section III, the separated scheme). */
 #include <math.h>
@@ -88,9 +91,15 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
     if (!d || !d->offset || d->width <= 0 || d->height <= 0)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no deep image");
     obs_params_resolve(params, &p);
-    if (p.method != OBS_METHOD_VAOPP && p.method != OBS_METHOD_VAO)
+    if (p.method != OBS_METHOD_VAOPP && p.method != OBS_METHOD_VAO &&
+        p.method != OBS_METHOD_HEMISPHERE) {
+        char name[32];
+        obs_param_format(&p, obs_param_find("method"), name, sizeof name);
         return obs__fail(err, OBS_INVALID_ARGUMENT,
-                         "deep input runs the VAO estimator (methods vaopp, vao) only");
+                         "method %s does not run on deep input: the multi-layer chain takes "
+                         "methods vaopp, vao and hemisphere",
+                         name);
+    }
     s = obs_deep_compress(d, p.deep_layers, p.deep_front_half == OBS_ON, &df->layers, err);
     if (s != OBS_OK)
         return s;
@@ -224,6 +233,78 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
     return F > 0.0f ? open / F : 1.0f; /* VAO++ eq 1 */
 }
 
+/* GLSL: hemisphere_ao() in deep.frag.glsl.  Method hemisphere on the
+ * nodes: the normal-oriented hemisphere kernel of hemisphere_cpu.c (radius
+ * R, the frame's tile rotation), each point sample s occluded by a node at
+ * its pixel as obs__hemisphere_pixel is by the flat depth buffer, with the
+ * node as that buffer: occluded when s lies more than the bias behind the
+ * node's depth, the node being taken to fill everything behind it, and
+ * weighted by the method's range check (smoothstep of R / |z_p - z_node|)
+ * so that a node far in front of the receiver fades out, as eq 4 does for
+ * node_occlusion's pipes.  Each sample's occlusion is the largest over the
+ * nodes at its pixel (OITAO Algorithm 1, line 9: ao = max(ao, GetAO(p,
+ * f)) over the fragment list), each node's weighted by its alpha (OITAO
+ * eq 1's alpha_omega); the samples' occlusions are averaged (lines 10-12).
+ * With `interior` (n is then the back side's direction, OITAO eqs 2-4) a
+ * node on the exterior side of the receiver's tangent plane (not more than
+ * the bias along n from p) hides nothing, as node_occlusion's node in
+ * front of the pipe. */
+static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float p[3],
+                           const float n[3], int interior)
+{
+    const obs__frame *f = &df->f;
+    const float R = f->radius;
+    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    const int layers = df->multi ? df->m : 1;
+    const size_t npx = (size_t)f->width * (size_t)f->height;
+    /* the tangent frame of n (Duff et al. 2017), as obs__hemisphere_pixel */
+    float sg = n[2] >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (sg + n[2]), b = n[0] * n[1] * a;
+    const float t1[3] = {1.0f + sg * n[0] * n[0] * a, sg * b, -sg * n[0]};
+    const float t2[3] = {b, sg + n[1] * n[1] * a, -n[1]};
+    float occ = 0.0f;
+    for (int i = 0; i < f->hs_count; i++) {
+        const float *kv = f->hs_kernel[i];
+        float kx = rot[0] * kv[0] - rot[1] * kv[1], ky = rot[1] * kv[0] + rot[0] * kv[1];
+        float s[3];
+        for (int j = 0; j < 3; j++)
+            s[j] = p[j] + R * (kx * t1[j] + ky * t2[j] + kv[2] * n[j]);
+        int qx, qy;
+        if (!obs__view_to_px(f, s, &qx, &qy))
+            continue;
+        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
+        float best = 0.0f;
+        for (int k = 0; k < layers; k++) {
+            const float *pk = df->pos + ((size_t)k * npx + q) * 4;
+            float zn = pk[3];
+            if (!(zn > 0.0f))
+                continue; /* empty node: background never occludes */
+            if (!(zn <= -s[2] - f->hs_bias))
+                continue; /* s is not behind the node */
+            if (interior &&
+                (pk[0] - p[0]) * n[0] + (pk[1] - p[1]) * n[1] + (pk[2] - p[2]) * n[2] <= f->hs_bias)
+                continue; /* on the hull's exterior side */
+            float dz = fabsf(-p[2] - zn);
+            float r = dz > R ? R / dz : 1.0f;
+            float an = df->nrm[((size_t)k * npx + q) * 4 + 3];
+            best = fmaxf(best, an * r * r * (3.0f - 2.0f * r));
+        }
+        occ += best;
+    }
+    return f->hs_count > 0 ? 1.0f - occ / (float)f->hs_count : 1.0f;
+}
+
+/* The per-sample estimator of the frame's method: VAO++'s line samples or
+ * method hemisphere's point samples, each against every node (Algorithm
+ * 1). */
+static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3], const float n[3],
+                       int interior)
+{
+    if (df->f.method == OBS_METHOD_HEMISPHERE)
+        return hemisphere_ao(df, x, y, p, n, interior);
+    return sphere_ao(df, x, y, p, n, interior);
+}
+
 float obs__deep_node_ao(const obs__deep_frame *df, int x, int y, int k)
 {
     const size_t npx = (size_t)df->f.width * (size_t)df->f.height;
@@ -232,14 +313,14 @@ float obs__deep_node_ao(const obs__deep_frame *df, int x, int y, int k)
     float alpha = n[3];
     if (!(p[3] > 0.0f))
         return 1.0f;
-    float ve = sphere_ao(df, x, y, p, n, 0);
+    float ve = method_ao(df, x, y, p, n, 0);
     if (!df->thin)
         return 1.0f - alpha * (1.0f - ve); /* OITAO eq 1: the receiver's alpha_p */
     /* OITAO eqs 2-4: the interior AO from the sphere on -n; W(p) = alpha
      * on a front face (normal towards the camera), 1 - alpha on a back
      * face. */
     const float nn[3] = {-n[0], -n[1], -n[2]};
-    float vi = sphere_ao(df, x, y, p, nn, 1);
+    float vi = method_ao(df, x, y, p, nn, 1);
     float facing = -(p[0] * n[0] + p[1] * n[1] + p[2] * n[2]);
     float W = facing >= 0.0f ? alpha : 1.0f - alpha; /* eq 3 */
     return W * ve + (1.0f - W) * vi;                 /* eq 4 */

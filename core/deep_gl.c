@@ -187,6 +187,10 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform1i(glGetUniformLocation(prog, "u_m"), df.m);
     glUniform1i(glGetUniformLocation(prog, "u_multi"), df.multi);
     glUniform1i(glGetUniformLocation(prog, "u_thin"), df.thin);
+    glUniform1i(glGetUniformLocation(prog, "u_hemisphere"), f->method == OBS_METHOD_HEMISPHERE);
+    glUniform1i(glGetUniformLocation(prog, "u_hs_count"), f->hs_count);
+    glUniform1f(glGetUniformLocation(prog, "u_hs_bias"), f->hs_bias);
+    glUniform1fv(glGetUniformLocation(prog, "u_hs_kernel"), 3 * f->hs_count, &f->hs_kernel[0][0]);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, t->tex_pos);
     glUniform1i(glGetUniformLocation(prog, "u_lpos"), 0);

@@ -4,8 +4,11 @@
 // (section 3) whose line samples are occluded by every node at their
 // pixel, the largest occlusion counting (OITAO Algorithm 1), weighted by
 // opacity (eq 1, or eqs 2-4 for thin hulls); the nodes' AO blended front
-// to back by alpha (section III, the separated scheme).  C twin:
-// core/deep_cpu.c (same function names).
+// to back by alpha (section III, the separated scheme).  With
+// u_hemisphere the per-node occlusion is method hemisphere's point samples
+// (the normal-oriented hemisphere kernel), each against every node, the
+// largest counting (Algorithm 1).  C twin: core/deep_cpu.c (same function
+// names).
 
 uniform sampler2DArray u_lpos;  // node view position xyz, planar depth w (0: empty)
 uniform sampler2DArray u_lnrm;  // node view normal xyz, alpha w
@@ -19,6 +22,10 @@ uniform vec2 u_samples[32];     // the set of section 4.5
 uniform vec2 u_rot[9];          // (cos, sin) of the 3x3 tile's rotations
 uniform int u_range_check;      // 1: depth range check (VAO++ 4.4, eq 4)
 uniform float u_range_u;        // u of eq 4
+uniform int u_hemisphere;       // 1: method hemisphere's point samples; 0: VAO's line samples
+uniform int u_hs_count;         // method hemisphere: samples
+uniform float u_hs_bias;        // occluders must be this far in front (depth units)
+uniform float u_hs_kernel[192]; // unit hemisphere around +z, (x, y, z) per sample
 
 layout(location = 0) out vec4 o_ao; // (front node's AO, blended AO, 0, 1)
 
@@ -81,6 +88,66 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
     return F > 0.0 ? open / F : 1.0;
 }
 
+// Method hemisphere on the nodes: each point sample of the hemisphere
+// kernel is occluded by a node at its pixel when it lies more than the
+// bias behind the node's depth (the node fills what is behind it), with
+// the method's range check as the falloff for a node far in front of the
+// receiver; the largest occlusion over the nodes counts (Algorithm 1, line
+// 9), each node's weighted by its alpha (eq 1's alpha_omega).  interior:
+// a node on the exterior side of the receiver's tangent plane hides
+// nothing (eqs 2-4).
+float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
+{
+    float R = u_radius;
+    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
+    int layers = u_multi != 0 ? u_m : 1;
+    float sg = n.z >= 0.0 ? 1.0 : -1.0;
+    float a = -1.0 / (sg + n.z), b = n.x * n.y * a;
+    vec3 t1 = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x);
+    vec3 t2 = vec3(b, sg + n.y * n.y * a, -n.y);
+    float occ = 0.0;
+    for (int i = 0; i < u_hs_count; i++) {
+        vec3 kv = vec3(u_hs_kernel[3 * i], u_hs_kernel[3 * i + 1], u_hs_kernel[3 * i + 2]);
+        float kx = rot.x * kv.x - rot.y * kv.y, ky = rot.y * kv.x + rot.x * kv.y;
+        vec3 s = vec3(p.x + R * (kx * t1.x + ky * t2.x + kv.z * n.x),
+                      p.y + R * (kx * t1.y + ky * t2.y + kv.z * n.y),
+                      p.z + R * (kx * t1.z + ky * t2.z + kv.z * n.z));
+        float cw = PM(3, 0) * s.x + PM(3, 1) * s.y + PM(3, 2) * s.z + PM(3, 3);
+        if (!(cw > 0.0))
+            continue;
+        float cx = PM(0, 0) * s.x + PM(0, 1) * s.y + PM(0, 2) * s.z + PM(0, 3);
+        float cy = PM(1, 0) * s.x + PM(1, 1) * s.y + PM(1, 2) * s.z + PM(1, 3);
+        float u = (cx / cw * 0.5 + 0.5) * u_viewport.z - u_viewport.x;
+        float v = (0.5 - cy / cw * 0.5) * u_viewport.w - u_viewport.y;
+        float fu = floor(u), fv = floor(v);
+        if (!(fu >= 0.0 && fv >= 0.0 && fu < float(u_size.x) && fv < float(u_size.y)))
+            continue;
+        ivec2 q = ivec2(int(fu), int(fv));
+        float best = 0.0;
+        for (int k = 0; k < layers; k++) {
+            vec4 pk = texelFetch(u_lpos, ivec3(q, k), 0);
+            if (!(pk.w > 0.0))
+                continue;                 // empty node
+            if (!(pk.w <= -s.z - u_hs_bias))
+                continue;                 // s is not behind the node
+            if (interior && dot(pk.xyz - p, n) <= u_hs_bias)
+                continue;                 // on the hull's exterior side
+            float dz = abs(-p.z - pk.w);
+            float r = dz > R ? R / dz : 1.0;
+            float an = texelFetch(u_lnrm, ivec3(q, k), 0).w;
+            best = max(best, an * r * r * (3.0 - 2.0 * r));
+        }
+        occ += best;
+    }
+    return u_hs_count > 0 ? 1.0 - occ / float(u_hs_count) : 1.0;
+}
+
+// The per-sample estimator of the method: VAO++'s or method hemisphere's.
+float method_ao(ivec2 px, vec3 p, vec3 n, bool interior)
+{
+    return u_hemisphere != 0 ? hemisphere_ao(px, p, n, interior) : sphere_ao(px, p, n, interior);
+}
+
 // OITAO eq 1 (solid) or eqs 2-4 (thin hull) for node k at px.
 float node_ao(ivec2 px, int k)
 {
@@ -88,10 +155,10 @@ float node_ao(ivec2 px, int k)
     vec4 n = texelFetch(u_lnrm, ivec3(px, k), 0);
     if (!(p.w > 0.0))
         return 1.0;
-    float ve = sphere_ao(px, p.xyz, n.xyz, false);
+    float ve = method_ao(px, p.xyz, n.xyz, false);
     if (u_thin == 0)
         return 1.0 - n.w * (1.0 - ve);              // eq 1: alpha_p
-    float vi = sphere_ao(px, p.xyz, -n.xyz, true);
+    float vi = method_ao(px, p.xyz, -n.xyz, true);
     float facing = -(p.x * n.x + p.y * n.y + p.z * n.z);
     float W = facing >= 0.0 ? n.w : 1.0 - n.w;      // eq 3
     return W * ve + (1.0 - W) * vi;                 // eq 4

@@ -1,8 +1,9 @@
 /* Deep input: the deep scanline reader (fixture written by
  * tools/deep_fixture.cpp, damaged files), the list compression of OITAO
  * III-B (eq 5 against a hand-computed case), multi-layer AO (a hidden
- * occluder seen only in a deeper layer), opacity (eqs 1-4), the GL pass
- * against its CPU twin, and the three deep EXRs of OpenEXR's
+ * occluder seen only in a deeper layer, with VAO++'s line samples and
+ * with method hemisphere's point samples), opacity (eqs 1-4), the methods
+ * deep input refuses, the GL pass against its CPU twin, and the three deep EXRs of OpenEXR's
  * LowResLeftView set when ../shared is present. */
 #include "testutil.h"
 
@@ -10,6 +11,7 @@
 #include <math.h>
 
 #include "deep.h"
+#include "deep_internal.h"
 #include "gl/gl.h"
 
 #define FIXTURE TESTDATA "/deep_small.exr"
@@ -377,6 +379,77 @@ static void test_hidden_occluder(void **state)
     obs_deep_free(&d);
 }
 
+/* Method hemisphere on deep input: the same hidden box occludes the wall
+ * pixel beside the near object in multi-layer mode and not in single
+ * mode; the near object, 7 in front of the receiver, fades out by the
+ * method's range check in both. */
+static void test_hidden_occluder_hemisphere(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    char err[OBS_ERR_LEN];
+    obs_params single = deep_params(OBS_DEEP_SINGLE), multi = deep_params(OBS_DEEP_MULTI);
+    assert_int_equal(obs_param_set(&single, "method", "hemisphere", err), OBS_OK);
+    assert_int_equal(obs_param_set(&multi, "method", "hemisphere", err), OBS_OK);
+    scene(&d, 9.3f, 1.0f);
+    float s = ao_at(&d, &single, 15, 16, NULL);
+    float m = ao_at(&d, &multi, 15, 16, NULL);
+    print_message("hemisphere, hidden occluder: AO single %.4f, multi %.4f\n", s, m);
+    assert_true(s > 0.95f);
+    assert_true(m < s - 0.1f);
+    assert_float_equal(ao_at(&d, &single, 4, 16, NULL), 1.0f, 1e-5);
+    assert_float_equal(ao_at(&d, &multi, 4, 16, NULL), 1.0f, 1e-5);
+    obs_deep_free(&d);
+
+    /* without the hidden box, multi-layer equals single-layer there */
+    scene(&d, 0.0f, 0.0f);
+    assert_float_equal(ao_at(&d, &multi, 15, 16, NULL), s, 1e-6);
+
+    /* one opaque node per pixel, single mode: the flat hemisphere kernel
+     * (obs__hemisphere_pixel) with the front node plane as depth buffer */
+    obs__deep_frame df;
+    if (obs__deep_frame_setup(&d, &single, &df, err) != OBS_OK)
+        fail_msg("%s", err);
+    for (int y = 0; y < d.height; y += 3)
+        for (int x = 0; x < d.width; x += 3) {
+            size_t i = (size_t)y * d.width + x;
+            const float *pp = df.pos + 4 * i, *nn = df.nrm + 4 * i;
+            float flat = obs__hemisphere_pixel(&df.f, df.pos, x, y, pp, nn);
+            assert_float_equal(obs__deep_node_ao(&df, x, y, 0), flat, 1e-6);
+        }
+    obs__deep_frame_free(&df);
+    obs_deep_free(&d);
+
+    /* eq 1: a half-transparent box occludes (about) half as much */
+    scene(&d, 9.3f, 0.5f);
+    float half = ao_at(&d, &multi, 15, 16, NULL);
+    print_message("hemisphere, alpha 0.5 box: AO %.4f\n", half);
+    assert_float_equal(1.0f - half, 0.5f * (1.0f - m), 0.02f);
+    obs_deep_free(&d);
+}
+
+/* Deep input takes methods vaopp, vao and hemisphere; the others are
+ * refused with a message naming the method. */
+static void test_methods_refused(void **state)
+{
+    (void)state;
+    static const char *const refused[] = {"hbao", "angle"};
+    obs_deep_image d;
+    obs_deep_result r;
+    scene(&d, 9.3f, 1.0f);
+    for (int k = 0; k < 2; k++) {
+        obs_params p = deep_params(OBS_DEEP_MULTI);
+        char err[OBS_ERR_LEN] = "", want[64];
+        assert_int_equal(obs_param_set(&p, "method", refused[k], err), OBS_OK);
+        assert_int_equal(obs_deep_run_cpu(&d, &p, &r, err), OBS_INVALID_ARGUMENT);
+        snprintf(want, sizeof want, "method %s does not run on deep input", refused[k]);
+        if (!strstr(err, want))
+            fail_msg("unexpected message: %s", err);
+        assert_null(r.ao_blend.data);
+    }
+    obs_deep_free(&d);
+}
+
 /* The blend of OITAO III's separated scheme and eq 1's receiver alpha: a
  * pane of alpha a over a wall gives a AO_pane + (1 - a) AO_wall; with
  * thin hulls the front face weighs exterior AO by alpha (eqs 2-4). */
@@ -413,6 +486,23 @@ static void test_blend_and_hull(void **state)
     assert_int_equal(obs_deep_run_cpu(&d, &p, &r, err), OBS_OK);
     /* the pane's interior sphere (behind it) holds the wall: W = 0.4 of
      * the open exterior, 0.6 of the occluded interior */
+    assert_true(r.ao_front.data[c] < 0.9f);
+    obs_deep_result_free(&r);
+
+    /* the same with method hemisphere: the pane is open as a solid
+     * volume; as a thin hull its interior hemisphere reaches the wall 0.2
+     * behind it (the pane itself, on the exterior side, hides nothing) */
+    p = deep_params(OBS_DEEP_MULTI);
+    assert_int_equal(obs_param_set(&p, "method", "hemisphere", err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(&d, &p, &r, err), OBS_OK);
+    assert_float_equal(r.ao_front.data[c], 1.0f, 1e-5);
+    blend = r.ao_blend.data[c];
+    print_message("hemisphere, pane over wall: blended AO %.4f\n", blend);
+    assert_true(blend < 1.0f && blend > 0.6f);
+    obs_deep_result_free(&r);
+    assert_int_equal(obs_param_set(&p, "deep_hull", "thin", err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(&d, &p, &r, err), OBS_OK);
+    print_message("hemisphere, thin pane: front AO %.4f\n", r.ao_front.data[c]);
     assert_true(r.ao_front.data[c] < 0.9f);
     obs_deep_result_free(&r);
     obs_deep_free(&d);
@@ -467,6 +557,23 @@ static void test_gl_twin(void **state)
     assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
     assert_int_equal(obs_param_set(&p, "deep_front_half", "on", err), OBS_OK);
     compare_gl(ctx, &d, &p, "fixture, thin, m = 2, front half");
+    /* method hemisphere: the uniform selects its point samples */
+    p = (obs_params){0};
+    assert_int_equal(obs_param_set(&p, "radius", "1", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "method", "hemisphere", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "fixture, hemisphere, solid");
+    assert_int_equal(obs_param_set(&p, "hemisphere_samples", "16", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "deep_hull", "thin", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "fixture, hemisphere, thin, m = 2");
+    obs_deep_free(&d);
+    scene(&d, 9.8f, 0.7f);
+    p = deep_params(OBS_DEEP_MULTI);
+    assert_int_equal(obs_param_set(&p, "method", "hemisphere", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "hidden occluder, hemisphere, multi");
+    p = deep_params(OBS_DEEP_SINGLE);
+    assert_int_equal(obs_param_set(&p, "method", "hemisphere", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "hidden occluder, hemisphere, single");
     obs_deep_free(&d);
     obs_ctx_destroy(ctx);
 }
@@ -571,6 +678,8 @@ int main(void)
         cmocka_unit_test(test_read_damaged_files),
         cmocka_unit_test(test_compress_eq5),
         cmocka_unit_test(test_hidden_occluder),
+        cmocka_unit_test(test_hidden_occluder_hemisphere),
+        cmocka_unit_test(test_methods_refused),
         cmocka_unit_test(test_blend_and_hull),
         cmocka_unit_test(test_gl_twin),
         cmocka_unit_test(test_gl_resources_reused),
