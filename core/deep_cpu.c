@@ -254,21 +254,14 @@ static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float 
 {
     const obs__frame *f = &df->f;
     const float R = f->radius;
-    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
     const int layers = df->multi ? df->m : 1;
     const size_t npx = (size_t)f->width * (size_t)f->height;
-    /* the tangent frame of n (Duff et al. 2017), as obs__hemisphere_pixel */
-    float sg = n[2] >= 0.0f ? 1.0f : -1.0f;
-    float a = -1.0f / (sg + n[2]), b = n[0] * n[1] * a;
-    const float t1[3] = {1.0f + sg * n[0] * n[0] * a, sg * b, -sg * n[0]};
-    const float t2[3] = {b, sg + n[1] * n[1] * a, -n[1]};
+    float t1[3], t2[3];
+    obs__hemisphere_basis(n, t1, t2);
     float occ = 0.0f;
     for (int i = 0; i < f->hs_count; i++) {
-        const float *kv = f->hs_kernel[i];
-        float kx = rot[0] * kv[0] - rot[1] * kv[1], ky = rot[1] * kv[0] + rot[0] * kv[1];
         float s[3];
-        for (int j = 0; j < 3; j++)
-            s[j] = p[j] + R * (kx * t1[j] + ky * t2[j] + kv[2] * n[j]);
+        obs__hemisphere_sample(f, x, y, p, n, t1, t2, i, s);
         int qx, qy;
         if (!obs__view_to_px(f, s, &qx, &qy))
             continue;

@@ -180,6 +180,15 @@ int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy);
  * 3 floats each, around +z (hemisphere_cpu.c). */
 void obs__hemisphere_kernel(int n, float *out);
 
+/* Method hemisphere's kernel (GLSL: hemisphere.glsl): the view-space
+ * position s of kernel sample i for the point p with normal n at pixel
+ * (x, y), the kernel's +z turned to n and rotated by the pixel's 3x3 tile
+ * rotation.  obs__hemisphere_basis() gives the tangent frame t1, t2 once
+ * per pixel. */
+void obs__hemisphere_basis(const float n[3], float t1[3], float t2[3]);
+void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3], const float n[3],
+                            const float t1[3], const float t2[3], int i, float s[3]);
+
 /* Normal-oriented hemisphere SSAO of the point p (xyz; planar depth in
  * p[3] is not needed) with normal n at pixel (x, y); `pos` is the prep
  * pass's position plane (GLSL: hemisphere.glsl). */

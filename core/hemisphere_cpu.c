@@ -38,27 +38,43 @@ void obs__hemisphere_kernel(int n, float *out)
     }
 }
 
+void obs__hemisphere_basis(const float n[3], float t1[3], float t2[3])
+{
+    /* The tangent frame of n (Duff et al., "Building an orthonormal
+     * basis, revisited", 2017): the kernel's +z goes to n. */
+    float sg = n[2] >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (sg + n[2]), b = n[0] * n[1] * a;
+    t1[0] = 1.0f + sg * n[0] * n[0] * a;
+    t1[1] = sg * b;
+    t1[2] = -sg * n[0];
+    t2[0] = b;
+    t2[1] = sg + n[1] * n[1] * a;
+    t2[2] = -n[1];
+}
+
+void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3], const float n[3],
+                            const float t1[3], const float t2[3], int i, float s[3])
+{
+    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    const float *k = f->hs_kernel[i];
+    /* the 3x3 tile's rotation about the normal (interleaved sampling,
+     * removed by the shared blur as for VAO++) */
+    float kx = rot[0] * k[0] - rot[1] * k[1], ky = rot[1] * k[0] + rot[0] * k[1];
+    for (int j = 0; j < 3; j++)
+        s[j] = p[j] + f->radius * (kx * t1[j] + ky * t2[j] + k[2] * n[j]);
+}
+
 /* GLSL: hemisphere_ao() in hemisphere.glsl */
 float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                             const float n[3])
 {
     const float R = f->radius;
-    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
-    /* The tangent frame of n (Duff et al., "Building an orthonormal
-     * basis, revisited", 2017): the kernel's +z goes to n. */
-    float sg = n[2] >= 0.0f ? 1.0f : -1.0f;
-    float a = -1.0f / (sg + n[2]), b = n[0] * n[1] * a;
-    const float t1[3] = {1.0f + sg * n[0] * n[0] * a, sg * b, -sg * n[0]};
-    const float t2[3] = {b, sg + n[1] * n[1] * a, -n[1]};
+    float t1[3], t2[3];
+    obs__hemisphere_basis(n, t1, t2);
     float occ = 0.0f;
     for (int i = 0; i < f->hs_count; i++) {
-        const float *k = f->hs_kernel[i];
-        /* the 3x3 tile's rotation about the normal (interleaved sampling,
-         * removed by the shared blur as for VAO++) */
-        float kx = rot[0] * k[0] - rot[1] * k[1], ky = rot[1] * k[0] + rot[0] * k[1];
         float s[3];
-        for (int j = 0; j < 3; j++)
-            s[j] = p[j] + R * (kx * t1[j] + ky * t2[j] + k[2] * n[j]);
+        obs__hemisphere_sample(f, x, y, p, n, t1, t2, i, s);
         int qx, qy;
         if (!obs__view_to_px(f, s, &qx, &qy))
             continue;

@@ -181,25 +181,10 @@ obs_status obs_raster_deep(obs_ctx *ctx, const obs_scene *scene, const obs_camer
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_raster_deep: no output");
     memset(out, 0, sizeof *out);
-    if (!scene || !scene->positions || !scene->indices || scene->triangle_count == 0)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "empty scene: no triangles");
-    if (scene->triangle_count > (size_t)INT32_MAX / 3)
-        return obs__fail(err, OBS_TOO_LARGE, "%zu triangles; at most %d", scene->triangle_count,
-                         INT32_MAX / 3);
-    if (!cam || !cam->has_projection)
-        return obs__fail(err, OBS_NO_CAMERA, "the camera has no projection");
-    if (width < 1 || height < 1)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "image size %dx%d", width, height);
-    if ((s = obs_check_size(NULL, width, height, err)) != OBS_OK)
+    if ((s = obs__raster_check(ctx, scene, cam, width, height, err)) != OBS_OK)
         return s;
-    if ((s = obs__ctx_bind(ctx, err)) != OBS_OK)
-        return s;
-    GLint max_size = 0, max_block = 0;
-    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+    GLint max_block = 0;
     glGetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
-    if (width > max_size || height > max_size)
-        return obs__fail(err, OBS_TOO_LARGE, "%dx%d exceeds the GL limit %d", width, height,
-                         max_size);
     /* The pool's limit: the deep image's, and what one storage block of
      * this GL can address. */
     uint64_t limit = OBS_DEEP_MAX_SAMPLES;

@@ -144,16 +144,10 @@ obs_status obs__raster_set_camera(GLuint prog, const obs_camera *cam, char err[O
     return OBS_OK;
 }
 
-obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
-                              int width, int height, obs_raster *out, char err[OBS_ERR_LEN])
+obs_status obs__raster_check(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
+                             int width, int height, char err[OBS_ERR_LEN])
 {
-    static const char *const frag[] = {"#version 430 core\n", obs__shader_raster_common,
-                                       obs__shader_raster_frag};
-    raster_gl g = {0};
-    float *rgba = NULL;
     obs_status s;
-
-    memset(out, 0, sizeof *out);
     if (!scene || !scene->positions || !scene->indices || scene->triangle_count == 0)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "empty scene: no triangles");
     if (scene->triangle_count > (size_t)INT32_MAX / 3)
@@ -172,6 +166,21 @@ obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_ca
     if (width > max_size || height > max_size)
         return obs__fail(err, OBS_TOO_LARGE, "%dx%d exceeds the GL limit %d", width, height,
                          max_size);
+    return OBS_OK;
+}
+
+obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
+                              int width, int height, obs_raster *out, char err[OBS_ERR_LEN])
+{
+    static const char *const frag[] = {"#version 430 core\n", obs__shader_raster_common,
+                                       obs__shader_raster_frag};
+    raster_gl g = {0};
+    float *rgba = NULL;
+    obs_status s;
+
+    memset(out, 0, sizeof *out);
+    if ((s = obs__raster_check(ctx, scene, cam, width, height, err)) != OBS_OK)
+        return s;
 
     static const int channels[T_COUNT] = {1, 3, 3, 3, 4};
     obs_image *imgs[T_COUNT] = {&out->depth, &out->normal, &out->normal_cam, &out->position,

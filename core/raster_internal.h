@@ -7,6 +7,12 @@
 #include "gl/gl.h"
 #include "scene.h"
 
+/* The checks both rasterisers make before any GL work: a scene with
+ * triangles (at most INT32_MAX / 3), a camera with a projection, an image
+ * size within the limits and GL_MAX_TEXTURE_SIZE; binds the context. */
+obs_status obs__raster_check(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
+                             int width, int height, char err[OBS_ERR_LEN]);
+
 /* A buffer object holding a copy of data (GL_STATIC_DRAW), left bound to
  * target. */
 GLuint obs__gl_buffer(GLenum target, const void *data, size_t bytes);
