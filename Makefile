@@ -6,7 +6,7 @@
 #   make test     unit + end-to-end tests, then the same under ASan/UBSan
 #   make bench    benchmarks (bench/RESULTS.md)
 #   make quality  AO against ray-traced ground truth (bench/QUALITY.md)
-#   make fuzz     libFuzzer target of the binary protocol (clang; tests/fuzz/fuzz.mk)
+#   make fuzz     libFuzzer targets: binary protocol, EXR readers (clang; tests/fuzz/fuzz.mk)
 #   make readme   regenerate README.md's parameter and daemon option tables
 #   make samples  regenerate core/sample_tables.c (VAO++ 4.5 sample sets)
 #

@@ -1,6 +1,7 @@
 #!/bin/sh
-# A short, bounded libFuzzer run of the binary protocol's decoders
-# (tests/fuzz/fuzz_binary.c) on the seed corpus: fails on a crash, a read
+# Short, bounded libFuzzer runs of the binary protocol's decoders
+# (tests/fuzz/fuzz_binary.c) and of the EXR readers, flat and deep
+# (tests/fuzz/fuzz_exr.c), on their seeds: fails on a crash, a read
 # past the buffer, undefined behaviour or a leak.  Needs clang (libFuzzer);
 # without it, prints "skip".  The fuzzer carries its own sanitizers, so it
 # runs once, in the plain build (BUILD without "asan").
@@ -23,21 +24,31 @@ if ! make --no-print-directory -s fuzz BUILD="$BUILD" >"$T/build" 2>&1; then
     sed 's/^/       /' "$T/build" | tail -10
     exit 1
 fi
-mkdir -p "$T/corpus"
-# New inputs go to $T/corpus; the committed seeds are only read.
-if "$BUILD/fuzz/fuzz_binary" -max_total_time="$SECONDS_MAX" -runs=2000000 -timeout=10 \
-        -rss_limit_mb=2048 -artifact_prefix="$T/" -print_final_stats=1 \
-        "$T/corpus" tests/fuzz/corpus/binary >"$T/log" 2>&1; then
-    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$T/log")
-    cov=$(grep -o 'cov: [0-9]*' "$T/log" | tail -1)
-    echo "  ok   fuzz: binary protocol decoders, ${runs:-?} inputs, $cov, no crash"
-    exit 0
-fi
-echo "  FAIL fuzz: the binary protocol's decoder crashed (libFuzzer log, tail):"
-tail -40 "$T/log" | sed 's/^/       /'
-for a in "$T"/crash-* "$T"/leak-* "$T"/timeout-* "$T"/oom-*; do
-    [ -e "$a" ] || continue
-    mkdir -p "$BUILD/fuzz/artifacts" && cp "$a" "$BUILD/fuzz/artifacts/"
-    echo "       input kept: $BUILD/fuzz/artifacts/$(basename "$a")"
-done
-exit 1
+# fuzz TARGET WHAT SEED_DIR...: a bounded run; new inputs go to a scratch
+# corpus, the committed seeds are only read.
+rc=0
+fuzz() {
+    target=$1 what=$2
+    shift 2
+    rm -rf "$T/corpus" && mkdir -p "$T/corpus"
+    if "$BUILD/fuzz/$target" -max_total_time="$SECONDS_MAX" -runs=2000000 -timeout=10 \
+            -rss_limit_mb=2048 -max_len=2000000 -artifact_prefix="$T/" -print_final_stats=1 \
+            "$T/corpus" "$@" >"$T/log" 2>&1; then
+        runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$T/log")
+        cov=$(grep -o 'cov: [0-9]*' "$T/log" | tail -1)
+        echo "  ok   fuzz: $what, ${runs:-?} inputs, $cov, no crash"
+        return
+    fi
+    rc=1
+    echo "  FAIL fuzz: $what crashed (libFuzzer log, tail):"
+    tail -40 "$T/log" | sed 's/^/       /'
+    for a in "$T"/crash-* "$T"/leak-* "$T"/timeout-* "$T"/oom-*; do
+        [ -e "$a" ] || continue
+        mkdir -p "$BUILD/fuzz/artifacts" && cp "$a" "$BUILD/fuzz/artifacts/"
+        echo "       input kept: $BUILD/fuzz/artifacts/$(basename "$a")"
+    done
+}
+fuzz fuzz_binary "binary protocol decoders" tests/fuzz/corpus/binary
+mkdir -p "$T/exr_seeds" && cp tests/data/*.exr "$T/exr_seeds/"
+fuzz fuzz_exr "EXR readers (flat and deep)" tests/data/damaged "$T/exr_seeds"
+exit $rc

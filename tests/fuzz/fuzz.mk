@@ -1,9 +1,10 @@
 # tests/fuzz/: libFuzzer targets, built with clang (-fsanitize=fuzzer,
 # address,undefined).  Included by the top Makefile; not part of `all`.
 #
-#   make fuzz        build $(BUILD)/fuzz/fuzz_binary and refresh the seed
-#                    corpus tests/fuzz/corpus/binary
+#   make fuzz        build $(BUILD)/fuzz/fuzz_binary and $(BUILD)/fuzz/fuzz_exr
+#                    and refresh the seed corpus tests/fuzz/corpus/binary
 #   $(BUILD)/fuzz/fuzz_binary -max_total_time=60 NEW_DIR tests/fuzz/corpus/binary
+#   $(BUILD)/fuzz/fuzz_exr -max_total_time=60 NEW_DIR tests/data/damaged
 #
 # The protocol sources and the few core files they need are compiled here,
 # with clang and the fuzzer's sanitizers, not taken from $(BUILD)/obj.
@@ -16,9 +17,13 @@ FUZZ_LIBS := $(shell pkg-config --libs libcjson 2>/dev/null) -lm
 FUZZ_SRC := protocol/binary.c protocol/http.c core/status.c core/util.c core/params.c \
             core/bytes.c core/channel_map.c
 FUZZ_HDR := $(wildcard protocol/*.h core/*.h)
+# The EXR readers (flat and deep) against OpenEXR's C library.
+FUZZ_EXR_SRC := core/exr_read.c core/exr_deep.c core/status.c core/util.c core/channel_map.c \
+                core/bytes.c core/params.c
+FUZZ_EXR_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libcjson 2>/dev/null) -lz -lm -lpthread
 
 .PHONY: fuzz fuzz-check
-fuzz: fuzz-check $(FUZZ_DIR)/fuzz_binary $(FUZZ_DIR)/corpus.stamp
+fuzz: fuzz-check $(FUZZ_DIR)/fuzz_binary $(FUZZ_DIR)/fuzz_exr $(FUZZ_DIR)/corpus.stamp
 
 fuzz-check:
 	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { \
@@ -28,6 +33,10 @@ fuzz-check:
 $(FUZZ_DIR)/fuzz_binary: tests/fuzz/fuzz_binary.c $(FUZZ_SRC) $(FUZZ_HDR) | fuzz-check
 	@mkdir -p $(dir $@)
 	$(FUZZ_CC) $(FUZZ_CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SRC) -o $@ $(FUZZ_LIBS)
+
+$(FUZZ_DIR)/fuzz_exr: tests/fuzz/fuzz_exr.c $(FUZZ_EXR_SRC) $(FUZZ_HDR) | fuzz-check
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_EXR_SRC) -o $@ $(FUZZ_EXR_LIBS)
 
 $(FUZZ_DIR)/gen_corpus: tests/fuzz/gen_corpus.c $(FUZZ_SRC) $(FUZZ_HDR) | fuzz-check
 	@mkdir -p $(dir $@)
