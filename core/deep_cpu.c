@@ -196,7 +196,6 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
                        int interior)
 {
     const obs__frame *f = &df->f;
-    const float *P = f->proj;
     const float R = f->radius, r = 0.5f * R;
     const float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
     const float *rot = f->rot[3 * (x % 3) + (y % 3)];
@@ -210,17 +209,10 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         float h = r * l;
         float s[3] = {c[0] + r * (rot[0] * sx - rot[1] * sy), c[1] + r * (rot[1] * sx + rot[0] * sy),
                       c[2]};
-        float cw = P[12] * s[0] + P[13] * s[1] + P[14] * s[2] + P[15];
-        if (!(cw > 0.0f))
+        int qx, qy;
+        if (!obs__view_to_px(f, s, &qx, &qy))
             continue; /* off the planes: left out of eq 1's sum and F */
-        float cx = P[0] * s[0] + P[1] * s[1] + P[2] * s[2] + P[3];
-        float cy = P[4] * s[0] + P[5] * s[1] + P[6] * s[2] + P[7];
-        float u = (cx / cw * 0.5f + 0.5f) * f->viewport[2] - f->viewport[0];
-        float v = (0.5f - cy / cw * 0.5f) * f->viewport[3] - f->viewport[1];
-        float fu = floorf(u), fv = floorf(v);
-        if (!(fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height))
-            continue;
-        size_t q = (size_t)fv * (size_t)f->width + (size_t)fu;
+        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
         float front = -c[2] - h, occ = 0.0f;
         for (int k = 0; k < layers; k++) {
             const float *pk = df->pos + ((size_t)k * npx + q) * 4;

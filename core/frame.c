@@ -203,7 +203,7 @@ obs_status obs__gbuffer_validate(const obs_gbuffer *gb, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
-/* GLSL: view_to_px() in method.glsl; the projection of vao_estimate. */
+/* GLSL: view_to_px() in common.glsl. */
 int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy)
 {
     const float *P = f->proj;

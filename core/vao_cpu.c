@@ -213,7 +213,6 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
                               int y, const float p[3], const float n[3], int ns, const float *xy,
                               float bleed[3])
 {
-    const float *P = f->proj;
     const float R = f->radius, r = 0.5f * f->radius;
     /* Centre of the tangent sphere of radius R/2, moved along the normal. */
     float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
@@ -235,24 +234,17 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         /* Sample on the disk through the centre, perpendicular to view Z. */
         float s[3] = {c[0] + r * (rot[0] * sx - rot[1] * sy), c[1] + r * (rot[1] * sx + rot[0] * sy),
                       c[2]};
-        float cw = P[12] * s[0] + P[13] * s[1] + P[14] * s[2] + P[15];
         float zs = INFINITY; /* scene depth at the sample's pixel */
-        if (cw > 0.0f) {
-            float cx = P[0] * s[0] + P[1] * s[1] + P[2] * s[2] + P[3];
-            float cy = P[4] * s[0] + P[5] * s[1] + P[6] * s[2] + P[7];
-            float u = (cx / cw * 0.5f + 0.5f) * f->viewport[2] - f->viewport[0];
-            float v = (0.5f - cy / cw * 0.5f) * f->viewport[3] - f->viewport[1];
-            float fu = floorf(u), fv = floorf(v);
-            if (fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height) {
-                size_t k = (size_t)fv * (size_t)f->width + (size_t)fu;
-                seen = 1;
-                float d = pos[4 * k + 3];
-                if (d > 0.0f) {
-                    zs = d;
-                    if (bleeds) { /* eq 5 with x the surface point at the sample's pixel */
-                        c5 = obs__bleed_weight(pos + 4 * k, p, n, R);
-                        cx5 = col + 4 * k;
-                    }
+        int qx, qy;
+        seen = obs__view_to_px(f, s, &qx, &qy);
+        if (seen) {
+            size_t k = (size_t)qy * (size_t)f->width + (size_t)qx;
+            float d = pos[4 * k + 3];
+            if (d > 0.0f) {
+                zs = d;
+                if (bleeds) { /* eq 5 with x the surface point at the sample's pixel */
+                    c5 = obs__bleed_weight(pos + 4 * k, p, n, R);
+                    cx5 = col + 4 * k;
                 }
             }
         }

@@ -60,3 +60,34 @@ vec4 prep_position(float raw, ivec2 p)
         return vec4(0.0);
     return vec4(o.x + d * dir.x, o.y + d * dir.y, -d, d);
 }
+
+// The pixel holding the view-space point s on planes of the given size;
+// false when s is behind the camera or off the image.  Shared by the VAO
+// estimator, the comparison methods and the deep pass.  C twin:
+// obs__view_to_px.
+bool view_to_px(vec3 s, ivec2 size, out ivec2 q)
+{
+    q = ivec2(0);
+    float cw = PM(3, 0) * s.x + PM(3, 1) * s.y + PM(3, 2) * s.z + PM(3, 3);
+    if (!(cw > 0.0))
+        return false;
+    float cx = PM(0, 0) * s.x + PM(0, 1) * s.y + PM(0, 2) * s.z + PM(0, 3);
+    float cy = PM(1, 0) * s.x + PM(1, 1) * s.y + PM(1, 2) * s.z + PM(1, 3);
+    float u = (cx / cw * 0.5 + 0.5) * u_viewport.z - u_viewport.x;
+    float v = (0.5 - cy / cw * 0.5) * u_viewport.w - u_viewport.y;
+    float fu = floor(u), fv = floor(v);
+    if (!(fu >= 0.0 && fv >= 0.0 && fu < float(size.x) && fv < float(size.y)))
+        return false;
+    q = ivec2(int(fu), int(fv));
+    return true;
+}
+
+// Tangent frame of n (Duff et al., "Building an orthonormal basis,
+// revisited", 2017): t1, t2, n orthonormal.  C twin: obs__hemisphere_basis.
+void tangent_basis(vec3 n, out vec3 t1, out vec3 t2)
+{
+    float sg = n.z >= 0.0 ? 1.0 : -1.0;
+    float a = -1.0 / (sg + n.z), b = n.x * n.y * a;
+    t1 = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x);
+    t2 = vec3(b, sg + n.y * n.y * a, -n.y);
+}

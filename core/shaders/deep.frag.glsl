@@ -65,17 +65,9 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
         float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
         float h = r * l;
         vec3 s = vec3(c.x + r * (rot.x * sx - rot.y * sy), c.y + r * (rot.y * sx + rot.x * sy), c.z);
-        float cw = PM(3, 0) * s.x + PM(3, 1) * s.y + PM(3, 2) * s.z + PM(3, 3);
-        if (!(cw > 0.0))
-            continue;
-        float cx = PM(0, 0) * s.x + PM(0, 1) * s.y + PM(0, 2) * s.z + PM(0, 3);
-        float cy = PM(1, 0) * s.x + PM(1, 1) * s.y + PM(1, 2) * s.z + PM(1, 3);
-        float u = (cx / cw * 0.5 + 0.5) * u_viewport.z - u_viewport.x;
-        float v = (0.5 - cy / cw * 0.5) * u_viewport.w - u_viewport.y;
-        float fu = floor(u), fv = floor(v);
-        if (!(fu >= 0.0 && fv >= 0.0 && fu < float(u_size.x) && fv < float(u_size.y)))
-            continue;
-        ivec2 q = ivec2(int(fu), int(fv));
+        ivec2 q;
+        if (!view_to_px(s, u_size, q))
+            continue;               // off the planes: left out
         float front = -c.z - h, occ = 0.0;
         for (int k = 0; k < layers; k++) {
             float zs = texelFetch(u_lpos, ivec3(q, k), 0).w;
@@ -101,10 +93,8 @@ float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
     float R = u_radius;
     vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
     int layers = u_multi != 0 ? u_m : 1;
-    float sg = n.z >= 0.0 ? 1.0 : -1.0;
-    float a = -1.0 / (sg + n.z), b = n.x * n.y * a;
-    vec3 t1 = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x);
-    vec3 t2 = vec3(b, sg + n.y * n.y * a, -n.y);
+    vec3 t1, t2;
+    tangent_basis(n, t1, t2);
     float occ = 0.0;
     for (int i = 0; i < u_hs_count; i++) {
         vec3 kv = vec3(u_hs_kernel[3 * i], u_hs_kernel[3 * i + 1], u_hs_kernel[3 * i + 2]);
@@ -112,17 +102,9 @@ float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
         vec3 s = vec3(p.x + R * (kx * t1.x + ky * t2.x + kv.z * n.x),
                       p.y + R * (kx * t1.y + ky * t2.y + kv.z * n.y),
                       p.z + R * (kx * t1.z + ky * t2.z + kv.z * n.z));
-        float cw = PM(3, 0) * s.x + PM(3, 1) * s.y + PM(3, 2) * s.z + PM(3, 3);
-        if (!(cw > 0.0))
-            continue;
-        float cx = PM(0, 0) * s.x + PM(0, 1) * s.y + PM(0, 2) * s.z + PM(0, 3);
-        float cy = PM(1, 0) * s.x + PM(1, 1) * s.y + PM(1, 2) * s.z + PM(1, 3);
-        float u = (cx / cw * 0.5 + 0.5) * u_viewport.z - u_viewport.x;
-        float v = (0.5 - cy / cw * 0.5) * u_viewport.w - u_viewport.y;
-        float fu = floor(u), fv = floor(v);
-        if (!(fu >= 0.0 && fv >= 0.0 && fu < float(u_size.x) && fv < float(u_size.y)))
-            continue;
-        ivec2 q = ivec2(int(fu), int(fv));
+        ivec2 q;
+        if (!view_to_px(s, u_size, q))
+            continue;               // off the planes: left out
         float best = 0.0;
         for (int k = 0; k < layers; k++) {
             vec4 pk = texelFetch(u_lpos, ivec3(q, k), 0);

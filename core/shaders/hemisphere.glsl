@@ -12,11 +12,8 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
 {
     float R = u_radius;
     vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
-    // Tangent frame of n (Duff et al. 2017): the kernel's +z goes to n.
-    float sg = n.z >= 0.0 ? 1.0 : -1.0;
-    float a = -1.0 / (sg + n.z), b = n.x * n.y * a;
-    vec3 t1 = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x);
-    vec3 t2 = vec3(b, sg + n.y * n.y * a, -n.y);
+    vec3 t1, t2;                // the kernel's +z goes to n
+    tangent_basis(n, t1, t2);
     float occ = 0.0;
     count = u_hs_count;
     for (int i = 0; i < u_hs_count; i++) {
@@ -27,7 +24,7 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
                       p.y + R * (kx * t1.y + ky * t2.y + k.z * n.y),
                       p.z + R * (kx * t1.z + ky * t2.z + k.z * n.z));
         ivec2 q;
-        if (!view_to_px(s, q))
+        if (!view_to_px(s, u_size, q))
             continue;
         float zq = texelFetch(u_pos, q, 0).w;
         if (!(zq > 0.0))

@@ -60,24 +60,15 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
         bool seen = false;      // the sample's pixel is on the planes
 
         vec3 s = vec3(c.x + r * (rot.x * sx - rot.y * sy), c.y + r * (rot.y * sx + rot.x * sy), c.z);
-        float cw = PM(3, 0) * s.x + PM(3, 1) * s.y + PM(3, 2) * s.z + PM(3, 3);
         float zs = FAR_AWAY;    // scene depth at the sample's pixel
-        if (cw > 0.0) {
-            float cx = PM(0, 0) * s.x + PM(0, 1) * s.y + PM(0, 2) * s.z + PM(0, 3);
-            float cy = PM(1, 0) * s.x + PM(1, 1) * s.y + PM(1, 2) * s.z + PM(1, 3);
-            float u = (cx / cw * 0.5 + 0.5) * u_viewport.z - u_viewport.x;
-            float v = (0.5 - cy / cw * 0.5) * u_viewport.w - u_viewport.y;
-            float fu = floor(u), fv = floor(v);
-            if (fu >= 0.0 && fv >= 0.0 && fu < float(u_size.x) && fv < float(u_size.y)) {
-                q = ivec2(int(fu), int(fv));
-                seen = true;
-                vec4 xs = texelFetch(u_pos, q, 0);
-                if (xs.w > 0.0) {
-                    zs = xs.w;
-                    if (bleeds) {   // eq 5, x the surface point at the sample's pixel
-                        c5 = bleed_weight(xs.xyz, p.xyz, n, R);
-                        hit = true;
-                    }
+        seen = view_to_px(s, u_size, q);
+        if (seen) {
+            vec4 xs = texelFetch(u_pos, q, 0);
+            if (xs.w > 0.0) {
+                zs = xs.w;
+                if (bleeds) {       // eq 5, x the surface point at the sample's pixel
+                    c5 = bleed_weight(xs.xyz, p.xyz, n, R);
+                    hit = true;
                 }
             }
         }
