@@ -11,6 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cli.h"
 #include "deep.h"
 #include "ground.h"
 #include "io.h"
@@ -18,7 +19,6 @@
 #include "reference.h"
 #include "scene.h"
 
-enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_BADINPUT = 3 };
 
 void cli_ground_usage(FILE *f)
 {
@@ -45,27 +45,6 @@ static void die_usage(const char *cmd, const char *fmt, ...)
     fprintf(stderr, "\n(run 'obscura help' for usage)\n");
     va_end(ap);
     exit(EXIT_USAGE);
-}
-
-/* Bad input (a file that is damaged, missing or not a mesh) is exit 3;
- * GL and memory failures exit 1. */
-static int fail(obs_status s, const char *what, const char *err)
-{
-    const char *msg = err && *err ? err : obs_status_message(s);
-    if (strncmp(msg, what, strlen(what)) == 0)
-        fprintf(stderr, "obscura: %s (%s)\n", msg, obs_status_name(s));
-    else
-        fprintf(stderr, "obscura: %s: %s (%s)\n", what, msg, obs_status_name(s));
-    switch (s) {
-    case OBS_IO:
-    case OBS_BAD_FILE:
-    case OBS_UNSUPPORTED:
-    case OBS_MISSING_CHANNEL:
-    case OBS_TOO_LARGE:
-    case OBS_NO_CAMERA:
-    case OBS_INVALID_ARGUMENT: return EXIT_BADINPUT;
-    default: return EXIT_FAIL;
-    }
 }
 
 static double now_s(void)
@@ -188,9 +167,9 @@ static int load_camera(const ground_args *a, obs_camera *cam, int *w, int *h)
     int cw = 0, ch = 0;
     obs_status s = obs_camera_read_json(a->camera, cam, &cw, &ch, err);
     if (s != OBS_OK)
-        return fail(s == OBS_IO ? OBS_IO : s, a->camera, err);
+        return cli_input_fail(s, a->camera, err);
     if (!cam->has_projection)
-        return fail(OBS_NO_CAMERA, a->camera, "the camera has no projection (fov_y_deg or projection)");
+        return cli_input_fail(OBS_NO_CAMERA, a->camera, "the camera has no projection (fov_y_deg or projection)");
     *w = a->width ? (int)a->width : cw;
     *h = a->height ? (int)a->height : ch;
     if (*w <= 0 || *h <= 0)
@@ -225,11 +204,11 @@ static int load_scene(const ground_args *a, obs_scene *scene)
     double t0 = now_s();
     obs_status s = obs_scene_load(a->scene, scene, err);
     if (s != OBS_OK)
-        return fail(s, a->scene, err);
+        return cli_input_fail(s, a->scene, err);
     for (int k = 0; k < a->nalpha; k++)
         if ((s = obs_scene_set_opacity(scene, a->alpha[k], err)) != OBS_OK) {
             obs_scene_free(scene);
-            return fail(s, a->scene, err);
+            return cli_input_fail(s, a->scene, err);
         }
     if (!a->quiet)
         fprintf(stderr, "obscura: info: %s: %zu triangles, %zu vertices%s%s (%.2f s)\n", a->scene,
@@ -248,11 +227,11 @@ static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene
     char err[OBS_ERR_LEN] = "";
     obs_status s = obs_raster_deep(ctx, scene, cam, w, h, &d, err);
     if (s != OBS_OK)
-        return fail(s, a->scene, err);
+        return cli_input_fail(s, a->scene, err);
     double t_raster = now_s() - t0;
     if ((s = obs_deep_write_exr(a->out, &d, err)) != OBS_OK) {
         obs_deep_free(&d);
-        return fail(s, a->out, err);
+        return cli_fail(s, a->out, err);
     }
     if (!a->quiet) {
         size_t npx = (size_t)w * h, covered = 0;
@@ -298,7 +277,7 @@ int cli_gbuffer(int argc, char **argv)
         die_usage(a.cmd, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
     double t0 = now_s();
     if ((s = obs_ctx_create(&desc, &ctx, err)) != OBS_OK) {
-        rc = fail(s, "OpenGL", err);
+        rc = cli_fail(s, "OpenGL", err);
         goto done;
     }
     if (a.deep) {
@@ -306,7 +285,7 @@ int cli_gbuffer(int argc, char **argv)
         goto done;
     }
     if ((s = obs_raster_gbuffer(ctx, &scene, &cam, w, h, &r, err)) != OBS_OK) {
-        rc = fail(s, a.scene, err);
+        rc = cli_input_fail(s, a.scene, err);
         goto done;
     }
     double t_raster = now_s() - t0;
@@ -320,7 +299,7 @@ int cli_gbuffer(int argc, char **argv)
     if (!r.has_albedo) {
         size_t n = (size_t)w * h;
         if (!(alpha.data = malloc(n * sizeof(float)))) {
-            rc = fail(OBS_NO_MEMORY, a.out, NULL);
+            rc = cli_fail(OBS_NO_MEMORY, a.out, NULL);
             goto done;
         }
         alpha.width = w;
@@ -337,7 +316,7 @@ int cli_gbuffer(int argc, char **argv)
     s = obs_exr_write(a.out, layers, 5, OBS_EXR_FLOAT, &cam, err);
     obs_image_free(&alpha);
     if (s != OBS_OK) {
-        rc = fail(s, a.out, err);
+        rc = cli_fail(s, a.out, err);
         goto done;
     }
     if (!a.quiet) {
@@ -431,16 +410,16 @@ int cli_reference(int argc, char **argv)
         if (!a.camera) {
             obs_gbuffer_file gf = {0};
             if ((s = obs_gbuffer_read_exr(a.gbuffer, NULL, NULL, &gf, err)) != OBS_OK)
-                return fail(s == OBS_IO ? OBS_IO : s, a.gbuffer, err);
+                return cli_input_fail(s, a.gbuffer, err);
             cam = gf.gb.camera;
             obs_gbuffer_free(&gf);
             if (!cam.has_projection)
-                return fail(OBS_NO_CAMERA, a.gbuffer,
+                return cli_input_fail(OBS_NO_CAMERA, a.gbuffer,
                             "no worldToCamera/worldToNDC in the header: use --camera");
         }
         if ((s = read_triple(a.gbuffer, pos_cands, 2, &pos, err)) != OBS_OK ||
             (s = read_triple(a.gbuffer, nrm_cands, 2, &nrm, err)) != OBS_OK) {
-            rc = fail(s, a.gbuffer, err);
+            rc = cli_input_fail(s, a.gbuffer, err);
             goto done;
         }
         w = pos.width;
@@ -461,7 +440,7 @@ int cli_reference(int argc, char **argv)
     }
     double t0 = now_s();
     if ((s = obs_reference_render(&scene, &view, &desc, &ao, &depth, err)) != OBS_OK) {
-        rc = fail(s, a.scene, err);
+        rc = cli_input_fail(s, a.scene, err);
         goto done;
     }
     double t = now_s() - t0;
@@ -474,7 +453,7 @@ int cli_reference(int argc, char **argv)
         s = obs_exr_write(a.out, layers, 2, OBS_EXR_FLOAT, &cam, err);
     }
     if (s != OBS_OK) {
-        rc = fail(s, a.out, err);
+        rc = cli_fail(s, a.out, err);
         goto done;
     }
     if (!a.quiet)

@@ -21,13 +21,13 @@
 
 #include "batch.h"
 #include "deep.h"
+#include "cli.h"
 #include "ground.h"
 #include "io.h"
 #include "metrics.h"
 #include "obscura.h"
 #include "remote.h"
 
-enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_BADINPUT = 3 };
 
 static int verbosity = OBS_LOG_INFO;
 
@@ -52,37 +52,6 @@ static void die_usage(const char *fmt, ...)
     fprintf(stderr, "\n(run 'obscura help' for usage)\n");
     va_end(ap);
     exit(EXIT_USAGE);
-}
-
-/* Exit code for a failed status: bad input is permanent (3). */
-static int status_exit(obs_status s)
-{
-    switch (s) {
-    case OBS_BAD_FILE:
-    case OBS_UNSUPPORTED:
-    case OBS_MISSING_CHANNEL:
-    case OBS_TOO_LARGE:
-    case OBS_NO_CAMERA:
-    case OBS_INVALID_ARGUMENT: return EXIT_BADINPUT;
-    default: return EXIT_FAIL;
-    }
-}
-
-static int fail(obs_status s, const char *what, const char *err)
-{
-    const char *msg = err && *err ? err : obs_status_message(s);
-    if (strncmp(msg, what, strlen(what)) == 0) /* the message names it already */
-        fprintf(stderr, "obscura: %s (%s)\n", msg, obs_status_name(s));
-    else
-        fprintf(stderr, "obscura: %s: %s (%s)\n", what, msg, obs_status_name(s));
-    return status_exit(s);
-}
-
-/* A file that cannot be read is bad input too: retrying will not help. */
-static int input_fail(obs_status s, const char *what, const char *err)
-{
-    int rc = fail(s, what, err);
-    return s == OBS_IO ? EXIT_BADINPUT : rc;
 }
 
 static double now_ms(void)
@@ -439,7 +408,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         die_usage("ao: deep input takes the camera from the EXR header or --fov-y");
     double t0 = now_ms();
     if ((s = obs_deep_read_exr(a->in, lim, &d, err)) != OBS_OK)
-        return input_fail(s, a->in, err);
+        return cli_input_fail(s, a->in, err);
     double t_read = now_ms() - t0;
     t0 = now_ms();
     if (a->cpu) {
@@ -451,13 +420,13 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         obs_ctx_desc desc = {.debug = a->debug_gl, .log = log_cb};
         backend_from_args(a->backend, &desc.backend);
         if ((s = obs_ctx_create(&desc, &ctx, err)) != OBS_OK) {
-            rc = fail(s, "OpenGL", err);
+            rc = cli_fail(s, "OpenGL", err);
             goto done;
         }
         s = obs_deep_run(ctx, &d, &a->params, &r, err);
     }
     if (s != OBS_OK) {
-        rc = fail(s, a->in, err);
+        rc = cli_fail(s, a->in, err);
         goto done;
     }
     double t_run = now_ms() - t0;
@@ -488,7 +457,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         }
     }
     if (s != OBS_OK) {
-        rc = fail(s, a->out, err);
+        rc = cli_fail(s, a->out, err);
         goto done;
     }
     if (verbosity >= OBS_LOG_INFO) {
@@ -533,7 +502,7 @@ static int cmd_ao(int argc, char **argv)
     double t0 = now_ms();
     s = obs_gbuffer_read_exr(a.in, &a.map, &lim, &gf, err);
     if (s != OBS_OK)
-        return input_fail(s, a.in, err);
+        return cli_input_fail(s, a.in, err);
     double t_read = now_ms() - t0;
     const obs_exr_info *info = &gf.info;
     if (verbosity >= OBS_LOG_INFO) {
@@ -546,7 +515,7 @@ static int cmd_ao(int argc, char **argv)
         int cw = 0, ch = 0;
         s = obs_camera_read_json(a.camera, &gf.gb.camera, &cw, &ch, err);
         if (s != OBS_OK) {
-            rc = input_fail(s, a.camera, err);
+            rc = cli_input_fail(s, a.camera, err);
             goto done;
         }
         int dw = gf.gb.display_width > 0 ? gf.gb.display_width : gf.gb.width;
@@ -567,7 +536,7 @@ static int cmd_ao(int argc, char **argv)
         backend_from_args(a.backend, &desc.backend);
         s = kept_ctx ? (ctx = kept_ctx, OBS_OK) : obs_ctx_create(&desc, &ctx, err);
         if (s != OBS_OK) {
-            rc = fail(s, "OpenGL", err);
+            rc = cli_fail(s, "OpenGL", err);
             goto done;
         }
         if (verbosity >= OBS_LOG_DEBUG)
@@ -576,7 +545,7 @@ static int cmd_ao(int argc, char **argv)
         s = obs_run(ctx, &gf.gb, &a.params, a.outputs, &res, err);
     }
     if (s != OBS_OK) {
-        rc = fail(s, a.in, err);
+        rc = cli_fail(s, a.in, err);
         goto done;
     }
     double t_run = now_ms() - t0;
@@ -584,7 +553,7 @@ static int cmd_ao(int argc, char **argv)
     t0 = now_ms();
     s = write_outputs(&a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, err);
     if (s != OBS_OK) {
-        rc = fail(s, a.out, err);
+        rc = cli_fail(s, a.out, err);
         goto done;
     }
     if (verbosity >= OBS_LOG_INFO) {
@@ -656,7 +625,7 @@ static int cmd_info(int argc, char **argv)
     verbosity = OBS_LOG_WARN;
     obs_status s = obs_ctx_create(&desc, &ctx, err);
     if (s != OBS_OK)
-        return fail(s, "OpenGL", err);
+        return cli_fail(s, "OpenGL", err);
     obs_ctx_info info;
     obs_ctx_get_info(ctx, &info);
     printf("obscura %s\nbackend: %s\nGL version: %s\nGL vendor: %s\nGL renderer: %s\n", OBS_VERSION,
@@ -726,7 +695,7 @@ static int cmd_samples(int argc, char **argv)
         float xy[64];
         obs_status s = obs_samples_generate(n, xy);
         if (s != OBS_OK)
-            return fail(s, "samples", NULL);
+            return cli_fail(s, "samples", NULL);
         if (c_source)
             printf("    /* %d samples, from pair %d */\n", n, n - 2);
         else
@@ -892,13 +861,13 @@ static int cmd_compare(int argc, char **argv)
     obs_status s;
     int rc = EXIT_OK;
     if (!cha && !(cha = pick_channel(pa, ao_cands, bufa, sizeof bufa, err)))
-        return fail(OBS_MISSING_CHANNEL, pa, err);
+        return cli_fail(OBS_MISSING_CHANNEL, pa, err);
     if (!chb && !(chb = pick_channel(pb, ao_cands, bufb, sizeof bufb, err)))
-        return fail(OBS_MISSING_CHANNEL, pb, err);
+        return cli_fail(OBS_MISSING_CHANNEL, pb, err);
     if ((s = obs_exr_read_channel(pa, cha, NULL, &a, err)) != OBS_OK)
-        return fail(s, pa, err);
+        return cli_fail(s, pa, err);
     if ((s = obs_exr_read_channel(pb, chb, NULL, &b, err)) != OBS_OK) {
-        rc = fail(s, pb, err);
+        rc = cli_fail(s, pb, err);
         goto done;
     }
     if (strcmp(mask_opt, "none") != 0) {
@@ -908,7 +877,7 @@ static int cmd_compare(int argc, char **argv)
             char err2[OBS_ERR_LEN];
             if (mch || load_mask(pb, NULL, &a, &mask, err2) != 0) {
                 if (mch) {
-                    rc = fail(OBS_MISSING_CHANNEL, "--mask", err);
+                    rc = cli_fail(OBS_MISSING_CHANNEL, "--mask", err);
                     goto done;
                 }
                 mask = NULL; /* no depth anywhere: compare every pixel */
@@ -918,7 +887,7 @@ static int cmd_compare(int argc, char **argv)
     obs_metrics m;
     s = obs_metrics_compute(&a, &b, mask, &m, err);
     if (s != OBS_OK) {
-        rc = fail(s, "compare", err);
+        rc = cli_fail(s, "compare", err);
         goto done;
     }
     if (json)
@@ -935,7 +904,7 @@ static int cmd_compare(int argc, char **argv)
             s = write_diff(diff, &a, &b, &d, err);
         obs_image_free(&d);
         if (s != OBS_OK)
-            rc = fail(s, diff, err);
+            rc = cli_fail(s, diff, err);
     }
 done:
     free(mask);

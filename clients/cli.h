@@ -1,0 +1,23 @@
+/* What the CLI's commands share (clients/cli.c): exit codes and how a
+ * failed status is reported. */
+#ifndef OBSCURA_CLIENT_CLI_H
+#define OBSCURA_CLIENT_CLI_H
+
+#include "status.h"
+
+/* Process exit codes of every command: 3 is bad input (retrying will not
+ * help), 1 any other failure. */
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_BADINPUT = 3 };
+
+/* The exit code for a failed status: bad input is 3, the rest 1. */
+int cli_status_exit(obs_status s);
+
+/* Prints "obscura: WHAT: message (STATUS)" (WHAT left out when the message
+ * names it already) and returns cli_status_exit(s). */
+int cli_fail(obs_status s, const char *what, const char *err);
+
+/* The same for reading an input: a file that cannot be read is bad input
+ * too. */
+int cli_input_fail(obs_status s, const char *what, const char *err);
+
+#endif
