@@ -37,4 +37,21 @@ static inline const char *obs_test_tmp(void)
     return s && *s ? s : "/tmp";
 }
 
+/* A path under obs_test_tmp(); with text, the file is written with it.
+ * The last four paths stay valid. */
+static inline const char *obs_test_tmp_file(const char *name, const char *text)
+{
+    static char path[4][512];
+    static int k;
+    char *p = path[k++ & 3];
+    snprintf(p, sizeof path[0], "%s/%s", obs_test_tmp(), name);
+    if (text) {
+        FILE *f = fopen(p, "wb");
+        assert_non_null(f);
+        fputs(text, f);
+        fclose(f);
+    }
+    return p;
+}
+
 #endif

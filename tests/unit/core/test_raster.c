@@ -32,21 +32,6 @@ static int teardown(void **state)
     return 0;
 }
 
-static const char *tmp_file(const char *name, const char *text)
-{
-    static char path[4][512];
-    static int k;
-    char *p = path[k++ & 3];
-    snprintf(p, 512, "%s/%s", obs_test_tmp(), name);
-    if (text) {
-        FILE *f = fopen(p, "wb");
-        assert_non_null(f);
-        fputs(text, f);
-        fclose(f);
-    }
-    return p;
-}
-
 /* A floor (z = 0, 4 x 4 m) and a tilted quad above it, as an OBJ with
  * vertex normals; the floor's winding faces +Z. */
 static const char *const scene_obj =
@@ -92,7 +77,7 @@ static void look_at_camera(obs_camera *cam)
 static void load_test_scene(obs_scene *s)
 {
     char err[OBS_ERR_LEN] = "";
-    if (obs_scene_load(tmp_file("scene.obj", scene_obj), s, err) != OBS_OK)
+    if (obs_scene_load(obs_test_tmp_file("scene.obj", scene_obj), s, err) != OBS_OK)
         fail_msg("%s", err);
     assert_int_equal(s->triangle_count, 4);
     assert_non_null(s->normals);
@@ -119,7 +104,7 @@ static void test_conventions(void **state)
 
     static const char *const nz[] = {"Z"}, *const np[] = {"P.X", "P.Y", "P.Z"};
     obs_exr_layer layers[] = {{&r.depth, nz}, {&r.position, np}};
-    const char *path = tmp_file("raster.exr", NULL);
+    const char *path = obs_test_tmp_file("raster.exr", NULL);
     assert_int_equal(obs_exr_write(path, layers, 2, OBS_EXR_FLOAT, &cam, err), OBS_OK);
     exr_context_t ex;
     exr_attr_m44f_t ndc;
@@ -235,8 +220,8 @@ static void test_backface_albedo_formats(void **state)
     const char *obj = "mtllib back.mtl\nusemtl red\n"
                       "v -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nvn 0 0 -1\n"
                       "f 1//1 4//1 3//1 2//1\n";
-    tmp_file("back.mtl", mtl);
-    if (obs_scene_load(tmp_file("back.obj", obj), &s, err) != OBS_OK)
+    obs_test_tmp_file("back.mtl", mtl);
+    if (obs_scene_load(obs_test_tmp_file("back.obj", obj), &s, err) != OBS_OK)
         fail_msg("%s", err);
     assert_non_null(s.albedo);
     assert_float_equal(s.albedo[0], 0.8f, 1e-6);
@@ -258,10 +243,10 @@ static void test_backface_albedo_formats(void **state)
                       "property float y\nproperty float z\nelement face 1\n"
                       "property list uchar int vertex_indices\nend_header\n"
                       "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
-    assert_int_equal(obs_scene_load(tmp_file("quad.off", off), &s, err), OBS_OK);
+    assert_int_equal(obs_scene_load(obs_test_tmp_file("quad.off", off), &s, err), OBS_OK);
     assert_int_equal(s.triangle_count, 2);
     obs_scene_free(&s);
-    assert_int_equal(obs_scene_load(tmp_file("tri.ply", ply), &s, err), OBS_OK);
+    assert_int_equal(obs_scene_load(obs_test_tmp_file("tri.ply", ply), &s, err), OBS_OK);
     assert_int_equal(s.triangle_count, 1);
     assert_float_equal(fabsf(s.normals[2]), 1.0f, 1e-5);
     obs_scene_free(&s);
@@ -280,7 +265,7 @@ static void test_backface_albedo_formats(void **state)
         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
         "\"min\":[0,0,0],\"max\":[1,1,0]},"
         "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
-    if (obs_scene_load(tmp_file("tri.gltf", gltf), &s, err) != OBS_OK)
+    if (obs_scene_load(obs_test_tmp_file("tri.gltf", gltf), &s, err) != OBS_OK)
         fail_msg("%s", err);
     assert_int_equal(s.triangle_count, 1);
     assert_float_equal(s.bounds_min[2], 1.0f, 0);
@@ -298,11 +283,11 @@ static void test_errors(void **state)
     obs_raster r;
     assert_int_equal(obs_scene_load("tests/data/no-such-mesh.obj", &s, err), OBS_IO);
     assert_non_null(strstr(err, "no-such-mesh.obj"));
-    assert_int_equal(obs_scene_load(tmp_file("junk.ply", "ply\nthis is not a mesh\n"), &s, err),
+    assert_int_equal(obs_scene_load(obs_test_tmp_file("junk.ply", "ply\nthis is not a mesh\n"), &s, err),
                      OBS_BAD_FILE);
-    assert_int_equal(obs_scene_load(tmp_file("empty.obj", "# nothing\nv 0 0 0\n"), &s, err),
+    assert_int_equal(obs_scene_load(obs_test_tmp_file("empty.obj", "# nothing\nv 0 0 0\n"), &s, err),
                      OBS_BAD_FILE);
-    assert_int_equal(obs_scene_load(tmp_file("lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n"), &s, err),
+    assert_int_equal(obs_scene_load(obs_test_tmp_file("lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n"), &s, err),
                      OBS_BAD_FILE);
     assert_non_null(strstr(err, "no triangles"));
     assert_null(s.positions);

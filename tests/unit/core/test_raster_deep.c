@@ -322,27 +322,14 @@ static void test_write_roundtrip(void **state)
 
 /* ---- opacity: specs and materials ------------------------------------------------ */
 
-static const char *write_tmp(const char *name, const char *text)
-{
-    static char path[4][512];
-    static int k;
-    char *p = path[k++ & 3];
-    snprintf(p, 512, "%s/%s", obs_test_tmp(), name);
-    FILE *f = fopen(p, "wb");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-    return p;
-}
-
 static void test_opacity_specs(void **state)
 {
     (void)state;
     char err[OBS_ERR_LEN] = "";
     obs_scene s;
     /* two named objects; the pane's material has d 0.4 (OBJ opacity) */
-    write_tmp("glass.mtl", "newmtl glass\nKd 0.9 0.9 1\nd 0.4\nnewmtl white\nKd 1 1 1\nd 1\n");
-    const char *obj = write_tmp("panes.obj",
+    obs_test_tmp_file("glass.mtl", "newmtl glass\nKd 0.9 0.9 1\nd 0.4\nnewmtl white\nKd 1 1 1\nd 1\n");
+    const char *obj = obs_test_tmp_file("panes.obj",
                                 "mtllib glass.mtl\n"
                                 "o floor\nusemtl white\nv -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\n"
                                 "f 1 2 3 4\n"
@@ -400,7 +387,7 @@ static void test_opacity_specs(void **state)
                  "\"min\":[0,0,0],\"max\":[1,1,0]},"
                  "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
                  blend ? ",\"alphaMode\":\"BLEND\"" : "");
-        if (obs_scene_load(write_tmp("glass.gltf", gltf), &s, err) != OBS_OK)
+        if (obs_scene_load(obs_test_tmp_file("glass.gltf", gltf), &s, err) != OBS_OK)
             fail_msg("%s", err);
         if (blend) {
             assert_non_null(s.opacity);
