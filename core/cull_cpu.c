@@ -33,7 +33,8 @@ void obs__cull_prepass(const obs__frame *f, const float *pos, const float *nrm, 
             size_t k = (size_t)y * (size_t)f->width + (size_t)x;
             est[(size_t)j * (size_t)f->cull_w + (size_t)i] =
                 pos[4 * k + 3] > 0.0f
-                    ? obs__vao_estimate(f, pos, x, y, pos + 4 * k, nrm + 3 * k, OBS__CULL_SAMPLES, xy)
+                    ? obs__vao_estimate(f, pos, nrm, x, y, pos + 4 * k, nrm + 3 * k,
+                                        OBS__CULL_SAMPLES, xy)
                     : 1.0f;
         }
 }

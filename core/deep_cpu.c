@@ -165,13 +165,14 @@ fail:
 }
 
 /* GLSL: node_occlusion() in deep.frag.glsl.  The length of the pipe
- * [front, front + 2h] (depths) hidden by a node at planar depth zs: the
- * cases A, B, C of VAO++ section 3 with the node as the depth buffer, and
- * the depth range check (section 4.4, eq 4) when the node lies in front of
+ * [front, front + 2h] (depths) hidden by a node at planar depth zs with
+ * view normal z nz: the cases A, B, C of VAO++ section 3 with the node as
+ * the depth buffer, and the depth range check (section 4.4, eq 4) when the node lies in front of
  * the pipe.  With `interior` (the sphere on the back side of a thin hull,
  * OITAO eqs 2-4) a node in front of the pipe is on the hull's exterior
  * side and hides nothing of the interior. */
-static float node_occlusion(const obs__frame *f, float zs, float front, float h, int interior)
+static float node_occlusion(const obs__frame *f, float zs, float nz, float front, float h,
+                            int interior)
 {
     if (!(zs > 0.0f))
         return 0.0f; /* empty node */
@@ -180,8 +181,7 @@ static float node_occlusion(const obs__frame *f, float zs, float front, float h,
         if (interior)
             return 0.0f;
         if (f->range_check) {
-            float d = front - zs;
-            float sd = f->range_u / fmaxf(f->range_u, d / f->radius);
+            float sd = obs__range_falloff(f, front - zs, nz);
             dz = 2.0f * h * (1.0f - sd);
         }
     }
@@ -216,8 +216,8 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         float front = -c[2] - h, occ = 0.0f;
         for (int k = 0; k < layers; k++) {
             const float *pk = df->pos + ((size_t)k * npx + q) * 4;
-            float a = df->nrm[((size_t)k * npx + q) * 4 + 3];
-            occ = fmaxf(occ, a * node_occlusion(f, pk[3], front, h, interior));
+            const float *nk = df->nrm + ((size_t)k * npx + q) * 4; /* normal, alpha */
+            occ = fmaxf(occ, nk[3] * node_occlusion(f, pk[3], nk[2], front, h, interior));
         }
         open += 2.0f * h - occ;
         F += R * l; /* VAO++ eq 2 */

@@ -184,6 +184,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
     glUniform1i(glGetUniformLocation(prog, "u_range_check"), f->range_check);
     glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
+    glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
     glUniform1i(glGetUniformLocation(prog, "u_m"), df.m);
     glUniform1i(glGetUniformLocation(prog, "u_multi"), df.multi);
     glUniform1i(glGetUniformLocation(prog, "u_thin"), df.thin);

@@ -95,6 +95,7 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     f->adaptive_k = f->viewport[2] / (f->viewport[3] * p->adaptive_diameter * p->adaptive_diameter);
     f->range_check = p->range_check == OBS_ON;
     f->range_u = p->range_u;
+    f->range_normal = p->range_distance == OBS_RANGE_DISTANCE_NORMAL;
     /* Section 4.2: the pre-pass texture has one texel per 8 x 8 block. */
     f->culling = p->culling == OBS_CULLING_GREEDY ? 1 : p->culling == OBS_CULLING_CAREFUL ? 2 : 0;
     f->cull_threshold = 1.0f - p->culling_epsilon;

@@ -62,6 +62,7 @@ typedef struct obs__frame {
     float rot[9][2];        /* (cos, sin) of the 3x3 tile's rotations */
     int range_check;        /* 1: depth range check (section 4.4, eq 4) */
     float range_u;          /* u of eq 4 */
+    int range_normal;       /* 1: eq 4's d along the occluder's normal (range_distance) */
     int culling;            /* section 4.2: 0 off, 1 greedy, 2 careful */
     float cull_threshold;   /* an estimate below this shows occlusion: 1 - culling_epsilon */
     int cull_w, cull_h;     /* the low-resolution texture: ceil(width / 8) x ceil(height / 8) */
@@ -113,10 +114,11 @@ void obs__prep_normal(const obs__frame *f, const float *pos, const float *in_nor
 int obs__adaptive_count(const obs__frame *f, const float c[3]);
 
 /* Volumetric AO of the point p with normal n at pixel (x, y), eq 1 and 2
- * of VAO++ section 3; `pos` is the prep pass's position plane.  The count
- * of samples taken goes to *count when count is not NULL. */
-float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                     const float n[3], int *count);
+ * of VAO++ section 3; `pos` and `nrm` are the prep pass's position and
+ * view normal planes (4 and 3 floats per pixel).  The count of samples
+ * taken goes to *count when count is not NULL. */
+float obs__vao_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                     const float p[3], const float n[3], int *count);
 
 /* The sample count pixel (x, y) takes without culling: the samples
  * parameter, or the adaptive count (section 4.1) of its tangent sphere. */
@@ -124,8 +126,8 @@ int obs__vao_count(const obs__frame *f, const float p[3], const float n[3]);
 
 /* The volumetric AO estimator of obs__vao_pixel with an explicit set:
  * the ns samples at xy (GLSL: vao_estimate() in vao.glsl). */
-float obs__vao_estimate(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                        const float n[3], int ns, const float *xy);
+float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                        const float p[3], const float n[3], int ns, const float *xy);
 
 /* Culling pre-pass, VAO++ section 4.2 (GLSL: cull.frag.glsl), CPU twin
  * in cull_cpu.c.  The low-resolution AO: texel (i, j) of cull_w x cull_h
@@ -146,9 +148,9 @@ int obs__cull_candidate(const obs__frame *f, const float *est, int x, int y);
  * f->bleed_step > 0, bleed gets the mean over every bleed_step-th sample
  * of white mixed towards the colour at the sample's pixel by c(x); else
  * (1, 1, 1).  col: 4 floats (RGBA) per pixel; NULL: no bleeding. */
-float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *col, int x,
-                              int y, const float p[3], const float n[3], int ns, const float *xy,
-                              float bleed[3]);
+float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *nrm,
+                              const float *col, int x, int y, const float p[3], const float n[3],
+                              int ns, const float *xy, float bleed[3]);
 
 /* Eq 5 of VAO++ section 4.7 (GLSL: bleed_weight() in vao.glsl): the
  * indirect contribution c(x) of the surface point x to the point p with
@@ -170,6 +172,13 @@ float obs__blur_pixel(const obs__frame *f, const float *pos, const float *ao, in
                       int dy);
 
 /* ---- comparison methods (parameter `method`) ----------------------------- */
+
+/* The depth range check's falloff (VAO++ 4.4, eq 4): s(d) = u / max(u,
+ * d / R) for a pipe d behind its occluder along view Z; with
+ * f->range_normal, d |nz|, the pipe's depth below the occluding surface
+ * whose view normal has z component nz (GLSL: range_falloff() in
+ * common.glsl). */
+float obs__range_falloff(const obs__frame *f, float d, float nz);
 
 /* The pixel whose planes hold the view-space point s: 1 and (qx, qy) when s
  * projects into the image in front of the camera, else 0 (GLSL:

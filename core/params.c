@@ -232,6 +232,8 @@ static const struct {
     {offsetof(obs_params, range_check), M(VAOPP), OBS_OFF,
      "the depth range check is VAO++'s (4.4, eq 4)"},
     {offsetof(obs_params, range_u), M(VAOPP), 0, "the depth range check is VAO++'s (4.4, eq 4)"},
+    {offsetof(obs_params, range_distance), M(VAOPP), 0,
+     "the depth range check is VAO++'s (4.4, eq 4)"},
     {offsetof(obs_params, bleeding), M(VAOPP) | M(VAO), OBS_BLEEDING_OFF,
      "colour bleeding (4.7) gathers the colour at the VAO samples"},
     {offsetof(obs_params, hemisphere_samples), M(HEMISPHERE), 0, "it is method hemisphere's"},

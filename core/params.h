@@ -39,6 +39,14 @@ typedef enum obs_culling {
     OBS_CULLING_CAREFUL  /* culling candidates take the 4-sample set */
 } obs_culling;
 
+/* How the depth range check (VAO++ 4.4, eq 4) measures d (parameter
+ * `range_distance`). */
+typedef enum obs_range_distance {
+    OBS_RANGE_DISTANCE_DEFAULT,
+    OBS_RANGE_DISTANCE_NORMAL, /* below the occluding surface, along its normal */
+    OBS_RANGE_DISTANCE_VIEW    /* behind the visible surface, along view Z */
+} obs_range_distance;
+
 /* Luminance sensitivity, VAO++ section 4.3 (parameter `luminance`). */
 typedef enum obs_luminance {
     OBS_LUMINANCE_DEFAULT,
@@ -149,6 +157,13 @@ typedef enum obs_normal_space {
     X(range_u, FLOAT, 0.03, 1e-4, 1.0, NULL,                                   \
       "u of the depth range check's falloff (eq 4): occluders are taken as "   \
       "fully thick up to u * R behind the visible surface")                    \
+    X(range_distance, ENUM, "normal", 0, 0, "normal|view",                     \
+      "how the depth range check measures eq 4's d, the distance of a pipe "  \
+      "behind its occluder: normal: the pipe's depth below the occluding "     \
+      "surface, along that surface's normal (d along view Z times |n.z| of "  \
+      "the surface seen at the sample's pixel), the thickness of a flat "      \
+      "occluder; view: along view Z (a floor seen at a grazing angle then "    \
+      "counts as thin as a sheet facing the camera)")                          \
     X(blur, ENUM, "on", 0, 0, "on|off",                                        \
       "low-pass filter (VAO++ 4.6): depth-aware cross-bilateral Gaussian "     \
       "blur of the AO, a horizontal then a vertical pass; neighbours whose "   \

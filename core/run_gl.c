@@ -205,6 +205,7 @@ static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
     glUniform1i(glGetUniformLocation(prog, "u_range_check"), f->range_check);
     glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
+    glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
 }
 
 /* Selects the AO program of a comparison method (hemisphere, angle,

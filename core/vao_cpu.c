@@ -188,8 +188,8 @@ int obs__vao_count(const obs__frame *f, const float p[3], const float n[3])
     return obs__adaptive_count(f, c);
 }
 
-float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                     const float n[3], int *count)
+float obs__vao_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                     const float p[3], const float n[3], int *count)
 {
     /* Section 4.1: the set of the pixel's count, found in the one table of
      * all sets by its offset (the shader's single uniform array). */
@@ -197,21 +197,29 @@ float obs__vao_pixel(const obs__frame *f, const float *pos, int x, int y, const 
     if (count)
         *count = ns;
     const float *xy = f->adaptive ? f->sample_table + 2 * (ns - 2) : f->sample_xy;
-    return obs__vao_estimate(f, pos, x, y, p, n, ns, xy);
+    return obs__vao_estimate(f, pos, nrm, x, y, p, n, ns, xy);
+}
+
+/* GLSL: range_falloff() in common.glsl */
+float obs__range_falloff(const obs__frame *f, float d, float nz)
+{
+    if (f->range_normal)
+        d *= fabsf(nz); /* the pipe's depth below the flat occluder */
+    return f->range_u / fmaxf(f->range_u, d / f->radius); /* eq 4 */
 }
 
 /* GLSL: vao_estimate() in vao.glsl, without colour bleeding */
-float obs__vao_estimate(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                        const float n[3], int ns, const float *xy)
+float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                        const float p[3], const float n[3], int ns, const float *xy)
 {
     float bleed[3];
-    return obs__vao_estimate_bleed(f, pos, NULL, x, y, p, n, ns, xy, bleed);
+    return obs__vao_estimate_bleed(f, pos, nrm, NULL, x, y, p, n, ns, xy, bleed);
 }
 
 /* GLSL: vao_estimate() in vao.glsl */
-float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *col, int x,
-                              int y, const float p[3], const float n[3], int ns, const float *xy,
-                              float bleed[3])
+float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *nrm,
+                              const float *col, int x, int y, const float p[3], const float n[3],
+                              int ns, const float *xy, float bleed[3])
 {
     const float R = f->radius, r = 0.5f * f->radius;
     /* Centre of the tangent sphere of radius R/2, moved along the normal. */
@@ -235,6 +243,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         float s[3] = {c[0] + r * (rot[0] * sx - rot[1] * sy), c[1] + r * (rot[1] * sx + rot[0] * sy),
                       c[2]};
         float zs = INFINITY; /* scene depth at the sample's pixel */
+        float nz = 1.0f; /* view normal z of the surface there */
         int qx, qy;
         seen = obs__view_to_px(f, s, &qx, &qy);
         if (seen) {
@@ -242,6 +251,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
             float d = pos[4 * k + 3];
             if (d > 0.0f) {
                 zs = d;
+                nz = nrm[3 * k + 2];
                 if (bleeds) { /* eq 5 with x the surface point at the sample's pixel */
                     c5 = obs__bleed_weight(pos + 4 * k, p, n, R);
                     cx5 = col + 4 * k;
@@ -266,8 +276,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
              * the pipe's weight 2h counts as occluded times s(d).  d is
              * taken from the pipe's near end, so s = 1 where case C meets
              * case A (zs = front) and the two join without a step. */
-            float d = front - zs;
-            float sd = f->range_u / fmaxf(f->range_u, d / R);
+            float sd = obs__range_falloff(f, front - zs, nz);
             dz = 2.0f * h * (1.0f - sd);
         }
         /* A sample off the planes (or behind the camera) says nothing
@@ -421,13 +430,13 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
                     /* section 4.1: the set of the pixel's count */
                     n = obs__vao_count(&f, pos + 4 * i, nrm + 3 * i);
                     const float *xy = f.adaptive ? f.sample_table + 2 * (n - 2) : f.sample_xy;
-                    ao[i] = obs__vao_estimate_bleed(&f, pos, col, x, y, pos + 4 * i, nrm + 3 * i,
-                                                    n, xy, b);
+                    ao[i] = obs__vao_estimate_bleed(&f, pos, nrm, col, x, y, pos + 4 * i,
+                                                    nrm + 3 * i, n, xy, b);
                 } else if (f.culling == 2) {
                     n = obs__vao_count(&f, pos + 4 * i, nrm + 3 * i);
                     n = n < OBS__CULL_CAREFUL ? n : OBS__CULL_CAREFUL;
-                    ao[i] = obs__vao_estimate_bleed(&f, pos, col, x, y, pos + 4 * i, nrm + 3 * i,
-                                                    n, f.sample_table + 2 * (n - 2), b);
+                    ao[i] = obs__vao_estimate_bleed(&f, pos, nrm, col, x, y, pos + 4 * i,
+                                                    nrm + 3 * i, n, f.sample_table + 2 * (n - 2), b);
                 }
             }
             if (count)

@@ -82,6 +82,21 @@ bool view_to_px(vec3 s, ivec2 size, out ivec2 q)
     return true;
 }
 
+// The depth range check's falloff, VAO++ section 4.4, eq 4:
+// s(d) = u / max(u, d / R), the weight of a pipe's occlusion when it lies
+// d behind the surface that hides it ("we assume they are flat and their
+// thickness gradually decreases").  d comes in along view Z, the
+// direction of the pipes (eq 1's dz); along_normal != 0 turns it into the
+// pipe's depth below that flat surface, d |n.z| with nz the surface's view
+// normal z, so a floor seen at a grazing angle is as thick as one seen
+// from above.  C twin: obs__range_falloff.
+float range_falloff(float d, float nz, float R, float u, int along_normal)
+{
+    if (along_normal != 0)
+        d *= abs(nz);
+    return u / max(u, d / R);
+}
+
 // Tangent frame of n (Duff et al., "Building an orthonormal basis,
 // revisited", 2017): t1, t2, n orthonormal.  C twin: obs__hemisphere_basis.
 void tangent_basis(vec3 n, out vec3 t1, out vec3 t2)

@@ -22,6 +22,7 @@ uniform vec2 u_samples[32];     // the set of section 4.5
 uniform vec2 u_rot[9];          // (cos, sin) of the 3x3 tile's rotations
 uniform int u_range_check;      // 1: depth range check (VAO++ 4.4, eq 4)
 uniform float u_range_u;        // u of eq 4
+uniform int u_range_normal;     // 1: eq 4's d along the node's normal (range_distance)
 uniform int u_hemisphere;       // 1: method hemisphere's point samples; 0: VAO's line samples
 uniform int u_hs_count;         // method hemisphere: samples
 uniform float u_hs_bias;        // occluders must be this far in front (depth units)
@@ -30,10 +31,11 @@ uniform float u_hs_kernel[192]; // unit hemisphere around +z, (x, y, z) per samp
 layout(location = 0) out vec4 o_ao; // (front node's AO, blended AO, 0, 1)
 
 // The length of the pipe [front, front + 2h] hidden by a node at planar
-// depth zs: VAO++ section 3's cases with the node as the depth buffer, eq
-// 4's falloff when it lies in front.  interior: a node in front of the
-// pipe is on a thin hull's exterior side (eqs 2-4) and hides nothing.
-float node_occlusion(float zs, float front, float h, bool interior)
+// depth zs with view normal z nz: VAO++ section 3's cases with the node as
+// the depth buffer, eq 4's falloff when it lies in front.  interior: a
+// node in front of the pipe is on a thin hull's exterior side (eqs 2-4)
+// and hides nothing.
+float node_occlusion(float zs, float nz, float front, float h, bool interior)
 {
     if (!(zs > 0.0))
         return 0.0;
@@ -42,8 +44,7 @@ float node_occlusion(float zs, float front, float h, bool interior)
         if (interior)
             return 0.0;
         if (u_range_check != 0) {
-            float d = front - zs;
-            float sd = u_range_u / max(u_range_u, d / u_radius);
+            float sd = range_falloff(front - zs, nz, u_radius, u_range_u, u_range_normal);
             dz = 2.0 * h * (1.0 - sd);
         }
     }
@@ -71,8 +72,8 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
         float front = -c.z - h, occ = 0.0;
         for (int k = 0; k < layers; k++) {
             float zs = texelFetch(u_lpos, ivec3(q, k), 0).w;
-            float a = texelFetch(u_lnrm, ivec3(q, k), 0).w;
-            occ = max(occ, a * node_occlusion(zs, front, h, interior));
+            vec4 nk = texelFetch(u_lnrm, ivec3(q, k), 0);   // normal, alpha
+            occ = max(occ, nk.w * node_occlusion(zs, nk.z, front, h, interior));
         }
         open += 2.0 * h - occ;
         F += R * l;

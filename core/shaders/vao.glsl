@@ -14,6 +14,7 @@ uniform vec2 u_samples[62];      // all sets of section 4.5 (core/sample_tables.
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
 uniform int u_range_check;       // 1: depth range check (section 4.4, eq 4)
 uniform float u_range_u;         // u of eq 4
+uniform int u_range_normal;      // 1: eq 4's d along the occluder's normal (range_distance)
 uniform sampler2D u_color;       // G-buffer colour (section 4.7)
 
 // Colour bleeding, section 4.7, eq 5:
@@ -89,8 +90,8 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             // s(d) = u / max(u, d / radius), d behind the visible surface,
             // measured from the pipe's near end (s = 1 where case C meets
             // case A); the occluded weight 2h is multiplied by s(d).
-            float d = front - zs;
-            float sd = u_range_u / max(u_range_u, d / R);
+            float nz = u_range_normal != 0 ? texelFetch(u_vnormal, q, 0).z : 1.0;
+            float sd = range_falloff(front - zs, nz, R, u_range_u, u_range_normal);
             dz = 2.0 * h * (1.0 - sd);
         }
         // A sample off the planes (or behind the camera) is left out of

@@ -32,6 +32,7 @@ static void test_gl_matches_cpu(void **state)
         static const char *const variants[][2][2] = {
             {{NULL, NULL}, {NULL, NULL}},
             {{"blur_radius", "7"}, {"range_check", "off"}},
+            {{"range_distance", "view"}, {"blur", "off"}},
             {{"blur", "off"}, {NULL, NULL}},
             {{"adaptive_diameter", "0.04"}, {"samples", "32"}},
             {{"adaptive", "off"}, {NULL, NULL}},

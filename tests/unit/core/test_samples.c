@@ -191,7 +191,7 @@ static float *frame_ao(const obs_gbuffer *gb, int n, const float *xy)
         for (int x = 0; x < f.width; x++) {
             size_t i = (size_t)y * f.width + x;
             ao[i] = pos[4 * i + 3] > 0.0f
-                        ? obs__vao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, NULL)
+                        ? obs__vao_pixel(&f, pos, nrm, x, y, pos + 4 * i, nrm + 3 * i, NULL)
                         : 1.0f;
         }
     obs__blur(&f, pos, ao, tmp);

@@ -270,9 +270,9 @@ static void test_inner_corner(void **state)
         for (int k = 0; k < 9; k++) { /* every rotation of the 3x3 tile */
             int x = W / 2 + k / 3, y = H / 2 + k % 3;
             const float corner[3] = {0.0f, -0.5f, -5.0f};
-            assert_float_equal(obs__vao_pixel(&f, pos, x, y, corner, floor_n, NULL), 0.5f, 1e-5f);
+            assert_float_equal(obs__vao_pixel(&f, pos, s->normal, x, y, corner, floor_n, NULL), 0.5f, 1e-5f);
             const float near[3] = {0.0f, -0.5f, -5.0f + e};
-            assert_float_equal(obs__vao_pixel(&f, pos, x, y, near, floor_n, NULL),
+            assert_float_equal(obs__vao_pixel(&f, pos, s->normal, x, y, near, floor_n, NULL),
                                (float)(0.5 + n * e / F), 1e-5f);
         }
         free(pos);
@@ -345,7 +345,11 @@ static void test_corner_scene(void **state)
  * [dc - h_i, dc + h_i] around the sphere centre dc = z_P - R/2, so it lies
  * d_i = D - R/2 - h_i behind the surface (case C).  Without the check every
  * pipe is closed: V = 0.  With it, pipe i is occluded by s(d_i) of its
- * length: V = sum 2 h_i (1 - s(d_i)) / F, s(d) = u / max(u, d / R). */
+ * length: V = sum 2 h_i (1 - s(d_i)) / F, s(d) = u / max(u, d / R).
+ * Passes 3 and 4 give the occluder's normal plane a tilt of 60 degrees
+ * (n.z = 1/2; the depths stay those of the plane facing the camera):
+ * range_distance normal measures d along that normal, d_i / 2, and view
+ * along view Z, d_i, which the normal plane does not change. */
 static void test_range_check_closed_form(void **state)
 {
     scene *s = malloc(sizeof *s);
@@ -355,8 +359,14 @@ static void test_range_check_closed_form(void **state)
     plane front = {{0, 0, 1}, -4.0f}; /* the occluder, at depth 4 */
     render(s, P, &front, 1);
     const float n_cam[3] = {0, 0, 1};
+    float *tilted = malloc(sizeof(float) * 3 * W * H);
+    for (int i = 0; i < W * H; i++) {
+        tilted[3 * i] = 0.0f;
+        tilted[3 * i + 1] = sqrtf(3.0f) / 2.0f;
+        tilted[3 * i + 2] = 0.5f;
+    }
 
-    for (int pass = 0; pass < 3; pass++) {
+    for (int pass = 0; pass < 5; pass++) {
         obs_params p = camera_normals(16), rp;
         char err[OBS_ERR_LEN];
         /* R = 0.5 (the occluder depths below are chosen for it): radius is
@@ -366,6 +376,10 @@ static void test_range_check_closed_form(void **state)
             obs_param_set(&p, "range_check", "off", err);
         if (pass == 2)
             p.range_u = 0.2f;
+        if (pass == 4)
+            obs_param_set(&p, "range_distance", "view", err);
+        const float *nrm = pass >= 3 ? tilted : s->normal;
+        float along = pass == 3 ? 0.5f : 1.0f; /* |n.z| when d is taken along the normal */
         obs__frame f;
         obs_params_resolve(&p, &rp);
         assert_int_equal(obs__frame_setup(NULL, &s->gb, &rp, &f, err), OBS_OK);
@@ -380,13 +394,13 @@ static void test_range_check_closed_form(void **state)
             for (int i = 0; i < f.samples; i++) {
                 float sx = f.sample_xy[2 * i], sy = f.sample_xy[2 * i + 1];
                 float l = sqrtf(1 - sx * sx - sy * sy), h = 0.5f * R * l;
-                float d = D - 0.5f * R - h;
+                float d = (D - 0.5f * R - h) * along;
                 F += R * l; /* eq 2 */
                 float sd = u / fmaxf(u, d / R); /* eq 4 */
                 open += f.range_check ? 2 * h * (1 - sd) : 0.0;
             }
             const float pt[3] = {0.0f, 0.0f, -4.0f - D};
-            float v = obs__vao_pixel(&f, pos, W / 2, H / 2, pt, n_cam, NULL);
+            float v = obs__vao_pixel(&f, pos, nrm, W / 2, H / 2, pt, n_cam, NULL);
             assert_float_equal(v, (float)(open / F), 1e-5f);
             if (pass == 1)
                 assert_float_equal(v, 0.0f, 0.0f);
@@ -395,6 +409,7 @@ static void test_range_check_closed_form(void **state)
         }
         free(pos);
     }
+    free(tilted);
     free(s);
 }
 
