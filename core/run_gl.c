@@ -9,22 +9,30 @@
 #include "obs_shaders.h"
 
 static const char glsl_version[] = "#version 430 core\n";
+/* vao.glsl's colour bleeding (section 4.7) is compiled in or out: a
+ * uniform branch does not skip its body on a SIMD rasteriser such as
+ * llvmpipe, and the bleed code cost the AO pass a third of its time with
+ * bleeding off (bench/RESULTS.md). */
+static const char bleed_off[] = "#define OBS_BLEED 0\n";
+static const char bleed_on[] = "#define OBS_BLEED 1\n";
 
 static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
 {
     if (ctx->prog.prep)
         return OBS_OK;
     const char *prep[] = {glsl_version, obs__shader_common, obs__shader_prep_frag};
-    const char *vao[] = {glsl_version, obs__shader_common, obs__shader_vao, obs__shader_vao_frag};
-    const char *cull[] = {glsl_version, obs__shader_common, obs__shader_vao, obs__shader_cull_frag};
+    const char *vao[] = {glsl_version, bleed_off, obs__shader_common, obs__shader_vao,
+                         obs__shader_vao_frag};
+    const char *cull[] = {glsl_version, bleed_off, obs__shader_common, obs__shader_vao,
+                          obs__shader_cull_frag};
     const char *blur[] = {glsl_version, obs__shader_common, obs__shader_blur_frag};
     const char *comp[] = {glsl_version, obs__shader_composite_frag};
     const char *lum[] = {glsl_version, obs__shader_luminance_frag};
     obs_status s = obs__gl_program("prep", obs__shader_fullscreen_vert, prep, 3, &ctx->prog.prep, err);
     if (s == OBS_OK)
-        s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 4, &ctx->prog.vao, err);
+        s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 5, &ctx->prog.vao, err);
     if (s == OBS_OK)
-        s = obs__gl_program("cull", obs__shader_fullscreen_vert, cull, 4, &ctx->prog.cull, err);
+        s = obs__gl_program("cull", obs__shader_fullscreen_vert, cull, 5, &ctx->prog.cull, err);
     if (s == OBS_OK)
         s = obs__gl_program("blur", obs__shader_fullscreen_vert, blur, 3, &ctx->prog.blur, err);
     if (s == OBS_OK)
@@ -34,6 +42,17 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
         s = obs__gl_program("luminance", obs__shader_fullscreen_vert, lum, 2, &ctx->prog.luminance,
                             err);
     return s;
+}
+
+/* The AO pass with colour bleeding compiled in, built on its first use. */
+static obs_status build_bleed_program(obs_ctx *ctx, char err[OBS_ERR_LEN])
+{
+    if (ctx->prog.vao_bleed)
+        return OBS_OK;
+    const char *src[] = {glsl_version, bleed_on, obs__shader_common, obs__shader_vao,
+                         obs__shader_vao_frag};
+    return obs__gl_program("vao (bleeding)", obs__shader_fullscreen_vert, src, 5,
+                           &ctx->prog.vao_bleed, err);
 }
 
 /* The AO program of a comparison method (parameter method), built on its
@@ -95,6 +114,8 @@ void obs__frame_release(obs_ctx *ctx)
         glDeleteProgram(ctx->prog.prep);
     if (ctx->prog.vao)
         glDeleteProgram(ctx->prog.vao);
+    if (ctx->prog.vao_bleed)
+        glDeleteProgram(ctx->prog.vao_bleed);
     if (ctx->prog.cull)
         glDeleteProgram(ctx->prog.cull);
     if (ctx->prog.blur)
@@ -344,6 +365,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     s = build_programs(ctx, err);
     if (s == OBS_OK)
         s = build_method_program(ctx, f.method, err);
+    if (s == OBS_OK && f.bleed_step)
+        s = build_bleed_program(ctx, err);
     if (s != OBS_OK)
         return s;
     s = ensure_targets(ctx, f.width, f.height, err);
@@ -394,7 +417,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     if (f.method > OBS_METHOD_VAO) { /* a comparison method in place of VAO */
         prog = use_method_program(ctx, &f, t);
     } else {
-        prog = ctx->prog.vao;
+        prog = f.bleed_step ? ctx->prog.vao_bleed : ctx->prog.vao;
         glUseProgram(prog);
         set_common(prog, &f);
         set_vao(prog, &f, t);

@@ -184,6 +184,7 @@ obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 
 typedef struct obs__programs {
     GLuint prep, vao, cull, blur, composite, luminance;
+    GLuint vao_bleed; /* the AO pass with colour bleeding (OBS_BLEED 1; built on first use) */
     GLuint method[3]; /* parameter method: hemisphere, angle, hbao (built on first use) */
 } obs__programs;
 

@@ -51,7 +51,9 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
     for (int i = 0; i < ns; i++) {
         // Section 4.7: "every second or fourth sample"; the sets are
         // z-ordered, so those still cover the disk evenly.
-        bool bleeds = bleed_step > 0 && i % bleed_step == 0;
+        // OBS_BLEED (0 or 1) is defined by the program: with 0 the bleed
+        // code below is compiled out.
+        bool bleeds = OBS_BLEED != 0 && bleed_step > 0 && i % bleed_step == 0;
         float c5 = 0.0;         // eq 5's c(x); 0 (white) without a surface there
         bool hit = false;
         ivec2 q = ivec2(0);
