@@ -167,8 +167,8 @@ fail:
 /* GLSL: node_occlusion() in deep.frag.glsl.  The length of the pipe
  * [front, front + 2h] (depths) hidden by a node at planar depth zs with
  * view normal z nz: the cases A, B, C of VAO++ section 3 with the node as
- * the depth buffer, and the depth range check (section 4.4, eq 4) when the node lies in front of
- * the pipe.  With `interior` (the sphere on the back side of a thin hull,
+ * the depth buffer, and the depth range check (section 4.4, eq 4,
+ * obs__range_falloff) when the node lies in front of the pipe.  With `interior` (the sphere on the back side of a thin hull,
  * OITAO eqs 2-4) a node in front of the pipe is on the hull's exterior
  * side and hides nothing of the interior. */
 static float node_occlusion(const obs__frame *f, float zs, float nz, float front, float h,

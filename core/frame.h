@@ -129,6 +129,13 @@ int obs__vao_count(const obs__frame *f, const float p[3], const float n[3]);
 float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         const float p[3], const float n[3], int ns, const float *xy);
 
+/* The depth range check's falloff (VAO++ 4.4, eq 4): s(d) = u / max(u,
+ * d / R) for a pipe d behind its occluder along view Z; with
+ * f->range_normal, d |nz|, the pipe's depth below the occluding surface
+ * whose view normal has z component nz (GLSL: range_falloff() in
+ * common.glsl). */
+float obs__range_falloff(const obs__frame *f, float d, float nz);
+
 /* Culling pre-pass, VAO++ section 4.2 (GLSL: cull.frag.glsl), CPU twin
  * in cull_cpu.c.  The low-resolution AO: texel (i, j) of cull_w x cull_h
  * (written to est) is the 8-sample AO of the pixel at the block's centre,
@@ -172,13 +179,6 @@ float obs__blur_pixel(const obs__frame *f, const float *pos, const float *ao, in
                       int dy);
 
 /* ---- comparison methods (parameter `method`) ----------------------------- */
-
-/* The depth range check's falloff (VAO++ 4.4, eq 4): s(d) = u / max(u,
- * d / R) for a pipe d behind its occluder along view Z; with
- * f->range_normal, d |nz|, the pipe's depth below the occluding surface
- * whose view normal has z component nz (GLSL: range_falloff() in
- * common.glsl). */
-float obs__range_falloff(const obs__frame *f, float d, float nz);
 
 /* The pixel whose planes hold the view-space point s: 1 and (qx, qy) when s
  * projects into the image in front of the camera, else 0 (GLSL:

@@ -435,8 +435,9 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
                 } else if (f.culling == 2) {
                     n = obs__vao_count(&f, pos + 4 * i, nrm + 3 * i);
                     n = n < OBS__CULL_CAREFUL ? n : OBS__CULL_CAREFUL;
+                    const float *xy = f.sample_table + 2 * (n - 2);
                     ao[i] = obs__vao_estimate_bleed(&f, pos, nrm, col, x, y, pos + 4 * i,
-                                                    nrm + 3 * i, n, f.sample_table + 2 * (n - 2), b);
+                                                    nrm + 3 * i, n, xy, b);
                 }
             }
             if (count)

@@ -270,7 +270,8 @@ static void test_inner_corner(void **state)
         for (int k = 0; k < 9; k++) { /* every rotation of the 3x3 tile */
             int x = W / 2 + k / 3, y = H / 2 + k % 3;
             const float corner[3] = {0.0f, -0.5f, -5.0f};
-            assert_float_equal(obs__vao_pixel(&f, pos, s->normal, x, y, corner, floor_n, NULL), 0.5f, 1e-5f);
+            assert_float_equal(obs__vao_pixel(&f, pos, s->normal, x, y, corner, floor_n, NULL),
+                               0.5f, 1e-5f);
             const float near[3] = {0.0f, -0.5f, -5.0f + e};
             assert_float_equal(obs__vao_pixel(&f, pos, s->normal, x, y, near, floor_n, NULL),
                                (float)(0.5 + n * e / F), 1e-5f);
