@@ -103,7 +103,7 @@ static obs_status make_fbo(obs_ctx *ctx, GLuint *fbo, const GLuint *tex, int cou
 void obs__frame_release(obs_ctx *ctx)
 {
     obs__targets *t = &ctx->tg;
-    GLuint tex[] = {t->tex_depth, t->tex_normal,    t->tex_color, t->tex_viewpos, t->tex_vnormal,
+    GLuint tex[] = {t->tex_depth, t->tex_normal,    t->tex_color, t->tex_viewpos, t->tex_vnormal, t->tex_dz,
                     t->tex_ao,    t->tex_composite, t->tex_blur,  t->tex_count,
                     t->tex_cull,  t->tex_cullmask, t->tex_bleed, t->tex_lumfactor};
     GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao, t->fbo_cull};
@@ -147,6 +147,7 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     t->tex_color = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_viewpos = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_vnormal = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_dz = make_texture(ctx, GL_RG32F, w, h);
     t->tex_ao = make_texture(ctx, GL_R32F, w, h);
     t->tex_composite = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_blur = make_texture(ctx, GL_R32F, w, h);
@@ -160,10 +161,10 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
                                (h + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    GLuint prep[] = {t->tex_viewpos, t->tex_vnormal};
+    GLuint prep[] = {t->tex_viewpos, t->tex_vnormal, t->tex_dz};
     GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask, t->tex_bleed};
     GLuint blur[] = {t->tex_blur, t->tex_lumfactor};
-    obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 2, "prep", err);
+    obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 3, "prep", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_vao, vao, 4, "vao", err);
     if (s == OBS_OK)
@@ -220,6 +221,7 @@ static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
 {
     bind_tex(prog, "u_pos", 0, t->tex_viewpos);
     bind_tex(prog, "u_vnormal", 1, t->tex_vnormal);
+    bind_tex(prog, "u_dz", 4, t->tex_dz);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
     /* section 4.1: all sets in one uniform array, picked by offset */
     glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS__SAMPLE_TABLE_LEN, f->sample_table);
@@ -450,7 +452,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         prog = ctx->prog.blur;
         glUseProgram(prog);
         set_common(prog, &f);
-        bind_tex(prog, "u_pos", 1, t->tex_viewpos);
+        bind_tex(prog, "u_dz", 1, t->tex_dz);
         glUniform1i(glGetUniformLocation(prog, "u_blur_radius"), f.blur_radius);
         glUniform1fv(glGetUniformLocation(prog, "u_blur_w"), f.blur_radius + 1, f.blur_w);
         glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);

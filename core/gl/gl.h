@@ -192,6 +192,7 @@ typedef struct obs__targets {
     int width, height;          /* 0: none allocated yet */
     GLuint tex_depth, tex_normal, tex_color;  /* inputs */
     GLuint tex_viewpos, tex_vnormal;          /* prep outputs */
+    GLuint tex_dz;                            /* prep: planar depth, view normal z (RG) */
     GLuint tex_ao, tex_composite;             /* results */
     GLuint tex_blur;                          /* between the two blur passes */
     GLuint tex_count;                         /* debug: samples per pixel (4.1) */
@@ -199,7 +200,7 @@ typedef struct obs__targets {
     GLuint tex_cullmask;                      /* debug: culling candidates (4.2) */
     GLuint tex_bleed;                         /* colour-bleed term (4.7), RGBA */
     GLuint tex_lumfactor;                     /* debug: factor of eq 3 (4.3) */
-    GLuint fbo_prep, fbo_ao, fbo_composite;
+    GLuint fbo_prep, fbo_ao, fbo_composite;  /* fbo_prep: viewpos + vnormal + dz */
     GLuint fbo_blur;                          /* tex_blur + tex_lumfactor */
     GLuint fbo_vao;                           /* AO pass: tex_ao + tex_count + tex_cullmask + tex_bleed */
     GLuint fbo_cull;                          /* culling pre-pass: tex_cull */

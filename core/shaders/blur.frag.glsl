@@ -5,7 +5,7 @@
 // bleed across depth edges.  C twin: obs__blur_pixel in blur_cpu.c.
 
 uniform sampler2D u_ao;          // AO to filter
-uniform sampler2D u_pos;         // prep: view position, planar depth in w
+uniform sampler2D u_dz;          // prep: planar depth in x
 uniform ivec2 u_size;
 uniform ivec2 u_dir;             // (1, 0) horizontal pass, (0, 1) vertical
 uniform int u_blur_radius;       // half-width in pixels
@@ -18,7 +18,7 @@ void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
     float a = texelFetch(u_ao, px, 0).r;
-    float zc = texelFetch(u_pos, px, 0).w;
+    float zc = texelFetch(u_dz, px, 0).x;
     if (zc <= 0.0) {            // background: nothing to filter
         o_ao = a;
         return;
@@ -28,7 +28,7 @@ void main()
         ivec2 q = px + k * u_dir;
         if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
             continue;
-        float zq = texelFetch(u_pos, q, 0).w;
+        float zq = texelFetch(u_dz, q, 0).x;
         // section 4.6: leave out neighbours over the depth threshold
         if (zq <= 0.0 || abs(zq - zc) > u_radius)
             continue;

@@ -9,6 +9,7 @@ uniform ivec2 u_size;
 
 layout(location = 0) out vec4 o_pos;
 layout(location = 1) out vec4 o_normal;
+layout(location = 2) out vec2 o_dz;     // planar depth and n.z: what the samples read
 
 vec4 position_at(ivec2 p)
 {
@@ -65,4 +66,5 @@ void main()
         n = normalize_safe(n);
     }
     o_normal = vec4(n, 0.0);
+    o_dz = vec2(c.w, n.z);
 }

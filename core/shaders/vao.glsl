@@ -7,6 +7,7 @@
 
 uniform sampler2D u_pos;         // prep: view position, planar depth in w
 uniform sampler2D u_vnormal;     // prep: view normal
+uniform sampler2D u_dz;          // prep: planar depth and view normal z, one fetch per sample
 uniform ivec2 u_size;
 uniform float u_radius;          // R, in depth units
 uniform vec2 u_samples[62];      // all sets of section 4.5 (core/sample_tables.c), the
@@ -64,13 +65,15 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
 
         vec3 s = vec3(c.x + r * (rot.x * sx - rot.y * sy), c.y + r * (rot.y * sx + rot.x * sy), c.z);
         float zs = FAR_AWAY;    // scene depth at the sample's pixel
+        float nz = 1.0;         // view normal z there
         seen = view_to_px(s, u_size, q);
         if (seen) {
-            vec4 xs = texelFetch(u_pos, q, 0);
-            if (xs.w > 0.0) {
-                zs = xs.w;
+            vec2 dq = texelFetch(u_dz, q, 0).xy;
+            if (dq.x > 0.0) {
+                zs = dq.x;
+                nz = dq.y;
                 if (bleeds) {       // eq 5, x the surface point at the sample's pixel
-                    c5 = bleed_weight(xs.xyz, p.xyz, n, R);
+                    c5 = bleed_weight(texelFetch(u_pos, q, 0).xyz, p.xyz, n, R);
                     hit = true;
                 }
             }
@@ -92,7 +95,6 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             // s(d) = u / max(u, d / radius), d behind the visible surface,
             // measured from the pipe's near end (s = 1 where case C meets
             // case A); the occluded weight 2h is multiplied by s(d).
-            float nz = u_range_normal != 0 ? texelFetch(u_vnormal, q, 0).z : 1.0;
             float sd = range_falloff(front - zs, nz, R, u_range_u, u_range_normal);
             dz = 2.0 * h * (1.0 - sd);
         }
