@@ -24,8 +24,8 @@
 #define OBS__CULL_SAMPLES 8
 #define OBS__CULL_CAREFUL 4
 
-/* Largest blur_radius of the parameter table (uniform array size - 1 in
- * blur.frag.glsl). */
+/* Largest blur_radius of the parameter table (one blur program per
+ * radius, BLUR_RADIUS in blur.frag.glsl). */
 #define OBS__MAX_BLUR 16
 
 /* k of R = k * D: the paper's kernel width R (hemisphere radius; the

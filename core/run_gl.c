@@ -1,6 +1,7 @@
 /* obs_run: uploads a G-buffer, runs the passes on the GL context, reads the
  * results back.  Textures and framebuffers are allocated once per
  * resolution and reused for every frame of that size. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -25,7 +26,6 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
                          obs__shader_vao_frag};
     const char *cull[] = {glsl_version, bleed_off, obs__shader_common, obs__shader_vao,
                           obs__shader_cull_frag};
-    const char *blur[] = {glsl_version, obs__shader_common, obs__shader_blur_frag};
     const char *comp[] = {glsl_version, obs__shader_composite_frag};
     const char *lum[] = {glsl_version, obs__shader_luminance_frag};
     obs_status s = obs__gl_program("prep", obs__shader_fullscreen_vert, prep, 3, &ctx->prog.prep, err);
@@ -33,8 +33,6 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
         s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 5, &ctx->prog.vao, err);
     if (s == OBS_OK)
         s = obs__gl_program("cull", obs__shader_fullscreen_vert, cull, 5, &ctx->prog.cull, err);
-    if (s == OBS_OK)
-        s = obs__gl_program("blur", obs__shader_fullscreen_vert, blur, 3, &ctx->prog.blur, err);
     if (s == OBS_OK)
         s = obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2, &ctx->prog.composite,
                             err);
@@ -53,6 +51,19 @@ static obs_status build_bleed_program(obs_ctx *ctx, char err[OBS_ERR_LEN])
                          obs__shader_vao_frag};
     return obs__gl_program("vao (bleeding)", obs__shader_fullscreen_vert, src, 5,
                            &ctx->prog.vao_bleed, err);
+}
+
+/* The blur of half-width radius (section 4.6), built on its first use:
+ * the radius is a compile-time constant, so the taps' loop is unrolled. */
+static obs_status build_blur_program(obs_ctx *ctx, int radius, char err[OBS_ERR_LEN])
+{
+    if (radius <= 0 || ctx->prog.blur[radius])
+        return OBS_OK;
+    char def[32];
+    snprintf(def, sizeof def, "#define BLUR_RADIUS %d\n", radius);
+    const char *src[] = {glsl_version, def, obs__shader_common, obs__shader_blur_frag};
+    return obs__gl_program("blur", obs__shader_fullscreen_vert, src, 4, &ctx->prog.blur[radius],
+                           err);
 }
 
 /* The AO program of a comparison method (parameter method), built on its
@@ -118,8 +129,9 @@ void obs__frame_release(obs_ctx *ctx)
         glDeleteProgram(ctx->prog.vao_bleed);
     if (ctx->prog.cull)
         glDeleteProgram(ctx->prog.cull);
-    if (ctx->prog.blur)
-        glDeleteProgram(ctx->prog.blur);
+    for (int k = 0; k <= OBS__MAX_BLUR; k++)
+        if (ctx->prog.blur[k])
+            glDeleteProgram(ctx->prog.blur[k]);
     if (ctx->prog.composite)
         glDeleteProgram(ctx->prog.composite);
     if (ctx->prog.luminance)
@@ -148,9 +160,9 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     t->tex_viewpos = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_vnormal = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_dz = make_texture(ctx, GL_RG32F, w, h);
-    t->tex_ao = make_texture(ctx, GL_R32F, w, h);
+    t->tex_ao = make_texture(ctx, GL_RG32F, w, h);     /* AO, depth (blur.frag.glsl) */
     t->tex_composite = make_texture(ctx, GL_RGBA32F, w, h);
-    t->tex_blur = make_texture(ctx, GL_R32F, w, h);
+    t->tex_blur = make_texture(ctx, GL_RG32F, w, h);
     t->tex_count = make_texture(ctx, GL_R32F, w, h);
     t->tex_cullmask = make_texture(ctx, GL_R32F, w, h);
     t->tex_bleed = make_texture(ctx, GL_RGBA32F, w, h);
@@ -369,6 +381,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         s = build_method_program(ctx, f.method, err);
     if (s == OBS_OK && f.bleed_step)
         s = build_bleed_program(ctx, err);
+    if (s == OBS_OK)
+        s = build_blur_program(ctx, f.blur_radius, err);
     if (s != OBS_OK)
         return s;
     s = ensure_targets(ctx, f.width, f.height, err);
@@ -449,11 +463,9 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     /* low-pass filter (section 4.6): ao -> blur along x -> ao along y */
     if (f.blur_radius > 0) {
         pass_begin(ctx, OBS_PASS_BLUR, &ran);
-        prog = ctx->prog.blur;
+        prog = ctx->prog.blur[f.blur_radius];
         glUseProgram(prog);
         set_common(prog, &f);
-        bind_tex(prog, "u_dz", 1, t->tex_dz);
-        glUniform1i(glGetUniformLocation(prog, "u_blur_radius"), f.blur_radius);
         glUniform1fv(glGetUniformLocation(prog, "u_blur_w"), f.blur_radius + 1, f.blur_w);
         glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
         bind_tex(prog, "u_ao", 0, t->tex_ao);

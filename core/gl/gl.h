@@ -10,7 +10,7 @@
 
 #include <GL/glcorearb.h>
 
-#include "internal.h"
+#include "frame.h"
 #include "gl/backend.h"
 
 #define OBS__GL_FUNCS(X)                                                       \
@@ -183,7 +183,8 @@ obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 /* ---- the per-resolution frame resources and programs -------------------- */
 
 typedef struct obs__programs {
-    GLuint prep, vao, cull, blur, composite, luminance;
+    GLuint prep, vao, cull, composite, luminance;
+    GLuint blur[OBS__MAX_BLUR + 1]; /* by blur_radius (BLUR_RADIUS; built on first use) */
     GLuint vao_bleed; /* the AO pass with colour bleeding (OBS_BLEED 1; built on first use) */
     GLuint method[3]; /* parameter method: hemisphere, angle, hbao (built on first use) */
 } obs__programs;

@@ -3,38 +3,42 @@
 // were separable.  Neighbours whose linear view depth differs from the
 // centre's by more than the AO radius are left out, so occlusion does not
 // bleed across depth edges.  C twin: obs__blur_pixel in blur_cpu.c.
+//
+// BLUR_RADIUS, the half-width in pixels, is defined by the program (one
+// program per radius, built on first use): a loop of constant length is
+// unrolled, which halves the pass's time on llvmpipe (bench/RESULTS.md).
+// The AO planes carry the pixel's planar depth beside the AO (rg, written
+// by the AO pass and by each blur pass): one texel fetch per tap.
 
-uniform sampler2D u_ao;          // AO to filter
-uniform sampler2D u_dz;          // prep: planar depth in x
+uniform sampler2D u_ao;          // AO to filter (r), planar depth (g; 0: background)
 uniform ivec2 u_size;
 uniform ivec2 u_dir;             // (1, 0) horizontal pass, (0, 1) vertical
-uniform int u_blur_radius;       // half-width in pixels
-uniform float u_blur_w[17];      // Gaussian weight of offset 0..radius
+uniform float u_blur_w[BLUR_RADIUS + 1]; // Gaussian weight of offset 0..radius
 uniform float u_radius;          // depth threshold: the AO radius R
 
-out float o_ao;
+out vec2 o_ao;                   // blurred AO, the centre's depth
 
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    float a = texelFetch(u_ao, px, 0).r;
-    float zc = texelFetch(u_dz, px, 0).x;
+    vec2 c = texelFetch(u_ao, px, 0).rg;
+    float zc = c.y;
     if (zc <= 0.0) {            // background: nothing to filter
-        o_ao = a;
+        o_ao = c;
         return;
     }
     float sum = 0.0, wsum = 0.0;
-    for (int k = -u_blur_radius; k <= u_blur_radius; k++) {
+    for (int k = -BLUR_RADIUS; k <= BLUR_RADIUS; k++) {
         ivec2 q = px + k * u_dir;
         if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
             continue;
-        float zq = texelFetch(u_dz, q, 0).x;
+        vec2 aq = texelFetch(u_ao, q, 0).rg;
         // section 4.6: leave out neighbours over the depth threshold
-        if (zq <= 0.0 || abs(zq - zc) > u_radius)
+        if (aq.y <= 0.0 || abs(aq.y - zc) > u_radius)
             continue;
         float w = u_blur_w[abs(k)];
-        sum += w * texelFetch(u_ao, q, 0).r;
+        sum += w * aq.x;
         wsum += w;
     }
-    o_ao = sum / wsum;          // the centre always counts: wsum > 0
+    o_ao = vec2(sum / wsum, zc); // the centre always counts: wsum > 0
 }

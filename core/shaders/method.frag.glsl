@@ -2,7 +2,7 @@
 // place of the VAO estimator; writes the attachments of the VAO pass (no
 // culling, no bleeding).  C twin: obs__method_pixel (method_cpu.c).
 
-layout(location = 0) out float o_ao;
+layout(location = 0) out vec2 o_ao;    // AO, planar depth (for the blur)
 layout(location = 1) out float o_count; // samples taken (debug output)
 layout(location = 2) out float o_cull;  // always 0: no culling pre-pass
 layout(location = 3) out vec4 o_bleed;  // always white: no bleeding
@@ -15,11 +15,11 @@ void main()
     o_bleed = vec4(1.0);
     o_count = 0.0;
     if (p.w <= 0.0) {
-        o_ao = 1.0;
+        o_ao = vec2(1.0, 0.0);
         return;
     }
     vec3 n = texelFetch(u_vnormal, px, 0).xyz;
     int count = 0;
-    o_ao = method_ao(px, p, n, count);
+    o_ao = vec2(method_ao(px, p, n, count), p.w);
     o_count = float(count);
 }

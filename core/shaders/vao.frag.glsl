@@ -12,7 +12,7 @@ uniform vec2 u_cull_scale;       // 1 / (8 * its size): pixel corner -> texture 
 uniform float u_cull_threshold;  // an estimate below this shows occlusion
 uniform int u_bleed_step;        // section 4.7: 0 off, else every u_bleed_step-th sample
 
-layout(location = 0) out float o_ao;
+layout(location = 0) out vec2 o_ao;    // AO, planar depth (for the blur)
 layout(location = 1) out float o_count; // samples taken (debug output)
 layout(location = 2) out float o_cull;  // 1: culling candidate (debug output)
 layout(location = 3) out vec4 o_bleed;  // section 4.7: the colour-bleed term
@@ -71,7 +71,7 @@ void main()
     o_cull = 0.0;
     o_bleed = vec4(1.0);
     if (p.w <= 0.0) {
-        o_ao = 1.0;
+        o_ao = vec2(1.0, 0.0);
         o_count = 0.0;
         return;
     }
@@ -87,6 +87,6 @@ void main()
     }
     o_count = float(ns);
     vec3 bleed = vec3(1.0);
-    o_ao = ns > 0 ? vao_estimate(px, p, n, ns, u_bleed_step, bleed) : 1.0;
+    o_ao = vec2(ns > 0 ? vao_estimate(px, p, n, ns, u_bleed_step, bleed) : 1.0, p.w);
     o_bleed = vec4(bleed, 1.0);
 }
