@@ -19,18 +19,15 @@ static const char bleed_on[] = "#define OBS_BLEED 1\n";
 
 static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
 {
-    if (ctx->prog.prep)
+    if (ctx->prog.vao)
         return OBS_OK;
-    const char *prep[] = {glsl_version, obs__shader_common, obs__shader_prep_frag};
     const char *vao[] = {glsl_version, bleed_off, obs__shader_common, obs__shader_vao,
                          obs__shader_vao_frag};
     const char *cull[] = {glsl_version, bleed_off, obs__shader_common, obs__shader_vao,
                           obs__shader_cull_frag};
     const char *comp[] = {glsl_version, obs__shader_composite_frag};
     const char *lum[] = {glsl_version, obs__shader_luminance_frag};
-    obs_status s = obs__gl_program("prep", obs__shader_fullscreen_vert, prep, 3, &ctx->prog.prep, err);
-    if (s == OBS_OK)
-        s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 5, &ctx->prog.vao, err);
+    obs_status s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 5, &ctx->prog.vao, err);
     if (s == OBS_OK)
         s = obs__gl_program("cull", obs__shader_fullscreen_vert, cull, 5, &ctx->prog.cull, err);
     if (s == OBS_OK)
@@ -40,6 +37,19 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
         s = obs__gl_program("luminance", obs__shader_fullscreen_vert, lum, 2, &ctx->prog.luminance,
                             err);
     return s;
+}
+
+/* The prep pass that reads the normals (reconstruct 0) or derives them from
+ * depth (1), built on its first use. */
+static obs_status build_prep_program(obs_ctx *ctx, int reconstruct, char err[OBS_ERR_LEN])
+{
+    if (ctx->prog.prep[reconstruct])
+        return OBS_OK;
+    const char *src[] = {glsl_version, reconstruct ? "#define OBS_RECONSTRUCT 1\n"
+                                                   : "#define OBS_RECONSTRUCT 0\n",
+                         obs__shader_common, obs__shader_prep_frag};
+    return obs__gl_program(reconstruct ? "prep (normals from depth)" : "prep",
+                           obs__shader_fullscreen_vert, src, 4, &ctx->prog.prep[reconstruct], err);
 }
 
 /* The AO pass with colour bleeding compiled in, built on its first use. */
@@ -121,8 +131,9 @@ void obs__frame_release(obs_ctx *ctx)
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
     memset(t, 0, sizeof *t);
-    if (ctx->prog.prep)
-        glDeleteProgram(ctx->prog.prep);
+    for (int k = 0; k < 2; k++)
+        if (ctx->prog.prep[k])
+            glDeleteProgram(ctx->prog.prep[k]);
     if (ctx->prog.vao)
         glDeleteProgram(ctx->prog.vao);
     if (ctx->prog.vao_bleed)
@@ -383,6 +394,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         s = build_bleed_program(ctx, err);
     if (s == OBS_OK)
         s = build_blur_program(ctx, f.blur_radius, err);
+    if (s == OBS_OK)
+        s = build_prep_program(ctx, f.reconstruct_normals != 0, err);
     if (s != OBS_OK)
         return s;
     s = ensure_targets(ctx, f.width, f.height, err);
@@ -407,12 +420,11 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
 
     /* prep pass */
     pass_begin(ctx, OBS_PASS_PREP, &ran);
-    GLuint prog = ctx->prog.prep;
+    GLuint prog = ctx->prog.prep[f.reconstruct_normals != 0];
     glUseProgram(prog);
     set_common(prog, &f);
     bind_tex(prog, "u_depth", 0, t->tex_depth);
     bind_tex(prog, "u_normal", 1, t->tex_normal);
-    glUniform1i(glGetUniformLocation(prog, "u_reconstruct"), f.reconstruct_normals);
     glUniformMatrix3fv(glGetUniformLocation(prog, "u_normal_matrix"), 1, GL_TRUE, f.normal_matrix);
     draw(ctx, t->fbo_prep, w, h);
     pass_end(ctx);

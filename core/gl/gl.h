@@ -183,7 +183,8 @@ obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 /* ---- the per-resolution frame resources and programs -------------------- */
 
 typedef struct obs__programs {
-    GLuint prep, vao, cull, composite, luminance;
+    GLuint prep[2];   /* normals read (0) or derived from depth (1); built on first use */
+    GLuint vao, cull, composite, luminance;
     GLuint blur[OBS__MAX_BLUR + 1]; /* by blur_radius (BLUR_RADIUS; built on first use) */
     GLuint vao_bleed; /* the AO pass with colour bleeding (OBS_BLEED 1; built on first use) */
     GLuint method[3]; /* parameter method: hemisphere, angle, hbao (built on first use) */

@@ -3,7 +3,9 @@
 
 uniform sampler2D u_depth;       // raw depth
 uniform sampler2D u_normal;      // input normals (when given)
-uniform int u_reconstruct;       // 1: derive normals from depth
+// OBS_RECONSTRUCT (0 or 1, defined by the program): 1 derives the normals
+// from depth, 0 reads them from u_normal.  A define, not a uniform: a
+// SIMD rasteriser runs both sides of a uniform branch.
 uniform mat3 u_normal_matrix;    // input normal -> view normal
 uniform ivec2 u_size;
 
@@ -52,19 +54,19 @@ void main()
     vec4 c = position_at(p);
     o_pos = c;
     vec3 n;
-    if (u_reconstruct == 0) {
-        n = normalize_safe(u_normal_matrix * texelFetch(u_normal, p, 0).xyz);
-    } else {
-        vec3 dx, dy;
-        n = vec3(0.0);
-        if (neighbour_delta(p, c, ivec2(1, 0), dx) && neighbour_delta(p, c, ivec2(0, 1), dy))
-            n = cross(dx, dy);
-        if (n == vec3(0.0))
-            n = -c.xyz;             // isolated pixel: face the camera
-        else if (dot(n, c.xyz) > 0.0)
-            n = -n;                 // a visible surface faces the camera
-        n = normalize_safe(n);
-    }
+#if OBS_RECONSTRUCT == 0
+    n = normalize_safe(u_normal_matrix * texelFetch(u_normal, p, 0).xyz);
+#else
+    vec3 dx, dy;
+    n = vec3(0.0);
+    if (neighbour_delta(p, c, ivec2(1, 0), dx) && neighbour_delta(p, c, ivec2(0, 1), dy))
+        n = cross(dx, dy);
+    if (n == vec3(0.0))
+        n = -c.xyz;             // isolated pixel: face the camera
+    else if (dot(n, c.xyz) > 0.0)
+        n = -n;                 // a visible surface faces the camera
+    n = normalize_safe(n);
+#endif
     o_normal = vec4(n, 0.0);
     o_dz = vec2(c.w, n.z);
 }

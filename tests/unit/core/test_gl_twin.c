@@ -10,17 +10,56 @@
  * one side and not the other, changing that pixel's AO by up to one
  * sample's weight (~1/n).  So: the mean difference is tiny and few pixels
  * differ at all (bounds: mean < 1e-3, fewer than 2 % of pixels > 1e-3). */
+/* One frame through GL and through the CPU twin, compared as above. */
+static void check_twin(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *p, const char *scene,
+                       const char *label)
+{
+    unsigned out = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT |
+                   OBS_OUTPUT_CULL_MASK | OBS_OUTPUT_BLEED;
+    obs_result gl, cpu;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_run(ctx, gb, p, out, &gl, err), OBS_OK);
+    assert_int_equal(obs_run_cpu(gb, p, out, &cpu, err), OBS_OK);
+    double mean, frac, cmean, cfrac, nmean, nfrac;
+    diff(&gl.ao, &cpu.ao, &mean, &frac);
+    diff(&gl.composite, &cpu.composite, &cmean, &cfrac);
+    /* the sample count (section 4.1) compares the disk's area with powers
+     * of two: only a pixel within rounding of one may differ */
+    diff(&gl.sample_count, &cpu.sample_count, &nmean, &nfrac);
+    /* the culling mask (section 4.2): the pre-pass is the same estimator at
+     * the same pixels, and the C bilinear fetch reproduces llvmpipe's
+     * GL_LINEAR bit for bit (fma form, see cull_cpu.c), so only a pre-pass
+     * texel hit by the border rounding above could move a decision */
+    double mmean, mfrac;
+    diff(&gl.cull_mask, &cpu.cull_mask, &mmean, &mfrac);
+    /* the bleed term (section 4.7): the same samples, so the same border
+     * rounding as the AO */
+    double bmean, bfrac;
+    diff(&gl.bleed, &cpu.bleed, &bmean, &bfrac);
+    print_message("%s (%s): GL vs CPU AO: mean |diff| %.2e, %.3f %% of pixels > 1e-3; "
+                  "composite mean %.2e; sample counts differ at %.3f %% of pixels, "
+                  "culling mask at %.3f %%; bleed mean %.2e, %.3f %% > 1e-3\n",
+                  scene, label, mean, 100 * frac, cmean, 100 * nfrac, 100 * mfrac, bmean,
+                  100 * bfrac);
+    assert_true(mean < 1e-3);
+    assert_true(frac < 0.02);
+    assert_true(cmean < 1e-3);
+    assert_true(nfrac < 1e-3);
+    assert_true(mfrac < 1e-3);
+    assert_true(bmean < 1e-3);
+    assert_true(bfrac < 0.02);
+    obs_result_free(&gl);
+    obs_result_free(&cpu);
+}
+
 static void test_gl_matches_cpu(void **state)
 {
     obs_ctx *ctx = make_ctx(OBS_BACKEND_EGL_SURFACELESS);
     (void)state;
     for (size_t s = 0; s < sizeof scenes / sizeof scenes[0]; s++) {
         obs_gbuffer_file gf = {0};
-        obs_result gl, cpu;
         char err[OBS_ERR_LEN] = "";
         load(scenes[s], &gf);
-        unsigned out = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT |
-                       OBS_OUTPUT_CULL_MASK | OBS_OUTPUT_BLEED;
         /* the defaults (range check, 5-tap blur, adaptive sampling on),
          * then a wide blur with the range check off, then no blur, then
          * adaptive sampling with a diameter that spreads the counts over
@@ -45,46 +84,21 @@ static void test_gl_matches_cpu(void **state)
         };
         for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
             obs_params p = {0};
+            char label[64];
             for (int k = 0; k < 2; k++)
                 if (variants[v][k][0])
                     assert_int_equal(obs_param_set(&p, variants[v][k][0], variants[v][k][1], err),
                                      OBS_OK);
-            assert_int_equal(obs_run(ctx, &gf.gb, &p, out, &gl, err), OBS_OK);
-            assert_int_equal(obs_run_cpu(&gf.gb, &p, out, &cpu, err), OBS_OK);
-            double mean, frac, cmean, cfrac, nmean, nfrac;
-            diff(&gl.ao, &cpu.ao, &mean, &frac);
-            diff(&gl.composite, &cpu.composite, &cmean, &cfrac);
-            /* the sample count (section 4.1) compares the disk's area
-             * with powers of two: only a pixel within rounding of one
-             * may differ */
-            diff(&gl.sample_count, &cpu.sample_count, &nmean, &nfrac);
-            /* the culling mask (section 4.2): the pre-pass is the same
-             * estimator at the same pixels, and the C bilinear fetch
-             * reproduces llvmpipe's GL_LINEAR bit for bit (fma form, see
-             * cull_cpu.c), so only a pre-pass texel hit by the border
-             * rounding above could move a decision */
-            double mmean, mfrac;
-            diff(&gl.cull_mask, &cpu.cull_mask, &mmean, &mfrac);
-            /* the bleed term (section 4.7): the same samples, so the same
-             * border rounding as the AO */
-            double bmean, bfrac;
-            diff(&gl.bleed, &cpu.bleed, &bmean, &bfrac);
-            print_message("%s (%s %s): GL vs CPU AO: mean |diff| %.2e, %.3f %% of pixels > 1e-3; "
-                          "composite mean %.2e; sample counts differ at %.3f %% of pixels, "
-                          "culling mask at %.3f %%; bleed mean %.2e, %.3f %% > 1e-3\n",
-                          scenes[s], variants[v][0][0] ? variants[v][0][0] : "defaults",
-                          variants[v][0][1] ? variants[v][0][1] : "", mean, 100 * frac, cmean,
-                          100 * nfrac, 100 * mfrac, bmean, 100 * bfrac);
-            assert_true(mean < 1e-3);
-            assert_true(frac < 0.02);
-            assert_true(cmean < 1e-3);
-            assert_true(nfrac < 1e-3);
-            assert_true(mfrac < 1e-3);
-            assert_true(bmean < 1e-3);
-            assert_true(bfrac < 0.02);
-            obs_result_free(&gl);
-            obs_result_free(&cpu);
+            snprintf(label, sizeof label, "%s %s", variants[v][0][0] ? variants[v][0][0] : "defaults",
+                     variants[v][0][1] ? variants[v][0][1] : "");
+            check_twin(ctx, &gf.gb, &p, scenes[s], label);
         }
+        /* without a normal plane: normals derived from depth (the prep
+         * pass's other program) */
+        obs_gbuffer nonormals = gf.gb;
+        nonormals.normal.data = NULL;
+        obs_params p = {0};
+        check_twin(ctx, &nonormals, &p, scenes[s], "normals from depth");
         obs_gbuffer_free(&gf);
     }
     obs_ctx_destroy(ctx);
