@@ -129,6 +129,20 @@ int obs__vao_count(const obs__frame *f, const float p[3], const float n[3]);
 float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         const float p[3], const float n[3], int ns, const float *xy);
 
+/* The samples' pixels (GLSL: disk_map(), disk_px() in vao.glsl).  The
+ * disk c + r (dx, dy, 0), (dx, dy) a sample (sx, sy) turned by rot (cos,
+ * sin), lies in the plane z = c.z, so its pixel coordinates are a
+ * projective map of (sx, sy): u = (U.s) / (W.s), v = (V.s) / (W.s) with
+ * s = (sx, sy, 1), set up once per pixel.  obs__disk_px gives the pixel
+ * obs__view_to_px gives for the sample's view-space point, up to rounding
+ * at pixel borders; 0 when behind the camera or off the planes. */
+typedef struct obs__disk {
+    float u[3], v[3], w[3];
+} obs__disk;
+void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
+                   obs__disk *m);
+int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx, int *qy);
+
 /* The depth range check's falloff (VAO++ 4.4, eq 4): s(d) = u / max(u,
  * d / R) for a pipe d behind its occluder along view Z; with
  * f->range_normal, d |nz|, the pipe's depth below the occluding surface

@@ -208,6 +208,47 @@ float obs__range_falloff(const obs__frame *f, float d, float nz)
     return f->range_u / fmaxf(f->range_u, d / f->radius); /* eq 4 */
 }
 
+/* GLSL: disk_map() in vao.glsl */
+void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
+                   obs__disk *m)
+{
+    const float *P = f->proj, *vp = f->viewport;
+    float k0[4], A[4], B[4];
+    for (int i = 0; i < 4; i++) {
+        const float *row = P + 4 * i;
+        k0[i] = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + row[3];
+        float ex = row[0] * r, ey = row[1] * r; /* a step r along view x, y */
+        A[i] = rot[0] * ex + rot[1] * ey;
+        B[i] = rot[0] * ey - rot[1] * ex;
+    }
+    float hx = 0.5f * vp[2], hy = 0.5f * vp[3];
+    float ox = hx - vp[0], oy = hy - vp[1];
+    m->u[0] = hx * A[0] + ox * A[3];
+    m->u[1] = hx * B[0] + ox * B[3];
+    m->u[2] = hx * k0[0] + ox * k0[3];
+    m->v[0] = -hy * A[1] + oy * A[3];
+    m->v[1] = -hy * B[1] + oy * B[3];
+    m->v[2] = -hy * k0[1] + oy * k0[3];
+    m->w[0] = A[3];
+    m->w[1] = B[3];
+    m->w[2] = k0[3];
+}
+
+/* GLSL: disk_px() in vao.glsl */
+int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx, int *qy)
+{
+    float sw = m->w[0] * sx + m->w[1] * sy + m->w[2];
+    if (!(sw > 0.0f))
+        return 0;
+    float fu = floorf((m->u[0] * sx + m->u[1] * sy + m->u[2]) / sw);
+    float fv = floorf((m->v[0] * sx + m->v[1] * sy + m->v[2]) / sw);
+    if (!(fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height))
+        return 0;
+    *qx = (int)fu;
+    *qy = (int)fv;
+    return 1;
+}
+
 /* GLSL: vao_estimate() in vao.glsl, without colour bleeding */
 float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         const float p[3], const float n[3], int ns, const float *xy)
@@ -225,6 +266,8 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
     /* Centre of the tangent sphere of radius R/2, moved along the normal. */
     float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
     const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    obs__disk disk;
+    obs__disk_map(f, c, r, rot, &disk);
     float open = 0.0f, F = 0.0f;
     float acc[3] = {0.0f, 0.0f, 0.0f}, taken = 0.0f; /* section 4.7 */
 
@@ -239,13 +282,11 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         float h = r * l; /* half length of the pipe through the sphere */
         int seen = 0;    /* the sample's pixel is on the planes */
 
-        /* Sample on the disk through the centre, perpendicular to view Z. */
-        float s[3] = {c[0] + r * (rot[0] * sx - rot[1] * sy), c[1] + r * (rot[1] * sx + rot[0] * sy),
-                      c[2]};
         float zs = INFINITY; /* scene depth at the sample's pixel */
         float nz = 1.0f; /* view normal z of the surface there */
         int qx, qy;
-        seen = obs__view_to_px(f, s, &qx, &qy);
+        /* The sample on the disk through the centre, perpendicular to view Z. */
+        seen = obs__disk_px(f, &disk, sx, sy, &qx, &qy);
         if (seen) {
             size_t k = (size_t)qy * (size_t)f->width + (size_t)qx;
             float d = pos[4 * k + 3];
