@@ -10,29 +10,51 @@
 #include "obs_shaders.h"
 
 static const char glsl_version[] = "#version 430 core\n";
-/* vao.glsl's colour bleeding (section 4.7) is compiled in or out: a
- * uniform branch does not skip its body on a SIMD rasteriser such as
- * llvmpipe, and the bleed code cost the AO pass a third of its time with
- * bleeding off (bench/RESULTS.md). */
-static const char bleed_off[] = "#define OBS_BLEED 0\n";
-static const char bleed_on[] = "#define OBS_BLEED 1\n";
+/* Switches of the AO pass compiled in or out, by defines, instead of read
+ * from uniforms: a uniform branch does not skip its body on a SIMD
+ * rasteriser such as llvmpipe, which runs both sides for every pixel (the
+ * bleed code cost the AO pass a third of its time with bleeding off;
+ * bench/RESULTS.md).  Bits of the index of ctx->prog.vao; each program is
+ * built on its first use. */
+enum {
+    AO_BLEED = 1,    /* OBS_BLEED: colour bleeding (section 4.7) */
+    AO_ADAPTIVE = 2, /* OBS_ADAPTIVE: adaptive sampling (section 4.1) */
+    AO_CULLING = 4,  /* OBS_CULLING: the culling test (section 4.2) */
+    AO_RANGE = 8     /* OBS_RANGE_CHECK: the depth range check (section 4.4) */
+};
+
+static unsigned ao_variant(const obs__frame *f)
+{
+    return (f->bleed_step ? AO_BLEED : 0u) | (f->adaptive ? AO_ADAPTIVE : 0u) |
+           (f->culling ? AO_CULLING : 0u) | (f->range_check ? AO_RANGE : 0u);
+}
+
+/* The AO program (pre 0) or the culling pre-pass's (pre 1; its variants
+ * differ only in AO_RANGE) of the given variant, built on its first use. */
+static obs_status build_vao_program(obs_ctx *ctx, int pre, unsigned v, char err[OBS_ERR_LEN])
+{
+    GLuint *prog = pre ? &ctx->prog.cull[(v & AO_RANGE) != 0] : &ctx->prog.vao[v];
+    if (*prog)
+        return OBS_OK;
+    char defs[160];
+    snprintf(defs, sizeof defs,
+             "#define OBS_BLEED %d\n#define OBS_ADAPTIVE %d\n#define OBS_CULLING %d\n"
+             "#define OBS_RANGE_CHECK %d\n",
+             !pre && (v & AO_BLEED), !pre && (v & AO_ADAPTIVE), !pre && (v & AO_CULLING),
+             (v & AO_RANGE) != 0);
+    const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_vao,
+                         pre ? obs__shader_cull_frag : obs__shader_vao_frag};
+    return obs__gl_program(pre ? "cull" : "vao", obs__shader_fullscreen_vert, src, 5, prog, err);
+}
 
 static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
 {
-    if (ctx->prog.vao)
+    if (ctx->prog.composite)
         return OBS_OK;
-    const char *vao[] = {glsl_version, bleed_off, obs__shader_common, obs__shader_vao,
-                         obs__shader_vao_frag};
-    const char *cull[] = {glsl_version, bleed_off, obs__shader_common, obs__shader_vao,
-                          obs__shader_cull_frag};
     const char *comp[] = {glsl_version, obs__shader_composite_frag};
     const char *lum[] = {glsl_version, obs__shader_luminance_frag};
-    obs_status s = obs__gl_program("vao", obs__shader_fullscreen_vert, vao, 5, &ctx->prog.vao, err);
-    if (s == OBS_OK)
-        s = obs__gl_program("cull", obs__shader_fullscreen_vert, cull, 5, &ctx->prog.cull, err);
-    if (s == OBS_OK)
-        s = obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2, &ctx->prog.composite,
-                            err);
+    obs_status s = obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2,
+                                   &ctx->prog.composite, err);
     if (s == OBS_OK)
         s = obs__gl_program("luminance", obs__shader_fullscreen_vert, lum, 2, &ctx->prog.luminance,
                             err);
@@ -50,17 +72,6 @@ static obs_status build_prep_program(obs_ctx *ctx, int reconstruct, char err[OBS
                          obs__shader_common, obs__shader_prep_frag};
     return obs__gl_program(reconstruct ? "prep (normals from depth)" : "prep",
                            obs__shader_fullscreen_vert, src, 4, &ctx->prog.prep[reconstruct], err);
-}
-
-/* The AO pass with colour bleeding compiled in, built on its first use. */
-static obs_status build_bleed_program(obs_ctx *ctx, char err[OBS_ERR_LEN])
-{
-    if (ctx->prog.vao_bleed)
-        return OBS_OK;
-    const char *src[] = {glsl_version, bleed_on, obs__shader_common, obs__shader_vao,
-                         obs__shader_vao_frag};
-    return obs__gl_program("vao (bleeding)", obs__shader_fullscreen_vert, src, 5,
-                           &ctx->prog.vao_bleed, err);
 }
 
 /* The blur of half-width radius (section 4.6), built on its first use:
@@ -134,12 +145,12 @@ void obs__frame_release(obs_ctx *ctx)
     for (int k = 0; k < 2; k++)
         if (ctx->prog.prep[k])
             glDeleteProgram(ctx->prog.prep[k]);
-    if (ctx->prog.vao)
-        glDeleteProgram(ctx->prog.vao);
-    if (ctx->prog.vao_bleed)
-        glDeleteProgram(ctx->prog.vao_bleed);
-    if (ctx->prog.cull)
-        glDeleteProgram(ctx->prog.cull);
+    for (int k = 0; k < OBS__AO_VARIANTS; k++)
+        if (ctx->prog.vao[k])
+            glDeleteProgram(ctx->prog.vao[k]);
+    for (int k = 0; k < 2; k++)
+        if (ctx->prog.cull[k])
+            glDeleteProgram(ctx->prog.cull[k]);
     for (int k = 0; k <= OBS__MAX_BLUR; k++)
         if (ctx->prog.blur[k])
             glDeleteProgram(ctx->prog.blur[k]);
@@ -249,7 +260,6 @@ static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
     /* section 4.1: all sets in one uniform array, picked by offset */
     glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS__SAMPLE_TABLE_LEN, f->sample_table);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
-    glUniform1i(glGetUniformLocation(prog, "u_range_check"), f->range_check);
     glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
     glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
 }
@@ -390,8 +400,10 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     s = build_programs(ctx, err);
     if (s == OBS_OK)
         s = build_method_program(ctx, f.method, err);
-    if (s == OBS_OK && f.bleed_step)
-        s = build_bleed_program(ctx, err);
+    if (s == OBS_OK && f.method <= OBS_METHOD_VAO)
+        s = build_vao_program(ctx, 0, ao_variant(&f), err);
+    if (s == OBS_OK && f.culling)
+        s = build_vao_program(ctx, 1, ao_variant(&f), err);
     if (s == OBS_OK)
         s = build_blur_program(ctx, f.blur_radius, err);
     if (s == OBS_OK)
@@ -432,7 +444,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     /* culling pre-pass (section 4.2): 8-sample AO at 1/8 resolution */
     if (f.culling) {
         pass_begin(ctx, OBS_PASS_CULL, &ran);
-        prog = ctx->prog.cull;
+        prog = ctx->prog.cull[f.range_check != 0];
         glUseProgram(prog);
         set_common(prog, &f);
         set_vao(prog, &f, t);
@@ -445,12 +457,11 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     if (f.method > OBS_METHOD_VAO) { /* a comparison method in place of VAO */
         prog = use_method_program(ctx, &f, t);
     } else {
-        prog = f.bleed_step ? ctx->prog.vao_bleed : ctx->prog.vao;
+        prog = ctx->prog.vao[ao_variant(&f)];
         glUseProgram(prog);
         set_common(prog, &f);
         set_vao(prog, &f, t);
         glUniform1i(glGetUniformLocation(prog, "u_count"), f.samples);
-        glUniform1i(glGetUniformLocation(prog, "u_adaptive"), f.adaptive);
         glUniform1f(glGetUniformLocation(prog, "u_adaptive_k"), f.adaptive_k);
         /* section 4.2: the pre-pass result, read at the pixel corners */
         glUniform1i(glGetUniformLocation(prog, "u_culling"), f.culling);

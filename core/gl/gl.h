@@ -182,11 +182,14 @@ obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 
 /* ---- the per-resolution frame resources and programs -------------------- */
 
+#define OBS__AO_VARIANTS 16 /* 4 switches of the AO pass, compiled in or out */
+
 typedef struct obs__programs {
     GLuint prep[2];   /* normals read (0) or derived from depth (1); built on first use */
-    GLuint vao, cull, composite, luminance;
+    GLuint vao[OBS__AO_VARIANTS]; /* AO pass by switches compiled in (run_gl.c: AO_*) */
+    GLuint cull[2];               /* culling pre-pass without, with the range check */
+    GLuint composite, luminance;
     GLuint blur[OBS__MAX_BLUR + 1]; /* by blur_radius (BLUR_RADIUS; built on first use) */
-    GLuint vao_bleed; /* the AO pass with colour bleeding (OBS_BLEED 1; built on first use) */
     GLuint method[3]; /* parameter method: hemisphere, angle, hbao (built on first use) */
 } obs__programs;
 

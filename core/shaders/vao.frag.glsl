@@ -3,10 +3,11 @@
 // the culling test of the pre-pass (section 4.2).  C twin: obs_run_cpu's
 // AO loop (obs__vao_count, obs__cull_candidate, obs__vao_estimate).
 
+// OBS_ADAPTIVE and OBS_CULLING (0 or 1) are defined by the program (see
+// run_gl.c): with 0 the stage is compiled out.
 uniform int u_count;             // samples (with adaptive sampling: the most)
-uniform int u_adaptive;          // 1: adaptive sampling (section 4.1)
 uniform float u_adaptive_k;      // vw / (vh * D0^2), see adaptive_count
-uniform int u_culling;           // section 4.2: 0 off, 1 greedy, 2 careful
+uniform int u_culling;           // section 4.2: 1 greedy, 2 careful (0 off: OBS_CULLING 0)
 uniform sampler2D u_cull;        // the pre-pass's 1/8-resolution AO, GL_LINEAR
 uniform vec2 u_cull_scale;       // 1 / (8 * its size): pixel corner -> texture coordinate
 uniform float u_cull_threshold;  // an estimate below this shows occlusion
@@ -77,14 +78,20 @@ void main()
     }
     vec3 n = texelFetch(u_vnormal, px, 0).xyz;
     // Section 4.1: the pixel's set, by its offset in the one array of sets.
-    int ns = u_adaptive != 0 ? adaptive_count(p.xyz + n * (0.5 * u_radius)) : u_count;
+#if OBS_ADAPTIVE
+    int ns = adaptive_count(p.xyz + n * (0.5 * u_radius));
+#else
+    int ns = u_count;
+#endif
+#if OBS_CULLING
     // Section 4.2: a culling candidate gets AO 1 (greedy) or at most the
     // 4-sample set (careful: "calculates occlusion with 4 samples in areas
     // where no AO is estimated"; never more than the pixel would take).
-    if (u_culling != 0 && cull_candidate(px)) {
+    if (cull_candidate(px)) {
         o_cull = 1.0;
         ns = u_culling == 1 ? 0 : min(ns, 4);
     }
+#endif
     o_count = float(ns);
     vec3 bleed = vec3(1.0);
     o_ao = vec2(ns > 0 ? vao_estimate(px, p, n, ns, u_bleed_step, bleed) : 1.0, p.w);

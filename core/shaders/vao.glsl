@@ -13,10 +13,11 @@ uniform float u_radius;          // R, in depth units
 uniform vec2 u_samples[62];      // all sets of section 4.5 (core/sample_tables.c), the
                                  // set of n from n - 2: the single array of section 4.1
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
-uniform int u_range_check;       // 1: depth range check (section 4.4, eq 4)
 uniform float u_range_u;         // u of eq 4
 uniform int u_range_normal;      // 1: eq 4's d along the occluder's normal (range_distance)
 uniform sampler2D u_color;       // G-buffer colour (section 4.7)
+// Defined by the program (run_gl.c), 0 or 1: OBS_BLEED, colour bleeding
+// compiled in; OBS_RANGE_CHECK, the depth range check (section 4.4).
 
 // Colour bleeding, section 4.7, eq 5:
 //   c(x) = max(0, (x - p).n / |x - p|) (1 - |x - p| / radius)^2,
@@ -91,8 +92,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
     for (int i = 0; i < ns; i++) {
         // Section 4.7: "every second or fourth sample"; the sets are
         // z-ordered, so those still cover the disk evenly.
-        // OBS_BLEED (0 or 1) is defined by the program: with 0 the bleed
-        // code below is compiled out.
+        // With OBS_BLEED 0 the bleed code below is compiled out.
         bool bleeds = OBS_BLEED != 0 && bleed_step > 0 && i % bleed_step == 0;
         float c5 = 0.0;         // eq 5's c(x); 0 (white) without a surface there
         bool hit = false;
@@ -128,7 +128,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
         // Unoccluded length of the pipe (cases A, B, C of section 3).
         float front = -c.z - h;
         float dz = min(max(zs - front, 0.0), 2.0 * h);
-        if (u_range_check != 0 && zs < front) {
+        if (OBS_RANGE_CHECK != 0 && zs < front) {
             // Case C with the depth range check, section 4.4, eq 4:
             // s(d) = u / max(u, d / radius), d behind the visible surface,
             // measured from the pipe's near end (s = 1 where case C meets
