@@ -202,15 +202,15 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
     const int layers = df->multi ? df->m : 1;
     const size_t npx = (size_t)f->width * (size_t)f->height;
     float open = 0.0f, F = 0.0f;
+    obs__disk disk; /* the samples' pixels */
+    obs__disk_map(f, c, r, rot, &disk);
 
     for (int i = 0; i < f->samples; i++) {
         float sx = f->sample_xy[2 * i], sy = f->sample_xy[2 * i + 1];
         float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
         float h = r * l;
-        float s[3] = {c[0] + r * (rot[0] * sx - rot[1] * sy), c[1] + r * (rot[1] * sx + rot[0] * sy),
-                      c[2]};
         int qx, qy;
-        if (!obs__view_to_px(f, s, &qx, &qy))
+        if (!obs__disk_px(f, &disk, sx, sy, &qx, &qy))
             continue; /* off the planes: left out of eq 1's sum and F */
         size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
         float front = -c[2] - h, occ = 0.0f;

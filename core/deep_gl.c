@@ -17,6 +17,7 @@
  * the node textures of the last frame reused the AO pass's whole cost
  * was reported as the upload's.  Finishing each stage costs a GPU its
  * overlap, which timing mode gives up anyway (it waits for the results). */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -55,27 +56,52 @@ static void release(obs_ctx *ctx, int all)
     glDeleteTextures(3, tex);
     if (t->fbo)
         glDeleteFramebuffers(1, &t->fbo);
-    GLuint prog = t->prog;
+    GLuint prog[8];
+    memcpy(prog, t->prog, sizeof prog);
     memset(t, 0, sizeof *t);
-    if (all && prog)
-        glDeleteProgram(prog);
-    else
-        t->prog = prog;
+    for (int k = 0; k < 8; k++) {
+        if (all && prog[k])
+            glDeleteProgram(prog[k]);
+        else
+            t->prog[k] = prog[k];
+    }
 }
 
 void obs__deep_release(obs_ctx *ctx) { release(ctx, 1); }
 
-/* The program, and the targets for w x h with m nodes: kept from the last
- * frame when they match. */
-static obs_status ensure_deep(obs_ctx *ctx, int w, int h, int m, char err[OBS_ERR_LEN])
+/* Switches of the deep pass compiled in or out by defines (a SIMD
+ * rasteriser runs both sides of a uniform branch): bits of the index of
+ * ctx->deep.prog. */
+enum {
+    DEEP_HEMISPHERE = 1, /* OBS_DEEP_HEMISPHERE: method hemisphere's samples */
+    DEEP_THIN = 2,       /* OBS_DEEP_THIN: thin hulls, OITAO eqs 2-4 */
+    DEEP_RANGE = 4       /* OBS_RANGE_CHECK: VAO++ 4.4, eq 4 */
+};
+
+static unsigned deep_variant(const obs__deep_frame *df)
+{
+    return (df->f.method == OBS_METHOD_HEMISPHERE ? DEEP_HEMISPHERE : 0u) |
+           (df->thin ? DEEP_THIN : 0u) | (df->f.range_check ? DEEP_RANGE : 0u);
+}
+
+/* The program of variant v, and the targets for w x h with m nodes: kept
+ * from the last frame when they match. */
+static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
+                              char err[OBS_ERR_LEN])
 {
     static const char glsl_version[] = "#version 430 core\n";
     obs__deep_targets *t = &ctx->deep;
     obs_status s;
-    if (!t->prog) {
-        const char *src[] = {glsl_version, obs__shader_common, obs__shader_deep_frag};
-        if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, 3, &t->prog, err)) != OBS_OK) {
-            t->prog = 0;
+    if (!t->prog[v]) {
+        char defs[128];
+        snprintf(defs, sizeof defs,
+                 "#define OBS_DEEP_HEMISPHERE %d\n#define OBS_DEEP_THIN %d\n"
+                 "#define OBS_RANGE_CHECK %d\n",
+                 (v & DEEP_HEMISPHERE) != 0, (v & DEEP_THIN) != 0, (v & DEEP_RANGE) != 0);
+        const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_deep_frag};
+        if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, 4, &t->prog[v], err)) !=
+            OBS_OK) {
+            t->prog[v] = 0;
             return s;
         }
     }
@@ -159,10 +185,11 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
         s = obs__fail(err, OBS_NO_MEMORY, "deep AO read-back of %dx%d", w, h);
         goto fail;
     }
-    if ((s = ensure_deep(ctx, w, h, df.m, err)) != OBS_OK)
+    const unsigned variant = deep_variant(&df);
+    if ((s = ensure_deep(ctx, variant, w, h, df.m, err)) != OBS_OK)
         goto fail;
     const obs__deep_targets *t = &ctx->deep;
-    const GLuint prog = t->prog;
+    const GLuint prog = t->prog[variant];
     for (int p = 0; p < OBS_PASS_COUNT; p++)
         times.ms[p] = -1.0;
 
@@ -182,13 +209,10 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform1i(glGetUniformLocation(prog, "u_ns"), f->samples);
     glUniform2fv(glGetUniformLocation(prog, "u_samples"), f->samples, f->sample_xy);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
-    glUniform1i(glGetUniformLocation(prog, "u_range_check"), f->range_check);
     glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
     glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
     glUniform1i(glGetUniformLocation(prog, "u_m"), df.m);
     glUniform1i(glGetUniformLocation(prog, "u_multi"), df.multi);
-    glUniform1i(glGetUniformLocation(prog, "u_thin"), df.thin);
-    glUniform1i(glGetUniformLocation(prog, "u_hemisphere"), f->method == OBS_METHOD_HEMISPHERE);
     glUniform1i(glGetUniformLocation(prog, "u_hs_count"), f->hs_count);
     glUniform1f(glGetUniformLocation(prog, "u_hs_bias"), f->hs_bias);
     glUniform1fv(glGetUniformLocation(prog, "u_hs_kernel"), 3 * f->hs_count, &f->hs_kernel[0][0]);

@@ -214,7 +214,7 @@ typedef struct obs__targets {
 /* Deep input's pass (deep_gl.c): its program, and the node planes and
  * the output target of one size and node count. */
 typedef struct obs__deep_targets {
-    GLuint prog;                 /* built on first use, kept */
+    GLuint prog[8];              /* by variant (deep_gl.c: DEEP_*), built on first use, kept */
     int width, height, m;        /* 0: none allocated yet */
     GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
     GLuint tex_out, fbo;         /* AO of the front node and the blend */

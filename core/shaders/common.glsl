@@ -82,6 +82,44 @@ bool view_to_px(vec3 s, ivec2 size, out ivec2 q)
     return true;
 }
 
+// The samples' pixels.  The disk of the samples, c + r (dx, dy, 0) with
+// (dx, dy) a sample rotated by the pixel's tile rotation, lies in the plane
+// z = c.z, perpendicular to view Z, so its pixel coordinates are a
+// projective map of the sample (sx, sy): (u, v) = (U.s, V.s) / W.s with
+// s = (sx, sy, 1).  disk_map sets U, V, W up once per pixel; disk_px is
+// then 9 multiply-adds and two divisions per sample instead of projecting
+// the sample's view-space point (view_to_px, which gives the same pixel
+// up to rounding at pixel borders).  Shared by the VAO estimator and the
+// deep pass.  C twin: obs__disk_map, obs__disk_px.
+void disk_map(vec3 c, float r, vec2 rot, out vec3 U, out vec3 V, out vec3 W)
+{
+    vec4 k0 = u_proj * vec4(c, 1.0);                 // clip coordinates of c
+    vec4 ex = u_proj[0] * r, ey = u_proj[1] * r;     // of a step r along view x, y
+    vec4 A = rot.x * ex + rot.y * ey, B = rot.x * ey - rot.y * ex; // of sx, sy
+    // pixel u = (X / W * 0.5 + 0.5) vw - vx, v = (0.5 - Y / W * 0.5) vh - vy
+    float hx = 0.5 * u_viewport.z, hy = 0.5 * u_viewport.w;
+    float ox = hx - u_viewport.x, oy = hy - u_viewport.y;
+    U = vec3(hx * A.x + ox * A.w, hx * B.x + ox * B.w, hx * k0.x + ox * k0.w);
+    V = vec3(-hy * A.y + oy * A.w, -hy * B.y + oy * B.w, -hy * k0.y + oy * k0.w);
+    W = vec3(A.w, B.w, k0.w);
+}
+
+// The pixel q of the sample (sx, sy) under disk_map's U, V, W on planes of
+// the given size; false when it is behind the camera or off the planes.
+bool disk_px(vec3 U, vec3 V, vec3 W, float sx, float sy, ivec2 size, out ivec2 q)
+{
+    q = ivec2(0);
+    float sw = W.x * sx + W.y * sy + W.z;
+    if (!(sw > 0.0))
+        return false;
+    float fu = floor((U.x * sx + U.y * sy + U.z) / sw);
+    float fv = floor((V.x * sx + V.y * sy + V.z) / sw);
+    if (!(fu >= 0.0 && fv >= 0.0 && fu < float(size.x) && fv < float(size.y)))
+        return false;
+    q = ivec2(int(fu), int(fv));
+    return true;
+}
+
 // The depth range check's falloff, VAO++ section 4.4, eq 4:
 // s(d) = u / max(u, d / R), the weight of a pipe's occlusion when it lies
 // d behind the surface that hides it ("we assume they are flat and their

@@ -5,7 +5,7 @@
 // pixel, the largest occlusion counting (OITAO Algorithm 1), weighted by
 // opacity (eq 1, or eqs 2-4 for thin hulls); the nodes' AO blended front
 // to back by alpha (section III, the separated scheme).  With
-// u_hemisphere the per-node occlusion is method hemisphere's point samples
+// OBS_DEEP_HEMISPHERE the per-node occlusion is method hemisphere's point samples
 // (the normal-oriented hemisphere kernel), each against every node, the
 // largest counting (Algorithm 1).  C twin: core/deep_cpu.c (same function
 // names).
@@ -14,16 +14,18 @@ uniform sampler2DArray u_lpos;  // node view position xyz, planar depth w (0: em
 uniform sampler2DArray u_lnrm;  // node view normal xyz, alpha w
 uniform int u_m;                // nodes per pixel
 uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node 0 only
-uniform int u_thin;             // 1: thin hulls (eqs 2-4); 0: solid volumes (eq 1)
 uniform ivec2 u_size;
 uniform float u_radius;         // R, in depth units
 uniform int u_ns;               // line samples
 uniform vec2 u_samples[32];     // the set of section 4.5
 uniform vec2 u_rot[9];          // (cos, sin) of the 3x3 tile's rotations
-uniform int u_range_check;      // 1: depth range check (VAO++ 4.4, eq 4)
 uniform float u_range_u;        // u of eq 4
 uniform int u_range_normal;     // 1: eq 4's d along the node's normal (range_distance)
-uniform int u_hemisphere;       // 1: method hemisphere's point samples; 0: VAO's line samples
+// Defined by the program (deep_gl.c), 0 or 1, so that a SIMD rasteriser
+// does not run the unused side of a uniform branch for every node:
+// OBS_DEEP_HEMISPHERE, method hemisphere's point samples (else VAO's line
+// samples); OBS_DEEP_THIN, thin hulls (eqs 2-4; else solid volumes, eq 1);
+// OBS_RANGE_CHECK, the depth range check (VAO++ 4.4, eq 4).
 uniform int u_hs_count;         // method hemisphere: samples
 uniform float u_hs_bias;        // occluders must be this far in front (depth units)
 uniform float u_hs_kernel[192]; // unit hemisphere around +z, (x, y, z) per sample
@@ -43,7 +45,7 @@ float node_occlusion(float zs, float nz, float front, float h, bool interior)
     if (zs < front) {
         if (interior)
             return 0.0;
-        if (u_range_check != 0) {
+        if (OBS_RANGE_CHECK != 0) {
             float sd = range_falloff(front - zs, nz, u_radius, u_range_u, u_range_normal);
             dz = 2.0 * h * (1.0 - sd);
         }
@@ -59,15 +61,16 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
     float R = u_radius, r = 0.5 * u_radius;
     vec3 c = p + n * r;
     vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
+    vec3 U, V, W;
+    disk_map(c, r, rot, U, V, W);   // the samples' pixels (common.glsl)
     int layers = u_multi != 0 ? u_m : 1;
     float open = 0.0, F = 0.0;
     for (int i = 0; i < u_ns; i++) {
         float sx = u_samples[i].x, sy = u_samples[i].y;
         float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
         float h = r * l;
-        vec3 s = vec3(c.x + r * (rot.x * sx - rot.y * sy), c.y + r * (rot.y * sx + rot.x * sy), c.z);
         ivec2 q;
-        if (!view_to_px(s, u_size, q))
+        if (!disk_px(U, V, W, sx, sy, u_size, q))
             continue;               // off the planes: left out
         float front = -c.z - h, occ = 0.0;
         for (int k = 0; k < layers; k++) {
@@ -128,7 +131,11 @@ float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
 // The per-sample estimator of the method: VAO++'s or method hemisphere's.
 float method_ao(ivec2 px, vec3 p, vec3 n, bool interior)
 {
-    return u_hemisphere != 0 ? hemisphere_ao(px, p, n, interior) : sphere_ao(px, p, n, interior);
+#if OBS_DEEP_HEMISPHERE
+    return hemisphere_ao(px, p, n, interior);
+#else
+    return sphere_ao(px, p, n, interior);
+#endif
 }
 
 // OITAO eq 1 (solid) or eqs 2-4 (thin hull) for node k at px.
@@ -139,12 +146,14 @@ float node_ao(ivec2 px, int k)
     if (!(p.w > 0.0))
         return 1.0;
     float ve = method_ao(px, p.xyz, n.xyz, false);
-    if (u_thin == 0)
-        return 1.0 - n.w * (1.0 - ve);              // eq 1: alpha_p
+#if OBS_DEEP_THIN == 0
+    return 1.0 - n.w * (1.0 - ve);                  // eq 1: alpha_p
+#else
     float vi = method_ao(px, p.xyz, -n.xyz, true);
     float facing = -(p.x * n.x + p.y * n.y + p.z * n.z);
     float W = facing >= 0.0 ? n.w : 1.0 - n.w;      // eq 3
     return W * ve + (1.0 - W) * vi;                 // eq 4
+#endif
 }
 
 void main()

@@ -548,6 +548,10 @@ static void test_gl_twin(void **state)
     compare_gl(ctx, &d, &p, "hidden occluder, multi");
     p = deep_params(OBS_DEEP_SINGLE);
     compare_gl(ctx, &d, &p, "hidden occluder, single");
+    /* the depth range check compiled out (the deep pass's variants) */
+    p = deep_params(OBS_DEEP_MULTI);
+    assert_int_equal(obs_param_set(&p, "range_check", "off", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "hidden occluder, multi, range check off");
     obs_deep_free(&d);
     assert_int_equal(obs_deep_read_exr(FIXTURE, NULL, &d, err), OBS_OK);
     p = (obs_params){0};
@@ -557,7 +561,7 @@ static void test_gl_twin(void **state)
     assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
     assert_int_equal(obs_param_set(&p, "deep_front_half", "on", err), OBS_OK);
     compare_gl(ctx, &d, &p, "fixture, thin, m = 2, front half");
-    /* method hemisphere: the uniform selects its point samples */
+    /* method hemisphere: the program with its point samples */
     p = (obs_params){0};
     assert_int_equal(obs_param_set(&p, "radius", "1", err), OBS_OK);
     assert_int_equal(obs_param_set(&p, "method", "hemisphere", err), OBS_OK);
