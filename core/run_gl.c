@@ -135,9 +135,9 @@ static obs_status make_fbo(obs_ctx *ctx, GLuint *fbo, const GLuint *tex, int cou
 void obs__frame_release(obs_ctx *ctx)
 {
     obs__targets *t = &ctx->tg;
-    GLuint tex[] = {t->tex_depth, t->tex_normal,    t->tex_color, t->tex_viewpos, t->tex_vnormal, t->tex_dz,
-                    t->tex_ao,    t->tex_composite, t->tex_blur,  t->tex_count,
-                    t->tex_cull,  t->tex_cullmask, t->tex_bleed, t->tex_lumfactor};
+    GLuint tex[] = {t->tex_depth,   t->tex_normal, t->tex_color,     t->tex_viewpos, t->tex_vnormal,
+                    t->tex_dz,      t->tex_ao,     t->tex_composite, t->tex_blur,    t->tex_count,
+                    t->tex_cull,    t->tex_cullmask, t->tex_bleed,   t->tex_lumfactor};
     GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao, t->fbo_cull};
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);

@@ -89,7 +89,8 @@ static void test_gl_matches_cpu(void **state)
                 if (variants[v][k][0])
                     assert_int_equal(obs_param_set(&p, variants[v][k][0], variants[v][k][1], err),
                                      OBS_OK);
-            snprintf(label, sizeof label, "%s %s", variants[v][0][0] ? variants[v][0][0] : "defaults",
+            snprintf(label, sizeof label, "%s %s",
+                     variants[v][0][0] ? variants[v][0][0] : "defaults",
                      variants[v][0][1] ? variants[v][0][1] : "");
             check_twin(ctx, &gf.gb, &p, scenes[s], label);
         }
