@@ -274,6 +274,7 @@ static GLuint use_method_program(obs_ctx *ctx, const obs__frame *f, const obs__t
     set_common(prog, f);
     bind_tex(prog, "u_pos", 0, t->tex_viewpos);
     bind_tex(prog, "u_vnormal", 1, t->tex_vnormal);
+    bind_tex(prog, "u_dz", 4, t->tex_dz);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
     if (f->method == OBS_METHOD_HEMISPHERE) {

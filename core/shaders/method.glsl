@@ -4,6 +4,7 @@
 
 uniform sampler2D u_pos;         // prep: view position, planar depth in w
 uniform sampler2D u_vnormal;     // prep: view normal
+uniform sampler2D u_dz;          // prep: planar depth (x), view normal z (y)
 uniform ivec2 u_size;
 uniform float u_radius;          // R, the AO distance, in depth units
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
