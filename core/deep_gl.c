@@ -216,11 +216,11 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform1i(glGetUniformLocation(prog, "u_hs_count"), f->hs_count);
     glUniform1f(glGetUniformLocation(prog, "u_hs_bias"), f->hs_bias);
     glUniform1fv(glGetUniformLocation(prog, "u_hs_kernel"), 3 * f->hs_count, &f->hs_kernel[0][0]);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, t->tex_pos);
+    /* the node planes are read through images (imageLoad), as the planes
+     * of run_gl.c are: cheaper than texelFetch on llvmpipe */
+    glBindImageTexture(0, t->tex_pos, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glUniform1i(glGetUniformLocation(prog, "u_lpos"), 0);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, t->tex_nrm);
+    glBindImageTexture(1, t->tex_nrm, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glUniform1i(glGetUniformLocation(prog, "u_lnrm"), 1);
     glViewport(0, 0, w, h);
     glBindVertexArray(ctx->vao);

@@ -177,7 +177,7 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
         ctx->prog = keep;
     }
     t->tex_depth = make_texture(ctx, GL_R32F, w, h);
-    t->tex_normal = make_texture(ctx, GL_RGB32F, w, h);
+    t->tex_normal = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_color = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_viewpos = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_vnormal = make_texture(ctx, GL_RGBA32F, w, h);
@@ -241,6 +241,12 @@ static void bind_tex(GLuint prog, const char *name, int unit, GLuint tex)
     glUniform1i(glGetUniformLocation(prog, name), unit);
 }
 
+static void bind_img(GLuint prog, const char *name, int unit, GLuint tex, GLenum format)
+{
+    glBindImageTexture((GLuint)unit, tex, 0, GL_FALSE, 0, GL_READ_ONLY, format);
+    glUniform1i(glGetUniformLocation(prog, name), unit);
+}
+
 /* Uniforms of common.glsl. */
 static void set_common(GLuint prog, const obs__frame *f)
 {
@@ -253,9 +259,9 @@ static void set_common(GLuint prog, const obs__frame *f)
 /* Uniforms of vao.glsl, the estimator of the AO pass and the pre-pass. */
 static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
 {
-    bind_tex(prog, "u_pos", 0, t->tex_viewpos);
-    bind_tex(prog, "u_vnormal", 1, t->tex_vnormal);
-    bind_tex(prog, "u_dz", 4, t->tex_dz);
+    bind_img(prog, "u_pos", 0, t->tex_viewpos, GL_RGBA32F);
+    bind_img(prog, "u_vnormal", 1, t->tex_vnormal, GL_RGBA32F);
+    bind_img(prog, "u_dz", 2, t->tex_dz, GL_RG32F);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
     /* section 4.1: all sets in one uniform array, picked by offset */
     glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS__SAMPLE_TABLE_LEN, f->sample_table);
@@ -272,9 +278,9 @@ static GLuint use_method_program(obs_ctx *ctx, const obs__frame *f, const obs__t
     GLuint prog = ctx->prog.method[f->method - OBS_METHOD_HEMISPHERE];
     glUseProgram(prog);
     set_common(prog, f);
-    bind_tex(prog, "u_pos", 0, t->tex_viewpos);
-    bind_tex(prog, "u_vnormal", 1, t->tex_vnormal);
-    bind_tex(prog, "u_dz", 4, t->tex_dz);
+    bind_img(prog, "u_pos", 0, t->tex_viewpos, GL_RGBA32F);
+    bind_img(prog, "u_vnormal", 1, t->tex_vnormal, GL_RGBA32F);
+    bind_img(prog, "u_dz", 2, t->tex_dz, GL_RG32F);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
     if (f->method == OBS_METHOD_HEMISPHERE) {
@@ -436,8 +442,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     GLuint prog = ctx->prog.prep[f.reconstruct_normals != 0];
     glUseProgram(prog);
     set_common(prog, &f);
-    bind_tex(prog, "u_depth", 0, t->tex_depth);
-    bind_tex(prog, "u_normal", 1, t->tex_normal);
+    bind_img(prog, "u_depth", 0, t->tex_depth, GL_R32F);
+    bind_img(prog, "u_normal", 1, t->tex_normal, GL_RGBA32F);
     glUniformMatrix3fv(glGetUniformLocation(prog, "u_normal_matrix"), 1, GL_TRUE, f.normal_matrix);
     draw(ctx, t->fbo_prep, w, h);
     pass_end(ctx);
@@ -471,7 +477,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         glUniform1f(glGetUniformLocation(prog, "u_cull_threshold"), f.cull_threshold);
         /* section 4.7: colour bleeding reads the colour at the samples */
         glUniform1i(glGetUniformLocation(prog, "u_bleed_step"), f.bleed_step);
-        bind_tex(prog, "u_color", 3, t->tex_color);
+        bind_img(prog, "u_color", 3, t->tex_color, GL_RGBA32F);
     }
     /* the debug outputs go to their textures only when asked for */
     const GLenum vao_bufs[] = {
@@ -492,13 +498,13 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         set_common(prog, &f);
         glUniform1fv(glGetUniformLocation(prog, "u_blur_w"), f.blur_radius + 1, f.blur_w);
         glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
-        bind_tex(prog, "u_ao", 0, t->tex_ao);
+        bind_img(prog, "u_ao", 0, t->tex_ao, GL_RG32F);
         glUniform2i(glGetUniformLocation(prog, "u_dir"), 1, 0);
         const GLenum blur_bufs[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
         glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_blur);
         glDrawBuffers(2, blur_bufs);
         draw(ctx, t->fbo_blur, w, h);
-        bind_tex(prog, "u_ao", 0, t->tex_blur);
+        bind_img(prog, "u_ao", 0, t->tex_blur, GL_RG32F);
         glUniform2i(glGetUniformLocation(prog, "u_dir"), 0, 1);
         draw(ctx, t->fbo_ao, w, h);
         pass_end(ctx);

@@ -84,7 +84,8 @@
     /* the A-buffer rasteriser's linked lists (raster_deep_gl.c) */            \
     X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                                 \
     X(PFNGLGETBUFFERSUBDATAPROC, GetBufferSubData)                             \
-    X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)
+    X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                   \
+    X(PFNGLBINDIMAGETEXTUREPROC, BindImageTexture)
 
 /* Optional entry points (may be NULL). */
 #define OBS__GL_FUNCS_OPT(X) X(PFNGLDEBUGMESSAGECALLBACKPROC, DebugMessageCallback)
@@ -167,6 +168,7 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glBindBufferBase obs__glp->BindBufferBase
 #define glGetBufferSubData obs__glp->GetBufferSubData
 #define glMemoryBarrier obs__glp->MemoryBarrier
+#define glBindImageTexture obs__glp->BindImageTexture
 
 /* Loads every entry point; fails naming the first one missing. */
 obs_status obs__gl_load(obs__gl *gl, obs__getproc_fn getproc, char err[OBS_ERR_LEN]);

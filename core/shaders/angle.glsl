@@ -45,7 +45,7 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
             ivec2 q;
             vec4 xq = vec4(0.0);
             if (view_to_px(s, u_size, q))
-                xq = texelFetch(u_pos, q, 0);
+                xq = imageLoad(u_pos, q);
             if (!(xq.w > 0.0)) {          // off the image or background: far
                 v[k] = vec3(0.0);
                 far[k] = 1.0;

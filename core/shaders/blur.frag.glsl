@@ -8,9 +8,9 @@
 // program per radius, built on first use): a loop of constant length is
 // unrolled, which halves the pass's time on llvmpipe (bench/RESULTS.md).
 // The AO planes carry the pixel's planar depth beside the AO (rg, written
-// by the AO pass and by each blur pass): one texel fetch per tap.
+// by the AO pass and by each blur pass): one image load per tap.
 
-uniform sampler2D u_ao;          // AO to filter (r), planar depth (g; 0: background)
+layout(rg32f) readonly uniform image2D u_ao; // AO to filter (r), planar depth (g; 0: background)
 uniform ivec2 u_size;
 uniform ivec2 u_dir;             // (1, 0) horizontal pass, (0, 1) vertical
 uniform float u_blur_w[BLUR_RADIUS + 1]; // Gaussian weight of offset 0..radius
@@ -21,7 +21,7 @@ out vec2 o_ao;                   // blurred AO, the centre's depth
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    vec2 c = texelFetch(u_ao, px, 0).rg;
+    vec2 c = imageLoad(u_ao, px).rg;
     float zc = c.y;
     if (zc <= 0.0) {            // background: nothing to filter
         o_ao = c;
@@ -32,7 +32,7 @@ void main()
         ivec2 q = px + k * u_dir;
         if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
             continue;
-        vec2 aq = texelFetch(u_ao, q, 0).rg;
+        vec2 aq = imageLoad(u_ao, q).rg;
         // section 4.6: leave out neighbours over the depth threshold
         if (aq.y <= 0.0 || abs(aq.y - zc) > u_radius)
             continue;

@@ -4,6 +4,17 @@
 // Pixel (x, y) is row y from the top, as the planes are uploaded: texel
 // row y of every texture is image row y, so gl_FragCoord.xy (row 0 first)
 // indexes the planes directly.
+//
+// The planes a pass reads at more than its own pixel (the prep pass's
+// neighbours, the samples of the AO passes, the blur's taps) are bound as
+// read-only images and read with imageLoad, not texelFetch: on llvmpipe an
+// image load is a bounds check and a load, a texel fetch goes through the
+// sampler's code (level, swizzle, format), and the blur took 0.55x, the AO
+// pass 0.85x the time (bench/RESULTS.md).  An image load off the image
+// returns 0 like a texel fetch; the passes test their bounds anyway.  The
+// images were written by earlier draws through the framebuffer, which GL
+// orders before later commands' loads (no barrier: barriers are for a
+// shader's own image stores).
 
 uniform mat4 u_proj;        // view -> clip
 uniform vec4 u_viewport;    // display x, y, width, height of the planes

@@ -12,7 +12,7 @@ out float o_est;
 void main()
 {
     ivec2 px = min(ivec2(gl_FragCoord.xy) * 8 + 4, u_size - 1);
-    vec4 p = texelFetch(u_pos, px, 0);
+    vec4 p = imageLoad(u_pos, px);
     vec3 unused;                // no colour bleeding in the pre-pass
-    o_est = p.w > 0.0 ? vao_estimate(px, p, texelFetch(u_vnormal, px, 0).xyz, 8, 0, unused) : 1.0;
+    o_est = p.w > 0.0 ? vao_estimate(px, p, imageLoad(u_vnormal, px).xyz, 8, 0, unused) : 1.0;
 }

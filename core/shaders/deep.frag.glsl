@@ -10,8 +10,8 @@
 // largest counting (Algorithm 1).  C twin: core/deep_cpu.c (same function
 // names).
 
-uniform sampler2DArray u_lpos;  // node view position xyz, planar depth w (0: empty)
-uniform sampler2DArray u_lnrm;  // node view normal xyz, alpha w
+layout(rgba32f) readonly uniform image2DArray u_lpos; // node view position xyz, planar depth w (0: empty)
+layout(rgba32f) readonly uniform image2DArray u_lnrm; // node view normal xyz, alpha w
 uniform int u_m;                // nodes per pixel
 uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node 0 only
 uniform ivec2 u_size;
@@ -74,8 +74,8 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
             continue;               // off the planes: left out
         float front = -c.z - h, occ = 0.0;
         for (int k = 0; k < layers; k++) {
-            float zs = texelFetch(u_lpos, ivec3(q, k), 0).w;
-            vec4 nk = texelFetch(u_lnrm, ivec3(q, k), 0);   // normal, alpha
+            float zs = imageLoad(u_lpos, ivec3(q, k)).w;
+            vec4 nk = imageLoad(u_lnrm, ivec3(q, k));   // normal, alpha
             occ = max(occ, nk.w * node_occlusion(zs, nk.z, front, h, interior));
         }
         open += 2.0 * h - occ;
@@ -111,7 +111,7 @@ float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
             continue;               // off the planes: left out
         float best = 0.0;
         for (int k = 0; k < layers; k++) {
-            vec4 pk = texelFetch(u_lpos, ivec3(q, k), 0);
+            vec4 pk = imageLoad(u_lpos, ivec3(q, k));
             if (!(pk.w > 0.0))
                 continue;                 // empty node
             if (!(pk.w <= -s.z - u_hs_bias))
@@ -120,7 +120,7 @@ float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
                 continue;                 // on the hull's exterior side
             float dz = abs(-p.z - pk.w);
             float r = dz > R ? R / dz : 1.0;
-            float an = texelFetch(u_lnrm, ivec3(q, k), 0).w;
+            float an = imageLoad(u_lnrm, ivec3(q, k)).w;
             best = max(best, an * r * r * (3.0 - 2.0 * r));
         }
         occ += best;
@@ -141,8 +141,8 @@ float method_ao(ivec2 px, vec3 p, vec3 n, bool interior)
 // OITAO eq 1 (solid) or eqs 2-4 (thin hull) for node k at px.
 float node_ao(ivec2 px, int k)
 {
-    vec4 p = texelFetch(u_lpos, ivec3(px, k), 0);
-    vec4 n = texelFetch(u_lnrm, ivec3(px, k), 0);
+    vec4 p = imageLoad(u_lpos, ivec3(px, k));
+    vec4 n = imageLoad(u_lnrm, ivec3(px, k));
     if (!(p.w > 0.0))
         return 1.0;
     float ve = method_ao(px, p.xyz, n.xyz, false);
@@ -161,10 +161,10 @@ void main()
     ivec2 px = ivec2(gl_FragCoord.xy);
     float T = 1.0, acc = 0.0, front = 1.0;
     for (int k = 0; k < u_m; k++) {
-        vec4 p = texelFetch(u_lpos, ivec3(px, k), 0);
+        vec4 p = imageLoad(u_lpos, ivec3(px, k));
         if (!(p.w > 0.0))
             break;
-        float a = texelFetch(u_lnrm, ivec3(px, k), 0).w;
+        float a = imageLoad(u_lnrm, ivec3(px, k)).w;
         float ao = node_ao(px, k);
         if (k == 0)
             front = ao;

@@ -50,7 +50,7 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
             if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
                 break;
             count++;
-            vec4 xq = texelFetch(u_pos, q, 0);
+            vec4 xq = imageLoad(u_pos, q);
             if (!(xq.w > 0.0))
                 continue;
             vec3 v = xq.xyz - p.xyz;

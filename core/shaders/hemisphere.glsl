@@ -26,7 +26,7 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
         ivec2 q;
         if (!view_to_px(s, u_size, q))
             continue;
-        float zq = texelFetch(u_dz, q, 0).x;   // the depth plane: one RG texel
+        float zq = imageLoad(u_dz, q).x;   // the depth plane: one RG texel
         if (!(zq > 0.0))
             continue;                     // background never occludes
         // occluded: a surface in front of the sample, past the bias

@@ -10,7 +10,7 @@ layout(location = 3) out vec4 o_bleed;  // always white: no bleeding
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    vec4 p = texelFetch(u_pos, px, 0);
+    vec4 p = imageLoad(u_pos, px);
     o_cull = 0.0;
     o_bleed = vec4(1.0);
     o_count = 0.0;
@@ -18,7 +18,7 @@ void main()
         o_ao = vec2(1.0, 0.0);
         return;
     }
-    vec3 n = texelFetch(u_vnormal, px, 0).xyz;
+    vec3 n = imageLoad(u_vnormal, px).xyz;
     int count = 0;
     o_ao = vec2(method_ao(px, p, n, count), p.w);
     o_count = float(count);

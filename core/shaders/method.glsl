@@ -2,9 +2,9 @@
 // hemisphere.glsl, angle.glsl, hbao.glsl, each defining method_ao(), and
 // method.frag.glsl's main).  C twins: frame.c, *_cpu.c.
 
-uniform sampler2D u_pos;         // prep: view position, planar depth in w
-uniform sampler2D u_vnormal;     // prep: view normal
-uniform sampler2D u_dz;          // prep: planar depth (x), view normal z (y)
+layout(rgba32f) readonly uniform image2D u_pos;     // prep: view position, planar depth in w
+layout(rgba32f) readonly uniform image2D u_vnormal; // prep: view normal
+layout(rg32f) readonly uniform image2D u_dz;        // prep: planar depth (x), view normal z (y)
 uniform ivec2 u_size;
 uniform float u_radius;          // R, the AO distance, in depth units
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations

@@ -1,8 +1,8 @@
 // Prep pass: view-space position (xyz, planar depth in w) and view-space
 // unit normal of every pixel.  C twin: obs__prep_position/_normal.
 
-uniform sampler2D u_depth;       // raw depth
-uniform sampler2D u_normal;      // input normals (when given)
+layout(r32f) readonly uniform image2D u_depth;     // raw depth
+layout(rgba32f) readonly uniform image2D u_normal;  // input normals (when given)
 // OBS_RECONSTRUCT (0 or 1, defined by the program): 1 derives the normals
 // from depth, 0 reads them from u_normal.  A define, not a uniform: a
 // SIMD rasteriser runs both sides of a uniform branch.
@@ -15,7 +15,7 @@ layout(location = 2) out vec2 o_dz;     // planar depth and n.z: what the sample
 
 vec4 position_at(ivec2 p)
 {
-    return prep_position(texelFetch(u_depth, p, 0).r, p);
+    return prep_position(imageLoad(u_depth, p).r, p);
 }
 
 // Difference towards the neighbour along step whose depth is closer to the
@@ -55,7 +55,7 @@ void main()
     o_pos = c;
     vec3 n;
 #if OBS_RECONSTRUCT == 0
-    n = normalize_safe(u_normal_matrix * texelFetch(u_normal, p, 0).xyz);
+    n = normalize_safe(u_normal_matrix * imageLoad(u_normal, p).xyz);
 #else
     vec3 dx, dy;
     n = vec3(0.0);

@@ -68,7 +68,7 @@ bool cull_candidate(ivec2 px)
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    vec4 p = texelFetch(u_pos, px, 0);
+    vec4 p = imageLoad(u_pos, px);
     o_cull = 0.0;
     o_bleed = vec4(1.0);
     if (p.w <= 0.0) {
@@ -76,7 +76,7 @@ void main()
         o_count = 0.0;
         return;
     }
-    vec3 n = texelFetch(u_vnormal, px, 0).xyz;
+    vec3 n = imageLoad(u_vnormal, px).xyz;
     // Section 4.1: the pixel's set, by its offset in the one array of sets.
 #if OBS_ADAPTIVE
     int ns = adaptive_count(p.xyz + n * (0.5 * u_radius));

@@ -5,9 +5,9 @@
 // (vao.frag.glsl) and the culling pre-pass (cull.frag.glsl).  C twin:
 // obs__vao_estimate.
 
-uniform sampler2D u_pos;         // prep: view position, planar depth in w
-uniform sampler2D u_vnormal;     // prep: view normal
-uniform sampler2D u_dz;          // prep: planar depth and view normal z, one fetch per sample
+layout(rgba32f) readonly uniform image2D u_pos;     // prep: view position, planar depth in w
+layout(rgba32f) readonly uniform image2D u_vnormal; // prep: view normal
+layout(rg32f) readonly uniform image2D u_dz; // prep: planar depth and view normal z, one load per sample
 uniform ivec2 u_size;
 uniform float u_radius;          // R, in depth units
 uniform vec2 u_samples[62];      // all sets of section 4.5 (core/sample_tables.c), the
@@ -15,7 +15,7 @@ uniform vec2 u_samples[62];      // all sets of section 4.5 (core/sample_tables.
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
 uniform float u_range_u;         // u of eq 4
 uniform int u_range_normal;      // 1: eq 4's d along the occluder's normal (range_distance)
-uniform sampler2D u_color;       // G-buffer colour (section 4.7)
+layout(rgba32f) readonly uniform image2D u_color;   // G-buffer colour (section 4.7)
 // Defined by the program (run_gl.c), 0 or 1: OBS_BLEED, colour bleeding
 // compiled in; OBS_RANGE_CHECK, the depth range check (section 4.4).
 
@@ -69,12 +69,12 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
         float nz = 1.0;         // view normal z there
         seen = disk_px(U, V, W, sx, sy, u_size, q);
         if (seen) {
-            vec2 dq = texelFetch(u_dz, q, 0).xy;
+            vec2 dq = imageLoad(u_dz, q).xy;
             if (dq.x > 0.0) {
                 zs = dq.x;
                 nz = dq.y;
                 if (bleeds) {       // eq 5, x the surface point at the sample's pixel
-                    c5 = bleed_weight(texelFetch(u_pos, q, 0).xyz, p.xyz, n, R);
+                    c5 = bleed_weight(imageLoad(u_pos, q).xyz, p.xyz, n, R);
                     hit = true;
                 }
             }
@@ -82,7 +82,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
         if (bleeds) {
             // "We use c(x) to linearly interpolate between the white color
             // and the sampled color."
-            vec3 col = hit ? texelFetch(u_color, q, 0).rgb : vec3(1.0);
+            vec3 col = hit ? imageLoad(u_color, q).rgb : vec3(1.0);
             acc += hit ? vec3(1.0 + c5 * (col.r - 1.0), 1.0 + c5 * (col.g - 1.0),
                               1.0 + c5 * (col.b - 1.0))
                        : vec3(1.0);
