@@ -203,7 +203,6 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUseProgram(prog);
     glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_TRUE, f->proj);
     glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
-    glUniform1i(glGetUniformLocation(prog, "u_depth_mode"), f->depth_mode);
     glUniform2i(glGetUniformLocation(prog, "u_size"), w, h);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
     glUniform1i(glGetUniformLocation(prog, "u_ns"), f->samples);

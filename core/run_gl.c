@@ -61,17 +61,29 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
     return s;
 }
 
-/* The prep pass that reads the normals (reconstruct 0) or derives them from
- * depth (1), built on its first use. */
-static obs_status build_prep_program(obs_ctx *ctx, int reconstruct, char err[OBS_ERR_LEN])
+/* The prep pass that reads the normals or derives them from depth
+ * (OBS_RECONSTRUCT), for the frame's depth mode (OBS_DEPTH_MODE: planar,
+ * radial, ndc; resolved, never OBS_DEPTH_DEFAULT), built on its first use:
+ * ctx->prog.prep[prep_index(f)]. */
+static int prep_index(const obs__frame *f)
 {
-    if (ctx->prog.prep[reconstruct])
+    int mode = f->depth_mode >= OBS_DEPTH_PLANAR && f->depth_mode <= OBS_DEPTH_NDC
+                   ? f->depth_mode
+                   : OBS_DEPTH_PLANAR;
+    return 3 * (f->reconstruct_normals != 0) + mode - OBS_DEPTH_PLANAR;
+}
+
+static obs_status build_prep_program(obs_ctx *ctx, const obs__frame *f, char err[OBS_ERR_LEN])
+{
+    int k = prep_index(f);
+    if (ctx->prog.prep[k])
         return OBS_OK;
-    const char *src[] = {glsl_version, reconstruct ? "#define OBS_RECONSTRUCT 1\n"
-                                                   : "#define OBS_RECONSTRUCT 0\n",
-                         obs__shader_common, obs__shader_prep_frag};
-    return obs__gl_program(reconstruct ? "prep (normals from depth)" : "prep",
-                           obs__shader_fullscreen_vert, src, 4, &ctx->prog.prep[reconstruct], err);
+    char defs[80];
+    snprintf(defs, sizeof defs, "#define OBS_RECONSTRUCT %d\n#define OBS_DEPTH_MODE %d\n",
+             k / 3, k % 3 + OBS_DEPTH_PLANAR);
+    const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_prep_frag};
+    return obs__gl_program(k / 3 ? "prep (normals from depth)" : "prep",
+                           obs__shader_fullscreen_vert, src, 4, &ctx->prog.prep[k], err);
 }
 
 /* The blur of half-width radius (section 4.6), built on its first use:
@@ -142,7 +154,7 @@ void obs__frame_release(obs_ctx *ctx)
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
     memset(t, 0, sizeof *t);
-    for (int k = 0; k < 2; k++)
+    for (int k = 0; k < 6; k++)
         if (ctx->prog.prep[k])
             glDeleteProgram(ctx->prog.prep[k]);
     for (int k = 0; k < OBS__AO_VARIANTS; k++)
@@ -252,7 +264,6 @@ static void set_common(GLuint prog, const obs__frame *f)
 {
     glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_TRUE, f->proj);
     glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
-    glUniform1i(glGetUniformLocation(prog, "u_depth_mode"), f->depth_mode);
     glUniform2i(glGetUniformLocation(prog, "u_size"), f->width, f->height);
 }
 
@@ -414,7 +425,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     if (s == OBS_OK)
         s = build_blur_program(ctx, f.blur_radius, err);
     if (s == OBS_OK)
-        s = build_prep_program(ctx, f.reconstruct_normals != 0, err);
+        s = build_prep_program(ctx, &f, err);
     if (s != OBS_OK)
         return s;
     s = ensure_targets(ctx, f.width, f.height, err);
@@ -439,7 +450,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
 
     /* prep pass */
     pass_begin(ctx, OBS_PASS_PREP, &ran);
-    GLuint prog = ctx->prog.prep[f.reconstruct_normals != 0];
+    GLuint prog = ctx->prog.prep[prep_index(&f)];
     glUseProgram(prog);
     set_common(prog, &f);
     bind_img(prog, "u_depth", 0, t->tex_depth, GL_R32F);

@@ -33,7 +33,7 @@ static void view_ray(const float *P, const float ndc[2], float origin[3], float 
     dir[2] = -1.0f;
 }
 
-/* GLSL: linear_depth() in common.glsl.  Planar depth from the raw value,
+/* GLSL: linear_depth() in prep.frag.glsl.  Planar depth from the raw value,
  * 0 for background. */
 static float linear_depth(const obs__frame *f, float raw, const float dir[3])
 {

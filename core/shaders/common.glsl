@@ -18,7 +18,6 @@
 
 uniform mat4 u_proj;        // view -> clip
 uniform vec4 u_viewport;    // display x, y, width, height of the planes
-uniform int u_depth_mode;   // 1 planar, 2 radial, 3 ndc (obs_depth_mode)
 
 const float SKY_DEPTH = 1e9;
 const float FAR_AWAY = 1e30;
@@ -42,34 +41,6 @@ void view_ray(vec2 ndc, out vec3 origin, out vec3 dir)
     float inv = 1.0 / (a * d - b * c);
     origin = vec3((d * b0x - b * b0y) * inv, (a * b0y - c * b0x) * inv, 0.0);
     dir = vec3(-(d * b1x - b * b1y) * inv, -(a * b1y - c * b1x) * inv, -1.0);
-}
-
-// Planar depth from the raw value; 0 for background.
-float linear_depth(float raw, vec3 dir)
-{
-    if (!(raw > 0.0) || raw >= SKY_DEPTH)
-        return 0.0;
-    if (u_depth_mode == 2)
-        return raw / sqrt(dir.x * dir.x + dir.y * dir.y + dir.z * dir.z);
-    if (u_depth_mode == 3) {
-        if (raw >= 1.0)
-            return 0.0;
-        float zn = 2.0 * raw - 1.0;
-        float z = (PM(2, 3) - zn * PM(3, 3)) / (zn * PM(3, 2) - PM(2, 2));
-        return -z > 0.0 ? -z : 0.0;
-    }
-    return raw;
-}
-
-// View-space position and planar depth; vec4(0) for background.
-vec4 prep_position(float raw, ivec2 p)
-{
-    vec3 o, dir;
-    view_ray(px_ndc(p), o, dir);
-    float d = linear_depth(raw, dir);
-    if (d <= 0.0 || isinf(d) || isnan(d))
-        return vec4(0.0);
-    return vec4(o.x + d * dir.x, o.y + d * dir.y, -d, d);
 }
 
 // The pixel holding the view-space point s on planes of the given size;

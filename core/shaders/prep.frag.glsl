@@ -13,6 +13,37 @@ layout(location = 0) out vec4 o_pos;
 layout(location = 1) out vec4 o_normal;
 layout(location = 2) out vec2 o_dz;     // planar depth and n.z: what the samples read
 
+// Planar depth from the raw value; 0 for background.  OBS_DEPTH_MODE (1
+// planar, 2 radial, 3 ndc: obs_depth_mode) is defined by the program, one
+// per mode: as uniform branches, the radial and ndc code ran for every
+// pixel (bench/RESULTS.md).  C twin: linear_depth in vao_cpu.c.
+float linear_depth(float raw, vec3 dir)
+{
+    if (!(raw > 0.0) || raw >= SKY_DEPTH)
+        return 0.0;
+    if (OBS_DEPTH_MODE == 2)
+        return raw / sqrt(dir.x * dir.x + dir.y * dir.y + dir.z * dir.z);
+    if (OBS_DEPTH_MODE == 3) {
+        if (raw >= 1.0)
+            return 0.0;
+        float zn = 2.0 * raw - 1.0;
+        float z = (PM(2, 3) - zn * PM(3, 3)) / (zn * PM(3, 2) - PM(2, 2));
+        return -z > 0.0 ? -z : 0.0;
+    }
+    return raw;
+}
+
+// View-space position and planar depth; vec4(0) for background.
+vec4 prep_position(float raw, ivec2 p)
+{
+    vec3 o, dir;
+    view_ray(px_ndc(p), o, dir);
+    float d = linear_depth(raw, dir);
+    if (d <= 0.0 || isinf(d) || isnan(d))
+        return vec4(0.0);
+    return vec4(o.x + d * dir.x, o.y + d * dir.y, -d, d);
+}
+
 vec4 position_at(ivec2 p)
 {
     return prep_position(imageLoad(u_depth, p).r, p);

@@ -52,6 +52,59 @@ static void check_twin(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *p,
     obs_result_free(&cpu);
 }
 
+/* The depth modes other than planar (the prep pass has a program per
+ * mode): the scene's planar depths rewritten as distances from the camera
+ * and as OpenGL depth-buffer values give GL = CPU, and the AO of the
+ * planar depths (the same points; ndc within float rounding). */
+static void check_depth_modes(obs_ctx *ctx, const obs_gbuffer *gb, const char *scene)
+{
+    char err[OBS_ERR_LEN] = "";
+    obs_params planar = {0}, resolved;
+    obs_params_resolve(&planar, &resolved);
+    obs__frame f;
+    assert_int_equal(obs__frame_setup(NULL, gb, &resolved, &f, err), OBS_OK);
+    const float *P = f.proj;
+    float *radial = malloc((size_t)gb->width * gb->height * sizeof *radial);
+    float *ndc = malloc((size_t)gb->width * gb->height * sizeof *ndc);
+    assert_non_null(radial);
+    assert_non_null(ndc);
+    for (int y = 0; y < gb->height; y++)
+        for (int x = 0; x < gb->width; x++) {
+            float v[4];
+            obs__prep_position(&f, *obs__plane_px(&gb->depth, gb->width, x, y), x, y, v);
+            size_t i = (size_t)y * gb->width + x;
+            radial[i] = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            float zn = (P[10] * v[2] + P[11]) / (P[14] * v[2] + P[15]);
+            ndc[i] = v[3] > 0.0f ? 0.5f * zn + 0.5f : 1.0f; /* background: far plane */
+        }
+    obs_result ref;
+    assert_int_equal(obs_run(ctx, gb, &planar, OBS_OUTPUT_AO, &ref, err), OBS_OK);
+    static const char *const modes[] = {"radial", "ndc"};
+    for (int m = 0; m < 2; m++) {
+        obs_gbuffer g = *gb;
+        g.depth.data = m == 0 ? radial : ndc;
+        g.depth.channels = 1;
+        g.depth.row_stride = (size_t)gb->width * sizeof(float);
+        obs_params p = {0};
+        assert_int_equal(obs_param_set(&p, "depth_mode", modes[m], err), OBS_OK);
+        char label[32];
+        snprintf(label, sizeof label, "depth_mode %s", modes[m]);
+        check_twin(ctx, &g, &p, scene, label);
+        obs_result r;
+        double mean, frac;
+        assert_int_equal(obs_run(ctx, &g, &p, OBS_OUTPUT_AO, &r, err), OBS_OK);
+        diff(&r.ao, &ref.ao, &mean, &frac);
+        print_message("%s: depth_mode %s vs planar: mean |diff| %.2e, %.3f %% > 1e-3\n", scene,
+                      modes[m], mean, 100 * frac);
+        assert_true(mean < 1e-3);
+        assert_true(frac < 0.02);
+        obs_result_free(&r);
+    }
+    obs_result_free(&ref);
+    free(radial);
+    free(ndc);
+}
+
 static void test_gl_matches_cpu(void **state)
 {
     obs_ctx *ctx = make_ctx(OBS_BACKEND_EGL_SURFACELESS);
@@ -100,6 +153,7 @@ static void test_gl_matches_cpu(void **state)
         nonormals.normal.data = NULL;
         obs_params p = {0};
         check_twin(ctx, &nonormals, &p, scenes[s], "normals from depth");
+        check_depth_modes(ctx, &gf.gb, scenes[s]);
         obs_gbuffer_free(&gf);
     }
     obs_ctx_destroy(ctx);
