@@ -154,7 +154,7 @@ void obs__frame_release(obs_ctx *ctx)
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
     memset(t, 0, sizeof *t);
-    for (int k = 0; k < 6; k++)
+    for (size_t k = 0; k < sizeof ctx->prog.prep / sizeof ctx->prog.prep[0]; k++)
         if (ctx->prog.prep[k])
             glDeleteProgram(ctx->prog.prep[k]);
     for (int k = 0; k < OBS__AO_VARIANTS; k++)
@@ -189,7 +189,7 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
         ctx->prog = keep;
     }
     t->tex_depth = make_texture(ctx, GL_R32F, w, h);
-    t->tex_normal = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_normal = make_texture(ctx, GL_RGBA32F, w, h); /* read as an image: no RGB32F */
     t->tex_color = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_viewpos = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_vnormal = make_texture(ctx, GL_RGBA32F, w, h);
@@ -253,10 +253,20 @@ static void bind_tex(GLuint prog, const char *name, int unit, GLuint tex)
     glUniform1i(glGetUniformLocation(prog, name), unit);
 }
 
+/* A plane read with imageLoad (common.glsl says why not texelFetch). */
 static void bind_img(GLuint prog, const char *name, int unit, GLuint tex, GLenum format)
 {
     glBindImageTexture((GLuint)unit, tex, 0, GL_FALSE, 0, GL_READ_ONLY, format);
     glUniform1i(glGetUniformLocation(prog, name), unit);
+}
+
+/* The prep pass's planes, as the AO passes (VAO's and the methods') read
+ * them. */
+static void bind_prep_planes(GLuint prog, const obs__targets *t)
+{
+    bind_img(prog, "u_pos", 0, t->tex_viewpos, GL_RGBA32F);
+    bind_img(prog, "u_vnormal", 1, t->tex_vnormal, GL_RGBA32F);
+    bind_img(prog, "u_dz", 2, t->tex_dz, GL_RG32F);
 }
 
 /* Uniforms of common.glsl. */
@@ -270,9 +280,7 @@ static void set_common(GLuint prog, const obs__frame *f)
 /* Uniforms of vao.glsl, the estimator of the AO pass and the pre-pass. */
 static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
 {
-    bind_img(prog, "u_pos", 0, t->tex_viewpos, GL_RGBA32F);
-    bind_img(prog, "u_vnormal", 1, t->tex_vnormal, GL_RGBA32F);
-    bind_img(prog, "u_dz", 2, t->tex_dz, GL_RG32F);
+    bind_prep_planes(prog, t);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
     /* section 4.1: all sets in one uniform array, picked by offset */
     glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS__SAMPLE_TABLE_LEN, f->sample_table);
@@ -289,9 +297,7 @@ static GLuint use_method_program(obs_ctx *ctx, const obs__frame *f, const obs__t
     GLuint prog = ctx->prog.method[f->method - OBS_METHOD_HEMISPHERE];
     glUseProgram(prog);
     set_common(prog, f);
-    bind_img(prog, "u_pos", 0, t->tex_viewpos, GL_RGBA32F);
-    bind_img(prog, "u_vnormal", 1, t->tex_vnormal, GL_RGBA32F);
-    bind_img(prog, "u_dz", 2, t->tex_dz, GL_RG32F);
+    bind_prep_planes(prog, t);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
     if (f->method == OBS_METHOD_HEMISPHERE) {
