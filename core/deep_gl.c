@@ -56,15 +56,13 @@ static void release(obs_ctx *ctx, int all)
     glDeleteTextures(3, tex);
     if (t->fbo)
         glDeleteFramebuffers(1, &t->fbo);
-    GLuint prog[8];
+    GLuint prog[OBS__DEEP_VARIANTS];
     memcpy(prog, t->prog, sizeof prog);
     memset(t, 0, sizeof *t);
-    for (int k = 0; k < 8; k++) {
-        if (all && prog[k])
-            glDeleteProgram(prog[k]);
-        else
-            t->prog[k] = prog[k];
-    }
+    if (all)
+        OBS__GL_DELETE_PROGRAMS(prog);
+    else
+        memcpy(t->prog, prog, sizeof prog);
 }
 
 void obs__deep_release(obs_ctx *ctx) { release(ctx, 1); }

@@ -129,7 +129,7 @@ int obs__vao_count(const obs__frame *f, const float p[3], const float n[3]);
 float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         const float p[3], const float n[3], int ns, const float *xy);
 
-/* The samples' pixels (GLSL: disk_map(), disk_px() in vao.glsl).  The
+/* The samples' pixels (GLSL: disk_map(), disk_px() in common.glsl).  The
  * disk c + r (dx, dy, 0), (dx, dy) a sample (sx, sy) turned by rot (cos,
  * sin), lies in the plane z = c.z, so its pixel coordinates are a
  * projective map of (sx, sy): u = (U.s) / (W.s), v = (V.s) / (W.s) with

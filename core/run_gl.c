@@ -154,25 +154,14 @@ void obs__frame_release(obs_ctx *ctx)
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
     memset(t, 0, sizeof *t);
-    for (size_t k = 0; k < sizeof ctx->prog.prep / sizeof ctx->prog.prep[0]; k++)
-        if (ctx->prog.prep[k])
-            glDeleteProgram(ctx->prog.prep[k]);
-    for (int k = 0; k < OBS__AO_VARIANTS; k++)
-        if (ctx->prog.vao[k])
-            glDeleteProgram(ctx->prog.vao[k]);
-    for (int k = 0; k < 2; k++)
-        if (ctx->prog.cull[k])
-            glDeleteProgram(ctx->prog.cull[k]);
-    for (int k = 0; k <= OBS__MAX_BLUR; k++)
-        if (ctx->prog.blur[k])
-            glDeleteProgram(ctx->prog.blur[k]);
-    if (ctx->prog.composite)
-        glDeleteProgram(ctx->prog.composite);
-    if (ctx->prog.luminance)
-        glDeleteProgram(ctx->prog.luminance);
-    for (int k = 0; k < 3; k++)
-        if (ctx->prog.method[k])
-            glDeleteProgram(ctx->prog.method[k]);
+    obs__programs *g = &ctx->prog;
+    OBS__GL_DELETE_PROGRAMS(g->prep);
+    OBS__GL_DELETE_PROGRAMS(g->vao);
+    OBS__GL_DELETE_PROGRAMS(g->cull);
+    OBS__GL_DELETE_PROGRAMS(g->blur);
+    OBS__GL_DELETE_PROGRAMS(g->method);
+    obs__gl_delete_programs(&g->composite, 1);
+    obs__gl_delete_programs(&g->luminance, 1);
     memset(&ctx->prog, 0, sizeof ctx->prog);
 }
 

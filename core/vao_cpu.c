@@ -208,7 +208,7 @@ float obs__range_falloff(const obs__frame *f, float d, float nz)
     return f->range_u / fmaxf(f->range_u, d / f->radius); /* eq 4 */
 }
 
-/* GLSL: disk_map() in vao.glsl */
+/* GLSL: disk_map() in common.glsl */
 void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
                    obs__disk *m)
 {
@@ -234,7 +234,7 @@ void obs__disk_map(const obs__frame *f, const float c[3], float r, const float r
     m->w[2] = k0[3];
 }
 
-/* GLSL: disk_px() in vao.glsl */
+/* GLSL: disk_px() in common.glsl */
 int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx, int *qy)
 {
     float sw = m->w[0] * sx + m->w[1] * sy + m->w[2];

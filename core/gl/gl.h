@@ -179,12 +179,17 @@ obs_status obs__gl_load(obs__gl *gl, obs__getproc_fn getproc, char err[OBS_ERR_L
 obs_status obs__gl_program(const char *name, const char *vert, const char *const *frag_parts,
                            int frag_count, GLuint *out, char err[OBS_ERR_LEN]);
 
+/* Deletes the programs of p[0..n) that were built (0: never built). */
+void obs__gl_delete_programs(const GLuint *p, size_t n);
+#define OBS__GL_DELETE_PROGRAMS(a) obs__gl_delete_programs((a), sizeof(a) / sizeof((a)[0]))
+
 /* Drains glGetError; returns OBS_GL_ERROR naming `where` if any. */
 obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 
 /* ---- the per-resolution frame resources and programs -------------------- */
 
-#define OBS__AO_VARIANTS 16 /* 4 switches of the AO pass, compiled in or out */
+#define OBS__AO_VARIANTS 16  /* 4 switches of the AO pass, compiled in or out */
+#define OBS__DEEP_VARIANTS 8 /* 3 switches of the deep pass (deep_gl.c: DEEP_*) */
 
 typedef struct obs__programs {
     GLuint prep[6];   /* 3 * (normals derived from depth) + depth mode - 1; built on first use */
@@ -216,7 +221,7 @@ typedef struct obs__targets {
 /* Deep input's pass (deep_gl.c): its program, and the node planes and
  * the output target of one size and node count. */
 typedef struct obs__deep_targets {
-    GLuint prog[8];              /* by variant (deep_gl.c: DEEP_*), built on first use, kept */
+    GLuint prog[OBS__DEEP_VARIANTS]; /* by variant (deep_gl.c: DEEP_*), built on first use, kept */
     int width, height, m;        /* 0: none allocated yet */
     GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
     GLuint tex_out, fbo;         /* AO of the front node and the blend */

@@ -55,6 +55,13 @@ fail:
     return s;
 }
 
+void obs__gl_delete_programs(const GLuint *p, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        if (p[k])
+            glDeleteProgram(p[k]);
+}
+
 obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN])
 {
     GLenum e, first = GL_NO_ERROR;
