@@ -287,7 +287,8 @@ static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3]
 {
     if (df->f.method == OBS_METHOD_HEMISPHERE)
         return hemisphere_ao(df, x, y, p, n, interior);
-    return sphere_ao(df, x, y, p, n, interior);
+    float v = sphere_ao(df, x, y, p, n, interior);
+    return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */
 }
 
 float obs__deep_node_ao(const obs__deep_frame *df, int x, int y, int k)

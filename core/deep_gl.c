@@ -203,6 +203,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
     glUniform2i(glGetUniformLocation(prog, "u_size"), w, h);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
+    glUniform1i(glGetUniformLocation(prog, "u_rays"), f->rays);
     glUniform1i(glGetUniformLocation(prog, "u_ns"), f->samples);
     glUniform2fv(glGetUniformLocation(prog, "u_samples"), f->samples, f->sample_xy);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);

@@ -80,11 +80,17 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     f->depth_mode = p->depth_mode;
     /* The radius parameter is the ray-traced AO distance D (the reach of
      * Cycles' AO pass); the VAO kernel width R of eq 1 is k * D, so the
-     * tangent sphere has radius k * D / 2.  k = OBS__RADIUS_K (frame.h),
-     * chosen in bench/QUALITY.md "How --radius maps to the AO distance".
-     * Everything downstream (eq 2's F, eq 4's falloff, the blur's depth
-     * threshold, eq 5) takes this R, the paper's "kernel radius". */
-    f->radius = OBS__RADIUS_K * p->radius / p->unit_scale;
+     * tangent sphere has radius k * D / 2: k = 2 when the AO is to be the
+     * ray tracer's (ao_definition rays, converted after the blur by
+     * obs__rays_from_volume), 1 for the paper's volumetric obscurance
+     * (frame.h, OBS__RADIUS_K_*; bench/QUALITY.md "How --radius maps to
+     * the AO distance").  Everything downstream (eq 2's F, eq 4's falloff,
+     * the blur's depth threshold, eq 5) takes this R, the paper's "kernel
+     * radius".  The comparison methods take D itself. */
+    int vao_method = p->method == OBS_METHOD_VAOPP || p->method == OBS_METHOD_VAO;
+    f->rays = vao_method && p->ao_definition == OBS_AO_RAYS;
+    float k_r = f->rays ? OBS__RADIUS_K_RAYS : vao_method ? OBS__RADIUS_K_VOLUME : 1.0f;
+    f->radius = k_r * p->radius / p->unit_scale;
     f->samples = p->samples;
     f->sample_xy = obs__samples(p->samples);
     f->sample_table = &obs__sample_table[0][0];

@@ -30,15 +30,24 @@
 
 /* k of R = k * D: the paper's kernel width R (hemisphere radius; the
  * tangent sphere has radius R/2) for the ray-traced AO distance D that the
- * radius parameter gives.  k = 1: the tangent sphere of radius D/2 is the
- * largest sphere inside the ray tracer's hemisphere of radius D that
- * touches p, so both measure occluders within D of p along the normal
- * (same support).  The crease-integral mapping k = 64/(9 pi) was examined
- * and not adopted: it matches a floor-wall crease but not a slab (k = 4/3)
- * and made yard.exr markedly worse (bench/QUALITY.md, "How --radius maps
- * to the AO distance"; tools/radius_mapping.py).  Applied in one place,
- * obs__frame_setup (frame.c). */
-#define OBS__RADIUS_K 1.0f
+ * radius parameter gives, by ao_definition (bench/QUALITY.md, "How
+ * --radius maps to the AO distance"; tools/radius_mapping.py).
+ *
+ * rays, k = 2: on a floor at distance x from a wall, the rays of length D
+ * reach the wall for x < D, and the tangent sphere of radius R/2 = D
+ * touches it for x < D: the same support, so the crease profile of the
+ * volume fraction can be converted to the ray tracer's one exactly
+ * (obs__rays_from_volume).  k = 2 is the smallest k for which that is
+ * possible: for k < 2 the volume fraction is 0 where the rays still see
+ * the wall.
+ *
+ * volume, k = 1: the tangent sphere of radius D/2 is the largest sphere
+ * inside the ray tracer's hemisphere of radius D that touches p.
+ *
+ * Applied in one place, obs__frame_setup (frame.c), to methods vaopp and
+ * vao (the comparison methods take the radius as D). */
+#define OBS__RADIUS_K_RAYS 2.0f
+#define OBS__RADIUS_K_VOLUME 1.0f
 
 /* Largest counts of the comparison methods' parameters (uniform array
  * sizes in hemisphere.glsl, angle.glsl, hbao.glsl). */
@@ -53,7 +62,9 @@ typedef struct obs__frame {
     float normal_matrix[9]; /* input normal -> view normal, row-major 3x3 */
     int reconstruct_normals;/* 1: no usable normals, derive them from depth */
     int depth_mode;         /* OBS_DEPTH_PLANAR/RADIAL/NDC */
-    float radius;           /* R, the kernel width, in depth units: OBS__RADIUS_K * radius / unit_scale */
+    float radius;           /* R, the kernel width, in depth units: k * radius / unit_scale
+                             * (OBS__RADIUS_K_*); D for the comparison methods */
+    int rays;               /* 1: eq 1's V converted to the ray-traced AO (ao_definition rays) */
     int samples;            /* the count of the parameter: adaptive sampling's maximum */
     const float *sample_xy; /* samples * (x, y) on the unit disk */
     const float *sample_table; /* all sets, 62 (x, y) pairs: the set of n at pair n - 2 */
@@ -149,6 +160,16 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
  * whose view normal has z component nz (GLSL: range_falloff() in
  * common.glsl). */
 float obs__range_falloff(const obs__frame *f, float d, float nz);
+
+/* ao_definition rays (GLSL: rays_from_volume() in luminance.frag.glsl):
+ * the AO a ray tracer gives with rays of length D for the AO ao of the
+ * tangent sphere of radius D (R = 2 D), through the floor-wall crease,
+ * where both are known in closed form: a wall at distance x = b D from p
+ * fills (1 - b)^2 (2 + b) / 4 of the sphere and blocks
+ * (acos b - b sqrt(1 - b^2)) / pi of the cosine-weighted rays.  The
+ * first is inverted for b, the second returned as AO; both are 1/2 at the
+ * corner (b = 0), and an occlusion over 1/2 is returned unchanged. */
+float obs__rays_from_volume(float ao);
 
 /* Culling pre-pass, VAO++ section 4.2 (GLSL: cull.frag.glsl), CPU twin
  * in cull_cpu.c.  The low-resolution AO: texel (i, j) of cull_w x cull_h

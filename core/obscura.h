@@ -195,13 +195,13 @@ typedef enum obs_pass {
     OBS_PASS_CULL,
     OBS_PASS_AO,
     OBS_PASS_BLUR,
-    OBS_PASS_LUMINANCE,
+    OBS_PASS_FINISH,    /* ao_definition rays' conversion and luminance sensitivity */
     OBS_PASS_COMPOSITE,
     OBS_PASS_READBACK,
     OBS_PASS_COUNT
 } obs_pass;
 
-/* "upload", "prep", "cull", "ao", "blur", "luminance", "composite",
+/* "upload", "prep", "cull", "ao", "blur", "finish", "composite",
  * "readback". */
 const char *obs_pass_name(obs_pass p);
 

@@ -224,6 +224,8 @@ static const struct {
     {offsetof(obs_params, samples), M(VAOPP) | M(VAO), 0,
      "the VAO sample sets; hemisphere takes hemisphere_samples, angle angle_pairs, hbao "
      "hbao_directions and hbao_steps"},
+    {offsetof(obs_params, ao_definition), M(VAOPP) | M(VAO), 0,
+     "it converts the volumetric obscurance of VAO (section 3)"},
     {offsetof(obs_params, adaptive), M(VAOPP), OBS_OFF, "adaptive sampling is VAO++'s (4.1)"},
     {offsetof(obs_params, adaptive_diameter), M(VAOPP), 0, "adaptive sampling is VAO++'s (4.1)"},
     {offsetof(obs_params, culling), M(VAOPP), OBS_CULLING_OFF,

@@ -74,6 +74,13 @@ typedef enum obs_method {
     OBS_METHOD_HBAO        /* horizon-based AO (hbao_cpu.c) */
 } obs_method;
 
+/* What the VAO methods' AO measures (parameter `ao_definition`). */
+typedef enum obs_ao_definition {
+    OBS_AO_DEFINITION_DEFAULT,
+    OBS_AO_RAYS,   /* a ray tracer's AO within radius: R = 2 radius, eq 1's V converted */
+    OBS_AO_VOLUME  /* the paper's volumetric obscurance: R = radius */
+} obs_ao_definition;
+
 /* The arc cosine of the angle-based method (parameter `angle_acos`). */
 typedef enum obs_acos {
     OBS_ACOS_DEFAULT,
@@ -103,8 +110,16 @@ typedef enum obs_normal_space {
     X(radius, FLOAT, 0.5, 1e-4, 1e4, NULL,                                     \
       "AO distance D in world units, as in a ray tracer's AO (the fraction "  \
       "of cosine-weighted rays unblocked within D, Cycles' AO pass); VAO's "   \
-      "kernel width R = D: its tangent sphere (radius D/2) is the largest "    \
-      "sphere inside that hemisphere (bench/QUALITY.md); R below is this")     \
+      "kernel width R (below) follows from it by ao_definition: 2 D (rays) "   \
+      "or D (volume)")                                                         \
+    X(ao_definition, ENUM, "rays", 0, 0, "rays|volume",                        \
+      "what methods vaopp and vao return: rays, a ray tracer's AO within "    \
+      "radius D: R = 2 D, so the tangent sphere (radius D) touches a wall "    \
+      "exactly when rays of length D reach it, and eq 1's volume fraction is " \
+      "converted to the fraction of unblocked cosine-weighted rays through "   \
+      "a floor-wall crease, where both are known in closed form (occlusion "   \
+      "over 1/2 unchanged; bench/QUALITY.md); volume: the paper's "            \
+      "volumetric obscurance itself, R = D (tangent sphere of radius D/2)")    \
     X(samples, INT, 16, 2, 32, "2|4|8|16|32",                                  \
       "line samples per pixel on the tangent sphere's disk; the sets of "     \
       "VAO++ 4.5 (rotation-aware Poisson disk, best rotation permutation, "    \

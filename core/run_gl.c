@@ -52,11 +52,11 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
     if (ctx->prog.composite)
         return OBS_OK;
     const char *comp[] = {glsl_version, obs__shader_composite_frag};
-    const char *lum[] = {glsl_version, obs__shader_luminance_frag};
+    const char *lum[] = {glsl_version, obs__shader_common, obs__shader_luminance_frag};
     obs_status s = obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2,
                                    &ctx->prog.composite, err);
     if (s == OBS_OK)
-        s = obs__gl_program("luminance", obs__shader_fullscreen_vert, lum, 2, &ctx->prog.luminance,
+        s = obs__gl_program("luminance", obs__shader_fullscreen_vert, lum, 3, &ctx->prog.luminance,
                             err);
     return s;
 }
@@ -328,7 +328,7 @@ static void read_back(GLuint fbo, GLenum attachment, int w, int h, GLenum format
 const char *obs_pass_name(obs_pass p)
 {
     static const char *const names[OBS_PASS_COUNT] = {
-        "upload", "prep", "cull", "ao", "blur", "luminance", "composite", "readback"};
+        "upload", "prep", "cull", "ao", "blur", "finish", "composite", "readback"};
     return (unsigned)p < OBS_PASS_COUNT ? names[p] : "unknown";
 }
 
@@ -516,15 +516,17 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         pass_end(ctx);
     }
 
-    /* luminance sensitivity (section 4.3, eq 3), after the blur (see
-     * luminance.frag.glsl): ao -> tex_blur, free once the blur is done */
+    /* the finishing pass, after the blur (luminance.frag.glsl): the
+     * conversion of ao_definition rays, luminance sensitivity (section
+     * 4.3, eq 3); ao -> tex_blur, free once the blur is done */
     GLuint ao_tex = t->tex_ao, ao_fbo = t->fbo_ao;
-    if (f.luminance) {
-        pass_begin(ctx, OBS_PASS_LUMINANCE, &ran);
+    if (f.rays || f.luminance) {
+        pass_begin(ctx, OBS_PASS_FINISH, &ran);
         prog = ctx->prog.luminance;
         glUseProgram(prog);
         bind_tex(prog, "u_ao", 0, t->tex_ao);
         bind_tex(prog, "u_color", 1, t->tex_color);
+        glUniform1i(glGetUniformLocation(prog, "u_rays"), f.rays);
         glUniform1i(glGetUniformLocation(prog, "u_luminance"), f.luminance);
         glUniform1f(glGetUniformLocation(prog, "u_lum_threshold"), f.lum_threshold);
         glUniform1f(glGetUniformLocation(prog, "u_lum_width"), f.lum_width);

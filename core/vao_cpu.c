@@ -208,6 +208,23 @@ float obs__range_falloff(const obs__frame *f, float d, float nz)
     return f->range_u / fmaxf(f->range_u, d / f->radius); /* eq 4 */
 }
 
+/* GLSL: rays_from_volume() in luminance.frag.glsl */
+float obs__rays_from_volume(float ao)
+{
+    const float pi = 3.14159265358979f;
+    float o = 1.0f - fminf(fmaxf(ao, 0.0f), 1.0f); /* occluded fraction of the sphere */
+    if (o >= 0.5f)
+        return ao; /* deeper than the crease's corner: unchanged */
+    /* o = (1 - b)^2 (2 + b) / 4 is the cubic t^3 - 3t^2 + 4o = 0 in
+     * t = 1 - b; its root with b in [0, 1] (trigonometric form):
+     * b = 2 cos((acos(1 - 2o) + pi) / 3), 1 at o = 0, 0 at o = 1/2. */
+    float b = 2.0f * cosf((acosf(1.0f - 2.0f * o) + pi) / 3.0f);
+    b = fminf(fmaxf(b, 0.0f), 1.0f);
+    /* cosine-weighted rays of length D blocked by the wall at b D */
+    float blocked = (acosf(b) - b * sqrtf(fmaxf(0.0f, 1.0f - b * b))) / pi;
+    return 1.0f - blocked;
+}
+
 /* GLSL: disk_map() in common.glsl */
 void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
                    obs__disk *m)
@@ -488,9 +505,14 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
         }
     /* low-pass filter (section 4.6), then composite */
     obs__blur(&f, pos, ao, tmp);
-    /* luminance sensitivity (section 4.3, eq 3), after the blur: the
-     * blur is depth-aware only and would carry a bright pixel's
+    /* the finishing pass (luminance.frag.glsl), after the blur: the
+     * conversion of ao_definition rays (not linear: applied to the
+     * filtered estimate), then luminance sensitivity (section 4.3, eq 3):
+     * the blur is depth-aware only and would carry a bright pixel's
      * suppression onto its dark neighbours (and their occlusion onto it) */
+    if (f.rays)
+        for (size_t i = 0; i < npx; i++)
+            ao[i] = obs__rays_from_volume(ao[i]);
     for (size_t i = 0; out->luminance.data && i < npx; i++)
         out->luminance.data[i] = f.luminance ? obs__luminance_factor(&f, col + 4 * i) : 1.0f;
     if (f.luminance)

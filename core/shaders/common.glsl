@@ -117,6 +117,25 @@ float range_falloff(float d, float nz, float R, float u, int along_normal)
     return u / max(u, d / R);
 }
 
+// ao_definition rays: the AO of cosine-weighted rays of length D for the
+// AO ao of the tangent sphere of radius D (R = 2 D), through a floor-wall
+// crease, where both are known in closed form: a wall at x = b D fills
+// (1 - b)^2 (2 + b) / 4 of the sphere and blocks (acos b - b sqrt(1 -
+// b^2)) / pi of the rays.  The first is inverted for b (the root in
+// [0, 1] of the cubic, trigonometric form), the second is returned as
+// AO; an occlusion over 1/2, deeper than the crease's corner, is kept.
+// Run after the blur (luminance.frag.glsl) and on the deep pass's nodes.
+// C twin: obs__rays_from_volume.
+float rays_from_volume(float ao)
+{
+    const float PI = 3.14159265358979;
+    float o = 1.0 - clamp(ao, 0.0, 1.0);
+    if (o >= 0.5)
+        return ao;
+    float b = clamp(2.0 * cos((acos(1.0 - 2.0 * o) + PI) / 3.0), 0.0, 1.0);
+    return 1.0 - (acos(b) - b * sqrt(max(0.0, 1.0 - b * b))) / PI;
+}
+
 // Tangent frame of n (Duff et al., "Building an orthonormal basis,
 // revisited", 2017): t1, t2, n orthonormal.  C twin: obs__hemisphere_basis.
 void tangent_basis(vec3 n, out vec3 t1, out vec3 t2)

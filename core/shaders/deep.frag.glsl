@@ -128,13 +128,18 @@ float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
     return u_hs_count > 0 ? 1.0 - occ / float(u_hs_count) : 1.0;
 }
 
-// The per-sample estimator of the method: VAO++'s or method hemisphere's.
+uniform int u_rays;     // 1: ao_definition rays (rays_from_volume, common.glsl)
+
+// The per-sample estimator of the method: VAO++'s or method hemisphere's;
+// VAO++'s converted to the ray-traced AO under ao_definition rays (C
+// twin: method_ao in deep_cpu.c).
 float method_ao(ivec2 px, vec3 p, vec3 n, bool interior)
 {
 #if OBS_DEEP_HEMISPHERE
     return hemisphere_ao(px, p, n, interior);
 #else
-    return sphere_ao(px, p, n, interior);
+    float v = sphere_ao(px, p, n, interior);
+    return u_rays != 0 ? rays_from_volume(v) : v;
 #endif
 }
 

@@ -1,11 +1,17 @@
-// Luminance sensitivity (VAO++ section 4.3, eq 3), run after the blur:
-// the blur is depth-aware only and would carry a bright pixel's
-// suppression onto its dark neighbours (and their occlusion onto it).
-// C twin: obs__luminance_ao (luminance_cpu.c).
+// The finishing pass, run after the blur: ao_definition rays' conversion
+// of the volume fraction, then luminance sensitivity (VAO++ section 4.3,
+// eq 3).  Both act on the filtered AO: the conversion is not linear, so
+// it is applied to the blur's noise-free estimate; the blur is
+// depth-aware only and would carry a bright pixel's suppression onto its
+// dark neighbours (and their occlusion onto it).  Two cheap per-pixel
+// switches, uniforms (this pass samples nothing around the pixel).
+// rays_from_volume is in common.glsl.  C twins: obs__rays_from_volume
+// (vao_cpu.c), obs__luminance_ao (luminance_cpu.c).
 
 uniform sampler2D u_ao;          // AO after the blur
 uniform sampler2D u_color;       // G-buffer colour
-uniform int u_luminance;         // 1 Rec. 709 luminance, 2 HSV V
+uniform int u_rays;              // 1: convert the volume fraction (ao_definition rays)
+uniform int u_luminance;         // 0 off, 1 Rec. 709 luminance, 2 HSV V
 uniform float u_lum_threshold, u_lum_width, u_lum_sigma;
 
 layout(location = 0) out float o_ao;
@@ -29,7 +35,10 @@ float luminance_factor(vec3 rgb)
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    float k = luminance_factor(texelFetch(u_color, px, 0).rgb);
-    o_ao = 1.0 - (1.0 - texelFetch(u_ao, px, 0).r) * k;
+    float ao = texelFetch(u_ao, px, 0).r;
+    if (u_rays != 0)
+        ao = rays_from_volume(ao);
+    float k = u_luminance != 0 ? luminance_factor(texelFetch(u_color, px, 0).rgb) : 1.0;
+    o_ao = 1.0 - (1.0 - ao) * k;
     o_factor = k;
 }

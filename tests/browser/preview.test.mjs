@@ -105,11 +105,11 @@ try {
   check('slider defaults come from the table (radius ' + radiusDefault + ')', radiusDefault === '0.5');
 
   await page.locator('input[name=view][value=ao]').check();
-  let resp = await postFrame('shot', CAM + '&radius=0.01');
+  let resp = await postFrame('shot', CAM + '&radius=0.1');
   check('frame 1 posted to stream shot: ' + resp.status, resp.status === 200 && resp.headers.get('x-obscura-frame') === '1');
   await shown(page, 1, 'shot');
   const m1 = pngMean(await page.locator('#img-base').screenshot());
-  resp = await postFrame('shot', CAM + '&radius=1');
+  resp = await postFrame('shot', CAM + '&radius=3');
   check('frame 2 posted: ' + resp.status, resp.status === 200 && resp.headers.get('x-obscura-frame') === '2');
   await shown(page, 2, 'shot');
   const m2 = pngMean(await page.locator('#img-base').screenshot());

@@ -92,7 +92,10 @@ static void test_count_ortho(void **state)
     /* half-width 40, half-height 30 world units: a disk of diameter 0.5
      * spans 0.5 / 60 of the height, q = (0.5/60 / 0.01)^2 = 0.69 -> 2 */
     const float P[16] = {1.0f / 40, 0, 0, 0, 0, 1.0f / 30, 0, 0, 0, 0, -0.02f, -1, 0, 0, 0, 1};
-    in.radius = 0.5f / OBS__RADIUS_K; /* a disk of diameter R = 0.5: radius is the AO distance D, R = OBS__RADIUS_K * D */
+    /* a disk of diameter R = 0.5: radius is the AO distance D, and the
+     * volume definition's kernel width is R = D (frame.h) */
+    in.radius = 0.5f;
+    in.ao_definition = OBS_AO_VOLUME;
     setup(&f, P, &in);
     for (float z = 1.0f; z < 100.0f; z *= 3.0f) {
         const float c[3] = {1, 2, -z};
@@ -130,8 +133,11 @@ static double check_scene(const char *exr, const char *camera, int samples, floa
     load(exr, camera, &gf);
     p.samples = samples;
     p.adaptive_diameter = diameter;
-    /* the kernel width R = 0.5 these expectations were built for: radius is the AO distance D, R = OBS__RADIUS_K * D (frame.h); the bounds below (fractions surely far) were set for it */
-    p.radius = 0.5f / OBS__RADIUS_K;
+    /* the kernel width R = 0.5 these expectations were built for: radius
+     * is the AO distance D, and the volume definition's R = D (frame.h);
+     * the bounds below (fractions surely far) were set for it */
+    p.radius = 0.5f;
+    p.ao_definition = OBS_AO_VOLUME;
     p.blur = OBS_OFF;
     p.culling = OBS_CULLING_OFF; /* 4.2 would cap culled pixels at 4 samples */
     p.adaptive = OBS_OFF;

@@ -38,7 +38,10 @@ static void run(const obs_gbuffer *gb, const char *bleeding, unsigned outputs, o
 {
     obs_params p = {0};
     char err[OBS_ERR_LEN] = "";
-    p.radius = 0.5f / OBS__RADIUS_K; /* the kernel width R = 0.5 these expectations were built for: radius is the AO distance D, R = OBS__RADIUS_K * D (frame.h) */
+    /* the kernel width R = 0.5 these expectations were built for: radius
+     * is the AO distance D, and the volume definition's R = D (frame.h) */
+    p.radius = 0.5f;
+    p.ao_definition = OBS_AO_VOLUME;
     assert_int_equal(obs_param_set(&p, "normal_space", "camera", err), OBS_OK);
     assert_int_equal(obs_param_set(&p, "bleeding", bleeding, err), OBS_OK);
     if (obs_run_cpu(gb, &p, outputs, r, err) != OBS_OK)
@@ -125,7 +128,8 @@ static void test_room_small(void **state)
     obs_params p = {0};
     char err[OBS_ERR_LEN] = "";
     (void)state;
-    p.radius = 0.5f / OBS__RADIUS_K; /* R = 0.5, as measured below (see run()) */
+    p.radius = 0.5f; /* R = 0.5, as measured below (see run()) */
+    p.ao_definition = OBS_AO_VOLUME;
     if (obs_gbuffer_read_exr(TESTDATA "/room_small.exr", NULL, NULL, &gf, err) != OBS_OK ||
         obs_camera_read_json(TESTDATA "/room_small.camera.json", &gf.gb.camera, NULL, NULL, err) !=
             OBS_OK)

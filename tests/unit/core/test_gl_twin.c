@@ -113,8 +113,9 @@ static void test_gl_matches_cpu(void **state)
         obs_gbuffer_file gf = {0};
         char err[OBS_ERR_LEN] = "";
         load(scenes[s], &gf);
-        /* the defaults (range check, 5-tap blur, adaptive sampling on),
-         * then a wide blur with the range check off, then no blur, then
+        /* the defaults (range check, 5-tap blur, adaptive sampling on,
+         * ao_definition rays), then the paper's volume fraction without
+         * and with luminance sensitivity, then a wide blur with the range check off, then no blur, then
          * adaptive sampling with a diameter that spreads the counts over
          * 2..32, then a fixed count, then the greedy culling pre-pass
          * (section 4.2; the defaults use careful) and none, then
@@ -123,6 +124,8 @@ static void test_gl_matches_cpu(void **state)
          * every fourth, the latter with luminance sensitivity too */
         static const char *const variants[][2][2] = {
             {{NULL, NULL}, {NULL, NULL}},
+            {{"ao_definition", "volume"}, {NULL, NULL}},
+            {{"ao_definition", "volume"}, {"luminance", "lum"}},
             {{"blur_radius", "7"}, {"range_check", "off"}},
             {{"range_distance", "view"}, {"blur", "off"}},
             {{"blur", "off"}, {NULL, NULL}},
@@ -228,6 +231,7 @@ static void test_pass_times(void **state)
     assert_int_equal(obs_ctx_set_timing(ctx, 1, err), OBS_OK);
     obs_params p = {0};
     assert_int_equal(obs_param_set(&p, "culling", "off", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "ao_definition", "volume", err), OBS_OK);
     assert_int_equal(obs_run(ctx, &gf.gb, &p, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE, &r, err),
                      OBS_OK);
     obs_result_free(&r);
@@ -239,7 +243,7 @@ static void test_pass_times(void **state)
             sum += t.ms[k];
     }
     assert_true(t.ms[OBS_PASS_CULL] == -1.0);      /* culling off */
-    assert_true(t.ms[OBS_PASS_LUMINANCE] == -1.0); /* off by default */
+    assert_true(t.ms[OBS_PASS_FINISH] == -1.0); /* no conversion, luminance off */
     assert_true(t.ms[OBS_PASS_AO] > 0.0);
     assert_true(t.ms[OBS_PASS_PREP] >= 0.0 && t.ms[OBS_PASS_BLUR] >= 0.0 &&
                 t.ms[OBS_PASS_COMPOSITE] >= 0.0 && t.ms[OBS_PASS_READBACK] >= 0.0);
@@ -249,6 +253,7 @@ static void test_pass_times(void **state)
     obs_result_free(&r);
     assert_true(obs_ctx_last_times(ctx, &t));
     assert_true(t.ms[OBS_PASS_CULL] >= 0.0 && t.ms[OBS_PASS_COMPOSITE] == -1.0);
+    assert_true(t.ms[OBS_PASS_FINISH] >= 0.0); /* ao_definition rays' conversion */
     assert_int_equal(obs_ctx_set_timing(ctx, 0, err), OBS_OK);
     assert_false(obs_ctx_last_times(ctx, &t));
     assert_string_equal(obs_pass_name(OBS_PASS_COUNT), "unknown");

@@ -436,10 +436,13 @@ static void test_method_params(void **state)
     expect_refused("vaopp", "hbao_steps", "4");
     expect_refused("hbao", "hemisphere_samples", "6");
     expect_refused("hemisphere", "angle_acos", "exact");
+    expect_refused("hbao", "ao_definition", "rays");
+    expect_refused("angle", "ao_definition", "volume");
     /* agreeing values and the shared chain are fine */
     expect_accepted("vao", "adaptive", "off");
     expect_accepted("vao", "samples", "32");
     expect_accepted("vao", "bleeding", "full");
+    expect_accepted("vao", "ao_definition", "volume");
     expect_accepted("hbao", "culling", "off");
     expect_accepted("hbao", "luminance", "lum");
     expect_accepted("angle", "blur_radius", "4");

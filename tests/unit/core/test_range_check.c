@@ -93,12 +93,12 @@ static void check_scene(const char *exr, const char *camera)
     obs_params_resolve(NULL, &p);
     /* the range check alone: the blur would smear the band's edges */
     p.blur = OBS_OFF;
-    /* radius is the AO distance D and the kernel width is R = OBS__RADIUS_K
-     * * D (frame.h); this test was set up for R = 0.5 (the old meaning of
-     * radius 0.5), and at the default R = 1.13 the image-wide MSE no longer
-     * drops with the check on (bench/QUALITY.md), so it keeps R = 0.5 */
-    p.radius = 0.5f / OBS__RADIUS_K;
-    unsigned char *band = halo_band(&depth, OBS__RADIUS_K * p.radius / p.unit_scale);
+    /* radius is the AO distance D; this test measures eq 4 on the paper's
+     * volumetric obscurance with the kernel width R = D = 0.5 (frame.h,
+     * ao_definition volume) */
+    p.radius = 0.5f;
+    p.ao_definition = OBS_AO_VOLUME;
+    unsigned char *band = halo_band(&depth, p.radius / p.unit_scale);
     err_stats on, view, off;
     obs_result r;
     p.range_check = OBS_ON;

@@ -1,6 +1,9 @@
 /* The VAO math of the CPU twin on analytic scenes (VAO++ section 3):
  * an open plane is unoccluded, a point on the inner corner of two
- * perpendicular planes is half occluded. */
+ * perpendicular planes is half occluded.  These run the paper's
+ * volumetric obscurance (ao_definition volume); the conversion of
+ * ao_definition rays is checked in closed form and on the crease at the
+ * end. */
 #include <math.h>
 
 #include "testutil.h"
@@ -97,6 +100,8 @@ static obs_params camera_normals(int samples)
     obs_params p = {0};
     char err[OBS_ERR_LEN];
     obs_param_set(&p, "normal_space", "camera", err);
+    /* the paper's volume fraction, R = radius (frame.h) */
+    obs_param_set(&p, "ao_definition", "volume", err);
     /* the VAO estimate itself, not the low-pass filter (test_blur.c) */
     obs_param_set(&p, "blur", "off", err);
     /* every pixel with its own count, none culled (4.2: test_culling.c) */
@@ -371,8 +376,8 @@ static void test_range_check_closed_form(void **state)
         obs_params p = camera_normals(16), rp;
         char err[OBS_ERR_LEN];
         /* R = 0.5 (the occluder depths below are chosen for it): radius is
-         * the AO distance D, R = OBS__RADIUS_K * D (frame.h) */
-        p.radius = 0.5f / OBS__RADIUS_K;
+         * the AO distance D, and the volume definition's R = D (frame.h) */
+        p.radius = 0.5f;
         if (pass == 1)
             obs_param_set(&p, "range_check", "off", err);
         if (pass == 2)
@@ -414,6 +419,109 @@ static void test_range_check_closed_form(void **state)
     free(s);
 }
 
+/* The crease profiles of frame.h, written out here: a wall at distance
+ * x = b D from p on the floor fills vol(b) of the tangent sphere of
+ * radius D and blocks ray(b) of the cosine-weighted rays of length D. */
+static double crease_vol(double b) { return b >= 1 ? 0 : (1 - b) * (1 - b) * (2 + b) / 4; }
+static double crease_ray(double b) { return b >= 1 ? 0 : (acos(b) - b * sqrt(1 - b * b)) / M_PI; }
+
+/* ao_definition rays in closed form: the volume AO of a crease at b
+ * becomes the ray AO of the same crease (values of bench/QUALITY.md's
+ * crease table: 0.436 at b = 0.1, 0.343 at 0.25, 0.196 at 0.5, 0.072 at
+ * 0.75 blocked); open stays open, the corner stays 1/2, an occlusion over
+ * 1/2 is unchanged, and the map is monotone. */
+static void test_rays_closed_form(void **state)
+{
+    (void)state;
+    static const double table[][2] = {{0.1, 0.436}, {0.25, 0.343}, {0.5, 0.196}, {0.75, 0.072}};
+    for (size_t i = 0; i < sizeof table / sizeof table[0]; i++) {
+        double b = table[i][0];
+        assert_float_equal(crease_ray(b), table[i][1], 5e-4);
+        float ao = obs__rays_from_volume((float)(1 - crease_vol(b)));
+        assert_float_equal(ao, 1 - table[i][1], 1e-3);
+        assert_float_equal(ao, 1 - crease_ray(b), 2e-5);
+    }
+    for (double b = 0; b <= 1.0; b += 1.0 / 64)
+        assert_float_equal(obs__rays_from_volume((float)(1 - crease_vol(b))), 1 - crease_ray(b),
+                           5e-5);
+    assert_float_equal(obs__rays_from_volume(1.0f), 1.0f, 1e-6f);
+    assert_float_equal(obs__rays_from_volume(0.5f), 0.5f, 1e-6f);
+    assert_float_equal(obs__rays_from_volume(0.3f), 0.3f, 0.0f);
+    assert_float_equal(obs__rays_from_volume(0.0f), 0.0f, 0.0f);
+    float last = -1.0f;
+    for (int i = 0; i <= 1000; i++) {
+        float ao = obs__rays_from_volume((float)i / 1000.0f);
+        assert_true(ao >= last && ao <= (float)i / 1000.0f + 1e-6f); /* never lighter */
+        last = ao;
+    }
+}
+
+/* ao_definition rays through obs_run_cpu on the scenes above: an open
+ * plane facing the camera stays exactly open, and the floor in front of a
+ * wall follows the ray tracer's crease profile 1 - ray(x / D) (R = 2 D)
+ * where the paper's volume (R = D) follows 1 - vol(x / (D / 2)), zero from
+ * x = D / 2 on although the rays reach the wall up to x = D. */
+static void test_rays_crease(void **state)
+{
+    scene *s = malloc(sizeof *s);
+    (void)state;
+    float P[16];
+    char err[OBS_ERR_LEN];
+    perspective(P, 60.0f);
+    plane facing = {{0, 0, 1}, -5.0f};
+    render(s, P, &facing, 1);
+    obs_params p = camera_normals(16);
+    obs_param_set(&p, "ao_definition", "rays", err);
+    obs_result r;
+    run(s, &p, &r);
+    for (int i = 0; i < W * H; i++)
+        assert_float_equal(r.ao.data[i], 1.0f, 1e-6f);
+    obs_result_free(&r);
+
+    /* the corner of test_corner_scene, D = 0.5 */
+    float wall_depth = P[5] / ((52 + 0.5f) / H * 2 - 1);
+    plane pl[2] = {{{0, 1, 0}, -1.0f}, {{0, 0, 1}, -wall_depth}};
+    render(s, P, pl, 2);
+    const double D = 0.5;
+    double dev[2] = {0, 0}, at_reach[2] = {0, 0};
+    int n = 0, n_reach = 0;
+    for (int v = 0; v < 2; v++) {
+        obs_params q = camera_normals(32);
+        q.radius = (float)D;
+        obs_param_set(&q, "ao_definition", v ? "volume" : "rays", err);
+        run(s, &q, &r);
+        n = n_reach = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 3; x < W - 3; x++) {
+                float o[3], d[3];
+                pixel_ray(P, x, y, o, d);
+                if (s->normal[3 * (y * W + x) + 1] < 0.5f)
+                    continue; /* the wall */
+                double dist = wall_depth - s->depth[y * W + x]; /* floor to wall */
+                if (dist > D)
+                    continue;
+                double e = r.ao.data[y * W + x] - (1 - crease_ray(dist / D));
+                dev[v] += fabs(e);
+                n++;
+                if (dist > 0.5 * D) { /* beyond the volume sphere's reach */
+                    at_reach[v] += r.ao.data[y * W + x];
+                    n_reach++;
+                }
+            }
+        dev[v] /= n;
+        at_reach[v] /= n_reach;
+        obs_result_free(&r);
+    }
+    print_message("crease, %d floor px within D of the wall: mean |AO - (1 - ray(x/D))| rays "
+                  "%.4f, volume %.4f; mean AO from D/2 to D (%d px): rays %.4f, volume %.4f\n",
+                  n, dev[0], dev[1], n_reach, at_reach[0], at_reach[1]);
+    assert_true(n > 100 && n_reach > 20);
+    assert_true(dev[0] < 0.03);
+    assert_true(dev[0] < dev[1] / 3);
+    assert_true(at_reach[1] > 0.99 && at_reach[0] < 0.97);
+    free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -423,6 +531,8 @@ int main(void)
         cmocka_unit_test(test_inner_corner),
         cmocka_unit_test(test_corner_scene),
         cmocka_unit_test(test_range_check_closed_form),
+        cmocka_unit_test(test_rays_closed_form),
+        cmocka_unit_test(test_rays_crease),
     };
     return cmocka_run_group_tests_name("vao_math", tests, NULL, NULL);
 }
