@@ -13,7 +13,8 @@ set -eu
 # (every row runs at --radius $DISTANCE on the scene's Blender G-buffer; a
 # row whose parameters this build refuses is reported and skipped)
 METHODS='
-vao          --adaptive off --culling off --range-check off --blur off
+vao          --adaptive off --culling off --range-check off --blur off --ao-definition volume
+vaopp-volume --ao-definition volume
 vaopp-8      --samples 8
 vaopp-16     --samples 16
 vaopp-32     --samples 32
