@@ -73,13 +73,15 @@ void obs__deep_release(obs_ctx *ctx) { release(ctx, 1); }
 enum {
     DEEP_HEMISPHERE = 1, /* OBS_DEEP_HEMISPHERE: method hemisphere's samples */
     DEEP_THIN = 2,       /* OBS_DEEP_THIN: thin hulls, OITAO eqs 2-4 */
-    DEEP_RANGE = 4       /* OBS_RANGE_CHECK: VAO++ 4.4, eq 4 */
+    DEEP_RANGE = 4,      /* OBS_RANGE_CHECK: VAO++ 4.4, eq 4 */
+    DEEP_RAYS = 8        /* OBS_RAYS: ao_definition rays' conversion of the VAO nodes */
 };
 
 static unsigned deep_variant(const obs__deep_frame *df)
 {
     return (df->f.method == OBS_METHOD_HEMISPHERE ? DEEP_HEMISPHERE : 0u) |
-           (df->thin ? DEEP_THIN : 0u) | (df->f.range_check ? DEEP_RANGE : 0u);
+           (df->thin ? DEEP_THIN : 0u) | (df->f.range_check ? DEEP_RANGE : 0u) |
+           (df->f.rays ? DEEP_RAYS : 0u);
 }
 
 /* The program of variant v, and the targets for w x h with m nodes: kept
@@ -94,8 +96,9 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
         char defs[128];
         snprintf(defs, sizeof defs,
                  "#define OBS_DEEP_HEMISPHERE %d\n#define OBS_DEEP_THIN %d\n"
-                 "#define OBS_RANGE_CHECK %d\n",
-                 (v & DEEP_HEMISPHERE) != 0, (v & DEEP_THIN) != 0, (v & DEEP_RANGE) != 0);
+                 "#define OBS_RANGE_CHECK %d\n#define OBS_RAYS %d\n",
+                 (v & DEEP_HEMISPHERE) != 0, (v & DEEP_THIN) != 0, (v & DEEP_RANGE) != 0,
+                 (v & DEEP_RAYS) != 0);
         const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_deep_frag};
         if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, 4, &t->prog[v], err)) !=
             OBS_OK) {
@@ -203,7 +206,6 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
     glUniform2i(glGetUniformLocation(prog, "u_size"), w, h);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
-    glUniform1i(glGetUniformLocation(prog, "u_rays"), f->rays);
     glUniform1i(glGetUniformLocation(prog, "u_ns"), f->samples);
     glUniform2fv(glGetUniformLocation(prog, "u_samples"), f->samples, f->sample_xy);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);

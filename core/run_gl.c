@@ -52,13 +52,22 @@ static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
     if (ctx->prog.composite)
         return OBS_OK;
     const char *comp[] = {glsl_version, obs__shader_composite_frag};
-    const char *lum[] = {glsl_version, obs__shader_common, obs__shader_luminance_frag};
-    obs_status s = obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2,
-                                   &ctx->prog.composite, err);
-    if (s == OBS_OK)
-        s = obs__gl_program("luminance", obs__shader_fullscreen_vert, lum, 3, &ctx->prog.luminance,
-                            err);
-    return s;
+    return obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2, &ctx->prog.composite,
+                           err);
+}
+
+/* The finishing pass (luminance.frag.glsl) with the conversion of
+ * ao_definition rays (OBS_RAYS) and luminance sensitivity (OBS_LUMINANCE)
+ * compiled in or out, built on its first use: prog.finish[2 * rays + lum]. */
+static obs_status build_finish_program(obs_ctx *ctx, int rays, int lum, char err[OBS_ERR_LEN])
+{
+    GLuint *prog = &ctx->prog.finish[2 * rays + lum];
+    if ((!rays && !lum) || *prog)
+        return OBS_OK;
+    char defs[64];
+    snprintf(defs, sizeof defs, "#define OBS_RAYS %d\n#define OBS_LUMINANCE %d\n", rays, lum);
+    const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_luminance_frag};
+    return obs__gl_program("finish", obs__shader_fullscreen_vert, src, 4, prog, err);
 }
 
 /* The prep pass that reads the normals or derives them from depth
@@ -87,16 +96,18 @@ static obs_status build_prep_program(obs_ctx *ctx, const obs__frame *f, char err
 }
 
 /* The blur of half-width radius (section 4.6), built on its first use:
- * the radius is a compile-time constant, so the taps' loop is unrolled. */
-static obs_status build_blur_program(obs_ctx *ctx, int radius, char err[OBS_ERR_LEN])
+ * the radius is a compile-time constant, so the taps' loop is unrolled;
+ * rays 1 is the vertical pass that also converts its result
+ * (ao_definition rays, OBS_RAYS in blur.frag.glsl). */
+static obs_status build_blur_program(obs_ctx *ctx, int rays, int radius, char err[OBS_ERR_LEN])
 {
-    if (radius <= 0 || ctx->prog.blur[radius])
+    if (radius <= 0 || ctx->prog.blur[rays][radius])
         return OBS_OK;
-    char def[32];
-    snprintf(def, sizeof def, "#define BLUR_RADIUS %d\n", radius);
+    char def[64];
+    snprintf(def, sizeof def, "#define BLUR_RADIUS %d\n#define OBS_RAYS %d\n", radius, rays);
     const char *src[] = {glsl_version, def, obs__shader_common, obs__shader_blur_frag};
-    return obs__gl_program("blur", obs__shader_fullscreen_vert, src, 4, &ctx->prog.blur[radius],
-                           err);
+    return obs__gl_program("blur", obs__shader_fullscreen_vert, src, 4,
+                           &ctx->prog.blur[rays][radius], err);
 }
 
 /* The AO program of a comparison method (parameter method), built on its
@@ -158,10 +169,10 @@ void obs__frame_release(obs_ctx *ctx)
     OBS__GL_DELETE_PROGRAMS(g->prep);
     OBS__GL_DELETE_PROGRAMS(g->vao);
     OBS__GL_DELETE_PROGRAMS(g->cull);
-    OBS__GL_DELETE_PROGRAMS(g->blur);
+    obs__gl_delete_programs(&g->blur[0][0], sizeof g->blur / sizeof g->blur[0][0]);
     OBS__GL_DELETE_PROGRAMS(g->method);
+    OBS__GL_DELETE_PROGRAMS(g->finish);
     obs__gl_delete_programs(&g->composite, 1);
-    obs__gl_delete_programs(&g->luminance, 1);
     memset(&ctx->prog, 0, sizeof ctx->prog);
 }
 
@@ -417,8 +428,16 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         s = build_vao_program(ctx, 0, ao_variant(&f), err);
     if (s == OBS_OK && f.culling)
         s = build_vao_program(ctx, 1, ao_variant(&f), err);
+    /* ao_definition rays converts the blurred AO: in the blur's vertical
+     * pass, or in the finishing pass when there is no blur */
+    const int rays_in_blur = f.rays && f.blur_radius > 0;
+    const int finish_rays = f.rays && !rays_in_blur, finish_lum = f.luminance != 0;
     if (s == OBS_OK)
-        s = build_blur_program(ctx, f.blur_radius, err);
+        s = build_blur_program(ctx, 0, f.blur_radius, err);
+    if (s == OBS_OK)
+        s = build_blur_program(ctx, rays_in_blur, f.blur_radius, err);
+    if (s == OBS_OK)
+        s = build_finish_program(ctx, finish_rays, finish_lum, err);
     if (s == OBS_OK)
         s = build_prep_program(ctx, &f, err);
     if (s != OBS_OK)
@@ -499,34 +518,35 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     /* low-pass filter (section 4.6): ao -> blur along x -> ao along y */
     if (f.blur_radius > 0) {
         pass_begin(ctx, OBS_PASS_BLUR, &ran);
-        prog = ctx->prog.blur[f.blur_radius];
-        glUseProgram(prog);
-        set_common(prog, &f);
-        glUniform1fv(glGetUniformLocation(prog, "u_blur_w"), f.blur_radius + 1, f.blur_w);
-        glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
-        bind_img(prog, "u_ao", 0, t->tex_ao, GL_RG32F);
-        glUniform2i(glGetUniformLocation(prog, "u_dir"), 1, 0);
-        const GLenum blur_bufs[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
-        glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_blur);
-        glDrawBuffers(2, blur_bufs);
-        draw(ctx, t->fbo_blur, w, h);
-        bind_img(prog, "u_ao", 0, t->tex_blur, GL_RG32F);
-        glUniform2i(glGetUniformLocation(prog, "u_dir"), 0, 1);
-        draw(ctx, t->fbo_ao, w, h);
+        for (int pass = 0; pass < 2; pass++) { /* along x, then along y */
+            prog = ctx->prog.blur[pass ? rays_in_blur : 0][f.blur_radius];
+            glUseProgram(prog);
+            set_common(prog, &f);
+            glUniform1fv(glGetUniformLocation(prog, "u_blur_w"), f.blur_radius + 1, f.blur_w);
+            glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
+            bind_img(prog, "u_ao", 0, pass ? t->tex_blur : t->tex_ao, GL_RG32F);
+            glUniform2i(glGetUniformLocation(prog, "u_dir"), !pass, pass);
+            if (!pass) {
+                const GLenum blur_bufs[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+                glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_blur);
+                glDrawBuffers(2, blur_bufs);
+            }
+            draw(ctx, pass ? t->fbo_ao : t->fbo_blur, w, h);
+        }
         pass_end(ctx);
     }
 
     /* the finishing pass, after the blur (luminance.frag.glsl): the
-     * conversion of ao_definition rays, luminance sensitivity (section
-     * 4.3, eq 3); ao -> tex_blur, free once the blur is done */
+     * conversion of ao_definition rays when there was no blur to do it,
+     * luminance sensitivity (section 4.3, eq 3); ao -> tex_blur, free once
+     * the blur is done */
     GLuint ao_tex = t->tex_ao, ao_fbo = t->fbo_ao;
-    if (f.rays || f.luminance) {
+    if (finish_rays || finish_lum) {
         pass_begin(ctx, OBS_PASS_FINISH, &ran);
-        prog = ctx->prog.luminance;
+        prog = ctx->prog.finish[2 * finish_rays + finish_lum];
         glUseProgram(prog);
         bind_tex(prog, "u_ao", 0, t->tex_ao);
         bind_tex(prog, "u_color", 1, t->tex_color);
-        glUniform1i(glGetUniformLocation(prog, "u_rays"), f.rays);
         glUniform1i(glGetUniformLocation(prog, "u_luminance"), f.luminance);
         glUniform1f(glGetUniformLocation(prog, "u_lum_threshold"), f.lum_threshold);
         glUniform1f(glGetUniformLocation(prog, "u_lum_width"), f.lum_width);

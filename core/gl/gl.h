@@ -189,14 +189,17 @@ obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 /* ---- the per-resolution frame resources and programs -------------------- */
 
 #define OBS__AO_VARIANTS 16  /* 4 switches of the AO pass, compiled in or out */
-#define OBS__DEEP_VARIANTS 8 /* 3 switches of the deep pass (deep_gl.c: DEEP_*) */
+#define OBS__DEEP_VARIANTS 16 /* 4 switches of the deep pass (deep_gl.c: DEEP_*) */
 
 typedef struct obs__programs {
     GLuint prep[6];   /* 3 * (normals derived from depth) + depth mode - 1; built on first use */
     GLuint vao[OBS__AO_VARIANTS]; /* AO pass by switches compiled in (run_gl.c: AO_*) */
     GLuint cull[2];               /* culling pre-pass without, with the range check */
-    GLuint composite, luminance;
-    GLuint blur[OBS__MAX_BLUR + 1]; /* by blur_radius (BLUR_RADIUS; built on first use) */
+    GLuint composite;
+    GLuint finish[4]; /* 2 * (ao_definition rays) + luminance: OBS_RAYS, OBS_LUMINANCE */
+    /* by (the vertical pass with ao_definition rays' conversion: OBS_RAYS)
+     * and blur_radius (BLUR_RADIUS); built on first use */
+    GLuint blur[2][OBS__MAX_BLUR + 1];
     GLuint method[3]; /* parameter method: hemisphere, angle, hbao (built on first use) */
 } obs__programs;
 

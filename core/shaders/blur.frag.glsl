@@ -9,6 +9,9 @@
 // unrolled, which halves the pass's time on llvmpipe (bench/RESULTS.md).
 // The AO planes carry the pixel's planar depth beside the AO (rg, written
 // by the AO pass and by each blur pass): one image load per tap.
+// OBS_RAYS (defined by the program, 0 or 1): the vertical pass converts
+// its result for ao_definition rays, so that the conversion costs no pass
+// of its own (the finishing pass does it when the blur is off).
 
 layout(rg32f) readonly uniform image2D u_ao; // AO to filter (r), planar depth (g; 0: background)
 uniform ivec2 u_size;
@@ -40,5 +43,9 @@ void main()
         sum += w * aq.x;
         wsum += w;
     }
-    o_ao = vec2(sum / wsum, zc); // the centre always counts: wsum > 0
+    float ao = sum / wsum;      // the centre always counts: wsum > 0
+#if OBS_RAYS
+    ao = rays_from_volume(ao);  // the vertical pass under ao_definition rays (common.glsl)
+#endif
+    o_ao = vec2(ao, zc);
 }

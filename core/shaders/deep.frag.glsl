@@ -128,18 +128,19 @@ float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
     return u_hs_count > 0 ? 1.0 - occ / float(u_hs_count) : 1.0;
 }
 
-uniform int u_rays;     // 1: ao_definition rays (rays_from_volume, common.glsl)
-
 // The per-sample estimator of the method: VAO++'s or method hemisphere's;
-// VAO++'s converted to the ray-traced AO under ao_definition rays (C
-// twin: method_ao in deep_cpu.c).
+// VAO++'s converted to the ray-traced AO under ao_definition rays
+// (OBS_RAYS, defined by the program; C twin: method_ao in deep_cpu.c).
 float method_ao(ivec2 px, vec3 p, vec3 n, bool interior)
 {
 #if OBS_DEEP_HEMISPHERE
     return hemisphere_ao(px, p, n, interior);
 #else
-    float v = sphere_ao(px, p, n, interior);
-    return u_rays != 0 ? rays_from_volume(v) : v;
+#if OBS_RAYS
+    return rays_from_volume(sphere_ao(px, p, n, interior)); // common.glsl
+#else
+    return sphere_ao(px, p, n, interior);
+#endif
 #endif
 }
 

@@ -3,15 +3,16 @@
 // eq 3).  Both act on the filtered AO: the conversion is not linear, so
 // it is applied to the blur's noise-free estimate; the blur is
 // depth-aware only and would carry a bright pixel's suppression onto its
-// dark neighbours (and their occlusion onto it).  Two cheap per-pixel
-// switches, uniforms (this pass samples nothing around the pixel).
+// dark neighbours (and their occlusion onto it).  OBS_RAYS and
+// OBS_LUMINANCE (0 or 1) are defined by the program: a SIMD rasteriser
+// would run both sides of a uniform branch.  With the blur on, the
+// conversion is done by the blur's vertical pass instead (blur.frag.glsl).
 // rays_from_volume is in common.glsl.  C twins: obs__rays_from_volume
 // (vao_cpu.c), obs__luminance_ao (luminance_cpu.c).
 
 uniform sampler2D u_ao;          // AO after the blur
 uniform sampler2D u_color;       // G-buffer colour
-uniform int u_rays;              // 1: convert the volume fraction (ao_definition rays)
-uniform int u_luminance;         // 0 off, 1 Rec. 709 luminance, 2 HSV V
+uniform int u_luminance;         // 1 Rec. 709 luminance, 2 HSV V
 uniform float u_lum_threshold, u_lum_width, u_lum_sigma;
 
 layout(location = 0) out float o_ao;
@@ -36,9 +37,14 @@ void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
     float ao = texelFetch(u_ao, px, 0).r;
-    if (u_rays != 0)
-        ao = rays_from_volume(ao);
-    float k = u_luminance != 0 ? luminance_factor(texelFetch(u_color, px, 0).rgb) : 1.0;
+#if OBS_RAYS
+    ao = rays_from_volume(ao);
+#endif
+#if OBS_LUMINANCE
+    float k = luminance_factor(texelFetch(u_color, px, 0).rgb);
+#else
+    float k = 1.0;
+#endif
     o_ao = 1.0 - (1.0 - ao) * k;
     o_factor = k;
 }

@@ -126,6 +126,7 @@ static void test_gl_matches_cpu(void **state)
             {{NULL, NULL}, {NULL, NULL}},
             {{"ao_definition", "volume"}, {NULL, NULL}},
             {{"ao_definition", "volume"}, {"luminance", "lum"}},
+            {{"blur", "off"}, {"luminance", "value"}},
             {{"blur_radius", "7"}, {"range_check", "off"}},
             {{"range_distance", "view"}, {"blur", "off"}},
             {{"blur", "off"}, {NULL, NULL}},
@@ -253,7 +254,15 @@ static void test_pass_times(void **state)
     obs_result_free(&r);
     assert_true(obs_ctx_last_times(ctx, &t));
     assert_true(t.ms[OBS_PASS_CULL] >= 0.0 && t.ms[OBS_PASS_COMPOSITE] == -1.0);
-    assert_true(t.ms[OBS_PASS_FINISH] >= 0.0); /* ao_definition rays' conversion */
+    /* ao_definition rays' conversion is done by the blur's vertical pass */
+    assert_true(t.ms[OBS_PASS_FINISH] == -1.0);
+    /* without the blur, by the finishing pass */
+    p = (obs_params){0};
+    assert_int_equal(obs_param_set(&p, "blur", "off", err), OBS_OK);
+    assert_int_equal(obs_run(ctx, &gf.gb, &p, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    obs_result_free(&r);
+    assert_true(obs_ctx_last_times(ctx, &t));
+    assert_true(t.ms[OBS_PASS_FINISH] >= 0.0 && t.ms[OBS_PASS_BLUR] == -1.0);
     assert_int_equal(obs_ctx_set_timing(ctx, 0, err), OBS_OK);
     assert_false(obs_ctx_last_times(ctx, &t));
     assert_string_equal(obs_pass_name(OBS_PASS_COUNT), "unknown");
