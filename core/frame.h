@@ -49,6 +49,11 @@
 #define OBS__RADIUS_K_RAYS 2.0f
 #define OBS__RADIUS_K_VOLUME 1.0f
 
+/* A VAO sample on the shaded pixel itself reads p's tangent plane under
+ * its pipe unless |n.z| is below this (the plane nearly edge-on); GLSL:
+ * OWN_PLANE_NZ in vao.glsl. */
+#define OBS__OWN_PLANE_NZ 0.05f
+
 /* Largest counts of the comparison methods' parameters (uniform array
  * sizes in hemisphere.glsl, angle.glsl, hbao.glsl). */
 #define OBS__MAX_HEMISPHERE 64

@@ -310,6 +310,16 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
             if (d > 0.0f) {
                 zs = d;
                 nz = nrm[3 * k + 2];
+                /* A sample on the shaded pixel itself reads p's tangent
+                 * plane under the pipe: the depth at the pixel's centre is
+                 * p's, not the surface's under the pipe, and a sphere
+                 * smaller than a pixel would see its own surface as an
+                 * occluder. */
+                if (qx == x && qy == y && fabsf(n[2]) > OBS__OWN_PLANE_NZ) {
+                    float spx = c[0] + r * (rot[0] * sx - rot[1] * sy);
+                    float spy = c[1] + r * (rot[1] * sx + rot[0] * sy);
+                    zs = -p[2] + (n[0] * (spx - p[0]) + n[1] * (spy - p[1])) / n[2];
+                }
                 if (bleeds) { /* eq 5 with x the surface point at the sample's pixel */
                     c5 = obs__bleed_weight(pos + 4 * k, p, n, R);
                     cx5 = col + 4 * k;

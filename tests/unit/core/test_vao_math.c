@@ -9,6 +9,7 @@
 #include "testutil.h"
 
 #include "frame.h"
+#include "io.h"
 
 #define W 96
 #define H 72
@@ -232,6 +233,73 @@ static void test_open_plane_tilted_perspective(void **state)
     assert_true(mn > 0.95f);
     obs_result_free(&r);
     free(s);
+}
+
+/* A floor seen at a grazing angle (n.z = 1/sqrt 5, depths 3 to 88) with
+ * a tangent sphere smaller than a pixel (radius 0.002; a pixel is 0.04
+ * wide at depth 3): every sample lands on the shaded pixel itself, which
+ * reads its own tangent plane under the pipe.  With the depth at the
+ * pixel's centre, p's depth, instead, a pipe of half length h = r l
+ * through c = p + r n would be open for only n.z r + h of its 2 h, an
+ * occluder made of the surface itself.  Both definitions, rays after its
+ * conversion. */
+static void test_open_plane_subpixel(void **state)
+{
+    scene *s = malloc(sizeof *s);
+    (void)state;
+    float P[16];
+    perspective(P, 50.0f);
+    float l = sqrtf(5.0f);
+    plane pl = {{0, 2.0f / l, 1 / l}, -6.0f / l};
+    render(s, P, &pl, 1);
+    for (int v = 0; v < 2; v++) {
+        char err[OBS_ERR_LEN];
+        obs_params p = camera_normals(16);
+        p.radius = 0.002f;
+        obs_param_set(&p, "ao_definition", v ? "rays" : "volume", err);
+        obs_result r;
+        run(s, &p, &r);
+        float mn = 1;
+        for (int i = 0; i < W * H; i++)
+            mn = fminf(mn, r.ao.data[i]);
+        print_message("grazing floor, sphere under a pixel, %s: min AO %.6f\n", v ? "rays" : "volume",
+                      mn);
+        assert_true(mn > 0.999f);
+        obs_result_free(&r);
+    }
+    free(s);
+}
+
+/* The same on real input: room_small (320x240) with a radius of 1 cm, a
+ * sphere of about a pixel; nothing there is that close to an occluder but
+ * at the creases, so the image is nearly open (mean 0.87 with the depth at
+ * the pixel's centre). */
+static void test_small_radius_room(void **state)
+{
+    (void)state;
+    obs_gbuffer_file gf = {0};
+    char err[OBS_ERR_LEN] = "";
+    if (obs_gbuffer_read_exr(TESTDATA "/room_small.exr", NULL, NULL, &gf, err) != OBS_OK ||
+        obs_camera_read_json(TESTDATA "/room_small.camera.json", &gf.gb.camera, NULL, NULL,
+                             err) != OBS_OK)
+        fail_msg("room_small: %s", err);
+    obs_params p = {0};
+    p.radius = 0.01f;
+    obs_result r;
+    assert_int_equal(obs_run_cpu(&gf.gb, &p, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    double sum = 0;
+    long n = 0;
+    for (int i = 0; i < gf.gb.width * gf.gb.height; i++) {
+        float d = gf.gb.depth.data[i];
+        if (d > 0.0f && d < OBS__SKY_DEPTH) {
+            sum += r.ao.data[i];
+            n++;
+        }
+    }
+    print_message("room_small at radius 0.01: mean AO %.4f over %ld px\n", sum / n, n);
+    assert_true(sum / n > 0.99);
+    obs_result_free(&r);
+    obs_gbuffer_free(&gf);
 }
 
 /* The inner corner: P on the floor (normal +Y) where it meets a wall
@@ -528,6 +596,8 @@ int main(void)
         cmocka_unit_test(test_open_plane_ortho),
         cmocka_unit_test(test_open_plane_frontal),
         cmocka_unit_test(test_open_plane_tilted_perspective),
+        cmocka_unit_test(test_open_plane_subpixel),
+        cmocka_unit_test(test_small_radius_room),
         cmocka_unit_test(test_inner_corner),
         cmocka_unit_test(test_corner_scene),
         cmocka_unit_test(test_range_check_closed_form),
