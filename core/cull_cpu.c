@@ -41,12 +41,13 @@ void obs__cull_prepass(const obs__frame *f, const float *pos, const float *nrm, 
 
 static int clampi(int v, int hi) { return v < 0 ? 0 : v > hi ? hi : v; }
 
-/* GL_LINEAR with GL_CLAMP_TO_EDGE at the normalised coordinate
- * (px, py) * cull_scale, as the shader passes it to texture(). */
+/* GL_LINEAR with GL_CLAMP_TO_EDGE at the pixel corner (px, py), texel
+ * coordinate (px / 8 - 0.5, py / 8 - 0.5) (exact in float), as
+ * cull_candidate() in vao.frag.glsl computes it from four image loads. */
 float obs__cull_fetch(const obs__frame *f, const float *est, int px, int py)
 {
-    float u = (float)px * f->cull_scale[0] * (float)f->cull_w - 0.5f;
-    float v = (float)py * f->cull_scale[1] * (float)f->cull_h - 0.5f;
+    float u = (float)px * 0.125f - 0.5f;
+    float v = (float)py * 0.125f - 0.5f;
     float fu = floorf(u), fv = floorf(v);
     float a = u - fu, b = v - fv;
     int i0 = clampi((int)fu, f->cull_w - 1), i1 = clampi((int)fu + 1, f->cull_w - 1);
@@ -54,10 +55,11 @@ float obs__cull_fetch(const obs__frame *f, const float *est, int px, int py)
     size_t w = (size_t)f->cull_w;
     float t00 = est[(size_t)j0 * w + (size_t)i0], t10 = est[(size_t)j0 * w + (size_t)i1];
     float t01 = est[(size_t)j1 * w + (size_t)i0], t11 = est[(size_t)j1 * w + (size_t)i1];
-    /* llvmpipe filters R32F in float, lerp(t0, t1, a) = fma(a, t1 - t0,
-     * t0): this form gives its results bit for bit (measured on the test
-     * scenes: every pixel; t0 + a * (t1 - t0) unfused differs by one ulp
-     * at ~1 % of them, (1 - a) t0 + a t1 at ~15 %). */
+    /* lerp(t0, t1, a) = fma(a, t1 - t0, t0), as the shader and llvmpipe's
+     * sampler filter R32F (measured on the test scenes against the
+     * sampler: every pixel; t0 + a * (t1 - t0) unfused differs by one ulp
+     * at ~1 % of them, (1 - a) t0 + a t1 at ~15 %).  Where a = 0 this is
+     * t0 exactly, the texel the shader takes there. */
     float top = fmaf(a, t10 - t00, t00), bottom = fmaf(a, t11 - t01, t01);
     return fmaf(b, bottom - top, top);
 }

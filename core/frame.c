@@ -107,8 +107,6 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     f->cull_threshold = 1.0f - p->culling_epsilon;
     f->cull_w = (f->width + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK;
     f->cull_h = (f->height + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK;
-    f->cull_scale[0] = 1.0f / (float)(OBS__CULL_BLOCK * f->cull_w);
-    f->cull_scale[1] = 1.0f / (float)(OBS__CULL_BLOCK * f->cull_h);
     f->blur_radius = p->blur == OBS_ON ? p->blur_radius : 0;
     for (int k = 0; k <= f->blur_radius; k++) /* section 4.6: Gaussian kernel */
         f->blur_w[k] = expf(-(float)(k * k) / (2.0f * p->blur_sigma * p->blur_sigma));

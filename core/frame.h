@@ -82,7 +82,6 @@ typedef struct obs__frame {
     int culling;            /* section 4.2: 0 off, 1 greedy, 2 careful */
     float cull_threshold;   /* an estimate below this shows occlusion: 1 - culling_epsilon */
     int cull_w, cull_h;     /* the low-resolution texture: ceil(width / 8) x ceil(height / 8) */
-    float cull_scale[2];    /* 1 / (8 cull_w), 1 / (8 cull_h): pixel corner -> texture coordinate */
     int blur_radius;        /* low-pass filter half-width (section 4.6); 0: off */
     float blur_w[OBS__MAX_BLUR + 1]; /* Gaussian weight of offset 0..blur_radius */
     int luminance;          /* section 4.3, eq 3: 0 off, 1 Rec. 709 luminance, 2 HSV V */

@@ -497,8 +497,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         glUniform1f(glGetUniformLocation(prog, "u_adaptive_k"), f.adaptive_k);
         /* section 4.2: the pre-pass result, read at the pixel corners */
         glUniform1i(glGetUniformLocation(prog, "u_culling"), f.culling);
-        bind_tex(prog, "u_cull", 2, t->tex_cull);
-        glUniform2fv(glGetUniformLocation(prog, "u_cull_scale"), 1, f.cull_scale);
+        bind_img(prog, "u_cull", 4, t->tex_cull, GL_R32F);
+        glUniform2i(glGetUniformLocation(prog, "u_cull_size"), f.cull_w, f.cull_h);
         glUniform1f(glGetUniformLocation(prog, "u_cull_threshold"), f.cull_threshold);
         /* section 4.7: colour bleeding reads the colour at the samples */
         glUniform1i(glGetUniformLocation(prog, "u_bleed_step"), f.bleed_step);

@@ -8,8 +8,8 @@
 uniform int u_count;             // samples (with adaptive sampling: the most)
 uniform float u_adaptive_k;      // vw / (vh * D0^2), see adaptive_count
 uniform int u_culling;           // section 4.2: 1 greedy, 2 careful (0 off: OBS_CULLING 0)
-uniform sampler2D u_cull;        // the pre-pass's 1/8-resolution AO, GL_LINEAR
-uniform vec2 u_cull_scale;       // 1 / (8 * its size): pixel corner -> texture coordinate
+layout(r32f) readonly uniform image2D u_cull; // the pre-pass's 1/8-resolution AO
+uniform ivec2 u_cull_size;       // its size: ceil(width / 8) x ceil(height / 8)
 uniform float u_cull_threshold;  // an estimate below this shows occlusion
 uniform int u_bleed_step;        // section 4.7: 0 off, else every u_bleed_step-th sample
 
@@ -52,14 +52,32 @@ int adaptive_count(vec3 c)
 // second pass is done via four texel fetches from downsized AO texture in
 // given pixel corners.  Texture interpolation mode is set to linear ...
 // When at least one of these pixels exhibits occlusion, we calculate full
-// AO - otherwise the pixel is a candidate for culling."  A corner (x, y)
-// lies at texel coordinate x / 8 - 0.5: the bilinear weights are multiples
-// of 1/8.  C twin: obs__cull_candidate, obs__cull_fetch (cull_cpu.c).
+// AO - otherwise the pixel is a candidate for culling."  The four linear
+// fetches are done here from four image loads: a corner c (integers, in
+// pixels) lies at texel coordinate c / 8 - 0.5, so the corners px and
+// px + 1 share the 2 x 2 texels around the first one.  Only where px + 1
+// sits on a texel's centre (weight 1 on the next texel: t0 + 1 exactly)
+// does it reach past them, and there GL_LINEAR gives that texel itself.
+// Same filtering (lerp as fma, clamped to the edge) as llvmpipe's
+// sampler; on llvmpipe the sampler's four fetches took ~18 ms of the AO
+// pass at 1080p (bench/RESULTS.md).  C twin: obs__cull_candidate,
+// obs__cull_fetch (cull_cpu.c).
+float cull_texel(ivec2 t)
+{
+    return imageLoad(u_cull, clamp(t, ivec2(0), u_cull_size - ivec2(1))).r;
+}
+
 bool cull_candidate(ivec2 px)
 {
+    ivec2 t0 = ivec2(floor(vec2(px) * 0.125 - 0.5));
+    float t00 = cull_texel(t0), t10 = cull_texel(t0 + ivec2(1, 0));
+    float t01 = cull_texel(t0 + ivec2(0, 1)), t11 = cull_texel(t0 + ivec2(1, 1));
     for (int k = 0; k < 4; k++) {
-        vec2 corner = vec2(px + ivec2(k & 1, k >> 1));
-        if (texture(u_cull, corner * u_cull_scale).r < u_cull_threshold)
+        vec2 w = vec2(px + ivec2(k & 1, k >> 1)) * 0.125 - 0.5 - vec2(t0); // in [0, 1]
+        float top = w.x < 1.0 ? fma(w.x, t10 - t00, t00) : t10;
+        float bottom = w.x < 1.0 ? fma(w.x, t11 - t01, t01) : t11;
+        float est = w.y < 1.0 ? fma(w.y, bottom - top, top) : bottom;
+        if (est < u_cull_threshold)
             return false;
     }
     return true;

@@ -171,8 +171,6 @@ static void test_fetch(void **state)
     f.height = 12;
     f.cull_w = 3;
     f.cull_h = 2;
-    f.cull_scale[0] = 1.0f / 24.0f;
-    f.cull_scale[1] = 1.0f / 16.0f;
     f.cull_threshold = 0.98f;
     const float est[6] = {1.0f, 1.0f, 0.5f, 1.0f, 1.0f, 1.0f};
     /* texel centres at 4, 12, 20 (x) and 4, 12 (y) */
