@@ -14,7 +14,10 @@ Configurations (solid = a half-space), x the distance to the occluder:
 and k = R / D is chosen so that both give the same integrated occlusion
 over x (the area under the occlusion profile across the crease); the
 least-squares k over x is printed for comparison.  Closed forms are
-printed beside the Monte-Carlo / quadrature values as a check.
+printed beside the Monte-Carlo / quadrature values as a check.  Last,
+ao_definition rays (the default): the Monte-Carlo volume fraction at
+R = 2D converted as obs__rays_from_volume does (core/vao_cpu.c), beside
+the reference, on both configurations.
 
 usage: tools/radius_mapping.py        (deterministic, ~2 s)
 """
@@ -87,3 +90,18 @@ for cfg in ("crease", "slab"):
           f"least squares over x: k = {k_ls:.3f}; "
           f"squared error k=1: {sse_1:.5f}, k_int: {sse_int:.5f}, k_ls: {min(sse):.5f}")
 print(f"closed forms: crease k = 64/(9 pi) = {64 / (9 * np.pi):.4f}; slab k = 4/3 = {4 / 3:.4f}")
+
+
+def rays_from_volume(o):
+    """occlusion o of the sphere of radius D -> of the rays of length D
+    (obs__rays_from_volume, in occlusion rather than AO)."""
+    o = np.clip(o, 0, 1)
+    b = np.clip(2 * np.cos((np.arccos(1 - 2 * np.minimum(o, 0.5)) + np.pi) / 3), 0, 1)
+    return np.where(o >= 0.5, o, closed_ref("crease", b))
+
+
+print("ao_definition rays: R = 2D, converted (Monte Carlo volume), against ref")
+print("x/D   crease: ref  rays    slab: ref  rays")
+for x in (0.0, 0.1, 0.25, 0.5, 0.75, 1.0, 1.5):
+    print(f"{x:4.2f}   {ref_occ('crease', x):.4f} {rays_from_volume(vao_occ('crease', x, 2.0)):.4f}   "
+          f"{ref_occ('slab', x):.4f} {rays_from_volume(vao_occ('slab', x, 2.0)):.4f}")
