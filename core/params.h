@@ -145,8 +145,8 @@ typedef enum obs_normal_space {
       "careful computes it with at most 4 samples; off: no pre-pass")         \
     X(culling_epsilon, FLOAT, 0.02, 1e-6, 0.5, NULL,                           \
       "a culling pre-pass estimate below 1 - culling_epsilon shows "           \
-      "occlusion; 0.02 culls 54-84 % of the test scenes' pixels with a mean "  \
-      "|AO(careful) - AO(off)| under 0.001 (a quarter of an 8-bit step)")      \
+      "occlusion; 0.02 culls 48-79 % of the test scenes' pixels with a mean "  \
+      "|AO(careful) - AO(off)| under 0.002 (half an 8-bit step)")              \
     X(depth_mode, ENUM, "planar", 0, 0, "planar|radial|ndc",                   \
       "what the depth channel holds: distance along the camera axis, "         \
       "distance from the camera, or a [0,1] OpenGL depth-buffer value")        \
