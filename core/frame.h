@@ -165,7 +165,7 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
  * common.glsl). */
 float obs__range_falloff(const obs__frame *f, float d, float nz);
 
-/* ao_definition rays (GLSL: rays_from_volume() in luminance.frag.glsl):
+/* ao_definition rays (GLSL: rays_from_volume() in common.glsl):
  * the AO a ray tracer gives with rays of length D for the AO ao of the
  * tangent sphere of radius D (R = 2 D), through the floor-wall crease,
  * where both are known in closed form: a wall at distance x = b D from p

@@ -195,7 +195,7 @@ typedef enum obs_pass {
     OBS_PASS_CULL,
     OBS_PASS_AO,
     OBS_PASS_BLUR,
-    OBS_PASS_FINISH,    /* ao_definition rays' conversion and luminance sensitivity */
+    OBS_PASS_FINISH,    /* luminance sensitivity; ao_definition rays' conversion without blur */
     OBS_PASS_COMPOSITE,
     OBS_PASS_READBACK,
     OBS_PASS_COUNT
