@@ -191,9 +191,11 @@ static float node_occlusion(const obs__frame *f, float zs, float nz, float front
 /* GLSL: sphere_ao() in deep.frag.glsl.  VAO (eq 1, 2 of VAO++ section 3)
  * of the tangent sphere of radius R/2 at p along n, each line sample's
  * occlusion the largest over the nodes at its pixel (OITAO Algorithm 1,
- * line 9), each node's weighted by its alpha (OITAO eq 1's alpha_omega). */
+ * line 9), each node's weighted by its alpha (OITAO eq 1's alpha_omega).
+ * self: the receiver's node at (x, y), which a sample on that pixel reads
+ * as its tangent plane (obs__own_plane_depth). */
 static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3], const float n[3],
-                       int interior)
+                       int interior, int self)
 {
     const obs__frame *f = &df->f;
     const float R = f->radius, r = 0.5f * R;
@@ -217,7 +219,10 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         for (int k = 0; k < layers; k++) {
             const float *pk = df->pos + ((size_t)k * npx + q) * 4;
             const float *nk = df->nrm + ((size_t)k * npx + q) * 4; /* normal, alpha */
-            occ = fmaxf(occ, nk[3] * node_occlusion(f, pk[3], nk[2], front, h, interior));
+            float zs = pk[3];
+            if (k == self && qx == x && qy == y && fabsf(n[2]) > OBS__OWN_PLANE_NZ)
+                zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy);
+            occ = fmaxf(occ, nk[3] * node_occlusion(f, zs, nk[2], front, h, interior));
         }
         open += 2.0f * h - occ;
         F += R * l; /* VAO++ eq 2 */
@@ -283,11 +288,11 @@ static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float 
  * method hemisphere's point samples, each against every node (Algorithm
  * 1). */
 static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3], const float n[3],
-                       int interior)
+                       int interior, int self)
 {
     if (df->f.method == OBS_METHOD_HEMISPHERE)
         return hemisphere_ao(df, x, y, p, n, interior);
-    float v = sphere_ao(df, x, y, p, n, interior);
+    float v = sphere_ao(df, x, y, p, n, interior, self);
     return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */
 }
 
@@ -299,14 +304,14 @@ float obs__deep_node_ao(const obs__deep_frame *df, int x, int y, int k)
     float alpha = n[3];
     if (!(p[3] > 0.0f))
         return 1.0f;
-    float ve = method_ao(df, x, y, p, n, 0);
+    float ve = method_ao(df, x, y, p, n, 0, k);
     if (!df->thin)
         return 1.0f - alpha * (1.0f - ve); /* OITAO eq 1: the receiver's alpha_p */
     /* OITAO eqs 2-4: the interior AO from the sphere on -n; W(p) = alpha
      * on a front face (normal towards the camera), 1 - alpha on a back
      * face. */
     const float nn[3] = {-n[0], -n[1], -n[2]};
-    float vi = method_ao(df, x, y, p, nn, 1);
+    float vi = method_ao(df, x, y, p, nn, 1, k);
     float facing = -(p[0] * n[0] + p[1] * n[1] + p[2] * n[2]);
     float W = facing >= 0.0f ? alpha : 1.0f - alpha; /* eq 3 */
     return W * ve + (1.0f - W) * vi;                 /* eq 4 */

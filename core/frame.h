@@ -50,8 +50,8 @@
 #define OBS__RADIUS_K_VOLUME 1.0f
 
 /* A VAO sample on the shaded pixel itself reads p's tangent plane under
- * its pipe unless |n.z| is below this (the plane nearly edge-on); GLSL:
- * OWN_PLANE_NZ in vao.glsl. */
+ * its pipe (obs__own_plane_depth) unless |n.z| is below this (the plane
+ * nearly edge-on); GLSL: OWN_PLANE_NZ in common.glsl. */
 #define OBS__OWN_PLANE_NZ 0.05f
 
 /* Largest counts of the comparison methods' parameters (uniform array
@@ -164,6 +164,14 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
  * whose view normal has z component nz (GLSL: range_falloff() in
  * common.glsl). */
 float obs__range_falloff(const obs__frame *f, float d, float nz);
+
+/* The planar depth of the tangent plane at p (normal n) under the pipe of
+ * the disk's sample (sx, sy): what a sample on the shaded pixel itself
+ * reads instead of the depth at the pixel's centre, which is p's (GLSL:
+ * own_plane_depth(p, n, disk_point(c, r, rot, sx, sy)) in common.glsl).
+ * Call only with |n[2]| > OBS__OWN_PLANE_NZ. */
+float obs__own_plane_depth(const float p[3], const float n[3], const float c[3], float r,
+                           const float rot[2], float sx, float sy);
 
 /* ao_definition rays (GLSL: rays_from_volume() in common.glsl):
  * the AO a ray tracer gives with rays of length D for the AO ao of the

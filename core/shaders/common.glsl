@@ -102,6 +102,26 @@ bool disk_px(vec3 U, vec3 V, vec3 W, float sx, float sy, ivec2 size, out ivec2 q
     return true;
 }
 
+// The planar depth under a pipe of the view-space sample point s (x, y)
+// when its pixel is the shaded pixel itself: the tangent plane at p
+// (normal n) there, not the depth at the pixel's centre, which is p's
+// (with it, a sphere smaller than a pixel would see its own surface as an
+// occluder).  Used when |n.z| > OWN_PLANE_NZ (else the plane is nearly
+// edge-on).  Shared by the VAO estimator and the deep pass.  C twin:
+// obs__own_plane_depth.
+const float OWN_PLANE_NZ = 0.05;
+float own_plane_depth(vec3 p, vec3 n, vec2 s)
+{
+    return -p.z + (n.x * (s.x - p.x) + n.y * (s.y - p.y)) / n.z;
+}
+
+// The view-space x, y of the sample (sx, sy) on the disk of radius r
+// around c, turned by the tile rotation rot (the point disk_map maps).
+vec2 disk_point(vec3 c, float r, vec2 rot, float sx, float sy)
+{
+    return c.xy + r * vec2(rot.x * sx - rot.y * sy, rot.y * sx + rot.x * sy);
+}
+
 // The depth range check's falloff, VAO++ section 4.4, eq 4:
 // s(d) = u / max(u, d / R), the weight of a pipe's occlusion when it lies
 // d behind the surface that hides it ("we assume they are flat and their

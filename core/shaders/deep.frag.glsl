@@ -55,8 +55,10 @@ float node_occlusion(float zs, float nz, float front, float h, bool interior)
 
 // VAO++ eqs 1-2 for the tangent sphere at p along n; each sample's
 // occlusion is the largest over the nodes at its pixel (Algorithm 1, line
-// 9), each node's weighted by its alpha (eq 1's alpha_omega).
-float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
+// 9), each node's weighted by its alpha (eq 1's alpha_omega).  self: the
+// receiver's node at px, which a sample on px reads as its tangent plane
+// (own_plane_depth, common.glsl).
+float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
 {
     float R = u_radius, r = 0.5 * u_radius;
     vec3 c = p + n * r;
@@ -76,6 +78,8 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
         for (int k = 0; k < layers; k++) {
             float zs = imageLoad(u_lpos, ivec3(q, k)).w;
             vec4 nk = imageLoad(u_lnrm, ivec3(q, k));   // normal, alpha
+            if (k == self && q == px && abs(n.z) > OWN_PLANE_NZ)
+                zs = own_plane_depth(p, n, disk_point(c, r, rot, sx, sy));
             occ = max(occ, nk.w * node_occlusion(zs, nk.z, front, h, interior));
         }
         open += 2.0 * h - occ;
@@ -131,15 +135,15 @@ float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
 // The per-sample estimator of the method: VAO++'s or method hemisphere's;
 // VAO++'s converted to the ray-traced AO under ao_definition rays
 // (OBS_RAYS, defined by the program; C twin: method_ao in deep_cpu.c).
-float method_ao(ivec2 px, vec3 p, vec3 n, bool interior)
+float method_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
 {
 #if OBS_DEEP_HEMISPHERE
     return hemisphere_ao(px, p, n, interior);
 #else
 #if OBS_RAYS
-    return rays_from_volume(sphere_ao(px, p, n, interior)); // common.glsl
+    return rays_from_volume(sphere_ao(px, p, n, interior, self)); // common.glsl
 #else
-    return sphere_ao(px, p, n, interior);
+    return sphere_ao(px, p, n, interior, self);
 #endif
 #endif
 }
@@ -151,11 +155,11 @@ float node_ao(ivec2 px, int k)
     vec4 n = imageLoad(u_lnrm, ivec3(px, k));
     if (!(p.w > 0.0))
         return 1.0;
-    float ve = method_ao(px, p.xyz, n.xyz, false);
+    float ve = method_ao(px, p.xyz, n.xyz, false, k);
 #if OBS_DEEP_THIN == 0
     return 1.0 - n.w * (1.0 - ve);                  // eq 1: alpha_p
 #else
-    float vi = method_ao(px, p.xyz, -n.xyz, true);
+    float vi = method_ao(px, p.xyz, -n.xyz, true, k);
     float facing = -(p.x * n.x + p.y * n.y + p.z * n.z);
     float W = facing >= 0.0 ? n.w : 1.0 - n.w;      // eq 3
     return W * ve + (1.0 - W) * vi;                 // eq 4

@@ -9,7 +9,6 @@ layout(rgba32f) readonly uniform image2D u_pos;     // prep: view position, plan
 layout(rgba32f) readonly uniform image2D u_vnormal; // prep: view normal
 layout(rg32f) readonly uniform image2D u_dz; // prep: planar depth and view normal z, one load per sample
 uniform ivec2 u_size;
-const float OWN_PLANE_NZ = 0.05;  // below: p's plane is edge-on, keep p's depth
 uniform float u_radius;          // R, in depth units
 uniform vec2 u_samples[62];      // all sets of section 4.5 (core/sample_tables.c), the
                                  // set of n from n - 2: the single array of section 4.1
@@ -74,15 +73,9 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             if (dq.x > 0.0) {
                 zs = dq.x;
                 nz = dq.y;
-                // A sample on the shaded pixel itself reads p's tangent
-                // plane under the pipe: the depth at the pixel's centre is
-                // p's, not the surface's under the pipe, and a sphere
-                // smaller than a pixel would see its own surface as an
-                // occluder (C twin: the same comment).
-                if (q == px && abs(n.z) > OWN_PLANE_NZ) {
-                    vec2 sp = c.xy + r * vec2(rot.x * sx - rot.y * sy, rot.y * sx + rot.x * sy);
-                    zs = -p.z + (n.x * (sp.x - p.x) + n.y * (sp.y - p.y)) / n.z;
-                }
+                // a sample on the shaded pixel itself: p's tangent plane
+                if (q == px && abs(n.z) > OWN_PLANE_NZ)
+                    zs = own_plane_depth(p.xyz, n, disk_point(c, r, rot, sx, sy));
                 if (bleeds) {       // eq 5, x the surface point at the sample's pixel
                     c5 = bleed_weight(imageLoad(u_pos, q).xyz, p.xyz, n, R);
                     hit = true;

@@ -379,6 +379,56 @@ static void test_hidden_occluder(void **state)
     obs_deep_free(&d);
 }
 
+/* A floor seen at a grazing angle (view plane 2y + z = -6, one opaque
+ * node per pixel, normals derived from depth) with a tangent sphere
+ * smaller than a pixel (radius 0.002): a sample on the shaded pixel reads
+ * the receiver node's tangent plane, as the flat estimator does
+ * (test_vao_math.c), so the open floor stays open; with the node's depth
+ * at the pixel's centre it would occlude itself. */
+static void grazing_floor(obs_deep_image *d)
+{
+    synth_init(d, 32, 32);
+    const float t = tanf(20.0f * (float)M_PI / 180.0f); /* fov_y 40 */
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++) {
+            synth_next(d, x, y);
+            float dy = (1.0f - (y + 0.5f) / 16.0f) * t; /* view ray (., dy, -1) */
+            synth_add(d, x, y, 6.0f / (1.0f - 2.0f * dy), 1.0f);
+        }
+}
+
+static obs_params subpixel_params(int volume)
+{
+    obs_params p = deep_params(OBS_DEEP_MULTI);
+    char err[OBS_ERR_LEN];
+    assert_int_equal(obs_param_set(&p, "radius", "0.002", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "ao_definition", volume ? "volume" : "rays", err), OBS_OK);
+    return p;
+}
+
+static void test_subpixel_sphere(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    grazing_floor(&d);
+    for (int v = 0; v < 2; v++) {
+        obs_params p = subpixel_params(v);
+        char err[OBS_ERR_LEN];
+        obs_deep_result r;
+        if (obs_deep_run_cpu(&d, &p, &r, err) != OBS_OK)
+            fail_msg("%s", err);
+        float mn = 1.0f;
+        for (int y = 1; y < 31; y++)
+            for (int x = 1; x < 31; x++)
+                mn = fminf(mn, r.ao_front.data[y * 32 + x]);
+        print_message("deep grazing floor, sphere under a pixel, %s: min AO %.6f\n",
+                      v ? "volume" : "rays", mn);
+        assert_true(mn > 0.999f);
+        obs_deep_result_free(&r);
+    }
+    obs_deep_free(&d);
+}
+
 /* Method hemisphere on deep input: the same hidden box occludes the wall
  * pixel beside the near object in multi-layer mode and not in single
  * mode; the near object, 7 in front of the receiver, fades out by the
@@ -553,6 +603,13 @@ static void test_gl_twin(void **state)
     assert_int_equal(obs_param_set(&p, "range_check", "off", err), OBS_OK);
     compare_gl(ctx, &d, &p, "hidden occluder, multi, range check off");
     obs_deep_free(&d);
+    /* the receiver's own tangent plane (spheres under a pixel) */
+    grazing_floor(&d);
+    p = subpixel_params(0);
+    compare_gl(ctx, &d, &p, "grazing floor, sphere under a pixel, rays");
+    p = subpixel_params(1);
+    compare_gl(ctx, &d, &p, "grazing floor, sphere under a pixel, volume");
+    obs_deep_free(&d);
     assert_int_equal(obs_deep_read_exr(FIXTURE, NULL, &d, err), OBS_OK);
     p = (obs_params){0};
     assert_int_equal(obs_param_set(&p, "radius", "1", err), OBS_OK);
@@ -682,6 +739,7 @@ int main(void)
         cmocka_unit_test(test_read_damaged_files),
         cmocka_unit_test(test_compress_eq5),
         cmocka_unit_test(test_hidden_occluder),
+        cmocka_unit_test(test_subpixel_sphere),
         cmocka_unit_test(test_hidden_occluder_hemisphere),
         cmocka_unit_test(test_methods_refused),
         cmocka_unit_test(test_blend_and_hull),
