@@ -163,9 +163,10 @@ check "bytes in/out, in-flight, queue depth" "grep -q '^obscurad_bytes_received_
 echo "-- SIGTERM with frames queued: all answered, exit 0"
 i=0
 while [ $i -lt 5 ]; do
-    # heavy frames (no culling, widest blur) keep the GL worker busy long
-    # enough for the others to wait in the queue
-    post $A "$CAM&samples=32&culling=off&blur_radius=16" "$R" "$T/t$i.exr" > "$T/t$i.code" &
+    # heavy frames (HBAO with 32 x 32 steps, widest blur: ~0.2 s each)
+    # keep the GL worker busy long enough for the others to wait in the
+    # queue; lighter ones could all be answered before the last arrived
+    post $A "$CAM&method=hbao&hbao_directions=32&hbao_steps=32&blur_radius=16" "$R" "$T/t$i.exr" > "$T/t$i.code" &
     BG="$BG $!"
     i=$((i + 1))
 done
