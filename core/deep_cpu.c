@@ -220,8 +220,8 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
             const float *pk = df->pos + ((size_t)k * npx + q) * 4;
             const float *nk = df->nrm + ((size_t)k * npx + q) * 4; /* normal, alpha */
             float zs = pk[3];
-            if (k == self && qx == x && qy == y && fabsf(n[2]) > OBS__OWN_PLANE_NZ)
-                zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy);
+            if (k == self && qx == x && qy == y)
+                zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy, zs);
             occ = fmaxf(occ, nk[3] * node_occlusion(f, zs, nk[2], front, h, interior));
         }
         open += 2.0f * h - occ;

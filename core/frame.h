@@ -50,7 +50,7 @@
 #define OBS__RADIUS_K_VOLUME 1.0f
 
 /* A VAO sample on the shaded pixel itself reads p's tangent plane under
- * its pipe (obs__own_plane_depth) unless |n.z| is below this (the plane
+ * its pipe (obs__own_plane_depth) unless |n.z| is at most this (the plane
  * nearly edge-on); GLSL: OWN_PLANE_NZ in common.glsl. */
 #define OBS__OWN_PLANE_NZ 0.05f
 
@@ -166,12 +166,13 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
 float obs__range_falloff(const obs__frame *f, float d, float nz);
 
 /* The planar depth of the tangent plane at p (normal n) under the pipe of
- * the disk's sample (sx, sy): what a sample on the shaded pixel itself
- * reads instead of the depth at the pixel's centre, which is p's (GLSL:
- * own_plane_depth(p, n, disk_point(c, r, rot, sx, sy)) in common.glsl).
- * Call only with |n[2]| > OBS__OWN_PLANE_NZ. */
+ * the disk's sample (sx, sy), for eq 1's dz: what a sample on the shaded
+ * pixel itself reads instead of the depth at the pixel's centre zs, which
+ * is p's; zs itself when |n[2]| <= OBS__OWN_PLANE_NZ (GLSL:
+ * own_plane_depth(p, n, disk_point(c, r, rot, sx, sy), zs) in
+ * common.glsl). */
 float obs__own_plane_depth(const float p[3], const float n[3], const float c[3], float r,
-                           const float rot[2], float sx, float sy);
+                           const float rot[2], float sx, float sy, float zs);
 
 /* ao_definition rays (GLSL: rays_from_volume() in common.glsl):
  * the AO a ray tracer gives with rays of length D for the AO ao of the

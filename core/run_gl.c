@@ -201,12 +201,10 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     t->tex_cullmask = make_texture(ctx, GL_R32F, w, h);
     t->tex_bleed = make_texture(ctx, GL_RGBA32F, w, h);
     t->tex_lumfactor = make_texture(ctx, GL_R32F, w, h);
-    /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block, read
-     * with linear filtering (R32F filters in desktop GL). */
+    /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block; the AO
+     * pass filters it itself (cull_candidate in vao.frag.glsl). */
     t->tex_cull = make_texture(ctx, GL_R32F, (w + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK,
                                (h + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     GLuint prep[] = {t->tex_viewpos, t->tex_vnormal, t->tex_dz};
     GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask, t->tex_bleed};
     GLuint blur[] = {t->tex_blur, t->tex_lumfactor};

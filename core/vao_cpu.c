@@ -210,8 +210,10 @@ float obs__range_falloff(const obs__frame *f, float d, float nz)
 
 /* GLSL: own_plane_depth(), disk_point() in common.glsl */
 float obs__own_plane_depth(const float p[3], const float n[3], const float c[3], float r,
-                           const float rot[2], float sx, float sy)
+                           const float rot[2], float sx, float sy, float zs)
 {
+    if (!(fabsf(n[2]) > OBS__OWN_PLANE_NZ))
+        return zs;
     float spx = c[0] + r * (rot[0] * sx - rot[1] * sy);
     float spy = c[1] + r * (rot[1] * sx + rot[0] * sy);
     return -p[2] + (n[0] * (spx - p[0]) + n[1] * (spy - p[1])) / n[2];
@@ -320,8 +322,8 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
                 zs = d;
                 nz = nrm[3 * k + 2];
                 /* a sample on the shaded pixel itself: p's tangent plane */
-                if (qx == x && qy == y && fabsf(n[2]) > OBS__OWN_PLANE_NZ)
-                    zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy);
+                if (qx == x && qy == y)
+                    zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy, zs);
                 if (bleeds) { /* eq 5 with x the surface point at the sample's pixel */
                     c5 = obs__bleed_weight(pos + 4 * k, p, n, R);
                     cx5 = col + 4 * k;

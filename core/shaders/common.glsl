@@ -103,15 +103,17 @@ bool disk_px(vec3 U, vec3 V, vec3 W, float sx, float sy, ivec2 size, out ivec2 q
 }
 
 // The planar depth under a pipe of the view-space sample point s (x, y)
-// when its pixel is the shaded pixel itself: the tangent plane at p
-// (normal n) there, not the depth at the pixel's centre, which is p's
-// (with it, a sphere smaller than a pixel would see its own surface as an
-// occluder).  Used when |n.z| > OWN_PLANE_NZ (else the plane is nearly
-// edge-on).  Shared by the VAO estimator and the deep pass.  C twin:
-// obs__own_plane_depth.
+// when its pixel is the shaded pixel itself, for eq 1's dz: the tangent
+// plane at p (normal n) there, not the depth at the pixel's centre zs,
+// which is p's (with it, a sphere smaller than a pixel would see its own
+// surface as an occluder).  zs where |n.z| <= OWN_PLANE_NZ (the plane
+// nearly edge-on).  Shared by the VAO estimator and the deep pass.  C
+// twin: obs__own_plane_depth.
 const float OWN_PLANE_NZ = 0.05;
-float own_plane_depth(vec3 p, vec3 n, vec2 s)
+float own_plane_depth(vec3 p, vec3 n, vec2 s, float zs)
 {
+    if (!(abs(n.z) > OWN_PLANE_NZ))
+        return zs;
     return -p.z + (n.x * (s.x - p.x) + n.y * (s.y - p.y)) / n.z;
 }
 

@@ -78,8 +78,8 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
         for (int k = 0; k < layers; k++) {
             float zs = imageLoad(u_lpos, ivec3(q, k)).w;
             vec4 nk = imageLoad(u_lnrm, ivec3(q, k));   // normal, alpha
-            if (k == self && q == px && abs(n.z) > OWN_PLANE_NZ)
-                zs = own_plane_depth(p, n, disk_point(c, r, rot, sx, sy));
+            if (k == self && q == px)
+                zs = own_plane_depth(p, n, disk_point(c, r, rot, sx, sy), zs);
             occ = max(occ, nk.w * node_occlusion(zs, nk.z, front, h, interior));
         }
         open += 2.0 * h - occ;

@@ -74,8 +74,8 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
                 zs = dq.x;
                 nz = dq.y;
                 // a sample on the shaded pixel itself: p's tangent plane
-                if (q == px && abs(n.z) > OWN_PLANE_NZ)
-                    zs = own_plane_depth(p.xyz, n, disk_point(c, r, rot, sx, sy));
+                if (q == px)
+                    zs = own_plane_depth(p.xyz, n, disk_point(c, r, rot, sx, sy), zs);
                 if (bleeds) {       // eq 5, x the surface point at the sample's pixel
                     c5 = bleed_weight(imageLoad(u_pos, q).xyz, p.xyz, n, R);
                     hit = true;

@@ -7,7 +7,6 @@
  * test_vao_math.c, is amplified).  The closed forms are in
  * test_vao_math.c; GL against the CPU twin in test_gl_twin.c. */
 #include <math.h>
-#include <unistd.h>
 
 #include "gl_testutil.h"
 
@@ -96,11 +95,10 @@ static void test_small_scenes(void **state)
 static void test_shared_scenes(void **state)
 {
     (void)state;
-    char stem[512];
+    char stem[512], exr[520];
     snprintf(stem, sizeof stem, "%s/blender/room", obs_test_shared());
-    char exr[520];
     snprintf(exr, sizeof exr, "%s.exr", stem);
-    if (access(exr, R_OK) != 0) {
+    if (!obs_test_exists(exr)) {
         print_message("skip: %s not found\n", exr);
         return;
     }

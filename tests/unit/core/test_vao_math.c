@@ -6,10 +6,9 @@
  * end. */
 #include <math.h>
 
-#include "testutil.h"
+#include "gl_testutil.h"
 
 #include "frame.h"
-#include "io.h"
 
 #define W 96
 #define H 72
@@ -279,10 +278,7 @@ static void test_small_radius_room(void **state)
     (void)state;
     obs_gbuffer_file gf = {0};
     char err[OBS_ERR_LEN] = "";
-    if (obs_gbuffer_read_exr(TESTDATA "/room_small.exr", NULL, NULL, &gf, err) != OBS_OK ||
-        obs_camera_read_json(TESTDATA "/room_small.camera.json", &gf.gb.camera, NULL, NULL,
-                             err) != OBS_OK)
-        fail_msg("room_small: %s", err);
+    load(scenes[0], &gf); /* room_small */
     obs_params p = {0};
     p.radius = 0.01f;
     obs_result r;
