@@ -8,7 +8,7 @@
 #   make quality  AO against ray-traced ground truth (bench/QUALITY.md)
 #   make fuzz     libFuzzer targets: binary protocol, EXR readers (clang; tests/fuzz/fuzz.mk)
 #   make readme   regenerate README.md's parameter and daemon option tables
-#   make samples  regenerate core/sample_tables.c (VAO++ 4.5 sample sets)
+#   make samples  regenerate core/chain/sample_tables.c (VAO++ 4.5 sample sets)
 #
 # BUILD selects the output folder, so the sanitizer build lives beside the
 # normal one: make BUILD=build/asan SAN=1.
@@ -20,16 +20,16 @@ DEBUG ?= 0
 CC ?= cc
 PKGS := OpenEXR egl osmesa libpng libcjson
 # OpenEXR's C core library (openexr.h) reads and writes; its C++ library
-# only writes deep files (core/exr_deep_write.cpp, see below).
+# only writes deep files (core/io/exr_deep_write.cpp, see below).
 EXR_CFLAGS := $(shell pkg-config --cflags OpenEXR 2>/dev/null)
 PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson 2>/dev/null) $(EXR_CFLAGS)
 PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson 2>/dev/null) -lz -lm -lpthread
-# Scene loading (core/scene.c: assimp) and the ray-traced reference
-# (core/reference.c: Embree 3, no .pc file) live in libobscura.a too; as
+# Scene loading (core/ground/scene.c: assimp) and the ray-traced reference
+# (core/ground/reference.c: Embree 3, no .pc file) live in libobscura.a too; as
 # static members they are linked only into binaries that call them, and
 # --as-needed keeps the shared libraries out of the others (the daemon).
 PKG_LIBS += -Wl,--push-state,--as-needed $(shell pkg-config --libs assimp 2>/dev/null) -lembree3 -Wl,--pop-state
-# The deep EXR writer (core/exr_deep_write.cpp, OpenEXR's C++ deep API; the
+# The deep EXR writer (core/io/exr_deep_write.cpp, OpenEXR's C++ deep API; the
 # C API of 3.1 cannot write deep data): the same arrangement, so only the
 # binaries that write deep files (the CLI, tests) need the C++ libraries.
 PKG_LIBS += -Wl,--push-state,--as-needed $(shell pkg-config --libs OpenEXR 2>/dev/null) -lstdc++ -Wl,--pop-state
@@ -40,7 +40,7 @@ CXXFLAGS += -std=c++14 -Wall -Wextra -Wshadow -fno-strict-aliasing
 CFLAGS ?= -O2 -g
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -Wall -Wextra -Wshadow -Wstrict-prototypes \
           -Wno-missing-field-initializers -fno-strict-aliasing
-CPPFLAGS += -Icore -I$(BUILD)/gen
+CPPFLAGS += -Iinclude -Icore -I$(BUILD)/gen
 ifeq ($(SAN),1)
 CFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 CXXFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
@@ -52,8 +52,8 @@ ifeq ($(DEBUG),1)
 CPPFLAGS += -DOBS_DEBUG=1
 endif
 
-CORE_SRC := $(wildcard core/*.c core/gl/*.c)
-CORE_CXX_SRC := $(wildcard core/*.cpp)
+CORE_SRC := $(wildcard core/*.c core/*/*.c)
+CORE_CXX_SRC := $(wildcard core/*.cpp core/*/*.cpp)
 CORE_OBJ := $(CORE_SRC:%.c=$(BUILD)/obj/%.o) $(CORE_CXX_SRC:%.cpp=$(BUILD)/obj/%.o)
 SHADERS := $(wildcard core/shaders/*.glsl)
 SHADER_HDR := $(BUILD)/gen/obs_shaders.h
@@ -182,7 +182,7 @@ readme: $(CLI) $(BUILD)/obscurad
 # The sample sets are the generator's output, checked in as C source
 # (tests/unit/core/test_samples.c fails when they are stale).
 samples: $(CLI)
-	$(CLI) samples --c > core/sample_tables.c.tmp && mv core/sample_tables.c.tmp core/sample_tables.c
+	$(CLI) samples --c > core/chain/sample_tables.c.tmp && mv core/chain/sample_tables.c.tmp core/chain/sample_tables.c
 
 readme-check: $(CLI) $(BUILD)/obscurad
 	@tools/readme_params.sh --check $(CLI) $(BUILD)/obscurad README.md && echo "readme: generated tables up to date"
@@ -199,11 +199,11 @@ e2e: $(CLI) $(E2E_DEPS)
 # Every public header compiles alone, as C and as C++.
 headers:
 	@mkdir -p $(BUILD)/headers
-	@for h in core/obscura.h core/status.h core/params.h core/io.h core/deep.h core/metrics.h core/scene.h core/reference.h protocol/http.h protocol/binary.h; do \
+	@for h in include/obscura/*.h protocol/http.h protocol/binary.h; do \
 	  echo "#include \"$$h\"" > $(BUILD)/headers/t.c; \
-	  $(CC) -I. -Wall -Wextra -Werror -std=c99 -c $(BUILD)/headers/t.c -o /dev/null || exit 1; \
+	  $(CC) -I. -Iinclude -Wall -Wextra -Werror -std=c99 -c $(BUILD)/headers/t.c -o /dev/null || exit 1; \
 	  cp $(BUILD)/headers/t.c $(BUILD)/headers/t.cpp; \
-	  c++ -I. -Wall -Wextra -Werror -c $(BUILD)/headers/t.cpp -o /dev/null || exit 1; \
+	  c++ -I. -Iinclude -Wall -Wextra -Werror -c $(BUILD)/headers/t.cpp -o /dev/null || exit 1; \
 	done
 	@echo "headers: each public header compiles alone as C and C++"
 

@@ -20,8 +20,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "io.h"
-#include "obscura.h"
+#include "obscura/io.h"
+#include "obscura/obscura.h"
 #include "remote.h"
 
 static double now_ms(void)

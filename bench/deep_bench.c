@@ -4,7 +4,7 @@
  * LowResLeftView set merged into one A-buffer (Balls, Leaves, Trunks:
  * their flat composite is composited.exr).  Stages: the compression
  * (eq 5, CPU, timed alone), the upload of the node planes, the AO pass and
- * the read-back (obs_ctx_set_timing: core/deep_gl.c times them between
+ * the read-back (obs_ctx_set_timing: core/deep/deep_gl.c times them between
  * glFinish calls), and the
  * rest of the run on the CPU (node prep, composite).  Writes the AO PNGs
  * of bench/deep/ and a Markdown table on stdout.
@@ -19,8 +19,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "deep.h"
-#include "io.h"
+#include "obscura/deep.h"
+#include "obscura/io.h"
 
 static double now_ms(void)
 {

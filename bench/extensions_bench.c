@@ -30,8 +30,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "io.h"
-#include "obscura.h"
+#include "obscura/io.h"
+#include "obscura/obscura.h"
 
 enum { VARIANTS = 4, COUNTS = 5, MAX_FRAMES = 64, MAX_SIZES = 4 };
 

@@ -11,8 +11,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "io.h"
-#include "obscura.h"
+#include "obscura/io.h"
+#include "obscura/obscura.h"
 
 static double now_ms(void)
 {

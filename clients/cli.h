@@ -3,7 +3,7 @@
 #ifndef OBSCURA_CLIENT_CLI_H
 #define OBSCURA_CLIENT_CLI_H
 
-#include "status.h"
+#include "obscura/status.h"
 
 /* Process exit codes of every command: 3 is bad input (retrying will not
  * help), 1 any other failure. */

@@ -12,12 +12,12 @@
 #include <unistd.h>
 
 #include "cli.h"
-#include "deep.h"
+#include "obscura/deep.h"
 #include "ground.h"
-#include "io.h"
-#include "obscura.h"
-#include "reference.h"
-#include "scene.h"
+#include "obscura/io.h"
+#include "obscura/obscura.h"
+#include "obscura/reference.h"
+#include "obscura/scene.h"
 
 
 void cli_ground_usage(FILE *f)

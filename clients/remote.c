@@ -18,7 +18,7 @@
 #include <unistd.h>
 
 #include "binary.h"
-#include "io.h"
+#include "obscura/io.h"
 
 enum { RC_OK = 0, RC_FAIL = 1, RC_USAGE = 2, RC_BADINPUT = 3, RC_UNAVAILABLE = 4 };
 

@@ -22,8 +22,8 @@
 #ifndef OBSCURA_CLIENT_REMOTE_H
 #define OBSCURA_CLIENT_REMOTE_H
 
-#include "deep.h"
-#include "obscura.h"
+#include "obscura/deep.h"
+#include "obscura/obscura.h"
 
 #define CLI_REMOTE_MAX_SERVERS 16
 

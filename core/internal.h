@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "obscura.h"
+#include "obscura/obscura.h"
 
 #if defined(__GNUC__)
 #define OBS__PRINTF(a, b) __attribute__((format(printf, a, b)))
@@ -47,7 +47,7 @@ obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p,
 
 /* Sample sets on the unit disk (VAO++ section 4.5), n = 2, 4, 8, 16, 32:
  * the checked-in output of the generator in samples_gen.c
- * (core/sample_tables.c).  All five sets lie one after the other in one
+ * (core/chain/sample_tables.c).  All five sets lie one after the other in one
  * table of OBS__SAMPLE_TABLE_LEN (x, y) pairs, the set of n starting at
  * pair n - 2: the layout of the shader's single uniform array (4.1). */
 #define OBS__MAX_SAMPLES 32
@@ -79,7 +79,7 @@ obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs,
 void obs__log(obs_ctx *ctx, obs_log_level level, const char *fmt, ...)
     OBS__PRINTF(3, 4);
 
-/* A growable byte buffer (core/bytes.c) behind obs_*_write_mem. */
+/* A growable byte buffer (core/io/bytes.c) behind obs_*_write_mem. */
 typedef struct obs__membuf {
     unsigned char *data;
     size_t size, cap;

@@ -1,5 +1,5 @@
 /* Status names and messages, generated from OBS_STATUS_MAP. */
-#include "obscura.h"
+#include "obscura/obscura.h"
 
 const char *obs_status_name(obs_status s)
 {

@@ -8,7 +8,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "status.h"
+#include "obscura/status.h"
 
 #define OBSD_STR_LEN 256
 

@@ -9,7 +9,7 @@
 
 #include "http.h"
 #include "http_server.h"
-#include "io.h"
+#include "obscura/io.h"
 #include "stats.h"
 #include "stream_store.h"
 

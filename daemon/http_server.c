@@ -355,7 +355,7 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     char err[OBS_ERR_LEN] = "";
     obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
     double t0 = obsd_now_ms();
-    /* A deep EXR runs the multi-layer chain (core/deep.h), on /v1/ao only:
+    /* A deep EXR runs the multi-layer chain (include/obscura/deep.h), on /v1/ao only:
      * streams keep flat frames. */
     int deep = 0;
     obs_status s = obs_exr_is_deep_mem(body, len, &deep, err);

@@ -5,14 +5,14 @@
 
 #include <pthread.h>
 
-#include "deep.h"
-#include "obscura.h"
+#include "obscura/deep.h"
+#include "obscura/obscura.h"
 
 typedef struct obsd_job obsd_job;
 struct obsd_job {
     /* in: owned by the submitter, valid until `done` runs; either a flat
      * G-buffer (gb, the VAO++ chain) or a deep one (deep, the multi-layer
-     * chain of core/deep.h) */
+     * chain of include/obscura/deep.h) */
     const obs_gbuffer *gb;
     const obs_deep_image *deep;
     const obs_params *params;

@@ -2,7 +2,7 @@
 #ifndef OBSD_LOG_H
 #define OBSD_LOG_H
 
-#include "obscura.h"
+#include "obscura/obscura.h"
 
 void obsd_log_set_level(int level); /* OBSD_LOG_* of config.h */
 int obsd_log_enabled(int level);

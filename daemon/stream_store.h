@@ -18,7 +18,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "obscura.h"
+#include "obscura/obscura.h"
 
 #define OBSD_STREAM_NAME_LEN 64   /* longest name, in characters */
 #define OBSD_STREAM_MAX_SUBS 256  /* event subscribers over all streams */

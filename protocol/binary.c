@@ -583,7 +583,7 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
         d->samples = total ? (float *)(uintptr_t)(r->p + r->off) : NULL;
     }
     r->off += (size_t)sample_bytes;
-    /* front to back, as the deep reader leaves them (core/exr_deep.c) */
+    /* front to back, as the deep reader leaves them (core/io/exr_deep.c) */
     for (uint64_t i = 0; i < npx; i++)
         for (uint64_t k = d->offset[i] + 1; k < d->offset[i + 1]; k++)
             if (sort_key(d->samples[(k - 1) * OBS_DEEP_CH + OBS_DEEP_Z]) >

@@ -20,7 +20,7 @@
 #include <stdint.h>
 
 #include "http.h"
-#include "../core/deep.h"
+#include "obscura/deep.h"
 
 #ifdef __cplusplus
 extern "C" {

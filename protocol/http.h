@@ -9,7 +9,7 @@
 #ifndef OBSCURA_PROTOCOL_HTTP_H
 #define OBSCURA_PROTOCOL_HTTP_H
 
-#include "../core/io.h"
+#include "obscura/io.h"
 
 #ifdef __cplusplus
 extern "C" {

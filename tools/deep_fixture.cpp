@@ -40,7 +40,7 @@ int main(int argc, char **argv)
     hdr.channels().insert("Z", Channel(FLOAT));
     hdr.channels().insert("ZBack", Channel(FLOAT));
     // Imath row-vector matrices; camera space +Z forward (OpenEXR's
-    // convention, as core/exr_read.c reads it).
+    // convention, as core/io/exr_read.c reads it).
     IMATH_NAMESPACE::M44f wtc; // identity
     float t = std::tan(20.0f * float(M_PI) / 180.0f), aspect = float(W) / float(H);
     // NDC (0,0) top-left .. (1,1) bottom-right: x_ndc = 0.5 + 0.5 x / (z t aspect),

@@ -11,8 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "io.h"
-#include "obscura.h"
+#include "obscura/io.h"
+#include "obscura/obscura.h"
 
 /* Nearest-neighbour upscale of one plane into a tightly packed image. */
 static int upscale(const obs_plane *p, int sw, int sh, int w, int h, obs_image *out)

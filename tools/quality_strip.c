@@ -17,8 +17,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "io.h"
-#include "metrics.h"
+#include "obscura/io.h"
+#include "obscura/metrics.h"
 
 #define MAX_TILES 64
 #define GUTTER 4

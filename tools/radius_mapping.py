@@ -16,7 +16,7 @@ over x (the area under the occlusion profile across the crease); the
 least-squares k over x is printed for comparison.  Closed forms are
 printed beside the Monte-Carlo / quadrature values as a check.  Last,
 ao_definition rays (the default): the Monte-Carlo volume fraction at
-R = 2D converted as obs__rays_from_volume does (core/vao_cpu.c), beside
+R = 2D converted as obs__rays_from_volume does (core/chain/vao_cpu.c), beside
 the reference, on both configurations.
 
 usage: tools/radius_mapping.py        (deterministic, ~2 s)

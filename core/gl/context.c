@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gl.h"
+#include "gl/gl.h"
 
 _Thread_local const obs__gl *obs__glp;
 

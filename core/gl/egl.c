@@ -6,7 +6,7 @@
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 
-#include "backend.h"
+#include "gl/backend.h"
 
 static int has_ext(const char *exts, const char *name)
 {

@@ -10,7 +10,7 @@
 
 #include <GL/glcorearb.h>
 
-#include "frame.h"
+#include "chain/frame.h"
 #include "gl/backend.h"
 
 #define OBS__GL_FUNCS(X)                                                       \

@@ -5,7 +5,7 @@
 
 #include <GL/osmesa.h>
 
-#include "backend.h"
+#include "gl/backend.h"
 
 static obs__glproc osmesa_getproc(const char *name)
 {

@@ -2,7 +2,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "gl.h"
+#include "gl/gl.h"
 
 static obs_status compile(const char *name, GLenum type, const char *const *parts, int count,
                           GLuint *out, char err[OBS_ERR_LEN])

@@ -1,6 +1,6 @@
 // Method angle: angle-based paired-sample SSAO
 // (shared/papers/angle-based-ssao.txt).  C twin: obs__angle_pixel
-// (angle_cpu.c), which documents the method.
+// (methods/angle.c), which documents the method.
 
 uniform int u_angle_pairs;       // sample pairs
 uniform vec2 u_angle_xy[16];     // pair offsets on the unit disk (obs__angle_pattern)

@@ -1,5 +1,5 @@
 // Shared by the passes (prepended to each fragment shader).  Each function
-// has a C twin of the same name in core/vao_cpu.c.
+// has a C twin of the same name in core/chain/vao_cpu.c.
 //
 // Pixel (x, y) is row y from the top, as the planes are uploaded: texel
 // row y of every texture is image row y, so gl_FragCoord.xy (row 0 first)

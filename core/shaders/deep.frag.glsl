@@ -7,7 +7,7 @@
 // to back by alpha (section III, the separated scheme).  With
 // OBS_DEEP_HEMISPHERE the per-node occlusion is method hemisphere's point samples
 // (the normal-oriented hemisphere kernel), each against every node, the
-// largest counting (Algorithm 1).  C twin: core/deep_cpu.c (same function
+// largest counting (Algorithm 1).  C twin: core/deep/deep_cpu.c (same function
 // names).
 
 layout(rgba32f) readonly uniform image2DArray u_lpos; // node view position xyz, planar depth w (0: empty)

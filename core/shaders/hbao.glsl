@@ -2,7 +2,7 @@
 // SIGGRAPH 2008):
 //   AO = 1 - 1/(2 pi) Int (sin h(theta) - sin t(theta)) W(theta) dtheta,
 // per-sample attenuation W(r) = 1 - r^2 / R^2.  C twin: obs__hbao_pixel
-// (hbao_cpu.c), which documents the method.
+// (methods/hbao.c), which documents the method.
 
 uniform int u_hbao_dirs;         // Nd
 uniform int u_hbao_steps;        // Ns

@@ -1,7 +1,7 @@
 // Method hemisphere: normal-oriented hemisphere SSAO (Crytek's SSAO with
 // the kernel in the hemisphere around the normal, as Unity's
 // post-processing stack ships it).  C twin: obs__hemisphere_pixel
-// (hemisphere_cpu.c), which documents the kernel.
+// (methods/hemisphere.c), which documents the kernel.
 
 uniform int u_hs_count;          // samples
 uniform float u_hs_bias;         // occluders must be this far in front (depth units)

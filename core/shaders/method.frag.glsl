@@ -1,6 +1,6 @@
 // AO pass of the comparison methods: method_ao() of the method's file in
 // place of the VAO estimator; writes the attachments of the VAO pass (no
-// culling, no bleeding).  C twin: obs__method_pixel (method_cpu.c).
+// culling, no bleeding).  C twin: obs__method_pixel (methods/methods.c).
 
 layout(location = 0) out vec2 o_ao;    // AO, planar depth (for the blur)
 layout(location = 1) out float o_count; // samples taken (debug output)

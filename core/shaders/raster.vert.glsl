@@ -1,5 +1,5 @@
 #version 430 core
-// G-buffer rasteriser (core/raster_gl.c): world-space triangles through the
+// G-buffer rasteriser (core/ground/raster_gl.c): world-space triangles through the
 // camera; the fragment stage writes the G-buffer's planes.
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;

@@ -1,4 +1,4 @@
-// G-buffer rasterisers (core/raster_gl.c, core/raster_deep_gl.c), fragment
+// G-buffer rasterisers (core/ground/raster_gl.c, core/ground/raster_deep_gl.c), fragment
 // stage, shared part: the vertex stage's outputs and the shading normal.
 in vec3 v_world;
 in vec3 v_normal;

@@ -1,4 +1,4 @@
-// A-buffer rasteriser (core/raster_deep_gl.c), fragment stage (after a
+// A-buffer rasteriser (core/ground/raster_deep_gl.c), fragment stage (after a
 // #version line and raster_common.glsl): every fragment is appended to its
 // pixel's linked list, the PPLL of OITAO section IV-A (Yang et al.): one
 // geometry pass, depth test off, a node pool in a shader storage buffer

@@ -1,4 +1,4 @@
-/* libFuzzer target for the EXR readers (core/exr_read.c, core/exr_deep.c):
+/* libFuzzer target for the EXR readers (core/io/exr_read.c, core/io/exr_deep.c):
  * every input is read from memory as a flat G-buffer and as a deep image,
  * with small size limits so that a valid-looking header cannot ask for
  * much memory; whatever a reader returns is touched and freed (ASan and
@@ -8,8 +8,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 
-#include "deep.h"
-#include "io.h"
+#include "obscura/deep.h"
+#include "obscura/io.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

@@ -7,7 +7,7 @@
 
 #include "testutil.h"
 
-#include "io.h"
+#include "obscura/io.h"
 
 static const char *const scenes[] = {TESTDATA "/room_small", TESTDATA "/yard_small"};
 

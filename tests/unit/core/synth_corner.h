@@ -8,7 +8,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "frame.h"
+#include "chain/frame.h"
 
 #define SC_W 96
 #define SC_H 72

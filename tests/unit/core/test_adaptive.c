@@ -7,8 +7,8 @@
 
 #include "testutil.h"
 
-#include "frame.h"
-#include "io.h"
+#include "chain/frame.h"
+#include "obscura/io.h"
 
 #define W 64
 #define H 48

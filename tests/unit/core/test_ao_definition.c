@@ -10,7 +10,7 @@
 
 #include "gl_testutil.h"
 
-#include "frame.h"
+#include "chain/frame.h"
 
 typedef struct stats {
     double mse, contact_bias, open_mean;

@@ -7,8 +7,8 @@
 
 #include "testutil.h"
 
-#include "frame.h"
-#include "io.h"
+#include "chain/frame.h"
+#include "obscura/io.h"
 #include "synth_corner.h"
 
 /* Eq 5: c(x) = max(0, (x - p).n / |x - p|) (1 - |x - p| / radius)^2,

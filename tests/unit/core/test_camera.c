@@ -5,8 +5,8 @@
 
 #include "testutil.h"
 
-#include "frame.h"
-#include "io.h"
+#include "chain/frame.h"
+#include "obscura/io.h"
 
 static obs__frame setup(obs_gbuffer *gb, const char *normal_space)
 {

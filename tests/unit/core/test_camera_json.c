@@ -3,7 +3,7 @@
 
 #include <math.h>
 
-#include "io.h"
+#include "obscura/io.h"
 
 static const char *write_tmp(const char *name, const char *text)
 {

@@ -2,7 +2,7 @@
  * that name what was looked for. */
 #include "testutil.h"
 
-#include "exr_internal.h"
+#include "io/exr_internal.h"
 
 #define N(a) ((int)(sizeof(a) / sizeof((a)[0])))
 

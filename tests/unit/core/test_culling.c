@@ -14,8 +14,8 @@
 
 #include "testutil.h"
 
-#include "frame.h"
-#include "io.h"
+#include "chain/frame.h"
+#include "obscura/io.h"
 
 #define IMPERCEPTIBLE (1.0 / 510.0)
 

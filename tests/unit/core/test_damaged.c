@@ -10,7 +10,7 @@
 
 #include <dirent.h>
 
-#include "io.h"
+#include "obscura/io.h"
 
 typedef struct tally {
     int files, rejected, read;     /* the G-buffer with the auto map */

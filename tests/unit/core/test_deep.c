@@ -10,8 +10,8 @@
 #include <dirent.h>
 #include <math.h>
 
-#include "deep.h"
-#include "deep_internal.h"
+#include "obscura/deep.h"
+#include "deep/deep_internal.h"
 #include "gl/gl.h"
 
 #define FIXTURE TESTDATA "/deep_small.exr"

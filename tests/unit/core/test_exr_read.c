@@ -7,7 +7,7 @@
 #include <openexr.h>
 
 #include "internal.h"
-#include "io.h"
+#include "obscura/io.h"
 
 /* ---- synthetic files ---------------------------------------------------- */
 

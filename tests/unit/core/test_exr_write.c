@@ -6,7 +6,7 @@
 #include <openexr.h>
 
 #include "internal.h"
-#include "io.h"
+#include "obscura/io.h"
 
 #define W 37
 #define H 23

@@ -6,8 +6,8 @@
 
 #include "gl_testutil.h"
 
-#include "frame.h"
-#include "io.h"
+#include "chain/frame.h"
+#include "obscura/io.h"
 #include "synth_corner.h"
 
 /* Eq 3: AO_L = AO (1 - min(1, max(0, lum - threshold + width)) / (2 width))^sigma,

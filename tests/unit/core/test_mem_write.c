@@ -2,7 +2,7 @@
  * same bytes as the file writers, and fail the same way. */
 #include "testutil.h"
 
-#include "io.h"
+#include "obscura/io.h"
 
 #define W 61
 #define H 29

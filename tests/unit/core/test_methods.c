@@ -8,7 +8,7 @@
 
 #include "gl_testutil.h"
 
-#include "frame.h"
+#include "chain/frame.h"
 
 /* Odd sizes: with an orthographic camera of pixel size PX the centre of
  * pixel (CX, CY) is the view axis, x = y = 0. */

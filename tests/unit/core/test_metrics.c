@@ -1,10 +1,10 @@
-/* Image comparison metrics (core/metrics.c) against closed forms and
+/* Image comparison metrics (core/ground/metrics.c) against closed forms and
  * against shared/tools/aometrics.py, the project's referee. */
 #include "testutil.h"
 
 #include <math.h>
 
-#include "metrics.h"
+#include "obscura/metrics.h"
 
 /* cmocka 1.1.5 (Debian 12) has no assert_double_equal, and its
  * assert_float_equal compares in float. */

@@ -1,7 +1,7 @@
 /* The parameter table: lookup, parsing, ranges, defaults. */
 #include "testutil.h"
 
-#include "obscura.h"
+#include "obscura/obscura.h"
 
 static void test_zero_means_defaults(void **state)
 {

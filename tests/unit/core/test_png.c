@@ -5,7 +5,7 @@
 #include <math.h>
 #include <png.h>
 
-#include "io.h"
+#include "obscura/io.h"
 
 static const char *tmp_path(const char *name)
 {

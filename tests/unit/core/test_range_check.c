@@ -10,8 +10,8 @@
 
 #include "testutil.h"
 
-#include "frame.h"
-#include "io.h"
+#include "chain/frame.h"
+#include "obscura/io.h"
 
 /* The halo band: background pixels with a neighbour within BAND_PX pixels
  * that is closer to the camera by more than the AO radius R, so that the

@@ -6,8 +6,8 @@
 
 #include "testutil.h"
 
-#include "io.h"
-#include "scene.h"
+#include "obscura/io.h"
+#include "obscura/scene.h"
 
 #define W 96
 #define H 64

@@ -1,6 +1,6 @@
 /* The A-buffer rasteriser (obs_raster_deep: per-pixel linked lists, OITAO
  * section IV-A) against the flat one, node counts of stacked quads, the
- * deep EXR writer read back by core/exr_deep.c, opacity specs and
+ * deep EXR writer read back by core/io/exr_deep.c, opacity specs and
  * materials, the ray-traced reference with transparency on an analytic
  * case, and multi-layer against single-layer AO on a scene with a
  * transparent pane (built here; the Blender room when ../shared is
@@ -9,11 +9,11 @@
 
 #include "testutil.h"
 
-#include "deep.h"
-#include "io.h"
-#include "metrics.h"
-#include "reference.h"
-#include "scene.h"
+#include "obscura/deep.h"
+#include "obscura/io.h"
+#include "obscura/metrics.h"
+#include "obscura/reference.h"
+#include "obscura/scene.h"
 
 /* The mesh of room.obj made transparent (see bench/QUALITY.md). */
 #define ROOM_TRANSPARENT "Cube.012"

@@ -6,9 +6,9 @@
 
 #include "testutil.h"
 
-#include "io.h"
-#include "reference.h"
-#include "scene.h"
+#include "obscura/io.h"
+#include "obscura/reference.h"
+#include "obscura/scene.h"
 
 #define PI 3.14159265358979323846
 

@@ -8,13 +8,13 @@
 
 #include "testutil.h"
 
-#include "frame.h"
-#include "io.h"
+#include "chain/frame.h"
+#include "obscura/io.h"
 
 static const int sizes[] = {2, 4, 8, 16, 32};
 #define NSIZES ((int)(sizeof sizes / sizeof sizes[0]))
 
-/* core/sample_tables.c is the generator's output, bit for bit
+/* core/chain/sample_tables.c is the generator's output, bit for bit
  * (otherwise: make samples). */
 static void test_tables_match_generator(void **state)
 {
@@ -28,7 +28,7 @@ static void test_tables_match_generator(void **state)
         assert_ptr_equal(t, obs_samples_table(n));
         assert_ptr_equal(t, obs__sample_table[n - 2]);
         if (memcmp(t, xy, sizeof(float) * 2 * (size_t)n) != 0)
-            fail_msg("core/sample_tables.c: the %d-sample set differs from the generator's; "
+            fail_msg("core/chain/sample_tables.c: the %d-sample set differs from the generator's; "
                      "run make samples",
                      n);
         for (int i = 0; i < n; i++)

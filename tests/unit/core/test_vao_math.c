@@ -8,7 +8,7 @@
 
 #include "gl_testutil.h"
 
-#include "frame.h"
+#include "chain/frame.h"
 
 #define W 96
 #define H 72

@@ -1,0 +1,285 @@
+/* One frame's resolved setup, shared by the GL passes (as uniforms) and by
+ * their CPU twin, plus the twin's per-pixel functions.  Each function here
+ * has a GLSL counterpart of the same name in core/shaders/common.glsl (or
+ * the pass shader named beside it); tests compare the two. */
+#ifndef OBSCURA_FRAME_H
+#define OBSCURA_FRAME_H
+
+#include "internal.h"
+
+/* Raw depth at or beyond this (Blender writes 1e10 for the sky), non-finite
+ * or <= 0 is background: no geometry, AO 1, never an occluder. */
+#define OBS__SKY_DEPTH 1e9f
+
+/* Every OBS_OUTPUT_* bit. */
+#define OBS__OUTPUTS_ALL                                                                           \
+    (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |        \
+     OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE)
+
+/* Culling pre-pass (VAO++ section 4.2): one low-resolution texel per
+ * OBS__CULL_BLOCK x OBS__CULL_BLOCK pixels ("1/8 resolution"), always
+ * OBS__CULL_SAMPLES samples; a culling candidate of the careful variant
+ * takes at most OBS__CULL_CAREFUL samples. */
+#define OBS__CULL_BLOCK 8
+#define OBS__CULL_SAMPLES 8
+#define OBS__CULL_CAREFUL 4
+
+/* Largest blur_radius of the parameter table (one blur program per
+ * radius, BLUR_RADIUS in blur.frag.glsl). */
+#define OBS__MAX_BLUR 16
+
+/* k of R = k * D: the paper's kernel width R (hemisphere radius; the
+ * tangent sphere has radius R/2) for the ray-traced AO distance D that the
+ * radius parameter gives, by ao_definition (bench/QUALITY.md, "How
+ * --radius maps to the AO distance"; tools/radius_mapping.py).
+ *
+ * rays, k = 2: on a floor at distance x from a wall, the rays of length D
+ * reach the wall for x < D, and the tangent sphere of radius R/2 = D
+ * touches it for x < D: the same support, so the crease profile of the
+ * volume fraction can be converted to the ray tracer's one exactly
+ * (obs__rays_from_volume).  k = 2 is the smallest k for which that is
+ * possible: for k < 2 the volume fraction is 0 where the rays still see
+ * the wall.
+ *
+ * volume, k = 1: the tangent sphere of radius D/2 is the largest sphere
+ * inside the ray tracer's hemisphere of radius D that touches p.
+ *
+ * Applied in one place, obs__frame_setup (frame.c), to methods vaopp and
+ * vao (the comparison methods take the radius as D). */
+#define OBS__RADIUS_K_RAYS 2.0f
+#define OBS__RADIUS_K_VOLUME 1.0f
+
+/* A VAO sample on the shaded pixel itself reads p's tangent plane under
+ * its pipe (obs__own_plane_depth) unless |n.z| is at most this (the plane
+ * nearly edge-on); GLSL: OWN_PLANE_NZ in common.glsl. */
+#define OBS__OWN_PLANE_NZ 0.05f
+
+/* Largest counts of the comparison methods' parameters (uniform array
+ * sizes in hemisphere.glsl, angle.glsl, hbao.glsl). */
+#define OBS__MAX_HEMISPHERE 64
+#define OBS__MAX_PAIRS 16
+#define OBS__MAX_DIRECTIONS 32
+
+typedef struct obs__frame {
+    int width, height;
+    float viewport[4];      /* display_x, display_y, display_width, display_height */
+    float proj[16];         /* view -> clip, row-major */
+    float normal_matrix[9]; /* input normal -> view normal, row-major 3x3 */
+    int reconstruct_normals;/* 1: no usable normals, derive them from depth */
+    int depth_mode;         /* OBS_DEPTH_PLANAR/RADIAL/NDC */
+    float radius;           /* R, the kernel width, in depth units: k * radius / unit_scale
+                             * (OBS__RADIUS_K_*); D for the comparison methods */
+    int rays;               /* 1: eq 1's V converted to the ray-traced AO (ao_definition rays) */
+    int samples;            /* the count of the parameter: adaptive sampling's maximum */
+    const float *sample_xy; /* samples * (x, y) on the unit disk */
+    const float *sample_table; /* all sets, 62 (x, y) pairs: the set of n at pair n - 2 */
+    int adaptive;           /* 1: adaptive sampling (section 4.1) */
+    float adaptive_k;       /* vw / (vh * D0^2): disk area ratio = r^2 |det J| * adaptive_k */
+    float rot[9][2];        /* (cos, sin) of the 3x3 tile's rotations */
+    int range_check;        /* 1: depth range check (section 4.4, eq 4) */
+    float range_u;          /* u of eq 4 */
+    int range_normal;       /* 1: eq 4's d along the occluder's normal (range_distance) */
+    int culling;            /* section 4.2: 0 off, 1 greedy, 2 careful */
+    float cull_threshold;   /* an estimate below this shows occlusion: 1 - culling_epsilon */
+    int cull_w, cull_h;     /* the low-resolution texture: ceil(width / 8) x ceil(height / 8) */
+    int blur_radius;        /* low-pass filter half-width (section 4.6); 0: off */
+    float blur_w[OBS__MAX_BLUR + 1]; /* Gaussian weight of offset 0..blur_radius */
+    int luminance;          /* section 4.3, eq 3: 0 off, 1 Rec. 709 luminance, 2 HSV V */
+    float lum_threshold, lum_width, lum_sigma; /* threshold, width, sigma of eq 3 */
+    int bleed_step;         /* section 4.7, eq 5: 0 off, else every bleed_step-th sample */
+    int method;             /* OBS_METHOD_*: which estimator the AO pass runs */
+    /* method hemisphere (methods/hemisphere.c): the kernel, unit hemisphere
+     * around +z, scaled by radius at use */
+    int hs_count;
+    float hs_bias;          /* in depth units: hemisphere_bias * R */
+    float hs_kernel[OBS__MAX_HEMISPHERE][3];
+    /* method angle (methods/angle.c): pair i's offset on the unit disk (its
+     * partner is the negation); the arc cosine used (OBS_ACOS_*) */
+    int angle_pairs;
+    float angle_xy[OBS__MAX_PAIRS][2];
+    int angle_acos;
+    /* method hbao (methods/hbao.c): directions (unit, view xy), steps, bias */
+    int hbao_dirs, hbao_steps;
+    float hbao_dir[OBS__MAX_DIRECTIONS][2];
+    float hbao_bias_cs[2];  /* cos, sin of the angle bias */
+} obs__frame;
+
+/* Resolves camera, parameters and normal handling for one frame. */
+obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *resolved,
+                            obs__frame *f, char err[OBS_ERR_LEN]);
+
+/* ---- per-pixel twins (GLSL: common.glsl, prep.frag, vao.frag) ----------- */
+
+/* Pixel centre (x, y) of the planes -> NDC of the display window. */
+void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2]);
+
+/* View-space position of the point seen at pixel (x, y): the prep pass.
+ * out = (x, y, z, d) with d the planar depth; (0,0,0,0) for background. */
+void obs__prep_position(const obs__frame *f, float raw_depth, int x, int y, float out[4]);
+
+/* View-space unit normal of pixel (x, y) from the input normal (or, with
+ * reconstruct_normals, from the neighbouring positions in `pos`, 4 floats
+ * per pixel as obs__prep_position writes them). */
+void obs__prep_normal(const obs__frame *f, const float *pos, const float *in_normal, int x, int y,
+                      float out[3]);
+
+/* Adaptive sampling, VAO++ section 4.1 (GLSL: adaptive_count() in
+ * vao.frag.glsl): the sample count for a tangent sphere centred at the
+ * view-space point c, from the screen area of its disk of radius R/2. */
+int obs__adaptive_count(const obs__frame *f, const float c[3]);
+
+/* Volumetric AO of the point p with normal n at pixel (x, y), eq 1 and 2
+ * of VAO++ section 3; `pos` and `nrm` are the prep pass's position and
+ * view normal planes (4 and 3 floats per pixel).  The count of samples
+ * taken goes to *count when count is not NULL. */
+float obs__vao_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                     const float p[3], const float n[3], int *count);
+
+/* The sample count pixel (x, y) takes without culling: the samples
+ * parameter, or the adaptive count (section 4.1) of its tangent sphere. */
+int obs__vao_count(const obs__frame *f, const float p[3], const float n[3]);
+
+/* The volumetric AO estimator of obs__vao_pixel with an explicit set:
+ * the ns samples at xy (GLSL: vao_estimate() in vao.glsl). */
+float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                        const float p[3], const float n[3], int ns, const float *xy);
+
+/* The samples' pixels (GLSL: disk_map(), disk_px() in common.glsl).  The
+ * disk c + r (dx, dy, 0), (dx, dy) a sample (sx, sy) turned by rot (cos,
+ * sin), lies in the plane z = c.z, so its pixel coordinates are a
+ * projective map of (sx, sy): u = (U.s) / (W.s), v = (V.s) / (W.s) with
+ * s = (sx, sy, 1), set up once per pixel.  obs__disk_px gives the pixel
+ * obs__view_to_px gives for the sample's view-space point, up to rounding
+ * at pixel borders; 0 when behind the camera or off the planes. */
+typedef struct obs__disk {
+    float u[3], v[3], w[3];
+} obs__disk;
+void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
+                   obs__disk *m);
+int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx, int *qy);
+
+/* The depth range check's falloff (VAO++ 4.4, eq 4): s(d) = u / max(u,
+ * d / R) for a pipe d behind its occluder along view Z; with
+ * f->range_normal, d |nz|, the pipe's depth below the occluding surface
+ * whose view normal has z component nz (GLSL: range_falloff() in
+ * common.glsl). */
+float obs__range_falloff(const obs__frame *f, float d, float nz);
+
+/* The planar depth of the tangent plane at p (normal n) under the pipe of
+ * the disk's sample (sx, sy), for eq 1's dz: what a sample on the shaded
+ * pixel itself reads instead of the depth at the pixel's centre zs, which
+ * is p's; zs itself when |n[2]| <= OBS__OWN_PLANE_NZ (GLSL:
+ * own_plane_depth(p, n, disk_point(c, r, rot, sx, sy), zs) in
+ * common.glsl). */
+float obs__own_plane_depth(const float p[3], const float n[3], const float c[3], float r,
+                           const float rot[2], float sx, float sy, float zs);
+
+/* ao_definition rays (GLSL: rays_from_volume() in common.glsl):
+ * the AO a ray tracer gives with rays of length D for the AO ao of the
+ * tangent sphere of radius D (R = 2 D), through the floor-wall crease,
+ * where both are known in closed form: a wall at distance x = b D from p
+ * fills (1 - b)^2 (2 + b) / 4 of the sphere and blocks
+ * (acos b - b sqrt(1 - b^2)) / pi of the cosine-weighted rays.  The
+ * first is inverted for b, the second returned as AO; both are 1/2 at the
+ * corner (b = 0), and an occlusion over 1/2 is returned unchanged. */
+float obs__rays_from_volume(float ao);
+
+/* Culling pre-pass, VAO++ section 4.2 (GLSL: cull.frag.glsl), CPU twin
+ * in cull_cpu.c.  The low-resolution AO: texel (i, j) of cull_w x cull_h
+ * (written to est) is the 8-sample AO of the pixel at the block's centre,
+ * (min(8i + 4, width - 1), min(8j + 4, height - 1)); 1 for background. */
+void obs__cull_prepass(const obs__frame *f, const float *pos, const float *nrm, float *est);
+
+/* GL_LINEAR fetch of the low-resolution AO at the full-resolution
+ * position (px, py) (pixel corners are integers), clamped to the edge. */
+float obs__cull_fetch(const obs__frame *f, const float *est, int px, int py);
+
+/* 1 when none of the four corners of pixel (x, y) shows occlusion: the
+ * pixel is a culling candidate (GLSL: cull_candidate() in vao.frag.glsl). */
+int obs__cull_candidate(const obs__frame *f, const float *est, int x, int y);
+
+/* The estimator of obs__vao_estimate that also gathers colour bleeding
+ * (VAO++ section 4.7, eq 5; GLSL: vao_estimate() in vao.glsl): with
+ * f->bleed_step > 0, bleed gets the mean over every bleed_step-th sample
+ * of white mixed towards the colour at the sample's pixel by c(x); else
+ * (1, 1, 1).  col: 4 floats (RGBA) per pixel; NULL: no bleeding. */
+float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *nrm,
+                              const float *col, int x, int y, const float p[3], const float n[3],
+                              int ns, const float *xy, float bleed[3]);
+
+/* Eq 5 of VAO++ section 4.7 (GLSL: bleed_weight() in vao.glsl): the
+ * indirect contribution c(x) of the surface point x to the point p with
+ * normal n, for the AO radius R. */
+float obs__bleed_weight(const float x[3], const float p[3], const float n[3], float R);
+
+/* Luminance sensitivity, VAO++ section 4.3, eq 3 (GLSL:
+ * luminance_factor() in luminance.frag.glsl): the factor of eq 3 for a
+ * pixel of colour rgb, 1 keeps its occlusion, 0 removes it; and the AO
+ * after the correction, 1 - (1 - ao) * factor.  f->luminance must be
+ * non-zero. */
+float obs__luminance_factor(const obs__frame *f, const float rgb[3]);
+float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3]);
+
+/* Low-pass filter, VAO++ section 4.6 (GLSL: blur.frag.glsl): one pass of
+ * the depth-aware cross-bilateral Gaussian along (dx, dy) at pixel (x, y)
+ * of the AO plane `ao`; `pos` gives each pixel's view depth (w). */
+float obs__blur_pixel(const obs__frame *f, const float *pos, const float *ao, int x, int y, int dx,
+                      int dy);
+
+/* ---- comparison methods (parameter `method`) ----------------------------- */
+
+/* The pixel whose planes hold the view-space point s: 1 and (qx, qy) when s
+ * projects into the image in front of the camera, else 0 (GLSL:
+ * view_to_px() in method.glsl). */
+int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy);
+
+/* The unit-hemisphere kernel of n samples (n <= OBS__MAX_HEMISPHERE),
+ * 3 floats each, around +z (methods/hemisphere.c). */
+void obs__hemisphere_kernel(int n, float *out);
+
+/* Method hemisphere's kernel (GLSL: hemisphere.glsl): the view-space
+ * position s of kernel sample i for the point p with normal n at pixel
+ * (x, y), the kernel's +z turned to n and rotated by the pixel's 3x3 tile
+ * rotation.  obs__hemisphere_basis() gives the tangent frame t1, t2 once
+ * per pixel. */
+void obs__hemisphere_basis(const float n[3], float t1[3], float t2[3]);
+void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3], const float n[3],
+                            const float t1[3], const float t2[3], int i, float s[3]);
+
+/* Normal-oriented hemisphere SSAO of the point p (xyz; planar depth in
+ * p[3] is not needed) with normal n at pixel (x, y); `pos` is the prep
+ * pass's position plane (GLSL: hemisphere.glsl). */
+float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                            const float n[3]);
+
+/* The pair offsets of the angle-based method on the unit disk, 2 floats
+ * per pair (methods/angle.c). */
+void obs__angle_pattern(int pairs, float *out);
+
+/* The arc cosine of the angle-based method: mode OBS_ACOS_QUADRATIC,
+ * _LINEAR or _EXACT; x is clamped to [-1, 1] (GLSL: acos_mode() in
+ * angle.glsl). */
+float obs__acos_mode(int mode, float x);
+
+/* Angle-based paired-sample SSAO of the point p (xyzw, w the planar
+ * depth) with normal n at pixel (x, y) (GLSL: angle.glsl). */
+float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[4],
+                       const float n[3]);
+
+/* Horizon-based AO of the point p with normal n at pixel (x, y), marched
+ * from that pixel (GLSL: hbao.glsl).  The count of depth samples read
+ * goes to *count when count is not NULL. */
+float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                      const float n[3], int *count);
+
+/* The AO of pixel (x, y) by the frame's method other than vaopp/vao
+ * (position and normal from the planes); *count: samples taken (GLSL:
+ * main() of method.frag.glsl). */
+float obs__method_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                        int *count);
+
+/* Both passes over the whole plane, horizontal then vertical, in place in
+ * `ao`; `tmp` holds width * height floats. */
+void obs__blur(const obs__frame *f, const float *pos, float *ao, float *tmp);
+
+#endif

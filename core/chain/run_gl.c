@@ -1,0 +1,607 @@
+/* obs_run: uploads a G-buffer, runs the passes on the GL context, reads the
+ * results back.  Textures and framebuffers are allocated once per
+ * resolution and reused for every frame of that size. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "chain/frame.h"
+#include "gl/gl.h"
+#include "obs_shaders.h"
+
+static const char glsl_version[] = "#version 430 core\n";
+/* Switches of the AO pass compiled in or out, by defines, instead of read
+ * from uniforms: a uniform branch does not skip its body on a SIMD
+ * rasteriser such as llvmpipe, which runs both sides for every pixel (the
+ * bleed code cost the AO pass a third of its time with bleeding off;
+ * bench/RESULTS.md).  Bits of the index of ctx->prog.vao; each program is
+ * built on its first use. */
+enum {
+    AO_BLEED = 1,    /* OBS_BLEED: colour bleeding (section 4.7) */
+    AO_ADAPTIVE = 2, /* OBS_ADAPTIVE: adaptive sampling (section 4.1) */
+    AO_CULLING = 4,  /* OBS_CULLING: the culling test (section 4.2) */
+    AO_RANGE = 8     /* OBS_RANGE_CHECK: the depth range check (section 4.4) */
+};
+
+static unsigned ao_variant(const obs__frame *f)
+{
+    return (f->bleed_step ? AO_BLEED : 0u) | (f->adaptive ? AO_ADAPTIVE : 0u) |
+           (f->culling ? AO_CULLING : 0u) | (f->range_check ? AO_RANGE : 0u);
+}
+
+/* The AO program (pre 0) or the culling pre-pass's (pre 1; its variants
+ * differ only in AO_RANGE) of the given variant, built on its first use. */
+static obs_status build_vao_program(obs_ctx *ctx, int pre, unsigned v, char err[OBS_ERR_LEN])
+{
+    GLuint *prog = pre ? &ctx->prog.cull[(v & AO_RANGE) != 0] : &ctx->prog.vao[v];
+    if (*prog)
+        return OBS_OK;
+    char defs[160];
+    snprintf(defs, sizeof defs,
+             "#define OBS_BLEED %d\n#define OBS_ADAPTIVE %d\n#define OBS_CULLING %d\n"
+             "#define OBS_RANGE_CHECK %d\n",
+             !pre && (v & AO_BLEED), !pre && (v & AO_ADAPTIVE), !pre && (v & AO_CULLING),
+             (v & AO_RANGE) != 0);
+    const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_vao,
+                         pre ? obs__shader_cull_frag : obs__shader_vao_frag};
+    return obs__gl_program(pre ? "cull" : "vao", obs__shader_fullscreen_vert, src, 5, prog, err);
+}
+
+static obs_status build_programs(obs_ctx *ctx, char err[OBS_ERR_LEN])
+{
+    if (ctx->prog.composite)
+        return OBS_OK;
+    const char *comp[] = {glsl_version, obs__shader_composite_frag};
+    return obs__gl_program("composite", obs__shader_fullscreen_vert, comp, 2, &ctx->prog.composite,
+                           err);
+}
+
+/* The finishing pass (luminance.frag.glsl) with the conversion of
+ * ao_definition rays (OBS_RAYS) and luminance sensitivity (OBS_LUMINANCE)
+ * compiled in or out, built on its first use: prog.finish[2 * rays + lum]. */
+static obs_status build_finish_program(obs_ctx *ctx, int rays, int lum, char err[OBS_ERR_LEN])
+{
+    GLuint *prog = &ctx->prog.finish[2 * rays + lum];
+    if ((!rays && !lum) || *prog)
+        return OBS_OK;
+    char defs[64];
+    snprintf(defs, sizeof defs, "#define OBS_RAYS %d\n#define OBS_LUMINANCE %d\n", rays, lum);
+    const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_luminance_frag};
+    return obs__gl_program("finish", obs__shader_fullscreen_vert, src, 4, prog, err);
+}
+
+/* The prep pass that reads the normals or derives them from depth
+ * (OBS_RECONSTRUCT), for the frame's depth mode (OBS_DEPTH_MODE: planar,
+ * radial, ndc; resolved, never OBS_DEPTH_DEFAULT), built on its first use:
+ * ctx->prog.prep[prep_index(f)]. */
+static int prep_index(const obs__frame *f)
+{
+    int mode = f->depth_mode >= OBS_DEPTH_PLANAR && f->depth_mode <= OBS_DEPTH_NDC
+                   ? f->depth_mode
+                   : OBS_DEPTH_PLANAR;
+    return 3 * (f->reconstruct_normals != 0) + mode - OBS_DEPTH_PLANAR;
+}
+
+static obs_status build_prep_program(obs_ctx *ctx, const obs__frame *f, char err[OBS_ERR_LEN])
+{
+    int k = prep_index(f);
+    if (ctx->prog.prep[k])
+        return OBS_OK;
+    char defs[80];
+    snprintf(defs, sizeof defs, "#define OBS_RECONSTRUCT %d\n#define OBS_DEPTH_MODE %d\n",
+             k / 3, k % 3 + OBS_DEPTH_PLANAR);
+    const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_prep_frag};
+    return obs__gl_program(k / 3 ? "prep (normals from depth)" : "prep",
+                           obs__shader_fullscreen_vert, src, 4, &ctx->prog.prep[k], err);
+}
+
+/* The blur of half-width radius (section 4.6), built on its first use:
+ * the radius is a compile-time constant, so the taps' loop is unrolled;
+ * rays 1 is the vertical pass that also converts its result
+ * (ao_definition rays, OBS_RAYS in blur.frag.glsl). */
+static obs_status build_blur_program(obs_ctx *ctx, int rays, int radius, char err[OBS_ERR_LEN])
+{
+    if (radius <= 0 || ctx->prog.blur[rays][radius])
+        return OBS_OK;
+    char def[64];
+    snprintf(def, sizeof def, "#define BLUR_RADIUS %d\n#define OBS_RAYS %d\n", radius, rays);
+    const char *src[] = {glsl_version, def, obs__shader_common, obs__shader_blur_frag};
+    return obs__gl_program("blur", obs__shader_fullscreen_vert, src, 4,
+                           &ctx->prog.blur[rays][radius], err);
+}
+
+/* The AO program of a comparison method (parameter method), built on its
+ * first use: common.glsl, method.glsl, the method's file, method.frag. */
+static obs_status build_method_program(obs_ctx *ctx, int method, char err[OBS_ERR_LEN])
+{
+    static const char *const names[3] = {"hemisphere", "angle", "hbao"};
+    const char *const files[3] = {obs__shader_hemisphere, obs__shader_angle, obs__shader_hbao};
+    int k = method - OBS_METHOD_HEMISPHERE;
+    if (k < 0 || k > 2 || ctx->prog.method[k])
+        return OBS_OK;
+    const char *src[] = {glsl_version, obs__shader_common, obs__shader_method, files[k],
+                         obs__shader_method_frag};
+    return obs__gl_program(names[k], obs__shader_fullscreen_vert, src, 5, &ctx->prog.method[k], err);
+}
+
+static GLuint make_texture(obs_ctx *ctx, GLenum format, int w, int h)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    ctx->gl_objects_created++;
+    return t;
+}
+
+static obs_status make_fbo(obs_ctx *ctx, GLuint *fbo, const GLuint *tex, int count,
+                           const char *name, char err[OBS_ERR_LEN])
+{
+    static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1,
+                                  GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+    glGenFramebuffers(1, fbo);
+    ctx->gl_objects_created++;
+    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+    for (int i = 0; i < count; i++)
+        glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, tex[i], 0);
+    glDrawBuffers(count, bufs);
+    GLenum st = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (st != GL_FRAMEBUFFER_COMPLETE)
+        return obs__fail(err, OBS_GL_ERROR, "framebuffer %s incomplete (0x%04x)", name, (unsigned)st);
+    return OBS_OK;
+}
+
+void obs__frame_release(obs_ctx *ctx)
+{
+    obs__targets *t = &ctx->tg;
+    GLuint tex[] = {t->tex_depth,   t->tex_normal, t->tex_color,     t->tex_viewpos, t->tex_vnormal,
+                    t->tex_dz,      t->tex_ao,     t->tex_composite, t->tex_blur,    t->tex_count,
+                    t->tex_cull,    t->tex_cullmask, t->tex_bleed,   t->tex_lumfactor};
+    GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao, t->fbo_cull};
+    glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
+    glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
+    memset(t, 0, sizeof *t);
+    obs__programs *g = &ctx->prog;
+    OBS__GL_DELETE_PROGRAMS(g->prep);
+    OBS__GL_DELETE_PROGRAMS(g->vao);
+    OBS__GL_DELETE_PROGRAMS(g->cull);
+    obs__gl_delete_programs(&g->blur[0][0], sizeof g->blur / sizeof g->blur[0][0]);
+    OBS__GL_DELETE_PROGRAMS(g->method);
+    OBS__GL_DELETE_PROGRAMS(g->finish);
+    obs__gl_delete_programs(&g->composite, 1);
+    memset(&ctx->prog, 0, sizeof ctx->prog);
+}
+
+static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LEN])
+{
+    obs__targets *t = &ctx->tg;
+    if (t->width == w && t->height == h)
+        return OBS_OK;
+    if (t->width) {
+        /* a new resolution: drop the old set, keep the programs */
+        obs__programs keep = ctx->prog;
+        memset(&ctx->prog, 0, sizeof ctx->prog);
+        obs__frame_release(ctx);
+        ctx->prog = keep;
+    }
+    t->tex_depth = make_texture(ctx, GL_R32F, w, h);
+    t->tex_normal = make_texture(ctx, GL_RGBA32F, w, h); /* read as an image: no RGB32F */
+    t->tex_color = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_viewpos = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_vnormal = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_dz = make_texture(ctx, GL_RG32F, w, h);
+    t->tex_ao = make_texture(ctx, GL_RG32F, w, h);     /* AO, depth (blur.frag.glsl) */
+    t->tex_composite = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_blur = make_texture(ctx, GL_RG32F, w, h);
+    t->tex_count = make_texture(ctx, GL_R32F, w, h);
+    t->tex_cullmask = make_texture(ctx, GL_R32F, w, h);
+    t->tex_bleed = make_texture(ctx, GL_RGBA32F, w, h);
+    t->tex_lumfactor = make_texture(ctx, GL_R32F, w, h);
+    /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block; the AO
+     * pass filters it itself (cull_candidate in vao.frag.glsl). */
+    t->tex_cull = make_texture(ctx, GL_R32F, (w + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK,
+                               (h + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK);
+    GLuint prep[] = {t->tex_viewpos, t->tex_vnormal, t->tex_dz};
+    GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask, t->tex_bleed};
+    GLuint blur[] = {t->tex_blur, t->tex_lumfactor};
+    obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 3, "prep", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_vao, vao, 4, "vao", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_cull, &t->tex_cull, 1, "cull", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_ao, &t->tex_ao, 1, "ao", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_blur, blur, 2, "blur", err);
+    if (s == OBS_OK)
+        s = make_fbo(ctx, &t->fbo_composite, &t->tex_composite, 1, "composite", err);
+    if (s == OBS_OK)
+        s = obs__gl_check("allocating frame targets", err);
+    if (s != OBS_OK) {
+        obs__programs keep = ctx->prog;
+        memset(&ctx->prog, 0, sizeof ctx->prog);
+        obs__frame_release(ctx);
+        ctx->prog = keep;
+        return s;
+    }
+    t->width = w;
+    t->height = h;
+    obs__log(ctx, OBS_LOG_DEBUG, "allocated frame targets for %dx%d", w, h);
+    return OBS_OK;
+}
+
+static void upload(GLuint tex, const obs_plane *p, int w, int h, GLenum format)
+{
+    size_t px_bytes = (size_t)p->channels * sizeof(float);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, (GLint)(obs__plane_stride(p, w) / px_bytes));
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, GL_FLOAT, p->data);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+}
+
+static void bind_tex(GLuint prog, const char *name, int unit, GLuint tex)
+{
+    glActiveTexture(GL_TEXTURE0 + (GLenum)unit);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glUniform1i(glGetUniformLocation(prog, name), unit);
+}
+
+/* A plane read with imageLoad (common.glsl says why not texelFetch). */
+static void bind_img(GLuint prog, const char *name, int unit, GLuint tex, GLenum format)
+{
+    glBindImageTexture((GLuint)unit, tex, 0, GL_FALSE, 0, GL_READ_ONLY, format);
+    glUniform1i(glGetUniformLocation(prog, name), unit);
+}
+
+/* The prep pass's planes, as the AO passes (VAO's and the methods') read
+ * them. */
+static void bind_prep_planes(GLuint prog, const obs__targets *t)
+{
+    bind_img(prog, "u_pos", 0, t->tex_viewpos, GL_RGBA32F);
+    bind_img(prog, "u_vnormal", 1, t->tex_vnormal, GL_RGBA32F);
+    bind_img(prog, "u_dz", 2, t->tex_dz, GL_RG32F);
+}
+
+/* Uniforms of common.glsl. */
+static void set_common(GLuint prog, const obs__frame *f)
+{
+    glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_TRUE, f->proj);
+    glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
+    glUniform2i(glGetUniformLocation(prog, "u_size"), f->width, f->height);
+}
+
+/* Uniforms of vao.glsl, the estimator of the AO pass and the pre-pass. */
+static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
+{
+    bind_prep_planes(prog, t);
+    glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
+    /* section 4.1: all sets in one uniform array, picked by offset */
+    glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS__SAMPLE_TABLE_LEN, f->sample_table);
+    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
+    glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
+    glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
+}
+
+/* Selects the AO program of a comparison method (hemisphere, angle,
+ * hbao; built by build_method_program) and sets its uniforms: method.glsl's
+ * and the method's own. */
+static GLuint use_method_program(obs_ctx *ctx, const obs__frame *f, const obs__targets *t)
+{
+    GLuint prog = ctx->prog.method[f->method - OBS_METHOD_HEMISPHERE];
+    glUseProgram(prog);
+    set_common(prog, f);
+    bind_prep_planes(prog, t);
+    glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
+    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
+    if (f->method == OBS_METHOD_HEMISPHERE) {
+        glUniform1i(glGetUniformLocation(prog, "u_hs_count"), f->hs_count);
+        glUniform1f(glGetUniformLocation(prog, "u_hs_bias"), f->hs_bias);
+        glUniform1fv(glGetUniformLocation(prog, "u_hs_kernel"), 3 * f->hs_count,
+                     &f->hs_kernel[0][0]);
+    } else if (f->method == OBS_METHOD_ANGLE) {
+        glUniform1i(glGetUniformLocation(prog, "u_angle_pairs"), f->angle_pairs);
+        glUniform2fv(glGetUniformLocation(prog, "u_angle_xy"), f->angle_pairs, &f->angle_xy[0][0]);
+        glUniform1i(glGetUniformLocation(prog, "u_angle_acos"), f->angle_acos);
+    } else {
+        glUniform1i(glGetUniformLocation(prog, "u_hbao_dirs"), f->hbao_dirs);
+        glUniform1i(glGetUniformLocation(prog, "u_hbao_steps"), f->hbao_steps);
+        glUniform2fv(glGetUniformLocation(prog, "u_hbao_dir"), f->hbao_dirs, &f->hbao_dir[0][0]);
+        glUniform2fv(glGetUniformLocation(prog, "u_hbao_bias_cs"), 1, f->hbao_bias_cs);
+    }
+    return prog;
+}
+
+static void draw(obs_ctx *ctx, GLuint fbo, int w, int h)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, w, h);
+    glBindVertexArray(ctx->vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+static void read_back(GLuint fbo, GLenum attachment, int w, int h, GLenum format, float *dst)
+{
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glReadBuffer(attachment);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, format, GL_FLOAT, dst);
+}
+
+/* ---- per-pass timings (GL_TIME_ELAPSED queries) ------------------------ */
+
+const char *obs_pass_name(obs_pass p)
+{
+    static const char *const names[OBS_PASS_COUNT] = {
+        "upload", "prep", "cull", "ao", "blur", "finish", "composite", "readback"};
+    return (unsigned)p < OBS_PASS_COUNT ? names[p] : "unknown";
+}
+
+obs_status obs_ctx_set_timing(obs_ctx *ctx, int on, char err[OBS_ERR_LEN])
+{
+    if (!ctx)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
+    obs_status s = obs__ctx_bind(ctx, err);
+    if (s != OBS_OK)
+        return s;
+    if (on && !ctx->queries[0])
+        glGenQueries(OBS_PASS_COUNT, ctx->queries);
+    ctx->timing = on != 0;
+    ctx->times_valid = 0;
+    return obs__gl_check("creating timer queries", err);
+}
+
+int obs_ctx_last_times(const obs_ctx *ctx, obs_pass_times *out)
+{
+    if (!ctx || !ctx->times_valid)
+        return 0;
+    *out = ctx->times;
+    return 1;
+}
+
+/* Brackets one pass; passes never nest (GL allows one active
+ * GL_TIME_ELAPSED query). */
+static void pass_begin(obs_ctx *ctx, obs_pass p, unsigned *ran)
+{
+    if (!ctx->timing)
+        return;
+    glBeginQuery(GL_TIME_ELAPSED, ctx->queries[p]);
+    *ran |= 1u << p;
+}
+
+static void pass_end(obs_ctx *ctx)
+{
+    if (ctx->timing)
+        glEndQuery(GL_TIME_ELAPSED);
+}
+
+/* Waits for the queries of the passes in `ran` (the frame has been read
+ * back, so the GPU is done with them anyway). */
+static void collect_times(obs_ctx *ctx, unsigned ran)
+{
+    if (!ctx->timing)
+        return;
+    obs_pass_times *t = &ctx->times;
+    t->total_ms = 0.0;
+    for (int p = 0; p < OBS_PASS_COUNT; p++) {
+        t->ms[p] = -1.0;
+        if (!(ran & (1u << p)))
+            continue;
+        GLuint64 ns = 0;
+        glGetQueryObjectui64v(ctx->queries[p], GL_QUERY_RESULT, &ns);
+        t->ms[p] = (double)ns / 1e6;
+        t->total_ms += t->ms[p];
+    }
+    ctx->times_valid = 1;
+}
+
+obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                   obs_result *out, char err[OBS_ERR_LEN])
+{
+    unsigned ran = 0; /* passes timed in this frame */
+    obs_params p;
+    obs__frame f;
+    obs_status s;
+
+    memset(out, 0, sizeof *out);
+    if (!ctx)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
+    if (!(outputs & OBS__OUTPUTS_ALL))
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no output requested");
+    obs_params_resolve(params, &p);
+    s = obs__frame_setup(ctx, gb, &p, &f, err);
+    if (s != OBS_OK)
+        return s;
+    s = obs__ctx_bind(ctx, err);
+    if (s != OBS_OK)
+        return s;
+    s = build_programs(ctx, err);
+    if (s == OBS_OK)
+        s = build_method_program(ctx, f.method, err);
+    if (s == OBS_OK && f.method <= OBS_METHOD_VAO)
+        s = build_vao_program(ctx, 0, ao_variant(&f), err);
+    if (s == OBS_OK && f.culling)
+        s = build_vao_program(ctx, 1, ao_variant(&f), err);
+    /* ao_definition rays converts the blurred AO: in the blur's vertical
+     * pass, or in the finishing pass when there is no blur */
+    const int rays_in_blur = f.rays && f.blur_radius > 0;
+    const int finish_rays = f.rays && !rays_in_blur, finish_lum = f.luminance != 0;
+    if (s == OBS_OK)
+        s = build_blur_program(ctx, 0, f.blur_radius, err);
+    if (s == OBS_OK)
+        s = build_blur_program(ctx, rays_in_blur, f.blur_radius, err);
+    if (s == OBS_OK)
+        s = build_finish_program(ctx, finish_rays, finish_lum, err);
+    if (s == OBS_OK)
+        s = build_prep_program(ctx, &f, err);
+    if (s != OBS_OK)
+        return s;
+    s = ensure_targets(ctx, f.width, f.height, err);
+    if (s != OBS_OK)
+        return s;
+    s = obs__alloc_result(out, f.width, f.height, outputs, err);
+    if (s != OBS_OK)
+        return s;
+
+    obs__targets *t = &ctx->tg;
+    int w = f.width, h = f.height;
+    pass_begin(ctx, OBS_PASS_UPLOAD, &ran);
+    upload(t->tex_depth, &gb->depth, w, h, GL_RED);
+    if (!f.reconstruct_normals)
+        upload(t->tex_normal, &gb->normal, w, h, GL_RGB);
+    /* colour: for the composite, luminance sensitivity (4.3), bleeding (4.7) */
+    int has_color = gb->color.data != NULL &&
+                    ((outputs & OBS_OUTPUT_COMPOSITE) || f.luminance || f.bleed_step);
+    if (has_color)
+        upload(t->tex_color, &gb->color, w, h, GL_RGBA);
+    pass_end(ctx);
+
+    /* prep pass */
+    pass_begin(ctx, OBS_PASS_PREP, &ran);
+    GLuint prog = ctx->prog.prep[prep_index(&f)];
+    glUseProgram(prog);
+    set_common(prog, &f);
+    bind_img(prog, "u_depth", 0, t->tex_depth, GL_R32F);
+    bind_img(prog, "u_normal", 1, t->tex_normal, GL_RGBA32F);
+    glUniformMatrix3fv(glGetUniformLocation(prog, "u_normal_matrix"), 1, GL_TRUE, f.normal_matrix);
+    draw(ctx, t->fbo_prep, w, h);
+    pass_end(ctx);
+
+    /* culling pre-pass (section 4.2): 8-sample AO at 1/8 resolution */
+    if (f.culling) {
+        pass_begin(ctx, OBS_PASS_CULL, &ran);
+        prog = ctx->prog.cull[f.range_check != 0];
+        glUseProgram(prog);
+        set_common(prog, &f);
+        set_vao(prog, &f, t);
+        draw(ctx, t->fbo_cull, f.cull_w, f.cull_h);
+        pass_end(ctx);
+    }
+
+    /* AO pass */
+    pass_begin(ctx, OBS_PASS_AO, &ran);
+    if (f.method > OBS_METHOD_VAO) { /* a comparison method in place of VAO */
+        prog = use_method_program(ctx, &f, t);
+    } else {
+        prog = ctx->prog.vao[ao_variant(&f)];
+        glUseProgram(prog);
+        set_common(prog, &f);
+        set_vao(prog, &f, t);
+        glUniform1i(glGetUniformLocation(prog, "u_count"), f.samples);
+        glUniform1f(glGetUniformLocation(prog, "u_adaptive_k"), f.adaptive_k);
+        /* section 4.2: the pre-pass result, read at the pixel corners */
+        glUniform1i(glGetUniformLocation(prog, "u_culling"), f.culling);
+        bind_img(prog, "u_cull", 4, t->tex_cull, GL_R32F);
+        glUniform2i(glGetUniformLocation(prog, "u_cull_size"), f.cull_w, f.cull_h);
+        glUniform1f(glGetUniformLocation(prog, "u_cull_threshold"), f.cull_threshold);
+        /* section 4.7: colour bleeding reads the colour at the samples */
+        glUniform1i(glGetUniformLocation(prog, "u_bleed_step"), f.bleed_step);
+        bind_img(prog, "u_color", 3, t->tex_color, GL_RGBA32F);
+    }
+    /* the debug outputs go to their textures only when asked for */
+    const GLenum vao_bufs[] = {
+        GL_COLOR_ATTACHMENT0,
+        (outputs & OBS_OUTPUT_SAMPLE_COUNT) ? GL_COLOR_ATTACHMENT1 : GL_NONE,
+        (outputs & OBS_OUTPUT_CULL_MASK) ? GL_COLOR_ATTACHMENT2 : GL_NONE,
+        f.bleed_step ? GL_COLOR_ATTACHMENT3 : GL_NONE};
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_vao);
+    glDrawBuffers(4, vao_bufs);
+    draw(ctx, t->fbo_vao, w, h);
+    pass_end(ctx);
+
+    /* low-pass filter (section 4.6): ao -> blur along x -> ao along y */
+    if (f.blur_radius > 0) {
+        pass_begin(ctx, OBS_PASS_BLUR, &ran);
+        for (int pass = 0; pass < 2; pass++) { /* along x, then along y */
+            prog = ctx->prog.blur[pass ? rays_in_blur : 0][f.blur_radius];
+            glUseProgram(prog);
+            set_common(prog, &f);
+            glUniform1fv(glGetUniformLocation(prog, "u_blur_w"), f.blur_radius + 1, f.blur_w);
+            glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
+            bind_img(prog, "u_ao", 0, pass ? t->tex_blur : t->tex_ao, GL_RG32F);
+            glUniform2i(glGetUniformLocation(prog, "u_dir"), !pass, pass);
+            if (!pass) {
+                const GLenum blur_bufs[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+                glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_blur);
+                glDrawBuffers(2, blur_bufs);
+            }
+            draw(ctx, pass ? t->fbo_ao : t->fbo_blur, w, h);
+        }
+        pass_end(ctx);
+    }
+
+    /* the finishing pass, after the blur (luminance.frag.glsl): the
+     * conversion of ao_definition rays when there was no blur to do it,
+     * luminance sensitivity (section 4.3, eq 3); ao -> tex_blur, free once
+     * the blur is done */
+    GLuint ao_tex = t->tex_ao, ao_fbo = t->fbo_ao;
+    if (finish_rays || finish_lum) {
+        pass_begin(ctx, OBS_PASS_FINISH, &ran);
+        prog = ctx->prog.finish[2 * finish_rays + finish_lum];
+        glUseProgram(prog);
+        bind_tex(prog, "u_ao", 0, t->tex_ao);
+        bind_tex(prog, "u_color", 1, t->tex_color);
+        glUniform1i(glGetUniformLocation(prog, "u_luminance"), f.luminance);
+        glUniform1f(glGetUniformLocation(prog, "u_lum_threshold"), f.lum_threshold);
+        glUniform1f(glGetUniformLocation(prog, "u_lum_width"), f.lum_width);
+        glUniform1f(glGetUniformLocation(prog, "u_lum_sigma"), f.lum_sigma);
+        const GLenum lum_bufs[] = {
+            GL_COLOR_ATTACHMENT0,
+            (outputs & OBS_OUTPUT_LUMINANCE) ? GL_COLOR_ATTACHMENT1 : GL_NONE};
+        glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_blur);
+        glDrawBuffers(2, lum_bufs);
+        draw(ctx, t->fbo_blur, w, h);
+        ao_tex = t->tex_blur;
+        ao_fbo = t->fbo_blur;
+        pass_end(ctx);
+    }
+
+    if (outputs & OBS_OUTPUT_COMPOSITE) {
+        pass_begin(ctx, OBS_PASS_COMPOSITE, &ran);
+        prog = ctx->prog.composite;
+        glUseProgram(prog);
+        bind_tex(prog, "u_ao", 0, ao_tex);
+        bind_tex(prog, "u_color", 1, t->tex_color);
+        bind_tex(prog, "u_bleed", 2, t->tex_bleed);
+        glUniform1i(glGetUniformLocation(prog, "u_has_color"), has_color);
+        glUniform1i(glGetUniformLocation(prog, "u_has_bleed"), f.bleed_step > 0);
+        draw(ctx, t->fbo_composite, w, h);
+        pass_end(ctx);
+    }
+    pass_begin(ctx, OBS_PASS_READBACK, &ran);
+    if (outputs & OBS_OUTPUT_COMPOSITE)
+        read_back(t->fbo_composite, GL_COLOR_ATTACHMENT0, w, h, GL_RGBA, out->composite.data);
+    if (outputs & OBS_OUTPUT_AO)
+        read_back(ao_fbo, GL_COLOR_ATTACHMENT0, w, h, GL_RED, out->ao.data);
+    if (outputs & OBS_OUTPUT_SAMPLE_COUNT)
+        read_back(t->fbo_vao, GL_COLOR_ATTACHMENT1, w, h, GL_RED, out->sample_count.data);
+    if (outputs & OBS_OUTPUT_CULL_MASK)
+        read_back(t->fbo_vao, GL_COLOR_ATTACHMENT2, w, h, GL_RED, out->cull_mask.data);
+    if (outputs & OBS_OUTPUT_BLEED) {
+        if (f.bleed_step)
+            read_back(t->fbo_vao, GL_COLOR_ATTACHMENT3, w, h, GL_RGB, out->bleed.data);
+        else /* bleeding off: the neutral term, no GL work */
+            for (size_t i = 0; i < (size_t)w * h * 3; i++)
+                out->bleed.data[i] = 1.0f;
+    }
+    if (outputs & OBS_OUTPUT_LUMINANCE) {
+        if (f.luminance)
+            read_back(t->fbo_blur, GL_COLOR_ATTACHMENT1, w, h, GL_RED, out->luminance.data);
+        else /* off: the factor is 1, no GL work */
+            for (size_t i = 0; i < (size_t)w * h; i++)
+                out->luminance.data[i] = 1.0f;
+    }
+    pass_end(ctx);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glUseProgram(0);
+    collect_times(ctx, ran);
+
+    s = obs__gl_check("running the AO passes", err);
+    if (s != OBS_OK)
+        obs_result_free(out);
+    return s;
+}

@@ -1,0 +1,142 @@
+/* List compression, OITAO (Bauer et al.) section III-B.
+ *
+ * Each pixel's fragment list is inserted into a fixed array of m nodes
+ * sorted by depth; when more than m were inserted, the node j minimising
+ *     a[j].alpha * (1 - a[j].z)                      (eq 5)
+ * is eliminated: opaque nodes and near nodes are kept, transparent and
+ * distant ones dropped.  Optionally the search runs over the back half of
+ * the array only, preserving the front nodes (section V-A, Fig. 6 column
+ * C).
+ *
+ * z in eq 5 is a normalised depth: the paper's array "is initialized with
+ * depth values of 1", the far end of a [0, 1] depth buffer.  A deep EXR
+ * has no near and far planes, so z here is the planar depth normalised
+ * over the image's own range, z = (Z - zmin) / (zmax - zmin) with zmin,
+ * zmax the nearest and farthest sample: 0 at the nearest fragment of the
+ * image, 1 at the farthest (linear in depth, where a perspective depth
+ * buffer would crowd distant fragments towards 1). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "obscura/deep.h"
+#include "internal.h"
+
+/* Normalised depth of eq 5 (see above); 0 for a degenerate range. */
+static float norm_z(float z, float zmin, float zmax)
+{
+    if (!(zmax > zmin) || !isfinite(z))
+        return isfinite(z) ? 0.0f : 1.0f;
+    float t = (z - zmin) / (zmax - zmin);
+    return t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+}
+
+int obs_deep_compress_list(const float *samples, int n, int m, int front_half, float zmin,
+                           float zmax, float *out)
+{
+    /* m + 1 slots: the insertion that overflows is followed at once by
+     * the elimination of eq 5 over the m + 1 candidates. */
+    float a[(OBS_DEEP_MAX_LAYERS + 1) * OBS_DEEP_CH];
+    int count = 0;
+    if (m < 1)
+        m = 1;
+    if (m > OBS_DEEP_MAX_LAYERS)
+        m = OBS_DEEP_MAX_LAYERS;
+    for (int s = 0; s < n; s++) {
+        const float *f = samples + (size_t)s * OBS_DEEP_CH;
+        float fz = f[OBS_DEEP_Z];
+        /* "looking up the index i of a where a[i]z < fz < a[i+1]z" */
+        int i = count;
+        while (i > 0 && a[(i - 1) * OBS_DEEP_CH + OBS_DEEP_Z] > fz)
+            i--;
+        memmove(a + (i + 1) * OBS_DEEP_CH, a + i * OBS_DEEP_CH,
+                (size_t)(count - i) * OBS_DEEP_CH * sizeof(float));
+        memcpy(a + i * OBS_DEEP_CH, f, OBS_DEEP_CH * sizeof(float));
+        count++;
+        if (count <= m)
+            continue;
+        /* eq 5, over every node or the back half (j >= m / 2) */
+        int j0 = front_half ? m / 2 : 0, drop = j0;
+        float best = INFINITY;
+        for (int j = j0; j < count; j++) {
+            const float *nd = a + j * OBS_DEEP_CH;
+            float v = nd[OBS_DEEP_A] * (1.0f - norm_z(nd[OBS_DEEP_Z], zmin, zmax));
+            if (v < best) {
+                best = v;
+                drop = j;
+            }
+        }
+        memmove(a + drop * OBS_DEEP_CH, a + (drop + 1) * OBS_DEEP_CH,
+                (size_t)(count - drop - 1) * OBS_DEEP_CH * sizeof(float));
+        count--;
+    }
+    memcpy(out, a, (size_t)count * OBS_DEEP_CH * sizeof(float));
+    return count;
+}
+
+void obs_deep_layers_free(obs_deep_layers *l)
+{
+    if (!l)
+        return;
+    free(l->node);
+    free(l->count);
+    memset(l, 0, sizeof *l);
+}
+
+obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs_deep_layers *out,
+                             char err[OBS_ERR_LEN])
+{
+    size_t npx, bytes;
+    float zmin = INFINITY, zmax = -INFINITY;
+
+    memset(out, 0, sizeof *out);
+    if (!d || !d->offset || d->width <= 0 || d->height <= 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "deep compression: no deep image");
+    if (m < 0 || m > OBS_DEEP_MAX_LAYERS)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "deep compression: %d nodes (1..%d)", m,
+                         OBS_DEEP_MAX_LAYERS);
+    int keep_all = m == 0;
+    if (keep_all)
+        m = OBS_DEEP_MAX_LAYERS;
+    npx = (size_t)d->width * (size_t)d->height;
+    if (obs__size_mul3(npx, (size_t)m, OBS_DEEP_CH * sizeof(float), &bytes) != 0)
+        return obs__fail(err, OBS_TOO_LARGE, "deep layers of %dx%dx%d", d->width, d->height, m);
+    out->node = calloc(1, bytes);
+    out->count = calloc(npx, sizeof *out->count);
+    if (!out->node || !out->count) {
+        obs_deep_layers_free(out);
+        return obs__fail(err, OBS_NO_MEMORY, "deep layers of %dx%dx%d", d->width, d->height, m);
+    }
+    for (uint64_t s = 0; s < d->offset[npx]; s++) {
+        float z = d->samples[s * OBS_DEEP_CH + OBS_DEEP_Z];
+        if (z > 0.0f && isfinite(z)) {
+            zmin = z < zmin ? z : zmin;
+            zmax = z > zmax ? z : zmax;
+        }
+    }
+    if (!(zmax >= zmin))
+        zmin = zmax = 0.0f;
+    out->width = d->width;
+    out->height = d->height;
+    out->m = m;
+    out->zmin = zmin;
+    out->zmax = zmax;
+    float list[OBS_DEEP_MAX_LAYERS * OBS_DEEP_CH];
+    for (size_t i = 0; i < npx; i++) {
+        const float *s = d->samples + d->offset[i] * OBS_DEEP_CH;
+        uint64_t n64 = d->offset[i + 1] - d->offset[i];
+        int n = n64 > OBS_DEEP_MAX_PER_PIXEL ? OBS_DEEP_MAX_PER_PIXEL : (int)n64;
+        int c;
+        if (keep_all) { /* the front OBS_DEEP_MAX_LAYERS as they are */
+            c = n < m ? n : m;
+            memcpy(list, s, (size_t)c * OBS_DEEP_CH * sizeof(float));
+        } else {
+            c = obs_deep_compress_list(s, n, m, front_half, zmin, zmax, list);
+        }
+        out->count[i] = c;
+        for (int k = 0; k < c; k++)
+            memcpy(out->node + ((size_t)k * npx + i) * OBS_DEEP_CH, list + k * OBS_DEEP_CH,
+                   OBS_DEEP_CH * sizeof(float));
+    }
+    return OBS_OK;
+}

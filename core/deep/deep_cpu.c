@@ -1,0 +1,381 @@
+/* Multi-layer, opacity-based AO from a deep image: the CPU twin of
+ * core/shaders/deep.frag.glsl (tests/unit/core/test_deep.c compares them).
+ *
+ * OITAO (Bauer et al.) Algorithm 1: for each sample, the occlusion
+ * against every node of the compressed list at the sample's pixel, the
+ * largest counting.  The per-node occlusion ("GetAO") is VAO++'s (section
+ * 3): the length of the pipe through the tangent sphere hidden behind the
+ * node's depth, with the depth range check of section 4.4 (eq 4) applied
+ * per node.  Opacity enters as in OITAO section III: eq 1 weights the
+ * occluder by its alpha and the receiver's occlusion by its own (solid
+ * volumes); for thin hulls eqs 2-4 mix the exterior AO (sphere on the
+ * normal's side) and the interior AO (sphere on the other side) by W(p).
+ * With method hemisphere the per-node occlusion is instead that of the
+ * normal-oriented hemisphere kernel's point samples (methods/hemisphere.c),
+ * each against every node, the largest counting (hemisphere_ao() below).
+ * The AO of each node is blended front to back by alpha into one 2D AO
+ * (section III, the separated scheme). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "deep/deep_internal.h"
+
+void obs_deep_result_free(obs_deep_result *r)
+{
+    if (!r)
+        return;
+    obs_image_free(&r->ao_front);
+    obs_image_free(&r->ao_blend);
+    obs_image_free(&r->composite);
+}
+
+int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_exr_layer layers[3])
+{
+    static const char *const ao[] = {"AO.Y"}, *const front[] = {"AOFront.Y"};
+    static const char *const rgba[] = {"R", "G", "B", "A"};
+    int n = 0;
+    if ((outputs & OBS_OUTPUT_AO) && r->ao_blend.data)
+        layers[n++] = (obs_exr_layer){&r->ao_blend, ao};
+    if ((outputs & OBS_OUTPUT_AO) && r->ao_front.data)
+        layers[n++] = (obs_exr_layer){&r->ao_front, front};
+    if ((outputs & OBS_OUTPUT_COMPOSITE) && r->composite.data)
+        layers[n++] = (obs_exr_layer){&r->composite, rgba};
+    return n;
+}
+
+static obs_status alloc_img(obs_image *img, int w, int h, int c, char err[OBS_ERR_LEN])
+{
+    size_t n;
+    if (obs__size_mul3((size_t)w, (size_t)h, (size_t)c * sizeof(float), &n) != 0)
+        return obs__fail(err, OBS_TOO_LARGE, "image %dx%dx%d overflows", w, h, c);
+    if (!(img->data = malloc(n)))
+        return obs__fail(err, OBS_NO_MEMORY, "image of %dx%d", w, h);
+    img->width = w;
+    img->height = h;
+    img->channels = c;
+    return OBS_OK;
+}
+
+obs_status obs__deep_result_alloc(obs_deep_result *out, int w, int h, char err[OBS_ERR_LEN])
+{
+    obs_status s;
+    memset(out, 0, sizeof *out);
+    if ((s = alloc_img(&out->ao_front, w, h, 1, err)) == OBS_OK &&
+        (s = alloc_img(&out->ao_blend, w, h, 1, err)) == OBS_OK)
+        s = alloc_img(&out->composite, w, h, 4, err);
+    if (s != OBS_OK)
+        obs_deep_result_free(out);
+    return s;
+}
+
+void obs__deep_frame_free(obs__deep_frame *df)
+{
+    if (!df)
+        return;
+    free(df->pos);
+    free(df->nrm);
+    obs_deep_layers_free(&df->layers);
+    memset(df, 0, sizeof *df);
+}
+
+obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *params,
+                                 obs__deep_frame *df, char err[OBS_ERR_LEN])
+{
+    obs_params p;
+    obs_gbuffer gb;
+    float *depth = NULL, *in_n = NULL;
+    obs_status s;
+
+    memset(df, 0, sizeof *df);
+    if (!d || !d->offset || d->width <= 0 || d->height <= 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no deep image");
+    obs_params_resolve(params, &p);
+    if (p.method != OBS_METHOD_VAOPP && p.method != OBS_METHOD_VAO &&
+        p.method != OBS_METHOD_HEMISPHERE) {
+        char name[32];
+        obs_param_format(&p, obs_param_find("method"), name, sizeof name);
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "method %s does not run on deep input: the multi-layer chain takes "
+                         "methods vaopp, vao and hemisphere",
+                         name);
+    }
+    s = obs_deep_compress(d, p.deep_layers, p.deep_front_half == OBS_ON, &df->layers, err);
+    if (s != OBS_OK)
+        return s;
+    size_t npx = (size_t)d->width * (size_t)d->height;
+    int m = df->layers.m;
+    depth = calloc(npx, sizeof *depth);
+    in_n = d->has_normal ? calloc(npx * 3, sizeof *in_n) : NULL;
+    df->pos = malloc(npx * (size_t)m * 4 * sizeof *df->pos);
+    df->nrm = malloc(npx * (size_t)m * 4 * sizeof *df->nrm);
+    if (!depth || !df->pos || !df->nrm || (d->has_normal && !in_n)) {
+        s = obs__fail(err, OBS_NO_MEMORY, "deep frame of %dx%dx%d", d->width, d->height, m);
+        goto fail;
+    }
+    /* The frame (camera, R, samples) as for a flat G-buffer of the front
+     * nodes; normals given when the file has them. */
+    memset(&gb, 0, sizeof gb);
+    gb.width = d->width;
+    gb.height = d->height;
+    gb.display_x = d->display_x;
+    gb.display_y = d->display_y;
+    gb.display_width = d->display_width;
+    gb.display_height = d->display_height;
+    gb.depth = (obs_plane){depth, 1, 0};
+    gb.normal = (obs_plane){in_n, in_n ? 3 : 0, 0};
+    gb.camera = d->camera;
+    if ((s = obs__frame_setup(NULL, &gb, &p, &df->f, err)) != OBS_OK)
+        goto fail;
+    df->m = m;
+    df->multi = p.deep_mode != OBS_DEEP_SINGLE;
+    df->thin = p.deep_hull == OBS_DEEP_THIN;
+
+    /* The prep pass of every node plane. */
+    for (int k = 0; k < m; k++) {
+        const float *node = df->layers.node + (size_t)k * npx * OBS_DEEP_CH;
+        float *pos = df->pos + (size_t)k * npx * 4, *nrm = df->nrm + (size_t)k * npx * 4;
+        for (int y = 0; y < d->height; y++)
+            for (int x = 0; x < d->width; x++) {
+                size_t i = (size_t)y * d->width + x;
+                /* an empty node is background (raw depth 0) */
+                float z = (int)k < df->layers.count[i] ? node[i * OBS_DEEP_CH + OBS_DEEP_Z] : 0.0f;
+                obs__prep_position(&df->f, z, x, y, pos + 4 * i);
+            }
+        for (int y = 0; y < d->height; y++)
+            for (int x = 0; x < d->width; x++) {
+                size_t i = (size_t)y * d->width + x;
+                const float *nd = node + i * OBS_DEEP_CH;
+                float v[3];
+                obs__prep_normal(&df->f, pos, nd + OBS_DEEP_NX, x, y, v);
+                nrm[4 * i] = v[0];
+                nrm[4 * i + 1] = v[1];
+                nrm[4 * i + 2] = v[2];
+                nrm[4 * i + 3] = pos[4 * i + 3] > 0.0f ? fminf(fmaxf(nd[OBS_DEEP_A], 0.0f), 1.0f) : 0.0f;
+            }
+    }
+    free(depth);
+    free(in_n);
+    return OBS_OK;
+fail:
+    free(depth);
+    free(in_n);
+    obs__deep_frame_free(df);
+    return s;
+}
+
+/* GLSL: node_occlusion() in deep.frag.glsl.  The length of the pipe
+ * [front, front + 2h] (depths) hidden by a node at planar depth zs with
+ * view normal z nz: the cases A, B, C of VAO++ section 3 with the node as
+ * the depth buffer, and the depth range check (section 4.4, eq 4,
+ * obs__range_falloff) when the node lies in front of the pipe.  With `interior` (the sphere on the back side of a thin hull,
+ * OITAO eqs 2-4) a node in front of the pipe is on the hull's exterior
+ * side and hides nothing of the interior. */
+static float node_occlusion(const obs__frame *f, float zs, float nz, float front, float h,
+                            int interior)
+{
+    if (!(zs > 0.0f))
+        return 0.0f; /* empty node */
+    float dz = fminf(fmaxf(zs - front, 0.0f), 2.0f * h);
+    if (zs < front) {
+        if (interior)
+            return 0.0f;
+        if (f->range_check) {
+            float sd = obs__range_falloff(f, front - zs, nz);
+            dz = 2.0f * h * (1.0f - sd);
+        }
+    }
+    return 2.0f * h - dz;
+}
+
+/* GLSL: sphere_ao() in deep.frag.glsl.  VAO (eq 1, 2 of VAO++ section 3)
+ * of the tangent sphere of radius R/2 at p along n, each line sample's
+ * occlusion the largest over the nodes at its pixel (OITAO Algorithm 1,
+ * line 9), each node's weighted by its alpha (OITAO eq 1's alpha_omega).
+ * self: the receiver's node at (x, y), which a sample on that pixel reads
+ * as its tangent plane (obs__own_plane_depth). */
+static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3], const float n[3],
+                       int interior, int self)
+{
+    const obs__frame *f = &df->f;
+    const float R = f->radius, r = 0.5f * R;
+    const float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
+    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    const int layers = df->multi ? df->m : 1;
+    const size_t npx = (size_t)f->width * (size_t)f->height;
+    float open = 0.0f, F = 0.0f;
+    obs__disk disk; /* the samples' pixels */
+    obs__disk_map(f, c, r, rot, &disk);
+
+    for (int i = 0; i < f->samples; i++) {
+        float sx = f->sample_xy[2 * i], sy = f->sample_xy[2 * i + 1];
+        float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
+        float h = r * l;
+        int qx, qy;
+        if (!obs__disk_px(f, &disk, sx, sy, &qx, &qy))
+            continue; /* off the planes: left out of eq 1's sum and F */
+        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
+        float front = -c[2] - h, occ = 0.0f;
+        for (int k = 0; k < layers; k++) {
+            const float *pk = df->pos + ((size_t)k * npx + q) * 4;
+            const float *nk = df->nrm + ((size_t)k * npx + q) * 4; /* normal, alpha */
+            float zs = pk[3];
+            if (k == self && qx == x && qy == y)
+                zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy, zs);
+            occ = fmaxf(occ, nk[3] * node_occlusion(f, zs, nk[2], front, h, interior));
+        }
+        open += 2.0f * h - occ;
+        F += R * l; /* VAO++ eq 2 */
+    }
+    return F > 0.0f ? open / F : 1.0f; /* VAO++ eq 1 */
+}
+
+/* GLSL: hemisphere_ao() in deep.frag.glsl.  Method hemisphere on the
+ * nodes: the normal-oriented hemisphere kernel of methods/hemisphere.c (radius
+ * R, the frame's tile rotation), each point sample s occluded by a node at
+ * its pixel as obs__hemisphere_pixel is by the flat depth buffer, with the
+ * node as that buffer: occluded when s lies more than the bias behind the
+ * node's depth, the node being taken to fill everything behind it, and
+ * weighted by the method's range check (smoothstep of R / |z_p - z_node|)
+ * so that a node far in front of the receiver fades out, as eq 4 does for
+ * node_occlusion's pipes.  Each sample's occlusion is the largest over the
+ * nodes at its pixel (OITAO Algorithm 1, line 9: ao = max(ao, GetAO(p,
+ * f)) over the fragment list), each node's weighted by its alpha (OITAO
+ * eq 1's alpha_omega); the samples' occlusions are averaged (lines 10-12).
+ * With `interior` (n is then the back side's direction, OITAO eqs 2-4) a
+ * node on the exterior side of the receiver's tangent plane (not more than
+ * the bias along n from p) hides nothing, as node_occlusion's node in
+ * front of the pipe. */
+static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float p[3],
+                           const float n[3], int interior)
+{
+    const obs__frame *f = &df->f;
+    const float R = f->radius;
+    const int layers = df->multi ? df->m : 1;
+    const size_t npx = (size_t)f->width * (size_t)f->height;
+    float t1[3], t2[3];
+    obs__hemisphere_basis(n, t1, t2);
+    float occ = 0.0f;
+    for (int i = 0; i < f->hs_count; i++) {
+        float s[3];
+        obs__hemisphere_sample(f, x, y, p, n, t1, t2, i, s);
+        int qx, qy;
+        if (!obs__view_to_px(f, s, &qx, &qy))
+            continue;
+        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
+        float best = 0.0f;
+        for (int k = 0; k < layers; k++) {
+            const float *pk = df->pos + ((size_t)k * npx + q) * 4;
+            float zn = pk[3];
+            if (!(zn > 0.0f))
+                continue; /* empty node: background never occludes */
+            if (!(zn <= -s[2] - f->hs_bias))
+                continue; /* s is not behind the node */
+            if (interior &&
+                (pk[0] - p[0]) * n[0] + (pk[1] - p[1]) * n[1] + (pk[2] - p[2]) * n[2] <= f->hs_bias)
+                continue; /* on the hull's exterior side */
+            float dz = fabsf(-p[2] - zn);
+            float r = dz > R ? R / dz : 1.0f;
+            float an = df->nrm[((size_t)k * npx + q) * 4 + 3];
+            best = fmaxf(best, an * r * r * (3.0f - 2.0f * r));
+        }
+        occ += best;
+    }
+    return f->hs_count > 0 ? 1.0f - occ / (float)f->hs_count : 1.0f;
+}
+
+/* The per-sample estimator of the frame's method: VAO++'s line samples or
+ * method hemisphere's point samples, each against every node (Algorithm
+ * 1). */
+static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3], const float n[3],
+                       int interior, int self)
+{
+    if (df->f.method == OBS_METHOD_HEMISPHERE)
+        return hemisphere_ao(df, x, y, p, n, interior);
+    float v = sphere_ao(df, x, y, p, n, interior, self);
+    return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */
+}
+
+float obs__deep_node_ao(const obs__deep_frame *df, int x, int y, int k)
+{
+    const size_t npx = (size_t)df->f.width * (size_t)df->f.height;
+    const size_t i = (size_t)k * npx + (size_t)y * (size_t)df->f.width + (size_t)x;
+    const float *p = df->pos + 4 * i, *n = df->nrm + 4 * i;
+    float alpha = n[3];
+    if (!(p[3] > 0.0f))
+        return 1.0f;
+    float ve = method_ao(df, x, y, p, n, 0, k);
+    if (!df->thin)
+        return 1.0f - alpha * (1.0f - ve); /* OITAO eq 1: the receiver's alpha_p */
+    /* OITAO eqs 2-4: the interior AO from the sphere on -n; W(p) = alpha
+     * on a front face (normal towards the camera), 1 - alpha on a back
+     * face. */
+    const float nn[3] = {-n[0], -n[1], -n[2]};
+    float vi = method_ao(df, x, y, p, nn, 1, k);
+    float facing = -(p[0] * n[0] + p[1] * n[1] + p[2] * n[2]);
+    float W = facing >= 0.0f ? alpha : 1.0f - alpha; /* eq 3 */
+    return W * ve + (1.0f - W) * vi;                 /* eq 4 */
+}
+
+float obs__deep_pixel(const obs__deep_frame *df, int x, int y, float *front)
+{
+    const size_t npx = (size_t)df->f.width * (size_t)df->f.height;
+    const size_t i = (size_t)y * (size_t)df->f.width + (size_t)x;
+    float T = 1.0f, acc = 0.0f;
+    *front = 1.0f;
+    for (int k = 0; k < df->m; k++) {
+        if (!(df->pos[((size_t)k * npx + i) * 4 + 3] > 0.0f))
+            break; /* nodes are packed front to back */
+        float a = df->nrm[((size_t)k * npx + i) * 4 + 3];
+        float ao = obs__deep_node_ao(df, x, y, k);
+        if (k == 0)
+            *front = ao;
+        acc += T * a * ao; /* "over", front to back */
+        T *= 1.0f - a;
+    }
+    return acc + T; /* what shows through is open (AO 1) */
+}
+
+void obs__deep_composite(const obs_deep_image *d, obs_deep_result *out)
+{
+    size_t npx = (size_t)d->width * (size_t)d->height;
+    for (size_t i = 0; i < npx; i++) {
+        float T = 1.0f, rgb[3] = {0.0f, 0.0f, 0.0f};
+        for (uint64_t s = d->offset[i]; s < d->offset[i + 1]; s++) {
+            const float *v = d->samples + s * OBS_DEEP_CH;
+            float a = fminf(fmaxf(v[OBS_DEEP_A], 0.0f), 1.0f);
+            for (int c = 0; c < 3; c++) /* premultiplied; grey without colour */
+                rgb[c] += T * (d->has_color ? v[OBS_DEEP_R + c] : a);
+            T *= 1.0f - a;
+        }
+        float ao = out->ao_blend.data[i], *o = out->composite.data + 4 * i;
+        for (int c = 0; c < 3; c++)
+            o[c] = rgb[c] * ao;
+        o[3] = 1.0f - T;
+    }
+}
+
+obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
+                            obs_deep_result *out, char err[OBS_ERR_LEN])
+{
+    obs__deep_frame df;
+    obs_status s;
+    if (out)
+        memset(out, 0, sizeof *out);
+    if (!out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_run_cpu: no output");
+    if ((s = obs__deep_frame_setup(d, params, &df, err)) != OBS_OK)
+        return s;
+    if ((s = obs__deep_result_alloc(out, d->width, d->height, err)) != OBS_OK) {
+        obs__deep_frame_free(&df);
+        return s;
+    }
+    for (int y = 0; y < d->height; y++)
+        for (int x = 0; x < d->width; x++) {
+            size_t i = (size_t)y * d->width + x;
+            out->ao_blend.data[i] = obs__deep_pixel(&df, x, y, &out->ao_front.data[i]);
+        }
+    obs__deep_composite(d, out);
+    obs__deep_frame_free(&df);
+    return OBS_OK;
+}

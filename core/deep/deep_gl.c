@@ -1,0 +1,256 @@
+/* obs_deep_run: the multi-layer AO of deep input on the GL context.  The
+ * compressed nodes (OITAO III-B) are prepared as for the CPU twin
+ * (deep_cpu.c: view position, normal, alpha), uploaded as two 2D array
+ * textures of m layers (RGBA32F: position + planar depth, normal +
+ * alpha) and one fragment pass (core/shaders/deep.frag.glsl) writes the
+ * front node's AO and the blended AO.
+ *
+ * The program is built once per context; the array textures, the output
+ * texture and its framebuffer are kept for the next frame of the same
+ * size and node count (the daemon runs deep frames back to back), as the
+ * flat chain keeps its targets (run_gl.c).
+ *
+ * With obs_ctx_set_timing the upload, the AO pass and the read-back
+ * (OBS_PASS_UPLOAD, OBS_PASS_AO, OBS_PASS_READBACK) are timed on the host
+ * between glFinish calls, not with GL_TIME_ELAPSED queries: Mesa's
+ * llvmpipe ends a query that no draw follows at its next flush, so with
+ * the node textures of the last frame reused the AO pass's whole cost
+ * was reported as the upload's.  Finishing each stage costs a GPU its
+ * overlap, which timing mode gives up anyway (it waits for the results). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "deep/deep_internal.h"
+#include "gl/gl.h"
+#include "obs_shaders.h"
+
+static GLuint array_texture(obs_ctx *ctx, int w, int h, int m)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    ctx->gl_objects_created++;
+    glBindTexture(GL_TEXTURE_2D_ARRAY, t);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, w, h, m);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+static void upload_layers(GLuint tex, int w, int h, int m, const float *data)
+{
+    glBindTexture(GL_TEXTURE_2D_ARRAY, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, m, GL_RGBA, GL_FLOAT, data);
+}
+
+/* Drops the size-dependent objects; the program stays unless `all`. */
+static void release(obs_ctx *ctx, int all)
+{
+    obs__deep_targets *t = &ctx->deep;
+    GLuint tex[] = {t->tex_pos, t->tex_nrm, t->tex_out};
+    glDeleteTextures(3, tex);
+    if (t->fbo)
+        glDeleteFramebuffers(1, &t->fbo);
+    GLuint prog[OBS__DEEP_VARIANTS];
+    memcpy(prog, t->prog, sizeof prog);
+    memset(t, 0, sizeof *t);
+    if (all)
+        OBS__GL_DELETE_PROGRAMS(prog);
+    else
+        memcpy(t->prog, prog, sizeof prog);
+}
+
+void obs__deep_release(obs_ctx *ctx) { release(ctx, 1); }
+
+/* Switches of the deep pass compiled in or out by defines (a SIMD
+ * rasteriser runs both sides of a uniform branch): bits of the index of
+ * ctx->deep.prog. */
+enum {
+    DEEP_HEMISPHERE = 1, /* OBS_DEEP_HEMISPHERE: method hemisphere's samples */
+    DEEP_THIN = 2,       /* OBS_DEEP_THIN: thin hulls, OITAO eqs 2-4 */
+    DEEP_RANGE = 4,      /* OBS_RANGE_CHECK: VAO++ 4.4, eq 4 */
+    DEEP_RAYS = 8        /* OBS_RAYS: ao_definition rays' conversion of the VAO nodes */
+};
+
+static unsigned deep_variant(const obs__deep_frame *df)
+{
+    return (df->f.method == OBS_METHOD_HEMISPHERE ? DEEP_HEMISPHERE : 0u) |
+           (df->thin ? DEEP_THIN : 0u) | (df->f.range_check ? DEEP_RANGE : 0u) |
+           (df->f.rays ? DEEP_RAYS : 0u);
+}
+
+/* The program of variant v, and the targets for w x h with m nodes: kept
+ * from the last frame when they match. */
+static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
+                              char err[OBS_ERR_LEN])
+{
+    static const char glsl_version[] = "#version 430 core\n";
+    obs__deep_targets *t = &ctx->deep;
+    obs_status s;
+    if (!t->prog[v]) {
+        char defs[128];
+        snprintf(defs, sizeof defs,
+                 "#define OBS_DEEP_HEMISPHERE %d\n#define OBS_DEEP_THIN %d\n"
+                 "#define OBS_RANGE_CHECK %d\n#define OBS_RAYS %d\n",
+                 (v & DEEP_HEMISPHERE) != 0, (v & DEEP_THIN) != 0, (v & DEEP_RANGE) != 0,
+                 (v & DEEP_RAYS) != 0);
+        const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_deep_frag};
+        if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, 4, &t->prog[v], err)) !=
+            OBS_OK) {
+            t->prog[v] = 0;
+            return s;
+        }
+    }
+    if (t->width == w && t->height == h && t->m == m)
+        return OBS_OK;
+    release(ctx, 0);
+    t->tex_pos = array_texture(ctx, w, h, m);
+    t->tex_nrm = array_texture(ctx, w, h, m);
+    glGenTextures(1, &t->tex_out);
+    ctx->gl_objects_created++;
+    glBindTexture(GL_TEXTURE_2D, t->tex_out);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
+    glGenFramebuffers(1, &t->fbo);
+    ctx->gl_objects_created++;
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->tex_out, 0);
+    GLenum buf = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &buf);
+    GLenum st = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    s = st == GL_FRAMEBUFFER_COMPLETE
+            ? obs__gl_check("allocating deep targets", err)
+            : obs__fail(err, OBS_GL_ERROR, "deep AO framebuffer incomplete (0x%04x)", (unsigned)st);
+    if (s != OBS_OK) {
+        release(ctx, 0);
+        return s;
+    }
+    t->width = w;
+    t->height = h;
+    t->m = m;
+    obs__log(ctx, OBS_LOG_DEBUG, "allocated deep targets for %dx%d, %d nodes", w, h, m);
+    return OBS_OK;
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+/* Starts stage p when timing is on: the GL work queued before it is done
+ * first. */
+static void stage_begin(obs_ctx *ctx, double *t0)
+{
+    if (!ctx->timing)
+        return;
+    glFinish();
+    *t0 = now_ms();
+}
+
+static void stage_end(obs_ctx *ctx, obs_pass p, double t0, obs_pass_times *t)
+{
+    if (!ctx->timing)
+        return;
+    glFinish();
+    t->ms[p] = now_ms() - t0;
+}
+
+obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
+                        obs_deep_result *out, char err[OBS_ERR_LEN])
+{
+    obs__deep_frame df;
+    float *rgba = NULL;
+    obs_pass_times times;
+    double t0 = 0.0;
+    obs_status s;
+
+    if (!ctx || !out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_run: NULL argument");
+    memset(out, 0, sizeof *out);
+    if ((s = obs__ctx_bind(ctx, err)) != OBS_OK)
+        return s;
+    ctx->times_valid = 0;
+    if ((s = obs__deep_frame_setup(d, params, &df, err)) != OBS_OK)
+        return s;
+    const obs__frame *f = &df.f;
+    const int w = f->width, h = f->height;
+    if ((s = obs__deep_result_alloc(out, w, h, err)) != OBS_OK)
+        goto fail;
+    if (!(rgba = malloc((size_t)w * (size_t)h * 4 * sizeof *rgba))) {
+        s = obs__fail(err, OBS_NO_MEMORY, "deep AO read-back of %dx%d", w, h);
+        goto fail;
+    }
+    const unsigned variant = deep_variant(&df);
+    if ((s = ensure_deep(ctx, variant, w, h, df.m, err)) != OBS_OK)
+        goto fail;
+    const obs__deep_targets *t = &ctx->deep;
+    const GLuint prog = t->prog[variant];
+    for (int p = 0; p < OBS_PASS_COUNT; p++)
+        times.ms[p] = -1.0;
+
+    stage_begin(ctx, &t0);
+    upload_layers(t->tex_pos, w, h, df.m, df.pos);
+    upload_layers(t->tex_nrm, w, h, df.m, df.nrm);
+    stage_end(ctx, OBS_PASS_UPLOAD, t0, &times);
+
+    stage_begin(ctx, &t0);
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    glUseProgram(prog);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_TRUE, f->proj);
+    glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
+    glUniform2i(glGetUniformLocation(prog, "u_size"), w, h);
+    glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
+    glUniform1i(glGetUniformLocation(prog, "u_ns"), f->samples);
+    glUniform2fv(glGetUniformLocation(prog, "u_samples"), f->samples, f->sample_xy);
+    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
+    glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
+    glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
+    glUniform1i(glGetUniformLocation(prog, "u_m"), df.m);
+    glUniform1i(glGetUniformLocation(prog, "u_multi"), df.multi);
+    glUniform1i(glGetUniformLocation(prog, "u_hs_count"), f->hs_count);
+    glUniform1f(glGetUniformLocation(prog, "u_hs_bias"), f->hs_bias);
+    glUniform1fv(glGetUniformLocation(prog, "u_hs_kernel"), 3 * f->hs_count, &f->hs_kernel[0][0]);
+    /* the node planes are read through images (imageLoad), as the planes
+     * of run_gl.c are: cheaper than texelFetch on llvmpipe */
+    glBindImageTexture(0, t->tex_pos, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glUniform1i(glGetUniformLocation(prog, "u_lpos"), 0);
+    glBindImageTexture(1, t->tex_nrm, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glUniform1i(glGetUniformLocation(prog, "u_lnrm"), 1);
+    glViewport(0, 0, w, h);
+    glBindVertexArray(ctx->vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    stage_end(ctx, OBS_PASS_AO, t0, &times);
+
+    stage_begin(ctx, &t0);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba);
+    stage_end(ctx, OBS_PASS_READBACK, t0, &times);
+    glActiveTexture(GL_TEXTURE0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if ((s = obs__gl_check("deep AO pass", err)) != OBS_OK)
+        goto fail;
+    if (ctx->timing) {
+        times.total_ms = times.ms[OBS_PASS_UPLOAD] + times.ms[OBS_PASS_AO] + times.ms[OBS_PASS_READBACK];
+        ctx->times = times;
+        ctx->times_valid = 1;
+    }
+    for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
+        out->ao_front.data[i] = rgba[4 * i];
+        out->ao_blend.data[i] = rgba[4 * i + 1];
+    }
+    obs__deep_composite(d, out);
+fail:
+    free(rgba);
+    obs__deep_frame_free(&df);
+    if (s != OBS_OK)
+        obs_deep_result_free(out);
+    return s;
+}

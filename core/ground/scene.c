@@ -1,0 +1,334 @@
+/* Scene loading through assimp's C API: every triangle of the file, in
+ * world space, as one indexed mesh. */
+#include <assimp/GltfMaterial.h>
+#include <assimp/cimport.h>
+#include <assimp/config.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <errno.h>
+#include <fnmatch.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "obscura/scene.h"
+
+/* Indices are 32-bit (GL and Embree take them so). */
+#define MAX_VERTICES ((size_t)UINT32_MAX)
+
+void obs_scene_free(obs_scene *s)
+{
+    if (!s)
+        return;
+    free(s->positions);
+    free(s->normals);
+    free(s->albedo);
+    free(s->indices);
+    free(s->opacity);
+    for (size_t m = 0; m < s->mesh_count && s->meshes; m++) {
+        free(s->meshes[m].name);
+        free(s->meshes[m].node);
+    }
+    free(s->meshes);
+    memset(s, 0, sizeof *s);
+}
+
+obs_status obs_scene_check(obs_scene *s, char err[OBS_ERR_LEN])
+{
+    if (!s->positions || !s->indices || s->vertex_count == 0 || s->triangle_count == 0)
+        return obs__fail(err, OBS_BAD_FILE, "empty scene: no triangles");
+    if (s->vertex_count > MAX_VERTICES)
+        return obs__fail(err, OBS_TOO_LARGE, "%zu vertices; at most %zu", s->vertex_count,
+                         MAX_VERTICES);
+    for (int k = 0; k < 3; k++) {
+        s->bounds_min[k] = INFINITY;
+        s->bounds_max[k] = -INFINITY;
+    }
+    for (size_t v = 0; v < s->vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            float x = s->positions[3 * v + k];
+            if (!isfinite(x))
+                return obs__fail(err, OBS_BAD_FILE, "vertex %zu has a non-finite coordinate", v);
+            s->bounds_min[k] = fminf(s->bounds_min[k], x);
+            s->bounds_max[k] = fmaxf(s->bounds_max[k], x);
+        }
+    for (size_t i = 0; i < 3 * s->triangle_count; i++)
+        if (s->indices[i] >= s->vertex_count)
+            return obs__fail(err, OBS_BAD_FILE, "triangle %zu refers to vertex %u of %zu", i / 3,
+                             (unsigned)s->indices[i], s->vertex_count);
+    return OBS_OK;
+}
+
+/* The diffuse (or PBR base) colour of a material, unless it is assimp's
+ * stand-in for a file without materials. */
+static int material_albedo(const struct aiMaterial *mat, float rgb[3])
+{
+    struct aiString name;
+    struct aiColor4D c;
+    if (!mat)
+        return 0;
+    if (aiGetMaterialString(mat, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS &&
+        strcmp(name.data, AI_DEFAULT_MATERIAL_NAME) == 0)
+        return 0;
+    if (aiGetMaterialColor(mat, AI_MATKEY_BASE_COLOR, &c) != aiReturn_SUCCESS &&
+        aiGetMaterialColor(mat, AI_MATKEY_COLOR_DIFFUSE, &c) != aiReturn_SUCCESS)
+        return 0;
+    rgb[0] = c.r;
+    rgb[1] = c.g;
+    rgb[2] = c.b;
+    return 1;
+}
+
+/* A material's opacity: glTF's base colour alpha when its alphaMode is
+ * BLEND (OPAQUE and MASK render opaque), else AI_MATKEY_OPACITY (OBJ's
+ * d, FBX's, ...); 1 when the material says nothing. */
+static float material_opacity(const struct aiMaterial *mat)
+{
+    struct aiString s;
+    struct aiColor4D c;
+    float o = 1.0f;
+    if (!mat)
+        return 1.0f;
+    if (aiGetMaterialString(mat, AI_MATKEY_NAME, &s) == aiReturn_SUCCESS &&
+        strcmp(s.data, AI_DEFAULT_MATERIAL_NAME) == 0)
+        return 1.0f;
+    if (aiGetMaterialString(mat, AI_MATKEY_GLTF_ALPHAMODE, &s) == aiReturn_SUCCESS) {
+        if (strcmp(s.data, "BLEND") != 0 ||
+            aiGetMaterialColor(mat, AI_MATKEY_BASE_COLOR, &c) != aiReturn_SUCCESS)
+            return 1.0f;
+        o = c.a;
+    } else if (aiGetMaterialFloat(mat, AI_MATKEY_OPACITY, &o) != aiReturn_SUCCESS) {
+        return 1.0f;
+    }
+    return isfinite(o) ? fminf(fmaxf(o, 0.0f), 1.0f) : 1.0f;
+}
+
+/* The name of the first node (depth first) that holds mesh i. */
+static const char *node_name_of(const struct aiNode *n, unsigned i)
+{
+    if (!n)
+        return NULL;
+    for (unsigned k = 0; k < n->mNumMeshes; k++)
+        if (n->mMeshes[k] == i)
+            return n->mName.data;
+    for (unsigned c = 0; c < n->mNumChildren; c++) {
+        const char *r = node_name_of(n->mChildren[c], i);
+        if (r)
+            return r;
+    }
+    return NULL;
+}
+
+static int triangle_mesh(const struct aiMesh *m)
+{
+    return m && m->mNumVertices > 0 && m->mNumFaces > 0 &&
+           (m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE);
+}
+
+obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
+    fclose(fp);
+
+    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                           aiProcess_SortByPType | aiProcess_GenNormals |
+                           aiProcess_FindInvalidData;
+    /* Keep the meshes apart (PreTransformVertices otherwise joins those
+     * of one material): their names select opacities. */
+    struct aiPropertyStore *props = aiCreatePropertyStore();
+    if (props)
+        aiSetImportPropertyInteger(props, AI_CONFIG_PP_PTV_KEEP_HIERARCHY, 1);
+    const struct aiScene *sc = aiImportFileExWithProperties(path, flags, NULL, props);
+    if (props)
+        aiReleasePropertyStore(props);
+    if (!sc)
+        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
+                         aiGetErrorString());
+
+    obs_status st = OBS_OK;
+    size_t nv = 0, nt = 0;
+    int any_albedo = 0, any_opacity = 0;
+    size_t nmesh = 0;
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[i];
+        if (!triangle_mesh(m))
+            continue;
+        nmesh++;
+        any_opacity |= m->mMaterialIndex < sc->mNumMaterials &&
+                       material_opacity(sc->mMaterials[m->mMaterialIndex]) < 1.0f;
+        nv += m->mNumVertices;
+        for (unsigned f = 0; f < m->mNumFaces; f++)
+            nt += m->mFaces[f].mNumIndices == 3;
+        float rgb[3];
+        any_albedo |= m->mMaterialIndex < sc->mNumMaterials &&
+                      material_albedo(sc->mMaterials[m->mMaterialIndex], rgb);
+    }
+    if (nt == 0) {
+        st = obs__fail(err, OBS_BAD_FILE, "%s: empty scene: no triangles (%u meshes)", path,
+                       sc->mNumMeshes);
+        goto fail;
+    }
+    if (nv > MAX_VERTICES) {
+        st = obs__fail(err, OBS_TOO_LARGE, "%s: %zu vertices; at most %zu", path, nv,
+                       MAX_VERTICES);
+        goto fail;
+    }
+    size_t vbytes, ibytes;
+    if (obs__size_mul3(nv, 3, sizeof(float), &vbytes) || obs__size_mul3(nt, 3, sizeof(uint32_t), &ibytes)) {
+        st = obs__fail(err, OBS_TOO_LARGE, "%s: mesh too large", path);
+        goto fail;
+    }
+    out->positions = malloc(vbytes);
+    out->normals = malloc(vbytes);
+    out->albedo = any_albedo ? malloc(vbytes) : NULL;
+    out->indices = malloc(ibytes);
+    out->opacity = any_opacity ? malloc(nt * sizeof(float)) : NULL;
+    out->meshes = calloc(nmesh, sizeof *out->meshes);
+    if (!out->positions || !out->normals || !out->indices || (any_albedo && !out->albedo) ||
+        (any_opacity && !out->opacity) || !out->meshes) {
+        st = obs__fail(err, OBS_NO_MEMORY, "%s: %zu vertices, %zu triangles", path, nv, nt);
+        goto fail;
+    }
+
+    size_t v0 = 0, t = 0;
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[i];
+        if (!triangle_mesh(m))
+            continue;
+        float rgb[3] = {0, 0, 0};
+        if (any_albedo && !(m->mMaterialIndex < sc->mNumMaterials &&
+                            material_albedo(sc->mMaterials[m->mMaterialIndex], rgb)))
+            rgb[0] = rgb[1] = rgb[2] = 0.8f; /* a mesh without a colour among coloured ones */
+        float opacity = m->mMaterialIndex < sc->mNumMaterials
+                            ? material_opacity(sc->mMaterials[m->mMaterialIndex])
+                            : 1.0f;
+        obs_scene_mesh *mesh = &out->meshes[out->mesh_count++];
+        const char *node = node_name_of(sc->mRootNode, i);
+        mesh->first_triangle = t;
+        if (!(mesh->name = strdup(m->mName.data)) || !(mesh->node = strdup(node ? node : ""))) {
+            st = obs__fail(err, OBS_NO_MEMORY, "%s: mesh names", path);
+            goto fail;
+        }
+        for (unsigned v = 0; v < m->mNumVertices; v++) {
+            float *p = out->positions + 3 * (v0 + v), *n = out->normals + 3 * (v0 + v);
+            p[0] = m->mVertices[v].x;
+            p[1] = m->mVertices[v].y;
+            p[2] = m->mVertices[v].z;
+            /* GenNormals fills absent normals; FindInvalidData may still
+             * leave a zero or NaN one, which the rasteriser replaces by
+             * the triangle's own. */
+            n[0] = n[1] = n[2] = 0.0f;
+            if (m->mNormals) {
+                float x = m->mNormals[v].x, y = m->mNormals[v].y, z = m->mNormals[v].z;
+                float len = sqrtf(x * x + y * y + z * z);
+                if (isfinite(len) && len > 1e-12f) {
+                    n[0] = x / len;
+                    n[1] = y / len;
+                    n[2] = z / len;
+                }
+            }
+            if (out->albedo)
+                memcpy(out->albedo + 3 * (v0 + v), rgb, sizeof rgb);
+        }
+        for (unsigned f = 0; f < m->mNumFaces; f++) {
+            const struct aiFace *fc = &m->mFaces[f];
+            if (fc->mNumIndices != 3)
+                continue;
+            for (int k = 0; k < 3; k++)
+                out->indices[3 * t + k] = (uint32_t)(v0 + fc->mIndices[k]);
+            if (out->opacity)
+                out->opacity[t] = opacity;
+            t++;
+        }
+        mesh->triangle_count = t - mesh->first_triangle;
+        v0 += m->mNumVertices;
+    }
+    out->vertex_count = nv;
+    out->triangle_count = nt;
+    if ((st = obs_scene_check(out, err)) != OBS_OK) {
+        char msg[OBS_ERR_LEN];
+        snprintf(msg, sizeof msg, "%s", err ? err : "");
+        obs__fail(err, st, "%s: %s", path, msg);
+        goto fail;
+    }
+    aiReleaseImport(sc);
+    return OBS_OK;
+
+fail:
+    aiReleaseImport(sc);
+    obs_scene_free(out);
+    return st;
+}
+
+obs_status obs_scene_set_opacity(obs_scene *s, const char *spec, char err[OBS_ERR_LEN])
+{
+    if (!s || !s->indices || s->triangle_count == 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "opacity: empty scene");
+    if (!spec || !*spec)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "opacity: empty spec (expected A or NAME=A)");
+    const char *eq = strrchr(spec, '='), *num = eq ? eq + 1 : spec;
+    char *end;
+    errno = 0;
+    double a = strtod(num, &end);
+    if (end == num || *end || errno || !(a >= 0.0 && a <= 1.0))
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "opacity '%s': expected A or NAME=A with A a number from 0 to 1", spec);
+    if (eq == spec)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "opacity '%s': empty mesh name", spec);
+    size_t namelen = eq ? (size_t)(eq - spec) : 0;
+    char *pattern = NULL;
+    if (eq && !(pattern = strndup(spec, namelen)))
+        return obs__fail(err, OBS_NO_MEMORY, "opacity '%s'", spec);
+    if (!s->opacity) {
+        if (!(s->opacity = malloc(s->triangle_count * sizeof(float)))) {
+            free(pattern);
+            return obs__fail(err, OBS_NO_MEMORY, "opacity of %zu triangles", s->triangle_count);
+        }
+        for (size_t t = 0; t < s->triangle_count; t++)
+            s->opacity[t] = 1.0f;
+    }
+    size_t hit = 0;
+    if (!pattern) {
+        for (size_t t = 0; t < s->triangle_count; t++)
+            s->opacity[t] = (float)a;
+        hit = 1;
+    }
+    for (size_t m = 0; pattern && m < s->mesh_count; m++) {
+        const obs_scene_mesh *me = &s->meshes[m];
+        if (fnmatch(pattern, me->name, 0) != 0 && fnmatch(pattern, me->node, 0) != 0)
+            continue;
+        for (size_t t = 0; t < me->triangle_count; t++)
+            s->opacity[me->first_triangle + t] = (float)a;
+        hit++;
+    }
+    if (hit == 0) {
+        /* Name the meshes there are (as many as fit). */
+        char list[OBS_ERR_LEN / 2] = "";
+        size_t used = 0;
+        for (size_t m = 0; m < s->mesh_count && used + 8 < sizeof list; m++) {
+            const obs_scene_mesh *me = &s->meshes[m];
+            int n = strcmp(me->name, me->node) && *me->node
+                        ? snprintf(list + used, sizeof list - used, "%s'%s' (node '%s')",
+                                   m ? ", " : "", me->name, me->node)
+                        : snprintf(list + used, sizeof list - used, "%s'%s'", m ? ", " : "",
+                                   me->name);
+            if (n < 0 || (size_t)n >= sizeof list - used) {
+                snprintf(list + used, sizeof list - used, ", ...");
+                break;
+            }
+            used += (size_t)n;
+        }
+        obs__fail(err, OBS_INVALID_ARGUMENT, "opacity '%s': no mesh is named '%s'; the meshes: %s",
+                  spec, pattern, s->mesh_count ? list : "(none: a scene built in memory)");
+        free(pattern);
+        return OBS_INVALID_ARGUMENT;
+    }
+    free(pattern);
+    return OBS_OK;
+}

@@ -1,0 +1,251 @@
+/* Channel maps: which EXR channels hold depth, normal and colour.
+ * Presets know the names common renderers write; explicit names override
+ * them.  Channels are matched by name only, never by position. */
+#include <stdio.h>
+#include <string.h>
+
+#include "io/exr_internal.h"
+#include "internal.h"
+
+const char *const obs_channel_presets[] = {"auto", "blender", "generic", NULL};
+
+/* Blender's multilayer EXRs prefix every pass with the view layer. */
+#define BLENDER_DEPTH_SUFFIX ".Depth.Z"
+#define DEFAULT_BLENDER_LAYER "ViewLayer"
+
+
+static int find(const char *const *names, int count, const char *name)
+{
+    for (int i = 0; i < count; i++)
+        if (strcmp(names[i], name) == 0)
+            return i;
+    return -1;
+}
+
+/* Finds prefix+sfx[i] for i < n; all found -> 1 with out[] filled. */
+static int find_set(const char *const *names, int count, const char *prefix,
+                    const char *const *sfx, int n, int *out)
+{
+    char buf[512];
+    int idx[4];
+    for (int i = 0; i < n; i++) {
+        if (snprintf(buf, sizeof buf, "%s%s", prefix, sfx[i]) >= (int)sizeof buf)
+            return 0;
+        if ((idx[i] = find(names, count, buf)) < 0)
+            return 0;
+    }
+    memcpy(out, idx, (size_t)n * sizeof(int));
+    return 1;
+}
+
+static void clear_match(obs__channel_match *m)
+{
+    m->depth = -1;
+    for (int i = 0; i < 3; i++)
+        m->normal[i] = -1;
+    for (int i = 0; i < 4; i++)
+        m->color[i] = -1;
+    m->preset = "explicit";
+}
+
+static const char *const XYZ[] = {".X", ".Y", ".Z"};
+static const char *const RGB[] = {".R", ".G", ".B"};
+
+/* blender: <Layer>.Depth.Z, <Layer>.Normal.X/Y/Z, <Layer>.DiffCol.R/G/B
+ * else <Layer>.Combined.R/G/B/A.  The layer is the prefix of any channel
+ * ending in ".Depth.Z", Blender's default layer first. */
+static void preset_blender(const char *const *names, int count, obs__channel_match *m)
+{
+    char layer[256] = "";
+    size_t sl = strlen(BLENDER_DEPTH_SUFFIX);
+    clear_match(m);
+    m->preset = "blender";
+    m->depth = find(names, count, DEFAULT_BLENDER_LAYER BLENDER_DEPTH_SUFFIX);
+    if (m->depth >= 0)
+        snprintf(layer, sizeof layer, "%s", DEFAULT_BLENDER_LAYER);
+    for (int i = 0; m->depth < 0 && i < count; i++) {
+        size_t n = strlen(names[i]);
+        if (n > sl && n - sl < sizeof layer && strcmp(names[i] + n - sl, BLENDER_DEPTH_SUFFIX) == 0) {
+            memcpy(layer, names[i], n - sl);
+            layer[n - sl] = '\0';
+            m->depth = i;
+        }
+    }
+    if (m->depth < 0)
+        return;
+    char pre[300];
+    snprintf(pre, sizeof pre, "%s.Normal", layer);
+    find_set(names, count, pre, XYZ, 3, m->normal);
+    snprintf(pre, sizeof pre, "%s.DiffCol", layer);
+    if (!find_set(names, count, pre, RGB, 3, m->color)) {
+        snprintf(pre, sizeof pre, "%s.Combined", layer);
+        if (find_set(names, count, pre, RGB, 3, m->color)) {
+            snprintf(pre, sizeof pre, "%s.Combined.A", layer);
+            m->color[3] = find(names, count, pre);
+        }
+    }
+}
+
+/* generic: Z (depth.Z, Depth.Z); N.X/Y/Z, N.R/G/B, normal.X/Y/Z,
+ * Normal.X/Y/Z; R, G, B and optionally A. */
+static void preset_generic(const char *const *names, int count, obs__channel_match *m)
+{
+    static const char *const depths[] = {"Z", "depth.Z", "Depth.Z"};
+    static const char *const rgb[] = {"R", "G", "B"};
+    clear_match(m);
+    m->preset = "generic";
+    for (int i = 0; i < 3 && m->depth < 0; i++)
+        m->depth = find(names, count, depths[i]);
+    if (!find_set(names, count, "N", XYZ, 3, m->normal) &&
+        !find_set(names, count, "N", RGB, 3, m->normal) &&
+        !find_set(names, count, "normal", XYZ, 3, m->normal))
+        find_set(names, count, "Normal", XYZ, 3, m->normal);
+    if (find_set(names, count, "", rgb, 3, m->color))
+        m->color[3] = find(names, count, "A");
+}
+
+/* "A, B, C", cut short with "... (N channels)". */
+void obs__list_names(const char *const *names, int count, char *buf, size_t len)
+{
+    size_t at = 0;
+    buf[0] = '\0';
+    if (count == 0) {
+        snprintf(buf, len, "no channels");
+        return;
+    }
+    for (int i = 0; i < count; i++) {
+        size_t n = strlen(names[i]) + (i ? 2 : 0);
+        if (at + n > OBS__LIST_CHARS) {
+            snprintf(buf + at, len - at, "%s... (%d channels)", i ? ", " : "", count);
+            return;
+        }
+        at += (size_t)snprintf(buf + at, len - at, "%s%s", i ? ", " : "", names[i]);
+    }
+}
+
+static obs_status missing(char err[OBS_ERR_LEN], const char *const *names, int count,
+                          const char *what)
+{
+    char list[OBS__LIST_CHARS + 32];
+    obs__list_names(names, count, list, sizeof list);
+    return obs__fail(err, OBS_MISSING_CHANNEL, "%s; the file has: %s", what, list);
+}
+
+/* Looks up one explicitly named channel; a name the file lacks is an
+ * error, since the caller asked for it. */
+static obs_status explicit_channel(const char *const *names, int count, const char *name,
+                                   const char *plane, int *idx, char err[OBS_ERR_LEN])
+{
+    char what[320];
+    if ((*idx = find(names, count, name)) >= 0)
+        return OBS_OK;
+    snprintf(what, sizeof what, "%s channel '%.256s' not found", plane, name);
+    return missing(err, names, count, what);
+}
+
+static int in_set(int idx, const int *set, int n)
+{
+    for (int i = 0; idx >= 0 && i < n; i++)
+        if (set[i] == idx)
+            return 1;
+    return 0;
+}
+
+static int count_set(const char *const *v, int n)
+{
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        k += v[i] && *v[i];
+    return k;
+}
+
+obs_status obs__channel_map_resolve(const obs_channel_map *map,
+                                    const char *const *names, int count,
+                                    obs__channel_match *m,
+                                    char err[OBS_ERR_LEN])
+{
+    static const obs_channel_map automap = {0};
+    obs__channel_match cand[2];
+    int ncand = 0, pick = -1;
+    obs_status st;
+
+    if (!map)
+        map = &automap;
+    const char *preset = map->preset && *map->preset ? map->preset : "auto";
+    int is_auto = strcmp(preset, "auto") == 0;
+    if (is_auto || strcmp(preset, "blender") == 0)
+        preset_blender(names, count, &cand[ncand++]);
+    if (is_auto || strcmp(preset, "generic") == 0)
+        preset_generic(names, count, &cand[ncand++]);
+    if (ncand == 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "unknown channel preset '%.64s' (valid: auto, blender, generic)", preset);
+    int nd = count_set(&map->depth, 1), nn = count_set(map->normal, 3), nc = count_set(map->color, 3);
+    if (nn != 0 && nn != 3)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "explicit normal needs three channel names (X, Y, Z)");
+    if (nc != 3 && (nc != 0 || (map->color[3] && *map->color[3])))
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "explicit colour needs three channel names (R, G, B) and an optional alpha");
+
+    /* The first preset that finds its depth wins; with an explicit depth,
+     * the first that finds anything supplies the other planes. */
+    for (int i = 0; i < ncand && pick < 0; i++)
+        if (cand[i].depth >= 0)
+            pick = i;
+    for (int i = 0; i < ncand && pick < 0 && nd; i++)
+        if (cand[i].normal[0] >= 0 || cand[i].color[0] >= 0)
+            pick = i;
+    if (pick >= 0)
+        *m = cand[pick];
+    else
+        clear_match(m); /* preset "explicit" */
+
+    if (nd && (st = explicit_channel(names, count, map->depth, "depth", &m->depth, err)) != OBS_OK)
+        return st;
+    for (int i = 0; nn == 3 && i < 3; i++)
+        if ((st = explicit_channel(names, count, map->normal[i], "normal", &m->normal[i], err)) != OBS_OK)
+            return st;
+    if (nc == 3) {
+        for (int i = 0; i < 3; i++)
+            if ((st = explicit_channel(names, count, map->color[i], "colour", &m->color[i], err)) != OBS_OK)
+                return st;
+        m->color[3] = -1;
+        if (map->color[3] && *map->color[3] &&
+            (st = explicit_channel(names, count, map->color[3], "alpha", &m->color[3], err)) != OBS_OK)
+            return st;
+    }
+    if (m->depth < 0)
+        return missing(err, names, count,
+                       is_auto ? "no depth channel: looked for '<layer>.Depth.Z' (blender) "
+                                 "and Z, depth.Z, Depth.Z (generic)"
+                       : strcmp(preset, "blender") == 0
+                           ? "no depth channel: looked for '<layer>.Depth.Z' (blender, "
+                             "e.g. ViewLayer.Depth.Z)"
+                           : "no depth channel: looked for Z, depth.Z, Depth.Z (generic)");
+
+    /* A preset's plane that reuses an explicitly named channel gives way;
+     * explicit names that clash among themselves are an error, since one
+     * EXR channel decodes into one place. */
+    int ex[8], nex = 0;
+    if (nd)
+        ex[nex++] = m->depth;
+    for (int i = 0; nn == 3 && i < 3; i++)
+        ex[nex++] = m->normal[i];
+    for (int i = 0; nc == 3 && i < 4; i++)
+        if (m->color[i] >= 0)
+            ex[nex++] = m->color[i];
+    if (nn != 3 && (in_set(m->normal[0], ex, nex) || in_set(m->normal[1], ex, nex) ||
+                    in_set(m->normal[2], ex, nex)))
+        m->normal[0] = m->normal[1] = m->normal[2] = -1;
+    if (nc != 3 && (in_set(m->color[0], ex, nex) || in_set(m->color[1], ex, nex) ||
+                    in_set(m->color[2], ex, nex)))
+        m->color[0] = m->color[1] = m->color[2] = m->color[3] = -1;
+    if (nc != 3 && in_set(m->color[3], ex, nex))
+        m->color[3] = -1;
+    int idx[8] = {m->depth, m->normal[0], m->normal[1], m->normal[2],
+                  m->color[0], m->color[1], m->color[2], m->color[3]};
+    for (int i = 0; i < 8; i++)
+        if (idx[i] >= 0 && in_set(idx[i], idx + i + 1, 7 - i))
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "channel '%.256s' is mapped twice",
+                             names[idx[i]]);
+    return OBS_OK;
+}

@@ -1,0 +1,70 @@
+/* Internal to the EXR reader and writer: channel-map resolution and the
+ * capture of OpenEXR's own error messages.  Not installed. */
+#ifndef OBSCURA_EXR_INTERNAL_H
+#define OBSCURA_EXR_INTERNAL_H
+
+#include <openexr.h>
+
+#include "obscura/io.h"
+
+/* A channel map resolved against one part's channel list: indices into
+ * the list, -1 where absent. */
+typedef struct obs__channel_match {
+    int depth;
+    int normal[3];    /* all three or all -1 */
+    int color[4];     /* R, G, B all or none; alpha may be -1 alone */
+    const char *preset; /* "blender", "generic" or "explicit" (static) */
+} obs__channel_match;
+
+/* Resolves `map` (NULL = auto) against the channel names of one part.
+ * OBS_OK when the depth was found; OBS_MISSING_CHANNEL when it was not, or
+ * when an explicitly named channel is absent (the message names what was
+ * looked for and lists `names`, truncated); OBS_INVALID_ARGUMENT for an
+ * unknown preset or a partial explicit normal/colour. */
+obs_status obs__channel_map_resolve(const obs_channel_map *map,
+                                    const char *const *names, int count,
+                                    obs__channel_match *m,
+                                    char err[OBS_ERR_LEN]);
+
+/* "A, B, C" up to OBS__LIST_CHARS characters, then ", ... (N channels)";
+ * `len` should be OBS__LIST_CHARS + 32. */
+#define OBS__LIST_CHARS 240
+void obs__list_names(const char *const *names, int count, char *buf, size_t len);
+
+/* OpenEXR reports errors through a callback without a user pointer for
+ * files it opens itself, so the message is kept per thread: reset before
+ * a call, read after a failure.  The handler never prints. */
+void obs__exr_msg_reset(void);
+const char *obs__exr_msg(void);
+void obs__exr_error_handler(exr_const_context_t ctxt, exr_result_t code,
+                            const char *msg);
+
+/* The status class of an OpenEXR result code. */
+obs_status obs__exr_status(exr_result_t rv);
+
+/* Fails with the status of `rv`: "<what>: <library message>". */
+obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv,
+                         const char *what);
+
+/* The worldToCamera and worldToNDC attributes (row-major, OpenEXR's
+ * row-vector convention) of a camera (exr_write.c); the deep writer
+ * (exr_deep_write.cpp, C++) declares it itself. */
+void obs__exr_camera_matrices(const obs_camera *cam, float wtc[16], float ndc[16]);
+
+/* The camera of a part's header (worldToCamera / worldToNDC) in obscura's
+ * conventions; zeroed when the header has none (exr_read.c). */
+void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam);
+
+/* A file in memory, read through OpenEXR's custom-stream callbacks. */
+typedef struct obs__exr_mem {
+    const unsigned char *buf;
+    size_t len;
+} obs__exr_mem;
+
+/* Opens a file (mem == NULL) or a memory buffer for reading, chunk table
+ * reconstruction off (a damaged table is an error); *size receives the
+ * byte count when known (else -1).  Shared by exr_read.c and exr_deep.c. */
+obs_status obs__exr_open(const char *path, const obs__exr_mem *mem, exr_context_t *ctx,
+                         int64_t *size, char err[OBS_ERR_LEN]);
+
+#endif

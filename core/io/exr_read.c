@@ -1,0 +1,860 @@
+/* G-buffer EXR input through OpenEXR's C API (openexr.h).
+ *
+ * Files are untrusted: every size from a header is checked (overflow,
+ * limits, what the file can hold) before anything is allocated, and
+ * every library failure becomes a status with the library's message. */
+#include <limits.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "io/exr_internal.h"
+#include "internal.h"
+
+/* Camera-space clip range used for the projection built from worldToNDC,
+ * whose z row an EXR does not define. */
+#define EXR_NEAR 0.1f
+#define EXR_FAR 1000.0f
+
+/* A decoded chunk is held whole by the library; the header decides its
+ * size, so a damaged header could ask for gigabytes from a tiny file. */
+#define MAX_CHUNK_BYTES ((uint64_t)1 << 30)
+
+/* Upper bound on obs_limits.threads. */
+#define OBS_MAX_DECODE_THREADS 64
+
+/* ---- OpenEXR messages --------------------------------------------------- */
+
+static _Thread_local char exr_msg[384];
+
+void obs__exr_msg_reset(void)
+{
+    exr_msg[0] = '\0';
+}
+
+const char *obs__exr_msg(void)
+{
+    return exr_msg;
+}
+
+void obs__exr_error_handler(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+{
+    size_t n = strlen(exr_msg);
+    (void)ctxt;
+    if (!msg || !*msg)
+        msg = exr_get_default_error_message(code);
+    /* The first message names the cause; later ones add context. */
+    if (n == 0)
+        snprintf(exr_msg, sizeof exr_msg, "%s", msg);
+    else if (n + 3 < sizeof exr_msg)
+        snprintf(exr_msg + n, sizeof exr_msg - n, "; %s", msg);
+}
+
+obs_status obs__exr_status(exr_result_t rv)
+{
+    switch (rv) {
+    case EXR_ERR_SUCCESS: return OBS_OK;
+    case EXR_ERR_OUT_OF_MEMORY: return OBS_NO_MEMORY;
+    case EXR_ERR_FILE_ACCESS:
+    case EXR_ERR_WRITE_IO: return OBS_IO;
+    case EXR_ERR_FEATURE_NOT_IMPLEMENTED: return OBS_UNSUPPORTED;
+    /* The reader passes valid arguments, so anything else (out of range,
+     * bad header, corrupt chunk, short read) comes from the file. */
+    default: return OBS_BAD_FILE;
+    }
+}
+
+obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv, const char *what)
+{
+    const char *msg = exr_msg[0] ? exr_msg : exr_get_default_error_message(rv);
+    return obs__fail(err, obs__exr_status(rv), "%s: %s", what, msg);
+}
+
+/* ---- opening ------------------------------------------------------------ */
+
+typedef obs__exr_mem mem_src;
+
+static int64_t mem_read(exr_const_context_t ctxt, void *user, void *buffer, uint64_t sz,
+                        uint64_t offset, exr_stream_error_func_ptr_t error_cb)
+{
+    const mem_src *m = user;
+    (void)ctxt;
+    (void)error_cb;
+    if (offset >= m->len)
+        return 0; /* end of data: the library reports the short read */
+    uint64_t n = m->len - offset < sz ? m->len - offset : sz;
+    memcpy(buffer, m->buf + offset, (size_t)n);
+    return (int64_t)n;
+}
+
+static int64_t mem_size(exr_const_context_t ctxt, void *user)
+{
+    (void)ctxt;
+    return (int64_t)((const mem_src *)user)->len;
+}
+
+obs_status obs__exr_open(const char *path, const mem_src *mem, exr_context_t *ctx,
+                           int64_t *size, char err[OBS_ERR_LEN])
+{
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    struct stat st;
+    init.error_handler_fn = obs__exr_error_handler;
+    /* A damaged offset table is an error, not a reason to scan the file. */
+    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+    if (mem) {
+        init.user_data = (void *)mem;
+        init.read_fn = mem_read;
+        init.size_fn = mem_size;
+    }
+    *ctx = NULL;
+    *size = mem ? (int64_t)mem->len
+            : stat(path, &st) == 0 && S_ISREG(st.st_mode) ? (int64_t)st.st_size : -1;
+    obs__exr_msg_reset();
+    exr_result_t rv = exr_start_read(ctx, mem ? "<memory>" : path, &init);
+    if (rv != EXR_ERR_SUCCESS) {
+        exr_finish(ctx);
+        *ctx = NULL;
+        return obs__exr_fail(err, rv, "not a readable OpenEXR file");
+    }
+    obs__exr_msg_reset(); /* header warnings the library got past */
+    return OBS_OK;
+}
+
+/* ---- parts and channels -------------------------------------------------- */
+
+/* Channel names of one part, pointing into the context (valid until
+ * exr_finish()).  Caller frees the array. */
+static obs_status part_names(exr_const_context_t ctx, int part, const char ***names,
+                             int *count, char err[OBS_ERR_LEN])
+{
+    const exr_attr_chlist_t *cl = NULL;
+    exr_result_t rv = exr_get_channels(ctx, part, &cl);
+    if (rv != EXR_ERR_SUCCESS || !cl)
+        return obs__exr_fail(err, rv ? rv : EXR_ERR_MISSING_REQ_ATTR, "channel list");
+    if (cl->num_channels < 0)
+        return obs__fail(err, OBS_BAD_FILE, "part %d: negative channel count", part);
+    *names = malloc(((size_t)cl->num_channels + 1) * sizeof **names);
+    if (!*names)
+        return obs__fail(err, OBS_NO_MEMORY, "channel list of %d names", cl->num_channels);
+    for (int i = 0; i < cl->num_channels; i++)
+        (*names)[i] = cl->entries[i].name.str ? cl->entries[i].name.str : "";
+    *count = cl->num_channels;
+    return OBS_OK;
+}
+
+static const char *compression_name(exr_compression_t c, int upper)
+{
+    static const char *const lower[] = {"none", "rle", "zips", "zip", "piz",
+                                        "pxr24", "b44", "b44a", "dwaa", "dwab"};
+    static const char *const caps[] = {"NONE", "RLE", "ZIPS", "ZIP", "PIZ",
+                                       "PXR24", "B44", "B44A", "DWAA", "DWAB"};
+    if ((int)c < 0 || c >= EXR_COMPRESSION_LAST_TYPE)
+        return "unknown";
+    return upper ? caps[c] : lower[c];
+}
+
+/* What a part looks like, checked before anything is decoded. */
+typedef struct part_geom {
+    exr_attr_box2i_t dw, disp;
+    int width, height;
+    int tiled;
+    exr_compression_t compression;
+} part_geom;
+
+/* Refuses what the decoder cannot or should not handle, and checks every
+ * size the header gives: storage kind, compression, sampling, windows
+ * against the limits, and the chunk table against the file size. */
+static obs_status check_part(exr_const_context_t ctx, int part, int64_t file_size,
+                             const obs_limits *lim, part_geom *g, char err[OBS_ERR_LEN])
+{
+    exr_storage_t storage;
+    const exr_attr_chlist_t *cl = NULL;
+    int32_t chunks = 0;
+    uint64_t unpacked = 0;
+    exr_result_t rv;
+    obs_status st;
+
+    memset(g, 0, sizeof *g);
+    if ((rv = exr_get_storage(ctx, part, &storage)) != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, "part type");
+    if (storage == EXR_STORAGE_DEEP_SCANLINE || storage == EXR_STORAGE_DEEP_TILED)
+        return obs__fail(err, OBS_UNSUPPORTED, "part %d holds deep (%s) data; deep input is not supported",
+                         part, storage == EXR_STORAGE_DEEP_TILED ? "tiled" : "scanline");
+    if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED)
+        return obs__fail(err, OBS_UNSUPPORTED, "part %d has unknown storage type %d", part, (int)storage);
+    g->tiled = storage == EXR_STORAGE_TILED;
+
+    /* Checked from the header: 3.1's C API cannot decode DWA at all. */
+    if ((rv = exr_get_compression(ctx, part, &g->compression)) != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, "compression");
+    if (g->compression == EXR_COMPRESSION_DWAA || g->compression == EXR_COMPRESSION_DWAB)
+        return obs__fail(err, OBS_UNSUPPORTED, "compression %s is not supported by OpenEXR 3.1's C API",
+                         compression_name(g->compression, 1));
+    if ((int)g->compression < 0 || g->compression >= EXR_COMPRESSION_LAST_TYPE)
+        return obs__fail(err, OBS_UNSUPPORTED, "unknown compression %d", (int)g->compression);
+
+    if ((rv = exr_get_channels(ctx, part, &cl)) != EXR_ERR_SUCCESS || !cl)
+        return obs__exr_fail(err, rv ? rv : EXR_ERR_MISSING_REQ_ATTR, "channel list");
+    for (int i = 0; i < cl->num_channels; i++)
+        if (cl->entries[i].x_sampling != 1 || cl->entries[i].y_sampling != 1)
+            return obs__fail(err, OBS_UNSUPPORTED, "channel '%.256s' is subsampled (%dx%d); subsampled channels are not supported",
+                             cl->entries[i].name.str, cl->entries[i].x_sampling, cl->entries[i].y_sampling);
+        else if ((int)cl->entries[i].pixel_type < 0 || cl->entries[i].pixel_type >= EXR_PIXEL_LAST_TYPE)
+            return obs__fail(err, OBS_BAD_FILE, "channel '%.256s' has unknown pixel type %d",
+                             cl->entries[i].name.str, (int)cl->entries[i].pixel_type);
+
+    if ((rv = exr_get_data_window(ctx, part, &g->dw)) != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, "data window");
+    if ((rv = exr_get_display_window(ctx, part, &g->disp)) != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, "display window");
+    int64_t w = (int64_t)g->dw.max.x - g->dw.min.x + 1, h = (int64_t)g->dw.max.y - g->dw.min.y + 1;
+    int64_t dispw = (int64_t)g->disp.max.x - g->disp.min.x + 1;
+    int64_t disph = (int64_t)g->disp.max.y - g->disp.min.y + 1;
+    if ((st = obs_check_size(lim, w, h, err)) != OBS_OK)
+        return st;
+    /* Row strides handed to the decoder are int32 (4 floats a pixel). */
+    if (w > INT32_MAX / 16)
+        return obs__fail(err, OBS_TOO_LARGE, "data window %lld pixels wide", (long long)w);
+    int64_t ox = (int64_t)g->dw.min.x - g->disp.min.x, oy = (int64_t)g->dw.min.y - g->disp.min.y;
+    if (dispw <= 0 || disph <= 0 || dispw > INT_MAX || disph > INT_MAX || ox < INT_MIN ||
+        ox > INT_MAX || oy < INT_MIN || oy > INT_MAX)
+        return obs__fail(err, OBS_BAD_FILE, "display window %lldx%lld at an offset of (%lld, %lld) is not usable",
+                         (long long)dispw, (long long)disph, (long long)ox, (long long)oy);
+    g->width = (int)w;
+    g->height = (int)h;
+
+    /* Each chunk has an 8-byte entry in the offset table, so a file
+     * smaller than the table is damaged; this keeps the library from
+     * allocating a table the file cannot hold. */
+    if ((rv = exr_get_chunk_count(ctx, part, &chunks)) != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, "chunk count");
+    if (chunks <= 0)
+        return obs__fail(err, OBS_BAD_FILE, "part %d has no chunks", part);
+    if (file_size >= 0 && (uint64_t)chunks * 8u > (uint64_t)file_size)
+        return obs__fail(err, OBS_BAD_FILE, "a table of %d chunks does not fit in a file of %lld bytes",
+                         (int)chunks, (long long)file_size);
+    if ((rv = exr_get_chunk_unpacked_size(ctx, part, &unpacked)) != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, "chunk size");
+    if (unpacked > MAX_CHUNK_BYTES)
+        return obs__fail(err, OBS_TOO_LARGE, "a chunk of %llu bytes exceeds the limit of %llu",
+                         (unsigned long long)unpacked, (unsigned long long)MAX_CHUNK_BYTES);
+    return OBS_OK;
+}
+
+/* ---- decoding ----------------------------------------------------------- */
+
+/* Where one EXR channel goes: `base` is its value at pixel (0, 0) of a
+ * plane of `pch` interleaved floats a pixel, width g->width. */
+typedef struct target {
+    const char *name;
+    float *base;
+    int pch;
+} target;
+
+/* One decode pipeline reused across the chunks of a part. */
+typedef struct decoder {
+    exr_decode_pipeline_t dec;
+    int started;
+    float *scratch; /* sink for channels nobody asked for, see below */
+    size_t scratch_len;
+} decoder;
+
+/* OpenEXR 3.1 picks its half-to-float fast paths for 3- and 4-channel
+ * parts without checking that every channel has a destination, and then
+ * writes through the NULL ones.  Such parts get a scratch destination for
+ * their unmapped channels. */
+static obs_status bind_scratch(decoder *d, const exr_chunk_info_t *ci, char err[OBS_ERR_LEN])
+{
+    size_t n = (size_t)ci->width * (size_t)ci->height; /* within the data window */
+    if (d->dec.channel_count > 4)
+        return OBS_OK;
+    if (n > d->scratch_len) {
+        free(d->scratch);
+        d->scratch_len = 0;
+        if (!(d->scratch = malloc(n * sizeof(float))))
+            return obs__fail(err, OBS_NO_MEMORY, "decoding a chunk of %dx%d", ci->width, ci->height);
+        d->scratch_len = n;
+    }
+    for (int c = 0; c < d->dec.channel_count; c++) {
+        exr_coding_channel_info_t *ch = &d->dec.channels[c];
+        if (ch->decode_to_ptr)
+            continue;
+        ch->decode_to_ptr = (uint8_t *)d->scratch;
+        ch->user_pixel_stride = sizeof(float);
+        ch->user_line_stride = ci->width * (int32_t)sizeof(float);
+        ch->user_data_type = EXR_PIXEL_FLOAT;
+        ch->user_bytes_per_element = sizeof(float);
+    }
+    return OBS_OK;
+}
+
+static obs_status decode_chunk(exr_const_context_t ctx, int part, const part_geom *g,
+                               const exr_chunk_info_t *ci, int64_t x0, int64_t y0,
+                               const target *t, int nt, decoder *d, char err[OBS_ERR_LEN])
+{
+    char what[96];
+    exr_result_t rv;
+    obs_status st;
+
+    snprintf(what, sizeof what, "decoding the chunk at (%lld, %lld)", (long long)x0, (long long)y0);
+    if (ci->width <= 0 || ci->height <= 0 || x0 < 0 || y0 < 0 ||
+        x0 + ci->width > g->width || y0 + ci->height > g->height)
+        return obs__fail(err, OBS_BAD_FILE, "%s: chunk of %dx%d lies outside the data window",
+                         what, ci->width, ci->height);
+    rv = d->started ? exr_decoding_update(ctx, part, ci, &d->dec)
+                    : exr_decoding_initialize(ctx, part, ci, &d->dec);
+    d->started = 1;
+    if (rv != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, what);
+    for (int c = 0; c < d->dec.channel_count; c++) {
+        exr_coding_channel_info_t *ch = &d->dec.channels[c];
+        ch->decode_to_ptr = NULL;
+        for (int k = 0; k < nt; k++) {
+            if (strcmp(ch->channel_name, t[k].name) != 0)
+                continue;
+            if (ch->width != ci->width || ch->height != ci->height)
+                return obs__fail(err, OBS_BAD_FILE, "%s: channel '%.256s' is %dx%d in a %dx%d chunk",
+                                 what, t[k].name, ch->width, ch->height, ci->width, ci->height);
+            float *p = t[k].base + ((size_t)y0 * (size_t)g->width + (size_t)x0) * (size_t)t[k].pch;
+            ch->decode_to_ptr = (uint8_t *)p;
+            ch->user_pixel_stride = t[k].pch * (int32_t)sizeof(float);
+            ch->user_line_stride = g->width * t[k].pch * (int32_t)sizeof(float);
+            ch->user_data_type = EXR_PIXEL_FLOAT;
+            ch->user_bytes_per_element = sizeof(float);
+        }
+    }
+    if ((st = bind_scratch(d, ci, err)) != OBS_OK)
+        return st;
+    if ((rv = exr_decoding_choose_default_routines(ctx, part, &d->dec)) != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, what);
+    if ((rv = exr_decoding_run(ctx, part, &d->dec)) != EXR_ERR_SUCCESS) {
+        st = obs__exr_fail(err, rv, what);
+        /* 3.1 reports some corrupt compressed chunks as out of memory;
+         * its buffers here are bounded by MAX_CHUNK_BYTES, so the file is
+         * the likelier culprit. */
+        return rv == EXR_ERR_OUT_OF_MEMORY ? OBS_BAD_FILE : st;
+    }
+    return OBS_OK;
+}
+
+/* Level 0 of a part, decoded by a few threads at once.  OpenEXR's C API
+ * lets many threads read and decode chunks of one context concurrently
+ * (openexr_context.h, openexr_decode.h), each with its own decode
+ * pipeline; mem_read() reads at explicit offsets, so it is safe too.
+ * Chunks are handed out in file order from a counter, and on failure the
+ * error of the lowest failing chunk is kept: every chunk before it was
+ * handed out before it and is finished, so the result is the one a single
+ * thread gives, whatever the timing. */
+typedef struct part_job {
+    exr_const_context_t ctx;
+    int part;
+    const part_geom *g;
+    const target *t;
+    int nt;
+    int32_t lines;        /* scanlines per chunk (scanline parts) */
+    uint32_t tw, th;      /* tile size (tiled parts) */
+    int64_t ntx, chunks;  /* tiles across; chunks in all */
+    _Atomic int64_t next; /* next chunk to hand out */
+    atomic_int stop;      /* set on the first failure: hand out no more */
+    pthread_mutex_t lock; /* guards the three below */
+    int64_t failed;       /* lowest failing chunk (chunks = none) */
+    obs_status st;
+    char err[OBS_ERR_LEN];
+} part_job;
+
+static obs_status decode_nth(part_job *j, int64_t i, decoder *d, char err[OBS_ERR_LEN])
+{
+    const part_geom *g = j->g;
+    exr_chunk_info_t ci;
+    exr_result_t rv;
+
+    if (!g->tiled) {
+        int64_t y = g->dw.min.y + i * j->lines;
+        if ((rv = exr_read_scanline_chunk_info(j->ctx, j->part, (int)y, &ci)) != EXR_ERR_SUCCESS)
+            return obs__exr_fail(err, rv, "reading a scanline chunk");
+        return decode_chunk(j->ctx, j->part, g, &ci, (int64_t)ci.start_x - g->dw.min.x,
+                            (int64_t)ci.start_y - g->dw.min.y, j->t, j->nt, d, err);
+    }
+    int64_t tx = i % j->ntx, ty = i / j->ntx;
+    if ((rv = exr_read_tile_chunk_info(j->ctx, j->part, (int)tx, (int)ty, 0, 0, &ci)) != EXR_ERR_SUCCESS)
+        return obs__exr_fail(err, rv, "reading a tile");
+    return decode_chunk(j->ctx, j->part, g, &ci, tx * j->tw, ty * j->th, j->t, j->nt, d, err);
+}
+
+static void *decode_worker(void *arg)
+{
+    part_job *j = arg;
+    decoder d = {EXR_DECODE_PIPELINE_INITIALIZER};
+    char err[OBS_ERR_LEN] = "";
+
+    obs__exr_msg_reset(); /* the library's messages are per thread */
+    while (!atomic_load(&j->stop)) {
+        int64_t i = atomic_fetch_add(&j->next, 1);
+        if (i >= j->chunks)
+            break;
+        obs_status st = decode_nth(j, i, &d, err);
+        if (st != OBS_OK) {
+            pthread_mutex_lock(&j->lock);
+            if (i < j->failed) {
+                j->failed = i;
+                j->st = st;
+                memcpy(j->err, err, sizeof err);
+            }
+            pthread_mutex_unlock(&j->lock);
+            atomic_store(&j->stop, 1);
+            break;
+        }
+    }
+    if (d.started)
+        exr_decoding_destroy(j->ctx, &d.dec);
+    free(d.scratch);
+    return NULL;
+}
+
+/* Decode threads for a part of `chunks` chunks: the configured count
+ * (0 = CPUs online, up to 8), but no more than one for every 4 chunks. */
+static int decode_threads(const obs_limits *lim, int64_t chunks)
+{
+    long n = lim && lim->threads > 0 ? lim->threads : 0;
+    if (n <= 0) {
+        n = sysconf(_SC_NPROCESSORS_ONLN);
+        n = n < 1 ? 1 : n > 8 ? 8 : n;
+    }
+    if (n > OBS_MAX_DECODE_THREADS)
+        n = OBS_MAX_DECODE_THREADS;
+    if (n > chunks / 4)
+        n = (long)(chunks / 4);
+    return n < 1 ? 1 : (int)n;
+}
+
+/* Decodes level 0 of a part into the targets. */
+static obs_status decode_part(exr_const_context_t ctx, int part, const part_geom *g,
+                              const target *t, int nt, const obs_limits *lim,
+                              char err[OBS_ERR_LEN])
+{
+    part_job j = {.ctx = ctx, .part = part, .g = g, .t = t, .nt = nt, .st = OBS_OK};
+    pthread_t tid[OBS_MAX_DECODE_THREADS];
+    int started = 0;
+    exr_result_t rv;
+
+    if (!g->tiled) {
+        if ((rv = exr_get_scanlines_per_chunk(ctx, part, &j.lines)) != EXR_ERR_SUCCESS || j.lines < 1)
+            return obs__exr_fail(err, rv ? rv : EXR_ERR_INVALID_ATTR, "scanlines per chunk");
+        j.chunks = ((int64_t)g->height + j.lines - 1) / j.lines;
+    } else {
+        exr_tile_level_mode_t level;
+        exr_tile_round_mode_t round;
+        rv = exr_get_tile_descriptor(ctx, part, &j.tw, &j.th, &level, &round);
+        if (rv != EXR_ERR_SUCCESS || j.tw == 0 || j.th == 0)
+            return obs__exr_fail(err, rv ? rv : EXR_ERR_INVALID_ATTR, "tile description");
+        j.ntx = ((int64_t)g->width + j.tw - 1) / j.tw;
+        j.chunks = j.ntx * (((int64_t)g->height + j.th - 1) / j.th);
+    }
+    j.failed = j.chunks;
+    atomic_init(&j.next, 0);
+    atomic_init(&j.stop, 0);
+    if (pthread_mutex_init(&j.lock, NULL) != 0)
+        return obs__fail(err, OBS_NO_MEMORY, "decode lock");
+
+    /* This thread decodes too; threads that fail to start are not needed. */
+    int threads = decode_threads(lim, j.chunks);
+    while (started < threads - 1 && pthread_create(&tid[started], NULL, decode_worker, &j) == 0)
+        started++;
+    decode_worker(&j);
+    for (int i = 0; i < started; i++)
+        pthread_join(tid[i], NULL);
+    pthread_mutex_destroy(&j.lock);
+    if (j.st != OBS_OK)
+        memcpy(err, j.err, OBS_ERR_LEN);
+    return j.st;
+}
+
+/* ---- camera ------------------------------------------------------------- */
+
+/* A finite m44f or m44d attribute, as floats in the file's order. */
+static int header_m44(exr_const_context_t ctx, int part, const char *name, float m[16])
+{
+    const exr_attribute_t *a = NULL;
+    if (exr_get_attribute_by_name(ctx, part, name, &a) != EXR_ERR_SUCCESS || !a)
+        return 0;
+    for (int i = 0; i < 16; i++) {
+        if (a->type == EXR_ATTR_M44F && a->m44f)
+            m[i] = a->m44f->m[i];
+        else if (a->type == EXR_ATTR_M44D && a->m44d)
+            m[i] = (float)a->m44d->m[i];
+        else
+            return 0;
+        if (!isfinite(m[i]))
+            return 0;
+    }
+    return 1;
+}
+
+/* OpenEXR's camera attributes in our conventions.  Imath matrices are
+ * row-vector (p' = p M), camera space is left-handed with +Z forward, and
+ * worldToNDC maps to (0,0) top-left .. (1,1) bottom-right of the display
+ * window after dividing by w.  Ours are column-vector, right-handed with
+ * -Z forward, and the projection is OpenGL clip space.  With
+ * F = diag(1,1,-1,1), Mc = wtc^T, Nc = ndc^T:
+ *   world_to_camera = F Mc
+ *   Q = Nc Mc^-1 F        (our camera space -> homogeneous EXR NDC q)
+ *   x_clip = 2 q_x - q_w,  y_clip = q_w - 2 q_y,  w_clip = q_w
+ * and the z row, which EXR leaves undefined, is OpenGL's for
+ * EXR_NEAR..EXR_FAR.  obs_exr_write() does the inverse. */
+static void camera_from_exr(const float wtc[16], const float *ndc, obs_camera *cam)
+{
+    static const float F[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1};
+    float mc[16], inv[16], nc[16], q[16];
+    const float n = EXR_NEAR, f = EXR_FAR;
+
+    memset(cam, 0, sizeof *cam);
+    obs__mat4_transpose(wtc, mc);
+    if (obs__mat4_invert(mc, inv) != 0)
+        return; /* no camera maps the world onto a plane */
+    obs__mat4_mul(F, mc, cam->world_to_camera);
+    obs__mat4_identity(cam->projection);
+    cam->has_world_to_camera = 1;
+    cam->source = OBS_CAMERA_EXR_HEADER;
+    if (!ndc)
+        return;
+    obs__mat4_transpose(ndc, nc);
+    obs__mat4_mul(nc, inv, q);
+    obs__mat4_mul(q, F, q);
+
+    /* Scale q (a homogeneous quantity) so that w_clip is -z for a
+     * perspective camera and 1 for an orthographic one. */
+    const float *w = q + 12;
+    double eps = 1e-6 * (fabs(w[0]) + fabs(w[1]) + fabs(w[2]) + fabs(w[3]));
+    int flat_xy = fabs(w[0]) <= eps && fabs(w[1]) <= eps;
+    int persp = flat_xy && fabs(w[3]) <= eps && w[2] != 0.0f;
+    double s = persp ? -w[2] : flat_xy && fabs(w[2]) <= eps && w[3] != 0.0f ? w[3] : 1.0;
+    for (int i = 0; i < 16; i++)
+        q[i] = (float)(q[i] / s);
+
+    float *p = cam->projection;
+    for (int j = 0; j < 4; j++) {
+        p[0 + j] = 2.0f * q[0 + j] - q[12 + j];
+        p[4 + j] = q[12 + j] - 2.0f * q[4 + j];
+        p[8 + j] = 0.0f;
+        p[12 + j] = q[12 + j];
+    }
+    p[10] = persp ? -(f + n) / (f - n) : -2.0f / (f - n);
+    p[11] = persp ? -2.0f * f * n / (f - n) : -(f + n) / (f - n);
+    cam->has_projection = 1;
+}
+
+void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam)
+{
+    float wtc[16], ndc[16];
+    memset(cam, 0, sizeof *cam);
+    if (header_m44(ctx, part, "worldToCamera", wtc))
+        camera_from_exr(wtc, header_m44(ctx, part, "worldToNDC", ndc) ? ndc : NULL, cam);
+    obs__exr_msg_reset(); /* a missing attribute is not an error */
+}
+
+/* ---- G-buffer ----------------------------------------------------------- */
+
+/* The first part holding the mapped depth.  When none does, the message
+ * lists the channels of every part. */
+static obs_status find_part(exr_const_context_t ctx, int parts, const obs_channel_map *map,
+                            int *part, obs__channel_match *m, const char ***names,
+                            char err[OBS_ERR_LEN])
+{
+    const char **all = NULL, **pn = NULL;
+    int nall = 0, n = 0;
+    obs_status st = OBS_OK;
+    char perr[OBS_ERR_LEN] = "", first_err[OBS_ERR_LEN] = "";
+
+    for (int p = 0; p < parts; p++) {
+        if ((st = part_names(ctx, p, &pn, &n, err)) != OBS_OK)
+            goto fail;
+        if ((st = obs__channel_map_resolve(map, pn, n, m, perr)) == OBS_OK) {
+            *part = p;
+            *names = pn;
+            pn = NULL;
+            goto fail;
+        }
+        if (st != OBS_MISSING_CHANNEL) {
+            obs__fail(err, st, "%s", perr);
+            goto fail;
+        }
+        if (p == 0)
+            memcpy(first_err, perr, sizeof perr);
+        const char **grown = realloc(all, ((size_t)nall + (size_t)n + 1) * sizeof *all);
+        if (!grown) {
+            st = obs__fail(err, OBS_NO_MEMORY, "channel list");
+            goto fail;
+        }
+        all = grown;
+        memcpy(all + nall, pn, (size_t)n * sizeof *pn);
+        nall += n;
+        free(pn);
+        pn = NULL;
+    }
+    /* Resolving against the union gives one message naming every part's
+     * channels; should that succeed (channels split across parts), part
+     * 0's message stands. */
+    st = OBS_MISSING_CHANNEL;
+    if (parts <= 1 || obs__channel_map_resolve(map, all, nall, m, err) != OBS_MISSING_CHANNEL)
+        obs__fail(err, st, "%s", first_err);
+fail:
+    free(pn);
+    free(all);
+    return st;
+}
+
+static void copy_name(char *dst, size_t len, const char *const *names, int idx)
+{
+    snprintf(dst, len, "%s", idx >= 0 ? names[idx] : "");
+}
+
+static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_channel_map *map,
+                               const obs_limits *lim, obs_gbuffer_file *out,
+                               char err[OBS_ERR_LEN])
+{
+    const char **names = NULL;
+    obs__channel_match m;
+    part_geom g;
+    int parts = 0, part = 0;
+    exr_result_t rv;
+    obs_status st;
+
+    if ((rv = exr_get_count(ctx, &parts)) != EXR_ERR_SUCCESS || parts < 1) {
+        st = obs__exr_fail(err, rv ? rv : EXR_ERR_FILE_BAD_HEADER, "part count");
+        goto fail;
+    }
+    if ((st = find_part(ctx, parts, map, &part, &m, &names, err)) != OBS_OK)
+        goto fail;
+    if ((st = check_part(ctx, part, file_size, lim, &g, err)) != OBS_OK)
+        goto fail;
+
+    /* Planes: depth (1), normal (3), colour (4), in one allocation. */
+    int has_n = m.normal[0] >= 0, has_c = m.color[0] >= 0;
+    size_t px = (size_t)g.width * (size_t)g.height, bytes;
+    if (obs__size_mul3((size_t)g.width, (size_t)g.height,
+                       (size_t)(1 + 3 * has_n + 4 * has_c) * sizeof(float), &bytes) != 0) {
+        st = obs__fail(err, OBS_TOO_LARGE, "G-buffer of %dx%d does not fit in memory", g.width, g.height);
+        goto fail;
+    }
+    if (!(out->storage = calloc(1, bytes))) {
+        st = obs__fail(err, OBS_NO_MEMORY, "G-buffer of %dx%d", g.width, g.height);
+        goto fail;
+    }
+    float *depth = out->storage, *normal = has_n ? depth + px : NULL;
+    float *color = has_c ? depth + px * (1 + 3 * has_n) : NULL;
+    target t[8];
+    int nt = 0;
+    t[nt++] = (target){names[m.depth], depth, 1};
+    for (int i = 0; has_n && i < 3; i++)
+        t[nt++] = (target){names[m.normal[i]], normal + i, 3};
+    for (int i = 0; has_c && i < 4; i++)
+        if (m.color[i] >= 0)
+            t[nt++] = (target){names[m.color[i]], color + i, 4};
+    if (has_c && m.color[3] < 0) /* colour without alpha is opaque */
+        for (size_t i = 0; i < px; i++)
+            color[i * 4 + 3] = 1.0f;
+    if ((st = decode_part(ctx, part, &g, t, nt, lim, err)) != OBS_OK)
+        goto fail;
+
+    obs_gbuffer *gb = &out->gb;
+    gb->width = g.width;
+    gb->height = g.height;
+    gb->display_x = (int)((int64_t)g.dw.min.x - g.disp.min.x);
+    gb->display_y = (int)((int64_t)g.dw.min.y - g.disp.min.y);
+    gb->display_width = (int)((int64_t)g.disp.max.x - g.disp.min.x + 1);
+    gb->display_height = (int)((int64_t)g.disp.max.y - g.disp.min.y + 1);
+    gb->depth = (obs_plane){depth, 1, 0};
+    gb->normal = (obs_plane){normal, has_n ? 3 : 0, 0};
+    gb->color = (obs_plane){color, has_c ? 4 : 0, 0};
+    obs__exr_read_camera(ctx, part, &gb->camera);
+
+    obs_exr_info *info = &out->info;
+    info->part = part;
+    info->part_count = parts;
+    info->tiled = g.tiled;
+    info->compression = compression_name(g.compression, 0);
+    copy_name(info->depth, sizeof info->depth, names, m.depth);
+    for (int i = 0; i < 3; i++)
+        copy_name(info->normal[i], sizeof info->normal[i], names, m.normal[i]);
+    for (int i = 0; i < 4; i++)
+        copy_name(info->color[i], sizeof info->color[i], names, m.color[i]);
+    snprintf(info->preset, sizeof info->preset, "%s", m.preset);
+    st = OBS_OK;
+fail:
+    free(names);
+    return st;
+}
+
+/* Shared by the file and memory readers; `label` prefixes messages. */
+static obs_status read_any(const char *label, const char *path, const mem_src *mem,
+                           const obs_channel_map *map, const obs_limits *lim,
+                           obs_gbuffer_file *out, char err[OBS_ERR_LEN])
+{
+    char sub[OBS_ERR_LEN] = "";
+    exr_context_t ctx = NULL;
+    int64_t size;
+    obs_status st;
+
+    if (!out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
+    memset(out, 0, sizeof *out);
+    if ((st = obs__exr_open(path, mem, &ctx, &size, sub)) != OBS_OK)
+        goto fail;
+    st = read_gbuffer(ctx, size, map, lim, out, sub);
+fail:
+    if (ctx)
+        exr_finish(&ctx);
+    if (st != OBS_OK) {
+        obs_gbuffer_free(out);
+        obs__fail(err, st, "%s: %s", label, sub);
+    }
+    return st;
+}
+
+obs_status obs_gbuffer_read_exr(const char *path, const obs_channel_map *map,
+                                const obs_limits *lim, obs_gbuffer_file *out,
+                                char err[OBS_ERR_LEN])
+{
+    if (!path || !*path)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no EXR path given");
+    return read_any(path, path, NULL, map, lim, out, err);
+}
+
+obs_status obs_gbuffer_read_exr_mem(const void *buf, size_t len, const obs_channel_map *map,
+                                    const obs_limits *lim, obs_gbuffer_file *out,
+                                    char err[OBS_ERR_LEN])
+{
+    mem_src mem = {buf, len};
+    if (!buf || len == 0)
+        return obs__fail(err, OBS_BAD_FILE, "EXR in memory: empty buffer");
+    return read_any("EXR in memory", NULL, &mem, map, lim, out, err);
+}
+
+void obs_gbuffer_free(obs_gbuffer_file *f)
+{
+    if (!f)
+        return;
+    free(f->storage);
+    memset(f, 0, sizeof *f);
+}
+
+/* ---- single channels and channel lists ---------------------------------- */
+
+obs_status obs_exr_read_channel(const char *path, const char *channel, const obs_limits *lim,
+                                obs_image *out, char err[OBS_ERR_LEN])
+{
+    char sub[OBS_ERR_LEN] = "";
+    exr_context_t ctx = NULL;
+    const char **names = NULL, **first = NULL; /* first: part 0's, for the message */
+    int64_t size;
+    int parts = 0, n = 0, nfirst = 0, found = -1;
+    part_geom g;
+    exr_result_t rv;
+    obs_status st;
+
+    if (!path || !channel || !out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_read_channel: NULL argument");
+    memset(out, 0, sizeof *out);
+    if ((st = obs__exr_open(path, NULL, &ctx, &size, sub)) != OBS_OK)
+        goto fail;
+    if ((rv = exr_get_count(ctx, &parts)) != EXR_ERR_SUCCESS) {
+        st = obs__exr_fail(sub, rv, "part count");
+        goto fail;
+    }
+    for (int p = 0; p < parts && found < 0; p++) {
+        if ((st = part_names(ctx, p, &names, &n, sub)) != OBS_OK)
+            goto fail;
+        for (int i = 0; i < n; i++)
+            if (strcmp(names[i], channel) == 0)
+                found = p;
+        if (p == 0) {
+            first = names;
+            nfirst = n;
+        } else {
+            free(names);
+        }
+        names = NULL;
+    }
+    if (found < 0) {
+        char list[OBS__LIST_CHARS + 32];
+        obs__list_names(first, nfirst, list, sizeof list);
+        st = obs__fail(sub, OBS_MISSING_CHANNEL, "channel '%.256s' not found; the file has: %s",
+                       channel, list);
+        goto fail;
+    }
+    if ((st = check_part(ctx, found, size, lim, &g, sub)) != OBS_OK)
+        goto fail;
+    /* check_part() bounded width x height by the limits. */
+    if (!(out->data = malloc((size_t)g.width * (size_t)g.height * sizeof(float)))) {
+        st = obs__fail(sub, OBS_NO_MEMORY, "channel of %dx%d", g.width, g.height);
+        goto fail;
+    }
+    target t = {channel, out->data, 1};
+    if ((st = decode_part(ctx, found, &g, &t, 1, lim, sub)) != OBS_OK)
+        goto fail;
+    out->width = g.width;
+    out->height = g.height;
+    out->channels = 1;
+fail:
+    free(names);
+    free(first);
+    if (ctx)
+        exr_finish(&ctx);
+    if (st != OBS_OK) {
+        obs_image_free(out);
+        obs__fail(err, st, "%s: %s", path, sub);
+    }
+    return st;
+}
+
+obs_status obs_exr_list_channels(const char *path, char ***names_out, char err[OBS_ERR_LEN])
+{
+    char sub[OBS_ERR_LEN] = "";
+    exr_context_t ctx = NULL;
+    const char **names = NULL;
+    char **v = NULL;
+    int64_t size;
+    int n = 0;
+    obs_status st;
+
+    if (!path || !names_out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_list_channels: NULL argument");
+    *names_out = NULL;
+    if ((st = obs__exr_open(path, NULL, &ctx, &size, sub)) != OBS_OK)
+        goto fail;
+    if ((st = part_names(ctx, 0, &names, &n, sub)) != OBS_OK)
+        goto fail;
+    if (!(v = calloc((size_t)n + 1, sizeof *v))) {
+        st = obs__fail(sub, OBS_NO_MEMORY, "list of %d channel names", n);
+        goto fail;
+    }
+    for (int i = 0; i < n; i++)
+        if (!(v[i] = strdup(names[i]))) {
+            st = obs__fail(sub, OBS_NO_MEMORY, "channel name");
+            goto fail;
+        }
+    *names_out = v;
+    v = NULL;
+fail:
+    obs_strv_free(v);
+    free(names);
+    if (ctx)
+        exr_finish(&ctx);
+    if (st != OBS_OK)
+        obs__fail(err, st, "%s: %s", path, sub);
+    return st;
+}
+
+void obs_strv_free(char **v)
+{
+    if (!v)
+        return;
+    for (char **p = v; *p; p++)
+        free(*p);
+    free(v);
+}

@@ -1,0 +1,164 @@
+/* PNG output through libpng: 8 or 16 bit, grey, RGB or RGBA.  libpng
+ * reports errors by longjmp; they come back as a status, never a crash
+ * and never a line on stderr. */
+#include <errno.h>
+#include <math.h>
+#include <png.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "internal.h"
+#include "obscura/io.h"
+
+/* libpng states the cause of an error in a warning just before it. */
+typedef struct png_msgs {
+    char error[OBS_ERR_LEN];
+    char warning[200];
+} png_msgs;
+
+static void png_error_fn(png_structp png, png_const_charp msg)
+{
+    png_msgs *m = png_get_error_ptr(png);
+    snprintf(m->error, sizeof m->error, "libpng: %s%s%s%s", msg, m->warning[0] ? " (" : "",
+             m->warning, m->warning[0] ? ")" : "");
+    png_longjmp(png, 1);
+}
+
+static void png_warning_fn(png_structp png, png_const_charp msg)
+{
+    png_msgs *m = png_get_error_ptr(png);
+    snprintf(m->warning, sizeof m->warning, "%s", msg);
+}
+
+/* Linear [0,1] to the sRGB transfer curve (IEC 61966-2-1). */
+static double srgb_encode(double v)
+{
+    return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+}
+
+/* One row of float pixels to big-endian 8- or 16-bit samples. */
+static void convert_row(const float *src, unsigned char *dst, int width, int channels,
+                        int bits, int srgb)
+{
+    const double max = bits == 16 ? 65535.0 : 255.0;
+    for (int i = 0; i < width * channels; i++) {
+        double v = src[i];
+        v = v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0; /* NaN becomes 0 too */
+        /* Colour channels only: grey (AO) and alpha stay linear. */
+        if (srgb && channels >= 3 && i % channels < 3)
+            v = srgb_encode(v);
+        unsigned q = (unsigned)lrint(v * max);
+        if (bits == 16) {
+            dst[2 * i] = (unsigned char)(q >> 8);
+            dst[2 * i + 1] = (unsigned char)(q & 0xff);
+        } else {
+            dst[i] = (unsigned char)q;
+        }
+    }
+}
+
+/* libpng's write callbacks for the in-memory stream. */
+static void mem_write(png_structp png, png_bytep data, size_t len)
+{
+    obs__membuf *m = png_get_io_ptr(png);
+    if (obs__membuf_write(m, m->size, data, len) != 0)
+        png_error(png, "out of memory");
+}
+
+static void mem_flush(png_structp png)
+{
+    (void)png;
+}
+
+/* Writes to `path`, or into `mem` when it is non-NULL (`path` then only
+ * names the output in messages). */
+static obs_status write_png(const char *path, obs__membuf *mem, const obs_image *img, int bits,
+                            int srgb, char err[OBS_ERR_LEN])
+{
+    png_msgs msgs = {"", ""};
+    char *const msg = msgs.error; /* what obs__fail() fills on our own errors */
+    /* Written between setjmp and a possible longjmp, hence volatile. */
+    FILE *volatile fp = NULL;
+    unsigned char *volatile row = NULL;
+    png_structp png = NULL;
+    png_infop info = NULL;
+    volatile obs_status st = OBS_OK;
+    size_t rowbytes;
+    struct stat sb;
+
+    if (!path || !*path || !img || !img->data)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_png_write: no path or image");
+    if (bits != 8 && bits != 16)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: PNG bit depth must be 8 or 16, not %d", path, bits);
+    if (img->channels != 1 && img->channels != 3 && img->channels != 4)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: PNG needs 1, 3 or 4 channels, not %d", path,
+                         img->channels);
+    if (img->width <= 0 || img->height <= 0 || img->width > 0x7fffffff / 8)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: image size %dx%d", path, img->width, img->height);
+    if (obs__size_mul3((size_t)img->width, (size_t)img->channels, (size_t)bits / 8, &rowbytes) != 0 ||
+        !(row = malloc(rowbytes)))
+        return obs__fail(err, OBS_NO_MEMORY, "%s: row of %d pixels", path, img->width);
+    if (!mem && !(fp = fopen(path, "wb"))) {
+        st = obs__fail(msg, OBS_IO, "cannot create: %s", strerror(errno));
+        goto fail;
+    }
+    png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &msgs, png_error_fn, png_warning_fn);
+    if (!png || !(info = png_create_info_struct(png))) {
+        st = obs__fail(msg, OBS_NO_MEMORY, "libpng could not start");
+        goto fail;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        st = OBS_IO; /* msgs was filled by png_error_fn */
+        goto fail;
+    }
+    static const int types[] = {0, PNG_COLOR_TYPE_GRAY, 0, PNG_COLOR_TYPE_RGB, PNG_COLOR_TYPE_RGB_ALPHA};
+    if (mem)
+        png_set_write_fn(png, mem, mem_write, mem_flush);
+    else
+        png_init_io(png, fp);
+    png_set_IHDR(png, info, (png_uint_32)img->width, (png_uint_32)img->height, bits,
+                 types[img->channels], PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
+    if (srgb && img->channels >= 3)
+        png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (int y = 0; y < img->height; y++) {
+        const float *src = img->data + (size_t)y * (size_t)img->width * (size_t)img->channels;
+        convert_row(src, row, img->width, img->channels, bits, srgb);
+        png_write_row(png, row);
+    }
+    png_write_end(png, info);
+fail:
+    png_destroy_write_struct(&png, &info);
+    if (fp && fclose(fp) != 0 && st == OBS_OK)
+        st = obs__fail(msg, OBS_IO, "closing: %s", strerror(errno));
+    free(row);
+    if (st == OBS_OK)
+        return OBS_OK;
+    /* No truncated PNG left behind; devices and pipes are not ours. */
+    if (fp && stat(path, &sb) == 0 && S_ISREG(sb.st_mode))
+        remove(path);
+    return obs__fail(err, st, "%s: %s", path, msg);
+}
+
+obs_status obs_png_write(const char *path, const obs_image *img, int bits, int srgb,
+                         char err[OBS_ERR_LEN])
+{
+    return write_png(path, NULL, img, bits, srgb, err);
+}
+
+obs_status obs_png_write_mem(const obs_image *img, int bits, int srgb, obs_bytes *out,
+                             char err[OBS_ERR_LEN])
+{
+    obs__membuf mem = {0};
+    if (!out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_png_write_mem: no output");
+    *out = (obs_bytes){0};
+    obs_status st = write_png("(memory)", &mem, img, bits, srgb, err);
+    if (st == OBS_OK)
+        obs__membuf_take(&mem, out);
+    free(mem.data);
+    return st;
+}

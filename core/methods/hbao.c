@@ -1,0 +1,89 @@
+/* Method hbao: horizon-based ambient occlusion (Bavoil, Sainz, Dimitrov,
+ * "Image-space horizon-based ambient occlusion", SIGGRAPH 2008 talk; the
+ * baseline of shared/papers/oitao-abuffer-ssao.txt).  The CPU twin of
+ * hbao.glsl.
+ *
+ * HBAO integrates, over the directions theta around the view axis, the
+ * occlusion between the tangent plane and the horizon:
+ *   AO = 1 - 1/(2 pi) Int (sin h(theta) - sin t(theta)) W(theta) dtheta,
+ * t(theta) the elevation of the tangent in direction theta (plus an angle
+ * bias against the self-occlusion of tessellated surfaces), h(theta) the
+ * horizon elevation found by ray marching the depth buffer in screen
+ * space.  With per-sample attenuation each step that raises the horizon
+ * adds W(r_i) (sin h_i - sin h_(i-1)), W(r) = 1 - r^2 / R^2, r the
+ * distance of the sample; samples at r >= R are left out.  Nd directions
+ * (the 3x3 tile's rotation as the jitter), Ns steps of R_px / (Ns + 1)
+ * pixels each, R_px the radius projected at p (at most R_px steps). */
+#include <math.h>
+
+#include "chain/frame.h"
+
+/* R projected at p in pixels (the square root of the projected area of a
+ * disk of radius R perpendicular to the view axis, as obs__adaptive_count
+ * measures it); 0 behind the camera. */
+static float radius_px(const obs__frame *f, const float p[3])
+{
+    const float *P = f->proj;
+    float w = P[12] * p[0] + P[13] * p[1] + P[14] * p[2] + P[15];
+    if (!(w > 0.0f))
+        return 0.0f;
+    float X = P[0] * p[0] + P[1] * p[1] + P[2] * p[2] + P[3];
+    float Y = P[4] * p[0] + P[5] * p[1] + P[6] * p[2] + P[7];
+    float w2 = w * w;
+    float j00 = (P[0] * w - X * P[12]) / w2, j01 = (P[1] * w - X * P[13]) / w2;
+    float j10 = (P[4] * w - Y * P[12]) / w2, j11 = (P[5] * w - Y * P[13]) / w2;
+    return f->radius * sqrtf(fabsf(j00 * j11 - j01 * j10) * f->viewport[2] * f->viewport[3] * 0.25f);
+}
+
+/* GLSL: hbao_ao() in hbao.glsl */
+float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                      const float n[3], int *count)
+{
+    const float R = f->radius, R2 = R * R;
+    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    float rpx = radius_px(f, p);
+    if (count)
+        *count = 0;
+    if (!(rpx >= 1.0f))
+        return 1.0f; /* the kernel reaches no other pixel */
+    int ns = f->hbao_steps < (int)rpx ? f->hbao_steps : (int)rpx;
+    float step = rpx / (float)(ns + 1); /* the farthest sample is not fully attenuated */
+    float ao = 0.0f;
+    int taken = 0;
+    for (int d = 0; d < f->hbao_dirs; d++) {
+        const float *e = f->hbao_dir[d];
+        float dx = rot[0] * e[0] - rot[1] * e[1], dy = rot[1] * e[0] + rot[0] * e[1];
+        /* t(theta): the tangent (n . T = 0, T.xy = (dx, dy)) rises by
+         * -(n.x dx + n.y dy) / n.z per unit; its sine and cosine, then
+         * t + bias by the angle sum (sin 1 from t + bias >= pi/2 on). */
+        float nd = n[0] * dx + n[1] * dy, nz = fmaxf(n[2], 0.0f);
+        float l = sqrtf(nd * nd + nz * nz);
+        float st = l > 0.0f ? -nd / l : 0.0f, ct = l > 0.0f ? nz / l : 1.0f;
+        float sin_h = st * f->hbao_bias_cs[0] + ct * f->hbao_bias_cs[1];
+        if (ct * f->hbao_bias_cs[0] - st * f->hbao_bias_cs[1] < 0.0f)
+            sin_h = 1.0f;
+        for (int j = 1; j <= ns; j++) {
+            /* screen y runs down, view y up */
+            int qx = x + (int)floorf(dx * step * (float)j + 0.5f);
+            int qy = y + (int)floorf(-dy * step * (float)j + 0.5f);
+            if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height)
+                break;
+            taken++;
+            const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+            if (!(q[3] > 0.0f))
+                continue;
+            float v[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+            float r2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            if (!(r2 < R2) || !(r2 > 0.0f))
+                continue;
+            float sin_s = v[2] / sqrtf(r2); /* elevation of the sample: view +z faces the camera */
+            if (sin_s > sin_h) {
+                ao += (1.0f - r2 / R2) * (sin_s - sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
+                sin_h = sin_s;
+            }
+        }
+    }
+    if (count)
+        *count = taken;
+    return fmaxf(0.0f, 1.0f - ao / (float)f->hbao_dirs);
+}

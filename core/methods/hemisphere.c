@@ -1,0 +1,95 @@
+/* Method hemisphere: the conventional normal-oriented hemisphere SSAO
+ * (Mittring's Crytek SSAO with its sphere kernel turned into a hemisphere
+ * around the normal; the kind Unity's post-processing stack ships, whose
+ * quality levels take 3, 6, 10 and 16 samples, VAO++ Table 2).  Each
+ * sample is a point of the hemisphere of radius R (the AO distance) on
+ * the surface; it is occluded when the depth buffer holds a surface more
+ * than the bias in front of it, weighted by a range check so that a
+ * surface far in front does not count.  The CPU twin of hemisphere.glsl. */
+#include <math.h>
+
+#include "chain/frame.h"
+
+/* Radical inverse of i in base b: the van der Corput sequence. */
+static double radical_inverse(unsigned i, unsigned b)
+{
+    double inv = 1.0 / b, f = inv, r = 0.0;
+    for (; i; i /= b, f *= inv)
+        r += f * (double)(i % b);
+    return r;
+}
+
+/* Sample i of n: a direction of the unit hemisphere around +z, uniform in
+ * solid angle (cos of the polar angle from the base-2, azimuth from the
+ * base-3 radical inverse: a Halton set instead of the random kernel, so
+ * GL and C use the same one), at the distance sqrt((i + 1) / n) of the
+ * radius, the distribution of Unity's post-processing stack ("distributed
+ * between [0, radius]": more samples near the point). */
+void obs__hemisphere_kernel(int n, float *out)
+{
+    for (int i = 0; i < n && i < OBS__MAX_HEMISPHERE; i++) {
+        double c = fmin(1.0, radical_inverse((unsigned)i, 2) + 0.5 / n);
+        double s = sqrt(fmax(0.0, 1.0 - c * c));
+        double phi = 2.0 * M_PI * radical_inverse((unsigned)i, 3);
+        double l = sqrt((i + 1.0) / n);
+        out[3 * i] = (float)(l * s * cos(phi));
+        out[3 * i + 1] = (float)(l * s * sin(phi));
+        out[3 * i + 2] = (float)(l * c);
+    }
+}
+
+void obs__hemisphere_basis(const float n[3], float t1[3], float t2[3])
+{
+    /* The tangent frame of n (Duff et al., "Building an orthonormal
+     * basis, revisited", 2017): the kernel's +z goes to n. */
+    float sg = n[2] >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (sg + n[2]), b = n[0] * n[1] * a;
+    t1[0] = 1.0f + sg * n[0] * n[0] * a;
+    t1[1] = sg * b;
+    t1[2] = -sg * n[0];
+    t2[0] = b;
+    t2[1] = sg + n[1] * n[1] * a;
+    t2[2] = -n[1];
+}
+
+void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3], const float n[3],
+                            const float t1[3], const float t2[3], int i, float s[3])
+{
+    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    const float *k = f->hs_kernel[i];
+    /* the 3x3 tile's rotation about the normal (interleaved sampling,
+     * removed by the shared blur as for VAO++) */
+    float kx = rot[0] * k[0] - rot[1] * k[1], ky = rot[1] * k[0] + rot[0] * k[1];
+    for (int j = 0; j < 3; j++)
+        s[j] = p[j] + f->radius * (kx * t1[j] + ky * t2[j] + k[2] * n[j]);
+}
+
+/* GLSL: hemisphere_ao() in hemisphere.glsl */
+float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                            const float n[3])
+{
+    const float R = f->radius;
+    float t1[3], t2[3];
+    obs__hemisphere_basis(n, t1, t2);
+    float occ = 0.0f;
+    for (int i = 0; i < f->hs_count; i++) {
+        float s[3];
+        obs__hemisphere_sample(f, x, y, p, n, t1, t2, i, s);
+        int qx, qy;
+        if (!obs__view_to_px(f, s, &qx, &qy))
+            continue;
+        float zq = pos[4 * ((size_t)qy * (size_t)f->width + (size_t)qx) + 3];
+        if (!(zq > 0.0f))
+            continue; /* background never occludes */
+        /* Occluded: the depth buffer holds a surface in front of the
+         * sample (planar depths, -s.z for the sample), past the bias. */
+        if (zq <= -s[2] - f->hs_bias) {
+            /* Range check: smoothstep(0, 1, R / |z_p - z_q|), a surface
+             * much nearer than R counts fully, one far in front fades. */
+            float dz = fabsf(-p[2] - zq);
+            float r = dz > R ? R / dz : 1.0f;
+            occ += r * r * (3.0f - 2.0f * r);
+        }
+    }
+    return f->hs_count > 0 ? 1.0f - occ / (float)f->hs_count : 1.0f;
+}

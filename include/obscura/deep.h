@@ -1,0 +1,162 @@
+/* Deep (A-buffer) input and multi-layer ambient occlusion.
+ *
+ * A deep scanline EXR holds, per pixel, a list of samples (fragments):
+ * depth Z (and ZBack), alpha A, premultiplied colour R, G, B and, when a
+ * renderer wrote them, normals.  obscura reads them into a per-pixel
+ * A-buffer, compresses each pixel's list to m nodes (OITAO, Bauer et al.,
+ * section III-B, eq 5) and computes multi-layer, opacity-based AO over the
+ * compressed layers (OITAO Algorithm 1, eqs 1-4) with VAO++'s volumetric
+ * estimator (section 3, depth range check of 4.4) as the per-sample
+ * occlusion, or with method hemisphere the normal-oriented hemisphere
+ * kernel's point samples.  See README.md, "Deep input". */
+#ifndef OBSCURA_DEEP_H
+#define OBSCURA_DEEP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "obscura/io.h"
+#include "obscura/obscura.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The values of one deep sample, in this order. */
+enum {
+    OBS_DEEP_Z,     /* front depth (planar, as the depth_mode parameter says) */
+    OBS_DEEP_ZBACK, /* back depth (= Z when the file has no ZBack) */
+    OBS_DEEP_R,     /* colour, premultiplied by alpha as OpenEXR's deep data is */
+    OBS_DEEP_G,
+    OBS_DEEP_B,
+    OBS_DEEP_A,     /* opacity (1 when the file has no A) */
+    OBS_DEEP_NX,    /* normal (0 when the file has none) */
+    OBS_DEEP_NY,
+    OBS_DEEP_NZ,
+    OBS_DEEP_CH     /* floats per sample */
+};
+
+/* Most samples one pixel may hold, and in all (each is OBS_DEEP_CH
+ * floats); a file asking for more is refused before allocation. */
+#define OBS_DEEP_MAX_PER_PIXEL 65536
+#define OBS_DEEP_MAX_SAMPLES ((uint64_t)1 << 25)
+
+/* A per-pixel A-buffer.  Pixel i = y * width + x holds the samples
+ * offset[i] .. offset[i + 1] - 1, sorted by Z front to back (ties keep the
+ * file's order). */
+typedef struct obs_deep_image {
+    int width, height;                 /* the data window */
+    int display_x, display_y;          /* as in obs_gbuffer */
+    int display_width, display_height;
+    uint64_t *offset;                  /* width * height + 1 entries */
+    float *samples;                    /* offset[width * height] samples */
+    int has_zback, has_alpha, has_color, has_normal;
+    obs_camera camera;                 /* from worldToCamera/worldToNDC, if any */
+    int part;                          /* the part read */
+} obs_deep_image;
+
+/* 1 when the file's first deep part is deep data (scanline or tiled),
+ * 0 when it has none; an unreadable file is an error. */
+obs_status obs_exr_is_deep(const char *path, int *deep, char err[OBS_ERR_LEN]);
+/* The same for an EXR in memory (a request body). */
+obs_status obs_exr_is_deep_mem(const void *buf, size_t len, int *deep, char err[OBS_ERR_LEN]);
+
+/* Reads the first deep scanline part of an EXR: a pass over the sample
+ * count tables (checked: non-negative, cumulative per scanline, within
+ * OBS_DEEP_MAX_* and the chunk's size) before any sample memory is
+ * allocated, then the samples.  Channels by name: Z (required), ZBack,
+ * A, R, G, B, and N.X/N.Y/N.Z (or N.R/N.G/N.B).  Caller frees with
+ * obs_deep_free(). */
+obs_status obs_deep_read_exr(const char *path, const obs_limits *lim, obs_deep_image *out,
+                             char err[OBS_ERR_LEN]);
+obs_status obs_deep_read_exr_mem(const void *buf, size_t len, const obs_limits *lim,
+                                 obs_deep_image *out, char err[OBS_ERR_LEN]);
+
+/* Frees and zeroes; NULL-safe. */
+void obs_deep_free(obs_deep_image *d);
+
+/* Writes a deep scanline EXR (ZIPS, float channels): Z always, ZBack, A,
+ * R, G, B and N.X/N.Y/N.Z as d->has_* say (the names obs_deep_read_exr()
+ * reads), the camera as worldToCamera/worldToNDC when d->camera has one.
+ * Samples are written in their order (front to back).  Through OpenEXR's
+ * C++ library (core/io/exr_deep_write.cpp).  Fails with OBS_IO when the
+ * file cannot be written. */
+obs_status obs_deep_write_exr(const char *path, const obs_deep_image *d, char err[OBS_ERR_LEN]);
+
+/* Values of the parameters deep_mode and deep_hull (params.h). */
+enum { OBS_DEEP_MULTI = 1, OBS_DEEP_SINGLE = 2 };
+enum { OBS_DEEP_SOLID = 1, OBS_DEEP_THIN = 2 };
+
+/* ---- list compression (OITAO section III-B) ----------------------------- */
+
+/* At most this many nodes per pixel (parameter deep_layers). */
+#define OBS_DEEP_MAX_LAYERS 8
+
+/* One node of a compressed list: OBS_DEEP_CH values of a sample; an empty
+ * node has Z = 0 and A = 0 (background). */
+typedef struct obs_deep_layers {
+    int width, height, m;
+    float *node;   /* m planes, node k of pixel i at (k * width * height + i) * OBS_DEEP_CH */
+    int *count;    /* valid nodes per pixel, front to back from node 0 */
+    float zmin, zmax; /* the depth range normalised depth is taken over */
+} obs_deep_layers;
+
+/* Compresses one list (OITAO section III-B): the n samples (OBS_DEEP_CH
+ * floats each, in insertion order) are inserted by depth into an array of
+ * m nodes; once more than m were inserted the node j minimising
+ * a[j].alpha * (1 - a[j].z) (eq 5) is dropped, searched over every node or,
+ * with front_half, over the back half only (j >= m / 2).  z is the depth
+ * normalised to [0, 1] over zmin..zmax (see deep_compress.c).  Writes the
+ * kept nodes front to back to out (m * OBS_DEEP_CH floats) and returns
+ * their count. */
+int obs_deep_compress_list(const float *samples, int n, int m, int front_half, float zmin,
+                           float zmax, float *out);
+
+/* Compresses every pixel of a deep image to m nodes (1 <= m <=
+ * OBS_DEEP_MAX_LAYERS); m = 0 keeps up to OBS_DEEP_MAX_LAYERS front
+ * nodes unchanged when they fit (no eq 5 needed), i.e. the uncompressed
+ * reference for lists up to that length.  Caller frees with
+ * obs_deep_layers_free(). */
+obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs_deep_layers *out,
+                             char err[OBS_ERR_LEN]);
+void obs_deep_layers_free(obs_deep_layers *l);
+
+/* ---- multi-layer AO -------------------------------------------------------- */
+
+typedef struct obs_deep_result {
+    obs_image ao_front;  /* 1 channel: AO of the front node of each pixel */
+    obs_image ao_blend;  /* 1 channel: per-node AO blended front to back by
+                            alpha onto AO 1 (OITAO III, the separated scheme) */
+    obs_image composite; /* RGBA: the front-to-back "over" composite of
+                            every sample's colour, times ao_blend */
+} obs_deep_result;
+
+void obs_deep_result_free(obs_deep_result *r);
+
+/* The result's images as EXR layers, as `obscura ao`, the daemon and its
+ * clients write them: with OBS_OUTPUT_AO in `outputs`, AO.Y (ao_blend)
+ * and AOFront.Y (ao_front); with OBS_OUTPUT_COMPOSITE, R,G,B,A.  Returns
+ * how many (images the result does not hold are left out). */
+int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_exr_layer layers[3]);
+
+/* Multi-layer AO of the deep image on the CPU: compression to the
+ * parameters' deep_layers nodes, then OITAO Algorithm 1 with VAO++'s
+ * per-sample occlusion (methods vaopp, vao) or the hemisphere kernel's
+ * (method hemisphere) against every node (or the front one alone with
+ * deep_mode single), opacity-weighted (eq 1, or eqs 2-4 with deep_hull
+ * thin).  Other methods are refused (OBS_INVALID_ARGUMENT, naming the
+ * method).  The camera is the image's unless the parameters carry one. */
+obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
+                            obs_deep_result *out, char err[OBS_ERR_LEN]);
+
+/* The same on the GL context: the nodes go to 2D array textures and one
+ * fragment pass (core/shaders/deep.frag.glsl) computes the AO; the CPU
+ * functions above are its twin. */
+obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
+                        obs_deep_result *out, char err[OBS_ERR_LEN]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

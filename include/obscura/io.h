@@ -1,0 +1,168 @@
+/* Image I/O of libobscura: G-buffer EXR in (OpenEXR C API), EXR and PNG
+ * out, camera JSON.  No GL here; safe to call from any thread. */
+#ifndef OBSCURA_IO_H
+#define OBSCURA_IO_H
+
+#include <stddef.h>
+
+#include "obscura/obscura.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- channel map -------------------------------------------------------- */
+
+/* Which EXR channels hold depth, normal and colour.  A NULL/empty preset
+ * means "auto": try blender, then generic.  Explicit names override the
+ * preset's.  Channels are matched by name, never by position.
+ *
+ *   blender: depth ViewLayer.Depth.Z; normal ViewLayer.Normal.X/Y/Z;
+ *            colour ViewLayer.DiffCol.R/G/B, else ViewLayer.Combined.R/G/B/A
+ *   generic: depth Z (or depth.Z, Depth.Z); normal N.X/Y/Z or N.R/G/B
+ *            (or normal.X/Y/Z, Normal.X/Y/Z); colour R/G/B/A
+ */
+typedef struct obs_channel_map {
+    const char *preset;    /* "auto" (or NULL), "blender", "generic" */
+    const char *depth;     /* explicit channel names, NULL = from preset */
+    const char *normal[3];
+    const char *color[4];  /* color[3] (alpha) may be NULL */
+} obs_channel_map;
+
+/* Valid preset names, NULL-terminated. */
+extern const char *const obs_channel_presets[];
+
+/* What the reader found, for logs and errors. */
+typedef struct obs_exr_info {
+    int part;                  /* part index the channels were read from */
+    int part_count;
+    int tiled;
+    const char *compression;   /* "zip", "piz", ... (static string) */
+    char depth[64];            /* matched channel names ("" = absent) */
+    char normal[3][64];
+    char color[4][64];
+    char preset[16];           /* preset that matched ("explicit" if none) */
+} obs_exr_info;
+
+/* A G-buffer read from a file.  Frees with obs_gbuffer_free(). */
+typedef struct obs_gbuffer_file {
+    obs_gbuffer gb;    /* planes point into `storage` */
+    float *storage;
+    obs_exr_info info;
+} obs_gbuffer_file;
+
+/* Reads a G-buffer EXR (scanline or tiled, single or multipart, any
+ * compression OpenEXR's C API decodes).  Honours the data window: the
+ * G-buffer covers the data window.  The camera comes from the header's
+ * worldToCamera/worldToNDC attributes when present.  Every size is checked
+ * against `lim` (NULL = defaults) before anything is allocated.  The
+ * chunks of the part are decoded by lim->threads threads (see
+ * obs_limits); the result does not depend on the count. */
+obs_status obs_gbuffer_read_exr(const char *path, const obs_channel_map *map,
+                                const obs_limits *lim, obs_gbuffer_file *out,
+                                char err[OBS_ERR_LEN]);
+
+/* Same, from memory (the daemon reads request bodies this way).  `buf`
+ * must stay valid during the call only. */
+obs_status obs_gbuffer_read_exr_mem(const void *buf, size_t len,
+                                    const obs_channel_map *map,
+                                    const obs_limits *lim, obs_gbuffer_file *out,
+                                    char err[OBS_ERR_LEN]);
+
+/* Frees storage and zeroes *f; NULL-safe. */
+void obs_gbuffer_free(obs_gbuffer_file *f);
+
+/* Reads one named channel of an EXR (any part that holds it) as float32;
+ * for comparisons and tests.  Caller frees with obs_image_free(). */
+obs_status obs_exr_read_channel(const char *path, const char *channel,
+                                const obs_limits *lim, obs_image *out,
+                                char err[OBS_ERR_LEN]);
+
+/* Lists channel names of the first part into a newly allocated,
+ * NULL-terminated array; caller frees with obs_strv_free(). */
+obs_status obs_exr_list_channels(const char *path, char ***names,
+                                 char err[OBS_ERR_LEN]);
+void obs_strv_free(char **v);
+
+/* ---- output ------------------------------------------------------------ */
+
+typedef enum obs_exr_pixel {
+    OBS_EXR_HALF,  /* default */
+    OBS_EXR_FLOAT
+} obs_exr_pixel;
+
+/* One image to store in an EXR under the given channel names
+ * (names[c] for channel c of the image). */
+typedef struct obs_exr_layer {
+    const obs_image *image;
+    const char *const *names;
+} obs_exr_layer;
+
+/* The layers of a result under obscura's channel names, in this order:
+ * AO.Y; R,G,B,A (composite); Samples.Y (sample count); Cull.Y (culling
+ * mask); Bleed.R,G,B.  Fills `layers` with the images the result holds;
+ * returns how many. */
+#define OBS_RESULT_LAYERS 6
+int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_LAYERS]);
+
+/* Writes a scanline EXR (ZIP compression) holding every layer's channels;
+ * all images must have the same size.  When `cam` is non-NULL and has
+ * a world_to_camera, worldToCamera and worldToNDC are written. */
+obs_status obs_exr_write(const char *path, const obs_exr_layer *layers,
+                         int layer_count, obs_exr_pixel pixel,
+                         const obs_camera *cam, char err[OBS_ERR_LEN]);
+
+/* Writes an 8- or 16-bit PNG: 1 channel -> grey, 3 -> RGB, 4 -> RGBA.
+ * Values are clamped to [0,1]; with `srgb` colour channels are encoded with
+ * the sRGB transfer function (alpha and grey AO stay linear). */
+obs_status obs_png_write(const char *path, const obs_image *img, int bits,
+                         int srgb, char err[OBS_ERR_LEN]);
+
+/* ---- in-memory output (the daemon answers with these) ------------------ */
+
+/* Bytes owned by the library.  Caller frees with obs_bytes_free(). */
+typedef struct obs_bytes {
+    unsigned char *data; /* malloc'd; free() also releases it */
+    size_t size;
+} obs_bytes;
+
+/* Frees the bytes and zeroes the struct; NULL-safe. */
+void obs_bytes_free(obs_bytes *b);
+
+/* obs_exr_write() into memory: the same file, byte for byte.  On success
+ * *out holds the EXR; caller frees with obs_bytes_free(). */
+obs_status obs_exr_write_mem(const obs_exr_layer *layers, int layer_count,
+                             obs_exr_pixel pixel, const obs_camera *cam,
+                             obs_bytes *out, char err[OBS_ERR_LEN]);
+
+/* obs_png_write() into memory: the same file, byte for byte.  On success
+ * *out holds the PNG; caller frees with obs_bytes_free(). */
+obs_status obs_png_write_mem(const obs_image *img, int bits, int srgb,
+                             obs_bytes *out, char err[OBS_ERR_LEN]);
+
+/* ---- camera ------------------------------------------------------------ */
+
+/* Reads a camera JSON (width, height, fov_y_deg, near, far,
+ * world_to_camera, projection: 4x4 row-major, column-vector convention)
+ * into *cam.  `width`/`height` receive the JSON's image size (0 if
+ * absent); either may be NULL. */
+obs_status obs_camera_read_json(const char *path, obs_camera *cam, int *width,
+                                int *height, char err[OBS_ERR_LEN]);
+
+/* A perspective camera from a vertical field of view (degrees), the image
+ * aspect and clip range; world_to_camera is identity. */
+void obs_camera_from_fov(float fov_y_deg, float aspect, float near_z,
+                         float far_z, obs_camera *cam);
+
+/* Fits a centred perspective projection to an image of width x height:
+ * the vertical field of view stays, the horizontal one follows the aspect
+ * (x scale = y scale * height / width).  Returns 1 when it changed the
+ * projection, 0 when the projection is not a centred perspective (an
+ * off-centre or orthographic one is left as it is) or already fits. */
+int obs_camera_fit_aspect(obs_camera *cam, int width, int height);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,238 @@
+/* obscura: headless ambient occlusion (VAO / VAO++) on a live OpenGL context.
+ *
+ * The core library computes; it never prints and never exits.  Every
+ * function that can fail returns an obs_status and, where it takes one,
+ * fills a caller-owned `char err[OBS_ERR_LEN]` with a message naming what
+ * is wrong.  Logging goes through the callback installed on the context.
+ *
+ * Conventions (see README.md, "Input conventions"):
+ *   - images are row-major, row 0 at the top, as OpenEXR stores them;
+ *   - matrices are 4x4, row-major, column-vector convention
+ *     (p_cam = M * p_world), as the camera JSON writes them;
+ *   - view (camera) space is right-handed, the camera looks down -Z, +Y up;
+ *   - AO is 1 where a point is unoccluded, 0 where fully occluded.
+ */
+#ifndef OBSCURA_H
+#define OBSCURA_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "obscura/status.h"
+#include "obscura/params.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- logging ----------------------------------------------------------- */
+
+typedef enum obs_log_level {
+    OBS_LOG_ERROR,
+    OBS_LOG_WARN,
+    OBS_LOG_INFO,
+    OBS_LOG_DEBUG
+} obs_log_level;
+
+typedef void (*obs_log_fn)(void *user, obs_log_level level, const char *msg);
+
+/* ---- images and G-buffers ---------------------------------------------- */
+
+/* One plane of float32 pixels, `channels` interleaved per pixel.
+ * row_stride is in bytes; 0 means tightly packed. */
+typedef struct obs_plane {
+    const float *data;
+    int channels;
+    size_t row_stride;
+} obs_plane;
+
+/* Where the camera of a G-buffer came from. */
+typedef enum obs_camera_source {
+    OBS_CAMERA_NONE,
+    OBS_CAMERA_EXR_HEADER, /* worldToCamera / worldToNDC attributes */
+    OBS_CAMERA_JSON,       /* a camera JSON file */
+    OBS_CAMERA_PARAMS      /* fov_y / world_to_camera parameters */
+} obs_camera_source;
+
+typedef struct obs_camera {
+    float world_to_camera[16]; /* row-major, column-vector convention */
+    float projection[16];      /* OpenGL clip space, row-major */
+    int has_world_to_camera;   /* 0: world_to_camera is identity/unknown */
+    int has_projection;        /* 0: projection unknown */
+    obs_camera_source source;
+} obs_camera;
+
+/* A G-buffer: depth is required, normal (3 channels) and colour (4
+ * channels, RGBA) are optional (data == NULL).  All planes share
+ * width x height.
+ *
+ * The camera's projection covers the display window; the planes cover a
+ * rectangle of it whose top-left pixel is (display_x, display_y) (an EXR's
+ * data window).  display_width/height 0 mean "same as the planes". */
+typedef struct obs_gbuffer {
+    int width, height;
+    int display_x, display_y;
+    int display_width, display_height;
+    obs_plane depth;
+    obs_plane normal;
+    obs_plane color;
+    obs_camera camera;
+} obs_gbuffer;
+
+/* An image owned by the library: `channels` interleaved float32 values
+ * per pixel, tightly packed, row 0 at the top. */
+typedef struct obs_image {
+    int width, height, channels;
+    float *data;
+} obs_image;
+
+/* Frees the pixels and zeroes the struct; NULL-safe. */
+void obs_image_free(obs_image *img);
+
+/* ---- size limits ------------------------------------------------------- */
+
+typedef struct obs_limits {
+    int max_width;      /* 0 -> 16384 */
+    int max_height;     /* 0 -> 16384 */
+    uint64_t max_pixels; /* 0 -> max_width * max_height */
+    int threads;        /* EXR decode threads; 0 -> CPUs online, up to 8 (at
+                           most 64, and one for every 4 chunks of a part) */
+} obs_limits;
+
+/* Checks width x height against the limits (zeroed limits = defaults). */
+obs_status obs_check_size(const obs_limits *lim, int64_t width, int64_t height,
+                          char err[OBS_ERR_LEN]);
+
+/* ---- GL context -------------------------------------------------------- */
+
+typedef enum obs_backend {
+    OBS_BACKEND_AUTO,
+    OBS_BACKEND_EGL_DEVICE,
+    OBS_BACKEND_EGL_SURFACELESS,
+    OBS_BACKEND_OSMESA,
+    OBS_BACKEND_COUNT
+} obs_backend;
+
+/* "auto", "egl-device", "egl-surfaceless", "osmesa". */
+const char *obs_backend_name(obs_backend b);
+/* Parses a backend name; returns OBS_INVALID_ARGUMENT for unknown names. */
+obs_status obs_backend_parse(const char *name, obs_backend *out);
+
+typedef struct obs_ctx obs_ctx;
+
+typedef struct obs_ctx_desc {
+    obs_backend backend; /* AUTO tries egl-device, egl-surfaceless, osmesa */
+    int debug;           /* install a KHR_debug callback (logs GL messages) */
+    obs_log_fn log;      /* may be NULL */
+    void *log_user;
+} obs_ctx_desc;
+
+typedef struct obs_ctx_info {
+    obs_backend backend;
+    const char *gl_version; /* owned by the context */
+    const char *gl_vendor;
+    const char *gl_renderer;
+} obs_ctx_info;
+
+/* Creates the GL context and makes it current on the calling thread; only
+ * that thread may use the context afterwards.  Caller frees with
+ * obs_ctx_destroy(). */
+obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out,
+                          char err[OBS_ERR_LEN]);
+void obs_ctx_destroy(obs_ctx *ctx);
+void obs_ctx_get_info(const obs_ctx *ctx, obs_ctx_info *info);
+
+/* ---- running the AO chain ---------------------------------------------- */
+
+enum {
+    OBS_OUTPUT_AO = 1,          /* one channel, 1 = unoccluded */
+    OBS_OUTPUT_COMPOSITE = 2,   /* RGBA: colour x AO (x bleed with bleeding) */
+    OBS_OUTPUT_SAMPLE_COUNT = 4, /* debug: one channel, the samples each pixel
+                                    took (VAO++ 4.1); 0 for background and
+                                    for greedily culled pixels (4.2) */
+    OBS_OUTPUT_CULL_MASK = 8,    /* debug: one channel, 1 where the culling
+                                    pre-pass (VAO++ 4.2) made the pixel a
+                                    culling candidate, else 0 */
+    OBS_OUTPUT_BLEED = 16,       /* RGB: the colour-bleed term (VAO++ 4.7),
+                                    (1,1,1) where there is none or bleeding
+                                    is off */
+    OBS_OUTPUT_LUMINANCE = 32    /* debug: one channel, the luminance-
+                                    sensitivity factor of VAO++ eq 3 (4.3):
+                                    1 keeps the pixel's occlusion, 0 removes
+                                    it; 1 everywhere when it is off */
+};
+
+typedef struct obs_result {
+    obs_image ao;           /* filled when OBS_OUTPUT_AO was asked */
+    obs_image composite;    /* filled when OBS_OUTPUT_COMPOSITE was asked */
+    obs_image sample_count; /* filled when OBS_OUTPUT_SAMPLE_COUNT was asked */
+    obs_image cull_mask;    /* filled when OBS_OUTPUT_CULL_MASK was asked */
+    obs_image bleed;        /* filled when OBS_OUTPUT_BLEED was asked */
+    obs_image luminance;    /* filled when OBS_OUTPUT_LUMINANCE was asked */
+} obs_result;
+
+/* Runs the AO chain on the context's thread.  `params` may be NULL or
+ * zeroed for defaults.  The G-buffer's camera is used unless the params
+ * carry one (fov_y / world_to_camera).  Caller frees with
+ * obs_result_free(). */
+obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params,
+                   unsigned outputs, obs_result *out, char err[OBS_ERR_LEN]);
+
+/* The same computation on the CPU (the "twin" of the GL passes), used by
+ * tests and as a reference.  Same ownership as obs_run(). */
+obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params,
+                       unsigned outputs, obs_result *out, char err[OBS_ERR_LEN]);
+
+void obs_result_free(obs_result *r);
+
+/* ---- per-pass GPU timings ---------------------------------------------- */
+
+/* The passes of obs_run, in order.  UPLOAD and READBACK are the texture
+ * transfers of the G-buffer and of the results. */
+typedef enum obs_pass {
+    OBS_PASS_UPLOAD,
+    OBS_PASS_PREP,
+    OBS_PASS_CULL,
+    OBS_PASS_AO,
+    OBS_PASS_BLUR,
+    OBS_PASS_FINISH,    /* luminance sensitivity; ao_definition rays' conversion without blur */
+    OBS_PASS_COMPOSITE,
+    OBS_PASS_READBACK,
+    OBS_PASS_COUNT
+} obs_pass;
+
+/* "upload", "prep", "cull", "ao", "blur", "finish", "composite",
+ * "readback". */
+const char *obs_pass_name(obs_pass p);
+
+typedef struct obs_pass_times {
+    double ms[OBS_PASS_COUNT]; /* GL time of each pass; -1: it did not run */
+    double total_ms;           /* sum of the passes that ran */
+} obs_pass_times;
+
+/* Turns per-pass timing on or off for the following obs_run calls: each
+ * pass is bracketed by a GL_TIME_ELAPSED query (GL 3.3 timer queries),
+ * read back when the frame ends.  Off by default: reading the queries
+ * waits for the GPU. */
+obs_status obs_ctx_set_timing(obs_ctx *ctx, int on, char err[OBS_ERR_LEN]);
+
+/* The times of the last obs_run with timing on; 0 when there is none. */
+int obs_ctx_last_times(const obs_ctx *ctx, obs_pass_times *out);
+
+/* ---- sample sets --------------------------------------------------------- */
+
+/* Runs the VAO++ sample generator (section 4.5: rotation-aware Poisson
+ * disk, best permutation of rotations, z-order) for n = 2, 4, 8, 16 or 32
+ * points, writing n (x, y) pairs on the unit disk to xy.  Deterministic
+ * (fixed seed); its output is the table the library uses.  Takes about
+ * 0.1 s for n = 32. */
+obs_status obs_samples_generate(int n, float *xy);
+
+/* The library's table for n = 2, 4, 8, 16, 32 (n pairs); NULL otherwise. */
+const float *obs_samples_table(int n);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,325 @@
+/* The one parameter table.
+ *
+ * Every tunable of the AO chain is declared once, here: name, type,
+ * default, range, choices and a one-line doc.  The CLI flags and help, the
+ * README's parameter list and (later) the HTTP and binary protocols are all
+ * generated from this table.  A zero-initialised obs_params means "all
+ * defaults"; obs_params_resolve() applies them in one place.
+ */
+#ifndef OBSCURA_PARAMS_H
+#define OBSCURA_PARAMS_H
+
+#include <stddef.h>
+
+#include "obscura/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Enumerated parameter values.  0 always means "default". */
+typedef enum obs_depth_mode {
+    OBS_DEPTH_DEFAULT,
+    OBS_DEPTH_PLANAR, /* distance along the camera axis (Blender's Depth.Z) */
+    OBS_DEPTH_RADIAL, /* distance from the camera centre */
+    OBS_DEPTH_NDC     /* OpenGL depth-buffer value in [0,1] */
+} obs_depth_mode;
+
+typedef enum obs_switch {
+    OBS_SWITCH_DEFAULT,
+    OBS_ON,
+    OBS_OFF
+} obs_switch;
+
+/* Culling pre-pass, VAO++ section 4.2 (parameter `culling`). */
+typedef enum obs_culling {
+    OBS_CULLING_DEFAULT,
+    OBS_CULLING_OFF,
+    OBS_CULLING_GREEDY,  /* culling candidates get AO 1 */
+    OBS_CULLING_CAREFUL  /* culling candidates take the 4-sample set */
+} obs_culling;
+
+/* How the depth range check (VAO++ 4.4, eq 4) measures d (parameter
+ * `range_distance`). */
+typedef enum obs_range_distance {
+    OBS_RANGE_DISTANCE_DEFAULT,
+    OBS_RANGE_DISTANCE_NORMAL, /* below the occluding surface, along its normal */
+    OBS_RANGE_DISTANCE_VIEW    /* behind the visible surface, along view Z */
+} obs_range_distance;
+
+/* Luminance sensitivity, VAO++ section 4.3 (parameter `luminance`). */
+typedef enum obs_luminance {
+    OBS_LUMINANCE_DEFAULT,
+    OBS_LUMINANCE_OFF,
+    OBS_LUMINANCE_LUM,   /* Rec. 709 luminance of the colour */
+    OBS_LUMINANCE_VALUE  /* HSV V: max(r, g, b) */
+} obs_luminance;
+
+/* Colour bleeding, VAO++ section 4.7 (parameter `bleeding`). */
+typedef enum obs_bleeding {
+    OBS_BLEEDING_DEFAULT,
+    OBS_BLEEDING_OFF,
+    OBS_BLEEDING_FULL,    /* every sample */
+    OBS_BLEEDING_HALF,    /* every second sample */
+    OBS_BLEEDING_QUARTER  /* every fourth sample */
+} obs_bleeding;
+
+/* The AO method (parameter `method`). */
+typedef enum obs_method {
+    OBS_METHOD_DEFAULT,
+    OBS_METHOD_VAOPP,      /* VAO++: the whole chain */
+    OBS_METHOD_VAO,        /* plain VAO: no adaptive sampling, culling, range check */
+    OBS_METHOD_HEMISPHERE, /* normal-oriented hemisphere SSAO (methods/hemisphere.c) */
+    OBS_METHOD_ANGLE,      /* angle-based paired-sample SSAO (methods/angle.c) */
+    OBS_METHOD_HBAO        /* horizon-based AO (methods/hbao.c) */
+} obs_method;
+
+/* What the VAO methods' AO measures (parameter `ao_definition`). */
+typedef enum obs_ao_definition {
+    OBS_AO_DEFINITION_DEFAULT,
+    OBS_AO_RAYS,   /* a ray tracer's AO within radius: R = 2 radius, eq 1's V converted */
+    OBS_AO_VOLUME  /* the paper's volumetric obscurance: R = radius */
+} obs_ao_definition;
+
+/* The arc cosine of the angle-based method (parameter `angle_acos`). */
+typedef enum obs_acos {
+    OBS_ACOS_DEFAULT,
+    OBS_ACOS_QUADRATIC, /* pi (1 - sign(x) x^2) / 2 */
+    OBS_ACOS_LINEAR,    /* pi (1 - x) / 2 */
+    OBS_ACOS_EXACT      /* acos(x) */
+} obs_acos;
+
+typedef enum obs_normal_space {
+    OBS_NORMALS_DEFAULT,
+    OBS_NORMALS_WORLD,  /* world space: rotated by world_to_camera */
+    OBS_NORMALS_CAMERA  /* view space, camera looking down -Z */
+} obs_normal_space;
+
+/* X(name, type, default, min, max, choices, doc)
+ * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4.
+ * An INT with choices takes only the listed numbers (within min..max). 
+ * For ENUM the default is the choice's name; for MAT4 it is unused. */
+#define OBS_PARAM_TABLE(X)                                                     \
+    X(method, ENUM, "vaopp", 0, 0, "vaopp|vao|hemisphere|angle|hbao",          \
+      "AO method: vaopp (the VAO++ chain), vao (plain VAO, VAO++ section 3: "  \
+      "adaptive, culling and range_check off), hemisphere (normal-oriented "   \
+      "hemisphere SSAO), angle (angle-based paired-sample SSAO), hbao "        \
+      "(horizon-based AO); every method shares the input, blur, luminance "    \
+      "and composite; the others have no adaptive sampling, culling, range "   \
+      "check or bleeding; a parameter of another method is refused")           \
+    X(radius, FLOAT, 0.5, 1e-4, 1e4, NULL,                                     \
+      "AO distance D in world units, as in a ray tracer's AO (the fraction "  \
+      "of cosine-weighted rays unblocked within D, Cycles' AO pass); VAO's "   \
+      "kernel width R (below) follows from it by ao_definition: 2 D (rays) "   \
+      "or D (volume)")                                                         \
+    X(ao_definition, ENUM, "rays", 0, 0, "rays|volume",                        \
+      "what methods vaopp and vao return: rays, a ray tracer's AO within "    \
+      "radius D: R = 2 D, so the tangent sphere (radius D) touches a wall "    \
+      "exactly when rays of length D reach it, and eq 1's volume fraction is " \
+      "converted to the fraction of unblocked cosine-weighted rays through "   \
+      "a floor-wall crease, where both are known in closed form (occlusion "   \
+      "over 1/2 unchanged; bench/QUALITY.md); volume: the paper's "            \
+      "volumetric obscurance itself, R = D (tangent sphere of radius D/2)")    \
+    X(samples, INT, 16, 2, 32, "2|4|8|16|32",                                  \
+      "line samples per pixel on the tangent sphere's disk; the sets of "     \
+      "VAO++ 4.5 (rotation-aware Poisson disk, best rotation permutation, "    \
+      "z-order) exist for 2, 4, 8, 16 and 32 only, other counts are "          \
+      "refused: the first n of a larger z-ordered set would cover one part "   \
+      "of the disk")                                                           \
+    X(adaptive, ENUM, "on", 0, 0, "on|off",                                    \
+      "adaptive sampling (VAO++ 4.1): each pixel takes the sample set whose "  \
+      "size fits the area of its tangent sphere's disk projected on the "      \
+      "screen: 2 samples up to twice the area of a disk of diameter "          \
+      "adaptive_diameter, doubling with every doubling of the area, at most "  \
+      "samples; off: every pixel takes samples")                               \
+    X(adaptive_diameter, FLOAT, 0.01, 1e-4, 1.0, NULL,                         \
+      "projected disk diameter, as a fraction of the image height, at which "  \
+      "adaptive sampling uses its minimum of 2 samples (4x this diameter "     \
+      "takes 32); 0.01 is 4.8 px at 480 px, where the 3x3 rotation tile's "    \
+      "9 x 2 sample positions are as many as the pixels the disk covers")      \
+    X(culling, ENUM, "careful", 0, 0, "off|greedy|careful",                    \
+      "culling pre-pass (VAO++ 4.2): AO with 8 samples at 1/8 resolution, "   \
+      "read back at each pixel's four corners with bilinear filtering; a "     \
+      "pixel where none of the four shows occlusion (estimate below 1 - "      \
+      "culling_epsilon) is a culling candidate: greedy gives it AO 1, "        \
+      "careful computes it with at most 4 samples; off: no pre-pass")         \
+    X(culling_epsilon, FLOAT, 0.02, 1e-6, 0.5, NULL,                           \
+      "a culling pre-pass estimate below 1 - culling_epsilon shows "           \
+      "occlusion; 0.02 culls 48-79 % of the test scenes' pixels with a mean "  \
+      "|AO(careful) - AO(off)| under 0.002 (half an 8-bit step)")              \
+    X(depth_mode, ENUM, "planar", 0, 0, "planar|radial|ndc",                   \
+      "what the depth channel holds: distance along the camera axis, "         \
+      "distance from the camera, or a [0,1] OpenGL depth-buffer value")        \
+    X(normal_space, ENUM, "world", 0, 0, "world|camera",                       \
+      "space of the normal channel (world normals need world_to_camera)")      \
+    X(unit_scale, FLOAT, 1.0, 1e-6, 1e6, NULL,                                 \
+      "depth values are multiplied by this to reach the units of radius")      \
+    X(fov_y, FLOAT, 0.0, 0.0, 179.0, NULL,                                     \
+      "vertical field of view in degrees (0: take the camera from the EXR "    \
+      "header or camera JSON)")                                                \
+    X(near, FLOAT, 0.1, 1e-6, 1e9, NULL,                                       \
+      "near clip distance, used with fov_y (ndc depth is linearised with it)") \
+    X(far, FLOAT, 1000.0, 1e-6, 1e12, NULL,                                    \
+      "far clip distance, used with fov_y")                                    \
+    X(world_to_camera, MAT4, 0, 0, 0, NULL,                                    \
+      "16 numbers, row-major, column-vector convention: world to camera "      \
+      "(-Z forward); overrides the file's camera rotation")                    \
+    X(range_check, ENUM, "on", 0, 0, "on|off",                                 \
+      "depth range check (VAO++ 4.4, eq 4): a pipe hidden behind a surface "   \
+      "counts as occluded only by the falloff s(d) = u / max(u, d/R), "      \
+      "d its distance behind that surface; off: occluders are infinitely "     \
+      "thick")                                                                 \
+    X(range_u, FLOAT, 0.03, 1e-4, 1.0, NULL,                                   \
+      "u of the depth range check's falloff (eq 4): occluders are taken as "   \
+      "fully thick up to u * R behind the visible surface")                    \
+    X(range_distance, ENUM, "normal", 0, 0, "normal|view",                     \
+      "how the depth range check measures eq 4's d, the distance of a pipe "  \
+      "behind its occluder: normal: the pipe's depth below the occluding "     \
+      "surface, along that surface's normal (d along view Z times |n.z| of "  \
+      "the surface seen at the sample's pixel), the thickness of a flat "      \
+      "occluder; view: along view Z (a floor seen at a grazing angle then "    \
+      "counts as thin as a sheet facing the camera)")                          \
+    X(blur, ENUM, "on", 0, 0, "on|off",                                        \
+      "low-pass filter (VAO++ 4.6): depth-aware cross-bilateral Gaussian "     \
+      "blur of the AO, a horizontal then a vertical pass; neighbours whose "   \
+      "view depth differs from the centre's by more than R are left out")      \
+    X(blur_radius, INT, 2, 1, 16, NULL,                                        \
+      "blur kernel half-width in pixels (the kernel is 2 * blur_radius + 1 "   \
+      "taps per pass)")                                                        \
+    X(blur_sigma, FLOAT, 1.25, 0.1, 64.0, NULL,                                \
+      "standard deviation of the blur's Gaussian in pixels; with the default " \
+      "radius 2, sigma 1.25 nulls the period-3 pattern of the 3x3 rotation "   \
+      "tile (exp(-1/2s^2) + exp(-4/2s^2) = 1)")                                 \
+    X(luminance, ENUM, "off", 0, 0, "off|lum|value",                           \
+      "luminance sensitivity (VAO++ 4.3, eq 3): suppress the occlusion of "    \
+      "bright pixels of the G-buffer colour, after the blur: occlusion 1 - AO "\
+      "times (1 - min(1, max(0, lum - threshold + width)) / (2 width))^sigma, "\
+      "lum the Rec. 709 luminance (lum) or HSV V = max(r, g, b) (value); "     \
+      "off without a colour plane")                                            \
+    X(lum_threshold, FLOAT, 0.5, 1e-4, 1e4, NULL,                               \
+      "threshold of eq 3: the middle of the ramp from full to no occlusion "   \
+      "(paper's Figure 9: 0.5)")                                               \
+    X(lum_width, FLOAT, 0.3, 1e-3, 1e4, NULL,                                  \
+      "width of eq 3: occlusion is untouched up to lum = threshold - width "   \
+      "and gone from threshold + width (paper's Figure 9: 0.3); eq 3 as "      \
+      "printed clamps lum - threshold + width at 1 before dividing by "        \
+      "2 width, so above 0.5 some occlusion always stays")                     \
+    X(lum_sigma, FLOAT, 1.0, 0.01, 100.0, NULL,                                \
+      "sigma of eq 3, the ramp's linearity: 1 a straight ramp, above 1 "       \
+      "occlusion falls off sooner, below 1 later")                             \
+    X(bleeding, ENUM, "off", 0, 0, "off|full|half|quarter",                    \
+      "colour bleeding (VAO++ 4.7, eq 5): the bleed term averages, over "      \
+      "every sample (full), every second (half) or every fourth (quarter), "   \
+      "white mixed towards the colour at the sample's pixel by c(x) = "        \
+      "max(0, (x-p).n / |x-p|) max(0, 1 - |x-p|/R)^2, x the surface "          \
+      "point seen there; the composite is multiplied by it; off without a "    \
+      "colour plane")                                                          \
+    X(hemisphere_samples, INT, 10, 1, 64, NULL,                                \
+      "method hemisphere: samples in the normal-oriented hemisphere of "       \
+      "radius D; Unity's post-processing stack (VAO++ Table 2) takes 3, 6, "   \
+      "10 (its default, Medium) and 16")                                       \
+    X(hemisphere_bias, FLOAT, 0.05, 1e-6, 1.0, NULL,                           \
+      "method hemisphere: a sample is occluded when the surface at its pixel " \
+      "lies more than hemisphere_bias * D in front of it (self-occlusion "     \
+      "guard; 0.025 at radius 0.5 in the common kernel tutorials)")            \
+    X(angle_pairs, INT, 6, 1, 16, NULL,                                        \
+      "method angle: sample pairs per pixel, each pair two opposite points "   \
+      "of a disk of radius D (6 in the angle-based SSAO article)")              \
+    X(angle_acos, ENUM, "quadratic", 0, 0, "quadratic|linear|exact",           \
+      "method angle: the arc cosine of the pair angles: the article's "        \
+      "quadratic pi (1 - sign(x) x^2) / 2 (max error 9.47 degrees), its "      \
+      "linear pi (1 - x) / 2 (18.95 degrees), or exact acos")                  \
+    X(hbao_directions, INT, 8, 1, 32, NULL,                                    \
+      "method hbao: screen-space directions per pixel, Nd of HBAO (8 in "      \
+      "NVIDIA's HBAO sample)")                                                 \
+    X(hbao_steps, INT, 6, 1, 32, NULL,                                         \
+      "method hbao: ray-marching steps per direction, Ns of HBAO (6 in "       \
+      "NVIDIA's HBAO sample), spread over the projected radius D / (Ns + 1) "  \
+      "apart")                                                                 \
+    X(hbao_angle_bias, FLOAT, 30.0, 1e-6, 89.0, NULL,                          \
+      "method hbao: angle bias in degrees added to the tangent angle t(theta) "\
+      "against the self-occlusion of tessellated surfaces")                   \
+    X(deep_mode, ENUM, "multi", 0, 0, "multi|single",                          \
+      "deep input: multi (OITAO Algorithm 1: each sample is occluded by every "\
+      "compressed node at its pixel, the largest occlusion counts) or single " \
+      "(the front node alone, as a flat depth buffer would)")                  \
+    X(deep_layers, INT, 4, 1, 8, NULL,                                         \
+      "deep input: nodes m kept per pixel by the list compression of OITAO "   \
+      "III-B (eq 5 drops the node of least alpha (1 - z), z the depth "        \
+      "normalised over the image)")                                           \
+    X(deep_front_half, ENUM, "off", 0, 0, "on|off",                            \
+      "deep input: eq 5 searches the back half of the list only, keeping the " \
+      "m/2 front nodes (OITAO V-A, Fig. 6 column C)")                          \
+    X(deep_hull, ENUM, "solid", 0, 0, "solid|thin",                            \
+      "deep input: transparent surfaces as solid volumes (OITAO eq 1: "        \
+      "occluders and receivers weighted by alpha) or thin hulls (eqs 2-4: "    \
+      "exterior and interior AO mixed by W(p), alpha or 1 - alpha on back "    \
+      "faces)")
+
+#define OBS__PDECL_FLOAT(n) float n;
+#define OBS__PDECL_INT(n) int n;
+#define OBS__PDECL_ENUM(n) int n;
+#define OBS__PDECL_MAT4(n) float n[16];
+
+typedef struct obs_params {
+#define OBS__PDECL(name, type, def, lo, hi, choices, doc) OBS__PDECL_##type(name)
+    OBS_PARAM_TABLE(OBS__PDECL)
+#undef OBS__PDECL
+    int has_world_to_camera; /* set by obs_param_set for world_to_camera */
+    /* Set by obs_params_resolve: 1 + the table index of the first
+     * parameter the request gave that does not apply to its method
+     * (obs_params_check refuses it, naming it); -1: none; 0: not resolved
+     * yet.  Resolving a resolved struct again keeps it. */
+    int method_conflict;
+} obs_params;
+
+typedef enum obs_param_type {
+    OBS_PARAM_FLOAT,
+    OBS_PARAM_INT,
+    OBS_PARAM_ENUM,
+    OBS_PARAM_MAT4
+} obs_param_type;
+
+typedef struct obs_param_info {
+    const char *name;     /* snake_case; flags use the same name with '-' */
+    obs_param_type type;
+    const char *def;      /* default as text, for help and docs */
+    double min, max;      /* FLOAT and INT only */
+    const char *choices;  /* ENUM only: "a|b|c" */
+    const char *doc;
+    size_t offset;        /* offsetof(obs_params, name) */
+} obs_param_info;
+
+int obs_param_count(void);
+/* NULL when i is out of range. */
+const obs_param_info *obs_param_at(int i);
+/* Finds a parameter by name; '-' and '_' are interchangeable. */
+const obs_param_info *obs_param_find(const char *name);
+
+/* Parses `value` for the parameter `name` into p, checking its range.
+ * Errors name the parameter and the allowed values. */
+obs_status obs_param_set(obs_params *p, const char *name, const char *value,
+                         char err[OBS_ERR_LEN]);
+
+/* Writes the value of parameter `pi` in p as text (the resolved value). */
+void obs_param_format(const obs_params *p, const obs_param_info *pi, char *buf,
+                      size_t len);
+
+/* out = in with every zero field replaced by its default, then the
+ * settings the method fixes: methods other than vaopp have adaptive
+ * sampling, culling and the depth range check off (VAO++ features), and
+ * methods hemisphere, angle and hbao have bleeding off too (it gathers the
+ * colour at the VAO samples).  A parameter that in gave (non-zero) and
+ * that the method does not use or fixes otherwise is recorded in
+ * out->method_conflict; obs_params_check then refuses it. */
+void obs_params_resolve(const obs_params *in, obs_params *out);
+
+/* Checks every field of a resolved struct against the table's ranges;
+ * the message names the first field out of range. */
+obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

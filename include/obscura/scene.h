@@ -1,0 +1,119 @@
+/* Scenes of libobscura: triangle meshes loaded through assimp (OBJ, PLY,
+ * glTF/GLB, OFF, ...) and rasterised into a G-buffer on the GL context.
+ * The ray-traced reference over the same scenes is in reference.h.
+ *
+ * Conventions are those of obscura.h: world space as the file gives it
+ * (node transforms applied), matrices row-major with column vectors,
+ * images row-major with row 0 at the top. */
+#ifndef OBSCURA_SCENE_H
+#define OBSCURA_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "obscura/obscura.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Planar depth written where no geometry is (Blender's value; the AO
+ * chain takes depth >= 1e9 as sky). */
+#define OBS_SKY_DEPTH 1e10f
+
+/* One mesh of a scene file: its names (assimp's mesh name, and the name
+ * of the first node that holds it; either may be "") and its run of
+ * triangles. */
+typedef struct obs_scene_mesh {
+    char *name, *node;
+    size_t first_triangle, triangle_count;
+} obs_scene_mesh;
+
+/* An indexed triangle mesh in world space.  Arrays are malloc'd;
+ * obs_scene_free() releases them.  normals and albedo may be NULL:
+ * without normals the rasteriser uses each triangle's geometric normal;
+ * albedo is per vertex, linear RGB, present only when some material of
+ * the file has a diffuse or base colour.  opacity is per triangle, in
+ * [0, 1], present only when some material is not opaque (assimp's
+ * AI_MATKEY_OPACITY, glTF's base colour alpha with alphaMode BLEND) or
+ * obs_scene_set_opacity() set one; NULL means opaque. */
+typedef struct obs_scene {
+    size_t vertex_count;
+    float *positions;    /* 3 per vertex */
+    float *normals;      /* 3 per vertex, unit length, or NULL */
+    float *albedo;       /* 3 per vertex, or NULL */
+    size_t triangle_count;
+    uint32_t *indices;   /* 3 per triangle, each < vertex_count */
+    float *opacity;      /* 1 per triangle, or NULL (opaque) */
+    size_t mesh_count;   /* the file's meshes, in triangle order; 0 for */
+    obs_scene_mesh *meshes; /* a scene built in memory */
+    float bounds_min[3]; /* filled by obs_scene_check() */
+    float bounds_max[3];
+} obs_scene;
+
+/* Loads every triangle of a mesh file through assimp: meshes are
+ * triangulated, node transforms applied, points and lines dropped, and
+ * missing normals generated per face.  Fails with OBS_IO when the file
+ * cannot be opened, OBS_BAD_FILE when assimp cannot read it or it holds
+ * no triangle.  Caller frees with obs_scene_free(). */
+obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN]);
+
+/* Checks a scene built in memory (counts, indices in range, finite
+ * positions) and computes its bounds.  obs_scene_load() calls it. */
+obs_status obs_scene_check(obs_scene *s, char err[OBS_ERR_LEN]);
+
+/* Frees the arrays and zeroes *s; NULL-safe. */
+void obs_scene_free(obs_scene *s);
+
+/* Sets the opacity of meshes from a spec: "A" (every triangle) or
+ * "NAME=A" (the meshes whose name or node name matches the fnmatch(3)
+ * pattern NAME),
+ * A a number in [0, 1].  Specs apply in order, a later one overriding.
+ * Fails with OBS_INVALID_ARGUMENT on a malformed spec or a pattern no
+ * mesh matches (the message lists the mesh names), OBS_NO_MEMORY. */
+obs_status obs_scene_set_opacity(obs_scene *s, const char *spec, char err[OBS_ERR_LEN]);
+
+/* A G-buffer rasterised from a scene, one sample per pixel at the pixel
+ * centre.  Background pixels: depth OBS_SKY_DEPTH, everything else 0. */
+typedef struct obs_raster {
+    obs_image depth;      /* 1 channel: planar view depth (-z_view) */
+    obs_image normal;     /* 3: world-space shading normal, facing the camera */
+    obs_image normal_cam; /* 3: the same normal in camera space */
+    obs_image position;   /* 3: world-space position */
+    obs_image color;      /* 4: albedo RGB (0 without albedo), alpha = coverage */
+    int has_albedo;       /* the scene has albedo */
+} obs_raster;
+
+/* Rasterises the scene with the camera (world_to_camera and an OpenGL
+ * projection, both required) at width x height on the context's thread.
+ * Normals are flipped to face the camera where a triangle is seen from
+ * its back (as a path tracer's shading normal is).  Caller frees with
+ * obs_raster_free(). */
+obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
+                              int width, int height, obs_raster *out, char err[OBS_ERR_LEN]);
+
+/* Frees the images and zeroes *r; NULL-safe. */
+void obs_raster_free(obs_raster *r);
+
+struct obs_deep_image; /* deep.h */
+
+/* Rasterises the scene into an A-buffer: every fragment at every pixel
+ * centre, depth test off, kept in per-pixel linked lists on the GPU (GL
+ * 4.3 shader storage buffers and an atomic counter: OITAO section IV-A,
+ * the PPLL of Yang et al.), read back and sorted front to back.  Each
+ * sample: Z (planar view depth; ZBack = Z), A (the triangle's opacity;
+ * fragments of opacity 0 are left out), R, G, B (albedo premultiplied by
+ * A; has_color only when the scene has albedo) and the world-space
+ * shading normal facing the camera (N, as obs_raster's).
+ * A node pool too small for the frame is grown to the fragment count and
+ * the scene drawn again; more than OBS_DEEP_MAX_SAMPLES fragments, or
+ * more than OBS_DEEP_MAX_PER_PIXEL at one pixel, is OBS_TOO_LARGE.  The
+ * camera is copied into out->camera.  Caller frees with obs_deep_free(). */
+obs_status obs_raster_deep(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam, int width,
+                           int height, struct obs_deep_image *out, char err[OBS_ERR_LEN]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
