@@ -71,13 +71,21 @@ double obs__samples_min_distance(const float *xy, int n, int rotations);
  * (VAO++ section 4.5), computed from pixel coordinates. */
 void obs__pixel_rotation(int x, int y, float *cos_a, float *sin_a);
 
+/* The one image allocator (core/image.c): w x h x channels floats, the
+ * size checked for overflow first.  Free with obs_image_free(). */
+obs_status obs__image_alloc(obs_image *img, int w, int h, int channels, char err[OBS_ERR_LEN]);
+
 /* Allocates the images of a result for `outputs` (OBS_OUTPUT_* bits). */
 obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs,
                              char err[OBS_ERR_LEN]);
 
-/* Reports through a context's log callback (no-op without one). */
+/* Reports through a context's log callback (no-op without a context or
+ * a callback; core/log.c). */
 void obs__log(obs_ctx *ctx, obs_log_level level, const char *fmt, ...)
     OBS__PRINTF(3, 4);
+/* The same through a callback and its user pointer (NULL fn: no-op). */
+void obs__logf(obs_log_fn fn, void *user, obs_log_level level, const char *fmt, ...)
+    OBS__PRINTF(4, 5);
 
 /* A growable byte buffer (core/io/bytes.c) behind obs_*_write_mem. */
 typedef struct obs__membuf {

@@ -252,7 +252,7 @@ static const struct {
  * that does not apply to `method`; 0 if none. */
 static int method_conflict(const obs_params *in, int method)
 {
-    if (!in || method < OBS_METHOD_VAOPP || method > OBS_METHOD_HBAO)
+    if (!in || method < OBS_METHOD_VAOPP || method >= OBS_METHOD_COUNT)
         return 0;
     for (size_t k = 0; k < sizeof method_params / sizeof method_params[0]; k++) {
         if (method_params[k].methods & (1u << method))

@@ -54,14 +54,6 @@ obs_status obs_check_size(const obs_limits *lim, int64_t width, int64_t height,
     return OBS_OK;
 }
 
-void obs_image_free(obs_image *img)
-{
-    if (!img)
-        return;
-    free(img->data);
-    memset(img, 0, sizeof *img);
-}
-
 size_t obs__plane_stride(const obs_plane *p, int width)
 {
     return p->row_stride ? p->row_stride : (size_t)width * (size_t)p->channels * sizeof(float);

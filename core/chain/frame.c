@@ -5,34 +5,6 @@
 #include "chain/frame.h"
 #include "obscura/io.h"
 
-obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p, obs_camera *out,
-                               char err[OBS_ERR_LEN])
-{
-    obs_camera cam = gb->camera;
-    int dw = gb->display_width > 0 ? gb->display_width : gb->width;
-    int dh = gb->display_height > 0 ? gb->display_height : gb->height;
-
-    if (p->fov_y > 0.0f) {
-        obs_camera fov;
-        obs_camera_from_fov(p->fov_y, (float)dw / (float)dh, p->near, p->far, &fov);
-        memcpy(cam.projection, fov.projection, sizeof cam.projection);
-        cam.has_projection = 1;
-        cam.source = OBS_CAMERA_PARAMS;
-    }
-    if (p->has_world_to_camera) {
-        memcpy(cam.world_to_camera, p->world_to_camera, sizeof cam.world_to_camera);
-        cam.has_world_to_camera = 1;
-    }
-    if (!cam.has_world_to_camera)
-        obs__mat4_identity(cam.world_to_camera);
-    if (!cam.has_projection)
-        return obs__fail(err, OBS_NO_CAMERA,
-                         "no camera: the G-buffer has no worldToCamera/worldToNDC header "
-                         "attributes; give a camera JSON (--camera) or a field of view (--fov-y)");
-    *out = cam;
-    return OBS_OK;
-}
-
 /* Inverse transpose of the upper 3x3 of m: the matrix that carries normals
  * the way m carries points. */
 static int normal_matrix(const float m[16], float out[9])
@@ -206,23 +178,4 @@ obs_status obs__gbuffer_validate(const obs_gbuffer *gb, char err[OBS_ERR_LEN])
                              planes[i].name, pl->row_stride, row);
     }
     return OBS_OK;
-}
-
-/* GLSL: view_to_px() in common.glsl. */
-int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy)
-{
-    const float *P = f->proj;
-    float cw = P[12] * s[0] + P[13] * s[1] + P[14] * s[2] + P[15];
-    if (!(cw > 0.0f))
-        return 0;
-    float cx = P[0] * s[0] + P[1] * s[1] + P[2] * s[2] + P[3];
-    float cy = P[4] * s[0] + P[5] * s[1] + P[6] * s[2] + P[7];
-    float u = (cx / cw * 0.5f + 0.5f) * f->viewport[2] - f->viewport[0];
-    float v = (0.5f - cy / cw * 0.5f) * f->viewport[3] - f->viewport[1];
-    float fu = floorf(u), fv = floorf(v);
-    if (!(fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height))
-        return 0;
-    *qx = (int)fu;
-    *qy = (int)fv;
-    return 1;
 }

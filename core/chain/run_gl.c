@@ -5,8 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "chain/frame.h"
-#include "gl/gl.h"
+#include "context.h"
 #include "obs_shaders.h"
 
 static const char glsl_version[] = "#version 430 core\n";
@@ -155,9 +154,8 @@ static obs_status make_fbo(obs_ctx *ctx, GLuint *fbo, const GLuint *tex, int cou
     return OBS_OK;
 }
 
-void obs__frame_release(obs_ctx *ctx)
+void obs__chain_release(obs__programs *g, obs__targets *t)
 {
-    obs__targets *t = &ctx->tg;
     GLuint tex[] = {t->tex_depth,   t->tex_normal, t->tex_color,     t->tex_viewpos, t->tex_vnormal,
                     t->tex_dz,      t->tex_ao,     t->tex_composite, t->tex_blur,    t->tex_count,
                     t->tex_cull,    t->tex_cullmask, t->tex_bleed,   t->tex_lumfactor};
@@ -165,7 +163,6 @@ void obs__frame_release(obs_ctx *ctx)
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
     memset(t, 0, sizeof *t);
-    obs__programs *g = &ctx->prog;
     OBS__GL_DELETE_PROGRAMS(g->prep);
     OBS__GL_DELETE_PROGRAMS(g->vao);
     OBS__GL_DELETE_PROGRAMS(g->cull);
@@ -173,7 +170,7 @@ void obs__frame_release(obs_ctx *ctx)
     OBS__GL_DELETE_PROGRAMS(g->method);
     OBS__GL_DELETE_PROGRAMS(g->finish);
     obs__gl_delete_programs(&g->composite, 1);
-    memset(&ctx->prog, 0, sizeof ctx->prog);
+    memset(g, 0, sizeof *g);
 }
 
 static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LEN])
@@ -183,10 +180,8 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
         return OBS_OK;
     if (t->width) {
         /* a new resolution: drop the old set, keep the programs */
-        obs__programs keep = ctx->prog;
-        memset(&ctx->prog, 0, sizeof ctx->prog);
-        obs__frame_release(ctx);
-        ctx->prog = keep;
+        obs__programs none = {0};
+        obs__chain_release(&none, t);
     }
     t->tex_depth = make_texture(ctx, GL_R32F, w, h);
     t->tex_normal = make_texture(ctx, GL_RGBA32F, w, h); /* read as an image: no RGB32F */
@@ -222,10 +217,8 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     if (s == OBS_OK)
         s = obs__gl_check("allocating frame targets", err);
     if (s != OBS_OK) {
-        obs__programs keep = ctx->prog;
-        memset(&ctx->prog, 0, sizeof ctx->prog);
-        obs__frame_release(ctx);
-        ctx->prog = keep;
+        obs__programs none = {0};
+        obs__chain_release(&none, t);
         return s;
     }
     t->width = w;
@@ -320,7 +313,7 @@ static void draw(obs_ctx *ctx, GLuint fbo, int w, int h)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, w, h);
-    glBindVertexArray(ctx->vao);
+    glBindVertexArray(ctx->dev.vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
@@ -333,35 +326,6 @@ static void read_back(GLuint fbo, GLenum attachment, int w, int h, GLenum format
 }
 
 /* ---- per-pass timings (GL_TIME_ELAPSED queries) ------------------------ */
-
-const char *obs_pass_name(obs_pass p)
-{
-    static const char *const names[OBS_PASS_COUNT] = {
-        "upload", "prep", "cull", "ao", "blur", "finish", "composite", "readback"};
-    return (unsigned)p < OBS_PASS_COUNT ? names[p] : "unknown";
-}
-
-obs_status obs_ctx_set_timing(obs_ctx *ctx, int on, char err[OBS_ERR_LEN])
-{
-    if (!ctx)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
-    obs_status s = obs__ctx_bind(ctx, err);
-    if (s != OBS_OK)
-        return s;
-    if (on && !ctx->queries[0])
-        glGenQueries(OBS_PASS_COUNT, ctx->queries);
-    ctx->timing = on != 0;
-    ctx->times_valid = 0;
-    return obs__gl_check("creating timer queries", err);
-}
-
-int obs_ctx_last_times(const obs_ctx *ctx, obs_pass_times *out)
-{
-    if (!ctx || !ctx->times_valid)
-        return 0;
-    *out = ctx->times;
-    return 1;
-}
 
 /* Brackets one pass; passes never nest (GL allows one active
  * GL_TIME_ELAPSED query). */

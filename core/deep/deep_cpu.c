@@ -21,15 +21,6 @@
 
 #include "deep/deep_internal.h"
 
-void obs_deep_result_free(obs_deep_result *r)
-{
-    if (!r)
-        return;
-    obs_image_free(&r->ao_front);
-    obs_image_free(&r->ao_blend);
-    obs_image_free(&r->composite);
-}
-
 int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_exr_layer layers[3])
 {
     static const char *const ao[] = {"AO.Y"}, *const front[] = {"AOFront.Y"};
@@ -42,31 +33,6 @@ int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_e
     if ((outputs & OBS_OUTPUT_COMPOSITE) && r->composite.data)
         layers[n++] = (obs_exr_layer){&r->composite, rgba};
     return n;
-}
-
-static obs_status alloc_img(obs_image *img, int w, int h, int c, char err[OBS_ERR_LEN])
-{
-    size_t n;
-    if (obs__size_mul3((size_t)w, (size_t)h, (size_t)c * sizeof(float), &n) != 0)
-        return obs__fail(err, OBS_TOO_LARGE, "image %dx%dx%d overflows", w, h, c);
-    if (!(img->data = malloc(n)))
-        return obs__fail(err, OBS_NO_MEMORY, "image of %dx%d", w, h);
-    img->width = w;
-    img->height = h;
-    img->channels = c;
-    return OBS_OK;
-}
-
-obs_status obs__deep_result_alloc(obs_deep_result *out, int w, int h, char err[OBS_ERR_LEN])
-{
-    obs_status s;
-    memset(out, 0, sizeof *out);
-    if ((s = alloc_img(&out->ao_front, w, h, 1, err)) == OBS_OK &&
-        (s = alloc_img(&out->ao_blend, w, h, 1, err)) == OBS_OK)
-        s = alloc_img(&out->composite, w, h, 4, err);
-    if (s != OBS_OK)
-        obs_deep_result_free(out);
-    return s;
 }
 
 void obs__deep_frame_free(obs__deep_frame *df)

@@ -22,8 +22,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "context.h"
 #include "deep/deep_internal.h"
-#include "gl/gl.h"
 #include "obs_shaders.h"
 
 static GLuint array_texture(obs_ctx *ctx, int w, int h, int m)
@@ -49,9 +49,8 @@ static void upload_layers(GLuint tex, int w, int h, int m, const float *data)
 }
 
 /* Drops the size-dependent objects; the program stays unless `all`. */
-static void release(obs_ctx *ctx, int all)
+static void release(obs__deep_targets *t, int all)
 {
-    obs__deep_targets *t = &ctx->deep;
     GLuint tex[] = {t->tex_pos, t->tex_nrm, t->tex_out};
     glDeleteTextures(3, tex);
     if (t->fbo)
@@ -65,7 +64,7 @@ static void release(obs_ctx *ctx, int all)
         memcpy(t->prog, prog, sizeof prog);
 }
 
-void obs__deep_release(obs_ctx *ctx) { release(ctx, 1); }
+void obs__deep_release(obs__deep_targets *t) { release(t, 1); }
 
 /* Switches of the deep pass compiled in or out by defines (a SIMD
  * rasteriser runs both sides of a uniform branch): bits of the index of
@@ -108,7 +107,7 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     }
     if (t->width == w && t->height == h && t->m == m)
         return OBS_OK;
-    release(ctx, 0);
+    release(&ctx->deep, 0);
     t->tex_pos = array_texture(ctx, w, h, m);
     t->tex_nrm = array_texture(ctx, w, h, m);
     glGenTextures(1, &t->tex_out);
@@ -126,7 +125,7 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
             ? obs__gl_check("allocating deep targets", err)
             : obs__fail(err, OBS_GL_ERROR, "deep AO framebuffer incomplete (0x%04x)", (unsigned)st);
     if (s != OBS_OK) {
-        release(ctx, 0);
+        release(&ctx->deep, 0);
         return s;
     }
     t->width = w;
@@ -223,7 +222,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glBindImageTexture(1, t->tex_nrm, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glUniform1i(glGetUniformLocation(prog, "u_lnrm"), 1);
     glViewport(0, 0, w, h);
-    glBindVertexArray(ctx->vao);
+    glBindVertexArray(ctx->dev.vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     stage_end(ctx, OBS_PASS_AO, t0, &times);
 

@@ -10,7 +10,6 @@
 
 #include <GL/glcorearb.h>
 
-#include "chain/frame.h"
 #include "gl/backend.h"
 
 #define OBS__GL_FUNCS(X)                                                       \
@@ -186,76 +185,29 @@ void obs__gl_delete_programs(const GLuint *p, size_t n);
 /* Drains glGetError; returns OBS_GL_ERROR naming `where` if any. */
 obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 
-/* ---- the per-resolution frame resources and programs -------------------- */
+/* ---- one context of one backend (device.c) ------------------------------ */
 
-#define OBS__AO_VARIANTS 16  /* 4 switches of the AO pass, compiled in or out */
-#define OBS__DEEP_VARIANTS 16 /* 4 switches of the deep pass (deep_gl.c: DEEP_*) */
-
-typedef struct obs__programs {
-    GLuint prep[6];   /* 3 * (normals derived from depth) + depth mode - 1; built on first use */
-    GLuint vao[OBS__AO_VARIANTS]; /* AO pass by switches compiled in (run_gl.c: AO_*) */
-    GLuint cull[2];               /* culling pre-pass without, with the range check */
-    GLuint composite;
-    GLuint finish[4]; /* 2 * (ao_definition rays) + luminance: OBS_RAYS, OBS_LUMINANCE */
-    /* by (the vertical pass with ao_definition rays' conversion: OBS_RAYS)
-     * and blur_radius (BLUR_RADIUS); built on first use */
-    GLuint blur[2][OBS__MAX_BLUR + 1];
-    GLuint method[3]; /* parameter method: hemisphere, angle, hbao (built on first use) */
-} obs__programs;
-
-typedef struct obs__targets {
-    int width, height;          /* 0: none allocated yet */
-    GLuint tex_depth, tex_normal, tex_color;  /* inputs */
-    GLuint tex_viewpos, tex_vnormal;          /* prep outputs */
-    GLuint tex_dz;                            /* prep: planar depth, view normal z (RG) */
-    GLuint tex_ao, tex_composite;             /* results */
-    GLuint tex_blur;                          /* between the two blur passes */
-    GLuint tex_count;                         /* debug: samples per pixel (4.1) */
-    GLuint tex_cull;                          /* culling pre-pass AO, 1/8 size (4.2) */
-    GLuint tex_cullmask;                      /* debug: culling candidates (4.2) */
-    GLuint tex_bleed;                         /* colour-bleed term (4.7), RGBA */
-    GLuint tex_lumfactor;                     /* debug: factor of eq 3 (4.3) */
-    GLuint fbo_prep, fbo_ao, fbo_composite;  /* fbo_prep: viewpos + vnormal + dz */
-    GLuint fbo_blur;                          /* tex_blur + tex_lumfactor */
-    GLuint fbo_vao;                           /* AO pass: tex_ao + tex_count + tex_cullmask + tex_bleed */
-    GLuint fbo_cull;                          /* culling pre-pass: tex_cull */
-} obs__targets;
-
-/* Deep input's pass (deep_gl.c): its program, and the node planes and
- * the output target of one size and node count. */
-typedef struct obs__deep_targets {
-    GLuint prog[OBS__DEEP_VARIANTS]; /* by variant (deep_gl.c: DEEP_*), built on first use, kept */
-    int width, height, m;        /* 0: none allocated yet */
-    GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
-    GLuint tex_out, fbo;         /* AO of the front node and the blend */
-} obs__deep_targets;
-
-struct obs_ctx {
+typedef struct obs__gl_device {
     obs_backend backend;
     obs__backend_state st;
     obs__gl gl;
-    int debug;
-    obs_log_fn log;
+    int debug;            /* install the KHR_debug callback */
+    obs_log_fn log;       /* where the callback and backend probing report */
     void *log_user;
     char version[128], vendor[128], renderer[256];
-    GLuint vao;  /* empty vertex array for the full-screen triangle */
-    obs__programs prog;
-    obs__targets tg;
-    obs__deep_targets deep;
-    unsigned long gl_objects_created; /* textures + framebuffers, for tests */
-    int timing;                          /* obs_ctx_set_timing */
-    GLuint queries[OBS_PASS_COUNT];      /* GL_TIME_ELAPSED, one per pass */
-    int times_valid;
-    obs_pass_times times;                /* of the last timed frame */
-};
+    GLuint vao;           /* empty vertex array for the full-screen triangle */
+} obs__gl_device;
 
-/* Deletes the per-resolution textures, framebuffers and programs. */
-void obs__frame_release(obs_ctx *ctx);
-
-/* Deletes deep input's program, textures and framebuffer. */
-void obs__deep_release(obs_ctx *ctx);
+/* Creates the context of `backend` (AUTO: the first of EGL device, EGL
+ * surfaceless, OSMesa that works, the others' failures logged at debug
+ * level), loads its table and leaves it current.  debug, log and
+ * log_user are read from *d; the rest is filled. */
+obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, char err[OBS_ERR_LEN]);
 
 /* Makes the context current on the calling thread (and its table). */
-obs_status obs__ctx_bind(obs_ctx *ctx, char err[OBS_ERR_LEN]);
+obs_status obs__gl_device_bind(obs__gl_device *d, char err[OBS_ERR_LEN]);
+
+/* Deletes what create made and the context itself. */
+void obs__gl_device_destroy(obs__gl_device *d);
 
 #endif

@@ -37,7 +37,7 @@ static void release(deep_gl *g, obs_ctx *ctx)
     if (g->vao)
         glDeleteVertexArrays(1, &g->vao);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glBindVertexArray(ctx->vao);
+    glBindVertexArray(ctx->dev.vao);
 }
 
 /* One geometry pass into a pool of `capacity` nodes; *fragments gets the

@@ -47,22 +47,8 @@ static void release(raster_gl *g, obs_ctx *ctx)
         glDeleteVertexArrays(1, &g->vao);
     /* Back to the state the AO chain expects. */
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glBindVertexArray(ctx->vao);
+    glBindVertexArray(ctx->dev.vao);
     glDisable(GL_DEPTH_TEST);
-}
-
-static obs_status alloc_image(obs_image *img, int w, int h, int c, char err[OBS_ERR_LEN])
-{
-    size_t n;
-    if (obs__size_mul3((size_t)w * (size_t)h, (size_t)c, sizeof(float), &n))
-        return obs__fail(err, OBS_TOO_LARGE, "G-buffer of %dx%d", w, h);
-    img->data = malloc(n);
-    if (!img->data)
-        return obs__fail(err, OBS_NO_MEMORY, "G-buffer of %dx%d", w, h);
-    img->width = w;
-    img->height = h;
-    img->channels = c;
-    return OBS_OK;
 }
 
 /* Reads one colour attachment into a top-row-first image of `channels`
@@ -186,7 +172,7 @@ obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_ca
     obs_image *imgs[T_COUNT] = {&out->depth, &out->normal, &out->normal_cam, &out->position,
                                 &out->color};
     for (int t = 0; t < T_COUNT; t++)
-        if ((s = alloc_image(imgs[t], width, height, channels[t], err)) != OBS_OK)
+        if ((s = obs__image_alloc(imgs[t], width, height, channels[t], err)) != OBS_OK)
             goto fail;
     if (!(rgba = malloc((size_t)width * height * 4 * sizeof(float)))) {
         s = obs__fail(err, OBS_NO_MEMORY, "G-buffer of %dx%d", width, height);

@@ -4,7 +4,7 @@
 #ifndef OBSCURA_RASTER_INTERNAL_H
 #define OBSCURA_RASTER_INTERNAL_H
 
-#include "gl/gl.h"
+#include "context.h"
 #include "obscura/scene.h"
 
 /* The checks both rasterisers make before any GL work: a scene with

@@ -1,5 +1,5 @@
-/* Cameras: the camera JSON written beside a render (see
- * tests/data/room_small.camera.json) and the plain field-of-view camera. */
+/* The camera JSON written beside a render (see
+ * tests/data/room_small.camera.json); the camera maths is core/camera.c. */
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <math.h>
@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "obscura/io.h"
 
 /* A camera file is a few hundred bytes; anything near this is not one. */
 #define MAX_JSON_BYTES (1 << 20)
@@ -15,33 +16,6 @@
 /* Clip range of a camera JSON that gives a field of view but no near/far. */
 #define DEFAULT_NEAR 0.1
 #define DEFAULT_FAR 1000.0
-
-int obs_camera_fit_aspect(obs_camera *cam, int width, int height)
-{
-    float *P = cam->projection; /* row-major */
-    if (width <= 0 || height <= 0 || P[14] != -1.0f || P[15] != 0.0f || P[1] != 0.0f ||
-        P[2] != 0.0f || P[4] != 0.0f || P[6] != 0.0f)
-        return 0;
-    float x = P[5] * (float)height / (float)width;
-    if (x == P[0])
-        return 0;
-    P[0] = x;
-    return 1;
-}
-
-void obs_camera_from_fov(float fov_y_deg, float aspect, float near_z, float far_z, obs_camera *cam)
-{
-    const double f = 1.0 / tan(fov_y_deg * 3.14159265358979323846 / 360.0);
-    memset(cam, 0, sizeof *cam);
-    obs__mat4_identity(cam->world_to_camera);
-    cam->projection[0] = (float)(f / aspect);
-    cam->projection[5] = (float)f;
-    cam->projection[10] = -(far_z + near_z) / (far_z - near_z);
-    cam->projection[11] = -2.0f * far_z * near_z / (far_z - near_z);
-    cam->projection[14] = -1.0f;
-    cam->has_projection = 1;
-    cam->source = OBS_CAMERA_PARAMS;
-}
 
 /* Reads the whole file, NUL-terminated; caller frees *buf. */
 static obs_status slurp(const char *path, char **buf, size_t *len, char err[OBS_ERR_LEN])

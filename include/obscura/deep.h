@@ -83,9 +83,8 @@ void obs_deep_free(obs_deep_image *d);
  * file cannot be written. */
 obs_status obs_deep_write_exr(const char *path, const obs_deep_image *d, char err[OBS_ERR_LEN]);
 
-/* Values of the parameters deep_mode and deep_hull (params.h). */
-enum { OBS_DEEP_MULTI = 1, OBS_DEEP_SINGLE = 2 };
-enum { OBS_DEEP_SOLID = 1, OBS_DEEP_THIN = 2 };
+/* The values of the parameters deep_mode and deep_hull, OBS_DEEP_MULTI
+ * and so on, are in obscura/params.h with the others. */
 
 /* ---- list compression (OITAO section III-B) ----------------------------- */
 

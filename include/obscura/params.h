@@ -17,90 +17,131 @@
 extern "C" {
 #endif
 
-/* Enumerated parameter values.  0 always means "default". */
-typedef enum obs_depth_mode {
-    OBS_DEPTH_DEFAULT,
-    OBS_DEPTH_PLANAR, /* distance along the camera axis (Blender's Depth.Z) */
-    OBS_DEPTH_RADIAL, /* distance from the camera centre */
-    OBS_DEPTH_NDC     /* OpenGL depth-buffer value in [0,1] */
-} obs_depth_mode;
+/* Enumerated parameter values.  Each enum is generated from one list,
+ * X(VALUE, choice) in the order of the parameter's choices, and so is the
+ * choices string of its row in the table below (OBS_CHOICES): the enum,
+ * the names users give and the code cannot disagree.  Values are 1-based;
+ * 0 always means "default". */
+#define OBS__ENUM_VALUE(value, choice) value,
+#define OBS__ENUM_CHOICE(value, choice) "|" #choice
+/* "a|b|c" from a list (the leading '|' skipped). */
+#define OBS_CHOICES(LIST) (LIST(OBS__ENUM_CHOICE) + 1)
 
-typedef enum obs_switch {
-    OBS_SWITCH_DEFAULT,
-    OBS_ON,
-    OBS_OFF
-} obs_switch;
+#define OBS_DEPTH_MODE_LIST(X)                                                 \
+    X(OBS_DEPTH_PLANAR, planar) /* distance along the camera axis (Depth.Z) */ \
+    X(OBS_DEPTH_RADIAL, radial) /* distance from the camera centre */          \
+    X(OBS_DEPTH_NDC, ndc)       /* OpenGL depth-buffer value in [0,1] */
+typedef enum obs_depth_mode { OBS_DEPTH_DEFAULT, OBS_DEPTH_MODE_LIST(OBS__ENUM_VALUE) } obs_depth_mode;
+
+#define OBS_SWITCH_LIST(X) X(OBS_ON, on) X(OBS_OFF, off)
+typedef enum obs_switch { OBS_SWITCH_DEFAULT, OBS_SWITCH_LIST(OBS__ENUM_VALUE) } obs_switch;
 
 /* Culling pre-pass, VAO++ section 4.2 (parameter `culling`). */
-typedef enum obs_culling {
-    OBS_CULLING_DEFAULT,
-    OBS_CULLING_OFF,
-    OBS_CULLING_GREEDY,  /* culling candidates get AO 1 */
-    OBS_CULLING_CAREFUL  /* culling candidates take the 4-sample set */
-} obs_culling;
+#define OBS_CULLING_LIST(X)                                                    \
+    X(OBS_CULLING_OFF, off)                                                    \
+    X(OBS_CULLING_GREEDY, greedy)   /* culling candidates get AO 1 */          \
+    X(OBS_CULLING_CAREFUL, careful) /* culling candidates take the 4-sample set */
+typedef enum obs_culling { OBS_CULLING_DEFAULT, OBS_CULLING_LIST(OBS__ENUM_VALUE) } obs_culling;
 
 /* How the depth range check (VAO++ 4.4, eq 4) measures d (parameter
  * `range_distance`). */
+#define OBS_RANGE_DISTANCE_LIST(X)                                             \
+    X(OBS_RANGE_DISTANCE_NORMAL, normal) /* below the occluding surface, along its normal */ \
+    X(OBS_RANGE_DISTANCE_VIEW, view)     /* behind the visible surface, along view Z */
 typedef enum obs_range_distance {
     OBS_RANGE_DISTANCE_DEFAULT,
-    OBS_RANGE_DISTANCE_NORMAL, /* below the occluding surface, along its normal */
-    OBS_RANGE_DISTANCE_VIEW    /* behind the visible surface, along view Z */
+    OBS_RANGE_DISTANCE_LIST(OBS__ENUM_VALUE)
 } obs_range_distance;
 
 /* Luminance sensitivity, VAO++ section 4.3 (parameter `luminance`). */
-typedef enum obs_luminance {
-    OBS_LUMINANCE_DEFAULT,
-    OBS_LUMINANCE_OFF,
-    OBS_LUMINANCE_LUM,   /* Rec. 709 luminance of the colour */
-    OBS_LUMINANCE_VALUE  /* HSV V: max(r, g, b) */
-} obs_luminance;
+#define OBS_LUMINANCE_LIST(X)                                                  \
+    X(OBS_LUMINANCE_OFF, off)                                                  \
+    X(OBS_LUMINANCE_LUM, lum)     /* Rec. 709 luminance of the colour */       \
+    X(OBS_LUMINANCE_VALUE, value) /* HSV V: max(r, g, b) */
+typedef enum obs_luminance { OBS_LUMINANCE_DEFAULT, OBS_LUMINANCE_LIST(OBS__ENUM_VALUE) } obs_luminance;
 
 /* Colour bleeding, VAO++ section 4.7 (parameter `bleeding`). */
-typedef enum obs_bleeding {
-    OBS_BLEEDING_DEFAULT,
-    OBS_BLEEDING_OFF,
-    OBS_BLEEDING_FULL,    /* every sample */
-    OBS_BLEEDING_HALF,    /* every second sample */
-    OBS_BLEEDING_QUARTER  /* every fourth sample */
-} obs_bleeding;
+#define OBS_BLEEDING_LIST(X)                                                   \
+    X(OBS_BLEEDING_OFF, off)                                                   \
+    X(OBS_BLEEDING_FULL, full)       /* every sample */                        \
+    X(OBS_BLEEDING_HALF, half)       /* every second sample */                 \
+    X(OBS_BLEEDING_QUARTER, quarter) /* every fourth sample */
+typedef enum obs_bleeding { OBS_BLEEDING_DEFAULT, OBS_BLEEDING_LIST(OBS__ENUM_VALUE) } obs_bleeding;
 
-/* The AO method (parameter `method`). */
+/* The AO method (parameter `method`); each has a row in the method table
+ * (core/methods/methods.c). */
+#define OBS_METHOD_LIST(X)                                                     \
+    X(OBS_METHOD_VAOPP, vaopp)           /* VAO++: the whole chain */          \
+    X(OBS_METHOD_VAO, vao)               /* plain VAO: no adaptive sampling, culling, range check */ \
+    X(OBS_METHOD_HEMISPHERE, hemisphere) /* normal-oriented hemisphere SSAO */ \
+    X(OBS_METHOD_ANGLE, angle)           /* angle-based paired-sample SSAO */  \
+    X(OBS_METHOD_HBAO, hbao)             /* horizon-based AO */
 typedef enum obs_method {
     OBS_METHOD_DEFAULT,
-    OBS_METHOD_VAOPP,      /* VAO++: the whole chain */
-    OBS_METHOD_VAO,        /* plain VAO: no adaptive sampling, culling, range check */
-    OBS_METHOD_HEMISPHERE, /* normal-oriented hemisphere SSAO (methods/hemisphere.c) */
-    OBS_METHOD_ANGLE,      /* angle-based paired-sample SSAO (methods/angle.c) */
-    OBS_METHOD_HBAO        /* horizon-based AO (methods/hbao.c) */
+    OBS_METHOD_LIST(OBS__ENUM_VALUE)
+    OBS_METHOD_COUNT /* 1 + the last method */
 } obs_method;
 
 /* What the VAO methods' AO measures (parameter `ao_definition`). */
+#define OBS_AO_DEFINITION_LIST(X)                                              \
+    X(OBS_AO_RAYS, rays)     /* a ray tracer's AO within radius: R = 2 radius, eq 1's V converted */ \
+    X(OBS_AO_VOLUME, volume) /* the paper's volumetric obscurance: R = radius */
 typedef enum obs_ao_definition {
     OBS_AO_DEFINITION_DEFAULT,
-    OBS_AO_RAYS,   /* a ray tracer's AO within radius: R = 2 radius, eq 1's V converted */
-    OBS_AO_VOLUME  /* the paper's volumetric obscurance: R = radius */
+    OBS_AO_DEFINITION_LIST(OBS__ENUM_VALUE)
 } obs_ao_definition;
 
 /* The arc cosine of the angle-based method (parameter `angle_acos`). */
-typedef enum obs_acos {
-    OBS_ACOS_DEFAULT,
-    OBS_ACOS_QUADRATIC, /* pi (1 - sign(x) x^2) / 2 */
-    OBS_ACOS_LINEAR,    /* pi (1 - x) / 2 */
-    OBS_ACOS_EXACT      /* acos(x) */
-} obs_acos;
+#define OBS_ACOS_LIST(X)                                                       \
+    X(OBS_ACOS_QUADRATIC, quadratic) /* pi (1 - sign(x) x^2) / 2 */            \
+    X(OBS_ACOS_LINEAR, linear)       /* pi (1 - x) / 2 */                      \
+    X(OBS_ACOS_EXACT, exact)         /* acos(x) */
+typedef enum obs_acos { OBS_ACOS_DEFAULT, OBS_ACOS_LIST(OBS__ENUM_VALUE) } obs_acos;
 
+#define OBS_NORMAL_SPACE_LIST(X)                                               \
+    X(OBS_NORMALS_WORLD, world)   /* world space: rotated by world_to_camera */ \
+    X(OBS_NORMALS_CAMERA, camera) /* view space, camera looking down -Z */
 typedef enum obs_normal_space {
     OBS_NORMALS_DEFAULT,
-    OBS_NORMALS_WORLD,  /* world space: rotated by world_to_camera */
-    OBS_NORMALS_CAMERA  /* view space, camera looking down -Z */
+    OBS_NORMAL_SPACE_LIST(OBS__ENUM_VALUE)
 } obs_normal_space;
+
+/* Deep input (obscura/deep.h): parameters deep_mode and deep_hull. */
+#define OBS_DEEP_MODE_LIST(X)                                                  \
+    X(OBS_DEEP_MULTI, multi)   /* OITAO Algorithm 1 over every node */         \
+    X(OBS_DEEP_SINGLE, single) /* the front node alone */
+typedef enum obs_deep_mode { OBS_DEEP_MODE_DEFAULT, OBS_DEEP_MODE_LIST(OBS__ENUM_VALUE) } obs_deep_mode;
+
+#define OBS_DEEP_HULL_LIST(X)                                                  \
+    X(OBS_DEEP_SOLID, solid) /* OITAO eq 1: solid volumes */                   \
+    X(OBS_DEEP_THIN, thin)   /* OITAO eqs 2-4: thin hulls */
+typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM_VALUE) } obs_deep_hull;
+
+/* Every ENUM row of the table and its list, for the test that walks them
+ * (tests/unit/core/test_params.c).  X(parameter, LIST) */
+#define OBS_PARAM_ENUMS(X)                                                     \
+    X(method, OBS_METHOD_LIST)                                                 \
+    X(ao_definition, OBS_AO_DEFINITION_LIST)                                   \
+    X(adaptive, OBS_SWITCH_LIST)                                               \
+    X(culling, OBS_CULLING_LIST)                                               \
+    X(depth_mode, OBS_DEPTH_MODE_LIST)                                         \
+    X(normal_space, OBS_NORMAL_SPACE_LIST)                                     \
+    X(range_check, OBS_SWITCH_LIST)                                            \
+    X(range_distance, OBS_RANGE_DISTANCE_LIST)                                 \
+    X(blur, OBS_SWITCH_LIST)                                                   \
+    X(luminance, OBS_LUMINANCE_LIST)                                           \
+    X(bleeding, OBS_BLEEDING_LIST)                                             \
+    X(angle_acos, OBS_ACOS_LIST)                                               \
+    X(deep_mode, OBS_DEEP_MODE_LIST)                                           \
+    X(deep_front_half, OBS_SWITCH_LIST)                                        \
+    X(deep_hull, OBS_DEEP_HULL_LIST)
 
 /* X(name, type, default, min, max, choices, doc)
  * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4.
  * An INT with choices takes only the listed numbers (within min..max). 
  * For ENUM the default is the choice's name; for MAT4 it is unused. */
 #define OBS_PARAM_TABLE(X)                                                     \
-    X(method, ENUM, "vaopp", 0, 0, "vaopp|vao|hemisphere|angle|hbao",          \
+    X(method, ENUM, "vaopp", 0, 0, OBS_CHOICES(OBS_METHOD_LIST),          \
       "AO method: vaopp (the VAO++ chain), vao (plain VAO, VAO++ section 3: "  \
       "adaptive, culling and range_check off), hemisphere (normal-oriented "   \
       "hemisphere SSAO), angle (angle-based paired-sample SSAO), hbao "        \
@@ -112,7 +153,7 @@ typedef enum obs_normal_space {
       "of cosine-weighted rays unblocked within D, Cycles' AO pass); VAO's "   \
       "kernel width R (below) follows from it by ao_definition: 2 D (rays) "   \
       "or D (volume)")                                                         \
-    X(ao_definition, ENUM, "rays", 0, 0, "rays|volume",                        \
+    X(ao_definition, ENUM, "rays", 0, 0, OBS_CHOICES(OBS_AO_DEFINITION_LIST),                        \
       "what methods vaopp and vao return: rays, a ray tracer's AO within "    \
       "radius D: R = 2 D, so the tangent sphere (radius D) touches a wall "    \
       "exactly when rays of length D reach it, and eq 1's volume fraction is " \
@@ -126,7 +167,7 @@ typedef enum obs_normal_space {
       "z-order) exist for 2, 4, 8, 16 and 32 only, other counts are "          \
       "refused: the first n of a larger z-ordered set would cover one part "   \
       "of the disk")                                                           \
-    X(adaptive, ENUM, "on", 0, 0, "on|off",                                    \
+    X(adaptive, ENUM, "on", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),                                    \
       "adaptive sampling (VAO++ 4.1): each pixel takes the sample set whose "  \
       "size fits the area of its tangent sphere's disk projected on the "      \
       "screen: 2 samples up to twice the area of a disk of diameter "          \
@@ -137,7 +178,7 @@ typedef enum obs_normal_space {
       "adaptive sampling uses its minimum of 2 samples (4x this diameter "     \
       "takes 32); 0.01 is 4.8 px at 480 px, where the 3x3 rotation tile's "    \
       "9 x 2 sample positions are as many as the pixels the disk covers")      \
-    X(culling, ENUM, "careful", 0, 0, "off|greedy|careful",                    \
+    X(culling, ENUM, "careful", 0, 0, OBS_CHOICES(OBS_CULLING_LIST),                    \
       "culling pre-pass (VAO++ 4.2): AO with 8 samples at 1/8 resolution, "   \
       "read back at each pixel's four corners with bilinear filtering; a "     \
       "pixel where none of the four shows occlusion (estimate below 1 - "      \
@@ -147,10 +188,10 @@ typedef enum obs_normal_space {
       "a culling pre-pass estimate below 1 - culling_epsilon shows "           \
       "occlusion; 0.02 culls 48-79 % of the test scenes' pixels with a mean "  \
       "|AO(careful) - AO(off)| under 0.002 (half an 8-bit step)")              \
-    X(depth_mode, ENUM, "planar", 0, 0, "planar|radial|ndc",                   \
+    X(depth_mode, ENUM, "planar", 0, 0, OBS_CHOICES(OBS_DEPTH_MODE_LIST),                   \
       "what the depth channel holds: distance along the camera axis, "         \
       "distance from the camera, or a [0,1] OpenGL depth-buffer value")        \
-    X(normal_space, ENUM, "world", 0, 0, "world|camera",                       \
+    X(normal_space, ENUM, "world", 0, 0, OBS_CHOICES(OBS_NORMAL_SPACE_LIST),                       \
       "space of the normal channel (world normals need world_to_camera)")      \
     X(unit_scale, FLOAT, 1.0, 1e-6, 1e6, NULL,                                 \
       "depth values are multiplied by this to reach the units of radius")      \
@@ -164,7 +205,7 @@ typedef enum obs_normal_space {
     X(world_to_camera, MAT4, 0, 0, 0, NULL,                                    \
       "16 numbers, row-major, column-vector convention: world to camera "      \
       "(-Z forward); overrides the file's camera rotation")                    \
-    X(range_check, ENUM, "on", 0, 0, "on|off",                                 \
+    X(range_check, ENUM, "on", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),                                 \
       "depth range check (VAO++ 4.4, eq 4): a pipe hidden behind a surface "   \
       "counts as occluded only by the falloff s(d) = u / max(u, d/R), "      \
       "d its distance behind that surface; off: occluders are infinitely "     \
@@ -172,14 +213,14 @@ typedef enum obs_normal_space {
     X(range_u, FLOAT, 0.03, 1e-4, 1.0, NULL,                                   \
       "u of the depth range check's falloff (eq 4): occluders are taken as "   \
       "fully thick up to u * R behind the visible surface")                    \
-    X(range_distance, ENUM, "normal", 0, 0, "normal|view",                     \
+    X(range_distance, ENUM, "normal", 0, 0, OBS_CHOICES(OBS_RANGE_DISTANCE_LIST),                     \
       "how the depth range check measures eq 4's d, the distance of a pipe "  \
       "behind its occluder: normal: the pipe's depth below the occluding "     \
       "surface, along that surface's normal (d along view Z times |n.z| of "  \
       "the surface seen at the sample's pixel), the thickness of a flat "      \
       "occluder; view: along view Z (a floor seen at a grazing angle then "    \
       "counts as thin as a sheet facing the camera)")                          \
-    X(blur, ENUM, "on", 0, 0, "on|off",                                        \
+    X(blur, ENUM, "on", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),                                        \
       "low-pass filter (VAO++ 4.6): depth-aware cross-bilateral Gaussian "     \
       "blur of the AO, a horizontal then a vertical pass; neighbours whose "   \
       "view depth differs from the centre's by more than R are left out")      \
@@ -190,7 +231,7 @@ typedef enum obs_normal_space {
       "standard deviation of the blur's Gaussian in pixels; with the default " \
       "radius 2, sigma 1.25 nulls the period-3 pattern of the 3x3 rotation "   \
       "tile (exp(-1/2s^2) + exp(-4/2s^2) = 1)")                                 \
-    X(luminance, ENUM, "off", 0, 0, "off|lum|value",                           \
+    X(luminance, ENUM, "off", 0, 0, OBS_CHOICES(OBS_LUMINANCE_LIST),                           \
       "luminance sensitivity (VAO++ 4.3, eq 3): suppress the occlusion of "    \
       "bright pixels of the G-buffer colour, after the blur: occlusion 1 - AO "\
       "times (1 - min(1, max(0, lum - threshold + width)) / (2 width))^sigma, "\
@@ -207,7 +248,7 @@ typedef enum obs_normal_space {
     X(lum_sigma, FLOAT, 1.0, 0.01, 100.0, NULL,                                \
       "sigma of eq 3, the ramp's linearity: 1 a straight ramp, above 1 "       \
       "occlusion falls off sooner, below 1 later")                             \
-    X(bleeding, ENUM, "off", 0, 0, "off|full|half|quarter",                    \
+    X(bleeding, ENUM, "off", 0, 0, OBS_CHOICES(OBS_BLEEDING_LIST),                    \
       "colour bleeding (VAO++ 4.7, eq 5): the bleed term averages, over "      \
       "every sample (full), every second (half) or every fourth (quarter), "   \
       "white mixed towards the colour at the sample's pixel by c(x) = "        \
@@ -225,7 +266,7 @@ typedef enum obs_normal_space {
     X(angle_pairs, INT, 6, 1, 16, NULL,                                        \
       "method angle: sample pairs per pixel, each pair two opposite points "   \
       "of a disk of radius D (6 in the angle-based SSAO article)")              \
-    X(angle_acos, ENUM, "quadratic", 0, 0, "quadratic|linear|exact",           \
+    X(angle_acos, ENUM, "quadratic", 0, 0, OBS_CHOICES(OBS_ACOS_LIST),           \
       "method angle: the arc cosine of the pair angles: the article's "        \
       "quadratic pi (1 - sign(x) x^2) / 2 (max error 9.47 degrees), its "      \
       "linear pi (1 - x) / 2 (18.95 degrees), or exact acos")                  \
@@ -239,7 +280,7 @@ typedef enum obs_normal_space {
     X(hbao_angle_bias, FLOAT, 30.0, 1e-6, 89.0, NULL,                          \
       "method hbao: angle bias in degrees added to the tangent angle t(theta) "\
       "against the self-occlusion of tessellated surfaces")                   \
-    X(deep_mode, ENUM, "multi", 0, 0, "multi|single",                          \
+    X(deep_mode, ENUM, "multi", 0, 0, OBS_CHOICES(OBS_DEEP_MODE_LIST),                          \
       "deep input: multi (OITAO Algorithm 1: each sample is occluded by every "\
       "compressed node at its pixel, the largest occlusion counts) or single " \
       "(the front node alone, as a flat depth buffer would)")                  \
@@ -247,10 +288,10 @@ typedef enum obs_normal_space {
       "deep input: nodes m kept per pixel by the list compression of OITAO "   \
       "III-B (eq 5 drops the node of least alpha (1 - z), z the depth "        \
       "normalised over the image)")                                           \
-    X(deep_front_half, ENUM, "off", 0, 0, "on|off",                            \
+    X(deep_front_half, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),                            \
       "deep input: eq 5 searches the back half of the list only, keeping the " \
       "m/2 front nodes (OITAO V-A, Fig. 6 column C)")                          \
-    X(deep_hull, ENUM, "solid", 0, 0, "solid|thin",                            \
+    X(deep_hull, ENUM, "solid", 0, 0, OBS_CHOICES(OBS_DEEP_HULL_LIST),                            \
       "deep input: transparent surfaces as solid volumes (OITAO eq 1: "        \
       "occluders and receivers weighted by alpha) or thin hulls (eqs 2-4: "    \
       "exterior and interior AO mixed by W(p), alpha or 1 - alpha on back "    \

@@ -12,7 +12,7 @@
 
 #include "obscura/deep.h"
 #include "deep/deep_internal.h"
-#include "gl/gl.h"
+#include "context.h"
 
 #define FIXTURE TESTDATA "/deep_small.exr"
 

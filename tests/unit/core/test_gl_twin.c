@@ -3,7 +3,7 @@
  * test_backends.c.) */
 #include "gl_testutil.h"
 
-#include "gl/gl.h"
+#include "context.h"
 
 /* GL and CPU do the same float arithmetic, but a sample that lands within
  * rounding of a pixel border may read the neighbouring pixel's depth on

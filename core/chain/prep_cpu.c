@@ -1,0 +1,161 @@
+/* CPU twin of the prep pass (GLSL: prep.frag.glsl, common.glsl): each
+ * pixel's view-space position and normal, and the maps between pixels and
+ * view space that every pass shares (obs__px_ndc, obs__view_to_px). */
+#include <math.h>
+
+#include "chain/frame.h"
+
+/* GLSL: px_ndc() in common.glsl */
+void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2])
+{
+    ndc[0] = ((float)x + 0.5f + f->viewport[0]) / f->viewport[2] * 2.0f - 1.0f;
+    ndc[1] = 1.0f - ((float)y + 0.5f + f->viewport[1]) / f->viewport[3] * 2.0f;
+}
+
+/* GLSL: view_ray() in common.glsl.  The point seen at NDC (nx, ny) with
+ * planar depth d is origin + d * dir (dir.z = -1): the projection solved
+ * for view x, y as a 2x2 system that is affine in view z. */
+static void view_ray(const float *P, const float ndc[2], float origin[3], float dir[3])
+{
+    float nx = ndc[0], ny = ndc[1];
+    float a = P[0] - nx * P[12], b = P[1] - nx * P[13];
+    float c = P[4] - ny * P[12], d = P[5] - ny * P[13];
+    float b0x = nx * P[15] - P[3], b0y = ny * P[15] - P[7];
+    float b1x = nx * P[14] - P[2], b1y = ny * P[14] - P[6];
+    float inv = 1.0f / (a * d - b * c);
+    origin[0] = (d * b0x - b * b0y) * inv;
+    origin[1] = (a * b0y - c * b0x) * inv;
+    origin[2] = 0.0f;
+    dir[0] = -(d * b1x - b * b1y) * inv;
+    dir[1] = -(a * b1y - c * b1x) * inv;
+    dir[2] = -1.0f;
+}
+
+/* GLSL: linear_depth() in prep.frag.glsl.  Planar depth from the raw value,
+ * 0 for background. */
+static float linear_depth(const obs__frame *f, float raw, const float dir[3])
+{
+    if (!(raw > 0.0f) || raw >= OBS__SKY_DEPTH) /* also catches NaN */
+        return 0.0f;
+    if (f->depth_mode == OBS_DEPTH_RADIAL)
+        return raw / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    if (f->depth_mode == OBS_DEPTH_NDC) {
+        if (raw >= 1.0f)
+            return 0.0f;
+        /* z_ndc = (P22 z + P23) / (P32 z + P33), solved for view z. */
+        const float *P = f->proj;
+        float zn = 2.0f * raw - 1.0f;
+        float z = (P[11] - zn * P[15]) / (zn * P[14] - P[10]);
+        return -z > 0.0f ? -z : 0.0f;
+    }
+    return raw;
+}
+
+void obs__prep_position(const obs__frame *f, float raw_depth, int x, int y, float out[4])
+{
+    float ndc[2], o[3], dir[3];
+    obs__px_ndc(f, x, y, ndc);
+    view_ray(f->proj, ndc, o, dir);
+    float d = linear_depth(f, raw_depth, dir);
+    if (d <= 0.0f || !isfinite(d)) {
+        out[0] = out[1] = out[2] = out[3] = 0.0f;
+        return;
+    }
+    out[0] = o[0] + d * dir[0];
+    out[1] = o[1] + d * dir[1];
+    out[2] = -d;
+    out[3] = d;
+}
+
+static void normalize3(float v[3])
+{
+    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (l > 0.0f) {
+        v[0] /= l;
+        v[1] /= l;
+        v[2] /= l;
+    }
+}
+
+/* GLSL: neighbour_delta() in prep.frag.glsl.  The difference towards the
+ * neighbour (along +x or +y) whose depth is closer to the centre's, so
+ * that edges do not bend the normal; 0 if neither neighbour is geometry. */
+static int neighbour_delta(const obs__frame *f, const float *pos, int x, int y, int dx, int dy,
+                           float out[3])
+{
+    const float *c = pos + 4 * ((size_t)y * (size_t)f->width + (size_t)x);
+    const float *best = NULL;
+    float best_dz = 0.0f, sign = 1.0f;
+    for (int s = -1; s <= 1; s += 2) {
+        int nx = x + s * dx, ny = y + s * dy;
+        if (nx < 0 || ny < 0 || nx >= f->width || ny >= f->height)
+            continue;
+        const float *q = pos + 4 * ((size_t)ny * (size_t)f->width + (size_t)nx);
+        if (q[3] <= 0.0f)
+            continue;
+        float dz = fabsf(q[3] - c[3]);
+        if (!best || dz < best_dz) {
+            best = q;
+            best_dz = dz;
+            sign = (float)s;
+        }
+    }
+    if (!best)
+        return 0;
+    for (int k = 0; k < 3; k++)
+        out[k] = sign * (best[k] - c[k]);
+    return 1;
+}
+
+void obs__prep_normal(const obs__frame *f, const float *pos, const float *in_normal, int x, int y,
+                      float out[3])
+{
+    const float *p = pos + 4 * ((size_t)y * (size_t)f->width + (size_t)x);
+    if (!f->reconstruct_normals) {
+        const float *m = f->normal_matrix;
+        for (int k = 0; k < 3; k++)
+            out[k] = m[3 * k] * in_normal[0] + m[3 * k + 1] * in_normal[1] +
+                     m[3 * k + 2] * in_normal[2];
+        normalize3(out);
+        return;
+    }
+    float ddx[3], ddy[3];
+    if (neighbour_delta(f, pos, x, y, 1, 0, ddx) && neighbour_delta(f, pos, x, y, 0, 1, ddy)) {
+        out[0] = ddx[1] * ddy[2] - ddx[2] * ddy[1];
+        out[1] = ddx[2] * ddy[0] - ddx[0] * ddy[2];
+        out[2] = ddx[0] * ddy[1] - ddx[1] * ddy[0];
+    } else {
+        out[0] = out[1] = out[2] = 0.0f;
+    }
+    if (out[0] == 0.0f && out[1] == 0.0f && out[2] == 0.0f) {
+        /* isolated pixel: face the camera */
+        out[0] = -p[0];
+        out[1] = -p[1];
+        out[2] = -p[2];
+    } else if (out[0] * p[0] + out[1] * p[1] + out[2] * p[2] > 0.0f) {
+        /* a visible surface faces the camera */
+        out[0] = -out[0];
+        out[1] = -out[1];
+        out[2] = -out[2];
+    }
+    normalize3(out);
+}
+
+/* GLSL: view_to_px() in common.glsl. */
+int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy)
+{
+    const float *P = f->proj;
+    float cw = P[12] * s[0] + P[13] * s[1] + P[14] * s[2] + P[15];
+    if (!(cw > 0.0f))
+        return 0;
+    float cx = P[0] * s[0] + P[1] * s[1] + P[2] * s[2] + P[3];
+    float cy = P[4] * s[0] + P[5] * s[1] + P[6] * s[2] + P[7];
+    float u = (cx / cw * 0.5f + 0.5f) * f->viewport[2] - f->viewport[0];
+    float v = (0.5f - cy / cw * 0.5f) * f->viewport[3] - f->viewport[1];
+    float fu = floorf(u), fv = floorf(v);
+    if (!(fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height))
+        return 0;
+    *qx = (int)fu;
+    *qy = (int)fv;
+    return 1;
+}

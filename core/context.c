@@ -1,0 +1,91 @@
+/* The context's life: obs_ctx_create makes the GL device (core/gl), and
+ * every pass keeps its objects in the context until obs_ctx_destroy,
+ * which tears the passes' objects down first and the device last.  Also
+ * the context's info and per-pass timing switches. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "context.h"
+
+obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out, char err[OBS_ERR_LEN])
+{
+    obs_ctx_desc d = {0};
+    if (desc)
+        d = *desc;
+    *out = NULL;
+    if ((unsigned)d.backend >= OBS_BACKEND_COUNT)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown backend %d", (int)d.backend);
+
+    obs_ctx *ctx = calloc(1, sizeof *ctx);
+    if (!ctx)
+        return obs__fail(err, OBS_NO_MEMORY, "out of memory creating the context");
+#ifdef OBS_DEBUG
+    ctx->dev.debug = 1; /* debug builds always install the KHR_debug callback */
+#else
+    ctx->dev.debug = d.debug;
+#endif
+    ctx->dev.log = d.log;
+    ctx->dev.log_user = d.log_user;
+    obs_status s = obs__gl_device_create(&ctx->dev, d.backend, err);
+    if (s != OBS_OK) {
+        free(ctx);
+        return s;
+    }
+    obs__log(ctx, OBS_LOG_INFO, "GL context: %s, OpenGL %s, %s", obs_backend_name(ctx->dev.backend),
+             ctx->dev.version, ctx->dev.renderer);
+    *out = ctx;
+    return OBS_OK;
+}
+
+void obs_ctx_get_info(const obs_ctx *ctx, obs_ctx_info *info)
+{
+    info->backend = ctx->dev.backend;
+    info->gl_version = ctx->dev.version;
+    info->gl_vendor = ctx->dev.vendor;
+    info->gl_renderer = ctx->dev.renderer;
+}
+
+void obs_ctx_destroy(obs_ctx *ctx)
+{
+    if (!ctx)
+        return;
+    if (obs__ctx_bind(ctx, NULL) == OBS_OK) {
+        obs__chain_release(&ctx->prog, &ctx->tg);
+        obs__deep_release(&ctx->deep);
+        if (ctx->queries[0])
+            glDeleteQueries(OBS_PASS_COUNT, ctx->queries);
+    }
+    obs__gl_device_destroy(&ctx->dev);
+    free(ctx);
+}
+
+/* ---- per-pass timings (GL_TIME_ELAPSED queries, taken by the passes) ---- */
+
+const char *obs_pass_name(obs_pass p)
+{
+    static const char *const names[OBS_PASS_COUNT] = {
+        "upload", "prep", "cull", "ao", "blur", "finish", "composite", "readback"};
+    return (unsigned)p < OBS_PASS_COUNT ? names[p] : "unknown";
+}
+
+obs_status obs_ctx_set_timing(obs_ctx *ctx, int on, char err[OBS_ERR_LEN])
+{
+    if (!ctx)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
+    obs_status s = obs__ctx_bind(ctx, err);
+    if (s != OBS_OK)
+        return s;
+    if (on && !ctx->queries[0])
+        glGenQueries(OBS_PASS_COUNT, ctx->queries);
+    ctx->timing = on != 0;
+    ctx->times_valid = 0;
+    return obs__gl_check("creating timer queries", err);
+}
+
+int obs_ctx_last_times(const obs_ctx *ctx, obs_pass_times *out)
+{
+    if (!ctx || !ctx->times_valid)
+        return 0;
+    *out = ctx->times;
+    return 1;
+}

@@ -1,0 +1,22 @@
+/* Deep input's GL objects kept in the context between frames (deep_gl.c).
+ * Not installed. */
+#ifndef OBSCURA_DEEP_GL_H
+#define OBSCURA_DEEP_GL_H
+
+#include "gl/gl.h"
+
+#define OBS__DEEP_VARIANTS 16 /* 4 switches of the deep pass (deep_gl.c: DEEP_*) */
+
+/* The deep pass's programs, and the node planes and the output target of
+ * one size and node count. */
+typedef struct obs__deep_targets {
+    GLuint prog[OBS__DEEP_VARIANTS]; /* by variant (deep_gl.c: DEEP_*), built on first use, kept */
+    int width, height, m;        /* 0: none allocated yet */
+    GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
+    GLuint tex_out, fbo;         /* AO of the front node and the blend */
+} obs__deep_targets;
+
+/* Deletes the programs, textures and framebuffer; the context is current. */
+void obs__deep_release(obs__deep_targets *t);
+
+#endif
