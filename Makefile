@@ -61,8 +61,12 @@ SHADER_HDR := $(BUILD)/gen/obs_shaders.h
 CLI_SRC := $(wildcard clients/*.c)
 CLI_OBJ := $(CLI_SRC:%.c=$(BUILD)/obj/%.o)
 
-UNIT_SRC := $(wildcard tests/unit/*/test_*.c)
+UNIT_SRC := $(filter-out tests/unit/nogl/%,$(wildcard tests/unit/*/test_*.c))
 UNIT_BIN := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+# Tests that must link without the GL libraries (libobscura.a, libm and
+# cmocka only): the CPU twin of the chain.
+NOGL_SRC := $(wildcard tests/unit/nogl/test_*.c)
+NOGL_BIN := $(NOGL_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
 LIB := $(BUILD)/libobscura.a
 CLI := $(BUILD)/obscura
@@ -80,7 +84,7 @@ DAEMON_BENCH := $(BUILD)/daemon_bench
 -include protocol/protocol.mk daemon/daemon.mk clients/clients.mk tests/fuzz/fuzz.mk
 E2E_DEPS += $(UPSCALE)
 
-.PHONY: all deps demo demo-run test check unit e2e headers readme readme-check samples bench quality clean deep-fixture
+.PHONY: all deps demo demo-run test check unit e2e loops headers readme readme-check samples bench quality clean deep-fixture
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI) $(EXTRA_BINS)
@@ -147,6 +151,10 @@ $(BUILD)/tests/%: tests/unit/%.c $(PROTO_LIB) $(LIB) tests/unit/testutil.h $(wil
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) $(EXTRA_LIBS) -lcmocka
 
+$(BUILD)/tests/nogl/%: tests/unit/nogl/%.c $(LIB) tests/unit/testutil.h $(wildcard tests/unit/core/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) -lm -lcmocka
+
 -include $(CORE_OBJ:.o=.d) $(CLI_OBJ:.o=.d)
 
 
@@ -173,7 +181,7 @@ test: deps
 	$(MAKE) check
 	$(MAKE) check BUILD=build/asan SAN=1
 
-check: all headers unit e2e readme-check
+check: all headers loops unit e2e readme-check
 
 # The README's parameter table is generated from the parameter table.
 readme: $(CLI) $(BUILD)/obscurad
@@ -187,8 +195,18 @@ samples: $(CLI)
 readme-check: $(CLI) $(BUILD)/obscurad
 	@tools/readme_params.sh --check $(CLI) $(BUILD)/obscurad README.md && echo "readme: generated tables up to date"
 
-unit: $(UNIT_BIN)
-	@tests/run_unit.sh $(UNIT_BIN)
+unit: $(UNIT_BIN) $(NOGL_BIN)
+	@for t in $(NOGL_BIN); do \
+	  if readelf -d $$t | grep -E 'NEEDED.*lib(EGL|OSMesa|GL|OpenGL)' ; then \
+	    echo "unit: $$t needs a GL library"; exit 1; fi; done
+	@tests/run_unit.sh $(UNIT_BIN) $(NOGL_BIN)
+
+# No two source files call each other in a loop, in each part of the tree
+# (tools/call_loops.py: nm of the objects).
+loops: $(CORE_OBJ) $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
+	@tools/call_loops.py $(CORE_OBJ)
+	@tools/call_loops.py $(DAEMON_OBJ)
+	@tools/call_loops.py $(PROTO_OBJ) $(CLI_OBJ)
 
 # Every tests/e2e/*.sh runs with the binaries' paths in the environment.
 E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "chain/frame.h"
+#include "methods/methods.h"
 #include "obscura/io.h"
 
 /* Inverse transpose of the upper 3x3 of m: the matrix that carries normals
@@ -104,23 +105,12 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     }
 
     /* The comparison methods (parameter method); their AO runs in place
-     * of the VAO estimator, the rest of the chain is shared. */
+     * of the VAO estimator, the rest of the chain is shared.  Each fills
+     * its own fields (core/methods/methods.c). */
     f->method = p->method;
-    f->hs_count = p->hemisphere_samples;
-    f->hs_bias = p->hemisphere_bias * f->radius;
-    obs__hemisphere_kernel(f->hs_count, &f->hs_kernel[0][0]);
-    f->angle_pairs = p->angle_pairs;
-    obs__angle_pattern(f->angle_pairs, &f->angle_xy[0][0]);
-    f->angle_acos = p->angle_acos;
-    f->hbao_dirs = p->hbao_directions;
-    f->hbao_steps = p->hbao_steps;
-    for (int d = 0; d < f->hbao_dirs; d++) { /* HBAO: Nd directions over 2 pi */
-        double a = 2.0 * M_PI * d / f->hbao_dirs;
-        f->hbao_dir[d][0] = (float)cos(a);
-        f->hbao_dir[d][1] = (float)sin(a);
-    }
-    f->hbao_bias_cs[0] = (float)cos(p->hbao_angle_bias * M_PI / 180.0);
-    f->hbao_bias_cs[1] = (float)sin(p->hbao_angle_bias * M_PI / 180.0);
+    const obs__method *m = obs__method_get(p->method);
+    if (m && m->setup)
+        m->setup(p, f);
 
     static const float identity3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     memcpy(f->normal_matrix, identity3, sizeof identity3);

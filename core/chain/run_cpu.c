@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "chain/frame.h"
+#include "methods/methods.h"
 
 /* GLSL: composite.frag.glsl.  Section 5: "applied to resulting image
  * simply by multiplication by occlusion values": colour x AO, and x the
@@ -38,6 +39,7 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
     s = obs__frame_setup(NULL, gb, &p, &f, err);
     if (s != OBS_OK)
         return s;
+    const obs__method *method = obs__method_get(f.method);
 
     size_t npx = (size_t)f.width * (size_t)f.height;
     pos = malloc(npx * 4 * sizeof(float));
@@ -84,7 +86,7 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
             float *b = bleed + 3 * i;
             ao[i] = 1.0f;
             b[0] = b[1] = b[2] = 1.0f;
-            if (f.method > OBS_METHOD_VAO) {
+            if (method->pixel) {
                 /* a comparison method in place of the VAO estimator */
                 ao[i] = obs__method_pixel(&f, pos, nrm, x, y, &n);
             } else if (pos[4 * i + 3] > 0.0f) {

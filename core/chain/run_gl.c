@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "context.h"
+#include "methods/methods.h"
 #include "obs_shaders.h"
 
 static const char glsl_version[] = "#version 430 core\n";
@@ -110,17 +111,16 @@ static obs_status build_blur_program(obs_ctx *ctx, int rays, int radius, char er
 }
 
 /* The AO program of a comparison method (parameter method), built on its
- * first use: common.glsl, method.glsl, the method's file, method.frag. */
-static obs_status build_method_program(obs_ctx *ctx, int method, char err[OBS_ERR_LEN])
+ * first use: common.glsl, method.glsl, the method's file (its row of the
+ * method table), method.frag.  Nothing for vaopp and vao. */
+static obs_status build_method_program(obs_ctx *ctx, const obs__method *m, char err[OBS_ERR_LEN])
 {
-    static const char *const names[3] = {"hemisphere", "angle", "hbao"};
-    const char *const files[3] = {obs__shader_hemisphere, obs__shader_angle, obs__shader_hbao};
-    int k = method - OBS_METHOD_HEMISPHERE;
-    if (k < 0 || k > 2 || ctx->prog.method[k])
+    if (!m->glsl || ctx->prog.method[m->id])
         return OBS_OK;
-    const char *src[] = {glsl_version, obs__shader_common, obs__shader_method, files[k],
+    const char *src[] = {glsl_version, obs__shader_common, obs__shader_method, m->glsl,
                          obs__shader_method_frag};
-    return obs__gl_program(names[k], obs__shader_fullscreen_vert, src, 5, &ctx->prog.method[k], err);
+    return obs__gl_program(m->name, obs__shader_fullscreen_vert, src, 5, &ctx->prog.method[m->id],
+                           err);
 }
 
 static GLuint make_texture(obs_ctx *ctx, GLenum format, int w, int h)
@@ -280,32 +280,19 @@ static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
     glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
 }
 
-/* Selects the AO program of a comparison method (hemisphere, angle,
- * hbao; built by build_method_program) and sets its uniforms: method.glsl's
- * and the method's own. */
-static GLuint use_method_program(obs_ctx *ctx, const obs__frame *f, const obs__targets *t)
+/* Selects the AO program of a comparison method (built by
+ * build_method_program) and sets its uniforms: method.glsl's and the
+ * method's own (its row of the method table). */
+static GLuint use_method_program(obs_ctx *ctx, const obs__method *m, const obs__frame *f,
+                                 const obs__targets *t)
 {
-    GLuint prog = ctx->prog.method[f->method - OBS_METHOD_HEMISPHERE];
+    GLuint prog = ctx->prog.method[m->id];
     glUseProgram(prog);
     set_common(prog, f);
     bind_prep_planes(prog, t);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
-    if (f->method == OBS_METHOD_HEMISPHERE) {
-        glUniform1i(glGetUniformLocation(prog, "u_hs_count"), f->hs_count);
-        glUniform1f(glGetUniformLocation(prog, "u_hs_bias"), f->hs_bias);
-        glUniform1fv(glGetUniformLocation(prog, "u_hs_kernel"), 3 * f->hs_count,
-                     &f->hs_kernel[0][0]);
-    } else if (f->method == OBS_METHOD_ANGLE) {
-        glUniform1i(glGetUniformLocation(prog, "u_angle_pairs"), f->angle_pairs);
-        glUniform2fv(glGetUniformLocation(prog, "u_angle_xy"), f->angle_pairs, &f->angle_xy[0][0]);
-        glUniform1i(glGetUniformLocation(prog, "u_angle_acos"), f->angle_acos);
-    } else {
-        glUniform1i(glGetUniformLocation(prog, "u_hbao_dirs"), f->hbao_dirs);
-        glUniform1i(glGetUniformLocation(prog, "u_hbao_steps"), f->hbao_steps);
-        glUniform2fv(glGetUniformLocation(prog, "u_hbao_dir"), f->hbao_dirs, &f->hbao_dir[0][0]);
-        glUniform2fv(glGetUniformLocation(prog, "u_hbao_bias_cs"), 1, f->hbao_bias_cs);
-    }
+    obs__gl_set_uniforms(prog, f, m->uniforms);
     return prog;
 }
 
@@ -380,13 +367,14 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     s = obs__frame_setup(ctx, gb, &p, &f, err);
     if (s != OBS_OK)
         return s;
+    const obs__method *method = obs__method_get(f.method);
     s = obs__ctx_bind(ctx, err);
     if (s != OBS_OK)
         return s;
     s = build_programs(ctx, err);
     if (s == OBS_OK)
-        s = build_method_program(ctx, f.method, err);
-    if (s == OBS_OK && f.method <= OBS_METHOD_VAO)
+        s = build_method_program(ctx, method, err);
+    if (s == OBS_OK && !method->glsl)
         s = build_vao_program(ctx, 0, ao_variant(&f), err);
     if (s == OBS_OK && f.culling)
         s = build_vao_program(ctx, 1, ao_variant(&f), err);
@@ -448,8 +436,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
 
     /* AO pass */
     pass_begin(ctx, OBS_PASS_AO, &ran);
-    if (f.method > OBS_METHOD_VAO) { /* a comparison method in place of VAO */
-        prog = use_method_program(ctx, &f, t);
+    if (method->glsl) { /* a comparison method in place of VAO */
+        prog = use_method_program(ctx, method, &f, t);
     } else {
         prog = ctx->prog.vao[ao_variant(&f)];
         glUseProgram(prog);

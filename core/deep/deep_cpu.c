@@ -16,10 +16,12 @@
  * The AO of each node is blended front to back by alpha into one 2D AO
  * (section III, the separated scheme). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "deep/deep_internal.h"
+#include "methods/methods.h"
 
 int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_exr_layer layers[3])
 {
@@ -57,14 +59,29 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
     if (!d || !d->offset || d->width <= 0 || d->height <= 0)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no deep image");
     obs_params_resolve(params, &p);
-    if (p.method != OBS_METHOD_VAOPP && p.method != OBS_METHOD_VAO &&
-        p.method != OBS_METHOD_HEMISPHERE) {
-        char name[32];
+    const obs__method *method = obs__method_get(p.method);
+    if (!method || !method->deep) {
+        /* the message lists the rows of the method table that run here */
+        char name[32], list[128] = "";
+        size_t len = 0;
+        int k = 0, n = 0;
+        for (int i = 0; i < obs__method_count(); i++)
+            n += obs__method_at(i)->deep;
+        for (int i = 0; i < obs__method_count(); i++) {
+            const obs__method *r = obs__method_at(i);
+            if (!r->deep)
+                continue;
+            k++;
+            len += (size_t)snprintf(list + len, sizeof list - len, "%s%s",
+                                    k == 1 ? "" : k == n ? " and " : ", ", r->name);
+            if (len >= sizeof list)
+                break;
+        }
         obs_param_format(&p, obs_param_find("method"), name, sizeof name);
         return obs__fail(err, OBS_INVALID_ARGUMENT,
                          "method %s does not run on deep input: the multi-layer chain takes "
-                         "methods vaopp, vao and hemisphere",
-                         name);
+                         "methods %s",
+                         name, list);
     }
     s = obs_deep_compress(d, p.deep_layers, p.deep_front_half == OBS_ON, &df->layers, err);
     if (s != OBS_OK)

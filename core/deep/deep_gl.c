@@ -24,6 +24,7 @@
 
 #include "context.h"
 #include "deep/deep_internal.h"
+#include "methods/methods.h"
 #include "obs_shaders.h"
 
 static GLuint array_texture(obs_ctx *ctx, int w, int h, int m)
@@ -212,9 +213,8 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
     glUniform1i(glGetUniformLocation(prog, "u_m"), df.m);
     glUniform1i(glGetUniformLocation(prog, "u_multi"), df.multi);
-    glUniform1i(glGetUniformLocation(prog, "u_hs_count"), f->hs_count);
-    glUniform1f(glGetUniformLocation(prog, "u_hs_bias"), f->hs_bias);
-    glUniform1fv(glGetUniformLocation(prog, "u_hs_kernel"), 3 * f->hs_count, &f->hs_kernel[0][0]);
+    /* the method's own (method hemisphere's kernel; none for vaopp, vao) */
+    obs__gl_set_uniforms(prog, f, obs__method_get(f->method)->uniforms);
     /* the node planes are read through images (imageLoad), as the planes
      * of run_gl.c are: cheaper than texelFetch on llvmpipe */
     glBindImageTexture(0, t->tex_pos, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);

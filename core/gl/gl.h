@@ -11,6 +11,7 @@
 #include <GL/glcorearb.h>
 
 #include "gl/backend.h"
+#include "gl/uniform.h"
 
 #define OBS__GL_FUNCS(X)                                                       \
     X(PFNGLGETSTRINGPROC, GetString)                                           \
@@ -181,6 +182,10 @@ obs_status obs__gl_program(const char *name, const char *vert, const char *const
 /* Deletes the programs of p[0..n) that were built (0: never built). */
 void obs__gl_delete_programs(const GLuint *p, size_t n);
 #define OBS__GL_DELETE_PROGRAMS(a) obs__gl_delete_programs((a), sizeof(a) / sizeof((a)[0]))
+
+/* Sets the uniforms of the list u (ending at a NULL name) of the program
+ * in use, reading their values from the struct at base. */
+void obs__gl_set_uniforms(GLuint prog, const void *base, const obs__uniform *u);
 
 /* Drains glGetError; returns OBS_GL_ERROR naming `where` if any. */
 obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);

@@ -72,3 +72,22 @@ obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN])
         return OBS_OK;
     return obs__fail(err, OBS_GL_ERROR, "OpenGL error 0x%04x in %s", (unsigned)first, where);
 }
+
+void obs__gl_set_uniforms(GLuint prog, const void *base, const obs__uniform *u)
+{
+    for (; u->name; u++) {
+        const char *v = (const char *)base + u->offset;
+        GLint loc = glGetUniformLocation(prog, u->name);
+        GLsizei n = u->count_of ? *(const int *)((const char *)base + u->count_of) * u->scale : 1;
+        switch (u->type) {
+        case OBS__U_INT: glUniform1i(loc, *(const int *)v); break;
+        case OBS__U_FLOAT:
+            if (u->count_of)
+                glUniform1fv(loc, n, (const float *)v);
+            else
+                glUniform1f(loc, *(const float *)v);
+            break;
+        case OBS__U_VEC2: glUniform2fv(loc, n, (const float *)v); break;
+        }
+    }
+}

@@ -104,6 +104,55 @@ static void test_table_is_complete(void **state)
     assert_null(obs_param_at(obs_param_count()));
 }
 
+/* Each enumerated parameter: its enum and its choices come from one list
+ * (OBS_*_LIST in params.h); every choice parses to its enum value,
+ * formats back to its name, and the choices hold no other name. */
+static void check_choice(const char *param, const char *choice, int value, int *count)
+{
+    obs_params p = {0};
+    char err[OBS_ERR_LEN] = "", back[64];
+    const obs_param_info *pi = obs_param_find(param);
+    assert_non_null(pi);
+    assert_int_equal(pi->type, OBS_PARAM_ENUM);
+    if (obs_param_set(&p, param, choice, err) != OBS_OK)
+        fail_msg("%s=%s: %s", param, choice, err);
+    assert_int_equal(*(const int *)((const char *)&p + pi->offset), value);
+    obs_param_format(&p, pi, back, sizeof back);
+    assert_string_equal(back, choice);
+    (*count)++;
+}
+
+static int choice_count(const char *param)
+{
+    int n = 1;
+    for (const char *c = obs_param_find(param)->choices; *c; c++)
+        n += *c == '|';
+    return n;
+}
+
+static void test_enums_agree_with_choices(void **state)
+{
+    (void)state;
+    int enums = 0;
+#define CHOICE(value, choice) check_choice(param, #choice, value, &n);
+#define ENUM(name, LIST)                                                       \
+    {                                                                          \
+        const char *param = #name;                                             \
+        int n = 0;                                                             \
+        LIST(CHOICE)                                                           \
+        assert_int_equal(n, choice_count(param));                              \
+        enums++;                                                               \
+    }
+    OBS_PARAM_ENUMS(ENUM)
+#undef ENUM
+#undef CHOICE
+    /* every ENUM row of the table has its list in OBS_PARAM_ENUMS */
+    int rows = 0;
+    for (int i = 0; i < obs_param_count(); i++)
+        rows += obs_param_at(i)->type == OBS_PARAM_ENUM;
+    assert_int_equal(enums, rows);
+}
+
 static void test_status_names(void **state)
 {
     (void)state;
@@ -121,6 +170,7 @@ int main(void)
         cmocka_unit_test(test_set_and_format),
         cmocka_unit_test(test_errors_name_the_parameter),
         cmocka_unit_test(test_table_is_complete),
+        cmocka_unit_test(test_enums_agree_with_choices),
         cmocka_unit_test(test_status_names),
     };
     return cmocka_run_group_tests_name("params", tests, NULL, NULL);

@@ -1,0 +1,42 @@
+/* The table of AO methods (parameter `method`): one row per method, the
+ * one place that says what a method is made of.  Adding a method is a
+ * row here plus its files (a CPU twin in core/methods/, a GLSL file in
+ * core/shaders/ defining method_ao()); tests/unit/core/test_methods.c
+ * checks the rows against the parameter's choices.  No GL here: the
+ * uniforms are described as data, set by the GL pass (run_gl.c,
+ * deep_gl.c), so the CPU twin links without GL.  Not installed. */
+#ifndef OBSCURA_METHODS_H
+#define OBSCURA_METHODS_H
+
+#include "chain/frame.h"
+#include "gl/uniform.h"
+
+#define OBS__METHOD_MAX_UNIFORMS 6
+
+typedef struct obs__method {
+    obs_method id;
+    const char *name;     /* as the parameter's choices spell it */
+    /* The method's AO pass: NULL for vaopp and vao, which run the chain's
+     * own (vao.frag.glsl); else the GLSL file defining method_ao(),
+     * compiled between method.glsl and method.frag.glsl. */
+    const char *glsl;
+    /* Fills the method's fields of the frame from the resolved
+     * parameters (NULL: nothing of its own). */
+    void (*setup)(const obs_params *p, obs__frame *f);
+    /* The CPU twin of method_ao(): the AO of the point p with normal n at
+     * pixel (x, y), *count the samples taken (NULL for vaopp and vao). */
+    float (*pixel)(const obs__frame *f, const float *pos, int x, int y, const float p[4],
+                   const float n[3], int *count);
+    obs__uniform uniforms[OBS__METHOD_MAX_UNIFORMS]; /* ends at a NULL name */
+    int deep; /* 1: runs on deep input too (core/deep: OITAO's GetAO) */
+} obs__method;
+
+/* The row of method id (resolved, 1 .. OBS_METHOD_COUNT - 1); NULL for
+ * any other value. */
+const obs__method *obs__method_get(int id);
+
+/* Every row in the order of the enum (obs__method_count() rows). */
+const obs__method *obs__method_at(int i);
+int obs__method_count(void);
+
+#endif
