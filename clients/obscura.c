@@ -22,6 +22,7 @@
 #include "batch.h"
 #include "obscura/deep.h"
 #include "cli.h"
+#include "flags.h"
 #include "ground.h"
 #include "obscura/io.h"
 #include "obscura/metrics.h"
@@ -146,56 +147,34 @@ static void usage(FILE *f)
     fprintf(f, "\nexit codes: 0 ok, 1 failure, 2 usage, 3 bad input, 4 server unreachable or busy\n");
 }
 
-/* Splits "a,b,c" into at most n names (pointers into a copy kept in buf). */
-static int split_names(const char *s, char *buf, size_t len, const char **out, int n)
-{
-    snprintf(buf, len, "%s", s);
-    int k = 0;
-    for (char *tok = strtok(buf, ","); tok && k < n; tok = strtok(NULL, ","))
-        out[k++] = tok;
-    return k;
-}
-
+/* The request options (output, format, float, png_bits, the channel
+ * map) live in req, parsed by their rows in protocol/http.c; the rest are
+ * the client's own. */
 typedef struct ao_args {
-    const char *in, *out, *camera, *format, *backend;
-    unsigned outputs;
-    int float_exr, png_bits, cpu, debug_gl;
+    const char *in, *out, *camera, *backend;
+    int format_given; /* else the format comes from the file name */
+    int cpu, debug_gl;
     long max_size;
-    obs_channel_map map;
-    char normal_buf[256], color_buf[256];
-    obs_params params;
+    obs_http_request req;
 } ao_args;
 
 /* Matches "--name VALUE" or "--name=VALUE"; returns the value or NULL. */
 static const char *opt_value(int argc, char **argv, int *i, const char *name)
 {
-    const char *a = argv[*i];
-    size_t n = strlen(name);
-    if (a[0] != '-')
-        return NULL;
-    a += a[1] == '-' ? 2 : 1;
-    if (strncmp(a, name, n) != 0)
-        return NULL;
-    if (a[n] == '=')
-        return a + n + 1;
-    if (a[n] != '\0')
-        return NULL;
-    if (*i + 1 >= argc)
+    const char *v = NULL;
+    if (cli_flag_value(argc, argv, i, name, &v) < 0)
         die_usage("option --%s needs a value", name);
-    return argv[++*i];
-}
-
-static int is_switch(const char *arg, const char *name)
-{
-    return arg[0] == '-' && arg[1] == '-' && strcmp(arg + 2, name) == 0;
+    return v;
 }
 
 static void parse_ao(int argc, char **argv, ao_args *a)
 {
     const char *v;
+    const obs_http_option *op;
+    char err[OBS_ERR_LEN];
+    int k;
     memset(a, 0, sizeof *a);
-    a->outputs = OBS_OUTPUT_AO;
-    a->png_bits = 8;
+    obs_http_request_init(&a->req);
     for (int i = 0; i < argc; i++) {
         const char *arg = argv[i];
         if (arg[0] != '-' || arg[1] == '\0') {
@@ -204,69 +183,25 @@ static void parse_ao(int argc, char **argv, ao_args *a)
             a->in = arg;
         } else if ((v = opt_value(argc, argv, &i, "o")) || (v = opt_value(argc, argv, &i, "output-file"))) {
             a->out = v;
-        } else if ((v = opt_value(argc, argv, &i, "output"))) {
-            char buf[256];
-            const char *names[8];
-            int k = split_names(v, buf, sizeof buf, names, 8);
-            a->outputs = 0;
-            for (int j = 0; j < k; j++) {
-                if (!strcmp(names[j], "ao"))
-                    a->outputs |= OBS_OUTPUT_AO;
-                else if (!strcmp(names[j], "composite"))
-                    a->outputs |= OBS_OUTPUT_COMPOSITE;
-                else if (!strcmp(names[j], "both"))
-                    a->outputs |= OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE;
-                else if (!strcmp(names[j], "samples"))
-                    a->outputs |= OBS_OUTPUT_SAMPLE_COUNT;
-                else if (!strcmp(names[j], "cull"))
-                    a->outputs |= OBS_OUTPUT_CULL_MASK;
-                else if (!strcmp(names[j], "bleed"))
-                    a->outputs |= OBS_OUTPUT_BLEED;
-                else if (!strcmp(names[j], "luminance"))
-                    a->outputs |= OBS_OUTPUT_LUMINANCE;
-                else
-                    die_usage("--output: '%s' is not one of "
-                              "ao|composite|both|samples|cull|bleed|luminance",
-                              names[j]);
-            }
-            if (!a->outputs)
-                die_usage("--output: '%s' names no output", v);
-        } else if ((v = opt_value(argc, argv, &i, "format"))) {
-            if (strcmp(v, "exr") && strcmp(v, "png"))
-                die_usage("--format: '%s' is not one of exr|png", v);
-            a->format = v;
-        } else if (is_switch(arg, "float")) {
-            a->float_exr = 1;
-        } else if ((v = opt_value(argc, argv, &i, "png-bits"))) {
-            a->png_bits = atoi(v);
-            if (a->png_bits != 8 && a->png_bits != 16)
-                die_usage("--png-bits: '%s' is not 8 or 16", v);
+        } else if ((k = cli_request_flag(argc, argv, &i, &a->req, &op, err)) != 0) {
+            if (k < 0)
+                die_usage("%s", err);
+            a->format_given |= !strcmp(op->name, "format");
         } else if ((v = opt_value(argc, argv, &i, "camera"))) {
             a->camera = v;
-        } else if ((v = opt_value(argc, argv, &i, "preset"))) {
-            a->map.preset = v;
-        } else if ((v = opt_value(argc, argv, &i, "depth"))) {
-            a->map.depth = v;
-        } else if ((v = opt_value(argc, argv, &i, "normal"))) {
-            if (split_names(v, a->normal_buf, sizeof a->normal_buf, a->map.normal, 3) != 3)
-                die_usage("--normal needs three channel names X,Y,Z");
-        } else if ((v = opt_value(argc, argv, &i, "color"))) {
-            int k = split_names(v, a->color_buf, sizeof a->color_buf, a->map.color, 4);
-            if (k != 3 && k != 4)
-                die_usage("--color needs three or four channel names R,G,B[,A]");
         } else if ((v = opt_value(argc, argv, &i, "max-size"))) {
             a->max_size = strtol(v, NULL, 10);
             if (a->max_size < 1 || a->max_size > 1 << 20)
                 die_usage("--max-size: '%s' is not in [1, 1048576]", v);
         } else if ((v = opt_value(argc, argv, &i, "backend"))) {
             a->backend = v;
-        } else if (is_switch(arg, "cpu")) {
+        } else if (cli_is_switch(arg, "cpu")) {
             a->cpu = 1;
-        } else if (is_switch(arg, "debug-gl")) {
+        } else if (cli_is_switch(arg, "debug-gl")) {
             a->debug_gl = 1;
-        } else if (is_switch(arg, "quiet") || !strcmp(arg, "-q")) {
+        } else if (cli_is_switch(arg, "quiet") || !strcmp(arg, "-q")) {
             verbosity = OBS_LOG_WARN;
-        } else if (is_switch(arg, "verbose") || !strcmp(arg, "-v")) {
+        } else if (cli_is_switch(arg, "verbose") || !strcmp(arg, "-v")) {
             verbosity = OBS_LOG_DEBUG;
         } else if (arg[1] == '-') {
             /* a parameter of the table: --name VALUE or --name=VALUE */
@@ -278,8 +213,7 @@ static void parse_ao(int argc, char **argv, ao_args *a)
                 die_usage("unknown option '%s'", arg);
             if (!eq && i + 1 >= argc)
                 die_usage("parameter --%s needs a value", name);
-            char err[OBS_ERR_LEN];
-            if (obs_param_set(&a->params, name, eq ? eq + 1 : argv[++i], err) != OBS_OK)
+            if (obs_param_set(&a->req.params, name, eq ? eq + 1 : argv[++i], err) != OBS_OK)
                 die_usage("%s", err);
         } else {
             die_usage("unknown option '%s'", arg);
@@ -289,12 +223,12 @@ static void parse_ao(int argc, char **argv, ao_args *a)
         die_usage("ao: no input file");
     if (!a->out)
         die_usage("ao: no output file (-o FILE)");
-    if (!a->format) {
+    if (!a->format_given) {
         const char *dot = strrchr(a->out, '.');
         if (dot && !strcmp(dot, ".png"))
-            a->format = "png";
+            a->req.format = OBS_HTTP_PNG;
         else if (dot && !strcmp(dot, ".exr"))
-            a->format = "exr";
+            a->req.format = OBS_HTTP_EXR;
         else
             die_usage("cannot tell the format of '%s': use .exr or .png, or --format", a->out);
     }
@@ -329,10 +263,10 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
                                 char err[OBS_ERR_LEN])
 {
     obs_status s = OBS_OK;
-    if (!strcmp(a->format, "exr")) {
+    if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[OBS_RESULT_LAYERS];
         int n = obs_result_exr_layers(r, layers);
-        s = obs_exr_write(a->out, layers, n, a->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
+        s = obs_exr_write(a->out, layers, n, a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
         return s;
@@ -370,7 +304,7 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
             }
             img = &scaled;
         }
-        s = obs_png_write(path, img, a->png_bits, files[k].srgb, err);
+        s = obs_png_write(path, img, a->req.png_bits, files[k].srgb, err);
         obs_image_free(&scaled);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", path);
@@ -412,9 +346,9 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     double t_read = now_ms() - t0;
     t0 = now_ms();
     if (a->cpu) {
-        s = obs_deep_run_cpu(&d, &a->params, &r, err);
+        s = obs_deep_run_cpu(&d, &a->req.params, &r, err);
     } else if (server) { /* clients/remote.c prints its own errors */
-        if ((rc = cli_remote_run_deep(server, argc, argv, a->in, &d, a->outputs, &r)) != EXIT_OK)
+        if ((rc = cli_remote_run_deep(server, argc, argv, a->in, &d, a->req.outputs, &r)) != EXIT_OK)
             goto done;
     } else {
         obs_ctx_desc desc = {.debug = a->debug_gl, .log = log_cb};
@@ -423,7 +357,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
             rc = cli_fail(s, "OpenGL", err);
             goto done;
         }
-        s = obs_deep_run(ctx, &d, &a->params, &r, err);
+        s = obs_deep_run(ctx, &d, &a->req.params, &r, err);
     }
     if (s != OBS_OK) {
         rc = cli_fail(s, a->in, err);
@@ -431,11 +365,11 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     }
     double t_run = now_ms() - t0;
     const obs_camera *cam = d.camera.has_projection ? &d.camera : NULL;
-    int want_ao = (a->outputs & OBS_OUTPUT_AO) != 0, want_comp = (a->outputs & OBS_OUTPUT_COMPOSITE) != 0;
-    if (!strcmp(a->format, "exr")) {
+    int want_ao = (a->req.outputs & OBS_OUTPUT_AO) != 0, want_comp = (a->req.outputs & OBS_OUTPUT_COMPOSITE) != 0;
+    if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[3];
-        int n = obs_deep_result_exr_layers(&r, a->outputs, layers);
-        s = obs_exr_write(a->out, layers, n, a->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
+        int n = obs_deep_result_exr_layers(&r, a->req.outputs, layers);
+        s = obs_exr_write(a->out, layers, n, a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
     } else {
@@ -451,7 +385,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
             if (!files[k].on)
                 continue;
             suffixed(a->out, files[k].suffix, path, sizeof path);
-            s = obs_png_write(path, files[k].img, a->png_bits, files[k].srgb, err);
+            s = obs_png_write(path, files[k].img, a->req.png_bits, files[k].srgb, err);
             if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
                 fprintf(stderr, "obscura: wrote %s\n", path);
         }
@@ -462,7 +396,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     }
     if (verbosity >= OBS_LOG_INFO) {
         obs_params p;
-        obs_params_resolve(&a->params, &p);
+        obs_params_resolve(&a->req.params, &p);
         fprintf(stderr, "obscura: info: deep %dx%d, %llu samples, %s, %d nodes%s, %s hulls, "
                 "radius %g, %d %ssamples: read %.1f ms, AO %.1f ms\n",
                 d.width, d.height, (unsigned long long)d.offset[(size_t)d.width * d.height],
@@ -500,7 +434,7 @@ static int cmd_ao(int argc, char **argv)
     if (obs_exr_is_deep(a.in, &deep, err) == OBS_OK && deep)
         return cmd_ao_deep(&a, &lim, server, argc, argv);
     double t0 = now_ms();
-    s = obs_gbuffer_read_exr(a.in, &a.map, &lim, &gf, err);
+    s = obs_gbuffer_read_exr(a.in, &a.req.map, &lim, &gf, err);
     if (s != OBS_OK)
         return cli_input_fail(s, a.in, err);
     double t_read = now_ms() - t0;
@@ -527,9 +461,9 @@ static int cmd_ao(int argc, char **argv)
 
     t0 = now_ms();
     if (a.cpu) {
-        s = obs_run_cpu(&gf.gb, &a.params, a.outputs, &res, err);
+        s = obs_run_cpu(&gf.gb, &a.req.params, a.req.outputs, &res, err);
     } else if (server) { /* clients/remote.c prints its own errors */
-        if ((rc = cli_remote_run(server, argc, argv, a.in, &gf.gb, a.outputs, &res)) != EXIT_OK)
+        if ((rc = cli_remote_run(server, argc, argv, a.in, &gf.gb, a.req.outputs, &res)) != EXIT_OK)
             goto done;
     } else {
         obs_ctx_desc desc = {.debug = a.debug_gl, .log = log_cb};
@@ -542,7 +476,7 @@ static int cmd_ao(int argc, char **argv)
         if (verbosity >= OBS_LOG_DEBUG)
             fprintf(stderr, "obscura: debug: context created in %.1f ms\n", now_ms() - t0);
         t0 = now_ms();
-        s = obs_run(ctx, &gf.gb, &a.params, a.outputs, &res, err);
+        s = obs_run(ctx, &gf.gb, &a.req.params, a.req.outputs, &res, err);
     }
     if (s != OBS_OK) {
         rc = cli_fail(s, a.in, err);
@@ -559,7 +493,7 @@ static int cmd_ao(int argc, char **argv)
     if (verbosity >= OBS_LOG_INFO) {
         obs_params p;
         obs_ctx_info ci = {0};
-        obs_params_resolve(&a.params, &p);
+        obs_params_resolve(&a.req.params, &p);
         if (ctx)
             obs_ctx_get_info(ctx, &ci);
         char how[64]; /* the method and its sample counts */
@@ -679,7 +613,7 @@ static int cmd_samples(int argc, char **argv)
     static const int sizes[] = {2, 4, 8, 16, 32};
     int c_source = 0;
     for (int i = 0; i < argc; i++) {
-        if (is_switch(argv[i], "c"))
+        if (cli_is_switch(argv[i], "c"))
             c_source = 1;
         else
             die_usage("samples: unknown argument '%s'", argv[i]);
@@ -841,7 +775,7 @@ static int cmd_compare(int argc, char **argv)
             mask_opt = v;
         else if ((v = opt_value(argc, argv, &i, "diff")))
             diff = v;
-        else if (is_switch(argv[i], "json"))
+        else if (cli_is_switch(argv[i], "json"))
             json = 1;
         else if (argv[i][0] == '-')
             die_usage("compare: unknown option '%s'", argv[i]);

@@ -200,11 +200,12 @@ static int has(const pairs *ps, const char *name)
 }
 
 /* The table's parameters as given (parse_ao has checked them), and with
- * `map_too` the channel-map options.  Names keep their spelling ('-' or
- * '_'), which both protocols accept; leading "--" is dropped. */
+ * `map_too` the channel-map options (the request options' NAMES rows;
+ * output, format and float this client asks for itself).  Names keep
+ * their spelling ('-' or '_'), which both protocols accept; leading "--"
+ * is dropped. */
 static void collect(int argc, char **argv, int map_too, pairs *ps, char names[][OBS_BIN_MAX_NAME + 1])
 {
-    static const char *const map_opts[] = {"preset", "depth", "normal", "color", NULL};
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         if (strncmp(a, "--", 2) != 0)
@@ -216,8 +217,8 @@ static void collect(int argc, char **argv, int map_too, pairs *ps, char names[][
         char *name = names[ps->n];
         snprintf(name, OBS_BIN_MAX_NAME + 1, "%.*s", (int)n, a + 2);
         int is_map = 0;
-        for (int k = 0; map_opts[k]; k++)
-            is_map |= !strcmp(name, map_opts[k]);
+        for (const obs_http_option *op = obs_http_options; op->name; op++)
+            is_map |= op->kind == OBS_HTTP_OPT_NAMES && !strcmp(name, op->name);
         int is_param = obs_param_find(name) != NULL;
         if (!is_param && !(map_too && is_map))
             continue; /* a client option (its value, if any, is no "--" word) */

@@ -2,25 +2,72 @@
 #include "http.h"
 
 #include <cjson/cJSON.h>
+#include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-const obs_http_option obs_http_options[] = {
-    {"output", "enum", "ao", "ao|composite|both", "what to return: the AO, the composited colour, or both (EXR only)"},
-    {"format", "enum", "exr", "exr|png", "image format of the response"},
-    {"float", "bool", "0", "0|1", "EXR: 32-bit float channels instead of half"},
-    {"png_bits", "enum", "8", "8|16", "PNG bit depth"},
-    {"preset", "enum", "auto", "auto|blender|generic", "channel-name preset of the G-buffer"},
-    {"depth", "string", "", NULL, "depth channel name (overrides the preset)"},
-    {"normal", "string", "", NULL, "normal channel names X,Y,Z"},
-    {"color", "string", "", NULL, "colour channel names R,G,B[,A]"},
-    {NULL, NULL, NULL, NULL, NULL}};
+enum { Q = OBS_HTTP_QUERY, CLI = OBS_HTTP_CLI, ANY = Q | CLI };
 
-static obs_status bad(char err[OBS_ERR_LEN], const char *fmt, const char *a, const char *b)
+/* The debug outputs are the CLI's only: obscurad answers AO and the
+ * composite (clients/remote.c refuses the others with --server). */
+static const obs_http_choice output_choices[] = {
+    {"ao", OBS_OUTPUT_AO, ANY},
+    {"composite", OBS_OUTPUT_COMPOSITE, ANY},
+    {"both", OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE, ANY},
+    {"samples", OBS_OUTPUT_SAMPLE_COUNT, CLI},
+    {"cull", OBS_OUTPUT_CULL_MASK, CLI},
+    {"bleed", OBS_OUTPUT_BLEED, CLI},
+    {"luminance", OBS_OUTPUT_LUMINANCE, CLI},
+    {NULL, 0, 0}};
+static const obs_http_choice format_choices[] = {
+    {"exr", OBS_HTTP_EXR, ANY}, {"png", OBS_HTTP_PNG, ANY}, {NULL, 0, 0}};
+static const obs_http_choice png_bits_choices[] = {{"8", 8, ANY}, {"16", 16, ANY}, {NULL, 0, 0}};
+
+#define FIELD(f) offsetof(obs_http_request, f)
+#define SLOT(f) sizeof ((obs_http_request *)0)->f
+
+const obs_http_option obs_http_options[] = {
+    /* a comma list in the CLI only: one answer holds AO and composite at most */
+    {.name = "output", .kind = OBS_HTTP_OPT_CHOICE, .field = FIELD(outputs), .def = "ao",
+     .choices = output_choices, .list = CLI,
+     .doc = "what to return: the AO, the composited colour, or both (EXR only)"},
+    {.name = "format", .kind = OBS_HTTP_OPT_CHOICE, .field = FIELD(format), .def = "exr",
+     .choices = format_choices, .doc = "image format of the response"},
+    {.name = "float", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(float_exr), .def = "0",
+     .doc = "EXR: 32-bit float channels instead of half"},
+    {.name = "png_bits", .kind = OBS_HTTP_OPT_CHOICE, .field = FIELD(png_bits), .def = "8",
+     .choices = png_bits_choices, .doc = "PNG bit depth"},
+    {.name = "preset", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(preset), .def = "auto",
+     .names = obs_channel_presets, .min = 1, .max = 1, .slot = SLOT(preset), .map = FIELD(map.preset),
+     .doc = "channel-name preset of the G-buffer"},
+    {.name = "depth", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(depth), .def = "", .min = 1,
+     .max = 1, .slot = SLOT(depth), .map = FIELD(map.depth),
+     .what = "a channel name (1 to 63 characters)", .doc = "depth channel name (overrides the preset)"},
+    {.name = "normal", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(normal), .def = "", .min = 3,
+     .max = 3, .slot = SLOT(normal[0]), .map = FIELD(map.normal),
+     .what = "three channel names X,Y,Z", .doc = "normal channel names X,Y,Z"},
+    {.name = "color", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(color), .def = "", .min = 3,
+     .max = 4, .slot = SLOT(color[0]), .map = FIELD(map.color),
+     .what = "three or four channel names R,G,B[,A]", .doc = "colour channel names R,G,B[,A]"},
+    {.name = NULL}};
+
+/* CHOICE and BOOL rows store through an int. */
+_Static_assert(sizeof(obs_http_format) == sizeof(int) && sizeof(unsigned) == sizeof(int),
+               "request option fields are int-sized");
+
+/* The most names a NAMES row takes, and the longest slot. */
+#define NAMES_MAX 4
+#define SLOT_MAX 64
+
+static obs_status bad(char err[OBS_ERR_LEN], const char *fmt, ...)
 {
+    va_list ap;
+    va_start(ap, fmt);
     if (err)
-        snprintf(err, OBS_ERR_LEN, fmt, a, b);
+        vsnprintf(err, OBS_ERR_LEN, fmt, ap);
+    va_end(ap);
     return OBS_INVALID_ARGUMENT;
 }
 
@@ -34,18 +81,18 @@ static int name_is(const char *name, const char *want)
     return *name == *want;
 }
 
-/* Copies "a,b,c" into n fixed slots; returns how many names it held, or
- * -1 when one is empty or too long. */
-static int split_names(const char *s, char (*slots)[64], int n)
+/* Copies "a,b,c" into n slots of `slot` bytes; returns how many names it
+ * held, or -1 when one is empty or too long. */
+static int split_names(const char *s, char *slots, size_t slot, int n)
 {
     int k = 0;
     while (k < n) {
         const char *comma = strchr(s, ',');
         size_t len = comma ? (size_t)(comma - s) : strlen(s);
-        if (len == 0 || len >= 64)
+        if (len == 0 || len >= slot)
             return -1;
-        memcpy(slots[k], s, len);
-        slots[k][len] = '\0';
+        memcpy(slots + k * slot, s, len);
+        slots[k * slot + len] = '\0';
         k++;
         if (!comma)
             return k;
@@ -54,86 +101,150 @@ static int split_names(const char *s, char (*slots)[64], int n)
     return -1; /* more names than slots */
 }
 
+/* "a|b|c": the choices of a row taken from `from`, for messages and
+ * /v1/params. */
+static const char *choices_text(const obs_http_option *op, unsigned from, char *buf, size_t len)
+{
+    size_t o = 0;
+    buf[0] = '\0';
+    if (op->kind == OBS_HTTP_OPT_BOOL)
+        snprintf(buf, len, "0|1");
+    for (const obs_http_choice *c = op->choices; c && c->name; c++)
+        if ((c->from & from) && o < len)
+            o += (size_t)snprintf(buf + o, len - o, "%s%s", o ? "|" : "", c->name);
+    for (const char *const *n = op->names; n && *n; n++)
+        if (o < len)
+            o += (size_t)snprintf(buf + o, len - o, "%s%s", o ? "|" : "", *n);
+    return buf;
+}
+
+static const obs_http_choice *find_choice(const obs_http_option *op, const char *s, size_t len,
+                                          unsigned from)
+{
+    for (const obs_http_choice *c = op->choices; c->name; c++)
+        if ((c->from & from) && strlen(c->name) == len && !strncmp(c->name, s, len))
+            return c;
+    return NULL;
+}
+
+/* The CLI's list skips empty items ("ao,,cull"), as it always has. */
+static obs_status set_choice(obs_http_request *r, const obs_http_option *op, const char *value,
+                             unsigned from, char err[OBS_ERR_LEN])
+{
+    char all[256];
+    int v = 0, n = 0;
+    const char *s = value;
+    do {
+        size_t len = op->list & from ? strcspn(s, ",") : strlen(s);
+        const obs_http_choice *c = find_choice(op, s, len, from);
+        if (c) {
+            v |= c->value;
+            n++;
+        } else if (len || !(op->list & from)) {
+            return bad(err, "parameter %s: '%.*s' is not one of %s", op->name, (int)len, s,
+                       choices_text(op, from, all, sizeof all));
+        }
+        s += len;
+    } while (*s++ == ',');
+    if (!n)
+        return bad(err, "parameter %s: '%s' names none of %s", op->name, value,
+                   choices_text(op, from, all, sizeof all));
+    memcpy((char *)r + op->field, &v, sizeof v);
+    return OBS_OK;
+}
+
+static obs_status set_bool(obs_http_request *r, const obs_http_option *op, const char *value,
+                           char err[OBS_ERR_LEN])
+{
+    int v;
+    if (!strcmp(value, "1") || !strcmp(value, "true") || !*value)
+        v = 1;
+    else if (!strcmp(value, "0") || !strcmp(value, "false"))
+        v = 0;
+    else
+        return bad(err, "parameter %s: '%s' is not one of %s", op->name, value, "0|1|true|false");
+    memcpy((char *)r + op->field, &v, sizeof v);
+    return OBS_OK;
+}
+
+/* Parsed into a copy first, so a bad value leaves the request as it was. */
+static obs_status set_names(obs_http_request *r, const obs_http_option *op, const char *value,
+                            char err[OBS_ERR_LEN])
+{
+    char tmp[NAMES_MAX * SLOT_MAX] = "", all[256];
+    int k, known = !op->names;
+    if (op->max < 1 || op->max > NAMES_MAX || op->slot > SLOT_MAX)
+        return bad(err, "parameter %s: its row takes more names than %d of %d bytes", op->name,
+                   NAMES_MAX, SLOT_MAX);
+    for (const char *const *n = op->names; n && *n; n++)
+        known |= !strcmp(value, *n);
+    if (!known)
+        return bad(err, "parameter %s: '%s' is not one of %s", op->name, value,
+                   choices_text(op, Q, all, sizeof all));
+    if (op->max == 1) { /* one name, whole: a comma may be part of it */
+        k = *value && strlen(value) < op->slot ? 1 : -1;
+        if (k == 1)
+            memcpy(tmp, value, strlen(value) + 1);
+    } else {
+        k = split_names(value, tmp, op->slot, op->max);
+    }
+    if (k < op->min)
+        return bad(err, "parameter %s: '%.100s' is not %s", op->name, value, op->what);
+    char *slots = (char *)r + op->field;
+    const char **map = (const char **)(void *)((char *)r + op->map);
+    memcpy(slots, tmp, (size_t)op->max * op->slot);
+    for (int i = 0; i < op->max; i++)
+        map[i] = i < k ? slots + (size_t)i * op->slot : NULL;
+    return OBS_OK;
+}
+
+const obs_http_option *obs_http_option_find(const char *name)
+{
+    for (const obs_http_option *op = obs_http_options; name && op->name; op++)
+        if (name_is(name, op->name))
+            return op;
+    return NULL;
+}
+
+obs_status obs_http_option_set(obs_http_request *r, const obs_http_option *op, const char *value,
+                               obs_http_from from, char err[OBS_ERR_LEN])
+{
+    if (!value)
+        value = "";
+    switch (op->kind) {
+    case OBS_HTTP_OPT_CHOICE: return set_choice(r, op, value, from, err);
+    case OBS_HTTP_OPT_BOOL: return set_bool(r, op, value, err);
+    case OBS_HTTP_OPT_NAMES: return set_names(r, op, value, err);
+    }
+    return bad(err, "parameter %s has an unknown kind", op->name);
+}
+
 void obs_http_request_init(obs_http_request *r)
 {
     memset(r, 0, sizeof *r);
-    r->outputs = OBS_OUTPUT_AO;
-    r->format = OBS_HTTP_EXR;
-    r->png_bits = 8;
+    for (const obs_http_option *op = obs_http_options; op->name; op++)
+        if (op->kind != OBS_HTTP_OPT_NAMES)
+            (void)obs_http_option_set(r, op, op->def, OBS_HTTP_QUERY, NULL);
 }
 
 obs_status obs_http_request_set(obs_http_request *r, const char *name, const char *value,
                                 char err[OBS_ERR_LEN])
 {
+    const obs_http_option *op;
     if (!name || !*name)
-        return bad(err, "empty parameter name%s%s", "", "");
-    if (!value)
-        value = "";
-    if (name_is(name, "output")) {
-        if (!strcmp(value, "ao"))
-            r->outputs = OBS_OUTPUT_AO;
-        else if (!strcmp(value, "composite"))
-            r->outputs = OBS_OUTPUT_COMPOSITE;
-        else if (!strcmp(value, "both"))
-            r->outputs = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE;
-        else
-            return bad(err, "parameter output: '%s' is not one of %s", value, "ao|composite|both");
-    } else if (name_is(name, "format")) {
-        if (!strcmp(value, "exr"))
-            r->format = OBS_HTTP_EXR;
-        else if (!strcmp(value, "png"))
-            r->format = OBS_HTTP_PNG;
-        else
-            return bad(err, "parameter format: '%s' is not one of %s", value, "exr|png");
-    } else if (name_is(name, "float")) {
-        if (!strcmp(value, "1") || !strcmp(value, "true") || !*value)
-            r->float_exr = 1;
-        else if (!strcmp(value, "0") || !strcmp(value, "false"))
-            r->float_exr = 0;
-        else
-            return bad(err, "parameter float: '%s' is not one of %s", value, "0|1|true|false");
-    } else if (name_is(name, "png_bits")) {
-        if (!strcmp(value, "8") || !strcmp(value, "16"))
-            r->png_bits = atoi(value);
-        else
-            return bad(err, "parameter png_bits: '%s' is not one of %s", value, "8|16");
-    } else if (name_is(name, "preset")) {
-        int ok = 0;
-        for (int i = 0; obs_channel_presets[i]; i++)
-            ok |= !strcmp(value, obs_channel_presets[i]);
-        if (!ok)
-            return bad(err, "parameter preset: '%s' is not one of %s", value, "auto|blender|generic");
-        snprintf(r->preset, sizeof r->preset, "%s", value);
-        r->map.preset = r->preset;
-    } else if (name_is(name, "depth")) {
-        if (!*value || strlen(value) >= sizeof r->depth)
-            return bad(err, "parameter depth: '%.100s' is not a channel name (1 to 63 characters)%s", value, "");
-        snprintf(r->depth, sizeof r->depth, "%s", value);
-        r->map.depth = r->depth;
-    } else if (name_is(name, "normal")) {
-        if (split_names(value, r->normal, 3) != 3)
-            return bad(err, "parameter normal: '%.100s' is not three channel names X,Y,Z%s", value, "");
-        for (int i = 0; i < 3; i++)
-            r->map.normal[i] = r->normal[i];
-    } else if (name_is(name, "color")) {
-        int k = split_names(value, r->color, 4);
-        if (k != 3 && k != 4)
-            return bad(err, "parameter color: '%.100s' is not three or four channel names R,G,B[,A]%s", value, "");
-        for (int i = 0; i < 4; i++)
-            r->map.color[i] = i < k ? r->color[i] : NULL;
-    } else if (obs_param_find(name)) {
-        return obs_param_set(&r->params, name, value, err);
-    } else {
-        return bad(err, "unknown parameter '%.100s' (GET /v1/params lists them)%s", name, "");
-    }
-    return OBS_OK;
+        return bad(err, "empty parameter name");
+    if ((op = obs_http_option_find(name)))
+        return obs_http_option_set(r, op, value, OBS_HTTP_QUERY, err);
+    if (obs_param_find(name))
+        return obs_param_set(&r->params, name, value ? value : "", err);
+    return bad(err, "unknown parameter '%.100s' (GET /v1/params lists them)", name);
 }
 
 obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LEN])
 {
     if (r->format == OBS_HTTP_PNG && r->outputs == (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE))
         return bad(err, "format=png holds one image: ask for one output (output=ao or "
-                        "output=composite), or use format=exr for both%s%s", "", "");
+                        "output=composite), or use format=exr for both");
     return OBS_OK;
 }
 
@@ -230,11 +341,13 @@ char *obs_http_params_json(void)
         if (!o)
             goto done;
         cJSON_AddItemToArray(opts, o);
+        char choices[256];
+        choices_text(op, OBS_HTTP_QUERY, choices, sizeof choices);
         cJSON_AddStringToObject(o, "name", op->name);
-        cJSON_AddStringToObject(o, "type", op->type);
+        cJSON_AddStringToObject(o, "type", op->kind == OBS_HTTP_OPT_BOOL ? "bool" : *choices ? "enum" : "string");
         cJSON_AddStringToObject(o, "default", op->def);
-        if (op->choices)
-            cJSON_AddItemToObject(o, "choices", choices_array(op->choices));
+        if (*choices)
+            cJSON_AddItemToObject(o, "choices", choices_array(choices));
         cJSON_AddStringToObject(o, "doc", op->doc);
     }
     out = cJSON_Print(root);

@@ -9,6 +9,8 @@
 #ifndef OBSCURA_PROTOCOL_HTTP_H
 #define OBSCURA_PROTOCOL_HTTP_H
 
+#include <stddef.h>
+
 #include "obscura/io.h"
 
 #ifdef __cplusplus
@@ -47,12 +49,60 @@ obs_status obs_http_request_set(obs_http_request *r, const char *name, const cha
  * image, so format=png with output=both is refused). */
 obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LEN]);
 
-/* The request options that are not in the parameter table, for
- * /v1/params and help: name, choices or type, default, doc. */
+/* Where an option's value comes from: a query parameter of obscurad
+ * (HTTP, or a name=value pair of the binary protocol), or a flag of
+ * `obscura ao` (clients/ao_flags.c).  The CLI takes a little more where a
+ * row says so: the debug outputs, which obscurad does not return, and a
+ * comma list of outputs (the CLI writes several files). */
+typedef enum obs_http_from {
+    OBS_HTTP_QUERY = 1,
+    OBS_HTTP_CLI = 2
+} obs_http_from;
+
+/* How a request option's value is parsed and stored. */
+typedef enum obs_http_option_kind {
+    OBS_HTTP_OPT_CHOICE, /* one of `choices` (a comma list, or'ed, where `list`), stored as an int */
+    OBS_HTTP_OPT_BOOL,   /* 1, true or empty; 0 or false; stored as an int (the CLI: a switch) */
+    OBS_HTTP_OPT_NAMES   /* min..max comma-separated names into the request's slots, the
+                          * channel map pointing at them; max 1: the value whole */
+} obs_http_option_kind;
+
+/* One name an OBS_HTTP_OPT_CHOICE row takes: the int it stores and
+ * where it is taken (OBS_HTTP_QUERY | OBS_HTTP_CLI bits). */
+typedef struct obs_http_choice {
+    const char *name;
+    int value;
+    unsigned from;
+} obs_http_choice;
+
+/* The request options that are not in the parameter table: one row
+ * each, which both obs_http_request_set() and the CLI's flags parse
+ * through obs_http_option_set(), and which /v1/params lists. */
 typedef struct obs_http_option {
-    const char *name, *type, *def, *choices, *doc;
+    const char *name;
+    obs_http_option_kind kind;
+    size_t field;                   /* offsetof(obs_http_request, ...): the int, or the first slot */
+    const char *def;                /* CHOICE, BOOL: set by obs_http_request_init(); NAMES: shown
+                                     * only (unset is the map's NULL: the preset decides) */
+    const obs_http_choice *choices; /* CHOICE: ends with name NULL */
+    unsigned list;                  /* CHOICE: where a comma list is taken */
+    const char *const *names;       /* NAMES: the names taken, NULL-ended; NULL: any */
+    int min, max;                   /* NAMES: how many names */
+    size_t slot;                    /* NAMES: bytes of one slot (with its '\0') */
+    size_t map;                     /* NAMES: offsetof(obs_http_request, map...), max pointers */
+    const char *what;               /* NAMES without `names`: what the value must be, for errors */
+    const char *doc;
 } obs_http_option;
 extern const obs_http_option obs_http_options[]; /* ends with name NULL */
+
+/* The row named `name` ('-' or '_'), or NULL. */
+const obs_http_option *obs_http_option_find(const char *name);
+
+/* Parses `value` by the row and stores it in r (nothing when it fails:
+ * OBS_INVALID_ARGUMENT, and a message naming the parameter and what it
+ * accepts).  `from` says which choices are taken. */
+obs_status obs_http_option_set(obs_http_request *r, const obs_http_option *op, const char *value,
+                               obs_http_from from, char err[OBS_ERR_LEN]);
 
 /* HTTP status for a core status, and the error code string of the JSON
  * body ("bad_parameter", "missing_channel", ...; static). */

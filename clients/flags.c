@@ -1,0 +1,58 @@
+/* How the CLI's commands read their flags: see flags.h. */
+#include "flags.h"
+
+#include <stdio.h>
+#include <string.h>
+
+int cli_flag_value(int argc, char **argv, int *i, const char *name, const char **value)
+{
+    const char *a = argv[*i];
+    size_t n = strlen(name);
+    if (a[0] != '-')
+        return 0;
+    a += a[1] == '-' ? 2 : 1;
+    if (strncmp(a, name, n) != 0)
+        return 0;
+    if (a[n] == '=') {
+        *value = a + n + 1;
+        return 1;
+    }
+    if (a[n] != '\0')
+        return 0;
+    if (*i + 1 >= argc)
+        return -1;
+    *value = argv[++*i];
+    return 1;
+}
+
+int cli_is_switch(const char *arg, const char *name)
+{
+    return arg[0] == '-' && arg[1] == '-' && strcmp(arg + 2, name) == 0;
+}
+
+int cli_request_flag(int argc, char **argv, int *i, obs_http_request *r,
+                     const obs_http_option **which, char err[OBS_ERR_LEN])
+{
+    for (const obs_http_option *op = obs_http_options; op->name; op++) {
+        char flag[64];
+        const char *v = NULL;
+        int k;
+        snprintf(flag, sizeof flag, "%s", op->name);
+        for (char *c = flag; *c; c++)
+            if (*c == '_')
+                *c = '-';
+        /* a switch means 1, as an empty query value does */
+        k = op->kind == OBS_HTTP_OPT_BOOL ? cli_is_switch(argv[*i], flag)
+                                          : cli_flag_value(argc, argv, i, flag, &v);
+        if (k == 0)
+            continue;
+        if (which)
+            *which = op;
+        if (k < 0) {
+            snprintf(err, OBS_ERR_LEN, "option --%s needs a value", flag);
+            return -1;
+        }
+        return obs_http_option_set(r, op, v, OBS_HTTP_CLI, err) == OBS_OK ? 1 : -1;
+    }
+    return 0;
+}
