@@ -246,6 +246,24 @@ void obs__hemisphere_basis(const float n[3], float t1[3], float t2[3]);
 void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3], const float n[3],
                             const float t1[3], const float t2[3], int i, float s[3]);
 
+/* The nodes the hemisphere estimator tests its samples against: layers
+ * planes of layer_px pixels, 4 floats each (view xyz, planar depth w; 0:
+ * empty), one after the other; nrm: the same layout with alpha in w (NULL:
+ * opaque); interior: OITAO eqs 2-4's back side, where a node on the
+ * exterior side of p's tangent plane hides nothing.  The flat chain's
+ * prep plane is one layer. */
+typedef struct obs__hemisphere_nodes {
+    const float *pos, *nrm;
+    int layers;
+    size_t layer_px;
+    int interior;
+} obs__hemisphere_nodes;
+
+/* Method hemisphere's estimator, for the flat and the deep chain alike
+ * (methods/hemisphere.c). */
+float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes *nodes, int x,
+                               int y, const float p[3], const float n[3]);
+
 /* Normal-oriented hemisphere SSAO of the point p (xyz; planar depth in
  * p[3] is not needed) with normal n at pixel (x, y); `pos` is the prep
  * pass's position plane (GLSL: hemisphere.glsl). */

@@ -139,14 +139,7 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
                                 ao[i], f.bleed_step ? bleed + 3 * i : NULL,
                                 out->composite.data + 4 * i);
             }
-    free(pos);
-    free(nrm);
-    free(ao);
-    free(tmp);
-    free(est);
-    free(col);
-    free(bleed);
-    return OBS_OK;
+    s = OBS_OK;
 
 fail:
     free(pos);
@@ -156,6 +149,7 @@ fail:
     free(est);
     free(col);
     free(bleed);
-    obs_result_free(out);
+    if (s != OBS_OK)
+        obs_result_free(out);
     return s;
 }

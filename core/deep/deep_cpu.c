@@ -233,38 +233,9 @@ static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float 
                            const float n[3], int interior)
 {
     const obs__frame *f = &df->f;
-    const float R = f->radius;
-    const int layers = df->multi ? df->m : 1;
-    const size_t npx = (size_t)f->width * (size_t)f->height;
-    float t1[3], t2[3];
-    obs__hemisphere_basis(n, t1, t2);
-    float occ = 0.0f;
-    for (int i = 0; i < f->hs_count; i++) {
-        float s[3];
-        obs__hemisphere_sample(f, x, y, p, n, t1, t2, i, s);
-        int qx, qy;
-        if (!obs__view_to_px(f, s, &qx, &qy))
-            continue;
-        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
-        float best = 0.0f;
-        for (int k = 0; k < layers; k++) {
-            const float *pk = df->pos + ((size_t)k * npx + q) * 4;
-            float zn = pk[3];
-            if (!(zn > 0.0f))
-                continue; /* empty node: background never occludes */
-            if (!(zn <= -s[2] - f->hs_bias))
-                continue; /* s is not behind the node */
-            if (interior &&
-                (pk[0] - p[0]) * n[0] + (pk[1] - p[1]) * n[1] + (pk[2] - p[2]) * n[2] <= f->hs_bias)
-                continue; /* on the hull's exterior side */
-            float dz = fabsf(-p[2] - zn);
-            float r = dz > R ? R / dz : 1.0f;
-            float an = df->nrm[((size_t)k * npx + q) * 4 + 3];
-            best = fmaxf(best, an * r * r * (3.0f - 2.0f * r));
-        }
-        occ += best;
-    }
-    return f->hs_count > 0 ? 1.0f - occ / (float)f->hs_count : 1.0f;
+    const obs__hemisphere_nodes nodes = {df->pos, df->nrm, df->multi ? df->m : 1,
+                                         (size_t)f->width * (size_t)f->height, interior};
+    return obs__hemisphere_estimate(f, &nodes, x, y, p, n);
 }
 
 /* The per-sample estimator of the frame's method: VAO++'s line samples or

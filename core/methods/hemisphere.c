@@ -64,9 +64,16 @@ void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3],
         s[j] = p[j] + f->radius * (kx * t1[j] + ky * t2[j] + k[2] * n[j]);
 }
 
-/* GLSL: hemisphere_ao() in hemisphere.glsl */
-float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                            const float n[3])
+/* The one hemisphere estimator of the flat and the deep chain (GLSL:
+ * hemisphere_ao() in hemisphere.glsl, node_hemisphere_ao() in
+ * deep.frag.glsl).  Sample s of the kernel is occluded by a node at its
+ * pixel whose surface lies in front of it (planar depths, -s.z for the
+ * sample) past the bias; with several nodes (deep input, OITAO Algorithm
+ * 1) the largest occlusion counts, each weighted by the node's alpha.
+ * Range check: smoothstep(0, 1, R / |z_p - z_q|), a surface much nearer
+ * than R counts fully, one far in front fades. */
+float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes *nodes, int x,
+                               int y, const float p[3], const float n[3])
 {
     const float R = f->radius;
     float t1[3], t2[3];
@@ -78,18 +85,32 @@ float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y,
         int qx, qy;
         if (!obs__view_to_px(f, s, &qx, &qy))
             continue;
-        float zq = pos[4 * ((size_t)qy * (size_t)f->width + (size_t)qx) + 3];
-        if (!(zq > 0.0f))
-            continue; /* background never occludes */
-        /* Occluded: the depth buffer holds a surface in front of the
-         * sample (planar depths, -s.z for the sample), past the bias. */
-        if (zq <= -s[2] - f->hs_bias) {
-            /* Range check: smoothstep(0, 1, R / |z_p - z_q|), a surface
-             * much nearer than R counts fully, one far in front fades. */
-            float dz = fabsf(-p[2] - zq);
+        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
+        float best = 0.0f;
+        for (int k = 0; k < nodes->layers; k++) {
+            const float *pk = nodes->pos + ((size_t)k * nodes->layer_px + q) * 4;
+            float zn = pk[3];
+            if (!(zn > 0.0f))
+                continue; /* empty node: background never occludes */
+            if (!(zn <= -s[2] - f->hs_bias))
+                continue; /* s is not behind the node */
+            if (nodes->interior &&
+                (pk[0] - p[0]) * n[0] + (pk[1] - p[1]) * n[1] + (pk[2] - p[2]) * n[2] <= f->hs_bias)
+                continue; /* on the hull's exterior side */
+            float dz = fabsf(-p[2] - zn);
             float r = dz > R ? R / dz : 1.0f;
-            occ += r * r * (3.0f - 2.0f * r);
+            float an = nodes->nrm ? nodes->nrm[((size_t)k * nodes->layer_px + q) * 4 + 3] : 1.0f;
+            best = fmaxf(best, an * r * r * (3.0f - 2.0f * r));
         }
+        occ += best;
     }
     return f->hs_count > 0 ? 1.0f - occ / (float)f->hs_count : 1.0f;
+}
+
+/* GLSL: hemisphere_ao() in hemisphere.glsl */
+float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                            const float n[3])
+{
+    const obs__hemisphere_nodes flat = {pos, NULL, 1, 0, 0};
+    return obs__hemisphere_estimate(f, &flat, x, y, p, n);
 }
