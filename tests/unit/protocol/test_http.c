@@ -97,6 +97,70 @@ static void test_options(void **state)
     assert_string_equal(r.map.color[3], "A");
 }
 
+/* The rows of obs_http_options: names unique and not the parameter
+ * table's (a row would hide the parameter), every default parses and is
+ * what obs_http_request_init() set. */
+static void test_option_table(void **state)
+{
+    (void)state;
+    int rows = 0;
+    for (const obs_http_option *op = obs_http_options; op->name; op++, rows++) {
+        obs_http_request r, d;
+        char err[OBS_ERR_LEN] = "";
+        assert_null(obs_param_find(op->name));
+        assert_ptr_equal(obs_http_option_find(op->name), op);
+        for (const obs_http_option *o2 = op + 1; o2->name; o2++)
+            assert_string_not_equal(op->name, o2->name);
+        assert_non_null(op->def);
+        assert_non_null(op->doc);
+        if (op->kind == OBS_HTTP_OPT_NAMES) {
+            assert_true(op->min >= 1 && op->min <= op->max);
+            assert_true(op->names || op->what);
+            continue;
+        }
+        obs_http_request_init(&d);
+        obs_http_request_init(&r);
+        assert_int_equal(obs_http_option_set(&r, op, op->def, OBS_HTTP_QUERY, err), OBS_OK);
+        assert_memory_equal(&r, &d, sizeof r);
+    }
+    assert_int_equal(rows, 8);
+    assert_ptr_equal(obs_http_option_find("png-bits"), obs_http_option_find("png_bits"));
+    assert_null(obs_http_option_find("radius"));
+    assert_null(obs_http_option_find(NULL));
+}
+
+/* The CLI takes the debug outputs and a comma list of outputs; a query
+ * one of ao|composite|both. */
+static void test_option_from(void **state)
+{
+    (void)state;
+    const obs_http_option *out = obs_http_option_find("output");
+    obs_http_request r;
+    char err[OBS_ERR_LEN] = "";
+    obs_http_request_init(&r);
+    assert_int_equal(obs_http_option_set(&r, out, "ao,samples,,cull", OBS_HTTP_CLI, err), OBS_OK);
+    assert_int_equal(r.outputs, OBS_OUTPUT_AO | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK);
+    assert_int_equal(obs_http_option_set(&r, out, "bleed,luminance", OBS_HTTP_CLI, err), OBS_OK);
+    assert_int_equal(r.outputs, OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE);
+    assert_int_equal(obs_http_option_set(&r, out, "ao,depth", OBS_HTTP_CLI, err), OBS_INVALID_ARGUMENT);
+    assert_string_equal(err, "parameter output: 'depth' is not one of "
+                             "ao|composite|both|samples|cull|bleed|luminance");
+    assert_int_equal(obs_http_option_set(&r, out, ",", OBS_HTTP_CLI, err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(r.outputs, OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE); /* unchanged */
+    assert_int_equal(obs_http_request_set(&r, "output", "samples", err), OBS_INVALID_ARGUMENT);
+    assert_string_equal(err, "parameter output: 'samples' is not one of ao|composite|both");
+    assert_int_equal(obs_http_request_set(&r, "output", "ao,composite", err), OBS_INVALID_ARGUMENT);
+    /* a refused list of names leaves the earlier one */
+    assert_int_equal(obs_http_request_set(&r, "normal", "A,B,C", err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "normal", "X,Y", err), OBS_INVALID_ARGUMENT);
+    assert_string_equal(err, "parameter normal: 'X,Y' is not three channel names X,Y,Z");
+    assert_string_equal(r.map.normal[0], "A");
+    assert_string_equal(r.normal[1], "B");
+    /* one name is taken whole, commas and all */
+    assert_int_equal(obs_http_request_set(&r, "depth", "a,b", err), OBS_OK);
+    assert_string_equal(r.map.depth, "a,b");
+}
+
 static void test_status_map(void **state)
 {
     (void)state;
@@ -147,7 +211,29 @@ static void test_json(void **state)
         if (pi->type == OBS_PARAM_ENUM)
             assert_true(cJSON_GetArraySize(cJSON_GetObjectItem(o, "choices")) >= 2);
     }
-    assert_true(cJSON_GetArraySize(cJSON_GetObjectItem(j, "options")) >= 5);
+    /* the options as the table's rows say: type, choices of a query */
+    static const struct {
+        const char *name, *type, *choices;
+    } want[] = {{"output", "enum", "ao|composite|both"}, {"format", "enum", "exr|png"},
+                {"float", "bool", "0|1"},                {"png_bits", "enum", "8|16"},
+                {"preset", "enum", "auto|blender|generic"}, {"depth", "string", NULL},
+                {"normal", "string", NULL},              {"color", "string", NULL}};
+    cJSON *opts = cJSON_GetObjectItem(j, "options");
+    assert_int_equal(cJSON_GetArraySize(opts), 8);
+    for (int i = 0; i < 8; i++) {
+        cJSON *o = cJSON_GetArrayItem(opts, i), *c = cJSON_GetObjectItem(o, "choices"), *it;
+        char got[128] = "";
+        assert_string_equal(cJSON_GetObjectItem(o, "name")->valuestring, want[i].name);
+        assert_string_equal(cJSON_GetObjectItem(o, "type")->valuestring, want[i].type);
+        cJSON_ArrayForEach(it, c) {
+            size_t n = strlen(got);
+            snprintf(got + n, sizeof got - n, "%s%s", n ? "|" : "", it->valuestring);
+        }
+        if (want[i].choices)
+            assert_string_equal(got, want[i].choices);
+        else
+            assert_null(c);
+    }
     cJSON_Delete(j);
     free(p);
 }
@@ -171,7 +257,8 @@ int main(void)
         cmocka_unit_test(test_defaults),   cmocka_unit_test(test_table_params),
         cmocka_unit_test(test_bad_params), cmocka_unit_test(test_options),
         cmocka_unit_test(test_status_map), cmocka_unit_test(test_json),
-        cmocka_unit_test(test_bearer),
+        cmocka_unit_test(test_bearer),     cmocka_unit_test(test_option_table),
+        cmocka_unit_test(test_option_from),
     };
     return cmocka_run_group_tests_name("protocol_http", tests, NULL, NULL);
 }
