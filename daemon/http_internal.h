@@ -7,6 +7,7 @@
 #include <microhttpd.h>
 #include <stdatomic.h>
 
+#include "frame_path.h"
 #include "http.h"
 #include "http_server.h"
 #include "obscura/io.h"
@@ -63,10 +64,7 @@ typedef struct obsd__req {
     size_t discarded;    /* bytes thrown away after too_big */
     int before_drain;    /* started before SIGTERM: finished in the drain */
     obs_http_request hr;
-    obs_gbuffer_file gf;
-    obs_deep_image deep; /* a deep EXR body (POST /v1/ao) */
-    obsd_job job;
-    double ms_decode, ms_queue, ms_gl, ms_encode;
+    obsd_fp fp;          /* the frame: its input, job, result and stage times */
     /* /v1/streams */
     obsd__stream_op op;
     char stream[OBSD_STREAM_NAME_LEN + 1];
@@ -105,17 +103,13 @@ enum MHD_Result obsd__frame_start(obsd__req *r);
 /* The request's query parameters into r->hr (recorded into r->query
  * when r->record_query); 400 answered on a bad one (returns 0, *rc set). */
 int obsd__parse_query(obsd__req *r, enum MHD_Result *rc);
-/* Decodes `body` with r->hr's channel map (a deep EXR into r->deep, on
+/* Decodes `body` into r->fp with r->hr's channel map (a deep EXR on
  * POST /v1/ao only), queues the frame (outputs) and suspends the
  * connection; answers the error itself. */
 enum MHD_Result obsd__queue_frame(obsd__req *r, const unsigned char *body, size_t len, unsigned outputs);
-/* The stages of a finished job into r and the metrics. */
-void obsd__job_timings(obsd__req *r);
-/* Answers with images as r->hr asks (format, outputs, float, png_bits):
- * ao / composite / colour, any may be NULL when not asked for.  With
- * `timing`, a Server-Timing header. */
-enum MHD_Result obsd__answer_images(obsd__req *r, const obs_image *ao, const obs_image *composite,
-                                    const obs_image *color, const obs_camera *cam, int timing,
+/* Answers with images as r->hr asks (format, float, png_bits), a colour
+ * PNG exposed by r->exposure.  With `timing`, a Server-Timing header. */
+enum MHD_Result obsd__answer_images(obsd__req *r, const obsd_fp_images *im, const obs_camera *cam, int timing,
                                     const char *extra_name, const char *extra_value);
 
 /* /v1/streams: the first call of a request (token checked); the call

@@ -35,7 +35,7 @@ static void log_request(const req *r, const char *note)
              "req=%llu peer=%s %s %s status=%d in=%zu out=%zu queue=%.1f decode=%.1f gl=%.1f "
              "encode=%.1f total=%.1f ms%s%s",
              (unsigned long long)r->id, r->peer, r->method, r->path, r->status,
-             r->len + r->discarded, r->bytes_out, r->ms_queue, r->ms_decode, r->ms_gl, r->ms_encode,
+             r->len + r->discarded, r->bytes_out, r->fp.ms_queue, r->fp.ms_decode, r->fp.ms_gl, r->fp.ms_encode,
              obsd_now_ms() - r->t0, note && *note ? " " : "", note ? note : "");
 }
 
@@ -259,9 +259,8 @@ int obsd__parse_query(req *r, enum MHD_Result *rc)
 }
 
 /* Called on the GL worker thread: give the connection back to MHD. */
-static void job_done(obsd_job *job, void *user)
+static void job_done(void *user)
 {
-    (void)job;
     req *r = user;
     MHD_resume_connection(r->conn);
 }
@@ -354,28 +353,18 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     obsd_http *h = r->srv;
     char err[OBS_ERR_LEN] = "";
     obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
-    double t0 = obsd_now_ms();
-    /* A deep EXR runs the multi-layer chain (include/obscura/deep.h), on /v1/ao only:
-     * streams keep flat frames. */
-    int deep = 0;
-    obs_status s = obs_exr_is_deep_mem(body, len, &deep, err);
-    if (s == OBS_OK && deep && r->op == STREAM_POST)
-        s = OBS_UNSUPPORTED, snprintf(err, sizeof err, "deep EXR input runs on POST /v1/ao, not in streams");
-    else if (s == OBS_OK && deep)
-        s = obs_deep_read_exr_mem(body, len, &lim, &r->deep, err);
-    else if (s == OBS_OK)
-        s = obs_gbuffer_read_exr_mem(body, len, &r->hr.map, &lim, &r->gf, err);
-    r->ms_decode = obsd_now_ms() - t0;
-    obsd_stats_stage(OBSD_STAGE_DECODE, r->ms_decode);
+    /* A deep EXR runs on /v1/ao only: streams keep flat frames. */
+    obs_status s = obsd_fp_decode(&r->fp, body, len, &r->hr.map, &lim,
+                                  r->op == STREAM_POST ? "deep EXR input runs on POST /v1/ao, not in streams"
+                                                       : NULL,
+                                  err);
     if (s != OBS_OK)
         return obsd__answer_status(r, s, err);
-
-    r->job = (obsd_job){.gb = deep ? NULL : &r->gf.gb, .deep = deep ? &r->deep : NULL,
-                        .params = &r->hr.params, .outputs = outputs, .done = job_done, .user = r};
     /* Suspend before queueing: the worker may finish and resume at once. */
     r->state = REQ_QUEUED;
     MHD_suspend_connection(r->conn);
-    if ((atomic_load(&h->draining) && !r->before_drain) || obsd_queue_push(h->queue, &r->job) != 0) {
+    if ((atomic_load(&h->draining) && !r->before_drain) ||
+        obsd_fp_queue(&r->fp, h->queue, &r->hr.params, outputs, job_done, r) != 0) {
         r->state = REQ_REFUSED;
         MHD_resume_connection(r->conn);
     }
@@ -399,19 +388,6 @@ static enum MHD_Result ao_run(req *r)
     return rc;
 }
 
-void obsd__job_timings(req *r)
-{
-    obsd_job *job = &r->job;
-    r->ms_queue = job->t_started - job->t_queued;
-    r->ms_gl = job->t_finished - job->t_started;
-    obsd_stats_stage(OBSD_STAGE_QUEUE, r->ms_queue);
-    obsd_stats_stage(OBSD_STAGE_GL, r->ms_gl);
-    if (job->status == OBS_OK && job->deep)
-        obsd_stats_frame(job->deep->width, job->deep->height);
-    else if (job->status == OBS_OK)
-        obsd_stats_frame(r->gf.gb.width, r->gf.gb.height);
-}
-
 /* A copy of a colour image with its RGB times 2^ev (alpha kept). */
 static int expose(const obs_image *src, double ev, obs_image *out)
 {
@@ -423,47 +399,6 @@ static int expose(const obs_image *src, double ev, obs_image *out)
     for (size_t i = 0; i < n * (size_t)src->channels; i++)
         out->data[i] = (src->channels == 4 && i % 4 == 3) ? src->data[i] : src->data[i] * k;
     return 0;
-}
-
-static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, int timing,
-                                    const char *extra_name, const char *extra_value);
-
-enum MHD_Result obsd__answer_images(req *r, const obs_image *ao, const obs_image *composite,
-                                    const obs_image *color, const obs_camera *cam, int timing,
-                                    const char *extra_name, const char *extra_value)
-{
-    char err[OBS_ERR_LEN] = "";
-    double t0 = obsd_now_ms();
-    obs_bytes out = {0};
-    obs_status s;
-    const char *type;
-    if (r->hr.format == OBS_HTTP_EXR) {
-        obs_result tmp = {0};
-        obs_exr_layer layers[OBS_RESULT_LAYERS];
-        if (ao)
-            tmp.ao = *ao;
-        if (composite || color)
-            tmp.composite = composite ? *composite : *color;
-        int n = obs_result_exr_layers(&tmp, layers);
-        s = obs_exr_write_mem(layers, n, r->hr.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, &out, err);
-        type = "image/x-exr";
-    } else {
-        const obs_image *img = ao ? ao : composite ? composite : color;
-        obs_image exposed = {0};
-        if (img != ao && r->exposure != 0.0) {
-            if (expose(img, r->exposure, &exposed) != 0)
-                return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the image");
-            img = &exposed;
-        }
-        s = obs_png_write_mem(img, r->hr.png_bits, img != ao, &out, err);
-        obs_image_free(&exposed);
-        type = "image/png";
-    }
-    r->ms_encode = obsd_now_ms() - t0;
-    obsd_stats_stage(OBSD_STAGE_ENCODE, r->ms_encode);
-    if (s != OBS_OK)
-        return obsd__answer_error(r, 500, "encode_failed", err, NULL, NULL);
-    return answer_bytes(r, &out, type, timing, extra_name, extra_value);
 }
 
 /* Answers 200 with an encoded image (taking `out`), the Server-Timing
@@ -480,7 +415,7 @@ static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, in
     if (timing) {
         char t[192];
         snprintf(t, sizeof t, "queue;dur=%.2f, decode;dur=%.2f, gl;dur=%.2f, encode;dur=%.2f",
-                 r->ms_queue, r->ms_decode, r->ms_gl, r->ms_encode);
+                 r->fp.ms_queue, r->fp.ms_decode, r->fp.ms_gl, r->fp.ms_encode);
         MHD_add_response_header(resp, "Server-Timing", t);
     }
     if (extra_name)
@@ -488,53 +423,39 @@ static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, in
     return obsd__answer(r, 200, resp, out->size, NULL);
 }
 
-/* The answer of deep input: an EXR of AO.Y, AOFront.Y and R,G,B,A as
- * `obscura ao` writes it, or a PNG of the blended AO or the composite. */
-static enum MHD_Result answer_deep(req *r)
+enum MHD_Result obsd__answer_images(req *r, const obsd_fp_images *im, const obs_camera *cam, int timing,
+                                    const char *extra_name, const char *extra_value)
 {
-    const obs_deep_result *dr = &r->job.deep_result;
-    const obs_camera *cam = r->deep.camera.has_projection ? &r->deep.camera : NULL;
     char err[OBS_ERR_LEN] = "";
-    double t0 = obsd_now_ms();
-    obs_bytes out = {0};
-    obs_status s;
-    const char *type;
-    if (r->hr.format == OBS_HTTP_EXR) {
-        obs_exr_layer layers[3];
-        int n = obs_deep_result_exr_layers(dr, r->hr.outputs, layers);
-        s = obs_exr_write_mem(layers, n, r->hr.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, &out, err);
-        type = "image/x-exr";
-    } else {
-        int comp = !(r->hr.outputs & OBS_OUTPUT_AO);
-        s = obs_png_write_mem(comp ? &dr->composite : &dr->ao_blend, r->hr.png_bits, comp, &out, err);
-        type = "image/png";
+    obsd_fp_images shown = *im;
+    obs_image exposed = {0};
+    /* exposure is a view of a colour PNG; the AO is never exposed */
+    const obs_image *img = obsd_fp_png_image(im);
+    if (r->hr.format != OBS_HTTP_EXR && img != im->ao && r->exposure != 0.0) {
+        if (expose(img, r->exposure, &exposed) != 0)
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the image");
+        shown.composite = &exposed;
     }
-    r->ms_encode = obsd_now_ms() - t0;
-    obsd_stats_stage(OBSD_STAGE_ENCODE, r->ms_encode);
+    obs_bytes out;
+    obs_status s = obsd_fp_encode(&r->fp, &shown, &r->hr, 0, cam, &out, err);
+    obs_image_free(&exposed);
     if (s != OBS_OK)
         return obsd__answer_error(r, 500, "encode_failed", err, NULL, NULL);
-    return answer_bytes(r, &out, type, 1, NULL, NULL);
+    return answer_bytes(r, &out, r->hr.format == OBS_HTTP_EXR ? "image/x-exr" : "image/png", timing,
+                        extra_name, extra_value);
 }
 
-/* Called again once the GL worker resumed the connection. */
+/* Called again once the GL worker resumed the connection.  Deep input
+ * answers an EXR of AO.Y, AOFront.Y and R,G,B,A as `obscura ao` writes
+ * it, or a PNG of the blended AO or the composite. */
 static enum MHD_Result ao_finish(req *r)
 {
-    obsd_job *job = &r->job;
-    obsd__job_timings(r);
-    if (job->status != OBS_OK)
-        return obsd__answer_status(r, job->status, job->err);
-    if (job->deep) {
-        enum MHD_Result rc = answer_deep(r);
-        obs_deep_result_free(&job->deep_result);
-        return rc;
-    }
-    const obs_result *res = &job->result;
-    const obs_camera *cam = r->gf.gb.camera.has_projection ? &r->gf.gb.camera : NULL;
-    enum MHD_Result rc = obsd__answer_images(r, res->ao.data ? &res->ao : NULL,
-                                             res->composite.data ? &res->composite : NULL, NULL, cam, 1,
-                                             NULL, NULL);
-    obs_result_free(&job->result);
-    return rc;
+    obs_status s = obsd_fp_finished(&r->fp);
+    if (s != OBS_OK)
+        return obsd__answer_status(r, s, r->fp.job.err);
+    obsd_fp_images im;
+    obsd_fp_images_of(&r->fp, r->hr.outputs, &im);
+    return obsd__answer_images(r, &im, obsd_fp_camera(&r->fp), 1, NULL, NULL);
 }
 
 /* ---- dispatch -------------------------------------------------------- */
@@ -563,6 +484,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
             return MHD_NO;
         *con_cls = r;
         atomic_fetch_add(&h->in_flight, 1);
+        obsd_fp_init(&r->fp);
         r->srv = h;
         r->conn = conn;
         r->id = atomic_fetch_add(&h->next_id, 1) + 1;
@@ -635,10 +557,7 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
                  (unsigned long long)r->id, r->peer, r->method, obsd_route_path(r->route), (int)why);
     obsd__streams_done(r);
     free(r->body);
-    obs_result_free(&r->job.result);
-    obs_deep_result_free(&r->job.deep_result);
-    obs_gbuffer_free(&r->gf);
-    obs_deep_free(&r->deep);
+    obsd_fp_free(&r->fp);
     free(r);
     *con_cls = NULL;
     atomic_fetch_sub(&h->in_flight, 1);
