@@ -4,9 +4,10 @@
  *                   it sees the drain), a detached thread per connection
  *   connection      read a header (idle --timeout), check it, read the
  *                   payload (a bad size is answered and the connection
- *                   closed: the stream cannot be resynchronised), decode,
- *                   queue the job, wait for the GL worker, encode, answer;
- *                   then the next frame.  Answers go in request order. */
+ *                   closed: the stream cannot be resynchronised), decode
+ *                   the request, then the frame path (frame_path.c: the
+ *                   EXR, the GL worker, the encode), answer; then the
+ *                   next frame.  Answers go in request order. */
 #include <arpa/inet.h>
 #include <errno.h>
 #include <netinet/in.h>
@@ -25,6 +26,7 @@
 
 #include "binary.h"
 #include "binary_server.h"
+#include "frame_path.h"
 #include "log.h"
 #include "stats.h"
 
@@ -48,10 +50,6 @@ typedef struct conn {
     obsd_bin *srv;
     int fd;
     char peer[80];
-    /* the job under way */
-    pthread_mutex_t lock;
-    pthread_cond_t done_cond;
-    int done;
 } conn;
 
 /* ---- socket I/O with deadlines ------------------------------------------- */
@@ -183,128 +181,70 @@ static int send_status(frame *f, obs_status s, const char *msg)
     return send_error(f, http, code, msg && *msg ? msg : obs_status_message(s));
 }
 
-static void job_done(obsd_job *job, void *user)
-{
-    (void)job;
-    conn *c = user;
-    pthread_mutex_lock(&c->lock);
-    c->done = 1;
-    pthread_cond_signal(&c->done_cond);
-    pthread_mutex_unlock(&c->lock);
-}
-
-/* Encodes the answer of a finished job as the request asks: raw float32
- * images, an EXR or a PNG.  Deep input answers AO.Y (the blended AO),
- * AOFront.Y (raw output OBS_BIN_OUTPUT_AO_FRONT) and the composite. */
-static obs_status encode_answer(const obs_bin_request *q, const obsd_job *job, const obs_camera *cam,
-                                obs_bin_response_desc *d, obs_bin_image images[3], obs_bytes *blob,
-                                char err[OBS_ERR_LEN])
-{
-    const obs_result *res = &job->result;
-    const obs_deep_result *dr = &job->deep_result;
-    const int deep = job->deep != NULL, want_ao = (q->hr.outputs & OBS_OUTPUT_AO) != 0;
-    const obs_image *ao = deep ? (want_ao ? &dr->ao_blend : NULL) : (res->ao.data ? &res->ao : NULL);
-    const obs_image *front = deep && want_ao ? &dr->ao_front : NULL;
-    const obs_image *comp = deep ? ((q->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &dr->composite : NULL)
-                                 : (res->composite.data ? &res->composite : NULL);
-    if (q->raw_out) {
-        int n = 0;
-        if (ao)
-            images[n++] = (obs_bin_image){OBS_OUTPUT_AO, *ao};
-        if (front)
-            images[n++] = (obs_bin_image){OBS_BIN_OUTPUT_AO_FRONT, *front};
-        if (comp)
-            images[n++] = (obs_bin_image){OBS_OUTPUT_COMPOSITE, *comp};
-        d->body = OBS_BIN_RAW;
-        d->images = images;
-        d->image_count = n;
-        return OBS_OK;
-    }
-    if (q->hr.format == OBS_HTTP_EXR) {
-        obs_exr_layer layers[OBS_RESULT_LAYERS];
-        int n = deep ? obs_deep_result_exr_layers(dr, q->hr.outputs, layers) : obs_result_exr_layers(res, layers);
-        d->body = OBS_BIN_EXR;
-        return obs_exr_write_mem(layers, n, q->hr.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, blob, err);
-    }
-    const obs_image *img = ao ? ao : comp;
-    d->body = OBS_BIN_PNG;
-    return obs_png_write_mem(img, q->hr.png_bits, img == comp, blob, err);
-}
-
-/* Runs a decoded request through the queue and answers it. */
+/* Runs a decoded request through the frame path and answers it. */
 static int run_frame(frame *f, obs_bin_request *q)
 {
-    conn *c = f->c;
-    obsd_bin *b = c->srv;
+    obsd_bin *b = f->c->srv;
     obs_limits lim = {.max_pixels = (uint64_t)b->cfg->max_pixels};
-    obs_gbuffer_file exr = {0};
-    obs_deep_image deep_exr = {0};
-    const obs_gbuffer *gb = &q->gf.gb;
-    const obs_deep_image *deep = q->body == OBS_BIN_DEEP ? &q->deep : NULL;
     char err[OBS_ERR_LEN] = "";
+    obsd_fp fp;
     int rc;
 
+    obsd_fp_init(&fp);
     if (q->body == OBS_BIN_EXR) {
         /* a deep EXR runs the deep chain, as on POST /v1/ao */
-        int is_deep = 0;
-        double t0 = obsd_now_ms();
-        obs_status s = obs_exr_is_deep_mem(q->exr, q->exr_len, &is_deep, err);
-        if (s == OBS_OK && is_deep)
-            s = obs_deep_read_exr_mem(q->exr, q->exr_len, &lim, &deep_exr, err);
-        else if (s == OBS_OK)
-            s = obs_gbuffer_read_exr_mem(q->exr, q->exr_len, &q->hr.map, &lim, &exr, err);
-        f->ms_decode = obsd_now_ms() - t0;
-        obsd_stats_stage(OBSD_STAGE_DECODE, f->ms_decode);
-        if (s != OBS_OK)
-            return send_status(f, s, err);
-        gb = &exr.gb;
-        deep = is_deep ? &deep_exr : NULL;
+        obs_status s = obsd_fp_decode(&fp, q->exr, q->exr_len, &q->hr.map, &lim, NULL, err);
+        f->ms_decode = fp.ms_decode;
+        if (s != OBS_OK) {
+            rc = send_status(f, s, err);
+            goto done;
+        }
+    } else {
+        obsd_fp_use(&fp, &q->gf.gb, q->body == OBS_BIN_DEEP ? &q->deep : NULL);
     }
-    obsd_job job = {.gb = deep ? NULL : gb, .deep = deep, .params = &q->hr.params,
-                    .outputs = q->hr.outputs, .done = job_done, .user = c};
-    c->done = 0;
-    if (obsd_queue_push(b->queue, &job) != 0) {
-        obs_gbuffer_free(&exr);
-        obs_deep_free(&deep_exr);
-        return send_error(f, 503, atomic_load(&b->draining) ? "shutting_down" : "queue_full",
-                          "the frame queue is full; retry later");
-    }
-    pthread_mutex_lock(&c->lock);
-    while (!c->done)
-        pthread_cond_wait(&c->done_cond, &c->lock);
-    pthread_mutex_unlock(&c->lock);
-    f->ms_queue = job.t_started - job.t_queued;
-    f->ms_gl = job.t_finished - job.t_started;
-    obsd_stats_stage(OBSD_STAGE_QUEUE, f->ms_queue);
-    obsd_stats_stage(OBSD_STAGE_GL, f->ms_gl);
-    if (job.status != OBS_OK) {
-        rc = send_status(f, job.status, job.err);
+    if (obsd_fp_queue(&fp, b->queue, &q->hr.params, q->hr.outputs, NULL, NULL) != 0) {
+        rc = send_error(f, 503, atomic_load(&b->draining) ? "shutting_down" : "queue_full",
+                        "the frame queue is full; retry later");
         goto done;
     }
-    obsd_stats_frame(deep ? deep->width : gb->width, deep ? deep->height : gb->height);
-
-    double t0 = obsd_now_ms();
-    const obs_camera *cam = deep ? &deep->camera : &gb->camera;
-    obs_bin_response_desc d = {.id = f->id, .status = 200, .code = "ok", .message = ""};
-    obs_bin_image images[3];
-    obs_bytes blob = {0};
-    obs_status s = encode_answer(q, &job, cam->has_projection ? cam : NULL, &d, images, &blob, err);
-    d.blob = blob.data;
-    d.blob_len = blob.size;
+    obsd_fp_wait(&fp);
+    obs_status s = obsd_fp_finished(&fp);
+    f->ms_queue = fp.ms_queue;
+    f->ms_gl = fp.ms_gl;
     if (s != OBS_OK) {
-        rc = send_error(f, 500, "encode_failed", err);
-    } else {
-        /* the encode time counts the frame's encoding up to the send */
-        f->ms_encode = obsd_now_ms() - t0;
-        obsd_stats_stage(OBSD_STAGE_ENCODE, f->ms_encode);
-        rc = send_response(f, &d);
+        rc = send_status(f, s, fp.job.err);
+        goto done;
     }
+
+    /* Raw float32 images, an EXR or a PNG.  Deep input answers AO.Y (the
+     * blended AO), AOFront.Y (raw output OBS_BIN_OUTPUT_AO_FRONT) and the
+     * composite. */
+    obsd_fp_images im;
+    obsd_fp_images_of(&fp, q->hr.outputs, &im);
+    obs_bytes blob;
+    s = obsd_fp_encode(&fp, &im, &q->hr, q->raw_out, obsd_fp_camera(&fp), &blob, err);
+    f->ms_encode = fp.ms_encode;
+    obs_bin_response_desc d = {.id = f->id, .status = 200, .code = "ok", .message = "",
+                               .blob = blob.data, .blob_len = blob.size};
+    obs_bin_image images[3];
+    int n = 0;
+    if (q->raw_out) {
+        if (im.ao)
+            images[n++] = (obs_bin_image){OBS_OUTPUT_AO, *im.ao};
+        if (im.ao_front)
+            images[n++] = (obs_bin_image){OBS_BIN_OUTPUT_AO_FRONT, *im.ao_front};
+        if (im.composite)
+            images[n++] = (obs_bin_image){OBS_OUTPUT_COMPOSITE, *im.composite};
+        d.body = OBS_BIN_RAW;
+        d.images = images;
+        d.image_count = n;
+    } else {
+        d.body = q->hr.format == OBS_HTTP_EXR ? OBS_BIN_EXR : OBS_BIN_PNG;
+    }
+    rc = s != OBS_OK ? send_error(f, 500, "encode_failed", err) : send_response(f, &d);
     obs_bytes_free(&blob);
 done:
-    obs_result_free(&job.result);
-    obs_deep_result_free(&job.deep_result);
-    obs_gbuffer_free(&exr);
-    obs_deep_free(&deep_exr);
+    obsd_fp_free(&fp);
     return rc;
 }
 
@@ -381,8 +321,6 @@ static void *conn_main(void *arg)
     while (serve_one(c))
         ;
     close(c->fd);
-    pthread_cond_destroy(&c->done_cond);
-    pthread_mutex_destroy(&c->lock);
     free(c);
     atomic_fetch_sub(&b->connections, 1);
     return NULL;
@@ -409,8 +347,6 @@ static void accept_one(obsd_bin *b, int lfd)
     }
     c->srv = b;
     c->fd = fd;
-    pthread_mutex_init(&c->lock, NULL);
-    pthread_cond_init(&c->done_cond, NULL);
     if (ss.ss_family == AF_INET) {
         const struct sockaddr_in *in = (const struct sockaddr_in *)(const void *)&ss;
         char ip[INET_ADDRSTRLEN] = "?";
@@ -429,8 +365,6 @@ static void accept_one(obsd_bin *b, int lfd)
     if (pthread_create(&t, &attr, conn_main, c) != 0) {
         atomic_fetch_sub(&b->connections, 1);
         close(fd);
-        pthread_cond_destroy(&c->done_cond);
-        pthread_mutex_destroy(&c->lock);
         free(c);
     }
     pthread_attr_destroy(&attr);

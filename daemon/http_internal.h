@@ -1,12 +1,14 @@
-/* Shared by the parts of obscurad's HTTP server: http_server.c (the
- * server, /v1/ao and the GET routes), http_streams.c (/v1/streams) and
- * http_page.c (the preview page).  Not a public header. */
+/* Shared by the parts of obscurad's HTTP server.  Not a public header.
+ * Calls go one way: http_server.c dispatches to http_frames.c,
+ * http_streams.c, http_info.c and http_page.c; they all answer through
+ * http_reply.c; http_streams.c also uses http_frames.c for its frames. */
 #ifndef OBSD_HTTP_INTERNAL_H
 #define OBSD_HTTP_INTERNAL_H
 
 #include <microhttpd.h>
 #include <stdatomic.h>
 
+#include "frame_path.h"
 #include "http.h"
 #include "http_server.h"
 #include "obscura/io.h"
@@ -63,10 +65,7 @@ typedef struct obsd__req {
     size_t discarded;    /* bytes thrown away after too_big */
     int before_drain;    /* started before SIGTERM: finished in the drain */
     obs_http_request hr;
-    obs_gbuffer_file gf;
-    obs_deep_image deep; /* a deep EXR body (POST /v1/ao) */
-    obsd_job job;
-    double ms_decode, ms_queue, ms_gl, ms_encode;
+    obsd_fp fp;          /* the frame: its input, job, result and stage times */
     /* /v1/streams */
     obsd__stream_op op;
     char stream[OBSD_STREAM_NAME_LEN + 1];
@@ -87,6 +86,8 @@ typedef struct obsd__req {
     size_t bytes_out;
 } obsd__req;
 
+/* ---- http_reply.c: answers, each logged and counted ---- */
+
 /* Queues `resp` (taking it) with status; logs and counts the request. */
 enum MHD_Result obsd__answer(obsd__req *r, int status, struct MHD_Response *resp, size_t body_len,
                              const char *note);
@@ -98,32 +99,41 @@ enum MHD_Result obsd__answer_error(obsd__req *r, int status, const char *code, c
                                    const char *hname, const char *hvalue);
 /* The error of a core status (503 with Retry-After). */
 enum MHD_Result obsd__answer_status(obsd__req *r, obs_status s, const char *msg);
+/* Answers with images as r->hr asks (format, float, png_bits), a colour
+ * PNG exposed by r->exposure.  With `timing`, a Server-Timing header. */
+enum MHD_Result obsd__answer_images(obsd__req *r, const obsd_fp_images *im, const obs_camera *cam, int timing,
+                                    const char *extra_name, const char *extra_value);
+
+/* ---- http_frames.c: a frame's query, body and trip to the GL worker ---- */
 
 /* The start of a frame's request: query, Content-Type, Content-Length,
  * a full queue; then the body is read (REQ_BODY). */
 enum MHD_Result obsd__frame_start(obsd__req *r);
+/* A call in REQ_BODY: `size` bytes of the body, or (size 0) its end,
+ * when the frame is decoded and queued. */
+enum MHD_Result obsd__frame_body(obsd__req *r, const char *data, size_t *size);
 /* The request's query parameters into r->hr (recorded into r->query
  * when r->record_query); 400 answered on a bad one (returns 0, *rc set). */
 int obsd__parse_query(obsd__req *r, enum MHD_Result *rc);
-/* Decodes `body` with r->hr's channel map (a deep EXR into r->deep, on
+/* Decodes `body` into r->fp with r->hr's channel map (a deep EXR on
  * POST /v1/ao only), queues the frame (outputs) and suspends the
  * connection; answers the error itself. */
 enum MHD_Result obsd__queue_frame(obsd__req *r, const unsigned char *body, size_t len, unsigned outputs);
-/* The stages of a finished job into r and the metrics. */
-void obsd__job_timings(obsd__req *r);
-/* Answers with images as r->hr asks (format, outputs, float, png_bits):
- * ao / composite / colour, any may be NULL when not asked for.  With
- * `timing`, a Server-Timing header. */
-enum MHD_Result obsd__answer_images(obsd__req *r, const obs_image *ao, const obs_image *composite,
-                                    const obs_image *color, const obs_camera *cam, int timing,
-                                    const char *extra_name, const char *extra_value);
+/* POST /v1/ao, resumed by the GL worker: the answer. */
+enum MHD_Result obsd__ao_finish(obsd__req *r);
 
-/* /v1/streams: the first call of a request (token checked); the call
- * after the GL worker resumed it; the end of a request. */
+/* ---- http_streams.c: /v1/streams ---- */
+
+/* The first call of a request (token checked); the call after the GL
+ * worker resumed it; the end of a request. */
 enum MHD_Result obsd__streams_start(obsd__req *r, const char *url);
 enum MHD_Result obsd__streams_finish(obsd__req *r);
 void obsd__streams_done(obsd__req *r);
 
+/* ---- http_info.c, http_page.c ---- */
+
+/* GET /v1/params, /v1/info, /healthz, /readyz, /metrics (r->route). */
+enum MHD_Result obsd__info_route(obsd__req *r);
 /* GET / and /preview/...: the embedded page. */
 enum MHD_Result obsd__page(obsd__req *r, const char *url);
 

@@ -147,6 +147,13 @@ static void apply_stored(req *r, const obsd_frame *f)
     r->hr.png_bits = 8;
 }
 
+/* A kept frame's images that r->hr asks for. */
+static obsd_fp_images kept_images(const req *r, const obsd_frame *f)
+{
+    return (obsd_fp_images){.ao = (r->hr.outputs & OBS_OUTPUT_AO) ? &f->ao : NULL,
+                            .composite = (r->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &f->composite : NULL};
+}
+
 static enum MHD_Result get_frame(req *r, uint64_t seq)
 {
     obsd_http *h = r->srv;
@@ -173,12 +180,14 @@ static enum MHD_Result get_frame(req *r, uint64_t seq)
         if (!f->color.data)
             return obsd__answer_error(r, 404, "no_color", "the frame's G-buffer has no colour plane", NULL,
                                       NULL);
-        return obsd__answer_images(r, NULL, NULL, &f->color, NULL, 0, "X-Obscura-Frame", num);
+        obsd_fp_images color = {.composite = &f->color};
+        return obsd__answer_images(r, &color, NULL, 0, "X-Obscura-Frame", num);
     }
-    if (!r->rerun)
-        return obsd__answer_images(r, (r->hr.outputs & OBS_OUTPUT_AO) ? &f->ao : NULL,
-                                   (r->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &f->composite : NULL, NULL,
-                                   f->camera.has_projection ? &f->camera : NULL, 0, "X-Obscura-Frame", num);
+    if (!r->rerun) {
+        obsd_fp_images im = kept_images(r, f);
+        return obsd__answer_images(r, &im, f->camera.has_projection ? &f->camera : NULL, 0, "X-Obscura-Frame",
+                                   num);
+    }
     /* other parameters: the frame runs again (not kept) */
     r->before_drain = !atomic_load(&h->draining);
     if (!r->before_drain)
@@ -269,15 +278,15 @@ static int copy_color(const obs_gbuffer *gb, obs_image *out)
 static enum MHD_Result post_finish(req *r)
 {
     obsd_http *h = r->srv;
-    obsd_job *job = &r->job;
-    obs_result *res = &job->result;
+    const obs_gbuffer *gb = &r->fp.gf.gb;
+    obs_result *res = &r->fp.job.result;
     obsd_frame *f = obsd_frame_new();
-    if (!f || copy_color(&r->gf.gb, &f->color) != 0) {
+    if (!f || copy_color(gb, &f->color) != 0) {
         obsd_frame_release(f);
         return obsd__answer_status(r, OBS_NO_MEMORY, "no memory to keep the frame");
     }
-    f->width = r->gf.gb.width;
-    f->height = r->gf.gb.height;
+    f->width = gb->width;
+    f->height = gb->height;
     f->body = r->body;
     f->body_len = r->len;
     r->body = NULL;
@@ -291,10 +300,10 @@ static enum MHD_Result post_finish(req *r)
     res->ao = (obs_image){0};
     res->composite = (obs_image){0};
     obs_result_free(res);
-    f->camera = r->gf.gb.camera;
-    f->ms_queue = r->ms_queue;
-    f->ms_decode = r->ms_decode;
-    f->ms_gl = r->ms_gl;
+    f->camera = gb->camera;
+    f->ms_queue = r->fp.ms_queue;
+    f->ms_decode = r->fp.ms_decode;
+    f->ms_gl = r->fp.ms_gl;
     atomic_fetch_add(&f->refs, 1); /* ours, to answer with */
     uint64_t seq = obsd_streams_add(h->streams, r->stream, f);
     if (!seq) {
@@ -304,29 +313,23 @@ static enum MHD_Result post_finish(req *r)
     char num[32];
     snprintf(num, sizeof num, "%llu", (unsigned long long)seq);
     r->frame = f; /* released when the request ends */
-    return obsd__answer_images(r, (r->hr.outputs & OBS_OUTPUT_AO) ? &f->ao : NULL,
-                               (r->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &f->composite : NULL, NULL,
-                               f->camera.has_projection ? &f->camera : NULL, 1, "X-Obscura-Frame", num);
+    obsd_fp_images im = kept_images(r, f);
+    return obsd__answer_images(r, &im, f->camera.has_projection ? &f->camera : NULL, 1, "X-Obscura-Frame", num);
 }
 
 enum MHD_Result obsd__streams_finish(req *r)
 {
-    obsd_job *job = &r->job;
-    obsd__job_timings(r);
-    if (job->status != OBS_OK)
-        return obsd__answer_status(r, job->status, job->err);
+    obs_status s = obsd_fp_finished(&r->fp);
+    if (s != OBS_OK)
+        return obsd__answer_status(r, s, r->fp.job.err);
     if (r->op == STREAM_POST)
         return post_finish(r);
     /* a re-run of a kept frame */
-    const obs_result *res = &job->result;
     char num[32];
     snprintf(num, sizeof num, "%llu", (unsigned long long)r->frame->seq);
-    enum MHD_Result rc = obsd__answer_images(r, res->ao.data ? &res->ao : NULL,
-                                             res->composite.data ? &res->composite : NULL, NULL,
-                                             r->gf.gb.camera.has_projection ? &r->gf.gb.camera : NULL, 1,
-                                             "X-Obscura-Frame", num);
-    obs_result_free(&job->result);
-    return rc;
+    obsd_fp_images im;
+    obsd_fp_images_of(&r->fp, r->hr.outputs, &im);
+    return obsd__answer_images(r, &im, obsd_fp_camera(&r->fp), 1, "X-Obscura-Frame", num);
 }
 
 void obsd__streams_done(req *r)

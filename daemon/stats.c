@@ -1,4 +1,5 @@
-/* Counters and histograms behind GET /metrics (Prometheus text 0.0.4). */
+/* Counters and histograms, and their Prometheus text (0.0.4) for GET
+ * /metrics; the route labels come from routes.c. */
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -7,9 +8,6 @@
 
 #include "stats.h"
 
-static const char *const route_paths[OBSD_ROUTE_COUNT] = {
-    "/v1/ao", "/v1/params", "/v1/info", "/healthz", "/readyz", "/metrics", "/v1/streams", "/",
-    "binary", "other"};
 static const char *const stage_names[OBSD_STAGE_COUNT] = {"queue", "decode", "gl", "encode", "total"};
 /* The statuses the daemon answers; anything else counts as the last. */
 static const int codes[] = {200, 400, 401, 404, 405, 413, 415, 422, 500, 503, 0};
@@ -31,23 +29,6 @@ static struct {
     uint64_t count[OBSD_STAGE_COUNT];
     uint64_t frames[NRES];
 } st = {PTHREAD_MUTEX_INITIALIZER};
-
-const char *obsd_route_path(obsd_route r)
-{
-    return r >= 0 && r < OBSD_ROUTE_COUNT ? route_paths[r] : "other";
-}
-
-obsd_route obsd_route_of(const char *path)
-{
-    for (int r = 0; r < OBSD_ROUTE_BINARY; r++)
-        if (path && !strcmp(path, route_paths[r]))
-            return (obsd_route)r;
-    if (path && !strncmp(path, "/v1/streams/", 12))
-        return OBSD_ROUTE_STREAMS;
-    if (path && !strncmp(path, "/preview/", 9))
-        return OBSD_ROUTE_PAGE;
-    return OBSD_ROUTE_OTHER;
-}
 
 void obsd_stats_init(void)
 {
@@ -145,7 +126,7 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
     for (int r = 0; r < OBSD_ROUTE_COUNT; r++)
         for (int c = 0; c < NCODES; c++)
             if (st.requests[r][c])
-                put(&b, "obscurad_requests_total{route=\"%s\",code=\"%s%d\"} %llu\n", route_paths[r],
+                put(&b, "obscurad_requests_total{route=\"%s\",code=\"%s%d\"} %llu\n", obsd_route_path((obsd_route)r),
                     codes[c] ? "" : "other", codes[c] ? codes[c] : 0,
                     (unsigned long long)st.requests[r][c]);
     put(&b, "# HELP obscurad_stage_seconds Latency of each stage of a frame "

@@ -1,24 +1,12 @@
-/* The daemon's counters and latency histograms, rendered as Prometheus
- * text for GET /metrics.  Thread-safe. */
+/* The daemon's counters and latency histograms, and their Prometheus
+ * text (served by the HTTP side on GET /metrics).  Thread-safe. */
 #ifndef OBSD_STATS_H
 #define OBSD_STATS_H
 
 #include <stddef.h>
 #include <stdint.h>
 
-typedef enum obsd_route {
-    OBSD_ROUTE_AO,
-    OBSD_ROUTE_PARAMS,
-    OBSD_ROUTE_INFO,
-    OBSD_ROUTE_HEALTHZ,
-    OBSD_ROUTE_READYZ,
-    OBSD_ROUTE_METRICS,
-    OBSD_ROUTE_STREAMS, /* /v1/streams and everything under it */
-    OBSD_ROUTE_PAGE,    /* the preview page: / and /preview/... */
-    OBSD_ROUTE_BINARY, /* the binary protocol (socket / TCP), not a URL */
-    OBSD_ROUTE_OTHER,
-    OBSD_ROUTE_COUNT
-} obsd_route;
+#include "routes.h"
 
 typedef enum obsd_stage {
     OBSD_STAGE_QUEUE,
@@ -28,12 +16,6 @@ typedef enum obsd_stage {
     OBSD_STAGE_TOTAL,
     OBSD_STAGE_COUNT
 } obsd_stage;
-
-/* "/v1/ao", ... ; "other" for OBSD_ROUTE_OTHER. */
-const char *obsd_route_path(obsd_route r);
-/* The route of a URL path (exact match; /v1/streams/... and /preview/...
- * by prefix), OBSD_ROUTE_OTHER if none. */
-obsd_route obsd_route_of(const char *path);
 
 void obsd_stats_init(void);
 /* One answered request. */

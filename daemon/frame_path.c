@@ -1,0 +1,177 @@
+/* One frame: decode, queue to the GL worker, wait, encode; each stage
+ * timed and counted.  The HTTP and binary servers both go through here,
+ * so a frame is read and written the same way whichever way it came. */
+#include <stdio.h>
+#include <string.h>
+
+#include "frame_path.h"
+#include "obscura/deep.h"
+#include "stats.h"
+
+void obsd_fp_init(obsd_fp *fp)
+{
+    memset(fp, 0, sizeof *fp);
+    pthread_mutex_init(&fp->lock, NULL);
+    pthread_cond_init(&fp->cond, NULL);
+}
+
+void obsd_fp_free(obsd_fp *fp)
+{
+    obs_result_free(&fp->job.result);
+    obs_deep_result_free(&fp->job.deep_result);
+    obs_gbuffer_free(&fp->gf);
+    obs_deep_free(&fp->deep_exr);
+    pthread_cond_destroy(&fp->cond);
+    pthread_mutex_destroy(&fp->lock);
+}
+
+obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len, const obs_channel_map *map,
+                          const obs_limits *lim, const char *no_deep, char err[OBS_ERR_LEN])
+{
+    double t0 = obsd_now_ms();
+    /* A deep EXR runs the multi-layer chain (include/obscura/deep.h). */
+    int deep = 0;
+    obs_status s = obs_exr_is_deep_mem(body, len, &deep, err);
+    if (s == OBS_OK && deep && no_deep)
+        s = OBS_UNSUPPORTED, snprintf(err, OBS_ERR_LEN, "%s", no_deep);
+    else if (s == OBS_OK && deep)
+        s = obs_deep_read_exr_mem(body, len, lim, &fp->deep_exr, err);
+    else if (s == OBS_OK)
+        s = obs_gbuffer_read_exr_mem(body, len, map, lim, &fp->gf, err);
+    fp->ms_decode = obsd_now_ms() - t0;
+    obsd_stats_stage(OBSD_STAGE_DECODE, fp->ms_decode);
+    if (s == OBS_OK)
+        obsd_fp_use(fp, deep ? NULL : &fp->gf.gb, deep ? &fp->deep_exr : NULL);
+    return s;
+}
+
+void obsd_fp_use(obsd_fp *fp, const obs_gbuffer *gb, const obs_deep_image *deep)
+{
+    fp->gb = deep ? NULL : gb;
+    fp->deep = deep;
+}
+
+/* Called on the GL worker thread.  The frame may be gone once the caller
+ * is told, so nothing of it is touched after that. */
+static void job_done(obsd_job *job, void *user)
+{
+    (void)job;
+    obsd_fp *fp = user;
+    if (fp->on_done) {
+        fp->on_done(fp->user);
+        return;
+    }
+    pthread_mutex_lock(&fp->lock);
+    fp->done = 1;
+    pthread_cond_signal(&fp->cond);
+    pthread_mutex_unlock(&fp->lock);
+}
+
+int obsd_fp_queue(obsd_fp *fp, obsd_queue *q, const obs_params *params, unsigned outputs,
+                  void (*on_done)(void *user), void *user)
+{
+    fp->job = (obsd_job){.gb = fp->gb, .deep = fp->deep, .params = params, .outputs = outputs,
+                         .done = job_done, .user = fp};
+    fp->on_done = on_done;
+    fp->user = user;
+    fp->done = 0;
+    return obsd_queue_push(q, &fp->job);
+}
+
+void obsd_fp_wait(obsd_fp *fp)
+{
+    pthread_mutex_lock(&fp->lock);
+    while (!fp->done)
+        pthread_cond_wait(&fp->cond, &fp->lock);
+    pthread_mutex_unlock(&fp->lock);
+}
+
+obs_status obsd_fp_finished(obsd_fp *fp)
+{
+    const obsd_job *job = &fp->job;
+    fp->ms_queue = job->t_started - job->t_queued;
+    fp->ms_gl = job->t_finished - job->t_started;
+    obsd_stats_stage(OBSD_STAGE_QUEUE, fp->ms_queue);
+    obsd_stats_stage(OBSD_STAGE_GL, fp->ms_gl);
+    if (job->status == OBS_OK && job->deep)
+        obsd_stats_frame(job->deep->width, job->deep->height);
+    else if (job->status == OBS_OK)
+        obsd_stats_frame(job->gb->width, job->gb->height);
+    return job->status;
+}
+
+void obsd_fp_images_of(const obsd_fp *fp, unsigned outputs, obsd_fp_images *im)
+{
+    const obs_result *res = &fp->job.result;
+    const obs_deep_result *dr = &fp->job.deep_result;
+    *im = (obsd_fp_images){0};
+    if (fp->job.deep) {
+        /* the deep chain fills every image; the request picks */
+        im->deep = 1;
+        if (outputs & OBS_OUTPUT_AO) {
+            im->ao = &dr->ao_blend;
+            im->ao_front = &dr->ao_front;
+        }
+        if (outputs & OBS_OUTPUT_COMPOSITE)
+            im->composite = &dr->composite;
+        return;
+    }
+    /* the flat chain fills only what was asked for */
+    im->ao = res->ao.data ? &res->ao : NULL;
+    im->composite = res->composite.data ? &res->composite : NULL;
+}
+
+const obs_camera *obsd_fp_camera(const obsd_fp *fp)
+{
+    const obs_camera *cam = fp->deep ? &fp->deep->camera : &fp->gb->camera;
+    return cam->has_projection ? cam : NULL;
+}
+
+const obs_image *obsd_fp_png_image(const obsd_fp_images *im)
+{
+    return im->ao ? im->ao : im->composite;
+}
+
+/* The EXR layers of `im`, named by core's own tables. */
+static int exr_layers(const obsd_fp_images *im, obs_result *flat, obs_deep_result *deep,
+                      obs_exr_layer layers[OBS_RESULT_LAYERS])
+{
+    if (im->deep) {
+        if (im->ao)
+            deep->ao_blend = *im->ao;
+        if (im->ao_front)
+            deep->ao_front = *im->ao_front;
+        if (im->composite)
+            deep->composite = *im->composite;
+        return obs_deep_result_exr_layers(deep, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE, layers);
+    }
+    if (im->ao)
+        flat->ao = *im->ao;
+    if (im->composite)
+        flat->composite = *im->composite;
+    return obs_result_exr_layers(flat, layers);
+}
+
+obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_request *hr, int raw,
+                          const obs_camera *cam, obs_bytes *out, char err[OBS_ERR_LEN])
+{
+    double t0 = obsd_now_ms();
+    obs_status s = OBS_OK;
+    *out = (obs_bytes){0};
+    if (raw) {
+        /* nothing to write: the protocol sends the planes */
+    } else if (hr->format == OBS_HTTP_EXR) {
+        /* copies of the image headers only: the pixels stay where they are */
+        obs_result flat = {0};
+        obs_deep_result deep = {0};
+        obs_exr_layer layers[OBS_RESULT_LAYERS];
+        int n = exr_layers(im, &flat, &deep, layers);
+        s = obs_exr_write_mem(layers, n, hr->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, out, err);
+    } else {
+        const obs_image *img = obsd_fp_png_image(im);
+        s = obs_png_write_mem(img, hr->png_bits, img != im->ao, out, err);
+    }
+    fp->ms_encode = obsd_now_ms() - t0;
+    obsd_stats_stage(OBSD_STAGE_ENCODE, fp->ms_encode);
+    return s;
+}

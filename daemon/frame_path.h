@@ -1,0 +1,89 @@
+/* The one path of a frame through the daemon, shared by the HTTP server
+ * and the binary-protocol server:
+ *
+ *   decode     an EXR body (flat or deep) into the frame's G-buffer, on
+ *              the network thread; or planes the protocol decoded itself
+ *   queue      the job to the GL worker (a full queue is refused)
+ *   wait       obsd_fp_wait(), or a callback on the GL worker thread for a
+ *              caller that must not block (HTTP resumes its connection)
+ *   finished   the job's queue and GL times, the frame's size class
+ *   encode     the images asked for as EXR or PNG (or none: raw planes)
+ *
+ * Each step counts its stage in the metrics (stats.h): decode (EXR bodies
+ * only), queue, gl, the frame class (frames that ran), encode.  Answering
+ * and counting the request itself stay with the transport. */
+#ifndef OBSD_FRAME_PATH_H
+#define OBSD_FRAME_PATH_H
+
+#include "http.h"
+#include "job.h"
+#include "obscura/io.h"
+
+typedef struct obsd_fp {
+    /* the input the job runs: one of them, pointing into gf / deep_exr
+     * after obsd_fp_decode(), or the caller's (obsd_fp_use()) */
+    const obs_gbuffer *gb;
+    const obs_deep_image *deep;
+    obs_gbuffer_file gf;      /* a decoded flat EXR (owned) */
+    obs_deep_image deep_exr;  /* a decoded deep EXR (owned) */
+    obsd_job job;             /* its result is owned until obsd_fp_free() */
+    double ms_decode, ms_queue, ms_gl, ms_encode;
+    /* the way back from the GL worker */
+    void (*on_done)(void *user);
+    void *user;
+    pthread_mutex_t lock;
+    pthread_cond_t cond;
+    int done;
+} obsd_fp;
+
+/* The images an answer holds; NULL for those not asked for.  `composite`
+ * also carries a plain colour image (HTTP's kept frames), written the
+ * same way.  `deep` names the EXR layers as the deep chain does. */
+typedef struct obsd_fp_images {
+    const obs_image *ao;       /* AO.Y (deep: the blended AO) */
+    const obs_image *ao_front; /* deep: AOFront.Y */
+    const obs_image *composite;
+    int deep;
+} obsd_fp_images;
+
+/* An empty frame; free it with obsd_fp_free(). */
+void obsd_fp_init(obsd_fp *fp);
+/* Frees what the frame holds: the decoded input, the result. */
+void obsd_fp_free(obsd_fp *fp);
+
+/* Reads an EXR body: a deep one into fp->deep_exr (refused with OBS_UNSUPPORTED
+ * and the message `no_deep` when that is set), else a G-buffer with `map`.
+ * Sizes are checked against lim.  Sets ms_decode either way. */
+obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len, const obs_channel_map *map,
+                          const obs_limits *lim, const char *no_deep, char err[OBS_ERR_LEN]);
+/* Runs planes decoded elsewhere (gb or deep); they must outlive the frame. */
+void obsd_fp_use(obsd_fp *fp, const obs_gbuffer *gb, const obs_deep_image *deep);
+
+/* Queues the input with params and outputs (which must outlive the job).
+ * With on_done, it is called on the GL worker thread when the job is
+ * finished (it must not block); without, obsd_fp_wait() waits for that.
+ * 0: queued; -1: the queue is full or closed. */
+int obsd_fp_queue(obsd_fp *fp, obsd_queue *q, const obs_params *params, unsigned outputs,
+                  void (*on_done)(void *user), void *user);
+/* Waits for a job queued without on_done. */
+void obsd_fp_wait(obsd_fp *fp);
+/* The job is back: its times and the frame into the metrics.  Returns its
+ * status (the message is in fp->job.err). */
+obs_status obsd_fp_finished(obsd_fp *fp);
+
+/* The images of the finished job for `outputs` (OBS_OUTPUT_AO and/or
+ * OBS_OUTPUT_COMPOSITE), and the camera to write with them (NULL when the
+ * input had no projection). */
+void obsd_fp_images_of(const obsd_fp *fp, unsigned outputs, obsd_fp_images *im);
+const obs_camera *obsd_fp_camera(const obsd_fp *fp);
+/* The one image a PNG of `im` shows: the AO, else the composite. */
+const obs_image *obsd_fp_png_image(const obsd_fp_images *im);
+
+/* Writes `im` as hr asks (format exr|png, float, png_bits) into *out
+ * (caller frees with obs_bytes_free()); with `raw`, writes nothing (the
+ * caller sends the images as they are).  Sets ms_encode and counts it,
+ * failed or not. */
+obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_request *hr, int raw,
+                          const obs_camera *cam, obs_bytes *out, char err[OBS_ERR_LEN]);
+
+#endif

@@ -1,0 +1,259 @@
+/* The HTTP side of a frame, POST /v1/ao and the streams' frames: the
+ * query, the body, then the frame path (frame_path.c) with the
+ * connection suspended while the GL worker has the job.
+ *
+ *   first call    query parameters, Content-Type, Content-Length (413
+ *                 before any of the body is read), a full queue (503)
+ *   body calls    append, 413 when it grows over --max-body
+ *   last call     decode the EXR here (a network thread), suspend the
+ *                 connection, queue the frame (503 when full)
+ *   resumed       the GL worker is done: encode here, answer */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "http_internal.h"
+#include "log.h"
+
+typedef obsd__req req;
+
+typedef struct arg_ctx {
+    req *r;
+    obs_status status;
+    char err[OBS_ERR_LEN];
+} arg_ctx;
+
+static int record_pair(req *r, const char *key, const char *value)
+{
+    size_t kl = strlen(key) + 1, vl = strlen(value) + 1;
+    if (r->query_len + kl + vl > r->query_cap) {
+        size_t cap = (r->query_cap ? r->query_cap * 2 : 256) + kl + vl;
+        char *p = realloc(r->query, cap);
+        if (!p)
+            return -1;
+        r->query = p;
+        r->query_cap = cap;
+    }
+    memcpy(r->query + r->query_len, key, kl);
+    memcpy(r->query + r->query_len + kl, value, vl);
+    r->query_len += kl + vl;
+    return 0;
+}
+
+static int name_is(const char *name, const char *want)
+{
+    for (; *name && *want; name++, want++)
+        if ((*name == '-' ? '_' : *name) != *want)
+            return 0;
+    return *name == *want;
+}
+
+static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+{
+    arg_ctx *a = cls;
+    req *r = a->r;
+    (void)kind;
+    if (a->status != OBS_OK)
+        return MHD_NO;
+    if (!value)
+        value = "";
+    if (r->op == STREAM_FRAME) {
+        /* a stored frame: the view options, and anything else re-runs it */
+        if (name_is(key, "exposure")) {
+            char *end;
+            double ev = strtod(value, &end);
+            if (end == value || *end || !(ev >= -20.0 && ev <= 20.0)) {
+                snprintf(a->err, OBS_ERR_LEN, "parameter exposure: '%.100s' is not a number in [-20, 20] "
+                         "(stops)", value);
+                a->status = OBS_INVALID_ARGUMENT;
+                return MHD_NO;
+            }
+            r->exposure = ev;
+            return MHD_YES;
+        }
+        if (name_is(key, "output") && !strcmp(value, "color")) {
+            r->want_color = 1;
+            return MHD_YES;
+        }
+        if (name_is(key, "output"))
+            r->want_color = 0;
+        else if (!name_is(key, "format") && !name_is(key, "float") && !name_is(key, "png_bits"))
+            r->rerun = 1;
+    }
+    a->status = obs_http_request_set(&r->hr, key, value, a->err);
+    if (a->status == OBS_OK && r->record_query && record_pair(r, key, value) != 0) {
+        snprintf(a->err, OBS_ERR_LEN, "no memory for the query");
+        a->status = OBS_NO_MEMORY;
+    }
+    return a->status == OBS_OK ? MHD_YES : MHD_NO;
+}
+
+int obsd__parse_query(req *r, enum MHD_Result *rc)
+{
+    arg_ctx a = {r, OBS_OK, ""};
+    MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
+    if (a.status == OBS_OK)
+        a.status = obs_http_request_check(&r->hr, a.err);
+    if (a.status == OBS_OK)
+        return 1;
+    *rc = a.status == OBS_INVALID_ARGUMENT ? obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL)
+                                           : obsd__answer_status(r, a.status, a.err);
+    return 0;
+}
+
+/* Called on the GL worker thread: give the connection back to MHD. */
+static void job_done(void *user)
+{
+    req *r = user;
+    MHD_resume_connection(r->conn);
+}
+
+enum MHD_Result obsd__frame_start(req *r)
+{
+    obsd_http *h = r->srv;
+    const char *v;
+    enum MHD_Result rc;
+    r->before_drain = !atomic_load(&h->draining);
+    if (!r->before_drain)
+        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
+                            MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    obs_http_request_init(&r->hr);
+    if (!obsd__parse_query(r, &rc))
+        return rc;
+    v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
+    if (v && strncmp(v, "image/x-exr", 11) != 0 && strncmp(v, "application/octet-stream", 24) != 0)
+        return obsd__answer_error(r, 415, "unsupported_media_type",
+                            "the body must be a G-buffer EXR (Content-Type: image/x-exr)", NULL, NULL);
+    v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (v) {
+        char *end;
+        errno = 0;
+        unsigned long long n = strtoull(v, &end, 10);
+        if (errno == ERANGE || n > (unsigned long long)h->cfg->max_body) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "body of %s bytes is over the limit of %lld bytes (--max-body)",
+                     v, (long long)h->cfg->max_body);
+            return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
+        }
+        /* Sized by the claim, which is within the limit; grows if it lied. */
+        r->cap = n ? (size_t)n : 0;
+        if (r->cap && !(r->body = malloc(r->cap)))
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the body");
+    }
+    /* Refuse early when the queue is already full: no need for the body. */
+    int full;
+    obsd_queue_stats(h->queue, NULL, NULL, &full);
+    if (full)
+        return obsd__answer_error(r, 503, "queue_full", "the frame queue is full; retry later",
+                            MHD_HTTP_HEADER_RETRY_AFTER, "1");
+    r->state = REQ_BODY;
+    return MHD_YES;
+}
+
+static enum MHD_Result append_body(req *r, const char *data, size_t *size)
+{
+    obsd_http *h = r->srv;
+    const size_t max = (size_t)h->cfg->max_body;
+    size_t n = *size;
+    *size = 0;
+    if (r->too_big || n > max - r->len) {
+        /* No Content-Length (chunked), or more than it said.  libmicrohttpd
+         * cannot answer in the middle of a body: keep nothing, discard up
+         * to another --max-body so that the client gets its 413, and close
+         * the connection on anything beyond that. */
+        if (!r->too_big) {
+            r->too_big = 1;
+            free(r->body);
+            r->body = NULL;
+            r->cap = 0;
+        }
+        r->discarded += n;
+        if (r->discarded > max) {
+            obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: body over twice --max-body, "
+                     "connection closed", (unsigned long long)r->id, r->peer, r->method,
+                     obsd_route_path(r->route));
+            return MHD_NO;
+        }
+        return MHD_YES;
+    }
+    if (r->len + n > r->cap) {
+        size_t cap = r->cap ? r->cap : 1 << 16;
+        while (cap < r->len + n)
+            cap = cap > max / 2 ? max : cap * 2;
+        unsigned char *p = realloc(r->body, cap);
+        if (!p)
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the body");
+        r->body = p;
+        r->cap = cap;
+    }
+    memcpy(r->body + r->len, data, n);
+    r->len += n;
+    return MHD_YES;
+}
+
+enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len, unsigned outputs)
+{
+    obsd_http *h = r->srv;
+    char err[OBS_ERR_LEN] = "";
+    obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
+    /* A deep EXR runs on /v1/ao only: streams keep flat frames. */
+    obs_status s = obsd_fp_decode(&r->fp, body, len, &r->hr.map, &lim,
+                                  r->op == STREAM_POST ? "deep EXR input runs on POST /v1/ao, not in streams"
+                                                       : NULL,
+                                  err);
+    if (s != OBS_OK)
+        return obsd__answer_status(r, s, err);
+    /* Suspend before queueing: the worker may finish and resume at once. */
+    r->state = REQ_QUEUED;
+    MHD_suspend_connection(r->conn);
+    if ((atomic_load(&h->draining) && !r->before_drain) ||
+        obsd_fp_queue(&r->fp, h->queue, &r->hr.params, outputs, job_done, r) != 0) {
+        r->state = REQ_REFUSED;
+        MHD_resume_connection(r->conn);
+    }
+    return MHD_YES;
+}
+
+static enum MHD_Result queue_body(req *r)
+{
+    if (r->len == 0) {
+        char msg[128];
+        snprintf(msg, sizeof msg, "%s %s needs a G-buffer EXR as its body", r->method,
+                 r->op == STREAM_POST ? "/v1/streams/NAME/frames" : "/v1/ao");
+        return obsd__answer_error(r, 400, "empty_body", msg, NULL, NULL);
+    }
+    if (r->op == STREAM_POST) /* the body is kept with the frame: re-runs decode it again */
+        return obsd__queue_frame(r, r->body, r->len, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE);
+    enum MHD_Result rc = obsd__queue_frame(r, r->body, r->len, r->hr.outputs);
+    free(r->body);
+    r->body = NULL;
+    r->cap = 0;
+    return rc;
+}
+
+enum MHD_Result obsd__frame_body(req *r, const char *data, size_t *size)
+{
+    if (*size)
+        return append_body(r, data, size);
+    if (r->too_big) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "body is over the limit of %lld bytes (--max-body)",
+                 (long long)r->srv->cfg->max_body);
+        return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
+    }
+    return queue_body(r);
+}
+
+/* Called again once the GL worker resumed the connection.  Deep input
+ * answers an EXR of AO.Y, AOFront.Y and R,G,B,A as `obscura ao` writes
+ * it, or a PNG of the blended AO or the composite. */
+enum MHD_Result obsd__ao_finish(req *r)
+{
+    obs_status s = obsd_fp_finished(&r->fp);
+    if (s != OBS_OK)
+        return obsd__answer_status(r, s, r->fp.job.err);
+    obsd_fp_images im;
+    obsd_fp_images_of(&r->fp, r->hr.outputs, &im);
+    return obsd__answer_images(r, &im, obsd_fp_camera(&r->fp), 1, NULL, NULL);
+}

@@ -1,0 +1,83 @@
+/* The small GET routes of the HTTP API: /v1/params, /v1/info, /healthz,
+ * /readyz and /metrics (the counters are stats.c's; the gauges are read
+ * here, from the queue, the GL worker and the stream store). */
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "http_internal.h"
+
+typedef obsd__req req;
+
+static void gauges(obsd_http *h, obsd_gauges *g)
+{
+    int waiting, running, full;
+    obsd_queue_stats(h->queue, &waiting, &running, &full);
+    g->queue_depth = waiting;
+    g->queue_capacity = h->cfg->queue;
+    g->gl_running = running;
+    g->in_flight = atomic_load(&h->in_flight);
+    g->gl_alive = atomic_load(&h->gl->alive);
+    g->gl_recreations = (unsigned long long)atomic_load(&h->gl->recreations);
+    obsd_streams_gauges(h->streams, &g->streams, &g->stream_frames, &g->stream_bytes, &g->sse_subscribers);
+}
+
+static enum MHD_Result get_info(req *r)
+{
+    obsd_http *h = r->srv;
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return MHD_NO;
+    cJSON_AddStringToObject(o, "name", "obscurad");
+    cJSON_AddStringToObject(o, "version", OBS_VERSION);
+    cJSON_AddStringToObject(o, "backend", h->gl->backend);
+    cJSON_AddStringToObject(o, "gl_version", h->gl->gl_version);
+    cJSON_AddStringToObject(o, "gl_vendor", h->gl->gl_vendor);
+    cJSON_AddStringToObject(o, "gl_renderer", h->gl->gl_renderer);
+    cJSON_AddNumberToObject(o, "queue", h->cfg->queue);
+    cJSON_AddNumberToObject(o, "max_pixels", (double)h->cfg->max_pixels);
+    cJSON_AddNumberToObject(o, "max_body", (double)h->cfg->max_body);
+    char *text = cJSON_Print(o);
+    cJSON_Delete(o);
+    return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
+}
+
+enum MHD_Result obsd__info_route(req *r)
+{
+    obsd_http *h = r->srv;
+    switch (r->route) {
+    case OBSD_ROUTE_PARAMS: {
+        char *text = obs_http_params_json();
+        return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
+    }
+    case OBSD_ROUTE_INFO:
+        return get_info(r);
+    case OBSD_ROUTE_HEALTHZ: {
+        char *text = strdup("ok\n");
+        return text ? obsd__answer_text(r, 200, "text/plain", text, 3, NULL) : MHD_NO;
+    }
+    case OBSD_ROUTE_READYZ: {
+        obsd_gauges g;
+        int full;
+        gauges(h, &g);
+        obsd_queue_stats(h->queue, NULL, NULL, &full);
+        const char *why = !g.gl_alive ? "GL context not alive"
+                          : atomic_load(&h->draining) ? "shutting down"
+                          : full ? "queue full" : NULL;
+        if (why)
+            return obsd__answer_error(r, 503, "not_ready", why, MHD_HTTP_HEADER_RETRY_AFTER, "1");
+        char *text = strdup("ready\n");
+        return text ? obsd__answer_text(r, 200, "text/plain", text, 6, NULL) : MHD_NO;
+    }
+    case OBSD_ROUTE_METRICS: {
+        obsd_gauges g;
+        size_t len = 0;
+        gauges(h, &g);
+        char *text = obsd_stats_text(&g, &len);
+        return text ? obsd__answer_text(r, 200, "text/plain; version=0.0.4", text, len, NULL) : MHD_NO;
+    }
+    default:
+        return obsd__answer_error(r, 404, "not_found", "no such route", NULL, NULL);
+    }
+}

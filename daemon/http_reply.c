@@ -1,0 +1,141 @@
+/* obscurad's HTTP answers: every request ends here, so that each one is
+ * logged once (the line the tests and operators grep for) and counted
+ * once in the metrics.  Errors are the JSON of protocol/http.h; images
+ * are written by the frame path (frame_path.c). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "http_internal.h"
+#include "log.h"
+
+typedef obsd__req req;
+
+static void log_request(const req *r, const char *note)
+{
+    if (!obsd_log_enabled(OBSD_LOG_INFO))
+        return;
+    obsd_log(OBSD_LOG_INFO,
+             "req=%llu peer=%s %s %s status=%d in=%zu out=%zu queue=%.1f decode=%.1f gl=%.1f "
+             "encode=%.1f total=%.1f ms%s%s",
+             (unsigned long long)r->id, r->peer, r->method, r->path, r->status,
+             r->len + r->discarded, r->bytes_out, r->fp.ms_queue, r->fp.ms_decode, r->fp.ms_gl, r->fp.ms_encode,
+             obsd_now_ms() - r->t0, note && *note ? " " : "", note ? note : "");
+}
+
+enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size_t body_len,
+                              const char *note)
+{
+    if (!resp)
+        return MHD_NO;
+    r->status = status;
+    r->bytes_out = body_len;
+    r->state = REQ_ANSWERED;
+    MHD_add_response_header(resp, "Server", "obscurad/" OBS_VERSION);
+    enum MHD_Result rc = MHD_queue_response(r->conn, (unsigned)status, resp);
+    MHD_destroy_response(resp);
+    obsd_stats_request(r->route, status, r->len + r->discarded, body_len);
+    if (r->route == OBSD_ROUTE_AO || r->op == STREAM_POST)
+        obsd_stats_stage(OBSD_STAGE_TOTAL, obsd_now_ms() - r->t0);
+    log_request(r, rc == MHD_YES ? note : "(could not queue the answer)");
+    return rc;
+}
+
+enum MHD_Result obsd__answer_text(req *r, int status, const char *type, char *text, size_t len,
+                                   const char *note)
+{
+    struct MHD_Response *resp =
+        MHD_create_response_from_buffer(len, text, MHD_RESPMEM_MUST_FREE);
+    if (!resp) {
+        free(text);
+        return MHD_NO;
+    }
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, type);
+    return obsd__answer(r, status, resp, len, note);
+}
+
+enum MHD_Result obsd__answer_error(req *r, int status, const char *code, const char *msg,
+                                    const char *hname, const char *hvalue)
+{
+    char *body = obs_http_error_json(code, msg);
+    if (!body)
+        return MHD_NO;
+    size_t len = strlen(body);
+    struct MHD_Response *resp = MHD_create_response_from_buffer(len, body, MHD_RESPMEM_MUST_FREE);
+    if (!resp) {
+        free(body);
+        return MHD_NO;
+    }
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "application/json");
+    if (hname)
+        MHD_add_response_header(resp, hname, hvalue);
+    char note[OBS_ERR_LEN + 32];
+    snprintf(note, sizeof note, "error=%s: %s", code, msg);
+    return obsd__answer(r, status, resp, len, note);
+}
+
+enum MHD_Result obsd__answer_status(req *r, obs_status s, const char *msg)
+{
+    const char *code;
+    int http = obs_http_status_of(s, &code);
+    return obsd__answer_error(r, http, code, msg && *msg ? msg : obs_status_message(s),
+                        http == 503 ? MHD_HTTP_HEADER_RETRY_AFTER : NULL, "1");
+}
+
+/* A copy of a colour image with its RGB times 2^ev (alpha kept). */
+static int expose(const obs_image *src, double ev, obs_image *out)
+{
+    size_t n = (size_t)src->width * (size_t)src->height;
+    float k = (float)pow(2.0, ev);
+    *out = *src;
+    if (!(out->data = malloc(n * (size_t)src->channels * sizeof(float))))
+        return -1;
+    for (size_t i = 0; i < n * (size_t)src->channels; i++)
+        out->data[i] = (src->channels == 4 && i % 4 == 3) ? src->data[i] : src->data[i] * k;
+    return 0;
+}
+
+/* Answers 200 with an encoded image (taking `out`), the Server-Timing
+ * header with `timing`, and one extra header when extra_name is set. */
+static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, int timing,
+                                    const char *extra_name, const char *extra_value)
+{
+    struct MHD_Response *resp = MHD_create_response_from_buffer(out->size, out->data, MHD_RESPMEM_MUST_FREE);
+    if (!resp) {
+        obs_bytes_free(out);
+        return MHD_NO;
+    }
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, type);
+    if (timing) {
+        char t[192];
+        snprintf(t, sizeof t, "queue;dur=%.2f, decode;dur=%.2f, gl;dur=%.2f, encode;dur=%.2f",
+                 r->fp.ms_queue, r->fp.ms_decode, r->fp.ms_gl, r->fp.ms_encode);
+        MHD_add_response_header(resp, "Server-Timing", t);
+    }
+    if (extra_name)
+        MHD_add_response_header(resp, extra_name, extra_value);
+    return obsd__answer(r, 200, resp, out->size, NULL);
+}
+
+enum MHD_Result obsd__answer_images(req *r, const obsd_fp_images *im, const obs_camera *cam, int timing,
+                                    const char *extra_name, const char *extra_value)
+{
+    char err[OBS_ERR_LEN] = "";
+    obsd_fp_images shown = *im;
+    obs_image exposed = {0};
+    /* exposure is a view of a colour PNG; the AO is never exposed */
+    const obs_image *img = obsd_fp_png_image(im);
+    if (r->hr.format != OBS_HTTP_EXR && img != im->ao && r->exposure != 0.0) {
+        if (expose(img, r->exposure, &exposed) != 0)
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the image");
+        shown.composite = &exposed;
+    }
+    obs_bytes out;
+    obs_status s = obsd_fp_encode(&r->fp, &shown, &r->hr, 0, cam, &out, err);
+    obs_image_free(&exposed);
+    if (s != OBS_OK)
+        return obsd__answer_error(r, 500, "encode_failed", err, NULL, NULL);
+    return answer_bytes(r, &out, r->hr.format == OBS_HTTP_EXR ? "image/x-exr" : "image/png", timing,
+                        extra_name, extra_value);
+}
