@@ -1,5 +1,6 @@
 /* obscurad's option table: parsing, config files, flags and --help. */
 #include "config.h"
+#include "internal.h"
 
 #include <ctype.h>
 #include <stdarg.h>
@@ -56,18 +57,6 @@ const obsd_opt_info *obsd_opt_find(const char *name)
     return name ? find_n(name, strlen(name)) : NULL;
 }
 
-static obs_status fail(char err[OBS_ERR_LEN], const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
-static obs_status fail(char err[OBS_ERR_LEN], const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    if (err)
-        vsnprintf(err, OBS_ERR_LEN, fmt, ap);
-    va_end(ap);
-    return OBS_INVALID_ARGUMENT;
-}
-
 /* Index of `value` in "a|b|c", or -1. */
 static int choice_index(const char *choices, const char *value)
 {
@@ -90,7 +79,7 @@ static obs_status set_opt(obsd_config *c, const obsd_opt_info *o, const char *va
     switch (o->type) {
     case OBSD_OPT_STRING:
         if ((int64_t)strlen(value) > o->max)
-            return fail(err, "option %s: value is longer than %lld characters", o->name,
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: value is longer than %lld characters", o->name,
                         (long long)o->max);
         snprintf(field, OBSD_STR_LEN, "%s", value);
         return OBS_OK;
@@ -100,7 +89,7 @@ static obs_status set_opt(obsd_config *c, const obsd_opt_info *o, const char *va
         errno = 0;
         long long v = strtoll(value, &end, 10);
         if (end == value || errno == ERANGE)
-            return fail(err, "option %s: '%s' is not a number in [%lld, %lld]", o->name, value,
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: '%s' is not a number in [%lld, %lld]", o->name, value,
                         (long long)o->min, (long long)o->max);
         if (o->type == OBSD_OPT_SIZE && *end) {
             int shift = 0;
@@ -111,17 +100,17 @@ static obs_status set_opt(obsd_config *c, const obsd_opt_info *o, const char *va
             default: shift = -1; break;
             }
             if (shift < 0 || end[1] != '\0' || v < 0 || v > (INT64_MAX >> shift))
-                return fail(err, "option %s: '%s' is not a size (a number, optionally with k, m "
+                return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: '%s' is not a size (a number, optionally with k, m "
                             "or g) in [%lld, %lld]", o->name, value, (long long)o->min,
                             (long long)o->max);
             v <<= shift;
             end += 1;
         }
         if (*end)
-            return fail(err, "option %s: '%s' is not a number in [%lld, %lld]", o->name, value,
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: '%s' is not a number in [%lld, %lld]", o->name, value,
                         (long long)o->min, (long long)o->max);
         if (v < o->min || v > o->max)
-            return fail(err, "option %s: %s is out of range [%lld, %lld]", o->name, value,
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: %s is out of range [%lld, %lld]", o->name, value,
                         (long long)o->min, (long long)o->max);
         if (o->type == OBSD_OPT_INT)
             *(int *)(void *)field = (int)v;
@@ -132,12 +121,12 @@ static obs_status set_opt(obsd_config *c, const obsd_opt_info *o, const char *va
     case OBSD_OPT_ENUM: {
         int idx = choice_index(o->choices, value);
         if (idx < 0)
-            return fail(err, "option %s: '%s' is not one of %s", o->name, value, o->choices);
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: '%s' is not one of %s", o->name, value, o->choices);
         *(int *)(void *)field = idx;
         return OBS_OK;
     }
     }
-    return fail(err, "option %s has an unknown type", o->name);
+    return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s has an unknown type", o->name);
 }
 
 void obsd_config_defaults(obsd_config *c)
@@ -152,7 +141,7 @@ obs_status obsd_config_set(obsd_config *c, const char *name, const char *value,
 {
     const obsd_opt_info *o = obsd_opt_find(name);
     if (!o)
-        return fail(err, "unknown option '%s' (obscurad --help lists them)", name ? name : "");
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown option '%s' (obscurad --help lists them)", name ? name : "");
     obs_status s = set_opt(c, o, value ? value : "", err);
     if (s == OBS_OK)
         c->set[o - table] = 1;
@@ -173,7 +162,7 @@ obs_status obsd_config_load(obsd_config *c, const char *path, char err[OBS_ERR_L
         lineno++;
         size_t n = strlen(line);
         if (n == sizeof line - 1 && line[n - 1] != '\n') {
-            s = fail(err, "%s:%d: line longer than %d characters", path, lineno, (int)sizeof line - 2);
+            s = obs__fail(err, OBS_INVALID_ARGUMENT, "%s:%d: line longer than %d characters", path, lineno, (int)sizeof line - 2);
             break;
         }
         char *hash = strchr(line, '#');
@@ -200,7 +189,7 @@ obs_status obsd_config_load(obsd_config *c, const char *path, char err[OBS_ERR_L
         }
         name[name_len] = '\0';
         if (obsd_config_set(c, name, value, msg) != OBS_OK) {
-            s = fail(err, "%s:%d: %s", path, lineno, msg);
+            s = obs__fail(err, OBS_INVALID_ARGUMENT, "%s:%d: %s", path, lineno, msg);
             break;
         }
     }
@@ -218,7 +207,7 @@ obs_status obsd_config_args(obsd_config *c, int argc, char **argv, int *help,
         const char *a = argv[i], *path = NULL;
         if (!strcmp(a, "--config")) {
             if (i + 1 >= argc)
-                return fail(err, "--config needs a file");
+                return obs__fail(err, OBS_INVALID_ARGUMENT, "--config needs a file");
             path = argv[++i];
         } else if (!strncmp(a, "--config=", 9)) {
             path = a + 9;
@@ -242,21 +231,21 @@ obs_status obsd_config_args(obsd_config *c, int argc, char **argv, int *help,
         if (!strncmp(a, "--config=", 9))
             continue;
         if (strncmp(a, "--", 2) != 0 || !a[2])
-            return fail(err, "unexpected argument '%s'", a);
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "unexpected argument '%s'", a);
         const char *eq = strchr(a + 2, '=');
         size_t n = eq ? (size_t)(eq - a - 2) : strlen(a + 2);
         const obsd_opt_info *o = find_n(a + 2, n);
         if (!o)
-            return fail(err, "unknown option '%.*s' (obscurad --help lists them)", (int)n + 2, a);
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown option '%.*s' (obscurad --help lists them)", (int)n + 2, a);
         const char *value;
         if (eq)
             value = eq + 1;
         else if (i + 1 < argc)
             value = argv[++i];
         else
-            return fail(err, "option --%s needs a value", o->name);
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "option --%s needs a value", o->name);
         if (obsd_config_set(c, o->name, value, msg) != OBS_OK)
-            return fail(err, "%s", msg);
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s", msg);
     }
     return OBS_OK;
 }

@@ -1,5 +1,6 @@
 /* The HTTP API's request parsing, status mapping and JSON bodies. */
 #include "http.h"
+#include "internal.h"
 
 #include <cjson/cJSON.h>
 #include <stdarg.h>
@@ -60,16 +61,6 @@ _Static_assert(sizeof(obs_http_format) == sizeof(int) && sizeof(unsigned) == siz
 /* The most names a NAMES row takes, and the longest slot. */
 #define NAMES_MAX 4
 #define SLOT_MAX 64
-
-static obs_status bad(char err[OBS_ERR_LEN], const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    if (err)
-        vsnprintf(err, OBS_ERR_LEN, fmt, ap);
-    va_end(ap);
-    return OBS_INVALID_ARGUMENT;
-}
 
 static int name_is(const char *name, const char *want)
 {
@@ -141,13 +132,13 @@ static obs_status set_choice(obs_http_request *r, const obs_http_option *op, con
             v |= c->value;
             n++;
         } else if (len || !(op->list & from)) {
-            return bad(err, "parameter %s: '%.*s' is not one of %s", op->name, (int)len, s,
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%.*s' is not one of %s", op->name, (int)len, s,
                        choices_text(op, from, all, sizeof all));
         }
         s += len;
     } while (*s++ == ',');
     if (!n)
-        return bad(err, "parameter %s: '%s' names none of %s", op->name, value,
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' names none of %s", op->name, value,
                    choices_text(op, from, all, sizeof all));
     memcpy((char *)r + op->field, &v, sizeof v);
     return OBS_OK;
@@ -162,7 +153,7 @@ static obs_status set_bool(obs_http_request *r, const obs_http_option *op, const
     else if (!strcmp(value, "0") || !strcmp(value, "false"))
         v = 0;
     else
-        return bad(err, "parameter %s: '%s' is not one of %s", op->name, value, "0|1|true|false");
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s", op->name, value, "0|1|true|false");
     memcpy((char *)r + op->field, &v, sizeof v);
     return OBS_OK;
 }
@@ -174,12 +165,12 @@ static obs_status set_names(obs_http_request *r, const obs_http_option *op, cons
     char tmp[NAMES_MAX * SLOT_MAX] = "", all[256];
     int k, known = !op->names;
     if (op->max < 1 || op->max > NAMES_MAX || op->slot > SLOT_MAX)
-        return bad(err, "parameter %s: its row takes more names than %d of %d bytes", op->name,
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: its row takes more names than %d of %d bytes", op->name,
                    NAMES_MAX, SLOT_MAX);
     for (const char *const *n = op->names; n && *n; n++)
         known |= !strcmp(value, *n);
     if (!known)
-        return bad(err, "parameter %s: '%s' is not one of %s", op->name, value,
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s", op->name, value,
                    choices_text(op, Q, all, sizeof all));
     if (op->max == 1) { /* one name, whole: a comma may be part of it */
         k = *value && strlen(value) < op->slot ? 1 : -1;
@@ -189,7 +180,7 @@ static obs_status set_names(obs_http_request *r, const obs_http_option *op, cons
         k = split_names(value, tmp, op->slot, op->max);
     }
     if (k < op->min)
-        return bad(err, "parameter %s: '%.100s' is not %s", op->name, value, op->what);
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%.100s' is not %s", op->name, value, op->what);
     char *slots = (char *)r + op->field;
     const char **map = (const char **)(void *)((char *)r + op->map);
     memcpy(slots, tmp, (size_t)op->max * op->slot);
@@ -216,7 +207,7 @@ obs_status obs_http_option_set(obs_http_request *r, const obs_http_option *op, c
     case OBS_HTTP_OPT_BOOL: return set_bool(r, op, value, err);
     case OBS_HTTP_OPT_NAMES: return set_names(r, op, value, err);
     }
-    return bad(err, "parameter %s has an unknown kind", op->name);
+    return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s has an unknown kind", op->name);
 }
 
 void obs_http_request_init(obs_http_request *r)
@@ -232,18 +223,18 @@ obs_status obs_http_request_set(obs_http_request *r, const char *name, const cha
 {
     const obs_http_option *op;
     if (!name || !*name)
-        return bad(err, "empty parameter name");
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "empty parameter name");
     if ((op = obs_http_option_find(name)))
         return obs_http_option_set(r, op, value, OBS_HTTP_QUERY, err);
     if (obs_param_find(name))
         return obs_param_set(&r->params, name, value ? value : "", err);
-    return bad(err, "unknown parameter '%.100s' (GET /v1/params lists them)", name);
+    return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown parameter '%.100s' (GET /v1/params lists them)", name);
 }
 
 obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LEN])
 {
     if (r->format == OBS_HTTP_PNG && r->outputs == (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE))
-        return bad(err, "format=png holds one image: ask for one output (output=ao or "
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "format=png holds one image: ask for one output (output=ao or "
                         "output=composite), or use format=exr for both");
     return OBS_OK;
 }

@@ -24,6 +24,24 @@ static inline const char *obs_test_shared(void)
     return s && *s ? s : "../shared/data";
 }
 
+/* The whole of a file, one byte more allocated (a NUL may follow);
+ * *len its size.  Caller frees. */
+static inline unsigned char *obs_test_slurp(const char *path, size_t *len)
+{
+    FILE *fp = fopen(path, "rb");
+    assert_non_null(fp);
+    assert_int_equal(fseek(fp, 0, SEEK_END), 0);
+    long n = ftell(fp);
+    assert_true(n >= 0);
+    rewind(fp);
+    unsigned char *buf = malloc((size_t)n + 1);
+    assert_non_null(buf);
+    assert_int_equal(fread(buf, 1, (size_t)n, fp), (size_t)n);
+    fclose(fp);
+    *len = (size_t)n;
+    return buf;
+}
+
 static inline int obs_test_exists(const char *path)
 {
     struct stat st;

@@ -17,21 +17,6 @@ typedef struct tally {
     int forced_rejected, forced_read; /* with the first channel as depth */
 } tally;
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *fp = fopen(path, "rb");
-    assert_non_null(fp);
-    assert_int_equal(fseek(fp, 0, SEEK_END), 0);
-    long n = ftell(fp);
-    assert_true(n >= 0);
-    rewind(fp);
-    unsigned char *buf = malloc((size_t)n + 1);
-    assert_int_equal(fread(buf, 1, (size_t)n, fp), (size_t)n);
-    fclose(fp);
-    *len = (size_t)n;
-    return buf;
-}
-
 /* OK, or a failure with a message. */
 static void check(const char *path, const char *what, obs_status st, const char *err)
 {
@@ -53,7 +38,7 @@ static void run_file(const char *path, tally *t)
     obs_gbuffer_file f, m;
     char err[OBS_ERR_LEN] = "", merr[OBS_ERR_LEN] = "";
     size_t len;
-    unsigned char *buf = slurp(path, &len);
+    unsigned char *buf = obs_test_slurp(path, &len);
 
     obs_status st = obs_gbuffer_read_exr(path, NULL, NULL, &f, err);
     check(path, "obs_gbuffer_read_exr", st, err);

@@ -16,21 +16,6 @@
 
 #define FIXTURE TESTDATA "/deep_small.exr"
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *fp = fopen(path, "rb");
-    assert_non_null(fp);
-    assert_int_equal(fseek(fp, 0, SEEK_END), 0);
-    long n = ftell(fp);
-    assert_true(n >= 0);
-    rewind(fp);
-    unsigned char *buf = malloc((size_t)n + 1);
-    assert_int_equal(fread(buf, 1, (size_t)n, fp), (size_t)n);
-    fclose(fp);
-    *len = (size_t)n;
-    return buf;
-}
-
 static const float *px_samples(const obs_deep_image *d, int x, int y, int *n)
 {
     size_t i = (size_t)y * d->width + x;
@@ -81,7 +66,7 @@ static void test_read_fixture(void **state)
 
     /* the same from memory */
     size_t len;
-    unsigned char *buf = slurp(FIXTURE, &len);
+    unsigned char *buf = obs_test_slurp(FIXTURE, &len);
     obs_deep_image m;
     assert_int_equal(obs_deep_read_exr_mem(buf, len, NULL, &m, err), OBS_OK);
     assert_int_equal(memcmp(m.offset, d.offset, (48 * 32 + 1) * sizeof *d.offset), 0);
@@ -141,7 +126,7 @@ static void test_read_damaged_fixture(void **state)
 {
     (void)state;
     size_t len;
-    unsigned char *buf = slurp(FIXTURE, &len);
+    unsigned char *buf = obs_test_slurp(FIXTURE, &len);
     unsigned char *bad = malloc(len);
     int ok = 0;
     char what[64];
@@ -183,7 +168,7 @@ static void run_dir(const char *dir, int *files)
         check_status(path, st, err);
         obs_deep_free(&d);
         size_t len;
-        unsigned char *buf = slurp(path, &len);
+        unsigned char *buf = obs_test_slurp(path, &len);
         int ok = 0;
         if (len > 0)
             read_any(path, buf, len, &ok);

@@ -334,26 +334,13 @@ static void test_size_limit(void **state)
     obs_gbuffer_free(&f);
 }
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *fp = fopen(path, "rb");
-    assert_non_null(fp);
-    fseek(fp, 0, SEEK_END);
-    *len = (size_t)ftell(fp);
-    rewind(fp);
-    unsigned char *buf = malloc(*len ? *len : 1);
-    assert_int_equal(fread(buf, 1, *len, fp), *len);
-    fclose(fp);
-    return buf;
-}
-
 static void test_memory_equals_file(void **state)
 {
     (void)state;
     obs_gbuffer_file a, b;
     char err[OBS_ERR_LEN] = "";
     size_t len;
-    unsigned char *buf = slurp(TESTDATA "/yard_small.exr", &len);
+    unsigned char *buf = obs_test_slurp(TESTDATA "/yard_small.exr", &len);
     assert_int_equal(obs_gbuffer_read_exr(TESTDATA "/yard_small.exr", NULL, NULL, &a, err), OBS_OK);
     assert_int_equal(obs_gbuffer_read_exr_mem(buf, len, NULL, NULL, &b, err), OBS_OK);
     assert_int_equal(a.gb.width, b.gb.width);
@@ -575,7 +562,7 @@ static void test_compressions(void **state)
 static void patch_compression(const char *path, unsigned char value)
 {
     size_t len;
-    unsigned char *buf = slurp(path, &len);
+    unsigned char *buf = obs_test_slurp(path, &len);
     static const char key[] = "compression\0compression"; /* name, type */
     size_t klen = sizeof key; /* includes the type's NUL */
     size_t at = 0;
@@ -748,7 +735,7 @@ static void test_threads_blender(void **state)
     const char *files[] = {TESTDATA "/room_small.exr", TESTDATA "/yard_small.exr"};
     for (int i = 0; i < 2; i++) {
         size_t len;
-        unsigned char *buf = slurp(files[i], &len);
+        unsigned char *buf = obs_test_slurp(files[i], &len);
         for (int n = 2; n <= 8; n *= 2) {
             same_with_threads(files[i], NULL, 0, NULL, n);
             same_with_threads(files[i], buf, len, NULL, n);

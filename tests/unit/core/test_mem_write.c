@@ -15,25 +15,10 @@ static obs_image make_image(int channels)
     return img;
 }
 
-/* Reads a whole file; caller frees. */
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *buf = malloc((size_t)n + 1);
-    assert_int_equal(fread(buf, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *len = (size_t)n;
-    return buf;
-}
-
 static void assert_same_bytes(const char *path, const obs_bytes *mem)
 {
     size_t n;
-    unsigned char *file = slurp(path, &n);
+    unsigned char *file = obs_test_slurp(path, &n);
     assert_int_equal(mem->size, n);
     assert_memory_equal(mem->data, file, n);
     free(file);

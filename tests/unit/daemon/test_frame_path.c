@@ -8,22 +8,6 @@
 
 #include "frame_path.h"
 
-/* The whole of a small file; caller frees. */
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *p = malloc((size_t)n);
-    assert_non_null(p);
-    assert_int_equal(fread(p, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *len = (size_t)n;
-    return p;
-}
-
 static void test_decode(void **state)
 {
     (void)state;
@@ -32,7 +16,7 @@ static void test_decode(void **state)
     obs_channel_map map = {0};
     obsd_fp fp;
 
-    unsigned char *flat = slurp(TESTDATA "/room_small.exr", &len);
+    unsigned char *flat = obs_test_slurp(TESTDATA "/room_small.exr", &len);
     obsd_fp_init(&fp);
     assert_int_equal(obsd_fp_decode(&fp, flat, len, &map, NULL, "no deep here", err), OBS_OK);
     assert_ptr_equal(fp.gb, &fp.gf.gb);
@@ -41,7 +25,7 @@ static void test_decode(void **state)
     obsd_fp_free(&fp);
     free(flat);
 
-    unsigned char *deep = slurp(TESTDATA "/deep_small.exr", &len);
+    unsigned char *deep = obs_test_slurp(TESTDATA "/deep_small.exr", &len);
     obsd_fp_init(&fp);
     assert_int_equal(obsd_fp_decode(&fp, deep, len, &map, NULL, "no deep here", err), OBS_UNSUPPORTED);
     assert_string_equal(err, "no deep here");
