@@ -187,6 +187,10 @@ static void parse_ao(int argc, char **argv, ao_args *a)
             if (k < 0)
                 die_usage("%s", err);
             a->format_given |= !strcmp(op->name, "format");
+            /* The flags below have no request option, so they stay the
+             * CLI's: the camera JSON is sent as parameters (remote.c), the
+             * size limit and the backend are obscurad's own configuration,
+             * and the rest are this process's. */
         } else if ((v = opt_value(argc, argv, &i, "camera"))) {
             a->camera = v;
         } else if ((v = opt_value(argc, argv, &i, "max-size"))) {
