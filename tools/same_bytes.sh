@@ -45,6 +45,7 @@ for s in room_small yard_small; do
         --float -o "$OUT/$s.all.exr" -q
     for m in hemisphere angle hbao vao; do
         run "$s.$m" "$D/$s.exr" --camera "$D/$s.camera.json" --method $m
+        "$OBSCURA" ao "$D/$s.exr" --camera "$D/$s.camera.json" --method $m --float -o "$OUT/$s.$m.float.exr" -q
     done
     "$OBSCURA" ao "$D/$s.exr" --camera "$D/$s.camera.json" --output both --cpu -o "$OUT/$s.cpu.exr" -q
     for m in hemisphere angle hbao; do
@@ -55,5 +56,6 @@ run deep "$D/deep_small.exr" --output both --deep-layers 3
 run deep.single "$D/deep_small.exr" --deep-mode single --deep-hull thin
 "$OBSCURA" ao "$D/deep_small.exr" --output both --deep-layers 3 --cpu -o "$OUT/deep.cpu.exr" -q
 run deep.hemisphere "$D/deep_small.exr" --method hemisphere --deep-hull thin
+"$OBSCURA" ao "$D/deep_small.exr" --method hemisphere --float -o "$OUT/deep.hemisphere.float.exr" -q
 "$OBSCURA" ao "$D/deep_small.exr" --method hemisphere --deep-hull thin --cpu -o "$OUT/deep.hemisphere.cpu.exr" -q
 echo "same_bytes: $(ls "$OUT" | wc -l) files in $OUT"

@@ -213,7 +213,8 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
     return F > 0.0f ? open / F : 1.0f; /* VAO++ eq 1 */
 }
 
-/* GLSL: hemisphere_ao() in deep.frag.glsl.  Method hemisphere on the
+/* GLSL: hemisphere_estimate() in hemisphere.glsl with deep.frag.glsl's
+ * nodes (HS_NODE).  Method hemisphere on the
  * nodes: the normal-oriented hemisphere kernel of methods/hemisphere.c (radius
  * R, the frame's tile rotation), each point sample s occluded by a node at
  * its pixel as obs__hemisphere_pixel is by the flat depth buffer, with the

@@ -99,8 +99,12 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
                  "#define OBS_RANGE_CHECK %d\n#define OBS_RAYS %d\n",
                  (v & DEEP_HEMISPHERE) != 0, (v & DEEP_THIN) != 0, (v & DEEP_RANGE) != 0,
                  (v & DEEP_RAYS) != 0);
-        const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_deep_frag};
-        if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, 4, &t->prog[v], err)) !=
+        /* method hemisphere's estimator comes after the pass, which
+         * defines how it reads the nodes (HS_NODE in deep.frag.glsl) */
+        const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_deep_frag,
+                             obs__shader_hemisphere};
+        const int parts = (v & DEEP_HEMISPHERE) ? 5 : 4;
+        if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, parts, &t->prog[v], err)) !=
             OBS_OK) {
             t->prog[v] = 0;
             return s;

@@ -26,8 +26,9 @@ void obs__deep_frame_free(obs__deep_frame *df);
 
 /* The AO (1 = open) of node k at pixel (x, y): OITAO Algorithm 1 with
  * VAO++'s pipe through the tangent sphere as GetAO (with f.method
- * hemisphere: the hemisphere kernel's point samples, hemisphere_ao() in
- * deep_cpu.c), eq 1 or eqs 2-4 (GLSL: node_ao() in deep.frag.glsl). */
+ * hemisphere: the hemisphere kernel's point samples, the flat chain's
+ * obs__hemisphere_estimate over the nodes), eq 1 or eqs 2-4 (GLSL:
+ * node_ao() in deep.frag.glsl). */
 float obs__deep_node_ao(const obs__deep_frame *df, int x, int y, int k);
 
 /* The per-node AO of pixel (x, y) blended front to back by alpha onto

@@ -65,9 +65,9 @@ void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3],
 }
 
 /* The one hemisphere estimator of the flat and the deep chain (GLSL:
- * hemisphere_ao() in hemisphere.glsl, node_hemisphere_ao() in
- * deep.frag.glsl).  Sample s of the kernel is occluded by a node at its
- * pixel whose surface lies in front of it (planar depths, -s.z for the
+ * hemisphere_estimate() in hemisphere.glsl, also one function for both
+ * chains: the deep pass defines the nodes it reads, HS_NODE).  Sample s
+ * of the kernel is occluded by a node at its pixel whose surface lies in front of it (planar depths, -s.z for the
  * sample) past the bias; with several nodes (deep input, OITAO Algorithm
  * 1) the largest occlusion counts, each weighted by the node's alpha.
  * Range check: smoothstep(0, 1, R / |z_p - z_q|), a surface much nearer
@@ -107,7 +107,7 @@ float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes 
     return f->hs_count > 0 ? 1.0f - occ / (float)f->hs_count : 1.0f;
 }
 
-/* GLSL: hemisphere_ao() in hemisphere.glsl */
+/* GLSL: method_ao() in hemisphere.glsl (one opaque node per pixel) */
 float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                             const float n[3])
 {

@@ -26,9 +26,11 @@ uniform int u_range_normal;     // 1: eq 4's d along the node's normal (range_di
 // OBS_DEEP_HEMISPHERE, method hemisphere's point samples (else VAO's line
 // samples); OBS_DEEP_THIN, thin hulls (eqs 2-4; else solid volumes, eq 1);
 // OBS_RANGE_CHECK, the depth range check (VAO++ 4.4, eq 4).
-uniform int u_hs_count;         // method hemisphere: samples
-uniform float u_hs_bias;        // occluders must be this far in front (depth units)
-uniform float u_hs_kernel[192]; // unit hemisphere around +z, (x, y, z) per sample
+// Method hemisphere's estimator (hemisphere.glsl, appended after this file
+// in the OBS_DEEP_HEMISPHERE programs) reads the nodes through these.
+#define HS_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
+#define HS_ALPHA(q, k) imageLoad(u_lnrm, ivec3(q, k)).w
+float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
 
 layout(location = 0) out vec4 o_ao; // (front node's AO, blended AO, 0, 1)
 
@@ -88,57 +90,13 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
     return F > 0.0 ? open / F : 1.0;
 }
 
-// Method hemisphere on the nodes: each point sample of the hemisphere
-// kernel is occluded by a node at its pixel when it lies more than the
-// bias behind the node's depth (the node fills what is behind it), with
-// the method's range check as the falloff for a node far in front of the
-// receiver; the largest occlusion over the nodes counts (Algorithm 1, line
-// 9), each node's weighted by its alpha (eq 1's alpha_omega).  interior:
-// a node on the exterior side of the receiver's tangent plane hides
-// nothing (eqs 2-4).
-float hemisphere_ao(ivec2 px, vec3 p, vec3 n, bool interior)
-{
-    float R = u_radius;
-    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
-    int layers = u_multi != 0 ? u_m : 1;
-    vec3 t1, t2;
-    tangent_basis(n, t1, t2);
-    float occ = 0.0;
-    for (int i = 0; i < u_hs_count; i++) {
-        vec3 kv = vec3(u_hs_kernel[3 * i], u_hs_kernel[3 * i + 1], u_hs_kernel[3 * i + 2]);
-        float kx = rot.x * kv.x - rot.y * kv.y, ky = rot.y * kv.x + rot.x * kv.y;
-        vec3 s = vec3(p.x + R * (kx * t1.x + ky * t2.x + kv.z * n.x),
-                      p.y + R * (kx * t1.y + ky * t2.y + kv.z * n.y),
-                      p.z + R * (kx * t1.z + ky * t2.z + kv.z * n.z));
-        ivec2 q;
-        if (!view_to_px(s, u_size, q))
-            continue;               // off the planes: left out
-        float best = 0.0;
-        for (int k = 0; k < layers; k++) {
-            vec4 pk = imageLoad(u_lpos, ivec3(q, k));
-            if (!(pk.w > 0.0))
-                continue;                 // empty node
-            if (!(pk.w <= -s.z - u_hs_bias))
-                continue;                 // s is not behind the node
-            if (interior && dot(pk.xyz - p, n) <= u_hs_bias)
-                continue;                 // on the hull's exterior side
-            float dz = abs(-p.z - pk.w);
-            float r = dz > R ? R / dz : 1.0;
-            float an = imageLoad(u_lnrm, ivec3(q, k)).w;
-            best = max(best, an * r * r * (3.0 - 2.0 * r));
-        }
-        occ += best;
-    }
-    return u_hs_count > 0 ? 1.0 - occ / float(u_hs_count) : 1.0;
-}
-
 // The per-sample estimator of the method: VAO++'s or method hemisphere's;
 // VAO++'s converted to the ray-traced AO under ao_definition rays
 // (OBS_RAYS, defined by the program; C twin: method_ao in deep_cpu.c).
 float method_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
 {
 #if OBS_DEEP_HEMISPHERE
-    return hemisphere_ao(px, p, n, interior);
+    return hemisphere_estimate(px, p, n, u_multi != 0 ? u_m : 1, interior);
 #else
 #if OBS_RAYS
     return rays_from_volume(sphere_ao(px, p, n, interior, self)); // common.glsl

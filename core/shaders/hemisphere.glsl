@@ -1,21 +1,39 @@
 // Method hemisphere: normal-oriented hemisphere SSAO (Crytek's SSAO with
 // the kernel in the hemisphere around the normal, as Unity's
-// post-processing stack ships it).  C twin: obs__hemisphere_pixel
-// (methods/hemisphere.c), which documents the kernel.
+// post-processing stack ships it).  C twin: obs__hemisphere_estimate and
+// obs__hemisphere_pixel (methods/hemisphere.c), which document the kernel.
+//
+// One estimator for the flat and the deep chain: a sample is tested
+// against the nodes at its pixel, read through HS_NODE(q, k) (view xyz,
+// planar depth w; w 0: empty) and HS_ALPHA(q, k).  The deep pass
+// (deep.frag.glsl) defines them for its node arrays; without them this
+// file is the flat method's AO pass, one opaque node per pixel from the
+// depth plane, and defines method_ao().
+
+#ifndef HS_NODE
+#define HS_NODE(q, k) vec4(0.0, 0.0, 0.0, imageLoad(u_dz, q).x) // the depth plane: one RG texel
+#define HS_ALPHA(q, k) 1.0
+#define HS_FLAT 1
+#endif
 
 uniform int u_hs_count;          // samples
 uniform float u_hs_bias;         // occluders must be this far in front (depth units)
 uniform float u_hs_kernel[192];  // unit hemisphere around +z, (x, y, z) per sample
                                  // (obs__hemisphere_kernel)
 
-float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
+// The AO of p with normal n at px against `layers` nodes per pixel: a
+// sample is occluded by a node whose surface lies in front of it past the
+// bias, by the range check's smoothstep(0, 1, R / |z_p - z_q|), times the
+// node's alpha; the largest over the nodes counts (OITAO Algorithm 1).
+// interior: a node on the exterior side of p's tangent plane hides
+// nothing (OITAO eqs 2-4).
+float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior)
 {
     float R = u_radius;
     vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
     vec3 t1, t2;                // the kernel's +z goes to n
     tangent_basis(n, t1, t2);
     float occ = 0.0;
-    count = u_hs_count;
     for (int i = 0; i < u_hs_count; i++) {
         vec3 k = vec3(u_hs_kernel[3 * i], u_hs_kernel[3 * i + 1], u_hs_kernel[3 * i + 2]);
         // the 3x3 tile's rotation about the normal
@@ -25,17 +43,29 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
                       p.z + R * (kx * t1.z + ky * t2.z + k.z * n.z));
         ivec2 q;
         if (!view_to_px(s, u_size, q))
-            continue;
-        float zq = imageLoad(u_dz, q).x;   // the depth plane: one RG texel
-        if (!(zq > 0.0))
-            continue;                     // background never occludes
-        // occluded: a surface in front of the sample, past the bias
-        if (zq <= -s.z - u_hs_bias) {
-            // range check: smoothstep(0, 1, R / |z_p - z_q|)
-            float dz = abs(-p.z - zq);
+            continue;               // off the planes: left out
+        float best = 0.0;
+        for (int j = 0; j < layers; j++) {
+            vec4 pk = HS_NODE(q, j);
+            if (!(pk.w > 0.0))
+                continue;           // empty node: background never occludes
+            if (!(pk.w <= -s.z - u_hs_bias))
+                continue;           // s is not behind the node
+            if (interior && dot(pk.xyz - p, n) <= u_hs_bias)
+                continue;           // on the hull's exterior side
+            float dz = abs(-p.z - pk.w);
             float r = dz > R ? R / dz : 1.0;
-            occ += r * r * (3.0 - 2.0 * r);
+            best = max(best, HS_ALPHA(q, j) * r * r * (3.0 - 2.0 * r));
         }
+        occ += best;
     }
     return u_hs_count > 0 ? 1.0 - occ / float(u_hs_count) : 1.0;
 }
+
+#ifdef HS_FLAT
+float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
+{
+    count = u_hs_count;
+    return hemisphere_estimate(px, p.xyz, n, 1, false);
+}
+#endif

@@ -66,6 +66,7 @@ done
 check "in-process references (640x480 and 1920x1080)" "[ -s '$T/ref_small.exr' ] && [ -s '$T/ref_big.exr' ]"
 
 SOCK="$T/obscurad.sock"
+: > "$T/d.log"
 "$OBSCURAD" --http 127.0.0.1:0 --socket "$SOCK" --tcp 127.0.0.1:0 --queue $QUEUE 2>"$T/d.log" &
 PID=$!
 i=0; HP=""; TP=""
