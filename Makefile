@@ -95,9 +95,9 @@ deps:
 
 
 # ---- build --------------------------------------------------------------
-$(SHADER_HDR): $(SHADERS) tools/embed_shaders.sh
+$(SHADER_HDR): $(SHADERS) core/shaders/shared.h tools/embed_shaders.sh
 	@mkdir -p $(dir $@)
-	tools/embed_shaders.sh $(SHADERS) > $@.tmp && mv $@.tmp $@
+	tools/embed_shaders.sh core/shaders/shared.h $(SHADERS) > $@.tmp && mv $@.tmp $@
 
 $(BUILD)/obj/%.o: %.c | $(SHADER_HDR)
 	@mkdir -p $(dir $@)

@@ -627,7 +627,7 @@ static int cmd_samples(int argc, char **argv)
                " * (make samples) from core/chain/samples_gen.c; do not edit.\n"
                " * tests/unit/core/test_samples.c regenerates them and compares. */\n"
                "#include \"internal.h\"\n\n"
-               "const float obs__sample_table[OBS__SAMPLE_TABLE_LEN][2] = {\n");
+               "const float obs__sample_table[OBS_SAMPLE_TABLE_LEN][2] = {\n");
     for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
         int n = sizes[k];
         float xy[64];

@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "obscura/obscura.h"
+#include "shaders/shared.h"
 
 #if defined(__GNUC__)
 #define OBS__PRINTF(a, b) __attribute__((format(printf, a, b)))
@@ -48,11 +49,9 @@ obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p,
 /* Sample sets on the unit disk (VAO++ section 4.5), n = 2, 4, 8, 16, 32:
  * the checked-in output of the generator in samples_gen.c
  * (core/chain/sample_tables.c).  All five sets lie one after the other in one
- * table of OBS__SAMPLE_TABLE_LEN (x, y) pairs, the set of n starting at
+ * table of OBS_SAMPLE_TABLE_LEN (x, y) pairs, the set of n starting at
  * pair n - 2: the layout of the shader's single uniform array (4.1). */
-#define OBS__MAX_SAMPLES 32
-#define OBS__SAMPLE_TABLE_LEN 62 /* 2 + 4 + 8 + 16 + 32 */
-extern const float obs__sample_table[OBS__SAMPLE_TABLE_LEN][2];
+extern const float obs__sample_table[OBS_SAMPLE_TABLE_LEN][2];
 /* n (x, y) pairs of the table; NULL unless n is 2, 4, 8, 16 or 32. */
 const float *obs__samples(int n);
 

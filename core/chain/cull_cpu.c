@@ -23,18 +23,18 @@
 
 void obs__cull_prepass(const obs__frame *f, const float *pos, const float *nrm, float *est)
 {
-    const float *xy = f->sample_table + 2 * (OBS__CULL_SAMPLES - 2);
+    const float *xy = f->sample_table + 2 * (OBS_CULL_SAMPLES - 2);
     for (int j = 0; j < f->cull_h; j++)
         for (int i = 0; i < f->cull_w; i++) {
-            int x = OBS__CULL_BLOCK * i + OBS__CULL_BLOCK / 2;
-            int y = OBS__CULL_BLOCK * j + OBS__CULL_BLOCK / 2;
+            int x = OBS_CULL_BLOCK * i + OBS_CULL_BLOCK / 2;
+            int y = OBS_CULL_BLOCK * j + OBS_CULL_BLOCK / 2;
             x = x < f->width ? x : f->width - 1;
             y = y < f->height ? y : f->height - 1;
             size_t k = (size_t)y * (size_t)f->width + (size_t)x;
             est[(size_t)j * (size_t)f->cull_w + (size_t)i] =
                 pos[4 * k + 3] > 0.0f
                     ? obs__vao_estimate(f, pos, nrm, x, y, pos + 4 * k, nrm + 3 * k,
-                                        OBS__CULL_SAMPLES, xy)
+                                        OBS_CULL_SAMPLES, xy)
                     : 1.0f;
         }
 }

@@ -78,8 +78,8 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     /* Section 4.2: the pre-pass texture has one texel per 8 x 8 block. */
     f->culling = p->culling == OBS_CULLING_GREEDY ? 1 : p->culling == OBS_CULLING_CAREFUL ? 2 : 0;
     f->cull_threshold = 1.0f - p->culling_epsilon;
-    f->cull_w = (f->width + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK;
-    f->cull_h = (f->height + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK;
+    f->cull_w = (f->width + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK;
+    f->cull_h = (f->height + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK;
     f->blur_radius = p->blur == OBS_ON ? p->blur_radius : 0;
     for (int k = 0; k <= f->blur_radius; k++) /* section 4.6: Gaussian kernel */
         f->blur_w[k] = expf(-(float)(k * k) / (2.0f * p->blur_sigma * p->blur_sigma));

@@ -6,23 +6,12 @@
 #define OBSCURA_FRAME_H
 
 #include "internal.h"
-
-/* Raw depth at or beyond this (Blender writes 1e10 for the sky), non-finite
- * or <= 0 is background: no geometry, AO 1, never an occluder. */
-#define OBS__SKY_DEPTH 1e9f
+#include "shaders/shared.h" /* constants shared with the shaders */
 
 /* Every OBS_OUTPUT_* bit. */
 #define OBS__OUTPUTS_ALL                                                                           \
     (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |        \
      OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE)
-
-/* Culling pre-pass (VAO++ section 4.2): one low-resolution texel per
- * OBS__CULL_BLOCK x OBS__CULL_BLOCK pixels ("1/8 resolution"), always
- * OBS__CULL_SAMPLES samples; a culling candidate of the careful variant
- * takes at most OBS__CULL_CAREFUL samples. */
-#define OBS__CULL_BLOCK 8
-#define OBS__CULL_SAMPLES 8
-#define OBS__CULL_CAREFUL 4
 
 /* Largest blur_radius of the parameter table (one blur program per
  * radius, BLUR_RADIUS in blur.frag.glsl). */
@@ -48,17 +37,6 @@
  * vao (the comparison methods take the radius as D). */
 #define OBS__RADIUS_K_RAYS 2.0f
 #define OBS__RADIUS_K_VOLUME 1.0f
-
-/* A VAO sample on the shaded pixel itself reads p's tangent plane under
- * its pipe (obs__own_plane_depth) unless |n.z| is at most this (the plane
- * nearly edge-on); GLSL: OWN_PLANE_NZ in common.glsl. */
-#define OBS__OWN_PLANE_NZ 0.05f
-
-/* Largest counts of the comparison methods' parameters (uniform array
- * sizes in hemisphere.glsl, angle.glsl, hbao.glsl). */
-#define OBS__MAX_HEMISPHERE 64
-#define OBS__MAX_PAIRS 16
-#define OBS__MAX_DIRECTIONS 32
 
 typedef struct obs__frame {
     int width, height;
@@ -92,15 +70,15 @@ typedef struct obs__frame {
      * around +z, scaled by radius at use */
     int hs_count;
     float hs_bias;          /* in depth units: hemisphere_bias * R */
-    float hs_kernel[OBS__MAX_HEMISPHERE][3];
+    float hs_kernel[OBS_MAX_HEMISPHERE][3];
     /* method angle (methods/angle.c): pair i's offset on the unit disk (its
      * partner is the negation); the arc cosine used (OBS_ACOS_*) */
     int angle_pairs;
-    float angle_xy[OBS__MAX_PAIRS][2];
+    float angle_xy[OBS_MAX_PAIRS][2];
     int angle_acos;
     /* method hbao (methods/hbao.c): directions (unit, view xy), steps, bias */
     int hbao_dirs, hbao_steps;
-    float hbao_dir[OBS__MAX_DIRECTIONS][2];
+    float hbao_dir[OBS_MAX_DIRECTIONS][2];
     float hbao_bias_cs[2];  /* cos, sin of the angle bias */
 } obs__frame;
 
@@ -168,7 +146,7 @@ float obs__range_falloff(const obs__frame *f, float d, float nz);
 /* The planar depth of the tangent plane at p (normal n) under the pipe of
  * the disk's sample (sx, sy), for eq 1's dz: what a sample on the shaded
  * pixel itself reads instead of the depth at the pixel's centre zs, which
- * is p's; zs itself when |n[2]| <= OBS__OWN_PLANE_NZ (GLSL:
+ * is p's; zs itself when |n[2]| <= OBS_OWN_PLANE_NZ (GLSL:
  * own_plane_depth(p, n, disk_point(c, r, rot, sx, sy), zs) in
  * common.glsl). */
 float obs__own_plane_depth(const float p[3], const float n[3], const float c[3], float r,
@@ -233,7 +211,7 @@ float obs__blur_pixel(const obs__frame *f, const float *pos, const float *ao, in
  * view_to_px() in method.glsl). */
 int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy);
 
-/* The unit-hemisphere kernel of n samples (n <= OBS__MAX_HEMISPHERE),
+/* The unit-hemisphere kernel of n samples (n <= OBS_MAX_HEMISPHERE),
  * 3 floats each, around +z (methods/hemisphere.c). */
 void obs__hemisphere_kernel(int n, float *out);
 

@@ -35,7 +35,7 @@ static void view_ray(const float *P, const float ndc[2], float origin[3], float 
  * 0 for background. */
 static float linear_depth(const obs__frame *f, float raw, const float dir[3])
 {
-    if (!(raw > 0.0f) || raw >= OBS__SKY_DEPTH) /* also catches NaN */
+    if (!(raw > 0.0f) || raw >= OBS_BACKGROUND_DEPTH) /* also catches NaN */
         return 0.0f;
     if (f->depth_mode == OBS_DEPTH_RADIAL)
         return raw / sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);

@@ -101,7 +101,7 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
                                                     nrm + 3 * i, n, xy, b);
                 } else if (f.culling == 2) {
                     n = obs__vao_count(&f, pos + 4 * i, nrm + 3 * i);
-                    n = n < OBS__CULL_CAREFUL ? n : OBS__CULL_CAREFUL;
+                    n = n < OBS_CULL_CAREFUL ? n : OBS_CULL_CAREFUL;
                     const float *xy = f.sample_table + 2 * (n - 2);
                     ao[i] = obs__vao_estimate_bleed(&f, pos, nrm, col, x, y, pos + 4 * i,
                                                     nrm + 3 * i, n, xy, b);

@@ -198,8 +198,8 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     t->tex_lumfactor = make_texture(ctx, GL_R32F, w, h);
     /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block; the AO
      * pass filters it itself (cull_candidate in vao.frag.glsl). */
-    t->tex_cull = make_texture(ctx, GL_R32F, (w + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK,
-                               (h + OBS__CULL_BLOCK - 1) / OBS__CULL_BLOCK);
+    t->tex_cull = make_texture(ctx, GL_R32F, (w + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK,
+                               (h + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK);
     GLuint prep[] = {t->tex_viewpos, t->tex_vnormal, t->tex_dz};
     GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask, t->tex_bleed};
     GLuint blur[] = {t->tex_blur, t->tex_lumfactor};
@@ -274,7 +274,7 @@ static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
     bind_prep_planes(prog, t);
     glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
     /* section 4.1: all sets in one uniform array, picked by offset */
-    glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS__SAMPLE_TABLE_LEN, f->sample_table);
+    glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS_SAMPLE_TABLE_LEN, f->sample_table);
     glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
     glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
     glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);

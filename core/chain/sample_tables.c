@@ -3,7 +3,7 @@
  * tests/unit/core/test_samples.c regenerates them and compares. */
 #include "internal.h"
 
-const float obs__sample_table[OBS__SAMPLE_TABLE_LEN][2] = {
+const float obs__sample_table[OBS_SAMPLE_TABLE_LEN][2] = {
     /* 2 samples, from pair 0 */
     {-3.621596694e-01f, -6.510452032e-01f},
     {2.385391146e-01f, 4.203230441e-01f},

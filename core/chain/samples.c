@@ -11,7 +11,7 @@
 
 const float *obs__samples(int n)
 {
-    if (n < 2 || n > OBS__MAX_SAMPLES || (n & (n - 1)) != 0)
+    if (n < 2 || n > OBS_MAX_SAMPLES || (n & (n - 1)) != 0)
         return NULL;
     return obs__sample_table[n - 2]; /* sets of 2, 4, 8, ... follow each other */
 }

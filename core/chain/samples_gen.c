@@ -226,12 +226,12 @@ static void z_order(pt *p, int n)
 
 /* ---- the sets ---------------------------------------------------------- */
 
-static int valid_size(int n) { return n >= 2 && n <= OBS__MAX_SAMPLES && (n & (n - 1)) == 0; }
+static int valid_size(int n) { return n >= 2 && n <= OBS_MAX_SAMPLES && (n & (n - 1)) == 0; }
 
 obs_status obs__samples_generate_ex(int n, int mode, float *xy)
 {
     int rotation_aware = mode != OBS__SAMPLES_PLAIN;
-    pt p[OBS__MAX_SAMPLES], trial[OBS__MAX_SAMPLES];
+    pt p[OBS_MAX_SAMPLES], trial[OBS_MAX_SAMPLES];
     if (!valid_size(n) || !xy)
         return OBS_INVALID_ARGUMENT;
     pthread_once(&rot_once, init_rotations);

@@ -78,7 +78,7 @@ float obs__range_falloff(const obs__frame *f, float d, float nz)
 float obs__own_plane_depth(const float p[3], const float n[3], const float c[3], float r,
                            const float rot[2], float sx, float sy, float zs)
 {
-    if (!(fabsf(n[2]) > OBS__OWN_PLANE_NZ))
+    if (!(fabsf(n[2]) > OBS_OWN_PLANE_NZ))
         return zs;
     float spx = c[0] + r * (rot[0] * sx - rot[1] * sy);
     float spy = c[1] + r * (rot[1] * sx + rot[0] * sy);

@@ -33,7 +33,7 @@ static double radical_inverse2(unsigned i)
  * the jitter. */
 void obs__angle_pattern(int pairs, float *out)
 {
-    for (int i = 0; i < pairs && i < OBS__MAX_PAIRS; i++) {
+    for (int i = 0; i < pairs && i < OBS_MAX_PAIRS; i++) {
         double a = M_PI * i / pairs;
         double r = sqrt(fmin(1.0, radical_inverse2((unsigned)i) + 0.5 / pairs));
         out[2 * i] = (float)(r * cos(a));

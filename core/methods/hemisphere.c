@@ -27,7 +27,7 @@ static double radical_inverse(unsigned i, unsigned b)
  * between [0, radius]": more samples near the point). */
 void obs__hemisphere_kernel(int n, float *out)
 {
-    for (int i = 0; i < n && i < OBS__MAX_HEMISPHERE; i++) {
+    for (int i = 0; i < n && i < OBS_MAX_HEMISPHERE; i++) {
         double c = fmin(1.0, radical_inverse((unsigned)i, 2) + 0.5 / n);
         double s = sqrt(fmax(0.0, 1.0 - c * c));
         double phi = 2.0 * M_PI * radical_inverse((unsigned)i, 3);

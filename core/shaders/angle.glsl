@@ -3,7 +3,7 @@
 // (methods/angle.c), which documents the method.
 
 uniform int u_angle_pairs;       // sample pairs
-uniform vec2 u_angle_xy[16];     // pair offsets on the unit disk (obs__angle_pattern)
+uniform vec2 u_angle_xy[OBS_MAX_PAIRS];     // pair offsets on the unit disk (obs__angle_pattern)
 uniform int u_angle_acos;        // 1 quadratic, 2 linear, 3 exact (obs_acos)
 
 const float PI = 3.14159265358979;

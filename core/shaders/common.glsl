@@ -19,7 +19,7 @@
 uniform mat4 u_proj;        // view -> clip
 uniform vec4 u_viewport;    // display x, y, width, height of the planes
 
-const float SKY_DEPTH = 1e9;
+const float SKY_DEPTH = OBS_BACKGROUND_DEPTH; // shared.h
 const float FAR_AWAY = 1e30;
 
 #define PM(r, c) u_proj[c][r]
@@ -109,7 +109,7 @@ bool disk_px(vec3 U, vec3 V, vec3 W, float sx, float sy, ivec2 size, out ivec2 q
 // surface as an occluder).  zs where |n.z| <= OWN_PLANE_NZ (the plane
 // nearly edge-on).  Shared by the VAO estimator and the deep pass.  C
 // twin: obs__own_plane_depth.
-const float OWN_PLANE_NZ = 0.05;
+const float OWN_PLANE_NZ = OBS_OWN_PLANE_NZ; // shared.h
 float own_plane_depth(vec3 p, vec3 n, vec2 s, float zs)
 {
     if (!(abs(n.z) > OWN_PLANE_NZ))

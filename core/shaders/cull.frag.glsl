@@ -11,8 +11,8 @@ out float o_est;
 
 void main()
 {
-    ivec2 px = min(ivec2(gl_FragCoord.xy) * 8 + 4, u_size - 1);
+    ivec2 px = min(ivec2(gl_FragCoord.xy) * OBS_CULL_BLOCK + OBS_CULL_BLOCK / 2, u_size - 1);
     vec4 p = imageLoad(u_pos, px);
     vec3 unused;                // no colour bleeding in the pre-pass
-    o_est = p.w > 0.0 ? vao_estimate(px, p, imageLoad(u_vnormal, px).xyz, 8, 0, unused) : 1.0;
+    o_est = p.w > 0.0 ? vao_estimate(px, p, imageLoad(u_vnormal, px).xyz, OBS_CULL_SAMPLES, 0, unused) : 1.0;
 }

@@ -17,7 +17,7 @@ uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node
 uniform ivec2 u_size;
 uniform float u_radius;         // R, in depth units
 uniform int u_ns;               // line samples
-uniform vec2 u_samples[32];     // the set of section 4.5
+uniform vec2 u_samples[OBS_MAX_SAMPLES];     // the set of section 4.5
 uniform vec2 u_rot[9];          // (cos, sin) of the 3x3 tile's rotations
 uniform float u_range_u;        // u of eq 4
 uniform int u_range_normal;     // 1: eq 4's d along the node's normal (range_distance)

@@ -6,7 +6,7 @@
 
 uniform int u_hbao_dirs;         // Nd
 uniform int u_hbao_steps;        // Ns
-uniform vec2 u_hbao_dir[32];     // unit directions over 2 pi (view xy)
+uniform vec2 u_hbao_dir[OBS_MAX_DIRECTIONS];     // unit directions over 2 pi (view xy)
 uniform vec2 u_hbao_bias_cs;     // cos, sin of the angle bias
 
 // R projected at p in pixels; 0 behind the camera.

@@ -18,7 +18,7 @@
 
 uniform int u_hs_count;          // samples
 uniform float u_hs_bias;         // occluders must be this far in front (depth units)
-uniform float u_hs_kernel[192];  // unit hemisphere around +z, (x, y, z) per sample
+uniform float u_hs_kernel[3 * OBS_MAX_HEMISPHERE]; // unit hemisphere around +z, (x, y, z) per sample
                                  // (obs__hemisphere_kernel)
 
 // The AO of p with normal n at px against `layers` nodes per pixel: a

@@ -69,11 +69,11 @@ float cull_texel(ivec2 t)
 
 bool cull_candidate(ivec2 px)
 {
-    ivec2 t0 = ivec2(floor(vec2(px) * 0.125 - 0.5));
+    ivec2 t0 = ivec2(floor(vec2(px) * (1.0 / float(OBS_CULL_BLOCK)) - 0.5));
     float t00 = cull_texel(t0), t10 = cull_texel(t0 + ivec2(1, 0));
     float t01 = cull_texel(t0 + ivec2(0, 1)), t11 = cull_texel(t0 + ivec2(1, 1));
     for (int k = 0; k < 4; k++) {
-        vec2 w = vec2(px + ivec2(k & 1, k >> 1)) * 0.125 - 0.5 - vec2(t0); // in [0, 1]
+        vec2 w = vec2(px + ivec2(k & 1, k >> 1)) * (1.0 / float(OBS_CULL_BLOCK)) - 0.5 - vec2(t0); // in [0, 1]
         float top = w.x < 1.0 ? fma(w.x, t10 - t00, t00) : t10;
         float bottom = w.x < 1.0 ? fma(w.x, t11 - t01, t01) : t11;
         float est = w.y < 1.0 ? fma(w.y, bottom - top, top) : bottom;
@@ -107,7 +107,7 @@ void main()
     // where no AO is estimated"; never more than the pixel would take).
     if (cull_candidate(px)) {
         o_cull = 1.0;
-        ns = u_culling == 1 ? 0 : min(ns, 4);
+        ns = u_culling == 1 ? 0 : min(ns, OBS_CULL_CAREFUL);
     }
 #endif
     o_count = float(ns);

@@ -10,7 +10,7 @@ layout(rgba32f) readonly uniform image2D u_vnormal; // prep: view normal
 layout(rg32f) readonly uniform image2D u_dz; // prep: planar depth and view normal z, one load per sample
 uniform ivec2 u_size;
 uniform float u_radius;          // R, in depth units
-uniform vec2 u_samples[62];      // all sets of section 4.5 (core/chain/sample_tables.c), the
+uniform vec2 u_samples[OBS_SAMPLE_TABLE_LEN];      // all sets of section 4.5 (core/chain/sample_tables.c), the
                                  // set of n from n - 2: the single array of section 4.1
 uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
 uniform float u_range_u;         // u of eq 4

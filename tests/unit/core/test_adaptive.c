@@ -159,7 +159,7 @@ static double check_scene(const char *exr, const char *camera, int samples, floa
             size_t i = (size_t)y * gf.gb.width + x;
             float d = *obs__plane_px(&gf.gb.depth, gf.gb.width, x, y);
             int n = (int)adapt.sample_count.data[i];
-            if (!(d > 0.0f) || d >= OBS__SKY_DEPTH) {
+            if (!(d > 0.0f) || d >= OBS_BACKGROUND_DEPTH) {
                 assert_int_equal(n, 0);
                 continue;
             }

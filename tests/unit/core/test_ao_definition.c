@@ -22,7 +22,7 @@ static void measure(const obs_image *truth, const obs_image *depth, const obs_im
     memset(s, 0, sizeof *s);
     for (size_t i = 0; i < (size_t)truth->width * truth->height; i++) {
         float d = depth->data[i];
-        if (!(d > 0.0f && d < OBS__SKY_DEPTH))
+        if (!(d > 0.0f && d < OBS_BACKGROUND_DEPTH))
             continue;
         double t = fmin(fmax(truth->data[i], 0.0), 1.0), e = ao->data[i] - t;
         s->mse += e * e;

@@ -151,7 +151,7 @@ static void test_room_small(void **state)
             assert_float_equal(on.composite.data[4 * i + k], off.composite.data[4 * i + k] * b[k],
                                1e-5f);
         changed += dev > 1e-3f;
-        if (raw.ao.data[i] >= 1.0f && gf.gb.depth.data[i] < OBS__SKY_DEPTH) {
+        if (raw.ao.data[i] >= 1.0f && gf.gb.depth.data[i] < OBS_BACKGROUND_DEPTH) {
             open++;
             open_dev += dev;
             open_max = fmax(open_max, dev);

@@ -92,14 +92,14 @@ static double tile_noise(const obs_image *ao, const obs_image *depth, float R)
     for (int y = 1; y < h - 1; y++)
         for (int x = 1; x < w - 1; x++) {
             float zc = depth->data[y * w + x];
-            if (!(zc > 0.0f && zc < OBS__SKY_DEPTH))
+            if (!(zc > 0.0f && zc < OBS_BACKGROUND_DEPTH))
                 continue;
             double m = 0;
             int ok = 1;
             for (int dy = -1; dy <= 1 && ok; dy++)
                 for (int dx = -1; dx <= 1; dx++) {
                     float zq = depth->data[(y + dy) * w + x + dx];
-                    if (!(zq < OBS__SKY_DEPTH) || fabsf(zq - zc) > R) {
+                    if (!(zq < OBS_BACKGROUND_DEPTH) || fabsf(zq - zc) > R) {
                         ok = 0;
                         break;
                     }
@@ -119,7 +119,7 @@ static double mse_vs(const obs_image *truth, const obs_image *depth, const obs_i
     long n = 0;
     for (int i = 0; i < truth->width * truth->height; i++) {
         float z = depth->data[i];
-        if (!(z > 0.0f && z < OBS__SKY_DEPTH))
+        if (!(z > 0.0f && z < OBS_BACKGROUND_DEPTH))
             continue;
         double d = ao->data[i] - fmin(fmax(truth->data[i], 0.0), 1.0);
         sum += d * d;

@@ -24,7 +24,7 @@ typedef struct scene {
     obs_image truth; /* Cycles AO pass */
 } scene;
 
-static int is_geometry(float d) { return d > 0.0f && d < OBS__SKY_DEPTH; }
+static int is_geometry(float d) { return d > 0.0f && d < OBS_BACKGROUND_DEPTH; }
 
 static void load(const char *exr, const char *camera, scene *s)
 {

@@ -27,7 +27,7 @@ typedef struct err_stats {
  * halo band. */
 #define CONTACT_AO 0.9
 
-static int is_geometry(float d) { return d > 0.0f && d < OBS__SKY_DEPTH; }
+static int is_geometry(float d) { return d > 0.0f && d < OBS_BACKGROUND_DEPTH; }
 
 static unsigned char *halo_band(const obs_image *depth, float R)
 {

@@ -20,7 +20,7 @@ static void test_tables_match_generator(void **state)
 {
     (void)state;
     for (int k = 0; k < NSIZES; k++) {
-        float xy[2 * OBS__MAX_SAMPLES];
+        float xy[2 * OBS_MAX_SAMPLES];
         int n = sizes[k];
         assert_int_equal(obs_samples_generate(n, xy), OBS_OK);
         const float *t = obs__samples(n);
@@ -34,7 +34,7 @@ static void test_tables_match_generator(void **state)
         for (int i = 0; i < n; i++)
             assert_true(xy[2 * i] * xy[2 * i] + xy[2 * i + 1] * xy[2 * i + 1] < 1.0f);
     }
-    float xy[2 * OBS__MAX_SAMPLES];
+    float xy[2 * OBS_MAX_SAMPLES];
     assert_null(obs__samples(3));
     assert_null(obs__samples(64));
     assert_int_equal(obs_samples_generate(12, xy), OBS_INVALID_ARGUMENT);
@@ -51,7 +51,7 @@ static void test_rotation_aware_spacing(void **state)
     (void)state;
     for (int k = 0; k < NSIZES; k++) {
         int n = sizes[k];
-        float aware[2 * OBS__MAX_SAMPLES], plain[2 * OBS__MAX_SAMPLES];
+        float aware[2 * OBS_MAX_SAMPLES], plain[2 * OBS_MAX_SAMPLES];
         assert_int_equal(obs__samples_generate_ex(n, OBS__SAMPLES_VAOPP, aware), OBS_OK);
         assert_int_equal(obs__samples_generate_ex(n, OBS__SAMPLES_PLAIN, plain), OBS_OK);
         double da = obs__samples_min_distance(aware, n, 1);
@@ -72,7 +72,7 @@ static void test_rotation_aware_spacing(void **state)
 
 static double set_sum(const float *xy, int n, const int *rot)
 {
-    double px[OBS__MAX_SAMPLES], py[OBS__MAX_SAMPLES], s = 0;
+    double px[OBS_MAX_SAMPLES], py[OBS_MAX_SAMPLES], s = 0;
     for (int i = 0; i < n; i++) {
         double a = 2.0 * M_PI * rot[i] / 9.0;
         px[i] = cos(a) * xy[2 * i] - sin(a) * xy[2 * i + 1];
@@ -111,8 +111,8 @@ static void test_best_permutation_and_z_order(void **state)
 {
     (void)state;
     for (int k = 0; k < NSIZES; k++) {
-        int n = sizes[k], rot[OBS__MAX_SAMPLES] = {0};
-        float poisson[2 * OBS__MAX_SAMPLES];
+        int n = sizes[k], rot[OBS_MAX_SAMPLES] = {0};
+        float poisson[2 * OBS_MAX_SAMPLES];
         assert_int_equal(obs__samples_generate_ex(n, OBS__SAMPLES_POISSON, poisson), OBS_OK);
         double stored = set_sum(obs__samples(n), n, rot), unpermuted = set_sum(poisson, n, rot);
         if (n <= 8) {
@@ -208,7 +208,7 @@ static double mse(const float *a, const float *b, const obs_image *depth)
     long cnt = 0;
     for (size_t i = 0; i < (size_t)depth->width * depth->height; i++) {
         float d = depth->data[i];
-        if (!(d > 0.0f && d < OBS__SKY_DEPTH))
+        if (!(d > 0.0f && d < OBS_BACKGROUND_DEPTH))
             continue;
         double e = a[i] - fmin(fmax(b[i], 0.0), 1.0);
         sum += e * e;
@@ -251,7 +251,7 @@ static void test_real_input(void **state)
                       mse(ref, truth.data, &depth));
         for (int k = 0; k < NSIZES; k++) {
             int n = sizes[k];
-            float plain[2 * OBS__MAX_SAMPLES];
+            float plain[2 * OBS_MAX_SAMPLES];
             assert_int_equal(obs__samples_generate_ex(n, OBS__SAMPLES_PLAIN, plain), OBS_OK);
             float *a = frame_ao(&gf.gb, n, obs__samples(n)), *b = frame_ao(&gf.gb, n, plain);
             double ea = mse(a, ref, &depth), eb = mse(b, ref, &depth);

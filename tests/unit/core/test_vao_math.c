@@ -287,7 +287,7 @@ static void test_small_radius_room(void **state)
     long n = 0;
     for (int i = 0; i < gf.gb.width * gf.gb.height; i++) {
         float d = gf.gb.depth.data[i];
-        if (d > 0.0f && d < OBS__SKY_DEPTH) {
+        if (d > 0.0f && d < OBS_BACKGROUND_DEPTH) {
             sum += r.ao.data[i];
             n++;
         }
