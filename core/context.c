@@ -52,6 +52,8 @@ void obs_ctx_destroy(obs_ctx *ctx)
     if (obs__ctx_bind(ctx, NULL) == OBS_OK) {
         obs__chain_release(&ctx->prog, &ctx->tg);
         obs__deep_release(&ctx->deep);
+        if (ctx->frame_ubo)
+            glDeleteBuffers(1, &ctx->frame_ubo);
         if (ctx->queries[0])
             glDeleteQueries(OBS_PASS_COUNT, ctx->queries);
     }

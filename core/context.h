@@ -13,6 +13,7 @@ struct obs_ctx {
     obs__programs prog;        /* the chain's (chain/run_gl.c) */
     obs__targets tg;
     obs__deep_targets deep;    /* deep input's (deep/deep_gl.c) */
+    GLuint frame_ubo;                 /* the frame's uniform block (chain/frame_gl.c) */
     unsigned long gl_objects_created; /* textures + framebuffers, for tests */
     int timing;                       /* obs_ctx_set_timing */
     GLuint queries[OBS_PASS_COUNT];   /* GL_TIME_ELAPSED, one per pass */

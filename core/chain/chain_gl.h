@@ -17,7 +17,7 @@ typedef struct obs__programs {
     GLuint finish[4]; /* 2 * (ao_definition rays) + luminance: OBS_RAYS, OBS_LUMINANCE */
     /* by (the vertical pass with ao_definition rays' conversion: OBS_RAYS)
      * and blur_radius (BLUR_RADIUS); built on first use */
-    GLuint blur[2][OBS__MAX_BLUR + 1];
+    GLuint blur[2][OBS_MAX_BLUR + 1];
     GLuint method[OBS_METHOD_COUNT]; /* a comparison method's AO pass, by obs_method (first use) */
 } obs__programs;
 

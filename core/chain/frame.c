@@ -169,3 +169,39 @@ obs_status obs__gbuffer_validate(const obs_gbuffer *gb, char err[OBS_ERR_LEN])
     }
     return OBS_OK;
 }
+
+void obs__frame_block_fill(const obs__frame *f, obs__frame_block *b)
+{
+    memset(b, 0, sizeof *b);
+    memcpy(b->proj, f->proj, sizeof b->proj);
+    memcpy(b->viewport, f->viewport, sizeof b->viewport);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            b->normal_matrix[r][c] = f->normal_matrix[3 * r + c];
+    b->size[0] = f->width;
+    b->size[1] = f->height;
+    b->cull_size[0] = f->cull_w;
+    b->cull_size[1] = f->cull_h;
+    b->radius = f->radius;
+    b->range_u = f->range_u;
+    b->range_normal = f->range_normal;
+    b->count = f->samples;
+    b->adaptive_k = f->adaptive_k;
+    b->culling = f->culling;
+    b->cull_threshold = f->cull_threshold;
+    b->bleed_step = f->bleed_step;
+    b->luminance = f->luminance;
+    b->lum_threshold = f->lum_threshold;
+    b->lum_width = f->lum_width;
+    b->lum_sigma = f->lum_sigma;
+    for (int k = 0; k < 9; k++) {
+        b->rot[k][0] = f->rot[k][0];
+        b->rot[k][1] = f->rot[k][1];
+    }
+    for (int k = 0; k < OBS_SAMPLE_TABLE_LEN; k++) {
+        b->samples[k][0] = f->sample_table[2 * k];
+        b->samples[k][1] = f->sample_table[2 * k + 1];
+    }
+    for (int k = 0; k <= f->blur_radius && k <= OBS_MAX_BLUR; k++)
+        b->blur_w[k][0] = f->blur_w[k];
+}

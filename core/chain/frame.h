@@ -13,10 +13,6 @@
     (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |        \
      OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE)
 
-/* Largest blur_radius of the parameter table (one blur program per
- * radius, BLUR_RADIUS in blur.frag.glsl). */
-#define OBS__MAX_BLUR 16
-
 /* k of R = k * D: the paper's kernel width R (hemisphere radius; the
  * tangent sphere has radius R/2) for the ray-traced AO distance D that the
  * radius parameter gives, by ao_definition (bench/QUALITY.md, "How
@@ -61,7 +57,7 @@ typedef struct obs__frame {
     float cull_threshold;   /* an estimate below this shows occlusion: 1 - culling_epsilon */
     int cull_w, cull_h;     /* the low-resolution texture: ceil(width / 8) x ceil(height / 8) */
     int blur_radius;        /* low-pass filter half-width (section 4.6); 0: off */
-    float blur_w[OBS__MAX_BLUR + 1]; /* Gaussian weight of offset 0..blur_radius */
+    float blur_w[OBS_MAX_BLUR + 1]; /* Gaussian weight of offset 0..blur_radius */
     int luminance;          /* section 4.3, eq 3: 0 off, 1 Rec. 709 luminance, 2 HSV V */
     float lum_threshold, lum_width, lum_sigma; /* threshold, width, sigma of eq 3 */
     int bleed_step;         /* section 4.7, eq 5: 0 off, else every bleed_step-th sample */
@@ -81,6 +77,37 @@ typedef struct obs__frame {
     float hbao_dir[OBS_MAX_DIRECTIONS][2];
     float hbao_bias_cs[2];  /* cos, sin of the angle bias */
 } obs__frame;
+
+/* The frame's values as the shaders read them: the uniform block Frame
+ * of common.glsl, layout std140, mirrored member for member (a vec2 or a
+ * float of an array takes 16 bytes, a row_major mat3 three vec4 rows).
+ * Filled once per frame (obs__frame_block_fill) and uploaded to one
+ * buffer that every pass of the chain and the deep pass bind; the test
+ * in tests/unit/core/test_frame_block.c checks these offsets against
+ * the ones GL reports. */
+typedef struct obs__frame_block {
+    float proj[16];            /* layout(row_major) mat4 u_proj */
+    float viewport[4];         /* vec4 u_viewport */
+    float normal_matrix[3][4]; /* layout(row_major) mat3 u_normal_matrix */
+    int32_t size[2];           /* ivec2 u_size */
+    int32_t cull_size[2];      /* ivec2 u_cull_size */
+    float radius;              /* u_radius */
+    float range_u;             /* u_range_u */
+    int32_t range_normal;      /* u_range_normal */
+    int32_t count;             /* u_count: the samples parameter */
+    float adaptive_k;          /* u_adaptive_k */
+    int32_t culling;           /* u_culling */
+    float cull_threshold;      /* u_cull_threshold */
+    int32_t bleed_step;        /* u_bleed_step */
+    int32_t luminance;         /* u_luminance */
+    float lum_threshold, lum_width, lum_sigma; /* u_lum_threshold, _width, _sigma */
+    float rot[9][4];           /* vec2 u_rot[9] */
+    float samples[OBS_SAMPLE_TABLE_LEN][4]; /* vec2 u_samples[OBS_SAMPLE_TABLE_LEN] */
+    float blur_w[OBS_MAX_BLUR + 1][4];     /* float u_blur_w[OBS_MAX_BLUR + 1] */
+} obs__frame_block;
+
+/* The block of frame f. */
+void obs__frame_block_fill(const obs__frame *f, obs__frame_block *b);
 
 /* Resolves camera, parameters and normal handling for one frame. */
 obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *resolved,

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "chain/frame_gl.h"
 #include "context.h"
 #include "methods/methods.h"
 #include "obs_shaders.h"
@@ -260,26 +261,6 @@ static void bind_prep_planes(GLuint prog, const obs__targets *t)
     bind_img(prog, "u_dz", 2, t->tex_dz, GL_RG32F);
 }
 
-/* Uniforms of common.glsl. */
-static void set_common(GLuint prog, const obs__frame *f)
-{
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_TRUE, f->proj);
-    glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
-    glUniform2i(glGetUniformLocation(prog, "u_size"), f->width, f->height);
-}
-
-/* Uniforms of vao.glsl, the estimator of the AO pass and the pre-pass. */
-static void set_vao(GLuint prog, const obs__frame *f, const obs__targets *t)
-{
-    bind_prep_planes(prog, t);
-    glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
-    /* section 4.1: all sets in one uniform array, picked by offset */
-    glUniform2fv(glGetUniformLocation(prog, "u_samples"), OBS_SAMPLE_TABLE_LEN, f->sample_table);
-    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
-    glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
-    glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
-}
-
 /* Selects the AO program of a comparison method (built by
  * build_method_program) and sets its uniforms: method.glsl's and the
  * method's own (its row of the method table). */
@@ -288,10 +269,7 @@ static GLuint use_method_program(obs_ctx *ctx, const obs__method *m, const obs__
 {
     GLuint prog = ctx->prog.method[m->id];
     glUseProgram(prog);
-    set_common(prog, f);
     bind_prep_planes(prog, t);
-    glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
-    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
     obs__gl_set_uniforms(prog, f, m->uniforms);
     return prog;
 }
@@ -393,6 +371,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     if (s != OBS_OK)
         return s;
     s = ensure_targets(ctx, f.width, f.height, err);
+    if (s == OBS_OK) /* the frame's values, read by every pass (common.glsl) */
+        s = obs__frame_block_bind(ctx, &f, err);
     if (s != OBS_OK)
         return s;
     s = obs__alloc_result(out, f.width, f.height, outputs, err);
@@ -416,10 +396,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     pass_begin(ctx, OBS_PASS_PREP, &ran);
     GLuint prog = ctx->prog.prep[prep_index(&f)];
     glUseProgram(prog);
-    set_common(prog, &f);
     bind_img(prog, "u_depth", 0, t->tex_depth, GL_R32F);
     bind_img(prog, "u_normal", 1, t->tex_normal, GL_RGBA32F);
-    glUniformMatrix3fv(glGetUniformLocation(prog, "u_normal_matrix"), 1, GL_TRUE, f.normal_matrix);
     draw(ctx, t->fbo_prep, w, h);
     pass_end(ctx);
 
@@ -428,8 +406,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         pass_begin(ctx, OBS_PASS_CULL, &ran);
         prog = ctx->prog.cull[f.range_check != 0];
         glUseProgram(prog);
-        set_common(prog, &f);
-        set_vao(prog, &f, t);
+        bind_prep_planes(prog, t);
         draw(ctx, t->fbo_cull, f.cull_w, f.cull_h);
         pass_end(ctx);
     }
@@ -441,17 +418,10 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     } else {
         prog = ctx->prog.vao[ao_variant(&f)];
         glUseProgram(prog);
-        set_common(prog, &f);
-        set_vao(prog, &f, t);
-        glUniform1i(glGetUniformLocation(prog, "u_count"), f.samples);
-        glUniform1f(glGetUniformLocation(prog, "u_adaptive_k"), f.adaptive_k);
+        bind_prep_planes(prog, t);
         /* section 4.2: the pre-pass result, read at the pixel corners */
-        glUniform1i(glGetUniformLocation(prog, "u_culling"), f.culling);
         bind_img(prog, "u_cull", 4, t->tex_cull, GL_R32F);
-        glUniform2i(glGetUniformLocation(prog, "u_cull_size"), f.cull_w, f.cull_h);
-        glUniform1f(glGetUniformLocation(prog, "u_cull_threshold"), f.cull_threshold);
         /* section 4.7: colour bleeding reads the colour at the samples */
-        glUniform1i(glGetUniformLocation(prog, "u_bleed_step"), f.bleed_step);
         bind_img(prog, "u_color", 3, t->tex_color, GL_RGBA32F);
     }
     /* the debug outputs go to their textures only when asked for */
@@ -471,9 +441,6 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         for (int pass = 0; pass < 2; pass++) { /* along x, then along y */
             prog = ctx->prog.blur[pass ? rays_in_blur : 0][f.blur_radius];
             glUseProgram(prog);
-            set_common(prog, &f);
-            glUniform1fv(glGetUniformLocation(prog, "u_blur_w"), f.blur_radius + 1, f.blur_w);
-            glUniform1f(glGetUniformLocation(prog, "u_radius"), f.radius);
             bind_img(prog, "u_ao", 0, pass ? t->tex_blur : t->tex_ao, GL_RG32F);
             glUniform2i(glGetUniformLocation(prog, "u_dir"), !pass, pass);
             if (!pass) {
@@ -497,10 +464,6 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         glUseProgram(prog);
         bind_tex(prog, "u_ao", 0, t->tex_ao);
         bind_tex(prog, "u_color", 1, t->tex_color);
-        glUniform1i(glGetUniformLocation(prog, "u_luminance"), f.luminance);
-        glUniform1f(glGetUniformLocation(prog, "u_lum_threshold"), f.lum_threshold);
-        glUniform1f(glGetUniformLocation(prog, "u_lum_width"), f.lum_width);
-        glUniform1f(glGetUniformLocation(prog, "u_lum_sigma"), f.lum_sigma);
         const GLenum lum_bufs[] = {
             GL_COLOR_ATTACHMENT0,
             (outputs & OBS_OUTPUT_LUMINANCE) ? GL_COLOR_ATTACHMENT1 : GL_NONE};

@@ -22,6 +22,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "chain/frame_gl.h"
 #include "context.h"
 #include "deep/deep_internal.h"
 #include "methods/methods.h"
@@ -193,6 +194,9 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     const unsigned variant = deep_variant(&df);
     if ((s = ensure_deep(ctx, variant, w, h, df.m, err)) != OBS_OK)
         goto fail;
+    /* the frame's values, read by the pass (common.glsl's Frame block) */
+    if ((s = obs__frame_block_bind(ctx, f, err)) != OBS_OK)
+        goto fail;
     const obs__deep_targets *t = &ctx->deep;
     const GLuint prog = t->prog[variant];
     for (int p = 0; p < OBS_PASS_COUNT; p++)
@@ -206,15 +210,6 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     stage_begin(ctx, &t0);
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
     glUseProgram(prog);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_TRUE, f->proj);
-    glUniform4fv(glGetUniformLocation(prog, "u_viewport"), 1, f->viewport);
-    glUniform2i(glGetUniformLocation(prog, "u_size"), w, h);
-    glUniform1f(glGetUniformLocation(prog, "u_radius"), f->radius);
-    glUniform1i(glGetUniformLocation(prog, "u_ns"), f->samples);
-    glUniform2fv(glGetUniformLocation(prog, "u_samples"), f->samples, f->sample_xy);
-    glUniform2fv(glGetUniformLocation(prog, "u_rot"), 9, &f->rot[0][0]);
-    glUniform1f(glGetUniformLocation(prog, "u_range_u"), f->range_u);
-    glUniform1i(glGetUniformLocation(prog, "u_range_normal"), f->range_normal);
     glUniform1i(glGetUniformLocation(prog, "u_m"), df.m);
     glUniform1i(glGetUniformLocation(prog, "u_multi"), df.multi);
     /* the method's own (method hemisphere's kernel; none for vaopp, vao) */

@@ -85,7 +85,10 @@
     X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                                 \
     X(PFNGLGETBUFFERSUBDATAPROC, GetBufferSubData)                             \
     X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                   \
-    X(PFNGLBINDIMAGETEXTUREPROC, BindImageTexture)
+    X(PFNGLBINDIMAGETEXTUREPROC, BindImageTexture)                             \
+    /* the frame's uniform block, its layout as the tests read it */           \
+    X(PFNGLGETPROGRAMRESOURCEINDEXPROC, GetProgramResourceIndex)               \
+    X(PFNGLGETPROGRAMRESOURCEIVPROC, GetProgramResourceiv)
 
 /* Optional entry points (may be NULL). */
 #define OBS__GL_FUNCS_OPT(X) X(PFNGLDEBUGMESSAGECALLBACKPROC, DebugMessageCallback)
@@ -169,6 +172,8 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glGetBufferSubData obs__glp->GetBufferSubData
 #define glMemoryBarrier obs__glp->MemoryBarrier
 #define glBindImageTexture obs__glp->BindImageTexture
+#define glGetProgramResourceIndex obs__glp->GetProgramResourceIndex
+#define glGetProgramResourceiv obs__glp->GetProgramResourceiv
 
 /* Loads every entry point; fails naming the first one missing. */
 obs_status obs__gl_load(obs__gl *gl, obs__getproc_fn getproc, char err[OBS_ERR_LEN]);

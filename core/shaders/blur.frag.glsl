@@ -14,10 +14,9 @@
 // of its own (the finishing pass does it when the blur is off).
 
 layout(rg32f) readonly uniform image2D u_ao; // AO to filter (r), planar depth (g; 0: background)
-uniform ivec2 u_size;
 uniform ivec2 u_dir;             // (1, 0) horizontal pass, (0, 1) vertical
-uniform float u_blur_w[BLUR_RADIUS + 1]; // Gaussian weight of offset 0..radius
-uniform float u_radius;          // depth threshold: the AO radius R
+// u_size, u_blur_w (the Gaussian weights), u_radius (the depth threshold,
+// the AO radius R): the Frame block (common.glsl)
 
 out vec2 o_ao;                   // blurred AO, the centre's depth
 

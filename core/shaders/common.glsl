@@ -16,8 +16,31 @@
 // orders before later commands' loads (no barrier: barriers are for a
 // shader's own image stores).
 
-uniform mat4 u_proj;        // view -> clip
-uniform vec4 u_viewport;    // display x, y, width, height of the planes
+// The frame's values, one uniform block for every pass of the chain and
+// the deep pass, filled once per frame from the C struct that mirrors it
+// (obs__frame_block in core/chain/frame.h; std140, so the C side can
+// place each member).
+layout(std140, binding = 0) uniform Frame {
+    layout(row_major) mat4 u_proj;          // view -> clip
+    vec4 u_viewport;                        // display x, y, width, height of the planes
+    layout(row_major) mat3 u_normal_matrix; // input normal -> view normal (prep)
+    ivec2 u_size;                           // the planes' size
+    ivec2 u_cull_size;                      // the pre-pass texture: ceil(size / OBS_CULL_BLOCK)
+    float u_radius;                         // R, in depth units (the methods: D)
+    float u_range_u;                        // u of eq 4
+    int u_range_normal;                     // 1: eq 4's d along the occluder's normal
+    int u_count;                            // samples (with adaptive sampling: the most)
+    float u_adaptive_k;                     // vw / (vh * D0^2), see adaptive_count
+    int u_culling;                          // section 4.2: 1 greedy, 2 careful (0 off)
+    float u_cull_threshold;                 // a pre-pass estimate below this shows occlusion
+    int u_bleed_step;                       // section 4.7: 0 off, else every u_bleed_step-th sample
+    int u_luminance;                        // section 4.3: 1 Rec. 709 luminance, 2 HSV V
+    float u_lum_threshold, u_lum_width, u_lum_sigma; // eq 3
+    vec2 u_rot[9];                          // (cos, sin) of the 3x3 tile's rotations
+    vec2 u_samples[OBS_SAMPLE_TABLE_LEN];   // all sets of section 4.5, the set of n from n - 2:
+                                            // the single array of section 4.1
+    float u_blur_w[OBS_MAX_BLUR + 1];       // Gaussian weight of offset 0..blur_radius (4.6)
+};
 
 const float SKY_DEPTH = OBS_BACKGROUND_DEPTH; // shared.h
 const float FAR_AWAY = 1e30;

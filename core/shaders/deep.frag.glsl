@@ -14,13 +14,9 @@ layout(rgba32f) readonly uniform image2DArray u_lpos; // node view position xyz,
 layout(rgba32f) readonly uniform image2DArray u_lnrm; // node view normal xyz, alpha w
 uniform int u_m;                // nodes per pixel
 uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node 0 only
-uniform ivec2 u_size;
-uniform float u_radius;         // R, in depth units
-uniform int u_ns;               // line samples
-uniform vec2 u_samples[OBS_MAX_SAMPLES];     // the set of section 4.5
-uniform vec2 u_rot[9];          // (cos, sin) of the 3x3 tile's rotations
-uniform float u_range_u;        // u of eq 4
-uniform int u_range_normal;     // 1: eq 4's d along the node's normal (range_distance)
+// u_size, u_radius (R), u_count (the line samples, the set of section 4.5
+// at u_samples[u_count - 2]), u_rot, u_range_u, u_range_normal: the Frame
+// block (common.glsl)
 // Defined by the program (deep_gl.c), 0 or 1, so that a SIMD rasteriser
 // does not run the unused side of a uniform branch for every node:
 // OBS_DEEP_HEMISPHERE, method hemisphere's point samples (else VAO's line
@@ -69,8 +65,9 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
     disk_map(c, r, rot, U, V, W);   // the samples' pixels (common.glsl)
     int layers = u_multi != 0 ? u_m : 1;
     float open = 0.0, F = 0.0;
-    for (int i = 0; i < u_ns; i++) {
-        float sx = u_samples[i].x, sy = u_samples[i].y;
+    for (int i = 0; i < u_count; i++) {
+        vec2 xy = u_samples[u_count - 2 + i];
+        float sx = xy.x, sy = xy.y;
         float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
         float h = r * l;
         ivec2 q;

@@ -12,8 +12,8 @@
 
 uniform sampler2D u_ao;          // AO after the blur
 uniform sampler2D u_color;       // G-buffer colour
-uniform int u_luminance;         // 1 Rec. 709 luminance, 2 HSV V
-uniform float u_lum_threshold, u_lum_width, u_lum_sigma;
+// u_luminance (1 Rec. 709 luminance, 2 HSV V), u_lum_threshold,
+// u_lum_width, u_lum_sigma: the Frame block (common.glsl)
 
 layout(location = 0) out float o_ao;
 layout(location = 1) out float o_factor; // debug output: the factor of eq 3

@@ -5,6 +5,5 @@
 layout(rgba32f) readonly uniform image2D u_pos;     // prep: view position, planar depth in w
 layout(rgba32f) readonly uniform image2D u_vnormal; // prep: view normal
 layout(rg32f) readonly uniform image2D u_dz;        // prep: planar depth (x), view normal z (y)
-uniform ivec2 u_size;
-uniform float u_radius;          // R, the AO distance, in depth units
-uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
+// u_size, u_radius (the AO distance D, in depth units), u_rot: the Frame
+// block (common.glsl)

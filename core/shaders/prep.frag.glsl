@@ -6,8 +6,8 @@ layout(rgba32f) readonly uniform image2D u_normal;  // input normals (when given
 // OBS_RECONSTRUCT (0 or 1, defined by the program): 1 derives the normals
 // from depth, 0 reads them from u_normal.  A define, not a uniform: a
 // SIMD rasteriser runs both sides of a uniform branch.
-uniform mat3 u_normal_matrix;    // input normal -> view normal
-uniform ivec2 u_size;
+// u_normal_matrix (input normal -> view normal), u_size: the Frame block
+// (common.glsl)
 
 layout(location = 0) out vec4 o_pos;
 layout(location = 1) out vec4 o_normal;

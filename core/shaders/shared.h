@@ -38,4 +38,8 @@
 #define OBS_MAX_PAIRS 16
 #define OBS_MAX_DIRECTIONS 32
 
+/* Largest blur_radius of the parameter table (one blur program per
+ * radius, BLUR_RADIUS in blur.frag.glsl; the weights' array size). */
+#define OBS_MAX_BLUR 16
+
 #endif

@@ -5,13 +5,9 @@
 
 // OBS_ADAPTIVE and OBS_CULLING (0 or 1) are defined by the program (see
 // run_gl.c): with 0 the stage is compiled out.
-uniform int u_count;             // samples (with adaptive sampling: the most)
-uniform float u_adaptive_k;      // vw / (vh * D0^2), see adaptive_count
-uniform int u_culling;           // section 4.2: 1 greedy, 2 careful (0 off: OBS_CULLING 0)
+// u_count, u_adaptive_k, u_culling, u_cull_size, u_cull_threshold,
+// u_bleed_step: the Frame block (common.glsl)
 layout(r32f) readonly uniform image2D u_cull; // the pre-pass's 1/8-resolution AO
-uniform ivec2 u_cull_size;       // its size: ceil(width / 8) x ceil(height / 8)
-uniform float u_cull_threshold;  // an estimate below this shows occlusion
-uniform int u_bleed_step;        // section 4.7: 0 off, else every u_bleed_step-th sample
 
 layout(location = 0) out vec2 o_ao;    // AO, planar depth (for the blur)
 layout(location = 1) out float o_count; // samples taken (debug output)

@@ -8,13 +8,8 @@
 layout(rgba32f) readonly uniform image2D u_pos;     // prep: view position, planar depth in w
 layout(rgba32f) readonly uniform image2D u_vnormal; // prep: view normal
 layout(rg32f) readonly uniform image2D u_dz; // prep: planar depth and view normal z, one load per sample
-uniform ivec2 u_size;
-uniform float u_radius;          // R, in depth units
-uniform vec2 u_samples[OBS_SAMPLE_TABLE_LEN];      // all sets of section 4.5 (core/chain/sample_tables.c), the
-                                 // set of n from n - 2: the single array of section 4.1
-uniform vec2 u_rot[9];           // (cos, sin) of the 3x3 tile's rotations
-uniform float u_range_u;         // u of eq 4
-uniform int u_range_normal;      // 1: eq 4's d along the occluder's normal (range_distance)
+// u_size, u_radius, u_samples, u_rot, u_range_u, u_range_normal: the
+// Frame block (common.glsl)
 layout(rgba32f) readonly uniform image2D u_color;   // G-buffer colour (section 4.7)
 // Defined by the program (run_gl.c), 0 or 1: OBS_BLEED, colour bleeding
 // compiled in; OBS_RANGE_CHECK, the depth range check (section 4.4).
