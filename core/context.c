@@ -51,7 +51,7 @@ void obs_ctx_destroy(obs_ctx *ctx)
         return;
     if (obs__ctx_bind(ctx, NULL) == OBS_OK) {
         obs__chain_release(&ctx->prog, &ctx->tg);
-        obs__deep_release(&ctx->deep);
+        obs__deep_release(&ctx->deep, 1);
         if (ctx->frame_ubo)
             glDeleteBuffers(1, &ctx->frame_ubo);
         if (ctx->queries[0])
@@ -90,4 +90,27 @@ int obs_ctx_last_times(const obs_ctx *ctx, obs_pass_times *out)
         return 0;
     *out = ctx->times;
     return 1;
+}
+
+/* ---- what the context keeps between frames ------------------------------ */
+
+unsigned long long obs_ctx_kept_bytes(const obs_ctx *ctx)
+{
+    return ctx ? ctx->tg.bytes + ctx->deep.bytes : 0;
+}
+
+obs_status obs_ctx_trim(obs_ctx *ctx, unsigned long long budget, char err[OBS_ERR_LEN])
+{
+    if (!ctx)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
+    if (obs_ctx_kept_bytes(ctx) <= budget)
+        return OBS_OK;
+    obs_status s = obs__ctx_bind(ctx, err);
+    if (s != OBS_OK)
+        return s;
+    unsigned long long before = obs_ctx_kept_bytes(ctx);
+    obs__chain_release(NULL, &ctx->tg); /* the programs stay: they cost no frame size */
+    obs__deep_release(&ctx->deep, 0);
+    obs__log(ctx, OBS_LOG_DEBUG, "released %llu bytes of frame targets (budget %llu)", before, budget);
+    return obs__gl_check("releasing frame targets", err);
 }

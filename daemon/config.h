@@ -49,6 +49,15 @@
     X(stream_memory, SIZE, 1048576, 17179869184, "256m",                       \
       "memory a stream's frames may hold (input EXR, AO, composite, colour); " \
       "the oldest are dropped beyond it, the newest is always kept")          \
+    X(max_cost, SIZE, 0, 1099511627776, "768m",                                \
+      "largest work one frame may ask for, in samples: width x height x "      \
+      "the method's samples per pixel (x nodes^2 for deep input); 422 "        \
+      "too_costly above, before it runs (0: no limit; the default takes the "  \
+      "default chain at the largest accepted frame, max_pixels x 16)")         \
+    X(keep_memory, SIZE, 0, 1099511627776, "512m",                             \
+      "texture memory the GL worker keeps for the next frame of the same "     \
+      "size; above it, and whenever the queue runs empty, it is released, "   \
+      "and freed heap memory is returned to the system (malloc_trim)")         \
     X(backend, ENUM, 0, 0, "auto",                                             \
       "GL backend: auto|egl-device|egl-surfaceless|osmesa (default: "          \
       "OBSCURA_BACKEND, else auto)")                                           \

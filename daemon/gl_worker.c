@@ -1,5 +1,6 @@
 /* The GL worker thread: creates the context, runs jobs, recreates the
  * context after a GL failure, destroys it. */
+#include <malloc.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -52,6 +53,43 @@ static obs_ctx *recreate(obsd_gl_worker *w, obs_ctx *ctx, obs_status why, const 
     }
 }
 
+/* 1 (and the job answered OBS_TOO_COSTLY) when the frame asks for more
+ * work than --max-cost. */
+static int too_costly(const obsd_gl_worker *w, obsd_job *job)
+{
+    if (!w->max_cost)
+        return 0;
+    obs_params p;
+    obs_params_resolve(job->params, &p);
+    int width = job->deep ? job->deep->width : job->gb->width;
+    int height = job->deep ? job->deep->height : job->gb->height;
+    unsigned long long cost = obs_frame_cost(&p, width, height, job->deep ? p.deep_layers : 0);
+    if (cost <= w->max_cost)
+        return 0;
+    job->status = OBS_TOO_COSTLY;
+    snprintf(job->err, OBS_ERR_LEN,
+             "the frame asks for %llu samples (%dx%d, %llu per pixel), over --max-cost %llu: "
+             "lower the samples or the size",
+             cost, width, height, cost / ((unsigned long long)width * (unsigned long long)height),
+             w->max_cost);
+    return 1;
+}
+
+/* When the queue has run empty: the kept targets over --keep-memory are
+ * released, and freed heap returned to the system. */
+static void idle(obsd_gl_worker *w, obs_ctx *ctx)
+{
+    int waiting, running, full;
+    obsd_queue_stats(w->queue, &waiting, &running, &full);
+    if (waiting > 0)
+        return;
+    char err[OBS_ERR_LEN] = "";
+    if (ctx && obs_ctx_trim(ctx, w->keep_memory, err) != OBS_OK)
+        obsd_log(OBSD_LOG_WARN, "releasing frame targets: %s", err);
+    malloc_trim(0);
+    atomic_store(&w->kept_bytes, ctx ? obs_ctx_kept_bytes(ctx) : 0);
+}
+
 static void *worker_main(void *arg)
 {
     obsd_gl_worker *w = arg;
@@ -93,6 +131,8 @@ static void *worker_main(void *arg)
         } else if (w->fail_after > 0 && frame == w->fail_after) {
             job->status = OBS_GL_ERROR;
             snprintf(job->err, OBS_ERR_LEN, "injected GL failure on frame %ld (--fail-gl-after)", frame);
+        } else if (too_costly(w, job)) {
+            /* answered without running */
         } else if (job->deep) {
             job->status = obs_deep_run(ctx, job->deep, job->params, &job->deep_result, job->err);
         } else {
@@ -102,10 +142,13 @@ static void *worker_main(void *arg)
         obs_status st = job->status;
         char msg[OBS_ERR_LEN];
         snprintf(msg, sizeof msg, "%s", job->err);
+        if (ctx)
+            atomic_store(&w->kept_bytes, obs_ctx_kept_bytes(ctx));
         obsd_queue_done(w->queue);
         job->done(job, job->user); /* the job is not ours after this */
         if (ctx && (st == OBS_GL_ERROR || st == OBS_GL_UNAVAILABLE))
             ctx = recreate(w, ctx, st, msg);
+        idle(w, ctx);
     }
     atomic_store(&w->alive, 0);
     if (ctx)
@@ -114,12 +157,14 @@ static void *worker_main(void *arg)
 }
 
 obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *desc,
-                         int fail_after, char err[OBS_ERR_LEN])
+                         const obsd_config *cfg, char err[OBS_ERR_LEN])
 {
     memset(w, 0, sizeof *w);
     w->queue = q;
     w->desc = *desc;
-    w->fail_after = fail_after;
+    w->fail_after = cfg->fail_gl_after;
+    w->max_cost = (unsigned long long)cfg->max_cost;
+    w->keep_memory = (unsigned long long)cfg->keep_memory;
     atomic_init(&w->alive, 0);
     atomic_init(&w->recreations, 0);
     atomic_init(&w->stopping, 0);

@@ -11,6 +11,7 @@
 
 #include <stdatomic.h>
 
+#include "config.h"
 #include "job.h"
 
 typedef struct obsd_gl_worker {
@@ -18,6 +19,9 @@ typedef struct obsd_gl_worker {
     obsd_queue *queue;
     obs_ctx_desc desc;
     int fail_after; /* testing: frame number treated as a GL failure (0: none) */
+    unsigned long long max_cost;    /* --max-cost (0: none) */
+    unsigned long long keep_memory; /* --keep-memory */
+    atomic_ullong kept_bytes;       /* obs_ctx_kept_bytes after the last frame */
     /* set once the first context exists (read-only afterwards; a
      * recreated context uses the same options) */
     char backend[32], gl_version[128], gl_vendor[128], gl_renderer[256];
@@ -35,11 +39,13 @@ typedef struct obsd_gl_worker {
 } obsd_gl_worker;
 
 /* Starts the thread and waits until it has created the context; on
- * failure the thread has ended and err says why.  fail_after: testing
- * (--fail-gl-after), frame N is failed with OBS_GL_ERROR without running
- * it, as if the context were lost; 0: never. */
+ * failure the thread has ended and err says why.  From cfg: max_cost
+ * (a frame asking more is answered OBS_TOO_COSTLY without running),
+ * keep_memory (what the context may keep when the queue runs empty) and
+ * fail_gl_after (testing: frame N is failed with OBS_GL_ERROR without
+ * running it, as if the context were lost; 0: never). */
 obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *desc,
-                         int fail_after, char err[OBS_ERR_LEN]);
+                         const obsd_config *cfg, char err[OBS_ERR_LEN]);
 
 /* Closes the queue, lets the worker finish every queued job, joins it
  * (the context is destroyed on the worker thread). */

@@ -20,6 +20,7 @@ static void gauges(obsd_http *h, obsd_gauges *g)
     g->in_flight = atomic_load(&h->in_flight);
     g->gl_alive = atomic_load(&h->gl->alive);
     g->gl_recreations = (unsigned long long)atomic_load(&h->gl->recreations);
+    g->gl_kept_bytes = (unsigned long long)atomic_load(&h->gl->kept_bytes);
     obsd_streams_gauges(h->streams, &g->streams, &g->stream_frames, &g->stream_bytes, &g->sse_subscribers);
 }
 

@@ -135,7 +135,7 @@ int main(int argc, char **argv)
     }
     obsd_stats_init();
     mask_signals(SIG_BLOCK);
-    s = obsd_gl_start(&gl, &queue, &desc, cfg.fail_gl_after, err);
+    s = obsd_gl_start(&gl, &queue, &desc, &cfg, err);
     if (s != OBS_OK) {
         obsd_log(OBSD_LOG_ERROR, "OpenGL: %s (%s)", err, obs_status_name(s));
         obsd_queue_destroy(&queue);

@@ -177,9 +177,13 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
             "obscurad_gl_up %d\n"
             "# HELP obscurad_gl_context_recreations_total GL contexts recreated after a GL failure.\n"
             "# TYPE obscurad_gl_context_recreations_total counter\n"
-            "obscurad_gl_context_recreations_total %llu\n",
+            "obscurad_gl_context_recreations_total %llu\n"
+            "# HELP obscurad_gl_kept_bytes Texture memory the GL worker keeps for the next frame "
+            "(--keep-memory).\n"
+            "# TYPE obscurad_gl_kept_bytes gauge\n"
+            "obscurad_gl_kept_bytes %llu\n",
         g->queue_depth, g->queue_capacity, g->gl_running, g->in_flight, g->gl_alive,
-        g->gl_recreations);
+        g->gl_recreations, g->gl_kept_bytes);
     put(&b, "# HELP obscurad_streams Streams of frames kept for the preview page.\n"
             "# TYPE obscurad_streams gauge\n"
             "obscurad_streams %d\n"

@@ -23,6 +23,7 @@ typedef struct obs__programs {
 
 typedef struct obs__targets {
     int width, height;          /* 0: none allocated yet */
+    unsigned long long bytes;   /* the textures' storage (obs_ctx_kept_bytes) */
     GLuint tex_depth, tex_normal, tex_color;  /* inputs */
     GLuint tex_viewpos, tex_vnormal;          /* prep outputs */
     GLuint tex_dz;                            /* prep: planar depth, view normal z (RG) */
@@ -40,7 +41,7 @@ typedef struct obs__targets {
 } obs__targets;
 
 /* Deletes the chain's textures, framebuffers and programs (run_gl.c);
- * the context is current. */
+ * the context is current.  With prog NULL the programs stay. */
 void obs__chain_release(obs__programs *prog, obs__targets *tg);
 
 #endif

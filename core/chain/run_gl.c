@@ -135,6 +135,8 @@ static GLuint make_texture(obs_ctx *ctx, GLenum format, int w, int h)
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     ctx->gl_objects_created++;
+    const unsigned texel = format == GL_RGBA32F ? 16 : format == GL_RG32F ? 8 : 4;
+    ctx->tg.bytes += (unsigned long long)w * (unsigned long long)h * texel;
     return t;
 }
 
@@ -164,6 +166,8 @@ void obs__chain_release(obs__programs *g, obs__targets *t)
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
     memset(t, 0, sizeof *t);
+    if (!g)
+        return;
     OBS__GL_DELETE_PROGRAMS(g->prep);
     OBS__GL_DELETE_PROGRAMS(g->vao);
     OBS__GL_DELETE_PROGRAMS(g->cull);
@@ -181,8 +185,7 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
         return OBS_OK;
     if (t->width) {
         /* a new resolution: drop the old set, keep the programs */
-        obs__programs none = {0};
-        obs__chain_release(&none, t);
+        obs__chain_release(NULL, t);
     }
     t->tex_depth = make_texture(ctx, GL_R32F, w, h);
     t->tex_normal = make_texture(ctx, GL_RGBA32F, w, h); /* read as an image: no RGB32F */
@@ -218,8 +221,7 @@ static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LE
     if (s == OBS_OK)
         s = obs__gl_check("allocating frame targets", err);
     if (s != OBS_OK) {
-        obs__programs none = {0};
-        obs__chain_release(&none, t);
+        obs__chain_release(NULL, t);
         return s;
     }
     t->width = w;

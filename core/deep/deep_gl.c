@@ -66,7 +66,7 @@ static void release(obs__deep_targets *t, int all)
         memcpy(t->prog, prog, sizeof prog);
 }
 
-void obs__deep_release(obs__deep_targets *t) { release(t, 1); }
+void obs__deep_release(obs__deep_targets *t, int programs) { release(t, programs); }
 
 /* Switches of the deep pass compiled in or out by defines (a SIMD
  * rasteriser runs both sides of a uniform branch): bits of the index of
@@ -116,6 +116,8 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     release(&ctx->deep, 0);
     t->tex_pos = array_texture(ctx, w, h, m);
     t->tex_nrm = array_texture(ctx, w, h, m);
+    /* two RGBA32F arrays of m layers and the RGBA32F output */
+    t->bytes = (unsigned long long)w * (unsigned long long)h * 16ull * (2ull * (unsigned)m + 1ull);
     glGenTextures(1, &t->tex_out);
     ctx->gl_objects_created++;
     glBindTexture(GL_TEXTURE_2D, t->tex_out);

@@ -12,11 +12,13 @@
 typedef struct obs__deep_targets {
     GLuint prog[OBS__DEEP_VARIANTS]; /* by variant (deep_gl.c: DEEP_*), built on first use, kept */
     int width, height, m;        /* 0: none allocated yet */
+    unsigned long long bytes;    /* the textures' storage (obs_ctx_kept_bytes) */
     GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
     GLuint tex_out, fbo;         /* AO of the front node and the blend */
 } obs__deep_targets;
 
-/* Deletes the programs, textures and framebuffer; the context is current. */
-void obs__deep_release(obs__deep_targets *t);
+/* Deletes the programs, textures and framebuffer; the context is current.
+ * With programs 0 the programs stay. */
+void obs__deep_release(obs__deep_targets *t, int programs);
 
 #endif

@@ -56,25 +56,32 @@ static float hbao_ao(const obs__frame *f, const float *pos, int x, int y, const 
     return obs__hbao_pixel(f, pos, x, y, p, n, count);
 }
 
+/* Samples per pixel, for obs_frame_cost. */
+static int vao_samples(const obs_params *p) { return p->samples; }
+static int hemisphere_samples(const obs_params *p) { return p->hemisphere_samples; }
+static int angle_samples(const obs_params *p) { return 2 * p->angle_pairs; }
+static int hbao_samples(const obs_params *p) { return p->hbao_directions * p->hbao_steps; }
+
 #define F(field) offsetof(obs__frame, field)
 
 /* In the order of OBS_METHOD_LIST (params.h). */
 static const obs__method methods[] = {
-    {OBS_METHOD_VAOPP, "vaopp", NULL, NULL, NULL, {{NULL}}, 1},
-    {OBS_METHOD_VAO, "vao", NULL, NULL, NULL, {{NULL}}, 1},
+    {OBS_METHOD_VAOPP, "vaopp", NULL, NULL, NULL, vao_samples, {{NULL}}, 1},
+    {OBS_METHOD_VAO, "vao", NULL, NULL, NULL, vao_samples, {{NULL}}, 1},
     {OBS_METHOD_HEMISPHERE, "hemisphere", obs__shader_hemisphere, hemisphere_setup, hemisphere_ao,
+     hemisphere_samples,
      {{"u_hs_count", OBS__U_INT, F(hs_count), 0, 0},
       {"u_hs_bias", OBS__U_FLOAT, F(hs_bias), 0, 0},
       {"u_hs_kernel", OBS__U_FLOAT, F(hs_kernel), F(hs_count), 3},
       {NULL}},
      1},
-    {OBS_METHOD_ANGLE, "angle", obs__shader_angle, angle_setup, angle_ao,
+    {OBS_METHOD_ANGLE, "angle", obs__shader_angle, angle_setup, angle_ao, angle_samples,
      {{"u_angle_pairs", OBS__U_INT, F(angle_pairs), 0, 0},
       {"u_angle_xy", OBS__U_VEC2, F(angle_xy), F(angle_pairs), 1},
       {"u_angle_acos", OBS__U_INT, F(angle_acos), 0, 0},
       {NULL}},
      0},
-    {OBS_METHOD_HBAO, "hbao", obs__shader_hbao, hbao_setup, hbao_ao,
+    {OBS_METHOD_HBAO, "hbao", obs__shader_hbao, hbao_setup, hbao_ao, hbao_samples,
      {{"u_hbao_dirs", OBS__U_INT, F(hbao_dirs), 0, 0},
       {"u_hbao_steps", OBS__U_INT, F(hbao_steps), 0, 0},
       {"u_hbao_dir", OBS__U_VEC2, F(hbao_dir), F(hbao_dirs), 1},
@@ -111,4 +118,18 @@ float obs__method_pixel(const obs__frame *f, const float *pos, const float *nrm,
     if (!(p[3] > 0.0f) || !m || !m->pixel)
         return 1.0f;
     return m->pixel(f, pos, x, y, p, n, count);
+}
+
+unsigned long long obs_frame_cost(const obs_params *params, int width, int height, int deep_layers)
+{
+    obs_params p;
+    obs_params_resolve(params, &p);
+    const obs__method *m = obs__method_get(p.method);
+    if (!m || width <= 0 || height <= 0)
+        return 0;
+    unsigned long long n = (unsigned long long)width * (unsigned long long)height *
+                           (unsigned long long)m->samples_per_pixel(&p);
+    if (deep_layers > 1)
+        n *= (unsigned long long)deep_layers * (unsigned long long)deep_layers;
+    return n;
 }

@@ -27,6 +27,9 @@ typedef struct obs__method {
      * pixel (x, y), *count the samples taken (NULL for vaopp and vao). */
     float (*pixel)(const obs__frame *f, const float *pos, int x, int y, const float p[4],
                    const float n[3], int *count);
+    /* Samples a pixel takes at most, from the resolved parameters (the
+     * measure of obs_frame_cost). */
+    int (*samples_per_pixel)(const obs_params *p);
     obs__uniform uniforms[OBS__METHOD_MAX_UNIFORMS]; /* ends at a NULL name */
     int deep; /* 1: runs on deep input too (core/deep: OITAO's GetAO) */
 } obs__method;

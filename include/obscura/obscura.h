@@ -185,6 +185,29 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params,
 
 void obs_result_free(obs_result *r);
 
+/* The work a frame asks for, in samples: width x height x the samples per
+ * pixel of its method (vaopp, vao: samples; hemisphere:
+ * hemisphere_samples; angle: 2 x angle_pairs; hbao: hbao_directions x
+ * hbao_steps), times deep_layers squared for deep input (every node's
+ * samples test every node at their pixel; 0 or 1: a flat frame).  A
+ * measure to refuse frames by before running them (obscurad --max-cost);
+ * parameters as obs_run takes them (NULL: defaults). */
+unsigned long long obs_frame_cost(const obs_params *params, int width, int height,
+                                  int deep_layers);
+
+/* ---- what the context keeps between frames ----------------------------- */
+
+/* Bytes of texture storage the context keeps between frames: the chain's
+ * targets of the last frame size and deep input's of the last size and
+ * node count (reused by the next frame of that size; programs are not
+ * counted). */
+unsigned long long obs_ctx_kept_bytes(const obs_ctx *ctx);
+
+/* Releases the kept targets when they hold more than budget bytes (0:
+ * always); the next frame allocates them again.  Programs stay.  Call
+ * on the context's thread, e.g. when idle. */
+obs_status obs_ctx_trim(obs_ctx *ctx, unsigned long long budget, char err[OBS_ERR_LEN]);
+
 /* ---- per-pass GPU timings ---------------------------------------------- */
 
 /* The passes of obs_run, in order.  UPLOAD and READBACK are the texture

@@ -23,7 +23,8 @@ extern "C" {
     X(NO_CAMERA, "no usable camera for the G-buffer")                          \
     X(GL_UNAVAILABLE, "no OpenGL context could be created")                    \
     X(GL_SHADER, "a shader failed to compile or link")                         \
-    X(GL_ERROR, "OpenGL reported an error")
+    X(GL_ERROR, "OpenGL reported an error")                                    \
+    X(TOO_COSTLY, "the request's work exceeds the configured limit")
 
 typedef enum obs_status {
 #define OBS__STATUS_ENUM(name, msg) OBS_##name,
