@@ -737,30 +737,41 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
     return s;
 }
 
-/* The head, in the order obs_bin_request_decode() reads it. */
-static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, char err[OBS_ERR_LEN])
+/* The head, read and checked as obs_bin_request_decode() does, in the
+ * same order (so the first error is the same); q is scratch. */
+static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, obs_bin_request *q,
+                             char err[OBS_ERR_LEN])
 {
     uint32_t count;
     unsigned body;
-    obs_status s;
+    obs_status s = OBS_OK;
+    memset(q, 0, sizeof *q);
+    obs_http_request_init(&q->hr);
     if (!get_u32(r, &count))
         return truncated(r, "parameter count", err);
     if (count > OBS_BIN_MAX_PARAMS)
         return obs__fail(err, OBS_BAD_FILE, "malformed request: %u parameters (at most %d)", count,
                     OBS_BIN_MAX_PARAMS);
+    /* every parameter's framing first: the token is known even when a
+     * value is bad (the value's error is the answer, after the token) */
+    obs_status bad_value = OBS_OK;
+    char bad_err[OBS_ERR_LEN] = "";
     for (uint32_t i = 0; i < count; i++) {
         char name[OBS_BIN_MAX_NAME + 1], value[OBS_BIN_MAX_VALUE + 1];
         if ((s = get_param(r, i, name, value, err)) != OBS_OK)
-            return s;
-        if (!strcmp(name, "token")) {
-            size_t n = strlen(value);
-            if (n >= sizeof h->token)
-                return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter token: longer than %zu bytes",
-                            sizeof h->token - 1);
-            memcpy(h->token, value, n + 1);
-        }
+            return bad_value != OBS_OK ? (snprintf(err, OBS_ERR_LEN, "%s", bad_err), bad_value) : s;
+        if (!strcmp(name, "token") && strlen(value) < sizeof h->token)
+            memcpy(h->token, value, strlen(value) + 1);
+        if (bad_value == OBS_OK && (s = request_param(q, name, value, bad_err)) != OBS_OK)
+            bad_value = s;
     }
     h->params_done = 1;
+    if (bad_value != OBS_OK)
+        return snprintf(err, OBS_ERR_LEN, "%s", bad_err), bad_value;
+    if ((s = obs_http_request_check(&q->hr, err)) != OBS_OK)
+        return s;
+    if (q->raw_out && q->hr.format != OBS_HTTP_EXR)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
     if (!get_u8(r, &body))
         return truncated(r, "G-buffer kind", err);
     if (!get_pad8(r))
@@ -802,8 +813,9 @@ obs_status obs_bin_request_head(const unsigned char *p, size_t have_len, size_t 
                                 obs_bin_head *h, size_t *need, char err[OBS_ERR_LEN])
 {
     reader r = {p, have_len < len ? have_len : len, 0, "request", len, 0};
+    obs_bin_request scratch;
     memset(h, 0, sizeof *h);
-    obs_status s = parse_head(&r, lim, h, err);
+    obs_status s = parse_head(&r, lim, h, &scratch, err);
     *need = r.want;
     if (r.want) {
         h->len = 0;

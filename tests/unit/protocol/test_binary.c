@@ -367,6 +367,20 @@ static void test_head(void **state)
     assert_string_equal(h.token, "secret");
     assert_int_equal(h.body, OBS_BIN_EXR);
     assert_true(h.len == len - sizeof exr);
+    /* a bad value, then broken padding: the value's error first, as the
+     * decoder gives it, and the token is known */
+    p[1].value = "-1";
+    obs_bytes g;
+    assert_int_equal(obs_bin_request_encode(&d, &g, err), OBS_OK);
+    unsigned char *gp = g.data + OBS_BIN_HEADER_LEN;
+    size_t glen = g.size - OBS_BIN_HEADER_LEN;
+    gp[glen - sizeof exr - 8 - 1] = 7; /* the padding before the EXR length */
+    assert_int_equal(obs_bin_request_decode(gp, glen, NULL, &q, err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(head_incremental(gp, glen, NULL, &h, &calls, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "radius"));
+    assert_int_equal(h.params_done, 1);
+    assert_string_equal(h.token, "secret");
+    obs_bytes_free(&g);
     le32(payload, 300); /* 300 parameters */
     assert_int_equal(obs_bin_request_head(payload, 4, len, NULL, &h, &need, err), OBS_BAD_FILE);
     assert_int_equal(h.params_done, 0);
