@@ -162,10 +162,10 @@ static int write_all(obsd_bin *b, int fd, const void *buf, size_t len)
     return 0;
 }
 
-/* Closes after an answer given before all the client sent was read:
- * shuts our side, then reads and drops what comes for a moment, so that
- * the close does not reset the connection under the answer. */
-static void linger_close(int fd)
+/* Before closing after an answer given before all the client sent was
+ * read: shuts our side, then reads and drops what comes for a moment, so
+ * that the close does not reset the connection under the answer. */
+static void linger(int fd)
 {
     char scratch[16384];
     double until = obsd_now_ms() + LINGER_MS;
@@ -187,7 +187,6 @@ static void linger_close(int fd)
         if (n > 0)
             dropped += (size_t)n;
     }
-    close(fd);
 }
 
 /* ---- one frame ------------------------------------------------------------ */
@@ -513,12 +512,12 @@ static void *conn_main(void *arg)
     int r;
     while ((r = serve_one(c)) == NEXT_FRAME)
         ;
-    /* out of the list first: obsd_bin_cut() never shuts a closed fd */
-    conn_main_end(c);
     if (r == CLOSE_LINGER)
-        linger_close(c->fd);
-    else
-        close(c->fd);
+        linger(c->fd); /* in the list still: obsd_bin_cut() ends it */
+    /* out of the list before the close: obsd_bin_cut() never shuts a
+     * closed (or reused) fd */
+    conn_main_end(c);
+    close(c->fd);
     free(c);
     atomic_fetch_sub(&b->connections, 1);
     return NULL;

@@ -1,8 +1,10 @@
 /* The binary-protocol server (daemon/binary_server.c) without GL, on a
  * Unix socket: the connection limits answered with an error frame, frames
  * refused from their head (token, size, a full queue) before their
- * G-buffer is sent, the drain (no new frame starts) and obsd_bin_cut(). */
+ * G-buffer is sent, the drain (no new frame starts), a client that never
+ * reads its answer (the send gives up; obsd_bin_cut() ends it at once). */
 #include <poll.h>
+#include <pthread.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <time.h>
@@ -274,6 +276,89 @@ static void test_drain_and_cut(void **state)
     rmdir(dir);
 }
 
+/* A stand-in GL worker: finishes one job with an AO image of the
+ * G-buffer's size. */
+static void *worker(void *arg)
+{
+    obsd_queue *q = arg;
+    obsd_job *job = obsd_queue_pop(q);
+    if (!job)
+        return NULL;
+    size_t n = (size_t)job->gb->width * (size_t)job->gb->height;
+    job->t_started = job->t_finished = obsd_now_ms();
+    job->result.ao = (obs_image){job->gb->width, job->gb->height, 1, calloc(n, sizeof(float))};
+    job->status = OBS_OK;
+    obsd_queue_done(q);
+    job->done(job, job->user);
+    return NULL;
+}
+
+/* A 1024 x 1024 format=raw frame: a 4 MB answer, never read. */
+static int send_big_raw(void)
+{
+    const uint32_t w = 1024, h = 1024;
+    size_t plen = 4 + 2 + 6 + 4 + 3 + 1, n = 0;
+    while (plen % 8)
+        plen++;
+    plen += 160 + (size_t)w * h * 4;
+    unsigned char *f = calloc(1, OBS_BIN_HEADER_LEN + plen), *p = f + OBS_BIN_HEADER_LEN;
+    obs_bin_header_write(f, OBS_BIN_REQUEST, 1, plen);
+    uint32_t count = 1, vl = 3;
+    uint16_t nl = 6;
+    memcpy(p, &count, 4), n += 4;
+    memcpy(p + n, &nl, 2), n += 2;
+    memcpy(p + n, "format", 6), n += 6;
+    memcpy(p + n, &vl, 4), n += 4;
+    memcpy(p + n, "raw", 3), n += 3;
+    p[n++] = OBS_BIN_RAW;
+    while (n % 8)
+        n++;
+    memcpy(p + n, &w, 4);
+    memcpy(p + n + 4, &h, 4);
+    int fd = dial();
+    for (size_t put = 0; put < OBS_BIN_HEADER_LEN + plen;) {
+        ssize_t k = send(fd, f + put, OBS_BIN_HEADER_LEN + plen - put, 0);
+        assert_true(k > 0);
+        put += (size_t)k;
+    }
+    free(f);
+    return fd;
+}
+
+static void test_stuck_send(void **state)
+{
+    (void)state;
+    obsd_config cfg;
+    obsd_queue q;
+    pthread_t t;
+    obsd_config_defaults(&cfg); /* --timeout 60 */
+    obsd_bin *b = start(&cfg, &q, NULL);
+    pthread_create(&t, NULL, worker, &q);
+    int fd = send_big_raw();
+    sleep_ms(500); /* answered as far as the socket takes it */
+    assert_int_equal(obsd_bin_in_flight(b), 1);
+    double t0 = obsd_now_ms();
+    assert_int_equal(obsd_bin_cut(b), 1);
+    wait_in_flight(b, 0);
+    assert_true(obsd_now_ms() - t0 < 1000);
+    pthread_join(t, NULL);
+    close(fd);
+    finish(b, &q);
+
+    /* --timeout 1: the send gives up by itself */
+    obsd_config_defaults(&cfg);
+    cfg.timeout = 1;
+    b = start(&cfg, &q, NULL);
+    pthread_create(&t, NULL, worker, &q);
+    fd = send_big_raw();
+    t0 = obsd_now_ms();
+    wait_in_flight(b, 0);
+    assert_true(obsd_now_ms() - t0 > 500);
+    pthread_join(t, NULL);
+    close(fd);
+    finish(b, &q);
+}
+
 int main(void)
 {
     obsd_log_set_level(OBSD_LOG_ERROR);
@@ -281,6 +366,7 @@ int main(void)
         cmocka_unit_test(test_connection_limits),
         cmocka_unit_test(test_head_refusals),
         cmocka_unit_test(test_drain_and_cut),
+        cmocka_unit_test(test_stuck_send),
     };
     return cmocka_run_group_tests_name("daemon_binary_server", tests, NULL, NULL);
 }
