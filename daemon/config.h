@@ -25,7 +25,15 @@
       "(empty: none)")       \
     X(tcp, STRING, 0, OBSD_STR_LEN - 1, "",                                    \
       "binary protocol on this TCP [HOST:]PORT (host 127.0.0.1 unless "       \
-      "given; port 0 picks a free port; empty: none)")          \
+      "given; IPv6 in brackets: [::1]:PORT; port 0 picks a free port; "       \
+      "empty: none)")                                                          \
+    X(bin_connections, INT, 1, 4096, "256",                                    \
+      "binary-protocol connections open at once; one more is answered 503 "   \
+      "too_many_connections and closed")                                       \
+    X(max_per_client, INT, 0, 4096, "64",                                      \
+      "connections open at once from one client address (Unix-socket "        \
+      "clients count as one address); one more is answered 503 "               \
+      "too_many_connections and closed (0: no limit)")                         \
     X(queue, INT, 1, 1024, "8",                                                \
       "frames that may wait for the GL worker; more are answered 503")         \
     X(threads, INT, 1, 64, "4",                                                \

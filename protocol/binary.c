@@ -101,9 +101,21 @@ typedef struct reader {
     const unsigned char *p;
     size_t n, off;
     const char *what; /* "request" or "response", for messages */
+    /* A request's head is parsed from the part of the payload read so
+     * far: full is the whole payload's length (n or more), and a field
+     * that lies beyond n but within full sets `want` (the bytes needed)
+     * instead of being an error. */
+    size_t full, want;
 } reader;
 
-static int have(const reader *r, uint64_t len) { return len <= r->n - r->off; }
+static int have(reader *r, uint64_t len)
+{
+    if (len <= r->n - r->off)
+        return 1;
+    if (r->full > r->n && len <= r->full - r->off)
+        r->want = r->off + (size_t)len;
+    return 0;
+}
 
 static int get(reader *r, void *dst, size_t len)
 {
@@ -167,7 +179,7 @@ static int get_pad8(reader *r)
 static obs_status truncated(const reader *r, const char *field, char err[OBS_ERR_LEN])
 {
     return obs__fail(err, OBS_BAD_FILE, "malformed %s: %s at byte %zu of a %zu-byte payload "
-                "(truncated or corrupt)", r->what, field, r->off, r->n);
+                "(truncated or corrupt)", r->what, field, r->off, r->full > r->n ? r->full : r->n);
 }
 
 /* ---- header ---------------------------------------------------------------- */
@@ -186,7 +198,7 @@ obs_status obs_bin_header_parse(const unsigned char *in, obs_bin_header *h, uint
                                 char err[OBS_ERR_LEN])
 {
     reader r = {in, OBS_BIN_HEADER_LEN, 4, "header"};
-    unsigned version, kind;
+    unsigned version = 0, kind = 0;
     memset(h, 0, sizeof *h);
     if (memcmp(in, OBS_BIN_MAGIC, 4) != 0)
         return obs__fail(err, OBS_BAD_FILE, "not an obscura binary-protocol frame (magic is not '%s')",
@@ -367,6 +379,33 @@ static obs_status request_param(obs_bin_request *q, const char *name, const char
     return obs_http_request_set(&q->hr, name, value, err);
 }
 
+/* Parameter i: name and value, NUL-terminated. */
+static obs_status get_param(reader *r, uint32_t i, char name[OBS_BIN_MAX_NAME + 1],
+                            char value[OBS_BIN_MAX_VALUE + 1], char err[OBS_ERR_LEN])
+{
+    unsigned nl;
+    uint32_t vl;
+    if (!get_u16(r, &nl))
+        return truncated(r, "parameter name length", err);
+    if (nl == 0 || nl > OBS_BIN_MAX_NAME)
+        return obs__fail(err, OBS_BAD_FILE, "malformed request: parameter %u has a name of %u bytes "
+                    "(1 to %d)", i, nl, OBS_BIN_MAX_NAME);
+    if (!get(r, name, nl))
+        return truncated(r, "parameter name", err);
+    name[nl] = '\0';
+    if (!get_u32(r, &vl))
+        return truncated(r, "parameter value length", err);
+    if (vl > OBS_BIN_MAX_VALUE)
+        return obs__fail(err, OBS_BAD_FILE, "malformed request: parameter '%.64s' has a value of %u "
+                    "bytes (at most %d)", name, vl, OBS_BIN_MAX_VALUE);
+    if (!get(r, value, vl))
+        return truncated(r, "parameter value", err);
+    value[vl] = '\0';
+    if (memchr(name, 0, nl) || memchr(value, 0, vl))
+        return obs__fail(err, OBS_BAD_FILE, "malformed request: a NUL byte in parameter %u", i);
+    return OBS_OK;
+}
+
 /* A plane of `ch` floats per pixel at the reader's offset: points into
  * the payload when aligned, else into dst (a copy). */
 static const float *take_plane(reader *r, uint64_t bytes, float *dst)
@@ -420,29 +459,59 @@ static obs_status take_half_planes(reader *r, uint64_t px, uint64_t channels, ob
     return OBS_OK;
 }
 
-static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *q, char err[OBS_ERR_LEN])
-{
+/* The fixed fields of a raw G-buffer, before its planes. */
+typedef struct raw_fields {
     uint32_t width, height, dx, dy, dw, dh, flags, type;
+    uint64_t px, channels, bytes; /* the planes: pixels, channels, bytes */
+} raw_fields;
+
+/* Reads and checks the fields of a raw G-buffer's header (the matrices
+ * stay for the caller), and that the planes they announce are the rest
+ * of the payload (`rest` bytes after the header), exactly. */
+static obs_status get_raw_fields(reader *r, const obs_limits *lim, raw_fields *f, char err[OBS_ERR_LEN])
+{
     if (!have(r, RAW_HEADER_LEN))
         return truncated(r, "raw G-buffer header", err);
-    get_u32(r, &width);
-    get_u32(r, &height);
-    get_u32(r, &dx);
-    get_u32(r, &dy);
-    get_u32(r, &dw);
-    get_u32(r, &dh);
-    get_u32(r, &flags);
-    get_u32(r, &type);
-    if (flags & ~0xfu)
-        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: unknown flags 0x%x", flags);
-    if (type != OBS_BIN_F32 && type != OBS_BIN_F16)
+    get_u32(r, &f->width);
+    get_u32(r, &f->height);
+    get_u32(r, &f->dx);
+    get_u32(r, &f->dy);
+    get_u32(r, &f->dw);
+    get_u32(r, &f->dh);
+    get_u32(r, &f->flags);
+    get_u32(r, &f->type);
+    if (f->flags & ~0xfu)
+        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: unknown flags 0x%x", f->flags);
+    if (f->type != OBS_BIN_F32 && f->type != OBS_BIN_F16)
         return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: plane type %u is neither float32 (0) nor "
-                    "float16 (1)", type);
-    obs_status s = obs_check_size(lim, width, height, err);
+                    "float16 (1)", f->type);
+    obs_status s = obs_check_size(lim, f->width, f->height, err);
     if (s != OBS_OK)
         return s;
-    if ((int32_t)dw < 0 || (int32_t)dh < 0 || dw > (1u << 20) || dh > (1u << 20))
-        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: display window %u x %u is not a size", dw, dh);
+    if ((int32_t)f->dw < 0 || (int32_t)f->dh < 0 || f->dw > (1u << 20) || f->dh > (1u << 20))
+        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: display window %u x %u is not a size", f->dw,
+                    f->dh);
+    /* Exactly the planes the flags announce, and nothing after them. */
+    size_t full = r->full > r->n ? r->full : r->n, rest = full - r->off - 128;
+    uint64_t value_size = f->type == OBS_BIN_F16 ? 2 : sizeof(float);
+    f->px = (uint64_t)f->width * f->height;
+    f->channels = 1 + ((f->flags & OBS_BIN_HAS_NORMAL) ? 3 : 0) + ((f->flags & OBS_BIN_HAS_COLOR) ? 4 : 0);
+    f->bytes = 0;
+    if (!mul3(f->px, f->channels, value_size, &f->bytes) || f->bytes != rest)
+        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: %u x %u with %llu %s channels needs %llu bytes "
+                    "of planes, the frame holds %zu", f->width, f->height, (unsigned long long)f->channels,
+                    f->type == OBS_BIN_F16 ? "float16" : "float32", (unsigned long long)f->bytes, rest);
+    return OBS_OK;
+}
+
+static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *q, char err[OBS_ERR_LEN])
+{
+    raw_fields rf;
+    obs_status s = get_raw_fields(r, lim, &rf, err);
+    if (s != OBS_OK)
+        return s;
+    uint32_t width = rf.width, height = rf.height, dx = rf.dx, dy = rf.dy, dw = rf.dw, dh = rf.dh;
+    uint32_t flags = rf.flags, type = rf.type;
     obs_gbuffer *gb = &q->gf.gb;
     obs_camera *cam = &gb->camera;
     get(r, cam->world_to_camera, sizeof cam->world_to_camera);
@@ -450,17 +519,7 @@ static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *
     cam->has_world_to_camera = !!(flags & OBS_BIN_HAS_WORLD_TO_CAMERA);
     cam->has_projection = !!(flags & OBS_BIN_HAS_PROJECTION);
     cam->source = cam->has_projection ? OBS_CAMERA_PARAMS : OBS_CAMERA_NONE;
-
-    /* Exactly the planes the flags announce, and nothing after them. */
-    uint64_t px = (uint64_t)width * height, channels = 1, bytes = 0;
-    uint64_t value_size = type == OBS_BIN_F16 ? 2 : sizeof(float);
-    channels += (flags & OBS_BIN_HAS_NORMAL) ? 3 : 0;
-    channels += (flags & OBS_BIN_HAS_COLOR) ? 4 : 0;
-    if (!mul3(px, channels, value_size, &bytes) || bytes != r->n - r->off)
-        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: %u x %u with %llu %s channels needs %llu bytes "
-                    "of planes, the frame holds %zu", width, height, (unsigned long long)channels,
-                    type == OBS_BIN_F16 ? "float16" : "float32", (unsigned long long)bytes,
-                    r->n - r->off);
+    uint64_t px = rf.px, channels = rf.channels, bytes = rf.bytes;
     gb->width = (int)width;
     gb->height = (int)height;
     gb->display_x = (int32_t)dx;
@@ -498,48 +557,70 @@ static float sort_key(float z) { return z != z ? INFINITY : z; }
  * sample total against OBS_DEEP_MAX_SAMPLES, the counts' and samples'
  * bytes against the rest of the payload, then each count against
  * OBS_DEEP_MAX_PER_PIXEL and their sum against the total. */
-static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request *q, char err[OBS_ERR_LEN])
-{
+/* The fixed fields of a deep G-buffer, before its counts. */
+typedef struct deep_fields {
     uint32_t width, height, dx, dy, dw, dh, flags, values, type, reserved;
-    uint64_t total;
+    uint64_t total, npx, sample_bytes;
+} deep_fields;
+
+/* Reads and checks the fields of a deep G-buffer's header (the matrices
+ * stay for the caller), and that the counts and samples they announce
+ * are the rest of the payload, exactly. */
+static obs_status get_deep_fields(reader *r, const obs_limits *lim, deep_fields *f, char err[OBS_ERR_LEN])
+{
     if (!have(r, DEEP_HEADER_LEN))
         return truncated(r, "deep G-buffer header", err);
-    get_u32(r, &width);
-    get_u32(r, &height);
-    get_u32(r, &dx);
-    get_u32(r, &dy);
-    get_u32(r, &dw);
-    get_u32(r, &dh);
-    get_u32(r, &flags);
-    get_u32(r, &values);
-    get_u32(r, &type);
-    get_u32(r, &reserved);
-    get_u64(r, &total);
-    if (flags & ~(uint32_t)DEEP_FLAGS)
-        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: unknown flags 0x%x", flags);
-    if (values != OBS_DEEP_CH)
+    get_u32(r, &f->width);
+    get_u32(r, &f->height);
+    get_u32(r, &f->dx);
+    get_u32(r, &f->dy);
+    get_u32(r, &f->dw);
+    get_u32(r, &f->dh);
+    get_u32(r, &f->flags);
+    get_u32(r, &f->values);
+    get_u32(r, &f->type);
+    get_u32(r, &f->reserved);
+    get_u64(r, &f->total);
+    if (f->flags & ~(uint32_t)DEEP_FLAGS)
+        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: unknown flags 0x%x", f->flags);
+    if (f->values != OBS_DEEP_CH)
         return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: %u values per sample; the layout has %d "
-                    "(Z, ZBack, R, G, B, A, N.X, N.Y, N.Z)", values, OBS_DEEP_CH);
-    if (type != OBS_BIN_F32 || reserved != 0)
+                    "(Z, ZBack, R, G, B, A, N.X, N.Y, N.Z)", f->values, OBS_DEEP_CH);
+    if (f->type != OBS_BIN_F32 || f->reserved != 0)
         return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: sample type %u (only float32, 0) or reserved "
-                    "field %u (0)", type, reserved);
-    obs_status s = obs_check_size(lim, width, height, err);
+                    "field %u (0)", f->type, f->reserved);
+    obs_status s = obs_check_size(lim, f->width, f->height, err);
     if (s != OBS_OK)
         return s;
-    if ((int32_t)dw < 0 || (int32_t)dh < 0 || dw > (1u << 20) || dh > (1u << 20))
-        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: display window %u x %u is not a size", dw, dh);
-    if (total > OBS_DEEP_MAX_SAMPLES)
+    if ((int32_t)f->dw < 0 || (int32_t)f->dh < 0 || f->dw > (1u << 20) || f->dh > (1u << 20))
+        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: display window %u x %u is not a size", f->dw,
+                    f->dh);
+    if (f->total > OBS_DEEP_MAX_SAMPLES)
         return obs__fail(err, OBS_TOO_LARGE, "deep G-buffer: %llu samples, over the limit of %llu",
-                    (unsigned long long)total, (unsigned long long)OBS_DEEP_MAX_SAMPLES);
+                    (unsigned long long)f->total, (unsigned long long)OBS_DEEP_MAX_SAMPLES);
     /* width x height within the limits, total < 2^25: no overflow below */
-    uint64_t npx = (uint64_t)width * height, sample_bytes = total * OBS_DEEP_CH * sizeof(float);
+    size_t full = r->full > r->n ? r->full : r->n, rest = full - r->off - 128;
+    f->npx = (uint64_t)f->width * f->height;
+    f->sample_bytes = f->total * OBS_DEEP_CH * sizeof(float);
+    if (f->npx * 4 + f->sample_bytes != rest)
+        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: %u x %u counts and %llu samples need %llu bytes, "
+                    "the frame holds %zu", f->width, f->height, (unsigned long long)f->total,
+                    (unsigned long long)(f->npx * 4 + f->sample_bytes), rest);
+    return OBS_OK;
+}
+
+static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request *q, char err[OBS_ERR_LEN])
+{
+    deep_fields f;
+    obs_status s = get_deep_fields(r, lim, &f, err);
+    if (s != OBS_OK)
+        return s;
+    uint32_t width = f.width, height = f.height, dx = f.dx, dy = f.dy, dw = f.dw, dh = f.dh;
+    uint32_t flags = f.flags;
+    uint64_t total = f.total, npx = f.npx, sample_bytes = f.sample_bytes;
     obs_camera *cam = &q->deep.camera;
     get(r, cam->world_to_camera, sizeof cam->world_to_camera);
     get(r, cam->projection, sizeof cam->projection);
-    if (npx * 4 + sample_bytes != r->n - r->off)
-        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: %u x %u counts and %llu samples need %llu bytes, "
-                    "the frame holds %zu", width, height, (unsigned long long)total,
-                    (unsigned long long)(npx * 4 + sample_bytes), r->n - r->off);
     const unsigned char *cp = r->p + r->off;
     uint64_t sum = 0;
     for (uint64_t i = 0; i < npx; i++) {
@@ -612,26 +693,8 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
                     OBS_BIN_MAX_PARAMS);
     for (uint32_t i = 0; i < count; i++) {
         char name[OBS_BIN_MAX_NAME + 1], value[OBS_BIN_MAX_VALUE + 1];
-        unsigned nl;
-        uint32_t vl;
-        if (!get_u16(&r, &nl))
-            return truncated(&r, "parameter name length", err);
-        if (nl == 0 || nl > OBS_BIN_MAX_NAME)
-            return obs__fail(err, OBS_BAD_FILE, "malformed request: parameter %u has a name of %u bytes "
-                        "(1 to %d)", i, nl, OBS_BIN_MAX_NAME);
-        if (!get(&r, name, nl))
-            return truncated(&r, "parameter name", err);
-        name[nl] = '\0';
-        if (!get_u32(&r, &vl))
-            return truncated(&r, "parameter value length", err);
-        if (vl > OBS_BIN_MAX_VALUE)
-            return obs__fail(err, OBS_BAD_FILE, "malformed request: parameter '%.64s' has a value of %u "
-                        "bytes (at most %d)", name, vl, OBS_BIN_MAX_VALUE);
-        if (!get(&r, value, vl))
-            return truncated(&r, "parameter value", err);
-        value[vl] = '\0';
-        if (memchr(name, 0, nl) || memchr(value, 0, vl))
-            return obs__fail(err, OBS_BAD_FILE, "malformed request: a NUL byte in parameter %u", i);
+        if ((s = get_param(&r, i, name, value, err)) != OBS_OK)
+            return s;
         if ((s = request_param(out, name, value, err)) != OBS_OK)
             return s;
     }
@@ -671,6 +734,93 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
     s = decode_raw(&r, lim, out, err);
     if (s != OBS_OK)
         obs_bin_request_free(out);
+    return s;
+}
+
+/* The head, read and checked as obs_bin_request_decode() does, in the
+ * same order (so the first error is the same); q is scratch. */
+static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, obs_bin_request *q,
+                             char err[OBS_ERR_LEN])
+{
+    uint32_t count;
+    unsigned body;
+    obs_status s = OBS_OK;
+    memset(q, 0, sizeof *q);
+    obs_http_request_init(&q->hr);
+    if (!get_u32(r, &count))
+        return truncated(r, "parameter count", err);
+    if (count > OBS_BIN_MAX_PARAMS)
+        return obs__fail(err, OBS_BAD_FILE, "malformed request: %u parameters (at most %d)", count,
+                    OBS_BIN_MAX_PARAMS);
+    /* every parameter's framing first: the token is known even when a
+     * value is bad (the value's error is the answer, after the token) */
+    obs_status bad_value = OBS_OK;
+    char bad_err[OBS_ERR_LEN] = "";
+    for (uint32_t i = 0; i < count; i++) {
+        char name[OBS_BIN_MAX_NAME + 1], value[OBS_BIN_MAX_VALUE + 1];
+        if ((s = get_param(r, i, name, value, err)) != OBS_OK)
+            return bad_value != OBS_OK ? (snprintf(err, OBS_ERR_LEN, "%s", bad_err), bad_value) : s;
+        if (!strcmp(name, "token") && strlen(value) < sizeof h->token)
+            memcpy(h->token, value, strlen(value) + 1);
+        if (bad_value == OBS_OK && (s = request_param(q, name, value, bad_err)) != OBS_OK)
+            bad_value = s;
+    }
+    h->params_done = 1;
+    if (bad_value != OBS_OK)
+        return snprintf(err, OBS_ERR_LEN, "%s", bad_err), bad_value;
+    if ((s = obs_http_request_check(&q->hr, err)) != OBS_OK)
+        return s;
+    if (q->raw_out && q->hr.format != OBS_HTTP_EXR)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
+    if (!get_u8(r, &body))
+        return truncated(r, "G-buffer kind", err);
+    if (!get_pad8(r))
+        return truncated(r, "padding", err);
+    size_t full = r->full > r->n ? r->full : r->n;
+    if (body == OBS_BIN_EXR) {
+        uint64_t n;
+        if (!get_u64(r, &n))
+            return truncated(r, "EXR length", err);
+        if (n != full - r->off)
+            return obs__fail(err, OBS_BAD_FILE, "malformed request: EXR of %llu bytes, the frame holds %zu",
+                        (unsigned long long)n, full - r->off);
+        if (n == 0)
+            return obs__fail(err, OBS_BAD_FILE, "malformed request: empty EXR");
+    } else if (body == OBS_BIN_DEEP) {
+        deep_fields f;
+        if ((s = get_deep_fields(r, lim, &f, err)) != OBS_OK)
+            return s;
+        r->off += 128; /* the matrices: have() counted them in */
+        h->width = f.width;
+        h->height = f.height;
+    } else if (body == OBS_BIN_RAW) {
+        raw_fields f;
+        if ((s = get_raw_fields(r, lim, &f, err)) != OBS_OK)
+            return s;
+        r->off += 128;
+        h->width = f.width;
+        h->height = f.height;
+    } else {
+        return obs__fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is not EXR (1), raw (2) "
+                    "or deep (4)", body);
+    }
+    h->body = (obs_bin_body)body;
+    h->len = r->off;
+    return OBS_OK;
+}
+
+obs_status obs_bin_request_head(const unsigned char *p, size_t have_len, size_t len, const obs_limits *lim,
+                                obs_bin_head *h, size_t *need, char err[OBS_ERR_LEN])
+{
+    reader r = {p, have_len < len ? have_len : len, 0, "request", len, 0};
+    obs_bin_request scratch;
+    memset(h, 0, sizeof *h);
+    obs_status s = parse_head(&r, lim, h, &scratch, err);
+    *need = r.want;
+    if (r.want) {
+        h->len = 0;
+        return OBS_OK;
+    }
     return s;
 }
 

@@ -151,6 +151,29 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
                                   obs_bin_request *out, char err[OBS_ERR_LEN]);
 void obs_bin_request_free(obs_bin_request *r);
 
+/* A request's head: what the first bytes of its payload say, so that a
+ * server can refuse a frame before it reads (and buffers) its G-buffer.
+ * The head is the parameters, the G-buffer kind and the G-buffer's fixed
+ * fields (an EXR's length; raw and deep planes' sizes and flags, their
+ * camera), at most about 1 MiB. */
+typedef struct obs_bin_head {
+    size_t len;        /* the head's bytes (0 while more are needed) */
+    int params_done;   /* the parameters were read whole: `token` is known */
+    char token[512];   /* token=..., "" when absent */
+    obs_bin_body body; /* EXR, RAW or DEEP */
+    uint32_t width, height; /* RAW and DEEP */
+} obs_bin_head;
+
+/* Parses the head of a `len`-byte request payload from its first
+ * `have_len` bytes.  OBS_OK with *need > have_len: read the payload up to
+ * *need bytes and call again; OBS_OK with *need == 0: h is filled.
+ * Otherwise the error obs_bin_request_decode() gives for those bytes:
+ * the parameters' framing (their values are not checked here), the
+ * G-buffer kind, the size against `lim`, a deep frame's sample total,
+ * and the bytes the G-buffer announces against the rest of the payload. */
+obs_status obs_bin_request_head(const unsigned char *p, size_t have_len, size_t len, const obs_limits *lim,
+                                obs_bin_head *h, size_t *need, char err[OBS_ERR_LEN]);
+
 /* ---- responses ----------------------------------------------------------- */
 
 /* One raw output image: which output (OBS_OUTPUT_* bit) and its pixels. */

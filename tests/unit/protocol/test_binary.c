@@ -282,6 +282,116 @@ static void test_oversized(void **state)
     obs_bytes_free(&f);
 }
 
+/* Reads a head the way the daemon does: from nothing, as many bytes as
+ * the parser asks for, each time from a fresh, exactly sized copy (ASan
+ * sees a read past what was "received"). */
+static obs_status head_incremental(const unsigned char *payload, size_t len, const obs_limits *lim,
+                                   obs_bin_head *h, size_t *calls, char err[OBS_ERR_LEN])
+{
+    size_t got = 0, need = 0;
+    obs_status s;
+    *calls = 0;
+    for (;;) {
+        unsigned char *copy = malloc(got ? got : 1);
+        memcpy(copy, payload, got);
+        s = obs_bin_request_head(copy, got, len, lim, h, &need, err);
+        free(copy);
+        ++*calls;
+        if (s != OBS_OK || need == 0)
+            return s;
+        assert_true(need > got && need <= len);
+        got = need;
+    }
+}
+
+static void test_head(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+    obs_bin_head h;
+    size_t calls, need;
+    obs_bytes f = encode_raw_request();
+    unsigned char *payload = f.data + OBS_BIN_HEADER_LEN;
+    size_t len = f.size - OBS_BIN_HEADER_LEN;
+    size_t planes = (size_t)W * H * (1 + 3 + 4) * sizeof(float);
+    assert_int_equal(head_incremental(payload, len, NULL, &h, &calls, err), OBS_OK);
+    assert_true(h.len == len - planes); /* the planes are never asked for */
+    assert_int_equal(h.params_done, 1);
+    assert_string_equal(h.token, "t0k");
+    assert_int_equal(h.body, OBS_BIN_RAW);
+    assert_int_equal(h.width, W);
+    assert_int_equal(h.height, H);
+    assert_true(calls > 2 && calls < 40);
+    /* with the whole payload at hand: the same head at once */
+    assert_int_equal(obs_bin_request_head(payload, len, len, NULL, &h, &need, err), OBS_OK);
+    assert_true(need == 0 && h.len == len - planes);
+    size_t head = h.len;
+
+    /* every cut of the payload (the frame's own length then): the head
+     * fails as the decoder does, with the same status */
+    obs_bin_request q;
+    for (size_t n = 0; n < len; n++) {
+        unsigned char *copy = malloc(n ? n : 1);
+        memcpy(copy, payload, n);
+        obs_status sd = obs_bin_request_decode(copy, n, NULL, &q, err);
+        obs_status sh = obs_bin_request_head(copy, n, n, NULL, &h, &need, err);
+        assert_int_not_equal(sh, OBS_OK);
+        assert_int_equal(sh, sd);
+        free(copy);
+    }
+
+    /* sizes over the limits: refused from the head, the planes unread */
+    size_t off = head - 160; /* the raw header */
+    obs_limits lim = {.max_pixels = 10000};
+    le32(payload + off, 200);
+    le32(payload + off + 4, 100);
+    assert_int_equal(obs_bin_request_head(payload, head, len, &lim, &h, &need, err), OBS_TOO_LARGE);
+    assert_int_equal(obs_bin_request_decode(payload, len, &lim, &q, err), OBS_TOO_LARGE);
+    /* more planes than the frame holds: known from the head */
+    le32(payload + off, W + 1);
+    le32(payload + off + 4, H);
+    assert_int_equal(obs_bin_request_head(payload, len - planes, len, &lim, &h, &need, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "holds"));
+    le32(payload + off, W);
+    le32(payload + off + 4, H);
+    obs_bytes_free(&f);
+
+    /* a broken parameter list: params_done stays 0 (the token unknown) */
+    static const unsigned char exr[] = {1, 2, 3};
+    obs_bin_param p[] = {{"token", "secret"}, {"radius", "0.5"}};
+    obs_bin_request_desc d = {.id = 1, .params = p, .param_count = 2, .exr = exr, .exr_len = sizeof exr};
+    assert_int_equal(obs_bin_request_encode(&d, &f, err), OBS_OK);
+    payload = f.data + OBS_BIN_HEADER_LEN;
+    len = f.size - OBS_BIN_HEADER_LEN;
+    assert_int_equal(head_incremental(payload, len, NULL, &h, &calls, err), OBS_OK);
+    assert_string_equal(h.token, "secret");
+    assert_int_equal(h.body, OBS_BIN_EXR);
+    assert_true(h.len == len - sizeof exr);
+    /* a bad value, then broken padding: the value's error first, as the
+     * decoder gives it, and the token is known */
+    p[1].value = "-1";
+    obs_bytes g;
+    assert_int_equal(obs_bin_request_encode(&d, &g, err), OBS_OK);
+    unsigned char *gp = g.data + OBS_BIN_HEADER_LEN;
+    size_t glen = g.size - OBS_BIN_HEADER_LEN;
+    gp[glen - sizeof exr - 8 - 1] = 7; /* the padding before the EXR length */
+    assert_int_equal(obs_bin_request_decode(gp, glen, NULL, &q, err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(head_incremental(gp, glen, NULL, &h, &calls, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "radius"));
+    assert_int_equal(h.params_done, 1);
+    assert_string_equal(h.token, "secret");
+    obs_bytes_free(&g);
+    le32(payload, 300); /* 300 parameters */
+    assert_int_equal(obs_bin_request_head(payload, 4, len, NULL, &h, &need, err), OBS_BAD_FILE);
+    assert_int_equal(h.params_done, 0);
+    le32(payload, 2);
+    payload[4 + 2 + 5 + 4 + 6] = 0; /* the second name's length: 0 */
+    payload[4 + 2 + 5 + 4 + 6 + 1] = 0;
+    assert_int_equal(head_incremental(payload, len, NULL, &h, &calls, err), OBS_BAD_FILE);
+    assert_int_equal(h.params_done, 0);
+    obs_bytes_free(&f);
+}
+
 static void test_garbage(void **state)
 {
     (void)state;
@@ -682,6 +792,37 @@ static void test_deep_bad_sizes(void **state)
     obs_bytes_free(&f);
 }
 
+/* A deep frame's head: the fixed fields, not the counts or samples; the
+ * sample total and the window against the limits from the head alone. */
+static void test_deep_head(void **state)
+{
+    (void)state;
+    obs_bytes f = encode_deep_request();
+    char err[OBS_ERR_LEN];
+    obs_bin_head h;
+    size_t calls, need;
+    unsigned char *payload = f.data + OBS_BIN_HEADER_LEN, *hd = f.data + DEEP_AT;
+    size_t len = f.size - OBS_BIN_HEADER_LEN, head = DEEP_AT - OBS_BIN_HEADER_LEN + 176;
+    assert_int_equal(head_incremental(payload, len, NULL, &h, &calls, err), OBS_OK);
+    assert_int_equal(h.body, OBS_BIN_DEEP);
+    assert_true(h.len == head && h.width == DW && h.height == DH && h.token[0] == '\0');
+    obs_limits lim = {.max_pixels = 10000};
+    le32(hd + 40, (uint32_t)OBS_DEEP_MAX_SAMPLES + 1);
+    assert_int_equal(obs_bin_request_head(payload, head, len, &lim, &h, &need, err), OBS_TOO_LARGE);
+    le32(hd + 40, 8);
+    assert_int_equal(obs_bin_request_head(payload, head, len, &lim, &h, &need, err), OBS_BAD_FILE);
+    le32(hd + 40, 7);
+    le32(hd, 200);
+    le32(hd + 4, 100);
+    assert_int_equal(obs_bin_request_head(payload, head, len, &lim, &h, &need, err), OBS_TOO_LARGE);
+    le32(hd, DW);
+    le32(hd + 4, DH);
+    le32(hd + 28, 7); /* values per sample */
+    assert_int_equal(obs_bin_request_head(payload, head, len, &lim, &h, &need, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "7 values per sample"));
+    obs_bytes_free(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -691,6 +832,7 @@ int main(void)
         cmocka_unit_test(test_half_to_float),       cmocka_unit_test(test_f16_planes),
         cmocka_unit_test(test_deep_round_trip),     cmocka_unit_test(test_deep_truncated),
         cmocka_unit_test(test_deep_bad_counts),     cmocka_unit_test(test_deep_bad_sizes),
+        cmocka_unit_test(test_head),                cmocka_unit_test(test_deep_head),
     };
     return cmocka_run_group_tests_name("protocol_binary", tests, NULL, NULL);
 }
