@@ -97,6 +97,12 @@ static int parse_server(const char *url, server_addr *a)
     if (!colon || hl == 0 || hl >= sizeof a->host)
         return -1;
     memcpy(a->host, rest, hl);
+    if (a->host[0] == '[') { /* an IPv6 address, [::1]: getaddrinfo takes it bare */
+        if (hl < 3 || a->host[hl - 1] != ']')
+            return -1;
+        memmove(a->host, a->host + 1, hl - 2);
+        a->host[hl - 2] = '\0';
+    }
     const char *p = colon + 1;
     size_t pl = strcspn(p, "/");
     if (pl == 0 || pl >= sizeof a->port || strspn(p, "0123456789") != pl || (p[pl] && strcmp(p + pl, "/")))
@@ -439,8 +445,10 @@ static int http_once(const server_addr *a, const char *query, const unsigned cha
     char path[96] = "/v1/ao";
     if (stream_name)
         snprintf(path, sizeof path, "/v1/streams/%s/frames", stream_name);
-    snprintf(head, hcap, "POST %s?%s HTTP/1.1\r\nHost: %s:%s\r\nContent-Type: image/x-exr\r\n"
-             "Content-Length: %zu\r\nConnection: close\r\n%s%s%s\r\n", path, query, a->host, a->port, body_len,
+    const int v6 = strchr(a->host, ':') != NULL; /* Host: [::1]:PORT */
+    snprintf(head, hcap, "POST %s?%s HTTP/1.1\r\nHost: %s%s%s:%s\r\nContent-Type: image/x-exr\r\n"
+             "Content-Length: %zu\r\nConnection: close\r\n%s%s%s\r\n", path, query, v6 ? "[" : "",
+             a->host, v6 ? "]" : "", a->port, body_len,
              token && *token ? "Authorization: Bearer " : "", token && *token ? token : "",
              token && *token ? "\r\n" : "");
     /* a 413 or 401 may come before the body is read; the answer counts */

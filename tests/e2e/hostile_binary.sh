@@ -141,6 +141,9 @@ if python3 -c 'import socket; s = socket.socket(socket.AF_INET6); s.bind(("::1",
                 "grep -q 'binary protocol on tcp://\[$host\]:$TP_v6\$' '$T/v6.log'"
             r=$(timeout 30 $BC one "[::1]:$TP_v6")
             check "  a frame over [::1]:$TP_v6: 200 ($r)" "[ '$r' = 'status=200:ok' ]"
+            timeout 60 "$OBSCURA" ao tests/data/room_small.exr --camera tests/data/room_small.camera.json \
+                -o "$T/v6.exr" --server "tcp://[::1]:$TP_v6" -q 2>"$T/v6.err"
+            check "  obscura ao --server tcp://[::1]:$TP_v6: exit 0 ($?)" "[ -s '$T/v6.exr' ]"
             stop_wait "$PID_v6" 20
             check "  SIGTERM: exit 0 ($RC)" "[ '$RC' = 0 ]"
         fi
