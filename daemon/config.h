@@ -18,14 +18,15 @@
  * the `choices` column of obsd_enum_choices()). */
 #define OBSD_CONFIG_TABLE(X)                                                   \
     X(http, STRING, 0, OBSD_STR_LEN - 1, "127.0.0.1:8420",                     \
-      "HTTP listen address HOST:PORT (IPv4; port 0 picks a free port; "        \
-      "empty: no HTTP)")                                                       \
+      "HTTP listen address IPV4:PORT or [IPV6]:PORT (port 0 picks a free "     \
+      "port; empty: no HTTP)")                                                 \
     X(socket, STRING, 0, OBSD_STR_LEN - 1, "",                                 \
       "binary protocol (protocol/PROTOCOL.md) on this Unix socket path "      \
       "(empty: none)")       \
     X(tcp, STRING, 0, OBSD_STR_LEN - 1, "",                                    \
       "binary protocol on this TCP [HOST:]PORT (host 127.0.0.1 unless "       \
       "given; port 0 picks a free port; empty: none)")          \
+    X(max_per_client, INT, 0, 65536, "64", "connections at once from one client address, per listener (0: no limit)") \
     X(queue, INT, 1, 1024, "8",                                                \
       "frames that may wait for the GL worker; more are answered 503")         \
     X(threads, INT, 1, 64, "4",                                                \
@@ -37,6 +38,13 @@
       "largest accepted request body in bytes (413 above, before reading)")    \
     X(timeout, INT, 0, 86400, "60",                                            \
       "seconds a connection may stay idle (0: no limit)")                      \
+    X(request_timeout, INT, 0, 86400, "300",                                   \
+      "seconds a request may take to send its headers and body, however "     \
+      "steadily it trickles (408, or closed, past it; 0: no limit)")           \
+    X(http_connections, INT, 1, 65536, "512",                                  \
+      "HTTP connections at once; at the limit a new one displaces the oldest " \
+      "still waiting for its headers, else it may ask /healthz and /readyz "  \
+      "only (16 more are kept for that)")                                      \
     X(token_file, STRING, 0, OBSD_STR_LEN - 1, "",                             \
       "file holding a bearer token; when set, /v1/* and /metrics need "        \
       "'Authorization: Bearer TOKEN'")                                         \
