@@ -14,7 +14,6 @@
  *              left to free their requests */
 #include <arpa/inet.h>
 #include <netinet/in.h>
-#include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -246,17 +245,13 @@ int obsd_http_cut(obsd_http *h)
         if (!r)
             continue;
         /* A connection suspended for the GL worker: resume it here (it
-         * closes); the job runs on and its request is freed after both. */
-        for (;;) {
-            int s = JOB_PENDING;
-            if (atomic_compare_exchange_strong(&r->job, &s, JOB_CUT)) {
-                MHD_resume_connection(c->mc);
-                break;
-            }
-            if (s != JOB_RESUMING)
-                break;
-            sched_yield(); /* the worker is between its claim and its resume */
-        }
+         * closes); the job runs on and its request is freed after both.
+         * JOB_DONE: the worker claimed it and resumes it, maybe not yet;
+         * resuming again is harmless while the connection exists (its
+         * record is in the list: MHD frees it after the CLOSED notice). */
+        int s = JOB_PENDING;
+        if (atomic_compare_exchange_strong(&r->job, &s, JOB_CUT) || s == JOB_DONE)
+            MHD_resume_connection(c->mc);
     }
     pthread_mutex_unlock(&h->lock);
     return n;

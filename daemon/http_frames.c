@@ -115,15 +115,19 @@ static void job_done(void *user)
     req *r = user;
     for (;;) {
         int s = atomic_load(&r->job);
-        if (s == JOB_PENDING && atomic_compare_exchange_strong(&r->job, &s, JOB_RESUMING)) {
-            MHD_resume_connection(r->conn);
-            atomic_store(&r->job, JOB_DONE);
-            return;
-        }
-        if (s == JOB_CUT && atomic_compare_exchange_strong(&r->job, &s, JOB_CUT_DONE))
-            return;
-        if (s == JOB_ORPHAN) {
-            obsd__req_free(r);
+        if (s == JOB_PENDING) {
+            /* Claimed, then resumed: once resumed, the request may be
+             * answered and freed at once, so nothing of it after. */
+            if (atomic_compare_exchange_strong(&r->job, &s, JOB_DONE)) {
+                MHD_resume_connection(r->conn);
+                return;
+            }
+        } else if (s == JOB_CUT) {
+            if (atomic_compare_exchange_strong(&r->job, &s, JOB_CUT_DONE))
+                return;
+        } else {
+            if (s == JOB_ORPHAN)
+                obsd__req_free(r);
             return;
         }
     }
@@ -226,21 +230,25 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
         return obsd__answer_status(r, s, err);
     /* The request is whole: its deadline stops (the GL worker's time is
      * not the client's).  Suspend before queueing: the worker may finish
-     * and resume at once.  Under the server's lock, so that the drain's
-     * cut sees the job pending and the connection suspended together. */
+     * and resume at once.  The job is pending only once the connection is
+     * suspended, and the drain's cut (obsd_http_cut: the connection's
+     * `cut` set, then the job looked at) is checked after: one of the two
+     * sees the other, so a cut connection is never left suspended. */
     if (!obsd__req_hold(r))
         return MHD_NO;
     r->state = REQ_QUEUED;
-    pthread_mutex_lock(&h->lock);
-    atomic_store(&r->job, JOB_PENDING);
     MHD_suspend_connection(r->conn);
-    if ((atomic_load(&h->draining) && !r->before_drain) ||
+    atomic_store(&r->job, JOB_PENDING);
+    if ((r->cn && atomic_load(&r->cn->cut)) || (atomic_load(&h->draining) && !r->before_drain) ||
         obsd_fp_queue(&r->fp, h->queue, &r->hr.params, outputs, job_done, r) != 0) {
-        atomic_store(&r->job, JOB_NONE);
-        r->state = REQ_REFUSED;
-        MHD_resume_connection(r->conn);
+        int pending = JOB_PENDING;
+        if (atomic_compare_exchange_strong(&r->job, &pending, JOB_NONE)) {
+            r->state = REQ_REFUSED;
+            MHD_resume_connection(r->conn);
+        } else {
+            atomic_store(&r->job, JOB_CUT_DONE); /* the cut resumed it; no job runs */
+        }
     }
-    pthread_mutex_unlock(&h->lock);
     return MHD_YES;
 }
 

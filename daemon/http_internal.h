@@ -61,12 +61,11 @@ struct obsd_http {
 };
 
 /* A frame's trip to the GL worker, for the drain's cut (obsd_http_cut):
- * the one that moves a request out of JOB_PENDING resumes or frees it. */
+ * the one that moves a request out of JOB_PENDING resumes it. */
 enum {
     JOB_NONE,
     JOB_PENDING,   /* queued, the connection suspended */
-    JOB_RESUMING,  /* the worker is resuming the connection */
-    JOB_DONE,      /* resumed by the worker */
+    JOB_DONE,      /* claimed by the worker, which resumes the connection */
     JOB_CUT,       /* resumed by the cut: the connection closes; the job runs on */
     JOB_CUT_DONE,  /* the job ended after the cut */
     JOB_ORPHAN     /* the connection is gone first: the worker frees the request */
