@@ -12,10 +12,17 @@
  * context (what the daemon's GL worker does), and the same after an EXR
  * decode of the file.  Medians of N, all in one run.  Then, for the last
  * URL, 1, 2, 4 and 8 client processes send M frames each: frames per
- * second over the wall time. */
+ * second over the wall time.  Last, for the first http:// URL, small
+ * frames (the G-buffer's depth at 64x36) one after another: over one
+ * keep-alive connection, and on a new connection each, frames per second
+ * and their ratio. */
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -57,6 +64,110 @@ static void remote_frame(const char *url, const char *path, const obs_gbuffer *g
     if (cli_remote_run(url, 0, argv, path, gb, OBS_OUTPUT_AO, &r) != 0)
         die(url, "frame failed");
     obs_result_free(&r);
+}
+
+/* ---- small frames, keep-alive or not ---- */
+
+/* The depth plane at w x h (nearest), as an EXR in memory. */
+static void small_exr(const obs_gbuffer *gb, int w, int h, obs_bytes *out)
+{
+    static const char *const zn[] = {"Z"};
+    obs_image img = {w, h, 1, malloc(sizeof(float) * (size_t)w * (size_t)h)};
+    char err[OBS_ERR_LEN];
+    if (!img.data)
+        die("small frame", "no memory");
+    size_t stride = gb->depth.row_stride ? gb->depth.row_stride
+                                         : sizeof(float) * (size_t)gb->width * (size_t)gb->depth.channels;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            img.data[(size_t)y * w + x] =
+                ((const float *)((const char *)gb->depth.data + (size_t)((long long)y * gb->height / h) * stride))
+                    [(size_t)((long long)x * gb->width / w) * gb->depth.channels];
+    obs_exr_layer layer = {&img, zn};
+    if (obs_exr_write_mem(&layer, 1, OBS_EXR_FLOAT, &gb->camera, out, err) != OBS_OK)
+        die("small frame", err);
+    obs_image_free(&img);
+}
+
+static int http_connect(const char *url)
+{
+    char host[256], port[16];
+    if (sscanf(url, "http://%255[^:/]:%15[0-9]", host, port) != 2)
+        die(url, "not http://HOST:PORT");
+    struct addrinfo hints = {.ai_socktype = SOCK_STREAM}, *ai;
+    if (getaddrinfo(host, port, &hints, &ai) != 0)
+        die(url, "cannot resolve");
+    int fd = socket(ai->ai_family, ai->ai_socktype, ai->ai_protocol);
+    if (fd < 0 || connect(fd, ai->ai_addr, ai->ai_addrlen) != 0)
+        die(url, "cannot connect");
+    /* as curl does: no Nagle delay between a request's head and its body */
+    int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    freeaddrinfo(ai);
+    return fd;
+}
+
+/* One POST /v1/ao on fd, its answer read whole; 0 when it was a 200
+ * that leaves the connection open. */
+static int http_frame(int fd, const obs_bytes *body, int keep)
+{
+    char head[256], buf[1 << 16];
+    int n = snprintf(head, sizeof head, "POST /v1/ao HTTP/1.1\r\nHost: bench\r\nContent-Type: image/x-exr\r\n"
+                     "Content-Length: %zu\r\n%s\r\n", body->size, keep ? "" : "Connection: close\r\n");
+    if (send(fd, head, (size_t)n, MSG_NOSIGNAL | MSG_MORE) != n ||
+        send(fd, body->data, body->size, MSG_NOSIGNAL) != (ssize_t)body->size)
+        die("small frames", "send failed");
+    size_t got = 0, need = 0, head_len = 0;
+    for (;;) {
+        ssize_t k = recv(fd, buf + got, sizeof buf - 1 - got, 0);
+        if (k <= 0)
+            die("small frames", "the daemon closed the connection early");
+        got += (size_t)k;
+        buf[got] = '\0';
+        char *end = strstr(buf, "\r\n\r\n");
+        if (!head_len && end) {
+            head_len = (size_t)(end - buf) + 4;
+            const char *cl = strstr(buf, "Content-Length: ");
+            if (strncmp(buf, "HTTP/1.1 200", 12) != 0 || !cl)
+                die("small frames", "not a 200 answer");
+            need = head_len + strtoull(cl + 16, NULL, 10);
+            if (need >= sizeof buf)
+                die("small frames", "answer too large");
+        }
+        if (head_len && got >= need)
+            break;
+    }
+    return strstr(buf, "Connection: close") != NULL;
+}
+
+static void keepalive_bench(const char *url, const obs_gbuffer *gb, int count)
+{
+    obs_bytes body;
+    small_exr(gb, 64, 36, &body);
+    int fd = http_connect(url);
+    http_frame(fd, &body, 1); /* warm-up: the daemon's textures at this size */
+    double t0 = now_ms();
+    for (int k = 0; k < count; k++)
+        if (http_frame(fd, &body, 1) != 0)
+            die("keep-alive", "the daemon closed a keep-alive connection");
+    double keep_s = (now_ms() - t0) / 1e3;
+    close(fd);
+    t0 = now_ms();
+    for (int k = 0; k < count; k++) {
+        fd = http_connect(url);
+        http_frame(fd, &body, 0);
+        close(fd);
+    }
+    double new_s = (now_ms() - t0) / 1e3;
+    size_t size = body.size;
+    obs_bytes_free(&body);
+    printf("\nSmall frames (64x36 depth, %zu-byte EXR, AO EXR answer), %d one after another (%s):\n\n", size,
+           count, url);
+    printf("| connection | wall s | frames/s |\n|---|---|---|\n");
+    printf("| one keep-alive connection | %.2f | %.1f |\n", keep_s, count / keep_s);
+    printf("| a new connection per frame | %.2f | %.1f |\n", new_s, count / new_s);
+    printf("\nkeep-alive / new connection: %.2f x the frames per second\n", new_s / keep_s);
+    fflush(stdout);
 }
 
 int main(int argc, char **argv)
@@ -159,6 +270,11 @@ int main(int argc, char **argv)
         printf("| %d | %d | %.2f | %.2f |\n", n, n * per_client, s, n * per_client / s);
         fflush(stdout);
     }
+    for (int u = i; u < argc; u++)
+        if (!strncmp(argv[u], "http://", 7)) {
+            keepalive_bench(argv[u], &gf.gb, 200);
+            break;
+        }
     obs_gbuffer_free(&gf);
     return 0;
 }

@@ -18,8 +18,8 @@
  * the `choices` column of obsd_enum_choices()). */
 #define OBSD_CONFIG_TABLE(X)                                                   \
     X(http, STRING, 0, OBSD_STR_LEN - 1, "127.0.0.1:8420",                     \
-      "HTTP listen address HOST:PORT (IPv4; port 0 picks a free port; "        \
-      "empty: no HTTP)")                                                       \
+      "HTTP listen address IPV4:PORT or [IPV6]:PORT (port 0 picks a free "     \
+      "port; empty: no HTTP)")                                                 \
     X(socket, STRING, 0, OBSD_STR_LEN - 1, "",                                 \
       "binary protocol (protocol/PROTOCOL.md) on this Unix socket path "      \
       "(empty: none)")       \
@@ -31,8 +31,8 @@
       "binary-protocol connections open at once; one more is answered 503 "   \
       "too_many_connections and closed")                                       \
     X(max_per_client, INT, 0, 4096, "64",                                      \
-      "connections open at once from one client address (Unix-socket "        \
-      "clients count as one address); one more is answered 503 "               \
+      "connections open at once from one client address, per listener "      \
+      "(Unix-socket clients count as one address); one more is answered 503 " \
       "too_many_connections and closed (0: no limit)")                         \
     X(queue, INT, 1, 1024, "8",                                                \
       "frames that may wait for the GL worker; more are answered 503")         \
@@ -45,6 +45,13 @@
       "largest accepted request body in bytes (413 above, before reading)")    \
     X(timeout, INT, 0, 86400, "60",                                            \
       "seconds a connection may stay idle (0: no limit)")                      \
+    X(request_timeout, INT, 0, 86400, "300",                                   \
+      "seconds a request may take to send its headers and body, however "     \
+      "steadily it trickles (408, or closed, past it; 0: no limit)")           \
+    X(http_connections, INT, 1, 65536, "512",                                  \
+      "HTTP connections at once; at the limit a new one displaces the oldest " \
+      "still waiting for its headers, else it may ask /healthz and /readyz "  \
+      "only (16 more are kept for that)")                                      \
     X(token_file, STRING, 0, OBSD_STR_LEN - 1, "",                             \
       "file holding a bearer token; when set, /v1/* and /metrics need "        \
       "'Authorization: Bearer TOKEN'")                                         \

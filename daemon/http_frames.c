@@ -49,12 +49,16 @@ static int name_is(const char *name, const char *want)
     return *name == *want;
 }
 
-static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *key, size_t key_size,
+                              const char *value, size_t value_size)
 {
     arg_ctx *a = cls;
     req *r = a->r;
     (void)kind;
     if (a->status != OBS_OK)
+        return MHD_NO;
+    /* %00 would end the C string: 'radius=0.5%00x' would read 0.5 */
+    if ((a->status = obs_http_value_check(key, key_size, value, value_size, a->err)) != OBS_OK)
         return MHD_NO;
     if (!value)
         value = "";
@@ -92,7 +96,7 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
 int obsd__parse_query(req *r, enum MHD_Result *rc)
 {
     arg_ctx a = {r, OBS_OK, ""};
-    MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
+    MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
     if (a.status == OBS_OK)
         a.status = obs_http_request_check(&r->hr, a.err);
     if (a.status == OBS_OK)
@@ -102,11 +106,31 @@ int obsd__parse_query(req *r, enum MHD_Result *rc)
     return 0;
 }
 
-/* Called on the GL worker thread: give the connection back to MHD. */
+/* Called on the GL worker thread: give the connection back to MHD;
+ * after the drain's cut, leave it, or free the request when its
+ * connection is gone already (nothing of the server is touched then: it
+ * may have stopped). */
 static void job_done(void *user)
 {
     req *r = user;
-    MHD_resume_connection(r->conn);
+    for (;;) {
+        int s = atomic_load(&r->job);
+        if (s == JOB_PENDING) {
+            /* Claimed, then resumed: once resumed, the request may be
+             * answered and freed at once, so nothing of it after. */
+            if (atomic_compare_exchange_strong(&r->job, &s, JOB_DONE)) {
+                MHD_resume_connection(r->conn);
+                return;
+            }
+        } else if (s == JOB_CUT) {
+            if (atomic_compare_exchange_strong(&r->job, &s, JOB_CUT_DONE))
+                return;
+        } else {
+            if (s == JOB_ORPHAN)
+                obsd__req_free(r);
+            return;
+        }
+    }
 }
 
 enum MHD_Result obsd__frame_start(req *r)
@@ -204,13 +228,26 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
                                   err);
     if (s != OBS_OK)
         return obsd__answer_status(r, s, err);
-    /* Suspend before queueing: the worker may finish and resume at once. */
+    /* The request is whole: its deadline stops (the GL worker's time is
+     * not the client's).  Suspend before queueing: the worker may finish
+     * and resume at once.  The job is pending only once the connection is
+     * suspended, and the drain's cut (obsd_http_cut: the connection's
+     * `cut` set, then the job looked at) is checked after: one of the two
+     * sees the other, so a cut connection is never left suspended. */
+    if (!obsd__req_hold(r))
+        return MHD_NO;
     r->state = REQ_QUEUED;
     MHD_suspend_connection(r->conn);
-    if ((atomic_load(&h->draining) && !r->before_drain) ||
+    atomic_store(&r->job, JOB_PENDING);
+    if ((r->cn && atomic_load(&r->cn->cut)) || (atomic_load(&h->draining) && !r->before_drain) ||
         obsd_fp_queue(&r->fp, h->queue, &r->hr.params, outputs, job_done, r) != 0) {
-        r->state = REQ_REFUSED;
-        MHD_resume_connection(r->conn);
+        int pending = JOB_PENDING;
+        if (atomic_compare_exchange_strong(&r->job, &pending, JOB_NONE)) {
+            r->state = REQ_REFUSED;
+            MHD_resume_connection(r->conn);
+        } else {
+            atomic_store(&r->job, JOB_CUT_DONE); /* the cut resumed it; no job runs */
+        }
     }
     return MHD_YES;
 }
@@ -234,6 +271,8 @@ static enum MHD_Result queue_body(req *r)
 
 enum MHD_Result obsd__frame_body(req *r, const char *data, size_t *size)
 {
+    if (!obsd__req_alive(r))
+        return MHD_NO;
     if (*size)
         return append_body(r, data, size);
     if (r->too_big) {

@@ -1,11 +1,13 @@
 /* Shared by the parts of obscurad's HTTP server.  Not a public header.
  * Calls go one way: http_server.c dispatches to http_frames.c,
  * http_streams.c, http_info.c and http_page.c; they all answer through
- * http_reply.c; http_streams.c also uses http_frames.c for its frames. */
+ * http_reply.c; http_streams.c also uses http_frames.c for its frames;
+ * http_conn.c (the connections' records) is below them all. */
 #ifndef OBSD_HTTP_INTERNAL_H
 #define OBSD_HTTP_INTERNAL_H
 
 #include <microhttpd.h>
+#include <pthread.h>
 #include <stdatomic.h>
 
 #include "frame_path.h"
@@ -14,6 +16,26 @@
 #include "obscura/io.h"
 #include "stats.h"
 #include "stream_store.h"
+
+/* Connections kept beyond --http-connections for /healthz and /readyz. */
+#define OBSD_HTTP_RESERVE 16
+
+/* Why a connection was shut down from outside its MHD thread. */
+enum { CUT_NONE, CUT_DEADLINE, CUT_EVICTED, CUT_DRAIN };
+
+/* One open connection (http_server.c keeps the list, under obsd_http's
+ * lock): its deadline, for the sweeper thread, and its request, for the
+ * drain's cut. */
+typedef struct obsd__conn {
+    struct obsd__conn *prev, *next;
+    struct MHD_Connection *mc;
+    int fd;
+    char peer[64];
+    double deadline;          /* obsd_now_ms() past which it is cut; 0: none */
+    struct obsd__req *r;      /* the request under way; NULL before its headers, or idle */
+    int reserve;              /* opened beyond --http-connections: probes only */
+    atomic_int cut;           /* CUT_*: shut down, MHD closes it next */
+} obsd__conn;
 
 struct obsd_http {
     struct MHD_Daemon *mhd;
@@ -27,10 +49,31 @@ struct obsd_http {
     atomic_int in_flight;
     atomic_int draining;
     atomic_uint_fast64_t next_id;
+    /* the open connections (oldest first), their count and the sweeper */
+    pthread_mutex_t lock;
+    obsd__conn *conns, *conns_tail;
+    int open, evicting;
+    pthread_t sweeper;
+    int sweeper_running;
+    atomic_int sweeper_stop;
+    int family; /* AF_INET or AF_INET6 */
+    char host[OBSD_STR_LEN]; /* as --http gave it, for the log */
+};
+
+/* A frame's trip to the GL worker, for the drain's cut (obsd_http_cut):
+ * the one that moves a request out of JOB_PENDING resumes it. */
+enum {
+    JOB_NONE,
+    JOB_PENDING,   /* queued, the connection suspended */
+    JOB_DONE,      /* claimed by the worker, which resumes the connection */
+    JOB_CUT,       /* resumed by the cut: the connection closes; the job runs on */
+    JOB_CUT_DONE,  /* the job ended after the cut */
+    JOB_ORPHAN     /* the connection is gone first: the worker frees the request */
 };
 
 typedef enum obsd__req_state {
     REQ_NEW,
+    REQ_DEFERRED, /* no body: answered on the next call, so that the connection can stay open */
     REQ_BODY,     /* reading the body of a frame (POST /v1/ao, a stream's frames) */
     REQ_QUEUED,   /* suspended; the GL worker has the job */
     REQ_REFUSED,  /* suspended and resumed at once: the queue was full */
@@ -51,6 +94,8 @@ typedef enum obsd__stream_op {
 typedef struct obsd__req {
     obsd_http *srv;
     struct MHD_Connection *conn;
+    obsd__conn *cn;      /* its connection's record */
+    atomic_int job;      /* JOB_* */
     uint64_t id;
     obsd_route route;
     obsd__req_state state;
@@ -86,7 +131,30 @@ typedef struct obsd__req {
     size_t bytes_out;
 } obsd__req;
 
+/* ---- http_conn.c: the open connections ---- */
+
+/* MHD_OPTION_NOTIFY_CONNECTION: a connection's record made, or freed. */
+void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_context,
+                       enum MHD_ConnectionNotificationCode toe);
+/* The thread that cuts connections past their deadline (until
+ * h->sweeper_stop). */
+void *obsd__conn_sweeper(void *arg);
+/* A request's first call: it is the connection's request now; 1 when
+ * the deadline passed already (the caller answers 408). */
+int obsd__conn_attach(obsd_http *h, obsd__conn *c, obsd__req *r, double now);
+/* The request ended: the connection's next one gets its deadline. */
+void obsd__conn_detach(obsd_http *h, obsd__conn *c);
+/* The request is whole (or answered): its deadline no longer runs.  0
+ * when the connection was cut already (the caller returns MHD_NO). */
+int obsd__req_hold(obsd__req *r);
+/* A call with more of the body: 0 when the connection was cut, or is
+ * now, past its deadline (the caller returns MHD_NO). */
+int obsd__req_alive(obsd__req *r);
+/* Frees a request (not its connection's record). */
+void obsd__req_free(obsd__req *r);
+
 /* ---- http_reply.c: answers, each logged and counted ---- */
+
 
 /* Queues `resp` (taking it) with status; logs and counts the request. */
 enum MHD_Result obsd__answer(obsd__req *r, int status, struct MHD_Response *resp, size_t body_len,

@@ -29,6 +29,14 @@ enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size
 {
     if (!resp)
         return MHD_NO;
+    if (!obsd__req_hold(r)) { /* cut (its deadline, the drain) while we worked */
+        MHD_destroy_response(resp);
+        return MHD_NO;
+    }
+    /* In the drain, and on a connection beyond --http-connections, the
+     * answer is the connection's last. */
+    if (atomic_load(&r->srv->draining) || (r->cn && r->cn->reserve))
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
     r->status = status;
     r->bytes_out = body_len;
     r->state = REQ_ANSWERED;

@@ -6,12 +6,14 @@
  *   http_streams.c  /v1/streams
  *   http_info.c     /v1/params, /v1/info, /healthz, /readyz, /metrics
  *   http_page.c     the preview page
- *   http_reply.c    the answers, logged and counted */
+ *   http_reply.c    the answers, logged and counted
+ *   http_conn.c     the open connections: deadlines, room at the limit, the cut */
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -20,18 +22,85 @@
 
 typedef obsd__req req;
 
-/* ---- dispatch -------------------------------------------------------- */
+/* ---- a request's first call: framing, route, checks, dispatch --------- */
 
-static void peer_name(struct MHD_Connection *c, char *buf, size_t len)
+typedef struct framing {
+    int n_length, n_coding, lengths_differ;
+    char length[32], coding[64];
+} framing;
+
+static enum MHD_Result on_header(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
 {
-    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(c, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
-    snprintf(buf, len, "?");
-    if (ci && ci->client_addr && ci->client_addr->sa_family == AF_INET) {
-        const struct sockaddr_in *in = (const struct sockaddr_in *)(const void *)ci->client_addr;
-        char ip[INET_ADDRSTRLEN];
-        if (inet_ntop(AF_INET, &in->sin_addr, ip, sizeof ip))
-            snprintf(buf, len, "%s:%u", ip, ntohs(in->sin_port));
+    framing *f = cls;
+    (void)kind;
+    if (!key)
+        return MHD_YES;
+    if (!value)
+        value = "";
+    if (!strcasecmp(key, MHD_HTTP_HEADER_CONTENT_LENGTH)) {
+        if (f->n_length++ && strcmp(f->length, value) != 0)
+            f->lengths_differ = 1;
+        snprintf(f->length, sizeof f->length, "%s", value);
+    } else if (!strcasecmp(key, MHD_HTTP_HEADER_TRANSFER_ENCODING)) {
+        f->n_coding++;
+        snprintf(f->coding, sizeof f->coding, "%s", value);
     }
+    return MHD_YES;
+}
+
+/* Headers that make the body's length ambiguous (a request smuggled
+ * past a proxy that reads them the other way) or unknown: 400 before any
+ * of the body is read.  *has_body: the request announces one. */
+static int framing_ok(req *r, int *has_body, enum MHD_Result *rc)
+{
+    framing f = {0};
+    char msg[160];
+    MHD_get_connection_values(r->conn, MHD_HEADER_KIND, on_header, &f);
+    *has_body = f.n_coding > 0 || (f.n_length > 0 && strcmp(f.length, "0") != 0);
+    if (f.n_length && f.n_coding)
+        snprintf(msg, sizeof msg, "both Content-Length and Transfer-Encoding: the body's length is ambiguous");
+    else if (f.lengths_differ)
+        snprintf(msg, sizeof msg, "two different Content-Length headers");
+    else if (f.n_coding > 1 || (f.n_coding && strcasecmp(f.coding, "chunked") != 0))
+        snprintf(msg, sizeof msg, "Transfer-Encoding '%.60s' is not supported (chunked only)", f.coding);
+    else
+        return 1;
+    *rc = obsd__answer_error(r, 400, "bad_request", msg, NULL, NULL);
+    return 0;
+}
+
+static enum MHD_Result dispatch(req *r, const char *url, const char *method)
+{
+    obsd_http *h = r->srv;
+    if (r->cn && r->cn->reserve && r->route != OBSD_ROUTE_HEALTHZ && r->route != OBSD_ROUTE_READYZ) {
+        char msg[128];
+        snprintf(msg, sizeof msg, "%d connections are open (--http-connections); retry later",
+                 h->cfg->http_connections);
+        return obsd__answer_error(r, 503, "too_many_connections", msg, MHD_HTTP_HEADER_RETRY_AFTER, "1");
+    }
+    if (r->route == OBSD_ROUTE_PAGE) /* the page is static: no token */
+        return obsd__page(r, url);
+    if (r->route == OBSD_ROUTE_OTHER)
+        return obsd__answer_error(r, 404, "not_found", "no such route (try GET /v1/params)", NULL, NULL);
+    const char *allowed = r->route == OBSD_ROUTE_AO ? "POST" : "GET";
+    if (r->route != OBSD_ROUTE_STREAMS && strcmp(method, allowed) != 0 &&
+        !(r->route != OBSD_ROUTE_AO && !strcmp(method, "HEAD"))) {
+        char msg[64];
+        snprintf(msg, sizeof msg, "%s takes %s", obsd_route_path(r->route), allowed);
+        return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, allowed);
+    }
+    /* Probes stay open; the API and the metrics need the token. */
+    if (h->token && r->route != OBSD_ROUTE_HEALTHZ && r->route != OBSD_ROUTE_READYZ &&
+        !obs_http_bearer_ok(MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND,
+                                                        MHD_HTTP_HEADER_AUTHORIZATION),
+                            h->token))
+        return obsd__answer_error(r, 401, "unauthorized", "missing or wrong bearer token",
+                                  MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"obscurad\"");
+    if (r->route == OBSD_ROUTE_STREAMS)
+        return obsd__streams_start(r, url);
+    if (r->route != OBSD_ROUTE_AO)
+        return obsd__info_route(r);
+    return obsd__frame_start(r);
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const char *url,
@@ -42,48 +111,58 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
     req *r = *con_cls;
     (void)version;
     if (!r) {
+        const union MHD_ConnectionInfo *si = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+        obsd__conn *c = si ? si->socket_context : NULL;
+        if (c && atomic_load(&c->cut))
+            return MHD_NO;
         if (!(r = calloc(1, sizeof *r)))
             return MHD_NO;
         *con_cls = r;
         atomic_fetch_add(&h->in_flight, 1);
         obsd_fp_init(&r->fp);
+        atomic_init(&r->job, JOB_NONE);
         r->srv = h;
         r->conn = conn;
+        r->cn = c;
         r->id = atomic_fetch_add(&h->next_id, 1) + 1;
         r->t0 = obsd_now_ms();
         r->route = obsd_route_of(url);
         snprintf(r->method, sizeof r->method, "%s", method);
         snprintf(r->path, sizeof r->path, "%s", url);
-        for (char *c = r->path; *c; c++)
-            if ((unsigned char)*c < 0x21 || (unsigned char)*c > 0x7e)
-                *c = '?';
-        peer_name(conn, r->peer, sizeof r->peer);
-
-        if (r->route == OBSD_ROUTE_PAGE) /* the page is static: no token */
-            return obsd__page(r, url);
-        if (r->route == OBSD_ROUTE_OTHER)
-            return obsd__answer_error(r, 404, "not_found", "no such route (try GET /v1/params)", NULL, NULL);
-        const char *allowed = r->route == OBSD_ROUTE_AO ? "POST" : "GET";
-        if (r->route != OBSD_ROUTE_STREAMS && strcmp(method, allowed) != 0 &&
-            !(r->route != OBSD_ROUTE_AO && !strcmp(method, "HEAD"))) {
-            char msg[64];
-            snprintf(msg, sizeof msg, "%s takes %s", obsd_route_path(r->route), allowed);
-            return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, allowed);
+        for (char *p = r->path; *p; p++)
+            if ((unsigned char)*p < 0x21 || (unsigned char)*p > 0x7e)
+                *p = '?';
+        snprintf(r->peer, sizeof r->peer, "%s", c ? c->peer : "?");
+        if (c && obsd__conn_attach(h, c, r, r->t0)) { /* its headers came too late */
+            char msg[128];
+            snprintf(msg, sizeof msg, "the request took over %d s (--request-timeout) to send its headers",
+                     h->cfg->request_timeout);
+            return obsd__answer_error(r, 408, "request_timeout", msg, NULL, NULL);
         }
-        /* Probes stay open; the API and the metrics need the token. */
-        if (h->token && r->route != OBSD_ROUTE_HEALTHZ && r->route != OBSD_ROUTE_READYZ &&
-            !obs_http_bearer_ok(MHD_lookup_connection_value(conn, MHD_HEADER_KIND,
-                                                            MHD_HTTP_HEADER_AUTHORIZATION),
-                                h->token))
-            return obsd__answer_error(r, 401, "unauthorized", "missing or wrong bearer token",
-                                MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"obscurad\"");
-        if (r->route == OBSD_ROUTE_STREAMS)
-            return obsd__streams_start(r, url);
-        if (r->route != OBSD_ROUTE_AO)
-            return obsd__info_route(r);
-        return obsd__frame_start(r);
+        int has_body;
+        enum MHD_Result rc;
+        if (!framing_ok(r, &has_body, &rc))
+            return rc;
+        /* A frame reads its body; anything else without one is answered
+         * on the next call, once MHD holds the whole request, so that the
+         * connection stays open for the next (an answer queued now closes
+         * it).  With a body it is answered now, and the body never read. */
+        int frame = r->route == OBSD_ROUTE_AO || (r->route == OBSD_ROUTE_STREAMS && !strcmp(method, "POST"));
+        if (frame || has_body)
+            return dispatch(r, url, method);
+        r->state = REQ_DEFERRED;
+        return MHD_YES;
     }
+    int job = atomic_load(&r->job);
+    if (job == JOB_CUT || job == JOB_CUT_DONE)
+        return MHD_NO; /* resumed by the cut: the connection closes */
     switch (r->state) {
+    case REQ_DEFERRED:
+        if (*upload_data_size) {
+            *upload_data_size = 0;
+            return MHD_YES;
+        }
+        return dispatch(r, url, method);
     case REQ_BODY:
         return obsd__frame_body(r, upload_data, upload_data_size);
     case REQ_QUEUED:
@@ -106,15 +185,21 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
     (void)conn;
     if (!r)
         return;
-    if (why != MHD_REQUEST_TERMINATED_COMPLETED_OK && r->state != REQ_ANSWERED)
-        obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s ended without an answer (reason %d)",
-                 (unsigned long long)r->id, r->peer, r->method, obsd_route_path(r->route), (int)why);
+    obsd__conn *c = r->cn;
+    int cut = c ? atomic_load(&c->cut) : CUT_NONE;
+    if (why != MHD_REQUEST_TERMINATED_COMPLETED_OK && r->state != REQ_ANSWERED && cut != CUT_DEADLINE)
+        obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s ended without an answer (reason %d%s)",
+                 (unsigned long long)r->id, r->peer, r->method, obsd_route_path(r->route), (int)why,
+                 cut == CUT_DRAIN ? ", cut by the drain" : cut == CUT_EVICTED ? ", evicted" : "");
+    if (c)
+        obsd__conn_detach(h, c);
     obsd__streams_done(r);
-    free(r->body);
-    obsd_fp_free(&r->fp);
-    free(r);
     *con_cls = NULL;
     atomic_fetch_sub(&h->in_flight, 1);
+    /* cut while the GL worker had its frame: the worker frees it */
+    int s = JOB_CUT;
+    if (!atomic_compare_exchange_strong(&r->job, &s, JOB_ORPHAN))
+        obsd__req_free(r);
 }
 
 static void on_mhd_log(void *cls, const char *fmt, va_list ap)
@@ -128,34 +213,55 @@ static void on_mhd_log(void *cls, const char *fmt, va_list ap)
     obsd_log(OBSD_LOG_DEBUG, "microhttpd: %s", msg);
 }
 
-/* "HOST:PORT" (IPv4) into addr. */
-static int parse_addr(const char *s, struct sockaddr_in *addr, char err[OBS_ERR_LEN])
+/* "HOST:PORT" (IPv4, the host may be empty: any) or "[HOST]:PORT"
+ * (IPv6) into addr; host gets the host as written, for the log. */
+static int parse_addr(const char *s, struct sockaddr_storage *addr, socklen_t *alen, char *host, size_t hlen,
+                      char err[OBS_ERR_LEN])
 {
     const char *colon = strrchr(s, ':');
-    char host[64];
-    if (!colon || (size_t)(colon - s) >= sizeof host) {
-        snprintf(err, OBS_ERR_LEN, "--http '%s' is not HOST:PORT", s);
+    char name[OBSD_STR_LEN];
+    int v6 = s[0] == '[';
+    if (!colon || (v6 && (colon == s || colon[-1] != ']')) || (size_t)(colon - s) >= sizeof name ||
+        (size_t)(colon - s) >= hlen) {
+        snprintf(err, OBS_ERR_LEN, "--http '%s' is not HOST:PORT or [IPV6]:PORT", s);
         return -1;
     }
-    snprintf(host, sizeof host, "%.*s", (int)(colon - s), s);
+    snprintf(host, hlen, "%.*s", (int)(colon - s), s);
+    if (v6)
+        snprintf(name, sizeof name, "%.*s", (int)(colon - s) - 2, s + 1);
+    else
+        snprintf(name, sizeof name, "%s", host[0] ? host : "0.0.0.0");
     char *end;
     long port = strtol(colon + 1, &end, 10);
+    int ok = colon[1] && !*end && port >= 0 && port <= 65535;
     memset(addr, 0, sizeof *addr);
-    addr->sin_family = AF_INET;
-    if (!colon[1] || *end || port < 0 || port > 65535 ||
-        inet_pton(AF_INET, host[0] ? host : "0.0.0.0", &addr->sin_addr) != 1) {
-        snprintf(err, OBS_ERR_LEN, "--http '%s' is not IPv4-HOST:PORT with a port in 0..65535", s);
+    if (v6) {
+        struct sockaddr_in6 *a = (struct sockaddr_in6 *)addr;
+        a->sin6_family = AF_INET6;
+        a->sin6_port = htons((uint16_t)port);
+        ok = ok && inet_pton(AF_INET6, name, &a->sin6_addr) == 1;
+        *alen = sizeof *a;
+    } else {
+        struct sockaddr_in *a = (struct sockaddr_in *)addr;
+        a->sin_family = AF_INET;
+        a->sin_port = htons((uint16_t)port);
+        ok = ok && inet_pton(AF_INET, name, &a->sin_addr) == 1;
+        *alen = sizeof *a;
+    }
+    if (!ok) {
+        snprintf(err, OBS_ERR_LEN, "--http '%s' is not IPV4:PORT or [IPV6]:PORT with a port in 0..65535", s);
         return -1;
     }
-    addr->sin_port = htons((uint16_t)port);
     return 0;
 }
 
 obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue *q,
                            obsd_gl_worker *gl, obsd_http **out, char err[OBS_ERR_LEN])
 {
-    struct sockaddr_in addr;
-    if (parse_addr(cfg->http, &addr, err) != 0)
+    struct sockaddr_storage addr;
+    socklen_t alen;
+    char host[OBSD_STR_LEN];
+    if (parse_addr(cfg->http, &addr, &alen, host, sizeof host, err) != 0)
         return OBS_INVALID_ARGUMENT;
     obsd_http *h = calloc(1, sizeof *h);
     if (!h)
@@ -165,6 +271,8 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
     h->queue = q;
     h->gl = gl;
     h->listen_fd = MHD_INVALID_SOCKET;
+    h->family = addr.ss_family;
+    snprintf(h->host, sizeof h->host, "%s", host);
     if (!(h->streams = obsd_streams_new(cfg->streams, cfg->stream_frames, cfg->stream_memory))) {
         free(h);
         return OBS_NO_MEMORY;
@@ -172,36 +280,67 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
     atomic_init(&h->in_flight, 0);
     atomic_init(&h->draining, 0);
     atomic_init(&h->next_id, 0);
+    atomic_init(&h->sweeper_stop, 0);
+    pthread_mutex_init(&h->lock, NULL);
     unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL | MHD_USE_ITC |
                      MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG;
+    if (h->family == AF_INET6)
+        flags |= MHD_USE_IPv6;
+    /* MHD refuses beyond its limit before anything of ours runs: the
+     * reserve above --http-connections is where on_connection makes room
+     * or lets a probe in. */
     h->mhd = MHD_start_daemon(flags, 0, NULL, NULL, on_request, h,
                               MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
                               MHD_OPTION_THREAD_POOL_SIZE, (unsigned)cfg->threads,
                               MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg->timeout,
+                              MHD_OPTION_CONNECTION_LIMIT, (unsigned)(cfg->http_connections + OBSD_HTTP_RESERVE),
+                              MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg->max_per_client,
+                              MHD_OPTION_NOTIFY_CONNECTION, obsd__conn_notify, h,
                               MHD_OPTION_NOTIFY_COMPLETED, on_completed, h,
                               MHD_OPTION_EXTERNAL_LOGGER, on_mhd_log, h,
                               MHD_OPTION_END);
+    (void)alen;
     if (!h->mhd) {
         snprintf(err, OBS_ERR_LEN, "cannot listen on %s (in use, or not an address of this host?)",
                  cfg->http);
-        obsd_streams_free(h->streams);
-        free(h);
-        return OBS_IO;
+        goto fail;
     }
+    if (pthread_create(&h->sweeper, NULL, obsd__conn_sweeper, h) != 0) {
+        snprintf(err, OBS_ERR_LEN, "cannot start the HTTP deadline thread");
+        MHD_stop_daemon(h->mhd);
+        goto fail;
+    }
+    h->sweeper_running = 1;
     const union MHD_DaemonInfo *di = MHD_get_daemon_info(h->mhd, MHD_DAEMON_INFO_BIND_PORT);
-    h->port = di ? di->port : ntohs(addr.sin_port);
+    h->port = di ? di->port : 0;
     *out = h;
     return OBS_OK;
+fail:
+    pthread_mutex_destroy(&h->lock);
+    obsd_streams_free(h->streams);
+    free(h);
+    return OBS_IO;
 }
 
 int obsd_http_port(const obsd_http *h) { return h->port; }
+
+void obsd_http_url(const obsd_http *h, char *buf, size_t len)
+{
+    snprintf(buf, len, "http://%s:%d", h->host, h->port);
+}
 
 void obsd_http_quiesce(obsd_http *h)
 {
     atomic_store(&h->draining, 1);
     obsd_streams_end_all(h->streams); /* event streams end, so that the drain ends */
-    if (h->listen_fd == MHD_INVALID_SOCKET)
+    if (h->listen_fd == MHD_INVALID_SOCKET) {
         h->listen_fd = MHD_quiesce_daemon(h->mhd);
+        /* MHD no longer accepts, but the kernel still would, into a
+         * backlog nobody reads: stop listening, so that a client is
+         * refused at once (the socket is closed after the stop). */
+        if (h->listen_fd != MHD_INVALID_SOCKET)
+            shutdown(h->listen_fd, SHUT_RDWR);
+    }
 }
 
 int obsd_http_in_flight(obsd_http *h) { return atomic_load(&h->in_flight); }
@@ -216,10 +355,19 @@ void obsd_http_stop(obsd_http *h)
 {
     if (!h)
         return;
+    if (h->sweeper_running) {
+        atomic_store(&h->sweeper_stop, 1);
+        pthread_join(h->sweeper, NULL);
+    }
+    /* Whatever the clients do: every connection is shut, and every one
+     * suspended for the GL worker resumed (MHD must hold none suspended
+     * when it stops). */
+    obsd_http_cut(h);
     MHD_stop_daemon(h->mhd);
     /* MHD hands the quiesced socket to us, to close after the stop. */
     if (h->listen_fd != MHD_INVALID_SOCKET)
         close(h->listen_fd);
     obsd_streams_free(h->streams);
+    pthread_mutex_destroy(&h->lock);
     free(h);
 }

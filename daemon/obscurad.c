@@ -167,13 +167,10 @@ int main(int argc, char **argv)
         obsd_log(OBSD_LOG_INFO, "binary protocol on tcp://%s:%d", host, obsd_bin_tcp_port(bin));
     }
     if (http) {
-        char host[OBSD_STR_LEN];
-        snprintf(host, sizeof host, "%s", cfg.http);
-        char *colon = strrchr(host, ':');
-        if (colon)
-            *colon = '\0';
-        obsd_log(OBSD_LOG_INFO, "listening on http://%s:%d (queue %d, %d threads, max %lld pixels, "
-                 "max body %lld bytes%s)", host, obsd_http_port(http), cfg.queue, cfg.threads,
+        char url[OBSD_STR_LEN + 16];
+        obsd_http_url(http, url, sizeof url);
+        obsd_log(OBSD_LOG_INFO, "listening on %s (queue %d, %d threads, max %lld pixels, "
+                 "max body %lld bytes%s)", url, cfg.queue, cfg.threads,
                  (long long)cfg.max_pixels, (long long)cfg.max_body, token[0] ? ", token required" : "");
     }
 

@@ -231,6 +231,24 @@ obs_status obs_http_request_set(obs_http_request *r, const char *name, const cha
     return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown parameter '%.100s' (GET /v1/params lists them)", name);
 }
 
+obs_status obs_http_value_check(const char *name, size_t name_len, const char *value, size_t len,
+                                char err[OBS_ERR_LEN])
+{
+    if (name && memchr(name, '\0', name_len))
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter '%.100s': its name holds a NUL byte (%%00)", name);
+    if (value && memchr(value, '\0', len))
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %.100s: its value holds a NUL byte (%%00)",
+                         name ? name : "?");
+    return OBS_OK;
+}
+
+obs_status obs_http_request_set_n(obs_http_request *r, const char *name, size_t name_len, const char *value,
+                                  size_t len, char err[OBS_ERR_LEN])
+{
+    obs_status s = obs_http_value_check(name, name_len, value, len, err);
+    return s != OBS_OK ? s : obs_http_request_set(r, name, value, err);
+}
+
 obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LEN])
 {
     if (r->format == OBS_HTTP_PNG && r->outputs == (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE))
@@ -264,20 +282,75 @@ int obs_http_status_of(obs_status s, const char **code)
     return http;
 }
 
+/* The length of the UTF-8 sequence at s (n bytes left), or 0 when it is
+ * not one (overlong, a surrogate, past U+10FFFF, cut short). */
+static size_t utf8_len(const unsigned char *s, size_t n)
+{
+    unsigned c = s[0];
+    size_t k;
+    unsigned min, cp;
+    if (c < 0x80)
+        return 1;
+    if (c >= 0xc2 && c <= 0xdf)
+        k = 2, min = 0x80, cp = c & 0x1f;
+    else if (c >= 0xe0 && c <= 0xef)
+        k = 3, min = 0x800, cp = c & 0x0f;
+    else if (c >= 0xf0 && c <= 0xf4)
+        k = 4, min = 0x10000, cp = c & 0x07;
+    else
+        return 0;
+    if (n < k)
+        return 0;
+    for (size_t i = 1; i < k; i++) {
+        if ((s[i] & 0xc0) != 0x80)
+            return 0;
+        cp = cp << 6 | (s[i] & 0x3f);
+    }
+    if (cp < min || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff))
+        return 0;
+    return k;
+}
+
+/* A copy of s in which every byte that is not UTF-8 is U+FFFD. */
+static char *utf8_clean(const char *s)
+{
+    size_t n = strlen(s);
+    char *out = malloc(n * 3 + 1), *o = out;
+    if (!out)
+        return NULL;
+    for (size_t i = 0; i < n;) {
+        size_t k = utf8_len((const unsigned char *)s + i, n - i);
+        if (k) {
+            memcpy(o, s + i, k);
+            o += k;
+            i += k;
+        } else {
+            memcpy(o, "\xef\xbf\xbd", 3);
+            o += 3;
+            i++;
+        }
+    }
+    *o = '\0';
+    return out;
+}
+
 char *obs_http_error_json(const char *code, const char *message)
 {
     cJSON *root = cJSON_CreateObject(), *e = cJSON_CreateObject();
-    char *out = NULL;
-    if (!root || !e) {
+    char *out = NULL, *c = utf8_clean(code ? code : "error"), *m = utf8_clean(message ? message : "");
+    if (!root || !e || !c || !m) {
         cJSON_Delete(root);
         cJSON_Delete(e);
+        free(c);
+        free(m);
         return NULL;
     }
     cJSON_AddItemToObject(root, "error", e);
-    if (cJSON_AddStringToObject(e, "code", code ? code : "error") &&
-        cJSON_AddStringToObject(e, "message", message ? message : ""))
+    if (cJSON_AddStringToObject(e, "code", c) && cJSON_AddStringToObject(e, "message", m))
         out = cJSON_PrintUnformatted(root);
     cJSON_Delete(root);
+    free(c);
+    free(m);
     return out;
 }
 

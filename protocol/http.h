@@ -45,6 +45,18 @@ void obs_http_request_init(obs_http_request *r);
 obs_status obs_http_request_set(obs_http_request *r, const char *name, const char *value,
                                 char err[OBS_ERR_LEN]);
 
+/* A query parameter as the wire holds it, `len` bytes of value: a NUL
+ * inside the name or the value (%00) is refused, naming the parameter
+ * (the C string would end there and the rest be dropped unseen); then
+ * obs_http_request_set(). */
+obs_status obs_http_request_set_n(obs_http_request *r, const char *name, size_t name_len, const char *value,
+                                  size_t len, char err[OBS_ERR_LEN]);
+
+/* OBS_OK when `name` (name_len bytes) and `value` (len bytes) hold no NUL;
+ * else OBS_INVALID_ARGUMENT and a message naming the parameter. */
+obs_status obs_http_value_check(const char *name, size_t name_len, const char *value, size_t len,
+                                char err[OBS_ERR_LEN]);
+
 /* Checks the combination once every parameter is set (PNG holds one
  * image, so format=png with output=both is refused). */
 obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LEN]);
@@ -108,8 +120,10 @@ obs_status obs_http_option_set(obs_http_request *r, const obs_http_option *op, c
  * body ("bad_parameter", "missing_channel", ...; static). */
 int obs_http_status_of(obs_status s, const char **code);
 
-/* {"error": {"code": CODE, "message": MESSAGE}}.  Caller frees with
- * free(); NULL when out of memory. */
+/* {"error": {"code": CODE, "message": MESSAGE}}, valid UTF-8 whatever
+ * the message echoes (a byte that is not UTF-8 becomes U+FFFD; control
+ * characters are escaped).  Caller frees with free(); NULL when out of
+ * memory. */
 char *obs_http_error_json(const char *code, const char *message);
 
 /* The parameter table and the request options as JSON:

@@ -251,6 +251,41 @@ static void test_bearer(void **state)
     assert_false(obs_http_bearer_ok("Bearer ", ""));
 }
 
+/* %00 in a query value or name: refused, naming the parameter; the rest
+ * of the value is not read as a shorter one. */
+static void test_nul(void **state)
+{
+    (void)state;
+    obs_http_request r;
+    char err[OBS_ERR_LEN] = "";
+    obs_http_request_init(&r);
+    assert_int_equal(obs_http_request_set_n(&r, "radius", 6, "0.5\0x", 5, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "radius"));
+    assert_non_null(strstr(err, "NUL"));
+    assert_int_equal(obs_http_request_set_n(&r, "depth", 5, "Z\0junk", 6, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "depth"));
+    assert_null(r.map.depth); /* nothing set */
+    assert_int_equal(obs_http_request_set_n(&r, "dep\0th", 6, "Z", 1, err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_http_request_set_n(&r, "depth", 5, "Z", 1, err), OBS_OK);
+    assert_string_equal(r.map.depth, "Z");
+    assert_int_equal(obs_http_value_check("float", 5, NULL, 0, err), OBS_OK);
+}
+
+/* Every byte of an error's JSON is UTF-8, whatever the message echoes. */
+static void test_json_utf8(void **state)
+{
+    (void)state;
+    char *e = obs_http_error_json("bad_parameter", "unknown parameter '\xff\xfe\xc3(\xed\xa0\x80\xf0\x9f\x98\x80'");
+    assert_non_null(e);
+    /* ff, fe, a lone c3, a surrogate (3 bytes): U+FFFD each; the emoji kept */
+    assert_non_null(strstr(e, "'\xef\xbf\xbd\xef\xbf\xbd\xef\xbf\xbd(\xef\xbf\xbd\xef\xbf\xbd\xef\xbf\xbd"
+                              "\xf0\x9f\x98\x80'"));
+    free(e);
+    e = obs_http_error_json("x", "caf\xc3\xa9\nline");
+    assert_non_null(strstr(e, "caf\xc3\xa9\\nline")); /* valid UTF-8 kept; the newline escaped */
+    free(e);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -258,7 +293,8 @@ int main(void)
         cmocka_unit_test(test_bad_params), cmocka_unit_test(test_options),
         cmocka_unit_test(test_status_map), cmocka_unit_test(test_json),
         cmocka_unit_test(test_bearer),     cmocka_unit_test(test_option_table),
-        cmocka_unit_test(test_option_from),
+        cmocka_unit_test(test_option_from), cmocka_unit_test(test_nul),
+        cmocka_unit_test(test_json_utf8),
     };
     return cmocka_run_group_tests_name("protocol_http", tests, NULL, NULL);
 }
