@@ -64,6 +64,10 @@
     X(stream_memory, SIZE, 1048576, 17179869184, "256m",                       \
       "memory a stream's frames may hold (input EXR, AO, composite, colour); " \
       "the oldest are dropped beyond it, the newest is always kept")          \
+    X(drain_timeout, INT, 0, 86400, "30",                                      \
+      "seconds the drain after SIGTERM may wait for the requests and "         \
+      "connections under way; then they are cut, logged, and the daemon "    \
+      "exits 0 (0: wait for them)")                                            \
     X(max_cost, SIZE, 0, 1099511627776, "768m",                                \
       "largest work one frame may ask for, in samples: width x height x "      \
       "the method's samples per pixel (x nodes^2 for deep input); 422 "        \

@@ -180,16 +180,28 @@ int main(int argc, char **argv)
     }
 
     /* Drain: no new connections; every frame taken is finished and
-     * answered before the server stops. */
+     * answered before the server stops, within --drain-timeout: past it
+     * what is left is cut (logged), so the drain ends whatever the
+     * clients do. */
     obsd_log(OBSD_LOG_INFO, "stopping: finishing %d request(s) and %d binary connection(s) under way "
              "(SIGINT again to quit now)", http ? obsd_http_in_flight(http) : 0, obsd_bin_in_flight(bin));
     if (http)
         obsd_http_quiesce(http);
     obsd_bin_quiesce(bin);
+    const double drain_end = obsd_now_ms() + 1000.0 * cfg.drain_timeout;
     while ((http && obsd_http_in_flight(http) > 0) || obsd_bin_in_flight(bin) > 0) {
         if (interrupts >= 2) {
             obsd_log(OBSD_LOG_WARN, "second SIGINT: exiting now");
             _exit(130);
+        }
+        if (cfg.drain_timeout > 0 && obsd_now_ms() >= drain_end) {
+            int requests = http ? obsd_http_in_flight(http) : 0, conns = obsd_bin_in_flight(bin);
+            obsd_log(OBSD_LOG_WARN, "drain deadline (%d s) passed: cutting %d request(s) and %d "
+                     "binary connection(s)", cfg.drain_timeout, requests, conns);
+            if (http)
+                obsd_http_cut(http);
+            obsd_bin_cut(bin);
+            break;
         }
         sleep_ms(20);
     }
