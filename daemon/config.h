@@ -75,8 +75,9 @@
       "default chain at the largest accepted frame, max_pixels x 16)")         \
     X(keep_memory, SIZE, 0, 1099511627776, "512m",                             \
       "texture memory the GL worker keeps for the next frame of the same "     \
-      "size; above it, and whenever the queue runs empty, it is released, "   \
-      "and freed heap memory is returned to the system (malloc_trim)")         \
+      "size; above it, whenever the queue runs empty, it is released, and "   \
+      "freed heap memory is returned to the system (malloc_trim, at most "     \
+      "once a second)")                                                        \
     X(backend, ENUM, 0, 0, "auto",                                             \
       "GL backend: auto|egl-device|egl-surfaceless|osmesa (default: "          \
       "OBSCURA_BACKEND, else auto)")                                           \

@@ -59,11 +59,15 @@ static int too_costly(const obsd_gl_worker *w, obsd_job *job)
 {
     if (!w->max_cost)
         return 0;
-    obs_params p;
-    obs_params_resolve(job->params, &p);
     int width = job->deep ? job->deep->width : job->gb->width;
     int height = job->deep ? job->deep->height : job->gb->height;
-    unsigned long long cost = obs_frame_cost(&p, width, height, job->deep ? p.deep_layers : 0);
+    int layers = 0;
+    if (job->deep) {
+        obs_params p;
+        obs_params_resolve(job->params, &p);
+        layers = p.deep_layers;
+    }
+    unsigned long long cost = obs_frame_cost(job->params, width, height, layers);
     if (cost <= w->max_cost)
         return 0;
     job->status = OBS_TOO_COSTLY;
@@ -75,9 +79,14 @@ static int too_costly(const obsd_gl_worker *w, obsd_job *job)
     return 1;
 }
 
+/* Freed heap goes back to the system at most this often: malloc_trim
+ * walks the whole heap, too much for every frame of a client that sends
+ * them one after another (the queue runs empty between them). */
+#define TRIM_INTERVAL_MS 1000.0
+
 /* When the queue has run empty: the kept targets over --keep-memory are
  * released, and freed heap returned to the system. */
-static void idle(obsd_gl_worker *w, obs_ctx *ctx)
+static void idle(obsd_gl_worker *w, obs_ctx *ctx, double *last_trim)
 {
     int waiting, running, full;
     obsd_queue_stats(w->queue, &waiting, &running, &full);
@@ -86,7 +95,11 @@ static void idle(obsd_gl_worker *w, obs_ctx *ctx)
     char err[OBS_ERR_LEN] = "";
     if (ctx && obs_ctx_trim(ctx, w->keep_memory, err) != OBS_OK)
         obsd_log(OBSD_LOG_WARN, "releasing frame targets: %s", err);
-    malloc_trim(0);
+    double now = obsd_now_ms();
+    if (now - *last_trim >= TRIM_INTERVAL_MS) {
+        malloc_trim(0);
+        *last_trim = now;
+    }
     atomic_store(&w->kept_bytes, ctx ? obs_ctx_kept_bytes(ctx) : 0);
 }
 
@@ -120,6 +133,7 @@ static void *worker_main(void *arg)
 
     obsd_job *job;
     long frame = 0;
+    double last_trim = 0.0;
     while ((job = obsd_queue_pop(w->queue)) != NULL) {
         frame++;
         job->t_started = obsd_now_ms();
@@ -148,7 +162,7 @@ static void *worker_main(void *arg)
         job->done(job, job->user); /* the job is not ours after this */
         if (ctx && (st == OBS_GL_ERROR || st == OBS_GL_UNAVAILABLE))
             ctx = recreate(w, ctx, st, msg);
-        idle(w, ctx);
+        idle(w, ctx, &last_trim);
     }
     atomic_store(&w->alive, 0);
     if (ctx)
