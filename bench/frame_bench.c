@@ -92,6 +92,37 @@ static void bench(obs_ctx *ctx, const char *name, const obs_gbuffer *gb, int fra
     fflush(stdout);
 }
 
+/* The cost of a deadline (obs_ctx_set_deadline): the AO pass in 16
+ * scissored bands, each waited for, against one draw.  Frames alternate
+ * between the two, so that the machine's drift hits both alike. */
+static void bench_bands(obs_ctx *ctx, const char *name, const obs_gbuffer *gb, int frames,
+                        char *line, size_t len)
+{
+    double t[2][64];
+    char err[OBS_ERR_LEN];
+    obs_params p = {0};
+    p.samples = 16;
+    if (frames > 64)
+        frames = 64;
+    for (int i = 0; i < frames; i++)
+        for (int banded = 0; banded < 2; banded++) {
+            obs_result r;
+            obs_ctx_set_deadline(ctx, banded ? 3600.0 : 0.0, err);
+            double t0 = now_ms();
+            if (obs_run(ctx, gb, &p, OBS_OUTPUT_AO, &r, err) != OBS_OK) {
+                fprintf(stderr, "frame_bench: %s\n", err);
+                exit(1);
+            }
+            t[banded][i] = now_ms() - t0;
+            obs_result_free(&r);
+        }
+    obs_ctx_set_deadline(ctx, 0.0, err);
+    qsort(t[0], (size_t)frames, sizeof t[0][0], cmp);
+    qsort(t[1], (size_t)frames, sizeof t[1][0], cmp);
+    snprintf(line, len, "| %s | %dx%d | %.1f | %.1f | %.3f |\n", name, gb->width, gb->height,
+             t[0][frames / 2], t[1][frames / 2], t[1][frames / 2] / t[0][frames / 2]);
+}
+
 int main(int argc, char **argv)
 {
     obs_ctx_desc desc = {0};
@@ -122,6 +153,8 @@ int main(int argc, char **argv)
            obs_backend_name(info.backend), info.gl_version, info.gl_renderer, t_ctx, frames);
     printf("| G-buffer | size | first frame ms (16 samples, compiles shaders) | 8 samples ms | 16 samples ms | "
            "32 samples ms | CPU twin 16 samples ms (x GL) |\n|---|---|---|---|---|---|---|\n");
+    char bands[8][512]; /* the deadline's cost, printed after the table */
+    int nbands = 0;
     for (; i + 1 < argc; i += 2) {
         obs_gbuffer_file gf = {0};
         if (obs_gbuffer_read_exr(argv[i], NULL, NULL, &gf, err) != OBS_OK ||
@@ -148,11 +181,17 @@ int main(int argc, char **argv)
         char name[256];
         snprintf(name, sizeof name, "%s upscaled", base);
         bench(ctx, name, &big, frames, 0);
+        if (nbands < 8)
+            bench_bands(ctx, name, &big, frames, bands[nbands++], sizeof bands[0]);
         free(d);
         free(n);
         free(c);
         obs_gbuffer_free(&gf);
     }
+    printf("\n| G-buffer (16 samples) | size | frame ms, AO pass in one draw | AO pass in 16 "
+           "bands (a deadline set) ms | ratio |\n|---|---|---|---|---|\n");
+    for (int b = 0; b < nbands; b++)
+        fputs(bands[b], stdout);
     obs_ctx_destroy(ctx);
     return 0;
 }

@@ -84,6 +84,16 @@ obs_status obs_ctx_set_timing(obs_ctx *ctx, int on, char err[OBS_ERR_LEN])
     return obs__gl_check("creating timer queries", err);
 }
 
+obs_status obs_ctx_set_deadline(obs_ctx *ctx, double seconds, char err[OBS_ERR_LEN])
+{
+    if (!ctx)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
+    if (!(seconds >= 0.0 && seconds <= 1e6)) /* NaN fails too */
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "deadline %g s: not in 0..1e6", seconds);
+    ctx->deadline_ms = seconds * 1e3;
+    return OBS_OK;
+}
+
 int obs_ctx_last_times(const obs_ctx *ctx, obs_pass_times *out)
 {
     if (!ctx || !ctx->times_valid)

@@ -16,6 +16,7 @@ struct obs_ctx {
     GLuint frame_ubo;                 /* the frame's uniform block (chain/frame_gl.c) */
     unsigned long gl_objects_created; /* textures + framebuffers, for tests */
     int timing;                       /* obs_ctx_set_timing */
+    double deadline_ms;               /* obs_ctx_set_deadline; 0: none */
     GLuint queries[OBS_PASS_COUNT];   /* GL_TIME_ELAPSED, one per pass */
     int times_valid;
     obs_pass_times times;             /* of the last timed frame */

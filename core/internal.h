@@ -19,6 +19,9 @@
 obs_status obs__fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
     OBS__PRINTF(3, 4);
 
+/* Milliseconds of CLOCK_MONOTONIC (for deadlines and stage times). */
+double obs__now_ms(void);
+
 /* Overflow-checked size arithmetic: 0 on success, -1 when the product does
  * not fit in size_t (then *out is left alone). */
 int obs__size_mul(size_t a, size_t b, size_t *out);

@@ -33,6 +33,8 @@ static obs_ctx *recreate(obsd_gl_worker *w, obs_ctx *ctx, obs_status why, const 
         char err[OBS_ERR_LEN] = "";
         double t0 = obsd_now_ms();
         obs_status s = obs_ctx_create(&w->desc, &ctx, err);
+        if (s == OBS_OK)
+            s = obs_ctx_set_deadline(ctx, w->frame_deadline, err);
         if (s == OBS_OK) {
             atomic_fetch_add(&w->recreations, 1);
             atomic_store(&w->alive, 1);
@@ -110,6 +112,8 @@ static void *worker_main(void *arg)
     char err[OBS_ERR_LEN] = "";
     double t0 = obsd_now_ms();
     obs_status s = obs_ctx_create(&w->desc, &ctx, err);
+    if (s == OBS_OK)
+        s = obs_ctx_set_deadline(ctx, w->frame_deadline, err);
 
     pthread_mutex_lock(&w->lock);
     w->start_status = s;
@@ -153,6 +157,9 @@ static void *worker_main(void *arg)
             job->status = obs_run(ctx, job->gb, job->params, job->outputs, &job->result, job->err);
         }
         job->t_finished = obsd_now_ms();
+        if (job->status == OBS_DEADLINE) /* name the option that set it */
+            snprintf(job->err + strlen(job->err), OBS_ERR_LEN - strlen(job->err),
+                     " (--frame-deadline)");
         obs_status st = job->status;
         char msg[OBS_ERR_LEN];
         snprintf(msg, sizeof msg, "%s", job->err);
@@ -179,6 +186,7 @@ obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *d
     w->fail_after = cfg->fail_gl_after;
     w->max_cost = (unsigned long long)cfg->max_cost;
     w->keep_memory = (unsigned long long)cfg->keep_memory;
+    w->frame_deadline = cfg->frame_deadline;
     atomic_init(&w->alive, 0);
     atomic_init(&w->recreations, 0);
     atomic_init(&w->stopping, 0);

@@ -21,6 +21,7 @@ typedef struct obsd_gl_worker {
     int fail_after; /* testing: frame number treated as a GL failure (0: none) */
     unsigned long long max_cost;    /* --max-cost (0: none) */
     unsigned long long keep_memory; /* --keep-memory */
+    int frame_deadline;             /* --frame-deadline, seconds (0: none) */
     atomic_ullong kept_bytes;       /* obs_ctx_kept_bytes after the last frame */
     /* set once the first context exists (read-only afterwards; a
      * recreated context uses the same options) */

@@ -7,6 +7,7 @@
 
 #include "chain/frame_gl.h"
 #include "context.h"
+#include "gl/draw.h"
 #include "methods/methods.h"
 #include "obs_shaders.h"
 
@@ -333,6 +334,7 @@ static void collect_times(obs_ctx *ctx, unsigned ran)
 obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                    obs_result *out, char err[OBS_ERR_LEN])
 {
+    const double t_run = obs__now_ms(); /* obs_ctx_set_deadline counts from here */
     unsigned ran = 0; /* passes timed in this frame */
     obs_params p;
     obs__frame f;
@@ -434,8 +436,17 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         f.bleed_step ? GL_COLOR_ATTACHMENT3 : GL_NONE};
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_vao);
     glDrawBuffers(4, vao_bufs);
-    draw(ctx, t->fbo_vao, w, h);
+    /* the pass whose cost grows with the samples: in bands against the
+     * deadline (obs_ctx_set_deadline) */
+    s = obs__gl_draw_banded(ctx->dev.vao, w, h, t_run, ctx->deadline_ms, "AO", err);
     pass_end(ctx);
+    if (s != OBS_OK) {
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glUseProgram(0);
+        ctx->times_valid = 0; /* no times for a frame cut short */
+        obs_result_free(out);
+        return s;
+    }
 
     /* low-pass filter (section 4.6): ao -> blur along x -> ao along y */
     if (f.blur_radius > 0) {

@@ -25,6 +25,7 @@
 #include "chain/frame_gl.h"
 #include "context.h"
 #include "deep/deep_internal.h"
+#include "gl/draw.h"
 #include "methods/methods.h"
 #include "obs_shaders.h"
 
@@ -143,13 +144,6 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     return OBS_OK;
 }
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
-}
-
 /* Starts stage p when timing is on: the GL work queued before it is done
  * first. */
 static void stage_begin(obs_ctx *ctx, double *t0)
@@ -157,7 +151,7 @@ static void stage_begin(obs_ctx *ctx, double *t0)
     if (!ctx->timing)
         return;
     glFinish();
-    *t0 = now_ms();
+    *t0 = obs__now_ms();
 }
 
 static void stage_end(obs_ctx *ctx, obs_pass p, double t0, obs_pass_times *t)
@@ -165,7 +159,7 @@ static void stage_end(obs_ctx *ctx, obs_pass p, double t0, obs_pass_times *t)
     if (!ctx->timing)
         return;
     glFinish();
-    t->ms[p] = now_ms() - t0;
+    t->ms[p] = obs__now_ms() - t0;
 }
 
 obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
@@ -175,6 +169,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     float *rgba = NULL;
     obs_pass_times times;
     double t0 = 0.0;
+    const double t_run = obs__now_ms(); /* obs_ctx_set_deadline counts from here */
     obs_status s;
 
     if (!ctx || !out)
@@ -222,10 +217,12 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform1i(glGetUniformLocation(prog, "u_lpos"), 0);
     glBindImageTexture(1, t->tex_nrm, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glUniform1i(glGetUniformLocation(prog, "u_lnrm"), 1);
-    glViewport(0, 0, w, h);
-    glBindVertexArray(ctx->dev.vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    s = obs__gl_draw_banded(ctx->dev.vao, w, h, t_run, ctx->deadline_ms, "deep AO", err);
     stage_end(ctx, OBS_PASS_AO, t0, &times);
+    if (s != OBS_OK) {
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        goto fail;
+    }
 
     stage_begin(ctx, &t0);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo);

@@ -21,6 +21,7 @@
     X(PFNGLDISABLEPROC, Disable)                                               \
     X(PFNGLFINISHPROC, Finish)                                                 \
     X(PFNGLVIEWPORTPROC, Viewport)                                             \
+    X(PFNGLSCISSORPROC, Scissor)                                               \
     X(PFNGLCREATESHADERPROC, CreateShader)                                     \
     X(PFNGLSHADERSOURCEPROC, ShaderSource)                                     \
     X(PFNGLCOMPILESHADERPROC, CompileShader)                                   \
@@ -110,6 +111,7 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glDisable obs__glp->Disable
 #define glFinish obs__glp->Finish
 #define glViewport obs__glp->Viewport
+#define glScissor obs__glp->Scissor
 #define glCreateShader obs__glp->CreateShader
 #define glShaderSource obs__glp->ShaderSource
 #define glCompileShader obs__glp->CompileShader

@@ -208,6 +208,17 @@ unsigned long long obs_ctx_kept_bytes(const obs_ctx *ctx);
  * on the context's thread, e.g. when idle. */
 obs_status obs_ctx_trim(obs_ctx *ctx, unsigned long long budget, char err[OBS_ERR_LEN]);
 
+/* ---- a deadline on each frame's GL work -------------------------------- */
+
+/* Each following obs_run and obs_deep_run stops with OBS_DEADLINE when
+ * its GL work has taken longer than `seconds` since the call began (0:
+ * no deadline, the default).  With a deadline the AO pass, the one whose
+ * cost grows with the samples, is drawn in bands of rows (scissored),
+ * each waited for (glFinish) and the clock checked between them, so the
+ * frame stops at most one band past the deadline; the output is the same
+ * as without bands. */
+obs_status obs_ctx_set_deadline(obs_ctx *ctx, double seconds, char err[OBS_ERR_LEN]);
+
 /* ---- per-pass GPU timings ---------------------------------------------- */
 
 /* The passes of obs_run, in order.  UPLOAD and READBACK are the texture

@@ -24,7 +24,8 @@ extern "C" {
     X(GL_UNAVAILABLE, "no OpenGL context could be created")                    \
     X(GL_SHADER, "a shader failed to compile or link")                         \
     X(GL_ERROR, "OpenGL reported an error")                                    \
-    X(TOO_COSTLY, "the request's work exceeds the configured limit")
+    X(TOO_COSTLY, "the request's work exceeds the configured limit")          \
+    X(DEADLINE, "the frame's GL work ran past the configured deadline")
 
 typedef enum obs_status {
 #define OBS__STATUS_ENUM(name, msg) OBS_##name,

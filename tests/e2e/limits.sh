@@ -5,7 +5,9 @@
 # binary protocol, and lets a cheaper one through; --keep-memory bounds the
 # texture memory the GL worker keeps for the next frame (the gauge
 # obscurad_gl_kept_bytes of /metrics), which is released when the queue
-# runs empty.
+# runs empty; --frame-deadline stops a frame whose GL work runs past it
+# (422 deadline_exceeded, naming the option), and the GL worker goes on
+# with the next frame.
 #
 #   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/limits.sh
 #
@@ -13,6 +15,7 @@
 set -u
 OBSCURA=${OBSCURA:-build/obscura}
 OBSCURAD=${OBSCURAD:-build/obscurad}
+UPSCALE=${UPSCALE:-$(dirname "$OBSCURA")/exr_upscale}
 R=tests/data/room_small.exr
 CAM=tests/data/room_small.camera.json
 . tests/e2e/lib/common.sh
@@ -54,6 +57,31 @@ check "--keep-memory 1m: released once the queue ran empty ($kept bytes kept)" \
     "[ '$st' = 200 ] && [ '$kept' = 0 ]"
 st=$(post "$PORT_M" "$Q" "$R" "$T/m2.out")
 check "--keep-memory 1m: the next frame is the same ($st)" "[ '$st' = 200 ] && cmp -s '$T/m1.out' '$T/m2.out'"
+
+# --frame-deadline: HBAO 32 x 32 on a 1920x1080 frame holds the GL worker
+# for 8.7 s on llvmpipe (2 cores; answered 200 with no deadline); with a
+# 1 s deadline it is stopped within one of the AO pass's 16 bands past it.
+if "$UPSCALE" "$R" 1920x1080 "$T/hd.exr" 2>"$T/up.err"; then
+    HEAVY="$Q&method=hbao&hbao_directions=32&hbao_steps=32"
+    start D --frame-deadline 1 --max-cost 0 --socket "$T/d.sock"
+    t0=$(date +%s%N)
+    st=$(post "$PORT_D" "$HEAVY" "$T/hd.exr" "$T/d1.json")
+    took=$(( ($(date +%s%N) - t0) / 1000000 ))
+    check "--frame-deadline 1: an 8.7 s frame is 422 deadline_exceeded in $took ms, naming the option ($st)" \
+        "[ '$st' = 422 ] && error_is '$T/d1.json' deadline_exceeded && grep -q 'frame-deadline' '$T/d1.json' && [ $took -lt 5000 ]"
+    "$OBSCURA" ao "$T/hd.exr" --camera "$CAM" --method hbao --hbao-directions 32 --hbao-steps 32 \
+        -o "$T/d2.exr" --server "unix:$T/d.sock" -q 2>"$T/d2.err"
+    rc=$?
+    check "--frame-deadline over the binary protocol: the CLI exits 3 and shows why (rc $rc)" \
+        "[ $rc -eq 3 ] && grep -q 'frame-deadline' '$T/d2.err'"
+    st=$(post "$PORT_D" "$Q" "$R" "$T/d3.out")
+    start E --frame-deadline 0
+    st0=$(post "$PORT_E" "$Q" "$R" "$T/e3.out")
+    check "after a cut frame the next is answered, the same as with no deadline ($st, $st0)" \
+        "[ '$st' = 200 ] && [ '$st0' = 200 ] && cmp -s '$T/d3.out' '$T/e3.out'"
+else
+    bad "exr_upscale 1280x720: $(cat "$T/up.err")"
+fi
 
 echo "e2e limits: $pass passed, $failed failed"
 [ "$failed" -eq 0 ]
