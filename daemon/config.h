@@ -80,9 +80,9 @@
       "the next frame (0: no deadline, the AO pass drawn at once)")           \
     X(keep_memory, SIZE, 0, 1099511627776, "512m",                             \
       "texture memory the GL worker keeps for the next frame of the same "     \
-      "size; above it, whenever the queue runs empty, it is released, and "   \
-      "freed heap memory is returned to the system (malloc_trim, at most "     \
-      "once a second)")                                                        \
+      "size; above it, whenever the queue runs empty, it is released; "       \
+      "freed heap memory is returned to the system (malloc_trim) once the "    \
+      "queue has stayed empty for a second")                                   \
     X(backend, ENUM, 0, 0, "auto",                                             \
       "GL backend: auto|egl-device|egl-surfaceless|osmesa (default: "          \
       "OBSCURA_BACKEND, else auto)")                                           \

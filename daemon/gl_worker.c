@@ -81,14 +81,16 @@ static int too_costly(const obsd_gl_worker *w, obsd_job *job)
     return 1;
 }
 
-/* Freed heap goes back to the system at most this often: malloc_trim
- * walks the whole heap, too much for every frame of a client that sends
- * them one after another (the queue runs empty between them). */
-#define TRIM_INTERVAL_MS 1000.0
+/* Freed heap goes back to the system (malloc_trim, which walks the whole
+ * heap) once the queue has stayed empty this long: not after every frame
+ * of a client that sends them one after another, and only after the
+ * network threads have freed the last frames' decoded G-buffers and
+ * encoded answers, which they do once the worker is done with them. */
+#define TRIM_IDLE_MS 1000
 
 /* When the queue has run empty: the kept targets over --keep-memory are
- * released, and freed heap returned to the system. */
-static void idle(obsd_gl_worker *w, obs_ctx *ctx, double *last_trim)
+ * released. */
+static void idle(obsd_gl_worker *w, obs_ctx *ctx)
 {
     int waiting, running, full;
     obsd_queue_stats(w->queue, &waiting, &running, &full);
@@ -97,11 +99,6 @@ static void idle(obsd_gl_worker *w, obs_ctx *ctx, double *last_trim)
     char err[OBS_ERR_LEN] = "";
     if (ctx && obs_ctx_trim(ctx, w->keep_memory, err) != OBS_OK)
         obsd_log(OBSD_LOG_WARN, "releasing frame targets: %s", err);
-    double now = obsd_now_ms();
-    if (now - *last_trim >= TRIM_INTERVAL_MS) {
-        malloc_trim(0);
-        *last_trim = now;
-    }
     atomic_store(&w->kept_bytes, ctx ? obs_ctx_kept_bytes(ctx) : 0);
 }
 
@@ -135,10 +132,19 @@ static void *worker_main(void *arg)
     if (s != OBS_OK)
         return NULL;
 
-    obsd_job *job;
     long frame = 0;
-    double last_trim = 0.0;
-    while ((job = obsd_queue_pop(w->queue)) != NULL) {
+    int trim_pending = 0; /* frames ran since the last malloc_trim */
+    for (;;) {
+        int idle_long;
+        obsd_job *job = obsd_queue_pop_wait(w->queue, trim_pending ? TRIM_IDLE_MS : -1, &idle_long);
+        if (idle_long) {
+            malloc_trim(0);
+            atomic_fetch_add(&w->heap_trims, 1);
+            trim_pending = 0;
+            continue;
+        }
+        if (!job)
+            break; /* closed and drained */
         frame++;
         job->t_started = obsd_now_ms();
         job->err[0] = '\0';
@@ -169,7 +175,8 @@ static void *worker_main(void *arg)
         job->done(job, job->user); /* the job is not ours after this */
         if (ctx && (st == OBS_GL_ERROR || st == OBS_GL_UNAVAILABLE))
             ctx = recreate(w, ctx, st, msg);
-        idle(w, ctx, &last_trim);
+        idle(w, ctx);
+        trim_pending = 1;
     }
     atomic_store(&w->alive, 0);
     if (ctx)
@@ -189,6 +196,7 @@ obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *d
     w->frame_deadline = cfg->frame_deadline;
     atomic_init(&w->alive, 0);
     atomic_init(&w->recreations, 0);
+    atomic_init(&w->heap_trims, 0);
     atomic_init(&w->stopping, 0);
     pthread_mutex_init(&w->lock, NULL);
     pthread_cond_init(&w->ready, NULL);

@@ -23,6 +23,7 @@ typedef struct obsd_gl_worker {
     unsigned long long keep_memory; /* --keep-memory */
     int frame_deadline;             /* --frame-deadline, seconds (0: none) */
     atomic_ullong kept_bytes;       /* obs_ctx_kept_bytes after the last frame */
+    atomic_ullong heap_trims;       /* malloc_trim calls, once idle after frames */
     /* set once the first context exists (read-only afterwards; a
      * recreated context uses the same options) */
     char backend[32], gl_version[128], gl_vendor[128], gl_renderer[256];

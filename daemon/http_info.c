@@ -21,6 +21,7 @@ static void gauges(obsd_http *h, obsd_gauges *g)
     g->gl_alive = atomic_load(&h->gl->alive);
     g->gl_recreations = (unsigned long long)atomic_load(&h->gl->recreations);
     g->gl_kept_bytes = (unsigned long long)atomic_load(&h->gl->kept_bytes);
+    g->heap_trims = (unsigned long long)atomic_load(&h->gl->heap_trims);
     obsd_streams_gauges(h->streams, &g->streams, &g->stream_frames, &g->stream_bytes, &g->sse_subscribers);
 }
 

@@ -48,6 +48,9 @@ int obsd_queue_push(obsd_queue *q, obsd_job *job);
 /* Waits for a job; NULL once the queue is closed and empty.  Marks the
  * worker running until obsd_queue_done(). */
 obsd_job *obsd_queue_pop(obsd_queue *q);
+/* The same, waiting at most timeout_ms (< 0: no limit): NULL with
+ * *timed_out set when the queue stayed empty and open that long. */
+obsd_job *obsd_queue_pop_wait(obsd_queue *q, int timeout_ms, int *timed_out);
 void obsd_queue_done(obsd_queue *q);
 /* No more pushes; the worker drains what is queued, then pop gives NULL. */
 void obsd_queue_close(obsd_queue *q);

@@ -1,4 +1,5 @@
 /* The bounded job queue between the network threads and the GL worker. */
+#include <errno.h>
 #include <stdlib.h>
 #include <time.h>
 
@@ -19,7 +20,12 @@ int obsd_queue_init(obsd_queue *q, int capacity)
     q->cap = capacity;
     q->head = q->count = q->closed = q->running = 0;
     pthread_mutex_init(&q->lock, NULL);
-    pthread_cond_init(&q->nonempty, NULL);
+    /* obsd_queue_pop_wait's timeout runs on the monotonic clock */
+    pthread_condattr_t attr;
+    pthread_condattr_init(&attr);
+    pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
+    pthread_cond_init(&q->nonempty, &attr);
+    pthread_condattr_destroy(&attr);
     return 0;
 }
 
@@ -50,10 +56,31 @@ int obsd_queue_push(obsd_queue *q, obsd_job *job)
 
 obsd_job *obsd_queue_pop(obsd_queue *q)
 {
+    int timed_out;
+    return obsd_queue_pop_wait(q, -1, &timed_out);
+}
+
+obsd_job *obsd_queue_pop_wait(obsd_queue *q, int timeout_ms, int *timed_out)
+{
     obsd_job *job = NULL;
+    struct timespec until;
+    clock_gettime(CLOCK_MONOTONIC, &until);
+    if (timeout_ms >= 0) {
+        until.tv_sec += timeout_ms / 1000;
+        until.tv_nsec += (long)(timeout_ms % 1000) * 1000000L;
+        if (until.tv_nsec >= 1000000000L) {
+            until.tv_sec++;
+            until.tv_nsec -= 1000000000L;
+        }
+    }
+    *timed_out = 0;
     pthread_mutex_lock(&q->lock);
-    while (q->count == 0 && !q->closed)
-        pthread_cond_wait(&q->nonempty, &q->lock);
+    while (q->count == 0 && !q->closed && !*timed_out) {
+        if (timeout_ms < 0)
+            pthread_cond_wait(&q->nonempty, &q->lock);
+        else if (pthread_cond_timedwait(&q->nonempty, &q->lock, &until) == ETIMEDOUT)
+            *timed_out = q->count == 0 && !q->closed;
+    }
     if (q->count > 0) {
         job = q->ring[q->head];
         q->head = (q->head + 1) % q->cap;

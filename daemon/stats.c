@@ -181,9 +181,13 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
             "# HELP obscurad_gl_kept_bytes Texture memory the GL worker keeps for the next frame "
             "(--keep-memory).\n"
             "# TYPE obscurad_gl_kept_bytes gauge\n"
-            "obscurad_gl_kept_bytes %llu\n",
+            "obscurad_gl_kept_bytes %llu\n"
+            "# HELP obscurad_heap_trims_total Times freed heap memory was returned to the "
+            "system (malloc_trim), each once the queue had stayed empty 1 s after frames.\n"
+            "# TYPE obscurad_heap_trims_total counter\n"
+            "obscurad_heap_trims_total %llu\n",
         g->queue_depth, g->queue_capacity, g->gl_running, g->in_flight, g->gl_alive,
-        g->gl_recreations, g->gl_kept_bytes);
+        g->gl_recreations, g->gl_kept_bytes, g->heap_trims);
     put(&b, "# HELP obscurad_streams Streams of frames kept for the preview page.\n"
             "# TYPE obscurad_streams gauge\n"
             "obscurad_streams %d\n"

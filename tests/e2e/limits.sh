@@ -5,7 +5,8 @@
 # binary protocol, and lets a cheaper one through; --keep-memory bounds the
 # texture memory the GL worker keeps for the next frame (the gauge
 # obscurad_gl_kept_bytes of /metrics), which is released when the queue
-# runs empty; --frame-deadline stops a frame whose GL work runs past it
+# runs empty, and freed heap memory is returned to the system once the
+# queue has stayed empty for a second; --frame-deadline stops a frame whose GL work runs past it
 # (422 deadline_exceeded, naming the option), and the GL worker goes on
 # with the next frame.
 #
@@ -57,6 +58,19 @@ check "--keep-memory 1m: released once the queue ran empty ($kept bytes kept)" \
     "[ '$st' = 200 ] && [ '$kept' = 0 ]"
 st=$(post "$PORT_M" "$Q" "$R" "$T/m2.out")
 check "--keep-memory 1m: the next frame is the same ($st)" "[ '$st' = 200 ] && cmp -s '$T/m1.out' '$T/m2.out'"
+
+# Freed heap goes back to the system once the queue has stayed empty for
+# a second: not between frames sent one after another, once after them,
+# and not again while nothing runs.
+start H
+for i in 1 2 3; do post "$PORT_H" "$Q" "$R" "$T/h$i.out" > "$T/h$i.st"; done
+t_now=$(metric "$PORT_H" obscurad_heap_trims_total)
+sleep 2
+t_idle=$(metric "$PORT_H" obscurad_heap_trims_total)
+sleep 2
+t_later=$(metric "$PORT_H" obscurad_heap_trims_total)
+check "heap trimmed once, a second after 3 back-to-back frames (trims: $t_now, then $t_idle, then $t_later)" \
+    "[ '$t_now' = 0 ] && [ '$t_idle' = 1 ] && [ '$t_later' = 1 ] && [ \"\$(cat '$T/h1.st' '$T/h2.st' '$T/h3.st')\" = 200200200 ]"
 
 # --frame-deadline: HBAO 32 x 32 on a 1920x1080 frame holds the GL worker
 # for 8.7 s on llvmpipe (2 cores; answered 200 with no deadline); with a
