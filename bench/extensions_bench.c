@@ -25,6 +25,7 @@
  * hbao at the same number of depth samples: n/2 pairs, directions x steps
  * = n), the same effect time, ratios VAO++ / method.
  * Output: Markdown. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -117,6 +118,10 @@ static double mean_samples(obs_ctx *ctx, const obs_gbuffer *gb, int v, int sampl
     char err[OBS_ERR_LEN];
     obs_params p = variant_params(v, samples);
     obs_result r;
+    obs_params resolved;
+    obs_params_resolve(&p, &resolved);
+    if (resolved.ao_resolution == OBS_RESOLUTION_HALF)
+        return NAN; /* no per-pixel count at half resolution; printed "nan" */
     if (obs_run(ctx, gb, &p, OBS_OUTPUT_SAMPLE_COUNT, &r, err) != OBS_OK)
         die("obs_run", err);
     double sum = 0.0;

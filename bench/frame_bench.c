@@ -123,19 +123,69 @@ static void bench_bands(obs_ctx *ctx, const char *name, const obs_gbuffer *gb, i
              t[0][frames / 2], t[1][frames / 2], t[1][frames / 2] / t[0][frames / 2]);
 }
 
+/* --quality's presets side by side: wall and GL time (the passes' timer
+ * queries) of each, medians of `frames`, frames of the presets
+ * interleaved so that the machine's drift hits them alike; the ratio to
+ * default's in the same run. */
+static void bench_presets(obs_ctx *ctx, const char *name, const obs_gbuffer *gb, int frames)
+{
+    static const char *const presets[] = {"preview", "default", "high", "reference"};
+    enum { NP = sizeof presets / sizeof presets[0] };
+    double wall[NP][64], gl[NP][64];
+    char err[OBS_ERR_LEN];
+    obs_params p[NP];
+    if (frames > 64)
+        frames = 64;
+    for (int k = 0; k < NP; k++) {
+        memset(&p[k], 0, sizeof p[k]);
+        obs_param_set(&p[k], "quality", presets[k], err);
+    }
+    obs_ctx_set_timing(ctx, 1, err);
+    for (int i = -1; i < frames; i++) /* i = -1: warm-up, builds the programs */
+        for (int k = 0; k < NP; k++) {
+            obs_result r;
+            obs_pass_times t;
+            double t0 = now_ms();
+            if (obs_run(ctx, gb, &p[k], OBS_OUTPUT_AO, &r, err) != OBS_OK) {
+                fprintf(stderr, "frame_bench: %s: %s\n", presets[k], err);
+                exit(1);
+            }
+            double took = now_ms() - t0;
+            obs_result_free(&r);
+            if (i < 0)
+                continue;
+            wall[k][i] = took;
+            gl[k][i] = obs_ctx_last_times(ctx, &t) ? t.total_ms : -1.0;
+        }
+    obs_ctx_set_timing(ctx, 0, err);
+    double mw[NP], mg[NP];
+    for (int k = 0; k < NP; k++) {
+        qsort(wall[k], (size_t)frames, sizeof wall[k][0], cmp);
+        qsort(gl[k], (size_t)frames, sizeof gl[k][0], cmp);
+        mw[k] = wall[k][frames / 2];
+        mg[k] = gl[k][frames / 2];
+    }
+    for (int k = 0; k < NP; k++)
+        printf("| %s | %dx%d | %s | %.1f | %.1f | %.2f | %.2f |\n", name, gb->width, gb->height,
+               presets[k], mw[k], mg[k], mw[k] / mw[1], mg[k] / mg[1]);
+    fflush(stdout);
+}
+
 int main(int argc, char **argv)
 {
     obs_ctx_desc desc = {0};
-    int frames = 15;
+    int frames = 15, presets = 0;
     int i = 1;
     for (; i < argc && argv[i][0] == '-'; i++) {
         if (!strcmp(argv[i], "--backend") && i + 1 < argc)
             obs_backend_parse(argv[++i], &desc.backend);
         else if (!strcmp(argv[i], "--frames") && i + 1 < argc)
             frames = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--presets"))
+            presets = 1;
     }
     if (argc - i < 2 || (argc - i) % 2) {
-        fprintf(stderr, "usage: frame_bench [--backend B] [--frames N] GBUFFER.exr CAMERA.json...\n");
+        fprintf(stderr, "usage: frame_bench [--backend B] [--frames N] [--presets] GBUFFER.exr CAMERA.json...\n");
         return 2;
     }
     char err[OBS_ERR_LEN];
@@ -151,7 +201,11 @@ int main(int argc, char **argv)
     printf("backend %s, %s, %s; context created in %.1f ms; median of %d warm frames "
            "(upload + passes + readback of AO)\n\n",
            obs_backend_name(info.backend), info.gl_version, info.gl_renderer, t_ctx, frames);
-    printf("| G-buffer | size | first frame ms (16 samples, compiles shaders) | 8 samples ms | 16 samples ms | "
+    if (presets)
+        printf("| G-buffer (upscaled) | size | --quality | wall ms | GL ms | wall x default | GL x "
+               "default |\n|---|---|---|---|---|---|---|\n");
+    else
+        printf("| G-buffer | size | first frame ms (16 samples, compiles shaders) | 8 samples ms | 16 samples ms | "
            "32 samples ms | CPU twin 16 samples ms (x GL) |\n|---|---|---|---|---|---|---|\n");
     char bands[8][512]; /* the deadline's cost, printed after the table */
     int nbands = 0;
@@ -163,6 +217,28 @@ int main(int argc, char **argv)
             return 1;
         }
         const char *base = strrchr(argv[i], '/') ? strrchr(argv[i], '/') + 1 : argv[i];
+        if (presets) {
+            /* --presets: --quality's presets at 1920x1080 and 3840x2160 */
+            static const int sizes[2][2] = {{1920, 1080}, {3840, 2160}};
+            for (int k = 0; k < 2; k++) {
+                int pw = sizes[k][0], ph = sizes[k][1];
+                float *pd = upscale(&gf.gb.depth, gf.gb.width, gf.gb.height, pw, ph);
+                float *pn = upscale(&gf.gb.normal, gf.gb.width, gf.gb.height, pw, ph);
+                obs_gbuffer up = gf.gb;
+                up.width = pw;
+                up.height = ph;
+                up.display_width = up.display_height = 0;
+                up.display_x = up.display_y = 0;
+                up.depth = (obs_plane){pd, 1, 0};
+                up.normal = (obs_plane){pn, 3, 0};
+                up.color = (obs_plane){NULL, 0, 0};
+                bench_presets(ctx, base, &up, k ? (frames < 5 ? frames : 5) : frames);
+                free(pd);
+                free(pn);
+            }
+            obs_gbuffer_free(&gf);
+            continue;
+        }
         bench(ctx, base, &gf.gb, frames, 1);
 
         /* the same frame at 1920x1080 */
@@ -188,7 +264,8 @@ int main(int argc, char **argv)
         free(c);
         obs_gbuffer_free(&gf);
     }
-    printf("\n| G-buffer (16 samples) | size | frame ms, AO pass in one draw | AO pass in 16 "
+    if (nbands)
+        printf("\n| G-buffer (16 samples) | size | frame ms, AO pass in one draw | AO pass in 16 "
            "bands (a deadline set) ms | ratio |\n|---|---|---|---|---|\n");
     for (int b = 0; b < nbands; b++)
         fputs(bands[b], stdout);

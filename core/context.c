@@ -51,6 +51,7 @@ void obs_ctx_destroy(obs_ctx *ctx)
         return;
     if (obs__ctx_bind(ctx, NULL) == OBS_OK) {
         obs__chain_release(&ctx->prog, &ctx->tg);
+        obs__chain_release(NULL, &ctx->tg_half);
         obs__deep_release(&ctx->deep, 1);
         if (ctx->frame_ubo)
             glDeleteBuffers(1, &ctx->frame_ubo);
@@ -66,7 +67,8 @@ void obs_ctx_destroy(obs_ctx *ctx)
 const char *obs_pass_name(obs_pass p)
 {
     static const char *const names[OBS_PASS_COUNT] = {
-        "upload", "prep", "cull", "ao", "blur", "finish", "composite", "readback"};
+        "upload", "prep",      "downsample", "cull",     "ao",
+        "blur",   "upsample",  "finish",     "composite", "readback"};
     return (unsigned)p < OBS_PASS_COUNT ? names[p] : "unknown";
 }
 
@@ -106,7 +108,7 @@ int obs_ctx_last_times(const obs_ctx *ctx, obs_pass_times *out)
 
 unsigned long long obs_ctx_kept_bytes(const obs_ctx *ctx)
 {
-    return ctx ? ctx->tg.bytes + ctx->deep.bytes : 0;
+    return ctx ? ctx->tg.bytes + ctx->tg_half.bytes + ctx->deep.bytes : 0;
 }
 
 obs_status obs_ctx_trim(obs_ctx *ctx, unsigned long long budget, char err[OBS_ERR_LEN])
@@ -120,6 +122,7 @@ obs_status obs_ctx_trim(obs_ctx *ctx, unsigned long long budget, char err[OBS_ER
         return s;
     unsigned long long before = obs_ctx_kept_bytes(ctx);
     obs__chain_release(NULL, &ctx->tg); /* the programs stay: they cost no frame size */
+    obs__chain_release(NULL, &ctx->tg_half);
     obs__deep_release(&ctx->deep, 0);
     obs__log(ctx, OBS_LOG_DEBUG, "released %llu bytes of frame targets (budget %llu)", before, budget);
     return obs__gl_check("releasing frame targets", err);

@@ -12,6 +12,7 @@ struct obs_ctx {
     obs__gl_device dev;
     obs__programs prog;        /* the chain's (chain/run_gl.c) */
     obs__targets tg;
+    obs__targets tg_half;      /* ao_resolution half: the AO passes' targets */
     obs__deep_targets deep;    /* deep input's (deep/deep_gl.c) */
     GLuint frame_ubo;                 /* the frame's uniform block (chain/frame_gl.c) */
     unsigned long gl_objects_created; /* textures + framebuffers, for tests */

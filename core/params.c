@@ -284,6 +284,34 @@ static const char *method_why(size_t offset)
     return "";
 }
 
+/* The rows of --quality's preset: each parameter the request left unset
+ * (0) takes the preset's value; an explicit one keeps its own. */
+static void apply_quality(obs_params *r)
+{
+    static const struct {
+        int quality;
+        const char *name, *value;
+    } rows[] = {
+#define OBS__PRESET_ROW(q, name, value) {q, #name, value},
+        OBS_QUALITY_PRESETS(OBS__PRESET_ROW)
+#undef OBS__PRESET_ROW
+    };
+    for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++) {
+        if (rows[k].quality != r->quality)
+            continue;
+        const obs_param_info *pi = obs_param_find(rows[k].name);
+        obs_params set;
+        memset(&set, 0, sizeof set);
+        /* the rows are checked by test_params.c: each value parses */
+        if (!pi || obs_param_set(&set, rows[k].name, rows[k].value, NULL) != OBS_OK)
+            continue;
+        char *field = (char *)r + pi->offset;
+        const char *value = (const char *)&set + pi->offset;
+        if (pi->type == OBS_PARAM_FLOAT ? *(float *)field == 0.0f : *(int *)field == 0)
+            memcpy(field, value, pi->type == OBS_PARAM_FLOAT ? sizeof(float) : sizeof(int));
+    }
+}
+
 void obs_params_resolve(const obs_params *in, obs_params *out)
 {
     obs_params r;
@@ -291,6 +319,7 @@ void obs_params_resolve(const obs_params *in, obs_params *out)
         r = *in;
     else
         memset(&r, 0, sizeof r);
+    apply_quality(&r);
     for (int i = 0; i < TABLE_LEN; i++) {
         const obs_param_info *pi = &table[i];
         char *field = (char *)&r + pi->offset;

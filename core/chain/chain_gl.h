@@ -14,6 +14,7 @@ typedef struct obs__programs {
     GLuint vao[OBS__AO_VARIANTS]; /* AO pass by switches compiled in (run_gl.c: AO_*) */
     GLuint cull[2];               /* culling pre-pass without, with the range check */
     GLuint composite;
+    GLuint down, up[2]; /* ao_resolution half: downsample; upsample by OBS_RAYS (first use) */
     GLuint finish[4]; /* 2 * (ao_definition rays) + luminance: OBS_RAYS, OBS_LUMINANCE */
     /* by (the vertical pass with ao_definition rays' conversion: OBS_RAYS)
      * and blur_radius (BLUR_RADIUS); built on first use */

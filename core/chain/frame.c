@@ -81,6 +81,7 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
     f->cull_w = (f->width + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK;
     f->cull_h = (f->height + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK;
     f->blur_radius = p->blur == OBS_ON ? p->blur_radius : 0;
+    f->half = p->ao_resolution == OBS_RESOLUTION_HALF;
     for (int k = 0; k <= f->blur_radius; k++) /* section 4.6: Gaussian kernel */
         f->blur_w[k] = expf(-(float)(k * k) / (2.0f * p->blur_sigma * p->blur_sigma));
     for (int k = 0; k < 9; k++)
@@ -103,6 +104,10 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
         f->bleed_step = 0;
         obs__log(log_ctx, OBS_LOG_INFO, "no colour channel: colour bleeding is off");
     }
+    if (f->half && f->bleed_step)
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "ao_resolution half does not take bleeding: eq 5 gathers the colour "
+                         "at each full-resolution pixel's samples (use ao_resolution full)");
 
     /* The comparison methods (parameter method); their AO runs in place
      * of the VAO estimator, the rest of the chain is shared.  Each fills
@@ -127,6 +132,15 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
             return obs__fail(err, OBS_NO_CAMERA, "world_to_camera is singular");
         }
     }
+    return OBS_OK;
+}
+
+obs_status obs__frame_check_outputs(const obs__frame *f, unsigned outputs, char err[OBS_ERR_LEN])
+{
+    if (f->half && (outputs & (OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK)))
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "ao_resolution half has no per-pixel sample_count or cull_mask output "
+                         "(they are of the half-resolution pixels; use ao_resolution full)");
     return OBS_OK;
 }
 

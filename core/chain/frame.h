@@ -57,6 +57,7 @@ typedef struct obs__frame {
     float cull_threshold;   /* an estimate below this shows occlusion: 1 - culling_epsilon */
     int cull_w, cull_h;     /* the low-resolution texture: ceil(width / 8) x ceil(height / 8) */
     int blur_radius;        /* low-pass filter half-width (section 4.6); 0: off */
+    int half;               /* 1: the AO at half resolution (ao_resolution half) */
     float blur_w[OBS_MAX_BLUR + 1]; /* Gaussian weight of offset 0..blur_radius */
     int luminance;          /* section 4.3, eq 3: 0 off, 1 Rec. 709 luminance, 2 HSV V */
     float lum_threshold, lum_width, lum_sigma; /* threshold, width, sigma of eq 3 */
@@ -112,6 +113,36 @@ void obs__frame_block_fill(const obs__frame *f, obs__frame_block *b);
 /* Resolves camera, parameters and normal handling for one frame. */
 obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *resolved,
                             obs__frame *f, char err[OBS_ERR_LEN]);
+
+/* ---- half resolution (ao_resolution half; half_cpu.c) ------------------- */
+
+/* OBS_INVALID_ARGUMENT when the frame cannot give an output asked for
+ * (half resolution: the per-pixel debug planes). */
+obs_status obs__frame_check_outputs(const obs__frame *f, unsigned outputs, char err[OBS_ERR_LEN]);
+
+/* The frame of the AO and blur passes at half resolution: the same camera
+ * over ceil(width / 2) x ceil(height / 2) pixels, half pixel (x, y)
+ * covering full pixels 2x..2x+1, 2y..2y+1 (the viewport halved). */
+void obs__frame_half(const obs__frame *f, obs__frame *hf);
+
+/* The full-resolution pixel that half pixel (hx, hy) takes its position,
+ * normal and depth from: of its 2x2 block's pixels with a surface, the
+ * nearest (planar depth) where hx + hy is even, the farthest where it is
+ * odd, the first in row order on a tie; -1 when all four are background.
+ * pos: the full frame's prep positions (4 floats a pixel, w the planar
+ * depth).  GLSL: down.frag.glsl. */
+long obs__half_source(const obs__frame *f, const float *pos, int hx, int hy);
+
+/* The AO of full pixel (x, y) from the half-resolution AO `hao`: the
+ * joint bilateral upsample of down.frag.glsl's twin up.frag.glsl.  The
+ * four half pixels around the pixel's centre, each weighted by its
+ * bilinear weight times max(0, n . n_q), n the pixel's view normal;
+ * a half pixel without a surface, or whose planar depth is more than R
+ * from the pixel's (the blur's threshold, section 4.6), is left out; when
+ * all are, the one nearest in depth gives its AO.  1 for background. */
+float obs__half_upsample(const obs__frame *f, const obs__frame *hf, const float *pos,
+                         const float *nrm, const float *hpos, const float *hnrm,
+                         const float *hao, int x, int y);
 
 /* ---- per-pixel twins (GLSL: common.glsl, prep.frag, vao.frag) ----------- */
 

@@ -125,7 +125,25 @@ static obs_status build_method_program(obs_ctx *ctx, const obs__method *m, char 
                            err);
 }
 
-static GLuint make_texture(obs_ctx *ctx, GLenum format, int w, int h)
+/* ao_resolution half's downsample and upsample (down.frag.glsl,
+ * up.frag.glsl), built on their first use. */
+static obs_status build_half_programs(obs_ctx *ctx, int rays, char err[OBS_ERR_LEN])
+{
+    obs_status s = OBS_OK;
+    if (!ctx->prog.down) {
+        const char *src[] = {glsl_version, obs__shader_common, obs__shader_down_frag};
+        s = obs__gl_program("downsample", obs__shader_fullscreen_vert, src, 3, &ctx->prog.down, err);
+    }
+    if (s == OBS_OK && !ctx->prog.up[rays]) {
+        const char *src[] = {glsl_version, rays ? "#define OBS_RAYS 1\n" : "#define OBS_RAYS 0\n",
+                             obs__shader_common, obs__shader_up_frag};
+        s = obs__gl_program("upsample", obs__shader_fullscreen_vert, src, 4, &ctx->prog.up[rays],
+                            err);
+    }
+    return s;
+}
+
+static GLuint make_texture(obs_ctx *ctx, obs__targets *set, GLenum format, int w, int h)
 {
     GLuint t;
     glGenTextures(1, &t);
@@ -137,7 +155,7 @@ static GLuint make_texture(obs_ctx *ctx, GLenum format, int w, int h)
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     ctx->gl_objects_created++;
     const unsigned texel = format == GL_RGBA32F ? 16 : format == GL_RG32F ? 8 : 4;
-    ctx->tg.bytes += (unsigned long long)w * (unsigned long long)h * texel;
+    set->bytes += (unsigned long long)w * (unsigned long long)h * texel;
     return t;
 }
 
@@ -176,34 +194,37 @@ void obs__chain_release(obs__programs *g, obs__targets *t)
     OBS__GL_DELETE_PROGRAMS(g->method);
     OBS__GL_DELETE_PROGRAMS(g->finish);
     obs__gl_delete_programs(&g->composite, 1);
+    obs__gl_delete_programs(&g->down, 1);
+    OBS__GL_DELETE_PROGRAMS(g->up);
     memset(g, 0, sizeof *g);
 }
 
-static obs_status ensure_targets(obs_ctx *ctx, int w, int h, char err[OBS_ERR_LEN])
+/* The targets t (the context's full-size set, or the half-size set of
+ * ao_resolution half) for w x h. */
+static obs_status ensure_targets(obs_ctx *ctx, obs__targets *t, int w, int h, char err[OBS_ERR_LEN])
 {
-    obs__targets *t = &ctx->tg;
     if (t->width == w && t->height == h)
         return OBS_OK;
     if (t->width) {
         /* a new resolution: drop the old set, keep the programs */
         obs__chain_release(NULL, t);
     }
-    t->tex_depth = make_texture(ctx, GL_R32F, w, h);
-    t->tex_normal = make_texture(ctx, GL_RGBA32F, w, h); /* read as an image: no RGB32F */
-    t->tex_color = make_texture(ctx, GL_RGBA32F, w, h);
-    t->tex_viewpos = make_texture(ctx, GL_RGBA32F, w, h);
-    t->tex_vnormal = make_texture(ctx, GL_RGBA32F, w, h);
-    t->tex_dz = make_texture(ctx, GL_RG32F, w, h);
-    t->tex_ao = make_texture(ctx, GL_RG32F, w, h);     /* AO, depth (blur.frag.glsl) */
-    t->tex_composite = make_texture(ctx, GL_RGBA32F, w, h);
-    t->tex_blur = make_texture(ctx, GL_RG32F, w, h);
-    t->tex_count = make_texture(ctx, GL_R32F, w, h);
-    t->tex_cullmask = make_texture(ctx, GL_R32F, w, h);
-    t->tex_bleed = make_texture(ctx, GL_RGBA32F, w, h);
-    t->tex_lumfactor = make_texture(ctx, GL_R32F, w, h);
+    t->tex_depth = make_texture(ctx, t, GL_R32F, w, h);
+    t->tex_normal = make_texture(ctx, t, GL_RGBA32F, w, h); /* read as an image: no RGB32F */
+    t->tex_color = make_texture(ctx, t, GL_RGBA32F, w, h);
+    t->tex_viewpos = make_texture(ctx, t, GL_RGBA32F, w, h);
+    t->tex_vnormal = make_texture(ctx, t, GL_RGBA32F, w, h);
+    t->tex_dz = make_texture(ctx, t, GL_RG32F, w, h);
+    t->tex_ao = make_texture(ctx, t, GL_RG32F, w, h);     /* AO, depth (blur.frag.glsl) */
+    t->tex_composite = make_texture(ctx, t, GL_RGBA32F, w, h);
+    t->tex_blur = make_texture(ctx, t, GL_RG32F, w, h);
+    t->tex_count = make_texture(ctx, t, GL_R32F, w, h);
+    t->tex_cullmask = make_texture(ctx, t, GL_R32F, w, h);
+    t->tex_bleed = make_texture(ctx, t, GL_RGBA32F, w, h);
+    t->tex_lumfactor = make_texture(ctx, t, GL_R32F, w, h);
     /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block; the AO
      * pass filters it itself (cull_candidate in vao.frag.glsl). */
-    t->tex_cull = make_texture(ctx, GL_R32F, (w + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK,
+    t->tex_cull = make_texture(ctx, t, GL_R32F, (w + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK,
                                (h + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK);
     GLuint prep[] = {t->tex_viewpos, t->tex_vnormal, t->tex_dz};
     GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask, t->tex_bleed};
@@ -347,9 +368,18 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no output requested");
     obs_params_resolve(params, &p);
     s = obs__frame_setup(ctx, gb, &p, &f, err);
+    if (s == OBS_OK)
+        s = obs__frame_check_outputs(&f, outputs, err);
     if (s != OBS_OK)
         return s;
     const obs__method *method = obs__method_get(f.method);
+    /* ao_resolution half: the culling pre-pass, AO and blur run on the
+     * half frame hf (af) and its targets (at), between the downsample and
+     * the upsample; everything else at full size */
+    obs__frame hf;
+    if (f.half)
+        obs__frame_half(&f, &hf);
+    const obs__frame *af = f.half ? &hf : &f;
     s = obs__ctx_bind(ctx, err);
     if (s != OBS_OK)
         return s;
@@ -360,10 +390,14 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         s = build_vao_program(ctx, 0, ao_variant(&f), err);
     if (s == OBS_OK && f.culling)
         s = build_vao_program(ctx, 1, ao_variant(&f), err);
+    if (s == OBS_OK && f.half)
+        s = build_half_programs(ctx, f.rays, err);
     /* ao_definition rays converts the blurred AO: in the blur's vertical
-     * pass, or in the finishing pass when there is no blur */
-    const int rays_in_blur = f.rays && f.blur_radius > 0;
-    const int finish_rays = f.rays && !rays_in_blur, finish_lum = f.luminance != 0;
+     * pass, or in the finishing pass when there is no blur; at half
+     * resolution in the upsample (which filters the linear estimate, as
+     * the blur does) */
+    const int rays_in_blur = f.rays && f.blur_radius > 0 && !f.half;
+    const int finish_rays = f.rays && !rays_in_blur && !f.half, finish_lum = f.luminance != 0;
     if (s == OBS_OK)
         s = build_blur_program(ctx, 0, f.blur_radius, err);
     if (s == OBS_OK)
@@ -374,7 +408,9 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         s = build_prep_program(ctx, &f, err);
     if (s != OBS_OK)
         return s;
-    s = ensure_targets(ctx, f.width, f.height, err);
+    s = ensure_targets(ctx, &ctx->tg, f.width, f.height, err);
+    if (s == OBS_OK && f.half)
+        s = ensure_targets(ctx, &ctx->tg_half, hf.width, hf.height, err);
     if (s == OBS_OK) /* the frame's values, read by every pass (common.glsl) */
         s = obs__frame_block_bind(ctx, &f, err);
     if (s != OBS_OK)
@@ -384,7 +420,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         return s;
 
     obs__targets *t = &ctx->tg;
-    int w = f.width, h = f.height;
+    obs__targets *at = f.half ? &ctx->tg_half : t;
+    int w = f.width, h = f.height, aw = af->width, ah = af->height;
     pass_begin(ctx, OBS_PASS_UPLOAD, &ran);
     upload(t->tex_depth, &gb->depth, w, h, GL_RED);
     if (!f.reconstruct_normals)
@@ -405,26 +442,42 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     draw(ctx, t->fbo_prep, w, h);
     pass_end(ctx);
 
+    /* ao_resolution half: one pixel of each 2x2 block (down.frag.glsl),
+     * then the half frame's block for the passes at that size */
+    if (f.half) {
+        pass_begin(ctx, OBS_PASS_DOWNSAMPLE, &ran);
+        prog = ctx->prog.down;
+        glUseProgram(prog);
+        bind_prep_planes(prog, t);
+        draw(ctx, at->fbo_prep, aw, ah);
+        pass_end(ctx);
+        s = obs__frame_block_bind(ctx, &hf, err);
+        if (s != OBS_OK) {
+            obs_result_free(out);
+            return s;
+        }
+    }
+
     /* culling pre-pass (section 4.2): 8-sample AO at 1/8 resolution */
     if (f.culling) {
         pass_begin(ctx, OBS_PASS_CULL, &ran);
         prog = ctx->prog.cull[f.range_check != 0];
         glUseProgram(prog);
-        bind_prep_planes(prog, t);
-        draw(ctx, t->fbo_cull, f.cull_w, f.cull_h);
+        bind_prep_planes(prog, at);
+        draw(ctx, at->fbo_cull, af->cull_w, af->cull_h);
         pass_end(ctx);
     }
 
     /* AO pass */
     pass_begin(ctx, OBS_PASS_AO, &ran);
     if (method->glsl) { /* a comparison method in place of VAO */
-        prog = use_method_program(ctx, method, &f, t);
+        prog = use_method_program(ctx, method, af, at);
     } else {
         prog = ctx->prog.vao[ao_variant(&f)];
         glUseProgram(prog);
-        bind_prep_planes(prog, t);
+        bind_prep_planes(prog, at);
         /* section 4.2: the pre-pass result, read at the pixel corners */
-        bind_img(prog, "u_cull", 4, t->tex_cull, GL_R32F);
+        bind_img(prog, "u_cull", 4, at->tex_cull, GL_R32F);
         /* section 4.7: colour bleeding reads the colour at the samples */
         bind_img(prog, "u_color", 3, t->tex_color, GL_RGBA32F);
     }
@@ -434,11 +487,11 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         (outputs & OBS_OUTPUT_SAMPLE_COUNT) ? GL_COLOR_ATTACHMENT1 : GL_NONE,
         (outputs & OBS_OUTPUT_CULL_MASK) ? GL_COLOR_ATTACHMENT2 : GL_NONE,
         f.bleed_step ? GL_COLOR_ATTACHMENT3 : GL_NONE};
-    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_vao);
+    glBindFramebuffer(GL_FRAMEBUFFER, at->fbo_vao);
     glDrawBuffers(4, vao_bufs);
     /* the pass whose cost grows with the samples: in bands against the
      * deadline (obs_ctx_set_deadline) */
-    s = obs__gl_draw_banded(ctx->dev.vao, w, h, t_run, ctx->deadline_ms, "AO", err);
+    s = obs__gl_draw_banded(ctx->dev.vao, aw, ah, t_run, ctx->deadline_ms, "AO", err);
     pass_end(ctx);
     if (s != OBS_OK) {
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -454,15 +507,35 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         for (int pass = 0; pass < 2; pass++) { /* along x, then along y */
             prog = ctx->prog.blur[pass ? rays_in_blur : 0][f.blur_radius];
             glUseProgram(prog);
-            bind_img(prog, "u_ao", 0, pass ? t->tex_blur : t->tex_ao, GL_RG32F);
+            bind_img(prog, "u_ao", 0, pass ? at->tex_blur : at->tex_ao, GL_RG32F);
             glUniform2i(glGetUniformLocation(prog, "u_dir"), !pass, pass);
             if (!pass) {
                 const GLenum blur_bufs[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
-                glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_blur);
+                glBindFramebuffer(GL_FRAMEBUFFER, at->fbo_blur);
                 glDrawBuffers(2, blur_bufs);
             }
-            draw(ctx, pass ? t->fbo_ao : t->fbo_blur, w, h);
+            draw(ctx, pass ? at->fbo_ao : at->fbo_blur, aw, ah);
         }
+        pass_end(ctx);
+    }
+
+    /* ao_resolution half: the joint bilateral upsample (up.frag.glsl)
+     * into the full-size AO, under the full frame's block again */
+    if (f.half) {
+        s = obs__frame_block_bind(ctx, &f, err);
+        if (s != OBS_OK) {
+            obs_result_free(out);
+            return s;
+        }
+        pass_begin(ctx, OBS_PASS_UPSAMPLE, &ran);
+        prog = ctx->prog.up[f.rays];
+        glUseProgram(prog);
+        bind_img(prog, "u_dz", 0, t->tex_dz, GL_RG32F);
+        bind_img(prog, "u_vnormal", 1, t->tex_vnormal, GL_RGBA32F);
+        bind_img(prog, "u_hnormal", 3, at->tex_vnormal, GL_RGBA32F);
+        bind_img(prog, "u_hao", 4, at->tex_ao, GL_RG32F);
+        glUniform2i(glGetUniformLocation(prog, "u_half_size"), aw, ah);
+        draw(ctx, t->fbo_ao, w, h);
         pass_end(ctx);
     }
 

@@ -110,6 +110,12 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
     gb.camera = d->camera;
     if ((s = obs__frame_setup(NULL, &gb, &p, &df->f, err)) != OBS_OK)
         goto fail;
+    if (df->f.half) {
+        s = obs__fail(err, OBS_INVALID_ARGUMENT,
+                      "ao_resolution half is for flat G-buffers; deep input runs at full "
+                      "resolution (use ao_resolution full or a quality other than preview)");
+        goto fail;
+    }
     df->m = m;
     df->multi = p.deep_mode != OBS_DEEP_SINGLE;
     df->thin = p.deep_hull == OBS_DEEP_THIN;

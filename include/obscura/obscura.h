@@ -226,17 +226,19 @@ obs_status obs_ctx_set_deadline(obs_ctx *ctx, double seconds, char err[OBS_ERR_L
 typedef enum obs_pass {
     OBS_PASS_UPLOAD,
     OBS_PASS_PREP,
+    OBS_PASS_DOWNSAMPLE, /* ao_resolution half: the prep planes to half size */
     OBS_PASS_CULL,
     OBS_PASS_AO,
     OBS_PASS_BLUR,
+    OBS_PASS_UPSAMPLE,   /* ao_resolution half: the AO back to full size */
     OBS_PASS_FINISH,    /* luminance sensitivity; ao_definition rays' conversion without blur */
     OBS_PASS_COMPOSITE,
     OBS_PASS_READBACK,
     OBS_PASS_COUNT
 } obs_pass;
 
-/* "upload", "prep", "cull", "ao", "blur", "finish", "composite",
- * "readback". */
+/* "upload", "prep", "downsample", "cull", "ao", "blur", "upsample",
+ * "finish", "composite", "readback". */
 const char *obs_pass_name(obs_pass p);
 
 typedef struct obs_pass_times {

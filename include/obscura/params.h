@@ -82,6 +82,38 @@ typedef enum obs_method {
     OBS_METHOD_COUNT /* 1 + the last method */
 } obs_method;
 
+/* Where the AO is computed (parameter `ao_resolution`). */
+#define OBS_RESOLUTION_LIST(X)                                                 \
+    X(OBS_RESOLUTION_FULL, full) /* every pixel */                             \
+    X(OBS_RESOLUTION_HALF, half) /* half of each axis, upsampled */
+typedef enum obs_resolution {
+    OBS_RESOLUTION_DEFAULT,
+    OBS_RESOLUTION_LIST(OBS__ENUM_VALUE)
+} obs_resolution;
+
+/* Quality presets (parameter `quality`): each sets the parameters of its
+ * rows in OBS_QUALITY_PRESETS that the request did not give. */
+#define OBS_QUALITY_LIST(X)                                                    \
+    X(OBS_QUALITY_PREVIEW, preview)                                            \
+    X(OBS_QUALITY_STANDARD, default)                                           \
+    X(OBS_QUALITY_HIGH, high)                                                  \
+    X(OBS_QUALITY_REFERENCE, reference)
+typedef enum obs_quality { OBS_QUALITY_UNSET, OBS_QUALITY_LIST(OBS__ENUM_VALUE) } obs_quality;
+
+/* X(quality, parameter, value): what each preset sets (as text, through
+ * obs_param_set); `default` sets nothing.  preview: the AO at half
+ * resolution (a quarter of the pixels; upsampled by a joint bilateral
+ * filter); high: the largest VAO++ sample set at every pixel that
+ * adaptive sampling (4.1) leaves at its maximum; reference: the largest
+ * set at every pixel, no adaptive sampling and no culling (4.2), the
+ * chain's most samples and least approximation. */
+#define OBS_QUALITY_PRESETS(X)                                                 \
+    X(OBS_QUALITY_PREVIEW, ao_resolution, "half")                              \
+    X(OBS_QUALITY_HIGH, samples, "32")                                         \
+    X(OBS_QUALITY_REFERENCE, samples, "32")                                    \
+    X(OBS_QUALITY_REFERENCE, adaptive, "off")                                  \
+    X(OBS_QUALITY_REFERENCE, culling, "off")
+
 /* What the VAO methods' AO measures (parameter `ao_definition`). */
 #define OBS_AO_DEFINITION_LIST(X)                                              \
     X(OBS_AO_RAYS, rays)     /* a ray tracer's AO within radius: R = 2 radius, eq 1's V converted */ \
@@ -121,6 +153,8 @@ typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM
  * (tests/unit/core/test_params.c).  X(parameter, LIST) */
 #define OBS_PARAM_ENUMS(X)                                                     \
     X(method, OBS_METHOD_LIST)                                                 \
+    X(quality, OBS_QUALITY_LIST)                                               \
+    X(ao_resolution, OBS_RESOLUTION_LIST)                                      \
     X(ao_definition, OBS_AO_DEFINITION_LIST)                                   \
     X(adaptive, OBS_SWITCH_LIST)                                               \
     X(culling, OBS_CULLING_LIST)                                               \
@@ -148,6 +182,19 @@ typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM
       "(horizon-based AO); every method shares the input, blur, luminance "    \
       "and composite; the others have no adaptive sampling, culling, range "   \
       "check or bleeding; a parameter of another method is refused")           \
+    X(quality, ENUM, "default", 0, 0, OBS_CHOICES(OBS_QUALITY_LIST),           \
+      "a preset that sets other parameters (a parameter given explicitly "     \
+      "wins): preview (ao_resolution half), default (nothing), high "          \
+      "(samples 32), reference (samples 32, adaptive off, culling off)")       \
+    X(ao_resolution, ENUM, "full", 0, 0, OBS_CHOICES(OBS_RESOLUTION_LIST),     \
+      "full: the AO of every pixel; half: of a quarter of them (half of each " \
+      "axis), each a whole pixel of its 2x2 block (the nearest and the "      \
+      "farthest in a checkerboard, never an average: both sides of a depth "   \
+      "edge stay), blurred at that size, then upsampled to full size by a "    \
+      "joint bilateral filter guided by the full-size depth and normals "      \
+      "(bilinear weights times the cosine between the normals; a texel over "  \
+      "the blur's depth threshold R away is left out). Not with bleeding or "  \
+      "the sample_count/cull_mask outputs")                                    \
     X(radius, FLOAT, 0.5, 1e-4, 1e4, NULL,                                     \
       "AO distance D in world units, as in a ray tracer's AO (the fraction "  \
       "of cosine-weighted rays unblocked within D, Cycles' AO pass); VAO's "   \

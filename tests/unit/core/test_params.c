@@ -153,6 +153,47 @@ static void test_enums_agree_with_choices(void **state)
     assert_int_equal(enums, rows);
 }
 
+/* --quality: each preset row parses; a preset sets what the request left
+ * unset, an explicit parameter wins, default sets nothing. */
+static void test_quality_presets(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+#define ROW_PARSES(q, name, value)                                             \
+    {                                                                          \
+        obs_params t = {0};                                                    \
+        assert_int_equal(obs_param_set(&t, #name, value, err), OBS_OK);        \
+    }
+    OBS_QUALITY_PRESETS(ROW_PARSES)
+#undef ROW_PARSES
+    obs_params p = {0}, r, d;
+    obs_params_resolve(NULL, &d);
+    assert_int_equal(obs_param_set(&p, "quality", "preview", err), OBS_OK);
+    obs_params_resolve(&p, &r);
+    assert_int_equal(r.ao_resolution, OBS_RESOLUTION_HALF);
+    assert_int_equal(r.samples, d.samples);
+    assert_int_equal(obs_param_set(&p, "ao_resolution", "full", err), OBS_OK);
+    obs_params_resolve(&p, &r);
+    assert_int_equal(r.ao_resolution, OBS_RESOLUTION_FULL); /* explicit wins */
+
+    obs_params h = {0};
+    assert_int_equal(obs_param_set(&h, "quality", "reference", err), OBS_OK);
+    assert_int_equal(obs_param_set(&h, "samples", "8", err), OBS_OK);
+    obs_params_resolve(&h, &r);
+    assert_int_equal(r.samples, 8);
+    assert_int_equal(r.adaptive, OBS_OFF);
+    assert_int_equal(r.culling, OBS_CULLING_OFF);
+
+    obs_params s = {0};
+    assert_int_equal(obs_param_set(&s, "quality", "default", err), OBS_OK);
+    obs_params_resolve(&s, &r);
+    d.quality = r.quality;
+    d.method_conflict = r.method_conflict;
+    assert_memory_equal(&r, &d, sizeof r);
+    assert_int_equal(obs_param_set(&s, "quality", "best", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "preview|default|high|reference"));
+}
+
 static void test_status_names(void **state)
 {
     (void)state;
@@ -171,6 +212,7 @@ int main(void)
         cmocka_unit_test(test_errors_name_the_parameter),
         cmocka_unit_test(test_table_is_complete),
         cmocka_unit_test(test_enums_agree_with_choices),
+        cmocka_unit_test(test_quality_presets),
         cmocka_unit_test(test_status_names),
     };
     return cmocka_run_group_tests_name("params", tests, NULL, NULL);
