@@ -223,7 +223,7 @@ static const struct {
 } method_params[] = {
     {offsetof(obs_params, samples), M(VAOPP) | M(VAO), 0,
      "the VAO sample sets; hemisphere takes hemisphere_samples, angle angle_pairs, hbao "
-     "hbao_directions and hbao_steps"},
+     "hbao_directions and hbao_steps, gtao gtao_slices and gtao_steps"},
     {offsetof(obs_params, ao_definition), M(VAOPP) | M(VAO), 0,
      "it converts the volumetric obscurance of VAO (section 3)"},
     {offsetof(obs_params, adaptive), M(VAOPP), OBS_OFF, "adaptive sampling is VAO++'s (4.1)"},
@@ -245,6 +245,13 @@ static const struct {
     {offsetof(obs_params, hbao_directions), M(HBAO), 0, "it is method hbao's"},
     {offsetof(obs_params, hbao_steps), M(HBAO), 0, "it is method hbao's"},
     {offsetof(obs_params, hbao_angle_bias), M(HBAO), 0, "it is method hbao's"},
+    {offsetof(obs_params, gtao_slices), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_steps), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_radius_multiplier), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_falloff), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_thin), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_power), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_heuristics), M(GTAO), 0, "it is method gtao's"},
 };
 #undef M
 
