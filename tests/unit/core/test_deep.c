@@ -468,11 +468,11 @@ static void test_hidden_occluder_hemisphere(void **state)
 static void test_methods_refused(void **state)
 {
     (void)state;
-    static const char *const refused[] = {"hbao", "angle"};
+    static const char *const refused[] = {"hbao", "angle", "gtao"};
     obs_deep_image d;
     obs_deep_result r;
     scene(&d, 9.3f, 1.0f);
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 3; k++) {
         obs_params p = deep_params(OBS_DEEP_MULTI);
         char err[OBS_ERR_LEN] = "", want[64];
         assert_int_equal(obs_param_set(&p, "method", refused[k], err), OBS_OK);
