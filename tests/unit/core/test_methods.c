@@ -358,6 +358,19 @@ static obs_params gtao_exact(int slices, int steps)
     return p;
 }
 
+/* The smallest AO of the CPU chain on scene s. */
+static float min_ao(const scene *s, const obs_params *p)
+{
+    obs_result r;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_run_cpu(&s->gb, p, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    float mn = 1;
+    for (int i = 0; i < W * H; i++)
+        mn = fminf(mn, r.ao.data[i]);
+    obs_result_free(&r);
+    return mn;
+}
+
 /* The slice of angle phi (screen direction (cos phi, sin phi) in view
  * xy) for the orthographic view vector v = +z and the normal n: the
  * projected normal's length L and its angle gamma to v (signed: positive
@@ -422,16 +435,10 @@ static void test_gtao_open_plane(void **state)
     for (int variant = 0; variant < 2; variant++) {
         obs_params p = variant ? gtao_exact(3, 3) : method_params("gtao");
         p.radius = 0.4f;
-        obs_result r;
-        char err[OBS_ERR_LEN] = "";
-        assert_int_equal(obs_run_cpu(&s->gb, &p, OBS_OUTPUT_AO, &r, err), OBS_OK);
-        float mn = 1;
-        for (int i = 0; i < W * H; i++)
-            mn = fminf(mn, r.ao.data[i]);
+        float mn = min_ao(s, &p);
         print_message("gtao open plane facing, %s: min AO %.7f\n",
                       variant ? "heuristics off, power 1" : "defaults", mn);
         assert_true(mn > 1.0f - 1e-5f);
-        obs_result_free(&r);
     }
 
     plane tilted = {{tilt_n[0], tilt_n[1], tilt_n[2]}, -5.0f / l};
@@ -466,15 +473,9 @@ static void test_gtao_open_plane(void **state)
     }
     obs_params p = method_params("gtao");
     p.radius = 0.4f;
-    obs_result r;
-    char err[OBS_ERR_LEN] = "";
-    assert_int_equal(obs_run_cpu(&s->gb, &p, OBS_OUTPUT_AO, &r, err), OBS_OK);
-    float mn = 1;
-    for (int i = 0; i < W * H; i++)
-        mn = fminf(mn, r.ao.data[i]);
+    float mn = min_ao(s, &p);
     print_message("gtao open plane tilted, defaults: min AO %.4f\n", mn);
     assert_true(mn > 0.97f);
-    obs_result_free(&r);
     free(s);
 }
 
