@@ -306,8 +306,8 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
 /* The radius r (depth units) projected at the view point p, in pixels:
  * the square root of the projected area of a disk of radius r
  * perpendicular to the view axis (as obs__adaptive_count measures it);
- * 0 behind the camera (GLSL: radius_px() in method.glsl). */
-float obs__method_radius_px(const obs__frame *f, const float p[3], float r);
+ * 0 behind the camera (GLSL: radius_px() in method.glsl; prep_cpu.c). */
+float obs__radius_px(const obs__frame *f, const float p[3], float r);
 
 /* Ground-truth-based AO (Jimenez et al., as XeGTAO implements it) of the
  * point p with normal n at pixel (x, y) (GLSL: gtao.glsl).  The count of

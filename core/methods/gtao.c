@@ -117,7 +117,7 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const
     int taken = 0;
     if (count)
         *count = 0;
-    float rpx = obs__method_radius_px(f, p, f->gtao_radius);
+    float rpx = obs__radius_px(f, p, f->gtao_radius);
     if (!(rpx > 0.0f))
         return 1.0f; /* behind the camera */
     float c[3] = {p[0] * GTAO_CENTRE_SCALE, p[1] * GTAO_CENTRE_SCALE, p[2] * GTAO_CENTRE_SCALE};

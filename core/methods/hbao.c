@@ -24,7 +24,7 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
 {
     const float R = f->radius, R2 = R * R;
     const float *rot = f->rot[3 * (x % 3) + (y % 3)];
-    float rpx = obs__method_radius_px(f, p, R);
+    float rpx = obs__radius_px(f, p, R);
     if (count)
         *count = 0;
     if (!(rpx >= 1.0f))

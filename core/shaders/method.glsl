@@ -10,7 +10,7 @@ layout(rg32f) readonly uniform image2D u_dz;        // prep: planar depth (x), v
 
 // The radius r projected at p in pixels (the square root of the projected
 // area of a disk of radius r perpendicular to the view axis); 0 behind the
-// camera.  C twin: obs__method_radius_px (methods/methods.c).
+// camera.  C twin: obs__radius_px (chain/prep_cpu.c).
 float radius_px(vec3 p, float r)
 {
     float w = PM(3, 0) * p.x + PM(3, 1) * p.y + PM(3, 2) * p.z + PM(3, 3);
