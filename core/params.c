@@ -357,7 +357,10 @@ obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN])
         switch (pi->type) {
         case OBS_PARAM_FLOAT: {
             float v = *(const float *)field;
-            if (!isfinite(v) || v < pi->min || v > pi->max) {
+            /* the bounds as the float field holds them: obs_param_set
+             * accepts the table's min (1e-6 parsed as a double) and stores
+             * it rounded to a float, which may lie below the double */
+            if (!isfinite(v) || v < (float)pi->min || v > (float)pi->max) {
                 snprintf(text, sizeof text, "%g", v);
                 return range_error(pi, text, err);
             }
