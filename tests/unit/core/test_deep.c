@@ -708,8 +708,9 @@ static double pattern_energy(const obs_deep_image *d, const float *ao)
 
 /* Deep input takes the flat chain's blur: the 3x3 pattern's energy of
  * both planes (front node, blend) falls with it on, by more than 10 times
- * on the fixture (measured below), and GL equals the CPU twin with it
- * off, on and at another radius. */
+ * on the fixture (measured: 246 times on the front node's, 21 on the
+ * blend's), and GL equals the CPU twin with it off, on and at another
+ * radius. */
 static void test_blur(void **state)
 {
     (void)state;
