@@ -508,6 +508,8 @@ static int cmd_ao(int argc, char **argv)
         else if (p.method == OBS_METHOD_HBAO)
             snprintf(how, sizeof how, "hbao, %d directions x %d steps", p.hbao_directions,
                      p.hbao_steps);
+        else if (p.method == OBS_METHOD_GTAO)
+            snprintf(how, sizeof how, "gtao, %d slices x %d steps", p.gtao_slices, p.gtao_steps);
         else
             snprintf(how, sizeof how, "%s, %d samples", p.method == OBS_METHOD_VAO ? "vao" : "vaopp",
                      p.samples);

@@ -223,7 +223,7 @@ static const struct {
 } method_params[] = {
     {offsetof(obs_params, samples), M(VAOPP) | M(VAO), 0,
      "the VAO sample sets; hemisphere takes hemisphere_samples, angle angle_pairs, hbao "
-     "hbao_directions and hbao_steps"},
+     "hbao_directions and hbao_steps, gtao gtao_slices and gtao_steps"},
     {offsetof(obs_params, ao_definition), M(VAOPP) | M(VAO), 0,
      "it converts the volumetric obscurance of VAO (section 3)"},
     {offsetof(obs_params, adaptive), M(VAOPP), OBS_OFF, "adaptive sampling is VAO++'s (4.1)"},
@@ -245,6 +245,13 @@ static const struct {
     {offsetof(obs_params, hbao_directions), M(HBAO), 0, "it is method hbao's"},
     {offsetof(obs_params, hbao_steps), M(HBAO), 0, "it is method hbao's"},
     {offsetof(obs_params, hbao_angle_bias), M(HBAO), 0, "it is method hbao's"},
+    {offsetof(obs_params, gtao_slices), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_steps), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_radius_multiplier), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_falloff), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_thin), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_power), M(GTAO), 0, "it is method gtao's"},
+    {offsetof(obs_params, gtao_heuristics), M(GTAO), 0, "it is method gtao's"},
 };
 #undef M
 
@@ -379,7 +386,10 @@ obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN])
         switch (pi->type) {
         case OBS_PARAM_FLOAT: {
             float v = *(const float *)field;
-            if (!isfinite(v) || v < pi->min || v > pi->max) {
+            /* the bounds as the float field holds them: obs_param_set
+             * accepts the table's min (1e-6 parsed as a double) and stores
+             * it rounded to a float, which may lie below the double */
+            if (!isfinite(v) || v < (float)pi->min || v > (float)pi->max) {
                 snprintf(text, sizeof text, "%g", v);
                 return range_error(pi, text, err);
             }

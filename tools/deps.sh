@@ -8,9 +8,10 @@ libopenexr-dev libpng-dev libcjson-dev libcmocka-dev zlib1g-dev libmicrohttpd-de
 libassimp-dev libembree-dev"
 # Only for the tests: the preview page in a real browser (Chromium; node
 # and npm fetch playwright-core), the deploy checks (systemd-analyze,
-# PyYAML).  `deps.sh --build` leaves them out (deploy/container).
+# PyYAML), make quality's referee (shared/tools/aometrics.py: numpy,
+# OpenImageIO).  `deps.sh --build` leaves them out (deploy/container).
 if [ "${1:-}" != "--build" ]; then
-    PKGS="$PKGS chromium nodejs python3-yaml systemd"
+    PKGS="$PKGS chromium nodejs python3-yaml systemd python3-numpy python3-openimageio"
     command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
 fi
 

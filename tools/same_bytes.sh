@@ -43,12 +43,12 @@ for s in room_small yard_small; do
     run "$s" "$D/$s.exr" --camera "$D/$s.camera.json" --output both
     "$OBSCURA" ao "$D/$s.exr" --camera "$D/$s.camera.json" --output ao,composite,samples,cull,bleed,luminance \
         --float -o "$OUT/$s.all.exr" -q
-    for m in hemisphere angle hbao vao; do
+    for m in hemisphere angle hbao gtao vao; do
         run "$s.$m" "$D/$s.exr" --camera "$D/$s.camera.json" --method $m
         "$OBSCURA" ao "$D/$s.exr" --camera "$D/$s.camera.json" --method $m --float -o "$OUT/$s.$m.float.exr" -q
     done
     "$OBSCURA" ao "$D/$s.exr" --camera "$D/$s.camera.json" --output both --cpu -o "$OUT/$s.cpu.exr" -q
-    for m in hemisphere angle hbao; do
+    for m in hemisphere angle hbao gtao; do
         "$OBSCURA" ao "$D/$s.exr" --camera "$D/$s.camera.json" --method $m --cpu -o "$OUT/$s.$m.cpu.exr" -q
     done
 done

@@ -41,6 +41,12 @@ typedef struct obs__targets {
     GLuint fbo_cull;                          /* culling pre-pass: tex_cull */
 } obs__targets;
 
+/* Builds, on its first use, the blur program of half-width radius
+ * (section 4.6; rays 1: the vertical pass that converts for
+ * ao_definition rays) into ctx->prog.blur[rays][radius] (run_gl.c; the
+ * deep pass, deep_gl.c, blurs with it too). */
+obs_status obs__blur_program(obs_ctx *ctx, int rays, int radius, char err[OBS_ERR_LEN]);
+
 /* Deletes the chain's textures, framebuffers and programs (run_gl.c);
  * the context is current.  With prog NULL the programs stay. */
 void obs__chain_release(obs__programs *prog, obs__targets *tg);

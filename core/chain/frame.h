@@ -77,6 +77,14 @@ typedef struct obs__frame {
     int hbao_dirs, hbao_steps;
     float hbao_dir[OBS_MAX_DIRECTIONS][2];
     float hbao_bias_cs[2];  /* cos, sin of the angle bias */
+    /* method gtao (methods/gtao.c): slices, steps per side, XeGTAO's
+     * heuristics (1: on); the search radius gtao_multiplier * D in depth
+     * units; the falloff's weight = saturate(r * mul + add); the
+     * thin-occluder compensation and the final power */
+    int gtao_slices, gtao_steps, gtao_heuristics;
+    float gtao_radius;
+    float gtao_falloff[2];    /* mul, add */
+    float gtao_thin_power[2]; /* gtao_thin, gtao_power */
 } obs__frame;
 
 /* The frame's values as the shaders read them: the uniform block Frame
@@ -325,6 +333,24 @@ float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, cons
  * goes to *count when count is not NULL. */
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count);
+
+/* The radius r (depth units) projected at the view point p, in pixels:
+ * the square root of the projected area of a disk of radius r
+ * perpendicular to the view axis (as obs__adaptive_count measures it);
+ * 0 behind the camera (GLSL: radius_px() in method.glsl; prep_cpu.c). */
+float obs__radius_px(const obs__frame *f, const float p[3], float r);
+
+/* Ground-truth-based AO (Jimenez et al., as XeGTAO implements it) of the
+ * point p with normal n at pixel (x, y) (GLSL: gtao.glsl).  The count of
+ * depth samples read inside the image goes to *count when count is not
+ * NULL. */
+float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                      const float n[3], int *count);
+
+/* The noise of the 3x3 tile's pixel (x, y): XeGTAO's R2 sequence,
+ * fract(0.5 + k (0.754877666, 0.569840291)), k = 3 (x % 3) + (y % 3);
+ * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
+void obs__gtao_noise(int x, int y, float out[2]);
 
 /* The AO of pixel (x, y) by the frame's method other than vaopp/vao
  * (position and normal from the planes); *count: samples taken (GLSL:

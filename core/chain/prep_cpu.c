@@ -159,3 +159,18 @@ int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy)
     *qy = (int)fv;
     return 1;
 }
+
+/* GLSL: radius_px() in method.glsl */
+float obs__radius_px(const obs__frame *f, const float p[3], float r)
+{
+    const float *P = f->proj;
+    float w = P[12] * p[0] + P[13] * p[1] + P[14] * p[2] + P[15];
+    if (!(w > 0.0f))
+        return 0.0f;
+    float X = P[0] * p[0] + P[1] * p[1] + P[2] * p[2] + P[3];
+    float Y = P[4] * p[0] + P[5] * p[1] + P[6] * p[2] + P[7];
+    float w2 = w * w;
+    float j00 = (P[0] * w - X * P[12]) / w2, j01 = (P[1] * w - X * P[13]) / w2;
+    float j10 = (P[4] * w - Y * P[12]) / w2, j11 = (P[5] * w - Y * P[13]) / w2;
+    return r * sqrtf(fabsf(j00 * j11 - j01 * j10) * f->viewport[2] * f->viewport[3] * 0.25f);
+}

@@ -101,7 +101,7 @@ static obs_status build_prep_program(obs_ctx *ctx, const obs__frame *f, char err
  * the radius is a compile-time constant, so the taps' loop is unrolled;
  * rays 1 is the vertical pass that also converts its result
  * (ao_definition rays, OBS_RAYS in blur.frag.glsl). */
-static obs_status build_blur_program(obs_ctx *ctx, int rays, int radius, char err[OBS_ERR_LEN])
+obs_status obs__blur_program(obs_ctx *ctx, int rays, int radius, char err[OBS_ERR_LEN])
 {
     if (radius <= 0 || ctx->prog.blur[rays][radius])
         return OBS_OK;
@@ -399,9 +399,9 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     const int rays_in_blur = f.rays && f.blur_radius > 0 && !f.half;
     const int finish_rays = f.rays && !rays_in_blur && !f.half, finish_lum = f.luminance != 0;
     if (s == OBS_OK)
-        s = build_blur_program(ctx, 0, f.blur_radius, err);
+        s = obs__blur_program(ctx, 0, f.blur_radius, err);
     if (s == OBS_OK)
-        s = build_blur_program(ctx, rays_in_blur, f.blur_radius, err);
+        s = obs__blur_program(ctx, rays_in_blur, f.blur_radius, err);
     if (s == OBS_OK)
         s = build_finish_program(ctx, finish_rays, finish_lum, err);
     if (s == OBS_OK)

@@ -336,6 +336,19 @@ obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
             size_t i = (size_t)y * d->width + x;
             out->ao_blend.data[i] = obs__deep_pixel(&df, x, y, &out->ao_front.data[i]);
         }
+    /* the low-pass filter (VAO++ 4.6) of both, the flat chain's twin with
+     * the front node's plane as its positions (GLSL: deep_gl.c) */
+    if (df.f.blur_radius > 0) {
+        float *tmp = malloc((size_t)d->width * (size_t)d->height * sizeof *tmp);
+        if (!tmp) {
+            obs__deep_frame_free(&df);
+            obs_deep_result_free(out);
+            return obs__fail(err, OBS_NO_MEMORY, "deep blur of %dx%d", d->width, d->height);
+        }
+        obs__blur(&df.f, df.pos, out->ao_front.data, tmp);
+        obs__blur(&df.f, df.pos, out->ao_blend.data, tmp);
+        free(tmp);
+    }
     obs__deep_composite(d, out);
     obs__deep_frame_free(&df);
     return OBS_OK;

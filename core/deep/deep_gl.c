@@ -3,15 +3,21 @@
  * (deep_cpu.c: view position, normal, alpha), uploaded as two 2D array
  * textures of m layers (RGBA32F: position + planar depth, normal +
  * alpha) and one fragment pass (core/shaders/deep.frag.glsl) writes the
- * front node's AO and the blended AO.
+ * front node's AO and the blended AO, each beside the front node's
+ * planar depth; with the blur on (VAO++ 4.6, as the flat chain: --blur,
+ * --blur-radius) both are blurred by the flat chain's program
+ * (blur.frag.glsl, without the rays conversion: the deep pass converts
+ * each node's AO before the blend), the front node's depth as the edge
+ * guide, as the CPU twin does with obs__blur.
  *
  * The program is built once per context; the array textures, the output
  * texture and its framebuffer are kept for the next frame of the same
  * size and node count (the daemon runs deep frames back to back), as the
  * flat chain keeps its targets (run_gl.c).
  *
- * With obs_ctx_set_timing the upload, the AO pass and the read-back
- * (OBS_PASS_UPLOAD, OBS_PASS_AO, OBS_PASS_READBACK) are timed on the host
+ * With obs_ctx_set_timing the upload, the AO pass, the blur and the
+ * read-back (OBS_PASS_UPLOAD, OBS_PASS_AO, OBS_PASS_BLUR,
+ * OBS_PASS_READBACK) are timed on the host
  * between glFinish calls, not with GL_TIME_ELAPSED queries: Mesa's
  * llvmpipe ends a query that no draw follows at its next flush, so with
  * the node textures of the last frame reused the AO pass's whole cost
@@ -22,6 +28,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "chain/chain_gl.h"
 #include "chain/frame_gl.h"
 #include "context.h"
 #include "deep/deep_internal.h"
@@ -54,10 +61,12 @@ static void upload_layers(GLuint tex, int w, int h, int m, const float *data)
 /* Drops the size-dependent objects; the program stays unless `all`. */
 static void release(obs__deep_targets *t, int all)
 {
-    GLuint tex[] = {t->tex_pos, t->tex_nrm, t->tex_out};
-    glDeleteTextures(3, tex);
-    if (t->fbo)
-        glDeleteFramebuffers(1, &t->fbo);
+    GLuint tex[] = {t->tex_pos, t->tex_nrm, t->tex_front, t->tex_blend, t->tex_tmp};
+    glDeleteTextures(5, tex);
+    GLuint fbo[] = {t->fbo, t->fbo_front, t->fbo_blend, t->fbo_tmp};
+    for (int i = 0; i < 4; i++)
+        if (fbo[i])
+            glDeleteFramebuffers(1, &fbo[i]);
     GLuint prog[OBS__DEEP_VARIANTS];
     memcpy(prog, t->prog, sizeof prog);
     memset(t, 0, sizeof *t);
@@ -84,6 +93,39 @@ static unsigned deep_variant(const obs__deep_frame *df)
     return (df->f.method == OBS_METHOD_HEMISPHERE ? DEEP_HEMISPHERE : 0u) |
            (df->thin ? DEEP_THIN : 0u) | (df->f.range_check ? DEEP_RANGE : 0u) |
            (df->f.rays ? DEEP_RAYS : 0u);
+}
+
+/* A framebuffer writing the n textures; OBS_GL_ERROR when incomplete. */
+static obs_status deep_fbo(obs_ctx *ctx, GLuint *fbo, const GLuint *tex, int n)
+{
+    GLenum bufs[2];
+    glGenFramebuffers(1, fbo);
+    ctx->gl_objects_created++;
+    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+    for (int i = 0; i < n; i++) {
+        bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
+        glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, tex[i], 0);
+    }
+    glDrawBuffers(n, bufs);
+    return glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE ? OBS_OK
+                                                                              : OBS_GL_ERROR;
+}
+
+/* The flat chain's blur (blur.frag.glsl, no rays conversion) of the RG
+ * plane tex in place, through tmp: along x into tmp, along y back. */
+static void blur_plane(obs_ctx *ctx, GLuint prog, const obs__deep_targets *t, GLuint tex,
+                       GLuint fbo)
+{
+    glUseProgram(prog);
+    for (int pass = 0; pass < 2; pass++) {
+        glBindImageTexture(0, pass ? t->tex_tmp : tex, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RG32F);
+        glUniform1i(glGetUniformLocation(prog, "u_ao"), 0);
+        glUniform2i(glGetUniformLocation(prog, "u_dir"), pass ? 0 : 1, pass ? 1 : 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, pass ? fbo : t->fbo_tmp);
+        glViewport(0, 0, t->width, t->height);
+        glBindVertexArray(ctx->dev.vao);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
 }
 
 /* The program of variant v, and the targets for w x h with m nodes: kept
@@ -117,22 +159,25 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     release(&ctx->deep, 0);
     t->tex_pos = array_texture(ctx, w, h, m);
     t->tex_nrm = array_texture(ctx, w, h, m);
-    /* two RGBA32F arrays of m layers and the RGBA32F output */
-    t->bytes = (unsigned long long)w * (unsigned long long)h * 16ull * (2ull * (unsigned)m + 1ull);
-    glGenTextures(1, &t->tex_out);
-    ctx->gl_objects_created++;
-    glBindTexture(GL_TEXTURE_2D, t->tex_out);
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
-    glGenFramebuffers(1, &t->fbo);
-    ctx->gl_objects_created++;
-    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->tex_out, 0);
-    GLenum buf = GL_COLOR_ATTACHMENT0;
-    glDrawBuffers(1, &buf);
-    GLenum st = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    s = st == GL_FRAMEBUFFER_COMPLETE
-            ? obs__gl_check("allocating deep targets", err)
-            : obs__fail(err, OBS_GL_ERROR, "deep AO framebuffer incomplete (0x%04x)", (unsigned)st);
+    /* two RGBA32F arrays of m layers and three RG32F planes */
+    t->bytes = (unsigned long long)w * (unsigned long long)h * (16ull * 2ull * (unsigned)m + 3ull * 8ull);
+    GLuint *planes[] = {&t->tex_front, &t->tex_blend, &t->tex_tmp};
+    for (int i = 0; i < 3; i++) {
+        glGenTextures(1, planes[i]);
+        ctx->gl_objects_created++;
+        glBindTexture(GL_TEXTURE_2D, *planes[i]);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, w, h);
+    }
+    const GLuint pass_out[] = {t->tex_front, t->tex_blend};
+    s = deep_fbo(ctx, &t->fbo, pass_out, 2);
+    if (s == OBS_OK)
+        s = deep_fbo(ctx, &t->fbo_front, &t->tex_front, 1);
+    if (s == OBS_OK)
+        s = deep_fbo(ctx, &t->fbo_blend, &t->tex_blend, 1);
+    if (s == OBS_OK)
+        s = deep_fbo(ctx, &t->fbo_tmp, &t->tex_tmp, 1);
+    s = s == OBS_OK ? obs__gl_check("allocating deep targets", err)
+                    : obs__fail(err, OBS_GL_ERROR, "deep AO framebuffer incomplete");
     if (s != OBS_OK) {
         release(&ctx->deep, 0);
         return s;
@@ -166,7 +211,6 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
                         obs_deep_result *out, char err[OBS_ERR_LEN])
 {
     obs__deep_frame df;
-    float *rgba = NULL;
     obs_pass_times times;
     double t0 = 0.0;
     const double t_run = obs__now_ms(); /* obs_ctx_set_deadline counts from here */
@@ -184,12 +228,10 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     const int w = f->width, h = f->height;
     if ((s = obs__deep_result_alloc(out, w, h, err)) != OBS_OK)
         goto fail;
-    if (!(rgba = malloc((size_t)w * (size_t)h * 4 * sizeof *rgba))) {
-        s = obs__fail(err, OBS_NO_MEMORY, "deep AO read-back of %dx%d", w, h);
-        goto fail;
-    }
     const unsigned variant = deep_variant(&df);
     if ((s = ensure_deep(ctx, variant, w, h, df.m, err)) != OBS_OK)
+        goto fail;
+    if ((s = obs__blur_program(ctx, 0, f->blur_radius, err)) != OBS_OK)
         goto fail;
     /* the frame's values, read by the pass (common.glsl's Frame block) */
     if ((s = obs__frame_block_bind(ctx, f, err)) != OBS_OK)
@@ -224,28 +266,37 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
         goto fail;
     }
 
+    /* the low-pass filter (VAO++ 4.6) of both planes, as the flat chain's */
+    if (f->blur_radius > 0) {
+        stage_begin(ctx, &t0);
+        const GLuint blur = ctx->prog.blur[0][f->blur_radius];
+        blur_plane(ctx, blur, t, t->tex_front, t->fbo_front);
+        blur_plane(ctx, blur, t, t->tex_blend, t->fbo_blend);
+        stage_end(ctx, OBS_PASS_BLUR, t0, &times);
+    }
+
     stage_begin(ctx, &t0);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo_front);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, out->ao_front.data);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo_blend);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, out->ao_blend.data);
     stage_end(ctx, OBS_PASS_READBACK, t0, &times);
     glActiveTexture(GL_TEXTURE0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if ((s = obs__gl_check("deep AO pass", err)) != OBS_OK)
         goto fail;
     if (ctx->timing) {
-        times.total_ms = times.ms[OBS_PASS_UPLOAD] + times.ms[OBS_PASS_AO] + times.ms[OBS_PASS_READBACK];
+        times.total_ms = times.ms[OBS_PASS_UPLOAD] + times.ms[OBS_PASS_AO] +
+                         (times.ms[OBS_PASS_BLUR] > 0.0 ? times.ms[OBS_PASS_BLUR] : 0.0) +
+                         times.ms[OBS_PASS_READBACK];
         ctx->times = times;
         ctx->times_valid = 1;
     }
-    for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
-        out->ao_front.data[i] = rgba[4 * i];
-        out->ao_blend.data[i] = rgba[4 * i + 1];
-    }
     obs__deep_composite(d, out);
 fail:
-    free(rgba);
     obs__deep_frame_free(&df);
     if (s != OBS_OK)
         obs_deep_result_free(out);

@@ -14,7 +14,11 @@ typedef struct obs__deep_targets {
     int width, height, m;        /* 0: none allocated yet */
     unsigned long long bytes;    /* the textures' storage (obs_ctx_kept_bytes) */
     GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
-    GLuint tex_out, fbo;         /* AO of the front node and the blend */
+    /* RG32F (AO, the front node's planar depth, for the blur): the front
+     * node's AO, the blend, and the blur's intermediate; fbo writes the
+     * first two (the deep pass), the others one each (the blur) */
+    GLuint tex_front, tex_blend, tex_tmp;
+    GLuint fbo, fbo_front, fbo_blend, fbo_tmp;
 } obs__deep_targets;
 
 /* Deletes the programs, textures and framebuffer; the context is current.

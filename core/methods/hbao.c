@@ -18,30 +18,13 @@
 
 #include "chain/frame.h"
 
-/* R projected at p in pixels (the square root of the projected area of a
- * disk of radius R perpendicular to the view axis, as obs__adaptive_count
- * measures it); 0 behind the camera. */
-static float radius_px(const obs__frame *f, const float p[3])
-{
-    const float *P = f->proj;
-    float w = P[12] * p[0] + P[13] * p[1] + P[14] * p[2] + P[15];
-    if (!(w > 0.0f))
-        return 0.0f;
-    float X = P[0] * p[0] + P[1] * p[1] + P[2] * p[2] + P[3];
-    float Y = P[4] * p[0] + P[5] * p[1] + P[6] * p[2] + P[7];
-    float w2 = w * w;
-    float j00 = (P[0] * w - X * P[12]) / w2, j01 = (P[1] * w - X * P[13]) / w2;
-    float j10 = (P[4] * w - Y * P[12]) / w2, j11 = (P[5] * w - Y * P[13]) / w2;
-    return f->radius * sqrtf(fabsf(j00 * j11 - j01 * j10) * f->viewport[2] * f->viewport[3] * 0.25f);
-}
-
 /* GLSL: hbao_ao() in hbao.glsl */
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count)
 {
     const float R = f->radius, R2 = R * R;
     const float *rot = f->rot[3 * (x % 3) + (y % 3)];
-    float rpx = radius_px(f, p);
+    float rpx = obs__radius_px(f, p, R);
     if (count)
         *count = 0;
     if (!(rpx >= 1.0f))

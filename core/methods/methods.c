@@ -1,5 +1,5 @@
 /* The table of AO methods (methods.h) and the AO pass of the comparison
- * methods (hemisphere, angle, hbao), which take the place of the VAO
+ * methods (hemisphere, angle, hbao, gtao), which take the place of the VAO
  * estimator in the chain: the CPU twin of method.frag.glsl. */
 #include <math.h>
 
@@ -35,6 +35,24 @@ static void hbao_setup(const obs_params *p, obs__frame *f)
     f->hbao_bias_cs[1] = (float)sin(p->hbao_angle_bias * M_PI / 180.0);
 }
 
+static void gtao_setup(const obs_params *p, obs__frame *f)
+{
+    f->gtao_slices = p->gtao_slices;
+    f->gtao_steps = p->gtao_steps;
+    f->gtao_heuristics = p->gtao_heuristics == OBS_ON;
+    /* XeGTAO: effectRadius = EffectRadius * RadiusMultiplier; the falloff
+     * range is EffectFalloffRange * effectRadius, and a sample at
+     * distance r weighs saturate(r * falloffMul + falloffAdd), 1 up to
+     * falloffFrom = effectRadius (1 - EffectFalloffRange), 0 at the
+     * radius */
+    float R = f->radius * p->gtao_radius_multiplier, range = p->gtao_falloff * R;
+    f->gtao_radius = R;
+    f->gtao_falloff[0] = -1.0f / range;
+    f->gtao_falloff[1] = R * (1.0f - p->gtao_falloff) / range + 1.0f;
+    f->gtao_thin_power[0] = p->gtao_thin;
+    f->gtao_thin_power[1] = p->gtao_power;
+}
+
 /* The methods' twins behind one signature (GLSL: method_ao()). */
 static float hemisphere_ao(const obs__frame *f, const float *pos, int x, int y, const float p[4],
                            const float n[3], int *count)
@@ -56,11 +74,18 @@ static float hbao_ao(const obs__frame *f, const float *pos, int x, int y, const 
     return obs__hbao_pixel(f, pos, x, y, p, n, count);
 }
 
+static float gtao_ao(const obs__frame *f, const float *pos, int x, int y, const float p[4],
+                     const float n[3], int *count)
+{
+    return obs__gtao_pixel(f, pos, x, y, p, n, count);
+}
+
 /* Samples per pixel, for obs_frame_cost. */
 static int vao_samples(const obs_params *p) { return p->samples; }
 static int hemisphere_samples(const obs_params *p) { return p->hemisphere_samples; }
 static int angle_samples(const obs_params *p) { return 2 * p->angle_pairs; }
 static int hbao_samples(const obs_params *p) { return p->hbao_directions * p->hbao_steps; }
+static int gtao_samples(const obs_params *p) { return 2 * p->gtao_slices * p->gtao_steps; }
 
 #define F(field) offsetof(obs__frame, field)
 
@@ -86,6 +111,15 @@ static const obs__method methods[] = {
       {"u_hbao_steps", OBS__U_INT, F(hbao_steps), 0, 0},
       {"u_hbao_dir", OBS__U_VEC2, F(hbao_dir), F(hbao_dirs), 1},
       {"u_hbao_bias_cs", OBS__U_VEC2, F(hbao_bias_cs), 0, 0},
+      {NULL}},
+     0},
+    {OBS_METHOD_GTAO, "gtao", obs__shader_gtao, gtao_setup, gtao_ao, gtao_samples,
+     {{"u_gtao_slices", OBS__U_INT, F(gtao_slices), 0, 0},
+      {"u_gtao_steps", OBS__U_INT, F(gtao_steps), 0, 0},
+      {"u_gtao_heuristics", OBS__U_INT, F(gtao_heuristics), 0, 0},
+      {"u_gtao_radius", OBS__U_FLOAT, F(gtao_radius), 0, 0},
+      {"u_gtao_falloff", OBS__U_VEC2, F(gtao_falloff), 0, 0},
+      {"u_gtao_thin_power", OBS__U_VEC2, F(gtao_thin_power), 0, 0},
       {NULL}},
      0},
 };

@@ -11,7 +11,7 @@
 #include "chain/frame.h"
 #include "gl/uniform.h"
 
-#define OBS__METHOD_MAX_UNIFORMS 6
+#define OBS__METHOD_MAX_UNIFORMS 8
 
 typedef struct obs__method {
     obs_method id;

@@ -28,7 +28,10 @@ uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node
 #define HS_ALPHA(q, k) imageLoad(u_lnrm, ivec3(q, k)).w
 float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
 
-layout(location = 0) out vec4 o_ao; // (front node's AO, blended AO, 0, 1)
+// the front node's AO and the blended AO, each beside the front node's
+// planar depth (0: empty), as the blur reads them (blur.frag.glsl)
+layout(location = 0) out vec2 o_front;
+layout(location = 1) out vec2 o_blend;
 
 // The length of the pipe [front, front + 2h] hidden by a node at planar
 // depth zs with view normal z nz: VAO++ section 3's cases with the node as
@@ -136,5 +139,7 @@ void main()
         acc += T * a * ao;   // "over", front to back
         T *= 1.0 - a;
     }
-    o_ao = vec4(front, acc + T, 0.0, 1.0);
+    float z0 = max(imageLoad(u_lpos, ivec3(px, 0)).w, 0.0);
+    o_front = vec2(front, z0);
+    o_blend = vec2(acc + T, z0);
 }

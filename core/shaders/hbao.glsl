@@ -9,25 +9,11 @@ uniform int u_hbao_steps;        // Ns
 uniform vec2 u_hbao_dir[OBS_MAX_DIRECTIONS];     // unit directions over 2 pi (view xy)
 uniform vec2 u_hbao_bias_cs;     // cos, sin of the angle bias
 
-// R projected at p in pixels; 0 behind the camera.
-float radius_px(vec3 p)
-{
-    float w = PM(3, 0) * p.x + PM(3, 1) * p.y + PM(3, 2) * p.z + PM(3, 3);
-    if (!(w > 0.0))
-        return 0.0;
-    float X = PM(0, 0) * p.x + PM(0, 1) * p.y + PM(0, 2) * p.z + PM(0, 3);
-    float Y = PM(1, 0) * p.x + PM(1, 1) * p.y + PM(1, 2) * p.z + PM(1, 3);
-    float w2 = w * w;
-    float j00 = (PM(0, 0) * w - X * PM(3, 0)) / w2, j01 = (PM(0, 1) * w - X * PM(3, 1)) / w2;
-    float j10 = (PM(1, 0) * w - Y * PM(3, 0)) / w2, j11 = (PM(1, 1) * w - Y * PM(3, 1)) / w2;
-    return u_radius * sqrt(abs(j00 * j11 - j01 * j10) * u_viewport.z * u_viewport.w * 0.25);
-}
-
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
 {
     float R = u_radius, R2 = R * R;
     vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
-    float rpx = radius_px(p.xyz);
+    float rpx = radius_px(p.xyz, R);
     count = 0;
     if (!(rpx >= 1.0))
         return 1.0;                       // the kernel reaches no other pixel

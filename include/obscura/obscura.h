@@ -188,7 +188,7 @@ void obs_result_free(obs_result *r);
 /* The work a frame asks for, in samples: width x height x the samples per
  * pixel of its method (vaopp, vao: samples; hemisphere:
  * hemisphere_samples; angle: 2 x angle_pairs; hbao: hbao_directions x
- * hbao_steps), times deep_layers squared for deep input (every node's
+ * hbao_steps; gtao: 2 x gtao_slices x gtao_steps), times deep_layers squared for deep input (every node's
  * samples test every node at their pixel; 0 or 1: a flat frame).  A
  * measure to refuse frames by before running them (obscurad --max-cost);
  * parameters as obs_run takes them (NULL: defaults). */

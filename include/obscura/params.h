@@ -75,7 +75,8 @@ typedef enum obs_bleeding { OBS_BLEEDING_DEFAULT, OBS_BLEEDING_LIST(OBS__ENUM_VA
     X(OBS_METHOD_VAO, vao)               /* plain VAO: no adaptive sampling, culling, range check */ \
     X(OBS_METHOD_HEMISPHERE, hemisphere) /* normal-oriented hemisphere SSAO */ \
     X(OBS_METHOD_ANGLE, angle)           /* angle-based paired-sample SSAO */  \
-    X(OBS_METHOD_HBAO, hbao)             /* horizon-based AO */
+    X(OBS_METHOD_HBAO, hbao)             /* horizon-based AO */            \
+    X(OBS_METHOD_GTAO, gtao)             /* ground-truth-based AO (XeGTAO) */
 typedef enum obs_method {
     OBS_METHOD_DEFAULT,
     OBS_METHOD_LIST(OBS__ENUM_VALUE)
@@ -166,6 +167,7 @@ typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM
     X(luminance, OBS_LUMINANCE_LIST)                                           \
     X(bleeding, OBS_BLEEDING_LIST)                                             \
     X(angle_acos, OBS_ACOS_LIST)                                               \
+    X(gtao_heuristics, OBS_SWITCH_LIST)                                        \
     X(deep_mode, OBS_DEEP_MODE_LIST)                                           \
     X(deep_front_half, OBS_SWITCH_LIST)                                        \
     X(deep_hull, OBS_DEEP_HULL_LIST)
@@ -179,7 +181,8 @@ typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM
       "AO method: vaopp (the VAO++ chain), vao (plain VAO, VAO++ section 3: "  \
       "adaptive, culling and range_check off), hemisphere (normal-oriented "   \
       "hemisphere SSAO), angle (angle-based paired-sample SSAO), hbao "        \
-      "(horizon-based AO); every method shares the input, blur, luminance "    \
+      "(horizon-based AO), gtao (ground-truth-based AO as XeGTAO implements "  \
+      "it); every method shares the input, blur, luminance "    \
       "and composite; the others have no adaptive sampling, culling, range "   \
       "check or bleeding; a parameter of another method is refused")           \
     X(quality, ENUM, "default", 0, 0, OBS_CHOICES(OBS_QUALITY_LIST),           \
@@ -327,6 +330,32 @@ typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM
     X(hbao_angle_bias, FLOAT, 30.0, 1e-6, 89.0, NULL,                          \
       "method hbao: angle bias in degrees added to the tangent angle t(theta) "\
       "against the self-occlusion of tessellated surfaces")                   \
+    X(gtao_slices, INT, 3, 1, 32, NULL,                                        \
+      "method gtao: slices (screen-space directions over pi, each searched "   \
+      "both ways) per pixel; XeGTAO's presets take 1, 2, 3 (High, its "        \
+      "default) and 9")                                                        \
+    X(gtao_steps, INT, 3, 1, 32, NULL,                                         \
+      "method gtao: horizon samples per side of a slice (XeGTAO: 2 to 3)")    \
+    X(gtao_radius_multiplier, FLOAT, 1.457, 0.1, 4.0, NULL,                    \
+      "method gtao: the search radius is gtao_radius_multiplier * D; 1.457 "   \
+      "is XeGTAO's default, fitted by its authors to their ray-traced "        \
+      "ground truth; 1 searches exactly the AO distance")                      \
+    X(gtao_falloff, FLOAT, 0.615, 1e-6, 1.0, NULL,                             \
+      "method gtao: a sample's weight falls linearly from 1 to 0 over the "    \
+      "last gtao_falloff of the search radius (XeGTAO's EffectFalloffRange, "  \
+      "0.615); near 0: a hard cut at the radius")                              \
+    X(gtao_thin, FLOAT, 0.0, 0.0, 0.7, NULL,                                   \
+      "method gtao: XeGTAO's thin-occluder compensation: the falloff reads "   \
+      "the sample's depth offset scaled by 1 + gtao_thin, so samples far in "  \
+      "depth fade sooner (XeGTAO's default 0)")                                \
+    X(gtao_power, FLOAT, 2.2, 0.5, 5.0, NULL,                                  \
+      "method gtao: the visibility is raised to this power (XeGTAO's "         \
+      "FinalValuePower, 2.2); 1 leaves the slice integral as it is")          \
+    X(gtao_heuristics, ENUM, "on", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),            \
+      "method gtao: XeGTAO's three empirical corrections: the projected "      \
+      "normal's length moved 5 % towards 1, a fade towards open for search "   \
+      "radii under 10 pixels, visibility at least 0.03; off: the slice "       \
+      "integral of Jimenez et al. as written")                                 \
     X(deep_mode, ENUM, "multi", 0, 0, OBS_CHOICES(OBS_DEEP_MODE_LIST),                          \
       "deep input: multi (OITAO Algorithm 1: each sample is occluded by every "\
       "compressed node at its pixel, the largest occlusion counts) or single " \
@@ -396,7 +425,7 @@ void obs_param_format(const obs_params *p, const obs_param_info *pi, char *buf,
 /* out = in with every zero field replaced by its default, then the
  * settings the method fixes: methods other than vaopp have adaptive
  * sampling, culling and the depth range check off (VAO++ features), and
- * methods hemisphere, angle and hbao have bleeding off too (it gathers the
+ * methods hemisphere, angle, hbao and gtao have bleeding off too (it gathers the
  * colour at the VAO samples).  A parameter that in gave (non-zero) and
  * that the method does not use or fixes otherwise is recorded in
  * out->method_conflict; obs_params_check then refuses it. */

@@ -468,11 +468,11 @@ static void test_hidden_occluder_hemisphere(void **state)
 static void test_methods_refused(void **state)
 {
     (void)state;
-    static const char *const refused[] = {"hbao", "angle"};
+    static const char *const refused[] = {"hbao", "angle", "gtao"};
     obs_deep_image d;
     obs_deep_result r;
     scene(&d, 9.3f, 1.0f);
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 3; k++) {
         obs_params p = deep_params(OBS_DEEP_MULTI);
         char err[OBS_ERR_LEN] = "", want[64];
         assert_int_equal(obs_param_set(&p, "method", refused[k], err), OBS_OK);
@@ -626,8 +626,8 @@ static void test_gl_twin(void **state)
 
 /* The deep pass keeps its program and targets: a second frame of the same
  * size and node count creates no GL objects and gives the same AO; another
- * node count makes one new set.  With timing on, the upload, the AO pass
- * and the read-back have GL times. */
+ * node count makes one new set.  With timing on, the upload, the AO pass,
+ * the blur and the read-back have GL times. */
 static void test_gl_resources_reused(void **state)
 {
     (void)state;
@@ -646,7 +646,9 @@ static void test_gl_resources_reused(void **state)
     unsigned long before = ctx->gl_objects_created;
     assert_int_equal(obs_deep_run(ctx, &d, &p, &a, err), OBS_OK);
     unsigned long first = ctx->gl_objects_created - before;
-    assert_int_equal(first, 4); /* two node arrays, the output, its framebuffer */
+    /* two node arrays, three RG planes (front, blend, the blur's
+     * intermediate), the pass's framebuffer and one per plane */
+    assert_int_equal(first, 9);
     assert_int_equal(obs_deep_run(ctx, &d, &p, &b, err), OBS_OK);
     assert_int_equal(ctx->gl_objects_created - before, first);
     size_t n = (size_t)d.width * d.height * sizeof(float);
@@ -667,12 +669,91 @@ static void test_gl_resources_reused(void **state)
     assert_int_equal(ctx->gl_objects_created - before, 3 * first);
     assert_memory_equal(a.ao_blend.data, b.ao_blend.data, n);
     assert_int_equal(obs_ctx_last_times(ctx, &t), 1);
-    assert_true(t.ms[OBS_PASS_UPLOAD] >= 0.0 && t.ms[OBS_PASS_AO] >= 0.0 && t.ms[OBS_PASS_READBACK] >= 0.0);
-    assert_true(t.ms[OBS_PASS_PREP] < 0.0 && t.ms[OBS_PASS_BLUR] < 0.0);
+    assert_true(t.ms[OBS_PASS_UPLOAD] >= 0.0 && t.ms[OBS_PASS_AO] >= 0.0 &&
+                t.ms[OBS_PASS_BLUR] >= 0.0 && t.ms[OBS_PASS_READBACK] >= 0.0);
+    assert_true(t.ms[OBS_PASS_PREP] < 0.0);
     obs_deep_result_free(&a);
     obs_deep_result_free(&b);
     obs_deep_free(&d);
     obs_ctx_destroy(ctx);
+}
+
+/* ---- the blur (VAO++ 4.6, the flat chain's) -------------------------------- */
+
+/* The energy of the 3x3 tile's pattern in a plane: the tile's rotation
+ * (frame.c's rot, by x % 3 and y % 3) repeats every 3 pixels, so its
+ * structure is what differs between the 9 phases' means; the sum of
+ * their squared deviations from the mean, over the pixels with a node. */
+static double pattern_energy(const obs_deep_image *d, const float *ao)
+{
+    double sum[9] = {0}, all = 0.0;
+    int cnt[9] = {0}, n = 0;
+    for (int y = 0; y < d->height; y++)
+        for (int x = 0; x < d->width; x++) {
+            size_t i = (size_t)y * d->width + x;
+            if (d->offset[i + 1] == d->offset[i])
+                continue;
+            int k = 3 * (x % 3) + (y % 3);
+            sum[k] += ao[i];
+            cnt[k]++;
+            all += ao[i];
+            n++;
+        }
+    double e = 0.0;
+    for (int k = 0; k < 9; k++)
+        if (cnt[k])
+            e += (sum[k] / cnt[k] - all / n) * (sum[k] / cnt[k] - all / n);
+    return e;
+}
+
+/* Deep input takes the flat chain's blur: the 3x3 pattern's energy of
+ * both planes (front node, blend) falls with it on, by more than 10 times
+ * on the fixture (measured: 246 times on the front node's, 21 on the
+ * blend's), and GL equals the CPU twin with it off, on and at another
+ * radius. */
+static void test_blur(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_deep_read_exr(FIXTURE, NULL, &d, err), OBS_OK);
+    obs_params on = {0}, off = {0};
+    assert_int_equal(obs_param_set(&on, "radius", "1", err), OBS_OK);
+    off = on;
+    assert_int_equal(obs_param_set(&off, "blur", "off", err), OBS_OK);
+    obs_deep_result a, b;
+    assert_int_equal(obs_deep_run_cpu(&d, &off, &a, err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(&d, &on, &b, err), OBS_OK);
+    double ef0 = pattern_energy(&d, a.ao_front.data), ef1 = pattern_energy(&d, b.ao_front.data);
+    double eb0 = pattern_energy(&d, a.ao_blend.data), eb1 = pattern_energy(&d, b.ao_blend.data);
+    print_message("deep blur: 3x3 pattern energy, front %.3e -> %.3e, blend %.3e -> %.3e\n", ef0,
+                  ef1, eb0, eb1);
+    assert_true(ef0 > 0.0 && eb0 > 0.0);
+    assert_true(ef1 < 0.1 * ef0);
+    assert_true(eb1 < 0.1 * eb0);
+    /* the composite follows the blurred blend */
+    size_t n = (size_t)d.width * d.height;
+    int changed = 0;
+    for (size_t i = 0; i < n; i++)
+        changed += a.composite.data[4 * i] != b.composite.data[4 * i];
+    assert_true(changed > 0);
+    obs_deep_result_free(&a);
+    obs_deep_result_free(&b);
+
+    obs_ctx *ctx = NULL;
+    obs_ctx_desc desc = {0};
+    if (obs_ctx_create(&desc, &ctx, err) != OBS_OK) {
+        print_message("no GL context (%s): GL half skipped\n", err);
+        obs_deep_free(&d);
+        return;
+    }
+    compare_gl(ctx, &d, &off, "fixture, blur off");
+    compare_gl(ctx, &d, &on, "fixture, blur on");
+    assert_int_equal(obs_param_set(&on, "blur_radius", "7", err), OBS_OK);
+    assert_int_equal(obs_param_set(&on, "deep_hull", "thin", err), OBS_OK);
+    compare_gl(ctx, &d, &on, "fixture, blur radius 7, thin");
+    obs_ctx_destroy(ctx);
+    obs_deep_free(&d);
 }
 
 /* ---- real deep EXRs (../shared) ---------------------------------------------- */
@@ -730,6 +811,7 @@ int main(void)
         cmocka_unit_test(test_blend_and_hull),
         cmocka_unit_test(test_gl_twin),
         cmocka_unit_test(test_gl_resources_reused),
+        cmocka_unit_test(test_blur),
         cmocka_unit_test(test_real_files),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

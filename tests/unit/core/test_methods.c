@@ -1,4 +1,4 @@
-/* The comparison methods (parameter method: hemisphere, angle, hbao; vao
+/* The comparison methods (parameter method: hemisphere, angle, hbao, gtao; vao
  * is VAO++ with its extensions off): each estimator's CPU twin on
  * analytic scenes (open plane -> 1, corner -> the value derived below),
  * the angle-based method's arc cosine approximations against the errors
@@ -341,6 +341,333 @@ static void test_hbao_valley(void **state)
     free(s);
 }
 
+/* ---- gtao: open plane, crease, radius and falloff ------------------------- */
+
+/* Parameters of gtao as Jimenez et al.'s slice integral with a hard cut
+ * at the radius: no XeGTAO heuristics, power 1, falloff ~0, multiplier 1. */
+static obs_params gtao_exact(int slices, int steps)
+{
+    obs_params p = method_params("gtao");
+    char err[OBS_ERR_LEN];
+    assert_int_equal(obs_param_set(&p, "gtao_heuristics", "off", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "gtao_power", "1", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "gtao_falloff", "1e-5", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "gtao_radius_multiplier", "1", err), OBS_OK);
+    p.gtao_slices = slices;
+    p.gtao_steps = steps;
+    return p;
+}
+
+/* The smallest AO of the CPU chain on scene s. */
+static float min_ao(const scene *s, const obs_params *p)
+{
+    obs_result r;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_run_cpu(&s->gb, p, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    float mn = 1;
+    for (int i = 0; i < W * H; i++)
+        mn = fminf(mn, r.ao.data[i]);
+    obs_result_free(&r);
+    return mn;
+}
+
+/* The slice of angle phi (screen direction (cos phi, sin phi) in view
+ * xy) for the orthographic view vector v = +z and the normal n: the
+ * projected normal's length L and its angle gamma to v (signed: positive
+ * towards +(cos phi, sin phi)).  With t = (cos phi, sin phi, 0) and the
+ * slice plane spanned by v and t, n_p = (n.t) t + n.z v. */
+static void ortho_slice(const float n[3], double phi, double *L, double *gamma)
+{
+    double nt = n[0] * cos(phi) + n[1] * sin(phi);
+    *L = sqrt(nt * nt + (double)n[2] * n[2]);
+    *gamma = atan2(nt, n[2]);
+}
+
+/* The slice integral's closed form: L (a(h0) + a(h1)),
+ * a(h) = (cos gamma + 2 h sin gamma - cos(2 h - gamma)) / 4. */
+static double slice_value(double L, double gamma, double h0, double h1)
+{
+    double a0 = (cos(gamma) + 2 * h0 * sin(gamma) - cos(2 * h0 - gamma)) / 4;
+    double a1 = (cos(gamma) + 2 * h1 * sin(gamma) - cos(2 * h1 - gamma)) / 4;
+    return L * (a0 + a1);
+}
+
+/* The slice angles gtao takes at pixel (x, y): (i + noise) pi / S. */
+static double gtao_phi(int x, int y, int i, int slices)
+{
+    float noise[2];
+    obs__gtao_noise(x, y, noise);
+    return ((double)i + noise[0]) / slices * M_PI;
+}
+
+/* An open plane: in every slice both horizons stay at the tangent plane,
+ * h = gamma -+ pi/2, and the slice gives L (cos gamma + gamma sin gamma);
+ * over phi that averages to 1, the cosine-weighted visibility of the open
+ * hemisphere (checked here by quadrature).  Facing an orthographic camera
+ * (n = v: L = 1, gamma = 0) every slice is 1, so gtao gives 1 with its
+ * defaults too (heuristics on, power 2.2; the radius is 20 pixels, over
+ * the 10 below which XeGTAO fades towards open).  On the plane tilted 31
+ * degrees, each pixel is the mean of the closed form over its slices up
+ * to the samples XeGTAO's rounding to a pixel puts off the slice plane
+ * (a point of the plane at another azimuth can lie above this slice's
+ * tangent): within 0.01 of it and of 1 (measured 4e-3 with 3 slices,
+ * 3e-3 with 8); with the defaults (3 slices, the heuristics' slope fudge
+ * raising L, power 2.2) every pixel is within 0.03 of 1. */
+static void test_gtao_open_plane(void **state)
+{
+    (void)state;
+    scene *s = malloc(sizeof *s);
+    float P[16];
+    ortho(P);
+    const float l = sqrtf(1 + 0.36f);
+    const float tilt_n[3] = {0, 0.6f / l, 1 / l};
+    double quad = 0;
+    for (int i = 0; i < 4096; i++) {
+        double L, g;
+        ortho_slice(tilt_n, (i + 0.5) / 4096 * M_PI, &L, &g);
+        quad += slice_value(L, g, g - M_PI / 2, g + M_PI / 2) / 4096;
+    }
+    print_message("gtao open plane: closed form's mean over phi %.7f\n", quad);
+    assert_float_equal(quad, 1.0, 1e-6);
+
+    plane facing = {{0, 0, 1}, -5.0f};
+    render(s, P, &facing, 1);
+    for (int variant = 0; variant < 2; variant++) {
+        obs_params p = variant ? gtao_exact(3, 3) : method_params("gtao");
+        p.radius = 0.4f;
+        float mn = min_ao(s, &p);
+        print_message("gtao open plane facing, %s: min AO %.7f\n",
+                      variant ? "heuristics off, power 1" : "defaults", mn);
+        assert_true(mn > 1.0f - 1e-5f);
+    }
+
+    plane tilted = {{tilt_n[0], tilt_n[1], tilt_n[2]}, -5.0f / l};
+    render(s, P, &tilted, 1);
+    const int slice_counts[] = {3, 8, 32};
+    for (size_t k = 0; k < sizeof slice_counts / sizeof slice_counts[0]; k++) {
+        obs_params p = gtao_exact(slice_counts[k], 3);
+        p.radius = 0.4f;
+        obs__frame f;
+        float *pos, *nrm;
+        setup(s, &p, &f, &pos, &nrm);
+        double worst = 0, worst1 = 0;
+        for (int y = 2; y < H - 2; y++)
+            for (int x = 2; x < W - 2; x++) {
+                double expect = 0;
+                for (int i = 0; i < f.gtao_slices; i++) {
+                    double L, g;
+                    ortho_slice(tilt_n, gtao_phi(x, y, i, f.gtao_slices), &L, &g);
+                    expect += slice_value(L, g, g - M_PI / 2, g + M_PI / 2) / f.gtao_slices;
+                }
+                size_t i = (size_t)y * W + x;
+                float ao = obs__gtao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, NULL);
+                worst = fmax(worst, fabs(ao - fmin(expect, 1.0)));
+                worst1 = fmax(worst1, fabs(ao - 1.0));
+            }
+        print_message("gtao open plane tilted, %2d slices: max |AO - closed form| %.2e, "
+                      "max |AO - 1| %.2e\n", f.gtao_slices, worst, worst1);
+        assert_true(worst < 0.01);
+        assert_true(worst1 < 0.01);
+        free(pos);
+        free(nrm);
+    }
+    obs_params p = method_params("gtao");
+    p.radius = 0.4f;
+    float mn = min_ao(s, &p);
+    print_message("gtao open plane tilted, defaults: min AO %.4f\n", mn);
+    assert_true(mn > 0.97f);
+    free(s);
+}
+
+/* The 90-degree valley of test_hbao_valley, P on the crease with the
+ * normal nB = (-1, 0, 1)/sqrt 2, v = +z.  Slice phi, c = cos phi:
+ * n_p = (-c^2, -s c, 1)/sqrt 2, so L = sqrt((1 + c^2)/2) and
+ * gamma = -atan(c).  Plane A (x < 0) through P is the occluder: on the
+ * side that crosses it, every point of A in the slice plane has
+ * cos h = |c| / sqrt(1 + c^2), so h = -+(pi/2 - atan|c|); on the other
+ * side the horizon is B's tangent, gamma +- pi/2.  The closed form's mean
+ * over phi is 1/2 (a wall through P perpendicular to the surface hides
+ * half the cosine-weighted hemisphere, as a ray tracer sees it; checked
+ * by quadrature).
+ *
+ * The samples: XeGTAO rounds a step's offset to a pixel, so a sample
+ * lies off the slice plane; the horizon it gives is the angle of the
+ * actual point, cos h = dot(q - c, v) / |q - c|, q on the valley at the
+ * rounded pixel, c = P moved 1e-5 of its depth towards the camera.  With
+ * one step per side (offset ((noise)^2 + 1.3 / R_px) R_px (cos phi,
+ * -sin phi) pixels), AO = mean over the slices of the closed form at
+ * those horizons, each at least the tangent: checked to 1e-5 at every
+ * pixel of the 3x3 tile (a sample farther than R is left out: weight 0
+ * with the hard cut); and with 32 slices and 8 steps P's own pixel is
+ * within 0.05 below 1/2: a sample rounded off the slice towards a
+ * steeper azimuth of A raises the horizon, and the horizon is the largest
+ * over 8 of them (measured 0.470). */
+static void test_gtao_crease(void **state)
+{
+    (void)state;
+    const float nB[3] = {-sqrtf(0.5f), 0, sqrtf(0.5f)};
+    double quad = 0;
+    for (int i = 0; i < 4096; i++) {
+        double phi = (i + 0.5) / 4096 * M_PI, c = cos(phi), L, g;
+        ortho_slice(nB, phi, &L, &g);
+        assert_float_equal(L, sqrt((1 + c * c) / 2), 1e-6);
+        assert_float_equal(g, -atan(c), 1e-6);
+        double hA = M_PI / 2 - atan(fabs(c));
+        double h0 = c > 0 ? -hA : g - M_PI / 2, h1 = c > 0 ? g + M_PI / 2 : hA;
+        quad += slice_value(L, g, h0, h1) / 4096;
+    }
+    print_message("gtao crease: closed form's mean over phi %.7f\n", quad);
+    assert_float_equal(quad, 0.5, 1e-6);
+
+    scene *s = malloc(sizeof *s);
+    valley(s);
+    {
+        obs_params p = gtao_exact(4, 1);
+        p.radius = 0.5f; /* 25 pixels */
+        obs__frame f;
+        float *pos, *nrm;
+        setup(s, &p, &f, &pos, &nrm);
+        const float *pt = pos + 4 * (CY * W + CX);
+        const double cz = pt[2] * 0.99999f;
+        for (int k = 0; k < 9; k++) {
+            int x = CX + k / 3, y = CY + k % 3; /* P's own point at every rotation of the tile */
+            float noise[2];
+            obs__gtao_noise(x, y, noise);
+            double rpx = f.radius / PX, min_s = 1.3 / rpx, expect = 0;
+            for (int i = 0; i < f.gtao_slices; i++) {
+                double phi = gtao_phi(x, y, i, f.gtao_slices), L, g;
+                ortho_slice(nB, phi, &L, &g);
+                double sn = noise[1] + i * 0.6180339887498948482;
+                sn -= floor(sn);
+                double sd = sn * sn + min_s;
+                int ox = (int)floor(sd * rpx * cos(phi) + 0.5);
+                int oy = (int)floor(-sd * rpx * sin(phi) + 0.5);
+                double h[2];
+                for (int side = 0; side < 2; side++) {
+                    int sg = side ? -1 : 1;
+                    /* the view offset from P of the pixel read (the pixel
+                     * of the tile is P's neighbour, P's point is passed) */
+                    double vx = (x - CX + sg * ox) * PX, vy = -(y - CY + sg * oy) * PX;
+                    double d[3] = {vx, vy, -5.0 + fabs(vx) - cz};   /* the valley there */
+                    double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), ch = d[2] / r;
+                    double low = cos(side ? g - M_PI / 2 : g + M_PI / 2);
+                    if (r >= f.gtao_radius)
+                        ch = low; /* beyond the cut: weight 0 */
+                    double hh = acos(fmax(ch, low));
+                    h[side] = side ? fmax(-hh, g - M_PI / 2) : fmin(hh, g + M_PI / 2);
+                }
+                expect += slice_value(L, g, h[1], h[0]) / f.gtao_slices;
+            }
+            int count;
+            float ao = obs__gtao_pixel(&f, pos, x, y, pt, nB, &count);
+            print_message("gtao crease, tile %d: AO %.6f, derived %.6f\n", k, ao, expect);
+            assert_float_equal(ao, (float)expect, 1e-5f);
+            assert_int_equal(count, 2 * f.gtao_slices);
+        }
+        free(pos);
+        free(nrm);
+    }
+    {
+        obs_params p = gtao_exact(32, 8);
+        p.radius = 0.5f;
+        obs__frame f;
+        float *pos, *nrm;
+        setup(s, &p, &f, &pos, &nrm);
+        const float *pt = pos + 4 * (CY * W + CX);
+        float ao = obs__gtao_pixel(&f, pos, CX, CY, pt, nB, NULL);
+        print_message("gtao crease, 32 slices x 8 steps: AO %.4f (1/2)\n", ao);
+        assert_true(ao > 0.45f && ao < 0.505f);
+        free(pos);
+        free(nrm);
+    }
+    free(s);
+}
+
+/* Radius and falloff.  The valley against a steeper one: B (x > 0) the
+ * same, A replaced by A2: z = -5 - 2x (x < 0).  Every point of A or A2
+ * lies at least 3 x_P / sqrt 5 from a point P = (x_P, ., -5 + x_P) of B
+ * (the distance to A2's plane, less than the sqrt 2 x_P to A's), so with
+ * a hard cut at R gtao gives the same AO at every P of B with
+ * 3 x_P / sqrt 5 > R in both scenes (the samples there are weighed 0),
+ * and a lower one in the steeper valley where the crease is well inside
+ * R.  The falloff only lowers a sample's weight as gtao_falloff grows, so
+ * at every pixel AO does not fall as it grows, and near the crease it
+ * rises. */
+static void test_gtao_radius_falloff(void **state)
+{
+    (void)state;
+    scene *s1 = malloc(sizeof *s1), *s2 = malloc(sizeof *s2);
+    float P[16];
+    const float r2 = sqrtf(0.5f), r5 = 1.0f / sqrtf(5.0f);
+    ortho(P);
+    plane pl1[2] = {{{-r2, 0, r2}, -5.0f * r2}, {{r2, 0, r2}, -5.0f * r2}};
+    plane pl2[2] = {{{-r2, 0, r2}, -5.0f * r2}, {{2 * r5, 0, r5}, -5.0f * r5}};
+    render(s1, P, pl1, 2);
+    render(s2, P, pl2, 2);
+    obs_params p = gtao_exact(3, 3);
+    p.radius = 0.3f; /* 15 pixels */
+    obs_result a, b;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_run_cpu(&s1->gb, &p, OBS_OUTPUT_AO, &a, err), OBS_OK);
+    assert_int_equal(obs_run_cpu(&s2->gb, &p, OBS_OUTPUT_AO, &b, err), OBS_OK);
+    int same = 0, inside = 0;
+    double near1 = 0, near2 = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = CX + 1; x < W; x++) {
+            float xp = (x + 0.5f - 0.5f * W) * PX;
+            size_t i = (size_t)y * W + x;
+            if (3 * xp * r5 > p.radius * 1.001f) {
+                assert_float_equal(a.ao.data[i], b.ao.data[i], 1e-7f);
+                same++;
+            } else if (sqrtf(2.0f) * xp < 0.5f * p.radius) {
+                near1 += a.ao.data[i];
+                near2 += b.ao.data[i];
+                inside++;
+            }
+        }
+    print_message("gtao radius: %d pixels beyond R equal; near the crease mean AO %.4f "
+                  "(valley), %.4f (steeper)\n", same, near1 / inside, near2 / inside);
+    assert_true(same > 1000 && inside > 100);
+    assert_true(near2 / inside < near1 / inside - 0.02);
+    obs_result_free(&a);
+    obs_result_free(&b);
+
+    const char *const falloffs[] = {"1e-5", "0.3", "0.615", "1"};
+    float *prev = NULL;
+    double prev_near = 0;
+    for (size_t k = 0; k < sizeof falloffs / sizeof falloffs[0]; k++) {
+        obs_params q = gtao_exact(3, 3);
+        assert_int_equal(obs_param_set(&q, "gtao_falloff", falloffs[k], err), OBS_OK);
+        q.radius = 0.3f;
+        assert_int_equal(obs_run_cpu(&s1->gb, &q, OBS_OUTPUT_AO, &a, err), OBS_OK);
+        double near = 0;
+        int nn = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = CX + 1; x < W; x++) {
+                size_t i = (size_t)y * W + x;
+                if (prev)
+                    assert_true(a.ao.data[i] >= prev[i] - 1e-6f);
+                if (x - CX < 8) {
+                    near += a.ao.data[i];
+                    nn++;
+                }
+            }
+        near /= nn;
+        print_message("gtao falloff %s: mean AO within 8 pixels of the crease %.4f\n", falloffs[k],
+                      near);
+        if (prev)
+            assert_true(near > prev_near);
+        free(prev);
+        prev = malloc(sizeof(float) * W * H);
+        memcpy(prev, a.ao.data, sizeof(float) * W * H);
+        prev_near = near;
+        obs_result_free(&a);
+    }
+    free(prev);
+    free(s1);
+    free(s2);
+}
+
 /* ---- the article's arc cosine approximations ------------------------------- */
 
 /* "the maximum error between the two functions is around 18.946 degrees"
@@ -438,6 +765,10 @@ static void test_method_params(void **state)
     expect_refused("hemisphere", "angle_acos", "exact");
     expect_refused("hbao", "ao_definition", "rays");
     expect_refused("angle", "ao_definition", "volume");
+    expect_refused("gtao", "hbao_steps", "4");
+    expect_refused("hbao", "gtao_slices", "4");
+    expect_refused("vaopp", "gtao_power", "1");
+    expect_refused("gtao", "samples", "8");
     /* agreeing values and the shared chain are fine */
     expect_accepted("vao", "adaptive", "off");
     expect_accepted("vao", "samples", "32");
@@ -449,13 +780,16 @@ static void test_method_params(void **state)
     expect_accepted("hemisphere", "hemisphere_samples", "3");
     expect_accepted("angle", "angle_pairs", "16");
     expect_accepted("hbao", "hbao_directions", "32");
+    expect_accepted("gtao", "gtao_slices", "9");
+    expect_accepted("gtao", "gtao_heuristics", "off");
+    expect_accepted("gtao", "blur", "off");
     /* ranges of the method parameters */
     assert_int_equal(obs_param_set(&p, "hbao_steps", "0", err), OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "hbao_steps"));
     assert_int_equal(obs_param_set(&p, "angle_pairs", "17", err), OBS_INVALID_ARGUMENT);
     assert_int_equal(obs_param_set(&p, "hemisphere_samples", "65", err), OBS_INVALID_ARGUMENT);
     assert_int_equal(obs_param_set(&p, "method", "ssao", err), OBS_INVALID_ARGUMENT);
-    assert_non_null(strstr(err, "vaopp|vao|hemisphere|angle|hbao"));
+    assert_non_null(strstr(err, "vaopp|vao|hemisphere|angle|hbao|gtao"));
     /* and the run itself refuses, naming it */
     scene *s = malloc(sizeof *s);
     valley(s);
@@ -489,6 +823,9 @@ static void test_gl_matches_cpu(void **state)
         {{"method", "hbao"}, {NULL, NULL}, {NULL, NULL}},
         {{"method", "hbao"}, {"hbao_directions", "4"}, {"blur", "off"}},
         {{"method", "hbao"}, {"hbao_steps", "16"}, {"hbao_angle_bias", "10"}},
+        {{"method", "gtao"}, {NULL, NULL}, {NULL, NULL}},
+        {{"method", "gtao"}, {"gtao_slices", "9"}, {"blur", "off"}},
+        {{"method", "gtao"}, {"gtao_heuristics", "off"}, {"gtao_thin", "0.5"}},
     };
     for (size_t sc = 0; sc < sizeof scenes / sizeof scenes[0]; sc++) {
         obs_gbuffer_file gf = {0};
@@ -540,6 +877,9 @@ int main(void)
         cmocka_unit_test(test_hemisphere_corner),
         cmocka_unit_test(test_angle_valley),
         cmocka_unit_test(test_hbao_valley),
+        cmocka_unit_test(test_gtao_open_plane),
+        cmocka_unit_test(test_gtao_crease),
+        cmocka_unit_test(test_gtao_radius_falloff),
         cmocka_unit_test(test_acos_errors),
         cmocka_unit_test(test_method_params),
         cmocka_unit_test(test_gl_matches_cpu),

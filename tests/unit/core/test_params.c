@@ -194,6 +194,38 @@ static void test_quality_presets(void **state)
     assert_non_null(strstr(err, "preview|default|high|reference"));
 }
 
+/* A FLOAT parameter set to the bounds its range error names (%g) is
+ * accepted by obs_params_check too, under a method it belongs to: the
+ * bound parsed as a double and stored as a float may round below it. */
+static void test_float_bounds_accepted(void **state)
+{
+    (void)state;
+    const obs_param_info *method = obs_param_find("method");
+    for (int i = 0; i < obs_param_count(); i++) {
+        const obs_param_info *pi = obs_param_at(i);
+        if (pi->type != OBS_PARAM_FLOAT)
+            continue;
+        for (int end = 0; end < 2; end++) {
+            char value[32], name[32], err[OBS_ERR_LEN] = "";
+            snprintf(value, sizeof value, "%g", end ? pi->max : pi->min);
+            int accepted = 0;
+            const char *c = method->choices;
+            while (*c && !accepted) {
+                size_t len = strcspn(c, "|");
+                snprintf(name, sizeof name, "%.*s", (int)len, c);
+                c += len + (c[len] == '|');
+                obs_params p = {0}, r;
+                assert_int_equal(obs_param_set(&p, "method", name, err), OBS_OK);
+                assert_int_equal(obs_param_set(&p, pi->name, value, err), OBS_OK);
+                obs_params_resolve(&p, &r);
+                accepted = obs_params_check(&r, err) == OBS_OK;
+            }
+            if (!accepted)
+                fail_msg("%s %s: set, then refused by every method: %s", pi->name, value, err);
+        }
+    }
+}
+
 static void test_status_names(void **state)
 {
     (void)state;
@@ -213,6 +245,7 @@ int main(void)
         cmocka_unit_test(test_table_is_complete),
         cmocka_unit_test(test_enums_agree_with_choices),
         cmocka_unit_test(test_quality_presets),
+        cmocka_unit_test(test_float_bounds_accepted),
         cmocka_unit_test(test_status_names),
     };
     return cmocka_run_group_tests_name("params", tests, NULL, NULL);

@@ -1,0 +1,176 @@
+/* Method gtao: ground-truth-based ambient occlusion (Jimenez, Wu,
+ * Pesce, Jarabo, "Practical real-time strategies for accurate indirect
+ * occlusion", SIGGRAPH 2016 course; Algorithm 1), as XeGTAO implements it
+ * (GameTechDev/XeGTAO, XeGTAO.hlsli, XeGTAO_MainPass).  The CPU twin of
+ * gtao.glsl.
+ *
+ * GTAO writes the cosine-weighted visibility of the hemisphere around n
+ * in slices around the view vector v: a slice of screen direction phi
+ * holds the directions at angle theta from v (theta in the slice plane),
+ * and with dw = |sin theta| dtheta dphi
+ *   A = 1/pi Int_0^pi |n_p| Int_h0^h1 cos(theta - gamma) |sin theta| dtheta dphi,
+ * n_p the normal projected onto the slice plane, gamma its angle to v,
+ * h0 <= gamma <= h1 the horizon angles on the slice's two sides (found by
+ * sampling the depth buffer along the slice within the search radius).
+ * The inner integral has the closed form (Algorithm 1's inner
+ * integral, XeGTAO's "line ~27")
+ *   a(h) = (cos gamma + 2 h sin gamma - cos(2 h - gamma)) / 4,
+ *   A_slice = |n_p| (a(h0) + a(h1)),
+ * and A is the mean of A_slice over the slices.  Unoccluded, h = gamma
+ * -+ pi/2 and A_slice = |n_p| (cos gamma + gamma sin gamma), whose mean
+ * over phi is 1.
+ *
+ * What XeGTAO adds, kept here: the horizon of each side starts at the
+ * tangent plane (cos(gamma +- pi/2)) and a sample at distance r moves it
+ * only by its falloff weight, saturate(r * falloffMul + falloffAdd); the
+ * thin-occluder compensation stretches r's depth component by
+ * 1 + gtao_thin before the weight; the steps along a side are
+ * s = ((step + noise) / steps)^2 of the screen radius plus 1.3 pixels
+ * (XeGTAO's sample distribution power 2 and pixelTooCloseThreshold),
+ * rounded to a pixel; the centre is moved towards the camera by 1e-5 of
+ * its depth (XeGTAO's value for 32-bit depth); the result is raised to
+ * gtao_power.  gtao_heuristics on adds its three empirical corrections:
+ * |n_p| moved 5 % towards 1, saturate((10 - r_px) / 100) / 2 added to the
+ * slices' sum before the mean (a fade towards open for small screen
+ * radii), and the result at least 0.03.
+ *
+ * Where it differs: the slice and step noise is XeGTAO's R2 sequence on
+ * the index of the chain's 3x3 tile (obs__gtao_noise) instead of its
+ * Hilbert-curve index, so the chain's blur averages 9 slice offsets; the
+ * arc cosines are exact (XeGTAO: a polynomial approximation); depth is
+ * read at full resolution (XeGTAO reads a MIP level that grows with the
+ * sample's distance); a sample outside the image or on the background
+ * leaves the horizon as it is (XeGTAO's clamp sampler repeats the border
+ * pixel); the view vector of an orthographic camera is +z. */
+#include <math.h>
+
+#include "chain/frame.h"
+
+/* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
+#define GTAO_TOO_CLOSE 1.3f       /* pixelTooCloseThreshold: first sample this far, in pixels */
+#define GTAO_CENTRE_SCALE 0.99999f /* viewspaceZ *= 0.99999 (FP32 depths) */
+#define GTAO_SLOPE_FUDGE 0.05f    /* projectedNormalVecLength = lerp(len, 1, 0.05) */
+#define GTAO_MIN_VISIBILITY 0.03f /* visibility = max(0.03, visibility) */
+#define GTAO_R1 0.6180339887498948482f /* the steps' R1 sequence */
+
+static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
+static float saturate(float v) { return clampf(v, 0.0f, 1.0f); }
+static float signf(float v) { return (float)((v > 0.0f) - (v < 0.0f)); }
+static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* GLSL: gtao_noise() in gtao.glsl */
+void obs__gtao_noise(int x, int y, float out[2])
+{
+    float k = (float)(3 * (x % 3) + (y % 3));
+    float a = 0.5f + k * 0.75487766624669276f, b = 0.5f + k * 0.56984029099805327f;
+    out[0] = a - floorf(a);
+    out[1] = b - floorf(b);
+}
+
+/* The horizon cosine of side `dir` (+1 or -1) of a slice after its
+ * steps: the largest of the tangent's cosine `low` and the samples',
+ * each moved from low by its falloff weight. */
+static float side_horizon(const obs__frame *f, const float *pos, int x, int y, const float c[3],
+                          const float v[3], const float omega[2], int slice, float noise_step,
+                          float min_s, int dir, float low, int *taken)
+{
+    float hc = low;
+    for (int st = 0; st < f->gtao_steps; st++) {
+        float base = (float)(slice + st * f->gtao_steps) * GTAO_R1;
+        float sn = noise_step + base;
+        sn -= floorf(sn);
+        float s = ((float)st + sn) / (float)f->gtao_steps;
+        s = s * s + min_s; /* sample distribution power 2, then off the centre pixel */
+        int qx = x + dir * (int)floorf(s * omega[0] + 0.5f);
+        int qy = y + dir * (int)floorf(s * omega[1] + 0.5f);
+        if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height)
+            continue;
+        (*taken)++;
+        const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+        if (!(q[3] > 0.0f))
+            continue;
+        float d[3] = {q[0] - c[0], q[1] - c[1], q[2] - c[2]};
+        float dist = sqrtf(dot3(d, d));
+        if (!(dist > 0.0f))
+            continue;
+        float shc = dot3(d, v) / dist;
+        float dz = d[2] * (1.0f + f->gtao_thin_power[0]); /* thin-occluder compensation */
+        float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
+        float w = saturate(fb * f->gtao_falloff[0] + f->gtao_falloff[1]);
+        shc = low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
+        hc = fmaxf(hc, shc);
+    }
+    return hc;
+}
+
+/* a(h) of the header: the inner integral's closed form */
+static float arc(float h, float gamma, float cos_gamma)
+{
+    return (cos_gamma + 2.0f * h * sinf(gamma) - cosf(2.0f * h - gamma)) / 4.0f;
+}
+
+/* GLSL: method_ao() in gtao.glsl */
+float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                      const float n[3], int *count)
+{
+    const float half_pi = (float)M_PI_2;
+    int taken = 0;
+    if (count)
+        *count = 0;
+    float rpx = obs__radius_px(f, p, f->gtao_radius);
+    if (!(rpx > 0.0f))
+        return 1.0f; /* behind the camera */
+    float c[3] = {p[0] * GTAO_CENTRE_SCALE, p[1] * GTAO_CENTRE_SCALE, p[2] * GTAO_CENTRE_SCALE};
+    float v[3] = {0.0f, 0.0f, 1.0f}; /* towards the camera; orthographic: +z */
+    if (f->proj[14] != 0.0f) {
+        float l = sqrtf(dot3(c, c));
+        if (!(l > 0.0f))
+            return 1.0f;
+        v[0] = -c[0] / l;
+        v[1] = -c[1] / l;
+        v[2] = -c[2] / l;
+    }
+    float noise[2];
+    obs__gtao_noise(x, y, noise);
+    const float min_s = GTAO_TOO_CLOSE / rpx;
+    float vis = f->gtao_heuristics ? saturate((10.0f - rpx) / 100.0f) * 0.5f : 0.0f;
+    for (int sl = 0; sl < f->gtao_slices; sl++) {
+        float phi = ((float)sl + noise[0]) / (float)f->gtao_slices * (float)M_PI;
+        float cp = cosf(phi), sp = sinf(phi);
+        float omega[2] = {cp * rpx, -sp * rpx}; /* screen pixels: y runs down, view y up */
+        float d[3] = {cp, sp, 0.0f};
+        float dv = dot3(d, v);
+        float od[3] = {d[0] - dv * v[0], d[1] - dv * v[1], d[2] - dv * v[2]};
+        /* the slice plane's normal: normalize(cross(od, v)) */
+        float ax[3] = {od[1] * v[2] - od[2] * v[1], od[2] * v[0] - od[0] * v[2],
+                       od[0] * v[1] - od[1] * v[0]};
+        float al = sqrtf(dot3(ax, ax));
+        ax[0] /= al;
+        ax[1] /= al;
+        ax[2] /= al;
+        float na = dot3(n, ax);
+        float np[3] = {n[0] - ax[0] * na, n[1] - ax[1] * na, n[2] - ax[2] * na};
+        float np_len = sqrtf(dot3(np, np));
+        float cos_g = np_len > 0.0f ? saturate(dot3(np, v) / np_len) : 1.0f;
+        float gamma = signf(dot3(od, np)) * acosf(cos_g);
+        float low0 = cosf(gamma + half_pi), low1 = cosf(gamma - half_pi);
+        float hc0 = side_horizon(f, pos, x, y, c, v, omega, sl, noise[1], min_s, 1, low0, &taken);
+        float hc1 = side_horizon(f, pos, x, y, c, v, omega, sl, noise[1], min_s, -1, low1, &taken);
+        if (f->gtao_heuristics)
+            np_len += (1.0f - np_len) * GTAO_SLOPE_FUDGE;
+        /* the horizons as angles from v, clamped to the hemisphere of n
+         * (Algorithm 1's h1 = n + max(h1 - n, -pi/2), h2 = n + min(h2 - n, pi/2)) */
+        float h0 = -acosf(clampf(hc1, -1.0f, 1.0f));
+        float h1 = acosf(clampf(hc0, -1.0f, 1.0f));
+        h0 = gamma + fmaxf(h0 - gamma, -half_pi);
+        h1 = gamma + fminf(h1 - gamma, half_pi);
+        vis += np_len * (arc(h0, gamma, cos_g) + arc(h1, gamma, cos_g));
+    }
+    vis /= (float)f->gtao_slices;
+    vis = powf(fmaxf(vis, 0.0f), f->gtao_thin_power[1]);
+    if (f->gtao_heuristics)
+        vis = fmaxf(vis, GTAO_MIN_VISIBILITY);
+    if (count)
+        *count = taken;
+    return saturate(vis);
+}
