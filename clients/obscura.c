@@ -417,6 +417,21 @@ done:
     return rc;
 }
 
+/* Prints the reader's sanity warnings; with --strict they fail the
+ * frame (exit 3). */
+static int cli_input_warnings(const char *in, const obs_exr_info *info, int strict)
+{
+    for (int i = 0; i < info->warning_count; i++)
+        fprintf(stderr, "obscura: %s: %s: %s\n", strict ? "error" : "warning", in,
+                info->warnings[i]);
+    if (strict && info->warning_count > 0) {
+        fprintf(stderr, "obscura: %s: %d sanity warning%s and --strict: not computed\n", in,
+                info->warning_count, info->warning_count == 1 ? "" : "s");
+        return EXIT_BADINPUT;
+    }
+    return EXIT_OK;
+}
+
 static int cmd_ao(int argc, char **argv)
 {
     ao_args a;
@@ -449,6 +464,9 @@ static int cmd_ao(int argc, char **argv)
                 info->normal[0][0] ? info->normal[0] : "(none)",
                 info->color[0][0] ? info->color[0] : "(none)");
     }
+    if (verbosity >= OBS_LOG_INFO && info->camera_source[0])
+        fprintf(stderr, "obscura: info: camera from %s%s%s\n", info->camera_source,
+                info->camera_check[0] ? "; " : "", info->camera_check);
     if (a.camera) {
         int cw = 0, ch = 0;
         s = obs_camera_read_json(a.camera, &gf.gb.camera, &cw, &ch, err);
@@ -462,6 +480,10 @@ static int cmd_ao(int argc, char **argv)
             fprintf(stderr, "obscura: warning: camera %s is %dx%d but the image is %dx%d (aspect differs)\n",
                     a.camera, cw, ch, dw, dh);
     }
+
+    obs_gbuffer_sanity(&gf.gb, &a.req.params, &gf.info);
+    if ((rc = cli_input_warnings(a.in, &gf.info, a.req.strict)) != EXIT_OK)
+        goto done;
 
     t0 = now_ms();
     if (a.cpu) {

@@ -52,6 +52,9 @@ const obs_http_option obs_http_options[] = {
     {.name = "color", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(color), .def = "", .min = 3,
      .max = 4, .slot = SLOT(color[0]), .map = FIELD(map.color),
      .what = "three or four channel names R,G,B[,A]", .doc = "colour channel names R,G,B[,A]"},
+    {.name = "strict", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(strict), .def = "0",
+     .doc = "sanity warnings on the input (depth looks normalized or inverted, normals not unit "
+            "length or in the other space, camera metadata that disagrees) are errors"},
     {.name = NULL}};
 
 /* CHOICE and BOOL rows store through an int. */

@@ -29,6 +29,7 @@ typedef struct obs_http_request {
     obs_http_format format; /* default EXR */
     int float_exr;          /* EXR: 32-bit float channels (default half) */
     int png_bits;           /* 8 (default) or 16 */
+    int strict;             /* sanity warnings on the input are errors */
     obs_channel_map map;    /* points into the buffers below */
     char preset[16];
     char depth[64];

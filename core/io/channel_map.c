@@ -7,7 +7,9 @@
 #include "io/exr_internal.h"
 #include "internal.h"
 
-const char *const obs_channel_presets[] = {"auto", "blender", "generic", NULL};
+const char *const obs_channel_presets[] = {"auto",     "blender",   "generic", "arnold",
+                                           "vray",     "renderman", "redshift", "karma",
+                                           "mantra",   "octane",    "nuke",    NULL};
 
 /* Blender's multilayer EXRs prefix every pass with the view layer. */
 #define BLENDER_DEPTH_SUFFIX ".Depth.Z"
@@ -46,6 +48,8 @@ static void clear_match(obs__channel_match *m)
     for (int i = 0; i < 4; i++)
         m->color[i] = -1;
     m->preset = "explicit";
+    m->depth_mode = OBS_DEPTH_DEFAULT;
+    m->normal_space = OBS_NORMALS_DEFAULT;
 }
 
 static const char *const XYZ[] = {".X", ".Y", ".Z"};
@@ -60,6 +64,10 @@ static void preset_blender(const char *const *names, int count, obs__channel_mat
     size_t sl = strlen(BLENDER_DEPTH_SUFFIX);
     clear_match(m);
     m->preset = "blender";
+    /* Blender's Depth.Z is planar, its Normal pass world space
+     * (../shared/data/README.md, Blender manual "Render Passes"). */
+    m->depth_mode = OBS_DEPTH_PLANAR;
+    m->normal_space = OBS_NORMALS_WORLD;
     m->depth = find(names, count, DEFAULT_BLENDER_LAYER BLENDER_DEPTH_SUFFIX);
     if (m->depth >= 0)
         snprintf(layer, sizeof layer, "%s", DEFAULT_BLENDER_LAYER);
@@ -102,6 +110,36 @@ static void preset_generic(const char *const *names, int count, obs__channel_mat
         find_set(names, count, "Normal", XYZ, 3, m->normal);
     if (find_set(names, count, "", rgb, 3, m->color))
         m->color[3] = find(names, count, "A");
+}
+
+static const char *const XYZ_LOWER[] = {".x", ".y", ".z"};
+static const char *const RGB_LOWER[] = {".r", ".g", ".b"};
+
+/* A renderer's row of presets.c: its first depth name the file has, the
+ * first normal and colour prefixes that are complete. */
+static void preset_row(const char *const *names, int count, const obs__preset *pr,
+                       obs__channel_match *m)
+{
+    static const char *const bare[] = {"R", "G", "B"};
+    clear_match(m);
+    m->preset = pr->name;
+    m->depth_mode = pr->depth_mode;
+    m->normal_space = pr->normal_space;
+    for (const char *const *d = pr->depth; *d && m->depth < 0; d++)
+        m->depth = find(names, count, *d);
+    for (const char *const *n = pr->normal; *n && m->normal[0] < 0; n++)
+        if (!find_set(names, count, *n, XYZ, 3, m->normal) &&
+            !find_set(names, count, *n, RGB, 3, m->normal) &&
+            !find_set(names, count, *n, XYZ_LOWER, 3, m->normal))
+            find_set(names, count, *n, RGB_LOWER, 3, m->normal);
+    for (const char *const *c = pr->color; *c && m->color[0] < 0; c++) {
+        char alpha[300];
+        if (**c ? find_set(names, count, *c, RGB, 3, m->color)
+                : find_set(names, count, "", bare, 3, m->color)) {
+            snprintf(alpha, sizeof alpha, "%s%s", *c, **c ? ".A" : "A");
+            m->color[3] = find(names, count, alpha);
+        }
+    }
 }
 
 /* "A, B, C", cut short with "... (N channels)". */
@@ -164,8 +202,15 @@ obs_status obs__channel_map_resolve(const obs_channel_map *map,
                                     obs__channel_match *m,
                                     char err[OBS_ERR_LEN])
 {
+    return obs__channel_map_resolve_for(map, NULL, names, count, m, err);
+}
+
+obs_status obs__channel_map_resolve_for(const obs_channel_map *map, const char *detected,
+                                        const char *const *names, int count,
+                                        obs__channel_match *m, char err[OBS_ERR_LEN])
+{
     static const obs_channel_map automap = {0};
-    obs__channel_match cand[2];
+    obs__channel_match cand[3];
     int ncand = 0, pick = -1;
     obs_status st;
 
@@ -173,13 +218,17 @@ obs_status obs__channel_map_resolve(const obs_channel_map *map,
         map = &automap;
     const char *preset = map->preset && *map->preset ? map->preset : "auto";
     int is_auto = strcmp(preset, "auto") == 0;
+    const obs__preset *row = obs__preset_find(is_auto ? detected : preset);
+    if (row)
+        preset_row(names, count, row, &cand[ncand++]);
     if (is_auto || strcmp(preset, "blender") == 0)
         preset_blender(names, count, &cand[ncand++]);
     if (is_auto || strcmp(preset, "generic") == 0)
         preset_generic(names, count, &cand[ncand++]);
     if (ncand == 0)
         return obs__fail(err, OBS_INVALID_ARGUMENT,
-                         "unknown channel preset '%.64s' (valid: auto, blender, generic)", preset);
+                         "unknown channel preset '%.64s' (valid: auto, blender, generic, arnold, "
+                         "vray, renderman, redshift, karma, mantra, octane, nuke)", preset);
     int nd = count_set(&map->depth, 1), nn = count_set(map->normal, 3), nc = count_set(map->color, 3);
     if (nn != 0 && nn != 3)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "explicit normal needs three channel names (X, Y, Z)");
@@ -212,6 +261,19 @@ obs_status obs__channel_map_resolve(const obs_channel_map *map,
         if (map->color[3] && *map->color[3] &&
             (st = explicit_channel(names, count, map->color[3], "alpha", &m->color[3], err)) != OBS_OK)
             return st;
+    }
+    if (m->depth < 0 && find(names, count, "VRayZDepth") + find(names, count, "VRayZDepth.R") +
+                                find(names, count, "VRayZDepth.Z") > -3)
+        return missing(err, names, count,
+                       "no depth channel: VRayZDepth holds depth normalized between the render "
+                       "element's zdepth min and max (white near), which the file does not record; "
+                       "render V-Ray's raw Z-depth (a Z channel), or name a planar depth "
+                       "channel with --depth");
+    if (m->depth < 0 && row && !is_auto) {
+        char what[320];
+        snprintf(what, sizeof what, "no depth channel: looked for %s's %s%s%s", row->name,
+                 row->depth[0], row->depth[1] ? ", " : "", row->depth[1] ? row->depth[1] : "");
+        return missing(err, names, count, what);
     }
     if (m->depth < 0)
         return missing(err, names, count,

@@ -16,11 +16,6 @@
 #include "io/exr_internal.h"
 #include "internal.h"
 
-/* Camera-space clip range used for the projection built from worldToNDC,
- * whose z row an EXR does not define. */
-#define EXR_NEAR 0.1f
-#define EXR_FAR 1000.0f
-
 /* A decoded chunk is held whole by the library; the header decides its
  * size, so a damaged header could ask for gigabytes from a tiny file. */
 #define MAX_CHUNK_BYTES ((uint64_t)1 << 30)
@@ -474,89 +469,6 @@ static obs_status decode_part(exr_const_context_t ctx, int part, const part_geom
     return j.st;
 }
 
-/* ---- camera ------------------------------------------------------------- */
-
-/* A finite m44f or m44d attribute, as floats in the file's order. */
-static int header_m44(exr_const_context_t ctx, int part, const char *name, float m[16])
-{
-    const exr_attribute_t *a = NULL;
-    if (exr_get_attribute_by_name(ctx, part, name, &a) != EXR_ERR_SUCCESS || !a)
-        return 0;
-    for (int i = 0; i < 16; i++) {
-        if (a->type == EXR_ATTR_M44F && a->m44f)
-            m[i] = a->m44f->m[i];
-        else if (a->type == EXR_ATTR_M44D && a->m44d)
-            m[i] = (float)a->m44d->m[i];
-        else
-            return 0;
-        if (!isfinite(m[i]))
-            return 0;
-    }
-    return 1;
-}
-
-/* OpenEXR's camera attributes in our conventions.  Imath matrices are
- * row-vector (p' = p M), camera space is left-handed with +Z forward, and
- * worldToNDC maps to (0,0) top-left .. (1,1) bottom-right of the display
- * window after dividing by w.  Ours are column-vector, right-handed with
- * -Z forward, and the projection is OpenGL clip space.  With
- * F = diag(1,1,-1,1), Mc = wtc^T, Nc = ndc^T:
- *   world_to_camera = F Mc
- *   Q = Nc Mc^-1 F        (our camera space -> homogeneous EXR NDC q)
- *   x_clip = 2 q_x - q_w,  y_clip = q_w - 2 q_y,  w_clip = q_w
- * and the z row, which EXR leaves undefined, is OpenGL's for
- * EXR_NEAR..EXR_FAR.  obs_exr_write() does the inverse. */
-static void camera_from_exr(const float wtc[16], const float *ndc, obs_camera *cam)
-{
-    static const float F[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1};
-    float mc[16], inv[16], nc[16], q[16];
-    const float n = EXR_NEAR, f = EXR_FAR;
-
-    memset(cam, 0, sizeof *cam);
-    obs__mat4_transpose(wtc, mc);
-    if (obs__mat4_invert(mc, inv) != 0)
-        return; /* no camera maps the world onto a plane */
-    obs__mat4_mul(F, mc, cam->world_to_camera);
-    obs__mat4_identity(cam->projection);
-    cam->has_world_to_camera = 1;
-    cam->source = OBS_CAMERA_EXR_HEADER;
-    if (!ndc)
-        return;
-    obs__mat4_transpose(ndc, nc);
-    obs__mat4_mul(nc, inv, q);
-    obs__mat4_mul(q, F, q);
-
-    /* Scale q (a homogeneous quantity) so that w_clip is -z for a
-     * perspective camera and 1 for an orthographic one. */
-    const float *w = q + 12;
-    double eps = 1e-6 * (fabs(w[0]) + fabs(w[1]) + fabs(w[2]) + fabs(w[3]));
-    int flat_xy = fabs(w[0]) <= eps && fabs(w[1]) <= eps;
-    int persp = flat_xy && fabs(w[3]) <= eps && w[2] != 0.0f;
-    double s = persp ? -w[2] : flat_xy && fabs(w[2]) <= eps && w[3] != 0.0f ? w[3] : 1.0;
-    for (int i = 0; i < 16; i++)
-        q[i] = (float)(q[i] / s);
-
-    float *p = cam->projection;
-    for (int j = 0; j < 4; j++) {
-        p[0 + j] = 2.0f * q[0 + j] - q[12 + j];
-        p[4 + j] = q[12 + j] - 2.0f * q[4 + j];
-        p[8 + j] = 0.0f;
-        p[12 + j] = q[12 + j];
-    }
-    p[10] = persp ? -(f + n) / (f - n) : -2.0f / (f - n);
-    p[11] = persp ? -2.0f * f * n / (f - n) : -(f + n) / (f - n);
-    cam->has_projection = 1;
-}
-
-void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam)
-{
-    float wtc[16], ndc[16];
-    memset(cam, 0, sizeof *cam);
-    if (header_m44(ctx, part, "worldToCamera", wtc))
-        camera_from_exr(wtc, header_m44(ctx, part, "worldToNDC", ndc) ? ndc : NULL, cam);
-    obs__exr_msg_reset(); /* a missing attribute is not an error */
-}
-
 /* ---- G-buffer ----------------------------------------------------------- */
 
 /* The first part holding the mapped depth.  When none does, the message
@@ -571,9 +483,11 @@ static obs_status find_part(exr_const_context_t ctx, int parts, const obs_channe
     char perr[OBS_ERR_LEN] = "", first_err[OBS_ERR_LEN] = "";
 
     for (int p = 0; p < parts; p++) {
+        char why[96];
         if ((st = part_names(ctx, p, &pn, &n, err)) != OBS_OK)
             goto fail;
-        if ((st = obs__channel_map_resolve(map, pn, n, m, perr)) == OBS_OK) {
+        const char *detected = obs__preset_detect(ctx, p, why, sizeof why);
+        if ((st = obs__channel_map_resolve_for(map, detected, pn, n, m, perr)) == OBS_OK) {
             *part = p;
             *names = pn;
             pn = NULL;
@@ -671,9 +585,11 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     gb->depth = (obs_plane){depth, 1, 0};
     gb->normal = (obs_plane){normal, has_n ? 3 : 0, 0};
     gb->color = (obs_plane){color, has_c ? 4 : 0, 0};
-    obs__exr_read_camera(ctx, part, &gb->camera);
+    gb->depth_mode = m.depth_mode;
+    gb->normal_space = m.normal_space;
 
     obs_exr_info *info = &out->info;
+    obs__exr_describe(ctx, part, &m, gb, info);
     info->part = part;
     info->part_count = parts;
     info->tiled = g.tiled;

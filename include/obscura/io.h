@@ -32,7 +32,12 @@ typedef struct obs_channel_map {
 /* Valid preset names, NULL-terminated. */
 extern const char *const obs_channel_presets[];
 
-/* What the reader found, for logs and errors. */
+/* Most sanity warnings one read reports. */
+#define OBS_EXR_WARNINGS 8
+
+/* What the reader found, for logs and errors.  `warnings` are one line
+ * each: the file looks unlike what its convention says (README.md,
+ * "Sanity warnings"); --strict makes them errors. */
 typedef struct obs_exr_info {
     int part;                  /* part index the channels were read from */
     int part_count;
@@ -42,6 +47,16 @@ typedef struct obs_exr_info {
     char normal[3][64];
     char color[4][64];
     char preset[16];           /* preset that matched ("explicit" if none) */
+    char renderer[16];         /* the renderer the header names ("" = none) */
+    char renderer_why[96];     /* what in the header named it */
+    obs_depth_mode depth_mode;     /* the preset's depth convention (0: not known) */
+    obs_normal_space normal_space; /* the preset's normal space (0: not known) */
+    char camera_source[160];   /* the attributes the camera came from ("" = none) */
+    char camera_check[160];    /* cross-checks of the camera ("" = none made) */
+    char camera_clip[64];      /* where the clip range came from ("" = default) */
+    int camera_arnold;         /* 1: worldToNDC was in Arnold's convention */
+    int warning_count;         /* sanity warnings (obs_exr_info.warnings) */
+    char warnings[OBS_EXR_WARNINGS][224];
 } obs_exr_info;
 
 /* A G-buffer read from a file.  Frees with obs_gbuffer_free(). */
@@ -71,6 +86,13 @@ obs_status obs_gbuffer_read_exr_mem(const void *buf, size_t len,
 
 /* Frees storage and zeroes *f; NULL-safe. */
 void obs_gbuffer_free(obs_gbuffer_file *f);
+
+/* Sanity checks of a G-buffer under the conventions `params` (NULL =
+ * defaults) and the G-buffer's own give: depth all in 0..1 under a metric
+ * depth mode, normals not unit length, normals that agree with the
+ * normals derived from depth only in the other space or with the depth
+ * inverted.  Appends one line each to info->warnings; returns how many. */
+int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_info *info);
 
 /* Reads one named channel of an EXR (any part that holds it) as float32;
  * for comparisons and tests.  Caller frees with obs_image_free(). */
