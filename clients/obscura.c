@@ -23,6 +23,7 @@
 #include "obscura/deep.h"
 #include "cli.h"
 #include "flags.h"
+#include "inspect.h"
 #include "ground.h"
 #include "obscura/io.h"
 #include "obscura/metrics.h"
@@ -85,7 +86,9 @@ static const cli_opt ao_opts[] = {
     {"float", NULL, "EXR: 32-bit float channels (default half)"},
     {"png-bits", "8|16", "PNG bit depth (default 8)"},
     {"camera", "FILE", "camera JSON (width, height, fov_y_deg, world_to_camera, projection)"},
-    {"preset", "auto|blender|generic", "channel-name preset (default auto)"},
+    {"preset", "P", "renderer preset: auto (default: from the header), blender, generic, arnold, "
+     "vray, renderman, redshift, karma, mantra, octane, nuke"},
+    {"strict", NULL, "sanity warnings on the input are errors (exit 3)"},
     {"depth", "CH", "depth channel name"},
     {"normal", "X,Y,Z", "normal channel names"},
     {"color", "R,G,B[,A]", "colour channel names"},
@@ -113,6 +116,9 @@ static void usage(FILE *f)
             "                  --mask auto: where TRUTH's (else CANDIDATE's) depth channel has\n"
             "                  geometry (0 < Z < 1e9); none: every pixel; CH: where channel CH of\n"
             "                  TRUTH is a depth with geometry\n"
+            "  obscura inspect IN.exr [--json] [--preset P] [--depth-mode M] ...\n"
+            "                  what obscura reads: renderer, channels, camera and its source,\n"
+            "                  conventions, windows, part, sanity warnings\n"
             "  obscura info [--backend B]\n"
             "  obscura params [--markdown]\n"
             "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as core/chain/sample_tables.c\n"
@@ -882,6 +888,8 @@ int main(int argc, char **argv)
     const char *cmd = argv[1];
     if (!strcmp(cmd, "ao"))
         return cmd_ao(argc - 2, argv + 2);
+    if (!strcmp(cmd, "inspect"))
+        return cli_inspect(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
         return cmd_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "info"))

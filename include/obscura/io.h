@@ -87,6 +87,12 @@ obs_status obs_gbuffer_read_exr_mem(const void *buf, size_t len,
 /* Frees storage and zeroes *f; NULL-safe. */
 void obs_gbuffer_free(obs_gbuffer_file *f);
 
+/* The renderer, camera (and its source, cross-check and warnings) of part
+ * `part` of an EXR, flat or deep, as the readers find them: fills those
+ * fields of *info and *cam. */
+obs_status obs_exr_describe_camera(const char *path, int part, obs_exr_info *info,
+                                   obs_camera *cam, char err[OBS_ERR_LEN]);
+
 /* Sanity checks of a G-buffer under the conventions `params` (NULL =
  * defaults) and the G-buffer's own give: depth all in 0..1 under a metric
  * depth mode, normals not unit length, normals that agree with the
