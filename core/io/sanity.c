@@ -140,7 +140,8 @@ int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_
     obs__params_for_gbuffer(params, gb, &p);
     int w = gb->width, h = gb->height;
 
-    /* depth: every foreground value inside 0..1 under a metric mode */
+    /* depth: every foreground value inside 0..1 (1 included: the far
+     * plane of a normalized depth) under a metric mode */
     long valid = 0, unit = 0;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -148,7 +149,7 @@ int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_
             if (!(v > 0.0f) || v >= OBS_BACKGROUND_DEPTH || !isfinite(v))
                 continue;
             valid++;
-            unit += v < 1.0f;
+            unit += v <= 1.0f; /* 1: a normalized depth's far plane */
         }
     if ((p.depth_mode == OBS_DEPTH_PLANAR || p.depth_mode == OBS_DEPTH_RADIAL) &&
         valid >= MIN_PIXELS && unit == valid)
