@@ -256,7 +256,6 @@ void obs__exr_read_camera_report(exr_const_context_t ctx, int part, const char *
                   has_clip ? (float)f : EXR_FAR);
     if (cam->has_projection && has_clip)
         snprintf(rep->clip, sizeof rep->clip, "%g..%g from the header", n, f);
-    obs__exr_msg_reset(); /* a missing attribute is not an error */
 }
 
 void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam)
@@ -281,23 +280,4 @@ void obs__exr_describe(exr_const_context_t ctx, int part, const obs__channel_mat
     for (int i = 0; i < rep.warning_count && info->warning_count < OBS_EXR_WARNINGS; i++)
         snprintf(info->warnings[info->warning_count++], sizeof info->warnings[0], "%s",
                  rep.warnings[i]);
-}
-
-obs_status obs_exr_describe_camera(const char *path, int part, obs_exr_info *info,
-                                   obs_camera *cam, char err[OBS_ERR_LEN])
-{
-    exr_context_t ctx = NULL;
-    int64_t size;
-    obs_gbuffer gb;
-    obs__channel_match m;
-    char sub[OBS_ERR_LEN] = "";
-    obs_status st = obs__exr_open(path, NULL, &ctx, &size, sub);
-    if (st != OBS_OK)
-        return obs__fail(err, st, "%s: %s", path, sub);
-    memset(&gb, 0, sizeof gb);
-    memset(&m, 0, sizeof m);
-    obs__exr_describe(ctx, part, &m, &gb, info);
-    *cam = gb.camera;
-    exr_finish(&ctx);
-    return OBS_OK;
 }

@@ -487,6 +487,7 @@ static obs_status find_part(exr_const_context_t ctx, int parts, const obs_channe
         if ((st = part_names(ctx, p, &pn, &n, err)) != OBS_OK)
             goto fail;
         const char *detected = obs__preset_detect(ctx, p, why, sizeof why);
+        obs__exr_msg_reset(); /* a missing attribute is not an error */
         if ((st = obs__channel_map_resolve_for(map, detected, pn, n, m, perr)) == OBS_OK) {
             *part = p;
             *names = pn;
@@ -590,6 +591,7 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
 
     obs_exr_info *info = &out->info;
     obs__exr_describe(ctx, part, &m, gb, info);
+    obs__exr_msg_reset();
     info->part = part;
     info->part_count = parts;
     info->tiled = g.tiled;

@@ -123,7 +123,6 @@ const char *obs__preset_detect(exr_const_context_t ctx, int part, char *why, siz
     const exr_attribute_t *b = NULL;
     if (exr_get_attribute_by_name(ctx, part, "BlenderMultiChannel", &b) == EXR_ERR_SUCCESS && b) {
         snprintf(why, len, "header key BlenderMultiChannel");
-        obs__exr_msg_reset();
         return "blender";
     }
     /* A key prefix is the surest sign: the first attribute that has one. */
@@ -148,6 +147,5 @@ const char *obs__preset_detect(exr_const_context_t ctx, int part, char *why, siz
                     snprintf(why, len, "%s \"%.60s\"", *key, v);
                 }
     }
-    obs__exr_msg_reset(); /* a missing attribute is not an error */
     return found ? found->name : NULL;
 }
