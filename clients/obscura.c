@@ -89,6 +89,7 @@ static const cli_opt ao_opts[] = {
     {"preset", "P", "renderer preset: auto (default: from the header), blender, generic, arnold, "
      "vray, renderman, redshift, karma, mantra, octane, nuke"},
     {"strict", NULL, "sanity warnings on the input are errors (exit 3)"},
+    {"solve-camera", NULL, "no camera given or in the file: solve it from the position pass"},
     {"depth", "CH", "depth channel name"},
     {"normal", "X,Y,Z", "normal channel names"},
     {"color", "R,G,B[,A]", "colour channel names"},
@@ -487,6 +488,13 @@ static int cmd_ao(int argc, char **argv)
                     a.camera, cw, ch, dw, dh);
     }
 
+    if (a.req.solve_camera && (s = obs_gbuffer_solve_camera(&gf, &a.req.params, err)) != OBS_OK) {
+        rc = cli_input_fail(s, a.in, err);
+        goto done;
+    }
+    if (a.req.solve_camera && verbosity >= OBS_LOG_INFO)
+        fprintf(stderr, "obscura: info: camera %s, %s\n", gf.info.camera_source,
+                gf.info.camera_check);
     obs_gbuffer_sanity(&gf.gb, &a.req.params, &gf.info);
     if ((rc = cli_input_warnings(a.in, &gf.info, a.req.strict)) != EXIT_OK)
         goto done;

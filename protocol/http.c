@@ -55,6 +55,9 @@ const obs_http_option obs_http_options[] = {
     {.name = "strict", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(strict), .def = "0",
      .doc = "sanity warnings on the input (depth looks normalized or inverted, normals not unit "
             "length or in the other space, camera metadata that disagrees) are errors"},
+    {.name = "solve_camera", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(solve_camera), .def = "0",
+     .doc = "with no camera in the file or the request: solve the pinhole camera from the "
+            "file's world-space position pass (P, Position)"},
     {.name = NULL}};
 
 /* CHOICE and BOOL rows store through an int. */

@@ -30,6 +30,7 @@ typedef struct obs_http_request {
     int float_exr;          /* EXR: 32-bit float channels (default half) */
     int png_bits;           /* 8 (default) or 16 */
     int strict;             /* sanity warnings on the input are errors */
+    int solve_camera;       /* no camera: solve it from the position pass */
     obs_channel_map map;    /* points into the buffers below */
     char preset[16];
     char depth[64];

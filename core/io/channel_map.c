@@ -47,6 +47,8 @@ static void clear_match(obs__channel_match *m)
         m->normal[i] = -1;
     for (int i = 0; i < 4; i++)
         m->color[i] = -1;
+    for (int i = 0; i < 3; i++)
+        m->position[i] = -1;
     m->preset = "explicit";
     m->depth_mode = OBS_DEPTH_DEFAULT;
     m->normal_space = OBS_NORMALS_DEFAULT;
@@ -142,6 +144,37 @@ static void preset_row(const char *const *names, int count, const obs__preset *p
     }
 }
 
+static int in_set(int idx, const int *set, int n)
+{
+    for (int i = 0; idx >= 0 && i < n; i++)
+        if (set[i] == idx)
+            return 1;
+    return 0;
+}
+
+/* A world-space position pass, to solve or check the camera with:
+ * Blender's <Layer>.Position (the depth's layer), else P, Position,
+ * position, Pworld, worldPosition (.X/Y/Z or .R/G/B); none that reuses a
+ * channel of the other planes. */
+static void find_position(const char *const *names, int count, obs__channel_match *m,
+                          const int used[8])
+{
+    static const char *const prefixes[] = {"P", "Position", "position", "Pworld", "worldPosition",
+                                           NULL};
+    size_t sl = strlen(BLENDER_DEPTH_SUFFIX), n = strlen(names[m->depth]);
+    char pre[300];
+    if (n > sl && n - sl < 256 && strcmp(names[m->depth] + n - sl, BLENDER_DEPTH_SUFFIX) == 0) {
+        snprintf(pre, sizeof pre, "%.*s.Position", (int)(n - sl), names[m->depth]);
+        find_set(names, count, pre, XYZ, 3, m->position);
+    }
+    for (const char *const *p = prefixes; *p && m->position[0] < 0; p++)
+        if (!find_set(names, count, *p, XYZ, 3, m->position))
+            find_set(names, count, *p, RGB, 3, m->position);
+    for (int i = 0; i < 3; i++)
+        if (in_set(m->position[i], used, 8))
+            m->position[0] = m->position[1] = m->position[2] = -1;
+}
+
 /* "A, B, C", cut short with "... (N channels)". */
 void obs__list_names(const char *const *names, int count, char *buf, size_t len)
 {
@@ -181,13 +214,6 @@ static obs_status explicit_channel(const char *const *names, int count, const ch
     return missing(err, names, count, what);
 }
 
-static int in_set(int idx, const int *set, int n)
-{
-    for (int i = 0; idx >= 0 && i < n; i++)
-        if (set[i] == idx)
-            return 1;
-    return 0;
-}
 
 static int count_set(const char *const *v, int n)
 {
@@ -309,5 +335,6 @@ obs_status obs__channel_map_resolve_for(const obs_channel_map *map, const char *
         if (idx[i] >= 0 && in_set(idx[i], idx + i + 1, 7 - i))
             return obs__fail(err, OBS_INVALID_ARGUMENT, "channel '%.256s' is mapped twice",
                              names[idx[i]]);
+    find_position(names, count, m, idx);
     return OBS_OK;
 }

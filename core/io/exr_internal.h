@@ -13,6 +13,7 @@ typedef struct obs__channel_match {
     int depth;
     int normal[3];    /* all three or all -1 */
     int color[4];     /* R, G, B all or none; alpha may be -1 alone */
+    int position[3];  /* a world-space position pass: all three or all -1 */
     const char *preset; /* "blender", "generic", a renderer's or "explicit" (static) */
     obs_depth_mode depth_mode;     /* the preset's convention; 0: not known */
     obs_normal_space normal_space;

@@ -548,11 +548,12 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     if ((st = check_part(ctx, part, file_size, lim, &g, err)) != OBS_OK)
         goto fail;
 
-    /* Planes: depth (1), normal (3), colour (4), in one allocation. */
-    int has_n = m.normal[0] >= 0, has_c = m.color[0] >= 0;
+    /* Planes: depth (1), normal (3), colour (4), position (3), in one
+     * allocation. */
+    int has_n = m.normal[0] >= 0, has_c = m.color[0] >= 0, has_p = m.position[0] >= 0;
     size_t px = (size_t)g.width * (size_t)g.height, bytes;
     if (obs__size_mul3((size_t)g.width, (size_t)g.height,
-                       (size_t)(1 + 3 * has_n + 4 * has_c) * sizeof(float), &bytes) != 0) {
+                       (size_t)(1 + 3 * has_n + 4 * has_c + 3 * has_p) * sizeof(float), &bytes) != 0) {
         st = obs__fail(err, OBS_TOO_LARGE, "G-buffer of %dx%d does not fit in memory", g.width, g.height);
         goto fail;
     }
@@ -562,7 +563,8 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     }
     float *depth = out->storage, *normal = has_n ? depth + px : NULL;
     float *color = has_c ? depth + px * (1 + 3 * has_n) : NULL;
-    target t[8];
+    float *position = has_p ? depth + px * (1 + 3 * has_n + 4 * has_c) : NULL;
+    target t[11];
     int nt = 0;
     t[nt++] = (target){names[m.depth], depth, 1};
     for (int i = 0; has_n && i < 3; i++)
@@ -570,6 +572,8 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     for (int i = 0; has_c && i < 4; i++)
         if (m.color[i] >= 0)
             t[nt++] = (target){names[m.color[i]], color + i, 4};
+    for (int i = 0; has_p && i < 3; i++)
+        t[nt++] = (target){names[m.position[i]], position + i, 3};
     if (has_c && m.color[3] < 0) /* colour without alpha is opaque */
         for (size_t i = 0; i < px; i++)
             color[i * 4 + 3] = 1.0f;
@@ -586,6 +590,7 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     gb->depth = (obs_plane){depth, 1, 0};
     gb->normal = (obs_plane){normal, has_n ? 3 : 0, 0};
     gb->color = (obs_plane){color, has_c ? 4 : 0, 0};
+    gb->position = (obs_plane){position, has_p ? 3 : 0, 0};
     gb->depth_mode = m.depth_mode;
     gb->normal_space = m.normal_space;
 
@@ -601,6 +606,8 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
         copy_name(info->normal[i], sizeof info->normal[i], names, m.normal[i]);
     for (int i = 0; i < 4; i++)
         copy_name(info->color[i], sizeof info->color[i], names, m.color[i]);
+    for (int i = 0; i < 3; i++)
+        copy_name(info->position[i], sizeof info->position[i], names, m.position[i]);
     snprintf(info->preset, sizeof info->preset, "%s", m.preset);
     st = OBS_OK;
 fail:

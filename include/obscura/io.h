@@ -46,6 +46,7 @@ typedef struct obs_exr_info {
     char depth[64];            /* matched channel names ("" = absent) */
     char normal[3][64];
     char color[4][64];
+    char position[3][64];      /* a world-space position pass ("" = none) */
     char preset[16];           /* preset that matched ("explicit" if none) */
     char renderer[16];         /* the renderer the header names ("" = none) */
     char renderer_why[96];     /* what in the header named it */
@@ -93,11 +94,36 @@ void obs_gbuffer_free(obs_gbuffer_file *f);
 obs_status obs_exr_describe_camera(const char *path, int part, obs_exr_info *info,
                                    obs_camera *cam, char err[OBS_ERR_LEN]);
 
+/* The pinhole camera of a world-space position pass `pos` (3 floats a
+ * pixel, the G-buffer's size; pixels with background depth are left out):
+ * normalised DLT, Gauss-Newton refinement, then intrinsics and rotation.
+ * A P no pinhole camera explains (RMS reprojection error over 0.5 px, an
+ * affine or mirrored fit) is OBS_NO_CAMERA with the error in `err`.
+ * *rms (may be NULL) receives the RMS reprojection error in pixels. */
+obs_status obs_camera_solve_position(const obs_gbuffer *gb, const obs_plane *pos, obs_camera *cam,
+                                     double *rms, char err[OBS_ERR_LEN]);
+
+/* With no camera (none in the file, none in `params`: fov_y, fov_x or
+ * focal_length with aperture), the camera solved from the file's position
+ * pass (obs_camera_solve_position), its source and error in f->info; the
+ * solver's refusal, or no position pass, is OBS_NO_CAMERA with a message.
+ * With a camera, nothing (obs_gbuffer_sanity() checks it against P). */
+obs_status obs_gbuffer_solve_camera(obs_gbuffer_file *f, const obs_params *params,
+                                    char err[OBS_ERR_LEN]);
+
+/* RMS and largest distance in pixels between each pixel centre and its
+ * position projected by `cam`. */
+obs_status obs_camera_reprojection(const obs_gbuffer *gb, const obs_plane *pos,
+                                   const obs_camera *cam, double *rms, double *max_err,
+                                   char err[OBS_ERR_LEN]);
+
 /* Sanity checks of a G-buffer under the conventions `params` (NULL =
  * defaults) and the G-buffer's own give: depth all in 0..1 under a metric
  * depth mode, normals not unit length, normals that agree with the
  * normals derived from depth only in the other space or with the depth
- * inverted.  Appends one line each to info->warnings; returns how many. */
+ * inverted, and a camera whose reprojection of the position pass (when
+ * the G-buffer has one) misses the pixel centres by more than a pixel
+ * (RMS).  Appends one line each to info->warnings; returns how many. */
 int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_info *info);
 
 /* Reads one named channel of an EXR (any part that holds it) as float32;

@@ -82,6 +82,9 @@ typedef struct obs_gbuffer {
      * at 0 (their default). */
     obs_depth_mode depth_mode;
     obs_normal_space normal_space;
+    /* Optional world-space position pass (3 channels, data NULL when
+     * absent): only to solve or check the camera, never drawn. */
+    obs_plane position;
 } obs_gbuffer;
 
 /* An image owned by the library: `channels` interleaved float32 values
