@@ -2,7 +2,8 @@
  * an EXR and why: the renderer its header names, each plane's channel and
  * the preset that mapped it, the camera and the attributes it came from
  * with their cross-check, the depth and normal conventions, the windows,
- * the part, and the sanity warnings.  Reads the file the way `obscura ao`
+ * the part, the position pass (and the camera solved from it when the file
+ * has none), and the sanity warnings.  Reads the file the way `obscura ao`
  * does (same flags for the channel map and the conventions). */
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,6 +59,9 @@ static int print_json(const char *path, const obs_gbuffer *gb, const obs_exr_inf
     cJSON_AddItemToObject(ch, "normal", info->normal[0][0] ? cJSON_CreateStringArray(n, 3) : cJSON_CreateNull());
     cJSON_AddItemToObject(ch, "color", info->color[0][0] ? cJSON_CreateStringArray(c, info->color[3][0] ? 4 : 3)
                                                          : cJSON_CreateNull());
+    const char *p[3] = {info->position[0], info->position[1], info->position[2]};
+    cJSON_AddItemToObject(ch, "position", info->position[0][0] ? cJSON_CreateStringArray(p, 3)
+                                                               : cJSON_CreateNull());
     cJSON_AddItemToObject(o, "channels", ch);
     cJSON_AddStringToObject(o, "depth_mode", info->depth_mode ? depth_name(info->depth_mode) : "");
     cJSON_AddStringToObject(o, "normal_space",
@@ -108,6 +112,9 @@ static void print_text(const char *path, const obs_gbuffer *gb, const obs_exr_in
                info->color[3][0] ? ", " : "", info->color[3]);
     else
         printf("    colour  (none)\n");
+    if (info->position[0][0])
+        printf("    position %s, %s, %s (world space: solves or checks the camera)\n",
+               info->position[0], info->position[1], info->position[2]);
     printf("  depth: %s\n  normals: %s space\n", depth_name(info->depth_mode),
            space_name(info->normal_space));
     printf("  camera: %s\n", info->camera_source[0] ? info->camera_source : "(none in the header)");
@@ -211,6 +218,11 @@ int cli_inspect(int argc, char **argv)
         fprintf(stderr, "obscura: %s\n", err);
         return EXIT_BADINPUT;
     }
+    /* a file with a position pass and no camera: what the solver finds */
+    if (gf.gb.position.data && obs_gbuffer_solve_camera(&gf, &req.params, err) != OBS_OK &&
+        gf.info.warning_count < OBS_EXR_WARNINGS)
+        snprintf(gf.info.warnings[gf.info.warning_count++], sizeof gf.info.warnings[0],
+                 "the camera cannot be solved from the position pass: %.160s", err);
     obs_gbuffer_sanity(&gf.gb, &req.params, &gf.info);
     int rc = json ? print_json(in, &gf.gb, &gf.info) : (print_text(in, &gf.gb, &gf.info), EXIT_OK);
     obs_gbuffer_free(&gf);

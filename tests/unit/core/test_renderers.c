@@ -8,6 +8,7 @@
 
 #include "gl_testutil.h"
 
+#include "chain/frame.h"
 #include "internal.h"
 #include "io/exr_internal.h"
 #include "obscura/deep.h"
@@ -387,6 +388,89 @@ static void test_lens_parameters(void **state)
     obs_gbuffer_free(&gf);
 }
 
+/* P from depth and camera: the view point of each pixel (the prep pass's
+ * CPU twin) taken back to the world.  `fisheye` bends the rays by an
+ * equidistant fisheye mapping instead (a camera no pinhole explains). */
+static float *position_from_depth(const obs_gbuffer *gb, int fisheye)
+{
+    char err[OBS_ERR_LEN] = "";
+    obs_params p;
+    obs__frame f;
+    float inv[16];
+    obs_params_resolve(NULL, &p);
+    assert_int_equal(obs__frame_setup(NULL, gb, &p, &f, err), OBS_OK);
+    assert_int_equal(obs__mat4_invert(gb->camera.world_to_camera, inv), 0);
+    float *P = malloc((size_t)gb->width * gb->height * 3 * sizeof *P);
+    assert_non_null(P);
+    for (int y = 0; y < gb->height; y++)
+        for (int x = 0; x < gb->width; x++) {
+            float v[4], wv[4], o[4];
+            obs__prep_position(&f, *obs__plane_px(&gb->depth, gb->width, x, y), x, y, v);
+            if (fisheye && v[3] > 0.0f) { /* angle from the axis = 1.2 * pinhole's tangent */
+                double r = sqrt(v[0] * v[0] + v[1] * v[1]) / v[3], th = 1.2 * r;
+                double k = r > 0 ? tan(th) / r : 1.0;
+                v[0] = (float)(v[0] * k);
+                v[1] = (float)(v[1] * k);
+            }
+            wv[0] = v[0], wv[1] = v[1], wv[2] = v[2], wv[3] = 1.0f;
+            obs__mat4_apply(inv, wv, o);
+            memcpy(P + ((size_t)y * gb->width + x) * 3, o, 3 * sizeof *o);
+        }
+    return P;
+}
+
+static void test_solve_camera(void **state)
+{
+    obs_gbuffer_file gf = {0};
+    obs_camera cam;
+    double rms, maxe;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    load(scenes[0], &gf);
+    float *P = position_from_depth(&gf.gb, 0);
+    obs_plane pos = {P, 3, 0};
+    assert_int_equal(obs_camera_solve_position(&gf.gb, &pos, &cam, &rms, err), OBS_OK);
+    assert_int_equal(obs_camera_reprojection(&gf.gb, &pos, &cam, &rms, &maxe, err), OBS_OK);
+    print_message("solved from P (depth + camera): RMS %.2e px, max %.2e px\n", rms, maxe);
+    assert_true(rms < 0.05 && maxe < 0.05);
+    /* the camera JSON's camera: rotation, translation and lens */
+    for (int i = 0; i < 12; i++)
+        assert_float_equal(cam.world_to_camera[i], gf.gb.camera.world_to_camera[i], 1e-3);
+    for (int i = 0; i < 8; i++)
+        assert_float_equal(cam.projection[i], gf.gb.camera.projection[i], 1e-3);
+    /* Blender's own Position pass solves the same camera */
+    assert_non_null(gf.gb.position.data);
+    assert_string_equal(gf.info.position[0], "ViewLayer.Position.X");
+    assert_int_equal(obs_camera_solve_position(&gf.gb, &gf.gb.position, &cam, &rms, err), OBS_OK);
+    print_message("solved from ViewLayer.Position: RMS %.2e px\n", rms);
+    assert_true(rms < 0.05);
+    assert_float_equal(cam.projection[5], gf.gb.camera.projection[5], 1e-3);
+    /* obs_gbuffer_solve_camera: only without a camera */
+    obs_gbuffer_file nocam = {0};
+    assert_int_equal(obs_gbuffer_read_exr(TESTDATA "/room_small.exr", NULL, NULL, &nocam, err), OBS_OK);
+    assert_int_equal(nocam.gb.camera.has_projection, 0);
+    assert_int_equal(obs_gbuffer_solve_camera(&nocam, NULL, err), OBS_OK);
+    assert_int_equal(nocam.gb.camera.has_projection, 1);
+    assert_non_null(strstr(nocam.info.camera_source, "solved from the position pass"));
+    obs_gbuffer_free(&nocam);
+    free(P);
+
+    /* a fisheye's P is refused, naming the error */
+    P = position_from_depth(&gf.gb, 1);
+    pos.data = P;
+    assert_int_equal(obs_camera_solve_position(&gf.gb, &pos, &cam, &rms, err), OBS_NO_CAMERA);
+    print_message("fisheye P: %s\n", err);
+    assert_non_null(strstr(err, "not consistent with a pinhole camera"));
+    /* ... and the JSON camera disagrees with it: a sanity warning */
+    obs_gbuffer g = gf.gb;
+    g.position = pos;
+    obs_exr_info info = {0};
+    assert_true(obs_gbuffer_sanity(&g, NULL, &info) >= 1);
+    assert_non_null(strstr(info.warnings[0], "disagrees with the position pass"));
+    free(P);
+    obs_gbuffer_free(&gf);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -394,6 +478,7 @@ int main(void)
         cmocka_unit_test(test_arnold_frame),
         cmocka_unit_test(test_sanity_warnings),
         cmocka_unit_test(test_lens_parameters),
+        cmocka_unit_test(test_solve_camera),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
