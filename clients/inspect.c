@@ -82,6 +82,8 @@ static int print_json(const char *path, const obs_gbuffer *gb, const obs_exr_inf
     cJSON_AddItemToObject(o, "display_size", cJSON_CreateIntArray(disp, 2));
     cJSON_AddNumberToObject(o, "part", info->part);
     cJSON_AddNumberToObject(o, "parts", info->part_count);
+    cJSON_AddStringToObject(o, "view", info->view);
+    cJSON_AddNumberToObject(o, "parts_read", info->parts_read);
     cJSON_AddStringToObject(o, "compression", info->compression ? info->compression : "");
     cJSON_AddBoolToObject(o, "tiled", info->tiled);
     for (int i = 0; i < info->warning_count; i++)
@@ -130,6 +132,9 @@ static void print_text(const char *path, const obs_gbuffer *gb, const obs_exr_in
            gb->display_height ? gb->display_height : gb->height);
     printf("  part %d of %d, %s, %s\n", info->part, info->part_count,
            info->tiled ? "tiled" : "scanline", info->compression ? info->compression : "?");
+    if (info->view[0])
+        printf("  view: %s, channels gathered from %d part%s\n", info->view, info->parts_read,
+               info->parts_read == 1 ? "" : "s");
     for (int i = 0; i < info->warning_count; i++)
         printf("  warning: %s\n", info->warnings[i]);
     if (!info->warning_count)

@@ -36,6 +36,8 @@ typedef struct obs_http_request {
     char depth[64];
     char normal[3][64];
     char color[4][64];
+    char part[64];
+    char view[64];
 } obs_http_request;
 
 /* Zeroes the request: every option at its default. */

@@ -111,6 +111,22 @@ void obs__exr_read_camera_report(exr_const_context_t ctx, int part, const char *
 void obs__exr_describe(exr_const_context_t ctx, int part, const obs__channel_match *m,
                        obs_gbuffer *gb, obs_exr_info *info);
 
+/* The parts a G-buffer is read from (core/io/exr_parts.c). */
+typedef struct obs__part_set {
+    int *part;    /* indices, in the order they are tried */
+    int count;
+    int by_view;  /* 1: the parts of one view, channels gathered across them */
+    char view[64];
+    char why[96];
+} obs__part_set;
+
+/* The parts map->part or map->view select (see exr_parts.c); a part or
+ * view the file lacks is OBS_INVALID_ARGUMENT naming the file's parts.
+ * Free with obs__part_set_free(). */
+obs_status obs__exr_select_parts(exr_const_context_t ctx, int parts, const obs_channel_map *map,
+                                 obs__part_set *s, char err[OBS_ERR_LEN]);
+void obs__part_set_free(obs__part_set *s);
+
 typedef struct obs__exr_mem {
     const unsigned char *buf;
     size_t len;

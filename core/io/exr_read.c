@@ -471,45 +471,66 @@ static obs_status decode_part(exr_const_context_t ctx, int part, const part_geom
 
 /* ---- G-buffer ----------------------------------------------------------- */
 
-/* The first part holding the mapped depth.  When none does, the message
- * lists the channels of every part. */
-static obs_status find_part(exr_const_context_t ctx, int parts, const obs_channel_map *map,
-                            int *part, obs__channel_match *m, const char ***names,
-                            char err[OBS_ERR_LEN])
+/* The first selected part holding the mapped depth; with a view, the
+ * channels of the view's parts together (*owner: the part of each name).
+ * When none does, the message lists the channels of every part. */
+static obs_status find_part(exr_const_context_t ctx, const obs__part_set *ps,
+                            const obs_channel_map *map, int *part, obs__channel_match *m,
+                            const char ***names, int **owner, char err[OBS_ERR_LEN])
 {
     const char **all = NULL, **pn = NULL;
-    int nall = 0, n = 0;
+    int nall = 0, n = 0, parts = ps->count, *own = NULL;
     obs_status st = OBS_OK;
-    char perr[OBS_ERR_LEN] = "", first_err[OBS_ERR_LEN] = "";
+    char perr[OBS_ERR_LEN] = "", first_err[OBS_ERR_LEN] = "", why[96];
 
-    for (int p = 0; p < parts; p++) {
-        char why[96];
+    *owner = NULL;
+    for (int i = 0; i < parts; i++) {
+        int p = ps->part[i];
         if ((st = part_names(ctx, p, &pn, &n, err)) != OBS_OK)
             goto fail;
         const char *detected = obs__preset_detect(ctx, p, why, sizeof why);
         obs__exr_msg_reset(); /* a missing attribute is not an error */
-        if ((st = obs__channel_map_resolve_for(map, detected, pn, n, m, perr)) == OBS_OK) {
+        if (!ps->by_view && (st = obs__channel_map_resolve_for(map, detected, pn, n, m, perr)) == OBS_OK) {
             *part = p;
             *names = pn;
             pn = NULL;
             goto fail;
         }
-        if (st != OBS_MISSING_CHANNEL) {
+        if (!ps->by_view && st != OBS_MISSING_CHANNEL) {
             obs__fail(err, st, "%s", perr);
             goto fail;
         }
-        if (p == 0)
+        if (i == 0)
             memcpy(first_err, perr, sizeof perr);
         const char **grown = realloc(all, ((size_t)nall + (size_t)n + 1) * sizeof *all);
-        if (!grown) {
+        int *grown_own = realloc(own, ((size_t)nall + (size_t)n + 1) * sizeof *own);
+        if (grown)
+            all = grown;
+        if (grown_own)
+            own = grown_own;
+        if (!grown || !grown_own) {
             st = obs__fail(err, OBS_NO_MEMORY, "channel list");
             goto fail;
         }
-        all = grown;
         memcpy(all + nall, pn, (size_t)n * sizeof *pn);
+        for (int k = 0; k < n; k++)
+            own[nall + k] = p;
         nall += n;
         free(pn);
         pn = NULL;
+    }
+    /* A view's parts: their channels together, the first part's renderer. */
+    if (ps->by_view) {
+        const char *detected = obs__preset_detect(ctx, ps->part[0], why, sizeof why);
+        obs__exr_msg_reset();
+        if ((st = obs__channel_map_resolve_for(map, detected, all, nall, m, err)) == OBS_OK) {
+            *part = own[m->depth];
+            *names = all;
+            *owner = own;
+            all = NULL;
+            own = NULL;
+        }
+        goto fail;
     }
     /* Resolving against the union gives one message naming every part's
      * channels; should that succeed (channels split across parts), part
@@ -520,7 +541,42 @@ static obs_status find_part(exr_const_context_t ctx, int parts, const obs_channe
 fail:
     free(pn);
     free(all);
+    free(own);
     return st;
+}
+
+/* Decodes the targets of a view's parts other than the depth's, part by
+ * part; each part's data window must be the depth part's. */
+static obs_status decode_other_parts(exr_const_context_t ctx, int64_t file_size, int part,
+                                     const part_geom *g, const target *t, const int *tpart, int nt,
+                                     const obs_limits *lim, char err[OBS_ERR_LEN])
+{
+    for (int i = 0; i < nt; i++) {
+        int q = tpart[i], seen = q == part;
+        for (int k = 0; k < i && !seen; k++)
+            seen = tpart[k] == q;
+        if (seen)
+            continue;
+        part_geom gq;
+        target sub[11];
+        int ns = 0;
+        obs_status st = check_part(ctx, q, file_size, lim, &gq, err);
+        if (st != OBS_OK)
+            return st;
+        if (gq.dw.min.x != g->dw.min.x || gq.dw.min.y != g->dw.min.y || gq.width != g->width ||
+            gq.height != g->height)
+            return obs__fail(err, OBS_UNSUPPORTED, "part %d's data window (%dx%d at %d,%d) is not "
+                             "the depth part's (%dx%d at %d,%d): channels of one view are gathered "
+                             "from parts of the same window only (give --part)", q, gq.width,
+                             gq.height, gq.dw.min.x, gq.dw.min.y, g->width, g->height,
+                             g->dw.min.x, g->dw.min.y);
+        for (int k = 0; k < nt; k++)
+            if (tpart[k] == q)
+                sub[ns++] = t[k];
+        if ((st = decode_part(ctx, q, &gq, sub, ns, lim, err)) != OBS_OK)
+            return st;
+    }
+    return OBS_OK;
 }
 
 static void copy_name(char *dst, size_t len, const char *const *names, int idx)
@@ -533,6 +589,8 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
                                char err[OBS_ERR_LEN])
 {
     const char **names = NULL;
+    int *owner = NULL;
+    obs__part_set ps = {0};
     obs__channel_match m;
     part_geom g;
     int parts = 0, part = 0;
@@ -543,7 +601,9 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
         st = obs__exr_fail(err, rv ? rv : EXR_ERR_FILE_BAD_HEADER, "part count");
         goto fail;
     }
-    if ((st = find_part(ctx, parts, map, &part, &m, &names, err)) != OBS_OK)
+    if ((st = obs__exr_select_parts(ctx, parts, map, &ps, err)) != OBS_OK)
+        goto fail;
+    if ((st = find_part(ctx, &ps, map, &part, &m, &names, &owner, err)) != OBS_OK)
         goto fail;
     if ((st = check_part(ctx, part, file_size, lim, &g, err)) != OBS_OK)
         goto fail;
@@ -565,19 +625,30 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     float *color = has_c ? depth + px * (1 + 3 * has_n) : NULL;
     float *position = has_p ? depth + px * (1 + 3 * has_n + 4 * has_c) : NULL;
     target t[11];
-    int nt = 0;
+    int nt = 0, tpart[11], idx[11];
+    idx[nt] = m.depth;
     t[nt++] = (target){names[m.depth], depth, 1};
     for (int i = 0; has_n && i < 3; i++)
-        t[nt++] = (target){names[m.normal[i]], normal + i, 3};
+        idx[nt] = m.normal[i], t[nt++] = (target){names[m.normal[i]], normal + i, 3};
     for (int i = 0; has_c && i < 4; i++)
         if (m.color[i] >= 0)
-            t[nt++] = (target){names[m.color[i]], color + i, 4};
+            idx[nt] = m.color[i], t[nt++] = (target){names[m.color[i]], color + i, 4};
     for (int i = 0; has_p && i < 3; i++)
-        t[nt++] = (target){names[m.position[i]], position + i, 3};
+        idx[nt] = m.position[i], t[nt++] = (target){names[m.position[i]], position + i, 3};
+    /* a view's channels may lie in several parts: the depth part's here,
+     * the others' by decode_other_parts() */
+    target here[11];
+    int nt_here = 0;
+    for (int i = 0; i < nt; i++) {
+        tpart[i] = owner ? owner[idx[i]] : part;
+        if (tpart[i] == part)
+            here[nt_here++] = t[i];
+    }
     if (has_c && m.color[3] < 0) /* colour without alpha is opaque */
         for (size_t i = 0; i < px; i++)
             color[i * 4 + 3] = 1.0f;
-    if ((st = decode_part(ctx, part, &g, t, nt, lim, err)) != OBS_OK)
+    if ((st = decode_part(ctx, part, &g, here, nt_here, lim, err)) != OBS_OK ||
+        (st = decode_other_parts(ctx, file_size, part, &g, t, tpart, nt, lim, err)) != OBS_OK)
         goto fail;
 
     obs_gbuffer *gb = &out->gb;
@@ -609,9 +680,19 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     for (int i = 0; i < 3; i++)
         copy_name(info->position[i], sizeof info->position[i], names, m.position[i]);
     snprintf(info->preset, sizeof info->preset, "%s", m.preset);
+    snprintf(info->view, sizeof info->view, "%s", ps.view);
+    info->parts_read = 1;
+    for (int i = 1; i < nt; i++) {
+        int seen = 0;
+        for (int k = 0; k < i; k++)
+            seen |= tpart[k] == tpart[i];
+        info->parts_read += !seen;
+    }
     st = OBS_OK;
 fail:
     free(names);
+    free(owner);
+    obs__part_set_free(&ps);
     return st;
 }
 

@@ -27,6 +27,10 @@ typedef struct obs_channel_map {
     const char *depth;     /* explicit channel names, NULL = from preset */
     const char *normal[3];
     const char *color[4];  /* color[3] (alpha) may be NULL */
+    const char *part;      /* a part by name or index (NULL: by view, or the first part
+                            * holding the depth) */
+    const char *view;      /* a view of a multi-view, multi-part file (NULL: its default
+                            * view); its parts' channels are gathered */
 } obs_channel_map;
 
 /* Valid preset names, NULL-terminated. */
@@ -48,6 +52,8 @@ typedef struct obs_exr_info {
     char color[4][64];
     char position[3][64];      /* a world-space position pass ("" = none) */
     char preset[16];           /* preset that matched ("explicit" if none) */
+    char view[64];             /* the view read ("" = the file has no views) */
+    int parts_read;            /* parts the channels came from (1, or more for a view) */
     char renderer[16];         /* the renderer the header names ("" = none) */
     char renderer_why[96];     /* what in the header named it */
     obs_depth_mode depth_mode;     /* the preset's depth convention (0: not known) */

@@ -471,6 +471,172 @@ static void test_solve_camera(void **state)
     obs_gbuffer_free(&gf);
 }
 
+/* One part of a multi-part file the test writes. */
+typedef struct part_spec {
+    const char *name, *view; /* view NULL: none */
+    plane *pl;
+    int np;
+} part_spec;
+
+static void write_parts(const char *path, int w, int h, const part_spec *ps, int n,
+                        const char **multiview, int nviews)
+{
+    exr_context_t ctx = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    assert_int_equal(exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init), EXR_ERR_SUCCESS);
+    for (int k = 0; k < n; k++) {
+        int part = 0;
+        assert_int_equal(exr_add_part(ctx, ps[k].name, EXR_STORAGE_SCANLINE, &part), EXR_ERR_SUCCESS);
+        assert_int_equal(exr_initialize_required_attr_simple(ctx, part, w, h, EXR_COMPRESSION_ZIP), EXR_ERR_SUCCESS);
+        for (int c = 0; c < ps[k].np; c++)
+            assert_int_equal(exr_add_channel(ctx, part, ps[k].pl[c].name, EXR_PIXEL_FLOAT,
+                                             EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1), EXR_ERR_SUCCESS);
+        if (ps[k].view)
+            assert_int_equal(exr_attr_set_string(ctx, part, "view", ps[k].view), EXR_ERR_SUCCESS);
+        if (multiview)
+            assert_int_equal(exr_attr_set_string_vector(ctx, part, "multiView", nviews, multiview), EXR_ERR_SUCCESS);
+    }
+    assert_int_equal(exr_write_header(ctx), EXR_ERR_SUCCESS);
+    for (int k = 0; k < n; k++) {
+        int32_t lines = 1;
+        exr_chunk_info_t ci;
+        exr_encode_pipeline_t enc;
+        int started = 0;
+        assert_int_equal(exr_get_scanlines_per_chunk(ctx, k, &lines), EXR_ERR_SUCCESS);
+        for (int y = 0; y < h; y += lines) {
+            assert_int_equal(exr_write_scanline_chunk_info(ctx, k, y, &ci), EXR_ERR_SUCCESS);
+            assert_int_equal(started ? exr_encoding_update(ctx, k, &ci, &enc)
+                                     : exr_encoding_initialize(ctx, k, &ci, &enc), EXR_ERR_SUCCESS);
+            started = 1;
+            for (int c = 0; c < enc.channel_count; c++) {
+                exr_coding_channel_info_t *ch = &enc.channels[c];
+                for (int q = 0; q < ps[k].np; q++)
+                    if (strcmp(ch->channel_name, ps[k].pl[q].name) == 0)
+                        ch->encode_from_ptr = (const uint8_t *)(ps[k].pl[q].data + (size_t)ci.start_y * w);
+                ch->user_pixel_stride = sizeof(float);
+                ch->user_line_stride = w * (int32_t)sizeof(float);
+                ch->user_data_type = EXR_PIXEL_FLOAT;
+                ch->user_bytes_per_element = sizeof(float);
+            }
+            assert_int_equal(exr_encoding_choose_default_routines(ctx, k, &enc), EXR_ERR_SUCCESS);
+            assert_int_equal(exr_encoding_run(ctx, k, &enc), EXR_ERR_SUCCESS);
+        }
+        exr_encoding_destroy(ctx, &enc);
+    }
+    assert_int_equal(exr_finish(&ctx), EXR_ERR_SUCCESS);
+}
+
+/* room_small split over parts of two views (right the default: first in
+ * multiView; the left view's depth doubled), colour and normals in parts
+ * of their own: no flags reads the right view with its channels gathered
+ * across parts, AO equal to the single-part file's; --view left and
+ * --part pick the others. */
+static void test_multipart_views(void **state)
+{
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_EGL_SURFACELESS);
+    obs_gbuffer_file room = {0};
+    obs_result ref, res;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    load(scenes[0], &room);
+    int w = room.gb.width, h = room.gb.height;
+    size_t px = (size_t)w * h;
+    plane z_r = {"Z", malloc(px * 4)}, z_l = {"Z", malloc(px * 4)};
+    plane n[3] = {{"N.X", malloc(px * 4)}, {"N.Y", malloc(px * 4)}, {"N.Z", malloc(px * 4)}};
+    plane c[3] = {{"R", malloc(px * 4)}, {"G", malloc(px * 4)}, {"B", malloc(px * 4)}};
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            z_r.data[i] = *obs__plane_px(&room.gb.depth, w, x, y);
+            z_l.data[i] = 2.0f * z_r.data[i];
+            for (int k = 0; k < 3; k++) {
+                n[k].data[i] = obs__plane_px(&room.gb.normal, w, x, y)[k];
+                c[k].data[i] = obs__plane_px(&room.gb.color, w, x, y)[k];
+            }
+        }
+    part_spec parts[] = {{"rgba_left", "left", c, 3},   {"depth_left", "left", &z_l, 1},
+                         {"rgba_right", "right", c, 3}, {"normal_right", "right", n, 3},
+                         {"depth_right", "right", &z_r, 1}};
+    const char *views[] = {"right", "left"};
+    const char *path = obs_test_tmp_file("views.exr", NULL);
+    write_parts(path, w, h, parts, 5, views, 2);
+
+    obs_gbuffer_file gf = {0};
+    assert_int_equal(obs_gbuffer_read_exr(path, NULL, NULL, &gf, err), OBS_OK);
+    assert_string_equal(gf.info.view, "right");
+    assert_int_equal(gf.info.part, 4);
+    assert_int_equal(gf.info.parts_read, 3);
+    assert_non_null(gf.gb.normal.data);
+    assert_non_null(gf.gb.color.data);
+    gf.gb.camera = room.gb.camera;
+    assert_int_equal(obs_run(ctx, &room.gb, NULL, OBS_OUTPUT_AO, &ref, err), OBS_OK);
+    assert_int_equal(obs_run(ctx, &gf.gb, NULL, OBS_OUTPUT_AO, &res, err), OBS_OK);
+    print_message("multi-part, default view right: max |AO - AO(single part)| %.2e\n",
+                  max_diff(&res.ao, &ref.ao));
+    assert_true(max_diff(&res.ao, &ref.ao) < 1e-4);
+    obs_result_free(&res);
+    obs_gbuffer_free(&gf);
+
+    obs_channel_map left = {.view = "left"};
+    assert_int_equal(obs_gbuffer_read_exr(path, &left, NULL, &gf, err), OBS_OK);
+    assert_string_equal(gf.info.view, "left");
+    assert_int_equal(gf.info.part, 1);
+    assert_non_null(gf.gb.color.data);
+    assert_null(gf.gb.normal.data);
+    assert_float_equal(gf.gb.depth.data[w * (h / 2) + w / 2], z_l.data[w * (h / 2) + w / 2], 0);
+    obs_gbuffer_free(&gf);
+
+    obs_channel_map one = {.part = "depth_right"}, idx = {.part = "1"};
+    assert_int_equal(obs_gbuffer_read_exr(path, &one, NULL, &gf, err), OBS_OK);
+    assert_int_equal(gf.info.part, 4);
+    assert_null(gf.gb.color.data);
+    obs_gbuffer_free(&gf);
+    assert_int_equal(obs_gbuffer_read_exr(path, &idx, NULL, &gf, err), OBS_OK);
+    assert_int_equal(gf.info.part, 1);
+    obs_gbuffer_free(&gf);
+    obs_channel_map nope = {.view = "middle"}, nopart = {.part = "9"};
+    assert_int_equal(obs_gbuffer_read_exr(path, &nope, NULL, &gf, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "no part of view 'middle'"));
+    assert_int_equal(obs_gbuffer_read_exr(path, &nopart, NULL, &gf, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "depth_right"));
+
+    free(z_r.data);
+    free(z_l.data);
+    for (int k = 0; k < 3; k++) {
+        free(n[k].data);
+        free(c[k].data);
+    }
+    obs_result_free(&ref);
+    obs_gbuffer_free(&room);
+    obs_ctx_destroy(ctx);
+}
+
+/* OpenEXR's Beachball/multipart.0001.exr (../shared, when present): the
+ * default view is right (the first part's view; the first part with a
+ * depth is the left view's), depth from depth_right, colour gathered from
+ * rgba_right. */
+static void test_beachball(void **state)
+{
+    char path[512], err[OBS_ERR_LEN] = "";
+    obs_gbuffer_file gf = {0};
+    (void)state;
+    snprintf(path, sizeof path, "%s/openexr-images/Beachball/multipart.0001.exr", obs_test_shared());
+    if (!obs_test_exists(path)) {
+        print_message("skipped: %s is absent\n", path);
+        skip();
+    }
+    assert_int_equal(obs_gbuffer_read_exr(path, NULL, NULL, &gf, err), OBS_OK);
+    assert_string_equal(gf.info.view, "right");
+    assert_int_equal(gf.info.part, 5);
+    assert_int_equal(gf.info.parts_read, 2);
+    assert_non_null(gf.gb.color.data);
+    obs_gbuffer_free(&gf);
+    obs_channel_map left = {.view = "left"};
+    assert_int_equal(obs_gbuffer_read_exr(path, &left, NULL, &gf, err), OBS_OK);
+    assert_int_equal(gf.info.part, 1);
+    obs_gbuffer_free(&gf);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -479,6 +645,8 @@ int main(void)
         cmocka_unit_test(test_sanity_warnings),
         cmocka_unit_test(test_lens_parameters),
         cmocka_unit_test(test_solve_camera),
+        cmocka_unit_test(test_multipart_views),
+        cmocka_unit_test(test_beachball),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
