@@ -87,6 +87,26 @@ for url in "unix:$T/obscurad.sock" "http://127.0.0.1:$PORT_d"; do
     check "--solve-camera --server $url: exit 0, the local AO" \
         "[ $rc -eq 0 ] && python3 -c 'import json,sys; sys.exit(not json.load(open(sys.argv[1]))[\"mae\"] < 1e-4)' '$T/cmp3.json'"
 done
+
+echo "-- multi-part and multi-view"
+B=${OBSCURA_SHARED_DATA:-../shared/data}/openexr-images/Beachball/multipart.0001.exr
+if [ -f "$B" ]; then
+    "$OBSCURA" inspect "$B" > "$T/bb.txt"
+    check "Beachball: the default view right, channels from 2 parts" \
+        "grep -q 'view: right, channels gathered from 2 parts' '$T/bb.txt'"
+    "$OBSCURA" inspect "$B" --view left > "$T/bbl.txt"
+    check "Beachball --view left: part 1" "grep -q 'part 1 of 10' '$T/bbl.txt'"
+    "$OBSCURA" ao "$B" --view left --fov-y 40 -o "$T/bbl.exr" -q
+    check "CLI --view left: exit 0" "[ $? -eq 0 ]"
+    code=$(post "$PORT_d" "view=left&fov_y=40" "$B" "$T/bb.out")
+    check "HTTP view=left: 200" "[ '$code' = 200 ]"
+    code=$(post "$PORT_d" "view=middle&fov_y=40" "$B" "$T/bb2.out")
+    check "HTTP view=middle: 4xx naming the file's parts" "[ '${code%??}' = 4 ] && grep -q 'depth_right' '$T/bb2.out'"
+    "$OBSCURA" ao "$B" --part depth_right --fov-y 40 -o "$T/bbp.exr" -q --server "unix:$T/obscurad.sock"
+    check "binary protocol client --part depth_right: exit 0" "[ $? -eq 0 ]"
+else
+    echo "  skip multi-part checks: $B is absent"
+fi
 kill -TERM "$PID_d" 2>/dev/null
 
 [ $failed -ne 0 ] && tail -20 "$T/d.log" | sed 's/^/       /'
