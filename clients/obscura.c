@@ -340,6 +340,21 @@ static obs_status backend_from_args(const char *name, obs_backend *b)
  * A-buffer.  Outputs: AO.Y, the per-node AO blended by alpha; AOFront.Y,
  * the front node's AO; R,G,B,A, the front-to-back composite times AO.Y
  * (premultiplied).  PNG: NAME.ao.png, NAME.front.png, NAME.composite.png. */
+/* Prints the reader's sanity warnings; with --strict they fail the
+ * frame (exit 3). */
+static int cli_input_warnings(const char *in, const obs_exr_info *info, int strict)
+{
+    for (int i = 0; i < info->warning_count; i++)
+        fprintf(stderr, "obscura: %s: %s: %s\n", strict ? "error" : "warning", in,
+                info->warnings[i]);
+    if (strict && info->warning_count > 0) {
+        fprintf(stderr, "obscura: %s: %d sanity warning%s and --strict: not computed\n", in,
+                info->warning_count, info->warning_count == 1 ? "" : "s");
+        return EXIT_BADINPUT;
+    }
+    return EXIT_OK;
+}
+
 static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server, int argc, char **argv)
 {
     char err[OBS_ERR_LEN] = "";
@@ -355,6 +370,12 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     if ((s = obs_deep_read_exr(a->in, lim, &d, err)) != OBS_OK)
         return cli_input_fail(s, a->in, err);
     double t_read = now_ms() - t0;
+    /* the camera's cross-checks (the deep reader keeps the camera only) */
+    obs_exr_info dinfo = {0};
+    obs_camera dcam;
+    if (obs_exr_describe_camera(a->in, d.part, &dinfo, &dcam, err) == OBS_OK &&
+        (rc = cli_input_warnings(a->in, &dinfo, a->req.strict)) != EXIT_OK)
+        goto done;
     t0 = now_ms();
     if (a->cpu) {
         s = obs_deep_run_cpu(&d, &a->req.params, &r, err);
@@ -422,21 +443,6 @@ done:
     obs_ctx_destroy(ctx);
     obs_deep_free(&d);
     return rc;
-}
-
-/* Prints the reader's sanity warnings; with --strict they fail the
- * frame (exit 3). */
-static int cli_input_warnings(const char *in, const obs_exr_info *info, int strict)
-{
-    for (int i = 0; i < info->warning_count; i++)
-        fprintf(stderr, "obscura: %s: %s: %s\n", strict ? "error" : "warning", in,
-                info->warnings[i]);
-    if (strict && info->warning_count > 0) {
-        fprintf(stderr, "obscura: %s: %d sanity warning%s and --strict: not computed\n", in,
-                info->warning_count, info->warning_count == 1 ? "" : "s");
-        return EXIT_BADINPUT;
-    }
-    return EXIT_OK;
 }
 
 static int cmd_ao(int argc, char **argv)

@@ -89,7 +89,9 @@ static int exr_q(const float wtc[16], const float ndc[16], float q[16], int *per
     obs__mat4_transpose(ndc, nc);
     obs__mat4_mul(nc, inv, q);
     const float *w = q + 12;
-    double eps = 1e-6 * (fabs(w[0]) + fabs(w[1]) + fabs(w[2]) + fabs(w[3]));
+    /* the matrices are floats and the inversion loses a few digits with a
+     * far translation (23 units: w's x, y terms of 1e-6) */
+    double eps = 1e-4 * (fabs(w[0]) + fabs(w[1]) + fabs(w[2]) + fabs(w[3]));
     int flat_xy = fabs(w[0]) <= eps && fabs(w[1]) <= eps;
     *persp = flat_xy && fabs(w[3]) <= eps && w[2] != 0.0f;
     double s = *persp ? w[2] : flat_xy && fabs(w[2]) <= eps && w[3] != 0.0f ? w[3] : 1.0;

@@ -274,6 +274,20 @@ static void test_arnold_frame(void **state)
     assert_int_equal(info.camera_arnold, 1);
     assert_non_null(strstr(info.camera_check, "agrees"));
     assert_int_equal(info.warning_count, 0);
+    /* the larger frame of the same set (../shared, when present): its
+     * camera 23 units away once made the perspective test fail */
+    char big[512];
+    snprintf(big, sizeof big, "%s/renderers/arnold/sample1.exr", obs_test_shared());
+    if (obs_test_exists(big)) {
+        obs_exr_info i1 = {0};
+        obs_camera c1;
+        assert_int_equal(obs_exr_describe_camera(big, 0, &i1, &c1, err), OBS_OK);
+        assert_int_equal(i1.camera_arnold, 1);
+        assert_non_null(strstr(i1.camera_check, "agrees"));
+        assert_float_equal(c1.projection[14], -1.0, 1e-6);
+    } else {
+        print_message("%s is absent: sample1 not checked\n", big);
+    }
     assert_int_equal(obs_deep_read_exr(path, NULL, &d, err), OBS_OK);
     assert_int_equal(d.camera.has_projection, 1);
     /* focal 0.972222, aperture 1: tan(fov/2) = 1 / (2 * 0.972222) */
@@ -637,6 +651,54 @@ static void test_beachball(void **state)
     obs_gbuffer_free(&gf);
 }
 
+/* The sky as renderers write it (0, inf, 1e10, 1e30; 1/Z: 0) is
+ * background: AO 1 and never an occluder. */
+static void test_background_values(void **state)
+{
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_EGL_SURFACELESS);
+    obs_gbuffer_file gf = {0};
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    load(scenes[0], &gf);
+    int w = gf.gb.width, h = gf.gb.height;
+    float *z = malloc((size_t)w * h * sizeof *z);
+    obs_result ref;
+    assert_non_null(z);
+    assert_int_equal(obs_run(ctx, &gf.gb, NULL, OBS_OUTPUT_AO, &ref, err), OBS_OK);
+    static const float sky[] = {0.0f, INFINITY, 1e10f, 1e30f};
+    for (int mode = 0; mode < 2; mode++)
+        for (size_t k = 0; k < sizeof sky / sizeof sky[0]; k++) {
+            int first = -1;
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) {
+                    float d = *obs__plane_px(&gf.gb.depth, w, x, y);
+                    int bg = !(d < 1e9f);
+                    size_t i = (size_t)y * w + x;
+                    if (bg && first < 0)
+                        first = (int)i;
+                    /* inverse: 1/Z, the sky 0 (the only value tried there) */
+                    z[i] = mode ? (bg ? 0.0f : 1.0f / d) : (bg ? sky[k] : d);
+                }
+            assert_true(first >= 0);
+            obs_gbuffer g = gf.gb;
+            g.depth = (obs_plane){z, 1, 0};
+            obs_params p = {0};
+            obs_result r;
+            assert_int_equal(obs_param_set(&p, "depth_mode", mode ? "inverse" : "planar", err), OBS_OK);
+            assert_int_equal(obs_run(ctx, &g, &p, OBS_OUTPUT_AO, &r, err), OBS_OK);
+            assert_float_equal(r.ao.data[first], 1.0f, 0);
+            /* ... and the rest is Blender's (sky 1e10) AO: the sky occludes nothing */
+            assert_true(max_diff(&r.ao, &ref.ao) < (mode ? 1e-3 : 1e-6));
+            obs_result_free(&r);
+            if (mode)
+                break;
+        }
+    free(z);
+    obs_result_free(&ref);
+    obs_gbuffer_free(&gf);
+    obs_ctx_destroy(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -647,6 +709,7 @@ int main(void)
         cmocka_unit_test(test_solve_camera),
         cmocka_unit_test(test_multipart_views),
         cmocka_unit_test(test_beachball),
+        cmocka_unit_test(test_background_values),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
