@@ -57,7 +57,8 @@ code=$(post "$PORT_d" "$Q&strict=1" "$R" "$T/h.out")
 check "HTTP strict=1 on a warned frame: 422 bad_file naming the warning" \
     "[ '$code' = 422 ] && error_is '$T/h.out' bad_file && grep -q 'normals look world-space' '$T/h.out'"
 code=$(post "$PORT_d" "$Q" "$R" "$T/h2.out")
-check "HTTP without strict: 200" "[ '$code' = 200 ]"
+check "HTTP without strict: 200 with an X-Obscura-Warning header" \
+    "[ '$code' = 200 ] && grep -qi '^X-Obscura-Warning: normals look world-space' '$T/h2.out.h'"
 code=$(post "$PORT_d" "fov_y=50&near=0.05&far=100&world_to_camera=$WTC&strict=1" "$R" "$T/h3.out")
 check "HTTP strict=1 on room_small as it is: 200" "[ '$code' = 200 ]"
 "$OBSCURA" ao "$R" --camera "$RC" --normal-space camera --strict -o "$T/b.exr" -q \
