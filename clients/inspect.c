@@ -45,6 +45,8 @@ static void print_matrix(const char *name, const float m[16])
                m[r * 4 + 3]);
 }
 
+static char **part_lines; /* obs_exr_describe_parts() of the file */
+
 static int print_json(const char *path, const obs_gbuffer *gb, const obs_exr_info *info)
 {
     cJSON *o = cJSON_CreateObject(), *ch = cJSON_CreateObject(), *cam = cJSON_CreateObject();
@@ -82,6 +84,10 @@ static int print_json(const char *path, const obs_gbuffer *gb, const obs_exr_inf
     cJSON_AddItemToObject(o, "display_size", cJSON_CreateIntArray(disp, 2));
     cJSON_AddNumberToObject(o, "part", info->part);
     cJSON_AddNumberToObject(o, "parts", info->part_count);
+    cJSON *pl = cJSON_CreateArray();
+    for (char **l = part_lines; l && *l; l++)
+        cJSON_AddItemToArray(pl, cJSON_CreateString(*l));
+    cJSON_AddItemToObject(o, "part_list", pl);
     cJSON_AddStringToObject(o, "view", info->view);
     cJSON_AddNumberToObject(o, "parts_read", info->parts_read);
     cJSON_AddStringToObject(o, "compression", info->compression ? info->compression : "");
@@ -135,6 +141,9 @@ static void print_text(const char *path, const obs_gbuffer *gb, const obs_exr_in
     if (info->view[0])
         printf("  view: %s, channels gathered from %d part%s\n", info->view, info->parts_read,
                info->parts_read == 1 ? "" : "s");
+    if (part_lines && part_lines[0] && part_lines[1])
+        for (char **l = part_lines; *l; l++)
+            printf("    part %s\n", *l);
     for (int i = 0; i < info->warning_count; i++)
         printf("  warning: %s\n", info->warnings[i]);
     if (!info->warning_count)
@@ -163,10 +172,11 @@ static int usable_flag(obs_http_request *req, int argc, char **argv, int *i, cha
     return obs_param_set(&req->params, name, eq ? eq + 1 : argv[++*i], err) == OBS_OK;
 }
 
+static int cli_inspect_file(const char *in, int json, obs_http_request *req);
+
 int cli_inspect(int argc, char **argv)
 {
     obs_http_request req;
-    obs_gbuffer_file gf = {0};
     char err[OBS_ERR_LEN] = "";
     const char *in = NULL;
     int json = 0;
@@ -188,6 +198,20 @@ int cli_inspect(int argc, char **argv)
         fprintf(stderr, "obscura: inspect: no input file (usage: obscura inspect FILE [--json])\n");
         return EXIT_USAGE;
     }
+    if (obs_exr_describe_parts(in, &part_lines, err) != OBS_OK) {
+        fprintf(stderr, "obscura: %s\n", err);
+        return EXIT_BADINPUT;
+    }
+    int rc = cli_inspect_file(in, json, &req);
+    obs_strv_free(part_lines);
+    part_lines = NULL;
+    return rc;
+}
+
+static int cli_inspect_file(const char *in, int json, obs_http_request *req)
+{
+    obs_gbuffer_file gf = {0};
+    char err[OBS_ERR_LEN] = "";
     int deep = 0;
     if (obs_exr_is_deep(in, &deep, err) == OBS_OK && deep) {
         obs_deep_image d = {0};
@@ -219,16 +243,16 @@ int cli_inspect(int argc, char **argv)
         int rc = json ? print_json(in, &gf.gb, &gf.info) : (print_text(in, &gf.gb, &gf.info), EXIT_OK);
         return rc;
     }
-    if (obs_gbuffer_read_exr(in, &req.map, NULL, &gf, err) != OBS_OK) {
+    if (obs_gbuffer_read_exr(in, &req->map, NULL, &gf, err) != OBS_OK) {
         fprintf(stderr, "obscura: %s\n", err);
         return EXIT_BADINPUT;
     }
     /* a file with a position pass and no camera: what the solver finds */
-    if (gf.gb.position.data && obs_gbuffer_solve_camera(&gf, &req.params, err) != OBS_OK &&
+    if (gf.gb.position.data && obs_gbuffer_solve_camera(&gf, &req->params, err) != OBS_OK &&
         gf.info.warning_count < OBS_EXR_WARNINGS)
         snprintf(gf.info.warnings[gf.info.warning_count++], sizeof gf.info.warnings[0],
                  "the camera cannot be solved from the position pass: %.160s", err);
-    obs_gbuffer_sanity(&gf.gb, &req.params, &gf.info);
+    obs_gbuffer_sanity(&gf.gb, &req->params, &gf.info);
     int rc = json ? print_json(in, &gf.gb, &gf.info) : (print_text(in, &gf.gb, &gf.info), EXIT_OK);
     obs_gbuffer_free(&gf);
     return rc;

@@ -123,6 +123,10 @@ obs_status obs_camera_reprojection(const obs_gbuffer *gb, const obs_plane *pos,
                                    const obs_camera *cam, double *rms, double *max_err,
                                    char err[OBS_ERR_LEN]);
 
+/* One line a part, "INDEX 'NAME' (view VIEW): CH, CH, ...", into a newly
+ * allocated, NULL-terminated array; caller frees with obs_strv_free(). */
+obs_status obs_exr_describe_parts(const char *path, char ***lines, char err[OBS_ERR_LEN]);
+
 /* Sanity checks of a G-buffer under the conventions `params` (NULL =
  * defaults) and the G-buffer's own give: depth all in 0..1 under a metric
  * depth mode, normals not unit length, normals that agree with the

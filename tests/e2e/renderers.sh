@@ -95,6 +95,8 @@ if [ -f "$B" ]; then
     "$OBSCURA" inspect "$B" > "$T/bb.txt"
     check "Beachball: the default view right, channels from 2 parts" \
         "grep -q 'view: right, channels gathered from 2 parts' '$T/bb.txt'"
+    check "Beachball inspect: every part with its view and channels" \
+        "grep -q \"part 5 'depth_right' (view right): Z\" '$T/bb.txt' && [ \$(grep -c '^    part ' '$T/bb.txt') -eq 10 ]"
     "$OBSCURA" inspect "$B" --view left > "$T/bbl.txt"
     check "Beachball --view left: part 1" "grep -q 'part 1 of 10' '$T/bbl.txt'"
     "$OBSCURA" ao "$B" --view left --fov-y 40 -o "$T/bbl.exr" -q
