@@ -99,6 +99,10 @@ static void write_exr(const char *path, int w, int h, plane *pl, int np, const c
     assert_int_equal(exr_finish(&ctx), EXR_ERR_SUCCESS);
 }
 
+/* The focal length written with an Arnold camera, times this (a header
+ * that disagrees with itself when not 1). */
+static double focal_scale = 1.0;
+
 /* room_small in renderer r's convention, written to `path`. */
 static void write_rewrite(const rewrite *r, const obs_gbuffer *gb, const char *path)
 {
@@ -157,7 +161,7 @@ static void write_rewrite(const rewrite *r, const obs_gbuffer *gb, const char *p
         names[1] = "worldToNDC";
         /* Arnold writes the lens too: aperture / (2 focal) = tan */
         write_exr(path, w, h, pl, np, keys, values, names, (const float (*)[16])m,
-                  r->cam == CAM_ARNOLD ? "CameraFocalLength" : NULL, (float)(0.5 / tx),
+                  r->cam == CAM_ARNOLD ? "CameraFocalLength" : NULL, (float)(focal_scale * 0.5 / tx),
                   r->cam == CAM_ARNOLD ? "CameraFilmApertureHorizontal" : NULL, 1.0f);
     }
     for (int k = 0; k < 7; k++)
@@ -327,6 +331,21 @@ static void test_sanity_warnings(void **state)
     }
     obs_gbuffer_file gf = {0};
     load(scenes[0], &gf);
+    /* an Arnold header whose focal length says another field of view */
+    const char *path = obs_test_tmp_file("arnold_bad_lens.exr", NULL);
+    obs_gbuffer_file bad = {0};
+    char err[OBS_ERR_LEN] = "";
+    focal_scale = 1.5;
+    write_rewrite(&rewrites[0], &gf.gb, path);
+    focal_scale = 1.0;
+    assert_int_equal(obs_gbuffer_read_exr(path, NULL, NULL, &bad, err), OBS_OK);
+    print_message("bad lens: %s\n", bad.info.warning_count ? bad.info.warnings[0] : "(none)");
+    assert_int_equal(bad.info.warning_count, 1);
+    assert_non_null(strstr(bad.info.warnings[0], "disagrees with itself"));
+    assert_non_null(strstr(bad.info.camera_check, "DISAGREES"));
+    assert_int_equal(bad.info.camera_arnold, 1); /* the forward axis decides */
+    obs_gbuffer_free(&bad);
+
     int w = gf.gb.width, h = gf.gb.height;
     size_t px = (size_t)w * h;
     float *depth = malloc(px * sizeof *depth), *nrm = malloc(px * 3 * sizeof *nrm);
