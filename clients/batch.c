@@ -394,6 +394,7 @@ int cli_batch(int argc, char **argv, const cli_batch_ops *ops)
             }
         } else if (!strcmp(a, "--strict")) {
             strict = 1;
+            extra[nextra++] = argv[i]; /* each frame's sanity warnings are errors too */
         } else if (!in && a[0] != '-' && (i == 0 || cli_batch_check_pattern(a, NULL, 0) == 0)) {
             in = a; /* the input pattern: first, or the first word with a placeholder */
         } else {

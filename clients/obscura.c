@@ -23,6 +23,7 @@
 #include "obscura/deep.h"
 #include "cli.h"
 #include "flags.h"
+#include "inspect.h"
 #include "ground.h"
 #include "obscura/io.h"
 #include "obscura/metrics.h"
@@ -85,7 +86,10 @@ static const cli_opt ao_opts[] = {
     {"float", NULL, "EXR: 32-bit float channels (default half)"},
     {"png-bits", "8|16", "PNG bit depth (default 8)"},
     {"camera", "FILE", "camera JSON (width, height, fov_y_deg, world_to_camera, projection)"},
-    {"preset", "auto|blender|generic", "channel-name preset (default auto)"},
+    {"preset", "P", "renderer preset: auto (default: from the header), blender, generic, arnold, "
+     "vray, renderman, redshift, karma, mantra, octane, nuke"},
+    {"strict", NULL, "sanity warnings on the input are errors (exit 3)"},
+    {"solve-camera", NULL, "no camera given or in the file: solve it from the position pass"},
     {"depth", "CH", "depth channel name"},
     {"normal", "X,Y,Z", "normal channel names"},
     {"color", "R,G,B[,A]", "colour channel names"},
@@ -113,6 +117,9 @@ static void usage(FILE *f)
             "                  --mask auto: where TRUTH's (else CANDIDATE's) depth channel has\n"
             "                  geometry (0 < Z < 1e9); none: every pixel; CH: where channel CH of\n"
             "                  TRUTH is a depth with geometry\n"
+            "  obscura inspect IN.exr [--json] [--preset P] [--depth-mode M] ...\n"
+            "                  what obscura reads: renderer, channels, camera and its source,\n"
+            "                  conventions, windows, part, sanity warnings\n"
             "  obscura info [--backend B]\n"
             "  obscura params [--markdown]\n"
             "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as core/chain/sample_tables.c\n"
@@ -333,6 +340,21 @@ static obs_status backend_from_args(const char *name, obs_backend *b)
  * A-buffer.  Outputs: AO.Y, the per-node AO blended by alpha; AOFront.Y,
  * the front node's AO; R,G,B,A, the front-to-back composite times AO.Y
  * (premultiplied).  PNG: NAME.ao.png, NAME.front.png, NAME.composite.png. */
+/* Prints the reader's sanity warnings; with --strict they fail the
+ * frame (exit 3). */
+static int cli_input_warnings(const char *in, const obs_exr_info *info, int strict)
+{
+    for (int i = 0; i < info->warning_count; i++)
+        fprintf(stderr, "obscura: %s: %s: %s\n", strict ? "error" : "warning", in,
+                info->warnings[i]);
+    if (strict && info->warning_count > 0) {
+        fprintf(stderr, "obscura: %s: %d sanity warning%s and --strict: not computed\n", in,
+                info->warning_count, info->warning_count == 1 ? "" : "s");
+        return EXIT_BADINPUT;
+    }
+    return EXIT_OK;
+}
+
 static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server, int argc, char **argv)
 {
     char err[OBS_ERR_LEN] = "";
@@ -348,6 +370,12 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     if ((s = obs_deep_read_exr(a->in, lim, &d, err)) != OBS_OK)
         return cli_input_fail(s, a->in, err);
     double t_read = now_ms() - t0;
+    /* the camera's cross-checks (the deep reader keeps the camera only) */
+    obs_exr_info dinfo = {0};
+    obs_camera dcam;
+    if (obs_exr_describe_camera(a->in, d.part, &dinfo, &dcam, err) == OBS_OK &&
+        (rc = cli_input_warnings(a->in, &dinfo, a->req.strict)) != EXIT_OK)
+        goto done;
     t0 = now_ms();
     if (a->cpu) {
         s = obs_deep_run_cpu(&d, &a->req.params, &r, err);
@@ -449,6 +477,9 @@ static int cmd_ao(int argc, char **argv)
                 info->normal[0][0] ? info->normal[0] : "(none)",
                 info->color[0][0] ? info->color[0] : "(none)");
     }
+    if (verbosity >= OBS_LOG_INFO && info->camera_source[0])
+        fprintf(stderr, "obscura: info: camera from %s%s%s\n", info->camera_source,
+                info->camera_check[0] ? "; " : "", info->camera_check);
     if (a.camera) {
         int cw = 0, ch = 0;
         s = obs_camera_read_json(a.camera, &gf.gb.camera, &cw, &ch, err);
@@ -462,6 +493,17 @@ static int cmd_ao(int argc, char **argv)
             fprintf(stderr, "obscura: warning: camera %s is %dx%d but the image is %dx%d (aspect differs)\n",
                     a.camera, cw, ch, dw, dh);
     }
+
+    if (a.req.solve_camera && (s = obs_gbuffer_solve_camera(&gf, &a.req.params, err)) != OBS_OK) {
+        rc = cli_input_fail(s, a.in, err);
+        goto done;
+    }
+    if (a.req.solve_camera && verbosity >= OBS_LOG_INFO)
+        fprintf(stderr, "obscura: info: camera %s, %s\n", gf.info.camera_source,
+                gf.info.camera_check);
+    obs_gbuffer_sanity(&gf.gb, &a.req.params, &gf.info);
+    if ((rc = cli_input_warnings(a.in, &gf.info, a.req.strict)) != EXIT_OK)
+        goto done;
 
     t0 = now_ms();
     if (a.cpu) {
@@ -862,6 +904,8 @@ int main(int argc, char **argv)
     const char *cmd = argv[1];
     if (!strcmp(cmd, "ao"))
         return cmd_ao(argc - 2, argv + 2);
+    if (!strcmp(cmd, "inspect"))
+        return cli_inspect(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
         return cmd_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "info"))

@@ -8,6 +8,8 @@
 #include "internal.h"
 #include "obscura/io.h"
 
+#define OBS__PI 3.14159265358979323846
+
 int obs_camera_fit_aspect(obs_camera *cam, int width, int height)
 {
     float *P = cam->projection; /* row-major */
@@ -42,9 +44,19 @@ obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p, obs_c
     int dw = gb->display_width > 0 ? gb->display_width : gb->width;
     int dh = gb->display_height > 0 ? gb->display_height : gb->height;
 
-    if (p->fov_y > 0.0f) {
+    /* The vertical field of view: given, or from the horizontal one
+     * (tan(fy/2) = tan(fx/2) h / w), or from focal length and horizontal
+     * aperture (tan(fx/2) = aperture / (2 focal)). */
+    double half_x = p->fov_x > 0.0f ? tan(p->fov_x * OBS__PI / 360.0)
+                    : p->focal_length > 0.0f && p->aperture > 0.0f
+                        ? p->aperture / (2.0 * p->focal_length)
+                        : 0.0;
+    float fov_y = p->fov_y > 0.0f ? p->fov_y
+                  : half_x > 0.0 ? (float)(360.0 / OBS__PI * atan(half_x * dh / dw))
+                                 : 0.0f;
+    if (fov_y > 0.0f) {
         obs_camera fov;
-        obs_camera_from_fov(p->fov_y, (float)dw / (float)dh, p->near, p->far, &fov);
+        obs_camera_from_fov(fov_y, (float)dw / (float)dh, p->near, p->far, &fov);
         memcpy(cam.projection, fov.projection, sizeof cam.projection);
         cam.has_projection = 1;
         cam.source = OBS_CAMERA_PARAMS;
@@ -58,7 +70,8 @@ obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p, obs_c
     if (!cam.has_projection)
         return obs__fail(err, OBS_NO_CAMERA,
                          "no camera: the G-buffer has no worldToCamera/worldToNDC header "
-                         "attributes; give a camera JSON (--camera) or a field of view (--fov-y)");
+                         "attributes; give a camera JSON (--camera) or a field of view (--fov-y, "
+                         "--fov-x, or --focal-length with --aperture)");
     *out = cam;
     return OBS_OK;
 }

@@ -46,6 +46,10 @@ void obs__mat4_apply(const float m[16], const float v[4], float out[4]);
 /* The camera a frame is computed with: the G-buffer's camera, overridden
  * by parameters (fov_y, world_to_camera) where they are set.  Fails with
  * NO_CAMERA when neither gives a projection. */
+/* obs_params_resolve() of `in` with depth_mode and normal_space, where
+ * `in` leaves them at 0, taken from the G-buffer's convention. */
+void obs__params_for_gbuffer(const obs_params *in, const obs_gbuffer *gb, obs_params *out);
+
 obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p,
                                obs_camera *out, char err[OBS_ERR_LEN]);
 

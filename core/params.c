@@ -367,6 +367,20 @@ void obs_params_resolve(const obs_params *in, obs_params *out)
     *out = r;
 }
 
+void obs__params_for_gbuffer(const obs_params *in, const obs_gbuffer *gb, obs_params *out)
+{
+    obs_params q;
+    if (in)
+        q = *in;
+    else
+        memset(&q, 0, sizeof q);
+    if (gb && q.depth_mode == OBS_DEPTH_DEFAULT)
+        q.depth_mode = gb->depth_mode;
+    if (gb && q.normal_space == OBS_NORMALS_DEFAULT)
+        q.normal_space = gb->normal_space;
+    obs_params_resolve(&q, out);
+}
+
 obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN])
 {
     if (p->method_conflict > 0 && p->method_conflict <= TABLE_LEN) {

@@ -271,7 +271,7 @@ static int run_frame(frame *f, obs_bin_request *q)
     obsd_fp_init(&fp);
     if (q->body == OBS_BIN_EXR) {
         /* a deep EXR runs the deep chain, as on POST /v1/ao */
-        obs_status s = obsd_fp_decode(&fp, q->exr, q->exr_len, &q->hr.map, &lim, NULL, err);
+        obs_status s = obsd_fp_decode(&fp, q->exr, q->exr_len, &q->hr, &lim, NULL, err);
         f->ms_decode = fp.ms_decode;
         if (s != OBS_OK) {
             rc = send_status(f, s, err);

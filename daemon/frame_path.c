@@ -8,6 +8,13 @@
 #include "obscura/deep.h"
 #include "stats.h"
 
+static obs_status fail_strict(char err[OBS_ERR_LEN], const obs_exr_info *info)
+{
+    snprintf(err, OBS_ERR_LEN, "strict: %d sanity warning%s: %s", info->warning_count,
+             info->warning_count == 1 ? "" : "s", info->warnings[0]);
+    return OBS_BAD_FILE;
+}
+
 void obsd_fp_init(obsd_fp *fp)
 {
     memset(fp, 0, sizeof *fp);
@@ -25,9 +32,11 @@ void obsd_fp_free(obsd_fp *fp)
     pthread_mutex_destroy(&fp->lock);
 }
 
-obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len, const obs_channel_map *map,
-                          const obs_limits *lim, const char *no_deep, char err[OBS_ERR_LEN])
+obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
+                          const obs_http_request *hr, const obs_limits *lim, const char *no_deep,
+                          char err[OBS_ERR_LEN])
 {
+    const obs_channel_map *map = &hr->map;
     double t0 = obsd_now_ms();
     /* A deep EXR runs the multi-layer chain (include/obscura/deep.h). */
     int deep = 0;
@@ -38,6 +47,12 @@ obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len, co
         s = obs_deep_read_exr_mem(body, len, lim, &fp->deep_exr, err);
     else if (s == OBS_OK)
         s = obs_gbuffer_read_exr_mem(body, len, map, lim, &fp->gf, err);
+    if (s == OBS_OK && !deep && hr->solve_camera)
+        s = obs_gbuffer_solve_camera(&fp->gf, &hr->params, err);
+    /* strict: a sanity warning on the input fails the frame (HTTP 422) */
+    if (s == OBS_OK && !deep && obs_gbuffer_sanity(&fp->gf.gb, &hr->params, &fp->gf.info) > 0 &&
+        hr->strict)
+        s = fail_strict(err, &fp->gf.info);
     fp->ms_decode = obsd_now_ms() - t0;
     obsd_stats_stage(OBSD_STAGE_DECODE, fp->ms_decode);
     if (s == OBS_OK)

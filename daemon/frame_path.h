@@ -52,10 +52,12 @@ void obsd_fp_init(obsd_fp *fp);
 void obsd_fp_free(obsd_fp *fp);
 
 /* Reads an EXR body: a deep one into fp->deep_exr (refused with OBS_UNSUPPORTED
- * and the message `no_deep` when that is set), else a G-buffer with `map`.
- * Sizes are checked against lim.  Sets ms_decode either way. */
-obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len, const obs_channel_map *map,
-                          const obs_limits *lim, const char *no_deep, char err[OBS_ERR_LEN]);
+ * and the message `no_deep` when that is set), else a G-buffer with
+ * hr->map, checked for sanity under hr->params (with hr->strict a warning
+ * fails it: OBS_BAD_FILE).  Sizes are checked against lim.  Sets ms_decode either way. */
+obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
+                          const obs_http_request *hr, const obs_limits *lim, const char *no_deep,
+                          char err[OBS_ERR_LEN]);
 /* Runs planes decoded elsewhere (gb or deep); they must outlive the frame. */
 void obsd_fp_use(obsd_fp *fp, const obs_gbuffer *gb, const obs_deep_image *deep);
 

@@ -222,7 +222,7 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     char err[OBS_ERR_LEN] = "";
     obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
     /* A deep EXR runs on /v1/ao only: streams keep flat frames. */
-    obs_status s = obsd_fp_decode(&r->fp, body, len, &r->hr.map, &lim,
+    obs_status s = obsd_fp_decode(&r->fp, body, len, &r->hr, &lim,
                                   r->op == STREAM_POST ? "deep EXR input runs on POST /v1/ao, not in streams"
                                                        : NULL,
                                   err);

@@ -123,6 +123,9 @@ static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, in
     }
     if (extra_name)
         MHD_add_response_header(resp, extra_name, extra_value);
+    /* the input's sanity warnings (strict=1 makes them a 422 instead) */
+    for (int i = 0; i < r->fp.gf.info.warning_count; i++)
+        MHD_add_response_header(resp, "X-Obscura-Warning", r->fp.gf.info.warnings[i]);
     return obsd__answer(r, 200, resp, out->size, NULL);
 }
 

@@ -52,6 +52,21 @@ const obs_http_option obs_http_options[] = {
     {.name = "color", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(color), .def = "", .min = 3,
      .max = 4, .slot = SLOT(color[0]), .map = FIELD(map.color),
      .what = "three or four channel names R,G,B[,A]", .doc = "colour channel names R,G,B[,A]"},
+    {.name = "part", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(part), .def = "", .min = 1,
+     .max = 1, .slot = SLOT(part), .map = FIELD(map.part),
+     .what = "a part name or index (1 to 63 characters)",
+     .doc = "the part of a multi-part EXR to read (name or index)"},
+    {.name = "view", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(view), .def = "", .min = 1,
+     .max = 1, .slot = SLOT(view), .map = FIELD(map.view),
+     .what = "a view name (1 to 63 characters)",
+     .doc = "the view of a multi-view EXR (default: its default view); its parts' channels are "
+            "gathered"},
+    {.name = "strict", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(strict), .def = "0",
+     .doc = "sanity warnings on the input (depth looks normalized or inverted, normals not unit "
+            "length or in the other space, camera metadata that disagrees) are errors"},
+    {.name = "solve_camera", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(solve_camera), .def = "0",
+     .doc = "with no camera in the file or the request: solve the pinhole camera from the "
+            "file's world-space position pass (P, Position)"},
     {.name = NULL}};
 
 /* CHOICE and BOOL rows store through an int. */

@@ -29,11 +29,15 @@ typedef struct obs_http_request {
     obs_http_format format; /* default EXR */
     int float_exr;          /* EXR: 32-bit float channels (default half) */
     int png_bits;           /* 8 (default) or 16 */
+    int strict;             /* sanity warnings on the input are errors */
+    int solve_camera;       /* no camera: solve it from the position pass */
     obs_channel_map map;    /* points into the buffers below */
     char preset[16];
     char depth[64];
     char normal[3][64];
     char color[4][64];
+    char part[64];
+    char view[64];
 } obs_http_request;
 
 /* Zeroes the request: every option at its default. */

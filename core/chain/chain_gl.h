@@ -10,7 +10,8 @@
 #define OBS__AO_VARIANTS 16  /* 4 switches of the AO pass, compiled in or out */
 
 typedef struct obs__programs {
-    GLuint prep[6];   /* 3 * (normals derived from depth) + depth mode - 1; built on first use */
+    GLuint prep[2 * OBS__DEPTH_MODES]; /* OBS__DEPTH_MODES * (normals derived from depth) + depth
+                                        * mode - 1; built on first use */
     GLuint vao[OBS__AO_VARIANTS]; /* AO pass by switches compiled in (run_gl.c: AO_*) */
     GLuint cull[2];               /* culling pre-pass without, with the range check */
     GLuint composite;

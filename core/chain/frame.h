@@ -31,6 +31,9 @@
  *
  * Applied in one place, obs__frame_setup (frame.c), to methods vaopp and
  * vao (the comparison methods take the radius as D). */
+/* How many depth modes there are (the prep pass has a program for each). */
+#define OBS__DEPTH_MODES (OBS_DEPTH_NORMALIZED - OBS_DEPTH_DEFAULT)
+
 #define OBS__RADIUS_K_RAYS 2.0f
 #define OBS__RADIUS_K_VOLUME 1.0f
 

@@ -31,10 +31,29 @@ static void view_ray(const float *P, const float ndc[2], float origin[3], float 
     dir[2] = -1.0f;
 }
 
+/* GLSL: clip_range() in prep.frag.glsl.  The clip range (near, far) of
+ * the projection's z row, z_ndc = (a z + b) / (c z + d): the planar depths
+ * whose OpenGL depth is -1 and 1. */
+static void clip_range(const float *P, float nf[2])
+{
+    float a = P[10], b = P[11], c = P[14], d = P[15];
+    nf[0] = (d + b) / (a + c);
+    nf[1] = (b - d) / (a - c);
+}
+
 /* GLSL: linear_depth() in prep.frag.glsl.  Planar depth from the raw value,
  * 0 for background. */
 static float linear_depth(const obs__frame *f, float raw, const float dir[3])
 {
+    if (f->depth_mode == OBS_DEPTH_INVERSE) /* 1/Z: 0 (or below) is background */
+        return raw > 0.0f && 1.0f / raw < OBS_BACKGROUND_DEPTH ? 1.0f / raw : 0.0f;
+    if (f->depth_mode == OBS_DEPTH_NORMALIZED) { /* 0..1 between the clip planes */
+        if (!(raw >= 0.0f) || raw >= 1.0f)
+            return 0.0f;
+        float nf[2];
+        clip_range(f->proj, nf);
+        return nf[0] + raw * (nf[1] - nf[0]);
+    }
     if (!(raw > 0.0f) || raw >= OBS_BACKGROUND_DEPTH) /* also catches NaN */
         return 0.0f;
     if (f->depth_mode == OBS_DEPTH_RADIAL)

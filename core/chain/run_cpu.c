@@ -121,7 +121,7 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
     memset(out, 0, sizeof *out);
     if (!(outputs & OBS__OUTPUTS_ALL))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no output requested");
-    obs_params_resolve(params, &p);
+    obs__params_for_gbuffer(params, gb, &p);
     s = obs__frame_setup(NULL, gb, &p, &f, err);
     if (s == OBS_OK)
         s = obs__frame_check_outputs(&f, outputs, err);

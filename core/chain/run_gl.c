@@ -74,14 +74,14 @@ static obs_status build_finish_program(obs_ctx *ctx, int rays, int lum, char err
 
 /* The prep pass that reads the normals or derives them from depth
  * (OBS_RECONSTRUCT), for the frame's depth mode (OBS_DEPTH_MODE: planar,
- * radial, ndc; resolved, never OBS_DEPTH_DEFAULT), built on its first use:
+ * radial, ndc, inverse, normalized; resolved, never OBS_DEPTH_DEFAULT), built on its first use:
  * ctx->prog.prep[prep_index(f)]. */
 static int prep_index(const obs__frame *f)
 {
-    int mode = f->depth_mode >= OBS_DEPTH_PLANAR && f->depth_mode <= OBS_DEPTH_NDC
+    int mode = f->depth_mode >= OBS_DEPTH_PLANAR && f->depth_mode <= OBS_DEPTH_NORMALIZED
                    ? f->depth_mode
                    : OBS_DEPTH_PLANAR;
-    return 3 * (f->reconstruct_normals != 0) + mode - OBS_DEPTH_PLANAR;
+    return OBS__DEPTH_MODES * (f->reconstruct_normals != 0) + mode - OBS_DEPTH_PLANAR;
 }
 
 static obs_status build_prep_program(obs_ctx *ctx, const obs__frame *f, char err[OBS_ERR_LEN])
@@ -91,9 +91,9 @@ static obs_status build_prep_program(obs_ctx *ctx, const obs__frame *f, char err
         return OBS_OK;
     char defs[80];
     snprintf(defs, sizeof defs, "#define OBS_RECONSTRUCT %d\n#define OBS_DEPTH_MODE %d\n",
-             k / 3, k % 3 + OBS_DEPTH_PLANAR);
+             k / OBS__DEPTH_MODES, k % OBS__DEPTH_MODES + OBS_DEPTH_PLANAR);
     const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_prep_frag};
-    return obs__gl_program(k / 3 ? "prep (normals from depth)" : "prep",
+    return obs__gl_program(k / OBS__DEPTH_MODES ? "prep (normals from depth)" : "prep",
                            obs__shader_fullscreen_vert, src, 4, &ctx->prog.prep[k], err);
 }
 
@@ -366,7 +366,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no context");
     if (!(outputs & OBS__OUTPUTS_ALL))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no output requested");
-    obs_params_resolve(params, &p);
+    obs__params_for_gbuffer(params, gb, &p);
     s = obs__frame_setup(ctx, gb, &p, &f, err);
     if (s == OBS_OK)
         s = obs__frame_check_outputs(&f, outputs, err);

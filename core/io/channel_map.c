@@ -7,7 +7,9 @@
 #include "io/exr_internal.h"
 #include "internal.h"
 
-const char *const obs_channel_presets[] = {"auto", "blender", "generic", NULL};
+const char *const obs_channel_presets[] = {"auto",     "blender",   "generic", "arnold",
+                                           "vray",     "renderman", "redshift", "karma",
+                                           "mantra",   "octane",    "nuke",    NULL};
 
 /* Blender's multilayer EXRs prefix every pass with the view layer. */
 #define BLENDER_DEPTH_SUFFIX ".Depth.Z"
@@ -45,7 +47,11 @@ static void clear_match(obs__channel_match *m)
         m->normal[i] = -1;
     for (int i = 0; i < 4; i++)
         m->color[i] = -1;
+    for (int i = 0; i < 3; i++)
+        m->position[i] = -1;
     m->preset = "explicit";
+    m->depth_mode = OBS_DEPTH_DEFAULT;
+    m->normal_space = OBS_NORMALS_DEFAULT;
 }
 
 static const char *const XYZ[] = {".X", ".Y", ".Z"};
@@ -60,6 +66,10 @@ static void preset_blender(const char *const *names, int count, obs__channel_mat
     size_t sl = strlen(BLENDER_DEPTH_SUFFIX);
     clear_match(m);
     m->preset = "blender";
+    /* Blender's Depth.Z is planar, its Normal pass world space
+     * (../shared/data/README.md, Blender manual "Render Passes"). */
+    m->depth_mode = OBS_DEPTH_PLANAR;
+    m->normal_space = OBS_NORMALS_WORLD;
     m->depth = find(names, count, DEFAULT_BLENDER_LAYER BLENDER_DEPTH_SUFFIX);
     if (m->depth >= 0)
         snprintf(layer, sizeof layer, "%s", DEFAULT_BLENDER_LAYER);
@@ -104,6 +114,67 @@ static void preset_generic(const char *const *names, int count, obs__channel_mat
         m->color[3] = find(names, count, "A");
 }
 
+static const char *const XYZ_LOWER[] = {".x", ".y", ".z"};
+static const char *const RGB_LOWER[] = {".r", ".g", ".b"};
+
+/* A renderer's row of presets.c: its first depth name the file has, the
+ * first normal and colour prefixes that are complete. */
+static void preset_row(const char *const *names, int count, const obs__preset *pr,
+                       obs__channel_match *m)
+{
+    static const char *const bare[] = {"R", "G", "B"};
+    clear_match(m);
+    m->preset = pr->name;
+    m->depth_mode = pr->depth_mode;
+    m->normal_space = pr->normal_space;
+    for (const char *const *d = pr->depth; *d && m->depth < 0; d++)
+        m->depth = find(names, count, *d);
+    for (const char *const *n = pr->normal; *n && m->normal[0] < 0; n++)
+        if (!find_set(names, count, *n, XYZ, 3, m->normal) &&
+            !find_set(names, count, *n, RGB, 3, m->normal) &&
+            !find_set(names, count, *n, XYZ_LOWER, 3, m->normal))
+            find_set(names, count, *n, RGB_LOWER, 3, m->normal);
+    for (const char *const *c = pr->color; *c && m->color[0] < 0; c++) {
+        char alpha[300];
+        if (**c ? find_set(names, count, *c, RGB, 3, m->color)
+                : find_set(names, count, "", bare, 3, m->color)) {
+            snprintf(alpha, sizeof alpha, "%s%s", *c, **c ? ".A" : "A");
+            m->color[3] = find(names, count, alpha);
+        }
+    }
+}
+
+static int in_set(int idx, const int *set, int n)
+{
+    for (int i = 0; idx >= 0 && i < n; i++)
+        if (set[i] == idx)
+            return 1;
+    return 0;
+}
+
+/* A world-space position pass, to solve or check the camera with:
+ * Blender's <Layer>.Position (the depth's layer), else P, Position,
+ * position, Pworld, worldPosition (.X/Y/Z or .R/G/B); none that reuses a
+ * channel of the other planes. */
+static void find_position(const char *const *names, int count, obs__channel_match *m,
+                          const int used[8])
+{
+    static const char *const prefixes[] = {"P", "Position", "position", "Pworld", "worldPosition",
+                                           NULL};
+    size_t sl = strlen(BLENDER_DEPTH_SUFFIX), n = strlen(names[m->depth]);
+    char pre[300];
+    if (n > sl && n - sl < 256 && strcmp(names[m->depth] + n - sl, BLENDER_DEPTH_SUFFIX) == 0) {
+        snprintf(pre, sizeof pre, "%.*s.Position", (int)(n - sl), names[m->depth]);
+        find_set(names, count, pre, XYZ, 3, m->position);
+    }
+    for (const char *const *p = prefixes; *p && m->position[0] < 0; p++)
+        if (!find_set(names, count, *p, XYZ, 3, m->position))
+            find_set(names, count, *p, RGB, 3, m->position);
+    for (int i = 0; i < 3; i++)
+        if (in_set(m->position[i], used, 8))
+            m->position[0] = m->position[1] = m->position[2] = -1;
+}
+
 /* "A, B, C", cut short with "... (N channels)". */
 void obs__list_names(const char *const *names, int count, char *buf, size_t len)
 {
@@ -143,13 +214,6 @@ static obs_status explicit_channel(const char *const *names, int count, const ch
     return missing(err, names, count, what);
 }
 
-static int in_set(int idx, const int *set, int n)
-{
-    for (int i = 0; idx >= 0 && i < n; i++)
-        if (set[i] == idx)
-            return 1;
-    return 0;
-}
 
 static int count_set(const char *const *v, int n)
 {
@@ -164,8 +228,15 @@ obs_status obs__channel_map_resolve(const obs_channel_map *map,
                                     obs__channel_match *m,
                                     char err[OBS_ERR_LEN])
 {
+    return obs__channel_map_resolve_for(map, NULL, names, count, m, err);
+}
+
+obs_status obs__channel_map_resolve_for(const obs_channel_map *map, const char *detected,
+                                        const char *const *names, int count,
+                                        obs__channel_match *m, char err[OBS_ERR_LEN])
+{
     static const obs_channel_map automap = {0};
-    obs__channel_match cand[2];
+    obs__channel_match cand[3];
     int ncand = 0, pick = -1;
     obs_status st;
 
@@ -173,13 +244,17 @@ obs_status obs__channel_map_resolve(const obs_channel_map *map,
         map = &automap;
     const char *preset = map->preset && *map->preset ? map->preset : "auto";
     int is_auto = strcmp(preset, "auto") == 0;
+    const obs__preset *row = obs__preset_find(is_auto ? detected : preset);
+    if (row)
+        preset_row(names, count, row, &cand[ncand++]);
     if (is_auto || strcmp(preset, "blender") == 0)
         preset_blender(names, count, &cand[ncand++]);
     if (is_auto || strcmp(preset, "generic") == 0)
         preset_generic(names, count, &cand[ncand++]);
     if (ncand == 0)
         return obs__fail(err, OBS_INVALID_ARGUMENT,
-                         "unknown channel preset '%.64s' (valid: auto, blender, generic)", preset);
+                         "unknown channel preset '%.64s' (valid: auto, blender, generic, arnold, "
+                         "vray, renderman, redshift, karma, mantra, octane, nuke)", preset);
     int nd = count_set(&map->depth, 1), nn = count_set(map->normal, 3), nc = count_set(map->color, 3);
     if (nn != 0 && nn != 3)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "explicit normal needs three channel names (X, Y, Z)");
@@ -212,6 +287,19 @@ obs_status obs__channel_map_resolve(const obs_channel_map *map,
         if (map->color[3] && *map->color[3] &&
             (st = explicit_channel(names, count, map->color[3], "alpha", &m->color[3], err)) != OBS_OK)
             return st;
+    }
+    if (m->depth < 0 && find(names, count, "VRayZDepth") + find(names, count, "VRayZDepth.R") +
+                                find(names, count, "VRayZDepth.Z") > -3)
+        return missing(err, names, count,
+                       "no depth channel: VRayZDepth holds depth normalized between the render "
+                       "element's zdepth min and max (white near), which the file does not record; "
+                       "render V-Ray's raw Z-depth (a Z channel), or name a planar depth "
+                       "channel with --depth");
+    if (m->depth < 0 && row && !is_auto) {
+        char what[320];
+        snprintf(what, sizeof what, "no depth channel: looked for %s's %s%s%s", row->name,
+                 row->depth[0], row->depth[1] ? ", " : "", row->depth[1] ? row->depth[1] : "");
+        return missing(err, names, count, what);
     }
     if (m->depth < 0)
         return missing(err, names, count,
@@ -247,5 +335,6 @@ obs_status obs__channel_map_resolve(const obs_channel_map *map,
         if (idx[i] >= 0 && in_set(idx[i], idx + i + 1, 7 - i))
             return obs__fail(err, OBS_INVALID_ARGUMENT, "channel '%.256s' is mapped twice",
                              names[idx[i]]);
+    find_position(names, count, m, idx);
     return OBS_OK;
 }

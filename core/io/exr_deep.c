@@ -431,6 +431,7 @@ static obs_status read_deep(exr_context_t ctx, int64_t file_size, const obs_limi
     d->has_normal = j.map.ch[OBS_DEEP_NX] >= 0;
     d->part = j.part;
     obs__exr_read_camera(ctx, j.part, &d->camera);
+    obs__exr_msg_reset(); /* a missing attribute is not an error */
     st = OBS_OK;
 fail:
     free(counts);

@@ -13,8 +13,41 @@ typedef struct obs__channel_match {
     int depth;
     int normal[3];    /* all three or all -1 */
     int color[4];     /* R, G, B all or none; alpha may be -1 alone */
-    const char *preset; /* "blender", "generic" or "explicit" (static) */
+    int position[3];  /* a world-space position pass: all three or all -1 */
+    const char *preset; /* "blender", "generic", a renderer's or "explicit" (static) */
+    obs_depth_mode depth_mode;     /* the preset's convention; 0: not known */
+    obs_normal_space normal_space;
 } obs__channel_match;
+
+/* A renderer preset (core/io/presets.c): channel names tried in order
+ * (normals and colour as prefixes: P.X/Y/Z or P.R/G/B; "" is the bare
+ * R, G, B), its depth and normal conventions, and what in a header names
+ * the renderer (attribute-name prefixes; substrings of the software
+ * attribute).  Lists end with NULL. */
+typedef struct obs__preset {
+    const char *name;
+    const char *const *depth;
+    const char *const *normal;
+    const char *const *color;
+    obs_depth_mode depth_mode;
+    obs_normal_space normal_space;
+    const char *const *keys;
+    const char *const *software;
+} obs__preset;
+
+/* The preset named `name`, or NULL (blender and generic are not rows). */
+const obs__preset *obs__preset_find(const char *name);
+/* Row i of the table, NULL past its end. */
+const obs__preset *obs__preset_at(int i);
+/* The renderer that wrote part `part` ("blender" or a row's name, static),
+ * or NULL; `why` receives what said so. */
+const char *obs__preset_detect(exr_const_context_t ctx, int part, char *why, size_t len);
+
+/* obs__channel_map_resolve() with the renderer the header names (NULL:
+ * none) tried first when the preset is auto. */
+obs_status obs__channel_map_resolve_for(const obs_channel_map *map, const char *detected,
+                                        const char *const *names, int count,
+                                        obs__channel_match *m, char err[OBS_ERR_LEN]);
 
 /* Resolves `map` (NULL = auto) against the channel names of one part.
  * OBS_OK when the depth was found; OBS_MISSING_CHANNEL when it was not, or
@@ -55,7 +88,45 @@ void obs__exr_camera_matrices(const obs_camera *cam, float wtc[16], float ndc[16
  * conventions; zeroed when the header has none (exr_read.c). */
 void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam);
 
+/* What obs__exr_read_camera_report() found (core/io/camera_detect.c). */
+#define OBS__CAMERA_WARNINGS 2
+typedef struct obs__camera_report {
+    char source[160];  /* the attributes the camera came from ("" none) */
+    char check[160];   /* the cross-check of worldToNDC against the lens */
+    char clip[64];     /* the clip range's source, "" = the default */
+    int arnold;        /* 1: worldToNDC in Arnold's convention */
+    int warning_count;
+    char warnings[OBS__CAMERA_WARNINGS][224];
+} obs__camera_report;
+
+/* The camera of part `part` from every attribute that describes one (see
+ * camera_detect.c); `renderer` is the detected preset (may be NULL);
+ * `rep` may be NULL. */
+void obs__exr_read_camera_report(exr_const_context_t ctx, int part, const char *renderer,
+                                 obs_camera *cam, obs__camera_report *rep);
+
 /* A file in memory, read through OpenEXR's custom-stream callbacks. */
+/* Fills the renderer, conventions, camera (into gb->camera) and camera
+ * warnings of `info` for part `part` read with match `m`. */
+void obs__exr_describe(exr_const_context_t ctx, int part, const obs__channel_match *m,
+                       obs_gbuffer *gb, obs_exr_info *info);
+
+/* The parts a G-buffer is read from (core/io/exr_parts.c). */
+typedef struct obs__part_set {
+    int *part;    /* indices, in the order they are tried */
+    int count;
+    int by_view;  /* 1: the parts of one view, channels gathered across them */
+    char view[64];
+    char why[96];
+} obs__part_set;
+
+/* The parts map->part or map->view select (see exr_parts.c); a part or
+ * view the file lacks is OBS_INVALID_ARGUMENT naming the file's parts.
+ * Free with obs__part_set_free(). */
+obs_status obs__exr_select_parts(exr_const_context_t ctx, int parts, const obs_channel_map *map,
+                                 obs__part_set *s, char err[OBS_ERR_LEN]);
+void obs__part_set_free(obs__part_set *s);
+
 typedef struct obs__exr_mem {
     const unsigned char *buf;
     size_t len;

@@ -16,11 +16,6 @@
 #include "io/exr_internal.h"
 #include "internal.h"
 
-/* Camera-space clip range used for the projection built from worldToNDC,
- * whose z row an EXR does not define. */
-#define EXR_NEAR 0.1f
-#define EXR_FAR 1000.0f
-
 /* A decoded chunk is held whole by the library; the header decides its
  * size, so a damaged header could ask for gigabytes from a tiny file. */
 #define MAX_CHUNK_BYTES ((uint64_t)1 << 30)
@@ -474,127 +469,68 @@ static obs_status decode_part(exr_const_context_t ctx, int part, const part_geom
     return j.st;
 }
 
-/* ---- camera ------------------------------------------------------------- */
-
-/* A finite m44f or m44d attribute, as floats in the file's order. */
-static int header_m44(exr_const_context_t ctx, int part, const char *name, float m[16])
-{
-    const exr_attribute_t *a = NULL;
-    if (exr_get_attribute_by_name(ctx, part, name, &a) != EXR_ERR_SUCCESS || !a)
-        return 0;
-    for (int i = 0; i < 16; i++) {
-        if (a->type == EXR_ATTR_M44F && a->m44f)
-            m[i] = a->m44f->m[i];
-        else if (a->type == EXR_ATTR_M44D && a->m44d)
-            m[i] = (float)a->m44d->m[i];
-        else
-            return 0;
-        if (!isfinite(m[i]))
-            return 0;
-    }
-    return 1;
-}
-
-/* OpenEXR's camera attributes in our conventions.  Imath matrices are
- * row-vector (p' = p M), camera space is left-handed with +Z forward, and
- * worldToNDC maps to (0,0) top-left .. (1,1) bottom-right of the display
- * window after dividing by w.  Ours are column-vector, right-handed with
- * -Z forward, and the projection is OpenGL clip space.  With
- * F = diag(1,1,-1,1), Mc = wtc^T, Nc = ndc^T:
- *   world_to_camera = F Mc
- *   Q = Nc Mc^-1 F        (our camera space -> homogeneous EXR NDC q)
- *   x_clip = 2 q_x - q_w,  y_clip = q_w - 2 q_y,  w_clip = q_w
- * and the z row, which EXR leaves undefined, is OpenGL's for
- * EXR_NEAR..EXR_FAR.  obs_exr_write() does the inverse. */
-static void camera_from_exr(const float wtc[16], const float *ndc, obs_camera *cam)
-{
-    static const float F[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1};
-    float mc[16], inv[16], nc[16], q[16];
-    const float n = EXR_NEAR, f = EXR_FAR;
-
-    memset(cam, 0, sizeof *cam);
-    obs__mat4_transpose(wtc, mc);
-    if (obs__mat4_invert(mc, inv) != 0)
-        return; /* no camera maps the world onto a plane */
-    obs__mat4_mul(F, mc, cam->world_to_camera);
-    obs__mat4_identity(cam->projection);
-    cam->has_world_to_camera = 1;
-    cam->source = OBS_CAMERA_EXR_HEADER;
-    if (!ndc)
-        return;
-    obs__mat4_transpose(ndc, nc);
-    obs__mat4_mul(nc, inv, q);
-    obs__mat4_mul(q, F, q);
-
-    /* Scale q (a homogeneous quantity) so that w_clip is -z for a
-     * perspective camera and 1 for an orthographic one. */
-    const float *w = q + 12;
-    double eps = 1e-6 * (fabs(w[0]) + fabs(w[1]) + fabs(w[2]) + fabs(w[3]));
-    int flat_xy = fabs(w[0]) <= eps && fabs(w[1]) <= eps;
-    int persp = flat_xy && fabs(w[3]) <= eps && w[2] != 0.0f;
-    double s = persp ? -w[2] : flat_xy && fabs(w[2]) <= eps && w[3] != 0.0f ? w[3] : 1.0;
-    for (int i = 0; i < 16; i++)
-        q[i] = (float)(q[i] / s);
-
-    float *p = cam->projection;
-    for (int j = 0; j < 4; j++) {
-        p[0 + j] = 2.0f * q[0 + j] - q[12 + j];
-        p[4 + j] = q[12 + j] - 2.0f * q[4 + j];
-        p[8 + j] = 0.0f;
-        p[12 + j] = q[12 + j];
-    }
-    p[10] = persp ? -(f + n) / (f - n) : -2.0f / (f - n);
-    p[11] = persp ? -2.0f * f * n / (f - n) : -(f + n) / (f - n);
-    cam->has_projection = 1;
-}
-
-void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam)
-{
-    float wtc[16], ndc[16];
-    memset(cam, 0, sizeof *cam);
-    if (header_m44(ctx, part, "worldToCamera", wtc))
-        camera_from_exr(wtc, header_m44(ctx, part, "worldToNDC", ndc) ? ndc : NULL, cam);
-    obs__exr_msg_reset(); /* a missing attribute is not an error */
-}
-
 /* ---- G-buffer ----------------------------------------------------------- */
 
-/* The first part holding the mapped depth.  When none does, the message
- * lists the channels of every part. */
-static obs_status find_part(exr_const_context_t ctx, int parts, const obs_channel_map *map,
-                            int *part, obs__channel_match *m, const char ***names,
-                            char err[OBS_ERR_LEN])
+/* The first selected part holding the mapped depth; with a view, the
+ * channels of the view's parts together (*owner: the part of each name).
+ * When none does, the message lists the channels of every part. */
+static obs_status find_part(exr_const_context_t ctx, const obs__part_set *ps,
+                            const obs_channel_map *map, int *part, obs__channel_match *m,
+                            const char ***names, int **owner, char err[OBS_ERR_LEN])
 {
     const char **all = NULL, **pn = NULL;
-    int nall = 0, n = 0;
+    int nall = 0, n = 0, parts = ps->count, *own = NULL;
     obs_status st = OBS_OK;
-    char perr[OBS_ERR_LEN] = "", first_err[OBS_ERR_LEN] = "";
+    char perr[OBS_ERR_LEN] = "", first_err[OBS_ERR_LEN] = "", why[96];
 
-    for (int p = 0; p < parts; p++) {
+    *owner = NULL;
+    for (int i = 0; i < parts; i++) {
+        int p = ps->part[i];
         if ((st = part_names(ctx, p, &pn, &n, err)) != OBS_OK)
             goto fail;
-        if ((st = obs__channel_map_resolve(map, pn, n, m, perr)) == OBS_OK) {
+        const char *detected = obs__preset_detect(ctx, p, why, sizeof why);
+        obs__exr_msg_reset(); /* a missing attribute is not an error */
+        if (!ps->by_view && (st = obs__channel_map_resolve_for(map, detected, pn, n, m, perr)) == OBS_OK) {
             *part = p;
             *names = pn;
             pn = NULL;
             goto fail;
         }
-        if (st != OBS_MISSING_CHANNEL) {
+        if (!ps->by_view && st != OBS_MISSING_CHANNEL) {
             obs__fail(err, st, "%s", perr);
             goto fail;
         }
-        if (p == 0)
+        if (i == 0)
             memcpy(first_err, perr, sizeof perr);
         const char **grown = realloc(all, ((size_t)nall + (size_t)n + 1) * sizeof *all);
-        if (!grown) {
+        int *grown_own = realloc(own, ((size_t)nall + (size_t)n + 1) * sizeof *own);
+        if (grown)
+            all = grown;
+        if (grown_own)
+            own = grown_own;
+        if (!grown || !grown_own) {
             st = obs__fail(err, OBS_NO_MEMORY, "channel list");
             goto fail;
         }
-        all = grown;
         memcpy(all + nall, pn, (size_t)n * sizeof *pn);
+        for (int k = 0; k < n; k++)
+            own[nall + k] = p;
         nall += n;
         free(pn);
         pn = NULL;
+    }
+    /* A view's parts: their channels together, the first part's renderer. */
+    if (ps->by_view) {
+        const char *detected = obs__preset_detect(ctx, ps->part[0], why, sizeof why);
+        obs__exr_msg_reset();
+        if ((st = obs__channel_map_resolve_for(map, detected, all, nall, m, err)) == OBS_OK) {
+            *part = own[m->depth];
+            *names = all;
+            *owner = own;
+            all = NULL;
+            own = NULL;
+        }
+        goto fail;
     }
     /* Resolving against the union gives one message naming every part's
      * channels; should that succeed (channels split across parts), part
@@ -605,7 +541,42 @@ static obs_status find_part(exr_const_context_t ctx, int parts, const obs_channe
 fail:
     free(pn);
     free(all);
+    free(own);
     return st;
+}
+
+/* Decodes the targets of a view's parts other than the depth's, part by
+ * part; each part's data window must be the depth part's. */
+static obs_status decode_other_parts(exr_const_context_t ctx, int64_t file_size, int part,
+                                     const part_geom *g, const target *t, const int *tpart, int nt,
+                                     const obs_limits *lim, char err[OBS_ERR_LEN])
+{
+    for (int i = 0; i < nt; i++) {
+        int q = tpart[i], seen = q == part;
+        for (int k = 0; k < i && !seen; k++)
+            seen = tpart[k] == q;
+        if (seen)
+            continue;
+        part_geom gq;
+        target sub[11];
+        int ns = 0;
+        obs_status st = check_part(ctx, q, file_size, lim, &gq, err);
+        if (st != OBS_OK)
+            return st;
+        if (gq.dw.min.x != g->dw.min.x || gq.dw.min.y != g->dw.min.y || gq.width != g->width ||
+            gq.height != g->height)
+            return obs__fail(err, OBS_UNSUPPORTED, "part %d's data window (%dx%d at %d,%d) is not "
+                             "the depth part's (%dx%d at %d,%d): channels of one view are gathered "
+                             "from parts of the same window only (give --part)", q, gq.width,
+                             gq.height, gq.dw.min.x, gq.dw.min.y, g->width, g->height,
+                             g->dw.min.x, g->dw.min.y);
+        for (int k = 0; k < nt; k++)
+            if (tpart[k] == q)
+                sub[ns++] = t[k];
+        if ((st = decode_part(ctx, q, &gq, sub, ns, lim, err)) != OBS_OK)
+            return st;
+    }
+    return OBS_OK;
 }
 
 static void copy_name(char *dst, size_t len, const char *const *names, int idx)
@@ -618,6 +589,8 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
                                char err[OBS_ERR_LEN])
 {
     const char **names = NULL;
+    int *owner = NULL;
+    obs__part_set ps = {0};
     obs__channel_match m;
     part_geom g;
     int parts = 0, part = 0;
@@ -628,16 +601,19 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
         st = obs__exr_fail(err, rv ? rv : EXR_ERR_FILE_BAD_HEADER, "part count");
         goto fail;
     }
-    if ((st = find_part(ctx, parts, map, &part, &m, &names, err)) != OBS_OK)
+    if ((st = obs__exr_select_parts(ctx, parts, map, &ps, err)) != OBS_OK)
+        goto fail;
+    if ((st = find_part(ctx, &ps, map, &part, &m, &names, &owner, err)) != OBS_OK)
         goto fail;
     if ((st = check_part(ctx, part, file_size, lim, &g, err)) != OBS_OK)
         goto fail;
 
-    /* Planes: depth (1), normal (3), colour (4), in one allocation. */
-    int has_n = m.normal[0] >= 0, has_c = m.color[0] >= 0;
+    /* Planes: depth (1), normal (3), colour (4), position (3), in one
+     * allocation. */
+    int has_n = m.normal[0] >= 0, has_c = m.color[0] >= 0, has_p = m.position[0] >= 0;
     size_t px = (size_t)g.width * (size_t)g.height, bytes;
     if (obs__size_mul3((size_t)g.width, (size_t)g.height,
-                       (size_t)(1 + 3 * has_n + 4 * has_c) * sizeof(float), &bytes) != 0) {
+                       (size_t)(1 + 3 * has_n + 4 * has_c + 3 * has_p) * sizeof(float), &bytes) != 0) {
         st = obs__fail(err, OBS_TOO_LARGE, "G-buffer of %dx%d does not fit in memory", g.width, g.height);
         goto fail;
     }
@@ -647,18 +623,32 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     }
     float *depth = out->storage, *normal = has_n ? depth + px : NULL;
     float *color = has_c ? depth + px * (1 + 3 * has_n) : NULL;
-    target t[8];
-    int nt = 0;
+    float *position = has_p ? depth + px * (1 + 3 * has_n + 4 * has_c) : NULL;
+    target t[11];
+    int nt = 0, tpart[11], idx[11];
+    idx[nt] = m.depth;
     t[nt++] = (target){names[m.depth], depth, 1};
     for (int i = 0; has_n && i < 3; i++)
-        t[nt++] = (target){names[m.normal[i]], normal + i, 3};
+        idx[nt] = m.normal[i], t[nt++] = (target){names[m.normal[i]], normal + i, 3};
     for (int i = 0; has_c && i < 4; i++)
         if (m.color[i] >= 0)
-            t[nt++] = (target){names[m.color[i]], color + i, 4};
+            idx[nt] = m.color[i], t[nt++] = (target){names[m.color[i]], color + i, 4};
+    for (int i = 0; has_p && i < 3; i++)
+        idx[nt] = m.position[i], t[nt++] = (target){names[m.position[i]], position + i, 3};
+    /* a view's channels may lie in several parts: the depth part's here,
+     * the others' by decode_other_parts() */
+    target here[11];
+    int nt_here = 0;
+    for (int i = 0; i < nt; i++) {
+        tpart[i] = owner ? owner[idx[i]] : part;
+        if (tpart[i] == part)
+            here[nt_here++] = t[i];
+    }
     if (has_c && m.color[3] < 0) /* colour without alpha is opaque */
         for (size_t i = 0; i < px; i++)
             color[i * 4 + 3] = 1.0f;
-    if ((st = decode_part(ctx, part, &g, t, nt, lim, err)) != OBS_OK)
+    if ((st = decode_part(ctx, part, &g, here, nt_here, lim, err)) != OBS_OK ||
+        (st = decode_other_parts(ctx, file_size, part, &g, t, tpart, nt, lim, err)) != OBS_OK)
         goto fail;
 
     obs_gbuffer *gb = &out->gb;
@@ -671,9 +661,13 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     gb->depth = (obs_plane){depth, 1, 0};
     gb->normal = (obs_plane){normal, has_n ? 3 : 0, 0};
     gb->color = (obs_plane){color, has_c ? 4 : 0, 0};
-    obs__exr_read_camera(ctx, part, &gb->camera);
+    gb->position = (obs_plane){position, has_p ? 3 : 0, 0};
+    gb->depth_mode = m.depth_mode;
+    gb->normal_space = m.normal_space;
 
     obs_exr_info *info = &out->info;
+    obs__exr_describe(ctx, part, &m, gb, info);
+    obs__exr_msg_reset();
     info->part = part;
     info->part_count = parts;
     info->tiled = g.tiled;
@@ -683,10 +677,22 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
         copy_name(info->normal[i], sizeof info->normal[i], names, m.normal[i]);
     for (int i = 0; i < 4; i++)
         copy_name(info->color[i], sizeof info->color[i], names, m.color[i]);
+    for (int i = 0; i < 3; i++)
+        copy_name(info->position[i], sizeof info->position[i], names, m.position[i]);
     snprintf(info->preset, sizeof info->preset, "%s", m.preset);
+    snprintf(info->view, sizeof info->view, "%s", ps.view);
+    info->parts_read = 1;
+    for (int i = 1; i < nt; i++) {
+        int seen = 0;
+        for (int k = 0; k < i; k++)
+            seen |= tpart[k] == tpart[i];
+        info->parts_read += !seen;
+    }
     st = OBS_OK;
 fail:
     free(names);
+    free(owner);
+    obs__part_set_free(&ps);
     return st;
 }
 

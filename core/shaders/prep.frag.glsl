@@ -13,12 +13,29 @@ layout(location = 0) out vec4 o_pos;
 layout(location = 1) out vec4 o_normal;
 layout(location = 2) out vec2 o_dz;     // planar depth and n.z: what the samples read
 
+// The clip range (near, far) of the projection's z row: the planar depths
+// whose OpenGL depth is -1 and 1.  C twin: clip_range in prep_cpu.c.
+vec2 clip_range()
+{
+    float a = PM(2, 2), b = PM(2, 3), c = PM(3, 2), d = PM(3, 3);
+    return vec2((d + b) / (a + c), (b - d) / (a - c));
+}
+
 // Planar depth from the raw value; 0 for background.  OBS_DEPTH_MODE (1
-// planar, 2 radial, 3 ndc: obs_depth_mode) is defined by the program, one
+// planar, 2 radial, 3 ndc, 4 inverse, 5 normalized: obs_depth_mode) is
+// defined by the program, one
 // per mode: as uniform branches, the radial and ndc code ran for every
 // pixel (bench/RESULTS.md).  C twin: linear_depth in vao_cpu.c.
 float linear_depth(float raw, vec3 dir)
 {
+    if (OBS_DEPTH_MODE == 4) // 1/Z: 0 (or below) is background
+        return raw > 0.0 && 1.0 / raw < SKY_DEPTH ? 1.0 / raw : 0.0;
+    if (OBS_DEPTH_MODE == 5) { // 0..1 between the clip planes; 1 is background
+        if (!(raw >= 0.0) || raw >= 1.0)
+            return 0.0;
+        vec2 nf = clip_range();
+        return nf.x + raw * (nf.y - nf.x);
+    }
     if (!(raw > 0.0) || raw >= SKY_DEPTH)
         return 0.0;
     if (OBS_DEPTH_MODE == 2)

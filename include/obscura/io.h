@@ -27,12 +27,21 @@ typedef struct obs_channel_map {
     const char *depth;     /* explicit channel names, NULL = from preset */
     const char *normal[3];
     const char *color[4];  /* color[3] (alpha) may be NULL */
+    const char *part;      /* a part by name or index (NULL: by view, or the first part
+                            * holding the depth) */
+    const char *view;      /* a view of a multi-view, multi-part file (NULL: its default
+                            * view); its parts' channels are gathered */
 } obs_channel_map;
 
 /* Valid preset names, NULL-terminated. */
 extern const char *const obs_channel_presets[];
 
-/* What the reader found, for logs and errors. */
+/* Most sanity warnings one read reports. */
+#define OBS_EXR_WARNINGS 8
+
+/* What the reader found, for logs and errors.  `warnings` are one line
+ * each: the file looks unlike what its convention says (README.md,
+ * "Sanity warnings"); --strict makes them errors. */
 typedef struct obs_exr_info {
     int part;                  /* part index the channels were read from */
     int part_count;
@@ -41,7 +50,20 @@ typedef struct obs_exr_info {
     char depth[64];            /* matched channel names ("" = absent) */
     char normal[3][64];
     char color[4][64];
+    char position[3][64];      /* a world-space position pass ("" = none) */
     char preset[16];           /* preset that matched ("explicit" if none) */
+    char view[64];             /* the view read ("" = the file has no views) */
+    int parts_read;            /* parts the channels came from (1, or more for a view) */
+    char renderer[16];         /* the renderer the header names ("" = none) */
+    char renderer_why[96];     /* what in the header named it */
+    obs_depth_mode depth_mode;     /* the preset's depth convention (0: not known) */
+    obs_normal_space normal_space; /* the preset's normal space (0: not known) */
+    char camera_source[160];   /* the attributes the camera came from ("" = none) */
+    char camera_check[160];    /* cross-checks of the camera ("" = none made) */
+    char camera_clip[64];      /* where the clip range came from ("" = default) */
+    int camera_arnold;         /* 1: worldToNDC was in Arnold's convention */
+    int warning_count;         /* sanity warnings (obs_exr_info.warnings) */
+    char warnings[OBS_EXR_WARNINGS][224];
 } obs_exr_info;
 
 /* A G-buffer read from a file.  Frees with obs_gbuffer_free(). */
@@ -71,6 +93,48 @@ obs_status obs_gbuffer_read_exr_mem(const void *buf, size_t len,
 
 /* Frees storage and zeroes *f; NULL-safe. */
 void obs_gbuffer_free(obs_gbuffer_file *f);
+
+/* The renderer, camera (and its source, cross-check and warnings) of part
+ * `part` of an EXR, flat or deep, as the readers find them: fills those
+ * fields of *info and *cam. */
+obs_status obs_exr_describe_camera(const char *path, int part, obs_exr_info *info,
+                                   obs_camera *cam, char err[OBS_ERR_LEN]);
+
+/* The pinhole camera of a world-space position pass `pos` (3 floats a
+ * pixel, the G-buffer's size; pixels with background depth are left out):
+ * normalised DLT, Gauss-Newton refinement, then intrinsics and rotation.
+ * A P no pinhole camera explains (RMS reprojection error over 0.5 px, an
+ * affine or mirrored fit) is OBS_NO_CAMERA with the error in `err`.
+ * *rms (may be NULL) receives the RMS reprojection error in pixels. */
+obs_status obs_camera_solve_position(const obs_gbuffer *gb, const obs_plane *pos, obs_camera *cam,
+                                     double *rms, char err[OBS_ERR_LEN]);
+
+/* With no camera (none in the file, none in `params`: fov_y, fov_x or
+ * focal_length with aperture), the camera solved from the file's position
+ * pass (obs_camera_solve_position), its source and error in f->info; the
+ * solver's refusal, or no position pass, is OBS_NO_CAMERA with a message.
+ * With a camera, nothing (obs_gbuffer_sanity() checks it against P). */
+obs_status obs_gbuffer_solve_camera(obs_gbuffer_file *f, const obs_params *params,
+                                    char err[OBS_ERR_LEN]);
+
+/* RMS and largest distance in pixels between each pixel centre and its
+ * position projected by `cam`. */
+obs_status obs_camera_reprojection(const obs_gbuffer *gb, const obs_plane *pos,
+                                   const obs_camera *cam, double *rms, double *max_err,
+                                   char err[OBS_ERR_LEN]);
+
+/* One line a part, "INDEX 'NAME' (view VIEW): CH, CH, ...", into a newly
+ * allocated, NULL-terminated array; caller frees with obs_strv_free(). */
+obs_status obs_exr_describe_parts(const char *path, char ***lines, char err[OBS_ERR_LEN]);
+
+/* Sanity checks of a G-buffer under the conventions `params` (NULL =
+ * defaults) and the G-buffer's own give: depth all in 0..1 under a metric
+ * depth mode, normals not unit length, normals that agree with the
+ * normals derived from depth only in the other space or with the depth
+ * inverted, and a camera whose reprojection of the position pass (when
+ * the G-buffer has one) misses the pixel centres by more than a pixel
+ * (RMS).  Appends one line each to info->warnings; returns how many. */
+int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_info *info);
 
 /* Reads one named channel of an EXR (any part that holds it) as float32;
  * for comparisons and tests.  Caller frees with obs_image_free(). */

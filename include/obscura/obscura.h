@@ -77,6 +77,14 @@ typedef struct obs_gbuffer {
     obs_plane normal;
     obs_plane color;
     obs_camera camera;
+    /* What the planes hold by the file's renderer convention (0: not
+     * known); used where the parameters leave depth_mode or normal_space
+     * at 0 (their default). */
+    obs_depth_mode depth_mode;
+    obs_normal_space normal_space;
+    /* Optional world-space position pass (3 channels, data NULL when
+     * absent): only to solve or check the camera, never drawn. */
+    obs_plane position;
 } obs_gbuffer;
 
 /* An image owned by the library: `channels` interleaved float32 values

@@ -30,7 +30,9 @@ extern "C" {
 #define OBS_DEPTH_MODE_LIST(X)                                                 \
     X(OBS_DEPTH_PLANAR, planar) /* distance along the camera axis (Depth.Z) */ \
     X(OBS_DEPTH_RADIAL, radial) /* distance from the camera centre */          \
-    X(OBS_DEPTH_NDC, ndc)       /* OpenGL depth-buffer value in [0,1] */
+    X(OBS_DEPTH_NDC, ndc)       /* OpenGL depth-buffer value in [0,1] */ \
+    X(OBS_DEPTH_INVERSE, inverse) /* 1 / planar depth (Nuke's depth.Z) */    \
+    X(OBS_DEPTH_NORMALIZED, normalized) /* (planar - near) / (far - near) */
 typedef enum obs_depth_mode { OBS_DEPTH_DEFAULT, OBS_DEPTH_MODE_LIST(OBS__ENUM_VALUE) } obs_depth_mode;
 
 #define OBS_SWITCH_LIST(X) X(OBS_ON, on) X(OBS_OFF, off)
@@ -240,14 +242,25 @@ typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM
       "|AO(careful) - AO(off)| under 0.002 (half an 8-bit step)")              \
     X(depth_mode, ENUM, "planar", 0, 0, OBS_CHOICES(OBS_DEPTH_MODE_LIST),                   \
       "what the depth channel holds: distance along the camera axis, "         \
-      "distance from the camera, or a [0,1] OpenGL depth-buffer value")        \
+      "distance from the camera, a [0,1] OpenGL depth-buffer value, 1 / "      \
+      "planar depth, or planar depth normalized to [0,1] between near and "    \
+      "far (ndc and normalized take the camera's clip range; 0 (default): "   \
+      "what the file's renderer preset says, else planar)")                   \
     X(normal_space, ENUM, "world", 0, 0, OBS_CHOICES(OBS_NORMAL_SPACE_LIST),                       \
-      "space of the normal channel (world normals need world_to_camera)")      \
+      "space of the normal channel (world normals need world_to_camera; "     \
+      "default: what the file's renderer preset says, else world)")          \
     X(unit_scale, FLOAT, 1.0, 1e-6, 1e6, NULL,                                 \
       "depth values are multiplied by this to reach the units of radius")      \
     X(fov_y, FLOAT, 0.0, 0.0, 179.0, NULL,                                     \
       "vertical field of view in degrees (0: take the camera from the EXR "    \
       "header or camera JSON)")                                                \
+    X(fov_x, FLOAT, 0.0, 0.0, 179.0, NULL,                                     \
+      "horizontal field of view in degrees, used when fov_y is 0")            \
+    X(focal_length, FLOAT, 0.0, 0.0, 1e6, NULL,                               \
+      "focal length (same unit as aperture), with aperture: the field of "    \
+      "view when fov_y and fov_x are 0")                                       \
+    X(aperture, FLOAT, 0.0, 0.0, 1e6, NULL,                                    \
+      "horizontal film aperture (same unit as focal_length)")                 \
     X(near, FLOAT, 0.1, 1e-6, 1e9, NULL,                                       \
       "near clip distance, used with fov_y (ndc depth is linearised with it)") \
     X(far, FLOAT, 1000.0, 1e-6, 1e12, NULL,                                    \

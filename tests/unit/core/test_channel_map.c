@@ -20,7 +20,11 @@ static void test_presets_list(void **state)
     assert_string_equal(obs_channel_presets[0], "auto");
     assert_string_equal(obs_channel_presets[1], "blender");
     assert_string_equal(obs_channel_presets[2], "generic");
-    assert_null(obs_channel_presets[3]);
+    /* the renderers of core/io/presets.c, each a row there */
+    for (int i = 3; obs_channel_presets[i]; i++)
+        assert_non_null(obs__preset_find(obs_channel_presets[i]));
+    assert_string_equal(obs_channel_presets[10], "nuke");
+    assert_null(obs_channel_presets[11]);
 }
 
 /* Blender's multilayer order (alphabetical, as EXR stores it). */

@@ -53,9 +53,10 @@ static void check_twin(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *p,
 }
 
 /* The depth modes other than planar (the prep pass has a program per
- * mode): the scene's planar depths rewritten as distances from the camera
- * and as OpenGL depth-buffer values give GL = CPU, and the AO of the
- * planar depths (the same points; ndc within float rounding). */
+ * mode): the scene's planar depths rewritten as distances from the camera,
+ * as OpenGL depth-buffer values, as 1/Z and normalized over the clip range
+ * give GL = CPU, and the AO of the planar depths (the same points; ndc,
+ * inverse and normalized within float rounding). */
 static void check_depth_modes(obs_ctx *ctx, const obs_gbuffer *gb, const char *scene)
 {
     char err[OBS_ERR_LEN] = "";
@@ -66,8 +67,14 @@ static void check_depth_modes(obs_ctx *ctx, const obs_gbuffer *gb, const char *s
     const float *P = f.proj;
     float *radial = malloc((size_t)gb->width * gb->height * sizeof *radial);
     float *ndc = malloc((size_t)gb->width * gb->height * sizeof *ndc);
+    float *inv = malloc((size_t)gb->width * gb->height * sizeof *inv);
+    float *nrm = malloc((size_t)gb->width * gb->height * sizeof *nrm);
     assert_non_null(radial);
     assert_non_null(ndc);
+    assert_non_null(inv);
+    assert_non_null(nrm);
+    /* the clip range of the projection's z row (normalized depth's) */
+    double cn = (P[15] + P[11]) / (P[10] + P[14]), cf = (P[11] - P[15]) / (P[10] - P[14]);
     for (int y = 0; y < gb->height; y++)
         for (int x = 0; x < gb->width; x++) {
             float v[4];
@@ -76,13 +83,16 @@ static void check_depth_modes(obs_ctx *ctx, const obs_gbuffer *gb, const char *s
             radial[i] = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
             float zn = (P[10] * v[2] + P[11]) / (P[14] * v[2] + P[15]);
             ndc[i] = v[3] > 0.0f ? 0.5f * zn + 0.5f : 1.0f; /* background: far plane */
+            inv[i] = v[3] > 0.0f ? 1.0f / v[3] : 0.0f;        /* background: 1/inf */
+            nrm[i] = v[3] > 0.0f ? (float)((v[3] - cn) / (cf - cn)) : 1.0f;
         }
     obs_result ref;
     assert_int_equal(obs_run(ctx, gb, &planar, OBS_OUTPUT_AO, &ref, err), OBS_OK);
-    static const char *const modes[] = {"radial", "ndc"};
-    for (int m = 0; m < 2; m++) {
+    static const char *const modes[] = {"radial", "ndc", "inverse", "normalized"};
+    float *const planes[] = {radial, ndc, inv, nrm};
+    for (int m = 0; m < 4; m++) {
         obs_gbuffer g = *gb;
-        g.depth.data = m == 0 ? radial : ndc;
+        g.depth.data = planes[m];
         g.depth.channels = 1;
         g.depth.row_stride = (size_t)gb->width * sizeof(float);
         obs_params p = {0};
@@ -103,6 +113,8 @@ static void check_depth_modes(obs_ctx *ctx, const obs_gbuffer *gb, const char *s
     obs_result_free(&ref);
     free(radial);
     free(ndc);
+    free(inv);
+    free(nrm);
 }
 
 static void test_gl_matches_cpu(void **state)

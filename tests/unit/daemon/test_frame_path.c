@@ -13,27 +13,43 @@ static void test_decode(void **state)
     (void)state;
     size_t len;
     char err[OBS_ERR_LEN] = "";
-    obs_channel_map map = {0};
+    obs_http_request hr;
     obsd_fp fp;
+    obs_http_request_init(&hr);
 
     unsigned char *flat = obs_test_slurp(TESTDATA "/room_small.exr", &len);
     obsd_fp_init(&fp);
-    assert_int_equal(obsd_fp_decode(&fp, flat, len, &map, NULL, "no deep here", err), OBS_OK);
+    assert_int_equal(obsd_fp_decode(&fp, flat, len, &hr, NULL, "no deep here", err), OBS_OK);
     assert_ptr_equal(fp.gb, &fp.gf.gb);
     assert_null(fp.deep);
     assert_true(fp.gb->width > 0 && fp.ms_decode >= 0.0);
     obsd_fp_free(&fp);
+
+    /* strict=1: a sanity warning on the input fails the frame (world
+     * normals read as camera-space disagree with the depth's) */
+    obsd_fp_init(&fp);
+    assert_int_equal(obs_http_request_set(&hr, "normal_space", "camera", err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&hr, "fov_y", "50", err), OBS_OK);
+    assert_int_equal(obsd_fp_decode(&fp, flat, len, &hr, NULL, NULL, err), OBS_OK);
+    assert_true(fp.gf.info.warning_count >= 1);
+    obsd_fp_free(&fp);
+    obsd_fp_init(&fp);
+    assert_int_equal(obs_http_request_set(&hr, "strict", "1", err), OBS_OK);
+    assert_int_equal(obsd_fp_decode(&fp, flat, len, &hr, NULL, NULL, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "strict: "));
+    obsd_fp_free(&fp);
+    obs_http_request_init(&hr);
     free(flat);
 
     unsigned char *deep = obs_test_slurp(TESTDATA "/deep_small.exr", &len);
     obsd_fp_init(&fp);
-    assert_int_equal(obsd_fp_decode(&fp, deep, len, &map, NULL, "no deep here", err), OBS_UNSUPPORTED);
+    assert_int_equal(obsd_fp_decode(&fp, deep, len, &hr, NULL, "no deep here", err), OBS_UNSUPPORTED);
     assert_string_equal(err, "no deep here");
     assert_null(fp.gb);
     assert_null(fp.deep);
     obsd_fp_free(&fp);
     obsd_fp_init(&fp);
-    assert_int_equal(obsd_fp_decode(&fp, deep, len, &map, NULL, NULL, err), OBS_OK);
+    assert_int_equal(obsd_fp_decode(&fp, deep, len, &hr, NULL, NULL, err), OBS_OK);
     assert_ptr_equal(fp.deep, &fp.deep_exr);
     assert_null(fp.gb);
     assert_int_equal(obsd_fp_camera(&fp) != NULL, fp.deep_exr.camera.has_projection);
@@ -41,7 +57,7 @@ static void test_decode(void **state)
     free(deep);
 
     obsd_fp_init(&fp);
-    assert_int_not_equal(obsd_fp_decode(&fp, (const unsigned char *)"not an EXR", 10, &map, NULL, NULL, err),
+    assert_int_not_equal(obsd_fp_decode(&fp, (const unsigned char *)"not an EXR", 10, &hr, NULL, NULL, err),
                          OBS_OK);
     assert_true(err[0] != '\0');
     obsd_fp_free(&fp);

@@ -1,0 +1,74 @@
+/* What obscura inspect shows beside the G-buffer: the renderer and camera
+ * of any EXR part (flat or deep) as the readers find them, and the list
+ * of parts with their names, views and channels. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/exr_internal.h"
+#include "internal.h"
+
+obs_status obs_exr_describe_camera(const char *path, int part, obs_exr_info *info,
+                                   obs_camera *cam, char err[OBS_ERR_LEN])
+{
+    exr_context_t ctx = NULL;
+    int64_t size;
+    obs_gbuffer gb;
+    obs__channel_match m;
+    char sub[OBS_ERR_LEN] = "";
+    obs_status st = obs__exr_open(path, NULL, &ctx, &size, sub);
+    if (st != OBS_OK)
+        return obs__fail(err, st, "%s: %s", path, sub);
+    memset(&gb, 0, sizeof gb);
+    memset(&m, 0, sizeof m);
+    obs__exr_describe(ctx, part, &m, &gb, info);
+    obs__exr_msg_reset(); /* a missing attribute is not an error */
+    *cam = gb.camera;
+    exr_finish(&ctx);
+    return OBS_OK;
+}
+
+obs_status obs_exr_describe_parts(const char *path, char ***lines, char err[OBS_ERR_LEN])
+{
+    exr_context_t ctx = NULL;
+    int64_t size;
+    int parts = 0;
+    char sub[OBS_ERR_LEN] = "";
+    char **v = NULL;
+    obs_status st = obs__exr_open(path, NULL, &ctx, &size, sub);
+    *lines = NULL;
+    if (st != OBS_OK)
+        return obs__fail(err, st, "%s: %s", path, sub);
+    if (exr_get_count(ctx, &parts) != EXR_ERR_SUCCESS || parts < 1 ||
+        !(v = calloc((size_t)parts + 1, sizeof *v))) {
+        exr_finish(&ctx);
+        return obs__fail(err, parts < 1 ? OBS_BAD_FILE : OBS_NO_MEMORY, "%s: part list", path);
+    }
+    for (int p = 0; p < parts; p++) {
+        const exr_attribute_t *n = NULL, *w = NULL;
+        const exr_attr_chlist_t *cl = NULL;
+        char buf[OBS__LIST_CHARS + 200], list[OBS__LIST_CHARS + 32] = "";
+        const char *names[OBS__LIST_CHARS];
+        int count = 0;
+        exr_get_attribute_by_name(ctx, p, "name", &n);
+        exr_get_attribute_by_name(ctx, p, "view", &w);
+        if (exr_get_channels(ctx, p, &cl) == EXR_ERR_SUCCESS && cl)
+            for (int i = 0; i < cl->num_channels && count < OBS__LIST_CHARS; i++)
+                names[count++] = cl->entries[i].name.str ? cl->entries[i].name.str : "";
+        obs__list_names(names, count, list, sizeof list);
+        int named = n && n->type == EXR_ATTR_STRING && n->string && n->string->str;
+        int viewed = w && w->type == EXR_ATTR_STRING && w->string && w->string->str;
+        snprintf(buf, sizeof buf, "%d%s%.60s%s%s%.30s%s: %s", p, named ? " '" : "",
+                 named ? n->string->str : "", named ? "'" : "", viewed ? " (view " : "",
+                 viewed ? w->string->str : "", viewed ? ")" : "", list);
+        if (!(v[p] = strdup(buf))) {
+            obs_strv_free(v);
+            exr_finish(&ctx);
+            return obs__fail(err, OBS_NO_MEMORY, "%s: part list", path);
+        }
+    }
+    obs__exr_msg_reset(); /* a missing attribute is not an error */
+    exr_finish(&ctx);
+    *lines = v;
+    return OBS_OK;
+}

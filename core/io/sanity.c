@@ -1,0 +1,227 @@
+/* Sanity warnings on a G-buffer read under a convention: values that look
+ * unlike what the convention says (depth normalized or inverted, normals
+ * not unit length or in the other space).  Normals are tested against the
+ * normals derived from depth: under the right depth mode and normal
+ * space the two agree on smooth surfaces.  One line each; --strict makes
+ * them errors.  Never changes the G-buffer. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/exr_internal.h"
+#include "internal.h"
+
+/* A G-buffer with fewer valid pixels than this is not judged. */
+#define MIN_PIXELS 64
+/* Normals whose mean | |n| - 1 | exceeds this are not unit length. */
+#define UNIT_TOLERANCE 0.05
+/* Mean n . n_depth under which normals disagree with depth, and over
+ * which the alternative agrees. */
+#define AGREE_BAD 0.5
+#define AGREE_GOOD 0.8
+/* RMS reprojection error of the position pass over which the camera is
+ * said to disagree with it. */
+#define MAX_REPROJECTION_PX 1.0
+/* Neighbours farther apart than this fraction of the depth are an edge. */
+#define EDGE_FRACTION 0.05
+
+__attribute__((format(printf, 3, 4)))
+static void warn(obs_exr_info *info, int *added, const char *fmt, ...)
+{
+    va_list ap;
+    if (info->warning_count >= OBS_EXR_WARNINGS)
+        return;
+    va_start(ap, fmt);
+    vsnprintf(info->warnings[info->warning_count++], sizeof info->warnings[0], fmt, ap);
+    va_end(ap);
+    (*added)++;
+}
+
+/* Planar depth of raw value v under a depth mode (planar, inverse, or
+ * normalized over near..far); 0 for background.  radial and ndc are left
+ * to the chain: the depth-derived normals are not computed for them. */
+static double planar(double v, obs_depth_mode mode, double n, double f)
+{
+    if (!isfinite(v))
+        return 0.0;
+    if (mode == OBS_DEPTH_INVERSE)
+        v = v > 0.0 ? 1.0 / v : 0.0;
+    else if (mode == OBS_DEPTH_NORMALIZED)
+        v = v >= 0.0 && v < 1.0 ? n + v * (f - n) : 0.0;
+    return v > 0.0 && v < OBS_BACKGROUND_DEPTH ? v : 0.0;
+}
+
+/* View-space point of pixel (x, y) at planar depth d, for a perspective
+ * projection P (display window dw x dh, the planes at ox, oy). */
+static void view_point(const float *P, double x, double y, double d, double out[3])
+{
+    /* x_ndc = (P00 X + P01 Y + P02 Z + P03) / -Z, with Z = -d */
+    double nx = x, ny = y;
+    double a = P[0], b = P[1], c = P[4], e = P[5];
+    double rx = nx * d - (P[2] * -d + P[3]), ry = ny * d - (P[6] * -d + P[7]);
+    double det = a * e - b * c;
+    out[0] = (e * rx - b * ry) / det;
+    out[1] = (a * ry - c * rx) / det;
+    out[2] = -d;
+}
+
+/* Mean agreement n . n_depth over smooth pixels of the given normals
+ * (3 floats a pixel, already in view space) with the normals derived from
+ * depth under `mode`; -2 when too few pixels were usable. */
+static double agreement(const obs_gbuffer *gb, const float *P, const float *vn,
+                        obs_depth_mode mode, double n, double f)
+{
+    int w = gb->width, h = gb->height;
+    int dw = gb->display_width > 0 ? gb->display_width : w;
+    int dh = gb->display_height > 0 ? gb->display_height : h;
+    double sum = 0.0;
+    long count = 0;
+    int step = w * h > 40000 ? 2 : 1;
+    for (int y = 1; y + 1 < h; y += step)
+        for (int x = 1; x + 1 < w; x += step) {
+            double d[3], p[3][3];
+            const int px[3][2] = {{x, y}, {x + 1, y}, {x, y + 1}};
+            int ok = 1;
+            for (int k = 0; k < 3 && ok; k++) {
+                d[k] = planar(*obs__plane_px(&gb->depth, w, px[k][0], px[k][1]), mode, n, f);
+                ok = d[k] > 0.0;
+                double ndx = (px[k][0] + 0.5 + gb->display_x) / dw * 2.0 - 1.0;
+                double ndy = 1.0 - (px[k][1] + 0.5 + gb->display_y) / dh * 2.0;
+                view_point(P, ndx, ndy, d[k], p[k]);
+            }
+            if (!ok || fabs(d[1] - d[0]) > EDGE_FRACTION * d[0] ||
+                fabs(d[2] - d[0]) > EDGE_FRACTION * d[0])
+                continue;
+            double u[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+            double v[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+            /* rows grow downwards: u x v points away from the camera */
+            double c[3] = {v[1] * u[2] - v[2] * u[1], v[2] * u[0] - v[0] * u[2],
+                           v[0] * u[1] - v[1] * u[0]};
+            double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+            const float *m = vn + ((size_t)y * w + x) * 3;
+            double ml = sqrt((double)m[0] * m[0] + (double)m[1] * m[1] + (double)m[2] * m[2]);
+            if (len <= 0.0 || !(ml > 0.0) || !isfinite(ml))
+                continue;
+            sum += (c[0] * m[0] + c[1] * m[1] + c[2] * m[2]) / (len * ml);
+            count++;
+        }
+    return count >= MIN_PIXELS ? sum / (double)count : -2.0;
+}
+
+/* The normals in view space as `space` says (3 floats a pixel). */
+static float *view_normals(const obs_gbuffer *gb, const float *wtc, obs_normal_space space)
+{
+    size_t px = (size_t)gb->width * gb->height;
+    float *out = malloc(px * 3 * sizeof *out);
+    if (!out)
+        return NULL;
+    for (int y = 0; y < gb->height; y++)
+        for (int x = 0; x < gb->width; x++) {
+            const float *n = obs__plane_px(&gb->normal, gb->width, x, y);
+            float *o = out + ((size_t)y * gb->width + x) * 3;
+            for (int r = 0; r < 3; r++)
+                o[r] = space == OBS_NORMALS_CAMERA
+                           ? n[r]
+                           : wtc[r * 4] * n[0] + wtc[r * 4 + 1] * n[1] + wtc[r * 4 + 2] * n[2];
+        }
+    return out;
+}
+
+static const char *space_name(obs_normal_space s)
+{
+    return s == OBS_NORMALS_CAMERA ? "camera" : "world";
+}
+
+int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_info *info)
+{
+    obs_params p;
+    obs_camera cam;
+    char err[OBS_ERR_LEN];
+    int added = 0;
+    obs__params_for_gbuffer(params, gb, &p);
+    int w = gb->width, h = gb->height;
+
+    /* depth: every foreground value inside 0..1 (1 included: the far
+     * plane of a normalized depth) under a metric mode */
+    long valid = 0, unit = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float v = *obs__plane_px(&gb->depth, w, x, y);
+            if (!(v > 0.0f) || v >= OBS_BACKGROUND_DEPTH || !isfinite(v))
+                continue;
+            valid++;
+            unit += v <= 1.0f; /* 1: a normalized depth's far plane */
+        }
+    if ((p.depth_mode == OBS_DEPTH_PLANAR || p.depth_mode == OBS_DEPTH_RADIAL) &&
+        valid >= MIN_PIXELS && unit == valid)
+        warn(info, &added, "depth looks normalized or inverted: all %ld foreground values "
+             "lie in 0..1 (depth_mode %s); give --depth-mode inverse, normalized or ndc if it is",
+             valid, p.depth_mode == OBS_DEPTH_RADIAL ? "radial" : "planar");
+    /* the camera against the position pass */
+    if (gb->position.data && obs__camera_resolve(gb, &p, &cam, err) == OBS_OK &&
+        cam.has_world_to_camera) {
+        double rms, maxe;
+        if (obs_camera_reprojection(gb, &gb->position, &cam, &rms, &maxe, err) == OBS_OK &&
+            !(rms <= MAX_REPROJECTION_PX))
+            warn(info, &added, "the camera disagrees with the position pass: it projects P "
+                 "%.3g px (RMS, max %.3g px) from the pixel centres", rms, maxe);
+    }
+    if (!gb->normal.data)
+        return added;
+
+    /* normals: unit length */
+    double dev = 0.0;
+    long nn = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const float *n = obs__plane_px(&gb->normal, w, x, y);
+            double l = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+            if (!(l > 0.0) || !isfinite(l))
+                continue; /* background */
+            dev += fabs(l - 1.0);
+            nn++;
+        }
+    if (nn >= MIN_PIXELS && dev / nn > UNIT_TOLERANCE)
+        warn(info, &added, "normals are not unit length: mean | |n| - 1 | is %.3g over %.0f pixels "
+             "(encoded as 0..1 colours, or not normals?)", dev / nn, (double)nn);
+
+    /* normals against the normals derived from depth */
+    if (obs__camera_resolve(gb, &p, &cam, err) != OBS_OK || cam.projection[14] != -1.0f ||
+        (p.depth_mode != OBS_DEPTH_PLANAR && p.depth_mode != OBS_DEPTH_INVERSE &&
+         p.depth_mode != OBS_DEPTH_NORMALIZED))
+        return added;
+    const float *P = cam.projection;
+    double cn = (P[15] + P[11]) / (P[10] + P[14]), cf = (P[11] - P[15]) / (P[10] - P[14]);
+    obs_normal_space other = p.normal_space == OBS_NORMALS_CAMERA ? OBS_NORMALS_WORLD
+                                                                  : OBS_NORMALS_CAMERA;
+    float *vn = view_normals(gb, cam.world_to_camera, p.normal_space);
+    float *vo = cam.has_world_to_camera ? view_normals(gb, cam.world_to_camera, other) : NULL;
+    if (!vn) {
+        free(vo);
+        return added;
+    }
+    double here = agreement(gb, P, vn, p.depth_mode, cn, cf);
+    double there = vo ? agreement(gb, P, vo, p.depth_mode, cn, cf) : -2.0;
+    obs_depth_mode alt = p.depth_mode == OBS_DEPTH_INVERSE ? OBS_DEPTH_PLANAR : OBS_DEPTH_INVERSE;
+    double inverted = agreement(gb, P, vn, alt, cn, cf);
+    if (here > -2.0 && here < AGREE_BAD) {
+        if (there >= AGREE_GOOD)
+            warn(info, &added, "normals look %s-space, not %s-space as the convention says: "
+                 "they agree with the normals derived from depth at %.2f (%.2f as given); "
+                 "give --normal-space %s if so", space_name(other), space_name(p.normal_space),
+                 there, here, space_name(other));
+        else if (inverted >= AGREE_GOOD)
+            warn(info, &added, "depth looks %s: the normals agree with the normals derived from "
+                 "it at %.2f read that way (%.2f as given); give --depth-mode %s if so",
+                 alt == OBS_DEPTH_INVERSE ? "inverse (1/Z)" : "planar", inverted, here,
+                 alt == OBS_DEPTH_INVERSE ? "inverse" : "planar");
+        else
+            warn(info, &added, "normals disagree with the normals derived from depth (mean "
+                 "cosine %.2f): check the camera, the depth mode and the normal space", here);
+    }
+    free(vn);
+    free(vo);
+    return added;
+}
