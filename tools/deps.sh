@@ -8,9 +8,11 @@ libopenexr-dev libpng-dev libcjson-dev libcmocka-dev zlib1g-dev libmicrohttpd-de
 libassimp-dev libembree-dev"
 # Only for the tests: the preview page in a real browser (Chromium; node
 # and npm fetch playwright-core), the deploy checks (systemd-analyze,
-# PyYAML).  `deps.sh --build` leaves them out (deploy/container).
+# PyYAML), oiiotool (tests/e2e/output.sh reads obscura's EXRs back with
+# OpenImageIO), python3 (the Python client's tests).  `deps.sh --build`
+# leaves them out (deploy/container).
 if [ "${1:-}" != "--build" ]; then
-    PKGS="$PKGS chromium nodejs python3-yaml systemd"
+    PKGS="$PKGS chromium nodejs python3-yaml systemd openimageio-tools python3"
     command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
 fi
 
