@@ -7,7 +7,8 @@ its folder on sys.path, in the Python of Nuke, Houdini, Maya or Blender.
     oc.ao("frame.exr", server="unix:/run/obscurad.sock", append=1, layer="occ",
           out="frame.ao.exr")
 
-Servers: http://HOST:PORT (the HTTP API, POST /v1/ao), unix:/PATH and
+Servers: http://HOST:PORT (the HTTP API, POST /v1/ao, through http.client,
+on which urllib.request runs), unix:/PATH and
 tcp://HOST:PORT (the binary protocol, protocol/PROTOCOL.md).  Parameters
 are the daemon's query parameters (GET /v1/params): the parameter table
 (radius, samples, fov_y, world_to_camera, ...) and the request options
@@ -23,13 +24,12 @@ an unreachable daemon raises ObscuraError with code "unreachable".
 
 Works with Python 3.6 and later.
 """
+import http.client
 import json
 import os
 import socket
 import struct
-import urllib.error
 import urllib.parse
-import urllib.request
 
 __all__ = ["ao", "ObscuraError", "DEFAULT_SERVER"]
 __version__ = "1.0.0"
@@ -169,26 +169,44 @@ def _http_error(status, body):
 
 
 def _ao_http(server, src, params, token, sink, timeout):
-    url = server.rstrip("/") + "/v1/ao?" + urllib.parse.urlencode(params)
-    req = urllib.request.Request(url, data=src.body(), method="POST")
-    req.add_header("Content-Type", "image/x-exr")
-    req.add_header("Content-Length", str(src.size))
-    if token:
-        req.add_header("Authorization", "Bearer " + token)
+    # http.client (what urllib.request runs on) rather than urlopen: the
+    # daemon refuses a bad request before it reads the body and closes,
+    # and the answer must still be read after the send breaks off.
+    u = urllib.parse.urlsplit(server)
+    path = (u.path.rstrip("/") or "") + "/v1/ao?" + urllib.parse.urlencode(params)
+    conn = http.client.HTTPConnection(u.hostname or "127.0.0.1", u.port or 80, timeout=timeout)
     try:
-        resp = urllib.request.urlopen(req, timeout=timeout)
-    except urllib.error.HTTPError as e:
-        code, msg = _http_error(e.code, e.read())
-        retry = e.headers.get("Retry-After") if e.headers else None
-        raise ObscuraError(e.code, code, msg, int(retry) if retry and retry.isdigit() else 0)
-    except (urllib.error.URLError, OSError) as e:
-        raise ObscuraError(None, "unreachable", "%s: %s" % (server, getattr(e, "reason", e)))
-    with resp:
+        try:
+            conn.putrequest("POST", path)
+            conn.putheader("Content-Type", "image/x-exr")
+            conn.putheader("Content-Length", str(src.size))
+            if token:
+                conn.putheader("Authorization", "Bearer " + token)
+            conn.endheaders()
+        except OSError as e:
+            raise ObscuraError(None, "unreachable", "%s: %s" % (server, e))
+        try:
+            for b in src.chunks():
+                conn.send(b)
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # refused before the body was read: the answer says why
+        try:
+            resp = conn.getresponse()
+        except (OSError, http.client.HTTPException) as e:
+            raise ObscuraError(None, "unreachable", "%s: no answer: %s" % (server, e))
+        if resp.status != 200:
+            code, msg = _http_error(resp.status, resp.read())
+            retry = resp.getheader("Retry-After")
+            raise ObscuraError(resp.status, code, msg, int(retry) if retry and retry.isdigit() else 0)
         while True:
             b = resp.read(CHUNK)
             if not b:
                 break
             sink.write(b)
+    except socket.timeout:
+        raise ObscuraError(None, "unreachable", "%s: no answer within %s s" % (server, timeout))
+    finally:
+        conn.close()
 
 
 def _connect(server, timeout):
