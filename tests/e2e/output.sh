@@ -112,8 +112,8 @@ check "multi-part input: exit $rc, both parts, the AO added to the second (the o
      oiiotool --info -a '$T/multiapp.exr' 2>&1 | grep -q 'subimage  1: *224 x  144, 5 channel'"
 
 echo "-- over HTTP and the binary protocol"
-start d --tcp 127.0.0.1:0
-TP=$(sed -n 's/.*binary protocol on tcp:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$T/d.log")
+start_all d
+TP=$TCP_d
 Q="fov_y=50&near=0.05&far=100&world_to_camera=$(echo "$W2C" | sed 's/,/%2C/g')&radius=0.05"
 code=$(post "$PORT_d" "append=1&layer=occ&$Q" "$T/crop.exr" "$T/happ.exr")
 check "POST append=1&layer=occ: $code, the input's channels plus occ.Y" \

@@ -15,7 +15,6 @@ OBSCURAD=${OBSCURAD:-build/obscurad}
 DATA=tests/data
 R="$DATA/room_small.exr"
 . tests/e2e/lib/common.sh
-PID=""
 
 echo "e2e python client: $OBSCURAD"
 if ! command -v python3 >/dev/null 2>&1; then
@@ -25,20 +24,8 @@ fi
 W2C=$(tr -d ' \n' < "$DATA/room_small.camera.json" |
     sed 's/.*"world_to_camera":\[\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\]\].*/\1,\2,\3,\4/')
 CAM_CLI="--fov-y 50 --near 0.05 --far 100 --world-to-camera $W2C"
-SOCK="$T/obscurad.sock"
-
-"$OBSCURAD" --http 127.0.0.1:0 --socket "$SOCK" --tcp 127.0.0.1:0 --max-body 8m --queue 4 2>"$T/d.log" &
-PID=$!
-i=0; HP=""; TP=""
-while [ $i -lt 300 ] && { [ -z "$HP" ] || [ -z "$TP" ]; }; do
-    HP=$(sed -n 's/.*listening on http:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$T/d.log")
-    TP=$(sed -n 's/.*binary protocol on tcp:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$T/d.log")
-    kill -0 "$PID" 2>/dev/null || break
-    sleep 0.1
-    i=$((i + 1))
-done
-if [ -n "$HP" ] && [ -n "$TP" ] && [ -S "$SOCK" ]; then ok "obscurad on http :$HP, tcp :$TP and unix:$SOCK"; else
-    bad "obscurad did not start"; tail -5 "$T/d.log"; exit 1; fi
+start_all d --max-body 8m --queue 4
+HP=$PORT_d TP=$TCP_d SOCK=$SOCK_d
 
 # py ARGS...: the client's folder on sys.path by hand, nothing else
 cat > "$T/run.py" <<'EOF'
@@ -124,9 +111,8 @@ check "the Blender example compiles, and imports only the standard library, bpy 
     "python3 -I -m py_compile clients/python/examples/blender_post_render.py &&
      ! grep -E '^(import|from) ' clients/python/examples/blender_post_render.py | grep -vqE '^(import|from) (bpy|os|sys|obscura_client)\\b'"
 
-kill "$PID" 2>/dev/null
-wait "$PID" 2>/dev/null
-PID=""
+kill "$PID_d" 2>/dev/null
+wait "$PID_d" 2>/dev/null
 [ $failed -ne 0 ] && tail -20 "$T/d.log" | sed 's/^/       /'
 echo "e2e python client: $pass passed, $failed failed"
 [ "$failed" -eq 0 ]
