@@ -75,8 +75,11 @@ static obs_status decode_native(exr_const_context_t ctx, int part, const obs__wp
                 rv = EXR_ERR_INVALID_ARGUMENT;
                 break;
             }
-            size_t off = (size_t)((int64_t)ci.start_y - p->dw.min.y) * (size_t)t->line_stride +
-                         (size_t)((int64_t)ci.start_x - p->dw.min.x) * (size_t)t->pixel_stride;
+            /* a tile's start_x/start_y are its tile indices, a
+             * scanline chunk's its first pixel */
+            int64_t x0 = storage == EXR_STORAGE_TILED ? (i % ntx) * (int64_t)tw : 0;
+            int64_t y0 = storage == EXR_STORAGE_TILED ? (i / ntx) * (int64_t)th : (int64_t)ci.start_y - p->dw.min.y;
+            size_t off = (size_t)y0 * (size_t)t->line_stride + (size_t)x0 * (size_t)t->pixel_stride;
             ch->decode_to_ptr = (uint8_t *)(uintptr_t)(t->base + off);
             ch->user_pixel_stride = t->pixel_stride;
             ch->user_line_stride = t->line_stride;
