@@ -3,7 +3,7 @@ Python standard library (no pip needed): copy it next to a script, or put
 its folder on sys.path, in the Python of Nuke, Houdini, Maya or Blender.
 
     import obscura_client as oc
-    exr = oc.ao("frame.exr", server="http://127.0.0.1:8080", radius=0.5)
+    exr = oc.ao("frame.exr", server="http://127.0.0.1:8420", radius=0.5)
     oc.ao("frame.exr", server="unix:/run/obscurad.sock", append=1, layer="occ",
           out="frame.ao.exr")
 
@@ -34,7 +34,7 @@ import urllib.parse
 __all__ = ["ao", "ObscuraError", "DEFAULT_SERVER"]
 __version__ = "1.0.0"
 
-DEFAULT_SERVER = "http://127.0.0.1:8080"
+DEFAULT_SERVER = "http://127.0.0.1:8420"
 CHUNK = 1 << 16
 
 # protocol/PROTOCOL.md: frame header and body kinds
@@ -291,7 +291,7 @@ def ao(source, server=None, out=None, token=None, timeout=300, **params):
 
     source: a path (streamed from disk), bytes, or a binary file object.
     server: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT (default: the
-    OBSCURA_SERVER environment variable, else http://127.0.0.1:8080).
+    OBSCURA_SERVER environment variable, else http://127.0.0.1:8420).
     out: a path or a binary file object to stream the answer into (a
     path is written whole or not at all); then None is returned.
     token: the bearer token (default: OBSCURA_TOKEN).

@@ -131,7 +131,7 @@ check "POST deep with append=1: $code unsupported" "[ '$code' = 415 ] && error_i
 code=$(post "$PORT_d" "layer=a%01b&$Q" "$T/crop.exr" "$T/e4.json")
 check "POST layer with a control character: $code bad_parameter" "[ '$code' = 400 ] && error_is '$T/e4.json' bad_parameter"
 if [ -n "$TP" ]; then
-    PYTHONPATH=clients/python python3 -I -c '
+    python3 -I -B -c '
 import sys; sys.path.insert(0, "clients/python")
 import obscura_client as oc
 p = dict(fov_y=50, near=0.05, far=100, world_to_camera=sys.argv[3], radius=0.05, append=1, layer="occ")

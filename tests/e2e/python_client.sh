@@ -65,7 +65,7 @@ except oc.ObscuraError as e:
 open(out, "wb").write(data)
 print("ok %d bytes" % len(data))
 EOF
-py() { python3 -I "$T/run.py" "$@"; }
+py() { python3 -I -B "$T/run.py" "$@"; }
 
 echo "-- the same bytes as the CLI, over every transport"
 # shellcheck disable=SC2086
@@ -108,7 +108,7 @@ check "pyproject.toml names the module it packages" \
     "python3 -I -c 'import sys, tomllib; d = tomllib.load(open(\"clients/python/pyproject.toml\", \"rb\")); sys.exit(d[\"tool\"][\"setuptools\"][\"py-modules\"] != [\"obscura_client\"])' 2>/dev/null ||
      grep -q 'py-modules = \[\"obscura_client\"\]' clients/python/pyproject.toml"
 check "the Blender example compiles, and imports only the standard library, bpy and the client" \
-    "python3 -I -m py_compile clients/python/examples/blender_post_render.py &&
+    "python3 -I -B -c \"import ast, sys; ast.parse(open(sys.argv[1]).read())\" clients/python/examples/blender_post_render.py &&
      ! grep -E '^(import|from) ' clients/python/examples/blender_post_render.py | grep -vqE '^(import|from) (bpy|os|sys|obscura_client)\\b'"
 
 kill "$PID_d" 2>/dev/null

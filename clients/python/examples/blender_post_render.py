@@ -15,7 +15,7 @@ Blender's EXRs carry no camera matrices, so the scene camera goes with
 the request: its vertical field of view, clip range and world-to-camera
 matrix.
 Settings come from the environment: OBSCURA_SERVER (default
-http://127.0.0.1:8080; unix:/PATH or tcp://HOST:PORT for the binary
+http://127.0.0.1:8420; unix:/PATH or tcp://HOST:PORT for the binary
 protocol), OBSCURA_TOKEN, OBSCURA_CLIENT (the folder holding
 obscura_client.py, default: this file's parent folder).
 """
@@ -28,7 +28,7 @@ HERE = os.path.dirname(os.path.abspath(__file__)) if "__file__" in globals() els
 sys.path.insert(0, os.environ.get("OBSCURA_CLIENT", os.path.dirname(HERE)))
 import obscura_client  # noqa: E402  (after sys.path)
 
-SERVER = os.environ.get("OBSCURA_SERVER", "http://127.0.0.1:8080")
+SERVER = os.environ.get("OBSCURA_SERVER", "http://127.0.0.1:8420")
 APPEND = False
 LAYER = "AO"
 PARAMS = {"radius": 0.5}
