@@ -277,8 +277,9 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
     exr_pixel_type_t type = o->pixel == OBS_EXR_FLOAT ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
     const int w = layers[0].image->width, h = layers[0].image->height;
 
+    /* the input in memory: the read context points at it until the end */
+    obs__exr_mem m = {o->src ? o->src->buf : NULL, o->src ? o->src->len : 0};
     if (o->src) {
-        obs__exr_mem m = {o->src->buf, o->src->len};
         if (!o->src->path && (!o->src->buf || !o->src->len)) {
             st = obs__fail(sub, OBS_INVALID_ARGUMENT, "the input is neither a file nor bytes");
             goto fail;

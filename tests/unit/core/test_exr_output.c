@@ -436,6 +436,20 @@ static void test_append_parts(void **state)
         fail_msg("%s", err);
     check_unchanged(in, out);
 
+    /* from the input in memory (the daemon's way): the same bytes */
+    size_t len, flen;
+    unsigned char *buf = obs_test_slurp(in, &len), *file = obs_test_slurp(out, &flen);
+    obs_exr_source msrc = {.buf = buf, .len = len, .part = 1};
+    obs_exr_options mo = {.pixel = OBS_EXR_FLOAT, .src = &msrc, .append = 1};
+    obs_bytes mem;
+    if (obs_exr_write_ex_mem(&l, 1, &mo, &mem, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_int_equal(mem.size, flen);
+    assert_memory_equal(mem.data, file, flen);
+    obs_bytes_free(&mem);
+    free(buf);
+    free(file);
+
     exr_context_t a = open_exr(in), b = open_exr(out);
     static const char *const layout[] = {"channels", "compression", "dataWindow", "displayWindow",
                                          "lineOrder", "tiles", "chunkCount", "type", NULL};
