@@ -274,7 +274,7 @@ static int run_frame(frame *f, obs_bin_request *q)
         obs_status s = obsd_fp_decode(&fp, q->exr, q->exr_len, &q->hr.map, &lim, NULL, err);
         f->ms_decode = fp.ms_decode;
         if (s == OBS_OK && !q->raw_out && q->hr.format == OBS_HTTP_EXR)
-            obsd_fp_keep_source(&fp, q->exr, q->exr_len); /* the answer takes its header */
+            obsd_fp_keep_source(&fp, q->exr, q->exr_len, obsd_fp_part(&fp)); /* the answer takes its header */
         if (s != OBS_OK) {
             rc = send_status(f, s, err);
             goto done;

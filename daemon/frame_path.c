@@ -45,10 +45,16 @@ obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len, co
     return s;
 }
 
-void obsd_fp_keep_source(obsd_fp *fp, const unsigned char *body, size_t len)
+void obsd_fp_keep_source(obsd_fp *fp, const unsigned char *body, size_t len, int part)
 {
     fp->src = body;
     fp->src_len = len;
+    fp->src_part = part;
+}
+
+int obsd_fp_part(const obsd_fp *fp)
+{
+    return fp->deep == &fp->deep_exr ? fp->deep_exr.part : fp->gb == &fp->gf.gb ? fp->gf.info.part : 0;
 }
 
 obs_status obsd_fp_check_output(const obsd_fp *fp, const obs_http_request *hr, char err[OBS_ERR_LEN])
@@ -56,7 +62,8 @@ obs_status obsd_fp_check_output(const obsd_fp *fp, const obs_http_request *hr, c
     if (!hr->append)
         return OBS_OK;
     if (!fp->src) {
-        snprintf(err, OBS_ERR_LEN, "append=1 needs the frame as an EXR body: its parts and channels are written back");
+        snprintf(err, OBS_ERR_LEN, "append=1 writes the input EXR back with the AO added: it needs the frame as an "
+                 "EXR body (raw planes have no input file to write back)");
         return OBS_INVALID_ARGUMENT;
     }
     if (fp->deep) {
@@ -189,8 +196,7 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
         obs_exr_layer layers[OBS_RESULT_LAYERS];
         obs_exr_names names;
         int n = exr_layers(im, &flat, &deep, layers);
-        obs_exr_source src = {.buf = fp->src, .len = fp->src_len,
-                              .part = fp->deep ? fp->deep->part : fp->gf.info.part};
+        obs_exr_source src = {.buf = fp->src, .len = fp->src_len, .part = fp->src_part};
         obs_exr_options o = {.pixel = hr->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam,
                              .src = fp->src ? &src : NULL, .append = hr->append};
         if (hr->layer)

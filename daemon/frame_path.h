@@ -30,6 +30,7 @@ typedef struct obsd_fp {
      * encode: obsd_fp_keep_source()), or NULL */
     const unsigned char *src;
     size_t src_len;
+    int src_part;             /* its part the input was read from */
     obsd_job job;             /* its result is owned until obsd_fp_free() */
     double ms_decode, ms_queue, ms_gl, ms_encode;
     /* the way back from the GL worker */
@@ -60,10 +61,12 @@ void obsd_fp_free(obsd_fp *fp);
  * Sizes are checked against lim.  Sets ms_decode either way. */
 obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len, const obs_channel_map *map,
                           const obs_limits *lim, const char *no_deep, char err[OBS_ERR_LEN]);
-/* The EXR body the input was decoded from, which the caller keeps until
- * the encode: the answer takes its windows and header attributes, and
- * append=1 writes it back with the AO added. */
-void obsd_fp_keep_source(obsd_fp *fp, const unsigned char *body, size_t len);
+/* The EXR body the input was decoded from (its part `part`), which the
+ * caller keeps until the encode: the answer takes its windows and header
+ * attributes, and append=1 writes it back with the AO added. */
+void obsd_fp_keep_source(obsd_fp *fp, const unsigned char *body, size_t len, int part);
+/* The part of the decoded EXR the input was read from (0 for planes). */
+int obsd_fp_part(const obsd_fp *fp);
 /* Refuses, before the frame runs, what the encode could not do for hr:
  * append=1 without an EXR body kept, or with deep input. */
 obs_status obsd_fp_check_output(const obsd_fp *fp, const obs_http_request *hr, char err[OBS_ERR_LEN]);

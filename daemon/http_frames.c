@@ -226,10 +226,11 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
                                   r->op == STREAM_POST ? "deep EXR input runs on POST /v1/ao, not in streams"
                                                        : NULL,
                                   err);
-    /* /v1/ao's EXR answer takes the body's header (its windows and
-     * attributes; append=1: the body itself): kept until the answer */
-    if (s == OBS_OK && r->op == STREAM_NONE && r->hr.format == OBS_HTTP_EXR)
-        obsd_fp_keep_source(&r->fp, body, len);
+    /* An EXR answer takes the body's header (its windows and attributes;
+     * append=1: the body itself), which lives until the answer: r->body,
+     * freed with the request, or a stream frame's, which it holds. */
+    if (s == OBS_OK && r->hr.format == OBS_HTTP_EXR)
+        obsd_fp_keep_source(&r->fp, body, len, obsd_fp_part(&r->fp));
     if (s == OBS_OK)
         s = obsd_fp_check_output(&r->fp, &r->hr, err);
     if (s != OBS_OK)

@@ -142,6 +142,20 @@ oc.ao(sys.argv[1], server="tcp://127.0.0.1:" + sys.argv[2], out=sys.argv[4], **p
 else
     bad "the daemon's binary port was not found in its log"
 fi
+"$OBSCURA" ao "$T/crop.exr" --camera "$CAMJ" --radius 0.05 -q --append --layer occ -o "$T/lapp.exr"
+for url in "http://127.0.0.1:$PORT_d" "tcp://127.0.0.1:$TP"; do
+    "$OBSCURA" ao "$T/crop.exr" --camera "$CAMJ" --radius 0.05 -q --append --layer occ --server "$url" -o "$T/rapp.exr"
+    rc=$?
+    check "obscura ao --append --server ${url%%:*}: exit $rc, the in-process file's bytes" \
+        "[ $rc -eq 0 ] && cmp -s '$T/lapp.exr' '$T/rapp.exr'"
+done
+code=$($CURL -o "$T/sapp.exr" -w '%{http_code}' -H 'Content-Type: image/x-exr' --data-binary @"$T/crop.exr" \
+    "http://127.0.0.1:$PORT_d/v1/streams/s/frames?append=1&layer=occ&$Q")
+check "a stream frame posted with append=1&layer=occ: $code, the same bytes as POST /v1/ao's" \
+    "[ '$code' = 200 ] && cmp -s '$T/happ.exr' '$T/sapp.exr'"
+code=$(get "$PORT_d" "/v1/streams/s/frames/latest?append=0&layer=k" "$T/kept.exr")
+check "the kept frame with append=0&layer=k (the post had append=1): $code, the crop's windows, k.Y" \
+    "[ '$code' = 200 ] && [ \"\$(windows '$T/crop.exr')\" = \"\$(windows '$T/kept.exr')\" ] && [ \"\$(channels '$T/kept.exr')\" = k.Y ]"
 kill "$PID_d" 2>/dev/null
 wait "$PID_d" 2>/dev/null
 
