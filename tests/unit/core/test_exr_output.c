@@ -192,6 +192,26 @@ static const in_part cropped = {.storage = EXR_STORAGE_SCANLINE, .x0 = 3, .y0 = 
                                 .dx0 = -2, .dy0 = -1, .dx1 = 29, .dy1 = 19, .comp = EXR_COMPRESSION_ZIP, .nch = 2,
                                 .ch = {"Z", "N.X"}, .type = {EXR_PIXEL_FLOAT, EXR_PIXEL_HALF}};
 
+/* obs_exr_write_ex_mem() with the input `in` in memory, the options
+ * otherwise `o`'s: the bytes of the file `out` written with `o`. */
+static void same_from_memory(const char *in, const char *out, const obs_exr_layer *l, const obs_exr_options *o)
+{
+    size_t len, flen;
+    char err[OBS_ERR_LEN] = "";
+    unsigned char *buf = obs_test_slurp(in, &len), *file = obs_test_slurp(out, &flen);
+    obs_exr_source msrc = {.buf = buf, .len = len, .part = o->src->part};
+    obs_exr_options mo = *o;
+    obs_bytes mem;
+    mo.src = &msrc;
+    if (obs_exr_write_ex_mem(l, 1, &mo, &mem, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_int_equal(mem.size, flen);
+    assert_memory_equal(mem.data, file, flen);
+    obs_bytes_free(&mem);
+    free(buf);
+    free(file);
+}
+
 /* ---- plain output ------------------------------------------------------- */
 
 static void test_windows_from_options(void **state)
@@ -312,24 +332,13 @@ static void test_source_header(void **state)
     exr_finish(&b);
 
     /* the memory writer, from the input in memory: the same bytes */
-    size_t len, flen;
-    unsigned char *buf = obs_test_slurp(in, &len), *file = obs_test_slurp(out, &flen);
-    obs_exr_source msrc = {.buf = buf, .len = len, .part = 0};
-    obs_exr_options mo = {.cam = &cam, .src = &msrc};
-    obs_bytes mem;
-    if (obs_exr_write_ex_mem(&l, 1, &mo, &mem, err) != OBS_OK)
-        fail_msg("%s", err);
-    assert_int_equal(mem.size, flen);
-    assert_memory_equal(mem.data, file, flen);
-    obs_bytes_free(&mem);
+    same_from_memory(in, out, &l, &o);
 
     /* an image of another size than the input's data window is refused */
     obs_image small = {9, 8, 1, img.data};
     obs_exr_layer ls = {&small, names};
     assert_int_equal(obs_exr_write_ex(out, &ls, 1, &o, err), OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "data window"));
-    free(buf);
-    free(file);
     free(img.data);
 }
 
@@ -437,18 +446,7 @@ static void test_append_parts(void **state)
     check_unchanged(in, out);
 
     /* from the input in memory (the daemon's way): the same bytes */
-    size_t len, flen;
-    unsigned char *buf = obs_test_slurp(in, &len), *file = obs_test_slurp(out, &flen);
-    obs_exr_source msrc = {.buf = buf, .len = len, .part = 1};
-    obs_exr_options mo = {.pixel = OBS_EXR_FLOAT, .src = &msrc, .append = 1};
-    obs_bytes mem;
-    if (obs_exr_write_ex_mem(&l, 1, &mo, &mem, err) != OBS_OK)
-        fail_msg("%s", err);
-    assert_int_equal(mem.size, flen);
-    assert_memory_equal(mem.data, file, flen);
-    obs_bytes_free(&mem);
-    free(buf);
-    free(file);
+    same_from_memory(in, out, &l, &o);
 
     exr_context_t a = open_exr(in), b = open_exr(out);
     static const char *const layout[] = {"channels", "compression", "dataWindow", "displayWindow",
