@@ -102,6 +102,11 @@ check "--append onto a file that has occ.Y: refused (exit $rc), naming the chann
 rc=$?
 check "deep input with --append: refused (exit $rc): $(head -c 100 "$T/err")" \
     "[ $rc -ne 0 ] && grep -q 'deep' '$T/err' && [ ! -e '$T/deep.exr' ]"
+cp "$T/crop.exr" "$T/inplace.exr"
+"$OBSCURA" ao "$T/inplace.exr" --camera "$CAMJ" --cpu --radius 0.05 -q --append --layer occ -o "$T/inplace.exr"
+rc=$?
+check "--append onto the input itself (-o the same file): exit $rc, the same file as to another path" \
+    "[ $rc -eq 0 ] && cmp -s '$T/inplace.exr' '$T/app.exr'"
 # a multi-part input: every part kept, the AO in the part read
 oiiotool "$T/crop.exr" --ch ViewLayer.Combined.R,ViewLayer.Combined.G,ViewLayer.Combined.B "$T/crop.exr" \
     --ch ViewLayer.Depth.Z,ViewLayer.Normal.X,ViewLayer.Normal.Y,ViewLayer.Normal.Z --siappend -o "$T/multi.exr" 2>/dev/null
