@@ -1,6 +1,7 @@
 /* The header attributes of an input EXR carried into an output part:
  * every attribute of any type, except those that describe the pixels
  * of the part the writer lays out itself. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "io/exr_internal.h"
@@ -49,13 +50,16 @@ static exr_result_t copy_one(exr_context_t out, int part, const exr_attribute_t 
     case EXR_ATTR_STRING: return exr_attr_set_string(out, part, n, a->string->str ? a->string->str : "");
     case EXR_ATTR_STRING_VECTOR: {
         const exr_attr_string_vector_t *sv = a->stringvector;
-        enum { MAX_STRINGS = 256 };
-        const char *strs[MAX_STRINGS];
-        if (sv->n_strings < 0 || sv->n_strings > MAX_STRINGS)
+        if (sv->n_strings < 0)
             return EXR_ERR_INVALID_ATTR;
+        const char **strs = malloc(((size_t)sv->n_strings + 1) * sizeof *strs);
+        if (!strs)
+            return EXR_ERR_OUT_OF_MEMORY;
         for (int i = 0; i < sv->n_strings; i++)
             strs[i] = sv->strings[i].str ? sv->strings[i].str : "";
-        return exr_attr_set_string_vector(out, part, n, sv->n_strings, strs);
+        exr_result_t rv = exr_attr_set_string_vector(out, part, n, sv->n_strings, strs);
+        free(strs);
+        return rv;
     }
     case EXR_ATTR_TILEDESC: return exr_attr_set_tiledesc(out, part, n, a->tiledesc);
     case EXR_ATTR_TIMECODE: return exr_attr_set_timecode(out, part, n, a->timecode);
