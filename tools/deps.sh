@@ -9,10 +9,11 @@ libassimp-dev libembree-dev"
 # Only for the tests: the preview page in a real browser (Chromium; node
 # and npm fetch playwright-core), the deploy checks (systemd-analyze,
 # PyYAML), oiiotool (tests/e2e/output.sh reads obscura's EXRs back with
-# OpenImageIO), python3 (the Python client's tests).  `deps.sh --build`
+# OpenImageIO), python3 with pip and wheel (the Python client's tests,
+# pip install clients/python offline).  `deps.sh --build`
 # leaves them out (deploy/container).
 if [ "${1:-}" != "--build" ]; then
-    PKGS="$PKGS chromium nodejs python3-yaml systemd openimageio-tools python3"
+    PKGS="$PKGS chromium nodejs python3-yaml systemd openimageio-tools python3 python3-pip python3-wheel"
     command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
 fi
 

@@ -111,6 +111,31 @@ check "the Blender example compiles, and imports only the standard library, bpy 
     "python3 -I -B -c \"import ast, sys; ast.parse(open(sys.argv[1]).read())\" clients/python/examples/blender_post_render.py &&
      ! grep -E '^(import|from) ' clients/python/examples/blender_post_render.py | grep -vqE '^(import|from) (bpy|os|sys|obscura_client)\\b'"
 
+# pip install clients/python, offline (--no-build-isolation: the
+# setuptools and wheel already there), into a folder of its own; with the
+# first python3 that has pip, setuptools and wheel (Debian: python3-pip,
+# python3-wheel)
+PIPPY=""
+for p in python3 /usr/bin/python3; do
+    if "$p" -c 'import setuptools, wheel, pip' 2>/dev/null; then PIPPY=$p; break; fi
+done
+if [ -n "$PIPPY" ]; then
+    cp -r clients/python "$T/pkg"
+    rm -rf "$T/pkg/build" "$T/pkg/"*.egg-info
+    "$PIPPY" -m pip install -q --no-build-isolation --no-deps --no-index --target "$T/site" "$T/pkg" >"$T/pip.log" 2>&1
+    rc=$?
+    "$PIPPY" -I -B -c 'import sys; sys.path.insert(0, sys.argv[1]); import obscura_client as oc
+assert oc.__file__.startswith(sys.argv[1]), oc.__file__
+open(sys.argv[4], "wb").write(oc.ao(sys.argv[2], server=sys.argv[3], fov_y=50, near=0.05, far=100,
+                                    world_to_camera=sys.argv[5]))' "$T/site" "$R" "tcp://127.0.0.1:$TP" "$T/pip.exr" "$W2C" \
+        >>"$T/pip.log" 2>&1
+    check "pip install clients/python ($PIPPY): exit $rc, the installed module gives the CLI's bytes" \
+        "[ $rc -eq 0 ] && cmp -s '$T/cli.exr' '$T/pip.exr'"
+    [ -e "$T/pip.exr" ] || sed 's/^/       /' "$T/pip.log" | tail -5
+else
+    echo "  skip pip install: no python3 with pip, setuptools and wheel (Debian python3-pip, python3-wheel)"
+fi
+
 kill "$PID_d" 2>/dev/null
 wait "$PID_d" 2>/dev/null
 [ $failed -ne 0 ] && tail -20 "$T/d.log" | sed 's/^/       /'
