@@ -243,6 +243,28 @@ static void parse_ao(int argc, char **argv, ao_args *a)
         else
             die_usage("cannot tell the format of '%s': use .exr or .png, or --format", a->out);
     }
+    if (a->req.format != OBS_HTTP_EXR && (a->req.append || a->req.layer))
+        die_usage("--%s names the channels of an EXR: the output '%s' is a PNG", a->req.append ? "append" : "layer",
+                  a->out);
+    obs_exr_names names;
+    if (a->req.layer && obs_exr_layers_rename(NULL, 0, a->req.layer, &names, err) != OBS_OK)
+        die_usage("--layer: %s", err);
+}
+
+/* An EXR of `obscura ao`: the input's windows and header attributes
+ * kept (from part `part`, the one read), under --layer's names, the
+ * input itself with the AO added under --append. */
+static obs_status write_exr_out(const ao_args *a, obs_exr_layer *layers, int n, const obs_camera *cam, int part,
+                                char err[OBS_ERR_LEN])
+{
+    obs_exr_source src = {.path = a->in, .part = part};
+    obs_exr_options o = {.pixel = a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam, .src = &src,
+                         .append = a->req.append};
+    obs_exr_names names;
+    obs_status s = OBS_OK;
+    if (a->req.layer && (s = obs_exr_layers_rename(layers, n, a->req.layer, &names, err)) != OBS_OK)
+        return s;
+    return obs_exr_write_ex(a->out, layers, n, &o, err);
 }
 
 /* "dir/out.png" + "ao" -> "dir/out.ao.png" */
@@ -270,14 +292,14 @@ static obs_status count_scaled(const obs_image *count, obs_image *out)
     return OBS_OK;
 }
 
-static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs_camera *cam,
+static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs_camera *cam, int part,
                                 char err[OBS_ERR_LEN])
 {
     obs_status s = OBS_OK;
     if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[OBS_RESULT_LAYERS];
         int n = obs_result_exr_layers(r, layers);
-        s = obs_exr_write(a->out, layers, n, a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
+        s = write_exr_out(a, layers, n, cam, part, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
         return s;
@@ -366,6 +388,11 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
 
     if (a->camera)
         die_usage("ao: deep input takes the camera from the EXR header or --fov-y");
+    if (a->req.append) {
+        snprintf(err, OBS_ERR_LEN, "--append: the input is a deep EXR; appending the AO to a deep file is not "
+                 "supported (write the AO on its own, without --append)");
+        return cli_fail(OBS_UNSUPPORTED, a->in, err);
+    }
     double t0 = now_ms();
     if ((s = obs_deep_read_exr(a->in, lim, &d, err)) != OBS_OK)
         return cli_input_fail(s, a->in, err);
@@ -401,7 +428,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[3];
         int n = obs_deep_result_exr_layers(&r, a->req.outputs, layers);
-        s = obs_exr_write(a->out, layers, n, a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, err);
+        s = write_exr_out(a, layers, n, cam, d.part, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
     } else {
@@ -531,7 +558,7 @@ static int cmd_ao(int argc, char **argv)
     double t_run = now_ms() - t0;
 
     t0 = now_ms();
-    s = write_outputs(&a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, err);
+    s = write_outputs(&a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part, err);
     if (s != OBS_OK) {
         rc = cli_fail(s, a.out, err);
         goto done;

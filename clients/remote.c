@@ -8,6 +8,7 @@
 #include <netdb.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -224,7 +225,11 @@ static void collect(int argc, char **argv, int map_too, pairs *ps, char names[][
         snprintf(name, OBS_BIN_MAX_NAME + 1, "%.*s", (int)n, a + 2);
         int is_map = 0;
         for (const obs_http_option *op = obs_http_options; op->name; op++)
-            is_map |= op->kind == OBS_HTTP_OPT_NAMES && !strcmp(name, op->name);
+            /* the channel map's rows only: layer= and append= are this
+             * client's, which writes the answer itself */
+            is_map |= op->kind == OBS_HTTP_OPT_NAMES && op->map >= offsetof(obs_http_request, map) &&
+                      op->map < offsetof(obs_http_request, map) + sizeof(obs_channel_map) &&
+                      !strcmp(name, op->name);
         int is_param = obs_param_find(name) != NULL;
         /* the switches that change how the daemon reads the frame
          * (strict, solve_camera) go as name=1; float is the client's */

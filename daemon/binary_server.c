@@ -273,12 +273,19 @@ static int run_frame(frame *f, obs_bin_request *q)
         /* a deep EXR runs the deep chain, as on POST /v1/ao */
         obs_status s = obsd_fp_decode(&fp, q->exr, q->exr_len, &q->hr, &lim, NULL, err);
         f->ms_decode = fp.ms_decode;
+        if (s == OBS_OK && !q->raw_out && q->hr.format == OBS_HTTP_EXR)
+            obsd_fp_keep_source(&fp, q->exr, q->exr_len, obsd_fp_part(&fp)); /* the answer takes its header */
         if (s != OBS_OK) {
             rc = send_status(f, s, err);
             goto done;
         }
     } else {
         obsd_fp_use(&fp, &q->gf.gb, q->body == OBS_BIN_DEEP ? &q->deep : NULL);
+    }
+    obs_status cs = obsd_fp_check_output(&fp, &q->hr, err);
+    if (cs != OBS_OK) {
+        rc = send_status(f, cs, err);
+        goto done;
     }
     if (atomic_load(&b->draining) ||
         obsd_fp_queue(&fp, b->queue, &q->hr.params, q->hr.outputs, NULL, NULL) != 0) {
@@ -321,7 +328,9 @@ static int run_frame(frame *f, obs_bin_request *q)
     } else {
         d.body = q->hr.format == OBS_HTTP_EXR ? OBS_BIN_EXR : OBS_BIN_PNG;
     }
-    rc = s != OBS_OK ? send_error(f, 500, "encode_failed", err) : send_response(f, &d);
+    rc = s == OBS_INVALID_ARGUMENT || s == OBS_UNSUPPORTED ? send_status(f, s, err)
+         : s != OBS_OK                                      ? send_error(f, 500, "encode_failed", err)
+                                                            : send_response(f, &d);
     obs_bytes_free(&blob);
 done:
     obsd_fp_free(&fp);

@@ -60,6 +60,35 @@ obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
     return s;
 }
 
+void obsd_fp_keep_source(obsd_fp *fp, const unsigned char *body, size_t len, int part)
+{
+    fp->src = body;
+    fp->src_len = len;
+    fp->src_part = part;
+}
+
+int obsd_fp_part(const obsd_fp *fp)
+{
+    return fp->deep == &fp->deep_exr ? fp->deep_exr.part : fp->gb == &fp->gf.gb ? fp->gf.info.part : 0;
+}
+
+obs_status obsd_fp_check_output(const obsd_fp *fp, const obs_http_request *hr, char err[OBS_ERR_LEN])
+{
+    if (!hr->append)
+        return OBS_OK;
+    if (!fp->src) {
+        snprintf(err, OBS_ERR_LEN, "append=1 writes the input EXR back with the AO added: it needs the frame as an "
+                 "EXR body (raw planes have no input file to write back)");
+        return OBS_INVALID_ARGUMENT;
+    }
+    if (fp->deep) {
+        snprintf(err, OBS_ERR_LEN, "append=1: the input is a deep EXR; appending the AO to a deep file is not "
+                 "supported (ask without append)");
+        return OBS_UNSUPPORTED;
+    }
+    return OBS_OK;
+}
+
 void obsd_fp_use(obsd_fp *fp, const obs_gbuffer *gb, const obs_deep_image *deep)
 {
     fp->gb = deep ? NULL : gb;
@@ -180,8 +209,15 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
         obs_result flat = {0};
         obs_deep_result deep = {0};
         obs_exr_layer layers[OBS_RESULT_LAYERS];
+        obs_exr_names names;
         int n = exr_layers(im, &flat, &deep, layers);
-        s = obs_exr_write_mem(layers, n, hr->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, cam, out, err);
+        obs_exr_source src = {.buf = fp->src, .len = fp->src_len, .part = fp->src_part};
+        obs_exr_options o = {.pixel = hr->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam,
+                             .src = fp->src ? &src : NULL, .append = hr->append};
+        if (hr->layer)
+            s = obs_exr_layers_rename(layers, n, hr->layer, &names, err);
+        if (s == OBS_OK)
+            s = obs_exr_write_ex_mem(layers, n, &o, out, err);
     } else {
         const obs_image *img = obsd_fp_png_image(im);
         s = obs_png_write_mem(img, hr->png_bits, img != im->ao, out, err);

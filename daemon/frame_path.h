@@ -26,6 +26,11 @@ typedef struct obsd_fp {
     const obs_deep_image *deep;
     obs_gbuffer_file gf;      /* a decoded flat EXR (owned) */
     obs_deep_image deep_exr;  /* a decoded deep EXR (owned) */
+    /* the EXR body the input came from (the caller's, kept until the
+     * encode: obsd_fp_keep_source()), or NULL */
+    const unsigned char *src;
+    size_t src_len;
+    int src_part;             /* its part the input was read from */
     obsd_job job;             /* its result is owned until obsd_fp_free() */
     double ms_decode, ms_queue, ms_gl, ms_encode;
     /* the way back from the GL worker */
@@ -58,6 +63,15 @@ void obsd_fp_free(obsd_fp *fp);
 obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
                           const obs_http_request *hr, const obs_limits *lim, const char *no_deep,
                           char err[OBS_ERR_LEN]);
+/* The EXR body the input was decoded from (its part `part`), which the
+ * caller keeps until the encode: the answer takes its windows and header
+ * attributes, and append=1 writes it back with the AO added. */
+void obsd_fp_keep_source(obsd_fp *fp, const unsigned char *body, size_t len, int part);
+/* The part of the decoded EXR the input was read from (0 for planes). */
+int obsd_fp_part(const obsd_fp *fp);
+/* Refuses, before the frame runs, what the encode could not do for hr:
+ * append=1 without an EXR body kept, or with deep input. */
+obs_status obsd_fp_check_output(const obsd_fp *fp, const obs_http_request *hr, char err[OBS_ERR_LEN]);
 /* Runs planes decoded elsewhere (gb or deep); they must outlive the frame. */
 void obsd_fp_use(obsd_fp *fp, const obs_gbuffer *gb, const obs_deep_image *deep);
 
@@ -81,7 +95,8 @@ const obs_camera *obsd_fp_camera(const obsd_fp *fp);
 /* The one image a PNG of `im` shows: the AO, else the composite. */
 const obs_image *obsd_fp_png_image(const obsd_fp_images *im);
 
-/* Writes `im` as hr asks (format exr|png, float, png_bits) into *out
+/* Writes `im` as hr asks (format exr|png, float, png_bits, layer,
+ * append; the kept source's windows and attributes) into *out
  * (caller frees with obs_bytes_free()); with `raw`, writes nothing (the
  * caller sends the images as they are).  Sets ms_encode and counts it,
  * failed or not. */

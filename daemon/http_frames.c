@@ -226,6 +226,13 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
                                   r->op == STREAM_POST ? "deep EXR input runs on POST /v1/ao, not in streams"
                                                        : NULL,
                                   err);
+    /* An EXR answer takes the body's header (its windows and attributes;
+     * append=1: the body itself), which lives until the answer: r->body,
+     * freed with the request, or a stream frame's, which it holds. */
+    if (s == OBS_OK && r->hr.format == OBS_HTTP_EXR)
+        obsd_fp_keep_source(&r->fp, body, len, obsd_fp_part(&r->fp));
+    if (s == OBS_OK)
+        s = obsd_fp_check_output(&r->fp, &r->hr, err);
     if (s != OBS_OK)
         return obsd__answer_status(r, s, err);
     /* The request is whole: its deadline stops (the GL worker's time is
@@ -263,9 +270,11 @@ static enum MHD_Result queue_body(req *r)
     if (r->op == STREAM_POST) /* the body is kept with the frame: re-runs decode it again */
         return obsd__queue_frame(r, r->body, r->len, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE);
     enum MHD_Result rc = obsd__queue_frame(r, r->body, r->len, r->hr.outputs);
-    free(r->body);
-    r->body = NULL;
-    r->cap = 0;
+    if (!r->fp.src) { /* else the answer needs it; freed with the request */
+        free(r->body);
+        r->body = NULL;
+        r->cap = 0;
+    }
     return rc;
 }
 

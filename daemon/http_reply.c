@@ -145,6 +145,10 @@ enum MHD_Result obsd__answer_images(req *r, const obsd_fp_images *im, const obs_
     obs_bytes out;
     obs_status s = obsd_fp_encode(&r->fp, &shown, &r->hr, 0, cam, &out, err);
     obs_image_free(&exposed);
+    /* what the request asked for and the input cannot give (append=1: a
+     * channel named like the AO layer) is the request's fault */
+    if (s == OBS_INVALID_ARGUMENT || s == OBS_UNSUPPORTED)
+        return obsd__answer_status(r, s, err);
     if (s != OBS_OK)
         return obsd__answer_error(r, 500, "encode_failed", err, NULL, NULL);
     return answer_bytes(r, &out, r->hr.format == OBS_HTTP_EXR ? "image/x-exr" : "image/png", timing,

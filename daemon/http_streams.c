@@ -176,6 +176,9 @@ static enum MHD_Result get_frame(req *r, uint64_t seq)
     const obsd_frame *f = r->frame;
     char num[32];
     snprintf(num, sizeof num, "%llu", (unsigned long long)f->seq);
+    /* a kept frame's EXR takes its body's header, as its POST's did */
+    if (r->hr.format == OBS_HTTP_EXR)
+        obsd_fp_keep_source(&r->fp, f->body, f->body_len, f->part);
     if (r->want_color) {
         if (!f->color.data)
             return obsd__answer_error(r, 404, "no_color", "the frame's G-buffer has no colour plane", NULL,
@@ -301,6 +304,7 @@ static enum MHD_Result post_finish(req *r)
     res->composite = (obs_image){0};
     obs_result_free(res);
     f->camera = gb->camera;
+    f->part = obsd_fp_part(&r->fp);
     f->ms_queue = r->fp.ms_queue;
     f->ms_decode = r->fp.ms_decode;
     f->ms_gl = r->fp.ms_gl;

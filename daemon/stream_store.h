@@ -37,6 +37,7 @@ typedef struct obsd_frame {
     obs_image composite;   /* colour x AO (RGBA) */
     obs_image color;       /* the G-buffer's colour (RGBA); empty without one */
     obs_camera camera;
+    int part;              /* the body's part the G-buffer was read from */
     double ms_queue, ms_decode, ms_gl; /* the stages of its run */
     double posted_unix;    /* seconds since the epoch */
 } obsd_frame;

@@ -702,6 +702,8 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
         return s;
     if (out->raw_out && out->hr.format != OBS_HTTP_EXR)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
+    if (out->raw_out && out->hr.append)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "append=1 writes an EXR: it needs format=exr, not raw");
     if (!get_u8(&r, &body))
         return truncated(&r, "G-buffer kind", err);
     if (!get_pad8(&r))
@@ -772,6 +774,8 @@ static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, 
         return s;
     if (q->raw_out && q->hr.format != OBS_HTTP_EXR)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
+    if (q->raw_out && q->hr.append)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "append=1 writes an EXR: it needs format=exr, not raw");
     if (!get_u8(r, &body))
         return truncated(r, "G-buffer kind", err);
     if (!get_pad8(r))

@@ -67,6 +67,11 @@ const obs_http_option obs_http_options[] = {
     {.name = "solve_camera", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(solve_camera), .def = "0",
      .doc = "with no camera in the file or the request: solve the pinhole camera from the "
             "file's world-space position pass (P, Position)"},
+    {.name = "layer", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(layer_name), .def = "", .min = 1, .max = 1,
+     .slot = SLOT(layer_name), .map = FIELD(layer), .what = "a layer name (1 to 63 characters)",
+     .doc = "EXR: the output's layer: NAME.Y for the AO, NAME.R,G,B,A for the composite (default AO.Y; R,G,B,A)"},
+    {.name = "append", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(append), .def = "0",
+     .doc = "EXR: the input file back, every part and channel unchanged, with the AO added as a layer"},
     {.name = NULL}};
 
 /* CHOICE and BOOL rows store through an int. */
@@ -269,6 +274,15 @@ obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LE
     if (r->format == OBS_HTTP_PNG && r->outputs == (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "format=png holds one image: ask for one output (output=ao or "
                         "output=composite), or use format=exr for both");
+    if (r->append && r->format != OBS_HTTP_EXR)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "append=1 writes the input EXR back with the AO added: it needs "
+                         "format=exr");
+    if (r->layer) {
+        obs_exr_names names;
+        obs_status s = obs_exr_layers_rename(NULL, 0, r->layer, &names, err);
+        if (s != OBS_OK)
+            return s;
+    }
     return OBS_OK;
 }
 

@@ -38,6 +38,11 @@ typedef struct obs_http_request {
     char color[4][64];
     char part[64];
     char view[64];
+    /* the output's channel names: layer=NAME gives NAME.Y (AO) and
+     * NAME.R,G,B,A (composite); NULL: AO.Y and R,G,B,A */
+    const char *layer;
+    char layer_name[64];
+    int append;             /* EXR: the input's parts and channels, the AO added */
 } obs_http_request;
 
 /* Zeroes the request: every option at its default. */

@@ -9,9 +9,12 @@ libassimp-dev libembree-dev"
 # Only for the tests: the preview page in a real browser (Chromium; node
 # and npm fetch playwright-core), the deploy checks (systemd-analyze,
 # PyYAML), make quality's referee (shared/tools/aometrics.py: numpy,
-# OpenImageIO).  `deps.sh --build` leaves them out (deploy/container).
+# OpenImageIO), oiiotool (tests/e2e/output.sh reads obscura's EXRs back with
+# OpenImageIO), python3 with pip and wheel (the Python client's tests,
+# pip install clients/python offline).  `deps.sh --build` leaves them out
+# (deploy/container).
 if [ "${1:-}" != "--build" ]; then
-    PKGS="$PKGS chromium nodejs python3-yaml systemd python3-numpy python3-openimageio"
+    PKGS="$PKGS chromium nodejs python3-yaml systemd python3-numpy python3-openimageio openimageio-tools python3 python3-pip python3-wheel"
     command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
 fi
 

@@ -138,4 +138,60 @@ typedef struct obs__exr_mem {
 obs_status obs__exr_open(const char *path, const obs__exr_mem *mem, exr_context_t *ctx,
                          int64_t *size, char err[OBS_ERR_LEN]);
 
+/* ---- output parts (exr_write.c, exr_append.c, exr_header.c) ------------ */
+
+/* One channel an output part writes: `base` is its value at the data
+ * window's first pixel, rows `line_stride` bytes apart. */
+typedef struct obs__wchan {
+    const char *name;
+    exr_pixel_type_t type;       /* in the file */
+    exr_perceptual_treatment_t plinear;
+    const uint8_t *base;
+    int32_t pixel_stride, line_stride;
+    exr_pixel_type_t user_type;  /* in memory */
+    int32_t user_bytes;
+} obs__wchan;
+
+/* One scanline part of an output file. */
+typedef struct obs__wpart {
+    const char *name;            /* the part's name (multi-part files), or NULL */
+    int src_part;                /* the input part whose attributes it carries, -1: none */
+    exr_compression_t compression;
+    exr_attr_box2i_t dw, disp;
+    obs__wchan *ch;
+    int nch;
+} obs__wpart;
+
+/* Attributes of the storage layout, which the writer sets itself:
+ * channels, compression, windows, lineOrder, tiles, chunkCount, type,
+ * name, version (exr_header.c). */
+int obs__exr_attr_is_layout(const char *name);
+
+/* Copies every attribute of the input part `src_part` into the output
+ * part, but the layout's and those named in `skip` (NULL-ended, may be
+ * NULL); an attribute the output already has takes the input's value.
+ * On failure *failed names the attribute. */
+exr_result_t obs__exr_copy_attrs(exr_context_t out, int part, exr_const_context_t src, int src_part,
+                                 const char *const *skip, const char **failed);
+
+/* 1 when an attribute of the part has a name or type name longer than 31
+ * characters (the output needs the long-name flag). */
+int obs__exr_attrs_long_names(exr_const_context_t src, int src_part);
+
+/* The input's flat parts decoded for --append (exr_append.c): every
+ * channel in its own pixel type, one obs__wpart per part of the input,
+ * then `layers` (float, written as `type`) added to part `src_part`.
+ * Refuses deep and subsampled parts and a layer channel named like an
+ * input channel of its part.  *bufs holds the pixels; the caller frees
+ * every parts[i].ch, *parts and *bufs with obs__exr_append_free(). */
+obs_status obs__exr_append_parts(exr_const_context_t src, int64_t file_size, int src_part,
+                                 const obs_exr_layer *layers, int layer_count, exr_pixel_type_t type,
+                                 obs__wpart **parts, int *nparts, void **bufs, char err[OBS_ERR_LEN]);
+void obs__exr_append_free(obs__wpart *parts, int nparts, void *bufs);
+
+/* check_part() of exr_read.c: the part's storage, compression, sampling,
+ * windows (against `lim`) and chunk table checked; its data window. */
+obs_status obs__exr_check_part(exr_const_context_t ctx, int part, int64_t file_size, const obs_limits *lim,
+                               exr_attr_box2i_t *dw, char err[OBS_ERR_LEN]);
+
 #endif

@@ -241,6 +241,15 @@ static obs_status check_part(exr_const_context_t ctx, int part, int64_t file_siz
     return OBS_OK;
 }
 
+obs_status obs__exr_check_part(exr_const_context_t ctx, int part, int64_t file_size, const obs_limits *lim,
+                               exr_attr_box2i_t *dw, char err[OBS_ERR_LEN])
+{
+    part_geom g;
+    obs_status st = check_part(ctx, part, file_size, lim, &g, err);
+    *dw = g.dw;
+    return st;
+}
+
 /* ---- decoding ----------------------------------------------------------- */
 
 /* Where one EXR channel goes: `base` is its value at pixel (0, 0) of a

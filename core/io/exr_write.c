@@ -1,6 +1,7 @@
 /* EXR output through OpenEXR's C API: one scanline part, ZIP, half or
  * float, each layer's channels under the names the caller gives. */
 #include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -85,23 +86,20 @@ static exr_result_t write_camera(exr_context_t ctx, int part, const obs_camera *
 }
 
 /* Points the encoder's channels (sorted by name by the library) at the
- * layer channel of the same name, rows [start_y, start_y + height). */
-static void bind_channels(exr_encode_pipeline_t *enc, const obs_exr_layer *layers, int count,
-                          int start_y)
+ * part's channel of the same name, rows from ci->start_y. */
+static void bind_channels(exr_encode_pipeline_t *enc, const obs__wpart *p, const exr_chunk_info_t *ci)
 {
     for (int c = 0; c < enc->channel_count; c++) {
         exr_coding_channel_info_t *ch = &enc->channels[c];
-        for (int l = 0; l < count; l++) {
-            const obs_image *img = layers[l].image;
-            for (int k = 0; k < img->channels; k++) {
-                if (strcmp(layers[l].names[k], ch->channel_name) != 0)
-                    continue;
-                ch->encode_from_ptr = (const uint8_t *)(img->data + (size_t)start_y * (size_t)img->width * (size_t)img->channels + (size_t)k);
-                ch->user_pixel_stride = img->channels * (int32_t)sizeof(float);
-                ch->user_line_stride = img->width * img->channels * (int32_t)sizeof(float);
-                ch->user_data_type = EXR_PIXEL_FLOAT;
-                ch->user_bytes_per_element = sizeof(float);
-            }
+        for (int k = 0; k < p->nch; k++) {
+            const obs__wchan *w = &p->ch[k];
+            if (strcmp(w->name, ch->channel_name) != 0)
+                continue;
+            ch->encode_from_ptr = w->base + (size_t)((int64_t)ci->start_y - p->dw.min.y) * (size_t)w->line_stride;
+            ch->user_pixel_stride = w->pixel_stride;
+            ch->user_line_stride = w->line_stride;
+            ch->user_data_type = w->user_type;
+            ch->user_bytes_per_element = (int16_t)w->user_bytes;
         }
     }
 }
@@ -120,30 +118,194 @@ static int64_t mem_write(exr_const_context_t ctxt, void *user, const void *buf, 
     return (int64_t)sz;
 }
 
+static int has_attr(exr_const_context_t ctx, int part, const char *name)
+{
+    const exr_attribute_t *a = NULL;
+    int has = exr_get_attribute_by_name(ctx, part, name, &a) == EXR_ERR_SUCCESS && a;
+    obs__exr_msg_reset(); /* a missing attribute is not an error */
+    return has;
+}
+
+/* Writes the parts' headers and pixels into ctx.  With `src`, each part
+ * carries the attributes of its src_part; the camera goes on the part of
+ * `cam_part` unless the input has one there. */
+static exr_result_t write_parts(exr_context_t ctx, const obs__wpart *parts, int np, exr_const_context_t src,
+                                const char *const *skip, const obs_camera *cam, int cam_part,
+                                const char **what, const char **attr)
+{
+    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+    static const exr_attr_v2f_t centre = {{{0.0f, 0.0f}}};
+    int longnames = 0, started = 0, enc_part = 0;
+    exr_result_t rv = EXR_ERR_SUCCESS;
+
+    *what = "writing the header";
+    for (int i = 0; i < np; i++) {
+        for (int k = 0; k < parts[i].nch; k++)
+            longnames |= strlen(parts[i].ch[k].name) > SHORT_NAME_MAX;
+        longnames |= src && parts[i].src_part >= 0 && obs__exr_attrs_long_names(src, parts[i].src_part);
+    }
+    if (longnames && (rv = exr_set_longname_support(ctx, 1)) != EXR_ERR_SUCCESS)
+        return rv;
+    for (int i = 0; i < np; i++) {
+        const obs__wpart *p = &parts[i];
+        int part = 0;
+        if ((rv = exr_add_part(ctx, p->name, EXR_STORAGE_SCANLINE, &part)) != EXR_ERR_SUCCESS ||
+            (rv = exr_initialize_required_attr(ctx, part, &p->disp, &p->dw, 1.0f, &centre, 1.0f,
+                                               EXR_LINEORDER_INCREASING_Y, p->compression)) != EXR_ERR_SUCCESS)
+            return rv;
+        for (int k = 0; k < p->nch; k++)
+            if ((rv = exr_add_channel(ctx, part, p->ch[k].name, p->ch[k].type, p->ch[k].plinear, 1, 1)) !=
+                EXR_ERR_SUCCESS)
+                return rv;
+        if (src && p->src_part >= 0 && (rv = obs__exr_copy_attrs(ctx, part, src, p->src_part, skip, attr)) != EXR_ERR_SUCCESS)
+            return rv;
+        if (i == cam_part && cam && cam->has_world_to_camera &&
+            !(src && p->src_part >= 0 && has_attr(src, p->src_part, "worldToCamera")) &&
+            (rv = write_camera(ctx, part, cam)) != EXR_ERR_SUCCESS)
+            return rv;
+    }
+    if ((rv = exr_write_header(ctx)) != EXR_ERR_SUCCESS)
+        return rv;
+
+    *what = "writing pixels";
+    for (int i = 0; i < np && rv == EXR_ERR_SUCCESS; i++) {
+        const obs__wpart *p = &parts[i];
+        int32_t lines = 0;
+        if ((rv = exr_get_scanlines_per_chunk(ctx, i, &lines)) != EXR_ERR_SUCCESS)
+            break;
+        for (int64_t y = p->dw.min.y; y <= p->dw.max.y && rv == EXR_ERR_SUCCESS; y += lines) {
+            exr_chunk_info_t ci;
+            if ((rv = exr_write_scanline_chunk_info(ctx, i, (int)y, &ci)) != EXR_ERR_SUCCESS)
+                break;
+            rv = started && enc_part == i ? exr_encoding_update(ctx, i, &ci, &enc)
+                                          : exr_encoding_initialize(ctx, i, &ci, &enc);
+            started = 1;
+            enc_part = i;
+            if (rv != EXR_ERR_SUCCESS)
+                break;
+            bind_channels(&enc, p, &ci);
+            if ((rv = exr_encoding_choose_default_routines(ctx, i, &enc)) == EXR_ERR_SUCCESS)
+                rv = exr_encoding_run(ctx, i, &enc);
+        }
+        if (started)
+            exr_encoding_destroy(ctx, &enc);
+        started = 0;
+    }
+    return rv;
+}
+
+/* The one part of a plain output: the layers' channels, as `type`. */
+static obs_status layers_part(const obs_exr_layer *layers, int count, exr_pixel_type_t type, obs__wpart *p,
+                              char err[OBS_ERR_LEN])
+{
+    int n = 0;
+    for (int l = 0; l < count; l++)
+        n += layers[l].image->channels;
+    if (!(p->ch = calloc((size_t)n, sizeof *p->ch)))
+        return obs__fail(err, OBS_NO_MEMORY, "channel list");
+    for (int l = 0; l < count; l++) {
+        const obs_image *img = layers[l].image;
+        for (int k = 0; k < img->channels; k++)
+            p->ch[p->nch++] = (obs__wchan){layers[l].names[k], type, EXR_PERCEPTUALLY_LOGARITHMIC,
+                                           (const uint8_t *)(img->data + k), img->channels * (int32_t)sizeof(float),
+                                           img->width * img->channels * (int32_t)sizeof(float), EXR_PIXEL_FLOAT,
+                                           sizeof(float)};
+    }
+    return OBS_OK;
+}
+
+/* The windows of a plain output: the source part's, or those the options
+ * give. */
+static obs_status plain_windows(const obs_exr_options *o, exr_const_context_t src, int w, int h, obs__wpart *p,
+                                char err[OBS_ERR_LEN])
+{
+    if (src) {
+        exr_result_t rv;
+        if ((rv = exr_get_data_window(src, o->src->part, &p->dw)) != EXR_ERR_SUCCESS ||
+            (rv = exr_get_display_window(src, o->src->part, &p->disp)) != EXR_ERR_SUCCESS)
+            return obs__exr_fail(err, rv, "the input's windows");
+        int64_t iw = (int64_t)p->dw.max.x - p->dw.min.x + 1, ih = (int64_t)p->dw.max.y - p->dw.min.y + 1;
+        if (iw != w || ih != h)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "the images are %dx%d but the input part %d's data window is %lldx%lld",
+                             w, h, o->src->part, (long long)iw, (long long)ih);
+        return OBS_OK;
+    }
+    int dw = o->display_width > 0 ? o->display_width : w, dh = o->display_height > 0 ? o->display_height : h;
+    int64_t x1 = (int64_t)o->display_x + w - 1, y1 = (int64_t)o->display_y + h - 1;
+    if (x1 > INT32_MAX || y1 > INT32_MAX || o->display_height < 0 || o->display_width < 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "a data window at (%d, %d) of %dx%d does not fit",
+                         o->display_x, o->display_y, w, h);
+    p->disp.min.x = 0;
+    p->disp.min.y = 0;
+    p->disp.max.x = dw - 1;
+    p->disp.max.y = dh - 1;
+    p->dw.min.x = o->display_x;
+    p->dw.min.y = o->display_y;
+    p->dw.max.x = (int32_t)x1;
+    p->dw.max.y = (int32_t)y1;
+    return OBS_OK;
+}
+
 /* Writes to `path`, or into `mem` when it is non-NULL (`path` then only
  * names the output in messages). */
 static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_layer *layers,
-                            int layer_count, obs_exr_pixel pixel, const obs_camera *cam,
-                            char err[OBS_ERR_LEN])
+                            int layer_count, const obs_exr_options *o, char err[OBS_ERR_LEN])
 {
+    static const char *const plain_skip[] = {"multiView", NULL};
+    static const obs_exr_options zero = {0};
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
-    exr_context_t ctx = NULL;
-    exr_chunk_info_t ci;
-    exr_pixel_type_t type = pixel == OBS_EXR_FLOAT ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
-    int part = 0, longnames = 0, started = 0;
-    int32_t lines = 0;
-    const char *what = "creating the file";
-    exr_result_t rv;
+    exr_context_t ctx = NULL, src = NULL;
+    obs__wpart one = {0}, *parts = &one;
+    void *bufs = NULL;
+    int np = 1, longnames = 0;
+    int64_t src_size = -1;
+    const char *what = "reading the input's header", *attr = NULL;
+    char sub[OBS_ERR_LEN] = "";
+    exr_result_t rv = EXR_ERR_SUCCESS;
     obs_status st;
 
+    if (!o)
+        o = &zero;
     if (!path || !*path)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "no EXR path given");
-    if (pixel != OBS_EXR_HALF && pixel != OBS_EXR_FLOAT)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: unknown pixel type %d", path, (int)pixel);
+    if (o->pixel != OBS_EXR_HALF && o->pixel != OBS_EXR_FLOAT)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: unknown pixel type %d", path, (int)o->pixel);
     if ((st = check_layers(layers, layer_count, &longnames, err)) != OBS_OK)
         return st;
+    if (o->append && !o->src)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: appending needs the input file", path);
+    exr_pixel_type_t type = o->pixel == OBS_EXR_FLOAT ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
     const int w = layers[0].image->width, h = layers[0].image->height;
+
+    /* the input in memory: the read context points at it until the end */
+    obs__exr_mem m = {o->src ? o->src->buf : NULL, o->src ? o->src->len : 0};
+    if (o->src) {
+        if (!o->src->path && (!o->src->buf || !o->src->len)) {
+            st = obs__fail(sub, OBS_INVALID_ARGUMENT, "the input is neither a file nor bytes");
+            goto fail;
+        }
+        if ((st = obs__exr_open(o->src->path, o->src->path ? NULL : &m, &src, &src_size, sub)) != OBS_OK)
+            goto fail;
+        int count = 0;
+        if (exr_get_count(src, &count) != EXR_ERR_SUCCESS || o->src->part < 0 || o->src->part >= count) {
+            st = obs__fail(sub, OBS_INVALID_ARGUMENT, "the input has no part %d", o->src->part);
+            goto fail;
+        }
+    }
+    if (o->append) {
+        if ((st = obs__exr_append_parts(src, src_size, o->src->part, layers, layer_count, type, &parts, &np,
+                                        &bufs, sub)) != OBS_OK) {
+            parts = &one;
+            np = 1;
+            goto fail;
+        }
+    } else {
+        one.src_part = src ? o->src->part : -1;
+        one.compression = EXR_COMPRESSION_ZIP;
+        if ((st = layers_part(layers, layer_count, type, &one, sub)) != OBS_OK ||
+            (st = plain_windows(o, src, w, h, &one, sub)) != OBS_OK)
+            goto fail;
+    }
 
     init.error_handler_fn = obs__exr_error_handler;
     obs__exr_msg_reset();
@@ -153,76 +315,104 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
         init.user_data = mem;
         init.write_fn = mem_write;
     }
+    what = "creating the file";
     if ((rv = exr_start_write(&ctx, path, mem ? EXR_WRITE_FILE_DIRECTLY : EXR_INTERMEDIATE_TEMP_FILE,
-                              &init)) != EXR_ERR_SUCCESS)
-        goto fail;
-    what = "writing the header";
-    if ((rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part)) != EXR_ERR_SUCCESS ||
-        (rv = exr_initialize_required_attr_simple(ctx, part, w, h, EXR_COMPRESSION_ZIP)) != EXR_ERR_SUCCESS ||
-        (longnames && (rv = exr_set_longname_support(ctx, 1)) != EXR_ERR_SUCCESS))
-        goto fail;
-    for (int l = 0; l < layer_count; l++)
-        for (int k = 0; k < layers[l].image->channels; k++)
-            if ((rv = exr_add_channel(ctx, part, layers[l].names[k], type,
-                                      EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1)) != EXR_ERR_SUCCESS)
-                goto fail;
-    if (cam && cam->has_world_to_camera && (rv = write_camera(ctx, part, cam)) != EXR_ERR_SUCCESS)
-        goto fail;
-    if ((rv = exr_write_header(ctx)) != EXR_ERR_SUCCESS ||
-        (rv = exr_get_scanlines_per_chunk(ctx, part, &lines)) != EXR_ERR_SUCCESS)
-        goto fail;
-
-    what = "writing pixels";
-    for (int y = 0; y < h; y += lines) {
-        if ((rv = exr_write_scanline_chunk_info(ctx, part, y, &ci)) != EXR_ERR_SUCCESS)
-            goto fail;
-        rv = started ? exr_encoding_update(ctx, part, &ci, &enc)
-                     : exr_encoding_initialize(ctx, part, &ci, &enc);
-        started = 1;
-        if (rv != EXR_ERR_SUCCESS)
-            goto fail;
-        bind_channels(&enc, layers, layer_count, ci.start_y);
-        if ((rv = exr_encoding_choose_default_routines(ctx, part, &enc)) != EXR_ERR_SUCCESS ||
-            (rv = exr_encoding_run(ctx, part, &enc)) != EXR_ERR_SUCCESS)
-            goto fail;
+                              &init)) == EXR_ERR_SUCCESS) {
+        int cam_part = 0;
+        for (int i = 0; o->append && i < np; i++)
+            if (parts[i].src_part == o->src->part)
+                cam_part = i;
+        rv = write_parts(ctx, parts, np, src, o->append ? NULL : plain_skip, o->cam, cam_part, &what, &attr);
+        if (rv == EXR_ERR_SUCCESS) {
+            what = "finishing the file";
+            rv = exr_finish(&ctx);
+        }
     }
-    exr_encoding_destroy(ctx, &enc);
-    started = 0;
-    what = "finishing the file";
-    rv = exr_finish(&ctx);
+    st = OBS_OK;
+    if (rv != EXR_ERR_SUCCESS) {
+        st = obs__exr_status(rv);
+        /* Here a bad argument or attribute is ours, not the file's. */
+        if (st == OBS_BAD_FILE)
+            st = rv == EXR_ERR_INVALID_ARGUMENT || rv == EXR_ERR_NAME_TOO_LONG ? OBS_INVALID_ARGUMENT : OBS_IO;
+        const char *msg = obs__exr_msg()[0] ? obs__exr_msg() : exr_get_default_error_message(rv);
+        if (attr)
+            obs__fail(sub, st, "%s: the input's attribute '%.100s': %s", what, attr, msg);
+        else
+            obs__fail(sub, st, "%s: %s", what, msg);
+    }
 fail:
-    if (started)
-        exr_encoding_destroy(ctx, &enc);
     if (ctx)
         exr_finish(&ctx);
-    if (rv == EXR_ERR_SUCCESS)
-        return OBS_OK;
-    st = obs__exr_status(rv);
-    /* Here a bad argument or attribute is ours, not the file's. */
-    if (st == OBS_BAD_FILE)
-        st = rv == EXR_ERR_INVALID_ARGUMENT || rv == EXR_ERR_NAME_TOO_LONG ? OBS_INVALID_ARGUMENT : OBS_IO;
-    const char *msg = obs__exr_msg()[0] ? obs__exr_msg() : exr_get_default_error_message(rv);
-    return obs__fail(err, st, "%s: %s: %s", path, what, msg);
+    if (src)
+        exr_finish(&src);
+    if (parts == &one)
+        free(one.ch);
+    else
+        obs__exr_append_free(parts, np, bufs);
+    if (st != OBS_OK)
+        return obs__fail(err, st, "%s: %s", path, sub);
+    return OBS_OK;
 }
 
 obs_status obs_exr_write(const char *path, const obs_exr_layer *layers, int layer_count,
                          obs_exr_pixel pixel, const obs_camera *cam, char err[OBS_ERR_LEN])
 {
-    return write_exr(path, NULL, layers, layer_count, pixel, cam, err);
+    obs_exr_options o = {.pixel = pixel, .cam = cam};
+    return write_exr(path, NULL, layers, layer_count, &o, err);
 }
 
-obs_status obs_exr_write_mem(const obs_exr_layer *layers, int layer_count, obs_exr_pixel pixel,
-                             const obs_camera *cam, obs_bytes *out, char err[OBS_ERR_LEN])
+obs_status obs_exr_write_ex(const char *path, const obs_exr_layer *layers, int layer_count,
+                            const obs_exr_options *opt, char err[OBS_ERR_LEN])
+{
+    return write_exr(path, NULL, layers, layer_count, opt, err);
+}
+
+obs_status obs_exr_write_ex_mem(const obs_exr_layer *layers, int layer_count, const obs_exr_options *opt,
+                                obs_bytes *out, char err[OBS_ERR_LEN])
 {
     obs__membuf mem = {0};
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_write_mem: no output");
     *out = (obs_bytes){0};
-    obs_status st = write_exr("(memory)", &mem, layers, layer_count, pixel, cam, err);
+    obs_status st = write_exr("(memory)", &mem, layers, layer_count, opt, err);
     if (st == OBS_OK)
         obs__membuf_take(&mem, out);
     free(mem.data);
     return st;
+}
+
+obs_status obs_exr_write_mem(const obs_exr_layer *layers, int layer_count, obs_exr_pixel pixel,
+                             const obs_camera *cam, obs_bytes *out, char err[OBS_ERR_LEN])
+{
+    obs_exr_options o = {.pixel = pixel, .cam = cam};
+    return obs_exr_write_ex_mem(layers, layer_count, &o, out, err);
+}
+
+obs_status obs_exr_layers_rename(obs_exr_layer *layers, int layer_count, const char *name,
+                                 obs_exr_names *store, char err[OBS_ERR_LEN])
+{
+    size_t len = name ? strlen(name) : 0, used = 0;
+    if (len == 0 || len > OBS_EXR_LAYER_MAX || name[0] == '.' || name[len - 1] == '.')
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "layer name '%.100s' must be 1 to %d characters, not starting or ending with '.'",
+                         name ? name : "", OBS_EXR_LAYER_MAX);
+    for (const char *c = name; *c; c++)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "layer name '%.100s' holds a control character", name);
+    for (int l = 0; l < layer_count; l++) {
+        int ch = layers[l].image->channels;
+        if (used + (size_t)ch > sizeof store->ptr / sizeof store->ptr[0])
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "too many channels to rename");
+        for (int k = 0; k < ch; k++) {
+            const char *old = layers[l].names[k];
+            /* AO.Y -> NAME.Y; R -> NAME.R; Samples.Y -> NAME.Samples.Y */
+            const char *rest = !strncmp(old, "AO.", 3) ? old + 3 : old;
+            snprintf(store->name[used + k], sizeof store->name[0], "%s.%.30s", name, rest);
+            store->ptr[used + k] = store->name[used + k];
+        }
+        layers[l].names = store->ptr + used;
+        used += (size_t)ch;
+    }
+    return OBS_OK;
 }
 
 int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_LAYERS])

@@ -176,6 +176,55 @@ obs_status obs_exr_write(const char *path, const obs_exr_layer *layers,
                          int layer_count, obs_exr_pixel pixel,
                          const obs_camera *cam, char err[OBS_ERR_LEN]);
 
+/* The input an output EXR was computed from: its header goes with it. */
+typedef struct obs_exr_source {
+    const char *path;  /* the input file, or NULL and: */
+    const void *buf;   /* the input in memory, `len` bytes */
+    size_t len;
+    int part;          /* the part the images were computed from
+                        * (obs_exr_info.part, obs_deep_image.part) */
+} obs_exr_source;
+
+/* How obs_exr_write_ex() writes.  Zeroed: half, no camera, no source,
+ * the data window at the origin with the display window equal to it. */
+typedef struct obs_exr_options {
+    obs_exr_pixel pixel;
+    /* worldToCamera / worldToNDC, written unless the source has its own */
+    const obs_camera *cam;
+    /* With a source, the output part takes its data window and display
+     * window (the images must be the size of its data window) and every
+     * header attribute of its part but the layout's (channels,
+     * compression, windows, lineOrder, tiles, chunkCount, type, name,
+     * version) and multiView (the output's channels are not the views'). */
+    const obs_exr_source *src;
+    /* With a source: the output is the input, every part and channel
+     * (pixels unchanged, each channel in its own type), the layers added
+     * to part src->part.  Parts are written as scanline parts, with the
+     * input's compression where it is lossless (NONE, RLE, ZIPS, ZIP,
+     * PIZ), else ZIP.  Refused (OBS_UNSUPPORTED) for deep parts. */
+    int append;
+    /* Without a source: the images' place in a display window, as in
+     * obs_gbuffer (display_width 0: the display window is the images). */
+    int display_x, display_y, display_width, display_height;
+} obs_exr_options;
+
+/* obs_exr_write() with options (NULL: as zeroed). */
+obs_status obs_exr_write_ex(const char *path, const obs_exr_layer *layers, int layer_count,
+                            const obs_exr_options *opt, char err[OBS_ERR_LEN]);
+
+/* The layers renamed under one layer name, for --layer NAME: AO.Y
+ * becomes NAME.Y, R,G,B,A NAME.R,G,B,A, any other channel C NAME.C.
+ * The names live in `store`.  OBS_INVALID_ARGUMENT when NAME is empty,
+ * over OBS_EXR_LAYER_MAX characters, starts or ends with '.', or holds a
+ * control character. */
+#define OBS_EXR_LAYER_MAX 63
+typedef struct obs_exr_names {
+    char name[OBS_RESULT_LAYERS * 4][OBS_EXR_LAYER_MAX + 32];
+    const char *ptr[OBS_RESULT_LAYERS * 4];
+} obs_exr_names;
+obs_status obs_exr_layers_rename(obs_exr_layer *layers, int layer_count, const char *name,
+                                 obs_exr_names *store, char err[OBS_ERR_LEN]);
+
 /* Writes an 8- or 16-bit PNG: 1 channel -> grey, 3 -> RGB, 4 -> RGBA.
  * Values are clamped to [0,1]; with `srgb` colour channels are encoded with
  * the sRGB transfer function (alpha and grey AO stay linear). */
@@ -198,6 +247,10 @@ void obs_bytes_free(obs_bytes *b);
 obs_status obs_exr_write_mem(const obs_exr_layer *layers, int layer_count,
                              obs_exr_pixel pixel, const obs_camera *cam,
                              obs_bytes *out, char err[OBS_ERR_LEN]);
+
+/* obs_exr_write_ex() into memory: the same file, byte for byte. */
+obs_status obs_exr_write_ex_mem(const obs_exr_layer *layers, int layer_count, const obs_exr_options *opt,
+                                obs_bytes *out, char err[OBS_ERR_LEN]);
 
 /* obs_png_write() into memory: the same file, byte for byte.  On success
  * *out holds the PNG; caller frees with obs_bytes_free(). */

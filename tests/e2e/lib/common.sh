@@ -39,6 +39,24 @@ start() {
         bad "$name: obscurad did not start"; sed 's/^/       /' "$T/$name.log" | tail -5; exit 1; fi
 }
 
+# start_all NAME ARGS...: start with the binary protocol too, on a Unix
+# socket ($T/NAME.sock) and TCP (a free port); sets SOCK_NAME and
+# TCP_NAME besides PID_NAME and PORT_NAME.
+start_all() {
+    sname=$1; shift
+    start "$sname" --socket "$T/$sname.sock" --tcp 127.0.0.1:0 "$@"
+    tport=""
+    i=0
+    while [ $i -lt 300 ] && { [ -z "$tport" ] || [ ! -S "$T/$sname.sock" ]; }; do
+        tport=$(sed -n 's/.*binary protocol on tcp:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$T/$sname.log")
+        [ -z "$tport" ] && sleep 0.1
+        i=$((i + 1))
+    done
+    eval "SOCK_$sname=$T/$sname.sock; TCP_$sname=$tport"
+    if [ -n "$tport" ] && [ -S "$T/$sname.sock" ]; then ok "$sname: binary protocol on tcp :$tport and unix:$T/$sname.sock"; else
+        bad "$sname: the binary listeners did not start"; exit 1; fi
+}
+
 # post PORT QUERY FILE OUT [curl args]: prints the HTTP status
 post() {
     p=$1 q=$2 f=$3 o=$4; shift 4

@@ -8,18 +8,21 @@
 
 #include "flags.h"
 
-/* A copy of r with the channel map's pointers made offsets into r, so
- * two requests compare with memcmp. */
+/* A copy of r with the pointers the NAMES rows set (the channel map's,
+ * the layer's) made offsets into r, so two requests compare with memcmp. */
 static void normalise(const obs_http_request *r, obs_http_request *out)
 {
-    const char **m;
     memcpy(out, r, sizeof *r);
-    m = (const char **)(void *)&out->map;
-    for (size_t i = 0; i < sizeof out->map / sizeof *m; i++) {
-        if (!m[i])
+    for (const obs_http_option *op = obs_http_options; op->name; op++) {
+        if (op->kind != OBS_HTTP_OPT_NAMES)
             continue;
-        assert_true(m[i] >= (const char *)r && m[i] < (const char *)(r + 1));
-        m[i] = (const char *)(uintptr_t)(m[i] - (const char *)r + 1);
+        const char **m = (const char **)(void *)((char *)out + op->map);
+        for (int i = 0; i < op->max; i++) {
+            if (!m[i])
+                continue;
+            assert_true(m[i] >= (const char *)r && m[i] < (const char *)(r + 1));
+            m[i] = (const char *)(uintptr_t)(m[i] - (const char *)r + 1);
+        }
     }
 }
 

@@ -392,6 +392,37 @@ static void test_head(void **state)
     obs_bytes_free(&f);
 }
 
+/* append=1 writes an EXR: with format=raw it is refused, by the decoder
+ * and by the head's check alike; layer= and append= are parsed. */
+static void test_append_raw(void **state)
+{
+    (void)state;
+    static const unsigned char exr[] = {1, 2, 3};
+    obs_bin_param p[] = {{"append", "1"}, {"layer", "occ"}, {"format", "raw"}};
+    obs_bin_request_desc d = {.id = 1, .params = p, .param_count = 3, .exr = exr, .exr_len = sizeof exr};
+    obs_bytes f;
+    obs_bin_request q;
+    obs_bin_head h;
+    size_t need;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_bin_request_encode(&d, &f, err), OBS_OK);
+    unsigned char *payload = f.data + OBS_BIN_HEADER_LEN;
+    size_t len = f.size - OBS_BIN_HEADER_LEN;
+    assert_int_equal(obs_bin_request_decode(payload, len, NULL, &q, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "append=1"));
+    assert_int_equal(obs_bin_request_head(payload, len, len, NULL, &h, &need, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "append=1"));
+    obs_bytes_free(&f);
+    p[2].value = "exr";
+    assert_int_equal(obs_bin_request_encode(&d, &f, err), OBS_OK);
+    assert_int_equal(obs_bin_request_decode(f.data + OBS_BIN_HEADER_LEN, f.size - OBS_BIN_HEADER_LEN, NULL, &q, err),
+                     OBS_OK);
+    assert_int_equal(q.hr.append, 1);
+    assert_string_equal(q.hr.layer, "occ");
+    obs_bin_request_free(&q);
+    obs_bytes_free(&f);
+}
+
 static void test_garbage(void **state)
 {
     (void)state;
@@ -828,7 +859,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_raw_round_trip),      cmocka_unit_test(test_exr_round_trip),
         cmocka_unit_test(test_response_round_trip), cmocka_unit_test(test_every_truncation),
-        cmocka_unit_test(test_oversized),           cmocka_unit_test(test_garbage),
+        cmocka_unit_test(test_oversized),           cmocka_unit_test(test_append_raw),
+        cmocka_unit_test(test_garbage),
         cmocka_unit_test(test_half_to_float),       cmocka_unit_test(test_f16_planes),
         cmocka_unit_test(test_deep_round_trip),     cmocka_unit_test(test_deep_truncated),
         cmocka_unit_test(test_deep_bad_counts),     cmocka_unit_test(test_deep_bad_sizes),

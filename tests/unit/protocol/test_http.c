@@ -123,10 +123,37 @@ static void test_option_table(void **state)
         assert_int_equal(obs_http_option_set(&r, op, op->def, OBS_HTTP_QUERY, err), OBS_OK);
         assert_memory_equal(&r, &d, sizeof r);
     }
-    assert_int_equal(rows, 12);
+    assert_int_equal(rows, 14);
     assert_ptr_equal(obs_http_option_find("png-bits"), obs_http_option_find("png_bits"));
     assert_null(obs_http_option_find("radius"));
     assert_null(obs_http_option_find(NULL));
+}
+
+/* layer= and append=: parsed by their rows, checked with the rest of the
+ * request (a layer name; append needs an EXR answer). */
+static void test_output_options(void **state)
+{
+    (void)state;
+    obs_http_request r;
+    char err[OBS_ERR_LEN] = "";
+    obs_http_request_init(&r);
+    assert_null(r.layer);
+    assert_int_equal(r.append, 0);
+    assert_int_equal(obs_http_request_set(&r, "layer", "occ", err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "append", "", err), OBS_OK);
+    assert_string_equal(r.layer, "occ");
+    assert_int_equal(r.append, 1);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "format", "png", err), OBS_OK);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "append=1"));
+    assert_int_equal(obs_http_request_set(&r, "append", "0", err), OBS_OK);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "layer", "a.", err), OBS_OK);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "layer name 'a.'"));
+    assert_int_equal(obs_http_request_set(&r, "layer", "", err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_http_request_set(&r, "append", "2", err), OBS_INVALID_ARGUMENT);
 }
 
 /* The CLI takes the debug outputs and a comma list of outputs; a query
@@ -220,10 +247,11 @@ static void test_json(void **state)
                 {"depth", "string", NULL},
                 {"normal", "string", NULL},              {"color", "string", NULL},
                 {"part", "string", NULL},                {"view", "string", NULL},
-                {"strict", "bool", "0|1"},               {"solve_camera", "bool", "0|1"}};
+                {"strict", "bool", "0|1"},               {"solve_camera", "bool", "0|1"},
+                {"layer", "string", NULL},               {"append", "bool", "0|1"}};
     cJSON *opts = cJSON_GetObjectItem(j, "options");
-    assert_int_equal(cJSON_GetArraySize(opts), 12);
-    for (int i = 0; i < 12; i++) {
+    assert_int_equal(cJSON_GetArraySize(opts), 14);
+    for (int i = 0; i < 14; i++) {
         cJSON *o = cJSON_GetArrayItem(opts, i), *c = cJSON_GetObjectItem(o, "choices"), *it;
         char got[128] = "";
         assert_string_equal(cJSON_GetObjectItem(o, "name")->valuestring, want[i].name);
@@ -296,7 +324,8 @@ int main(void)
         cmocka_unit_test(test_bad_params), cmocka_unit_test(test_options),
         cmocka_unit_test(test_status_map), cmocka_unit_test(test_json),
         cmocka_unit_test(test_bearer),     cmocka_unit_test(test_option_table),
-        cmocka_unit_test(test_option_from), cmocka_unit_test(test_nul),
+        cmocka_unit_test(test_option_from),
+        cmocka_unit_test(test_output_options), cmocka_unit_test(test_nul),
         cmocka_unit_test(test_json_utf8),
     };
     return cmocka_run_group_tests_name("protocol_http", tests, NULL, NULL);

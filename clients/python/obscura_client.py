@@ -1,0 +1,321 @@
+"""A client of obscurad, the ambient-occlusion daemon, in one file of the
+Python standard library (no pip needed): copy it next to a script, or put
+its folder on sys.path, in the Python of Nuke, Houdini, Maya or Blender.
+
+    import obscura_client as oc
+    exr = oc.ao("frame.exr", server="http://127.0.0.1:8420", radius=0.5)
+    oc.ao("frame.exr", server="unix:/run/obscurad.sock", append=1, layer="occ",
+          out="frame.ao.exr")
+
+Servers: http://HOST:PORT (the HTTP API, POST /v1/ao, through http.client,
+on which urllib.request runs), unix:/PATH and
+tcp://HOST:PORT (the binary protocol, protocol/PROTOCOL.md).  Parameters
+are the daemon's query parameters (GET /v1/params): the parameter table
+(radius, samples, fov_y, world_to_camera, ...) and the request options
+(output, format, float, png_bits, preset, depth, normal, color, layer,
+append).  Values may be str, int, float, bool (1/0) or a list or tuple
+(joined with commas: world_to_camera, normal, color).
+
+A file is streamed to the daemon as it is read (never held whole in
+memory), and with out= the answer is streamed into a file.  A refusal is
+an ObscuraError whose .code is the daemon's JSON error code
+("bad_parameter", "missing_channel", "no_camera", "queue_full", ...);
+an unreachable daemon raises ObscuraError with code "unreachable".
+
+Works with Python 3.6 and later.
+"""
+import http.client
+import json
+import os
+import socket
+import struct
+import urllib.parse
+
+__all__ = ["ao", "ObscuraError", "DEFAULT_SERVER"]
+__version__ = "1.0.0"
+
+DEFAULT_SERVER = "http://127.0.0.1:8420"
+CHUNK = 1 << 16
+
+# protocol/PROTOCOL.md: frame header and body kinds
+MAGIC = b"OBSP"
+VERSION = 1
+KIND_REQUEST, KIND_RESPONSE = 1, 2
+BODY_NONE, BODY_EXR, BODY_RAW, BODY_PNG = 0, 1, 2, 3
+MAX_NAME, MAX_VALUE, MAX_PARAMS = 64, 4096, 256
+
+
+class ObscuraError(Exception):
+    """A request obscurad refused or could not answer.
+
+    status: the HTTP status (the binary protocol uses the same numbers),
+    None when the daemon was not reached; code: the JSON error code;
+    message: what is wrong; retry_after: seconds to wait (503), or 0."""
+
+    def __init__(self, status, code, message, retry_after=0):
+        Exception.__init__(self, "%s%s: %s" % (code, " (%d)" % status if status else "", message))
+        self.status = status
+        self.code = code
+        self.message = message
+        self.retry_after = retry_after
+
+
+def _value(v):
+    if isinstance(v, bool):
+        return "1" if v else "0"
+    if isinstance(v, (list, tuple)):
+        return ",".join(_value(x) for x in v)
+    if isinstance(v, float):
+        return repr(v)
+    return str(v)
+
+
+def _params(params, token):
+    out = []
+    for k, v in params.items():
+        if v is None:
+            continue
+        out.append((str(k), _value(v)))
+    if token:
+        out.append(("token", token))
+    return out
+
+
+class _Source(object):
+    """The EXR to send: a path (streamed), bytes, or a readable file
+    object with a known size."""
+
+    def __init__(self, source):
+        self.f = None
+        self.data = None
+        if isinstance(source, (bytes, bytearray, memoryview)):
+            self.data = bytes(source)
+            self.size = len(self.data)
+        elif isinstance(source, (str, os.PathLike)):
+            self.f = open(source, "rb")
+            self.size = os.fstat(self.f.fileno()).st_size
+        elif hasattr(source, "read"):
+            self.f = source
+            pos = source.tell()
+            source.seek(0, os.SEEK_END)
+            self.size = source.tell() - pos
+            source.seek(pos)
+        else:
+            raise TypeError("ao(): the source is a path, bytes or a binary file object, not %r" % type(source))
+        if self.size == 0:
+            raise ValueError("ao(): the EXR is empty")
+
+    def chunks(self):
+        if self.data is not None:
+            yield self.data
+            return
+        while True:
+            b = self.f.read(CHUNK)
+            if not b:
+                return
+            yield b
+
+    def body(self):
+        return self.data if self.data is not None else self.f
+
+    def close(self, opened_here):
+        if opened_here and self.f is not None:
+            self.f.close()
+
+
+class _Sink(object):
+    """Where the answer goes: a file (path or object) or memory."""
+
+    def __init__(self, out):
+        self.parts = []
+        self.f = None
+        self.path = None
+        if isinstance(out, (str, os.PathLike)):
+            self.path = os.fspath(out)
+            self.f = open(self.path + ".part", "wb")
+        elif out is not None:
+            self.f = out
+
+    def write(self, b):
+        if self.f is not None:
+            self.f.write(b)
+        else:
+            self.parts.append(b)
+
+    def done(self):
+        if self.path is not None:
+            self.f.close()
+            os.replace(self.path + ".part", self.path)
+            return None
+        if self.f is not None:
+            return None
+        return b"".join(self.parts)
+
+    def fail(self):
+        if self.path is not None:
+            self.f.close()
+            try:
+                os.unlink(self.path + ".part")
+            except OSError:
+                pass
+
+
+def _http_error(status, body):
+    try:
+        e = json.loads(body.decode("utf-8", "replace"))["error"]
+        return e.get("code", "error"), e.get("message", "")
+    except (ValueError, KeyError, TypeError):
+        return "http_%d" % status, body.decode("utf-8", "replace")[:500]
+
+
+def _ao_http(server, src, params, token, sink, timeout):
+    # http.client (what urllib.request runs on) rather than urlopen: the
+    # daemon refuses a bad request before it reads the body and closes,
+    # and the answer must still be read after the send breaks off.
+    u = urllib.parse.urlsplit(server)
+    path = (u.path.rstrip("/") or "") + "/v1/ao?" + urllib.parse.urlencode(params)
+    conn = http.client.HTTPConnection(u.hostname or "127.0.0.1", u.port or 80, timeout=timeout)
+    try:
+        try:
+            conn.putrequest("POST", path)
+            conn.putheader("Content-Type", "image/x-exr")
+            conn.putheader("Content-Length", str(src.size))
+            if token:
+                conn.putheader("Authorization", "Bearer " + token)
+            conn.endheaders()
+        except OSError as e:
+            raise ObscuraError(None, "unreachable", "%s: %s" % (server, e))
+        try:
+            for b in src.chunks():
+                conn.send(b)
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # refused before the body was read: the answer says why
+        try:
+            resp = conn.getresponse()
+        except (OSError, http.client.HTTPException) as e:
+            raise ObscuraError(None, "unreachable", "%s: no answer: %s" % (server, e))
+        if resp.status != 200:
+            code, msg = _http_error(resp.status, resp.read())
+            retry = resp.getheader("Retry-After")
+            raise ObscuraError(resp.status, code, msg, int(retry) if retry and retry.isdigit() else 0)
+        while True:
+            b = resp.read(CHUNK)
+            if not b:
+                break
+            sink.write(b)
+    except socket.timeout:
+        raise ObscuraError(None, "unreachable", "%s: no answer within %s s" % (server, timeout))
+    finally:
+        conn.close()
+
+
+def _connect(server, timeout):
+    try:
+        if server.startswith("unix:"):
+            s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+            s.settimeout(timeout)
+            s.connect(server[5:])
+            return s
+        host, _, port = server[len("tcp://"):].rpartition(":")
+        host = host[1:-1] if host.startswith("[") else host
+        return socket.create_connection((host or "127.0.0.1", int(port)), timeout=timeout)
+    except (OSError, ValueError) as e:
+        raise ObscuraError(None, "unreachable", "%s: %s" % (server, e))
+
+
+def _recv_exact(s, n, server):
+    buf = bytearray()
+    while len(buf) < n:
+        b = s.recv(min(n - len(buf), CHUNK))
+        if not b:
+            raise ObscuraError(None, "unreachable", "%s: the connection closed mid-answer" % server)
+        buf += b
+    return bytes(buf)
+
+
+def _ao_binary(server, src, params, sink, timeout):
+    # Request payload: parameters, kind 1 (EXR), padding to 8, the EXR's
+    # length, then the EXR itself (sent as it is read).
+    if len(params) > MAX_PARAMS:
+        raise ValueError("ao(): at most %d parameters" % MAX_PARAMS)
+    head = struct.pack("<I", len(params))
+    for k, v in params:
+        kb, vb = k.encode("utf-8"), v.encode("utf-8")
+        if not 1 <= len(kb) <= MAX_NAME or len(vb) > MAX_VALUE:
+            raise ValueError("ao(): parameter %r: the name is 1..%d bytes, the value at most %d" % (k, MAX_NAME, MAX_VALUE))
+        head += struct.pack("<H", len(kb)) + kb + struct.pack("<I", len(vb)) + vb
+    head += bytes([BODY_EXR])
+    head += b"\0" * ((8 - len(head) % 8) % 8)
+    head += struct.pack("<Q", src.size)
+    frame_id = 1
+    header = MAGIC + struct.pack("<HHQQ", VERSION, KIND_REQUEST, frame_id, len(head) + src.size)
+    s = _connect(server, timeout)
+    try:
+        try:
+            s.sendall(header + head)
+            for b in src.chunks():
+                s.sendall(b)
+        except OSError:
+            pass  # refused from the head: the answer says why
+        h = _recv_exact(s, 24, server)
+        magic, version, kind, rid, length = struct.unpack("<4sHHQQ", h)
+        if magic != MAGIC or kind != KIND_RESPONSE or version != VERSION:
+            raise ObscuraError(None, "bad_answer", "%s: not an obscurad binary-protocol answer" % server)
+        off = 0
+        status, retry, clen = struct.unpack("<HHH", _recv_exact(s, 6, server))
+        code = _recv_exact(s, clen, server).decode("utf-8", "replace")
+        (mlen,) = struct.unpack("<I", _recv_exact(s, 4, server))
+        msg = _recv_exact(s, mlen, server).decode("utf-8", "replace")
+        body = _recv_exact(s, 1, server)[0]
+        off = 6 + clen + 4 + mlen + 1
+        _recv_exact(s, (8 - off % 8) % 8, server)
+        if status != 200:
+            raise ObscuraError(status, code, msg, retry)
+        if body not in (BODY_EXR, BODY_PNG):
+            raise ObscuraError(status, "bad_answer", "%s: answer body kind %d (ask format=exr or png)" % (server, body))
+        (n,) = struct.unpack("<Q", _recv_exact(s, 8, server))
+        while n > 0:
+            b = s.recv(min(n, CHUNK))
+            if not b:
+                raise ObscuraError(None, "unreachable", "%s: the connection closed mid-answer" % server)
+            sink.write(b)
+            n -= len(b)
+    except socket.timeout:
+        raise ObscuraError(None, "unreachable", "%s: no answer within %s s" % (server, timeout))
+    finally:
+        s.close()
+
+
+def ao(source, server=None, out=None, token=None, timeout=300, **params):
+    """The AO of one G-buffer EXR from obscurad.
+
+    source: a path (streamed from disk), bytes, or a binary file object.
+    server: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT (default: the
+    OBSCURA_SERVER environment variable, else http://127.0.0.1:8420).
+    out: a path or a binary file object to stream the answer into (a
+    path is written whole or not at all); then None is returned.
+    token: the bearer token (default: OBSCURA_TOKEN).
+    params: the daemon's query parameters.
+    Returns the answer's bytes (an EXR, or a PNG with format="png").
+    Raises ObscuraError (with .code) when the daemon refuses or cannot
+    be reached, TypeError/ValueError for arguments it cannot send."""
+    server = server or os.environ.get("OBSCURA_SERVER") or DEFAULT_SERVER
+    token = token if token is not None else os.environ.get("OBSCURA_TOKEN")
+    if str(params.get("format", "exr")) == "raw":
+        raise ValueError("ao(): format=raw is not an answer this client returns (use exr or png)")
+    opened_here = isinstance(source, (str, os.PathLike))
+    src = _Source(source)
+    sink = _Sink(out)
+    try:
+        if server.startswith("http://"):
+            _ao_http(server, src, _params(params, None), token, sink, timeout)
+        elif server.startswith("unix:") or server.startswith("tcp://"):
+            _ao_binary(server, src, _params(params, token), sink, timeout)
+        else:
+            raise ValueError("ao(): server %r is not http://HOST:PORT, unix:/PATH or tcp://HOST:PORT" % server)
+    except BaseException:
+        sink.fail()
+        raise
+    finally:
+        src.close(opened_here)
+    return sink.done()

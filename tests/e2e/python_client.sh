@@ -1,0 +1,143 @@
+#!/bin/sh
+# End-to-end tests of clients/python/obscura_client.py against a real
+# obscurad on HTTP, a Unix socket and TCP: the same answer, byte for byte,
+# as `obscura ao` writes in process, over every transport and from a path,
+# bytes or a file object; the answer streamed into a file; errors as
+# ObscuraError with the daemon's JSON code; run with `python3 -I` (no site
+# packages, no PYTHONPATH), as in the Pythons of DCC applications.
+#
+#   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/python_client.sh
+#
+# The daemon it starts is killed on exit; every wait is bounded.
+set -u
+OBSCURA=${OBSCURA:-build/obscura}
+OBSCURAD=${OBSCURAD:-build/obscurad}
+DATA=tests/data
+R="$DATA/room_small.exr"
+. tests/e2e/lib/common.sh
+
+echo "e2e python client: $OBSCURAD"
+if ! command -v python3 >/dev/null 2>&1; then
+    echo "  FAIL python3 not found (tools/deps.sh)"
+    exit 1
+fi
+W2C=$(tr -d ' \n' < "$DATA/room_small.camera.json" |
+    sed 's/.*"world_to_camera":\[\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\]\].*/\1,\2,\3,\4/')
+CAM_CLI="--fov-y 50 --near 0.05 --far 100 --world-to-camera $W2C"
+start_all d --max-body 8m --queue 4
+HP=$PORT_d TP=$TCP_d SOCK=$SOCK_d
+
+# py ARGS...: the client's folder on sys.path by hand, nothing else
+cat > "$T/run.py" <<'EOF'
+import io, os, sys
+sys.path.insert(0, os.path.join(os.getcwd(), "clients", "python"))
+import obscura_client as oc
+
+mode, server, src, out, w2c = sys.argv[1:6]
+cam = dict(fov_y=50, near=0.05, far=100, world_to_camera=[float(x) for x in w2c.split(",")])
+try:
+    if mode == "path":
+        data = oc.ao(src, server=server, **cam)
+    elif mode == "bytes":
+        data = oc.ao(open(src, "rb").read(), server=server, **cam)
+    elif mode == "file":
+        with open(src, "rb") as f:
+            data = oc.ao(f, server=server, **cam)
+    elif mode == "stream":
+        data = oc.ao(src, server=server, out=out, **cam)
+        assert data is None
+        data = open(out, "rb").read()
+    elif mode == "png":
+        data = oc.ao(src, server=server, format="png", png_bits=16, **cam)
+    elif mode == "missing":
+        data = oc.ao(src, server=server, depth="NoSuchChannel", **cam)
+    elif mode == "badparam":
+        data = oc.ao(src, server=server, radius=-3, **cam)
+    elif mode == "nocamera":
+        data = oc.ao(src, server=server)
+    elif mode == "failout":
+        data = oc.ao(src, server=server, out=out, depth="NoSuchChannel", **cam)
+    else:
+        raise SystemExit("unknown mode " + mode)
+except oc.ObscuraError as e:
+    print("error status=%s code=%s message=%s" % (e.status, e.code, e.message))
+    raise SystemExit(3)
+open(out, "wb").write(data)
+print("ok %d bytes" % len(data))
+EOF
+py() { python3 -I -B "$T/run.py" "$@"; }
+
+echo "-- the same bytes as the CLI, over every transport"
+# shellcheck disable=SC2086
+"$OBSCURA" ao "$R" $CAM_CLI -o "$T/cli.exr" -q 2>/dev/null
+for url in "http://127.0.0.1:$HP" "unix:$SOCK" "tcp://127.0.0.1:$TP"; do
+    for mode in path bytes file stream; do
+        py "$mode" "$url" "$R" "$T/py.exr" "$W2C" >"$T/out" 2>&1
+        rc=$?
+        check "${url%%:*} from a $mode: exit $rc, the CLI's bytes ($(cat "$T/out" | head -c 80))" \
+            "[ $rc -eq 0 ] && cmp -s '$T/cli.exr' '$T/py.exr'"
+        rm -f "$T/py.exr"
+    done
+done
+# shellcheck disable=SC2086
+"$OBSCURA" ao "$R" $CAM_CLI --png-bits 16 -o "$T/cli.png" -q 2>/dev/null
+py png "tcp://127.0.0.1:$TP" "$R" "$T/py.png" "$W2C" >/dev/null 2>&1
+check "tcp format=png png_bits=16: the CLI's PNG" "cmp -s '$T/cli.png' '$T/py.png'"
+
+echo "-- errors carry the daemon's code"
+for url in "http://127.0.0.1:$HP" "unix:$SOCK"; do
+    py missing "$url" "$R" "$T/x.exr" "$W2C" >"$T/out" 2>&1
+    rc=$?
+    check "${url%%:*} missing channel: exit $rc, ObscuraError missing_channel 422 ($(head -c 90 "$T/out"))" \
+        "[ $rc -eq 3 ] && grep -q 'status=422 code=missing_channel message=.*NoSuchChannel' '$T/out'"
+    py badparam "$url" "$R" "$T/x.exr" "$W2C" >"$T/out" 2>&1
+    check "${url%%:*} radius=-3: bad_parameter 400 naming radius" \
+        "grep -q 'status=400 code=bad_parameter message=.*radius' '$T/out'"
+done
+py nocamera "tcp://127.0.0.1:$TP" "$R" "$T/x.exr" "$W2C" >"$T/out" 2>&1
+check "tcp no camera: no_camera ($(head -c 80 "$T/out"))" "grep -q 'code=no_camera' '$T/out'"
+py failout "http://127.0.0.1:$HP" "$R" "$T/fail.exr" "$W2C" >/dev/null 2>&1
+check "a refused request leaves no output file behind" "[ ! -e '$T/fail.exr' ] && [ ! -e '$T/fail.exr.part' ]"
+py path "http://127.0.0.1:1" "$R" "$T/x.exr" "$W2C" >"$T/out" 2>&1
+check "an unreachable daemon: ObscuraError unreachable" "grep -q 'status=None code=unreachable' '$T/out'"
+py path "ftp://x" "$R" "$T/x.exr" "$W2C" >"$T/out" 2>&1
+check "a server it cannot talk to: ValueError naming it" "grep -q \"ValueError: ao(): server 'ftp://x'\" '$T/out'"
+
+echo "-- packaging and the example"
+check "pyproject.toml names the module it packages" \
+    "python3 -I -c 'import sys, tomllib; d = tomllib.load(open(\"clients/python/pyproject.toml\", \"rb\")); sys.exit(d[\"tool\"][\"setuptools\"][\"py-modules\"] != [\"obscura_client\"])' 2>/dev/null ||
+     grep -q 'py-modules = \[\"obscura_client\"\]' clients/python/pyproject.toml"
+check "the Blender example compiles, and imports only the standard library, bpy and the client" \
+    "python3 -I -B -c \"import ast, sys; ast.parse(open(sys.argv[1]).read())\" clients/python/examples/blender_post_render.py &&
+     ! grep -E '^(import|from) ' clients/python/examples/blender_post_render.py | grep -vqE '^(import|from) (bpy|os|sys|obscura_client)\\b'"
+
+# pip install clients/python, offline (--no-build-isolation: the
+# setuptools and wheel already there), into a folder of its own; with the
+# first python3 that has pip, setuptools and wheel (Debian: python3-pip,
+# python3-wheel)
+PIPPY=""
+for p in python3 /usr/bin/python3; do
+    if "$p" -c 'import setuptools, wheel, pip' 2>/dev/null; then PIPPY=$p; break; fi
+done
+if [ -n "$PIPPY" ]; then
+    cp -r clients/python "$T/pkg"
+    rm -rf "$T/pkg/build" "$T/pkg/"*.egg-info
+    "$PIPPY" -m pip install -q --no-build-isolation --no-deps --no-index --target "$T/site" "$T/pkg" >"$T/pip.log" 2>&1
+    rc=$?
+    "$PIPPY" -I -B -c 'import sys; sys.path.insert(0, sys.argv[1]); import obscura_client as oc
+assert oc.__file__.startswith(sys.argv[1]), oc.__file__
+open(sys.argv[4], "wb").write(oc.ao(sys.argv[2], server=sys.argv[3], fov_y=50, near=0.05, far=100,
+                                    world_to_camera=sys.argv[5]))' "$T/site" "$R" "tcp://127.0.0.1:$TP" "$T/pip.exr" "$W2C" \
+        >>"$T/pip.log" 2>&1
+    check "pip install clients/python ($PIPPY): exit $rc, the installed module gives the CLI's bytes" \
+        "[ $rc -eq 0 ] && cmp -s '$T/cli.exr' '$T/pip.exr'"
+    [ -e "$T/pip.exr" ] || sed 's/^/       /' "$T/pip.log" | tail -5
+else
+    echo "  skip pip install: no python3 with pip, setuptools and wheel (Debian python3-pip, python3-wheel)"
+fi
+
+kill "$PID_d" 2>/dev/null
+wait "$PID_d" 2>/dev/null
+[ $failed -ne 0 ] && tail -20 "$T/d.log" | sed 's/^/       /'
+echo "e2e python client: $pass passed, $failed failed"
+[ "$failed" -eq 0 ]
