@@ -1,0 +1,55 @@
+/* OpenEXR's messages and statuses, for every EXR file of core/io: the
+ * library reports through a callback (obs__exr_error_handler) into a
+ * per-thread buffer, which the failing call's message then quotes.  Below
+ * the readers and writers, so that each can use it. */
+#include <stdio.h>
+#include <string.h>
+
+#include "io/exr_internal.h"
+#include "internal.h"
+
+static _Thread_local char exr_msg[384];
+
+void obs__exr_msg_reset(void)
+{
+    exr_msg[0] = '\0';
+}
+
+const char *obs__exr_msg(void)
+{
+    return exr_msg;
+}
+
+void obs__exr_error_handler(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+{
+    size_t n = strlen(exr_msg);
+    (void)ctxt;
+    if (!msg || !*msg)
+        msg = exr_get_default_error_message(code);
+    /* The first message names the cause; later ones add context. */
+    if (n == 0)
+        snprintf(exr_msg, sizeof exr_msg, "%s", msg);
+    else if (n + 3 < sizeof exr_msg)
+        snprintf(exr_msg + n, sizeof exr_msg - n, "; %s", msg);
+}
+
+obs_status obs__exr_status(exr_result_t rv)
+{
+    switch (rv) {
+    case EXR_ERR_SUCCESS: return OBS_OK;
+    case EXR_ERR_OUT_OF_MEMORY: return OBS_NO_MEMORY;
+    case EXR_ERR_FILE_ACCESS:
+    case EXR_ERR_WRITE_IO: return OBS_IO;
+    case EXR_ERR_FEATURE_NOT_IMPLEMENTED: return OBS_UNSUPPORTED;
+    /* The reader passes valid arguments, so anything else (out of range,
+     * bad header, corrupt chunk, short read) comes from the file. */
+    default: return OBS_BAD_FILE;
+    }
+}
+
+obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv, const char *what)
+{
+    const char *msg = exr_msg[0] ? exr_msg : exr_get_default_error_message(rv);
+    return obs__fail(err, obs__exr_status(rv), "%s: %s", what, msg);
+}
+
