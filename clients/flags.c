@@ -30,6 +30,15 @@ int cli_is_switch(const char *arg, const char *name)
     return arg[0] == '-' && arg[1] == '-' && strcmp(arg + 2, name) == 0;
 }
 
+/* --name=VALUE of a switch (--solve-camera=0): VALUE, else NULL. */
+static const char *switch_value(const char *arg, const char *name)
+{
+    size_t n = strlen(name);
+    return arg[0] == '-' && arg[1] == '-' && strncmp(arg + 2, name, n) == 0 && arg[2 + n] == '='
+               ? arg + 3 + n
+               : NULL;
+}
+
 int cli_request_flag(int argc, char **argv, int *i, obs_http_request *r,
                      const obs_http_option **which, char err[OBS_ERR_LEN])
 {
@@ -42,8 +51,11 @@ int cli_request_flag(int argc, char **argv, int *i, obs_http_request *r,
             if (*c == '_')
                 *c = '-';
         /* a switch means 1, as an empty query value does */
-        k = op->kind == OBS_HTTP_OPT_BOOL ? cli_is_switch(argv[*i], flag)
-                                          : cli_flag_value(argc, argv, i, flag, &v);
+        if (op->kind == OBS_HTTP_OPT_BOOL && (v = switch_value(argv[*i], flag)))
+            k = 1;
+        else
+            k = op->kind == OBS_HTTP_OPT_BOOL ? cli_is_switch(argv[*i], flag)
+                                              : cli_flag_value(argc, argv, i, flag, &v);
         if (k == 0)
             continue;
         if (which)

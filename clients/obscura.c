@@ -521,11 +521,13 @@ static int cmd_ao(int argc, char **argv)
                     a.camera, cw, ch, dw, dh);
     }
 
-    if (a.req.solve_camera && (s = obs_gbuffer_solve_camera(&gf, &a.req.params, err)) != OBS_OK) {
+    const int had_camera = gf.gb.camera.has_projection;
+    if (a.req.solve_camera && gf.gb.position.data &&
+        (s = obs_gbuffer_solve_camera(&gf, &a.req.params, err)) != OBS_OK) {
         rc = cli_input_fail(s, a.in, err);
         goto done;
     }
-    if (a.req.solve_camera && verbosity >= OBS_LOG_INFO)
+    if (!had_camera && gf.gb.camera.has_projection && verbosity >= OBS_LOG_INFO)
         fprintf(stderr, "obscura: info: camera %s, %s\n", gf.info.camera_source,
                 gf.info.camera_check);
     obs_gbuffer_sanity(&gf.gb, &a.req.params, &gf.info);

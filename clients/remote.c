@@ -232,12 +232,12 @@ static void collect(int argc, char **argv, int map_too, pairs *ps, char names[][
                       !strcmp(name, op->name);
         int is_param = obs_param_find(name) != NULL;
         /* the switches that change how the daemon reads the frame
-         * (strict, solve_camera) go as name=1; float is the client's */
+         * (strict, solve_camera) go as name=1, or name=VALUE from
+         * --name=VALUE; float is the client's */
         const obs_http_option *sw = obs_http_option_find(name);
-        if (map_too && sw && sw->kind == OBS_HTTP_OPT_BOOL && strcmp(sw->name, "float") != 0 &&
-            !eq) {
+        if (map_too && sw && sw->kind == OBS_HTTP_OPT_BOOL && strcmp(sw->name, "float") != 0) {
             snprintf(name, OBS_BIN_MAX_NAME + 1, "%s", sw->name);
-            add(ps, name, "1");
+            add(ps, name, eq ? eq + 1 : "1");
             continue;
         }
         if (!is_param && !(map_too && is_map))

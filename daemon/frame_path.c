@@ -47,7 +47,7 @@ obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
         s = obs_deep_read_exr_mem(body, len, lim, &fp->deep_exr, err);
     else if (s == OBS_OK)
         s = obs_gbuffer_read_exr_mem(body, len, map, lim, &fp->gf, err);
-    if (s == OBS_OK && !deep && hr->solve_camera)
+    if (s == OBS_OK && !deep && hr->solve_camera && fp->gf.gb.position.data)
         s = obs_gbuffer_solve_camera(&fp->gf, &hr->params, err);
     /* strict: a sanity warning on the input fails the frame (HTTP 422) */
     if (s == OBS_OK && !deep && obs_gbuffer_sanity(&fp->gf.gb, &hr->params, &fp->gf.info) > 0 &&

@@ -64,9 +64,9 @@ const obs_http_option obs_http_options[] = {
     {.name = "strict", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(strict), .def = "0",
      .doc = "sanity warnings on the input (depth looks normalized or inverted, normals not unit "
             "length or in the other space, camera metadata that disagrees) are errors"},
-    {.name = "solve_camera", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(solve_camera), .def = "0",
+    {.name = "solve_camera", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(solve_camera), .def = "1",
      .doc = "with no camera in the file or the request: solve the pinhole camera from the "
-            "file's world-space position pass (P, Position)"},
+            "file's world-space position pass (P, Position) (0: never)"},
     {.name = "layer", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(layer_name), .def = "", .min = 1, .max = 1,
      .slot = SLOT(layer_name), .map = FIELD(layer), .what = "a layer name (1 to 63 characters)",
      .doc = "EXR: the output's layer: NAME.Y for the AO, NAME.R,G,B,A for the composite (default AO.Y; R,G,B,A)"},

@@ -70,8 +70,8 @@ done
 check "PNG composite over unix: same bytes as in-process" "cmp -s '$T/lc.png' '$T/rc.png'"
 
 echo "-- exit codes"
-"$OBSCURA" ao "$R" -o "$T/x.exr" --server "unix:$SOCK" -q 2>"$T/err"
-check "no camera: the server's 422 is exit 3, message shown" "[ $? -eq 3 ] && grep -q 'no_camera' '$T/err'"
+"$OBSCURA" ao "$R" -o "$T/x.exr" --server "unix:$SOCK" --solve-camera=0 -q 2>"$T/err"
+check "no camera (--solve-camera=0 sent along): the server's 422 is exit 3, message shown" "[ $? -eq 3 ] && grep -q 'no_camera' '$T/err'"
 "$OBSCURA" ao "$R" $CAM_CLI -o "$T/x.exr" --server "ftp://x:1" -q 2>"$T/err"
 check "a bad --server URL is exit 2" "[ $? -eq 2 ]"
 "$OBSCURA" ao "$R" $CAM_CLI -o "$T/x.exr" --server "unix:$T/nobody.sock" -q 2>"$T/err"

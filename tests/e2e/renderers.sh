@@ -69,23 +69,24 @@ check "binary protocol: the frame as it is: exit 0" "[ $? -eq 0 ]"
 
 echo "-- the camera solved from the position pass"
 "$OBSCURA" ao "$R" --camera "$RC" -o "$T/json.exr" -q
-"$OBSCURA" ao "$R" --solve-camera -o "$T/solved.exr" -q 2>"$T/err"
-check "CLI --solve-camera: exit 0" "[ $? -eq 0 ]"
+"$OBSCURA" ao "$R" -o "$T/solved.exr" 2>"$T/err"
+check "CLI, no camera given: solved from the position pass, said so, exit 0" \
+    "[ $? -eq 0 ] && grep -q 'solved from the position pass' '$T/err'"
 "$OBSCURA" compare "$T/json.exr" "$T/solved.exr" --channel-a AO.Y --channel-b AO.Y --mask none --json > "$T/cmp2.json"
 check "solved camera = camera JSON (AO MAE < 1e-4)" \
     "python3 -c 'import json,sys; sys.exit(not json.load(open(sys.argv[1]))[\"mae\"] < 1e-4)' '$T/cmp2.json'"
 "$OBSCURA" inspect "$R" > "$T/insp2.txt"
 check "inspect: the camera solved from ViewLayer.Position" \
     "grep -q 'camera: solved from the position pass ViewLayer.Position.X' '$T/insp2.txt'"
-code=$(post "$PORT_d" "solve_camera=1" "$R" "$T/h4.out")
-check "HTTP solve_camera=1: 200" "[ '$code' = 200 ]"
-code=$(post "$PORT_d" "" "$R" "$T/h5.out")
-check "HTTP without a camera: 422 no_camera" "[ '$code' = 422 ] && error_is '$T/h5.out' no_camera"
+code=$(post "$PORT_d" "" "$R" "$T/h4.out")
+check "HTTP without a camera: solved from the position pass by default, 200" "[ '$code' = 200 ]"
+code=$(post "$PORT_d" "solve_camera=0" "$R" "$T/h5.out")
+check "HTTP solve_camera=0 without a camera: 422 no_camera" "[ '$code' = 422 ] && error_is '$T/h5.out' no_camera"
 for url in "unix:$T/obscurad.sock" "http://127.0.0.1:$PORT_d"; do
-    "$OBSCURA" ao "$R" --solve-camera -o "$T/rs.exr" -q --server "$url" 2>"$T/err"
+    "$OBSCURA" ao "$R" -o "$T/rs.exr" -q --server "$url" 2>"$T/err"
     rc=$?
     "$OBSCURA" compare "$T/solved.exr" "$T/rs.exr" --channel-a AO.Y --channel-b AO.Y --mask none --json > "$T/cmp3.json" 2>/dev/null
-    check "--solve-camera --server $url: exit 0, the local AO" \
+    check "no camera, --server $url: solved there, exit 0, the local AO" \
         "[ $rc -eq 0 ] && python3 -c 'import json,sys; sys.exit(not json.load(open(sys.argv[1]))[\"mae\"] < 1e-4)' '$T/cmp3.json'"
 done
 

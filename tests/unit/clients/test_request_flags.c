@@ -183,7 +183,8 @@ static void test_rows_same_both_ways(void **state)
 }
 
 /* A BOOL row is a switch in the CLI: --float is float=1 (and float=,
- * which a query takes as 1); --float=1 is not the switch. */
+ * which a query takes as 1); --float=0 and --float=1 set it to the value
+ * (solve_camera, on by default, is turned off so). */
 static void test_switches(void **state)
 {
     (void)state;
@@ -204,10 +205,17 @@ static void test_switches(void **state)
         assert_int_equal(i, 0); /* a switch takes no value */
         assert_same_request(&h1, &c, op->name);
         assert_same_request(&h0, &c, op->name);
-        if (memcmp(&c, &def, sizeof c) == 0)
-            fail_msg("%s: the switch changes nothing", op->name);
-        snprintf(arg, sizeof arg, "--%s=1", flag);
-        assert_int_equal(cli_request_flag(2, argv, &i, &c, &which, err), 0);
+        obs_http_request off = fresh(), c0 = fresh();
+        assert_int_equal(obs_http_request_set(&off, op->name, "0", NULL), OBS_OK);
+        if (memcmp(&c, &def, sizeof c) == 0 && memcmp(&off, &def, sizeof off) == 0)
+            fail_msg("%s: neither value changes anything", op->name);
+        snprintf(arg, sizeof arg, "--%s=0", flag);
+        assert_int_equal(cli_request_flag(2, argv, &i, &c0, &which, err), 1);
+        assert_int_equal(i, 0);
+        assert_same_request(&off, &c0, op->name);
+        snprintf(arg, sizeof arg, "--%s=maybe", flag);
+        assert_int_equal(cli_request_flag(2, argv, &i, &c0, &which, err), -1);
+        assert_non_null(strstr(err, op->name));
     }
 }
 
