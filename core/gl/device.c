@@ -67,6 +67,7 @@ obs_status obs__gl_device_bind(obs__gl_device *d, char err[OBS_ERR_LEN])
         return obs__fail(err, OBS_GL_ERROR, "%s: the context could not be made current",
                          obs_backend_name(d->backend));
     obs__glp = &d->gl;
+    obs__progcache_cur = &d->cache;
     return OBS_OK;
 }
 
@@ -78,6 +79,8 @@ static void destroy_backend(obs__gl_device *d)
         obs__egl_destroy(&d->st);
     if (obs__glp == &d->gl)
         obs__glp = NULL;
+    if (obs__progcache_cur == &d->cache)
+        obs__progcache_cur = NULL;
 }
 
 static obs_status try_backend(obs__gl_device *d, obs_backend b, char err[OBS_ERR_LEN])
@@ -116,13 +119,17 @@ fail:
     return s;
 }
 
-obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, char err[OBS_ERR_LEN])
+obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, const char *cache_dir,
+                                 char err[OBS_ERR_LEN])
 {
     static const obs_backend order[] = {OBS_BACKEND_EGL_DEVICE, OBS_BACKEND_EGL_SURFACELESS,
                                         OBS_BACKEND_OSMESA};
     if ((unsigned)backend >= OBS_BACKEND_COUNT)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown backend %d", (int)backend);
     obs_status s = OBS_GL_UNAVAILABLE;
+    /* before any backend: Mesa reads where its shader cache is when the
+     * display is initialised */
+    obs__progcache_open(&d->cache, cache_dir, d->log, d->log_user);
     if (backend != OBS_BACKEND_AUTO) {
         s = try_backend(d, backend, err);
     } else {
@@ -149,6 +156,8 @@ obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, char er
         d->gl.DebugMessageCallback(debug_cb, d);
     }
     glGenVertexArrays(1, &d->vao);
+    obs__progcache_cur = &d->cache;
+    obs__progcache_attach(&d->cache, d->vendor, d->renderer, d->version);
     return OBS_OK;
 }
 
