@@ -28,6 +28,7 @@
 #include "obscura/metrics.h"
 #include "obscura/obscura.h"
 #include "remote.h"
+#include "warmup.h"
 
 
 static int verbosity = OBS_LOG_INFO;
@@ -123,6 +124,7 @@ static void usage(FILE *f)
             "                #### or %%04d is the frame; missing inputs are skipped (--strict: exit 3)\n",
             OBS_VERSION);
     cli_ground_usage(f);
+    cli_warmup_usage(f);
     fprintf(f, "\nao options:\n");
     for (const cli_opt *o = ao_opts; o->name; o++) {
         char left[48];
@@ -906,6 +908,8 @@ int main(int argc, char **argv)
         return cli_gbuffer(argc - 2, argv + 2);
     if (!strcmp(cmd, "reference"))
         return cli_reference(argc - 2, argv + 2);
+    if (!strcmp(cmd, "warmup"))
+        return cli_warmup(argc - 2, argv + 2);
     if (!strcmp(cmd, "batch")) {
         static const cli_batch_ops ops = {batch_check, batch_ao, batch_finish};
         return cli_batch(argc - 2, argv + 2, &ops);

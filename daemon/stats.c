@@ -181,9 +181,20 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
             "# HELP obscurad_gl_kept_bytes Texture memory the GL worker keeps for the next frame "
             "(--keep-memory).\n"
             "# TYPE obscurad_gl_kept_bytes gauge\n"
-            "obscurad_gl_kept_bytes %llu\n",
+            "obscurad_gl_kept_bytes %llu\n"
+            "# HELP obscurad_programs_compiled_total GL programs built from source.\n"
+            "# TYPE obscurad_programs_compiled_total counter\n"
+            "obscurad_programs_compiled_total %llu\n"
+            "# HELP obscurad_programs_loaded_total GL programs loaded from the program cache (--cache-dir).\n"
+            "# TYPE obscurad_programs_loaded_total counter\n"
+            "obscurad_programs_loaded_total %llu\n"
+            "# HELP obscurad_programs_rejected_total Program cache entries found unusable (damaged, another "
+            "driver's) and rebuilt.\n"
+            "# TYPE obscurad_programs_rejected_total counter\n"
+            "obscurad_programs_rejected_total %llu\n",
         g->queue_depth, g->queue_capacity, g->gl_running, g->in_flight, g->gl_alive,
-        g->gl_recreations, g->gl_kept_bytes);
+        g->gl_recreations, g->gl_kept_bytes, g->programs_compiled, g->programs_loaded,
+        g->programs_rejected);
     put(&b, "# HELP obscurad_streams Streams of frames kept for the preview page.\n"
             "# TYPE obscurad_streams gauge\n"
             "obscurad_streams %d\n"

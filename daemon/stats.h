@@ -30,6 +30,7 @@ typedef struct obsd_gauges {
     int queue_depth, queue_capacity, gl_running, in_flight, gl_alive;
     unsigned long long gl_recreations; /* GL contexts recreated after a failure */
     unsigned long long gl_kept_bytes;  /* texture memory kept for the next frame */
+    unsigned long long programs_compiled, programs_loaded, programs_rejected; /* program cache */
     int streams, stream_frames, sse_subscribers;
     uint64_t stream_bytes;
 } obsd_gauges;
