@@ -354,8 +354,8 @@ static void log_programs(const obs_ctx *ctx)
     obs_ctx_info ci;
     obs_ctx_get_info(ctx, &ci);
     if (verbosity >= OBS_LOG_DEBUG)
-        fprintf(stderr, "obscura: debug: programs: %lu compiled, %lu loaded, %lu rejected (program "
-                "cache %s%s)\n", ci.programs_compiled, ci.programs_loaded, ci.programs_rejected,
+        fprintf(stderr, "obscura: debug: programs: %lu compiled, %lu loaded, %lu rejected (cache "
+                "%s%s)\n", ci.programs_compiled, ci.programs_loaded, ci.programs_rejected,
                 ci.cache_dir ? ci.cache_dir : "off", ci.cache_dir && !ci.cache_writable ? ", read-only" : "");
 }
 
