@@ -9,6 +9,9 @@
 #include "gl/gl.h"
 
 _Thread_local const obs__gl *obs__glp;
+/* beside obs__glp: bound with it (progcache.c reads it, device.c calls
+ * nothing of progcache.c; context.c opens the cache) */
+_Thread_local obs__progcache *obs__progcache_cur;
 
 static const char *const backend_names[OBS_BACKEND_COUNT] = {
     "auto", "egl-device", "egl-surfaceless", "osmesa"};
@@ -119,17 +122,13 @@ fail:
     return s;
 }
 
-obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, const char *cache_dir,
-                                 char err[OBS_ERR_LEN])
+obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, char err[OBS_ERR_LEN])
 {
     static const obs_backend order[] = {OBS_BACKEND_EGL_DEVICE, OBS_BACKEND_EGL_SURFACELESS,
                                         OBS_BACKEND_OSMESA};
     if ((unsigned)backend >= OBS_BACKEND_COUNT)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown backend %d", (int)backend);
     obs_status s = OBS_GL_UNAVAILABLE;
-    /* before any backend: Mesa reads where its shader cache is when the
-     * display is initialised */
-    obs__progcache_open(&d->cache, cache_dir, d->log, d->log_user);
     if (backend != OBS_BACKEND_AUTO) {
         s = try_backend(d, backend, err);
     } else {
@@ -157,7 +156,6 @@ obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, const c
     }
     glGenVertexArrays(1, &d->vao);
     obs__progcache_cur = &d->cache;
-    obs__progcache_attach(&d->cache, d->vendor, d->renderer, d->version);
     return OBS_OK;
 }
 

@@ -222,10 +222,10 @@ typedef struct obs__gl_device {
 /* Creates the context of `backend` (AUTO: the first of EGL device, EGL
  * surfaceless, OSMesa that works, the others' failures logged at debug
  * level), loads its table and leaves it current.  debug, log and
- * log_user are read from *d; the rest is filled.  cache_dir: the program
- * cache's folder (NULL or "": none), opened before the context is made. */
-obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, const char *cache_dir,
-                                 char err[OBS_ERR_LEN]);
+ * log_user are read from *d; the rest is filled, d->cache but for its
+ * counters (the caller opens it before, attaches it after:
+ * progcache.h). */
+obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, char err[OBS_ERR_LEN]);
 
 /* Makes the context current on the calling thread (and its table). */
 obs_status obs__gl_device_bind(obs__gl_device *d, char err[OBS_ERR_LEN]);

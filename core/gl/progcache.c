@@ -13,8 +13,6 @@
 #include "gl/gl.h"
 #include "gl/progcache.h"
 
-_Thread_local obs__progcache *obs__progcache_cur;
-
 /* The entry's header; the key and the binary follow it. */
 #define MAGIC "OBSPRG1\n"
 typedef struct entry_head {

@@ -39,8 +39,8 @@ typedef struct obs__progcache {
     void *log_user;
 } obs__progcache;
 
-/* The cache of the context current on this thread (set by
- * obs__gl_device_bind); NULL when none is current. */
+/* The cache of the context current on this thread (defined and set by
+ * device.c with the function table); NULL when none is current. */
 extern _Thread_local obs__progcache *obs__progcache_cur;
 
 /* Opens the cache at root (NULL or "": none) before the context is made:
