@@ -142,6 +142,16 @@ void obs__progcache_open(obs__progcache *pc, const char *root, obs_log_fn log, v
                   strerror(e));
         return;
     }
+    /* A binary is code the driver runs: a folder others may write to
+     * (a shared /tmp, a umask of 0) could hand this process any. */
+    struct stat pst;
+    if (stat(progs, &pst) == 0 && (pst.st_mode & (S_IWGRP | S_IWOTH))) {
+        obs__logf(log, user, OBS_LOG_WARN,
+                  "program cache off: %s is writable by %s (mode %03o): chmod go-w it or name "
+                  "another folder", progs, pst.st_mode & S_IWOTH ? "others" : "its group",
+                  (unsigned)(pst.st_mode & 0777));
+        return;
+    }
     /* a real write, not access(): a read-only mount or an ACL says no here */
     snprintf(probe, sizeof probe, "%s/.probe.%ld", progs, (long)getpid());
     int fd = open(probe, O_WRONLY | O_CREAT | O_EXCL, 0644);

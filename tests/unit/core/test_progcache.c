@@ -299,6 +299,22 @@ static void test_unusable_folder(void **state)
         assert_int_equal(cache_lines, 1);
         obs_ctx_destroy(ctx);
     }
+    /* a folder others may write to: off, one line naming the mode */
+    char *dir = new_dir(), progs[600];
+    obs_ctx *ctx = cache_ctx(dir);
+    obs_ctx_destroy(ctx);
+    snprintf(progs, sizeof progs, "%s/programs", dir);
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(chmod(progs, k ? 0775 : 0777), 0);
+        cache_lines = 0;
+        ctx = cache_ctx(dir);
+        obs_ctx_info ci;
+        obs_ctx_get_info(ctx, &ci);
+        assert_null(ci.cache_dir);
+        assert_int_equal(cache_lines, 1);
+        obs_ctx_destroy(ctx);
+    }
+    free(dir);
     /* no folder at all: the caller is told why */
     char buf[64], why[OBS_ERR_LEN];
     unsetenv("OBSCURA_CACHE_DIR");
