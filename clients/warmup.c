@@ -159,6 +159,10 @@ int cli_warmup(int argc, char **argv)
             verbosity = OBS_LOG_DEBUG;
             continue;
         }
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            cli_warmup_usage(stdout);
+            return EXIT_OK;
+        }
         if (strncmp(a, "--", 2) != 0 || n - 2 >= sizeof name) {
             fprintf(stderr, "obscura: warmup: unknown argument '%s'\n", a);
             return EXIT_USAGE;
