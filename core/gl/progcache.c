@@ -113,6 +113,21 @@ static void point_mesa(obs__progcache *pc)
                          : "");
 }
 
+/* A binary is code the driver runs: a folder others may write to (a
+ * shared /tmp, a umask of 0) could hand this process any.  1 (and the one
+ * log line) when progs is such a folder. */
+static int open_to_others(const char *progs, obs_log_fn log, void *user)
+{
+    struct stat st;
+    if (stat(progs, &st) != 0 || !(st.st_mode & (S_IWGRP | S_IWOTH)))
+        return 0;
+    obs__logf(log, user, OBS_LOG_WARN,
+              "program cache off: %s is writable by %s (mode %03o): chmod go-w it or name "
+              "another folder", progs, st.st_mode & S_IWOTH ? "others" : "its group",
+              (unsigned)(st.st_mode & 0777));
+    return 1;
+}
+
 void obs__progcache_open(obs__progcache *pc, const char *root, obs_log_fn log, void *user)
 {
     pc->log = log;
@@ -132,6 +147,8 @@ void obs__progcache_open(obs__progcache *pc, const char *root, obs_log_fn log, v
         int e = errno;
         struct stat st;
         if (stat(progs, &st) == 0 && S_ISDIR(st.st_mode) && access(progs, R_OK | X_OK) == 0) {
+            if (open_to_others(progs, log, user))
+                return;
             snprintf(pc->dir, sizeof pc->dir, "%s", root);
             obs__logf(log, user, OBS_LOG_WARN,
                       "program cache %s is read-only (%s): programs are loaded from it, none is stored",
@@ -142,16 +159,8 @@ void obs__progcache_open(obs__progcache *pc, const char *root, obs_log_fn log, v
                   strerror(e));
         return;
     }
-    /* A binary is code the driver runs: a folder others may write to
-     * (a shared /tmp, a umask of 0) could hand this process any. */
-    struct stat pst;
-    if (stat(progs, &pst) == 0 && (pst.st_mode & (S_IWGRP | S_IWOTH))) {
-        obs__logf(log, user, OBS_LOG_WARN,
-                  "program cache off: %s is writable by %s (mode %03o): chmod go-w it or name "
-                  "another folder", progs, pst.st_mode & S_IWOTH ? "others" : "its group",
-                  (unsigned)(pst.st_mode & 0777));
+    if (open_to_others(progs, log, user))
         return;
-    }
     /* a real write, not access(): a read-only mount or an ACL says no here */
     snprintf(probe, sizeof probe, "%s/.probe.%ld", progs, (long)getpid());
     int fd = open(probe, O_WRONLY | O_CREAT | O_EXCL, 0644);
