@@ -138,6 +138,19 @@ get "$PORT_d" /metrics "$T/metrics" > /dev/null
 check "/metrics: obscurad_programs_compiled_total 0, loaded > 0" \
     "grep -q '^obscurad_programs_compiled_total 0\$' '$T/metrics' && grep -q '^obscurad_programs_loaded_total [1-9]' '$T/metrics'"
 kill "$PID_d"; wait "$PID_d" 2>/dev/null
+# a GL failure recreates the context: the new one loads too, and the
+# counters go on over both contexts
+start f --cache-dir "$W" --fail-gl-after 2
+post "$PORT_f" "fov_y=50&output=ao&format=exr" "$DATA/room_small.exr" "$T/f1.exr" > /dev/null
+get "$PORT_f" /v1/info "$T/f1.json" > /dev/null
+c2=$(post "$PORT_f" "fov_y=50&output=ao&format=exr" "$DATA/room_small.exr" "$T/f2.exr")
+i=0
+while [ $i -lt 100 ] && ! grep -q 'GL context recreated' "$T/f.log"; do sleep 0.1; i=$((i + 1)); done
+c3=$(post "$PORT_f" "fov_y=50&output=ao&format=exr" "$DATA/room_small.exr" "$T/f3.exr")
+get "$PORT_f" /v1/info "$T/f3.json" > /dev/null
+check "after a recreated context (frame 2: $c2, frame 3: $c3): 0 compiled, loaded twice as many" \
+    "[ '$c2' = 500 ] && [ '$c3' = 200 ] && python3 -c 'import json,sys; a=json.load(open(sys.argv[1]))[\"program_cache\"]; b=json.load(open(sys.argv[2]))[\"program_cache\"]; sys.exit(not (b[\"compiled\"]==0 and a[\"loaded\"]>0 and b[\"loaded\"]==2*a[\"loaded\"]))' '$T/f1.json' '$T/f3.json' && cmp -s '$T/f1.exr' '$T/f3.exr'"
+kill "$PID_f"; wait "$PID_f" 2>/dev/null
 start e --cache-dir ''
 code=$(post "$PORT_e" "fov_y=50&output=ao&format=exr" "$DATA/room_small.exr" "$T/e.exr")
 get "$PORT_e" /v1/info "$T/info2.json" > /dev/null
