@@ -6,9 +6,10 @@
  * adaptive, culling, range_check, bleeding, luminance, blur_radius,
  * depth_mode, deep_hull) and from what a frame holds (normals or not,
  * colour or not, flat or deep).  So warmup fixes the parameters and runs
- * the frames that reach every input-dependent choice: one with depth,
- * normals and colour and every output, one with depth alone, and a deep
- * one for each method that takes deep input.  Running real frames, not
+ * the frames that reach every input-dependent choice: with depth,
+ * normals and colour for each set of outputs that changes the passes'
+ * draw buffers, with depth alone, deep for each method that takes deep
+ * input, each at four sizes (below).  Running real frames, not
  * only linking, matters on llvmpipe: it generates a shader's machine code
  * at its first draw, and Mesa's cache (in the same folder) keeps it. */
 #include <stdlib.h>
@@ -19,15 +20,25 @@
 #include "obscura/obscura.h"
 #include "warmup.h"
 
-#define W 48
-#define H 40
+/* llvmpipe makes separate machine code for images whose width or height
+ * is a power of two (most frames have neither, 1920x1080; DCI 4K,
+ * 4096x2160, has one): the four kinds, each with the culling pre-pass's
+ * 1/8 size of the same kind. */
+static const int sizes[][2] = {{48, 40}, {64, 40}, {48, 32}, {64, 64}};
+#define WMAX 64
+#define HMAX 64
 
 static int verbosity = OBS_LOG_INFO;
 
+/* The frames' own info lines ("no normal channel", of the synthetic
+ * frames) only with -v; the context's and the cache's always. */
 static void log_cb(void *user, obs_log_level level, const char *msg)
 {
     static const char *const names[] = {"error", "warning", "info", "debug"};
     (void)user;
+    if (level == OBS_LOG_INFO && verbosity < OBS_LOG_DEBUG && strncmp(msg, "program cache", 13) &&
+        strncmp(msg, "GL context", 10))
+        return;
     if ((int)level <= verbosity)
         fprintf(stderr, "obscura: %s: %s\n", names[level], msg);
 }
@@ -39,21 +50,21 @@ void cli_warmup_usage(FILE *f)
                "                  LIST, default the --method given) into the program cache\n");
 }
 
-/* Neither side a power of two, as most frames (1920x1080): llvmpipe
- * makes separate variants for power-of-two images; so is the culling
- * pre-pass's 1/8 size. */
 /* A floor seen at an angle with a step on it: depth (planar, or ndc in
  * (0, 1)), camera-space normals facing the camera, grey colour. */
 typedef struct synth {
-    float depth[W * H], normal[W * H * 3], color[W * H * 4];
+    int w, h;
+    float depth[WMAX * HMAX], normal[WMAX * HMAX * 3], color[WMAX * HMAX * 4];
 } synth;
 
-static void make_synth(synth *s, int ndc)
+static void make_synth(synth *s, int w, int h, int ndc)
 {
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            int i = y * W + x;
-            float z = 2.0f + 2.0f * (float)(H - y) / H - (x > W / 2 ? 0.5f : 0.0f);
+    s->w = w;
+    s->h = h;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            int i = y * w + x;
+            float z = 2.0f + 2.0f * (float)(h - y) / h - (x > w / 2 ? 0.5f : 0.0f);
             s->depth[i] = ndc ? 0.9f + 0.02f * z : z;
             s->normal[3 * i] = 0.0f;
             s->normal[3 * i + 1] = 0.6f;
@@ -67,6 +78,7 @@ static void make_synth(synth *s, int ndc)
 static obs_status deep_frame(const synth *s, obs_deep_image *d)
 {
     memset(d, 0, sizeof *d);
+    const int W = s->w, H = s->h;
     d->width = W;
     d->height = H;
     d->has_zback = d->has_alpha = d->has_color = d->has_normal = 1;
@@ -89,13 +101,15 @@ static obs_status deep_frame(const synth *s, obs_deep_image *d)
     return OBS_OK;
 }
 
-/* The frames of one configuration; OBS_OK, or the first failure. */
-static obs_status warm_method(obs_ctx *ctx, const obs_params *p, int deep, char err[OBS_ERR_LEN])
+/* The frames of one configuration at one size; OBS_OK, or the first
+ * failure. */
+static obs_status warm_size(obs_ctx *ctx, const obs_params *p, int deep, int W, int H,
+                            char err[OBS_ERR_LEN])
 {
     obs_params r;
     obs_params_resolve(p, &r);
     static synth s;
-    make_synth(&s, r.depth_mode == OBS_DEPTH_NDC);
+    make_synth(&s, W, H, r.depth_mode == OBS_DEPTH_NDC);
     obs_gbuffer full = {.width = W, .height = H};
     full.depth = (obs_plane){s.depth, 1, 0};
     full.normal = (obs_plane){s.normal, 3, 0};
@@ -218,59 +232,74 @@ int cli_warmup(int argc, char **argv)
         fprintf(stderr, "obscura: warmup: %s\n", why[0] ? why : "the program cache is off (--cache-dir '')");
         return EXIT_FAIL;
     }
-    obs_ctx *ctx;
-    obs_status s = obs_ctx_create(&desc, &ctx, err);
-    if (s != OBS_OK)
-        return cli_fail(s, "OpenGL", err);
-    obs_ctx_info ci;
-    obs_ctx_get_info(ctx, &ci);
-    if (!ci.cache_dir || !ci.cache_writable) {
-        fprintf(stderr, "obscura: warmup: no writable program cache at %s (see the warning above)\n",
-                desc.cache_dir);
-        obs_ctx_destroy(ctx);
-        return EXIT_FAIL;
-    }
-    /* a synthetic frame has no camera: a field of view unless one is given */
-    if (p.fov_y == 0.0f)
-        obs_param_set(&p, "fov_y", "60", err);
-    obs_param_set(&p, "normal_space", "camera", err);
-
-    int rc = EXIT_OK, runs = 0;
+    /* the methods to warm: the list, else the configured one */
+    char *names[OBS_METHOD_COUNT + 8];
+    int nm = 0;
+    char one[32] = "vaopp";
     if (!*list) {
         obs_params r;
         obs_params_resolve(&p, &r);
-        char one[32] = "vaopp";
         /* the configured method's name: the choice at its 1-based index */
         const char *c = all;
         for (int k = 1; k < (int)r.method && c; k++)
             c = strchr(c, '|') ? strchr(c, '|') + 1 : NULL;
         if (c)
             snprintf(one, sizeof one, "%.*s", (int)strcspn(c, "|"), c);
-        s = warm_method(ctx, &p, method_deep(one), err);
-        runs++;
-        if (s != OBS_OK)
-            rc = cli_fail(s, one, err);
+        names[nm++] = one;
     }
-    for (char *m = list, *next; *list && m && rc == EXIT_OK; m = next) {
+    for (char *m = list, *next; *list && m && nm < (int)(sizeof names / sizeof names[0]); m = next) {
         next = strchr(m, ',');
         if (next)
             *next++ = '\0';
-        obs_params q = p;
-        obs_param_set(&q, "method", m, err);
-        s = warm_method(ctx, &q, method_deep(m), err);
-        runs++;
-        if (s != OBS_OK)
-            rc = cli_fail(s, m, err);
-        else if (verbosity >= OBS_LOG_DEBUG)
-            fprintf(stderr, "obscura: debug: warmup: method %s done\n", m);
+        names[nm++] = m;
     }
-    obs_ctx_get_info(ctx, &ci);
-    unsigned long compiled = ci.programs_compiled, loaded = ci.programs_loaded,
-                  rejected = ci.programs_rejected;
-    obs_ctx_destroy(ctx); /* Mesa writes its cache out as the context goes */
+    /* a synthetic frame has no camera: a field of view unless one is given */
+    if (p.fov_y == 0.0f)
+        obs_param_set(&p, "fov_y", "60", err);
+    obs_param_set(&p, "normal_space", "camera", err);
+
+    /* One context per size: llvmpipe's machine code for a frame depends
+     * on what the context drew before (measured: one context over every
+     * size left a third of a real process's variants out of Mesa's
+     * cache), and a real process draws one size from a fresh context. */
+    unsigned long compiled = 0, there = 0, rejected = 0;
+    int rc = EXIT_OK, runs = 0;
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0] && rc == EXIT_OK; k++) {
+        obs_ctx *ctx;
+        obs_status s = obs_ctx_create(&desc, &ctx, err);
+        if (s != OBS_OK)
+            return cli_fail(s, "OpenGL", err);
+        obs_ctx_info ci;
+        obs_ctx_get_info(ctx, &ci);
+        if (!ci.cache_dir || !ci.cache_writable) {
+            fprintf(stderr, "obscura: warmup: no writable program cache at %s (see the warning "
+                    "above)\n", desc.cache_dir);
+            obs_ctx_destroy(ctx);
+            return EXIT_FAIL;
+        }
+        desc.log = NULL; /* the cache's and the context's lines once */
+        for (int i = 0; i < nm && rc == EXIT_OK; i++) {
+            obs_params q = p;
+            obs_param_set(&q, "method", names[i], err);
+            s = warm_size(ctx, &q, method_deep(names[i]), sizes[k][0], sizes[k][1], err);
+            runs++;
+            if (s != OBS_OK)
+                rc = cli_fail(s, names[i], err);
+            else if (verbosity >= OBS_LOG_DEBUG)
+                fprintf(stderr, "obscura: debug: warmup: method %s at %dx%d done\n", names[i],
+                        sizes[k][0], sizes[k][1]);
+        }
+        obs_ctx_get_info(ctx, &ci);
+        compiled += ci.programs_compiled;
+        if (k == 0) /* later contexts load what the first built */
+            there = ci.programs_loaded;
+        rejected += ci.programs_rejected;
+        obs_ctx_destroy(ctx);
+    }
     if (rc == EXIT_OK && verbosity >= OBS_LOG_INFO)
         printf("warmup: %s: %lu programs built and stored, %lu already there (%lu damaged or "
-               "foreign entries rebuilt), %d configuration%s\n",
-               dir, compiled, loaded, rejected, runs, runs == 1 ? "" : "s");
+               "foreign entries rebuilt), %d method%s at %d sizes\n",
+               dir, compiled, there, rejected, nm, nm == 1 ? "" : "s",
+               (int)(sizeof sizes / sizeof sizes[0]));
     return rc;
 }

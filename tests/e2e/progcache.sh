@@ -108,6 +108,8 @@ W="$T/warm"
 "$OBSCURA" warmup --methods all --cache-dir "$W" > "$T/warmup.out" 2> "$T/warmup.err"
 check "warmup --methods all: exit 0, programs built" \
     "[ \$? -eq 0 ] && grep -q 'programs built and stored' '$T/warmup.out' && ! grep -q ' 0 programs built' '$T/warmup.out'"
+mesa_entries() { find "$W/mesa_shader_cache" -type f 2>/dev/null | wc -l; }
+before=$(mesa_entries)
 for m in vaopp vao hemisphere angle hbao; do
     run "warm_$m" --cache-dir "$W" --method "$m" --output both
     check "after warmup, method $m compiles nothing ($COMPILED compiled, $LOADED loaded)" \
@@ -115,6 +117,10 @@ for m in vaopp vao hemisphere angle hbao; do
 done
 "$OBSCURA" ao "$DATA/deep_small.exr" --fov-y 50 -o "$T/deep.exr" -v --cache-dir "$W" 2> "$T/deep.err"
 check "after warmup, deep input compiles nothing" "grep -q 'programs: 0 compiled' '$T/deep.err'"
+# llvmpipe's machine code too: Mesa's cache gains nothing from these frames
+# (deep_small is 48x32, a power-of-two height: warmup's sizes cover it)
+after=$(mesa_entries)
+check "after warmup, Mesa's cache gains no entry from these frames ($before -> $after)" "[ $before -eq $after ]"
 "$OBSCURA" warmup --methods all --cache-dir "$W" > "$T/warmup2.out" 2>&1
 check "a second warmup builds nothing" "grep -q ' 0 programs built' '$T/warmup2.out'"
 "$OBSCURA" warmup --methods bogus --cache-dir "$W" > "$T/bogus" 2>&1
