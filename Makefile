@@ -22,8 +22,9 @@ PKGS := OpenEXR egl osmesa libpng libcjson
 # OpenEXR's C core library (openexr.h) reads and writes; its C++ library
 # only writes deep files (core/io/exr_deep_write.cpp, see below).
 EXR_CFLAGS := $(shell pkg-config --cflags OpenEXR 2>/dev/null)
-PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson 2>/dev/null) $(EXR_CFLAGS)
-PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson 2>/dev/null) -lz -lm -lpthread
+PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson nettle 2>/dev/null) $(EXR_CFLAGS)
+# nettle: SHA-256 of the program cache's keys (core/gl/progcache.c)
+PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson nettle 2>/dev/null) -lz -lm -lpthread
 # Scene loading (core/ground/scene.c: assimp) and the ray-traced reference
 # (core/ground/reference.c: Embree 3, no .pc file) live in libobscura.a too; as
 # static members they are linked only into binaries that call them, and

@@ -16,6 +16,10 @@ echo "## $(date -u +%Y-%m-%d) $(uname -m), $(nproc) cores"
 echo
 "$BUILD/frame_bench" "$@"
 echo
+# cold start: one process with obscura's program cache warm and Mesa's
+# off, against Mesa's cache warm and no cache (bench/coldstart.sh)
+BUILD="$BUILD" bench/coldstart.sh
+echo
 # VAO++ Table 1: the extensions at 2..32 samples, 1080p and 4K, GL timer
 # queries (bench/extensions_bench.c).  G-buffers rendered at those sizes
 # from the scene's mesh (obscura gbuffer, same camera, same vertical field

@@ -29,6 +29,7 @@
 #include "obscura/metrics.h"
 #include "obscura/obscura.h"
 #include "remote.h"
+#include "warmup.h"
 
 
 static int verbosity = OBS_LOG_INFO;
@@ -95,6 +96,8 @@ static const cli_opt ao_opts[] = {
     {"color", "R,G,B[,A]", "colour channel names"},
     {"max-size", "N", "largest accepted width or height (default 16384)"},
     {"backend", "B", "auto|egl-device|egl-surfaceless|osmesa (or OBSCURA_BACKEND)"},
+    {"cache-dir", "DIR", "program cache folder (or OBSCURA_CACHE_DIR; default "
+     "$XDG_CACHE_HOME/obscura, else ~/.cache/obscura; '': none)"},
     {"cpu", NULL, "run the CPU twin instead of OpenGL (slow; for reference)"},
     {"server", "URL[,URL...]", "run on obscurad: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT; a "
      "comma list spreads frames over several (the next one when one is busy or down)"},
@@ -128,6 +131,7 @@ static void usage(FILE *f)
             "                #### or %%04d is the frame; missing inputs are skipped (--strict: exit 3)\n",
             OBS_VERSION);
     cli_ground_usage(f);
+    cli_warmup_usage(f);
     fprintf(f, "\nao options:\n");
     for (const cli_opt *o = ao_opts; o->name; o++) {
         char left[48];
@@ -158,7 +162,7 @@ static void usage(FILE *f)
  * map) live in req, parsed by their rows in protocol/http.c; the rest are
  * the client's own. */
 typedef struct ao_args {
-    const char *in, *out, *camera, *backend;
+    const char *in, *out, *camera, *backend, *cache_dir;
     int format_given; /* else the format comes from the file name */
     int cpu, debug_gl;
     long max_size;
@@ -206,6 +210,8 @@ static void parse_ao(int argc, char **argv, ao_args *a)
                 die_usage("--max-size: '%s' is not in [1, 1048576]", v);
         } else if ((v = opt_value(argc, argv, &i, "backend"))) {
             a->backend = v;
+        } else if ((v = opt_value(argc, argv, &i, "cache-dir"))) {
+            a->cache_dir = v;
         } else if (cli_is_switch(arg, "cpu")) {
             a->cpu = 1;
         } else if (cli_is_switch(arg, "debug-gl")) {
@@ -358,6 +364,30 @@ static obs_status backend_from_args(const char *name, obs_backend *b)
     return OBS_OK;
 }
 
+/* The program cache's folder of --cache-dir (NULL: not given); when
+ * none can be found, says so once. */
+static const char *cache_dir_of(const char *flag)
+{
+    static char buf[4096];
+    static int said;
+    char why[OBS_ERR_LEN];
+    const char *d = obs_cache_dir_default(flag, buf, sizeof buf, why);
+    if (why[0] && !said++)
+        log_cb(NULL, OBS_LOG_WARN, why);
+    return d;
+}
+
+/* -v: what the context built and what it loaded from the cache. */
+static void log_programs(const obs_ctx *ctx)
+{
+    obs_ctx_info ci;
+    obs_ctx_get_info(ctx, &ci);
+    if (verbosity >= OBS_LOG_DEBUG)
+        fprintf(stderr, "obscura: debug: programs: %lu compiled, %lu loaded, %lu rejected (cache "
+                "%s%s)\n", ci.programs_compiled, ci.programs_loaded, ci.programs_rejected,
+                ci.cache_dir ? ci.cache_dir : "off", ci.cache_dir && !ci.cache_writable ? ", read-only" : "");
+}
+
 /* Deep input (include/obscura/deep.h): multi-layer AO of OITAO over the compressed
  * A-buffer.  Outputs: AO.Y, the per-node AO blended by alpha; AOFront.Y,
  * the front node's AO; R,G,B,A, the front-to-back composite times AO.Y
@@ -410,13 +440,14 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         if ((rc = cli_remote_run_deep(server, argc, argv, a->in, &d, a->req.outputs, &r)) != EXIT_OK)
             goto done;
     } else {
-        obs_ctx_desc desc = {.debug = a->debug_gl, .log = log_cb};
+        obs_ctx_desc desc = {.debug = a->debug_gl, .log = log_cb, .cache_dir = cache_dir_of(a->cache_dir)};
         backend_from_args(a->backend, &desc.backend);
         if ((s = obs_ctx_create(&desc, &ctx, err)) != OBS_OK) {
             rc = cli_fail(s, "OpenGL", err);
             goto done;
         }
         s = obs_deep_run(ctx, &d, &a->req.params, &r, err);
+        log_programs(ctx);
     }
     if (s != OBS_OK) {
         rc = cli_fail(s, a->in, err);
@@ -541,7 +572,7 @@ static int cmd_ao(int argc, char **argv)
         if ((rc = cli_remote_run(server, argc, argv, a.in, &gf.gb, a.req.outputs, &res)) != EXIT_OK)
             goto done;
     } else {
-        obs_ctx_desc desc = {.debug = a.debug_gl, .log = log_cb};
+        obs_ctx_desc desc = {.debug = a.debug_gl, .log = log_cb, .cache_dir = cache_dir_of(a.cache_dir)};
         backend_from_args(a.backend, &desc.backend);
         s = kept_ctx ? (ctx = kept_ctx, OBS_OK) : obs_ctx_create(&desc, &ctx, err);
         if (s != OBS_OK) {
@@ -552,6 +583,7 @@ static int cmd_ao(int argc, char **argv)
             fprintf(stderr, "obscura: debug: context created in %.1f ms\n", now_ms() - t0);
         t0 = now_ms();
         s = obs_run(ctx, &gf.gb, &a.req.params, a.req.outputs, &res, err);
+        log_programs(ctx);
     }
     if (s != OBS_OK) {
         rc = cli_fail(s, a.in, err);
@@ -622,14 +654,16 @@ static void batch_finish(void)
 
 static int cmd_info(int argc, char **argv)
 {
-    const char *backend = NULL;
+    const char *backend = NULL, *cache = NULL, *v;
     for (int i = 0; i < argc; i++) {
-        const char *v = opt_value(argc, argv, &i, "backend");
-        if (!v)
+        if ((v = opt_value(argc, argv, &i, "backend")))
+            backend = v;
+        else if ((v = opt_value(argc, argv, &i, "cache-dir")))
+            cache = v;
+        else
             die_usage("info: unknown argument '%s'", argv[i]);
-        backend = v;
     }
-    obs_ctx_desc desc = {.log = log_cb};
+    obs_ctx_desc desc = {.log = log_cb, .cache_dir = cache_dir_of(cache)};
     char err[OBS_ERR_LEN] = "";
     obs_ctx *ctx;
     backend_from_args(backend, &desc.backend);
@@ -641,6 +675,8 @@ static int cmd_info(int argc, char **argv)
     obs_ctx_get_info(ctx, &info);
     printf("obscura %s\nbackend: %s\nGL version: %s\nGL vendor: %s\nGL renderer: %s\n", OBS_VERSION,
            obs_backend_name(info.backend), info.gl_version, info.gl_vendor, info.gl_renderer);
+    printf("program cache: %s%s\n", info.cache_dir ? info.cache_dir : "off",
+           !info.cache_dir ? "" : info.cache_writable ? "" : " (read-only)");
     obs_ctx_destroy(ctx);
     return EXIT_OK;
 }
@@ -947,6 +983,8 @@ int main(int argc, char **argv)
         return cli_gbuffer(argc - 2, argv + 2);
     if (!strcmp(cmd, "reference"))
         return cli_reference(argc - 2, argv + 2);
+    if (!strcmp(cmd, "warmup"))
+        return cli_warmup(argc - 2, argv + 2);
     if (!strcmp(cmd, "batch")) {
         static const cli_batch_ops ops = {batch_check, batch_ao, batch_finish};
         return cli_batch(argc - 2, argv + 2, &ops);

@@ -26,11 +26,15 @@ obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out, char err[OBS_
 #endif
     ctx->dev.log = d.log;
     ctx->dev.log_user = d.log_user;
+    /* before the backend: Mesa reads where its shader cache is when the
+     * display is initialised */
+    obs__progcache_open(&ctx->dev.cache, d.cache_dir, d.log, d.log_user);
     obs_status s = obs__gl_device_create(&ctx->dev, d.backend, err);
     if (s != OBS_OK) {
         free(ctx);
         return s;
     }
+    obs__progcache_attach(&ctx->dev.cache, ctx->dev.vendor, ctx->dev.renderer, ctx->dev.version);
     obs__log(ctx, OBS_LOG_INFO, "GL context: %s, OpenGL %s, %s", obs_backend_name(ctx->dev.backend),
              ctx->dev.version, ctx->dev.renderer);
     *out = ctx;
@@ -43,6 +47,11 @@ void obs_ctx_get_info(const obs_ctx *ctx, obs_ctx_info *info)
     info->gl_version = ctx->dev.version;
     info->gl_vendor = ctx->dev.vendor;
     info->gl_renderer = ctx->dev.renderer;
+    info->cache_dir = ctx->dev.cache.dir[0] ? ctx->dev.cache.dir : NULL;
+    info->cache_writable = ctx->dev.cache.writable;
+    info->programs_compiled = ctx->dev.cache.compiled;
+    info->programs_loaded = ctx->dev.cache.loaded;
+    info->programs_rejected = ctx->dev.cache.rejected;
 }
 
 void obs_ctx_destroy(obs_ctx *ctx)

@@ -83,6 +83,10 @@
       "size; above it, whenever the queue runs empty, it is released; "       \
       "freed heap memory is returned to the system (malloc_trim) once the "    \
       "queue has stayed empty for a second")                                   \
+    X(cache_dir, STRING, 0, OBSD_STR_LEN - 1, "",                              \
+      "program cache folder (default: OBSCURA_CACHE_DIR, else "                \
+      "$XDG_CACHE_HOME/obscura, else ~/.cache/obscura; given empty: none); "  \
+      "read-only when it cannot be written")                                   \
     X(backend, ENUM, 0, 0, "auto",                                             \
       "GL backend: auto|egl-device|egl-surfaceless|osmesa (default: "          \
       "OBSCURA_BACKEND, else auto)")                                           \

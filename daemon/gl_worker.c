@@ -18,6 +18,21 @@ static void sleep_ms(int ms)
     nanosleep(&ts, NULL);
 }
 
+/* The program counters, over every context the worker made. */
+static void count_programs(obsd_gl_worker *w, const obs_ctx *ctx, int destroying)
+{
+    obs_ctx_info ci;
+    obs_ctx_get_info(ctx, &ci);
+    unsigned long long n[3] = {w->programs_base[0] + ci.programs_compiled,
+                               w->programs_base[1] + ci.programs_loaded,
+                               w->programs_base[2] + ci.programs_rejected};
+    atomic_store(&w->programs_compiled, n[0]);
+    atomic_store(&w->programs_loaded, n[1]);
+    atomic_store(&w->programs_rejected, n[2]);
+    if (destroying)
+        memcpy(w->programs_base, n, sizeof n);
+}
+
 /* Destroys the context and creates a new one with the same options,
  * retrying with backoff until it exists or the worker is stopped.
  * Returns the new context, or NULL when stopped before one existed. */
@@ -26,6 +41,7 @@ static obs_ctx *recreate(obsd_gl_worker *w, obs_ctx *ctx, obs_status why, const 
     atomic_store(&w->alive, 0);
     obsd_log(OBSD_LOG_WARN, "GL failure (%s: %s): destroying and recreating the GL context",
              obs_status_name(why), msg && *msg ? msg : obs_status_message(why));
+    count_programs(w, ctx, 1);
     obs_ctx_destroy(ctx);
     ctx = NULL;
     int backoff = BACKOFF_FIRST_MS;
@@ -121,6 +137,8 @@ static void *worker_main(void *arg)
         snprintf(w->gl_version, sizeof w->gl_version, "%s", info.gl_version ? info.gl_version : "");
         snprintf(w->gl_vendor, sizeof w->gl_vendor, "%s", info.gl_vendor ? info.gl_vendor : "");
         snprintf(w->gl_renderer, sizeof w->gl_renderer, "%s", info.gl_renderer ? info.gl_renderer : "");
+        snprintf(w->cache_dir, sizeof w->cache_dir, "%s", info.cache_dir ? info.cache_dir : "");
+        w->cache_writable = info.cache_writable;
         w->create_ms = obsd_now_ms() - t0;
         atomic_store(&w->alive, 1);
     } else {
@@ -169,8 +187,10 @@ static void *worker_main(void *arg)
         obs_status st = job->status;
         char msg[OBS_ERR_LEN];
         snprintf(msg, sizeof msg, "%s", job->err);
-        if (ctx)
+        if (ctx) {
             atomic_store(&w->kept_bytes, obs_ctx_kept_bytes(ctx));
+            count_programs(w, ctx, 0);
+        }
         obsd_queue_done(w->queue);
         job->done(job, job->user); /* the job is not ours after this */
         if (ctx && (st == OBS_GL_ERROR || st == OBS_GL_UNAVAILABLE))

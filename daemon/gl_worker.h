@@ -24,6 +24,12 @@ typedef struct obsd_gl_worker {
     int frame_deadline;             /* --frame-deadline, seconds (0: none) */
     atomic_ullong kept_bytes;       /* obs_ctx_kept_bytes after the last frame */
     atomic_ullong heap_trims;       /* malloc_trim calls, once idle after frames */
+    /* programs built from source, loaded from the program cache, cache
+     * entries rejected: over every context, after the last frame */
+    atomic_ullong programs_compiled, programs_loaded, programs_rejected;
+    unsigned long long programs_base[3]; /* of the contexts destroyed (worker only) */
+    char cache_dir[4096];          /* the program cache in use ("" none), set with backend */
+    int cache_writable;
     /* set once the first context exists (read-only afterwards; a
      * recreated context uses the same options) */
     char backend[32], gl_version[128], gl_vendor[128], gl_renderer[256];

@@ -22,6 +22,9 @@ static void gauges(obsd_http *h, obsd_gauges *g)
     g->gl_recreations = (unsigned long long)atomic_load(&h->gl->recreations);
     g->gl_kept_bytes = (unsigned long long)atomic_load(&h->gl->kept_bytes);
     g->heap_trims = (unsigned long long)atomic_load(&h->gl->heap_trims);
+    g->programs_compiled = (unsigned long long)atomic_load(&h->gl->programs_compiled);
+    g->programs_loaded = (unsigned long long)atomic_load(&h->gl->programs_loaded);
+    g->programs_rejected = (unsigned long long)atomic_load(&h->gl->programs_rejected);
     obsd_streams_gauges(h->streams, &g->streams, &g->stream_frames, &g->stream_bytes, &g->sse_subscribers);
 }
 
@@ -40,6 +43,17 @@ static enum MHD_Result get_info(req *r)
     cJSON_AddNumberToObject(o, "queue", h->cfg->queue);
     cJSON_AddNumberToObject(o, "max_pixels", (double)h->cfg->max_pixels);
     cJSON_AddNumberToObject(o, "max_body", (double)h->cfg->max_body);
+    cJSON *pc = cJSON_AddObjectToObject(o, "program_cache");
+    if (pc) {
+        if (h->gl->cache_dir[0])
+            cJSON_AddStringToObject(pc, "dir", h->gl->cache_dir);
+        else
+            cJSON_AddNullToObject(pc, "dir");
+        cJSON_AddBoolToObject(pc, "writable", h->gl->cache_dir[0] && h->gl->cache_writable);
+        cJSON_AddNumberToObject(pc, "compiled", (double)atomic_load(&h->gl->programs_compiled));
+        cJSON_AddNumberToObject(pc, "loaded", (double)atomic_load(&h->gl->programs_loaded));
+        cJSON_AddNumberToObject(pc, "rejected", (double)atomic_load(&h->gl->programs_rejected));
+    }
     char *text = cJSON_Print(o);
     cJSON_Delete(o);
     return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;

@@ -120,6 +120,14 @@ int main(int argc, char **argv)
         obsd_log(OBSD_LOG_ERROR, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
         return 2;
     }
+    /* the program cache: an explicit --cache-dir (even empty) wins */
+    const obsd_opt_info *co = obsd_opt_find("cache_dir");
+    static char cache[OBSD_STR_LEN + 64];
+    char why[OBS_ERR_LEN];
+    desc.cache_dir = obs_cache_dir_default(cfg.set[co - obsd_opt_at(0)] ? cfg.cache_dir : NULL, cache,
+                                           sizeof cache, why);
+    if (why[0])
+        obsd_log(OBSD_LOG_WARN, "%s", why);
     if (install_signals() != 0) {
         obsd_log(OBSD_LOG_ERROR, "cannot install signal handlers: %s", strerror(errno));
         return 1;

@@ -185,9 +185,20 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
             "# HELP obscurad_heap_trims_total Times freed heap memory was returned to the "
             "system (malloc_trim), each once the queue had stayed empty 1 s after frames.\n"
             "# TYPE obscurad_heap_trims_total counter\n"
-            "obscurad_heap_trims_total %llu\n",
+            "obscurad_heap_trims_total %llu\n"
+            "# HELP obscurad_programs_compiled_total GL programs built from source.\n"
+            "# TYPE obscurad_programs_compiled_total counter\n"
+            "obscurad_programs_compiled_total %llu\n"
+            "# HELP obscurad_programs_loaded_total GL programs loaded from the program cache (--cache-dir).\n"
+            "# TYPE obscurad_programs_loaded_total counter\n"
+            "obscurad_programs_loaded_total %llu\n"
+            "# HELP obscurad_programs_rejected_total Program cache entries found unusable (damaged, another "
+            "driver's) and rebuilt.\n"
+            "# TYPE obscurad_programs_rejected_total counter\n"
+            "obscurad_programs_rejected_total %llu\n",
         g->queue_depth, g->queue_capacity, g->gl_running, g->in_flight, g->gl_alive,
-        g->gl_recreations, g->gl_kept_bytes, g->heap_trims);
+        g->gl_recreations, g->gl_kept_bytes, g->heap_trims, g->programs_compiled, g->programs_loaded,
+        g->programs_rejected);
     put(&b, "# HELP obscurad_streams Streams of frames kept for the preview page.\n"
             "# TYPE obscurad_streams gauge\n"
             "obscurad_streams %d\n"

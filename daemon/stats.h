@@ -31,6 +31,7 @@ typedef struct obsd_gauges {
     unsigned long long gl_recreations; /* GL contexts recreated after a failure */
     unsigned long long gl_kept_bytes;  /* texture memory kept for the next frame */
     unsigned long long heap_trims;     /* freed heap returned to the system */
+    unsigned long long programs_compiled, programs_loaded, programs_rejected; /* program cache */
     int streams, stream_frames, sse_subscribers;
     uint64_t stream_bytes;
 } obsd_gauges;

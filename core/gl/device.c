@@ -9,6 +9,9 @@
 #include "gl/gl.h"
 
 _Thread_local const obs__gl *obs__glp;
+/* beside obs__glp: bound with it (progcache.c reads it, device.c calls
+ * nothing of progcache.c; context.c opens the cache) */
+_Thread_local obs__progcache *obs__progcache_cur;
 
 static const char *const backend_names[OBS_BACKEND_COUNT] = {
     "auto", "egl-device", "egl-surfaceless", "osmesa"};
@@ -67,6 +70,7 @@ obs_status obs__gl_device_bind(obs__gl_device *d, char err[OBS_ERR_LEN])
         return obs__fail(err, OBS_GL_ERROR, "%s: the context could not be made current",
                          obs_backend_name(d->backend));
     obs__glp = &d->gl;
+    obs__progcache_cur = &d->cache;
     return OBS_OK;
 }
 
@@ -78,6 +82,8 @@ static void destroy_backend(obs__gl_device *d)
         obs__egl_destroy(&d->st);
     if (obs__glp == &d->gl)
         obs__glp = NULL;
+    if (obs__progcache_cur == &d->cache)
+        obs__progcache_cur = NULL;
 }
 
 static obs_status try_backend(obs__gl_device *d, obs_backend b, char err[OBS_ERR_LEN])
@@ -149,6 +155,7 @@ obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, char er
         d->gl.DebugMessageCallback(debug_cb, d);
     }
     glGenVertexArrays(1, &d->vao);
+    obs__progcache_cur = &d->cache;
     return OBS_OK;
 }
 

@@ -11,6 +11,7 @@
 #include <GL/glcorearb.h>
 
 #include "gl/backend.h"
+#include "gl/progcache.h"
 #include "gl/uniform.h"
 
 #define OBS__GL_FUNCS(X)                                                       \
@@ -89,7 +90,11 @@
     X(PFNGLBINDIMAGETEXTUREPROC, BindImageTexture)                             \
     /* the frame's uniform block, its layout as the tests read it */           \
     X(PFNGLGETPROGRAMRESOURCEINDEXPROC, GetProgramResourceIndex)               \
-    X(PFNGLGETPROGRAMRESOURCEIVPROC, GetProgramResourceiv)
+    X(PFNGLGETPROGRAMRESOURCEIVPROC, GetProgramResourceiv)                     \
+    /* the program cache (progcache.c) */                                      \
+    X(PFNGLPROGRAMBINARYPROC, ProgramBinary)                                   \
+    X(PFNGLGETPROGRAMBINARYPROC, GetProgramBinary)                             \
+    X(PFNGLPROGRAMPARAMETERIPROC, ProgramParameteri)
 
 /* Optional entry points (may be NULL). */
 #define OBS__GL_FUNCS_OPT(X) X(PFNGLDEBUGMESSAGECALLBACKPROC, DebugMessageCallback)
@@ -176,13 +181,18 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glBindImageTexture obs__glp->BindImageTexture
 #define glGetProgramResourceIndex obs__glp->GetProgramResourceIndex
 #define glGetProgramResourceiv obs__glp->GetProgramResourceiv
+#define glProgramBinary obs__glp->ProgramBinary
+#define glGetProgramBinary obs__glp->GetProgramBinary
+#define glProgramParameteri obs__glp->ProgramParameteri
 
 /* Loads every entry point; fails naming the first one missing. */
 obs_status obs__gl_load(obs__gl *gl, obs__getproc_fn getproc, char err[OBS_ERR_LEN]);
 
 /* Compiles and links a program from a vertex and a fragment source (the
  * fragment source is the concatenation of `frag_parts`).  A compile or
- * link failure is OBS_GL_SHADER with the shader's name and info log. */
+ * link failure is OBS_GL_SHADER with the shader's name and info log.
+ * With a program cache on the current context (progcache.h) the program
+ * is loaded from it when there, and stored in it when built. */
 obs_status obs__gl_program(const char *name, const char *vert, const char *const *frag_parts,
                            int frag_count, GLuint *out, char err[OBS_ERR_LEN]);
 
@@ -208,12 +218,15 @@ typedef struct obs__gl_device {
     void *log_user;
     char version[128], vendor[128], renderer[256];
     GLuint vao;           /* empty vertex array for the full-screen triangle */
+    obs__progcache cache; /* the program cache and the build counters */
 } obs__gl_device;
 
 /* Creates the context of `backend` (AUTO: the first of EGL device, EGL
  * surfaceless, OSMesa that works, the others' failures logged at debug
  * level), loads its table and leaves it current.  debug, log and
- * log_user are read from *d; the rest is filled. */
+ * log_user are read from *d; the rest is filled, d->cache but for its
+ * counters (the caller opens it before, attaches it after:
+ * progcache.h). */
 obs_status obs__gl_device_create(obs__gl_device *d, obs_backend backend, char err[OBS_ERR_LEN]);
 
 /* Makes the context current on the calling thread (and its table). */

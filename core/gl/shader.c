@@ -28,6 +28,14 @@ obs_status obs__gl_program(const char *name, const char *vert, const char *const
 {
     GLuint vs = 0, fs = 0, prog = 0;
     GLint ok = 0;
+    obs__progcache *pc = obs__progcache_cur;
+    obs__progkey key = {0};
+    int cached = pc && pc->dir[0] && pc->formats &&
+                 obs__progkey_make(pc, vert, frag_parts, frag_count, &key) == 0;
+    if (cached && obs__progcache_load(pc, &key, out)) {
+        obs__progkey_free(&key);
+        return OBS_OK;
+    }
     obs_status s = compile(name, GL_VERTEX_SHADER, &vert, 1, &vs, err);
     if (s != OBS_OK)
         goto fail;
@@ -37,6 +45,8 @@ obs_status obs__gl_program(const char *name, const char *vert, const char *const
     prog = glCreateProgram();
     glAttachShader(prog, vs);
     glAttachShader(prog, fs);
+    if (cached) /* asked before linking, so that the binary can be read back */
+        glProgramParameteri(prog, GL_PROGRAM_BINARY_RETRIEVABLE_HINT, GL_TRUE);
     glLinkProgram(prog);
     glGetProgramiv(prog, GL_LINK_STATUS, &ok);
     if (!ok) {
@@ -47,7 +57,12 @@ obs_status obs__gl_program(const char *name, const char *vert, const char *const
         goto fail;
     }
     *out = prog;
+    if (pc)
+        pc->compiled++;
+    if (cached)
+        obs__progcache_store(pc, &key, prog);
 fail:
+    obs__progkey_free(&key);
     if (vs)
         glDeleteShader(vs);
     if (fs)

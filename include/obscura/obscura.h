@@ -133,6 +133,14 @@ typedef struct obs_ctx_desc {
     int debug;           /* install a KHR_debug callback (logs GL messages) */
     obs_log_fn log;      /* may be NULL */
     void *log_user;
+    /* The program cache's folder (obs_cache_dir_default gives the usual
+     * one); NULL or "": no cache.  Linked programs are kept there as the
+     * driver's program binaries, and Mesa's shader cache is pointed there
+     * too (MESA_SHADER_CACHE_DIR, unless set; on in this process): create
+     * the first context before starting threads that read the
+     * environment.  A folder that cannot be written is read-only; one
+     * that cannot be read or made is no cache (one log line each). */
+    const char *cache_dir;
 } obs_ctx_desc;
 
 typedef struct obs_ctx_info {
@@ -140,7 +148,20 @@ typedef struct obs_ctx_info {
     const char *gl_version; /* owned by the context */
     const char *gl_vendor;
     const char *gl_renderer;
+    const char *cache_dir;  /* the program cache in use, owned by the context; NULL: none */
+    int cache_writable;     /* 0: programs are loaded from it, none is stored */
+    unsigned long programs_compiled; /* built from source by this context */
+    unsigned long programs_loaded;   /* loaded from the program cache */
+    unsigned long programs_rejected; /* cache entries found unusable (damaged,
+                                        another driver's), rebuilt */
 } obs_ctx_info;
+
+/* The program cache's folder: `given` when not NULL (a --cache-dir flag),
+ * else $OBSCURA_CACHE_DIR when set, else $XDG_CACHE_HOME/obscura, else
+ * $HOME/.cache/obscura; written to buf (n bytes) and returned.  "" (given
+ * or the variable set to it) means no cache; "" with why filled (when
+ * not NULL) means no folder could be found. */
+const char *obs_cache_dir_default(const char *given, char *buf, size_t n, char why[OBS_ERR_LEN]);
 
 /* Creates the GL context and makes it current on the calling thread; only
  * that thread may use the context afterwards.  Caller frees with

@@ -68,6 +68,16 @@ check("Deployment: readiness on /readyz, liveness on /healthz",
 check("Deployment: resource requests (cpu, memory)",
       get(c, "resources", "requests", "cpu") and get(c, "resources", "requests", "memory"))
 check("Deployment: runs as non-root", get(tmpl, "spec", "securityContext", "runAsNonRoot") is True)
+# the program cache: a writable volume at the image's OBSCURA_CACHE_DIR,
+# filled from the image's warm cache by an init container
+vols = {v.get("name"): v for v in get(tmpl, "spec", "volumes", default=[]) or []}
+mounts = {m.get("mountPath"): m.get("name") for m in c.get("volumeMounts", []) or []}
+inits = get(tmpl, "spec", "initContainers", default=[]) or []
+cache_vol = mounts.get("/var/cache/obscura")
+check("Deployment: the program cache is a writable volume at /var/cache/obscura, filled from the image",
+      cache_vol in vols and "emptyDir" in vols[cache_vol] and
+      any(any(m.get("name") == cache_vol for m in i.get("volumeMounts", []) or []) and
+          "/var/cache/obscura/." in " ".join(i.get("command", [])) for i in inits))
 check("Deployment: Prometheus scrape annotations on /metrics",
       get(tmpl, "metadata", "annotations", "prometheus.io/scrape") == "true" and
       get(tmpl, "metadata", "annotations", "prometheus.io/path") == "/metrics")

@@ -21,6 +21,8 @@ echo "-- systemd"
 U=deploy/systemd/obscurad.service
 check "unit: unprivileged user, ProtectSystem=strict, restart on failure, config in /etc/obscura" \
     "grep -q '^DynamicUser=yes' $U && grep -q '^ProtectSystem=strict' $U && grep -q '^Restart=on-failure' $U && grep -q -- '--config /etc/obscura/obscurad.conf' $U"
+check "unit: CacheDirectory=obscura, passed as --cache-dir /var/cache/obscura" \
+    "grep -q '^CacheDirectory=obscura\$' $U && grep -q '^ExecStart=.* --cache-dir /var/cache/obscura' $U"
 if command -v systemd-analyze >/dev/null 2>&1; then
     # verify wants the ExecStart binary to exist: point it at this build
     sed "s|/usr/local/bin/obscurad|$(pwd)/$OBSCURAD|" "$U" > "$T/obscurad.service"
@@ -45,6 +47,18 @@ echo "-- container"
 D=deploy/container/Dockerfile
 check "Dockerfile: Debian 12, non-root, /healthz health check, NVIDIA graphics capability" \
     "grep -q '^FROM debian:12' $D && grep -q '^USER 10001' $D && grep -q '^HEALTHCHECK' $D && grep -q 'CMD curl.*/healthz' $D && grep -q 'NVIDIA_DRIVER_CAPABILITIES=graphics' $D"
+# the warmup runs as the run-time user, after USER, into the folder the
+# daemon reads (OBSCURA_CACHE_DIR), which that user owns
+check "Dockerfile: obscura warmup --methods all at image build, as user 10001, into OBSCURA_CACHE_DIR" \
+    "sed -n '/^USER 10001/,\$p' $D | grep -q '^RUN obscura warmup --methods all' && sed -n '/^USER 10001/,\$p' $D | grep -q '^ENV OBSCURA_CACHE_DIR=/var/cache/obscura' && grep -q 'install -d -o 10001 -g 10001 .*/var/cache/obscura' $D"
+# what the image's build step runs works here: the same command into a
+# fresh folder, then a frame that compiles nothing
+"$OBSCURA" warmup --methods all --cache-dir "$T/imgcache" -q > "$T/warmup" 2>&1
+wrc=$?
+"$OBSCURA" ao "$DATA/room_small.exr" --camera "$DATA/room_small.camera.json" -o "$T/warm.exr" -v \
+    --cache-dir "$T/imgcache" 2> "$T/warm.err"
+check "the Dockerfile's warmup runs (exit $wrc); a frame after it compiles nothing" \
+    "[ $wrc -eq 0 ] && grep -q 'programs: 0 compiled' '$T/warm.err'"
 # every shared library the binaries need, by Debian package, is installed
 # in the run-time stage (or is in every Debian base image)
 runtime=$(sed -n '/^FROM debian:12-slim/,$p' "$D")
