@@ -5,6 +5,7 @@
 #ifndef OBSCURA_FRAME_H
 #define OBSCURA_FRAME_H
 
+#include <math.h>
 #include "internal.h"
 #include "shaders/shared.h" /* constants shared with the shaders */
 
@@ -156,6 +157,17 @@ float obs__half_upsample(const obs__frame *f, const obs__frame *hf, const float 
                          const float *hao, int x, int y);
 
 /* ---- per-pixel twins (GLSL: common.glsl, prep.frag, vao.frag) ----------- */
+
+/* The place of pixel (x, y) in the 3x3 rotation tile (VAO++ 4.5), counted
+ * from the display window's corner (viewport[0..1] is the data window's
+ * offset in it), so that a crop gets the whole frame's rotations (GLSL:
+ * tile_index in common.glsl). */
+static inline int obs__tile_index(const obs__frame *f, int x, int y)
+{
+    int dx = x + (int)floorf(f->viewport[0]), dy = y + (int)floorf(f->viewport[1]);
+    int tx = dx - 3 * (int)floorf((float)dx / 3.0f), ty = dy - 3 * (int)floorf((float)dy / 3.0f);
+    return 3 * tx + ty;
+}
 
 /* Pixel centre (x, y) of the planes -> NDC of the display window. */
 void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2]);
@@ -350,10 +362,10 @@ float obs__radius_px(const obs__frame *f, const float p[3], float r);
 float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count);
 
-/* The noise of the 3x3 tile's pixel (x, y): XeGTAO's R2 sequence,
- * fract(0.5 + k (0.754877666, 0.569840291)), k = 3 (x % 3) + (y % 3);
+/* The noise of the 3x3 tile's pixel `tile` (obs__tile_index): XeGTAO's R2
+ * sequence, fract(0.5 + k (0.754877666, 0.569840291)), k = tile;
  * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
-void obs__gtao_noise(int x, int y, float out[2]);
+void obs__gtao_noise(int tile, float out[2]);
 
 /* The AO of pixel (x, y) by the frame's method other than vaopp/vao
  * (position and normal from the planes); *count: samples taken (GLSL:

@@ -159,7 +159,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
     const float R = f->radius, r = 0.5f * f->radius;
     /* Centre of the tangent sphere of radius R/2, moved along the normal. */
     float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
-    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    const float *rot = f->rot[obs__tile_index(f, x, y)];
     obs__disk disk;
     obs__disk_map(f, c, r, rot, &disk);
     float open = 0.0f, F = 0.0f;

@@ -189,7 +189,7 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
     const obs__frame *f = &df->f;
     const float R = f->radius, r = 0.5f * R;
     const float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
-    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    const float *rot = f->rot[obs__tile_index(f, x, y)];
     const int layers = df->multi ? df->m : 1;
     const size_t npx = (size_t)f->width * (size_t)f->height;
     float open = 0.0f, F = 0.0f;

@@ -67,7 +67,7 @@ float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, cons
                        const float n[3])
 {
     const float R = f->radius;
-    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    const float *rot = f->rot[obs__tile_index(f, x, y)];
     float sum = 0.0f, wsum = 0.0f;
     for (int i = 0; i < f->angle_pairs; i++) {
         const float *a = f->angle_xy[i];

@@ -58,10 +58,10 @@ static float saturate(float v) { return clampf(v, 0.0f, 1.0f); }
 static float signf(float v) { return (float)((v > 0.0f) - (v < 0.0f)); }
 static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/* GLSL: gtao_noise() in gtao.glsl */
-void obs__gtao_noise(int x, int y, float out[2])
+/* GLSL: gtao_noise() in gtao.glsl; tile: the pixel's obs__tile_index */
+void obs__gtao_noise(int tile, float out[2])
 {
-    float k = (float)(3 * (x % 3) + (y % 3));
+    float k = (float)tile;
     float a = 0.5f + k * 0.75487766624669276f, b = 0.5f + k * 0.56984029099805327f;
     out[0] = a - floorf(a);
     out[1] = b - floorf(b);
@@ -131,7 +131,7 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const
         v[2] = -c[2] / l;
     }
     float noise[2];
-    obs__gtao_noise(x, y, noise);
+    obs__gtao_noise(obs__tile_index(f, x, y), noise);
     const float min_s = GTAO_TOO_CLOSE / rpx;
     float vis = f->gtao_heuristics ? saturate((10.0f - rpx) / 100.0f) * 0.5f : 0.0f;
     for (int sl = 0; sl < f->gtao_slices; sl++) {

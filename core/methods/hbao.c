@@ -23,7 +23,7 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
                       const float n[3], int *count)
 {
     const float R = f->radius, R2 = R * R;
-    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    const float *rot = f->rot[obs__tile_index(f, x, y)];
     float rpx = obs__radius_px(f, p, R);
     if (count)
         *count = 0;

@@ -55,7 +55,7 @@ void obs__hemisphere_basis(const float n[3], float t1[3], float t2[3])
 void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3], const float n[3],
                             const float t1[3], const float t2[3], int i, float s[3])
 {
-    const float *rot = f->rot[3 * (x % 3) + (y % 3)];
+    const float *rot = f->rot[obs__tile_index(f, x, y)];
     const float *k = f->hs_kernel[i];
     /* the 3x3 tile's rotation about the normal (interleaved sampling,
      * removed by the shared blur as for VAO++) */

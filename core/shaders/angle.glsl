@@ -31,7 +31,7 @@ float angle_to_normal(vec3 n, vec3 v)
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
 {
     float R = u_radius;
-    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
+    vec2 rot = u_rot[tile_index(px)];
     float sum = 0.0, wsum = 0.0;
     count = 2 * u_angle_pairs;
     for (int i = 0; i < u_angle_pairs; i++) {

@@ -47,6 +47,17 @@ const float FAR_AWAY = 1e30;
 
 #define PM(r, c) u_proj[c][r]
 
+// The pixel's place in the 3x3 rotation tile (VAO++ 4.5), counted from
+// the display window's corner, so that a cropped frame (a data window
+// inside the display window) gets the whole frame's rotations.  C twin:
+// obs__tile_index (frame.h).
+int tile_index(ivec2 p)
+{
+    ivec2 d = p + ivec2(floor(u_viewport.xy));
+    ivec2 t = d - 3 * ivec2(floor(vec2(d) / 3.0));
+    return 3 * t.x + t.y;
+}
+
 vec2 px_ndc(ivec2 p)
 {
     return vec2((float(p.x) + 0.5 + u_viewport.x) / u_viewport.z * 2.0 - 1.0,

@@ -63,7 +63,7 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
 {
     float R = u_radius, r = 0.5 * u_radius;
     vec3 c = p + n * r;
-    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
+    vec2 rot = u_rot[tile_index(px)];
     vec3 U, V, W;
     disk_map(c, r, rot, U, V, W);   // the samples' pixels (common.glsl)
     int layers = u_multi != 0 ? u_m : 1;

@@ -22,7 +22,7 @@ const float GTAO_HALF_PI = 1.5707963267948966;
 // C twin: obs__gtao_noise
 vec2 gtao_noise(ivec2 px)
 {
-    float k = float(3 * (px.x % 3) + (px.y % 3));
+    float k = float(tile_index(px));
     return fract(vec2(0.5) + k * vec2(0.75487766624669276, 0.56984029099805327));
 }
 

@@ -12,7 +12,7 @@ uniform vec2 u_hbao_bias_cs;     // cos, sin of the angle bias
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
 {
     float R = u_radius, R2 = R * R;
-    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
+    vec2 rot = u_rot[tile_index(px)];
     float rpx = radius_px(p.xyz, R);
     count = 0;
     if (!(rpx >= 1.0))

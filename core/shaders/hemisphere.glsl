@@ -30,7 +30,7 @@ uniform float u_hs_kernel[3 * OBS_MAX_HEMISPHERE]; // unit hemisphere around +z,
 float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior)
 {
     float R = u_radius;
-    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
+    vec2 rot = u_rot[tile_index(px)];
     vec3 t1, t2;                // the kernel's +z goes to n
     tangent_basis(n, t1, t2);
     float occ = 0.0;

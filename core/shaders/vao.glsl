@@ -40,7 +40,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
 {
     float R = u_radius, r = 0.5 * u_radius;
     vec3 c = p.xyz + n * r;     // tangent sphere centre
-    vec2 rot = u_rot[3 * (px.x % 3) + (px.y % 3)];
+    vec2 rot = u_rot[tile_index(px)];
     vec3 U, V, W;
     disk_map(c, r, rot, U, V, W);
     float open = 0.0, F = 0.0;
