@@ -2,7 +2,7 @@
  * every input is read from memory as a flat G-buffer and as a deep image,
  * with small size limits so that a valid-looking header cannot ask for
  * much memory; whatever a reader returns is touched and freed (ASan and
- * LeakSanitizer check).  Seeds: tests/data/*.exr and tests/data/damaged.
+ * LeakSanitizer check).  Seeds: the EXRs of tests/data and tests/data/damaged.
  *
  *   make fuzz && build/fuzz/fuzz_exr NEW_DIR tests/data/damaged */
 #include <stdint.h>

@@ -1,0 +1,59 @@
+/* The output's channel names: the result's layers (AO.Y, R,G,B,A, ...)
+ * and --layer's renaming of them.  No OpenEXR calls: the request parser
+ * (protocol/http.c) checks a layer name with them too. */
+#include <stdio.h>
+#include <string.h>
+
+#include "obscura/io.h"
+#include "internal.h"
+
+obs_status obs_exr_layers_rename(obs_exr_layer *layers, int layer_count, const char *name,
+                                 obs_exr_names *store, char err[OBS_ERR_LEN])
+{
+    size_t len = name ? strlen(name) : 0, used = 0;
+    if (len == 0 || len > OBS_EXR_LAYER_MAX || name[0] == '.' || name[len - 1] == '.')
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "layer name '%.100s' must be 1 to %d characters, not starting or ending with '.'",
+                         name ? name : "", OBS_EXR_LAYER_MAX);
+    for (const char *c = name; *c; c++)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "layer name '%.100s' holds a control character", name);
+    for (int l = 0; l < layer_count; l++) {
+        int ch = layers[l].image->channels;
+        if (used + (size_t)ch > sizeof store->ptr / sizeof store->ptr[0])
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "too many channels to rename");
+        for (int k = 0; k < ch; k++) {
+            const char *old = layers[l].names[k];
+            /* AO.Y -> NAME.Y; R -> NAME.R; Samples.Y -> NAME.Samples.Y */
+            const char *rest = !strncmp(old, "AO.", 3) ? old + 3 : old;
+            snprintf(store->name[used + k], sizeof store->name[0], "%s.%.30s", name, rest);
+            store->ptr[used + k] = store->name[used + k];
+        }
+        layers[l].names = store->ptr + used;
+        used += (size_t)ch;
+    }
+    return OBS_OK;
+}
+
+int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_LAYERS])
+{
+    static const char *const ao[] = {"AO.Y"};
+    static const char *const rgba[] = {"R", "G", "B", "A"};
+    static const char *const count[] = {"Samples.Y"};
+    static const char *const cull[] = {"Cull.Y"};
+    static const char *const bleed[] = {"Bleed.R", "Bleed.G", "Bleed.B"};
+    static const char *const lum[] = {"Luminance.Y"};
+    int n = 0;
+    if (r->ao.data)
+        layers[n++] = (obs_exr_layer){&r->ao, ao};
+    if (r->composite.data)
+        layers[n++] = (obs_exr_layer){&r->composite, rgba};
+    if (r->sample_count.data)
+        layers[n++] = (obs_exr_layer){&r->sample_count, count};
+    if (r->cull_mask.data)
+        layers[n++] = (obs_exr_layer){&r->cull_mask, cull};
+    if (r->bleed.data)
+        layers[n++] = (obs_exr_layer){&r->bleed, bleed};
+    if (r->luminance.data)
+        layers[n++] = (obs_exr_layer){&r->luminance, lum};
+    return n;
+}
