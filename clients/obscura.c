@@ -23,6 +23,7 @@
 #include "obscura/deep.h"
 #include "cli.h"
 #include "flags.h"
+#include "bake.h"
 #include "ground.h"
 #include "obscura/io.h"
 #include "obscura/metrics.h"
@@ -121,6 +122,7 @@ static void usage(FILE *f)
             "                #### or %%04d is the frame; missing inputs are skipped (--strict: exit 3)\n",
             OBS_VERSION);
     cli_ground_usage(f);
+    cli_bake_usage(f);
     fprintf(f, "\nao options:\n");
     for (const cli_opt *o = ao_opts; o->name; o++) {
         char left[48];
@@ -872,6 +874,8 @@ int main(int argc, char **argv)
         return cli_gbuffer(argc - 2, argv + 2);
     if (!strcmp(cmd, "reference"))
         return cli_reference(argc - 2, argv + 2);
+    if (!strcmp(cmd, "bake"))
+        return cli_bake(argc - 2, argv + 2);
     if (!strcmp(cmd, "batch")) {
         static const cli_batch_ops ops = {batch_check, batch_ao, batch_finish};
         return cli_batch(argc - 2, argv + 2, &ops);
