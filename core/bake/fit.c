@@ -458,11 +458,16 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
         rc = obs__fail(err, OBS_NO_MEMORY, "CHOLMOD could not factorise (status %d)", cm.status);
         goto done;
     }
-    if (cm.status == CHOLMOD_NOT_POSDEF) {
+    /* A singular system need not stop the factorisation (rounding leaves
+     * tiny pivots): the cheap condition estimate (the ratio of L's
+     * extreme diagonal entries) catches it too. */
+    double rcond = cm.status == CHOLMOD_NOT_POSDEF ? 0.0 : cholmod_rcond(L, &cm);
+    if (cm.status == CHOLMOD_NOT_POSDEF || !(rcond > 1e-13)) {
         rc = obs__fail(err, OBS_INVALID_ARGUMENT,
-                       "the least-squares system is singular at column %d: a vertex without "
-                       "valid samples or neighbours (ridge %g; a ridge above 0 gives it a value)",
-                       (int)L->minor, (double)p->ridge);
+                       "the least-squares system is singular (condition estimate %g, column %d): "
+                       "vertices without valid samples (ridge %g; a ridge above 0 gives them "
+                       "their neighbours' value)",
+                       rcond, (int)L->minor, (double)p->ridge);
         goto done;
     }
     X = cholmod_solve(CHOLMOD_A, L, B, &cm);

@@ -105,7 +105,7 @@ obs_status obs__bake_weld_make(const obs__bake_world *w, float tolerance, float 
                     float dn = nv[0] * ng[0] + nv[1] * ng[1] + nv[2] * ng[2];
                     int none = (nv[0] == 0 && nv[1] == 0 && nv[2] == 0) ||
                                (ng[0] == 0 && ng[1] == 0 && ng[2] == 0);
-                    if (none || dn > cos_max)
+                    if (none || dn > cos_max || angle_deg >= 180.0f)
                         break;
                 }
                 if (g == groups)
