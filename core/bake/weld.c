@@ -2,11 +2,14 @@
  * soup; Kavan et al.'s regulariser needs the shared edges).  Our own pass,
  * not meshoptimizer's meshopt_generateVertexRemap: that welds only
  * byte-identical vertices, and the split by normal below needs a pass of
- * its own anyway.  Within one instance, vertices whose positions quantise
- * to the same cell of size tolerance x (the instance's box diagonal) are
+ * its own anyway.  Vertices whose positions quantise to the same cell of
+ * size tolerance x (the level's box diagonal) are
  * one vertex, unless their normals are weld_angle or more apart: the two
- * sides of a back-to-back pair of faces stay two vertices.  The cells are
- * found by sorting the quantised keys (deterministic, O(n log n)). */
+ * sides of a back-to-back pair of faces stay two vertices.  The weld spans
+ * the whole level, not one instance at a time: a soup level such as a
+ * TORCS track cuts one surface into many objects, whose shared edges the
+ * regulariser must see too.  The cells are found by sorting the quantised
+ * keys (deterministic, O(n log n)). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -52,14 +55,9 @@ obs_status obs__bake_weld_make(const obs__bake_world *w, float tolerance, float 
 {
     memset(out, 0, sizeof *out);
     out->of = malloc(w->vertex_count * sizeof *out->of);
-    size_t most = 0;
-    for (size_t i = 0; i < w->instance_count; i++) {
-        size_t end = i + 1 < w->instance_count ? w->inst[i + 1].first_vertex : w->vertex_count;
-        size_t n = end - w->inst[i].first_vertex;
-        most = n > most ? n : most;
-    }
-    key *keys = malloc((most ? most : 1) * sizeof *keys);
-    uint32_t *rep = malloc((most ? most : 1) * sizeof *rep);
+    size_t n = w->vertex_count;
+    key *keys = malloc((n ? n : 1) * sizeof *keys);
+    uint32_t *rep = malloc((n ? n : 1) * sizeof *rep);
     if (!out->of || !keys || !rep) {
         free(keys);
         free(rep);
@@ -68,12 +66,9 @@ obs_status obs__bake_weld_make(const obs__bake_world *w, float tolerance, float 
     }
     const float cos_max = cosf(angle_deg * 3.14159265f / 180.0f);
     size_t next = 0;
-    for (size_t i = 0; i < w->instance_count; i++) {
-        size_t v0 = w->inst[i].first_vertex;
-        size_t v1 = i + 1 < w->instance_count ? w->inst[i + 1].first_vertex : w->vertex_count;
-        size_t n = v1 - v0;
+    {
         float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (size_t v = v0; v < v1; v++)
+        for (size_t v = 0; v < n; v++)
             for (int k = 0; k < 3; k++) {
                 lo[k] = fminf(lo[k], w->pos[3 * v + k]);
                 hi[k] = fmaxf(hi[k], w->pos[3 * v + k]);
@@ -82,8 +77,8 @@ obs_status obs__bake_weld_make(const obs__bake_world *w, float tolerance, float 
         for (int k = 0; k < 3 && n; k++)
             diag += (double)(hi[k] - lo[k]) * (hi[k] - lo[k]);
         double cell = tolerance * sqrt(diag);
-        for (size_t v = v0; v < v1; v++) {
-            key *kk = &keys[v - v0];
+        for (size_t v = 0; v < n; v++) {
+            key *kk = &keys[v];
             for (int k = 0; k < 3; k++)
                 kk->q[k] = quantise(w->pos[3 * v + k], cell);
             kk->v = (uint32_t)v;
