@@ -61,8 +61,13 @@ static void list_params(int markdown)
             snprintf(range, sizeof range, "%s", pi->choices);
         else
             snprintf(range, sizeof range, "%g .. %g", pi->min, pi->max);
-        if (markdown)
-            printf("| `%s` | %s | %s | %s |\n", flag, def, range, pi->doc);
+        if (markdown) {
+            /* a '|' of the choices would end a cell */
+            printf("| `%s` | %s | ", flag, def);
+            for (const char *c = range; *c; c++)
+                printf(*c == '|' ? "\\|" : "%c", *c);
+            printf(" | %s |\n", pi->doc);
+        }
         else
             printf("%-24s %-10s %-22s %s\n", flag, def, range, pi->doc);
     }

@@ -68,7 +68,7 @@ static int accessor(out *o, const void *data, size_t count, int comps, int ctype
     cJSON_AddNumberToObject(v, "target", target);
     cJSON_AddItemToArray(o->views, v);
     cJSON *a = cJSON_CreateObject();
-    cJSON_AddNumberToObject(a, "bufferView", cJSON_GetArraySize(o->views) - 1);
+    cJSON_AddNumberToObject(a, "bufferView", o->nacc); /* one view per accessor */
     cJSON_AddNumberToObject(a, "componentType", ctype);
     cJSON_AddNumberToObject(a, "count", (double)count);
     cJSON_AddStringToObject(a, "type", comps == 1 ? "SCALAR" : "VEC3");
@@ -197,6 +197,7 @@ obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,
         goto done;
     }
     size_t inst = 0;
+    int nmesh = 0; /* cJSON_GetArraySize walks the list: counted here */
     for (size_t n = 0; n < scene->node_count; n++) {
         const obs_bake_node *nd = &scene->nodes[n];
         cJSON *j = items[n] = cJSON_CreateObject();
@@ -238,7 +239,7 @@ obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,
                                                       &r->instances[inst], color));
             }
             cJSON_AddItemToArray(meshes, m);
-            cJSON_AddNumberToObject(j, "mesh", cJSON_GetArraySize(meshes) - 1);
+            cJSON_AddNumberToObject(j, "mesh", nmesh++);
         }
     }
     free(items);
