@@ -131,6 +131,8 @@ typedef struct sys {
     double *b;     /* 2 per vertex */
     double *x0;    /* 2 per vertex */
     double *lump;  /* lumped area */
+    size_t *interior; /* the first record of each interior edge's pair */
+    size_t ninterior;
 } sys;
 
 static void sys_free(sys *y)
@@ -140,6 +142,7 @@ static void sys_free(sys *y)
     free(y->b);
     free(y->x0);
     free(y->lump);
+    free(y->interior);
 }
 
 /* x0: a vertex's own sample mean; where it has none, the mean of its
@@ -237,14 +240,15 @@ static void baselines(const obs__bake_world *w, const obs__bake_weld *wd,
                       const obs__bake_samples *s, const sys *y, obs_bake_stats *st)
 {
     size_t n = y->n;
-    double *mean = calloc(3 * n, sizeof *mean), *val = malloc(2 * n * sizeof *val);
+    double *mean = calloc(3 * n, sizeof *mean), *face = malloc(2 * n * sizeof *face),
+           *point = malloc(2 * n * sizeof *point);
     float *best = malloc(n * sizeof *best);
-    if (!mean || !val || !best)
+    if (!mean || !face || !point || !best)
         goto done;
     for (size_t v = 0; v < n; v++) {
         best[v] = -1.0f;
-        val[2 * v] = y->x0[2 * v];
-        val[2 * v + 1] = y->x0[2 * v + 1];
+        memcpy(face + 2 * v, y->x0 + 2 * v, 2 * sizeof *face);
+        memcpy(point + 2 * v, y->x0 + 2 * v, 2 * sizeof *point);
     }
     for (size_t i = 0; i < s->count; i++) {
         if (!s->valid[i])
@@ -255,36 +259,40 @@ static void baselines(const obs__bake_world *w, const obs__bake_weld *wd,
             mean[3 * v] += s->weight[i] * s->ao[2 * i];
             mean[3 * v + 1] += s->weight[i] * s->ao[2 * i + 1];
             mean[3 * v + 2] += s->weight[i];
+            if (s->bary[3 * i + k] > best[v]) {
+                best[v] = s->bary[3 * i + k];
+                point[2 * v] = s->ao[2 * i];
+                point[2 * v + 1] = s->ao[2 * i + 1];
+            }
         }
     }
     for (size_t v = 0; v < n; v++)
         if (mean[3 * v + 2] > 0.0) {
-            val[2 * v] = mean[3 * v] / mean[3 * v + 2];
-            val[2 * v + 1] = mean[3 * v + 1] / mean[3 * v + 2];
+            face[2 * v] = mean[3 * v] / mean[3 * v + 2];
+            face[2 * v + 1] = mean[3 * v + 1] / mean[3 * v + 2];
         }
-    residual(w, wd, s, val, st->residual_face_mean);
-    for (size_t v = 0; v < n; v++) {
-        val[2 * v] = y->x0[2 * v];
-        val[2 * v + 1] = y->x0[2 * v + 1];
-    }
-    for (size_t i = 0; i < s->count; i++) {
-        if (!s->valid[i])
-            continue;
-        const uint32_t *t = w->tri + 3 * s->tri[i];
-        for (int k = 0; k < 3; k++) {
-            uint32_t v = wd->of[t[k]];
-            if (s->bary[3 * i + k] > best[v]) {
-                best[v] = s->bary[3 * i + k];
-                val[2 * v] = s->ao[2 * i];
-                val[2 * v + 1] = s->ao[2 * i + 1];
-            }
-        }
-    }
-    residual(w, wd, s, val, st->residual_point);
+    residual(w, wd, s, face, st->residual_face_mean);
+    residual(w, wd, s, point, st->residual_point);
 done:
     free(mean);
-    free(val);
+    free(face);
+    free(point);
     free(best);
+}
+
+/* The regulariser's row of an interior edge (its two faces' records):
+ * the welded vertices a, b (the edge), c, d (the apexes) in idx, the jump's
+ * weights in j; returns the weight of its square, <= 0 to skip it. */
+static double edge_row(const obs__bake_world *w, const obs__bake_weld *wd, const edge *e1,
+                       const edge *e2, uint32_t idx[4], double j[4])
+{
+    const uint32_t *t1 = w->tri + 3 * (size_t)e1->face, *t2 = w->tri + 3 * (size_t)e2->face;
+    uint32_t c[4] = {t1[(e1->corner + 1) % 3], t1[(e1->corner + 2) % 3], t1[e1->corner],
+                     t2[e2->corner]};
+    for (int k = 0; k < 4; k++)
+        idx[k] = wd->of[c[k]];
+    return obs__bake_edge_jump(w->pos + 3 * (size_t)c[0], w->pos + 3 * (size_t)c[1],
+                               w->pos + 3 * (size_t)c[2], w->pos + 3 * (size_t)c[3], j);
 }
 
 /* The faces' edges in the welded mesh, sorted so that the faces of one
@@ -356,8 +364,11 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
     initial_values(s, &y, st);
 
     /* Interior edges: exactly two faces on the welded edge. */
-    size_t interior = 0;
     st->boundary_edges = st->nonmanifold_edges = 0;
+    if (!(y.interior = malloc((y.nedges ? y.nedges : 1) * sizeof *y.interior))) {
+        rc = obs__fail(err, OBS_NO_MEMORY, "%zu edges", y.nedges);
+        goto done;
+    }
     for (size_t e = 0; e < y.nedges;) {
         size_t f = e + 1;
         while (f < y.nedges && y.edges[f].u == y.edges[e].u && y.edges[f].v == y.edges[e].v)
@@ -365,12 +376,13 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
         if (f - e == 1)
             st->boundary_edges++;
         else if (f - e == 2)
-            interior++;
+            y.interior[y.ninterior++] = e;
         else
             st->nonmanifold_edges++;
         e = f;
     }
-    st->interior_edges = interior;
+    st->interior_edges = y.ninterior;
+    size_t interior = y.ninterior;
 
     cholmod_start(&cm);
     started = 1;
@@ -410,27 +422,16 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
         put_local(&tr, idx, 3, m);
     }
     /* alpha R */
-    for (size_t e = 0; e < y.nedges && p->alpha > 0.0f;) {
-        size_t f = e + 1;
-        while (f < y.nedges && y.edges[f].u == y.edges[e].u && y.edges[f].v == y.edges[e].v)
-            f++;
-        if (f - e == 2) {
-            const edge *e1 = &y.edges[e], *e2 = &y.edges[e + 1];
-            const uint32_t *t1 = w->tri + 3 * (size_t)e1->face, *t2 = w->tri + 3 * (size_t)e2->face;
-            uint32_t ca = t1[(e1->corner + 1) % 3], cb = t1[(e1->corner + 2) % 3];
-            uint32_t cc = t1[e1->corner], cd = t2[e2->corner];
-            double j[4], m[16];
-            double om = obs__bake_edge_jump(w->pos + 3 * (size_t)ca, w->pos + 3 * (size_t)cb,
-                                            w->pos + 3 * (size_t)cc, w->pos + 3 * (size_t)cd, j);
-            if (om > 0.0) {
-                uint32_t idx[4] = {wd->of[ca], wd->of[cb], wd->of[cc], wd->of[cd]};
-                for (int a = 0; a < 4; a++)
-                    for (int c = 0; c < 4; c++)
-                        m[4 * a + c] = p->alpha * om * j[a] * j[c];
-                put_local(&tr, idx, 4, m);
-            }
-        }
-        e = f;
+    for (size_t k = 0; k < y.ninterior && p->alpha > 0.0f; k++) {
+        uint32_t idx[4];
+        double j[4], m[16];
+        double om = edge_row(w, wd, &y.edges[y.interior[k]], &y.edges[y.interior[k] + 1], idx, j);
+        if (!(om > 0.0))
+            continue;
+        for (int a = 0; a < 4; a++)
+            for (int c = 0; c < 4; c++)
+                m[4 * a + c] = p->alpha * om * j[a] * j[c];
+        put_local(&tr, idx, 4, m);
     }
     /* ridge D, and the right-hand side */
     B = cholmod_zeros(y.n, 2, CHOLMOD_REAL, &cm);
@@ -489,25 +490,14 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
     baselines(w, wd, s, &y, st);
     /* alpha x^T R x, edge by edge */
     st->regulariser_energy[0] = st->regulariser_energy[1] = 0.0;
-    for (size_t e = 0; e + 1 < y.nedges; e++) {
-        const edge *e1 = &y.edges[e], *e2 = &y.edges[e + 1];
-        int two = e2->u == e1->u && e2->v == e1->v &&
-                  (e + 2 >= y.nedges || y.edges[e + 2].u != e1->u || y.edges[e + 2].v != e1->v) &&
-                  (e == 0 || y.edges[e - 1].u != e1->u || y.edges[e - 1].v != e1->v);
-        if (!two)
-            continue;
-        const uint32_t *t1 = w->tri + 3 * (size_t)e1->face, *t2 = w->tri + 3 * (size_t)e2->face;
-        uint32_t c[4] = {t1[(e1->corner + 1) % 3], t1[(e1->corner + 2) % 3], t1[e1->corner],
-                         t2[e2->corner]};
+    for (size_t k = 0; k < y.ninterior; k++) {
+        uint32_t idx[4];
         double j[4];
-        double om = obs__bake_edge_jump(w->pos + 3 * (size_t)c[0], w->pos + 3 * (size_t)c[1],
-                                        w->pos + 3 * (size_t)c[2], w->pos + 3 * (size_t)c[3], j);
-        if (!(om > 0.0))
-            continue;
-        for (int ch = 0; ch < 2; ch++) {
+        double om = edge_row(w, wd, &y.edges[y.interior[k]], &y.edges[y.interior[k] + 1], idx, j);
+        for (int ch = 0; ch < 2 && om > 0.0; ch++) {
             double jump = 0.0;
-            for (int k = 0; k < 4; k++)
-                jump += j[k] * x[2 * wd->of[c[k]] + ch];
+            for (int c = 0; c < 4; c++)
+                jump += j[c] * x[2 * idx[c] + ch];
             st->regulariser_energy[ch] += p->alpha * om * jump * jump;
         }
     }
