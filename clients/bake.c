@@ -147,6 +147,13 @@ static int write_report(const char *path, const char *level, const obs_bake_para
     cJSON_AddItemToObject(res, "face_mean", pair(st->residual_face_mean));
     cJSON_AddItemToObject(res, "point_sample", pair(st->residual_point));
     cJSON_AddItemToObject(r, "regulariser_energy", pair(st->regulariser_energy));
+    if (p->holdout > 0.0f) {
+        cJSON *h = cJSON_AddObjectToObject(r, "holdout_rms");
+        cJSON_AddNumberToObject(h, "samples", (double)st->holdout_samples);
+        cJSON_AddItemToObject(h, "least_squares", pair(st->holdout_fit));
+        cJSON_AddItemToObject(h, "face_mean", pair(st->holdout_face_mean));
+        cJSON_AddItemToObject(h, "point_sample", pair(st->holdout_point));
+    }
     cJSON *ao = cJSON_AddObjectToObject(r, "ao");
     cJSON_AddNumberToObject(ao, "mean", st->ao_mean);
     cJSON_AddNumberToObject(ao, "min", st->ao_min);

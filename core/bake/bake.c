@@ -78,6 +78,30 @@ static obs_status copy_back(const obs_bake_scene *scene, const obs__bake_world *
     return OBS_OK;
 }
 
+/* Held-out samples (parameter holdout): another seed places them and
+ * draws their rays; the fit and the baselines are compared with them. */
+static obs_status holdout(const obs__bake_world *w, const obs__bake_weld *wd,
+                          const obs_bake_params *p, const double *x, const double *face,
+                          const double *point, obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    obs__bake_samples h;
+    uint64_t seed = (uint64_t)p->seed ^ 0x5bd1e995u;
+    obs_status rc = obs__bake_samples_make(w, p->holdout, p->max_samples_per_face, seed, &h, err);
+    if (rc != OBS_OK)
+        return rc;
+    obs__bake_trace_desc td = {{p->distance_short, p->distance_long}, p->rays, p->threads,
+                               p->backface_limit, seed, NULL, NULL};
+    double bvh;
+    if ((rc = obs__bake_trace(w, &h, &td, &bvh, err)) == OBS_OK) {
+        obs__bake_residual(w, wd, &h, x, st->holdout_fit);
+        obs__bake_residual(w, wd, &h, face, st->holdout_face_mean);
+        obs__bake_residual(w, wd, &h, point, st->holdout_point);
+        st->holdout_samples = h.count - h.dropped;
+    }
+    obs__bake_samples_free(&h);
+    return rc;
+}
+
 obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
                         obs_bake_result *out, char err[OBS_ERR_LEN])
 {
@@ -88,7 +112,7 @@ obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
     obs__bake_world w = {0};
     obs__bake_samples s = {0};
     obs__bake_weld wd = {0};
-    double *x = NULL;
+    double *x = NULL, *face = NULL, *point = NULL;
     obs_status rc;
     if (!scene || scene->node_count == 0)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "bake: no scene");
@@ -131,15 +155,23 @@ obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
     st->welded_vertices = wd.count;
     st->seconds[OBS_BAKE_STAGE_weld] = now() - t;
 
-    if (!(x = malloc(2 * (wd.count ? wd.count : 1) * sizeof *x))) {
+    size_t nx = 2 * (wd.count ? wd.count : 1);
+    x = malloc(nx * sizeof *x);
+    face = malloc(nx * sizeof *face);
+    point = malloc(nx * sizeof *point);
+    if (!x || !face || !point) {
         rc = obs__fail(err, OBS_NO_MEMORY, "solution of %zu vertices", wd.count);
         goto done;
     }
-    if ((rc = obs__bake_fit(&w, &wd, &s, &p, x, st, err)) != OBS_OK)
+    if ((rc = obs__bake_fit(&w, &wd, &s, &p, x, face, point, st, err)) != OBS_OK)
+        goto done;
+    if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
     rc = copy_back(scene, &w, &wd, x, p.blend, out, err);
 done:
     free(x);
+    free(face);
+    free(point);
     obs__bake_weld_free(&wd);
     obs__bake_samples_free(&s);
     obs__bake_world_free(&w);

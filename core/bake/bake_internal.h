@@ -75,10 +75,16 @@ obs_status obs__bake_weld_make(const obs__bake_world *w, float tolerance, float 
 void obs__bake_weld_free(obs__bake_weld *wd);
 
 /* The least-squares fit (fit.c): x holds 2 values (short, long) per welded
- * vertex.  Fills the fit's counts and residuals in st. */
+ * vertex; face and point the two baselines' values (obs_bake_stats), 2 per
+ * welded vertex too.  Fills the fit's counts and residuals in st. */
 obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
                          const obs__bake_samples *s, const obs_bake_params *p, double *x,
-                         obs_bake_stats *st, char err[OBS_ERR_LEN]);
+                         double *face, double *point, obs_bake_stats *st,
+                         char err[OBS_ERR_LEN]);
+/* RMS over the valid samples of s (weights w) of the piecewise-linear
+ * signal of the vertex values val minus the traced value, per distance. */
+void obs__bake_residual(const obs__bake_world *w, const obs__bake_weld *wd,
+                        const obs__bake_samples *s, const double *val, double out[2]);
 
 /* Pieces of the fit, for the tests: the edge regulariser's row of one
  * interior edge (fit.c).  Triangles (a, b, c) and (b, a, d) share the

@@ -209,9 +209,8 @@ static void initial_values(const obs__bake_samples *s, sys *y, obs_bake_stats *s
     free(acc);
 }
 
-/* RMS over the valid samples of g - f for the vertex values val. */
-static void residual(const obs__bake_world *w, const obs__bake_weld *wd,
-                     const obs__bake_samples *s, const double *val, double out[2])
+void obs__bake_residual(const obs__bake_world *w, const obs__bake_weld *wd,
+                        const obs__bake_samples *s, const double *val, double out[2])
 {
     double e[2] = {0, 0}, ws = 0.0;
     for (size_t i = 0; i < s->count; i++) {
@@ -237,13 +236,13 @@ static void residual(const obs__bake_world *w, const obs__bake_weld *wd,
  * and point sampling (the sample nearest the vertex, by its barycentric
  * weight, among those faces). */
 static void baselines(const obs__bake_world *w, const obs__bake_weld *wd,
-                      const obs__bake_samples *s, const sys *y, obs_bake_stats *st)
+                      const obs__bake_samples *s, const sys *y, double *face, double *point,
+                      obs_bake_stats *st)
 {
     size_t n = y->n;
-    double *mean = calloc(3 * n, sizeof *mean), *face = malloc(2 * n * sizeof *face),
-           *point = malloc(2 * n * sizeof *point);
+    double *mean = calloc(3 * n, sizeof *mean);
     float *best = malloc(n * sizeof *best);
-    if (!mean || !face || !point || !best)
+    if (!mean || !best)
         goto done;
     for (size_t v = 0; v < n; v++) {
         best[v] = -1.0f;
@@ -271,12 +270,10 @@ static void baselines(const obs__bake_world *w, const obs__bake_weld *wd,
             face[2 * v] = mean[3 * v] / mean[3 * v + 2];
             face[2 * v + 1] = mean[3 * v + 1] / mean[3 * v + 2];
         }
-    residual(w, wd, s, face, st->residual_face_mean);
-    residual(w, wd, s, point, st->residual_point);
+    obs__bake_residual(w, wd, s, face, st->residual_face_mean);
+    obs__bake_residual(w, wd, s, point, st->residual_point);
 done:
     free(mean);
-    free(face);
-    free(point);
     free(best);
 }
 
@@ -323,7 +320,7 @@ static obs_status collect_edges(const obs__bake_world *w, const obs__bake_weld *
 
 obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
                          const obs__bake_samples *s, const obs_bake_params *p, double *x,
-                         obs_bake_stats *st, char err[OBS_ERR_LEN])
+                         double *face, double *point, obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
     sys y = {0};
     y.n = wd->count;
@@ -486,8 +483,8 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
         }
     }
     st->seconds[OBS_BAKE_STAGE_solve] = now() - t_solve;
-    residual(w, wd, s, x, st->residual_fit);
-    baselines(w, wd, s, &y, st);
+    obs__bake_residual(w, wd, s, x, st->residual_fit);
+    baselines(w, wd, s, &y, face, point, st);
     /* alpha x^T R x, edge by edge */
     st->regulariser_energy[0] = st->regulariser_energy[1] = 0.0;
     for (size_t k = 0; k < y.ninterior; k++) {

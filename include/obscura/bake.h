@@ -83,6 +83,10 @@ typedef enum obs_bake_mass {
     X(weld_angle, FLOAT, 120.0, 0.0, 180.0, NULL,                              \
       "welded vertices must have normals less than this many degrees apart, " \
       "so back-to-back faces stay apart")                                      \
+    X(holdout, FLOAT, 0.0, 0.0, 4096.0, NULL,                                  \
+      "held-out check: this many samples per face (mean, placed and capped "   \
+      "as above, other positions and rays) traced after the fit and compared " \
+      "with the fit and the two baselines (the report's holdout rows); 0: off") \
     X(seed, INT, 1, 0, 2147483647, NULL,                                       \
       "random seed; the bake depends on it alone, not on the thread count")    \
     X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
@@ -209,6 +213,10 @@ typedef struct obs_bake_stats {
      * samples of its faces (per-face averaging, area weighted), and the
      * nearest samples' value (point sampling at the vertex). */
     double residual_fit[2], residual_face_mean[2], residual_point[2];
+    /* The same three at held-out samples (parameter holdout): other
+     * positions, other rays, never fitted; 0 when holdout is 0. */
+    double holdout_fit[2], holdout_face_mean[2], holdout_point[2];
+    size_t holdout_samples;
     double regulariser_energy[2]; /* alpha x^T R x of the solution */
     double ao_mean, ao_min, ao_max;
 } obs_bake_stats;

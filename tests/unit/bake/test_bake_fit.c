@@ -68,9 +68,10 @@ static void run_linear(const char *mass, const char *ridge, double tol, double *
     bt_set(&p, "mass", mass);
     bt_set(&p, "ridge", ridge);
     obs_bake_params_resolve(&p, &p);
-    double *x = malloc(2 * wd.count * sizeof *x);
+    double *x = malloc(6 * wd.count * sizeof *x);
     obs_bake_stats st = {0};
-    assert_int_equal(obs__bake_fit(&w, &wd, &s, &p, x, &st, err), OBS_OK);
+    assert_int_equal(obs__bake_fit(&w, &wd, &s, &p, x, x + 2 * wd.count, x + 4 * wd.count, &st, err),
+                     OBS_OK);
     double worst = 0.0;
     for (size_t v2 = 0; v2 < w.vertex_count; v2++) {
         const float *q = w.pos + 3 * v2;
@@ -171,9 +172,10 @@ static void test_fill_from_neighbours(void **state)
     assert_int_equal(obs__bake_weld_make(&w, 1e-5f, 120.0f, &wd, err), OBS_OK);
     obs_bake_params p;
     obs_bake_params_resolve(NULL, &p);
-    double *x = malloc(2 * wd.count * sizeof *x);
+    double *x = malloc(6 * wd.count * sizeof *x);
     obs_bake_stats st = {0};
-    assert_int_equal(obs__bake_fit(&w, &wd, &s, &p, x, &st, err), OBS_OK);
+    assert_int_equal(obs__bake_fit(&w, &wd, &s, &p, x, x + 2 * wd.count, x + 4 * wd.count, &st, err),
+                     OBS_OK);
     assert_true(st.vertices_without_samples >= 1);
     assert_int_equal(st.vertices_isolated, 0);
     assert_true(fabs(x[2 * wd.of[0]] - 0.6) < 1e-3);
@@ -182,8 +184,9 @@ static void test_fill_from_neighbours(void **state)
      * a clear error */
     memset(s.valid, 0, s.count);
     bt_set(&p, "ridge", "0");
-    x = malloc(2 * wd.count * sizeof *x);
-    assert_int_equal(obs__bake_fit(&w, &wd, &s, &p, x, &st, err), OBS_INVALID_ARGUMENT);
+    x = malloc(6 * wd.count * sizeof *x);
+    assert_int_equal(obs__bake_fit(&w, &wd, &s, &p, x, x + 2 * wd.count, x + 4 * wd.count, &st, err),
+                     OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "singular"));
     free(x);
     obs__bake_weld_free(&wd);

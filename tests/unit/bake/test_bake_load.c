@@ -86,9 +86,15 @@ static void test_fixture_round_trip(void **state)
     assert_int_equal(sc.world_triangles, 811);
     obs_bake_desc d = {0};
     bt_set(&d.params, "rays", "32");
+    bt_set(&d.params, "holdout", "1");
     obs_bake_result r;
     assert_int_equal(obs_bake_run(&sc, &d, &r, err), OBS_OK);
     assert_int_equal(r.instance_count, 62);
+    /* held-out samples: traced apart, compared with all three */
+    assert_true(r.stats.holdout_samples > 700);
+    for (int c = 0; c < 2; c++)
+        assert_true(r.stats.holdout_fit[c] > 0.0 && r.stats.holdout_fit[c] < 0.5 &&
+                    r.stats.holdout_point[c] > 0.0 && r.stats.holdout_face_mean[c] > 0.0);
     assert_true(r.stats.ao_min >= 0.0 && r.stats.ao_max <= 1.0);
     assert_true(r.stats.ao_mean > 0.3 && r.stats.ao_mean < 1.0);
     /* With alpha 0 the fit is the least-squares fit of the samples: no
