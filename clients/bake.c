@@ -170,6 +170,31 @@ static int write_report(const char *path, const char *level, const obs_bake_para
     return ok;
 }
 
+/* What the bake noticed about its input and could not decide for the
+ * user: printed even with --quiet. */
+static void warn(const obs_bake_stats *st)
+{
+    if (st->faces_against_normals)
+        fprintf(stderr,
+                "obscura: bake: warning: %zu of %zu faces wind against their vertex normals; "
+                "their winding decides the side that is traced\n",
+                st->faces_against_normals, st->triangles);
+    if (st->degenerate_triangles)
+        fprintf(stderr, "obscura: bake: warning: %zu degenerate (zero-area) faces skipped\n",
+                st->degenerate_triangles);
+    if (st->samples && st->samples_dropped_backface * 10 > st->samples)
+        fprintf(stderr,
+                "obscura: bake: warning: %zu of %zu samples (%.0f %%) dropped by the back-face "
+                "rule: inside geometry, or one-sided faces seen from behind\n",
+                st->samples_dropped_backface, st->samples,
+                100.0 * (double)st->samples_dropped_backface / (double)st->samples);
+    if (st->vertices_isolated)
+        fprintf(stderr,
+                "obscura: bake: warning: %zu vertices have no valid sample and no neighbour "
+                "with one: they take the mean of the level's samples\n",
+                st->vertices_isolated);
+}
+
 static int ends_with(const char *s, const char *tail)
 {
     size_t n = strlen(s), m = strlen(tail);
@@ -259,6 +284,7 @@ int cli_bake(int argc, char **argv)
         obs_bake_scene_free(&sc);
         return cli_fail(s, in, err);
     }
+    warn(&r.stats);
     double t1 = now_s();
     s = out_ply ? obs_bake_write_ply(out, &sc, &r, err)
                 : obs_bake_write_glb(out, &sc, &r, color, err);
