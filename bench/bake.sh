@@ -1,10 +1,11 @@
 #!/bin/sh
 # The bake on the real levels (bench/BAKE.md): each run's --report into
-# out/bake/, one markdown row per run.
+# out/bake/, then two markdown tables from the reports: quality (RMS of
+# the fit and the two baselines at held-out samples) and stage times.
 #   bench/bake.sh [quick|full]      (OBSCURA: the CLI; OBSCURA_SHARED_DATA)
-# quick: the TORCS tracks and polynesia with the defaults, the fit's
-# variants on aalborg, battle_for_the_tiber at 32 rays and 1 sample per
-# face; full: battle_for_the_tiber with the defaults too.
+# quick: the TORCS tracks and polynesia with the defaults and --holdout 1,
+# the fit's variants on aalborg, battle_for_the_tiber at 32 rays and 1
+# sample per face; full: battle_for_the_tiber with the defaults too.
 set -eu
 OBSCURA=${OBSCURA:-build/obscura}
 DATA=${OBSCURA_SHARED_DATA:-../shared/data}/levels
@@ -14,28 +15,50 @@ if [ ! -d "$DATA" ]; then
     exit 0
 fi
 mkdir -p out/bake
-row() { # name level args...
+runs=""
+run() { # name level args...
     name=$1; level=$2; shift 2
+    echo "bake bench: $name: $level $*" >&2
     "$OBSCURA" bake "$DATA/$level" -o "out/bake/$name.glb" --report "out/bake/$name.json" -q "$@"
-    python3 - "out/bake/$name.json" "$name" "$*" <<'PY'
-import json, sys
-r = json.load(open(sys.argv[1])); c = r["counts"]; s = r["seconds"]; q = r["residual_rms"]
-print("| %s | %s | %d | %d | %d | %d | %.1f | %.1f | %.2f | %.4f / %.4f | %.4f / %.4f | %.4f / %.4f | %.3f |" % (
-    sys.argv[2], sys.argv[3] or "defaults", c["triangles"], c["samples"], c["samples_dropped_backface"],
-    c["welded_vertices"], s["trace"], s["total"], r["rays_per_second"] / 1e6,
-    q["least_squares"]["short"], q["least_squares"]["long"], q["face_mean"]["short"], q["face_mean"]["long"],
-    q["point_sample"]["short"], q["point_sample"]["long"], r["ao"]["mean"]))
-PY
+    runs="$runs $name"
 }
-echo "| run | options | triangles | samples | dropped | welded vertices | trace s | total s | Mrays/s | RMS LS short / long | RMS face mean | RMS point | mean _AO |"
-echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
-row aalborg torcs/aalborg/aalborg.acc
-row aalborg_analytic torcs/aalborg/aalborg.acc --mass analytic
-row aalborg_alpha0 torcs/aalborg/aalborg.acc --alpha 0
-row aalborg_nobackface torcs/aalborg/aalborg.acc --backface-limit 1
-row forza torcs/forza/forza.acc
-row polynesia 0ad/polynesia.glb
-row tiber_quick 0ad/battle_for_the_tiber.glb --rays 32 --samples-per-face 1
+run aalborg torcs/aalborg/aalborg.acc --holdout 1
+run aalborg_alpha0 torcs/aalborg/aalborg.acc --holdout 1 --alpha 0
+run aalborg_alpha0.1 torcs/aalborg/aalborg.acc --holdout 1 --alpha 0.1
+run aalborg_alpha10 torcs/aalborg/aalborg.acc --holdout 1 --alpha 10
+run aalborg_analytic torcs/aalborg/aalborg.acc --holdout 1 --mass analytic
+run aalborg_nobackface torcs/aalborg/aalborg.acc --holdout 1 --backface-limit 1
+run forza torcs/forza/forza.acc --holdout 1
+run polynesia 0ad/polynesia.glb --holdout 1
+run tiber_quick 0ad/battle_for_the_tiber.glb --rays 32 --samples-per-face 1
 if [ "$mode" = full ]; then
-    row tiber 0ad/battle_for_the_tiber.glb
+    run tiber 0ad/battle_for_the_tiber.glb
 fi
+python3 - $runs <<'PY'
+import json, sys
+rs = [(n, json.load(open("out/bake/%s.json" % n))) for n in sys.argv[1:]]
+def opts(r):
+    p = r["params"]
+    return "alpha %g, mass %s, backface %g, %d rays, %g/face" % (
+        p["alpha"], p["mass"], p["backface_limit"], p["rays"], p["samples_per_face"])
+print("| run | options | samples | dropped | held-out samples | LS short / long | face mean | point | mean _AO |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+for n, r in rs:
+    h = r.get("holdout_rms")
+    if not h:
+        continue
+    c = r["counts"]
+    f = lambda k: "%.4f / %.4f" % (h[k]["short"], h[k]["long"])
+    print("| %s | %s | %d | %d | %d | %s | %s | %s | %.3f |" % (
+        n, opts(r), c["samples"], c["samples_dropped_backface"], h["samples"],
+        f("least_squares"), f("face_mean"), f("point_sample"), r["ao"]["mean"]))
+print()
+st = ["load", "flatten", "samples", "bvh", "trace", "weld", "assemble", "solve", "write", "total"]
+print("| run | triangles | welded vertices | rays | " + " | ".join(st) + " | Mrays/s |")
+print("| --- " * (len(st) + 5) + "|")
+for n, r in rs:
+    c, s = r["counts"], r["seconds"]
+    print("| %s | %d | %d | %.3g | %s | %.2f |" % (
+        n, c["triangles"], c["welded_vertices"], c["rays"],
+        " | ".join("%.2f" % s[k] for k in st), r["rays_per_second"] / 1e6))
+PY

@@ -37,6 +37,34 @@ static void test_edge_jump(void **state)
     assert_true(obs__bake_edge_jump(a, b, e, d, j) < 0.0);
 }
 
+/* One plane, flattened and sampled: the fit's input without the trace. */
+typedef struct plane {
+    obs_bake_scene sc;
+    obs__bake_world w;
+    obs__bake_samples s;
+    obs__bake_weld wd;
+} plane;
+
+static void plane_make(plane *pl, const float o[3], const float u[3], const float v[3], int nu,
+                       int nv, double per_face)
+{
+    obs_bake_mesh m;
+    char err[OBS_ERR_LEN] = "";
+    bt_grid(&m, "plane", o, u, v, nu, nv);
+    bt_scene(&pl->sc, &m, 1);
+    assert_int_equal(obs__bake_flatten(&pl->sc, &pl->w, err), OBS_OK);
+    assert_int_equal(obs__bake_samples_make(&pl->w, per_face, 16, 5, &pl->s, err), OBS_OK);
+    memset(&pl->wd, 0, sizeof pl->wd);
+}
+
+static void plane_free(plane *pl)
+{
+    obs__bake_weld_free(&pl->wd);
+    obs__bake_samples_free(&pl->s);
+    obs__bake_world_free(&pl->w);
+    obs_bake_scene_free(&pl->sc);
+}
+
 /* A welded plane whose samples carry a linear signal: with the mass matrix
  * from the samples the fit is the least-squares fit of the samples, which
  * a linear signal meets exactly (and the regulariser is zero there); the
@@ -44,39 +72,32 @@ static void test_edge_jump(void **state)
  * hat products exactly. */
 static void run_linear(const char *mass, const char *ridge, double tol, double *worst_out)
 {
-    obs_bake_mesh m;
     const float o[3] = {-3, 0.5f, -2}, u[3] = {0, 0.8f, 5}, v[3] = {6, 0.3f, 0};
-    bt_grid(&m, "slope", o, u, v, 10, 12);
-    obs_bake_scene sc;
-    bt_scene(&sc, &m, 1);
-    obs__bake_world w;
-    obs__bake_samples s;
-    obs__bake_weld wd;
+    plane pl;
+    plane_make(&pl, o, u, v, 10, 12, 3.0);
     char err[OBS_ERR_LEN] = "";
-    assert_int_equal(obs__bake_flatten(&sc, &w, err), OBS_OK);
-    assert_int_equal(obs__bake_samples_make(&w, 3.0, 16, 5, &s, err), OBS_OK);
-    for (size_t i = 0; i < s.count; i++) {
+    for (size_t i = 0; i < pl.s.count; i++) {
         float p[3];
-        obs__bake_sample_pos(&w, &s, i, p);
-        s.ao[2 * i] = 0.2f + 0.05f * p[0] + 0.03f * p[2];
-        s.ao[2 * i + 1] = 0.9f - 0.02f * p[0] + 0.01f * p[1];
-        s.valid[i] = 1;
+        obs__bake_sample_pos(&pl.w, &pl.s, i, p);
+        pl.s.ao[2 * i] = 0.2f + 0.05f * p[0] + 0.03f * p[2];
+        pl.s.ao[2 * i + 1] = 0.9f - 0.02f * p[0] + 0.01f * p[1];
+        pl.s.valid[i] = 1;
     }
-    assert_int_equal(obs__bake_weld_make(&w, 1e-5f, 120.0f, &wd, err), OBS_OK);
-    assert_int_equal(wd.count, w.vertex_count); /* indexed already */
+    assert_int_equal(obs__bake_weld_make(&pl.w, 1e-5f, 120.0f, &pl.wd, err), OBS_OK);
+    assert_int_equal(pl.wd.count, pl.w.vertex_count); /* indexed already */
     obs_bake_params p = {0};
     bt_set(&p, "mass", mass);
     bt_set(&p, "ridge", ridge);
     obs_bake_params_resolve(&p, &p);
-    double *x = malloc(6 * wd.count * sizeof *x);
+    double *x = malloc(6 * pl.wd.count * sizeof *x);
     obs_bake_stats st = {0};
-    assert_int_equal(obs__bake_fit(&w, &wd, &s, &p, x, x + 2 * wd.count, x + 4 * wd.count, &st, err),
+    assert_int_equal(obs__bake_fit(&pl.w, &pl.wd, &pl.s, &p, x, x + 2 * pl.wd.count, x + 4 * pl.wd.count, &st, err),
                      OBS_OK);
     double worst = 0.0;
-    for (size_t v2 = 0; v2 < w.vertex_count; v2++) {
-        const float *q = w.pos + 3 * v2;
+    for (size_t v2 = 0; v2 < pl.w.vertex_count; v2++) {
+        const float *q = pl.w.pos + 3 * v2;
         double f0 = 0.2 + 0.05 * q[0] + 0.03 * q[2], f1 = 0.9 - 0.02 * q[0] + 0.01 * q[1];
-        worst = fmax(worst, fmax(fabs(x[2 * wd.of[v2]] - f0), fabs(x[2 * wd.of[v2] + 1] - f1)));
+        worst = fmax(worst, fmax(fabs(x[2 * pl.wd.of[v2]] - f0), fabs(x[2 * pl.wd.of[v2] + 1] - f1)));
     }
     print_message("linear signal, mass %s, ridge %s: worst vertex error %.2e, residual %.2e, "
                   "regulariser %.2e\n",
@@ -86,10 +107,7 @@ static void run_linear(const char *mass, const char *ridge, double tol, double *
         *worst_out = worst;
     assert_true(st.interior_edges > 0);
     free(x);
-    obs__bake_weld_free(&wd);
-    obs__bake_samples_free(&s);
-    obs__bake_world_free(&w);
-    obs_bake_scene_free(&sc);
+    plane_free(&pl);
 }
 
 static void test_linear_signal(void **state)
@@ -151,48 +169,38 @@ static void test_weld(void **state)
 static void test_fill_from_neighbours(void **state)
 {
     (void)state;
-    obs_bake_mesh m;
     const float o[3] = {0, 0, 0}, u[3] = {0, 0, 4}, v[3] = {4, 0, 0};
-    bt_grid(&m, "plane", o, u, v, 4, 4);
-    obs_bake_scene sc;
-    bt_scene(&sc, &m, 1);
-    obs__bake_world w;
-    obs__bake_samples s;
-    obs__bake_weld wd;
+    plane pl;
+    plane_make(&pl, o, u, v, 4, 4, 2.0);
     char err[OBS_ERR_LEN] = "";
-    assert_int_equal(obs__bake_flatten(&sc, &w, err), OBS_OK);
-    assert_int_equal(obs__bake_samples_make(&w, 2.0, 16, 5, &s, err), OBS_OK);
     /* every sample valid at 0.6, except those of faces touching the
      * corner vertex 0 */
-    for (size_t i = 0; i < s.count; i++) {
-        const uint32_t *t = w.tri + 3 * s.tri[i];
-        s.ao[2 * i] = s.ao[2 * i + 1] = 0.6f;
-        s.valid[i] = !(t[0] == 0 || t[1] == 0 || t[2] == 0);
+    for (size_t i = 0; i < pl.s.count; i++) {
+        const uint32_t *t = pl.w.tri + 3 * pl.s.tri[i];
+        pl.s.ao[2 * i] = pl.s.ao[2 * i + 1] = 0.6f;
+        pl.s.valid[i] = !(t[0] == 0 || t[1] == 0 || t[2] == 0);
     }
-    assert_int_equal(obs__bake_weld_make(&w, 1e-5f, 120.0f, &wd, err), OBS_OK);
+    assert_int_equal(obs__bake_weld_make(&pl.w, 1e-5f, 120.0f, &pl.wd, err), OBS_OK);
     obs_bake_params p;
     obs_bake_params_resolve(NULL, &p);
-    double *x = malloc(6 * wd.count * sizeof *x);
+    double *x = malloc(6 * pl.wd.count * sizeof *x);
     obs_bake_stats st = {0};
-    assert_int_equal(obs__bake_fit(&w, &wd, &s, &p, x, x + 2 * wd.count, x + 4 * wd.count, &st, err),
+    assert_int_equal(obs__bake_fit(&pl.w, &pl.wd, &pl.s, &p, x, x + 2 * pl.wd.count, x + 4 * pl.wd.count, &st, err),
                      OBS_OK);
     assert_true(st.vertices_without_samples >= 1);
     assert_int_equal(st.vertices_isolated, 0);
-    assert_true(fabs(x[2 * wd.of[0]] - 0.6) < 1e-3);
+    assert_true(fabs(x[2 * pl.wd.of[0]] - 0.6) < 1e-3);
     free(x);
     /* with no valid sample at all and no ridge the system is singular:
      * a clear error */
-    memset(s.valid, 0, s.count);
+    memset(pl.s.valid, 0, pl.s.count);
     bt_set(&p, "ridge", "0");
-    x = malloc(6 * wd.count * sizeof *x);
-    assert_int_equal(obs__bake_fit(&w, &wd, &s, &p, x, x + 2 * wd.count, x + 4 * wd.count, &st, err),
+    x = malloc(6 * pl.wd.count * sizeof *x);
+    assert_int_equal(obs__bake_fit(&pl.w, &pl.wd, &pl.s, &p, x, x + 2 * pl.wd.count, x + 4 * pl.wd.count, &st, err),
                      OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "singular"));
     free(x);
-    obs__bake_weld_free(&wd);
-    obs__bake_samples_free(&s);
-    obs__bake_world_free(&w);
-    obs_bake_scene_free(&sc);
+    plane_free(&pl);
 }
 
 /* The sample counts: proportional to area, at least 1, capped. */
