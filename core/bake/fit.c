@@ -145,6 +145,14 @@ static void sys_free(sys *y)
     free(y->interior);
 }
 
+static double wsum_valid(const obs__bake_samples *s)
+{
+    double w = 0.0;
+    for (size_t i = 0; i < s->count; i++)
+        w += s->valid[i] ? s->weight[i] : 0.0;
+    return w;
+}
+
 /* x0: a vertex's own sample mean; where it has none, the mean of its
  * neighbours' values, front by front; where no neighbour has one, the
  * mean of every valid sample (1 with none at all). */
@@ -381,6 +389,22 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
     st->interior_edges = y.ninterior;
     size_t interior = y.ninterior;
 
+    /* Without the ridge only samples make the system definite (R is zero
+     * on linear signals): refuse rather than solve a singular system. */
+    if (!(wsum_valid(s) > 0.0)) {
+        rc = obs__fail(err, OBS_INVALID_ARGUMENT,
+                       "no valid sample in the level: all %zu dropped by the back-face rule "
+                       "(backface_limit %g)",
+                       s->count, (double)p->backface_limit);
+        goto done;
+    }
+    if (p->ridge <= 0.0f && st->vertices_without_samples) {
+        rc = obs__fail(err, OBS_INVALID_ARGUMENT,
+                       "ridge 0 leaves the system singular: %zu vertices have no valid sample "
+                       "(a ridge above 0 gives them their neighbours' value)",
+                       st->vertices_without_samples);
+        goto done;
+    }
     cholmod_start(&cm);
     started = 1;
     cm.print = 0;
@@ -436,9 +460,13 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
         rc = obs__fail(err, OBS_NO_MEMORY, "right-hand side of %zu vertices", y.n);
         goto done;
     }
-    double *bx = B->x;
+    double *bx = B->x, lump_mean = 0.0;
+    for (size_t v = 0; v < y.n; v++)
+        lump_mean += y.lump[v] / (double)y.n;
     for (size_t v = 0; v < y.n; v++) {
-        double r = p->ridge * y.lump[v];
+        /* A vertex of no face with area (unused by the mesh, or of
+         * degenerate faces only) has no row otherwise: pinned to x0. */
+        double r = y.lump[v] > 0.0 ? p->ridge * y.lump[v] : lump_mean;
         put(&tr, (uint32_t)v, (uint32_t)v, r);
         bx[v] = y.b[2 * v] + r * y.x0[2 * v];
         bx[y.n + v] = y.b[2 * v + 1] + r * y.x0[2 * v + 1];
@@ -456,16 +484,10 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
         rc = obs__fail(err, OBS_NO_MEMORY, "CHOLMOD could not factorise (status %d)", cm.status);
         goto done;
     }
-    /* A singular system need not stop the factorisation (rounding leaves
-     * tiny pivots): the cheap condition estimate (the ratio of L's
-     * extreme diagonal entries) catches it too. */
-    double rcond = cm.status == CHOLMOD_NOT_POSDEF ? 0.0 : cholmod_rcond(L, &cm);
-    if (cm.status == CHOLMOD_NOT_POSDEF || !(rcond > 1e-13)) {
+    if (cm.status == CHOLMOD_NOT_POSDEF) {
         rc = obs__fail(err, OBS_INVALID_ARGUMENT,
-                       "the least-squares system is singular (condition estimate %g, column %d): "
-                       "vertices without valid samples (ridge %g; a ridge above 0 gives them "
-                       "their neighbours' value)",
-                       rcond, (int)L->minor, (double)p->ridge);
+                       "the least-squares system is singular at column %d of %zu", (int)L->minor,
+                       y.n);
         goto done;
     }
     X = cholmod_solve(CHOLMOD_A, L, B, &cm);
@@ -477,8 +499,13 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
     for (size_t v = 0; v < y.n; v++) {
         x[2 * v] = xx[v];
         x[2 * v + 1] = xx[y.n + v];
-        if (!isfinite(x[2 * v]) || !isfinite(x[2 * v + 1])) {
-            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "the fit is not finite at vertex %zu", v);
+        /* The samples lie in [0, 1]; a fit far outside is a system too
+         * ill-conditioned to trust, not an answer. */
+        if (!(fabs(x[2 * v]) < 1e3) || !(fabs(x[2 * v + 1]) < 1e3)) {
+            rc = obs__fail(err, OBS_INVALID_ARGUMENT,
+                           "the fit is %g at welded vertex %zu: the least-squares system is "
+                           "ill-conditioned",
+                           x[2 * v], v);
             goto done;
         }
     }

@@ -191,14 +191,21 @@ static void test_fill_from_neighbours(void **state)
     assert_int_equal(st.vertices_isolated, 0);
     assert_true(fabs(x[2 * pl.wd.of[0]] - 0.6) < 1e-3);
     free(x);
-    /* with no valid sample at all and no ridge the system is singular:
-     * a clear error */
-    memset(pl.s.valid, 0, pl.s.count);
+    /* ridge 0 with vertices without samples: a clear error, not a
+     * singular solve */
     bt_set(&p, "ridge", "0");
     x = malloc(6 * pl.wd.count * sizeof *x);
     assert_int_equal(obs__bake_fit(&pl.w, &pl.wd, &pl.s, &p, x, x + 2 * pl.wd.count, x + 4 * pl.wd.count, &st, err),
                      OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "singular"));
+    free(x);
+    /* no valid sample at all: the same */
+    memset(pl.s.valid, 0, pl.s.count);
+    bt_set(&p, "ridge", "1e-4");
+    x = malloc(6 * pl.wd.count * sizeof *x);
+    assert_int_equal(obs__bake_fit(&pl.w, &pl.wd, &pl.s, &p, x, x + 2 * pl.wd.count, x + 4 * pl.wd.count, &st, err),
+                     OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "no valid sample"));
     free(x);
     plane_free(&pl);
 }
