@@ -256,6 +256,7 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
             /* first visit */
             obs_bake_node *o = &out->nodes[count];
             ids[sp] = (int)count++;
+            out->node_count = count; /* what obs_bake_scene_free releases on failure */
             o->parent = sp ? ids[sp - 1] : -1;
             to_mat(&nd->mTransformation, o->local);
             if (o->parent >= 0)
