@@ -128,6 +128,8 @@ obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
     st->vertices = w.vertex_count;
     st->degenerate_triangles = w.degenerate;
     st->faces_against_normals = w.against_normals;
+    for (size_t k = 0; k < w.triangle_count; k++)
+        st->two_sided_triangles += w.two_sided[k];
     st->seconds[OBS_BAKE_STAGE_flatten] = now() - t;
 
     t = now();

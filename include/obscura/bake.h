@@ -202,6 +202,7 @@ typedef struct obs_bake_stats {
     double seconds[OBS_BAKE_STAGE_COUNT];
     size_t instances, triangles, degenerate_triangles, vertices;
     size_t faces_against_normals; /* winding disagrees with the normals */
+    size_t two_sided_triangles;   /* of double-sided materials: no back */
     size_t samples, samples_dropped_backface;
     uint64_t rays;
     size_t welded_vertices, interior_edges, boundary_edges, nonmanifold_edges;
