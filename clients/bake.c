@@ -178,12 +178,13 @@ static int ends_with(const char *s, const char *tail);
 static void warn(const char *level, const obs_bake_stats *st)
 {
     /* assimp 5.2's AC3D reader drops the surfaces' double-sided flag
-     * (SURF 0x20): measured, no face of the TORCS tracks comes out
-     * double-sided, though aalborg's tree cards all are. */
+     * (SURF 0x20); the loader reads it from the file, unless the file's
+     * objects and assimp's nodes disagree. */
     if ((ends_with(level, ".ac") || ends_with(level, ".acc")) && !st->two_sided_triangles)
         fprintf(stderr,
-                "obscura: bake: warning: %s: AC3D's double-sided surfaces are not known "
-                "through assimp: every face counts as one-sided for the back-face rule\n",
+                "obscura: bake: warning: %s: no double-sided AC3D surface found (or its "
+                "objects did not match assimp's nodes): every face counts as one-sided for "
+                "the back-face rule\n",
                 level);
     if (st->faces_against_normals)
         fprintf(stderr,

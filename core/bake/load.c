@@ -1,7 +1,8 @@
 /* A level through assimp with its node graph kept (core/ground/scene.c
  * pre-transforms the vertices, which loses the instancing): meshes in their
  * own space, every node with its name, transform, meshes and glTF extras
- * (assimp 5.2 gives them as the node's metadata). */
+ * (assimp 5.2 gives them as the node's metadata), and AC3D's double-sided
+ * surfaces, which assimp drops, from the file itself. */
 #include <assimp/cimport.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -12,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "internal.h"
 #include "obscura/bake.h"
@@ -193,6 +195,54 @@ static size_t count_nodes(const struct aiNode *root, char err[OBS_ERR_LEN], int 
     return n;
 }
 
+static int has_suffix(const char *s, const char *tail)
+{
+    size_t n = strlen(s), m = strlen(tail);
+    return n >= m && !strcasecmp(s + n - m, tail);
+}
+
+/* AC3D's double-sided flag (SURF 0x20) as assimp 5.2 does not pass it on:
+ * read from the file itself.  assimp makes one node per OBJECT, in the
+ * file's order (depth first, the world object first), so node i is OBJECT
+ * i; an object whose surfaces are mostly double-sided makes its meshes
+ * double-sided (AC3D meshes belong to one node each).  Nothing is changed
+ * when the counts disagree.  Returns the number of objects marked. */
+static size_t ac3d_two_sided(const char *path, obs_bake_scene *s)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    size_t cap = s->node_count, obj = 0;
+    int *two = calloc(cap ? cap : 1, sizeof *two), *one = calloc(cap ? cap : 1, sizeof *one);
+    char line[512];
+    int ok = two && one;
+    while (ok && fgets(line, sizeof line, f)) {
+        if (!strncmp(line, "OBJECT ", 7)) {
+            if (++obj > cap)
+                ok = 0;
+        } else if (!strncmp(line, "SURF ", 5) && obj > 0) {
+            unsigned long flags = strtoul(line + 5, NULL, 0);
+            if (flags & 0x20u)
+                two[obj - 1]++;
+            else
+                one[obj - 1]++;
+        }
+    }
+    fclose(f);
+    size_t marked = 0;
+    if (ok && obj == s->node_count)
+        for (size_t n = 0; n < s->node_count; n++) {
+            if (two[n] <= one[n])
+                continue;
+            marked++;
+            for (uint32_t k = 0; k < s->nodes[n].mesh_count; k++)
+                s->meshes[s->nodes[n].meshes[k]].two_sided = 1;
+        }
+    free(two);
+    free(one);
+    return marked;
+}
+
 obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene *out,
                          char err[OBS_ERR_LEN])
 {
@@ -309,6 +359,8 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
         st = obs__fail(err, OBS_BAD_FILE, "%s: no triangles under the scene's nodes", path);
         goto fail;
     }
+    if (has_suffix(path, ".ac") || has_suffix(path, ".acc"))
+        ac3d_two_sided(path, out);
     aiReleaseImport(sc);
     return OBS_OK;
 fail:
