@@ -6,7 +6,9 @@
  * instances of a shared mesh.  Attributes: POSITION, NORMAL (when every
  * normal of the mesh is usable), _AO, _AO_SHORT, _AO_LONG (float scalars;
  * custom attributes begin with '_', glTF 2.0 3.7.2.1), COLOR_0 = _AO as
- * grey when asked; indices as unsigned int. */
+ * grey when asked; indices as unsigned int.  The materials keep their
+ * names, base colours, alpha mode BLEND and sidedness, not their
+ * textures. */
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <math.h>
@@ -93,7 +95,8 @@ static void range(const float *v, size_t n, int comps, float *mn, float *mx)
         }
 }
 
-static cJSON *primitive(out *o, const obs_bake_mesh *m, const obs_bake_instance *r, int color)
+static cJSON *primitive(out *o, const obs_bake_mesh *m, const obs_bake_instance *r, int color,
+                        size_t materials)
 {
     float mn[3], mx[3];
     cJSON *p = cJSON_CreateObject(), *at = cJSON_CreateObject();
@@ -132,6 +135,8 @@ static cJSON *primitive(out *o, const obs_bake_mesh *m, const obs_bake_instance 
     cJSON_AddNumberToObject(p, "indices", accessor(o, m->indices, 3 * m->triangle_count, 1,
                                                    GL_UNSIGNED_INT, ELEMENT_ARRAY_BUFFER, NULL,
                                                    NULL));
+    if (m->material >= 0 && (size_t)m->material < materials)
+        cJSON_AddNumberToObject(p, "material", m->material);
     cJSON_AddNumberToObject(p, "mode", 4);
     return p;
 }
@@ -236,13 +241,29 @@ obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,
                     goto done;
                 }
                 cJSON_AddItemToArray(prims, primitive(&o, &scene->meshes[nd->meshes[k]],
-                                                      &r->instances[inst], color));
+                                                      &r->instances[inst], color,
+                                                      scene->material_count));
             }
             cJSON_AddItemToArray(meshes, m);
             cJSON_AddNumberToObject(j, "mesh", nmesh++);
         }
     }
     free(items);
+    if (scene->material_count) {
+        cJSON *mats = cJSON_AddArrayToObject(o.root, "materials");
+        for (size_t i = 0; i < scene->material_count; i++) {
+            const obs_bake_material *mt = &scene->materials[i];
+            cJSON *j = cJSON_CreateObject(), *pbr = cJSON_AddObjectToObject(j, "pbrMetallicRoughness");
+            cJSON_AddStringToObject(j, "name", mt->name);
+            cJSON_AddItemToObject(pbr, "baseColorFactor", cJSON_CreateFloatArray(mt->base_color, 4));
+            cJSON_AddNumberToObject(pbr, "metallicFactor", 0);
+            if (mt->double_sided)
+                cJSON_AddBoolToObject(j, "doubleSided", 1);
+            if (mt->blend)
+                cJSON_AddStringToObject(j, "alphaMode", "BLEND");
+            cJSON_AddItemToArray(mats, j);
+        }
+    }
     cJSON *buffers = cJSON_AddArrayToObject(o.root, "buffers"), *buf = cJSON_CreateObject();
     cJSON_AddNumberToObject(buf, "byteLength", (double)((o.b.len + 3) & ~(size_t)3));
     cJSON_AddItemToArray(buffers, buf);

@@ -3,6 +3,7 @@
  * own space, every node with its name, transform, meshes and glTF extras
  * (assimp 5.2 gives them as the node's metadata), and AC3D's double-sided
  * surfaces, which assimp drops, from the file itself. */
+#include <assimp/GltfMaterial.h>
 #include <assimp/cimport.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -36,6 +37,9 @@ void obs_bake_scene_free(obs_bake_scene *s)
         free(s->nodes[n].meshes);
         free(s->nodes[n].extras);
     }
+    for (size_t m = 0; m < s->material_count && s->materials; m++)
+        free(s->materials[m].name);
+    free(s->materials);
     free(s->meshes);
     free(s->nodes);
     memset(s, 0, sizeof *s);
@@ -91,6 +95,29 @@ static int material_two_sided(const struct aiScene *sc, unsigned mi)
            two != 0;
 }
 
+/* What the output keeps of a material; assimp's stand-in for a file
+ * without materials is kept too (it is what the meshes refer to). */
+static obs_status copy_material(const struct aiMaterial *mat, obs_bake_material *out)
+{
+    struct aiString s;
+    struct aiColor4D c = {0.8f, 0.8f, 0.8f, 1.0f};
+    out->name = strdup(aiGetMaterialString(mat, AI_MATKEY_NAME, &s) == aiReturn_SUCCESS ? s.data
+                                                                                        : "");
+    if (aiGetMaterialColor(mat, AI_MATKEY_BASE_COLOR, &c) != aiReturn_SUCCESS &&
+        aiGetMaterialColor(mat, AI_MATKEY_COLOR_DIFFUSE, &c) != aiReturn_SUCCESS)
+        c = (struct aiColor4D){0.8f, 0.8f, 0.8f, 1.0f};
+    const float rgba[4] = {c.r, c.g, c.b, c.a};
+    for (int k = 0; k < 4; k++)
+        out->base_color[k] = isfinite(rgba[k]) ? fminf(fmaxf(rgba[k], 0.0f), 1.0f) : 1.0f;
+    int two = 0;
+    out->double_sided = aiGetMaterialIntegerArray(mat, AI_MATKEY_TWOSIDED, &two, NULL) ==
+                            aiReturn_SUCCESS &&
+                        two;
+    out->blend = aiGetMaterialString(mat, AI_MATKEY_GLTF_ALPHAMODE, &s) == aiReturn_SUCCESS &&
+                 !strcmp(s.data, "BLEND");
+    return out->name ? OBS_OK : OBS_NO_MEMORY;
+}
+
 static obs_status copy_mesh(const char *path, const struct aiScene *sc, unsigned i,
                             obs_bake_mesh *out, char err[OBS_ERR_LEN])
 {
@@ -101,6 +128,7 @@ static obs_status copy_mesh(const char *path, const struct aiScene *sc, unsigned
     out->vertex_count = m->mNumVertices;
     out->triangle_count = nt;
     out->two_sided = material_two_sided(sc, m->mMaterialIndex);
+    out->material = m->mMaterialIndex < sc->mNumMaterials ? (int)m->mMaterialIndex : -1;
     if (!(out->name = strdup(m->mName.data)))
         return obs__fail(err, OBS_NO_MEMORY, "%s: mesh names", path);
     out->positions = malloc((m->mNumVertices ? m->mNumVertices : 1) * 3 * sizeof(float));
@@ -268,6 +296,17 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
         goto fail;
     }
     out->mesh_count = sc->mNumMeshes;
+    if (sc->mNumMaterials && !(out->materials = calloc(sc->mNumMaterials, sizeof *out->materials))) {
+        st = obs__fail(err, OBS_NO_MEMORY, "%s: %u materials", path, sc->mNumMaterials);
+        goto fail;
+    }
+    for (unsigned i = 0; i < sc->mNumMaterials; i++) {
+        out->material_count = i + 1;
+        if (copy_material(sc->mMaterials[i], &out->materials[i]) != OBS_OK) {
+            st = obs__fail(err, OBS_NO_MEMORY, "%s: material names", path);
+            goto fail;
+        }
+    }
     size_t stored = 0;
     for (unsigned i = 0; i < sc->mNumMeshes; i++) {
         if ((st = copy_mesh(path, sc, i, &out->meshes[i], err)) != OBS_OK)

@@ -142,7 +142,16 @@ typedef struct obs_bake_mesh {
     float *normals;   /* 3 per vertex, unit, or NULL */
     uint32_t *indices; /* 3 per triangle, each < vertex_count */
     int two_sided;    /* its material is double-sided */
+    int material;     /* index into the scene's materials, -1 for none */
 } obs_bake_mesh;
+
+/* A material as far as the output carries it: no textures. */
+typedef struct obs_bake_material {
+    char *name;
+    float base_color[4]; /* linear RGBA (glTF base colour, else diffuse) */
+    int double_sided;
+    int blend;           /* glTF alphaMode BLEND */
+} obs_bake_material;
 
 /* One node of the graph.  Nodes are depth first, a parent before its
  * children; world = parent's world * local. */
@@ -158,6 +167,8 @@ typedef struct obs_bake_node {
 typedef struct obs_bake_scene {
     obs_bake_mesh *meshes;
     size_t mesh_count;
+    obs_bake_material *materials;
+    size_t material_count;
     obs_bake_node *nodes;
     size_t node_count;
     size_t instance_count;  /* (node, mesh) pairs */
@@ -247,7 +258,8 @@ void obs_bake_result_free(obs_bake_result *r);
 /* glTF 2.0 binary: the node graph as loaded (names, transforms, extras),
  * every instance its own mesh with POSITION, NORMAL, indices and the
  * float attributes _AO, _AO_SHORT, _AO_LONG (and COLOR_0 = _AO as grey
- * when color is set). */
+ * when color is set); the materials' names, base colours, alpha modes
+ * and sidedness (no textures). */
 obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,
                               const obs_bake_result *r, int color, char err[OBS_ERR_LEN]);
 /* Binary PLY of the world-space level: x y z (nx ny nz) quality (= _AO)

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Checks a .glb that obscura bake wrote, with the standard library only:
 header and chunk lengths, every bufferView inside the buffer, every
-accessor inside its view, POSITION min/max the true ones, and per
+accessor inside its view, POSITION min/max the true ones, material
+indices in range, and per
 primitive _AO, _AO_SHORT, _AO_LONG of POSITION's count with values in
 [0, 1] and _AO = blend of the other two.  Usage: glb_check.py FILE [PRIMS]
 (PRIMS: the number of primitives expected)."""
@@ -45,6 +46,8 @@ def main():
                 col = pos[k::3]
                 assert abs(min(col) - a["min"][k]) < 1e-6 and abs(max(col) - a["max"][k]) < 1e-6
             nv = a["count"]
+            if "material" in p:
+                assert 0 <= p["material"] < len(doc.get("materials", [])), "material index"
             _, idx, _ = values(p["indices"])
             assert len(idx) % 3 == 0 and max(idx) < nv
             vals = {}

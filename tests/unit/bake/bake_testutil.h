@@ -18,6 +18,7 @@ static inline void bt_grid_graded(obs_bake_mesh *m, const char *name, const floa
 {
     memset(m, 0, sizeof *m);
     m->name = strdup(name);
+    m->material = -1;
     m->vertex_count = (size_t)(nu + 1) * (nv + 1);
     m->triangle_count = (size_t)2 * nu * nv;
     m->positions = malloc(m->vertex_count * 3 * sizeof(float));

@@ -128,6 +128,7 @@ static void test_weld(void **state)
     obs_bake_mesh m;
     memset(&m, 0, sizeof m);
     m.name = strdup("soup");
+    m.material = -1;
     const float P[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
     const int corners[4][3] = {{0, 2, 1}, {0, 3, 2}, {0, 1, 2}, {0, 2, 3}};
     m.vertex_count = 12;

@@ -168,6 +168,20 @@ static void test_fixture_round_trip(void **state)
         }
     }
     assert_int_equal(prims, 62);
+    /* the materials: as many as loaded, each primitive's in range */
+    cJSON *mats = cJSON_GetObjectItem(js, "materials");
+    assert_int_equal(cJSON_GetArraySize(mats), (int)sc.material_count);
+    assert_true(sc.material_count >= 1);
+    cJSON_ArrayForEach(mesh, cJSON_GetObjectItem(js, "meshes"))
+    {
+        cJSON *p;
+        cJSON_ArrayForEach(p, cJSON_GetObjectItem(mesh, "primitives"))
+        {
+            cJSON *mi = cJSON_GetObjectItem(p, "material");
+            assert_non_null(mi);
+            assert_true(mi->valueint >= 0 && mi->valueint < (int)sc.material_count);
+        }
+    }
     cJSON_Delete(js);
     free(bytes);
 
