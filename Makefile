@@ -26,10 +26,11 @@ PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson nettle 2>/d
 # nettle: SHA-256 of the program cache's keys (core/gl/progcache.c)
 PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson nettle 2>/dev/null) -lz -lm -lpthread
 # Scene loading (core/ground/scene.c: assimp) and the ray-traced reference
-# (core/ground/reference.c: Embree 3, no .pc file) live in libobscura.a too; as
+# (core/ground/reference.c: Embree 3, no .pc file) and the bake's least-squares
+# solve (core/bake/fit.c: SuiteSparse CHOLMOD) live in libobscura.a too; as
 # static members they are linked only into binaries that call them, and
 # --as-needed keeps the shared libraries out of the others (the daemon).
-PKG_LIBS += -Wl,--push-state,--as-needed $(shell pkg-config --libs assimp 2>/dev/null) -lembree3 -Wl,--pop-state
+PKG_LIBS += -Wl,--push-state,--as-needed $(shell pkg-config --libs assimp 2>/dev/null) -lembree3 -lcholmod -Wl,--pop-state
 # The deep EXR writer (core/io/exr_deep_write.cpp, OpenEXR's C++ deep API; the
 # C API of 3.1 cannot write deep data): the same arrangement, so only the
 # binaries that write deep files (the CLI, tests) need the C++ libraries.
@@ -151,6 +152,9 @@ $(DAEMON_BENCH): bench/daemon_bench.c $(BUILD)/obj/clients/remote.o $(PROTO_LIB)
 $(BUILD)/tests/%: tests/unit/%.c $(PROTO_LIB) $(LIB) tests/unit/testutil.h $(wildcard tests/unit/core/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) $(EXTRA_LIBS) -lcmocka
+
+# The bake tests' scene helpers (tests/unit/bake/bake_testutil.h).
+$(filter $(BUILD)/tests/bake/%,$(UNIT_BIN)): $(wildcard tests/unit/bake/*.h)
 
 $(BUILD)/tests/nogl/%: tests/unit/nogl/%.c $(LIB) tests/unit/testutil.h $(wildcard tests/unit/core/*.h)
 	@mkdir -p $(dir $@)

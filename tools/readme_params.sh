@@ -2,6 +2,7 @@
 # Writes the generated blocks of README.md:
 #   params:begin .. params:end     `obscura params --markdown` (the parameter table)
 #   obscurad:begin .. obscurad:end `obscurad --help` (the daemon's option table)
+#   bake-params:begin .. bake-params:end  `obscura bake --params-markdown`
 #   tools/readme_params.sh [--check] OBSCURA OBSCURAD [README]     (make readme)
 # With --check, exits 1 when README.md is out of date instead.
 set -eu
@@ -11,13 +12,15 @@ OBSCURA=${1:-build/obscura}
 OBSCURAD=${2:-build/obscurad}
 README=${3:-README.md}
 tmp=$(mktemp)
-trap 'rm -f "$tmp" "$tmp.d" "$tmp.new"' EXIT
+trap 'rm -f "$tmp" "$tmp.d" "$tmp.b" "$tmp.new"' EXIT
 "$OBSCURA" params --markdown > "$tmp"
+"$OBSCURA" bake --params-markdown > "$tmp.b"
 { echo '```'; "$OBSCURAD" --help | sed -n '/^options:/,$p'; echo '```'; } > "$tmp.d"
-awk -v table="$tmp" -v daemon="$tmp.d" '
+awk -v table="$tmp" -v daemon="$tmp.d" -v bake="$tmp.b" '
     /<!-- params:begin -->/ { print; while ((getline l < table) > 0) print l; skip = 1; next }
     /<!-- obscurad:begin -->/ { print; while ((getline l < daemon) > 0) print l; skip = 1; next }
-    /<!-- (params|obscurad):end -->/ { skip = 0 }
+    /<!-- bake-params:begin -->/ { print; while ((getline l < bake) > 0) print l; skip = 1; next }
+    /<!-- (params|obscurad|bake-params):end -->/ { skip = 0 }
     !skip { print }' "$README" > "$tmp.new"
 if [ "$check" -eq 1 ]; then
     if cmp -s "$README" "$tmp.new"; then exit 0; fi

@@ -1,0 +1,186 @@
+/* The bake's steps in order (obscura/bake.h), each timed. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "bake/bake_internal.h"
+#include "internal.h"
+
+static const char *const stage_names[] = {
+#define X(n, d) #n,
+    OBS_BAKE_STAGE_LIST(X)
+#undef X
+};
+
+const char *obs_bake_stage_name(int stage)
+{
+    return stage >= 0 && stage < OBS_BAKE_STAGE_COUNT ? stage_names[stage] : "?";
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+void obs_bake_result_free(obs_bake_result *r)
+{
+    if (!r)
+        return;
+    for (size_t i = 0; i < r->instance_count && r->instances; i++) {
+        free(r->instances[i].ao);
+        free(r->instances[i].ao_short);
+        free(r->instances[i].ao_long);
+    }
+    free(r->instances);
+    memset(r, 0, sizeof *r);
+}
+
+static float clamp01(double v) { return (float)(v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v); }
+
+/* The welded solution copied back to every instance's own vertices. */
+static obs_status copy_back(const obs_bake_scene *scene, const obs__bake_world *w,
+                            const obs__bake_weld *wd, const double *x, float blend,
+                            obs_bake_result *out, char err[OBS_ERR_LEN])
+{
+    out->instances = calloc(w->instance_count, sizeof *out->instances);
+    if (!out->instances)
+        return obs__fail(err, OBS_NO_MEMORY, "%zu instances", w->instance_count);
+    out->instance_count = w->instance_count;
+    double sum = 0.0, lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < w->instance_count; i++) {
+        obs_bake_instance *r = &out->instances[i];
+        const obs__bake_inst *in = &w->inst[i];
+        size_t n = scene->meshes[in->mesh].vertex_count;
+        r->node = in->node;
+        r->mesh = in->mesh;
+        r->ao = malloc((n ? n : 1) * sizeof(float));
+        r->ao_short = malloc((n ? n : 1) * sizeof(float));
+        r->ao_long = malloc((n ? n : 1) * sizeof(float));
+        if (!r->ao || !r->ao_short || !r->ao_long)
+            return obs__fail(err, OBS_NO_MEMORY, "results of %zu vertices", n);
+        for (size_t v = 0; v < n; v++) {
+            uint32_t k = wd->of[in->first_vertex + v];
+            r->ao_short[v] = clamp01(x[2 * k]);
+            r->ao_long[v] = clamp01(x[2 * k + 1]);
+            /* _AO, the artists' blend (section 2) */
+            r->ao[v] = clamp01(blend * r->ao_short[v] + (1.0f - blend) * r->ao_long[v]);
+            sum += r->ao[v];
+            lo = fmin(lo, r->ao[v]);
+            hi = fmax(hi, r->ao[v]);
+        }
+    }
+    out->stats.ao_mean = w->vertex_count ? sum / (double)w->vertex_count : 0.0;
+    out->stats.ao_min = lo;
+    out->stats.ao_max = hi;
+    return OBS_OK;
+}
+
+/* Held-out samples (parameter holdout): another seed places them and
+ * draws their rays; the fit and the baselines are compared with them. */
+static obs_status holdout(const obs__bake_world *w, const obs__bake_weld *wd,
+                          const obs_bake_params *p, const double *x, const double *face,
+                          const double *point, obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    obs__bake_samples h;
+    uint64_t seed = (uint64_t)p->seed ^ 0x5bd1e995u;
+    obs_status rc = obs__bake_samples_make(w, p->holdout, p->max_samples_per_face, seed, &h, err);
+    if (rc != OBS_OK)
+        return rc;
+    obs__bake_trace_desc td = {{p->distance_short, p->distance_long}, p->rays, p->threads,
+                               p->backface_limit, seed, NULL, NULL};
+    double bvh;
+    if ((rc = obs__bake_trace(w, &h, &td, &bvh, err)) == OBS_OK) {
+        obs__bake_residual(w, wd, &h, x, st->holdout_fit);
+        obs__bake_residual(w, wd, &h, face, st->holdout_face_mean);
+        obs__bake_residual(w, wd, &h, point, st->holdout_point);
+        st->holdout_samples = h.count - h.dropped;
+    }
+    obs__bake_samples_free(&h);
+    return rc;
+}
+
+obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
+                        obs_bake_result *out, char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    obs_bake_params p;
+    obs_bake_params_resolve(desc ? &desc->params : NULL, &p);
+    obs_bake_stats *st = &out->stats;
+    obs__bake_world w = {0};
+    obs__bake_samples s = {0};
+    obs__bake_weld wd = {0};
+    double *x = NULL, *face = NULL, *point = NULL;
+    obs_status rc;
+    if (!scene || scene->node_count == 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "bake: no scene");
+    if (scene->world_triangles > (size_t)p.max_triangles)
+        return obs__fail(err, OBS_TOO_LARGE, "%zu triangles once flattened; max_triangles is %d",
+                         scene->world_triangles, p.max_triangles);
+
+    double t = now();
+    if ((rc = obs__bake_flatten(scene, &w, err)) != OBS_OK)
+        goto done;
+    st->instances = w.instance_count;
+    st->triangles = w.triangle_count;
+    st->vertices = w.vertex_count;
+    st->degenerate_triangles = w.degenerate;
+    st->faces_against_normals = w.against_normals;
+    for (size_t k = 0; k < w.triangle_count; k++)
+        st->two_sided_triangles += w.two_sided[k];
+    st->seconds[OBS_BAKE_STAGE_flatten] = now() - t;
+
+    t = now();
+    if ((rc = obs__bake_samples_make(&w, p.samples_per_face, p.max_samples_per_face,
+                                     (uint64_t)p.seed, &s, err)) != OBS_OK)
+        goto done;
+    st->samples = s.count;
+    st->seconds[OBS_BAKE_STAGE_samples] = now() - t;
+
+    t = now();
+    obs__bake_trace_desc td = {{p.distance_short, p.distance_long}, p.rays, p.threads,
+                               p.backface_limit, (uint64_t)p.seed,
+                               desc ? desc->progress : NULL, desc ? desc->progress_user : NULL};
+    double bvh = 0.0;
+    if ((rc = obs__bake_trace(&w, &s, &td, &bvh, err)) != OBS_OK)
+        goto done;
+    st->seconds[OBS_BAKE_STAGE_bvh] = bvh;
+    st->seconds[OBS_BAKE_STAGE_trace] = now() - t - bvh;
+    st->rays = s.rays;
+    st->samples_dropped_backface = s.dropped;
+
+    t = now();
+    if ((rc = obs__bake_weld_make(&w, p.weld_tolerance, p.weld_angle, &wd, err)) != OBS_OK)
+        goto done;
+    st->welded_vertices = wd.count;
+    st->seconds[OBS_BAKE_STAGE_weld] = now() - t;
+
+    size_t nx = 2 * (wd.count ? wd.count : 1);
+    x = malloc(nx * sizeof *x);
+    face = malloc(nx * sizeof *face);
+    point = malloc(nx * sizeof *point);
+    if (!x || !face || !point) {
+        rc = obs__fail(err, OBS_NO_MEMORY, "solution of %zu vertices", wd.count);
+        goto done;
+    }
+    if ((rc = obs__bake_fit(&w, &wd, &s, &p, x, face, point, st, err)) != OBS_OK)
+        goto done;
+    if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &p, x, face, point, st, err)) != OBS_OK)
+        goto done;
+    rc = copy_back(scene, &w, &wd, x, p.blend, out, err);
+done:
+    free(x);
+    free(face);
+    free(point);
+    obs__bake_weld_free(&wd);
+    obs__bake_samples_free(&s);
+    obs__bake_world_free(&w);
+    if (rc != OBS_OK) {
+        obs_bake_stats keep = out->stats;
+        obs_bake_result_free(out);
+        out->stats = keep;
+    }
+    return rc;
+}

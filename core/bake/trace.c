@@ -1,0 +1,249 @@
+/* Ambient obscurance at the surface samples, eq 1 of the paper:
+ *
+ *   AO(p) = 1/pi  integral over the hemisphere of rho(d(p, w)) cos(theta) dw
+ *
+ * d the distance to the closest hit in direction w, with the exponential
+ * kernel rho(x) = 1 - exp(a x), a = ln(0.5) / d_half (section 2), at two
+ * distances at once from the same rays.  Directions are cosine
+ * importance-sampled (pdf cos(theta) / pi), so AO is the mean of rho over
+ * the rays; a miss counts rho = 1.  Closest hits through Embree 3; a ray
+ * that hits the back of a one-sided face counts towards the back-face
+ * rule (section 2.1): a sample with more than backface_limit of its rays
+ * on back faces lies inside geometry and is dropped. */
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "bake/bake_internal.h"
+#include "bake/rng.h"
+#include "internal.h"
+
+#define MAX_THREADS 64
+#define CHUNK 64
+#define PACKET 8
+/* Rays stop at this many long distances: rho is within 2^-16 of 1. */
+#define RAY_LENGTH_FACTOR 16.0f
+#define PI_D 3.14159265358979323846
+
+typedef struct job {
+    const obs__bake_world *w;
+    obs__bake_samples *s;
+    const obs__bake_trace_desc *d;
+    RTCScene rtc;
+    float a[2]; /* the kernels' a = ln(0.5) / d */
+    atomic_size_t next;
+    pthread_mutex_t lock;
+    size_t done;
+    uint64_t rays;
+    size_t dropped;
+} job;
+
+/* An orthonormal tangent frame around unit n (Frisvad 2012, with the
+ * n.z = -1 case handled by symmetry). */
+static void frame(const float n[3], float t[3], float b[3])
+{
+    if (n[2] < -0.9999999f) {
+        t[0] = 0.0f, t[1] = -1.0f, t[2] = 0.0f;
+        b[0] = -1.0f, b[1] = 0.0f, b[2] = 0.0f;
+        return;
+    }
+    float a = 1.0f / (1.0f + n[2]), c = -n[0] * n[1] * a;
+    t[0] = 1.0f - n[0] * n[0] * a, t[1] = c, t[2] = -n[0];
+    b[0] = c, b[1] = 1.0f - n[1] * n[1] * a, b[2] = -n[1];
+}
+
+static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint64_t *rays,
+                         size_t *dropped)
+{
+    const obs__bake_world *w = j->w;
+    obs__bake_samples *s = j->s;
+    const int nr = j->d->rays;
+    uint32_t t = s->tri[i];
+    const float *n = w->fn + 3 * t;
+    float p[3], tg[3], bt[3], o[3];
+    obs__bake_sample_pos(w, s, i, p);
+    float m = fmaxf(1.0f, fmaxf(fabsf(p[0]), fmaxf(fabsf(p[1]), fabsf(p[2]))));
+    for (int k = 0; k < 3; k++)
+        o[k] = p[k] + n[k] * 1e-4f * m; /* off the surface: float spacing */
+    frame(n, tg, bt);
+    /* Cosine-weighted directions (Malley's method: a point of the unit
+     * disk lifted to the hemisphere) from a rank-1 lattice with a random
+     * shift per sample: each direction has the cosine density, the set
+     * is stratified. */
+    obs__bake_rng r = obs__bake_rng_stream(j->d->seed, i, 2);
+    double o1 = obs__bake_rng_unit(&r), o2 = obs__bake_rng_unit(&r);
+    double acc[2] = {0.0, 0.0};
+    int back = 0;
+    float tfar = RAY_LENGTH_FACTOR * fmaxf(j->d->distance[0], j->d->distance[1]);
+    /* Packets of 8 rays (rtcIntersect8): one sample's rays share their
+     * origin; lanes are summed in ray order, so the result is the
+     * packet's, whatever the thread. */
+    for (int k0 = 0; k0 < nr; k0 += PACKET) {
+        RTC_ALIGN(32) struct RTCRayHit8 rh;
+        RTC_ALIGN(32) int valid[PACKET];
+        for (int l = 0; l < PACKET; l++) {
+            int k = k0 + l;
+            valid[l] = k < nr ? -1 : 0;
+            double u1 = fmod((k + 0.5) / nr + o1, 1.0), u2 = fmod(k * 0.6180339887498949 + o2, 1.0);
+            double rad = sqrt(u1), phi = 2.0 * PI_D * u2;
+            float x = (float)(rad * cos(phi)), y = (float)(rad * sin(phi)),
+                  z = (float)sqrt(fmax(0.0, 1.0 - u1));
+            rh.ray.org_x[l] = o[0], rh.ray.org_y[l] = o[1], rh.ray.org_z[l] = o[2];
+            rh.ray.dir_x[l] = x * tg[0] + y * bt[0] + z * n[0];
+            rh.ray.dir_y[l] = x * tg[1] + y * bt[1] + z * n[1];
+            rh.ray.dir_z[l] = x * tg[2] + y * bt[2] + z * n[2];
+            rh.ray.tnear[l] = 0.0f;
+            rh.ray.tfar[l] = tfar;
+            rh.ray.time[l] = 0.0f;
+            rh.ray.mask[l] = 0xffffffffu;
+            rh.ray.id[l] = 0;
+            rh.ray.flags[l] = 0;
+            rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect8(valid, j->rtc, ctx, &rh);
+        for (int l = 0; l < PACKET && k0 + l < nr; l++) {
+            if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
+                acc[0] += 1.0;
+                acc[1] += 1.0;
+                continue;
+            }
+            for (int c = 0; c < 2; c++)
+                acc[c] += 1.0 - exp((double)j->a[c] * rh.ray.tfar[l]); /* rho(x), section 2 */
+            const float *hn = w->fn + 3 * (size_t)rh.hit.primID[l];
+            if (!w->two_sided[rh.hit.primID[l]] &&
+                hn[0] * rh.ray.dir_x[l] + hn[1] * rh.ray.dir_y[l] + hn[2] * rh.ray.dir_z[l] > 0.0f)
+                back++;
+        }
+    }
+    *rays += (uint64_t)nr;
+    s->ao[2 * i] = (float)(acc[0] / nr);
+    s->ao[2 * i + 1] = (float)(acc[1] / nr);
+    s->valid[i] = (double)back <= (double)j->d->backface_limit * nr;
+    *dropped += !s->valid[i];
+}
+
+static void *worker(void *arg)
+{
+    job *j = arg;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    uint64_t rays = 0;
+    size_t dropped = 0, i0;
+    while ((i0 = atomic_fetch_add(&j->next, CHUNK)) < j->s->count) {
+        size_t i1 = i0 + CHUNK < j->s->count ? i0 + CHUNK : j->s->count;
+        for (size_t i = i0; i < i1; i++)
+            trace_sample(j, &ctx, i, &rays, &dropped);
+        pthread_mutex_lock(&j->lock);
+        j->done += i1 - i0;
+        if (j->d->progress)
+            j->d->progress(j->d->progress_user, j->done, j->s->count);
+        pthread_mutex_unlock(&j->lock);
+    }
+    pthread_mutex_lock(&j->lock);
+    j->rays += rays;
+    j->dropped += dropped;
+    pthread_mutex_unlock(&j->lock);
+    return NULL;
+}
+
+static void device_error(void *user, enum RTCError code, const char *msg)
+{
+    char *buf = user;
+    if (!buf[0])
+        snprintf(buf, OBS_ERR_LEN, "Embree error %d: %s", (int)code, msg ? msg : "");
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
+                           const obs__bake_trace_desc *d, double *bvh_seconds,
+                           char err[OBS_ERR_LEN])
+{
+    char dev_err[OBS_ERR_LEN] = "";
+    obs_status st = OBS_OK;
+    double t0 = now();
+    RTCDevice dev = rtcNewDevice(NULL);
+    if (!dev)
+        return obs__fail(err, OBS_UNSUPPORTED, "Embree: no device (error %d)",
+                         (int)rtcGetDeviceError(NULL));
+    rtcSetDeviceErrorFunction(dev, device_error, dev_err);
+    RTCScene rs = rtcNewScene(dev);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    /* Copies: Embree reads vertex buffers in 16-byte loads and wants them
+     * padded. */
+    float *v = rs && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                 3 * sizeof(float), w->vertex_count)
+                       : NULL;
+    unsigned *ix = rs && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0,
+                                                     RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                                     w->triangle_count)
+                           : NULL;
+    if (!v || !ix) {
+        if (g)
+            rtcReleaseGeometry(g);
+        st = obs__fail(err, OBS_NO_MEMORY, "Embree scene of %zu triangles: %s", w->triangle_count,
+                       dev_err[0] ? dev_err : "out of memory");
+        goto done;
+    }
+    memcpy(v, w->pos, w->vertex_count * 3 * sizeof(float));
+    memcpy(ix, w->tri, w->triangle_count * 3 * sizeof(unsigned));
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(rs, g);
+    rtcReleaseGeometry(g);
+    rtcSetSceneBuildQuality(rs, RTC_BUILD_QUALITY_HIGH);
+    rtcCommitScene(rs);
+    if (dev_err[0]) {
+        st = obs__fail(err, OBS_NO_MEMORY, "Embree scene: %s", dev_err);
+        goto done;
+    }
+    *bvh_seconds = now() - t0;
+
+    job *j = calloc(1, sizeof *j);
+    if (!j) {
+        st = obs__fail(err, OBS_NO_MEMORY, "trace job");
+        goto done;
+    }
+    j->w = w;
+    j->s = s;
+    j->d = d;
+    j->rtc = rs;
+    for (int c = 0; c < 2; c++)
+        j->a[c] = logf(0.5f) / d->distance[c]; /* a = ln(0.5) / d, section 2 */
+    atomic_init(&j->next, 0);
+    pthread_mutex_init(&j->lock, NULL);
+    int nt = d->threads;
+    if (nt <= 0) {
+        long c = sysconf(_SC_NPROCESSORS_ONLN);
+        nt = c < 1 ? 1 : c > MAX_THREADS ? MAX_THREADS : (int)c;
+    }
+    pthread_t th[MAX_THREADS];
+    int started = 0;
+    for (; started < nt && started < MAX_THREADS; started++)
+        if (pthread_create(&th[started], NULL, worker, j) != 0)
+            break;
+    if (started == 0)
+        worker(j);
+    for (int k = 0; k < started; k++)
+        pthread_join(th[k], NULL);
+    pthread_mutex_destroy(&j->lock);
+    s->rays = j->rays;
+    s->dropped = j->dropped;
+    free(j);
+done:
+    if (rs)
+        rtcReleaseScene(rs);
+    rtcReleaseDevice(dev);
+    return st;
+}

@@ -1,0 +1,274 @@
+/* Baking ambient obscurance onto the vertices of a level (obscura bake).
+ *
+ * The pipeline, one file of core/bake/ per step:
+ *   load.c     the file through assimp, node graph kept (meshes, node
+ *              transforms, instances, node names, glTF extras)
+ *   flatten.c  every (node, mesh) instance in world space, checked
+ *   samples.c  surface samples per face: area-proportional, capped
+ *   trace.c    obscurance (eq 1) at two distances, Embree closest hits
+ *   weld.c     triangle soup welded for the fit
+ *   fit.c      least-squares vertex fit (Kavan et al. 2011), CHOLMOD
+ *   glb.c ply.c  the output files
+ *   bake.c     the steps in order, timed (obs_bake_run)
+ * The paper is "Baked ambient obscurance on the vertices of game levels"
+ * (shared/papers/baked-ambient-obscurance-vertices.txt).
+ *
+ * Matrices are row-major with column vectors, as in obscura.h. */
+#ifndef OBSCURA_BAKE_H
+#define OBSCURA_BAKE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "obscura/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* How the fit's mass matrix M of eq 2's data term is made (parameter
+ * `mass`). */
+#define OBS_BAKE_MASS_LIST(X)                                                  \
+    X(OBS_BAKE_MASS_SAMPLES, samples)   /* sum over the samples of w phi_i phi_j */ \
+    X(OBS_BAKE_MASS_ANALYTIC, analytic) /* A/12 [[2,1,1],[1,2,1],[1,1,2]] per face */
+#define OBS__BAKE_ENUM(value, choice) value,
+#define OBS__BAKE_CHOICE(value, choice) "|" #choice
+typedef enum obs_bake_mass {
+    OBS_BAKE_MASS_DEFAULT,
+    OBS_BAKE_MASS_LIST(OBS__BAKE_ENUM)
+} obs_bake_mass;
+
+/* The bake parameters: X(name, type, default, min, max, choices, doc),
+ * type FLOAT, INT or ENUM (choices '|'-separated, stored 1-based).  The
+ * CLI's flags, `obscura bake --params` and README's bake table come from
+ * this table. */
+#define OBS_BAKE_PARAM_TABLE(X)                                                \
+    X(distance_short, FLOAT, 2.0, 1e-4, 1e7, NULL,                             \
+      "short obscurance distance d (world units): eq 1's kernel "              \
+      "rho(x) = 1 - exp(a x), a = ln(0.5) / d, halves visibility at d "        \
+      "(paper: 2 m)")                                                          \
+    X(distance_long, FLOAT, 300.0, 1e-4, 1e7, NULL,                            \
+      "long obscurance distance (paper: 300 m); rays stop at 16 times it, "    \
+      "where the kernel is within 2^-16 of 1")                                 \
+    X(blend, FLOAT, 0.03, 0.0, 1.0, NULL,                                      \
+      "weight of the short distance in _AO = blend _AO_SHORT + (1 - blend) "   \
+      "_AO_LONG (paper: 3 % short)")                                           \
+    X(rays, INT, 256, 1, 65536, NULL,                                          \
+      "cosine-importance-sampled rays per surface sample (paper: 256)")        \
+    X(samples_per_face, FLOAT, 4.0, 0.01, 4096.0, NULL,                        \
+      "sample budget as a mean per face: the budget is spread over the "      \
+      "faces in proportion to their area, each face taking at least 1 and "   \
+      "at most max_samples_per_face (section 2.1)")                            \
+    X(max_samples_per_face, INT, 16, 1, 4096, NULL,                            \
+      "the paper's cap on the samples of one face, so that large coarse "      \
+      "distant faces do not take the budget of the playable area")            \
+    X(backface_limit, FLOAT, 0.25, 0.0, 1.0, NULL,                             \
+      "a sample whose rays hit back faces more often than this fraction is "  \
+      "dropped (inside geometry; paper: 25 %); 1 keeps every sample")          \
+    X(alpha, FLOAT, 1.0, 0.0, 1e6, NULL,                                       \
+      "weight alpha of the edge regulariser in eq 2 (paper: 1)")               \
+    X(mass, ENUM, "samples", 0, 0, (OBS_BAKE_MASS_LIST(OBS__BAKE_CHOICE) + 1), \
+      "mass matrix of eq 2's data term: samples (from the same samples as "    \
+      "b, so the fit is the least-squares fit of the samples and reproduces " \
+      "a linear signal exactly) or analytic (the hat basis integrated "        \
+      "exactly, A/12 [[2,1,1],[1,2,1],[1,1,2]], scaled by the face's share "   \
+      "of valid samples)")                                                     \
+    X(ridge, FLOAT, 1e-4, 0.0, 1.0, NULL,                                      \
+      "a small pull of each vertex towards the mean of its own samples (or "   \
+      "its neighbours' when it has none), weighted by its lumped area: "       \
+      "keeps the system definite where samples are missing; 0 for none")      \
+    X(weld_tolerance, FLOAT, 1e-5, 0.0, 0.01, NULL,                            \
+      "vertices of one instance closer than this fraction of its box "         \
+      "diagonal (quantised) are one vertex for the fit")                       \
+    X(weld_angle, FLOAT, 120.0, 0.0, 180.0, NULL,                              \
+      "welded vertices must have normals less than this many degrees apart, " \
+      "so back-to-back faces stay apart")                                      \
+    X(holdout, FLOAT, 0.0, 0.0, 4096.0, NULL,                                  \
+      "held-out check: this many samples per face (mean, placed and capped "   \
+      "as above, other positions and rays) traced after the fit and compared " \
+      "with the fit and the two baselines (the report's holdout rows); 0: off") \
+    X(seed, INT, 1, 0, 2147483647, NULL,                                       \
+      "random seed; the bake depends on it alone, not on the thread count")    \
+    X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
+    X(max_triangles, INT, 100000000, 1, 2147483647, NULL,                      \
+      "refuse a level with more triangles than this once instances are "      \
+      "flattened")
+
+#define OBS__BAKE_DECL_FLOAT(n) float n;
+#define OBS__BAKE_DECL_INT(n) int n;
+#define OBS__BAKE_DECL_ENUM(n) int n;
+
+/* Zero-initialised means "all defaults"; obs_bake_param_set records which
+ * fields were given (set), so a given 0 stays 0. */
+typedef struct obs_bake_params {
+#define OBS__BAKE_DECL(name, type, def, lo, hi, choices, doc) OBS__BAKE_DECL_##type(name)
+    OBS_BAKE_PARAM_TABLE(OBS__BAKE_DECL)
+#undef OBS__BAKE_DECL
+    uint64_t set; /* bit i: row i of the table was given */
+} obs_bake_params;
+
+typedef enum obs_bake_param_type {
+    OBS_BAKE_PARAM_FLOAT,
+    OBS_BAKE_PARAM_INT,
+    OBS_BAKE_PARAM_ENUM
+} obs_bake_param_type;
+
+typedef struct obs_bake_param_info {
+    const char *name, *def, *choices, *doc;
+    obs_bake_param_type type;
+    double min, max;
+    size_t offset;
+} obs_bake_param_info;
+
+int obs_bake_param_count(void);
+const obs_bake_param_info *obs_bake_param_at(int i); /* NULL out of range */
+/* '-' and '_' are the same; NULL when unknown. */
+const obs_bake_param_info *obs_bake_param_find(const char *name);
+/* Parses value into p, checking the range; the message names the row. */
+obs_status obs_bake_param_set(obs_bake_params *p, const char *name, const char *value,
+                              char err[OBS_ERR_LEN]);
+/* out = in with the fields not given set to their defaults. */
+void obs_bake_params_resolve(const obs_bake_params *in, obs_bake_params *out);
+void obs_bake_param_format(const obs_bake_params *p, const obs_bake_param_info *pi, char *buf,
+                           size_t len);
+
+/* ---- the level -------------------------------------------------------- */
+
+/* One mesh of the file, in its own space.  normals may be NULL. */
+typedef struct obs_bake_mesh {
+    char *name;
+    size_t vertex_count, triangle_count;
+    float *positions; /* 3 per vertex */
+    float *normals;   /* 3 per vertex, unit, or NULL */
+    uint32_t *indices; /* 3 per triangle, each < vertex_count */
+    int two_sided;    /* its material is double-sided */
+    int material;     /* index into the scene's materials, -1 for none */
+} obs_bake_mesh;
+
+/* A material as far as the output carries it: no textures. */
+typedef struct obs_bake_material {
+    char *name;
+    float base_color[4]; /* linear RGBA (glTF base colour, else diffuse) */
+    int double_sided;
+    int blend;           /* glTF alphaMode BLEND */
+} obs_bake_material;
+
+/* One node of the graph.  Nodes are depth first, a parent before its
+ * children; world = parent's world * local. */
+typedef struct obs_bake_node {
+    char *name;
+    int parent;          /* index, -1 for the root */
+    float local[16], world[16];
+    uint32_t *meshes;    /* indices into the meshes */
+    uint32_t mesh_count;
+    char *extras;        /* the node's extras (glTF) as JSON text, or NULL */
+} obs_bake_node;
+
+typedef struct obs_bake_scene {
+    obs_bake_mesh *meshes;
+    size_t mesh_count;
+    obs_bake_material *materials;
+    size_t material_count;
+    obs_bake_node *nodes;
+    size_t node_count;
+    size_t instance_count;  /* (node, mesh) pairs */
+    size_t world_triangles; /* triangles with instances flattened */
+} obs_bake_scene;
+
+/* Loads a level through assimp (glTF/GLB, AC3D, OBJ, ...), keeping the node
+ * graph.  Refuses a file without triangles, with non-finite coordinates, or
+ * with more than max_triangles once flattened (0: no limit), naming the
+ * mesh.  Free with obs_bake_scene_free(). */
+obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene *out,
+                         char err[OBS_ERR_LEN]);
+void obs_bake_scene_free(obs_bake_scene *s);
+
+/* ---- the bake --------------------------------------------------------- */
+
+/* Per-vertex results of one instance: node `node`'s mesh `mesh`, one value
+ * per vertex of the mesh. */
+typedef struct obs_bake_instance {
+    uint32_t node, mesh;
+    float *ao, *ao_short, *ao_long;
+} obs_bake_instance;
+
+/* Stages of the bake, in order (the report's rows). */
+#define OBS_BAKE_STAGE_LIST(X)                                                 \
+    X(flatten, "instances to world space")                                     \
+    X(samples, "surface samples")                                              \
+    X(bvh, "Embree BVH build")                                                 \
+    X(trace, "ray trace samples")                                              \
+    X(weld, "weld")                                                            \
+    X(assemble, "least-squares system")                                        \
+    X(solve, "CHOLMOD factorise and solve")
+typedef enum obs_bake_stage {
+#define OBS__BAKE_STAGE(n, d) OBS_BAKE_STAGE_##n,
+    OBS_BAKE_STAGE_LIST(OBS__BAKE_STAGE)
+#undef OBS__BAKE_STAGE
+    OBS_BAKE_STAGE_COUNT
+} obs_bake_stage;
+const char *obs_bake_stage_name(int stage);
+
+typedef struct obs_bake_stats {
+    double seconds[OBS_BAKE_STAGE_COUNT];
+    size_t instances, triangles, degenerate_triangles, vertices;
+    size_t faces_against_normals; /* winding disagrees with the normals */
+    size_t two_sided_triangles;   /* of double-sided materials: no back */
+    size_t samples, samples_dropped_backface;
+    uint64_t rays;
+    size_t welded_vertices, interior_edges, boundary_edges, nonmanifold_edges;
+    size_t vertices_without_samples; /* valued from their neighbours */
+    size_t vertices_isolated;        /* no neighbour had a value either */
+    /* RMS over the valid samples (weights w) of the fitted signal minus
+     * the traced value, [0] short, [1] long; and the same for the two
+     * baselines from the same rays: the vertex value the mean of the
+     * samples of its faces (per-face averaging, area weighted), and the
+     * nearest samples' value (point sampling at the vertex). */
+    double residual_fit[2], residual_face_mean[2], residual_point[2];
+    /* The same three at held-out samples (parameter holdout): other
+     * positions, other rays, never fitted; 0 when holdout is 0. */
+    double holdout_fit[2], holdout_face_mean[2], holdout_point[2];
+    size_t holdout_samples;
+    double regulariser_energy[2]; /* alpha x^T R x of the solution */
+    double ao_mean, ao_min, ao_max;
+} obs_bake_stats;
+
+typedef struct obs_bake_result {
+    obs_bake_instance *instances;
+    size_t instance_count;
+    obs_bake_stats stats;
+} obs_bake_result;
+
+typedef struct obs_bake_desc {
+    obs_bake_params params;
+    /* Called from the tracing threads (serialised) with the samples done
+     * so far; may be NULL. */
+    void (*progress)(void *user, size_t done, size_t total);
+    void *progress_user;
+} obs_bake_desc;
+
+/* Bakes the level: per-vertex obscurance for every instance.  Free with
+ * obs_bake_result_free(). */
+obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
+                        obs_bake_result *out, char err[OBS_ERR_LEN]);
+void obs_bake_result_free(obs_bake_result *r);
+
+/* ---- output ----------------------------------------------------------- */
+
+/* glTF 2.0 binary: the node graph as loaded (names, transforms, extras),
+ * every instance its own mesh with POSITION, NORMAL, indices and the
+ * float attributes _AO, _AO_SHORT, _AO_LONG (and COLOR_0 = _AO as grey
+ * when color is set); the materials' names, base colours, alpha modes
+ * and sidedness (no textures). */
+obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,
+                              const obs_bake_result *r, int color, char err[OBS_ERR_LEN]);
+/* Binary PLY of the world-space level: x y z (nx ny nz) quality (= _AO)
+ * ao_short ao_long per vertex, triangles. */
+obs_status obs_bake_write_ply(const char *path, const obs_bake_scene *scene,
+                              const obs_bake_result *r, char err[OBS_ERR_LEN]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

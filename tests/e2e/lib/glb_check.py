@@ -1,0 +1,76 @@
+#!/usr/bin/env python3
+"""Checks a .glb that obscura bake wrote, with the standard library only:
+header and chunk lengths, every bufferView inside the buffer, every
+accessor inside its view, POSITION min/max the true ones, material
+indices in range, and per
+primitive _AO, _AO_SHORT, _AO_LONG of POSITION's count with values in
+[0, 1] and _AO = blend of the other two.  Usage: glb_check.py FILE [PRIMS]
+(PRIMS: the number of primitives expected)."""
+import array
+import json
+import struct
+import sys
+
+
+def main():
+    data = open(sys.argv[1], "rb").read()
+    magic, version, total = struct.unpack_from("<III", data, 0)
+    assert magic == 0x46546C67 and version == 2, "not glTF 2.0 binary"
+    assert total == len(data), "length %d, file %d" % (total, len(data))
+    jlen, jtype = struct.unpack_from("<II", data, 12)
+    assert jtype == 0x4E4F534A and jlen % 4 == 0
+    doc = json.loads(data[20:20 + jlen])
+    blen, btype = struct.unpack_from("<II", data, 20 + jlen)
+    assert btype == 0x004E4942 and blen % 4 == 0
+    buf = data[28 + jlen:28 + jlen + blen]
+    assert doc["buffers"][0]["byteLength"] <= blen
+    for v in doc["bufferViews"]:
+        assert v["byteOffset"] % 4 == 0 and v["byteOffset"] + v["byteLength"] <= blen
+
+    def values(i):
+        a = doc["accessors"][i]
+        v = doc["bufferViews"][a["bufferView"]]
+        n = {"SCALAR": 1, "VEC3": 3}[a["type"]]
+        assert a["count"] * n * 4 <= v["byteLength"]
+        x = array.array("f" if a["componentType"] == 5126 else "I")
+        x.frombytes(buf[v["byteOffset"]:v["byteOffset"] + a["count"] * n * 4])
+        return a, x, n
+
+    blend = None
+    prims = 0
+    for mesh in doc["meshes"]:
+        for p in mesh["primitives"]:
+            at = p["attributes"]
+            a, pos, _ = values(at["POSITION"])
+            for k in range(3):
+                col = pos[k::3]
+                assert abs(min(col) - a["min"][k]) < 1e-6 and abs(max(col) - a["max"][k]) < 1e-6
+            nv = a["count"]
+            if "material" in p:
+                assert 0 <= p["material"] < len(doc.get("materials", [])), "material index"
+            _, idx, _ = values(p["indices"])
+            assert len(idx) % 3 == 0 and max(idx) < nv
+            vals = {}
+            for name in ("_AO", "_AO_SHORT", "_AO_LONG"):
+                acc, x, n = values(at[name])
+                assert n == 1 and acc["count"] == nv, name
+                assert 0.0 <= min(x) and max(x) <= 1.0, name
+                vals[name] = x
+            for ao, s, l in zip(vals["_AO"], vals["_AO_SHORT"], vals["_AO_LONG"]):
+                if abs(s - l) > 1e-3:  # the blend, where it is determined
+                    b = (ao - l) / (s - l)
+                    blend = b if blend is None else blend
+                    assert abs(b - blend) < 2e-3 or abs(ao - (blend * s + (1 - blend) * l)) < 1e-5
+            prims += 1
+    if len(sys.argv) > 2:
+        assert prims == int(sys.argv[2]), "%d primitives" % prims
+    nodes = doc["nodes"]
+    seen = set(doc["scenes"][0]["nodes"])
+    for n in nodes:
+        seen.update(n.get("children", []))
+    assert len(seen) == len(nodes), "every node reachable"
+    print("glb ok: %d nodes, %d primitives, blend %s" % (len(nodes), prims,
+                                                        "%.4f" % blend if blend is not None else "-"))
+
+
+main()
