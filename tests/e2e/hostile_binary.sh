@@ -150,6 +150,10 @@ if python3 -c 'import socket; s = socket.socket(socket.AF_INET6); s.bind(("::1",
     done
     "$OBSCURAD" --http '' --tcp '::1:0' 2>"$T/bad6.log" &
     p=$!
+    # it exits by itself: a SIGTERM at once could end the shell's child
+    # before it has even opened the log
+    i=0
+    while [ $i -lt 100 ] && kill -0 $p 2>/dev/null; do sleep 0.1; i=$((i + 1)); done
     stop_wait $p 10
     check "--tcp ::1:0 (no brackets) is refused, names the form" \
         "[ '$RC' != 0 ] && grep -q 'IPv6 one in brackets' '$T/bad6.log'"
