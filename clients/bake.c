@@ -25,24 +25,6 @@ void cli_bake_usage(FILE *f)
             "                  'obscura bake --params' lists the parameters\n");
 }
 
-static void die_usage(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "obscura: bake: ");
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\n(run 'obscura help' for usage)\n");
-    va_end(ap);
-    exit(EXIT_USAGE);
-}
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
-}
-
 /* The parameter table: plain text, or README's markdown table. */
 static void list_params(int markdown)
 {
@@ -80,7 +62,7 @@ typedef struct progress {
 static void on_progress(void *user, size_t done, size_t total)
 {
     progress *p = user;
-    double t = now_s();
+    double t = cli_now_s();
     if (t - p->last < 0.5 && done < total)
         return;
     p->last = t;
@@ -224,7 +206,7 @@ int cli_bake(int argc, char **argv)
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
         if (a[0] != '-' || !a[1]) {
             if (in)
-                die_usage("more than one level ('%s' and '%s')", in, a);
+                cli_die_usage("bake", "more than one level ('%s' and '%s')", in, a);
             in = a;
             continue;
         }
@@ -243,7 +225,7 @@ int cli_bake(int argc, char **argv)
         } else if (!strcmp(key, "quiet") || !strcmp(key, "q")) {
             quiet = 1, takes = 0;
         } else if (!val) {
-            die_usage("option --%s needs a value", key);
+            cli_die_usage("bake", "option --%s needs a value", key);
         } else if (!strcmp(key, "o") || !strcmp(key, "output")) {
             out = val;
         } else if (!strcmp(key, "report")) {
@@ -254,38 +236,38 @@ int cli_bake(int argc, char **argv)
             char s[64], l[64];
             const char *comma = strchr(val, ',');
             if (!comma || strchr(comma + 1, ','))
-                die_usage("--distances '%s': expected SHORT,LONG (e.g. 2,300)", val);
+                cli_die_usage("bake", "--distances '%s': expected SHORT,LONG (e.g. 2,300)", val);
             snprintf(s, sizeof s, "%.*s", (int)(comma - val), val);
             snprintf(l, sizeof l, "%s", comma + 1);
             if (obs_bake_param_set(&desc.params, "distance_short", s, err) != OBS_OK ||
                 obs_bake_param_set(&desc.params, "distance_long", l, err) != OBS_OK)
-                die_usage("--distances: %s", err);
+                cli_die_usage("bake", "--distances: %s", err);
         } else if (obs_bake_param_find(key)) {
             if (obs_bake_param_set(&desc.params, key, val, err) != OBS_OK)
-                die_usage("%s", err);
+                cli_die_usage("bake", "%s", err);
         } else {
-            die_usage("unknown option '%s' ('obscura bake --params' lists the parameters)", a);
+            cli_die_usage("bake", "unknown option '%s' ('obscura bake --params' lists the parameters)", a);
         }
         if (takes && !eq)
             i++;
     }
     if (!in)
-        die_usage("no level file");
+        cli_die_usage("bake", "no level file");
     if (!out)
-        die_usage("no output file (-o OUT.glb or OUT.ply)");
+        cli_die_usage("bake", "no output file (-o OUT.glb or OUT.ply)");
     int out_ply = ends_with(out, ".ply");
     if (!out_ply && !ends_with(out, ".glb"))
-        die_usage("cannot tell the format of '%s': use .glb or .ply", out);
+        cli_die_usage("bake", "cannot tell the format of '%s': use .glb or .ply", out);
     obs_bake_params p;
     obs_bake_params_resolve(&desc.params, &p);
 
-    double t0 = now_s();
+    double t0 = cli_now_s();
     obs_bake_scene sc;
     obs_status s = obs_bake_load(in, (size_t)p.max_triangles, &sc, err);
     if (s != OBS_OK)
         return cli_input_fail(s, in, err);
-    double load_s = now_s() - t0;
-    progress pr = {now_s(), 0.0};
+    double load_s = cli_now_s() - t0;
+    progress pr = {cli_now_s(), 0.0};
     if (!quiet && isatty(2)) {
         desc.progress = on_progress;
         desc.progress_user = &pr;
@@ -297,12 +279,12 @@ int cli_bake(int argc, char **argv)
         return cli_fail(s, in, err);
     }
     warn(in, &r.stats);
-    double t1 = now_s();
+    double t1 = cli_now_s();
     s = out_ply ? obs_bake_write_ply(out, &sc, &r, err)
                 : obs_bake_write_glb(out, &sc, &r, color, err);
     if (s == OBS_OK && ply)
         s = obs_bake_write_ply(ply, &sc, &r, err);
-    double write_s = now_s() - t1;
+    double write_s = cli_now_s() - t1;
     int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, out, err);
     const obs_bake_stats *st = &r.stats;
     if (rc == EXIT_OK && report &&

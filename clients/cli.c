@@ -1,7 +1,10 @@
 /* What the CLI's commands share: see cli.h. */
 #include "cli.h"
 
+#include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
 #include <string.h>
 
 int cli_status_exit(obs_status s)
@@ -31,4 +34,22 @@ int cli_input_fail(obs_status s, const char *what, const char *err)
 {
     int rc = cli_fail(s, what, err);
     return s == OBS_IO ? EXIT_BADINPUT : rc;
+}
+
+void cli_die_usage(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "obscura: %s: ", cmd);
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n(run 'obscura help' for usage)\n");
+    va_end(ap);
+    exit(EXIT_USAGE);
+}
+
+double cli_now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
 }

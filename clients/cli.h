@@ -20,4 +20,11 @@ int cli_fail(obs_status s, const char *what, const char *err);
  * too. */
 int cli_input_fail(obs_status s, const char *what, const char *err);
 
+/* "obscura CMD: MESSAGE" and the pointer to help on stderr, then exit
+ * EXIT_USAGE. */
+void cli_die_usage(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3), noreturn));
+
+/* Seconds of CLOCK_MONOTONIC (progress, stage times). */
+double cli_now_s(void);
+
 #endif

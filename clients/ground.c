@@ -36,24 +36,6 @@ void cli_ground_usage(FILE *f)
             "                  attenuate rays, transparent layers blend by alpha\n");
 }
 
-static void die_usage(const char *cmd, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "obscura: %s: ", cmd);
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\n(run 'obscura help' for usage)\n");
-    va_end(ap);
-    exit(EXIT_USAGE);
-}
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
-}
-
 /* The options both commands share. */
 typedef struct ground_args {
     const char *cmd, *scene, *out, *camera, *backend, *gbuffer;
@@ -79,7 +61,7 @@ static const char *opt_value(const ground_args *a, int argc, char **argv, int *i
     if (s[n] == '=')
         return s + n + 1;
     if (*i + 1 >= argc)
-        die_usage(a->cmd, "option --%s needs a value", name);
+        cli_die_usage(a->cmd, "option --%s needs a value", name);
     return argv[++*i];
 }
 
@@ -89,7 +71,7 @@ static long parse_long(const ground_args *a, const char *name, const char *v, lo
     errno = 0;
     long x = strtol(v, &end, 10);
     if (errno || end == v || *end || x < lo || x > hi)
-        die_usage(a->cmd, "--%s '%s': expected an integer from %ld to %ld", name, v, lo, hi);
+        cli_die_usage(a->cmd, "--%s '%s': expected an integer from %ld to %ld", name, v, lo, hi);
     return x;
 }
 
@@ -115,9 +97,9 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
             char *end;
             double x = strtod(num, &end);
             if (end == num || *end || !(x >= 0.0 && x <= 1.0) || eq == v)
-                die_usage(a->cmd, "--alpha '%s': expected A or NAME=A, A from 0 to 1", v);
+                cli_die_usage(a->cmd, "--alpha '%s': expected A or NAME=A, A from 0 to 1", v);
             if (a->nalpha == MAX_ALPHA_SPECS)
-                die_usage(a->cmd, "more than %d --alpha options", MAX_ALPHA_SPECS);
+                cli_die_usage(a->cmd, "more than %d --alpha options", MAX_ALPHA_SPECS);
             a->alpha[a->nalpha++] = v;
         }
         else if (reference && (v = opt_value(a, argc, argv, &i, "spp")))
@@ -132,26 +114,26 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
             char *end;
             a->distance = strtod(v, &end);
             if (end == v || *end || !(a->distance > 0) || !isfinite(a->distance))
-                die_usage(a->cmd, "--distance '%s': expected a positive length", v);
+                cli_die_usage(a->cmd, "--distance '%s': expected a positive length", v);
         } else if (!strcmp(argv[i], "-q") || !strcmp(argv[i], "--quiet"))
             a->quiet = 1;
         else if (!strcmp(argv[i], "-v") || !strcmp(argv[i], "--verbose"))
             a->verbose = 1;
         else if (argv[i][0] == '-' && argv[i][1])
-            die_usage(a->cmd, "unknown option '%s'", argv[i]);
+            cli_die_usage(a->cmd, "unknown option '%s'", argv[i]);
         else if (!a->scene)
             a->scene = argv[i];
         else
-            die_usage(a->cmd, "more than one scene ('%s', '%s')", a->scene, argv[i]);
+            cli_die_usage(a->cmd, "more than one scene ('%s', '%s')", a->scene, argv[i]);
     }
     if (!a->scene)
-        die_usage(a->cmd, "no scene file");
+        cli_die_usage(a->cmd, "no scene file");
     if (!a->out)
-        die_usage(a->cmd, "no output file (-o OUT)");
+        cli_die_usage(a->cmd, "no output file (-o OUT)");
     if (!a->camera && !(reference && a->gbuffer))
-        die_usage(a->cmd, "no camera (--camera CAM.json)");
+        cli_die_usage(a->cmd, "no camera (--camera CAM.json)");
     if (!reference && a->nalpha && !a->deep)
-        die_usage(a->cmd, "--alpha needs --deep (the flat G-buffer is the front surface only)");
+        cli_die_usage(a->cmd, "--alpha needs --deep (the flat G-buffer is the front surface only)");
 }
 
 static int ends_with(const char *s, const char *suffix)
@@ -173,7 +155,7 @@ static int load_camera(const ground_args *a, obs_camera *cam, int *w, int *h)
     *w = a->width ? (int)a->width : cw;
     *h = a->height ? (int)a->height : ch;
     if (*w <= 0 || *h <= 0)
-        die_usage(a->cmd, "%s gives no image size: use --width and --height", a->camera);
+        cli_die_usage(a->cmd, "%s gives no image size: use --width and --height", a->camera);
     if (cw > 0 && ch > 0 && fabs((double)cw / ch - (double)*w / *h) > 1e-3) {
         /* Another aspect: a centred perspective keeps its vertical field
          * of view and widens or narrows horizontally (x scale = y scale /
@@ -201,7 +183,7 @@ static void log_cb(void *user, obs_log_level level, const char *msg)
 static int load_scene(const ground_args *a, obs_scene *scene)
 {
     char err[OBS_ERR_LEN] = "";
-    double t0 = now_s();
+    double t0 = cli_now_s();
     obs_status s = obs_scene_load(a->scene, scene, err);
     if (s != OBS_OK)
         return cli_input_fail(s, a->scene, err);
@@ -213,7 +195,7 @@ static int load_scene(const ground_args *a, obs_scene *scene)
     if (!a->quiet)
         fprintf(stderr, "obscura: info: %s: %zu triangles, %zu vertices%s%s (%.2f s)\n", a->scene,
                 scene->triangle_count, scene->vertex_count, scene->albedo ? ", albedo" : "",
-                scene->opacity ? ", opacity" : "", now_s() - t0);
+                scene->opacity ? ", opacity" : "", cli_now_s() - t0);
     return EXIT_OK;
 }
 
@@ -228,7 +210,7 @@ static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene
     obs_status s = obs_raster_deep(ctx, scene, cam, w, h, &d, err);
     if (s != OBS_OK)
         return cli_input_fail(s, a->scene, err);
-    double t_raster = now_s() - t0;
+    double t_raster = cli_now_s() - t0;
     if ((s = obs_deep_write_exr(a->out, &d, err)) != OBS_OK) {
         obs_deep_free(&d);
         return cli_fail(s, a->out, err);
@@ -257,7 +239,7 @@ int cli_gbuffer(int argc, char **argv)
     ground_args a = {.cmd = "gbuffer"};
     parse(&a, argc, argv, 0);
     if (!ends_with(a.out, ".exr"))
-        die_usage(a.cmd, "%s: the G-buffer is written as .exr", a.out);
+        cli_die_usage(a.cmd, "%s: the G-buffer is written as .exr", a.out);
 
     obs_camera cam;
     obs_scene scene = {0};
@@ -274,8 +256,8 @@ int cli_gbuffer(int argc, char **argv)
     obs_ctx_desc desc = {.log = log_cb, .log_user = &a};
     const char *bname = a.backend ? a.backend : getenv("OBSCURA_BACKEND");
     if (bname && *bname && obs_backend_parse(bname, &desc.backend) != OBS_OK)
-        die_usage(a.cmd, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
-    double t0 = now_s();
+        cli_die_usage(a.cmd, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
+    double t0 = cli_now_s();
     if ((s = obs_ctx_create(&desc, &ctx, err)) != OBS_OK) {
         rc = cli_fail(s, "OpenGL", err);
         goto done;
@@ -288,7 +270,7 @@ int cli_gbuffer(int argc, char **argv)
         rc = cli_input_fail(s, a.scene, err);
         goto done;
     }
-    double t_raster = now_s() - t0;
+    double t_raster = cli_now_s() - t0;
 
     static const char *const n_z[] = {"Z"}, *const n_n[] = {"N.X", "N.Y", "N.Z"},
                              *const n_nc[] = {"Ncam.X", "Ncam.Y", "Ncam.Z"},
@@ -393,7 +375,7 @@ int cli_reference(int argc, char **argv)
     parse(&a, argc, argv, 1);
     int png = ends_with(a.out, ".png");
     if (!png && !ends_with(a.out, ".exr"))
-        die_usage(a.cmd, "%s: the reference is written as .exr or .png", a.out);
+        cli_die_usage(a.cmd, "%s: the reference is written as .exr or .png", a.out);
 
     obs_camera cam = {0};
     obs_scene scene = {0};
@@ -438,12 +420,12 @@ int cli_reference(int argc, char **argv)
         desc.progress = progress_cb;
         desc.progress_user = &last;
     }
-    double t0 = now_s();
+    double t0 = cli_now_s();
     if ((s = obs_reference_render(&scene, &view, &desc, &ao, &depth, err)) != OBS_OK) {
         rc = cli_input_fail(s, a.scene, err);
         goto done;
     }
-    double t = now_s() - t0;
+    double t = cli_now_s() - t0;
 
     if (png) {
         s = obs_png_write(a.out, &ao, 8, 0, err);
