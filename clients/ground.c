@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "obscura/bake.h"
 #include "obscura/deep.h"
 #include "ground.h"
 #include "obscura/io.h"
@@ -33,7 +34,10 @@ void cli_ground_usage(FILE *f)
             "                  [--spp N] [--seed N] [--threads N] [--width W] [--height H]\n"
             "                  [--gbuffer G.exr] [--alpha [NAME=]A]...\n"
             "                  ray-traced AO (Embree): AO.Y and Z; transparent surfaces\n"
-            "                  attenuate rays, transparent layers blend by alpha\n");
+            "                  attenuate rays, transparent layers blend by alpha\n"
+            "                  [--obscurance SHORT,LONG [--blend B]]   the bake's obscurance\n"
+            "                  instead (eq 1, closest hits, rho = 1 - exp(a x), a = ln 0.5 / d;\n"
+            "                  opaque): AO.Y = B short + (1 - B) long, AO_SHORT.Y, AO_LONG.Y, Z\n");
 }
 
 /* The options both commands share. */
@@ -43,6 +47,10 @@ typedef struct ground_args {
     unsigned long long seed;
     double distance;
     int quiet, verbose, deep;
+    /* --obscurance and --blend, through the bake's table (its ranges and
+     * its default blend) */
+    int obscurance, blend_given;
+    obs_bake_params bake;
 #define MAX_ALPHA_SPECS 64
     const char *alpha[MAX_ALPHA_SPECS]; /* --alpha specs, in order */
     int nalpha;
@@ -110,7 +118,23 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
             a->seed = (unsigned long long)parse_long(a, "seed", v, 0, 0x7fffffffL);
         else if (reference && (v = opt_value(a, argc, argv, &i, "gbuffer")))
             a->gbuffer = v;
-        else if (reference && (v = opt_value(a, argc, argv, &i, "distance"))) {
+        else if (reference && (v = opt_value(a, argc, argv, &i, "obscurance"))) {
+            char sh[64], lo[64], err[OBS_ERR_LEN] = "";
+            const char *comma = strchr(v, ',');
+            if (!comma || strchr(comma + 1, ',') || comma == v || !comma[1])
+                cli_die_usage(a->cmd, "--obscurance '%s': expected SHORT,LONG (e.g. 2,300)", v);
+            snprintf(sh, sizeof sh, "%.*s", (int)(comma - v), v);
+            snprintf(lo, sizeof lo, "%s", comma + 1);
+            if (obs_bake_param_set(&a->bake, "distance_short", sh, err) != OBS_OK ||
+                obs_bake_param_set(&a->bake, "distance_long", lo, err) != OBS_OK)
+                cli_die_usage(a->cmd, "--obscurance '%s': %s", v, err);
+            a->obscurance = 1;
+        } else if (reference && (v = opt_value(a, argc, argv, &i, "blend"))) {
+            char err[OBS_ERR_LEN] = "";
+            if (obs_bake_param_set(&a->bake, "blend", v, err) != OBS_OK)
+                cli_die_usage(a->cmd, "--blend '%s': %s", v, err);
+            a->blend_given = 1;
+        } else if (reference && (v = opt_value(a, argc, argv, &i, "distance"))) {
             char *end;
             a->distance = strtod(v, &end);
             if (end == v || *end || !(a->distance > 0) || !isfinite(a->distance))
@@ -132,6 +156,11 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
         cli_die_usage(a->cmd, "no output file (-o OUT)");
     if (!a->camera && !(reference && a->gbuffer))
         cli_die_usage(a->cmd, "no camera (--camera CAM.json)");
+    if (a->blend_given && !a->obscurance)
+        cli_die_usage(a->cmd, "--blend needs --obscurance SHORT,LONG");
+    if (a->obscurance && a->nalpha)
+        cli_die_usage(a->cmd, "--alpha does not apply to --obscurance (every surface is opaque, "
+                              "as the bake traces it)");
     if (!reference && a->nalpha && !a->deep)
         cli_die_usage(a->cmd, "--alpha needs --deep (the flat G-buffer is the front surface only)");
 }
@@ -416,6 +445,17 @@ int cli_reference(int argc, char **argv)
                                .normal = a.gbuffer ? &nrm : NULL};
     obs_reference_desc desc = {.distance = (float)a.distance, .spp = (int)a.spp,
                                .seed = a.seed, .threads = (int)a.threads};
+    obs_bake_params bp;
+    obs_bake_params_resolve(&a.bake, &bp);
+    if (a.obscurance) {
+        desc.obscurance = 1;
+        desc.obscurance_distance[0] = bp.distance_short;
+        desc.obscurance_distance[1] = bp.distance_long;
+        desc.blend = bp.blend;
+        if (scene.opacity && !a.quiet)
+            fprintf(stderr, "obscura: info: %s: opacities not used: the obscurance traces every "
+                            "surface as opaque, as the bake does\n", a.scene);
+    }
     if (!a.quiet && isatty(STDERR_FILENO)) {
         desc.progress = progress_cb;
         desc.progress_user = &last;
@@ -428,7 +468,18 @@ int cli_reference(int argc, char **argv)
     double t = cli_now_s() - t0;
 
     if (png) {
+        /* obscurance: the blend alone (channel 0 of 3) */
+        if (a.obscurance) {
+            size_t n = (size_t)ao.width * ao.height;
+            for (size_t i = 0; i < n; i++)
+                ao.data[i] = ao.data[3 * i];
+            ao.channels = 1;
+        }
         s = obs_png_write(a.out, &ao, 8, 0, err);
+    } else if (a.obscurance) {
+        static const char *const n_ao[] = {"AO.Y", "AO_SHORT.Y", "AO_LONG.Y"}, *const n_z[] = {"Z"};
+        const obs_exr_layer layers[] = {{&ao, n_ao}, {&depth, n_z}};
+        s = obs_exr_write(a.out, layers, 2, OBS_EXR_FLOAT, &cam, err);
     } else {
         static const char *const n_ao[] = {"AO.Y"}, *const n_z[] = {"Z"};
         const obs_exr_layer layers[] = {{&ao, n_ao}, {&depth, n_z}};
@@ -438,7 +489,12 @@ int cli_reference(int argc, char **argv)
         rc = cli_fail(s, a.out, err);
         goto done;
     }
-    if (!a.quiet)
+    if (!a.quiet && a.obscurance)
+        fprintf(stderr, "obscura: info: wrote %s: %dx%d, obscurance %g,%g blend %g, %ld rays, "
+                        "seed %llu, %.2f s\n",
+                a.out, w, h, (double)bp.distance_short, (double)bp.distance_long,
+                (double)bp.blend, a.spp ? a.spp : 256L, a.seed, t);
+    else if (!a.quiet)
         fprintf(stderr, "obscura: info: wrote %s: %dx%d, distance %g, %ld spp, seed %llu, %.2f s\n",
                 a.out, w, h, a.distance, a.spp ? a.spp : 256L, a.seed, t);
 

@@ -3,6 +3,7 @@
  *   obscura gbuffer SCENE -o OUT.exr --camera CAM.json [--width W] [--height H]
  *   obscura reference SCENE -o REF.(exr|png) --camera CAM.json [--distance D]
  *                     [--spp N] [--seed N] [--threads N] [--gbuffer G.exr]
+ *                     [--obscurance SHORT,LONG [--blend B]]
  *
  * Each returns the process exit code (0 ok, 1 failure, 2 usage, 3 bad
  * input). */

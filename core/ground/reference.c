@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "ground/reference_internal.h"
 #include "internal.h"
 #include "obscura/reference.h"
 
@@ -114,6 +115,7 @@ typedef struct job {
     float clip_to_world[16];
     float eye[4]; /* camera position (w 1) or direction towards it (w 0) */
     float *ao, *depth;
+    obs__obscurance ob; /* obscurance mode */
     atomic_int next_row;
     int rows_done;
     pthread_mutex_t progress_lock;
@@ -338,6 +340,19 @@ static void *worker(void *arg)
             float p[3], n[3], ng[3];
             pcg32 rng;
             pcg32_seed(&rng, j->desc.seed, i);
+            if (j->desc.obscurance) {
+                /* eq 1 around the normal facing the viewer; opaque */
+                float *o = j->ao + 3 * i, v[2] = {1.0f, 1.0f};
+                int hit = surface_point(j, &ictx, x, y, p, n, ng);
+                if (hit)
+                    obs__obscurance_at(j->rtc, &ictx, &j->ob, i, p, ng, v);
+                o[0] = j->desc.blend * v[0] + (1.0f - j->desc.blend) * v[1];
+                o[1] = v[0];
+                o[2] = v[1];
+                if (j->depth)
+                    j->depth[i] = hit ? planar_depth(j, p) : OBS_SKY_DEPTH;
+                continue;
+            }
             if (j->scene->opacity && !j->view->position) {
                 float z;
                 j->ao[i] = layered_ao(j, &ictx, &rng, x, y, &z);
@@ -418,7 +433,16 @@ static obs_status check_args(const obs_scene *scene, const obs_reference_view *v
         return obs__fail(err, OBS_INVALID_ARGUMENT, "empty scene: no triangles");
     if (!v || !v->camera || !v->camera->has_projection)
         return obs__fail(err, OBS_NO_CAMERA, "the reference needs a camera with a projection");
-    if (!(d->distance > 0.0f) || !isfinite(d->distance))
+    if (d->obscurance) {
+        for (int c = 0; c < 2; c++)
+            if (!(d->obscurance_distance[c] > 0.0f) || !isfinite(d->obscurance_distance[c]))
+                return obs__fail(err, OBS_INVALID_ARGUMENT,
+                                 "obscurance %s distance %g: expected a positive length",
+                                 c ? "long" : "short", (double)d->obscurance_distance[c]);
+        if (!(d->blend >= 0.0f && d->blend <= 1.0f))
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "blend %g: expected 0 to 1",
+                             (double)d->blend);
+    } else if (!(d->distance > 0.0f) || !isfinite(d->distance))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "distance %g: expected a positive length",
                          (double)d->distance);
     if (d->spp == 0)
@@ -475,14 +499,15 @@ obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view
 
     job *j = calloc(1, sizeof *j);
     size_t px = (size_t)w * (size_t)h;
-    if (!j || !(ao->data = malloc(px * sizeof(float))) ||
+    const int ao_channels = d.obscurance ? 3 : 1;
+    if (!j || !(ao->data = malloc(px * ao_channels * sizeof(float))) ||
         (depth && !(depth->data = malloc(px * sizeof(float))))) {
         s = obs__fail(err, OBS_NO_MEMORY, "reference image of %dx%d", w, h);
         goto fail;
     }
     ao->width = w;
     ao->height = h;
-    ao->channels = 1;
+    ao->channels = ao_channels;
     if (depth) {
         depth->width = w;
         depth->height = h;
@@ -517,6 +542,8 @@ obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view
     j->rtc = rs;
     j->view = view;
     j->desc = d;
+    if (d.obscurance)
+        obs__obscurance_init(&j->ob, d.obscurance_distance, d.spp, d.seed);
     j->width = w;
     j->height = h;
     j->ao = ao->data;

@@ -23,7 +23,20 @@
  *   AO = sum_k alpha_k AO_k prod_{j<k} (1 - alpha_j) + prod_k (1 - alpha_k).
  * An opaque front surface gives the definition above.  G-buffer points
  * (obs_reference_view.position) are taken as opaque; only their rays are
- * attenuated. */
+ * attenuated.
+ *
+ * Obscurance mode (obs_reference_desc.obscurance): the quantity the bake
+ * puts on the vertices (bake.h), eq 1 of "Baked ambient obscurance on the
+ * vertices of game levels" at two distances d from the same rays,
+ *   AO_d(p) = 1/pi integral over the hemisphere of rho(t(p, w)) cos dw,
+ *   rho(x) = 1 - exp(a x), a = ln(0.5) / d,
+ * t the distance to the closest hit (any face, front or back; a miss is
+ * rho = 1; rays stop at 16 times the longer d), the hemisphere around the
+ * geometric normal facing the viewer (the G-buffer's normal for G-buffer
+ * points), the bake's own kernel, ray lattice and random shifts
+ * (core/bake/kernel.h).  Every surface is opaque, as the bake traces it:
+ * opacities are not used.  The image has three channels: the blend
+ * b AO_short + (1 - b) AO_long, AO_short, AO_long. */
 #ifndef OBSCURA_REFERENCE_H
 #define OBSCURA_REFERENCE_H
 
@@ -47,6 +60,10 @@ typedef struct obs_reference_desc {
     int threads;      /* worker threads; 0 -> CPUs online (at most 64) */
     obs_progress_fn progress; /* may be NULL */
     void *progress_user;
+    /* Obscurance mode (above) when set; distance is then unused. */
+    int obscurance;
+    float obscurance_distance[2]; /* short, long (> 0) */
+    float blend;                  /* weight of the short one, in [0, 1] */
 } obs_reference_desc;
 
 /* Where the AO is evaluated: the first hit of a primary ray from the
@@ -62,8 +79,8 @@ typedef struct obs_reference_view {
     const obs_image *normal;   /* them), both or neither */
 } obs_reference_view;
 
-/* The AO estimate (1 channel, 1 = unoccluded, 1 where nothing is hit)
- * and, when depth is non-NULL, the planar view depth of the points (the
+/* The AO estimate (1 channel, 1 = unoccluded, 1 where nothing is hit;
+ * obscurance mode: 3 channels, blend, short, long, all 1 there) and, when depth is non-NULL, the planar view depth of the points (the
  * front layer's with opacities; OBS_SKY_DEPTH where there is none).  Caller frees both with
  * obs_image_free(). */
 obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view *view,

@@ -75,6 +75,35 @@ expect 0 "camera rays and G-buffer points agree" -- "$OBSCURA" compare "$T/ref.e
 mae=$(json mae)
 check "camera rays vs G-buffer points: MAE $mae < 0.05" "awk 'BEGIN { exit !($mae < 0.05) }'"
 
+echo "-- reference --obscurance (the bake's eq 1 per pixel)"
+expect 0 "reference --obscurance 0.5,4 --blend 0.25" -- "$OBSCURA" reference "$T/corner.obj" \
+    --camera "$C" -o "$T/obs.exr" --obscurance 0.5,4 --blend 0.25 --spp 16 -q
+expect 0 "short against long distance" -- "$OBSCURA" compare "$T/obs.exr" "$T/obs.exr" \
+    --channel-a AO_SHORT.Y --channel-b AO_LONG.Y --json
+bias=$(json bias)
+check "the long distance is darker: bias $bias < -0.01" "awk 'BEGIN { exit !($bias < -0.01) }'"
+expect 0 "the blend against the short distance" -- "$OBSCURA" compare "$T/obs.exr" "$T/obs.exr" \
+    --channel-a AO_SHORT.Y --channel-b AO.Y --json
+b2=$(json bias)
+check "AO.Y = 0.25 short + 0.75 long: bias $b2 = 0.75 x $bias" \
+    "awk 'BEGIN { d = $b2 - 0.75 * $bias; exit !(d < 1e-4 && d > -1e-4) }'"
+expect 0 "reference --obscurance as PNG (the blend)" -- "$OBSCURA" reference "$T/corner.obj" \
+    --camera "$C" -o "$T/obs.png" --obscurance 2,300 --spp 4 -q
+for bad_list in 2 2,3,4 ,3 2, a,b 0,300 2,-1; do
+    expect 2 "--obscurance '$bad_list'" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" \
+        -o "$T/x.exr" --obscurance "$bad_list"
+done
+said "distance_long"
+expect 2 "--blend out of range" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" \
+    -o "$T/x.exr" --obscurance 2,300 --blend 1.5
+said "blend"
+expect 2 "--blend without --obscurance" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" \
+    -o "$T/x.exr" --blend 0.5
+said "needs --obscurance"
+expect 2 "--alpha with --obscurance" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" \
+    -o "$T/x.exr" --obscurance 2,300 --alpha 0.5
+said "opaque"
+
 echo "-- deep: gbuffer --deep, reference --alpha"
 # a floor, a wall, a box and a pane in front of it (named objects)
 cat >"$T/pane.obj" <<'OBJ'
