@@ -27,6 +27,9 @@ void cli_ground_usage(FILE *f)
             "  obscura gbuffer SCENE -o OUT.exr --camera CAM.json [--width W] [--height H]\n"
             "                  [--backend B]    rasterise a mesh (OBJ, PLY, glTF/GLB, OFF, ...)\n"
             "                  into a G-buffer EXR: Z, N (world), Ncam, P, R,G,B (albedo), A\n"
+            "                  [--baked]        a level baked by obscura bake (.glb, found by\n"
+            "                  its attributes; --baked: required) adds _AO, _AO_SHORT, _AO_LONG,\n"
+            "                  the vertex values interpolated\n"
             "                  [--deep] [--alpha [NAME=]A]...   every fragment into a deep\n"
             "                  EXR (A-buffer): Z, A, R,G,B, N (world); opacity from the\n"
             "                  materials or --alpha (all meshes, or those matching NAME)\n"
@@ -46,7 +49,7 @@ typedef struct ground_args {
     long width, height, spp, threads;
     unsigned long long seed;
     double distance;
-    int quiet, verbose, deep;
+    int quiet, verbose, deep, baked;
     /* --obscurance and --blend, through the bake's table (its ranges and
      * its default blend) */
     int obscurance, blend_given;
@@ -99,6 +102,8 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
             a->backend = v;
         else if (!reference && !strcmp(argv[i], "--deep"))
             a->deep = 1;
+        else if (!reference && !strcmp(argv[i], "--baked"))
+            a->baked = 1;
         else if ((v = opt_value(a, argc, argv, &i, "alpha"))) {
             /* A or NAME=A, A in [0, 1]; the name is matched on loading. */
             const char *eq = strrchr(v, '='), *num = eq ? eq + 1 : v;
@@ -161,6 +166,9 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
     if (a->obscurance && a->nalpha)
         cli_die_usage(a->cmd, "--alpha does not apply to --obscurance (every surface is opaque, "
                               "as the bake traces it)");
+    if (a->baked && a->deep)
+        cli_die_usage(a->cmd, "--baked and --deep: the deep G-buffer does not carry the baked "
+                              "channels");
     if (!reference && a->nalpha && !a->deep)
         cli_die_usage(a->cmd, "--alpha needs --deep (the flat G-buffer is the front surface only)");
 }
@@ -213,7 +221,10 @@ static int load_scene(const ground_args *a, obs_scene *scene)
 {
     char err[OBS_ERR_LEN] = "";
     double t0 = cli_now_s();
-    obs_status s = obs_scene_load(a->scene, scene, err);
+    /* A baked level is read for its _AO attributes, which assimp drops. */
+    obs_status s = a->baked || (!a->deep && !a->nalpha && obs_scene_file_is_baked(a->scene))
+                       ? obs_scene_load_baked(a->scene, scene, err)
+                       : obs_scene_load(a->scene, scene, err);
     if (s != OBS_OK)
         return cli_input_fail(s, a->scene, err);
     for (int k = 0; k < a->nalpha; k++)
@@ -222,9 +233,12 @@ static int load_scene(const ground_args *a, obs_scene *scene)
             return cli_input_fail(s, a->scene, err);
         }
     if (!a->quiet)
-        fprintf(stderr, "obscura: info: %s: %zu triangles, %zu vertices%s%s (%.2f s)\n", a->scene,
-                scene->triangle_count, scene->vertex_count, scene->albedo ? ", albedo" : "",
-                scene->opacity ? ", opacity" : "", cli_now_s() - t0);
+        fprintf(stderr, "obscura: info: %s: %zu triangles, %zu vertices%s%s%s (%.2f s)\n",
+                a->scene, scene->triangle_count, scene->vertex_count,
+                scene->albedo ? ", albedo" : "", scene->opacity ? ", opacity" : "",
+                !scene->baked ? "" : scene->baked_mask == 7 ? ", baked _AO, _AO_SHORT, _AO_LONG"
+                                                            : ", baked _AO",
+                cli_now_s() - t0);
     return EXIT_OK;
 }
 
@@ -274,6 +288,7 @@ int cli_gbuffer(int argc, char **argv)
     obs_scene scene = {0};
     obs_raster r = {0};
     obs_ctx *ctx = NULL;
+    obs_image baked = {0};
     char err[OBS_ERR_LEN] = "";
     int w, h, rc;
     obs_status s;
@@ -299,8 +314,19 @@ int cli_gbuffer(int argc, char **argv)
         rc = cli_input_fail(s, a.scene, err);
         goto done;
     }
+    if (scene.baked && (s = obs_raster_baked(ctx, &scene, &cam, w, h, &baked, err)) != OBS_OK) {
+        rc = cli_input_fail(s, a.scene, err);
+        goto done;
+    }
+    /* _AO alone unless every primitive has the two distances */
+    if (scene.baked && scene.baked_mask != 7) {
+        for (size_t i = 0; i < (size_t)w * h; i++)
+            baked.data[i] = baked.data[3 * i];
+        baked.channels = 1;
+    }
     double t_raster = cli_now_s() - t0;
 
+    static const char *const n_baked[] = {"_AO", "_AO_SHORT", "_AO_LONG"};
     static const char *const n_z[] = {"Z"}, *const n_n[] = {"N.X", "N.Y", "N.Z"},
                              *const n_nc[] = {"Ncam.X", "Ncam.Y", "Ncam.Z"},
                              *const n_p[] = {"P.X", "P.Y", "P.Z"}, *const n_c[] = {"R", "G", "B", "A"},
@@ -322,9 +348,10 @@ int cli_gbuffer(int argc, char **argv)
     const obs_exr_layer layers[] = {{&r.depth, n_z},       {&r.normal, n_n},
                                     {&r.normal_cam, n_nc}, {&r.position, n_p},
                                     r.has_albedo ? (obs_exr_layer){&r.color, n_c}
-                                                 : (obs_exr_layer){&alpha, n_a}};
+                                                 : (obs_exr_layer){&alpha, n_a},
+                                    {&baked, n_baked}};
     /* Float: the sky depth (1e10) and world positions do not fit a half. */
-    s = obs_exr_write(a.out, layers, 5, OBS_EXR_FLOAT, &cam, err);
+    s = obs_exr_write(a.out, layers, scene.baked ? 6 : 5, OBS_EXR_FLOAT, &cam, err);
     obs_image_free(&alpha);
     if (s != OBS_OK) {
         rc = cli_fail(s, a.out, err);
@@ -338,6 +365,7 @@ int cli_gbuffer(int argc, char **argv)
     }
 
 done:
+    obs_image_free(&baked);
     obs_raster_free(&r);
     obs_ctx_destroy(ctx);
     obs_scene_free(&scene);

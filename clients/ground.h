@@ -1,6 +1,6 @@
 /* obscura's ground-truth commands (clients/ground.c):
  *
- *   obscura gbuffer SCENE -o OUT.exr --camera CAM.json [--width W] [--height H]
+ *   obscura gbuffer SCENE -o OUT.exr --camera CAM.json [--width W] [--height H] [--baked]
  *   obscura reference SCENE -o REF.(exr|png) --camera CAM.json [--distance D]
  *                     [--spp N] [--seed N] [--threads N] [--gbuffer G.exr]
  *                     [--obscurance SHORT,LONG [--blend B]]

@@ -28,6 +28,7 @@ void obs_scene_free(obs_scene *s)
     free(s->albedo);
     free(s->indices);
     free(s->opacity);
+    free(s->baked);
     for (size_t m = 0; m < s->mesh_count && s->meshes; m++) {
         free(s->meshes[m].name);
         free(s->meshes[m].node);

@@ -49,6 +49,11 @@ typedef struct obs_scene {
     obs_scene_mesh *meshes; /* a scene built in memory */
     float bounds_min[3]; /* filled by obs_scene_check() */
     float bounds_max[3];
+    /* A baked level (obs_scene_load_baked): 3 per vertex, the attributes
+     * _AO, _AO_SHORT, _AO_LONG of obscura bake; baked_mask bit k set when
+     * attribute k is in every primitive (bit 0 always).  NULL otherwise. */
+    float *baked;
+    unsigned baked_mask;
 } obs_scene;
 
 /* Loads every triangle of a mesh file through assimp: meshes are
@@ -57,6 +62,20 @@ typedef struct obs_scene {
  * cannot be opened, OBS_BAD_FILE when assimp cannot read it or it holds
  * no triangle.  Caller frees with obs_scene_free(). */
 obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN]);
+
+/* Loads a level that obscura bake wrote (glTF 2.0 binary, bake.h's
+ * obs_bake_write_glb) with its per-vertex _AO, _AO_SHORT and _AO_LONG in
+ * `baked` (assimp drops custom attributes, so the .glb is read here): node
+ * transforms (matrix or TRS) applied, world space, normals when present,
+ * base colours as albedo; only the file's own binary chunk.  Fails with
+ * OBS_MISSING_CHANNEL, naming the mesh, when a primitive has no _AO;
+ * OBS_BAD_FILE for a file that is not such a .glb or whose accessors lie
+ * outside its buffer.  Caller frees with obs_scene_free(). */
+obs_status obs_scene_load_baked(const char *path, obs_scene *out, char err[OBS_ERR_LEN]);
+
+/* 1 when path is a .glb some of whose primitives have an _AO attribute
+ * (a level baked by obscura bake), else 0. */
+int obs_scene_file_is_baked(const char *path);
 
 /* Checks a scene built in memory (counts, indices in range, finite
  * positions) and computes its bounds.  obs_scene_load() calls it. */
@@ -94,6 +113,16 @@ obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_ca
 
 /* Frees the images and zeroes *r; NULL-safe. */
 void obs_raster_free(obs_raster *r);
+
+/* The scene's baked values (obs_scene.baked) rasterised as
+ * obs_raster_gbuffer rasterises the albedo: the same triangles and
+ * pixels, each value interpolated across its triangle with perspective
+ * correction, as a game engine interpolates a vertex attribute.  out: 3
+ * channels (_AO, _AO_SHORT, _AO_LONG), 1 where no geometry is.  Fails
+ * with OBS_MISSING_CHANNEL when the scene has no baked values.  Caller
+ * frees with obs_image_free(). */
+obs_status obs_raster_baked(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
+                            int width, int height, obs_image *out, char err[OBS_ERR_LEN]);
 
 struct obs_deep_image; /* deep.h */
 

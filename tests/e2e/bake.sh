@@ -2,7 +2,8 @@
 # End-to-end tests of `obscura bake`: the aalborg fixture of tests/data
 # baked to .glb and PLY with a report, the .glb checked chunk by chunk
 # (tests/e2e/lib/glb_check.py) and read back through assimp (baked
-# again), the same bytes for 1 and 2 threads, the Khronos validator when
+# again), `obscura gbuffer` of the .glb (the baked channels, against the
+# level's own G-buffer and the obscurance reference), the same bytes for 1 and 2 threads, the Khronos validator when
 # it is installed, clear errors for bad input and usage; a TORCS track of
 # ../shared/data when present.
 #
@@ -58,6 +59,83 @@ JS
 else
     echo "  skip Khronos glTF validator: npm package gltf-validator not installed (offline)"
 fi
+
+echo "-- gbuffer of the baked .glb: _AO, _AO_SHORT, _AO_LONG as channels"
+json() { sed -n "s/.*\"$1\": \([-0-9.e+]*\).*/\1/p" "$T/out"; }
+expect 0 "cameras from the level's vertices" -- python3 tools/level_cameras.py "$T/a.glb" "$T" 2 160 120
+expect 0 "gbuffer a.glb (baked, found by its attributes)" -- "$OBSCURA" gbuffer "$T/a.glb" \
+    --camera "$T/cam0.json" -o "$T/g.exr"
+said "baked _AO, _AO_SHORT, _AO_LONG"
+expect 0 "_AO = 0.03 _AO_SHORT + 0.97 _AO_LONG, interpolated" -- "$OBSCURA" compare "$T/g.exr" \
+    "$T/g.exr" --channel-a _AO_LONG --channel-b _AO --json
+b1=$(json bias)
+expect 0 "_AO_SHORT against _AO_LONG" -- "$OBSCURA" compare "$T/g.exr" "$T/g.exr" \
+    --channel-a _AO_LONG --channel-b _AO_SHORT --json
+b2=$(json bias)
+check "bias(_AO - long) $b1 = 0.03 bias(short - long) $b2" \
+    "awk 'BEGIN { d = $b1 - 0.03 * $b2; exit !(d < 1e-5 && d > -1e-5 && ($b2 > 0.005 || $b2 < -0.005)) }'"
+expect 0 "gbuffer of the level itself (assimp)" -- "$OBSCURA" gbuffer "$FIX" \
+    --camera "$T/cam0.json" -o "$T/g_level.exr" -q
+for ch in N.Y N.X P.Y; do
+    expect 0 "the baked .glb's $ch against the level's" -- "$OBSCURA" compare "$T/g_level.exr" \
+        "$T/g.exr" --channel-a $ch --channel-b $ch --json
+    m=$(json mse)
+    check "$ch: MSE $m < 1e-4 (same triangles, same transforms)" "awk 'BEGIN { exit !($m < 1e-4) }'"
+done
+expect 0 "the obscurance reference of the same camera" -- "$OBSCURA" reference "$T/a.glb" \
+    --camera "$T/cam0.json" -o "$T/r.exr" --obscurance 2,300 --blend 0.03 --spp 64 -q
+expect 0 "baked _AO against the reference" -- "$OBSCURA" compare "$T/r.exr" "$T/g.exr" \
+    --channel-b _AO --json
+m=$(json mse); c=$(json corr)
+check "baked vs reference: MSE $m < 0.02, corr $c > 0.6" "awk 'BEGIN { exit !($m < 0.02 && $c > 0.6) }'"
+expect 0 "the reference's short distance against the baked long one" -- "$OBSCURA" compare \
+    "$T/r.exr" "$T/g.exr" --channel-a AO_SHORT.Y --channel-b _AO_LONG --json
+m2=$(json mse)
+check "a mismatched channel is further: MSE $m2 > $m" "awk 'BEGIN { exit !($m2 > $m) }'"
+for e in trs matrix noao; do python3 tests/e2e/lib/glb_edit.py "$T/a.glb" "$T/$e.glb" $e; done
+python3 tests/e2e/lib/glb_edit.py "$T/trs.glb" "$T/trs_noao.glb" noao
+# the camera of the transformed level: cam0 moved by the same transform
+python3 - "$T/cam0.json" "$T/camt.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+W = c["world_to_camera"]
+# world' = T R S world: W' = W (T R S)^-1, (T R S)^-1 p = S^-1 R^-1 (p - t)
+Minv = [[0, 0, -0.5, 0], [0, 0.5, 0, 0], [0.5, 0, 0, 0], [0, 0, 0, 1]]  # S^-1 R^T
+t = [10, 2, -5]
+Tinv = [[1, 0, 0, -t[0]], [0, 1, 0, -t[1]], [0, 0, 1, -t[2]], [0, 0, 0, 1]]
+mul = lambda A, B: [[sum(A[i][k] * B[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
+c["world_to_camera"] = mul(W, mul(Minv, Tinv))
+json.dump(c, open(sys.argv[2], "w"))
+PY
+for e in trs matrix; do
+    expect 0 "gbuffer of the baked level under a $e transform" -- "$OBSCURA" gbuffer "$T/$e.glb" \
+        --camera "$T/camt.json" -o "$T/g_$e.exr" -q
+done
+expect 0 "the same through assimp (no _AO)" -- "$OBSCURA" gbuffer "$T/trs_noao.glb" \
+    --camera "$T/camt.json" -o "$T/g_trs_assimp.exr" -q
+# (compare clamps to [0, 1]: normals, coverage A and the baked values)
+for pair in "g_trs g_matrix N.X N.Y N.Z A _AO" "g_trs_assimp g_trs N.X N.Y N.Z A" "g g_trs A _AO"; do
+    set -- $pair
+    x=$1; y=$2; shift 2
+    for ch in "$@"; do
+        expect 0 "$x against $y: $ch" -- "$OBSCURA" compare "$T/$x.exr" "$T/$y.exr" \
+            --channel-a $ch --channel-b $ch --json
+        m=$(json mse)
+        check "$x vs $y $ch: MSE $m < 1e-4" "awk 'BEGIN { exit !($m < 1e-4) }'"
+    done
+done
+expect 3 "gbuffer --baked of a .glb without _AO" -- "$OBSCURA" gbuffer "$T/noao.glb" --baked \
+    --camera "$T/cam0.json" -o "$T/x.exr"
+said "no _AO attribute"
+expect 0 "without --baked the same file is an ordinary mesh" -- "$OBSCURA" gbuffer "$T/noao.glb" \
+    --camera "$T/cam0.json" -o "$T/x.exr"
+check "no baked channels then" "! grep -q 'baked _AO' $T/err"
+head -c 3000 "$T/a.glb" > "$T/cut.glb"
+expect 3 "a truncated baked .glb" -- "$OBSCURA" gbuffer "$T/cut.glb" --baked \
+    --camera "$T/cam0.json" -o "$T/x.exr"
+said "truncated"
+expect 2 "--baked with --deep" -- "$OBSCURA" gbuffer "$T/a.glb" --baked --deep \
+    --camera "$T/cam0.json" -o "$T/x.exr"
 
 echo "-- bad input"
 for f in no_triangles.obj:"no triangles" nan_vertex.obj:"not finite" \

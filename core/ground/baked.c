@@ -1,0 +1,484 @@
+/* A baked level read back for the G-buffer (scene.h, obs_scene_load_baked):
+ * glTF 2.0 binary with the per-vertex float attributes _AO, _AO_SHORT and
+ * _AO_LONG, as core/bake/glb.c writes them.  assimp cannot carry them
+ * (5.2's aiMesh has no place for custom attributes: its glTF importer
+ * keeps POSITION, NORMAL, TANGENT, TEXCOORD_n, COLOR_n, JOINTS_n,
+ * WEIGHTS_n), so the file is read here with cJSON: the
+ * header and chunks, the node graph from the scene's roots (matrix or
+ * TRS), each primitive's POSITION, NORMAL, indices and the three
+ * attributes, its material's base colour.  Every size and offset is
+ * checked against its view and the binary chunk before it is read. */
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "obscura/scene.h"
+
+#define GLB_MAGIC 0x46546C67u
+#define CHUNK_JSON 0x4E4F534Au
+#define CHUNK_BIN 0x004E4942u
+#define C_BYTE_U 5121
+#define C_SHORT_U 5123
+#define C_UINT 5125
+#define C_FLOAT 5126
+/* Depth of the node graph followed (a deeper one is refused: a cycle). */
+#define MAX_DEPTH 256
+#define MAX_FILE ((size_t)UINT32_MAX)
+
+static const char *const ao_names[3] = {"_AO", "_AO_SHORT", "_AO_LONG"};
+
+typedef struct glb {
+    const char *path;
+    unsigned char *file;
+    size_t size;
+    cJSON *doc;
+    const unsigned char *bin;
+    size_t bin_len;
+} glb;
+
+static void glb_free(glb *g)
+{
+    cJSON_Delete(g->doc);
+    free(g->file);
+    memset(g, 0, sizeof *g);
+}
+
+static uint32_t u32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static obs_status glb_open(const char *path, glb *g, char err[OBS_ERR_LEN])
+{
+    memset(g, 0, sizeof *g);
+    g->path = path;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
+    long n = -1;
+    if (fseek(f, 0, SEEK_END) == 0)
+        n = ftell(f);
+    if (n < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        return obs__fail(err, OBS_IO, "%s: cannot read: %s", path, strerror(errno));
+    }
+    if ((size_t)n > MAX_FILE) {
+        fclose(f);
+        return obs__fail(err, OBS_TOO_LARGE, "%s: %ld bytes; a .glb holds at most 4 GiB", path, n);
+    }
+    g->size = (size_t)n;
+    g->file = malloc(g->size ? g->size : 1);
+    if (!g->file) {
+        fclose(f);
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %zu bytes", path, g->size);
+    }
+    size_t got = fread(g->file, 1, g->size, f);
+    fclose(f);
+    if (got != g->size) {
+        glb_free(g);
+        return obs__fail(err, OBS_IO, "%s: short read", path);
+    }
+    const unsigned char *d = g->file;
+    if (g->size < 20 || u32(d) != GLB_MAGIC) {
+        glb_free(g);
+        return obs__fail(err, OBS_BAD_FILE, "%s: not a glTF binary (.glb)", path);
+    }
+    if (u32(d + 4) != 2 || u32(d + 16) != CHUNK_JSON) {
+        glb_free(g);
+        return obs__fail(err, OBS_BAD_FILE, "%s: not glTF 2.0 binary (version %u, first chunk "
+                                            "not JSON)", path, (unsigned)u32(d + 4));
+    }
+    if (u32(d + 8) > g->size) {
+        glb_free(g);
+        return obs__fail(err, OBS_BAD_FILE, "%s: the header says %u bytes, the file has %zu "
+                                            "(truncated?)", path, (unsigned)u32(d + 8), g->size);
+    }
+    size_t total = u32(d + 8), jlen = u32(d + 12);
+    if (jlen > total - 20) {
+        glb_free(g);
+        return obs__fail(err, OBS_BAD_FILE, "%s: JSON chunk of %zu bytes beyond the file", path,
+                         jlen);
+    }
+    g->doc = cJSON_ParseWithLength((const char *)d + 20, jlen);
+    if (!g->doc || !cJSON_IsObject(g->doc)) {
+        glb_free(g);
+        return obs__fail(err, OBS_BAD_FILE, "%s: the JSON chunk does not parse", path);
+    }
+    size_t at = 20 + ((jlen + 3) & ~(size_t)3);
+    if (at + 8 <= total && u32(d + at + 4) == CHUNK_BIN) {
+        size_t blen = u32(d + at);
+        if (blen > total - at - 8) {
+            glb_free(g);
+            return obs__fail(err, OBS_BAD_FILE, "%s: binary chunk of %zu bytes beyond the file",
+                             path, blen);
+        }
+        g->bin = d + at + 8;
+        g->bin_len = blen;
+    }
+    return OBS_OK;
+}
+
+static const cJSON *item(const cJSON *o, const char *name)
+{
+    return cJSON_GetObjectItemCaseSensitive(o, name);
+}
+
+/* A non-negative integer member, or -1. */
+static long index_of(const cJSON *o, const char *name)
+{
+    const cJSON *v = item(o, name);
+    if (!cJSON_IsNumber(v) || !(v->valuedouble >= 0.0) || v->valuedouble > 2147483647.0 ||
+        v->valuedouble != floor(v->valuedouble))
+        return -1;
+    return (long)v->valuedouble;
+}
+
+/* One accessor: its data in the binary chunk, checked. */
+typedef struct acc {
+    const unsigned char *data;
+    size_t count, stride;
+    int ctype, comps;
+} acc;
+
+static obs_status accessor(const glb *g, long idx, int comps, acc *a, const char *what,
+                           char err[OBS_ERR_LEN])
+{
+    const cJSON *accs = item(g->doc, "accessors"), *views = item(g->doc, "bufferViews");
+    const cJSON *ac = cJSON_GetArrayItem(accs, (int)idx);
+    if (idx < 0 || !cJSON_IsObject(ac))
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: accessor %ld does not exist", g->path, what,
+                         idx);
+    const cJSON *type = item(ac, "type");
+    static const char *const types[] = {NULL, "SCALAR", NULL, "VEC3"};
+    if (!cJSON_IsString(type) || strcmp(type->valuestring, types[comps]) != 0)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: accessor %ld is not %s", g->path, what, idx,
+                         types[comps]);
+    if (item(ac, "sparse"))
+        return obs__fail(err, OBS_UNSUPPORTED, "%s: %s: sparse accessors are not read", g->path,
+                         what);
+    long count = index_of(ac, "count"), vi = index_of(ac, "bufferView");
+    long ctype = index_of(ac, "componentType");
+    const cJSON *view = cJSON_GetArrayItem(views, (int)vi);
+    if (count < 0 || vi < 0 || !cJSON_IsObject(view))
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: accessor %ld has no count or bufferView",
+                         g->path, what, idx);
+    size_t csize = ctype == C_BYTE_U ? 1 : ctype == C_SHORT_U ? 2 : 4;
+    if (ctype != C_FLOAT && ctype != C_UINT && ctype != C_SHORT_U && ctype != C_BYTE_U)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: component type %ld", g->path, what, ctype);
+    long buf = index_of(view, "buffer");
+    const cJSON *b0 = cJSON_GetArrayItem(item(g->doc, "buffers"), 0);
+    if (buf != 0 || item(b0, "uri") || !g->bin)
+        return obs__fail(err, OBS_UNSUPPORTED, "%s: %s: only the .glb's own binary chunk is "
+                                               "read (buffer 0, no uri)", g->path, what);
+    long voff = index_of(view, "byteOffset"), vlen = index_of(view, "byteLength");
+    long aoff = index_of(ac, "byteOffset"), vstride = index_of(view, "byteStride");
+    if (voff < 0)
+        voff = 0;
+    if (aoff < 0)
+        aoff = 0;
+    size_t elem = csize * (size_t)comps, stride = vstride > 0 ? (size_t)vstride : elem;
+    if (vlen < 0 || (size_t)voff > g->bin_len || (size_t)vlen > g->bin_len - (size_t)voff ||
+        stride < elem)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: bufferView %ld out of range", g->path, what,
+                         vi);
+    /* the last element must end inside the view */
+    if (count > 0 && ((size_t)aoff > (size_t)vlen || (size_t)vlen - (size_t)aoff < elem ||
+                      (size_t)(count - 1) > ((size_t)vlen - (size_t)aoff - elem) / stride))
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: accessor %ld (%ld elements) out of range "
+                                            "of its view", g->path, what, idx, count);
+    a->data = g->bin + voff + aoff;
+    a->count = (size_t)count;
+    a->stride = stride;
+    a->ctype = (int)ctype;
+    a->comps = comps;
+    return OBS_OK;
+}
+
+static float acc_float(const acc *a, size_t i, int k)
+{
+    float v;
+    memcpy(&v, a->data + i * a->stride + 4 * (size_t)k, 4);
+    return v;
+}
+
+static uint32_t acc_index(const acc *a, size_t i)
+{
+    const unsigned char *p = a->data + i * a->stride;
+    if (a->ctype == C_BYTE_U)
+        return p[0];
+    if (a->ctype == C_SHORT_U)
+        return (uint32_t)p[0] | (uint32_t)p[1] << 8;
+    return u32(p);
+}
+
+/* The node's local matrix (row-major, column vectors): `matrix`
+ * (column-major in glTF) or T * R * S. */
+static void local_matrix(const cJSON *node, float m[16])
+{
+    obs__mat4_identity(m);
+    const cJSON *mat = item(node, "matrix");
+    if (cJSON_IsArray(mat) && cJSON_GetArraySize(mat) == 16) {
+        for (int k = 0; k < 16; k++)
+            m[4 * (k % 4) + k / 4] = (float)cJSON_GetArrayItem(mat, k)->valuedouble;
+        return;
+    }
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    const cJSON *jt = item(node, "translation"), *jr = item(node, "rotation"),
+                *js = item(node, "scale");
+    for (int k = 0; k < 3; k++) {
+        if (cJSON_GetArraySize(jt) == 3)
+            t[k] = cJSON_GetArrayItem(jt, k)->valuedouble;
+        if (cJSON_GetArraySize(js) == 3)
+            s[k] = cJSON_GetArrayItem(js, k)->valuedouble;
+    }
+    if (cJSON_GetArraySize(jr) == 4)
+        for (int k = 0; k < 4; k++)
+            q[k] = cJSON_GetArrayItem(jr, k)->valuedouble;
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    double r[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+                      {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+                      {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++)
+            m[4 * i + j] = (float)(r[i][j] * s[j]);
+        m[4 * i + 3] = (float)t[i];
+    }
+}
+
+/* What the walk over the nodes builds. */
+typedef struct build {
+    const glb *g;
+    obs_scene *s;
+    int count_only;      /* first pass: sizes */
+    size_t nv, nt, nmesh;
+    int any_material;
+    int has[3];          /* primitives with _AO, _AO_SHORT, _AO_LONG */
+    int prims;
+} build;
+
+static obs_status primitive(build *b, const cJSON *prim, const char *mname, const char *nname,
+                            int pi, const float world[16], char err[OBS_ERR_LEN])
+{
+    const glb *g = b->g;
+    char what[300];
+    snprintf(what, sizeof what, "mesh '%s' (node '%s') primitive %d", mname, nname, pi);
+    long mode = index_of(prim, "mode");
+    if (item(prim, "mode") && mode != 4)
+        return OBS_OK; /* points and lines have no surface */
+    const cJSON *attrs = item(prim, "attributes");
+    acc pos, nrm, ind, ao[3];
+    obs_status st;
+    if ((st = accessor(g, index_of(attrs, "POSITION"), 3, &pos, what, err)) != OBS_OK)
+        return st;
+    if (pos.ctype != C_FLOAT)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: POSITION is not float", g->path, what);
+    int have[3] = {0, 0, 0};
+    for (int k = 0; k < 3; k++) {
+        if (!item(attrs, ao_names[k]))
+            continue;
+        if ((st = accessor(g, index_of(attrs, ao_names[k]), 1, &ao[k], what, err)) != OBS_OK)
+            return st;
+        if (ao[k].ctype != C_FLOAT || ao[k].count != pos.count)
+            return obs__fail(err, OBS_BAD_FILE, "%s: %s: %s is not one float per vertex",
+                             g->path, what, ao_names[k]);
+        have[k] = 1;
+    }
+    if (!have[0])
+        return obs__fail(err, OBS_MISSING_CHANNEL,
+                         "%s: %s has no _AO attribute (not a level baked by obscura bake?)",
+                         g->path, what);
+    int has_n = item(attrs, "NORMAL") != NULL;
+    if (has_n && ((st = accessor(g, index_of(attrs, "NORMAL"), 3, &nrm, what, err)) != OBS_OK))
+        return st;
+    if (has_n && (nrm.ctype != C_FLOAT || nrm.count != pos.count))
+        has_n = 0; /* unusable: the rasteriser takes the face's */
+    int has_i = item(prim, "indices") != NULL;
+    if (has_i && (st = accessor(g, index_of(prim, "indices"), 1, &ind, what, err)) != OBS_OK)
+        return st;
+    if (has_i && ind.ctype == C_FLOAT)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: float indices", g->path, what);
+    size_t ni = has_i ? ind.count : pos.count;
+    if (ni % 3 != 0)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %zu indices, not triangles", g->path, what,
+                         ni);
+    if (pos.count > (size_t)UINT32_MAX - b->nv)
+        return obs__fail(err, OBS_TOO_LARGE, "%s: more than 2^32 vertices", g->path);
+    if (b->count_only) {
+        for (int k = 0; k < 3; k++)
+            b->has[k] += have[k];
+        b->prims++;
+        b->nv += pos.count;
+        b->nt += ni / 3;
+        b->nmesh++;
+        b->any_material |= index_of(prim, "material") >= 0;
+        return OBS_OK;
+    }
+
+    obs_scene *s = b->s;
+    float nm[16], inv[16];
+    if (obs__mat4_invert(world, inv) != 0)
+        obs__mat4_identity(inv); /* a singular node: its normals stay */
+    obs__mat4_transpose(inv, nm);
+    float rgb[3] = {0.8f, 0.8f, 0.8f};
+    const cJSON *mat = cJSON_GetArrayItem(item(g->doc, "materials"), (int)index_of(prim, "material"));
+    const cJSON *bc = item(item(mat, "pbrMetallicRoughness"), "baseColorFactor");
+    if (index_of(prim, "material") >= 0 && cJSON_GetArraySize(bc) >= 3)
+        for (int k = 0; k < 3; k++)
+            rgb[k] = (float)cJSON_GetArrayItem(bc, k)->valuedouble;
+    for (size_t v = 0; v < pos.count; v++) {
+        float p[4] = {acc_float(&pos, v, 0), acc_float(&pos, v, 1), acc_float(&pos, v, 2), 1.0f},
+              wp[4];
+        obs__mat4_apply(world, p, wp);
+        float *dp = s->positions + 3 * (b->nv + v), *dn = s->normals + 3 * (b->nv + v);
+        memcpy(dp, wp, 3 * sizeof(float));
+        dn[0] = dn[1] = dn[2] = 0.0f;
+        if (has_n) {
+            float n4[4] = {acc_float(&nrm, v, 0), acc_float(&nrm, v, 1), acc_float(&nrm, v, 2), 0},
+                  wn[4];
+            obs__mat4_apply(nm, n4, wn);
+            float len = sqrtf(wn[0] * wn[0] + wn[1] * wn[1] + wn[2] * wn[2]);
+            if (isfinite(len) && len > 1e-12f)
+                for (int k = 0; k < 3; k++)
+                    dn[k] = wn[k] / len;
+        }
+        float *db = s->baked + 3 * (b->nv + v);
+        for (int k = 0; k < 3; k++)
+            db[k] = have[k] ? acc_float(&ao[k], v, 0) : 1.0f;
+        if (s->albedo)
+            memcpy(s->albedo + 3 * (b->nv + v), rgb, sizeof rgb);
+    }
+    for (size_t i = 0; i < ni; i++) {
+        uint32_t ix = has_i ? acc_index(&ind, i) : (uint32_t)i;
+        if (ix >= pos.count)
+            return obs__fail(err, OBS_BAD_FILE, "%s: %s: index %u of %zu vertices", g->path, what,
+                             (unsigned)ix, pos.count);
+        s->indices[3 * b->nt + i] = (uint32_t)b->nv + ix;
+    }
+    obs_scene_mesh *me = &s->meshes[s->mesh_count++];
+    me->first_triangle = b->nt;
+    me->triangle_count = ni / 3;
+    if (!(me->name = strdup(mname)) || !(me->node = strdup(nname)))
+        return obs__fail(err, OBS_NO_MEMORY, "%s: mesh names", g->path);
+    b->nv += pos.count;
+    b->nt += ni / 3;
+    return OBS_OK;
+}
+
+static obs_status walk(build *b, long n, const float parent[16], int depth,
+                       char err[OBS_ERR_LEN])
+{
+    const cJSON *node = cJSON_GetArrayItem(item(b->g->doc, "nodes"), (int)n);
+    if (n < 0 || !cJSON_IsObject(node))
+        return obs__fail(err, OBS_BAD_FILE, "%s: node %ld does not exist", b->g->path, n);
+    if (depth > MAX_DEPTH)
+        return obs__fail(err, OBS_BAD_FILE, "%s: the node graph is deeper than %d (a cycle?)",
+                         b->g->path, MAX_DEPTH);
+    float local[16], world[16];
+    local_matrix(node, local);
+    obs__mat4_mul(parent, local, world);
+    const cJSON *nm = item(node, "name");
+    const char *nname = cJSON_IsString(nm) ? nm->valuestring : "";
+    long mi = index_of(node, "mesh");
+    obs_status st;
+    if (item(node, "mesh")) {
+        const cJSON *mesh = cJSON_GetArrayItem(item(b->g->doc, "meshes"), (int)mi);
+        if (mi < 0 || !cJSON_IsObject(mesh))
+            return obs__fail(err, OBS_BAD_FILE, "%s: node '%s': mesh %ld does not exist",
+                             b->g->path, nname, mi);
+        const cJSON *mn = item(mesh, "name"), *prim;
+        const char *mname = cJSON_IsString(mn) ? mn->valuestring : "";
+        int pi = 0;
+        cJSON_ArrayForEach(prim, item(mesh, "primitives"))
+            if ((st = primitive(b, prim, mname, nname, pi++, world, err)) != OBS_OK)
+                return st;
+    }
+    const cJSON *c;
+    cJSON_ArrayForEach(c, item(node, "children"))
+        if ((st = walk(b, cJSON_IsNumber(c) ? (long)c->valuedouble : -1, world, depth + 1, err)) !=
+            OBS_OK)
+            return st;
+    return OBS_OK;
+}
+
+static obs_status walk_scene(build *b, char err[OBS_ERR_LEN])
+{
+    long si = index_of(b->g->doc, "scene");
+    const cJSON *sc = cJSON_GetArrayItem(item(b->g->doc, "scenes"), (int)(si < 0 ? 0 : si)), *r;
+    float id[16];
+    obs__mat4_identity(id);
+    obs_status st;
+    cJSON_ArrayForEach(r, item(sc, "nodes"))
+        if ((st = walk(b, cJSON_IsNumber(r) ? (long)r->valuedouble : -1, id, 0, err)) != OBS_OK)
+            return st;
+    return OBS_OK;
+}
+
+int obs_scene_file_is_baked(const char *path)
+{
+    glb g;
+    if (glb_open(path, &g, NULL) != OBS_OK)
+        return 0;
+    int baked = 0;
+    const cJSON *mesh, *prim;
+    cJSON_ArrayForEach(mesh, item(g.doc, "meshes"))
+        cJSON_ArrayForEach(prim, item(mesh, "primitives"))
+            baked |= item(item(prim, "attributes"), "_AO") != NULL;
+    glb_free(&g);
+    return baked;
+}
+
+obs_status obs_scene_load_baked(const char *path, obs_scene *out, char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    glb g;
+    obs_status st = glb_open(path, &g, err);
+    if (st != OBS_OK)
+        return st;
+    build b = {.g = &g, .s = out, .count_only = 1};
+    if ((st = walk_scene(&b, err)) != OBS_OK)
+        goto fail;
+    if (b.nt == 0) {
+        st = obs__fail(err, OBS_BAD_FILE, "%s: empty scene: no triangles", path);
+        goto fail;
+    }
+    size_t vbytes, ibytes;
+    if (obs__size_mul3(b.nv, 3, sizeof(float), &vbytes) ||
+        obs__size_mul3(b.nt, 3, sizeof(uint32_t), &ibytes)) {
+        st = obs__fail(err, OBS_TOO_LARGE, "%s: mesh too large", path);
+        goto fail;
+    }
+    out->positions = malloc(vbytes);
+    out->normals = malloc(vbytes);
+    out->baked = malloc(vbytes);
+    out->albedo = b.any_material ? malloc(vbytes) : NULL;
+    out->indices = malloc(ibytes);
+    out->meshes = calloc(b.nmesh, sizeof *out->meshes);
+    if (!out->positions || !out->normals || !out->baked || (b.any_material && !out->albedo) ||
+        !out->indices || !out->meshes) {
+        st = obs__fail(err, OBS_NO_MEMORY, "%s: %zu vertices, %zu triangles", path, b.nv, b.nt);
+        goto fail;
+    }
+    /* _AO_SHORT and _AO_LONG count where every primitive has them */
+    out->baked_mask = 1u | (b.has[1] == b.prims ? 2u : 0u) | (b.has[2] == b.prims ? 4u : 0u);
+    build b2 = {.g = &g, .s = out};
+    if ((st = walk_scene(&b2, err)) != OBS_OK)
+        goto fail;
+    out->vertex_count = b2.nv;
+    out->triangle_count = b2.nt;
+    if ((st = obs_scene_check(out, err)) != OBS_OK) {
+        char msg[OBS_ERR_LEN];
+        snprintf(msg, sizeof msg, "%s", err ? err : "");
+        obs__fail(err, st, "%s: %s", path, msg);
+        goto fail;
+    }
+    glb_free(&g);
+    return OBS_OK;
+fail:
+    glb_free(&g);
+    obs_scene_free(out);
+    return st;
+}

@@ -1,0 +1,34 @@
+/* The baked values of a level rasterised (scene.h, obs_raster_baked):
+ * the G-buffer rasteriser run with the baked triple in the place of the
+ * albedo, whose vertex attribute it interpolates and writes unchanged
+ * (raster.frag.glsl), so that depth, normals and the baked channels come
+ * from the same triangles at the same pixels. */
+#include <string.h>
+
+#include "internal.h"
+#include "obscura/scene.h"
+
+obs_status obs_raster_baked(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
+                            int width, int height, obs_image *out, char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    if (!scene || !scene->baked)
+        return obs__fail(err, OBS_MISSING_CHANNEL,
+                         "the scene has no baked _AO values (load a baked level)");
+    obs_scene as_albedo = *scene;
+    as_albedo.albedo = scene->baked;
+    obs_raster r;
+    obs_status s = obs_raster_gbuffer(ctx, &as_albedo, cam, width, height, &r, err);
+    if (s != OBS_OK)
+        return s;
+    if ((s = obs__image_alloc(out, width, height, 3, err)) == OBS_OK) {
+        size_t n = (size_t)width * height;
+        for (size_t i = 0; i < n; i++) {
+            const float *c = r.color.data + 4 * i;
+            for (int k = 0; k < 3; k++)
+                out->data[3 * i + k] = c[3] > 0.0f ? c[k] : 1.0f; /* coverage 0: open */
+        }
+    }
+    obs_raster_free(&r);
+    return s;
+}

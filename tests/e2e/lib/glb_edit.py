@@ -1,0 +1,44 @@
+#!/usr/bin/env python3
+"""Rewrites the JSON chunk of a .glb (tests/e2e/bake.sh), the binary chunk
+kept: glb_edit.py IN OUT EDIT, EDIT one of
+  trs     the root nodes get translation (10, 2, -5), rotation 90 degrees
+          about +Y and scale (2, 2, 2) as TRS
+  matrix  the same transform as a column-major matrix
+  noao    every _AO attribute renamed (no baked values left)"""
+import json
+import math
+import struct
+import sys
+
+
+def main():
+    src, dst, edit = sys.argv[1:4]
+    data = open(src, "rb").read()
+    jlen = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(data[20:20 + jlen])
+    rest = data[20 + jlen:]
+    s = math.sqrt(0.5)
+    # R_y(90): x -> -z, z -> x; times scale 2; then the translation
+    m = [0, 0, -2, 0, 0, 2, 0, 0, 2, 0, 0, 0, 10, 2, -5, 1]  # column-major
+    for r in doc["scenes"][doc.get("scene", 0)]["nodes"]:
+        n = doc["nodes"][r]
+        n.pop("matrix", None)
+        if edit == "trs":
+            n.update(translation=[10, 2, -5], rotation=[0, s, 0, s], scale=[2, 2, 2])
+        elif edit == "matrix":
+            n["matrix"] = m
+    if edit == "noao":
+        for mesh in doc["meshes"]:
+            for p in mesh["primitives"]:
+                a = p["attributes"]
+                if "_AO" in a:
+                    a["_XO"] = a.pop("_AO")
+    j = json.dumps(doc).encode()
+    j += b" " * (-len(j) % 4)
+    out = struct.pack("<III", 0x46546C67, 2, 12 + 8 + len(j) + len(rest)) + \
+        struct.pack("<II", len(j), 0x4E4F534A) + j + rest
+    open(dst, "wb").write(out)
+
+
+if __name__ == "__main__":
+    main()
