@@ -525,6 +525,11 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
             st->regulariser_energy[ch] += p->alpha * om * jump * jump;
         }
     }
+    /* parameter values: a baseline written instead of the fit */
+    if (p->values == OBS_BAKE_VALUES_FACE_MEAN || p->values == OBS_BAKE_VALUES_POINT) {
+        memcpy(x, p->values == OBS_BAKE_VALUES_POINT ? point : face, 2 * y.n * sizeof *x);
+        obs__bake_residual(w, wd, s, x, st->residual_fit);
+    }
 done:
     if (started) {
         cholmod_free_triplet(&T, &cm);

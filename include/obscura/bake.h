@@ -38,6 +38,18 @@ typedef enum obs_bake_mass {
     OBS_BAKE_MASS_LIST(OBS__BAKE_ENUM)
 } obs_bake_mass;
 
+/* Which vertex values the bake writes (parameter `values`): the fit, or
+ * one of the two baselines the common tools use, from the same samples,
+ * for comparisons (bench/bake_quality.sh). */
+#define OBS_BAKE_VALUES_LIST(X)                                                \
+    X(OBS_BAKE_VALUES_FIT, fit)             /* the least-squares fit (eq 2) */ \
+    X(OBS_BAKE_VALUES_FACE_MEAN, face_mean) /* per-face averaging */           \
+    X(OBS_BAKE_VALUES_POINT, point)         /* point sampling at the vertex */
+typedef enum obs_bake_values {
+    OBS_BAKE_VALUES_DEFAULT,
+    OBS_BAKE_VALUES_LIST(OBS__BAKE_ENUM)
+} obs_bake_values;
+
 /* The bake parameters: X(name, type, default, min, max, choices, doc),
  * type FLOAT, INT or ENUM (choices '|'-separated, stored 1-based).  The
  * CLI's flags, `obscura bake --params` and README's bake table come from
@@ -73,6 +85,11 @@ typedef enum obs_bake_mass {
       "a linear signal exactly) or analytic (the hat basis integrated "        \
       "exactly, A/12 [[2,1,1],[1,2,1],[1,1,2]], scaled by the face's share "   \
       "of valid samples)")                                                     \
+    X(values, ENUM, "fit", 0, 0, (OBS_BAKE_VALUES_LIST(OBS__BAKE_CHOICE) + 1),  \
+      "vertex values written: fit (the least-squares fit), or a baseline "     \
+      "from the same samples for comparisons: face_mean (the area-weighted "   \
+      "mean of the samples of the vertex's faces) or point (the sample "       \
+      "nearest the vertex); the report's fit rows are then the baseline's")    \
     X(ridge, FLOAT, 1e-4, 0.0, 1.0, NULL,                                      \
       "a small pull of each vertex towards the mean of its own samples (or "   \
       "its neighbours' when it has none), weighted by its lumped area: "       \

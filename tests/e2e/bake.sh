@@ -60,6 +60,16 @@ else
     echo "  skip Khronos glTF validator: npm package gltf-validator not installed (offline)"
 fi
 
+for v in face_mean:face_mean point:point_sample; do
+    expect 0 "--values ${v%%:*} (a baseline written)" -- "$OBSCURA" bake "$FIX" -o "$T/v.glb" \
+        --rays 16 --values ${v%%:*} --report "$T/v.json" -q
+    check "${v%%:*}: the written values' residual is the baseline's" \
+        "[ \"\$(field $T/v.json \"['residual_rms']['least_squares']\")\" = \"\$(field $T/v.json \"['residual_rms']['${v#*:}']\")\" ]"
+    check "${v%%:*}: other values than the fit's" "! cmp -s $T/t1.glb $T/v.glb"
+done
+expect 2 "--values of no kind" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" --values mean
+said "fit|face_mean|point"
+
 echo "-- gbuffer of the baked .glb: _AO, _AO_SHORT, _AO_LONG as channels"
 json() { sed -n "s/.*\"$1\": \([-0-9.e+]*\).*/\1/p" "$T/out"; }
 expect 0 "cameras from the level's vertices" -- python3 tools/level_cameras.py "$T/a.glb" "$T" 2 160 120
