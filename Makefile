@@ -6,6 +6,7 @@
 #   make test     unit + end-to-end tests, then the same under ASan/UBSan
 #   make bench    benchmarks (bench/RESULTS.md)
 #   make quality  AO against ray-traced ground truth (bench/QUALITY.md)
+#   make bake-quality  baked vertices against the per-pixel reference (bench/BAKE.md)
 #   make fuzz     libFuzzer targets: binary protocol, EXR readers (clang; tests/fuzz/fuzz.mk)
 #   make readme   regenerate README.md's parameter and daemon option tables
 #   make samples  regenerate core/chain/sample_tables.c (VAO++ 4.5 sample sets)
@@ -86,7 +87,7 @@ DAEMON_BENCH := $(BUILD)/daemon_bench
 -include protocol/protocol.mk daemon/daemon.mk clients/clients.mk tests/fuzz/fuzz.mk
 E2E_DEPS += $(UPSCALE)
 
-.PHONY: all deps demo demo-run test check unit e2e loops headers readme readme-check samples bench quality clean deep-fixture
+.PHONY: all deps demo demo-run test check unit e2e loops headers readme readme-check samples bench quality bake-quality clean deep-fixture
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI) $(EXTRA_BINS)
@@ -240,6 +241,13 @@ bench: deps
 quality: deps
 	@$(MAKE) --no-print-directory all $(QSTRIP)
 	@BUILD=$(BUILD) bench/quality.sh
+
+# The baked vertices against the per-pixel obscurance reference
+# (bench/BAKE.md, "Against a per-pixel reference"): the levels of
+# $(OBSCURA_SHARED_DATA)/levels, sizes from bench/bake_quality.sh's
+# environment (LEVELS, RAYS, SPP, CAMS, ...).
+bake-quality: all $(QSTRIP)
+	@OBSCURA=$(CLI) QSTRIP=$(QSTRIP) bench/bake_quality.sh
 
 clean:
 	rm -rf build out
