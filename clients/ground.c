@@ -40,7 +40,9 @@ void cli_ground_usage(FILE *f)
             "                  attenuate rays, transparent layers blend by alpha\n"
             "                  [--obscurance SHORT,LONG [--blend B]]   the bake's obscurance\n"
             "                  instead (eq 1, closest hits, rho = 1 - exp(a x), a = ln 0.5 / d;\n"
-            "                  opaque): AO.Y = B short + (1 - B) long, AO_SHORT.Y, AO_LONG.Y, Z\n");
+            "                  opaque): AO.Y = B short + (1 - B) long, AO_SHORT.Y, AO_LONG.Y, Z;\n"
+            "                  [--near D]: also AO_NEAR.Y (the AO above at distance D) and\n"
+            "                  AO_BOTH.Y = AO_NEAR x AO_LONG (baked long x screen-space's reference)\n");
 }
 
 /* The options both commands share. */
@@ -53,6 +55,7 @@ typedef struct ground_args {
     /* --obscurance and --blend, through the bake's table (its ranges and
      * its default blend) */
     int obscurance, blend_given;
+    double near;
     obs_bake_params bake;
 #define MAX_ALPHA_SPECS 64
     const char *alpha[MAX_ALPHA_SPECS]; /* --alpha specs, in order */
@@ -134,6 +137,11 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
                 obs_bake_param_set(&a->bake, "distance_long", lo, err) != OBS_OK)
                 cli_die_usage(a->cmd, "--obscurance '%s': %s", v, err);
             a->obscurance = 1;
+        } else if (reference && (v = opt_value(a, argc, argv, &i, "near"))) {
+            char *end;
+            a->near = strtod(v, &end);
+            if (end == v || *end || !(a->near > 0) || !isfinite(a->near))
+                cli_die_usage(a->cmd, "--near '%s': expected a positive length", v);
         } else if (reference && (v = opt_value(a, argc, argv, &i, "blend"))) {
             char err[OBS_ERR_LEN] = "";
             if (obs_bake_param_set(&a->bake, "blend", v, err) != OBS_OK)
@@ -161,8 +169,8 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
         cli_die_usage(a->cmd, "no output file (-o OUT)");
     if (!a->camera && !(reference && a->gbuffer))
         cli_die_usage(a->cmd, "no camera (--camera CAM.json)");
-    if (a->blend_given && !a->obscurance)
-        cli_die_usage(a->cmd, "--blend needs --obscurance SHORT,LONG");
+    if ((a->blend_given || a->near > 0) && !a->obscurance)
+        cli_die_usage(a->cmd, "--%s needs --obscurance SHORT,LONG", a->near > 0 ? "near" : "blend");
     if (a->obscurance && a->nalpha)
         cli_die_usage(a->cmd, "--alpha does not apply to --obscurance (every surface is opaque, "
                               "as the bake traces it)");
@@ -480,6 +488,7 @@ int cli_reference(int argc, char **argv)
         desc.obscurance_distance[0] = bp.distance_short;
         desc.obscurance_distance[1] = bp.distance_long;
         desc.blend = bp.blend;
+        desc.obscurance_near = (float)a.near;
         if (scene.opacity && !a.quiet)
             fprintf(stderr, "obscura: info: %s: opacities not used: the obscurance traces every "
                             "surface as opaque, as the bake does\n", a.scene);
@@ -496,16 +505,18 @@ int cli_reference(int argc, char **argv)
     double t = cli_now_s() - t0;
 
     if (png) {
-        /* obscurance: the blend alone (channel 0 of 3) */
+        /* obscurance: the blend alone (channel 0 of 3 or 5) */
         if (a.obscurance) {
             size_t n = (size_t)ao.width * ao.height;
             for (size_t i = 0; i < n; i++)
-                ao.data[i] = ao.data[3 * i];
+                ao.data[i] = ao.data[(size_t)ao.channels * i];
             ao.channels = 1;
         }
         s = obs_png_write(a.out, &ao, 8, 0, err);
     } else if (a.obscurance) {
-        static const char *const n_ao[] = {"AO.Y", "AO_SHORT.Y", "AO_LONG.Y"}, *const n_z[] = {"Z"};
+        static const char *const n_ao[] = {"AO.Y", "AO_SHORT.Y", "AO_LONG.Y", "AO_NEAR.Y",
+                                           "AO_BOTH.Y"},
+                                 *const n_z[] = {"Z"};
         const obs_exr_layer layers[] = {{&ao, n_ao}, {&depth, n_z}};
         s = obs_exr_write(a.out, layers, 2, OBS_EXR_FLOAT, &cam, err);
     } else {

@@ -95,6 +95,10 @@ static const cli_opt ao_opts[] = {
     {"depth", "CH", "depth channel name"},
     {"normal", "X,Y,Z", "normal channel names"},
     {"color", "R,G,B[,A]", "colour channel names"},
+    {"baked", "CH|none", "a baked AO channel of the input (obscura gbuffer of a level baked by "
+     "obscura bake: _AO, _AO_SHORT, _AO_LONG; default _AO when the input has it) combined with "
+     "the chain's AO (--baked-combine, default product): AO.Y is the combination, "
+     "AOScreen.Y the chain's, AOBaked.Y the channel; none: not combined"},
     {"max-size", "N", "largest accepted width or height (default 16384)"},
     {"backend", "B", "auto|egl-device|egl-surfaceless|osmesa (or OBSCURA_BACKEND)"},
     {"cache-dir", "DIR", "program cache folder (or OBSCURA_CACHE_DIR; default "
@@ -165,6 +169,7 @@ static void usage(FILE *f)
  * the client's own. */
 typedef struct ao_args {
     const char *in, *out, *camera, *backend, *cache_dir;
+    const char *baked; /* --baked CH, "none", or NULL (auto: _AO) */
     int format_given; /* else the format comes from the file name */
     int cpu, debug_gl;
     long max_size;
@@ -206,6 +211,10 @@ static void parse_ao(int argc, char **argv, ao_args *a)
              * and the rest are this process's. */
         } else if ((v = opt_value(argc, argv, &i, "camera"))) {
             a->camera = v;
+        } else if ((v = opt_value(argc, argv, &i, "baked"))) {
+            if (!*v)
+                die_usage("--baked: an empty channel name (give CH, or none)");
+            a->baked = v;
         } else if ((v = opt_value(argc, argv, &i, "max-size"))) {
             a->max_size = strtol(v, NULL, 10);
             if (a->max_size < 1 || a->max_size > 1 << 20)
@@ -313,8 +322,8 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
         return s;
     }
     /* PNG: one file per output; NAME.ao.png, NAME.composite.png,
-     * NAME.samples.png, NAME.cull.png, NAME.bleed.png, NAME.luminance.png
-     * when there are several */
+     * NAME.samples.png, NAME.cull.png, NAME.bleed.png, NAME.luminance.png,
+     * NAME.screen.png, NAME.baked.png when there are several */
     const struct {
         const obs_image *img;
         const char *suffix;
@@ -324,9 +333,11 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
                  {&r->sample_count, "samples", 0},
                  {&r->cull_mask, "cull", 0},
                  {&r->bleed, "bleed", 1},
-                 {&r->luminance, "luminance", 0}};
+                 {&r->luminance, "luminance", 0},
+                 {&r->ao_screen, "screen", 0},
+                 {&r->ao_baked, "baked", 0}};
     int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data + !!r->cull_mask.data +
-                !!r->bleed.data + !!r->luminance.data;
+                !!r->bleed.data + !!r->luminance.data + !!r->ao_screen.data + !!r->ao_baked.data;
     for (size_t k = 0; k < sizeof files / sizeof files[0] && s == OBS_OK; k++) {
         char path[4096];
         obs_image scaled = {0};
@@ -511,6 +522,7 @@ static int cmd_ao(int argc, char **argv)
     char err[OBS_ERR_LEN] = "";
     obs_gbuffer_file gf = {0};
     obs_result res = {0};
+    obs_image baked = {0};
     obs_ctx *ctx = NULL;
     obs_status s;
     int rc = EXIT_OK;
@@ -523,8 +535,12 @@ static int cmd_ao(int argc, char **argv)
         lim.max_width = lim.max_height = (int)a.max_size;
 
     int deep = 0;
-    if (obs_exr_is_deep(a.in, &deep, err) == OBS_OK && deep)
+    if (obs_exr_is_deep(a.in, &deep, err) == OBS_OK && deep) {
+        if (a.baked && strcmp(a.baked, "none") != 0)
+            die_usage("ao: --baked: the input is a deep EXR; a baked channel is combined with "
+                      "flat input only");
         return cmd_ao_deep(&a, &lim, server, argc, argv);
+    }
     double t0 = now_ms();
     s = obs_gbuffer_read_exr(a.in, &a.req.map, &lim, &gf, err);
     if (s != OBS_OK)
@@ -566,12 +582,31 @@ static int cmd_ao(int argc, char **argv)
     obs_gbuffer_sanity(&gf.gb, &a.req.params, &gf.info);
     if ((rc = cli_input_warnings(a.in, &gf.info, a.req.strict)) != EXIT_OK)
         goto done;
+    /* The baked channel: --baked CH, else _AO when the input has it. */
+    const char *bch = a.baked ? a.baked : "_AO";
+    if (strcmp(bch, "none") != 0) {
+        s = obs_exr_read_channel(a.in, bch, &lim, &baked, err);
+        if (s == OBS_MISSING_CHANNEL && !a.baked) {
+            bch = "none"; /* auto: not a baked level's G-buffer */
+        } else if (s != OBS_OK) {
+            rc = cli_input_fail(s, a.in, err);
+            goto done;
+        } else if (baked.width != gf.gb.width || baked.height != gf.gb.height) {
+            snprintf(err, OBS_ERR_LEN, "--baked %s is %dx%d, the G-buffer %dx%d", bch,
+                     baked.width, baked.height, gf.gb.width, gf.gb.height);
+            rc = cli_input_fail(OBS_INVALID_ARGUMENT, a.in, err);
+            goto done;
+        }
+    }
+    unsigned outputs = a.req.outputs;
+    if (baked.data)
+        outputs |= OBS_OUTPUT_AO; /* the combination needs the chain's AO */
 
     t0 = now_ms();
     if (a.cpu) {
-        s = obs_run_cpu(&gf.gb, &a.req.params, a.req.outputs, &res, err);
+        s = obs_run_cpu(&gf.gb, &a.req.params, outputs, &res, err);
     } else if (server) { /* clients/remote.c prints its own errors */
-        if ((rc = cli_remote_run(server, argc, argv, a.in, &gf.gb, a.req.outputs, &res)) != EXIT_OK)
+        if ((rc = cli_remote_run(server, argc, argv, a.in, &gf.gb, outputs, &res)) != EXIT_OK)
             goto done;
     } else {
         obs_ctx_desc desc = {.debug = a.debug_gl, .log = log_cb, .cache_dir = cache_dir_of(a.cache_dir)};
@@ -584,12 +619,22 @@ static int cmd_ao(int argc, char **argv)
         if (verbosity >= OBS_LOG_DEBUG)
             fprintf(stderr, "obscura: debug: context created in %.1f ms\n", now_ms() - t0);
         t0 = now_ms();
-        s = obs_run(ctx, &gf.gb, &a.req.params, a.req.outputs, &res, err);
+        s = obs_run(ctx, &gf.gb, &a.req.params, outputs, &res, err);
         log_programs(ctx);
     }
     if (s != OBS_OK) {
         rc = cli_fail(s, a.in, err);
         goto done;
+    }
+    if (baked.data && (s = obs_result_combine_baked(&res, &baked, &a.req.params, err)) != OBS_OK) {
+        rc = cli_fail(s, a.in, err);
+        goto done;
+    }
+    if (baked.data && verbosity >= OBS_LOG_INFO) {
+        obs_params bp;
+        obs_params_resolve(&a.req.params, &bp);
+        fprintf(stderr, "obscura: info: baked channel %s combined (%s): AO.Y, AOScreen.Y, "
+                        "AOBaked.Y\n", bch, bp.baked_combine == OBS_BAKED_MIN ? "min" : "product");
     }
     double t_run = now_ms() - t0;
 
@@ -624,6 +669,7 @@ static int cmd_ao(int argc, char **argv)
     }
 
 done:
+    obs_image_free(&baked);
     obs_result_free(&res);
     if (keep_ctx)
         kept_ctx = ctx;

@@ -58,6 +58,8 @@ void obs_result_free(obs_result *r)
     obs_image_free(&r->cull_mask);
     obs_image_free(&r->luminance);
     obs_image_free(&r->bleed);
+    obs_image_free(&r->ao_screen);
+    obs_image_free(&r->ao_baked);
 }
 
 void obs_deep_result_free(obs_deep_result *r)

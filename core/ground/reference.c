@@ -342,13 +342,20 @@ static void *worker(void *arg)
             pcg32_seed(&rng, j->desc.seed, i);
             if (j->desc.obscurance) {
                 /* eq 1 around the normal facing the viewer; opaque */
-                float *o = j->ao + 3 * i, v[2] = {1.0f, 1.0f};
+                const int near = j->desc.obscurance_near > 0.0f;
+                float *o = j->ao + (near ? 5 : 3) * i, v[2] = {1.0f, 1.0f}, a = 1.0f;
                 int hit = surface_point(j, &ictx, x, y, p, n, ng);
                 if (hit)
                     obs__obscurance_at(j->rtc, &ictx, &j->ob, i, p, ng, v);
+                if (hit && near)
+                    a = ao_at(j, &ictx, &rng, p, n, ng); /* desc.distance is the near one */
                 o[0] = j->desc.blend * v[0] + (1.0f - j->desc.blend) * v[1];
                 o[1] = v[0];
                 o[2] = v[1];
+                if (near) {
+                    o[3] = a;
+                    o[4] = a * v[1];
+                }
                 if (j->depth)
                     j->depth[i] = hit ? planar_depth(j, p) : OBS_SKY_DEPTH;
                 continue;
@@ -442,6 +449,11 @@ static obs_status check_args(const obs_scene *scene, const obs_reference_view *v
         if (!(d->blend >= 0.0f && d->blend <= 1.0f))
             return obs__fail(err, OBS_INVALID_ARGUMENT, "blend %g: expected 0 to 1",
                              (double)d->blend);
+        if (!(d->obscurance_near >= 0.0f) || !isfinite(d->obscurance_near))
+            return obs__fail(err, OBS_INVALID_ARGUMENT,
+                             "near distance %g: expected a positive length (0: none)",
+                             (double)d->obscurance_near);
+        d->distance = d->obscurance_near; /* ao_at's */
     } else if (!(d->distance > 0.0f) || !isfinite(d->distance))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "distance %g: expected a positive length",
                          (double)d->distance);
@@ -499,7 +511,7 @@ obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view
 
     job *j = calloc(1, sizeof *j);
     size_t px = (size_t)w * (size_t)h;
-    const int ao_channels = d.obscurance ? 3 : 1;
+    const int ao_channels = !d.obscurance ? 1 : d.obscurance_near > 0.0f ? 5 : 3;
     if (!j || !(ao->data = malloc(px * ao_channels * sizeof(float))) ||
         (depth && !(depth->data = malloc(px * sizeof(float))))) {
         s = obs__fail(err, OBS_NO_MEMORY, "reference image of %dx%d", w, h);

@@ -42,6 +42,7 @@ int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_L
     static const char *const cull[] = {"Cull.Y"};
     static const char *const bleed[] = {"Bleed.R", "Bleed.G", "Bleed.B"};
     static const char *const lum[] = {"Luminance.Y"};
+    static const char *const screen[] = {"AOScreen.Y"}, *const baked[] = {"AOBaked.Y"};
     int n = 0;
     if (r->ao.data)
         layers[n++] = (obs_exr_layer){&r->ao, ao};
@@ -55,5 +56,9 @@ int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_L
         layers[n++] = (obs_exr_layer){&r->bleed, bleed};
     if (r->luminance.data)
         layers[n++] = (obs_exr_layer){&r->luminance, lum};
+    if (r->ao_screen.data)
+        layers[n++] = (obs_exr_layer){&r->ao_screen, screen};
+    if (r->ao_baked.data)
+        layers[n++] = (obs_exr_layer){&r->ao_baked, baked};
     return n;
 }

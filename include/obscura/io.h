@@ -164,9 +164,11 @@ typedef struct obs_exr_layer {
 
 /* The layers of a result under obscura's channel names, in this order:
  * AO.Y; R,G,B,A (composite); Samples.Y (sample count); Cull.Y (culling
- * mask); Bleed.R,G,B.  Fills `layers` with the images the result holds;
- * returns how many. */
-#define OBS_RESULT_LAYERS 6
+ * mask); Bleed.R,G,B; Luminance.Y; AOScreen.Y and AOBaked.Y (after
+ * obs_result_combine_baked: the chain's AO and the baked channel; AO.Y
+ * is then their combination).  Fills `layers` with the images the result
+ * holds; returns how many. */
+#define OBS_RESULT_LAYERS 8
 int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_LAYERS]);
 
 /* Writes a scanline EXR (ZIP compression) holding every layer's channels;

@@ -198,6 +198,9 @@ typedef struct obs_result {
     obs_image cull_mask;    /* filled when OBS_OUTPUT_CULL_MASK was asked */
     obs_image bleed;        /* filled when OBS_OUTPUT_BLEED was asked */
     obs_image luminance;    /* filled when OBS_OUTPUT_LUMINANCE was asked */
+    /* After obs_result_combine_baked: the chain's own AO (ao is then the
+     * combination) and the baked channel it was combined with. */
+    obs_image ao_screen, ao_baked;
 } obs_result;
 
 /* Runs the AO chain on the context's thread.  `params` may be NULL or
@@ -213,6 +216,19 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params,
                        unsigned outputs, obs_result *out, char err[OBS_ERR_LEN]);
 
 void obs_result_free(obs_result *r);
+
+/* Baked and screen-space AO in one frame: r->ao (the chain's, 1 channel)
+ * combined per pixel with `baked` (1 channel of the same size: a baked AO
+ * channel of the G-buffer, obscura gbuffer's _AO) by the parameter
+ * baked_combine: product b x s (default) or min(b, s).  Baked values are
+ * clamped to [0, 1]; a non-finite one counts as 1 (no baked value).
+ * Afterwards r->ao is the combination, r->ao_screen the chain's AO,
+ * r->ao_baked the baked values used, and the composite (when r has one)
+ * is the colour times the combination: its RGB scaled by combination /
+ * screen-space AO, as the composite is linear in the AO.  Fails with
+ * OBS_INVALID_ARGUMENT when r has no AO, or the sizes differ. */
+obs_status obs_result_combine_baked(obs_result *r, const obs_image *baked,
+                                    const obs_params *params, char err[OBS_ERR_LEN]);
 
 /* The work a frame asks for, in samples: width x height x the samples per
  * pixel of its method (vaopp, vao: samples; hemisphere:

@@ -152,6 +152,16 @@ typedef enum obs_deep_mode { OBS_DEEP_MODE_DEFAULT, OBS_DEEP_MODE_LIST(OBS__ENUM
     X(OBS_DEEP_THIN, thin)   /* OITAO eqs 2-4: thin hulls */
 typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM_VALUE) } obs_deep_hull;
 
+/* How `obscura ao --baked CH` combines a baked AO channel of the G-buffer
+ * with the chain's AO (parameter `baked_combine`; obs_result_combine_baked). */
+#define OBS_BAKED_COMBINE_LIST(X)                                              \
+    X(OBS_BAKED_PRODUCT, product) /* baked x screen-space */                   \
+    X(OBS_BAKED_MIN, min)         /* the darker of the two */
+typedef enum obs_baked_combine {
+    OBS_BAKED_COMBINE_DEFAULT,
+    OBS_BAKED_COMBINE_LIST(OBS__ENUM_VALUE)
+} obs_baked_combine;
+
 /* Every ENUM row of the table and its list, for the test that walks them
  * (tests/unit/core/test_params.c).  X(parameter, LIST) */
 #define OBS_PARAM_ENUMS(X)                                                     \
@@ -172,7 +182,8 @@ typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM
     X(gtao_heuristics, OBS_SWITCH_LIST)                                        \
     X(deep_mode, OBS_DEEP_MODE_LIST)                                           \
     X(deep_front_half, OBS_SWITCH_LIST)                                        \
-    X(deep_hull, OBS_DEEP_HULL_LIST)
+    X(deep_hull, OBS_DEEP_HULL_LIST)                                           \
+    X(baked_combine, OBS_BAKED_COMBINE_LIST)
 
 /* X(name, type, default, min, max, choices, doc)
  * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4.
@@ -384,7 +395,14 @@ typedef enum obs_deep_hull { OBS_DEEP_HULL_DEFAULT, OBS_DEEP_HULL_LIST(OBS__ENUM
       "deep input: transparent surfaces as solid volumes (OITAO eq 1: "        \
       "occluders and receivers weighted by alpha) or thin hulls (eqs 2-4: "    \
       "exterior and interior AO mixed by W(p), alpha or 1 - alpha on back "    \
-      "faces)")
+      "faces)")                                                                \
+    X(baked_combine, ENUM, "product", 0, 0, OBS_CHOICES(OBS_BAKED_COMBINE_LIST), \
+      "obscura ao --baked CH: how the G-buffer's baked AO channel (obscura "   \
+      "bake's _AO, rasterised by obscura gbuffer) is combined with the "       \
+      "chain's AO: product (two visibility factors of separate scales, the "   \
+      "baked distant obscurance times the screen-space detail) or min (the "   \
+      "darker of the two: an occluder both see darkens once); the daemon "     \
+      "takes no baked channel yet")
 
 #define OBS__PDECL_FLOAT(n) float n;
 #define OBS__PDECL_INT(n) int n;

@@ -36,7 +36,11 @@
  * points), the bake's own kernel, ray lattice and random shifts
  * (core/bake/kernel.h).  Every surface is opaque, as the bake traces it:
  * opacities are not used.  The image has three channels: the blend
- * b AO_short + (1 - b) AO_long, AO_short, AO_long. */
+ * b AO_short + (1 - b) AO_long, AO_short, AO_long.  With obscurance_near
+ * D > 0, two more: AO_near, the AO of the definition above with distance
+ * D at the same point (what a screen-space method of radius D estimates),
+ * and AO_near x AO_long, the reference of both scales for the baked long
+ * distance times screen-space AO (obs_result_combine_baked). */
 #ifndef OBSCURA_REFERENCE_H
 #define OBSCURA_REFERENCE_H
 
@@ -64,6 +68,7 @@ typedef struct obs_reference_desc {
     int obscurance;
     float obscurance_distance[2]; /* short, long (> 0) */
     float blend;                  /* weight of the short one, in [0, 1] */
+    float obscurance_near;        /* > 0: the AO at this distance too */
 } obs_reference_desc;
 
 /* Where the AO is evaluated: the first hit of a primary ray from the
@@ -80,7 +85,8 @@ typedef struct obs_reference_view {
 } obs_reference_view;
 
 /* The AO estimate (1 channel, 1 = unoccluded, 1 where nothing is hit;
- * obscurance mode: 3 channels, blend, short, long, all 1 there) and, when depth is non-NULL, the planar view depth of the points (the
+ * obscurance mode: 3 channels, blend, short, long, or 5 with near, near x
+ * long; all 1 there) and, when depth is non-NULL, the planar view depth of the points (the
  * front layer's with opacities; OBS_SKY_DEPTH where there is none).  Caller frees both with
  * obs_image_free(). */
 obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view *view,

@@ -84,6 +84,37 @@ expect 0 "_AO_SHORT against _AO_LONG" -- "$OBSCURA" compare "$T/g.exr" "$T/g.exr
 b2=$(json bias)
 check "bias(_AO - long) $b1 = 0.03 bias(short - long) $b2" \
     "awk 'BEGIN { d = $b1 - 0.03 * $b2; exit !(d < 1e-5 && d > -1e-5 && ($b2 > 0.005 || $b2 < -0.005)) }'"
+echo "-- obscura ao with the baked channel (screen-space x baked)"
+expect 0 "ao on the baked G-buffer: _AO found by name" -- "$OBSCURA" ao "$T/g.exr" -o "$T/c.exr" --radius 2
+said "baked channel _AO combined (product)"
+expect 0 "AO.Y (product) against AOScreen.Y" -- "$OBSCURA" compare "$T/c.exr" "$T/c.exr" \
+    --channel-a AOScreen.Y --channel-b AO.Y --json
+b1=$(json bias)
+check "the product is darker than the chain's AO: bias $b1 < 0" "awk 'BEGIN { exit !($b1 < 0) }'"
+expect 0 "AOBaked.Y is the G-buffer's _AO" -- "$OBSCURA" compare "$T/g.exr" "$T/c.exr" \
+    --channel-a _AO --channel-b AOBaked.Y --json
+m=$(json mse)
+check "AOBaked.Y = _AO: MSE $m < 1e-6 (half floats)" "awk 'BEGIN { exit !($m < 1e-6) }'"
+expect 0 "--baked _AO_LONG --baked-combine min" -- "$OBSCURA" ao "$T/g.exr" -o "$T/cmin.exr" \
+    --radius 2 --baked _AO_LONG --baked-combine min
+expect 0 "--baked _AO_LONG (product)" -- "$OBSCURA" ao "$T/g.exr" -o "$T/cprod.exr" \
+    --radius 2 --baked _AO_LONG
+expect 0 "min against product" -- "$OBSCURA" compare "$T/cprod.exr" "$T/cmin.exr" --json
+b2=$(json bias)
+check "min(s, b) >= s b: bias $b2 > 0" "awk 'BEGIN { exit !($b2 > 0) }'"
+expect 0 "--baked none: the chain's AO alone" -- "$OBSCURA" ao "$T/g.exr" -o "$T/cnone.exr" \
+    --radius 2 --baked none
+expect 3 "... so no AOBaked.Y" -- "$OBSCURA" compare "$T/cnone.exr" "$T/cnone.exr" \
+    --channel-a AOBaked.Y --channel-b AO.Y
+expect 0 "--baked none equals AOScreen.Y" -- "$OBSCURA" compare "$T/cnone.exr" "$T/c.exr" \
+    --channel-b AOScreen.Y --json
+m=$(json mse)
+check "MSE $m = 0" "awk 'BEGIN { exit !($m == 0) }'"
+expect 3 "--baked naming no channel" -- "$OBSCURA" ao "$T/g.exr" -o "$T/x.exr" --baked _AO_MID
+said "channel '_AO_MID' not found"
+expect 2 "--baked-combine of no kind" -- "$OBSCURA" ao "$T/g.exr" -o "$T/x.exr" --baked-combine sum
+said "product|min"
+
 expect 0 "gbuffer of the level itself (assimp)" -- "$OBSCURA" gbuffer "$FIX" \
     --camera "$T/cam0.json" -o "$T/g_level.exr" -q
 for ch in N.Y N.X P.Y; do

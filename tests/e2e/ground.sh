@@ -89,6 +89,17 @@ check "AO.Y = 0.25 short + 0.75 long: bias $b2 = 0.75 x $bias" \
     "awk 'BEGIN { d = $b2 - 0.75 * $bias; exit !(d < 1e-4 && d > -1e-4) }'"
 expect 0 "reference --obscurance as PNG (the blend)" -- "$OBSCURA" reference "$T/corner.obj" \
     --camera "$C" -o "$T/obs.png" --obscurance 2,300 --spp 4 -q
+expect 0 "reference --obscurance --near 0.5 (both scales)" -- "$OBSCURA" reference "$T/corner.obj" \
+    --camera "$C" -o "$T/obs5.exr" --obscurance 0.5,4 --near 0.5 --spp 16 -q
+expect 0 "AO_BOTH against AO_NEAR" -- "$OBSCURA" compare "$T/obs5.exr" "$T/obs5.exr" \
+    --channel-a AO_NEAR.Y --channel-b AO_BOTH.Y --json
+b3=$(json bias)
+check "AO_BOTH = AO_NEAR x AO_LONG is darker: bias $b3 < 0" "awk 'BEGIN { exit !($b3 < 0) }'"
+expect 2 "--near without --obscurance" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" \
+    -o "$T/x.exr" --near 0.5
+said "needs --obscurance"
+expect 2 "--near 0" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" \
+    -o "$T/x.exr" --obscurance 2,300 --near 0
 for bad_list in 2 2,3,4 ,3 2, a,b 0,300 2,-1; do
     expect 2 "--obscurance '$bad_list'" -- "$OBSCURA" reference "$T/corner.obj" --camera "$C" \
         -o "$T/x.exr" --obscurance "$bad_list"

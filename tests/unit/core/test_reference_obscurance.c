@@ -135,6 +135,55 @@ static void test_crease(void **state)
     obs_scene_free(&s);
 }
 
+/* With a near distance D: AO_NEAR is the reference's AO at D (a crease's
+ * closed form: a floor point x from the wall is blocked where the disk
+ * point's component towards the wall exceeds x / D, O = (acos a -
+ * a sqrt(1 - a^2)) / pi, a = x / D; reference.c's ray estimator, binomial
+ * within 4 standard errors) and AO_BOTH = AO_NEAR x AO_LONG exactly. */
+static void test_near(void **state)
+{
+    (void)state;
+    const float crease[2][4][3] = {{{-6, -6, 0}, {0, -6, 0}, {0, 6, 0}, {-6, 6, 0}},
+                                   {{0, -6, 0}, {0, -6, 6}, {0, 6, 6}, {0, 6, 0}}};
+    enum { N = 5 };
+    const float xs[N] = {0.02f, 0.1f, 0.25f, 0.4f, 0.7f}, D = 0.5f;
+    const int spp = 4096;
+    obs_scene s;
+    obs_camera cam;
+    char err[OBS_ERR_LEN] = "";
+    quads(&s, crease, 2);
+    top_camera(&cam, 1.0f);
+    obs_image pos = {N, 1, 3, calloc(3 * N, sizeof(float))};
+    obs_image nrm = {N, 1, 3, calloc(3 * N, sizeof(float))};
+    obs_image ao = {0};
+    for (int i = 0; i < N; i++) {
+        pos.data[3 * i] = -xs[i] * D;
+        nrm.data[3 * i + 2] = 1.0f;
+    }
+    obs_reference_view v = {.camera = &cam, .position = &pos, .normal = &nrm};
+    obs_reference_desc d = obscurance(0.25f, 3.0f, 0.1f, spp);
+    d.obscurance_near = D;
+    assert_int_equal(obs_reference_render(&s, &v, &d, &ao, NULL, err), OBS_OK);
+    assert_int_equal(ao.channels, 5);
+    for (int i = 0; i < N; i++) {
+        const float *o = ao.data + 5 * i;
+        double a = xs[i], exact = 1.0 - (acos(a) - a * sqrt(1 - a * a)) / 3.14159265358979;
+        double tol = 4.0 * sqrt(exact * (1.0 - exact) / spp) + 2e-3;
+        print_message("near AO at x/D = %.2f: %.4f, closed form %.4f\n", a, (double)o[3], exact);
+        assert_true(fabs(o[3] - exact) < tol);
+        assert_float_equal(o[4], o[3] * o[2], 1e-6f);
+        assert_true(o[2] < 1.0f); /* the long distance sees the wall too */
+    }
+    d.obscurance_near = -1.0f;
+    obs_image bad = {0};
+    assert_int_equal(obs_reference_render(&s, &v, &d, &bad, NULL, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "near"));
+    obs_image_free(&ao);
+    obs_image_free(&pos);
+    obs_image_free(&nrm);
+    obs_scene_free(&s);
+}
+
 /* The image depends on the seed, not on the thread count. */
 static void test_deterministic(void **state)
 {
@@ -192,6 +241,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plane_is_one),
         cmocka_unit_test(test_crease),
+        cmocka_unit_test(test_near),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_errors),
     };
