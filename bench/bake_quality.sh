@@ -13,12 +13,20 @@
 # share of every MSE.  Prints a markdown table; files in out/bake_quality/;
 # with QSTRIP (build/quality_strip) a strip per level in bench/quality/
 # (rows: cameras; columns: reference, alpha 1, alpha 0, face mean, point).
+# Second table, baked and screen-space AO in one frame: the reference of
+# both scales (reference --near NEAR: AO_BOTH.Y = the AO within NEAR x eq 1
+# at the long distance) against the alpha-1 bake's _AO_LONG alone, the
+# chain's AO at --radius NEAR alone, and the two combined (obscura ao
+# --baked _AO_LONG, product and min); its strip bench/quality/
+# bake_combined_LEVEL.png (columns: AO_BOTH.Y, baked, screen-space,
+# product, min).
 #
 #   bench/bake_quality.sh        (OBSCURA: the CLI; OBSCURA_SHARED_DATA)
 # Sizes (environment): LEVELS (default "aalborg polynesia"; also forza,
 # tiber), RAYS (bake rays per sample, 64), SPF (bake samples per face, 4),
 # SPP (reference rays per pixel, 64), CAMS (cameras per level, 3), WIDTH
-# and HEIGHT (256 x 192), DISTANCES (2,300), BLEND (0.03).
+# and HEIGHT (256 x 192), DISTANCES (2,300), BLEND (0.03), NEAR (2: the
+# screen-space AO's distance).
 set -eu
 OBSCURA=${OBSCURA:-build/obscura}
 DATA=${OBSCURA_SHARED_DATA:-../shared/data}/levels
@@ -31,6 +39,7 @@ WIDTH=${WIDTH:-256}
 HEIGHT=${HEIGHT:-192}
 DISTANCES=${DISTANCES:-2,300}
 BLEND=${BLEND:-0.03}
+NEAR=${NEAR:-2}
 QSTRIP=${QSTRIP:-}
 VARIANTS="fit fit_alpha0 face_mean point"
 if [ ! -d "$DATA" ]; then
@@ -40,7 +49,9 @@ fi
 O=out/bake_quality
 mkdir -p "$O"
 rows="$O/rows.txt"
+both="$O/both.txt"
 : >"$rows"
+: >"$both"
 
 path_of() {
     case $1 in
@@ -76,6 +87,7 @@ for name in $LEVELS; do
             --distances "$DISTANCES" --blend "$BLEND" $opt --report "$O/${name}_$v.json" -q
     done
     tiles=""
+    tiles2=""
     python3 tools/level_cameras.py "$O/${name}_fit.glb" "$O" "$CAMS" "$WIDTH" "$HEIGHT" >/dev/null
     i=0
     while [ "$i" -lt "$CAMS" ]; do
@@ -84,7 +96,7 @@ for name in $LEVELS; do
         echo "bake quality: $name camera $i: reference" >&2
         ref="$O/${name}_ref$i.exr"
         "$OBSCURA" reference "$O/${name}_fit.glb" --camera "$cam" -o "$ref" --obscurance "$DISTANCES" \
-            --blend "$BLEND" --spp "$SPP" --seed 1 -q
+            --blend "$BLEND" --near "$NEAR" --spp "$SPP" --seed 1 -q
         if [ "$i" -eq 0 ]; then
             "$OBSCURA" reference "$O/${name}_fit.glb" --camera "$cam" -o "$O/${name}_ref0b.exr" \
                 --obscurance "$DISTANCES" --blend "$BLEND" --spp "$SPP" --seed 2 -q
@@ -102,16 +114,32 @@ for name in $LEVELS; do
                    $(metrics "$ref" "$g" AO_LONG.Y _AO_LONG)
             echo "$name $v $i $1 $2 $4 $5 $7 $8 $3" >>"$rows"
         done
+        # baked and screen-space AO in one frame, on the alpha-1 G-buffer
+        g="$O/${name}_fit_g$i.exr"
+        "$OBSCURA" ao "$g" -o "$O/${name}_prod$i.exr" --radius "$NEAR" --baked _AO_LONG --float -q
+        "$OBSCURA" ao "$g" -o "$O/${name}_min$i.exr" --radius "$NEAR" --baked _AO_LONG \
+            --baked-combine min --float -q
+        for what in baked:prod:AOBaked.Y screen:prod:AOScreen.Y product:prod:AO.Y min:min:AO.Y; do
+            label=${what%%:*}; rest=${what#*:}; file=${rest%%:*}; ch=${rest#*:}
+            set -- $(metrics "$ref" "$O/${name}_$file$i.exr" AO_BOTH.Y "$ch")
+            echo "$name $label $i $1 $2 $3" >>"$both"
+        done
+        tiles2="$tiles2 --grey $ref AO_BOTH.Y --grey $O/${name}_prod$i.exr AOBaked.Y"
+        tiles2="$tiles2 --grey $O/${name}_prod$i.exr AOScreen.Y --grey $O/${name}_prod$i.exr AO.Y"
+        tiles2="$tiles2 --grey $O/${name}_min$i.exr AO.Y"
+        set -- $(metrics "$ref" "$O/${name}_prod$i.exr" AO_NEAR.Y AOScreen.Y)
+        echo "$name screen_vs_near $i $1 $2 $3" >>"$both"
         i=$((i + 1))
     done
     if [ -n "$QSTRIP" ] && [ -x "$QSTRIP" ]; then
         mkdir -p bench/quality
         "$QSTRIP" "bench/quality/bake_$name.png" --scale 2 --cols 5 $tiles
-        echo "bake quality: wrote bench/quality/bake_$name.png" >&2
+        "$QSTRIP" "bench/quality/bake_combined_$name.png" --scale 2 --cols 5 $tiles2
+        echo "bake quality: wrote bench/quality/bake_$name.png, bake_combined_$name.png" >&2
     fi
 done
 
-python3 - "$rows" <<'PY'
+python3 - "$rows" "$both" "$NEAR" <<'PY'
 import sys
 rows = [l.split() for l in open(sys.argv[1]) if l.strip()]
 names = {"fit": "least squares (alpha 1)", "fit_alpha0": "least squares (alpha 0)",
@@ -137,4 +165,23 @@ for lv in levels:
 print()
 print("Per camera (_AO MSE): " + "; ".join(
     "%s cam %s %s %.5f" % (r[0], r[2], r[1], float(r[3])) for r in rows if r[1] != "noise"))
+both = [l.split() for l in open(sys.argv[2]) if l.strip()]
+near = sys.argv[3]
+labels = {"baked": "baked _AO_LONG alone", "screen": "screen-space alone (--radius %s)" % near,
+          "product": "product (--baked _AO_LONG)", "min": "min (--baked-combine min)",
+          "screen_vs_near": "screen-space against AO_NEAR.Y (its own reference)"}
+print()
+print("| level | against AO_BOTH.Y (AO within %s x eq 1 at the long distance) | cameras | pixels | MSE | SSIM |" % near)
+print("| --- | --- | --- | --- | --- | --- |")
+for lv in levels:
+    for k in ("baked", "screen", "product", "min", "screen_vs_near"):
+        sel = [r for r in both if r[0] == lv and r[1] == k]
+        if not sel:
+            continue
+        print("| %s | %s | %d | %d | %.5f | %.4f |" % (
+            lv, labels[k], len(sel), sum(int(float(r[5])) for r in sel),
+            sum(float(r[3]) for r in sel) / len(sel), sum(float(r[4]) for r in sel) / len(sel)))
+print()
+print("Per camera (MSE against AO_BOTH.Y): " + "; ".join(
+    "%s cam %s %s %.5f" % (r[0], r[2], r[1], float(r[3])) for r in both if r[1] != "screen_vs_near"))
 PY
