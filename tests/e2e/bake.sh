@@ -3,7 +3,8 @@
 # baked to .glb and PLY with a report, the .glb checked chunk by chunk
 # (tests/e2e/lib/glb_check.py) and read back through assimp (baked
 # again), `obscura gbuffer` of the .glb (the baked channels, against the
-# level's own G-buffer and the obscurance reference), the same bytes for 1 and 2 threads, the Khronos validator when
+# level's own G-buffer and the obscurance reference), `obscura ao` with
+# the baked channel (--baked, --baked-combine), the same bytes for 1 and 2 threads, the Khronos validator when
 # it is installed, clear errors for bad input and usage; a TORCS track of
 # ../shared/data when present.
 #
