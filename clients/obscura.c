@@ -586,17 +586,23 @@ static int cmd_ao(int argc, char **argv)
     const char *bch = a.baked ? a.baked : "_AO";
     if (strcmp(bch, "none") != 0) {
         s = obs_exr_read_channel(a.in, bch, &lim, &baked, err);
-        if (s == OBS_MISSING_CHANNEL && !a.baked) {
-            bch = "none"; /* auto: not a baked level's G-buffer */
-        } else if (s != OBS_OK) {
+        if (s == OBS_OK && (baked.width != gf.gb.width || baked.height != gf.gb.height)) {
+            snprintf(err, OBS_ERR_LEN, "baked channel %s is %dx%d, the G-buffer %dx%d", bch,
+                     baked.width, baked.height, gf.gb.width, gf.gb.height);
+            obs_image_free(&baked);
+            s = OBS_INVALID_ARGUMENT;
+        }
+        if (s != OBS_OK && a.baked) {
             rc = cli_input_fail(s, a.in, err);
             goto done;
-        } else if (baked.width != gf.gb.width || baked.height != gf.gb.height) {
-            snprintf(err, OBS_ERR_LEN, "--baked %s is %dx%d, the G-buffer %dx%d", bch,
-                     baked.width, baked.height, gf.gb.width, gf.gb.height);
-            rc = cli_input_fail(OBS_INVALID_ARGUMENT, a.in, err);
-            goto done;
         }
+        if (s != OBS_OK && s != OBS_MISSING_CHANNEL) /* auto: said, and left out */
+            fprintf(stderr, "obscura: warning: %s: %s; the AO is not combined with it (--baked "
+                            "none: not looked for)\n", a.in, err);
+        if (s != OBS_OK)
+            bch = "none"; /* auto: not a baked level's G-buffer */
+        s = OBS_OK;
+        err[0] = '\0';
     }
     unsigned outputs = a.req.outputs;
     if (baked.data)

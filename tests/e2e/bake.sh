@@ -111,6 +111,20 @@ expect 0 "--baked none equals AOScreen.Y" -- "$OBSCURA" compare "$T/cnone.exr" "
     --channel-b AOScreen.Y --json
 m=$(json mse)
 check "MSE $m = 0" "awk 'BEGIN { exit !($m == 0) }'"
+if [ -x "${OBSCURAD:-build/obscurad}" ]; then
+    OBSCURAD=${OBSCURAD:-build/obscurad}
+    start D --socket "$T/d.sock"
+    expect 0 "ao --server with the baked channel (combined here)" -- "$OBSCURA" ao "$T/g.exr" \
+        -o "$T/cr.exr" --radius 2 --server "unix:$T/d.sock"
+    expect 0 "the remote combination against the in-process one" -- "$OBSCURA" compare \
+        "$T/c.exr" "$T/cr.exr" --json
+    m=$(json mse)
+    check "remote = in process: MSE $m < 1e-6" "awk 'BEGIN { exit !($m < 1e-6) }'"
+    expect 0 "... AOBaked.Y there too" -- "$OBSCURA" compare "$T/c.exr" "$T/cr.exr" \
+        --channel-a AOBaked.Y --channel-b AOBaked.Y
+else
+    echo "  skip ao --server: no obscurad built"
+fi
 expect 3 "--baked naming no channel" -- "$OBSCURA" ao "$T/g.exr" -o "$T/x.exr" --baked _AO_MID
 said "channel '_AO_MID' not found"
 expect 2 "--baked-combine of no kind" -- "$OBSCURA" ao "$T/g.exr" -o "$T/x.exr" --baked-combine sum
