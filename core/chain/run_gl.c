@@ -74,8 +74,11 @@ static obs_status build_finish_program(obs_ctx *ctx, int rays, int lum, char err
 
 /* The prep pass that reads the normals or derives them from depth
  * (OBS_RECONSTRUCT), for the frame's depth mode (OBS_DEPTH_MODE: planar,
- * radial, ndc, inverse, normalized; resolved, never OBS_DEPTH_DEFAULT), built on its first use:
- * ctx->prog.prep[prep_index(f)]. */
+ * radial, ndc, inverse, normalized; resolved, never OBS_DEPTH_DEFAULT), at
+ * full size or, for ao_resolution half, straight to the half planes
+ * (OBS_HALF), built on its first use: ctx->prog.prep[half][prep_index(f)].
+ * The same defines select ao_resolution half's upsample, which derives its
+ * own pixel's depth and normal with prep.glsl. */
 static int prep_index(const obs__frame *f)
 {
     int mode = f->depth_mode >= OBS_DEPTH_PLANAR && f->depth_mode <= OBS_DEPTH_NORMALIZED
@@ -84,17 +87,26 @@ static int prep_index(const obs__frame *f)
     return OBS__DEPTH_MODES * (f->reconstruct_normals != 0) + mode - OBS_DEPTH_PLANAR;
 }
 
+static void prep_defines(int k, char *defs, size_t size)
+{
+    snprintf(defs, size, "#define OBS_RECONSTRUCT %d\n#define OBS_DEPTH_MODE %d\n",
+             k / OBS__DEPTH_MODES, k % OBS__DEPTH_MODES + OBS_DEPTH_PLANAR);
+}
+
 static obs_status build_prep_program(obs_ctx *ctx, const obs__frame *f, char err[OBS_ERR_LEN])
 {
-    int k = prep_index(f);
-    if (ctx->prog.prep[k])
+    int k = prep_index(f), half = f->half != 0;
+    if (ctx->prog.prep[half][k])
         return OBS_OK;
     char defs[80];
-    snprintf(defs, sizeof defs, "#define OBS_RECONSTRUCT %d\n#define OBS_DEPTH_MODE %d\n",
-             k / OBS__DEPTH_MODES, k % OBS__DEPTH_MODES + OBS_DEPTH_PLANAR);
-    const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_prep_frag};
-    return obs__gl_program(k / OBS__DEPTH_MODES ? "prep (normals from depth)" : "prep",
-                           obs__shader_fullscreen_vert, src, 4, &ctx->prog.prep[k], err);
+    prep_defines(k, defs, sizeof defs);
+    const char *src[] = {glsl_version, defs, half ? "#define OBS_HALF 1\n" : "#define OBS_HALF 0\n",
+                         obs__shader_common, obs__shader_prep, obs__shader_prep_frag};
+    const char *name = half ? (k / OBS__DEPTH_MODES ? "prep to half size (normals from depth)"
+                                                    : "prep to half size")
+                            : (k / OBS__DEPTH_MODES ? "prep (normals from depth)" : "prep");
+    return obs__gl_program(name, obs__shader_fullscreen_vert, src, 6, &ctx->prog.prep[half][k],
+                           err);
 }
 
 /* The blur of half-width radius (section 4.6), built on its first use:
@@ -125,22 +137,19 @@ static obs_status build_method_program(obs_ctx *ctx, const obs__method *m, char 
                            err);
 }
 
-/* ao_resolution half's downsample and upsample (down.frag.glsl,
- * up.frag.glsl), built on their first use. */
-static obs_status build_half_programs(obs_ctx *ctx, int rays, char err[OBS_ERR_LEN])
+/* ao_resolution half's upsample (up.frag.glsl), built on its first use;
+ * the downsample is the prep pass's OBS_HALF variant. */
+static obs_status build_up_program(obs_ctx *ctx, const obs__frame *f, char err[OBS_ERR_LEN])
 {
-    obs_status s = OBS_OK;
-    if (!ctx->prog.down) {
-        const char *src[] = {glsl_version, obs__shader_common, obs__shader_down_frag};
-        s = obs__gl_program("downsample", obs__shader_fullscreen_vert, src, 3, &ctx->prog.down, err);
-    }
-    if (s == OBS_OK && !ctx->prog.up[rays]) {
-        const char *src[] = {glsl_version, rays ? "#define OBS_RAYS 1\n" : "#define OBS_RAYS 0\n",
-                             obs__shader_common, obs__shader_up_frag};
-        s = obs__gl_program("upsample", obs__shader_fullscreen_vert, src, 4, &ctx->prog.up[rays],
-                            err);
-    }
-    return s;
+    int k = prep_index(f), rays = f->rays != 0;
+    if (ctx->prog.up[rays][k])
+        return OBS_OK;
+    char defs[80];
+    prep_defines(k, defs, sizeof defs);
+    const char *src[] = {glsl_version, defs, rays ? "#define OBS_RAYS 1\n" : "#define OBS_RAYS 0\n",
+                         obs__shader_common, obs__shader_prep, obs__shader_up_frag};
+    return obs__gl_program("upsample", obs__shader_fullscreen_vert, src, 6, &ctx->prog.up[rays][k],
+                           err);
 }
 
 static GLuint make_texture(obs_ctx *ctx, obs__targets *set, GLenum format, int w, int h)
@@ -187,15 +196,14 @@ void obs__chain_release(obs__programs *g, obs__targets *t)
     memset(t, 0, sizeof *t);
     if (!g)
         return;
-    OBS__GL_DELETE_PROGRAMS(g->prep);
     OBS__GL_DELETE_PROGRAMS(g->vao);
     OBS__GL_DELETE_PROGRAMS(g->cull);
     obs__gl_delete_programs(&g->blur[0][0], sizeof g->blur / sizeof g->blur[0][0]);
     OBS__GL_DELETE_PROGRAMS(g->method);
     OBS__GL_DELETE_PROGRAMS(g->finish);
     obs__gl_delete_programs(&g->composite, 1);
-    obs__gl_delete_programs(&g->down, 1);
-    OBS__GL_DELETE_PROGRAMS(g->up);
+    obs__gl_delete_programs(&g->prep[0][0], sizeof g->prep / sizeof g->prep[0][0]);
+    obs__gl_delete_programs(&g->up[0][0], sizeof g->up / sizeof g->up[0][0]);
     memset(g, 0, sizeof *g);
 }
 
@@ -391,7 +399,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     if (s == OBS_OK && f.culling)
         s = build_vao_program(ctx, 1, ao_variant(&f), err);
     if (s == OBS_OK && f.half)
-        s = build_half_programs(ctx, f.rays, err);
+        s = build_up_program(ctx, &f, err);
     /* ao_definition rays converts the blurred AO: in the blur's vertical
      * pass, or in the finishing pass when there is no blur; at half
      * resolution in the upsample (which filters the linear estimate, as
@@ -433,24 +441,17 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         upload(t->tex_color, &gb->color, w, h, GL_RGBA);
     pass_end(ctx);
 
-    /* prep pass */
-    pass_begin(ctx, OBS_PASS_PREP, &ran);
-    GLuint prog = ctx->prog.prep[prep_index(&f)];
+    /* prep pass; ao_resolution half: straight to the half planes, one
+     * whole pixel of each 2x2 block (prep.frag.glsl, OBS_HALF), then the
+     * half frame's block for the passes at that size */
+    pass_begin(ctx, f.half ? OBS_PASS_DOWNSAMPLE : OBS_PASS_PREP, &ran);
+    GLuint prog = ctx->prog.prep[f.half != 0][prep_index(&f)];
     glUseProgram(prog);
     bind_img(prog, "u_depth", 0, t->tex_depth, GL_R32F);
     bind_img(prog, "u_normal", 1, t->tex_normal, GL_RGBA32F);
-    draw(ctx, t->fbo_prep, w, h);
+    draw(ctx, at->fbo_prep, aw, ah);
     pass_end(ctx);
-
-    /* ao_resolution half: one pixel of each 2x2 block (down.frag.glsl),
-     * then the half frame's block for the passes at that size */
     if (f.half) {
-        pass_begin(ctx, OBS_PASS_DOWNSAMPLE, &ran);
-        prog = ctx->prog.down;
-        glUseProgram(prog);
-        bind_prep_planes(prog, t);
-        draw(ctx, at->fbo_prep, aw, ah);
-        pass_end(ctx);
         s = obs__frame_block_bind(ctx, &hf, err);
         if (s != OBS_OK) {
             obs_result_free(out);
@@ -528,10 +529,10 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
             return s;
         }
         pass_begin(ctx, OBS_PASS_UPSAMPLE, &ran);
-        prog = ctx->prog.up[f.rays];
+        prog = ctx->prog.up[f.rays != 0][prep_index(&f)];
         glUseProgram(prog);
-        bind_img(prog, "u_dz", 0, t->tex_dz, GL_RG32F);
-        bind_img(prog, "u_vnormal", 1, t->tex_vnormal, GL_RGBA32F);
+        bind_img(prog, "u_depth", 0, t->tex_depth, GL_R32F);
+        bind_img(prog, "u_normal", 1, t->tex_normal, GL_RGBA32F);
         bind_img(prog, "u_hnormal", 3, at->tex_vnormal, GL_RGBA32F);
         bind_img(prog, "u_hao", 4, at->tex_ao, GL_RG32F);
         glUniform2i(glGetUniformLocation(prog, "u_half_size"), aw, ah);
