@@ -233,6 +233,7 @@ int cli_bake(int argc, char **argv)
         int takes = 1;
         if (!strcmp(key, "params") || !strcmp(key, "params-markdown")) {
             list_params(key[6] != '\0');
+            free(parts);
             return EXIT_OK;
         } else if (!strcmp(key, "color")) {
             color = 1, takes = 0;
@@ -298,8 +299,10 @@ int cli_bake(int argc, char **argv)
     double t0 = cli_now_s();
     obs_bake_scene sc;
     obs_status s = obs_bake_load(in, (size_t)p.max_triangles, &sc, err);
-    if (s != OBS_OK)
+    if (s != OBS_OK) {
+        free(parts);
         return cli_input_fail(s, in, err);
+    }
     double load_s = cli_now_s() - t0;
     progress pr = {cli_now_s(), 0.0};
     if (!quiet && isatty(2)) {

@@ -595,7 +595,7 @@ int obsd_bakes_subscribe(obsd_bakes *b, const char *id, obsd_bake_sub *s)
     int rc = !j ? -1 : b->ended ? -2 : 0;
     if (rc == 0) {
         s->job = j;
-        s->seen = 0;
+        s->seen = UINT64_MAX; /* its state is the first event */
         s->parked = s->ended = s->final_sent = s->keepalive = 0;
         s->next = j->subs;
         j->subs = s;
