@@ -89,6 +89,16 @@ expect 3 "a truncated part" -- "$OBSCURA" bake "$FIX" --merge "$T/part3.0.bin" "
 said "truncated: 1000 bytes"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$T/tri.obj"
 expect 0 "a shard of another level" -- "$OBSCURA" bake "$T/tri.obj" --shard 0/1 -o "$T/tri.bin" --rays 24 -q
+i=0; ok_shards=1
+while [ $i -lt 8 ]; do
+    "$OBSCURA" bake "$T/tri.obj" --shard $i/8 -o "$T/tri8.$i.bin" --rays 24 -q 2>"$T/err" || ok_shards=0
+    i=$((i + 1))
+done
+expect 0 "8 shards of a level of 4 samples (4 of them empty) merged" -- "$OBSCURA" bake "$T/tri.obj" \
+    --merge "$T"/tri8.*.bin -o "$T/tri8.glb" -q
+"$OBSCURA" bake "$T/tri.obj" -o "$T/tri1.glb" --rays 24 -q
+check "... = unsharded, the empty parts 128 bytes" \
+    "[ $ok_shards = 1 ] && cmp -s $T/tri1.glb $T/tri8.glb && [ \$(wc -c < $T/tri8.7.bin) = 137 ] && [ \$(wc -c < $T/tri8.0.bin) = 128 ]"
 expect 3 "a part of another level" -- "$OBSCURA" bake "$FIX" --merge "$T/tri.bin" -o "$T/x.glb" -q
 said "traced from another level"
 expect 3 "not a part" -- "$OBSCURA" bake "$FIX" --merge "$T/whole.json" -o "$T/x.glb" -q
