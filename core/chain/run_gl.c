@@ -217,37 +217,22 @@ static obs_status ensure_targets(obs_ctx *ctx, obs__targets *t, int w, int h, ch
         /* a new resolution: drop the old set, keep the programs */
         obs__chain_release(NULL, t);
     }
+    /* what every frame needs; the rest is made on a frame's first need
+     * of it (need_texture, need_planes) and kept with the set */
     t->tex_depth = make_texture(ctx, t, GL_R32F, w, h);
-    t->tex_normal = make_texture(ctx, t, GL_RGBA32F, w, h); /* read as an image: no RGB32F */
-    t->tex_color = make_texture(ctx, t, GL_RGBA32F, w, h);
-    t->tex_viewpos = make_texture(ctx, t, GL_RGBA32F, w, h);
-    t->tex_vnormal = make_texture(ctx, t, GL_RGBA32F, w, h);
-    t->tex_dz = make_texture(ctx, t, GL_RG32F, w, h);
     t->tex_ao = make_texture(ctx, t, GL_RG32F, w, h);     /* AO, depth (blur.frag.glsl) */
-    t->tex_composite = make_texture(ctx, t, GL_RGBA32F, w, h);
     t->tex_blur = make_texture(ctx, t, GL_RG32F, w, h);
-    t->tex_count = make_texture(ctx, t, GL_R32F, w, h);
-    t->tex_cullmask = make_texture(ctx, t, GL_R32F, w, h);
-    t->tex_bleed = make_texture(ctx, t, GL_RGBA32F, w, h);
-    t->tex_lumfactor = make_texture(ctx, t, GL_R32F, w, h);
     /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block; the AO
      * pass filters it itself (cull_candidate in vao.frag.glsl). */
     t->tex_cull = make_texture(ctx, t, GL_R32F, (w + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK,
                                (h + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK);
-    GLuint prep[] = {t->tex_viewpos, t->tex_vnormal, t->tex_dz};
-    GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask, t->tex_bleed};
-    GLuint blur[] = {t->tex_blur, t->tex_lumfactor};
-    obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 3, "prep", err);
-    if (s == OBS_OK)
-        s = make_fbo(ctx, &t->fbo_vao, vao, 4, "vao", err);
+    obs_status s = make_fbo(ctx, &t->fbo_vao, &t->tex_ao, 1, "vao", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_cull, &t->tex_cull, 1, "cull", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_ao, &t->tex_ao, 1, "ao", err);
     if (s == OBS_OK)
-        s = make_fbo(ctx, &t->fbo_blur, blur, 2, "blur", err);
-    if (s == OBS_OK)
-        s = make_fbo(ctx, &t->fbo_composite, &t->tex_composite, 1, "composite", err);
+        s = make_fbo(ctx, &t->fbo_blur, &t->tex_blur, 1, "blur", err);
     if (s == OBS_OK)
         s = obs__gl_check("allocating frame targets", err);
     if (s != OBS_OK) {
@@ -258,6 +243,66 @@ static obs_status ensure_targets(obs_ctx *ctx, obs__targets *t, int w, int h, ch
     t->height = h;
     obs__log(ctx, OBS_LOG_DEBUG, "allocated frame targets for %dx%d", w, h);
     return OBS_OK;
+}
+
+/* A texture of set t made on the first frame that needs it (the normals
+ * and colour, the debug outputs, the colour-bleed term), attached to fbo
+ * at attachment when fbo is not 0. */
+static obs_status need_texture(obs_ctx *ctx, obs__targets *t, GLuint *tex, GLenum format,
+                               GLuint fbo, GLenum attachment, char err[OBS_ERR_LEN])
+{
+    if (*tex)
+        return OBS_OK;
+    *tex = make_texture(ctx, t, format, t->width, t->height);
+    if (fbo) {
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, attachment, GL_TEXTURE_2D, *tex, 0);
+    }
+    return obs__gl_check("allocating a frame target", err);
+}
+
+/* The prep planes of set t and their framebuffer, made when a frame's
+ * prep pass first writes that size (not the full set of ao_resolution
+ * half, whose prep runs at half size). */
+static obs_status need_prep_planes(obs_ctx *ctx, obs__targets *t, char err[OBS_ERR_LEN])
+{
+    if (t->fbo_prep)
+        return OBS_OK;
+    t->tex_viewpos = make_texture(ctx, t, GL_RGBA32F, t->width, t->height);
+    t->tex_vnormal = make_texture(ctx, t, GL_RGBA32F, t->width, t->height);
+    t->tex_dz = make_texture(ctx, t, GL_RG32F, t->width, t->height);
+    GLuint prep[] = {t->tex_viewpos, t->tex_vnormal, t->tex_dz};
+    return make_fbo(ctx, &t->fbo_prep, prep, 3, "prep", err);
+}
+
+/* The targets a frame needs beyond what every frame does: t the full
+ * set, at the set the AO runs at (t, or the half set). */
+static obs_status need_frame_targets(obs_ctx *ctx, const obs__frame *f, obs__targets *t,
+                                     obs__targets *at, int has_color, unsigned outputs,
+                                     char err[OBS_ERR_LEN])
+{
+    obs_status s = need_prep_planes(ctx, at, err);
+    if (s == OBS_OK && !f->reconstruct_normals) /* read as an image: no RGB32F */
+        s = need_texture(ctx, t, &t->tex_normal, GL_RGBA32F, 0, 0, err);
+    if (s == OBS_OK && has_color)
+        s = need_texture(ctx, t, &t->tex_color, GL_RGBA32F, 0, 0, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_SAMPLE_COUNT))
+        s = need_texture(ctx, at, &at->tex_count, GL_R32F, at->fbo_vao, GL_COLOR_ATTACHMENT1, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_CULL_MASK))
+        s = need_texture(ctx, at, &at->tex_cullmask, GL_R32F, at->fbo_vao, GL_COLOR_ATTACHMENT2,
+                         err);
+    if (s == OBS_OK && f->bleed_step)
+        s = need_texture(ctx, at, &at->tex_bleed, GL_RGBA32F, at->fbo_vao, GL_COLOR_ATTACHMENT3,
+                         err);
+    if (s == OBS_OK && f->luminance && (outputs & OBS_OUTPUT_LUMINANCE))
+        s = need_texture(ctx, t, &t->tex_lumfactor, GL_R32F, t->fbo_blur, GL_COLOR_ATTACHMENT1,
+                         err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_COMPOSITE) && !t->fbo_composite) {
+        s = need_texture(ctx, t, &t->tex_composite, GL_RGBA32F, 0, 0, err);
+        if (s == OBS_OK)
+            s = make_fbo(ctx, &t->fbo_composite, &t->tex_composite, 1, "composite", err);
+    }
+    return s;
 }
 
 static void upload(GLuint tex, const obs_plane *p, int w, int h, GLenum format)
@@ -419,6 +464,13 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     s = ensure_targets(ctx, &ctx->tg, f.width, f.height, err);
     if (s == OBS_OK && f.half)
         s = ensure_targets(ctx, &ctx->tg_half, hf.width, hf.height, err);
+    obs__targets *t = &ctx->tg;
+    obs__targets *at = f.half ? &ctx->tg_half : t;
+    /* colour: for the composite, luminance sensitivity (4.3), bleeding (4.7) */
+    int has_color = gb->color.data != NULL &&
+                    ((outputs & OBS_OUTPUT_COMPOSITE) || f.luminance || f.bleed_step);
+    if (s == OBS_OK)
+        s = need_frame_targets(ctx, &f, t, at, has_color, outputs, err);
     if (s == OBS_OK) /* the frame's values, read by every pass (common.glsl) */
         s = obs__frame_block_bind(ctx, &f, err);
     if (s != OBS_OK)
@@ -427,16 +479,11 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     if (s != OBS_OK)
         return s;
 
-    obs__targets *t = &ctx->tg;
-    obs__targets *at = f.half ? &ctx->tg_half : t;
     int w = f.width, h = f.height, aw = af->width, ah = af->height;
     pass_begin(ctx, OBS_PASS_UPLOAD, &ran);
     upload(t->tex_depth, &gb->depth, w, h, GL_RED);
     if (!f.reconstruct_normals)
         upload(t->tex_normal, &gb->normal, w, h, GL_RGB);
-    /* colour: for the composite, luminance sensitivity (4.3), bleeding (4.7) */
-    int has_color = gb->color.data != NULL &&
-                    ((outputs & OBS_OUTPUT_COMPOSITE) || f.luminance || f.bleed_step);
     if (has_color)
         upload(t->tex_color, &gb->color, w, h, GL_RGBA);
     pass_end(ctx);
