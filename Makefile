@@ -218,7 +218,8 @@ loops: $(CORE_OBJ) $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
 E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)
 
 e2e: $(CLI) $(E2E_DEPS)
-	@rc=0; for t in tests/e2e/*.sh; do $(E2E_ENV) $$t || rc=1; done; exit $$rc
+	@rc=0; for t in tests/e2e/*.sh; do s=$$(date +%s); $(E2E_ENV) $$t || rc=1; \
+	  echo "e2e: $$t took $$(( $$(date +%s) - s )) s"; done; exit $$rc
 
 # Every public header compiles alone, as C and as C++.
 headers:

@@ -22,7 +22,11 @@ void cli_bake_usage(FILE *f)
             "                  [--PARAM VALUE]...  ambient obscurance baked onto the vertices\n"
             "                  of a level (glTF/GLB, AC3D, anything assimp reads; node graph\n"
             "                  and instances kept): _AO, _AO_SHORT, _AO_LONG per vertex;\n"
-            "                  'obscura bake --params' lists the parameters\n");
+            "                  'obscura bake --params' lists the parameters\n"
+            "  obscura bake LEVEL --shard I/N -o PART [--PARAM VALUE]...\n"
+            "                  trace shard I (0 .. N-1) of the level's samples into a part file\n"
+            "  obscura bake LEVEL --merge PART... -o OUT.(glb|ply) [...]\n"
+            "                  every shard's part read back and fitted: the unsharded bake\n");
 }
 
 /* The parameter table: plain text, or README's markdown table. */
@@ -59,17 +63,18 @@ typedef struct progress {
     double start, last;
 } progress;
 
-static void on_progress(void *user, size_t done, size_t total)
+static int on_progress(void *user, size_t done, size_t total)
 {
     progress *p = user;
     double t = cli_now_s();
     if (t - p->last < 0.5 && done < total)
-        return;
+        return 0;
     p->last = t;
     fprintf(stderr, "\robscura: bake: traced %zu / %zu samples (%.0f %%), %.1f s", done, total,
             total ? 100.0 * (double)done / (double)total : 100.0, t - p->start);
     if (done >= total)
         fprintf(stderr, "\n");
+    return 0;
 }
 
 static cJSON *pair(const double v[2])
@@ -198,12 +203,21 @@ static int ends_with(const char *s, const char *tail)
 int cli_bake(int argc, char **argv)
 {
     const char *in = NULL, *out = NULL, *report = NULL, *ply = NULL;
-    int color = 0, quiet = 0;
+    int color = 0, quiet = 0, shard = -1, shards = 0, merging = 0, merge = 0;
+    const char **parts = calloc((size_t)argc + 1, sizeof *parts);
+    size_t nparts = 0;
+    if (!parts)
+        cli_die_usage("bake", "out of memory");
     obs_bake_desc desc = {0};
     char err[OBS_ERR_LEN] = "";
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if ((a[0] != '-' || !a[1]) && merging) {
+            parts[nparts++] = a; /* --merge PART...: up to the next option */
+            continue;
+        }
+        merging = 0;
         if (a[0] != '-' || !a[1]) {
             if (in)
                 cli_die_usage("bake", "more than one level ('%s' and '%s')", in, a);
@@ -219,15 +233,30 @@ int cli_bake(int argc, char **argv)
         int takes = 1;
         if (!strcmp(key, "params") || !strcmp(key, "params-markdown")) {
             list_params(key[6] != '\0');
+            free(parts);
             return EXIT_OK;
         } else if (!strcmp(key, "color")) {
             color = 1, takes = 0;
         } else if (!strcmp(key, "quiet") || !strcmp(key, "q")) {
             quiet = 1, takes = 0;
+        } else if (!strcmp(key, "merge")) {
+            merging = merge = 1, takes = 0;
+            if (eq && *val)
+                parts[nparts++] = val;
         } else if (!val) {
             cli_die_usage("bake", "option --%s needs a value", key);
         } else if (!strcmp(key, "o") || !strcmp(key, "output")) {
             out = val;
+        } else if (!strcmp(key, "shard")) {
+            char *end, *end2;
+            long si = strtol(val, &end, 10), n = 0;
+            end2 = end;
+            if (*end == '/')
+                n = strtol(end + 1, &end2, 10);
+            if (*end != '/' || end == val || *end2 || end2 == end + 1 || n < 1 || n > 1000000 ||
+                si < 0 || si >= n)
+                cli_die_usage("bake", "--shard '%s': expected I/N with 0 <= I < N (e.g. 0/4)", val);
+            shard = (int)si, shards = (int)n;
         } else if (!strcmp(key, "report")) {
             report = val;
         } else if (!strcmp(key, "ply")) {
@@ -254,9 +283,15 @@ int cli_bake(int argc, char **argv)
     if (!in)
         cli_die_usage("bake", "no level file");
     if (!out)
-        cli_die_usage("bake", "no output file (-o OUT.glb or OUT.ply)");
+        cli_die_usage("bake", shards ? "no part file (-o PART)" : "no output file (-o OUT.glb or OUT.ply)");
+    if (merge && !nparts)
+        cli_die_usage("bake", "--merge needs the part files (--merge PART...)");
+    if (shards && nparts)
+        cli_die_usage("bake", "--shard traces a part, --merge reads them: not both");
+    if (shards && (ply || color))
+        cli_die_usage("bake", "--shard writes a part, not a model: --ply and --color go with --merge");
     int out_ply = ends_with(out, ".ply");
-    if (!out_ply && !ends_with(out, ".glb"))
+    if (!shards && !out_ply && !ends_with(out, ".glb"))
         cli_die_usage("bake", "cannot tell the format of '%s': use .glb or .ply", out);
     obs_bake_params p;
     obs_bake_params_resolve(&desc.params, &p);
@@ -264,8 +299,10 @@ int cli_bake(int argc, char **argv)
     double t0 = cli_now_s();
     obs_bake_scene sc;
     obs_status s = obs_bake_load(in, (size_t)p.max_triangles, &sc, err);
-    if (s != OBS_OK)
+    if (s != OBS_OK) {
+        free(parts);
         return cli_input_fail(s, in, err);
+    }
     double load_s = cli_now_s() - t0;
     progress pr = {cli_now_s(), 0.0};
     if (!quiet && isatty(2)) {
@@ -273,11 +310,29 @@ int cli_bake(int argc, char **argv)
         desc.progress_user = &pr;
     }
     obs_bake_result r;
-    s = obs_bake_run(&sc, &desc, &r, err);
+    if (shards) {
+        obs_bake_stats st;
+        s = obs_bake_shard(&sc, &desc, shard, shards, out, &st, err);
+        int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, in, err);
+        if (rc == EXIT_OK && report && !write_report(report, in, &p, &sc, &st, load_s, 0.0))
+            rc = EXIT_FAIL;
+        if (rc == EXIT_OK && !quiet)
+            fprintf(stderr, "obscura: bake: shard %d/%d: %zu samples (%zu dropped by the back-face "
+                    "rule), %llu rays in %.1f s; wrote %s\n", shard, shards, st.samples,
+                    st.samples_dropped_backface, (unsigned long long)st.rays,
+                    st.seconds[OBS_BAKE_STAGE_trace], out);
+        obs_bake_scene_free(&sc);
+        free(parts);
+        return rc;
+    }
+    s = nparts ? obs_bake_merge(&sc, &desc, parts, nparts, &r, err) : obs_bake_run(&sc, &desc, &r, err);
+    free(parts);
     if (s != OBS_OK) {
         obs_bake_scene_free(&sc);
-        return cli_fail(s, in, err);
+        return nparts ? cli_input_fail(s, in, err) : cli_fail(s, in, err);
     }
+    if (nparts) /* the parts' trace parameters, for the report */
+        obs_bake_params_resolve(&desc.params, &p);
     warn(in, &r.stats);
     double t1 = cli_now_s();
     s = out_ply ? obs_bake_write_ply(out, &sc, &r, err)

@@ -64,6 +64,21 @@
     X(stream_memory, SIZE, 1048576, 17179869184, "256m",                       \
       "memory a stream's frames may hold (input EXR, AO, composite, colour); " \
       "the oldest are dropped beyond it, the newest is always kept")          \
+    X(max_bakes, INT, 0, 1024, "4",                                            \
+      "bake jobs (POST /v1/bakes) queued or running at once; one more is "    \
+      "answered 503 bake_queue_full (0: bakes off, 404)")                      \
+    X(bake_workers, INT, 1, 16, "1",                                           \
+      "bake jobs run at once, each on its own thread beside the GL worker "   \
+      "(its ray tracing on every core unless its threads parameter says)")    \
+    X(bake_keep, INT, 1, 1024, "16",                                           \
+      "finished bake jobs kept for their state and result (in memory: a "     \
+      "restart loses them); beyond it the oldest finished is dropped")        \
+    X(max_level, SIZE, 1024, 17179869184, "256m",                              \
+      "largest accepted level (POST /v1/bakes body) in bytes (413 above, "    \
+      "before reading)")                                                       \
+    X(bake_max_triangles, INT, 1, 2147483647, "20000000",                      \
+      "most triangles of a bake job's level once instances are flattened "    \
+      "(caps its max_triangles parameter: the bake's memory grows with it)")  \
     X(drain_timeout, INT, 0, 86400, "30",                                      \
       "seconds the drain after SIGTERM may wait for the requests and "         \
       "connections under way; then they are cut, logged, and the daemon "    \

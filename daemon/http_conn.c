@@ -235,6 +235,7 @@ int obsd_http_cut(obsd_http *h)
     if (!h)
         return 0;
     obsd_streams_end_all(h->streams); /* parked event streams resume and end */
+    obsd_bakes_cancel_all(h->bakes);  /* and the bakes' */
     pthread_mutex_lock(&h->lock);
     for (obsd__conn *c = h->conns; c; c = c->next) {
         if (!atomic_load(&c->cut)) {

@@ -175,10 +175,8 @@ enum MHD_Result obsd__frame_start(req *r)
     return MHD_YES;
 }
 
-static enum MHD_Result append_body(req *r, const char *data, size_t *size)
+enum MHD_Result obsd__append_body(req *r, const char *data, size_t *size, size_t max)
 {
-    obsd_http *h = r->srv;
-    const size_t max = (size_t)h->cfg->max_body;
     size_t n = *size;
     *size = 0;
     if (r->too_big || n > max - r->len) {
@@ -283,7 +281,7 @@ enum MHD_Result obsd__frame_body(req *r, const char *data, size_t *size)
     if (!obsd__req_alive(r))
         return MHD_NO;
     if (*size)
-        return append_body(r, data, size);
+        return obsd__append_body(r, data, size, (size_t)r->srv->cfg->max_body);
     if (r->too_big) {
         char msg[160];
         snprintf(msg, sizeof msg, "body is over the limit of %lld bytes (--max-body)",

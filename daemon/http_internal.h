@@ -1,6 +1,6 @@
 /* Shared by the parts of obscurad's HTTP server.  Not a public header.
  * Calls go one way: http_server.c dispatches to http_frames.c,
- * http_streams.c, http_info.c and http_page.c; they all answer through
+ * http_streams.c, http_bakes.c, http_info.c and http_page.c; they all answer through
  * http_reply.c; http_streams.c also uses http_frames.c for its frames;
  * http_conn.c (the connections' records) is below them all. */
 #ifndef OBSD_HTTP_INTERNAL_H
@@ -10,6 +10,7 @@
 #include <pthread.h>
 #include <stdatomic.h>
 
+#include "bake_jobs.h"
 #include "frame_path.h"
 #include "http.h"
 #include "http_server.h"
@@ -44,6 +45,7 @@ struct obsd_http {
     obsd_queue *queue;
     obsd_gl_worker *gl;
     obsd_streams *streams;
+    obsd_bakes *bakes;
     int port;
     MHD_socket listen_fd;
     atomic_int in_flight;
@@ -126,6 +128,13 @@ typedef struct obsd__req {
     int subscribed;
     char event[512];
     int event_len, event_off;
+    /* /v1/bakes */
+    int bake_op;
+    char bake_id[OBSD_BAKE_ID_LEN + 1];
+    char bake_ext[16];
+    obs_bake_params bake_params;
+    obsd_bake_sub bsub;
+    int bsubscribed;
     /* answer */
     int status;
     size_t bytes_out;
@@ -180,6 +189,9 @@ enum MHD_Result obsd__frame_start(obsd__req *r);
 /* A call in REQ_BODY: `size` bytes of the body, or (size 0) its end,
  * when the frame is decoded and queued. */
 enum MHD_Result obsd__frame_body(obsd__req *r, const char *data, size_t *size);
+/* Appends `size` bytes of a body up to max bytes (then r->too_big, the
+ * rest discarded, the connection closed past twice max). */
+enum MHD_Result obsd__append_body(obsd__req *r, const char *data, size_t *size, size_t max);
 /* The request's query parameters into r->hr (recorded into r->query
  * when r->record_query); 400 answered on a bad one (returns 0, *rc set). */
 int obsd__parse_query(obsd__req *r, enum MHD_Result *rc);
@@ -197,6 +209,14 @@ enum MHD_Result obsd__ao_finish(obsd__req *r);
 enum MHD_Result obsd__streams_start(obsd__req *r, const char *url);
 enum MHD_Result obsd__streams_finish(obsd__req *r);
 void obsd__streams_done(obsd__req *r);
+
+/* ---- http_bakes.c: /v1/bakes ---- */
+
+/* The first call (token checked); a call with the body of a POST; the
+ * end of a request. */
+enum MHD_Result obsd__bakes_start(obsd__req *r, const char *url);
+enum MHD_Result obsd__bakes_body(obsd__req *r, const char *data, size_t *size);
+void obsd__bakes_done(obsd__req *r);
 
 /* ---- http_info.c, http_page.c ---- */
 

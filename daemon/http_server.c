@@ -4,6 +4,7 @@
  *
  *   http_frames.c   POST /v1/ao and the frames of streams
  *   http_streams.c  /v1/streams
+ *   http_bakes.c    /v1/bakes
  *   http_info.c     /v1/params, /v1/info, /healthz, /readyz, /metrics
  *   http_page.c     the preview page
  *   http_reply.c    the answers, logged and counted
@@ -83,7 +84,7 @@ static enum MHD_Result dispatch(req *r, const char *url, const char *method)
     if (r->route == OBSD_ROUTE_OTHER)
         return obsd__answer_error(r, 404, "not_found", "no such route (try GET /v1/params)", NULL, NULL);
     const char *allowed = r->route == OBSD_ROUTE_AO ? "POST" : "GET";
-    if (r->route != OBSD_ROUTE_STREAMS && strcmp(method, allowed) != 0 &&
+    if (r->route != OBSD_ROUTE_STREAMS && r->route != OBSD_ROUTE_BAKES && strcmp(method, allowed) != 0 &&
         !(r->route != OBSD_ROUTE_AO && !strcmp(method, "HEAD"))) {
         char msg[64];
         snprintf(msg, sizeof msg, "%s takes %s", obsd_route_path(r->route), allowed);
@@ -98,6 +99,8 @@ static enum MHD_Result dispatch(req *r, const char *url, const char *method)
                                   MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"obscurad\"");
     if (r->route == OBSD_ROUTE_STREAMS)
         return obsd__streams_start(r, url);
+    if (r->route == OBSD_ROUTE_BAKES)
+        return obsd__bakes_start(r, url);
     if (r->route != OBSD_ROUTE_AO)
         return obsd__info_route(r);
     return obsd__frame_start(r);
@@ -147,7 +150,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
          * on the next call, once MHD holds the whole request, so that the
          * connection stays open for the next (an answer queued now closes
          * it).  With a body it is answered now, and the body never read. */
-        int frame = r->route == OBSD_ROUTE_AO || (r->route == OBSD_ROUTE_STREAMS && !strcmp(method, "POST"));
+        int frame = r->route == OBSD_ROUTE_AO ||
+                    ((r->route == OBSD_ROUTE_STREAMS || r->route == OBSD_ROUTE_BAKES) && !strcmp(method, "POST"));
         if (frame || has_body)
             return dispatch(r, url, method);
         r->state = REQ_DEFERRED;
@@ -164,7 +168,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         }
         return dispatch(r, url, method);
     case REQ_BODY:
-        return obsd__frame_body(r, upload_data, upload_data_size);
+        return r->route == OBSD_ROUTE_BAKES ? obsd__bakes_body(r, upload_data, upload_data_size)
+                                            : obsd__frame_body(r, upload_data, upload_data_size);
     case REQ_QUEUED:
         return r->route == OBSD_ROUTE_STREAMS ? obsd__streams_finish(r) : obsd__ao_finish(r);
     case REQ_REFUSED:
@@ -194,6 +199,7 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
     if (c)
         obsd__conn_detach(h, c);
     obsd__streams_done(r);
+    obsd__bakes_done(r);
     *con_cls = NULL;
     atomic_fetch_sub(&h->in_flight, 1);
     /* cut while the GL worker had its frame: the worker frees it */
@@ -277,6 +283,12 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
         free(h);
         return OBS_NO_MEMORY;
     }
+    if (!(h->bakes = obsd_bakes_new(cfg->max_bakes, cfg->bake_workers, cfg->bake_keep,
+                                    cfg->bake_max_triangles))) {
+        obsd_streams_free(h->streams);
+        free(h);
+        return OBS_NO_MEMORY;
+    }
     atomic_init(&h->in_flight, 0);
     atomic_init(&h->draining, 0);
     atomic_init(&h->next_id, 0);
@@ -317,6 +329,7 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
     return OBS_OK;
 fail:
     pthread_mutex_destroy(&h->lock);
+    obsd_bakes_free(h->bakes);
     obsd_streams_free(h->streams);
     free(h);
     return OBS_IO;
@@ -333,6 +346,7 @@ void obsd_http_quiesce(obsd_http *h)
 {
     atomic_store(&h->draining, 1);
     obsd_streams_end_all(h->streams); /* event streams end, so that the drain ends */
+    obsd_bakes_cancel_all(h->bakes);  /* running bakes stop between batches of rays */
     if (h->listen_fd == MHD_INVALID_SOCKET) {
         h->listen_fd = MHD_quiesce_daemon(h->mhd);
         /* MHD no longer accepts, but the kernel still would, into a
@@ -347,8 +361,10 @@ int obsd_http_in_flight(obsd_http *h) { return atomic_load(&h->in_flight); }
 
 void obsd_http_tick(obsd_http *h)
 {
-    if (h)
+    if (h) {
         obsd_streams_tick(h->streams, obsd_now_ms());
+        obsd_bakes_tick(h->bakes, obsd_now_ms());
+    }
 }
 
 void obsd_http_stop(obsd_http *h)
@@ -364,6 +380,7 @@ void obsd_http_stop(obsd_http *h)
      * when it stops). */
     obsd_http_cut(h);
     MHD_stop_daemon(h->mhd);
+    obsd_bakes_free(h->bakes); /* cancelled in the quiesce: the workers end */
     /* MHD hands the quiesced socket to us, to close after the stop. */
     if (h->listen_fd != MHD_INVALID_SOCKET)
         close(h->listen_fd);

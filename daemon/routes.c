@@ -5,7 +5,7 @@
 #include "routes.h"
 
 static const char *const route_paths[OBSD_ROUTE_COUNT] = {
-    "/v1/ao", "/v1/params", "/v1/info", "/healthz", "/readyz", "/metrics", "/v1/streams", "/",
+    "/v1/ao", "/v1/params", "/v1/info", "/healthz", "/readyz", "/metrics", "/v1/streams", "/v1/bakes", "/",
     "binary", "other"};
 
 const char *obsd_route_path(obsd_route r)
@@ -20,6 +20,8 @@ obsd_route obsd_route_of(const char *path)
             return (obsd_route)r;
     if (path && !strncmp(path, "/v1/streams/", 12))
         return OBSD_ROUTE_STREAMS;
+    if (path && !strncmp(path, "/v1/bakes/", 10))
+        return OBSD_ROUTE_BAKES;
     if (path && !strncmp(path, "/preview/", 9))
         return OBSD_ROUTE_PAGE;
     return OBSD_ROUTE_OTHER;

@@ -11,6 +11,7 @@ typedef enum obsd_route {
     OBSD_ROUTE_READYZ,
     OBSD_ROUTE_METRICS,
     OBSD_ROUTE_STREAMS, /* /v1/streams and everything under it */
+    OBSD_ROUTE_BAKES,   /* /v1/bakes and everything under it */
     OBSD_ROUTE_PAGE,    /* the preview page: / and /preview/... */
     OBSD_ROUTE_BINARY, /* the binary protocol (socket / TCP), not a URL */
     OBSD_ROUTE_OTHER,
@@ -19,7 +20,7 @@ typedef enum obsd_route {
 
 /* "/v1/ao", ... ; "other" for OBSD_ROUTE_OTHER. */
 const char *obsd_route_path(obsd_route r);
-/* The route of a URL path (exact match; /v1/streams/... and /preview/...
+/* The route of a URL path (exact match; /v1/streams/..., /v1/bakes/... and /preview/...
  * by prefix), OBSD_ROUTE_OTHER if none. */
 obsd_route obsd_route_of(const char *path);
 

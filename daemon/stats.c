@@ -10,7 +10,7 @@
 
 static const char *const stage_names[OBSD_STAGE_COUNT] = {"queue", "decode", "gl", "encode", "total"};
 /* The statuses the daemon answers; anything else counts as the last. */
-static const int codes[] = {200, 400, 401, 404, 405, 408, 413, 415, 422, 500, 503, 0};
+static const int codes[] = {200, 202, 400, 401, 404, 405, 408, 409, 413, 415, 422, 500, 503, 0};
 #define NCODES ((int)(sizeof codes / sizeof codes[0]))
 /* Histogram bucket upper bounds in milliseconds (+Inf implied). */
 static const double buckets[] = {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000};

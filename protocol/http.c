@@ -303,6 +303,7 @@ int obs_http_status_of(obs_status s, const char **code)
     case OBS_NO_MEMORY: http = 503; c = "no_memory"; break;
     case OBS_TOO_COSTLY: http = 422; c = "too_costly"; break;
     case OBS_DEADLINE: http = 422; c = "deadline_exceeded"; break;
+    case OBS_CANCELLED: http = 409; c = "cancelled"; break;
     case OBS_GL_UNAVAILABLE: http = 500; c = "gl_unavailable"; break;
     case OBS_GL_SHADER: http = 500; c = "gl_shader"; break;
     default: http = 500; c = "gl_error"; break;

@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include "bake/bake_internal.h"
+#include "bake/shard.h"
 #include "internal.h"
 
 static const char *const stage_names[] = {
@@ -105,6 +106,15 @@ static obs_status holdout(const obs__bake_world *w, const obs__bake_weld *wd,
 obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
                         obs_bake_result *out, char err[OBS_ERR_LEN])
 {
+    return obs__bake_run_shard(scene, desc, NULL, out, err);
+}
+
+/* The steps; with a shard (shard.c) the trace is its step instead: one
+ * shard's samples traced and written (then the bake stops there), or
+ * every shard's read back. */
+obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc *desc,
+                               obs__bake_shard *sh, obs_bake_result *out, char err[OBS_ERR_LEN])
+{
     memset(out, 0, sizeof *out);
     obs_bake_params p;
     obs_bake_params_resolve(desc ? &desc->params : NULL, &p);
@@ -144,12 +154,19 @@ obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
                                p.backface_limit, (uint64_t)p.seed,
                                desc ? desc->progress : NULL, desc ? desc->progress_user : NULL};
     double bvh = 0.0;
-    if ((rc = obs__bake_trace(&w, &s, &td, &bvh, err)) != OBS_OK)
-        goto done;
-    st->seconds[OBS_BAKE_STAGE_bvh] = bvh;
-    st->seconds[OBS_BAKE_STAGE_trace] = now() - t - bvh;
+    if (sh) {
+        if ((rc = obs__bake_shard_step(sh, &w, &s, &td, st, err)) != OBS_OK)
+            goto done;
+    } else {
+        if ((rc = obs__bake_trace(&w, &s, &td, &bvh, err)) != OBS_OK)
+            goto done;
+        st->seconds[OBS_BAKE_STAGE_bvh] = bvh;
+        st->seconds[OBS_BAKE_STAGE_trace] = now() - t - bvh;
+    }
     st->rays = s.rays;
     st->samples_dropped_backface = s.dropped;
+    if (sh && sh->stop) /* a shard: its part is written; the merge fits */
+        goto done;
 
     t = now();
     if ((rc = obs__bake_weld_make(&w, p.weld_tolerance, p.weld_angle, &wd, err)) != OBS_OK)

@@ -55,11 +55,13 @@ typedef struct obs__bake_trace_desc {
     int rays, threads;
     float backface_limit;
     uint64_t seed;
-    void (*progress)(void *user, size_t done, size_t total);
+    int (*progress)(void *user, size_t done, size_t total); /* nonzero: stop */
     void *progress_user;
+    size_t first, end; /* the samples traced: [first, end), end 0 for all (shard.c) */
 } obs__bake_trace_desc;
 
-/* Eq 1 at every sample (trace.c). */
+/* Eq 1 at every sample (trace.c); OBS_CANCELLED when the progress
+ * callback asked to stop. */
 obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
                            const obs__bake_trace_desc *d, double *bvh_seconds,
                            char err[OBS_ERR_LEN]);

@@ -39,7 +39,8 @@ typedef struct job {
     float a[2]; /* the kernels' a = ln(0.5) / d */
     atomic_size_t next;
     pthread_mutex_t lock;
-    size_t done;
+    size_t end, done; /* the range ends at end (d->first .. end) */
+    atomic_int stop;  /* the progress callback asked to stop */
     uint64_t rays;
     size_t dropped;
 } job;
@@ -136,14 +137,14 @@ static void *worker(void *arg)
     rtcInitIntersectContext(&ctx);
     uint64_t rays = 0;
     size_t dropped = 0, i0;
-    while ((i0 = atomic_fetch_add(&j->next, CHUNK)) < j->s->count) {
-        size_t i1 = i0 + CHUNK < j->s->count ? i0 + CHUNK : j->s->count;
+    while (!atomic_load(&j->stop) && (i0 = atomic_fetch_add(&j->next, CHUNK)) < j->end) {
+        size_t i1 = i0 + CHUNK < j->end ? i0 + CHUNK : j->end;
         for (size_t i = i0; i < i1; i++)
             trace_sample(j, &ctx, i, &rays, &dropped);
         pthread_mutex_lock(&j->lock);
         j->done += i1 - i0;
-        if (j->d->progress)
-            j->d->progress(j->d->progress_user, j->done, j->s->count);
+        if (j->d->progress && j->d->progress(j->d->progress_user, j->done, j->end - j->d->first))
+            atomic_store(&j->stop, 1); /* between batches: the bake is cancelled */
         pthread_mutex_unlock(&j->lock);
     }
     pthread_mutex_lock(&j->lock);
@@ -221,7 +222,10 @@ obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
     j->rtc = rs;
     for (int c = 0; c < 2; c++)
         j->a[c] = logf(0.5f) / d->distance[c]; /* a = ln(0.5) / d, section 2 */
-    atomic_init(&j->next, 0);
+    /* The samples [first, end): a shard of the bake (shard.c), or all. */
+    j->end = d->end && d->end < s->count ? d->end : s->count;
+    atomic_init(&j->next, d->first < j->end ? d->first : j->end);
+    atomic_init(&j->stop, 0);
     pthread_mutex_init(&j->lock, NULL);
     int nt = d->threads;
     if (nt <= 0) {
@@ -240,6 +244,9 @@ obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
     pthread_mutex_destroy(&j->lock);
     s->rays = j->rays;
     s->dropped = j->dropped;
+    if (atomic_load(&j->stop))
+        st = obs__fail(err, OBS_CANCELLED, "bake cancelled after %zu of %zu samples", j->done,
+                       j->end - d->first);
     free(j);
 done:
     if (rs)

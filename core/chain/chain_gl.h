@@ -10,12 +10,16 @@
 #define OBS__AO_VARIANTS 16  /* 4 switches of the AO pass, compiled in or out */
 
 typedef struct obs__programs {
-    GLuint prep[2 * OBS__DEPTH_MODES]; /* OBS__DEPTH_MODES * (normals derived from depth) + depth
-                                        * mode - 1; built on first use */
+    /* [OBS_HALF: ao_resolution half's prep straight to half size][
+     * OBS__DEPTH_MODES * (normals derived from depth) + depth mode - 1];
+     * built on first use */
+    GLuint prep[2][2 * OBS__DEPTH_MODES];
     GLuint vao[OBS__AO_VARIANTS]; /* AO pass by switches compiled in (run_gl.c: AO_*) */
     GLuint cull[2];               /* culling pre-pass without, with the range check */
     GLuint composite;
-    GLuint down, up[2]; /* ao_resolution half: downsample; upsample by OBS_RAYS (first use) */
+    /* ao_resolution half's upsample [OBS_RAYS][as prep's second index]
+     * (it derives its own pixel's depth and normal as prep does) */
+    GLuint up[2][2 * OBS__DEPTH_MODES];
     GLuint finish[4]; /* 2 * (ao_definition rays) + luminance: OBS_RAYS, OBS_LUMINANCE */
     /* by (the vertical pass with ao_definition rays' conversion: OBS_RAYS)
      * and blur_radius (BLUR_RADIUS); built on first use */

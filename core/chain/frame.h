@@ -142,11 +142,12 @@ void obs__frame_half(const obs__frame *f, obs__frame *hf);
  * nearest (planar depth) where hx + hy is even, the farthest where it is
  * odd, the first in row order on a tie; -1 when all four are background.
  * pos: the full frame's prep positions (4 floats a pixel, w the planar
- * depth).  GLSL: down.frag.glsl. */
+ * depth).  GLSL: prep.frag.glsl with OBS_HALF (the prep of the chosen
+ * pixel, straight from the raw planes). */
 long obs__half_source(const obs__frame *f, const float *pos, int hx, int hy);
 
 /* The AO of full pixel (x, y) from the half-resolution AO `hao`: the
- * joint bilateral upsample of down.frag.glsl's twin up.frag.glsl.  The
+ * joint bilateral upsample, up.frag.glsl.  The
  * four half pixels around the pixel's centre, each weighted by its
  * bilinear weight times max(0, n . n_q), n the pixel's view normal;
  * a half pixel without a surface, or whose planar depth is more than R

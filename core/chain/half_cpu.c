@@ -1,5 +1,5 @@
 /* The AO at half resolution (parameter ao_resolution half), CPU twins of
- * down.frag.glsl and up.frag.glsl: the half frame, the depth-aware
+ * prep.frag.glsl (OBS_HALF) and up.frag.glsl: the half frame, the depth-aware
  * downsample of the prep planes and the joint bilateral upsample of the
  * AO (frame.h says what each does).
  *

@@ -74,8 +74,11 @@ static obs_status build_finish_program(obs_ctx *ctx, int rays, int lum, char err
 
 /* The prep pass that reads the normals or derives them from depth
  * (OBS_RECONSTRUCT), for the frame's depth mode (OBS_DEPTH_MODE: planar,
- * radial, ndc, inverse, normalized; resolved, never OBS_DEPTH_DEFAULT), built on its first use:
- * ctx->prog.prep[prep_index(f)]. */
+ * radial, ndc, inverse, normalized; resolved, never OBS_DEPTH_DEFAULT), at
+ * full size or, for ao_resolution half, straight to the half planes
+ * (OBS_HALF), built on its first use: ctx->prog.prep[half][prep_index(f)].
+ * The same defines select ao_resolution half's upsample, which derives its
+ * own pixel's depth and normal with prep.glsl. */
 static int prep_index(const obs__frame *f)
 {
     int mode = f->depth_mode >= OBS_DEPTH_PLANAR && f->depth_mode <= OBS_DEPTH_NORMALIZED
@@ -84,17 +87,26 @@ static int prep_index(const obs__frame *f)
     return OBS__DEPTH_MODES * (f->reconstruct_normals != 0) + mode - OBS_DEPTH_PLANAR;
 }
 
+static void prep_defines(int k, char *defs, size_t size)
+{
+    snprintf(defs, size, "#define OBS_RECONSTRUCT %d\n#define OBS_DEPTH_MODE %d\n",
+             k / OBS__DEPTH_MODES, k % OBS__DEPTH_MODES + OBS_DEPTH_PLANAR);
+}
+
 static obs_status build_prep_program(obs_ctx *ctx, const obs__frame *f, char err[OBS_ERR_LEN])
 {
-    int k = prep_index(f);
-    if (ctx->prog.prep[k])
+    int k = prep_index(f), half = f->half != 0;
+    if (ctx->prog.prep[half][k])
         return OBS_OK;
     char defs[80];
-    snprintf(defs, sizeof defs, "#define OBS_RECONSTRUCT %d\n#define OBS_DEPTH_MODE %d\n",
-             k / OBS__DEPTH_MODES, k % OBS__DEPTH_MODES + OBS_DEPTH_PLANAR);
-    const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_prep_frag};
-    return obs__gl_program(k / OBS__DEPTH_MODES ? "prep (normals from depth)" : "prep",
-                           obs__shader_fullscreen_vert, src, 4, &ctx->prog.prep[k], err);
+    prep_defines(k, defs, sizeof defs);
+    const char *src[] = {glsl_version, defs, half ? "#define OBS_HALF 1\n" : "#define OBS_HALF 0\n",
+                         obs__shader_common, obs__shader_prep, obs__shader_prep_frag};
+    const char *name = half ? (k / OBS__DEPTH_MODES ? "prep to half size (normals from depth)"
+                                                    : "prep to half size")
+                            : (k / OBS__DEPTH_MODES ? "prep (normals from depth)" : "prep");
+    return obs__gl_program(name, obs__shader_fullscreen_vert, src, 6, &ctx->prog.prep[half][k],
+                           err);
 }
 
 /* The blur of half-width radius (section 4.6), built on its first use:
@@ -125,22 +137,19 @@ static obs_status build_method_program(obs_ctx *ctx, const obs__method *m, char 
                            err);
 }
 
-/* ao_resolution half's downsample and upsample (down.frag.glsl,
- * up.frag.glsl), built on their first use. */
-static obs_status build_half_programs(obs_ctx *ctx, int rays, char err[OBS_ERR_LEN])
+/* ao_resolution half's upsample (up.frag.glsl), built on its first use;
+ * the downsample is the prep pass's OBS_HALF variant. */
+static obs_status build_up_program(obs_ctx *ctx, const obs__frame *f, char err[OBS_ERR_LEN])
 {
-    obs_status s = OBS_OK;
-    if (!ctx->prog.down) {
-        const char *src[] = {glsl_version, obs__shader_common, obs__shader_down_frag};
-        s = obs__gl_program("downsample", obs__shader_fullscreen_vert, src, 3, &ctx->prog.down, err);
-    }
-    if (s == OBS_OK && !ctx->prog.up[rays]) {
-        const char *src[] = {glsl_version, rays ? "#define OBS_RAYS 1\n" : "#define OBS_RAYS 0\n",
-                             obs__shader_common, obs__shader_up_frag};
-        s = obs__gl_program("upsample", obs__shader_fullscreen_vert, src, 4, &ctx->prog.up[rays],
-                            err);
-    }
-    return s;
+    int k = prep_index(f), rays = f->rays != 0;
+    if (ctx->prog.up[rays][k])
+        return OBS_OK;
+    char defs[80];
+    prep_defines(k, defs, sizeof defs);
+    const char *src[] = {glsl_version, defs, rays ? "#define OBS_RAYS 1\n" : "#define OBS_RAYS 0\n",
+                         obs__shader_common, obs__shader_prep, obs__shader_up_frag};
+    return obs__gl_program("upsample", obs__shader_fullscreen_vert, src, 6, &ctx->prog.up[rays][k],
+                           err);
 }
 
 static GLuint make_texture(obs_ctx *ctx, obs__targets *set, GLenum format, int w, int h)
@@ -187,15 +196,14 @@ void obs__chain_release(obs__programs *g, obs__targets *t)
     memset(t, 0, sizeof *t);
     if (!g)
         return;
-    OBS__GL_DELETE_PROGRAMS(g->prep);
     OBS__GL_DELETE_PROGRAMS(g->vao);
     OBS__GL_DELETE_PROGRAMS(g->cull);
     obs__gl_delete_programs(&g->blur[0][0], sizeof g->blur / sizeof g->blur[0][0]);
     OBS__GL_DELETE_PROGRAMS(g->method);
     OBS__GL_DELETE_PROGRAMS(g->finish);
     obs__gl_delete_programs(&g->composite, 1);
-    obs__gl_delete_programs(&g->down, 1);
-    OBS__GL_DELETE_PROGRAMS(g->up);
+    obs__gl_delete_programs(&g->prep[0][0], sizeof g->prep / sizeof g->prep[0][0]);
+    obs__gl_delete_programs(&g->up[0][0], sizeof g->up / sizeof g->up[0][0]);
     memset(g, 0, sizeof *g);
 }
 
@@ -209,37 +217,22 @@ static obs_status ensure_targets(obs_ctx *ctx, obs__targets *t, int w, int h, ch
         /* a new resolution: drop the old set, keep the programs */
         obs__chain_release(NULL, t);
     }
+    /* what every frame needs; the rest is made on a frame's first need
+     * of it (need_texture, need_planes) and kept with the set */
     t->tex_depth = make_texture(ctx, t, GL_R32F, w, h);
-    t->tex_normal = make_texture(ctx, t, GL_RGBA32F, w, h); /* read as an image: no RGB32F */
-    t->tex_color = make_texture(ctx, t, GL_RGBA32F, w, h);
-    t->tex_viewpos = make_texture(ctx, t, GL_RGBA32F, w, h);
-    t->tex_vnormal = make_texture(ctx, t, GL_RGBA32F, w, h);
-    t->tex_dz = make_texture(ctx, t, GL_RG32F, w, h);
     t->tex_ao = make_texture(ctx, t, GL_RG32F, w, h);     /* AO, depth (blur.frag.glsl) */
-    t->tex_composite = make_texture(ctx, t, GL_RGBA32F, w, h);
     t->tex_blur = make_texture(ctx, t, GL_RG32F, w, h);
-    t->tex_count = make_texture(ctx, t, GL_R32F, w, h);
-    t->tex_cullmask = make_texture(ctx, t, GL_R32F, w, h);
-    t->tex_bleed = make_texture(ctx, t, GL_RGBA32F, w, h);
-    t->tex_lumfactor = make_texture(ctx, t, GL_R32F, w, h);
     /* Section 4.2: the pre-pass texture, one texel per 8 x 8 block; the AO
      * pass filters it itself (cull_candidate in vao.frag.glsl). */
     t->tex_cull = make_texture(ctx, t, GL_R32F, (w + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK,
                                (h + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK);
-    GLuint prep[] = {t->tex_viewpos, t->tex_vnormal, t->tex_dz};
-    GLuint vao[] = {t->tex_ao, t->tex_count, t->tex_cullmask, t->tex_bleed};
-    GLuint blur[] = {t->tex_blur, t->tex_lumfactor};
-    obs_status s = make_fbo(ctx, &t->fbo_prep, prep, 3, "prep", err);
-    if (s == OBS_OK)
-        s = make_fbo(ctx, &t->fbo_vao, vao, 4, "vao", err);
+    obs_status s = make_fbo(ctx, &t->fbo_vao, &t->tex_ao, 1, "vao", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_cull, &t->tex_cull, 1, "cull", err);
     if (s == OBS_OK)
         s = make_fbo(ctx, &t->fbo_ao, &t->tex_ao, 1, "ao", err);
     if (s == OBS_OK)
-        s = make_fbo(ctx, &t->fbo_blur, blur, 2, "blur", err);
-    if (s == OBS_OK)
-        s = make_fbo(ctx, &t->fbo_composite, &t->tex_composite, 1, "composite", err);
+        s = make_fbo(ctx, &t->fbo_blur, &t->tex_blur, 1, "blur", err);
     if (s == OBS_OK)
         s = obs__gl_check("allocating frame targets", err);
     if (s != OBS_OK) {
@@ -250,6 +243,66 @@ static obs_status ensure_targets(obs_ctx *ctx, obs__targets *t, int w, int h, ch
     t->height = h;
     obs__log(ctx, OBS_LOG_DEBUG, "allocated frame targets for %dx%d", w, h);
     return OBS_OK;
+}
+
+/* A texture of set t made on the first frame that needs it (the normals
+ * and colour, the debug outputs, the colour-bleed term), attached to fbo
+ * at attachment when fbo is not 0. */
+static obs_status need_texture(obs_ctx *ctx, obs__targets *t, GLuint *tex, GLenum format,
+                               GLuint fbo, GLenum attachment, char err[OBS_ERR_LEN])
+{
+    if (*tex)
+        return OBS_OK;
+    *tex = make_texture(ctx, t, format, t->width, t->height);
+    if (fbo) {
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, attachment, GL_TEXTURE_2D, *tex, 0);
+    }
+    return obs__gl_check("allocating a frame target", err);
+}
+
+/* The prep planes of set t and their framebuffer, made when a frame's
+ * prep pass first writes that size (not the full set of ao_resolution
+ * half, whose prep runs at half size). */
+static obs_status need_prep_planes(obs_ctx *ctx, obs__targets *t, char err[OBS_ERR_LEN])
+{
+    if (t->fbo_prep)
+        return OBS_OK;
+    t->tex_viewpos = make_texture(ctx, t, GL_RGBA32F, t->width, t->height);
+    t->tex_vnormal = make_texture(ctx, t, GL_RGBA32F, t->width, t->height);
+    t->tex_dz = make_texture(ctx, t, GL_RG32F, t->width, t->height);
+    GLuint prep[] = {t->tex_viewpos, t->tex_vnormal, t->tex_dz};
+    return make_fbo(ctx, &t->fbo_prep, prep, 3, "prep", err);
+}
+
+/* The targets a frame needs beyond what every frame does: t the full
+ * set, at the set the AO runs at (t, or the half set). */
+static obs_status need_frame_targets(obs_ctx *ctx, const obs__frame *f, obs__targets *t,
+                                     obs__targets *at, int has_color, unsigned outputs,
+                                     char err[OBS_ERR_LEN])
+{
+    obs_status s = need_prep_planes(ctx, at, err);
+    if (s == OBS_OK && !f->reconstruct_normals) /* read as an image: no RGB32F */
+        s = need_texture(ctx, t, &t->tex_normal, GL_RGBA32F, 0, 0, err);
+    if (s == OBS_OK && has_color)
+        s = need_texture(ctx, t, &t->tex_color, GL_RGBA32F, 0, 0, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_SAMPLE_COUNT))
+        s = need_texture(ctx, at, &at->tex_count, GL_R32F, at->fbo_vao, GL_COLOR_ATTACHMENT1, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_CULL_MASK))
+        s = need_texture(ctx, at, &at->tex_cullmask, GL_R32F, at->fbo_vao, GL_COLOR_ATTACHMENT2,
+                         err);
+    if (s == OBS_OK && f->bleed_step)
+        s = need_texture(ctx, at, &at->tex_bleed, GL_RGBA32F, at->fbo_vao, GL_COLOR_ATTACHMENT3,
+                         err);
+    if (s == OBS_OK && f->luminance && (outputs & OBS_OUTPUT_LUMINANCE))
+        s = need_texture(ctx, t, &t->tex_lumfactor, GL_R32F, t->fbo_blur, GL_COLOR_ATTACHMENT1,
+                         err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_COMPOSITE) && !t->fbo_composite) {
+        s = need_texture(ctx, t, &t->tex_composite, GL_RGBA32F, 0, 0, err);
+        if (s == OBS_OK)
+            s = make_fbo(ctx, &t->fbo_composite, &t->tex_composite, 1, "composite", err);
+    }
+    return s;
 }
 
 static void upload(GLuint tex, const obs_plane *p, int w, int h, GLenum format)
@@ -391,7 +444,7 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     if (s == OBS_OK && f.culling)
         s = build_vao_program(ctx, 1, ao_variant(&f), err);
     if (s == OBS_OK && f.half)
-        s = build_half_programs(ctx, f.rays, err);
+        s = build_up_program(ctx, &f, err);
     /* ao_definition rays converts the blurred AO: in the blur's vertical
      * pass, or in the finishing pass when there is no blur; at half
      * resolution in the upsample (which filters the linear estimate, as
@@ -411,6 +464,13 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     s = ensure_targets(ctx, &ctx->tg, f.width, f.height, err);
     if (s == OBS_OK && f.half)
         s = ensure_targets(ctx, &ctx->tg_half, hf.width, hf.height, err);
+    obs__targets *t = &ctx->tg;
+    obs__targets *at = f.half ? &ctx->tg_half : t;
+    /* colour: for the composite, luminance sensitivity (4.3), bleeding (4.7) */
+    int has_color = gb->color.data != NULL &&
+                    ((outputs & OBS_OUTPUT_COMPOSITE) || f.luminance || f.bleed_step);
+    if (s == OBS_OK)
+        s = need_frame_targets(ctx, &f, t, at, has_color, outputs, err);
     if (s == OBS_OK) /* the frame's values, read by every pass (common.glsl) */
         s = obs__frame_block_bind(ctx, &f, err);
     if (s != OBS_OK)
@@ -419,38 +479,26 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     if (s != OBS_OK)
         return s;
 
-    obs__targets *t = &ctx->tg;
-    obs__targets *at = f.half ? &ctx->tg_half : t;
     int w = f.width, h = f.height, aw = af->width, ah = af->height;
     pass_begin(ctx, OBS_PASS_UPLOAD, &ran);
     upload(t->tex_depth, &gb->depth, w, h, GL_RED);
     if (!f.reconstruct_normals)
         upload(t->tex_normal, &gb->normal, w, h, GL_RGB);
-    /* colour: for the composite, luminance sensitivity (4.3), bleeding (4.7) */
-    int has_color = gb->color.data != NULL &&
-                    ((outputs & OBS_OUTPUT_COMPOSITE) || f.luminance || f.bleed_step);
     if (has_color)
         upload(t->tex_color, &gb->color, w, h, GL_RGBA);
     pass_end(ctx);
 
-    /* prep pass */
-    pass_begin(ctx, OBS_PASS_PREP, &ran);
-    GLuint prog = ctx->prog.prep[prep_index(&f)];
+    /* prep pass; ao_resolution half: straight to the half planes, one
+     * whole pixel of each 2x2 block (prep.frag.glsl, OBS_HALF), then the
+     * half frame's block for the passes at that size */
+    pass_begin(ctx, f.half ? OBS_PASS_DOWNSAMPLE : OBS_PASS_PREP, &ran);
+    GLuint prog = ctx->prog.prep[f.half != 0][prep_index(&f)];
     glUseProgram(prog);
     bind_img(prog, "u_depth", 0, t->tex_depth, GL_R32F);
     bind_img(prog, "u_normal", 1, t->tex_normal, GL_RGBA32F);
-    draw(ctx, t->fbo_prep, w, h);
+    draw(ctx, at->fbo_prep, aw, ah);
     pass_end(ctx);
-
-    /* ao_resolution half: one pixel of each 2x2 block (down.frag.glsl),
-     * then the half frame's block for the passes at that size */
     if (f.half) {
-        pass_begin(ctx, OBS_PASS_DOWNSAMPLE, &ran);
-        prog = ctx->prog.down;
-        glUseProgram(prog);
-        bind_prep_planes(prog, t);
-        draw(ctx, at->fbo_prep, aw, ah);
-        pass_end(ctx);
         s = obs__frame_block_bind(ctx, &hf, err);
         if (s != OBS_OK) {
             obs_result_free(out);
@@ -528,10 +576,10 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
             return s;
         }
         pass_begin(ctx, OBS_PASS_UPSAMPLE, &ran);
-        prog = ctx->prog.up[f.rays];
+        prog = ctx->prog.up[f.rays != 0][prep_index(&f)];
         glUseProgram(prog);
-        bind_img(prog, "u_dz", 0, t->tex_dz, GL_RG32F);
-        bind_img(prog, "u_vnormal", 1, t->tex_vnormal, GL_RGBA32F);
+        bind_img(prog, "u_depth", 0, t->tex_depth, GL_R32F);
+        bind_img(prog, "u_normal", 1, t->tex_normal, GL_RGBA32F);
         bind_img(prog, "u_hnormal", 3, at->tex_vnormal, GL_RGBA32F);
         bind_img(prog, "u_hao", 4, at->tex_ao, GL_RG32F);
         glUniform2i(glGetUniformLocation(prog, "u_half_size"), aw, ah);

@@ -1,120 +1,46 @@
 // Prep pass: view-space position (xyz, planar depth in w) and view-space
-// unit normal of every pixel.  C twin: obs__prep_position/_normal.
-
-layout(r32f) readonly uniform image2D u_depth;     // raw depth
-layout(rgba32f) readonly uniform image2D u_normal;  // input normals (when given)
-// OBS_RECONSTRUCT (0 or 1, defined by the program): 1 derives the normals
-// from depth, 0 reads them from u_normal.  A define, not a uniform: a
-// SIMD rasteriser runs both sides of a uniform branch.
-// u_normal_matrix (input normal -> view normal), u_size: the Frame block
-// (common.glsl)
+// unit normal of every pixel (prep.glsl).  C twin: obs__prep_position/_normal.
+//
+// OBS_HALF 1 (ao_resolution half): drawn over the half frame, with the
+// full frame's block bound; half pixel (x, y) takes the prep of one whole
+// pixel of its 2x2 block, never an average: the nearest with a surface
+// where x + y is even, the farthest where it is odd (half_cpu.c says why).
+// That is the full prep planes' downsample, without computing the full
+// planes.  C twin: obs__half_source in half_cpu.c.
 
 layout(location = 0) out vec4 o_pos;
 layout(location = 1) out vec4 o_normal;
 layout(location = 2) out vec2 o_dz;     // planar depth and n.z: what the samples read
 
-// The clip range (near, far) of the projection's z row: the planar depths
-// whose OpenGL depth is -1 and 1.  C twin: clip_range in prep_cpu.c.
-vec2 clip_range()
-{
-    float a = PM(2, 2), b = PM(2, 3), c = PM(3, 2), d = PM(3, 3);
-    return vec2((d + b) / (a + c), (b - d) / (a - c));
-}
-
-// Planar depth from the raw value; 0 for background.  OBS_DEPTH_MODE (1
-// planar, 2 radial, 3 ndc, 4 inverse, 5 normalized: obs_depth_mode) is
-// defined by the program, one
-// per mode: as uniform branches, the radial and ndc code ran for every
-// pixel (bench/RESULTS.md).  C twin: linear_depth in vao_cpu.c.
-float linear_depth(float raw, vec3 dir)
-{
-    if (OBS_DEPTH_MODE == 4) // 1/Z: 0 (or below) is background
-        return raw > 0.0 && 1.0 / raw < SKY_DEPTH ? 1.0 / raw : 0.0;
-    if (OBS_DEPTH_MODE == 5) { // 0..1 between the clip planes; 1 is background
-        if (!(raw >= 0.0) || raw >= 1.0)
-            return 0.0;
-        vec2 nf = clip_range();
-        return nf.x + raw * (nf.y - nf.x);
-    }
-    if (!(raw > 0.0) || raw >= SKY_DEPTH)
-        return 0.0;
-    if (OBS_DEPTH_MODE == 2)
-        return raw / sqrt(dir.x * dir.x + dir.y * dir.y + dir.z * dir.z);
-    if (OBS_DEPTH_MODE == 3) {
-        if (raw >= 1.0)
-            return 0.0;
-        float zn = 2.0 * raw - 1.0;
-        float z = (PM(2, 3) - zn * PM(3, 3)) / (zn * PM(3, 2) - PM(2, 2));
-        return -z > 0.0 ? -z : 0.0;
-    }
-    return raw;
-}
-
-// View-space position and planar depth; vec4(0) for background.
-vec4 prep_position(float raw, ivec2 p)
-{
-    vec3 o, dir;
-    view_ray(px_ndc(p), o, dir);
-    float d = linear_depth(raw, dir);
-    if (d <= 0.0 || isinf(d) || isnan(d))
-        return vec4(0.0);
-    return vec4(o.x + d * dir.x, o.y + d * dir.y, -d, d);
-}
-
-vec4 position_at(ivec2 p)
-{
-    return prep_position(imageLoad(u_depth, p).r, p);
-}
-
-// Difference towards the neighbour along step whose depth is closer to the
-// centre's, so that edges do not bend the normal.
-bool neighbour_delta(ivec2 p, vec4 c, ivec2 step, out vec3 delta)
-{
-    bool found = false;
-    float best_dz = 0.0;
-    delta = vec3(0.0);
-    for (int s = -1; s <= 1; s += 2) {
-        ivec2 q = p + s * step;
-        if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
-            continue;
-        vec4 n = position_at(q);
-        if (n.w <= 0.0)
-            continue;
-        float dz = abs(n.w - c.w);
-        if (!found || dz < best_dz) {
-            found = true;
-            best_dz = dz;
-            delta = float(s) * (n.xyz - c.xyz);
-        }
-    }
-    return found;
-}
-
-vec3 normalize_safe(vec3 v)
-{
-    float l = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-    return l > 0.0 ? v / l : v;
-}
-
 void main()
 {
+#if OBS_HALF == 0
     ivec2 p = ivec2(gl_FragCoord.xy);
-    vec4 c = position_at(p);
-    o_pos = c;
-    vec3 n;
-#if OBS_RECONSTRUCT == 0
-    n = normalize_safe(u_normal_matrix * imageLoad(u_normal, p).xyz);
 #else
-    vec3 dx, dy;
-    n = vec3(0.0);
-    if (neighbour_delta(p, c, ivec2(1, 0), dx) && neighbour_delta(p, c, ivec2(0, 1), dy))
-        n = cross(dx, dy);
-    if (n == vec3(0.0))
-        n = -c.xyz;             // isolated pixel: face the camera
-    else if (dot(n, c.xyz) > 0.0)
-        n = -n;                 // a visible surface faces the camera
-    n = normalize_safe(n);
+    ivec2 hp = ivec2(gl_FragCoord.xy);
+    bool nearest = ((hp.x + hp.y) & 1) == 0;
+    ivec2 p = 2 * hp; // all background: the block's first pixel
+    float best_z = 0.0;
+    bool found = false;
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            ivec2 q = 2 * hp + ivec2(i, j);
+            if (q.x >= u_size.x || q.y >= u_size.y)
+                continue;
+            float z = position_at(q).w;
+            if (z <= 0.0)
+                continue;
+            if (!found || (nearest ? z < best_z : z > best_z)) {
+                found = true;
+                p = q;
+                best_z = z;
+            }
+        }
 #endif
+    vec4 c;
+    vec3 n;
+    prep_pixel(p, c, n);
+    o_pos = c;
     o_normal = vec4(n, 0.0);
     o_dz = vec2(c.w, n.z);
 }

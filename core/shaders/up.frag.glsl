@@ -4,14 +4,15 @@
 // weight times max(0, n . n_q); one without a surface, or whose planar
 // depth is more than R from the pixel's (the blur's threshold, section
 // 4.6), is left out; when all are, the one nearest in depth gives its AO.
-// Drawn over the full frame with its block bound.  OBS_RAYS (0 or 1,
-// defined by the program): the result converted for ao_definition rays,
-// as the blur's vertical pass does at full resolution.  C twin:
-// obs__half_upsample in half_cpu.c (the conversion: run_cpu.c).
+// Drawn over the full frame with its block bound; the pixel's own depth
+// and normal come from the raw planes through prep.glsl (the prep pass
+// ran at half size only).  OBS_RAYS (0 or 1, defined by the program): the
+// result converted for ao_definition rays, as the blur's vertical pass
+// does at full resolution; OBS_RECONSTRUCT and OBS_DEPTH_MODE: as for the
+// prep pass.  C twin: obs__half_upsample in half_cpu.c (the conversion:
+// run_cpu.c).
 
-layout(rg32f) readonly uniform image2D u_dz;        // full prep planes: planar depth (r)
-layout(rgba32f) readonly uniform image2D u_vnormal;
-layout(rgba32f) readonly uniform image2D u_hnormal; // half planes (down.frag.glsl)
+layout(rgba32f) readonly uniform image2D u_hnormal; // half planes (prep.frag.glsl, OBS_HALF)
 layout(rg32f) readonly uniform image2D u_hao;       // half AO after the blur, planar depth
 uniform ivec2 u_half_size;
 
@@ -20,12 +21,14 @@ out vec2 o_ao;                                      // AO, the pixel's planar de
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    float zp = imageLoad(u_dz, px).r;
+    vec4 c;
+    vec3 n;
+    prep_pixel(px, c, n);
+    float zp = c.w;
     if (zp <= 0.0) {            // background: what the AO pass writes there
         o_ao = vec2(1.0, zp);
         return;
     }
-    vec3 n = imageLoad(u_vnormal, px).xyz;
     // the 2x2 half pixels around the centre; at the border the two inside
     // (half_cpu.c says why)
     float u = (float(px.x) + 0.5) * 0.5 - 0.5, v = (float(px.y) + 0.5) * 0.5 - 0.5;

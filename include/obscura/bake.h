@@ -259,8 +259,9 @@ typedef struct obs_bake_result {
 typedef struct obs_bake_desc {
     obs_bake_params params;
     /* Called from the tracing threads (serialised) with the samples done
-     * so far; may be NULL. */
-    void (*progress)(void *user, size_t done, size_t total);
+     * so far, after each batch of samples; may be NULL.  A nonzero return
+     * stops the bake: obs_bake_run returns OBS_CANCELLED. */
+    int (*progress)(void *user, size_t done, size_t total);
     void *progress_user;
 } obs_bake_desc;
 
@@ -269,6 +270,27 @@ typedef struct obs_bake_desc {
 obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
                         obs_bake_result *out, char err[OBS_ERR_LEN]);
 void obs_bake_result_free(obs_bake_result *r);
+
+/* ---- a bake spread over many machines (shard.c) ------------------------ */
+
+/* Traces shard `index` of `count` (0 <= index < count) of the level's
+ * surface samples: the contiguous range [index n / count, (index + 1) n /
+ * count) of the n samples obs_bake_run makes, each with the rays it gets
+ * there, and writes them to `path` as a part (core/bake/shard.c has the
+ * layout).  st (may be NULL) gets the counts and the trace's times. */
+obs_status obs_bake_shard(const obs_bake_scene *scene, const obs_bake_desc *desc, int index,
+                          int count, const char *path, obs_bake_stats *st, char err[OBS_ERR_LEN]);
+/* The parts (any order; every shard of one split once, traced from this
+ * level) read back and fitted: the result obs_bake_run gives.  The trace
+ * parameters (rays, seed, the sample budget, the distances, the back-face
+ * limit) not given in desc are the parts'; given ones must agree; desc's
+ * parameters hold those the merge used once it returns.  The
+ * stats' bvh and trace rows are the parts' times summed (plus the
+ * reading); holdout samples are traced here.  Free with
+ * obs_bake_result_free(). */
+obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
+                          const char *const *parts, size_t n, obs_bake_result *out,
+                          char err[OBS_ERR_LEN]);
 
 /* ---- output ----------------------------------------------------------- */
 

@@ -271,7 +271,7 @@ obs_status obs_ctx_set_deadline(obs_ctx *ctx, double seconds, char err[OBS_ERR_L
 typedef enum obs_pass {
     OBS_PASS_UPLOAD,
     OBS_PASS_PREP,
-    OBS_PASS_DOWNSAMPLE, /* ao_resolution half: the prep planes to half size */
+    OBS_PASS_DOWNSAMPLE, /* ao_resolution half: the prep pass straight to half size (no full prep) */
     OBS_PASS_CULL,
     OBS_PASS_AO,
     OBS_PASS_BLUR,

@@ -25,7 +25,8 @@ extern "C" {
     X(GL_SHADER, "a shader failed to compile or link")                         \
     X(GL_ERROR, "OpenGL reported an error")                                    \
     X(TOO_COSTLY, "the request's work exceeds the configured limit")          \
-    X(DEADLINE, "the frame's GL work ran past the configured deadline")
+    X(DEADLINE, "the frame's GL work ran past the configured deadline")       \
+    X(CANCELLED, "the work was cancelled")
 
 typedef enum obs_status {
 #define OBS__STATUS_ENUM(name, msg) OBS_##name,

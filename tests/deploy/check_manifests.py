@@ -109,7 +109,7 @@ check("ServiceMonitor: selects the Service, scrapes /metrics on its port",
       get(sm, "spec", "endpoints", 0, "path") == "/metrics" and
       get(sm, "spec", "endpoints", 0, "port") == get(svc, "spec", "ports", 0, "name"))
 
-job = docs["Job"][0][1]
+job = [d for f, d in docs["Job"] if f == "batch-job.yaml"][0]
 js = job["spec"]
 check("Job: Indexed, completions, restartPolicy Never",
       js.get("completionMode") == "Indexed" and js.get("completions", 0) > 0 and
@@ -149,6 +149,131 @@ try:
     check("OpenJD: every {{Param.X}} used is defined (" + ", ".join(sorted(used)) + ")", used <= params)
 except (yaml.YAMLError, KeyError, IndexError, TypeError) as e:
     check(f"OpenJD: openjd_job.yaml ({e})", False)
+
+# ---- the bake spread over shards: Kubernetes, OpenJD, OpenCue ----------
+# With OBSCURA (the binary) and OBSCURA_BAKE_LEVEL (a level file), each
+# template's commands run here: its shards, then its merge, on the level
+# with few rays, and the merged .glb must be the unsharded bake's bytes.
+import re
+import shutil
+import subprocess
+import tempfile
+
+obscura = os.environ.get("OBSCURA")
+level = os.environ.get("OBSCURA_BAKE_LEVEL")
+RAYS = "16"
+
+
+def run_sh(script, env, cwd):
+    e = dict(os.environ)
+    e.update(env)
+    r = subprocess.run(["/bin/sh", "-c", script], env=e, cwd=cwd, capture_output=True, text=True, timeout=300)
+    if r.returncode != 0:
+        print("       " + (r.stderr or r.stdout).strip().replace("\n", "\n       "))
+    return r.returncode == 0
+
+
+def unsharded(tmp):
+    out = os.path.join(tmp, "whole.glb")
+    subprocess.run([obscura, "bake", level, "-o", out, "--rays", RAYS, "-q"], check=True, timeout=300)
+    return open(out, "rb").read()
+
+
+bake_jobs = {d["metadata"]["name"]: d for f, d in docs["Job"] if f == "bake-job.yaml"}
+sj, mj = bake_jobs.get("obscura-bake-shards"), bake_jobs.get("obscura-bake-merge")
+check("bake-job: a shard Job and a merge Job", sj is not None and mj is not None)
+if sj and mj:
+    ss = sj["spec"]
+    sc = get(ss, "template", "spec", "containers", 0)
+    senv = {e["name"]: e["value"] for e in sc.get("env", [])}
+    mc = get(mj, "spec", "template", "spec", "containers", 0)
+    menv = {e["name"]: e["value"] for e in mc.get("env", [])}
+    winit = get(mj, "spec", "template", "spec", "initContainers", 0)
+    wenv = {e["name"]: e["value"] for e in winit.get("env", [])}
+    check("bake-job: shards Indexed, restartPolicy Never, completions = SHARDS of every container",
+          ss.get("completionMode") == "Indexed" and get(ss, "template", "spec", "restartPolicy") == "Never" and
+          str(ss.get("completions")) == senv.get("SHARDS") == menv.get("SHARDS") == wenv.get("SHARDS"))
+    sscript = " ".join(sc.get("args", []))
+    check("bake-job: shard i traces --shard $JOB_COMPLETION_INDEX/$SHARDS",
+          '--shard "$JOB_COMPLETION_INDEX/$SHARDS"' in sscript)
+    check("bake-job: the merge waits for the parts, with a deadline, and merges them",
+          "--merge" in " ".join(mc.get("args", [])) and "part_" in " ".join(winit.get("args", [])) and
+          (get(mj, "spec", "activeDeadlineSeconds") or 0) > 0)
+    codes = [v for r in get(ss, "podFailurePolicy", "rules", default=[]) if r.get("action") == "FailJob"
+             for v in get(r, "onExitCodes", "values", default=[])]
+    check("bake-job: exit 3 (bad input) fails the shard Job at once", 3 in codes)
+    check("bake-job: same level for shards and merge, same claim",
+          senv.get("LEVEL") == menv.get("LEVEL") and
+          get(ss, "template", "spec", "volumes", 0, "persistentVolumeClaim", "claimName") ==
+          get(mj, "spec", "template", "spec", "volumes", 0, "persistentVolumeClaim", "claimName"))
+    if obscura and level:
+        tmp = tempfile.mkdtemp(prefix="obs_bakejob_")
+        name = os.path.basename(level)
+        shutil.copy(level, os.path.join(tmp, name))
+        fix = lambda s: s.replace("/levels", tmp).replace("exec obscura ", f"exec {obscura} ")
+        n = 4  # fewer shards than the example's 8: the same commands
+        env = {"LEVEL": name, "SHARDS": str(n), "RAYS": RAYS}
+        ok = all(run_sh(fix(sscript), dict(env, JOB_COMPLETION_INDEX=str(i)), tmp) for i in range(n))
+        with open(os.path.join(tmp, "wait.sh"), "w") as w:
+            w.write(fix(" ".join(winit.get("args", []))))
+        ok = ok and run_sh("timeout 20 sh wait.sh", env, tmp)  # the parts are all there
+        ok = ok and run_sh(fix(" ".join(mc.get("args", []))), env, tmp)
+        out = os.path.join(tmp, os.path.splitext(name)[0] + "_baked.glb")
+        check(f"bake-job: its commands run here ({n} shards of {name}, {RAYS} rays), merged = unsharded",
+              ok and os.path.exists(out) and open(out, "rb").read() == unsharded(tmp))
+        shutil.rmtree(tmp)
+
+try:
+    t = yaml.safe_load(open(os.path.join(farm, "openjd_bake.yaml")))
+    steps = {s["name"]: s for s in t["steps"]}
+    params = {p["name"]: p.get("default") for p in t["parameterDefinitions"]}
+    used = {w.split("}}")[0] for w in (yaml.safe_dump(t).split("{{Param.")[1:])}
+    check("OpenJD bake: a Shards step over 1-{{Param.Shards}}, a Merge step that depends on it",
+          get(steps, "Shards", "parameterSpace", "taskParameterDefinitions", 0, "range") == "1-{{Param.Shards}}" and
+          get(steps, "Merge", "dependencies", 0, "dependsOn") == "Shards")
+    check("OpenJD bake: every {{Param.X}} used is defined (" + ", ".join(sorted(used)) + ")", used <= set(params))
+    if obscura and level:
+        tmp = tempfile.mkdtemp(prefix="obs_openjd_")
+        n = 3
+        vals = dict(params, Level=level, Output=os.path.join(tmp, "out.glb"), PartsDir=os.path.join(tmp, "parts"),
+                    Shards=n, Rays=RAYS)
+
+        def fill(s, task=None):
+            s = re.sub(r"\{\{Param\.(\w+)\}\}", lambda m: str(vals[m.group(1)]), s)
+            s = s.replace("{{Task.Param.ShardNumber}}", str(task))
+            return s.replace("exec obscura ", f"exec {obscura} ")
+        sdata = steps["Shards"]["script"]["embeddedFiles"][0]["data"]
+        mdata = steps["Merge"]["script"]["embeddedFiles"][0]["data"]
+        ok = all(run_sh(fill(sdata, k), {}, tmp) for k in range(1, n + 1)) and run_sh(fill(mdata), {}, tmp)
+        check(f"OpenJD bake: its scripts run here ({n} shards, {RAYS} rays), merged = unsharded",
+              ok and open(vals["Output"], "rb").read() == unsharded(tmp))
+        shutil.rmtree(tmp)
+except (yaml.YAMLError, KeyError, IndexError, TypeError, OSError) as e:
+    check(f"OpenJD bake: openjd_bake.yaml ({e})", False)
+
+try:
+    spec = ET.parse(os.path.join(farm, "opencue_bake.xml")).getroot()
+    layers = {l.get("name"): l for l in spec.findall("./job/layers/layer")}
+    dep = spec.find("./depends/depend")
+    check("OpenCue bake: layers shards and merge, merge LAYER_ON_LAYER on shards",
+          set(layers) == {"shards", "merge"} and dep is not None and dep.get("type") == "LAYER_ON_LAYER" and
+          dep.find("deplayer").text == "merge" and dep.find("onlayer").text == "shards")
+    scmd, mcmd = layers["shards"].find("cmd").text, layers["merge"].find("cmd").text
+    rng = layers["shards"].find("range").text
+    n = int(rng.split("-")[1])
+    check(f"OpenCue bake: frames 1-{n} are shards 0..{n - 1} of {n}",
+          rng == f"1-{n}" and f"--shard $((#IFRAME# - 1))/{n}" in scmd and "--merge" in mcmd)
+    if obscura and level:
+        tmp = tempfile.mkdtemp(prefix="obs_opencue_")
+        fix = lambda s: (s.replace("/show/levels/level.glb", level).replace("/show/levels", tmp)
+                         .replace("exec obscura ", f"exec {obscura} ").replace("--rays 256", "--rays " + RAYS))
+        ok = all(run_sh(fix(scmd.replace("#IFRAME#", str(f))), {}, tmp) for f in range(1, n + 1))
+        ok = ok and run_sh(fix(mcmd), {}, tmp)
+        check(f"OpenCue bake: its commands run here ({n} shards, {RAYS} rays), merged = unsharded",
+              ok and open(os.path.join(tmp, "level_baked.glb"), "rb").read() == unsharded(tmp))
+        shutil.rmtree(tmp)
+except (ET.ParseError, AttributeError, KeyError, ValueError, OSError) as e:
+    check(f"OpenCue bake: opencue_bake.xml ({e})", False)
 
 print(f"manifests: {passed} passed, {failed} failed")
 sys.exit(1 if failed else 0)

@@ -193,6 +193,57 @@ said "truncated"
 expect 2 "--baked with --deep" -- "$OBSCURA" gbuffer "$T/a.glb" --baked --deep \
     --camera "$T/cam0.json" -o "$T/x.exr"
 
+echo "-- shards: --shard I/N then --merge"
+expect 0 "unsharded, 24 rays" -- "$OBSCURA" bake "$FIX" -o "$T/whole.glb" --rays 24 --report "$T/whole.json" -q
+for n in 1 3 4; do
+    i=0; ok_shards=1
+    while [ $i -lt $n ]; do
+        "$OBSCURA" bake "$FIX" --shard $i/$n -o "$T/part$n.$i.bin" --rays 24 --threads 2 -q 2>"$T/err" || ok_shards=0
+        i=$((i + 1))
+    done
+    check "$n shard(s) traced" "[ $ok_shards = 1 ]"
+    # shell order: part$n.0 .. part$n.(n-1); the merge takes any order
+    expect 0 "merge of $n shard(s)" -- "$OBSCURA" bake "$FIX" --merge $(ls -r "$T"/part$n.*.bin) \
+        -o "$T/merged$n.glb" --report "$T/merged$n.json" -q
+    check "merged of $n = unsharded, byte for byte" "cmp -s $T/whole.glb $T/merged$n.glb"
+    check "merged of $n: the rays of the unsharded bake" \
+        "[ \"\$(field $T/merged$n.json \"['counts']['rays']\")\" = \"\$(field $T/whole.json \"['counts']['rays']\")\" ]"
+    check "merged of $n: the parts' rays (24) in the report" "[ \"\$(field $T/merged$n.json \"['params']['rays']\")\" = 24 ]"
+done
+check "a part is 128 + 9 bytes a sample" \
+    "[ \$((\$(cat $T/part3.*.bin | wc -c) - 3 * 128)) = \$((9 * \$(field $T/whole.json \"['counts']['samples']\"))) ]"
+expect 3 "a missing shard" -- "$OBSCURA" bake "$FIX" --merge "$T/part4.0.bin" "$T/part4.1.bin" "$T/part4.3.bin" -o "$T/x.glb" -q
+said "1 of 4 shards missing (2)"
+expect 3 "a shard twice" -- "$OBSCURA" bake "$FIX" --merge "$T/part3.0.bin" "$T/part3.1.bin" "$T/part3.1.bin" -o "$T/x.glb" -q
+said "shard 1/3 given twice"
+expect 3 "shards of two splits" -- "$OBSCURA" bake "$FIX" --merge "$T/part3.0.bin" "$T/part4.1.bin" "$T/part3.2.bin" -o "$T/x.glb" -q
+said "parts of different splits"
+head -c 1000 "$T/part3.1.bin" >"$T/cut.bin"
+expect 3 "a truncated part" -- "$OBSCURA" bake "$FIX" --merge "$T/part3.0.bin" "$T/cut.bin" "$T/part3.2.bin" -o "$T/x.glb" -q
+said "truncated: 1000 bytes"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$T/tri.obj"
+expect 0 "a shard of another level" -- "$OBSCURA" bake "$T/tri.obj" --shard 0/1 -o "$T/tri.bin" --rays 24 -q
+i=0; ok_shards=1
+while [ $i -lt 8 ]; do
+    "$OBSCURA" bake "$T/tri.obj" --shard $i/8 -o "$T/tri8.$i.bin" --rays 24 -q 2>"$T/err" || ok_shards=0
+    i=$((i + 1))
+done
+expect 0 "8 shards of a level of 4 samples (4 of them empty) merged" -- "$OBSCURA" bake "$T/tri.obj" \
+    --merge "$T"/tri8.*.bin -o "$T/tri8.glb" -q
+"$OBSCURA" bake "$T/tri.obj" -o "$T/tri1.glb" --rays 24 -q
+check "... = unsharded, the empty parts 128 bytes" \
+    "[ $ok_shards = 1 ] && cmp -s $T/tri1.glb $T/tri8.glb && [ \$(wc -c < $T/tri8.7.bin) = 137 ] && [ \$(wc -c < $T/tri8.0.bin) = 128 ]"
+expect 3 "a part of another level" -- "$OBSCURA" bake "$FIX" --merge "$T/tri.bin" -o "$T/x.glb" -q
+said "traced from another level"
+expect 3 "not a part" -- "$OBSCURA" bake "$FIX" --merge "$T/whole.json" -o "$T/x.glb" -q
+said "not a bake part"
+expect 3 "a merge asking for other rays" -- "$OBSCURA" bake "$FIX" --merge "$T"/part1.0.bin -o "$T/x.glb" --rays 8 -q
+said "traced with rays 24; this merge asks for 8"
+expect 2 "--shard 4/4" -- "$OBSCURA" bake "$FIX" --shard 4/4 -o "$T/x.bin"
+said "0 <= I < N"
+expect 2 "--merge without parts" -- "$OBSCURA" bake "$FIX" --merge -o "$T/x.glb"
+said "needs the part files"
+
 echo "-- bad input"
 for f in no_triangles.obj:"no triangles" nan_vertex.obj:"not finite" \
          huge_index_count.glb:"out of range" degenerate.obj:"degenerate"; do
@@ -220,6 +271,11 @@ if [ -f "$L" ]; then
     check "aalborg: 11,698 triangles, 1,315 instances" \
         "[ \"\$(field $T/aalborg.json \"['counts']['triangles']\")\" = 11698 ] && [ \"\$(field $T/aalborg.json \"['counts']['instances']\")\" = 1315 ]"
     expect 0 "aalborg .glb checked" -- python3 tests/e2e/lib/glb_check.py "$T/aalborg.glb" 1315
+    for i in 0 1 2; do
+        "$OBSCURA" bake "$L" --shard $i/3 -o "$T/aal.$i.bin" --rays 16 -q 2>"$T/err"
+    done
+    expect 0 "aalborg: merge of 3 shards" -- "$OBSCURA" bake "$L" --merge "$T"/aal.*.bin -o "$T/aal_merged.glb" -q
+    check "aalborg: merged of 3 = unsharded, byte for byte" "cmp -s $T/aalborg.glb $T/aal_merged.glb"
 else
     echo "  skip aalborg: $L absent (shared data)"
 fi

@@ -3,7 +3,8 @@
 # example config (obscurad reads it), the Dockerfile (its run-time
 # packages cover every library obscurad and obscura link; hadolint when
 # installed), the Kubernetes manifests and farm job templates
-# (tests/deploy/check_manifests.py, PyYAML), and the plain farm script
+# (tests/deploy/check_manifests.py, PyYAML; the bake templates' commands
+# run on the fixture level, merged = unsharded), and the plain farm script
 # (runs a chunk in-process).  There is no container engine here: the
 # image itself is not built.
 #
@@ -91,7 +92,10 @@ for p in /usr/bin/python3 python3; do
     if command -v "$p" >/dev/null 2>&1 && "$p" -c 'import yaml' 2>/dev/null; then PY=$p; break; fi
 done
 if [ -n "$PY" ]; then
-    "$PY" tests/deploy/check_manifests.py deploy > "$T/manifests" 2>&1
+    # the bake templates' commands run on the fixture level
+    OBSCURA="$(cd "$(dirname "$OBSCURA")" && pwd)/$(basename "$OBSCURA")" \
+        OBSCURA_BAKE_LEVEL="$(pwd)/$DATA/levels/aalborg_cut.acc" \
+        "$PY" tests/deploy/check_manifests.py deploy > "$T/manifests" 2>&1
     rc=$?
     grep -v '^manifests: ' "$T/manifests"
     check "manifests: exit $rc" "[ $rc -eq 0 ]"

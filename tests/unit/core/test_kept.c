@@ -7,17 +7,15 @@
 #include "context.h"
 #include "obscura/deep.h"
 
-/* The chain's targets for w x h: the 13 full-size textures run_gl.c
- * allocates (their formats' texel sizes) and the culling pre-pass's one
- * at 1/8 size. */
+/* The chain's targets of an AO-only frame, w x h, normals given: the 7
+ * full-size textures run_gl.c makes for it (their formats' texel sizes)
+ * and the culling pre-pass's one at 1/8 size.  Colour, the composite and
+ * the debug outputs are made on the first frame that asks for them. */
 static unsigned long long chain_bytes(int w, int h)
 {
     const unsigned long long px = (unsigned long long)w * h;
-    const unsigned long long per_px = 4 /* depth */ + 16 /* normal */ + 16 /* color */ +
-                                      16 /* viewpos */ + 16 /* vnormal */ + 8 /* dz */ +
-                                      8 /* ao */ + 16 /* composite */ + 8 /* blur */ +
-                                      4 /* count */ + 4 /* cull mask */ + 16 /* bleed */ +
-                                      4 /* luminance factor */;
+    const unsigned long long per_px = 4 /* depth */ + 16 /* normal */ + 16 /* viewpos */ +
+                                      16 /* vnormal */ + 8 /* dz */ + 8 /* ao */ + 8 /* blur */;
     const unsigned long long cull = (unsigned long long)((w + 7) / 8) * ((h + 7) / 8) * 4;
     return px * per_px + cull;
 }
@@ -49,6 +47,29 @@ static void test_flat(void **state)
     assert_memory_equal(a.ao.data, b.ao.data, (size_t)gf.gb.width * gf.gb.height * sizeof(float));
     obs_result_free(&a);
     obs_result_free(&b);
+
+    /* a composite: colour and the composite target added (16 bytes a
+     * pixel each), kept for the next frames */
+    const unsigned long long px = (unsigned long long)gf.gb.width * gf.gb.height;
+    assert_non_null(gf.gb.color.data);
+    assert_int_equal(obs_run(ctx, &gf.gb, NULL, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE, &a, err),
+                     OBS_OK);
+    assert_int_equal(obs_ctx_kept_bytes(ctx), kept + 32 * px);
+    obs_result_free(&a);
+
+    /* ao_resolution half, after a trim: the full set without prep planes
+     * (40 bytes a pixel), the half set with them */
+    assert_int_equal(obs_ctx_trim(ctx, 0, err), OBS_OK);
+    obs_params p = {0}; /* zero: every default */
+    assert_int_equal(obs_param_set(&p, "ao_resolution", "half", err), OBS_OK);
+    assert_int_equal(obs_run(ctx, &gf.gb, &p, OBS_OUTPUT_AO, &a, err), OBS_OK);
+    const int hw = (gf.gb.width + 1) / 2, hh = (gf.gb.height + 1) / 2;
+    const unsigned long long half_set = (unsigned long long)hw * hh * (4 + 8 + 8 + 16 + 16 + 8) +
+                                        (unsigned long long)((hw + 7) / 8) * ((hh + 7) / 8) * 4;
+    assert_int_equal(obs_ctx_kept_bytes(ctx), chain_bytes(gf.gb.width, gf.gb.height) - 40 * px +
+                                                  half_set);
+    print_message("half: %llu bytes kept\n", obs_ctx_kept_bytes(ctx));
+    obs_result_free(&a);
     obs_ctx_destroy(ctx);
     obs_gbuffer_free(&gf);
 }

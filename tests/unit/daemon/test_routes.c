@@ -13,6 +13,9 @@ static void test_route_of(void **state)
     assert_int_equal(obsd_route_of("/preview/app.js"), OBSD_ROUTE_PAGE);
     assert_int_equal(obsd_route_of("/v1/streams"), OBSD_ROUTE_STREAMS);
     assert_int_equal(obsd_route_of("/v1/streams/shot/frames"), OBSD_ROUTE_STREAMS);
+    assert_int_equal(obsd_route_of("/v1/bakes"), OBSD_ROUTE_BAKES);
+    assert_int_equal(obsd_route_of("/v1/bakes/0123456789abcdef/result"), OBSD_ROUTE_BAKES);
+    assert_int_equal(obsd_route_of("/v1/bakesx"), OBSD_ROUTE_OTHER);
     /* exact: no prefix match for the others, and "binary" is not a URL */
     assert_int_equal(obsd_route_of("/v1/ao/x"), OBSD_ROUTE_OTHER);
     assert_int_equal(obsd_route_of("binary"), OBSD_ROUTE_OTHER);
@@ -23,6 +26,8 @@ static void test_route_path(void **state)
 {
     (void)state;
     assert_string_equal(obsd_route_path(OBSD_ROUTE_AO), "/v1/ao");
+    assert_string_equal(obsd_route_path(OBSD_ROUTE_BAKES), "/v1/bakes");
+    assert_string_equal(obsd_route_path(OBSD_ROUTE_PAGE), "/");
     assert_string_equal(obsd_route_path(OBSD_ROUTE_BINARY), "binary");
     assert_string_equal(obsd_route_path(OBSD_ROUTE_OTHER), "other");
     assert_string_equal(obsd_route_path(OBSD_ROUTE_COUNT), "other");

@@ -1,0 +1,388 @@
+/* A bake spread over many machines (paper, section 4: the bakes ran on a
+ * farm).  The level's surface samples, numbered as the unsharded bake
+ * numbers them, are split into count contiguous ranges; shard i traces
+ * the samples [i n / count, (i + 1) n / count) with the rays of the
+ * unsharded bake (each sample's random numbers are keyed by its index
+ * and the seed alone, rng.h) and writes them as a part.  The merge makes
+ * the same samples again, reads every part into them and fits: the
+ * merged bake is the unsharded one, value for value.
+ *
+ * A part file, every field little-endian:
+ *
+ *   offset size  field
+ *     0     8    magic "OBSSHARD"
+ *     8     4    u32 version (1)
+ *    12     4    u32 header size in bytes (128)
+ *    16     8    u64 level fingerprint: FNV-1a 64 of the flattened level
+ *                (vertex and triangle counts, positions' float bits,
+ *                triangles, double-sidedness)
+ *    24     4    u32 shard index I (0 .. N-1)
+ *    28     4    u32 shard count N
+ *    32     8    u64 samples of the whole level
+ *    40     8    u64 first sample of this shard
+ *    48     8    u64 samples of this shard (n)
+ *    56     8    u64 rays traced
+ *    64     8    u64 samples dropped by the back-face rule
+ *    72     4    i32 rays            76  4  i32 seed
+ *    80     4    i32 max_samples_per_face
+ *    84     4    f32 samples_per_face   88  4  f32 distance_short
+ *    92     4    f32 distance_long      96  4  f32 backface_limit
+ *   100     4    u32 reserved (0)
+ *   104     8    f64 seconds of the BVH build
+ *   112     8    f64 seconds of the trace
+ *   120     8    u64 FNV-1a 64 of the payload
+ *   128  8 n     payload: per sample f32 obscurance at the short
+ *                distance, f32 at the long one
+ *   128+8n  n    per sample u8: 1 valid, 0 dropped by the back-face rule
+ *
+ * The file is exactly 128 + 9 n bytes.  The trace parameters (rays,
+ * seed, the sample budget, the distances, the back-face limit) are the
+ * ones that decide the samples' values; the merge takes those it is not
+ * given from the parts and refuses parts that disagree with it or each
+ * other.  A shard writes its part under PATH.tmp and renames it, so a
+ * killed shard leaves no part that looks whole. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "bake/shard.h"
+#include "internal.h"
+
+#define MAGIC "OBSSHARD"
+#define VERSION 1u
+#define HEADER 128u
+#define FNV_OFFSET 0xcbf29ce484222325ULL
+#define FNV_PRIME 0x100000001b3ULL
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+size_t obs__bake_shard_first(size_t total, int index, int count)
+{
+    /* total * index / count without overflow for any size_t total */
+    return total / (size_t)count * (size_t)index + total % (size_t)count * (size_t)index / (size_t)count;
+}
+
+/* ---- little-endian fields and the hash -------------------------------- */
+
+static void put32(unsigned char *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++)
+        p[i] = (unsigned char)(v >> (8 * i));
+}
+
+static void put64(unsigned char *p, uint64_t v)
+{
+    for (int i = 0; i < 8; i++)
+        p[i] = (unsigned char)(v >> (8 * i));
+}
+
+static uint32_t get32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static uint64_t get64(const unsigned char *p) { return (uint64_t)get32(p) | (uint64_t)get32(p + 4) << 32; }
+
+static uint32_t fbits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+static float bitsf(uint32_t u)
+{
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+static uint64_t dbits(double d)
+{
+    uint64_t u;
+    memcpy(&u, &d, sizeof u);
+    return u;
+}
+
+static double bitsd(uint64_t u)
+{
+    double d;
+    memcpy(&d, &u, sizeof d);
+    return d;
+}
+
+static uint64_t fnv(uint64_t h, const unsigned char *p, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ p[i]) * FNV_PRIME;
+    return h;
+}
+
+static uint64_t fnv32(uint64_t h, uint32_t v)
+{
+    unsigned char b[4];
+    put32(b, v);
+    return fnv(h, b, 4);
+}
+
+uint64_t obs__bake_level_fingerprint(const obs__bake_world *w)
+{
+    uint64_t h = fnv(FNV_OFFSET, (const unsigned char *)"obscura level 1", 15);
+    h = fnv32(fnv32(h, (uint32_t)w->vertex_count), (uint32_t)w->triangle_count);
+    for (size_t i = 0; i < 3 * w->vertex_count; i++)
+        h = fnv32(h, fbits(w->pos[i]));
+    for (size_t i = 0; i < 3 * w->triangle_count; i++)
+        h = fnv32(h, w->tri[i]);
+    return fnv(h, w->two_sided, w->triangle_count);
+}
+
+/* ---- writing a part ----------------------------------------------------- */
+
+static void header_bytes(const obs__bake_part *h, unsigned char b[HEADER])
+{
+    memset(b, 0, HEADER);
+    memcpy(b, MAGIC, 8);
+    put32(b + 8, VERSION);
+    put32(b + 12, HEADER);
+    put64(b + 16, h->level);
+    put32(b + 24, h->index);
+    put32(b + 28, h->count);
+    put64(b + 32, h->total);
+    put64(b + 40, h->first);
+    put64(b + 48, h->n);
+    put64(b + 56, h->rays);
+    put64(b + 64, h->dropped);
+    put32(b + 72, (uint32_t)h->rays_per_sample);
+    put32(b + 76, (uint32_t)h->seed);
+    put32(b + 80, (uint32_t)h->max_samples_per_face);
+    put32(b + 84, fbits(h->samples_per_face));
+    put32(b + 88, fbits(h->distance_short));
+    put32(b + 92, fbits(h->distance_long));
+    put32(b + 96, fbits(h->backface_limit));
+    put64(b + 104, dbits(h->bvh_seconds));
+    put64(b + 112, dbits(h->trace_seconds));
+    put64(b + 120, h->checksum);
+}
+
+/* The payload of samples [first, first + n) as the file holds it. */
+static unsigned char *payload_bytes(const obs__bake_samples *s, size_t first, size_t n)
+{
+    unsigned char *p = malloc(n * 9 + 1);
+    if (!p)
+        return NULL;
+    for (size_t i = 0; i < n; i++) {
+        put32(p + 8 * i, fbits(s->ao[2 * (first + i)]));
+        put32(p + 8 * i + 4, fbits(s->ao[2 * (first + i) + 1]));
+        p[8 * n + i] = s->valid[first + i] ? 1 : 0;
+    }
+    return p;
+}
+
+static obs_status write_part(const char *path, const obs__bake_part *h, const unsigned char *payload,
+                             char err[OBS_ERR_LEN])
+{
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 5);
+    if (!tmp)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: the file name", path);
+    memcpy(tmp, path, len);
+    memcpy(tmp + len, ".tmp", 5);
+    unsigned char head[HEADER];
+    header_bytes(h, head);
+    FILE *f = fopen(tmp, "wb");
+    int ok = f && fwrite(head, 1, HEADER, f) == HEADER &&
+             (h->n == 0 || fwrite(payload, 1, (size_t)h->n * 9, f) == (size_t)h->n * 9);
+    int e = errno;
+    if (f && fclose(f) != 0 && ok)
+        ok = 0, e = errno;
+    if (ok && rename(tmp, path) != 0)
+        ok = 0, e = errno;
+    if (!ok)
+        remove(tmp);
+    free(tmp);
+    return ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: cannot write the part: %s", path, strerror(e));
+}
+
+static void part_params(obs__bake_part *h, const obs__bake_trace_desc *td, const obs_bake_params *p)
+{
+    h->rays_per_sample = td->rays;
+    h->seed = (int32_t)td->seed;
+    h->distance_short = td->distance[0];
+    h->distance_long = td->distance[1];
+    h->backface_limit = td->backface_limit;
+    if (p) {
+        h->samples_per_face = p->samples_per_face;
+        h->max_samples_per_face = p->max_samples_per_face;
+    }
+}
+
+static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs__bake_samples *s,
+                              const obs__bake_trace_desc *td, const obs_bake_params *p,
+                              obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    obs__bake_part h = {0};
+    h.level = obs__bake_level_fingerprint(w);
+    h.index = (uint32_t)sh->index;
+    h.count = (uint32_t)sh->count;
+    h.total = s->count;
+    h.first = obs__bake_shard_first(s->count, sh->index, sh->count);
+    h.n = obs__bake_shard_first(s->count, sh->index + 1, sh->count) - h.first;
+    part_params(&h, td, p);
+    double t = now(), bvh = 0.0;
+    obs_status rc = OBS_OK;
+    s->rays = 0;
+    s->dropped = 0;
+    if (h.n) { /* an empty shard builds no BVH */
+        obs__bake_trace_desc d = *td;
+        d.first = (size_t)h.first;
+        d.end = (size_t)(h.first + h.n);
+        if ((rc = obs__bake_trace(w, s, &d, &bvh, err)) != OBS_OK)
+            return rc;
+    }
+    h.bvh_seconds = bvh;
+    h.trace_seconds = now() - t - bvh;
+    h.rays = s->rays;
+    h.dropped = s->dropped;
+    unsigned char *payload = payload_bytes(s, (size_t)h.first, (size_t)h.n);
+    if (!payload)
+        return obs__fail(err, OBS_NO_MEMORY, "the part of %llu samples", (unsigned long long)h.n);
+    h.checksum = fnv(FNV_OFFSET, payload, (size_t)h.n * 9);
+    rc = write_part(sh->path, &h, payload, err);
+    free(payload);
+    st->seconds[OBS_BAKE_STAGE_bvh] = h.bvh_seconds;
+    st->seconds[OBS_BAKE_STAGE_trace] = h.trace_seconds;
+    st->samples = (size_t)h.n;
+    sh->stop = 1;
+    return rc;
+}
+
+/* ---- reading parts ------------------------------------------------------- */
+
+obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN])
+{
+    memset(h, 0, sizeof *h);
+    h->path = path;
+    unsigned char b[HEADER];
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return obs__fail(err, OBS_IO, "%s: cannot open the part: %s", path, strerror(errno));
+    size_t got = fread(b, 1, HEADER, f);
+    struct stat sb;
+    int have_size = fstat(fileno(f), &sb) == 0;
+    fclose(f);
+    if (got >= 8 && memcmp(b, MAGIC, 8) != 0)
+        return obs__fail(err, OBS_BAD_FILE, "%s: not a bake part (no '" MAGIC "' magic; "
+                         "'obscura bake --shard I/N' writes them)", path);
+    if (got < HEADER)
+        return obs__fail(err, OBS_BAD_FILE, "%s: truncated: %zu bytes, shorter than a part's "
+                         "header (%u)", path, got, HEADER);
+    h->version = get32(b + 8);
+    if (h->version != VERSION || get32(b + 12) != HEADER)
+        return obs__fail(err, OBS_UNSUPPORTED, "%s: part version %u (header %u bytes); this "
+                         "obscura reads version %u", path, h->version, get32(b + 12), VERSION);
+    h->level = get64(b + 16);
+    h->index = get32(b + 24);
+    h->count = get32(b + 28);
+    h->total = get64(b + 32);
+    h->first = get64(b + 40);
+    h->n = get64(b + 48);
+    h->rays = get64(b + 56);
+    h->dropped = get64(b + 64);
+    h->rays_per_sample = (int32_t)get32(b + 72);
+    h->seed = (int32_t)get32(b + 76);
+    h->max_samples_per_face = (int32_t)get32(b + 80);
+    h->samples_per_face = bitsf(get32(b + 84));
+    h->distance_short = bitsf(get32(b + 88));
+    h->distance_long = bitsf(get32(b + 92));
+    h->backface_limit = bitsf(get32(b + 96));
+    h->bvh_seconds = bitsd(get64(b + 104));
+    h->trace_seconds = bitsd(get64(b + 112));
+    h->checksum = get64(b + 120);
+    if (h->count == 0 || h->index >= h->count || h->count > (uint32_t)INT32_MAX ||
+        h->total > UINT32_MAX || h->first != obs__bake_shard_first((size_t)h->total, (int)h->index, (int)h->count) ||
+        h->first + h->n != obs__bake_shard_first((size_t)h->total, (int)h->index + 1, (int)h->count))
+        return obs__fail(err, OBS_BAD_FILE, "%s: damaged header: shard %u/%u of %llu samples "
+                         "cannot hold samples %llu .. %llu", path, h->index, h->count,
+                         (unsigned long long)h->total, (unsigned long long)h->first,
+                         (unsigned long long)(h->first + h->n));
+    uint64_t want = HEADER + 9 * h->n;
+    if (have_size && (uint64_t)sb.st_size != want)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %lld bytes, its header promises %llu (%llu samples)",
+                         path, (uint64_t)sb.st_size < want ? "truncated" : "longer than a part",
+                         (long long)sb.st_size, (unsigned long long)want, (unsigned long long)h->n);
+    return OBS_OK;
+}
+
+static obs_status read_payload(const obs__bake_part *h, obs__bake_samples *s, char err[OBS_ERR_LEN])
+{
+    size_t n = (size_t)h->n, first = (size_t)h->first;
+    unsigned char *p = malloc(9 * n + 1);
+    if (!p)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %zu samples", h->path, n);
+    FILE *f = fopen(h->path, "rb");
+    int ok = f && fseek(f, HEADER, SEEK_SET) == 0 && fread(p, 1, 9 * n, f) == 9 * n;
+    if (f)
+        fclose(f);
+    if (!ok) {
+        free(p);
+        return obs__fail(err, OBS_IO, "%s: cannot read its %zu samples", h->path, n);
+    }
+    if (fnv(FNV_OFFSET, p, 9 * n) != h->checksum) {
+        free(p);
+        return obs__fail(err, OBS_BAD_FILE, "%s: damaged: its samples do not match the header's "
+                         "checksum", h->path);
+    }
+    for (size_t i = 0; i < n; i++) {
+        s->ao[2 * (first + i)] = bitsf(get32(p + 8 * i));
+        s->ao[2 * (first + i) + 1] = bitsf(get32(p + 8 * i + 4));
+        s->valid[first + i] = p[8 * n + i] != 0;
+    }
+    free(p);
+    return OBS_OK;
+}
+
+static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs__bake_samples *s,
+                              obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    uint64_t level = obs__bake_level_fingerprint(w);
+    const obs__bake_part *p0 = &sh->parts[0];
+    if (p0->level != level)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s was traced from another level (or "
+                         "another version of it): fingerprint %016llx, this level's %016llx",
+                         p0->path, (unsigned long long)p0->level, (unsigned long long)level);
+    if (p0->total != s->count)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: the parts split %llu samples; this level "
+                         "and these parameters make %zu", p0->path, (unsigned long long)p0->total,
+                         s->count);
+    double t = now();
+    s->rays = 0;
+    s->dropped = 0;
+    for (int i = 0; i < sh->count; i++) {
+        obs_status rc = read_payload(&sh->parts[i], s, err);
+        if (rc != OBS_OK)
+            return rc;
+        s->rays += sh->parts[i].rays;
+        s->dropped += (size_t)sh->parts[i].dropped;
+        /* the parts' times, summed: the farm's machine time */
+        st->seconds[OBS_BAKE_STAGE_bvh] += sh->parts[i].bvh_seconds;
+        st->seconds[OBS_BAKE_STAGE_trace] += sh->parts[i].trace_seconds;
+    }
+    st->seconds[OBS_BAKE_STAGE_trace] += now() - t;
+    return OBS_OK;
+}
+
+obs_status obs__bake_shard_step(obs__bake_shard *sh, const obs__bake_world *w,
+                                obs__bake_samples *s, const obs__bake_trace_desc *td,
+                                obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    return sh->parts ? read_shards(sh, w, s, st, err) : trace_shard(sh, w, s, td, &sh->params, st, err);
+}

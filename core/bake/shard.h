@@ -1,0 +1,51 @@
+/* A bake spread over many machines (shard.c): the hook of bake.c's steps
+ * and the pieces the tests look at. */
+#ifndef OBSCURA_BAKE_SHARD_H
+#define OBSCURA_BAKE_SHARD_H
+
+#include "bake/bake_internal.h"
+
+/* A part's header as read (shard.c documents the layout). */
+typedef struct obs__bake_part {
+    const char *path;
+    uint32_t version, index, count;
+    uint64_t level;             /* fingerprint of the flattened level */
+    uint64_t total, first, n;   /* the level's samples; this part's range */
+    uint64_t rays, dropped;
+    int32_t rays_per_sample, seed, max_samples_per_face;
+    float samples_per_face, distance_short, distance_long, backface_limit;
+    double bvh_seconds, trace_seconds;
+    uint64_t checksum;          /* FNV-1a 64 of the payload */
+} obs__bake_part;
+
+/* What the bake does instead of its trace: with path, trace shard
+ * index/count and write it there (stop is set: the bake ends after the
+ * step); with parts (count of them, shard order), read every shard's
+ * samples back and go on to the fit. */
+typedef struct obs__bake_shard {
+    obs_bake_params params; /* resolved */
+    int index, count;
+    const char *path;
+    const obs__bake_part *parts;
+    int stop;
+} obs__bake_shard;
+
+/* bake.c: obs_bake_run's steps with the hook (sh NULL: obs_bake_run). */
+obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc *desc,
+                               obs__bake_shard *sh, obs_bake_result *out, char err[OBS_ERR_LEN]);
+/* shard.c: the step; fills st's trace rows (times, rays, samples). */
+obs_status obs__bake_shard_step(obs__bake_shard *sh, const obs__bake_world *w,
+                                obs__bake_samples *s, const obs__bake_trace_desc *td,
+                                obs_bake_stats *st, char err[OBS_ERR_LEN]);
+
+/* The first sample of shard index of count over total samples: shard i
+ * traces [first(i), first(i + 1)); first(count) = total. */
+size_t obs__bake_shard_first(size_t total, int index, int count);
+/* FNV-1a 64 of the flattened level (positions, triangles, sidedness),
+ * independent of the host's byte order. */
+uint64_t obs__bake_level_fingerprint(const obs__bake_world *w);
+/* Reads and checks a part's header (magic, version, sizes, the file's
+ * length against its count). */
+obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN]);
+
+#endif

@@ -1,0 +1,149 @@
+/* obs_bake_shard and obs_bake_merge (obscura/bake.h): the checks of a
+ * merge's parts against each other and its parameters, then bake.c's
+ * steps with shard.c's step in place of the trace.  (Apart from shard.c,
+ * which bake.c calls: no two files call each other.) */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake/shard.h"
+#include "internal.h"
+
+obs_status obs_bake_shard(const obs_bake_scene *scene, const obs_bake_desc *desc, int index,
+                          int count, const char *path, obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    if (st)
+        memset(st, 0, sizeof *st);
+    if (count < 1 || index < 0 || index >= count)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %d/%d: the index is 0 .. count-1 "
+                         "(count at least 1)", index, count);
+    if (!path || !*path)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %d/%d: no part file to write", index, count);
+    obs__bake_shard sh = {.index = index, .count = count, .path = path};
+    obs_bake_params_resolve(desc ? &desc->params : NULL, &sh.params);
+    obs_bake_result r;
+    obs_status rc = obs__bake_run_shard(scene, desc, &sh, &r, err);
+    if (st)
+        *st = r.stats;
+    obs_bake_result_free(&r);
+    return rc;
+}
+
+/* The trace parameters a part carries: name, and whether it agrees. */
+#define TRACE_PARAMS(X)                                                         \
+    X(rays, rays_per_sample, INT)                                               \
+    X(seed, seed, INT)                                                          \
+    X(max_samples_per_face, max_samples_per_face, INT)                          \
+    X(samples_per_face, samples_per_face, FLOAT)                                \
+    X(distance_short, distance_short, FLOAT)                                    \
+    X(distance_long, distance_long, FLOAT)                                      \
+    X(backface_limit, backface_limit, FLOAT)
+
+static int row_of(const char *name)
+{
+    const obs_bake_param_info *pi = obs_bake_param_find(name);
+    return pi ? (int)(pi - obs_bake_param_at(0)) : -1;
+}
+
+/* The merge's parameters: those of the trace the parts' (all alike),
+ * unless given, when they must agree. */
+static obs_status adopt(obs_bake_params *p, const obs__bake_part *parts, size_t n, char err[OBS_ERR_LEN])
+{
+    const obs__bake_part *a = &parts[0];
+    for (size_t i = 1; i < n; i++) {
+        const obs__bake_part *b = &parts[i];
+#define SAME(name, field, type)                                                 \
+        if (memcmp(&a->field, &b->field, sizeof a->field) != 0)                 \
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced with different " \
+                             #name " (%g and %g): they are not parts of one bake", a->path,      \
+                             b->path, (double)a->field, (double)b->field);
+        TRACE_PARAMS(SAME)
+#undef SAME
+    }
+#define TAKE(name, field, type)                                                 \
+    {                                                                           \
+        int row = row_of(#name);                                                \
+        if (row >= 0 && (p->set >> row & 1)) {                                  \
+            if (p->name != a->field)                                            \
+                return obs__fail(err, OBS_INVALID_ARGUMENT, "the parts were traced with " #name \
+                                 " %g; this merge asks for %g (leave it out to take the parts')", \
+                                 (double)a->field, (double)p->name);            \
+        } else {                                                                \
+            p->name = a->field;                                                 \
+            if (row >= 0)                                                       \
+                p->set |= (uint64_t)1 << row;                                   \
+        }                                                                       \
+    }
+    TRACE_PARAMS(TAKE)
+#undef TAKE
+    return OBS_OK;
+}
+
+/* parts in shard order: every shard of one split, once. */
+static obs_status order_parts(const obs__bake_part *in, size_t n, obs__bake_part *out,
+                              char err[OBS_ERR_LEN])
+{
+    uint32_t count = in[0].count;
+    for (size_t i = 0; i < n; i++) {
+        if (in[i].count != count)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s is shard %u/%u, %s shard %u/%u: parts "
+                             "of different splits", in[0].path, in[0].index, count, in[i].path,
+                             in[i].index, in[i].count);
+        if (in[i].level != in[0].level)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced from different levels "
+                             "(fingerprints %016llx and %016llx)", in[0].path, in[i].path,
+                             (unsigned long long)in[0].level, (unsigned long long)in[i].level);
+        if (out[in[i].index].path)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %u/%u given twice: %s and %s",
+                             in[i].index, count, out[in[i].index].path, in[i].path);
+        out[in[i].index] = in[i];
+    }
+    if (n == count)
+        return OBS_OK;
+    char list[256] = "";
+    size_t len = 0, missing = 0;
+    for (uint32_t k = 0; k < count; k++)
+        if (!out[k].path && len + 16 < sizeof list) {
+            len += (size_t)snprintf(list + len, sizeof list - len, "%s%u", missing ? ", " : "", k);
+            missing++;
+        } else if (!out[k].path) {
+            missing++;
+        }
+    return obs__fail(err, OBS_INVALID_ARGUMENT, "%zu of %u shards missing (%s%s): a merge needs "
+                     "every shard of the split once", missing, count, list,
+                     missing * 4 > sizeof list ? ", ..." : "");
+}
+
+obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
+                          const char *const *paths, size_t n, obs_bake_result *out,
+                          char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    if (n == 0 || !paths)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "merge: no parts");
+    obs__bake_part *heads = calloc(n, sizeof *heads), *ordered = NULL;
+    obs_status rc = heads ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
+    for (size_t i = 0; rc == OBS_OK && i < n; i++)
+        rc = obs__bake_part_read_header(paths[i], &heads[i], err);
+    if (rc == OBS_OK && n > heads[0].count)
+        rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%zu parts given for a split into %u shards "
+                       "(%s): one is given twice, or belongs to another split", n, heads[0].count,
+                       heads[0].path);
+    if (rc == OBS_OK && !(ordered = calloc(heads[0].count, sizeof *ordered)))
+        rc = obs__fail(err, OBS_NO_MEMORY, "%u parts", heads[0].count);
+    if (rc == OBS_OK)
+        rc = order_parts(heads, n, ordered, err);
+    obs_bake_desc d = desc ? *desc : (obs_bake_desc){0};
+    if (rc == OBS_OK)
+        rc = adopt(&d.params, ordered, n, err);
+    if (rc == OBS_OK) {
+        obs__bake_shard sh = {.index = 0, .count = (int)n, .parts = ordered};
+        obs_bake_params_resolve(&d.params, &sh.params);
+        rc = obs__bake_run_shard(scene, &d, &sh, out, err);
+        if (desc)
+            desc->params = d.params;
+    }
+    free(ordered);
+    free(heads);
+    return rc;
+}

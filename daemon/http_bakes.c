@@ -1,0 +1,385 @@
+/* /v1/bakes: levels baked on the daemon's bake workers (bake_jobs.c).
+ *
+ *   GET    /v1/bakes                 the jobs (JSON)
+ *   POST   /v1/bakes?PARAM=V...      a level as the body: 202, the job's id
+ *   GET    /v1/bakes/ID              state, stage, progress, per-stage times
+ *   GET    /v1/bakes/ID/events       text/event-stream: progress, then the end
+ *   GET    /v1/bakes/ID/result       the baked .glb (409 until done)
+ *   DELETE /v1/bakes/ID              cancel (queued, running) or drop (finished)
+ *
+ * The query takes the bake parameters (`obscura bake --params`) by name,
+ * `distances=S,L`, and `format=EXT` (the level's file extension, else told
+ * from its first bytes).  An event stream is a suspended connection, as
+ * the streams' are (http_streams.c). */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "http_internal.h"
+#include "log.h"
+
+typedef obsd__req req;
+
+enum { OP_LIST = 1, OP_INFO, OP_RESULT, OP_EVENTS };
+
+#define ROUTES "GET|POST /v1/bakes, GET|DELETE /v1/bakes/ID, GET /v1/bakes/ID/result, GET /v1/bakes/ID/events"
+
+static int id_ok(const char *s, size_t n)
+{
+    if (n == 0 || n > OBSD_BAKE_ID_LEN)
+        return 0;
+    for (size_t i = 0; i < n; i++)
+        if (!((s[i] >= '0' && s[i] <= '9') || (s[i] >= 'a' && s[i] <= 'f')))
+            return 0;
+    return 1;
+}
+
+/* 1: a route (r->bake_op, r->bake_id); 0: none; -1: not an id. */
+static int parse_path(req *r, const char *url)
+{
+    const char *p = url + strlen("/v1/bakes");
+    if (!*p || !strcmp(p, "/")) {
+        r->bake_op = OP_LIST;
+        return 1;
+    }
+    p++;
+    size_t n = strcspn(p, "/");
+    if (!id_ok(p, n))
+        return -1;
+    memcpy(r->bake_id, p, n);
+    r->bake_id[n] = '\0';
+    p += n;
+    r->bake_op = !*p ? OP_INFO : !strcmp(p, "/result") ? OP_RESULT : !strcmp(p, "/events") ? OP_EVENTS : 0;
+    return r->bake_op ? 1 : 0;
+}
+
+static enum MHD_Result unknown(req *r)
+{
+    char msg[160];
+    snprintf(msg, sizeof msg, "no bake job '%s' (jobs live in the daemon's memory: a restart loses them; "
+             "finished ones are dropped beyond --bake-keep)", r->bake_id);
+    return obsd__answer_error(r, 404, "not_found", msg, NULL, NULL);
+}
+
+/* ---- POST: the query, then the body ------------------------------------ */
+
+typedef struct arg_ctx {
+    req *r;
+    int bad;
+    char err[OBS_ERR_LEN];
+} arg_ctx;
+
+static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *key, size_t key_size,
+                              const char *value, size_t value_size)
+{
+    arg_ctx *a = cls;
+    req *r = a->r;
+    (void)kind;
+    if (a->bad)
+        return MHD_NO;
+    if (obs_http_value_check(key, key_size, value, value_size, a->err) != OBS_OK) {
+        a->bad = 1;
+        return MHD_NO;
+    }
+    if (!value)
+        value = "";
+    if (!strcmp(key, "format")) {
+        size_t n = strlen(value);
+        int ok = n > 0 && n < sizeof r->bake_ext;
+        for (size_t i = 0; ok && i < n; i++)
+            ok = (value[i] >= 'a' && value[i] <= 'z') || (value[i] >= '0' && value[i] <= '9');
+        if (!ok) {
+            snprintf(a->err, OBS_ERR_LEN, "format '%.40s' is not a file extension (glb, gltf, ac, obj, ...)",
+                     value);
+            a->bad = 1;
+            return MHD_NO;
+        }
+        snprintf(r->bake_ext, sizeof r->bake_ext, "%s", value);
+        return MHD_YES;
+    }
+    if (!strcmp(key, "distances")) {
+        char s[64], l[64];
+        const char *comma = strchr(value, ',');
+        if (!comma || strchr(comma + 1, ',') || (size_t)(comma - value) >= sizeof s || strlen(comma + 1) >= sizeof l) {
+            snprintf(a->err, OBS_ERR_LEN, "distances '%.40s': expected SHORT,LONG (e.g. 2,300)", value);
+            a->bad = 1;
+            return MHD_NO;
+        }
+        snprintf(s, sizeof s, "%.*s", (int)(comma - value), value);
+        snprintf(l, sizeof l, "%s", comma + 1);
+        a->bad = obs_bake_param_set(&r->bake_params, "distance_short", s, a->err) != OBS_OK ||
+                 obs_bake_param_set(&r->bake_params, "distance_long", l, a->err) != OBS_OK;
+        return a->bad ? MHD_NO : MHD_YES;
+    }
+    if (obs_bake_param_set(&r->bake_params, key, value, a->err) != OBS_OK) {
+        if (!obs_bake_param_find(key))
+            snprintf(a->err, OBS_ERR_LEN, "unknown bake parameter '%.60s' (GET /v1/bakes lists none; "
+                     "'obscura bake --params' lists them; also format=EXT, distances=S,L)", key);
+        a->bad = 1;
+        return MHD_NO;
+    }
+    return MHD_YES;
+}
+
+static enum MHD_Result post_start(req *r)
+{
+    obsd_http *h = r->srv;
+    if (atomic_load(&h->draining))
+        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
+                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    arg_ctx a = {r, 0, ""};
+    MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
+    if (a.bad)
+        return obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL);
+    const char *v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (v) {
+        char *end;
+        errno = 0;
+        unsigned long long n = strtoull(v, &end, 10);
+        if (errno == ERANGE || n > (unsigned long long)h->cfg->max_level) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "level of %s bytes is over the limit of %lld bytes (--max-level)", v,
+                     (long long)h->cfg->max_level);
+            return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
+        }
+        r->cap = (size_t)n;
+        if (r->cap && !(r->body = malloc(r->cap)))
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the level");
+    }
+    r->state = REQ_BODY;
+    return MHD_YES;
+}
+
+/* The level's format from its first bytes, or NULL. */
+static const char *sniff(const unsigned char *p, size_t n)
+{
+    if (n >= 4 && !memcmp(p, "glTF", 4))
+        return "glb";
+    if (n >= 4 && !memcmp(p, "AC3D", 4))
+        return "ac";
+    if (n >= 4 && !memcmp(p, "ply", 3) && (p[3] == '\n' || p[3] == '\r'))
+        return "ply";
+    size_t i = 0;
+    while (i < n && (p[i] == ' ' || p[i] == '\t' || p[i] == '\r' || p[i] == '\n'))
+        i++;
+    if (i < n && p[i] == '{')
+        return "gltf";
+    if (i + 1 < n && (p[i] == 'v' || p[i] == 'o' || p[i] == 'g' || p[i] == '#') &&
+        (p[i + 1] == ' ' || p[i + 1] == '\t'))
+        return "obj";
+    if (n >= 6 && !memcmp(p + i, "mtllib", 6))
+        return "obj";
+    return NULL;
+}
+
+enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
+{
+    obsd_http *h = r->srv;
+    if (!obsd__req_alive(r))
+        return MHD_NO;
+    if (*size)
+        return obsd__append_body(r, data, size, (size_t)h->cfg->max_level);
+    char msg[320];
+    if (r->too_big) {
+        snprintf(msg, sizeof msg, "level is over the limit of %lld bytes (--max-level)",
+                 (long long)h->cfg->max_level);
+        return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
+    }
+    if (r->len == 0)
+        return obsd__answer_error(r, 400, "empty_body",
+                                  "POST /v1/bakes needs a level (glTF/GLB, AC3D, OBJ, ...) as its body", NULL, NULL);
+    const char *ext = r->bake_ext[0] ? r->bake_ext : sniff(r->body, r->len);
+    if (!ext)
+        return obsd__answer_error(r, 415, "unsupported_media_type",
+                                  "cannot tell the level's format from its first bytes: give format=EXT "
+                                  "(glb, gltf, ac, obj, fbx, ... as assimp names them)", NULL, NULL);
+    char id[OBSD_BAKE_ID_LEN + 1];
+    unsigned char *level = r->body;
+    size_t len = r->len;
+    r->body = NULL; /* the job has it */
+    r->cap = 0;
+    int rc = obsd_bakes_submit(h->bakes, level, len, ext, &r->bake_params, id);
+    if (rc == -1) {
+        snprintf(msg, sizeof msg, "%d bake jobs are queued or running (--max-bakes); retry later",
+                 h->cfg->max_bakes);
+        return obsd__answer_error(r, 503, "bake_queue_full", msg, MHD_HTTP_HEADER_RETRY_AFTER, "10");
+    }
+    if (rc == -2)
+        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
+                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    if (rc != 0)
+        return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the bake job");
+    char *text = malloc(512);
+    if (!text)
+        return MHD_NO;
+    int n = snprintf(text, 512,
+                     "{\"id\":\"%s\",\"state\":\"queued\",\"format\":\"%s\",\"status\":\"/v1/bakes/%s\","
+                     "\"events\":\"/v1/bakes/%s/events\",\"result\":\"/v1/bakes/%s/result\"}",
+                     id, ext, id, id, id);
+    struct MHD_Response *resp = MHD_create_response_from_buffer((size_t)n, text, MHD_RESPMEM_MUST_FREE);
+    if (!resp) {
+        free(text);
+        return MHD_NO;
+    }
+    char loc[64];
+    snprintf(loc, sizeof loc, "/v1/bakes/%s", id);
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "application/json");
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_LOCATION, loc);
+    char note[64];
+    snprintf(note, sizeof note, "bake=%s", id);
+    return obsd__answer(r, 202, resp, (size_t)n, note);
+}
+
+/* ---- events -------------------------------------------------------------- */
+
+static void sub_park(void *arg)
+{
+    req *r = arg;
+    MHD_suspend_connection(r->conn);
+}
+
+static void sub_wake(void *arg)
+{
+    req *r = arg;
+    MHD_resume_connection(r->conn);
+}
+
+static ssize_t sse_reader(void *cls, uint64_t pos, char *buf, size_t max)
+{
+    req *r = cls;
+    (void)pos;
+    if (r->event_off >= r->event_len) {
+        int n = obsd_bakes_next_event(r->srv->bakes, &r->bsub, r->event, sizeof r->event);
+        if (n < 0)
+            return MHD_CONTENT_READER_END_OF_STREAM;
+        if (n == 0)
+            return 0; /* parked until woken */
+        r->event_len = n;
+        r->event_off = 0;
+    }
+    size_t k = (size_t)(r->event_len - r->event_off);
+    if (k > max)
+        k = max;
+    memcpy(buf, r->event + r->event_off, k);
+    r->event_off += (int)k;
+    return (ssize_t)k;
+}
+
+static enum MHD_Result events(req *r)
+{
+    obsd_http *h = r->srv;
+    if (atomic_load(&h->draining))
+        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
+                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    r->bsub = (obsd_bake_sub){.park = sub_park, .wake = sub_wake, .arg = r};
+    int rc = obsd_bakes_subscribe(h->bakes, r->bake_id, &r->bsub);
+    if (rc == -1)
+        return unknown(r);
+    if (rc != 0)
+        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
+                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    r->bsubscribed = 1;
+    struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 1024, sse_reader, r, NULL);
+    if (!resp)
+        return MHD_NO;
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "text/event-stream");
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
+    MHD_add_response_header(resp, "X-Accel-Buffering", "no");
+    r->state = REQ_EVENTS;
+    return obsd__answer(r, 200, resp, 0, "event stream opened");
+}
+
+/* ---- the routes ------------------------------------------------------------- */
+
+static enum MHD_Result result(req *r)
+{
+    unsigned char *data = NULL;
+    size_t len = 0;
+    obsd_bake_state st = OBSD_BAKE_QUEUED;
+    int rc = obsd_bakes_result(r->srv->bakes, r->bake_id, &data, &len, &st);
+    if (rc == -1)
+        return unknown(r);
+    if (rc == -3)
+        return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the result");
+    if (rc == 1) {
+        char msg[192];
+        snprintf(msg, sizeof msg, "bake %s is %s%s (GET /v1/bakes/%s says more)", r->bake_id,
+                 obsd_bake_state_name(st), st == OBSD_BAKE_FAILED || st == OBSD_BAKE_CANCELLED ? ": no result" : "",
+                 r->bake_id);
+        return obsd__answer_error(r, 409,
+                                  st == OBSD_BAKE_FAILED      ? "bake_failed"
+                                  : st == OBSD_BAKE_CANCELLED ? "bake_cancelled"
+                                                              : "bake_not_done",
+                                  msg, NULL, NULL);
+    }
+    struct MHD_Response *resp = MHD_create_response_from_buffer(len, data, MHD_RESPMEM_MUST_FREE);
+    if (!resp) {
+        free(data);
+        return MHD_NO;
+    }
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "model/gltf-binary");
+    return obsd__answer(r, 200, resp, len, NULL);
+}
+
+static enum MHD_Result delete_job(req *r)
+{
+    obsd_bake_state st;
+    int removed = 0;
+    if (obsd_bakes_delete(r->srv->bakes, r->bake_id, &st, &removed) != 0)
+        return unknown(r);
+    char *text = malloc(160);
+    if (!text)
+        return MHD_NO;
+    int n = snprintf(text, 160, "{\"id\":\"%s\",\"state\":\"%s\",\"removed\":%s%s}", r->bake_id,
+                     obsd_bake_state_name(st), removed ? "true" : "false",
+                     st == OBSD_BAKE_RUNNING ? ",\"cancel_requested\":true" : "");
+    return obsd__answer_text(r, 200, "application/json", text, (size_t)n, NULL);
+}
+
+enum MHD_Result obsd__bakes_start(req *r, const char *url)
+{
+    obsd_http *h = r->srv;
+    int ok = parse_path(r, url);
+    if (h->cfg->max_bakes < 1)
+        return obsd__answer_error(r, 404, "bakes_off", "bake jobs are off (--max-bakes 0)", NULL, NULL);
+    if (ok < 0)
+        return obsd__answer_error(r, 404, "not_found", "a bake job's id is 16 hex digits, as POST /v1/bakes "
+                                  "answered it", NULL, NULL);
+    if (ok == 0)
+        return obsd__answer_error(r, 404, "not_found", "no such route (" ROUTES ")", NULL, NULL);
+    const char *allowed = r->bake_op == OP_LIST ? "GET, POST" : r->bake_op == OP_INFO ? "GET, DELETE" : "GET";
+    int get = !strcmp(r->method, "GET") || !strcmp(r->method, "HEAD");
+    if (!get && !(r->bake_op == OP_LIST && !strcmp(r->method, "POST")) &&
+        !(r->bake_op == OP_INFO && !strcmp(r->method, "DELETE"))) {
+        char msg[96];
+        snprintf(msg, sizeof msg, "this /v1/bakes route takes %s", allowed);
+        return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, allowed);
+    }
+    switch (r->bake_op) {
+    case OP_LIST: {
+        if (!get)
+            return post_start(r);
+        char *text = obsd_bakes_list_json(h->bakes);
+        return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
+    }
+    case OP_INFO: {
+        if (!get)
+            return delete_job(r);
+        char *text = obsd_bakes_json(h->bakes, r->bake_id);
+        return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : unknown(r);
+    }
+    case OP_RESULT:
+        return result(r);
+    default:
+        return events(r);
+    }
+}
+
+void obsd__bakes_done(req *r)
+{
+    if (r->bsubscribed) {
+        obsd_bakes_unsubscribe(r->srv->bakes, &r->bsub);
+        r->bsubscribed = 0;
+    }
+}
