@@ -169,7 +169,6 @@ static void usage(FILE *f)
  * the client's own. */
 typedef struct ao_args {
     const char *in, *out, *camera, *backend, *cache_dir;
-    const char *baked; /* --baked CH, "none", or NULL (auto: _AO) */
     int format_given; /* else the format comes from the file name */
     int cpu, debug_gl;
     long max_size;
@@ -211,10 +210,6 @@ static void parse_ao(int argc, char **argv, ao_args *a)
              * and the rest are this process's. */
         } else if ((v = opt_value(argc, argv, &i, "camera"))) {
             a->camera = v;
-        } else if ((v = opt_value(argc, argv, &i, "baked"))) {
-            if (!*v)
-                die_usage("--baked: an empty channel name (give CH, or none)");
-            a->baked = v;
         } else if ((v = opt_value(argc, argv, &i, "max-size"))) {
             a->max_size = strtol(v, NULL, 10);
             if (a->max_size < 1 || a->max_size > 1 << 20)
@@ -536,7 +531,7 @@ static int cmd_ao(int argc, char **argv)
 
     int deep = 0;
     if (obs_exr_is_deep(a.in, &deep, err) == OBS_OK && deep) {
-        if (a.baked && strcmp(a.baked, "none") != 0)
+        if (a.req.baked && strcmp(a.req.baked, "none") != 0)
             die_usage("ao: --baked: the input is a deep EXR; a baked channel is combined with "
                       "flat input only");
         return cmd_ao_deep(&a, &lim, server, argc, argv);
@@ -583,7 +578,7 @@ static int cmd_ao(int argc, char **argv)
     if ((rc = cli_input_warnings(a.in, &gf.info, a.req.strict)) != EXIT_OK)
         goto done;
     /* The baked channel: --baked CH, else _AO when the input has it. */
-    const char *bch = a.baked ? a.baked : "_AO";
+    const char *bch = a.req.baked ? a.req.baked : "_AO";
     if (strcmp(bch, "none") != 0) {
         s = obs_exr_read_channel(a.in, bch, &lim, &baked, err);
         if (s == OBS_OK && (baked.width != gf.gb.width || baked.height != gf.gb.height)) {
@@ -592,7 +587,7 @@ static int cmd_ao(int argc, char **argv)
             obs_image_free(&baked);
             s = OBS_INVALID_ARGUMENT;
         }
-        if (s != OBS_OK && a.baked) {
+        if (s != OBS_OK && a.req.baked) {
             rc = cli_input_fail(s, a.in, err);
             goto done;
         }

@@ -662,6 +662,9 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
         add(&ps, "output", oname);
         add(&ps, "format", "exr");
         add(&ps, "float", "1");
+        /* the baked channel: this client combines it (obscura.c), so the
+         * daemon does not do it a second time */
+        add(&ps, "baked", "none");
         camera_params(gb, &ps, cam, sizeof cam);
         if (!(body = read_file(in_path, &body_len))) {
             fprintf(stderr, "obscura: %s: cannot read it to send\n", in_path);

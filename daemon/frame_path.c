@@ -28,8 +28,36 @@ void obsd_fp_free(obsd_fp *fp)
     obs_deep_result_free(&fp->job.deep_result);
     obs_gbuffer_free(&fp->gf);
     obs_deep_free(&fp->deep_exr);
+    obs_image_free(&fp->baked);
     pthread_cond_destroy(&fp->cond);
     pthread_mutex_destroy(&fp->lock);
+}
+
+/* The baked AO channel of a flat EXR body (baked=CH, else _AO when the
+ * body has one; baked=none: not looked for), the G-buffer's size; the
+ * chain's AO is combined with it once the frame has run
+ * (obsd_fp_finished, obs_result_combine_baked). */
+static obs_status read_baked(obsd_fp *fp, const unsigned char *body, size_t len,
+                             const obs_http_request *hr, const obs_limits *lim,
+                             char err[OBS_ERR_LEN])
+{
+    const char *name = hr->baked ? hr->baked : "_AO";
+    if (!strcmp(name, "none"))
+        return OBS_OK;
+    char sub[OBS_ERR_LEN];
+    obs_status s = obs_exr_read_channel_mem(body, len, name, lim, &fp->baked, sub);
+    if (s == OBS_MISSING_CHANNEL && !hr->baked)
+        return OBS_OK; /* not a baked level's G-buffer */
+    if (s == OBS_OK && (fp->baked.width != fp->gf.gb.width || fp->baked.height != fp->gf.gb.height)) {
+        snprintf(sub, sizeof sub, "it is %dx%d, the G-buffer %dx%d", fp->baked.width,
+                 fp->baked.height, fp->gf.gb.width, fp->gf.gb.height);
+        s = OBS_INVALID_ARGUMENT;
+    }
+    if (s != OBS_OK) {
+        obs_image_free(&fp->baked);
+        snprintf(err, OBS_ERR_LEN, "baked channel %.64s: %.400s", name, sub);
+    }
+    return s;
 }
 
 obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
@@ -47,6 +75,8 @@ obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
         s = obs_deep_read_exr_mem(body, len, lim, &fp->deep_exr, err);
     else if (s == OBS_OK)
         s = obs_gbuffer_read_exr_mem(body, len, map, lim, &fp->gf, err);
+    if (s == OBS_OK && !deep)
+        s = read_baked(fp, body, len, hr, lim, err);
     if (s == OBS_OK && !deep && hr->solve_camera && fp->gf.gb.position.data)
         s = obs_gbuffer_solve_camera(&fp->gf, &hr->params, err);
     /* strict: a sanity warning on the input fails the frame (HTTP 422) */
@@ -114,6 +144,8 @@ static void job_done(obsd_job *job, void *user)
 int obsd_fp_queue(obsd_fp *fp, obsd_queue *q, const obs_params *params, unsigned outputs,
                   void (*on_done)(void *user), void *user)
 {
+    if (fp->baked.data && !fp->deep)
+        outputs |= OBS_OUTPUT_AO; /* the combination needs the chain's AO */
     fp->job = (obsd_job){.gb = fp->gb, .deep = fp->deep, .params = params, .outputs = outputs,
                          .done = job_done, .user = fp};
     fp->on_done = on_done;
@@ -141,6 +173,8 @@ obs_status obsd_fp_finished(obsd_fp *fp)
         obsd_stats_frame(job->deep->width, job->deep->height);
     else if (job->status == OBS_OK)
         obsd_stats_frame(job->gb->width, job->gb->height);
+    if (job->status == OBS_OK && fp->baked.data && !job->deep)
+        return obs_result_combine_baked(&fp->job.result, &fp->baked, job->params, fp->job.err);
     return job->status;
 }
 
@@ -160,8 +194,12 @@ void obsd_fp_images_of(const obsd_fp *fp, unsigned outputs, obsd_fp_images *im)
             im->composite = &dr->composite;
         return;
     }
-    /* the flat chain fills only what was asked for */
-    im->ao = res->ao.data ? &res->ao : NULL;
+    /* the flat chain fills what was asked for (and the AO for a baked
+     * channel's combination: answered only when asked for) */
+    const int ao = (outputs & OBS_OUTPUT_AO) && res->ao.data;
+    im->ao = ao ? &res->ao : NULL;
+    im->ao_screen = ao && res->ao_screen.data ? &res->ao_screen : NULL;
+    im->ao_baked = ao && res->ao_baked.data ? &res->ao_baked : NULL;
     im->composite = res->composite.data ? &res->composite : NULL;
 }
 
@@ -193,6 +231,10 @@ static int exr_layers(const obsd_fp_images *im, obs_result *flat, obs_deep_resul
         flat->ao = *im->ao;
     if (im->composite)
         flat->composite = *im->composite;
+    if (im->ao_screen)
+        flat->ao_screen = *im->ao_screen;
+    if (im->ao_baked)
+        flat->ao_baked = *im->ao_baked;
     return obs_result_exr_layers(flat, layers);
 }
 

@@ -26,6 +26,7 @@ typedef struct obsd_fp {
     const obs_deep_image *deep;
     obs_gbuffer_file gf;      /* a decoded flat EXR (owned) */
     obs_deep_image deep_exr;  /* a decoded deep EXR (owned) */
+    obs_image baked;          /* the input's baked AO channel (baked=, default _AO), or none */
     /* the EXR body the input came from (the caller's, kept until the
      * encode: obsd_fp_keep_source()), or NULL */
     const unsigned char *src;
@@ -48,6 +49,7 @@ typedef struct obsd_fp_images {
     const obs_image *ao;       /* AO.Y (deep: the blended AO) */
     const obs_image *ao_front; /* deep: AOFront.Y */
     const obs_image *composite;
+    const obs_image *ao_screen, *ao_baked; /* with a baked channel: AOScreen.Y, AOBaked.Y */
     int deep;
 } obsd_fp_images;
 

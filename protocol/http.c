@@ -72,6 +72,13 @@ const obs_http_option obs_http_options[] = {
      .doc = "EXR: the output's layer: NAME.Y for the AO, NAME.R,G,B,A for the composite (default AO.Y; R,G,B,A)"},
     {.name = "append", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(append), .def = "0",
      .doc = "EXR: the input file back, every part and channel unchanged, with the AO added as a layer"},
+    {.name = "baked", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(baked_name), .def = "", .min = 1,
+     .max = 1, .slot = SLOT(baked_name), .map = FIELD(baked),
+     .what = "a channel name (1 to 63 characters), or none",
+     .doc = "EXR: a baked AO channel of the input (obscura gbuffer of a level baked by obscura "
+            "bake) combined with the chain's AO by baked_combine (AO.Y the combination, "
+            "AOScreen.Y the chain's, AOBaked.Y the channel); default _AO when the input has it; "
+            "none: not combined"},
     {.name = NULL}};
 
 /* CHOICE and BOOL rows store through an int. */

@@ -43,6 +43,10 @@ typedef struct obs_http_request {
     const char *layer;
     char layer_name[64];
     int append;             /* EXR: the input's parts and channels, the AO added */
+    /* baked=CH: a baked AO channel of the input combined with the chain's
+     * AO (baked_combine); NULL: _AO when the input has it; "none": not */
+    const char *baked;
+    char baked_name[64];
 } obs_http_request;
 
 /* Zeroes the request: every option at its default. */

@@ -713,8 +713,10 @@ void obs_gbuffer_free(obs_gbuffer_file *f)
 
 /* ---- single channels and channel lists ---------------------------------- */
 
-obs_status obs_exr_read_channel(const char *path, const char *channel, const obs_limits *lim,
-                                obs_image *out, char err[OBS_ERR_LEN])
+/* obs_exr_read_channel and obs_exr_read_channel_mem: the file at path,
+ * or the buffer mem (path then names it in messages). */
+static obs_status read_channel(const char *path, const obs__exr_mem *mem, const char *channel,
+                               const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN])
 {
     char sub[OBS_ERR_LEN] = "";
     exr_context_t ctx = NULL;
@@ -725,10 +727,10 @@ obs_status obs_exr_read_channel(const char *path, const char *channel, const obs
     exr_result_t rv;
     obs_status st;
 
-    if (!path || !channel || !out)
+    if ((!path && !mem) || !channel || !out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_read_channel: NULL argument");
     memset(out, 0, sizeof *out);
-    if ((st = obs__exr_open(path, NULL, &ctx, &size, sub)) != OBS_OK)
+    if ((st = obs__exr_open(mem ? NULL : path, mem, &ctx, &size, sub)) != OBS_OK)
         goto fail;
     if ((rv = exr_get_count(ctx, &parts)) != EXR_ERR_SUCCESS) {
         st = obs__exr_fail(sub, rv, "part count");
@@ -775,9 +777,26 @@ fail:
         exr_finish(&ctx);
     if (st != OBS_OK) {
         obs_image_free(out);
-        obs__fail(err, st, "%s: %s", path, sub);
+        obs__fail(err, st, "%s: %s", path ? path : "EXR", sub);
     }
     return st;
+}
+
+obs_status obs_exr_read_channel(const char *path, const char *channel, const obs_limits *lim,
+                                obs_image *out, char err[OBS_ERR_LEN])
+{
+    if (!path)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_read_channel: NULL argument");
+    return read_channel(path, NULL, channel, lim, out, err);
+}
+
+obs_status obs_exr_read_channel_mem(const void *data, size_t len, const char *channel,
+                                    const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN])
+{
+    if (!data)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_read_channel_mem: NULL argument");
+    const obs__exr_mem mem = {data, len};
+    return read_channel(NULL, &mem, channel, lim, out, err);
 }
 
 obs_status obs_exr_list_channels(const char *path, char ***names_out, char err[OBS_ERR_LEN])

@@ -141,6 +141,11 @@ int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_
 obs_status obs_exr_read_channel(const char *path, const char *channel,
                                 const obs_limits *lim, obs_image *out,
                                 char err[OBS_ERR_LEN]);
+/* The same from an EXR in memory (`len` bytes at data); messages name
+ * it "EXR". */
+obs_status obs_exr_read_channel_mem(const void *data, size_t len, const char *channel,
+                                    const obs_limits *lim, obs_image *out,
+                                    char err[OBS_ERR_LEN]);
 
 /* Lists channel names of the first part into a newly allocated,
  * NULL-terminated array; caller frees with obs_strv_free(). */

@@ -397,12 +397,11 @@ typedef enum obs_baked_combine {
       "exterior and interior AO mixed by W(p), alpha or 1 - alpha on back "    \
       "faces)")                                                                \
     X(baked_combine, ENUM, "product", 0, 0, OBS_CHOICES(OBS_BAKED_COMBINE_LIST), \
-      "obscura ao --baked CH: how the G-buffer's baked AO channel (obscura "   \
-      "bake's _AO, rasterised by obscura gbuffer) is combined with the "       \
-      "chain's AO: product (two visibility factors of separate scales, the "   \
-      "baked distant obscurance times the screen-space detail) or min (the "   \
-      "darker of the two: an occluder both see darkens once); the daemon "     \
-      "takes no baked channel yet")
+      "--baked CH (HTTP: baked=CH): how the G-buffer's baked AO channel "      \
+      "(obscura bake's _AO, rasterised by obscura gbuffer) is combined with "  \
+      "the chain's AO: product (two visibility factors of separate scales, "   \
+      "the baked distant obscurance times the screen-space detail) or min "    \
+      "(the darker of the two: an occluder both see darkens once)")
 
 #define OBS__PDECL_FLOAT(n) float n;
 #define OBS__PDECL_INT(n) int n;

@@ -166,6 +166,37 @@ wait "$PID_S"; rc=$?
 check "the daemon exits 0 within 3 s, the running bake cancelled, its stream ended" \
     "[ $rc = 0 ] && [ \$((\$(date +%s) - t0)) -le 3 ] && grep -q 'bake=$ID6 cancelled' $T/S.log && wait_for $T/ev6 '^event: end'"
 
+echo "-- a baked G-buffer's _AO combined by the daemon (baked=, baked_combine=)"
+"$OBSCURA" bake "$FIX" -o "$T/lv.glb" --rays 16 -q &&
+    python3 tools/level_cameras.py "$T/lv.glb" "$T" 1 160 120 >/dev/null &&
+    "$OBSCURA" gbuffer "$T/lv.glb" --camera "$T/cam0.json" -o "$T/lg.exr" -q
+"$OBSCURA" ao "$T/lg.exr" -o "$T/lc.exr" --radius 2 -q
+start B
+code=$(post $PORT_B "radius=2&float=1" "$T/lg.exr" "$T/b1.exr")
+m=$("$OBSCURA" compare "$T/lc.exr" "$T/b1.exr" --json 2>/dev/null | sed -n 's/.*"mse": \([-0-9.e+]*\).*/\1/p')
+mb=$("$OBSCURA" compare "$T/lc.exr" "$T/b1.exr" --channel-a AOBaked.Y --channel-b AOBaked.Y --json 2>/dev/null |
+    sed -n 's/.*"mse": \([-0-9.e+]*\).*/\1/p')
+ms=$("$OBSCURA" compare "$T/lc.exr" "$T/b1.exr" --channel-a AOScreen.Y --channel-b AOScreen.Y --json 2>/dev/null |
+    sed -n 's/.*"mse": \([-0-9.e+]*\).*/\1/p')
+check "POST /v1/ao of a baked G-buffer: AO.Y, AOScreen.Y, AOBaked.Y as obscura ao writes them (MSE $m, $ms, $mb)" \
+    "[ $code = 200 ] && [ -n '$m' ] && awk 'BEGIN { exit !($m < 1e-6 && $ms < 1e-6 && $mb < 1e-6) }'"
+code=$(post $PORT_B "radius=2&float=1&baked=none" "$T/lg.exr" "$T/b2.exr")
+m=$("$OBSCURA" compare "$T/lc.exr" "$T/b2.exr" --channel-a AOScreen.Y --json 2>/dev/null | sed -n 's/.*"mse": \([-0-9.e+]*\).*/\1/p')
+check "baked=none: the chain's AO alone, no AOBaked.Y (MSE against AOScreen.Y $m)" \
+    "[ $code = 200 ] && awk 'BEGIN { exit !($m < 1e-6) }' && ! '$OBSCURA' compare '$T/b2.exr' '$T/b2.exr' --channel-a AOBaked.Y >/dev/null 2>&1"
+code=$(post $PORT_B "radius=2&baked=_AO_LONG&baked_combine=min" "$T/lg.exr" "$T/b3.exr")
+"$OBSCURA" ao "$T/lg.exr" -o "$T/lc3.exr" --radius 2 --baked _AO_LONG --baked-combine min -q
+m=$("$OBSCURA" compare "$T/lc3.exr" "$T/b3.exr" --json 2>/dev/null | sed -n 's/.*"mse": \([-0-9.e+]*\).*/\1/p')
+check "baked=_AO_LONG&baked_combine=min as the CLI's (MSE $m, half floats)" \
+    "[ $code = 200 ] && awk 'BEGIN { exit !($m < 1e-5) }'"
+code=$(post $PORT_B "radius=2&baked=_AO_MID" "$T/lg.exr" "$T/b4.json")
+check "baked naming no channel: 422 naming it ($code)" \
+    "[ $code = 422 ] && grep -q '_AO_MID' $T/b4.json"
+code=$(post $PORT_B "radius=2" "$DATA/room_small.exr" "$T/b5.exr")
+check "a G-buffer without _AO: not combined, no AOBaked.Y ($code)" \
+    "[ $code = 200 ] && ! '$OBSCURA' compare '$T/b5.exr' '$T/b5.exr' --channel-a AOBaked.Y >/dev/null 2>&1"
+kill -TERM "$PID_B"; wait "$PID_B"
+
 echo "-- bakes off"
 start O --max-bakes 0
 code=$(get $PORT_O /v1/bakes "$T/u")
