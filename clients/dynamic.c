@@ -150,6 +150,8 @@ static int write_report(const char *path, const char *level, const obs_dyn_param
         cJSON_AddNumberToObject(pa, "crossings", (double)ps->crossings);
         cJSON_AddItemToObject(pa, "rms_linear_quadratic", pair(ps->rms[0], ps->rms[1]));
         cJSON_AddItemToObject(pa, "bias_linear_quadratic", pair(ps->bias[0], ps->bias[1]));
+        cJSON_AddNumberToObject(pa, "rms_point_sh", ps->rms_point_sh);
+        cJSON_AddNumberToObject(pa, "rms_quadratic_unregularised", ps->rms_unregularised);
         const char *names[3] = {"unregularised", "regularised", "regularised_blended"};
         for (int k = 0; k < 3; k++) {
             cJSON *o = cJSON_AddObjectToObject(pa, names[k]);

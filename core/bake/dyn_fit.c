@@ -17,7 +17,8 @@
  * squared difference of the two models at the points), each edge once,
  * w_ij the shared boundary area divided by the mean over the edges (so
  * beta does not depend on the level's units), b_ij the centre of the
- * shared face.  "Instead of solving a global linear system, we simply use a
+ * shared face (boundary_points > 1: a grid of points over the face, the
+ * weight shared among them; not the paper's).  "Instead of solving a global linear system, we simply use a
  * variant of block coordinate descent": each sweep minimises E over one
  * model at a time, the others fixed (a 7 x 7 system with 18 right-hand
  * sides); E never grows.
@@ -229,6 +230,15 @@ static double energy(const obs_dyn_fit *x, const obs_dyn_fit *x0, const double *
     return e;
 }
 
+/* As the runtime sees it: each distance clamped to [0, 1], then blended
+ * (obs_dyn_eval). */
+static double clamped_ao(const double *ch, const float n[3], float blend)
+{
+    double s = fmin(fmax(obs__dyn_sh_eval(ch, n, 2), 0.0), 1.0);
+    double l = fmin(fmax(obs__dyn_sh_eval(ch + OBS_DYN_SH, n, 2), 0.0), 1.0);
+    return blend * s + (1.0 - blend) * l;
+}
+
 static void jumps(const obs_dyn_fit *x, const uint32_t *em, const float *eb, size_t ne,
                   float blend, double *mean, double *max)
 {
@@ -238,7 +248,7 @@ static void jumps(const obs_dyn_fit *x, const uint32_t *em, const float *eb, siz
         fit_channels(&x[em[2 * k]], eb + 3 * k, u);
         fit_channels(&x[em[2 * k + 1]], eb + 3 * k, v);
         for (int a = 0; a < 6; a++) {
-            double d = fabs(obs__dyn_blend_ao(u, axes[a], blend, 2) - obs__dyn_blend_ao(v, axes[a], blend, 2));
+            double d = fabs(clamped_ao(u, axes[a], blend) - clamped_ao(v, axes[a], blend));
             s += d;
             mx = fmax(mx, d);
         }
@@ -273,9 +283,9 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
     obs_dyn_fit *own = calloc(nr ? nr : 1, sizeof *own), *x = NULL, *x0 = NULL;
     int32_t *model_of = malloc((nr ? nr : 1) * sizeof *model_of);
     int32_t *absorbed = calloc(nr ? nr : 1, sizeof *absorbed);
-    uint32_t *em = NULL;
-    float *eb = NULL;
-    double *ew = NULL, *A = NULL;
+    uint32_t *em = NULL, *pm = NULL;
+    float *eb = NULL, *pb = NULL;
+    double *ew = NULL, *pw = NULL, *A = NULL;
     obs_dyn_model *o = &r->original;
     memset(o, 0, sizeof *o);
     if (!first || !hfirst || !idx || !hidx || !own || !model_of || !absorbed) {
@@ -455,13 +465,52 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
     }
     for (size_t k = 0; k < me; k++)
         ew[k] /= wsum / (double)me;
+    /* The points where the neighbours are compared: the paper's b_ij
+     * (boundary_points 1), or a bp x bp grid of the shared face sharing
+     * w_ij, so that the models agree over the face and not only at its
+     * centre. */
+    int bp = p->boundary_points;
+    size_t mp = me * (size_t)bp * (size_t)bp;
+    pm = malloc((mp ? 2 * mp : 1) * sizeof *pm);
+    pb = malloc((mp ? 3 * mp : 1) * sizeof *pb);
+    pw = malloc((mp ? mp : 1) * sizeof *pw);
+    if (!pm || !pb || !pw) {
+        st = obs__fail(err, OBS_NO_MEMORY, "regularisation");
+        goto done;
+    }
+    for (size_t k = 0, e = 0, q = 0; k < ne; k++) {
+        uint32_t a = rg->edge[2 * k], b = rg->edge[2 * k + 1];
+        int32_t ma = o->regions[a].model, mb = o->regions[b].model;
+        if (ma < 0 || mb < 0 || ma == mb)
+            continue;
+        const obs_dyn_box *A_ = &rg->box[a], *B_ = &rg->box[b];
+        float lo[3], hi[3];
+        for (int c = 0; c < 3; c++)
+            lo[c] = fmaxf(A_->lo[c], B_->lo[c]), hi[c] = fminf(A_->hi[c], B_->hi[c]);
+        int ax = 0; /* the face's normal axis: where the overlap is thinnest */
+        for (int c = 1; c < 3; c++)
+            if (hi[c] - lo[c] < hi[ax] - lo[ax])
+                ax = c;
+        int u = (ax + 1) % 3, v = (ax + 2) % 3;
+        for (int i = 0; i < bp; i++)
+            for (int j = 0; j < bp; j++, q++) {
+                float *pt3 = pb + 3 * q;
+                pt3[ax] = eb[3 * e + ax];
+                pt3[u] = bp == 1 ? eb[3 * e + u] : lo[u] + (hi[u] - lo[u]) * ((float)i + 0.5f) / (float)bp;
+                pt3[v] = bp == 1 ? eb[3 * e + v] : lo[v] + (hi[v] - lo[v]) * ((float)j + 0.5f) / (float)bp;
+                pm[2 * q] = em[2 * e];
+                pm[2 * q + 1] = em[2 * e + 1];
+                pw[q] = ew[e] / (double)(bp * bp);
+            }
+        e++;
+    }
     memcpy(x, o->models, nm * sizeof *x);
     memcpy(x0, o->models, nm * sizeof *x0);
     double beta = p->beta;
-    ss->energy[0] = energy(x, x0, A, nm, em, eb, ew, me, beta);
+    ss->energy[0] = energy(x, x0, A, nm, pm, pb, pw, mp, beta);
     jumps(x, em, eb, me, p->blend, &ss->jump_mean[0], &ss->jump_max[0]);
     /* Block coordinate descent: one model at a time, the others fixed. */
-    for (int it = 0; beta > 0.0 && me && it < p->iterations; it++)
+    for (int it = 0; beta > 0.0 && mp && it < p->iterations; it++)
         for (size_t m = 0; m < nm; m++) {
             double H[T * T], B[T * C] = {0};
             memcpy(H, A + m * T * T, sizeof H);
@@ -470,25 +519,25 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
                     for (int b = 0; b < T; b++)
                         B[a * C + ch] += H[a * T + b] * x0[m].coef[ch][b];
             int any = 0;
-            for (size_t k = 0; k < me; k++) {
+            for (size_t k = 0; k < mp; k++) {
                 uint32_t other;
-                if (em[2 * k] == m)
-                    other = em[2 * k + 1];
-                else if (em[2 * k + 1] == m)
-                    other = em[2 * k];
+                if (pm[2 * k] == m)
+                    other = pm[2 * k + 1];
+                else if (pm[2 * k + 1] == m)
+                    other = pm[2 * k];
                 else
                     continue;
                 any = 1;
-                const float *bp = eb + 3 * k;
-                float q[3] = {bp[0] - x[m].c[0], bp[1] - x[m].c[1], bp[2] - x[m].c[2]};
+                const float *bpt = pb + 3 * k;
+                float q[3] = {bpt[0] - x[m].c[0], bpt[1] - x[m].c[1], bpt[2] - x[m].c[2]};
                 double row[T], y[C];
                 obs__dyn_eq4_row(q, row);
-                fit_channels(&x[other], bp, y);
+                fit_channels(&x[other], bpt, y);
                 for (int a = 0; a < T; a++) {
                     for (int b = 0; b < T; b++)
-                        H[a * T + b] += beta * ew[k] * row[a] * row[b];
+                        H[a * T + b] += beta * pw[k] * row[a] * row[b];
                     for (int ch = 0; ch < C; ch++)
-                        B[a * C + ch] += beta * ew[k] * row[a] * y[ch];
+                        B[a * C + ch] += beta * pw[k] * row[a] * y[ch];
                 }
             }
             if (!any || !chol_solve(H, B, T))
@@ -497,7 +546,7 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
                 for (int k = 0; k < T; k++)
                     x[m].coef[ch][k] = (float)B[k * C + ch];
         }
-    ss->energy[1] = energy(x, x0, A, nm, em, eb, ew, me, beta);
+    ss->energy[1] = energy(x, x0, A, nm, pm, pb, pw, mp, beta);
     jumps(x, em, eb, me, p->blend, &ss->jump_mean[1], &ss->jump_max[1]);
     if ((st = copy_shape(&r->model, o, err)) != OBS_OK)
         goto done;
@@ -527,6 +576,9 @@ done:
     free(em);
     free(eb);
     free(ew);
+    free(pm);
+    free(pb);
+    free(pw);
     free(A);
     free(x);
     free(x0);

@@ -68,6 +68,12 @@ obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *b
                                 char err[OBS_ERR_LEN]);
 void obs__dyn_points_free(obs__dyn_points *pt);
 
+/* One point's 18 channels (projected, convolved) from p->rays
+ * directions keyed by (seed, stream); *dropped when its rays met back
+ * faces more often than the limit.  0 when out of memory. */
+int obs__dyn_point_sh(const obs__bake_bvh *bvh, const float o[3], const obs_dyn_params *p,
+                      uint64_t stream, double sh[OBS_DYN_CHANNELS], int *dropped);
+
 /* Eq 1 at point o for the unit normal n by `rays` cosine-weighted rays
  * (the bake's estimator): ao[0] short, ao[1] long. */
 void obs__dyn_trace_eq1(const obs__bake_bvh *bvh, const float o[3], const float n[3],

@@ -3,10 +3,12 @@
  * where a path crosses from one region into another, before and after the
  * regularisation and with the temporal blender.
  *
- * A path joins two points drawn uniformly in the boxes of two different
- * regions with a model, both outside geometry (the back-face test of
- * probes.c) and in sight of each other (no geometry on the segment), so
- * that an object could move along it; `steps` points along it, each
+ * A path joins two points drawn uniformly in the regions' bounding box,
+ * each in a region with a model and outside geometry (the back-face test
+ * of probes.c), at least a tenth of the box's diagonal apart and in sight
+ * of each other (no geometry on the segment), so that an object could
+ * move along it, whatever the regions (the same paths for any
+ * subdivision of the same box); `steps` points along it, each
  * with two normals: up (+y, the levels' up axis) and one random unit
  * vector per path (the same along the path, so its steps compare like
  * with like). */
@@ -21,20 +23,18 @@
 #define PI_D 3.14159265358979323846
 #define TRIES 2000
 
-static int pick_point(const obs_dyn_model *m, const obs__bake_bvh *bvh, float limit,
-                      obs__bake_rng *r, float q[3], int *region)
+static int pick_point(const obs_dyn_model *m, const obs_dyn_box *all, const obs__bake_bvh *bvh,
+                      float limit, obs__bake_rng *r, float q[3])
 {
     for (int t = 0; t < TRIES; t++) {
-        size_t i = (size_t)(obs__bake_rng_unit(r) * (double)m->region_count);
-        const obs_dyn_model_region *g = &m->regions[i];
-        if (g->model < 0 || g->absorbed || !g->points)
-            continue;
         for (int a = 0; a < 3; a++)
-            q[a] = g->box.lo[a] + (g->box.hi[a] - g->box.lo[a]) * (float)obs__bake_rng_unit(r);
-        if (!obs__dyn_inside(bvh, q, 32, limit)) {
-            *region = (int)i;
+            q[a] = all->lo[a] + (all->hi[a] - all->lo[a]) * (float)obs__bake_rng_unit(r);
+        float c[3];
+        int g = obs_dyn_model_region_at(m, q, c);
+        if (g < 0 || c[0] != q[0] || c[1] != q[1] || c[2] != q[2])
+            continue; /* in no region with a model */
+        if (!obs__dyn_inside(bvh, q, 32, limit))
             return 1;
-        }
     }
     return 0;
 }
@@ -65,17 +65,33 @@ obs_status obs_dyn_measure_paths(const obs_bake_scene *scene, const obs_dyn_resu
         goto done;
     }
     obs__bake_rng r = obs__bake_rng_stream((uint64_t)p.seed, 0, 17);
+    /* The regions' bounding box: paths do not depend on how it is cut. */
+    obs_dyn_box all = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    for (size_t i = 0; i < res->model.region_count; i++)
+        for (int c = 0; c < 3; c++) {
+            all.lo[c] = fminf(all.lo[c], res->model.regions[i].box.lo[c]);
+            all.hi[c] = fmaxf(all.hi[c], res->model.regions[i].box.hi[c]);
+        }
+    double diag = 0.0;
+    for (int c = 0; c < 3; c++)
+        diag += ((double)all.hi[c] - all.lo[c]) * ((double)all.hi[c] - all.lo[c]);
+    diag = sqrt(diag);
     const obs_dyn_model *mods[2] = {&res->original, &res->model};
     float dist[2] = {p.distance_short, p.distance_long};
-    double se[2] = {0, 0}, sb[2] = {0, 0}, cs[3] = {0, 0, 0}, ss[3] = {0, 0, 0};
+    double se[4] = {0, 0, 0, 0}, sb[2] = {0, 0}, cs[3] = {0, 0, 0}, ss[3] = {0, 0, 0};
     size_t nsteps = 0, nval = 0;
     for (int path = 0; path < paths; path++) {
         float a[3], b[3];
-        int ra = -1, rb = -1, found = 0;
-        for (int t = 0; t < TRIES && !found; t++)
-            found = pick_point(&res->model, bvh, p.backface_limit, &r, a, &ra) &&
-                    pick_point(&res->model, bvh, p.backface_limit, &r, b, &rb) && ra != rb &&
+        int found = 0;
+        for (int t = 0; t < TRIES && !found; t++) {
+            found = pick_point(&res->model, &all, bvh, p.backface_limit, &r, a) &&
+                    pick_point(&res->model, &all, bvh, p.backface_limit, &r, b) &&
                     !obs__bake_bvh_occluded(bvh, a, b);
+            double len = 0.0;
+            for (int c = 0; c < 3; c++)
+                len += ((double)b[c] - a[c]) * ((double)b[c] - a[c]);
+            found = found && sqrt(len) >= 0.1 * diag;
+        }
         if (!found)
             break;
         double z = 2.0 * obs__bake_rng_unit(&r) - 1.0, ph = 2.0 * PI_D * obs__bake_rng_unit(&r);
@@ -99,11 +115,22 @@ obs_status obs_dyn_measure_paths(const obs_bake_scene *scene, const obs_dyn_resu
                     se[o] += (ao[2] - truth) * (ao[2] - truth);
                     sb[o] += ao[2] - truth;
                 }
+                /* the point's own SH (no eq 4): what the projection alone loses */
+                double sh[OBS_DYN_CHANNELS];
+                int dropped;
+                if (obs__dyn_point_sh(bvh, q, &p, ((uint64_t)path * 2 + ni) * 65536 + (uint64_t)k,
+                                      sh, &dropped)) {
+                    double v = p.blend * fmin(fmax(obs__dyn_sh_eval(sh, nr[ni], 2), 0.0), 1.0) +
+                               (1.0 - p.blend) *
+                                   fmin(fmax(obs__dyn_sh_eval(sh + OBS_DYN_SH, nr[ni], 2), 0.0), 1.0);
+                    se[2] += (v - truth) * (v - truth);
+                }
                 nval++;
                 for (int v = 0; v < 2; v++) {
                     reg[k * 2 + v] = obs_dyn_eval(mods[v], q, nr[ni], OBS_DYN_QUADRATIC, ao);
                     val[k * 4 + v] = ao[2];
                 }
+                se[3] += (val[k * 4] - truth) * (val[k * 4] - truth);
                 obs_dyn_blend_step(&bl, &res->model, q, nr[ni], OBS_DYN_QUADRATIC, 1.0f, tau, ao);
                 val[k * 4 + 2] = ao[2];
             }
@@ -128,6 +155,8 @@ obs_status obs_dyn_measure_paths(const obs_bake_scene *scene, const obs_dyn_resu
         out->rms[o] = nval ? sqrt(se[o] / (double)nval) : 0.0;
         out->bias[o] = nval ? sb[o] / (double)nval : 0.0;
     }
+    out->rms_unregularised = nval ? sqrt(se[3] / (double)nval) : 0.0;
+    out->rms_point_sh = nval ? sqrt(se[2] / (double)nval) : 0.0;
     for (int v = 0; v < 3; v++) {
         out->cross_mean[v] = out->crossings ? cs[v] / (double)out->crossings : 0.0;
         out->step_mean[v] = nsteps ? ss[v] / (double)nsteps : 0.0;

@@ -164,22 +164,18 @@ typedef struct sph_job {
     uint8_t *dropped;
 } sph_job;
 
-static void trace_point(void *ctx, size_t i)
+int obs__dyn_point_sh(const obs__bake_bvh *bvh, const float o[3], const obs_dyn_params *p,
+                      uint64_t stream, double sh[OBS_DYN_CHANNELS], int *dropped)
 {
-    sph_job *j = ctx;
-    int n = j->p->rays;
+    int n = p->rays, ok = 0;
     float *dirs = malloc((size_t)n * 3 * sizeof *dirs), *t = malloc((size_t)n * sizeof *t);
     uint8_t *back = malloc((size_t)n);
     double *w = malloc((size_t)n * sizeof *w), *f = malloc(2 * (size_t)n * sizeof *f);
-    if (!dirs || !t || !back || !w || !f) {
-        j->dropped[i] = 2; /* no memory: reported by the caller */
+    if (!dirs || !t || !back || !w || !f)
         goto done;
-    }
-    obs__dyn_sphere_dirs(n, (uint64_t)j->p->seed, j->id[i], dirs);
-    float dist[2] = {j->p->distance_short, j->p->distance_long};
-    const float *o = j->pt->pos + 3 * i;
-    obs__bake_bvh_cast(j->bvh, o, dirs, n, RAY_LENGTH_FACTOR * fmaxf(dist[0], dist[1]), t,
-                       back);
+    obs__dyn_sphere_dirs(n, (uint64_t)p->seed, stream, dirs);
+    float dist[2] = {p->distance_short, p->distance_long};
+    obs__bake_bvh_cast(bvh, o, dirs, n, RAY_LENGTH_FACTOR * fmaxf(dist[0], dist[1]), t, back);
     int nb = 0;
     for (int k = 0; k < n; k++) {
         w[k] = 4.0 * PI_D / n; /* equal-area directions */
@@ -189,18 +185,29 @@ static void trace_point(void *ctx, size_t i)
             f[(size_t)c * n + k] = isinf(t[k]) ? 1.0 : 1.0 - exp(a * t[k]); /* rho(x) */
         }
     }
-    j->dropped[i] = (double)nb > (double)j->p->backface_limit * n;
+    *dropped = (double)nb > (double)p->backface_limit * n;
     for (int c = 0; c < 2; c++) {
-        double *sh = j->pt->sh + (size_t)OBS_DYN_CHANNELS * i + OBS_DYN_SH * c;
-        obs__dyn_sh_project(dirs, w, f + (size_t)c * n, (size_t)n, sh);
-        obs__dyn_sh_convolve(sh);
+        obs__dyn_sh_project(dirs, w, f + (size_t)c * n, (size_t)n, sh + OBS_DYN_SH * c);
+        obs__dyn_sh_convolve(sh + OBS_DYN_SH * c);
     }
+    ok = 1;
 done:
     free(dirs);
     free(t);
     free(back);
     free(w);
     free(f);
+    return ok;
+}
+
+static void trace_point(void *ctx, size_t i)
+{
+    sph_job *j = ctx;
+    int dropped = 0;
+    if (!obs__dyn_point_sh(j->bvh, j->pt->pos + 3 * i, j->p, j->id[i],
+                           j->pt->sh + (size_t)OBS_DYN_CHANNELS * i, &dropped))
+        dropped = 2; /* no memory: reported by the caller */
+    j->dropped[i] = (uint8_t)dropped;
 }
 
 obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *bvh,

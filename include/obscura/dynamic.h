@@ -74,6 +74,9 @@ extern "C" {
       "weight beta of the neighbour regularisation (section 2.3); 0: off")     \
     X(iterations, INT, 8, 0, 10000, NULL,                                      \
       "sweeps of block coordinate descent over the regions")                   \
+    X(boundary_points, INT, 1, 1, 16, NULL,                                    \
+      "neighbours are compared at the centre of their shared face (1, the "    \
+      "paper's b_ij) or at an N x N grid over it sharing w_ij")                \
     X(holdout, FLOAT, 0.0, 0.0, 0.9, NULL,                                     \
       "this fraction of each region's valid points is held back from the fit " \
       "and measures eq 4 against a constant and a single gradient (the "      \
@@ -257,14 +260,19 @@ typedef struct obs_dyn_path_stats {
     /* evaluated AO (blended) minus ray-traced eq 1 at the path's points
      * and normals: RMS and mean, linear and quadratic SH */
     double rms[2], bias[2];
+    /* the same for the point's own quadratic SH from `rays` (of the
+     * params) sphere rays, without eq 4: the projection's share */
+    double rms_point_sh;
+    double rms_unregularised; /* rms[1] for the model before the regularisation */
     /* |AO(k+1) - AO(k)| along the paths at steps that cross a region
      * boundary, and at the other steps: mean, max; [0] unregularised, [1]
      * regularised, [2] regularised and temporally blended */
     double cross_mean[3], cross_max[3], step_mean[3];
 } obs_dyn_path_stats;
 
-/* `paths` straight paths, each between two valid points of different
- * regions that see each other, `steps` points along each; at each point
+/* `paths` straight paths, each between two points outside geometry that
+ * see each other, drawn in the regions' bounding box (dyn_measure.c),
+ * `steps` points along each; at each point
  * two normals (up +y and one drawn at random) are traced with `rays`
  * cosine-weighted rays (eq 1) and evaluated on the models; tau is the
  * blender's decay time in steps. */

@@ -235,11 +235,16 @@ static void test_room_points(void **state)
                 sum += fabs(got - want);
                 nchk++;
             }
-    assert_true(worst < 0.03);
-    assert_true(sum / nchk < 0.008);
+    print_message("room, traced points (1024 rays) against the exact SH: worst %.4f, mean %.4f\n",
+                  worst, sum / nchk);
+    /* a closed room: no ray misses, the spiral's stratified estimate of
+     * a smooth function is far below the Monte Carlo error */
+    assert_true(worst < 0.005);
+    assert_true(sum / nchk < 0.002);
     const float mid[3] = {L / 2, L / 2, L / 2}, up[3] = {0, 1, 0};
     for (int c = 0; c < 2; c++) {
         double d = c ? DL : DS, e1 = room_eq1(mid, up, d), sh = room_sh(mid, up, d);
+        print_message("room centre, d = %g, normal +y: eq 1 %.4f, its quadratic SH %.4f\n", d, e1, sh);
         assert_true(fabs(e1 - sh) < 0.01);
         /* and the cosine-weighted trace of the measurement */
         double tr[2];
@@ -276,6 +281,9 @@ static void test_room_model(void **state)
     assert_int_equal(obs_dyn_bake(&sc, &d, &r, err), OBS_OK);
     assert_int_equal(r.model.model_count, 1);
     assert_true(r.stats.holdout_points > 50);
+    print_message("room, held back (%zu points): eq 4 %.4f, single gradient %.4f, constant %.4f\n",
+                  r.stats.holdout_points, r.stats.holdout_eq4, r.stats.holdout_gradient,
+                  r.stats.holdout_constant);
     assert_true(r.stats.holdout_eq4 < 0.6 * r.stats.holdout_gradient);
     assert_true(r.stats.holdout_eq4 < 0.6 * r.stats.holdout_constant);
     const float mid[3] = {L / 2, L / 2, L / 2};
@@ -289,13 +297,18 @@ static void test_room_model(void **state)
         obs_dyn_eval(&r.model, q, axes6[a], OBS_DYN_QUADRATIC, ao);
         assert_true(ao[1] < centre[1] - 0.05f);
         double want = room_eq1(q, axes6[a], DL);
-        assert_true(fabs(ao[1] - want) < 0.06);
+        print_message("room, facing wall %d at 0.6 from it: model %.4f (centre %.4f), eq 1 %.4f\n", a,
+                      ao[1], centre[1], want);
+        /* within half the centre-to-wall contrast (0.22 here) */
+        assert_true(fabs(ao[1] - want) < 0.08);
     }
     obs_dyn_eval(&r.model, mid, axes6[2], OBS_DYN_QUADRATIC, ao);
     /* At the centre the field has its peak, which a tent (eq 4 around
      * the peak) fitted in least squares overshoots: in one dimension the
      * tent's apex fitted to 1 - x^2 on [-1, 1] is 7/6, 1/6 of the dome's
      * height above it (here 0.09 of 0.45 at the short distance). */
+    print_message("room centre, normal +y: model %.4f / %.4f, eq 1 %.4f / %.4f (short / long)\n",
+                  ao[0], ao[1], room_eq1(mid, axes6[2], DS), room_eq1(mid, axes6[2], DL));
     assert_true(ao[1] > room_eq1(mid, axes6[2], DL) - 0.01);
     assert_true(fabs(ao[1] - room_eq1(mid, axes6[2], DL)) < 0.06);
     assert_true(fabs(ao[0] - room_eq1(mid, axes6[2], DS)) < 0.12);
@@ -448,6 +461,12 @@ static void test_regularise_absorb(void **state)
     obs_dyn_eval_fit(&r.model.models[0], bc, up, OBS_DYN_QUADRATIC, u);
     obs_dyn_eval_fit(&r.model.models[1], bc, up, OBS_DYN_QUADRATIC, v);
     assert_true(fabsf(u[1] - v[1]) < 0.2f);
+    obs_dyn_result_free(&r);
+    /* compared over a 3 x 3 grid of the shared face: the same decrease */
+    assert_int_equal(obs_dyn_param_set(&p, "boundary_points", "3", err), OBS_OK);
+    assert_int_equal(obs__dyn_fit_all(&pt, &rg, &p, &r, err), OBS_OK);
+    assert_true(r.stats.energy[1] < 0.5 * r.stats.energy[0]);
+    assert_true(r.stats.jump_mean[1] < 0.5 * r.stats.jump_mean[0]);
     obs_dyn_result_free(&r);
     obs__dyn_points_free(&pt);
     obs_dyn_regions_free(&rg);
