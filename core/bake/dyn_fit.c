@@ -413,7 +413,8 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
         st = obs__fail(err, OBS_NO_MEMORY, "model of %zu regions", nr);
         goto done;
     }
-    memcpy(o->edge, rg->edge, 2 * ne * sizeof *o->edge);
+    if (ne)
+        memcpy(o->edge, rg->edge, 2 * ne * sizeof *o->edge);
     for (size_t g = 0; g < nr; g++) {
         obs_dyn_model_region *mr = &o->regions[g];
         mr->box = rg->box[g];

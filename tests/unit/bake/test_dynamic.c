@@ -637,6 +637,7 @@ static void test_model_file_and_blender(void **state)
     for (int k = 0; k < 60; k++)
         obs_dyn_blend_step(&bl, &m, p1, up, OBS_DYN_QUADRATIC, 1.0f, 2.0f, ao);
     assert_true(fabsf(ao[2] - 0.3f) < 1e-4f);
+    obs_dyn_model_free(&back);
     /* a damaged file */
     const char *bad = obs_test_tmp_file("dyn_bad.json", "{\"format\": \"obscura-dynamic-ao\"}");
     assert_int_equal(obs_dyn_model_read(bad, &back, err), OBS_BAD_FILE);
