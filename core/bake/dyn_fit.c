@@ -257,6 +257,28 @@ static void jumps(const obs_dyn_fit *x, const uint32_t *em, const float *eb, siz
     *max = mx;
 }
 
+/* For each of n nodes, the pairs (index k of pairs[2k], pairs[2k+1]) it
+ * is in: items[first[i] .. first[i+1]).  0 when out of memory. */
+static int csr_build(size_t n, const uint32_t *pairs, size_t np, size_t **first,
+                     uint32_t **items)
+{
+    *first = calloc(n + 1, sizeof **first);
+    *items = malloc((np ? 2 * np : 1) * sizeof **items);
+    size_t *fill = calloc(n ? n : 1, sizeof *fill);
+    if (!*first || !*items || !fill) {
+        free(fill);
+        return 0;
+    }
+    for (size_t k = 0; k < 2 * np; k++)
+        (*first)[pairs[k] + 1]++;
+    for (size_t i = 0; i < n; i++)
+        (*first)[i + 1] += (*first)[i];
+    for (size_t k = 0; k < 2 * np; k++)
+        (*items)[(*first)[pairs[k]] + fill[pairs[k]]++] = (uint32_t)(k / 2);
+    free(fill);
+    return 1;
+}
+
 static obs_status copy_shape(obs_dyn_model *dst, const obs_dyn_model *src, char err[OBS_ERR_LEN])
 {
     *dst = *src;
@@ -283,7 +305,8 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
     obs_dyn_fit *own = calloc(nr ? nr : 1, sizeof *own), *x = NULL, *x0 = NULL;
     int32_t *model_of = malloc((nr ? nr : 1) * sizeof *model_of);
     int32_t *absorbed = calloc(nr ? nr : 1, sizeof *absorbed);
-    uint32_t *em = NULL, *pm = NULL;
+    uint32_t *em = NULL, *pm = NULL, *nitem = NULL, *mitem = NULL;
+    size_t *nfirst = NULL, *mfirst = NULL;
     float *eb = NULL, *pb = NULL;
     double *ew = NULL, *pw = NULL, *A = NULL;
     obs_dyn_model *o = &r->original;
@@ -360,6 +383,10 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
         model_of[g] = n && n >= (size_t)p->absorb_points ? (int32_t)g : -1;
         ss->regions_without_points += n == 0;
     }
+    if (!csr_build(nr, rg->edge, ne, &nfirst, &nitem)) {
+        st = obs__fail(err, OBS_NO_MEMORY, "adjacency of %zu regions", nr);
+        goto done;
+    }
     for (int changed = 1; changed;) {
         changed = 0;
         for (size_t g = 0; g < nr; g++) {
@@ -368,10 +395,11 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
             size_t n = first[g + 1] - first[g];
             int32_t best = -1;
             double be = INFINITY;
-            for (size_t k = 0; k < ne; k++) {
+            for (size_t q = nfirst[g]; q < nfirst[g + 1]; q++) {
+                size_t k = nitem[q];
                 uint32_t a = rg->edge[2 * k], b = rg->edge[2 * k + 1];
-                uint32_t nb = a == g ? b : b == g ? a : UINT32_MAX;
-                if (nb == UINT32_MAX || model_of[nb] < 0)
+                uint32_t nb = a == g ? b : a;
+                if (model_of[nb] < 0)
                     continue;
                 double e = n ? sse_of(pt, idx + first[g], n, &own[model_of[nb]])
                              : -obs__dyn_shared_face(&rg->box[g], &rg->box[nb], NULL);
@@ -510,6 +538,10 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
     double beta = p->beta;
     ss->energy[0] = energy(x, x0, A, nm, pm, pb, pw, mp, beta);
     jumps(x, em, eb, me, p->blend, &ss->jump_mean[0], &ss->jump_max[0]);
+    if (!csr_build(nm, pm, mp, &mfirst, &mitem)) {
+        st = obs__fail(err, OBS_NO_MEMORY, "regularisation");
+        goto done;
+    }
     /* Block coordinate descent: one model at a time, the others fixed. */
     for (int it = 0; beta > 0.0 && mp && it < p->iterations; it++)
         for (size_t m = 0; m < nm; m++) {
@@ -520,14 +552,9 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
                     for (int b = 0; b < T; b++)
                         B[a * C + ch] += H[a * T + b] * x0[m].coef[ch][b];
             int any = 0;
-            for (size_t k = 0; k < mp; k++) {
-                uint32_t other;
-                if (pm[2 * k] == m)
-                    other = pm[2 * k + 1];
-                else if (pm[2 * k + 1] == m)
-                    other = pm[2 * k];
-                else
-                    continue;
+            for (size_t e = mfirst[m]; e < mfirst[m + 1]; e++) {
+                size_t k = mitem[e];
+                uint32_t other = pm[2 * k] == m ? pm[2 * k + 1] : pm[2 * k];
                 any = 1;
                 const float *bpt = pb + 3 * k;
                 float q[3] = {bpt[0] - x[m].c[0], bpt[1] - x[m].c[1], bpt[2] - x[m].c[2]};
@@ -580,6 +607,10 @@ done:
     free(pm);
     free(pb);
     free(pw);
+    free(nfirst);
+    free(nitem);
+    free(mfirst);
+    free(mitem);
     free(A);
     free(x);
     free(x0);

@@ -104,17 +104,69 @@ static int push_edge(obs_dyn_regions *r, size_t *cap, uint32_t i, uint32_t j)
     return 1;
 }
 
+/* The regions ordered by their lower x, so that the pairs that can
+ * touch or overlap are found by a sweep: j after i with lo_x(j) <=
+ * hi_x(i) + slack.  NULL when out of memory. */
+typedef struct keyed {
+    float x;
+    uint32_t i;
+} keyed;
+
+static int cmp_keyed(const void *a, const void *b)
+{
+    const keyed *p = a, *q = b;
+    return p->x < q->x ? -1 : p->x > q->x ? 1 : (p->i > q->i) - (p->i < q->i);
+}
+
+static uint32_t *sweep_order(const obs_dyn_regions *r, double *slack)
+{
+    uint32_t *o = malloc((r->count ? r->count : 1) * sizeof *o);
+    keyed *k = malloc((r->count ? r->count : 1) * sizeof *k);
+    if (!o || !k) {
+        free(o);
+        free(k);
+        return NULL;
+    }
+    double big = 0.0;
+    for (size_t i = 0; i < r->count; i++) {
+        k[i].x = r->box[i].lo[0];
+        k[i].i = (uint32_t)i;
+        big = fmax(big, box_size(&r->box[i]));
+    }
+    qsort(k, r->count, sizeof *k, cmp_keyed);
+    for (size_t i = 0; i < r->count; i++)
+        o[i] = k[i].i;
+    free(k);
+    *slack = 2e-5 * big;
+    return o;
+}
+
+static int cmp_edge(const void *a, const void *b);
+
 obs_status obs__dyn_adjacency(obs_dyn_regions *r, char err[OBS_ERR_LEN])
 {
     free(r->edge);
     r->edge = NULL;
     r->edge_count = 0;
     size_t cap = 0;
-    for (size_t i = 0; i < r->count; i++)
-        for (size_t j = i + 1; j < r->count; j++)
+    double slack;
+    uint32_t *o = sweep_order(r, &slack);
+    if (!o)
+        return obs__fail(err, OBS_NO_MEMORY, "adjacency of %zu regions", r->count);
+    for (size_t a = 0; a < r->count; a++)
+        for (size_t b = a + 1; b < r->count; b++) {
+            uint32_t i = o[a], j = o[b];
+            if (r->box[j].lo[0] > r->box[i].hi[0] + slack)
+                break;
             if (obs__dyn_shared_face(&r->box[i], &r->box[j], NULL) > 0.0 &&
-                !push_edge(r, &cap, (uint32_t)i, (uint32_t)j))
+                !push_edge(r, &cap, i, j)) {
+                free(o);
                 return obs__fail(err, OBS_NO_MEMORY, "adjacency of %zu regions", r->count);
+            }
+        }
+    free(o);
+    if (r->edge_count)
+        qsort(r->edge, r->edge_count, 2 * sizeof *r->edge, cmp_edge);
     return OBS_OK;
 }
 
@@ -133,13 +185,24 @@ static obs_status check_boxes(const obs_dyn_regions *r, char err[OBS_ERR_LEN])
                                  "region %zu is empty: max %c %g is not above min %c %g", i,
                                  axis[ax], b->hi[ax], axis[ax], b->lo[ax]);
         }
-    for (size_t i = 0; i < r->count; i++)
-        for (size_t j = i + 1; j < r->count; j++)
-            if (overlap(&r->box[i], &r->box[j]))
+    double slack;
+    uint32_t *o = sweep_order(r, &slack);
+    if (!o)
+        return obs__fail(err, OBS_NO_MEMORY, "%zu regions", r->count);
+    for (size_t a = 0; a < r->count; a++)
+        for (size_t b = a + 1; b < r->count; b++) {
+            uint32_t i = o[a], j = o[b];
+            if (r->box[j].lo[0] > r->box[i].hi[0] + slack)
+                break;
+            if (overlap(&r->box[i], &r->box[j])) {
+                free(o);
                 return obs__fail(err, OBS_INVALID_ARGUMENT,
-                                 "regions %zu and %zu overlap (boxes may share faces, not "
+                                 "regions %u and %u overlap (boxes may share faces, not "
                                  "volume)",
-                                 i, j);
+                                 i < j ? i : j, i < j ? j : i);
+            }
+        }
+    free(o);
     return OBS_OK;
 }
 
