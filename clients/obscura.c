@@ -25,6 +25,7 @@
 #include "flags.h"
 #include "inspect.h"
 #include "bake.h"
+#include "dynamic.h"
 #include "ground.h"
 #include "obscura/io.h"
 #include "obscura/metrics.h"
@@ -138,6 +139,7 @@ static void usage(FILE *f)
     cli_ground_usage(f);
     cli_warmup_usage(f);
     cli_bake_usage(f);
+    cli_dynamic_usage(f);
     fprintf(f, "\nao options:\n");
     for (const cli_opt *o = ao_opts; o->name; o++) {
         char left[48];
@@ -1036,6 +1038,8 @@ int main(int argc, char **argv)
         return cli_warmup(argc - 2, argv + 2);
     if (!strcmp(cmd, "bake"))
         return cli_bake(argc - 2, argv + 2);
+    if (!strcmp(cmd, "bake-dynamic"))
+        return cli_dynamic(argc - 2, argv + 2);
     if (!strcmp(cmd, "batch")) {
         static const cli_batch_ops ops = {batch_check, batch_ao, batch_finish};
         return cli_batch(argc - 2, argv + 2, &ops);

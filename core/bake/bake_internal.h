@@ -97,4 +97,18 @@ void obs__bake_residual(const obs__bake_world *w, const obs__bake_weld *wd,
 double obs__bake_edge_jump(const float a[3], const float b[3], const float c[3],
                            const float d[3], double j[4]);
 
+/* The level's BVH on its own, for points in space (trace.c; the
+ * dynamic-object bake).  w must outlive it. */
+typedef struct obs__bake_bvh obs__bake_bvh;
+obs_status obs__bake_bvh_new(const obs__bake_world *w, obs__bake_bvh **out,
+                             char err[OBS_ERR_LEN]);
+void obs__bake_bvh_free(obs__bake_bvh *b);
+/* Closest hits of the n unit directions dirs (3 each) from o, up to
+ * tfar: t[k] the distance (INFINITY for a miss), back[k] 1 when the ray
+ * met a one-sided face from behind.  Thread-safe. */
+void obs__bake_bvh_cast(const obs__bake_bvh *b, const float o[3], const float *dirs, int n,
+                        float tfar, float *t, uint8_t *back);
+/* 1 when geometry lies on the segment a-c. */
+int obs__bake_bvh_occluded(const obs__bake_bvh *b, const float a[3], const float c[3]);
+
 #endif

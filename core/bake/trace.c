@@ -254,3 +254,129 @@ done:
     rtcReleaseDevice(dev);
     return st;
 }
+
+/* ---- the level's BVH and single rays, for the dynamic-object bake ------
+ * (probes.c, regions.c, dyn_measure.c: points in space rather than on the
+ * surface).  The same scene as obs__bake_trace builds; kept beside it. */
+struct obs__bake_bvh {
+    RTCDevice dev;
+    RTCScene rtc;
+    const obs__bake_world *w;
+};
+
+obs_status obs__bake_bvh_new(const obs__bake_world *w, obs__bake_bvh **out,
+                             char err[OBS_ERR_LEN])
+{
+    char dev_err[OBS_ERR_LEN] = "";
+    *out = NULL;
+    obs__bake_bvh *b = calloc(1, sizeof *b);
+    if (!b)
+        return obs__fail(err, OBS_NO_MEMORY, "BVH");
+    b->w = w;
+    b->dev = rtcNewDevice(NULL);
+    if (!b->dev) {
+        free(b);
+        return obs__fail(err, OBS_UNSUPPORTED, "Embree: no device (error %d)",
+                         (int)rtcGetDeviceError(NULL));
+    }
+    rtcSetDeviceErrorFunction(b->dev, device_error, dev_err);
+    b->rtc = rtcNewScene(b->dev);
+    RTCGeometry g = rtcNewGeometry(b->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *v = b->rtc && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                     RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                     w->vertex_count)
+                           : NULL;
+    unsigned *ix = b->rtc && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0,
+                                                         RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                                         w->triangle_count)
+                               : NULL;
+    if (!v || !ix) {
+        if (g)
+            rtcReleaseGeometry(g);
+        obs_status st = obs__fail(err, OBS_NO_MEMORY, "Embree scene of %zu triangles: %s",
+                                  w->triangle_count, dev_err[0] ? dev_err : "out of memory");
+        obs__bake_bvh_free(b);
+        return st;
+    }
+    memcpy(v, w->pos, w->vertex_count * 3 * sizeof(float));
+    memcpy(ix, w->tri, w->triangle_count * 3 * sizeof(unsigned));
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(b->rtc, g);
+    rtcReleaseGeometry(g);
+    rtcSetSceneBuildQuality(b->rtc, RTC_BUILD_QUALITY_HIGH);
+    rtcCommitScene(b->rtc);
+    rtcSetDeviceErrorFunction(b->dev, NULL, NULL);
+    if (dev_err[0]) {
+        obs_status st = obs__fail(err, OBS_NO_MEMORY, "Embree scene: %s", dev_err);
+        obs__bake_bvh_free(b);
+        return st;
+    }
+    *out = b;
+    return OBS_OK;
+}
+
+void obs__bake_bvh_free(obs__bake_bvh *b)
+{
+    if (!b)
+        return;
+    if (b->rtc)
+        rtcReleaseScene(b->rtc);
+    rtcReleaseDevice(b->dev);
+    free(b);
+}
+
+void obs__bake_bvh_cast(const obs__bake_bvh *b, const float o[3], const float *dirs, int n,
+                        float tfar, float *t, uint8_t *back)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    const obs__bake_world *w = b->w;
+    for (int k0 = 0; k0 < n; k0 += PACKET) {
+        RTC_ALIGN(32) struct RTCRayHit8 rh;
+        RTC_ALIGN(32) int valid[PACKET];
+        for (int l = 0; l < PACKET; l++) {
+            int k = k0 + l < n ? k0 + l : n - 1;
+            valid[l] = k0 + l < n ? -1 : 0;
+            rh.ray.org_x[l] = o[0], rh.ray.org_y[l] = o[1], rh.ray.org_z[l] = o[2];
+            rh.ray.dir_x[l] = dirs[3 * k], rh.ray.dir_y[l] = dirs[3 * k + 1];
+            rh.ray.dir_z[l] = dirs[3 * k + 2];
+            rh.ray.tnear[l] = 0.0f;
+            rh.ray.tfar[l] = tfar;
+            rh.ray.time[l] = 0.0f;
+            rh.ray.mask[l] = 0xffffffffu;
+            rh.ray.id[l] = 0;
+            rh.ray.flags[l] = 0;
+            rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect8(valid, b->rtc, &ctx, &rh);
+        for (int l = 0; l < PACKET && k0 + l < n; l++) {
+            int k = k0 + l;
+            if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
+                t[k] = INFINITY;
+                back[k] = 0;
+                continue;
+            }
+            t[k] = rh.ray.tfar[l];
+            unsigned pr = rh.hit.primID[l];
+            const float *hn = w->fn + 3 * (size_t)pr;
+            back[k] = !w->two_sided[pr] && hn[0] * rh.ray.dir_x[l] + hn[1] * rh.ray.dir_y[l] +
+                                                   hn[2] * rh.ray.dir_z[l] >
+                                               0.0f;
+        }
+    }
+}
+
+int obs__bake_bvh_occluded(const obs__bake_bvh *b, const float a[3], const float c[3])
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    float d[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (len <= 0.0f)
+        return 0;
+    struct RTCRay r = {a[0], a[1], a[2], 0.0f, d[0] / len, d[1] / len, d[2] / len, 0.0f,
+                       len, 0xffffffffu, 0, 0};
+    rtcOccluded1(b->rtc, &ctx, &r);
+    return r.tfar < 0.0f; /* Embree sets tfar to -inf on a hit */
+}

@@ -1,0 +1,95 @@
+/* The dynamic-object bake's steps in order (obscura/dynamic.h), each
+ * timed: flatten, BVH, regions, valid points, spherical obscurance, the
+ * fit. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake/dyn_internal.h"
+#include "internal.h"
+
+static const char *const stage_names[] = {
+#define X(n, d) #n,
+    OBS_DYN_STAGE_LIST(X)
+#undef X
+};
+
+const char *obs_dyn_stage_name(int stage)
+{
+    return stage >= 0 && stage < OBS_DYN_STAGE_COUNT ? stage_names[stage] : "?";
+}
+
+static double now(void) { return obs__now_ms() * 1e-3; }
+
+void obs_dyn_result_free(obs_dyn_result *r)
+{
+    if (!r)
+        return;
+    obs_dyn_model_free(&r->model);
+    obs_dyn_model_free(&r->original);
+    memset(r, 0, sizeof *r);
+}
+
+obs_status obs_dyn_bake(const obs_bake_scene *scene, const obs_dyn_desc *desc,
+                        obs_dyn_result *out, char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    obs_dyn_params p;
+    obs_dyn_params_resolve(desc ? &desc->params : NULL, &p);
+    obs_dyn_stats *st = &out->stats;
+    obs__bake_world w = {0};
+    obs__bake_bvh *bvh = NULL;
+    obs_dyn_regions own = {0};
+    const obs_dyn_regions *rg = desc ? desc->regions : NULL;
+    obs__dyn_points pt = {0};
+    obs_status rc;
+    if (!scene || scene->node_count == 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "bake-dynamic: no scene");
+    if (scene->world_triangles > (size_t)p.max_triangles)
+        return obs__fail(err, OBS_TOO_LARGE, "%zu triangles once flattened; max_triangles is %d",
+                         scene->world_triangles, p.max_triangles);
+    double t = now();
+    if ((rc = obs__bake_flatten(scene, &w, err)) != OBS_OK)
+        goto done;
+    st->seconds[OBS_DYN_STAGE_flatten] = now() - t;
+    t = now();
+    if ((rc = obs__bake_bvh_new(&w, &bvh, err)) != OBS_OK)
+        goto done;
+    st->seconds[OBS_DYN_STAGE_bvh] = now() - t;
+    t = now();
+    if (!rg) {
+        if ((rc = obs__dyn_regions_build(&w, bvh, &p, &own, err)) != OBS_OK)
+            goto done;
+        rg = &own;
+    }
+    st->regions = rg->count;
+    st->edges = rg->edge_count;
+    st->seconds[OBS_DYN_STAGE_regions] = now() - t;
+    t = now();
+    double valid_s = 0.0;
+    if ((rc = obs__dyn_points_make(&w, bvh, rg, &p, &pt, &valid_s, desc ? desc->progress : NULL,
+                                   desc ? desc->progress_user : NULL, err)) != OBS_OK)
+        goto done;
+    st->seconds[OBS_DYN_STAGE_valid] = valid_s;
+    st->seconds[OBS_DYN_STAGE_trace] = now() - t - valid_s;
+    st->grid_points = pt.grid;
+    st->points_inside = pt.inside;
+    st->points_hidden = pt.hidden;
+    st->points_backface = pt.backface;
+    st->points_valid = pt.count;
+    st->rays = pt.rays;
+    t = now();
+    if ((rc = obs__dyn_fit_all(&pt, rg, &p, out, err)) != OBS_OK)
+        goto done;
+    st->seconds[OBS_DYN_STAGE_fit] = now() - t;
+done:
+    obs__dyn_points_free(&pt);
+    obs_dyn_regions_free(&own);
+    obs__bake_bvh_free(bvh);
+    obs__bake_world_free(&w);
+    if (rc != OBS_OK) {
+        obs_dyn_stats keep = out->stats;
+        obs_dyn_result_free(out);
+        out->stats = keep;
+    }
+    return rc;
+}

@@ -1,0 +1,336 @@
+/* The valid points of the regions and their spherical obscurance
+ * (section 2.3).
+ *
+ * "Before the bake is launched we compute a one bit flag at 8 x 8 x 8
+ * samples in the region where the bit is set if the point is valid": the
+ * grid's points are the centres of grid^3 equal cells of the box.  A
+ * point is valid when both hold:
+ *   - it is outside geometry: at most backface_limit of 32 rays (a fixed
+ *     spiral over the sphere) meet a one-sided face from behind (the
+ *     bake's back-face rule of section 2.1, through Embree);
+ *   - it is not behind a wall from the region's viewpoint: the segment
+ *     from the viewpoint to the point meets no geometry (an Embree
+ *     occlusion ray).  The viewpoint is the outside grid point nearest the
+ *     box's centre; it stands in for the visibility system's "not on the
+ *     other side of a diagonal wall".
+ * Then every valid point traces `rays` directions over the whole sphere
+ * (equal-area Fibonacci spiral, a random rotation per point): the
+ * spherical obscurance f(w) = rho(d(p, w)), rho(x) = 1 - exp(a x),
+ * a = ln 0.5 / d, at both distances (section 2; a miss is rho = 1), is
+ * projected to quadratic SH and convolved with the clamped cosine (sh.c).
+ * "We start by eliminating any points that see too many back faces": a
+ * point whose rays meet back faces more often than backface_limit is
+ * dropped here too (the full ray set sees more than the 32 of the flag). */
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "bake/dyn_internal.h"
+#include "bake/rng.h"
+#include "internal.h"
+
+#define MAX_THREADS 64
+#define PI_D 3.14159265358979323846
+/* Rays stop at this many long distances: rho is within 2^-16 of 1 (as
+ * trace.c). */
+#define RAY_LENGTH_FACTOR 16.0f
+#define FLAG_RAYS 32
+
+int obs__dyn_inside(const obs__bake_bvh *bvh, const float p[3], int rays, float limit)
+{
+    float dirs[3 * 256], t[256];
+    uint8_t back[256];
+    if (rays > 256)
+        rays = 256;
+    obs__dyn_sphere_dirs(rays, 0, 0, dirs);
+    obs__bake_bvh_cast(bvh, p, dirs, rays, INFINITY, t, back);
+    int nb = 0;
+    for (int k = 0; k < rays; k++)
+        nb += back[k];
+    return (double)nb > (double)limit * rays;
+}
+
+void obs__dyn_points_free(obs__dyn_points *pt)
+{
+    free(pt->pos);
+    free(pt->sh);
+    free(pt->region);
+    free(pt->held);
+    memset(pt, 0, sizeof *pt);
+}
+
+/* A parallel loop over [0, n) in chunks; fn(ctx, i). */
+typedef struct pfor {
+    size_t n, chunk;
+    atomic_size_t next;
+    void (*fn)(void *, size_t);
+    void *ctx;
+    pthread_mutex_t lock;
+    size_t done;
+    void (*progress)(void *, size_t, size_t);
+    void *user;
+} pfor;
+
+static void *pfor_worker(void *arg)
+{
+    pfor *f = arg;
+    size_t i0;
+    while ((i0 = atomic_fetch_add(&f->next, f->chunk)) < f->n) {
+        size_t i1 = i0 + f->chunk < f->n ? i0 + f->chunk : f->n;
+        for (size_t i = i0; i < i1; i++)
+            f->fn(f->ctx, i);
+        pthread_mutex_lock(&f->lock);
+        f->done += i1 - i0;
+        if (f->progress)
+            f->progress(f->user, f->done, f->n);
+        pthread_mutex_unlock(&f->lock);
+    }
+    return NULL;
+}
+
+static void run_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx,
+                     void (*progress)(void *, size_t, size_t), void *user)
+{
+    pfor f = {.n = n, .chunk = chunk, .fn = fn, .ctx = ctx, .progress = progress, .user = user};
+    atomic_init(&f.next, 0);
+    pthread_mutex_init(&f.lock, NULL);
+    int nt = threads;
+    if (nt <= 0) {
+        long c = sysconf(_SC_NPROCESSORS_ONLN);
+        nt = c < 1 ? 1 : c > MAX_THREADS ? MAX_THREADS : (int)c;
+    }
+    pthread_t th[MAX_THREADS];
+    int started = 0;
+    for (; started < nt && started < MAX_THREADS; started++)
+        if (pthread_create(&th[started], NULL, pfor_worker, &f) != 0)
+            break;
+    if (started == 0)
+        pfor_worker(&f);
+    for (int k = 0; k < started; k++)
+        pthread_join(th[k], NULL);
+    pthread_mutex_destroy(&f.lock);
+}
+
+typedef struct flag_job {
+    const obs__bake_bvh *bvh;
+    const obs_dyn_regions *rg;
+    const obs_dyn_params *p;
+    uint8_t *state; /* per grid point: 0 valid, 1 inside, 2 hidden */
+} flag_job;
+
+static void grid_point(const obs_dyn_box *b, int g, size_t k, float q[3])
+{
+    size_t ix[3] = {k % (size_t)g, k / (size_t)g % (size_t)g, k / ((size_t)g * g)};
+    for (int a = 0; a < 3; a++)
+        q[a] = b->lo[a] + (b->hi[a] - b->lo[a]) * ((float)ix[a] + 0.5f) / (float)g;
+}
+
+static void flag_region(void *ctx, size_t r)
+{
+    flag_job *j = ctx;
+    int g = j->p->grid;
+    size_t n = (size_t)g * g * g;
+    uint8_t *s = j->state + r * n;
+    const obs_dyn_box *b = &j->rg->box[r];
+    float c[3], view[3], best = INFINITY;
+    int have = 0;
+    for (int a = 0; a < 3; a++)
+        c[a] = 0.5f * (b->lo[a] + b->hi[a]);
+    for (size_t k = 0; k < n; k++) {
+        float q[3];
+        grid_point(b, g, k, q);
+        s[k] = obs__dyn_inside(j->bvh, q, FLAG_RAYS, j->p->backface_limit) ? 1 : 0;
+        float d = (q[0] - c[0]) * (q[0] - c[0]) + (q[1] - c[1]) * (q[1] - c[1]) +
+                  (q[2] - c[2]) * (q[2] - c[2]);
+        if (!s[k] && d < best)
+            best = d, memcpy(view, q, sizeof view), have = 1;
+    }
+    for (size_t k = 0; have && k < n; k++) {
+        float q[3];
+        grid_point(b, g, k, q);
+        if (!s[k] && obs__bake_bvh_occluded(j->bvh, view, q))
+            s[k] = 2;
+    }
+}
+
+typedef struct sph_job {
+    const obs__bake_bvh *bvh;
+    const obs_dyn_params *p;
+    obs__dyn_points *pt;
+    const uint64_t *id; /* each point's grid index over the level */
+    uint8_t *dropped;
+} sph_job;
+
+int obs__dyn_point_sh(const obs__bake_bvh *bvh, const float o[3], const obs_dyn_params *p,
+                      uint64_t stream, double sh[OBS_DYN_CHANNELS], int *dropped)
+{
+    int n = p->rays, ok = 0;
+    float *dirs = malloc((size_t)n * 3 * sizeof *dirs), *t = malloc((size_t)n * sizeof *t);
+    uint8_t *back = malloc((size_t)n);
+    double *w = malloc((size_t)n * sizeof *w), *f = malloc(2 * (size_t)n * sizeof *f);
+    if (!dirs || !t || !back || !w || !f)
+        goto done;
+    obs__dyn_sphere_dirs(n, (uint64_t)p->seed, stream, dirs);
+    float dist[2] = {p->distance_short, p->distance_long};
+    obs__bake_bvh_cast(bvh, o, dirs, n, RAY_LENGTH_FACTOR * fmaxf(dist[0], dist[1]), t, back);
+    int nb = 0;
+    for (int k = 0; k < n; k++) {
+        w[k] = 4.0 * PI_D / n; /* equal-area directions */
+        nb += back[k];
+        for (int c = 0; c < 2; c++) {
+            double a = log(0.5) / dist[c]; /* a = ln(0.5) / d, section 2 */
+            f[(size_t)c * n + k] = isinf(t[k]) ? 1.0 : 1.0 - exp(a * t[k]); /* rho(x) */
+        }
+    }
+    *dropped = (double)nb > (double)p->backface_limit * n;
+    for (int c = 0; c < 2; c++) {
+        obs__dyn_sh_project(dirs, w, f + (size_t)c * n, (size_t)n, sh + OBS_DYN_SH * c);
+        obs__dyn_sh_convolve(sh + OBS_DYN_SH * c);
+    }
+    ok = 1;
+done:
+    free(dirs);
+    free(t);
+    free(back);
+    free(w);
+    free(f);
+    return ok;
+}
+
+static void trace_point(void *ctx, size_t i)
+{
+    sph_job *j = ctx;
+    int dropped = 0;
+    if (!obs__dyn_point_sh(j->bvh, j->pt->pos + 3 * i, j->p, j->id[i],
+                           j->pt->sh + (size_t)OBS_DYN_CHANNELS * i, &dropped))
+        dropped = 2; /* no memory: reported by the caller */
+    j->dropped[i] = (uint8_t)dropped;
+}
+
+obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *bvh,
+                                const obs_dyn_regions *rg, const obs_dyn_params *p,
+                                obs__dyn_points *out, double *valid_seconds,
+                                void (*progress)(void *, size_t, size_t), void *user,
+                                char err[OBS_ERR_LEN])
+{
+    (void)w;
+    memset(out, 0, sizeof *out);
+    obs_status st = OBS_OK;
+    size_t per = (size_t)p->grid * p->grid * p->grid;
+    if (rg->count > SIZE_MAX / per / 2)
+        return obs__fail(err, OBS_TOO_LARGE, "%zu regions", rg->count);
+    size_t total = rg->count * per, nv = 0;
+    uint8_t *state = calloc(total ? total : 1, 1), *dropped = NULL;
+    uint64_t *id = NULL;
+    if (!state)
+        return obs__fail(err, OBS_NO_MEMORY, "valid flags of %zu points", total);
+    double t0 = (obs__now_ms() * 1e-3);
+    flag_job fj = {bvh, rg, p, state};
+    run_pfor(rg->count, 1, p->threads, flag_region, &fj, NULL, NULL);
+    *valid_seconds = (obs__now_ms() * 1e-3) - t0;
+    out->grid = total;
+    for (size_t k = 0; k < total; k++) {
+        out->inside += state[k] == 1;
+        out->hidden += state[k] == 2;
+        nv += state[k] == 0;
+    }
+    out->pos = malloc((nv ? nv : 1) * 3 * sizeof *out->pos);
+    out->sh = malloc((nv ? nv : 1) * OBS_DYN_CHANNELS * sizeof *out->sh);
+    out->region = malloc((nv ? nv : 1) * sizeof *out->region);
+    out->held = malloc(nv ? nv : 1);
+    id = malloc((nv ? nv : 1) * sizeof *id);
+    dropped = malloc(nv ? nv : 1);
+    if (!out->pos || !out->sh || !out->region || !out->held || !id || !dropped) {
+        st = obs__fail(err, OBS_NO_MEMORY, "%zu valid points", nv);
+        goto done;
+    }
+    size_t i = 0;
+    for (size_t k = 0; k < total; k++) {
+        if (state[k])
+            continue;
+        grid_point(&rg->box[k / per], p->grid, k % per, out->pos + 3 * i);
+        out->region[i] = (uint32_t)(k / per);
+        id[i] = k;
+        obs__bake_rng r = obs__bake_rng_stream((uint64_t)p->seed, k, 11);
+        out->held[i] = obs__bake_rng_unit(&r) < p->holdout;
+        i++;
+    }
+    out->count = nv;
+    sph_job sj = {bvh, p, out, id, dropped};
+    run_pfor(nv, 16, p->threads, trace_point, &sj, progress, user);
+    out->rays = (uint64_t)nv * (uint64_t)p->rays;
+    /* Drop the points that see too many back faces, keeping the order. */
+    size_t m = 0;
+    for (size_t k = 0; k < nv; k++) {
+        if (dropped[k] == 2) {
+            st = obs__fail(err, OBS_NO_MEMORY, "rays of one point");
+            goto done;
+        }
+        if (dropped[k]) {
+            out->backface++;
+            continue;
+        }
+        memmove(out->pos + 3 * m, out->pos + 3 * k, 3 * sizeof *out->pos);
+        memmove(out->sh + OBS_DYN_CHANNELS * m, out->sh + OBS_DYN_CHANNELS * k,
+                OBS_DYN_CHANNELS * sizeof *out->sh);
+        out->region[m] = out->region[k];
+        out->held[m] = out->held[k];
+        m++;
+    }
+    out->count = m;
+done:
+    free(state);
+    free(id);
+    free(dropped);
+    if (st != OBS_OK)
+        obs__dyn_points_free(out);
+    return st;
+}
+
+/* An orthonormal tangent frame around unit n (as trace.c's). */
+static void frame(const float n[3], float t[3], float b[3])
+{
+    if (n[2] < -0.9999999f) {
+        t[0] = 0.0f, t[1] = -1.0f, t[2] = 0.0f;
+        b[0] = -1.0f, b[1] = 0.0f, b[2] = 0.0f;
+        return;
+    }
+    float a = 1.0f / (1.0f + n[2]), c = -n[0] * n[1] * a;
+    t[0] = 1.0f - n[0] * n[0] * a, t[1] = c, t[2] = -n[0];
+    b[0] = c, b[1] = 1.0f - n[1] * n[1] * a, b[2] = -n[1];
+}
+
+void obs__dyn_trace_eq1(const obs__bake_bvh *bvh, const float o[3], const float n[3],
+                        int rays, const float distance[2], uint64_t seed, uint64_t stream,
+                        double ao[2])
+{
+    /* Eq 1 with cosine-weighted directions (Malley's method on a rank-1
+     * lattice with a random shift, as trace.c): AO is the mean of rho. */
+    float tg[3], bt[3], dirs[3 * 8], t[8];
+    uint8_t back[8];
+    frame(n, tg, bt);
+    obs__bake_rng r = obs__bake_rng_stream(seed, stream, 13);
+    double o1 = obs__bake_rng_unit(&r), o2 = obs__bake_rng_unit(&r), acc[2] = {0.0, 0.0};
+    float tfar = RAY_LENGTH_FACTOR * fmaxf(distance[0], distance[1]);
+    for (int k0 = 0; k0 < rays; k0 += 8) {
+        int m = rays - k0 < 8 ? rays - k0 : 8;
+        for (int l = 0; l < m; l++) {
+            int k = k0 + l;
+            double u1 = fmod((k + 0.5) / rays + o1, 1.0), u2 = fmod(k * 0.6180339887498949 + o2, 1.0);
+            double rad = sqrt(u1), phi = 2.0 * PI_D * u2;
+            float x = (float)(rad * cos(phi)), y = (float)(rad * sin(phi)),
+                  z = (float)sqrt(fmax(0.0, 1.0 - u1));
+            for (int a = 0; a < 3; a++)
+                dirs[3 * l + a] = x * tg[a] + y * bt[a] + z * n[a];
+        }
+        obs__bake_bvh_cast(bvh, o, dirs, m, tfar, t, back);
+        for (int l = 0; l < m; l++)
+            for (int c = 0; c < 2; c++)
+                acc[c] += isinf(t[l]) ? 1.0 : 1.0 - exp(log(0.5) / distance[c] * t[l]);
+    }
+    ao[0] = acc[0] / rays;
+    ao[1] = acc[1] / rays;
+}

@@ -1,0 +1,127 @@
+#!/bin/sh
+# End-to-end tests of `obscura bake-dynamic`: the aalborg fixture of
+# tests/data with built regions and with a regions file, the model file
+# read back by an independent reader of its documented format
+# (tests/e2e/lib/dyn_eval.py) against `--eval`, the same bytes for 1 and 2
+# threads, the report's measures, clear errors for bad regions files and
+# usage.
+#
+#   OBSCURA=build/obscura tests/e2e/dynamic.sh
+set -u
+OBSCURA=${OBSCURA:-build/obscura}
+. tests/e2e/lib/common.sh
+
+expect() {
+    code=$1; what=$2; shift 3
+    "$@" >"$T/out" 2>"$T/err"
+    rc=$?
+    if [ "$rc" -eq "$code" ]; then ok "$what"; else
+        bad "$what (exit $rc, expected $code)"; sed 's/^/       /' "$T/err" | tail -5; fi
+}
+said() {
+    if grep -q -- "$1" "$T/err" "$T/out"; then ok "message: $1"; else
+        bad "message '$1' missing"; sed 's/^/       /' "$T/err" | tail -5; fi
+}
+field() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval('d'+sys.argv[2]))" "$@"; }
+
+echo "e2e bake-dynamic: $OBSCURA"
+FIX=tests/data/levels/aalborg_cut.acc
+FAST="--rays 64 --max-regions 24 -q"
+expect 0 "bake-dynamic the aalborg fixture" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/m.json" \
+    --report "$T/r.json" $FAST --holdout 0.2 --paths 6 --path-steps 32 --path-rays 64
+check "report: 24 regions, 512 grid points each" \
+    "[ \"\$(field $T/r.json \"['counts']['regions']\")\" = 24 ] && [ \"\$(field $T/r.json \"['counts']['grid_points']\")\" = 12288 ]"
+check "report: some grid points inside geometry, most valid" \
+    "python3 -c \"import json; c=json.load(open('$T/r.json'))['counts']; assert c['points_inside'] > 0 and c['points_valid'] > c['grid_points'] / 2\""
+check "report: 64 rays per valid point" \
+    "python3 -c \"import json; c=json.load(open('$T/r.json'))['counts']; assert c['rays'] == 64 * (c['points_valid'] + c['points_backface'])\""
+check "held back: eq 4 beats a constant" \
+    "python3 -c \"import json; h=json.load(open('$T/r.json'))['holdout_rms']; assert h['points'] > 0 and h['eq4'] < h['constant'], h\""
+check "regularisation: smaller jumps at the boundaries, lower energy" \
+    "python3 -c \"import json; j=json.load(open('$T/r.json'))['boundary_jump']; assert j['mean'][1] < j['mean'][0] and j['energy'][1] < j['energy'][0], j\""
+check "paths: measured, blending lowers the crossing jumps" \
+    "python3 -c \"import json; p=json.load(open('$T/r.json'))['paths']; assert p['points'] > 0 and p['crossings'] > 0 and p['regularised_blended']['crossing_mean'] < p['unregularised']['crossing_mean'], p\""
+check "model file: format, one model per region or absorbed" \
+    "python3 -c \"import json; d=json.load(open('$T/m.json')); assert d['format'] == 'obscura-dynamic-ao' and len(d['regions']) == 24 and all(r['model'] < len(d['models']) for r in d['regions']) and all(len(m['coefficients']) == 18 and all(len(c) == 7 for c in m['coefficients']) for m in d['models'])\""
+
+# --eval against an independent reader of the documented file format, at
+# points inside regions and outside every box, both SH orders.
+n=0
+for spec in "0.3,0.6,0.2:0,1,0:quadratic" "0.7,0.2,0.9:0.6,0,0.8:linear" "0.5,0.5,0.5:-1,0,0:quadratic" \
+            "-2,0.5,3:0,0,1:quadratic" "0.1,0.9,0.4:0,-1,0:linear"; do
+    rel=${spec%%:*}; rest=${spec#*:}; nrm=${rest%%:*}; sh=${rest#*:}
+    at=$(python3 -c "
+import json,sys; d=json.load(open('$T/m.json')); r=[g for g in d['regions'] if g['model']>=0][3]
+f=[float(x) for x in '$rel'.split(',')]
+print(','.join(repr(r['min'][a]+(r['max'][a]-r['min'][a])*f[a]) for a in range(3)))")
+    expect 0 "--eval at $at ($sh)" -- "$OBSCURA" bake-dynamic --eval "$T/m.json" --at "$at" --normal "$nrm" --sh "$sh"
+    got=$(cat "$T/out")
+    want=$(python3 tests/e2e/lib/dyn_eval.py "$T/m.json" "$at" "$nrm" "$sh")
+    check "--eval $got = the reader's $want" "python3 -c 'import sys; sys.exit(abs($got - $want) > 2e-5)'"
+    n=$((n + 1))
+done
+"$OBSCURA" bake-dynamic --eval "$T/m.json" --at 0.5,5,-690 --normal 0,1,0 --sh linear >"$T/lin" 2>/dev/null
+"$OBSCURA" bake-dynamic --eval "$T/m.json" --at 0.5,5,-690 --normal 0,1,0 --sh quadratic >"$T/quad" 2>/dev/null
+check "linear and quadratic SH differ" "! cmp -s $T/lin $T/quad"
+
+expect 0 "1 thread" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/t1.json" $FAST --threads 1
+expect 0 "2 threads" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/t2.json" $FAST --threads 2
+check "the same bytes whatever the thread count" "cmp -s $T/t1.json $T/t2.json"
+expect 0 "beta 0" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/b0.json" $FAST --beta 0 --report "$T/b0r.json"
+check "beta 0: the jumps stay as fitted" \
+    "python3 -c \"import json; j=json.load(open('$T/b0r.json'))['boundary_jump']; assert j['mean'][1] == j['mean'][0], j\""
+check "beta 0 gives another model" "! cmp -s $T/t1.json $T/b0.json"
+
+# A regions file: two boxes of the built ones, adjacency computed, then
+# given.
+python3 - "$T/m.json" "$T/two.json" "$T/two_adj.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+lo = [min(r['min'][a] for r in d['regions']) for a in range(3)]
+hi = [max(r['max'][a] for r in d['regions']) for a in range(3)]
+mid = 0.5 * (lo[0] + hi[0])
+boxes = [{"min": lo, "max": [mid, hi[1], hi[2]]}, {"min": [mid, lo[1], lo[2]], "max": hi}]
+json.dump({"regions": boxes}, open(sys.argv[2], "w"))
+json.dump({"regions": boxes, "adjacency": [[0, 1]]}, open(sys.argv[3], "w"))
+PY
+expect 0 "--regions: two boxes" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/two_m.json" --regions "$T/two.json" \
+    --rays 32 --report "$T/two_r.json" -q
+check "--regions: 2 regions, 1 edge" \
+    "[ \"\$(field $T/two_r.json \"['counts']['regions']\")\" = 2 ] && [ \"\$(field $T/two_r.json \"['counts']['edges']\")\" = 1 ]"
+expect 0 "--regions with adjacency" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/two_a.json" --regions "$T/two_adj.json" --rays 32 -q
+check "given adjacency = computed" "cmp -s $T/two_m.json $T/two_a.json"
+
+echo '{"regions": [{"min": [0,0,0], "max": [2,2,2]}, {"min": [1,1,1], "max": [3,3,3]}]}' >"$T/overlap.json"
+expect 3 "refuses overlapping boxes" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/x.json" --regions "$T/overlap.json" -q
+said "regions 0 and 1 overlap"
+echo '{"regions": [{"min": [0,0,0], "max": [2,0,2]}]}' >"$T/empty.json"
+expect 3 "refuses an empty box" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/x.json" --regions "$T/empty.json" -q
+said "region 0 is empty"
+echo '{"regions": [{"min": [0,0,0], "max": [1,1,1]}, {"min": [4,0,0], "max": [5,1,1]}], "adjacency": [[0,1]]}' >"$T/apart.json"
+expect 3 "refuses adjacency of boxes apart" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/x.json" --regions "$T/apart.json" -q
+said "share no face"
+echo '{"regions": [{"min": [0,0,0], "max": [1,1,1]}], "adjacency": [[0,7]]}' >"$T/range.json"
+expect 3 "refuses adjacency out of range" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/x.json" --regions "$T/range.json" -q
+said "out of 0..0"
+echo '{"regions": ' >"$T/broken.json"
+expect 3 "refuses a broken regions file" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/x.json" --regions "$T/broken.json" -q
+said "not JSON"
+expect 3 "a missing regions file" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/x.json" --regions "$T/none.json" -q
+expect 3 "a damaged model" -- "$OBSCURA" bake-dynamic --eval "$T/overlap.json" --at 0,0,0
+said "not an obscura-dynamic-ao model"
+expect 2 "--eval without --at" -- "$OBSCURA" bake-dynamic --eval "$T/m.json"
+said "--at X,Y,Z"
+expect 2 "--normal of zeros" -- "$OBSCURA" bake-dynamic --eval "$T/m.json" --at 0,0,0 --normal 0,0,0
+expect 2 "--sh cubic" -- "$OBSCURA" bake-dynamic --eval "$T/m.json" --at 0,0,0 --sh cubic
+expect 2 "no output" -- "$OBSCURA" bake-dynamic "$FIX"
+said "no output file"
+expect 2 "beta out of range" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/x.json" --beta -1
+said "beta"
+expect 2 "an unknown option" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/x.json" --nope 1
+expect 0 "--params" -- "$OBSCURA" bake-dynamic --params
+said "absorb-points"
+expect 0 "help lists bake-dynamic" -- "$OBSCURA" help
+said "bake-dynamic LEVEL"
+
+echo "e2e bake-dynamic: $pass passed, $failed failed"
+[ "$failed" -eq 0 ]
