@@ -87,17 +87,20 @@ static obs_status glb_open(const char *path, glb *g, char err[OBS_ERR_LEN])
         glb_free(g);
         return obs__fail(err, OBS_BAD_FILE, "%s: not a glTF binary (.glb)", path);
     }
-    if (u32(d + 4) != 2 || u32(d + 16) != CHUNK_JSON) {
+    /* The header's fields are read before any error frees the file. */
+    uint32_t version = u32(d + 4), first = u32(d + 16);
+    size_t total = u32(d + 8), jlen = u32(d + 12);
+    if (version != 2 || first != CHUNK_JSON) {
         glb_free(g);
         return obs__fail(err, OBS_BAD_FILE, "%s: not glTF 2.0 binary (version %u, first chunk "
-                                            "not JSON)", path, (unsigned)u32(d + 4));
+                                            "not JSON)", path, (unsigned)version);
     }
-    if (u32(d + 8) > g->size) {
+    if (total > g->size) {
+        size_t have = g->size;
         glb_free(g);
-        return obs__fail(err, OBS_BAD_FILE, "%s: the header says %u bytes, the file has %zu "
-                                            "(truncated?)", path, (unsigned)u32(d + 8), g->size);
+        return obs__fail(err, OBS_BAD_FILE, "%s: the header says %zu bytes, the file has %zu "
+                                            "(truncated?)", path, total, have);
     }
-    size_t total = u32(d + 8), jlen = u32(d + 12);
     if (jlen > total - 20) {
         glb_free(g);
         return obs__fail(err, OBS_BAD_FILE, "%s: JSON chunk of %zu bytes beyond the file", path,
