@@ -4,8 +4,10 @@
 # read back by an independent reader of its documented format
 # (tests/e2e/lib/dyn_eval.py) against `--eval`, the same bytes for 1 and 2
 # threads, the report's measures, the bake over shards (--shard I/N,
-# --merge: merged = unsharded byte for byte, bad parts refused), clear
-# errors for bad regions files and usage.
+# --merge: merged = unsharded byte for byte, bad parts refused), `obscura
+# gbuffer --dynamic` (a dynamic object in the baked level valued from the
+# model per pixel, checked by the independent reader; the static pixels
+# unchanged), clear errors for bad regions files, models and usage.
 #
 #   OBSCURA=build/obscura tests/e2e/dynamic.sh
 set -u
@@ -129,6 +131,71 @@ said "needs the part files"
 expect 2 "--shard and --merge" -- "$OBSCURA" bake-dynamic "$FIX" --shard 0/2 --merge "$T/dpart1.0.bin" -o "$T/x.json"
 said "not both"
 check "no part left behind by the refused runs" "[ ! -e $T/x.bin ] && [ ! -e $T/x.json ]"
+
+echo "-- gbuffer --dynamic: a dynamic object in the baked level"
+expect 0 "bake the fixture's vertices" -- "$OBSCURA" bake "$FIX" -o "$T/a.glb" --rays 16 -q
+# a cube of 3 m inside region 0 of the model (the aalborg cut's first box)
+at=$(python3 -c "
+import json; r=json.load(open('$T/t1.json'))['regions'][0]
+print(','.join(repr(r['min'][a] + (r['max'][a] - r['min'][a]) * f) for a, f in zip(range(3), (0.5, 0.35, 0.5))))")
+python3 tests/e2e/lib/glb_dynamic.py "$T/a.glb" "$T/dyn.glb" "$T/dcam.json" dyn_cube "$at" 3
+python3 tests/e2e/lib/glb_dynamic.py "$T/a.glb" "$T/dynx.glb" "$T/dcam.json" crate "$at" 3 extras
+expect 0 "gbuffer of the level alone" -- "$OBSCURA" gbuffer "$T/a.glb" --camera "$T/dcam.json" -o "$T/g0.exr" -q
+expect 0 "gbuffer with the cube, --dynamic-nodes 'dyn_*'" -- "$OBSCURA" gbuffer "$T/dyn.glb" \
+    --camera "$T/dcam.json" -o "$T/g1.exr" --dynamic "$T/t1.json" --dynamic-nodes 'dyn_*'
+said "pixels of dynamic objects valued from the region model"
+expect 0 "the cube's pixels = the model at their P and N (quadratic), the rest unchanged" -- \
+    python3 tests/e2e/lib/dyn_gbuffer_check.py "$T/g0.exr" "$T/g1.exr" "$T/t1.json" quadratic
+sed 's/^/       /' "$T/out"
+expect 1 "... which the linear SH does not give" -- \
+    python3 tests/e2e/lib/dyn_gbuffer_check.py "$T/g0.exr" "$T/g1.exr" "$T/t1.json" linear
+expect 0 "--dynamic-sh linear" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/g1l.exr" --dynamic "$T/t1.json" --dynamic-nodes 'dyn_*' --dynamic-sh linear -q
+expect 0 "--dynamic-sh linear: the model's linear SH" -- \
+    python3 tests/e2e/lib/dyn_gbuffer_check.py "$T/g0.exr" "$T/g1l.exr" "$T/t1.json" linear
+expect 0 "marked by its extras (\"obscura_dynamic\": true)" -- "$OBSCURA" gbuffer "$T/dynx.glb" \
+    --camera "$T/dcam.json" -o "$T/gx.exr" --dynamic "$T/t1.json" -q
+expect 0 "... the same check" -- \
+    python3 tests/e2e/lib/dyn_gbuffer_check.py "$T/g0.exr" "$T/gx.exr" "$T/t1.json" quadratic
+expect 3 "the cube unmarked" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" -o "$T/x.exr" \
+    --dynamic "$T/t1.json" -q
+said "node 'dyn_cube') primitive 0 has no _AO attribute and is not marked dynamic"
+expect 3 "--dynamic on a level without dynamic objects" -- "$OBSCURA" gbuffer "$T/a.glb" \
+    --camera "$T/dcam.json" -o "$T/x.exr" --dynamic "$T/t1.json" -q
+said "no node is marked dynamic"
+expect 3 "a pattern matching no node" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic "$T/t1.json" --dynamic-nodes 'car*' -q
+said "no node's name matches 'car\*'"
+expect 3 "a missing model" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" -o "$T/x.exr" \
+    --dynamic "$T/none.json" --dynamic-nodes 'dyn_*' -q
+said "none.json"
+expect 0 "a model of another level" -- "$OBSCURA" bake-dynamic "$T/box.obj" -o "$T/boxm.json" --rays 16 --max-regions 2 -q
+expect 3 "... refused" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" -o "$T/x.exr" \
+    --dynamic "$T/boxm.json" --dynamic-nodes 'dyn_*' -q
+said "baked from another level (4 triangles"
+static_node=$(python3 -c "
+import json,struct; d=open('$T/a.glb','rb').read(); j=json.loads(d[20:20+struct.unpack_from('<I',d,12)[0]])
+print(next(n['name'] for n in j['nodes'] if 'mesh' in n))")
+expect 3 "a static node marked dynamic" -- "$OBSCURA" gbuffer "$T/dynx.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic "$T/t1.json" --dynamic-nodes "$static_node" -q
+said "the scene's static nodes have"
+python3 -c "
+import json; d=json.load(open('$T/t1.json')); d.pop('level'); json.dump(d, open('$T/nolevel.json', 'w'))"
+expect 0 "a model without its level: a warning" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/gn.exr" --dynamic "$T/nolevel.json" --dynamic-nodes 'dyn_*' -q
+said "records no level"
+check "... and the same channels" "python3 tests/e2e/lib/dyn_gbuffer_check.py $T/g0.exr $T/gn.exr $T/t1.json quadratic >/dev/null"
+expect 3 "a damaged model" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" -o "$T/x.exr" \
+    --dynamic "$T/one.json" --dynamic-nodes 'dyn_*' -q
+said "not an obscura-dynamic-ao model"
+expect 2 "--dynamic-nodes without --dynamic" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic-nodes 'dyn_*'
+said "needs --dynamic MODEL.json"
+expect 2 "--dynamic with --deep" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic "$T/t1.json" --deep
+expect 2 "--dynamic-sh cubic" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic "$T/t1.json" --dynamic-sh cubic
+check "no G-buffer written by the refused runs" "[ ! -e $T/x.exr ]"
 
 expect 0 "beta 0" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/b0.json" $FAST --beta 0 --report "$T/b0r.json"
 check "beta 0: the jumps stay as fitted" \
