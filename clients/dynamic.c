@@ -302,8 +302,10 @@ int cli_dynamic(int argc, char **argv)
     obs_dyn_regions rg = {0};
     obs_status s;
     if (regions) {
-        if ((s = obs_dyn_regions_read(regions, &rg, err)) != OBS_OK)
+        if ((s = obs_dyn_regions_read(regions, &rg, err)) != OBS_OK) {
+            free(parts);
             return cli_input_fail(s, regions, err);
+        }
         desc.regions = &rg;
     }
     double t0 = cli_now_s();
