@@ -54,11 +54,7 @@ static obs_status adopt(obs_dyn_params *p, const obs__dyn_part *parts, size_t n,
     const obs__dyn_part *a = &parts[0];
     for (size_t i = 1; i < n; i++) {
         const obs__dyn_part *b = &parts[i];
-#define SAME(name, field)                                                       \
-        if (memcmp(&a->field, &b->field, sizeof a->field) != 0)                 \
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced with different " \
-                             #name " (%g and %g): they are not parts of one bake", a->path,      \
-                             b->path, (double)a->field, (double)b->field);
+#define SAME(name, field) OBS__PART_SAME(a, b, name, field)
         PART_PARAMS(SAME)
 #undef SAME
         if (a->points != b->points || a->total != b->total)
@@ -67,20 +63,7 @@ static obs_status adopt(obs_dyn_params *p, const obs__dyn_part *parts, size_t n,
                              "of one bake", a->path, b->path, (unsigned long long)a->total,
                              (unsigned long long)b->total);
     }
-#define TAKE(name, field)                                                       \
-    {                                                                           \
-        int row = row_of(#name);                                                \
-        if (row >= 0 && (p->set >> row & 1)) {                                  \
-            if (p->name != a->field)                                            \
-                return obs__fail(err, OBS_INVALID_ARGUMENT, "the parts were traced with " #name \
-                                 " %g; this merge asks for %g (leave it out to take the parts')", \
-                                 (double)a->field, (double)p->name);            \
-        } else {                                                                \
-            p->name = a->field;                                                 \
-            if (row >= 0)                                                       \
-                p->set |= (uint64_t)1 << row;                                   \
-        }                                                                       \
-    }
+#define TAKE(name, field) OBS__PART_TAKE(p, a, row_of(#name), name, field)
     PART_PARAMS(TAKE)
 #undef TAKE
     return OBS_OK;

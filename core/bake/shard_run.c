@@ -52,28 +52,11 @@ static obs_status adopt(obs_bake_params *p, const obs__bake_part *parts, size_t 
     const obs__bake_part *a = &parts[0];
     for (size_t i = 1; i < n; i++) {
         const obs__bake_part *b = &parts[i];
-#define SAME(name, field, type)                                                 \
-        if (memcmp(&a->field, &b->field, sizeof a->field) != 0)                 \
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced with different " \
-                             #name " (%g and %g): they are not parts of one bake", a->path,      \
-                             b->path, (double)a->field, (double)b->field);
+#define SAME(name, field, type) OBS__PART_SAME(a, b, name, field)
         TRACE_PARAMS(SAME)
 #undef SAME
     }
-#define TAKE(name, field, type)                                                 \
-    {                                                                           \
-        int row = row_of(#name);                                                \
-        if (row >= 0 && (p->set >> row & 1)) {                                  \
-            if (p->name != a->field)                                            \
-                return obs__fail(err, OBS_INVALID_ARGUMENT, "the parts were traced with " #name \
-                                 " %g; this merge asks for %g (leave it out to take the parts')", \
-                                 (double)a->field, (double)p->name);            \
-        } else {                                                                \
-            p->name = a->field;                                                 \
-            if (row >= 0)                                                       \
-                p->set |= (uint64_t)1 << row;                                   \
-        }                                                                       \
-    }
+#define TAKE(name, field, type) OBS__PART_TAKE(p, a, row_of(#name), name, field)
     TRACE_PARAMS(TAKE)
 #undef TAKE
     return OBS_OK;

@@ -172,18 +172,6 @@ static void expect_refused(const obs_bake_scene *sc, const char *const *paths, s
     assert_int_equal(r.model.region_count, 0);
 }
 
-static void copy_cut(const char *from, const char *to, long keep, long flip)
-{
-    FILE *f = fopen(from, "rb"), *g = fopen(to, "wb");
-    assert_non_null(f);
-    assert_non_null(g);
-    int ch;
-    for (long k = 0; (ch = fgetc(f)) != EOF && (keep < 0 || k < keep); k++)
-        fputc(k == flip ? ch ^ 0x40 : ch, g);
-    fclose(f);
-    fclose(g);
-}
-
 static void test_bad_parts(void **state)
 {
     (void)state;
@@ -205,8 +193,8 @@ static void test_bad_parts(void **state)
     path_of(p[9], sizeof p[9], "none", 0);
     path_of(p[10], sizeof p[10], "r", 1);
     path_of(p[11], sizeof p[11], "static", 0);
-    copy_cut(p[1], p[7], 1000, -1);
-    copy_cut(p[1], p[8], -1, 700);
+    bt_copy_cut(p[1], p[7], 1000, -1);
+    bt_copy_cut(p[1], p[8], -1, 700);
     const char *ok[] = {p[0], p[1], p[2]};
     obs_dyn_result r;
     char err[OBS_ERR_LEN];
