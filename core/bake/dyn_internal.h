@@ -146,6 +146,8 @@ typedef struct obs__dyn_shard {
     const char *path;
     const obs__dyn_part *parts;
     int stop;
+    void (*progress)(void *user, size_t done, size_t total); /* the shard's trace */
+    void *progress_user;
 } obs__dyn_shard;
 
 /* dynamic.c: obs_dyn_bake's steps with the hook (sh NULL: obs_dyn_bake). */

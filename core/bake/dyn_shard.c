@@ -148,7 +148,8 @@ static obs_status trace_shard(obs__dyn_shard *sh, const obs__bake_world *w,
         h.prep_seconds += st->seconds[k];
     double t = now();
     pt->rays = 0;
-    obs__dyn_points_trace(bvh, p, pt, (size_t)h.first, (size_t)(h.first + h.n), NULL, NULL);
+    obs__dyn_points_trace(bvh, p, pt, (size_t)h.first, (size_t)(h.first + h.n), sh->progress,
+                          sh->progress_user);
     h.trace_seconds = now() - t;
     size_t n = (size_t)h.n, first = (size_t)h.first, dropped = 0;
     unsigned char *payload = malloc(n * (POINT_BYTES + 1) + 1);

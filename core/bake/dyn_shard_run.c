@@ -20,7 +20,9 @@ obs_status obs_dyn_bake_shard(const obs_bake_scene *scene, const obs_dyn_desc *d
     if (!path || !*path)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %d/%d: no part file to write", index,
                          count);
-    obs__dyn_shard sh = {.index = index, .count = count, .path = path};
+    obs__dyn_shard sh = {.index = index, .count = count, .path = path,
+                         .progress = desc ? desc->progress : NULL,
+                         .progress_user = desc ? desc->progress_user : NULL};
     obs_dyn_result r;
     obs_status rc = obs__dyn_bake_run(scene, desc, &sh, &r, err);
     if (st)
