@@ -248,15 +248,7 @@ int cli_bake(int argc, char **argv)
         } else if (!strcmp(key, "o") || !strcmp(key, "output")) {
             out = val;
         } else if (!strcmp(key, "shard")) {
-            char *end, *end2;
-            long si = strtol(val, &end, 10), n = 0;
-            end2 = end;
-            if (*end == '/')
-                n = strtol(end + 1, &end2, 10);
-            if (*end != '/' || end == val || *end2 || end2 == end + 1 || n < 1 || n > 1000000 ||
-                si < 0 || si >= n)
-                cli_die_usage("bake", "--shard '%s': expected I/N with 0 <= I < N (e.g. 0/4)", val);
-            shard = (int)si, shards = (int)n;
+            cli_parse_shard("bake", val, &shard, &shards);
         } else if (!strcmp(key, "report")) {
             report = val;
         } else if (!strcmp(key, "ply")) {

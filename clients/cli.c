@@ -47,6 +47,20 @@ void cli_die_usage(const char *cmd, const char *fmt, ...)
     exit(EXIT_USAGE);
 }
 
+void cli_parse_shard(const char *cmd, const char *val, int *index, int *count)
+{
+    char *end, *end2;
+    long si = strtol(val, &end, 10), n = 0;
+    end2 = end;
+    if (*end == '/')
+        n = strtol(end + 1, &end2, 10);
+    if (*end != '/' || end == val || *end2 || end2 == end + 1 || n < 1 || n > 1000000 || si < 0 ||
+        si >= n)
+        cli_die_usage(cmd, "--shard '%s': expected I/N with 0 <= I < N (e.g. 0/4)", val);
+    *index = (int)si;
+    *count = (int)n;
+}
+
 double cli_now_s(void)
 {
     struct timespec ts;

@@ -26,5 +26,8 @@ void cli_die_usage(const char *cmd, const char *fmt, ...) __attribute__((format(
 
 /* Seconds of CLOCK_MONOTONIC (progress, stage times). */
 double cli_now_s(void);
+/* --shard I/N of obscura bake and bake-dynamic: 0 <= I < N <= 10^6, else
+ * a usage error of cmd. */
+void cli_parse_shard(const char *cmd, const char *val, int *index, int *count);
 
 #endif

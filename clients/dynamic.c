@@ -21,6 +21,10 @@ void cli_dynamic_usage(FILE *f)
             "                  [--paths N] [--PARAM VALUE]...  obscurance for dynamic objects:\n"
             "                  regions, valid points, SH at two distances, eq 4 per region,\n"
             "                  regularised (section 2.3); 'obscura bake-dynamic --params'\n"
+            "  obscura bake-dynamic LEVEL --shard I/N -o PART [--regions R.json] [--PARAM VALUE]...\n"
+            "                  trace shard I (0 .. N-1) of the valid points into a part file\n"
+            "  obscura bake-dynamic LEVEL --merge PART... -o MODEL.json [...]\n"
+            "                  every shard's part read back and fitted: the unsharded model\n"
             "  obscura bake-dynamic --eval MODEL.json --at X,Y,Z --normal X,Y,Z\n"
             "                  [--sh linear|quadratic]  prints short, long and blended AO\n");
 }
@@ -195,12 +199,22 @@ int cli_dynamic(int argc, char **argv)
     const char *in = NULL, *out = NULL, *regions = NULL, *report = NULL, *eval = NULL,
                *at = NULL, *normal = NULL, *sh = NULL;
     int quiet = 0, paths = 0, path_steps = 64, path_rays = 256;
+    int shard = -1, shards = 0, merging = 0, merge = 0;
     float tau = 4.0f;
     obs_dyn_desc desc = {0};
     char err[OBS_ERR_LEN] = "";
+    const char **parts = calloc((size_t)argc + 1, sizeof *parts);
+    size_t nparts = 0;
+    if (!parts)
+        cli_die_usage("bake-dynamic", "out of memory");
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if ((a[0] != '-' || !a[1]) && merging) {
+            parts[nparts++] = a; /* --merge PART...: up to the next option */
+            continue;
+        }
+        merging = 0;
         if (a[0] != '-' || !a[1]) {
             if (in)
                 cli_die_usage("bake-dynamic", "more than one level ('%s' and '%s')", in, a);
@@ -217,15 +231,22 @@ int cli_dynamic(int argc, char **argv)
         char *end;
         if (!strcmp(key, "params") || !strcmp(key, "params-markdown")) {
             list_params(key[6] != '\0');
+            free(parts);
             return EXIT_OK;
         } else if (!strcmp(key, "quiet") || !strcmp(key, "q")) {
             quiet = 1, takes = 0;
+        } else if (!strcmp(key, "merge")) {
+            merging = merge = 1, takes = 0;
+            if (eq && *val)
+                parts[nparts++] = val;
         } else if (!val) {
             cli_die_usage("bake-dynamic", "option --%s needs a value", key);
         } else if (!strcmp(key, "o") || !strcmp(key, "output")) {
             out = val;
         } else if (!strcmp(key, "regions")) {
             regions = val;
+        } else if (!strcmp(key, "shard")) {
+            cli_parse_shard("bake-dynamic", val, &shard, &shards);
         } else if (!strcmp(key, "report")) {
             report = val;
         } else if (!strcmp(key, "eval")) {
@@ -262,19 +283,29 @@ int cli_dynamic(int argc, char **argv)
         if (takes && !eq)
             i++;
     }
-    if (eval)
+    if (eval) {
+        free(parts);
         return eval_cmd(eval, at, normal, sh);
+    }
     if (!in)
         cli_die_usage("bake-dynamic", "no level file");
     if (!out)
-        cli_die_usage("bake-dynamic", "no output file (-o MODEL.json)");
+        cli_die_usage("bake-dynamic", shards ? "no part file (-o PART)" : "no output file (-o MODEL.json)");
+    if (merge && !nparts)
+        cli_die_usage("bake-dynamic", "--merge needs the part files (--merge PART...)");
+    if (shards && nparts)
+        cli_die_usage("bake-dynamic", "--shard traces a part, --merge reads them: not both");
+    if (shards && paths)
+        cli_die_usage("bake-dynamic", "--shard writes a part, not a model: --paths goes with --merge");
     obs_dyn_params p;
     obs_dyn_params_resolve(&desc.params, &p);
     obs_dyn_regions rg = {0};
     obs_status s;
     if (regions) {
-        if ((s = obs_dyn_regions_read(regions, &rg, err)) != OBS_OK)
+        if ((s = obs_dyn_regions_read(regions, &rg, err)) != OBS_OK) {
+            free(parts);
             return cli_input_fail(s, regions, err);
+        }
         desc.regions = &rg;
     }
     double t0 = cli_now_s();
@@ -282,6 +313,7 @@ int cli_dynamic(int argc, char **argv)
     s = obs_bake_load(in, (size_t)p.max_triangles, &sc, err);
     if (s != OBS_OK) {
         obs_dyn_regions_free(&rg);
+        free(parts);
         return cli_input_fail(s, in, err);
     }
     double load_s = cli_now_s() - t0;
@@ -290,13 +322,33 @@ int cli_dynamic(int argc, char **argv)
         desc.progress = on_progress;
         desc.progress_user = &pr;
     }
+    if (shards) {
+        obs_dyn_stats st;
+        s = obs_dyn_bake_shard(&sc, &desc, shard, shards, out, &st, err);
+        int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, in, err);
+        if (rc == EXIT_OK && report && !write_report(report, in, &p, &st, NULL, load_s))
+            rc = EXIT_FAIL;
+        if (rc == EXIT_OK && !quiet)
+            fprintf(stderr, "obscura: bake-dynamic: shard %d/%d: %zu points (%zu dropped by the "
+                    "back-face rule), %llu rays in %.1f s; wrote %s\n", shard, shards,
+                    st.points_valid + st.points_backface, st.points_backface,
+                    (unsigned long long)st.rays, st.seconds[OBS_DYN_STAGE_trace], out);
+        obs_dyn_regions_free(&rg);
+        obs_bake_scene_free(&sc);
+        free(parts);
+        return rc;
+    }
     obs_dyn_result r;
-    s = obs_dyn_bake(&sc, &desc, &r, err);
+    s = nparts ? obs_dyn_bake_merge(&sc, &desc, parts, nparts, &r, err)
+               : obs_dyn_bake(&sc, &desc, &r, err);
     obs_dyn_regions_free(&rg);
+    free(parts);
     if (s != OBS_OK) {
         obs_bake_scene_free(&sc);
-        return cli_fail(s, in, err);
+        return nparts ? cli_input_fail(s, in, err) : cli_fail(s, in, err);
     }
+    if (nparts) /* the parts' parameters, for the paths and the report */
+        obs_dyn_params_resolve(&desc.params, &p);
     int rc = EXIT_OK;
     obs_dyn_path_stats ps;
     if (paths > 0 &&

@@ -30,6 +30,12 @@ void cli_ground_usage(FILE *f)
             "                  [--baked]        a level baked by obscura bake (.glb, found by\n"
             "                  its attributes; --baked: required) adds _AO, _AO_SHORT, _AO_LONG,\n"
             "                  the vertex values interpolated\n"
+            "                  [--dynamic MODEL.json [--dynamic-nodes PATTERN] [--dynamic-sh S]]\n"
+            "                  dynamic objects in the baked level (nodes whose name matches the\n"
+            "                  pattern, or with glTF extras \"obscura_dynamic\": true, and their\n"
+            "                  children) take the baked channels from obscura bake-dynamic's\n"
+            "                  region model at each pixel's position and normal (S: quadratic\n"
+            "                  or linear SH)\n"
             "                  [--deep] [--alpha [NAME=]A]...   every fragment into a deep\n"
             "                  EXR (A-buffer): Z, A, R,G,B, N (world); opacity from the\n"
             "                  materials or --alpha (all meshes, or those matching NAME)\n"
@@ -48,6 +54,8 @@ void cli_ground_usage(FILE *f)
 /* The options both commands share. */
 typedef struct ground_args {
     const char *cmd, *scene, *out, *camera, *backend, *gbuffer;
+    const char *dynamic, *dynamic_nodes; /* gbuffer --dynamic MODEL, --dynamic-nodes */
+    int dynamic_linear;
     long width, height, spp, threads;
     unsigned long long seed;
     double distance;
@@ -107,6 +115,15 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
             a->deep = 1;
         else if (!reference && !strcmp(argv[i], "--baked"))
             a->baked = 1;
+        else if (!reference && (v = opt_value(a, argc, argv, &i, "dynamic")))
+            a->dynamic = v;
+        else if (!reference && (v = opt_value(a, argc, argv, &i, "dynamic-nodes")))
+            a->dynamic_nodes = v;
+        else if (!reference && (v = opt_value(a, argc, argv, &i, "dynamic-sh"))) {
+            if (strcmp(v, "linear") && strcmp(v, "quadratic"))
+                cli_die_usage(a->cmd, "--dynamic-sh '%s': linear or quadratic", v);
+            a->dynamic_linear = !strcmp(v, "linear");
+        }
         else if ((v = opt_value(a, argc, argv, &i, "alpha"))) {
             /* A or NAME=A, A in [0, 1]; the name is matched on loading. */
             const char *eq = strrchr(v, '='), *num = eq ? eq + 1 : v;
@@ -177,6 +194,12 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
     if (a->baked && a->deep)
         cli_die_usage(a->cmd, "--baked and --deep: the deep G-buffer does not carry the baked "
                               "channels");
+    if (a->dynamic_nodes && !a->dynamic)
+        cli_die_usage(a->cmd, "--dynamic-nodes needs --dynamic MODEL.json (the region model of "
+                              "obscura bake-dynamic)");
+    if (a->dynamic && (a->deep || a->nalpha))
+        cli_die_usage(a->cmd, "--dynamic and --%s: the deep G-buffer does not carry the baked "
+                              "channels", a->deep ? "deep" : "alpha");
     if (!reference && a->nalpha && !a->deep)
         cli_die_usage(a->cmd, "--alpha needs --deep (the flat G-buffer is the front surface only)");
 }
@@ -230,11 +253,20 @@ static int load_scene(const ground_args *a, obs_scene *scene)
     char err[OBS_ERR_LEN] = "";
     double t0 = cli_now_s();
     /* A baked level is read for its _AO attributes, which assimp drops. */
-    obs_status s = a->baked || (!a->deep && !a->nalpha && obs_scene_file_is_baked(a->scene))
+    size_t marked = 0;
+    obs_status s = a->dynamic
+                       ? obs_scene_load_baked_dynamic(a->scene, a->dynamic_nodes, scene, &marked, err)
+                   : a->baked || (!a->deep && !a->nalpha && obs_scene_file_is_baked(a->scene))
                        ? obs_scene_load_baked(a->scene, scene, err)
                        : obs_scene_load(a->scene, scene, err);
     if (s != OBS_OK)
         return cli_input_fail(s, a->scene, err);
+    if (a->dynamic && !marked) {
+        obs_scene_free(scene);
+        return cli_input_fail(OBS_INVALID_ARGUMENT, a->scene,
+                              "--dynamic: no node is marked dynamic (--dynamic-nodes PATTERN on "
+                              "the nodes' names, or glTF node extras \"obscura_dynamic\": true)");
+    }
     for (int k = 0; k < a->nalpha; k++)
         if ((s = obs_scene_set_opacity(scene, a->alpha[k], err)) != OBS_OK) {
             obs_scene_free(scene);
@@ -297,13 +329,26 @@ int cli_gbuffer(int argc, char **argv)
     obs_raster r = {0};
     obs_ctx *ctx = NULL;
     obs_image baked = {0};
+    obs_dyn_model model = {0};
     char err[OBS_ERR_LEN] = "";
     int w, h, rc;
+    size_t dyn_pixels = 0;
     obs_status s;
     if ((rc = load_camera(&a, &cam, &w, &h)) != EXIT_OK)
         return rc;
-    if ((rc = load_scene(&a, &scene)) != EXIT_OK)
+    if (a.dynamic && (s = obs_dyn_model_read(a.dynamic, &model, err)) != OBS_OK)
+        return cli_input_fail(s, a.dynamic, err);
+    if ((rc = load_scene(&a, &scene)) != EXIT_OK) {
+        obs_dyn_model_free(&model);
         return rc;
+    }
+    if (a.dynamic && !model.level.triangles)
+        fprintf(stderr, "obscura: warning: %s records no level: cannot check that it was baked "
+                        "from %s\n", a.dynamic, a.scene);
+    else if (a.dynamic && (s = obs_scene_check_dynamic_level(&scene, &model, err)) != OBS_OK) {
+        rc = cli_input_fail(s, a.dynamic, err);
+        goto done;
+    }
 
     obs_ctx_desc desc = {.log = log_cb, .log_user = &a};
     const char *bname = a.backend ? a.backend : getenv("OBSCURA_BACKEND");
@@ -322,7 +367,14 @@ int cli_gbuffer(int argc, char **argv)
         rc = cli_input_fail(s, a.scene, err);
         goto done;
     }
-    if (scene.baked && (s = obs_raster_baked(ctx, &scene, &cam, w, h, &baked, err)) != OBS_OK) {
+    if (scene.baked && !a.dynamic &&
+        (s = obs_raster_baked(ctx, &scene, &cam, w, h, &baked, err)) != OBS_OK) {
+        rc = cli_input_fail(s, a.scene, err);
+        goto done;
+    }
+    if (a.dynamic && (s = obs_raster_baked_dynamic(ctx, &scene, &cam, w, h, &r, &model,
+                                                   !a.dynamic_linear, &baked, &dyn_pixels,
+                                                   err)) != OBS_OK) {
         rc = cli_input_fail(s, a.scene, err);
         goto done;
     }
@@ -370,6 +422,9 @@ int cli_gbuffer(int argc, char **argv)
         obs_ctx_get_info(ctx, &ci);
         fprintf(stderr, "obscura: info: wrote %s: %dx%d, %s, rasterised in %.2f s\n", a.out, w, h,
                 obs_backend_name(ci.backend), t_raster);
+        if (a.dynamic)
+            fprintf(stderr, "obscura: info: %zu pixels of dynamic objects valued from the region "
+                            "model %s\n", dyn_pixels, a.dynamic);
     }
 
 done:
@@ -377,6 +432,7 @@ done:
     obs_raster_free(&r);
     obs_ctx_destroy(ctx);
     obs_scene_free(&scene);
+    obs_dyn_model_free(&model);
     return rc;
 }
 

@@ -50,16 +50,32 @@ int obs__dyn_inside(const obs__bake_bvh *bvh, const float p[3], int rays, float 
 
 /* The valid points of every region and their spherical obscurance.
  * Point k of region r: pos[3 k], sh[OBS_DYN_CHANNELS k] (convolved),
- * region[k]; held[k] 1 when held back from the fit. */
+ * region[k]; held[k] 1 when held back from the fit; id[k] its index
+ * over the level's grid points (its rays' stream); dropped[k] 1 when its
+ * rays met back faces more often than the limit (2: no memory). */
 typedef struct obs__dyn_points {
     size_t count;
     float *pos;
     double *sh;
     uint32_t *region;
     uint8_t *held;
+    uint64_t *id;
+    uint8_t *dropped;
     size_t grid, inside, hidden, backface;
     uint64_t rays;
 } obs__dyn_points;
+
+/* The three steps of obs__dyn_points_make, apart for the shards
+ * (dyn_shard.c): the grid points flagged, the valid ones listed (count,
+ * pos, region, held, id; sh 0); points [first, end) traced (sh, dropped,
+ * rays); the dropped ones removed, the order kept. */
+obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions *rg,
+                                const obs_dyn_params *p, obs__dyn_points *out,
+                                char err[OBS_ERR_LEN]);
+void obs__dyn_points_trace(const obs__bake_bvh *bvh, const obs_dyn_params *p,
+                           obs__dyn_points *pt, size_t first, size_t end,
+                           void (*progress)(void *, size_t, size_t), void *user);
+obs_status obs__dyn_points_compact(obs__dyn_points *pt, char err[OBS_ERR_LEN]);
 
 obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *bvh,
                                 const obs_dyn_regions *rg, const obs_dyn_params *p,
@@ -105,5 +121,52 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
 /* The blended AO of one model for a point's SH at one normal (the
  * stats' measure). */
 double obs__dyn_blend_ao(const double *sh, const float n[3], float blend, int order);
+
+/* ---- dyn_shard.c: bake-dynamic over many machines ----------------------- */
+
+/* A part's header as read (dyn_shard.c documents the layout). */
+typedef struct obs__dyn_part {
+    const char *path;
+    uint32_t version, index, count, regions;
+    uint64_t level;           /* fingerprint of the flattened level */
+    uint64_t total, first, n; /* the valid points; this part's range */
+    uint64_t points;          /* fingerprint of the regions and their valid points */
+    int32_t rays, seed, grid, max_regions;
+    float distance_short, distance_long, backface_limit, min_region_size;
+    double prep_seconds, trace_seconds;
+    uint64_t checksum; /* FNV-1a 64 of the payload */
+} obs__dyn_part;
+
+/* What the bake does in place of its trace: with path, trace shard
+ * index/count of the valid points and write it there (stop is set: the
+ * bake ends after the step); with parts (count of them, in shard
+ * order), read every shard's points back and go on to the fit. */
+typedef struct obs__dyn_shard {
+    int index, count;
+    const char *path;
+    const obs__dyn_part *parts;
+    int stop;
+    void (*progress)(void *user, size_t done, size_t total); /* the shard's trace */
+    void *progress_user;
+} obs__dyn_shard;
+
+/* dynamic.c: obs_dyn_bake's steps with the hook (sh NULL: obs_dyn_bake). */
+obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *desc,
+                             obs__dyn_shard *sh, obs_dyn_result *out, char err[OBS_ERR_LEN]);
+/* dyn_shard.c: the step, after the points are flagged (pt->count listed,
+ * not traced) and before the dropped ones are removed; fills st's trace
+ * row. */
+obs_status obs__dyn_shard_step(obs__dyn_shard *sh, const obs__bake_world *w,
+                               const obs_dyn_regions *rg, const obs_dyn_params *p,
+                               const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
+                               char err[OBS_ERR_LEN]);
+/* Reads and checks a part's header (magic, version, sizes, the file's
+ * length against its count). */
+obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char err[OBS_ERR_LEN]);
+/* FNV-1a 64 of the regions' boxes and the valid points' grid indices,
+ * independent of the host's byte order. */
+uint64_t obs__dyn_points_fingerprint(const obs_dyn_regions *rg, const obs__dyn_points *pt);
+/* The level's triangles, box and fingerprint, for the model file. */
+obs_dyn_level obs__dyn_level_of(const obs__bake_world *w);
 
 #endif

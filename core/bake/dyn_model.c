@@ -130,6 +130,15 @@ obs_status obs_dyn_model_write(const char *path, const obs_dyn_model *m, char er
     cJSON *d = cJSON_CreateObject();
     cJSON_AddStringToObject(d, "format", FORMAT_NAME);
     cJSON_AddNumberToObject(d, "version", FORMAT_VERSION);
+    if (m->level.triangles) {
+        cJSON *lv = cJSON_AddObjectToObject(d, "level");
+        char fp[32];
+        snprintf(fp, sizeof fp, "%016llx", (unsigned long long)m->level.fingerprint);
+        cJSON_AddStringToObject(lv, "fingerprint", fp);
+        cJSON_AddNumberToObject(lv, "triangles", (double)m->level.triangles);
+        cJSON_AddItemToObject(lv, "min", vec(m->level.lo, 3));
+        cJSON_AddItemToObject(lv, "max", vec(m->level.hi, 3));
+    }
     cJSON_AddItemToObject(d, "distances", vec(m->distance, 2));
     cJSON_AddNumberToObject(d, "blend", m->blend);
     cJSON_AddStringToObject(d, "sh", "real SH bands 0-2, index l(l+1)+m, convolved with the "
@@ -219,6 +228,23 @@ obs_status obs_dyn_model_read(const char *path, obs_dyn_model *out, char err[OBS
         goto done;
     }
     out->blend = (float)bl->valuedouble;
+    const cJSON *lv = cJSON_GetObjectItemCaseSensitive(d, "level");
+    if (lv) {
+        const cJSON *fp = cJSON_GetObjectItemCaseSensitive(lv, "fingerprint");
+        const cJSON *nt = cJSON_GetObjectItemCaseSensitive(lv, "triangles");
+        char *end = NULL;
+        unsigned long long v = cJSON_IsString(fp) ? strtoull(fp->valuestring, &end, 16) : 0;
+        if (!cJSON_IsString(fp) || strlen(fp->valuestring) != 16 || *end || !cJSON_IsNumber(nt) ||
+            !(nt->valuedouble >= 1.0) || nt->valuedouble > 9e15 ||
+            !get_vec(cJSON_GetObjectItemCaseSensitive(lv, "min"), out->level.lo, 3) ||
+            !get_vec(cJSON_GetObjectItemCaseSensitive(lv, "max"), out->level.hi, 3)) {
+            st = obs__fail(err, OBS_BAD_FILE, "%s: level: a fingerprint (16 hex digits), "
+                                              "triangles, min and max", path);
+            goto done;
+        }
+        out->level.fingerprint = v;
+        out->level.triangles = (uint64_t)nt->valuedouble;
+    }
     out->region_count = (size_t)cJSON_GetArraySize(regs);
     out->model_count = (size_t)cJSON_GetArraySize(mods);
     out->edge_count = cJSON_IsArray(adj) ? (size_t)cJSON_GetArraySize(adj) : 0;

@@ -32,6 +32,15 @@ void obs_dyn_result_free(obs_dyn_result *r)
 obs_status obs_dyn_bake(const obs_bake_scene *scene, const obs_dyn_desc *desc,
                         obs_dyn_result *out, char err[OBS_ERR_LEN])
 {
+    return obs__dyn_bake_run(scene, desc, NULL, out, err);
+}
+
+/* The steps; with a shard (dyn_shard.c) its step takes the trace's
+ * place: one shard's points traced and written (the bake stops there),
+ * or every shard's read back. */
+obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *desc,
+                             obs__dyn_shard *sh, obs_dyn_result *out, char err[OBS_ERR_LEN])
+{
     memset(out, 0, sizeof *out);
     obs_dyn_params p;
     obs_dyn_params_resolve(desc ? &desc->params : NULL, &p);
@@ -65,12 +74,20 @@ obs_status obs_dyn_bake(const obs_bake_scene *scene, const obs_dyn_desc *desc,
     st->edges = rg->edge_count;
     st->seconds[OBS_DYN_STAGE_regions] = now() - t;
     t = now();
-    double valid_s = 0.0;
-    if ((rc = obs__dyn_points_make(&w, bvh, rg, &p, &pt, &valid_s, desc ? desc->progress : NULL,
-                                   desc ? desc->progress_user : NULL, err)) != OBS_OK)
+    if ((rc = obs__dyn_points_flag(bvh, rg, &p, &pt, err)) != OBS_OK)
         goto done;
-    st->seconds[OBS_DYN_STAGE_valid] = valid_s;
-    st->seconds[OBS_DYN_STAGE_trace] = now() - t - valid_s;
+    st->seconds[OBS_DYN_STAGE_valid] = now() - t;
+    t = now();
+    if (sh) {
+        if ((rc = obs__dyn_shard_step(sh, &w, rg, &p, bvh, &pt, st, err)) != OBS_OK || sh->stop)
+            goto done;
+    } else {
+        obs__dyn_points_trace(bvh, &p, &pt, 0, pt.count, desc ? desc->progress : NULL,
+                              desc ? desc->progress_user : NULL);
+        st->seconds[OBS_DYN_STAGE_trace] = now() - t;
+    }
+    if ((rc = obs__dyn_points_compact(&pt, err)) != OBS_OK)
+        goto done;
     st->grid_points = pt.grid;
     st->points_inside = pt.inside;
     st->points_hidden = pt.hidden;
@@ -81,6 +98,7 @@ obs_status obs_dyn_bake(const obs_bake_scene *scene, const obs_dyn_desc *desc,
     if ((rc = obs__dyn_fit_all(&pt, rg, &p, out, err)) != OBS_OK)
         goto done;
     st->seconds[OBS_DYN_STAGE_fit] = now() - t;
+    out->model.level = out->original.level = obs__dyn_level_of(&w);
 done:
     obs__dyn_points_free(&pt);
     obs_dyn_regions_free(&own);

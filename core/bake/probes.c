@@ -59,6 +59,8 @@ void obs__dyn_points_free(obs__dyn_points *pt)
     free(pt->sh);
     free(pt->region);
     free(pt->held);
+    free(pt->id);
+    free(pt->dropped);
     memset(pt, 0, sizeof *pt);
 }
 
@@ -160,8 +162,7 @@ typedef struct sph_job {
     const obs__bake_bvh *bvh;
     const obs_dyn_params *p;
     obs__dyn_points *pt;
-    const uint64_t *id; /* each point's grid index over the level */
-    uint8_t *dropped;
+    size_t first;
 } sph_job;
 
 int obs__dyn_point_sh(const obs__bake_bvh *bvh, const float o[3], const obs_dyn_params *p,
@@ -203,11 +204,93 @@ done:
 static void trace_point(void *ctx, size_t i)
 {
     sph_job *j = ctx;
+    obs__dyn_points *pt = j->pt;
+    size_t k = j->first + i;
     int dropped = 0;
-    if (!obs__dyn_point_sh(j->bvh, j->pt->pos + 3 * i, j->p, j->id[i],
-                           j->pt->sh + (size_t)OBS_DYN_CHANNELS * i, &dropped))
+    if (!obs__dyn_point_sh(j->bvh, pt->pos + 3 * k, j->p, pt->id[k],
+                           pt->sh + (size_t)OBS_DYN_CHANNELS * k, &dropped))
         dropped = 2; /* no memory: reported by the caller */
-    j->dropped[i] = (uint8_t)dropped;
+    pt->dropped[k] = (uint8_t)dropped;
+}
+
+obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions *rg,
+                                const obs_dyn_params *p, obs__dyn_points *out,
+                                char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    size_t per = (size_t)p->grid * p->grid * p->grid;
+    if (rg->count > SIZE_MAX / per / 2)
+        return obs__fail(err, OBS_TOO_LARGE, "%zu regions", rg->count);
+    size_t total = rg->count * per, nv = 0;
+    uint8_t *state = calloc(total ? total : 1, 1);
+    if (!state)
+        return obs__fail(err, OBS_NO_MEMORY, "valid flags of %zu points", total);
+    flag_job fj = {bvh, rg, p, state};
+    run_pfor(rg->count, 1, p->threads, flag_region, &fj, NULL, NULL);
+    out->grid = total;
+    for (size_t k = 0; k < total; k++) {
+        out->inside += state[k] == 1;
+        out->hidden += state[k] == 2;
+        nv += state[k] == 0;
+    }
+    out->pos = malloc((nv ? nv : 1) * 3 * sizeof *out->pos);
+    out->sh = calloc((nv ? nv : 1) * OBS_DYN_CHANNELS, sizeof *out->sh);
+    out->region = malloc((nv ? nv : 1) * sizeof *out->region);
+    out->held = malloc(nv ? nv : 1);
+    out->id = malloc((nv ? nv : 1) * sizeof *out->id);
+    out->dropped = calloc(nv ? nv : 1, 1);
+    if (!out->pos || !out->sh || !out->region || !out->held || !out->id || !out->dropped) {
+        free(state);
+        obs__dyn_points_free(out);
+        return obs__fail(err, OBS_NO_MEMORY, "%zu valid points", nv);
+    }
+    size_t i = 0;
+    for (size_t k = 0; k < total; k++) {
+        if (state[k])
+            continue;
+        grid_point(&rg->box[k / per], p->grid, k % per, out->pos + 3 * i);
+        out->region[i] = (uint32_t)(k / per);
+        out->id[i] = k;
+        obs__bake_rng r = obs__bake_rng_stream((uint64_t)p->seed, k, 11);
+        out->held[i] = obs__bake_rng_unit(&r) < p->holdout;
+        i++;
+    }
+    out->count = nv;
+    free(state);
+    return OBS_OK;
+}
+
+void obs__dyn_points_trace(const obs__bake_bvh *bvh, const obs_dyn_params *p,
+                           obs__dyn_points *pt, size_t first, size_t end,
+                           void (*progress)(void *, size_t, size_t), void *user)
+{
+    sph_job sj = {bvh, p, pt, first};
+    run_pfor(end - first, 16, p->threads, trace_point, &sj, progress, user);
+    pt->rays += (uint64_t)(end - first) * (uint64_t)p->rays;
+}
+
+obs_status obs__dyn_points_compact(obs__dyn_points *pt, char err[OBS_ERR_LEN])
+{
+    /* Drop the points that see too many back faces, keeping the order. */
+    size_t m = 0;
+    for (size_t k = 0; k < pt->count; k++) {
+        if (pt->dropped[k] == 2)
+            return obs__fail(err, OBS_NO_MEMORY, "rays of one point");
+        if (pt->dropped[k]) {
+            pt->backface++;
+            continue;
+        }
+        memmove(pt->pos + 3 * m, pt->pos + 3 * k, 3 * sizeof *pt->pos);
+        memmove(pt->sh + OBS_DYN_CHANNELS * m, pt->sh + OBS_DYN_CHANNELS * k,
+                OBS_DYN_CHANNELS * sizeof *pt->sh);
+        pt->region[m] = pt->region[k];
+        pt->held[m] = pt->held[k];
+        pt->id[m] = pt->id[k];
+        pt->dropped[m] = 0;
+        m++;
+    }
+    pt->count = m;
+    return OBS_OK;
 }
 
 obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *bvh,
@@ -217,75 +300,13 @@ obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *b
                                 char err[OBS_ERR_LEN])
 {
     (void)w;
-    memset(out, 0, sizeof *out);
-    obs_status st = OBS_OK;
-    size_t per = (size_t)p->grid * p->grid * p->grid;
-    if (rg->count > SIZE_MAX / per / 2)
-        return obs__fail(err, OBS_TOO_LARGE, "%zu regions", rg->count);
-    size_t total = rg->count * per, nv = 0;
-    uint8_t *state = calloc(total ? total : 1, 1), *dropped = NULL;
-    uint64_t *id = NULL;
-    if (!state)
-        return obs__fail(err, OBS_NO_MEMORY, "valid flags of %zu points", total);
-    double t0 = (obs__now_ms() * 1e-3);
-    flag_job fj = {bvh, rg, p, state};
-    run_pfor(rg->count, 1, p->threads, flag_region, &fj, NULL, NULL);
-    *valid_seconds = (obs__now_ms() * 1e-3) - t0;
-    out->grid = total;
-    for (size_t k = 0; k < total; k++) {
-        out->inside += state[k] == 1;
-        out->hidden += state[k] == 2;
-        nv += state[k] == 0;
-    }
-    out->pos = malloc((nv ? nv : 1) * 3 * sizeof *out->pos);
-    out->sh = malloc((nv ? nv : 1) * OBS_DYN_CHANNELS * sizeof *out->sh);
-    out->region = malloc((nv ? nv : 1) * sizeof *out->region);
-    out->held = malloc(nv ? nv : 1);
-    id = malloc((nv ? nv : 1) * sizeof *id);
-    dropped = malloc(nv ? nv : 1);
-    if (!out->pos || !out->sh || !out->region || !out->held || !id || !dropped) {
-        st = obs__fail(err, OBS_NO_MEMORY, "%zu valid points", nv);
-        goto done;
-    }
-    size_t i = 0;
-    for (size_t k = 0; k < total; k++) {
-        if (state[k])
-            continue;
-        grid_point(&rg->box[k / per], p->grid, k % per, out->pos + 3 * i);
-        out->region[i] = (uint32_t)(k / per);
-        id[i] = k;
-        obs__bake_rng r = obs__bake_rng_stream((uint64_t)p->seed, k, 11);
-        out->held[i] = obs__bake_rng_unit(&r) < p->holdout;
-        i++;
-    }
-    out->count = nv;
-    sph_job sj = {bvh, p, out, id, dropped};
-    run_pfor(nv, 16, p->threads, trace_point, &sj, progress, user);
-    out->rays = (uint64_t)nv * (uint64_t)p->rays;
-    /* Drop the points that see too many back faces, keeping the order. */
-    size_t m = 0;
-    for (size_t k = 0; k < nv; k++) {
-        if (dropped[k] == 2) {
-            st = obs__fail(err, OBS_NO_MEMORY, "rays of one point");
-            goto done;
-        }
-        if (dropped[k]) {
-            out->backface++;
-            continue;
-        }
-        memmove(out->pos + 3 * m, out->pos + 3 * k, 3 * sizeof *out->pos);
-        memmove(out->sh + OBS_DYN_CHANNELS * m, out->sh + OBS_DYN_CHANNELS * k,
-                OBS_DYN_CHANNELS * sizeof *out->sh);
-        out->region[m] = out->region[k];
-        out->held[m] = out->held[k];
-        m++;
-    }
-    out->count = m;
-done:
-    free(state);
-    free(id);
-    free(dropped);
+    double t0 = obs__now_ms() * 1e-3;
+    obs_status st = obs__dyn_points_flag(bvh, rg, p, out, err);
+    *valid_seconds = obs__now_ms() * 1e-3 - t0;
     if (st != OBS_OK)
+        return st;
+    obs__dyn_points_trace(bvh, p, out, 0, out->count, progress, user);
+    if ((st = obs__dyn_points_compact(out, err)) != OBS_OK)
         obs__dyn_points_free(out);
     return st;
 }

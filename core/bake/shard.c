@@ -55,7 +55,7 @@
 #define MAGIC "OBSSHARD"
 #define VERSION 1u
 #define HEADER 128u
-#define FNV_OFFSET 0xcbf29ce484222325ULL
+#define FNV_OFFSET OBS__BAKE_FNV_OFFSET
 #define FNV_PRIME 0x100000001b3ULL
 
 static double now(void)
@@ -71,57 +71,11 @@ size_t obs__bake_shard_first(size_t total, int index, int count)
     return total / (size_t)count * (size_t)index + total % (size_t)count * (size_t)index / (size_t)count;
 }
 
-/* ---- little-endian fields and the hash -------------------------------- */
+/* ---- little-endian fields and the hash (shard.h) ----------------------- */
 
-static void put32(unsigned char *p, uint32_t v)
+uint64_t obs__bake_fnv(uint64_t h, const void *data, size_t n)
 {
-    for (int i = 0; i < 4; i++)
-        p[i] = (unsigned char)(v >> (8 * i));
-}
-
-static void put64(unsigned char *p, uint64_t v)
-{
-    for (int i = 0; i < 8; i++)
-        p[i] = (unsigned char)(v >> (8 * i));
-}
-
-static uint32_t get32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static uint64_t get64(const unsigned char *p) { return (uint64_t)get32(p) | (uint64_t)get32(p + 4) << 32; }
-
-static uint32_t fbits(float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return u;
-}
-
-static float bitsf(uint32_t u)
-{
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-static uint64_t dbits(double d)
-{
-    uint64_t u;
-    memcpy(&u, &d, sizeof u);
-    return u;
-}
-
-static double bitsd(uint64_t u)
-{
-    double d;
-    memcpy(&d, &u, sizeof d);
-    return d;
-}
-
-static uint64_t fnv(uint64_t h, const unsigned char *p, size_t n)
-{
+    const unsigned char *p = data;
     for (size_t i = 0; i < n; i++)
         h = (h ^ p[i]) * FNV_PRIME;
     return h;
@@ -130,19 +84,19 @@ static uint64_t fnv(uint64_t h, const unsigned char *p, size_t n)
 static uint64_t fnv32(uint64_t h, uint32_t v)
 {
     unsigned char b[4];
-    put32(b, v);
-    return fnv(h, b, 4);
+    obs__le_put32(b, v);
+    return obs__bake_fnv(h, b, 4);
 }
 
 uint64_t obs__bake_level_fingerprint(const obs__bake_world *w)
 {
-    uint64_t h = fnv(FNV_OFFSET, (const unsigned char *)"obscura level 1", 15);
+    uint64_t h = obs__bake_fnv(FNV_OFFSET, (const unsigned char *)"obscura level 1", 15);
     h = fnv32(fnv32(h, (uint32_t)w->vertex_count), (uint32_t)w->triangle_count);
     for (size_t i = 0; i < 3 * w->vertex_count; i++)
-        h = fnv32(h, fbits(w->pos[i]));
+        h = fnv32(h, obs__le_fbits(w->pos[i]));
     for (size_t i = 0; i < 3 * w->triangle_count; i++)
         h = fnv32(h, w->tri[i]);
-    return fnv(h, w->two_sided, w->triangle_count);
+    return obs__bake_fnv(h, w->two_sided, w->triangle_count);
 }
 
 /* ---- writing a part ----------------------------------------------------- */
@@ -151,26 +105,26 @@ static void header_bytes(const obs__bake_part *h, unsigned char b[HEADER])
 {
     memset(b, 0, HEADER);
     memcpy(b, MAGIC, 8);
-    put32(b + 8, VERSION);
-    put32(b + 12, HEADER);
-    put64(b + 16, h->level);
-    put32(b + 24, h->index);
-    put32(b + 28, h->count);
-    put64(b + 32, h->total);
-    put64(b + 40, h->first);
-    put64(b + 48, h->n);
-    put64(b + 56, h->rays);
-    put64(b + 64, h->dropped);
-    put32(b + 72, (uint32_t)h->rays_per_sample);
-    put32(b + 76, (uint32_t)h->seed);
-    put32(b + 80, (uint32_t)h->max_samples_per_face);
-    put32(b + 84, fbits(h->samples_per_face));
-    put32(b + 88, fbits(h->distance_short));
-    put32(b + 92, fbits(h->distance_long));
-    put32(b + 96, fbits(h->backface_limit));
-    put64(b + 104, dbits(h->bvh_seconds));
-    put64(b + 112, dbits(h->trace_seconds));
-    put64(b + 120, h->checksum);
+    obs__le_put32(b + 8, VERSION);
+    obs__le_put32(b + 12, HEADER);
+    obs__le_put64(b + 16, h->level);
+    obs__le_put32(b + 24, h->index);
+    obs__le_put32(b + 28, h->count);
+    obs__le_put64(b + 32, h->total);
+    obs__le_put64(b + 40, h->first);
+    obs__le_put64(b + 48, h->n);
+    obs__le_put64(b + 56, h->rays);
+    obs__le_put64(b + 64, h->dropped);
+    obs__le_put32(b + 72, (uint32_t)h->rays_per_sample);
+    obs__le_put32(b + 76, (uint32_t)h->seed);
+    obs__le_put32(b + 80, (uint32_t)h->max_samples_per_face);
+    obs__le_put32(b + 84, obs__le_fbits(h->samples_per_face));
+    obs__le_put32(b + 88, obs__le_fbits(h->distance_short));
+    obs__le_put32(b + 92, obs__le_fbits(h->distance_long));
+    obs__le_put32(b + 96, obs__le_fbits(h->backface_limit));
+    obs__le_put64(b + 104, obs__le_dbits(h->bvh_seconds));
+    obs__le_put64(b + 112, obs__le_dbits(h->trace_seconds));
+    obs__le_put64(b + 120, h->checksum);
 }
 
 /* The payload of samples [first, first + n) as the file holds it. */
@@ -180,15 +134,16 @@ static unsigned char *payload_bytes(const obs__bake_samples *s, size_t first, si
     if (!p)
         return NULL;
     for (size_t i = 0; i < n; i++) {
-        put32(p + 8 * i, fbits(s->ao[2 * (first + i)]));
-        put32(p + 8 * i + 4, fbits(s->ao[2 * (first + i) + 1]));
+        obs__le_put32(p + 8 * i, obs__le_fbits(s->ao[2 * (first + i)]));
+        obs__le_put32(p + 8 * i + 4, obs__le_fbits(s->ao[2 * (first + i) + 1]));
         p[8 * n + i] = s->valid[first + i] ? 1 : 0;
     }
     return p;
 }
 
-static obs_status write_part(const char *path, const obs__bake_part *h, const unsigned char *payload,
-                             char err[OBS_ERR_LEN])
+obs_status obs__bake_part_write(const char *path, const unsigned char *head, size_t head_len,
+                                const unsigned char *payload, size_t payload_len,
+                                char err[OBS_ERR_LEN])
 {
     size_t len = strlen(path);
     char *tmp = malloc(len + 5);
@@ -196,11 +151,9 @@ static obs_status write_part(const char *path, const obs__bake_part *h, const un
         return obs__fail(err, OBS_NO_MEMORY, "%s: the file name", path);
     memcpy(tmp, path, len);
     memcpy(tmp + len, ".tmp", 5);
-    unsigned char head[HEADER];
-    header_bytes(h, head);
     FILE *f = fopen(tmp, "wb");
-    int ok = f && fwrite(head, 1, HEADER, f) == HEADER &&
-             (h->n == 0 || fwrite(payload, 1, (size_t)h->n * 9, f) == (size_t)h->n * 9);
+    int ok = f && fwrite(head, 1, head_len, f) == head_len &&
+             (payload_len == 0 || fwrite(payload, 1, payload_len, f) == payload_len);
     int e = errno;
     if (f && fclose(f) != 0 && ok)
         ok = 0, e = errno;
@@ -255,8 +208,10 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
     unsigned char *payload = payload_bytes(s, (size_t)h.first, (size_t)h.n);
     if (!payload)
         return obs__fail(err, OBS_NO_MEMORY, "the part of %llu samples", (unsigned long long)h.n);
-    h.checksum = fnv(FNV_OFFSET, payload, (size_t)h.n * 9);
-    rc = write_part(sh->path, &h, payload, err);
+    h.checksum = obs__bake_fnv(FNV_OFFSET, payload, (size_t)h.n * 9);
+    unsigned char head[HEADER];
+    header_bytes(&h, head);
+    rc = obs__bake_part_write(sh->path, head, HEADER, payload, (size_t)h.n * 9, err);
     free(payload);
     st->seconds[OBS_BAKE_STAGE_bvh] = h.bvh_seconds;
     st->seconds[OBS_BAKE_STAGE_trace] = h.trace_seconds;
@@ -267,46 +222,82 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
 
 /* ---- reading parts ------------------------------------------------------- */
 
+obs_status obs__bake_part_head(const char *path, const char *magic, const char *what, const char *writer,
+                               unsigned char *head, size_t head_len, uint64_t *size,
+                               char err[OBS_ERR_LEN])
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return obs__fail(err, OBS_IO, "%s: cannot open the part: %s", path, strerror(errno));
+    size_t got = fread(head, 1, head_len, f);
+    struct stat sb;
+    int have_size = fstat(fileno(f), &sb) == 0;
+    fclose(f);
+    *size = have_size ? (uint64_t)sb.st_size : UINT64_MAX;
+    if (got >= 8 && memcmp(head, magic, 8) != 0)
+        return obs__fail(err, OBS_BAD_FILE, "%s: not a %s (no '%.8s' magic; '%s' writes "
+                         "them)", path, what, magic, writer);
+    if (got < head_len)
+        return obs__fail(err, OBS_BAD_FILE, "%s: truncated: %zu bytes, shorter than a part's "
+                         "header (%zu)", path, got, head_len);
+    return OBS_OK;
+}
+
+obs_status obs__bake_part_payload(const char *path, size_t offset, size_t len, uint64_t checksum,
+                                  unsigned char **out, char err[OBS_ERR_LEN])
+{
+    *out = NULL;
+    unsigned char *p = malloc(len + 1);
+    if (!p)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: a payload of %zu bytes", path, len);
+    FILE *f = fopen(path, "rb");
+    int ok = f && fseek(f, (long)offset, SEEK_SET) == 0 && fread(p, 1, len, f) == len;
+    if (f)
+        fclose(f);
+    if (!ok) {
+        free(p);
+        return obs__fail(err, OBS_IO, "%s: cannot read its payload (%zu bytes)", path, len);
+    }
+    if (obs__bake_fnv(OBS__BAKE_FNV_OFFSET, p, len) != checksum) {
+        free(p);
+        return obs__fail(err, OBS_BAD_FILE, "%s: damaged: its payload does not match the header's "
+                         "checksum", path);
+    }
+    *out = p;
+    return OBS_OK;
+}
+
 obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN])
 {
     memset(h, 0, sizeof *h);
     h->path = path;
     unsigned char b[HEADER];
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return obs__fail(err, OBS_IO, "%s: cannot open the part: %s", path, strerror(errno));
-    size_t got = fread(b, 1, HEADER, f);
-    struct stat sb;
-    int have_size = fstat(fileno(f), &sb) == 0;
-    fclose(f);
-    if (got >= 8 && memcmp(b, MAGIC, 8) != 0)
-        return obs__fail(err, OBS_BAD_FILE, "%s: not a bake part (no '" MAGIC "' magic; "
-                         "'obscura bake --shard I/N' writes them)", path);
-    if (got < HEADER)
-        return obs__fail(err, OBS_BAD_FILE, "%s: truncated: %zu bytes, shorter than a part's "
-                         "header (%u)", path, got, HEADER);
-    h->version = get32(b + 8);
-    if (h->version != VERSION || get32(b + 12) != HEADER)
+    uint64_t size;
+    obs_status rc = obs__bake_part_head(path, MAGIC, "bake part", "obscura bake --shard I/N", b, HEADER, &size, err);
+    if (rc != OBS_OK)
+        return rc;
+    h->version = obs__le_get32(b + 8);
+    if (h->version != VERSION || obs__le_get32(b + 12) != HEADER)
         return obs__fail(err, OBS_UNSUPPORTED, "%s: part version %u (header %u bytes); this "
-                         "obscura reads version %u", path, h->version, get32(b + 12), VERSION);
-    h->level = get64(b + 16);
-    h->index = get32(b + 24);
-    h->count = get32(b + 28);
-    h->total = get64(b + 32);
-    h->first = get64(b + 40);
-    h->n = get64(b + 48);
-    h->rays = get64(b + 56);
-    h->dropped = get64(b + 64);
-    h->rays_per_sample = (int32_t)get32(b + 72);
-    h->seed = (int32_t)get32(b + 76);
-    h->max_samples_per_face = (int32_t)get32(b + 80);
-    h->samples_per_face = bitsf(get32(b + 84));
-    h->distance_short = bitsf(get32(b + 88));
-    h->distance_long = bitsf(get32(b + 92));
-    h->backface_limit = bitsf(get32(b + 96));
-    h->bvh_seconds = bitsd(get64(b + 104));
-    h->trace_seconds = bitsd(get64(b + 112));
-    h->checksum = get64(b + 120);
+                         "obscura reads version %u", path, h->version, obs__le_get32(b + 12), VERSION);
+    h->level = obs__le_get64(b + 16);
+    h->index = obs__le_get32(b + 24);
+    h->count = obs__le_get32(b + 28);
+    h->total = obs__le_get64(b + 32);
+    h->first = obs__le_get64(b + 40);
+    h->n = obs__le_get64(b + 48);
+    h->rays = obs__le_get64(b + 56);
+    h->dropped = obs__le_get64(b + 64);
+    h->rays_per_sample = (int32_t)obs__le_get32(b + 72);
+    h->seed = (int32_t)obs__le_get32(b + 76);
+    h->max_samples_per_face = (int32_t)obs__le_get32(b + 80);
+    h->samples_per_face = obs__le_bitsf(obs__le_get32(b + 84));
+    h->distance_short = obs__le_bitsf(obs__le_get32(b + 88));
+    h->distance_long = obs__le_bitsf(obs__le_get32(b + 92));
+    h->backface_limit = obs__le_bitsf(obs__le_get32(b + 96));
+    h->bvh_seconds = obs__le_bitsd(obs__le_get64(b + 104));
+    h->trace_seconds = obs__le_bitsd(obs__le_get64(b + 112));
+    h->checksum = obs__le_get64(b + 120);
     if (h->count == 0 || h->index >= h->count || h->count > (uint32_t)INT32_MAX ||
         h->total > UINT32_MAX || h->first != obs__bake_shard_first((size_t)h->total, (int)h->index, (int)h->count) ||
         h->first + h->n != obs__bake_shard_first((size_t)h->total, (int)h->index + 1, (int)h->count))
@@ -315,35 +306,23 @@ obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char 
                          (unsigned long long)h->total, (unsigned long long)h->first,
                          (unsigned long long)(h->first + h->n));
     uint64_t want = HEADER + 9 * h->n;
-    if (have_size && (uint64_t)sb.st_size != want)
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %lld bytes, its header promises %llu (%llu samples)",
-                         path, (uint64_t)sb.st_size < want ? "truncated" : "longer than a part",
-                         (long long)sb.st_size, (unsigned long long)want, (unsigned long long)h->n);
+    if (size != UINT64_MAX && size != want)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %llu bytes, its header promises %llu (%llu samples)",
+                         path, size < want ? "truncated" : "longer than a part",
+                         (unsigned long long)size, (unsigned long long)want, (unsigned long long)h->n);
     return OBS_OK;
 }
 
 static obs_status read_payload(const obs__bake_part *h, obs__bake_samples *s, char err[OBS_ERR_LEN])
 {
     size_t n = (size_t)h->n, first = (size_t)h->first;
-    unsigned char *p = malloc(9 * n + 1);
-    if (!p)
-        return obs__fail(err, OBS_NO_MEMORY, "%s: %zu samples", h->path, n);
-    FILE *f = fopen(h->path, "rb");
-    int ok = f && fseek(f, HEADER, SEEK_SET) == 0 && fread(p, 1, 9 * n, f) == 9 * n;
-    if (f)
-        fclose(f);
-    if (!ok) {
-        free(p);
-        return obs__fail(err, OBS_IO, "%s: cannot read its %zu samples", h->path, n);
-    }
-    if (fnv(FNV_OFFSET, p, 9 * n) != h->checksum) {
-        free(p);
-        return obs__fail(err, OBS_BAD_FILE, "%s: damaged: its samples do not match the header's "
-                         "checksum", h->path);
-    }
+    unsigned char *p;
+    obs_status rc = obs__bake_part_payload(h->path, HEADER, 9 * n, h->checksum, &p, err);
+    if (rc != OBS_OK)
+        return rc;
     for (size_t i = 0; i < n; i++) {
-        s->ao[2 * (first + i)] = bitsf(get32(p + 8 * i));
-        s->ao[2 * (first + i) + 1] = bitsf(get32(p + 8 * i + 4));
+        s->ao[2 * (first + i)] = obs__le_bitsf(obs__le_get32(p + 8 * i));
+        s->ao[2 * (first + i) + 1] = obs__le_bitsf(obs__le_get32(p + 8 * i + 4));
         s->valid[first + i] = p[8 * n + i] != 0;
     }
     free(p);
@@ -385,4 +364,51 @@ obs_status obs__bake_shard_step(obs__bake_shard *sh, const obs__bake_world *w,
                                 obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
     return sh->parts ? read_shards(sh, w, s, st, err) : trace_shard(sh, w, s, td, &sh->params, st, err);
+}
+
+/* ---- the parts of one split ----------------------------------------------- */
+
+obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t *order,
+                                 char err[OBS_ERR_LEN])
+{
+    uint32_t count = in[0].count;
+    if (n > count)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%zu parts given for a split into %u shards "
+                         "(%s): one is given twice, or belongs to another split", n, count,
+                         in[0].path);
+    unsigned char *seen = calloc(count, 1);
+    if (!seen)
+        return obs__fail(err, OBS_NO_MEMORY, "%u shards", count);
+    obs_status rc = OBS_OK;
+    for (size_t i = 0; rc == OBS_OK && i < n; i++) {
+        if (in[i].count != count)
+            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%s is shard %u/%u, %s shard %u/%u: parts "
+                           "of different splits", in[0].path, in[0].index, count, in[i].path,
+                           in[i].index, in[i].count);
+        else if (in[i].level != in[0].level)
+            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced from different levels "
+                           "(fingerprints %016llx and %016llx)", in[0].path, in[i].path,
+                           (unsigned long long)in[0].level, (unsigned long long)in[i].level);
+        else if (seen[in[i].index])
+            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "shard %u/%u given twice: %s and %s",
+                           in[i].index, count, in[order[in[i].index]].path, in[i].path);
+        else
+            seen[in[i].index] = 1, order[in[i].index] = i;
+    }
+    if (rc == OBS_OK && n < count) {
+        char list[256] = "";
+        size_t len = 0, missing = 0;
+        for (uint32_t k = 0; k < count; k++) {
+            if (seen[k])
+                continue;
+            if (len + 16 < sizeof list)
+                len += (size_t)snprintf(list + len, sizeof list - len, "%s%u", missing ? ", " : "", k);
+            missing++;
+        }
+        rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%zu of %u shards missing (%s%s): a merge needs "
+                       "every shard of the split once", missing, count, list,
+                       missing * 4 > sizeof list ? ", ..." : "");
+    }
+    free(seen);
+    return rc;
 }

@@ -52,66 +52,32 @@ static obs_status adopt(obs_bake_params *p, const obs__bake_part *parts, size_t 
     const obs__bake_part *a = &parts[0];
     for (size_t i = 1; i < n; i++) {
         const obs__bake_part *b = &parts[i];
-#define SAME(name, field, type)                                                 \
-        if (memcmp(&a->field, &b->field, sizeof a->field) != 0)                 \
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced with different " \
-                             #name " (%g and %g): they are not parts of one bake", a->path,      \
-                             b->path, (double)a->field, (double)b->field);
+#define SAME(name, field, type) OBS__PART_SAME(a, b, name, field)
         TRACE_PARAMS(SAME)
 #undef SAME
     }
-#define TAKE(name, field, type)                                                 \
-    {                                                                           \
-        int row = row_of(#name);                                                \
-        if (row >= 0 && (p->set >> row & 1)) {                                  \
-            if (p->name != a->field)                                            \
-                return obs__fail(err, OBS_INVALID_ARGUMENT, "the parts were traced with " #name \
-                                 " %g; this merge asks for %g (leave it out to take the parts')", \
-                                 (double)a->field, (double)p->name);            \
-        } else {                                                                \
-            p->name = a->field;                                                 \
-            if (row >= 0)                                                       \
-                p->set |= (uint64_t)1 << row;                                   \
-        }                                                                       \
-    }
+#define TAKE(name, field, type) OBS__PART_TAKE(p, a, row_of(#name), name, field)
     TRACE_PARAMS(TAKE)
 #undef TAKE
     return OBS_OK;
 }
 
-/* parts in shard order: every shard of one split, once. */
+/* parts in shard order: every shard of one split, once (shard.c). */
 static obs_status order_parts(const obs__bake_part *in, size_t n, obs__bake_part *out,
                               char err[OBS_ERR_LEN])
 {
-    uint32_t count = in[0].count;
-    for (size_t i = 0; i < n; i++) {
-        if (in[i].count != count)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s is shard %u/%u, %s shard %u/%u: parts "
-                             "of different splits", in[0].path, in[0].index, count, in[i].path,
-                             in[i].index, in[i].count);
-        if (in[i].level != in[0].level)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced from different levels "
-                             "(fingerprints %016llx and %016llx)", in[0].path, in[i].path,
-                             (unsigned long long)in[0].level, (unsigned long long)in[i].level);
-        if (out[in[i].index].path)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %u/%u given twice: %s and %s",
-                             in[i].index, count, out[in[i].index].path, in[i].path);
-        out[in[i].index] = in[i];
-    }
-    if (n == count)
-        return OBS_OK;
-    char list[256] = "";
-    size_t len = 0, missing = 0;
-    for (uint32_t k = 0; k < count; k++)
-        if (!out[k].path && len + 16 < sizeof list) {
-            len += (size_t)snprintf(list + len, sizeof list - len, "%s%u", missing ? ", " : "", k);
-            missing++;
-        } else if (!out[k].path) {
-            missing++;
-        }
-    return obs__fail(err, OBS_INVALID_ARGUMENT, "%zu of %u shards missing (%s%s): a merge needs "
-                     "every shard of the split once", missing, count, list,
-                     missing * 4 > sizeof list ? ", ..." : "");
+    obs__bake_part_key *keys = calloc(n, sizeof *keys);
+    size_t *order = calloc(in[0].count, sizeof *order);
+    obs_status rc = keys && order ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
+    for (size_t i = 0; rc == OBS_OK && i < n; i++)
+        keys[i] = (obs__bake_part_key){in[i].path, in[i].index, in[i].count, in[i].level};
+    if (rc == OBS_OK)
+        rc = obs__bake_parts_order(keys, n, order, err);
+    for (uint32_t k = 0; rc == OBS_OK && k < in[0].count; k++)
+        out[k] = in[order[k]];
+    free(keys);
+    free(order);
+    return rc;
 }
 
 obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
@@ -125,10 +91,6 @@ obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
     obs_status rc = heads ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
     for (size_t i = 0; rc == OBS_OK && i < n; i++)
         rc = obs__bake_part_read_header(paths[i], &heads[i], err);
-    if (rc == OBS_OK && n > heads[0].count)
-        rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%zu parts given for a split into %u shards "
-                       "(%s): one is given twice, or belongs to another split", n, heads[0].count,
-                       heads[0].path);
     if (rc == OBS_OK && !(ordered = calloc(heads[0].count, sizeof *ordered)))
         rc = obs__fail(err, OBS_NO_MEMORY, "%u parts", heads[0].count);
     if (rc == OBS_OK)

@@ -10,6 +10,7 @@
  * checked against its view and the binary chunk before it is read. */
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <fnmatch.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -259,12 +260,18 @@ typedef struct build {
     int count_only;      /* first pass: sizes */
     size_t nv, nt, nmesh;
     int any_material;
-    int has[3];          /* primitives with _AO, _AO_SHORT, _AO_LONG */
-    int prims;
+    int has[3];          /* static primitives with _AO, _AO_SHORT, _AO_LONG */
+    int prims;           /* static primitives */
+    /* dynamic objects (obs_scene_load_baked_dynamic): allowed, the
+     * pattern on node names, the nodes it matched, the nodes marked
+     * (by the pattern or their extras) */
+    int dynamic;
+    const char *pattern;
+    size_t marked;
 } build;
 
 static obs_status primitive(build *b, const cJSON *prim, const char *mname, const char *nname,
-                            int pi, const float world[16], char err[OBS_ERR_LEN])
+                            int pi, const float world[16], int dyn, char err[OBS_ERR_LEN])
 {
     const glb *g = b->g;
     char what[300];
@@ -290,9 +297,13 @@ static obs_status primitive(build *b, const cJSON *prim, const char *mname, cons
                              g->path, what, ao_names[k]);
         have[k] = 1;
     }
-    if (!have[0])
+    if (!have[0] && !dyn)
         return obs__fail(err, OBS_MISSING_CHANNEL,
-                         "%s: %s has no _AO attribute (not a level baked by obscura bake?)",
+                         b->dynamic ? "%s: %s has no _AO attribute and is not marked dynamic (by "
+                                      "the pattern on node names or glTF node extras "
+                                      "\"obscura_dynamic\": true)"
+                                    : "%s: %s has no _AO attribute (not a level baked by obscura "
+                                      "bake?)",
                          g->path, what);
     int has_n = item(attrs, "NORMAL") != NULL;
     if (has_n && ((st = accessor(g, index_of(attrs, "NORMAL"), 3, &nrm, what, err)) != OBS_OK))
@@ -311,9 +322,9 @@ static obs_status primitive(build *b, const cJSON *prim, const char *mname, cons
     if (pos.count > (size_t)UINT32_MAX - b->nv)
         return obs__fail(err, OBS_TOO_LARGE, "%s: more than 2^32 vertices", g->path);
     if (b->count_only) {
-        for (int k = 0; k < 3; k++)
+        for (int k = 0; k < 3 && !dyn; k++)
             b->has[k] += have[k];
-        b->prims++;
+        b->prims += !dyn;
         b->nv += pos.count;
         b->nt += ni / 3;
         b->nmesh++;
@@ -350,7 +361,7 @@ static obs_status primitive(build *b, const cJSON *prim, const char *mname, cons
         }
         float *db = s->baked + 3 * (b->nv + v);
         for (int k = 0; k < 3; k++)
-            db[k] = have[k] ? acc_float(&ao[k], v, 0) : 1.0f;
+            db[k] = have[k] && !dyn ? acc_float(&ao[k], v, 0) : 1.0f;
         if (s->albedo)
             memcpy(s->albedo + 3 * (b->nv + v), rgb, sizeof rgb);
     }
@@ -364,6 +375,7 @@ static obs_status primitive(build *b, const cJSON *prim, const char *mname, cons
     obs_scene_mesh *me = &s->meshes[s->mesh_count++];
     me->first_triangle = b->nt;
     me->triangle_count = ni / 3;
+    me->dynamic = dyn;
     if (!(me->name = strdup(mname)) || !(me->node = strdup(nname)))
         return obs__fail(err, OBS_NO_MEMORY, "%s: mesh names", g->path);
     b->nv += pos.count;
@@ -371,7 +383,20 @@ static obs_status primitive(build *b, const cJSON *prim, const char *mname, cons
     return OBS_OK;
 }
 
-static obs_status walk(build *b, long n, const float parent[16], int depth,
+/* A node marked dynamic: its name matches the pattern, or its extras
+ * say "obscura_dynamic": true. */
+static int marked_dynamic(build *b, const cJSON *node, const char *nname)
+{
+    if (!b->dynamic)
+        return 0;
+    int by_name = b->pattern && fnmatch(b->pattern, nname, 0) == 0;
+    int by_extras = cJSON_IsTrue(item(item(node, "extras"), "obscura_dynamic"));
+    if (b->count_only)
+        b->marked += by_name || by_extras;
+    return by_name || by_extras;
+}
+
+static obs_status walk(build *b, long n, const float parent[16], int depth, int dyn,
                        char err[OBS_ERR_LEN])
 {
     const cJSON *node = cJSON_GetArrayItem(item(b->g->doc, "nodes"), (int)n);
@@ -385,6 +410,7 @@ static obs_status walk(build *b, long n, const float parent[16], int depth,
     obs__mat4_mul(parent, local, world);
     const cJSON *nm = item(node, "name");
     const char *nname = cJSON_IsString(nm) ? nm->valuestring : "";
+    dyn = marked_dynamic(b, node, nname) || dyn; /* a dynamic node's children move with it */
     long mi = index_of(node, "mesh");
     obs_status st;
     if (item(node, "mesh")) {
@@ -396,13 +422,13 @@ static obs_status walk(build *b, long n, const float parent[16], int depth,
         const char *mname = cJSON_IsString(mn) ? mn->valuestring : "";
         int pi = 0;
         cJSON_ArrayForEach(prim, item(mesh, "primitives"))
-            if ((st = primitive(b, prim, mname, nname, pi++, world, err)) != OBS_OK)
+            if ((st = primitive(b, prim, mname, nname, pi++, world, dyn, err)) != OBS_OK)
                 return st;
     }
     const cJSON *c;
     cJSON_ArrayForEach(c, item(node, "children"))
-        if ((st = walk(b, cJSON_IsNumber(c) ? (long)c->valuedouble : -1, world, depth + 1, err)) !=
-            OBS_OK)
+        if ((st = walk(b, cJSON_IsNumber(c) ? (long)c->valuedouble : -1, world, depth + 1, dyn,
+                       err)) != OBS_OK)
             return st;
     return OBS_OK;
 }
@@ -415,7 +441,7 @@ static obs_status walk_scene(build *b, char err[OBS_ERR_LEN])
     obs__mat4_identity(id);
     obs_status st;
     cJSON_ArrayForEach(r, item(sc, "nodes"))
-        if ((st = walk(b, cJSON_IsNumber(r) ? (long)r->valuedouble : -1, id, 0, err)) != OBS_OK)
+        if ((st = walk(b, cJSON_IsNumber(r) ? (long)r->valuedouble : -1, id, 0, 0, err)) != OBS_OK)
             return st;
     return OBS_OK;
 }
@@ -434,16 +460,60 @@ int obs_scene_file_is_baked(const char *path)
     return baked;
 }
 
-obs_status obs_scene_load_baked(const char *path, obs_scene *out, char err[OBS_ERR_LEN])
+/* Whether some node of the file has a name matching the pattern. */
+static int pattern_matches(const glb *g, const char *pattern)
+{
+    const cJSON *n;
+    cJSON_ArrayForEach(n, item(g->doc, "nodes"))
+    {
+        const cJSON *nm = item(n, "name");
+        if (fnmatch(pattern, cJSON_IsString(nm) ? nm->valuestring : "", 0) == 0)
+            return 1;
+    }
+    return 0;
+}
+
+/* The names of the file's nodes, for a pattern that matched none. */
+static void node_names(const glb *g, char *buf, size_t len)
+{
+    size_t at = 0;
+    int k = 0;
+    const cJSON *n;
+    buf[0] = '\0';
+    cJSON_ArrayForEach(n, item(g->doc, "nodes"))
+    {
+        const cJSON *nm = item(n, "name");
+        const char *s = cJSON_IsString(nm) ? nm->valuestring : "";
+        if (at + strlen(s) + 8 >= len) {
+            snprintf(buf + at, len - at, ", ...");
+            return;
+        }
+        at += (size_t)snprintf(buf + at, len - at, "%s'%s'", k++ ? ", " : "", s);
+    }
+}
+
+static obs_status load(const char *path, int dynamic, const char *pattern, obs_scene *out,
+                       size_t *marked, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
+    if (marked)
+        *marked = 0;
     glb g;
     obs_status st = glb_open(path, &g, err);
     if (st != OBS_OK)
         return st;
-    build b = {.g = &g, .s = out, .count_only = 1};
+    build b = {.g = &g, .s = out, .count_only = 1, .dynamic = dynamic, .pattern = pattern};
+    if (pattern && !pattern_matches(&g, pattern)) {
+        char names[200];
+        node_names(&g, names, sizeof names);
+        st = obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no node's name matches '%s' (the nodes: "
+                                                  "%s)", path, pattern, names);
+        goto fail;
+    }
     if ((st = walk_scene(&b, err)) != OBS_OK)
         goto fail;
+    if (marked)
+        *marked = b.marked;
     if (b.nt == 0) {
         st = obs__fail(err, OBS_BAD_FILE, "%s: empty scene: no triangles", path);
         goto fail;
@@ -467,7 +537,7 @@ obs_status obs_scene_load_baked(const char *path, obs_scene *out, char err[OBS_E
     }
     /* _AO_SHORT and _AO_LONG count where every primitive has them */
     out->baked_mask = 1u | (b.has[1] == b.prims ? 2u : 0u) | (b.has[2] == b.prims ? 4u : 0u);
-    build b2 = {.g = &g, .s = out};
+    build b2 = {.g = &g, .s = out, .dynamic = dynamic, .pattern = pattern};
     if ((st = walk_scene(&b2, err)) != OBS_OK)
         goto fail;
     out->vertex_count = b2.nv;
@@ -484,4 +554,15 @@ fail:
     glb_free(&g);
     obs_scene_free(out);
     return st;
+}
+
+obs_status obs_scene_load_baked(const char *path, obs_scene *out, char err[OBS_ERR_LEN])
+{
+    return load(path, 0, NULL, out, NULL, err);
+}
+
+obs_status obs_scene_load_baked_dynamic(const char *path, const char *dynamic_nodes,
+                                        obs_scene *out, size_t *marked, char err[OBS_ERR_LEN])
+{
+    return load(path, 1, dynamic_nodes, out, marked, err);
 }

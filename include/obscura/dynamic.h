@@ -149,7 +149,17 @@ typedef struct obs_dyn_model_region {
     uint32_t points; /* valid points fitted */
 } obs_dyn_model_region;
 
+/* The level a model was baked from (the file's "level"): its triangles
+ * once instances are flattened, their box, and the fingerprint of the
+ * flattened level that the parts of obscura bake and bake-dynamic carry.
+ * triangles 0: unknown (a file without it). */
+typedef struct obs_dyn_level {
+    uint64_t fingerprint, triangles;
+    float lo[3], hi[3];
+} obs_dyn_level;
+
 typedef struct obs_dyn_model {
+    obs_dyn_level level;
     float distance[2], blend;
     size_t region_count, model_count, edge_count;
     obs_dyn_model_region *regions;
@@ -252,6 +262,30 @@ typedef struct obs_dyn_result {
 obs_status obs_dyn_bake(const obs_bake_scene *scene, const obs_dyn_desc *desc,
                         obs_dyn_result *out, char err[OBS_ERR_LEN]);
 void obs_dyn_result_free(obs_dyn_result *r);
+
+/* ---- the bake over many machines (dyn_shard.c) -------------------------- */
+
+/* Traces shard `index` of `count` (0 <= index < count) of the valid
+ * points obs_dyn_bake makes (the same regions and points: the regions
+ * are built, or desc->regions, and the points flagged, by every shard):
+ * the contiguous range [index n / count, (index + 1) n / count) of the n
+ * valid points, each with the directions it gets there, written to
+ * `path` as a part (core/bake/dyn_shard.c has the layout).  st (may be
+ * NULL) gets the counts of the shard's points and the trace's time. */
+obs_status obs_dyn_bake_shard(const obs_bake_scene *scene, const obs_dyn_desc *desc, int index,
+                              int count, const char *path, obs_dyn_stats *st,
+                              char err[OBS_ERR_LEN]);
+/* The parts (any order; every shard of one split once, traced from this
+ * level over these regions) read back and fitted: the result obs_dyn_bake
+ * gives.  The parameters the parts carry (rays, seed, grid, the
+ * distances, the back-face limit, max_regions, min_region_size) not
+ * given in desc are the parts'; given ones must agree; desc's parameters
+ * hold those the merge used once it returns.  The stats' trace row is
+ * the parts' times summed (plus the reading).  Free with
+ * obs_dyn_result_free(). */
+obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
+                              const char *const *parts, size_t n, obs_dyn_result *out,
+                              char err[OBS_ERR_LEN]);
 
 /* ---- measurement -------------------------------------------------------- */
 

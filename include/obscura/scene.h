@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "obscura/dynamic.h"
 #include "obscura/obscura.h"
 
 #ifdef __cplusplus
@@ -27,6 +28,7 @@ extern "C" {
 typedef struct obs_scene_mesh {
     char *name, *node;
     size_t first_triangle, triangle_count;
+    int dynamic; /* a dynamic object's (obs_scene_load_baked_dynamic) */
 } obs_scene_mesh;
 
 /* An indexed triangle mesh in world space.  Arrays are malloc'd;
@@ -72,6 +74,19 @@ obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN
  * OBS_BAD_FILE for a file that is not such a .glb or whose accessors lie
  * outside its buffer.  Caller frees with obs_scene_free(). */
 obs_status obs_scene_load_baked(const char *path, obs_scene *out, char err[OBS_ERR_LEN]);
+
+/* obs_scene_load_baked for a level with dynamic objects in it (obscura
+ * gbuffer --dynamic): the nodes whose name matches the fnmatch(3) pattern
+ * dynamic_nodes (NULL: none), those whose glTF extras hold
+ * "obscura_dynamic": true, and their descendants are dynamic: their
+ * meshes' `dynamic` is set and their primitives need no _AO (their
+ * `baked` is 1; obs_raster_baked_dynamic values them).  *marked (may be
+ * NULL) gets the number of nodes marked (descendants not counted).
+ * Fails with OBS_INVALID_ARGUMENT, listing the nodes' names, when the
+ * pattern matches no node; else as obs_scene_load_baked for the static
+ * meshes. */
+obs_status obs_scene_load_baked_dynamic(const char *path, const char *dynamic_nodes,
+                                        obs_scene *out, size_t *marked, char err[OBS_ERR_LEN]);
 
 /* 1 when path is a .glb some of whose primitives have an _AO attribute
  * (a level baked by obscura bake), else 0. */
@@ -123,6 +138,28 @@ void obs_raster_free(obs_raster *r);
  * frees with obs_image_free(). */
 obs_status obs_raster_baked(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
                             int width, int height, obs_image *out, char err[OBS_ERR_LEN]);
+
+/* Checks that the scene's static meshes (those not `dynamic`) are the
+ * level the region model was baked from (obscura bake-dynamic; the
+ * model's `level`): the same triangle count and box (within 1e-4 of its
+ * diagonal).  OBS_INVALID_ARGUMENT, naming both, when not.  A model
+ * without a level (m->level.triangles 0) cannot be checked: the caller
+ * decides. */
+obs_status obs_scene_check_dynamic_level(const obs_scene *s, const obs_dyn_model *m,
+                                         char err[OBS_ERR_LEN]);
+
+/* obs_raster_baked for a scene with dynamic meshes
+ * (obs_scene_load_baked_dynamic): the static meshes' pixels as there, a
+ * dynamic mesh's pixels the region model m evaluated (obs_dyn_eval,
+ * quadratic SH when `quadratic`, else linear) at the pixel's world
+ * position and normal from g, the G-buffer obs_raster_gbuffer made of
+ * the same scene and camera: _AO the blend, _AO_SHORT, _AO_LONG.
+ * *dynamic_pixels (may be NULL) gets their count.  Caller frees out
+ * with obs_image_free(). */
+obs_status obs_raster_baked_dynamic(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
+                                    int width, int height, const obs_raster *g,
+                                    const obs_dyn_model *m, int quadratic, obs_image *out,
+                                    size_t *dynamic_pixels, char err[OBS_ERR_LEN]);
 
 struct obs_deep_image; /* deep.h */
 

@@ -173,16 +173,22 @@ def run_sh(script, env, cwd):
     return r.returncode == 0
 
 
-def unsharded(tmp):
-    out = os.path.join(tmp, "whole.glb")
-    subprocess.run([obscura, "bake", level, "-o", out, "--rays", RAYS, "-q"], check=True, timeout=300)
+def unsharded(tmp, cmd="bake", ext=".glb"):
+    out = os.path.join(tmp, "whole" + ext)
+    subprocess.run([obscura, cmd, level, "-o", out, "--rays", RAYS, "-q"], check=True, timeout=300)
     return open(out, "rb").read()
 
 
-bake_jobs = {d["metadata"]["name"]: d for f, d in docs["Job"] if f == "bake-job.yaml"}
-sj, mj = bake_jobs.get("obscura-bake-shards"), bake_jobs.get("obscura-bake-merge")
-check("bake-job: a shard Job and a merge Job", sj is not None and mj is not None)
-if sj and mj:
+def check_bake_job(fname, cmd, prefix, suffix, ext):
+    """A shard Job and a merge Job of `obscura CMD` in kubernetes/FNAME;
+    with OBSCURA and the level, their commands run here, merged =
+    unsharded (the merge writes <level>SUFFIX)."""
+    tag = os.path.splitext(fname)[0]
+    jobs = {d["metadata"]["name"]: d for f, d in docs["Job"] if f == fname}
+    sj, mj = jobs.get(prefix + "-shards"), jobs.get(prefix + "-merge")
+    check(f"{tag}: a shard Job and a merge Job", sj is not None and mj is not None)
+    if not (sj and mj):
+        return
     ss = sj["spec"]
     sc = get(ss, "template", "spec", "containers", 0)
     senv = {e["name"]: e["value"] for e in sc.get("env", [])}
@@ -190,19 +196,19 @@ if sj and mj:
     menv = {e["name"]: e["value"] for e in mc.get("env", [])}
     winit = get(mj, "spec", "template", "spec", "initContainers", 0)
     wenv = {e["name"]: e["value"] for e in winit.get("env", [])}
-    check("bake-job: shards Indexed, restartPolicy Never, completions = SHARDS of every container",
+    check(f"{tag}: shards Indexed, restartPolicy Never, completions = SHARDS of every container",
           ss.get("completionMode") == "Indexed" and get(ss, "template", "spec", "restartPolicy") == "Never" and
           str(ss.get("completions")) == senv.get("SHARDS") == menv.get("SHARDS") == wenv.get("SHARDS"))
     sscript = " ".join(sc.get("args", []))
-    check("bake-job: shard i traces --shard $JOB_COMPLETION_INDEX/$SHARDS",
-          '--shard "$JOB_COMPLETION_INDEX/$SHARDS"' in sscript)
-    check("bake-job: the merge waits for the parts, with a deadline, and merges them",
+    check(f"{tag}: shard i runs obscura {cmd} --shard $JOB_COMPLETION_INDEX/$SHARDS",
+          f"obscura {cmd} " in sscript and '--shard "$JOB_COMPLETION_INDEX/$SHARDS"' in sscript)
+    check(f"{tag}: the merge waits for the parts, with a deadline, and merges them",
           "--merge" in " ".join(mc.get("args", [])) and "part_" in " ".join(winit.get("args", [])) and
           (get(mj, "spec", "activeDeadlineSeconds") or 0) > 0)
     codes = [v for r in get(ss, "podFailurePolicy", "rules", default=[]) if r.get("action") == "FailJob"
              for v in get(r, "onExitCodes", "values", default=[])]
-    check("bake-job: exit 3 (bad input) fails the shard Job at once", 3 in codes)
-    check("bake-job: same level for shards and merge, same claim",
+    check(f"{tag}: exit 3 (bad input) fails the shard Job at once", 3 in codes)
+    check(f"{tag}: same level for shards and merge, same claim",
           senv.get("LEVEL") == menv.get("LEVEL") and
           get(ss, "template", "spec", "volumes", 0, "persistentVolumeClaim", "claimName") ==
           get(mj, "spec", "template", "spec", "volumes", 0, "persistentVolumeClaim", "claimName"))
@@ -218,10 +224,14 @@ if sj and mj:
             w.write(fix(" ".join(winit.get("args", []))))
         ok = ok and run_sh("timeout 20 sh wait.sh", env, tmp)  # the parts are all there
         ok = ok and run_sh(fix(" ".join(mc.get("args", []))), env, tmp)
-        out = os.path.join(tmp, os.path.splitext(name)[0] + "_baked.glb")
-        check(f"bake-job: its commands run here ({n} shards of {name}, {RAYS} rays), merged = unsharded",
-              ok and os.path.exists(out) and open(out, "rb").read() == unsharded(tmp))
+        out = os.path.join(tmp, os.path.splitext(name)[0] + suffix)
+        check(f"{tag}: its commands run here ({n} shards of {name}, {RAYS} rays), merged = unsharded",
+              ok and os.path.exists(out) and open(out, "rb").read() == unsharded(tmp, cmd, ext))
         shutil.rmtree(tmp)
+
+
+check_bake_job("bake-job.yaml", "bake", "obscura-bake", "_baked.glb", ".glb")
+check_bake_job("bake-dynamic-job.yaml", "bake-dynamic", "obscura-bake-dynamic", "_dynamic.json", ".json")
 
 try:
     t = yaml.safe_load(open(os.path.join(farm, "openjd_bake.yaml")))

@@ -4,7 +4,8 @@
 # packages cover every library obscurad and obscura link; hadolint when
 # installed), the Kubernetes manifests and farm job templates
 # (tests/deploy/check_manifests.py, PyYAML; the bake templates' commands
-# run on the fixture level, merged = unsharded), and the plain farm script
+# and bake-dynamic templates' commands run on the fixture level, merged =
+# unsharded), and the plain farm script
 # (runs a chunk in-process).  There is no container engine here: the
 # image itself is not built.
 #

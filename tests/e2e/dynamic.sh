@@ -3,8 +3,11 @@
 # tests/data with built regions and with a regions file, the model file
 # read back by an independent reader of its documented format
 # (tests/e2e/lib/dyn_eval.py) against `--eval`, the same bytes for 1 and 2
-# threads, the report's measures, clear errors for bad regions files and
-# usage.
+# threads, the report's measures, the bake over shards (--shard I/N,
+# --merge: merged = unsharded byte for byte, bad parts refused), `obscura
+# gbuffer --dynamic` (a dynamic object in the baked level valued from the
+# model per pixel, checked by the independent reader; the static pixels
+# unchanged), clear errors for bad regions files, models and usage.
 #
 #   OBSCURA=build/obscura tests/e2e/dynamic.sh
 set -u
@@ -67,6 +70,133 @@ check "linear and quadratic SH differ" "! cmp -s $T/lin $T/quad"
 expect 0 "1 thread" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/t1.json" $FAST --threads 1
 expect 0 "2 threads" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/t2.json" $FAST --threads 2
 check "the same bytes whatever the thread count" "cmp -s $T/t1.json $T/t2.json"
+echo "-- shards: --shard I/N then --merge"
+for n in 1 3 4; do
+    i=0; ok_shards=1
+    while [ $i -lt $n ]; do
+        "$OBSCURA" bake-dynamic "$FIX" --shard $i/$n -o "$T/dpart$n.$i.bin" $FAST --threads 2 2>"$T/err" || ok_shards=0
+        i=$((i + 1))
+    done
+    check "$n shard(s) traced" "[ $ok_shards = 1 ]"
+    # given backwards: the merge takes any order; the parts' rays (64) taken
+    expect 0 "merge of $n shard(s)" -- "$OBSCURA" bake-dynamic "$FIX" --merge $(ls -r "$T"/dpart$n.*.bin) \
+        -o "$T/dmerged$n.json" --max-regions 24 --report "$T/dmerged$n.r.json" -q
+    check "merged of $n = unsharded, byte for byte" "cmp -s $T/t1.json $T/dmerged$n.json"
+    check "merged of $n: the parts' rays (64) and counts in the report" \
+        "python3 -c \"import json; a=json.load(open('$T/dmerged$n.r.json')); b=json.load(open('$T/r.json')); assert a['params']['rays'] == 64 and a['counts']['points_valid'] == b['counts']['points_valid'] and a['counts']['rays'] == b['counts']['rays'], (a['counts'], b['counts'])\""
+done
+check "parts: 128-byte header, 145 bytes a point, every point once" \
+    "python3 -c \"import os,struct,glob; fs=sorted(glob.glob('$T/dpart3.*.bin')); h=[open(f,'rb').read(128) for f in fs]; n=[struct.unpack_from('<Q',x,48)[0] for x in h]; assert all(x[:8]==b'OBSDYNPT' for x in h) and all(os.path.getsize(f)==128+145*k for f,k in zip(fs,n)) and sum(n)==struct.unpack_from('<Q',h[0],32)[0], n\""
+expect 3 "a missing shard" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/dpart4.0.bin" "$T/dpart4.1.bin" "$T/dpart4.3.bin" -o "$T/x.json" -q
+said "1 of 4 shards missing (2)"
+expect 3 "a shard twice" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/dpart3.0.bin" "$T/dpart3.1.bin" "$T/dpart3.1.bin" -o "$T/x.json" -q
+said "shard 1/3 given twice"
+expect 3 "shards of two splits" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/dpart3.0.bin" "$T/dpart4.1.bin" "$T/dpart3.2.bin" -o "$T/x.json" -q
+said "different splits"
+head -c 1000 "$T/dpart3.1.bin" >"$T/dcut.bin"
+expect 3 "a truncated part" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/dpart3.0.bin" "$T/dcut.bin" "$T/dpart3.2.bin" -o "$T/x.json" -q
+said "truncated: 1000 bytes"
+"$OBSCURA" bake-dynamic "$FIX" --shard 1/3 -o "$T/drays.bin" --rays 32 --max-regions 24 -q
+expect 3 "parts traced with other rays" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/dpart3.0.bin" "$T/drays.bin" "$T/dpart3.2.bin" -o "$T/x.json" -q
+said "different rays (64 and 32)"
+expect 3 "a merge asking for other rays" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T"/dpart1.0.bin -o "$T/x.json" --rays 8 -q
+said "traced with rays 64; this merge asks for 8"
+echo '{"regions": [{"min": [0, 0, 0], "max": [1, 1, 1]}]}' >"$T/one.json"
+expect 3 "a merge over other regions" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T"/dpart1.0.bin -o "$T/x.json" --regions "$T/one.json" -q
+said "give the merge the shards' --regions"
+cat >"$T/box.obj" <<'OBJ'
+v -2 0 -2
+v 2 0 -2
+v 2 0 2
+v -2 0 2
+v -2 2 -2
+v 2 2 -2
+f 1 3 2
+f 1 4 3
+f 1 2 6
+f 1 6 5
+OBJ
+expect 0 "a shard of another level" -- "$OBSCURA" bake-dynamic "$T/box.obj" --shard 0/1 -o "$T/dbox.bin" --rays 16 --max-regions 2 -q
+expect 3 "a part of another level" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/dbox.bin" -o "$T/x.json" -q
+said "traced from another level"
+expect 0 "a part of obscura bake" -- "$OBSCURA" bake "$T/box.obj" --shard 0/1 -o "$T/sbox.bin" --rays 4 -q
+expect 3 "... is not a bake-dynamic part" -- "$OBSCURA" bake-dynamic "$T/box.obj" --merge "$T/sbox.bin" -o "$T/x.json" -q
+said "not a bake-dynamic part"
+expect 3 "a model is not a part" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/t1.json" -o "$T/x.json" -q
+said "no 'OBSDYNPT' magic"
+expect 2 "--shard 4/4" -- "$OBSCURA" bake-dynamic "$FIX" --shard 4/4 -o "$T/x.bin"
+said "0 <= I < N"
+expect 2 "--merge without parts" -- "$OBSCURA" bake-dynamic "$FIX" --merge -o "$T/x.json"
+said "needs the part files"
+expect 2 "--shard and --merge" -- "$OBSCURA" bake-dynamic "$FIX" --shard 0/2 --merge "$T/dpart1.0.bin" -o "$T/x.json"
+said "not both"
+check "no part left behind by the refused runs" "[ ! -e $T/x.bin ] && [ ! -e $T/x.json ]"
+
+echo "-- gbuffer --dynamic: a dynamic object in the baked level"
+expect 0 "bake the fixture's vertices" -- "$OBSCURA" bake "$FIX" -o "$T/a.glb" --rays 16 -q
+# a cube of 3 m inside region 0 of the model (the aalborg cut's first box)
+at=$(python3 -c "
+import json; r=json.load(open('$T/t1.json'))['regions'][0]
+print(','.join(repr(r['min'][a] + (r['max'][a] - r['min'][a]) * f) for a, f in zip(range(3), (0.5, 0.35, 0.5))))")
+python3 tests/e2e/lib/glb_dynamic.py "$T/a.glb" "$T/dyn.glb" "$T/dcam.json" dyn_cube "$at" 3
+python3 tests/e2e/lib/glb_dynamic.py "$T/a.glb" "$T/dynx.glb" "$T/dcam.json" crate "$at" 3 extras
+expect 0 "gbuffer of the level alone" -- "$OBSCURA" gbuffer "$T/a.glb" --camera "$T/dcam.json" -o "$T/g0.exr" -q
+expect 0 "gbuffer with the cube, --dynamic-nodes 'dyn_*'" -- "$OBSCURA" gbuffer "$T/dyn.glb" \
+    --camera "$T/dcam.json" -o "$T/g1.exr" --dynamic "$T/t1.json" --dynamic-nodes 'dyn_*'
+said "pixels of dynamic objects valued from the region model"
+expect 0 "the cube's pixels = the model at their P and N (quadratic), the rest unchanged" -- \
+    python3 tests/e2e/lib/dyn_gbuffer_check.py "$T/g0.exr" "$T/g1.exr" "$T/t1.json" quadratic
+sed 's/^/       /' "$T/out"
+expect 1 "... which the linear SH does not give" -- \
+    python3 tests/e2e/lib/dyn_gbuffer_check.py "$T/g0.exr" "$T/g1.exr" "$T/t1.json" linear
+expect 0 "--dynamic-sh linear" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/g1l.exr" --dynamic "$T/t1.json" --dynamic-nodes 'dyn_*' --dynamic-sh linear -q
+expect 0 "--dynamic-sh linear: the model's linear SH" -- \
+    python3 tests/e2e/lib/dyn_gbuffer_check.py "$T/g0.exr" "$T/g1l.exr" "$T/t1.json" linear
+expect 0 "marked by its extras (\"obscura_dynamic\": true)" -- "$OBSCURA" gbuffer "$T/dynx.glb" \
+    --camera "$T/dcam.json" -o "$T/gx.exr" --dynamic "$T/t1.json" -q
+expect 0 "... the same check" -- \
+    python3 tests/e2e/lib/dyn_gbuffer_check.py "$T/g0.exr" "$T/gx.exr" "$T/t1.json" quadratic
+expect 3 "the cube unmarked" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" -o "$T/x.exr" \
+    --dynamic "$T/t1.json" -q
+said "node 'dyn_cube') primitive 0 has no _AO attribute and is not marked dynamic"
+expect 3 "--dynamic on a level without dynamic objects" -- "$OBSCURA" gbuffer "$T/a.glb" \
+    --camera "$T/dcam.json" -o "$T/x.exr" --dynamic "$T/t1.json" -q
+said "no node is marked dynamic"
+expect 3 "a pattern matching no node" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic "$T/t1.json" --dynamic-nodes 'car*' -q
+said "no node's name matches 'car\*'"
+expect 3 "a missing model" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" -o "$T/x.exr" \
+    --dynamic "$T/none.json" --dynamic-nodes 'dyn_*' -q
+said "none.json"
+expect 0 "a model of another level" -- "$OBSCURA" bake-dynamic "$T/box.obj" -o "$T/boxm.json" --rays 16 --max-regions 2 -q
+expect 3 "... refused" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" -o "$T/x.exr" \
+    --dynamic "$T/boxm.json" --dynamic-nodes 'dyn_*' -q
+said "baked from another level (4 triangles"
+static_node=$(python3 -c "
+import json,struct; d=open('$T/a.glb','rb').read(); j=json.loads(d[20:20+struct.unpack_from('<I',d,12)[0]])
+print(next(n['name'] for n in j['nodes'] if 'mesh' in n))")
+expect 3 "a static node marked dynamic" -- "$OBSCURA" gbuffer "$T/dynx.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic "$T/t1.json" --dynamic-nodes "$static_node" -q
+said "the scene's static nodes have"
+python3 -c "
+import json; d=json.load(open('$T/t1.json')); d.pop('level'); json.dump(d, open('$T/nolevel.json', 'w'))"
+expect 0 "a model without its level: a warning" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/gn.exr" --dynamic "$T/nolevel.json" --dynamic-nodes 'dyn_*' -q
+said "records no level"
+check "... and the same channels" "python3 tests/e2e/lib/dyn_gbuffer_check.py $T/g0.exr $T/gn.exr $T/t1.json quadratic >/dev/null"
+expect 3 "a damaged model" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" -o "$T/x.exr" \
+    --dynamic "$T/one.json" --dynamic-nodes 'dyn_*' -q
+said "not an obscura-dynamic-ao model"
+expect 2 "--dynamic-nodes without --dynamic" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic-nodes 'dyn_*'
+said "needs --dynamic MODEL.json"
+expect 2 "--dynamic with --deep" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic "$T/t1.json" --deep
+expect 2 "--dynamic-sh cubic" -- "$OBSCURA" gbuffer "$T/dyn.glb" --camera "$T/dcam.json" \
+    -o "$T/x.exr" --dynamic "$T/t1.json" --dynamic-sh cubic
+check "no G-buffer written by the refused runs" "[ ! -e $T/x.exr ]"
+
 expect 0 "beta 0" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/b0.json" $FAST --beta 0 --report "$T/b0r.json"
 check "beta 0: the jumps stay as fitted" \
     "python3 -c \"import json; j=json.load(open('$T/b0r.json'))['boundary_jump']; assert j['mean'][1] == j['mean'][0], j\""

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """An engine's reader of obscura's dynamic-object model (README, "Dynamic
-model file"), written from the documentation alone: the region holding
+"), written from the documentation alone: the region holding
 the point (else the nearest, the point clamped into it), eq 4 there, the
-SH for the normal.  Prints the blended AO.
+SH for the normal.  Prints the blended AO; evaluate() for other scripts.
 
     dyn_eval.py MODEL.json X,Y,Z NX,NY,NZ linear|quadratic
 """
@@ -18,11 +18,10 @@ def sh9(x, y, z):
             0.5462742152960396 * (x * x - y * y)]
 
 
-def main():
-    d = json.load(open(sys.argv[1]))
-    p = [float(v) for v in sys.argv[2].split(",")]
-    n = [float(v) for v in sys.argv[3].split(",")]
-    k = 4 if sys.argv[4] == "linear" else 9
+def evaluate(d, p, n, order):
+    """(short, long, blended) AO of model d at point p for the normal n,
+    order "linear" or "quadratic"."""
+    k = 4 if order == "linear" else 9
     regs = d["regions"]
     hit = next((r for r in regs if r["model"] >= 0 and
                 all(r["min"][a] <= p[a] <= r["max"][a] for a in range(3))), None)
@@ -43,7 +42,15 @@ def main():
     y = sh9(*[v / ln for v in n])
     ao = [min(max(sum(ch[9 * j + i] * y[i] for i in range(k)), 0.0), 1.0) for j in range(2)]
     b = d["blend"]
-    print("%.6f" % min(max(b * ao[0] + (1 - b) * ao[1], 0.0), 1.0))
+    return ao[0], ao[1], min(max(b * ao[0] + (1 - b) * ao[1], 0.0), 1.0)
 
 
-main()
+def main():
+    d = json.load(open(sys.argv[1]))
+    p = [float(v) for v in sys.argv[2].split(",")]
+    n = [float(v) for v in sys.argv[3].split(",")]
+    print("%.6f" % evaluate(d, p, n, sys.argv[4])[2])
+
+
+if __name__ == "__main__":
+    main()

@@ -3,6 +3,7 @@
 #define OBS_BAKE_TESTUTIL_H
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "obscura/bake.h"
@@ -85,6 +86,20 @@ static inline void bt_set(obs_bake_params *p, const char *name, const char *valu
 {
     char err[OBS_ERR_LEN];
     assert_int_equal(obs_bake_param_set(p, name, value, err), OBS_OK);
+}
+
+/* A copy of file `from` in `to`: its first `keep` bytes (< 0: all), byte
+ * `flip` (< 0: none) with a bit flipped: truncated and damaged parts. */
+static inline void bt_copy_cut(const char *from, const char *to, long keep, long flip)
+{
+    FILE *f = fopen(from, "rb"), *g = fopen(to, "wb");
+    assert_non_null(f);
+    assert_non_null(g);
+    int ch;
+    for (long k = 0; (ch = fgetc(f)) != EOF && (keep < 0 || k < keep); k++)
+        fputc(k == flip ? ch ^ 0x40 : ch, g);
+    fclose(f);
+    fclose(g);
 }
 
 #endif

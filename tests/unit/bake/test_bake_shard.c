@@ -131,18 +131,6 @@ static void expect_refused(const obs_bake_scene *sc, const char *const *paths, s
     assert_int_equal(r.instance_count, 0);
 }
 
-static void copy_cut(const char *from, const char *to, long keep, long flip)
-{
-    FILE *f = fopen(from, "rb"), *g = fopen(to, "wb");
-    assert_non_null(f);
-    assert_non_null(g);
-    int ch;
-    for (long k = 0; (ch = fgetc(f)) != EOF && (keep < 0 || k < keep); k++)
-        fputc(k == flip ? ch ^ 0x40 : ch, g);
-    fclose(f);
-    fclose(g);
-}
-
 static void test_bad_parts(void **state)
 {
     (void)state;
@@ -161,8 +149,8 @@ static void test_bad_parts(void **state)
     path_of(p[7], sizeof p[7], "cut", 1);
     path_of(p[8], sizeof p[8], "flip", 1);
     path_of(p[9], sizeof p[9], "none", 0);
-    copy_cut(p[1], p[7], 200, -1);
-    copy_cut(p[1], p[8], -1, 140);
+    bt_copy_cut(p[1], p[7], 200, -1);
+    bt_copy_cut(p[1], p[8], -1, 140);
     const char *ok[] = {p[0], p[1], p[2]};
     obs_bake_result r;
     char err[OBS_ERR_LEN];

@@ -1,0 +1,296 @@
+/* bake-dynamic spread over many machines (obscura bake-dynamic --shard
+ * I/N, --merge).  The expensive step is the spherical obscurance of the
+ * regions' valid points (probes.c); every shard builds the same regions
+ * and flags the same grid points (cheap: 32 rays a point), then traces
+ * its contiguous range [i n / count, (i + 1) n / count) of the n valid
+ * points, each with the directions of the unsharded bake (keyed by the
+ * seed and the point's grid index alone), and writes them as a part.
+ * The merge flags the points again, reads every part into them, and fits:
+ * the merged model is the unsharded one, byte for byte.  The part file
+ * follows the bake's parts (shard.c) and uses its pieces (shard.h).
+ *
+ * A part file, every field little-endian:
+ *
+ *   offset size  field
+ *     0     8    magic "OBSDYNPT"
+ *     8     4    u32 version (1)
+ *    12     4    u32 header size in bytes (128)
+ *    16     8    u64 level fingerprint (shard.c's, of the flattened level)
+ *    24     4    u32 shard index I (0 .. N-1)
+ *    28     4    u32 shard count N
+ *    32     8    u64 valid points of the whole level (before the back-face
+ *                rule of the full ray set)
+ *    40     8    u64 first point of this shard
+ *    48     8    u64 points of this shard (n)
+ *    56     8    u64 fingerprint of the regions (boxes) and the valid
+ *                points (their grid indices)
+ *    64     4    i32 rays           68  4  i32 seed
+ *    72     4    i32 grid           76  4  i32 max_regions
+ *    80     4    f32 distance_short 84  4  f32 distance_long
+ *    88     4    f32 backface_limit 92  4  f32 min_region_size
+ *    96     4    u32 regions        100 4  u32 reserved (0)
+ *   104     8    f64 seconds before the trace (flatten, BVH, regions,
+ *                valid points: every shard spends them)
+ *   112     8    f64 seconds of the trace
+ *   120     8    u64 FNV-1a 64 of the payload
+ *   128  144 n   payload: per point its 18 channels (dynamic.h), f64
+ *   128+144n n   per point u8: 1 dropped by the back-face rule, else 0
+ *
+ * The file is exactly 128 + 145 n bytes.  The parameters in the header
+ * decide the points and their values (grid, max_regions and
+ * min_region_size the regions and points; rays, seed, the distances and
+ * the back-face limit the channels); the merge takes those it is not
+ * given from the parts and refuses parts that disagree with it or each
+ * other (dyn_shard_run.c). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake/dyn_internal.h"
+#include "bake/shard.h"
+#include "internal.h"
+
+#define MAGIC "OBSDYNPT"
+#define VERSION 1u
+#define HEADER 128u
+#define POINT_BYTES (8u * OBS_DYN_CHANNELS)
+
+static double now(void) { return obs__now_ms() * 1e-3; }
+
+obs_dyn_level obs__dyn_level_of(const obs__bake_world *w)
+{
+    obs_dyn_level l = {.fingerprint = obs__bake_level_fingerprint(w),
+                       .triangles = w->triangle_count};
+    for (int a = 0; a < 3; a++)
+        l.lo[a] = INFINITY, l.hi[a] = -INFINITY;
+    for (size_t i = 0; i < w->vertex_count; i++)
+        for (int a = 0; a < 3; a++) {
+            l.lo[a] = fminf(l.lo[a], w->pos[3 * i + a]);
+            l.hi[a] = fmaxf(l.hi[a], w->pos[3 * i + a]);
+        }
+    return l;
+}
+
+uint64_t obs__dyn_points_fingerprint(const obs_dyn_regions *rg, const obs__dyn_points *pt)
+{
+    unsigned char b[8];
+    uint64_t h = obs__bake_fnv(OBS__BAKE_FNV_OFFSET, "obscura dyn points 1", 20);
+    obs__le_put64(b, rg->count);
+    h = obs__bake_fnv(h, b, 8);
+    for (size_t r = 0; r < rg->count; r++)
+        for (int a = 0; a < 6; a++) {
+            obs__le_put32(b, obs__le_fbits(a < 3 ? rg->box[r].lo[a] : rg->box[r].hi[a - 3]));
+            h = obs__bake_fnv(h, b, 4);
+        }
+    obs__le_put64(b, pt->count);
+    h = obs__bake_fnv(h, b, 8);
+    for (size_t i = 0; i < pt->count; i++) {
+        obs__le_put64(b, pt->id[i]);
+        h = obs__bake_fnv(h, b, 8);
+    }
+    return h;
+}
+
+/* ---- writing a part ------------------------------------------------------ */
+
+static void header_bytes(const obs__dyn_part *h, unsigned char b[HEADER])
+{
+    memset(b, 0, HEADER);
+    memcpy(b, MAGIC, 8);
+    obs__le_put32(b + 8, VERSION);
+    obs__le_put32(b + 12, HEADER);
+    obs__le_put64(b + 16, h->level);
+    obs__le_put32(b + 24, h->index);
+    obs__le_put32(b + 28, h->count);
+    obs__le_put64(b + 32, h->total);
+    obs__le_put64(b + 40, h->first);
+    obs__le_put64(b + 48, h->n);
+    obs__le_put64(b + 56, h->points);
+    obs__le_put32(b + 64, (uint32_t)h->rays);
+    obs__le_put32(b + 68, (uint32_t)h->seed);
+    obs__le_put32(b + 72, (uint32_t)h->grid);
+    obs__le_put32(b + 76, (uint32_t)h->max_regions);
+    obs__le_put32(b + 80, obs__le_fbits(h->distance_short));
+    obs__le_put32(b + 84, obs__le_fbits(h->distance_long));
+    obs__le_put32(b + 88, obs__le_fbits(h->backface_limit));
+    obs__le_put32(b + 92, obs__le_fbits(h->min_region_size));
+    obs__le_put32(b + 96, h->regions);
+    obs__le_put64(b + 104, obs__le_dbits(h->prep_seconds));
+    obs__le_put64(b + 112, obs__le_dbits(h->trace_seconds));
+    obs__le_put64(b + 120, h->checksum);
+}
+
+static obs_status trace_shard(obs__dyn_shard *sh, const obs__bake_world *w,
+                              const obs_dyn_regions *rg, const obs_dyn_params *p,
+                              const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
+                              char err[OBS_ERR_LEN])
+{
+    obs__dyn_part h = {
+        .level = obs__bake_level_fingerprint(w),
+        .index = (uint32_t)sh->index,
+        .count = (uint32_t)sh->count,
+        .total = pt->count,
+        .first = obs__bake_shard_first(pt->count, sh->index, sh->count),
+        .points = obs__dyn_points_fingerprint(rg, pt),
+        .rays = p->rays,
+        .seed = p->seed,
+        .grid = p->grid,
+        .max_regions = p->max_regions,
+        .distance_short = p->distance_short,
+        .distance_long = p->distance_long,
+        .backface_limit = p->backface_limit,
+        .min_region_size = p->min_region_size,
+        .regions = (uint32_t)rg->count,
+    };
+    h.n = obs__bake_shard_first(pt->count, sh->index + 1, sh->count) - h.first;
+    for (int k = 0; k < OBS_DYN_STAGE_trace; k++)
+        h.prep_seconds += st->seconds[k];
+    double t = now();
+    pt->rays = 0;
+    obs__dyn_points_trace(bvh, p, pt, (size_t)h.first, (size_t)(h.first + h.n), sh->progress,
+                          sh->progress_user);
+    h.trace_seconds = now() - t;
+    size_t n = (size_t)h.n, first = (size_t)h.first, dropped = 0;
+    unsigned char *payload = malloc(n * (POINT_BYTES + 1) + 1);
+    if (!payload)
+        return obs__fail(err, OBS_NO_MEMORY, "the part of %zu points", n);
+    for (size_t i = 0; i < n; i++) {
+        const double *c = pt->sh + (size_t)OBS_DYN_CHANNELS * (first + i);
+        for (int k = 0; k < OBS_DYN_CHANNELS; k++)
+            obs__le_put64(payload + POINT_BYTES * i + 8 * (size_t)k, obs__le_dbits(c[k]));
+        if (pt->dropped[first + i] == 2) {
+            free(payload);
+            return obs__fail(err, OBS_NO_MEMORY, "rays of one point");
+        }
+        payload[POINT_BYTES * n + i] = pt->dropped[first + i];
+        dropped += pt->dropped[first + i];
+    }
+    h.checksum = obs__bake_fnv(OBS__BAKE_FNV_OFFSET, payload, n * (POINT_BYTES + 1));
+    unsigned char head[HEADER];
+    header_bytes(&h, head);
+    obs_status rc = obs__bake_part_write(sh->path, head, HEADER, payload, n * (POINT_BYTES + 1), err);
+    free(payload);
+    st->seconds[OBS_DYN_STAGE_trace] = h.trace_seconds;
+    st->grid_points = pt->grid;
+    st->points_inside = pt->inside;
+    st->points_hidden = pt->hidden;
+    st->points_valid = n - dropped;
+    st->points_backface = dropped;
+    st->rays = pt->rays;
+    sh->stop = 1;
+    return rc;
+}
+
+/* ---- reading parts ------------------------------------------------------- */
+
+obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char err[OBS_ERR_LEN])
+{
+    memset(h, 0, sizeof *h);
+    h->path = path;
+    unsigned char b[HEADER];
+    uint64_t size;
+    obs_status rc = obs__bake_part_head(path, MAGIC, "bake-dynamic part",
+                                        "obscura bake-dynamic --shard I/N", b, HEADER, &size, err);
+    if (rc != OBS_OK)
+        return rc;
+    h->version = obs__le_get32(b + 8);
+    if (h->version != VERSION || obs__le_get32(b + 12) != HEADER)
+        return obs__fail(err, OBS_UNSUPPORTED, "%s: bake-dynamic part version %u (header %u "
+                         "bytes); this obscura reads version %u", path, h->version,
+                         obs__le_get32(b + 12), VERSION);
+    h->level = obs__le_get64(b + 16);
+    h->index = obs__le_get32(b + 24);
+    h->count = obs__le_get32(b + 28);
+    h->total = obs__le_get64(b + 32);
+    h->first = obs__le_get64(b + 40);
+    h->n = obs__le_get64(b + 48);
+    h->points = obs__le_get64(b + 56);
+    h->rays = (int32_t)obs__le_get32(b + 64);
+    h->seed = (int32_t)obs__le_get32(b + 68);
+    h->grid = (int32_t)obs__le_get32(b + 72);
+    h->max_regions = (int32_t)obs__le_get32(b + 76);
+    h->distance_short = obs__le_bitsf(obs__le_get32(b + 80));
+    h->distance_long = obs__le_bitsf(obs__le_get32(b + 84));
+    h->backface_limit = obs__le_bitsf(obs__le_get32(b + 88));
+    h->min_region_size = obs__le_bitsf(obs__le_get32(b + 92));
+    h->regions = obs__le_get32(b + 96);
+    h->prep_seconds = obs__le_bitsd(obs__le_get64(b + 104));
+    h->trace_seconds = obs__le_bitsd(obs__le_get64(b + 112));
+    h->checksum = obs__le_get64(b + 120);
+    /* total at most 2^40: a size the payload's bytes cannot overflow */
+    if (h->count == 0 || h->index >= h->count || h->count > (uint32_t)INT32_MAX ||
+        h->total > ((uint64_t)1 << 40) ||
+        h->first != obs__bake_shard_first((size_t)h->total, (int)h->index, (int)h->count) ||
+        h->first + h->n != obs__bake_shard_first((size_t)h->total, (int)h->index + 1, (int)h->count))
+        return obs__fail(err, OBS_BAD_FILE, "%s: damaged header: shard %u/%u of %llu points "
+                         "cannot hold points %llu .. %llu", path, h->index, h->count,
+                         (unsigned long long)h->total, (unsigned long long)h->first,
+                         (unsigned long long)(h->first + h->n));
+    uint64_t want = HEADER + (POINT_BYTES + 1) * h->n;
+    if (size != UINT64_MAX && size != want)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %llu bytes, its header promises %llu (%llu "
+                         "points)", path, size < want ? "truncated" : "longer than a part",
+                         (unsigned long long)size, (unsigned long long)want,
+                         (unsigned long long)h->n);
+    return OBS_OK;
+}
+
+static obs_status read_payload(const obs__dyn_part *h, obs__dyn_points *pt, char err[OBS_ERR_LEN])
+{
+    size_t n = (size_t)h->n, first = (size_t)h->first;
+    unsigned char *p;
+    obs_status rc = obs__bake_part_payload(h->path, HEADER, n * (POINT_BYTES + 1), h->checksum, &p, err);
+    if (rc != OBS_OK)
+        return rc;
+    for (size_t i = 0; rc == OBS_OK && i < n; i++) {
+        double *c = pt->sh + (size_t)OBS_DYN_CHANNELS * (first + i);
+        for (int k = 0; k < OBS_DYN_CHANNELS; k++)
+            c[k] = obs__le_bitsd(obs__le_get64(p + POINT_BYTES * i + 8 * (size_t)k));
+        pt->dropped[first + i] = p[POINT_BYTES * n + i];
+        if (p[POINT_BYTES * n + i] > 1)
+            rc = obs__fail(err, OBS_BAD_FILE, "%s: damaged: point %zu's back-face flag is %u",
+                           h->path, first + i, p[POINT_BYTES * n + i]);
+    }
+    free(p);
+    return rc;
+}
+
+static obs_status read_shards(obs__dyn_shard *sh, const obs__bake_world *w,
+                              const obs_dyn_regions *rg, obs__dyn_points *pt, obs_dyn_stats *st,
+                              char err[OBS_ERR_LEN])
+{
+    const obs__dyn_part *p0 = &sh->parts[0];
+    uint64_t level = obs__bake_level_fingerprint(w);
+    if (p0->level != level)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s was traced from another level (or "
+                         "another version of it): fingerprint %016llx, this level's %016llx",
+                         p0->path, (unsigned long long)p0->level, (unsigned long long)level);
+    if (p0->regions != rg->count || p0->total != pt->count ||
+        p0->points != obs__dyn_points_fingerprint(rg, pt))
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: the parts split %llu valid points of %u "
+                         "regions; this level, these regions and parameters make %zu of %zu "
+                         "(or other ones): give the merge the shards' --regions", p0->path,
+                         (unsigned long long)p0->total, p0->regions, pt->count, rg->count);
+    double t = now();
+    pt->rays = 0;
+    for (int i = 0; i < sh->count; i++) {
+        obs_status rc = read_payload(&sh->parts[i], pt, err);
+        if (rc != OBS_OK)
+            return rc;
+        pt->rays += sh->parts[i].n * (uint64_t)sh->parts[i].rays;
+        /* the parts' times, summed: the farm's machine time */
+        st->seconds[OBS_DYN_STAGE_trace] += sh->parts[i].trace_seconds;
+    }
+    st->seconds[OBS_DYN_STAGE_trace] += now() - t;
+    return OBS_OK;
+}
+
+obs_status obs__dyn_shard_step(obs__dyn_shard *sh, const obs__bake_world *w,
+                               const obs_dyn_regions *rg, const obs_dyn_params *p,
+                               const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
+                               char err[OBS_ERR_LEN])
+{
+    return sh->parts ? read_shards(sh, w, rg, pt, st, err)
+                     : trace_shard(sh, w, rg, p, bvh, pt, st, err);
+}

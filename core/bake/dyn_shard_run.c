@@ -1,0 +1,110 @@
+/* obs_dyn_bake_shard and obs_dyn_bake_merge (obscura/dynamic.h): the
+ * checks of a merge's parts against each other and its parameters, then
+ * dynamic.c's steps with dyn_shard.c's step in place of the trace. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake/dyn_internal.h"
+#include "bake/shard.h"
+#include "internal.h"
+
+obs_status obs_dyn_bake_shard(const obs_bake_scene *scene, const obs_dyn_desc *desc, int index,
+                              int count, const char *path, obs_dyn_stats *st,
+                              char err[OBS_ERR_LEN])
+{
+    if (st)
+        memset(st, 0, sizeof *st);
+    if (count < 1 || index < 0 || index >= count)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %d/%d: the index is 0 .. count-1 "
+                         "(count at least 1)", index, count);
+    if (!path || !*path)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %d/%d: no part file to write", index,
+                         count);
+    obs__dyn_shard sh = {.index = index, .count = count, .path = path,
+                         .progress = desc ? desc->progress : NULL,
+                         .progress_user = desc ? desc->progress_user : NULL};
+    obs_dyn_result r;
+    obs_status rc = obs__dyn_bake_run(scene, desc, &sh, &r, err);
+    if (st)
+        *st = r.stats;
+    obs_dyn_result_free(&r);
+    return rc;
+}
+
+/* The parameters a part carries: its row's name and its header field. */
+#define PART_PARAMS(X)                                                          \
+    X(rays, rays)                                                               \
+    X(seed, seed)                                                               \
+    X(grid, grid)                                                               \
+    X(max_regions, max_regions)                                                 \
+    X(distance_short, distance_short)                                           \
+    X(distance_long, distance_long)                                             \
+    X(backface_limit, backface_limit)                                           \
+    X(min_region_size, min_region_size)
+
+static int row_of(const char *name)
+{
+    const obs_bake_param_info *pi = obs_dyn_param_find(name);
+    return pi ? (int)(pi - obs_dyn_param_at(0)) : -1;
+}
+
+/* The merge's parameters: the parts' (all alike), unless given, when
+ * they must agree. */
+static obs_status adopt(obs_dyn_params *p, const obs__dyn_part *parts, size_t n,
+                        char err[OBS_ERR_LEN])
+{
+    const obs__dyn_part *a = &parts[0];
+    for (size_t i = 1; i < n; i++) {
+        const obs__dyn_part *b = &parts[i];
+#define SAME(name, field) OBS__PART_SAME(a, b, name, field)
+        PART_PARAMS(SAME)
+#undef SAME
+        if (a->points != b->points || a->total != b->total)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced over different "
+                             "regions or valid points (%llu and %llu points): they are not parts "
+                             "of one bake", a->path, b->path, (unsigned long long)a->total,
+                             (unsigned long long)b->total);
+    }
+#define TAKE(name, field) OBS__PART_TAKE(p, a, row_of(#name), name, field)
+    PART_PARAMS(TAKE)
+#undef TAKE
+    return OBS_OK;
+}
+
+obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
+                              const char *const *paths, size_t n, obs_dyn_result *out,
+                              char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    if (n == 0 || !paths)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "merge: no parts");
+    obs__dyn_part *heads = calloc(n, sizeof *heads), *ordered = NULL;
+    obs__bake_part_key *keys = calloc(n, sizeof *keys);
+    size_t *order = NULL;
+    obs_status rc = heads && keys ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
+    for (size_t i = 0; rc == OBS_OK && i < n; i++) {
+        rc = obs__dyn_part_read_header(paths[i], &heads[i], err);
+        keys[i] = (obs__bake_part_key){heads[i].path, heads[i].index, heads[i].count, heads[i].level};
+    }
+    if (rc == OBS_OK && (!(ordered = calloc(heads[0].count, sizeof *ordered)) ||
+                         !(order = calloc(heads[0].count, sizeof *order))))
+        rc = obs__fail(err, OBS_NO_MEMORY, "%u parts", heads[0].count);
+    if (rc == OBS_OK)
+        rc = obs__bake_parts_order(keys, n, order, err);
+    for (size_t k = 0; rc == OBS_OK && k < n; k++)
+        ordered[k] = heads[order[k]];
+    obs_dyn_desc d = desc ? *desc : (obs_dyn_desc){0};
+    if (rc == OBS_OK)
+        rc = adopt(&d.params, ordered, n, err);
+    if (rc == OBS_OK) {
+        obs__dyn_shard sh = {.index = 0, .count = (int)n, .parts = ordered};
+        rc = obs__dyn_bake_run(scene, &d, &sh, out, err);
+        if (desc)
+            desc->params = d.params;
+    }
+    free(order);
+    free(ordered);
+    free(keys);
+    free(heads);
+    return rc;
+}
