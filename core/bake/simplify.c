@@ -85,6 +85,26 @@ static obs_status weld(const obs_bake_mesh *m, float tolerance, float angle, wel
     return OBS_OK;
 }
 
+/* flatten.c's degenerate face: zero area, or a sliver whose normal
+ * float rounding decides. */
+static int flat(const float *pos, const uint32_t t[3])
+{
+    const float *p0 = pos + 3 * (size_t)t[0], *p1 = pos + 3 * (size_t)t[1],
+                *p2 = pos + 3 * (size_t)t[2];
+    double e1[3], e2[3], n[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = (double)p1[k] - p0[k];
+        e2[k] = (double)p2[k] - p0[k];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    double scale = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2] + e2[0] * e2[0] +
+                   e2[1] * e2[1] + e2[2] * e2[2];
+    return !(len > 1e-7 * scale);
+}
+
 obs_status obs__bake_simplify(const obs_bake_mesh *m, int level, float ratio, float error,
                               float weld_tolerance, float weld_angle, obs_bake_mesh *out,
                               char err[OBS_ERR_LEN])
@@ -119,7 +139,17 @@ obs_status obs__bake_simplify(const obs_bake_mesh *m, int level, float ratio, fl
     target = 3 * (target < 1 ? 1 : target);
     size_t nd = meshopt_simplify(dst, k.idx, k.ni, k.pos, k.wd.count, 3 * sizeof(float), target,
                                  (float)level * error, 0, NULL);
-    if (nd == 0) { /* cannot happen for a surface with area; kept whole */
+    /* Zero-area triangles the collapses left along straight borders are
+     * dropped (flatten.c's test: the bake would skip them anyway, and a
+     * vertex of only such triangles would have no sample). */
+    size_t keep = 0;
+    for (size_t i = 0; i < nd; i += 3)
+        if (!flat(k.pos, dst + i)) {
+            memmove(dst + keep, dst + i, 3 * sizeof *dst);
+            keep += 3;
+        }
+    nd = keep;
+    if (nd == 0) { /* only for a surface without area: kept whole */
         memcpy(dst, k.idx, k.ni * sizeof *dst);
         nd = k.ni;
     }

@@ -4,7 +4,8 @@
 # (tests/e2e/lib/glb_check.py) and read back through assimp (baked
 # again), `obscura gbuffer` of the .glb (the baked channels, against the
 # level's own G-buffer and the obscurance reference), `obscura ao` with
-# the baked channel (--baked, --baked-combine), the same bytes for 1 and 2 threads, the Khronos validator when
+# the baked channel (--baked, --baked-combine), the same bytes for 1 and 2 threads, --lods 2 (the LOD
+# nodes read back, the report's levels), the Khronos validator when
 # it is installed, clear errors for bad input and usage; a TORCS track of
 # ../shared/data when present.
 #
@@ -48,6 +49,39 @@ check "the same bytes whatever the thread count" "cmp -s $T/t1.glb $T/t2.glb"
 expect 0 "another seed" -- "$OBSCURA" bake "$FIX" -o "$T/s2.glb" --rays 16 --seed 2 -q
 check "another seed, other values" "! cmp -s $T/t1.glb $T/s2.glb"
 
+echo "-- LODs: --lods 2 (meshoptimizer's levels, the bake resampled onto them and fitted, MSFT_lod)"
+expect 0 "bake --lods 2 --lod-check 1" -- "$OBSCURA" bake "$FIX" -o "$T/lod.glb" --report "$T/lod.json" \
+    --rays 32 --lods 2 --lod-check 1
+said "LOD 2: "
+expect 0 "the same bake without LODs" -- "$OBSCURA" bake "$FIX" -o "$T/nolod.glb" --report "$T/nolod.json" --rays 32 -q
+check "the full detail is the bake without LODs (same residuals)" \
+    "[ \"\$(field $T/lod.json \"['residual_rms']\")\" = \"\$(field $T/nolod.json \"['residual_rms']\")\" ]"
+check "report: 2 levels, fewer triangles level by level, the lod stage timed" \
+    "field $T/lod.json \"['lods']['per_level'][1]['triangles']\" >/dev/null && python3 -c \"
+import json, sys; d = json.load(open('$T/lod.json')); l = d['lods']['per_level']
+sys.exit(not (d['lods']['levels'] == 2 and len(l) == 2 and 0 < l[1]['triangles'] < l[0]['triangles'] < d['counts']['triangles'] and d['seconds']['lod'] > 0 and l[1]['samples'] > 0))\""
+# against the bake made directly on the LOD geometry (traced there, fitted):
+# the resampled fit nearer than sampling at the LOD's vertices (aalborg
+# fixture, 32 rays: 0.031 / 0.036 at level 1, 0.040 / 0.051 at level 2)
+for k in 0 1; do
+    check "LOD $((k + 1)): fit nearer the direct LOD bake than vertex sampling (long)" "python3 -c \"
+import json, sys; r = json.load(open('$T/lod.json'))['lods']['per_level'][$k]['direct_bake_rms']
+sys.exit(not (r['least_squares']['long'] < r['vertex_sample']['long']))\""
+done
+expect 0 "the --lods .glb: each node's 2 LOD nodes with _AO, _AO_SHORT, _AO_LONG (glb_check --lods 2)" -- \
+    python3 tests/e2e/lib/glb_check.py "$T/lod.glb" 186 --lods 2
+expect 1 "... and glb_check tells a .glb without them" -- python3 tests/e2e/lib/glb_check.py "$T/nolod.glb" 62 --lods 2
+expect 0 "the --lods .glb read back through assimp (LOD nodes outside the scene)" -- "$OBSCURA" bake \
+    "$T/lod.glb" -o "$T/lod_b.glb" --report "$T/lod_b.json" --rays 8 -q
+check "read back: 811 triangles, 62 instances" \
+    "[ \"\$(field $T/lod_b.json \"['counts']['triangles']\")\" = 811 ] && [ \"\$(field $T/lod_b.json \"['counts']['instances']\")\" = 62 ]"
+expect 2 "--lods with a .ply output" -- "$OBSCURA" bake "$FIX" -o "$T/x.ply" --lods 1
+said "a .ply has no LODs"
+expect 2 "--lods 9" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" --lods 9
+said "lods"
+expect 2 "--lod-ratio 1" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" --lods 1 --lod-ratio 1
+said "lod_ratio"
+
 # The Khronos validator from npm, installed once into build/npm when npm
 # reaches its registry; skipped (saying so) when it cannot.
 NPM_DIR=build/npm
@@ -60,6 +94,7 @@ fi
 export NODE_PATH="$PWD/$NPM_DIR/node_modules${NODE_PATH:+:$NODE_PATH}"
 if command -v gltf_validator >/dev/null 2>&1; then
     expect 0 "Khronos glTF validator" -- gltf_validator -m "$T/a.glb"
+    expect 0 "Khronos glTF validator: the --lods .glb" -- gltf_validator -m "$T/lod.glb"
 elif node -e "require('gltf-validator')" >/dev/null 2>&1; then
     cat >"$T/validate.js" <<'JS'
 const v = require('gltf-validator'), fs = require('fs');
@@ -69,7 +104,7 @@ v.validateBytes(new Uint8Array(fs.readFileSync(process.argv[2])))
     if (i.numErrors || i.numWarnings) console.log(JSON.stringify(i.messages));
     process.exit(i.numErrors || i.numWarnings ? 1 : 0); });
 JS
-    for g in a b; do
+    for g in a b lod; do
         expect 0 "Khronos glTF validator (npm gltf-validator): $g.glb, no errors or warnings" -- \
             node "$T/validate.js" "$T/$g.glb"
     done
