@@ -1,7 +1,8 @@
 /* The LOD rows of obscura bake's report (parameter lods; core/bake/lod.c):
  * per level the counts, the RMS of the fit and of the vertex baseline
- * against the resampled values, and with lod_check against the direct
- * bake of the LOD (traced on the LOD geometry and fitted); the lod stage's parts in seconds. */
+ * against the resampled values, and with lod_check the same at held-out
+ * samples and against the direct bake of the LOD (traced on the LOD
+ * geometry and fitted); the lod stage's parts in seconds. */
 #include <cjson/cJSON.h>
 
 #include "bake.h"
@@ -35,6 +36,9 @@ void cli_bake_lod_report(cJSON *r, const obs_bake_params *p, const obs_bake_stat
         cJSON_AddItemToObject(res, "least_squares", pair(st->lod_fit[k]));
         cJSON_AddItemToObject(res, "vertex_sample", pair(st->lod_vertex[k]));
         if (p->lod_check) {
+            cJSON *ho = cJSON_AddObjectToObject(o, "holdout_resampled_rms");
+            cJSON_AddItemToObject(ho, "least_squares", pair(st->lod_holdout_fit[k]));
+            cJSON_AddItemToObject(ho, "vertex_sample", pair(st->lod_holdout_vertex[k]));
             cJSON *tr = cJSON_AddObjectToObject(o, "direct_bake_rms");
             cJSON_AddNumberToObject(tr, "samples", (double)st->lod_traced_samples[k]);
             cJSON_AddItemToObject(tr, "least_squares", pair(st->lod_traced_fit[k]));

@@ -18,15 +18,21 @@
  * the value at its own nearest full-detail point.  With lod_check the
  * LOD's samples are also traced on the LOD geometry (eq 1, the bake's
  * rays) and fitted (eq 2): the bake made directly on the LOD, which both
- * are compared with over the LOD's samples. */
+ * are compared with over the LOD's samples; and both are compared with
+ * the resampled values at held-out positions (never fitted). */
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "bake/lod.h"
 #include "internal.h"
+
+#define MAX_THREADS 64 /* the threads parameter's maximum */
 
 static double now(void)
 {
@@ -54,62 +60,111 @@ void obs__bake_lods_free(obs_bake_result *out)
     out->lod_levels = 0;
 }
 
+/* The work of the resampling: instances taken one at a time by each
+ * thread (each writes only its own instance's samples and vertices). */
+typedef struct job {
+    const obs__bake_world *full, *lw;
+    const obs__bake_weld *fwd;
+    const double *x;
+    obs__bake_samples *ls;
+    double *vertex;
+    atomic_size_t next;
+    atomic_int failed; /* out of memory for a nearest-point search */
+} job;
+
+static size_t end_of(const obs__bake_world *w, size_t i, int tri)
+{
+    if (i + 1 < w->instance_count)
+        return tri ? w->inst[i + 1].first_triangle : w->inst[i + 1].first_vertex;
+    return tri ? w->triangle_count : w->vertex_count;
+}
+
+/* The full-detail signal at the nearest point of c's triangles to p. */
+static void value_at(const job *j, const obs__bake_closest *c, const float p[3], double out[2])
+{
+    float b[3];
+    int64_t ft;
+    obs__bake_closest_query(c, p, &ft, b);
+    for (int ch = 0; ch < 2; ch++) {
+        double g = ft >= 0 ? 0.0 : 1.0; /* an instance of degenerate faces only */
+        for (int k = 0; k < 3 && ft >= 0; k++)
+            g += b[k] * j->x[2 * j->fwd->of[j->full->tri[3 * (size_t)ft + k]] + ch];
+        out[ch] = g;
+    }
+}
+
+static void resample_instance(job *j, size_t i)
+{
+    const obs__bake_inst *fi = &j->full->inst[i], *li = &j->lw->inst[i];
+    size_t lend = end_of(j->lw, i, 1), vend = end_of(j->lw, i, 0);
+    if (lend == li->first_triangle && vend == li->first_vertex)
+        return;
+    obs__bake_closest *c;
+    char err[OBS_ERR_LEN];
+    if (obs__bake_closest_new(j->full, fi->first_triangle,
+                              end_of(j->full, i, 1) - fi->first_triangle, &c, err) != OBS_OK) {
+        atomic_store(&j->failed, 1);
+        return;
+    }
+    obs__bake_samples *ls = j->ls;
+    for (size_t t = li->first_triangle; t < lend; t++)
+        for (size_t k = ls->first[t]; k < ls->first[t + 1]; k++) {
+            float p[3];
+            double g[2];
+            obs__bake_sample_pos(j->lw, ls, k, p);
+            value_at(j, c, p, g);
+            ls->valid[k] = 1;
+            ls->ao[2 * k] = (float)g[0];
+            ls->ao[2 * k + 1] = (float)g[1];
+        }
+    for (size_t v = li->first_vertex; j->vertex && v < vend; v++)
+        value_at(j, c, j->lw->pos + 3 * v, j->vertex + 2 * v);
+    obs__bake_closest_free(c);
+}
+
+static void *worker(void *arg)
+{
+    job *j = arg;
+    for (;;) {
+        size_t i = atomic_fetch_add(&j->next, 1);
+        if (i >= j->lw->instance_count || atomic_load(&j->failed))
+            return NULL;
+        resample_instance(j, i);
+    }
+}
+
 obs_status obs__bake_lod_resample(const obs__bake_world *full, const obs__bake_weld *fwd,
                                   const double *x, const obs__bake_world *lw,
-                                  obs__bake_samples *ls, double *vertex, char err[OBS_ERR_LEN])
+                                  obs__bake_samples *ls, double *vertex, int threads,
+                                  char err[OBS_ERR_LEN])
 {
     if (full->instance_count != lw->instance_count)
         return obs__fail(err, OBS_INVALID_ARGUMENT,
                          "LOD resampling: %zu instances at full detail, %zu in the LOD",
                          full->instance_count, lw->instance_count);
-    size_t t = 0; /* the LOD's triangles, instance by instance */
-    for (size_t i = 0; i < lw->instance_count; i++) {
-        const obs__bake_inst *fi = &full->inst[i], *li = &lw->inst[i];
-        size_t fend = i + 1 < full->instance_count ? full->inst[i + 1].first_triangle
-                                                   : full->triangle_count;
-        size_t lend = i + 1 < lw->instance_count ? lw->inst[i + 1].first_triangle
-                                                 : lw->triangle_count;
-        size_t vend = i + 1 < lw->instance_count ? lw->inst[i + 1].first_vertex
-                                                 : lw->vertex_count;
-        if (fi->node != li->node || fi->mesh != li->mesh)
+    for (size_t i = 0; i < lw->instance_count; i++)
+        if (full->inst[i].node != lw->inst[i].node || full->inst[i].mesh != lw->inst[i].mesh)
             return obs__fail(err, OBS_INVALID_ARGUMENT,
                              "LOD resampling: instance %zu is not the same (node, mesh)", i);
-        if (lend == li->first_triangle && vend == li->first_vertex)
-            continue;
-        obs__bake_closest *c;
-        obs_status rc = obs__bake_closest_new(full, fi->first_triangle,
-                                              fend - fi->first_triangle, &c, err);
-        if (rc != OBS_OK)
-            return rc;
-        for (t = li->first_triangle; t < lend; t++) {
-            for (size_t k = ls->first[t]; k < ls->first[t + 1]; k++) {
-                float p[3], b[3];
-                int64_t ft;
-                obs__bake_sample_pos(lw, ls, k, p);
-                obs__bake_closest_query(c, p, &ft, b);
-                ls->valid[k] = 1;
-                for (int ch = 0; ch < 2; ch++) {
-                    double g = 0.0;
-                    for (int j = 0; j < 3 && ft >= 0; j++)
-                        g += b[j] * x[2 * fwd->of[full->tri[3 * (size_t)ft + j]] + ch];
-                    /* an instance of degenerate faces only: no value near */
-                    ls->ao[2 * k + ch] = (float)(ft >= 0 ? g : 1.0);
-                }
-            }
-        }
-        for (size_t v = li->first_vertex; vertex && v < vend; v++) {
-            float b[3];
-            int64_t ft;
-            obs__bake_closest_query(c, lw->pos + 3 * v, &ft, b);
-            for (int ch = 0; ch < 2; ch++) {
-                double g = ft >= 0 ? 0.0 : 1.0;
-                for (int j = 0; j < 3 && ft >= 0; j++)
-                    g += b[j] * x[2 * fwd->of[full->tri[3 * (size_t)ft + j]] + ch];
-                vertex[2 * v + ch] = g;
-            }
-        }
-        obs__bake_closest_free(c);
+    job j = {full, lw, fwd, x, ls, vertex};
+    atomic_init(&j.next, 0);
+    atomic_init(&j.failed, 0);
+    int nt = threads;
+    if (nt <= 0) {
+        long c = sysconf(_SC_NPROCESSORS_ONLN);
+        nt = c < 1 ? 1 : c > MAX_THREADS ? MAX_THREADS : (int)c;
     }
+    pthread_t th[MAX_THREADS];
+    int started = 0;
+    for (; started < nt && started < MAX_THREADS; started++)
+        if (pthread_create(&th[started], NULL, worker, &j) != 0)
+            break;
+    if (started == 0)
+        worker(&j);
+    for (int k = 0; k < started; k++)
+        pthread_join(th[k], NULL);
+    if (atomic_load(&j.failed))
+        return obs__fail(err, OBS_NO_MEMORY, "LOD resampling: a nearest-point search");
     ls->dropped = 0;
     return OBS_OK;
 }
@@ -186,7 +241,7 @@ static obs_status level(const obs_bake_scene *scene, const obs__bake_world *w,
         rc = obs__fail(err, OBS_NO_MEMORY, "LOD %d: %zu vertices", l, lw.vertex_count);
         goto done;
     }
-    if ((rc = obs__bake_lod_resample(w, wd, x, &lw, &s, vert, err)) != OBS_OK)
+    if ((rc = obs__bake_lod_resample(w, wd, x, &lw, &s, vert, p->threads, err)) != OBS_OK)
         goto done;
     st->lod_seconds[1] += now() - t;
 
@@ -225,6 +280,20 @@ static obs_status level(const obs_bake_scene *scene, const obs__bake_world *w,
 
     if (p->lod_check) {
         t = now();
+        /* held out: other positions (the holdout's seed), resampled,
+         * never fitted */
+        obs__bake_samples h;
+        uint64_t hseed = (uint64_t)p->seed ^ 0x5bd1e995u;
+        if ((rc = obs__bake_samples_make(&lw, p->samples_per_face, p->max_samples_per_face, hseed,
+                                         &h, err)) != OBS_OK)
+            goto done;
+        if ((rc = obs__bake_lod_resample(w, wd, x, &lw, &h, NULL, p->threads, err)) == OBS_OK) {
+            obs__bake_residual(&lw, &lwd, &h, vx, st->lod_holdout_fit[k]);
+            obs__bake_residual(&lw, &lwd, &h, vw, st->lod_holdout_vertex[k]);
+        }
+        obs__bake_samples_free(&h);
+        if (rc != OBS_OK)
+            goto done;
         /* the same samples (same seed), traced on the LOD geometry */
         if ((rc = obs__bake_samples_make(&lw, p->samples_per_face, p->max_samples_per_face,
                                          (uint64_t)p->seed, &chk, err)) != OBS_OK)

@@ -44,10 +44,13 @@ double obs__bake_closest_tri(const float p[3], const float a[3], const float b[3
  * nearest point of the same instance's full-detail surface, interpolated
  * from its vertex values; every sample valid.  vertex (may be NULL): 2
  * values per vertex of lw, the same signal at the vertex's nearest point
- * (the baseline "sampling at the LOD's vertices"). */
+ * (the baseline "sampling at the LOD's vertices").  On `threads` threads
+ * (0: every core), instance by instance; the result does not depend on
+ * their number. */
 obs_status obs__bake_lod_resample(const obs__bake_world *full, const obs__bake_weld *fwd,
                                   const double *x, const obs__bake_world *lw,
-                                  obs__bake_samples *ls, double *vertex, char err[OBS_ERR_LEN]);
+                                  obs__bake_samples *ls, double *vertex, int threads,
+                                  char err[OBS_ERR_LEN]);
 
 /* The lod stage (bake.c calls it after the full-detail fit): every level
  * of every mesh, resampled and fitted; fills out's lod_* fields and

@@ -127,9 +127,11 @@ typedef enum obs_bake_values {
       "of the mesh's extent; a level stops short of its ratio rather than "   \
       "move the surface further")                                              \
     X(lod_check, INT, 0, 0, 1, NULL,                                           \
-      "1: also trace each LOD level's samples on the LOD geometry (every "    \
-      "instance at that level) and report the fit's and the vertex "          \
-      "baseline's RMS against that trace (one more trace per level)")
+      "1: also bake each LOD level directly (its samples traced on the LOD " \
+      "geometry, every instance at that level, and fitted) and report the "   \
+      "RMS of the resampled fit and of the vertex baseline against it, and "  \
+      "against the resampled values at held-out samples (one more trace per " \
+      "level)")
 
 #define OBS__BAKE_DECL_FLOAT(n) float n;
 #define OBS__BAKE_DECL_INT(n) int n;
@@ -285,6 +287,9 @@ typedef struct obs_bake_stats {
     double lod_traced_fit[OBS_BAKE_MAX_LODS][2], lod_traced_vertex[OBS_BAKE_MAX_LODS][2];
     double lod_traced_resampled[OBS_BAKE_MAX_LODS][2];
     double lod_direct_residual[OBS_BAKE_MAX_LODS][2];
+    /* lod_check: the fit's and the baseline's RMS against the resampled
+     * values at held-out LOD samples (the holdout's seed; never fitted) */
+    double lod_holdout_fit[OBS_BAKE_MAX_LODS][2], lod_holdout_vertex[OBS_BAKE_MAX_LODS][2];
     size_t lod_traced_samples[OBS_BAKE_MAX_LODS];
     /* the lod stage's parts: simplify, resample, fit, check */
     double lod_seconds[4];

@@ -75,6 +75,9 @@ expect 0 "the --lods .glb read back through assimp (LOD nodes outside the scene)
     "$T/lod.glb" -o "$T/lod_b.glb" --report "$T/lod_b.json" --rays 8 -q
 check "read back: 811 triangles, 62 instances" \
     "[ \"\$(field $T/lod_b.json \"['counts']['triangles']\")\" = 811 ] && [ \"\$(field $T/lod_b.json \"['counts']['instances']\")\" = 62 ]"
+expect 0 "--lods 2, 1 thread" -- "$OBSCURA" bake "$FIX" -o "$T/lod_t1.glb" --rays 16 --lods 2 --threads 1 -q
+expect 0 "--lods 2, 2 threads" -- "$OBSCURA" bake "$FIX" -o "$T/lod_t2.glb" --rays 16 --lods 2 --threads 2 -q
+check "LODs: the same bytes whatever the thread count" "cmp -s $T/lod_t1.glb $T/lod_t2.glb"
 expect 2 "--lods with a .ply output" -- "$OBSCURA" bake "$FIX" -o "$T/x.ply" --lods 1
 said "a .ply has no LODs"
 expect 2 "--lods 9" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" --lods 9

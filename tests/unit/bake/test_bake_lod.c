@@ -193,7 +193,7 @@ static void test_resample_plane(void **state)
         assert_int_equal(obs__bake_samples_make(&lw, 20.0, 64, 3, &s, err), OBS_OK);
         double *vert = malloc(2 * lw.vertex_count * sizeof *vert);
         assert_non_null(vert);
-        assert_int_equal(obs__bake_lod_resample(&f.w, &f.wd, f.x, &lw, &s, vert, err), OBS_OK);
+        assert_int_equal(obs__bake_lod_resample(&f.w, &f.wd, f.x, &lw, &s, vert, 2, err), OBS_OK);
         double worst = 0.0;
         for (size_t i = 0; i < s.count; i++) {
             float p[3];
@@ -229,7 +229,7 @@ static void test_resample_plane(void **state)
     bt_scene(&other, two, 2);
     assert_int_equal(obs__bake_flatten(&other, &lw, err), OBS_OK);
     assert_int_equal(obs__bake_samples_make(&lw, 1.0, 4, 3, &s, err), OBS_OK);
-    assert_int_equal(obs__bake_lod_resample(&f.w, &f.wd, f.x, &lw, &s, NULL, err),
+    assert_int_equal(obs__bake_lod_resample(&f.w, &f.wd, f.x, &lw, &s, NULL, 1, err),
                      OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "instances"));
     obs__bake_samples_free(&s);
@@ -267,7 +267,7 @@ static void run_fit_linear(int fold, const char *alpha)
     assert_true(lw.triangle_count < f.w.triangle_count);
     assert_int_equal(lw.degenerate, 0); /* the simplifier drops its zero-area slivers */
     assert_int_equal(obs__bake_samples_make(&lw, 8.0, 16, 3, &s, err), OBS_OK);
-    assert_int_equal(obs__bake_lod_resample(&f.w, &f.wd, f.x, &lw, &s, NULL, err), OBS_OK);
+    assert_int_equal(obs__bake_lod_resample(&f.w, &f.wd, f.x, &lw, &s, NULL, 1, err), OBS_OK);
     assert_int_equal(obs__bake_weld_make(&lw, 1e-5f, 120.0f, &lwd, err), OBS_OK);
     obs_bake_params p = {0};
     bt_set(&p, "alpha", alpha);
