@@ -29,6 +29,7 @@ void cli_bake_lod_report(cJSON *r, const obs_bake_params *p, const obs_bake_stat
         cJSON *o = cJSON_CreateObject();
         cJSON_AddNumberToObject(o, "level", (double)(k + 1));
         cJSON_AddNumberToObject(o, "triangles", (double)st->lod_triangles[k]);
+        cJSON_AddNumberToObject(o, "meshes_from_file", (double)st->lod_file_meshes[k]);
         cJSON_AddNumberToObject(o, "vertices", (double)st->lod_vertices[k]);
         cJSON_AddNumberToObject(o, "welded_vertices", (double)st->lod_welded[k]);
         cJSON_AddNumberToObject(o, "samples", (double)st->lod_samples[k]);

@@ -354,6 +354,25 @@ done:
     return rc;
 }
 
+static obs_status mesh_copy(const obs_bake_mesh *a, obs_bake_mesh *b, char err[OBS_ERR_LEN])
+{
+    *b = *a;
+    size_t nv = a->vertex_count, ni = 3 * a->triangle_count;
+    b->name = strdup(a->name ? a->name : "");
+    b->positions = malloc(3 * (nv ? nv : 1) * sizeof(float));
+    b->normals = a->normals ? malloc(3 * (nv ? nv : 1) * sizeof(float)) : NULL;
+    b->indices = malloc((ni ? ni : 1) * sizeof(uint32_t));
+    if (!b->name || !b->positions || (a->normals && !b->normals) || !b->indices) {
+        obs__bake_mesh_free(b);
+        return obs__fail(err, OBS_NO_MEMORY, "LOD '%s': %zu vertices", a->name, nv);
+    }
+    memcpy(b->positions, a->positions, 3 * nv * sizeof(float));
+    if (a->normals)
+        memcpy(b->normals, a->normals, 3 * nv * sizeof(float));
+    memcpy(b->indices, a->indices, ni * sizeof(uint32_t));
+    return OBS_OK;
+}
+
 obs_status obs__bake_lods(const obs_bake_scene *scene, const obs__bake_world *w,
                           const obs__bake_weld *wd, const double *x, const obs_bake_params *p,
                           obs_bake_result *out, char err[OBS_ERR_LEN])
@@ -375,12 +394,28 @@ obs_status obs__bake_lods(const obs_bake_scene *scene, const obs__bake_world *w,
     }
     out->lod_levels = (size_t)levels;
     out->stats.lod_levels = (size_t)levels;
+    int from_file = p->lod_source != OBS_BAKE_LOD_SOURCE_SIMPLIFY;
+    if (from_file && scene->file_lod_error) {
+        obs__bake_lods_free(out);
+        return obs__fail(err, OBS_BAD_FILE, "%s (lod_source simplify ignores them)",
+                         scene->file_lod_error);
+    }
     obs_status rc = OBS_OK;
     for (int l = 1; l <= levels && rc == OBS_OK; l++)
-        for (size_t m = 0; m < nm && rc == OBS_OK; m++)
-            rc = obs__bake_simplify(&scene->meshes[m], l, p->lod_ratio, p->lod_error,
-                                    p->weld_tolerance, p->weld_angle,
-                                    &out->lod_meshes[(size_t)(l - 1) * nm + m], err);
+        for (size_t m = 0; m < nm && rc == OBS_OK; m++) {
+            size_t c = (size_t)(l - 1) * nm + m;
+            const obs_bake_mesh *fl = from_file && (size_t)l <= scene->file_lod_levels
+                                          ? &scene->file_lods[c]
+                                          : NULL;
+            if (fl && fl->triangle_count) { /* the file's own level */
+                rc = mesh_copy(fl, &out->lod_meshes[c], err);
+                out->stats.lod_file_meshes[l - 1]++;
+            } else {
+                rc = obs__bake_simplify(&scene->meshes[m], l, p->lod_ratio, p->lod_error,
+                                        p->weld_tolerance, p->weld_angle, &out->lod_meshes[c],
+                                        err);
+            }
+        }
     out->stats.lod_seconds[0] = now() - t;
     for (int l = 1; l <= levels && rc == OBS_OK; l++)
         rc = level(scene, w, wd, x, p, l, out, err);

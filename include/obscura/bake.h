@@ -8,8 +8,9 @@
  *   trace.c    obscurance (eq 1) at two distances, Embree closest hits
  *   weld.c     triangle soup welded for the fit
  *   fit.c      least-squares vertex fit (Kavan et al. 2011), CHOLMOD
- *   lod.c      LODs: simplify.c (meshoptimizer), closest.c (nearest
- *              full-detail point), the resampled fit (section 2.2.1)
+ *   lod.c      LODs: lod_file.c (a .glb's MSFT_lod), simplify.c
+ *              (meshoptimizer), closest.c (nearest full-detail point),
+ *              the resampled fit (section 2.2.1)
  *   glb.c ply.c  the output files
  *   bake.c     the steps in order, timed (obs_bake_run)
  * The paper is "Baked ambient obscurance on the vertices of game levels"
@@ -54,6 +55,15 @@ typedef enum obs_bake_values {
 
 /* The most LOD levels a bake makes (parameter lods). */
 #define OBS_BAKE_MAX_LODS 8
+
+/* Where the LODs come from (parameter lod_source). */
+#define OBS_BAKE_LOD_SOURCE_LIST(X)                                            \
+    X(OBS_BAKE_LOD_SOURCE_FILE, file)         /* the file's MSFT_lod, else simplified */ \
+    X(OBS_BAKE_LOD_SOURCE_SIMPLIFY, simplify) /* meshoptimizer's for every mesh */
+typedef enum obs_bake_lod_source {
+    OBS_BAKE_LOD_SOURCE_DEFAULT,
+    OBS_BAKE_LOD_SOURCE_LIST(OBS__BAKE_ENUM)
+} obs_bake_lod_source;
 
 /* The bake parameters: X(name, type, default, min, max, choices, doc),
  * type FLOAT, INT or ENUM (choices '|'-separated, stored 1-based).  The
@@ -116,10 +126,16 @@ typedef enum obs_bake_values {
       "refuse a level with more triangles than this once instances are "      \
       "flattened")                                                             \
     X(lods, INT, 0, 0, OBS_BAKE_MAX_LODS, NULL,                                \
-      "lower levels of detail per mesh, made with meshoptimizer's simplifier " \
-      "and valued by resampling the full-detail bake onto their surface "      \
+      "lower levels of detail per mesh (the file's own or meshoptimizer's, "   \
+      "see lod_source), valued by resampling the full-detail bake onto their " \
+      "surface "                                                               \
       "samples and the fit of eq 2 (section 2.2.1), written as MSFT_lod "      \
       "levels of the .glb's nodes; 0: none")                                   \
+    X(lod_source, ENUM, "file", 0, 0,                                          \
+      (OBS_BAKE_LOD_SOURCE_LIST(OBS__BAKE_CHOICE) + 1),                        \
+      "where level l of a mesh comes from: file (the file's own, glTF "       \
+      "MSFT_lod, where it has one; the simplifier's elsewhere) or simplify "  \
+      "(the simplifier's for every mesh)")                                     \
     X(lod_ratio, FLOAT, 0.5, 0.01, 0.99, NULL,                                 \
       "target triangle count of LOD level l: lod_ratio^l of the mesh's")       \
     X(lod_error, FLOAT, 0.02, 0.0, 1.0, NULL,                                  \
@@ -212,10 +228,17 @@ typedef struct obs_bake_scene {
     size_t node_count;
     size_t instance_count;  /* (node, mesh) pairs */
     size_t world_triangles; /* triangles with instances flattened */
+    /* The file's own LODs (a .glb's MSFT_lod, core/bake/lod_file.c):
+     * level l of mesh m is file_lods[(l - 1) * mesh_count + m], with no
+     * triangles where the file has none; file_lod_error the reason they
+     * could not be read (the bake refuses --lods then), else NULL. */
+    obs_bake_mesh *file_lods;
+    size_t file_lod_levels;
+    char *file_lod_error;
 } obs_bake_scene;
 
 /* Loads a level through assimp (glTF/GLB, AC3D, OBJ, ...), keeping the node
- * graph.  Refuses a file without triangles, with non-finite coordinates, or
+ * graph, and a .glb's own LODs (MSFT_lod) into file_lods.  Refuses a file without triangles, with non-finite coordinates, or
  * with more than max_triangles once flattened (0: no limit), naming the
  * mesh.  Free with obs_bake_scene_free(). */
 obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene *out,
@@ -283,6 +306,7 @@ typedef struct obs_bake_stats {
     size_t lod_levels;
     size_t lod_triangles[OBS_BAKE_MAX_LODS], lod_vertices[OBS_BAKE_MAX_LODS];
     size_t lod_welded[OBS_BAKE_MAX_LODS], lod_samples[OBS_BAKE_MAX_LODS];
+    size_t lod_file_meshes[OBS_BAKE_MAX_LODS]; /* meshes whose level is the file's own */
     double lod_fit[OBS_BAKE_MAX_LODS][2], lod_vertex[OBS_BAKE_MAX_LODS][2];
     double lod_traced_fit[OBS_BAKE_MAX_LODS][2], lod_traced_vertex[OBS_BAKE_MAX_LODS][2];
     double lod_traced_resampled[OBS_BAKE_MAX_LODS][2];

@@ -5,7 +5,8 @@
 # again), `obscura gbuffer` of the .glb (the baked channels, against the
 # level's own G-buffer and the obscurance reference), `obscura ao` with
 # the baked channel (--baked, --baked-combine), the same bytes for 1 and 2 threads, --lods 2 (the LOD
-# nodes read back, the report's levels), the Khronos validator when
+# nodes read back, the report's levels, the file's own MSFT_lod levels read on a re-bake), the Khronos
+# validator when
 # it is installed, clear errors for bad input and usage; a TORCS track of
 # ../shared/data when present.
 #
@@ -75,6 +76,26 @@ expect 0 "the --lods .glb read back through assimp (LOD nodes outside the scene)
     "$T/lod.glb" -o "$T/lod_b.glb" --report "$T/lod_b.json" --rays 8 -q
 check "read back: 811 triangles, 62 instances" \
     "[ \"\$(field $T/lod_b.json \"['counts']['triangles']\")\" = 811 ] && [ \"\$(field $T/lod_b.json \"['counts']['instances']\")\" = 62 ]"
+echo "-- a file's own LODs (MSFT_lod): the --lods .glb baked again"
+expect 0 "re-bake of the --lods .glb with --lods 2 --lod-ratio 0.3 (lod_source file)" -- "$OBSCURA" bake \
+    "$T/lod.glb" -o "$T/lodf.glb" --report "$T/lodf.json" --rays 16 --lods 2 --lod-ratio 0.3 -q
+check "the file's levels used as they are: 62 meshes a level from the file, the first bake's triangles" "python3 -c \"
+import json, sys; a = json.load(open('$T/lod.json'))['lods']['per_level']; b = json.load(open('$T/lodf.json'))['lods']['per_level']
+sys.exit(not all(y['meshes_from_file'] == 62 and y['triangles'] == x['triangles'] for x, y in zip(a, b)))\""
+expect 0 "the re-baked .glb keeps its 2 LOD nodes a node" -- python3 tests/e2e/lib/glb_check.py "$T/lodf.glb" 186 --lods 2
+expect 0 "--lod-source simplify: simplified again" -- "$OBSCURA" bake "$T/lod.glb" -o "$T/lods.glb" \
+    --report "$T/lods.json" --rays 16 --lods 2 --lod-ratio 0.3 --lod-source simplify -q
+check "... at ratio 0.3: fewer triangles than the file's, none from the file" "python3 -c \"
+import json, sys; a = json.load(open('$T/lod.json'))['lods']['per_level']; b = json.load(open('$T/lods.json'))['lods']['per_level']
+sys.exit(not all(y['meshes_from_file'] == 0 and y['triangles'] < x['triangles'] for x, y in zip(a, b)))\""
+python3 tests/e2e/lib/glb_edit.py "$T/lod.glb" "$T/lodmove.glb" lodmove
+python3 tests/e2e/lib/glb_edit.py "$T/lod.glb" "$T/lodprims.glb" lodprims
+expect 3 "a LOD node moved against its node, with --lods" -- "$OBSCURA" bake "$T/lodmove.glb" -o "$T/x.glb" --lods 1 -q
+said "has another transform than its node"
+expect 0 "... baked without --lods" -- "$OBSCURA" bake "$T/lodmove.glb" -o "$T/x.glb" --rays 4 -q
+expect 0 "... or with --lod-source simplify" -- "$OBSCURA" bake "$T/lodmove.glb" -o "$T/x.glb" --rays 4 --lods 1 --lod-source simplify -q
+expect 3 "a LOD node whose mesh lacks a primitive" -- "$OBSCURA" bake "$T/lodprims.glb" -o "$T/x.glb" --lods 1 -q
+said "primitives like its node's"
 expect 0 "--lods 2, 1 thread" -- "$OBSCURA" bake "$FIX" -o "$T/lod_t1.glb" --rays 16 --lods 2 --threads 1 -q
 expect 0 "--lods 2, 2 threads" -- "$OBSCURA" bake "$FIX" -o "$T/lod_t2.glb" --rays 16 --lods 2 --threads 2 -q
 check "LODs: the same bytes whatever the thread count" "cmp -s $T/lod_t1.glb $T/lod_t2.glb"
@@ -107,7 +128,7 @@ v.validateBytes(new Uint8Array(fs.readFileSync(process.argv[2])))
     if (i.numErrors || i.numWarnings) console.log(JSON.stringify(i.messages));
     process.exit(i.numErrors || i.numWarnings ? 1 : 0); });
 JS
-    for g in a b lod; do
+    for g in a b lod lodf; do
         expect 0 "Khronos glTF validator (npm gltf-validator): $g.glb, no errors or warnings" -- \
             node "$T/validate.js" "$T/$g.glb"
     done

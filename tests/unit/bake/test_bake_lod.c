@@ -1,6 +1,7 @@
-/* LODs of the bake (core/bake/lod.c, simplify.c, closest.c; paper 2.2.1):
- * the simplifier, the nearest point, the resampling, the fit onto the
- * LOD's vertices, the whole stage through obs_bake_run, bad parameters. */
+/* LODs of the bake (core/bake/lod.c, simplify.c, closest.c, lod_file.c;
+ * paper 2.2.1): the simplifier, the nearest point, the resampling, the fit
+ * onto the LOD's vertices, the whole stage through obs_bake_run, a file's
+ * own LODs, bad parameters. */
 #include <stdio.h>
 #include <unistd.h>
 
@@ -366,6 +367,66 @@ static void test_bake_run(void **state)
     obs_bake_scene_free(&sc);
 }
 
+/* A .glb's own LODs (MSFT_lod, lod_file.c): the bake's output loaded
+ * again brings its levels, geometry for geometry; baked with --lods they
+ * are used as they are (lod_source file: not simplified again, whatever
+ * lod_ratio), or simplified anew (lod_source simplify). */
+static void test_file_lods(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+    obs_bake_mesh m[2];
+    const float o[3] = {0, 0, 0}, u[3] = {4, 0, 0}, v[3] = {0, 0, -4}, w[3] = {0, 4, 0};
+    bt_grid(&m[0], "floor", o, u, v, 16, 16);
+    bt_grid(&m[1], "wall", o, w, u, 12, 8);
+    obs_bake_scene sc;
+    bt_scene(&sc, m, 2);
+    obs_bake_desc d = {0};
+    bt_set(&d.params, "rays", "8");
+    bt_set(&d.params, "lods", "2");
+    obs_bake_result r;
+    assert_int_equal(obs_bake_run(&sc, &d, &r, err), OBS_OK);
+    char path[] = "/tmp/obs_lodf_XXXXXX.glb";
+    int fd = mkstemps(path, 4); /* assimp tells the format by the name */
+    assert_true(fd >= 0);
+    close(fd);
+    assert_int_equal(obs_bake_write_glb(path, &sc, &r, 0, err), OBS_OK);
+    obs_bake_scene back;
+    if (obs_bake_load(path, 0, &back, err) != OBS_OK)
+        fail_msg("load: %s", err);
+    unlink(path);
+    assert_null(back.file_lod_error);
+    assert_int_equal(back.file_lod_levels, 2);
+    assert_int_equal(back.mesh_count, 2);
+    for (size_t l = 1; l <= 2; l++)
+        for (size_t k = 0; k < 2; k++) {
+            const obs_bake_mesh *f = &back.file_lods[(l - 1) * 2 + k];
+            /* the original mesh of the same size (the load may reorder) */
+            size_t o2 = back.meshes[k].triangle_count == sc.meshes[0].triangle_count ? 0 : 1;
+            const obs_bake_mesh *a = &r.lod_meshes[(l - 1) * 2 + o2];
+            assert_int_equal(f->triangle_count, a->triangle_count);
+            assert_int_equal(f->vertex_count, a->vertex_count);
+            assert_memory_equal(f->positions, a->positions, 3 * a->vertex_count * sizeof(float));
+            assert_memory_equal(f->indices, a->indices, 3 * a->triangle_count * sizeof(uint32_t));
+        }
+    obs_bake_result r2;
+    bt_set(&d.params, "lod_ratio", "0.2");
+    assert_int_equal(obs_bake_run(&back, &d, &r2, err), OBS_OK);
+    for (int l = 0; l < 2; l++) {
+        assert_int_equal(r2.stats.lod_file_meshes[l], 2);
+        assert_int_equal(r2.stats.lod_triangles[l], r.stats.lod_triangles[l]);
+    }
+    obs_bake_result_free(&r2);
+    bt_set(&d.params, "lod_source", "simplify");
+    assert_int_equal(obs_bake_run(&back, &d, &r2, err), OBS_OK);
+    assert_int_equal(r2.stats.lod_file_meshes[0], 0);
+    assert_true(r2.stats.lod_triangles[0] < r.stats.lod_triangles[0]);
+    obs_bake_result_free(&r2);
+    obs_bake_scene_free(&back);
+    obs_bake_result_free(&r);
+    obs_bake_scene_free(&sc);
+}
+
 /* Bad parameters: each refused with the row's name; the simplifier's own
  * checks. */
 static void test_bad_params(void **state)
@@ -375,7 +436,8 @@ static void test_bad_params(void **state)
     obs_bake_params p = {0};
     const char *bad[][2] = {{"lods", "9"},      {"lods", "-1"},      {"lods", "two"},
                             {"lod_ratio", "1"}, {"lod_ratio", "0"},  {"lod-ratio", "x"},
-                            {"lod_error", "-0.1"}, {"lod_error", "2"}, {"lod_check", "2"}};
+                            {"lod_error", "-0.1"}, {"lod_error", "2"}, {"lod_check", "2"},
+                            {"lod_source", "both"}};
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         err[0] = '\0';
         assert_int_not_equal(obs_bake_param_set(&p, bad[i][0], bad[i][1], err), OBS_OK);
@@ -407,6 +469,7 @@ int main(void)
         cmocka_unit_test(test_resample_plane),
         cmocka_unit_test(test_fit_linear),
         cmocka_unit_test(test_bake_run),
+        cmocka_unit_test(test_file_lods),
         cmocka_unit_test(test_bad_params),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
