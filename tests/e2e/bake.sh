@@ -160,6 +160,15 @@ expect 0 "_AO_SHORT against _AO_LONG" -- "$OBSCURA" compare "$T/g.exr" "$T/g.exr
 b2=$(json bias)
 check "bias(_AO - long) $b1 = 0.03 bias(short - long) $b2" \
     "awk 'BEGIN { d = $b1 - 0.03 * $b2; exit !(d < 1e-5 && d > -1e-5 && ($b2 > 0.005 || $b2 < -0.005)) }'"
+expect 0 "gbuffer of the --lods .glb" -- "$OBSCURA" gbuffer "$T/lod.glb" --camera "$T/cam0.json" -o "$T/g_lod.exr" -q
+expect 0 "gbuffer of the same bake without LODs" -- "$OBSCURA" gbuffer "$T/nolod.glb" --camera "$T/cam0.json" \
+    -o "$T/g_nolod.exr" -q
+for ch in A _AO N.Y; do
+    expect 0 "--lods .glb against the one without: $ch" -- "$OBSCURA" compare "$T/g_nolod.exr" "$T/g_lod.exr" \
+        --channel-a $ch --channel-b $ch --json
+    m=$(json mse)
+    check "the LOD nodes outside the scene are not drawn: $ch MSE $m = 0" "awk 'BEGIN { exit !($m == 0) }'"
+done
 echo "-- obscura ao with the baked channel (screen-space x baked)"
 expect 0 "ao on the baked G-buffer: _AO found by name" -- "$OBSCURA" ao "$T/g.exr" -o "$T/c.exr" --radius 2
 said "baked channel _AO combined (product)"
