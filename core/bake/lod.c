@@ -397,7 +397,8 @@ obs_status obs__bake_lods(const obs_bake_scene *scene, const obs__bake_world *w,
     int from_file = p->lod_source != OBS_BAKE_LOD_SOURCE_SIMPLIFY;
     if (from_file && scene->file_lod_error) {
         obs__bake_lods_free(out);
-        return obs__fail(err, OBS_BAD_FILE, "%s (lod_source simplify ignores them)",
+        return obs__fail(err, OBS_BAD_FILE,
+                         "%s (with lod_source simplify the file's LODs are not read)",
                          scene->file_lod_error);
     }
     obs_status rc = OBS_OK;

@@ -7,7 +7,9 @@ kept: glb_edit.py IN OUT EDIT, EDIT one of
   noao    every _AO attribute renamed (no baked values left)
   lodmove the first MSFT_lod level node moved (translation 1, 0, 0): a LOD
           against its node's transform
-  lodprims the first MSFT_lod level node's mesh loses a primitive"""
+  lodprims the first MSFT_lod level node's mesh loses a primitive
+  lodcount the first MSFT_lod level's POSITION accessor claims 10^9
+          vertices, beyond its view"""
 import json
 import math
 import struct
@@ -33,6 +35,9 @@ def main():
         mesh["primitives"] = mesh["primitives"][:-1] or []
         doc["meshes"].append(mesh)
         doc["nodes"][lods[0]]["mesh"] = len(doc["meshes"]) - 1
+    if edit == "lodcount":
+        prim = doc["meshes"][doc["nodes"][lods[0]]["mesh"]]["primitives"][0]
+        doc["accessors"][prim["attributes"]["POSITION"]]["count"] = 10 ** 9
     for r in doc["scenes"][doc.get("scene", 0)]["nodes"] if edit in ("trs", "matrix") else []:
         n = doc["nodes"][r]
         n.pop("matrix", None)

@@ -124,6 +124,66 @@ static void test_closest_tri(void **state)
     assert_true(fabs(bary[1]) < 1e-6 && fabs(bary[2] - 0.5f) < 1e-6);
 }
 
+/* The hierarchy's nearest point is the nearest of all triangles: a soup
+ * of random triangles (some degenerate), random points in and around it,
+ * against a search over every triangle. */
+static void test_closest_bvh(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+    enum { NT = 700, NP = 300 };
+    obs_bake_mesh m;
+    memset(&m, 0, sizeof m);
+    m.name = strdup("soup");
+    m.material = -1;
+    m.vertex_count = 3 * NT;
+    m.triangle_count = NT;
+    m.positions = malloc(9 * NT * sizeof(float));
+    m.indices = malloc(3 * NT * sizeof(uint32_t));
+    assert_non_null(m.positions);
+    assert_non_null(m.indices);
+    uint32_t seed = 12345;
+#define RND() ((seed = seed * 1664525u + 1013904223u) >> 8) / 16777216.0f
+    for (int t = 0; t < NT; t++) {
+        float c[3] = {10 * RND(), 3 * RND(), 10 * RND()};
+        for (int k = 0; k < 3; k++) {
+            float *p = m.positions + 9 * t + 3 * k;
+            for (int a = 0; a < 3; a++)
+                p[a] = c[a] + (t % 50 == 0 && k == 2 ? 0.0f : 0.8f * RND() - 0.4f);
+            m.indices[3 * t + k] = (uint32_t)(3 * t + k);
+        }
+        if (t % 50 == 0) /* degenerate: the third corner on the first */
+            memcpy(m.positions + 9 * t + 6, m.positions + 9 * t, 3 * sizeof(float));
+    }
+    obs_bake_scene sc;
+    bt_scene(&sc, &m, 1);
+    obs__bake_world w;
+    assert_int_equal(obs__bake_flatten(&sc, &w, err), OBS_OK);
+    assert_true(w.degenerate >= NT / 50);
+    obs__bake_closest *c;
+    assert_int_equal(obs__bake_closest_new(&w, 0, w.triangle_count, &c, err), OBS_OK);
+    for (int i = 0; i < NP; i++) {
+        float p[3] = {12 * RND() - 1, 5 * RND() - 1, 12 * RND() - 1}, b[3], bb[3];
+        int64_t t;
+        double d = obs__bake_closest_query(c, p, &t, b), best = INFINITY;
+        for (size_t k = 0; k < w.triangle_count; k++) {
+            if (!(w.area[k] > 0.0f))
+                continue;
+            const uint32_t *v = w.tri + 3 * k;
+            best = fmin(best, obs__bake_closest_tri(p, w.pos + 3 * v[0], w.pos + 3 * v[1],
+                                                    w.pos + 3 * v[2], bb));
+        }
+        assert_true(t >= 0 && w.area[t] > 0.0f);
+        if (fabs(d - best) > 1e-9 * (1.0 + best))
+            fail_msg("point %d: the hierarchy's %.9g, every triangle's %.9g", i, d, best);
+        assert_true(fabs(b[0] + b[1] + b[2] - 1.0f) < 1e-5f);
+    }
+#undef RND
+    obs__bake_closest_free(c);
+    obs__bake_world_free(&w);
+    obs_bake_scene_free(&sc);
+}
+
 /* The full-detail world of scene sc, welded, its vertex values the linear
  * signal. */
 typedef struct full {
@@ -466,6 +526,7 @@ int main(void)
         cmocka_unit_test(test_simplify_plane),
         cmocka_unit_test(test_simplify_error_bound),
         cmocka_unit_test(test_closest_tri),
+        cmocka_unit_test(test_closest_bvh),
         cmocka_unit_test(test_resample_plane),
         cmocka_unit_test(test_fit_linear),
         cmocka_unit_test(test_bake_run),
