@@ -238,7 +238,7 @@ static obs_status level(const obs_bake_scene *scene, const obs__bake_world *w,
         goto done;
     vert = malloc(2 * (lw.vertex_count ? lw.vertex_count : 1) * sizeof *vert);
     if (!vert) {
-        rc = obs__fail(err, OBS_NO_MEMORY, "LOD %d: %zu vertices", l, lw.vertex_count);
+        rc = obs__fail(err, OBS_NO_MEMORY, "%zu vertices", lw.vertex_count);
         goto done;
     }
     if ((rc = obs__bake_lod_resample(w, wd, x, &lw, &s, vert, p->threads, err)) != OBS_OK)
@@ -254,20 +254,17 @@ static obs_status level(const obs_bake_scene *scene, const obs__bake_world *w,
     cnt = malloc(n * sizeof *cnt);
     face = malloc(2 * n * sizeof *face);
     point = malloc(2 * n * sizeof *point);
-    direct = malloc(2 * n * sizeof *direct);
-    if (!vx || !vw || !cnt || !face || !point || !direct) {
-        rc = obs__fail(err, OBS_NO_MEMORY, "LOD %d: solution of %zu vertices", l, lwd.count);
+    if (p->lod_check)
+        direct = malloc(2 * n * sizeof *direct);
+    if (!vx || !vw || !cnt || !face || !point || (p->lod_check && !direct)) {
+        rc = obs__fail(err, OBS_NO_MEMORY, "solution of %zu vertices", lwd.count);
         goto done;
     }
     obs_bake_params fp = *p;
     fp.values = OBS_BAKE_VALUES_FIT; /* the fit itself, whatever the full detail writes */
     obs_bake_stats fst = {0};
-    if ((rc = obs__bake_fit(&lw, &lwd, &s, &fp, vx, face, point, &fst, err)) != OBS_OK) {
-        char why[OBS_ERR_LEN];
-        memcpy(why, err, sizeof why);
-        snprintf(err, OBS_ERR_LEN, "LOD level %d: %.*s", l, OBS_ERR_LEN - 20, why);
+    if ((rc = obs__bake_fit(&lw, &lwd, &s, &fp, vx, face, point, &fst, err)) != OBS_OK)
         goto done;
-    }
     weld_values(&lw, &lwd, vert, vw, cnt);
     int k = l - 1;
     st->lod_triangles[k] = lw.triangle_count;
@@ -419,7 +416,11 @@ obs_status obs__bake_lods(const obs_bake_scene *scene, const obs__bake_world *w,
         }
     out->stats.lod_seconds[0] = now() - t;
     for (int l = 1; l <= levels && rc == OBS_OK; l++)
-        rc = level(scene, w, wd, x, p, l, out, err);
+        if ((rc = level(scene, w, wd, x, p, l, out, err)) != OBS_OK) {
+            char why[OBS_ERR_LEN];
+            memcpy(why, err, sizeof why);
+            snprintf(err, OBS_ERR_LEN, "LOD level %d: %.*s", l, OBS_ERR_LEN - 20, why);
+        }
     out->stats.seconds[OBS_BAKE_STAGE_lod] = now() - t0;
     return rc;
 }
