@@ -297,6 +297,10 @@ for n in 1 3 4; do
         "[ \"\$(field $T/merged$n.json \"['counts']['rays']\")\" = \"\$(field $T/whole.json \"['counts']['rays']\")\" ]"
     check "merged of $n: the parts' rays (24) in the report" "[ \"\$(field $T/merged$n.json \"['params']['rays']\")\" = 24 ]"
 done
+expect 0 "unsharded, 24 rays, --lods 2" -- "$OBSCURA" bake "$FIX" -o "$T/whole_lod.glb" --rays 24 --lods 2 -q
+expect 0 "merge of 3 shards with --lods 2" -- "$OBSCURA" bake "$FIX" --merge "$T"/part3.*.bin \
+    -o "$T/merged_lod.glb" --lods 2 -q
+check "merged with --lods = unsharded with --lods, byte for byte" "cmp -s $T/whole_lod.glb $T/merged_lod.glb"
 check "a part is 128 + 9 bytes a sample" \
     "[ \$((\$(cat $T/part3.*.bin | wc -c) - 3 * 128)) = \$((9 * \$(field $T/whole.json \"['counts']['samples']\"))) ]"
 expect 3 "a missing shard" -- "$OBSCURA" bake "$FIX" --merge "$T/part4.0.bin" "$T/part4.1.bin" "$T/part4.3.bin" -o "$T/x.glb" -q
