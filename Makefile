@@ -28,10 +28,11 @@ PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson nettle 2>/d
 PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson nettle 2>/dev/null) -lz -lm -lpthread
 # Scene loading (core/ground/scene.c: assimp) and the ray-traced reference
 # (core/ground/reference.c: Embree 3, no .pc file) and the bake's least-squares
-# solve (core/bake/fit.c: SuiteSparse CHOLMOD) live in libobscura.a too; as
+# solve (core/bake/fit.c: SuiteSparse CHOLMOD) and its LODs (core/bake/simplify.c:
+# meshoptimizer, a C API over a C++ library) live in libobscura.a too; as
 # static members they are linked only into binaries that call them, and
 # --as-needed keeps the shared libraries out of the others (the daemon).
-PKG_LIBS += -Wl,--push-state,--as-needed $(shell pkg-config --libs assimp 2>/dev/null) -lembree3 -lcholmod -Wl,--pop-state
+PKG_LIBS += -Wl,--push-state,--as-needed $(shell pkg-config --libs assimp 2>/dev/null) -lembree3 -lcholmod -lmeshoptimizer -Wl,--pop-state
 # The deep EXR writer (core/io/exr_deep_write.cpp, OpenEXR's C++ deep API; the
 # C API of 3.1 cannot write deep data): the same arrangement, so only the
 # binaries that write deep files (the CLI, tests) need the C++ libraries.

@@ -142,6 +142,8 @@ static int write_report(const char *path, const char *level, const obs_bake_para
         cJSON_AddItemToObject(h, "face_mean", pair(st->holdout_face_mean));
         cJSON_AddItemToObject(h, "point_sample", pair(st->holdout_point));
     }
+    if (st->lod_levels)
+        cli_bake_lod_report(r, p, st);
     cJSON *ao = cJSON_AddObjectToObject(r, "ao");
     cJSON_AddNumberToObject(ao, "mean", st->ao_mean);
     cJSON_AddNumberToObject(ao, "min", st->ao_min);
@@ -287,6 +289,9 @@ int cli_bake(int argc, char **argv)
         cli_die_usage("bake", "cannot tell the format of '%s': use .glb or .ply", out);
     obs_bake_params p;
     obs_bake_params_resolve(&desc.params, &p);
+    if (p.lods && !shards && (out_ply || ply))
+        cli_die_usage("bake", "--lods writes its levels into the .glb (MSFT_lod); a .ply has "
+                              "no LODs: drop --ply or --lods");
 
     double t0 = cli_now_s();
     obs_bake_scene sc;
@@ -343,6 +348,12 @@ int cli_bake(int argc, char **argv)
                 "back-face rule), %llu rays in %.1f s; mean _AO %.3f; wrote %s\n",
                 st->instances, st->triangles, st->samples, st->samples_dropped_backface,
                 (unsigned long long)st->rays, st->seconds[OBS_BAKE_STAGE_trace], st->ao_mean, out);
+    if (rc == EXIT_OK && !quiet && st->lod_levels)
+        for (size_t k = 0; k < st->lod_levels && k < OBS_BAKE_MAX_LODS; k++)
+            fprintf(stderr, "obscura: bake: LOD %zu: %zu triangles (%.0f %%), %zu samples "
+                    "resampled and fitted\n", k + 1, st->lod_triangles[k],
+                    st->triangles ? 100.0 * (double)st->lod_triangles[k] / (double)st->triangles : 0.0,
+                    st->lod_samples[k]);
     obs_bake_result_free(&r);
     obs_bake_scene_free(&sc);
     return rc;

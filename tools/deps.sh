@@ -5,7 +5,7 @@ set -eu
 
 PKGS="build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libosmesa6-dev \
 libopenexr-dev libpng-dev libcjson-dev libcmocka-dev zlib1g-dev libmicrohttpd-dev curl \
-libassimp-dev libembree-dev nettle-dev libsuitesparse-dev"
+libassimp-dev libembree-dev nettle-dev libsuitesparse-dev libmeshoptimizer-dev"
 # Only for the tests: the preview page in a real browser (Chromium; node
 # and npm fetch playwright-core), the deploy checks (systemd-analyze,
 # PyYAML), make quality's referee (shared/tools/aometrics.py: numpy,

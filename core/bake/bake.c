@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include "bake/bake_internal.h"
+#include "bake/lod.h"
 #include "bake/shard.h"
 #include "internal.h"
 
@@ -36,6 +37,7 @@ void obs_bake_result_free(obs_bake_result *r)
         free(r->instances[i].ao_long);
     }
     free(r->instances);
+    obs__bake_lods_free(r);
     memset(r, 0, sizeof *r);
 }
 
@@ -186,7 +188,8 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
         goto done;
     if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
-    rc = copy_back(scene, &w, &wd, x, p.blend, out, err);
+    if ((rc = copy_back(scene, &w, &wd, x, p.blend, out, err)) == OBS_OK)
+        rc = obs__bake_lods(scene, &w, &wd, x, &p, out, err); /* lod.c, paper 2.2.1 */
 done:
     free(x);
     free(face);

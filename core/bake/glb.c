@@ -8,7 +8,7 @@
  * custom attributes begin with '_', glTF 2.0 3.7.2.1), COLOR_0 = _AO as
  * grey when asked; indices as unsigned int.  The materials keep their
  * names, base colours, alpha mode BLEND and sidedness, not their
- * textures. */
+ * textures.  LODs: MSFT_lod levels of the nodes (lod_nodes). */
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <math.h>
@@ -141,6 +141,49 @@ static cJSON *primitive(out *o, const obs_bake_mesh *m, const obs_bake_instance 
     return p;
 }
 
+/* LODs (obs_bake_result's lod_*): after the scene's nodes, for each node
+ * that holds meshes, one node per level with that level's meshes, the
+ * same name + "_LOD<l>" and matrix and no children, outside the scene's
+ * graph, listed in order in the node's MSFT_lod extension (glTF's
+ * vendor extension MSFT_lod: "ids", from high to low detail). */
+static void lod_nodes(out *o, const obs_bake_scene *scene, const obs_bake_result *r, int color,
+                      cJSON *nodes, cJSON *meshes, cJSON *const *items, int nmesh)
+{
+    size_t inst = 0, next = scene->node_count;
+    for (size_t n = 0; n < scene->node_count; n++) {
+        const obs_bake_node *nd = &scene->nodes[n];
+        if (!nd->mesh_count)
+            continue;
+        cJSON *ids = cJSON_CreateArray();
+        for (size_t l = 1; l <= r->lod_levels; l++) {
+            cJSON *j = cJSON_CreateObject(), *m = cJSON_CreateObject();
+            cJSON *prims = cJSON_AddArrayToObject(m, "primitives");
+            char name[512];
+            snprintf(name, sizeof name, "%.480s_LOD%zu", nd->name ? nd->name : "", l);
+            cJSON_AddStringToObject(j, "name", name);
+            cJSON *matrix = cJSON_GetObjectItem(items[n], "matrix");
+            if (matrix)
+                cJSON_AddItemToObject(j, "matrix", cJSON_Duplicate(matrix, 1));
+            const obs_bake_mesh *lm = r->lod_meshes + (l - 1) * scene->mesh_count;
+            cJSON_AddStringToObject(m, "name", lm[nd->meshes[0]].name);
+            for (uint32_t k = 0; k < nd->mesh_count; k++)
+                cJSON_AddItemToArray(prims, primitive(o, &lm[nd->meshes[k]],
+                                                      &r->lod_instances[(l - 1) * r->instance_count +
+                                                                        inst + k],
+                                                      color, scene->material_count));
+            cJSON_AddItemToArray(meshes, m);
+            cJSON_AddNumberToObject(j, "mesh", nmesh++);
+            cJSON_AddItemToArray(nodes, j);
+            cJSON_AddItemToArray(ids, cJSON_CreateNumber((double)next++));
+        }
+        cJSON *ext = cJSON_AddObjectToObject(items[n], "extensions");
+        cJSON_AddItemToObject(cJSON_AddObjectToObject(ext, "MSFT_lod"), "ids", ids);
+        inst += nd->mesh_count;
+    }
+    cJSON *used = cJSON_AddArrayToObject(o->root, "extensionsUsed");
+    cJSON_AddItemToArray(used, cJSON_CreateString("MSFT_lod"));
+}
+
 static int identity(const float m[16])
 {
     for (int i = 0; i < 16; i++)
@@ -248,6 +291,8 @@ obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,
             cJSON_AddNumberToObject(j, "mesh", nmesh++);
         }
     }
+    if (r->lod_levels && r->lod_meshes && r->lod_instances)
+        lod_nodes(&o, scene, r, color, nodes, meshes, items, nmesh);
     free(items);
     if (scene->material_count) {
         cJSON *mats = cJSON_AddArrayToObject(o.root, "materials");

@@ -2,7 +2,8 @@
  * pre-transforms the vertices, which loses the instancing): meshes in their
  * own space, every node with its name, transform, meshes and glTF extras
  * (assimp 5.2 gives them as the node's metadata), and AC3D's double-sided
- * surfaces, which assimp drops, from the file itself. */
+ * surfaces, which assimp drops, from the file itself; a .glb's own LODs
+ * (MSFT_lod, which assimp does not expose) through lod_file.c. */
 #include <assimp/GltfMaterial.h>
 #include <assimp/cimport.h>
 #include <assimp/material.h>
@@ -16,6 +17,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "bake/lod.h"
 #include "internal.h"
 #include "obscura/bake.h"
 
@@ -39,6 +41,8 @@ void obs_bake_scene_free(obs_bake_scene *s)
     }
     for (size_t m = 0; m < s->material_count && s->materials; m++)
         free(s->materials[m].name);
+    obs__bake_lod_file_free(s);
+    free(s->file_lod_error);
     free(s->materials);
     free(s->meshes);
     free(s->nodes);
@@ -401,6 +405,13 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
     if (has_suffix(path, ".ac") || has_suffix(path, ".acc"))
         ac3d_two_sided(path, out);
     aiReleaseImport(sc);
+    /* The file's own LODs (lod_file.c); a reason they cannot be read is
+     * kept for the bake to name if it is asked for LODs. */
+    char lerr[OBS_ERR_LEN] = "";
+    if (obs__bake_lod_file_read(path, out, lerr) != OBS_OK && !(out->file_lod_error = strdup(lerr))) {
+        obs_bake_scene_free(out);
+        return obs__fail(err, OBS_NO_MEMORY, "%s: LODs", path);
+    }
     return OBS_OK;
 fail:
     aiReleaseImport(sc);

@@ -8,6 +8,9 @@
  *   trace.c    obscurance (eq 1) at two distances, Embree closest hits
  *   weld.c     triangle soup welded for the fit
  *   fit.c      least-squares vertex fit (Kavan et al. 2011), CHOLMOD
+ *   lod.c      LODs: lod_file.c (a .glb's MSFT_lod), simplify.c
+ *              (meshoptimizer), closest.c (nearest full-detail point),
+ *              the resampled fit (section 2.2.1)
  *   glb.c ply.c  the output files
  *   bake.c     the steps in order, timed (obs_bake_run)
  * The paper is "Baked ambient obscurance on the vertices of game levels"
@@ -49,6 +52,18 @@ typedef enum obs_bake_values {
     OBS_BAKE_VALUES_DEFAULT,
     OBS_BAKE_VALUES_LIST(OBS__BAKE_ENUM)
 } obs_bake_values;
+
+/* The most LOD levels a bake makes (parameter lods). */
+#define OBS_BAKE_MAX_LODS 8
+
+/* Where the LODs come from (parameter lod_source). */
+#define OBS_BAKE_LOD_SOURCE_LIST(X)                                            \
+    X(OBS_BAKE_LOD_SOURCE_FILE, file)         /* the file's MSFT_lod, else simplified */ \
+    X(OBS_BAKE_LOD_SOURCE_SIMPLIFY, simplify) /* meshoptimizer's for every mesh */
+typedef enum obs_bake_lod_source {
+    OBS_BAKE_LOD_SOURCE_DEFAULT,
+    OBS_BAKE_LOD_SOURCE_LIST(OBS__BAKE_ENUM)
+} obs_bake_lod_source;
 
 /* The bake parameters: X(name, type, default, min, max, choices, doc),
  * type FLOAT, INT or ENUM (choices '|'-separated, stored 1-based).  The
@@ -109,7 +124,30 @@ typedef enum obs_bake_values {
     X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
     X(max_triangles, INT, 100000000, 1, 2147483647, NULL,                      \
       "refuse a level with more triangles than this once instances are "      \
-      "flattened")
+      "flattened")                                                             \
+    X(lods, INT, 0, 0, OBS_BAKE_MAX_LODS, NULL,                                \
+      "lower levels of detail per mesh (the file's own or meshoptimizer's, "   \
+      "see lod_source), valued by resampling the full-detail bake onto their " \
+      "surface "                                                               \
+      "samples and the fit of eq 2 (section 2.2.1), written as MSFT_lod "      \
+      "levels of the .glb's nodes; 0: none")                                   \
+    X(lod_source, ENUM, "file", 0, 0,                                          \
+      (OBS_BAKE_LOD_SOURCE_LIST(OBS__BAKE_CHOICE) + 1),                        \
+      "where level l of a mesh comes from: file (the file's own, glTF "       \
+      "MSFT_lod, where it has one; the simplifier's elsewhere) or simplify "  \
+      "(the simplifier's for every mesh)")                                     \
+    X(lod_ratio, FLOAT, 0.5, 0.01, 0.99, NULL,                                 \
+      "target triangle count of LOD level l: lod_ratio^l of the mesh's")       \
+    X(lod_error, FLOAT, 0.02, 0.0, 1.0, NULL,                                  \
+      "the simplifier's error bound for LOD level l: l times this fraction "  \
+      "of the mesh's extent; a level stops short of its ratio rather than "   \
+      "move the surface further")                                              \
+    X(lod_check, INT, 0, 0, 1, NULL,                                           \
+      "1: also bake each LOD level directly (its samples traced on the LOD " \
+      "geometry, every instance at that level, and fitted) and report the "   \
+      "RMS of the resampled fit and of the vertex baseline against it, and "  \
+      "against the resampled values at held-out samples (one more trace per " \
+      "level)")
 
 #define OBS__BAKE_DECL_FLOAT(n) float n;
 #define OBS__BAKE_DECL_INT(n) int n;
@@ -190,10 +228,17 @@ typedef struct obs_bake_scene {
     size_t node_count;
     size_t instance_count;  /* (node, mesh) pairs */
     size_t world_triangles; /* triangles with instances flattened */
+    /* The file's own LODs (a .glb's MSFT_lod, core/bake/lod_file.c):
+     * level l of mesh m is file_lods[(l - 1) * mesh_count + m], with no
+     * triangles where the file has none; file_lod_error the reason they
+     * could not be read (the bake refuses --lods then), else NULL. */
+    obs_bake_mesh *file_lods;
+    size_t file_lod_levels;
+    char *file_lod_error;
 } obs_bake_scene;
 
 /* Loads a level through assimp (glTF/GLB, AC3D, OBJ, ...), keeping the node
- * graph.  Refuses a file without triangles, with non-finite coordinates, or
+ * graph, and a .glb's own LODs (MSFT_lod) into file_lods.  Refuses a file without triangles, with non-finite coordinates, or
  * with more than max_triangles once flattened (0: no limit), naming the
  * mesh.  Free with obs_bake_scene_free(). */
 obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene *out,
@@ -217,7 +262,8 @@ typedef struct obs_bake_instance {
     X(trace, "ray trace samples")                                              \
     X(weld, "weld")                                                            \
     X(assemble, "least-squares system")                                        \
-    X(solve, "CHOLMOD factorise and solve")
+    X(solve, "CHOLMOD factorise and solve")                                    \
+    X(lod, "LOD simplify, resample and solve")
 typedef enum obs_bake_stage {
 #define OBS__BAKE_STAGE(n, d) OBS_BAKE_STAGE_##n,
     OBS_BAKE_STAGE_LIST(OBS__BAKE_STAGE)
@@ -248,12 +294,44 @@ typedef struct obs_bake_stats {
     size_t holdout_samples;
     double regulariser_energy[2]; /* alpha x^T R x of the solution */
     double ao_mean, ao_min, ao_max;
+    /* LODs (parameter lods): per level l (index l - 1), over every
+     * instance; the RMS of the fit and of the vertex baseline (each LOD
+     * vertex the full-detail value at its nearest full-detail point)
+     * against the resampled values at the LOD's samples, and, with
+     * lod_check, of both and of the resampled values themselves against
+     * the direct bake of the LOD (its samples traced on the LOD geometry
+     * and fitted), over the LOD's samples; lod_direct_residual is that
+     * bake's own in-sample RMS (residual_fit's kind: the trace's noise
+     * and what the fit cannot follow). */
+    size_t lod_levels;
+    size_t lod_triangles[OBS_BAKE_MAX_LODS], lod_vertices[OBS_BAKE_MAX_LODS];
+    size_t lod_welded[OBS_BAKE_MAX_LODS], lod_samples[OBS_BAKE_MAX_LODS];
+    size_t lod_file_meshes[OBS_BAKE_MAX_LODS]; /* meshes whose level is the file's own */
+    double lod_fit[OBS_BAKE_MAX_LODS][2], lod_vertex[OBS_BAKE_MAX_LODS][2];
+    double lod_traced_fit[OBS_BAKE_MAX_LODS][2], lod_traced_vertex[OBS_BAKE_MAX_LODS][2];
+    double lod_traced_resampled[OBS_BAKE_MAX_LODS][2];
+    double lod_direct_residual[OBS_BAKE_MAX_LODS][2];
+    /* lod_check: the fit's and the baseline's RMS against the resampled
+     * values at held-out LOD samples (the holdout's seed; never fitted) */
+    double lod_holdout_fit[OBS_BAKE_MAX_LODS][2], lod_holdout_vertex[OBS_BAKE_MAX_LODS][2];
+    size_t lod_traced_samples[OBS_BAKE_MAX_LODS];
+    /* the lod stage's parts: simplify, resample, fit, check */
+    double lod_seconds[4];
 } obs_bake_stats;
 
 typedef struct obs_bake_result {
     obs_bake_instance *instances;
     size_t instance_count;
     obs_bake_stats stats;
+    /* LODs (parameter lods; core/bake/lod.c): level l = 1 .. lod_levels of
+     * the scene's mesh m is lod_meshes[(l - 1) * mesh_count + m], in the
+     * mesh's own space; instance i's values at level l are
+     * lod_instances[(l - 1) * instance_count + i] (node and mesh those of
+     * instances[i], one value per vertex of that level's mesh).  Owned by
+     * the result. */
+    size_t lod_levels;
+    obs_bake_mesh *lod_meshes;
+    obs_bake_instance *lod_instances;
 } obs_bake_result;
 
 typedef struct obs_bake_desc {
@@ -298,7 +376,10 @@ obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
  * every instance its own mesh with POSITION, NORMAL, indices and the
  * float attributes _AO, _AO_SHORT, _AO_LONG (and COLOR_0 = _AO as grey
  * when color is set); the materials' names, base colours, alpha modes
- * and sidedness (no textures). */
+ * and sidedness (no textures).  With LODs each node that holds meshes
+ * lists its LOD nodes in the MSFT_lod extension: nodes outside the
+ * scene's graph, the same transform, the levels' meshes with the same
+ * attributes. */
 obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,
                               const obs_bake_result *r, int color, char err[OBS_ERR_LEN]);
 /* Binary PLY of the world-space level: x y z (nx ny nz) quality (= _AO)

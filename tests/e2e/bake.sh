@@ -4,7 +4,9 @@
 # (tests/e2e/lib/glb_check.py) and read back through assimp (baked
 # again), `obscura gbuffer` of the .glb (the baked channels, against the
 # level's own G-buffer and the obscurance reference), `obscura ao` with
-# the baked channel (--baked, --baked-combine), the same bytes for 1 and 2 threads, the Khronos validator when
+# the baked channel (--baked, --baked-combine), the same bytes for 1 and 2 threads, --lods 2 (the LOD
+# nodes read back, the report's levels, the file's own MSFT_lod levels read on a re-bake), the Khronos
+# validator when
 # it is installed, clear errors for bad input and usage; a TORCS track of
 # ../shared/data when present.
 #
@@ -48,6 +50,65 @@ check "the same bytes whatever the thread count" "cmp -s $T/t1.glb $T/t2.glb"
 expect 0 "another seed" -- "$OBSCURA" bake "$FIX" -o "$T/s2.glb" --rays 16 --seed 2 -q
 check "another seed, other values" "! cmp -s $T/t1.glb $T/s2.glb"
 
+echo "-- LODs: --lods 2 (meshoptimizer's levels, the bake resampled onto them and fitted, MSFT_lod)"
+expect 0 "bake --lods 2 --lod-check 1" -- "$OBSCURA" bake "$FIX" -o "$T/lod.glb" --report "$T/lod.json" \
+    --rays 32 --lods 2 --lod-check 1
+said "LOD 2: "
+expect 0 "the same bake without LODs" -- "$OBSCURA" bake "$FIX" -o "$T/nolod.glb" --report "$T/nolod.json" --rays 32 -q
+check "the full detail is the bake without LODs (same residuals)" \
+    "[ \"\$(field $T/lod.json \"['residual_rms']\")\" = \"\$(field $T/nolod.json \"['residual_rms']\")\" ]"
+check "report: 2 levels, fewer triangles level by level, the lod stage timed" \
+    "field $T/lod.json \"['lods']['per_level'][1]['triangles']\" >/dev/null && python3 -c \"
+import json, sys; d = json.load(open('$T/lod.json')); l = d['lods']['per_level']
+sys.exit(not (d['lods']['levels'] == 2 and len(l) == 2 and 0 < l[1]['triangles'] < l[0]['triangles'] < d['counts']['triangles'] and d['seconds']['lod'] > 0 and l[1]['samples'] > 0))\""
+# against the bake made directly on the LOD geometry (traced there, fitted):
+# the resampled fit nearer than sampling at the LOD's vertices (aalborg
+# fixture, 32 rays: 0.031 / 0.036 at level 1, 0.040 / 0.051 at level 2)
+for k in 0 1; do
+    check "LOD $((k + 1)): fit nearer the direct LOD bake than vertex sampling (long)" "python3 -c \"
+import json, sys; r = json.load(open('$T/lod.json'))['lods']['per_level'][$k]['direct_bake_rms']
+sys.exit(not (r['least_squares']['long'] < r['vertex_sample']['long']))\""
+done
+expect 0 "the --lods .glb: each node's 2 LOD nodes with _AO, _AO_SHORT, _AO_LONG (glb_check --lods 2)" -- \
+    python3 tests/e2e/lib/glb_check.py "$T/lod.glb" 186 --lods 2
+expect 1 "... and glb_check tells a .glb without them" -- python3 tests/e2e/lib/glb_check.py "$T/nolod.glb" 62 --lods 2
+expect 0 "the --lods .glb read back through assimp (LOD nodes outside the scene)" -- "$OBSCURA" bake \
+    "$T/lod.glb" -o "$T/lod_b.glb" --report "$T/lod_b.json" --rays 8 -q
+check "read back: 811 triangles, 62 instances" \
+    "[ \"\$(field $T/lod_b.json \"['counts']['triangles']\")\" = 811 ] && [ \"\$(field $T/lod_b.json \"['counts']['instances']\")\" = 62 ]"
+echo "-- a file's own LODs (MSFT_lod): the --lods .glb baked again"
+expect 0 "re-bake of the --lods .glb with --lods 2 --lod-ratio 0.3 (lod_source file)" -- "$OBSCURA" bake \
+    "$T/lod.glb" -o "$T/lodf.glb" --report "$T/lodf.json" --rays 16 --lods 2 --lod-ratio 0.3 -q
+check "the file's levels used as they are: 62 meshes a level from the file, the first bake's triangles" "python3 -c \"
+import json, sys; a = json.load(open('$T/lod.json'))['lods']['per_level']; b = json.load(open('$T/lodf.json'))['lods']['per_level']
+sys.exit(not all(y['meshes_from_file'] == 62 and y['triangles'] == x['triangles'] for x, y in zip(a, b)))\""
+expect 0 "the re-baked .glb keeps its 2 LOD nodes a node" -- python3 tests/e2e/lib/glb_check.py "$T/lodf.glb" 186 --lods 2
+expect 0 "--lod-source simplify: simplified again" -- "$OBSCURA" bake "$T/lod.glb" -o "$T/lods.glb" \
+    --report "$T/lods.json" --rays 16 --lods 2 --lod-ratio 0.3 --lod-source simplify -q
+check "... at ratio 0.3: fewer triangles than the file's, none from the file" "python3 -c \"
+import json, sys; a = json.load(open('$T/lod.json'))['lods']['per_level']; b = json.load(open('$T/lods.json'))['lods']['per_level']
+sys.exit(not all(y['meshes_from_file'] == 0 and y['triangles'] < x['triangles'] for x, y in zip(a, b)))\""
+python3 tests/e2e/lib/glb_edit.py "$T/lod.glb" "$T/lodmove.glb" lodmove
+python3 tests/e2e/lib/glb_edit.py "$T/lod.glb" "$T/lodprims.glb" lodprims
+expect 3 "a LOD node moved against its node, with --lods" -- "$OBSCURA" bake "$T/lodmove.glb" -o "$T/x.glb" --lods 1 -q
+said "has another transform than its node"
+expect 0 "... baked without --lods" -- "$OBSCURA" bake "$T/lodmove.glb" -o "$T/x.glb" --rays 4 -q
+expect 0 "... or with --lod-source simplify" -- "$OBSCURA" bake "$T/lodmove.glb" -o "$T/x.glb" --rays 4 --lods 1 --lod-source simplify -q
+expect 3 "a LOD node whose mesh lacks a primitive" -- "$OBSCURA" bake "$T/lodprims.glb" -o "$T/x.glb" --lods 1 -q
+said "primitives like its node's"
+python3 tests/e2e/lib/glb_edit.py "$T/lod.glb" "$T/lodcount.glb" lodcount
+expect 3 "a LOD accessor beyond its view" -- "$OBSCURA" bake "$T/lodcount.glb" -o "$T/x.glb" --lods 1 -q
+said "beyond its view"
+expect 0 "--lods 2, 1 thread" -- "$OBSCURA" bake "$FIX" -o "$T/lod_t1.glb" --rays 16 --lods 2 --threads 1 -q
+expect 0 "--lods 2, 2 threads" -- "$OBSCURA" bake "$FIX" -o "$T/lod_t2.glb" --rays 16 --lods 2 --threads 2 -q
+check "LODs: the same bytes whatever the thread count" "cmp -s $T/lod_t1.glb $T/lod_t2.glb"
+expect 2 "--lods with a .ply output" -- "$OBSCURA" bake "$FIX" -o "$T/x.ply" --lods 1
+said "a .ply has no LODs"
+expect 2 "--lods 9" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" --lods 9
+said "lods"
+expect 2 "--lod-ratio 1" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" --lods 1 --lod-ratio 1
+said "lod_ratio"
+
 # The Khronos validator from npm, installed once into build/npm when npm
 # reaches its registry; skipped (saying so) when it cannot.
 NPM_DIR=build/npm
@@ -60,6 +121,7 @@ fi
 export NODE_PATH="$PWD/$NPM_DIR/node_modules${NODE_PATH:+:$NODE_PATH}"
 if command -v gltf_validator >/dev/null 2>&1; then
     expect 0 "Khronos glTF validator" -- gltf_validator -m "$T/a.glb"
+    expect 0 "Khronos glTF validator: the --lods .glb" -- gltf_validator -m "$T/lod.glb"
 elif node -e "require('gltf-validator')" >/dev/null 2>&1; then
     cat >"$T/validate.js" <<'JS'
 const v = require('gltf-validator'), fs = require('fs');
@@ -69,7 +131,7 @@ v.validateBytes(new Uint8Array(fs.readFileSync(process.argv[2])))
     if (i.numErrors || i.numWarnings) console.log(JSON.stringify(i.messages));
     process.exit(i.numErrors || i.numWarnings ? 1 : 0); });
 JS
-    for g in a b; do
+    for g in a b lod lodf; do
         expect 0 "Khronos glTF validator (npm gltf-validator): $g.glb, no errors or warnings" -- \
             node "$T/validate.js" "$T/$g.glb"
     done
@@ -101,6 +163,15 @@ expect 0 "_AO_SHORT against _AO_LONG" -- "$OBSCURA" compare "$T/g.exr" "$T/g.exr
 b2=$(json bias)
 check "bias(_AO - long) $b1 = 0.03 bias(short - long) $b2" \
     "awk 'BEGIN { d = $b1 - 0.03 * $b2; exit !(d < 1e-5 && d > -1e-5 && ($b2 > 0.005 || $b2 < -0.005)) }'"
+expect 0 "gbuffer of the --lods .glb" -- "$OBSCURA" gbuffer "$T/lod.glb" --camera "$T/cam0.json" -o "$T/g_lod.exr" -q
+expect 0 "gbuffer of the same bake without LODs" -- "$OBSCURA" gbuffer "$T/nolod.glb" --camera "$T/cam0.json" \
+    -o "$T/g_nolod.exr" -q
+for ch in A _AO N.Y; do
+    expect 0 "--lods .glb against the one without: $ch" -- "$OBSCURA" compare "$T/g_nolod.exr" "$T/g_lod.exr" \
+        --channel-a $ch --channel-b $ch --json
+    m=$(json mse)
+    check "the LOD nodes outside the scene are not drawn: $ch MSE $m = 0" "awk 'BEGIN { exit !($m == 0) }'"
+done
 echo "-- obscura ao with the baked channel (screen-space x baked)"
 expect 0 "ao on the baked G-buffer: _AO found by name" -- "$OBSCURA" ao "$T/g.exr" -o "$T/c.exr" --radius 2
 said "baked channel _AO combined (product)"
@@ -226,6 +297,10 @@ for n in 1 3 4; do
         "[ \"\$(field $T/merged$n.json \"['counts']['rays']\")\" = \"\$(field $T/whole.json \"['counts']['rays']\")\" ]"
     check "merged of $n: the parts' rays (24) in the report" "[ \"\$(field $T/merged$n.json \"['params']['rays']\")\" = 24 ]"
 done
+expect 0 "unsharded, 24 rays, --lods 2" -- "$OBSCURA" bake "$FIX" -o "$T/whole_lod.glb" --rays 24 --lods 2 -q
+expect 0 "merge of 3 shards with --lods 2" -- "$OBSCURA" bake "$FIX" --merge "$T"/part3.*.bin \
+    -o "$T/merged_lod.glb" --lods 2 -q
+check "merged with --lods = unsharded with --lods, byte for byte" "cmp -s $T/whole_lod.glb $T/merged_lod.glb"
 check "a part is 128 + 9 bytes a sample" \
     "[ \$((\$(cat $T/part3.*.bin | wc -c) - 3 * 128)) = \$((9 * \$(field $T/whole.json \"['counts']['samples']\"))) ]"
 expect 3 "a missing shard" -- "$OBSCURA" bake "$FIX" --merge "$T/part4.0.bin" "$T/part4.1.bin" "$T/part4.3.bin" -o "$T/x.glb" -q

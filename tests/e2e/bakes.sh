@@ -5,7 +5,8 @@
 # progress streamed as Server-Sent Events; a cancelled job (running and
 # queued), a failed one (bad input), unknown ids (404), bad queries and
 # bodies, the job limit, the token; frames are served while a bake runs,
-# and SIGTERM during a bake cancels it and the drain ends.
+# and SIGTERM during a bake cancels it and the drain ends; a bake with
+# lods=2 (the LOD levels of obscura bake --lods 2).
 #
 #   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/bakes.sh
 set -u
@@ -65,6 +66,13 @@ check "GET /v1/bakes/ID: per-stage times (queued, load, each stage, write)" \
 code=$(bget $S "/v1/bakes/$ID/result" "$T/r1.glb")
 check "GET /v1/bakes/ID/result: 200 model/gltf-binary, the bytes of obscura bake" \
     "[ $code = 200 ] && grep -qi 'Content-Type: model/gltf-binary' $T/r1.glb.h && cmp -s $T/r1.glb $T/local.glb"
+"$OBSCURA" bake "$FIX" -o "$T/local_lod.glb" --rays 16 --lods 2 -q
+code=$(bpost $S "rays=16&lods=2" "$FIX" "$T/p_lod")
+ID_LOD=$(id_of "$T/p_lod")
+check "a bake job with lods=2 ends done" "[ $code = 202 ] && wait_state $S $ID_LOD done"
+code=$(bget $S "/v1/bakes/$ID_LOD/result" "$T/r_lod.glb")
+check "... its result: the bytes of obscura bake --lods 2 (MSFT_lod levels)" \
+    "[ $code = 200 ] && cmp -s $T/r_lod.glb $T/local_lod.glb && grep -q MSFT_lod $T/r_lod.glb"
 code=$(bget $S "/v1/bakes" "$T/list")
 check "GET /v1/bakes lists it" "[ $code = 200 ] && grep -q '\"id\":\"$ID\",\"state\":\"done\"' $T/list"
 code=$(bget $S "/v1/bakes/$ID/events" "$T/ev1")

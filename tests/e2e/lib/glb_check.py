@@ -5,7 +5,12 @@ accessor inside its view, POSITION min/max the true ones, material
 indices in range, and per
 primitive _AO, _AO_SHORT, _AO_LONG of POSITION's count with values in
 [0, 1] and _AO = blend of the other two.  Usage: glb_check.py FILE [PRIMS]
-(PRIMS: the number of primitives expected)."""
+(PRIMS: the number of primitives expected, LODs' included).
+With --lods N: extensionsUsed names MSFT_lod, every node with a mesh lists
+N LOD nodes in its MSFT_lod ids, each outside the scene's graph, with a
+mesh of as many primitives, each with fewer or as many triangles as the
+level above and the same _AO attributes (checked above); without it, no
+node has MSFT_lod."""
 import array
 import json
 import struct
@@ -62,15 +67,47 @@ def main():
                     blend = b if blend is None else blend
                     assert abs(b - blend) < 2e-3 or abs(ao - (blend * s + (1 - blend) * l)) < 1e-5
             prims += 1
-    if len(sys.argv) > 2:
+    if len(sys.argv) > 2 and sys.argv[2] != "--lods":
         assert prims == int(sys.argv[2]), "%d primitives" % prims
     nodes = doc["nodes"]
     seen = set(doc["scenes"][0]["nodes"])
     for n in nodes:
         seen.update(n.get("children", []))
+    lods = int(sys.argv[sys.argv.index("--lods") + 1]) if "--lods" in sys.argv else 0
+    lod_nodes = set()
+
+    def tris(mesh):
+        return [values(p["indices"])[0]["count"] // 3 for p in doc["meshes"][mesh]["primitives"]]
+
+    for i, n in enumerate(nodes):
+        ids = n.get("extensions", {}).get("MSFT_lod", {}).get("ids")
+        if not lods:
+            assert ids is None, "node %d: MSFT_lod without --lods" % i
+            continue
+        if i not in seen:  # a LOD node itself
+            assert ids is None, "LOD node %d: MSFT_lod of its own" % i
+            continue
+        if "mesh" not in n:
+            assert ids is None, "node %d: MSFT_lod without a mesh" % i
+            continue
+        assert ids is not None and len(ids) == lods, "node %d: MSFT_lod ids %s" % (i, ids)
+        above = tris(n["mesh"])
+        for k, j in enumerate(ids):
+            assert j not in seen, "LOD node %d is in the scene's graph" % j
+            lod = nodes[j]
+            assert lod["name"] == "%s_LOD%d" % (n["name"], k + 1), lod["name"]
+            assert lod.get("matrix") == n.get("matrix") and "children" not in lod
+            t = tris(lod["mesh"])
+            assert len(t) == len(above) and all(0 < a <= b for a, b in zip(t, above)), (t, above)
+            above = t
+            lod_nodes.add(j)
+    if lods:
+        assert "MSFT_lod" in doc.get("extensionsUsed", []), "extensionsUsed"
+        assert lod_nodes, "no LOD node"
+    seen |= lod_nodes
     assert len(seen) == len(nodes), "every node reachable"
-    print("glb ok: %d nodes, %d primitives, blend %s" % (len(nodes), prims,
-                                                        "%.4f" % blend if blend is not None else "-"))
+    print("glb ok: %d nodes (%d LOD), %d primitives, blend %s" % (
+        len(nodes), len(lod_nodes), prims, "%.4f" % blend if blend is not None else "-"))
 
 
 main()
