@@ -19,6 +19,7 @@ void cli_bake_usage(FILE *f)
     fprintf(f,
             "  obscura bake LEVEL -o OUT.(glb|ply) [--distances S,L] [--blend B]\n"
             "                  [--report R.json] [--ply P.ply] [--color] [--quiet]\n"
+            "                  [--decorators D.json]\n"
             "                  [--PARAM VALUE]...  ambient obscurance baked onto the vertices\n"
             "                  of a level (glTF/GLB, AC3D, anything assimp reads; node graph\n"
             "                  and instances kept): _AO, _AO_SHORT, _AO_LONG per vertex;\n"
@@ -57,6 +58,43 @@ static void list_params(int markdown)
         else
             printf("%-24s %-10s %-22s %s\n", flag, def, range, pi->doc);
     }
+}
+
+/* The whole of a small text file (a decorators file), NUL-terminated;
+ * caller frees. */
+static obs_status read_text(const char *path, char **out, char err[OBS_ERR_LEN])
+{
+    *out = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, OBS_ERR_LEN, "cannot open: %s", strerror(errno));
+        return OBS_IO;
+    }
+    size_t cap = 4096, n = 0;
+    char *b = malloc(cap);
+    for (size_t got; b && (got = fread(b + n, 1, cap - n - 1, f)) > 0;) {
+        n += got;
+        if (n + 1 == cap) {
+            char *nb = cap < ((size_t)1 << 30) ? realloc(b, cap * 2) : NULL;
+            if (!nb) {
+                free(b);
+                b = NULL;
+                break;
+            }
+            b = nb;
+            cap *= 2;
+        }
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (!b || bad) {
+        free(b);
+        snprintf(err, OBS_ERR_LEN, "%s", bad ? "read error" : "too large (1 GiB at most)");
+        return bad ? OBS_IO : OBS_TOO_LARGE;
+    }
+    b[n] = 0;
+    *out = b;
+    return OBS_OK;
 }
 
 typedef struct progress {
@@ -128,6 +166,10 @@ static int write_report(const char *path, const char *level, const obs_bake_para
     cJSON_AddNumberToObject(c, "vertices_without_samples", (double)st->vertices_without_samples);
     cJSON_AddNumberToObject(c, "vertices_isolated", (double)st->vertices_isolated);
     cJSON_AddNumberToObject(c, "rays", (double)st->rays);
+    cJSON *dn = cJSON_AddObjectToObject(r, "decorator_nodes");
+    static const char *const dnames[4] = {"none", "shrub", "tree", "small"};
+    for (int k = 0; k < 4; k++)
+        cJSON_AddNumberToObject(dn, dnames[k], (double)st->decorator_nodes[k]);
     double ts = st->seconds[OBS_BAKE_STAGE_trace];
     cJSON_AddNumberToObject(r, "rays_per_second", ts > 0.0 ? (double)st->rays / ts : 0.0);
     cJSON *res = cJSON_AddObjectToObject(r, "residual_rms");
@@ -164,6 +206,8 @@ static int ends_with(const char *s, const char *tail);
 
 static void warn(const char *level, const obs_bake_stats *st)
 {
+    if (st->decorator_warning[0])
+        fprintf(stderr, "obscura: bake: warning: %s\n", st->decorator_warning);
     /* assimp 5.2's AC3D reader drops the surfaces' double-sided flag
      * (SURF 0x20); the loader reads it from the file, unless the file's
      * objects and assimp's nodes disagree. */
@@ -202,7 +246,7 @@ static int ends_with(const char *s, const char *tail)
 
 int cli_bake(int argc, char **argv)
 {
-    const char *in = NULL, *out = NULL, *report = NULL, *ply = NULL;
+    const char *in = NULL, *out = NULL, *report = NULL, *ply = NULL, *decorators = NULL;
     int color = 0, quiet = 0, shard = -1, shards = 0, merging = 0, merge = 0;
     const char **parts = calloc((size_t)argc + 1, sizeof *parts);
     size_t nparts = 0;
@@ -259,6 +303,8 @@ int cli_bake(int argc, char **argv)
             shard = (int)si, shards = (int)n;
         } else if (!strcmp(key, "report")) {
             report = val;
+        } else if (!strcmp(key, "decorators")) {
+            decorators = val;
         } else if (!strcmp(key, "ply")) {
             ply = val;
         } else if (!strcmp(key, "distances")) {
@@ -296,11 +342,21 @@ int cli_bake(int argc, char **argv)
     obs_bake_params p;
     obs_bake_params_resolve(&desc.params, &p);
 
+    char *decor_text = NULL;
+    if (decorators) {
+        obs_status ds = read_text(decorators, &decor_text, err);
+        if (ds != OBS_OK) {
+            free(parts);
+            return cli_input_fail(ds, decorators, err);
+        }
+        desc.decorators_json = decor_text;
+    }
     double t0 = cli_now_s();
     obs_bake_scene sc;
     obs_status s = obs_bake_load(in, (size_t)p.max_triangles, &sc, err);
     if (s != OBS_OK) {
         free(parts);
+        free(decor_text);
         return cli_input_fail(s, in, err);
     }
     double load_s = cli_now_s() - t0;
@@ -323,10 +379,12 @@ int cli_bake(int argc, char **argv)
                     st.seconds[OBS_BAKE_STAGE_trace], out);
         obs_bake_scene_free(&sc);
         free(parts);
+        free(decor_text);
         return rc;
     }
     s = nparts ? obs_bake_merge(&sc, &desc, parts, nparts, &r, err) : obs_bake_run(&sc, &desc, &r, err);
     free(parts);
+    free(decor_text);
     if (s != OBS_OK) {
         obs_bake_scene_free(&sc);
         return nparts ? cli_input_fail(s, in, err) : cli_fail(s, in, err);

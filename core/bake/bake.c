@@ -1,10 +1,12 @@
 /* The bake's steps in order (obscura/bake.h), each timed. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "bake/bake_internal.h"
+#include "bake/decor.h"
 #include "bake/shard.h"
 #include "internal.h"
 
@@ -122,6 +124,7 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     obs__bake_world w = {0};
     obs__bake_samples s = {0};
     obs__bake_weld wd = {0};
+    obs__bake_decor dc = {0};
     double *x = NULL, *face = NULL, *point = NULL;
     obs_status rc;
     if (!scene || scene->node_count == 0)
@@ -140,6 +143,13 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     st->faces_against_normals = w.against_normals;
     for (size_t k = 0; k < w.triangle_count; k++)
         st->two_sided_triangles += w.two_sided[k];
+    /* Decorators (section 2.2): which nodes are shrubs, trees, small. */
+    if ((rc = obs__bake_decor_classify(scene, &p, desc ? desc->decorators_json : NULL, &dc,
+                                       err)) != OBS_OK)
+        goto done;
+    snprintf(st->decorator_warning, sizeof st->decorator_warning, "%s", err);
+    err[0] = 0;
+    memcpy(st->decorator_nodes, dc.counts, sizeof dc.counts);
     st->seconds[OBS_BAKE_STAGE_flatten] = now() - t;
 
     t = now();
@@ -192,6 +202,7 @@ done:
     free(face);
     free(point);
     obs__bake_weld_free(&wd);
+    obs__bake_decor_free(&dc);
     obs__bake_samples_free(&s);
     obs__bake_world_free(&w);
     if (rc != OBS_OK) {

@@ -50,6 +50,18 @@ typedef enum obs_bake_values {
     OBS_BAKE_VALUES_LIST(OBS__BAKE_ENUM)
 } obs_bake_values;
 
+/* Which nodes are decorators (parameter `decorator_source`, section 2.2;
+ * core/bake/decor.c): from the glTF extras, the node names and the
+ * --decorators file, from the file alone, or none (all opaque). */
+#define OBS_BAKE_DECOR_LIST(X)                                                 \
+    X(OBS_BAKE_DECOR_AUTO, auto) /* file, then extras, then names */        \
+    X(OBS_BAKE_DECOR_FILE, file) /* only the --decorators file */            \
+    X(OBS_BAKE_DECOR_OFF, off)   /* no decorators: everything opaque */
+typedef enum obs_bake_decor_mode {
+    OBS_BAKE_DECOR_DEFAULT,
+    OBS_BAKE_DECOR_LIST(OBS__BAKE_ENUM)
+} obs_bake_decor_mode;
+
 /* The bake parameters: X(name, type, default, min, max, choices, doc),
  * type FLOAT, INT or ENUM (choices '|'-separated, stored 1-based).  The
  * CLI's flags, `obscura bake --params` and README's bake table come from
@@ -104,6 +116,16 @@ typedef enum obs_bake_values {
       "held-out check: this many samples per face (mean, placed and capped "   \
       "as above, other positions and rays) traced after the fit and compared " \
       "with the fit and the two baselines (the report's holdout rows); 0: off") \
+    X(decorator_source, ENUM, "auto", 0, 0, (OBS_BAKE_DECOR_LIST(OBS__BAKE_CHOICE) + 1), \
+      "which nodes are decorators (section 2.2): auto (the --decorators "     \
+      "file first, then the glTF extras' class/kind, then words of the node " \
+      "name: tree, bush, shrub, hedge, grass; a node without any takes its "   \
+      "parent's class), file (the --decorators file only) or off (every "     \
+      "node opaque geometry)")                                                 \
+    X(shrub_density, FLOAT, 1.0, 0.0, 1000.0, NULL,                            \
+      "fog density (1/m) of a shrub's world box when neither the "            \
+      "--decorators file nor the node's extras give one: a ray's visibility " \
+      "is multiplied by exp(-density * length inside the box) (section 2.1)")  \
     X(seed, INT, 1, 0, 2147483647, NULL,                                       \
       "random seed; the bake depends on it alone, not on the thread count")    \
     X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
@@ -248,6 +270,11 @@ typedef struct obs_bake_stats {
     size_t holdout_samples;
     double regulariser_energy[2]; /* alpha x^T R x of the solution */
     double ao_mean, ao_min, ao_max;
+    /* Decorators (section 2.2, core/bake/decor.c): nodes per class, none,
+     * shrub, tree, small; and the classification's warning (entries of
+     * the decorators file that match no node), "" when none. */
+    size_t decorator_nodes[4];
+    char decorator_warning[OBS_ERR_LEN];
 } obs_bake_stats;
 
 typedef struct obs_bake_result {
@@ -263,6 +290,9 @@ typedef struct obs_bake_desc {
      * stops the bake: obs_bake_run returns OBS_CANCELLED. */
     int (*progress)(void *user, size_t done, size_t total);
     void *progress_user;
+    /* The text of a decorators file (README's bake section, parameter
+     * decorator_source), or NULL; read by the bake, kept by the caller. */
+    const char *decorators_json;
 } obs_bake_desc;
 
 /* Bakes the level: per-vertex obscurance for every instance.  Free with
