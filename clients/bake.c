@@ -123,9 +123,37 @@ static cJSON *pair(const double v[2])
     return o;
 }
 
+/* The instanced decorators (section 2.2): counts, the volume, eq 3's
+ * residual and every instance's coefficients (README's bake section). */
+static void report_instanced(cJSON *r, const obs_bake_scene *sc, const obs_bake_stats *st,
+                             const obs_bake_result *res)
+{
+    cJSON *in = cJSON_AddObjectToObject(r, "instanced");
+    cJSON_AddNumberToObject(in, "meshes", (double)st->instanced_meshes);
+    cJSON_AddNumberToObject(in, "instances", (double)st->instanced_instances);
+    cJSON_AddNumberToObject(in, "volume_bricks", (double)st->volume_bricks);
+    cJSON_AddNumberToObject(in, "volume_points", (double)st->volume_points);
+    cJSON_AddNumberToObject(in, "volume_points_inside", (double)st->volume_points_inside);
+    cJSON_AddNumberToObject(in, "volume_rays", (double)st->volume_rays);
+    cJSON_AddNumberToObject(in, "eq3_residual_rms", st->instanced_residual);
+    cJSON *list = cJSON_AddArrayToObject(in, "list");
+    static const char *const keys[3] = {"global_ao", "global_ao_short", "global_ao_long"};
+    for (size_t i = 0; res && i < res->instance_count; i++) {
+        const obs_bake_instance *b = &res->instances[i];
+        if (!b->ao_local)
+            continue;
+        cJSON *e = cJSON_CreateObject();
+        cJSON_AddStringToObject(e, "node", sc->nodes[b->node].name ? sc->nodes[b->node].name : "");
+        cJSON_AddStringToObject(e, "mesh", sc->meshes[b->mesh].name ? sc->meshes[b->mesh].name : "");
+        for (int c = 0; c < 3; c++)
+            cJSON_AddItemToObject(e, keys[c], cJSON_CreateFloatArray(b->global[c], 4));
+        cJSON_AddItemToArray(list, e);
+    }
+}
+
 static int write_report(const char *path, const char *level, const obs_bake_params *p,
-                        const obs_bake_scene *sc, const obs_bake_stats *st, double load_s,
-                        double write_s)
+                        const obs_bake_scene *sc, const obs_bake_stats *st,
+                        const obs_bake_result *result, double load_s, double write_s)
 {
     cJSON *r = cJSON_CreateObject();
     cJSON_AddStringToObject(r, "level", level);
@@ -184,6 +212,7 @@ static int write_report(const char *path, const char *level, const obs_bake_para
         cJSON_AddItemToObject(h, "face_mean", pair(st->holdout_face_mean));
         cJSON_AddItemToObject(h, "point_sample", pair(st->holdout_point));
     }
+    report_instanced(r, sc, st, result);
     cJSON *ao = cJSON_AddObjectToObject(r, "ao");
     cJSON_AddNumberToObject(ao, "mean", st->ao_mean);
     cJSON_AddNumberToObject(ao, "min", st->ao_min);
@@ -370,7 +399,7 @@ int cli_bake(int argc, char **argv)
         obs_bake_stats st;
         s = obs_bake_shard(&sc, &desc, shard, shards, out, &st, err);
         int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, in, err);
-        if (rc == EXIT_OK && report && !write_report(report, in, &p, &sc, &st, load_s, 0.0))
+        if (rc == EXIT_OK && report && !write_report(report, in, &p, &sc, &st, NULL, load_s, 0.0))
             rc = EXIT_FAIL;
         if (rc == EXIT_OK && !quiet)
             fprintf(stderr, "obscura: bake: shard %d/%d: %zu samples (%zu dropped by the back-face "
@@ -401,7 +430,7 @@ int cli_bake(int argc, char **argv)
     int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, out, err);
     const obs_bake_stats *st = &r.stats;
     if (rc == EXIT_OK && report &&
-        !write_report(report, in, &p, &sc, st, load_s, write_s))
+        !write_report(report, in, &p, &sc, st, &r, load_s, write_s))
         rc = EXIT_FAIL;
     if (rc == EXIT_OK && !quiet)
         fprintf(stderr,

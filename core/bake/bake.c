@@ -7,6 +7,7 @@
 
 #include "bake/bake_internal.h"
 #include "bake/decor.h"
+#include "bake/instanced.h"
 #include "bake/shard.h"
 #include "internal.h"
 
@@ -36,6 +37,7 @@ void obs_bake_result_free(obs_bake_result *r)
         free(r->instances[i].ao);
         free(r->instances[i].ao_short);
         free(r->instances[i].ao_long);
+        free(r->instances[i].ao_local);
     }
     free(r->instances);
     memset(r, 0, sizeof *r);
@@ -126,6 +128,8 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     obs__bake_weld wd = {0};
     obs__bake_decor dc = {0};
     double *x = NULL, *face = NULL, *point = NULL;
+    uint8_t *inst_sel = NULL;
+    size_t inst_n = 0;
     obs_status rc;
     if (!scene || scene->node_count == 0)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "bake: no scene");
@@ -150,6 +154,14 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     snprintf(st->decorator_warning, sizeof st->decorator_warning, "%s", err);
     err[0] = 0;
     memcpy(st->decorator_nodes, dc.counts, sizeof dc.counts);
+    /* Large instanced decorators (section 2.2, instanced.c): no surface
+     * samples of their own in the level. */
+    if (!(inst_sel = malloc(w.instance_count ? w.instance_count : 1))) {
+        rc = obs__fail(err, OBS_NO_MEMORY, "%zu instances", w.instance_count);
+        goto done;
+    }
+    if ((inst_n = obs__bake_instanced_select(scene, &w, &dc, &p, inst_sel)))
+        obs__bake_instanced_mask(&w, inst_sel);
     st->seconds[OBS_BAKE_STAGE_flatten] = now() - t;
 
     t = now();
@@ -194,10 +206,15 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     }
     if ((rc = obs__bake_fit(&w, &wd, &s, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
+    if (inst_n)
+        obs__bake_instanced_uncount(&w, &wd, inst_sel, st);
     if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
     rc = copy_back(scene, &w, &wd, x, p.blend, out, err);
+    if (rc == OBS_OK && inst_n)
+        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, out, err);
 done:
+    free(inst_sel);
     free(x);
     free(face);
     free(point);

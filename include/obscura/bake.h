@@ -8,6 +8,9 @@
  *   trace.c    obscurance (eq 1) at two distances, Embree closest hits
  *   weld.c     triangle soup welded for the fit
  *   fit.c      least-squares vertex fit (Kavan et al. 2011), CHOLMOD
+ *   instanced.c volume.c  instanced trees (section 2.2): local AO per
+ *              mesh x a linear global AO per instance (eq 3) fitted to a
+ *              sparse SH volume
  *   glb.c ply.c  the output files
  *   bake.c     the steps in order, timed (obs_bake_run)
  * The paper is "Baked ambient obscurance on the vertices of game levels"
@@ -61,6 +64,29 @@ typedef enum obs_bake_decor_mode {
     OBS_BAKE_DECOR_DEFAULT,
     OBS_BAKE_DECOR_LIST(OBS__BAKE_ENUM)
 } obs_bake_decor_mode;
+
+/* Which instances take the instanced-decorator path of section 2.2
+ * (parameter `instanced`; core/bake/instanced.c): a local AO per mesh
+ * baked in isolation times a per-instance linear global AO (eq 3). */
+#define OBS_BAKE_INSTANCED_LIST(X)                                             \
+    X(OBS_BAKE_INSTANCED_TREES, trees) /* nodes of class tree */              \
+    X(OBS_BAKE_INSTANCED_OFF, off)     /* none: every instance traced in place */
+typedef enum obs_bake_instanced_mode {
+    OBS_BAKE_INSTANCED_DEFAULT,
+    OBS_BAKE_INSTANCED_LIST(OBS__BAKE_ENUM)
+} obs_bake_instanced_mode;
+
+/* What the vertices of an instanced decorator get (parameter
+ * `instanced_values`): the paper's model, or one of its two halves alone
+ * for comparisons (bench/bake_instanced.sh). */
+#define OBS_BAKE_IVALUES_LIST(X)                                               \
+    X(OBS_BAKE_IVALUES_PRODUCT, product) /* local x global (section 2.2) */   \
+    X(OBS_BAKE_IVALUES_LINEAR, linear)   /* the linear global fit alone */    \
+    X(OBS_BAKE_IVALUES_LOCAL, local)     /* the local AO alone */
+typedef enum obs_bake_ivalues {
+    OBS_BAKE_IVALUES_DEFAULT,
+    OBS_BAKE_IVALUES_LIST(OBS__BAKE_ENUM)
+} obs_bake_ivalues;
 
 /* The bake parameters: X(name, type, default, min, max, choices, doc),
  * type FLOAT, INT or ENUM (choices '|'-separated, stored 1-based).  The
@@ -126,6 +152,25 @@ typedef enum obs_bake_decor_mode {
       "fog density (1/m) of a shrub's world box when neither the "            \
       "--decorators file nor the node's extras give one: a ray's visibility " \
       "is multiplied by exp(-density * length inside the box) (section 2.1)")  \
+    X(instanced, ENUM, "trees", 0, 0, (OBS_BAKE_INSTANCED_LIST(OBS__BAKE_CHOICE) + 1), \
+      "large instanced decorators (section 2.2): trees (every node of class "  \
+      "tree whose mesh at least instanced_min tree nodes use gets a local AO " \
+      "per mesh, baked alone, times a linear global AO per instance fitted "   \
+      "by eq 3 to a sparse volume of spherical visibility) or off (traced "    \
+      "in place like any other geometry)")                                     \
+    X(instanced_min, INT, 1, 1, 1000000, NULL,                                 \
+      "a mesh takes the instanced path when at least this many tree nodes "   \
+      "hold it")                                                               \
+    X(instanced_values, ENUM, "product", 0, 0, (OBS_BAKE_IVALUES_LIST(OBS__BAKE_CHOICE) + 1), \
+      "the instanced decorators' vertex values: product (local x global, "    \
+      "the paper's), or for comparisons linear (the global linear function "  \
+      "fitted alone, local AO taken as 1) or local (the local AO alone)")      \
+    X(volume_spacing, FLOAT, 1.0, 1e-3, 1e6, NULL,                             \
+      "spacing (world units) of the sparse volume's points around the "       \
+      "instanced decorators (section 2.2)")                                    \
+    X(volume_rays, INT, 128, 4, 65536, NULL,                                   \
+      "rays over the sphere per volume point, projected to quadratic SH at "  \
+      "both distances")                                                        \
     X(seed, INT, 1, 0, 2147483647, NULL,                                       \
       "random seed; the bake depends on it alone, not on the thread count")    \
     X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
@@ -229,6 +274,14 @@ void obs_bake_scene_free(obs_bake_scene *s);
 typedef struct obs_bake_instance {
     uint32_t node, mesh;
     float *ao, *ao_short, *ao_long;
+    /* Instanced decorators (section 2.2, parameter instanced): ao_local
+     * the mesh's local AO per vertex (the blend of its two distances; NULL
+     * for other instances) and global[c] the coefficients (g0, gx, gy, gz)
+     * of the linear global AO G(q) = g0 + gx qx + gy qy + gz qz, q the
+     * vertex's position in the mesh's own space, for c = 0 the blend
+     * (_AO), 1 short, 2 long; ao is ao_local x G (clamped to [0, 1]). */
+    float *ao_local;
+    float global[3][4];
 } obs_bake_instance;
 
 /* Stages of the bake, in order (the report's rows). */
@@ -239,7 +292,10 @@ typedef struct obs_bake_instance {
     X(trace, "ray trace samples")                                              \
     X(weld, "weld")                                                            \
     X(assemble, "least-squares system")                                        \
-    X(solve, "CHOLMOD factorise and solve")
+    X(solve, "CHOLMOD factorise and solve")                                   \
+    X(local, "instanced: local AO of each mesh alone")                        \
+    X(volume, "instanced: sparse volume of spherical visibility")             \
+    X(global, "instanced: eq 3 fits per instance")
 typedef enum obs_bake_stage {
 #define OBS__BAKE_STAGE(n, d) OBS_BAKE_STAGE_##n,
     OBS_BAKE_STAGE_LIST(OBS__BAKE_STAGE)
@@ -275,6 +331,15 @@ typedef struct obs_bake_stats {
      * the decorators file that match no node), "" when none. */
     size_t decorator_nodes[4];
     char decorator_warning[OBS_ERR_LEN];
+    /* Instanced decorators (section 2.2, core/bake/instanced.c): meshes
+     * baked alone, instances fitted, the volume's bricks and points (and
+     * those inside geometry by the back-face rule, left out of the
+     * interpolation), its rays, and the RMS over the instances' vertices
+     * of the volume's AO minus the model's (eq 3's residual, blend). */
+    size_t instanced_meshes, instanced_instances, volume_bricks, volume_points,
+        volume_points_inside;
+    uint64_t volume_rays;
+    double instanced_residual;
 } obs_bake_stats;
 
 typedef struct obs_bake_result {

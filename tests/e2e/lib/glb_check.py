@@ -4,8 +4,12 @@ header and chunk lengths, every bufferView inside the buffer, every
 accessor inside its view, POSITION min/max the true ones, material
 indices in range, and per
 primitive _AO, _AO_SHORT, _AO_LONG of POSITION's count with values in
-[0, 1] and _AO = blend of the other two.  Usage: glb_check.py FILE [PRIMS]
-(PRIMS: the number of primitives expected)."""
+[0, 1] and _AO = blend of the other two; for an instanced tree
+(section 2.2: _AO_LOCAL and its node's extras "obscura_instanced"),
+_AO = clamp(_AO_LOCAL x G(POSITION)) with G = global_ao instead (README's
+bake section).  Usage: glb_check.py FILE [PRIMS [INSTANCED]]
+(PRIMS: the number of primitives expected, INSTANCED: of instanced
+ones)."""
 import array
 import json
 import struct
@@ -37,9 +41,16 @@ def main():
         return a, x, n
 
     blend = None
-    prims = 0
-    for mesh in doc["meshes"]:
-        for p in mesh["primitives"]:
+    prims = instanced = 0
+    coef = {}  # (mesh, primitive) -> global_ao of the node holding it
+    for n in doc["nodes"]:
+        for e in n.get("extras", {}).get("obscura_instanced", []) if isinstance(
+                n.get("extras"), dict) else []:
+            for key in ("global_ao", "global_ao_short", "global_ao_long"):
+                assert len(e[key]) == 4, key
+            coef[(n["mesh"], e["primitive"])] = e["global_ao"]
+    for mi, mesh in enumerate(doc["meshes"]):
+        for pi, p in enumerate(mesh["primitives"]):
             at = p["attributes"]
             a, pos, _ = values(at["POSITION"])
             for k in range(3):
@@ -56,6 +67,18 @@ def main():
                 assert n == 1 and acc["count"] == nv, name
                 assert 0.0 <= min(x) and max(x) <= 1.0, name
                 vals[name] = x
+            if "_AO_LOCAL" in at:
+                _, loc, _ = values(at["_AO_LOCAL"])
+                g = coef[(mi, pi)]
+                for v in range(nv):
+                    want = loc[v] * (g[0] + g[1] * pos[3 * v] + g[2] * pos[3 * v + 1] +
+                                     g[3] * pos[3 * v + 2])
+                    want = min(1.0, max(0.0, want))
+                    assert abs(vals["_AO"][v] - want) < 1e-4, "_AO = _AO_LOCAL x G"
+                instanced += 1
+                prims += 1
+                continue
+            assert (mi, pi) not in coef, "coefficients without _AO_LOCAL"
             for ao, s, l in zip(vals["_AO"], vals["_AO_SHORT"], vals["_AO_LONG"]):
                 if abs(s - l) > 1e-3:  # the blend, where it is determined
                     b = (ao - l) / (s - l)
@@ -64,12 +87,14 @@ def main():
             prims += 1
     if len(sys.argv) > 2:
         assert prims == int(sys.argv[2]), "%d primitives" % prims
+    if len(sys.argv) > 3:
+        assert instanced == int(sys.argv[3]), "%d instanced primitives" % instanced
     nodes = doc["nodes"]
     seen = set(doc["scenes"][0]["nodes"])
     for n in nodes:
         seen.update(n.get("children", []))
     assert len(seen) == len(nodes), "every node reachable"
-    print("glb ok: %d nodes, %d primitives, blend %s" % (len(nodes), prims,
+    print("glb ok: %d nodes, %d primitives (%d instanced), blend %s" % (len(nodes), prims, instanced,
                                                         "%.4f" % blend if blend is not None else "-"))
 
 
