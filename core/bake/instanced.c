@@ -163,10 +163,15 @@ size_t obs__bake_instanced_select(const obs_bake_scene *s, const obs__bake_world
 
 void obs__bake_instanced_mask(obs__bake_world *w, const uint8_t *sel)
 {
+    /* Counted with the degenerate faces from here on (the report took
+     * its count before), so that the sample budget, a mean per face with
+     * area (samples.c), is the rest of the level's alone. */
     for (size_t i = 0; i < w->instance_count; i++)
         if (sel[i])
-            for (size_t t = w->inst[i].first_triangle; t < tri_end(w, i); t++)
+            for (size_t t = w->inst[i].first_triangle; t < tri_end(w, i); t++) {
+                w->degenerate += w->area[t] > 0.0f;
                 w->area[t] = 0.0f;
+            }
 }
 
 void obs__bake_instanced_uncount(const obs__bake_world *w, const obs__bake_weld *wd,

@@ -79,7 +79,8 @@ size_t obs__bake_instanced_select(const obs_bake_scene *s, const obs__bake_world
                                   const obs__bake_decor *dc, const obs_bake_params *p,
                                   uint8_t *sel);
 /* Their faces get no surface samples in the level (area 0: samples.c
- * gives none, fit.c pins their vertices); the BVH keeps them. */
+ * gives none, fit.c pins their vertices) nor a share of the sample
+ * budget (counted in w->degenerate); the BVH keeps them. */
 void obs__bake_instanced_mask(obs__bake_world *w, const uint8_t *sel);
 /* The fit's counts of vertices without samples and isolated ones (st)
  * less the welded vertices that only selected instances hold: those have

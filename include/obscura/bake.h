@@ -165,7 +165,7 @@ typedef enum obs_bake_ivalues {
       "the instanced decorators' vertex values: product (local x global, "    \
       "the paper's), or for comparisons linear (the global linear function "  \
       "fitted alone, local AO taken as 1) or local (the local AO alone)")      \
-    X(volume_spacing, FLOAT, 1.0, 1e-3, 1e6, NULL,                             \
+    X(volume_spacing, FLOAT, 2.0, 1e-3, 1e6, NULL,                             \
       "spacing (world units) of the sparse volume's points around the "       \
       "instanced decorators (section 2.2)")                                    \
     X(volume_rays, INT, 128, 4, 65536, NULL,                                   \
