@@ -1,7 +1,8 @@
 #!/bin/sh
 # bench/BAKE.md, "Instanced trees": the vertex AO of polynesia's tree
 # instances from the model of section 2.2 (local x global, eq 3) against
-# its two halves alone (the global linear function, the local AO) and
+# its two halves alone (the global linear function, the local AO), the
+# volume's AO that eq 3 fits (no model, per vertex), and
 # against the reference, a bake that traces every tree instance's own
 # surface samples in the level (--instanced off); RMS over the tree
 # vertices of _AO (and of the long distance) and the seconds of each run.
@@ -31,6 +32,7 @@ V="--volume-rays $VRAYS --volume-spacing $SPACING"
 run product $V
 run linear $V --instanced-values linear
 run local $V --instanced-values local
+run volume $V --instanced-values volume
 python3 - "$O" "$RAYS" "$VRAYS" "$SPACING" <<'PY'
 import array, json, struct, sys
 o = sys.argv[1]
@@ -73,7 +75,8 @@ print()
 print("| tree vertex AO | RMS _AO vs reference | RMS _AO_LONG | bake (s) | instanced stages (s) |")
 print("| --- | --- | --- | --- | --- |")
 rows = [("local x global (eq 3), the paper's", "product"), ("(a) linear only: G fitted with L = 1", "linear"),
-        ("(b) local only: L", "local"), ("reference, another seed (its noise)", "reference_seed2"),
+        ("(b) local only: L", "local"),
+        ("no model: the volume's AO at the vertices (what eq 3 fits)", "volume"), ("reference, another seed (its noise)", "reference_seed2"),
         ("(c) reference: trees traced in place", "reference")]
 for label, name in rows:
     r = rep(name)

@@ -350,6 +350,16 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
             for (size_t v = 0; v < 3 * nv; v++)
                 L[v] = 1.0; /* G alone: eq 3 with L = 1 */
         free(r->ao_local);
+        r->ao_local = NULL;
+        if (p->instanced_values == OBS_BAKE_IVALUES_VOLUME) {
+            /* no model: the volume's AO itself (the comparisons' row) */
+            float *d3[3] = {r->ao, r->ao_short, r->ao_long};
+            for (int c = 0; c < 3; c++)
+                for (size_t v = 0; v < nv; v++)
+                    d3[c][v] = clamp01(f[c * nv + v]);
+            st->instanced_instances++;
+            continue;
+        }
         if (!(r->ao_local = malloc((nv ? nv : 1) * sizeof *r->ao_local))) {
             rc = obs__fail(err, OBS_NO_MEMORY, "local AO of %zu vertices", nv);
             goto done;

@@ -82,7 +82,8 @@ typedef enum obs_bake_instanced_mode {
 #define OBS_BAKE_IVALUES_LIST(X)                                               \
     X(OBS_BAKE_IVALUES_PRODUCT, product) /* local x global (section 2.2) */   \
     X(OBS_BAKE_IVALUES_LINEAR, linear)   /* the linear global fit alone */    \
-    X(OBS_BAKE_IVALUES_LOCAL, local)     /* the local AO alone */
+    X(OBS_BAKE_IVALUES_LOCAL, local)     /* the local AO alone */              \
+    X(OBS_BAKE_IVALUES_VOLUME, volume)   /* the volume's AO, what eq 3 fits */
 typedef enum obs_bake_ivalues {
     OBS_BAKE_IVALUES_DEFAULT,
     OBS_BAKE_IVALUES_LIST(OBS__BAKE_ENUM)
@@ -164,7 +165,9 @@ typedef enum obs_bake_ivalues {
     X(instanced_values, ENUM, "product", 0, 0, (OBS_BAKE_IVALUES_LIST(OBS__BAKE_CHOICE) + 1), \
       "the instanced decorators' vertex values: product (local x global, "    \
       "the paper's), or for comparisons linear (the global linear function "  \
-      "fitted alone, local AO taken as 1) or local (the local AO alone)")      \
+      "fitted alone, local AO taken as 1), local (the local AO alone) or "    \
+      "volume (no model: the volume's AO at each vertex, what eq 3 fits; "    \
+      "no _AO_LOCAL nor coefficients written)")                               \
     X(volume_spacing, FLOAT, 2.0, 1e-3, 1e6, NULL,                             \
       "spacing (world units) of the sparse volume's points around the "       \
       "instanced decorators (section 2.2)")                                    \

@@ -278,6 +278,9 @@ for v in linear local; do
     expect 0 "--instanced-values $v" -- "$OBSCURA" bake "$TREES" -o "$T/tr_$v.glb" $IT --instanced-values $v
     expect 0 "--instanced-values $v: _AO = _AO_LOCAL x G" -- python3 tests/e2e/lib/glb_check.py "$T/tr_$v.glb" 6 4
 done
+expect 0 "--instanced-values volume" -- "$OBSCURA" bake "$TREES" -o "$T/tr_volume.glb" $IT --instanced-values volume
+expect 0 "--instanced-values volume: no model written, the .glb checked" -- \
+    python3 tests/e2e/lib/glb_check.py "$T/tr_volume.glb" 6 0
 check "--instanced-values: other values than the product" "! cmp -s $T/tr.glb $T/tr_linear.glb && ! cmp -s $T/tr.glb $T/tr_local.glb"
 expect 0 "--instanced-min 5: the mesh has 4 tree nodes" -- "$OBSCURA" bake "$TREES" -o "$T/x.glb" \
     --report "$T/trmin.json" $IT --instanced-min 5
