@@ -152,9 +152,13 @@ size_t obs__bake_instanced_select(const obs_bake_scene *s, const obs__bake_world
             uses[w->inst[i].mesh]++;
     for (size_t i = 0; i < w->instance_count; i++) {
         const obs__bake_inst *in = &w->inst[i];
+        /* a mesh of degenerate faces only has nothing to bake alone: it
+         * stays in place (the level's warnings name such faces) */
+        int area = 0;
+        for (size_t t = in->first_triangle; t < tri_end(w, i) && !area; t++)
+            area = w->area[t] > 0.0f;
         sel[i] = dc->node_class[in->node] == OBS__DECOR_TREE &&
-                 uses[in->mesh] >= (size_t)p->instanced_min &&
-                 s->meshes[in->mesh].triangle_count > 0;
+                 uses[in->mesh] >= (size_t)p->instanced_min && area;
         n += sel[i];
     }
     free(uses);
