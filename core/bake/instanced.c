@@ -33,7 +33,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "bake/instanced.h"
 #include "internal.h"
@@ -42,12 +41,7 @@
  * parameter that shrinks it. */
 #define MAX_VOLUME_POINTS ((size_t)4 << 20)
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
+static double now(void) { return obs__now_ms() * 1e-3; }
 
 static float clamp01(double v) { return (float)(v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v); }
 

@@ -319,6 +319,11 @@ static void test_overhang_darker(void **state)
     assert_true(g[0] < g[1] - 0.05);
     assert_true(mean(r.instances[2].ao, nv) < mean(r.instances[3].ao, nv) - 0.05);
     assert_true(g[1] > 0.5 && g[1] < 1.2);
+    /* the trees' faces take no samples nor a share of the budget: about
+     * 4 per face of the ground's 128 and the roof's 32 */
+    size_t samples_instanced = r.stats.samples;
+    assert_true(samples_instanced > 600 && samples_instanced < 680);
+    assert_int_equal(r.stats.degenerate_triangles, 0); /* the report's count is the level's */
     obs_bake_result_free(&r);
 
     /* instanced=off: traced in place, no model */
@@ -326,6 +331,7 @@ static void test_overhang_darker(void **state)
     assert_int_equal(obs_bake_run(&sc, &d, &r, err), OBS_OK);
     assert_int_equal(r.stats.instanced_instances, 0);
     assert_null(r.instances[2].ao_local);
+    assert_true(r.stats.samples > samples_instanced + 100); /* the trees' 64 faces too */
     obs_bake_result_free(&r);
 
     /* instanced_min 3: the shared mesh has only 2 tree nodes */
