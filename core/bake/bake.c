@@ -212,7 +212,7 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
         goto done;
     rc = copy_back(scene, &w, &wd, x, p.blend, out, err);
     if (rc == OBS_OK && inst_n)
-        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, out, err);
+        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, desc, s.count, out, err);
 done:
     free(inst_sel);
     free(x);

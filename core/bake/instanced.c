@@ -233,10 +233,25 @@ static obs_status local_ao(const obs_bake_scene *s, uint32_t m, const obs_bake_p
     return OBS_OK;
 }
 
+/* The bake's progress callback with every sample done: nonzero stops. */
+typedef struct stop_ctx {
+    const obs_bake_desc *desc;
+    size_t samples;
+} stop_ctx;
+
+static int stop_asked(void *user)
+{
+    const stop_ctx *c = user;
+    return c->desc && c->desc->progress &&
+           c->desc->progress(c->desc->progress_user, c->samples, c->samples);
+}
+
 obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_world *w,
                                    const uint8_t *sel, const obs_bake_params *p,
+                                   const obs_bake_desc *desc, size_t samples,
                                    obs_bake_result *out, char err[OBS_ERR_LEN])
 {
+    stop_ctx sc = {desc, samples};
     obs_bake_stats *st = &out->stats;
     obs_status rc = OBS_OK;
     double **local = calloc(s->mesh_count ? s->mesh_count : 1, sizeof *local);
@@ -261,6 +276,10 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
         max_v = nv > max_v ? nv : max_v;
         if (local[m])
             continue;
+        if (stop_asked(&sc)) {
+            rc = obs__fail(err, OBS_CANCELLED, "bake cancelled in the instanced trees' local AO");
+            goto done;
+        }
         if (!(local[m] = malloc((nv ? nv : 1) * 2 * sizeof **local))) {
             rc = obs__fail(err, OBS_NO_MEMORY, "local AO of %zu vertices", nv);
             goto done;
@@ -299,7 +318,7 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
         goto done;
     float dist[2] = {p->distance_short, p->distance_long};
     if ((rc = obs__vol_trace(&vol, bvh, p->volume_rays, dist, p->backface_limit,
-                             (uint64_t)p->seed, p->threads, err)) != OBS_OK)
+                             (uint64_t)p->seed, p->threads, stop_asked, &sc, err)) != OBS_OK)
         goto done;
     st->volume_bricks = vol.brick_count;
     st->volume_points = vol.count;

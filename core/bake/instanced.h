@@ -53,9 +53,11 @@ int obs__vol_corners(const obs__vol *v, const float p[3], int64_t idx[8], double
 /* Traces every point: `rays` directions over the sphere, spherical
  * obscurance at both distances projected to quadratic SH and convolved
  * with the clamped cosine (sh.c, as the dynamic-object bake's points). */
+/* stop (may be NULL) is called, serialised, every few hundred points;
+ * nonzero: the trace stops with OBS_CANCELLED. */
 obs_status obs__vol_trace(obs__vol *v, const obs__bake_bvh *bvh, int rays, const float dist[2],
                           float backface_limit, uint64_t seed, int threads,
-                          char err[OBS_ERR_LEN]);
+                          int (*stop)(void *), void *user, char err[OBS_ERR_LEN]);
 /* Eq 1 at p for the unit normal n from the volume: the corners' SH
  * interpolated trilinearly (those inside geometry left out, the weights
  * renormalised, unless all are) and evaluated at n (bands 0..2); n NULL:
@@ -91,9 +93,12 @@ void obs__bake_instanced_uncount(const obs__bake_world *w, const obs__bake_weld 
  * each of their meshes baked alone (samples, trace, fit), the volume
  * around them traced in the whole level, eq 3 per instance; their
  * results in out replaced (ao, ao_short, ao_long, ao_local, global) and
- * the stats filled. */
+ * the stats filled.  desc's progress callback (may be NULL) is called
+ * with (samples, samples) between the meshes and during the volume's
+ * trace; nonzero stops the bake with OBS_CANCELLED. */
 obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_world *w,
                                    const uint8_t *sel, const obs_bake_params *p,
+                                   const obs_bake_desc *desc, size_t samples,
                                    obs_bake_result *out, char err[OBS_ERR_LEN]);
 
 #endif

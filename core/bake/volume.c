@@ -15,6 +15,7 @@
  * sh.c); SH are linear in the function, so interpolating the
  * coefficients and evaluating them at a normal is interpolating the AO. */
 #include <math.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -247,13 +248,26 @@ typedef struct vol_job {
     obs__vol *v;
     const obs__bake_bvh *bvh;
     obs_dyn_params dp;
-    atomic_int failed;
+    atomic_int failed, stopped;
+    int (*stop)(void *);
+    void *user;
+    pthread_mutex_t lock;
 } vol_job;
+
+#define STOP_EVERY 256 /* points between two calls of the stop callback */
 
 static void vol_point(void *ctx, size_t i)
 {
     vol_job *j = ctx;
     obs__vol *v = j->v;
+    if (j->stop && i % STOP_EVERY == 0) {
+        pthread_mutex_lock(&j->lock);
+        if (!atomic_load(&j->stopped) && j->stop(j->user))
+            atomic_store(&j->stopped, 1);
+        pthread_mutex_unlock(&j->lock);
+    }
+    if (atomic_load(&j->stopped))
+        return;
     const int32_t *q = v->ijk + 3 * i;
     float o[3] = {(float)((double)q[0] * v->h), (float)((double)q[1] * v->h),
                   (float)((double)q[2] * v->h)};
@@ -268,7 +282,7 @@ static void vol_point(void *ctx, size_t i)
 
 obs_status obs__vol_trace(obs__vol *v, const obs__bake_bvh *bvh, int rays, const float dist[2],
                           float backface_limit, uint64_t seed, int threads,
-                          char err[OBS_ERR_LEN])
+                          int (*stop)(void *), void *user, char err[OBS_ERR_LEN])
 {
     vol_job *j = calloc(1, sizeof *j);
     if (!j)
@@ -281,9 +295,16 @@ obs_status obs__vol_trace(obs__vol *v, const obs__bake_bvh *bvh, int rays, const
     j->dp.distance_long = dist[1];
     j->dp.backface_limit = backface_limit;
     atomic_init(&j->failed, 0);
+    atomic_init(&j->stopped, 0);
+    j->stop = stop;
+    j->user = user;
+    pthread_mutex_init(&j->lock, NULL);
     obs__bake_pfor(v->count, 16, threads, vol_point, j);
-    int failed = atomic_load(&j->failed);
+    pthread_mutex_destroy(&j->lock);
+    int failed = atomic_load(&j->failed), stopped = atomic_load(&j->stopped);
     free(j);
+    if (stopped)
+        return obs__fail(err, OBS_CANCELLED, "bake cancelled in the instanced trees' volume");
     if (failed)
         return obs__fail(err, OBS_NO_MEMORY, "rays of a volume point");
     v->inside_count = 0;

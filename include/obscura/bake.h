@@ -354,7 +354,8 @@ typedef struct obs_bake_result {
 typedef struct obs_bake_desc {
     obs_bake_params params;
     /* Called from the tracing threads (serialised) with the samples done
-     * so far, after each batch of samples; may be NULL.  A nonzero return
+     * so far, after each batch of samples, and with every sample done
+     * during the instanced trees' stages; may be NULL.  A nonzero return
      * stops the bake: obs_bake_run returns OBS_CANCELLED. */
     int (*progress)(void *user, size_t done, size_t total);
     void *progress_user;

@@ -265,6 +265,17 @@ static void overhang_scene(obs_bake_scene *s)
     s->world_triangles = m[0].triangle_count + m[1].triangle_count + 2 * m[2].triangle_count;
 }
 
+/* Counts the calls with every sample done; asks to stop at call `at`. */
+typedef struct stopper {
+    int calls, at;
+} stopper;
+
+static int stop_at(void *user, size_t done, size_t total)
+{
+    stopper *s = user;
+    return done == total && ++s->calls == s->at;
+}
+
 static double mean(const float *v, size_t n)
 {
     double s = 0.0;
@@ -341,8 +352,28 @@ static void test_overhang_darker(void **state)
     assert_int_equal(r.stats.instanced_instances, 0);
     obs_bake_result_free(&r);
 
-    /* a volume too fine to trace is refused, naming the parameter */
+    /* cancelled through the progress callback: the trace's last call is
+     * the first with every sample done, then one before each mesh baked
+     * alone, then every few hundred volume points */
     bt_set(&d.params, "instanced_min", "1");
+    stopper st2 = {0, 2};
+    d.progress = stop_at;
+    d.progress_user = &st2;
+    assert_int_equal(obs_bake_run(&sc, &d, &r, err), OBS_CANCELLED);
+    assert_non_null(strstr(err, "local AO"));
+    stopper st3 = {0, 3};
+    d.progress_user = &st3;
+    assert_int_equal(obs_bake_run(&sc, &d, &r, err), OBS_CANCELLED);
+    assert_non_null(strstr(err, "volume"));
+    stopper never = {0, 1000};
+    d.progress_user = &never;
+    assert_int_equal(obs_bake_run(&sc, &d, &r, err), OBS_OK);
+    assert_int_equal(r.stats.instanced_instances, 2);
+    assert_true(never.calls >= 3);
+    obs_bake_result_free(&r);
+    d.progress = NULL;
+
+    /* a volume too fine to trace is refused, naming the parameter */
     bt_set(&d.params, "volume_spacing", "0.005");
     assert_int_equal(obs_bake_run(&sc, &d, &r, err), OBS_TOO_LARGE);
     assert_non_null(strstr(err, "volume_spacing"));
