@@ -5,8 +5,9 @@
 # again), `obscura gbuffer` of the .glb (the baked channels, against the
 # level's own G-buffer and the obscurance reference), `obscura ao` with
 # the baked channel (--baked, --baked-combine), the same bytes for 1 and 2 threads, the Khronos validator when
-# it is installed, clear errors for bad input and usage; a TORCS track of
-# ../shared/data when present.
+# it is installed, clear errors for bad input and usage; instanced trees
+# (section 2.2) on a generated 4-tree level (lib/trees_fixture.py); a
+# TORCS track of ../shared/data when present.
 #
 #   OBSCURA=build/obscura tests/e2e/bake.sh
 set -u
