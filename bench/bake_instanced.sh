@@ -7,24 +7,31 @@
 # surface samples in the level (--instanced off); RMS over the tree
 # vertices of _AO (and of the long distance) and the seconds of each run.
 # A second reference with another seed gives the reference's own noise.
-#   bench/bake_instanced.sh [RAYS [VOLUME_RAYS [SPACING]]]
-#   (OBSCURA: the CLI; OBSCURA_SHARED_DATA: ../shared/data)
+#   bench/bake_instanced.sh [RAYS [VOLUME_RAYS [SPACING [SAMPLES_PER_FACE]]]]
+#   (OBSCURA: the CLI; OBSCURA_SHARED_DATA: ../shared/data; LEVEL: under
+#   its levels/, default 0ad/polynesia.glb; RUNS: which of reference
+#   reference_seed2 product linear local volume, default all)
 set -eu
 OBSCURA=${OBSCURA:-build/obscura}
-LEVEL=${OBSCURA_SHARED_DATA:-../shared/data}/levels/0ad/polynesia.glb
+NAME=${LEVEL:-0ad/polynesia.glb}
+LEVEL=${OBSCURA_SHARED_DATA:-../shared/data}/levels/$NAME
+RUNS=${RUNS:-reference reference_seed2 product linear local volume}
 RAYS=${1:-64}
 VRAYS=${2:-128}
 SPACING=${3:-2}
+SPF=${4:-4}
 if [ ! -f "$LEVEL" ]; then
     echo "bake_instanced bench: $LEVEL is absent (../shared, the shared levels): skipped"
     exit 0
 fi
-O=out/bake_instanced
-mkdir -p $O
+O=out/bake_instanced/$(basename "$NAME" .glb)
+mkdir -p "$O"
 run() { # name args...
     name=$1; shift
+    case " $RUNS " in *" $name "*) ;; *) return 0 ;; esac
     echo "bake_instanced bench: $name: $*" >&2
-    "$OBSCURA" bake "$LEVEL" -o "$O/$name.glb" --report "$O/$name.json" -q --rays "$RAYS" "$@"
+    "$OBSCURA" bake "$LEVEL" -o "$O/$name.glb" --report "$O/$name.json" -q --rays "$RAYS" \
+        --samples-per-face "$SPF" "$@"
 }
 run reference --instanced off
 run reference_seed2 --instanced off --seed 2
@@ -33,9 +40,10 @@ run product $V
 run linear $V --instanced-values linear
 run local $V --instanced-values local
 run volume $V --instanced-values volume
-python3 - "$O" "$RAYS" "$VRAYS" "$SPACING" <<'PY'
+python3 - "$O" "$RAYS" "$VRAYS" "$SPACING" "$NAME" "$SPF" $RUNS <<'PY'
 import array, json, struct, sys
 o = sys.argv[1]
+runs = sys.argv[7:]
 
 def glb(path):
     data = open(path, "rb").read()
@@ -69,8 +77,9 @@ def rms(name, which):
     return (s / n) ** 0.5, n
 def rep(name):
     return json.load(open(o + "/" + name + ".json"))
-print("polynesia, %d tree primitives; %s rays per surface sample, %s per volume point, "
-      "spacing %s m" % (len(keys), sys.argv[2], sys.argv[3], sys.argv[4]))
+print("%s, %d tree primitives; %s rays per surface sample (%s samples per face), %s per "
+      "volume point, spacing %s m" % (sys.argv[5], len(keys), sys.argv[2], sys.argv[6],
+                                      sys.argv[3], sys.argv[4]))
 print()
 print("| tree vertex AO | RMS _AO vs reference | RMS _AO_LONG | bake (s) | instanced stages (s) |")
 print("| --- | --- | --- | --- | --- |")
@@ -79,6 +88,8 @@ rows = [("local x global (eq 3), the paper's", "product"), ("(a) linear only: G 
         ("no model: the volume's AO at the vertices (what eq 3 fits)", "volume"), ("reference, another seed (its noise)", "reference_seed2"),
         ("(c) reference: trees traced in place", "reference")]
 for label, name in rows:
+    if name not in runs:
+        continue
     r = rep(name)
     sec = r["seconds"]
     inst = sec.get("local", 0) + sec.get("volume", 0) + sec.get("global", 0)
