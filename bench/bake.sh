@@ -53,11 +53,13 @@ for n, r in rs:
         n, opts(r), c["samples"], c["samples_dropped_backface"], h["samples"],
         f("least_squares"), f("face_mean"), f("point_sample"), r["ao"]["mean"]))
 print()
-st = ["load", "flatten", "samples", "bvh", "trace", "weld", "assemble", "solve", "write", "total"]
+st = ["load", "flatten", "samples", "bvh", "trace", "weld", "assemble", "solve", "instanced", "write", "total"]
 print("| run | triangles | welded vertices | rays | " + " | ".join(st) + " | Mrays/s |")
 print("| --- " * (len(st) + 5) + "|")
 for n, r in rs:
     c, s = r["counts"], r["seconds"]
+    # instanced trees (section 2.2): local AO, volume, eq 3
+    s["instanced"] = s.get("local", 0) + s.get("volume", 0) + s.get("global", 0)
     print("| %s | %d | %d | %.3g | %s | %.2f |" % (
         n, c["triangles"], c["welded_vertices"], c["rays"],
         " | ".join("%.2f" % s[k] for k in st), r["rays_per_second"] / 1e6))

@@ -19,6 +19,7 @@ void cli_bake_usage(FILE *f)
     fprintf(f,
             "  obscura bake LEVEL -o OUT.(glb|ply) [--distances S,L] [--blend B]\n"
             "                  [--report R.json] [--ply P.ply] [--color] [--quiet]\n"
+            "                  [--decorators D.json]\n"
             "                  [--PARAM VALUE]...  ambient obscurance baked onto the vertices\n"
             "                  of a level (glTF/GLB, AC3D, anything assimp reads; node graph\n"
             "                  and instances kept): _AO, _AO_SHORT, _AO_LONG per vertex;\n"
@@ -59,6 +60,43 @@ static void list_params(int markdown)
     }
 }
 
+/* The whole of a small text file (a decorators file), NUL-terminated;
+ * caller frees. */
+static obs_status read_text(const char *path, char **out, char err[OBS_ERR_LEN])
+{
+    *out = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, OBS_ERR_LEN, "cannot open: %s", strerror(errno));
+        return OBS_IO;
+    }
+    size_t cap = 4096, n = 0;
+    char *b = malloc(cap);
+    for (size_t got; b && (got = fread(b + n, 1, cap - n - 1, f)) > 0;) {
+        n += got;
+        if (n + 1 == cap) {
+            char *nb = cap < ((size_t)1 << 30) ? realloc(b, cap * 2) : NULL;
+            if (!nb) {
+                free(b);
+                b = NULL;
+                break;
+            }
+            b = nb;
+            cap *= 2;
+        }
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (!b || bad) {
+        free(b);
+        snprintf(err, OBS_ERR_LEN, "%s", bad ? "read error" : "too large (1 GiB at most)");
+        return bad ? OBS_IO : OBS_TOO_LARGE;
+    }
+    b[n] = 0;
+    *out = b;
+    return OBS_OK;
+}
+
 typedef struct progress {
     double start, last;
 } progress;
@@ -85,9 +123,37 @@ static cJSON *pair(const double v[2])
     return o;
 }
 
+/* The instanced decorators (section 2.2): counts, the volume, eq 3's
+ * residual and every instance's coefficients (README's bake section). */
+static void report_instanced(cJSON *r, const obs_bake_scene *sc, const obs_bake_stats *st,
+                             const obs_bake_result *res)
+{
+    cJSON *in = cJSON_AddObjectToObject(r, "instanced");
+    cJSON_AddNumberToObject(in, "meshes", (double)st->instanced_meshes);
+    cJSON_AddNumberToObject(in, "instances", (double)st->instanced_instances);
+    cJSON_AddNumberToObject(in, "volume_bricks", (double)st->volume_bricks);
+    cJSON_AddNumberToObject(in, "volume_points", (double)st->volume_points);
+    cJSON_AddNumberToObject(in, "volume_points_inside", (double)st->volume_points_inside);
+    cJSON_AddNumberToObject(in, "volume_rays", (double)st->volume_rays);
+    cJSON_AddNumberToObject(in, "eq3_residual_rms", st->instanced_residual);
+    cJSON *list = cJSON_AddArrayToObject(in, "list");
+    static const char *const keys[3] = {"global_ao", "global_ao_short", "global_ao_long"};
+    for (size_t i = 0; res && i < res->instance_count; i++) {
+        const obs_bake_instance *b = &res->instances[i];
+        if (!b->ao_local)
+            continue;
+        cJSON *e = cJSON_CreateObject();
+        cJSON_AddStringToObject(e, "node", sc->nodes[b->node].name ? sc->nodes[b->node].name : "");
+        cJSON_AddStringToObject(e, "mesh", sc->meshes[b->mesh].name ? sc->meshes[b->mesh].name : "");
+        for (int c = 0; c < 3; c++)
+            cJSON_AddItemToObject(e, keys[c], cJSON_CreateFloatArray(b->global[c], 4));
+        cJSON_AddItemToArray(list, e);
+    }
+}
+
 static int write_report(const char *path, const char *level, const obs_bake_params *p,
-                        const obs_bake_scene *sc, const obs_bake_stats *st, double load_s,
-                        double write_s)
+                        const obs_bake_scene *sc, const obs_bake_stats *st,
+                        const obs_bake_result *result, double load_s, double write_s)
 {
     cJSON *r = cJSON_CreateObject();
     cJSON_AddStringToObject(r, "level", level);
@@ -128,6 +194,10 @@ static int write_report(const char *path, const char *level, const obs_bake_para
     cJSON_AddNumberToObject(c, "vertices_without_samples", (double)st->vertices_without_samples);
     cJSON_AddNumberToObject(c, "vertices_isolated", (double)st->vertices_isolated);
     cJSON_AddNumberToObject(c, "rays", (double)st->rays);
+    cJSON *dn = cJSON_AddObjectToObject(r, "decorator_nodes");
+    static const char *const dnames[4] = {"none", "shrub", "tree", "small"};
+    for (int k = 0; k < 4; k++)
+        cJSON_AddNumberToObject(dn, dnames[k], (double)st->decorator_nodes[k]);
     double ts = st->seconds[OBS_BAKE_STAGE_trace];
     cJSON_AddNumberToObject(r, "rays_per_second", ts > 0.0 ? (double)st->rays / ts : 0.0);
     cJSON *res = cJSON_AddObjectToObject(r, "residual_rms");
@@ -144,6 +214,7 @@ static int write_report(const char *path, const char *level, const obs_bake_para
     }
     if (st->lod_levels)
         cli_bake_lod_report(r, p, st);
+    report_instanced(r, sc, st, result);
     cJSON *ao = cJSON_AddObjectToObject(r, "ao");
     cJSON_AddNumberToObject(ao, "mean", st->ao_mean);
     cJSON_AddNumberToObject(ao, "min", st->ao_min);
@@ -166,6 +237,8 @@ static int ends_with(const char *s, const char *tail);
 
 static void warn(const char *level, const obs_bake_stats *st)
 {
+    if (st->decorator_warning[0])
+        fprintf(stderr, "obscura: bake: warning: %s\n", st->decorator_warning);
     /* assimp 5.2's AC3D reader drops the surfaces' double-sided flag
      * (SURF 0x20); the loader reads it from the file, unless the file's
      * objects and assimp's nodes disagree. */
@@ -204,7 +277,7 @@ static int ends_with(const char *s, const char *tail)
 
 int cli_bake(int argc, char **argv)
 {
-    const char *in = NULL, *out = NULL, *report = NULL, *ply = NULL;
+    const char *in = NULL, *out = NULL, *report = NULL, *ply = NULL, *decorators = NULL;
     int color = 0, quiet = 0, shard = -1, shards = 0, merging = 0, merge = 0;
     const char **parts = calloc((size_t)argc + 1, sizeof *parts);
     size_t nparts = 0;
@@ -253,6 +326,8 @@ int cli_bake(int argc, char **argv)
             cli_parse_shard("bake", val, &shard, &shards);
         } else if (!strcmp(key, "report")) {
             report = val;
+        } else if (!strcmp(key, "decorators")) {
+            decorators = val;
         } else if (!strcmp(key, "ply")) {
             ply = val;
         } else if (!strcmp(key, "distances")) {
@@ -293,11 +368,21 @@ int cli_bake(int argc, char **argv)
         cli_die_usage("bake", "--lods writes its levels into the .glb (MSFT_lod); a .ply has "
                               "no LODs: drop --ply or --lods");
 
+    char *decor_text = NULL;
+    if (decorators) {
+        obs_status ds = read_text(decorators, &decor_text, err);
+        if (ds != OBS_OK) {
+            free(parts);
+            return cli_input_fail(ds, decorators, err);
+        }
+        desc.decorators_json = decor_text;
+    }
     double t0 = cli_now_s();
     obs_bake_scene sc;
     obs_status s = obs_bake_load(in, (size_t)p.max_triangles, &sc, err);
     if (s != OBS_OK) {
         free(parts);
+        free(decor_text);
         return cli_input_fail(s, in, err);
     }
     double load_s = cli_now_s() - t0;
@@ -311,7 +396,7 @@ int cli_bake(int argc, char **argv)
         obs_bake_stats st;
         s = obs_bake_shard(&sc, &desc, shard, shards, out, &st, err);
         int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, in, err);
-        if (rc == EXIT_OK && report && !write_report(report, in, &p, &sc, &st, load_s, 0.0))
+        if (rc == EXIT_OK && report && !write_report(report, in, &p, &sc, &st, NULL, load_s, 0.0))
             rc = EXIT_FAIL;
         if (rc == EXIT_OK && !quiet)
             fprintf(stderr, "obscura: bake: shard %d/%d: %zu samples (%zu dropped by the back-face "
@@ -320,10 +405,12 @@ int cli_bake(int argc, char **argv)
                     st.seconds[OBS_BAKE_STAGE_trace], out);
         obs_bake_scene_free(&sc);
         free(parts);
+        free(decor_text);
         return rc;
     }
     s = nparts ? obs_bake_merge(&sc, &desc, parts, nparts, &r, err) : obs_bake_run(&sc, &desc, &r, err);
     free(parts);
+    free(decor_text);
     if (s != OBS_OK) {
         obs_bake_scene_free(&sc);
         return nparts ? cli_input_fail(s, in, err) : cli_fail(s, in, err);
@@ -340,7 +427,7 @@ int cli_bake(int argc, char **argv)
     int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, out, err);
     const obs_bake_stats *st = &r.stats;
     if (rc == EXIT_OK && report &&
-        !write_report(report, in, &p, &sc, st, load_s, write_s))
+        !write_report(report, in, &p, &sc, st, &r, load_s, write_s))
         rc = EXIT_FAIL;
     if (rc == EXIT_OK && !quiet)
         fprintf(stderr,

@@ -1,10 +1,13 @@
 /* The bake's steps in order (obscura/bake.h), each timed. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "bake/bake_internal.h"
+#include "bake/decor.h"
+#include "bake/instanced.h"
 #include "bake/lod.h"
 #include "bake/shard.h"
 #include "internal.h"
@@ -35,6 +38,7 @@ void obs_bake_result_free(obs_bake_result *r)
         free(r->instances[i].ao);
         free(r->instances[i].ao_short);
         free(r->instances[i].ao_long);
+        free(r->instances[i].ao_local);
     }
     free(r->instances);
     obs__bake_lods_free(r);
@@ -81,6 +85,26 @@ static obs_status copy_back(const obs_bake_scene *scene, const obs__bake_world *
     return OBS_OK;
 }
 
+/* The instanced decorators' values (instanced.c: local x global, section
+ * 2.2) written into the welded solution in place of the fit's, which had
+ * no samples on them, so the LODs (lod.c) resample what the .glb holds. */
+static void instanced_into_solution(const obs_bake_scene *scene, const obs__bake_world *w,
+                                    const obs__bake_weld *wd, const uint8_t *sel,
+                                    const obs_bake_result *out, double *x)
+{
+    for (size_t i = 0; i < w->instance_count; i++) {
+        if (!sel[i])
+            continue;
+        const obs__bake_inst *in = &w->inst[i];
+        size_t n = scene->meshes[in->mesh].vertex_count;
+        for (size_t v = 0; v < n; v++) {
+            uint32_t k = wd->of[in->first_vertex + v];
+            x[2 * k] = out->instances[i].ao_short[v];
+            x[2 * k + 1] = out->instances[i].ao_long[v];
+        }
+    }
+}
+
 /* Held-out samples (parameter holdout): another seed places them and
  * draws their rays; the fit and the baselines are compared with them. */
 static obs_status holdout(const obs__bake_world *w, const obs__bake_weld *wd,
@@ -124,7 +148,11 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     obs__bake_world w = {0};
     obs__bake_samples s = {0};
     obs__bake_weld wd = {0};
+    obs__bake_decor dc = {0};
     double *x = NULL, *face = NULL, *point = NULL;
+    uint8_t *inst_sel = NULL;
+    float *area_kept = NULL; /* the faces' areas before the mask, for the LODs */
+    size_t inst_n = 0;
     obs_status rc;
     if (!scene || scene->node_count == 0)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "bake: no scene");
@@ -142,6 +170,31 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     st->faces_against_normals = w.against_normals;
     for (size_t k = 0; k < w.triangle_count; k++)
         st->two_sided_triangles += w.two_sided[k];
+    /* Decorators (section 2.2): which nodes are shrubs, trees, small. */
+    if ((rc = obs__bake_decor_classify(scene, &p, desc ? desc->decorators_json : NULL, &dc,
+                                       err)) != OBS_OK)
+        goto done;
+    snprintf(st->decorator_warning, sizeof st->decorator_warning, "%s", err);
+    err[0] = 0;
+    memcpy(st->decorator_nodes, dc.counts, sizeof dc.counts);
+    /* Large instanced decorators (section 2.2, instanced.c): no surface
+     * samples of their own in the level. */
+    if (!(inst_sel = malloc(w.instance_count ? w.instance_count : 1))) {
+        rc = obs__fail(err, OBS_NO_MEMORY, "%zu instances", w.instance_count);
+        goto done;
+    }
+    if ((inst_n = obs__bake_instanced_select(scene, &w, &dc, &p, inst_sel))) {
+        /* the LODs resample the instanced faces' final values at their
+         * nearest points (lod.c), which needs their areas */
+        if (p.lods && w.triangle_count) {
+            if (!(area_kept = malloc(w.triangle_count * sizeof *area_kept))) {
+                rc = obs__fail(err, OBS_NO_MEMORY, "%zu triangles", w.triangle_count);
+                goto done;
+            }
+            memcpy(area_kept, w.area, w.triangle_count * sizeof *area_kept);
+        }
+        obs__bake_instanced_mask(&w, inst_sel);
+    }
     st->seconds[OBS_BAKE_STAGE_flatten] = now() - t;
 
     t = now();
@@ -186,15 +239,28 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     }
     if ((rc = obs__bake_fit(&w, &wd, &s, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
+    if (inst_n)
+        obs__bake_instanced_uncount(&w, &wd, inst_sel, st);
     if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
-    if ((rc = copy_back(scene, &w, &wd, x, p.blend, out, err)) == OBS_OK)
+    rc = copy_back(scene, &w, &wd, x, p.blend, out, err);
+    if (rc == OBS_OK && inst_n) {
+        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, desc, s.count, out, err);
+        if (rc == OBS_OK)
+            instanced_into_solution(scene, &w, &wd, inst_sel, out, x);
+        if (area_kept)
+            memcpy(w.area, area_kept, w.triangle_count * sizeof *area_kept);
+    }
+    if (rc == OBS_OK)
         rc = obs__bake_lods(scene, &w, &wd, x, &p, out, err); /* lod.c, paper 2.2.1 */
 done:
+    free(area_kept);
+    free(inst_sel);
     free(x);
     free(face);
     free(point);
     obs__bake_weld_free(&wd);
+    obs__bake_decor_free(&dc);
     obs__bake_samples_free(&s);
     obs__bake_world_free(&w);
     if (rc != OBS_OK) {

@@ -4,7 +4,8 @@
  * extras.  Each node that holds meshes gets a mesh of its own, one
  * primitive per loaded mesh, since the baked values differ between the
  * instances of a shared mesh.  Attributes: POSITION, NORMAL (when every
- * normal of the mesh is usable), _AO, _AO_SHORT, _AO_LONG (float scalars;
+ * normal of the mesh is usable), _AO, _AO_SHORT, _AO_LONG (and _AO_LOCAL
+ * for an instanced decorator, section 2.2; float scalars;
  * custom attributes begin with '_', glTF 2.0 3.7.2.1), COLOR_0 = _AO as
  * grey when asked; indices as unsigned int.  The materials keep their
  * names, base colours, alpha mode BLEND and sidedness, not their
@@ -95,6 +96,35 @@ static void range(const float *v, size_t n, int comps, float *mn, float *mx)
         }
 }
 
+/* An instanced decorator's global AO (section 2.2, eq 3; README's bake
+ * section): node extras "obscura_instanced", one entry per such
+ * primitive, {"primitive": k, "global_ao": [g0, gx, gy, gz],
+ * "global_ao_short": [...], "global_ao_long": [...]}; _AO = _AO_LOCAL x
+ * (g0 + gx x + gy y + gz z) at the primitive's POSITION (x, y, z).
+ * Nothing when the node's own extras are not an object. */
+static void instanced_extras(cJSON *node, const obs_bake_instance *r, uint32_t n)
+{
+    static const char *const keys[3] = {"global_ao", "global_ao_short", "global_ao_long"};
+    cJSON *list = NULL;
+    for (uint32_t k = 0; k < n; k++) {
+        if (!r[k].ao_local)
+            continue;
+        if (!list) {
+            cJSON *x = cJSON_GetObjectItem(node, "extras");
+            if (!x)
+                x = cJSON_AddObjectToObject(node, "extras");
+            if (!cJSON_IsObject(x))
+                return;
+            list = cJSON_AddArrayToObject(x, "obscura_instanced");
+        }
+        cJSON *e = cJSON_CreateObject();
+        cJSON_AddNumberToObject(e, "primitive", k);
+        for (int c = 0; c < 3; c++)
+            cJSON_AddItemToObject(e, keys[c], cJSON_CreateFloatArray(r[k].global[c], 4));
+        cJSON_AddItemToArray(list, e);
+    }
+}
+
 static cJSON *primitive(out *o, const obs_bake_mesh *m, const obs_bake_instance *r, int color,
                         size_t materials)
 {
@@ -112,9 +142,9 @@ static cJSON *primitive(out *o, const obs_bake_mesh *m, const obs_bake_instance 
     if (normals_ok)
         cJSON_AddNumberToObject(at, "NORMAL", accessor(o, m->normals, m->vertex_count, 3, GL_FLOAT,
                                                        ARRAY_BUFFER, NULL, NULL));
-    static const char *const names[3] = {"_AO", "_AO_SHORT", "_AO_LONG"};
-    const float *vals[3] = {r->ao, r->ao_short, r->ao_long};
-    for (int k = 0; k < 3; k++) {
+    static const char *const names[4] = {"_AO", "_AO_SHORT", "_AO_LONG", "_AO_LOCAL"};
+    const float *vals[4] = {r->ao, r->ao_short, r->ao_long, r->ao_local};
+    for (int k = 0; k < (r->ao_local ? 4 : 3); k++) {
         range(vals[k], m->vertex_count, 1, mn, mx);
         cJSON_AddNumberToObject(at, names[k], accessor(o, vals[k], m->vertex_count, 1, GL_FLOAT,
                                                        ARRAY_BUFFER, mn, mx));
@@ -289,6 +319,7 @@ obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,
             }
             cJSON_AddItemToArray(meshes, m);
             cJSON_AddNumberToObject(j, "mesh", nmesh++);
+            instanced_extras(j, r->instances + (inst - nd->mesh_count), nd->mesh_count);
         }
     }
     if (r->lod_levels && r->lod_meshes && r->lod_instances)

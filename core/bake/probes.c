@@ -116,6 +116,11 @@ static void run_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, siz
     pthread_mutex_destroy(&f.lock);
 }
 
+void obs__bake_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx)
+{
+    run_pfor(n, chunk, threads, fn, ctx, NULL, NULL);
+}
+
 typedef struct flag_job {
     const obs__bake_bvh *bvh;
     const obs_dyn_regions *rg;

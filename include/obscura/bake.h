@@ -11,6 +11,9 @@
  *   lod.c      LODs: lod_file.c (a .glb's MSFT_lod), simplify.c
  *              (meshoptimizer), closest.c (nearest full-detail point),
  *              the resampled fit (section 2.2.1)
+ *   instanced.c volume.c  instanced trees (section 2.2): local AO per
+ *              mesh x a linear global AO per instance (eq 3) fitted to a
+ *              sparse SH volume
  *   glb.c ply.c  the output files
  *   bake.c     the steps in order, timed (obs_bake_run)
  * The paper is "Baked ambient obscurance on the vertices of game levels"
@@ -64,6 +67,41 @@ typedef enum obs_bake_lod_source {
     OBS_BAKE_LOD_SOURCE_DEFAULT,
     OBS_BAKE_LOD_SOURCE_LIST(OBS__BAKE_ENUM)
 } obs_bake_lod_source;
+/* Which nodes are decorators (parameter `decorator_source`, section 2.2;
+ * core/bake/decor.c): from the glTF extras, the node names and the
+ * --decorators file, from the file alone, or none (all opaque). */
+#define OBS_BAKE_DECOR_LIST(X)                                                 \
+    X(OBS_BAKE_DECOR_AUTO, auto) /* file, then extras, then names */        \
+    X(OBS_BAKE_DECOR_FILE, file) /* only the --decorators file */            \
+    X(OBS_BAKE_DECOR_OFF, off)   /* no decorators: everything opaque */
+typedef enum obs_bake_decor_mode {
+    OBS_BAKE_DECOR_DEFAULT,
+    OBS_BAKE_DECOR_LIST(OBS__BAKE_ENUM)
+} obs_bake_decor_mode;
+
+/* Which instances take the instanced-decorator path of section 2.2
+ * (parameter `instanced`; core/bake/instanced.c): a local AO per mesh
+ * baked in isolation times a per-instance linear global AO (eq 3). */
+#define OBS_BAKE_INSTANCED_LIST(X)                                             \
+    X(OBS_BAKE_INSTANCED_TREES, trees) /* nodes of class tree */              \
+    X(OBS_BAKE_INSTANCED_OFF, off)     /* none: every instance traced in place */
+typedef enum obs_bake_instanced_mode {
+    OBS_BAKE_INSTANCED_DEFAULT,
+    OBS_BAKE_INSTANCED_LIST(OBS__BAKE_ENUM)
+} obs_bake_instanced_mode;
+
+/* What the vertices of an instanced decorator get (parameter
+ * `instanced_values`): the paper's model, or one of its two halves alone
+ * for comparisons (bench/bake_instanced.sh). */
+#define OBS_BAKE_IVALUES_LIST(X)                                               \
+    X(OBS_BAKE_IVALUES_PRODUCT, product) /* local x global (section 2.2) */   \
+    X(OBS_BAKE_IVALUES_LINEAR, linear)   /* the linear global fit alone */    \
+    X(OBS_BAKE_IVALUES_LOCAL, local)     /* the local AO alone */              \
+    X(OBS_BAKE_IVALUES_VOLUME, volume)   /* the volume's AO, what eq 3 fits */
+typedef enum obs_bake_ivalues {
+    OBS_BAKE_IVALUES_DEFAULT,
+    OBS_BAKE_IVALUES_LIST(OBS__BAKE_ENUM)
+} obs_bake_ivalues;
 
 /* The bake parameters: X(name, type, default, min, max, choices, doc),
  * type FLOAT, INT or ENUM (choices '|'-separated, stored 1-based).  The
@@ -119,6 +157,37 @@ typedef enum obs_bake_lod_source {
       "held-out check: this many samples per face (mean, placed and capped "   \
       "as above, other positions and rays) traced after the fit and compared " \
       "with the fit and the two baselines (the report's holdout rows); 0: off") \
+    X(decorator_source, ENUM, "auto", 0, 0, (OBS_BAKE_DECOR_LIST(OBS__BAKE_CHOICE) + 1), \
+      "which nodes are decorators (section 2.2): auto (the --decorators "     \
+      "file first, then the glTF extras' class/kind, then words of the node " \
+      "name: tree, bush, shrub, hedge, grass; a node without any takes its "   \
+      "parent's class), file (the --decorators file only) or off (every "     \
+      "node opaque geometry)")                                                 \
+    X(shrub_density, FLOAT, 1.0, 0.0, 1000.0, NULL,                            \
+      "fog density (1/m) of a shrub's world box when neither the "            \
+      "--decorators file nor the node's extras give one: a ray's visibility " \
+      "is multiplied by exp(-density * length inside the box) (section 2.1)")  \
+    X(instanced, ENUM, "trees", 0, 0, (OBS_BAKE_INSTANCED_LIST(OBS__BAKE_CHOICE) + 1), \
+      "large instanced decorators (section 2.2): trees (every node of class "  \
+      "tree whose mesh at least instanced_min tree nodes use gets a local AO " \
+      "per mesh, baked alone, times a linear global AO per instance fitted "   \
+      "by eq 3 to a sparse volume of spherical visibility) or off (traced "    \
+      "in place like any other geometry)")                                     \
+    X(instanced_min, INT, 1, 1, 1000000, NULL,                                 \
+      "a mesh takes the instanced path when at least this many tree nodes "   \
+      "hold it")                                                               \
+    X(instanced_values, ENUM, "product", 0, 0, (OBS_BAKE_IVALUES_LIST(OBS__BAKE_CHOICE) + 1), \
+      "the instanced decorators' vertex values: product (local x global, "    \
+      "the paper's), or for comparisons linear (the global linear function "  \
+      "fitted alone, local AO taken as 1), local (the local AO alone) or "    \
+      "volume (no model: the volume's AO at each vertex, what eq 3 fits; "    \
+      "no _AO_LOCAL nor coefficients written)")                               \
+    X(volume_spacing, FLOAT, 2.0, 1e-3, 1e6, NULL,                             \
+      "spacing (world units) of the sparse volume's points around the "       \
+      "instanced decorators (section 2.2)")                                    \
+    X(volume_rays, INT, 128, 4, 65536, NULL,                                   \
+      "rays over the sphere per volume point, projected to quadratic SH at "  \
+      "both distances")                                                        \
     X(seed, INT, 1, 0, 2147483647, NULL,                                       \
       "random seed; the bake depends on it alone, not on the thread count")    \
     X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
@@ -252,6 +321,14 @@ void obs_bake_scene_free(obs_bake_scene *s);
 typedef struct obs_bake_instance {
     uint32_t node, mesh;
     float *ao, *ao_short, *ao_long;
+    /* Instanced decorators (section 2.2, parameter instanced): ao_local
+     * the mesh's local AO per vertex (the blend of its two distances; NULL
+     * for other instances) and global[c] the coefficients (g0, gx, gy, gz)
+     * of the linear global AO G(q) = g0 + gx qx + gy qy + gz qz, q the
+     * vertex's position in the mesh's own space, for c = 0 the blend
+     * (_AO), 1 short, 2 long; ao is ao_local x G (clamped to [0, 1]). */
+    float *ao_local;
+    float global[3][4];
 } obs_bake_instance;
 
 /* Stages of the bake, in order (the report's rows). */
@@ -263,6 +340,9 @@ typedef struct obs_bake_instance {
     X(weld, "weld")                                                            \
     X(assemble, "least-squares system")                                        \
     X(solve, "CHOLMOD factorise and solve")                                    \
+    X(local, "instanced: local AO of each mesh alone")                         \
+    X(volume, "instanced: sparse volume of spherical visibility")              \
+    X(global, "instanced: eq 3 fits per instance")                             \
     X(lod, "LOD simplify, resample and solve")
 typedef enum obs_bake_stage {
 #define OBS__BAKE_STAGE(n, d) OBS_BAKE_STAGE_##n,
@@ -317,6 +397,20 @@ typedef struct obs_bake_stats {
     size_t lod_traced_samples[OBS_BAKE_MAX_LODS];
     /* the lod stage's parts: simplify, resample, fit, check */
     double lod_seconds[4];
+    /* Decorators (section 2.2, core/bake/decor.c): nodes per class, none,
+     * shrub, tree, small; and the classification's warning (entries of
+     * the decorators file that match no node), "" when none. */
+    size_t decorator_nodes[4];
+    char decorator_warning[OBS_ERR_LEN];
+    /* Instanced decorators (section 2.2, core/bake/instanced.c): meshes
+     * baked alone, instances fitted, the volume's bricks and points (and
+     * those inside geometry by the back-face rule, left out of the
+     * interpolation), its rays, and the RMS over the instances' vertices
+     * of the volume's AO minus the model's (eq 3's residual, blend). */
+    size_t instanced_meshes, instanced_instances, volume_bricks, volume_points,
+        volume_points_inside;
+    uint64_t volume_rays;
+    double instanced_residual;
 } obs_bake_stats;
 
 typedef struct obs_bake_result {
@@ -337,10 +431,14 @@ typedef struct obs_bake_result {
 typedef struct obs_bake_desc {
     obs_bake_params params;
     /* Called from the tracing threads (serialised) with the samples done
-     * so far, after each batch of samples; may be NULL.  A nonzero return
+     * so far, after each batch of samples, and with every sample done
+     * during the instanced trees' stages; may be NULL.  A nonzero return
      * stops the bake: obs_bake_run returns OBS_CANCELLED. */
     int (*progress)(void *user, size_t done, size_t total);
     void *progress_user;
+    /* The text of a decorators file (README's bake section, parameter
+     * decorator_source), or NULL; read by the bake, kept by the caller. */
+    const char *decorators_json;
 } obs_bake_desc;
 
 /* Bakes the level: per-vertex obscurance for every instance.  Free with

@@ -4,11 +4,12 @@
 # (tests/e2e/lib/glb_check.py) and read back through assimp (baked
 # again), `obscura gbuffer` of the .glb (the baked channels, against the
 # level's own G-buffer and the obscurance reference), `obscura ao` with
-# the baked channel (--baked, --baked-combine), the same bytes for 1 and 2 threads, --lods 2 (the LOD
-# nodes read back, the report's levels, the file's own MSFT_lod levels read on a re-bake), the Khronos
-# validator when
-# it is installed, clear errors for bad input and usage; a TORCS track of
-# ../shared/data when present.
+# the baked channel (--baked, --baked-combine), the same bytes for 1 and 2
+# threads, --lods 2 (the LOD nodes read back, the report's levels, the
+# file's own MSFT_lod levels read on a re-bake), the Khronos validator when
+# it is installed, clear errors for bad input and usage; instanced trees
+# (section 2.2) on a generated 4-tree level (lib/trees_fixture.py); a
+# TORCS track of ../shared/data when present.
 #
 #   OBSCURA=build/obscura tests/e2e/bake.sh
 set -u
@@ -334,6 +335,57 @@ expect 2 "--shard 4/4" -- "$OBSCURA" bake "$FIX" --shard 4/4 -o "$T/x.bin"
 said "0 <= I < N"
 expect 2 "--merge without parts" -- "$OBSCURA" bake "$FIX" --merge -o "$T/x.glb"
 said "needs the part files"
+
+echo "-- instanced trees (section 2.2): local AO x linear global AO (eq 3)"
+TREES="$T/trees.glb"
+python3 tests/e2e/lib/trees_fixture.py "$TREES"
+IT="--rays 32 --volume-rays 64 --volume-spacing 0.5 --distances 2,20 -q"
+expect 0 "bake 4 instanced trees" -- "$OBSCURA" bake "$TREES" -o "$T/tr.glb" --report "$T/tr.json" $IT
+check "report: 1 mesh baked alone, 4 instances fitted" \
+    "[ \"\$(field $T/tr.json \"['instanced']['meshes']\")\" = 1 ] && [ \"\$(field $T/tr.json \"['instanced']['instances']\")\" = 4 ] && [ \"\$(field $T/tr.json \"['decorator_nodes']['tree']\")\" = 4 ]"
+check "report: the volume's points and rays (64 each)" \
+    "[ \"\$(field $T/tr.json \"['instanced']['volume_rays']\")\" = \"\$((64 * \$(field $T/tr.json \"['instanced']['volume_points']\")))\" ]"
+check "report: 4 coefficient sets, stages local, volume, global timed" \
+    "[ \"\$(field $T/tr.json \"['instanced']['list'].__len__()\")\" = 4 ] && field $T/tr.json \"['seconds']['global']\" >/dev/null"
+expect 0 "the .glb: _AO = _AO_LOCAL x G(POSITION) from the node extras, 4 instanced" -- \
+    python3 tests/e2e/lib/glb_check.py "$T/tr.glb" 6 4
+expect 0 "instanced trees with --lods 1" -- "$OBSCURA" bake "$TREES" -o "$T/trl.glb" $IT --lods 1
+expect 0 "their LODs show the instanced AO (each level's mean _AO within 0.05 of its mesh's)" -- \
+    python3 tests/e2e/lib/glb_check.py "$T/trl.glb" 12 4 --lods 1 --lod-mean 0.05
+# G at the tree's middle (0, 1, 0): under the roof darker than each in the open
+check "the tree under the roof has the darkest global AO" "python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))[\"instanced\"][\"list\"]
+g = {e[\"node\"]: e[\"global_ao\"][0] + e[\"global_ao\"][2] for e in d}
+u = g.pop(\"palm_under_roof\")
+sys.exit(0 if all(u < v - 0.05 for v in g.values()) else 1)' $T/tr.json"
+expect 0 "instanced trees, 1 thread" -- "$OBSCURA" bake "$TREES" -o "$T/tr1.glb" $IT --threads 1
+expect 0 "instanced trees, 2 threads" -- "$OBSCURA" bake "$TREES" -o "$T/tr2.glb" $IT --threads 2
+check "instanced: the same bytes whatever the thread count" "cmp -s $T/tr1.glb $T/tr2.glb && cmp -s $T/tr.glb $T/tr1.glb"
+for i in 0 1; do "$OBSCURA" bake "$TREES" --shard $i/2 -o "$T/trp.$i.bin" $IT 2>"$T/err"; done
+expect 0 "instanced trees: merge of 2 shards" -- "$OBSCURA" bake "$TREES" --merge "$T"/trp.*.bin -o "$T/trm.glb" $IT
+check "instanced: merged = unsharded, byte for byte" "cmp -s $T/tr.glb $T/trm.glb"
+expect 0 "--instanced off" -- "$OBSCURA" bake "$TREES" -o "$T/troff.glb" --report "$T/troff.json" $IT --instanced off
+check "--instanced off: no model, no _AO_LOCAL" \
+    "[ \"\$(field $T/troff.json \"['instanced']['instances']\")\" = 0 ] && ! grep -q _AO_LOCAL $T/troff.glb"
+expect 0 "--instanced off: the .glb checked" -- python3 tests/e2e/lib/glb_check.py "$T/troff.glb" 6 0
+for v in linear local; do
+    expect 0 "--instanced-values $v" -- "$OBSCURA" bake "$TREES" -o "$T/tr_$v.glb" $IT --instanced-values $v
+    expect 0 "--instanced-values $v: _AO = _AO_LOCAL x G" -- python3 tests/e2e/lib/glb_check.py "$T/tr_$v.glb" 6 4
+done
+expect 0 "--instanced-values volume" -- "$OBSCURA" bake "$TREES" -o "$T/tr_volume.glb" $IT --instanced-values volume
+expect 0 "--instanced-values volume: no model written, the .glb checked" -- \
+    python3 tests/e2e/lib/glb_check.py "$T/tr_volume.glb" 6 0
+check "--instanced-values: other values than the product" "! cmp -s $T/tr.glb $T/tr_linear.glb && ! cmp -s $T/tr.glb $T/tr_local.glb"
+expect 0 "--instanced-min 5: the mesh has 4 tree nodes" -- "$OBSCURA" bake "$TREES" -o "$T/x.glb" \
+    --report "$T/trmin.json" $IT --instanced-min 5
+check "--instanced-min 5: nothing instanced" "[ \"\$(field $T/trmin.json \"['instanced']['instances']\")\" = 0 ]"
+expect 3 "a volume too fine" -- "$OBSCURA" bake "$TREES" -o "$T/x.glb" $IT --volume-spacing 0.01
+said "raise volume_spacing"
+expect 2 "--volume-spacing 0" -- "$OBSCURA" bake "$TREES" -o "$T/x.glb" --volume-spacing 0
+said "volume_spacing"
+expect 2 "--instanced bushes" -- "$OBSCURA" bake "$TREES" -o "$T/x.glb" --instanced bushes
+said "instanced"
 
 echo "-- bad input"
 for f in no_triangles.obj:"no triangles" nan_vertex.obj:"not finite" \
