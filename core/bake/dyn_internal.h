@@ -48,10 +48,6 @@ obs_status obs__dyn_regions_build(const obs__bake_world *w, const obs__bake_bvh 
  * (a fixed spiral) that meet a one-sided face from behind, > limit. */
 int obs__dyn_inside(const obs__bake_bvh *bvh, const float p[3], int rays, float limit);
 
-/* fn(ctx, i) for every i in [0, n), in chunks, on `threads` threads (0:
- * every core); also the instanced decorators' volume (volume.c). */
-void obs__bake_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx);
-
 /* The valid points of every region and their spherical obscurance.
  * Point k of region r: pos[3 k], sh[OBS_DYN_CHANNELS k] (convolved),
  * region[k]; held[k] 1 when held back from the fit; id[k] its index

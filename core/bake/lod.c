@@ -21,18 +21,15 @@
  * are compared with over the LOD's samples; and both are compared with
  * the resampled values at held-out positions (never fitted). */
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "bake/lod.h"
 #include "internal.h"
 
-#define MAX_THREADS 64 /* the threads parameter's maximum */
 
 static double now(void)
 {
@@ -68,7 +65,6 @@ typedef struct job {
     const double *x;
     obs__bake_samples *ls;
     double *vertex;
-    atomic_size_t next;
     atomic_int failed; /* out of memory for a nearest-point search */
 } job;
 
@@ -122,15 +118,11 @@ static void resample_instance(job *j, size_t i)
     obs__bake_closest_free(c);
 }
 
-static void *worker(void *arg)
+static void resample_one(void *ctx, size_t i)
 {
-    job *j = arg;
-    for (;;) {
-        size_t i = atomic_fetch_add(&j->next, 1);
-        if (i >= j->lw->instance_count || atomic_load(&j->failed))
-            return NULL;
+    job *j = ctx;
+    if (!atomic_load(&j->failed))
         resample_instance(j, i);
-    }
 }
 
 obs_status obs__bake_lod_resample(const obs__bake_world *full, const obs__bake_weld *fwd,
@@ -147,22 +139,8 @@ obs_status obs__bake_lod_resample(const obs__bake_world *full, const obs__bake_w
             return obs__fail(err, OBS_INVALID_ARGUMENT,
                              "LOD resampling: instance %zu is not the same (node, mesh)", i);
     job j = {full, lw, fwd, x, ls, vertex};
-    atomic_init(&j.next, 0);
     atomic_init(&j.failed, 0);
-    int nt = threads;
-    if (nt <= 0) {
-        long c = sysconf(_SC_NPROCESSORS_ONLN);
-        nt = c < 1 ? 1 : c > MAX_THREADS ? MAX_THREADS : (int)c;
-    }
-    pthread_t th[MAX_THREADS];
-    int started = 0;
-    for (; started < nt && started < MAX_THREADS; started++)
-        if (pthread_create(&th[started], NULL, worker, &j) != 0)
-            break;
-    if (started == 0)
-        worker(&j);
-    for (int k = 0; k < started; k++)
-        pthread_join(th[k], NULL);
+    obs__bake_pfor(lw->instance_count, 1, threads, resample_one, &j);
     if (atomic_load(&j.failed))
         return obs__fail(err, OBS_NO_MEMORY, "LOD resampling: a nearest-point search");
     ls->dropped = 0;
