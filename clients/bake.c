@@ -60,43 +60,6 @@ static void list_params(int markdown)
     }
 }
 
-/* The whole of a small text file (a decorators file), NUL-terminated;
- * caller frees. */
-static obs_status read_text(const char *path, char **out, char err[OBS_ERR_LEN])
-{
-    *out = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        snprintf(err, OBS_ERR_LEN, "cannot open: %s", strerror(errno));
-        return OBS_IO;
-    }
-    size_t cap = 4096, n = 0;
-    char *b = malloc(cap);
-    for (size_t got; b && (got = fread(b + n, 1, cap - n - 1, f)) > 0;) {
-        n += got;
-        if (n + 1 == cap) {
-            char *nb = cap < ((size_t)1 << 30) ? realloc(b, cap * 2) : NULL;
-            if (!nb) {
-                free(b);
-                b = NULL;
-                break;
-            }
-            b = nb;
-            cap *= 2;
-        }
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (!b || bad) {
-        free(b);
-        snprintf(err, OBS_ERR_LEN, "%s", bad ? "read error" : "too large (1 GiB at most)");
-        return bad ? OBS_IO : OBS_TOO_LARGE;
-    }
-    b[n] = 0;
-    *out = b;
-    return OBS_OK;
-}
-
 typedef struct progress {
     double start, last;
 } progress;
@@ -344,7 +307,7 @@ int cli_bake(int argc, char **argv)
 
     char *decor_text = NULL;
     if (decorators) {
-        obs_status ds = read_text(decorators, &decor_text, err);
+        obs_status ds = cli_read_text(decorators, &decor_text, err);
         if (ds != OBS_OK) {
             free(parts);
             return cli_input_fail(ds, decorators, err);

@@ -84,7 +84,7 @@ static obs_status copy_back(const obs_bake_scene *scene, const obs__bake_world *
 /* Held-out samples (parameter holdout): another seed places them and
  * draws their rays; the fit and the baselines are compared with them. */
 static obs_status holdout(const obs__bake_world *w, const obs__bake_weld *wd,
-                          const obs_bake_params *p, const double *x, const double *face,
+                          const obs__bake_decor *dc, const obs_bake_params *p, const double *x, const double *face,
                           const double *point, obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
     obs__bake_samples h;
@@ -94,6 +94,8 @@ static obs_status holdout(const obs__bake_world *w, const obs__bake_weld *wd,
         return rc;
     obs__bake_trace_desc td = {{p->distance_short, p->distance_long}, p->rays, p->threads,
                                p->backface_limit, seed, NULL, NULL};
+    td.decor = dc;
+    td.tree_attenuation = p->tree_attenuation;
     double bvh;
     if ((rc = obs__bake_trace(w, &h, &td, &bvh, err)) == OBS_OK) {
         obs__bake_residual(w, wd, &h, x, st->holdout_fit);
@@ -163,6 +165,8 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     obs__bake_trace_desc td = {{p.distance_short, p.distance_long}, p.rays, p.threads,
                                p.backface_limit, (uint64_t)p.seed,
                                desc ? desc->progress : NULL, desc ? desc->progress_user : NULL};
+    td.decor = &dc;
+    td.tree_attenuation = p.tree_attenuation;
     double bvh = 0.0;
     if (sh) {
         if ((rc = obs__bake_shard_step(sh, &w, &s, &td, st, err)) != OBS_OK)
@@ -194,7 +198,7 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     }
     if ((rc = obs__bake_fit(&w, &wd, &s, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
-    if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &p, x, face, point, st, err)) != OBS_OK)
+    if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &dc, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
     rc = copy_back(scene, &w, &wd, x, p.blend, out, err);
 done:

@@ -58,6 +58,9 @@ typedef struct obs__bake_trace_desc {
     int (*progress)(void *user, size_t done, size_t total); /* nonzero: stop */
     void *progress_user;
     size_t first, end; /* the samples traced: [first, end), end 0 for all (shard.c) */
+    /* Decorators (section 2.1, occl.c): NULL, every triangle opaque */
+    const struct obs__bake_decor *decor;
+    float tree_attenuation;
 } obs__bake_trace_desc;
 
 /* Eq 1 at every sample (trace.c); OBS_CANCELLED when the progress

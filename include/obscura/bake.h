@@ -126,6 +126,9 @@ typedef enum obs_bake_decor_mode {
       "fog density (1/m) of a shrub's world box when neither the "            \
       "--decorators file nor the node's extras give one: a ray's visibility " \
       "is multiplied by exp(-density * length inside the box) (section 2.1)")  \
+    X(tree_attenuation, FLOAT, 0.5, 0.0, 1.0, NULL,                            \
+      "fraction of a ray's visibility each tree triangle it crosses takes "   \
+      "away: trees are semi-transparent occluders (section 2.1; paper: 50 %)") \
     X(seed, INT, 1, 0, 2147483647, NULL,                                       \
       "random seed; the bake depends on it alone, not on the thread count")    \
     X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
@@ -321,6 +324,23 @@ obs_status obs_bake_shard(const obs_bake_scene *scene, const obs_bake_desc *desc
 obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
                           const char *const *parts, size_t n, obs_bake_result *out,
                           char err[OBS_ERR_LEN]);
+
+/* ---- what the bake's rays meet, for the per-pixel reference ------------ */
+
+/* The level's occluders as the bake's rays see them (core/bake/occl.c):
+ * the opaque triangles, the shrubs' fog boxes and the trees'
+ * semi-transparent triangles (section 2.1), from the decorators of s
+ * (params: decorator_source, shrub_density, tree_attenuation;
+ * decorators_json: the text of a decorators file or NULL).  *out is NULL
+ * when the level has no shrub, tree or small decorator: every surface is
+ * then opaque, as the scene itself.  warning (may be NULL) receives the
+ * classification's warning, "" when none.  Free with
+ * obs_bake_occluders_free(); s may be freed before. */
+typedef struct obs_bake_occluders obs_bake_occluders;
+obs_status obs_bake_occluders_new(const obs_bake_scene *s, const obs_bake_params *params,
+                                  const char *decorators_json, obs_bake_occluders **out,
+                                  char warning[OBS_ERR_LEN], char err[OBS_ERR_LEN]);
+void obs_bake_occluders_free(obs_bake_occluders *o);
 
 /* ---- output ----------------------------------------------------------- */
 

@@ -48,6 +48,39 @@ check "the same bytes whatever the thread count" "cmp -s $T/t1.glb $T/t2.glb"
 expect 0 "another seed" -- "$OBSCURA" bake "$FIX" -o "$T/s2.glb" --rays 16 --seed 2 -q
 check "another seed, other values" "! cmp -s $T/t1.glb $T/s2.glb"
 
+echo "-- decorators (section 2.2): the fixture's two tree cards from a trees.json cut"
+TREES=tests/data/levels/aalborg_cut.trees.json
+expect 0 "bake with --decorators (trees.json's layout)" -- "$OBSCURA" bake "$FIX" -o "$T/dt.glb" \
+    --rays 16 --decorators "$TREES" --report "$T/dt.json" -q
+check "report: 2 tree nodes, 60 opaque" \
+    "[ \"\$(field $T/dt.json \"['decorator_nodes']['tree']\")\" = 2 ] && [ \"\$(field $T/dt.json \"['decorator_nodes']['none']\")\" -gt 55 ]"
+check "the trees semi-transparent: other values" "! cmp -s $T/t1.glb $T/dt.glb"
+expect 0 "--tree-attenuation 1 (each card blocks all)" -- "$OBSCURA" bake "$FIX" -o "$T/dt1.glb" \
+    --rays 16 --decorators "$TREES" --tree-attenuation 1 -q
+check "... other values again" "! cmp -s $T/dt.glb $T/dt1.glb"
+expect 0 "--decorator-source off: the file is not used" -- "$OBSCURA" bake "$FIX" -o "$T/doff.glb" \
+    --rays 16 --decorators "$TREES" --decorator-source off -q
+check "... the same bytes as without decorators" "cmp -s $T/t1.glb $T/doff.glb"
+printf '{"decorators": [{"match": "OBJ147*", "class": "shrub", "density": 0.5}]}\n' >"$T/shrub.json"
+expect 0 "the cards as shrubs (fog boxes)" -- "$OBSCURA" bake "$FIX" -o "$T/ds.glb" --rays 16 \
+    --decorators "$T/shrub.json" --report "$T/ds.json" -q
+check "report: shrub nodes" "[ \"\$(field $T/ds.json \"['decorator_nodes']['shrub']\")\" -ge 2 ]"
+printf '{"decorators": [{"name": "OBJ1479", "class": "palm"}]}\n' >"$T/bad_class.json"
+expect 3 "a decorators file with an unknown class" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" \
+    --decorators "$T/bad_class.json"
+said "unknown class 'palm'"
+printf '{"decorators": [{"name": "OBJ1479", "class": "tree"}' >"$T/bad_json.json"
+expect 3 "a decorators file that is not JSON" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" \
+    --decorators "$T/bad_json.json"
+said "not JSON"
+expect 3 "a decorators file that is not there" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" \
+    --decorators "$T/none.json"
+said "cannot open"
+printf '{"trees": [{"name": "OBJ1479"}, {"name": "OBJ0000"}]}\n' >"$T/unmatched.json"
+expect 0 "entries matching no node: a warning" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" --rays 8 \
+    --decorators "$T/unmatched.json" -q
+said "1 of 2 entries match no node (the first: 'OBJ0000')"
+
 if command -v gltf_validator >/dev/null 2>&1; then
     expect 0 "Khronos glTF validator" -- gltf_validator -m "$T/a.glb"
 elif node -e "require('gltf-validator')" >/dev/null 2>&1; then
@@ -148,6 +181,20 @@ expect 0 "the reference's short distance against the baked long one" -- "$OBSCUR
     "$T/r.exr" "$T/g.exr" --channel-a AO_SHORT.Y --channel-b _AO_LONG --json
 m2=$(json mse)
 check "a mismatched channel is further: MSE $m2 > $m" "awk 'BEGIN { exit !($m2 > $m) }'"
+expect 0 "gbuffer of the bake with decorators" -- "$OBSCURA" gbuffer "$T/dt.glb" \
+    --camera "$T/cam0.json" -o "$T/gd.exr" -q
+expect 0 "the reference with the same decorators" -- "$OBSCURA" reference "$T/a.glb" \
+    --camera "$T/cam0.json" -o "$T/rd.exr" --obscurance 2,300 --blend 0.03 --spp 64 \
+    --decorators "$TREES"
+said "decorators traced as the bake does"
+expect 0 "baked _AO (decorators) against that reference" -- "$OBSCURA" compare "$T/rd.exr" \
+    "$T/gd.exr" --channel-b _AO --json
+m=$(json mse); c=$(json corr)
+check "decorators: baked vs reference: MSE $m < 0.02, corr $c > 0.6" \
+    "awk 'BEGIN { exit !($m < 0.02 && $c > 0.6) }'"
+expect 2 "reference --decorators without --obscurance" -- "$OBSCURA" reference "$T/a.glb" \
+    --camera "$T/cam0.json" -o "$T/x.exr" --decorators "$TREES"
+said "need --obscurance"
 for e in trs matrix noao; do python3 tests/e2e/lib/glb_edit.py "$T/a.glb" "$T/$e.glb" $e; done
 python3 tests/e2e/lib/glb_edit.py "$T/trs.glb" "$T/trs_noao.glb" noao
 # the camera of the transformed level: cam0 moved by the same transform
@@ -210,6 +257,17 @@ for n in 1 3 4; do
         "[ \"\$(field $T/merged$n.json \"['counts']['rays']\")\" = \"\$(field $T/whole.json \"['counts']['rays']\")\" ]"
     check "merged of $n: the parts' rays (24) in the report" "[ \"\$(field $T/merged$n.json \"['params']['rays']\")\" = 24 ]"
 done
+expect 0 "decorators: unsharded" -- "$OBSCURA" bake "$FIX" -o "$T/dwhole.glb" --rays 24 \
+    --decorators "$TREES" -q
+for i in 0 1; do
+    "$OBSCURA" bake "$FIX" --shard $i/2 -o "$T/dpart.$i.bin" --rays 24 --decorators "$TREES" -q
+done
+expect 0 "decorators: merge of 2 shards" -- "$OBSCURA" bake "$FIX" --merge "$T"/dpart.*.bin \
+    -o "$T/dmerged.glb" --decorators "$TREES" -q
+check "decorators: merged = unsharded, byte for byte" "cmp -s $T/dwhole.glb $T/dmerged.glb"
+expect 3 "decorators: parts merged without the decorators" -- "$OBSCURA" bake "$FIX" \
+    --merge "$T"/dpart.*.bin -o "$T/x.glb" -q
+said "with other decorators"
 check "a part is 128 + 9 bytes a sample" \
     "[ \$((\$(cat $T/part3.*.bin | wc -c) - 3 * 128)) = \$((9 * \$(field $T/whole.json \"['counts']['samples']\"))) ]"
 expect 3 "a missing shard" -- "$OBSCURA" bake "$FIX" --merge "$T/part4.0.bin" "$T/part4.1.bin" "$T/part4.3.bin" -o "$T/x.glb" -q
