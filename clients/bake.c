@@ -87,8 +87,8 @@ static cJSON *pair(const double v[2])
 }
 
 static int write_report(const char *path, const char *level, const obs_bake_params *p,
-                        const obs_bake_scene *sc, const obs_bake_stats *st, double load_s,
-                        double write_s)
+                        const obs_bake_scene *sc, const obs_bake_stats *st,
+                        const obs_bake_result *result, double load_s, double write_s)
 {
     cJSON *r = cJSON_CreateObject();
     cJSON_AddStringToObject(r, "level", level);
@@ -147,6 +147,25 @@ static int write_report(const char *path, const char *level, const obs_bake_para
         cJSON_AddItemToObject(h, "face_mean", pair(st->holdout_face_mean));
         cJSON_AddItemToObject(h, "point_sample", pair(st->holdout_point));
     }
+    if (st->small_decorators) {
+        /* section 2.2.1: one scalar per small decorator */
+        cJSON *sd = cJSON_AddObjectToObject(r, "small_decorators");
+        cJSON_AddNumberToObject(sd, "count", (double)st->small_decorators);
+        cJSON_AddNumberToObject(sd, "unresolved", (double)st->small_unresolved);
+        cJSON *arr = cJSON_AddArrayToObject(sd, "nodes");
+        for (size_t n = 0; result && result->node_ao && n < result->node_count; n++) {
+            const float *a = result->node_ao + 3 * n;
+            if (a[0] != a[0]) /* NaN: not a small decorator, or unresolved */
+                continue;
+            cJSON *e = cJSON_CreateObject();
+            cJSON_AddNumberToObject(e, "node", (double)n);
+            cJSON_AddStringToObject(e, "name", sc->nodes[n].name);
+            cJSON_AddNumberToObject(e, "_AO", a[0]);
+            cJSON_AddNumberToObject(e, "_AO_SHORT", a[1]);
+            cJSON_AddNumberToObject(e, "_AO_LONG", a[2]);
+            cJSON_AddItemToArray(arr, e);
+        }
+    }
     cJSON *ao = cJSON_AddObjectToObject(r, "ao");
     cJSON_AddNumberToObject(ao, "mean", st->ao_mean);
     cJSON_AddNumberToObject(ao, "min", st->ao_min);
@@ -171,6 +190,11 @@ static void warn(const char *level, const obs_bake_stats *st)
 {
     if (st->decorator_warning[0])
         fprintf(stderr, "obscura: bake: warning: %s\n", st->decorator_warning);
+    if (st->small_unresolved)
+        fprintf(stderr,
+                "obscura: bake: warning: %zu of %zu small decorators met no geometry within "
+                "their sphere (--small-radius): they keep their own fitted values\n",
+                st->small_unresolved, st->small_decorators);
     /* assimp 5.2's AC3D reader drops the surfaces' double-sided flag
      * (SURF 0x20); the loader reads it from the file, unless the file's
      * objects and assimp's nodes disagree. */
@@ -333,7 +357,7 @@ int cli_bake(int argc, char **argv)
         obs_bake_stats st;
         s = obs_bake_shard(&sc, &desc, shard, shards, out, &st, err);
         int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, in, err);
-        if (rc == EXIT_OK && report && !write_report(report, in, &p, &sc, &st, load_s, 0.0))
+        if (rc == EXIT_OK && report && !write_report(report, in, &p, &sc, &st, NULL, load_s, 0.0))
             rc = EXIT_FAIL;
         if (rc == EXIT_OK && !quiet)
             fprintf(stderr, "obscura: bake: shard %d/%d: %zu samples (%zu dropped by the back-face "
@@ -364,7 +388,7 @@ int cli_bake(int argc, char **argv)
     int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, out, err);
     const obs_bake_stats *st = &r.stats;
     if (rc == EXIT_OK && report &&
-        !write_report(report, in, &p, &sc, st, load_s, write_s))
+        !write_report(report, in, &p, &sc, st, &r, load_s, write_s))
         rc = EXIT_FAIL;
     if (rc == EXIT_OK && !quiet)
         fprintf(stderr,

@@ -38,6 +38,7 @@ void obs_bake_result_free(obs_bake_result *r)
         free(r->instances[i].ao_long);
     }
     free(r->instances);
+    free(r->node_ao);
     memset(r, 0, sizeof *r);
 }
 
@@ -200,7 +201,9 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
         goto done;
     if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &dc, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
-    rc = copy_back(scene, &w, &wd, x, p.blend, out, err);
+    if ((rc = copy_back(scene, &w, &wd, x, p.blend, out, err)) != OBS_OK)
+        goto done;
+    rc = obs__bake_small(scene, &w, wd.of, &dc, x, &p, out, err);
 done:
     free(x);
     free(face);

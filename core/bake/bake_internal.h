@@ -100,6 +100,15 @@ void obs__bake_residual(const obs__bake_world *w, const obs__bake_weld *wd,
 double obs__bake_edge_jump(const float a[3], const float b[3], const float c[3],
                            const float d[3], double j[4]);
 
+/* Small decorators (small.c, section 2.2.1): each small node's scalar
+ * resampled from the fitted vertex values x (2 per welded vertex, of[]
+ * the weld) around it, into out->node_ao and its instances' vertices
+ * (out's instances filled); nothing when d has none. */
+struct obs__bake_decor;
+obs_status obs__bake_small(const obs_bake_scene *scene, const obs__bake_world *w,
+                           const uint32_t *of, const struct obs__bake_decor *d, const double *x,
+                           const obs_bake_params *p, obs_bake_result *out, char err[OBS_ERR_LEN]);
+
 /* The level's BVH on its own, for points in space (trace.c; the
  * dynamic-object bake).  w must outlive it. */
 typedef struct obs__bake_bvh obs__bake_bvh;

@@ -184,16 +184,7 @@ double obs__bake_occl_transmittance(const obs__bake_occl *o, const float org[3],
     c.o = o;
     c.log_vis = 0.0;
     struct RTCRayHit rh;
-    rh.ray.org_x = org[0], rh.ray.org_y = org[1], rh.ray.org_z = org[2];
-    rh.ray.dir_x = dir[0], rh.ray.dir_y = dir[1], rh.ray.dir_z = dir[2];
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = tmax;
-    rh.ray.time = 0.0f;
-    rh.ray.mask = 0xffffffffu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    obs__bake_ray1(&rh, org, dir, tmax);
     rtcIntersect1(o->fog, &c.ctx, &rh);
     return exp(c.log_vis);
 }

@@ -26,6 +26,22 @@ typedef struct obs__bake_occl {
     double log_keep;       /* ln(1 - tree_attenuation): one tree crossing */
 } obs__bake_occl;
 
+/* One ray org + t dir, 0 <= t <= tfar, ready for rtcIntersect1. */
+static inline void obs__bake_ray1(struct RTCRayHit *rh, const float org[3], const float dir[3],
+                                  float tfar)
+{
+    rh->ray.org_x = org[0], rh->ray.org_y = org[1], rh->ray.org_z = org[2];
+    rh->ray.dir_x = dir[0], rh->ray.dir_y = dir[1], rh->ray.dir_z = dir[2];
+    rh->ray.tnear = 0.0f;
+    rh->ray.tfar = tfar;
+    rh->ray.time = 0.0f;
+    rh->ray.mask = 0xffffffffu;
+    rh->ray.id = 0;
+    rh->ray.flags = 0;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
 /* The two BVHs of world w; d NULL (or no decorators): every triangle
  * opaque, no second BVH.  Small decorators (section 2.2.1) are neither:
  * they occlude nothing.  Free with obs__bake_occl_free(). */

@@ -8,6 +8,9 @@
  *   trace.c    obscurance (eq 1) at two distances, Embree closest hits
  *   weld.c     triangle soup welded for the fit
  *   fit.c      least-squares vertex fit (Kavan et al. 2011), CHOLMOD
+ *   decor.c occl.c small.c  decorators (section 2.2): their classes, shrubs
+ *              as fog and trees semi-transparent (2.1), small ones' scalar
+ *              (2.2.1)
  *   glb.c ply.c  the output files
  *   bake.c     the steps in order, timed (obs_bake_run)
  * The paper is "Baked ambient obscurance on the vertices of game levels"
@@ -129,6 +132,10 @@ typedef enum obs_bake_decor_mode {
     X(tree_attenuation, FLOAT, 0.5, 0.0, 1.0, NULL,                            \
       "fraction of a ray's visibility each tree triangle it crosses takes "   \
       "away: trees are semi-transparent occluders (section 2.1; paper: 50 %)") \
+    X(small_radius, FLOAT, 1.0, 1e-4, 1e4, NULL,                               \
+      "radius (world units) of the sphere around a small decorator's "        \
+      "origin, added to the half diagonal of its box, over which the "        \
+      "surrounding AO is resampled into its one scalar (section 2.2.1)")      \
     X(seed, INT, 1, 0, 2147483647, NULL,                                       \
       "random seed; the bake depends on it alone, not on the thread count")    \
     X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
@@ -278,11 +285,20 @@ typedef struct obs_bake_stats {
      * the decorators file that match no node), "" when none. */
     size_t decorator_nodes[4];
     char decorator_warning[OBS_ERR_LEN];
+    /* Small decorators (section 2.2.1) given one scalar, and those whose
+     * rays met no geometry (they keep their own fit). */
+    size_t small_decorators, small_unresolved;
 } obs_bake_stats;
 
 typedef struct obs_bake_result {
     obs_bake_instance *instances;
     size_t instance_count;
+    /* Small decorators (section 2.2.1): 3 per node, _AO, _AO_SHORT,
+     * _AO_LONG, the one scalar of a small decorator resampled from the
+     * AO around it (its vertices have it too), NaN for other nodes; NULL
+     * (node_count 0) when the level has none. */
+    size_t node_count;
+    float *node_ao;
     obs_bake_stats stats;
 } obs_bake_result;
 

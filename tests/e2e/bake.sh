@@ -65,6 +65,13 @@ printf '{"decorators": [{"match": "OBJ147*", "class": "shrub", "density": 0.5}]}
 expect 0 "the cards as shrubs (fog boxes)" -- "$OBSCURA" bake "$FIX" -o "$T/ds.glb" --rays 16 \
     --decorators "$T/shrub.json" --report "$T/ds.json" -q
 check "report: shrub nodes" "[ \"\$(field $T/ds.json \"['decorator_nodes']['shrub']\")\" -ge 2 ]"
+printf '{"decorators": [{"name": "OBJ1479", "class": "small"}]}\n' >"$T/small.json"
+expect 0 "a card as a small decorator (section 2.2.1)" -- "$OBSCURA" bake "$FIX" -o "$T/dm.glb" \
+    --rays 16 --decorators "$T/small.json" --report "$T/dm.json" -q
+check "report: one small decorator's scalar" \
+    "[ \"\$(field $T/dm.json \"['small_decorators']['nodes'][0]['name']\")\" = OBJ1479 ]"
+check "the .glb: the scalar in the node's extras" \
+    "python3 -c \"import json,struct,sys; b=open(sys.argv[1],'rb').read(); n=struct.unpack('<I',b[12:16])[0]; j=json.loads(b[20:20+n]); sys.exit(not [x for x in j['nodes'] if x.get('name')=='OBJ1479' and '_AO' in x.get('extras',{})])\" $T/dm.glb"
 printf '{"decorators": [{"name": "OBJ1479", "class": "palm"}]}\n' >"$T/bad_class.json"
 expect 3 "a decorators file with an unknown class" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" \
     --decorators "$T/bad_class.json"
