@@ -23,12 +23,20 @@
 #include "bake/occl.h"
 #include "internal.h"
 
-/* The ray context the callbacks see: Embree's, then the sum. */
+/* The ray context the callbacks see: Embree's, then the sums, one per
+ * ray of a packet of 8, by the ray's id (Embree may hand a callback the
+ * packet or one ray of it). */
 typedef struct fog_ctx {
     struct RTCIntersectContext ctx;
     const obs__bake_occl *o;
-    double log_vis; /* ln of the visibility left */
+    double log_vis[8]; /* ln of the visibility left */
 } fog_ctx;
+
+/* Field k of ray i of a packet of N, structure of arrays (Embree's RTCRayN
+ * layout; its accessors are C++ only): org xyz 0-2, tnear 3, dir xyz 4-6,
+ * time 7, tfar 8, mask 9, id 10, flags 11. */
+#define RAYF(ray, N, k, i) (((const float *)(ray))[(k) * (N) + (i)])
+#define RAY_ID(ray, N, i) (((const unsigned *)(ray))[10 * (N) + (i)] & 7u)
 
 static void device_error(void *user, enum RTCError code, const char *msg)
 {
@@ -133,16 +141,14 @@ static void box_intersect(const struct RTCIntersectFunctionNArguments *args)
     const obs__bake_occl *o = args->geometryUserPtr;
     fog_ctx *c = (fog_ctx *)args->context;
     const float *b = o->box + 6 * (size_t)args->primID;
-    /* the packet's rays, structure of arrays: field k of ray i at k N + i
-     * (Embree's RTCRayN layout; its accessors are C++ only) */
-    const float *ray = (const float *)args->rayhit;
+    const void *ray = args->rayhit; /* the RTCRayN part comes first */
     const unsigned N = args->N;
     for (unsigned i = 0; i < N; i++) {
         if (args->valid[i] != -1)
             continue;
-        float org[3] = {ray[0 * N + i], ray[1 * N + i], ray[2 * N + i]};
-        float dir[3] = {ray[4 * N + i], ray[5 * N + i], ray[6 * N + i]};
-        double t0 = ray[3 * N + i], t1 = ray[8 * N + i]; /* tnear, tfar */
+        float org[3] = {RAYF(ray, N, 0, i), RAYF(ray, N, 1, i), RAYF(ray, N, 2, i)};
+        float dir[3] = {RAYF(ray, N, 4, i), RAYF(ray, N, 5, i), RAYF(ray, N, 6, i)};
+        double t0 = RAYF(ray, N, 3, i), t1 = RAYF(ray, N, 8, i); /* tnear, tfar */
         for (int k = 0; k < 3 && t0 < t1; k++) {
             if (dir[k] == 0.0f) {
                 if (org[k] < b[k] || org[k] > b[3 + k])
@@ -153,8 +159,8 @@ static void box_intersect(const struct RTCIntersectFunctionNArguments *args)
             t0 = fmax(t0, fmin(ta, tb));
             t1 = fmin(t1, fmax(ta, tb));
         }
-        if (t1 > t0)
-            c->log_vis -= (double)o->density[args->primID] * (t1 - t0); /* exp(-density len) */
+        if (t1 > t0) /* exp(-density len) */
+            c->log_vis[RAY_ID(ray, N, i)] -= (double)o->density[args->primID] * (t1 - t0);
     }
 }
 
@@ -169,24 +175,46 @@ static void tree_filter(const struct RTCFilterFunctionNArguments *args)
     for (unsigned i = 0; i < args->N; i++) {
         if (args->valid[i] == 0)
             continue;
-        c->log_vis += c->o->log_keep; /* one crossing keeps 1 - tree_attenuation */
-        args->valid[i] = 0;           /* rejected: traversal goes on */
+        /* one crossing keeps 1 - tree_attenuation */
+        c->log_vis[RAY_ID(args->ray, args->N, i)] += c->o->log_keep;
+        args->valid[i] = 0; /* rejected: traversal goes on */
     }
 }
 
-double obs__bake_occl_transmittance(const obs__bake_occl *o, const float org[3],
-                                    const float dir[3], float tmax)
+void obs__bake_occl_transmittance8(const obs__bake_occl *o, const int *valid,
+                                   const struct RTCRayHit8 *opaque, double tr[8])
 {
+    for (int l = 0; l < 8; l++)
+        tr[l] = 1.0;
     if (!o->fog)
-        return 1.0;
+        return;
     fog_ctx c;
     rtcInitIntersectContext(&c.ctx);
     c.o = o;
-    c.log_vis = 0.0;
-    struct RTCRayHit rh;
-    obs__bake_ray1(&rh, org, dir, tmax);
-    rtcIntersect1(o->fog, &c.ctx, &rh);
-    return exp(c.log_vis);
+    RTC_ALIGN(32) struct RTCRayHit8 rh;
+    RTC_ALIGN(32) int v[8];
+    for (int l = 0; l < 8; l++) {
+        c.log_vis[l] = 0.0;
+        v[l] = valid[l];
+        rh.ray.org_x[l] = opaque->ray.org_x[l];
+        rh.ray.org_y[l] = opaque->ray.org_y[l];
+        rh.ray.org_z[l] = opaque->ray.org_z[l];
+        rh.ray.dir_x[l] = opaque->ray.dir_x[l];
+        rh.ray.dir_y[l] = opaque->ray.dir_y[l];
+        rh.ray.dir_z[l] = opaque->ray.dir_z[l];
+        rh.ray.tnear[l] = 0.0f;
+        rh.ray.tfar[l] = opaque->ray.tfar[l]; /* up to the opaque hit */
+        rh.ray.time[l] = 0.0f;
+        rh.ray.mask[l] = 0xffffffffu;
+        rh.ray.id[l] = (unsigned)l; /* the callbacks' lane */
+        rh.ray.flags[l] = 0;
+        rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(v, o->fog, &c.ctx, &rh);
+    for (int l = 0; l < 8; l++)
+        if (valid[l])
+            tr[l] = exp(c.log_vis[l]);
 }
 
 /* ---- building ----------------------------------------------------------- */

@@ -50,12 +50,14 @@ obs_status obs__bake_occl_new(const obs__bake_world *w, const obs__bake_decor *d
                               char err[OBS_ERR_LEN]);
 void obs__bake_occl_free(obs__bake_occl *o);
 
-/* The fraction of visibility left along the ray org + t dir (dir unit),
- * 0 <= t <= tmax: exp(-sum density_i len_i) over the shrub boxes times
- * (1 - tree_attenuation) per tree triangle crossed (section 2.1).  1 when
- * there is no second BVH.  Thread-safe. */
-double obs__bake_occl_transmittance(const obs__bake_occl *o, const float org[3],
-                                    const float dir[3], float tmax);
+/* The fraction of visibility left along each ray of a packet of 8 that
+ * the opaque BVH has answered (opaque: its rays with tfar at the hit, or
+ * the ray's end; valid: -1 for the lanes in use): exp(-sum density_i
+ * len_i) over the shrub boxes times (1 - tree_attenuation) per tree
+ * triangle crossed, on [0, tfar] (section 2.1).  1 where there is no
+ * second BVH, and in unused lanes.  Thread-safe. */
+void obs__bake_occl_transmittance8(const obs__bake_occl *o, const int *valid,
+                                   const struct RTCRayHit8 *opaque, double tr[8]);
 
 /* The two BVHs of the public wrapper (obs_bake_occluders_new); NULL for
  * NULL. */

@@ -117,20 +117,16 @@ static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint
             rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect8(valid, j->rtc, ctx, &rh);
+        double tr[PACKET]; /* shrubs and trees up to the opaque hit (section 2.1) */
+        obs__bake_occl_transmittance8(j->occl, valid, &rh, tr);
         for (int l = 0; l < PACKET && k0 + l < nr; l++) {
-            /* shrubs and trees up to the opaque hit (section 2.1) */
-            double tr = 1.0;
-            if (j->occl->fog) {
-                const float dl[3] = {rh.ray.dir_x[l], rh.ray.dir_y[l], rh.ray.dir_z[l]};
-                tr = obs__bake_occl_transmittance(j->occl, o, dl, rh.ray.tfar[l]);
-            }
             if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
-                acc[0] += tr;
-                acc[1] += tr;
+                acc[0] += tr[l];
+                acc[1] += tr[l];
                 continue;
             }
             for (int c = 0; c < 2; c++)
-                acc[c] += (1.0 - exp((double)j->a[c] * rh.ray.tfar[l])) * tr; /* rho(x) T */
+                acc[c] += (1.0 - exp((double)j->a[c] * rh.ray.tfar[l])) * tr[l]; /* rho(x) T */
             size_t ht = j->occl->opaque_tri ? j->occl->opaque_tri[rh.hit.primID[l]]
                                             : rh.hit.primID[l];
             const float *hn = w->fn + 3 * ht;

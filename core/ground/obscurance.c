@@ -62,18 +62,15 @@ void obs__obscurance_at(RTCScene rtc, struct RTCIntersectContext *ctx, const obs
             rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect8(valid, o->occl ? o->occl->opaque : rtc, ctx, &rh);
-        for (int l = 0; l < PACKET && k0 + l < nr; l++) {
-            double tr = 1.0; /* shrubs and trees up to the hit, section 2.1 */
-            if (o->occl && o->occl->fog) {
-                const float dl[3] = {rh.ray.dir_x[l], rh.ray.dir_y[l], rh.ray.dir_z[l]};
-                tr = obs__bake_occl_transmittance(o->occl, org, dl, rh.ray.tfar[l]);
-            }
+        double tr[PACKET] = {1, 1, 1, 1, 1, 1, 1, 1}; /* shrubs and trees, section 2.1 */
+        if (o->occl)
+            obs__bake_occl_transmittance8(o->occl, valid, &rh, tr);
+        for (int l = 0; l < PACKET && k0 + l < nr; l++)
             for (int c = 0; c < 2; c++)
                 acc[c] += (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID
                                ? 1.0
                                : obs__bake_rho(o->a[c], rh.ray.tfar[l])) *
-                          tr;
-        }
+                          tr[l];
     }
     out[0] = (float)(acc[0] / nr);
     out[1] = (float)(acc[1] / nr);
