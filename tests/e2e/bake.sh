@@ -55,6 +55,12 @@ expect 0 "bake with --decorators (trees.json's layout)" -- "$OBSCURA" bake "$FIX
 check "report: 2 tree nodes, 60 opaque" \
     "[ \"\$(field $T/dt.json \"['decorator_nodes']['tree']\")\" = 2 ] && [ \"\$(field $T/dt.json \"['decorator_nodes']['none']\")\" -gt 55 ]"
 check "the trees semi-transparent: other values" "! cmp -s $T/t1.glb $T/dt.glb"
+printf '{"decorators": [{"name": "OBJ1479", "class": "tree"}, {"name": "OBJ1478", "class": "shrub"}]}\n' >"$T/mixed.json"
+expect 0 "a tree and a shrub, 1 thread" -- "$OBSCURA" bake "$FIX" -o "$T/dm1.glb" --rays 16 \
+    --threads 1 --decorators "$T/mixed.json" -q
+expect 0 "a tree and a shrub, 2 threads" -- "$OBSCURA" bake "$FIX" -o "$T/dm2.glb" --rays 16 \
+    --threads 2 --decorators "$T/mixed.json" -q
+check "decorators: the same bytes whatever the thread count" "cmp -s $T/dm1.glb $T/dm2.glb"
 expect 0 "--tree-attenuation 1 (each card blocks all)" -- "$OBSCURA" bake "$FIX" -o "$T/dt1.glb" \
     --rays 16 --decorators "$TREES" --tree-attenuation 1 -q
 check "... other values again" "! cmp -s $T/dt.glb $T/dt1.glb"
