@@ -60,43 +60,6 @@ static void list_params(int markdown)
     }
 }
 
-/* The whole of a small text file (a decorators file), NUL-terminated;
- * caller frees. */
-static obs_status read_text(const char *path, char **out, char err[OBS_ERR_LEN])
-{
-    *out = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        snprintf(err, OBS_ERR_LEN, "cannot open: %s", strerror(errno));
-        return OBS_IO;
-    }
-    size_t cap = 4096, n = 0;
-    char *b = malloc(cap);
-    for (size_t got; b && (got = fread(b + n, 1, cap - n - 1, f)) > 0;) {
-        n += got;
-        if (n + 1 == cap) {
-            char *nb = cap < ((size_t)1 << 30) ? realloc(b, cap * 2) : NULL;
-            if (!nb) {
-                free(b);
-                b = NULL;
-                break;
-            }
-            b = nb;
-            cap *= 2;
-        }
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (!b || bad) {
-        free(b);
-        snprintf(err, OBS_ERR_LEN, "%s", bad ? "read error" : "too large (1 GiB at most)");
-        return bad ? OBS_IO : OBS_TOO_LARGE;
-    }
-    b[n] = 0;
-    *out = b;
-    return OBS_OK;
-}
-
 typedef struct progress {
     double start, last;
 } progress;
@@ -215,6 +178,25 @@ static int write_report(const char *path, const char *level, const obs_bake_para
     if (st->lod_levels)
         cli_bake_lod_report(r, p, st);
     report_instanced(r, sc, st, result);
+    if (st->small_decorators) {
+        /* section 2.2.1: one scalar per small decorator */
+        cJSON *sd = cJSON_AddObjectToObject(r, "small_decorators");
+        cJSON_AddNumberToObject(sd, "count", (double)st->small_decorators);
+        cJSON_AddNumberToObject(sd, "unresolved", (double)st->small_unresolved);
+        cJSON *arr = cJSON_AddArrayToObject(sd, "nodes");
+        for (size_t n = 0; result && result->node_ao && n < result->node_count; n++) {
+            const float *a = result->node_ao + 3 * n;
+            if (a[0] != a[0]) /* NaN: not a small decorator, or unresolved */
+                continue;
+            cJSON *e = cJSON_CreateObject();
+            cJSON_AddNumberToObject(e, "node", (double)n);
+            cJSON_AddStringToObject(e, "name", sc->nodes[n].name);
+            cJSON_AddNumberToObject(e, "_AO", a[0]);
+            cJSON_AddNumberToObject(e, "_AO_SHORT", a[1]);
+            cJSON_AddNumberToObject(e, "_AO_LONG", a[2]);
+            cJSON_AddItemToArray(arr, e);
+        }
+    }
     cJSON *ao = cJSON_AddObjectToObject(r, "ao");
     cJSON_AddNumberToObject(ao, "mean", st->ao_mean);
     cJSON_AddNumberToObject(ao, "min", st->ao_min);
@@ -239,6 +221,11 @@ static void warn(const char *level, const obs_bake_stats *st)
 {
     if (st->decorator_warning[0])
         fprintf(stderr, "obscura: bake: warning: %s\n", st->decorator_warning);
+    if (st->small_unresolved)
+        fprintf(stderr,
+                "obscura: bake: warning: %zu of %zu small decorators met no geometry within "
+                "their sphere (--small-radius): they keep their own fitted values\n",
+                st->small_unresolved, st->small_decorators);
     /* assimp 5.2's AC3D reader drops the surfaces' double-sided flag
      * (SURF 0x20); the loader reads it from the file, unless the file's
      * objects and assimp's nodes disagree. */
@@ -370,7 +357,7 @@ int cli_bake(int argc, char **argv)
 
     char *decor_text = NULL;
     if (decorators) {
-        obs_status ds = read_text(decorators, &decor_text, err);
+        obs_status ds = cli_read_text(decorators, &decor_text, err);
         if (ds != OBS_OK) {
             free(parts);
             return cli_input_fail(ds, decorators, err);

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <time.h>
 #include <string.h>
+#include <errno.h>
 
 int cli_status_exit(obs_status s)
 {
@@ -67,3 +68,40 @@ double cli_now_s(void)
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + ts.tv_nsec / 1e9;
 }
+
+/* A decorators file (obscura bake, obscura reference) in memory. */
+obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN])
+{
+    *out = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, OBS_ERR_LEN, "cannot open: %s", strerror(errno));
+        return OBS_IO;
+    }
+    size_t cap = 4096, n = 0;
+    char *b = malloc(cap);
+    for (size_t got; b && (got = fread(b + n, 1, cap - n - 1, f)) > 0;) {
+        n += got;
+        if (n + 1 == cap) {
+            char *nb = cap < ((size_t)1 << 30) ? realloc(b, cap * 2) : NULL;
+            if (!nb) {
+                free(b);
+                b = NULL;
+                break;
+            }
+            b = nb;
+            cap *= 2;
+        }
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (!b || bad) {
+        free(b);
+        snprintf(err, OBS_ERR_LEN, "%s", bad ? "read error" : "too large (1 GiB at most)");
+        return bad ? OBS_IO : OBS_TOO_LARGE;
+    }
+    b[n] = 0;
+    *out = b;
+    return OBS_OK;
+}
+

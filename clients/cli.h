@@ -24,6 +24,10 @@ int cli_input_fail(obs_status s, const char *what, const char *err);
  * EXIT_USAGE. */
 void cli_die_usage(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3), noreturn));
 
+/* The whole of a text file, NUL-terminated, in *out (caller frees); the
+ * message in err. */
+obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN]);
+
 /* Seconds of CLOCK_MONOTONIC (progress, stage times). */
 double cli_now_s(void);
 /* --shard I/N of obscura bake and bake-dynamic: 0 <= I < N <= 10^6, else

@@ -48,12 +48,14 @@ void cli_ground_usage(FILE *f)
             "                  instead (eq 1, closest hits, rho = 1 - exp(a x), a = ln 0.5 / d;\n"
             "                  opaque): AO.Y = B short + (1 - B) long, AO_SHORT.Y, AO_LONG.Y, Z;\n"
             "                  [--near D]: also AO_NEAR.Y (the AO above at distance D) and\n"
-            "                  AO_BOTH.Y = AO_NEAR x AO_LONG (baked long x screen-space's reference)\n");
+            "                  AO_BOTH.Y = AO_NEAR x AO_LONG (baked long x screen-space's reference)\n"
+            "                  [--decorators D.json] [--decorator-source S] [--shrub-density F]\n"
+            "                  [--tree-attenuation A]   decorators traced as obscura bake does\n");
 }
 
 /* The options both commands share. */
 typedef struct ground_args {
-    const char *cmd, *scene, *out, *camera, *backend, *gbuffer;
+    const char *cmd, *scene, *out, *camera, *backend, *gbuffer, *decorators;
     const char *dynamic, *dynamic_nodes; /* gbuffer --dynamic MODEL, --dynamic-nodes */
     int dynamic_linear;
     long width, height, spp, threads;
@@ -62,13 +64,32 @@ typedef struct ground_args {
     int quiet, verbose, deep, baked;
     /* --obscurance and --blend, through the bake's table (its ranges and
      * its default blend) */
-    int obscurance, blend_given;
+    int obscurance, blend_given, decor_given;
     double near;
     obs_bake_params bake;
 #define MAX_ALPHA_SPECS 64
     const char *alpha[MAX_ALPHA_SPECS]; /* --alpha specs, in order */
     int nalpha;
 } ground_args;
+
+static const char *opt_value(const ground_args *a, int argc, char **argv, int *i,
+                             const char *name);
+
+/* One of the bake's decorator parameters (reference --obscurance): its
+ * value, *key its name; NULL when argv[*i] is none of them. */
+static const char *decor_opt(const ground_args *a, int argc, char **argv, int *i,
+                             const char **key)
+{
+    static const char *const rows[] = {"decorator-source", "shrub-density", "tree-attenuation"};
+    for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++) {
+        const char *v = opt_value(a, argc, argv, i, rows[k]);
+        if (v) {
+            *key = rows[k];
+            return v;
+        }
+    }
+    return NULL;
+}
 
 /* "--name VALUE" or "--name=VALUE"; NULL when argv[*i] is not --name. */
 static const char *opt_value(const ground_args *a, int argc, char **argv, int *i, const char *name)
@@ -100,7 +121,7 @@ static long parse_long(const ground_args *a, const char *name, const char *v, lo
 static void parse(ground_args *a, int argc, char **argv, int reference)
 {
     for (int i = 0; i < argc; i++) {
-        const char *v;
+        const char *v, *key = NULL;
         if ((v = opt_value(a, argc, argv, &i, "o")) || (v = opt_value(a, argc, argv, &i, "output")))
             a->out = v;
         else if ((v = opt_value(a, argc, argv, &i, "camera")))
@@ -154,6 +175,16 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
                 obs_bake_param_set(&a->bake, "distance_long", lo, err) != OBS_OK)
                 cli_die_usage(a->cmd, "--obscurance '%s': %s", v, err);
             a->obscurance = 1;
+        } else if (reference && (v = opt_value(a, argc, argv, &i, "decorators"))) {
+            a->decorators = v;
+        } else if (reference && (v = decor_opt(a, argc, argv, &i, &key))) {
+            /* the bake's decorator rows (obscura/bake.h), so that the
+             * reference traces the decorators as a bake of the same
+             * parameters does */
+            char err[OBS_ERR_LEN] = "";
+            if (obs_bake_param_set(&a->bake, key, v, err) != OBS_OK)
+                cli_die_usage(a->cmd, "--%s '%s': %s", key, v, err);
+            a->decor_given = 1;
         } else if (reference && (v = opt_value(a, argc, argv, &i, "near"))) {
             char *end;
             a->near = strtod(v, &end);
@@ -186,6 +217,9 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
         cli_die_usage(a->cmd, "no output file (-o OUT)");
     if (!a->camera && !(reference && a->gbuffer))
         cli_die_usage(a->cmd, "no camera (--camera CAM.json)");
+    if ((a->decorators || a->decor_given) && !a->obscurance)
+        cli_die_usage(a->cmd, "--decorators and the decorator parameters need --obscurance "
+                              "SHORT,LONG");
     if ((a->blend_given || a->near > 0) && !a->obscurance)
         cli_die_usage(a->cmd, "--%s needs --obscurance SHORT,LONG", a->near > 0 ? "near" : "blend");
     if (a->obscurance && a->nalpha)
@@ -246,6 +280,39 @@ static void log_cb(void *user, obs_log_level level, const char *msg)
     int verbosity = a->quiet ? OBS_LOG_WARN : a->verbose ? OBS_LOG_DEBUG : OBS_LOG_WARN;
     if ((int)level <= verbosity)
         fprintf(stderr, "obscura: %s: %s\n", names[level], msg);
+}
+
+/* reference --obscurance: the level read again as the bake reads it,
+ * its decorators classified, and the occluders the bake's rays meet
+ * (obs_bake_occluders_new); *out NULL when the level has no decorators. */
+static int load_occluders(const ground_args *a, obs_bake_occluders **out)
+{
+    char err[OBS_ERR_LEN] = "", warning[OBS_ERR_LEN] = "";
+    char *text = NULL;
+    obs_status s;
+    *out = NULL;
+    obs_bake_params p;
+    obs_bake_params_resolve(&a->bake, &p);
+    if (p.decorator_source == OBS_BAKE_DECOR_OFF)
+        return EXIT_OK;
+    if (a->decorators && (s = cli_read_text(a->decorators, &text, err)) != OBS_OK)
+        return cli_input_fail(s, a->decorators, err);
+    obs_bake_scene bs;
+    if ((s = obs_bake_load(a->scene, 0, &bs, err)) != OBS_OK) {
+        free(text);
+        return cli_input_fail(s, a->scene, err);
+    }
+    s = obs_bake_occluders_new(&bs, &a->bake, text, out, warning, err);
+    obs_bake_scene_free(&bs);
+    free(text);
+    if (s != OBS_OK)
+        return cli_input_fail(s, a->scene, err);
+    if (warning[0])
+        fprintf(stderr, "obscura: reference: warning: %s\n", warning);
+    if (*out && !a->quiet)
+        fprintf(stderr, "obscura: info: %s: decorators traced as the bake does (shrubs as fog, "
+                        "trees semi-transparent)\n", a->scene);
+    return EXIT_OK;
 }
 
 static int load_scene(const ground_args *a, obs_scene *scene)
@@ -500,6 +567,7 @@ int cli_reference(int argc, char **argv)
 
     obs_camera cam = {0};
     obs_scene scene = {0};
+    obs_bake_occluders *occl = NULL;
     obs_image pos = {0}, nrm = {0}, ao = {0}, depth = {0};
     char err[OBS_ERR_LEN] = "";
     int w = 0, h = 0, rc = EXIT_OK;
@@ -548,6 +616,9 @@ int cli_reference(int argc, char **argv)
         if (scene.opacity && !a.quiet)
             fprintf(stderr, "obscura: info: %s: opacities not used: the obscurance traces every "
                             "surface as opaque, as the bake does\n", a.scene);
+        if ((rc = load_occluders(&a, &occl)) != EXIT_OK)
+            goto done;
+        desc.occluders = occl;
     }
     if (!a.quiet && isatty(STDERR_FILENO)) {
         desc.progress = progress_cb;
@@ -594,6 +665,7 @@ int cli_reference(int argc, char **argv)
                 a.out, w, h, a.distance, a.spp ? a.spp : 256L, a.seed, t);
 
 done:
+    obs_bake_occluders_free(occl);
     obs_image_free(&ao);
     obs_image_free(&depth);
     obs_image_free(&pos);

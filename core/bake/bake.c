@@ -42,6 +42,7 @@ void obs_bake_result_free(obs_bake_result *r)
     }
     free(r->instances);
     obs__bake_lods_free(r);
+    free(r->node_ao);
     memset(r, 0, sizeof *r);
 }
 
@@ -85,10 +86,11 @@ static obs_status copy_back(const obs_bake_scene *scene, const obs__bake_world *
     return OBS_OK;
 }
 
-/* The instanced decorators' values (instanced.c: local x global, section
- * 2.2) written into the welded solution in place of the fit's, which had
- * no samples on them, so the LODs (lod.c) resample what the .glb holds. */
-static void instanced_into_solution(const obs_bake_scene *scene, const obs__bake_world *w,
+/* The values of the instances sel (the instanced decorators, instanced.c:
+ * local x global, section 2.2; the small decorators' scalars, small.c)
+ * written into the welded solution in place of the fit's, so that the
+ * LODs (lod.c) resample what the .glb holds. */
+static void results_into_solution(const obs_bake_scene *scene, const obs__bake_world *w,
                                     const obs__bake_weld *wd, const uint8_t *sel,
                                     const obs_bake_result *out, double *x)
 {
@@ -105,10 +107,51 @@ static void instanced_into_solution(const obs_bake_scene *scene, const obs__bake
     }
 }
 
+/* The local AO of mesh m, baked alone in its own space (steps 2-4 of the
+ * pipeline on a scene of that one mesh): 2 per vertex, short and long. */
+static obs_status local_ao(const obs_bake_scene *s, uint32_t m, const obs_bake_params *p,
+                           double *out, char err[OBS_ERR_LEN])
+{
+    obs_bake_node node = {0};
+    uint32_t zero = 0;
+    node.name = (char *)"local";
+    node.parent = -1;
+    for (int i = 0; i < 16; i++)
+        node.local[i] = node.world[i] = i % 5 == 0 ? 1.0f : 0.0f;
+    node.meshes = &zero;
+    node.mesh_count = 1;
+    obs_bake_scene one = {0};
+    one.meshes = &s->meshes[m];
+    one.mesh_count = 1;
+    one.materials = s->materials;
+    one.material_count = s->material_count;
+    one.nodes = &node;
+    one.node_count = 1;
+    one.instance_count = 1;
+    one.world_triangles = s->meshes[m].triangle_count;
+    obs_bake_desc d = {0};
+    d.params = *p;
+    d.params.instanced = OBS_BAKE_INSTANCED_OFF;
+    d.params.decorator_source = OBS_BAKE_DECOR_OFF;
+    d.params.holdout = 0.0f;
+    d.params.set = ~(uint64_t)0; /* every field as given here */
+    obs_bake_result r;
+    obs_status rc = obs_bake_run(&one, &d, &r, err);
+    if (rc != OBS_OK)
+        return rc;
+    size_t n = s->meshes[m].vertex_count;
+    for (size_t v = 0; v < n; v++) {
+        out[2 * v] = r.instances[0].ao_short[v];
+        out[2 * v + 1] = r.instances[0].ao_long[v];
+    }
+    obs_bake_result_free(&r);
+    return OBS_OK;
+}
+
 /* Held-out samples (parameter holdout): another seed places them and
  * draws their rays; the fit and the baselines are compared with them. */
 static obs_status holdout(const obs__bake_world *w, const obs__bake_weld *wd,
-                          const obs_bake_params *p, const double *x, const double *face,
+                          const obs__bake_decor *dc, const obs_bake_params *p, const double *x, const double *face,
                           const double *point, obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
     obs__bake_samples h;
@@ -118,6 +161,8 @@ static obs_status holdout(const obs__bake_world *w, const obs__bake_weld *wd,
         return rc;
     obs__bake_trace_desc td = {{p->distance_short, p->distance_long}, p->rays, p->threads,
                                p->backface_limit, seed, NULL, NULL};
+    td.decor = dc;
+    td.tree_attenuation = p->tree_attenuation;
     double bvh;
     if ((rc = obs__bake_trace(w, &h, &td, &bvh, err)) == OBS_OK) {
         obs__bake_residual(w, wd, &h, x, st->holdout_fit);
@@ -208,6 +253,8 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     obs__bake_trace_desc td = {{p.distance_short, p.distance_long}, p.rays, p.threads,
                                p.backface_limit, (uint64_t)p.seed,
                                desc ? desc->progress : NULL, desc ? desc->progress_user : NULL};
+    td.decor = &dc;
+    td.tree_attenuation = p.tree_attenuation;
     double bvh = 0.0;
     if (sh) {
         if ((rc = obs__bake_shard_step(sh, &w, &s, &td, st, err)) != OBS_OK)
@@ -241,18 +288,27 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
         goto done;
     if (inst_n)
         obs__bake_instanced_uncount(&w, &wd, inst_sel, st);
-    if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &p, x, face, point, st, err)) != OBS_OK)
+    if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &dc, &p, x, face, point, st, err)) != OBS_OK)
         goto done;
-    rc = copy_back(scene, &w, &wd, x, p.blend, out, err);
-    if (rc == OBS_OK && inst_n) {
-        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, desc, s.count, out, err);
+    if ((rc = copy_back(scene, &w, &wd, x, p.blend, out, err)) != OBS_OK)
+        goto done;
+    if (inst_n) {
+        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, desc, s.count, local_ao, out, err);
         if (rc == OBS_OK)
-            instanced_into_solution(scene, &w, &wd, inst_sel, out, x);
+            results_into_solution(scene, &w, &wd, inst_sel, out, x);
         if (area_kept)
             memcpy(w.area, area_kept, w.triangle_count * sizeof *area_kept);
+        if (rc != OBS_OK)
+            goto done;
     }
-    if (rc == OBS_OK)
-        rc = obs__bake_lods(scene, &w, &wd, x, &p, out, err); /* lod.c, paper 2.2.1 */
+    if ((rc = obs__bake_small(scene, &w, wd.of, &dc, x, &p, out, err)) != OBS_OK)
+        goto done;
+    if (out->node_ao && p.lods) { /* the small decorators' scalars, for the LODs too */
+        for (size_t i = 0; i < w.instance_count; i++)
+            inst_sel[i] = out->node_ao[3 * w.inst[i].node] == out->node_ao[3 * w.inst[i].node];
+        results_into_solution(scene, &w, &wd, inst_sel, out, x);
+    }
+    rc = obs__bake_lods(scene, &w, &wd, x, &p, out, err); /* lod.c, paper 2.2.1 */
 done:
     free(area_kept);
     free(inst_sel);

@@ -58,6 +58,9 @@ typedef struct obs__bake_trace_desc {
     int (*progress)(void *user, size_t done, size_t total); /* nonzero: stop */
     void *progress_user;
     size_t first, end; /* the samples traced: [first, end), end 0 for all (shard.c) */
+    /* Decorators (section 2.1, occl.c): NULL, every triangle opaque */
+    const struct obs__bake_decor *decor;
+    float tree_attenuation;
 } obs__bake_trace_desc;
 
 /* Eq 1 at every sample (trace.c); OBS_CANCELLED when the progress
@@ -101,6 +104,14 @@ double obs__bake_edge_jump(const float a[3], const float b[3], const float c[3],
  * every core; probes.c): the dynamic bake's points, the instanced
  * decorators' volume (volume.c), the LODs' instances (lod.c). */
 void obs__bake_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx);
+/* Small decorators (small.c, section 2.2.1): each small node's scalar
+ * resampled from the fitted vertex values x (2 per welded vertex, of[]
+ * the weld) around it, into out->node_ao and its instances' vertices
+ * (out's instances filled); nothing when d has none. */
+struct obs__bake_decor;
+obs_status obs__bake_small(const obs_bake_scene *scene, const obs__bake_world *w,
+                           const uint32_t *of, const struct obs__bake_decor *d, const double *x,
+                           const obs_bake_params *p, obs_bake_result *out, char err[OBS_ERR_LEN]);
 
 /* The level's BVH on its own, for points in space (trace.c; the
  * dynamic-object bake).  w must outlive it. */

@@ -296,11 +296,21 @@ obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,
                 ch = cJSON_AddArrayToObject(parent, "children");
             cJSON_AddItemToArray(ch, cJSON_CreateNumber((double)n));
         }
-        if (nd->extras) {
-            cJSON *x = cJSON_Parse(nd->extras);
-            if (x)
-                cJSON_AddItemToObject(j, "extras", x);
+        cJSON *x = nd->extras ? cJSON_Parse(nd->extras) : NULL;
+        if (r->node_ao && n < r->node_count && !isnan(r->node_ao[3 * n])) {
+            /* a small decorator's one scalar (section 2.2.1) */
+            if (!cJSON_IsObject(x)) {
+                cJSON_Delete(x);
+                x = cJSON_CreateObject();
+            }
+            static const char *const keys[3] = {"_AO", "_AO_SHORT", "_AO_LONG"};
+            for (int k = 0; k < 3; k++) {
+                cJSON_DeleteItemFromObjectCaseSensitive(x, keys[k]);
+                cJSON_AddNumberToObject(x, keys[k], r->node_ao[3 * n + k]);
+            }
         }
+        if (x)
+            cJSON_AddItemToObject(j, "extras", x);
         if (nd->mesh_count) {
             cJSON *m = cJSON_CreateObject(), *prims = cJSON_AddArrayToObject(m, "primitives");
             cJSON_AddStringToObject(m, "name", scene->meshes[nd->meshes[0]].name);

@@ -15,7 +15,8 @@
  * Here:
  *   - L, per distinct mesh (not per instance): the bake's steps 2-4
  *     (samples, trace, fit) on the mesh alone in its own space, through
- *     obs_bake_run on a scene of that one mesh;
+ *     obs_bake_run on a scene of that one mesh (bake.c's local_ao, handed
+ *     in);
  *   - f, the "actual AO signal" at the instance's vertices, from the
  *     sparse volume of spherical visibility traced in the whole level
  *     around the instances (volume.c), trilinear, evaluated at the
@@ -192,47 +193,6 @@ void obs__bake_instanced_uncount(const obs__bake_world *w, const obs__bake_weld 
     st->vertices_isolated -= n < st->vertices_isolated ? n : st->vertices_isolated;
 }
 
-/* The local AO of mesh m, baked alone in its own space (steps 2-4 of the
- * pipeline on a scene of that one mesh): 2 per vertex, short and long. */
-static obs_status local_ao(const obs_bake_scene *s, uint32_t m, const obs_bake_params *p,
-                           double *out, char err[OBS_ERR_LEN])
-{
-    obs_bake_node node = {0};
-    uint32_t zero = 0;
-    node.name = (char *)"local";
-    node.parent = -1;
-    for (int i = 0; i < 16; i++)
-        node.local[i] = node.world[i] = i % 5 == 0 ? 1.0f : 0.0f;
-    node.meshes = &zero;
-    node.mesh_count = 1;
-    obs_bake_scene one = {0};
-    one.meshes = &s->meshes[m];
-    one.mesh_count = 1;
-    one.materials = s->materials;
-    one.material_count = s->material_count;
-    one.nodes = &node;
-    one.node_count = 1;
-    one.instance_count = 1;
-    one.world_triangles = s->meshes[m].triangle_count;
-    obs_bake_desc d = {0};
-    d.params = *p;
-    d.params.instanced = OBS_BAKE_INSTANCED_OFF;
-    d.params.decorator_source = OBS_BAKE_DECOR_OFF;
-    d.params.holdout = 0.0f;
-    d.params.set = ~(uint64_t)0; /* every field as given here */
-    obs_bake_result r;
-    obs_status rc = obs_bake_run(&one, &d, &r, err);
-    if (rc != OBS_OK)
-        return rc;
-    size_t n = s->meshes[m].vertex_count;
-    for (size_t v = 0; v < n; v++) {
-        out[2 * v] = r.instances[0].ao_short[v];
-        out[2 * v + 1] = r.instances[0].ao_long[v];
-    }
-    obs_bake_result_free(&r);
-    return OBS_OK;
-}
-
 /* The bake's progress callback with every sample done: nonzero stops. */
 typedef struct stop_ctx {
     const obs_bake_desc *desc;
@@ -249,7 +209,8 @@ static int stop_asked(void *user)
 obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_world *w,
                                    const uint8_t *sel, const obs_bake_params *p,
                                    const obs_bake_desc *desc, size_t samples,
-                                   obs_bake_result *out, char err[OBS_ERR_LEN])
+                                   obs__bake_alone_fn local_ao, obs_bake_result *out,
+                                   char err[OBS_ERR_LEN])
 {
     stop_ctx sc = {desc, samples};
     obs_bake_stats *st = &out->stats;

@@ -89,16 +89,26 @@ void obs__bake_instanced_mask(obs__bake_world *w, const uint8_t *sel);
  * no samples by design (obs__bake_instanced_mask), not by accident. */
 void obs__bake_instanced_uncount(const obs__bake_world *w, const obs__bake_weld *wd,
                                  const uint8_t *sel, obs_bake_stats *st);
+/* The local AO of mesh m of s baked alone in its own space, the steps of
+ * the pipeline on a scene of that one mesh (bake.c, which hands it in so
+ * that the pipeline and this step do not call each other): 2 values per
+ * vertex, short and long, into out. */
+typedef obs_status (*obs__bake_alone_fn)(const obs_bake_scene *s, uint32_t m,
+                                         const obs_bake_params *p, double *out,
+                                         char err[OBS_ERR_LEN]);
+
 /* The model of section 2.2 for the selected instances: the local AO of
  * each of their meshes baked alone (samples, trace, fit), the volume
  * around them traced in the whole level, eq 3 per instance; their
  * results in out replaced (ao, ao_short, ao_long, ao_local, global) and
- * the stats filled.  desc's progress callback (may be NULL) is called
- * with (samples, samples) between the meshes and during the volume's
- * trace; nonzero stops the bake with OBS_CANCELLED. */
+ * the stats filled; local_ao bakes each mesh alone.  desc's progress
+ * callback (may be NULL) is called with (samples, samples) between the
+ * meshes and during the volume's trace; nonzero stops the bake with
+ * OBS_CANCELLED. */
 obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_world *w,
                                    const uint8_t *sel, const obs_bake_params *p,
                                    const obs_bake_desc *desc, size_t samples,
-                                   obs_bake_result *out, char err[OBS_ERR_LEN]);
+                                   obs__bake_alone_fn local_ao, obs_bake_result *out,
+                                   char err[OBS_ERR_LEN]);
 
 #endif

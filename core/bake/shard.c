@@ -15,7 +15,8 @@
  *    12     4    u32 header size in bytes (128)
  *    16     8    u64 level fingerprint: FNV-1a 64 of the flattened level
  *                (vertex and triangle counts, positions' float bits,
- *                triangles, double-sidedness)
+ *                triangles, double-sidedness; with decorators, each
+ *                instance's class and density and tree_attenuation too)
  *    24     4    u32 shard index I (0 .. N-1)
  *    28     4    u32 shard count N
  *    32     8    u64 samples of the whole level
@@ -49,6 +50,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "bake/decor.h"
 #include "bake/shard.h"
 #include "internal.h"
 
@@ -97,6 +99,26 @@ uint64_t obs__bake_level_fingerprint(const obs__bake_world *w)
     for (size_t i = 0; i < 3 * w->triangle_count; i++)
         h = fnv32(h, w->tri[i]);
     return obs__bake_fnv(h, w->two_sided, w->triangle_count);
+}
+
+/* The level's fingerprint with its decorators folded in (section 2.2,
+ * decor.c, occl.c): each instance's class, the shrubs' densities and the
+ * trees' attenuation decide the traced values as the geometry does, so a
+ * part traced with other decorators reads as another level.  Without
+ * decorators the fingerprint is the level's own. */
+static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_trace_desc *td)
+{
+    uint64_t h = obs__bake_level_fingerprint(w);
+    const obs__bake_decor *d = td ? td->decor : NULL;
+    if (!d || d->counts[OBS__DECOR_NONE] == d->node_count)
+        return h;
+    h = obs__bake_fnv(h, (const unsigned char *)"decorators 1", 12);
+    for (size_t i = 0; i < w->instance_count; i++) {
+        uint32_t n = w->inst[i].node;
+        h = fnv32(h, n < d->node_count ? d->node_class[n] : 0);
+        h = fnv32(h, n < d->node_count ? obs__le_fbits(d->density[n]) : 0);
+    }
+    return fnv32(h, obs__le_fbits(td->tree_attenuation));
 }
 
 /* ---- writing a part ----------------------------------------------------- */
@@ -183,7 +205,7 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
                               obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
     obs__bake_part h = {0};
-    h.level = obs__bake_level_fingerprint(w);
+    h.level = traced_fingerprint(w, td);
     h.index = (uint32_t)sh->index;
     h.count = (uint32_t)sh->count;
     h.total = s->count;
@@ -330,13 +352,15 @@ static obs_status read_payload(const obs__bake_part *h, obs__bake_samples *s, ch
 }
 
 static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs__bake_samples *s,
-                              obs_bake_stats *st, char err[OBS_ERR_LEN])
+                              const obs__bake_trace_desc *td, obs_bake_stats *st,
+                              char err[OBS_ERR_LEN])
 {
-    uint64_t level = obs__bake_level_fingerprint(w);
+    uint64_t level = traced_fingerprint(w, td);
     const obs__bake_part *p0 = &sh->parts[0];
     if (p0->level != level)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s was traced from another level (or "
-                         "another version of it): fingerprint %016llx, this level's %016llx",
+                         "another version of it, or with other decorators): fingerprint %016llx, "
+                         "this level's %016llx",
                          p0->path, (unsigned long long)p0->level, (unsigned long long)level);
     if (p0->total != s->count)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: the parts split %llu samples; this level "
@@ -363,7 +387,7 @@ obs_status obs__bake_shard_step(obs__bake_shard *sh, const obs__bake_world *w,
                                 obs__bake_samples *s, const obs__bake_trace_desc *td,
                                 obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
-    return sh->parts ? read_shards(sh, w, s, st, err) : trace_shard(sh, w, s, td, &sh->params, st, err);
+    return sh->parts ? read_shards(sh, w, s, td, st, err) : trace_shard(sh, w, s, td, &sh->params, st, err);
 }
 
 /* ---- the parts of one split ----------------------------------------------- */

@@ -9,7 +9,13 @@
  * the rays; a miss counts rho = 1.  Closest hits through Embree 3; a ray
  * that hits the back of a one-sided face counts towards the back-face
  * rule (section 2.1): a sample with more than backface_limit of its rays
- * on back faces lies inside geometry and is dropped. */
+ * on back faces lies inside geometry and is dropped.
+ *
+ * Decorators (section 2.1, core/bake/occl.c): the closest hit is of the
+ * opaque triangles alone; shrubs (fog boxes) and trees (semi-transparent
+ * triangles) on the ray's segment up to that hit multiply the ray's
+ * value by their transmittance T:  rho(d) T, a miss 1 T ("both simply
+ * attenuate the current AO value for a ray"). */
 #include <embree3/rtcore.h>
 #include <math.h>
 #include <pthread.h>
@@ -21,6 +27,7 @@
 #include <unistd.h>
 
 #include "bake/bake_internal.h"
+#include "bake/occl.h"
 #include "bake/rng.h"
 #include "internal.h"
 
@@ -35,6 +42,7 @@ typedef struct job {
     const obs__bake_world *w;
     obs__bake_samples *s;
     const obs__bake_trace_desc *d;
+    const obs__bake_occl *occl;
     RTCScene rtc;
     float a[2]; /* the kernels' a = ln(0.5) / d */
     atomic_size_t next;
@@ -109,16 +117,20 @@ static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint
             rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect8(valid, j->rtc, ctx, &rh);
+        double tr[PACKET]; /* shrubs and trees up to the opaque hit (section 2.1) */
+        obs__bake_occl_transmittance8(j->occl, valid, &rh, tr);
         for (int l = 0; l < PACKET && k0 + l < nr; l++) {
             if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
-                acc[0] += 1.0;
-                acc[1] += 1.0;
+                acc[0] += tr[l];
+                acc[1] += tr[l];
                 continue;
             }
             for (int c = 0; c < 2; c++)
-                acc[c] += 1.0 - exp((double)j->a[c] * rh.ray.tfar[l]); /* rho(x), section 2 */
-            const float *hn = w->fn + 3 * (size_t)rh.hit.primID[l];
-            if (!w->two_sided[rh.hit.primID[l]] &&
+                acc[c] += (1.0 - exp((double)j->a[c] * rh.ray.tfar[l])) * tr[l]; /* rho(x) T */
+            size_t ht = j->occl->opaque_tri ? j->occl->opaque_tri[rh.hit.primID[l]]
+                                            : rh.hit.primID[l];
+            const float *hn = w->fn + 3 * ht;
+            if (!w->two_sided[ht] &&
                 hn[0] * rh.ray.dir_x[l] + hn[1] * rh.ray.dir_y[l] + hn[2] * rh.ray.dir_z[l] > 0.0f)
                 back++;
         }
@@ -154,13 +166,6 @@ static void *worker(void *arg)
     return NULL;
 }
 
-static void device_error(void *user, enum RTCError code, const char *msg)
-{
-    char *buf = user;
-    if (!buf[0])
-        snprintf(buf, OBS_ERR_LEN, "Embree error %d: %s", (int)code, msg ? msg : "");
-}
-
 static double now(void)
 {
     struct timespec ts;
@@ -172,43 +177,11 @@ obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
                            const obs__bake_trace_desc *d, double *bvh_seconds,
                            char err[OBS_ERR_LEN])
 {
-    char dev_err[OBS_ERR_LEN] = "";
     obs_status st = OBS_OK;
     double t0 = now();
-    RTCDevice dev = rtcNewDevice(NULL);
-    if (!dev)
-        return obs__fail(err, OBS_UNSUPPORTED, "Embree: no device (error %d)",
-                         (int)rtcGetDeviceError(NULL));
-    rtcSetDeviceErrorFunction(dev, device_error, dev_err);
-    RTCScene rs = rtcNewScene(dev);
-    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    /* Copies: Embree reads vertex buffers in 16-byte loads and wants them
-     * padded. */
-    float *v = rs && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                 3 * sizeof(float), w->vertex_count)
-                       : NULL;
-    unsigned *ix = rs && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0,
-                                                     RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                                                     w->triangle_count)
-                           : NULL;
-    if (!v || !ix) {
-        if (g)
-            rtcReleaseGeometry(g);
-        st = obs__fail(err, OBS_NO_MEMORY, "Embree scene of %zu triangles: %s", w->triangle_count,
-                       dev_err[0] ? dev_err : "out of memory");
-        goto done;
-    }
-    memcpy(v, w->pos, w->vertex_count * 3 * sizeof(float));
-    memcpy(ix, w->tri, w->triangle_count * 3 * sizeof(unsigned));
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(rs, g);
-    rtcReleaseGeometry(g);
-    rtcSetSceneBuildQuality(rs, RTC_BUILD_QUALITY_HIGH);
-    rtcCommitScene(rs);
-    if (dev_err[0]) {
-        st = obs__fail(err, OBS_NO_MEMORY, "Embree scene: %s", dev_err);
-        goto done;
-    }
+    obs__bake_occl *occl = NULL;
+    if ((st = obs__bake_occl_new(w, d->decor, d->tree_attenuation, &occl, err)) != OBS_OK)
+        return st;
     *bvh_seconds = now() - t0;
 
     job *j = calloc(1, sizeof *j);
@@ -219,7 +192,8 @@ obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
     j->w = w;
     j->s = s;
     j->d = d;
-    j->rtc = rs;
+    j->occl = occl;
+    j->rtc = occl->opaque;
     for (int c = 0; c < 2; c++)
         j->a[c] = logf(0.5f) / d->distance[c]; /* a = ln(0.5) / d, section 2 */
     /* The samples [first, end): a shard of the bake (shard.c), or all. */
@@ -249,9 +223,7 @@ obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
                        j->end - d->first);
     free(j);
 done:
-    if (rs)
-        rtcReleaseScene(rs);
-    rtcReleaseDevice(dev);
+    obs__bake_occl_free(occl);
     return st;
 }
 
@@ -259,7 +231,7 @@ done:
  * (probes.c, regions.c, dyn_measure.c: points in space rather than on the
  * surface).  The same scene as obs__bake_trace builds; kept beside it. */
 struct obs__bake_bvh {
-    RTCDevice dev;
+    obs__bake_occl *occl; /* every triangle opaque */
     RTCScene rtc;
     const obs__bake_world *w;
 };
@@ -267,50 +239,17 @@ struct obs__bake_bvh {
 obs_status obs__bake_bvh_new(const obs__bake_world *w, obs__bake_bvh **out,
                              char err[OBS_ERR_LEN])
 {
-    char dev_err[OBS_ERR_LEN] = "";
     *out = NULL;
     obs__bake_bvh *b = calloc(1, sizeof *b);
     if (!b)
         return obs__fail(err, OBS_NO_MEMORY, "BVH");
     b->w = w;
-    b->dev = rtcNewDevice(NULL);
-    if (!b->dev) {
+    obs_status st = obs__bake_occl_new(w, NULL, 0.0f, &b->occl, err);
+    if (st != OBS_OK) {
         free(b);
-        return obs__fail(err, OBS_UNSUPPORTED, "Embree: no device (error %d)",
-                         (int)rtcGetDeviceError(NULL));
-    }
-    rtcSetDeviceErrorFunction(b->dev, device_error, dev_err);
-    b->rtc = rtcNewScene(b->dev);
-    RTCGeometry g = rtcNewGeometry(b->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float *v = b->rtc && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                     RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                     w->vertex_count)
-                           : NULL;
-    unsigned *ix = b->rtc && g ? rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0,
-                                                         RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                                                         w->triangle_count)
-                               : NULL;
-    if (!v || !ix) {
-        if (g)
-            rtcReleaseGeometry(g);
-        obs_status st = obs__fail(err, OBS_NO_MEMORY, "Embree scene of %zu triangles: %s",
-                                  w->triangle_count, dev_err[0] ? dev_err : "out of memory");
-        obs__bake_bvh_free(b);
         return st;
     }
-    memcpy(v, w->pos, w->vertex_count * 3 * sizeof(float));
-    memcpy(ix, w->tri, w->triangle_count * 3 * sizeof(unsigned));
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(b->rtc, g);
-    rtcReleaseGeometry(g);
-    rtcSetSceneBuildQuality(b->rtc, RTC_BUILD_QUALITY_HIGH);
-    rtcCommitScene(b->rtc);
-    rtcSetDeviceErrorFunction(b->dev, NULL, NULL);
-    if (dev_err[0]) {
-        obs_status st = obs__fail(err, OBS_NO_MEMORY, "Embree scene: %s", dev_err);
-        obs__bake_bvh_free(b);
-        return st;
-    }
+    b->rtc = b->occl->opaque;
     *out = b;
     return OBS_OK;
 }
@@ -319,9 +258,7 @@ void obs__bake_bvh_free(obs__bake_bvh *b)
 {
     if (!b)
         return;
-    if (b->rtc)
-        rtcReleaseScene(b->rtc);
-    rtcReleaseDevice(b->dev);
+    obs__bake_occl_free(b->occl);
     free(b);
 }
 

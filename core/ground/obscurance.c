@@ -3,11 +3,15 @@
  * the ray set and the random shifts are the bake's own (bake/kernel.h,
  * bake/rng.h), so that the per-pixel reference and the baked vertices
  * estimate one quantity the same way.  Closest hits in packets of 8, the
- * lanes summed in ray order, as core/bake/trace.c does. */
+ * lanes summed in ray order, as core/bake/trace.c does.  With the bake's
+ * occluders (obs_reference_desc.occluders) the rays meet what the bake's
+ * meet: its opaque BVH, and each ray's rho times the transmittance of the
+ * shrubs' fog and the trees up to the hit (section 2.1, core/bake/occl.c). */
 #include <embree3/rtcore.h>
 #include <math.h>
 
 #include "bake/kernel.h"
+#include "bake/occl.h"
 #include "bake/rng.h"
 #include "ground/reference_internal.h"
 
@@ -15,8 +19,10 @@
 /* The salt of the bake's ray shifts (core/bake/trace.c). */
 #define RAY_SALT 2
 
-void obs__obscurance_init(obs__obscurance *o, const float distance[2], int rays, uint64_t seed)
+void obs__obscurance_init(obs__obscurance *o, const float distance[2], int rays, uint64_t seed,
+                          const struct obs__bake_occl *occl)
 {
+    o->occl = occl;
     for (int c = 0; c < 2; c++)
         o->a[c] = obs__bake_kernel_a(distance[c]);
     o->tfar = OBS__BAKE_RAY_LENGTH_FACTOR * fmaxf(distance[0], distance[1]);
@@ -55,12 +61,16 @@ void obs__obscurance_at(RTCScene rtc, struct RTCIntersectContext *ctx, const obs
             rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
             rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect8(valid, rtc, ctx, &rh);
+        rtcIntersect8(valid, o->occl ? o->occl->opaque : rtc, ctx, &rh);
+        double tr[PACKET] = {1, 1, 1, 1, 1, 1, 1, 1}; /* shrubs and trees, section 2.1 */
+        if (o->occl)
+            obs__bake_occl_transmittance8(o->occl, valid, &rh, tr);
         for (int l = 0; l < PACKET && k0 + l < nr; l++)
             for (int c = 0; c < 2; c++)
-                acc[c] += rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID
-                              ? 1.0
-                              : obs__bake_rho(o->a[c], rh.ray.tfar[l]);
+                acc[c] += (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID
+                               ? 1.0
+                               : obs__bake_rho(o->a[c], rh.ray.tfar[l])) *
+                          tr[l];
     }
     out[0] = (float)(acc[0] / nr);
     out[1] = (float)(acc[1] / nr);

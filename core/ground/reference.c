@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "bake/occl.h"
 #include "ground/reference_internal.h"
 #include "internal.h"
 #include "obscura/reference.h"
@@ -555,7 +556,8 @@ obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view
     j->view = view;
     j->desc = d;
     if (d.obscurance)
-        obs__obscurance_init(&j->ob, d.obscurance_distance, d.spp, d.seed);
+        obs__obscurance_init(&j->ob, d.obscurance_distance, d.spp, d.seed,
+                             obs__bake_occluders_occl(d.occluders));
     j->width = w;
     j->height = h;
     j->ao = ao->data;

@@ -13,9 +13,14 @@ typedef struct obs__obscurance {
     float tfar;   /* ray length: OBS__BAKE_RAY_LENGTH_FACTOR times the longer d */
     int rays;
     uint64_t seed;
+    /* the bake's occluders (core/bake/occl.h), or NULL: the scene */
+    const struct obs__bake_occl *occl;
 } obs__obscurance;
 
-void obs__obscurance_init(obs__obscurance *o, const float distance[2], int rays, uint64_t seed);
+/* occl: the bake's occluders, whose opaque BVH and fog replace the
+ * caller's scene in obs__obscurance_at; NULL for none. */
+void obs__obscurance_init(obs__obscurance *o, const float distance[2], int rays, uint64_t seed,
+                          const struct obs__bake_occl *occl);
 
 /* Eq 1 at p around the unit normal n at both distances (out[0] short,
  * out[1] long), with the bake's rays: the lattice shift of stream `stream`

@@ -14,6 +14,9 @@
  *   instanced.c volume.c  instanced trees (section 2.2): local AO per
  *              mesh x a linear global AO per instance (eq 3) fitted to a
  *              sparse SH volume
+ *   decor.c occl.c small.c  decorators (section 2.2): their classes, shrubs
+ *              as fog and trees semi-transparent (2.1), small ones' scalar
+ *              (2.2.1)
  *   glb.c ply.c  the output files
  *   bake.c     the steps in order, timed (obs_bake_run)
  * The paper is "Baked ambient obscurance on the vertices of game levels"
@@ -188,6 +191,13 @@ typedef enum obs_bake_ivalues {
     X(volume_rays, INT, 128, 4, 65536, NULL,                                   \
       "rays over the sphere per volume point, projected to quadratic SH at "  \
       "both distances")                                                        \
+    X(tree_attenuation, FLOAT, 0.5, 0.0, 1.0, NULL,                            \
+      "fraction of a ray's visibility each tree triangle it crosses takes "   \
+      "away: trees are semi-transparent occluders (section 2.1; paper: 50 %)") \
+    X(small_radius, FLOAT, 1.0, 1e-4, 1e4, NULL,                               \
+      "radius (world units) of the sphere around a small decorator's "        \
+      "origin, added to the half diagonal of its box, over which the "        \
+      "surrounding AO is resampled into its one scalar (section 2.2.1)")      \
     X(seed, INT, 1, 0, 2147483647, NULL,                                       \
       "random seed; the bake depends on it alone, not on the thread count")    \
     X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
@@ -411,11 +421,20 @@ typedef struct obs_bake_stats {
         volume_points_inside;
     uint64_t volume_rays;
     double instanced_residual;
+    /* Small decorators (section 2.2.1) given one scalar, and those whose
+     * rays met no geometry (they keep their own fit). */
+    size_t small_decorators, small_unresolved;
 } obs_bake_stats;
 
 typedef struct obs_bake_result {
     obs_bake_instance *instances;
     size_t instance_count;
+    /* Small decorators (section 2.2.1): 3 per node, _AO, _AO_SHORT,
+     * _AO_LONG, the one scalar of a small decorator resampled from the
+     * AO around it (its vertices have it too), NaN for other nodes; NULL
+     * (node_count 0) when the level has none. */
+    size_t node_count;
+    float *node_ao;
     obs_bake_stats stats;
     /* LODs (parameter lods; core/bake/lod.c): level l = 1 .. lod_levels of
      * the scene's mesh m is lod_meshes[(l - 1) * mesh_count + m], in the
@@ -467,6 +486,23 @@ obs_status obs_bake_shard(const obs_bake_scene *scene, const obs_bake_desc *desc
 obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
                           const char *const *parts, size_t n, obs_bake_result *out,
                           char err[OBS_ERR_LEN]);
+
+/* ---- what the bake's rays meet, for the per-pixel reference ------------ */
+
+/* The level's occluders as the bake's rays see them (core/bake/occl.c):
+ * the opaque triangles, the shrubs' fog boxes and the trees'
+ * semi-transparent triangles (section 2.1), from the decorators of s
+ * (params: decorator_source, shrub_density, tree_attenuation;
+ * decorators_json: the text of a decorators file or NULL).  *out is NULL
+ * when the level has no shrub, tree or small decorator: every surface is
+ * then opaque, as the scene itself.  warning (may be NULL) receives the
+ * classification's warning, "" when none.  Free with
+ * obs_bake_occluders_free(); s may be freed before. */
+typedef struct obs_bake_occluders obs_bake_occluders;
+obs_status obs_bake_occluders_new(const obs_bake_scene *s, const obs_bake_params *params,
+                                  const char *decorators_json, obs_bake_occluders **out,
+                                  char warning[OBS_ERR_LEN], char err[OBS_ERR_LEN]);
+void obs_bake_occluders_free(obs_bake_occluders *o);
 
 /* ---- output ----------------------------------------------------------- */
 

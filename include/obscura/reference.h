@@ -35,7 +35,9 @@
  * geometric normal facing the viewer (the G-buffer's normal for G-buffer
  * points), the bake's own kernel, ray lattice and random shifts
  * (core/bake/kernel.h).  Every surface is opaque, as the bake traces it:
- * opacities are not used.  The image has three channels: the blend
+ * opacities are not used; with desc.occluders the rays meet the bake's
+ * occluders instead, the decorators' fog and semi-transparent trees
+ * multiplying each ray's rho by their transmittance (section 2.1).  The image has three channels: the blend
  * b AO_short + (1 - b) AO_long, AO_short, AO_long.  With obscurance_near
  * D > 0, two more: AO_near, the AO of the definition above with distance
  * D at the same point (what a screen-space method of radius D estimates),
@@ -69,6 +71,11 @@ typedef struct obs_reference_desc {
     float obscurance_distance[2]; /* short, long (> 0) */
     float blend;                  /* weight of the short one, in [0, 1] */
     float obscurance_near;        /* > 0: the AO at this distance too */
+    /* Obscurance mode: what its rays meet, as the bake's do (bake.h,
+     * obs_bake_occluders_new: shrubs as fog, trees semi-transparent,
+     * section 2.1), instead of the scene's surfaces; NULL: the scene,
+     * every surface opaque.  The primary rays still see the scene. */
+    const struct obs_bake_occluders *occluders;
 } obs_reference_desc;
 
 /* Where the AO is evaluated: the first hit of a primary ray from the

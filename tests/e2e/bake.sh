@@ -120,6 +120,52 @@ if ! command -v gltf_validator >/dev/null 2>&1 && command -v npm >/dev/null 2>&1
         >"$T/npm.log" 2>&1 || echo "  (npm install gltf-validator failed: $(tail -1 "$T/npm.log"))"
 fi
 export NODE_PATH="$PWD/$NPM_DIR/node_modules${NODE_PATH:+:$NODE_PATH}"
+echo "-- decorators (section 2.2): the fixture's two tree cards from a trees.json cut"
+TREES=tests/data/levels/aalborg_cut.trees.json
+expect 0 "bake with --decorators (trees.json's layout)" -- "$OBSCURA" bake "$FIX" -o "$T/dt.glb" \
+    --rays 16 --decorators "$TREES" --report "$T/dt.json" -q
+check "report: 2 tree nodes, 60 opaque" \
+    "[ \"\$(field $T/dt.json \"['decorator_nodes']['tree']\")\" = 2 ] && [ \"\$(field $T/dt.json \"['decorator_nodes']['none']\")\" -gt 55 ]"
+check "the trees semi-transparent: other values" "! cmp -s $T/t1.glb $T/dt.glb"
+printf '{"decorators": [{"name": "OBJ1479", "class": "tree"}, {"name": "OBJ1478", "class": "shrub"}]}\n' >"$T/mixed.json"
+expect 0 "a tree and a shrub, 1 thread" -- "$OBSCURA" bake "$FIX" -o "$T/dm1.glb" --rays 16 \
+    --threads 1 --decorators "$T/mixed.json" -q
+expect 0 "a tree and a shrub, 2 threads" -- "$OBSCURA" bake "$FIX" -o "$T/dm2.glb" --rays 16 \
+    --threads 2 --decorators "$T/mixed.json" -q
+check "decorators: the same bytes whatever the thread count" "cmp -s $T/dm1.glb $T/dm2.glb"
+expect 0 "--tree-attenuation 1 (each card blocks all)" -- "$OBSCURA" bake "$FIX" -o "$T/dt1.glb" \
+    --rays 16 --decorators "$TREES" --tree-attenuation 1 -q
+check "... other values again" "! cmp -s $T/dt.glb $T/dt1.glb"
+expect 0 "--decorator-source off: the file is not used" -- "$OBSCURA" bake "$FIX" -o "$T/doff.glb" \
+    --rays 16 --decorators "$TREES" --decorator-source off -q
+check "... the same bytes as without decorators" "cmp -s $T/t1.glb $T/doff.glb"
+printf '{"decorators": [{"match": "OBJ147*", "class": "shrub", "density": 0.5}]}\n' >"$T/shrub.json"
+expect 0 "the cards as shrubs (fog boxes)" -- "$OBSCURA" bake "$FIX" -o "$T/ds.glb" --rays 16 \
+    --decorators "$T/shrub.json" --report "$T/ds.json" -q
+check "report: shrub nodes" "[ \"\$(field $T/ds.json \"['decorator_nodes']['shrub']\")\" -ge 2 ]"
+printf '{"decorators": [{"name": "OBJ1479", "class": "small"}]}\n' >"$T/small.json"
+expect 0 "a card as a small decorator (section 2.2.1)" -- "$OBSCURA" bake "$FIX" -o "$T/dm.glb" \
+    --rays 16 --decorators "$T/small.json" --report "$T/dm.json" -q
+check "report: one small decorator's scalar" \
+    "[ \"\$(field $T/dm.json \"['small_decorators']['nodes'][0]['name']\")\" = OBJ1479 ]"
+check "the .glb: the scalar in the node's extras" \
+    "python3 -c \"import json,struct,sys; b=open(sys.argv[1],'rb').read(); n=struct.unpack('<I',b[12:16])[0]; j=json.loads(b[20:20+n]); sys.exit(not [x for x in j['nodes'] if x.get('name')=='OBJ1479' and '_AO' in x.get('extras',{})])\" $T/dm.glb"
+printf '{"decorators": [{"name": "OBJ1479", "class": "palm"}]}\n' >"$T/bad_class.json"
+expect 3 "a decorators file with an unknown class" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" \
+    --decorators "$T/bad_class.json"
+said "unknown class 'palm'"
+printf '{"decorators": [{"name": "OBJ1479", "class": "tree"}' >"$T/bad_json.json"
+expect 3 "a decorators file that is not JSON" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" \
+    --decorators "$T/bad_json.json"
+said "not JSON"
+expect 3 "a decorators file that is not there" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" \
+    --decorators "$T/none.json"
+said "cannot open"
+printf '{"trees": [{"name": "OBJ1479"}, {"name": "OBJ0000"}]}\n' >"$T/unmatched.json"
+expect 0 "entries matching no node: a warning" -- "$OBSCURA" bake "$FIX" -o "$T/x.glb" --rays 8 \
+    --decorators "$T/unmatched.json" -q
+said "1 of 2 entries match no node (the first: 'OBJ0000')"
+
 if command -v gltf_validator >/dev/null 2>&1; then
     expect 0 "Khronos glTF validator" -- gltf_validator -m "$T/a.glb"
     expect 0 "Khronos glTF validator: the --lods .glb" -- gltf_validator -m "$T/lod.glb"
@@ -236,6 +282,20 @@ expect 0 "the reference's short distance against the baked long one" -- "$OBSCUR
     "$T/r.exr" "$T/g.exr" --channel-a AO_SHORT.Y --channel-b _AO_LONG --json
 m2=$(json mse)
 check "a mismatched channel is further: MSE $m2 > $m" "awk 'BEGIN { exit !($m2 > $m) }'"
+expect 0 "gbuffer of the bake with decorators" -- "$OBSCURA" gbuffer "$T/dt.glb" \
+    --camera "$T/cam0.json" -o "$T/gd.exr" -q
+expect 0 "the reference with the same decorators" -- "$OBSCURA" reference "$T/a.glb" \
+    --camera "$T/cam0.json" -o "$T/rd.exr" --obscurance 2,300 --blend 0.03 --spp 64 \
+    --decorators "$TREES"
+said "decorators traced as the bake does"
+expect 0 "baked _AO (decorators) against that reference" -- "$OBSCURA" compare "$T/rd.exr" \
+    "$T/gd.exr" --channel-b _AO --json
+m=$(json mse); c=$(json corr)
+check "decorators: baked vs reference: MSE $m < 0.02, corr $c > 0.6" \
+    "awk 'BEGIN { exit !($m < 0.02 && $c > 0.6) }'"
+expect 2 "reference --decorators without --obscurance" -- "$OBSCURA" reference "$T/a.glb" \
+    --camera "$T/cam0.json" -o "$T/x.exr" --decorators "$TREES"
+said "need --obscurance"
 for e in trs matrix noao; do python3 tests/e2e/lib/glb_edit.py "$T/a.glb" "$T/$e.glb" $e; done
 python3 tests/e2e/lib/glb_edit.py "$T/trs.glb" "$T/trs_noao.glb" noao
 # the camera of the transformed level: cam0 moved by the same transform
@@ -302,6 +362,17 @@ expect 0 "unsharded, 24 rays, --lods 2" -- "$OBSCURA" bake "$FIX" -o "$T/whole_l
 expect 0 "merge of 3 shards with --lods 2" -- "$OBSCURA" bake "$FIX" --merge "$T"/part3.*.bin \
     -o "$T/merged_lod.glb" --lods 2 -q
 check "merged with --lods = unsharded with --lods, byte for byte" "cmp -s $T/whole_lod.glb $T/merged_lod.glb"
+expect 0 "decorators: unsharded" -- "$OBSCURA" bake "$FIX" -o "$T/dwhole.glb" --rays 24 \
+    --decorators "$TREES" -q
+for i in 0 1; do
+    "$OBSCURA" bake "$FIX" --shard $i/2 -o "$T/dpart.$i.bin" --rays 24 --decorators "$TREES" -q
+done
+expect 0 "decorators: merge of 2 shards" -- "$OBSCURA" bake "$FIX" --merge "$T"/dpart.*.bin \
+    -o "$T/dmerged.glb" --decorators "$TREES" -q
+check "decorators: merged = unsharded, byte for byte" "cmp -s $T/dwhole.glb $T/dmerged.glb"
+expect 3 "decorators: parts merged without the decorators" -- "$OBSCURA" bake "$FIX" \
+    --merge "$T"/dpart.*.bin -o "$T/x.glb" -q
+said "with other decorators"
 check "a part is 128 + 9 bytes a sample" \
     "[ \$((\$(cat $T/part3.*.bin | wc -c) - 3 * 128)) = \$((9 * \$(field $T/whole.json \"['counts']['samples']\"))) ]"
 expect 3 "a missing shard" -- "$OBSCURA" bake "$FIX" --merge "$T/part4.0.bin" "$T/part4.1.bin" "$T/part4.3.bin" -o "$T/x.glb" -q

@@ -82,6 +82,32 @@ static inline void bt_scene(obs_bake_scene *s, obs_bake_mesh *meshes, size_t n)
     s->instance_count = n;
 }
 
+/* bt_scene's one node split into n: node i named names[i] takes the next
+ * counts[i] meshes in order; node 0 the root, the others its children. */
+static inline void bt_split(obs_bake_scene *s, const char *const *names, const uint32_t *counts,
+                            size_t n)
+{
+    obs_bake_node *nodes = calloc(n, sizeof *nodes);
+    assert_non_null(nodes);
+    uint32_t next = 0;
+    for (size_t i = 0; i < n; i++) {
+        nodes[i] = s->nodes[0];
+        nodes[i].name = strdup(names[i]);
+        nodes[i].parent = i ? 0 : -1;
+        nodes[i].meshes = malloc((counts[i] ? counts[i] : 1) * sizeof(uint32_t));
+        assert_non_null(nodes[i].meshes);
+        nodes[i].mesh_count = counts[i];
+        for (uint32_t k = 0; k < counts[i]; k++)
+            nodes[i].meshes[k] = next++;
+    }
+    assert_int_equal(next, s->mesh_count);
+    free(s->nodes[0].name);
+    free(s->nodes[0].meshes);
+    free(s->nodes);
+    s->nodes = nodes;
+    s->node_count = n;
+}
+
 static inline void bt_set(obs_bake_params *p, const char *name, const char *value)
 {
     char err[OBS_ERR_LEN];
