@@ -108,7 +108,8 @@ static void results_into_solution(const obs_bake_scene *scene, const obs__bake_w
 }
 
 /* The local AO of mesh m, baked alone in its own space (steps 2-4 of the
- * pipeline on a scene of that one mesh): 2 per vertex, short and long. */
+ * pipeline on a scene of that one mesh, a tree): 2 per vertex, short and
+ * long. */
 static obs_status local_ao(const obs_bake_scene *s, uint32_t m, const obs_bake_params *p,
                            double *out, char err[OBS_ERR_LEN])
 {
@@ -132,7 +133,10 @@ static obs_status local_ao(const obs_bake_scene *s, uint32_t m, const obs_bake_p
     obs_bake_desc d = {0};
     d.params = *p;
     d.params.instanced = OBS_BAKE_INSTANCED_OFF;
-    d.params.decorator_source = OBS_BAKE_DECOR_OFF;
+    /* the mesh occludes itself as a tree occludes in the level (section
+     * 2.1: semi-transparent), as the volume's f sees it (instanced.c) */
+    d.params.decorator_source = OBS_BAKE_DECOR_FILE;
+    d.decorators_json = "{\"decorators\": [{\"name\": \"local\", \"class\": \"tree\"}]}";
     d.params.holdout = 0.0f;
     d.params.set = ~(uint64_t)0; /* every field as given here */
     obs_bake_result r;
@@ -293,7 +297,7 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     if ((rc = copy_back(scene, &w, &wd, x, p.blend, out, err)) != OBS_OK)
         goto done;
     if (inst_n) {
-        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, desc, s.count, local_ao, out, err);
+        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, desc, s.count, &dc, local_ao, out, err);
         if (rc == OBS_OK)
             results_into_solution(scene, &w, &wd, inst_sel, out, x);
         if (area_kept)

@@ -118,12 +118,21 @@ obs_status obs__bake_small(const obs_bake_scene *scene, const obs__bake_world *w
 typedef struct obs__bake_bvh obs__bake_bvh;
 obs_status obs__bake_bvh_new(const obs__bake_world *w, obs__bake_bvh **out,
                              char err[OBS_ERR_LEN]);
+/* The same with decorators (section 2.1, occl.c): the closest hits among
+ * the opaque triangles, shrub fog boxes and tree triangles attenuating
+ * the rays (obs__bake_bvh_cast's trans), as obs__bake_trace traces the
+ * surface samples; d NULL: every triangle opaque. */
+obs_status obs__bake_bvh_new_decor(const obs__bake_world *w, const struct obs__bake_decor *d,
+                                   float tree_attenuation, obs__bake_bvh **out,
+                                   char err[OBS_ERR_LEN]);
 void obs__bake_bvh_free(obs__bake_bvh *b);
 /* Closest hits of the n unit directions dirs (3 each) from o, up to
  * tfar: t[k] the distance (INFINITY for a miss), back[k] 1 when the ray
- * met a one-sided face from behind.  Thread-safe. */
+ * met a one-sided face from behind; trans (NULL: not wanted) the
+ * decorators' transmittance of each ray up to its hit (or tfar), 1
+ * without decorators.  Thread-safe. */
 void obs__bake_bvh_cast(const obs__bake_bvh *b, const float o[3], const float *dirs, int n,
-                        float tfar, float *t, uint8_t *back);
+                        float tfar, float *t, uint8_t *back, float *trans);
 /* 1 when geometry lies on the segment a-c. */
 int obs__bake_bvh_occluded(const obs__bake_bvh *b, const float a[3], const float c[3]);
 

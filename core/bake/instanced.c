@@ -209,8 +209,8 @@ static int stop_asked(void *user)
 obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_world *w,
                                    const uint8_t *sel, const obs_bake_params *p,
                                    const obs_bake_desc *desc, size_t samples,
-                                   obs__bake_alone_fn local_ao, obs_bake_result *out,
-                                   char err[OBS_ERR_LEN])
+                                   const obs__bake_decor *dc, obs__bake_alone_fn local_ao,
+                                   obs_bake_result *out, char err[OBS_ERR_LEN])
 {
     stop_ctx sc = {desc, samples};
     obs_bake_stats *st = &out->stats;
@@ -275,7 +275,10 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
     if ((rc = obs__vol_build(&vol, p->volume_spacing, boxes, nbox, MAX_VOLUME_POINTS, err)) !=
         OBS_OK)
         goto done;
-    if ((rc = obs__bake_bvh_new(w, &bvh, err)) != OBS_OK)
+    /* the level's occluders as its surface samples see them (section
+     * 2.1): f is the "actual AO signal" of the bake, trees and shrubs
+     * attenuating */
+    if ((rc = obs__bake_bvh_new_decor(w, dc, p->tree_attenuation, &bvh, err)) != OBS_OK)
         goto done;
     float dist[2] = {p->distance_short, p->distance_long};
     if ((rc = obs__vol_trace(&vol, bvh, p->volume_rays, dist, p->backface_limit,

@@ -108,7 +108,7 @@ typedef obs_status (*obs__bake_alone_fn)(const obs_bake_scene *s, uint32_t m,
 obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_world *w,
                                    const uint8_t *sel, const obs_bake_params *p,
                                    const obs_bake_desc *desc, size_t samples,
-                                   obs__bake_alone_fn local_ao, obs_bake_result *out,
-                                   char err[OBS_ERR_LEN]);
+                                   const obs__bake_decor *dc, obs__bake_alone_fn local_ao,
+                                   obs_bake_result *out, char err[OBS_ERR_LEN]);
 
 #endif

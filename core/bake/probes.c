@@ -46,7 +46,7 @@ int obs__dyn_inside(const obs__bake_bvh *bvh, const float p[3], int rays, float 
     if (rays > 256)
         rays = 256;
     obs__dyn_sphere_dirs(rays, 0, 0, dirs);
-    obs__bake_bvh_cast(bvh, p, dirs, rays, INFINITY, t, back);
+    obs__bake_bvh_cast(bvh, p, dirs, rays, INFINITY, t, back, NULL);
     int nb = 0;
     for (int k = 0; k < rays; k++)
         nb += back[k];
@@ -175,20 +175,24 @@ int obs__dyn_point_sh(const obs__bake_bvh *bvh, const float o[3], const obs_dyn_
 {
     int n = p->rays, ok = 0;
     float *dirs = malloc((size_t)n * 3 * sizeof *dirs), *t = malloc((size_t)n * sizeof *t);
+    float *tr = malloc((size_t)n * sizeof *tr);
     uint8_t *back = malloc((size_t)n);
     double *w = malloc((size_t)n * sizeof *w), *f = malloc(2 * (size_t)n * sizeof *f);
-    if (!dirs || !t || !back || !w || !f)
+    if (!dirs || !t || !tr || !back || !w || !f)
         goto done;
     obs__dyn_sphere_dirs(n, (uint64_t)p->seed, stream, dirs);
     float dist[2] = {p->distance_short, p->distance_long};
-    obs__bake_bvh_cast(bvh, o, dirs, n, RAY_LENGTH_FACTOR * fmaxf(dist[0], dist[1]), t, back);
+    obs__bake_bvh_cast(bvh, o, dirs, n, RAY_LENGTH_FACTOR * fmaxf(dist[0], dist[1]), t, back,
+                       tr);
     int nb = 0;
     for (int k = 0; k < n; k++) {
         w[k] = 4.0 * PI_D / n; /* equal-area directions */
         nb += back[k];
         for (int c = 0; c < 2; c++) {
             double a = log(0.5) / dist[c]; /* a = ln(0.5) / d, section 2 */
-            f[(size_t)c * n + k] = isinf(t[k]) ? 1.0 : 1.0 - exp(a * t[k]); /* rho(x) */
+            /* rho(x), times the decorators' transmittance (section 2.1;
+             * 1 without them): a ray's visibility as the surface samples' */
+            f[(size_t)c * n + k] = (isinf(t[k]) ? 1.0 : 1.0 - exp(a * t[k])) * tr[k];
         }
     }
     *dropped = (double)nb > (double)p->backface_limit * n;
@@ -200,6 +204,7 @@ int obs__dyn_point_sh(const obs__bake_bvh *bvh, const float o[3], const obs_dyn_
 done:
     free(dirs);
     free(t);
+    free(tr);
     free(back);
     free(w);
     free(f);
@@ -352,7 +357,7 @@ void obs__dyn_trace_eq1(const obs__bake_bvh *bvh, const float o[3], const float 
             for (int a = 0; a < 3; a++)
                 dirs[3 * l + a] = x * tg[a] + y * bt[a] + z * n[a];
         }
-        obs__bake_bvh_cast(bvh, o, dirs, m, tfar, t, back);
+        obs__bake_bvh_cast(bvh, o, dirs, m, tfar, t, back, NULL);
         for (int l = 0; l < m; l++)
             for (int c = 0; c < 2; c++)
                 acc[c] += isinf(t[l]) ? 1.0 : 1.0 - exp(log(0.5) / distance[c] * t[l]);

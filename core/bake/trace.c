@@ -231,7 +231,7 @@ done:
  * (probes.c, regions.c, dyn_measure.c: points in space rather than on the
  * surface).  The same scene as obs__bake_trace builds; kept beside it. */
 struct obs__bake_bvh {
-    obs__bake_occl *occl; /* every triangle opaque */
+    obs__bake_occl *occl; /* every triangle opaque, or with decorators */
     RTCScene rtc;
     const obs__bake_world *w;
 };
@@ -239,12 +239,19 @@ struct obs__bake_bvh {
 obs_status obs__bake_bvh_new(const obs__bake_world *w, obs__bake_bvh **out,
                              char err[OBS_ERR_LEN])
 {
+    return obs__bake_bvh_new_decor(w, NULL, 0.0f, out, err);
+}
+
+obs_status obs__bake_bvh_new_decor(const obs__bake_world *w, const struct obs__bake_decor *d,
+                                   float tree_attenuation, obs__bake_bvh **out,
+                                   char err[OBS_ERR_LEN])
+{
     *out = NULL;
     obs__bake_bvh *b = calloc(1, sizeof *b);
     if (!b)
         return obs__fail(err, OBS_NO_MEMORY, "BVH");
     b->w = w;
-    obs_status st = obs__bake_occl_new(w, NULL, 0.0f, &b->occl, err);
+    obs_status st = obs__bake_occl_new(w, d, tree_attenuation, &b->occl, err);
     if (st != OBS_OK) {
         free(b);
         return st;
@@ -263,7 +270,7 @@ void obs__bake_bvh_free(obs__bake_bvh *b)
 }
 
 void obs__bake_bvh_cast(const obs__bake_bvh *b, const float o[3], const float *dirs, int n,
-                        float tfar, float *t, uint8_t *back)
+                        float tfar, float *t, uint8_t *back, float *trans)
 {
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -287,6 +294,12 @@ void obs__bake_bvh_cast(const obs__bake_bvh *b, const float o[3], const float *d
             rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect8(valid, b->rtc, &ctx, &rh);
+        if (trans) { /* section 2.1: the segment up to the opaque hit (tfar on a miss) */
+            double tr[PACKET];
+            obs__bake_occl_transmittance8(b->occl, valid, &rh, tr);
+            for (int l = 0; l < PACKET && k0 + l < n; l++)
+                trans[k0 + l] = (float)tr[l];
+        }
         for (int l = 0; l < PACKET && k0 + l < n; l++) {
             int k = k0 + l;
             if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {

@@ -239,7 +239,7 @@ static void node(obs_bake_node *nd, const char *name, int parent, const float t[
 /* Ground (z = -0.05, 40 x 40), a roof (z = 2.6, 8 x 8, facing down)
  * over x = -10, and the tree twice: under the roof and at x = +10 in the
  * open.  Both are class tree by their extras. */
-static void overhang_scene(obs_bake_scene *s)
+static void overhang_scene(obs_bake_scene *s, const char *roof_extras)
 {
     obs_bake_mesh m[3];
     const float go[3] = {-20.0f, -20.0f, -0.05f}, gu[3] = {40.0f, 0.0f, 0.0f},
@@ -258,7 +258,7 @@ static void overhang_scene(obs_bake_scene *s)
     s->node_count = 4;
     const float under[3] = {-10.0f, 0.0f, 0.0f}, open[3] = {10.0f, 0.0f, 0.0f};
     node(&s->nodes[0], "ground", -1, NULL, 0, NULL);
-    node(&s->nodes[1], "roof", -1, NULL, 1, NULL);
+    node(&s->nodes[1], "roof", -1, NULL, 1, roof_extras);
     node(&s->nodes[2], "palm_under", -1, under, 2, "{\"class\": \"tree\"}");
     node(&s->nodes[3], "palm_open", -1, open, 2, "{\"class\": \"tree\"}");
     s->instance_count = 4;
@@ -288,7 +288,7 @@ static void test_overhang_darker(void **state)
 {
     (void)state;
     obs_bake_scene sc;
-    overhang_scene(&sc);
+    overhang_scene(&sc, NULL);
     obs_bake_desc d = {0};
     bt_set(&d.params, "rays", "64");
     bt_set(&d.params, "volume_rays", "256");
@@ -380,6 +380,51 @@ static void test_overhang_darker(void **state)
     obs_bake_scene_free(&sc);
 }
 
+/* The mean over the tree mesh's vertices of instance i's global term. */
+static double mean_global(const obs_bake_result *r, const obs_bake_mesh *tm, size_t i)
+{
+    double s = 0.0;
+    for (size_t v = 0; v < tm->vertex_count; v++) {
+        const float *q = tm->positions + 3 * v;
+        const float *g = r->instances[i].global[0];
+        s += (g[0] + g[1] * q[0] + g[2] * q[1] + g[3] * q[2]) / (double)tm->vertex_count;
+    }
+    return s;
+}
+
+/* The volume sees the level's occluders as its surface samples do
+ * (section 2.1): a roof that is itself a tree (semi-transparent, 50 %)
+ * darkens the tree under it less than an opaque roof, and more than
+ * no roof. */
+static void test_volume_sees_decorators(void **state)
+{
+    (void)state;
+    double g[2][2];
+    for (int k = 0; k < 2; k++) {
+        obs_bake_scene sc;
+        overhang_scene(&sc, k ? "{\"class\": \"tree\"}" : NULL);
+        obs_bake_desc d = {0};
+        bt_set(&d.params, "rays", "64");
+        bt_set(&d.params, "volume_rays", "256");
+        bt_set(&d.params, "volume_spacing", "0.5");
+        bt_set(&d.params, "distance_long", "20");
+        bt_set(&d.params, "threads", "2");
+        obs_bake_result r;
+        char err[OBS_ERR_LEN];
+        assert_int_equal(obs_bake_run(&sc, &d, &r, err), OBS_OK);
+        assert_int_equal(r.stats.instanced_instances, 2 + k);
+        g[k][0] = mean_global(&r, &sc.meshes[2], 2);
+        g[k][1] = mean_global(&r, &sc.meshes[2], 3);
+        obs_bake_result_free(&r);
+        obs_bake_scene_free(&sc);
+    }
+    print_message("global term under the roof: opaque %.3f, a tree %.3f; open %.3f, %.3f\n",
+                  g[0][0], g[1][0], g[0][1], g[1][1]);
+    assert_true(g[0][0] < g[1][0] - 0.05);
+    assert_true(g[1][0] < g[1][1] - 0.05);
+    assert_true(fabs(g[0][1] - g[1][1]) < 0.03); /* in the open the roof is far */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -387,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_grid_neighbours),
         cmocka_unit_test(test_trilinear_exact),
         cmocka_unit_test(test_overhang_darker),
+        cmocka_unit_test(test_volume_sees_decorators),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
