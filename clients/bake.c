@@ -39,24 +39,9 @@ static void list_params(int markdown)
         printf("| flag | default | range | meaning |\n| --- | --- | --- | --- |\n");
     for (int i = 0; i < obs_bake_param_count(); i++) {
         const obs_bake_param_info *pi = obs_bake_param_at(i);
-        char def[64], flag[64], range[64];
+        char def[64];
         obs_bake_param_format(&p, pi, def, sizeof def);
-        snprintf(flag, sizeof flag, "--%s", pi->name);
-        for (char *c = flag; *c; c++)
-            *c = *c == '_' ? '-' : *c;
-        if (pi->type == OBS_BAKE_PARAM_ENUM)
-            snprintf(range, sizeof range, "%s", pi->choices);
-        else
-            snprintf(range, sizeof range, "%g .. %g", pi->min, pi->max);
-        if (markdown) {
-            /* a '|' of the choices would end a cell */
-            printf("| `%s` | %s | ", flag, def);
-            for (const char *c = range; *c; c++)
-                printf(*c == '|' ? "\\|" : "%c", *c);
-            printf(" | %s |\n", pi->doc);
-        }
-        else
-            printf("%-24s %-10s %-22s %s\n", flag, def, range, pi->doc);
+        cli_param_row(pi, def, markdown);
     }
 }
 

@@ -69,7 +69,28 @@ double cli_now_s(void)
     return (double)ts.tv_sec + ts.tv_nsec / 1e9;
 }
 
-/* A decorators file (obscura bake, obscura reference) in memory. */
+void cli_param_row(const obs_bake_param_info *pi, const char *def, int markdown)
+{
+    char flag[64], range[64];
+    snprintf(flag, sizeof flag, "--%s", pi->name);
+    for (char *c = flag; *c; c++)
+        *c = *c == '_' ? '-' : *c;
+    if (pi->type == OBS_BAKE_PARAM_ENUM)
+        snprintf(range, sizeof range, "%s", pi->choices);
+    else
+        snprintf(range, sizeof range, "%g .. %g", pi->min, pi->max);
+    if (markdown) {
+        /* a '|' of the choices would end a cell */
+        printf("| `%s` | %s | ", flag, def);
+        for (const char *c = range; *c; c++)
+            printf(*c == '|' ? "\\|" : "%c", *c);
+        printf(" | %s |\n", pi->doc);
+    } else {
+        printf("%-24s %-10s %-22s %s\n", flag, def, range, pi->doc);
+    }
+}
+
+/* A decorators file (obscura bake, bake-dynamic, obscura reference) in memory. */
 obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN])
 {
     *out = NULL;

@@ -3,6 +3,7 @@
 #ifndef OBSCURA_CLIENT_CLI_H
 #define OBSCURA_CLIENT_CLI_H
 
+#include "obscura/bake.h"
 #include "obscura/status.h"
 
 /* Process exit codes of every command: 3 is bad input (retrying will not
@@ -24,6 +25,10 @@ int cli_input_fail(obs_status s, const char *what, const char *err);
  * EXIT_USAGE. */
 void cli_die_usage(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3), noreturn));
 
+/* One row of a parameter table (obscura bake --params, bake-dynamic
+ * --params; README's tables with markdown): flag, default, range (an
+ * enum's choices), doc. */
+void cli_param_row(const obs_bake_param_info *pi, const char *def, int markdown);
 /* The whole of a text file, NUL-terminated, in *out (caller frees); the
  * message in err. */
 obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN]);

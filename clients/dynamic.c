@@ -18,9 +18,10 @@ void cli_dynamic_usage(FILE *f)
 {
     fprintf(f,
             "  obscura bake-dynamic LEVEL -o MODEL.json [--regions R.json] [--report R.json]\n"
-            "                  [--paths N] [--PARAM VALUE]...  obscurance for dynamic objects:\n"
-            "                  regions, valid points, SH at two distances, eq 4 per region,\n"
-            "                  regularised (section 2.3); 'obscura bake-dynamic --params'\n"
+            "                  [--paths N] [--decorators D.json] [--PARAM VALUE]...  obscurance\n"
+            "                  for dynamic objects: regions, valid points, SH at two distances,\n"
+            "                  eq 4 per region, regularised (section 2.3), through the decorators\n"
+            "                  as obscura bake traces them; 'obscura bake-dynamic --params'\n"
             "  obscura bake-dynamic LEVEL --shard I/N -o PART [--regions R.json] [--PARAM VALUE]...\n"
             "                  trace shard I (0 .. N-1) of the valid points into a part file\n"
             "  obscura bake-dynamic LEVEL --merge PART... -o MODEL.json [...]\n"
@@ -37,16 +38,9 @@ static void list_params(int markdown)
         printf("| flag | default | range | meaning |\n| --- | --- | --- | --- |\n");
     for (int i = 0; i < obs_dyn_param_count(); i++) {
         const obs_bake_param_info *pi = obs_dyn_param_at(i);
-        char def[64], flag[64], range[64];
+        char def[64];
         obs_dyn_param_format(&p, pi, def, sizeof def);
-        snprintf(flag, sizeof flag, "--%s", pi->name);
-        for (char *c = flag; *c; c++)
-            *c = *c == '_' ? '-' : *c;
-        snprintf(range, sizeof range, "%g .. %g", pi->min, pi->max);
-        if (markdown)
-            printf("| `%s` | %s | %s | %s |\n", flag, def, range, pi->doc);
-        else
-            printf("%-24s %-10s %-22s %s\n", flag, def, range, pi->doc);
+        cli_param_row(pi, def, markdown);
     }
 }
 
@@ -114,8 +108,15 @@ static int write_report(const char *path, const char *level, const obs_dyn_param
         const obs_bake_param_info *pi = obs_dyn_param_at(i);
         char v[64];
         obs_dyn_param_format(p, pi, v, sizeof v);
-        cJSON_AddNumberToObject(par, pi->name, strtod(v, NULL));
+        if (pi->type == OBS_BAKE_PARAM_ENUM)
+            cJSON_AddStringToObject(par, pi->name, v);
+        else
+            cJSON_AddNumberToObject(par, pi->name, strtod(v, NULL));
     }
+    cJSON *dn = cJSON_AddObjectToObject(r, "decorator_nodes"); /* as obscura bake's report */
+    const char *dnames[4] = {"none", "shrub", "tree", "small"};
+    for (int k = 0; k < 4; k++)
+        cJSON_AddNumberToObject(dn, dnames[k], (double)st->decorator_nodes[k]);
     cJSON *sec = cJSON_AddObjectToObject(r, "seconds");
     cJSON_AddNumberToObject(sec, "load", load_s);
     for (int i = 0; i < OBS_DYN_STAGE_COUNT; i++)
@@ -197,7 +198,7 @@ static void on_progress(void *user, size_t done, size_t total)
 int cli_dynamic(int argc, char **argv)
 {
     const char *in = NULL, *out = NULL, *regions = NULL, *report = NULL, *eval = NULL,
-               *at = NULL, *normal = NULL, *sh = NULL;
+               *at = NULL, *normal = NULL, *sh = NULL, *decorators = NULL;
     int quiet = 0, paths = 0, path_steps = 64, path_rays = 256;
     int shard = -1, shards = 0, merging = 0, merge = 0;
     float tau = 4.0f;
@@ -245,6 +246,8 @@ int cli_dynamic(int argc, char **argv)
             out = val;
         } else if (!strcmp(key, "regions")) {
             regions = val;
+        } else if (!strcmp(key, "decorators")) {
+            decorators = val;
         } else if (!strcmp(key, "shard")) {
             cli_parse_shard("bake-dynamic", val, &shard, &shards);
         } else if (!strcmp(key, "report")) {
@@ -308,12 +311,22 @@ int cli_dynamic(int argc, char **argv)
         }
         desc.regions = &rg;
     }
+    char *decor_text = NULL; /* read as obscura bake reads it */
+    if (decorators) {
+        if ((s = cli_read_text(decorators, &decor_text, err)) != OBS_OK) {
+            obs_dyn_regions_free(&rg);
+            free(parts);
+            return cli_input_fail(s, decorators, err);
+        }
+        desc.decorators_json = decor_text;
+    }
     double t0 = cli_now_s();
     obs_bake_scene sc;
     s = obs_bake_load(in, (size_t)p.max_triangles, &sc, err);
     if (s != OBS_OK) {
         obs_dyn_regions_free(&rg);
         free(parts);
+        free(decor_text);
         return cli_input_fail(s, in, err);
     }
     double load_s = cli_now_s() - t0;
@@ -326,6 +339,8 @@ int cli_dynamic(int argc, char **argv)
         obs_dyn_stats st;
         s = obs_dyn_bake_shard(&sc, &desc, shard, shards, out, &st, err);
         int rc = s == OBS_OK ? EXIT_OK : cli_fail(s, in, err);
+        if (rc == EXIT_OK && st.decorator_warning[0])
+            fprintf(stderr, "obscura: bake-dynamic: warning: %s\n", st.decorator_warning);
         if (rc == EXIT_OK && report && !write_report(report, in, &p, &st, NULL, load_s))
             rc = EXIT_FAIL;
         if (rc == EXIT_OK && !quiet)
@@ -336,6 +351,7 @@ int cli_dynamic(int argc, char **argv)
         obs_dyn_regions_free(&rg);
         obs_bake_scene_free(&sc);
         free(parts);
+        free(decor_text);
         return rc;
     }
     obs_dyn_result r;
@@ -345,15 +361,18 @@ int cli_dynamic(int argc, char **argv)
     free(parts);
     if (s != OBS_OK) {
         obs_bake_scene_free(&sc);
+        free(decor_text);
         return nparts ? cli_input_fail(s, in, err) : cli_fail(s, in, err);
     }
+    if (r.stats.decorator_warning[0])
+        fprintf(stderr, "obscura: bake-dynamic: warning: %s\n", r.stats.decorator_warning);
     if (nparts) /* the parts' parameters, for the paths and the report */
         obs_dyn_params_resolve(&desc.params, &p);
     int rc = EXIT_OK;
     obs_dyn_path_stats ps;
     if (paths > 0 &&
-        (s = obs_dyn_measure_paths(&sc, &r, &p, paths, path_steps, path_rays, tau, &ps, err)) !=
-            OBS_OK)
+        (s = obs_dyn_measure_paths(&sc, &r, &p, desc.decorators_json, paths, path_steps,
+                                   path_rays, tau, &ps, err)) != OBS_OK)
         rc = cli_fail(s, in, err);
     if (rc == EXIT_OK && (s = obs_dyn_model_write(out, &r.model, err)) != OBS_OK)
         rc = cli_fail(s, out, err);
@@ -373,5 +392,6 @@ int cli_dynamic(int argc, char **argv)
                 (unsigned long long)st->rays, st->seconds[OBS_DYN_STAGE_trace], out);
     obs_dyn_result_free(&r);
     obs_bake_scene_free(&sc);
+    free(decor_text);
     return rc;
 }

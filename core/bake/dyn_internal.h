@@ -150,16 +150,30 @@ typedef struct obs__dyn_shard {
     void *progress_user;
 } obs__dyn_shard;
 
+/* dynamic.c: the level's decorators classified as obscura bake does
+ * (obs__bake_decor_classify, from p's decorator_source and
+ * shrub_density and decorators_json, the text of a decorators file or
+ * NULL) and the points' BVH built with them (obs__bake_bvh_new_decor,
+ * p's tree_attenuation): the static bake's occluders.  warning gets the
+ * classification's warning ("" when none).  w must outlive the BVH; free
+ * dc with obs__bake_decor_free, the BVH with obs__bake_bvh_free (both
+ * also on failure). */
+struct obs__bake_decor;
+obs_status obs__dyn_occluders(const obs_bake_scene *scene, const obs__bake_world *w,
+                              const obs_dyn_params *p, const char *decorators_json,
+                              struct obs__bake_decor *dc, obs__bake_bvh **bvh,
+                              char warning[OBS_ERR_LEN], char err[OBS_ERR_LEN]);
+
 /* dynamic.c: obs_dyn_bake's steps with the hook (sh NULL: obs_dyn_bake). */
 obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *desc,
                              obs__dyn_shard *sh, obs_dyn_result *out, char err[OBS_ERR_LEN]);
 /* dyn_shard.c: the step, after the points are flagged (pt->count listed,
  * not traced) and before the dropped ones are removed; fills st's trace
- * row. */
-obs_status obs__dyn_shard_step(obs__dyn_shard *sh, const obs__bake_world *w,
-                               const obs_dyn_regions *rg, const obs_dyn_params *p,
-                               const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
-                               char err[OBS_ERR_LEN]);
+ * row.  level: the traced fingerprint (obs__bake_traced_fingerprint),
+ * written into a part, checked against the parts read. */
+obs_status obs__dyn_shard_step(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
+                               const obs_dyn_params *p, const obs__bake_bvh *bvh,
+                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN]);
 /* Reads and checks a part's header (magic, version, sizes, the file's
  * length against its count). */
 obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char err[OBS_ERR_LEN]);

@@ -11,11 +11,18 @@
  * subdivision of the same box); `steps` points along it, each
  * with two normals: up (+y, the levels' up axis) and one random unit
  * vector per path (the same along the path, so its steps compare like
- * with like). */
+ * with like).
+ *
+ * The reference traces the bake's occluders (dynamic.c,
+ * obs__dyn_occluders): eq 1's rho times each ray's transmittance through
+ * the shrubs' fog and the trees, the quantity the model was fitted to; the
+ * endpoints' tests (outside geometry, in sight of each other) see the
+ * opaque triangles alone, as the valid points' flags do. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/decor.h"
 #include "bake/dyn_internal.h"
 #include "bake/rng.h"
 #include "internal.h"
@@ -40,7 +47,8 @@ static int pick_point(const obs_dyn_model *m, const obs_dyn_box *all, const obs_
 }
 
 obs_status obs_dyn_measure_paths(const obs_bake_scene *scene, const obs_dyn_result *res,
-                                 const obs_dyn_params *pin, int paths, int steps, int rays,
+                                 const obs_dyn_params *pin, const char *decorators_json,
+                                 int paths, int steps, int rays,
                                  float tau, obs_dyn_path_stats *out, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
@@ -48,6 +56,8 @@ obs_status obs_dyn_measure_paths(const obs_bake_scene *scene, const obs_dyn_resu
     obs_dyn_params_resolve(pin, &p);
     obs__bake_world w = {0};
     obs__bake_bvh *bvh = NULL;
+    obs__bake_decor dc = {0};
+    char warning[OBS_ERR_LEN];
     obs_status st;
     double *val = NULL;
     int *reg = NULL;
@@ -56,7 +66,8 @@ obs_status obs_dyn_measure_paths(const obs_bake_scene *scene, const obs_dyn_resu
                          paths, steps, rays);
     if ((st = obs__bake_flatten(scene, &w, err)) != OBS_OK)
         return st;
-    if ((st = obs__bake_bvh_new(&w, &bvh, err)) != OBS_OK)
+    if ((st = obs__dyn_occluders(scene, &w, &p, decorators_json, &dc, &bvh, warning, err)) !=
+        OBS_OK)
         goto done;
     val = malloc((size_t)steps * 4 * sizeof *val);
     reg = malloc((size_t)steps * 2 * sizeof *reg);
@@ -168,6 +179,7 @@ done:
     free(val);
     free(reg);
     obs__bake_bvh_free(bvh);
+    obs__bake_decor_free(&dc);
     obs__bake_world_free(&w);
     return st;
 }

@@ -15,7 +15,8 @@
  *     0     8    magic "OBSDYNPT"
  *     8     4    u32 version (1)
  *    12     4    u32 header size in bytes (128)
- *    16     8    u64 level fingerprint (shard.c's, of the flattened level)
+ *    16     8    u64 level fingerprint (shard.c's, of the flattened level
+ *                with its decorators folded in: obs__bake_traced_fingerprint)
  *    24     4    u32 shard index I (0 .. N-1)
  *    28     4    u32 shard count N
  *    32     8    u64 valid points of the whole level (before the back-face
@@ -121,13 +122,12 @@ static void header_bytes(const obs__dyn_part *h, unsigned char b[HEADER])
     obs__le_put64(b + 120, h->checksum);
 }
 
-static obs_status trace_shard(obs__dyn_shard *sh, const obs__bake_world *w,
-                              const obs_dyn_regions *rg, const obs_dyn_params *p,
+static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg, const obs_dyn_params *p,
                               const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
                               char err[OBS_ERR_LEN])
 {
     obs__dyn_part h = {
-        .level = obs__bake_level_fingerprint(w),
+        .level = level,
         .index = (uint32_t)sh->index,
         .count = (uint32_t)sh->count,
         .total = pt->count,
@@ -256,15 +256,13 @@ static obs_status read_payload(const obs__dyn_part *h, obs__dyn_points *pt, char
     return rc;
 }
 
-static obs_status read_shards(obs__dyn_shard *sh, const obs__bake_world *w,
-                              const obs_dyn_regions *rg, obs__dyn_points *pt, obs_dyn_stats *st,
-                              char err[OBS_ERR_LEN])
+static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
+                              obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
 {
     const obs__dyn_part *p0 = &sh->parts[0];
-    uint64_t level = obs__bake_level_fingerprint(w);
     if (p0->level != level)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s was traced from another level (or "
-                         "another version of it): fingerprint %016llx, this level's %016llx",
+                         "another version of it, or with other decorators): fingerprint %016llx, this level's %016llx",
                          p0->path, (unsigned long long)p0->level, (unsigned long long)level);
     if (p0->regions != rg->count || p0->total != pt->count ||
         p0->points != obs__dyn_points_fingerprint(rg, pt))
@@ -286,11 +284,10 @@ static obs_status read_shards(obs__dyn_shard *sh, const obs__bake_world *w,
     return OBS_OK;
 }
 
-obs_status obs__dyn_shard_step(obs__dyn_shard *sh, const obs__bake_world *w,
-                               const obs_dyn_regions *rg, const obs_dyn_params *p,
-                               const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
-                               char err[OBS_ERR_LEN])
+obs_status obs__dyn_shard_step(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
+                               const obs_dyn_params *p, const obs__bake_bvh *bvh,
+                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
 {
-    return sh->parts ? read_shards(sh, w, rg, pt, st, err)
-                     : trace_shard(sh, w, rg, p, bvh, pt, st, err);
+    return sh->parts ? read_shards(sh, level, rg, pt, st, err)
+                     : trace_shard(sh, level, rg, p, bvh, pt, st, err);
 }

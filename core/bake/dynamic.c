@@ -1,10 +1,31 @@
 /* The dynamic-object bake's steps in order (obscura/dynamic.h), each
  * timed: flatten, BVH, regions, valid points, spherical obscurance, the
- * fit. */
+ * fit.
+ *
+ * The BVH holds the static bake's occluders (section 2.1, occl.c): the
+ * level's nodes are classified as obscura bake classifies them (decor.c:
+ * the same parameter rows, the same --decorators file), shrubs become
+ * fog boxes and trees semi-transparent triangles of the second BVH, small
+ * decorators occlude nothing.  Per use:
+ *   - a valid point's spherical obscurance (probes.c, obs__dyn_point_sh)
+ *     and the probe paths' eq 1 reference (obs__dyn_trace_eq1): rho
+ *     times each ray's transmittance, the quantity of the static bake's
+ *     surface samples, so that obscura gbuffer --dynamic combines like
+ *     with like;
+ *   - the solid tests (obs__dyn_inside: inside geometry by back faces;
+ *     obs__bake_bvh_occluded: behind a wall; the regions' test of an
+ *     empty box): the opaque BVH alone.  Decorators are not solid: tree
+ *     and shrub triangles are not in it, so a point in a canopy or a
+ *     hedge is outside geometry and a tree hides nothing behind it.
+ * decorator_source off: every triangle opaque, the bytes of the bake
+ * before decorators. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake/decor.h"
 #include "bake/dyn_internal.h"
+#include "bake/shard.h"
 #include "internal.h"
 
 static const char *const stage_names[] = {
@@ -29,6 +50,39 @@ void obs_dyn_result_free(obs_dyn_result *r)
     memset(r, 0, sizeof *r);
 }
 
+/* The dynamic rows' values into bake parameters (the same names; set,
+ * so that a given 0 stays 0). */
+static void decor_params(const obs_dyn_params *p, obs_bake_params *bp)
+{
+    static const char *const names[] = {"decorator_source", "shrub_density",
+                                        "tree_attenuation"};
+    memset(bp, 0, sizeof *bp);
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        const obs_bake_param_info *b = obs_bake_param_find(names[i]),
+                                  *d = obs_dyn_param_find(names[i]);
+        /* both int or float fields of 4 bytes: the tables share the rows */
+        memcpy((char *)bp + b->offset, (const char *)p + d->offset, 4);
+        bp->set |= (uint64_t)1 << (b - obs_bake_param_at(0));
+    }
+}
+
+obs_status obs__dyn_occluders(const obs_bake_scene *scene, const obs__bake_world *w,
+                              const obs_dyn_params *p, const char *decorators_json,
+                              obs__bake_decor *dc, obs__bake_bvh **bvh,
+                              char warning[OBS_ERR_LEN], char err[OBS_ERR_LEN])
+{
+    obs_bake_params bp;
+    decor_params(p, &bp);
+    *bvh = NULL;
+    warning[0] = 0;
+    obs_status rc = obs__bake_decor_classify(scene, &bp, decorators_json, dc, err);
+    if (rc != OBS_OK)
+        return rc;
+    snprintf(warning, OBS_ERR_LEN, "%s", err);
+    err[0] = 0;
+    return obs__bake_bvh_new_decor(w, dc, p->tree_attenuation, bvh, err);
+}
+
 obs_status obs_dyn_bake(const obs_bake_scene *scene, const obs_dyn_desc *desc,
                         obs_dyn_result *out, char err[OBS_ERR_LEN])
 {
@@ -47,6 +101,7 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     obs_dyn_stats *st = &out->stats;
     obs__bake_world w = {0};
     obs__bake_bvh *bvh = NULL;
+    obs__bake_decor dc = {0};
     obs_dyn_regions own = {0};
     const obs_dyn_regions *rg = desc ? desc->regions : NULL;
     obs__dyn_points pt = {0};
@@ -61,8 +116,10 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
         goto done;
     st->seconds[OBS_DYN_STAGE_flatten] = now() - t;
     t = now();
-    if ((rc = obs__bake_bvh_new(&w, &bvh, err)) != OBS_OK)
+    if ((rc = obs__dyn_occluders(scene, &w, &p, desc ? desc->decorators_json : NULL, &dc, &bvh,
+                                 st->decorator_warning, err)) != OBS_OK)
         goto done;
+    memcpy(st->decorator_nodes, dc.counts, sizeof dc.counts);
     st->seconds[OBS_DYN_STAGE_bvh] = now() - t;
     t = now();
     if (!rg) {
@@ -79,7 +136,8 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     st->seconds[OBS_DYN_STAGE_valid] = now() - t;
     t = now();
     if (sh) {
-        if ((rc = obs__dyn_shard_step(sh, &w, rg, &p, bvh, &pt, st, err)) != OBS_OK || sh->stop)
+        if ((rc = obs__dyn_shard_step(sh, obs__bake_traced_fingerprint(&w, &dc, p.tree_attenuation),
+                                      rg, &p, bvh, &pt, st, err)) != OBS_OK || sh->stop)
             goto done;
     } else {
         obs__dyn_points_trace(bvh, &p, &pt, 0, pt.count, desc ? desc->progress : NULL,
@@ -103,6 +161,7 @@ done:
     obs__dyn_points_free(&pt);
     obs_dyn_regions_free(&own);
     obs__bake_bvh_free(bvh);
+    obs__bake_decor_free(&dc);
     obs__bake_world_free(&w);
     if (rc != OBS_OK) {
         obs_dyn_stats keep = out->stats;

@@ -13,10 +13,15 @@
  *     occlusion ray).  The viewpoint is the outside grid point nearest the
  *     box's centre; it stands in for the visibility system's "not on the
  *     other side of a diagonal wall".
+ * Both tests see the opaque triangles alone: decorators are not solid
+ * (a point in a tree's canopy or a shrub's box is outside geometry, and
+ * no tree hides a point behind it; dynamic.c).
  * Then every valid point traces `rays` directions over the whole sphere
  * (equal-area Fibonacci spiral, a random rotation per point): the
- * spherical obscurance f(w) = rho(d(p, w)), rho(x) = 1 - exp(a x),
- * a = ln 0.5 / d, at both distances (section 2; a miss is rho = 1), is
+ * spherical obscurance f(w) = rho(d(p, w)) T(w), rho(x) = 1 - exp(a x),
+ * a = ln 0.5 / d, at both distances (section 2; a miss is rho = 1), T
+ * the transmittance of the decorators' fog boxes and tree triangles up
+ * to the hit (section 2.1; 1 without decorators), is
  * projected to quadratic SH and convolved with the clamped cosine (sh.c).
  * "We start by eliminating any points that see too many back faces": a
  * point whose rays meet back faces more often than backface_limit is
@@ -339,8 +344,9 @@ void obs__dyn_trace_eq1(const obs__bake_bvh *bvh, const float o[3], const float 
                         double ao[2])
 {
     /* Eq 1 with cosine-weighted directions (Malley's method on a rank-1
-     * lattice with a random shift, as trace.c): AO is the mean of rho. */
-    float tg[3], bt[3], dirs[3 * 8], t[8];
+     * lattice with a random shift, as trace.c): AO is the mean of rho
+     * times each ray's transmittance (section 2.1; 1 without decorators). */
+    float tg[3], bt[3], dirs[3 * 8], t[8], tr[8];
     uint8_t back[8];
     frame(n, tg, bt);
     obs__bake_rng r = obs__bake_rng_stream(seed, stream, 13);
@@ -357,10 +363,10 @@ void obs__dyn_trace_eq1(const obs__bake_bvh *bvh, const float o[3], const float 
             for (int a = 0; a < 3; a++)
                 dirs[3 * l + a] = x * tg[a] + y * bt[a] + z * n[a];
         }
-        obs__bake_bvh_cast(bvh, o, dirs, m, tfar, t, back, NULL);
-        for (int l = 0; l < m; l++)
+        obs__bake_bvh_cast(bvh, o, dirs, m, tfar, t, back, tr);
+        for (int l = 0; l < m; l++) /* rho times the decorators' transmittance, as the points' */
             for (int c = 0; c < 2; c++)
-                acc[c] += isinf(t[l]) ? 1.0 : 1.0 - exp(log(0.5) / distance[c] * t[l]);
+                acc[c] += (isinf(t[l]) ? 1.0 : 1.0 - exp(log(0.5) / distance[c] * t[l])) * tr[l];
     }
     ao[0] = acc[0] / rays;
     ao[1] = acc[1] / rays;

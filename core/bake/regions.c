@@ -462,6 +462,7 @@ obs_status obs__dyn_regions_build(const obs__bake_world *w, const obs__bake_bvh 
         float c[3];
         for (int k = 0; k < 3; k++)
             c[k] = 0.5f * (L[i].box.lo[k] + L[i].box.hi[k]);
+        /* solid: the opaque triangles alone (decorators are not solid) */
         if (!L[i].n && obs__dyn_inside(bvh, c, 64, p->backface_limit))
             continue;
         out->box[out->count++] = L[i].box;

@@ -102,14 +102,11 @@ uint64_t obs__bake_level_fingerprint(const obs__bake_world *w)
 }
 
 /* The level's fingerprint with its decorators folded in (section 2.2,
- * decor.c, occl.c): each instance's class, the shrubs' densities and the
- * trees' attenuation decide the traced values as the geometry does, so a
- * part traced with other decorators reads as another level.  Without
- * decorators the fingerprint is the level's own. */
-static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_trace_desc *td)
+ * decor.c, occl.c; shard.h). */
+uint64_t obs__bake_traced_fingerprint(const obs__bake_world *w, const obs__bake_decor *d,
+                                      float tree_attenuation)
 {
     uint64_t h = obs__bake_level_fingerprint(w);
-    const obs__bake_decor *d = td ? td->decor : NULL;
     if (!d || d->counts[OBS__DECOR_NONE] == d->node_count)
         return h;
     h = obs__bake_fnv(h, (const unsigned char *)"decorators 1", 12);
@@ -118,7 +115,13 @@ static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_tra
         h = fnv32(h, n < d->node_count ? d->node_class[n] : 0);
         h = fnv32(h, n < d->node_count ? obs__le_fbits(d->density[n]) : 0);
     }
-    return fnv32(h, obs__le_fbits(td->tree_attenuation));
+    return fnv32(h, obs__le_fbits(tree_attenuation));
+}
+
+static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_trace_desc *td)
+{
+    return td ? obs__bake_traced_fingerprint(w, td->decor, td->tree_attenuation)
+              : obs__bake_level_fingerprint(w);
 }
 
 /* ---- writing a part ----------------------------------------------------- */

@@ -134,6 +134,14 @@ size_t obs__bake_shard_first(size_t total, int index, int count);
 /* FNV-1a 64 of the flattened level (positions, triangles, sidedness),
  * independent of the host's byte order. */
 uint64_t obs__bake_level_fingerprint(const obs__bake_world *w);
+/* The same with the decorators folded in (each instance's class, the
+ * shrubs' densities, tree_attenuation: they decide the traced values as
+ * the geometry does), so that a part traced with other decorators reads
+ * as another level; d NULL or without decorators: the level's own.
+ * obscura bake's parts and bake-dynamic's carry it. */
+struct obs__bake_decor;
+uint64_t obs__bake_traced_fingerprint(const obs__bake_world *w, const struct obs__bake_decor *d,
+                                      float tree_attenuation);
 /* Reads and checks a part's header (magic, version, sizes, the file's
  * length against its count). */
 obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN]);

@@ -308,8 +308,10 @@ void obs__bake_bvh_cast(const obs__bake_bvh *b, const float o[3], const float *d
                 continue;
             }
             t[k] = rh.ray.tfar[l];
-            unsigned pr = rh.hit.primID[l];
-            const float *hn = w->fn + 3 * (size_t)pr;
+            /* with decorators the opaque scene lists a subset: its world triangle */
+            size_t pr = b->occl->opaque_tri ? b->occl->opaque_tri[rh.hit.primID[l]]
+                                            : rh.hit.primID[l];
+            const float *hn = w->fn + 3 * pr;
             back[k] = !w->two_sided[pr] && hn[0] * rh.ray.dir_x[l] + hn[1] * rh.ray.dir_y[l] +
                                                    hn[2] * rh.ray.dir_z[l] >
                                                0.0f;

@@ -106,6 +106,26 @@ typedef enum obs_bake_ivalues {
     OBS_BAKE_IVALUES_LIST(OBS__BAKE_ENUM)
 } obs_bake_ivalues;
 
+/* The decorator rows, shared with bake-dynamic's table
+ * (OBS_DYN_PARAM_TABLE, obscura/dynamic.h), which traces the same
+ * occluders: one name, default, range and doc for both. */
+#define OBS_BAKE_PARAM_DECORATOR_SOURCE(X)                                     \
+    X(decorator_source, ENUM, "auto", 0, 0, (OBS_BAKE_DECOR_LIST(OBS__BAKE_CHOICE) + 1), \
+      "which nodes are decorators (section 2.2): auto (the --decorators "     \
+      "file first, then the glTF extras' class/kind, then words of the node " \
+      "name: tree, bush, shrub, hedge, grass; a node without any takes its "   \
+      "parent's class), file (the --decorators file only) or off (every "     \
+      "node opaque geometry)")
+#define OBS_BAKE_PARAM_SHRUB_DENSITY(X)                                        \
+    X(shrub_density, FLOAT, 1.0, 0.0, 1000.0, NULL,                            \
+      "fog density (1/m) of a shrub's world box when neither the "            \
+      "--decorators file nor the node's extras give one: a ray's visibility " \
+      "is multiplied by exp(-density * length inside the box) (section 2.1)")
+#define OBS_BAKE_PARAM_TREE_ATTENUATION(X)                                     \
+    X(tree_attenuation, FLOAT, 0.5, 0.0, 1.0, NULL,                            \
+      "fraction of a ray's visibility each tree triangle it crosses takes "   \
+      "away: trees are semi-transparent occluders (section 2.1; paper: 50 %)")
+
 /* The bake parameters: X(name, type, default, min, max, choices, doc),
  * type FLOAT, INT or ENUM (choices '|'-separated, stored 1-based).  The
  * CLI's flags, `obscura bake --params` and README's bake table come from
@@ -160,16 +180,8 @@ typedef enum obs_bake_ivalues {
       "held-out check: this many samples per face (mean, placed and capped "   \
       "as above, other positions and rays) traced after the fit and compared " \
       "with the fit and the two baselines (the report's holdout rows); 0: off") \
-    X(decorator_source, ENUM, "auto", 0, 0, (OBS_BAKE_DECOR_LIST(OBS__BAKE_CHOICE) + 1), \
-      "which nodes are decorators (section 2.2): auto (the --decorators "     \
-      "file first, then the glTF extras' class/kind, then words of the node " \
-      "name: tree, bush, shrub, hedge, grass; a node without any takes its "   \
-      "parent's class), file (the --decorators file only) or off (every "     \
-      "node opaque geometry)")                                                 \
-    X(shrub_density, FLOAT, 1.0, 0.0, 1000.0, NULL,                            \
-      "fog density (1/m) of a shrub's world box when neither the "            \
-      "--decorators file nor the node's extras give one: a ray's visibility " \
-      "is multiplied by exp(-density * length inside the box) (section 2.1)")  \
+    OBS_BAKE_PARAM_DECORATOR_SOURCE(X)                                         \
+    OBS_BAKE_PARAM_SHRUB_DENSITY(X)                                            \
     X(instanced, ENUM, "trees", 0, 0, (OBS_BAKE_INSTANCED_LIST(OBS__BAKE_CHOICE) + 1), \
       "large instanced decorators (section 2.2): trees (every node of class "  \
       "tree whose mesh at least instanced_min tree nodes use gets a local AO " \
@@ -191,9 +203,7 @@ typedef enum obs_bake_ivalues {
     X(volume_rays, INT, 128, 4, 65536, NULL,                                   \
       "rays over the sphere per volume point, projected to quadratic SH at "  \
       "both distances")                                                        \
-    X(tree_attenuation, FLOAT, 0.5, 0.0, 1.0, NULL,                            \
-      "fraction of a ray's visibility each tree triangle it crosses takes "   \
-      "away: trees are semi-transparent occluders (section 2.1; paper: 50 %)") \
+    OBS_BAKE_PARAM_TREE_ATTENUATION(X)                                         \
     X(small_radius, FLOAT, 1.0, 1e-4, 1e4, NULL,                               \
       "radius (world units) of the sphere around a small decorator's "        \
       "origin, added to the half diagonal of its box, over which the "        \

@@ -81,6 +81,10 @@ extern "C" {
       "this fraction of each region's valid points is held back from the fit " \
       "and measures eq 4 against a constant and a single gradient (the "      \
       "report); 0: off")                                                       \
+    /* the static bake's occluders (section 2.1), its rows (obscura/bake.h) */ \
+    OBS_BAKE_PARAM_DECORATOR_SOURCE(X)                                         \
+    OBS_BAKE_PARAM_SHRUB_DENSITY(X)                                            \
+    OBS_BAKE_PARAM_TREE_ATTENUATION(X)                                         \
     X(seed, INT, 1, 0, 2147483647, NULL,                                       \
       "random seed; the result depends on it alone, not on the thread count") \
     X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
@@ -243,11 +247,19 @@ typedef struct obs_dyn_stats {
      * normals): mean and max, before and after the regularisation. */
     double jump_mean[2], jump_max[2];
     double energy[2]; /* the regularisation's E before and after */
+    /* Decorators (section 2.1, as obscura bake): nodes per class (none,
+     * shrub, tree, small), and the classification's warning ("" when
+     * none: entries of the --decorators file that match no node). */
+    size_t decorator_nodes[4];
+    char decorator_warning[OBS_ERR_LEN];
 } obs_dyn_stats;
 
 typedef struct obs_dyn_desc {
     obs_dyn_params params;
     const obs_dyn_regions *regions; /* NULL: built from the level */
+    /* The text of a decorators file (README's bake section, parameter
+     * decorator_source), or NULL; read by the bake, kept by the caller. */
+    const char *decorators_json;
     void (*progress)(void *user, size_t done, size_t total);
     void *progress_user;
 } obs_dyn_desc;
@@ -309,9 +321,12 @@ typedef struct obs_dyn_path_stats {
  * `steps` points along each; at each point
  * two normals (up +y and one drawn at random) are traced with `rays`
  * cosine-weighted rays (eq 1) and evaluated on the models; tau is the
- * blender's decay time in steps. */
+ * blender's decay time in steps.  The reference traces the occluders the
+ * bake does (p's decorator rows, decorators_json: the text of a
+ * decorators file or NULL): eq 1's rho times each ray's transmittance. */
 obs_status obs_dyn_measure_paths(const obs_bake_scene *scene, const obs_dyn_result *r,
-                                 const obs_dyn_params *p, int paths, int steps, int rays,
+                                 const obs_dyn_params *p, const char *decorators_json,
+                                 int paths, int steps, int rays,
                                  float tau, obs_dyn_path_stats *out, char err[OBS_ERR_LEN]);
 
 #ifdef __cplusplus

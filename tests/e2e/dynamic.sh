@@ -3,8 +3,12 @@
 # tests/data with built regions and with a regions file, the model file
 # read back by an independent reader of its documented format
 # (tests/e2e/lib/dyn_eval.py) against `--eval`, the same bytes for 1 and 2
-# threads, the report's measures, the bake over shards (--shard I/N,
-# --merge: merged = unsharded byte for byte, bad parts refused), `obscura
+# threads, the report's measures, the decorators traced as obscura bake
+# traces them (none marked: the bytes of decorator-source off; a
+# --decorators file or a node named tree: another model, brighter under a
+# tree than under an opaque roof), the bake over shards (--shard I/N,
+# --merge: merged = unsharded byte for byte, bad parts refused, parts
+# traced with other decorators refused), `obscura
 # gbuffer --dynamic` (a dynamic object in the baked level valued from the
 # model per pixel, checked by the independent reader; the static pixels
 # unchanged), clear errors for bad regions files, models and usage.
@@ -70,6 +74,56 @@ check "linear and quadratic SH differ" "! cmp -s $T/lin $T/quad"
 expect 0 "1 thread" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/t1.json" $FAST --threads 1
 expect 0 "2 threads" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/t2.json" $FAST --threads 2
 check "the same bytes whatever the thread count" "cmp -s $T/t1.json $T/t2.json"
+echo "-- decorators (section 2.1): the static bake's occluders"
+# The fixture marks no decorator: auto and off give the bytes of the bake
+# before decorators (every triangle opaque).
+expect 0 "decorator-source off" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/doff.json" $FAST \
+    --threads 2 --decorator-source off
+check "no decorator in the level: auto = off, byte for byte" "cmp -s $T/t1.json $T/doff.json"
+check "report: no decorator node, the source named" \
+    "python3 -c \"import json; d=json.load(open('$T/r.json')); assert d['decorator_nodes']['tree'] == 0 and d['decorator_nodes']['shrub'] == 0 and d['params']['decorator_source'] == 'auto', d['decorator_nodes']\""
+TREES=tests/data/levels/aalborg_cut.trees.json
+expect 0 "--decorators (the fixture's two tree cards)" -- "$OBSCURA" bake-dynamic "$FIX" \
+    -o "$T/dtree.json" --report "$T/dtree.r.json" $FAST --threads 2 --decorators "$TREES"
+check "report: 2 tree nodes" "[ \"\$(field $T/dtree.r.json \"['decorator_nodes']['tree']\")\" = 2 ]"
+check "the trees semi-transparent: another model" "! cmp -s $T/t1.json $T/dtree.json"
+expect 0 "--decorators with decorator-source off" -- "$OBSCURA" bake-dynamic "$FIX" \
+    -o "$T/dtoff.json" $FAST --threads 2 --decorators "$TREES" --decorator-source off
+check "... the bytes without decorators" "cmp -s $T/t1.json $T/dtoff.json"
+# A level whose node is named tree: a canopy 2 above a ground.
+cat >"$T/canopy.obj" <<'OBJ'
+o ground
+v -4 0 -4
+v 4 0 -4
+v 4 0 4
+v -4 0 4
+f 1 3 2
+f 1 4 3
+o tree
+v -4 2 -4
+v 4 2 -4
+v 4 2 4
+v -4 2 4
+f 5 6 7
+f 5 7 8
+OBJ
+CAN="--rays 256 --max-regions 4 --distance-long 4 -q"
+expect 0 "a level with a tree node" -- "$OBSCURA" bake-dynamic "$T/canopy.obj" -o "$T/ctree.json" \
+    --report "$T/ctree.r.json" $CAN
+check "report: the node named tree is a tree" "[ \"\$(field $T/ctree.r.json \"['decorator_nodes']['tree']\")\" = 1 ]"
+expect 0 "... and with decorator-source off" -- "$OBSCURA" bake-dynamic "$T/canopy.obj" \
+    -o "$T/copaque.json" $CAN --decorator-source off
+check "a tree node: another model than all opaque" "! cmp -s $T/ctree.json $T/copaque.json"
+"$OBSCURA" bake-dynamic --eval "$T/ctree.json" --at 0.3,1,0.2 --normal 0,1,0 >"$T/ctree.ao" 2>/dev/null
+"$OBSCURA" bake-dynamic --eval "$T/copaque.json" --at 0.3,1,0.2 --normal 0,1,0 >"$T/copaque.ao" 2>/dev/null
+check "under the canopy, facing up: brighter through a tree than under an opaque roof" \
+    "python3 -c \"import sys; t=float(open('$T/ctree.ao').read()); o=float(open('$T/copaque.ao').read()); print(t, o); sys.exit(not t > o + 0.1)\""
+printf '{"decorators": [{"name": "tree", "class": "palm"}]}\n' >"$T/bad_class.json"
+expect 3 "a decorators file with an unknown class" -- "$OBSCURA" bake-dynamic "$T/canopy.obj" \
+    -o "$T/x.json" $CAN --decorators "$T/bad_class.json"
+said "palm"
+expect 3 "a missing decorators file" -- "$OBSCURA" bake-dynamic "$FIX" -o "$T/x.json" \
+    --decorators "$T/none.json" -q
 echo "-- shards: --shard I/N then --merge"
 for n in 1 3 4; do
     i=0; ok_shards=1
@@ -119,6 +173,22 @@ OBJ
 expect 0 "a shard of another level" -- "$OBSCURA" bake-dynamic "$T/box.obj" --shard 0/1 -o "$T/dbox.bin" --rays 16 --max-regions 2 -q
 expect 3 "a part of another level" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/dbox.bin" -o "$T/x.json" -q
 said "traced from another level"
+# The decorators are folded into the parts' level fingerprint.
+expect 0 "a shard traced with decorators" -- "$OBSCURA" bake-dynamic "$FIX" --shard 0/1 \
+    -o "$T/ddec.bin" $FAST --decorators "$TREES"
+expect 3 "... merged without them" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/ddec.bin" \
+    -o "$T/x.json" --max-regions 24 -q
+said "or with other decorators"
+expect 3 "... merged with another tree attenuation" -- "$OBSCURA" bake-dynamic "$FIX" \
+    --merge "$T/ddec.bin" -o "$T/x.json" --max-regions 24 --decorators "$TREES" \
+    --tree-attenuation 0.25 -q
+said "or with other decorators"
+expect 0 "... merged with them" -- "$OBSCURA" bake-dynamic "$FIX" --merge "$T/ddec.bin" \
+    -o "$T/ddec.json" --max-regions 24 --decorators "$TREES" -q
+check "merged with decorators = unsharded, byte for byte" "cmp -s $T/dtree.json $T/ddec.json"
+expect 3 "a part without decorators merged with them" -- "$OBSCURA" bake-dynamic "$FIX" \
+    --merge "$T/dpart1.0.bin" -o "$T/x.json" --max-regions 24 --decorators "$TREES" -q
+said "or with other decorators"
 expect 0 "a part of obscura bake" -- "$OBSCURA" bake "$T/box.obj" --shard 0/1 -o "$T/sbox.bin" --rays 4 -q
 expect 3 "... is not a bake-dynamic part" -- "$OBSCURA" bake-dynamic "$T/box.obj" --merge "$T/sbox.bin" -o "$T/x.json" -q
 said "not a bake-dynamic part"

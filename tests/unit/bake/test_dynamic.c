@@ -2,8 +2,10 @@
  * dyn_fit.c, dyn_model.c) against closed forms: SH projection and the
  * clamped cosine, the paper's room with 6 walls, eq 4 on known fields,
  * the regularisation, absorption, the region file's errors, the model
- * file and the blender. */
+ * file and the blender, and the decorators (a tree layer above a point
+ * attenuates its spherical obscurance, is not solid). */
 #include "bake/bake_testutil.h"
+#include "bake/decor.h"
 #include "bake/dyn_internal.h"
 
 #define PI 3.14159265358979323846
@@ -645,6 +647,88 @@ static void test_model_file_and_blender(void **state)
     obs_dyn_model_free(&m);
 }
 
+/* ---- decorators (section 2.1) --------------------------------------------- */
+
+/* A point under a wide horizontal layer 1 above it (a 200 x 200 grid
+ * facing down), nothing else within reach (an opaque ground far below,
+ * beyond the rays' length).  The layer is a node named tree: semi-
+ * transparent, tree_attenuation 0.3, so every upward ray keeps 0.7 and
+ * misses (rho 1), every downward ray misses: the AO for the up normal is
+ * 0.7 at both distances, in the point's SH and in the probe paths'
+ * reference (eq 1).  With decorator_source off the layer is an opaque
+ * roof: much darker.  The tree is not solid: a point above it is outside
+ * geometry and the segment through it is free; the roof's back face
+ * makes the same point inside, the segment blocked. */
+static void tree_layer(obs_bake_scene *sc)
+{
+    obs_bake_mesh m[2];
+    const float go[3] = {-100, -500, -100}, gu[3] = {0, 0, 200}, gv[3] = {200, 0, 0};
+    const float co[3] = {-100, 1, -100}, cu[3] = {200, 0, 0}, cv[3] = {0, 0, 200};
+    bt_grid(&m[0], "ground", go, gu, gv, 2, 2); /* z x x = +y: faces up */
+    bt_grid(&m[1], "canopy", co, cu, cv, 4, 4); /* x x z = -y: faces the point */
+    bt_scene(sc, m, 2);
+    const char *names[2] = {"level", "tree"};
+    const uint32_t counts[2] = {1, 1};
+    bt_split(sc, names, counts, 2);
+}
+
+static void test_tree_layer_attenuates(void **state)
+{
+    (void)state;
+    double sh_up[2][2], eq1_up[2][2];
+    int inside[2], blocked[2];
+    for (int opaque = 0; opaque < 2; opaque++) {
+        obs_bake_scene sc;
+        tree_layer(&sc);
+        obs__bake_world w = {0};
+        char err[OBS_ERR_LEN] = "", warn[OBS_ERR_LEN];
+        assert_int_equal(obs__bake_flatten(&sc, &w, err), OBS_OK);
+        obs_dyn_params p;
+        room_params(&p, "4096");
+        assert_int_equal(obs_dyn_param_set(&p, "tree_attenuation", "0.3", err), OBS_OK);
+        if (opaque)
+            assert_int_equal(obs_dyn_param_set(&p, "decorator_source", "off", err), OBS_OK);
+        obs_dyn_params_resolve(&p, &p);
+        obs__bake_decor dc = {0};
+        obs__bake_bvh *bvh = NULL;
+        assert_int_equal(obs__dyn_occluders(&sc, &w, &p, NULL, &dc, &bvh, warn, err), OBS_OK);
+        assert_int_equal(dc.counts[OBS__DECOR_TREE], opaque ? 0 : 1);
+        const float o[3] = {0, 0, 0}, up[3] = {0, 1, 0}, above[3] = {0, 1.5f, 0};
+        double sh[OBS_DYN_CHANNELS];
+        int dropped = 1;
+        assert_true(obs__dyn_point_sh(bvh, o, &p, 7, sh, &dropped));
+        assert_false(dropped);
+        float dist[2] = {p.distance_short, p.distance_long};
+        double ref[2];
+        obs__dyn_trace_eq1(bvh, o, up, 4096, dist, 1, 0, ref);
+        for (int c = 0; c < 2; c++) {
+            sh_up[opaque][c] = obs__dyn_sh_eval(sh + OBS_DYN_SH * c, up, 2);
+            eq1_up[opaque][c] = ref[c];
+        }
+        inside[opaque] = obs__dyn_inside(bvh, above, 32, p.backface_limit);
+        blocked[opaque] = obs__bake_bvh_occluded(bvh, o, above);
+        obs__bake_bvh_free(bvh);
+        obs__bake_decor_free(&dc);
+        obs__bake_world_free(&w);
+        obs_bake_scene_free(&sc);
+    }
+    print_message("up normal under a tree layer (attenuation 0.3): SH %.4f / %.4f, eq 1 %.4f / "
+                  "%.4f (short / long); the same layer opaque: SH %.4f / %.4f, eq 1 %.4f / %.4f\n",
+                  sh_up[0][0], sh_up[0][1], eq1_up[0][0], eq1_up[0][1], sh_up[1][0], sh_up[1][1],
+                  eq1_up[1][0], eq1_up[1][1]);
+    for (int c = 0; c < 2; c++) { /* 1 - tree_attenuation; 1 if the trace ignored it */
+        assert_true(fabs(sh_up[0][c] - 0.7) < 0.02);
+        assert_true(fabs(eq1_up[0][c] - 0.7) < 0.02);
+    }
+    /* the roof at the long distance (4): rho(1 / cos) well below 0.7 */
+    assert_true(sh_up[1][1] < 0.4);
+    assert_true(eq1_up[1][1] < 0.4);
+    assert_false(inside[0]); /* the tree is not solid */
+    assert_false(blocked[0]);
+    assert_true(inside[1]); /* the opaque roof's back face */
+    assert_true(blocked[1]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -656,6 +740,7 @@ int main(void)
         cmocka_unit_test(test_regions_file),
         cmocka_unit_test(test_built_regions_outside),
         cmocka_unit_test(test_model_file_and_blender),
+        cmocka_unit_test(test_tree_layer_attenuates),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
