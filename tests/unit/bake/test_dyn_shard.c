@@ -2,7 +2,8 @@
  * dyn_shard_run.c): merged == unsharded byte for byte for N = 1, 3, 4
  * (the model file too), the parts' layout, and the parts refused
  * (missing, twice, another split, another level, other regions, other
- * parameters, truncated, damaged, not a part). */
+ * parameters, truncated, damaged, not a part, traced with other
+ * decorators). */
 #include <stdio.h>
 #include <unistd.h>
 
@@ -261,6 +262,65 @@ static void test_bad_parts(void **state)
     obs_bake_scene_free(&other);
 }
 
+/* The decorators are folded into the parts' level fingerprint: the wall
+ * as a node named tree (semi-transparent), a part traced so is refused by
+ * a merge without decorators or with another tree attenuation, and
+ * merged with the same ones it is the unsharded model; a part traced all
+ * opaque is refused by a merge with the tree. */
+static obs_status merge_as(const obs_bake_scene *sc, const char *path, const char *source,
+                           const char *attenuation, obs_dyn_result *r, char err[OBS_ERR_LEN])
+{
+    obs_dyn_desc d;
+    params(&d, "16", "1");
+    dset(&d.params, "decorator_source", source);
+    if (attenuation)
+        dset(&d.params, "tree_attenuation", attenuation);
+    return obs_dyn_bake_merge(sc, &d, &path, 1, r, err);
+}
+
+static void test_decorators_in_fingerprint(void **state)
+{
+    (void)state;
+    obs_bake_scene sc;
+    level(&sc, 0.0f);
+    const char *names[2] = {"level", "tree"};
+    const uint32_t counts[2] = {1, 1};
+    bt_split(&sc, names, counts, 2);
+    char err[OBS_ERR_LEN] = "", tree[128], opaque[128], whole[128], merged[128];
+    path_of(tree, sizeof tree, "dtree", 0);
+    path_of(opaque, sizeof opaque, "dopaque", 0);
+    path_of(whole, sizeof whole, "dwhole", 0);
+    path_of(merged, sizeof merged, "dmerged", 0);
+    obs_dyn_desc d;
+    params(&d, "16", "2");
+    obs_dyn_stats st;
+    assert_int_equal(obs_dyn_bake_shard(&sc, &d, 0, 1, tree, &st, err), OBS_OK);
+    assert_int_equal(st.decorator_nodes[2], 1); /* the node named tree */
+    dset(&d.params, "decorator_source", "off");
+    assert_int_equal(obs_dyn_bake_shard(&sc, &d, 0, 1, opaque, &st, err), OBS_OK);
+    assert_int_equal(st.decorator_nodes[2], 0);
+    obs_dyn_result r;
+    assert_int_equal(merge_as(&sc, tree, "off", NULL, &r, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "other decorators"));
+    assert_int_equal(merge_as(&sc, tree, "auto", "0.25", &r, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "other decorators"));
+    assert_int_equal(merge_as(&sc, opaque, "auto", NULL, &r, err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(merge_as(&sc, opaque, "off", NULL, &r, err), OBS_OK);
+    obs_dyn_result_free(&r);
+    assert_int_equal(merge_as(&sc, tree, "auto", NULL, &r, err), OBS_OK);
+    assert_int_equal(obs_dyn_model_write(merged, &r.model, err), OBS_OK);
+    obs_dyn_result_free(&r);
+    params(&d, "16", "1");
+    assert_int_equal(obs_dyn_bake(&sc, &d, &r, err), OBS_OK);
+    assert_int_equal(obs_dyn_model_write(whole, &r.model, err), OBS_OK);
+    obs_dyn_result_free(&r);
+    same_file(merged, whole);
+    const char *made[4] = {tree, opaque, whole, merged};
+    for (int i = 0; i < 4; i++)
+        unlink(made[i]);
+    obs_bake_scene_free(&sc);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -281,6 +341,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_merged_is_unsharded),
         cmocka_unit_test(test_bad_parts),
+        cmocka_unit_test(test_decorators_in_fingerprint),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
