@@ -21,24 +21,7 @@
 
 #include "bake/lod.h"
 #include "internal.h"
-
-#define GLB_MAGIC 0x46546C67u
-#define CHUNK_JSON 0x4E4F534Au
-#define CHUNK_BIN 0x004E4942u
-
-typedef struct file {
-    const char *path;
-    unsigned char *data;
-    size_t size;
-    cJSON *doc;
-    const unsigned char *bin;
-    size_t bin_len;
-} file;
-
-static uint32_t u32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
+#include "io/glb_read.h"
 
 static int uses_lod(const cJSON *doc)
 {
@@ -51,7 +34,7 @@ static int uses_lod(const cJSON *doc)
 
 /* 0: not a .glb, or one without MSFT_lod (nothing to read; only its JSON
  * chunk was read); 1: read; -1: error (err set). */
-static int file_open(const char *path, file *f, char err[OBS_ERR_LEN])
+static int file_open(const char *path, obs__glb *f, char err[OBS_ERR_LEN])
 {
     memset(f, 0, sizeof *f);
     f->path = path;
@@ -59,20 +42,20 @@ static int file_open(const char *path, file *f, char err[OBS_ERR_LEN])
     if (!fp)
         return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno)), -1;
     unsigned char head[20];
-    if (fread(head, 1, 20, fp) != 20 || u32(head) != GLB_MAGIC) {
+    if (fread(head, 1, 20, fp) != 20 || obs__glb_u32(head) != OBS__GLB_MAGIC) {
         fclose(fp);
         return 0;
     }
-    uint32_t total = u32(head + 8), jlen = u32(head + 12);
-    if (total < 20 || u32(head + 16) != CHUNK_JSON || jlen > total - 20 ||
-        !(f->data = malloc(total))) {
+    uint32_t total = obs__glb_u32(head + 8), jlen = obs__glb_u32(head + 12);
+    if (total < 20 || obs__glb_u32(head + 16) != OBS__GLB_CHUNK_JSON || jlen > total - 20 ||
+        !(f->file = malloc(total))) {
         fclose(fp);
         return obs__fail(err, OBS_BAD_FILE, "%s: glTF binary of %u bytes without its JSON chunk",
                          path, total), -1;
     }
-    memcpy(f->data, head, 20);
-    size_t got = fread(f->data + 20, 1, jlen, fp);
-    if (got == jlen && !(f->doc = cJSON_ParseWithLength((const char *)f->data + 20, jlen))) {
+    memcpy(f->file, head, 20);
+    size_t got = fread(f->file + 20, 1, jlen, fp);
+    if (got == jlen && !(f->doc = cJSON_ParseWithLength((const char *)f->file + 20, jlen))) {
         fclose(fp);
         return obs__fail(err, OBS_BAD_FILE, "%s: the JSON chunk does not parse", path), -1;
     }
@@ -80,36 +63,23 @@ static int file_open(const char *path, file *f, char err[OBS_ERR_LEN])
         fclose(fp);
         return 0;
     }
-    got += fread(f->data + 20 + got, 1, total - 20 - got, fp);
+    got += fread(f->file + 20 + got, 1, total - 20 - got, fp);
     fclose(fp);
     if (got != total - 20)
         return obs__fail(err, OBS_BAD_FILE, "%s: truncated: %zu of %u bytes", path, got + 20,
                          total), -1;
     f->size = total;
-    size_t at = 20 + (size_t)jlen;
-    if (at + 8 <= total && u32(f->data + at + 4) == CHUNK_BIN) {
-        uint32_t blen = u32(f->data + at);
-        if (blen > total - at - 8)
-            return obs__fail(err, OBS_BAD_FILE, "%s: binary chunk beyond the file", path), -1;
-        f->bin = f->data + at + 8;
-        f->bin_len = blen;
-    }
+    if (obs__glb_find_bin(f, jlen, err) != OBS_OK)
+        return -1;
     return 1;
 }
 
-static void file_close(file *f)
-{
-    cJSON_Delete(f->doc);
-    free(f->data);
-    memset(f, 0, sizeof *f);
-}
 
+/* A non-negative integer member of o, or def. */
 static long num(const cJSON *o, const char *name, long def)
 {
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, name);
-    return cJSON_IsNumber(v) && v->valuedouble >= 0 && v->valuedouble < 4294967296.0
-               ? (long)v->valuedouble
-               : def;
+    long v = obs__glb_index_of(o, name);
+    return v < 0 ? def : v;
 }
 
 static const cJSON *at(const cJSON *doc, const char *array, long i)
@@ -118,87 +88,30 @@ static const cJSON *at(const cJSON *doc, const char *array, long i)
     return i >= 0 && cJSON_IsArray(a) ? cJSON_GetArrayItem(a, (int)i) : NULL;
 }
 
-/* Accessor i's elements: count, the byte address of each and its
- * stride, the component type; checked against its view and the chunk. */
-typedef struct acc {
-    const unsigned char *p;
-    size_t count, stride;
-    long ctype;
-} acc;
-
-static obs_status accessor(const file *f, long i, const char *type, acc *a, const char *what,
-                           char err[OBS_ERR_LEN])
-{
-    const cJSON *ac = at(f->doc, "accessors", i);
-    const cJSON *t = ac ? cJSON_GetObjectItemCaseSensitive(ac, "type") : NULL;
-    if (!ac || !cJSON_IsString(t) || strcmp(t->valuestring, type))
-        return obs__fail(err, OBS_BAD_FILE, "%s: MSFT_lod level: %s accessor %ld is not a %s",
-                         f->path, what, i, type);
-    const cJSON *v = at(f->doc, "bufferViews", num(ac, "bufferView", -1));
-    if (!v || num(v, "buffer", -1) != 0 || !f->bin || cJSON_GetObjectItem(ac, "sparse"))
-        return obs__fail(err, OBS_BAD_FILE,
-                         "%s: MSFT_lod level: %s accessor %ld not in the binary chunk", f->path,
-                         what, i);
-    a->ctype = num(ac, "componentType", 0);
-    size_t comps = !strcmp(type, "VEC3") ? 3 : 1;
-    size_t csize = a->ctype == 5126 || a->ctype == 5125 ? 4 : a->ctype == 5123 ? 2
-                   : a->ctype == 5121                   ? 1
-                                                        : 0;
-    a->count = (size_t)num(ac, "count", 0);
-    size_t voff = (size_t)num(v, "byteOffset", 0), vlen = (size_t)num(v, "byteLength", 0);
-    size_t aoff = (size_t)num(ac, "byteOffset", 0), elem = comps * csize;
-    a->stride = (size_t)num(v, "byteStride", 0);
-    if (!a->stride)
-        a->stride = elem;
-    int bad = !csize || a->stride < elem || voff > f->bin_len || vlen > f->bin_len - voff;
-    /* the last element ends inside the view: aoff + (count - 1) stride + elem <= vlen */
-    if (!bad && a->count)
-        bad = aoff > vlen || elem > vlen - aoff || (a->count - 1) > (vlen - aoff - elem) / a->stride;
-    if (bad)
-        return obs__fail(err, OBS_BAD_FILE,
-                         "%s: MSFT_lod level: %s accessor %ld (%zu elements) beyond its view",
-                         f->path, what, i, a->count);
-    a->p = f->bin + voff + aoff;
-    return OBS_OK;
-}
-
-static float getf(const acc *a, size_t i, int k)
-{
-    float x;
-    memcpy(&x, a->p + i * a->stride + 4 * (size_t)k, 4);
-    return x;
-}
-
-static uint32_t geti(const acc *a, size_t i)
-{
-    const unsigned char *q = a->p + i * a->stride;
-    if (a->ctype == 5121)
-        return q[0];
-    if (a->ctype == 5123)
-        return (uint32_t)q[0] | (uint32_t)q[1] << 8;
-    return u32(q);
-}
 
 /* Primitive prim of a LOD node's mesh as one mesh of the bake. */
-static obs_status read_prim(const file *f, const cJSON *prim, const obs_bake_mesh *full, int level,
+static obs_status read_prim(const obs__glb *f, const cJSON *prim, const obs_bake_mesh *full, int level,
                             obs_bake_mesh *out, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
     const cJSON *attr = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
-    acc pos, nrm = {0}, idx = {0};
-    obs_status rc = accessor(f, num(attr, "POSITION", -1), "VEC3", &pos, "POSITION", err);
-    if (rc == OBS_OK && pos.ctype != 5126)
+    obs__glb_acc pos, nrm = {0}, idx = {0};
+    obs_status rc = obs__glb_accessor(f, num(attr, "POSITION", -1), 3, &pos,
+                                      "MSFT_lod level POSITION", err);
+    if (rc == OBS_OK && pos.ctype != OBS__GLB_FLOAT)
         rc = obs__fail(err, OBS_BAD_FILE, "%s: MSFT_lod level: POSITION not float", f->path);
     int has_n = cJSON_GetObjectItem(attr, "NORMAL") != NULL;
     if (rc == OBS_OK && has_n &&
-        (rc = accessor(f, num(attr, "NORMAL", -1), "VEC3", &nrm, "NORMAL", err)) == OBS_OK &&
-        (nrm.ctype != 5126 || nrm.count != pos.count))
+        (rc = obs__glb_accessor(f, num(attr, "NORMAL", -1), 3, &nrm, "MSFT_lod level NORMAL",
+                                err)) == OBS_OK &&
+        (nrm.ctype != OBS__GLB_FLOAT || nrm.count != pos.count))
         rc = obs__fail(err, OBS_BAD_FILE, "%s: MSFT_lod level: NORMAL not float per vertex",
                        f->path);
     int has_i = cJSON_GetObjectItem(prim, "indices") != NULL;
     if (rc == OBS_OK && has_i &&
-        (rc = accessor(f, num(prim, "indices", -1), "SCALAR", &idx, "indices", err)) == OBS_OK &&
-        idx.ctype == 5126)
+        (rc = obs__glb_accessor(f, num(prim, "indices", -1), 1, &idx, "MSFT_lod level indices",
+                                err)) == OBS_OK &&
+        idx.ctype == OBS__GLB_FLOAT)
         rc = obs__fail(err, OBS_BAD_FILE, "%s: MSFT_lod level: float indices", f->path);
     if (rc != OBS_OK)
         return rc;
@@ -220,12 +133,12 @@ static obs_status read_prim(const file *f, const cJSON *prim, const obs_bake_mes
     snprintf(out->name, len, "%s_LOD%d", full->name ? full->name : "", level);
     for (size_t v = 0; v < pos.count; v++)
         for (int k = 0; k < 3; k++) {
-            out->positions[3 * v + k] = getf(&pos, v, k);
+            out->positions[3 * v + k] = obs__glb_float(&pos, v, k);
             if (has_n)
-                out->normals[3 * v + k] = getf(&nrm, v, k);
+                out->normals[3 * v + k] = obs__glb_float(&nrm, v, k);
         }
     for (size_t i = 0; i < ni; i++) {
-        uint32_t x = has_i ? geti(&idx, i) : (uint32_t)i;
+        uint32_t x = has_i ? obs__glb_index(&idx, i) : (uint32_t)i;
         if (x >= pos.count) {
             obs__bake_mesh_free(out);
             return obs__fail(err, OBS_BAD_FILE, "%s: MSFT_lod level: index %u of %zu vertices",
@@ -279,7 +192,7 @@ static const cJSON *lod_ids(const cJSON *node)
  * children in order, as assimp's importer builds it (under a root of its
  * own when the scene has several); -1 for that root.  0 when the two do
  * not line up (count, names, primitives against the node's meshes). */
-static int match_nodes(const file *f, const obs_bake_scene *s, long *of)
+static int match_nodes(const obs__glb *f, const obs_bake_scene *s, long *of)
 {
     const cJSON *scenes = cJSON_GetObjectItemCaseSensitive(f->doc, "scenes");
     const cJSON *sc = cJSON_GetArrayItem(scenes, (int)num(f->doc, "scene", 0));
@@ -348,10 +261,10 @@ static int match_nodes(const file *f, const obs_bake_scene *s, long *of)
 
 obs_status obs__bake_lod_file_read(const char *path, obs_bake_scene *s, char err[OBS_ERR_LEN])
 {
-    file f;
+    obs__glb f;
     int open = file_open(path, &f, err);
     if (open <= 0) {
-        file_close(&f);
+        obs__glb_free(&f);
         return open == 0 ? OBS_OK : OBS_BAD_FILE;
     }
     obs_status rc = OBS_OK;
@@ -443,7 +356,7 @@ done:
         obs__bake_lod_file_free(s);
     free(of);
     free(from);
-    file_close(&f);
+    obs__glb_free(&f);
     return rc;
 }
 

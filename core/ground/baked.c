@@ -17,43 +17,16 @@
 #include <string.h>
 
 #include "internal.h"
+#include "io/glb_read.h"
 #include "obscura/scene.h"
 
-#define GLB_MAGIC 0x46546C67u
-#define CHUNK_JSON 0x4E4F534Au
-#define CHUNK_BIN 0x004E4942u
-#define C_BYTE_U 5121
-#define C_SHORT_U 5123
-#define C_UINT 5125
-#define C_FLOAT 5126
 /* Depth of the node graph followed (a deeper one is refused: a cycle). */
 #define MAX_DEPTH 256
 #define MAX_FILE ((size_t)UINT32_MAX)
 
 static const char *const ao_names[3] = {"_AO", "_AO_SHORT", "_AO_LONG"};
 
-typedef struct glb {
-    const char *path;
-    unsigned char *file;
-    size_t size;
-    cJSON *doc;
-    const unsigned char *bin;
-    size_t bin_len;
-} glb;
-
-static void glb_free(glb *g)
-{
-    cJSON_Delete(g->doc);
-    free(g->file);
-    memset(g, 0, sizeof *g);
-}
-
-static uint32_t u32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static obs_status glb_open(const char *path, glb *g, char err[OBS_ERR_LEN])
+static obs_status glb_open(const char *path, obs__glb *g, char err[OBS_ERR_LEN])
 {
     memset(g, 0, sizeof *g);
     g->path = path;
@@ -80,143 +53,48 @@ static obs_status glb_open(const char *path, glb *g, char err[OBS_ERR_LEN])
     size_t got = fread(g->file, 1, g->size, f);
     fclose(f);
     if (got != g->size) {
-        glb_free(g);
+        obs__glb_free(g);
         return obs__fail(err, OBS_IO, "%s: short read", path);
     }
     const unsigned char *d = g->file;
-    if (g->size < 20 || u32(d) != GLB_MAGIC) {
-        glb_free(g);
+    if (g->size < 20 || obs__glb_u32(d) != OBS__GLB_MAGIC) {
+        obs__glb_free(g);
         return obs__fail(err, OBS_BAD_FILE, "%s: not a glTF binary (.glb)", path);
     }
     /* The header's fields are read before any error frees the file. */
-    uint32_t version = u32(d + 4), first = u32(d + 16);
-    size_t total = u32(d + 8), jlen = u32(d + 12);
-    if (version != 2 || first != CHUNK_JSON) {
-        glb_free(g);
+    uint32_t version = obs__glb_u32(d + 4), first = obs__glb_u32(d + 16);
+    size_t total = obs__glb_u32(d + 8), jlen = obs__glb_u32(d + 12);
+    if (version != 2 || first != OBS__GLB_CHUNK_JSON) {
+        obs__glb_free(g);
         return obs__fail(err, OBS_BAD_FILE, "%s: not glTF 2.0 binary (version %u, first chunk "
                                             "not JSON)", path, (unsigned)version);
     }
     if (total > g->size) {
         size_t have = g->size;
-        glb_free(g);
+        obs__glb_free(g);
         return obs__fail(err, OBS_BAD_FILE, "%s: the header says %zu bytes, the file has %zu "
                                             "(truncated?)", path, total, have);
     }
     if (jlen > total - 20) {
-        glb_free(g);
+        obs__glb_free(g);
         return obs__fail(err, OBS_BAD_FILE, "%s: JSON chunk of %zu bytes beyond the file", path,
                          jlen);
     }
     g->doc = cJSON_ParseWithLength((const char *)d + 20, jlen);
     if (!g->doc || !cJSON_IsObject(g->doc)) {
-        glb_free(g);
+        obs__glb_free(g);
         return obs__fail(err, OBS_BAD_FILE, "%s: the JSON chunk does not parse", path);
     }
-    size_t at = 20 + ((jlen + 3) & ~(size_t)3);
-    if (at + 8 <= total && u32(d + at + 4) == CHUNK_BIN) {
-        size_t blen = u32(d + at);
-        if (blen > total - at - 8) {
-            glb_free(g);
-            return obs__fail(err, OBS_BAD_FILE, "%s: binary chunk of %zu bytes beyond the file",
-                             path, blen);
-        }
-        g->bin = d + at + 8;
-        g->bin_len = blen;
-    }
-    return OBS_OK;
+    g->size = total; /* what follows the header's length is not the file's */
+    obs_status st = obs__glb_find_bin(g, jlen, err);
+    if (st != OBS_OK)
+        obs__glb_free(g);
+    return st;
 }
 
 static const cJSON *item(const cJSON *o, const char *name)
 {
     return cJSON_GetObjectItemCaseSensitive(o, name);
-}
-
-/* A non-negative integer member, or -1. */
-static long index_of(const cJSON *o, const char *name)
-{
-    const cJSON *v = item(o, name);
-    if (!cJSON_IsNumber(v) || !(v->valuedouble >= 0.0) || v->valuedouble > 2147483647.0 ||
-        v->valuedouble != floor(v->valuedouble))
-        return -1;
-    return (long)v->valuedouble;
-}
-
-/* One accessor: its data in the binary chunk, checked. */
-typedef struct acc {
-    const unsigned char *data;
-    size_t count, stride;
-    int ctype, comps;
-} acc;
-
-static obs_status accessor(const glb *g, long idx, int comps, acc *a, const char *what,
-                           char err[OBS_ERR_LEN])
-{
-    const cJSON *accs = item(g->doc, "accessors"), *views = item(g->doc, "bufferViews");
-    const cJSON *ac = cJSON_GetArrayItem(accs, (int)idx);
-    if (idx < 0 || !cJSON_IsObject(ac))
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: accessor %ld does not exist", g->path, what,
-                         idx);
-    const cJSON *type = item(ac, "type");
-    static const char *const types[] = {NULL, "SCALAR", NULL, "VEC3"};
-    if (!cJSON_IsString(type) || strcmp(type->valuestring, types[comps]) != 0)
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: accessor %ld is not %s", g->path, what, idx,
-                         types[comps]);
-    if (item(ac, "sparse"))
-        return obs__fail(err, OBS_UNSUPPORTED, "%s: %s: sparse accessors are not read", g->path,
-                         what);
-    long count = index_of(ac, "count"), vi = index_of(ac, "bufferView");
-    long ctype = index_of(ac, "componentType");
-    const cJSON *view = cJSON_GetArrayItem(views, (int)vi);
-    if (count < 0 || vi < 0 || !cJSON_IsObject(view))
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: accessor %ld has no count or bufferView",
-                         g->path, what, idx);
-    size_t csize = ctype == C_BYTE_U ? 1 : ctype == C_SHORT_U ? 2 : 4;
-    if (ctype != C_FLOAT && ctype != C_UINT && ctype != C_SHORT_U && ctype != C_BYTE_U)
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: component type %ld", g->path, what, ctype);
-    long buf = index_of(view, "buffer");
-    const cJSON *b0 = cJSON_GetArrayItem(item(g->doc, "buffers"), 0);
-    if (buf != 0 || item(b0, "uri") || !g->bin)
-        return obs__fail(err, OBS_UNSUPPORTED, "%s: %s: only the .glb's own binary chunk is "
-                                               "read (buffer 0, no uri)", g->path, what);
-    long voff = index_of(view, "byteOffset"), vlen = index_of(view, "byteLength");
-    long aoff = index_of(ac, "byteOffset"), vstride = index_of(view, "byteStride");
-    if (voff < 0)
-        voff = 0;
-    if (aoff < 0)
-        aoff = 0;
-    size_t elem = csize * (size_t)comps, stride = vstride > 0 ? (size_t)vstride : elem;
-    if (vlen < 0 || (size_t)voff > g->bin_len || (size_t)vlen > g->bin_len - (size_t)voff ||
-        stride < elem)
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: bufferView %ld out of range", g->path, what,
-                         vi);
-    /* the last element must end inside the view */
-    if (count > 0 && ((size_t)aoff > (size_t)vlen || (size_t)vlen - (size_t)aoff < elem ||
-                      (size_t)(count - 1) > ((size_t)vlen - (size_t)aoff - elem) / stride))
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: accessor %ld (%ld elements) out of range "
-                                            "of its view", g->path, what, idx, count);
-    a->data = g->bin + voff + aoff;
-    a->count = (size_t)count;
-    a->stride = stride;
-    a->ctype = (int)ctype;
-    a->comps = comps;
-    return OBS_OK;
-}
-
-static float acc_float(const acc *a, size_t i, int k)
-{
-    float v;
-    memcpy(&v, a->data + i * a->stride + 4 * (size_t)k, 4);
-    return v;
-}
-
-static uint32_t acc_index(const acc *a, size_t i)
-{
-    const unsigned char *p = a->data + i * a->stride;
-    if (a->ctype == C_BYTE_U)
-        return p[0];
-    if (a->ctype == C_SHORT_U)
-        return (uint32_t)p[0] | (uint32_t)p[1] << 8;
-    return u32(p);
 }
 
 /* The node's local matrix (row-major, column vectors): `matrix`
@@ -255,7 +133,7 @@ static void local_matrix(const cJSON *node, float m[16])
 
 /* What the walk over the nodes builds. */
 typedef struct build {
-    const glb *g;
+    const obs__glb *g;
     obs_scene *s;
     int count_only;      /* first pass: sizes */
     size_t nv, nt, nmesh;
@@ -273,26 +151,26 @@ typedef struct build {
 static obs_status primitive(build *b, const cJSON *prim, const char *mname, const char *nname,
                             int pi, const float world[16], int dyn, char err[OBS_ERR_LEN])
 {
-    const glb *g = b->g;
+    const obs__glb *g = b->g;
     char what[300];
     snprintf(what, sizeof what, "mesh '%s' (node '%s') primitive %d", mname, nname, pi);
-    long mode = index_of(prim, "mode");
+    long mode = obs__glb_index_of(prim, "mode");
     if (item(prim, "mode") && mode != 4)
         return OBS_OK; /* points and lines have no surface */
     const cJSON *attrs = item(prim, "attributes");
-    acc pos, nrm, ind, ao[3];
+    obs__glb_acc pos, nrm, ind, ao[3];
     obs_status st;
-    if ((st = accessor(g, index_of(attrs, "POSITION"), 3, &pos, what, err)) != OBS_OK)
+    if ((st = obs__glb_accessor(g, obs__glb_index_of(attrs, "POSITION"), 3, &pos, what, err)) != OBS_OK)
         return st;
-    if (pos.ctype != C_FLOAT)
+    if (pos.ctype != OBS__GLB_FLOAT)
         return obs__fail(err, OBS_BAD_FILE, "%s: %s: POSITION is not float", g->path, what);
     int have[3] = {0, 0, 0};
     for (int k = 0; k < 3; k++) {
         if (!item(attrs, ao_names[k]))
             continue;
-        if ((st = accessor(g, index_of(attrs, ao_names[k]), 1, &ao[k], what, err)) != OBS_OK)
+        if ((st = obs__glb_accessor(g, obs__glb_index_of(attrs, ao_names[k]), 1, &ao[k], what, err)) != OBS_OK)
             return st;
-        if (ao[k].ctype != C_FLOAT || ao[k].count != pos.count)
+        if (ao[k].ctype != OBS__GLB_FLOAT || ao[k].count != pos.count)
             return obs__fail(err, OBS_BAD_FILE, "%s: %s: %s is not one float per vertex",
                              g->path, what, ao_names[k]);
         have[k] = 1;
@@ -306,14 +184,14 @@ static obs_status primitive(build *b, const cJSON *prim, const char *mname, cons
                                       "bake?)",
                          g->path, what);
     int has_n = item(attrs, "NORMAL") != NULL;
-    if (has_n && ((st = accessor(g, index_of(attrs, "NORMAL"), 3, &nrm, what, err)) != OBS_OK))
+    if (has_n && ((st = obs__glb_accessor(g, obs__glb_index_of(attrs, "NORMAL"), 3, &nrm, what, err)) != OBS_OK))
         return st;
-    if (has_n && (nrm.ctype != C_FLOAT || nrm.count != pos.count))
+    if (has_n && (nrm.ctype != OBS__GLB_FLOAT || nrm.count != pos.count))
         has_n = 0; /* unusable: the rasteriser takes the face's */
     int has_i = item(prim, "indices") != NULL;
-    if (has_i && (st = accessor(g, index_of(prim, "indices"), 1, &ind, what, err)) != OBS_OK)
+    if (has_i && (st = obs__glb_accessor(g, obs__glb_index_of(prim, "indices"), 1, &ind, what, err)) != OBS_OK)
         return st;
-    if (has_i && ind.ctype == C_FLOAT)
+    if (has_i && ind.ctype == OBS__GLB_FLOAT)
         return obs__fail(err, OBS_BAD_FILE, "%s: %s: float indices", g->path, what);
     size_t ni = has_i ? ind.count : pos.count;
     if (ni % 3 != 0)
@@ -328,7 +206,7 @@ static obs_status primitive(build *b, const cJSON *prim, const char *mname, cons
         b->nv += pos.count;
         b->nt += ni / 3;
         b->nmesh++;
-        b->any_material |= index_of(prim, "material") >= 0;
+        b->any_material |= obs__glb_index_of(prim, "material") >= 0;
         return OBS_OK;
     }
 
@@ -338,20 +216,20 @@ static obs_status primitive(build *b, const cJSON *prim, const char *mname, cons
         obs__mat4_identity(inv); /* a singular node: its normals stay */
     obs__mat4_transpose(inv, nm);
     float rgb[3] = {0.8f, 0.8f, 0.8f};
-    const cJSON *mat = cJSON_GetArrayItem(item(g->doc, "materials"), (int)index_of(prim, "material"));
+    const cJSON *mat = cJSON_GetArrayItem(item(g->doc, "materials"), (int)obs__glb_index_of(prim, "material"));
     const cJSON *bc = item(item(mat, "pbrMetallicRoughness"), "baseColorFactor");
-    if (index_of(prim, "material") >= 0 && cJSON_GetArraySize(bc) >= 3)
+    if (obs__glb_index_of(prim, "material") >= 0 && cJSON_GetArraySize(bc) >= 3)
         for (int k = 0; k < 3; k++)
             rgb[k] = (float)cJSON_GetArrayItem(bc, k)->valuedouble;
     for (size_t v = 0; v < pos.count; v++) {
-        float p[4] = {acc_float(&pos, v, 0), acc_float(&pos, v, 1), acc_float(&pos, v, 2), 1.0f},
+        float p[4] = {obs__glb_float(&pos, v, 0), obs__glb_float(&pos, v, 1), obs__glb_float(&pos, v, 2), 1.0f},
               wp[4];
         obs__mat4_apply(world, p, wp);
         float *dp = s->positions + 3 * (b->nv + v), *dn = s->normals + 3 * (b->nv + v);
         memcpy(dp, wp, 3 * sizeof(float));
         dn[0] = dn[1] = dn[2] = 0.0f;
         if (has_n) {
-            float n4[4] = {acc_float(&nrm, v, 0), acc_float(&nrm, v, 1), acc_float(&nrm, v, 2), 0},
+            float n4[4] = {obs__glb_float(&nrm, v, 0), obs__glb_float(&nrm, v, 1), obs__glb_float(&nrm, v, 2), 0},
                   wn[4];
             obs__mat4_apply(nm, n4, wn);
             float len = sqrtf(wn[0] * wn[0] + wn[1] * wn[1] + wn[2] * wn[2]);
@@ -361,12 +239,12 @@ static obs_status primitive(build *b, const cJSON *prim, const char *mname, cons
         }
         float *db = s->baked + 3 * (b->nv + v);
         for (int k = 0; k < 3; k++)
-            db[k] = have[k] && !dyn ? acc_float(&ao[k], v, 0) : 1.0f;
+            db[k] = have[k] && !dyn ? obs__glb_float(&ao[k], v, 0) : 1.0f;
         if (s->albedo)
             memcpy(s->albedo + 3 * (b->nv + v), rgb, sizeof rgb);
     }
     for (size_t i = 0; i < ni; i++) {
-        uint32_t ix = has_i ? acc_index(&ind, i) : (uint32_t)i;
+        uint32_t ix = has_i ? obs__glb_index(&ind, i) : (uint32_t)i;
         if (ix >= pos.count)
             return obs__fail(err, OBS_BAD_FILE, "%s: %s: index %u of %zu vertices", g->path, what,
                              (unsigned)ix, pos.count);
@@ -411,7 +289,7 @@ static obs_status walk(build *b, long n, const float parent[16], int depth, int 
     const cJSON *nm = item(node, "name");
     const char *nname = cJSON_IsString(nm) ? nm->valuestring : "";
     dyn = marked_dynamic(b, node, nname) || dyn; /* a dynamic node's children move with it */
-    long mi = index_of(node, "mesh");
+    long mi = obs__glb_index_of(node, "mesh");
     obs_status st;
     if (item(node, "mesh")) {
         const cJSON *mesh = cJSON_GetArrayItem(item(b->g->doc, "meshes"), (int)mi);
@@ -435,7 +313,7 @@ static obs_status walk(build *b, long n, const float parent[16], int depth, int 
 
 static obs_status walk_scene(build *b, char err[OBS_ERR_LEN])
 {
-    long si = index_of(b->g->doc, "scene");
+    long si = obs__glb_index_of(b->g->doc, "scene");
     const cJSON *sc = cJSON_GetArrayItem(item(b->g->doc, "scenes"), (int)(si < 0 ? 0 : si)), *r;
     float id[16];
     obs__mat4_identity(id);
@@ -448,7 +326,7 @@ static obs_status walk_scene(build *b, char err[OBS_ERR_LEN])
 
 int obs_scene_file_is_baked(const char *path)
 {
-    glb g;
+    obs__glb g;
     if (glb_open(path, &g, NULL) != OBS_OK)
         return 0;
     int baked = 0;
@@ -456,12 +334,12 @@ int obs_scene_file_is_baked(const char *path)
     cJSON_ArrayForEach(mesh, item(g.doc, "meshes"))
         cJSON_ArrayForEach(prim, item(mesh, "primitives"))
             baked |= item(item(prim, "attributes"), "_AO") != NULL;
-    glb_free(&g);
+    obs__glb_free(&g);
     return baked;
 }
 
 /* Whether some node of the file has a name matching the pattern. */
-static int pattern_matches(const glb *g, const char *pattern)
+static int pattern_matches(const obs__glb *g, const char *pattern)
 {
     const cJSON *n;
     cJSON_ArrayForEach(n, item(g->doc, "nodes"))
@@ -474,7 +352,7 @@ static int pattern_matches(const glb *g, const char *pattern)
 }
 
 /* The names of the file's nodes, for a pattern that matched none. */
-static void node_names(const glb *g, char *buf, size_t len)
+static void node_names(const obs__glb *g, char *buf, size_t len)
 {
     size_t at = 0;
     int k = 0;
@@ -498,7 +376,7 @@ static obs_status load(const char *path, int dynamic, const char *pattern, obs_s
     memset(out, 0, sizeof *out);
     if (marked)
         *marked = 0;
-    glb g;
+    obs__glb g;
     obs_status st = glb_open(path, &g, err);
     if (st != OBS_OK)
         return st;
@@ -548,10 +426,10 @@ static obs_status load(const char *path, int dynamic, const char *pattern, obs_s
         obs__fail(err, st, "%s: %s", path, msg);
         goto fail;
     }
-    glb_free(&g);
+    obs__glb_free(&g);
     return OBS_OK;
 fail:
-    glb_free(&g);
+    obs__glb_free(&g);
     obs_scene_free(out);
     return st;
 }

@@ -99,7 +99,7 @@ expect 3 "a LOD node whose mesh lacks a primitive" -- "$OBSCURA" bake "$T/lodpri
 said "primitives like its node's"
 python3 tests/e2e/lib/glb_edit.py "$T/lod.glb" "$T/lodcount.glb" lodcount
 expect 3 "a LOD accessor beyond its view" -- "$OBSCURA" bake "$T/lodcount.glb" -o "$T/x.glb" --lods 1 -q
-said "beyond its view"
+said "out of range of its view"
 expect 0 "--lods 2, 1 thread" -- "$OBSCURA" bake "$FIX" -o "$T/lod_t1.glb" --rays 16 --lods 2 --threads 1 -q
 expect 0 "--lods 2, 2 threads" -- "$OBSCURA" bake "$FIX" -o "$T/lod_t2.glb" --rays 16 --lods 2 --threads 2 -q
 check "LODs: the same bytes whatever the thread count" "cmp -s $T/lod_t1.glb $T/lod_t2.glb"
