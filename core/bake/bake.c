@@ -297,7 +297,8 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     if ((rc = copy_back(scene, &w, &wd, x, p.blend, out, err)) != OBS_OK)
         goto done;
     if (inst_n) {
-        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, desc, s.count, &dc, local_ao, out, err);
+        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, desc, s.count, &dc, local_ao, out,
+                                     err);
         if (rc == OBS_OK)
             results_into_solution(scene, &w, &wd, inst_sel, out, x);
         if (area_kept)
@@ -308,8 +309,8 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     if ((rc = obs__bake_small(scene, &w, wd.of, &dc, x, &p, out, err)) != OBS_OK)
         goto done;
     if (out->node_ao && p.lods) { /* the small decorators' scalars, for the LODs too */
-        for (size_t i = 0; i < w.instance_count; i++)
-            inst_sel[i] = out->node_ao[3 * w.inst[i].node] == out->node_ao[3 * w.inst[i].node];
+        for (size_t i = 0; i < w.instance_count; i++) /* NaN: not one, or unresolved */
+            inst_sel[i] = !isnan(out->node_ao[3 * w.inst[i].node]);
         results_into_solution(scene, &w, &wd, inst_sel, out, x);
     }
     rc = obs__bake_lods(scene, &w, &wd, x, &p, out, err); /* lod.c, paper 2.2.1 */
