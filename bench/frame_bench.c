@@ -131,7 +131,7 @@ static void bench_presets(obs_ctx *ctx, const char *name, const obs_gbuffer *gb,
 {
     static const char *const presets[] = {"preview", "default", "high", "reference"};
     enum { NP = sizeof presets / sizeof presets[0] };
-    double wall[NP][64], gl[NP][64];
+    double wall[NP][64], gl[NP][64], pass[NP][OBS_PASS_COUNT][64];
     char err[OBS_ERR_LEN];
     obs_params p[NP];
     if (frames > 64)
@@ -155,7 +155,10 @@ static void bench_presets(obs_ctx *ctx, const char *name, const obs_gbuffer *gb,
             if (i < 0)
                 continue;
             wall[k][i] = took;
-            gl[k][i] = obs_ctx_last_times(ctx, &t) ? t.total_ms : -1.0;
+            int timed = obs_ctx_last_times(ctx, &t);
+            gl[k][i] = timed ? t.total_ms : -1.0;
+            for (int q = 0; q < OBS_PASS_COUNT; q++)
+                pass[k][q][i] = timed ? t.ms[q] : -1.0;
         }
     obs_ctx_set_timing(ctx, 0, err);
     double mw[NP], mg[NP];
@@ -168,6 +171,21 @@ static void bench_presets(obs_ctx *ctx, const char *name, const obs_gbuffer *gb,
     for (int k = 0; k < NP; k++)
         printf("| %s | %dx%d | %s | %.1f | %.1f | %.2f | %.2f |\n", name, gb->width, gb->height,
                presets[k], mw[k], mg[k], mw[k] / mw[1], mg[k] / mg[1]);
+    /* where the time goes: each pass's median GL ms, one line per preset
+     * (to stderr, so that the table above stays one table) */
+    fprintf(stderr, "frame_bench: %dx%d passes, median GL ms:", gb->width, gb->height);
+    for (int q = 0; q < OBS_PASS_COUNT; q++)
+        fprintf(stderr, " %s", obs_pass_name((obs_pass)q));
+    fprintf(stderr, "\n");
+    for (int k = 0; k < NP; k++) {
+        fprintf(stderr, "  %-9s", presets[k]);
+        for (int q = 0; q < OBS_PASS_COUNT; q++) {
+            qsort(pass[k][q], (size_t)frames, sizeof pass[k][q][0], cmp);
+            double m = pass[k][q][frames / 2];
+            fprintf(stderr, m < 0 ? " -" : " %.1f", m);
+        }
+        fprintf(stderr, "\n");
+    }
     fflush(stdout);
 }
 
