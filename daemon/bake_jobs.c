@@ -37,6 +37,8 @@ typedef struct obsd_bake {
     unsigned char *level;
     size_t level_len;
     char ext[16];
+    char *decorators; /* the text of a decorators file, or NULL */
+    size_t decorator_rules;
     obs_bake_params params;
     const char *stage;
     size_t done, total;
@@ -73,6 +75,7 @@ static int finished(const job *j) { return j->state >= OBSD_BAKE_DONE; }
 static void job_free(job *j)
 {
     free(j->level);
+    free(j->decorators);
     free(j->result);
     free(j);
 }
@@ -254,7 +257,10 @@ static void run_job(obsd_bakes *b, job *j)
         snprintf(err, sizeof err, "bake cancelled after the load");
         goto done;
     }
-    obs_bake_desc d = {.params = j->params, .progress = on_progress, .progress_user = &c};
+    obs_bake_desc d = {.params = j->params,
+                       .progress = on_progress,
+                       .progress_user = &c,
+                       .decorators_json = j->decorators};
     s = obs_bake_run(&sc, &d, &r, err);
     pthread_mutex_lock(&b->lock);
     j->stats = r.stats;
@@ -395,15 +401,19 @@ void obsd_bakes_free(obsd_bakes *b)
 }
 
 int obsd_bakes_submit(obsd_bakes *b, unsigned char *level, size_t len, const char *ext,
-                      const obs_bake_params *p, char id[OBSD_BAKE_ID_LEN + 1])
+                      char *decorators, size_t decorator_rules, const obs_bake_params *p,
+                      char id[OBSD_BAKE_ID_LEN + 1])
 {
     job *j = calloc(1, sizeof *j);
     if (!j) {
         free(level);
+        free(decorators);
         return -3;
     }
     j->level = level;
     j->level_len = len;
+    j->decorators = decorators;
+    j->decorator_rules = decorator_rules;
     snprintf(j->ext, sizeof j->ext, "%s", ext);
     j->params = *p;
     obs_bake_params r;
@@ -480,9 +490,18 @@ static cJSON *job_json(const job *j, int full)
         cJSON_AddNumberToObject(c, "triangles", (double)j->stats.triangles);
         cJSON_AddNumberToObject(c, "samples", (double)j->stats.samples);
         cJSON_AddNumberToObject(c, "rays", (double)j->stats.rays);
+        /* the decorators' classes (section 2.2): none, shrub, tree, small */
+        static const char *const cls[4] = {"none", "shrub", "tree", "small"};
+        cJSON *dn = cJSON_AddObjectToObject(o, "decorator_nodes");
+        for (int k = 0; k < 4; k++)
+            cJSON_AddNumberToObject(dn, cls[k], (double)j->stats.decorator_nodes[k]);
+        if (j->stats.decorator_warning[0])
+            cJSON_AddStringToObject(o, "decorator_warning", j->stats.decorator_warning);
         if (j->state == OBSD_BAKE_DONE)
             cJSON_AddNumberToObject(o, "ao_mean", j->stats.ao_mean);
     }
+    if (j->decorators) /* the job's decorators file: its rules */
+        cJSON_AddNumberToObject(o, "decorator_rules", (double)j->decorator_rules);
     cJSON *par = cJSON_AddObjectToObject(o, "params");
     obs_bake_params p;
     obs_bake_params_resolve(&j->params, &p);

@@ -51,11 +51,13 @@ void obsd_bakes_free(obsd_bakes *b);
  * drain): the workers stop between batches of rays. */
 void obsd_bakes_cancel_all(obsd_bakes *b);
 
-/* Takes `level` (malloc'ed, freed by the store) and queues a job; its id
- * into id.  -1: the store is full (max_active), -2: shutting down, -3:
- * no memory (level is freed in every case). */
+/* Takes `level` and `decorators` (malloc'ed, freed by the store; the
+ * text of a decorators file of decorator_rules rules, or NULL) and queues
+ * a job; its id into id.  -1: the store is full (max_active), -2:
+ * shutting down, -3: no memory (both are freed in every case). */
 int obsd_bakes_submit(obsd_bakes *b, unsigned char *level, size_t len, const char *ext,
-                      const obs_bake_params *p, char id[OBSD_BAKE_ID_LEN + 1]);
+                      char *decorators, size_t decorator_rules, const obs_bake_params *p,
+                      char id[OBSD_BAKE_ID_LEN + 1]);
 
 /* The job as JSON (caller frees); NULL when there is no such job. */
 char *obsd_bakes_json(obsd_bakes *b, const char *id);

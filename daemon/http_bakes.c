@@ -9,12 +9,17 @@
  *
  * The query takes the bake parameters (`obscura bake --params`) by name,
  * `distances=S,L`, and `format=EXT` (the level's file extension, else told
- * from its first bytes).  An event stream is a suspended connection, as
- * the streams' are (http_streams.c). */
+ * from its first bytes).  The body is the level itself, or a
+ * multipart/form-data body (curl -F) with a part `level` and a part
+ * `decorators`, a decorators file (obscura bake --decorators), checked
+ * before the job is queued; libmicrohttpd's post processor splits it.
+ * An event stream is a suspended connection, as the streams' are
+ * (http_streams.c). */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "http_internal.h"
 #include "log.h"
@@ -173,6 +178,80 @@ static const char *sniff(const unsigned char *p, size_t n)
     return NULL;
 }
 
+/* ---- a multipart/form-data body: the parts `level` and `decorators` ---- */
+
+typedef struct parts {
+    unsigned char *buf[2]; /* level, decorators */
+    size_t len[2], cap[2];
+    size_t max;
+    int seen[2];
+    char err[200];
+} parts;
+
+static const char *const part_name[2] = {"level", "decorators"};
+
+static enum MHD_Result on_part(void *cls, enum MHD_ValueKind kind, const char *key,
+                               const char *filename, const char *content_type,
+                               const char *transfer_encoding, const char *data, uint64_t off,
+                               size_t size)
+{
+    parts *pt = cls;
+    (void)kind;
+    (void)filename;
+    (void)content_type;
+    (void)transfer_encoding;
+    (void)off;
+    int k = !key ? -1 : !strcmp(key, "level") ? 0 : !strcmp(key, "decorators") ? 1 : -1;
+    if (k < 0) {
+        snprintf(pt->err, sizeof pt->err, "unknown part '%.40s' (the parts are level and decorators)",
+                 key ? key : "");
+        return MHD_NO;
+    }
+    pt->seen[k] = 1;
+    if (size > pt->max - pt->len[k]) {
+        snprintf(pt->err, sizeof pt->err, "part %s is over the limit of %zu bytes (--max-level)",
+                 part_name[k], pt->max);
+        return MHD_NO;
+    }
+    if (pt->len[k] + size + 1 > pt->cap[k]) { /* + 1: the decorators' NUL */
+        size_t cap = pt->cap[k] ? pt->cap[k] : 1 << 16;
+        while (cap < pt->len[k] + size + 1)
+            cap *= 2;
+        unsigned char *p = realloc(pt->buf[k], cap);
+        if (!p) {
+            snprintf(pt->err, sizeof pt->err, "no memory for part %s", part_name[k]);
+            return MHD_NO;
+        }
+        pt->buf[k] = p;
+        pt->cap[k] = cap;
+    }
+    memcpy(pt->buf[k] + pt->len[k], data, size);
+    pt->len[k] += size;
+    return MHD_YES;
+}
+
+/* Splits the received body into its parts: 0, or -1 with pt->err. */
+static int split_parts(req *r, parts *pt)
+{
+    struct MHD_PostProcessor *pp = MHD_create_post_processor(r->conn, 1 << 16, on_part, pt);
+    if (!pp) {
+        snprintf(pt->err, sizeof pt->err, "a multipart/form-data body without a boundary");
+        return -1;
+    }
+    enum MHD_Result ok = MHD_post_process(pp, (const char *)r->body, r->len);
+    if (MHD_destroy_post_processor(pp) != MHD_YES)
+        ok = MHD_NO;
+    if (ok != MHD_YES && !pt->err[0])
+        snprintf(pt->err, sizeof pt->err, "the multipart/form-data body is cut short or malformed");
+    if (ok == MHD_YES && !pt->seen[0])
+        snprintf(pt->err, sizeof pt->err, "a multipart/form-data body without a part 'level'");
+    if (pt->err[0])
+        return -1;
+    if (pt->buf[1])
+        pt->buf[1][pt->len[1]] = '\0';
+    return 0;
+}
+
 enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
 {
     obsd_http *h = r->srv;
@@ -186,20 +265,49 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
                  (long long)h->cfg->max_level);
         return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
     }
-    if (r->len == 0)
+    char *decor = NULL;
+    size_t rules = 0;
+    const char *ct = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
+    if (ct && !strncasecmp(ct, "multipart/form-data", strlen("multipart/form-data"))) {
+        parts pt = {.max = (size_t)h->cfg->max_level};
+        if (split_parts(r, &pt) != 0) {
+            free(pt.buf[0]);
+            free(pt.buf[1]);
+            return obsd__answer_error(r, 400, "bad_multipart", pt.err, NULL, NULL);
+        }
+        free(r->body); /* the level part in its place */
+        r->body = pt.buf[0];
+        r->len = pt.len[0];
+        r->cap = pt.cap[0];
+        decor = (char *)pt.buf[1];
+        if (pt.seen[1] && !decor) /* an empty part: an empty file */
+            decor = strdup("");
+        if (pt.seen[1] && !decor)
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the decorators");
+        char derr[OBS_ERR_LEN];
+        if (decor && obs_bake_decorators_check(decor, &rules, derr) != OBS_OK) {
+            free(decor);
+            return obsd__answer_error(r, 400, "bad_decorators", derr, NULL, NULL);
+        }
+    }
+    if (r->len == 0) {
+        free(decor);
         return obsd__answer_error(r, 400, "empty_body",
                                   "POST /v1/bakes needs a level (glTF/GLB, AC3D, OBJ, ...) as its body", NULL, NULL);
+    }
     const char *ext = r->bake_ext[0] ? r->bake_ext : sniff(r->body, r->len);
-    if (!ext)
+    if (!ext) {
+        free(decor);
         return obsd__answer_error(r, 415, "unsupported_media_type",
                                   "cannot tell the level's format from its first bytes: give format=EXT "
                                   "(glb, gltf, ac, obj, fbx, ... as assimp names them)", NULL, NULL);
+    }
     char id[OBSD_BAKE_ID_LEN + 1];
     unsigned char *level = r->body;
     size_t len = r->len;
     r->body = NULL; /* the job has it */
     r->cap = 0;
-    int rc = obsd_bakes_submit(h->bakes, level, len, ext, &r->bake_params, id);
+    int rc = obsd_bakes_submit(h->bakes, level, len, ext, decor, rules, &r->bake_params, id);
     if (rc == -1) {
         snprintf(msg, sizeof msg, "%d bake jobs are queued or running (--max-bakes); retry later",
                  h->cfg->max_bakes);

@@ -234,6 +234,19 @@ static obs_status parse_file(const char *text, cJSON **doc, rule **out, size_t *
     return OBS_OK;
 }
 
+obs_status obs_bake_decorators_check(const char *text, size_t *rules, char err[OBS_ERR_LEN])
+{
+    cJSON *doc = NULL;
+    rule *r = NULL;
+    size_t n = 0;
+    obs_status st = parse_file(text, &doc, &r, &n, err);
+    free(r);
+    cJSON_Delete(doc);
+    if (rules)
+        *rules = st == OBS_OK ? n : 0;
+    return st;
+}
+
 static int rule_matches(const rule *r, const char *name)
 {
     if (!name)

@@ -388,8 +388,21 @@ obs_status obs__bake_lods(const obs_bake_scene *scene, const obs__bake_world *w,
                 out->stats.lod_file_meshes[l - 1]++;
             } else {
                 rc = obs__bake_simplify(&scene->meshes[m], l, p->lod_ratio, p->lod_error,
-                                        p->weld_tolerance, p->weld_angle, &out->lod_meshes[c],
-                                        err);
+                                        p->lod_lock_border, p->weld_tolerance, p->weld_angle,
+                                        &out->lod_meshes[c], err);
+                /* each level starts from the full mesh, so a simplifier
+                 * held back (a locked border) can stop above the level
+                 * before; a level never has more triangles than that one:
+                 * it takes its geometry then */
+                obs_bake_mesh *lm = &out->lod_meshes[c], *up = l > 1 ? lm - nm : NULL;
+                if (rc == OBS_OK && up && lm->triangle_count > up->triangle_count) {
+                    char *name = lm->name;
+                    lm->name = NULL;
+                    obs__bake_mesh_free(lm);
+                    rc = mesh_copy(up, lm, err);
+                    free(lm->name);
+                    lm->name = name;
+                }
             }
         }
     out->stats.lod_seconds[0] = now() - t;

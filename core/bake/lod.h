@@ -11,13 +11,14 @@
 /* Level `level` (>= 1) of mesh m: m welded with the bake's own weld
  * (tolerance and angle as the weld_* parameters, within the mesh), then
  * meshopt_simplify towards ratio^level of its triangles with the error
- * bound level x error (relative to the mesh's extent), then compacted to
+ * bound level x error (relative to the mesh's extent; lock_border: the
+ * vertices of the welded mesh's open border stay), then compacted to
  * the vertices it uses (each the first of its weld group: position and
  * normal unchanged).  out->name is m's with "_LOD<level>"; never empty
  * when m has a triangle of nonzero area.  Free with obs__bake_mesh_free. */
 obs_status obs__bake_simplify(const obs_bake_mesh *m, int level, float ratio, float error,
-                              float weld_tolerance, float weld_angle, obs_bake_mesh *out,
-                              char err[OBS_ERR_LEN]);
+                              int lock_border, float weld_tolerance, float weld_angle,
+                              obs_bake_mesh *out, char err[OBS_ERR_LEN]);
 void obs__bake_mesh_free(obs_bake_mesh *m);
 
 /* The triangles [first, first + count) of a world, for nearest-point

@@ -12,7 +12,11 @@
  * not fold into one.  Each level starts again from the welded full mesh
  * (not from the level above), towards ratio^level of its triangles, with
  * level x error as meshopt_simplify's error bound (relative to the mesh's
- * extent). */
+ * extent).  With lod_lock_border the mesh's open border is locked: two
+ * meshes meeting along an edge (terrain tiles, the pieces of a modular
+ * wall) are simplified apart, and an unlocked border (the default, which
+ * reaches lod_ratio on levels made of open meshes) loses different
+ * vertices on either side, leaving T-junctions and cracks. */
 #include <math.h>
 #include <meshoptimizer.h>
 #include <stdio.h>
@@ -106,8 +110,8 @@ static int flat(const float *pos, const uint32_t t[3])
 }
 
 obs_status obs__bake_simplify(const obs_bake_mesh *m, int level, float ratio, float error,
-                              float weld_tolerance, float weld_angle, obs_bake_mesh *out,
-                              char err[OBS_ERR_LEN])
+                              int lock_border, float weld_tolerance, float weld_angle,
+                              obs_bake_mesh *out, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
     const char *name = m->name ? m->name : "";
@@ -137,8 +141,13 @@ obs_status obs__bake_simplify(const obs_bake_mesh *m, int level, float ratio, fl
     size_t tris = k.ni / 3;
     size_t target = (size_t)floor((double)tris * pow((double)ratio, level) + 0.5);
     target = 3 * (target < 1 ? 1 : target);
+    /* LockBorder: an open edge's vertices (an edge of one triangle; the
+     * weld's remaining normal splits are seams to meshoptimizer, which it
+     * keeps matched without the option) do not move, so a neighbouring
+     * mesh's border, locked too, still meets this one at every level */
     size_t nd = meshopt_simplify(dst, k.idx, k.ni, k.pos, k.wd.count, 3 * sizeof(float), target,
-                                 (float)level * error, 0, NULL);
+                                 (float)level * error,
+                                 lock_border ? (unsigned)meshopt_SimplifyLockBorder : 0u, NULL);
     /* Zero-area triangles the collapses left along straight borders are
      * dropped (flatten.c's test: the bake would skip them anyway, and a
      * vertex of only such triangles would have no sample). */

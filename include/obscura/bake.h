@@ -231,6 +231,13 @@ typedef enum obs_bake_ivalues {
       "the simplifier's error bound for LOD level l: l times this fraction "  \
       "of the mesh's extent; a level stops short of its ratio rather than "   \
       "move the surface further")                                              \
+    X(lod_lock_border, INT, 0, 0, 1, NULL,                                     \
+      "1: the simplifier keeps every vertex of a mesh's open border where it "\
+      "is (meshoptimizer's LockBorder), so meshes that meet along their "    \
+      "borders (terrain tiles, modular walls) meet at every level, whatever " \
+      "level each one shows, at the cost of fewer triangles saved; 0: "      \
+      "borders simplify too, towards lod_ratio, and neighbours can show "    \
+      "cracks between them")                                                  \
     X(lod_check, INT, 0, 0, 1, NULL,                                           \
       "1: also bake each LOD level directly (its samples traced on the LOD " \
       "geometry, every instance at that level, and fitted) and report the "   \
@@ -496,6 +503,12 @@ obs_status obs_bake_shard(const obs_bake_scene *scene, const obs_bake_desc *desc
 obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
                           const char *const *parts, size_t n, obs_bake_result *out,
                           char err[OBS_ERR_LEN]);
+
+/* The text of a decorators file checked as the bake reads it (JSON, the
+ * rules' keys, classes and densities), without a level: what obscurad
+ * refuses a bake job for before it queues it.  *rules (may be NULL): the
+ * count of rules.  The error names the entry, as the bake's. */
+obs_status obs_bake_decorators_check(const char *text, size_t *rules, char err[OBS_ERR_LEN]);
 
 /* ---- what the bake's rays meet, for the per-pixel reference ------------ */
 

@@ -89,6 +89,14 @@ expect 0 "--lod-source simplify: simplified again" -- "$OBSCURA" bake "$T/lod.gl
 check "... at ratio 0.3: fewer triangles than the file's, none from the file" "python3 -c \"
 import json, sys; a = json.load(open('$T/lod.json'))['lods']['per_level']; b = json.load(open('$T/lods.json'))['lods']['per_level']
 sys.exit(not all(y['meshes_from_file'] == 0 and y['triangles'] < x['triangles'] for x, y in zip(a, b)))\""
+expect 0 "--lod-lock-border 1: the meshes' open borders kept at every level" -- "$OBSCURA" bake "$FIX" \
+    -o "$T/lodlock.glb" --report "$T/lodlock.json" --rays 8 --lods 2 --lod-lock-border 1 -q
+expect 0 "... each level has no more triangles than the one above it (glb_check --lods 2)" -- \
+    python3 tests/e2e/lib/glb_check.py "$T/lodlock.glb" 186 --lods 2
+check "... and more triangles than the free borders' levels, fewer than the full detail" "python3 -c \"
+import json, sys; a = json.load(open('$T/lod.json')); b = json.load(open('$T/lodlock.json'))
+f, k = a['lods']['per_level'], b['lods']['per_level']
+sys.exit(not all(x['triangles'] < y['triangles'] < b['counts']['triangles'] for x, y in zip(f, k)))\""
 python3 tests/e2e/lib/glb_edit.py "$T/lod.glb" "$T/lodmove.glb" lodmove
 python3 tests/e2e/lib/glb_edit.py "$T/lod.glb" "$T/lodprims.glb" lodprims
 expect 3 "a LOD node moved against its node, with --lods" -- "$OBSCURA" bake "$T/lodmove.glb" -o "$T/x.glb" --lods 1 -q

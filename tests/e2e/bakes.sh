@@ -73,6 +73,41 @@ check "a bake job with lods=2 ends done" "[ $code = 202 ] && wait_state $S $ID_L
 code=$(bget $S "/v1/bakes/$ID_LOD/result" "$T/r_lod.glb")
 check "... its result: the bytes of obscura bake --lods 2 (MSFT_lod levels)" \
     "[ $code = 200 ] && cmp -s $T/r_lod.glb $T/local_lod.glb && grep -q MSFT_lod $T/r_lod.glb"
+echo "-- a decorators file beside the level (multipart/form-data)"
+TREES=tests/data/levels/aalborg_cut.trees.json
+"$OBSCURA" bake "$FIX" -o "$T/local_dec.glb" --rays 16 --distances 2,300 --decorators "$TREES" -q
+# mpost OUT PART...: POST /v1/bakes?rays=16&distances=2,300 with curl -F parts, prints the status
+mpost() {
+    o=$1; shift
+    $CURL -o "$o" -D "$o.h" -w '%{http_code}' -H "$AUTH" "$@" "http://127.0.0.1:$S/v1/bakes?rays=16&distances=2,300"
+}
+code=$(mpost "$T/p_dec" -F "level=@$FIX" -F "decorators=@$TREES")
+ID_DEC=$(id_of "$T/p_dec")
+check "POST level and decorators as multipart/form-data: 202, the job ends done" \
+    "[ $code = 202 ] && wait_state $S $ID_DEC done"
+bget $S "/v1/bakes/$ID_DEC" "$T/jdec" >/dev/null
+check "... GET /v1/bakes/ID: the file's rules, 2 tree nodes (as obscura bake --decorators)" \
+    "[ \"\$(field $T/jdec \"['decorator_rules']\")\" -gt 0 ] && [ \"\$(field $T/jdec \"['decorator_nodes']['tree']\")\" = 2 ]"
+code=$(bget $S "/v1/bakes/$ID_DEC/result" "$T/r_dec.glb")
+check "... its result: the bytes of obscura bake --decorators, not those without" \
+    "[ $code = 200 ] && cmp -s $T/r_dec.glb $T/local_dec.glb && ! cmp -s $T/r_dec.glb $T/local.glb"
+code=$(mpost "$T/p_lvl" -F "level=@$FIX")
+ID_LVL=$(id_of "$T/p_lvl")
+check "a multipart body with the level alone: the bytes of the plain POST" \
+    "[ $code = 202 ] && wait_state $S $ID_LVL done && [ \"\$(bget $S /v1/bakes/$ID_LVL/result $T/r_lvl.glb)\" = 200 ] && cmp -s $T/r_lvl.glb $T/local.glb"
+printf 'not json' >"$T/notjson.json"
+printf '{"decorators": [{"name": "OBJ1479", "class": "cactus"}]}' >"$T/badclass.json"
+code=$(mpost "$T/e1" -F "level=@$FIX" -F "decorators=@$T/notjson.json")
+check "decorators that are not JSON: 400 bad_decorators, before any job" \
+    "[ $code = 400 ] && grep -q bad_decorators $T/e1 && grep -q 'not JSON' $T/e1"
+code=$(mpost "$T/e2" -F "level=@$FIX" -F "decorators=@$T/badclass.json")
+check "a rule of an unknown class: 400 naming the entry and the class" \
+    "[ $code = 400 ] && grep -q \"decorators\\[0\\]\" $T/e2 && grep -q \"unknown class 'cactus'\" $T/e2"
+code=$(mpost "$T/e3" -F "level=@$FIX" -F "trees=@$TREES")
+check "an unknown part: 400 bad_multipart naming it" \
+    "[ $code = 400 ] && grep -q bad_multipart $T/e3 && grep -q \"unknown part 'trees'\" $T/e3"
+code=$(mpost "$T/e4" -F "decorators=@$TREES")
+check "no part level: 400 saying so" "[ $code = 400 ] && grep -q \"without a part 'level'\" $T/e4"
 code=$(bget $S "/v1/bakes" "$T/list")
 check "GET /v1/bakes lists it" "[ $code = 200 ] && grep -q '\"id\":\"$ID\",\"state\":\"done\"' $T/list"
 code=$(bget $S "/v1/bakes/$ID/events" "$T/ev1")

@@ -48,7 +48,7 @@ static void test_simplify_plane(void **state)
     bt_grid(&soup, "soup", O, U, V, 16, 16);
     explode(&soup);
     m.material = soup.material = 3;
-    assert_int_equal(obs__bake_simplify(&m, 1, 0.5f, 0.01f, 1e-5f, 120.0f, &l1, err), OBS_OK);
+    assert_int_equal(obs__bake_simplify(&m, 1, 0.5f, 0.01f, 0, 1e-5f, 120.0f, &l1, err), OBS_OK);
     assert_string_equal(l1.name, "plane_LOD1");
     assert_int_equal(l1.material, 3);
     assert_true(l1.triangle_count > 0 && l1.triangle_count < m.triangle_count);
@@ -63,12 +63,13 @@ static void test_simplify_plane(void **state)
     }
     for (size_t i = 0; i < 3 * l1.triangle_count; i++)
         assert_true(l1.indices[i] < l1.vertex_count);
-    assert_int_equal(obs__bake_simplify(&m, 2, 0.01f, 0.01f, 1e-5f, 120.0f, &l2, err), OBS_OK);
+    assert_int_equal(obs__bake_simplify(&m, 2, 0.01f, 0.01f, 0, 1e-5f, 120.0f, &l2, err), OBS_OK);
     print_message("plane of %zu triangles: LOD1 %zu, ratio 0.01 -> %zu\n", m.triangle_count,
                   l1.triangle_count, l2.triangle_count);
     assert_int_equal(l2.triangle_count, 2);
     assert_int_equal(l2.vertex_count, 4);
-    assert_int_equal(obs__bake_simplify(&soup, 2, 0.01f, 0.01f, 1e-5f, 120.0f, &ls, err), OBS_OK);
+    assert_int_equal(obs__bake_simplify(&soup, 2, 0.01f, 0.01f, 0, 1e-5f, 120.0f, &ls, err),
+                     OBS_OK);
     assert_int_equal(ls.triangle_count, 2);
     obs__bake_mesh_free(&l1);
     obs__bake_mesh_free(&l2);
@@ -91,8 +92,10 @@ static void test_simplify_error_bound(void **state)
         float *p = m.positions + 3 * k;
         p[1] = 0.4f * sinf(1.7f * p[0]) * cosf(1.3f * p[2]);
     }
-    assert_int_equal(obs__bake_simplify(&m, 1, 0.25f, 0.0f, 1e-5f, 180.0f, &tight, err), OBS_OK);
-    assert_int_equal(obs__bake_simplify(&m, 1, 0.25f, 0.5f, 1e-5f, 180.0f, &loose, err), OBS_OK);
+    assert_int_equal(obs__bake_simplify(&m, 1, 0.25f, 0.0f, 0, 1e-5f, 180.0f, &tight, err),
+                     OBS_OK);
+    assert_int_equal(obs__bake_simplify(&m, 1, 0.25f, 0.5f, 0, 1e-5f, 180.0f, &loose, err),
+                     OBS_OK);
     print_message("bumps of %zu triangles, ratio 0.25: error 0 -> %zu, error 0.5 -> %zu\n",
                   m.triangle_count, tight.triangle_count, loose.triangle_count);
     assert_true(loose.triangle_count > 0);
@@ -101,6 +104,73 @@ static void test_simplify_error_bound(void **state)
     obs__bake_mesh_free(&tight);
     obs__bake_mesh_free(&loose);
     obs__bake_mesh_free(&m);
+}
+
+/* The vertices of mesh m with x == at (the shared edge below), as
+ * their z, sorted; returns the count. */
+static size_t edge_z(const obs_bake_mesh *m, float at, float *z)
+{
+    size_t n = 0;
+    for (size_t v = 0; v < m->vertex_count; v++)
+        if (m->positions[3 * v] == at) {
+            size_t k = n++;
+            while (k > 0 && z[k - 1] > m->positions[3 * v + 2]) {
+                z[k] = z[k - 1];
+                k--;
+            }
+            z[k] = m->positions[3 * v + 2];
+        }
+    return n;
+}
+
+/* Two bumpy tiles meeting along x = 4 (17 shared vertices; 16 x 16 and
+ * 8 x 16 quads, so their interiors simplify differently), each
+ * simplified alone as the bake does.  Border locked (lod_lock_border 1,
+ * the default): each level keeps all 17 edge vertices, the two sides
+ * meet vertex for vertex.  Unlocked: the tiles drop edge vertices, and
+ * not the same ones, so the level has T-junctions (cracks) there; the
+ * locked level keeps more triangles. */
+static void test_simplify_lock_border(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+    const float oa[3] = {0, 0, 0}, ob[3] = {4, 0, 0}, u[3] = {4, 0, 0}, v[3] = {0, 0, 4};
+    obs_bake_mesh t[2], lk[2], fr[2];
+    bt_grid(&t[0], "tile_a", oa, u, v, 16, 16);
+    bt_grid(&t[1], "tile_b", ob, u, v, 8, 16);
+    for (int i = 0; i < 2; i++)
+        for (size_t k = 0; k < t[i].vertex_count; k++) {
+            float *p = t[i].positions + 3 * k;
+            p[1] = 0.3f * sinf(1.7f * p[0]) * cosf(1.3f * p[2]);
+        }
+    float za[64], zb[64];
+    assert_int_equal(edge_z(&t[0], 4.0f, za), 17);
+    assert_int_equal(edge_z(&t[1], 4.0f, zb), 17);
+    for (int i = 0; i < 2; i++) {
+        assert_int_equal(obs__bake_simplify(&t[i], 1, 0.05f, 0.5f, 1, 1e-5f, 180.0f, &lk[i], err),
+                         OBS_OK);
+        assert_int_equal(obs__bake_simplify(&t[i], 1, 0.05f, 0.5f, 0, 1e-5f, 180.0f, &fr[i], err),
+                         OBS_OK);
+        assert_true(lk[i].triangle_count < t[i].triangle_count);
+        assert_true(fr[i].triangle_count < lk[i].triangle_count);
+    }
+    size_t la = edge_z(&lk[0], 4.0f, za), lb = edge_z(&lk[1], 4.0f, zb);
+    assert_int_equal(la, 17);
+    assert_int_equal(lb, 17);
+    assert_memory_equal(za, zb, 17 * sizeof(float));
+    size_t fa = edge_z(&fr[0], 4.0f, za), fb = edge_z(&fr[1], 4.0f, zb);
+    print_message("tiles of %zu + %zu triangles, ratio 0.05: locked %zu + %zu (edge vertices "
+                  "%zu / %zu), free %zu + %zu (edge vertices %zu / %zu)\n",
+                  t[0].triangle_count, t[1].triangle_count, lk[0].triangle_count,
+                  lk[1].triangle_count, la, lb, fr[0].triangle_count, fr[1].triangle_count, fa,
+                  fb);
+    assert_true(fa < 17 || fb < 17);
+    assert_true(fa != fb || memcmp(za, zb, fa * sizeof(float)) != 0);
+    for (int i = 0; i < 2; i++) {
+        obs__bake_mesh_free(&lk[i]);
+        obs__bake_mesh_free(&fr[i]);
+        obs__bake_mesh_free(&t[i]);
+    }
 }
 
 /* The nearest point of a triangle: inside the face, beyond a corner,
@@ -217,7 +287,7 @@ static void lod_scene(const obs_bake_scene *sc, obs_bake_mesh *lm, int l, float 
 {
     char err[OBS_ERR_LEN] = "";
     for (size_t m = 0; m < sc->mesh_count; m++)
-        assert_int_equal(obs__bake_simplify(&sc->meshes[m], l, ratio, error, 1e-5f, 120.0f,
+        assert_int_equal(obs__bake_simplify(&sc->meshes[m], l, ratio, error, 0, 1e-5f, 120.0f,
                                             &lm[m], err),
                          OBS_OK);
     *out = *sc;
@@ -511,10 +581,10 @@ static void test_bad_params(void **state)
     }
     obs_bake_mesh m, out;
     bt_grid(&m, "plane", O, U, V, 2, 2);
-    assert_int_equal(obs__bake_simplify(&m, 0, 0.5f, 0.01f, 1e-5f, 120.0f, &out, err),
+    assert_int_equal(obs__bake_simplify(&m, 0, 0.5f, 0.01f, 0, 1e-5f, 120.0f, &out, err),
                      OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "level 0"));
-    assert_int_equal(obs__bake_simplify(&m, 1, 1.5f, 0.01f, 1e-5f, 120.0f, &out, err),
+    assert_int_equal(obs__bake_simplify(&m, 1, 1.5f, 0.01f, 0, 1e-5f, 120.0f, &out, err),
                      OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "ratio 1.5"));
     obs__bake_mesh_free(&m);
@@ -525,6 +595,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_simplify_plane),
         cmocka_unit_test(test_simplify_error_bound),
+        cmocka_unit_test(test_simplify_lock_border),
         cmocka_unit_test(test_closest_tri),
         cmocka_unit_test(test_closest_bvh),
         cmocka_unit_test(test_resample_plane),

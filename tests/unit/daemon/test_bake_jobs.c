@@ -59,10 +59,10 @@ static void test_done_failed_unknown(void **state)
     assert_non_null(b);
     char id[OBSD_BAKE_ID_LEN + 1], bad[OBSD_BAKE_ID_LEN + 1];
     obs_bake_params p = rays("8");
-    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", &p, id), 0);
+    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", NULL, 0, &p, id), 0);
     assert_int_equal(strlen(id), 16);
     static const char lines[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n";
-    assert_int_equal(obsd_bakes_submit(b, copy(lines), strlen(lines), "obj", &p, bad), 0);
+    assert_int_equal(obsd_bakes_submit(b, copy(lines), strlen(lines), "obj", NULL, 0, &p, bad), 0);
     assert_string_not_equal(id, bad);
     assert_int_equal(wait_end(b, id), OBSD_BAKE_DONE);
     unsigned char *glb = NULL;
@@ -74,6 +74,20 @@ static void test_done_failed_unknown(void **state)
     char *j = obsd_bakes_json(b, id);
     assert_non_null(strstr(j, "\"triangles\":3"));
     assert_non_null(strstr(j, "\"max_triangles\":1000")); /* the store's cap */
+    free(j);
+    /* a decorators file goes to the bake: its rule matches no node of
+     * the quad, which the job's JSON says, with the rule count */
+    char dec[OBSD_BAKE_ID_LEN + 1];
+    char *rules = strdup("{\"decorators\": [{\"name\": \"no_such_node\", \"class\": \"tree\"}]}");
+    assert_non_null(rules);
+    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", rules, 1, &p, dec), 0);
+    assert_int_equal(wait_end(b, dec), OBSD_BAKE_DONE);
+    j = obsd_bakes_json(b, dec);
+    assert_non_null(strstr(j, "\"decorator_rules\":1"));
+    assert_non_null(strstr(j, "no_such_node"));
+    free(j);
+    j = obsd_bakes_json(b, id); /* a job without a file has no rule count */
+    assert_null(strstr(j, "decorator_rules"));
     free(j);
     assert_int_equal(wait_end(b, bad), OBSD_BAKE_FAILED);
     j = obsd_bakes_json(b, bad);
@@ -106,9 +120,12 @@ static void test_limits_cancel_keep(void **state)
     obs_bake_params slow = rays("16384"), fast = rays("4");
     assert_int_equal(obs_bake_param_set(&slow, "samples_per_face", "4096", err), OBS_OK);
     assert_int_equal(obs_bake_param_set(&slow, "max_samples_per_face", "4096", err), OBS_OK);
-    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", &slow, a), 0);
-    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", &fast, c), 0);
-    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", &fast, d), -1);
+    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", NULL, 0, &slow, a), 0);
+    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", NULL, 0, &fast, c), 0);
+    /* refused (the store is full): the level and the decorators freed */
+    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj",
+                                       strdup("{\"decorators\": []}"), 0, &fast, d),
+                     -1);
     /* the second waits behind the first: cancelled at once */
     obsd_bake_state st;
     int removed;
@@ -130,7 +147,7 @@ static void test_limits_cancel_keep(void **state)
     assert_int_equal(obsd_bakes_next_event(b, &sub, ev, sizeof ev), -1);
     obsd_bakes_unsubscribe(b, &sub);
     /* keep 2: a third finished job drops the oldest finished (a) */
-    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", &fast, d), 0);
+    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", NULL, 0, &fast, d), 0);
     assert_int_equal(wait_end(b, d), OBSD_BAKE_DONE);
     assert_null(obsd_bakes_json(b, a));
     char *j = obsd_bakes_json(b, c);
@@ -142,7 +159,7 @@ static void test_limits_cancel_keep(void **state)
     assert_int_equal(counts[OBSD_BAKE_CANCELLED], 1);
     /* after the drain's cancel, nothing is taken */
     obsd_bakes_cancel_all(b);
-    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", &fast, d), -2);
+    assert_int_equal(obsd_bakes_submit(b, copy(quad), strlen(quad), "obj", NULL, 0, &fast, d), -2);
     obsd_bakes_free(b);
 }
 
