@@ -106,6 +106,15 @@ check "a rule of an unknown class: 400 naming the entry and the class" \
 code=$(mpost "$T/e3" -F "level=@$FIX" -F "trees=@$TREES")
 check "an unknown part: 400 bad_multipart naming it" \
     "[ $code = 400 ] && grep -q bad_multipart $T/e3 && grep -q \"unknown part 'trees'\" $T/e3"
+# a multipart body cut before its closing boundary (the level part unfinished)
+python3 -c "
+import sys
+lvl = open('$FIX', 'rb').read()
+b = b'--XyZ\\r\\nContent-Disposition: form-data; name=\\\"level\\\"; filename=\\\"a.acc\\\"\\r\\n\\r\\n' + lvl[:4000]
+open('$T/cut.mp', 'wb').write(b)"
+code=$($CURL -o "$T/e5" -w '%{http_code}' -H "$AUTH" -H 'Content-Type: multipart/form-data; boundary=XyZ' \
+    --data-binary @"$T/cut.mp" "http://127.0.0.1:$S/v1/bakes?rays=16")
+check "a multipart body cut short: 400 bad_multipart" "[ $code = 400 ] && grep -q bad_multipart $T/e5"
 code=$(mpost "$T/e4" -F "decorators=@$TREES")
 check "no part level: 400 saying so" "[ $code = 400 ] && grep -q \"without a part 'level'\" $T/e4"
 code=$(bget $S "/v1/bakes" "$T/list")
