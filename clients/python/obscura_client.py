@@ -22,6 +22,17 @@ an ObscuraError whose .code is the daemon's JSON error code
 ("bad_parameter", "missing_channel", "no_camera", "queue_full", ...);
 an unreachable daemon raises ObscuraError with code "unreachable".
 
+Level bakes (obscura bake on the daemon, POST /v1/bakes, HTTP only):
+
+    oc.bake("level.glb", out="baked.glb", rays=64, distances=(2, 300))
+    oc.bake("aalborg.acc", decorators="trees.json", out="baked.glb",
+            progress=lambda done, stage: print(done, stage))
+
+submit the level (and a decorators file, as multipart/form-data), wait for
+the job while it reports its progress, and fetch the baked .glb; a job that
+fails raises ObscuraError with the bake's status ("bad_file", "too_large",
+...) as .code.
+
 Works with Python 3.6 and later.
 """
 import http.client
@@ -31,8 +42,8 @@ import socket
 import struct
 import urllib.parse
 
-__all__ = ["ao", "ObscuraError", "DEFAULT_SERVER"]
-__version__ = "1.0.0"
+__all__ = ["ao", "bake", "ObscuraError", "DEFAULT_SERVER"]
+__version__ = "1.1.0"
 
 DEFAULT_SERVER = "http://127.0.0.1:8420"
 CHUNK = 1 << 16
@@ -85,7 +96,7 @@ class _Source(object):
     """The EXR to send: a path (streamed), bytes, or a readable file
     object with a known size."""
 
-    def __init__(self, source):
+    def __init__(self, source, what="ao(): the EXR"):
         self.f = None
         self.data = None
         if isinstance(source, (bytes, bytearray, memoryview)):
@@ -101,9 +112,9 @@ class _Source(object):
             self.size = source.tell() - pos
             source.seek(pos)
         else:
-            raise TypeError("ao(): the source is a path, bytes or a binary file object, not %r" % type(source))
+            raise TypeError("%s is a path, bytes or a binary file object, not %r" % (what, type(source)))
         if self.size == 0:
-            raise ValueError("ao(): the EXR is empty")
+            raise ValueError("%s is empty" % what)
 
     def chunks(self):
         if self.data is not None:
@@ -318,4 +329,125 @@ def ao(source, server=None, out=None, token=None, timeout=300, **params):
         raise
     finally:
         src.close(opened_here)
+    return sink.done()
+
+
+# ---- bake jobs (POST /v1/bakes, protocol/HTTP.md "Bake jobs") ----------
+
+def _request(server, method, path, token, timeout, body=None, headers=None, sink=None):
+    """One HTTP request; the status and the body (or None into sink).
+    body: None, bytes, or a list of bytes and _Source pieces sent in turn."""
+    u = urllib.parse.urlsplit(server)
+    conn = http.client.HTTPConnection(u.hostname or "127.0.0.1", u.port or 80, timeout=timeout)
+    try:
+        pieces = [] if body is None else body if isinstance(body, list) else [body]
+        size = sum(len(b) if isinstance(b, bytes) else b.size for b in pieces)
+        try:
+            conn.putrequest(method, (u.path.rstrip("/") or "") + path)
+            for k, v in (headers or {}).items():
+                conn.putheader(k, v)
+            if body is not None:
+                conn.putheader("Content-Length", str(size))
+            if token:
+                conn.putheader("Authorization", "Bearer " + token)
+            conn.endheaders()
+        except OSError as e:
+            raise ObscuraError(None, "unreachable", "%s: %s" % (server, e))
+        try:
+            for b in pieces:
+                for c in ([b] if isinstance(b, bytes) else b.chunks()):
+                    conn.send(c)
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # refused before the body was read: the answer says why
+        try:
+            resp = conn.getresponse()
+        except (OSError, http.client.HTTPException) as e:
+            raise ObscuraError(None, "unreachable", "%s: no answer: %s" % (server, e))
+        if resp.status >= 300:
+            code, msg = _http_error(resp.status, resp.read())
+            retry = resp.getheader("Retry-After")
+            raise ObscuraError(resp.status, code, msg, int(retry) if retry and retry.isdigit() else 0)
+        if sink is None:
+            return resp.status, resp.read()
+        while True:
+            b = resp.read(CHUNK)
+            if not b:
+                break
+            sink.write(b)
+        return resp.status, None
+    except socket.timeout:
+        raise ObscuraError(None, "unreachable", "%s: no answer within %s s" % (server, timeout))
+    finally:
+        conn.close()
+
+
+def _multipart(level, decorators):
+    """The body parts of a multipart/form-data POST: level and decorators."""
+    boundary = "obscura-" + os.urandom(12).hex()
+
+    def head(name):
+        return ("--%s\r\nContent-Disposition: form-data; name=\"%s\"; filename=\"%s\"\r\n"
+                "Content-Type: application/octet-stream\r\n\r\n" % (boundary, name, name)).encode()
+    body = [head("level"), level, b"\r\n", head("decorators"), decorators,
+            ("\r\n--%s--\r\n" % boundary).encode()]
+    return body, "multipart/form-data; boundary=" + boundary
+
+
+def bake(level, server=None, out=None, token=None, decorators=None, timeout=60,
+         poll=0.5, progress=None, **params):
+    """A level baked by obscurad (POST /v1/bakes): per-vertex ambient
+    obscurance into a .glb.
+
+    level: a path (streamed), bytes, or a binary file object; its format
+    is told from its first bytes unless format="EXT" says it.
+    decorators: a decorators file (path, bytes or file object), as
+    obscura bake --decorators takes it; sent beside the level.
+    server: http://HOST:PORT (default OBSCURA_SERVER, else
+    http://127.0.0.1:8420); token: the bearer token (default OBSCURA_TOKEN).
+    out: a path or binary file object for the .glb (then None is
+    returned); timeout: seconds for each request, not for the bake;
+    poll: seconds between looks at the job; progress(done, stage): called
+    on each look, done the share of samples traced.
+    params: the bake parameters (obscura bake --params), distances=(S, L).
+    Returns the .glb's bytes.  Raises ObscuraError: the daemon's refusal,
+    or the job's failure (.code its status, e.g. "bad_file")."""
+    import time
+    server = server or os.environ.get("OBSCURA_SERVER") or DEFAULT_SERVER
+    token = token if token is not None else os.environ.get("OBSCURA_TOKEN")
+    if not server.startswith("http://"):
+        raise ValueError("bake(): bake jobs are HTTP routes: server %r is not http://HOST:PORT" % server)
+    opened = [x for x in (level, decorators) if isinstance(x, (str, os.PathLike))]
+    src = _Source(level, "bake(): the level")
+    dec = _Source(decorators, "bake(): the decorators file") if decorators is not None else None
+    query = "/v1/bakes?" + urllib.parse.urlencode(_params(params, None))
+    try:
+        if dec is None:
+            body, ctype = [src], "application/octet-stream"
+        else:
+            body, ctype = _multipart(src, dec)
+        _, answer = _request(server, "POST", query, token, timeout, body, {"Content-Type": ctype})
+    finally:
+        src.close(level in opened)
+        if dec is not None:
+            dec.close(decorators in opened)
+    job = json.loads(answer.decode("utf-8"))
+    jid = job["id"]
+    while True:
+        _, answer = _request(server, "GET", "/v1/bakes/" + jid, token, timeout)
+        job = json.loads(answer.decode("utf-8"))
+        if progress is not None:
+            progress(job.get("progress", 0), job.get("stage", ""))
+        if job["state"] == "done":
+            break
+        if job["state"] in ("failed", "cancelled"):
+            e = job.get("error", {})
+            raise ObscuraError(None, str(e.get("status", job["state"])).lower(),
+                               e.get("message", "the bake job ended " + job["state"]))
+        time.sleep(poll)
+    sink = _Sink(out)
+    try:
+        _request(server, "GET", "/v1/bakes/%s/result" % jid, token, timeout, sink=sink)
+    except BaseException:
+        sink.fail()
+        raise
     return sink.done()
