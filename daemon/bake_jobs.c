@@ -241,6 +241,14 @@ static void run_job(obsd_bakes *b, job *j)
         obs_bake_params_resolve(&j->params, &p);
         s = obs_bake_load(path, (size_t)p.max_triangles, &sc, err);
         loaded = s == OBS_OK;
+        /* the loader names its file: the daemon's temporary copy means
+         * nothing to the client, the level does */
+        size_t n = strlen(path);
+        if (s != OBS_OK && !strncmp(err, path, n)) {
+            char rest[OBS_ERR_LEN];
+            snprintf(rest, sizeof rest, "%s", err + n);
+            snprintf(err, sizeof err, "the level (%.15s)%.*s", j->ext, (int)sizeof err - 32, rest);
+        }
     }
     unlink(path);
     pthread_mutex_lock(&b->lock);

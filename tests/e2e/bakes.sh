@@ -129,8 +129,8 @@ ID2=$(id_of "$T/p2")
 check "a level without triangles: 202 (told from the bytes: obj), then failed" \
     "[ $code = 202 ] && [ \"\$(field $T/p2 \"['format']\")\" = obj ] && wait_state $S $ID2 failed"
 bget $S "/v1/bakes/$ID2" "$T/j2" >/dev/null
-check "its error: BAD_FILE, 'no triangles'" \
-    "[ \"\$(field $T/j2 \"['error']['status']\")\" = BAD_FILE ] && field $T/j2 \"['error']['message']\" | grep -q 'no triangles'"
+check "its error: BAD_FILE, 'no triangles', naming the level, not the daemon's temporary file" \
+    "[ \"\$(field $T/j2 \"['error']['status']\")\" = BAD_FILE ] && field $T/j2 \"['error']['message']\" | grep -q '^the level (obj): no triangles' && ! field $T/j2 \"['error']['message']\" | grep -q obscurad-bake"
 code=$(bget $S "/v1/bakes/$ID2/result" "$T/r2")
 check "its result: 409 bake_failed" "[ $code = 409 ] && error_is $T/r2 bake_failed"
 
