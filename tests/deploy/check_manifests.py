@@ -233,57 +233,83 @@ def check_bake_job(fname, cmd, prefix, suffix, ext):
 check_bake_job("bake-job.yaml", "bake", "obscura-bake", "_baked.glb", ".glb")
 check_bake_job("bake-dynamic-job.yaml", "bake-dynamic", "obscura-bake-dynamic", "_dynamic.json", ".json")
 
-try:
-    t = yaml.safe_load(open(os.path.join(farm, "openjd_bake.yaml")))
-    steps = {s["name"]: s for s in t["steps"]}
-    params = {p["name"]: p.get("default") for p in t["parameterDefinitions"]}
-    used = {w.split("}}")[0] for w in (yaml.safe_dump(t).split("{{Param.")[1:])}
-    check("OpenJD bake: a Shards step over 1-{{Param.Shards}}, a Merge step that depends on it",
-          get(steps, "Shards", "parameterSpace", "taskParameterDefinitions", 0, "range") == "1-{{Param.Shards}}" and
-          get(steps, "Merge", "dependencies", 0, "dependsOn") == "Shards")
-    check("OpenJD bake: every {{Param.X}} used is defined (" + ", ".join(sorted(used)) + ")", used <= set(params))
-    if obscura and level:
-        tmp = tempfile.mkdtemp(prefix="obs_openjd_")
-        n = 3
-        vals = dict(params, Level=level, Output=os.path.join(tmp, "out.glb"), PartsDir=os.path.join(tmp, "parts"),
-                    Shards=n, Rays=RAYS)
-
-        def fill(s, task=None):
-            s = re.sub(r"\{\{Param\.(\w+)\}\}", lambda m: str(vals[m.group(1)]), s)
-            s = s.replace("{{Task.Param.ShardNumber}}", str(task))
-            return s.replace("exec obscura ", f"exec {obscura} ")
+def check_openjd(fname, cmd, ext):
+    """farm/FNAME, an OpenJD template of `obscura CMD` over shards: its
+    steps and parameters; with OBSCURA and the level, its scripts run
+    here, merged = unsharded (the output's extension EXT)."""
+    tag = f"OpenJD {cmd}"
+    try:
+        t = yaml.safe_load(open(os.path.join(farm, fname)))
+        steps = {s["name"]: s for s in t["steps"]}
+        params = {p["name"]: p.get("default") for p in t["parameterDefinitions"]}
+        used = {w.split("}}")[0] for w in (yaml.safe_dump(t).split("{{Param.")[1:])}
+        check(f"{tag}: a Shards step over 1-{{{{Param.Shards}}}}, a Merge step that depends on it",
+              get(steps, "Shards", "parameterSpace", "taskParameterDefinitions", 0, "range") ==
+              "1-{{Param.Shards}}" and get(steps, "Merge", "dependencies", 0, "dependsOn") == "Shards")
+        check(f"{tag}: every {{{{Param.X}}}} used is defined (" + ", ".join(sorted(used)) + ")",
+              used <= set(params))
         sdata = steps["Shards"]["script"]["embeddedFiles"][0]["data"]
         mdata = steps["Merge"]["script"]["embeddedFiles"][0]["data"]
-        ok = all(run_sh(fill(sdata, k), {}, tmp) for k in range(1, n + 1)) and run_sh(fill(mdata), {}, tmp)
-        check(f"OpenJD bake: its scripts run here ({n} shards, {RAYS} rays), merged = unsharded",
-              ok and open(vals["Output"], "rb").read() == unsharded(tmp))
-        shutil.rmtree(tmp)
-except (yaml.YAMLError, KeyError, IndexError, TypeError, OSError) as e:
-    check(f"OpenJD bake: openjd_bake.yaml ({e})", False)
+        check(f"{tag}: the shards run obscura {cmd} --shard, the merge --merge",
+              f"exec obscura {cmd} " in sdata and "--shard" in sdata and
+              f"exec obscura {cmd} " in mdata and "--merge" in mdata)
+        if obscura and level:
+            tmp = tempfile.mkdtemp(prefix="obs_openjd_")
+            n = 3
+            vals = dict(params, Level=level, Output=os.path.join(tmp, "out" + ext),
+                        PartsDir=os.path.join(tmp, "parts"), Shards=n, Rays=RAYS)
 
-try:
-    spec = ET.parse(os.path.join(farm, "opencue_bake.xml")).getroot()
-    layers = {l.get("name"): l for l in spec.findall("./job/layers/layer")}
-    dep = spec.find("./depends/depend")
-    check("OpenCue bake: layers shards and merge, merge LAYER_ON_LAYER on shards",
-          set(layers) == {"shards", "merge"} and dep is not None and dep.get("type") == "LAYER_ON_LAYER" and
-          dep.find("deplayer").text == "merge" and dep.find("onlayer").text == "shards")
-    scmd, mcmd = layers["shards"].find("cmd").text, layers["merge"].find("cmd").text
-    rng = layers["shards"].find("range").text
-    n = int(rng.split("-")[1])
-    check(f"OpenCue bake: frames 1-{n} are shards 0..{n - 1} of {n}",
-          rng == f"1-{n}" and f"--shard $((#IFRAME# - 1))/{n}" in scmd and "--merge" in mcmd)
-    if obscura and level:
-        tmp = tempfile.mkdtemp(prefix="obs_opencue_")
-        fix = lambda s: (s.replace("/show/levels/level.glb", level).replace("/show/levels", tmp)
-                         .replace("exec obscura ", f"exec {obscura} ").replace("--rays 256", "--rays " + RAYS))
-        ok = all(run_sh(fix(scmd.replace("#IFRAME#", str(f))), {}, tmp) for f in range(1, n + 1))
-        ok = ok and run_sh(fix(mcmd), {}, tmp)
-        check(f"OpenCue bake: its commands run here ({n} shards, {RAYS} rays), merged = unsharded",
-              ok and open(os.path.join(tmp, "level_baked.glb"), "rb").read() == unsharded(tmp))
-        shutil.rmtree(tmp)
-except (ET.ParseError, AttributeError, KeyError, ValueError, OSError) as e:
-    check(f"OpenCue bake: opencue_bake.xml ({e})", False)
+            def fill(s, task=None):
+                s = re.sub(r"\{\{Param\.(\w+)\}\}", lambda m: str(vals[m.group(1)]), s)
+                s = s.replace("{{Task.Param.ShardNumber}}", str(task))
+                return s.replace("exec obscura ", f"exec {obscura} ")
+            ok = all(run_sh(fill(sdata, k), {}, tmp) for k in range(1, n + 1)) and run_sh(fill(mdata), {}, tmp)
+            check(f"{tag}: its scripts run here ({n} shards, {RAYS} rays), merged = unsharded",
+                  ok and open(vals["Output"], "rb").read() == unsharded(tmp, cmd, ext))
+            shutil.rmtree(tmp)
+    except (yaml.YAMLError, KeyError, IndexError, TypeError, OSError) as e:
+        check(f"{tag}: {fname} ({e})", False)
+
+
+def check_opencue(fname, cmd, rays, out):
+    """farm/FNAME, an OpenCue job of `obscura CMD` over shards (its rays
+    flag RAYS, its merge writing /show/levels/OUT): layers, dependency,
+    frame range; with OBSCURA and the level, its commands run here,
+    merged = unsharded."""
+    tag = f"OpenCue {cmd}"
+    try:
+        spec = ET.parse(os.path.join(farm, fname)).getroot()
+        layers = {l.get("name"): l for l in spec.findall("./job/layers/layer")}
+        dep = spec.find("./depends/depend")
+        job = spec.find("./job").get("name")
+        check(f"{tag}: layers shards and merge, merge LAYER_ON_LAYER on shards of the same job",
+              set(layers) == {"shards", "merge"} and dep is not None and dep.get("type") == "LAYER_ON_LAYER" and
+              dep.find("deplayer").text == "merge" and dep.find("onlayer").text == "shards" and
+              dep.find("depjob").text == job == dep.find("onjob").text)
+        scmd, mcmd = layers["shards"].find("cmd").text, layers["merge"].find("cmd").text
+        rng = layers["shards"].find("range").text
+        n = int(rng.split("-")[1])
+        check(f"{tag}: frames 1-{n} are shards 0..{n - 1} of {n}",
+              rng == f"1-{n}" and f"exec obscura {cmd} " in scmd and f"--shard $((#IFRAME# - 1))/{n}" in scmd and
+              f"exec obscura {cmd} " in mcmd and "--merge" in mcmd)
+        if obscura and level:
+            tmp = tempfile.mkdtemp(prefix="obs_opencue_")
+            fix = lambda s: (s.replace("/show/levels/level.glb", level).replace("/show/levels", tmp)
+                             .replace("exec obscura ", f"exec {obscura} ").replace(rays, "--rays " + RAYS))
+            ok = all(run_sh(fix(scmd.replace("#IFRAME#", str(f))), {}, tmp) for f in range(1, n + 1))
+            ok = ok and run_sh(fix(mcmd), {}, tmp)
+            ext = os.path.splitext(out)[1]
+            check(f"{tag}: its commands run here ({n} shards, {RAYS} rays), merged = unsharded",
+                  ok and open(os.path.join(tmp, out), "rb").read() == unsharded(tmp, cmd, ext))
+            shutil.rmtree(tmp)
+    except (ET.ParseError, AttributeError, KeyError, ValueError, OSError) as e:
+        check(f"{tag}: {fname} ({e})", False)
+
+
+check_openjd("openjd_bake.yaml", "bake", ".glb")
+check_openjd("openjd_bake_dynamic.yaml", "bake-dynamic", ".json")
+check_opencue("opencue_bake.xml", "bake", "--rays 256", "level_baked.glb")
+check_opencue("opencue_bake_dynamic.xml", "bake-dynamic", "--rays 1024", "level_dynamic.json")
 
 print(f"manifests: {passed} passed, {failed} failed")
 sys.exit(1 if failed else 0)
