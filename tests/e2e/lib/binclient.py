@@ -259,16 +259,20 @@ def conns(target, n, srcs=None):
             socks.append(connect(target, src=srcs[i % len(srcs)]))
         except OSError:
             socks.append(None)
-    time.sleep(1.0)
-    # every socket waits in one window of 3 s: the ones with nothing to
-    # read by its end are open (not one socket after another, which made
-    # 256 open connections wait 0.05 s each after the window)
+    time.sleep(0.5)
+    # every socket waits in one window: the ones with nothing to read by
+    # its end are open.  Refusals are sent as the connections are
+    # accepted, so once one came the window ends when 1 s passes without
+    # another (at most 3 s, all of it when none came); not one socket after
+    # another (which made 256 open connections wait 0.05 s each)
     counts = {}
     t_end = time.time() + 3
     waiting = [s for s in socks if s is not None]
     readable = set()
     while waiting and time.time() < t_end:
-        r, _, _ = select.select(waiting, [], [], max(0.0, t_end - time.time()))
+        r, _, _ = select.select(waiting, [], [], max(0.0, min(1.0, t_end - time.time())))
+        if not r and readable:
+            break  # quiet for 1 s after an answer
         readable.update(r)
         waiting = [s for s in waiting if s not in readable]
     for s in socks:
