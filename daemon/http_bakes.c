@@ -12,7 +12,8 @@
  * from its first bytes).  The body is the level itself, or a
  * multipart/form-data body (curl -F) with a part `level` and a part
  * `decorators`, a decorators file (obscura bake --decorators), checked
- * before the job is queued; libmicrohttpd's post processor splits it.
+ * before the job is queued; libmicrohttpd's post processor copies the
+ * parts out as the body arrives.
  * An event stream is a suspended connection, as the streams' are
  * (http_streams.c). */
 #include <errno.h>
@@ -127,6 +128,78 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
     return MHD_YES;
 }
 
+/* ---- a multipart/form-data body: the parts `level` and `decorators` ---- */
+
+typedef struct obsd__parts {
+    unsigned char *buf[2]; /* level, decorators */
+    size_t len[2], cap[2];
+    size_t max;
+    int seen[2];
+    size_t discarded; /* bytes read past an error */
+    int too_large;    /* the error is a part over the limit: 413 */
+    char err[200];
+} parts;
+
+static const char *const part_name[2] = {"level", "decorators"};
+
+static enum MHD_Result on_part(void *cls, enum MHD_ValueKind kind, const char *key,
+                               const char *filename, const char *content_type,
+                               const char *transfer_encoding, const char *data, uint64_t off,
+                               size_t size)
+{
+    parts *pt = cls;
+    (void)kind;
+    (void)filename;
+    (void)content_type;
+    (void)transfer_encoding;
+    (void)off;
+    int k = !key ? -1 : !strcmp(key, "level") ? 0 : !strcmp(key, "decorators") ? 1 : -1;
+    if (k < 0) {
+        snprintf(pt->err, sizeof pt->err, "unknown part '%.40s' (the parts are level and decorators)",
+                 key ? key : "");
+        return MHD_NO;
+    }
+    pt->seen[k] = 1;
+    if (size > pt->max - pt->len[k]) {
+        snprintf(pt->err, sizeof pt->err, "part %s is over the limit of %zu bytes (--max-level)",
+                 part_name[k], pt->max);
+        pt->too_large = 1;
+        return MHD_NO;
+    }
+    if (pt->len[k] + size + 1 > pt->cap[k]) { /* + 1: the decorators' NUL */
+        size_t cap = pt->cap[k] ? pt->cap[k] : 1 << 16;
+        while (cap < pt->len[k] + size + 1)
+            cap *= 2;
+        unsigned char *p = realloc(pt->buf[k], cap);
+        if (!p) {
+            snprintf(pt->err, sizeof pt->err, "no memory for part %s", part_name[k]);
+            return MHD_NO;
+        }
+        pt->buf[k] = p;
+        pt->cap[k] = cap;
+    }
+    memcpy(pt->buf[k] + pt->len[k], data, size);
+    pt->len[k] += size;
+    return MHD_YES;
+}
+
+/* The end of a multipart body: 0 with its parts checked, or -1 with
+ * pt->err.  The post processor is destroyed. */
+static int parts_end(req *r, parts *pt)
+{
+    enum MHD_Result done = MHD_destroy_post_processor(r->bake_pp);
+    r->bake_pp = NULL;
+    if (done != MHD_YES && !pt->err[0])
+        snprintf(pt->err, sizeof pt->err, "the multipart/form-data body is cut short or malformed");
+    if (!pt->err[0] && !pt->seen[0])
+        snprintf(pt->err, sizeof pt->err, "a multipart/form-data body without a part 'level'");
+    if (pt->err[0])
+        return -1;
+    if (pt->buf[1])
+        pt->buf[1][pt->len[1]] = '\0';
+    return 0;
+}
+
 static enum MHD_Result post_start(req *r)
 {
     obsd_http *h = r->srv;
@@ -137,7 +210,19 @@ static enum MHD_Result post_start(req *r)
     MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
     if (a.bad)
         return obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL);
+    const char *ct = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
+    int multipart = ct && !strncasecmp(ct, "multipart/form-data", strlen("multipart/form-data"));
     const char *v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (multipart) {
+        /* the parts are copied out as the body comes: nothing is held twice */
+        if (!(r->bake_parts = calloc(1, sizeof *r->bake_parts)))
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the parts");
+        r->bake_parts->max = (size_t)h->cfg->max_level;
+        r->bake_pp = MHD_create_post_processor(r->conn, 1 << 16, on_part, r->bake_parts);
+        if (!r->bake_pp)
+            return obsd__answer_error(r, 400, "bad_multipart",
+                                      "a multipart/form-data body without a boundary", NULL, NULL);
+    }
     if (v) {
         char *end;
         errno = 0;
@@ -148,7 +233,7 @@ static enum MHD_Result post_start(req *r)
                      (long long)h->cfg->max_level);
             return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
         }
-        r->cap = (size_t)n;
+        r->cap = multipart ? 0 : (size_t)n;
         if (r->cap && !(r->body = malloc(r->cap)))
             return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the level");
     }
@@ -178,85 +263,21 @@ static const char *sniff(const unsigned char *p, size_t n)
     return NULL;
 }
 
-/* ---- a multipart/form-data body: the parts `level` and `decorators` ---- */
-
-typedef struct parts {
-    unsigned char *buf[2]; /* level, decorators */
-    size_t len[2], cap[2];
-    size_t max;
-    int seen[2];
-    char err[200];
-} parts;
-
-static const char *const part_name[2] = {"level", "decorators"};
-
-static enum MHD_Result on_part(void *cls, enum MHD_ValueKind kind, const char *key,
-                               const char *filename, const char *content_type,
-                               const char *transfer_encoding, const char *data, uint64_t off,
-                               size_t size)
-{
-    parts *pt = cls;
-    (void)kind;
-    (void)filename;
-    (void)content_type;
-    (void)transfer_encoding;
-    (void)off;
-    int k = !key ? -1 : !strcmp(key, "level") ? 0 : !strcmp(key, "decorators") ? 1 : -1;
-    if (k < 0) {
-        snprintf(pt->err, sizeof pt->err, "unknown part '%.40s' (the parts are level and decorators)",
-                 key ? key : "");
-        return MHD_NO;
-    }
-    pt->seen[k] = 1;
-    if (size > pt->max - pt->len[k]) {
-        snprintf(pt->err, sizeof pt->err, "part %s is over the limit of %zu bytes (--max-level)",
-                 part_name[k], pt->max);
-        return MHD_NO;
-    }
-    if (pt->len[k] + size + 1 > pt->cap[k]) { /* + 1: the decorators' NUL */
-        size_t cap = pt->cap[k] ? pt->cap[k] : 1 << 16;
-        while (cap < pt->len[k] + size + 1)
-            cap *= 2;
-        unsigned char *p = realloc(pt->buf[k], cap);
-        if (!p) {
-            snprintf(pt->err, sizeof pt->err, "no memory for part %s", part_name[k]);
-            return MHD_NO;
-        }
-        pt->buf[k] = p;
-        pt->cap[k] = cap;
-    }
-    memcpy(pt->buf[k] + pt->len[k], data, size);
-    pt->len[k] += size;
-    return MHD_YES;
-}
-
-/* Splits the received body into its parts: 0, or -1 with pt->err. */
-static int split_parts(req *r, parts *pt)
-{
-    struct MHD_PostProcessor *pp = MHD_create_post_processor(r->conn, 1 << 16, on_part, pt);
-    if (!pp) {
-        snprintf(pt->err, sizeof pt->err, "a multipart/form-data body without a boundary");
-        return -1;
-    }
-    enum MHD_Result ok = MHD_post_process(pp, (const char *)r->body, r->len);
-    if (MHD_destroy_post_processor(pp) != MHD_YES)
-        ok = MHD_NO;
-    if (ok != MHD_YES && !pt->err[0])
-        snprintf(pt->err, sizeof pt->err, "the multipart/form-data body is cut short or malformed");
-    if (ok == MHD_YES && !pt->seen[0])
-        snprintf(pt->err, sizeof pt->err, "a multipart/form-data body without a part 'level'");
-    if (pt->err[0])
-        return -1;
-    if (pt->buf[1])
-        pt->buf[1][pt->len[1]] = '\0';
-    return 0;
-}
-
 enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
 {
     obsd_http *h = r->srv;
     if (!obsd__req_alive(r))
         return MHD_NO;
+    parts *pt = r->bake_parts;
+    if (*size && pt) {
+        size_t n = *size;
+        *size = 0;
+        if (!pt->err[0] && MHD_post_process(r->bake_pp, data, n) != MHD_YES && !pt->err[0])
+            snprintf(pt->err, sizeof pt->err, "the multipart/form-data body is malformed");
+        if (pt->err[0] && (pt->discarded += n) > 2 * pt->max) /* answered at the end, as 413 is */
+            return MHD_NO;
+        return MHD_YES;
+    }
     if (*size)
         return obsd__append_body(r, data, size, (size_t)h->cfg->max_level);
     char msg[320];
@@ -267,22 +288,19 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
     }
     char *decor = NULL;
     size_t rules = 0;
-    const char *ct = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
-    if (ct && !strncasecmp(ct, "multipart/form-data", strlen("multipart/form-data"))) {
-        parts pt = {.max = (size_t)h->cfg->max_level};
-        if (split_parts(r, &pt) != 0) {
-            free(pt.buf[0]);
-            free(pt.buf[1]);
-            return obsd__answer_error(r, 400, "bad_multipart", pt.err, NULL, NULL);
-        }
+    if (pt) {
+        if (parts_end(r, pt) != 0)
+            return pt->too_large ? obsd__answer_error(r, 413, "body_too_large", pt->err, NULL, NULL)
+                                 : obsd__answer_error(r, 400, "bad_multipart", pt->err, NULL, NULL);
         free(r->body); /* the level part in its place */
-        r->body = pt.buf[0];
-        r->len = pt.len[0];
-        r->cap = pt.cap[0];
-        decor = (char *)pt.buf[1];
-        if (pt.seen[1] && !decor) /* an empty part: an empty file */
+        r->body = pt->buf[0];
+        r->len = pt->len[0];
+        r->cap = pt->cap[0];
+        decor = (char *)pt->buf[1];
+        pt->buf[0] = pt->buf[1] = NULL;
+        if (pt->seen[1] && !decor) /* an empty part: an empty file */
             decor = strdup("");
-        if (pt.seen[1] && !decor)
+        if (pt->seen[1] && !decor)
             return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the decorators");
         char derr[OBS_ERR_LEN];
         if (decor && obs_bake_decorators_check(decor, &rules, derr) != OBS_OK) {
@@ -489,5 +507,14 @@ void obsd__bakes_done(req *r)
     if (r->bsubscribed) {
         obsd_bakes_unsubscribe(r->srv->bakes, &r->bsub);
         r->bsubscribed = 0;
+    }
+    if (r->bake_pp)
+        MHD_destroy_post_processor(r->bake_pp);
+    r->bake_pp = NULL;
+    if (r->bake_parts) {
+        free(r->bake_parts->buf[0]);
+        free(r->bake_parts->buf[1]);
+        free(r->bake_parts);
+        r->bake_parts = NULL;
     }
 }

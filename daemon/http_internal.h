@@ -135,6 +135,8 @@ typedef struct obsd__req {
     obs_bake_params bake_params;
     obsd_bake_sub bsub;
     int bsubscribed;
+    struct MHD_PostProcessor *bake_pp; /* a multipart body, split as it comes */
+    struct obsd__parts *bake_parts;    /* its parts (http_bakes.c) */
     /* answer */
     int status;
     size_t bytes_out;

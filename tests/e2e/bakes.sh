@@ -115,6 +115,10 @@ open('$T/cut.mp', 'wb').write(b)"
 code=$($CURL -o "$T/e5" -w '%{http_code}' -H "$AUTH" -H 'Content-Type: multipart/form-data; boundary=XyZ' \
     --data-binary @"$T/cut.mp" "http://127.0.0.1:$S/v1/bakes?rays=16")
 check "a multipart body cut short: 400 bad_multipart" "[ $code = 400 ] && grep -q bad_multipart $T/e5"
+head -c 1100000 /dev/zero >"$T/big.bin"
+code=$(mpost "$T/e6" -H 'Transfer-Encoding: chunked' -F "level=@$T/big.bin")
+check "a chunked multipart body whose level part is over --max-level: 413 body_too_large naming the part" \
+    "[ $code = 413 ] && grep -q body_too_large $T/e6 && grep -q 'part level is over' $T/e6"
 code=$(mpost "$T/e4" -F "decorators=@$TREES")
 check "no part level: 400 saying so" "[ $code = 400 ] && grep -q \"without a part 'level'\" $T/e4"
 code=$(bget $S "/v1/bakes" "$T/list")
