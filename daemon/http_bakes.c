@@ -152,11 +152,14 @@ static enum MHD_Result on_part(void *cls, enum MHD_ValueKind kind, const char *k
     (void)filename;
     (void)content_type;
     (void)transfer_encoding;
-    (void)off;
     int k = !key ? -1 : !strcmp(key, "level") ? 0 : !strcmp(key, "decorators") ? 1 : -1;
     if (k < 0) {
         snprintf(pt->err, sizeof pt->err, "unknown part '%.40s' (the parts are level and decorators)",
                  key ? key : "");
+        return MHD_NO;
+    }
+    if (off == 0 && pt->seen[k] && pt->len[k] > 0) { /* a second part of that name */
+        snprintf(pt->err, sizeof pt->err, "part %s given twice", part_name[k]);
         return MHD_NO;
     }
     pt->seen[k] = 1;

@@ -119,6 +119,8 @@ head -c 1100000 /dev/zero >"$T/big.bin"
 code=$(mpost "$T/e6" -H 'Transfer-Encoding: chunked' -F "level=@$T/big.bin")
 check "a chunked multipart body whose level part is over --max-level: 413 body_too_large naming the part" \
     "[ $code = 413 ] && grep -q body_too_large $T/e6 && grep -q 'part level is over' $T/e6"
+code=$(mpost "$T/e7" -F "level=@$FIX" -F "level=@$FIX")
+check "a part given twice: 400 bad_multipart saying so" "[ $code = 400 ] && grep -q 'part level given twice' $T/e7"
 code=$(mpost "$T/e4" -F "decorators=@$TREES")
 check "no part level: 400 saying so" "[ $code = 400 ] && grep -q \"without a part 'level'\" $T/e4"
 code=$(bget $S "/v1/bakes" "$T/list")
