@@ -123,6 +123,20 @@ static void bench_bands(obs_ctx *ctx, const char *name, const obs_gbuffer *gb, i
              t[0][frames / 2], t[1][frames / 2], t[1][frames / 2] / t[0][frames / 2]);
 }
 
+/* The per-pass table of --presets, filled size by size. */
+static char passes_md[8192];
+
+static void presets_passes(void)
+{
+    printf("\nPer pass, median GL ms (\"-\": the pass did not run):\n\n| size | --quality |");
+    for (int q = 0; q < OBS_PASS_COUNT; q++)
+        printf(" %s |", obs_pass_name((obs_pass)q));
+    printf("\n|---|---|");
+    for (int q = 0; q < OBS_PASS_COUNT; q++)
+        printf("---|");
+    printf("\n%s", passes_md);
+}
+
 /* --quality's presets side by side: wall and GL time (the passes' timer
  * queries) of each, medians of `frames`, frames of the presets
  * interleaved so that the machine's drift hits them alike; the ratio to
@@ -171,20 +185,20 @@ static void bench_presets(obs_ctx *ctx, const char *name, const obs_gbuffer *gb,
     for (int k = 0; k < NP; k++)
         printf("| %s | %dx%d | %s | %.1f | %.1f | %.2f | %.2f |\n", name, gb->width, gb->height,
                presets[k], mw[k], mg[k], mw[k] / mw[1], mg[k] / mg[1]);
-    /* where the time goes: each pass's median GL ms, one line per preset
-     * (to stderr, so that the table above stays one table) */
-    fprintf(stderr, "frame_bench: %dx%d passes, median GL ms:", gb->width, gb->height);
-    for (int q = 0; q < OBS_PASS_COUNT; q++)
-        fprintf(stderr, " %s", obs_pass_name((obs_pass)q));
-    fprintf(stderr, "\n");
+    /* where the time goes: each pass's median GL ms per preset, rows of
+     * the second table, printed after the first (presets_passes) */
     for (int k = 0; k < NP; k++) {
-        fprintf(stderr, "  %-9s", presets[k]);
+        size_t n = strlen(passes_md);
+        snprintf(passes_md + n, sizeof passes_md - n, "| %dx%d | %s |", gb->width, gb->height,
+                 presets[k]);
         for (int q = 0; q < OBS_PASS_COUNT; q++) {
             qsort(pass[k][q], (size_t)frames, sizeof pass[k][q][0], cmp);
             double m = pass[k][q][frames / 2];
-            fprintf(stderr, m < 0 ? " -" : " %.1f", m);
+            n = strlen(passes_md);
+            snprintf(passes_md + n, sizeof passes_md - n, m < 0 ? " - |" : " %.1f |", m);
         }
-        fprintf(stderr, "\n");
+        n = strlen(passes_md);
+        snprintf(passes_md + n, sizeof passes_md - n, "\n");
     }
     fflush(stdout);
 }
@@ -287,6 +301,8 @@ int main(int argc, char **argv)
            "bands (a deadline set) ms | ratio |\n|---|---|---|---|---|\n");
     for (int b = 0; b < nbands; b++)
         fputs(bands[b], stdout);
+    if (presets)
+        presets_passes();
     obs_ctx_destroy(ctx);
     return 0;
 }

@@ -18,8 +18,8 @@ echo
 echo
 # --quality's presets side by side at 1920x1080 and 3840x2160 (the first
 # scene upscaled): wall and GL time and the ratio to default's in the same
-# run, then each pass's GL time per preset
-"$BUILD/frame_bench" --frames 5 --presets "$1" "$2" 2>&1
+# run, then a table of each pass's GL time per preset
+"$BUILD/frame_bench" --frames 5 --presets "$1" "$2"
 echo
 # cold start: one process with obscura's program cache warm and Mesa's
 # off, against Mesa's cache warm and no cache (bench/coldstart.sh)
