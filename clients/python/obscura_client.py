@@ -40,6 +40,7 @@ import json
 import os
 import socket
 import struct
+import time
 import urllib.parse
 
 __all__ = ["ao", "bake", "ObscuraError", "DEFAULT_SERVER"]
@@ -179,45 +180,59 @@ def _http_error(status, body):
         return "http_%d" % status, body.decode("utf-8", "replace")[:500]
 
 
-def _ao_http(server, src, params, token, sink, timeout):
-    # http.client (what urllib.request runs on) rather than urlopen: the
-    # daemon refuses a bad request before it reads the body and closes,
-    # and the answer must still be read after the send breaks off.
+def _request(server, method, path, token, timeout, body=None, headers=None, sink=None):
+    """One HTTP request; the status and the answer's body (None when it
+    was streamed into sink).  body: None or a list of bytes and _Source
+    pieces, sent in turn.  http.client (what urllib.request runs on)
+    rather than urlopen: the daemon refuses a bad request before it reads
+    the body and closes, and the answer must still be read after the send
+    breaks off."""
     u = urllib.parse.urlsplit(server)
-    path = (u.path.rstrip("/") or "") + "/v1/ao?" + urllib.parse.urlencode(params)
     conn = http.client.HTTPConnection(u.hostname or "127.0.0.1", u.port or 80, timeout=timeout)
     try:
+        pieces = body or []
+        size = sum(len(b) if isinstance(b, bytes) else b.size for b in pieces)
         try:
-            conn.putrequest("POST", path)
-            conn.putheader("Content-Type", "image/x-exr")
-            conn.putheader("Content-Length", str(src.size))
+            conn.putrequest(method, (u.path.rstrip("/") or "") + path)
+            for k, v in (headers or {}).items():
+                conn.putheader(k, v)
+            if body is not None:
+                conn.putheader("Content-Length", str(size))
             if token:
                 conn.putheader("Authorization", "Bearer " + token)
             conn.endheaders()
         except OSError as e:
             raise ObscuraError(None, "unreachable", "%s: %s" % (server, e))
         try:
-            for b in src.chunks():
-                conn.send(b)
+            for b in pieces:
+                for c in ([b] if isinstance(b, bytes) else b.chunks()):
+                    conn.send(c)
         except (BrokenPipeError, ConnectionResetError):
             pass  # refused before the body was read: the answer says why
         try:
             resp = conn.getresponse()
         except (OSError, http.client.HTTPException) as e:
             raise ObscuraError(None, "unreachable", "%s: no answer: %s" % (server, e))
-        if resp.status != 200:
+        if resp.status >= 300:
             code, msg = _http_error(resp.status, resp.read())
             retry = resp.getheader("Retry-After")
             raise ObscuraError(resp.status, code, msg, int(retry) if retry and retry.isdigit() else 0)
+        if sink is None:
+            return resp.status, resp.read()
         while True:
             b = resp.read(CHUNK)
             if not b:
                 break
             sink.write(b)
+        return resp.status, None
     except socket.timeout:
         raise ObscuraError(None, "unreachable", "%s: no answer within %s s" % (server, timeout))
     finally:
         conn.close()
+
+def _ao_http(server, src, params, token, sink, timeout):
+    _request(server, "POST", "/v1/ao?" + urllib.parse.urlencode(params), token, timeout, [src],
+             {"Content-Type": "image/x-exr"}, sink)
 
 
 def _connect(server, timeout):
@@ -334,53 +349,6 @@ def ao(source, server=None, out=None, token=None, timeout=300, **params):
 
 # ---- bake jobs (POST /v1/bakes, protocol/HTTP.md "Bake jobs") ----------
 
-def _request(server, method, path, token, timeout, body=None, headers=None, sink=None):
-    """One HTTP request; the status and the body (or None into sink).
-    body: None, bytes, or a list of bytes and _Source pieces sent in turn."""
-    u = urllib.parse.urlsplit(server)
-    conn = http.client.HTTPConnection(u.hostname or "127.0.0.1", u.port or 80, timeout=timeout)
-    try:
-        pieces = [] if body is None else body if isinstance(body, list) else [body]
-        size = sum(len(b) if isinstance(b, bytes) else b.size for b in pieces)
-        try:
-            conn.putrequest(method, (u.path.rstrip("/") or "") + path)
-            for k, v in (headers or {}).items():
-                conn.putheader(k, v)
-            if body is not None:
-                conn.putheader("Content-Length", str(size))
-            if token:
-                conn.putheader("Authorization", "Bearer " + token)
-            conn.endheaders()
-        except OSError as e:
-            raise ObscuraError(None, "unreachable", "%s: %s" % (server, e))
-        try:
-            for b in pieces:
-                for c in ([b] if isinstance(b, bytes) else b.chunks()):
-                    conn.send(c)
-        except (BrokenPipeError, ConnectionResetError):
-            pass  # refused before the body was read: the answer says why
-        try:
-            resp = conn.getresponse()
-        except (OSError, http.client.HTTPException) as e:
-            raise ObscuraError(None, "unreachable", "%s: no answer: %s" % (server, e))
-        if resp.status >= 300:
-            code, msg = _http_error(resp.status, resp.read())
-            retry = resp.getheader("Retry-After")
-            raise ObscuraError(resp.status, code, msg, int(retry) if retry and retry.isdigit() else 0)
-        if sink is None:
-            return resp.status, resp.read()
-        while True:
-            b = resp.read(CHUNK)
-            if not b:
-                break
-            sink.write(b)
-        return resp.status, None
-    except socket.timeout:
-        raise ObscuraError(None, "unreachable", "%s: no answer within %s s" % (server, timeout))
-    finally:
-        conn.close()
-
-
 def _multipart(level, decorators):
     """The body parts of a multipart/form-data POST: level and decorators."""
     boundary = "obscura-" + os.urandom(12).hex()
@@ -411,7 +379,6 @@ def bake(level, server=None, out=None, token=None, decorators=None, timeout=60,
     params: the bake parameters (obscura bake --params), distances=(S, L).
     Returns the .glb's bytes.  Raises ObscuraError: the daemon's refusal,
     or the job's failure (.code its status, e.g. "bad_file")."""
-    import time
     server = server or os.environ.get("OBSCURA_SERVER") or DEFAULT_SERVER
     token = token if token is not None else os.environ.get("OBSCURA_TOKEN")
     if not server.startswith("http://"):

@@ -122,9 +122,9 @@ static void header_bytes(const obs__dyn_part *h, unsigned char b[HEADER])
     obs__le_put64(b + 120, h->checksum);
 }
 
-static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg, const obs_dyn_params *p,
-                              const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
-                              char err[OBS_ERR_LEN])
+static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
+                              const obs_dyn_params *p, const obs__bake_bvh *bvh,
+                              obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
 {
     obs__dyn_part h = {
         .level = level,
@@ -261,8 +261,9 @@ static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
 {
     const obs__dyn_part *p0 = &sh->parts[0];
     if (p0->level != level)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s was traced from another level (or "
-                         "another version of it, or with other decorators): fingerprint %016llx, this level's %016llx",
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "%s was traced from another level (or another version of it, or with "
+                         "other decorators): fingerprint %016llx, this level's %016llx",
                          p0->path, (unsigned long long)p0->level, (unsigned long long)level);
     if (p0->regions != rg->count || p0->total != pt->count ||
         p0->points != obs__dyn_points_fingerprint(rg, pt))

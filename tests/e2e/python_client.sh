@@ -33,10 +33,30 @@ import io, os, sys
 sys.path.insert(0, os.path.join(os.getcwd(), "clients", "python"))
 import obscura_client as oc
 
-mode, server, src, out, w2c = sys.argv[1:6]
-cam = dict(fov_y=50, near=0.05, far=100, world_to_camera=[float(x) for x in w2c.split(",")])
+# the fifth argument: the camera's world_to_camera (ao), the decorators file (bake_*)
+mode, server, src, out, extra = sys.argv[1:6]
+cam = {} if mode.startswith("bake_") else dict(fov_y=50, near=0.05, far=100,
+                                               world_to_camera=[float(x) for x in extra.split(",")])
+seen = []  # oc.bake's progress
 try:
-    if mode == "path":
+    if mode == "bake_path":
+        data = oc.bake(src, server=server, rays=16, distances=(2, 300), poll=0.1,
+                       progress=lambda d, st: seen.append((d, st)))
+        print("progress %d looks, last %s %s" % (len(seen), seen[-1][0], seen[-1][1]))
+        assert seen[-1] == (1, "done"), seen[-1]
+    elif mode == "bake_decorators":
+        data = oc.bake(open(src, "rb").read(), server=server, decorators=extra, rays=16,
+                       distances=(2, 300), poll=0.1)
+    elif mode == "bake_out":
+        assert oc.bake(src, server=server, out=out, rays=16, distances=(2, 300), poll=0.1) is None
+        data = open(out, "rb").read()
+    elif mode == "bake_badrules":
+        data = oc.bake(src, server=server, decorators=b"not json", rays=16)
+    elif mode == "bake_failed":
+        data = oc.bake(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n", server=server, rays=4, poll=0.1)
+    elif mode == "bake_binary":
+        data = oc.bake(src, server=server.replace("http://", "tcp://"), rays=4)
+    elif mode == "path":
         data = oc.ao(src, server=server, **cam)
     elif mode == "bytes":
         data = oc.ao(open(src, "rb").read(), server=server, **cam)
@@ -108,55 +128,21 @@ FIX=tests/data/levels/aalborg_cut.acc
 TREES=tests/data/levels/aalborg_cut.trees.json
 "$OBSCURA" bake "$FIX" -o "$T/cli_bake.glb" --rays 16 --distances 2,300 -q
 "$OBSCURA" bake "$FIX" -o "$T/cli_dec.glb" --rays 16 --distances 2,300 --decorators "$TREES" -q
-cat > "$T/bake.py" <<'EOF'
-import os, sys
-sys.path.insert(0, os.path.join(os.getcwd(), "clients", "python"))
-import obscura_client as oc
-
-mode, server, level, out = sys.argv[1:5]
-seen = []
-try:
-    if mode == "path":
-        data = oc.bake(level, server=server, rays=16, distances=(2, 300), poll=0.1,
-                       progress=lambda d, st: seen.append((d, st)))
-        print("progress %d looks, last %s %s" % (len(seen), seen[-1][0], seen[-1][1]))
-        assert seen[-1] == (1, "done"), seen[-1]
-    elif mode == "decorators":
-        data = oc.bake(open(level, "rb").read(), server=server, decorators=sys.argv[5], rays=16,
-                       distances=(2, 300), poll=0.1)
-    elif mode == "out":
-        assert oc.bake(level, server=server, out=out, rays=16, distances=(2, 300), poll=0.1) is None
-        data = open(out, "rb").read()
-    elif mode == "badrules":
-        data = oc.bake(level, server=server, decorators=b"not json", rays=16)
-    elif mode == "failed":
-        data = oc.bake(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n", server=server, rays=4, poll=0.1)
-    elif mode == "binary":
-        data = oc.bake(level, server=server.replace("http://", "tcp://"), rays=4)
-    else:
-        raise SystemExit("unknown mode " + mode)
-except oc.ObscuraError as e:
-    print("error status=%s code=%s message=%s" % (e.status, e.code, e.message))
-    raise SystemExit(3)
-open(out, "wb").write(data)
-print("ok %d bytes" % len(data))
-EOF
-bpy() { python3 -I -B "$T/bake.py" "$@"; }
-bpy path "http://127.0.0.1:$HP" "$FIX" "$T/py_bake.glb" >"$T/out" 2>&1
+py bake_path "http://127.0.0.1:$HP" "$FIX" "$T/py_bake.glb" - >"$T/out" 2>&1
 check "bake from a path: obscura bake's bytes, progress to 1 and done ($(head -c 60 "$T/out"))" \
     "cmp -s '$T/cli_bake.glb' '$T/py_bake.glb' && grep -q 'last 1 done' '$T/out'"
-bpy decorators "http://127.0.0.1:$HP" "$FIX" "$T/py_dec.glb" "$TREES" >"$T/out" 2>&1
+py bake_decorators "http://127.0.0.1:$HP" "$FIX" "$T/py_dec.glb" "$TREES" >"$T/out" 2>&1
 check "bake from bytes with a decorators file: obscura bake --decorators' bytes" \
     "cmp -s '$T/cli_dec.glb' '$T/py_dec.glb' && ! cmp -s '$T/cli_dec.glb' '$T/cli_bake.glb'"
-bpy out "http://127.0.0.1:$HP" "$FIX" "$T/py_out.glb" >"$T/out" 2>&1
+py bake_out "http://127.0.0.1:$HP" "$FIX" "$T/py_out.glb" - >"$T/out" 2>&1
 check "bake out= a path: the same file" "cmp -s '$T/cli_bake.glb' '$T/py_out.glb' && [ ! -e '$T/py_out.glb.part' ]"
-bpy badrules "http://127.0.0.1:$HP" "$FIX" "$T/x.glb" >"$T/out" 2>&1
+py bake_badrules "http://127.0.0.1:$HP" "$FIX" "$T/x.glb" - >"$T/out" 2>&1
 check "decorators that are not JSON: ObscuraError 400 bad_decorators ($(head -c 70 "$T/out"))" \
     "grep -q 'status=400 code=bad_decorators message=.*not JSON' '$T/out'"
-bpy failed "http://127.0.0.1:$HP" "$FIX" "$T/x.glb" >"$T/out" 2>&1
+py bake_failed "http://127.0.0.1:$HP" "$FIX" "$T/x.glb" - >"$T/out" 2>&1
 check "a level without triangles: the job's failure as ObscuraError ($(head -c 90 "$T/out"))" \
     "grep -q 'status=None code=[a-z_]* message=.*triangles' '$T/out'"
-bpy binary "http://127.0.0.1:$HP" "$FIX" "$T/x.glb" >"$T/out" 2>&1
+py bake_binary "http://127.0.0.1:$HP" "$FIX" "$T/x.glb" - >"$T/out" 2>&1
 check "bake over the binary protocol: ValueError, bake jobs are HTTP routes" \
     "grep -q 'ValueError: bake(): bake jobs are HTTP routes' '$T/out'"
 
