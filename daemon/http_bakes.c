@@ -135,7 +135,6 @@ typedef struct obsd__parts {
     size_t len[2], cap[2];
     size_t max;
     int seen[2];
-    size_t discarded; /* bytes read past an error */
     int too_large;    /* the error is a part over the limit: 413 */
     char err[200];
 } parts;
@@ -169,17 +168,10 @@ static enum MHD_Result on_part(void *cls, enum MHD_ValueKind kind, const char *k
         pt->too_large = 1;
         return MHD_NO;
     }
-    if (pt->len[k] + size + 1 > pt->cap[k]) { /* + 1: the decorators' NUL */
-        size_t cap = pt->cap[k] ? pt->cap[k] : 1 << 16;
-        while (cap < pt->len[k] + size + 1)
-            cap *= 2;
-        unsigned char *p = realloc(pt->buf[k], cap);
-        if (!p) {
-            snprintf(pt->err, sizeof pt->err, "no memory for part %s", part_name[k]);
-            return MHD_NO;
-        }
-        pt->buf[k] = p;
-        pt->cap[k] = cap;
+    /* + 1: the decorators' NUL */
+    if (obsd__reserve(&pt->buf[k], &pt->cap[k], pt->len[k] + size + 1, pt->max + 1) != 0) {
+        snprintf(pt->err, sizeof pt->err, "no memory for part %s", part_name[k]);
+        return MHD_NO;
     }
     memcpy(pt->buf[k] + pt->len[k], data, size);
     pt->len[k] += size;
@@ -275,10 +267,10 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
     if (*size && pt) {
         size_t n = *size;
         *size = 0;
-        if (!pt->err[0] && MHD_post_process(r->bake_pp, data, n) != MHD_YES && !pt->err[0])
+        if (pt->err[0]) /* answered at the end, as 413 is */
+            return obsd__discard_body(r, n, pt->max);
+        if (MHD_post_process(r->bake_pp, data, n) != MHD_YES && !pt->err[0])
             snprintf(pt->err, sizeof pt->err, "the multipart/form-data body is malformed");
-        if (pt->err[0] && (pt->discarded += n) > 2 * pt->max) /* answered at the end, as 413 is */
-            return MHD_NO;
         return MHD_YES;
     }
     if (*size)
@@ -289,8 +281,6 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
                  (long long)h->cfg->max_level);
         return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
     }
-    char *decor = NULL;
-    size_t rules = 0;
     if (pt) {
         if (parts_end(r, pt) != 0)
             return pt->too_large ? obsd__answer_error(r, 413, "body_too_large", pt->err, NULL, NULL)
@@ -299,29 +289,28 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
         r->body = pt->buf[0];
         r->len = pt->len[0];
         r->cap = pt->cap[0];
-        decor = (char *)pt->buf[1];
-        pt->buf[0] = pt->buf[1] = NULL;
-        if (pt->seen[1] && !decor) /* an empty part: an empty file */
-            decor = strdup("");
-        if (pt->seen[1] && !decor)
-            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the decorators");
-        char derr[OBS_ERR_LEN];
-        if (decor && obs_bake_decorators_check(decor, &rules, derr) != OBS_OK) {
-            free(decor);
-            return obsd__answer_error(r, 400, "bad_decorators", derr, NULL, NULL);
-        }
+        pt->buf[0] = NULL;
     }
-    if (r->len == 0) {
-        free(decor);
+    if (r->len == 0)
         return obsd__answer_error(r, 400, "empty_body",
                                   "POST /v1/bakes needs a level (glTF/GLB, AC3D, OBJ, ...) as its body", NULL, NULL);
-    }
     const char *ext = r->bake_ext[0] ? r->bake_ext : sniff(r->body, r->len);
-    if (!ext) {
-        free(decor);
+    if (!ext)
         return obsd__answer_error(r, 415, "unsupported_media_type",
                                   "cannot tell the level's format from its first bytes: give format=EXT "
                                   "(glb, gltf, ac, obj, fbx, ... as assimp names them)", NULL, NULL);
+    char *decor = NULL; /* the decorators part, checked as the bake reads it */
+    size_t rules = 0;
+    if (pt && pt->seen[1]) {
+        decor = pt->buf[1] ? (char *)pt->buf[1] : strdup(""); /* an empty part: an empty file */
+        pt->buf[1] = NULL;
+        if (!decor)
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the decorators");
+        char derr[OBS_ERR_LEN];
+        if (obs_bake_decorators_check(decor, &rules, derr) != OBS_OK) {
+            free(decor);
+            return obsd__answer_error(r, 400, "bad_decorators", derr, NULL, NULL);
+        }
     }
     char id[OBSD_BAKE_ID_LEN + 1];
     unsigned char *level = r->body;

@@ -175,6 +175,33 @@ enum MHD_Result obsd__frame_start(req *r)
     return MHD_YES;
 }
 
+int obsd__reserve(unsigned char **buf, size_t *cap, size_t need, size_t max)
+{
+    if (need <= *cap)
+        return 0;
+    size_t c = *cap ? *cap : 1 << 16;
+    while (c < need)
+        c = c > max / 2 ? (max > need ? max : need) : c * 2;
+    unsigned char *p = realloc(*buf, c);
+    if (!p)
+        return -1;
+    *buf = p;
+    *cap = c;
+    return 0;
+}
+
+enum MHD_Result obsd__discard_body(req *r, size_t n, size_t max)
+{
+    r->discarded += n;
+    if (r->discarded > max) {
+        obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: body over twice the limit, "
+                 "connection closed", (unsigned long long)r->id, r->peer, r->method,
+                 obsd_route_path(r->route));
+        return MHD_NO;
+    }
+    return MHD_YES;
+}
+
 enum MHD_Result obsd__append_body(req *r, const char *data, size_t *size, size_t max)
 {
     size_t n = *size;
@@ -190,25 +217,10 @@ enum MHD_Result obsd__append_body(req *r, const char *data, size_t *size, size_t
             r->body = NULL;
             r->cap = 0;
         }
-        r->discarded += n;
-        if (r->discarded > max) {
-            obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: body over twice --max-body, "
-                     "connection closed", (unsigned long long)r->id, r->peer, r->method,
-                     obsd_route_path(r->route));
-            return MHD_NO;
-        }
-        return MHD_YES;
+        return obsd__discard_body(r, n, max);
     }
-    if (r->len + n > r->cap) {
-        size_t cap = r->cap ? r->cap : 1 << 16;
-        while (cap < r->len + n)
-            cap = cap > max / 2 ? max : cap * 2;
-        unsigned char *p = realloc(r->body, cap);
-        if (!p)
-            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the body");
-        r->body = p;
-        r->cap = cap;
-    }
+    if (obsd__reserve(&r->body, &r->cap, r->len + n, max) != 0)
+        return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the body");
     memcpy(r->body + r->len, data, n);
     r->len += n;
     return MHD_YES;

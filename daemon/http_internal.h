@@ -194,6 +194,13 @@ enum MHD_Result obsd__frame_body(obsd__req *r, const char *data, size_t *size);
 /* Appends `size` bytes of a body up to max bytes (then r->too_big, the
  * rest discarded, the connection closed past twice max). */
 enum MHD_Result obsd__append_body(obsd__req *r, const char *data, size_t *size, size_t max);
+/* n more bytes of a body thrown away after an error that is answered at
+ * its end (libmicrohttpd cannot answer in the middle of a body): MHD_NO,
+ * closing the connection, once they are over max. */
+enum MHD_Result obsd__discard_body(obsd__req *r, size_t n, size_t max);
+/* *buf of *cap bytes grown (doubling from 64 KiB, at most max unless need
+ * is more) to hold need bytes: 0, or -1 on no memory (*buf unchanged). */
+int obsd__reserve(unsigned char **buf, size_t *cap, size_t need, size_t max);
 /* The request's query parameters into r->hr (recorded into r->query
  * when r->record_query); 400 answered on a bad one (returns 0, *rc set). */
 int obsd__parse_query(obsd__req *r, enum MHD_Result *rc);
