@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "context.h"
+#include "gl/progcache.h"
 
 obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out, char err[OBS_ERR_LEN])
 {

@@ -11,7 +11,6 @@
 #include <GL/glcorearb.h>
 
 #include "gl/backend.h"
-#include "gl/progcache.h"
 #include "gl/uniform.h"
 
 #define OBS__GL_FUNCS(X)                                                       \
@@ -208,6 +207,28 @@ void obs__gl_set_uniforms(GLuint prog, const void *base, const obs__uniform *u);
 obs_status obs__gl_check(const char *where, char err[OBS_ERR_LEN]);
 
 /* ---- one context of one backend (device.c) ------------------------------ */
+
+#define OBS__CACHE_PATH_LEN 4096
+
+typedef struct obs__progcache {
+    char dir[OBS__CACHE_PATH_LEN]; /* the cache's root; "" : no cache */
+    int writable;                  /* 0: entries are loaded, none is stored */
+    int formats;                   /* GL_NUM_PROGRAM_BINARY_FORMATS of the context */
+    const char *vendor, *renderer, *version; /* the device's strings */
+    unsigned long compiled;        /* programs built from source */
+    unsigned long loaded;          /* programs loaded from the cache */
+    unsigned long rejected;        /* entries found but unusable (rebuilt) */
+    int store_warned;              /* one warning for failed writes */
+    obs_log_fn log;
+    void *log_user;
+} obs__progcache;
+
+/* The cache of the context current on this thread (defined and set by
+ * device.c with the function table); NULL when none is current.  The
+ * state is the device's; the code that fills and reads it is
+ * progcache.c (progcache.h), which sits above the device. */
+extern _Thread_local obs__progcache *obs__progcache_cur;
+
 
 typedef struct obs__gl_device {
     obs_backend backend;

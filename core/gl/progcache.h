@@ -22,26 +22,9 @@
 
 #include <GL/glcorearb.h>
 
-#include "internal.h"
+#include "gl/gl.h"
 
-#define OBS__CACHE_PATH_LEN 4096
-
-typedef struct obs__progcache {
-    char dir[OBS__CACHE_PATH_LEN]; /* the cache's root; "" : no cache */
-    int writable;                  /* 0: entries are loaded, none is stored */
-    int formats;                   /* GL_NUM_PROGRAM_BINARY_FORMATS of the context */
-    const char *vendor, *renderer, *version; /* the device's strings */
-    unsigned long compiled;        /* programs built from source */
-    unsigned long loaded;          /* programs loaded from the cache */
-    unsigned long rejected;        /* entries found but unusable (rebuilt) */
-    int store_warned;              /* one warning for failed writes */
-    obs_log_fn log;
-    void *log_user;
-} obs__progcache;
-
-/* The cache of the context current on this thread (defined and set by
- * device.c with the function table); NULL when none is current. */
-extern _Thread_local obs__progcache *obs__progcache_cur;
+/* obs__progcache, the cache's state, is a member of the device (gl.h). */
 
 /* Opens the cache at root (NULL or "": none) before the context is made:
  * creates root/programs, checks that it can be written (else read-only,

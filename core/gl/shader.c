@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "gl/gl.h"
+#include "gl/progcache.h"
 
 static obs_status compile(const char *name, GLenum type, const char *const *parts, int count,
                           GLuint *out, char err[OBS_ERR_LEN])

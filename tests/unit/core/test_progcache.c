@@ -14,6 +14,7 @@
 #include "testutil.h"
 
 #include "context.h"
+#include "gl/progcache.h"
 #include "obs_shaders.h"
 
 static const char frag_src[] = "#version 430 core\n"
