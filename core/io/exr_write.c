@@ -49,30 +49,8 @@ static obs_status check_layers(const obs_exr_layer *layers, int count, int *long
     return OBS_OK;
 }
 
-/* Our camera as OpenEXR attributes: the exact inverse of the reader's
- * mapping (see camera_from_exr() in exr_read.c).  With F = diag(1,1,-1,1),
- * W = world_to_camera and P = projection:
- *   worldToCamera = (F W)^T
- *   q = (x_clip + w_clip)/2, (w_clip - y_clip)/2, z_clip, w_clip  (rows of Q)
- *   worldToNDC = (Q W)^T */
-void obs__exr_camera_matrices(const obs_camera *cam, float wtc[16], float ndc[16])
-{
-    static const float F[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1};
-    float fw[16], q[16], qw[16];
-    const float *p = cam->projection;
-
-    obs__mat4_mul(F, cam->world_to_camera, fw);
-    obs__mat4_transpose(fw, wtc);
-    for (int j = 0; j < 4; j++) {
-        q[0 + j] = 0.5f * (p[0 + j] + p[12 + j]);
-        q[4 + j] = 0.5f * (p[12 + j] - p[4 + j]);
-        q[8 + j] = p[8 + j];
-        q[12 + j] = p[12 + j];
-    }
-    obs__mat4_mul(q, cam->world_to_camera, qw);
-    obs__mat4_transpose(qw, ndc);
-}
-
+/* The camera's attributes come from core/camera/exr.c, the inverse of its
+ * reader. */
 static exr_result_t write_camera(exr_context_t ctx, int part, const obs_camera *cam)
 {
     exr_attr_m44f_t wtc, ndc;

@@ -237,6 +237,22 @@ static void test_camera_resolution(void **state)
     assert_float_equal(cam.world_to_camera[2], 1.0f, 0.0f);
 }
 
+/* A binary request's matrices: the source says PARAMS only with a
+ * projection, and the flags are 0 or 1 whatever bit carried them. */
+static void test_camera_from_request(void **state)
+{
+    (void)state;
+    obs_camera cam = {0};
+    obs_camera_from_request(&cam, 1 << 5, 0);
+    assert_int_equal(cam.has_world_to_camera, 1);
+    assert_int_equal(cam.has_projection, 0);
+    assert_int_equal(cam.source, OBS_CAMERA_NONE);
+    obs_camera_from_request(&cam, 0, 1 << 6);
+    assert_int_equal(cam.has_world_to_camera, 0);
+    assert_int_equal(cam.has_projection, 1);
+    assert_int_equal(cam.source, OBS_CAMERA_PARAMS);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -245,6 +261,7 @@ int main(void)
         cmocka_unit_test(test_blender_positions),
         cmocka_unit_test(test_world_normals_match_geometry),
         cmocka_unit_test(test_camera_resolution),
+        cmocka_unit_test(test_camera_from_request),
     };
     return cmocka_run_group_tests_name("camera", tests, NULL, NULL);
 }
