@@ -7,7 +7,7 @@
  *   solve.c    the camera solved from a position pass, and the camera
  *              checked against it.
  * Readers hand over what they found and take back one camera with its
- * source; writers take the attributes from obs__exr_camera_matrices. */
+ * source; writers take the attributes from obs__camera_exr_attrs. */
 #ifndef OBS_CAMERA_CAMERA_H
 #define OBS_CAMERA_CAMERA_H
 
@@ -27,6 +27,19 @@ void obs__camera_read_header(exr_const_context_t ctx, int part, const char *rend
 /* obs__camera_read_header() with no renderer and no info (the deep
  * reader, core/io/exr_deep.c). */
 void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam);
+
+/* The header attributes that carry a camera, in the writer's order
+ * (exr.c): worldToCamera, then worldToNDC with a projection; none without
+ * a world_to_camera.  Returns how many; `attrs` may be NULL to ask only
+ * that.  The first's name is OBS__CAMERA_ATTR_WTC (a source that has it
+ * keeps its own camera). */
+#define OBS__CAMERA_ATTRS 2
+#define OBS__CAMERA_ATTR_WTC "worldToCamera"
+typedef struct obs__camera_attr {
+    const char *name;
+    float m[16]; /* row-major, OpenEXR's row-vector convention */
+} obs__camera_attr;
+int obs__camera_exr_attrs(const obs_camera *cam, obs__camera_attr attrs[OBS__CAMERA_ATTRS]);
 
 /* The worldToCamera and worldToNDC attributes (row-major, OpenEXR's
  * row-vector convention, the standard's NDC) of a camera: the exact

@@ -14,7 +14,7 @@
  * rs/camera/nearPlane/farPlane or cameraNearClip/cameraFarClip when the
  * file has them.  What was used, and what disagreed, goes to the report.
  * Written: worldToCamera and worldToNDC in the standard's NDC, the exact
- * inverse of detector 1 (obs__exr_camera_matrices). */
+ * inverse of detector 1 (obs__camera_exr_attrs, obs__exr_camera_matrices). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -375,6 +375,18 @@ void obs__exr_camera_matrices(const obs_camera *cam, float wtc[16], float ndc[16
     }
     obs__mat4_mul(q, cam->world_to_camera, qw);
     obs__mat4_transpose(qw, ndc);
+}
+
+int obs__camera_exr_attrs(const obs_camera *cam, obs__camera_attr attrs[OBS__CAMERA_ATTRS])
+{
+    if (!cam || !cam->has_world_to_camera)
+        return 0;
+    if (attrs) {
+        attrs[0].name = OBS__CAMERA_ATTR_WTC;
+        attrs[1].name = "worldToNDC";
+        obs__exr_camera_matrices(cam, attrs[0].m, attrs[1].m);
+    }
+    return cam->has_projection ? 2 : 1;
 }
 
 void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam)
