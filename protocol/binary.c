@@ -516,9 +516,7 @@ static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *
     obs_camera *cam = &gb->camera;
     get(r, cam->world_to_camera, sizeof cam->world_to_camera);
     get(r, cam->projection, sizeof cam->projection);
-    cam->has_world_to_camera = !!(flags & OBS_BIN_HAS_WORLD_TO_CAMERA);
-    cam->has_projection = !!(flags & OBS_BIN_HAS_PROJECTION);
-    cam->source = cam->has_projection ? OBS_CAMERA_PARAMS : OBS_CAMERA_NONE;
+    obs_camera_from_request(cam, flags & OBS_BIN_HAS_WORLD_TO_CAMERA, flags & OBS_BIN_HAS_PROJECTION);
     uint64_t px = rf.px, channels = rf.channels, bytes = rf.bytes;
     gb->width = (int)width;
     gb->height = (int)height;
@@ -671,9 +669,7 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
     d->has_alpha = !!(flags & OBS_BIN_DEEP_ALPHA);
     d->has_color = !!(flags & OBS_BIN_DEEP_COLOR);
     d->has_normal = !!(flags & OBS_BIN_DEEP_NORMAL);
-    cam->has_world_to_camera = !!(flags & OBS_BIN_HAS_WORLD_TO_CAMERA);
-    cam->has_projection = !!(flags & OBS_BIN_HAS_PROJECTION);
-    cam->source = cam->has_projection ? OBS_CAMERA_PARAMS : OBS_CAMERA_NONE;
+    obs_camera_from_request(cam, flags & OBS_BIN_HAS_WORLD_TO_CAMERA, flags & OBS_BIN_HAS_PROJECTION);
     return OBS_OK;
 }
 

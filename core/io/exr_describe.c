@@ -1,6 +1,6 @@
 /* What obscura inspect shows beside the G-buffer: the renderer and camera
- * of any EXR part (flat or deep) as the readers find them, and the list
- * of parts with their names, views and channels. */
+ * of any EXR part (flat or deep) as the readers find them (exr_info.c),
+ * and the list of parts with their names, views and channels. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -5,6 +5,7 @@
 
 #include <openexr.h>
 
+#include "camera/camera.h"
 #include "obscura/io.h"
 
 /* A channel map resolved against one part's channel list: indices into
@@ -79,35 +80,9 @@ obs_status obs__exr_status(exr_result_t rv);
 obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv,
                          const char *what);
 
-/* The worldToCamera and worldToNDC attributes (row-major, OpenEXR's
- * row-vector convention) of a camera (exr_write.c); the deep writer
- * (exr_deep_write.cpp, C++) declares it itself. */
-void obs__exr_camera_matrices(const obs_camera *cam, float wtc[16], float ndc[16]);
-
-/* The camera of a part's header (worldToCamera / worldToNDC) in obscura's
- * conventions; zeroed when the header has none (exr_read.c). */
-void obs__exr_read_camera(exr_const_context_t ctx, int part, obs_camera *cam);
-
-/* What obs__exr_read_camera_report() found (core/io/camera_detect.c). */
-#define OBS__CAMERA_WARNINGS 2
-typedef struct obs__camera_report {
-    char source[160];  /* the attributes the camera came from ("" none) */
-    char check[160];   /* the cross-check of worldToNDC against the lens */
-    char clip[64];     /* the clip range's source, "" = the default */
-    int arnold;        /* 1: worldToNDC in Arnold's convention */
-    int warning_count;
-    char warnings[OBS__CAMERA_WARNINGS][224];
-} obs__camera_report;
-
-/* The camera of part `part` from every attribute that describes one (see
- * camera_detect.c); `renderer` is the detected preset (may be NULL);
- * `rep` may be NULL. */
-void obs__exr_read_camera_report(exr_const_context_t ctx, int part, const char *renderer,
-                                 obs_camera *cam, obs__camera_report *rep);
-
-/* A file in memory, read through OpenEXR's custom-stream callbacks. */
 /* Fills the renderer, conventions, camera (into gb->camera) and camera
- * warnings of `info` for part `part` read with match `m`. */
+ * warnings of `info` for part `part` read with match `m` (exr_info.c; the
+ * camera from core/camera/exr.c). */
 void obs__exr_describe(exr_const_context_t ctx, int part, const obs__channel_match *m,
                        obs_gbuffer *gb, obs_exr_info *info);
 
@@ -127,6 +102,7 @@ obs_status obs__exr_select_parts(exr_const_context_t ctx, int parts, const obs_c
                                  obs__part_set *s, char err[OBS_ERR_LEN]);
 void obs__part_set_free(obs__part_set *s);
 
+/* A file in memory, read through OpenEXR's custom-stream callbacks. */
 typedef struct obs__exr_mem {
     const unsigned char *buf;
     size_t len;

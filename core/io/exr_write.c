@@ -49,40 +49,19 @@ static obs_status check_layers(const obs_exr_layer *layers, int count, int *long
     return OBS_OK;
 }
 
-/* Our camera as OpenEXR attributes: the exact inverse of the reader's
- * mapping (see camera_from_exr() in exr_read.c).  With F = diag(1,1,-1,1),
- * W = world_to_camera and P = projection:
- *   worldToCamera = (F W)^T
- *   q = (x_clip + w_clip)/2, (w_clip - y_clip)/2, z_clip, w_clip  (rows of Q)
- *   worldToNDC = (Q W)^T */
-void obs__exr_camera_matrices(const obs_camera *cam, float wtc[16], float ndc[16])
-{
-    static const float F[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1};
-    float fw[16], q[16], qw[16];
-    const float *p = cam->projection;
-
-    obs__mat4_mul(F, cam->world_to_camera, fw);
-    obs__mat4_transpose(fw, wtc);
-    for (int j = 0; j < 4; j++) {
-        q[0 + j] = 0.5f * (p[0 + j] + p[12 + j]);
-        q[4 + j] = 0.5f * (p[12 + j] - p[4 + j]);
-        q[8 + j] = p[8 + j];
-        q[12 + j] = p[12 + j];
-    }
-    obs__mat4_mul(q, cam->world_to_camera, qw);
-    obs__mat4_transpose(qw, ndc);
-}
-
+/* The camera's attributes, as core/camera/exr.c gives them (none without
+ * a world_to_camera). */
 static exr_result_t write_camera(exr_context_t ctx, int part, const obs_camera *cam)
 {
-    exr_attr_m44f_t wtc, ndc;
-    exr_result_t rv;
-
-    obs__exr_camera_matrices(cam, wtc.m, ndc.m);
-    if ((rv = exr_attr_set_m44f(ctx, part, "worldToCamera", &wtc)) != EXR_ERR_SUCCESS ||
-        !cam->has_projection)
-        return rv;
-    return exr_attr_set_m44f(ctx, part, "worldToNDC", &ndc);
+    obs__camera_attr a[OBS__CAMERA_ATTRS];
+    int n = obs__camera_exr_attrs(cam, a);
+    exr_result_t rv = EXR_ERR_SUCCESS;
+    for (int i = 0; i < n && rv == EXR_ERR_SUCCESS; i++) {
+        exr_attr_m44f_t m;
+        memcpy(m.m, a[i].m, sizeof m.m);
+        rv = exr_attr_set_m44f(ctx, part, a[i].name, &m);
+    }
+    return rv;
 }
 
 /* Points the encoder's channels (sorted by name by the library) at the
@@ -159,8 +138,8 @@ static exr_result_t write_parts(exr_context_t ctx, const obs__wpart *parts, int 
                 return rv;
         if (src && p->src_part >= 0 && (rv = obs__exr_copy_attrs(ctx, part, src, p->src_part, skip, attr)) != EXR_ERR_SUCCESS)
             return rv;
-        if (i == cam_part && cam && cam->has_world_to_camera &&
-            !(src && p->src_part >= 0 && has_attr(src, p->src_part, "worldToCamera")) &&
+        if (i == cam_part && obs__camera_exr_attrs(cam, NULL) &&
+            !(src && p->src_part >= 0 && has_attr(src, p->src_part, OBS__CAMERA_ATTR_WTC)) &&
             (rv = write_camera(ctx, part, cam)) != EXR_ERR_SUCCESS)
             return rv;
     }

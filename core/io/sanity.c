@@ -21,9 +21,6 @@
  * which the alternative agrees. */
 #define AGREE_BAD 0.5
 #define AGREE_GOOD 0.8
-/* RMS reprojection error of the position pass over which the camera is
- * said to disagree with it. */
-#define MAX_REPROJECTION_PX 1.0
 /* Neighbours farther apart than this fraction of the depth are an edge. */
 #define EDGE_FRACTION 0.05
 
@@ -160,14 +157,9 @@ int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_
              "lie in 0..1 (depth_mode %s); give --depth-mode inverse, normalized or ndc if it is",
              valid, p.depth_mode == OBS_DEPTH_RADIAL ? "radial" : "planar");
     /* the camera against the position pass */
-    if (gb->position.data && obs__camera_resolve(gb, &p, &cam, err) == OBS_OK &&
-        cam.has_world_to_camera) {
-        double rms, maxe;
-        if (obs_camera_reprojection(gb, &gb->position, &cam, &rms, &maxe, err) == OBS_OK &&
-            !(rms <= MAX_REPROJECTION_PX))
-            warn(info, &added, "the camera disagrees with the position pass: it projects P "
-                 "%.3g px (RMS, max %.3g px) from the pixel centres", rms, maxe);
-    }
+    char msg[OBS_ERR_LEN];
+    if (obs__camera_check_position(gb, &p, msg, sizeof msg))
+        warn(info, &added, "%s", msg);
     if (!gb->normal.data)
         return added;
 

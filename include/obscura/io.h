@@ -278,6 +278,11 @@ obs_status obs_camera_read_json(const char *path, obs_camera *cam, int *width,
 void obs_camera_from_fov(float fov_y_deg, float aspect, float near_z,
                          float far_z, obs_camera *cam);
 
+/* A camera whose matrices a request carried (the binary protocol's raw
+ * and deep frames, already in *cam): which of them it has, and its source
+ * (OBS_CAMERA_PARAMS with a projection, OBS_CAMERA_NONE without). */
+void obs_camera_from_request(obs_camera *cam, int has_world_to_camera, int has_projection);
+
 /* Fits a centred perspective projection to an image of width x height:
  * the vertical field of view stays, the horizontal one follows the aspect
  * (x scale = y scale * height / width).  Returns 1 when it changed the

@@ -5,6 +5,7 @@
 
 #include "testutil.h"
 
+#include "camera/camera.h"
 #include "chain/frame.h"
 #include "obscura/io.h"
 
@@ -237,6 +238,49 @@ static void test_camera_resolution(void **state)
     assert_float_equal(cam.world_to_camera[2], 1.0f, 0.0f);
 }
 
+/* A binary request's matrices: the source says PARAMS only with a
+ * projection, and the flags are 0 or 1 whatever bit carried them. */
+static void test_camera_from_request(void **state)
+{
+    (void)state;
+    obs_camera cam = {0};
+    obs_camera_from_request(&cam, 1 << 5, 0);
+    assert_int_equal(cam.has_world_to_camera, 1);
+    assert_int_equal(cam.has_projection, 0);
+    assert_int_equal(cam.source, OBS_CAMERA_NONE);
+    obs_camera_from_request(&cam, 0, 1 << 6);
+    assert_int_equal(cam.has_world_to_camera, 0);
+    assert_int_equal(cam.has_projection, 1);
+    assert_int_equal(cam.source, OBS_CAMERA_PARAMS);
+}
+
+/* The writer's attributes: none without a world_to_camera, worldToNDC
+ * only with a projection, and worldToNDC maps the view axis to the
+ * standard's NDC centre (0.5, 0.5). */
+static void test_camera_exr_attrs(void **state)
+{
+    (void)state;
+    obs_camera cam;
+    obs__camera_attr a[OBS__CAMERA_ATTRS];
+    obs_camera_from_fov(60.0f, 1.5f, 0.1f, 100.0f, &cam);
+    assert_int_equal(obs__camera_exr_attrs(NULL, a), 0);
+    assert_int_equal(obs__camera_exr_attrs(&cam, a), 0);
+    cam.has_world_to_camera = 1;
+    assert_int_equal(obs__camera_exr_attrs(&cam, a), 2);
+    assert_string_equal(a[0].name, "worldToCamera");
+    assert_string_equal(a[1].name, "worldToNDC");
+    /* a row vector (0, 0, -1, 1) in front of the camera, through worldToNDC */
+    const float x[4] = {0, 0, -1, 1};
+    float y[4] = {0, 0, 0, 0};
+    for (int c = 0; c < 4; c++)
+        for (int r = 0; r < 4; r++)
+            y[c] += x[r] * a[1].m[4 * r + c];
+    assert_float_equal(y[0] / y[3], 0.5f, 1e-6f);
+    assert_float_equal(y[1] / y[3], 0.5f, 1e-6f);
+    cam.has_projection = 0;
+    assert_int_equal(obs__camera_exr_attrs(&cam, NULL), 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -245,6 +289,8 @@ int main(void)
         cmocka_unit_test(test_blender_positions),
         cmocka_unit_test(test_world_normals_match_geometry),
         cmocka_unit_test(test_camera_resolution),
+        cmocka_unit_test(test_camera_from_request),
+        cmocka_unit_test(test_camera_exr_attrs),
     };
     return cmocka_run_group_tests_name("camera", tests, NULL, NULL);
 }

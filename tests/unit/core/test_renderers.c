@@ -8,9 +8,9 @@
 
 #include "gl_testutil.h"
 
+#include "camera/camera.h"
 #include "chain/frame.h"
 #include "internal.h"
-#include "io/exr_internal.h"
 #include "obscura/deep.h"
 #include "obscura/obscura.h"
 

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "camera/camera.h"
 #include "internal.h"
 #include "obscura/io.h"
 
@@ -22,6 +23,9 @@
 /* A solved camera whose RMS reprojection error exceeds this is refused. */
 #define SOLVE_MAX_RMS_PX 0.5
 #define REFINE_ITERATIONS 5
+/* RMS reprojection error of the position pass over which a given camera
+ * is said to disagree with it. */
+#define MAX_REPROJECTION_PX 1.0
 
 typedef struct pt {
     double X[3], u, v;
@@ -268,6 +272,22 @@ obs_status obs_camera_reprojection(const obs_gbuffer *gb, const obs_plane *pos,
     errors(m, p, n, rms, max_err);
     free(p);
     return OBS_OK;
+}
+
+int obs__camera_check_position(const obs_gbuffer *gb, const obs_params *p, char *msg,
+                               size_t len)
+{
+    obs_camera cam;
+    char err[OBS_ERR_LEN];
+    double rms, maxe;
+    if (!gb->position.data || obs__camera_resolve(gb, p, &cam, err) != OBS_OK ||
+        !cam.has_world_to_camera ||
+        obs_camera_reprojection(gb, &gb->position, &cam, &rms, &maxe, err) != OBS_OK ||
+        rms <= MAX_REPROJECTION_PX)
+        return 0;
+    snprintf(msg, len, "the camera disagrees with the position pass: it projects P "
+             "%.3g px (RMS, max %.3g px) from the pixel centres", rms, maxe);
+    return 1;
 }
 
 obs_status obs_camera_solve_position(const obs_gbuffer *gb, const obs_plane *pos, obs_camera *cam,

@@ -1,7 +1,8 @@
-/* Camera maths: the plain field-of-view camera, fitting a projection to
- * an image's aspect, and the camera a frame is computed with (the
- * G-buffer's, overridden by parameters).  No file formats here (the
- * camera JSON is core/io/camera_json.c). */
+/* The camera from a request: the plain field-of-view camera, fitting a
+ * projection to an image's aspect, the matrices a binary request carried,
+ * and the camera a frame is computed with (the G-buffer's, overridden by
+ * parameters: HTTP query/JSON fields, CLI flags).  No file formats here
+ * (core/camera/exr.c, json.c). */
 #include <math.h>
 #include <string.h>
 
@@ -35,6 +36,13 @@ void obs_camera_from_fov(float fov_y_deg, float aspect, float near_z, float far_
     cam->projection[14] = -1.0f;
     cam->has_projection = 1;
     cam->source = OBS_CAMERA_PARAMS;
+}
+
+void obs_camera_from_request(obs_camera *cam, int has_world_to_camera, int has_projection)
+{
+    cam->has_world_to_camera = !!has_world_to_camera;
+    cam->has_projection = !!has_projection;
+    cam->source = cam->has_projection ? OBS_CAMERA_PARAMS : OBS_CAMERA_NONE;
 }
 
 obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p, obs_camera *out,

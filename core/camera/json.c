@@ -1,5 +1,6 @@
 /* The camera JSON written beside a render (see
- * tests/data/room_small.camera.json); the camera maths is core/camera.c. */
+ * tests/data/room_small.camera.json); the camera maths is
+ * core/camera/request.c. */
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <math.h>
