@@ -17,7 +17,7 @@ static const obs__preset presets[] = {
      * (camera-space depth along the view axis), N (world-space shading
      * normal) as N.X/Y/Z or N.R/G/B, the beauty as R,G,B,A; the header
      * carries arnold/... keys (arnold/version) and worldToCamera/worldToNDC
-     * in Arnold's own screen space (camera_detect.c).  Source: Arnold
+     * in Arnold's own screen space (core/camera/exr.c).  Source: Arnold
      * user guide, "AOVs" (Z, N: world space); the real frames in
      * ../shared/data/renderers/arnold (Arnold 4.2.16) have Z, N.X/Y/Z,
      * P.X/Y/Z; exrflatten's EXROperation_FixArnold detects Arnold by
