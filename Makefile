@@ -253,3 +253,11 @@ bake-quality: all $(QSTRIP)
 
 clean:
 	rm -rf build out
+
+# deploy/slurm's templates run by a live one-node Slurm on this machine
+# (tests/farm/slurm.sh: installs slurm-wlm and munge as root when missing;
+# skipped, saying why, where Slurm cannot run).  Not part of `make test`:
+# CI (.ci/run) runs it after.
+.PHONY: test-farm
+test-farm: $(CLI)
+	@BUILD=$(BUILD) OBSCURA=$(CLI) tests/farm/slurm.sh

@@ -18,6 +18,7 @@
 #include <new>
 #include <vector>
 
+#include "io/out_file.h"
 #include "obscura/deep.h"
 
 // exr_internal.h (a C header that includes openexr.h) declares it too.
@@ -51,6 +52,10 @@ extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image 
     if (d->offset[npx] > OBS_DEEP_MAX_SAMPLES)
         return fail(err, OBS_TOO_LARGE, "%s: %llu samples; at most %llu", path,
                     (unsigned long long)d->offset[npx], (unsigned long long)OBS_DEEP_MAX_SAMPLES);
+    // a temporary sibling renamed into place once the file is closed (out_file.h)
+    obs__out_file out;
+    const char *tmp = obs__out_begin(&out, path);
+    obs_status st = OBS_OK;
     try {
         const int dispw = d->display_width > 0 ? d->display_width : w;
         const int disph = d->display_height > 0 ? d->display_height : h;
@@ -117,15 +122,20 @@ extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image 
             fb.insert(c.name, DeepSlice(FLOAT, (char *)(p.data() - origin), sizeof(float *),
                                         sizeof(float *) * (size_t)w, OBS_DEEP_CH * sizeof(float)));
         }
-        DeepScanLineOutputFile file(path, hdr);
+        DeepScanLineOutputFile file(tmp, hdr);
         file.setFrameBuffer(fb);
         file.writePixels(h);
     } catch (const std::bad_alloc &) {
-        return fail(err, OBS_NO_MEMORY, "%s: out of memory writing the deep EXR", path);
+        st = fail(err, OBS_NO_MEMORY, "%s: out of memory writing the deep EXR", path);
     } catch (const std::exception &e) {
-        return fail(err, OBS_IO, "%s: %s", path, e.what());
+        st = fail(err, OBS_IO, "%s: %s", path, e.what());
     } catch (...) {
-        return fail(err, OBS_IO, "%s: cannot write the deep EXR", path);
+        st = fail(err, OBS_IO, "%s: cannot write the deep EXR", path);
     }
+    if (st != OBS_OK)
+        return obs__out_end(&out, st, NULL);
+    char sub[OBS_ERR_LEN] = "";
+    if ((st = obs__out_end(&out, st, sub)) != OBS_OK)
+        return fail(err, st, "%s: %s", path, sub);
     return OBS_OK;
 }

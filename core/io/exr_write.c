@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "io/exr_internal.h"
+#include "io/out_file.h"
 #include "internal.h"
 
 /* Names longer than this need the long-name flag in the file version. */
@@ -242,6 +243,7 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
     char sub[OBS_ERR_LEN] = "";
     exr_result_t rv = EXR_ERR_SUCCESS;
     obs_status st;
+    obs__out_file out = {0};
 
     if (!o)
         o = &zero;
@@ -288,14 +290,14 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
 
     init.error_handler_fn = obs__exr_error_handler;
     obs__exr_msg_reset();
-    /* A temporary file renamed at the end: a failed write leaves no
-     * half-written EXR behind for the next step of a render farm. */
+    /* A temporary sibling renamed at the end (out_file.h): a failed or
+     * killed write leaves no half-written EXR for the next step of a farm. */
     if (mem) {
         init.user_data = mem;
         init.write_fn = mem_write;
     }
     what = "creating the file";
-    if ((rv = exr_start_write(&ctx, path, mem ? EXR_WRITE_FILE_DIRECTLY : EXR_INTERMEDIATE_TEMP_FILE,
+    if ((rv = exr_start_write(&ctx, mem ? path : obs__out_begin(&out, path), EXR_WRITE_FILE_DIRECTLY,
                               &init)) == EXR_ERR_SUCCESS) {
         int cam_part = 0;
         for (int i = 0; o->append && i < np; i++)
@@ -322,6 +324,8 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
 fail:
     if (ctx)
         exr_finish(&ctx);
+    if (out.path)
+        st = obs__out_end(&out, st, sub);
     if (src)
         exr_finish(&src);
     if (parts == &one)

@@ -7,10 +7,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "internal.h"
 #include "obscura/io.h"
+#include "out_file.h"
 
 /* libpng states the cause of an error in a warning just before it. */
 typedef struct png_msgs {
@@ -86,7 +86,7 @@ static obs_status write_png(const char *path, obs__membuf *mem, const obs_image 
     png_infop info = NULL;
     volatile obs_status st = OBS_OK;
     size_t rowbytes;
-    struct stat sb;
+    obs__out_file out;
 
     if (!path || !*path || !img || !img->data)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_png_write: no path or image");
@@ -100,7 +100,7 @@ static obs_status write_png(const char *path, obs__membuf *mem, const obs_image 
     if (obs__size_mul3((size_t)img->width, (size_t)img->channels, (size_t)bits / 8, &rowbytes) != 0 ||
         !(row = malloc(rowbytes)))
         return obs__fail(err, OBS_NO_MEMORY, "%s: row of %d pixels", path, img->width);
-    if (!mem && !(fp = fopen(path, "wb"))) {
+    if (!mem && !(fp = fopen(obs__out_begin(&out, path), "wb"))) {
         st = obs__fail(msg, OBS_IO, "cannot create: %s", strerror(errno));
         goto fail;
     }
@@ -135,11 +135,11 @@ fail:
     if (fp && fclose(fp) != 0 && st == OBS_OK)
         st = obs__fail(msg, OBS_IO, "closing: %s", strerror(errno));
     free(row);
+    /* renamed into place whole, or no truncated PNG left behind */
+    if (fp)
+        st = obs__out_end(&out, st, msg);
     if (st == OBS_OK)
         return OBS_OK;
-    /* No truncated PNG left behind; devices and pipes are not ours. */
-    if (fp && stat(path, &sb) == 0 && S_ISREG(sb.st_mode))
-        remove(path);
     return obs__fail(err, st, "%s: %s", path, msg);
 }
 
