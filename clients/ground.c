@@ -388,6 +388,39 @@ static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene
     return EXIT_OK;
 }
 
+/* The G-buffer's EXR: depth, normals (world and camera), positions, the
+ * colour (its coverage alone without albedo) and the baked channels. */
+static int write_gbuffer(const ground_args *a, const obs_raster *r, const obs_image *baked,
+                         int has_baked, const obs_camera *cam, int w, int h,
+                         char err[OBS_ERR_LEN])
+{
+    static const char *const n_baked[] = {"_AO", "_AO_SHORT", "_AO_LONG"};
+    static const char *const n_z[] = {"Z"}, *const n_n[] = {"N.X", "N.Y", "N.Z"},
+                             *const n_nc[] = {"Ncam.X", "Ncam.Y", "Ncam.Z"},
+                             *const n_p[] = {"P.X", "P.Y", "P.Z"}, *const n_c[] = {"R", "G", "B", "A"},
+                             *const n_a[] = {"A"};
+    obs_image alpha = {0};
+    if (!r->has_albedo) {
+        size_t n = (size_t)w * h;
+        if (!(alpha.data = malloc(n * sizeof(float))))
+            return cli_fail(OBS_NO_MEMORY, a->out, NULL);
+        alpha.width = w;
+        alpha.height = h;
+        alpha.channels = 1;
+        for (size_t i = 0; i < n; i++)
+            alpha.data[i] = r->color.data[4 * i + 3];
+    }
+    const obs_exr_layer layers[] = {{&r->depth, n_z},       {&r->normal, n_n},
+                                    {&r->normal_cam, n_nc}, {&r->position, n_p},
+                                    r->has_albedo ? (obs_exr_layer){&r->color, n_c}
+                                                  : (obs_exr_layer){&alpha, n_a},
+                                    {baked, n_baked}};
+    /* Float: the sky depth (1e10) and world positions do not fit a half. */
+    obs_status s = obs_exr_write(a->out, layers, has_baked ? 6 : 5, OBS_EXR_FLOAT, cam, err);
+    obs_image_free(&alpha);
+    return s == OBS_OK ? EXIT_OK : cli_fail(s, a->out, err);
+}
+
 int cli_gbuffer(int argc, char **argv)
 {
     ground_args a = {.cmd = "gbuffer"};
@@ -457,37 +490,8 @@ int cli_gbuffer(int argc, char **argv)
     }
     double t_raster = cli_now_s() - t0;
 
-    static const char *const n_baked[] = {"_AO", "_AO_SHORT", "_AO_LONG"};
-    static const char *const n_z[] = {"Z"}, *const n_n[] = {"N.X", "N.Y", "N.Z"},
-                             *const n_nc[] = {"Ncam.X", "Ncam.Y", "Ncam.Z"},
-                             *const n_p[] = {"P.X", "P.Y", "P.Z"}, *const n_c[] = {"R", "G", "B", "A"},
-                             *const n_a[] = {"A"};
-    /* Without albedo only the coverage (A) of the colour image is kept. */
-    obs_image alpha = {0};
-    if (!r.has_albedo) {
-        size_t n = (size_t)w * h;
-        if (!(alpha.data = malloc(n * sizeof(float)))) {
-            rc = cli_fail(OBS_NO_MEMORY, a.out, NULL);
-            goto done;
-        }
-        alpha.width = w;
-        alpha.height = h;
-        alpha.channels = 1;
-        for (size_t i = 0; i < n; i++)
-            alpha.data[i] = r.color.data[4 * i + 3];
-    }
-    const obs_exr_layer layers[] = {{&r.depth, n_z},       {&r.normal, n_n},
-                                    {&r.normal_cam, n_nc}, {&r.position, n_p},
-                                    r.has_albedo ? (obs_exr_layer){&r.color, n_c}
-                                                 : (obs_exr_layer){&alpha, n_a},
-                                    {&baked, n_baked}};
-    /* Float: the sky depth (1e10) and world positions do not fit a half. */
-    s = obs_exr_write(a.out, layers, scene.baked ? 6 : 5, OBS_EXR_FLOAT, &cam, err);
-    obs_image_free(&alpha);
-    if (s != OBS_OK) {
-        rc = cli_fail(s, a.out, err);
+    if ((rc = write_gbuffer(&a, &r, &baked, scene.baked != NULL, &cam, w, h, err)) != EXIT_OK)
         goto done;
-    }
     if (!a.quiet) {
         obs_ctx_info ci;
         obs_ctx_get_info(ctx, &ci);
