@@ -305,30 +305,49 @@ int cli_batch_rotate(const char *list, int k, char *buf, size_t len)
     return 0;
 }
 
+/* A batch's flags and what the steps find: the frames, those with an
+ * input, and the ao options handed to every frame. */
+typedef struct batch_job {
+    const char *in, *out, *spec, *server;
+    int jobs, strict, quiet_given;
+    char **extra; /* the ao options */
+    int nextra, server_at;
+    int *frames, nframes;
+    int *todo, ntodo, missing;
+} batch_job;
+
+/* One frame's `obscura ao` arguments into av (room for nextra + 4):
+ * INPUT -o OUTPUT, then the ao options.  Returns the count. */
+static int frame_argv(char **av, char *inp, char *outp, char **extra, int nextra)
+{
+    int n = 0;
+    av[n++] = inp;
+    av[n++] = "-o";
+    av[n++] = outp;
+    for (int k = 0; k < nextra; k++)
+        av[n++] = extra[k];
+    av[n] = NULL;
+    return n;
+}
+
 /* One worker: frames from the shared counter until none are left.  With
  * a list of servers, frame i starts at server i (round robin). */
-static void worker(int fd, shared *sh, const int *todo, int ntodo, const char *in, const char *out,
-                   char **extra, int nextra, int server_at, const cli_batch_ops *ops)
+static void worker(int fd, shared *sh, const batch_job *b, const cli_batch_ops *ops)
 {
-    char **av = malloc((size_t)(nextra + 4) * sizeof *av);
+    char **av = malloc((size_t)(b->nextra + 4) * sizeof *av);
     char inp[PATH_MAX], outp[PATH_MAX], servers[4096];
     for (;;) {
         int i = __atomic_fetch_add(&sh->next, 1, __ATOMIC_SEQ_CST);
-        if (i >= ntodo || __atomic_load_n(&sh->stop, __ATOMIC_SEQ_CST))
+        if (i >= b->ntodo || __atomic_load_n(&sh->stop, __ATOMIC_SEQ_CST))
             break;
         report r = {i, RC_FAIL, 0};
         double t0 = now_s();
-        if (av && cli_batch_expand(in, todo[i], inp, sizeof inp) == 0 &&
-            cli_batch_expand(out, todo[i], outp, sizeof outp) == 0) {
-            int n = 0;
-            av[n++] = inp;
-            av[n++] = "-o";
-            av[n++] = outp;
-            for (int k = 0; k < nextra; k++)
-                av[n++] = extra[k];
-            av[n] = NULL;
-            if (server_at >= 0 && cli_batch_rotate(extra[server_at], i, servers, sizeof servers) == 0)
-                av[3 + server_at] = servers;
+        if (av && cli_batch_expand(b->in, b->todo[i], inp, sizeof inp) == 0 &&
+            cli_batch_expand(b->out, b->todo[i], outp, sizeof outp) == 0) {
+            int n = frame_argv(av, inp, outp, b->extra, b->nextra);
+            if (b->server_at >= 0 &&
+                cli_batch_rotate(b->extra[b->server_at], i, servers, sizeof servers) == 0)
+                av[3 + b->server_at] = servers;
             r.rc = ops->ao(n, av);
         }
         r.seconds = now_s() - t0;
@@ -343,20 +362,10 @@ static void worker(int fd, shared *sh, const int *todo, int ntodo, const char *i
         ops->finish();
 }
 
-int cli_batch(int argc, char **argv, const cli_batch_ops *ops)
+/* The batch's own flags; the rest are ao options (b->extra, room for
+ * argc + 4).  Returns RC_OK or the usage error's code. */
+static int parse_args(int argc, char **argv, batch_job *b)
 {
-    const char *in = NULL, *out = NULL, *spec = NULL, *server = NULL;
-    int jobs = 1, strict = 0, quiet_given = 0;
-    char err[512];
-    char **extra = malloc((size_t)(argc + 4) * sizeof *extra);
-    int nextra = 0, rc = RC_OK;
-    int *frames = NULL, *todo = NULL, *code = NULL;
-    shared *sh = MAP_FAILED;
-    pid_t pids[MAX_JOBS];
-    int nworkers = 0;
-    if (!extra)
-        return RC_FAIL;
-
 #define VALUE(name)                                                                              \
     (!strcmp(a, name) ? (i + 1 < argc ? argv[++i] : NULL)                                        \
                       : (!strncmp(a, name "=", sizeof name) ? a + sizeof name : (const char *)0))
@@ -373,173 +382,157 @@ int cli_batch(int argc, char **argv, const cli_batch_ops *ops)
                             : MATCHES("--server")      ? VALUE("--server")
                             : MATCHES("--jobs")        ? VALUE("--jobs")
                                                        : VALUE("-j");
-            if (!v) {
-                rc = usage_error("option %s needs a value", name);
-                goto done;
-            }
+            if (!v)
+                return usage_error("option %s needs a value", name);
             if (!strncmp(name, "--frames", 8))
-                spec = v;
+                b->spec = v;
             else if (!strncmp(name, "-o", 2) || !strncmp(name, "--output-file", 13))
-                out = v;
+                b->out = v;
             else if (!strncmp(name, "--server", 8))
-                server = v;
+                b->server = v;
             else {
                 char *end;
                 long j = strtol(v, &end, 10);
-                if (*end || j < 1 || j > MAX_JOBS) {
-                    rc = usage_error("--jobs: '%s' is not in [1, 64]", v);
-                    goto done;
-                }
-                jobs = (int)j;
+                if (*end || j < 1 || j > MAX_JOBS)
+                    return usage_error("--jobs: '%s' is not in [1, 64]", v);
+                b->jobs = (int)j;
             }
         } else if (!strcmp(a, "--strict")) {
-            strict = 1;
-            extra[nextra++] = argv[i]; /* each frame's sanity warnings are errors too */
-        } else if (!in && a[0] != '-' && (i == 0 || cli_batch_check_pattern(a, NULL, 0) == 0)) {
-            in = a; /* the input pattern: first, or the first word with a placeholder */
+            b->strict = 1;
+            b->extra[b->nextra++] = argv[i]; /* each frame's sanity warnings are errors too */
+        } else if (!b->in && a[0] != '-' && (i == 0 || cli_batch_check_pattern(a, NULL, 0) == 0)) {
+            b->in = a; /* the input pattern: first, or the first word with a placeholder */
         } else {
-            quiet_given |= !strcmp(a, "-q") || !strcmp(a, "--quiet") || !strcmp(a, "-v") ||
-                           !strcmp(a, "--verbose");
-            extra[nextra++] = argv[i];
+            b->quiet_given |= !strcmp(a, "-q") || !strcmp(a, "--quiet") || !strcmp(a, "-v") ||
+                              !strcmp(a, "--verbose");
+            b->extra[b->nextra++] = argv[i];
         }
     }
 #undef VALUE
 #undef MATCHES
-    if (!in) {
-        rc = usage_error("%s", "no input pattern (e.g. 'shot/frame.####.exr')");
-        goto done;
-    }
-    if (!out) {
-        rc = usage_error("%s", "no output pattern (-o 'out/ao.####.exr')");
-        goto done;
-    }
-    if (!spec) {
-        rc = usage_error("%s", "no frames (--frames 1-100, 1-100x2, 1,5,9)");
-        goto done;
-    }
-    if (cli_batch_check_pattern(in, err, sizeof err) != 0 || cli_batch_check_pattern(out, err, sizeof err) != 0) {
-        rc = usage_error("%s", err);
-        goto done;
-    }
-    int nframes;
-    if (cli_batch_parse_frames(spec, &frames, &nframes, err, sizeof err) != 0) {
-        rc = usage_error("%s", err);
-        goto done;
-    }
-    if (!server && jobs > 1) {
-        rc = usage_error("%s", "--jobs > 1 needs --server: in-process, every frame runs on the one GL "
-                               "context (for parallel frames run obscurad and pass --server)");
-        goto done;
-    }
-    int server_at = -1;
-    if (server) {
-        extra[nextra++] = "--server";
-        server_at = nextra;
-        extra[nextra++] = (char *)server;
-    }
-    if (!quiet_given)
-        extra[nextra++] = "-q"; /* the progress replaces ao's per-frame lines */
+    return RC_OK;
+}
 
-    /* the ao options: checked once, before any frame (exits 2 when wrong) */
-    {
-        char inp[PATH_MAX], outp[PATH_MAX];
-        char **av = malloc((size_t)(nextra + 4) * sizeof *av);
-        if (!av || cli_batch_expand(in, frames[0], inp, sizeof inp) != 0 ||
-            cli_batch_expand(out, frames[0], outp, sizeof outp) != 0) {
-            free(av);
-            rc = usage_error("%s", "a pattern expands to a path that is too long");
-            goto done;
-        }
-        int n = 0;
-        av[n++] = inp;
-        av[n++] = "-o";
-        av[n++] = outp;
-        for (int k = 0; k < nextra; k++)
-            av[n++] = extra[k];
-        av[n] = NULL;
-        ops->check(n, av);
+/* The patterns, the frames, --jobs against --server; then --server and
+ * -q join the ao options.  Returns RC_OK or the usage error's code. */
+static int check_job(batch_job *b)
+{
+    char err[512];
+    if (!b->in)
+        return usage_error("%s", "no input pattern (e.g. 'shot/frame.####.exr')");
+    if (!b->out)
+        return usage_error("%s", "no output pattern (-o 'out/ao.####.exr')");
+    if (!b->spec)
+        return usage_error("%s", "no frames (--frames 1-100, 1-100x2, 1,5,9)");
+    if (cli_batch_check_pattern(b->in, err, sizeof err) != 0 ||
+        cli_batch_check_pattern(b->out, err, sizeof err) != 0)
+        return usage_error("%s", err);
+    if (cli_batch_parse_frames(b->spec, &b->frames, &b->nframes, err, sizeof err) != 0)
+        return usage_error("%s", err);
+    if (!b->server && b->jobs > 1)
+        return usage_error("%s", "--jobs > 1 needs --server: in-process, every frame runs on the one GL "
+                                 "context (for parallel frames run obscurad and pass --server)");
+    if (b->server) {
+        b->extra[b->nextra++] = "--server";
+        b->server_at = b->nextra;
+        b->extra[b->nextra++] = (char *)b->server;
+    }
+    if (!b->quiet_given)
+        b->extra[b->nextra++] = "-q"; /* the progress replaces ao's per-frame lines */
+    return RC_OK;
+}
+
+/* The ao options: checked once, before any frame (exits 2 when wrong). */
+static int check_ao_options(const batch_job *b, const cli_batch_ops *ops)
+{
+    char inp[PATH_MAX], outp[PATH_MAX];
+    char **av = malloc((size_t)(b->nextra + 4) * sizeof *av);
+    if (!av || cli_batch_expand(b->in, b->frames[0], inp, sizeof inp) != 0 ||
+        cli_batch_expand(b->out, b->frames[0], outp, sizeof outp) != 0) {
         free(av);
+        return usage_error("%s", "a pattern expands to a path that is too long");
     }
+    ops->check(frame_argv(av, inp, outp, b->extra, b->nextra), av);
+    free(av);
+    return RC_OK;
+}
 
-    /* missing inputs: reported; fatal (before any work) with --strict */
-    int ntodo = 0, missing = 0;
-    todo = malloc((size_t)nframes * sizeof *todo);
-    if (!todo) {
-        rc = RC_FAIL;
-        goto done;
-    }
-    for (int i = 0; i < nframes; i++) {
+/* The frames whose input exists (b->todo), their output folders made;
+ * missing inputs reported, fatal (before any work) with --strict. */
+static int find_inputs(batch_job *b)
+{
+    b->todo = malloc((size_t)b->nframes * sizeof *b->todo);
+    if (!b->todo)
+        return RC_FAIL;
+    for (int i = 0; i < b->nframes; i++) {
         char p[PATH_MAX];
-        cli_batch_expand(in, frames[i], p, sizeof p);
+        cli_batch_expand(b->in, b->frames[i], p, sizeof p);
         if (access(p, R_OK) != 0) {
-            fprintf(stderr, "obscura: batch: frame %d: missing input %s (%s)\n", frames[i], p, strerror(errno));
-            missing++;
+            fprintf(stderr, "obscura: batch: frame %d: missing input %s (%s)\n", b->frames[i], p, strerror(errno));
+            b->missing++;
             continue;
         }
-        cli_batch_expand(out, frames[i], p, sizeof p);
+        cli_batch_expand(b->out, b->frames[i], p, sizeof p);
         if (make_parent(p) != 0) {
             fprintf(stderr, "obscura: batch: cannot create the folder of %s: %s\n", p, strerror(errno));
-            rc = RC_FAIL;
-            goto done;
+            return RC_FAIL;
         }
-        todo[ntodo++] = frames[i];
+        b->todo[b->ntodo++] = b->frames[i];
     }
-    if (missing && strict) {
-        fprintf(stderr, "obscura: batch: %d of %d input frames missing; --strict: nothing rendered\n", missing,
-                nframes);
-        rc = RC_BADINPUT;
-        goto done;
+    if (b->missing && b->strict) {
+        fprintf(stderr, "obscura: batch: %d of %d input frames missing; --strict: nothing rendered\n",
+                b->missing, b->nframes);
+        return RC_BADINPUT;
     }
+    return RC_OK;
+}
 
-    /* the workers */
-    int fds[2] = {-1, -1};
-    code = malloc((size_t)(ntodo ? ntodo : 1) * sizeof *code);
-    sh = mmap(NULL, sizeof *sh, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
-    if (!code || sh == MAP_FAILED || pipe(fds) != 0) {
-        fprintf(stderr, "obscura: batch: %s\n", strerror(errno));
-        rc = RC_FAIL;
-        goto done;
-    }
-    sh->next = sh->stop = 0;
-    for (int i = 0; i < ntodo; i++)
-        code[i] = -1;
-    int want = jobs < ntodo ? jobs : ntodo;
+/* Forks up to --jobs workers writing to fd; returns how many started.
+ * A worker frees what the parent holds and exits 0. */
+static int start_workers(batch_job *b, const cli_batch_ops *ops, shared *sh, int fds[2],
+                         int *code, pid_t *pids)
+{
+    int want = b->jobs < b->ntodo ? b->jobs : b->ntodo, n = 0;
     fflush(NULL);
-    for (; nworkers < want; nworkers++) {
+    for (; n < want; n++) {
         pid_t p = fork();
         if (p < 0)
             break;
         if (p == 0) {
             close(fds[0]);
-            worker(fds[1], sh, todo, ntodo, in, out, extra, nextra, server_at, ops);
+            worker(fds[1], sh, b, ops);
             close(fds[1]);
-            free(extra);
-            free(frames);
-            free(todo);
+            free(b->extra);
+            free(b->frames);
+            free(b->todo);
             free(code);
             munmap(sh, sizeof *sh);
             exit(0);
         }
-        pids[nworkers] = p;
+        pids[n] = p;
     }
-    close(fds[1]);
+    return n;
+}
+
+/* Each frame's code from the workers' reports (code[i] -1 until then),
+ * the progress drawn as they come; then the workers reaped. */
+static void collect(const batch_job *b, int fd, int *code, const pid_t *pids, int nworkers,
+                    double t0)
+{
     int tty = isatty(2), done_n = 0;
-    double t0 = now_s();
-    if (nworkers == 0 && ntodo > 0)
-        fprintf(stderr, "obscura: batch: cannot start a worker: %s\n", strerror(errno));
     report r;
     for (;;) {
-        ssize_t got = read(fds[0], &r, sizeof r);
+        ssize_t got = read(fd, &r, sizeof r);
         if (got < 0 && errno == EINTR)
             continue;
         if (got != (ssize_t)sizeof r)
             break;
-        if (r.index < 0 || r.index >= ntodo || code[r.index] != -1)
+        if (r.index < 0 || r.index >= b->ntodo || code[r.index] != -1)
             continue;
         code[r.index] = r.rc;
-        progress(tty, ++done_n, ntodo, t0, todo[r.index], r.rc, r.seconds);
+        progress(tty, ++done_n, b->ntodo, t0, b->todo[r.index], r.rc, r.seconds);
     }
-    close(fds[0]);
+    close(fd);
     for (int k = 0; k < nworkers; k++) {
         int st;
         while (waitpid(pids[k], &st, 0) < 0 && errno == EINTR)
@@ -548,12 +541,15 @@ int cli_batch(int argc, char **argv, const cli_batch_ops *ops)
             fprintf(stderr, "obscura: batch: a worker %s %d\n", WIFSIGNALED(st) ? "died of signal" : "exited",
                     WIFSIGNALED(st) ? WTERMSIG(st) : WEXITSTATUS(st));
     }
-    double el = now_s() - t0;
-    if (tty && done_n < ntodo)
+    if (tty && done_n < b->ntodo)
         fputc('\n', stderr);
+}
 
+/* The closing line and the batch's exit code from the frames' codes. */
+static int summarise(const batch_job *b, const int *code, double el)
+{
     int ok = 0, failed = 0, not_run = 0, n3 = 0, n1 = 0, n4 = 0, n2 = 0;
-    for (int i = 0; i < ntodo; i++) {
+    for (int i = 0; i < b->ntodo; i++) {
         switch (code[i]) {
         case RC_OK: ok++; break;
         case -1: not_run++; break;
@@ -566,18 +562,60 @@ int cli_batch(int argc, char **argv, const cli_batch_ops *ops)
         }
     }
     fprintf(stderr, "obscura: batch: %d frames: %d ok, %d failed, %d missing, %d not run; %.1f s, %.2f frames/s\n",
-            nframes, ok, failed, missing, not_run, el, el > 0 ? ok / el : 0.0);
+            b->nframes, ok, failed, b->missing, not_run, el, el > 0 ? ok / el : 0.0);
     /* a permanent failure first (a retry cannot help), the server last */
-    rc = n2 ? RC_USAGE : n3 ? RC_BADINPUT : n1 ? RC_FAIL : (n4 || not_run) ? RC_UNAVAILABLE : RC_OK;
+    int rc = n2 ? RC_USAGE : n3 ? RC_BADINPUT : n1 ? RC_FAIL : (n4 || not_run) ? RC_UNAVAILABLE : RC_OK;
     if (not_run && !n4 && !n1 && !n3 && !n2)
         rc = RC_FAIL; /* a worker died */
+    return rc;
+}
 
+/* The frames in the workers, their codes collected, the summary. */
+static int run_frames(batch_job *b, const cli_batch_ops *ops)
+{
+    int rc = RC_OK, fds[2] = {-1, -1};
+    pid_t pids[MAX_JOBS];
+    int *code = malloc((size_t)(b->ntodo ? b->ntodo : 1) * sizeof *code);
+    shared *sh = mmap(NULL, sizeof *sh, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    if (!code || sh == MAP_FAILED || pipe(fds) != 0) {
+        fprintf(stderr, "obscura: batch: %s\n", strerror(errno));
+        rc = RC_FAIL;
+        goto done;
+    }
+    sh->next = sh->stop = 0;
+    for (int i = 0; i < b->ntodo; i++)
+        code[i] = -1;
+    int nworkers = start_workers(b, ops, sh, fds, code, pids);
+    close(fds[1]);
+    double t0 = now_s();
+    if (nworkers == 0 && b->ntodo > 0)
+        fprintf(stderr, "obscura: batch: cannot start a worker: %s\n", strerror(errno));
+    collect(b, fds[0], code, pids, nworkers, t0);
+    rc = summarise(b, code, now_s() - t0);
 done:
     if (sh != MAP_FAILED)
         munmap(sh, sizeof *sh);
     free(code);
-    free(todo);
-    free(frames);
-    free(extra);
+    return rc;
+}
+
+int cli_batch(int argc, char **argv, const cli_batch_ops *ops)
+{
+    batch_job b = {.jobs = 1, .server_at = -1};
+    b.extra = malloc((size_t)(argc + 4) * sizeof *b.extra);
+    if (!b.extra)
+        return RC_FAIL;
+    int rc = parse_args(argc, argv, &b);
+    if (rc == RC_OK)
+        rc = check_job(&b);
+    if (rc == RC_OK)
+        rc = check_ao_options(&b, ops);
+    if (rc == RC_OK)
+        rc = find_inputs(&b);
+    if (rc == RC_OK)
+        rc = run_frames(&b, ops);
+    free(b.todo);
+    free(b.frames);
+    free(b.extra);
     return rc;
 }

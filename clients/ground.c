@@ -118,6 +118,16 @@ static long parse_long(const ground_args *a, const char *name, const char *v, lo
     return x;
 }
 
+/* --near, --distance: a positive finite length, else a usage error. */
+static double positive_length(const ground_args *a, const char *key, const char *v)
+{
+    char *end;
+    double d = strtod(v, &end);
+    if (end == v || *end || !(d > 0) || !isfinite(d))
+        cli_die_usage(a->cmd, "--%s '%s': expected a positive length", key, v);
+    return d;
+}
+
 static void parse(ground_args *a, int argc, char **argv, int reference)
 {
     for (int i = 0; i < argc; i++) {
@@ -186,20 +196,14 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
                 cli_die_usage(a->cmd, "--%s '%s': %s", key, v, err);
             a->decor_given = 1;
         } else if (reference && (v = opt_value(a, argc, argv, &i, "near"))) {
-            char *end;
-            a->near = strtod(v, &end);
-            if (end == v || *end || !(a->near > 0) || !isfinite(a->near))
-                cli_die_usage(a->cmd, "--near '%s': expected a positive length", v);
+            a->near = positive_length(a, "near", v);
         } else if (reference && (v = opt_value(a, argc, argv, &i, "blend"))) {
             char err[OBS_ERR_LEN] = "";
             if (obs_bake_param_set(&a->bake, "blend", v, err) != OBS_OK)
                 cli_die_usage(a->cmd, "--blend '%s': %s", v, err);
             a->blend_given = 1;
         } else if (reference && (v = opt_value(a, argc, argv, &i, "distance"))) {
-            char *end;
-            a->distance = strtod(v, &end);
-            if (end == v || *end || !(a->distance > 0) || !isfinite(a->distance))
-                cli_die_usage(a->cmd, "--distance '%s': expected a positive length", v);
+            a->distance = positive_length(a, "distance", v);
         } else if (!strcmp(argv[i], "-q") || !strcmp(argv[i], "--quiet"))
             a->quiet = 1;
         else if (!strcmp(argv[i], "-v") || !strcmp(argv[i], "--verbose"))
@@ -384,6 +388,39 @@ static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene
     return EXIT_OK;
 }
 
+/* The G-buffer's EXR: depth, normals (world and camera), positions, the
+ * colour (its coverage alone without albedo) and the baked channels. */
+static int write_gbuffer(const ground_args *a, const obs_raster *r, const obs_image *baked,
+                         int has_baked, const obs_camera *cam, int w, int h,
+                         char err[OBS_ERR_LEN])
+{
+    static const char *const n_baked[] = {"_AO", "_AO_SHORT", "_AO_LONG"};
+    static const char *const n_z[] = {"Z"}, *const n_n[] = {"N.X", "N.Y", "N.Z"},
+                             *const n_nc[] = {"Ncam.X", "Ncam.Y", "Ncam.Z"},
+                             *const n_p[] = {"P.X", "P.Y", "P.Z"}, *const n_c[] = {"R", "G", "B", "A"},
+                             *const n_a[] = {"A"};
+    obs_image alpha = {0};
+    if (!r->has_albedo) {
+        size_t n = (size_t)w * h;
+        if (!(alpha.data = malloc(n * sizeof(float))))
+            return cli_fail(OBS_NO_MEMORY, a->out, NULL);
+        alpha.width = w;
+        alpha.height = h;
+        alpha.channels = 1;
+        for (size_t i = 0; i < n; i++)
+            alpha.data[i] = r->color.data[4 * i + 3];
+    }
+    const obs_exr_layer layers[] = {{&r->depth, n_z},       {&r->normal, n_n},
+                                    {&r->normal_cam, n_nc}, {&r->position, n_p},
+                                    r->has_albedo ? (obs_exr_layer){&r->color, n_c}
+                                                  : (obs_exr_layer){&alpha, n_a},
+                                    {baked, n_baked}};
+    /* Float: the sky depth (1e10) and world positions do not fit a half. */
+    obs_status s = obs_exr_write(a->out, layers, has_baked ? 6 : 5, OBS_EXR_FLOAT, cam, err);
+    obs_image_free(&alpha);
+    return s == OBS_OK ? EXIT_OK : cli_fail(s, a->out, err);
+}
+
 int cli_gbuffer(int argc, char **argv)
 {
     ground_args a = {.cmd = "gbuffer"};
@@ -453,37 +490,8 @@ int cli_gbuffer(int argc, char **argv)
     }
     double t_raster = cli_now_s() - t0;
 
-    static const char *const n_baked[] = {"_AO", "_AO_SHORT", "_AO_LONG"};
-    static const char *const n_z[] = {"Z"}, *const n_n[] = {"N.X", "N.Y", "N.Z"},
-                             *const n_nc[] = {"Ncam.X", "Ncam.Y", "Ncam.Z"},
-                             *const n_p[] = {"P.X", "P.Y", "P.Z"}, *const n_c[] = {"R", "G", "B", "A"},
-                             *const n_a[] = {"A"};
-    /* Without albedo only the coverage (A) of the colour image is kept. */
-    obs_image alpha = {0};
-    if (!r.has_albedo) {
-        size_t n = (size_t)w * h;
-        if (!(alpha.data = malloc(n * sizeof(float)))) {
-            rc = cli_fail(OBS_NO_MEMORY, a.out, NULL);
-            goto done;
-        }
-        alpha.width = w;
-        alpha.height = h;
-        alpha.channels = 1;
-        for (size_t i = 0; i < n; i++)
-            alpha.data[i] = r.color.data[4 * i + 3];
-    }
-    const obs_exr_layer layers[] = {{&r.depth, n_z},       {&r.normal, n_n},
-                                    {&r.normal_cam, n_nc}, {&r.position, n_p},
-                                    r.has_albedo ? (obs_exr_layer){&r.color, n_c}
-                                                 : (obs_exr_layer){&alpha, n_a},
-                                    {&baked, n_baked}};
-    /* Float: the sky depth (1e10) and world positions do not fit a half. */
-    s = obs_exr_write(a.out, layers, scene.baked ? 6 : 5, OBS_EXR_FLOAT, &cam, err);
-    obs_image_free(&alpha);
-    if (s != OBS_OK) {
-        rc = cli_fail(s, a.out, err);
+    if ((rc = write_gbuffer(&a, &r, &baked, scene.baked != NULL, &cam, w, h, err)) != EXIT_OK)
         goto done;
-    }
     if (!a.quiet) {
         obs_ctx_info ci;
         obs_ctx_get_info(ctx, &ci);
@@ -551,7 +559,10 @@ static obs_status read_triple(const char *path, const char *const cands[][3], in
     return s == OBS_NO_MEMORY ? s : OBS_MISSING_CHANNEL;
 }
 
-int cli_reference(int argc, char **argv)
+/* The points of a G-buffer: ours (P, N) or Blender's; the camera from
+ * its header unless --camera gave one. */
+static int read_gbuffer_points(const ground_args *a, obs_camera *cam, obs_image *pos,
+                               obs_image *nrm, char err[OBS_ERR_LEN])
 {
     static const char *const pos_cands[][3] = {{"P.X", "P.Y", "P.Z"},
                                                {"ViewLayer.Position.X", "ViewLayer.Position.Y",
@@ -559,6 +570,66 @@ int cli_reference(int argc, char **argv)
     static const char *const nrm_cands[][3] = {{"N.X", "N.Y", "N.Z"},
                                                {"ViewLayer.Normal.X", "ViewLayer.Normal.Y",
                                                 "ViewLayer.Normal.Z"}};
+    obs_status s;
+    if (!a->camera) {
+        obs_gbuffer_file gf = {0};
+        if ((s = obs_gbuffer_read_exr(a->gbuffer, NULL, NULL, &gf, err)) != OBS_OK)
+            return cli_input_fail(s, a->gbuffer, err);
+        *cam = gf.gb.camera;
+        obs_gbuffer_free(&gf);
+        if (!cam->has_projection)
+            return cli_input_fail(OBS_NO_CAMERA, a->gbuffer,
+                        "no worldToCamera/worldToNDC in the header: use --camera");
+    }
+    if ((s = read_triple(a->gbuffer, pos_cands, 2, pos, err)) != OBS_OK ||
+        (s = read_triple(a->gbuffer, nrm_cands, 2, nrm, err)) != OBS_OK)
+        return cli_input_fail(s, a->gbuffer, err);
+    return EXIT_OK;
+}
+
+/* --obscurance: the bake's two distances, blend and decorators instead
+ * of one distance. */
+static int setup_obscurance(const ground_args *a, const obs_bake_params *bp,
+                            const obs_scene *scene, obs_reference_desc *desc,
+                            obs_bake_occluders **occl)
+{
+    desc->obscurance = 1;
+    desc->obscurance_distance[0] = bp->distance_short;
+    desc->obscurance_distance[1] = bp->distance_long;
+    desc->blend = bp->blend;
+    desc->obscurance_near = (float)a->near;
+    if (scene->opacity && !a->quiet)
+        fprintf(stderr, "obscura: info: %s: opacities not used: the obscurance traces every "
+                        "surface as opaque, as the bake does\n", a->scene);
+    int rc = load_occluders(a, occl);
+    desc->occluders = *occl;
+    return rc;
+}
+
+/* The PNG (the blend alone: channel 0 of 3 or 5 with obscurance) or the
+ * EXR with the depth. */
+static obs_status write_reference(const ground_args *a, int png, obs_image *ao,
+                                  const obs_image *depth, const obs_camera *cam,
+                                  char err[OBS_ERR_LEN])
+{
+    if (png) {
+        if (a->obscurance) {
+            size_t n = (size_t)ao->width * ao->height;
+            for (size_t i = 0; i < n; i++)
+                ao->data[i] = ao->data[(size_t)ao->channels * i];
+            ao->channels = 1;
+        }
+        return obs_png_write(a->out, ao, 8, 0, err);
+    }
+    static const char *const n_obs[] = {"AO.Y", "AO_SHORT.Y", "AO_LONG.Y", "AO_NEAR.Y",
+                                        "AO_BOTH.Y"},
+                             *const n_ao[] = {"AO.Y"}, *const n_z[] = {"Z"};
+    const obs_exr_layer layers[] = {{ao, a->obscurance ? n_obs : n_ao}, {depth, n_z}};
+    return obs_exr_write(a->out, layers, 2, OBS_EXR_FLOAT, cam, err);
+}
+
+int cli_reference(int argc, char **argv)
+{
     ground_args a = {.cmd = "reference", .distance = 0.5};
     parse(&a, argc, argv, 1);
     int png = ends_with(a.out, ".png");
@@ -576,23 +647,8 @@ int cli_reference(int argc, char **argv)
     if (a.camera && (rc = load_camera(&a, &cam, &w, &h)) != EXIT_OK)
         return rc;
     if (a.gbuffer) {
-        /* The points of a G-buffer: ours (P, N) or Blender's; the camera
-         * from its header unless --camera gives one. */
-        if (!a.camera) {
-            obs_gbuffer_file gf = {0};
-            if ((s = obs_gbuffer_read_exr(a.gbuffer, NULL, NULL, &gf, err)) != OBS_OK)
-                return cli_input_fail(s, a.gbuffer, err);
-            cam = gf.gb.camera;
-            obs_gbuffer_free(&gf);
-            if (!cam.has_projection)
-                return cli_input_fail(OBS_NO_CAMERA, a.gbuffer,
-                            "no worldToCamera/worldToNDC in the header: use --camera");
-        }
-        if ((s = read_triple(a.gbuffer, pos_cands, 2, &pos, err)) != OBS_OK ||
-            (s = read_triple(a.gbuffer, nrm_cands, 2, &nrm, err)) != OBS_OK) {
-            rc = cli_input_fail(s, a.gbuffer, err);
+        if ((rc = read_gbuffer_points(&a, &cam, &pos, &nrm, err)) != EXIT_OK)
             goto done;
-        }
         w = pos.width;
         h = pos.height;
     }
@@ -607,19 +663,8 @@ int cli_reference(int argc, char **argv)
                                .seed = a.seed, .threads = (int)a.threads};
     obs_bake_params bp;
     obs_bake_params_resolve(&a.bake, &bp);
-    if (a.obscurance) {
-        desc.obscurance = 1;
-        desc.obscurance_distance[0] = bp.distance_short;
-        desc.obscurance_distance[1] = bp.distance_long;
-        desc.blend = bp.blend;
-        desc.obscurance_near = (float)a.near;
-        if (scene.opacity && !a.quiet)
-            fprintf(stderr, "obscura: info: %s: opacities not used: the obscurance traces every "
-                            "surface as opaque, as the bake does\n", a.scene);
-        if ((rc = load_occluders(&a, &occl)) != EXIT_OK)
-            goto done;
-        desc.occluders = occl;
-    }
+    if (a.obscurance && (rc = setup_obscurance(&a, &bp, &scene, &desc, &occl)) != EXIT_OK)
+        goto done;
     if (!a.quiet && isatty(STDERR_FILENO)) {
         desc.progress = progress_cb;
         desc.progress_user = &last;
@@ -630,28 +675,7 @@ int cli_reference(int argc, char **argv)
         goto done;
     }
     double t = cli_now_s() - t0;
-
-    if (png) {
-        /* obscurance: the blend alone (channel 0 of 3 or 5) */
-        if (a.obscurance) {
-            size_t n = (size_t)ao.width * ao.height;
-            for (size_t i = 0; i < n; i++)
-                ao.data[i] = ao.data[(size_t)ao.channels * i];
-            ao.channels = 1;
-        }
-        s = obs_png_write(a.out, &ao, 8, 0, err);
-    } else if (a.obscurance) {
-        static const char *const n_ao[] = {"AO.Y", "AO_SHORT.Y", "AO_LONG.Y", "AO_NEAR.Y",
-                                           "AO_BOTH.Y"},
-                                 *const n_z[] = {"Z"};
-        const obs_exr_layer layers[] = {{&ao, n_ao}, {&depth, n_z}};
-        s = obs_exr_write(a.out, layers, 2, OBS_EXR_FLOAT, &cam, err);
-    } else {
-        static const char *const n_ao[] = {"AO.Y"}, *const n_z[] = {"Z"};
-        const obs_exr_layer layers[] = {{&ao, n_ao}, {&depth, n_z}};
-        s = obs_exr_write(a.out, layers, 2, OBS_EXR_FLOAT, &cam, err);
-    }
-    if (s != OBS_OK) {
+    if ((s = write_reference(&a, png, &ao, &depth, &cam, err)) != OBS_OK) {
         rc = cli_fail(s, a.out, err);
         goto done;
     }

@@ -513,164 +513,185 @@ done:
     return rc;
 }
 
-static int cmd_ao(int argc, char **argv)
+/* The input's layout and camera, at --verbose. */
+static void print_input_info(const char *in, const obs_exr_info *info, const obs_gbuffer *gb)
 {
-    ao_args a;
-    char err[OBS_ERR_LEN] = "";
-    obs_gbuffer_file gf = {0};
-    obs_result res = {0};
-    obs_image baked = {0};
-    obs_ctx *ctx = NULL;
-    obs_status s;
-    int rc = EXIT_OK;
-    const char *server = NULL;
-
-    argc = cli_remote_take_server(argc, argv, &server);
-    parse_ao(argc, argv, &a);
-    obs_limits lim = {0};
-    if (a.max_size)
-        lim.max_width = lim.max_height = (int)a.max_size;
-
-    int deep = 0;
-    if (obs_exr_is_deep(a.in, &deep, err) == OBS_OK && deep) {
-        if (a.req.baked && strcmp(a.req.baked, "none") != 0)
-            die_usage("ao: --baked: the input is a deep EXR; a baked channel is combined with "
-                      "flat input only");
-        return cmd_ao_deep(&a, &lim, server, argc, argv);
-    }
-    double t0 = now_ms();
-    s = obs_gbuffer_read_exr(a.in, &a.req.map, &lim, &gf, err);
-    if (s != OBS_OK)
-        return cli_input_fail(s, a.in, err);
-    double t_read = now_ms() - t0;
-    const obs_exr_info *info = &gf.info;
     if (verbosity >= OBS_LOG_INFO) {
         fprintf(stderr, "obscura: info: %s: %dx%d, preset %s, depth %s, normals %s, colour %s\n",
-                a.in, gf.gb.width, gf.gb.height, info->preset, info->depth,
+                in, gb->width, gb->height, info->preset, info->depth,
                 info->normal[0][0] ? info->normal[0] : "(none)",
                 info->color[0][0] ? info->color[0] : "(none)");
     }
     if (verbosity >= OBS_LOG_INFO && info->camera_source[0])
         fprintf(stderr, "obscura: info: camera from %s%s%s\n", info->camera_source,
                 info->camera_check[0] ? "; " : "", info->camera_check);
-    if (a.camera) {
+}
+
+/* The camera: --camera's file, else the header's, else solved from the
+ * positions (--solve-camera); then the frame's sanity checks. */
+static int prepare_camera(const ao_args *a, obs_gbuffer_file *gf, char err[OBS_ERR_LEN])
+{
+    obs_status s;
+    if (a->camera) {
         int cw = 0, ch = 0;
-        s = obs_camera_read_json(a.camera, &gf.gb.camera, &cw, &ch, err);
-        if (s != OBS_OK) {
-            rc = cli_input_fail(s, a.camera, err);
-            goto done;
-        }
-        int dw = gf.gb.display_width > 0 ? gf.gb.display_width : gf.gb.width;
-        int dh = gf.gb.display_height > 0 ? gf.gb.display_height : gf.gb.height;
+        s = obs_camera_read_json(a->camera, &gf->gb.camera, &cw, &ch, err);
+        if (s != OBS_OK)
+            return cli_input_fail(s, a->camera, err);
+        int dw = gf->gb.display_width > 0 ? gf->gb.display_width : gf->gb.width;
+        int dh = gf->gb.display_height > 0 ? gf->gb.display_height : gf->gb.height;
         if (cw > 0 && ch > 0 && fabs((double)cw / ch - (double)dw / dh) > 1e-3)
             fprintf(stderr, "obscura: warning: camera %s is %dx%d but the image is %dx%d (aspect differs)\n",
-                    a.camera, cw, ch, dw, dh);
+                    a->camera, cw, ch, dw, dh);
     }
+    const int had_camera = gf->gb.camera.has_projection;
+    if (a->req.solve_camera && gf->gb.position.data &&
+        (s = obs_gbuffer_solve_camera(gf, &a->req.params, err)) != OBS_OK)
+        return cli_input_fail(s, a->in, err);
+    if (!had_camera && gf->gb.camera.has_projection && verbosity >= OBS_LOG_INFO)
+        fprintf(stderr, "obscura: info: camera %s, %s\n", gf->info.camera_source,
+                gf->info.camera_check);
+    obs_gbuffer_sanity(&gf->gb, &a->req.params, &gf->info);
+    return cli_input_warnings(a->in, &gf->info, a->req.strict);
+}
 
-    const int had_camera = gf.gb.camera.has_projection;
-    if (a.req.solve_camera && gf.gb.position.data &&
-        (s = obs_gbuffer_solve_camera(&gf, &a.req.params, err)) != OBS_OK) {
-        rc = cli_input_fail(s, a.in, err);
-        goto done;
+/* The baked channel: --baked CH, else _AO when the input has it (*bch
+ * "none" when there is none to combine). */
+static int read_baked(const ao_args *a, const obs_limits *lim, const obs_gbuffer *gb,
+                      obs_image *baked, const char **bch, char err[OBS_ERR_LEN])
+{
+    *bch = a->req.baked ? a->req.baked : "_AO";
+    if (strcmp(*bch, "none") == 0)
+        return EXIT_OK;
+    obs_status s = obs_exr_read_channel(a->in, *bch, lim, baked, err);
+    if (s == OBS_OK && (baked->width != gb->width || baked->height != gb->height)) {
+        snprintf(err, OBS_ERR_LEN, "baked channel %s is %dx%d, the G-buffer %dx%d", *bch,
+                 baked->width, baked->height, gb->width, gb->height);
+        obs_image_free(baked);
+        s = OBS_INVALID_ARGUMENT;
     }
-    if (!had_camera && gf.gb.camera.has_projection && verbosity >= OBS_LOG_INFO)
-        fprintf(stderr, "obscura: info: camera %s, %s\n", gf.info.camera_source,
-                gf.info.camera_check);
-    obs_gbuffer_sanity(&gf.gb, &a.req.params, &gf.info);
-    if ((rc = cli_input_warnings(a.in, &gf.info, a.req.strict)) != EXIT_OK)
-        goto done;
-    /* The baked channel: --baked CH, else _AO when the input has it. */
-    const char *bch = a.req.baked ? a.req.baked : "_AO";
-    if (strcmp(bch, "none") != 0) {
-        s = obs_exr_read_channel(a.in, bch, &lim, &baked, err);
-        if (s == OBS_OK && (baked.width != gf.gb.width || baked.height != gf.gb.height)) {
-            snprintf(err, OBS_ERR_LEN, "baked channel %s is %dx%d, the G-buffer %dx%d", bch,
-                     baked.width, baked.height, gf.gb.width, gf.gb.height);
-            obs_image_free(&baked);
-            s = OBS_INVALID_ARGUMENT;
-        }
-        if (s != OBS_OK && a.req.baked) {
-            rc = cli_input_fail(s, a.in, err);
-            goto done;
-        }
-        if (s != OBS_OK && s != OBS_MISSING_CHANNEL) /* auto: said, and left out */
-            fprintf(stderr, "obscura: warning: %s: %s; the AO is not combined with it (--baked "
-                            "none: not looked for)\n", a.in, err);
-        if (s != OBS_OK)
-            bch = "none"; /* auto: not a baked level's G-buffer */
-        s = OBS_OK;
-        err[0] = '\0';
-    }
-    unsigned outputs = a.req.outputs;
-    if (baked.data)
-        outputs |= OBS_OUTPUT_AO; /* the combination needs the chain's AO */
+    if (s != OBS_OK && a->req.baked)
+        return cli_input_fail(s, a->in, err);
+    if (s != OBS_OK && s != OBS_MISSING_CHANNEL) /* auto: said, and left out */
+        fprintf(stderr, "obscura: warning: %s: %s; the AO is not combined with it (--baked "
+                        "none: not looked for)\n", a->in, err);
+    if (s != OBS_OK)
+        *bch = "none"; /* auto: not a baked level's G-buffer */
+    err[0] = '\0';
+    return EXIT_OK;
+}
 
-    t0 = now_ms();
-    if (a.cpu) {
-        s = obs_run_cpu(&gf.gb, &a.req.params, outputs, &res, err);
+/* The chain on the CPU twin, on obscurad (--server) or on a GL context
+ * (kept across a batch's frames); *t0 restarts once the context exists. */
+static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, const char *server,
+                     int argc, char **argv, obs_result *res, obs_ctx **ctx, double *t0,
+                     char err[OBS_ERR_LEN])
+{
+    obs_status s;
+    if (a->cpu) {
+        s = obs_run_cpu(&gf->gb, &a->req.params, outputs, res, err);
     } else if (server) { /* clients/remote.c prints its own errors */
-        if ((rc = cli_remote_run(server, argc, argv, a.in, &gf.gb, outputs, &res)) != EXIT_OK)
-            goto done;
+        return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, res);
     } else {
-        obs_ctx_desc desc = {.debug = a.debug_gl, .log = log_cb, .cache_dir = cache_dir_of(a.cache_dir)};
-        backend_from_args(a.backend, &desc.backend);
-        s = kept_ctx ? (ctx = kept_ctx, OBS_OK) : obs_ctx_create(&desc, &ctx, err);
-        if (s != OBS_OK) {
-            rc = cli_fail(s, "OpenGL", err);
-            goto done;
-        }
+        obs_ctx_desc desc = {.debug = a->debug_gl, .log = log_cb, .cache_dir = cache_dir_of(a->cache_dir)};
+        backend_from_args(a->backend, &desc.backend);
+        s = kept_ctx ? (*ctx = kept_ctx, OBS_OK) : obs_ctx_create(&desc, ctx, err);
+        if (s != OBS_OK)
+            return cli_fail(s, "OpenGL", err);
         if (verbosity >= OBS_LOG_DEBUG)
-            fprintf(stderr, "obscura: debug: context created in %.1f ms\n", now_ms() - t0);
-        t0 = now_ms();
-        s = obs_run(ctx, &gf.gb, &a.req.params, outputs, &res, err);
-        log_programs(ctx);
+            fprintf(stderr, "obscura: debug: context created in %.1f ms\n", now_ms() - *t0);
+        *t0 = now_ms();
+        s = obs_run(*ctx, &gf->gb, &a->req.params, outputs, res, err);
+        log_programs(*ctx);
     }
-    if (s != OBS_OK) {
-        rc = cli_fail(s, a.in, err);
-        goto done;
-    }
-    if (baked.data && (s = obs_result_combine_baked(&res, &baked, &a.req.params, err)) != OBS_OK) {
-        rc = cli_fail(s, a.in, err);
-        goto done;
-    }
-    if (baked.data && verbosity >= OBS_LOG_INFO) {
+    return s == OBS_OK ? EXIT_OK : cli_fail(s, a->in, err);
+}
+
+/* The chain's AO with the baked channel's (parameter baked_combine). */
+static int combine_baked(const ao_args *a, obs_result *res, const obs_image *baked,
+                         const char *bch, char err[OBS_ERR_LEN])
+{
+    obs_status s = obs_result_combine_baked(res, baked, &a->req.params, err);
+    if (s != OBS_OK)
+        return cli_fail(s, a->in, err);
+    if (verbosity >= OBS_LOG_INFO) {
         obs_params bp;
-        obs_params_resolve(&a.req.params, &bp);
+        obs_params_resolve(&a->req.params, &bp);
         fprintf(stderr, "obscura: info: baked channel %s combined (%s): AO.Y, AOScreen.Y, "
                         "AOBaked.Y\n", bch, bp.baked_combine == OBS_BAKED_MIN ? "min" : "product");
     }
-    double t_run = now_ms() - t0;
+    return EXIT_OK;
+}
 
+/* The method and its sample counts, for the --verbose line. */
+static void method_text(const obs_params *p, char how[64])
+{
+    if (p->method == OBS_METHOD_HEMISPHERE)
+        snprintf(how, 64, "hemisphere, %d samples", p->hemisphere_samples);
+    else if (p->method == OBS_METHOD_ANGLE)
+        snprintf(how, 64, "angle, %d pairs", p->angle_pairs);
+    else if (p->method == OBS_METHOD_HBAO)
+        snprintf(how, 64, "hbao, %d directions x %d steps", p->hbao_directions, p->hbao_steps);
+    else if (p->method == OBS_METHOD_GTAO)
+        snprintf(how, 64, "gtao, %d slices x %d steps", p->gtao_slices, p->gtao_steps);
+    else
+        snprintf(how, 64, "%s, %d samples", p->method == OBS_METHOD_VAO ? "vao" : "vaopp", p->samples);
+}
+
+/* The frame's size, method, device and times, at --verbose. */
+static void print_run_info(const ao_args *a, const obs_gbuffer *gb, obs_ctx *ctx, double t_read,
+                           double t_run, double t_write)
+{
+    if (verbosity < OBS_LOG_INFO)
+        return;
+    obs_params p;
+    obs_ctx_info ci = {0};
+    obs_params_resolve(&a->req.params, &p);
+    if (ctx)
+        obs_ctx_get_info(ctx, &ci);
+    char how[64];
+    method_text(&p, how);
+    fprintf(stderr, "obscura: info: %dx%d, radius %g, %s, %s: read %.1f ms, AO %.1f ms, write %.1f ms\n",
+            gb->width, gb->height, p.radius, how, a->cpu ? "cpu" : obs_backend_name(ci.backend),
+            t_read, t_run, t_write);
+}
+
+/* A flat frame read: its camera, the baked channel, the chain, the
+ * combination, the outputs. */
+static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int argc, char **argv)
+{
+    char err[OBS_ERR_LEN] = "";
+    obs_gbuffer_file gf = {0};
+    obs_result res = {0};
+    obs_image baked = {0};
+    obs_ctx *ctx = NULL;
+    const char *bch;
+    double t0 = now_ms();
+    obs_status s = obs_gbuffer_read_exr(a->in, &a->req.map, lim, &gf, err);
+    if (s != OBS_OK)
+        return cli_input_fail(s, a->in, err);
+    double t_read = now_ms() - t0;
+    print_input_info(a->in, &gf.info, &gf.gb);
+    int rc = prepare_camera(a, &gf, err);
+    if (rc == EXIT_OK)
+        rc = read_baked(a, lim, &gf.gb, &baked, &bch, err);
+    if (rc != EXIT_OK)
+        goto done;
+    unsigned outputs = a->req.outputs;
+    if (baked.data)
+        outputs |= OBS_OUTPUT_AO; /* the combination needs the chain's AO */
     t0 = now_ms();
-    s = write_outputs(&a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part, err);
+    if ((rc = run_frame(a, &gf, outputs, server, argc, argv, &res, &ctx, &t0, err)) != EXIT_OK)
+        goto done;
+    if (baked.data && (rc = combine_baked(a, &res, &baked, bch, err)) != EXIT_OK)
+        goto done;
+    double t_run = now_ms() - t0;
+    t0 = now_ms();
+    s = write_outputs(a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part, err);
     if (s != OBS_OK) {
-        rc = cli_fail(s, a.out, err);
+        rc = cli_fail(s, a->out, err);
         goto done;
     }
-    if (verbosity >= OBS_LOG_INFO) {
-        obs_params p;
-        obs_ctx_info ci = {0};
-        obs_params_resolve(&a.req.params, &p);
-        if (ctx)
-            obs_ctx_get_info(ctx, &ci);
-        char how[64]; /* the method and its sample counts */
-        if (p.method == OBS_METHOD_HEMISPHERE)
-            snprintf(how, sizeof how, "hemisphere, %d samples", p.hemisphere_samples);
-        else if (p.method == OBS_METHOD_ANGLE)
-            snprintf(how, sizeof how, "angle, %d pairs", p.angle_pairs);
-        else if (p.method == OBS_METHOD_HBAO)
-            snprintf(how, sizeof how, "hbao, %d directions x %d steps", p.hbao_directions,
-                     p.hbao_steps);
-        else if (p.method == OBS_METHOD_GTAO)
-            snprintf(how, sizeof how, "gtao, %d slices x %d steps", p.gtao_slices, p.gtao_steps);
-        else
-            snprintf(how, sizeof how, "%s, %d samples", p.method == OBS_METHOD_VAO ? "vao" : "vaopp",
-                     p.samples);
-        fprintf(stderr, "obscura: info: %dx%d, radius %g, %s, %s: read %.1f ms, AO %.1f ms, write %.1f ms\n",
-                gf.gb.width, gf.gb.height, p.radius, how,
-                a.cpu ? "cpu" : obs_backend_name(ci.backend), t_read, t_run, now_ms() - t0);
-    }
-
+    print_run_info(a, &gf.gb, ctx, t_read, t_run, now_ms() - t0);
 done:
     obs_image_free(&baked);
     obs_result_free(&res);
@@ -680,6 +701,26 @@ done:
         obs_ctx_destroy(ctx);
     obs_gbuffer_free(&gf);
     return rc;
+}
+
+static int cmd_ao(int argc, char **argv)
+{
+    ao_args a;
+    char err[OBS_ERR_LEN] = "";
+    const char *server = NULL;
+    argc = cli_remote_take_server(argc, argv, &server);
+    parse_ao(argc, argv, &a);
+    obs_limits lim = {0};
+    if (a.max_size)
+        lim.max_width = lim.max_height = (int)a.max_size;
+    int deep = 0;
+    if (obs_exr_is_deep(a.in, &deep, err) == OBS_OK && deep) {
+        if (a.req.baked && strcmp(a.req.baked, "none") != 0)
+            die_usage("ao: --baked: the input is a deep EXR; a baked channel is combined with "
+                      "flat input only");
+        return cmd_ao_deep(&a, &lim, server, argc, argv);
+    }
+    return ao_flat(&a, &lim, server, argc, argv);
 }
 
 /* The hooks of obscura batch (clients/batch.c). */
@@ -1011,6 +1052,31 @@ done:
     return rc;
 }
 
+static int cmd_batch(int argc, char **argv)
+{
+    static const cli_batch_ops ops = {batch_check, batch_ao, batch_finish};
+    return cli_batch(argc, argv, &ops);
+}
+
+/* The commands: a new one is a row (and its usage lines). */
+static const struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+} commands[] = {
+    {"ao", cmd_ao},
+    {"inspect", cli_inspect},
+    {"compare", cmd_compare},
+    {"info", cmd_info},
+    {"params", cmd_params},
+    {"samples", cmd_samples},
+    {"gbuffer", cli_gbuffer},
+    {"reference", cli_reference},
+    {"warmup", cli_warmup},
+    {"bake", cli_bake},
+    {"bake-dynamic", cli_dynamic},
+    {"batch", cmd_batch},
+};
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -1018,32 +1084,9 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     const char *cmd = argv[1];
-    if (!strcmp(cmd, "ao"))
-        return cmd_ao(argc - 2, argv + 2);
-    if (!strcmp(cmd, "inspect"))
-        return cli_inspect(argc - 2, argv + 2);
-    if (!strcmp(cmd, "compare"))
-        return cmd_compare(argc - 2, argv + 2);
-    if (!strcmp(cmd, "info"))
-        return cmd_info(argc - 2, argv + 2);
-    if (!strcmp(cmd, "params"))
-        return cmd_params(argc - 2, argv + 2);
-    if (!strcmp(cmd, "samples"))
-        return cmd_samples(argc - 2, argv + 2);
-    if (!strcmp(cmd, "gbuffer"))
-        return cli_gbuffer(argc - 2, argv + 2);
-    if (!strcmp(cmd, "reference"))
-        return cli_reference(argc - 2, argv + 2);
-    if (!strcmp(cmd, "warmup"))
-        return cli_warmup(argc - 2, argv + 2);
-    if (!strcmp(cmd, "bake"))
-        return cli_bake(argc - 2, argv + 2);
-    if (!strcmp(cmd, "bake-dynamic"))
-        return cli_dynamic(argc - 2, argv + 2);
-    if (!strcmp(cmd, "batch")) {
-        static const cli_batch_ops ops = {batch_check, batch_ao, batch_finish};
-        return cli_batch(argc - 2, argv + 2, &ops);
-    }
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+        if (!strcmp(cmd, commands[i].name))
+            return commands[i].run(argc - 2, argv + 2);
     if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
         usage(stdout);
         return EXIT_OK;
