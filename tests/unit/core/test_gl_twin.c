@@ -4,6 +4,7 @@
 #include "gl_testutil.h"
 
 #include "context.h"
+#include "methods/methods.h"
 
 /* GL and CPU do the same float arithmetic, but a sample that lands within
  * rounding of a pixel border may read the neighbouring pixel's depth on

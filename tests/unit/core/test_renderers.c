@@ -8,7 +8,7 @@
 
 #include "gl_testutil.h"
 
-#include "chain/frame.h"
+#include "methods/methods.h"
 #include "internal.h"
 #include "io/exr_internal.h"
 #include "obscura/deep.h"
