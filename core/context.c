@@ -71,15 +71,8 @@ void obs_ctx_destroy(obs_ctx *ctx)
     free(ctx);
 }
 
-/* ---- per-pass timings (GL_TIME_ELAPSED queries, taken by the passes) ---- */
-
-const char *obs_pass_name(obs_pass p)
-{
-    static const char *const names[OBS_PASS_COUNT] = {
-        "upload", "prep",      "downsample", "cull",     "ao",
-        "blur",   "upsample",  "finish",     "composite", "readback"};
-    return (unsigned)p < OBS_PASS_COUNT ? names[p] : "unknown";
-}
+/* ---- per-pass timings (GL_TIME_ELAPSED queries, taken by the passes;
+ * their names: obs_pass_name, chain/passes.c) ---- */
 
 obs_status obs_ctx_set_timing(obs_ctx *ctx, int on, char err[OBS_ERR_LEN])
 {

@@ -219,7 +219,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     if (!ctx || !out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_run: NULL argument");
     memset(out, 0, sizeof *out);
-    if ((s = obs__ctx_bind(ctx, err)) != OBS_OK)
+    if ((s = obs__gl_device_bind(&ctx->dev, err)) != OBS_OK)
         return s;
     ctx->times_valid = 0;
     if ((s = obs__deep_frame_setup(d, params, &df, err)) != OBS_OK)
@@ -231,7 +231,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     const unsigned variant = deep_variant(&df);
     if ((s = ensure_deep(ctx, variant, w, h, df.m, err)) != OBS_OK)
         goto fail;
-    if ((s = obs__blur_program(ctx, 0, f->blur_radius, err)) != OBS_OK)
+    if ((s = obs__blur_program(&ctx->prog, 0, f->blur_radius, err)) != OBS_OK)
         goto fail;
     /* the frame's values, read by the pass (common.glsl's Frame block) */
     if ((s = obs__frame_block_bind(ctx, f, err)) != OBS_OK)
