@@ -7,6 +7,8 @@
 
 #include "context.h"
 
+_Static_assert(offsetof(struct obs_ctx, log) == 0, "obs__log reads the sink at the context's start");
+
 obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out, char err[OBS_ERR_LEN])
 {
     obs_ctx_desc d = {0};
@@ -24,6 +26,8 @@ obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out, char err[OBS_
 #else
     ctx->dev.debug = d.debug;
 #endif
+    ctx->log.fn = d.log;
+    ctx->log.user = d.log_user;
     ctx->dev.log = d.log;
     ctx->dev.log_user = d.log_user;
     /* before the backend: Mesa reads where its shader cache is when the

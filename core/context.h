@@ -7,8 +7,10 @@
 #include "chain/chain_gl.h"
 #include "deep/deep_gl.h"
 #include "gl/gl.h"
+#include "log.h"
 
 struct obs_ctx {
+    obs__log_sink log; /* first: obs__log (log.c) reads it through an obs_ctx pointer */
     obs__gl_device dev;
     obs__programs prog;        /* the chain's (chain/run_gl.c) */
     obs__targets tg;

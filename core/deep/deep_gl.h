@@ -1,4 +1,5 @@
-/* Deep input's GL objects kept in the context between frames (deep_gl.c).
+/* Deep input's GL objects kept in the context between frames (deep_gl.c;
+ * torn down by deep_release_gl.c).
  * Not installed. */
 #ifndef OBSCURA_DEEP_GL_H
 #define OBSCURA_DEEP_GL_H
