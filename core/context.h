@@ -5,7 +5,7 @@
 #define OBSCURA_CONTEXT_H
 
 #include "chain/chain_gl.h"
-#include "deep/deep_gl.h"
+#include "deep/deep_targets_gl.h"
 #include "gl/gl.h"
 #include "log.h"
 

@@ -1,10 +1,10 @@
-/* Deep input's kept GL objects torn down (deep_gl.h): by the deep pass
+/* Deep input's kept GL objects torn down (deep_targets_gl.h): by the deep pass
  * on a new size, by the context when it releases or is destroyed.  Needs
  * nothing of the context, so the context calls down into it and the deep
  * pass (deep_gl.c) does not call back up. */
 #include <string.h>
 
-#include "deep/deep_gl.h"
+#include "deep/deep_targets_gl.h"
 
 /* Drops the size-dependent objects; the program stays unless `all`. */
 void obs__deep_release(obs__deep_targets *t, int all)
