@@ -8,6 +8,8 @@
 #include "context.h"
 #include "gl/progcache.h"
 
+_Static_assert(offsetof(struct obs_ctx, log) == 0, "obs__log reads the sink at the context's start");
+
 obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out, char err[OBS_ERR_LEN])
 {
     obs_ctx_desc d = {0};
@@ -25,6 +27,8 @@ obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out, char err[OBS_
 #else
     ctx->dev.debug = d.debug;
 #endif
+    ctx->log.fn = d.log;
+    ctx->log.user = d.log_user;
     ctx->dev.log = d.log;
     ctx->dev.log_user = d.log_user;
     /* before the backend: Mesa reads where its shader cache is when the
@@ -72,15 +76,8 @@ void obs_ctx_destroy(obs_ctx *ctx)
     free(ctx);
 }
 
-/* ---- per-pass timings (GL_TIME_ELAPSED queries, taken by the passes) ---- */
-
-const char *obs_pass_name(obs_pass p)
-{
-    static const char *const names[OBS_PASS_COUNT] = {
-        "upload", "prep",      "downsample", "cull",     "ao",
-        "blur",   "upsample",  "finish",     "composite", "readback"};
-    return (unsigned)p < OBS_PASS_COUNT ? names[p] : "unknown";
-}
+/* ---- per-pass timings (GL_TIME_ELAPSED queries, taken by the passes;
+ * their names: obs_pass_name, chain/passes.c) ---- */
 
 obs_status obs_ctx_set_timing(obs_ctx *ctx, int on, char err[OBS_ERR_LEN])
 {

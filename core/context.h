@@ -5,10 +5,12 @@
 #define OBSCURA_CONTEXT_H
 
 #include "chain/chain_gl.h"
-#include "deep/deep_gl.h"
+#include "deep/deep_targets_gl.h"
 #include "gl/gl.h"
+#include "log.h"
 
 struct obs_ctx {
+    obs__log_sink log; /* first: obs__log (log.c) reads it through an obs_ctx pointer */
     obs__gl_device dev;
     obs__programs prog;        /* the chain's (chain/run_gl.c) */
     obs__targets tg;

@@ -2,7 +2,7 @@
  * the caller installed (obs_ctx_desc.log), or drops them. */
 #include <stdio.h>
 
-#include "context.h"
+#include "log.h"
 
 static void vlogf(obs_log_fn fn, void *user, obs_log_level level, const char *fmt, va_list ap)
 {
@@ -27,6 +27,8 @@ void obs__log(obs_ctx *ctx, obs_log_level level, const char *fmt, ...)
         return;
     va_list ap;
     va_start(ap, fmt);
-    vlogf(ctx->dev.log, ctx->dev.log_user, level, fmt, ap);
+    /* the sink is the context's first member (log.h, context.h) */
+    const obs__log_sink *sink = (const obs__log_sink *)(const void *)ctx;
+    vlogf(sink->fn, sink->user, level, fmt, ap);
     va_end(ap);
 }

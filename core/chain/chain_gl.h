@@ -14,7 +14,7 @@ typedef struct obs__programs {
      * OBS__DEPTH_MODES * (normals derived from depth) + depth mode - 1];
      * built on first use */
     GLuint prep[2][2 * OBS__DEPTH_MODES];
-    GLuint vao[OBS__AO_VARIANTS]; /* AO pass by switches compiled in (run_gl.c: AO_*) */
+    GLuint vao[OBS__AO_VARIANTS]; /* AO pass by switches compiled in (programs_gl.c: AO_*) */
     GLuint cull[2];               /* culling pre-pass without, with the range check */
     GLuint composite;
     /* ao_resolution half's upsample [OBS_RAYS][as prep's second index]
@@ -46,13 +46,42 @@ typedef struct obs__targets {
     GLuint fbo_cull;                          /* culling pre-pass: tex_cull */
 } obs__targets;
 
-/* Builds, on its first use, the blur program of half-width radius
- * (section 4.6; rays 1: the vertical pass that converts for
- * ao_definition rays) into ctx->prog.blur[rays][radius] (run_gl.c; the
- * deep pass, deep_gl.c, blurs with it too). */
-obs_status obs__blur_program(obs_ctx *ctx, int rays, int radius, char err[OBS_ERR_LEN]);
+/* The programs (programs_gl.c), each built on its first use into g.
+ * obs__prog_vao: the AO pass (pre 0) or the culling pre-pass (pre 1) of
+ * switch variant v (obs__ao_variant: bits of g->vao's index); _finish:
+ * the finishing pass with ao_definition rays' conversion and luminance
+ * sensitivity compiled in or out; _prep: the prep pass (or the
+ * downsample, f->half) of f's depth mode and normals, g->prep[half][
+ * obs__prep_index(f)]; _up: ao_resolution half's upsample; _method: a
+ * comparison method's AO pass (nothing for vaopp and vao). */
+unsigned obs__ao_variant(const obs__frame *f);
+int obs__prep_index(const obs__frame *f);
+struct obs__method;
+obs_status obs__prog_vao(obs__programs *g, int pre, unsigned v, char err[OBS_ERR_LEN]);
+obs_status obs__prog_composite(obs__programs *g, char err[OBS_ERR_LEN]);
+obs_status obs__prog_finish(obs__programs *g, int rays, int lum, char err[OBS_ERR_LEN]);
+obs_status obs__prog_prep(obs__programs *g, const obs__frame *f, char err[OBS_ERR_LEN]);
+obs_status obs__prog_up(obs__programs *g, const obs__frame *f, char err[OBS_ERR_LEN]);
+obs_status obs__prog_method(obs__programs *g, const struct obs__method *m, char err[OBS_ERR_LEN]);
 
-/* Deletes the chain's textures, framebuffers and programs (run_gl.c);
+/* The blur program of half-width radius (section 4.6; rays 1: the
+ * vertical pass that converts for ao_definition rays) into
+ * g->blur[rays][radius] (the deep pass, deep_gl.c, blurs with it too). */
+obs_status obs__blur_program(obs__programs *g, int rays, int radius, char err[OBS_ERR_LEN]);
+
+/* The targets (targets_gl.c).  obs__targets_ensure: what every frame of
+ * w x h needs in t (the full-size set, or the half-size set of
+ * ao_resolution half), kept while frames keep their size; _need: what
+ * frame f needs beyond that, t the full set, at the set the AO runs at
+ * (t, or the half set).  *created counts the textures and framebuffers
+ * made (obs_ctx's gl_objects_created); log_ctx: where to log. */
+obs_status obs__targets_ensure(obs_ctx *log_ctx, unsigned long *created, obs__targets *t, int w,
+                               int h, char err[OBS_ERR_LEN]);
+obs_status obs__targets_need(unsigned long *created, const obs__frame *f, obs__targets *t,
+                             obs__targets *at, int has_color, unsigned outputs,
+                             char err[OBS_ERR_LEN]);
+
+/* Deletes the chain's textures, framebuffers and programs (targets_gl.c);
  * the context is current.  With prog NULL the programs stay. */
 void obs__chain_release(obs__programs *prog, obs__targets *tg);
 

@@ -3,7 +3,6 @@
 #include <string.h>
 
 #include "chain/frame.h"
-#include "methods/methods.h"
 #include "obscura/io.h"
 
 /* Inverse transpose of the upper 3x3 of m: the matrix that carries normals
@@ -28,8 +27,8 @@ static int normal_matrix(const float m[16], float out[9])
     return 0;
 }
 
-obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *p,
-                            obs__frame *f, char err[OBS_ERR_LEN])
+obs_status obs__frame_setup_common(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *p,
+                                   obs__frame *f, char err[OBS_ERR_LEN])
 {
     obs_camera cam;
     obs_status s = obs__gbuffer_validate(gb, err);
@@ -109,13 +108,9 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
                          "ao_resolution half does not take bleeding: eq 5 gathers the colour "
                          "at each full-resolution pixel's samples (use ao_resolution full)");
 
-    /* The comparison methods (parameter method); their AO runs in place
-     * of the VAO estimator, the rest of the chain is shared.  Each fills
-     * its own fields (core/methods/methods.c). */
+    /* The comparison methods (parameter method): each fills its own
+     * values, f->ms, after this (obs__frame_setup, methods/methods.c). */
     f->method = p->method;
-    const obs__method *m = obs__method_get(p->method);
-    if (m && m->setup)
-        m->setup(p, f);
 
     static const float identity3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     memcpy(f->normal_matrix, identity3, sizeof identity3);

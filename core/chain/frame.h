@@ -30,13 +30,21 @@
  * volume, k = 1: the tangent sphere of radius D/2 is the largest sphere
  * inside the ray tracer's hemisphere of radius D that touches p.
  *
- * Applied in one place, obs__frame_setup (frame.c), to methods vaopp and
+ * Applied in one place, obs__frame_setup_common (frame.c), to methods vaopp and
  * vao (the comparison methods take the radius as D). */
 /* How many depth modes there are (the prep pass has a program for each). */
 #define OBS__DEPTH_MODES (OBS_DEPTH_NORMALIZED - OBS_DEPTH_DEFAULT)
 
 #define OBS__RADIUS_K_RAYS 2.0f
 #define OBS__RADIUS_K_VOLUME 1.0f
+
+/* Room for the largest method's state (core/methods/<method>.h, each
+ * checked against it with a _Static_assert). */
+#define OBS__METHOD_STATE_BYTES 800
+typedef union obs__method_state {
+    double align;
+    unsigned char bytes[OBS__METHOD_STATE_BYTES];
+} obs__method_state;
 
 typedef struct obs__frame {
     int width, height;
@@ -67,28 +75,11 @@ typedef struct obs__frame {
     float lum_threshold, lum_width, lum_sigma; /* threshold, width, sigma of eq 3 */
     int bleed_step;         /* section 4.7, eq 5: 0 off, else every bleed_step-th sample */
     int method;             /* OBS_METHOD_*: which estimator the AO pass runs */
-    /* method hemisphere (methods/hemisphere.c): the kernel, unit hemisphere
-     * around +z, scaled by radius at use */
-    int hs_count;
-    float hs_bias;          /* in depth units: hemisphere_bias * R */
-    float hs_kernel[OBS_MAX_HEMISPHERE][3];
-    /* method angle (methods/angle.c): pair i's offset on the unit disk (its
-     * partner is the negation); the arc cosine used (OBS_ACOS_*) */
-    int angle_pairs;
-    float angle_xy[OBS_MAX_PAIRS][2];
-    int angle_acos;
-    /* method hbao (methods/hbao.c): directions (unit, view xy), steps, bias */
-    int hbao_dirs, hbao_steps;
-    float hbao_dir[OBS_MAX_DIRECTIONS][2];
-    float hbao_bias_cs[2];  /* cos, sin of the angle bias */
-    /* method gtao (methods/gtao.c): slices, steps per side, XeGTAO's
-     * heuristics (1: on); the search radius gtao_multiplier * D in depth
-     * units; the falloff's weight = saturate(r * mul + add); the
-     * thin-occluder compensation and the final power */
-    int gtao_slices, gtao_steps, gtao_heuristics;
-    float gtao_radius;
-    float gtao_falloff[2];    /* mul, add */
-    float gtao_thin_power[2]; /* gtao_thin, gtao_power */
+    /* the method's own values, read by its functions only: their types
+     * are in core/methods/<method>.h (obs__gtao_of(f), ...), so the chain
+     * needs none of them; in place, so that a frame copies whole
+     * (obs__frame_half, the deep frame) */
+    obs__method_state ms;
 } obs__frame;
 
 /* The frame's values as the shaders read them: the uniform block Frame
@@ -122,9 +113,12 @@ typedef struct obs__frame_block {
 /* The block of frame f. */
 void obs__frame_block_fill(const obs__frame *f, obs__frame_block *b);
 
-/* Resolves camera, parameters and normal handling for one frame. */
-obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *resolved,
-                            obs__frame *f, char err[OBS_ERR_LEN]);
+/* Resolves camera, parameters and normal handling for one frame: every
+ * value but the method's own (obs__frame_setup in methods/methods.h adds
+ * those). */
+obs_status obs__frame_setup_common(obs_ctx *log_ctx, const obs_gbuffer *gb,
+                                   const obs_params *resolved, obs__frame *f,
+                                   char err[OBS_ERR_LEN]);
 
 /* ---- half resolution (ao_resolution half; half_cpu.c) ------------------- */
 
@@ -286,93 +280,18 @@ float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3]);
 float obs__blur_pixel(const obs__frame *f, const float *pos, const float *ao, int x, int y, int dx,
                       int dy);
 
-/* ---- comparison methods (parameter `method`) ----------------------------- */
+/* ---- what the comparison methods share (core/methods/) ------------------ */
 
 /* The pixel whose planes hold the view-space point s: 1 and (qx, qy) when s
  * projects into the image in front of the camera, else 0 (GLSL:
  * view_to_px() in method.glsl). */
 int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy);
 
-/* The unit-hemisphere kernel of n samples (n <= OBS_MAX_HEMISPHERE),
- * 3 floats each, around +z (methods/hemisphere.c). */
-void obs__hemisphere_kernel(int n, float *out);
-
-/* Method hemisphere's kernel (GLSL: hemisphere.glsl): the view-space
- * position s of kernel sample i for the point p with normal n at pixel
- * (x, y), the kernel's +z turned to n and rotated by the pixel's 3x3 tile
- * rotation.  obs__hemisphere_basis() gives the tangent frame t1, t2 once
- * per pixel. */
-void obs__hemisphere_basis(const float n[3], float t1[3], float t2[3]);
-void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3], const float n[3],
-                            const float t1[3], const float t2[3], int i, float s[3]);
-
-/* The nodes the hemisphere estimator tests its samples against: layers
- * planes of layer_px pixels, 4 floats each (view xyz, planar depth w; 0:
- * empty), one after the other; nrm: the same layout with alpha in w (NULL:
- * opaque); interior: OITAO eqs 2-4's back side, where a node on the
- * exterior side of p's tangent plane hides nothing.  The flat chain's
- * prep plane is one layer. */
-typedef struct obs__hemisphere_nodes {
-    const float *pos, *nrm;
-    int layers;
-    size_t layer_px;
-    int interior;
-} obs__hemisphere_nodes;
-
-/* Method hemisphere's estimator, for the flat and the deep chain alike
- * (methods/hemisphere.c). */
-float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes *nodes, int x,
-                               int y, const float p[3], const float n[3]);
-
-/* Normal-oriented hemisphere SSAO of the point p (xyz; planar depth in
- * p[3] is not needed) with normal n at pixel (x, y); `pos` is the prep
- * pass's position plane (GLSL: hemisphere.glsl). */
-float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                            const float n[3]);
-
-/* The pair offsets of the angle-based method on the unit disk, 2 floats
- * per pair (methods/angle.c). */
-void obs__angle_pattern(int pairs, float *out);
-
-/* The arc cosine of the angle-based method: mode OBS_ACOS_QUADRATIC,
- * _LINEAR or _EXACT; x is clamped to [-1, 1] (GLSL: acos_mode() in
- * angle.glsl). */
-float obs__acos_mode(int mode, float x);
-
-/* Angle-based paired-sample SSAO of the point p (xyzw, w the planar
- * depth) with normal n at pixel (x, y) (GLSL: angle.glsl). */
-float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[4],
-                       const float n[3]);
-
-/* Horizon-based AO of the point p with normal n at pixel (x, y), marched
- * from that pixel (GLSL: hbao.glsl).  The count of depth samples read
- * goes to *count when count is not NULL. */
-float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                      const float n[3], int *count);
-
 /* The radius r (depth units) projected at the view point p, in pixels:
  * the square root of the projected area of a disk of radius r
  * perpendicular to the view axis (as obs__adaptive_count measures it);
  * 0 behind the camera (GLSL: radius_px() in method.glsl; prep_cpu.c). */
 float obs__radius_px(const obs__frame *f, const float p[3], float r);
-
-/* Ground-truth-based AO (Jimenez et al., as XeGTAO implements it) of the
- * point p with normal n at pixel (x, y) (GLSL: gtao.glsl).  The count of
- * depth samples read inside the image goes to *count when count is not
- * NULL. */
-float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                      const float n[3], int *count);
-
-/* The noise of the 3x3 tile's pixel `tile` (obs__tile_index): XeGTAO's R2
- * sequence, fract(0.5 + k (0.754877666, 0.569840291)), k = tile;
- * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
-void obs__gtao_noise(int tile, float out[2]);
-
-/* The AO of pixel (x, y) by the frame's method other than vaopp/vao
- * (position and normal from the planes); *count: samples taken (GLSL:
- * main() of method.frag.glsl). */
-float obs__method_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
-                        int *count);
 
 /* Both passes over the whole plane, horizontal then vertical, in place in
  * `ao`; `tmp` holds width * height floats. */

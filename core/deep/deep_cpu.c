@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "deep/deep_internal.h"
+#include "methods/hemisphere.h"
 #include "methods/methods.h"
 
 int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_exr_layer layers[3])

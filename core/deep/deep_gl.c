@@ -58,26 +58,6 @@ static void upload_layers(GLuint tex, int w, int h, int m, const float *data)
     glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, m, GL_RGBA, GL_FLOAT, data);
 }
 
-/* Drops the size-dependent objects; the program stays unless `all`. */
-static void release(obs__deep_targets *t, int all)
-{
-    GLuint tex[] = {t->tex_pos, t->tex_nrm, t->tex_front, t->tex_blend, t->tex_tmp};
-    glDeleteTextures(5, tex);
-    GLuint fbo[] = {t->fbo, t->fbo_front, t->fbo_blend, t->fbo_tmp};
-    for (int i = 0; i < 4; i++)
-        if (fbo[i])
-            glDeleteFramebuffers(1, &fbo[i]);
-    GLuint prog[OBS__DEEP_VARIANTS];
-    memcpy(prog, t->prog, sizeof prog);
-    memset(t, 0, sizeof *t);
-    if (all)
-        OBS__GL_DELETE_PROGRAMS(prog);
-    else
-        memcpy(t->prog, prog, sizeof prog);
-}
-
-void obs__deep_release(obs__deep_targets *t, int programs) { release(t, programs); }
-
 /* Switches of the deep pass compiled in or out by defines (a SIMD
  * rasteriser runs both sides of a uniform branch): bits of the index of
  * ctx->deep.prog. */
@@ -156,7 +136,7 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     }
     if (t->width == w && t->height == h && t->m == m)
         return OBS_OK;
-    release(&ctx->deep, 0);
+    obs__deep_release(&ctx->deep, 0);
     t->tex_pos = array_texture(ctx, w, h, m);
     t->tex_nrm = array_texture(ctx, w, h, m);
     /* two RGBA32F arrays of m layers and three RG32F planes */
@@ -179,7 +159,7 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     s = s == OBS_OK ? obs__gl_check("allocating deep targets", err)
                     : obs__fail(err, OBS_GL_ERROR, "deep AO framebuffer incomplete");
     if (s != OBS_OK) {
-        release(&ctx->deep, 0);
+        obs__deep_release(&ctx->deep, 0);
         return s;
     }
     t->width = w;
@@ -219,7 +199,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     if (!ctx || !out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_run: NULL argument");
     memset(out, 0, sizeof *out);
-    if ((s = obs__ctx_bind(ctx, err)) != OBS_OK)
+    if ((s = obs__gl_device_bind(&ctx->dev, err)) != OBS_OK)
         return s;
     ctx->times_valid = 0;
     if ((s = obs__deep_frame_setup(d, params, &df, err)) != OBS_OK)
@@ -231,7 +211,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     const unsigned variant = deep_variant(&df);
     if ((s = ensure_deep(ctx, variant, w, h, df.m, err)) != OBS_OK)
         goto fail;
-    if ((s = obs__blur_program(ctx, 0, f->blur_radius, err)) != OBS_OK)
+    if ((s = obs__blur_program(&ctx->prog, 0, f->blur_radius, err)) != OBS_OK)
         goto fail;
     /* the frame's values, read by the pass (common.glsl's Frame block) */
     if ((s = obs__frame_block_bind(ctx, f, err)) != OBS_OK)

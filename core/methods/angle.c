@@ -15,7 +15,7 @@
  * one far, 0 with both far; the result is the weighted mean. */
 #include <math.h>
 
-#include "chain/frame.h"
+#include "methods/angle.h"
 
 /* Radical inverse of i in base 2. */
 static double radical_inverse2(unsigned i)
@@ -57,20 +57,22 @@ float obs__acos_mode(int mode, float x)
 /* theta of the article: the angle between n and v (pi/2 for v = 0). */
 static float angle_to_normal(const obs__frame *f, const float n[3], const float v[3])
 {
+    const obs__angle_state *an = obs__angle_of(f);
     float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     float c = l > 0.0f ? (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / l : 0.0f;
-    return obs__acos_mode(f->angle_acos, c);
+    return obs__acos_mode(an->acos, c);
 }
 
 /* GLSL: angle_ao() in angle.glsl */
 float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[4],
                        const float n[3])
 {
+    const obs__angle_state *an = obs__angle_of(f);
     const float R = f->radius;
     const float *rot = f->rot[obs__tile_index(f, x, y)];
     float sum = 0.0f, wsum = 0.0f;
-    for (int i = 0; i < f->angle_pairs; i++) {
-        const float *a = f->angle_xy[i];
+    for (int i = 0; i < an->pairs; i++) {
+        const float *a = an->xy[i];
         float ox = R * (rot[0] * a[0] - rot[1] * a[1]), oy = R * (rot[1] * a[0] + rot[0] * a[1]);
         float v[2][3], far[2];
         for (int k = 0; k < 2; k++) {
@@ -111,4 +113,12 @@ float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, cons
         wsum += w;
     }
     return wsum > 0.0f ? sum / wsum : 1.0f;
+}
+
+void obs__angle_setup(const obs_params *p, obs__frame *f)
+{
+    obs__angle_state *s = (obs__angle_state *)(void *)f->ms.bytes;
+    s->pairs = p->angle_pairs;
+    obs__angle_pattern(s->pairs, &s->xy[0][0]);
+    s->acos = p->angle_acos;
 }

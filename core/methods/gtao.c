@@ -44,7 +44,7 @@
  * pixel); the view vector of an orthographic camera is +z. */
 #include <math.h>
 
-#include "chain/frame.h"
+#include "methods/gtao.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
 #define GTAO_TOO_CLOSE 1.3f       /* pixelTooCloseThreshold: first sample this far, in pixels */
@@ -74,12 +74,13 @@ static float side_horizon(const obs__frame *f, const float *pos, int x, int y, c
                           const float v[3], const float omega[2], int slice, float noise_step,
                           float min_s, int dir, float low, int *taken)
 {
+    const obs__gtao_state *g = obs__gtao_of(f);
     float hc = low;
-    for (int st = 0; st < f->gtao_steps; st++) {
-        float base = (float)(slice + st * f->gtao_steps) * GTAO_R1;
+    for (int st = 0; st < g->steps; st++) {
+        float base = (float)(slice + st * g->steps) * GTAO_R1;
         float sn = noise_step + base;
         sn -= floorf(sn);
-        float s = ((float)st + sn) / (float)f->gtao_steps;
+        float s = ((float)st + sn) / (float)g->steps;
         s = s * s + min_s; /* sample distribution power 2, then off the centre pixel */
         int qx = x + dir * (int)floorf(s * omega[0] + 0.5f);
         int qy = y + dir * (int)floorf(s * omega[1] + 0.5f);
@@ -94,9 +95,9 @@ static float side_horizon(const obs__frame *f, const float *pos, int x, int y, c
         if (!(dist > 0.0f))
             continue;
         float shc = dot3(d, v) / dist;
-        float dz = d[2] * (1.0f + f->gtao_thin_power[0]); /* thin-occluder compensation */
+        float dz = d[2] * (1.0f + g->thin_power[0]); /* thin-occluder compensation */
         float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
-        float w = saturate(fb * f->gtao_falloff[0] + f->gtao_falloff[1]);
+        float w = saturate(fb * g->falloff[0] + g->falloff[1]);
         shc = low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
         hc = fmaxf(hc, shc);
     }
@@ -113,11 +114,12 @@ static float arc(float h, float gamma, float cos_gamma)
 float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count)
 {
+    const obs__gtao_state *g = obs__gtao_of(f);
     const float half_pi = (float)M_PI_2;
     int taken = 0;
     if (count)
         *count = 0;
-    float rpx = obs__radius_px(f, p, f->gtao_radius);
+    float rpx = obs__radius_px(f, p, g->radius);
     if (!(rpx > 0.0f))
         return 1.0f; /* behind the camera */
     float c[3] = {p[0] * GTAO_CENTRE_SCALE, p[1] * GTAO_CENTRE_SCALE, p[2] * GTAO_CENTRE_SCALE};
@@ -133,9 +135,9 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const
     float noise[2];
     obs__gtao_noise(obs__tile_index(f, x, y), noise);
     const float min_s = GTAO_TOO_CLOSE / rpx;
-    float vis = f->gtao_heuristics ? saturate((10.0f - rpx) / 100.0f) * 0.5f : 0.0f;
-    for (int sl = 0; sl < f->gtao_slices; sl++) {
-        float phi = ((float)sl + noise[0]) / (float)f->gtao_slices * (float)M_PI;
+    float vis = g->heuristics ? saturate((10.0f - rpx) / 100.0f) * 0.5f : 0.0f;
+    for (int sl = 0; sl < g->slices; sl++) {
+        float phi = ((float)sl + noise[0]) / (float)g->slices * (float)M_PI;
         float cp = cosf(phi), sp = sinf(phi);
         float omega[2] = {cp * rpx, -sp * rpx}; /* screen pixels: y runs down, view y up */
         float d[3] = {cp, sp, 0.0f};
@@ -156,7 +158,7 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const
         float low0 = cosf(gamma + half_pi), low1 = cosf(gamma - half_pi);
         float hc0 = side_horizon(f, pos, x, y, c, v, omega, sl, noise[1], min_s, 1, low0, &taken);
         float hc1 = side_horizon(f, pos, x, y, c, v, omega, sl, noise[1], min_s, -1, low1, &taken);
-        if (f->gtao_heuristics)
+        if (g->heuristics)
             np_len += (1.0f - np_len) * GTAO_SLOPE_FUDGE;
         /* the horizons as angles from v, clamped to the hemisphere of n
          * (Algorithm 1's h1 = n + max(h1 - n, -pi/2), h2 = n + min(h2 - n, pi/2)) */
@@ -166,11 +168,30 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const
         h1 = gamma + fminf(h1 - gamma, half_pi);
         vis += np_len * (arc(h0, gamma, cos_g) + arc(h1, gamma, cos_g));
     }
-    vis /= (float)f->gtao_slices;
-    vis = powf(fmaxf(vis, 0.0f), f->gtao_thin_power[1]);
-    if (f->gtao_heuristics)
+    vis /= (float)g->slices;
+    vis = powf(fmaxf(vis, 0.0f), g->thin_power[1]);
+    if (g->heuristics)
         vis = fmaxf(vis, GTAO_MIN_VISIBILITY);
     if (count)
         *count = taken;
     return saturate(vis);
+}
+
+void obs__gtao_setup(const obs_params *p, obs__frame *f)
+{
+    obs__gtao_state *s = (obs__gtao_state *)(void *)f->ms.bytes;
+    s->slices = p->gtao_slices;
+    s->steps = p->gtao_steps;
+    s->heuristics = p->gtao_heuristics == OBS_ON;
+    /* XeGTAO: effectRadius = EffectRadius * RadiusMultiplier; the falloff
+     * range is EffectFalloffRange * effectRadius, and a sample at
+     * distance r weighs saturate(r * falloffMul + falloffAdd), 1 up to
+     * falloffFrom = effectRadius (1 - EffectFalloffRange), 0 at the
+     * radius */
+    float R = f->radius * p->gtao_radius_multiplier, range = p->gtao_falloff * R;
+    s->radius = R;
+    s->falloff[0] = -1.0f / range;
+    s->falloff[1] = R * (1.0f - p->gtao_falloff) / range + 1.0f;
+    s->thin_power[0] = p->gtao_thin;
+    s->thin_power[1] = p->gtao_power;
 }

@@ -16,12 +16,13 @@
  * pixels each, R_px the radius projected at p (at most R_px steps). */
 #include <math.h>
 
-#include "chain/frame.h"
+#include "methods/hbao.h"
 
 /* GLSL: hbao_ao() in hbao.glsl */
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count)
 {
+    const obs__hbao_state *hb = obs__hbao_of(f);
     const float R = f->radius, R2 = R * R;
     const float *rot = f->rot[obs__tile_index(f, x, y)];
     float rpx = obs__radius_px(f, p, R);
@@ -29,12 +30,12 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
         *count = 0;
     if (!(rpx >= 1.0f))
         return 1.0f; /* the kernel reaches no other pixel */
-    int ns = f->hbao_steps < (int)rpx ? f->hbao_steps : (int)rpx;
+    int ns = hb->steps < (int)rpx ? hb->steps : (int)rpx;
     float step = rpx / (float)(ns + 1); /* the farthest sample is not fully attenuated */
     float ao = 0.0f;
     int taken = 0;
-    for (int d = 0; d < f->hbao_dirs; d++) {
-        const float *e = f->hbao_dir[d];
+    for (int d = 0; d < hb->dirs; d++) {
+        const float *e = hb->dir[d];
         float dx = rot[0] * e[0] - rot[1] * e[1], dy = rot[1] * e[0] + rot[0] * e[1];
         /* t(theta): the tangent (n . T = 0, T.xy = (dx, dy)) rises by
          * -(n.x dx + n.y dy) / n.z per unit; its sine and cosine, then
@@ -42,8 +43,8 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
         float nd = n[0] * dx + n[1] * dy, nz = fmaxf(n[2], 0.0f);
         float l = sqrtf(nd * nd + nz * nz);
         float st = l > 0.0f ? -nd / l : 0.0f, ct = l > 0.0f ? nz / l : 1.0f;
-        float sin_h = st * f->hbao_bias_cs[0] + ct * f->hbao_bias_cs[1];
-        if (ct * f->hbao_bias_cs[0] - st * f->hbao_bias_cs[1] < 0.0f)
+        float sin_h = st * hb->bias_cs[0] + ct * hb->bias_cs[1];
+        if (ct * hb->bias_cs[0] - st * hb->bias_cs[1] < 0.0f)
             sin_h = 1.0f;
         for (int j = 1; j <= ns; j++) {
             /* screen y runs down, view y up */
@@ -68,5 +69,19 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
     }
     if (count)
         *count = taken;
-    return fmaxf(0.0f, 1.0f - ao / (float)f->hbao_dirs);
+    return fmaxf(0.0f, 1.0f - ao / (float)hb->dirs);
+}
+
+void obs__hbao_setup(const obs_params *p, obs__frame *f)
+{
+    obs__hbao_state *s = (obs__hbao_state *)(void *)f->ms.bytes;
+    s->dirs = p->hbao_directions;
+    s->steps = p->hbao_steps;
+    for (int d = 0; d < s->dirs; d++) { /* HBAO: Nd directions over 2 pi */
+        double a = 2.0 * M_PI * d / s->dirs;
+        s->dir[d][0] = (float)cos(a);
+        s->dir[d][1] = (float)sin(a);
+    }
+    s->bias_cs[0] = (float)cos(p->hbao_angle_bias * M_PI / 180.0);
+    s->bias_cs[1] = (float)sin(p->hbao_angle_bias * M_PI / 180.0);
 }

@@ -8,7 +8,7 @@
  * surface far in front does not count.  The CPU twin of hemisphere.glsl. */
 #include <math.h>
 
-#include "chain/frame.h"
+#include "methods/hemisphere.h"
 
 /* Radical inverse of i in base b: the van der Corput sequence. */
 static double radical_inverse(unsigned i, unsigned b)
@@ -55,8 +55,9 @@ void obs__hemisphere_basis(const float n[3], float t1[3], float t2[3])
 void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3], const float n[3],
                             const float t1[3], const float t2[3], int i, float s[3])
 {
+    const obs__hemisphere_state *hs = obs__hemisphere_of(f);
     const float *rot = f->rot[obs__tile_index(f, x, y)];
-    const float *k = f->hs_kernel[i];
+    const float *k = hs->kernel[i];
     /* the 3x3 tile's rotation about the normal (interleaved sampling,
      * removed by the shared blur as for VAO++) */
     float kx = rot[0] * k[0] - rot[1] * k[1], ky = rot[1] * k[0] + rot[0] * k[1];
@@ -75,11 +76,12 @@ void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3],
 float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes *nodes, int x,
                                int y, const float p[3], const float n[3])
 {
+    const obs__hemisphere_state *hs = obs__hemisphere_of(f);
     const float R = f->radius;
     float t1[3], t2[3];
     obs__hemisphere_basis(n, t1, t2);
     float occ = 0.0f;
-    for (int i = 0; i < f->hs_count; i++) {
+    for (int i = 0; i < hs->count; i++) {
         float s[3];
         obs__hemisphere_sample(f, x, y, p, n, t1, t2, i, s);
         int qx, qy;
@@ -92,10 +94,10 @@ float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes 
             float zn = pk[3];
             if (!(zn > 0.0f))
                 continue; /* empty node: background never occludes */
-            if (!(zn <= -s[2] - f->hs_bias))
+            if (!(zn <= -s[2] - hs->bias))
                 continue; /* s is not behind the node */
             if (nodes->interior &&
-                (pk[0] - p[0]) * n[0] + (pk[1] - p[1]) * n[1] + (pk[2] - p[2]) * n[2] <= f->hs_bias)
+                (pk[0] - p[0]) * n[0] + (pk[1] - p[1]) * n[1] + (pk[2] - p[2]) * n[2] <= hs->bias)
                 continue; /* on the hull's exterior side */
             float dz = fabsf(-p[2] - zn);
             float r = dz > R ? R / dz : 1.0f;
@@ -104,7 +106,7 @@ float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes 
         }
         occ += best;
     }
-    return f->hs_count > 0 ? 1.0f - occ / (float)f->hs_count : 1.0f;
+    return hs->count > 0 ? 1.0f - occ / (float)hs->count : 1.0f;
 }
 
 /* GLSL: method_ao() in hemisphere.glsl (one opaque node per pixel) */
@@ -113,4 +115,12 @@ float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y,
 {
     const obs__hemisphere_nodes flat = {pos, NULL, 1, 0, 0};
     return obs__hemisphere_estimate(f, &flat, x, y, p, n);
+}
+
+void obs__hemisphere_setup(const obs_params *p, obs__frame *f)
+{
+    obs__hemisphere_state *s = (obs__hemisphere_state *)(void *)f->ms.bytes;
+    s->count = p->hemisphere_samples;
+    s->bias = p->hemisphere_bias * f->radius;
+    obs__hemisphere_kernel(s->count, &s->kernel[0][0]);
 }

@@ -3,68 +3,25 @@
  * estimator in the chain: the CPU twin of method.frag.glsl. */
 #include <math.h>
 
+#include "methods/angle.h"
+#include "methods/gtao.h"
+#include "methods/hbao.h"
+#include "methods/hemisphere.h"
 #include "methods/methods.h"
 #include "obs_shaders.h"
-
-/* Each method's setup: its fields of the frame (frame.h), after the
- * radius is resolved. */
-static void hemisphere_setup(const obs_params *p, obs__frame *f)
-{
-    f->hs_count = p->hemisphere_samples;
-    f->hs_bias = p->hemisphere_bias * f->radius;
-    obs__hemisphere_kernel(f->hs_count, &f->hs_kernel[0][0]);
-}
-
-static void angle_setup(const obs_params *p, obs__frame *f)
-{
-    f->angle_pairs = p->angle_pairs;
-    obs__angle_pattern(f->angle_pairs, &f->angle_xy[0][0]);
-    f->angle_acos = p->angle_acos;
-}
-
-static void hbao_setup(const obs_params *p, obs__frame *f)
-{
-    f->hbao_dirs = p->hbao_directions;
-    f->hbao_steps = p->hbao_steps;
-    for (int d = 0; d < f->hbao_dirs; d++) { /* HBAO: Nd directions over 2 pi */
-        double a = 2.0 * M_PI * d / f->hbao_dirs;
-        f->hbao_dir[d][0] = (float)cos(a);
-        f->hbao_dir[d][1] = (float)sin(a);
-    }
-    f->hbao_bias_cs[0] = (float)cos(p->hbao_angle_bias * M_PI / 180.0);
-    f->hbao_bias_cs[1] = (float)sin(p->hbao_angle_bias * M_PI / 180.0);
-}
-
-static void gtao_setup(const obs_params *p, obs__frame *f)
-{
-    f->gtao_slices = p->gtao_slices;
-    f->gtao_steps = p->gtao_steps;
-    f->gtao_heuristics = p->gtao_heuristics == OBS_ON;
-    /* XeGTAO: effectRadius = EffectRadius * RadiusMultiplier; the falloff
-     * range is EffectFalloffRange * effectRadius, and a sample at
-     * distance r weighs saturate(r * falloffMul + falloffAdd), 1 up to
-     * falloffFrom = effectRadius (1 - EffectFalloffRange), 0 at the
-     * radius */
-    float R = f->radius * p->gtao_radius_multiplier, range = p->gtao_falloff * R;
-    f->gtao_radius = R;
-    f->gtao_falloff[0] = -1.0f / range;
-    f->gtao_falloff[1] = R * (1.0f - p->gtao_falloff) / range + 1.0f;
-    f->gtao_thin_power[0] = p->gtao_thin;
-    f->gtao_thin_power[1] = p->gtao_power;
-}
 
 /* The methods' twins behind one signature (GLSL: method_ao()). */
 static float hemisphere_ao(const obs__frame *f, const float *pos, int x, int y, const float p[4],
                            const float n[3], int *count)
 {
-    *count = f->hs_count;
+    *count = obs__hemisphere_of(f)->count;
     return obs__hemisphere_pixel(f, pos, x, y, p, n);
 }
 
 static float angle_ao(const obs__frame *f, const float *pos, int x, int y, const float p[4],
                       const float n[3], int *count)
 {
-    *count = 2 * f->angle_pairs;
+    *count = 2 * obs__angle_of(f)->pairs;
     return obs__angle_pixel(f, pos, x, y, p, n);
 }
 
@@ -87,42 +44,51 @@ static int angle_samples(const obs_params *p) { return 2 * p->angle_pairs; }
 static int hbao_samples(const obs_params *p) { return p->hbao_directions * p->hbao_steps; }
 static int gtao_samples(const obs_params *p) { return 2 * p->gtao_slices * p->gtao_steps; }
 
-#define F(field) offsetof(obs__frame, field)
+/* A uniform's value in the method's state type, at its place in the frame. */
+#define F(type, field) (offsetof(obs__frame, ms) + offsetof(type, field))
+#define HS(field) F(obs__hemisphere_state, field)
+#define AN(field) F(obs__angle_state, field)
+#define HB(field) F(obs__hbao_state, field)
+#define GT(field) F(obs__gtao_state, field)
 
 /* In the order of OBS_METHOD_LIST (params.h). */
 static const obs__method methods[] = {
     {OBS_METHOD_VAOPP, "vaopp", NULL, NULL, NULL, vao_samples, {{NULL}}, 1},
     {OBS_METHOD_VAO, "vao", NULL, NULL, NULL, vao_samples, {{NULL}}, 1},
-    {OBS_METHOD_HEMISPHERE, "hemisphere", obs__shader_hemisphere, hemisphere_setup, hemisphere_ao,
+    {OBS_METHOD_HEMISPHERE, "hemisphere", obs__shader_hemisphere, obs__hemisphere_setup, hemisphere_ao,
      hemisphere_samples,
-     {{"u_hs_count", OBS__U_INT, F(hs_count), 0, 0},
-      {"u_hs_bias", OBS__U_FLOAT, F(hs_bias), 0, 0},
-      {"u_hs_kernel", OBS__U_FLOAT, F(hs_kernel), F(hs_count), 3},
+     {{"u_hs_count", OBS__U_INT, HS(count), 0, 0},
+      {"u_hs_bias", OBS__U_FLOAT, HS(bias), 0, 0},
+      {"u_hs_kernel", OBS__U_FLOAT, HS(kernel), HS(count), 3},
       {NULL}},
      1},
-    {OBS_METHOD_ANGLE, "angle", obs__shader_angle, angle_setup, angle_ao, angle_samples,
-     {{"u_angle_pairs", OBS__U_INT, F(angle_pairs), 0, 0},
-      {"u_angle_xy", OBS__U_VEC2, F(angle_xy), F(angle_pairs), 1},
-      {"u_angle_acos", OBS__U_INT, F(angle_acos), 0, 0},
+    {OBS_METHOD_ANGLE, "angle", obs__shader_angle, obs__angle_setup, angle_ao, angle_samples,
+     {{"u_angle_pairs", OBS__U_INT, AN(pairs), 0, 0},
+      {"u_angle_xy", OBS__U_VEC2, AN(xy), AN(pairs), 1},
+      {"u_angle_acos", OBS__U_INT, AN(acos), 0, 0},
       {NULL}},
      0},
-    {OBS_METHOD_HBAO, "hbao", obs__shader_hbao, hbao_setup, hbao_ao, hbao_samples,
-     {{"u_hbao_dirs", OBS__U_INT, F(hbao_dirs), 0, 0},
-      {"u_hbao_steps", OBS__U_INT, F(hbao_steps), 0, 0},
-      {"u_hbao_dir", OBS__U_VEC2, F(hbao_dir), F(hbao_dirs), 1},
-      {"u_hbao_bias_cs", OBS__U_VEC2, F(hbao_bias_cs), 0, 0},
+    {OBS_METHOD_HBAO, "hbao", obs__shader_hbao, obs__hbao_setup, hbao_ao, hbao_samples,
+     {{"u_hbao_dirs", OBS__U_INT, HB(dirs), 0, 0},
+      {"u_hbao_steps", OBS__U_INT, HB(steps), 0, 0},
+      {"u_hbao_dir", OBS__U_VEC2, HB(dir), HB(dirs), 1},
+      {"u_hbao_bias_cs", OBS__U_VEC2, HB(bias_cs), 0, 0},
       {NULL}},
      0},
-    {OBS_METHOD_GTAO, "gtao", obs__shader_gtao, gtao_setup, gtao_ao, gtao_samples,
-     {{"u_gtao_slices", OBS__U_INT, F(gtao_slices), 0, 0},
-      {"u_gtao_steps", OBS__U_INT, F(gtao_steps), 0, 0},
-      {"u_gtao_heuristics", OBS__U_INT, F(gtao_heuristics), 0, 0},
-      {"u_gtao_radius", OBS__U_FLOAT, F(gtao_radius), 0, 0},
-      {"u_gtao_falloff", OBS__U_VEC2, F(gtao_falloff), 0, 0},
-      {"u_gtao_thin_power", OBS__U_VEC2, F(gtao_thin_power), 0, 0},
+    {OBS_METHOD_GTAO, "gtao", obs__shader_gtao, obs__gtao_setup, gtao_ao, gtao_samples,
+     {{"u_gtao_slices", OBS__U_INT, GT(slices), 0, 0},
+      {"u_gtao_steps", OBS__U_INT, GT(steps), 0, 0},
+      {"u_gtao_heuristics", OBS__U_INT, GT(heuristics), 0, 0},
+      {"u_gtao_radius", OBS__U_FLOAT, GT(radius), 0, 0},
+      {"u_gtao_falloff", OBS__U_VEC2, GT(falloff), 0, 0},
+      {"u_gtao_thin_power", OBS__U_VEC2, GT(thin_power), 0, 0},
       {NULL}},
      0},
 };
+#undef GT
+#undef HB
+#undef AN
+#undef HS
 #undef F
 
 #define METHOD_COUNT ((int)(sizeof methods / sizeof methods[0]))
@@ -139,6 +105,18 @@ const obs__method *obs__method_get(int id)
 {
     const obs__method *m = obs__method_at(id - OBS_METHOD_VAOPP);
     return m && (int)m->id == id ? m : NULL;
+}
+
+obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *p,
+                            obs__frame *f, char err[OBS_ERR_LEN])
+{
+    obs_status s = obs__frame_setup_common(log_ctx, gb, p, f, err);
+    /* The comparison methods' AO runs in place of the VAO estimator, the
+     * rest of the chain is shared; each fills its own values. */
+    const obs__method *m = obs__method_get(f->method);
+    if (s == OBS_OK && m && m->setup)
+        m->setup(p, f);
+    return s;
 }
 
 /* GLSL: main() of method.frag.glsl */

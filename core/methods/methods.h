@@ -1,7 +1,8 @@
 /* The table of AO methods (parameter `method`): one row per method, the
  * one place that says what a method is made of.  Adding a method is a
- * row here plus its files (a CPU twin in core/methods/, a GLSL file in
- * core/shaders/ defining method_ao()); tests/unit/core/test_methods.c
+ * row here plus its files (its state and functions in core/methods/<name>.h,
+ * a CPU twin in core/methods/<name>.c, a GLSL file in core/shaders/
+ * defining method_ao()); tests/unit/core/test_methods.c
  * checks the rows against the parameter's choices.  No GL here: the
  * uniforms are described as data, set by the GL pass (run_gl.c,
  * deep_gl.c), so the CPU twin links without GL.  Not installed. */
@@ -20,8 +21,8 @@ typedef struct obs__method {
      * own (vao.frag.glsl); else the GLSL file defining method_ao(),
      * compiled between method.glsl and method.frag.glsl. */
     const char *glsl;
-    /* Fills the method's fields of the frame from the resolved
-     * parameters (NULL: nothing of its own). */
+    /* Fills the method's own values (f->ms, its header's state type)
+     * from the resolved parameters (NULL: nothing of its own). */
     void (*setup)(const obs_params *p, obs__frame *f);
     /* The CPU twin of method_ao(): the AO of the point p with normal n at
      * pixel (x, y), *count the samples taken (NULL for vaopp and vao). */
@@ -33,6 +34,17 @@ typedef struct obs__method {
     obs__uniform uniforms[OBS__METHOD_MAX_UNIFORMS]; /* ends at a NULL name */
     int deep; /* 1: runs on deep input too (core/deep: OITAO's GetAO) */
 } obs__method;
+
+/* Resolves one frame (obs__frame_setup_common, frame.c) and fills the
+ * method's own values by its row's setup. */
+obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_params *resolved,
+                            obs__frame *f, char err[OBS_ERR_LEN]);
+
+/* The AO of pixel (x, y) by the frame's method other than vaopp/vao
+ * (position and normal from the planes); *count: samples taken (GLSL:
+ * main() of method.frag.glsl). */
+float obs__method_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                        int *count);
 
 /* The row of method id (resolved, 1 .. OBS_METHOD_COUNT - 1); NULL for
  * any other value. */

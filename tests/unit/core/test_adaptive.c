@@ -7,7 +7,7 @@
 
 #include "testutil.h"
 
-#include "chain/frame.h"
+#include "methods/methods.h"
 #include "obscura/io.h"
 
 #define W 64

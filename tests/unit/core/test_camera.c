@@ -6,7 +6,7 @@
 #include "testutil.h"
 
 #include "camera/camera.h"
-#include "chain/frame.h"
+#include "methods/methods.h"
 #include "obscura/io.h"
 
 static obs__frame setup(obs_gbuffer *gb, const char *normal_space)

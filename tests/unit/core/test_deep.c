@@ -13,6 +13,8 @@
 #include "obscura/deep.h"
 #include "deep/deep_internal.h"
 #include "context.h"
+#include "methods/hemisphere.h"
+#include "methods/methods.h"
 
 #define FIXTURE TESTDATA "/deep_small.exr"
 

@@ -6,6 +6,7 @@
 #include "gl_testutil.h"
 
 #include "chain/frame_gl.h"
+#include "methods/methods.h"
 #include "obs_shaders.h"
 
 static const struct member {

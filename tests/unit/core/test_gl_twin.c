@@ -4,6 +4,8 @@
 #include "gl_testutil.h"
 
 #include "context.h"
+#include "chain/passes_gl.h"
+#include "methods/methods.h"
 
 /* GL and CPU do the same float arithmetic, but a sample that lands within
  * rounding of a pixel border may read the neighbouring pixel's depth on
@@ -347,6 +349,14 @@ static void test_bad_input(void **state)
     obs_ctx_destroy(ctx);
 }
 
+/* The GL column has a kernel for every row of the pass table. */
+static void test_gl_column(void **state)
+{
+    (void)state;
+    for (int i = 0; i < OBS_PASS_COUNT; i++)
+        assert_non_null(obs__gl_kernels[i].run);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -355,6 +365,7 @@ int main(void)
         cmocka_unit_test(test_pass_times),
         cmocka_unit_test(test_shader_failure_is_a_status),
         cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_gl_column),
     };
     return cmocka_run_group_tests_name("gl_twin", tests, NULL, NULL);
 }

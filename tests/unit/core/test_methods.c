@@ -8,7 +8,11 @@
 
 #include "gl_testutil.h"
 
-#include "chain/frame.h"
+#include "methods/angle.h"
+#include "methods/gtao.h"
+#include "methods/hbao.h"
+#include "methods/hemisphere.h"
+#include "methods/methods.h"
 
 /* Odd sizes: with an orthographic camera of pixel size PX the centre of
  * pixel (CX, CY) is the view axis, x = y = 0. */
@@ -194,18 +198,19 @@ static void test_hemisphere_corner(void **state)
         obs__frame f;
         float *pos, *nrm;
         setup(s, &p, &f, &pos, &nrm);
+        const obs__hemisphere_state *hs = obs__hemisphere_of(&f);
         const float floor_n[3] = {0, 1, 0}, pt[3] = {0.0f, -0.3f, -5.0f};
         double mean = 0;
         for (int k = 0; k < 9; k++) { /* every rotation of the 3x3 tile */
             int x = CX + k / 3, y = CY + k % 3;
             const float *rot = f.rot[3 * (x % 3) + (y % 3)];
             int behind = 0;
-            for (int i = 0; i < f.hs_count; i++) {
-                float ky = rot[1] * f.hs_kernel[i][0] + rot[0] * f.hs_kernel[i][1];
-                behind += f.radius * ky >= f.hs_bias;
+            for (int i = 0; i < hs->count; i++) {
+                float ky = rot[1] * hs->kernel[i][0] + rot[0] * hs->kernel[i][1];
+                behind += f.radius * ky >= hs->bias;
             }
             float ao = obs__hemisphere_pixel(&f, pos, x, y, pt, floor_n);
-            assert_float_equal(ao, 1.0f - (float)behind / (float)f.hs_count, 1e-6f);
+            assert_float_equal(ao, 1.0f - (float)behind / (float)hs->count, 1e-6f);
             mean += ao / 9;
         }
         print_message("hemisphere corner, %2d samples: mean AO over the tile %.4f\n", counts[c],
@@ -261,22 +266,23 @@ static void test_angle_valley(void **state)
             obs__frame f;
             float *pos, *nrm;
             setup(s, &p, &f, &pos, &nrm);
+            const obs__angle_state *as = obs__angle_of(&f);
             const float *pt = pos + 4 * (CY * W + CX);
             assert_float_equal(pt[0], 0.0f, 1e-6f);
             double expect = 0;
-            for (int i = 0; i < f.angle_pairs; i++) {
+            for (int i = 0; i < as->pairs; i++) {
                 /* tile rotation of (CX, CY) is 0: offset R * pattern */
-                float ox = f.radius * f.angle_xy[i][0], oy = f.radius * f.angle_xy[i][1];
+                float ox = f.radius * as->xy[i][0], oy = f.radius * as->xy[i][1];
                 double th = M_PI / 2;
                 for (int sg = -1; sg <= 1; sg += 2) {
                     int qx = (int)floorf((sg * ox) / PX + 0.5f * W);
                     int qy = (int)floorf(0.5f * H - (sg * oy) / PX);
                     float vx = (qx + 0.5f - 0.5f * W) * PX, vy = (0.5f * H - qy - 0.5f) * PX;
                     if (vx < 0)
-                        th = obs__acos_mode(f.angle_acos,
+                        th = obs__acos_mode(as->acos,
                                             sqrtf(2.0f) * fabsf(vx) / sqrtf(2 * vx * vx + vy * vy));
                 }
-                expect += fmin(0.5 + th / M_PI, 1.0) / f.angle_pairs;
+                expect += fmin(0.5 + th / M_PI, 1.0) / as->pairs;
             }
             float ao = obs__angle_pixel(&f, pos, CX, CY, pt, nB);
             if (pairs == 16)
@@ -321,7 +327,7 @@ static void test_hbao_valley(void **state)
         setup(s, &p, &f, &pos, &nrm);
         const float *pt = pos + 4 * (CY * W + CX);
         const double R = f.radius, bias = atof(biases[b]) * M_PI / 180;
-        const double step = (R / PX) / (f.hbao_steps + 1);
+        const double step = (R / PX) / (obs__hbao_of(&f)->steps + 1);
         const double k = floor(step + 0.5), k2 = floor(step * sqrt(0.5) + 0.5);
         const double W180 = 1 - 2 * k * k * PX * PX / (R * R);
         const double W135 = 1 - 3 * k2 * k2 * PX * PX / (R * R);
@@ -450,14 +456,15 @@ static void test_gtao_open_plane(void **state)
         obs__frame f;
         float *pos, *nrm;
         setup(s, &p, &f, &pos, &nrm);
+        const obs__gtao_state *gs = obs__gtao_of(&f);
         double worst = 0, worst1 = 0;
         for (int y = 2; y < H - 2; y++)
             for (int x = 2; x < W - 2; x++) {
                 double expect = 0;
-                for (int i = 0; i < f.gtao_slices; i++) {
+                for (int i = 0; i < gs->slices; i++) {
                     double L, g;
-                    ortho_slice(tilt_n, gtao_phi(x, y, i, f.gtao_slices), &L, &g);
-                    expect += slice_value(L, g, g - M_PI / 2, g + M_PI / 2) / f.gtao_slices;
+                    ortho_slice(tilt_n, gtao_phi(x, y, i, gs->slices), &L, &g);
+                    expect += slice_value(L, g, g - M_PI / 2, g + M_PI / 2) / gs->slices;
                 }
                 size_t i = (size_t)y * W + x;
                 float ao = obs__gtao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, NULL);
@@ -465,7 +472,7 @@ static void test_gtao_open_plane(void **state)
                 worst1 = fmax(worst1, fabs(ao - 1.0));
             }
         print_message("gtao open plane tilted, %2d slices: max |AO - closed form| %.2e, "
-                      "max |AO - 1| %.2e\n", f.gtao_slices, worst, worst1);
+                      "max |AO - 1| %.2e\n", gs->slices, worst, worst1);
         assert_true(worst < 0.01);
         assert_true(worst1 < 0.01);
         free(pos);
@@ -527,6 +534,7 @@ static void test_gtao_crease(void **state)
         obs__frame f;
         float *pos, *nrm;
         setup(s, &p, &f, &pos, &nrm);
+        const obs__gtao_state *gs = obs__gtao_of(&f);
         const float *pt = pos + 4 * (CY * W + CX);
         const double cz = pt[2] * 0.99999f;
         for (int k = 0; k < 9; k++) {
@@ -534,8 +542,8 @@ static void test_gtao_crease(void **state)
             float noise[2];
             obs__gtao_noise(3 * (x % 3) + (y % 3), noise); /* no display offset */
             double rpx = f.radius / PX, min_s = 1.3 / rpx, expect = 0;
-            for (int i = 0; i < f.gtao_slices; i++) {
-                double phi = gtao_phi(x, y, i, f.gtao_slices), L, g;
+            for (int i = 0; i < gs->slices; i++) {
+                double phi = gtao_phi(x, y, i, gs->slices), L, g;
                 ortho_slice(nB, phi, &L, &g);
                 double sn = noise[1] + i * 0.6180339887498948482;
                 sn -= floor(sn);
@@ -551,18 +559,18 @@ static void test_gtao_crease(void **state)
                     double d[3] = {vx, vy, -5.0 + fabs(vx) - cz};   /* the valley there */
                     double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), ch = d[2] / r;
                     double low = cos(side ? g - M_PI / 2 : g + M_PI / 2);
-                    if (r >= f.gtao_radius)
+                    if (r >= gs->radius)
                         ch = low; /* beyond the cut: weight 0 */
                     double hh = acos(fmax(ch, low));
                     h[side] = side ? fmax(-hh, g - M_PI / 2) : fmin(hh, g + M_PI / 2);
                 }
-                expect += slice_value(L, g, h[1], h[0]) / f.gtao_slices;
+                expect += slice_value(L, g, h[1], h[0]) / gs->slices;
             }
             int count;
             float ao = obs__gtao_pixel(&f, pos, x, y, pt, nB, &count);
             print_message("gtao crease, tile %d: AO %.6f, derived %.6f\n", k, ao, expect);
             assert_float_equal(ao, (float)expect, 1e-5f);
-            assert_int_equal(count, 2 * f.gtao_slices);
+            assert_int_equal(count, 2 * gs->slices);
         }
         free(pos);
         free(nrm);

@@ -9,7 +9,7 @@
 #include "gl_testutil.h"
 
 #include "camera/camera.h"
-#include "chain/frame.h"
+#include "methods/methods.h"
 #include "internal.h"
 #include "obscura/deep.h"
 #include "obscura/obscura.h"

@@ -8,7 +8,7 @@
 
 #include "testutil.h"
 
-#include "chain/frame.h"
+#include "methods/methods.h"
 #include "obscura/io.h"
 
 static const int sizes[] = {2, 4, 8, 16, 32};

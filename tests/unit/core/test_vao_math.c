@@ -8,7 +8,7 @@
 
 #include "gl_testutil.h"
 
-#include "chain/frame.h"
+#include "methods/methods.h"
 
 #define W 96
 #define H 72

@@ -6,6 +6,7 @@
  * default chain and by a comparison method from the method table. */
 #include "testutil.h"
 #include "core/synth_corner.h"
+#include "chain/passes_cpu.h"
 
 /* Mean AO over the floor pixels of rows [y0, y1). */
 static double floor_mean(const sc_scene *s, const float *ao, int y0, int y1)
@@ -67,11 +68,25 @@ static void test_method_from_table(void **state)
     run("hemisphere");
 }
 
+/* The pass table is in the order of obs_pass, every row has its test,
+ * and the CPU column has a kernel for every row. */
+static void test_pass_table(void **state)
+{
+    (void)state;
+    for (int i = 0; i < OBS_PASS_COUNT; i++) {
+        assert_int_equal(obs__passes[i].id, i);
+        assert_non_null(obs__passes[i].when);
+        assert_non_null(obs__cpu_kernels[i]);
+        assert_string_equal(obs_pass_name((obs_pass)i), obs__passes[i].name);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_default_chain),
         cmocka_unit_test(test_method_from_table),
+        cmocka_unit_test(test_pass_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

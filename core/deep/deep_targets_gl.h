@@ -1,7 +1,8 @@
-/* Deep input's GL objects kept in the context between frames (deep_gl.c).
+/* Deep input's GL objects kept in the context between frames (deep_gl.c;
+ * torn down by deep_targets_gl.c).
  * Not installed. */
-#ifndef OBSCURA_DEEP_GL_H
-#define OBSCURA_DEEP_GL_H
+#ifndef OBSCURA_DEEP_TARGETS_GL_H
+#define OBSCURA_DEEP_TARGETS_GL_H
 
 #include "gl/gl.h"
 

@@ -1,0 +1,236 @@
+/* The CPU kernel of each pass (passes_cpu.h): the twins of the GL passes
+ * (passes_gl.c), pixel by pixel.  The order and whether a pass runs are
+ * the table's (passes.c); the driver is run_cpu.c. */
+#include <string.h>
+
+#include "chain/passes_cpu.h"
+
+/* GLSL: composite.frag.glsl.  Section 5: "applied to resulting image
+ * simply by multiplication by occlusion values": colour x AO, and x the
+ * bleed term (section 4.7) when bleeding is on; grey AO when there is no
+ * colour. */
+static void composite_pixel(const float *color, float ao, const float *bleed, float out[4])
+{
+    if (!color) {
+        out[0] = out[1] = out[2] = ao;
+        out[3] = 1.0f;
+        return;
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = bleed ? color[k] * ao * bleed[k] : color[k] * ao;
+    out[3] = color[3];
+}
+
+/* The AO pass over frame f's planes (GLSL: vao.frag.glsl, or the method's
+ * method.frag.glsl): ao, the bleed term and the debug planes (NULL: not
+ * wanted) of every pixel. */
+static void ao_pass(const obs__frame *f, const obs__method *method, const float *pos,
+                    const float *nrm, const float *col, const float *est, float *ao, float *bleed,
+                    float *count, float *mask)
+{
+    for (int y = 0; y < f->height; y++)
+        for (int x = 0; x < f->width; x++) {
+            size_t i = (size_t)y * f->width + x;
+            int n = 0, culled = 0;
+            float *b = bleed + 3 * i;
+            ao[i] = 1.0f;
+            b[0] = b[1] = b[2] = 1.0f;
+            if (method->pixel) {
+                /* a comparison method in place of the VAO estimator */
+                ao[i] = obs__method_pixel(f, pos, nrm, x, y, &n);
+            } else if (pos[4 * i + 3] > 0.0f) {
+                /* Section 4.2: a culling candidate gets AO 1 (greedy) or
+                 * at most the 4-sample set (careful). */
+                culled = f->culling && obs__cull_candidate(f, est, x, y);
+                if (!culled) {
+                    /* section 4.1: the set of the pixel's count */
+                    n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
+                    const float *xy = f->adaptive ? f->sample_table + 2 * (n - 2) : f->sample_xy;
+                    ao[i] = obs__vao_estimate_bleed(f, pos, nrm, col, x, y, pos + 4 * i,
+                                                    nrm + 3 * i, n, xy, b);
+                } else if (f->culling == 2) {
+                    n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
+                    n = n < OBS_CULL_CAREFUL ? n : OBS_CULL_CAREFUL;
+                    const float *xy = f->sample_table + 2 * (n - 2);
+                    ao[i] = obs__vao_estimate_bleed(f, pos, nrm, col, x, y, pos + 4 * i,
+                                                    nrm + 3 * i, n, xy, b);
+                }
+            }
+            if (count)
+                count[i] = (float)n;
+            if (mask)
+                mask[i] = (float)culled;
+        }
+}
+
+/* The prep pass at full size: view positions, then normals (from the
+ * input or derived from the positions). */
+static void prep_full(obs__cpu_run *c)
+{
+    const obs__frame *f = &c->pl->f;
+    const obs_gbuffer *gb = c->pl->gb;
+    for (int y = 0; y < f->height; y++)
+        for (int x = 0; x < f->width; x++)
+            obs__prep_position(f, *obs__plane_px(&gb->depth, f->width, x, y), x, y,
+                               c->pos + 4 * ((size_t)y * f->width + x));
+    for (int y = 0; y < f->height; y++)
+        for (int x = 0; x < f->width; x++) {
+            const float *in = gb->normal.data ? obs__plane_px(&gb->normal, f->width, x, y) : NULL;
+            obs__prep_normal(f, c->pos, in, x, y, c->nrm + 3 * ((size_t)y * f->width + x));
+        }
+}
+
+/* The colour, packed, for sections 4.3 and 4.7. */
+static obs_status cpu_upload(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    const obs__frame *f = &c->pl->f;
+    (void)err;
+    if (c->col)
+        for (int y = 0; y < f->height; y++)
+            for (int x = 0; x < f->width; x++)
+                memcpy(c->col + 4 * ((size_t)y * f->width + x),
+                       obs__plane_px(&c->pl->gb->color, f->width, x, y), 4 * sizeof(float));
+    return OBS_OK;
+}
+
+static obs_status cpu_prep(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    (void)err;
+    prep_full(c);
+    return OBS_OK;
+}
+
+/* ao_resolution half: the full prep (the upsample reads it), then each
+ * half pixel takes the planes of the pixel obs__half_source picks (GLSL:
+ * prep.frag.glsl with OBS_HALF, straight from the raw planes). */
+static obs_status cpu_downsample(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    const obs__frame *f = &c->pl->f, *hf = c->pl->af;
+    (void)err;
+    prep_full(c);
+    for (int hy = 0; hy < hf->height; hy++)
+        for (int hx = 0; hx < hf->width; hx++) {
+            long k = obs__half_source(f, c->pos, hx, hy);
+            if (k < 0) /* all background: the block's first pixel, background too */
+                k = (long)(2 * hy) * f->width + 2 * hx;
+            const size_t h = (size_t)hy * hf->width + hx;
+            memcpy(c->hpos + 4 * h, c->pos + 4 * k, 4 * sizeof(float));
+            memcpy(c->hnrm + 3 * h, c->nrm + 3 * k, 3 * sizeof(float));
+        }
+    return OBS_OK;
+}
+
+/* Section 4.2: the culling pre-pass. */
+static obs_status cpu_cull(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    (void)err;
+    obs__cull_prepass(c->pl->af, c->apos, c->anrm, c->est);
+    return OBS_OK;
+}
+
+static obs_status cpu_ao(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    (void)err;
+    ao_pass(c->pl->af, c->pl->method, c->apos, c->anrm, c->col, c->est, c->aao, c->ableed,
+            c->out->sample_count.data, c->out->cull_mask.data);
+    return OBS_OK;
+}
+
+/* ao_definition rays (not linear: applied to the filtered estimate). */
+static void rays(float *ao, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        ao[i] = obs__rays_from_volume(ao[i]);
+}
+
+/* Section 4.6, the low-pass filter; the conversion of ao_definition rays
+ * after it, as GL's vertical pass does. */
+static obs_status cpu_blur(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    (void)err;
+    obs__blur(c->pl->af, c->apos, c->aao, c->atmp);
+    if (c->pl->rays_in_blur)
+        rays(c->ao, c->npx);
+    return OBS_OK;
+}
+
+/* ao_resolution half: the joint bilateral upsample, then ao_definition
+ * rays' conversion (GLSL: up.frag.glsl). */
+static obs_status cpu_up(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    const obs__frame *f = &c->pl->f, *hf = c->pl->af;
+    (void)err;
+    for (int y = 0; y < f->height; y++)
+        for (int x = 0; x < f->width; x++)
+            c->ao[(size_t)y * f->width + x] =
+                obs__half_upsample(f, hf, c->pos, c->nrm, c->hpos, c->hnrm, c->hao, x, y);
+    if (f->rays)
+        rays(c->ao, c->npx);
+    return OBS_OK;
+}
+
+/* The finishing pass (luminance.frag.glsl), after the blur: the
+ * conversion of ao_definition rays when no blur did it, then luminance
+ * sensitivity (section 4.3, eq 3): the blur is depth-aware only and would
+ * carry a bright pixel's suppression onto its dark neighbours (and their
+ * occlusion onto it). */
+static obs_status cpu_finish(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    const obs__frame *f = &c->pl->f;
+    (void)err;
+    if (c->pl->rays_in_finish)
+        rays(c->ao, c->npx);
+    if (!f->luminance)
+        return OBS_OK;
+    for (size_t i = 0; c->out->luminance.data && i < c->npx; i++)
+        c->out->luminance.data[i] = obs__luminance_factor(f, c->col + 4 * i);
+    for (size_t i = 0; i < c->npx; i++)
+        c->ao[i] = obs__luminance_ao(f, c->ao[i], c->col + 4 * i);
+    return OBS_OK;
+}
+
+static obs_status cpu_composite(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    const obs__frame *f = &c->pl->f;
+    const obs_gbuffer *gb = c->pl->gb;
+    (void)err;
+    for (int y = 0; y < f->height; y++)
+        for (int x = 0; x < f->width; x++) {
+            size_t i = (size_t)y * f->width + x;
+            composite_pixel(gb->color.data ? obs__plane_px(&gb->color, f->width, x, y) : NULL,
+                            c->ao[i], f->bleed_step ? c->bleed + 3 * i : NULL,
+                            c->out->composite.data + 4 * i);
+        }
+    return OBS_OK;
+}
+
+static void fill_ones(float *dst, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        dst[i] = 1.0f;
+}
+
+/* The planes into the result; the parts that are off give their neutral
+ * value (bleeding is refused at half resolution). */
+static obs_status cpu_readback(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    obs_result *out = c->out;
+    (void)err;
+    if (out->ao.data)
+        memcpy(out->ao.data, c->ao, c->npx * sizeof(float));
+    if (out->bleed.data && c->pl->f.half)
+        fill_ones(out->bleed.data, c->npx * 3);
+    else if (out->bleed.data)
+        memcpy(out->bleed.data, c->bleed, c->npx * 3 * sizeof(float));
+    if (out->luminance.data && !c->pl->f.luminance)
+        fill_ones(out->luminance.data, c->npx);
+    return OBS_OK;
+}
+
+const obs__cpu_kernel obs__cpu_kernels[OBS_PASS_COUNT] = {
+    [OBS_PASS_UPLOAD] = cpu_upload,       [OBS_PASS_PREP] = cpu_prep,
+    [OBS_PASS_DOWNSAMPLE] = cpu_downsample, [OBS_PASS_CULL] = cpu_cull,
+    [OBS_PASS_AO] = cpu_ao,               [OBS_PASS_BLUR] = cpu_blur,
+    [OBS_PASS_UPSAMPLE] = cpu_up,         [OBS_PASS_FINISH] = cpu_finish,
+    [OBS_PASS_COMPOSITE] = cpu_composite, [OBS_PASS_READBACK] = cpu_readback,
+};

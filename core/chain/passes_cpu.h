@@ -1,0 +1,26 @@
+/* The CPU device's column of the pass table (passes.h): one kernel per
+ * pass, each the CPU twin of the GL pass (passes_cpu.c), walked by
+ * obs_run_cpu (run_cpu.c).  No GL.  Not installed. */
+#ifndef OBSCURA_PASSES_CPU_H
+#define OBSCURA_PASSES_CPU_H
+
+#include "chain/passes.h"
+
+/* One frame's planes on the CPU: the full-size ones and, with
+ * ao_resolution half, the half-size ones the culling pre-pass, AO and
+ * blur run on (a* point to the one or the other). */
+typedef struct obs__cpu_run {
+    const obs__plan *pl;
+    obs_result *out;
+    size_t npx;
+    float *pos, *nrm, *ao, *tmp, *est, *col, *bleed; /* full size; col: packed RGBA */
+    float *hpos, *hnrm, *hao, *htmp, *hbleed;       /* half size */
+    float *apos, *anrm, *aao, *atmp, *ableed;       /* at the AO's size */
+} obs__cpu_run;
+
+typedef obs_status (*obs__cpu_kernel)(obs__cpu_run *c, char err[OBS_ERR_LEN]);
+
+/* By obs_pass: the kernel of each row of obs__passes. */
+extern const obs__cpu_kernel obs__cpu_kernels[OBS_PASS_COUNT];
+
+#endif

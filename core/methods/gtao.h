@@ -1,0 +1,40 @@
+/* Method gtao (gtao.c, gtao.glsl): its own values in the frame and its
+ * functions.  Not installed. */
+#ifndef OBSCURA_METHOD_GTAO_H
+#define OBSCURA_METHOD_GTAO_H
+
+#include "chain/frame.h"
+
+/* Slices, steps per side, XeGTAO's heuristics (1: on); the search radius
+ * gtao_multiplier * D in depth units; the falloff's weight =
+ * saturate(r * mul + add); the thin-occluder compensation and the final
+ * power. */
+typedef struct obs__gtao_state {
+    int slices, steps, heuristics;
+    float radius;
+    float falloff[2];    /* mul, add */
+    float thin_power[2]; /* gtao_thin, gtao_power */
+} obs__gtao_state;
+_Static_assert(sizeof(obs__gtao_state) <= OBS__METHOD_STATE_BYTES, "fits obs__frame.ms");
+
+static inline const obs__gtao_state *obs__gtao_of(const obs__frame *f)
+{
+    return (const obs__gtao_state *)(const void *)f->ms.bytes;
+}
+
+/* Fills the frame's method values from the resolved parameters. */
+void obs__gtao_setup(const obs_params *p, obs__frame *f);
+
+/* Ground-truth-based AO (Jimenez et al., as XeGTAO implements it) of the
+ * point p with normal n at pixel (x, y) (GLSL: gtao.glsl).  The count of
+ * depth samples read inside the image goes to *count when count is not
+ * NULL. */
+float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                      const float n[3], int *count);
+
+/* The noise of the 3x3 tile's pixel `tile` (obs__tile_index): XeGTAO's R2
+ * sequence, fract(0.5 + k (0.754877666, 0.569840291)), k = tile;
+ * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
+void obs__gtao_noise(int tile, float out[2]);
+
+#endif

@@ -1,0 +1,30 @@
+/* Method hbao (hbao.c, hbao.glsl): its own values in the frame and its
+ * functions.  Not installed. */
+#ifndef OBSCURA_METHOD_HBAO_H
+#define OBSCURA_METHOD_HBAO_H
+
+#include "chain/frame.h"
+
+/* Directions (unit, view xy), steps, the angle bias. */
+typedef struct obs__hbao_state {
+    int dirs, steps;
+    float dir[OBS_MAX_DIRECTIONS][2];
+    float bias_cs[2]; /* cos, sin of the angle bias */
+} obs__hbao_state;
+_Static_assert(sizeof(obs__hbao_state) <= OBS__METHOD_STATE_BYTES, "fits obs__frame.ms");
+
+static inline const obs__hbao_state *obs__hbao_of(const obs__frame *f)
+{
+    return (const obs__hbao_state *)(const void *)f->ms.bytes;
+}
+
+/* Fills the frame's method values from the resolved parameters. */
+void obs__hbao_setup(const obs_params *p, obs__frame *f);
+
+/* Horizon-based AO of the point p with normal n at pixel (x, y), marched
+ * from that pixel (GLSL: hbao.glsl).  The count of depth samples read
+ * goes to *count when count is not NULL. */
+float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                      const float n[3], int *count);
+
+#endif
