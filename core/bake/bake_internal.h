@@ -100,10 +100,6 @@ void obs__bake_residual(const obs__bake_world *w, const obs__bake_weld *wd,
 double obs__bake_edge_jump(const float a[3], const float b[3], const float c[3],
                            const float d[3], double j[4]);
 
-/* fn(ctx, i) for every i in [0, n), in chunks, on `threads` threads (0:
- * every core; probes.c): the dynamic bake's points, the instanced
- * decorators' volume (volume.c), the LODs' instances (lod.c). */
-void obs__bake_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx);
 /* Small decorators (small.c, section 2.2.1): each small node's scalar
  * resampled from the fitted vertex values x (2 per welded vertex, of[]
  * the weld) around it, into out->node_ao and its instances' vertices

@@ -29,6 +29,7 @@
 
 #include "bake/lod.h"
 #include "internal.h"
+#include "pool.h"
 
 
 static double now(void)
@@ -140,7 +141,7 @@ obs_status obs__bake_lod_resample(const obs__bake_world *full, const obs__bake_w
                              "LOD resampling: instance %zu is not the same (node, mesh)", i);
     job j = {full, lw, fwd, x, ls, vertex};
     atomic_init(&j.failed, 0);
-    obs__bake_pfor(lw->instance_count, 1, threads, resample_one, &j);
+    obs__pool_each(lw->instance_count, 1, threads, resample_one, &j);
     if (atomic_load(&j.failed))
         return obs__fail(err, OBS_NO_MEMORY, "LOD resampling: a nearest-point search");
     ls->dropped = 0;

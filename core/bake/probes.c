@@ -27,17 +27,14 @@
  * point whose rays meet back faces more often than backface_limit is
  * dropped here too (the full ray set sees more than the 32 of the flag). */
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "bake/dyn_internal.h"
 #include "bake/rng.h"
 #include "internal.h"
+#include "pool.h"
 
-#define MAX_THREADS 64
 #define PI_D 3.14159265358979323846
 /* Rays stop at this many long distances: rho is within 2^-16 of 1 (as
  * trace.c). */
@@ -67,63 +64,6 @@ void obs__dyn_points_free(obs__dyn_points *pt)
     free(pt->id);
     free(pt->dropped);
     memset(pt, 0, sizeof *pt);
-}
-
-/* A parallel loop over [0, n) in chunks; fn(ctx, i). */
-typedef struct pfor {
-    size_t n, chunk;
-    atomic_size_t next;
-    void (*fn)(void *, size_t);
-    void *ctx;
-    pthread_mutex_t lock;
-    size_t done;
-    void (*progress)(void *, size_t, size_t);
-    void *user;
-} pfor;
-
-static void *pfor_worker(void *arg)
-{
-    pfor *f = arg;
-    size_t i0;
-    while ((i0 = atomic_fetch_add(&f->next, f->chunk)) < f->n) {
-        size_t i1 = i0 + f->chunk < f->n ? i0 + f->chunk : f->n;
-        for (size_t i = i0; i < i1; i++)
-            f->fn(f->ctx, i);
-        pthread_mutex_lock(&f->lock);
-        f->done += i1 - i0;
-        if (f->progress)
-            f->progress(f->user, f->done, f->n);
-        pthread_mutex_unlock(&f->lock);
-    }
-    return NULL;
-}
-
-static void run_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx,
-                     void (*progress)(void *, size_t, size_t), void *user)
-{
-    pfor f = {.n = n, .chunk = chunk, .fn = fn, .ctx = ctx, .progress = progress, .user = user};
-    atomic_init(&f.next, 0);
-    pthread_mutex_init(&f.lock, NULL);
-    int nt = threads;
-    if (nt <= 0) {
-        long c = sysconf(_SC_NPROCESSORS_ONLN);
-        nt = c < 1 ? 1 : c > MAX_THREADS ? MAX_THREADS : (int)c;
-    }
-    pthread_t th[MAX_THREADS];
-    int started = 0;
-    for (; started < nt && started < MAX_THREADS; started++)
-        if (pthread_create(&th[started], NULL, pfor_worker, &f) != 0)
-            break;
-    if (started == 0)
-        pfor_worker(&f);
-    for (int k = 0; k < started; k++)
-        pthread_join(th[k], NULL);
-    pthread_mutex_destroy(&f.lock);
-}
-
-void obs__bake_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx)
-{
-    run_pfor(n, chunk, threads, fn, ctx, NULL, NULL);
 }
 
 typedef struct flag_job {
@@ -173,6 +113,8 @@ typedef struct sph_job {
     const obs_dyn_params *p;
     obs__dyn_points *pt;
     size_t first;
+    void (*progress)(void *, size_t, size_t);
+    void *user;
 } sph_job;
 
 int obs__dyn_point_sh(const obs__bake_bvh *bvh, const float o[3], const obs_dyn_params *p,
@@ -228,6 +170,22 @@ static void trace_point(void *ctx, size_t i)
     pt->dropped[k] = (uint8_t)dropped;
 }
 
+static int trace_points(void *ctx, void *local, size_t i0, size_t i1)
+{
+    (void)local;
+    for (size_t i = i0; i < i1; i++)
+        trace_point(ctx, i);
+    return 0;
+}
+
+/* The shard's progress never cancels. */
+static int report(void *ctx, size_t done, size_t total)
+{
+    const sph_job *j = ctx;
+    j->progress(j->user, done, total);
+    return 0;
+}
+
 obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions *rg,
                                 const obs_dyn_params *p, obs__dyn_points *out,
                                 char err[OBS_ERR_LEN])
@@ -241,7 +199,7 @@ obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions 
     if (!state)
         return obs__fail(err, OBS_NO_MEMORY, "valid flags of %zu points", total);
     flag_job fj = {bvh, rg, p, state};
-    run_pfor(rg->count, 1, p->threads, flag_region, &fj, NULL, NULL);
+    obs__pool_each(rg->count, 1, p->threads, flag_region, &fj);
     out->grid = total;
     for (size_t k = 0; k < total; k++) {
         out->inside += state[k] == 1;
@@ -279,8 +237,11 @@ void obs__dyn_points_trace(const obs__bake_bvh *bvh, const obs_dyn_params *p,
                            obs__dyn_points *pt, size_t first, size_t end,
                            void (*progress)(void *, size_t, size_t), void *user)
 {
-    sph_job sj = {bvh, p, pt, first};
-    run_pfor(end - first, 16, p->threads, trace_point, &sj, progress, user);
+    sph_job sj = {bvh, p, pt, first, progress, user};
+    obs__pool_for f = {.end = end - first, .chunk = 16, .threads = p->threads,
+                       .range = trace_points, .ctx = &sj, .progress = progress ? report : NULL,
+                       .progress_user = &sj};
+    obs__pool_run(&f, NULL);
     pt->rays += (uint64_t)(end - first) * (uint64_t)p->rays;
 }
 

@@ -18,20 +18,17 @@
  * attenuate the current AO value for a ray"). */
 #include <embree3/rtcore.h>
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "bake/bake_internal.h"
 #include "bake/occl.h"
 #include "bake/rng.h"
 #include "internal.h"
+#include "pool.h"
 
-#define MAX_THREADS 64
 #define CHUNK 64
 #define PACKET 8
 /* Rays stop at this many long distances: rho is within 2^-16 of 1. */
@@ -45,10 +42,7 @@ typedef struct job {
     const obs__bake_occl *occl;
     RTCScene rtc;
     float a[2]; /* the kernels' a = ln(0.5) / d */
-    atomic_size_t next;
-    pthread_mutex_t lock;
-    size_t end, done; /* the range ends at end (d->first .. end) */
-    atomic_int stop;  /* the progress callback asked to stop */
+    size_t end; /* the range ends at end (d->first .. end) */
     uint64_t rays;
     size_t dropped;
 } job;
@@ -142,28 +136,30 @@ static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint
     *dropped += !s->valid[i];
 }
 
-static void *worker(void *arg)
+/* One range of samples on one thread: rays and drops counted locally,
+ * added to the job when the thread ends (integer sums: any order). */
+typedef struct counts {
+    uint64_t rays;
+    size_t dropped;
+} counts;
+
+static int trace_range(void *ctx, void *local, size_t i0, size_t i1)
 {
-    job *j = arg;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    uint64_t rays = 0;
-    size_t dropped = 0, i0;
-    while (!atomic_load(&j->stop) && (i0 = atomic_fetch_add(&j->next, CHUNK)) < j->end) {
-        size_t i1 = i0 + CHUNK < j->end ? i0 + CHUNK : j->end;
-        for (size_t i = i0; i < i1; i++)
-            trace_sample(j, &ctx, i, &rays, &dropped);
-        pthread_mutex_lock(&j->lock);
-        j->done += i1 - i0;
-        if (j->d->progress && j->d->progress(j->d->progress_user, j->done, j->end - j->d->first))
-            atomic_store(&j->stop, 1); /* between batches: the bake is cancelled */
-        pthread_mutex_unlock(&j->lock);
-    }
-    pthread_mutex_lock(&j->lock);
-    j->rays += rays;
-    j->dropped += dropped;
-    pthread_mutex_unlock(&j->lock);
-    return NULL;
+    job *j = ctx;
+    counts *c = local;
+    struct RTCIntersectContext ictx;
+    rtcInitIntersectContext(&ictx);
+    for (size_t i = i0; i < i1; i++)
+        trace_sample(j, &ictx, i, &c->rays, &c->dropped);
+    return 0;
+}
+
+static void trace_end(void *ctx, void *local)
+{
+    job *j = ctx;
+    const counts *c = local;
+    j->rays += c->rays;
+    j->dropped += c->dropped;
 }
 
 static double now(void)
@@ -198,28 +194,18 @@ obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
         j->a[c] = logf(0.5f) / d->distance[c]; /* a = ln(0.5) / d, section 2 */
     /* The samples [first, end): a shard of the bake (shard.c), or all. */
     j->end = d->end && d->end < s->count ? d->end : s->count;
-    atomic_init(&j->next, d->first < j->end ? d->first : j->end);
-    atomic_init(&j->stop, 0);
-    pthread_mutex_init(&j->lock, NULL);
-    int nt = d->threads;
-    if (nt <= 0) {
-        long c = sysconf(_SC_NPROCESSORS_ONLN);
-        nt = c < 1 ? 1 : c > MAX_THREADS ? MAX_THREADS : (int)c;
-    }
-    pthread_t th[MAX_THREADS];
-    int started = 0;
-    for (; started < nt && started < MAX_THREADS; started++)
-        if (pthread_create(&th[started], NULL, worker, j) != 0)
-            break;
-    if (started == 0)
-        worker(j);
-    for (int k = 0; k < started; k++)
-        pthread_join(th[k], NULL);
-    pthread_mutex_destroy(&j->lock);
+    obs__pool_for f = {.first = d->first, .end = j->end, .chunk = CHUNK, .threads = d->threads,
+                       .range = trace_range, .ctx = j, .local_size = sizeof(counts),
+                       .end_thread = trace_end, .progress = d->progress,
+                       .progress_user = d->progress_user};
+    size_t traced = 0;
+    int stopped = obs__pool_run(&f, &traced); /* the progress callback cancels between ranges */
     s->rays = j->rays;
     s->dropped = j->dropped;
-    if (atomic_load(&j->stop))
-        st = obs__fail(err, OBS_CANCELLED, "bake cancelled after %zu of %zu samples", j->done,
+    if (stopped < 0)
+        st = obs__fail(err, OBS_NO_MEMORY, "trace threads");
+    else if (stopped)
+        st = obs__fail(err, OBS_CANCELLED, "bake cancelled after %zu of %zu samples", traced,
                        j->end - d->first);
     free(j);
 done:

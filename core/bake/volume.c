@@ -23,6 +23,7 @@
 #include "bake/dyn_internal.h"
 #include "bake/instanced.h"
 #include "internal.h"
+#include "pool.h"
 
 #define B OBS__VOL_BRICK
 #define B3 (B * B * B)
@@ -299,7 +300,7 @@ obs_status obs__vol_trace(obs__vol *v, const obs__bake_bvh *bvh, int rays, const
     j->stop = stop;
     j->user = user;
     pthread_mutex_init(&j->lock, NULL);
-    obs__bake_pfor(v->count, 16, threads, vol_point, j);
+    obs__pool_each(v->count, 16, threads, vol_point, j);
     pthread_mutex_destroy(&j->lock);
     int failed = atomic_load(&j->failed), stopped = atomic_load(&j->stopped);
     free(j);
