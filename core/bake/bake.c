@@ -6,7 +6,7 @@
 #include <time.h>
 
 #include "bake/bake_internal.h"
-#include "bake/decor.h"
+#include "level/decor.h"
 #include "bake/instanced.h"
 #include "bake/lod.h"
 #include "bake/shard.h"

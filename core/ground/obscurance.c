@@ -6,13 +6,13 @@
  * lanes summed in ray order, as core/bake/trace.c does.  With the bake's
  * occluders (obs_reference_desc.occluders) the rays meet what the bake's
  * meet: its opaque BVH, and each ray's rho times the transmittance of the
- * shrubs' fog and the trees up to the hit (section 2.1, core/bake/occl.c). */
+ * shrubs' fog and the trees up to the hit (section 2.1, core/level/occl.c). */
 #include <embree3/rtcore.h>
 #include <math.h>
 
-#include "bake/kernel.h"
-#include "bake/occl.h"
-#include "bake/rng.h"
+#include "level/kernel.h"
+#include "level/occl.h"
+#include "level/rng.h"
 #include "ground/reference_internal.h"
 
 #define PACKET 8

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/occl.h"
+#include "level/occl.h"
 #include "ground/reference_internal.h"
 #include "internal.h"
 #include "obscura/reference.h"

@@ -4,8 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/dyn_internal.h"
-#include "bake/shard.h"
+#include "dynamic/dyn_internal.h"
+#include "level/part.h"
 #include "internal.h"
 
 obs_status obs_dyn_bake_shard(const obs_bake_scene *scene, const obs_dyn_desc *desc, int index,

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/bake_internal.h"
+#include "level/level.h"
 #include "internal.h"
 
 void obs__bake_world_free(obs__bake_world *w)

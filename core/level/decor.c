@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/decor.h"
+#include "level/decor.h"
 #include "internal.h"
 
 #define CLASS_WORDS "none|shrub|tree|small (or opaque, bush, fruit_bush, hedge, fruit_tree, " \

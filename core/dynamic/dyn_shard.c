@@ -1,13 +1,13 @@
 /* bake-dynamic spread over many machines (obscura bake-dynamic --shard
  * I/N, --merge).  The expensive step is the spherical obscurance of the
- * regions' valid points (probes.c); every shard builds the same regions
+ * regions' valid points (dyn_probes.c); every shard builds the same regions
  * and flags the same grid points (cheap: 32 rays a point), then traces
  * its contiguous range [i n / count, (i + 1) n / count) of the n valid
  * points, each with the directions of the unsharded bake (keyed by the
  * seed and the point's grid index alone), and writes them as a part.
  * The merge flags the points again, reads every part into them, and fits:
  * the merged model is the unsharded one, byte for byte.  The part file
- * follows the bake's parts (shard.c) and uses its pieces (shard.h).
+ * follows the bake's parts (bake/shard.c) and uses their pieces (level/part.h).
  *
  * A part file, every field little-endian:
  *
@@ -15,7 +15,7 @@
  *     0     8    magic "OBSDYNPT"
  *     8     4    u32 version (1)
  *    12     4    u32 header size in bytes (128)
- *    16     8    u64 level fingerprint (shard.c's, of the flattened level
+ *    16     8    u64 level fingerprint (level/part.c's, of the flattened level
  *                with its decorators folded in: obs__bake_traced_fingerprint)
  *    24     4    u32 shard index I (0 .. N-1)
  *    28     4    u32 shard count N
@@ -48,8 +48,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/dyn_internal.h"
-#include "bake/shard.h"
+#include "dynamic/dyn_internal.h"
+#include "level/part.h"
 #include "internal.h"
 
 #define MAGIC "OBSDYNPT"

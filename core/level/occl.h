@@ -1,4 +1,4 @@
-/* What the rays of eq 1 meet (core/bake/occl.c): the opaque BVH of the
+/* What the rays of eq 1 meet (core/level/occl.c): the opaque BVH of the
  * level's non-decorator triangles, and a second BVH of the shrubs' world
  * boxes (fog) and the trees' triangles (semi-transparent), section 2.1 of
  * the paper.  The bake's trace (trace.c) and the per-pixel reference's
@@ -10,8 +10,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/bake_internal.h"
-#include "bake/decor.h"
+#include "level/level.h"
+#include "level/decor.h"
 
 typedef struct obs__bake_occl {
     RTCDevice dev;

@@ -1,6 +1,6 @@
 /* Decorator objects (section 2.2 of "Baked ambient obscurance on the
  * vertices of game levels"): which nodes of a level are decorators and of
- * which class (core/bake/decor.c).  The bake traces them differently:
+ * which class (core/level/decor.c).  The bake traces them differently:
  * shrubs as fog boxes and trees as semi-transparent triangles in a second
  * BVH (section 2.1), small decorators get one scalar each (2.2.1). */
 #ifndef OBSCURA_BAKE_DECOR_H

@@ -7,7 +7,7 @@
  * the same parameter rows, the same --decorators file), shrubs become
  * fog boxes and trees semi-transparent triangles of the second BVH, small
  * decorators occlude nothing.  Per use:
- *   - a valid point's spherical obscurance (probes.c, obs__dyn_point_sh)
+ *   - a valid point's spherical obscurance (dyn_probes.c, obs__point_sh)
  *     and the probe paths' eq 1 reference (obs__dyn_trace_eq1): rho
  *     times each ray's transmittance, the quantity of the static bake's
  *     surface samples, so that obscura gbuffer --dynamic combines like
@@ -23,9 +23,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/decor.h"
-#include "bake/dyn_internal.h"
-#include "bake/shard.h"
+#include "level/decor.h"
+#include "dynamic/dyn_internal.h"
+#include "level/part.h"
 #include "internal.h"
 
 static const char *const stage_names[] = {
