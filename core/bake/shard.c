@@ -60,13 +60,6 @@
 #define FNV_OFFSET OBS__BAKE_FNV_OFFSET
 #define FNV_PRIME 0x100000001b3ULL
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_trace_desc *td)
 {
     return td ? obs__bake_traced_fingerprint(w, td->decor, td->tree_attenuation)
@@ -77,16 +70,8 @@ static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_tra
 
 static void header_bytes(const obs__bake_part *h, unsigned char b[HEADER])
 {
-    memset(b, 0, HEADER);
-    memcpy(b, MAGIC, 8);
-    obs__le_put32(b + 8, VERSION);
-    obs__le_put32(b + 12, HEADER);
-    obs__le_put64(b + 16, h->level);
-    obs__le_put32(b + 24, h->index);
-    obs__le_put32(b + 28, h->count);
-    obs__le_put64(b + 32, h->total);
-    obs__le_put64(b + 40, h->first);
-    obs__le_put64(b + 48, h->n);
+    obs__part_range r = {VERSION, h->index, h->count, h->level, h->total, h->first, h->n};
+    obs__part_range_put(b, HEADER, MAGIC, &r);
     obs__le_put64(b + 56, h->rays);
     obs__le_put64(b + 64, h->dropped);
     obs__le_put32(b + 72, (uint32_t)h->rays_per_sample);
@@ -140,7 +125,7 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
     h.first = obs__bake_shard_first(s->count, sh->index, sh->count);
     h.n = obs__bake_shard_first(s->count, sh->index + 1, sh->count) - h.first;
     part_params(&h, td, p);
-    double t = now(), bvh = 0.0;
+    double t = obs__bake_now(), bvh = 0.0;
     obs_status rc = OBS_OK;
     s->rays = 0;
     s->dropped = 0;
@@ -152,7 +137,7 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
             return rc;
     }
     h.bvh_seconds = bvh;
-    h.trace_seconds = now() - t - bvh;
+    h.trace_seconds = obs__bake_now() - t - bvh;
     h.rays = s->rays;
     h.dropped = s->dropped;
     unsigned char *payload = payload_bytes(s, (size_t)h.first, (size_t)h.n);
@@ -172,25 +157,18 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
 
 /* ---- reading parts ------------------------------------------------------- */
 
+static const obs__part_format format = {MAGIC, "bake part", "obscura bake --shard I/N", "part",
+                                       "samples", VERSION, HEADER, UINT32_MAX, 9};
+
 obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN])
 {
-    memset(h, 0, sizeof *h);
-    h->path = path;
     unsigned char b[HEADER];
-    uint64_t size;
-    obs_status rc = obs__bake_part_head(path, MAGIC, "bake part", "obscura bake --shard I/N", b, HEADER, &size, err);
+    obs__part_range r = {0};
+    obs_status rc = obs__part_range_read(path, &format, b, &r, err);
+    *h = (obs__bake_part){.path = path, .version = r.version, .index = r.index, .count = r.count,
+                          .level = r.level, .total = r.total, .first = r.first, .n = r.n};
     if (rc != OBS_OK)
         return rc;
-    h->version = obs__le_get32(b + 8);
-    if (h->version != VERSION || obs__le_get32(b + 12) != HEADER)
-        return obs__fail(err, OBS_UNSUPPORTED, "%s: part version %u (header %u bytes); this "
-                         "obscura reads version %u", path, h->version, obs__le_get32(b + 12), VERSION);
-    h->level = obs__le_get64(b + 16);
-    h->index = obs__le_get32(b + 24);
-    h->count = obs__le_get32(b + 28);
-    h->total = obs__le_get64(b + 32);
-    h->first = obs__le_get64(b + 40);
-    h->n = obs__le_get64(b + 48);
     h->rays = obs__le_get64(b + 56);
     h->dropped = obs__le_get64(b + 64);
     h->rays_per_sample = (int32_t)obs__le_get32(b + 72);
@@ -203,18 +181,6 @@ obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char 
     h->bvh_seconds = obs__le_bitsd(obs__le_get64(b + 104));
     h->trace_seconds = obs__le_bitsd(obs__le_get64(b + 112));
     h->checksum = obs__le_get64(b + 120);
-    if (h->count == 0 || h->index >= h->count || h->count > (uint32_t)INT32_MAX ||
-        h->total > UINT32_MAX || h->first != obs__bake_shard_first((size_t)h->total, (int)h->index, (int)h->count) ||
-        h->first + h->n != obs__bake_shard_first((size_t)h->total, (int)h->index + 1, (int)h->count))
-        return obs__fail(err, OBS_BAD_FILE, "%s: damaged header: shard %u/%u of %llu samples "
-                         "cannot hold samples %llu .. %llu", path, h->index, h->count,
-                         (unsigned long long)h->total, (unsigned long long)h->first,
-                         (unsigned long long)(h->first + h->n));
-    uint64_t want = HEADER + 9 * h->n;
-    if (size != UINT64_MAX && size != want)
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %llu bytes, its header promises %llu (%llu samples)",
-                         path, size < want ? "truncated" : "longer than a part",
-                         (unsigned long long)size, (unsigned long long)want, (unsigned long long)h->n);
     return OBS_OK;
 }
 
@@ -249,7 +215,7 @@ static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: the parts split %llu samples; this level "
                          "and these parameters make %zu", p0->path, (unsigned long long)p0->total,
                          s->count);
-    double t = now();
+    double t = obs__bake_now();
     s->rays = 0;
     s->dropped = 0;
     for (int i = 0; i < sh->count; i++) {
@@ -262,7 +228,7 @@ static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs
         st->seconds[OBS_BAKE_STAGE_bvh] += sh->parts[i].bvh_seconds;
         st->seconds[OBS_BAKE_STAGE_trace] += sh->parts[i].trace_seconds;
     }
-    st->seconds[OBS_BAKE_STAGE_trace] += now() - t;
+    st->seconds[OBS_BAKE_STAGE_trace] += obs__bake_now() - t;
     return OBS_OK;
 }
 

@@ -79,16 +79,7 @@ static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint
             valid[l] = k < nr ? -1 : 0;
             float dir[3];
             obs__bake_lattice_dir(k, nr, o1, o2, n, tg, bt, dir);
-            rh.ray.org_x[l] = o[0], rh.ray.org_y[l] = o[1], rh.ray.org_z[l] = o[2];
-            rh.ray.dir_x[l] = dir[0], rh.ray.dir_y[l] = dir[1], rh.ray.dir_z[l] = dir[2];
-            rh.ray.tnear[l] = 0.0f;
-            rh.ray.tfar[l] = tfar;
-            rh.ray.time[l] = 0.0f;
-            rh.ray.mask[l] = 0xffffffffu;
-            rh.ray.id[l] = 0;
-            rh.ray.flags[l] = 0;
-            rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+            obs__bake_ray8_lane(&rh, l, o, dir, tfar);
         }
         rtcIntersect8(valid, j->rtc, ctx, &rh);
         double tr[PACKET]; /* shrubs and trees up to the opaque hit (section 2.1) */
@@ -142,23 +133,16 @@ static void trace_end(void *ctx, void *local)
     j->dropped += c->dropped;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
                            const obs__bake_trace_desc *d, double *bvh_seconds,
                            char err[OBS_ERR_LEN])
 {
     obs_status st = OBS_OK;
-    double t0 = now();
+    double t0 = obs__bake_now();
     obs__bake_occl *occl = NULL;
     if ((st = obs__bake_occl_new(w, d->decor, d->tree_attenuation, &occl, err)) != OBS_OK)
         return st;
-    *bvh_seconds = now() - t0;
+    *bvh_seconds = obs__bake_now() - t0;
 
     job *j = calloc(1, sizeof *j);
     if (!j) {

@@ -68,17 +68,7 @@ void obs__bake_bvh_cast(const obs__bake_bvh *b, const float o[3], const float *d
         for (int l = 0; l < PACKET; l++) {
             int k = k0 + l < n ? k0 + l : n - 1;
             valid[l] = k0 + l < n ? -1 : 0;
-            rh.ray.org_x[l] = o[0], rh.ray.org_y[l] = o[1], rh.ray.org_z[l] = o[2];
-            rh.ray.dir_x[l] = dirs[3 * k], rh.ray.dir_y[l] = dirs[3 * k + 1];
-            rh.ray.dir_z[l] = dirs[3 * k + 2];
-            rh.ray.tnear[l] = 0.0f;
-            rh.ray.tfar[l] = tfar;
-            rh.ray.time[l] = 0.0f;
-            rh.ray.mask[l] = 0xffffffffu;
-            rh.ray.id[l] = 0;
-            rh.ray.flags[l] = 0;
-            rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+            obs__bake_ray8_lane(&rh, l, o, dirs + 3 * k, tfar);
         }
         rtcIntersect8(valid, b->rtc, &ctx, &rh);
         if (trans) { /* section 2.1: the segment up to the opaque hit (tfar on a miss) */

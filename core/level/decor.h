@@ -35,6 +35,11 @@ typedef struct obs__bake_decor {
 obs_status obs__bake_decor_classify(const obs_bake_scene *s, const obs_bake_params *p,
                                     const char *decorators_json, obs__bake_decor *out,
                                     char err[OBS_ERR_LEN]);
+/* The same with the warning moved out of err into warning ("" when none):
+ * both bakes' decorator step. */
+obs_status obs__bake_decor_classify_warn(const obs_bake_scene *s, const obs_bake_params *p,
+                                         const char *decorators_json, obs__bake_decor *out,
+                                         char warning[OBS_ERR_LEN], char err[OBS_ERR_LEN]);
 void obs__bake_decor_free(obs__bake_decor *d);
 
 /* The class named by a word: none|opaque, shrub|bush|hedge, tree|tree_line,

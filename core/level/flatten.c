@@ -168,3 +168,14 @@ obs_status obs__bake_flatten(const obs_bake_scene *s, obs__bake_world *w, char e
     }
     return OBS_OK;
 }
+
+obs_status obs__bake_flatten_checked(const obs_bake_scene *scene, int max_triangles,
+                                     const char *who, obs__bake_world *w, char err[OBS_ERR_LEN])
+{
+    if (!scene || scene->node_count == 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no scene", who);
+    if (scene->world_triangles > (size_t)max_triangles)
+        return obs__fail(err, OBS_TOO_LARGE, "%zu triangles once flattened; max_triangles is %d",
+                         scene->world_triangles, max_triangles);
+    return obs__bake_flatten(scene, w, err);
+}

@@ -8,11 +8,20 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <time.h>
 
 #include "obscura/bake.h"
 #include "obscura/dynamic.h"
 
 struct obs__bake_decor; /* decor.h */
+
+/* Seconds on the monotonic clock: the bakes' stage timings. */
+static inline double obs__bake_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
 
 /* Every instance in world space (flatten.c).  Vertices and triangles of
  * instance i are the runs starting at inst[i].first_vertex and
@@ -36,6 +45,10 @@ typedef struct obs__bake_world {
 
 obs_status obs__bake_flatten(const obs_bake_scene *s, obs__bake_world *w, char err[OBS_ERR_LEN]);
 void obs__bake_world_free(obs__bake_world *w);
+/* Both bakes' first step: the scene refused when empty (the message
+ * names `who`) or over max_triangles once flattened, else flattened. */
+obs_status obs__bake_flatten_checked(const obs_bake_scene *scene, int max_triangles,
+                                     const char *who, obs__bake_world *w, char err[OBS_ERR_LEN]);
 
 /* The LODs a .glb brings itself (lod_file.c), read by the loader
  * (load.c). */

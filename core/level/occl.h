@@ -68,4 +68,22 @@ const obs__bake_occl *obs__bake_occluders_occl(const obs_bake_occluders *o);
  * intersections with the other boxes. */
 void obs__bake_fog_overlap(const float *box, size_t n, float *density);
 
+/* Lane l of an 8-ray packet: origin o, unit direction d, [0, tfar], no
+ * hit yet (the bake's samples, the points' rays, the reference's
+ * obscurance fill their packets alike). */
+static inline void obs__bake_ray8_lane(struct RTCRayHit8 *rh, int l, const float o[3],
+                                       const float d[3], float tfar)
+{
+    rh->ray.org_x[l] = o[0], rh->ray.org_y[l] = o[1], rh->ray.org_z[l] = o[2];
+    rh->ray.dir_x[l] = d[0], rh->ray.dir_y[l] = d[1], rh->ray.dir_z[l] = d[2];
+    rh->ray.tnear[l] = 0.0f;
+    rh->ray.tfar[l] = tfar;
+    rh->ray.time[l] = 0.0f;
+    rh->ray.mask[l] = 0xffffffffu;
+    rh->ray.id[l] = 0;
+    rh->ray.flags[l] = 0;
+    rh->hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+}
+
 #endif

@@ -5,6 +5,7 @@
  * checksum, the parts of one split put in order.  Each bake keeps its own
  * layout (its header's fields and payload) beside its step. */
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -183,5 +184,89 @@ obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t 
                        missing * 4 > sizeof list ? ", ..." : "");
     }
     free(seen);
+    return rc;
+}
+
+/* ---- the range every header starts with --------------------------------- */
+
+void obs__part_range_put(unsigned char *b, size_t head_len, const char *magic,
+                         const obs__part_range *r)
+{
+    memset(b, 0, head_len);
+    memcpy(b, magic, 8);
+    obs__le_put32(b + 8, r->version);
+    obs__le_put32(b + 12, (uint32_t)head_len);
+    obs__le_put64(b + 16, r->level);
+    obs__le_put32(b + 24, r->index);
+    obs__le_put32(b + 28, r->count);
+    obs__le_put64(b + 32, r->total);
+    obs__le_put64(b + 40, r->first);
+    obs__le_put64(b + 48, r->n);
+}
+
+obs_status obs__part_range_read(const char *path, const obs__part_format *f, unsigned char *b,
+                                obs__part_range *r, char err[OBS_ERR_LEN])
+{
+    uint64_t size;
+    obs_status rc = obs__bake_part_head(path, f->magic, f->what, f->writer, b, f->head_len, &size,
+                                        err);
+    if (rc != OBS_OK)
+        return rc;
+    r->version = obs__le_get32(b + 8);
+    if (r->version != f->version || obs__le_get32(b + 12) != f->head_len)
+        return obs__fail(err, OBS_UNSUPPORTED, "%s: %s version %u (header %u bytes); this "
+                         "obscura reads version %u", path, f->kind, r->version,
+                         obs__le_get32(b + 12), f->version);
+    r->level = obs__le_get64(b + 16);
+    r->index = obs__le_get32(b + 24);
+    r->count = obs__le_get32(b + 28);
+    r->total = obs__le_get64(b + 32);
+    r->first = obs__le_get64(b + 40);
+    r->n = obs__le_get64(b + 48);
+    if (r->count == 0 || r->index >= r->count || r->count > (uint32_t)INT32_MAX ||
+        r->total > f->max_total ||
+        r->first != obs__bake_shard_first((size_t)r->total, (int)r->index, (int)r->count) ||
+        r->first + r->n != obs__bake_shard_first((size_t)r->total, (int)r->index + 1, (int)r->count))
+        return obs__fail(err, OBS_BAD_FILE, "%s: damaged header: shard %u/%u of %llu %s "
+                         "cannot hold %s %llu .. %llu", path, r->index, r->count,
+                         (unsigned long long)r->total, f->items, f->items,
+                         (unsigned long long)r->first, (unsigned long long)(r->first + r->n));
+    uint64_t want = f->head_len + f->item_bytes * r->n;
+    if (size != UINT64_MAX && size != want)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %llu bytes, its header promises %llu (%llu "
+                         "%s)", path, size < want ? "truncated" : "longer than a part",
+                         (unsigned long long)size, (unsigned long long)want,
+                         (unsigned long long)r->n, f->items);
+    return OBS_OK;
+}
+
+obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
+                                obs_status (*read_header)(const char *path, void *h,
+                                                          char err[OBS_ERR_LEN]),
+                                obs__bake_part_key (*key)(const void *h), void **out,
+                                char err[OBS_ERR_LEN])
+{
+    *out = NULL;
+    unsigned char *heads = calloc(n, elem), *ordered = NULL;
+    obs__bake_part_key *keys = calloc(n, sizeof *keys);
+    size_t *order = NULL;
+    obs_status rc = heads && keys ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
+    for (size_t i = 0; rc == OBS_OK && i < n; i++)
+        if ((rc = read_header(paths[i], heads + i * elem, err)) == OBS_OK)
+            keys[i] = key(heads + i * elem);
+    if (rc == OBS_OK && (!(ordered = calloc(keys[0].count, elem)) ||
+                         !(order = calloc(keys[0].count, sizeof *order))))
+        rc = obs__fail(err, OBS_NO_MEMORY, "%u parts", keys[0].count);
+    if (rc == OBS_OK)
+        rc = obs__bake_parts_order(keys, n, order, err);
+    for (size_t k = 0; rc == OBS_OK && k < n; k++)
+        memcpy(ordered + k * elem, heads + order[k] * elem, elem);
+    free(order);
+    free(keys);
+    free(heads);
+    if (rc == OBS_OK)
+        *out = ordered;
+    else
+        free(ordered);
     return rc;
 }

@@ -28,30 +28,11 @@ static inline uint64_t obs__le_get64(const unsigned char *p)
 {
     return (uint64_t)obs__le_get32(p) | (uint64_t)obs__le_get32(p + 4) << 32;
 }
-static inline uint32_t obs__le_fbits(float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return u;
-}
-static inline float obs__le_bitsf(uint32_t u)
-{
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-static inline uint64_t obs__le_dbits(double d)
-{
-    uint64_t u;
-    memcpy(&u, &d, sizeof u);
-    return u;
-}
-static inline double obs__le_bitsd(uint64_t u)
-{
-    double d;
-    memcpy(&d, &u, sizeof d);
-    return d;
-}
+/* The bits of a float or double as an integer, and back. */
+static inline uint32_t obs__le_fbits(float f) { uint32_t u; memcpy(&u, &f, 4); return u; }
+static inline float obs__le_bitsf(uint32_t u) { float f; memcpy(&f, &u, 4); return f; }
+static inline uint64_t obs__le_dbits(double d) { uint64_t u; memcpy(&u, &d, 8); return u; }
+static inline double obs__le_bitsd(uint64_t u) { double d; memcpy(&d, &u, 8); return d; }
 
 /* FNV-1a 64: h = obs__bake_fnv(OBS__BAKE_FNV_OFFSET, data, n), chained. */
 #define OBS__BAKE_FNV_OFFSET 0xcbf29ce484222325ULL
@@ -93,6 +74,43 @@ typedef struct obs__bake_part_key {
  * order[k] with the position in `in` of shard k (count entries). */
 obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t *order,
                                  char err[OBS_ERR_LEN]);
+
+/* The fields every part's header starts with (bytes 0 .. 56, each bake's
+ * layout in its own file): magic, u32 version, u32 header size, u64 level
+ * fingerprint, u32 shard index, u32 shard count, u64 items of the whole
+ * level, u64 first item of this part, u64 items of this part. */
+typedef struct obs__part_range {
+    uint32_t version, index, count;
+    uint64_t level, total, first, n;
+} obs__part_range;
+/* Zeroes the head_len bytes of b and writes magic, head_len and r. */
+void obs__part_range_put(unsigned char *b, size_t head_len, const char *magic,
+                         const obs__part_range *r);
+/* What a reader expects of a part: its magic, the names for the messages
+ * (`what` and the command that writes it; `kind` before "version";
+ * `items` its items), its version and header size, the most items a level
+ * has, each item's bytes in the payload. */
+typedef struct obs__part_format {
+    const char *magic, *what, *writer, *kind, *items;
+    uint32_t version;
+    size_t head_len;
+    uint64_t max_total, item_bytes;
+} obs__part_format;
+/* Reads the part's header into b (head_len bytes) and its range into r,
+ * checking the magic, version and header size, the range against the
+ * split (obs__bake_shard_first) and the file's length against
+ * head_len + item_bytes n. */
+obs_status obs__part_range_read(const char *path, const obs__part_format *f, unsigned char *b,
+                                obs__part_range *r, char err[OBS_ERR_LEN]);
+/* The n parts at paths, their headers read by read_header into elem-byte
+ * structs, checked to be every shard of one split once
+ * (obs__bake_parts_order, with key's view of a header); *out the headers
+ * in shard order (n of them; caller frees). */
+obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
+                                obs_status (*read_header)(const char *path, void *h,
+                                                          char err[OBS_ERR_LEN]),
+                                obs__bake_part_key (*key)(const void *h), void **out,
+                                char err[OBS_ERR_LEN]);
 
 /* The first sample of shard index of count over total samples: shard i
  * traces [first(i), first(i + 1)); first(count) = total. */
