@@ -155,8 +155,9 @@ $(BUILD)/tests/%: tests/unit/%.c $(PROTO_LIB) $(LIB) tests/unit/testutil.h $(wil
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) $(EXTRA_LIBS) -lcmocka
 
-# The bake tests' scene helpers (tests/unit/bake/bake_testutil.h).
-$(filter $(BUILD)/tests/bake/%,$(UNIT_BIN)): $(wildcard tests/unit/bake/*.h)
+# The bake tests' scene helpers (tests/unit/level/bake_testutil.h), for the
+# tests of core/level, core/bake and core/dynamic.
+$(filter $(BUILD)/tests/level/% $(BUILD)/tests/bake/% $(BUILD)/tests/dynamic/%,$(UNIT_BIN)): $(wildcard tests/unit/level/*.h)
 
 $(BUILD)/tests/nogl/%: tests/unit/nogl/%.c $(LIB) tests/unit/testutil.h $(wildcard tests/unit/core/*.h)
 	@mkdir -p $(dir $@)

@@ -6,7 +6,7 @@
 #include <time.h>
 
 #include "bake/bake_internal.h"
-#include "bake/decor.h"
+#include "level/decor.h"
 #include "bake/instanced.h"
 #include "bake/lod.h"
 #include "bake/shard.h"
@@ -21,13 +21,6 @@ static const char *const stage_names[] = {
 const char *obs_bake_stage_name(int stage)
 {
     return stage >= 0 && stage < OBS_BAKE_STAGE_COUNT ? stage_names[stage] : "?";
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
 void obs_bake_result_free(obs_bake_result *r)
@@ -203,14 +196,8 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     float *area_kept = NULL; /* the faces' areas before the mask, for the LODs */
     size_t inst_n = 0;
     obs_status rc;
-    if (!scene || scene->node_count == 0)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "bake: no scene");
-    if (scene->world_triangles > (size_t)p.max_triangles)
-        return obs__fail(err, OBS_TOO_LARGE, "%zu triangles once flattened; max_triangles is %d",
-                         scene->world_triangles, p.max_triangles);
-
-    double t = now();
-    if ((rc = obs__bake_flatten(scene, &w, err)) != OBS_OK)
+    double t = obs__bake_now();
+    if ((rc = obs__bake_flatten_checked(scene, p.max_triangles, "bake", &w, err)) != OBS_OK)
         goto done;
     st->instances = w.instance_count;
     st->triangles = w.triangle_count;
@@ -220,11 +207,9 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     for (size_t k = 0; k < w.triangle_count; k++)
         st->two_sided_triangles += w.two_sided[k];
     /* Decorators (section 2.2): which nodes are shrubs, trees, small. */
-    if ((rc = obs__bake_decor_classify(scene, &p, desc ? desc->decorators_json : NULL, &dc,
-                                       err)) != OBS_OK)
+    if ((rc = obs__bake_decor_classify_warn(scene, &p, desc ? desc->decorators_json : NULL, &dc,
+                                            st->decorator_warning, err)) != OBS_OK)
         goto done;
-    snprintf(st->decorator_warning, sizeof st->decorator_warning, "%s", err);
-    err[0] = 0;
     memcpy(st->decorator_nodes, dc.counts, sizeof dc.counts);
     /* Large instanced decorators (section 2.2, instanced.c): no surface
      * samples of their own in the level. */
@@ -244,16 +229,16 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
         }
         obs__bake_instanced_mask(&w, inst_sel);
     }
-    st->seconds[OBS_BAKE_STAGE_flatten] = now() - t;
+    st->seconds[OBS_BAKE_STAGE_flatten] = obs__bake_now() - t;
 
-    t = now();
+    t = obs__bake_now();
     if ((rc = obs__bake_samples_make(&w, p.samples_per_face, p.max_samples_per_face,
                                      (uint64_t)p.seed, &s, err)) != OBS_OK)
         goto done;
     st->samples = s.count;
-    st->seconds[OBS_BAKE_STAGE_samples] = now() - t;
+    st->seconds[OBS_BAKE_STAGE_samples] = obs__bake_now() - t;
 
-    t = now();
+    t = obs__bake_now();
     obs__bake_trace_desc td = {{p.distance_short, p.distance_long}, p.rays, p.threads,
                                p.backface_limit, (uint64_t)p.seed,
                                desc ? desc->progress : NULL, desc ? desc->progress_user : NULL};
@@ -267,18 +252,18 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
         if ((rc = obs__bake_trace(&w, &s, &td, &bvh, err)) != OBS_OK)
             goto done;
         st->seconds[OBS_BAKE_STAGE_bvh] = bvh;
-        st->seconds[OBS_BAKE_STAGE_trace] = now() - t - bvh;
+        st->seconds[OBS_BAKE_STAGE_trace] = obs__bake_now() - t - bvh;
     }
     st->rays = s.rays;
     st->samples_dropped_backface = s.dropped;
     if (sh && sh->stop) /* a shard: its part is written; the merge fits */
         goto done;
 
-    t = now();
+    t = obs__bake_now();
     if ((rc = obs__bake_weld_make(&w, p.weld_tolerance, p.weld_angle, &wd, err)) != OBS_OK)
         goto done;
     st->welded_vertices = wd.count;
-    st->seconds[OBS_BAKE_STAGE_weld] = now() - t;
+    st->seconds[OBS_BAKE_STAGE_weld] = obs__bake_now() - t;
 
     size_t nx = 2 * (wd.count ? wd.count : 1);
     x = malloc(nx * sizeof *x);

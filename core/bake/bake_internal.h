@@ -1,34 +1,13 @@
-/* What the steps of the bake hand each other (core/bake/, obscura/bake.h). */
+/* What the steps of the vertex bake hand each other (core/bake/,
+ * obscura/bake.h); the level and its rays are core/level's (level.h). */
 #ifndef OBSCURA_BAKE_INTERNAL_H
 #define OBSCURA_BAKE_INTERNAL_H
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "level/level.h"
 #include "obscura/bake.h"
-
-/* Every instance in world space (flatten.c).  Vertices and triangles of
- * instance i are the runs starting at inst[i].first_vertex and
- * inst[i].first_triangle, in the order of the mesh's own. */
-typedef struct obs__bake_inst {
-    uint32_t node, mesh;
-    size_t first_vertex, first_triangle;
-} obs__bake_inst;
-
-typedef struct obs__bake_world {
-    size_t vertex_count, triangle_count, instance_count;
-    float *pos;         /* 3 per vertex */
-    float *nrm;         /* 3 per vertex, unit; zero where the mesh has none */
-    uint32_t *tri;      /* 3 per triangle, world vertex indices */
-    float *area;        /* per triangle; 0 for a degenerate one */
-    float *fn;          /* 3 per triangle: unit normal of the winding (CCW) */
-    uint8_t *two_sided; /* per triangle */
-    obs__bake_inst *inst;
-    size_t degenerate, against_normals;
-} obs__bake_world;
-
-obs_status obs__bake_flatten(const obs_bake_scene *s, obs__bake_world *w, char err[OBS_ERR_LEN]);
-void obs__bake_world_free(obs__bake_world *w);
 
 /* Surface samples (samples.c); ao and valid are filled by the trace. */
 typedef struct obs__bake_samples {
@@ -100,10 +79,6 @@ void obs__bake_residual(const obs__bake_world *w, const obs__bake_weld *wd,
 double obs__bake_edge_jump(const float a[3], const float b[3], const float c[3],
                            const float d[3], double j[4]);
 
-/* fn(ctx, i) for every i in [0, n), in chunks, on `threads` threads (0:
- * every core; probes.c): the dynamic bake's points, the instanced
- * decorators' volume (volume.c), the LODs' instances (lod.c). */
-void obs__bake_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx);
 /* Small decorators (small.c, section 2.2.1): each small node's scalar
  * resampled from the fitted vertex values x (2 per welded vertex, of[]
  * the weld) around it, into out->node_ao and its instances' vertices
@@ -112,28 +87,5 @@ struct obs__bake_decor;
 obs_status obs__bake_small(const obs_bake_scene *scene, const obs__bake_world *w,
                            const uint32_t *of, const struct obs__bake_decor *d, const double *x,
                            const obs_bake_params *p, obs_bake_result *out, char err[OBS_ERR_LEN]);
-
-/* The level's BVH on its own, for points in space (trace.c; the
- * dynamic-object bake).  w must outlive it. */
-typedef struct obs__bake_bvh obs__bake_bvh;
-obs_status obs__bake_bvh_new(const obs__bake_world *w, obs__bake_bvh **out,
-                             char err[OBS_ERR_LEN]);
-/* The same with decorators (section 2.1, occl.c): the closest hits among
- * the opaque triangles, shrub fog boxes and tree triangles attenuating
- * the rays (obs__bake_bvh_cast's trans), as obs__bake_trace traces the
- * surface samples; d NULL: every triangle opaque. */
-obs_status obs__bake_bvh_new_decor(const obs__bake_world *w, const struct obs__bake_decor *d,
-                                   float tree_attenuation, obs__bake_bvh **out,
-                                   char err[OBS_ERR_LEN]);
-void obs__bake_bvh_free(obs__bake_bvh *b);
-/* Closest hits of the n unit directions dirs (3 each) from o, up to
- * tfar: t[k] the distance (INFINITY for a miss), back[k] 1 when the ray
- * met a one-sided face from behind; trans (NULL: not wanted) the
- * decorators' transmittance of each ray up to its hit (or tfar), 1
- * without decorators.  Thread-safe. */
-void obs__bake_bvh_cast(const obs__bake_bvh *b, const float o[3], const float *dirs, int n,
-                        float tfar, float *t, uint8_t *back, float *trans);
-/* 1 when geometry lies on the segment a-c. */
-int obs__bake_bvh_occluded(const obs__bake_bvh *b, const float a[3], const float c[3]);
 
 #endif

@@ -71,13 +71,6 @@ double obs__bake_edge_jump(const float a[3], const float b[3], const float c[3],
     return (area0 * h[0] * h[0] + area1 * h[1] * h[1]) / 6.0;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 typedef struct edge {
     uint32_t u, v; /* welded, u < v */
     uint32_t face;
@@ -339,7 +332,7 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
     cholmod_factor *L = NULL;
     cholmod_dense *B = NULL, *X = NULL;
     int started = 0;
-    double t_start = now(), t_solve = t_start;
+    double t_start = obs__bake_now(), t_solve = t_start;
 
     y.cover = calloc(y.n, sizeof *y.cover);
     y.b = calloc(2 * y.n, sizeof *y.b);
@@ -477,7 +470,7 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
         goto done;
     }
     cholmod_free_triplet(&T, &cm);
-    t_solve = now();
+    t_solve = obs__bake_now();
     st->seconds[OBS_BAKE_STAGE_assemble] = t_solve - t_start;
     L = cholmod_analyze(A, &cm);
     if (!L || !cholmod_factorize(A, L, &cm)) {
@@ -509,7 +502,7 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
             goto done;
         }
     }
-    st->seconds[OBS_BAKE_STAGE_solve] = now() - t_solve;
+    st->seconds[OBS_BAKE_STAGE_solve] = obs__bake_now() - t_solve;
     obs__bake_residual(w, wd, s, x, st->residual_fit);
     baselines(w, wd, s, &y, face, point, st);
     /* alpha x^T R x, edge by edge */

@@ -42,8 +42,6 @@
  * parameter that shrinks it. */
 #define MAX_VOLUME_POINTS ((size_t)4 << 20)
 
-static double now(void) { return obs__now_ms() * 1e-3; }
-
 static float clamp01(double v) { return (float)(v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v); }
 
 /* Solves the symmetric 4x4 system a y = b by Gaussian elimination with
@@ -228,7 +226,7 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
     }
 
     /* The local AO, once per distinct mesh. */
-    double t = now();
+    double t = obs__bake_now();
     for (size_t i = 0; i < w->instance_count; i++) {
         if (!sel[i])
             continue;
@@ -254,11 +252,11 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
         }
         st->instanced_meshes++;
     }
-    st->seconds[OBS_BAKE_STAGE_local] = now() - t;
+    st->seconds[OBS_BAKE_STAGE_local] = obs__bake_now() - t;
 
     /* The sparse volume around the instances' world boxes, traced in the
      * whole level. */
-    t = now();
+    t = obs__bake_now();
     for (size_t i = 0; i < w->instance_count; i++) {
         if (!sel[i])
             continue;
@@ -288,10 +286,10 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
     st->volume_points = vol.count;
     st->volume_points_inside = vol.inside_count;
     st->volume_rays = vol.rays;
-    st->seconds[OBS_BAKE_STAGE_volume] = now() - t;
+    st->seconds[OBS_BAKE_STAGE_volume] = obs__bake_now() - t;
 
     /* Eq 3 per instance, at each distance and for the blend. */
-    t = now();
+    t = obs__bake_now();
     f = malloc((max_v ? max_v : 1) * 3 * sizeof *f);
     L = malloc((max_v ? max_v : 1) * 3 * sizeof *L);
     if (!f || !L) {
@@ -382,7 +380,7 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
     st->ao_mean = cnt ? sum / (double)cnt : 0.0;
     st->ao_min = lo;
     st->ao_max = hi;
-    st->seconds[OBS_BAKE_STAGE_global] = now() - t;
+    st->seconds[OBS_BAKE_STAGE_global] = obs__bake_now() - t;
 done:
     for (size_t m = 0; local && m < s->mesh_count; m++)
         free(local[m]);

@@ -9,7 +9,7 @@
 #include <stdint.h>
 
 #include "bake/bake_internal.h"
-#include "bake/decor.h"
+#include "level/decor.h"
 
 /* ---- volume.c: the two-level sparse grid -------------------------------
  *
@@ -52,7 +52,7 @@ int64_t obs__vol_find(const obs__vol *v, int32_t i, int32_t j, int32_t k);
 int obs__vol_corners(const obs__vol *v, const float p[3], int64_t idx[8], double wt[8]);
 /* Traces every point: `rays` directions over the sphere, spherical
  * obscurance at both distances projected to quadratic SH and convolved
- * with the clamped cosine (sh.c, as the dynamic-object bake's points). */
+ * with the clamped cosine (level/sh.c, as the dynamic-object bake's points). */
 /* stop (may be NULL) is called, serialised, every few hundred points;
  * nonzero: the trace stops with OBS_CANCELLED. */
 obs_status obs__vol_trace(obs__vol *v, const obs__bake_bvh *bvh, int rays, const float dist[2],

@@ -29,14 +29,8 @@
 
 #include "bake/lod.h"
 #include "internal.h"
+#include "pool.h"
 
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 void obs__bake_lods_free(obs_bake_result *out)
 {
@@ -140,7 +134,7 @@ obs_status obs__bake_lod_resample(const obs__bake_world *full, const obs__bake_w
                              "LOD resampling: instance %zu is not the same (node, mesh)", i);
     job j = {full, lw, fwd, x, ls, vertex};
     atomic_init(&j.failed, 0);
-    obs__bake_pfor(lw->instance_count, 1, threads, resample_one, &j);
+    obs__pool_each(lw->instance_count, 1, threads, resample_one, &j);
     if (atomic_load(&j.failed))
         return obs__fail(err, OBS_NO_MEMORY, "LOD resampling: a nearest-point search");
     ls->dropped = 0;
@@ -208,7 +202,7 @@ static obs_status level(const obs_bake_scene *scene, const obs__bake_world *w,
     double *vx = NULL, *vert = NULL, *vw = NULL, *cnt = NULL, *face = NULL, *point = NULL;
     double *direct = NULL;
     obs_status rc;
-    double t = now();
+    double t = obs__bake_now();
     if ((rc = obs__bake_flatten(&ls, &lw, err)) != OBS_OK)
         goto done;
     if ((rc = obs__bake_samples_make(&lw, p->samples_per_face, p->max_samples_per_face,
@@ -221,9 +215,9 @@ static obs_status level(const obs_bake_scene *scene, const obs__bake_world *w,
     }
     if ((rc = obs__bake_lod_resample(w, wd, x, &lw, &s, vert, p->threads, err)) != OBS_OK)
         goto done;
-    st->lod_seconds[1] += now() - t;
+    st->lod_seconds[1] += obs__bake_now() - t;
 
-    t = now();
+    t = obs__bake_now();
     if ((rc = obs__bake_weld_make(&lw, p->weld_tolerance, p->weld_angle, &lwd, err)) != OBS_OK)
         goto done;
     size_t n = lwd.count ? lwd.count : 1;
@@ -251,10 +245,10 @@ static obs_status level(const obs_bake_scene *scene, const obs__bake_world *w,
     st->lod_samples[k] = s.count;
     memcpy(st->lod_fit[k], fst.residual_fit, sizeof st->lod_fit[k]);
     obs__bake_residual(&lw, &lwd, &s, vw, st->lod_vertex[k]);
-    st->lod_seconds[2] += now() - t;
+    st->lod_seconds[2] += obs__bake_now() - t;
 
     if (p->lod_check) {
-        t = now();
+        t = obs__bake_now();
         /* held out: other positions (the holdout's seed), resampled,
          * never fitted */
         obs__bake_samples h;
@@ -310,7 +304,7 @@ static obs_status level(const obs_bake_scene *scene, const obs__bake_world *w,
         for (int c = 0; c < 2; c++)
             st->lod_traced_resampled[k][c] = ws > 0.0 ? sqrt(e[c] / ws) : 0.0;
         st->lod_traced_samples[k] = chk.count - chk.dropped;
-        st->lod_seconds[3] += now() - t;
+        st->lod_seconds[3] += obs__bake_now() - t;
     }
     rc = copy_level(&lw, &lwd, vx, p->blend,
                     out->lod_instances + (size_t)(l - 1) * out->instance_count, err);
@@ -358,7 +352,7 @@ obs_status obs__bake_lods(const obs_bake_scene *scene, const obs__bake_world *w,
     if (levels > OBS_BAKE_MAX_LODS)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "lods %d: at most %d", levels,
                          OBS_BAKE_MAX_LODS);
-    double t0 = now(), t = t0;
+    double t0 = obs__bake_now(), t = t0;
     size_t nm = scene->mesh_count;
     out->lod_meshes = calloc((size_t)levels * nm + 1, sizeof *out->lod_meshes);
     out->lod_instances = calloc((size_t)levels * out->instance_count + 1,
@@ -405,13 +399,13 @@ obs_status obs__bake_lods(const obs_bake_scene *scene, const obs__bake_world *w,
                 }
             }
         }
-    out->stats.lod_seconds[0] = now() - t;
+    out->stats.lod_seconds[0] = obs__bake_now() - t;
     for (int l = 1; l <= levels && rc == OBS_OK; l++)
         if ((rc = level(scene, w, wd, x, p, l, out, err)) != OBS_OK) {
             char why[OBS_ERR_LEN];
             memcpy(why, err, sizeof why);
             snprintf(err, OBS_ERR_LEN, "LOD level %d: %.*s", l, OBS_ERR_LEN - 20, why);
         }
-    out->stats.seconds[OBS_BAKE_STAGE_lod] = now() - t0;
+    out->stats.seconds[OBS_BAKE_STAGE_lod] = obs__bake_now() - t0;
     return rc;
 }

@@ -15,11 +15,11 @@
  * vertices of the welded mesh's open border stay), then compacted to
  * the vertices it uses (each the first of its weld group: position and
  * normal unchanged).  out->name is m's with "_LOD<level>"; never empty
- * when m has a triangle of nonzero area.  Free with obs__bake_mesh_free. */
+ * when m has a triangle of nonzero area.  Free with obs__bake_mesh_free
+ * (level.h). */
 obs_status obs__bake_simplify(const obs_bake_mesh *m, int level, float ratio, float error,
                               int lock_border, float weld_tolerance, float weld_angle,
                               obs_bake_mesh *out, char err[OBS_ERR_LEN]);
-void obs__bake_mesh_free(obs_bake_mesh *m);
 
 /* The triangles [first, first + count) of a world, for nearest-point
  * queries (closest.c; a bounding-volume hierarchy of its own: Embree's
@@ -53,13 +53,6 @@ obs_status obs__bake_lod_resample(const obs__bake_world *full, const obs__bake_w
                                   obs__bake_samples *ls, double *vertex, int threads,
                                   char err[OBS_ERR_LEN]);
 
-/* The file's own LODs (lod_file.c): a .glb's MSFT_lod levels into
- * s->file_lods (level l of mesh m at (l - 1) * mesh_count + m, an empty
- * mesh where the file has none); OBS_OK with none for another format or
- * a file without them.  Free with obs__bake_lod_file_free (and
- * obs_bake_scene_free). */
-obs_status obs__bake_lod_file_read(const char *path, obs_bake_scene *s, char err[OBS_ERR_LEN]);
-void obs__bake_lod_file_free(obs_bake_scene *s);
 
 /* The lod stage (bake.c calls it after the full-detail fit): every level
  * of every mesh, resampled and fitted; fills out's lod_* fields and

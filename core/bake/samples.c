@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "bake/bake_internal.h"
-#include "bake/rng.h"
+#include "level/rng.h"
 #include "internal.h"
 
 /* The golden ratio's fractional part: the second coordinate of a rank-1

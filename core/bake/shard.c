@@ -50,7 +50,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
-#include "bake/decor.h"
+#include "level/decor.h"
 #include "bake/shard.h"
 #include "internal.h"
 
@@ -59,64 +59,6 @@
 #define HEADER 128u
 #define FNV_OFFSET OBS__BAKE_FNV_OFFSET
 #define FNV_PRIME 0x100000001b3ULL
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-size_t obs__bake_shard_first(size_t total, int index, int count)
-{
-    /* total * index / count without overflow for any size_t total */
-    return total / (size_t)count * (size_t)index + total % (size_t)count * (size_t)index / (size_t)count;
-}
-
-/* ---- little-endian fields and the hash (shard.h) ----------------------- */
-
-uint64_t obs__bake_fnv(uint64_t h, const void *data, size_t n)
-{
-    const unsigned char *p = data;
-    for (size_t i = 0; i < n; i++)
-        h = (h ^ p[i]) * FNV_PRIME;
-    return h;
-}
-
-static uint64_t fnv32(uint64_t h, uint32_t v)
-{
-    unsigned char b[4];
-    obs__le_put32(b, v);
-    return obs__bake_fnv(h, b, 4);
-}
-
-uint64_t obs__bake_level_fingerprint(const obs__bake_world *w)
-{
-    uint64_t h = obs__bake_fnv(FNV_OFFSET, (const unsigned char *)"obscura level 1", 15);
-    h = fnv32(fnv32(h, (uint32_t)w->vertex_count), (uint32_t)w->triangle_count);
-    for (size_t i = 0; i < 3 * w->vertex_count; i++)
-        h = fnv32(h, obs__le_fbits(w->pos[i]));
-    for (size_t i = 0; i < 3 * w->triangle_count; i++)
-        h = fnv32(h, w->tri[i]);
-    return obs__bake_fnv(h, w->two_sided, w->triangle_count);
-}
-
-/* The level's fingerprint with its decorators folded in (section 2.2,
- * decor.c, occl.c; shard.h). */
-uint64_t obs__bake_traced_fingerprint(const obs__bake_world *w, const obs__bake_decor *d,
-                                      float tree_attenuation)
-{
-    uint64_t h = obs__bake_level_fingerprint(w);
-    if (!d || d->counts[OBS__DECOR_NONE] == d->node_count)
-        return h;
-    h = obs__bake_fnv(h, (const unsigned char *)"decorators 1", 12);
-    for (size_t i = 0; i < w->instance_count; i++) {
-        uint32_t n = w->inst[i].node;
-        h = fnv32(h, n < d->node_count ? d->node_class[n] : 0);
-        h = fnv32(h, n < d->node_count ? obs__le_fbits(d->density[n]) : 0);
-    }
-    return fnv32(h, obs__le_fbits(tree_attenuation));
-}
 
 static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_trace_desc *td)
 {
@@ -128,16 +70,8 @@ static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_tra
 
 static void header_bytes(const obs__bake_part *h, unsigned char b[HEADER])
 {
-    memset(b, 0, HEADER);
-    memcpy(b, MAGIC, 8);
-    obs__le_put32(b + 8, VERSION);
-    obs__le_put32(b + 12, HEADER);
-    obs__le_put64(b + 16, h->level);
-    obs__le_put32(b + 24, h->index);
-    obs__le_put32(b + 28, h->count);
-    obs__le_put64(b + 32, h->total);
-    obs__le_put64(b + 40, h->first);
-    obs__le_put64(b + 48, h->n);
+    obs__part_range r = {VERSION, h->index, h->count, h->level, h->total, h->first, h->n};
+    obs__part_range_put(b, HEADER, MAGIC, &r);
     obs__le_put64(b + 56, h->rays);
     obs__le_put64(b + 64, h->dropped);
     obs__le_put32(b + 72, (uint32_t)h->rays_per_sample);
@@ -166,30 +100,6 @@ static unsigned char *payload_bytes(const obs__bake_samples *s, size_t first, si
     return p;
 }
 
-obs_status obs__bake_part_write(const char *path, const unsigned char *head, size_t head_len,
-                                const unsigned char *payload, size_t payload_len,
-                                char err[OBS_ERR_LEN])
-{
-    size_t len = strlen(path);
-    char *tmp = malloc(len + 5);
-    if (!tmp)
-        return obs__fail(err, OBS_NO_MEMORY, "%s: the file name", path);
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp", 5);
-    FILE *f = fopen(tmp, "wb");
-    int ok = f && fwrite(head, 1, head_len, f) == head_len &&
-             (payload_len == 0 || fwrite(payload, 1, payload_len, f) == payload_len);
-    int e = errno;
-    if (f && fclose(f) != 0 && ok)
-        ok = 0, e = errno;
-    if (ok && rename(tmp, path) != 0)
-        ok = 0, e = errno;
-    if (!ok)
-        remove(tmp);
-    free(tmp);
-    return ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: cannot write the part: %s", path, strerror(e));
-}
-
 static void part_params(obs__bake_part *h, const obs__bake_trace_desc *td, const obs_bake_params *p)
 {
     h->rays_per_sample = td->rays;
@@ -215,7 +125,7 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
     h.first = obs__bake_shard_first(s->count, sh->index, sh->count);
     h.n = obs__bake_shard_first(s->count, sh->index + 1, sh->count) - h.first;
     part_params(&h, td, p);
-    double t = now(), bvh = 0.0;
+    double t = obs__bake_now(), bvh = 0.0;
     obs_status rc = OBS_OK;
     s->rays = 0;
     s->dropped = 0;
@@ -227,7 +137,7 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
             return rc;
     }
     h.bvh_seconds = bvh;
-    h.trace_seconds = now() - t - bvh;
+    h.trace_seconds = obs__bake_now() - t - bvh;
     h.rays = s->rays;
     h.dropped = s->dropped;
     unsigned char *payload = payload_bytes(s, (size_t)h.first, (size_t)h.n);
@@ -247,70 +157,18 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
 
 /* ---- reading parts ------------------------------------------------------- */
 
-obs_status obs__bake_part_head(const char *path, const char *magic, const char *what, const char *writer,
-                               unsigned char *head, size_t head_len, uint64_t *size,
-                               char err[OBS_ERR_LEN])
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return obs__fail(err, OBS_IO, "%s: cannot open the part: %s", path, strerror(errno));
-    size_t got = fread(head, 1, head_len, f);
-    struct stat sb;
-    int have_size = fstat(fileno(f), &sb) == 0;
-    fclose(f);
-    *size = have_size ? (uint64_t)sb.st_size : UINT64_MAX;
-    if (got >= 8 && memcmp(head, magic, 8) != 0)
-        return obs__fail(err, OBS_BAD_FILE, "%s: not a %s (no '%.8s' magic; '%s' writes "
-                         "them)", path, what, magic, writer);
-    if (got < head_len)
-        return obs__fail(err, OBS_BAD_FILE, "%s: truncated: %zu bytes, shorter than a part's "
-                         "header (%zu)", path, got, head_len);
-    return OBS_OK;
-}
-
-obs_status obs__bake_part_payload(const char *path, size_t offset, size_t len, uint64_t checksum,
-                                  unsigned char **out, char err[OBS_ERR_LEN])
-{
-    *out = NULL;
-    unsigned char *p = malloc(len + 1);
-    if (!p)
-        return obs__fail(err, OBS_NO_MEMORY, "%s: a payload of %zu bytes", path, len);
-    FILE *f = fopen(path, "rb");
-    int ok = f && fseek(f, (long)offset, SEEK_SET) == 0 && fread(p, 1, len, f) == len;
-    if (f)
-        fclose(f);
-    if (!ok) {
-        free(p);
-        return obs__fail(err, OBS_IO, "%s: cannot read its payload (%zu bytes)", path, len);
-    }
-    if (obs__bake_fnv(OBS__BAKE_FNV_OFFSET, p, len) != checksum) {
-        free(p);
-        return obs__fail(err, OBS_BAD_FILE, "%s: damaged: its payload does not match the header's "
-                         "checksum", path);
-    }
-    *out = p;
-    return OBS_OK;
-}
+static const obs__part_format format = {MAGIC, "bake part", "obscura bake --shard I/N", "part",
+                                       "samples", VERSION, HEADER, UINT32_MAX, 9};
 
 obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN])
 {
-    memset(h, 0, sizeof *h);
-    h->path = path;
     unsigned char b[HEADER];
-    uint64_t size;
-    obs_status rc = obs__bake_part_head(path, MAGIC, "bake part", "obscura bake --shard I/N", b, HEADER, &size, err);
+    obs__part_range r = {0};
+    obs_status rc = obs__part_range_read(path, &format, b, &r, err);
+    *h = (obs__bake_part){.path = path, .version = r.version, .index = r.index, .count = r.count,
+                          .level = r.level, .total = r.total, .first = r.first, .n = r.n};
     if (rc != OBS_OK)
         return rc;
-    h->version = obs__le_get32(b + 8);
-    if (h->version != VERSION || obs__le_get32(b + 12) != HEADER)
-        return obs__fail(err, OBS_UNSUPPORTED, "%s: part version %u (header %u bytes); this "
-                         "obscura reads version %u", path, h->version, obs__le_get32(b + 12), VERSION);
-    h->level = obs__le_get64(b + 16);
-    h->index = obs__le_get32(b + 24);
-    h->count = obs__le_get32(b + 28);
-    h->total = obs__le_get64(b + 32);
-    h->first = obs__le_get64(b + 40);
-    h->n = obs__le_get64(b + 48);
     h->rays = obs__le_get64(b + 56);
     h->dropped = obs__le_get64(b + 64);
     h->rays_per_sample = (int32_t)obs__le_get32(b + 72);
@@ -323,18 +181,6 @@ obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char 
     h->bvh_seconds = obs__le_bitsd(obs__le_get64(b + 104));
     h->trace_seconds = obs__le_bitsd(obs__le_get64(b + 112));
     h->checksum = obs__le_get64(b + 120);
-    if (h->count == 0 || h->index >= h->count || h->count > (uint32_t)INT32_MAX ||
-        h->total > UINT32_MAX || h->first != obs__bake_shard_first((size_t)h->total, (int)h->index, (int)h->count) ||
-        h->first + h->n != obs__bake_shard_first((size_t)h->total, (int)h->index + 1, (int)h->count))
-        return obs__fail(err, OBS_BAD_FILE, "%s: damaged header: shard %u/%u of %llu samples "
-                         "cannot hold samples %llu .. %llu", path, h->index, h->count,
-                         (unsigned long long)h->total, (unsigned long long)h->first,
-                         (unsigned long long)(h->first + h->n));
-    uint64_t want = HEADER + 9 * h->n;
-    if (size != UINT64_MAX && size != want)
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %llu bytes, its header promises %llu (%llu samples)",
-                         path, size < want ? "truncated" : "longer than a part",
-                         (unsigned long long)size, (unsigned long long)want, (unsigned long long)h->n);
     return OBS_OK;
 }
 
@@ -369,7 +215,7 @@ static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: the parts split %llu samples; this level "
                          "and these parameters make %zu", p0->path, (unsigned long long)p0->total,
                          s->count);
-    double t = now();
+    double t = obs__bake_now();
     s->rays = 0;
     s->dropped = 0;
     for (int i = 0; i < sh->count; i++) {
@@ -382,7 +228,7 @@ static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs
         st->seconds[OBS_BAKE_STAGE_bvh] += sh->parts[i].bvh_seconds;
         st->seconds[OBS_BAKE_STAGE_trace] += sh->parts[i].trace_seconds;
     }
-    st->seconds[OBS_BAKE_STAGE_trace] += now() - t;
+    st->seconds[OBS_BAKE_STAGE_trace] += obs__bake_now() - t;
     return OBS_OK;
 }
 
@@ -393,49 +239,3 @@ obs_status obs__bake_shard_step(obs__bake_shard *sh, const obs__bake_world *w,
     return sh->parts ? read_shards(sh, w, s, td, st, err) : trace_shard(sh, w, s, td, &sh->params, st, err);
 }
 
-/* ---- the parts of one split ----------------------------------------------- */
-
-obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t *order,
-                                 char err[OBS_ERR_LEN])
-{
-    uint32_t count = in[0].count;
-    if (n > count)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%zu parts given for a split into %u shards "
-                         "(%s): one is given twice, or belongs to another split", n, count,
-                         in[0].path);
-    unsigned char *seen = calloc(count, 1);
-    if (!seen)
-        return obs__fail(err, OBS_NO_MEMORY, "%u shards", count);
-    obs_status rc = OBS_OK;
-    for (size_t i = 0; rc == OBS_OK && i < n; i++) {
-        if (in[i].count != count)
-            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%s is shard %u/%u, %s shard %u/%u: parts "
-                           "of different splits", in[0].path, in[0].index, count, in[i].path,
-                           in[i].index, in[i].count);
-        else if (in[i].level != in[0].level)
-            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced from different levels "
-                           "(fingerprints %016llx and %016llx)", in[0].path, in[i].path,
-                           (unsigned long long)in[0].level, (unsigned long long)in[i].level);
-        else if (seen[in[i].index])
-            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "shard %u/%u given twice: %s and %s",
-                           in[i].index, count, in[order[in[i].index]].path, in[i].path);
-        else
-            seen[in[i].index] = 1, order[in[i].index] = i;
-    }
-    if (rc == OBS_OK && n < count) {
-        char list[256] = "";
-        size_t len = 0, missing = 0;
-        for (uint32_t k = 0; k < count; k++) {
-            if (seen[k])
-                continue;
-            if (len + 16 < sizeof list)
-                len += (size_t)snprintf(list + len, sizeof list - len, "%s%u", missing ? ", " : "", k);
-            missing++;
-        }
-        rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%zu of %u shards missing (%s%s): a merge needs "
-                       "every shard of the split once", missing, count, list,
-                       missing * 4 > sizeof list ? ", ..." : "");
-    }
-    free(seen);
-    return rc;
-}

@@ -62,22 +62,16 @@ static obs_status adopt(obs_bake_params *p, const obs__bake_part *parts, size_t 
     return OBS_OK;
 }
 
-/* parts in shard order: every shard of one split, once (shard.c). */
-static obs_status order_parts(const obs__bake_part *in, size_t n, obs__bake_part *out,
-                              char err[OBS_ERR_LEN])
+/* A part's header and its key among the parts (level/part.h). */
+static obs_status read_header(const char *path, void *h, char err[OBS_ERR_LEN])
 {
-    obs__bake_part_key *keys = calloc(n, sizeof *keys);
-    size_t *order = calloc(in[0].count, sizeof *order);
-    obs_status rc = keys && order ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
-    for (size_t i = 0; rc == OBS_OK && i < n; i++)
-        keys[i] = (obs__bake_part_key){in[i].path, in[i].index, in[i].count, in[i].level};
-    if (rc == OBS_OK)
-        rc = obs__bake_parts_order(keys, n, order, err);
-    for (uint32_t k = 0; rc == OBS_OK && k < in[0].count; k++)
-        out[k] = in[order[k]];
-    free(keys);
-    free(order);
-    return rc;
+    return obs__bake_part_read_header(path, h, err);
+}
+
+static obs__bake_part_key key_of(const void *p)
+{
+    const obs__bake_part *h = p;
+    return (obs__bake_part_key){h->path, h->index, h->count, h->level};
 }
 
 obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
@@ -87,14 +81,10 @@ obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
     memset(out, 0, sizeof *out);
     if (n == 0 || !paths)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "merge: no parts");
-    obs__bake_part *heads = calloc(n, sizeof *heads), *ordered = NULL;
-    obs_status rc = heads ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
-    for (size_t i = 0; rc == OBS_OK && i < n; i++)
-        rc = obs__bake_part_read_header(paths[i], &heads[i], err);
-    if (rc == OBS_OK && !(ordered = calloc(heads[0].count, sizeof *ordered)))
-        rc = obs__fail(err, OBS_NO_MEMORY, "%u parts", heads[0].count);
-    if (rc == OBS_OK)
-        rc = order_parts(heads, n, ordered, err);
+    void *parts = NULL;
+    obs_status rc = obs__bake_parts_read(paths, n, sizeof(obs__bake_part), read_header, key_of,
+                                         &parts, err);
+    obs__bake_part *ordered = parts;
     obs_bake_desc d = desc ? *desc : (obs_bake_desc){0};
     if (rc == OBS_OK)
         rc = adopt(&d.params, ordered, n, err);
@@ -106,6 +96,5 @@ obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
             desc->params = d.params;
     }
     free(ordered);
-    free(heads);
     return rc;
 }

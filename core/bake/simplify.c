@@ -26,17 +26,6 @@
 #include "bake/lod.h"
 #include "internal.h"
 
-void obs__bake_mesh_free(obs_bake_mesh *m)
-{
-    if (!m)
-        return;
-    free(m->name);
-    free(m->positions);
-    free(m->normals);
-    free(m->indices);
-    memset(m, 0, sizeof *m);
-}
-
 /* The welded mesh: positions of each group's first vertex, the triangles
  * that did not collapse. */
 typedef struct welded {

@@ -23,8 +23,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/occl.h"
-#include "bake/rng.h"
+#include "level/occl.h"
+#include "level/rng.h"
 #include "internal.h"
 
 #define RNG_SALT 3

@@ -11,32 +11,27 @@
  * rule (section 2.1): a sample with more than backface_limit of its rays
  * on back faces lies inside geometry and is dropped.
  *
- * Decorators (section 2.1, core/bake/occl.c): the closest hit is of the
+ * Decorators (section 2.1, core/level/occl.c): the closest hit is of the
  * opaque triangles alone; shrubs (fog boxes) and trees (semi-transparent
  * triangles) on the ray's segment up to that hit multiply the ray's
  * value by their transmittance T:  rho(d) T, a miss 1 T ("both simply
  * attenuate the current AO value for a ray"). */
 #include <embree3/rtcore.h>
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "bake/bake_internal.h"
-#include "bake/occl.h"
-#include "bake/rng.h"
+#include "level/kernel.h"
+#include "level/occl.h"
+#include "level/rng.h"
 #include "internal.h"
+#include "pool.h"
 
-#define MAX_THREADS 64
 #define CHUNK 64
 #define PACKET 8
-/* Rays stop at this many long distances: rho is within 2^-16 of 1. */
-#define RAY_LENGTH_FACTOR 16.0f
-#define PI_D 3.14159265358979323846
 
 typedef struct job {
     const obs__bake_world *w;
@@ -45,27 +40,10 @@ typedef struct job {
     const obs__bake_occl *occl;
     RTCScene rtc;
     float a[2]; /* the kernels' a = ln(0.5) / d */
-    atomic_size_t next;
-    pthread_mutex_t lock;
-    size_t end, done; /* the range ends at end (d->first .. end) */
-    atomic_int stop;  /* the progress callback asked to stop */
+    size_t end; /* the range ends at end (d->first .. end) */
     uint64_t rays;
     size_t dropped;
 } job;
-
-/* An orthonormal tangent frame around unit n (Frisvad 2012, with the
- * n.z = -1 case handled by symmetry). */
-static void frame(const float n[3], float t[3], float b[3])
-{
-    if (n[2] < -0.9999999f) {
-        t[0] = 0.0f, t[1] = -1.0f, t[2] = 0.0f;
-        b[0] = -1.0f, b[1] = 0.0f, b[2] = 0.0f;
-        return;
-    }
-    float a = 1.0f / (1.0f + n[2]), c = -n[0] * n[1] * a;
-    t[0] = 1.0f - n[0] * n[0] * a, t[1] = c, t[2] = -n[0];
-    b[0] = c, b[1] = 1.0f - n[1] * n[1] * a, b[2] = -n[1];
-}
 
 static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint64_t *rays,
                          size_t *dropped)
@@ -80,7 +58,7 @@ static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint
     float m = fmaxf(1.0f, fmaxf(fabsf(p[0]), fmaxf(fabsf(p[1]), fabsf(p[2]))));
     for (int k = 0; k < 3; k++)
         o[k] = p[k] + n[k] * 1e-4f * m; /* off the surface: float spacing */
-    frame(n, tg, bt);
+    obs__bake_frame(n, tg, bt);
     /* Cosine-weighted directions (Malley's method: a point of the unit
      * disk lifted to the hemisphere) from a rank-1 lattice with a random
      * shift per sample: each direction has the cosine density, the set
@@ -89,7 +67,7 @@ static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint
     double o1 = obs__bake_rng_unit(&r), o2 = obs__bake_rng_unit(&r);
     double acc[2] = {0.0, 0.0};
     int back = 0;
-    float tfar = RAY_LENGTH_FACTOR * fmaxf(j->d->distance[0], j->d->distance[1]);
+    float tfar = OBS__BAKE_RAY_LENGTH_FACTOR * fmaxf(j->d->distance[0], j->d->distance[1]);
     /* Packets of 8 rays (rtcIntersect8): one sample's rays share their
      * origin; lanes are summed in ray order, so the result is the
      * packet's, whatever the thread. */
@@ -99,22 +77,9 @@ static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint
         for (int l = 0; l < PACKET; l++) {
             int k = k0 + l;
             valid[l] = k < nr ? -1 : 0;
-            double u1 = fmod((k + 0.5) / nr + o1, 1.0), u2 = fmod(k * 0.6180339887498949 + o2, 1.0);
-            double rad = sqrt(u1), phi = 2.0 * PI_D * u2;
-            float x = (float)(rad * cos(phi)), y = (float)(rad * sin(phi)),
-                  z = (float)sqrt(fmax(0.0, 1.0 - u1));
-            rh.ray.org_x[l] = o[0], rh.ray.org_y[l] = o[1], rh.ray.org_z[l] = o[2];
-            rh.ray.dir_x[l] = x * tg[0] + y * bt[0] + z * n[0];
-            rh.ray.dir_y[l] = x * tg[1] + y * bt[1] + z * n[1];
-            rh.ray.dir_z[l] = x * tg[2] + y * bt[2] + z * n[2];
-            rh.ray.tnear[l] = 0.0f;
-            rh.ray.tfar[l] = tfar;
-            rh.ray.time[l] = 0.0f;
-            rh.ray.mask[l] = 0xffffffffu;
-            rh.ray.id[l] = 0;
-            rh.ray.flags[l] = 0;
-            rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+            float dir[3];
+            obs__bake_lattice_dir(k, nr, o1, o2, n, tg, bt, dir);
+            obs__bake_ray8_lane(&rh, l, o, dir, tfar);
         }
         rtcIntersect8(valid, j->rtc, ctx, &rh);
         double tr[PACKET]; /* shrubs and trees up to the opaque hit (section 2.1) */
@@ -126,7 +91,7 @@ static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint
                 continue;
             }
             for (int c = 0; c < 2; c++)
-                acc[c] += (1.0 - exp((double)j->a[c] * rh.ray.tfar[l])) * tr[l]; /* rho(x) T */
+                acc[c] += obs__bake_rho(j->a[c], rh.ray.tfar[l]) * tr[l]; /* rho(x) T */
             size_t ht = j->occl->opaque_tri ? j->occl->opaque_tri[rh.hit.primID[l]]
                                             : rh.hit.primID[l];
             const float *hn = w->fn + 3 * ht;
@@ -142,35 +107,30 @@ static void trace_sample(job *j, struct RTCIntersectContext *ctx, size_t i, uint
     *dropped += !s->valid[i];
 }
 
-static void *worker(void *arg)
+/* One range of samples on one thread: rays and drops counted locally,
+ * added to the job when the thread ends (integer sums: any order). */
+typedef struct counts {
+    uint64_t rays;
+    size_t dropped;
+} counts;
+
+static int trace_range(void *ctx, void *local, size_t i0, size_t i1)
 {
-    job *j = arg;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    uint64_t rays = 0;
-    size_t dropped = 0, i0;
-    while (!atomic_load(&j->stop) && (i0 = atomic_fetch_add(&j->next, CHUNK)) < j->end) {
-        size_t i1 = i0 + CHUNK < j->end ? i0 + CHUNK : j->end;
-        for (size_t i = i0; i < i1; i++)
-            trace_sample(j, &ctx, i, &rays, &dropped);
-        pthread_mutex_lock(&j->lock);
-        j->done += i1 - i0;
-        if (j->d->progress && j->d->progress(j->d->progress_user, j->done, j->end - j->d->first))
-            atomic_store(&j->stop, 1); /* between batches: the bake is cancelled */
-        pthread_mutex_unlock(&j->lock);
-    }
-    pthread_mutex_lock(&j->lock);
-    j->rays += rays;
-    j->dropped += dropped;
-    pthread_mutex_unlock(&j->lock);
-    return NULL;
+    job *j = ctx;
+    counts *c = local;
+    struct RTCIntersectContext ictx;
+    rtcInitIntersectContext(&ictx);
+    for (size_t i = i0; i < i1; i++)
+        trace_sample(j, &ictx, i, &c->rays, &c->dropped);
+    return 0;
 }
 
-static double now(void)
+static void trace_end(void *ctx, void *local)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+    job *j = ctx;
+    const counts *c = local;
+    j->rays += c->rays;
+    j->dropped += c->dropped;
 }
 
 obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
@@ -178,11 +138,11 @@ obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
                            char err[OBS_ERR_LEN])
 {
     obs_status st = OBS_OK;
-    double t0 = now();
+    double t0 = obs__bake_now();
     obs__bake_occl *occl = NULL;
     if ((st = obs__bake_occl_new(w, d->decor, d->tree_attenuation, &occl, err)) != OBS_OK)
         return st;
-    *bvh_seconds = now() - t0;
+    *bvh_seconds = obs__bake_now() - t0;
 
     job *j = calloc(1, sizeof *j);
     if (!j) {
@@ -195,140 +155,24 @@ obs_status obs__bake_trace(const obs__bake_world *w, obs__bake_samples *s,
     j->occl = occl;
     j->rtc = occl->opaque;
     for (int c = 0; c < 2; c++)
-        j->a[c] = logf(0.5f) / d->distance[c]; /* a = ln(0.5) / d, section 2 */
+        j->a[c] = obs__bake_kernel_a(d->distance[c]); /* a = ln(0.5) / d, section 2 */
     /* The samples [first, end): a shard of the bake (shard.c), or all. */
     j->end = d->end && d->end < s->count ? d->end : s->count;
-    atomic_init(&j->next, d->first < j->end ? d->first : j->end);
-    atomic_init(&j->stop, 0);
-    pthread_mutex_init(&j->lock, NULL);
-    int nt = d->threads;
-    if (nt <= 0) {
-        long c = sysconf(_SC_NPROCESSORS_ONLN);
-        nt = c < 1 ? 1 : c > MAX_THREADS ? MAX_THREADS : (int)c;
-    }
-    pthread_t th[MAX_THREADS];
-    int started = 0;
-    for (; started < nt && started < MAX_THREADS; started++)
-        if (pthread_create(&th[started], NULL, worker, j) != 0)
-            break;
-    if (started == 0)
-        worker(j);
-    for (int k = 0; k < started; k++)
-        pthread_join(th[k], NULL);
-    pthread_mutex_destroy(&j->lock);
+    obs__pool_for f = {.first = d->first, .end = j->end, .chunk = CHUNK, .threads = d->threads,
+                       .range = trace_range, .ctx = j, .local_size = sizeof(counts),
+                       .end_thread = trace_end, .progress = d->progress,
+                       .progress_user = d->progress_user};
+    size_t traced = 0;
+    int stopped = obs__pool_run(&f, &traced); /* the progress callback cancels between ranges */
     s->rays = j->rays;
     s->dropped = j->dropped;
-    if (atomic_load(&j->stop))
-        st = obs__fail(err, OBS_CANCELLED, "bake cancelled after %zu of %zu samples", j->done,
+    if (stopped < 0)
+        st = obs__fail(err, OBS_NO_MEMORY, "trace threads");
+    else if (stopped)
+        st = obs__fail(err, OBS_CANCELLED, "bake cancelled after %zu of %zu samples", traced,
                        j->end - d->first);
     free(j);
 done:
     obs__bake_occl_free(occl);
     return st;
-}
-
-/* ---- the level's BVH and single rays, for the dynamic-object bake ------
- * (probes.c, regions.c, dyn_measure.c: points in space rather than on the
- * surface).  The same scene as obs__bake_trace builds; kept beside it. */
-struct obs__bake_bvh {
-    obs__bake_occl *occl; /* every triangle opaque, or with decorators */
-    RTCScene rtc;
-    const obs__bake_world *w;
-};
-
-obs_status obs__bake_bvh_new(const obs__bake_world *w, obs__bake_bvh **out,
-                             char err[OBS_ERR_LEN])
-{
-    return obs__bake_bvh_new_decor(w, NULL, 0.0f, out, err);
-}
-
-obs_status obs__bake_bvh_new_decor(const obs__bake_world *w, const struct obs__bake_decor *d,
-                                   float tree_attenuation, obs__bake_bvh **out,
-                                   char err[OBS_ERR_LEN])
-{
-    *out = NULL;
-    obs__bake_bvh *b = calloc(1, sizeof *b);
-    if (!b)
-        return obs__fail(err, OBS_NO_MEMORY, "BVH");
-    b->w = w;
-    obs_status st = obs__bake_occl_new(w, d, tree_attenuation, &b->occl, err);
-    if (st != OBS_OK) {
-        free(b);
-        return st;
-    }
-    b->rtc = b->occl->opaque;
-    *out = b;
-    return OBS_OK;
-}
-
-void obs__bake_bvh_free(obs__bake_bvh *b)
-{
-    if (!b)
-        return;
-    obs__bake_occl_free(b->occl);
-    free(b);
-}
-
-void obs__bake_bvh_cast(const obs__bake_bvh *b, const float o[3], const float *dirs, int n,
-                        float tfar, float *t, uint8_t *back, float *trans)
-{
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    const obs__bake_world *w = b->w;
-    for (int k0 = 0; k0 < n; k0 += PACKET) {
-        RTC_ALIGN(32) struct RTCRayHit8 rh;
-        RTC_ALIGN(32) int valid[PACKET];
-        for (int l = 0; l < PACKET; l++) {
-            int k = k0 + l < n ? k0 + l : n - 1;
-            valid[l] = k0 + l < n ? -1 : 0;
-            rh.ray.org_x[l] = o[0], rh.ray.org_y[l] = o[1], rh.ray.org_z[l] = o[2];
-            rh.ray.dir_x[l] = dirs[3 * k], rh.ray.dir_y[l] = dirs[3 * k + 1];
-            rh.ray.dir_z[l] = dirs[3 * k + 2];
-            rh.ray.tnear[l] = 0.0f;
-            rh.ray.tfar[l] = tfar;
-            rh.ray.time[l] = 0.0f;
-            rh.ray.mask[l] = 0xffffffffu;
-            rh.ray.id[l] = 0;
-            rh.ray.flags[l] = 0;
-            rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
-        }
-        rtcIntersect8(valid, b->rtc, &ctx, &rh);
-        if (trans) { /* section 2.1: the segment up to the opaque hit (tfar on a miss) */
-            double tr[PACKET];
-            obs__bake_occl_transmittance8(b->occl, valid, &rh, tr);
-            for (int l = 0; l < PACKET && k0 + l < n; l++)
-                trans[k0 + l] = (float)tr[l];
-        }
-        for (int l = 0; l < PACKET && k0 + l < n; l++) {
-            int k = k0 + l;
-            if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
-                t[k] = INFINITY;
-                back[k] = 0;
-                continue;
-            }
-            t[k] = rh.ray.tfar[l];
-            /* with decorators the opaque scene lists a subset: its world triangle */
-            size_t pr = b->occl->opaque_tri ? b->occl->opaque_tri[rh.hit.primID[l]]
-                                            : rh.hit.primID[l];
-            const float *hn = w->fn + 3 * pr;
-            back[k] = !w->two_sided[pr] && hn[0] * rh.ray.dir_x[l] + hn[1] * rh.ray.dir_y[l] +
-                                                   hn[2] * rh.ray.dir_z[l] >
-                                               0.0f;
-        }
-    }
-}
-
-int obs__bake_bvh_occluded(const obs__bake_bvh *b, const float a[3], const float c[3])
-{
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    float d[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    if (len <= 0.0f)
-        return 0;
-    struct RTCRay r = {a[0], a[1], a[2], 0.0f, d[0] / len, d[1] / len, d[2] / len, 0.0f,
-                       len, 0xffffffffu, 0, 0};
-    rtcOccluded1(b->rtc, &ctx, &r);
-    return r.tfar < 0.0f; /* Embree sets tfar to -inf on a hit */
 }

@@ -11,8 +11,8 @@
  * The grid is the integer multiples of the spacing h (instanced.h); the
  * top level a hash of bricks of OBS__VOL_BRICK^3 points, the second each
  * brick's table of its points.  A point's spherical obscurance is traced
- * and projected as the dynamic-object bake's points are (probes.c,
- * sh.c); SH are linear in the function, so interpolating the
+ * and projected as the dynamic-object bake's points are (level/point_sh.c,
+ * level/sh.c); SH are linear in the function, so interpolating the
  * coefficients and evaluating them at a normal is interpolating the AO. */
 #include <math.h>
 #include <pthread.h>
@@ -20,9 +20,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/dyn_internal.h"
+#include "level/level.h"
 #include "bake/instanced.h"
 #include "internal.h"
+#include "pool.h"
 
 #define B OBS__VOL_BRICK
 #define B3 (B * B * B)
@@ -240,7 +241,7 @@ int obs__vol_eval(const obs__vol *v, const float p[3], const float *n, double ao
     }
     static const float up[3] = {0.0f, 0.0f, 1.0f};
     for (int d = 0; d < 2; d++)
-        ao[d] = obs__dyn_sh_eval(c + OBS_DYN_SH * d, n ? n : up, n ? 2 : 0);
+        ao[d] = obs__sh_eval(c + OBS_DYN_SH * d, n ? n : up, n ? 2 : 0);
     return 1;
 }
 
@@ -275,7 +276,7 @@ static void vol_point(void *ctx, size_t i)
      * list: the same point gets the same rays in any level */
     uint64_t stream = hash3(q[0], q[1], q[2]);
     int dropped = 0;
-    if (!obs__dyn_point_sh(j->bvh, o, &j->dp, stream, v->sh + i * OBS__VOL_CHANNELS, &dropped))
+    if (!obs__point_sh(j->bvh, o, &j->dp, stream, v->sh + i * OBS__VOL_CHANNELS, &dropped))
         atomic_store(&j->failed, 1);
     v->inside[i] = (uint8_t)(dropped != 0);
 }
@@ -299,7 +300,7 @@ obs_status obs__vol_trace(obs__vol *v, const obs__bake_bvh *bvh, int rays, const
     j->stop = stop;
     j->user = user;
     pthread_mutex_init(&j->lock, NULL);
-    obs__bake_pfor(v->count, 16, threads, vol_point, j);
+    obs__pool_each(v->count, 16, threads, vol_point, j);
     pthread_mutex_destroy(&j->lock);
     int failed = atomic_load(&j->failed), stopped = atomic_load(&j->stopped);
     free(j);

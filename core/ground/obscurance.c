@@ -6,13 +6,13 @@
  * lanes summed in ray order, as core/bake/trace.c does.  With the bake's
  * occluders (obs_reference_desc.occluders) the rays meet what the bake's
  * meet: its opaque BVH, and each ray's rho times the transmittance of the
- * shrubs' fog and the trees up to the hit (section 2.1, core/bake/occl.c). */
+ * shrubs' fog and the trees up to the hit (section 2.1, core/level/occl.c). */
 #include <embree3/rtcore.h>
 #include <math.h>
 
-#include "bake/kernel.h"
-#include "bake/occl.h"
-#include "bake/rng.h"
+#include "level/kernel.h"
+#include "level/occl.h"
+#include "level/rng.h"
 #include "ground/reference_internal.h"
 
 #define PACKET 8
@@ -50,16 +50,7 @@ void obs__obscurance_at(RTCScene rtc, struct RTCIntersectContext *ctx, const obs
             float d[3];
             valid[l] = k < nr ? -1 : 0;
             obs__bake_lattice_dir(k, nr, o1, o2, n, tg, bt, d);
-            rh.ray.org_x[l] = org[0], rh.ray.org_y[l] = org[1], rh.ray.org_z[l] = org[2];
-            rh.ray.dir_x[l] = d[0], rh.ray.dir_y[l] = d[1], rh.ray.dir_z[l] = d[2];
-            rh.ray.tnear[l] = 0.0f;
-            rh.ray.tfar[l] = o->tfar;
-            rh.ray.time[l] = 0.0f;
-            rh.ray.mask[l] = 0xffffffffu;
-            rh.ray.id[l] = 0;
-            rh.ray.flags[l] = 0;
-            rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+            obs__bake_ray8_lane(&rh, l, org, d, o->tfar);
         }
         rtcIntersect8(valid, o->occl ? o->occl->opaque : rtc, ctx, &rh);
         double tr[PACKET] = {1, 1, 1, 1, 1, 1, 1, 1}; /* shrubs and trees, section 2.1 */

@@ -1,23 +1,20 @@
 /* The ray-traced AO reference (reference.h): Embree 3 for the rays,
- * pthreads over rows, a counter-based random stream per pixel so that the
- * image depends on the seed alone. */
+ * rows over the worker pool (pool.c), a counter-based random stream per
+ * pixel so that the image depends on the seed alone. */
 #include <embree3/rtcore.h>
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
-#include "bake/occl.h"
+#include "level/occl.h"
 #include "ground/reference_internal.h"
 #include "internal.h"
 #include "obscura/reference.h"
+#include "pool.h"
 
 #define DEFAULT_SPP 256
 #define MAX_SPP (1 << 20)
-#define MAX_THREADS 64
 #define PI_F 3.14159265358979f
 /* Surfaces one ray may cross in a scene with opacities. */
 #define MAX_CROSSINGS 256
@@ -117,9 +114,6 @@ typedef struct job {
     float eye[4]; /* camera position (w 1) or direction towards it (w 0) */
     float *ao, *depth;
     obs__obscurance ob; /* obscurance mode */
-    atomic_int next_row;
-    int rows_done;
-    pthread_mutex_t progress_lock;
 } job;
 
 static void init_ray(struct RTCRay *r, const float o[3], const float d[3], float tfar)
@@ -329,62 +323,65 @@ static float layered_ao(const job *j, struct RTCIntersectContext *ictx, pcg32 *r
     return acc + T;
 }
 
-static void *worker(void *arg)
+/* One row on one thread (pool.h hands the rows out in order). */
+static int render_row(void *ctx, void *local, size_t row, size_t row_end)
 {
-    job *j = arg;
+    (void)local;
+    (void)row_end; /* ranges of one row */
+    job *j = ctx;
     struct RTCIntersectContext ictx;
     rtcInitIntersectContext(&ictx);
-    int y;
-    while ((y = atomic_fetch_add(&j->next_row, 1)) < j->height) {
-        for (int x = 0; x < j->width; x++) {
-            size_t i = (size_t)y * j->width + x;
-            float p[3], n[3], ng[3];
-            pcg32 rng;
-            pcg32_seed(&rng, j->desc.seed, i);
-            if (j->desc.obscurance) {
-                /* eq 1 around the normal facing the viewer; opaque */
-                const int near = j->desc.obscurance_near > 0.0f;
-                float *o = j->ao + (near ? 5 : 3) * i, v[2] = {1.0f, 1.0f}, a = 1.0f;
-                int hit = surface_point(j, &ictx, x, y, p, n, ng);
-                if (hit)
-                    obs__obscurance_at(j->rtc, &ictx, &j->ob, i, p, ng, v);
-                if (hit && near)
-                    a = ao_at(j, &ictx, &rng, p, n, ng); /* desc.distance is the near one */
-                o[0] = j->desc.blend * v[0] + (1.0f - j->desc.blend) * v[1];
-                o[1] = v[0];
-                o[2] = v[1];
-                if (near) {
-                    o[3] = a;
-                    o[4] = a * v[1];
-                }
-                if (j->depth)
-                    j->depth[i] = hit ? planar_depth(j, p) : OBS_SKY_DEPTH;
-                continue;
+    const int y = (int)row;
+    for (int x = 0; x < j->width; x++) {
+        size_t i = (size_t)y * j->width + x;
+        float p[3], n[3], ng[3];
+        pcg32 rng;
+        pcg32_seed(&rng, j->desc.seed, i);
+        if (j->desc.obscurance) {
+            /* eq 1 around the normal facing the viewer; opaque */
+            const int near = j->desc.obscurance_near > 0.0f;
+            float *o = j->ao + (near ? 5 : 3) * i, v[2] = {1.0f, 1.0f}, a = 1.0f;
+            int hit = surface_point(j, &ictx, x, y, p, n, ng);
+            if (hit)
+                obs__obscurance_at(j->rtc, &ictx, &j->ob, i, p, ng, v);
+            if (hit && near)
+                a = ao_at(j, &ictx, &rng, p, n, ng); /* desc.distance is the near one */
+            o[0] = j->desc.blend * v[0] + (1.0f - j->desc.blend) * v[1];
+            o[1] = v[0];
+            o[2] = v[1];
+            if (near) {
+                o[3] = a;
+                o[4] = a * v[1];
             }
-            if (j->scene->opacity && !j->view->position) {
-                float z;
-                j->ao[i] = layered_ao(j, &ictx, &rng, x, y, &z);
-                if (j->depth)
-                    j->depth[i] = z;
-                continue;
-            }
-            if (!surface_point(j, &ictx, x, y, p, n, ng)) {
-                j->ao[i] = 1.0f;
-                if (j->depth)
-                    j->depth[i] = OBS_SKY_DEPTH;
-                continue;
-            }
-            j->ao[i] = ao_at(j, &ictx, &rng, p, n, ng);
             if (j->depth)
-                j->depth[i] = planar_depth(j, p);
+                j->depth[i] = hit ? planar_depth(j, p) : OBS_SKY_DEPTH;
+            continue;
         }
-        pthread_mutex_lock(&j->progress_lock);
-        j->rows_done++;
-        if (j->desc.progress)
-            j->desc.progress(j->desc.progress_user, j->rows_done, j->height);
-        pthread_mutex_unlock(&j->progress_lock);
+        if (j->scene->opacity && !j->view->position) {
+            float z;
+            j->ao[i] = layered_ao(j, &ictx, &rng, x, y, &z);
+            if (j->depth)
+                j->depth[i] = z;
+            continue;
+        }
+        if (!surface_point(j, &ictx, x, y, p, n, ng)) {
+            j->ao[i] = 1.0f;
+            if (j->depth)
+                j->depth[i] = OBS_SKY_DEPTH;
+            continue;
+        }
+        j->ao[i] = ao_at(j, &ictx, &rng, p, n, ng);
+        if (j->depth)
+            j->depth[i] = planar_depth(j, p);
     }
-    return NULL;
+    return 0;
+}
+
+static int report(void *user, size_t done, size_t total)
+{
+    const job *j = user;
+    j->desc.progress(j->desc.progress_user, (int)done, (int)total);
+    return 0;
 }
 
 /* ---- Embree scene -------------------------------------------------------- */
@@ -462,13 +459,9 @@ static obs_status check_args(const obs_scene *scene, const obs_reference_view *v
         d->spp = DEFAULT_SPP;
     if (d->spp < 1 || d->spp > MAX_SPP)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "spp %d: expected 1 to %d", d->spp, MAX_SPP);
-    if (d->threads == 0) {
-        long n = sysconf(_SC_NPROCESSORS_ONLN);
-        d->threads = n < 1 ? 1 : n > MAX_THREADS ? MAX_THREADS : (int)n;
-    }
-    if (d->threads < 1 || d->threads > MAX_THREADS)
+    if (d->threads < 0 || d->threads > OBS__POOL_MAX_THREADS)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "threads %d: expected 1 to %d", d->threads,
-                         MAX_THREADS);
+                         OBS__POOL_MAX_THREADS);
     if (!v->position != !v->normal)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "G-buffer points need both position and normal");
     if (v->position) {
@@ -499,8 +492,6 @@ obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view
     char dev_err[OBS_ERR_LEN] = "";
     RTCDevice dev = NULL;
     RTCScene rs = NULL;
-    pthread_t threads[MAX_THREADS];
-    int started = 0;
 
     memset(ao, 0, sizeof *ao);
     if (depth)
@@ -562,16 +553,9 @@ obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view
     j->height = h;
     j->ao = ao->data;
     j->depth = depth ? depth->data : NULL;
-    atomic_init(&j->next_row, 0);
-    pthread_mutex_init(&j->progress_lock, NULL);
-    for (; started < d.threads; started++)
-        if (pthread_create(&threads[started], NULL, worker, j) != 0)
-            break;
-    if (started == 0)
-        worker(j); /* no thread could start: do it here */
-    for (int t = 0; t < started; t++)
-        pthread_join(threads[t], NULL);
-    pthread_mutex_destroy(&j->progress_lock);
+    obs__pool_for f = {.end = (size_t)h, .chunk = 1, .threads = d.threads, .range = render_row,
+                       .ctx = j, .progress = d.progress ? report : NULL, .progress_user = j};
+    obs__pool_run(&f, NULL);
 
 fail:
     if (rs)

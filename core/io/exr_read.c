@@ -5,8 +5,6 @@
  * every library failure becomes a status with the library's message. */
 #include <limits.h>
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,13 +13,11 @@
 
 #include "io/exr_internal.h"
 #include "internal.h"
+#include "pool.h"
 
 /* A decoded chunk is held whole by the library; the header decides its
  * size, so a damaged header could ask for gigabytes from a tiny file. */
 #define MAX_CHUNK_BYTES ((uint64_t)1 << 30)
-
-/* Upper bound on obs_limits.threads. */
-#define OBS_MAX_DECODE_THREADS 64
 
 /* ---- opening ------------------------------------------------------------ */
 
@@ -316,10 +312,7 @@ typedef struct part_job {
     int32_t lines;        /* scanlines per chunk (scanline parts) */
     uint32_t tw, th;      /* tile size (tiled parts) */
     int64_t ntx, chunks;  /* tiles across; chunks in all */
-    _Atomic int64_t next; /* next chunk to hand out */
-    atomic_int stop;      /* set on the first failure: hand out no more */
-    pthread_mutex_t lock; /* guards the three below */
-    int64_t failed;       /* lowest failing chunk (chunks = none) */
+    int64_t failed;       /* lowest failing chunk (chunks = none); under the pool's lock */
     obs_status st;
     char err[OBS_ERR_LEN];
 } part_job;
@@ -343,50 +336,59 @@ static obs_status decode_nth(part_job *j, int64_t i, decoder *d, char err[OBS_ER
     return decode_chunk(j->ctx, j->part, g, &ci, tx * j->tw, ty * j->th, j->t, j->nt, d, err);
 }
 
-static void *decode_worker(void *arg)
-{
-    part_job *j = arg;
-    decoder d = {EXR_DECODE_PIPELINE_INITIALIZER};
-    char err[OBS_ERR_LEN] = "";
+/* One decoder per thread; a failure is kept until the thread ends. */
+typedef struct decode_local {
+    decoder d;
+    int64_t failed;
+    obs_status st;
+    char err[OBS_ERR_LEN];
+} decode_local;
 
+static void decode_begin(void *ctx, void *local)
+{
+    (void)ctx;
+    decode_local *l = local;
+    l->d = (decoder){EXR_DECODE_PIPELINE_INITIALIZER};
+    l->st = OBS_OK;
     obs__exr_msg_reset(); /* the library's messages are per thread */
-    while (!atomic_load(&j->stop)) {
-        int64_t i = atomic_fetch_add(&j->next, 1);
-        if (i >= j->chunks)
-            break;
-        obs_status st = decode_nth(j, i, &d, err);
-        if (st != OBS_OK) {
-            pthread_mutex_lock(&j->lock);
-            if (i < j->failed) {
-                j->failed = i;
-                j->st = st;
-                memcpy(j->err, err, sizeof err);
-            }
-            pthread_mutex_unlock(&j->lock);
-            atomic_store(&j->stop, 1);
-            break;
-        }
+}
+
+/* One chunk; a failure stops handing out more. */
+static int decode_one(void *ctx, void *local, size_t i, size_t i1)
+{
+    (void)i1; /* ranges of one chunk */
+    decode_local *l = local;
+    obs_status st = decode_nth(ctx, (int64_t)i, &l->d, l->err);
+    if (st == OBS_OK)
+        return 0;
+    l->failed = (int64_t)i;
+    l->st = st;
+    return 1;
+}
+
+/* Under the pool's lock: the lowest failing chunk's error wins. */
+static void decode_end(void *ctx, void *local)
+{
+    part_job *j = ctx;
+    decode_local *l = local;
+    if (l->st != OBS_OK && l->failed < j->failed) {
+        j->failed = l->failed;
+        j->st = l->st;
+        memcpy(j->err, l->err, sizeof l->err);
     }
-    if (d.started)
-        exr_decoding_destroy(j->ctx, &d.dec);
-    free(d.scratch);
-    return NULL;
+    if (l->d.started)
+        exr_decoding_destroy(j->ctx, &l->d.dec);
+    free(l->d.scratch);
 }
 
 /* Decode threads for a part of `chunks` chunks: the configured count
- * (0 = CPUs online, up to 8), but no more than one for every 4 chunks. */
+ * (0 = CPUs online; pool.h), but no more than one for every 4 chunks. */
 static int decode_threads(const obs_limits *lim, int64_t chunks)
 {
-    long n = lim && lim->threads > 0 ? lim->threads : 0;
-    if (n <= 0) {
-        n = sysconf(_SC_NPROCESSORS_ONLN);
-        n = n < 1 ? 1 : n > 8 ? 8 : n;
-    }
-    if (n > OBS_MAX_DECODE_THREADS)
-        n = OBS_MAX_DECODE_THREADS;
+    int n = obs__pool_threads(lim ? lim->threads : 0);
     if (n > chunks / 4)
-        n = (long)(chunks / 4);
-    return n < 1 ? 1 : (int)n;
+        n = (int)(chunks / 4);
+    return n < 1 ? 1 : n;
 }
 
 /* Decodes level 0 of a part into the targets. */
@@ -395,8 +397,6 @@ static obs_status decode_part(exr_const_context_t ctx, int part, const part_geom
                               char err[OBS_ERR_LEN])
 {
     part_job j = {.ctx = ctx, .part = part, .g = g, .t = t, .nt = nt, .st = OBS_OK};
-    pthread_t tid[OBS_MAX_DECODE_THREADS];
-    int started = 0;
     exr_result_t rv;
 
     if (!g->tiled) {
@@ -413,19 +413,11 @@ static obs_status decode_part(exr_const_context_t ctx, int part, const part_geom
         j.chunks = j.ntx * (((int64_t)g->height + j.th - 1) / j.th);
     }
     j.failed = j.chunks;
-    atomic_init(&j.next, 0);
-    atomic_init(&j.stop, 0);
-    if (pthread_mutex_init(&j.lock, NULL) != 0)
-        return obs__fail(err, OBS_NO_MEMORY, "decode lock");
-
-    /* This thread decodes too; threads that fail to start are not needed. */
-    int threads = decode_threads(lim, j.chunks);
-    while (started < threads - 1 && pthread_create(&tid[started], NULL, decode_worker, &j) == 0)
-        started++;
-    decode_worker(&j);
-    for (int i = 0; i < started; i++)
-        pthread_join(tid[i], NULL);
-    pthread_mutex_destroy(&j.lock);
+    obs__pool_for f = {.end = (size_t)j.chunks, .chunk = 1, .threads = decode_threads(lim, j.chunks),
+                       .range = decode_one, .ctx = &j, .local_size = sizeof(decode_local),
+                       .begin = decode_begin, .end_thread = decode_end};
+    if (obs__pool_run(&f, NULL) < 0)
+        return obs__fail(err, OBS_NO_MEMORY, "decode threads");
     if (j.st != OBS_OK)
         memcpy(err, j.err, OBS_ERR_LEN);
     return j.st;

@@ -71,7 +71,7 @@ typedef enum obs_bake_lod_source {
     OBS_BAKE_LOD_SOURCE_LIST(OBS__BAKE_ENUM)
 } obs_bake_lod_source;
 /* Which nodes are decorators (parameter `decorator_source`, section 2.2;
- * core/bake/decor.c): from the glTF extras, the node names and the
+ * core/level/decor.c): from the glTF extras, the node names and the
  * --decorators file, from the file alone, or none (all opaque). */
 #define OBS_BAKE_DECOR_LIST(X)                                                 \
     X(OBS_BAKE_DECOR_AUTO, auto) /* file, then extras, then names */        \
@@ -324,7 +324,7 @@ typedef struct obs_bake_scene {
     size_t node_count;
     size_t instance_count;  /* (node, mesh) pairs */
     size_t world_triangles; /* triangles with instances flattened */
-    /* The file's own LODs (a .glb's MSFT_lod, core/bake/lod_file.c):
+    /* The file's own LODs (a .glb's MSFT_lod, core/level/lod_file.c):
      * level l of mesh m is file_lods[(l - 1) * mesh_count + m], with no
      * triangles where the file has none; file_lod_error the reason they
      * could not be read (the bake refuses --lods then), else NULL. */
@@ -424,7 +424,7 @@ typedef struct obs_bake_stats {
     size_t lod_traced_samples[OBS_BAKE_MAX_LODS];
     /* the lod stage's parts: simplify, resample, fit, check */
     double lod_seconds[4];
-    /* Decorators (section 2.2, core/bake/decor.c): nodes per class, none,
+    /* Decorators (section 2.2, core/level/decor.c): nodes per class, none,
      * shrub, tree, small; and the classification's warning (entries of
      * the decorators file that match no node), "" when none. */
     size_t decorator_nodes[4];
@@ -512,7 +512,7 @@ obs_status obs_bake_decorators_check(const char *text, size_t *rules, char err[O
 
 /* ---- what the bake's rays meet, for the per-pixel reference ------------ */
 
-/* The level's occluders as the bake's rays see them (core/bake/occl.c):
+/* The level's occluders as the bake's rays see them (core/level/occl.c):
  * the opaque triangles, the shrubs' fog boxes and the trees'
  * semi-transparent triangles (section 2.1), from the decorators of s
  * (params: decorator_source, shrub_density, tree_attenuation;

@@ -282,7 +282,7 @@ void obs_dyn_result_free(obs_dyn_result *r);
  * are built, or desc->regions, and the points flagged, by every shard):
  * the contiguous range [index n / count, (index + 1) n / count) of the n
  * valid points, each with the directions it gets there, written to
- * `path` as a part (core/bake/dyn_shard.c has the layout).  st (may be
+ * `path` as a part (core/dynamic/dyn_shard.c has the layout).  st (may be
  * NULL) gets the counts of the shard's points and the trace's time. */
 obs_status obs_dyn_bake_shard(const obs_bake_scene *scene, const obs_dyn_desc *desc, int index,
                               int count, const char *path, obs_dyn_stats *st,

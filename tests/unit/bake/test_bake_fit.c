@@ -1,5 +1,5 @@
 /* The least-squares vertex fit (core/bake/fit.c) and the weld (weld.c). */
-#include "bake/bake_testutil.h"
+#include "level/bake_testutil.h"
 #include "bake/bake_internal.h"
 
 /* A pair of triangles (a, b, c), (b, a, d) in one plane: the regulariser's

@@ -4,8 +4,8 @@
  * reconstruction of a constant and a linear field is exact; a tree under
  * an overhang gets a darker global term than one in the open, its local
  * AO baked once for both instances. */
-#include "bake/bake_testutil.h"
-#include "bake/dyn_internal.h"
+#include "level/bake_testutil.h"
+#include "dynamic/dyn_internal.h"
 #include "bake/instanced.h"
 
 static double urand(unsigned *s)
@@ -168,7 +168,7 @@ static void test_trilinear_exact(void **state)
         for (int k = 0; k < 4; k++)
             c[k] = a[k] + b[k][0] * p[0] + b[k][1] * p[1] + b[k][2] * p[2];
         assert_int_equal(obs__vol_eval(&v, p, n, ao), 1);
-        assert_true(fabs(ao[0] - obs__dyn_sh_eval(c, n, 2)) < 1e-9);
+        assert_true(fabs(ao[0] - obs__sh_eval(c, n, 2)) < 1e-9);
         assert_true(fabs(ao[1] - 0.6) < 1e-12);
         assert_int_equal(obs__vol_eval(&v, p, NULL, ao), 1); /* band 0 */
         assert_true(fabs(ao[0] - c[0] * y00) < 1e-9);

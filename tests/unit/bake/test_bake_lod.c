@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <unistd.h>
 
-#include "bake/bake_testutil.h"
+#include "level/bake_testutil.h"
 #include "bake/lod.h"
 
 static const float O[3] = {-3, 0.5f, -2}, U[3] = {0, 0.8f, 5}, V[3] = {6, 0.3f, 0};

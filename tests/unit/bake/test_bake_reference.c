@@ -7,9 +7,9 @@
  * The same with decorators: a shrub (fog box) and a tree (semi-transparent
  * card) in the crease, the reference given the bake's occluders
  * (obs_bake_occluders_new, section 2.1). */
-#include "bake/bake_testutil.h"
+#include "level/bake_testutil.h"
 #include "bake/bake_internal.h"
-#include "bake/decor.h"
+#include "level/decor.h"
 #include "obscura/io.h"
 #include "obscura/reference.h"
 #include "obscura/scene.h"

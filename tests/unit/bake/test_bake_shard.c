@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <unistd.h>
 
-#include "bake/bake_testutil.h"
+#include "level/bake_testutil.h"
 #include "bake/shard.h"
 
 static char dir[64];

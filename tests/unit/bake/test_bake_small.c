@@ -4,7 +4,7 @@
  * around it keeps its own fit and is counted. */
 #include <unistd.h>
 
-#include "bake/bake_testutil.h"
+#include "level/bake_testutil.h"
 
 static void bake(const obs_bake_scene *s, const char *source, obs_bake_result *r)
 {

@@ -1,6 +1,6 @@
 /* The obscurance of eq 1 at the samples and at the fitted vertices
  * (core/bake/trace.c, bake.c) against closed forms. */
-#include "bake/bake_testutil.h"
+#include "level/bake_testutil.h"
 #include "bake/bake_internal.h"
 #include "core/obscurance_crease.h"
 

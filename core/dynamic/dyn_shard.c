@@ -1,13 +1,13 @@
 /* bake-dynamic spread over many machines (obscura bake-dynamic --shard
  * I/N, --merge).  The expensive step is the spherical obscurance of the
- * regions' valid points (probes.c); every shard builds the same regions
+ * regions' valid points (dyn_probes.c); every shard builds the same regions
  * and flags the same grid points (cheap: 32 rays a point), then traces
  * its contiguous range [i n / count, (i + 1) n / count) of the n valid
  * points, each with the directions of the unsharded bake (keyed by the
  * seed and the point's grid index alone), and writes them as a part.
  * The merge flags the points again, reads every part into them, and fits:
  * the merged model is the unsharded one, byte for byte.  The part file
- * follows the bake's parts (shard.c) and uses its pieces (shard.h).
+ * follows the bake's parts (bake/shard.c) and uses their pieces (level/part.h).
  *
  * A part file, every field little-endian:
  *
@@ -15,7 +15,7 @@
  *     0     8    magic "OBSDYNPT"
  *     8     4    u32 version (1)
  *    12     4    u32 header size in bytes (128)
- *    16     8    u64 level fingerprint (shard.c's, of the flattened level
+ *    16     8    u64 level fingerprint (level/part.c's, of the flattened level
  *                with its decorators folded in: obs__bake_traced_fingerprint)
  *    24     4    u32 shard index I (0 .. N-1)
  *    28     4    u32 shard count N
@@ -48,16 +48,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/dyn_internal.h"
-#include "bake/shard.h"
+#include "dynamic/dyn_internal.h"
+#include "level/part.h"
 #include "internal.h"
 
 #define MAGIC "OBSDYNPT"
 #define VERSION 1u
 #define HEADER 128u
 #define POINT_BYTES (8u * OBS_DYN_CHANNELS)
-
-static double now(void) { return obs__now_ms() * 1e-3; }
 
 obs_dyn_level obs__dyn_level_of(const obs__bake_world *w)
 {
@@ -97,16 +95,8 @@ uint64_t obs__dyn_points_fingerprint(const obs_dyn_regions *rg, const obs__dyn_p
 
 static void header_bytes(const obs__dyn_part *h, unsigned char b[HEADER])
 {
-    memset(b, 0, HEADER);
-    memcpy(b, MAGIC, 8);
-    obs__le_put32(b + 8, VERSION);
-    obs__le_put32(b + 12, HEADER);
-    obs__le_put64(b + 16, h->level);
-    obs__le_put32(b + 24, h->index);
-    obs__le_put32(b + 28, h->count);
-    obs__le_put64(b + 32, h->total);
-    obs__le_put64(b + 40, h->first);
-    obs__le_put64(b + 48, h->n);
+    obs__part_range r = {VERSION, h->index, h->count, h->level, h->total, h->first, h->n};
+    obs__part_range_put(b, HEADER, MAGIC, &r);
     obs__le_put64(b + 56, h->points);
     obs__le_put32(b + 64, (uint32_t)h->rays);
     obs__le_put32(b + 68, (uint32_t)h->seed);
@@ -146,11 +136,11 @@ static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
     h.n = obs__bake_shard_first(pt->count, sh->index + 1, sh->count) - h.first;
     for (int k = 0; k < OBS_DYN_STAGE_trace; k++)
         h.prep_seconds += st->seconds[k];
-    double t = now();
+    double t = obs__bake_now();
     pt->rays = 0;
     obs__dyn_points_trace(bvh, p, pt, (size_t)h.first, (size_t)(h.first + h.n), sh->progress,
                           sh->progress_user);
-    h.trace_seconds = now() - t;
+    h.trace_seconds = obs__bake_now() - t;
     size_t n = (size_t)h.n, first = (size_t)h.first, dropped = 0;
     unsigned char *payload = malloc(n * (POINT_BYTES + 1) + 1);
     if (!payload)
@@ -184,27 +174,21 @@ static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
 
 /* ---- reading parts ------------------------------------------------------- */
 
+static const obs__part_format format = {MAGIC, "bake-dynamic part",
+                                       "obscura bake-dynamic --shard I/N", "bake-dynamic part",
+                                       "points", VERSION, HEADER, (uint64_t)1 << 40,
+                                       POINT_BYTES + 1};
+
 obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char err[OBS_ERR_LEN])
 {
-    memset(h, 0, sizeof *h);
-    h->path = path;
     unsigned char b[HEADER];
-    uint64_t size;
-    obs_status rc = obs__bake_part_head(path, MAGIC, "bake-dynamic part",
-                                        "obscura bake-dynamic --shard I/N", b, HEADER, &size, err);
+    obs__part_range r = {0};
+    /* total at most 2^40: a size the payload's bytes cannot overflow */
+    obs_status rc = obs__part_range_read(path, &format, b, &r, err);
+    *h = (obs__dyn_part){.path = path, .version = r.version, .index = r.index, .count = r.count,
+                         .level = r.level, .total = r.total, .first = r.first, .n = r.n};
     if (rc != OBS_OK)
         return rc;
-    h->version = obs__le_get32(b + 8);
-    if (h->version != VERSION || obs__le_get32(b + 12) != HEADER)
-        return obs__fail(err, OBS_UNSUPPORTED, "%s: bake-dynamic part version %u (header %u "
-                         "bytes); this obscura reads version %u", path, h->version,
-                         obs__le_get32(b + 12), VERSION);
-    h->level = obs__le_get64(b + 16);
-    h->index = obs__le_get32(b + 24);
-    h->count = obs__le_get32(b + 28);
-    h->total = obs__le_get64(b + 32);
-    h->first = obs__le_get64(b + 40);
-    h->n = obs__le_get64(b + 48);
     h->points = obs__le_get64(b + 56);
     h->rays = (int32_t)obs__le_get32(b + 64);
     h->seed = (int32_t)obs__le_get32(b + 68);
@@ -218,21 +202,6 @@ obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char er
     h->prep_seconds = obs__le_bitsd(obs__le_get64(b + 104));
     h->trace_seconds = obs__le_bitsd(obs__le_get64(b + 112));
     h->checksum = obs__le_get64(b + 120);
-    /* total at most 2^40: a size the payload's bytes cannot overflow */
-    if (h->count == 0 || h->index >= h->count || h->count > (uint32_t)INT32_MAX ||
-        h->total > ((uint64_t)1 << 40) ||
-        h->first != obs__bake_shard_first((size_t)h->total, (int)h->index, (int)h->count) ||
-        h->first + h->n != obs__bake_shard_first((size_t)h->total, (int)h->index + 1, (int)h->count))
-        return obs__fail(err, OBS_BAD_FILE, "%s: damaged header: shard %u/%u of %llu points "
-                         "cannot hold points %llu .. %llu", path, h->index, h->count,
-                         (unsigned long long)h->total, (unsigned long long)h->first,
-                         (unsigned long long)(h->first + h->n));
-    uint64_t want = HEADER + (POINT_BYTES + 1) * h->n;
-    if (size != UINT64_MAX && size != want)
-        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %llu bytes, its header promises %llu (%llu "
-                         "points)", path, size < want ? "truncated" : "longer than a part",
-                         (unsigned long long)size, (unsigned long long)want,
-                         (unsigned long long)h->n);
     return OBS_OK;
 }
 
@@ -271,7 +240,7 @@ static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
                          "regions; this level, these regions and parameters make %zu of %zu "
                          "(or other ones): give the merge the shards' --regions", p0->path,
                          (unsigned long long)p0->total, p0->regions, pt->count, rg->count);
-    double t = now();
+    double t = obs__bake_now();
     pt->rays = 0;
     for (int i = 0; i < sh->count; i++) {
         obs_status rc = read_payload(&sh->parts[i], pt, err);
@@ -281,7 +250,7 @@ static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
         /* the parts' times, summed: the farm's machine time */
         st->seconds[OBS_DYN_STAGE_trace] += sh->parts[i].trace_seconds;
     }
-    st->seconds[OBS_DYN_STAGE_trace] += now() - t;
+    st->seconds[OBS_DYN_STAGE_trace] += obs__bake_now() - t;
     return OBS_OK;
 }
 

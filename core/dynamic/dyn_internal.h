@@ -1,35 +1,16 @@
-/* What the steps of the dynamic-object bake hand each other (core/bake/,
- * obscura/dynamic.h). */
+/* What the steps of the dynamic-object bake hand each other
+ * (core/dynamic/, obscura/dynamic.h); the level and its rays are
+ * core/level's (level.h). */
 #ifndef OBSCURA_DYN_INTERNAL_H
 #define OBSCURA_DYN_INTERNAL_H
 
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/bake_internal.h"
+#include "level/level.h"
 #include "obscura/dynamic.h"
 
-/* ---- sh.c: real spherical harmonics, bands 0..2 ------------------------ */
-
-/* The 9 basis functions Y_k at the unit direction d, k = l (l + 1) + m. */
-void obs__dyn_sh_basis(const float d[3], double y[OBS_DYN_SH]);
-/* The zonal coefficients of the clamped cosine max(0, cos) per band:
- * pi, 2 pi / 3, pi / 4 (Ramamoorthi and Hanrahan 2001). */
-extern const double obs__dyn_sh_cosine[3];
-/* f's coefficients from a quadrature: f_k = sum_i w_i f(d_i) Y_k(d_i)
- * (n directions d, 3 each). */
-void obs__dyn_sh_project(const float *dirs, const double *w, const double *f, size_t n,
-                         double out[OBS_DYN_SH]);
-/* In place: f_k -> A_l f_k / pi, so that the eq 1 AO for the normal n is
- * sum_k out_k Y_k(n). */
-void obs__dyn_sh_convolve(double c[OBS_DYN_SH]);
-/* sum_k c_k Y_k(n) over bands 0..order. */
-double obs__dyn_sh_eval(const double c[OBS_DYN_SH], const float n[3], int order);
-/* n directions over the sphere, equal area and stratified (a Fibonacci
- * spiral) turned by a random rotation from r; each has weight 4 pi / n. */
-void obs__dyn_sphere_dirs(int n, uint64_t seed, uint64_t stream, float *dirs);
-
-/* ---- regions.c ---------------------------------------------------------- */
+/* ---- dyn_regions.c ---------------------------------------------------------- */
 
 /* Face adjacency of boxes: pairs whose boxes touch on a face with
  * positive area (tolerance: tol times the larger box's size). */
@@ -37,12 +18,12 @@ obs_status obs__dyn_adjacency(obs_dyn_regions *r, char err[OBS_ERR_LEN]);
 /* Shared face of boxes a and b: its area, its centre in b. 0 when they
  * share none. */
 double obs__dyn_shared_face(const obs_dyn_box *a, const obs_dyn_box *b, float centre[3]);
-/* Regions by adaptive subdivision of the level's box (regions.c). */
+/* Regions by adaptive subdivision of the level's box (dyn_regions.c). */
 obs_status obs__dyn_regions_build(const obs__bake_world *w, const obs__bake_bvh *bvh,
                                   const obs_dyn_params *p, obs_dyn_regions *out,
                                   char err[OBS_ERR_LEN]);
 
-/* ---- probes.c ----------------------------------------------------------- */
+/* ---- dyn_probes.c ----------------------------------------------------------- */
 
 /* Inside-geometry test of one point: the fraction of `rays` directions
  * (a fixed spiral) that meet a one-sided face from behind, > limit. */
@@ -83,12 +64,6 @@ obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *b
                                 void (*progress)(void *, size_t, size_t), void *user,
                                 char err[OBS_ERR_LEN]);
 void obs__dyn_points_free(obs__dyn_points *pt);
-
-/* One point's 18 channels (projected, convolved) from p->rays
- * directions keyed by (seed, stream); *dropped when its rays met back
- * faces more often than the limit.  0 when out of memory. */
-int obs__dyn_point_sh(const obs__bake_bvh *bvh, const float o[3], const obs_dyn_params *p,
-                      uint64_t stream, double sh[OBS_DYN_CHANNELS], int *dropped);
 
 /* Eq 1 at point o for the unit normal n by `rays` cosine-weighted rays
  * (the bake's estimator): ao[0] short, ao[1] long. */

@@ -1,4 +1,4 @@
-/* What the rays of eq 1 meet (core/bake/occl.c): the opaque BVH of the
+/* What the rays of eq 1 meet (core/level/occl.c): the opaque BVH of the
  * level's non-decorator triangles, and a second BVH of the shrubs' world
  * boxes (fog) and the trees' triangles (semi-transparent), section 2.1 of
  * the paper.  The bake's trace (trace.c) and the per-pixel reference's
@@ -10,8 +10,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bake/bake_internal.h"
-#include "bake/decor.h"
+#include "level/level.h"
+#include "level/decor.h"
 
 typedef struct obs__bake_occl {
     RTCDevice dev;
@@ -67,5 +67,23 @@ const obs__bake_occl *obs__bake_occluders_occl(const obs_bake_occluders *o);
  * density[i] *= V_i / (V_i + O_i), O_i the summed volume of box i's
  * intersections with the other boxes. */
 void obs__bake_fog_overlap(const float *box, size_t n, float *density);
+
+/* Lane l of an 8-ray packet: origin o, unit direction d, [0, tfar], no
+ * hit yet (the bake's samples, the points' rays, the reference's
+ * obscurance fill their packets alike). */
+static inline void obs__bake_ray8_lane(struct RTCRayHit8 *rh, int l, const float o[3],
+                                       const float d[3], float tfar)
+{
+    rh->ray.org_x[l] = o[0], rh->ray.org_y[l] = o[1], rh->ray.org_z[l] = o[2];
+    rh->ray.dir_x[l] = d[0], rh->ray.dir_y[l] = d[1], rh->ray.dir_z[l] = d[2];
+    rh->ray.tnear[l] = 0.0f;
+    rh->ray.tfar[l] = tfar;
+    rh->ray.time[l] = 0.0f;
+    rh->ray.mask[l] = 0xffffffffu;
+    rh->ray.id[l] = 0;
+    rh->ray.flags[l] = 0;
+    rh->hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+}
 
 #endif

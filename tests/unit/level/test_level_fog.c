@@ -2,8 +2,8 @@
  * the paper; core/bake/occl.c, trace.c): a plane under a fog slab and
  * under semi-transparent layers against their closed forms, the overlap
  * pre-pass, and decorator geometry kept out of the opaque BVH. */
-#include "bake/bake_testutil.h"
-#include "bake/occl.h"
+#include "level/bake_testutil.h"
+#include "level/occl.h"
 
 /* A scene of two nodes: "ground" holding the plane, and a child named
  * name holding the other meshes (its class from its name). */

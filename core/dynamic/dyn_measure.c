@@ -22,9 +22,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/decor.h"
-#include "bake/dyn_internal.h"
-#include "bake/rng.h"
+#include "level/decor.h"
+#include "dynamic/dyn_internal.h"
+#include "level/rng.h"
 #include "internal.h"
 
 #define PI_D 3.14159265358979323846
@@ -129,11 +129,11 @@ obs_status obs_dyn_measure_paths(const obs_bake_scene *scene, const obs_dyn_resu
                 /* the point's own SH (no eq 4): what the projection alone loses */
                 double sh[OBS_DYN_CHANNELS];
                 int dropped;
-                if (obs__dyn_point_sh(bvh, q, &p, ((uint64_t)path * 2 + ni) * 65536 + (uint64_t)k,
+                if (obs__point_sh(bvh, q, &p, ((uint64_t)path * 2 + ni) * 65536 + (uint64_t)k,
                                       sh, &dropped)) {
-                    double v = p.blend * fmin(fmax(obs__dyn_sh_eval(sh, nr[ni], 2), 0.0), 1.0) +
+                    double v = p.blend * fmin(fmax(obs__sh_eval(sh, nr[ni], 2), 0.0), 1.0) +
                                (1.0 - p.blend) *
-                                   fmin(fmax(obs__dyn_sh_eval(sh + OBS_DYN_SH, nr[ni], 2), 0.0), 1.0);
+                                   fmin(fmax(obs__sh_eval(sh + OBS_DYN_SH, nr[ni], 2), 0.0), 1.0);
                     se[2] += (v - truth) * (v - truth);
                 }
                 nval++;

@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/decor.h"
+#include "level/decor.h"
 #include "internal.h"
 
 #define CLASS_WORDS "none|shrub|tree|small (or opaque, bush, fruit_bush, hedge, fruit_tree, " \
@@ -50,6 +50,19 @@ const char *obs__bake_decor_class_name(int c)
 {
     static const char *const n[] = {"none", "shrub", "tree", "small"};
     return c >= 0 && c < 4 ? n[c] : "?";
+}
+
+obs_status obs__bake_decor_classify_warn(const obs_bake_scene *s, const obs_bake_params *p,
+                                         const char *decorators_json, obs__bake_decor *out,
+                                         char warning[OBS_ERR_LEN], char err[OBS_ERR_LEN])
+{
+    warning[0] = 0;
+    obs_status rc = obs__bake_decor_classify(s, p, decorators_json, out, err);
+    if (rc != OBS_OK)
+        return rc;
+    snprintf(warning, OBS_ERR_LEN, "%s", err);
+    err[0] = 0;
+    return OBS_OK;
 }
 
 void obs__bake_decor_free(obs__bake_decor *d)

@@ -7,7 +7,7 @@
  * the same parameter rows, the same --decorators file), shrubs become
  * fog boxes and trees semi-transparent triangles of the second BVH, small
  * decorators occlude nothing.  Per use:
- *   - a valid point's spherical obscurance (probes.c, obs__dyn_point_sh)
+ *   - a valid point's spherical obscurance (dyn_probes.c, obs__point_sh)
  *     and the probe paths' eq 1 reference (obs__dyn_trace_eq1): rho
  *     times each ray's transmittance, the quantity of the static bake's
  *     surface samples, so that obscura gbuffer --dynamic combines like
@@ -23,9 +23,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/decor.h"
-#include "bake/dyn_internal.h"
-#include "bake/shard.h"
+#include "level/decor.h"
+#include "dynamic/dyn_internal.h"
+#include "level/part.h"
 #include "internal.h"
 
 static const char *const stage_names[] = {
@@ -38,8 +38,6 @@ const char *obs_dyn_stage_name(int stage)
 {
     return stage >= 0 && stage < OBS_DYN_STAGE_COUNT ? stage_names[stage] : "?";
 }
-
-static double now(void) { return obs__now_ms() * 1e-3; }
 
 void obs_dyn_result_free(obs_dyn_result *r)
 {
@@ -74,12 +72,9 @@ obs_status obs__dyn_occluders(const obs_bake_scene *scene, const obs__bake_world
     obs_bake_params bp;
     decor_params(p, &bp);
     *bvh = NULL;
-    warning[0] = 0;
-    obs_status rc = obs__bake_decor_classify(scene, &bp, decorators_json, dc, err);
+    obs_status rc = obs__bake_decor_classify_warn(scene, &bp, decorators_json, dc, warning, err);
     if (rc != OBS_OK)
         return rc;
-    snprintf(warning, OBS_ERR_LEN, "%s", err);
-    err[0] = 0;
     return obs__bake_bvh_new_decor(w, dc, p->tree_attenuation, bvh, err);
 }
 
@@ -106,22 +101,17 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     const obs_dyn_regions *rg = desc ? desc->regions : NULL;
     obs__dyn_points pt = {0};
     obs_status rc;
-    if (!scene || scene->node_count == 0)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "bake-dynamic: no scene");
-    if (scene->world_triangles > (size_t)p.max_triangles)
-        return obs__fail(err, OBS_TOO_LARGE, "%zu triangles once flattened; max_triangles is %d",
-                         scene->world_triangles, p.max_triangles);
-    double t = now();
-    if ((rc = obs__bake_flatten(scene, &w, err)) != OBS_OK)
+    double t = obs__bake_now();
+    if ((rc = obs__bake_flatten_checked(scene, p.max_triangles, "bake-dynamic", &w, err)) != OBS_OK)
         goto done;
-    st->seconds[OBS_DYN_STAGE_flatten] = now() - t;
-    t = now();
+    st->seconds[OBS_DYN_STAGE_flatten] = obs__bake_now() - t;
+    t = obs__bake_now();
     if ((rc = obs__dyn_occluders(scene, &w, &p, desc ? desc->decorators_json : NULL, &dc, &bvh,
                                  st->decorator_warning, err)) != OBS_OK)
         goto done;
     memcpy(st->decorator_nodes, dc.counts, sizeof dc.counts);
-    st->seconds[OBS_DYN_STAGE_bvh] = now() - t;
-    t = now();
+    st->seconds[OBS_DYN_STAGE_bvh] = obs__bake_now() - t;
+    t = obs__bake_now();
     if (!rg) {
         if ((rc = obs__dyn_regions_build(&w, bvh, &p, &own, err)) != OBS_OK)
             goto done;
@@ -129,12 +119,12 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     }
     st->regions = rg->count;
     st->edges = rg->edge_count;
-    st->seconds[OBS_DYN_STAGE_regions] = now() - t;
-    t = now();
+    st->seconds[OBS_DYN_STAGE_regions] = obs__bake_now() - t;
+    t = obs__bake_now();
     if ((rc = obs__dyn_points_flag(bvh, rg, &p, &pt, err)) != OBS_OK)
         goto done;
-    st->seconds[OBS_DYN_STAGE_valid] = now() - t;
-    t = now();
+    st->seconds[OBS_DYN_STAGE_valid] = obs__bake_now() - t;
+    t = obs__bake_now();
     if (sh) {
         if ((rc = obs__dyn_shard_step(sh, obs__bake_traced_fingerprint(&w, &dc, p.tree_attenuation),
                                       rg, &p, bvh, &pt, st, err)) != OBS_OK || sh->stop)
@@ -142,7 +132,7 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     } else {
         obs__dyn_points_trace(bvh, &p, &pt, 0, pt.count, desc ? desc->progress : NULL,
                               desc ? desc->progress_user : NULL);
-        st->seconds[OBS_DYN_STAGE_trace] = now() - t;
+        st->seconds[OBS_DYN_STAGE_trace] = obs__bake_now() - t;
     }
     if ((rc = obs__dyn_points_compact(&pt, err)) != OBS_OK)
         goto done;
@@ -152,10 +142,10 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     st->points_backface = pt.backface;
     st->points_valid = pt.count;
     st->rays = pt.rays;
-    t = now();
+    t = obs__bake_now();
     if ((rc = obs__dyn_fit_all(&pt, rg, &p, out, err)) != OBS_OK)
         goto done;
-    st->seconds[OBS_DYN_STAGE_fit] = now() - t;
+    st->seconds[OBS_DYN_STAGE_fit] = obs__bake_now() - t;
     out->model.level = out->original.level = obs__dyn_level_of(&w);
 done:
     obs__dyn_points_free(&pt);

@@ -1,6 +1,6 @@
 /* Decorator objects (section 2.2 of "Baked ambient obscurance on the
  * vertices of game levels"): which nodes of a level are decorators and of
- * which class (core/bake/decor.c).  The bake traces them differently:
+ * which class (core/level/decor.c).  The bake traces them differently:
  * shrubs as fog boxes and trees as semi-transparent triangles in a second
  * BVH (section 2.1), small decorators get one scalar each (2.2.1). */
 #ifndef OBSCURA_BAKE_DECOR_H
@@ -35,6 +35,11 @@ typedef struct obs__bake_decor {
 obs_status obs__bake_decor_classify(const obs_bake_scene *s, const obs_bake_params *p,
                                     const char *decorators_json, obs__bake_decor *out,
                                     char err[OBS_ERR_LEN]);
+/* The same with the warning moved out of err into warning ("" when none):
+ * both bakes' decorator step. */
+obs_status obs__bake_decor_classify_warn(const obs_bake_scene *s, const obs_bake_params *p,
+                                         const char *decorators_json, obs__bake_decor *out,
+                                         char warning[OBS_ERR_LEN], char err[OBS_ERR_LEN]);
 void obs__bake_decor_free(obs__bake_decor *d);
 
 /* The class named by a word: none|opaque, shrub|bush|hedge, tree|tree_line,

@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/occl.h"
+#include "level/occl.h"
 #include "internal.h"
 
 /* The ray context the callbacks see: Embree's, then the sums, one per

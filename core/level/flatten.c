@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/bake_internal.h"
+#include "level/level.h"
 #include "internal.h"
 
 void obs__bake_world_free(obs__bake_world *w)
@@ -167,4 +167,15 @@ obs_status obs__bake_flatten(const obs_bake_scene *s, obs__bake_world *w, char e
         return obs__fail(err, OBS_BAD_FILE, "all %zu triangles are degenerate (zero area)", n);
     }
     return OBS_OK;
+}
+
+obs_status obs__bake_flatten_checked(const obs_bake_scene *scene, int max_triangles,
+                                     const char *who, obs__bake_world *w, char err[OBS_ERR_LEN])
+{
+    if (!scene || scene->node_count == 0)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no scene", who);
+    if (scene->world_triangles > (size_t)max_triangles)
+        return obs__fail(err, OBS_TOO_LARGE, "%zu triangles once flattened; max_triangles is %d",
+                         scene->world_triangles, max_triangles);
+    return obs__bake_flatten(scene, w, err);
 }

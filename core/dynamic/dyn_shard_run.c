@@ -4,8 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/dyn_internal.h"
-#include "bake/shard.h"
+#include "dynamic/dyn_internal.h"
+#include "level/part.h"
 #include "internal.h"
 
 obs_status obs_dyn_bake_shard(const obs_bake_scene *scene, const obs_dyn_desc *desc, int index,
@@ -71,6 +71,18 @@ static obs_status adopt(obs_dyn_params *p, const obs__dyn_part *parts, size_t n,
     return OBS_OK;
 }
 
+/* A part's header and its key among the parts (level/part.h). */
+static obs_status read_header(const char *path, void *h, char err[OBS_ERR_LEN])
+{
+    return obs__dyn_part_read_header(path, h, err);
+}
+
+static obs__bake_part_key key_of(const void *p)
+{
+    const obs__dyn_part *h = p;
+    return (obs__bake_part_key){h->path, h->index, h->count, h->level};
+}
+
 obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
                               const char *const *paths, size_t n, obs_dyn_result *out,
                               char err[OBS_ERR_LEN])
@@ -78,21 +90,10 @@ obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
     memset(out, 0, sizeof *out);
     if (n == 0 || !paths)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "merge: no parts");
-    obs__dyn_part *heads = calloc(n, sizeof *heads), *ordered = NULL;
-    obs__bake_part_key *keys = calloc(n, sizeof *keys);
-    size_t *order = NULL;
-    obs_status rc = heads && keys ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
-    for (size_t i = 0; rc == OBS_OK && i < n; i++) {
-        rc = obs__dyn_part_read_header(paths[i], &heads[i], err);
-        keys[i] = (obs__bake_part_key){heads[i].path, heads[i].index, heads[i].count, heads[i].level};
-    }
-    if (rc == OBS_OK && (!(ordered = calloc(heads[0].count, sizeof *ordered)) ||
-                         !(order = calloc(heads[0].count, sizeof *order))))
-        rc = obs__fail(err, OBS_NO_MEMORY, "%u parts", heads[0].count);
-    if (rc == OBS_OK)
-        rc = obs__bake_parts_order(keys, n, order, err);
-    for (size_t k = 0; rc == OBS_OK && k < n; k++)
-        ordered[k] = heads[order[k]];
+    void *parts = NULL;
+    obs_status rc = obs__bake_parts_read(paths, n, sizeof(obs__dyn_part), read_header, key_of,
+                                         &parts, err);
+    obs__dyn_part *ordered = parts;
     obs_dyn_desc d = desc ? *desc : (obs_dyn_desc){0};
     if (rc == OBS_OK)
         rc = adopt(&d.params, ordered, n, err);
@@ -102,9 +103,6 @@ obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
         if (desc)
             desc->params = d.params;
     }
-    free(order);
     free(ordered);
-    free(keys);
-    free(heads);
     return rc;
 }

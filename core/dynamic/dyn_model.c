@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/dyn_internal.h"
+#include "dynamic/dyn_internal.h"
 #include "internal.h"
 
 #define FORMAT_NAME "obscura-dynamic-ao"
@@ -78,8 +78,8 @@ void obs_dyn_eval_fit(const obs_dyn_fit *f, const float p[3], const float n[3],
     float u[3] = {0.0f, 1.0f, 0.0f};
     if (len > 0.0f)
         u[0] = n[0] / len, u[1] = n[1] / len, u[2] = n[2] / len;
-    ao[0] = clamp01(obs__dyn_sh_eval(ch, u, (int)order));
-    ao[1] = clamp01(obs__dyn_sh_eval(ch + OBS_DYN_SH, u, (int)order));
+    ao[0] = clamp01(obs__sh_eval(ch, u, (int)order));
+    ao[1] = clamp01(obs__sh_eval(ch + OBS_DYN_SH, u, (int)order));
     ao[2] = 0.0f; /* blended by the caller, who knows the model's blend */
 }
 

@@ -17,7 +17,7 @@
  *     back-face rule, section 2.1): those boxes are wholly inside (under
  *     the terrain, inside a building's closed shell);
  *   - the boxes that hold geometry stay: their grid points inside
- *     geometry are not valid (probes.c), so no region's samples lie in
+ *     geometry are not valid (dyn_probes.c), so no region's samples lie in
  *     solid geometry;
  *   - adjacency: boxes that share a face of positive area.
  * The boxes of a subdivision never overlap. */
@@ -28,7 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/dyn_internal.h"
+#include "dynamic/dyn_internal.h"
 #include "internal.h"
 
 void obs_dyn_regions_free(obs_dyn_regions *r)

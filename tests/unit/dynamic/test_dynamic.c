@@ -4,9 +4,9 @@
  * the regularisation, absorption, the region file's errors, the model
  * file and the blender, and the decorators (a tree layer above a point
  * attenuates its spherical obscurance, is not solid). */
-#include "bake/bake_testutil.h"
-#include "bake/decor.h"
-#include "bake/dyn_internal.h"
+#include "level/bake_testutil.h"
+#include "level/decor.h"
+#include "dynamic/dyn_internal.h"
 
 #define PI 3.14159265358979323846
 
@@ -66,42 +66,42 @@ static void test_sh_constant_linear_exact(void **state)
     for (size_t i = 0; i < n; i++)
         f[i] = a + b[0] * d[3 * i] + b[1] * d[3 * i + 1] + b[2] * d[3 * i + 2];
     double c[OBS_DYN_SH];
-    obs__dyn_sh_project(d, w, f, n, c);
+    obs__sh_project(d, w, f, n, c);
     for (int k = 4; k < OBS_DYN_SH; k++)
         assert_true(fabs(c[k]) < 1e-6); /* nothing in band 2 (float directions) */
-    obs__dyn_sh_convolve(c);
+    obs__sh_convolve(c);
     const float ns[4][3] = {{0, 0, 1}, {0.6f, 0.8f, 0}, {-1, 0, 0}, {0.48f, -0.6f, 0.64f}};
     for (int k = 0; k < 4; k++) {
         double want = a + 2.0 / 3.0 * (b[0] * ns[k][0] + b[1] * ns[k][1] + b[2] * ns[k][2]);
-        assert_true(fabs(obs__dyn_sh_eval(c, ns[k], 1) - want) < 1e-6);
-        assert_true(fabs(obs__dyn_sh_eval(c, ns[k], 2) - want) < 1e-6);
+        assert_true(fabs(obs__sh_eval(c, ns[k], 1) - want) < 1e-6);
+        assert_true(fabs(obs__sh_eval(c, ns[k], 2) - want) < 1e-6);
     }
     /* The ray directions: equal weights 4 pi / n give a constant exactly,
      * a linear function to the spiral's stratification. */
     const int nr = 1024;
     float *rd = malloc(nr * 3 * sizeof *rd);
     double *rw = malloc(nr * sizeof *rw), *rf = malloc(nr * sizeof *rf);
-    obs__dyn_sphere_dirs(nr, 5, 9, rd);
+    obs__sphere_dirs(nr, 5, 9, rd);
     for (int i = 0; i < nr; i++) {
         rw[i] = 4.0 * PI / nr;
         rf[i] = 1.0;
         float len = sqrtf(rd[3 * i] * rd[3 * i] + rd[3 * i + 1] * rd[3 * i + 1] + rd[3 * i + 2] * rd[3 * i + 2]);
         assert_true(fabsf(len - 1.0f) < 1e-5f);
     }
-    obs__dyn_sh_project(rd, rw, rf, nr, c);
-    obs__dyn_sh_convolve(c);
+    obs__sh_project(rd, rw, rf, nr, c);
+    obs__sh_convolve(c);
     for (int k = 0; k < 6; k++) {
-        assert_true(fabs(obs__dyn_sh_eval(c, axes6[k], 0) - 1.0) < 1e-6);
-        assert_true(fabs(obs__dyn_sh_eval(c, axes6[k], 2) - 1.0) < 2e-3);
+        assert_true(fabs(obs__sh_eval(c, axes6[k], 0) - 1.0) < 1e-6);
+        assert_true(fabs(obs__sh_eval(c, axes6[k], 2) - 1.0) < 2e-3);
     }
     for (int i = 0; i < nr; i++)
         rf[i] = a + b[0] * rd[3 * i] + b[1] * rd[3 * i + 1] + b[2] * rd[3 * i + 2];
-    obs__dyn_sh_project(rd, rw, rf, nr, c);
-    obs__dyn_sh_convolve(c);
+    obs__sh_project(rd, rw, rf, nr, c);
+    obs__sh_convolve(c);
     for (int k = 0; k < 6; k++) {
         const float *m = axes6[k];
         double want = a + 2.0 / 3.0 * (b[0] * m[0] + b[1] * m[1] + b[2] * m[2]);
-        assert_true(fabs(obs__dyn_sh_eval(c, m, 2) - want) < 2e-3);
+        assert_true(fabs(obs__sh_eval(c, m, 2) - want) < 2e-3);
     }
     free(rd);
     free(rw);
@@ -176,12 +176,12 @@ static double room_sh(const float q[3], const float n[3], double d)
     double *f = malloc(m * sizeof *f), c[OBS_DYN_SH];
     for (size_t i = 0; i < m; i++)
         f[i] = rho(room_t(q, dirs + 3 * i), d);
-    obs__dyn_sh_project(dirs, w, f, m, c);
-    obs__dyn_sh_convolve(c);
+    obs__sh_project(dirs, w, f, m, c);
+    obs__sh_convolve(c);
     free(f);
     free(dirs);
     free(w);
-    return obs__dyn_sh_eval(c, n, 2);
+    return obs__sh_eval(c, n, 2);
 }
 
 static obs_dyn_regions one_box(float lo, float hi)
@@ -231,7 +231,7 @@ static void test_room_points(void **state)
     for (size_t i = 0; i < pt.count; i += 37)
         for (int a = 0; a < 6; a++)
             for (int c = 0; c < 2; c++) {
-                double got = obs__dyn_sh_eval(pt.sh + OBS_DYN_CHANNELS * i + OBS_DYN_SH * c, axes6[a], 2);
+                double got = obs__sh_eval(pt.sh + OBS_DYN_CHANNELS * i + OBS_DYN_SH * c, axes6[a], 2);
                 double want = room_sh(pt.pos + 3 * i, axes6[a], c ? DL : DS);
                 worst = fmax(worst, fabs(got - want));
                 sum += fabs(got - want);
@@ -696,13 +696,13 @@ static void test_tree_layer_attenuates(void **state)
         const float o[3] = {0, 0, 0}, up[3] = {0, 1, 0}, above[3] = {0, 1.5f, 0};
         double sh[OBS_DYN_CHANNELS];
         int dropped = 1;
-        assert_true(obs__dyn_point_sh(bvh, o, &p, 7, sh, &dropped));
+        assert_true(obs__point_sh(bvh, o, &p, 7, sh, &dropped));
         assert_false(dropped);
         float dist[2] = {p.distance_short, p.distance_long};
         double ref[2];
         obs__dyn_trace_eq1(bvh, o, up, 4096, dist, 1, 0, ref);
         for (int c = 0; c < 2; c++) {
-            sh_up[opaque][c] = obs__dyn_sh_eval(sh + OBS_DYN_SH * c, up, 2);
+            sh_up[opaque][c] = obs__sh_eval(sh + OBS_DYN_SH * c, up, 2);
             eq1_up[opaque][c] = ref[c];
         }
         inside[opaque] = obs__dyn_inside(bvh, above, 32, p.backface_limit);

@@ -3,8 +3,8 @@
  * trees.json as it is), inheritance down the graph, and the errors. */
 #include <cjson/cJSON.h>
 
-#include "bake/bake_testutil.h"
-#include "bake/decor.h"
+#include "level/bake_testutil.h"
+#include "level/decor.h"
 
 #define LEVELS TESTDATA "/levels"
 

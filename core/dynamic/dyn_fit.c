@@ -32,7 +32,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/dyn_internal.h"
+#include "dynamic/dyn_internal.h"
 #include "internal.h"
 
 #define T OBS_DYN_TERMS
@@ -176,7 +176,7 @@ double obs__dyn_fit_centre(const obs__dyn_points *pt, const uint32_t *idx, size_
 
 double obs__dyn_blend_ao(const double *sh, const float n[3], float blend, int order)
 {
-    double s = obs__dyn_sh_eval(sh, n, order), l = obs__dyn_sh_eval(sh + OBS_DYN_SH, n, order);
+    double s = obs__sh_eval(sh, n, order), l = obs__sh_eval(sh + OBS_DYN_SH, n, order);
     return blend * s + (1.0 - blend) * l;
 }
 
@@ -234,8 +234,8 @@ static double energy(const obs_dyn_fit *x, const obs_dyn_fit *x0, const double *
  * (obs_dyn_eval). */
 static double clamped_ao(const double *ch, const float n[3], float blend)
 {
-    double s = fmin(fmax(obs__dyn_sh_eval(ch, n, 2), 0.0), 1.0);
-    double l = fmin(fmax(obs__dyn_sh_eval(ch + OBS_DYN_SH, n, 2), 0.0), 1.0);
+    double s = fmin(fmax(obs__sh_eval(ch, n, 2), 0.0), 1.0);
+    double l = fmin(fmax(obs__sh_eval(ch + OBS_DYN_SH, n, 2), 0.0), 1.0);
     return blend * s + (1.0 - blend) * l;
 }
 

@@ -7,8 +7,8 @@
 #include <stdio.h>
 #include <unistd.h>
 
-#include "bake/bake_testutil.h"
-#include "bake/dyn_internal.h"
+#include "level/bake_testutil.h"
+#include "dynamic/dyn_internal.h"
 
 static char dir[64];
 

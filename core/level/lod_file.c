@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/lod.h"
+#include "level/level.h"
 #include "internal.h"
 #include "io/glb_read.h"
 
@@ -358,6 +358,17 @@ done:
     free(from);
     obs__glb_free(&f);
     return rc;
+}
+
+void obs__bake_mesh_free(obs_bake_mesh *m)
+{
+    if (!m)
+        return;
+    free(m->name);
+    free(m->positions);
+    free(m->normals);
+    free(m->indices);
+    memset(m, 0, sizeof *m);
 }
 
 void obs__bake_lod_file_free(obs_bake_scene *s)

@@ -15,33 +15,28 @@
  *     other side of a diagonal wall".
  * Both tests see the opaque triangles alone: decorators are not solid
  * (a point in a tree's canopy or a shrub's box is outside geometry, and
- * no tree hides a point behind it; dynamic.c).
+ * no tree hides a point behind it; dyn_bake.c).
  * Then every valid point traces `rays` directions over the whole sphere
  * (equal-area Fibonacci spiral, a random rotation per point): the
  * spherical obscurance f(w) = rho(d(p, w)) T(w), rho(x) = 1 - exp(a x),
  * a = ln 0.5 / d, at both distances (section 2; a miss is rho = 1), T
  * the transmittance of the decorators' fog boxes and tree triangles up
  * to the hit (section 2.1; 1 without decorators), is
- * projected to quadratic SH and convolved with the clamped cosine (sh.c).
+ * projected to quadratic SH and convolved with the clamped cosine (level/sh.c,
+ * level/point_sh.c).
  * "We start by eliminating any points that see too many back faces": a
  * point whose rays meet back faces more often than backface_limit is
  * dropped here too (the full ray set sees more than the 32 of the flag). */
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
-#include "bake/dyn_internal.h"
-#include "bake/rng.h"
+#include "dynamic/dyn_internal.h"
+#include "level/kernel.h"
+#include "level/rng.h"
 #include "internal.h"
+#include "pool.h"
 
-#define MAX_THREADS 64
-#define PI_D 3.14159265358979323846
-/* Rays stop at this many long distances: rho is within 2^-16 of 1 (as
- * trace.c). */
-#define RAY_LENGTH_FACTOR 16.0f
 #define FLAG_RAYS 32
 
 int obs__dyn_inside(const obs__bake_bvh *bvh, const float p[3], int rays, float limit)
@@ -50,7 +45,7 @@ int obs__dyn_inside(const obs__bake_bvh *bvh, const float p[3], int rays, float 
     uint8_t back[256];
     if (rays > 256)
         rays = 256;
-    obs__dyn_sphere_dirs(rays, 0, 0, dirs);
+    obs__sphere_dirs(rays, 0, 0, dirs);
     obs__bake_bvh_cast(bvh, p, dirs, rays, INFINITY, t, back, NULL);
     int nb = 0;
     for (int k = 0; k < rays; k++)
@@ -67,63 +62,6 @@ void obs__dyn_points_free(obs__dyn_points *pt)
     free(pt->id);
     free(pt->dropped);
     memset(pt, 0, sizeof *pt);
-}
-
-/* A parallel loop over [0, n) in chunks; fn(ctx, i). */
-typedef struct pfor {
-    size_t n, chunk;
-    atomic_size_t next;
-    void (*fn)(void *, size_t);
-    void *ctx;
-    pthread_mutex_t lock;
-    size_t done;
-    void (*progress)(void *, size_t, size_t);
-    void *user;
-} pfor;
-
-static void *pfor_worker(void *arg)
-{
-    pfor *f = arg;
-    size_t i0;
-    while ((i0 = atomic_fetch_add(&f->next, f->chunk)) < f->n) {
-        size_t i1 = i0 + f->chunk < f->n ? i0 + f->chunk : f->n;
-        for (size_t i = i0; i < i1; i++)
-            f->fn(f->ctx, i);
-        pthread_mutex_lock(&f->lock);
-        f->done += i1 - i0;
-        if (f->progress)
-            f->progress(f->user, f->done, f->n);
-        pthread_mutex_unlock(&f->lock);
-    }
-    return NULL;
-}
-
-static void run_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx,
-                     void (*progress)(void *, size_t, size_t), void *user)
-{
-    pfor f = {.n = n, .chunk = chunk, .fn = fn, .ctx = ctx, .progress = progress, .user = user};
-    atomic_init(&f.next, 0);
-    pthread_mutex_init(&f.lock, NULL);
-    int nt = threads;
-    if (nt <= 0) {
-        long c = sysconf(_SC_NPROCESSORS_ONLN);
-        nt = c < 1 ? 1 : c > MAX_THREADS ? MAX_THREADS : (int)c;
-    }
-    pthread_t th[MAX_THREADS];
-    int started = 0;
-    for (; started < nt && started < MAX_THREADS; started++)
-        if (pthread_create(&th[started], NULL, pfor_worker, &f) != 0)
-            break;
-    if (started == 0)
-        pfor_worker(&f);
-    for (int k = 0; k < started; k++)
-        pthread_join(th[k], NULL);
-    pthread_mutex_destroy(&f.lock);
-}
-
-void obs__bake_pfor(size_t n, size_t chunk, int threads, void (*fn)(void *, size_t), void *ctx)
-{
-    run_pfor(n, chunk, threads, fn, ctx, NULL, NULL);
 }
 
 typedef struct flag_job {
@@ -173,48 +111,9 @@ typedef struct sph_job {
     const obs_dyn_params *p;
     obs__dyn_points *pt;
     size_t first;
+    void (*progress)(void *, size_t, size_t);
+    void *user;
 } sph_job;
-
-int obs__dyn_point_sh(const obs__bake_bvh *bvh, const float o[3], const obs_dyn_params *p,
-                      uint64_t stream, double sh[OBS_DYN_CHANNELS], int *dropped)
-{
-    int n = p->rays, ok = 0;
-    float *dirs = malloc((size_t)n * 3 * sizeof *dirs), *t = malloc((size_t)n * sizeof *t);
-    float *tr = malloc((size_t)n * sizeof *tr);
-    uint8_t *back = malloc((size_t)n);
-    double *w = malloc((size_t)n * sizeof *w), *f = malloc(2 * (size_t)n * sizeof *f);
-    if (!dirs || !t || !tr || !back || !w || !f)
-        goto done;
-    obs__dyn_sphere_dirs(n, (uint64_t)p->seed, stream, dirs);
-    float dist[2] = {p->distance_short, p->distance_long};
-    obs__bake_bvh_cast(bvh, o, dirs, n, RAY_LENGTH_FACTOR * fmaxf(dist[0], dist[1]), t, back,
-                       tr);
-    int nb = 0;
-    for (int k = 0; k < n; k++) {
-        w[k] = 4.0 * PI_D / n; /* equal-area directions */
-        nb += back[k];
-        for (int c = 0; c < 2; c++) {
-            double a = log(0.5) / dist[c]; /* a = ln(0.5) / d, section 2 */
-            /* rho(x), times the decorators' transmittance (section 2.1;
-             * 1 without them): a ray's visibility as the surface samples' */
-            f[(size_t)c * n + k] = (isinf(t[k]) ? 1.0 : 1.0 - exp(a * t[k])) * tr[k];
-        }
-    }
-    *dropped = (double)nb > (double)p->backface_limit * n;
-    for (int c = 0; c < 2; c++) {
-        obs__dyn_sh_project(dirs, w, f + (size_t)c * n, (size_t)n, sh + OBS_DYN_SH * c);
-        obs__dyn_sh_convolve(sh + OBS_DYN_SH * c);
-    }
-    ok = 1;
-done:
-    free(dirs);
-    free(t);
-    free(tr);
-    free(back);
-    free(w);
-    free(f);
-    return ok;
-}
 
 static void trace_point(void *ctx, size_t i)
 {
@@ -222,10 +121,26 @@ static void trace_point(void *ctx, size_t i)
     obs__dyn_points *pt = j->pt;
     size_t k = j->first + i;
     int dropped = 0;
-    if (!obs__dyn_point_sh(j->bvh, pt->pos + 3 * k, j->p, pt->id[k],
+    if (!obs__point_sh(j->bvh, pt->pos + 3 * k, j->p, pt->id[k],
                            pt->sh + (size_t)OBS_DYN_CHANNELS * k, &dropped))
         dropped = 2; /* no memory: reported by the caller */
     pt->dropped[k] = (uint8_t)dropped;
+}
+
+static int trace_points(void *ctx, void *local, size_t i0, size_t i1)
+{
+    (void)local;
+    for (size_t i = i0; i < i1; i++)
+        trace_point(ctx, i);
+    return 0;
+}
+
+/* The shard's progress never cancels. */
+static int report(void *ctx, size_t done, size_t total)
+{
+    const sph_job *j = ctx;
+    j->progress(j->user, done, total);
+    return 0;
 }
 
 obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions *rg,
@@ -241,7 +156,7 @@ obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions 
     if (!state)
         return obs__fail(err, OBS_NO_MEMORY, "valid flags of %zu points", total);
     flag_job fj = {bvh, rg, p, state};
-    run_pfor(rg->count, 1, p->threads, flag_region, &fj, NULL, NULL);
+    obs__pool_each(rg->count, 1, p->threads, flag_region, &fj);
     out->grid = total;
     for (size_t k = 0; k < total; k++) {
         out->inside += state[k] == 1;
@@ -279,8 +194,11 @@ void obs__dyn_points_trace(const obs__bake_bvh *bvh, const obs_dyn_params *p,
                            obs__dyn_points *pt, size_t first, size_t end,
                            void (*progress)(void *, size_t, size_t), void *user)
 {
-    sph_job sj = {bvh, p, pt, first};
-    run_pfor(end - first, 16, p->threads, trace_point, &sj, progress, user);
+    sph_job sj = {bvh, p, pt, first, progress, user};
+    obs__pool_for f = {.end = end - first, .chunk = 16, .threads = p->threads,
+                       .range = trace_points, .ctx = &sj, .progress = progress ? report : NULL,
+                       .progress_user = &sj};
+    obs__pool_run(&f, NULL);
     pt->rays += (uint64_t)(end - first) * (uint64_t)p->rays;
 }
 
@@ -326,19 +244,6 @@ obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *b
     return st;
 }
 
-/* An orthonormal tangent frame around unit n (as trace.c's). */
-static void frame(const float n[3], float t[3], float b[3])
-{
-    if (n[2] < -0.9999999f) {
-        t[0] = 0.0f, t[1] = -1.0f, t[2] = 0.0f;
-        b[0] = -1.0f, b[1] = 0.0f, b[2] = 0.0f;
-        return;
-    }
-    float a = 1.0f / (1.0f + n[2]), c = -n[0] * n[1] * a;
-    t[0] = 1.0f - n[0] * n[0] * a, t[1] = c, t[2] = -n[0];
-    b[0] = c, b[1] = 1.0f - n[1] * n[1] * a, b[2] = -n[1];
-}
-
 void obs__dyn_trace_eq1(const obs__bake_bvh *bvh, const float o[3], const float n[3],
                         int rays, const float distance[2], uint64_t seed, uint64_t stream,
                         double ao[2])
@@ -348,21 +253,14 @@ void obs__dyn_trace_eq1(const obs__bake_bvh *bvh, const float o[3], const float 
      * times each ray's transmittance (section 2.1; 1 without decorators). */
     float tg[3], bt[3], dirs[3 * 8], t[8], tr[8];
     uint8_t back[8];
-    frame(n, tg, bt);
+    obs__bake_frame(n, tg, bt);
     obs__bake_rng r = obs__bake_rng_stream(seed, stream, 13);
     double o1 = obs__bake_rng_unit(&r), o2 = obs__bake_rng_unit(&r), acc[2] = {0.0, 0.0};
-    float tfar = RAY_LENGTH_FACTOR * fmaxf(distance[0], distance[1]);
+    float tfar = OBS__BAKE_RAY_LENGTH_FACTOR * fmaxf(distance[0], distance[1]);
     for (int k0 = 0; k0 < rays; k0 += 8) {
         int m = rays - k0 < 8 ? rays - k0 : 8;
-        for (int l = 0; l < m; l++) {
-            int k = k0 + l;
-            double u1 = fmod((k + 0.5) / rays + o1, 1.0), u2 = fmod(k * 0.6180339887498949 + o2, 1.0);
-            double rad = sqrt(u1), phi = 2.0 * PI_D * u2;
-            float x = (float)(rad * cos(phi)), y = (float)(rad * sin(phi)),
-                  z = (float)sqrt(fmax(0.0, 1.0 - u1));
-            for (int a = 0; a < 3; a++)
-                dirs[3 * l + a] = x * tg[a] + y * bt[a] + z * n[a];
-        }
+        for (int l = 0; l < m; l++) /* the bake's ray set (kernel.h) */
+            obs__bake_lattice_dir(k0 + l, rays, o1, o2, n, tg, bt, dirs + 3 * l);
         obs__bake_bvh_cast(bvh, o, dirs, m, tfar, t, back, tr);
         for (int l = 0; l < m; l++) /* rho times the decorators' transmittance, as the points' */
             for (int c = 0; c < 2; c++)

@@ -14,14 +14,14 @@
 #include <math.h>
 #include <string.h>
 
-#include "bake/dyn_internal.h"
-#include "bake/rng.h"
+#include "level/level.h"
+#include "level/rng.h"
 
 #define PI_D 3.14159265358979323846
 
-const double obs__dyn_sh_cosine[3] = {PI_D, 2.0 * PI_D / 3.0, PI_D / 4.0};
+const double obs__sh_cosine[3] = {PI_D, 2.0 * PI_D / 3.0, PI_D / 4.0};
 
-void obs__dyn_sh_basis(const float d[3], double y[OBS_DYN_SH])
+void obs__sh_basis(const float d[3], double y[OBS_DYN_SH])
 {
     double x = d[0], yy = d[1], z = d[2];
     y[0] = 0.28209479177387814;            /* 1 / (2 sqrt(pi)) */
@@ -35,13 +35,13 @@ void obs__dyn_sh_basis(const float d[3], double y[OBS_DYN_SH])
     y[8] = 0.5462742152960396 * (x * x - yy * yy);  /* sqrt(15 / 16 pi) */
 }
 
-void obs__dyn_sh_project(const float *dirs, const double *w, const double *f, size_t n,
+void obs__sh_project(const float *dirs, const double *w, const double *f, size_t n,
                          double out[OBS_DYN_SH])
 {
     memset(out, 0, OBS_DYN_SH * sizeof *out);
     for (size_t i = 0; i < n; i++) {
         double y[OBS_DYN_SH];
-        obs__dyn_sh_basis(dirs + 3 * i, y);
+        obs__sh_basis(dirs + 3 * i, y);
         for (int k = 0; k < OBS_DYN_SH; k++)
             out[k] += w[i] * f[i] * y[k];
     }
@@ -49,23 +49,23 @@ void obs__dyn_sh_project(const float *dirs, const double *w, const double *f, si
 
 static int band(int k) { return k == 0 ? 0 : k < 4 ? 1 : 2; }
 
-void obs__dyn_sh_convolve(double c[OBS_DYN_SH])
+void obs__sh_convolve(double c[OBS_DYN_SH])
 {
     for (int k = 0; k < OBS_DYN_SH; k++)
-        c[k] *= obs__dyn_sh_cosine[band(k)] / PI_D; /* the 1/pi of eq 1 */
+        c[k] *= obs__sh_cosine[band(k)] / PI_D; /* the 1/pi of eq 1 */
 }
 
-double obs__dyn_sh_eval(const double c[OBS_DYN_SH], const float n[3], int order)
+double obs__sh_eval(const double c[OBS_DYN_SH], const float n[3], int order)
 {
     double y[OBS_DYN_SH], s = 0.0;
-    obs__dyn_sh_basis(n, y);
+    obs__sh_basis(n, y);
     int kmax = order >= 2 ? 9 : order == 1 ? 4 : 1;
     for (int k = 0; k < kmax; k++)
         s += c[k] * y[k];
     return s;
 }
 
-void obs__dyn_sphere_dirs(int n, uint64_t seed, uint64_t stream, float *dirs)
+void obs__sphere_dirs(int n, uint64_t seed, uint64_t stream, float *dirs)
 {
     /* A uniform random rotation (a unit quaternion from four normal
      * deviates, Box-Muller), so that neighbouring points do not share

@@ -3,7 +3,7 @@
  * back through assimp. */
 #include <cjson/cJSON.h>
 
-#include "bake/bake_testutil.h"
+#include "level/bake_testutil.h"
 
 #define LEVELS TESTDATA "/levels"
 

@@ -17,7 +17,7 @@
 #include <string.h>
 #include <strings.h>
 
-#include "bake/lod.h"
+#include "level/level.h"
 #include "internal.h"
 #include "obscura/bake.h"
 

@@ -1,0 +1,272 @@
+/* The machinery of a part file, shared by the bake's parts (bake/shard.c)
+ * and the dynamic-object bake's (dynamic/dyn_shard.c): the split of a
+ * count into shards, FNV-1a 64 and the level's fingerprints, the write
+ * under PATH.tmp and its rename, the header's magic and the payload's
+ * checksum, the parts of one split put in order.  Each bake keeps its own
+ * layout (its header's fields and payload) beside its step. */
+#include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "internal.h"
+#include "level/decor.h"
+#include "level/part.h"
+
+#define FNV_OFFSET OBS__BAKE_FNV_OFFSET
+#define FNV_PRIME 0x100000001b3ULL
+
+size_t obs__bake_shard_first(size_t total, int index, int count)
+{
+    /* total * index / count without overflow for any size_t total */
+    return total / (size_t)count * (size_t)index + total % (size_t)count * (size_t)index / (size_t)count;
+}
+
+/* ---- little-endian fields and the hash (shard.h) ----------------------- */
+
+uint64_t obs__bake_fnv(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ p[i]) * FNV_PRIME;
+    return h;
+}
+
+static uint64_t fnv32(uint64_t h, uint32_t v)
+{
+    unsigned char b[4];
+    obs__le_put32(b, v);
+    return obs__bake_fnv(h, b, 4);
+}
+
+uint64_t obs__bake_level_fingerprint(const obs__bake_world *w)
+{
+    uint64_t h = obs__bake_fnv(FNV_OFFSET, (const unsigned char *)"obscura level 1", 15);
+    h = fnv32(fnv32(h, (uint32_t)w->vertex_count), (uint32_t)w->triangle_count);
+    for (size_t i = 0; i < 3 * w->vertex_count; i++)
+        h = fnv32(h, obs__le_fbits(w->pos[i]));
+    for (size_t i = 0; i < 3 * w->triangle_count; i++)
+        h = fnv32(h, w->tri[i]);
+    return obs__bake_fnv(h, w->two_sided, w->triangle_count);
+}
+
+/* The level's fingerprint with its decorators folded in (section 2.2,
+ * decor.c, occl.c; shard.h). */
+uint64_t obs__bake_traced_fingerprint(const obs__bake_world *w, const obs__bake_decor *d,
+                                      float tree_attenuation)
+{
+    uint64_t h = obs__bake_level_fingerprint(w);
+    if (!d || d->counts[OBS__DECOR_NONE] == d->node_count)
+        return h;
+    h = obs__bake_fnv(h, (const unsigned char *)"decorators 1", 12);
+    for (size_t i = 0; i < w->instance_count; i++) {
+        uint32_t n = w->inst[i].node;
+        h = fnv32(h, n < d->node_count ? d->node_class[n] : 0);
+        h = fnv32(h, n < d->node_count ? obs__le_fbits(d->density[n]) : 0);
+    }
+    return fnv32(h, obs__le_fbits(tree_attenuation));
+}
+
+/* ---- writing and reading a part ----------------------------------------- */
+
+obs_status obs__bake_part_write(const char *path, const unsigned char *head, size_t head_len,
+                                const unsigned char *payload, size_t payload_len,
+                                char err[OBS_ERR_LEN])
+{
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 5);
+    if (!tmp)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: the file name", path);
+    memcpy(tmp, path, len);
+    memcpy(tmp + len, ".tmp", 5);
+    FILE *f = fopen(tmp, "wb");
+    int ok = f && fwrite(head, 1, head_len, f) == head_len &&
+             (payload_len == 0 || fwrite(payload, 1, payload_len, f) == payload_len);
+    int e = errno;
+    if (f && fclose(f) != 0 && ok)
+        ok = 0, e = errno;
+    if (ok && rename(tmp, path) != 0)
+        ok = 0, e = errno;
+    if (!ok)
+        remove(tmp);
+    free(tmp);
+    return ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: cannot write the part: %s", path, strerror(e));
+}
+
+obs_status obs__bake_part_head(const char *path, const char *magic, const char *what, const char *writer,
+                               unsigned char *head, size_t head_len, uint64_t *size,
+                               char err[OBS_ERR_LEN])
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return obs__fail(err, OBS_IO, "%s: cannot open the part: %s", path, strerror(errno));
+    size_t got = fread(head, 1, head_len, f);
+    struct stat sb;
+    int have_size = fstat(fileno(f), &sb) == 0;
+    fclose(f);
+    *size = have_size ? (uint64_t)sb.st_size : UINT64_MAX;
+    if (got >= 8 && memcmp(head, magic, 8) != 0)
+        return obs__fail(err, OBS_BAD_FILE, "%s: not a %s (no '%.8s' magic; '%s' writes "
+                         "them)", path, what, magic, writer);
+    if (got < head_len)
+        return obs__fail(err, OBS_BAD_FILE, "%s: truncated: %zu bytes, shorter than a part's "
+                         "header (%zu)", path, got, head_len);
+    return OBS_OK;
+}
+
+obs_status obs__bake_part_payload(const char *path, size_t offset, size_t len, uint64_t checksum,
+                                  unsigned char **out, char err[OBS_ERR_LEN])
+{
+    *out = NULL;
+    unsigned char *p = malloc(len + 1);
+    if (!p)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: a payload of %zu bytes", path, len);
+    FILE *f = fopen(path, "rb");
+    int ok = f && fseek(f, (long)offset, SEEK_SET) == 0 && fread(p, 1, len, f) == len;
+    if (f)
+        fclose(f);
+    if (!ok) {
+        free(p);
+        return obs__fail(err, OBS_IO, "%s: cannot read its payload (%zu bytes)", path, len);
+    }
+    if (obs__bake_fnv(OBS__BAKE_FNV_OFFSET, p, len) != checksum) {
+        free(p);
+        return obs__fail(err, OBS_BAD_FILE, "%s: damaged: its payload does not match the header's "
+                         "checksum", path);
+    }
+    *out = p;
+    return OBS_OK;
+}
+
+/* ---- the parts of one split ----------------------------------------------- */
+
+obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t *order,
+                                 char err[OBS_ERR_LEN])
+{
+    uint32_t count = in[0].count;
+    if (n > count)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%zu parts given for a split into %u shards "
+                         "(%s): one is given twice, or belongs to another split", n, count,
+                         in[0].path);
+    unsigned char *seen = calloc(count, 1);
+    if (!seen)
+        return obs__fail(err, OBS_NO_MEMORY, "%u shards", count);
+    obs_status rc = OBS_OK;
+    for (size_t i = 0; rc == OBS_OK && i < n; i++) {
+        if (in[i].count != count)
+            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%s is shard %u/%u, %s shard %u/%u: parts "
+                           "of different splits", in[0].path, in[0].index, count, in[i].path,
+                           in[i].index, in[i].count);
+        else if (in[i].level != in[0].level)
+            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced from different levels "
+                           "(fingerprints %016llx and %016llx)", in[0].path, in[i].path,
+                           (unsigned long long)in[0].level, (unsigned long long)in[i].level);
+        else if (seen[in[i].index])
+            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "shard %u/%u given twice: %s and %s",
+                           in[i].index, count, in[order[in[i].index]].path, in[i].path);
+        else
+            seen[in[i].index] = 1, order[in[i].index] = i;
+    }
+    if (rc == OBS_OK && n < count) {
+        char list[256] = "";
+        size_t len = 0, missing = 0;
+        for (uint32_t k = 0; k < count; k++) {
+            if (seen[k])
+                continue;
+            if (len + 16 < sizeof list)
+                len += (size_t)snprintf(list + len, sizeof list - len, "%s%u", missing ? ", " : "", k);
+            missing++;
+        }
+        rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%zu of %u shards missing (%s%s): a merge needs "
+                       "every shard of the split once", missing, count, list,
+                       missing * 4 > sizeof list ? ", ..." : "");
+    }
+    free(seen);
+    return rc;
+}
+
+/* ---- the range every header starts with --------------------------------- */
+
+void obs__part_range_put(unsigned char *b, size_t head_len, const char *magic,
+                         const obs__part_range *r)
+{
+    memset(b, 0, head_len);
+    memcpy(b, magic, 8);
+    obs__le_put32(b + 8, r->version);
+    obs__le_put32(b + 12, (uint32_t)head_len);
+    obs__le_put64(b + 16, r->level);
+    obs__le_put32(b + 24, r->index);
+    obs__le_put32(b + 28, r->count);
+    obs__le_put64(b + 32, r->total);
+    obs__le_put64(b + 40, r->first);
+    obs__le_put64(b + 48, r->n);
+}
+
+obs_status obs__part_range_read(const char *path, const obs__part_format *f, unsigned char *b,
+                                obs__part_range *r, char err[OBS_ERR_LEN])
+{
+    uint64_t size;
+    obs_status rc = obs__bake_part_head(path, f->magic, f->what, f->writer, b, f->head_len, &size,
+                                        err);
+    if (rc != OBS_OK)
+        return rc;
+    r->version = obs__le_get32(b + 8);
+    if (r->version != f->version || obs__le_get32(b + 12) != f->head_len)
+        return obs__fail(err, OBS_UNSUPPORTED, "%s: %s version %u (header %u bytes); this "
+                         "obscura reads version %u", path, f->kind, r->version,
+                         obs__le_get32(b + 12), f->version);
+    r->level = obs__le_get64(b + 16);
+    r->index = obs__le_get32(b + 24);
+    r->count = obs__le_get32(b + 28);
+    r->total = obs__le_get64(b + 32);
+    r->first = obs__le_get64(b + 40);
+    r->n = obs__le_get64(b + 48);
+    if (r->count == 0 || r->index >= r->count || r->count > (uint32_t)INT32_MAX ||
+        r->total > f->max_total ||
+        r->first != obs__bake_shard_first((size_t)r->total, (int)r->index, (int)r->count) ||
+        r->first + r->n != obs__bake_shard_first((size_t)r->total, (int)r->index + 1, (int)r->count))
+        return obs__fail(err, OBS_BAD_FILE, "%s: damaged header: shard %u/%u of %llu %s "
+                         "cannot hold %s %llu .. %llu", path, r->index, r->count,
+                         (unsigned long long)r->total, f->items, f->items,
+                         (unsigned long long)r->first, (unsigned long long)(r->first + r->n));
+    uint64_t want = f->head_len + f->item_bytes * r->n;
+    if (size != UINT64_MAX && size != want)
+        return obs__fail(err, OBS_BAD_FILE, "%s: %s: %llu bytes, its header promises %llu (%llu "
+                         "%s)", path, size < want ? "truncated" : "longer than a part",
+                         (unsigned long long)size, (unsigned long long)want,
+                         (unsigned long long)r->n, f->items);
+    return OBS_OK;
+}
+
+obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
+                                obs_status (*read_header)(const char *path, void *h,
+                                                          char err[OBS_ERR_LEN]),
+                                obs__bake_part_key (*key)(const void *h), void **out,
+                                char err[OBS_ERR_LEN])
+{
+    *out = NULL;
+    unsigned char *heads = calloc(n, elem), *ordered = NULL;
+    obs__bake_part_key *keys = calloc(n, sizeof *keys);
+    size_t *order = NULL;
+    obs_status rc = heads && keys ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
+    for (size_t i = 0; rc == OBS_OK && i < n; i++)
+        if ((rc = read_header(paths[i], heads + i * elem, err)) == OBS_OK)
+            keys[i] = key(heads + i * elem);
+    if (rc == OBS_OK && (!(ordered = calloc(keys[0].count, elem)) ||
+                         !(order = calloc(keys[0].count, sizeof *order))))
+        rc = obs__fail(err, OBS_NO_MEMORY, "%u parts", keys[0].count);
+    if (rc == OBS_OK)
+        rc = obs__bake_parts_order(keys, n, order, err);
+    for (size_t k = 0; rc == OBS_OK && k < n; k++)
+        memcpy(ordered + k * elem, heads + order[k] * elem, elem);
+    free(order);
+    free(keys);
+    free(heads);
+    if (rc == OBS_OK)
+        *out = ordered;
+    else
+        free(ordered);
+    return rc;
+}
