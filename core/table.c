@@ -21,9 +21,7 @@ obs_status obs_table_fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, 
     return s;
 }
 
-/* Compares a row's name with the first blen characters of b, '-' and '_'
- * alike. */
-static int name_eq(const char *a, const char *b, size_t blen)
+int obs_table_name_eq(const char *a, const char *b, size_t blen)
 {
     size_t i = 0;
     for (; a[i] && i < blen; i++) {
@@ -37,7 +35,7 @@ static int name_eq(const char *a, const char *b, size_t blen)
 const obs_table_row *obs_table_find_n(const obs_table *t, const char *name, size_t len)
 {
     for (int i = 0; name && i < t->count; i++)
-        if (name_eq(t->rows[i].name, name, len))
+        if (obs_table_name_eq(t->rows[i].name, name, len))
             return &t->rows[i];
     return NULL;
 }
@@ -350,7 +348,8 @@ void obs_table_defaults(const obs_table *t, void *base)
             break;
         case OBS_TABLE_ENUM:
             if (*(int *)(void *)field == 0)
-                *(int *)(void *)field = obs_table_choice(r->choices, r->def) - 1 + (int)t->enum_base;
+                *(int *)(void *)field =
+                    obs_table_choice(r->choices, r->def) - 1 + (int)t->enum_base;
             break;
         case OBS_TABLE_MAT4:
             break; /* unset stays unset */

@@ -69,6 +69,9 @@ typedef struct obs_table {
 obs_status obs_table_fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
     OBS_TABLE_PRINTF(3, 4);
 
+/* 1 when row name a is the first blen characters of b, '-' and '_' alike
+ * (for tables of other rows: the HTTP request options). */
+int obs_table_name_eq(const char *a, const char *b, size_t blen);
 /* Names compare with '-' and '_' alike.  NULL when unknown (or name NULL). */
 const obs_table_row *obs_table_find(const obs_table *t, const char *name);
 /* The same over the first len characters of name ("--name=value"). */
