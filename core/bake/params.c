@@ -1,52 +1,9 @@
-/* The bake parameter table (OBS_BAKE_PARAM_TABLE, obscura/bake.h): its
- * rows; parsing, defaults and formatting are the table engine's
- * (core/table.c). */
+/* The bake parameter table (OBS_BAKE_PARAM_TABLE, obscura/bake.h) and its
+ * accessors obs_bake_param_count/at/find/set, obs_bake_params_resolve and
+ * obs_bake_param_format: written once for the bake-style tables in
+ * core/param_table.h, over the table engine (core/table.c). */
 #include "obscura/bake.h"
+#include "param_table.h"
 
-#define STR(x) #x
-#define DEF_FLOAT(d) STR(d)
-#define DEF_INT(d) STR(d)
-#define DEF_ENUM(d) d
-
-static const obs_table_row rows[] = {
-#define X(name, type, def, lo, hi, choices, doc)                                    \
-    {#name, OBS_TABLE_##type, DEF_##type(def), lo, hi, choices, doc,               \
-     offsetof(obs_bake_params, name)},
-    OBS_BAKE_PARAM_TABLE(X)
-#undef X
-};
-#define LEN ((int)(sizeof rows / sizeof rows[0]))
-_Static_assert(LEN <= 64, "obs_bake_params.set has 64 bits");
-
-static const obs_table table = {
-    .rows = rows, .count = LEN, .noun = "bake parameter", .hint = "", .enum_base = 1,
-    .strict = 1, /* an empty value is missing; no blank may follow a number */
-    .given = offsetof(obs_bake_params, set)};
-
-int obs_bake_param_count(void) { return LEN; }
-
-const obs_bake_param_info *obs_bake_param_at(int i) { return i >= 0 && i < LEN ? &rows[i] : NULL; }
-
-const obs_bake_param_info *obs_bake_param_find(const char *name)
-{
-    return obs_table_find(&table, name);
-}
-
-obs_status obs_bake_param_set(obs_bake_params *p, const char *name, const char *value,
-                              char err[OBS_ERR_LEN])
-{
-    return obs_table_set(&table, p, name, value, NULL, err);
-}
-
-void obs_bake_params_resolve(const obs_bake_params *in, obs_bake_params *out)
-{
-    obs_bake_params r = in ? *in : (obs_bake_params){0};
-    obs_table_defaults(&table, &r);
-    *out = r;
-}
-
-void obs_bake_param_format(const obs_bake_params *p, const obs_bake_param_info *pi, char *buf,
-                           size_t len)
-{
-    obs_table_format(&table, pi, p, buf, len);
-}
+#define OBS__PARAM_STRUCT obs_bake_params
+OBS__PARAM_TABLE(bake_param, OBS_BAKE_PARAM_TABLE, "bake parameter")
