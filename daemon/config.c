@@ -9,12 +9,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CHOICES_backend "auto|egl-device|egl-surfaceless|osmesa"
-#define CHOICES_log_level "error|warn|info|debug"
 #define CHOICES_STRING(n) NULL
 #define CHOICES_INT(n) NULL
 #define CHOICES_SIZE(n) NULL
-#define CHOICES_ENUM(n) CHOICES_##n
+#define CHOICES_ENUM(n) OBSD_CHOICES_##n
 
 static const obs_table_row rows[] = {
 #define X(name, type, lo, hi, def, doc)                                                            \

@@ -15,8 +15,12 @@
 
 /* X(name, type, min, max, default, doc)
  * type: STRING (max = longest length), INT, SIZE (bytes; k/m/g suffixes,
- * powers of 1024), ENUM (choices in the doc's braces are checked against
- * the `choices` column of obsd_enum_choices()). */
+ * powers of 1024), ENUM (its choices are OBSD_CHOICES_name below; the
+ * value is the 0-based index).  A new option is its row and its use:
+ * parsing, the config file, the flag, --help and the README table follow
+ * from the row. */
+#define OBSD_CHOICES_backend "auto|egl-device|egl-surfaceless|osmesa"
+#define OBSD_CHOICES_log_level "error|warn|info|debug"
 #define OBSD_CONFIG_TABLE(X)                                                   \
     X(http, STRING, 0, OBSD_STR_LEN - 1, "127.0.0.1:8420",                     \
       "HTTP listen address IPV4:PORT or [IPV6]:PORT (port 0 picks a free "     \
