@@ -1,9 +1,6 @@
-/* The parameter table: metadata, parsing, defaults, range checks. */
-#include <ctype.h>
-#include <errno.h>
-#include <math.h>
-#include <stdio.h>
-#include <stdlib.h>
+/* The parameter table (OBS_PARAM_TABLE, obscura/params.h): its rows, the
+ * quality presets and what each method fixes; parsing, defaults and range
+ * checks are the table engine's (core/table.c). */
 #include <string.h>
 
 #include "internal.h"
@@ -14,200 +11,43 @@
 #define OBS__DEF_ENUM(d) d
 #define OBS__DEF_MAT4(d) "unset"
 
-static const obs_param_info table[] = {
+static const obs_table_row rows[] = {
 #define X(name, type, def, lo, hi, choices, doc)                                   \
-    {#name, OBS_PARAM_##type, OBS__DEF_##type(def), lo, hi, choices, doc,         \
+    {#name, OBS_TABLE_##type, OBS__DEF_##type(def), lo, hi, choices, doc,          \
      offsetof(obs_params, name)},
     OBS_PARAM_TABLE(X)
 #undef X
 };
 
-#define TABLE_LEN ((int)(sizeof table / sizeof table[0]))
+#define TABLE_LEN ((int)(sizeof rows / sizeof rows[0]))
+
+/* Zero means "default" (no mask); the engine's messages read "parameter
+ * radius: 'x' is not a number in [...]". */
+static const obs_table table = {.rows = rows, .count = TABLE_LEN, .noun = "parameter", .hint = "",
+                                .enum_base = 1, .given = OBS_TABLE_NO_MASK};
 
 int obs_param_count(void) { return TABLE_LEN; }
 
 const obs_param_info *obs_param_at(int i)
 {
-    return i >= 0 && i < TABLE_LEN ? &table[i] : NULL;
+    return i >= 0 && i < TABLE_LEN ? &rows[i] : NULL;
 }
 
-/* Compares names treating '-' and '_' as the same character. */
-static int name_eq(const char *a, const char *b)
-{
-    for (; *a && *b; a++, b++) {
-        char ca = *a == '-' ? '_' : *a, cb = *b == '-' ? '_' : *b;
-        if (ca != cb)
-            return 0;
-    }
-    return *a == *b;
-}
-
-const obs_param_info *obs_param_find(const char *name)
-{
-    for (int i = 0; name && i < TABLE_LEN; i++)
-        if (name_eq(table[i].name, name))
-            return &table[i];
-    return NULL;
-}
-
-/* Index (1-based) of `value` in the '|'-separated list, 0 if absent. */
-static int choice_index(const char *choices, const char *value)
-{
-    size_t vlen = strlen(value);
-    int idx = 1;
-    for (const char *p = choices; *p; idx++) {
-        const char *end = strchr(p, '|');
-        size_t len = end ? (size_t)(end - p) : strlen(p);
-        if (len == vlen && strncmp(p, value, len) == 0)
-            return idx;
-        if (!end)
-            break;
-        p = end + 1;
-    }
-    return 0;
-}
-
-/* Writes choice number idx (1-based) into buf. */
-static void choice_name(const char *choices, int idx, char *buf, size_t len)
-{
-    const char *p = choices;
-    for (int i = 1; i < idx && p; i++) {
-        p = strchr(p, '|');
-        if (p)
-            p++;
-    }
-    if (!p || idx < 1) {
-        snprintf(buf, len, "?");
-        return;
-    }
-    const char *end = strchr(p, '|');
-    int n = end ? (int)(end - p) : (int)strlen(p);
-    snprintf(buf, len, "%.*s", n, p);
-}
-
-static int parse_double(const char *s, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || errno == ERANGE || !isfinite(v))
-        return -1;
-    while (isspace((unsigned char)*end))
-        end++;
-    if (*end)
-        return -1;
-    *out = v;
-    return 0;
-}
-
-/* INT parameters with choices take only the listed numbers. */
-static int int_allowed(const obs_param_info *pi, int v)
-{
-    if (!pi->choices)
-        return 1;
-    for (const char *c = pi->choices; *c;) {
-        char *end;
-        long n = strtol(c, &end, 10);
-        if (end == c)
-            return 0;
-        if (n == v)
-            return 1;
-        c = *end == '|' ? end + 1 : end;
-    }
-    return 0;
-}
-
-static obs_status range_error(const obs_param_info *pi, const char *value, char err[OBS_ERR_LEN])
-{
-    if (pi->type == OBS_PARAM_INT && pi->choices)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s",
-                         pi->name, value, pi->choices);
-    if (pi->type == OBS_PARAM_INT)
-        return obs__fail(err, OBS_INVALID_ARGUMENT,
-                         "parameter %s: '%s' is not an integer in [%g, %g]", pi->name,
-                         value, pi->min, pi->max);
-    return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not a number in [%g, %g]",
-                     pi->name, value, pi->min, pi->max);
-}
+const obs_param_info *obs_param_find(const char *name) { return obs_table_find(&table, name); }
 
 obs_status obs_param_set(obs_params *p, const char *name, const char *value,
                          char err[OBS_ERR_LEN])
 {
-    const obs_param_info *pi = obs_param_find(name);
-    if (!pi)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown parameter '%s'", name ? name : "");
-    if (!value)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s needs a value", pi->name);
-    char *field = (char *)p + pi->offset;
-    double v;
-
-    switch (pi->type) {
-    case OBS_PARAM_FLOAT:
-        if (parse_double(value, &v) != 0 || v < pi->min || v > pi->max)
-            return range_error(pi, value, err);
-        *(float *)field = (float)v;
-        return OBS_OK;
-    case OBS_PARAM_INT:
-        if (parse_double(value, &v) != 0 || v != floor(v) || v < pi->min || v > pi->max ||
-            !int_allowed(pi, (int)v))
-            return range_error(pi, value, err);
-        *(int *)field = (int)v;
-        return OBS_OK;
-    case OBS_PARAM_ENUM: {
-        int idx = choice_index(pi->choices, value);
-        if (!idx)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s",
-                             pi->name, value, pi->choices);
-        *(int *)field = idx;
-        return OBS_OK;
-    }
-    case OBS_PARAM_MAT4: {
-        /* 16 numbers separated by commas and/or spaces. */
-        float m[16];
-        const char *s = value;
-        for (int i = 0; i < 16; i++) {
-            char *end;
-            while (isspace((unsigned char)*s) || *s == ',')
-                s++;
-            errno = 0;
-            double d = strtod(s, &end);
-            if (end == s || errno == ERANGE || !isfinite(d))
-                return obs__fail(err, OBS_INVALID_ARGUMENT,
-                                 "parameter %s: expected 16 numbers, number %d is missing or invalid",
-                                 pi->name, i + 1);
-            m[i] = (float)d;
-            s = end;
-        }
-        while (isspace((unsigned char)*s) || *s == ',')
-            s++;
-        if (*s)
-            return obs__fail(err, OBS_INVALID_ARGUMENT,
-                             "parameter %s: expected 16 numbers, found more", pi->name);
-        memcpy(field, m, sizeof m);
-        if (pi->offset == offsetof(obs_params, world_to_camera))
-            p->has_world_to_camera = 1;
-        return OBS_OK;
-    }
-    }
-    return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter %s has an unknown type", pi->name);
+    const obs_table_row *r;
+    obs_status s = obs_table_set(&table, p, name, value, &r, err);
+    if (s == OBS_OK && r->offset == offsetof(obs_params, world_to_camera))
+        p->has_world_to_camera = 1;
+    return s;
 }
 
 void obs_param_format(const obs_params *p, const obs_param_info *pi, char *buf, size_t len)
 {
-    const char *field = (const char *)p + pi->offset;
-    switch (pi->type) {
-    case OBS_PARAM_FLOAT: snprintf(buf, len, "%g", *(const float *)field); break;
-    case OBS_PARAM_INT: snprintf(buf, len, "%d", *(const int *)field); break;
-    case OBS_PARAM_ENUM: choice_name(pi->choices, *(const int *)field, buf, len); break;
-    case OBS_PARAM_MAT4: {
-        const float *m = (const float *)field;
-        size_t off = 0;
-        buf[0] = '\0';
-        for (int i = 0; i < 16 && off < len; i++)
-            off += (size_t)snprintf(buf + off, len - off, i ? ",%g" : "%g", m[i]);
-        break;
-    }
-    }
+    obs_table_format(&table, pi, p, buf, len);
 }
 
 /* Which methods a parameter belongs to (bits 1 << obs_method); the
@@ -267,9 +107,9 @@ static int method_conflict(const obs_params *in, int method)
         const char *field = (const char *)in + method_params[k].offset;
         int given = 0, agrees = 0;
         for (int i = 0; i < TABLE_LEN; i++) {
-            if (table[i].offset != method_params[k].offset)
+            if (rows[i].offset != method_params[k].offset)
                 continue;
-            if (table[i].type == OBS_PARAM_FLOAT) {
+            if (rows[i].type == OBS_PARAM_FLOAT) {
                 given = *(const float *)field != 0.0f;
             } else {
                 int v = *(const int *)field;
@@ -298,19 +138,19 @@ static void apply_quality(obs_params *r)
     static const struct {
         int quality;
         const char *name, *value;
-    } rows[] = {
+    } presets[] = {
 #define OBS__PRESET_ROW(q, name, value) {q, #name, value},
         OBS_QUALITY_PRESETS(OBS__PRESET_ROW)
 #undef OBS__PRESET_ROW
     };
-    for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++) {
-        if (rows[k].quality != r->quality)
+    for (size_t k = 0; k < sizeof presets / sizeof presets[0]; k++) {
+        if (presets[k].quality != r->quality)
             continue;
-        const obs_param_info *pi = obs_param_find(rows[k].name);
+        const obs_param_info *pi = obs_param_find(presets[k].name);
         obs_params set;
         memset(&set, 0, sizeof set);
         /* the rows are checked by test_params.c: each value parses */
-        if (!pi || obs_param_set(&set, rows[k].name, rows[k].value, NULL) != OBS_OK)
+        if (!pi || obs_param_set(&set, presets[k].name, presets[k].value, NULL) != OBS_OK)
             continue;
         char *field = (char *)r + pi->offset;
         const char *value = (const char *)&set + pi->offset;
@@ -327,26 +167,7 @@ void obs_params_resolve(const obs_params *in, obs_params *out)
     else
         memset(&r, 0, sizeof r);
     apply_quality(&r);
-    for (int i = 0; i < TABLE_LEN; i++) {
-        const obs_param_info *pi = &table[i];
-        char *field = (char *)&r + pi->offset;
-        switch (pi->type) {
-        case OBS_PARAM_FLOAT:
-            if (*(float *)field == 0.0f)
-                *(float *)field = (float)strtod(pi->def, NULL);
-            break;
-        case OBS_PARAM_INT:
-            if (*(int *)field == 0)
-                *(int *)field = (int)strtol(pi->def, NULL, 10);
-            break;
-        case OBS_PARAM_ENUM:
-            if (*(int *)field == 0)
-                *(int *)field = choice_index(pi->choices, pi->def);
-            break;
-        case OBS_PARAM_MAT4:
-            break; /* unset stays unset: has_world_to_camera says */
-        }
-    }
+    obs_table_defaults(&table, &r);
     /* A struct resolved before keeps its verdict: its fields are no
      * longer what a request gave. */
     if (!in || in->method_conflict == 0) {
@@ -384,59 +205,14 @@ void obs__params_for_gbuffer(const obs_params *in, const obs_gbuffer *gb, obs_pa
 obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN])
 {
     if (p->method_conflict > 0 && p->method_conflict <= TABLE_LEN) {
-        const obs_param_info *pi = &table[p->method_conflict - 1];
+        const obs_param_info *pi = &rows[p->method_conflict - 1];
         const obs_param_info *mi = obs_param_find("method");
         char method[32];
         obs_param_format(p, mi, method, sizeof method);
-        return obs__fail(err, OBS_INVALID_ARGUMENT,
+        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
                          "parameter %s does not apply to method %s: %s; leave it unset "
                          "or pick a method it belongs to",
                          pi->name, method, method_why(pi->offset));
     }
-    for (int i = 0; i < TABLE_LEN; i++) {
-        const obs_param_info *pi = &table[i];
-        const char *field = (const char *)p + pi->offset;
-        char text[64];
-        switch (pi->type) {
-        case OBS_PARAM_FLOAT: {
-            float v = *(const float *)field;
-            /* the bounds as the float field holds them: obs_param_set
-             * accepts the table's min (1e-6 parsed as a double) and stores
-             * it rounded to a float, which may lie below the double */
-            if (!isfinite(v) || v < (float)pi->min || v > (float)pi->max) {
-                snprintf(text, sizeof text, "%g", v);
-                return range_error(pi, text, err);
-            }
-            break;
-        }
-        case OBS_PARAM_INT: {
-            int v = *(const int *)field;
-            if (v < pi->min || v > pi->max || !int_allowed(pi, v)) {
-                snprintf(text, sizeof text, "%d", v);
-                return range_error(pi, text, err);
-            }
-            break;
-        }
-        case OBS_PARAM_ENUM: {
-            int v = *(const int *)field;
-            int n = 1;
-            for (const char *c = pi->choices; *c; c++)
-                n += *c == '|';
-            if (v < 1 || v > n)
-                return obs__fail(err, OBS_INVALID_ARGUMENT,
-                                 "parameter %s: value %d is not one of %s", pi->name, v,
-                                 pi->choices);
-            break;
-        }
-        case OBS_PARAM_MAT4: {
-            const float *m = (const float *)field;
-            for (int k = 0; k < 16; k++)
-                if (!isfinite(m[k]))
-                    return obs__fail(err, OBS_INVALID_ARGUMENT,
-                                     "parameter %s: element %d is not finite", pi->name, k + 1);
-            break;
-        }
-        }
-    }
-    return OBS_OK;
+    return obs_table_check(&table, p, err);
 }

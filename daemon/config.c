@@ -1,150 +1,57 @@
-/* obscurad's option table: parsing, config files, flags and --help. */
+/* obscurad's option table: its rows, config files, flags and --help;
+ * parsing, range checks and formatting are the table engine's
+ * (obscura/table.h). */
 #include "config.h"
-#include "internal.h"
 
 #include <ctype.h>
-#include <stdarg.h>
 #include <errno.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define CHOICES_backend "auto|egl-device|egl-surfaceless|osmesa"
-#define CHOICES_log_level "error|warn|info|debug"
 #define CHOICES_STRING(n) NULL
 #define CHOICES_INT(n) NULL
 #define CHOICES_SIZE(n) NULL
-#define CHOICES_ENUM(n) CHOICES_##n
+#define CHOICES_ENUM(n) OBSD_CHOICES_##n
 
-static const obsd_opt_info table[] = {
+static const obs_table_row rows[] = {
 #define X(name, type, lo, hi, def, doc)                                                            \
-    {#name, OBSD_OPT_##type, (int64_t)(lo), (int64_t)(hi), def, CHOICES_##type(name), doc,         \
+    {#name, OBSD_OPT_##type, def, (double)(lo), (double)(hi), CHOICES_##type(name), doc,           \
      offsetof(obsd_config, name)},
     OBSD_CONFIG_TABLE(X)
 #undef X
 };
 
-#define TABLE_LEN ((int)(sizeof table / sizeof table[0]))
+#define TABLE_LEN ((int)(sizeof rows / sizeof rows[0]))
+
+/* ENUM values count from 0 (OBSD_LOG_ERROR is 0); the file and flags
+ * record what was given in obsd_config.set, not in a mask. */
+static const obs_table table = {.rows = rows, .count = TABLE_LEN, .noun = "option",
+                                .hint = " (obscurad --help lists them)", .enum_base = 0,
+                                .given = OBS_TABLE_NO_MASK};
 
 int obsd_opt_count(void) { return TABLE_LEN; }
 
 const obsd_opt_info *obsd_opt_at(int i)
 {
-    return i >= 0 && i < TABLE_LEN ? &table[i] : NULL;
+    return i >= 0 && i < TABLE_LEN ? &rows[i] : NULL;
 }
 
-static int name_eq(const char *a, const char *b, size_t blen)
-{
-    size_t i = 0;
-    for (; a[i] && i < blen; i++) {
-        char ca = a[i] == '-' ? '_' : a[i], cb = b[i] == '-' ? '_' : b[i];
-        if (ca != cb)
-            return 0;
-    }
-    return a[i] == '\0' && i == blen;
-}
-
-static const obsd_opt_info *find_n(const char *name, size_t len)
-{
-    for (int i = 0; i < TABLE_LEN; i++)
-        if (name_eq(table[i].name, name, len))
-            return &table[i];
-    return NULL;
-}
-
-const obsd_opt_info *obsd_opt_find(const char *name)
-{
-    return name ? find_n(name, strlen(name)) : NULL;
-}
-
-/* Index of `value` in "a|b|c", or -1. */
-static int choice_index(const char *choices, const char *value)
-{
-    int idx = 0;
-    size_t n = strlen(value);
-    for (const char *s = choices; s; idx++) {
-        const char *bar = strchr(s, '|');
-        size_t len = bar ? (size_t)(bar - s) : strlen(s);
-        if (len == n && strncmp(s, value, n) == 0)
-            return idx;
-        s = bar ? bar + 1 : NULL;
-    }
-    return -1;
-}
-
-static obs_status set_opt(obsd_config *c, const obsd_opt_info *o, const char *value,
-                          char err[OBS_ERR_LEN])
-{
-    char *field = (char *)c + o->offset;
-    switch (o->type) {
-    case OBSD_OPT_STRING:
-        if ((int64_t)strlen(value) > o->max)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: value is longer than %lld characters", o->name,
-                        (long long)o->max);
-        snprintf(field, OBSD_STR_LEN, "%s", value);
-        return OBS_OK;
-    case OBSD_OPT_INT:
-    case OBSD_OPT_SIZE: {
-        char *end;
-        errno = 0;
-        long long v = strtoll(value, &end, 10);
-        if (end == value || errno == ERANGE)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: '%s' is not a number in [%lld, %lld]", o->name, value,
-                        (long long)o->min, (long long)o->max);
-        if (o->type == OBSD_OPT_SIZE && *end) {
-            int shift = 0;
-            switch (tolower((unsigned char)*end)) {
-            case 'k': shift = 10; break;
-            case 'm': shift = 20; break;
-            case 'g': shift = 30; break;
-            default: shift = -1; break;
-            }
-            if (shift < 0 || end[1] != '\0' || v < 0 || v > (INT64_MAX >> shift))
-                return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: '%s' is not a size (a number, optionally with k, m "
-                            "or g) in [%lld, %lld]", o->name, value, (long long)o->min,
-                            (long long)o->max);
-            v <<= shift;
-            end += 1;
-        }
-        if (*end)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: '%s' is not a number in [%lld, %lld]", o->name, value,
-                        (long long)o->min, (long long)o->max);
-        if (v < o->min || v > o->max)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: %s is out of range [%lld, %lld]", o->name, value,
-                        (long long)o->min, (long long)o->max);
-        if (o->type == OBSD_OPT_INT)
-            *(int *)(void *)field = (int)v;
-        else
-            *(int64_t *)(void *)field = v;
-        return OBS_OK;
-    }
-    case OBSD_OPT_ENUM: {
-        int idx = choice_index(o->choices, value);
-        if (idx < 0)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s: '%s' is not one of %s", o->name, value, o->choices);
-        *(int *)(void *)field = idx;
-        return OBS_OK;
-    }
-    }
-    return obs__fail(err, OBS_INVALID_ARGUMENT, "option %s has an unknown type", o->name);
-}
+const obsd_opt_info *obsd_opt_find(const char *name) { return obs_table_find(&table, name); }
 
 void obsd_config_defaults(obsd_config *c)
 {
     memset(c, 0, sizeof *c);
-    for (int i = 0; i < TABLE_LEN; i++)
-        (void)set_opt(c, &table[i], table[i].def, NULL); /* the table's defaults are valid */
+    obs_table_defaults(&table, c); /* every field is zero: each takes its default */
 }
 
 obs_status obsd_config_set(obsd_config *c, const char *name, const char *value,
                            char err[OBS_ERR_LEN])
 {
-    const obsd_opt_info *o = obsd_opt_find(name);
-    if (!o)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown option '%s' (obscurad --help lists them)", name ? name : "");
-    obs_status s = set_opt(c, o, value ? value : "", err);
+    const obs_table_row *r;
+    obs_status s = obs_table_set(&table, c, name, value ? value : "", &r, err);
     if (s == OBS_OK)
-        c->set[o - table] = 1;
+        c->set[r - rows] = 1;
     return s;
 }
 
@@ -162,7 +69,8 @@ obs_status obsd_config_load(obsd_config *c, const char *path, char err[OBS_ERR_L
         lineno++;
         size_t n = strlen(line);
         if (n == sizeof line - 1 && line[n - 1] != '\n') {
-            s = obs__fail(err, OBS_INVALID_ARGUMENT, "%s:%d: line longer than %d characters", path, lineno, (int)sizeof line - 2);
+            s = obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s:%d: line longer than %d characters",
+                               path, lineno, (int)sizeof line - 2);
             break;
         }
         char *hash = strchr(line, '#');
@@ -189,7 +97,7 @@ obs_status obsd_config_load(obsd_config *c, const char *path, char err[OBS_ERR_L
         }
         name[name_len] = '\0';
         if (obsd_config_set(c, name, value, msg) != OBS_OK) {
-            s = obs__fail(err, OBS_INVALID_ARGUMENT, "%s:%d: %s", path, lineno, msg);
+            s = obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s:%d: %s", path, lineno, msg);
             break;
         }
     }
@@ -207,7 +115,7 @@ obs_status obsd_config_args(obsd_config *c, int argc, char **argv, int *help,
         const char *a = argv[i], *path = NULL;
         if (!strcmp(a, "--config")) {
             if (i + 1 >= argc)
-                return obs__fail(err, OBS_INVALID_ARGUMENT, "--config needs a file");
+                return obs_table_fail(err, OBS_INVALID_ARGUMENT, "--config needs a file");
             path = argv[++i];
         } else if (!strncmp(a, "--config=", 9)) {
             path = a + 9;
@@ -231,49 +139,45 @@ obs_status obsd_config_args(obsd_config *c, int argc, char **argv, int *help,
         if (!strncmp(a, "--config=", 9))
             continue;
         if (strncmp(a, "--", 2) != 0 || !a[2])
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "unexpected argument '%s'", a);
+            return obs_table_fail(err, OBS_INVALID_ARGUMENT, "unexpected argument '%s'", a);
         const char *eq = strchr(a + 2, '=');
         size_t n = eq ? (size_t)(eq - a - 2) : strlen(a + 2);
-        const obsd_opt_info *o = find_n(a + 2, n);
+        const obsd_opt_info *o = obs_table_find_n(&table, a + 2, n);
         if (!o)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown option '%.*s' (obscurad --help lists them)", (int)n + 2, a);
+            return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+                                  "unknown option '%.*s' (obscurad --help lists them)", (int)n + 2,
+                                  a);
         const char *value;
         if (eq)
             value = eq + 1;
         else if (i + 1 < argc)
             value = argv[++i];
         else
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "option --%s needs a value", o->name);
+            return obs_table_fail(err, OBS_INVALID_ARGUMENT, "option --%s needs a value", o->name);
         if (obsd_config_set(c, o->name, value, msg) != OBS_OK)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s", msg);
+            return obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s", msg);
     }
     return OBS_OK;
 }
 
 void obsd_config_format(const obsd_config *c, const obsd_opt_info *o, char *buf, size_t len)
 {
-    const char *field = (const char *)c + o->offset;
+    obs_table_format(&table, o, c, buf, len);
+}
+
+/* What --help shows after the flag: the choices, or the value's kind. */
+static const char *arg_name(const obsd_opt_info *o)
+{
     switch (o->type) {
-    case OBSD_OPT_STRING: snprintf(buf, len, "%s", field); break;
-    case OBSD_OPT_INT: snprintf(buf, len, "%d", *(const int *)(const void *)field); break;
-    case OBSD_OPT_SIZE: snprintf(buf, len, "%lld", (long long)*(const int64_t *)(const void *)field); break;
-    case OBSD_OPT_ENUM: {
-        int idx = *(const int *)(const void *)field;
-        const char *s = o->choices;
-        for (int k = 0; k < idx && s; k++) {
-            s = strchr(s, '|');
-            s = s ? s + 1 : NULL;
-        }
-        const char *bar = s ? strchr(s, '|') : NULL;
-        snprintf(buf, len, "%.*s", s ? (int)(bar ? (size_t)(bar - s) : strlen(s)) : 0, s ? s : "");
-        break;
-    }
+    case OBSD_OPT_ENUM: return o->choices;
+    case OBSD_OPT_INT: return "N";
+    case OBSD_OPT_SIZE: return "SIZE"; /* takes k, m, g */
+    default: return "STRING";
     }
 }
 
 void obsd_config_help(FILE *f)
 {
-    static const char *const args[] = {"STRING", "N", "SIZE", "CHOICE"}; /* SIZE takes k, m, g */
     fprintf(f, "obscurad %s: the obscura daemon (one GL context, frames over HTTP and the binary protocol)\n\n"
                "usage: obscurad [--config FILE] [--OPTION VALUE]...\n\n"
                "Every option is also a config-file line 'name value' (# comments);\n"
@@ -282,9 +186,9 @@ void obsd_config_help(FILE *f)
             OBS_VERSION);
     fprintf(f, "  %-26s %s\n", "--config FILE", "read options from FILE first");
     for (int i = 0; i < TABLE_LEN; i++) {
-        const obsd_opt_info *o = &table[i];
+        const obsd_opt_info *o = &rows[i];
         char left[64], range[96] = "";
-        snprintf(left, sizeof left, "--%s %s", o->name, o->type == OBSD_OPT_ENUM ? o->choices : args[o->type]);
+        snprintf(left, sizeof left, "--%s %s", o->name, arg_name(o));
         for (char *p = left + 2; *p && *p != ' '; p++)
             if (*p == '_')
                 *p = '-';
@@ -296,5 +200,5 @@ void obsd_config_help(FILE *f)
     fprintf(f, "  %-26s %s\n", "--help", "this text");
 }
 
-_Static_assert(sizeof table / sizeof table[0] <= sizeof ((obsd_config *)0)->set,
+_Static_assert(sizeof rows / sizeof rows[0] <= sizeof ((obsd_config *)0)->set,
                "obsd_config.set has a slot per option");

@@ -9,13 +9,18 @@
 #include <stdio.h>
 
 #include "obscura/status.h"
+#include "obscura/table.h"
 
 #define OBSD_STR_LEN 256
 
 /* X(name, type, min, max, default, doc)
  * type: STRING (max = longest length), INT, SIZE (bytes; k/m/g suffixes,
- * powers of 1024), ENUM (choices in the doc's braces are checked against
- * the `choices` column of obsd_enum_choices()). */
+ * powers of 1024), ENUM (its choices are OBSD_CHOICES_name below; the
+ * value is the 0-based index).  A new option is its row and its use:
+ * parsing, the config file, the flag, --help and the README table follow
+ * from the row. */
+#define OBSD_CHOICES_backend "auto|egl-device|egl-surfaceless|osmesa"
+#define OBSD_CHOICES_log_level "error|warn|info|debug"
 #define OBSD_CONFIG_TABLE(X)                                                   \
     X(http, STRING, 0, OBSD_STR_LEN - 1, "127.0.0.1:8420",                     \
       "HTTP listen address IPV4:PORT or [IPV6]:PORT (port 0 picks a free "     \
@@ -110,12 +115,14 @@
     X(fail_gl_after, INT, 0, 1000000000, "0",                                  \
       "testing: report a GL failure on frame N (0: never)")
 
-typedef enum obsd_opt_type {
-    OBSD_OPT_STRING,
-    OBSD_OPT_INT,
-    OBSD_OPT_SIZE,
-    OBSD_OPT_ENUM
-} obsd_opt_type;
+/* The option types, as the table engine's (obscura/table.h) reads them:
+ * STRING a char[OBSD_STR_LEN], INT an int of digits, SIZE an int64_t with
+ * k/m/g, ENUM the 0-based index among the choices. */
+typedef obs_table_type obsd_opt_type;
+#define OBSD_OPT_STRING OBS_TABLE_STRING
+#define OBSD_OPT_INT OBS_TABLE_WHOLE
+#define OBSD_OPT_SIZE OBS_TABLE_SIZE
+#define OBSD_OPT_ENUM OBS_TABLE_ENUM
 
 typedef struct obsd_config {
 #define OBSD__FIELD_STRING(n) char n[OBSD_STR_LEN];
@@ -129,15 +136,9 @@ typedef struct obsd_config {
     unsigned char set[32];
 } obsd_config;
 
-typedef struct obsd_opt_info {
-    const char *name;
-    obsd_opt_type type;
-    int64_t min, max;
-    const char *def;
-    const char *choices; /* ENUM only: "a|b|c"; the value is the index */
-    const char *doc;
-    size_t offset;
-} obsd_opt_info;
+/* A row: name, type, default, min and max (STRING: the longest length),
+ * choices (ENUM: "a|b|c"; the value is the index), doc, offset. */
+typedef obs_table_row obsd_opt_info;
 
 int obsd_opt_count(void);
 const obsd_opt_info *obsd_opt_at(int i);

@@ -30,6 +30,7 @@
 #include <stdint.h>
 
 #include "obscura/status.h"
+#include "obscura/table.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -258,18 +259,13 @@ typedef struct obs_bake_params {
     uint64_t set; /* bit i: row i of the table was given */
 } obs_bake_params;
 
-typedef enum obs_bake_param_type {
-    OBS_BAKE_PARAM_FLOAT,
-    OBS_BAKE_PARAM_INT,
-    OBS_BAKE_PARAM_ENUM
-} obs_bake_param_type;
-
-typedef struct obs_bake_param_info {
-    const char *name, *def, *choices, *doc;
-    obs_bake_param_type type;
-    double min, max;
-    size_t offset;
-} obs_bake_param_info;
+/* The rows are the table engine's (obscura/table.h); the names below
+ * are the ones the bake's callers have always used. */
+typedef obs_table_type obs_bake_param_type;
+#define OBS_BAKE_PARAM_FLOAT OBS_TABLE_FLOAT
+#define OBS_BAKE_PARAM_INT OBS_TABLE_INT
+#define OBS_BAKE_PARAM_ENUM OBS_TABLE_ENUM
+typedef obs_table_row obs_bake_param_info;
 
 int obs_bake_param_count(void);
 const obs_bake_param_info *obs_bake_param_at(int i); /* NULL out of range */

@@ -100,7 +100,8 @@ typedef struct obs_dyn_params {
     uint64_t set;
 } obs_dyn_params;
 
-/* The rows share obs_bake_param_info (offset into obs_dyn_params). */
+/* The rows share obs_bake_param_info, the table engine's row (offset into
+ * obs_dyn_params). */
 int obs_dyn_param_count(void);
 const obs_bake_param_info *obs_dyn_param_at(int i); /* NULL out of range */
 const obs_bake_param_info *obs_dyn_param_find(const char *name); /* '-' = '_' */

@@ -12,6 +12,7 @@
 #include <stddef.h>
 
 #include "obscura/status.h"
+#include "obscura/table.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -420,22 +421,16 @@ typedef struct obs_params {
     int method_conflict;
 } obs_params;
 
-typedef enum obs_param_type {
-    OBS_PARAM_FLOAT,
-    OBS_PARAM_INT,
-    OBS_PARAM_ENUM,
-    OBS_PARAM_MAT4
-} obs_param_type;
-
-typedef struct obs_param_info {
-    const char *name;     /* snake_case; flags use the same name with '-' */
-    obs_param_type type;
-    const char *def;      /* default as text, for help and docs */
-    double min, max;      /* FLOAT and INT only */
-    const char *choices;  /* ENUM only: "a|b|c" */
-    const char *doc;
-    size_t offset;        /* offsetof(obs_params, name) */
-} obs_param_info;
+/* A row of the table is the table engine's (obscura/table.h): name
+ * (snake_case; flags use it with '-'), type, default as text, min and max
+ * (FLOAT and INT), choices (ENUM "a|b|c"; INT: the numbers allowed), doc,
+ * offsetof(obs_params, name). */
+typedef obs_table_type obs_param_type;
+#define OBS_PARAM_FLOAT OBS_TABLE_FLOAT
+#define OBS_PARAM_INT OBS_TABLE_INT
+#define OBS_PARAM_ENUM OBS_TABLE_ENUM
+#define OBS_PARAM_MAT4 OBS_TABLE_MAT4
+typedef obs_table_row obs_param_info;
 
 int obs_param_count(void);
 /* NULL when i is out of range. */
