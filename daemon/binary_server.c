@@ -204,7 +204,7 @@ typedef struct frame {
 
 static void log_frame(const frame *f)
 {
-    obsd_stats_request(OBSD_ROUTE_BINARY, f->status, f->bytes_in, f->bytes_out);
+    obsd_stats_request(OBSD_STATS_BINARY, f->status, f->bytes_in, f->bytes_out);
     if (f->status == 200)
         obsd_stats_stage(OBSD_STAGE_TOTAL, obsd_now_ms() - f->t0);
     if (!obsd_log_enabled(OBSD_LOG_INFO))
@@ -583,7 +583,7 @@ static void refuse(obsd_bin *b, int fd, const conn *c, const char *why)
         sent = n > 0 ? (size_t)n : 0;
         obs_bytes_free(&out);
     }
-    obsd_stats_request(OBSD_ROUTE_BINARY, 503, 0, sent);
+    obsd_stats_request(OBSD_STATS_BINARY, 503, 0, sent);
     b->refused_total++;
     double now = obsd_now_ms();
     if (now - b->refused_logged >= 1000) {

@@ -65,7 +65,7 @@ static void answer_timeout(obsd_http *h, obsd__conn *c)
         (void)!send(c->fd, body, len, MSG_NOSIGNAL | MSG_DONTWAIT);
     free(body);
     size_t in = r ? r->len + r->discarded : 0;
-    obsd_stats_request(r ? r->route : OBSD_ROUTE_OTHER, 408, in, len);
+    obsd_stats_request(r ? r->slot : OBSD_STATS_OTHER, 408, in, len);
     if (r)
         obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s status=408 in=%zu out=%zu total=%.1f ms "
                  "error=request_timeout: %s", (unsigned long long)r->id, r->peer, r->method, r->path, in, len,

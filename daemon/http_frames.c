@@ -133,11 +133,12 @@ static void job_done(void *user)
     }
 }
 
-enum MHD_Result obsd__frame_start(req *r)
+enum MHD_Result obsd__frame_start(req *r, const char *url)
 {
     obsd_http *h = r->srv;
     const char *v;
     enum MHD_Result rc;
+    (void)url;
     r->before_drain = !atomic_load(&h->draining);
     if (!r->before_drain)
         return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
@@ -196,7 +197,7 @@ enum MHD_Result obsd__discard_body(req *r, size_t n, size_t max)
     if (r->discarded > max) {
         obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: body over twice the limit, "
                  "connection closed", (unsigned long long)r->id, r->peer, r->method,
-                 obsd_route_path(r->route));
+                 r->label);
         return MHD_NO;
     }
     return MHD_YES;

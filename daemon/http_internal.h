@@ -1,6 +1,7 @@
 /* Shared by the parts of obscurad's HTTP server.  Not a public header.
- * Calls go one way: http_server.c dispatches to http_frames.c,
- * http_streams.c, http_bakes.c, http_info.c and http_page.c; they all answer through
+ * Calls go one way: http_server.c dispatches through the route table
+ * (routes.c) to http_frames.c, http_streams.c, http_bakes.c, http_info.c
+ * and http_page.c; they all answer through
  * http_reply.c; http_streams.c also uses http_frames.c for its frames;
  * http_conn.c (the connections' records) is below them all. */
 #ifndef OBSD_HTTP_INTERNAL_H
@@ -15,6 +16,7 @@
 #include "http.h"
 #include "http_server.h"
 #include "obscura/io.h"
+#include "routes.h"
 #include "stats.h"
 #include "stream_store.h"
 
@@ -99,7 +101,10 @@ typedef struct obsd__req {
     obsd__conn *cn;      /* its connection's record */
     atomic_int job;      /* JOB_* */
     uint64_t id;
-    obsd_route route;
+    const obsd__route *route; /* its row of the route table; NULL: no such route */
+    int slot;            /* its counters' slot (stats.h) */
+    const char *label;   /* the route's label in the log and the metrics ("other": none) */
+    int frame_total;     /* its answer ends a frame: timed as the `total` stage */
     obsd__req_state state;
     char method[8];
     char peer[64];
@@ -187,7 +192,7 @@ enum MHD_Result obsd__answer_images(obsd__req *r, const obsd_fp_images *im, cons
 
 /* The start of a frame's request: query, Content-Type, Content-Length,
  * a full queue; then the body is read (REQ_BODY). */
-enum MHD_Result obsd__frame_start(obsd__req *r);
+enum MHD_Result obsd__frame_start(obsd__req *r, const char *url);
 /* A call in REQ_BODY: `size` bytes of the body, or (size 0) its end,
  * when the frame is decoded and queued. */
 enum MHD_Result obsd__frame_body(obsd__req *r, const char *data, size_t *size);
@@ -229,8 +234,12 @@ void obsd__bakes_done(obsd__req *r);
 
 /* ---- http_info.c, http_page.c ---- */
 
-/* GET /v1/params, /v1/info, /healthz, /readyz, /metrics (r->route). */
-enum MHD_Result obsd__info_route(obsd__req *r);
+/* GET /v1/params, /v1/info, /healthz, /readyz, /metrics. */
+enum MHD_Result obsd__params_get(obsd__req *r, const char *url);
+enum MHD_Result obsd__info_get(obsd__req *r, const char *url);
+enum MHD_Result obsd__healthz_get(obsd__req *r, const char *url);
+enum MHD_Result obsd__readyz_get(obsd__req *r, const char *url);
+enum MHD_Result obsd__metrics_get(obsd__req *r, const char *url);
 /* GET / and /preview/...: the embedded page. */
 enum MHD_Result obsd__page(obsd__req *r, const char *url);
 

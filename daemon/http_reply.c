@@ -43,8 +43,8 @@ enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size
     MHD_add_response_header(resp, "Server", "obscurad/" OBS_VERSION);
     enum MHD_Result rc = MHD_queue_response(r->conn, (unsigned)status, resp);
     MHD_destroy_response(resp);
-    obsd_stats_request(r->route, status, r->len + r->discarded, body_len);
-    if (r->route == OBSD_ROUTE_AO || r->op == STREAM_POST)
+    obsd_stats_request(r->slot, status, r->len + r->discarded, body_len);
+    if (r->frame_total)
         obsd_stats_stage(OBSD_STAGE_TOTAL, obsd_now_ms() - r->t0);
     log_request(r, rc == MHD_YES ? note : "(could not queue the answer)");
     return rc;

@@ -242,7 +242,8 @@ enum MHD_Result obsd__streams_start(req *r, const char *url)
     }
     case STREAM_POST:
         r->record_query = 1;
-        return obsd__frame_start(r);
+        r->frame_total = 1;
+        return obsd__frame_start(r, url);
     case STREAM_FRAME:
         return get_frame(r, latest ? 0 : seq);
     case STREAM_EVENTS:

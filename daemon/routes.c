@@ -1,28 +1,37 @@
-/* The route table: a URL path to its route, a route to its name (the
- * metrics' route label). */
+/* The route table: one row per HTTP route (routes.h says what a row
+ * holds).  The order is the metrics' order; keep new rows after
+ * /v1/bakes so that existing scrapes keep their order. */
 #include <string.h>
 
+#include "http_internal.h"
 #include "routes.h"
 
-static const char *const route_paths[OBSD_ROUTE_COUNT] = {
-    "/v1/ao", "/v1/params", "/v1/info", "/healthz", "/readyz", "/metrics", "/v1/streams", "/v1/bakes", "/",
-    "binary", "other"};
+const obsd__route obsd__routes[] = {
+    {"/v1/ao", NULL, "POST", "*", OBSD_ROUTE_FRAME_TOTAL, obsd__frame_start, obsd__frame_body, obsd__ao_finish, NULL},
+    {"/v1/params", NULL, "GET", NULL, 0, obsd__params_get, NULL, NULL, NULL},
+    {"/v1/info", NULL, "GET", NULL, 0, obsd__info_get, NULL, NULL, NULL},
+    {"/healthz", NULL, "GET", NULL, OBSD_ROUTE_OPEN | OBSD_ROUTE_PROBE, obsd__healthz_get, NULL, NULL, NULL},
+    {"/readyz", NULL, "GET", NULL, OBSD_ROUTE_OPEN | OBSD_ROUTE_PROBE, obsd__readyz_get, NULL, NULL, NULL},
+    {"/metrics", NULL, "GET", NULL, 0, obsd__metrics_get, NULL, NULL, NULL},
+    {"/v1/streams", "/v1/streams/", NULL, "POST", 0, obsd__streams_start, obsd__frame_body, obsd__streams_finish,
+     obsd__streams_done},
+    {"/v1/bakes", "/v1/bakes/", NULL, "POST", 0, obsd__bakes_start, obsd__bakes_body, NULL, obsd__bakes_done},
+    {"/", "/preview/", NULL, NULL, OBSD_ROUTE_OPEN, obsd__page, NULL, NULL, NULL},
+};
+const int obsd__route_count = (int)(sizeof obsd__routes / sizeof obsd__routes[0]);
 
-const char *obsd_route_path(obsd_route r)
+_Static_assert(sizeof obsd__routes / sizeof obsd__routes[0] <= OBSD_STATS_ROUTES,
+               "more routes than the request counters have slots (stats.h)");
+
+int obsd__route_find(const char *path)
 {
-    return r >= 0 && r < OBSD_ROUTE_COUNT ? route_paths[r] : "other";
+    if (!path)
+        return -1;
+    for (int i = 0; i < obsd__route_count; i++) {
+        const obsd__route *rt = &obsd__routes[i];
+        if (!strcmp(path, rt->path) || (rt->under && !strncmp(path, rt->under, strlen(rt->under))))
+            return i;
+    }
+    return -1;
 }
 
-obsd_route obsd_route_of(const char *path)
-{
-    for (int r = 0; r < OBSD_ROUTE_BINARY; r++)
-        if (path && !strcmp(path, route_paths[r]))
-            return (obsd_route)r;
-    if (path && !strncmp(path, "/v1/streams/", 12))
-        return OBSD_ROUTE_STREAMS;
-    if (path && !strncmp(path, "/v1/bakes/", 10))
-        return OBSD_ROUTE_BAKES;
-    if (path && !strncmp(path, "/preview/", 9))
-        return OBSD_ROUTE_PAGE;
-    return OBSD_ROUTE_OTHER;
-}
