@@ -14,8 +14,7 @@
  * `decorators`, a decorators file (obscura bake --decorators), checked
  * before the job is queued; libmicrohttpd's post processor copies the
  * parts out as the body arrives.
- * An event stream is a suspended connection, as the streams' are
- * (http_streams.c). */
+ * An event stream is http_events.c's, as the streams' are. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -351,37 +350,9 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
 
 /* ---- events -------------------------------------------------------------- */
 
-static void sub_park(void *arg)
+static int next_event(req *r, char *buf, size_t len)
 {
-    req *r = arg;
-    MHD_suspend_connection(r->conn);
-}
-
-static void sub_wake(void *arg)
-{
-    req *r = arg;
-    MHD_resume_connection(r->conn);
-}
-
-static ssize_t sse_reader(void *cls, uint64_t pos, char *buf, size_t max)
-{
-    req *r = cls;
-    (void)pos;
-    if (r->event_off >= r->event_len) {
-        int n = obsd_bakes_next_event(r->srv->bakes, &r->bsub, r->event, sizeof r->event);
-        if (n < 0)
-            return MHD_CONTENT_READER_END_OF_STREAM;
-        if (n == 0)
-            return 0; /* parked until woken */
-        r->event_len = n;
-        r->event_off = 0;
-    }
-    size_t k = (size_t)(r->event_len - r->event_off);
-    if (k > max)
-        k = max;
-    memcpy(buf, r->event + r->event_off, k);
-    r->event_off += (int)k;
-    return (ssize_t)k;
+    return obsd_bakes_next_event(r->srv->bakes, &r->bsub, buf, len);
 }
 
 static enum MHD_Result events(req *r)
@@ -390,7 +361,7 @@ static enum MHD_Result events(req *r)
     if (atomic_load(&h->draining))
         return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
                                   MHD_HTTP_HEADER_RETRY_AFTER, "5");
-    r->bsub = (obsd_bake_sub){.park = sub_park, .wake = sub_wake, .arg = r};
+    r->bsub = (obsd_bake_sub){.park = obsd__events_park, .wake = obsd__events_wake, .arg = r};
     int rc = obsd_bakes_subscribe(h->bakes, r->bake_id, &r->bsub);
     if (rc == -1)
         return unknown(r);
@@ -398,14 +369,8 @@ static enum MHD_Result events(req *r)
         return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
                                   MHD_HTTP_HEADER_RETRY_AFTER, "5");
     r->bsubscribed = 1;
-    struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 1024, sse_reader, r, NULL);
-    if (!resp)
-        return MHD_NO;
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "text/event-stream");
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
-    MHD_add_response_header(resp, "X-Accel-Buffering", "no");
-    r->state = REQ_EVENTS;
-    return obsd__answer(r, 200, resp, 0, "event stream opened");
+    r->events.next = next_event;
+    return obsd__events_answer(r, &r->events);
 }
 
 /* ---- the routes ------------------------------------------------------------- */

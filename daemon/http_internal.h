@@ -95,6 +95,16 @@ typedef enum obsd__stream_op {
     STREAM_EVENTS     /* GET /v1/streams/NAME/events */
 } obsd__stream_op;
 
+/* An event stream's answer (http_events.c): `next` writes the source's
+ * next event into buf and returns its length; 0: none yet (the source
+ * parked the connection, obsd__events_park, and wakes it); -1: the end. */
+typedef struct obsd__events {
+    int (*next)(struct obsd__req *r, char *buf, size_t len);
+    struct obsd__req *r;
+    char buf[512];
+    int len, off;
+} obsd__events;
+
 typedef struct obsd__req {
     obsd_http *srv;
     struct MHD_Connection *conn;
@@ -131,8 +141,7 @@ typedef struct obsd__req {
     double exposure;     /* stops applied to colour PNGs */
     obsd_sub sub;        /* GET .../events */
     int subscribed;
-    char event[512];
-    int event_len, event_off;
+    obsd__events events; /* GET .../events, of /v1/streams or /v1/bakes */
     /* /v1/bakes */
     int bake_op;
     char bake_id[OBSD_BAKE_ID_LEN + 1];
@@ -231,6 +240,16 @@ void obsd__streams_done(obsd__req *r);
 enum MHD_Result obsd__bakes_start(obsd__req *r, const char *url);
 enum MHD_Result obsd__bakes_body(obsd__req *r, const char *data, size_t *size);
 void obsd__bakes_done(obsd__req *r);
+
+/* ---- http_events.c: Server-Sent Events ---- */
+
+/* A subscriber's park and wake callbacks (arg: the request): suspend and
+ * resume its connection. */
+void obsd__events_park(void *arg);
+void obsd__events_wake(void *arg);
+/* Answers 200 text/event-stream with the events of ev->next (ev, which
+ * must live as long as the request, is set up by the caller); REQ_EVENTS. */
+enum MHD_Result obsd__events_answer(obsd__req *r, obsd__events *ev);
 
 /* ---- http_info.c, http_page.c ---- */
 

@@ -10,9 +10,7 @@
  *                                       exposure; other parameters re-run it
  *   GET  /v1/streams/NAME/events        text/event-stream: `frame` events
  *
- * An event stream is a suspended connection: the content reader parks it
- * when there is nothing to send and the store wakes it (new frame, keep-
- * alive, shutdown), so it holds no thread while it waits. */
+ * An event stream is http_events.c's: the store parks and wakes it. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -71,37 +69,9 @@ static int parse_path(req *r, const char *url, uint64_t *seq, int *latest)
 
 /* ---- Server-Sent Events ----------------------------------------------- */
 
-static void sub_park(void *arg)
+static int next_event(req *r, char *buf, size_t len)
 {
-    req *r = arg;
-    MHD_suspend_connection(r->conn);
-}
-
-static void sub_wake(void *arg)
-{
-    req *r = arg;
-    MHD_resume_connection(r->conn);
-}
-
-static ssize_t sse_reader(void *cls, uint64_t pos, char *buf, size_t max)
-{
-    req *r = cls;
-    (void)pos;
-    if (r->event_off >= r->event_len) {
-        int n = obsd_streams_next_event(r->srv->streams, &r->sub, r->event, sizeof r->event, obsd_now_ms());
-        if (n < 0)
-            return MHD_CONTENT_READER_END_OF_STREAM;
-        if (n == 0)
-            return 0; /* parked: the connection is suspended until woken */
-        r->event_len = n;
-        r->event_off = 0;
-    }
-    size_t k = (size_t)(r->event_len - r->event_off);
-    if (k > max)
-        k = max;
-    memcpy(buf, r->event + r->event_off, k);
-    r->event_off += (int)k;
-    return (ssize_t)k;
+    return obsd_streams_next_event(r->srv->streams, &r->sub, buf, len, obsd_now_ms());
 }
 
 static enum MHD_Result events(req *r)
@@ -110,7 +80,7 @@ static enum MHD_Result events(req *r)
     if (atomic_load(&h->draining))
         return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
                                   MHD_HTTP_HEADER_RETRY_AFTER, "5");
-    r->sub = (obsd_sub){.park = sub_park, .wake = sub_wake, .arg = r};
+    r->sub = (obsd_sub){.park = obsd__events_park, .wake = obsd__events_wake, .arg = r};
     if (obsd_streams_subscribe(h->streams, r->stream, &r->sub, obsd_now_ms()) != 0) {
         char msg[192];
         snprintf(msg, sizeof msg, "too many event subscribers (at most %d), or no stream '%s' and no room "
@@ -118,14 +88,8 @@ static enum MHD_Result events(req *r)
         return obsd__answer_error(r, 503, "too_many_subscribers", msg, MHD_HTTP_HEADER_RETRY_AFTER, "5");
     }
     r->subscribed = 1;
-    struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 1024, sse_reader, r, NULL);
-    if (!resp)
-        return MHD_NO;
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "text/event-stream");
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
-    MHD_add_response_header(resp, "X-Accel-Buffering", "no");
-    r->state = REQ_EVENTS;
-    return obsd__answer(r, 200, resp, 0, "event stream opened");
+    r->events.next = next_event;
+    return obsd__events_answer(r, &r->events);
 }
 
 /* ---- frames ------------------------------------------------------------ */
