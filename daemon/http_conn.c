@@ -225,7 +225,11 @@ void *obsd__conn_sweeper(void *arg)
 void obsd__req_free(req *r)
 {
     free(r->body);
-    obsd_fp_free(&r->fp);
+    if (r->fr) { /* the frame's state is freed here, not by a route's done: the GL worker may hold it longer */
+        obsd_fp_free(&r->fr->fp);
+        free(r->fr->query);
+        free(r->fr);
+    }
     free(r);
 }
 

@@ -112,7 +112,6 @@ static req *req_new(obsd_http *h, struct MHD_Connection *conn, obsd__conn *c, co
     req *r = calloc(1, sizeof *r);
     if (!r)
         return NULL;
-    obsd_fp_init(&r->fp);
     atomic_init(&r->job, JOB_NONE);
     r->srv = h;
     r->conn = conn;
