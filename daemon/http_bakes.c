@@ -226,7 +226,6 @@ static enum MHD_Result post_start(req *r)
         return obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL);
     const char *ct = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
     int multipart = ct && !strncasecmp(ct, "multipart/form-data", strlen("multipart/form-data"));
-    const char *v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
     if (multipart) {
         /* the parts are copied out as the body comes: nothing is held twice */
         if (!(bk->parts = calloc(1, sizeof *bk->parts)))
@@ -237,20 +236,9 @@ static enum MHD_Result post_start(req *r)
             return obsd__answer_error(r, 400, "bad_multipart",
                                       "a multipart/form-data body without a boundary", NULL, NULL);
     }
-    if (v) {
-        char *end;
-        errno = 0;
-        unsigned long long n = strtoull(v, &end, 10);
-        if (errno == ERANGE || n > (unsigned long long)h->cfg->max_level) {
-            char msg[160];
-            snprintf(msg, sizeof msg, "level of %s bytes is over the limit of %lld bytes (--max-level)", v,
-                     (long long)h->cfg->max_level);
-            return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
-        }
-        r->cap = multipart ? 0 : (size_t)n;
-        if (r->cap && !(r->body = malloc(r->cap)))
-            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the level");
-    }
+    enum MHD_Result rc;
+    if (!obsd__body_expect(r, (size_t)h->cfg->max_level, "level", "--max-level", !multipart, &rc))
+        return rc;
     r->state = REQ_BODY;
     return MHD_YES;
 }

@@ -21,6 +21,7 @@
 #include <time.h>
 
 #include "http_internal.h"
+#include "list.h"
 #include "log.h"
 
 typedef obsd__req req;
@@ -112,14 +113,9 @@ void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_conte
         if (!c)
             return;
         pthread_mutex_lock(&h->lock);
-        if (c->prev)
-            c->prev->next = c->next;
-        else
-            h->conns = c->next;
-        if (c->next)
-            c->next->prev = c->prev;
-        else
+        if (!c->next)
             h->conns_tail = c->prev;
+        OBSD_LIST_UNLINK(h->conns, c);
         h->open--;
         if (atomic_load(&c->cut) == CUT_EVICTED)
             h->evicting--;

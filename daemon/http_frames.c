@@ -167,22 +167,8 @@ enum MHD_Result obsd__frame_start(req *r, const char *url)
     if (v && strncmp(v, "image/x-exr", 11) != 0 && strncmp(v, "application/octet-stream", 24) != 0)
         return obsd__answer_error(r, 415, "unsupported_media_type",
                             "the body must be a G-buffer EXR (Content-Type: image/x-exr)", NULL, NULL);
-    v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
-    if (v) {
-        char *end;
-        errno = 0;
-        unsigned long long n = strtoull(v, &end, 10);
-        if (errno == ERANGE || n > (unsigned long long)h->cfg->max_body) {
-            char msg[160];
-            snprintf(msg, sizeof msg, "body of %s bytes is over the limit of %lld bytes (--max-body)",
-                     v, (long long)h->cfg->max_body);
-            return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
-        }
-        /* Sized by the claim, which is within the limit; grows if it lied. */
-        r->cap = n ? (size_t)n : 0;
-        if (r->cap && !(r->body = malloc(r->cap)))
-            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the body");
-    }
+    if (!obsd__body_expect(r, (size_t)h->cfg->max_body, "body", "--max-body", 1, &rc))
+        return rc;
     /* Refuse early when the queue is already full: no need for the body. */
     int full;
     obsd_queue_stats(h->queue, NULL, NULL, &full);
@@ -191,6 +177,30 @@ enum MHD_Result obsd__frame_start(req *r, const char *url)
                             MHD_HTTP_HEADER_RETRY_AFTER, "1");
     r->state = REQ_BODY;
     return MHD_YES;
+}
+
+int obsd__body_expect(req *r, size_t max, const char *what, const char *flag, int keep, enum MHD_Result *rc)
+{
+    const char *v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (!v)
+        return 1;
+    char *end, msg[160];
+    errno = 0;
+    unsigned long long n = strtoull(v, &end, 10);
+    if (errno == ERANGE || n > (unsigned long long)max) {
+        snprintf(msg, sizeof msg, "%s of %s bytes is over the limit of %lld bytes (%s)", what, v, (long long)max,
+                 flag);
+        *rc = obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
+        return 0;
+    }
+    /* Sized by the claim, which is within the limit; grows if it lied. */
+    r->cap = keep ? (size_t)n : 0;
+    if (r->cap && !(r->body = malloc(r->cap))) {
+        snprintf(msg, sizeof msg, "no memory for the %s", what);
+        *rc = obsd__answer_status(r, OBS_NO_MEMORY, msg);
+        return 0;
+    }
+    return 1;
 }
 
 int obsd__reserve(unsigned char **buf, size_t *cap, size_t need, size_t max)

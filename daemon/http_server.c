@@ -19,6 +19,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "addr.h"
 #include "http_internal.h"
 #include "log.h"
 
@@ -258,21 +259,8 @@ static int parse_addr(const char *s, struct sockaddr_storage *addr, socklen_t *a
         snprintf(name, sizeof name, "%s", host[0] ? host : "0.0.0.0");
     char *end;
     long port = strtol(colon + 1, &end, 10);
-    int ok = colon[1] && !*end && port >= 0 && port <= 65535;
-    memset(addr, 0, sizeof *addr);
-    if (v6) {
-        struct sockaddr_in6 *a = (struct sockaddr_in6 *)addr;
-        a->sin6_family = AF_INET6;
-        a->sin6_port = htons((uint16_t)port);
-        ok = ok && inet_pton(AF_INET6, name, &a->sin6_addr) == 1;
-        *alen = sizeof *a;
-    } else {
-        struct sockaddr_in *a = (struct sockaddr_in *)addr;
-        a->sin_family = AF_INET;
-        a->sin_port = htons((uint16_t)port);
-        ok = ok && inet_pton(AF_INET, name, &a->sin_addr) == 1;
-        *alen = sizeof *a;
-    }
+    int ok = colon[1] && !*end && port >= 0 && port <= 65535 &&
+             obsd_addr_fill(v6, name, (uint16_t)port, addr, alen) == 0;
     if (!ok) {
         snprintf(err, OBS_ERR_LEN, "--http '%s' is not IPV4:PORT or [IPV6]:PORT with a port in 0..65535", s);
         return -1;
