@@ -20,19 +20,8 @@
                     OBS_BIN_HAS_PROJECTION | OBS_BIN_DEEP_COLOR | OBS_BIN_DEEP_NORMAL)
 
 /* The message into err (when set), and s.  This file's own: the protocol
- * is built against the public headers only, not core's internal ones. */
-static obs_status fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static obs_status fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
-{
-    if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, OBS_ERR_LEN, fmt, ap);
-        va_end(ap);
-    }
-    return s;
-}
+ * is built against the public headers, not core's internal ones. */
+#define fail(err, s, ...) ((err) ? (void)snprintf((err), OBS_ERR_LEN, __VA_ARGS__) : (void)0, (s))
 
 /* a * b * c without overflow; 0 on overflow. */
 static int mul3(uint64_t a, uint64_t b, uint64_t c, uint64_t *out)
