@@ -188,8 +188,8 @@ int obsd__body_expect(req *r, size_t max, const char *what, const char *flag, in
     errno = 0;
     unsigned long long n = strtoull(v, &end, 10);
     if (errno == ERANGE || n > (unsigned long long)max) {
-        snprintf(msg, sizeof msg, "%s of %s bytes is over the limit of %lld bytes (%s)", what, v, (long long)max,
-                 flag);
+        snprintf(msg, sizeof msg, "%s of %s bytes is over the limit of %lld bytes (%s)", what, v,
+                 (long long)max, flag);
         *rc = obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
         return 0;
     }

@@ -194,7 +194,8 @@ enum MHD_Result obsd__frame_body(obsd__req *r, const char *data, size_t *size);
  * (or unreadable), 413 naming the `what` and its option `flag` is
  * answered (returns 0, *rc set); else the body's buffer is sized by it
  * when `keep` (a body kept whole; a multipart one is not).  1: go on. */
-int obsd__body_expect(obsd__req *r, size_t max, const char *what, const char *flag, int keep, enum MHD_Result *rc);
+int obsd__body_expect(obsd__req *r, size_t max, const char *what, const char *flag, int keep,
+                      enum MHD_Result *rc);
 /* Appends `size` bytes of a body up to max bytes (then r->too_big, the
  * rest discarded, the connection closed past twice max). */
 enum MHD_Result obsd__append_body(obsd__req *r, const char *data, size_t *size, size_t max);

@@ -7,16 +7,19 @@
 #include "routes.h"
 
 const obsd__route obsd__routes[] = {
-    {"/v1/ao", NULL, "POST", "*", OBSD_ROUTE_FRAME_TOTAL, obsd__frame_start, obsd__frame_body, obsd__ao_finish, NULL},
-    {"/v1/params", NULL, "GET", NULL, 0, obsd__params_get, NULL, NULL, NULL},
-    {"/v1/info", NULL, "GET", NULL, 0, obsd__info_get, NULL, NULL, NULL},
-    {"/healthz", NULL, "GET", NULL, OBSD_ROUTE_OPEN | OBSD_ROUTE_PROBE, obsd__healthz_get, NULL, NULL, NULL},
-    {"/readyz", NULL, "GET", NULL, OBSD_ROUTE_OPEN | OBSD_ROUTE_PROBE, obsd__readyz_get, NULL, NULL, NULL},
-    {"/metrics", NULL, "GET", NULL, 0, obsd__metrics_get, NULL, NULL, NULL},
-    {"/v1/streams", "/v1/streams/", NULL, "POST", 0, obsd__streams_start, obsd__frame_body, obsd__streams_finish,
-     obsd__streams_done},
-    {"/v1/bakes", "/v1/bakes/", NULL, "POST", 0, obsd__bakes_start, obsd__bakes_body, NULL, obsd__bakes_done},
-    {"/", "/preview/", NULL, NULL, OBSD_ROUTE_OPEN, obsd__page, NULL, NULL, NULL},
+    {.path = "/v1/ao", .methods = "POST", .reads_body = "*", .flags = OBSD_ROUTE_FRAME_TOTAL,
+     .start = obsd__frame_start, .body = obsd__frame_body, .finish = obsd__ao_finish},
+    {.path = "/v1/params", .methods = "GET", .start = obsd__params_get},
+    {.path = "/v1/info", .methods = "GET", .start = obsd__info_get},
+    {.path = "/healthz", .methods = "GET", .flags = OBSD_ROUTE_OPEN | OBSD_ROUTE_PROBE, .start = obsd__healthz_get},
+    {.path = "/readyz", .methods = "GET", .flags = OBSD_ROUTE_OPEN | OBSD_ROUTE_PROBE, .start = obsd__readyz_get},
+    {.path = "/metrics", .methods = "GET", .start = obsd__metrics_get},
+    /* the methods of each sub-route are http_streams.c's and http_bakes.c's to check */
+    {.path = "/v1/streams", .under = "/v1/streams/", .reads_body = "POST", .start = obsd__streams_start,
+     .body = obsd__frame_body, .finish = obsd__streams_finish, .done = obsd__streams_done},
+    {.path = "/v1/bakes", .under = "/v1/bakes/", .reads_body = "POST", .start = obsd__bakes_start,
+     .body = obsd__bakes_body, .done = obsd__bakes_done},
+    {.path = "/", .under = "/preview/", .flags = OBSD_ROUTE_OPEN, .start = obsd__page}, /* static: no token */
 };
 const int obsd__route_count = (int)(sizeof obsd__routes / sizeof obsd__routes[0]);
 
