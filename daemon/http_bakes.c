@@ -218,8 +218,7 @@ static enum MHD_Result post_start(req *r)
     bake_req *bk = r->own;
     obsd_http *h = r->srv;
     if (atomic_load(&h->draining))
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+        return obsd__answer_shutting_down(r);
     arg_ctx a = {r, 0, ""};
     MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
     if (a.bad)
@@ -332,8 +331,7 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
         return obsd__answer_error(r, 503, "bake_queue_full", msg, MHD_HTTP_HEADER_RETRY_AFTER, "10");
     }
     if (rc == -2)
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+        return obsd__answer_shutting_down(r);
     if (rc != 0)
         return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the bake job");
     char *text = malloc(512);
@@ -370,15 +368,13 @@ static enum MHD_Result events(req *r)
     bake_req *bk = r->own;
     obsd_http *h = r->srv;
     if (atomic_load(&h->draining))
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+        return obsd__answer_shutting_down(r);
     bk->sub = (obsd_bake_sub){.park = obsd__events_park, .wake = obsd__events_wake, .arg = r};
     int rc = obsd_bakes_subscribe(h->bakes, bk->id, &bk->sub);
     if (rc == -1)
         return unknown(r);
     if (rc != 0)
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+        return obsd__answer_shutting_down(r);
     bk->subscribed = 1;
     bk->events.next = next_event;
     return obsd__events_answer(r, &bk->events);

@@ -158,8 +158,7 @@ enum MHD_Result obsd__frame_start(req *r, const char *url)
         return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the request");
     fr->before_drain = !atomic_load(&h->draining);
     if (!fr->before_drain)
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                            MHD_HTTP_HEADER_RETRY_AFTER, "5");
+        return obsd__answer_shutting_down(r);
     obs_http_request_init(&fr->hr);
     if (!obsd__parse_query(r, &rc))
         return rc;

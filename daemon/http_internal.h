@@ -175,6 +175,8 @@ enum MHD_Result obsd__answer_text(obsd__req *r, int status, const char *type, ch
 /* The JSON error; one extra header (name, value) when hname is set. */
 enum MHD_Result obsd__answer_error(obsd__req *r, int status, const char *code, const char *msg,
                                    const char *hname, const char *hvalue);
+/* 503 shutting_down (Retry-After: 5): the drain refuses what would start. */
+enum MHD_Result obsd__answer_shutting_down(obsd__req *r);
 /* The error of a core status (503 with Retry-After). */
 enum MHD_Result obsd__answer_status(obsd__req *r, obs_status s, const char *msg);
 /* Answers with images as r->fr->hr asks (format, float, png_bits), a colour

@@ -85,6 +85,12 @@ enum MHD_Result obsd__answer_error(req *r, int status, const char *code, const c
     return obsd__answer(r, status, resp, len, note);
 }
 
+enum MHD_Result obsd__answer_shutting_down(req *r)
+{
+    return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down", MHD_HTTP_HEADER_RETRY_AFTER,
+                              "5");
+}
+
 enum MHD_Result obsd__answer_status(req *r, obs_status s, const char *msg)
 {
     const char *code;

@@ -102,8 +102,7 @@ static enum MHD_Result events(req *r)
     stream_req *sr = r->own;
     obsd_http *h = r->srv;
     if (atomic_load(&h->draining))
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+        return obsd__answer_shutting_down(r);
     sr->sub = (obsd_sub){.park = obsd__events_park, .wake = obsd__events_wake, .arg = r};
     if (obsd_streams_subscribe(h->streams, sr->name, &sr->sub, obsd_now_ms()) != 0) {
         char msg[192];
@@ -188,8 +187,7 @@ static enum MHD_Result get_frame(req *r, uint64_t seq)
     /* other parameters: the frame runs again (not kept) */
     fr->before_drain = !atomic_load(&h->draining);
     if (!fr->before_drain)
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+        return obsd__answer_shutting_down(r);
     int full;
     obsd_queue_stats(h->queue, NULL, NULL, &full);
     if (full)
