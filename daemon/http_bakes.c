@@ -14,8 +14,7 @@
  * `decorators`, a decorators file (obscura bake --decorators), checked
  * before the job is queued; libmicrohttpd's post processor copies the
  * parts out as the body arrives.
- * An event stream is a suspended connection, as the streams' are
- * (http_streams.c). */
+ * An event stream is http_events.c's, as the streams' are. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,6 +28,21 @@ typedef obsd__req req;
 
 enum { OP_LIST = 1, OP_INFO, OP_RESULT, OP_EVENTS };
 
+typedef struct parts parts; /* a multipart body's parts (below) */
+
+/* A /v1/bakes request's own state (r->own), freed by obsd__bakes_done. */
+typedef struct bake_req {
+    int op;                       /* OP_* */
+    char id[OBSD_BAKE_ID_LEN + 1];
+    char ext[16];                 /* format=EXT */
+    obs_bake_params params;
+    obsd_bake_sub sub;            /* GET .../events */
+    int subscribed;
+    obsd__events events;
+    struct MHD_PostProcessor *pp; /* a multipart body, split as it comes */
+    parts *parts;                 /* its parts */
+} bake_req;
+
 #define ROUTES "GET|POST /v1/bakes, GET|DELETE /v1/bakes/ID, GET /v1/bakes/ID/result, GET /v1/bakes/ID/events"
 
 static int id_ok(const char *s, size_t n)
@@ -41,30 +55,32 @@ static int id_ok(const char *s, size_t n)
     return 1;
 }
 
-/* 1: a route (r->bake_op, r->bake_id); 0: none; -1: not an id. */
+/* 1: a route (bk->op, bk->id); 0: none; -1: not an id. */
 static int parse_path(req *r, const char *url)
 {
+    bake_req *bk = r->own;
     const char *p = url + strlen("/v1/bakes");
     if (!*p || !strcmp(p, "/")) {
-        r->bake_op = OP_LIST;
+        bk->op = OP_LIST;
         return 1;
     }
     p++;
     size_t n = strcspn(p, "/");
     if (!id_ok(p, n))
         return -1;
-    memcpy(r->bake_id, p, n);
-    r->bake_id[n] = '\0';
+    memcpy(bk->id, p, n);
+    bk->id[n] = '\0';
     p += n;
-    r->bake_op = !*p ? OP_INFO : !strcmp(p, "/result") ? OP_RESULT : !strcmp(p, "/events") ? OP_EVENTS : 0;
-    return r->bake_op ? 1 : 0;
+    bk->op = !*p ? OP_INFO : !strcmp(p, "/result") ? OP_RESULT : !strcmp(p, "/events") ? OP_EVENTS : 0;
+    return bk->op ? 1 : 0;
 }
 
 static enum MHD_Result unknown(req *r)
 {
+    bake_req *bk = r->own;
     char msg[160];
     snprintf(msg, sizeof msg, "no bake job '%s' (jobs live in the daemon's memory: a restart loses them; "
-             "finished ones are dropped beyond --bake-keep)", r->bake_id);
+             "finished ones are dropped beyond --bake-keep)", bk->id);
     return obsd__answer_error(r, 404, "not_found", msg, NULL, NULL);
 }
 
@@ -81,6 +97,7 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
 {
     arg_ctx *a = cls;
     req *r = a->r;
+    bake_req *bk = r->own;
     (void)kind;
     if (a->bad)
         return MHD_NO;
@@ -92,7 +109,7 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
         value = "";
     if (!strcmp(key, "format")) {
         size_t n = strlen(value);
-        int ok = n > 0 && n < sizeof r->bake_ext;
+        int ok = n > 0 && n < sizeof bk->ext;
         for (size_t i = 0; ok && i < n; i++)
             ok = (value[i] >= 'a' && value[i] <= 'z') || (value[i] >= '0' && value[i] <= '9');
         if (!ok) {
@@ -101,7 +118,7 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
             a->bad = 1;
             return MHD_NO;
         }
-        snprintf(r->bake_ext, sizeof r->bake_ext, "%s", value);
+        snprintf(bk->ext, sizeof bk->ext, "%s", value);
         return MHD_YES;
     }
     if (!strcmp(key, "distances")) {
@@ -114,11 +131,11 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
         }
         snprintf(s, sizeof s, "%.*s", (int)(comma - value), value);
         snprintf(l, sizeof l, "%s", comma + 1);
-        a->bad = obs_bake_param_set(&r->bake_params, "distance_short", s, a->err) != OBS_OK ||
-                 obs_bake_param_set(&r->bake_params, "distance_long", l, a->err) != OBS_OK;
+        a->bad = obs_bake_param_set(&bk->params, "distance_short", s, a->err) != OBS_OK ||
+                 obs_bake_param_set(&bk->params, "distance_long", l, a->err) != OBS_OK;
         return a->bad ? MHD_NO : MHD_YES;
     }
-    if (obs_bake_param_set(&r->bake_params, key, value, a->err) != OBS_OK) {
+    if (obs_bake_param_set(&bk->params, key, value, a->err) != OBS_OK) {
         if (!obs_bake_param_find(key))
             snprintf(a->err, OBS_ERR_LEN, "unknown bake parameter '%.60s' (GET /v1/bakes lists none; "
                      "'obscura bake --params' lists them; also format=EXT, distances=S,L)", key);
@@ -130,14 +147,14 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
 
 /* ---- a multipart/form-data body: the parts `level` and `decorators` ---- */
 
-typedef struct obsd__parts {
+struct parts {
     unsigned char *buf[2]; /* level, decorators */
     size_t len[2], cap[2];
     size_t max;
     int seen[2];
     int too_large;    /* the error is a part over the limit: 413 */
     char err[200];
-} parts;
+};
 
 static const char *const part_name[2] = {"level", "decorators"};
 
@@ -182,8 +199,9 @@ static enum MHD_Result on_part(void *cls, enum MHD_ValueKind kind, const char *k
  * pt->err.  The post processor is destroyed. */
 static int parts_end(req *r, parts *pt)
 {
-    enum MHD_Result done = MHD_destroy_post_processor(r->bake_pp);
-    r->bake_pp = NULL;
+    bake_req *bk = r->own;
+    enum MHD_Result done = MHD_destroy_post_processor(bk->pp);
+    bk->pp = NULL;
     if (done != MHD_YES && !pt->err[0])
         snprintf(pt->err, sizeof pt->err, "the multipart/form-data body is cut short or malformed");
     if (!pt->err[0] && !pt->seen[0])
@@ -197,41 +215,29 @@ static int parts_end(req *r, parts *pt)
 
 static enum MHD_Result post_start(req *r)
 {
+    bake_req *bk = r->own;
     obsd_http *h = r->srv;
     if (atomic_load(&h->draining))
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+        return obsd__answer_shutting_down(r);
     arg_ctx a = {r, 0, ""};
     MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
     if (a.bad)
         return obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL);
     const char *ct = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
     int multipart = ct && !strncasecmp(ct, "multipart/form-data", strlen("multipart/form-data"));
-    const char *v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
     if (multipart) {
         /* the parts are copied out as the body comes: nothing is held twice */
-        if (!(r->bake_parts = calloc(1, sizeof *r->bake_parts)))
+        if (!(bk->parts = calloc(1, sizeof *bk->parts)))
             return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the parts");
-        r->bake_parts->max = (size_t)h->cfg->max_level;
-        r->bake_pp = MHD_create_post_processor(r->conn, 1 << 16, on_part, r->bake_parts);
-        if (!r->bake_pp)
+        bk->parts->max = (size_t)h->cfg->max_level;
+        bk->pp = MHD_create_post_processor(r->conn, 1 << 16, on_part, bk->parts);
+        if (!bk->pp)
             return obsd__answer_error(r, 400, "bad_multipart",
                                       "a multipart/form-data body without a boundary", NULL, NULL);
     }
-    if (v) {
-        char *end;
-        errno = 0;
-        unsigned long long n = strtoull(v, &end, 10);
-        if (errno == ERANGE || n > (unsigned long long)h->cfg->max_level) {
-            char msg[160];
-            snprintf(msg, sizeof msg, "level of %s bytes is over the limit of %lld bytes (--max-level)", v,
-                     (long long)h->cfg->max_level);
-            return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
-        }
-        r->cap = multipart ? 0 : (size_t)n;
-        if (r->cap && !(r->body = malloc(r->cap)))
-            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the level");
-    }
+    enum MHD_Result rc;
+    if (!obsd__body_expect(r, (size_t)h->cfg->max_level, "level", "--max-level", !multipart, &rc))
+        return rc;
     r->state = REQ_BODY;
     return MHD_YES;
 }
@@ -260,16 +266,17 @@ static const char *sniff(const unsigned char *p, size_t n)
 
 enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
 {
+    bake_req *bk = r->own;
     obsd_http *h = r->srv;
     if (!obsd__req_alive(r))
         return MHD_NO;
-    parts *pt = r->bake_parts;
+    parts *pt = bk->parts;
     if (*size && pt) {
         size_t n = *size;
         *size = 0;
         if (pt->err[0]) /* answered at the end, as 413 is */
             return obsd__discard_body(r, n, pt->max);
-        if (MHD_post_process(r->bake_pp, data, n) != MHD_YES && !pt->err[0])
+        if (MHD_post_process(bk->pp, data, n) != MHD_YES && !pt->err[0])
             snprintf(pt->err, sizeof pt->err, "the multipart/form-data body is malformed");
         return MHD_YES;
     }
@@ -294,7 +301,7 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
     if (r->len == 0)
         return obsd__answer_error(r, 400, "empty_body",
                                   "POST /v1/bakes needs a level (glTF/GLB, AC3D, OBJ, ...) as its body", NULL, NULL);
-    const char *ext = r->bake_ext[0] ? r->bake_ext : sniff(r->body, r->len);
+    const char *ext = bk->ext[0] ? bk->ext : sniff(r->body, r->len);
     if (!ext)
         return obsd__answer_error(r, 415, "unsupported_media_type",
                                   "cannot tell the level's format from its first bytes: give format=EXT "
@@ -317,15 +324,14 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
     size_t len = r->len;
     r->body = NULL; /* the job has it */
     r->cap = 0;
-    int rc = obsd_bakes_submit(h->bakes, level, len, ext, decor, rules, &r->bake_params, id);
+    int rc = obsd_bakes_submit(h->bakes, level, len, ext, decor, rules, &bk->params, id);
     if (rc == -1) {
         snprintf(msg, sizeof msg, "%d bake jobs are queued or running (--max-bakes); retry later",
                  h->cfg->max_bakes);
         return obsd__answer_error(r, 503, "bake_queue_full", msg, MHD_HTTP_HEADER_RETRY_AFTER, "10");
     }
     if (rc == -2)
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+        return obsd__answer_shutting_down(r);
     if (rc != 0)
         return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the bake job");
     char *text = malloc(512);
@@ -351,80 +357,47 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
 
 /* ---- events -------------------------------------------------------------- */
 
-static void sub_park(void *arg)
+static int next_event(req *r, char *buf, size_t len)
 {
-    req *r = arg;
-    MHD_suspend_connection(r->conn);
-}
-
-static void sub_wake(void *arg)
-{
-    req *r = arg;
-    MHD_resume_connection(r->conn);
-}
-
-static ssize_t sse_reader(void *cls, uint64_t pos, char *buf, size_t max)
-{
-    req *r = cls;
-    (void)pos;
-    if (r->event_off >= r->event_len) {
-        int n = obsd_bakes_next_event(r->srv->bakes, &r->bsub, r->event, sizeof r->event);
-        if (n < 0)
-            return MHD_CONTENT_READER_END_OF_STREAM;
-        if (n == 0)
-            return 0; /* parked until woken */
-        r->event_len = n;
-        r->event_off = 0;
-    }
-    size_t k = (size_t)(r->event_len - r->event_off);
-    if (k > max)
-        k = max;
-    memcpy(buf, r->event + r->event_off, k);
-    r->event_off += (int)k;
-    return (ssize_t)k;
+    bake_req *bk = r->own;
+    return obsd_bakes_next_event(r->srv->bakes, &bk->sub, buf, len);
 }
 
 static enum MHD_Result events(req *r)
 {
+    bake_req *bk = r->own;
     obsd_http *h = r->srv;
     if (atomic_load(&h->draining))
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
-    r->bsub = (obsd_bake_sub){.park = sub_park, .wake = sub_wake, .arg = r};
-    int rc = obsd_bakes_subscribe(h->bakes, r->bake_id, &r->bsub);
+        return obsd__answer_shutting_down(r);
+    bk->sub = (obsd_bake_sub){.park = obsd__events_park, .wake = obsd__events_wake, .arg = r};
+    int rc = obsd_bakes_subscribe(h->bakes, bk->id, &bk->sub);
     if (rc == -1)
         return unknown(r);
     if (rc != 0)
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
-    r->bsubscribed = 1;
-    struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 1024, sse_reader, r, NULL);
-    if (!resp)
-        return MHD_NO;
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "text/event-stream");
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
-    MHD_add_response_header(resp, "X-Accel-Buffering", "no");
-    r->state = REQ_EVENTS;
-    return obsd__answer(r, 200, resp, 0, "event stream opened");
+        return obsd__answer_shutting_down(r);
+    bk->subscribed = 1;
+    bk->events.next = next_event;
+    return obsd__events_answer(r, &bk->events);
 }
 
 /* ---- the routes ------------------------------------------------------------- */
 
 static enum MHD_Result result(req *r)
 {
+    bake_req *bk = r->own;
     unsigned char *data = NULL;
     size_t len = 0;
     obsd_bake_state st = OBSD_BAKE_QUEUED;
-    int rc = obsd_bakes_result(r->srv->bakes, r->bake_id, &data, &len, &st);
+    int rc = obsd_bakes_result(r->srv->bakes, bk->id, &data, &len, &st);
     if (rc == -1)
         return unknown(r);
     if (rc == -3)
         return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the result");
     if (rc == 1) {
         char msg[192];
-        snprintf(msg, sizeof msg, "bake %s is %s%s (GET /v1/bakes/%s says more)", r->bake_id,
+        snprintf(msg, sizeof msg, "bake %s is %s%s (GET /v1/bakes/%s says more)", bk->id,
                  obsd_bake_state_name(st), st == OBSD_BAKE_FAILED || st == OBSD_BAKE_CANCELLED ? ": no result" : "",
-                 r->bake_id);
+                 bk->id);
         return obsd__answer_error(r, 409,
                                   st == OBSD_BAKE_FAILED      ? "bake_failed"
                                   : st == OBSD_BAKE_CANCELLED ? "bake_cancelled"
@@ -442,14 +415,15 @@ static enum MHD_Result result(req *r)
 
 static enum MHD_Result delete_job(req *r)
 {
+    bake_req *bk = r->own;
     obsd_bake_state st;
     int removed = 0;
-    if (obsd_bakes_delete(r->srv->bakes, r->bake_id, &st, &removed) != 0)
+    if (obsd_bakes_delete(r->srv->bakes, bk->id, &st, &removed) != 0)
         return unknown(r);
     char *text = malloc(160);
     if (!text)
         return MHD_NO;
-    int n = snprintf(text, 160, "{\"id\":\"%s\",\"state\":\"%s\",\"removed\":%s%s}", r->bake_id,
+    int n = snprintf(text, 160, "{\"id\":\"%s\",\"state\":\"%s\",\"removed\":%s%s}", bk->id,
                      obsd_bake_state_name(st), removed ? "true" : "false",
                      st == OBSD_BAKE_RUNNING ? ",\"cancel_requested\":true" : "");
     return obsd__answer_text(r, 200, "application/json", text, (size_t)n, NULL);
@@ -458,6 +432,9 @@ static enum MHD_Result delete_job(req *r)
 enum MHD_Result obsd__bakes_start(req *r, const char *url)
 {
     obsd_http *h = r->srv;
+    bake_req *bk = r->own = calloc(1, sizeof *bk);
+    if (!bk)
+        return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the request");
     int ok = parse_path(r, url);
     if (h->cfg->max_bakes < 1)
         return obsd__answer_error(r, 404, "bakes_off", "bake jobs are off (--max-bakes 0)", NULL, NULL);
@@ -466,15 +443,15 @@ enum MHD_Result obsd__bakes_start(req *r, const char *url)
                                   "answered it", NULL, NULL);
     if (ok == 0)
         return obsd__answer_error(r, 404, "not_found", "no such route (" ROUTES ")", NULL, NULL);
-    const char *allowed = r->bake_op == OP_LIST ? "GET, POST" : r->bake_op == OP_INFO ? "GET, DELETE" : "GET";
+    const char *allowed = bk->op == OP_LIST ? "GET, POST" : bk->op == OP_INFO ? "GET, DELETE" : "GET";
     int get = !strcmp(r->method, "GET") || !strcmp(r->method, "HEAD");
-    if (!get && !(r->bake_op == OP_LIST && !strcmp(r->method, "POST")) &&
-        !(r->bake_op == OP_INFO && !strcmp(r->method, "DELETE"))) {
+    if (!get && !(bk->op == OP_LIST && !strcmp(r->method, "POST")) &&
+        !(bk->op == OP_INFO && !strcmp(r->method, "DELETE"))) {
         char msg[96];
         snprintf(msg, sizeof msg, "this /v1/bakes route takes %s", allowed);
         return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, allowed);
     }
-    switch (r->bake_op) {
+    switch (bk->op) {
     case OP_LIST: {
         if (!get)
             return post_start(r);
@@ -484,7 +461,7 @@ enum MHD_Result obsd__bakes_start(req *r, const char *url)
     case OP_INFO: {
         if (!get)
             return delete_job(r);
-        char *text = obsd_bakes_json(h->bakes, r->bake_id);
+        char *text = obsd_bakes_json(h->bakes, bk->id);
         return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : unknown(r);
     }
     case OP_RESULT:
@@ -496,17 +473,18 @@ enum MHD_Result obsd__bakes_start(req *r, const char *url)
 
 void obsd__bakes_done(req *r)
 {
-    if (r->bsubscribed) {
-        obsd_bakes_unsubscribe(r->srv->bakes, &r->bsub);
-        r->bsubscribed = 0;
+    bake_req *bk = r->own;
+    if (!bk)
+        return;
+    if (bk->subscribed)
+        obsd_bakes_unsubscribe(r->srv->bakes, &bk->sub);
+    if (bk->pp)
+        MHD_destroy_post_processor(bk->pp);
+    if (bk->parts) {
+        free(bk->parts->buf[0]);
+        free(bk->parts->buf[1]);
+        free(bk->parts);
     }
-    if (r->bake_pp)
-        MHD_destroy_post_processor(r->bake_pp);
-    r->bake_pp = NULL;
-    if (r->bake_parts) {
-        free(r->bake_parts->buf[0]);
-        free(r->bake_parts->buf[1]);
-        free(r->bake_parts);
-        r->bake_parts = NULL;
-    }
+    free(bk);
+    r->own = NULL;
 }

@@ -21,6 +21,7 @@
 #include <time.h>
 
 #include "http_internal.h"
+#include "list.h"
 #include "log.h"
 
 typedef obsd__req req;
@@ -65,7 +66,7 @@ static void answer_timeout(obsd_http *h, obsd__conn *c)
         (void)!send(c->fd, body, len, MSG_NOSIGNAL | MSG_DONTWAIT);
     free(body);
     size_t in = r ? r->len + r->discarded : 0;
-    obsd_stats_request(r ? r->route : OBSD_ROUTE_OTHER, 408, in, len);
+    obsd_stats_request(r ? r->slot : OBSD_STATS_OTHER, 408, in, len);
     if (r)
         obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s status=408 in=%zu out=%zu total=%.1f ms "
                  "error=request_timeout: %s", (unsigned long long)r->id, r->peer, r->method, r->path, in, len,
@@ -112,14 +113,9 @@ void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_conte
         if (!c)
             return;
         pthread_mutex_lock(&h->lock);
-        if (c->prev)
-            c->prev->next = c->next;
-        else
-            h->conns = c->next;
-        if (c->next)
-            c->next->prev = c->prev;
-        else
+        if (!c->next)
             h->conns_tail = c->prev;
+        OBSD_LIST_UNLINK(h->conns, c);
         h->open--;
         if (atomic_load(&c->cut) == CUT_EVICTED)
             h->evicting--;
@@ -225,7 +221,11 @@ void *obsd__conn_sweeper(void *arg)
 void obsd__req_free(req *r)
 {
     free(r->body);
-    obsd_fp_free(&r->fp);
+    if (r->fr) { /* the frame's state is freed here, not by a route's done: the GL worker may hold it longer */
+        obsd_fp_free(&r->fr->fp);
+        free(r->fr->query);
+        free(r->fr);
+    }
     free(r);
 }
 

@@ -26,18 +26,19 @@ typedef struct arg_ctx {
 
 static int record_pair(req *r, const char *key, const char *value)
 {
+    obsd__frame_req *fr = r->fr;
     size_t kl = strlen(key) + 1, vl = strlen(value) + 1;
-    if (r->query_len + kl + vl > r->query_cap) {
-        size_t cap = (r->query_cap ? r->query_cap * 2 : 256) + kl + vl;
-        char *p = realloc(r->query, cap);
+    if (fr->query_len + kl + vl > fr->query_cap) {
+        size_t cap = (fr->query_cap ? fr->query_cap * 2 : 256) + kl + vl;
+        char *p = realloc(fr->query, cap);
         if (!p)
             return -1;
-        r->query = p;
-        r->query_cap = cap;
+        fr->query = p;
+        fr->query_cap = cap;
     }
-    memcpy(r->query + r->query_len, key, kl);
-    memcpy(r->query + r->query_len + kl, value, vl);
-    r->query_len += kl + vl;
+    memcpy(fr->query + fr->query_len, key, kl);
+    memcpy(fr->query + fr->query_len + kl, value, vl);
+    fr->query_len += kl + vl;
     return 0;
 }
 
@@ -54,6 +55,7 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
 {
     arg_ctx *a = cls;
     req *r = a->r;
+    obsd__frame_req *fr = r->fr;
     (void)kind;
     if (a->status != OBS_OK)
         return MHD_NO;
@@ -62,7 +64,7 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
         return MHD_NO;
     if (!value)
         value = "";
-    if (r->op == STREAM_FRAME) {
+    if (fr->view) {
         /* a stored frame: the view options, and anything else re-runs it */
         if (name_is(key, "exposure")) {
             char *end;
@@ -73,20 +75,20 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
                 a->status = OBS_INVALID_ARGUMENT;
                 return MHD_NO;
             }
-            r->exposure = ev;
+            fr->exposure = ev;
             return MHD_YES;
         }
         if (name_is(key, "output") && !strcmp(value, "color")) {
-            r->want_color = 1;
+            fr->want_color = 1;
             return MHD_YES;
         }
         if (name_is(key, "output"))
-            r->want_color = 0;
+            fr->want_color = 0;
         else if (!name_is(key, "format") && !name_is(key, "float") && !name_is(key, "png_bits"))
-            r->rerun = 1;
+            fr->rerun = 1;
     }
-    a->status = obs_http_request_set(&r->hr, key, value, a->err);
-    if (a->status == OBS_OK && r->record_query && record_pair(r, key, value) != 0) {
+    a->status = obs_http_request_set(&fr->hr, key, value, a->err);
+    if (a->status == OBS_OK && fr->kept && record_pair(r, key, value) != 0) {
         snprintf(a->err, OBS_ERR_LEN, "no memory for the query");
         a->status = OBS_NO_MEMORY;
     }
@@ -95,10 +97,11 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
 
 int obsd__parse_query(req *r, enum MHD_Result *rc)
 {
+    obsd__frame_req *fr = r->fr;
     arg_ctx a = {r, OBS_OK, ""};
     MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
     if (a.status == OBS_OK)
-        a.status = obs_http_request_check(&r->hr, a.err);
+        a.status = obs_http_request_check(&fr->hr, a.err);
     if (a.status == OBS_OK)
         return 1;
     *rc = a.status == OBS_INVALID_ARGUMENT ? obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL)
@@ -133,38 +136,38 @@ static void job_done(void *user)
     }
 }
 
-enum MHD_Result obsd__frame_start(req *r)
+obsd__frame_req *obsd__frame_req_new(req *r)
+{
+    if (r->fr)
+        return r->fr;
+    if (!(r->fr = calloc(1, sizeof *r->fr)))
+        return NULL;
+    obsd_fp_init(&r->fr->fp);
+    obs_http_request_init(&r->fr->hr);
+    return r->fr;
+}
+
+enum MHD_Result obsd__frame_start(req *r, const char *url)
 {
     obsd_http *h = r->srv;
+    obsd__frame_req *fr = obsd__frame_req_new(r);
     const char *v;
     enum MHD_Result rc;
-    r->before_drain = !atomic_load(&h->draining);
-    if (!r->before_drain)
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                            MHD_HTTP_HEADER_RETRY_AFTER, "5");
-    obs_http_request_init(&r->hr);
+    (void)url;
+    if (!fr)
+        return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the request");
+    fr->before_drain = !atomic_load(&h->draining);
+    if (!fr->before_drain)
+        return obsd__answer_shutting_down(r);
+    obs_http_request_init(&fr->hr);
     if (!obsd__parse_query(r, &rc))
         return rc;
     v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
     if (v && strncmp(v, "image/x-exr", 11) != 0 && strncmp(v, "application/octet-stream", 24) != 0)
         return obsd__answer_error(r, 415, "unsupported_media_type",
                             "the body must be a G-buffer EXR (Content-Type: image/x-exr)", NULL, NULL);
-    v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
-    if (v) {
-        char *end;
-        errno = 0;
-        unsigned long long n = strtoull(v, &end, 10);
-        if (errno == ERANGE || n > (unsigned long long)h->cfg->max_body) {
-            char msg[160];
-            snprintf(msg, sizeof msg, "body of %s bytes is over the limit of %lld bytes (--max-body)",
-                     v, (long long)h->cfg->max_body);
-            return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
-        }
-        /* Sized by the claim, which is within the limit; grows if it lied. */
-        r->cap = n ? (size_t)n : 0;
-        if (r->cap && !(r->body = malloc(r->cap)))
-            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the body");
-    }
+    if (!obsd__body_expect(r, (size_t)h->cfg->max_body, "body", "--max-body", 1, &rc))
+        return rc;
     /* Refuse early when the queue is already full: no need for the body. */
     int full;
     obsd_queue_stats(h->queue, NULL, NULL, &full);
@@ -173,6 +176,30 @@ enum MHD_Result obsd__frame_start(req *r)
                             MHD_HTTP_HEADER_RETRY_AFTER, "1");
     r->state = REQ_BODY;
     return MHD_YES;
+}
+
+int obsd__body_expect(req *r, size_t max, const char *what, const char *flag, int keep, enum MHD_Result *rc)
+{
+    const char *v = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (!v)
+        return 1;
+    char *end, msg[160];
+    errno = 0;
+    unsigned long long n = strtoull(v, &end, 10);
+    if (errno == ERANGE || n > (unsigned long long)max) {
+        snprintf(msg, sizeof msg, "%s of %s bytes is over the limit of %lld bytes (%s)", what, v,
+                 (long long)max, flag);
+        *rc = obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
+        return 0;
+    }
+    /* Sized by the claim, which is within the limit; grows if it lied. */
+    r->cap = keep ? (size_t)n : 0;
+    if (r->cap && !(r->body = malloc(r->cap))) {
+        snprintf(msg, sizeof msg, "no memory for the %s", what);
+        *rc = obsd__answer_status(r, OBS_NO_MEMORY, msg);
+        return 0;
+    }
+    return 1;
 }
 
 int obsd__reserve(unsigned char **buf, size_t *cap, size_t need, size_t max)
@@ -196,7 +223,7 @@ enum MHD_Result obsd__discard_body(req *r, size_t n, size_t max)
     if (r->discarded > max) {
         obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: body over twice the limit, "
                  "connection closed", (unsigned long long)r->id, r->peer, r->method,
-                 obsd_route_path(r->route));
+                 r->label);
         return MHD_NO;
     }
     return MHD_YES;
@@ -228,21 +255,22 @@ enum MHD_Result obsd__append_body(req *r, const char *data, size_t *size, size_t
 
 enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len, unsigned outputs)
 {
+    obsd__frame_req *fr = r->fr;
     obsd_http *h = r->srv;
     char err[OBS_ERR_LEN] = "";
     obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
     /* A deep EXR runs on /v1/ao only: streams keep flat frames. */
-    obs_status s = obsd_fp_decode(&r->fp, body, len, &r->hr, &lim,
-                                  r->op == STREAM_POST ? "deep EXR input runs on POST /v1/ao, not in streams"
+    obs_status s = obsd_fp_decode(&fr->fp, body, len, &fr->hr, &lim,
+                                  fr->kept ? "deep EXR input runs on POST /v1/ao, not in streams"
                                                        : NULL,
                                   err);
     /* An EXR answer takes the body's header (its windows and attributes;
      * append=1: the body itself), which lives until the answer: r->body,
      * freed with the request, or a stream frame's, which it holds. */
-    if (s == OBS_OK && r->hr.format == OBS_HTTP_EXR)
-        obsd_fp_keep_source(&r->fp, body, len, obsd_fp_part(&r->fp));
+    if (s == OBS_OK && fr->hr.format == OBS_HTTP_EXR)
+        obsd_fp_keep_source(&fr->fp, body, len, obsd_fp_part(&fr->fp));
     if (s == OBS_OK)
-        s = obsd_fp_check_output(&r->fp, &r->hr, err);
+        s = obsd_fp_check_output(&fr->fp, &fr->hr, err);
     if (s != OBS_OK)
         return obsd__answer_status(r, s, err);
     /* The request is whole: its deadline stops (the GL worker's time is
@@ -256,8 +284,8 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     r->state = REQ_QUEUED;
     MHD_suspend_connection(r->conn);
     atomic_store(&r->job, JOB_PENDING);
-    if ((r->cn && atomic_load(&r->cn->cut)) || (atomic_load(&h->draining) && !r->before_drain) ||
-        obsd_fp_queue(&r->fp, h->queue, &r->hr.params, outputs, job_done, r) != 0) {
+    if ((r->cn && atomic_load(&r->cn->cut)) || (atomic_load(&h->draining) && !fr->before_drain) ||
+        obsd_fp_queue(&fr->fp, h->queue, &fr->hr.params, outputs, job_done, r) != 0) {
         int pending = JOB_PENDING;
         if (atomic_compare_exchange_strong(&r->job, &pending, JOB_NONE)) {
             r->state = REQ_REFUSED;
@@ -271,16 +299,17 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
 
 static enum MHD_Result queue_body(req *r)
 {
+    obsd__frame_req *fr = r->fr;
     if (r->len == 0) {
         char msg[128];
         snprintf(msg, sizeof msg, "%s %s needs a G-buffer EXR as its body", r->method,
-                 r->op == STREAM_POST ? "/v1/streams/NAME/frames" : "/v1/ao");
+                 fr->kept ? "/v1/streams/NAME/frames" : "/v1/ao");
         return obsd__answer_error(r, 400, "empty_body", msg, NULL, NULL);
     }
-    if (r->op == STREAM_POST) /* the body is kept with the frame: re-runs decode it again */
+    if (fr->kept) /* the body is kept with the frame: re-runs decode it again */
         return obsd__queue_frame(r, r->body, r->len, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE);
-    enum MHD_Result rc = obsd__queue_frame(r, r->body, r->len, r->hr.outputs);
-    if (!r->fp.src) { /* else the answer needs it; freed with the request */
+    enum MHD_Result rc = obsd__queue_frame(r, r->body, r->len, fr->hr.outputs);
+    if (!fr->fp.src) { /* else the answer needs it; freed with the request */
         free(r->body);
         r->body = NULL;
         r->cap = 0;
@@ -308,10 +337,11 @@ enum MHD_Result obsd__frame_body(req *r, const char *data, size_t *size)
  * it, or a PNG of the blended AO or the composite. */
 enum MHD_Result obsd__ao_finish(req *r)
 {
-    obs_status s = obsd_fp_finished(&r->fp);
+    obsd__frame_req *fr = r->fr;
+    obs_status s = obsd_fp_finished(&fr->fp);
     if (s != OBS_OK)
-        return obsd__answer_status(r, s, r->fp.job.err);
+        return obsd__answer_status(r, s, fr->fp.job.err);
     obsd_fp_images im;
-    obsd_fp_images_of(&r->fp, r->hr.outputs, &im);
-    return obsd__answer_images(r, &im, obsd_fp_camera(&r->fp), 1, NULL, NULL);
+    obsd_fp_images_of(&fr->fp, fr->hr.outputs, &im);
+    return obsd__answer_images(r, &im, obsd_fp_camera(&fr->fp), 1, NULL, NULL);
 }

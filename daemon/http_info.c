@@ -28,8 +28,9 @@ static void gauges(obsd_http *h, obsd_gauges *g)
     obsd_streams_gauges(h->streams, &g->streams, &g->stream_frames, &g->stream_bytes, &g->sse_subscribers);
 }
 
-static enum MHD_Result get_info(req *r)
+enum MHD_Result obsd__info_get(req *r, const char *url)
 {
+    (void)url;
     obsd_http *h = r->srv;
     cJSON *o = cJSON_CreateObject();
     if (!o)
@@ -59,41 +60,43 @@ static enum MHD_Result get_info(req *r)
     return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
 }
 
-enum MHD_Result obsd__info_route(req *r)
+enum MHD_Result obsd__params_get(req *r, const char *url)
+{
+    (void)url;
+    char *text = obs_http_params_json();
+    return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
+}
+
+enum MHD_Result obsd__healthz_get(req *r, const char *url)
+{
+    (void)url;
+    char *text = strdup("ok\n");
+    return text ? obsd__answer_text(r, 200, "text/plain", text, 3, NULL) : MHD_NO;
+}
+
+enum MHD_Result obsd__readyz_get(req *r, const char *url)
 {
     obsd_http *h = r->srv;
-    switch (r->route) {
-    case OBSD_ROUTE_PARAMS: {
-        char *text = obs_http_params_json();
-        return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
-    }
-    case OBSD_ROUTE_INFO:
-        return get_info(r);
-    case OBSD_ROUTE_HEALTHZ: {
-        char *text = strdup("ok\n");
-        return text ? obsd__answer_text(r, 200, "text/plain", text, 3, NULL) : MHD_NO;
-    }
-    case OBSD_ROUTE_READYZ: {
-        obsd_gauges g;
-        int full;
-        gauges(h, &g);
-        obsd_queue_stats(h->queue, NULL, NULL, &full);
-        const char *why = !g.gl_alive ? "GL context not alive"
-                          : atomic_load(&h->draining) ? "shutting down"
-                          : full ? "queue full" : NULL;
-        if (why)
-            return obsd__answer_error(r, 503, "not_ready", why, MHD_HTTP_HEADER_RETRY_AFTER, "1");
-        char *text = strdup("ready\n");
-        return text ? obsd__answer_text(r, 200, "text/plain", text, 6, NULL) : MHD_NO;
-    }
-    case OBSD_ROUTE_METRICS: {
-        obsd_gauges g;
-        size_t len = 0;
-        gauges(h, &g);
-        char *text = obsd_stats_text(&g, &len);
-        return text ? obsd__answer_text(r, 200, "text/plain; version=0.0.4", text, len, NULL) : MHD_NO;
-    }
-    default:
-        return obsd__answer_error(r, 404, "not_found", "no such route", NULL, NULL);
-    }
+    obsd_gauges g;
+    int full;
+    (void)url;
+    gauges(h, &g);
+    obsd_queue_stats(h->queue, NULL, NULL, &full);
+    const char *why = !g.gl_alive ? "GL context not alive"
+                      : atomic_load(&h->draining) ? "shutting down"
+                      : full ? "queue full" : NULL;
+    if (why)
+        return obsd__answer_error(r, 503, "not_ready", why, MHD_HTTP_HEADER_RETRY_AFTER, "1");
+    char *text = strdup("ready\n");
+    return text ? obsd__answer_text(r, 200, "text/plain", text, 6, NULL) : MHD_NO;
+}
+
+enum MHD_Result obsd__metrics_get(req *r, const char *url)
+{
+    obsd_gauges g;
+    size_t len = 0;
+    (void)url;
+    gauges(r->srv, &g);
+    char *text = obsd_stats_text(&g, &len);
+    return text ? obsd__answer_text(r, 200, "text/plain; version=0.0.4", text, len, NULL) : MHD_NO;
 }

@@ -1,6 +1,7 @@
 /* Shared by the parts of obscurad's HTTP server.  Not a public header.
- * Calls go one way: http_server.c dispatches to http_frames.c,
- * http_streams.c, http_bakes.c, http_info.c and http_page.c; they all answer through
+ * Calls go one way: http_server.c dispatches through the route table
+ * (routes.c) to http_frames.c, http_streams.c, http_bakes.c, http_info.c
+ * and http_page.c; they all answer through
  * http_reply.c; http_streams.c also uses http_frames.c for its frames;
  * http_conn.c (the connections' records) is below them all. */
 #ifndef OBSD_HTTP_INTERNAL_H
@@ -15,6 +16,7 @@
 #include "http.h"
 #include "http_server.h"
 #include "obscura/io.h"
+#include "routes.h"
 #include "stats.h"
 #include "stream_store.h"
 
@@ -83,60 +85,57 @@ typedef enum obsd__req_state {
     REQ_ANSWERED
 } obsd__req_state;
 
-/* What a /v1/streams request does. */
-typedef enum obsd__stream_op {
-    STREAM_NONE,
-    STREAM_LIST,      /* GET /v1/streams */
-    STREAM_INFO,      /* GET /v1/streams/NAME */
-    STREAM_POST,      /* POST /v1/streams/NAME/frames */
-    STREAM_FRAME,     /* GET /v1/streams/NAME/frames/N */
-    STREAM_EVENTS     /* GET /v1/streams/NAME/events */
-} obsd__stream_op;
+/* A frame's request (http_frames.c's: POST /v1/ao, and the streams'
+ * frames posted, viewed or re-run): its query, its trip through the frame
+ * path, the view of its answer.  Freed with the request (the GL worker
+ * may outlive the connection). */
+typedef struct obsd__frame_req {
+    obs_http_request hr;
+    obsd_fp fp;          /* the frame: its input, job, result and stage times */
+    int before_drain;    /* started before SIGTERM: finished in the drain */
+    int kept;            /* a stream's frame: flat input only; its body and query are kept with it */
+    int view;            /* a kept frame's GET: exposure and output=color view it, other parameters re-run it */
+    char *query;         /* kept: the query as "name\0value\0" pairs */
+    size_t query_len, query_cap;
+    int want_color;      /* output=color */
+    int rerun;           /* view with parameters: run the frame again */
+    double exposure;     /* stops applied to colour PNGs */
+} obsd__frame_req;
 
+/* An event stream's answer (http_events.c): `next` writes the source's
+ * next event into buf and returns its length; 0: none yet (the source
+ * parked the connection, obsd__events_park, and wakes it); -1: the end. */
+typedef struct obsd__events {
+    int (*next)(struct obsd__req *r, char *buf, size_t len);
+    struct obsd__req *r;
+    char buf[512];
+    int len, off;
+} obsd__events;
+
+/* One request: what every route has (its connection, route, state, body,
+ * answer and times); what only one route needs is behind `fr` and `own`. */
 typedef struct obsd__req {
     obsd_http *srv;
     struct MHD_Connection *conn;
     obsd__conn *cn;      /* its connection's record */
     atomic_int job;      /* JOB_* */
     uint64_t id;
-    obsd_route route;
+    const obsd__route *route; /* its row of the route table; NULL: no such route */
+    int slot;            /* its counters' slot (stats.h) */
+    const char *label;   /* the route's label in the log and the metrics ("other": none) */
+    int frame_total;     /* its answer ends a frame: timed as the `total` stage */
     obsd__req_state state;
     char method[8];
     char peer[64];
     char path[128];      /* the URL's path, for the log */
     double t0;
-    /* a frame's body */
+    /* its body (a frame's, a level's) */
     unsigned char *body;
     size_t len, cap;
     int too_big;
     size_t discarded;    /* bytes thrown away after too_big */
-    int before_drain;    /* started before SIGTERM: finished in the drain */
-    obs_http_request hr;
-    obsd_fp fp;          /* the frame: its input, job, result and stage times */
-    /* /v1/streams */
-    obsd__stream_op op;
-    char stream[OBSD_STREAM_NAME_LEN + 1];
-    char *query;         /* the query as "name\0value\0" pairs (recorded for a posted frame) */
-    size_t query_len, query_cap;
-    int record_query;
-    int query_failed;
-    obsd_frame *frame;   /* GET .../frames/N: the stored frame (a reference) */
-    int want_color;      /* output=color */
-    int rerun;           /* GET .../frames/N with parameters: run the frame again */
-    double exposure;     /* stops applied to colour PNGs */
-    obsd_sub sub;        /* GET .../events */
-    int subscribed;
-    char event[512];
-    int event_len, event_off;
-    /* /v1/bakes */
-    int bake_op;
-    char bake_id[OBSD_BAKE_ID_LEN + 1];
-    char bake_ext[16];
-    obs_bake_params bake_params;
-    obsd_bake_sub bsub;
-    int bsubscribed;
-    struct MHD_PostProcessor *bake_pp; /* a multipart body, split as it comes */
-    struct obsd__parts *bake_parts;    /* its parts (http_bakes.c) */
+    obsd__frame_req *fr; /* the frame it carries (http_frames.c), or NULL */
+    void *own;           /* its route's own state (http_streams.c, http_bakes.c), freed by the row's done */
     /* answer */
     int status;
     size_t bytes_out;
@@ -176,10 +175,12 @@ enum MHD_Result obsd__answer_text(obsd__req *r, int status, const char *type, ch
 /* The JSON error; one extra header (name, value) when hname is set. */
 enum MHD_Result obsd__answer_error(obsd__req *r, int status, const char *code, const char *msg,
                                    const char *hname, const char *hvalue);
+/* 503 shutting_down (Retry-After: 5): the drain refuses what would start. */
+enum MHD_Result obsd__answer_shutting_down(obsd__req *r);
 /* The error of a core status (503 with Retry-After). */
 enum MHD_Result obsd__answer_status(obsd__req *r, obs_status s, const char *msg);
-/* Answers with images as r->hr asks (format, float, png_bits), a colour
- * PNG exposed by r->exposure.  With `timing`, a Server-Timing header. */
+/* Answers with images as r->fr->hr asks (format, float, png_bits), a colour
+ * PNG exposed by r->fr->exposure.  With `timing`, a Server-Timing header. */
 enum MHD_Result obsd__answer_images(obsd__req *r, const obsd_fp_images *im, const obs_camera *cam, int timing,
                                     const char *extra_name, const char *extra_value);
 
@@ -187,10 +188,16 @@ enum MHD_Result obsd__answer_images(obsd__req *r, const obsd_fp_images *im, cons
 
 /* The start of a frame's request: query, Content-Type, Content-Length,
  * a full queue; then the body is read (REQ_BODY). */
-enum MHD_Result obsd__frame_start(obsd__req *r);
+enum MHD_Result obsd__frame_start(obsd__req *r, const char *url);
 /* A call in REQ_BODY: `size` bytes of the body, or (size 0) its end,
  * when the frame is decoded and queued. */
 enum MHD_Result obsd__frame_body(obsd__req *r, const char *data, size_t *size);
+/* The request's Content-Length, when it has one, against max: over it
+ * (or unreadable), 413 naming the `what` and its option `flag` is
+ * answered (returns 0, *rc set); else the body's buffer is sized by it
+ * when `keep` (a body kept whole; a multipart one is not).  1: go on. */
+int obsd__body_expect(obsd__req *r, size_t max, const char *what, const char *flag, int keep,
+                      enum MHD_Result *rc);
 /* Appends `size` bytes of a body up to max bytes (then r->too_big, the
  * rest discarded, the connection closed past twice max). */
 enum MHD_Result obsd__append_body(obsd__req *r, const char *data, size_t *size, size_t max);
@@ -201,10 +208,13 @@ enum MHD_Result obsd__discard_body(obsd__req *r, size_t n, size_t max);
 /* *buf of *cap bytes grown (doubling from 64 KiB, at most max unless need
  * is more) to hold need bytes: 0, or -1 on no memory (*buf unchanged). */
 int obsd__reserve(unsigned char **buf, size_t *cap, size_t need, size_t max);
-/* The request's query parameters into r->hr (recorded into r->query
- * when r->record_query); 400 answered on a bad one (returns 0, *rc set). */
+/* The request's query parameters into r->fr->hr (recorded into its query
+ * when kept); 400 answered on a bad one (returns 0, *rc set). */
 int obsd__parse_query(obsd__req *r, enum MHD_Result *rc);
-/* Decodes `body` into r->fp with r->hr's channel map (a deep EXR on
+/* The request's frame state (r->fr), made on the first call; NULL on no
+ * memory. */
+obsd__frame_req *obsd__frame_req_new(obsd__req *r);
+/* Decodes `body` into r->fr's frame with its query's channel map (a deep EXR on
  * POST /v1/ao only), queues the frame (outputs) and suspends the
  * connection; answers the error itself. */
 enum MHD_Result obsd__queue_frame(obsd__req *r, const unsigned char *body, size_t len, unsigned outputs);
@@ -227,10 +237,24 @@ enum MHD_Result obsd__bakes_start(obsd__req *r, const char *url);
 enum MHD_Result obsd__bakes_body(obsd__req *r, const char *data, size_t *size);
 void obsd__bakes_done(obsd__req *r);
 
+/* ---- http_events.c: Server-Sent Events ---- */
+
+/* A subscriber's park and wake callbacks (arg: the request): suspend and
+ * resume its connection. */
+void obsd__events_park(void *arg);
+void obsd__events_wake(void *arg);
+/* Answers 200 text/event-stream with the events of ev->next (ev, which
+ * must live as long as the request, is set up by the caller); REQ_EVENTS. */
+enum MHD_Result obsd__events_answer(obsd__req *r, obsd__events *ev);
+
 /* ---- http_info.c, http_page.c ---- */
 
-/* GET /v1/params, /v1/info, /healthz, /readyz, /metrics (r->route). */
-enum MHD_Result obsd__info_route(obsd__req *r);
+/* GET /v1/params, /v1/info, /healthz, /readyz, /metrics. */
+enum MHD_Result obsd__params_get(obsd__req *r, const char *url);
+enum MHD_Result obsd__info_get(obsd__req *r, const char *url);
+enum MHD_Result obsd__healthz_get(obsd__req *r, const char *url);
+enum MHD_Result obsd__readyz_get(obsd__req *r, const char *url);
+enum MHD_Result obsd__metrics_get(obsd__req *r, const char *url);
 /* GET / and /preview/...: the embedded page. */
 enum MHD_Result obsd__page(obsd__req *r, const char *url);
 

@@ -14,13 +14,15 @@ typedef obsd__req req;
 
 static void log_request(const req *r, const char *note)
 {
+    static const obsd_fp none; /* a request without a frame: its stages took 0 ms */
     if (!obsd_log_enabled(OBSD_LOG_INFO))
         return;
+    const obsd_fp *fp = r->fr ? &r->fr->fp : &none;
     obsd_log(OBSD_LOG_INFO,
              "req=%llu peer=%s %s %s status=%d in=%zu out=%zu queue=%.1f decode=%.1f gl=%.1f "
              "encode=%.1f total=%.1f ms%s%s",
              (unsigned long long)r->id, r->peer, r->method, r->path, r->status,
-             r->len + r->discarded, r->bytes_out, r->fp.ms_queue, r->fp.ms_decode, r->fp.ms_gl, r->fp.ms_encode,
+             r->len + r->discarded, r->bytes_out, fp->ms_queue, fp->ms_decode, fp->ms_gl, fp->ms_encode,
              obsd_now_ms() - r->t0, note && *note ? " " : "", note ? note : "");
 }
 
@@ -43,8 +45,8 @@ enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size
     MHD_add_response_header(resp, "Server", "obscurad/" OBS_VERSION);
     enum MHD_Result rc = MHD_queue_response(r->conn, (unsigned)status, resp);
     MHD_destroy_response(resp);
-    obsd_stats_request(r->route, status, r->len + r->discarded, body_len);
-    if (r->route == OBSD_ROUTE_AO || r->op == STREAM_POST)
+    obsd_stats_request(r->slot, status, r->len + r->discarded, body_len);
+    if (r->frame_total)
         obsd_stats_stage(OBSD_STAGE_TOTAL, obsd_now_ms() - r->t0);
     log_request(r, rc == MHD_YES ? note : "(could not queue the answer)");
     return rc;
@@ -83,6 +85,12 @@ enum MHD_Result obsd__answer_error(req *r, int status, const char *code, const c
     return obsd__answer(r, status, resp, len, note);
 }
 
+enum MHD_Result obsd__answer_shutting_down(req *r)
+{
+    return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down", MHD_HTTP_HEADER_RETRY_AFTER,
+                              "5");
+}
+
 enum MHD_Result obsd__answer_status(req *r, obs_status s, const char *msg)
 {
     const char *code;
@@ -109,6 +117,7 @@ static int expose(const obs_image *src, double ev, obs_image *out)
 static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, int timing,
                                     const char *extra_name, const char *extra_value)
 {
+    obsd__frame_req *fr = r->fr;
     struct MHD_Response *resp = MHD_create_response_from_buffer(out->size, out->data, MHD_RESPMEM_MUST_FREE);
     if (!resp) {
         obs_bytes_free(out);
@@ -118,32 +127,33 @@ static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, in
     if (timing) {
         char t[192];
         snprintf(t, sizeof t, "queue;dur=%.2f, decode;dur=%.2f, gl;dur=%.2f, encode;dur=%.2f",
-                 r->fp.ms_queue, r->fp.ms_decode, r->fp.ms_gl, r->fp.ms_encode);
+                 fr->fp.ms_queue, fr->fp.ms_decode, fr->fp.ms_gl, fr->fp.ms_encode);
         MHD_add_response_header(resp, "Server-Timing", t);
     }
     if (extra_name)
         MHD_add_response_header(resp, extra_name, extra_value);
     /* the input's sanity warnings (strict=1 makes them a 422 instead) */
-    for (int i = 0; i < r->fp.gf.info.warning_count; i++)
-        MHD_add_response_header(resp, "X-Obscura-Warning", r->fp.gf.info.warnings[i]);
+    for (int i = 0; i < fr->fp.gf.info.warning_count; i++)
+        MHD_add_response_header(resp, "X-Obscura-Warning", fr->fp.gf.info.warnings[i]);
     return obsd__answer(r, 200, resp, out->size, NULL);
 }
 
 enum MHD_Result obsd__answer_images(req *r, const obsd_fp_images *im, const obs_camera *cam, int timing,
                                     const char *extra_name, const char *extra_value)
 {
+    obsd__frame_req *fr = r->fr;
     char err[OBS_ERR_LEN] = "";
     obsd_fp_images shown = *im;
     obs_image exposed = {0};
     /* exposure is a view of a colour PNG; the AO is never exposed */
     const obs_image *img = obsd_fp_png_image(im);
-    if (r->hr.format != OBS_HTTP_EXR && img != im->ao && r->exposure != 0.0) {
-        if (expose(img, r->exposure, &exposed) != 0)
+    if (fr->hr.format != OBS_HTTP_EXR && img != im->ao && fr->exposure != 0.0) {
+        if (expose(img, fr->exposure, &exposed) != 0)
             return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the image");
         shown.composite = &exposed;
     }
     obs_bytes out;
-    obs_status s = obsd_fp_encode(&r->fp, &shown, &r->hr, 0, cam, &out, err);
+    obs_status s = obsd_fp_encode(&fr->fp, &shown, &fr->hr, 0, cam, &out, err);
     obs_image_free(&exposed);
     /* what the request asked for and the input cannot give (append=1: a
      * channel named like the AO layer) is the request's fault */
@@ -151,6 +161,6 @@ enum MHD_Result obsd__answer_images(req *r, const obsd_fp_images *im, const obs_
         return obsd__answer_status(r, s, err);
     if (s != OBS_OK)
         return obsd__answer_error(r, 500, "encode_failed", err, NULL, NULL);
-    return answer_bytes(r, &out, r->hr.format == OBS_HTTP_EXR ? "image/x-exr" : "image/png", timing,
+    return answer_bytes(r, &out, fr->hr.format == OBS_HTTP_EXR ? "image/x-exr" : "image/png", timing,
                         extra_name, extra_value);
 }

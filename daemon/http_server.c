@@ -1,6 +1,7 @@
 /* The HTTP server of obscurad: libmicrohttpd set up, each request's
- * life (its first call, the route, method and token checks, its end) and
- * the dispatch to the parts:
+ * life (its first call, its row of the route table (routes.c), the row's
+ * method and token checks, its end) and the dispatch to the row's
+ * handlers, in the parts:
  *
  *   http_frames.c   POST /v1/ao and the frames of streams
  *   http_streams.c  /v1/streams
@@ -18,6 +19,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "addr.h"
 #include "http_internal.h"
 #include "log.h"
 
@@ -70,40 +72,101 @@ static int framing_ok(req *r, int *has_body, enum MHD_Result *rc)
     return 0;
 }
 
+/* The method the row takes: "GET" takes HEAD too. */
+static int method_ok(const obsd__route *rt, const char *method)
+{
+    return !strcmp(method, rt->methods) || (!strcmp(rt->methods, "GET") && !strcmp(method, "HEAD"));
+}
+
+/* The checks of the route's row, then its start. */
 static enum MHD_Result dispatch(req *r, const char *url, const char *method)
 {
     obsd_http *h = r->srv;
-    if (r->cn && r->cn->reserve && r->route != OBSD_ROUTE_HEALTHZ && r->route != OBSD_ROUTE_READYZ) {
+    const obsd__route *rt = r->route;
+    if (r->cn && r->cn->reserve && !(rt && (rt->flags & OBSD_ROUTE_PROBE))) {
         char msg[128];
         snprintf(msg, sizeof msg, "%d connections are open (--http-connections); retry later",
                  h->cfg->http_connections);
         return obsd__answer_error(r, 503, "too_many_connections", msg, MHD_HTTP_HEADER_RETRY_AFTER, "1");
     }
-    if (r->route == OBSD_ROUTE_PAGE) /* the page is static: no token */
-        return obsd__page(r, url);
-    if (r->route == OBSD_ROUTE_OTHER)
+    if (!rt)
         return obsd__answer_error(r, 404, "not_found", "no such route (try GET /v1/params)", NULL, NULL);
-    const char *allowed = r->route == OBSD_ROUTE_AO ? "POST" : "GET";
-    if (r->route != OBSD_ROUTE_STREAMS && r->route != OBSD_ROUTE_BAKES && strcmp(method, allowed) != 0 &&
-        !(r->route != OBSD_ROUTE_AO && !strcmp(method, "HEAD"))) {
+    if (rt->methods && !method_ok(rt, method)) {
         char msg[64];
-        snprintf(msg, sizeof msg, "%s takes %s", obsd_route_path(r->route), allowed);
-        return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, allowed);
+        snprintf(msg, sizeof msg, "%s takes %s", rt->path, rt->methods);
+        return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, rt->methods);
     }
-    /* Probes stay open; the API and the metrics need the token. */
-    if (h->token && r->route != OBSD_ROUTE_HEALTHZ && r->route != OBSD_ROUTE_READYZ &&
+    /* Probes and the static page stay open; the API and the metrics need the token. */
+    if (h->token && !(rt->flags & OBSD_ROUTE_OPEN) &&
         !obs_http_bearer_ok(MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND,
                                                         MHD_HTTP_HEADER_AUTHORIZATION),
                             h->token))
         return obsd__answer_error(r, 401, "unauthorized", "missing or wrong bearer token",
                                   MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"obscurad\"");
-    if (r->route == OBSD_ROUTE_STREAMS)
-        return obsd__streams_start(r, url);
-    if (r->route == OBSD_ROUTE_BAKES)
-        return obsd__bakes_start(r, url);
-    if (r->route != OBSD_ROUTE_AO)
-        return obsd__info_route(r);
-    return obsd__frame_start(r);
+    return rt->start(r, url);
+}
+
+/* A request's record, made on its first call; NULL on no memory. */
+static req *req_new(obsd_http *h, struct MHD_Connection *conn, obsd__conn *c, const char *url,
+                    const char *method)
+{
+    req *r = calloc(1, sizeof *r);
+    if (!r)
+        return NULL;
+    atomic_init(&r->job, JOB_NONE);
+    r->srv = h;
+    r->conn = conn;
+    r->cn = c;
+    r->id = atomic_fetch_add(&h->next_id, 1) + 1;
+    r->t0 = obsd_now_ms();
+    int row = obsd__route_find(url);
+    r->route = row >= 0 ? &obsd__routes[row] : NULL;
+    r->slot = row >= 0 ? row : OBSD_STATS_OTHER;
+    r->label = row >= 0 ? r->route->path : "other";
+    r->frame_total = r->route && (r->route->flags & OBSD_ROUTE_FRAME_TOTAL);
+    snprintf(r->method, sizeof r->method, "%s", method);
+    snprintf(r->path, sizeof r->path, "%s", url);
+    for (char *p = r->path; *p; p++)
+        if ((unsigned char)*p < 0x21 || (unsigned char)*p > 0x7e)
+            *p = '?';
+    snprintf(r->peer, sizeof r->peer, "%s", c ? c->peer : "?");
+    return r;
+}
+
+/* A request's first call: its record, its deadline, its framing; then
+ * its start now (it reads a body, or has one), or on the next call. */
+static enum MHD_Result first_call(obsd_http *h, struct MHD_Connection *conn, const char *url,
+                                  const char *method, void **con_cls)
+{
+    const union MHD_ConnectionInfo *si = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    obsd__conn *c = si ? si->socket_context : NULL;
+    if (c && atomic_load(&c->cut))
+        return MHD_NO;
+    req *r = req_new(h, conn, c, url, method);
+    if (!r)
+        return MHD_NO;
+    *con_cls = r;
+    atomic_fetch_add(&h->in_flight, 1);
+    if (c && obsd__conn_attach(h, c, r, r->t0)) { /* its headers came too late */
+        char msg[128];
+        snprintf(msg, sizeof msg, "the request took over %d s (--request-timeout) to send its headers",
+                 h->cfg->request_timeout);
+        return obsd__answer_error(r, 408, "request_timeout", msg, NULL, NULL);
+    }
+    int has_body;
+    enum MHD_Result rc;
+    if (!framing_ok(r, &has_body, &rc))
+        return rc;
+    /* A route that reads its body starts now; anything else without one
+     * is answered on the next call, once MHD holds the whole request, so
+     * that the connection stays open for the next (an answer queued now
+     * closes it).  With a body it is answered now, and the body never
+     * read. */
+    const char *rb = r->route ? r->route->reads_body : NULL;
+    if ((rb && (!strcmp(rb, "*") || !strcmp(rb, method))) || has_body)
+        return dispatch(r, url, method);
+    r->state = REQ_DEFERRED;
+    return MHD_YES;
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const char *url,
@@ -113,50 +176,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
     obsd_http *h = cls;
     req *r = *con_cls;
     (void)version;
-    if (!r) {
-        const union MHD_ConnectionInfo *si = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
-        obsd__conn *c = si ? si->socket_context : NULL;
-        if (c && atomic_load(&c->cut))
-            return MHD_NO;
-        if (!(r = calloc(1, sizeof *r)))
-            return MHD_NO;
-        *con_cls = r;
-        atomic_fetch_add(&h->in_flight, 1);
-        obsd_fp_init(&r->fp);
-        atomic_init(&r->job, JOB_NONE);
-        r->srv = h;
-        r->conn = conn;
-        r->cn = c;
-        r->id = atomic_fetch_add(&h->next_id, 1) + 1;
-        r->t0 = obsd_now_ms();
-        r->route = obsd_route_of(url);
-        snprintf(r->method, sizeof r->method, "%s", method);
-        snprintf(r->path, sizeof r->path, "%s", url);
-        for (char *p = r->path; *p; p++)
-            if ((unsigned char)*p < 0x21 || (unsigned char)*p > 0x7e)
-                *p = '?';
-        snprintf(r->peer, sizeof r->peer, "%s", c ? c->peer : "?");
-        if (c && obsd__conn_attach(h, c, r, r->t0)) { /* its headers came too late */
-            char msg[128];
-            snprintf(msg, sizeof msg, "the request took over %d s (--request-timeout) to send its headers",
-                     h->cfg->request_timeout);
-            return obsd__answer_error(r, 408, "request_timeout", msg, NULL, NULL);
-        }
-        int has_body;
-        enum MHD_Result rc;
-        if (!framing_ok(r, &has_body, &rc))
-            return rc;
-        /* A frame reads its body; anything else without one is answered
-         * on the next call, once MHD holds the whole request, so that the
-         * connection stays open for the next (an answer queued now closes
-         * it).  With a body it is answered now, and the body never read. */
-        int frame = r->route == OBSD_ROUTE_AO ||
-                    ((r->route == OBSD_ROUTE_STREAMS || r->route == OBSD_ROUTE_BAKES) && !strcmp(method, "POST"));
-        if (frame || has_body)
-            return dispatch(r, url, method);
-        r->state = REQ_DEFERRED;
-        return MHD_YES;
-    }
+    if (!r)
+        return first_call(h, conn, url, method, con_cls);
     int job = atomic_load(&r->job);
     if (job == JOB_CUT || job == JOB_CUT_DONE)
         return MHD_NO; /* resumed by the cut: the connection closes */
@@ -167,11 +188,10 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
             return MHD_YES;
         }
         return dispatch(r, url, method);
-    case REQ_BODY:
-        return r->route == OBSD_ROUTE_BAKES ? obsd__bakes_body(r, upload_data, upload_data_size)
-                                            : obsd__frame_body(r, upload_data, upload_data_size);
-    case REQ_QUEUED:
-        return r->route == OBSD_ROUTE_STREAMS ? obsd__streams_finish(r) : obsd__ao_finish(r);
+    case REQ_BODY: /* only a row with a body handler enters REQ_BODY */
+        return r->route->body(r, upload_data, upload_data_size);
+    case REQ_QUEUED: /* only a row with a finish handler queues a frame */
+        return r->route->finish(r);
     case REQ_REFUSED:
         return obsd__answer_error(r, 503, atomic_load(&h->draining) ? "shutting_down" : "queue_full",
                             "the frame queue is full; retry later", MHD_HTTP_HEADER_RETRY_AFTER, "1");
@@ -194,12 +214,12 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
     int cut = c ? atomic_load(&c->cut) : CUT_NONE;
     if (why != MHD_REQUEST_TERMINATED_COMPLETED_OK && r->state != REQ_ANSWERED && cut != CUT_DEADLINE)
         obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s ended without an answer (reason %d%s)",
-                 (unsigned long long)r->id, r->peer, r->method, obsd_route_path(r->route), (int)why,
+                 (unsigned long long)r->id, r->peer, r->method, r->label, (int)why,
                  cut == CUT_DRAIN ? ", cut by the drain" : cut == CUT_EVICTED ? ", evicted" : "");
     if (c)
         obsd__conn_detach(h, c);
-    obsd__streams_done(r);
-    obsd__bakes_done(r);
+    if (r->route && r->route->done)
+        r->route->done(r);
     *con_cls = NULL;
     atomic_fetch_sub(&h->in_flight, 1);
     /* cut while the GL worker had its frame: the worker frees it */
@@ -239,21 +259,8 @@ static int parse_addr(const char *s, struct sockaddr_storage *addr, socklen_t *a
         snprintf(name, sizeof name, "%s", host[0] ? host : "0.0.0.0");
     char *end;
     long port = strtol(colon + 1, &end, 10);
-    int ok = colon[1] && !*end && port >= 0 && port <= 65535;
-    memset(addr, 0, sizeof *addr);
-    if (v6) {
-        struct sockaddr_in6 *a = (struct sockaddr_in6 *)addr;
-        a->sin6_family = AF_INET6;
-        a->sin6_port = htons((uint16_t)port);
-        ok = ok && inet_pton(AF_INET6, name, &a->sin6_addr) == 1;
-        *alen = sizeof *a;
-    } else {
-        struct sockaddr_in *a = (struct sockaddr_in *)addr;
-        a->sin_family = AF_INET;
-        a->sin_port = htons((uint16_t)port);
-        ok = ok && inet_pton(AF_INET, name, &a->sin_addr) == 1;
-        *alen = sizeof *a;
-    }
+    int ok = colon[1] && !*end && port >= 0 && port <= 65535 &&
+             obsd_addr_fill(v6, name, (uint16_t)port, addr, alen) == 0;
     if (!ok) {
         snprintf(err, OBS_ERR_LEN, "--http '%s' is not IPV4:PORT or [IPV6]:PORT with a port in 0..65535", s);
         return -1;
@@ -294,6 +301,8 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
     atomic_init(&h->next_id, 0);
     atomic_init(&h->sweeper_stop, 0);
     pthread_mutex_init(&h->lock, NULL);
+    for (int i = 0; i < obsd__route_count; i++)
+        obsd_stats_label(i, obsd__routes[i].path);
     unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL | MHD_USE_ITC |
                      MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG;
     if (h->family == AF_INET6)

@@ -10,9 +10,7 @@
  *                                       exposure; other parameters re-run it
  *   GET  /v1/streams/NAME/events        text/event-stream: `frame` events
  *
- * An event stream is a suspended connection: the content reader parks it
- * when there is nothing to send and the store wakes it (new frame, keep-
- * alive, shutdown), so it holds no thread while it waits. */
+ * An event stream is http_events.c's: the store parks and wakes it. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,39 +20,61 @@
 
 typedef obsd__req req;
 
-/* Splits the path after /v1/streams into r->op and r->stream; 0 when it
+/* What a /v1/streams request does. */
+typedef enum stream_op {
+    STREAM_NONE,
+    STREAM_LIST,      /* GET /v1/streams */
+    STREAM_INFO,      /* GET /v1/streams/NAME */
+    STREAM_POST,      /* POST /v1/streams/NAME/frames */
+    STREAM_FRAME,     /* GET /v1/streams/NAME/frames/N */
+    STREAM_EVENTS     /* GET /v1/streams/NAME/events */
+} stream_op;
+
+/* A /v1/streams request's own state (r->own); its frame, when it posts
+ * or re-runs one, is http_frames.c's (r->fr). */
+typedef struct stream_req {
+    stream_op op;
+    char name[OBSD_STREAM_NAME_LEN + 1];
+    obsd_frame *frame;   /* GET .../frames/N, or the posted frame once kept: a reference */
+    obsd_sub sub;        /* GET .../events */
+    int subscribed;
+    obsd__events events;
+} stream_req;
+
+/* Splits the path after /v1/streams into sr->op and sr->name; 0 when it
  * is no route (404), -1 when the name is not valid. */
 static int parse_path(req *r, const char *url, uint64_t *seq, int *latest)
 {
+    stream_req *sr = r->own;
     const char *p = url + strlen("/v1/streams");
     if (!*p || !strcmp(p, "/")) {
-        r->op = STREAM_LIST;
+        sr->op = STREAM_LIST;
         return 1;
     }
     p++; /* the '/' */
     size_t n = strcspn(p, "/");
     if (n > OBSD_STREAM_NAME_LEN)
         return -1;
-    memcpy(r->stream, p, n);
-    r->stream[n] = '\0';
-    if (!obsd_stream_name_ok(r->stream))
+    memcpy(sr->name, p, n);
+    sr->name[n] = '\0';
+    if (!obsd_stream_name_ok(sr->name))
         return -1;
     p += n;
     if (!*p) {
-        r->op = STREAM_INFO;
+        sr->op = STREAM_INFO;
         return 1;
     }
     if (!strcmp(p, "/events")) {
-        r->op = STREAM_EVENTS;
+        sr->op = STREAM_EVENTS;
         return 1;
     }
     if (!strcmp(p, "/frames")) {
-        r->op = STREAM_POST;
+        sr->op = STREAM_POST;
         return 1;
     }
     if (!strncmp(p, "/frames/", 8)) {
         const char *s = p + 8;
-        r->op = STREAM_FRAME;
+        sr->op = STREAM_FRAME;
         if (!strcmp(s, "latest")) {
             *latest = 1;
             return 1;
@@ -71,61 +91,28 @@ static int parse_path(req *r, const char *url, uint64_t *seq, int *latest)
 
 /* ---- Server-Sent Events ----------------------------------------------- */
 
-static void sub_park(void *arg)
+static int next_event(req *r, char *buf, size_t len)
 {
-    req *r = arg;
-    MHD_suspend_connection(r->conn);
-}
-
-static void sub_wake(void *arg)
-{
-    req *r = arg;
-    MHD_resume_connection(r->conn);
-}
-
-static ssize_t sse_reader(void *cls, uint64_t pos, char *buf, size_t max)
-{
-    req *r = cls;
-    (void)pos;
-    if (r->event_off >= r->event_len) {
-        int n = obsd_streams_next_event(r->srv->streams, &r->sub, r->event, sizeof r->event, obsd_now_ms());
-        if (n < 0)
-            return MHD_CONTENT_READER_END_OF_STREAM;
-        if (n == 0)
-            return 0; /* parked: the connection is suspended until woken */
-        r->event_len = n;
-        r->event_off = 0;
-    }
-    size_t k = (size_t)(r->event_len - r->event_off);
-    if (k > max)
-        k = max;
-    memcpy(buf, r->event + r->event_off, k);
-    r->event_off += (int)k;
-    return (ssize_t)k;
+    stream_req *sr = r->own;
+    return obsd_streams_next_event(r->srv->streams, &sr->sub, buf, len, obsd_now_ms());
 }
 
 static enum MHD_Result events(req *r)
 {
+    stream_req *sr = r->own;
     obsd_http *h = r->srv;
     if (atomic_load(&h->draining))
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
-    r->sub = (obsd_sub){.park = sub_park, .wake = sub_wake, .arg = r};
-    if (obsd_streams_subscribe(h->streams, r->stream, &r->sub, obsd_now_ms()) != 0) {
+        return obsd__answer_shutting_down(r);
+    sr->sub = (obsd_sub){.park = obsd__events_park, .wake = obsd__events_wake, .arg = r};
+    if (obsd_streams_subscribe(h->streams, sr->name, &sr->sub, obsd_now_ms()) != 0) {
         char msg[192];
         snprintf(msg, sizeof msg, "too many event subscribers (at most %d), or no stream '%s' and no room "
-                 "for a new one (--streams)", OBSD_STREAM_MAX_SUBS, r->stream);
+                 "for a new one (--streams)", OBSD_STREAM_MAX_SUBS, sr->name);
         return obsd__answer_error(r, 503, "too_many_subscribers", msg, MHD_HTTP_HEADER_RETRY_AFTER, "5");
     }
-    r->subscribed = 1;
-    struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 1024, sse_reader, r, NULL);
-    if (!resp)
-        return MHD_NO;
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "text/event-stream");
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
-    MHD_add_response_header(resp, "X-Accel-Buffering", "no");
-    r->state = REQ_EVENTS;
-    return obsd__answer(r, 200, resp, 0, "event stream opened");
+    sr->subscribed = 1;
+    sr->events.next = next_event;
+    return obsd__events_answer(r, &sr->events);
 }
 
 /* ---- frames ------------------------------------------------------------ */
@@ -135,78 +122,86 @@ static enum MHD_Result events(req *r)
  * carry over. */
 static void apply_stored(req *r, const obsd_frame *f)
 {
+    obsd__frame_req *fr = r->fr;
     char err[OBS_ERR_LEN];
     for (size_t k = 0; k + 1 < f->query_len;) {
         const char *key = f->query + k, *val = key + strlen(key) + 1;
-        (void)obs_http_request_set(&r->hr, key, val, err); /* they were valid when posted */
+        (void)obs_http_request_set(&fr->hr, key, val, err); /* they were valid when posted */
         k = (size_t)(val - f->query) + strlen(val) + 1;
     }
-    r->hr.outputs = OBS_OUTPUT_AO;
-    r->hr.format = OBS_HTTP_EXR;
-    r->hr.float_exr = 0;
-    r->hr.png_bits = 8;
+    fr->hr.outputs = OBS_OUTPUT_AO;
+    fr->hr.format = OBS_HTTP_EXR;
+    fr->hr.float_exr = 0;
+    fr->hr.png_bits = 8;
 }
 
-/* A kept frame's images that r->hr asks for. */
+/* A kept frame's images that the request asks for. */
 static obsd_fp_images kept_images(const req *r, const obsd_frame *f)
 {
-    return (obsd_fp_images){.ao = (r->hr.outputs & OBS_OUTPUT_AO) ? &f->ao : NULL,
-                            .composite = (r->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &f->composite : NULL};
+    obsd__frame_req *fr = r->fr;
+    return (obsd_fp_images){.ao = (fr->hr.outputs & OBS_OUTPUT_AO) ? &f->ao : NULL,
+                            .composite = (fr->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &f->composite : NULL};
 }
 
 static enum MHD_Result get_frame(req *r, uint64_t seq)
 {
+    stream_req *sr = r->own;
     obsd_http *h = r->srv;
     int found = 0;
     enum MHD_Result rc;
     char msg[320];
-    r->frame = obsd_streams_get(h->streams, r->stream, seq, &found);
-    if (!r->frame) {
+    sr->frame = obsd_streams_get(h->streams, sr->name, seq, &found);
+    if (!sr->frame) {
         if (found && seq)
             snprintf(msg, sizeof msg, "stream '%s' has no frame %llu (GET /v1/streams/%s lists the kept ones)",
-                     r->stream, (unsigned long long)seq, r->stream);
+                     sr->name, (unsigned long long)seq, sr->name);
         else
-            snprintf(msg, sizeof msg, found ? "stream '%s' has no frame yet" : "no stream '%s'", r->stream);
+            snprintf(msg, sizeof msg, found ? "stream '%s' has no frame yet" : "no stream '%s'", sr->name);
         return obsd__answer_error(r, 404, "not_found", msg, NULL, NULL);
     }
-    obs_http_request_init(&r->hr);
-    apply_stored(r, r->frame);
+    obsd__frame_req *fr = obsd__frame_req_new(r);
+    if (!fr)
+        return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the request");
+    fr->view = 1;
+    apply_stored(r, sr->frame);
     if (!obsd__parse_query(r, &rc))
         return rc;
-    const obsd_frame *f = r->frame;
+    const obsd_frame *f = sr->frame;
     char num[32];
     snprintf(num, sizeof num, "%llu", (unsigned long long)f->seq);
     /* a kept frame's EXR takes its body's header, as its POST's did */
-    if (r->hr.format == OBS_HTTP_EXR)
-        obsd_fp_keep_source(&r->fp, f->body, f->body_len, f->part);
-    if (r->want_color) {
+    if (fr->hr.format == OBS_HTTP_EXR)
+        obsd_fp_keep_source(&fr->fp, f->body, f->body_len, f->part);
+    if (fr->want_color) {
         if (!f->color.data)
             return obsd__answer_error(r, 404, "no_color", "the frame's G-buffer has no colour plane", NULL,
                                       NULL);
         obsd_fp_images color = {.composite = &f->color};
         return obsd__answer_images(r, &color, NULL, 0, "X-Obscura-Frame", num);
     }
-    if (!r->rerun) {
+    if (!fr->rerun) {
         obsd_fp_images im = kept_images(r, f);
         return obsd__answer_images(r, &im, f->camera.has_projection ? &f->camera : NULL, 0, "X-Obscura-Frame",
                                    num);
     }
     /* other parameters: the frame runs again (not kept) */
-    r->before_drain = !atomic_load(&h->draining);
-    if (!r->before_drain)
-        return obsd__answer_error(r, 503, "shutting_down", "the daemon is shutting down",
-                                  MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    fr->before_drain = !atomic_load(&h->draining);
+    if (!fr->before_drain)
+        return obsd__answer_shutting_down(r);
     int full;
     obsd_queue_stats(h->queue, NULL, NULL, &full);
     if (full)
         return obsd__answer_error(r, 503, "queue_full", "the frame queue is full; retry later",
                                   MHD_HTTP_HEADER_RETRY_AFTER, "1");
-    return obsd__queue_frame(r, f->body, f->body_len, r->hr.outputs);
+    return obsd__queue_frame(r, f->body, f->body_len, fr->hr.outputs);
 }
 
 enum MHD_Result obsd__streams_start(req *r, const char *url)
 {
     obsd_http *h = r->srv;
+    stream_req *sr = r->own = calloc(1, sizeof *sr);
+    if (!sr)
+        return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the request");
     uint64_t seq = 0;
     int latest = 0;
     int ok = parse_path(r, url, &seq, &latest);
@@ -219,30 +214,33 @@ enum MHD_Result obsd__streams_start(req *r, const char *url)
                                   "GET /v1/streams/NAME/events)", NULL, NULL);
     if (h->cfg->streams < 1)
         return obsd__answer_error(r, 404, "streams_off", "streams are off (--streams 0)", NULL, NULL);
-    const char *allowed = r->op == STREAM_POST ? "POST" : "GET";
-    if (strcmp(r->method, allowed) != 0 && !(r->op != STREAM_POST && !strcmp(r->method, "HEAD"))) {
+    const char *allowed = sr->op == STREAM_POST ? "POST" : "GET";
+    if (strcmp(r->method, allowed) != 0 && !(sr->op != STREAM_POST && !strcmp(r->method, "HEAD"))) {
         char msg[96];
         snprintf(msg, sizeof msg, "this /v1/streams route takes %s", allowed);
         return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, allowed);
     }
-    switch (r->op) {
+    switch (sr->op) {
     case STREAM_LIST: {
         char *text = obsd_streams_list_json(h->streams);
         return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
     }
     case STREAM_INFO: {
         int found;
-        char *text = obsd_streams_stream_json(h->streams, r->stream, &found);
+        char *text = obsd_streams_stream_json(h->streams, sr->name, &found);
         if (!found) {
             char msg[96];
-            snprintf(msg, sizeof msg, "no stream '%s'", r->stream);
+            snprintf(msg, sizeof msg, "no stream '%s'", sr->name);
             return obsd__answer_error(r, 404, "not_found", msg, NULL, NULL);
         }
         return text ? obsd__answer_text(r, 200, "application/json", text, strlen(text), NULL) : MHD_NO;
     }
     case STREAM_POST:
-        r->record_query = 1;
-        return obsd__frame_start(r);
+        if (!obsd__frame_req_new(r))
+            return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the request");
+        r->fr->kept = 1;
+        r->frame_total = 1;
+        return obsd__frame_start(r, url);
     case STREAM_FRAME:
         return get_frame(r, latest ? 0 : seq);
     case STREAM_EVENTS:
@@ -280,9 +278,11 @@ static int copy_color(const obs_gbuffer *gb, obs_image *out)
 /* POST .../frames, the GL worker done: keep the frame, answer like /v1/ao. */
 static enum MHD_Result post_finish(req *r)
 {
+    obsd__frame_req *fr = r->fr;
+    stream_req *sr = r->own;
     obsd_http *h = r->srv;
-    const obs_gbuffer *gb = &r->fp.gf.gb;
-    obs_result *res = &r->fp.job.result;
+    const obs_gbuffer *gb = &fr->fp.gf.gb;
+    obs_result *res = &fr->fp.job.result;
     obsd_frame *f = obsd_frame_new();
     if (!f || copy_color(gb, &f->color) != 0) {
         obsd_frame_release(f);
@@ -294,56 +294,58 @@ static enum MHD_Result post_finish(req *r)
     f->body_len = r->len;
     r->body = NULL;
     r->cap = 0;
-    f->query = r->query;
-    f->query_len = r->query_len;
-    r->query = NULL;
-    r->query_len = r->query_cap = 0;
+    f->query = fr->query;
+    f->query_len = fr->query_len;
+    fr->query = NULL;
+    fr->query_len = fr->query_cap = 0;
     f->ao = res->ao;
     f->composite = res->composite;
     res->ao = (obs_image){0};
     res->composite = (obs_image){0};
     obs_result_free(res);
     f->camera = gb->camera;
-    f->part = obsd_fp_part(&r->fp);
-    f->ms_queue = r->fp.ms_queue;
-    f->ms_decode = r->fp.ms_decode;
-    f->ms_gl = r->fp.ms_gl;
+    f->part = obsd_fp_part(&fr->fp);
+    f->ms_queue = fr->fp.ms_queue;
+    f->ms_decode = fr->fp.ms_decode;
+    f->ms_gl = fr->fp.ms_gl;
     atomic_fetch_add(&f->refs, 1); /* ours, to answer with */
-    uint64_t seq = obsd_streams_add(h->streams, r->stream, f);
+    uint64_t seq = obsd_streams_add(h->streams, sr->name, f);
     if (!seq) {
         obsd_frame_release(f);
         return obsd__answer_status(r, OBS_NO_MEMORY, "no memory to keep the frame");
     }
     char num[32];
     snprintf(num, sizeof num, "%llu", (unsigned long long)seq);
-    r->frame = f; /* released when the request ends */
+    sr->frame = f; /* released when the request ends */
     obsd_fp_images im = kept_images(r, f);
     return obsd__answer_images(r, &im, f->camera.has_projection ? &f->camera : NULL, 1, "X-Obscura-Frame", num);
 }
 
 enum MHD_Result obsd__streams_finish(req *r)
 {
-    obs_status s = obsd_fp_finished(&r->fp);
+    obsd__frame_req *fr = r->fr;
+    stream_req *sr = r->own;
+    obs_status s = obsd_fp_finished(&fr->fp);
     if (s != OBS_OK)
-        return obsd__answer_status(r, s, r->fp.job.err);
-    if (r->op == STREAM_POST)
+        return obsd__answer_status(r, s, fr->fp.job.err);
+    if (sr->op == STREAM_POST)
         return post_finish(r);
     /* a re-run of a kept frame */
     char num[32];
-    snprintf(num, sizeof num, "%llu", (unsigned long long)r->frame->seq);
+    snprintf(num, sizeof num, "%llu", (unsigned long long)sr->frame->seq);
     obsd_fp_images im;
-    obsd_fp_images_of(&r->fp, r->hr.outputs, &im);
-    return obsd__answer_images(r, &im, obsd_fp_camera(&r->fp), 1, "X-Obscura-Frame", num);
+    obsd_fp_images_of(&fr->fp, fr->hr.outputs, &im);
+    return obsd__answer_images(r, &im, obsd_fp_camera(&fr->fp), 1, "X-Obscura-Frame", num);
 }
 
 void obsd__streams_done(req *r)
 {
-    if (r->subscribed) {
-        obsd_streams_unsubscribe(r->srv->streams, &r->sub);
-        r->subscribed = 0;
-    }
-    obsd_frame_release(r->frame);
-    r->frame = NULL;
-    free(r->query);
-    r->query = NULL;
+    stream_req *sr = r->own;
+    if (!sr)
+        return;
+    if (sr->subscribed)
+        obsd_streams_unsubscribe(r->srv->streams, &sr->sub);
+    obsd_frame_release(sr->frame);
+    free(sr);
+    r->own = NULL;
 }

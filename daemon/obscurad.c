@@ -85,6 +85,81 @@ static void sleep_ms(int ms)
     nanosleep(&ts, NULL); /* a signal cuts it short, which is what we want */
 }
 
+/* The GL context's backend (--backend, else OBSCURA_BACKEND, else auto)
+ * and program cache (an explicit --cache-dir, even empty, wins); -1 on a
+ * backend that is none (logged). */
+static int context_desc(const obsd_config *cfg, obs_ctx_desc *desc)
+{
+    const obsd_opt_info *bo = obsd_opt_find("backend");
+    const char *env = getenv("OBSCURA_BACKEND");
+    char bname[32];
+    obsd_config_format(cfg, bo, bname, sizeof bname);
+    if (!cfg->set[bo - obsd_opt_at(0)] && env && *env)
+        snprintf(bname, sizeof bname, "%s", env);
+    if (obs_backend_parse(bname, &desc->backend) != OBS_OK) {
+        obsd_log(OBSD_LOG_ERROR, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
+        return -1;
+    }
+    const obsd_opt_info *co = obsd_opt_find("cache_dir");
+    static char cache[OBSD_STR_LEN + 64];
+    char why[OBS_ERR_LEN];
+    desc->cache_dir = obs_cache_dir_default(cfg->set[co - obsd_opt_at(0)] ? cfg->cache_dir : NULL, cache,
+                                           sizeof cache, why);
+    if (why[0])
+        obsd_log(OBSD_LOG_WARN, "%s", why);
+    return 0;
+}
+
+/* The log's lines that say where obscurad listens. */
+static void log_listeners(const obsd_config *cfg, obsd_http *http, obsd_bin *bin, int token)
+{
+    if (cfg->socket[0])
+        obsd_log(OBSD_LOG_INFO, "binary protocol on unix:%s", cfg->socket);
+    if (cfg->tcp[0]) {
+        char host[OBSD_STR_LEN] = "127.0.0.1";
+        const char *colon = strrchr(cfg->tcp, ':');
+        if (colon && colon > cfg->tcp)
+            snprintf(host, sizeof host, "%.*s", (int)(colon - cfg->tcp), cfg->tcp);
+        obsd_log(OBSD_LOG_INFO, "binary protocol on tcp://%s:%d", host, obsd_bin_tcp_port(bin));
+    }
+    if (http) {
+        char url[OBSD_STR_LEN + 16];
+        obsd_http_url(http, url, sizeof url);
+        obsd_log(OBSD_LOG_INFO, "listening on %s (queue %d, %d threads, max %lld pixels, "
+                 "max body %lld bytes%s)", url, cfg->queue, cfg->threads,
+                 (long long)cfg->max_pixels, (long long)cfg->max_body, token ? ", token required" : "");
+    }
+}
+
+/* Drain: no new connections; every frame taken is finished and answered
+ * before the server stops, within --drain-timeout: past it what is left
+ * is cut (logged), so the drain ends whatever the clients do. */
+static void drain(const obsd_config *cfg, obsd_http *http, obsd_bin *bin)
+{
+    obsd_log(OBSD_LOG_INFO, "stopping: finishing %d request(s) and %d binary connection(s) under way "
+             "(SIGINT again to quit now)", http ? obsd_http_in_flight(http) : 0, obsd_bin_in_flight(bin));
+    if (http)
+        obsd_http_quiesce(http);
+    obsd_bin_quiesce(bin);
+    const double drain_end = obsd_now_ms() + 1000.0 * cfg->drain_timeout;
+    while ((http && obsd_http_in_flight(http) > 0) || obsd_bin_in_flight(bin) > 0) {
+        if (interrupts >= 2) {
+            obsd_log(OBSD_LOG_WARN, "second SIGINT: exiting now");
+            _exit(130);
+        }
+        if (cfg->drain_timeout > 0 && obsd_now_ms() >= drain_end) {
+            int requests = http ? obsd_http_in_flight(http) : 0, conns = obsd_bin_in_flight(bin);
+            obsd_log(OBSD_LOG_WARN, "drain deadline (%d s) passed: cutting %d request(s) and %d "
+                     "binary connection(s)", cfg->drain_timeout, requests, conns);
+            if (http)
+                obsd_http_cut(http);
+            obsd_bin_cut(bin);
+            break;
+        }
+        sleep_ms(20);
+    }
+}
+
 int main(int argc, char **argv)
 {
     obsd_config cfg;
@@ -110,24 +185,8 @@ int main(int argc, char **argv)
         return 2;
 
     obs_ctx_desc desc = {.log = obsd_log_core};
-    const obsd_opt_info *bo = obsd_opt_find("backend");
-    const char *env = getenv("OBSCURA_BACKEND");
-    char bname[32];
-    obsd_config_format(&cfg, bo, bname, sizeof bname);
-    if (!cfg.set[bo - obsd_opt_at(0)] && env && *env)
-        snprintf(bname, sizeof bname, "%s", env);
-    if (obs_backend_parse(bname, &desc.backend) != OBS_OK) {
-        obsd_log(OBSD_LOG_ERROR, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
+    if (context_desc(&cfg, &desc) != 0)
         return 2;
-    }
-    /* the program cache: an explicit --cache-dir (even empty) wins */
-    const obsd_opt_info *co = obsd_opt_find("cache_dir");
-    static char cache[OBSD_STR_LEN + 64];
-    char why[OBS_ERR_LEN];
-    desc.cache_dir = obs_cache_dir_default(cfg.set[co - obsd_opt_at(0)] ? cfg.cache_dir : NULL, cache,
-                                           sizeof cache, why);
-    if (why[0])
-        obsd_log(OBSD_LOG_WARN, "%s", why);
     if (install_signals() != 0) {
         obsd_log(OBSD_LOG_ERROR, "cannot install signal handlers: %s", strerror(errno));
         return 1;
@@ -165,54 +224,14 @@ int main(int argc, char **argv)
         obsd_queue_destroy(&queue);
         return 1;
     }
-    if (cfg.socket[0])
-        obsd_log(OBSD_LOG_INFO, "binary protocol on unix:%s", cfg.socket);
-    if (cfg.tcp[0]) {
-        char host[OBSD_STR_LEN] = "127.0.0.1";
-        const char *colon = strrchr(cfg.tcp, ':');
-        if (colon && colon > cfg.tcp)
-            snprintf(host, sizeof host, "%.*s", (int)(colon - cfg.tcp), cfg.tcp);
-        obsd_log(OBSD_LOG_INFO, "binary protocol on tcp://%s:%d", host, obsd_bin_tcp_port(bin));
-    }
-    if (http) {
-        char url[OBSD_STR_LEN + 16];
-        obsd_http_url(http, url, sizeof url);
-        obsd_log(OBSD_LOG_INFO, "listening on %s (queue %d, %d threads, max %lld pixels, "
-                 "max body %lld bytes%s)", url, cfg.queue, cfg.threads,
-                 (long long)cfg.max_pixels, (long long)cfg.max_body, token[0] ? ", token required" : "");
-    }
+    log_listeners(&cfg, http, bin, token[0] != 0);
 
     while (!stop_requested) {
         sleep_ms(200);
         obsd_http_tick(http); /* event streams' keep-alives */
     }
 
-    /* Drain: no new connections; every frame taken is finished and
-     * answered before the server stops, within --drain-timeout: past it
-     * what is left is cut (logged), so the drain ends whatever the
-     * clients do. */
-    obsd_log(OBSD_LOG_INFO, "stopping: finishing %d request(s) and %d binary connection(s) under way "
-             "(SIGINT again to quit now)", http ? obsd_http_in_flight(http) : 0, obsd_bin_in_flight(bin));
-    if (http)
-        obsd_http_quiesce(http);
-    obsd_bin_quiesce(bin);
-    const double drain_end = obsd_now_ms() + 1000.0 * cfg.drain_timeout;
-    while ((http && obsd_http_in_flight(http) > 0) || obsd_bin_in_flight(bin) > 0) {
-        if (interrupts >= 2) {
-            obsd_log(OBSD_LOG_WARN, "second SIGINT: exiting now");
-            _exit(130);
-        }
-        if (cfg.drain_timeout > 0 && obsd_now_ms() >= drain_end) {
-            int requests = http ? obsd_http_in_flight(http) : 0, conns = obsd_bin_in_flight(bin);
-            obsd_log(OBSD_LOG_WARN, "drain deadline (%d s) passed: cutting %d request(s) and %d "
-                     "binary connection(s)", cfg.drain_timeout, requests, conns);
-            if (http)
-                obsd_http_cut(http);
-            obsd_bin_cut(bin);
-            break;
-        }
-        sleep_ms(20);
-    }
+    drain(&cfg, http, bin);
     obsd_http_stop(http);
     obsd_bin_stop(bin);
     obsd_gl_stop(&gl);

@@ -1,27 +1,53 @@
-/* The routes a request is counted and dispatched under: the HTTP API's
- * paths, the preview page, and the binary protocol (not a URL). */
+/* The HTTP routes, one row each (routes.c): the path a request is found
+ * by, what http_server.c checks before the route's handler runs (method,
+ * token, room on a reserve connection), whether the first call reads a
+ * body, and the handlers of the request's life.  A row's index is its
+ * slot in the request counters (stats.h), so /metrics lists the routes in
+ * the table's order.  Adding a route: a row here, its handler file, its
+ * handlers' declarations (http_internal.h) and protocol/HTTP.md. */
 #ifndef OBSD_ROUTES_H
 #define OBSD_ROUTES_H
 
-typedef enum obsd_route {
-    OBSD_ROUTE_AO,
-    OBSD_ROUTE_PARAMS,
-    OBSD_ROUTE_INFO,
-    OBSD_ROUTE_HEALTHZ,
-    OBSD_ROUTE_READYZ,
-    OBSD_ROUTE_METRICS,
-    OBSD_ROUTE_STREAMS, /* /v1/streams and everything under it */
-    OBSD_ROUTE_BAKES,   /* /v1/bakes and everything under it */
-    OBSD_ROUTE_PAGE,    /* the preview page: / and /preview/... */
-    OBSD_ROUTE_BINARY, /* the binary protocol (socket / TCP), not a URL */
-    OBSD_ROUTE_OTHER,
-    OBSD_ROUTE_COUNT
-} obsd_route;
+#include <stddef.h>
 
-/* "/v1/ao", ... ; "other" for OBSD_ROUTE_OTHER. */
-const char *obsd_route_path(obsd_route r);
-/* The route of a URL path (exact match; /v1/streams/..., /v1/bakes/... and /preview/...
- * by prefix), OBSD_ROUTE_OTHER if none. */
-obsd_route obsd_route_of(const char *path);
+#include <microhttpd.h>
+
+struct obsd__req;
+
+/* The flags of a row. */
+enum {
+    OBSD_ROUTE_OPEN = 1,       /* no bearer token needed (probes, the static page) */
+    OBSD_ROUTE_PROBE = 2,      /* served on a connection beyond --http-connections */
+    OBSD_ROUTE_FRAME_TOTAL = 4 /* every answer is a frame's end: timed as the `total` stage */
+};
+
+typedef struct obsd__route {
+    const char *path;  /* matched exactly; also the metrics' route label and the 405 message's */
+    const char *under; /* with it, every path that starts so matches too ("/v1/streams/") */
+    /* "GET" (HEAD too) or "POST": any other method is 405 before `start`;
+     * NULL: the handler checks the method itself */
+    const char *methods;
+    /* Which methods' first call goes to `start` at once, reading the
+     * body: "*" every method, else one method; NULL: none.  The others
+     * are answered on the next call, once libmicrohttpd has the whole
+     * request, so that the connection stays open. */
+    const char *reads_body;
+    unsigned flags;    /* OBSD_ROUTE_* */
+    /* The first call with the checks passed (the answer, or the body's
+     * start: r->state = REQ_BODY). */
+    enum MHD_Result (*start)(struct obsd__req *r, const char *url);
+    /* A call in REQ_BODY: `size` bytes of the body, or (size 0) its end. */
+    enum MHD_Result (*body)(struct obsd__req *r, const char *data, size_t *size);
+    /* The call after the GL worker resumed the connection (REQ_QUEUED). */
+    enum MHD_Result (*finish)(struct obsd__req *r);
+    /* The request's end, answered or not: the handler frees its state. */
+    void (*done)(struct obsd__req *r);
+} obsd__route;
+
+extern const obsd__route obsd__routes[];
+extern const int obsd__route_count;
+
+/* The row of a URL path (its index), -1 when none (404). */
+int obsd__route_find(const char *path);
 
 #endif

@@ -1,5 +1,6 @@
 /* Counters and histograms, and their Prometheus text (0.0.4) for GET
- * /metrics; the route labels come from routes.c. */
+ * /metrics; the HTTP routes' labels are set by the server (their table
+ * is routes.c). */
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -22,13 +23,14 @@ static const int64_t res_max[] = {640 * 480, 1920 * 1080, 3840 * 2160, INT64_MAX
 
 static struct {
     pthread_mutex_t lock;
-    uint64_t requests[OBSD_ROUTE_COUNT][NCODES];
+    const char *labels[OBSD_STATS_SLOTS];
+    uint64_t requests[OBSD_STATS_SLOTS][NCODES];
     uint64_t bytes_in, bytes_out;
     uint64_t hist[OBSD_STAGE_COUNT][NBUCKETS + 1];
     double sum[OBSD_STAGE_COUNT];
     uint64_t count[OBSD_STAGE_COUNT];
     uint64_t frames[NRES];
-} st = {PTHREAD_MUTEX_INITIALIZER};
+} st = {PTHREAD_MUTEX_INITIALIZER, .labels = {[OBSD_STATS_BINARY] = "binary", [OBSD_STATS_OTHER] = "other"}};
 
 void obsd_stats_init(void)
 {
@@ -42,14 +44,23 @@ void obsd_stats_init(void)
     pthread_mutex_unlock(&st.lock);
 }
 
-void obsd_stats_request(obsd_route route, int http_status, uint64_t bytes_in, uint64_t bytes_out)
+void obsd_stats_label(int slot, const char *label)
+{
+    if (slot < 0 || slot >= OBSD_STATS_ROUTES)
+        return;
+    pthread_mutex_lock(&st.lock);
+    st.labels[slot] = label;
+    pthread_mutex_unlock(&st.lock);
+}
+
+void obsd_stats_request(int route, int http_status, uint64_t bytes_in, uint64_t bytes_out)
 {
     int c = 0;
     while (c < NCODES - 1 && codes[c] != http_status)
         c++;
-    if (route < 0 || route >= OBSD_ROUTE_COUNT)
-        route = OBSD_ROUTE_OTHER;
     pthread_mutex_lock(&st.lock);
+    if (route < 0 || route >= OBSD_STATS_SLOTS || !st.labels[route])
+        route = OBSD_STATS_OTHER;
     st.requests[route][c]++;
     st.bytes_in += bytes_in;
     st.bytes_out += bytes_out;
@@ -123,10 +134,10 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
     pthread_mutex_lock(&st.lock);
     put(&b, "# HELP obscurad_requests_total HTTP requests answered, by route and status.\n"
             "# TYPE obscurad_requests_total counter\n");
-    for (int r = 0; r < OBSD_ROUTE_COUNT; r++)
+    for (int r = 0; r < OBSD_STATS_SLOTS; r++)
         for (int c = 0; c < NCODES; c++)
             if (st.requests[r][c])
-                put(&b, "obscurad_requests_total{route=\"%s\",code=\"%s%d\"} %llu\n", obsd_route_path((obsd_route)r),
+                put(&b, "obscurad_requests_total{route=\"%s\",code=\"%s%d\"} %llu\n", st.labels[r],
                     codes[c] ? "" : "other", codes[c] ? codes[c] : 0,
                     (unsigned long long)st.requests[r][c]);
     put(&b, "# HELP obscurad_stage_seconds Latency of each stage of a frame "

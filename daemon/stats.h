@@ -6,8 +6,6 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "routes.h"
-
 typedef enum obsd_stage {
     OBSD_STAGE_QUEUE,
     OBSD_STAGE_DECODE,
@@ -17,9 +15,18 @@ typedef enum obsd_stage {
     OBSD_STAGE_COUNT
 } obsd_stage;
 
+/* Requests are counted by route: the HTTP route table's rows (routes.h:
+ * a row's index is its slot, its path the label), then the binary
+ * protocol's and the unknown paths' slots. */
+#define OBSD_STATS_ROUTES 32 /* HTTP rows at most */
+enum { OBSD_STATS_BINARY = OBSD_STATS_ROUTES, OBSD_STATS_OTHER, OBSD_STATS_SLOTS };
+
 void obsd_stats_init(void);
-/* One answered request. */
-void obsd_stats_request(obsd_route route, int http_status, uint64_t bytes_in, uint64_t bytes_out);
+/* The label of an HTTP route's slot (0 .. OBSD_STATS_ROUTES - 1), set
+ * before the server answers. */
+void obsd_stats_label(int slot, const char *label);
+/* One answered request; a slot out of range counts as OBSD_STATS_OTHER. */
+void obsd_stats_request(int slot, int http_status, uint64_t bytes_in, uint64_t bytes_out);
 /* One stage's latency of a frame, in milliseconds. */
 void obsd_stats_stage(obsd_stage stage, double ms);
 /* One frame computed, by its pixel count (resolution class). */

@@ -9,6 +9,8 @@
 
 #include <cjson/cJSON.h>
 
+#include "list.h"
+
 typedef struct obsd_stream obsd_stream;
 struct obsd_stream {
     char name[OBSD_STREAM_NAME_LEN + 1];
@@ -336,11 +338,7 @@ int obsd_streams_subscribe(obsd_streams *s, const char *name, obsd_sub *sub, dou
         sub->sent = 0;
         sub->parked = sub->ended = sub->said_end = 0;
         sub->last_write_ms = now_ms;
-        sub->prev = NULL;
-        sub->next = st->subs;
-        if (st->subs)
-            st->subs->prev = sub;
-        st->subs = sub;
+        OBSD_LIST_PUSH(st->subs, sub);
         st->nsubs++;
         s->nsubs++;
         rc = 0;
@@ -354,12 +352,7 @@ void obsd_streams_unsubscribe(obsd_streams *s, obsd_sub *sub)
     pthread_mutex_lock(&s->lock);
     obsd_stream *st = sub->stream;
     if (st) {
-        if (sub->prev)
-            sub->prev->next = sub->next;
-        else
-            st->subs = sub->next;
-        if (sub->next)
-            sub->next->prev = sub->prev;
+        OBSD_LIST_UNLINK(st->subs, sub);
         st->nsubs--;
         s->nsubs--;
         sub->stream = NULL;

@@ -3,7 +3,6 @@
  * bounds-checked cursor, the writer counts first and fills second, so a
  * frame is allocated once, at its exact size. */
 #include "binary.h"
-#include "internal.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -19,6 +18,10 @@
 #define DEEP_HEADER_LEN 176 /* width .. projection of a deep G-buffer */
 #define DEEP_FLAGS (OBS_BIN_DEEP_ZBACK | OBS_BIN_DEEP_ALPHA | OBS_BIN_HAS_WORLD_TO_CAMERA | \
                     OBS_BIN_HAS_PROJECTION | OBS_BIN_DEEP_COLOR | OBS_BIN_DEEP_NORMAL)
+
+/* The message into err (when set), and s.  This file's own: the protocol
+ * is built against the public headers, not core's internal ones. */
+#define fail(err, s, ...) ((err) ? (void)snprintf((err), OBS_ERR_LEN, __VA_ARGS__) : (void)0, (s))
 
 /* a * b * c without overflow; 0 on overflow. */
 static int mul3(uint64_t a, uint64_t b, uint64_t c, uint64_t *out)
@@ -178,7 +181,7 @@ static int get_pad8(reader *r)
 
 static obs_status truncated(const reader *r, const char *field, char err[OBS_ERR_LEN])
 {
-    return obs__fail(err, OBS_BAD_FILE, "malformed %s: %s at byte %zu of a %zu-byte payload "
+    return fail(err, OBS_BAD_FILE, "malformed %s: %s at byte %zu of a %zu-byte payload "
                 "(truncated or corrupt)", r->what, field, r->off, r->full > r->n ? r->full : r->n);
 }
 
@@ -201,20 +204,20 @@ obs_status obs_bin_header_parse(const unsigned char *in, obs_bin_header *h, uint
     unsigned version = 0, kind = 0;
     memset(h, 0, sizeof *h);
     if (memcmp(in, OBS_BIN_MAGIC, 4) != 0)
-        return obs__fail(err, OBS_BAD_FILE, "not an obscura binary-protocol frame (magic is not '%s')",
+        return fail(err, OBS_BAD_FILE, "not an obscura binary-protocol frame (magic is not '%s')",
                     OBS_BIN_MAGIC);
     get_u16(&r, &version);
     get_u16(&r, &kind);
     get_u64(&r, &h->id);
     get_u64(&r, &h->length);
     if (version != OBS_BIN_VERSION)
-        return obs__fail(err, OBS_UNSUPPORTED, "protocol version %u is not supported (this is version %d)",
+        return fail(err, OBS_UNSUPPORTED, "protocol version %u is not supported (this is version %d)",
                     version, OBS_BIN_VERSION);
     if (kind != OBS_BIN_REQUEST && kind != OBS_BIN_RESPONSE)
-        return obs__fail(err, OBS_BAD_FILE, "frame kind %u is neither request (1) nor response (2)", kind);
+        return fail(err, OBS_BAD_FILE, "frame kind %u is neither request (1) nor response (2)", kind);
     h->kind = (obs_bin_kind)kind;
     if (h->length > max_payload)
-        return obs__fail(err, OBS_TOO_LARGE, "frame payload of %llu bytes is over the limit of %llu bytes",
+        return fail(err, OBS_TOO_LARGE, "frame payload of %llu bytes is over the limit of %llu bytes",
                     (unsigned long long)h->length, (unsigned long long)max_payload);
     return OBS_OK;
 }
@@ -224,10 +227,10 @@ obs_status obs_bin_header_parse(const unsigned char *in, obs_bin_header *h, uint
 static obs_status check_gbuffer(const obs_gbuffer *gb, char err[OBS_ERR_LEN])
 {
     if (!gb->depth.data || gb->width <= 0 || gb->height <= 0)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "raw G-buffer: depth plane and a size are required");
+        return fail(err, OBS_INVALID_ARGUMENT, "raw G-buffer: depth plane and a size are required");
     if (gb->depth.channels != 1 || (gb->normal.data && gb->normal.channels != 3) ||
         (gb->color.data && gb->color.channels != 4))
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "raw G-buffer: planes must be depth 1, normal 3, "
+        return fail(err, OBS_INVALID_ARGUMENT, "raw G-buffer: planes must be depth 1, normal 3, "
                     "colour 4 channels");
     return OBS_OK;
 }
@@ -237,14 +240,14 @@ static obs_status check_gbuffer(const obs_gbuffer *gb, char err[OBS_ERR_LEN])
 static obs_status check_deep(const obs_deep_image *d, char err[OBS_ERR_LEN])
 {
     if (!d->offset || d->width <= 0 || d->height <= 0)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "deep G-buffer: offsets and a size are required");
+        return fail(err, OBS_INVALID_ARGUMENT, "deep G-buffer: offsets and a size are required");
     size_t npx = (size_t)d->width * (size_t)d->height;
     if (d->offset[0] != 0 || d->offset[npx] > OBS_DEEP_MAX_SAMPLES || (d->offset[npx] && !d->samples))
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "deep G-buffer: %llu samples (at most %llu)",
+        return fail(err, OBS_INVALID_ARGUMENT, "deep G-buffer: %llu samples (at most %llu)",
                     (unsigned long long)d->offset[npx], (unsigned long long)OBS_DEEP_MAX_SAMPLES);
     for (size_t i = 0; i < npx; i++)
         if (d->offset[i + 1] < d->offset[i] || d->offset[i + 1] - d->offset[i] > OBS_DEEP_MAX_PER_PIXEL)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "deep G-buffer: pixel %zu holds a bad sample count", i);
+            return fail(err, OBS_INVALID_ARGUMENT, "deep G-buffer: pixel %zu holds a bad sample count", i);
     return OBS_OK;
 }
 
@@ -333,14 +336,14 @@ obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out,
 {
     memset(out, 0, sizeof *out);
     if (!!d->gb + !!d->exr + !!d->deep != 1)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "a request carries one of raw planes, an EXR or a "
+        return fail(err, OBS_INVALID_ARGUMENT, "a request carries one of raw planes, an EXR or a "
                     "deep G-buffer");
     if (d->param_count < 0 || d->param_count > OBS_BIN_MAX_PARAMS)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "at most %d parameters", OBS_BIN_MAX_PARAMS);
+        return fail(err, OBS_INVALID_ARGUMENT, "at most %d parameters", OBS_BIN_MAX_PARAMS);
     for (int i = 0; i < d->param_count; i++) {
         size_t nl = strlen(d->params[i].name), vl = strlen(d->params[i].value);
         if (nl == 0 || nl > OBS_BIN_MAX_NAME || vl > OBS_BIN_MAX_VALUE)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter '%.64s': name of 1 to %d bytes and "
+            return fail(err, OBS_INVALID_ARGUMENT, "parameter '%.64s': name of 1 to %d bytes and "
                         "value of at most %d bytes", d->params[i].name, OBS_BIN_MAX_NAME, OBS_BIN_MAX_VALUE);
     }
     obs_status s = d->gb ? check_gbuffer(d->gb, err) : d->deep ? check_deep(d->deep, err) : OBS_OK;
@@ -349,7 +352,7 @@ obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out,
     writer w = {NULL, 0};
     write_request(&w, d, 0);
     if (!(w.p = malloc(w.n)))
-        return obs__fail(err, OBS_NO_MEMORY, "no memory for a %zu-byte request", w.n);
+        return fail(err, OBS_NO_MEMORY, "no memory for a %zu-byte request", w.n);
     size_t total = w.n;
     w.n = 0;
     write_request(&w, d, total - OBS_BIN_HEADER_LEN);
@@ -365,7 +368,7 @@ static obs_status request_param(obs_bin_request *q, const char *name, const char
     if (!strcmp(name, "token")) {
         size_t n = strlen(value);
         if (n >= sizeof q->token)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "parameter token: longer than %zu bytes",
+            return fail(err, OBS_INVALID_ARGUMENT, "parameter token: longer than %zu bytes",
                         sizeof q->token - 1);
         memcpy(q->token, value, n + 1);
         return OBS_OK;
@@ -388,7 +391,7 @@ static obs_status get_param(reader *r, uint32_t i, char name[OBS_BIN_MAX_NAME + 
     if (!get_u16(r, &nl))
         return truncated(r, "parameter name length", err);
     if (nl == 0 || nl > OBS_BIN_MAX_NAME)
-        return obs__fail(err, OBS_BAD_FILE, "malformed request: parameter %u has a name of %u bytes "
+        return fail(err, OBS_BAD_FILE, "malformed request: parameter %u has a name of %u bytes "
                     "(1 to %d)", i, nl, OBS_BIN_MAX_NAME);
     if (!get(r, name, nl))
         return truncated(r, "parameter name", err);
@@ -396,13 +399,13 @@ static obs_status get_param(reader *r, uint32_t i, char name[OBS_BIN_MAX_NAME + 
     if (!get_u32(r, &vl))
         return truncated(r, "parameter value length", err);
     if (vl > OBS_BIN_MAX_VALUE)
-        return obs__fail(err, OBS_BAD_FILE, "malformed request: parameter '%.64s' has a value of %u "
+        return fail(err, OBS_BAD_FILE, "malformed request: parameter '%.64s' has a value of %u "
                     "bytes (at most %d)", name, vl, OBS_BIN_MAX_VALUE);
     if (!get(r, value, vl))
         return truncated(r, "parameter value", err);
     value[vl] = '\0';
     if (memchr(name, 0, nl) || memchr(value, 0, vl))
-        return obs__fail(err, OBS_BAD_FILE, "malformed request: a NUL byte in parameter %u", i);
+        return fail(err, OBS_BAD_FILE, "malformed request: a NUL byte in parameter %u", i);
     return OBS_OK;
 }
 
@@ -451,7 +454,7 @@ static obs_status take_half_planes(reader *r, uint64_t px, uint64_t channels, ob
 {
     size_t n = (size_t)(px * channels);
     if (!(q->gf.storage = malloc(n * sizeof(float))))
-        return obs__fail(err, OBS_NO_MEMORY, "no memory for %zu float16 values", n);
+        return fail(err, OBS_NO_MEMORY, "no memory for %zu float16 values", n);
     const unsigned char *src = r->p + r->off;
     for (size_t i = 0; i < n; i++)
         q->gf.storage[i] = obs_bin_half_to_float((uint16_t)(src[2 * i] | src[2 * i + 1] << 8));
@@ -481,15 +484,15 @@ static obs_status get_raw_fields(reader *r, const obs_limits *lim, raw_fields *f
     get_u32(r, &f->flags);
     get_u32(r, &f->type);
     if (f->flags & ~0xfu)
-        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: unknown flags 0x%x", f->flags);
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: unknown flags 0x%x", f->flags);
     if (f->type != OBS_BIN_F32 && f->type != OBS_BIN_F16)
-        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: plane type %u is neither float32 (0) nor "
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: plane type %u is neither float32 (0) nor "
                     "float16 (1)", f->type);
     obs_status s = obs_check_size(lim, f->width, f->height, err);
     if (s != OBS_OK)
         return s;
     if ((int32_t)f->dw < 0 || (int32_t)f->dh < 0 || f->dw > (1u << 20) || f->dh > (1u << 20))
-        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: display window %u x %u is not a size", f->dw,
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: display window %u x %u is not a size", f->dw,
                     f->dh);
     /* Exactly the planes the flags announce, and nothing after them. */
     size_t full = r->full > r->n ? r->full : r->n, rest = full - r->off - 128;
@@ -498,7 +501,7 @@ static obs_status get_raw_fields(reader *r, const obs_limits *lim, raw_fields *f
     f->channels = 1 + ((f->flags & OBS_BIN_HAS_NORMAL) ? 3 : 0) + ((f->flags & OBS_BIN_HAS_COLOR) ? 4 : 0);
     f->bytes = 0;
     if (!mul3(f->px, f->channels, value_size, &f->bytes) || f->bytes != rest)
-        return obs__fail(err, OBS_BAD_FILE, "raw G-buffer: %u x %u with %llu %s channels needs %llu bytes "
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: %u x %u with %llu %s channels needs %llu bytes "
                     "of planes, the frame holds %zu", f->width, f->height, (unsigned long long)f->channels,
                     f->type == OBS_BIN_F16 ? "float16" : "float32", (unsigned long long)f->bytes, rest);
     return OBS_OK;
@@ -537,7 +540,7 @@ static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *
         return OBS_OK;
     }
     if (((uintptr_t)(r->p + r->off) & 3u) != 0 && !(q->gf.storage = malloc((size_t)bytes)))
-        return obs__fail(err, OBS_NO_MEMORY, "no memory for %llu bytes of planes", (unsigned long long)bytes);
+        return fail(err, OBS_NO_MEMORY, "no memory for %llu bytes of planes", (unsigned long long)bytes);
     float *copy = q->gf.storage;
     gb->depth = (obs_plane){take_plane(r, px * 4, copy), 1, 0};
     if (flags & OBS_BIN_HAS_NORMAL)
@@ -580,28 +583,28 @@ static obs_status get_deep_fields(reader *r, const obs_limits *lim, deep_fields 
     get_u32(r, &f->reserved);
     get_u64(r, &f->total);
     if (f->flags & ~(uint32_t)DEEP_FLAGS)
-        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: unknown flags 0x%x", f->flags);
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: unknown flags 0x%x", f->flags);
     if (f->values != OBS_DEEP_CH)
-        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: %u values per sample; the layout has %d "
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: %u values per sample; the layout has %d "
                     "(Z, ZBack, R, G, B, A, N.X, N.Y, N.Z)", f->values, OBS_DEEP_CH);
     if (f->type != OBS_BIN_F32 || f->reserved != 0)
-        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: sample type %u (only float32, 0) or reserved "
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: sample type %u (only float32, 0) or reserved "
                     "field %u (0)", f->type, f->reserved);
     obs_status s = obs_check_size(lim, f->width, f->height, err);
     if (s != OBS_OK)
         return s;
     if ((int32_t)f->dw < 0 || (int32_t)f->dh < 0 || f->dw > (1u << 20) || f->dh > (1u << 20))
-        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: display window %u x %u is not a size", f->dw,
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: display window %u x %u is not a size", f->dw,
                     f->dh);
     if (f->total > OBS_DEEP_MAX_SAMPLES)
-        return obs__fail(err, OBS_TOO_LARGE, "deep G-buffer: %llu samples, over the limit of %llu",
+        return fail(err, OBS_TOO_LARGE, "deep G-buffer: %llu samples, over the limit of %llu",
                     (unsigned long long)f->total, (unsigned long long)OBS_DEEP_MAX_SAMPLES);
     /* width x height within the limits, total < 2^25: no overflow below */
     size_t full = r->full > r->n ? r->full : r->n, rest = full - r->off - 128;
     f->npx = (uint64_t)f->width * f->height;
     f->sample_bytes = f->total * OBS_DEEP_CH * sizeof(float);
     if (f->npx * 4 + f->sample_bytes != rest)
-        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: %u x %u counts and %llu samples need %llu bytes, "
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: %u x %u counts and %llu samples need %llu bytes, "
                     "the frame holds %zu", f->width, f->height, (unsigned long long)f->total,
                     (unsigned long long)(f->npx * 4 + f->sample_bytes), rest);
     return OBS_OK;
@@ -625,17 +628,17 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
         uint32_t c = (uint32_t)cp[4 * i] | (uint32_t)cp[4 * i + 1] << 8 | (uint32_t)cp[4 * i + 2] << 16 |
                      (uint32_t)cp[4 * i + 3] << 24;
         if (c > OBS_DEEP_MAX_PER_PIXEL)
-            return obs__fail(err, OBS_TOO_LARGE, "deep G-buffer: pixel (%llu, %llu) holds %u samples, over the "
+            return fail(err, OBS_TOO_LARGE, "deep G-buffer: pixel (%llu, %llu) holds %u samples, over the "
                         "limit of %d", (unsigned long long)(i % width), (unsigned long long)(i / width), c,
                         OBS_DEEP_MAX_PER_PIXEL);
         sum += c;
     }
     if (sum != total)
-        return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: the pixels' counts sum to %llu samples, the "
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: the pixels' counts sum to %llu samples, the "
                     "header says %llu", (unsigned long long)sum, (unsigned long long)total);
     obs_deep_image *d = &q->deep;
     if (!(d->offset = malloc((size_t)(npx + 1) * sizeof *d->offset)))
-        return obs__fail(err, OBS_NO_MEMORY, "no memory for the offsets of %u x %u pixels", width, height);
+        return fail(err, OBS_NO_MEMORY, "no memory for the offsets of %u x %u pixels", width, height);
     d->offset[0] = 0;
     for (uint64_t i = 0; i < npx; i++)
         d->offset[i + 1] = d->offset[i] + ((uint32_t)cp[4 * i] | (uint32_t)cp[4 * i + 1] << 8 |
@@ -643,7 +646,7 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
     r->off += (size_t)npx * 4;
     if (total && ((uintptr_t)(r->p + r->off) & 3u) != 0) {
         if (!(q->gf.storage = malloc((size_t)sample_bytes)))
-            return obs__fail(err, OBS_NO_MEMORY, "no memory for %llu deep samples", (unsigned long long)total);
+            return fail(err, OBS_NO_MEMORY, "no memory for %llu deep samples", (unsigned long long)total);
         memcpy(q->gf.storage, r->p + r->off, (size_t)sample_bytes);
         d->samples = q->gf.storage;
     } else {
@@ -656,7 +659,7 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
         for (uint64_t k = d->offset[i] + 1; k < d->offset[i + 1]; k++)
             if (sort_key(d->samples[(k - 1) * OBS_DEEP_CH + OBS_DEEP_Z]) >
                 sort_key(d->samples[k * OBS_DEEP_CH + OBS_DEEP_Z]))
-                return obs__fail(err, OBS_BAD_FILE, "deep G-buffer: the samples of pixel (%llu, %llu) are not "
+                return fail(err, OBS_BAD_FILE, "deep G-buffer: the samples of pixel (%llu, %llu) are not "
                             "sorted by Z, front to back", (unsigned long long)(i % width),
                             (unsigned long long)(i / width));
     d->width = (int)width;
@@ -685,7 +688,7 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
     if (!get_u32(&r, &count))
         return truncated(&r, "parameter count", err);
     if (count > OBS_BIN_MAX_PARAMS)
-        return obs__fail(err, OBS_BAD_FILE, "malformed request: %u parameters (at most %d)", count,
+        return fail(err, OBS_BAD_FILE, "malformed request: %u parameters (at most %d)", count,
                     OBS_BIN_MAX_PARAMS);
     for (uint32_t i = 0; i < count; i++) {
         char name[OBS_BIN_MAX_NAME + 1], value[OBS_BIN_MAX_VALUE + 1];
@@ -697,9 +700,9 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
     if ((s = obs_http_request_check(&out->hr, err)) != OBS_OK)
         return s;
     if (out->raw_out && out->hr.format != OBS_HTTP_EXR)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
+        return fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
     if (out->raw_out && out->hr.append)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "append=1 writes an EXR: it needs format=exr, not raw");
+        return fail(err, OBS_INVALID_ARGUMENT, "append=1 writes an EXR: it needs format=exr, not raw");
     if (!get_u8(&r, &body))
         return truncated(&r, "G-buffer kind", err);
     if (!get_pad8(&r))
@@ -709,10 +712,10 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
         if (!get_u64(&r, &n))
             return truncated(&r, "EXR length", err);
         if (n != r.n - r.off)
-            return obs__fail(err, OBS_BAD_FILE, "malformed request: EXR of %llu bytes, the frame holds %zu",
+            return fail(err, OBS_BAD_FILE, "malformed request: EXR of %llu bytes, the frame holds %zu",
                         (unsigned long long)n, r.n - r.off);
         if (n == 0)
-            return obs__fail(err, OBS_BAD_FILE, "malformed request: empty EXR");
+            return fail(err, OBS_BAD_FILE, "malformed request: empty EXR");
         out->body = OBS_BIN_EXR;
         out->exr = r.p + r.off;
         out->exr_len = (size_t)n;
@@ -726,7 +729,7 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
         return s;
     }
     if (body != OBS_BIN_RAW)
-        return obs__fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is not EXR (1), raw (2) "
+        return fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is not EXR (1), raw (2) "
                     "or deep (4)", body);
     out->body = OBS_BIN_RAW;
     s = decode_raw(&r, lim, out, err);
@@ -748,7 +751,7 @@ static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, 
     if (!get_u32(r, &count))
         return truncated(r, "parameter count", err);
     if (count > OBS_BIN_MAX_PARAMS)
-        return obs__fail(err, OBS_BAD_FILE, "malformed request: %u parameters (at most %d)", count,
+        return fail(err, OBS_BAD_FILE, "malformed request: %u parameters (at most %d)", count,
                     OBS_BIN_MAX_PARAMS);
     /* every parameter's framing first: the token is known even when a
      * value is bad (the value's error is the answer, after the token) */
@@ -769,9 +772,9 @@ static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, 
     if ((s = obs_http_request_check(&q->hr, err)) != OBS_OK)
         return s;
     if (q->raw_out && q->hr.format != OBS_HTTP_EXR)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
+        return fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
     if (q->raw_out && q->hr.append)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "append=1 writes an EXR: it needs format=exr, not raw");
+        return fail(err, OBS_INVALID_ARGUMENT, "append=1 writes an EXR: it needs format=exr, not raw");
     if (!get_u8(r, &body))
         return truncated(r, "G-buffer kind", err);
     if (!get_pad8(r))
@@ -782,10 +785,10 @@ static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, 
         if (!get_u64(r, &n))
             return truncated(r, "EXR length", err);
         if (n != full - r->off)
-            return obs__fail(err, OBS_BAD_FILE, "malformed request: EXR of %llu bytes, the frame holds %zu",
+            return fail(err, OBS_BAD_FILE, "malformed request: EXR of %llu bytes, the frame holds %zu",
                         (unsigned long long)n, full - r->off);
         if (n == 0)
-            return obs__fail(err, OBS_BAD_FILE, "malformed request: empty EXR");
+            return fail(err, OBS_BAD_FILE, "malformed request: empty EXR");
     } else if (body == OBS_BIN_DEEP) {
         deep_fields f;
         if ((s = get_deep_fields(r, lim, &f, err)) != OBS_OK)
@@ -801,7 +804,7 @@ static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, 
         h->width = f.width;
         h->height = f.height;
     } else {
-        return obs__fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is not EXR (1), raw (2) "
+        return fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is not EXR (1), raw (2) "
                     "or deep (4)", body);
     }
     h->body = (obs_bin_body)body;
@@ -875,22 +878,22 @@ obs_status obs_bin_response_encode(const obs_bin_response_desc *d, obs_bytes *ou
 {
     memset(out, 0, sizeof *out);
     if (d->status < 100 || d->status > 599 || d->retry_after < 0 || d->retry_after > 65535)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "response status %d or retry-after %d out of range",
+        return fail(err, OBS_INVALID_ARGUMENT, "response status %d or retry-after %d out of range",
                     d->status, d->retry_after);
     if (d->body == OBS_BIN_RAW) {
         if (d->image_count < 1 || d->image_count > OBS_BIN_MAX_IMAGES)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "1 to %d raw images", OBS_BIN_MAX_IMAGES);
+            return fail(err, OBS_INVALID_ARGUMENT, "1 to %d raw images", OBS_BIN_MAX_IMAGES);
         for (int i = 0; i < d->image_count; i++) {
             const obs_image *im = &d->images[i].image;
             if (!im->data || im->width <= 0 || im->height <= 0 || im->channels < 1 || im->channels > 4)
-                return obs__fail(err, OBS_INVALID_ARGUMENT, "raw image %d is empty or has %d channels", i,
+                return fail(err, OBS_INVALID_ARGUMENT, "raw image %d is empty or has %d channels", i,
                             im->channels);
         }
     }
     writer w = {NULL, 0};
     write_response(&w, d, 0);
     if (!(w.p = malloc(w.n)))
-        return obs__fail(err, OBS_NO_MEMORY, "no memory for a %zu-byte response", w.n);
+        return fail(err, OBS_NO_MEMORY, "no memory for a %zu-byte response", w.n);
     size_t total = w.n;
     w.n = 0;
     write_response(&w, d, total - OBS_BIN_HEADER_LEN);
@@ -910,13 +913,13 @@ obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, con
     if (!get_u16(&r, &status) || !get_u16(&r, &retry) || !get_u16(&r, &cl))
         return truncated(&r, "status", err);
     if (cl >= sizeof out->code)
-        return obs__fail(err, OBS_BAD_FILE, "malformed response: code of %u bytes", cl);
+        return fail(err, OBS_BAD_FILE, "malformed response: code of %u bytes", cl);
     if (!get(&r, out->code, cl))
         return truncated(&r, "code", err);
     if (!get_u32(&r, &ml))
         return truncated(&r, "message length", err);
     if (ml > OBS_BIN_MAX_MESSAGE)
-        return obs__fail(err, OBS_BAD_FILE, "malformed response: message of %u bytes", ml);
+        return fail(err, OBS_BAD_FILE, "malformed response: message of %u bytes", ml);
     if (!get(&r, out->message, ml))
         return truncated(&r, "message", err);
     if (!get_u8(&r, &body) || !get_pad8(&r))
@@ -944,7 +947,7 @@ obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, con
         if (!get_u32(&r, &count))
             return truncated(&r, "image count", err);
         if (count < 1 || count > OBS_BIN_MAX_IMAGES)
-            return obs__fail(err, OBS_BAD_FILE, "malformed response: %u images (1 to %d)", count,
+            return fail(err, OBS_BAD_FILE, "malformed response: %u images (1 to %d)", count,
                         OBS_BIN_MAX_IMAGES);
         for (uint32_t i = 0; i < count; i++) {
             uint32_t output, w, h, c;
@@ -954,7 +957,7 @@ obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, con
                 goto fail;
             }
             if (c < 1 || c > 4) {
-                s = obs__fail(err, OBS_BAD_FILE, "malformed response: image %u has %u channels", i, c);
+                s = fail(err, OBS_BAD_FILE, "malformed response: image %u has %u channels", i, c);
                 goto fail;
             }
             if ((s = obs_check_size(lim, w, h, err)) != OBS_OK)
@@ -965,7 +968,7 @@ obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, con
             }
             obs_image *im = &out->images[i].image;
             if (!(im->data = malloc((size_t)bytes))) {
-                s = obs__fail(err, OBS_NO_MEMORY, "no memory for a %u x %u image", w, h);
+                s = fail(err, OBS_NO_MEMORY, "no memory for a %u x %u image", w, h);
                 goto fail;
             }
             get(&r, im->data, (size_t)bytes);
@@ -978,10 +981,10 @@ obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, con
         break;
     }
     default:
-        return obs__fail(err, OBS_BAD_FILE, "malformed response: body kind %u", body);
+        return fail(err, OBS_BAD_FILE, "malformed response: body kind %u", body);
     }
     if (r.off != r.n) {
-        s = obs__fail(err, OBS_BAD_FILE, "malformed response: %zu bytes after the body", r.n - r.off);
+        s = fail(err, OBS_BAD_FILE, "malformed response: %zu bytes after the body", r.n - r.off);
         goto fail;
     }
     return OBS_OK;

@@ -1,0 +1,58 @@
+/* Server-Sent Events, the one way both event routes answer
+ * (GET /v1/streams/NAME/events, GET /v1/bakes/ID/events): a 200 whose
+ * body is the source's events, one at a time, with the headers a proxy
+ * needs not to buffer them.
+ *
+ * An event stream is a suspended connection: the content reader parks it
+ * when the source has nothing to send (the source calls
+ * obsd__events_park) and the source wakes it (new event, keep-alive,
+ * shutdown), so it holds no thread while it waits. */
+#include <string.h>
+
+#include "http_internal.h"
+
+void obsd__events_park(void *arg)
+{
+    obsd__req *r = arg;
+    MHD_suspend_connection(r->conn);
+}
+
+void obsd__events_wake(void *arg)
+{
+    obsd__req *r = arg;
+    MHD_resume_connection(r->conn);
+}
+
+static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
+{
+    obsd__events *ev = cls;
+    (void)pos;
+    if (ev->off >= ev->len) {
+        int n = ev->next(ev->r, ev->buf, sizeof ev->buf);
+        if (n < 0)
+            return MHD_CONTENT_READER_END_OF_STREAM;
+        if (n == 0)
+            return 0; /* parked: the connection is suspended until woken */
+        ev->len = n;
+        ev->off = 0;
+    }
+    size_t k = (size_t)(ev->len - ev->off);
+    if (k > max)
+        k = max;
+    memcpy(buf, ev->buf + ev->off, k);
+    ev->off += (int)k;
+    return (ssize_t)k;
+}
+
+enum MHD_Result obsd__events_answer(obsd__req *r, obsd__events *ev)
+{
+    ev->r = r;
+    struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 1024, reader, ev, NULL);
+    if (!resp)
+        return MHD_NO;
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "text/event-stream");
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
+    MHD_add_response_header(resp, "X-Accel-Buffering", "no");
+    r->state = REQ_EVENTS;
+    return obsd__answer(r, 200, resp, 0, "event stream opened");
+}
