@@ -9,7 +9,8 @@
 # beside EEVEE's GTAO (SCENE_eevee_ao.exr, where the data set has one) and
 # our Embree reference (obscura reference).  Writes bench/QUALITY.md
 # between the "BEGIN make quality" / "END make quality" markers: one table
-# per method with EEVEE's column and the means, a summary, and per scene
+# per method with EEVEE's column and the means, a summary, the error split
+# by band (bench/error_split.py: halo, border, crease, open), and per scene
 # the scores of every method and one strip (Cycles, EEVEE, obscura's
 # default, gtao; below, the error maps) under bench/quality/.  The same
 # tables go to stdout.
@@ -170,6 +171,19 @@ while read -r s d; do
     } >>"$PERSCENE"
 done <"$SCENES"
 
+# ---- the error split by band (bench/error_split.py, on the outputs above) ----
+# halo, border, crease/contact and open pixels, from each scene's camera and
+# AO distance (the script's docstring defines them); needs what the referee
+# needs (numpy, OpenImageIO)
+SPLIT=$OUT/split.md
+: >"$SPLIT"
+if [ -n "$REFEREE" ]; then
+    # shellcheck disable=SC2046
+    OBSCURA_SHARED_DATA=$SHARED bench/error_split.py "$OUT" \
+        $(echo "$METHODS" | awk 'NF { print $1 }') >"$SPLIT" ||
+        { echo "quality: bench/error_split.py failed; no error split" >&2; : >"$SPLIT"; }
+fi
+
 # ---- the tables per method, and the summary ---------------------------------
 TABLES=$OUT/tables.md
 awk -v methods="$(echo "$METHODS" | awk 'NF { print $1 }' | tr '\n' ' ')" '
@@ -235,6 +249,23 @@ awk -v methods="$(echo "$METHODS" | awk 'NF { print $1 }' | tr '\n' ' ')" '
     echo "MSE over EEVEE's mean MSE on the scenes that have an EEVEE render."
     echo
     cat "$TABLES"
+    echo "### Error split by band"
+    echo
+    if [ -s "$SPLIT" ]; then
+        echo "\`bench/error_split.py out/quality\` on the outputs above: each scene's pixels with geometry in"
+        echo "four bands, from the scene's camera and AO distance D alone (r(p) = D f / z(p), D projected"
+        echo "at the pixel's depth): **halo** (within r(p), the near side of a depth discontinuity nearer"
+        echo "than p by more than D), **border** (within r(p) of the image edge), **crease** (a pixel"
+        echo "within r(p) whose surface is within D of p, above p's tangent plane and facing p), **open**"
+        echo "(the rest); each pixel in the first that applies. Definitions: bench/QUALITY.md, \"The error"
+        echo "split by band\", and the script's docstring. Per band: its MSE against Cycles (referee's"
+        echo "conventions), its share of the scene's squared error, and its MSE over EEVEE's in the band."
+        echo
+        cat "$SPLIT"
+    else
+        echo "Not made: bench/error_split.py needs numpy and OpenImageIO (tools/deps.sh)."
+        echo
+    fi
     echo "### Per scene"
     echo
     echo "Strips: Cycles, EEVEE (white where the data set has no EEVEE render), then obscura:"
