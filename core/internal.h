@@ -15,9 +15,9 @@
 #define OBS__PRINTF(a, b)
 #endif
 
-/* Writes a formatted message into err (if non-NULL) and returns s. */
-obs_status obs__fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
-    OBS__PRINTF(3, 4);
+/* Writes a formatted message into err (if non-NULL) and returns s
+ * (obscura/status.h). */
+#define obs__fail obs_status_fail
 
 /* Milliseconds of CLOCK_MONOTONIC (for deadlines and stage times). */
 double obs__now_ms(void);

@@ -209,7 +209,7 @@ obs_status obs_params_check(const obs_params *p, char err[OBS_ERR_LEN])
         const obs_param_info *mi = obs_param_find("method");
         char method[32];
         obs_param_format(p, mi, method, sizeof method);
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                          "parameter %s does not apply to method %s: %s; leave it unset "
                          "or pick a method it belongs to",
                          pi->name, method, method_why(pi->offset));

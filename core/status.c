@@ -1,4 +1,7 @@
 /* Status names and messages, generated from OBS_STATUS_MAP. */
+#include <stdarg.h>
+#include <stdio.h>
+
 #include "obscura/obscura.h"
 
 const char *obs_status_name(obs_status s)
@@ -19,4 +22,15 @@ const char *obs_status_message(obs_status s)
 #undef X
     default: return "unknown status";
     }
+}
+
+obs_status obs_status_fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
+{
+    if (err) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, OBS_ERR_LEN, fmt, ap);
+        va_end(ap);
+    }
+    return s;
 }

@@ -10,17 +10,6 @@
 
 #include "obscura/table.h"
 
-obs_status obs_table_fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
-{
-    if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, OBS_ERR_LEN, fmt, ap);
-        va_end(ap);
-    }
-    return s;
-}
-
 int obs_table_name_eq(const char *a, const char *b, size_t blen)
 {
     size_t i = 0;
@@ -113,23 +102,23 @@ obs_status obs_table_range_error(const obs_table *t, const obs_table_row *r, con
     const char *n = t->noun;
     /* an INT row with a list of numbers reads as choices */
     if (r->type == OBS_TABLE_ENUM || (r->type == OBS_TABLE_INT && r->choices))
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s %s: '%s' is not one of %s", n,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s %s: '%s' is not one of %s", n,
                               r->name, value, r->choices);
     switch (r->type) {
     case OBS_TABLE_INT:
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "%s %s: '%s' is not an integer in [%g, %g]", n, r->name, value,
                               r->min, r->max);
     case OBS_TABLE_WHOLE:
     case OBS_TABLE_SIZE:
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s %s: %s is out of range [%lld, %lld]",
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s %s: %s is out of range [%lld, %lld]",
                               n, r->name, value, (long long)r->min, (long long)r->max);
     case OBS_TABLE_STRING:
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "%s %s: value is longer than %lld characters", n, r->name,
                               (long long)r->max);
     default:
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "%s %s: '%s' is not a number in [%g, %g]", n, r->name, value,
                               r->min, r->max);
     }
@@ -147,7 +136,7 @@ static obs_status parse_mat4(const obs_table *t, const obs_table_row *r, float m
         errno = 0;
         double d = strtod(s, &end);
         if (end == s || errno == ERANGE || !isfinite(d))
-            return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+            return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                                   "%s %s: expected 16 numbers, number %d is missing or invalid",
                                   t->noun, r->name, i + 1);
         m[i] = (float)d;
@@ -156,7 +145,7 @@ static obs_status parse_mat4(const obs_table *t, const obs_table_row *r, float m
     while (isspace((unsigned char)*s) || *s == ',')
         s++;
     if (*s)
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s %s: expected 16 numbers, found more",
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s %s: expected 16 numbers, found more",
                               t->noun, r->name);
     return OBS_OK;
 }
@@ -179,7 +168,7 @@ static obs_status parse_whole(const obs_table *t, const obs_table_row *r, const 
         case 'g': shift = 30; break;
         }
         if (shift < 0 || end[1] != '\0' || v < 0 || v > (INT64_MAX >> shift))
-            return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+            return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                                   "%s %s: '%s' is not a size (a number, optionally with k, m "
                                   "or g) in [%lld, %lld]", t->noun, r->name, value, lo, hi);
         v <<= shift;
@@ -192,7 +181,7 @@ static obs_status parse_whole(const obs_table *t, const obs_table_row *r, const 
     *out = v;
     return OBS_OK;
 not_number:
-    return obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s %s: '%s' is not a number in [%lld, %lld]",
+    return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s %s: '%s' is not a number in [%lld, %lld]",
                           t->noun, r->name, value, lo, hi);
 }
 
@@ -201,7 +190,7 @@ obs_status obs_table_parse(const obs_table *t, const obs_table_row *r, void *bas
 {
     char *field = (char *)base + r->offset;
     if (!value || (t->strict && !*value))
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s %s needs a value", t->noun, r->name);
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s %s needs a value", t->noun, r->name);
     double v;
     long long w = 0;
     switch (r->type) {
@@ -245,7 +234,7 @@ obs_status obs_table_parse(const obs_table *t, const obs_table_row *r, void *bas
         return s;
     }
     }
-    return obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s %s has an unknown type", t->noun,
+    return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s %s has an unknown type", t->noun,
                           r->name);
 }
 
@@ -256,7 +245,7 @@ obs_status obs_table_set(const obs_table *t, void *base, const char *name, const
     if (row)
         *row = r;
     if (!r)
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "unknown %s '%s'%s", t->noun,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "unknown %s '%s'%s", t->noun,
                               name ? name : "", t->hint);
     obs_status s = obs_table_parse(t, r, base, value, err);
     if (s == OBS_OK && t->given != OBS_TABLE_NO_MASK)
@@ -294,14 +283,14 @@ static obs_status check_row(const obs_table *t, const obs_table_row *r, const ch
             n += *c == '|';
         if (v >= 0 && v < n)
             return OBS_OK;
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s %s: value %d is not one of %s",
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s %s: value %d is not one of %s",
                               t->noun, r->name, v + (int)t->enum_base, r->choices);
     }
     case OBS_TABLE_MAT4: {
         const float *m = (const float *)(const void *)field;
         for (int k = 0; k < 16; k++)
             if (!isfinite(m[k]))
-                return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+                return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                                       "%s %s: element %d is not finite", t->noun, r->name, k + 1);
         return OBS_OK;
     }

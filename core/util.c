@@ -14,17 +14,6 @@ double obs__now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
-obs_status obs__fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
-{
-    if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, OBS_ERR_LEN, fmt, ap);
-        va_end(ap);
-    }
-    return s;
-}
-
 int obs__size_mul(size_t a, size_t b, size_t *out)
 {
     if (a != 0 && b > SIZE_MAX / a)

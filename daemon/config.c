@@ -69,7 +69,7 @@ obs_status obsd_config_load(obsd_config *c, const char *path, char err[OBS_ERR_L
         lineno++;
         size_t n = strlen(line);
         if (n == sizeof line - 1 && line[n - 1] != '\n') {
-            s = obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s:%d: line longer than %d characters",
+            s = obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s:%d: line longer than %d characters",
                                path, lineno, (int)sizeof line - 2);
             break;
         }
@@ -97,7 +97,7 @@ obs_status obsd_config_load(obsd_config *c, const char *path, char err[OBS_ERR_L
         }
         name[name_len] = '\0';
         if (obsd_config_set(c, name, value, msg) != OBS_OK) {
-            s = obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s:%d: %s", path, lineno, msg);
+            s = obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s:%d: %s", path, lineno, msg);
             break;
         }
     }
@@ -115,7 +115,7 @@ obs_status obsd_config_args(obsd_config *c, int argc, char **argv, int *help,
         const char *a = argv[i], *path = NULL;
         if (!strcmp(a, "--config")) {
             if (i + 1 >= argc)
-                return obs_table_fail(err, OBS_INVALID_ARGUMENT, "--config needs a file");
+                return obs_status_fail(err, OBS_INVALID_ARGUMENT, "--config needs a file");
             path = argv[++i];
         } else if (!strncmp(a, "--config=", 9)) {
             path = a + 9;
@@ -139,12 +139,12 @@ obs_status obsd_config_args(obsd_config *c, int argc, char **argv, int *help,
         if (!strncmp(a, "--config=", 9))
             continue;
         if (strncmp(a, "--", 2) != 0 || !a[2])
-            return obs_table_fail(err, OBS_INVALID_ARGUMENT, "unexpected argument '%s'", a);
+            return obs_status_fail(err, OBS_INVALID_ARGUMENT, "unexpected argument '%s'", a);
         const char *eq = strchr(a + 2, '=');
         size_t n = eq ? (size_t)(eq - a - 2) : strlen(a + 2);
         const obsd_opt_info *o = obs_table_find_n(&table, a + 2, n);
         if (!o)
-            return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+            return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                                   "unknown option '%.*s' (obscurad --help lists them)", (int)n + 2,
                                   a);
         const char *value;
@@ -153,9 +153,9 @@ obs_status obsd_config_args(obsd_config *c, int argc, char **argv, int *help,
         else if (i + 1 < argc)
             value = argv[++i];
         else
-            return obs_table_fail(err, OBS_INVALID_ARGUMENT, "option --%s needs a value", o->name);
+            return obs_status_fail(err, OBS_INVALID_ARGUMENT, "option --%s needs a value", o->name);
         if (obsd_config_set(c, o->name, value, msg) != OBS_OK)
-            return obs_table_fail(err, OBS_INVALID_ARGUMENT, "%s", msg);
+            return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s", msg);
     }
     return OBS_OK;
 }

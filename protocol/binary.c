@@ -21,7 +21,7 @@
 
 /* The message into err (when set), and s.  This file's own: the protocol
  * is built against the public headers, not core's internal ones. */
-#define fail(err, s, ...) ((err) ? (void)snprintf((err), OBS_ERR_LEN, __VA_ARGS__) : (void)0, (s))
+#define fail obs_status_fail
 
 /* a * b * c without overflow; 0 on overflow. */
 static int mul3(uint64_t a, uint64_t b, uint64_t c, uint64_t *out)

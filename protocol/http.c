@@ -149,14 +149,14 @@ static obs_status set_choice(obs_http_request *r, const obs_http_option *op, con
             v |= c->value;
             n++;
         } else if (len || !(op->list & from)) {
-            return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+            return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                                   "parameter %s: '%.*s' is not one of %s", op->name, (int)len, s,
                                   choices_text(op, from, all, sizeof all));
         }
         s += len;
     } while (*s++ == ',');
     if (!n)
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' names none of %s",
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' names none of %s",
                               op->name, value, choices_text(op, from, all, sizeof all));
     memcpy((char *)r + op->field, &v, sizeof v);
     return OBS_OK;
@@ -171,7 +171,7 @@ static obs_status set_bool(obs_http_request *r, const obs_http_option *op, const
     else if (!strcmp(value, "0") || !strcmp(value, "false"))
         v = 0;
     else
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s",
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s",
                               op->name, value, "0|1|true|false");
     memcpy((char *)r + op->field, &v, sizeof v);
     return OBS_OK;
@@ -184,13 +184,13 @@ static obs_status set_names(obs_http_request *r, const obs_http_option *op, cons
     char tmp[NAMES_MAX * SLOT_MAX] = "", all[256];
     int k, known = !op->names;
     if (op->max < 1 || op->max > NAMES_MAX || op->slot > SLOT_MAX)
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "parameter %s: its row takes more names than %d of %d bytes",
                               op->name, NAMES_MAX, SLOT_MAX);
     for (const char *const *n = op->names; n && *n; n++)
         known |= !strcmp(value, *n);
     if (!known)
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s",
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s",
                               op->name, value, choices_text(op, Q, all, sizeof all));
     if (op->max == 1) { /* one name, whole: a comma may be part of it */
         k = *value && strlen(value) < op->slot ? 1 : -1;
@@ -200,7 +200,7 @@ static obs_status set_names(obs_http_request *r, const obs_http_option *op, cons
         k = split_names(value, tmp, op->slot, op->max);
     }
     if (k < op->min)
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%.100s' is not %s",
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%.100s' is not %s",
                               op->name, value, op->what);
     char *slots = (char *)r + op->field;
     const char **map = (const char **)(void *)((char *)r + op->map);
@@ -228,7 +228,7 @@ obs_status obs_http_option_set(obs_http_request *r, const obs_http_option *op, c
     case OBS_HTTP_OPT_BOOL: return set_bool(r, op, value, err);
     case OBS_HTTP_OPT_NAMES: return set_names(r, op, value, err);
     }
-    return obs_table_fail(err, OBS_INVALID_ARGUMENT, "parameter %s has an unknown kind", op->name);
+    return obs_status_fail(err, OBS_INVALID_ARGUMENT, "parameter %s has an unknown kind", op->name);
 }
 
 void obs_http_request_init(obs_http_request *r)
@@ -244,12 +244,12 @@ obs_status obs_http_request_set(obs_http_request *r, const char *name, const cha
 {
     const obs_http_option *op;
     if (!name || !*name)
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT, "empty parameter name");
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "empty parameter name");
     if ((op = obs_http_option_find(name)))
         return obs_http_option_set(r, op, value, OBS_HTTP_QUERY, err);
     if (obs_param_find(name))
         return obs_param_set(&r->params, name, value ? value : "", err);
-    return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+    return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                           "unknown parameter '%.100s' (GET /v1/params lists them)", name);
 }
 
@@ -257,10 +257,10 @@ obs_status obs_http_value_check(const char *name, size_t name_len, const char *v
                                 char err[OBS_ERR_LEN])
 {
     if (name && memchr(name, '\0', name_len))
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "parameter '%.100s': its name holds a NUL byte (%%00)", name);
     if (value && memchr(value, '\0', len))
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "parameter %.100s: its value holds a NUL byte (%%00)",
                               name ? name : "?");
     return OBS_OK;
@@ -276,11 +276,11 @@ obs_status obs_http_request_set_n(obs_http_request *r, const char *name, size_t 
 obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LEN])
 {
     if (r->format == OBS_HTTP_PNG && r->outputs == (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE))
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "format=png holds one image: ask for one output (output=ao or "
                               "output=composite), or use format=exr for both");
     if (r->append && r->format != OBS_HTTP_EXR)
-        return obs_table_fail(err, OBS_INVALID_ARGUMENT,
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "append=1 writes the input EXR back with the AO added: it needs "
                               "format=exr");
     if (r->layer) {

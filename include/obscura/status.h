@@ -40,6 +40,14 @@ const char *obs_status_name(obs_status s);
 /* One-line description of the status class; never NULL. */
 const char *obs_status_message(obs_status s);
 
+/* Writes a formatted message into err (if non-NULL) and returns s: the
+ * one formatter of every status with its detail, in core and in the
+ * units above it. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((format(printf, 3, 4)))
+#endif
+obs_status obs_status_fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...);
+
 #ifdef __cplusplus
 }
 #endif

@@ -20,12 +20,6 @@
 extern "C" {
 #endif
 
-#if defined(__GNUC__)
-#define OBS_TABLE_PRINTF(a, b) __attribute__((format(printf, a, b)))
-#else
-#define OBS_TABLE_PRINTF(a, b)
-#endif
-
 /* What a field holds and how its text is read.  The order of the first
  * four is the index of GET /v1/params' type names. */
 typedef enum obs_table_type {
@@ -63,11 +57,6 @@ typedef struct obs_table {
     size_t given;
 } obs_table;
 #define OBS_TABLE_NO_MASK ((size_t)-1)
-
-/* Writes a formatted message into err (if non-NULL) and returns s: the
- * engine's formatter, for units that check more than one row. */
-obs_status obs_table_fail(char err[OBS_ERR_LEN], obs_status s, const char *fmt, ...)
-    OBS_TABLE_PRINTF(3, 4);
 
 /* 1 when row name a is the first blen characters of b, '-' and '_' alike
  * (for tables of other rows: the HTTP request options). */
