@@ -44,7 +44,12 @@ CXXFLAGS += -std=c++14 -Wall -Wextra -Wshadow -fno-strict-aliasing
 CFLAGS ?= -O2 -g
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -Wall -Wextra -Wshadow -Wstrict-prototypes \
           -Wno-missing-field-initializers -fno-strict-aliasing
-CPPFLAGS += -Iinclude -Icore -I$(BUILD)/gen
+CPPFLAGS += -Iinclude -I$(BUILD)/gen
+# core's internal headers are seen by core itself and by the tests, benches
+# and developer tools that exercise its insides; daemon/, protocol/ and
+# clients/ are built without them, so `obs__` names stay internal.
+CORE_INC := -Icore
+$(BUILD)/obj/core/%.o: CPPFLAGS += $(CORE_INC)
 ifeq ($(SAN),1)
 CFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 CXXFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
@@ -122,18 +127,18 @@ $(CLI): $(CLI_OBJ) $(PROTO_LIB) $(LIB)
 	$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(PROTO_LIB) $(LIB) $(PKG_LIBS)
 
 $(BENCH): bench/frame_bench.c $(LIB)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+	$(CC) $(CPPFLAGS) $(CORE_INC) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 $(EXT_BENCH): bench/extensions_bench.c $(LIB)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+	$(CC) $(CPPFLAGS) $(CORE_INC) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 $(UPSCALE): tools/exr_upscale.c $(LIB)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+	$(CC) $(CPPFLAGS) $(CORE_INC) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 # Deep input: OITAO Table I structure (bench/RESULTS.md, "Deep input").
 DEEP_BENCH := $(BUILD)/deep_bench
 $(DEEP_BENCH): bench/deep_bench.c $(LIB)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+	$(CC) $(CPPFLAGS) $(CORE_INC) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 # The deep test fixture, written with OpenEXR's C++ deep API (the C API of
 # 3.1 cannot write deep data); its output tests/data/deep_small.exr is
@@ -144,16 +149,16 @@ deep-fixture:
 	$(BUILD)/deep_fixture tests/data/deep_small.exr
 
 $(QSTRIP): tools/quality_strip.c $(LIB)
-	$(CC) $(CPPFLAGS) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
+	$(CC) $(CPPFLAGS) $(CORE_INC) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 # The daemon bench is a client: the CLI's remote code and the protocol.
 $(DAEMON_BENCH): bench/daemon_bench.c $(BUILD)/obj/clients/remote.o $(PROTO_LIB) $(LIB)
-	$(CC) $(CPPFLAGS) -Iclients -Iprotocol $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(BUILD)/obj/clients/remote.o $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS)
+	$(CC) $(CPPFLAGS) $(CORE_INC) -Iclients -Iprotocol $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(BUILD)/obj/clients/remote.o $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
 # PROTO_LIB and EXTRA_LIBS come from protocol.mk / daemon.mk when present.
 $(BUILD)/tests/%: tests/unit/%.c $(PROTO_LIB) $(LIB) tests/unit/testutil.h $(wildcard tests/unit/core/*.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) $(EXTRA_LIBS) -lcmocka
+	$(CC) $(CPPFLAGS) $(CORE_INC) -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) $(EXTRA_LIBS) -lcmocka
 
 # The bake tests' scene helpers (tests/unit/level/bake_testutil.h), for the
 # tests of core/level, core/bake and core/dynamic.
@@ -161,7 +166,7 @@ $(filter $(BUILD)/tests/level/% $(BUILD)/tests/bake/% $(BUILD)/tests/dynamic/%,$
 
 $(BUILD)/tests/nogl/%: tests/unit/nogl/%.c $(LIB) tests/unit/testutil.h $(wildcard tests/unit/core/*.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) -lm -lcmocka
+	$(CC) $(CPPFLAGS) $(CORE_INC) -Itests/unit $(CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) -lm -lcmocka
 
 -include $(CORE_OBJ:.o=.d) $(CLI_OBJ:.o=.d)
 
@@ -215,6 +220,7 @@ loops: $(CORE_OBJ) $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
 	@tools/call_loops.py $(CORE_OBJ)
 	@tools/call_loops.py $(DAEMON_OBJ)
 	@tools/call_loops.py $(PROTO_OBJ) $(CLI_OBJ)
+	@tools/call_loops.py --internal $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
 
 # Every tests/e2e/*.sh runs with the binaries' paths in the environment.
 E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)

@@ -9,6 +9,7 @@
 
 #include "bake.h"
 #include "bake_common.h"
+#include "bake_lod.h"
 #include "cli.h"
 #include "obscura/bake.h"
 

@@ -5,7 +5,7 @@
  * geometry and fitted); the lod stage's parts in seconds. */
 #include <cjson/cJSON.h>
 
-#include "bake.h"
+#include "bake_lod.h"
 #include "obscura/bake.h"
 
 static cJSON *pair(const double v[2])

@@ -5,4 +5,4 @@ CLIENT_TEST_OBJ := $(BUILD)/obj/clients/batch.o $(BUILD)/obj/clients/flags.o \
 
 $(BUILD)/tests/clients/%: tests/unit/clients/%.c $(CLIENT_TEST_OBJ) $(PROTO_LIB) $(LIB) tests/unit/testutil.h
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Iclients -Iprotocol -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(CLIENT_TEST_OBJ) $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) -lcmocka
+	$(CC) $(CPPFLAGS) $(CORE_INC) -Iclients -Iprotocol -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(CLIENT_TEST_OBJ) $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) -lcmocka

@@ -10,7 +10,8 @@
 #include <stdatomic.h>
 #include <stddef.h>
 
-#include "binary_server.h"
+#include "config.h"
+#include "gl_worker.h"
 
 #define TICK_MS 200
 /* Before closing a connection that was answered without reading all it
@@ -39,6 +40,7 @@ typedef struct refused {
     size_t dropped;
 } refused;
 
+typedef struct obsd_bin obsd_bin; /* as binary_server.h, which only the listeners include */
 struct obsd_bin {
     const obsd_config *cfg;
     const char *token;

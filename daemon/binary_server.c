@@ -30,6 +30,7 @@
 #include "addr.h"
 #include "binary.h"
 #include "binary_internal.h"
+#include "binary_server.h"
 #include "list.h"
 #include "log.h"
 #include "stats.h"

@@ -35,6 +35,6 @@ $(OBSCURAD): $(DAEMON_MAIN) $(DAEMON_LIB) $(PROTO_LIB) $(LIB)
 # (a more specific pattern than the Makefile's, so make prefers it).
 $(BUILD)/tests/daemon/%: tests/unit/daemon/%.c $(DAEMON_LIB) $(PROTO_LIB) $(LIB) tests/unit/testutil.h
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Idaemon -Iprotocol -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(DAEMON_LIB) $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) $(EXTRA_LIBS) -lcmocka
+	$(CC) $(CPPFLAGS) $(CORE_INC) -Idaemon -Iprotocol -Itests/unit $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(DAEMON_LIB) $(PROTO_LIB) $(LIB) $(LDFLAGS) $(PKG_LIBS) $(EXTRA_LIBS) -lcmocka
 
 -include $(DAEMON_OBJ:.o=.d)

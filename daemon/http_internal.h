@@ -14,9 +14,9 @@
 #include "bake_jobs.h"
 #include "frame_path.h"
 #include "http.h"
-#include "http_server.h"
+#include "config.h"
+#include "gl_worker.h"
 #include "obscura/io.h"
-#include "routes.h"
 #include "stats.h"
 #include "stream_store.h"
 
@@ -40,6 +40,10 @@ typedef struct obsd__conn {
     atomic_int cut;           /* CUT_*: shut down, MHD closes it next */
 } obsd__conn;
 
+/* The server (obsd_http in http_server.h, which only http_server.c and
+ * obscurad.c include: the handlers reach the server through this
+ * struct, and http_server.c reaches them through the route table). */
+typedef struct obsd_http obsd_http;
 struct obsd_http {
     struct MHD_Daemon *mhd;
     const obsd_config *cfg;
@@ -120,7 +124,7 @@ typedef struct obsd__req {
     obsd__conn *cn;      /* its connection's record */
     atomic_int job;      /* JOB_* */
     uint64_t id;
-    const obsd__route *route; /* its row of the route table; NULL: no such route */
+    const struct obsd__route *route; /* its row of the route table; NULL: no such route */
     int slot;            /* its counters' slot (stats.h) */
     const char *label;   /* the route's label in the log and the metrics ("other": none) */
     int frame_total;     /* its answer ends a frame: timed as the `total` stage */

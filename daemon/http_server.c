@@ -21,7 +21,9 @@
 
 #include "addr.h"
 #include "http_internal.h"
+#include "http_server.h"
 #include "log.h"
+#include "routes.h"
 
 typedef obsd__req req;
 
