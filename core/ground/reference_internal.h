@@ -13,7 +13,7 @@ typedef struct obs__obscurance {
     float tfar;   /* ray length: OBS__BAKE_RAY_LENGTH_FACTOR times the longer d */
     int rays;
     uint64_t seed;
-    /* the bake's occluders (core/bake/occl.h), or NULL: the scene */
+    /* the bake's occluders (core/level/occl.h), or NULL: the scene */
     const struct obs__bake_occl *occl;
 } obs__obscurance;
 

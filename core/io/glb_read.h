@@ -2,7 +2,7 @@
  * brings: the binary chunk and accessors, every offset and size checked
  * against the chunk.  Shared by the two readers that assimp cannot serve
  * (it drops custom attributes and MSFT_lod): core/ground/baked.c (a
- * baked level's _AO, _AO_SHORT, _AO_LONG) and core/bake/lod_file.c (a
+ * baked level's _AO, _AO_SHORT, _AO_LONG) and core/level/lod_file.c (a
  * file's own LODs).  Each opens the file its own way (the LOD reader
  * stops after the JSON chunk when the file has no MSFT_lod). */
 #ifndef OBSCURA_IO_GLB_READ_H

@@ -34,7 +34,7 @@
  * rho = 1; rays stop at 16 times the longer d), the hemisphere around the
  * geometric normal facing the viewer (the G-buffer's normal for G-buffer
  * points), the bake's own kernel, ray lattice and random shifts
- * (core/bake/kernel.h).  Every surface is opaque, as the bake traces it:
+ * (core/level/kernel.h).  Every surface is opaque, as the bake traces it:
  * opacities are not used; with desc.occluders the rays meet the bake's
  * occluders instead, the decorators' fog and semi-transparent trees
  * multiplying each ray's rho by their transmittance (section 2.1).  The image has three channels: the blend
