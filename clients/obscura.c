@@ -7,7 +7,7 @@
  *   obscura samples [--c]
  *   obscura gbuffer SCENE -o OUT.exr --camera CAM.json   (clients/ground.c)
  *   obscura reference SCENE -o REF.exr --camera CAM.json (clients/ground.c)
- *   obscura batch IN.####.exr --frames 1-100x2 -o OUT.####.exr [--server URL] [--jobs N] [--strict] ...
+ *   obscura batch IN.####.exr --frames 1-100x2 -o OUT.####.exr [--server URL] [--jobs N] [--allow-missing] ...
  *
  * Exit codes: 0 ok, 1 failure (GL, I/O), 2 usage, 3 bad input. */
 #include <cjson/cJSON.h>
@@ -133,8 +133,10 @@ static void usage(FILE *f)
             "  obscura params [--markdown]\n"
             "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as core/chain/sample_tables.c\n"
             "  obscura batch IN.####.exr --frames SPEC -o OUT.####.exr [--server URL] [--jobs N]\n"
-            "                [--strict] [ao options]   a frame sequence; SPEC 1-100, 1-100x2, 1,5,9;\n"
-            "                #### or %%04d is the frame; missing inputs are skipped (--strict: exit 3)\n",
+            "                [--allow-missing] [--progress plain|percent] [-q] [ao options]\n"
+            "                a frame sequence; SPEC 1-100, 1-100x2, 1,5,9; #### or %%04d is the frame;\n"
+            "                a missing input is exit 3, the others still written (--allow-missing:\n"
+            "                exit 0, unless nothing was written); percent: 'Progress: N%%' on stdout\n",
             OBS_VERSION);
     cli_ground_usage(f);
     cli_warmup_usage(f);
