@@ -241,7 +241,7 @@ int cli_bake_report_write(const char *cmd, const char *path, cJSON *r)
         ok = 0;
     free(txt);
     if (!ok)
-        fprintf(stderr, "obscura: %s: %s: cannot write the report: %s\n", cmd, path,
+        fprintf(stderr, "obscura: error: %s: %s: cannot write the report: %s\n", cmd, path,
                 strerror(errno));
     return ok;
 }
