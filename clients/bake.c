@@ -17,7 +17,7 @@ void cli_bake_usage(FILE *f)
 {
     fprintf(f,
             "  obscura bake LEVEL -o OUT.(glb|ply) [--distances S,L] [--blend B]\n"
-            "                  [--report R.json] [--ply P.ply] [--color] [--quiet]\n"
+            "                  [--report R.json] [--ply P.ply] [--color] [--quiet] [--progress percent]\n"
             "                  [--decorators D.json]\n"
             "                  [--PARAM VALUE]...  ambient obscurance baked onto the vertices\n"
             "                  of a level (glTF/GLB, AC3D, anything assimp reads; node graph\n"

@@ -130,6 +130,10 @@ int cli_bake_parse(const cli_bake_cmd *c, int argc, char **argv, cli_bake_args *
             takes = 0;
         } else if (!strcmp(key, "quiet") || !strcmp(key, "q")) {
             a->quiet = 1, takes = 0;
+        } else if (!strcmp(key, "progress") && val) {
+            if (strcmp(val, "plain") && strcmp(val, "percent"))
+                cli_die_usage(c->name, "--progress: '%s' is not plain or percent", val);
+            a->progress.percent = !strcmp(val, "percent");
         } else if (!strcmp(key, "merge")) {
             merging = a->merge = 1, takes = 0;
             if (eq && *val)
@@ -171,13 +175,15 @@ int cli_bake_load(cli_bake_args *a, size_t max_triangles, char err[OBS_ERR_LEN])
         return cli_input_fail(s, a->in, err);
     a->loaded = 1;
     a->load_s = cli_now_s() - t0;
-    a->progress = (cli_progress){cli_now_s(), 0.0};
+    a->progress.start = cli_now_s();
+    a->progress.last = 0.0;
+    a->progress.pct_last = -1;
     return EXIT_OK;
 }
 
 int cli_bake_shows_progress(const cli_bake_args *a)
 {
-    return !a->quiet && isatty(2);
+    return a->progress.percent || (!a->quiet && isatty(2));
 }
 
 void cli_bake_args_free(cli_bake_args *a)
@@ -235,7 +241,7 @@ int cli_bake_report_write(const char *cmd, const char *path, cJSON *r)
         ok = 0;
     free(txt);
     if (!ok)
-        fprintf(stderr, "obscura: %s: %s: cannot write the report: %s\n", cmd, path,
+        fprintf(stderr, "obscura: error: %s: %s: cannot write the report: %s\n", cmd, path,
                 strerror(errno));
     return ok;
 }
@@ -243,6 +249,10 @@ int cli_bake_report_write(const char *cmd, const char *path, cJSON *r)
 int cli_progress_due(cli_progress *p, size_t done, size_t total, double *t)
 {
     *t = cli_now_s();
+    if (p->percent) {
+        cli_progress_percent(&p->pct_last, (long)done, (long)total);
+        return 0;
+    }
     if (*t - p->last < 0.5 && done < total)
         return 0;
     p->last = *t;

@@ -50,6 +50,8 @@ typedef struct cli_bake_cmd {
 /* The pace of a progress line: every half second, and at the end. */
 typedef struct cli_progress {
     double start, last;
+    int percent;  /* --progress percent: "Progress: N%" lines instead */
+    int pct_last; /* the last N printed, -1 none */
 } cli_progress;
 
 /* What every bake command's flags say, and the level they name once
@@ -79,7 +81,8 @@ void cli_bake_check(const cli_bake_cmd *c, const cli_bake_args *a);
  * timing the load.  Returns EXIT_OK, or the exit code once the failure is
  * printed. */
 int cli_bake_load(cli_bake_args *a, size_t max_triangles, char err[OBS_ERR_LEN]);
-/* Whether the progress line is drawn: not --quiet, and stderr a terminal. */
+/* Whether the progress is shown: --progress percent, else not --quiet
+ * and stderr a terminal. */
 int cli_bake_shows_progress(const cli_bake_args *a);
 
 /* The exit code of a failed bake or merge: a part that cannot be read is
@@ -102,7 +105,8 @@ int cli_bake_report_write(const char *cmd, const char *path, struct cJSON *r);
 /* The --params listing of a table (README's markdown with markdown). */
 void cli_bake_list_params(const cli_param_table *t, int markdown);
 
-/* 1 when a line is due; *t is now. */
+/* 1 when a line is due; *t is now.  Under --progress percent it prints
+ * the "Progress: N%" line itself (when N changed) and returns 0. */
 int cli_progress_due(cli_progress *p, size_t done, size_t total, double *t);
 /* Ends the line once done reaches total. */
 void cli_progress_end(size_t done, size_t total);

@@ -8,6 +8,7 @@
  * draws the progress.  A worker that dies leaves its frame unreported,
  * which counts as a failure, never as a hang. */
 #include "batch.h"
+#include "cli.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -230,11 +231,26 @@ static double now_s(void)
 
 static int usage_error(const char *fmt, const char *arg)
 {
-    fprintf(stderr, "obscura: batch: ");
+    fprintf(stderr, "obscura: error: batch: ");
     fprintf(stderr, fmt, arg);
     fprintf(stderr, "\n(run 'obscura help' for usage)\n");
     return RC_USAGE;
 }
+
+/* A batch's flags and what the steps find: the frames, those with an
+ * input, and the ao options handed to every frame. */
+typedef struct batch_job {
+    const char *in, *out, *spec, *server;
+    int jobs, quiet_given;
+    int allow_missing; /* missing inputs are not a failure (a batch that wrote nothing still is) */
+    int quiet;         /* -q: no line per frame that went well */
+    int percent;       /* --progress percent */
+    int percent_last;  /* the last "Progress: N%" printed, -1 none */
+    char **extra;      /* the ao options */
+    int nextra, server_at;
+    int *frames, nframes;
+    int *todo, ntodo, missing;
+} batch_job;
 
 /* mkdir -p of the folder that holds `path`. */
 static int make_parent(const char *path)
@@ -257,18 +273,26 @@ static int make_parent(const char *path)
     }
 }
 
-static void progress(int tty, int done, int total, double t0, int frame, int rc, double secs)
+/* One frame done: --progress percent's "Progress: N%" on stdout (what
+ * Deadline's and OpenCue's parsers read); a failed frame's error line;
+ * unless -q, the ok frame's line (stderr no terminal) or the bar. */
+static void progress(batch_job *b, int tty, int done, double t0, int frame, int rc, double secs)
 {
+    int total = b->ntodo;
     double el = now_s() - t0;
     double fps = el > 0 ? done / el : 0;
-    if (!tty) {
+    if (b->percent)
+        cli_progress_percent(&b->percent_last, done, total);
+    if (rc != RC_OK || (!tty && !b->quiet && !b->percent)) {
         char what[32] = "ok";
         if (rc != RC_OK)
             snprintf(what, sizeof what, "failed (exit %d)", rc);
-        fprintf(stderr, "obscura: batch: [%d/%d] frame %d %s (%.2f s, %.2f frames/s)\n", done, total, frame,
-                what, secs, fps);
+        fprintf(stderr, "%sobscura: %sbatch: [%d/%d] frame %d %s (%.2f s, %.2f frames/s)\n",
+                tty ? "\r\033[K" : "", rc != RC_OK ? "error: " : "", done, total, frame, what, secs, fps);
         return;
     }
+    if (!tty || b->quiet || b->percent)
+        return;
     enum { BAR = 30 };
     char bar[BAR + 1];
     int fill = total ? done * BAR / total : BAR;
@@ -304,17 +328,6 @@ int cli_batch_rotate(const char *list, int k, char *buf, size_t len)
     buf[total] = '\0';
     return 0;
 }
-
-/* A batch's flags and what the steps find: the frames, those with an
- * input, and the ao options handed to every frame. */
-typedef struct batch_job {
-    const char *in, *out, *spec, *server;
-    int jobs, strict, quiet_given;
-    char **extra; /* the ao options */
-    int nextra, server_at;
-    int *frames, nframes;
-    int *todo, ntodo, missing;
-} batch_job;
 
 /* One frame's `obscura ao` arguments into av (room for nextra + 4):
  * INPUT -o OUTPUT, then the ao options.  Returns the count. */
@@ -397,14 +410,19 @@ static int parse_args(int argc, char **argv, batch_job *b)
                     return usage_error("--jobs: '%s' is not in [1, 64]", v);
                 b->jobs = (int)j;
             }
-        } else if (!strcmp(a, "--strict")) {
-            b->strict = 1;
-            b->extra[b->nextra++] = argv[i]; /* each frame's sanity warnings are errors too */
+        } else if (!strcmp(a, "--allow-missing")) {
+            b->allow_missing = 1;
+        } else if (MATCHES("--progress")) {
+            const char *v = VALUE("--progress");
+            if (!v || (strcmp(v, "plain") && strcmp(v, "percent")))
+                return usage_error("--progress: '%s' is not plain or percent", v ? v : "");
+            b->percent = !strcmp(v, "percent");
         } else if (!b->in && a[0] != '-' && (i == 0 || cli_batch_check_pattern(a, NULL, 0) == 0)) {
             b->in = a; /* the input pattern: first, or the first word with a placeholder */
         } else {
-            b->quiet_given |= !strcmp(a, "-q") || !strcmp(a, "--quiet") || !strcmp(a, "-v") ||
-                              !strcmp(a, "--verbose");
+            int q = !strcmp(a, "-q") || !strcmp(a, "--quiet");
+            b->quiet |= q;
+            b->quiet_given |= q || !strcmp(a, "-v") || !strcmp(a, "--verbose");
             b->extra[b->nextra++] = argv[i];
         }
     }
@@ -458,7 +476,8 @@ static int check_ao_options(const batch_job *b, const cli_batch_ops *ops)
 }
 
 /* The frames whose input exists (b->todo), their output folders made;
- * missing inputs reported, fatal (before any work) with --strict. */
+ * missing inputs reported (an error unless --allow-missing): the run
+ * still does the others, summarise() says what the gaps cost. */
 static int find_inputs(batch_job *b)
 {
     b->todo = malloc((size_t)b->nframes * sizeof *b->todo);
@@ -468,21 +487,19 @@ static int find_inputs(batch_job *b)
         char p[PATH_MAX];
         cli_batch_expand(b->in, b->frames[i], p, sizeof p);
         if (access(p, R_OK) != 0) {
-            fprintf(stderr, "obscura: batch: frame %d: missing input %s (%s)\n", b->frames[i], p, strerror(errno));
+            char shown[PATH_MAX * 4];
+            cli_escape(p, shown, sizeof shown);
+            fprintf(stderr, "obscura: %s: batch: frame %d: missing input %s (%s)\n",
+                    b->allow_missing ? "warning" : "error", b->frames[i], shown, strerror(errno));
             b->missing++;
             continue;
         }
         cli_batch_expand(b->out, b->frames[i], p, sizeof p);
         if (make_parent(p) != 0) {
-            fprintf(stderr, "obscura: batch: cannot create the folder of %s: %s\n", p, strerror(errno));
+            fprintf(stderr, "obscura: error: batch: cannot create the folder of %s: %s\n", p, strerror(errno));
             return RC_FAIL;
         }
         b->todo[b->ntodo++] = b->frames[i];
-    }
-    if (b->missing && b->strict) {
-        fprintf(stderr, "obscura: batch: %d of %d input frames missing; --strict: nothing rendered\n",
-                b->missing, b->nframes);
-        return RC_BADINPUT;
     }
     return RC_OK;
 }
@@ -516,7 +533,7 @@ static int start_workers(batch_job *b, const cli_batch_ops *ops, shared *sh, int
 
 /* Each frame's code from the workers' reports (code[i] -1 until then),
  * the progress drawn as they come; then the workers reaped. */
-static void collect(const batch_job *b, int fd, int *code, const pid_t *pids, int nworkers,
+static void collect(batch_job *b, int fd, int *code, const pid_t *pids, int nworkers,
                     double t0)
 {
     int tty = isatty(2), done_n = 0;
@@ -530,7 +547,7 @@ static void collect(const batch_job *b, int fd, int *code, const pid_t *pids, in
         if (r.index < 0 || r.index >= b->ntodo || code[r.index] != -1)
             continue;
         code[r.index] = r.rc;
-        progress(tty, ++done_n, b->ntodo, t0, b->todo[r.index], r.rc, r.seconds);
+        progress(b, tty, ++done_n, t0, b->todo[r.index], r.rc, r.seconds);
     }
     close(fd);
     for (int k = 0; k < nworkers; k++) {
@@ -538,10 +555,10 @@ static void collect(const batch_job *b, int fd, int *code, const pid_t *pids, in
         while (waitpid(pids[k], &st, 0) < 0 && errno == EINTR)
             ;
         if (!WIFEXITED(st) || WEXITSTATUS(st) != 0)
-            fprintf(stderr, "obscura: batch: a worker %s %d\n", WIFSIGNALED(st) ? "died of signal" : "exited",
+            fprintf(stderr, "obscura: error: batch: a worker %s %d\n", WIFSIGNALED(st) ? "died of signal" : "exited",
                     WIFSIGNALED(st) ? WTERMSIG(st) : WEXITSTATUS(st));
     }
-    if (tty && done_n < b->ntodo)
+    if (tty && !b->quiet && !b->percent && done_n < b->ntodo)
         fputc('\n', stderr);
 }
 
@@ -561,12 +578,20 @@ static int summarise(const batch_job *b, const int *code, double el)
             n4 += code[i] == RC_UNAVAILABLE;
         }
     }
-    fprintf(stderr, "obscura: batch: %d frames: %d ok, %d failed, %d missing, %d not run; %.1f s, %.2f frames/s\n",
-            b->nframes, ok, failed, b->missing, not_run, el, el > 0 ? ok / el : 0.0);
     /* a permanent failure first (a retry cannot help), the server last */
     int rc = n2 ? RC_USAGE : n3 ? RC_BADINPUT : n1 ? RC_FAIL : (n4 || not_run) ? RC_UNAVAILABLE : RC_OK;
     if (not_run && !n4 && !n1 && !n3 && !n2)
         rc = RC_FAIL; /* a worker died */
+    /* A farm reads only the code: a gap is bad input (3: rerunning will
+     * not help until the frame is there) unless --allow-missing, and a
+     * batch that wrote nothing is never a success. */
+    if (rc == RC_OK && ((b->missing && !b->allow_missing) || ok == 0))
+        rc = RC_BADINPUT;
+    if (b->quiet && rc == RC_OK)
+        return rc;
+    fprintf(stderr, "obscura: %sbatch: %d frames: %d ok, %d failed, %d missing, %d not run; %.1f s, %.2f frames/s%s\n",
+            rc == RC_OK ? "" : "error: ", b->nframes, ok, failed, b->missing, not_run, el, el > 0 ? ok / el : 0.0,
+            ok == 0 && rc != RC_USAGE ? "; nothing written" : "");
     return rc;
 }
 
@@ -578,7 +603,7 @@ static int run_frames(batch_job *b, const cli_batch_ops *ops)
     int *code = malloc((size_t)(b->ntodo ? b->ntodo : 1) * sizeof *code);
     shared *sh = mmap(NULL, sizeof *sh, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
     if (!code || sh == MAP_FAILED || pipe(fds) != 0) {
-        fprintf(stderr, "obscura: batch: %s\n", strerror(errno));
+        fprintf(stderr, "obscura: error: batch: %s\n", strerror(errno));
         rc = RC_FAIL;
         goto done;
     }
@@ -589,7 +614,7 @@ static int run_frames(batch_job *b, const cli_batch_ops *ops)
     close(fds[1]);
     double t0 = now_s();
     if (nworkers == 0 && b->ntodo > 0)
-        fprintf(stderr, "obscura: batch: cannot start a worker: %s\n", strerror(errno));
+        fprintf(stderr, "obscura: error: batch: cannot start a worker: %s\n", strerror(errno));
     collect(b, fds[0], code, pids, nworkers, t0);
     rc = summarise(b, code, now_s() - t0);
 done:
@@ -601,7 +626,7 @@ done:
 
 int cli_batch(int argc, char **argv, const cli_batch_ops *ops)
 {
-    batch_job b = {.jobs = 1, .server_at = -1};
+    batch_job b = {.jobs = 1, .server_at = -1, .percent_last = -1};
     b.extra = malloc((size_t)(argc + 4) * sizeof *b.extra);
     if (!b.extra)
         return RC_FAIL;

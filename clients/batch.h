@@ -2,7 +2,8 @@
  * farm's task runs it.
  *
  *   obscura batch 'shot/frame.####.exr' --frames 1-100x2 -o 'out/ao.####.exr'
- *                 [--server URL] [--jobs N] [--strict] [ao options]
+ *                 [--server URL] [--jobs N] [--allow-missing]
+ *                 [--progress plain|percent] [-q] [ao options]
  *
  * The frame-spec and pattern parsers are pure functions (unit tests in
  * tests/unit/clients/test_batch.c); cli_batch() runs the frames through
@@ -47,8 +48,10 @@ typedef struct cli_batch_ops {
     void (*finish)(void);
 } cli_batch_ops;
 
-/* `obscura batch ARGS`; returns the exit code: 0 ok, 1 failure, 2 usage,
- * 3 bad input (permanent), 4 server unreachable or busy (retryable). */
+/* `obscura batch ARGS`; returns the exit code: 0 every frame written, 1
+ * failure, 2 usage, 3 bad input (permanent: a frame's input missing
+ * without --allow-missing, or damaged; or nothing written at all), 4
+ * server unreachable or busy (retryable). */
 int cli_batch(int argc, char **argv, const cli_batch_ops *ops);
 
 #endif

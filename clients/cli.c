@@ -24,11 +24,71 @@ int cli_status_exit(obs_status s)
 int cli_fail(obs_status s, const char *what, const char *err)
 {
     const char *msg = err && *err ? err : obs_status_message(s);
+    char shown[2 * OBS_ERR_LEN], name[1024];
+    /* a damaged header's bytes reach the message: escaped, not sent to the terminal */
+    cli_escape(msg, shown, sizeof shown);
+    cli_escape(what, name, sizeof name);
     if (strncmp(msg, what, strlen(what)) == 0) /* the message names it already */
-        fprintf(stderr, "obscura: %s (%s)\n", msg, obs_status_name(s));
+        fprintf(stderr, "obscura: error: %s (%s)\n", shown, obs_status_name(s));
     else
-        fprintf(stderr, "obscura: %s: %s (%s)\n", what, msg, obs_status_name(s));
+        fprintf(stderr, "obscura: error: %s: %s (%s)\n", name, shown, obs_status_name(s));
     return cli_status_exit(s);
+}
+
+void cli_escape(const char *in, char *out, size_t len)
+{
+    static const char hex[] = "0123456789abcdef";
+    size_t o = 0;
+    if (len == 0)
+        return;
+    for (const unsigned char *c = (const unsigned char *)in; *c && o + 1 < len; c++) {
+        if (*c >= 0x20 && *c != 0x7f) {
+            out[o++] = (char)*c;
+            continue;
+        }
+        if (o + 4 >= len)
+            break;
+        out[o++] = '\\';
+        out[o++] = 'x';
+        out[o++] = hex[*c >> 4];
+        out[o++] = hex[*c & 15];
+    }
+    out[o] = '\0';
+}
+
+int cli_edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    int row[64];
+    if (lb >= sizeof row / sizeof row[0] || la >= 64)
+        return 1 << 20; /* no option is that long */
+    for (size_t j = 0; j <= lb; j++)
+        row[j] = (int)j;
+    for (size_t i = 1; i <= la; i++) {
+        int diag = row[0];
+        row[0] = (int)i;
+        for (size_t j = 1; j <= lb; j++) {
+            int up = row[j];
+            int best = diag + (a[i - 1] != b[j - 1]);
+            if (up + 1 < best)
+                best = up + 1;
+            if (row[j - 1] + 1 < best)
+                best = row[j - 1] + 1;
+            row[j] = best;
+            diag = up;
+        }
+    }
+    return row[lb];
+}
+
+void cli_progress_percent(int *last, long done, long total)
+{
+    int pct = total > 0 ? (int)(100 * done / total) : 100;
+    if (pct == *last)
+        return;
+    *last = pct;
+    printf("Progress: %d%%\n", pct);
+    fflush(stdout);
 }
 
 int cli_input_fail(obs_status s, const char *what, const char *err)
@@ -41,7 +101,7 @@ void cli_die_usage(const char *cmd, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "obscura: %s: ", cmd);
+    fprintf(stderr, "obscura: error: %s: ", cmd);
     vfprintf(stderr, fmt, ap);
     fprintf(stderr, "\n(run 'obscura help' for usage)\n");
     va_end(ap);

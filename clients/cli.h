@@ -13,7 +13,7 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2, EXIT_BADINPUT = 3 };
 /* The exit code for a failed status: bad input is 3, the rest 1. */
 int cli_status_exit(obs_status s);
 
-/* Prints "obscura: WHAT: message (STATUS)" (WHAT left out when the message
+/* Prints "obscura: error: WHAT: message (STATUS)" (WHAT left out when the message
  * names it already) and returns cli_status_exit(s). */
 int cli_fail(obs_status s, const char *what, const char *err);
 
@@ -32,6 +32,18 @@ void cli_param_row(const obs_bake_param_info *pi, const char *def, int markdown)
 /* The whole of a text file, NUL-terminated, in *out (caller frees); the
  * message in err. */
 obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN]);
+
+/* `in` with its control bytes (below 0x20, 0x7f) as \xNN, truncated to
+ * fit len: a name or message read from a file cannot drive the terminal. */
+void cli_escape(const char *in, char *out, size_t len);
+
+/* Levenshtein distance of a and b (the "did you mean" of an unknown
+ * option); a large number for words of 64 bytes or more. */
+int cli_edit_distance(const char *a, const char *b);
+
+/* --progress percent: "Progress: N%" on stdout (the line Deadline's and
+ * OpenCue's progress parsers read) when N differs from *last. */
+void cli_progress_percent(int *last, long done, long total);
 
 /* Seconds of CLOCK_MONOTONIC (progress, stage times). */
 double cli_now_s(void);

@@ -19,8 +19,8 @@ void cli_dynamic_usage(FILE *f)
 {
     fprintf(f,
             "  obscura bake-dynamic LEVEL -o MODEL.json [--regions R.json] [--report R.json]\n"
-            "                  [--paths N] [--decorators D.json] [--PARAM VALUE]...  obscurance\n"
-            "                  for dynamic objects: regions, valid points, SH at two distances,\n"
+            "                  [--paths N] [--decorators D.json] [--progress percent] [--PARAM VALUE]...\n"
+            "                  obscurance for dynamic objects: regions, valid points, SH at two distances,\n"
             "                  eq 4 per region, regularised (section 2.3), through the decorators\n"
             "                  as obscura bake traces them; 'obscura bake-dynamic --params'\n"
             "  obscura bake-dynamic LEVEL --shard I/N -o PART [--regions R.json] [--PARAM VALUE]...\n"

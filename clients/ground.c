@@ -267,7 +267,7 @@ static int load_camera(const ground_args *a, obs_camera *cam, int *w, int *h)
          * of view and widens or narrows horizontally (x scale = y scale /
          * aspect); any other projection is used as it is, stretched. */
         if (obs_camera_fit_aspect(cam, *w, *h)) {
-            fprintf(stderr, "obscura: camera %s is %dx%d; rendering %dx%d with its vertical field "
+            fprintf(stderr, "obscura: warning: camera %s is %dx%d; rendering %dx%d with its vertical field "
                             "of view\n", a->camera, cw, ch, *w, *h);
         } else {
             fprintf(stderr, "obscura: warning: camera %s is %dx%d, the image %dx%d (aspect "

@@ -7,10 +7,11 @@
  *   obscura samples [--c]
  *   obscura gbuffer SCENE -o OUT.exr --camera CAM.json   (clients/ground.c)
  *   obscura reference SCENE -o REF.exr --camera CAM.json (clients/ground.c)
- *   obscura batch IN.####.exr --frames 1-100x2 -o OUT.####.exr [--server URL] [--jobs N] [--strict] ...
+ *   obscura batch IN.####.exr --frames 1-100x2 -o OUT.####.exr [--server URL] [--jobs N] [--allow-missing] ...
  *
  * Exit codes: 0 ok, 1 failure (GL, I/O), 2 usage, 3 bad input. */
 #include <cjson/cJSON.h>
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -52,7 +53,7 @@ static void die_usage(const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "obscura: ");
+    fprintf(stderr, "obscura: error: ");
     vfprintf(stderr, fmt, ap);
     fprintf(stderr, "\n(run 'obscura help' for usage)\n");
     va_end(ap);
@@ -114,43 +115,51 @@ static const cli_opt ao_opts[] = {
     {"verbose", NULL, "debug messages too (-v)"},
     {NULL, NULL, NULL}};
 
-static void usage(FILE *f)
+/* Each command's usage lines: `obscura help` prints them all, `obscura
+ * COMMAND --help` its own. */
+static const struct {
+    const char *cmd, *text;
+} usage_lines[] = {
+    {"ao", "  obscura ao IN.exr -o OUT.(exr|png) [options] [parameters]\n"
+           "                  IN '-': the EXR from stdin; OUT '-': to stdout (needs --format)\n"},
+    {"compare", "  obscura compare TRUTH.exr CANDIDATE.exr [--channel-a CH] [--channel-b CH]\n"
+                "                  [--mask auto|none|CH] [--diff OUT.(png|exr)] [--json]\n"
+                "                  metrics: MSE, PSNR, SSIM, MAE, corr, bias over the mask's pixels;\n"
+                "                  --mask auto: where TRUTH's (else CANDIDATE's) depth channel has\n"
+                "                  geometry (0 < Z < 1e9); none: every pixel; CH: where channel CH of\n"
+                "                  TRUTH is a depth with geometry\n"},
+    {"inspect", "  obscura inspect IN.exr [--json] [--preset P] [--depth-mode M] ...\n"
+                "                  what obscura reads: renderer, channels, camera and its source,\n"
+                "                  conventions, windows, part, sanity warnings\n"},
+    {"info", "  obscura info [--backend B]\n"},
+    {"params", "  obscura params [--markdown]\n"},
+    {"samples", "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as "
+                "core/chain/sample_tables.c\n"},
+    {"batch", "  obscura batch IN.####.exr --frames SPEC -o OUT.####.exr [--server URL] [--jobs N]\n"
+              "                [--allow-missing] [--progress plain|percent] [-q] [ao options]\n"
+              "                a frame sequence; SPEC 1-100, 1-100x2, 1,5,9; #### or %04d is the frame;\n"
+              "                a missing input is exit 3, the others still written (--allow-missing:\n"
+              "                exit 0, unless nothing was written); percent: 'Progress: N%' on stdout;\n"
+              "                -q: no line per frame\n"},
+};
+
+/* The ao options and the parameter table; the left column widens to
+ * the longest entry's line of its own, so no entry is cut. */
+static void usage_ao_options(FILE *f)
 {
-    fprintf(f,
-            "obscura %s: ambient occlusion for G-buffer EXRs (VAO on OpenGL)\n\n"
-            "usage:\n"
-            "  obscura ao IN.exr -o OUT.(exr|png) [options] [parameters]\n"
-            "  obscura compare TRUTH.exr CANDIDATE.exr [--channel-a CH] [--channel-b CH]\n"
-            "                  [--mask auto|none|CH] [--diff OUT.(png|exr)] [--json]\n"
-            "                  metrics: MSE, PSNR, SSIM, MAE, corr, bias over the mask's pixels;\n"
-            "                  --mask auto: where TRUTH's (else CANDIDATE's) depth channel has\n"
-            "                  geometry (0 < Z < 1e9); none: every pixel; CH: where channel CH of\n"
-            "                  TRUTH is a depth with geometry\n"
-            "  obscura inspect IN.exr [--json] [--preset P] [--depth-mode M] ...\n"
-            "                  what obscura reads: renderer, channels, camera and its source,\n"
-            "                  conventions, windows, part, sanity warnings\n"
-            "  obscura info [--backend B]\n"
-            "  obscura params [--markdown]\n"
-            "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as core/chain/sample_tables.c\n"
-            "  obscura batch IN.####.exr --frames SPEC -o OUT.####.exr [--server URL] [--jobs N]\n"
-            "                [--strict] [ao options]   a frame sequence; SPEC 1-100, 1-100x2, 1,5,9;\n"
-            "                #### or %%04d is the frame; missing inputs are skipped (--strict: exit 3)\n",
-            OBS_VERSION);
-    cli_ground_usage(f);
-    cli_warmup_usage(f);
-    cli_bake_usage(f);
-    cli_dynamic_usage(f);
     fprintf(f, "\nao options:\n");
     for (const cli_opt *o = ao_opts; o->name; o++) {
-        char left[48];
-        snprintf(left, sizeof left, "%s%s %s", o->name[1] ? "--" : "-", o->name,
-                 o->arg ? o->arg : "");
-        fprintf(f, "  %-30s %s\n", left, o->doc);
+        char left[128];
+        snprintf(left, sizeof left, "%s%s %s", o->name[1] ? "--" : "-", o->name, o->arg ? o->arg : "");
+        if (strlen(left) > 30) /* its own line, the doc under it */
+            fprintf(f, "  %s\n  %-30s %s\n", left, "", o->doc);
+        else
+            fprintf(f, "  %-30s %s\n", left, o->doc);
     }
     fprintf(f, "\nparameters (the one parameter table; 'obscura params' for details):\n");
     for (int i = 0; i < obs_param_count(); i++) {
         const obs_param_info *pi = obs_param_at(i);
-        char flag[48], range[64] = "";
+        char flag[80], range[256] = "";
         snprintf(flag, sizeof flag, "--%s", pi->name);
         for (char *c = flag; *c; c++)
             if (*c == '_')
@@ -163,7 +172,50 @@ static void usage(FILE *f)
             snprintf(range, sizeof range, " {%s}", pi->choices);
         fprintf(f, "  %-30s %s (default %s%s)\n", flag, pi->doc, pi->def, range);
     }
-    fprintf(f, "\nexit codes: 0 ok, 1 failure, 2 usage, 3 bad input, 4 server unreachable or busy\n");
+}
+
+static const char exit_codes[] =
+    "\nexit codes: 0 ok, 1 failure, 2 usage, 3 bad input (batch: also a missing frame, or\n"
+    "nothing written), 4 server unreachable or busy\n";
+
+static void usage(FILE *f)
+{
+    fprintf(f, "obscura %s: ambient occlusion for G-buffer EXRs (VAO on OpenGL)\n\nusage:\n", OBS_VERSION);
+    for (size_t i = 0; i < sizeof usage_lines / sizeof *usage_lines; i++)
+        fputs(usage_lines[i].text, f);
+    cli_ground_usage(f);
+    cli_warmup_usage(f);
+    cli_bake_usage(f);
+    cli_dynamic_usage(f);
+    usage_ao_options(f);
+    fputs(exit_codes, f);
+}
+
+/* `obscura COMMAND --help`: that command's lines (ao and batch: with the
+ * ao options); 0 when cmd is no command. */
+static int usage_of(FILE *f, const char *cmd)
+{
+    fprintf(f, "usage:\n");
+    for (size_t i = 0; i < sizeof usage_lines / sizeof *usage_lines; i++)
+        if (!strcmp(cmd, usage_lines[i].cmd)) {
+            fputs(usage_lines[i].text, f);
+            if (!strcmp(cmd, "ao") || !strcmp(cmd, "batch"))
+                usage_ao_options(f);
+            fputs(exit_codes, f);
+            return 1;
+        }
+    if (!strcmp(cmd, "gbuffer") || !strcmp(cmd, "reference"))
+        cli_ground_usage(f);
+    else if (!strcmp(cmd, "warmup"))
+        cli_warmup_usage(f);
+    else if (!strcmp(cmd, "bake"))
+        cli_bake_usage(f);
+    else if (!strcmp(cmd, "bake-dynamic"))
+        cli_dynamic_usage(f);
+    else
+        return 0;
+    fputs(exit_codes, f);
+    return 1;
 }
 
 /* The request options (output, format, float, png_bits, the channel
@@ -171,11 +223,48 @@ static void usage(FILE *f)
  * the client's own. */
 typedef struct ao_args {
     const char *in, *out, *camera, *backend, *cache_dir;
+    unsigned char *in_buf; /* IN '-': stdin's bytes (in_len), read once */
+    size_t in_len;
+    int to_stdout;         /* -o - */
     int format_given; /* else the format comes from the file name */
     int cpu, debug_gl;
     long max_size;
     obs_http_request req;
 } ao_args;
+
+/* c (an option's name) into best when it is nearer to word than *best_d
+ * edits, and fewer edits than word has letters. */
+static void nearer(const char *word, const char *c, int *best_d, char *best, size_t len)
+{
+    int d = cli_edit_distance(word, c);
+    if (d < *best_d && d < (int)strlen(word)) {
+        *best_d = d;
+        snprintf(best, len, "%s%s", c[1] ? "--" : "-", c);
+    }
+}
+
+/* An unknown option: a usage error, with the nearest of the ao options
+ * and the parameter table's names when one is at most two edits away
+ * ("--radiu": did you mean --radius?). */
+static void die_unknown_option(const char *arg)
+{
+    char word[64], cand[80], best[80] = "", shown[256];
+    const char *name = arg + strspn(arg, "-");
+    int best_d = 3;
+    snprintf(word, sizeof word, "%.*s", (int)strcspn(name, "="), name);
+    for (const cli_opt *o = ao_opts; o->name; o++)
+        nearer(word, o->name, &best_d, best, sizeof best);
+    for (int k = 0; k < obs_param_count(); k++) {
+        snprintf(cand, sizeof cand, "%s", obs_param_at(k)->name);
+        for (char *p = cand; *p; p++)
+            *p = *p == '_' ? '-' : *p;
+        nearer(word, cand, &best_d, best, sizeof best);
+    }
+    cli_escape(arg, shown, sizeof shown);
+    if (best[0])
+        die_usage("unknown option '%s'; did you mean %s?", shown, best);
+    die_usage("unknown option '%s'", shown);
+}
 
 /* Matches "--name VALUE" or "--name=VALUE"; returns the value or NULL. */
 static const char *opt_value(int argc, char **argv, int *i, const char *name)
@@ -235,19 +324,23 @@ static void parse_ao(int argc, char **argv, ao_args *a)
             size_t n = eq ? (size_t)(eq - arg - 2) : strlen(arg + 2);
             snprintf(name, sizeof name, "%.*s", (int)n, arg + 2);
             if (!obs_param_find(name))
-                die_usage("unknown option '%s'", arg);
+                die_unknown_option(arg);
             if (!eq && i + 1 >= argc)
                 die_usage("parameter --%s needs a value", name);
             if (obs_param_set(&a->req.params, name, eq ? eq + 1 : argv[++i], err) != OBS_OK)
                 die_usage("%s", err);
         } else {
-            die_usage("unknown option '%s'", arg);
+            die_unknown_option(arg);
         }
     }
     if (!a->in)
         die_usage("ao: no input file");
     if (!a->out)
         die_usage("ao: no output file (-o FILE)");
+    a->to_stdout = !strcmp(a->out, "-");
+    if (a->to_stdout && !a->format_given)
+        die_usage("ao: -o - writes to stdout, which has no file name to tell the format from: add "
+                  "--format exr or --format png");
     if (!a->format_given) {
         const char *dot = strrchr(a->out, '.');
         if (dot && !strcmp(dot, ".png"))
@@ -257,6 +350,9 @@ static void parse_ao(int argc, char **argv, ao_args *a)
         else
             die_usage("cannot tell the format of '%s': use .exr or .png, or --format", a->out);
     }
+    if (a->to_stdout && a->req.format == OBS_HTTP_PNG && (a->req.outputs & (a->req.outputs - 1)))
+        die_usage("ao: -o - writes one file to stdout, and these outputs are several PNGs: use --format exr "
+                  "(one file with every output), or a file name");
     if (a->req.format != OBS_HTTP_EXR && (a->req.append || a->req.layer))
         die_usage("--%s names the channels of an EXR: the output '%s' is a PNG", a->req.append ? "append" : "layer",
                   a->out);
@@ -265,30 +361,78 @@ static void parse_ao(int argc, char **argv, ao_args *a)
         die_usage("--layer: %s", err);
 }
 
+/* -o -: a whole file to stdout (oiiotool's convention). */
+static obs_status put_stdout(const obs_bytes *b, char err[OBS_ERR_LEN])
+{
+    if (fwrite(b->data, 1, b->size, stdout) != b->size || fflush(stdout) != 0) {
+        snprintf(err, OBS_ERR_LEN, "cannot write to stdout: %s", strerror(errno));
+        return OBS_IO;
+    }
+    return OBS_OK;
+}
+
+/* A PNG of `obscura ao` to its file, or to stdout under -o -. */
+static obs_status write_png_out(const ao_args *a, const char *path, const obs_image *img, int srgb,
+                                char err[OBS_ERR_LEN])
+{
+    if (!a->to_stdout)
+        return obs_png_write(path, img, a->req.png_bits, srgb, err);
+    obs_bytes b = {0};
+    obs_status s = obs_png_write_mem(img, a->req.png_bits, srgb, &b, err);
+    if (s == OBS_OK)
+        s = put_stdout(&b, err);
+    obs_bytes_free(&b);
+    return s;
+}
+
+/* -o - holds one image: several PNGs need files (an EXR holds them all). */
+static obs_status one_png_for_stdout(const ao_args *a, int count, char err[OBS_ERR_LEN])
+{
+    if (!a->to_stdout || count <= 1)
+        return OBS_OK;
+    snprintf(err, OBS_ERR_LEN, "-o - writes one file to stdout, and these outputs are %d PNGs: use "
+             "--format exr (one file with every output), or a file name", count);
+    return OBS_INVALID_ARGUMENT;
+}
+
 /* An EXR of `obscura ao`: the input's windows and header attributes
  * kept (from part `part`, the one read), under --layer's names, the
  * input itself with the AO added under --append. */
 static obs_status write_exr_out(const ao_args *a, obs_exr_layer *layers, int n, const obs_camera *cam, int part,
                                 char err[OBS_ERR_LEN])
 {
-    obs_exr_source src = {.path = a->in, .part = part};
+    obs_exr_source src = {.path = a->in_buf ? NULL : a->in, .buf = a->in_buf, .len = a->in_len, .part = part};
     obs_exr_options o = {.pixel = a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam, .src = &src,
                          .append = a->req.append};
     obs_exr_names names;
     obs_status s = OBS_OK;
     if (a->req.layer && (s = obs_exr_layers_rename(layers, n, a->req.layer, &names, err)) != OBS_OK)
         return s;
-    return obs_exr_write_ex(a->out, layers, n, &o, err);
+    if (!a->to_stdout)
+        return obs_exr_write_ex(a->out, layers, n, &o, err);
+    obs_bytes b = {0};
+    if ((s = obs_exr_write_ex_mem(layers, n, &o, &b, err)) == OBS_OK)
+        s = put_stdout(&b, err);
+    obs_bytes_free(&b);
+    return s;
 }
 
-/* "dir/out.png" + "ao" -> "dir/out.ao.png" */
+/* "dir/out.png" + "ao" -> "dir/out.ao.png"; a frame number stays last,
+ * where sequence readers look for it: "comp.0001.png" -> "comp.ao.0001.png". */
 static void suffixed(const char *path, const char *suffix, char *buf, size_t len)
 {
     const char *dot = strrchr(path, '.');
     const char *slash = strrchr(path, '/');
-    if (!dot || (slash && dot < slash))
+    const char *base = slash ? slash + 1 : path;
+    if (!dot || dot < base)
         dot = path + strlen(path);
-    snprintf(buf, len, "%.*s.%s%s", (int)(dot - path), path, suffix, dot);
+    const char *num = dot;
+    while (num > base && num[-1] >= '0' && num[-1] <= '9')
+        num--;
+    if (num < dot && num > base + 1 && num[-1] == '.') /* NAME.FRAME.ext */
+        snprintf(buf, len, "%.*s%s.%.*s", (int)(num - path), path, suffix, (int)(strlen(num)), num);
+    else
+        snprintf(buf, len, "%.*s.%s%s", (int)(dot - path), path, suffix, dot);
 }
 
 /* The sample count as an image of count / 32 (PNG holds [0, 1]). */
@@ -335,6 +479,8 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
                  {&r->ao_baked, "baked", 0}};
     int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data + !!r->cull_mask.data +
                 !!r->bleed.data + !!r->luminance.data + !!r->ao_screen.data + !!r->ao_baked.data;
+    if ((s = one_png_for_stdout(a, count, err)) != OBS_OK)
+        return s;
     for (size_t k = 0; k < sizeof files / sizeof files[0] && s == OBS_OK; k++) {
         char path[4096];
         obs_image scaled = {0};
@@ -353,7 +499,7 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
             }
             img = &scaled;
         }
-        s = obs_png_write(path, img, a->req.png_bits, files[k].srgb, err);
+        s = write_png_out(a, path, img, files[k].srgb, err);
         obs_image_free(&scaled);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", path);
@@ -406,11 +552,13 @@ static void log_programs(const obs_ctx *ctx)
  * frame (exit 3). */
 static int cli_input_warnings(const char *in, const obs_exr_info *info, int strict)
 {
-    for (int i = 0; i < info->warning_count; i++)
-        fprintf(stderr, "obscura: %s: %s: %s\n", strict ? "error" : "warning", in,
-                info->warnings[i]);
+    char shown[2 * OBS_ERR_LEN];
+    for (int i = 0; i < info->warning_count; i++) {
+        cli_escape(info->warnings[i], shown, sizeof shown); /* a header's bytes, not the terminal's */
+        fprintf(stderr, "obscura: %s: %s: %s\n", strict ? "error" : "warning", in, shown);
+    }
     if (strict && info->warning_count > 0) {
-        fprintf(stderr, "obscura: %s: %d sanity warning%s and --strict: not computed\n", in,
+        fprintf(stderr, "obscura: error: %s: %d sanity warning%s and --strict: not computed\n", in,
                 info->warning_count, info->warning_count == 1 ? "" : "s");
         return EXIT_BADINPUT;
     }
@@ -434,13 +582,14 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         return cli_fail(OBS_UNSUPPORTED, a->in, err);
     }
     double t0 = now_ms();
-    if ((s = obs_deep_read_exr(a->in, lim, &d, err)) != OBS_OK)
+    s = a->in_buf ? obs_deep_read_exr_mem(a->in_buf, a->in_len, lim, &d, err) : obs_deep_read_exr(a->in, lim, &d, err);
+    if (s != OBS_OK)
         return cli_input_fail(s, a->in, err);
     double t_read = now_ms() - t0;
     /* the camera's cross-checks (the deep reader keeps the camera only) */
     obs_exr_info dinfo = {0};
     obs_camera dcam;
-    if (obs_exr_describe_camera(a->in, d.part, &dinfo, &dcam, err) == OBS_OK &&
+    if (!a->in_buf && obs_exr_describe_camera(a->in, d.part, &dinfo, &dcam, err) == OBS_OK &&
         (rc = cli_input_warnings(a->in, &dinfo, a->req.strict)) != EXIT_OK)
         goto done;
     t0 = now_ms();
@@ -480,12 +629,13 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         } files[] = {{&r.ao_blend, "ao", want_ao, 0},
                      {&r.ao_front, "front", want_ao, 0},
                      {&r.composite, "composite", want_comp, 1}};
+        s = one_png_for_stdout(a, 2 * want_ao + want_comp, err);
         for (size_t k = 0; k < 3 && s == OBS_OK; k++) {
             char path[4096];
             if (!files[k].on)
                 continue;
             suffixed(a->out, files[k].suffix, path, sizeof path);
-            s = obs_png_write(path, files[k].img, a->req.png_bits, files[k].srgb, err);
+            s = write_png_out(a, path, files[k].img, files[k].srgb, err);
             if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
                 fprintf(stderr, "obscura: wrote %s\n", path);
         }
@@ -562,7 +712,8 @@ static int read_baked(const ao_args *a, const obs_limits *lim, const obs_gbuffer
     *bch = a->req.baked ? a->req.baked : "_AO";
     if (strcmp(*bch, "none") == 0)
         return EXIT_OK;
-    obs_status s = obs_exr_read_channel(a->in, *bch, lim, baked, err);
+    obs_status s = a->in_buf ? obs_exr_read_channel_mem(a->in_buf, a->in_len, *bch, lim, baked, err)
+                             : obs_exr_read_channel(a->in, *bch, lim, baked, err);
     if (s == OBS_OK && (baked->width != gb->width || baked->height != gb->height)) {
         snprintf(err, OBS_ERR_LEN, "baked channel %s is %dx%d, the G-buffer %dx%d", *bch,
                  baked->width, baked->height, gb->width, gb->height);
@@ -666,7 +817,8 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
     obs_ctx *ctx = NULL;
     const char *bch;
     double t0 = now_ms();
-    obs_status s = obs_gbuffer_read_exr(a->in, &a->req.map, lim, &gf, err);
+    obs_status s = a->in_buf ? obs_gbuffer_read_exr_mem(a->in_buf, a->in_len, &a->req.map, lim, &gf, err)
+                             : obs_gbuffer_read_exr(a->in, &a->req.map, lim, &gf, err);
     if (s != OBS_OK)
         return cli_input_fail(s, a->in, err);
     double t_read = now_ms() - t0;
@@ -703,6 +855,33 @@ done:
     return rc;
 }
 
+/* IN '-': stdin's whole EXR in memory (the readers take it from there,
+ * as the daemon's do a request body); 4 GiB at most. */
+static int read_stdin(ao_args *a)
+{
+    size_t cap = 1 << 20;
+    unsigned char *b = malloc(cap);
+    size_t n = 0, got;
+    while (b && (got = fread(b + n, 1, cap - n, stdin)) > 0) {
+        n += got;
+        if (n < cap)
+            continue;
+        unsigned char *nb = cap < ((size_t)1 << 32) ? realloc(b, cap * 2) : NULL;
+        if (!nb)
+            free(b);
+        b = nb;
+        cap *= 2;
+    }
+    if (!b || ferror(stdin)) {
+        obs_status s = b ? OBS_IO : OBS_TOO_LARGE;
+        free(b);
+        return cli_input_fail(s, "-", s == OBS_IO ? "cannot read stdin" : "stdin: too large (4 GiB at most) or out of memory");
+    }
+    a->in_buf = b;
+    a->in_len = n;
+    return EXIT_OK;
+}
+
 static int cmd_ao(int argc, char **argv)
 {
     ao_args a;
@@ -713,14 +892,24 @@ static int cmd_ao(int argc, char **argv)
     obs_limits lim = {0};
     if (a.max_size)
         lim.max_width = lim.max_height = (int)a.max_size;
-    int deep = 0;
-    if (obs_exr_is_deep(a.in, &deep, err) == OBS_OK && deep) {
+    int deep = 0, rc;
+    if (!strcmp(a.in, "-")) {
+        if (server)
+            die_usage("ao: IN '-' (stdin) runs in-process: with --server give the file's path");
+        if ((rc = read_stdin(&a)) != EXIT_OK)
+            return rc;
+    }
+    obs_status s = a.in_buf ? obs_exr_is_deep_mem(a.in_buf, a.in_len, &deep, err) : obs_exr_is_deep(a.in, &deep, err);
+    if (s == OBS_OK && deep) {
         if (a.req.baked && strcmp(a.req.baked, "none") != 0)
             die_usage("ao: --baked: the input is a deep EXR; a baked channel is combined with "
                       "flat input only");
-        return cmd_ao_deep(&a, &lim, server, argc, argv);
+        rc = cmd_ao_deep(&a, &lim, server, argc, argv);
+    } else {
+        rc = ao_flat(&a, &lim, server, argc, argv);
     }
-    return ao_flat(&a, &lim, server, argc, argv);
+    free(a.in_buf);
+    return rc;
 }
 
 /* The hooks of obscura batch (clients/batch.c). */
@@ -1084,6 +1273,9 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     const char *cmd = argv[1];
+    for (int i = 2; i < argc; i++) /* obscura COMMAND ... --help */
+        if ((!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) && usage_of(stdout, cmd))
+            return EXIT_OK;
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
         if (!strcmp(cmd, commands[i].name))
             return commands[i].run(argc - 2, argv + 2);

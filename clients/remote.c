@@ -62,7 +62,7 @@ int cli_remote_take_server(int argc, char **argv, const char **server)
         }
     }
     if (stream_name && (!*server || !stream_name_ok(stream_name))) {
-        fprintf(stderr, "obscura: --stream '%s': %s\n(run 'obscura help' for usage)\n", stream_name,
+        fprintf(stderr, "obscura: error: --stream '%s': %s\n(run 'obscura help' for usage)\n", stream_name,
                 !*server ? "needs --server http://HOST:PORT (streams live in obscurad)"
                          : "a stream name is 1 to 64 characters of A-Z a-z 0-9 . _ -");
         exit(RC_USAGE);
@@ -633,20 +633,20 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
         any_bin |= addrs[k].kind != PROTO_HTTP;
     }
     if (nserv < 1) {
-        fprintf(stderr, "obscura: --server '%s' is not http://HOST:PORT, unix:/PATH or tcp://HOST:PORT "
+        fprintf(stderr, "obscura: error: --server '%s' is not http://HOST:PORT, unix:/PATH or tcp://HOST:PORT "
                 "(or a comma-separated list of up to %d of them)\n", server, CLI_REMOTE_MAX_SERVERS);
         return RC_USAGE;
     }
     if (stream_name && deep) {
-        fprintf(stderr, "obscura: --stream: streams keep flat frames, not deep input\n");
+        fprintf(stderr, "obscura: error: --stream: streams keep flat frames, not deep input\n");
         return RC_USAGE;
     }
     if (stream_name && any_bin) {
-        fprintf(stderr, "obscura: --stream needs http:// servers (streams are an HTTP feature)\n");
+        fprintf(stderr, "obscura: error: --stream needs http:// servers (streams are an HTTP feature)\n");
         return RC_USAGE;
     }
     if (!oname) {
-        fprintf(stderr, "obscura: --server: the daemon answers ao, composite or both, not this --output\n");
+        fprintf(stderr, "obscura: error: --server: the daemon answers ao, composite or both, not this --output\n");
         return RC_USAGE;
     }
 
@@ -667,7 +667,7 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
         add(&ps, "baked", "none");
         camera_params(gb, &ps, cam, sizeof cam);
         if (!(body = read_file(in_path, &body_len))) {
-            fprintf(stderr, "obscura: %s: cannot read it to send\n", in_path);
+            fprintf(stderr, "obscura: error: %s: cannot read it to send\n", in_path);
             return RC_BADINPUT;
         }
         size_t qcap = 1;
@@ -690,7 +690,7 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
             add(&pb, "token", token);
         obs_bin_request_desc d = {.id = 1, .params = pb.p, .param_count = pb.n, .gb = gb, .deep = deep};
         if (obs_bin_request_encode(&d, &frame, err) != OBS_OK) {
-            fprintf(stderr, "obscura: cannot encode the request: %s\n", err);
+            fprintf(stderr, "obscura: error: cannot encode the request: %s\n", err);
             goto fail;
         }
     }
@@ -721,13 +721,13 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
                 if (last == -1)
                     mark_down(urls[k], mono_s() + DOWN_FOR_S);
                 if (nserv > 1)
-                    fprintf(stderr, "obscura: %s: %s; trying the next server\n", urls[k],
+                    fprintf(stderr, "obscura: warning: %s: %s; trying the next server\n", urls[k],
                             last == -1 ? msg : "busy (503)");
             }
         if (round == attempts)
             break;
         wait = wait < 1 ? 1 : wait > MAX_WAIT_S ? MAX_WAIT_S : wait;
-        fprintf(stderr, "obscura: %s: %s; retrying in %d s (%d of %d)\n", server,
+        fprintf(stderr, "obscura: warning: %s: %s; retrying in %d s (%d of %d)\n", server,
                 last == -1 ? msg : "busy (503)", wait, round, attempts - 1);
         sleep_s(wait);
     }
@@ -740,10 +740,10 @@ answered:
         return RC_OK;
     answer_free(out);
     if (rc == -1) {
-        fprintf(stderr, "obscura: %s: unreachable: %s\n", nserv > 1 ? server : urls[k_last], msg);
+        fprintf(stderr, "obscura: error: %s: unreachable: %s\n", nserv > 1 ? server : urls[k_last], msg);
         return RC_UNAVAILABLE;
     }
-    fprintf(stderr, "obscura: %s: %s%s\n", urls[k_last], msg, rc == 503 ? " (still busy after retries)" : "");
+    fprintf(stderr, "obscura: error: %s: %s%s\n", urls[k_last], msg, rc == 503 ? " (still busy after retries)" : "");
     return answer_rc(rc);
 fail:
     free(query);

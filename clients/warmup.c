@@ -196,12 +196,12 @@ int cli_warmup(int argc, char **argv)
             return EXIT_OK;
         }
         if (strncmp(a, "--", 2) != 0 || n - 2 >= sizeof name) {
-            fprintf(stderr, "obscura: warmup: unknown argument '%s'\n", a);
+            fprintf(stderr, "obscura: error: warmup: unknown argument '%s'\n", a);
             return EXIT_USAGE;
         }
         snprintf(name, sizeof name, "%.*s", (int)(n - 2), a + 2);
         if (!eq && i + 1 >= argc) {
-            fprintf(stderr, "obscura: warmup: --%s needs a value\n", name);
+            fprintf(stderr, "obscura: error: warmup: --%s needs a value\n", name);
             return EXIT_USAGE;
         }
         const char *v = eq ? eq + 1 : argv[++i];
@@ -212,7 +212,7 @@ int cli_warmup(int argc, char **argv)
         else if (!strcmp(name, "backend"))
             backend = v;
         else if (!obs_param_find(name) || obs_param_set(&p, name, v, err) != OBS_OK) {
-            fprintf(stderr, "obscura: warmup: %s\n", err[0] ? err : "unknown option");
+            fprintf(stderr, "obscura: error: warmup: %s\n", err[0] ? err : "unknown option");
             if (!err[0])
                 fprintf(stderr, "  (--%s is not a warmup option nor a parameter)\n", name);
             return EXIT_USAGE;
@@ -232,7 +232,7 @@ int cli_warmup(int argc, char **argv)
         snprintf(one, sizeof one, "%.*s", (int)len, m);
         obs_params q = p;
         if (len >= sizeof one || obs_param_set(&q, "method", one, err) != OBS_OK) {
-            fprintf(stderr, "obscura: warmup: --methods: '%.*s' is not one of all,%s\n", (int)len, m,
+            fprintf(stderr, "obscura: error: warmup: --methods: '%.*s' is not one of all,%s\n", (int)len, m,
                     all);
             return EXIT_USAGE;
         }
@@ -240,14 +240,14 @@ int cli_warmup(int argc, char **argv)
 
     obs_ctx_desc desc = {.log = log_cb};
     if (backend && *backend && obs_backend_parse(backend, &desc.backend) != OBS_OK) {
-        fprintf(stderr, "obscura: warmup: backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa\n",
+        fprintf(stderr, "obscura: error: warmup: backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa\n",
                 backend);
         return EXIT_USAGE;
     }
     char dir[4096], why[OBS_ERR_LEN];
     desc.cache_dir = obs_cache_dir_default(cache, dir, sizeof dir, why);
     if (!desc.cache_dir[0]) {
-        fprintf(stderr, "obscura: warmup: %s\n", why[0] ? why : "the program cache is off (--cache-dir '')");
+        fprintf(stderr, "obscura: error: warmup: %s\n", why[0] ? why : "the program cache is off (--cache-dir '')");
         return EXIT_FAIL;
     }
     /* the methods to warm: the list, else the configured one */
@@ -290,7 +290,7 @@ int cli_warmup(int argc, char **argv)
         obs_ctx_info ci;
         obs_ctx_get_info(ctx, &ci);
         if (!ci.cache_dir || !ci.cache_writable) {
-            fprintf(stderr, "obscura: warmup: no writable program cache at %s (see the warning "
+            fprintf(stderr, "obscura: error: warmup: no writable program cache at %s (see the warning "
                     "above)\n", desc.cache_dir);
             obs_ctx_destroy(ctx);
             return EXIT_FAIL;

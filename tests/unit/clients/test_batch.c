@@ -3,6 +3,8 @@
 
 #include "batch.h"
 
+#include <unistd.h>
+
 static void expect_frames(const char *spec, const int *want, int n)
 {
     int *f = NULL, count = -1;
@@ -121,6 +123,56 @@ static void test_rotate(void **state)
     assert_string_equal(buf, "b,c,a");
 }
 
+/* cli_batch's exit code with a stand-in for `obscura ao` (each frame
+ * "written" with exit 0): the farm's view of gaps. */
+static void fake_check(int argc, char **argv)
+{
+    (void)argc, (void)argv;
+}
+
+static int fake_ao(int argc, char **argv)
+{
+    (void)argc, (void)argv;
+    return 0;
+}
+
+static int run_batch(const char *dir, const char *frames, const char *extra)
+{
+    static const cli_batch_ops ops = {fake_check, fake_ao, NULL};
+    char in[512], out[512], fr[64], ex[64];
+    snprintf(in, sizeof in, "%s/f.####.exr", dir);
+    snprintf(out, sizeof out, "%s/o/ao.####.exr", dir);
+    snprintf(fr, sizeof fr, "%s", frames);
+    snprintf(ex, sizeof ex, "%s", extra ? extra : "-q");
+    char *argv[] = {in, "--frames", fr, "-o", out, ex, NULL};
+    return cli_batch(6, argv, &ops);
+}
+
+static void test_exit_codes(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/obscura-test-batch-XXXXXX", p[512];
+    assert_non_null(mkdtemp(dir));
+    for (int f = 1; f <= 3; f += 2) {
+        snprintf(p, sizeof p, "%s/f.%04d.exr", dir, f);
+        FILE *fp = fopen(p, "w");
+        assert_non_null(fp);
+        fclose(fp);
+    }
+    assert_int_equal(run_batch(dir, "1,3", NULL), 0);                /* every frame written */
+    assert_int_equal(run_batch(dir, "1-3", NULL), 3);                /* frame 2 missing */
+    assert_int_equal(run_batch(dir, "1-3", "--allow-missing"), 0);   /* a gap accepted */
+    assert_int_equal(run_batch(dir, "2,4", "--allow-missing"), 3);   /* nothing written */
+    assert_int_equal(run_batch(dir, "1-3", "--progress=percent"), 3); /* progress changes no code */
+    for (int f = 1; f <= 3; f += 2) {
+        snprintf(p, sizeof p, "%s/f.%04d.exr", dir, f);
+        remove(p);
+    }
+    snprintf(p, sizeof p, "%s/o", dir);
+    rmdir(p);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -128,6 +180,7 @@ int main(void)
         cmocka_unit_test(test_bad_frames),
         cmocka_unit_test(test_patterns),
         cmocka_unit_test(test_rotate),
+        cmocka_unit_test(test_exit_codes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
