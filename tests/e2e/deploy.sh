@@ -115,6 +115,6 @@ check "obscura-chunk.sh 2 3: exit $rc, frames 2 and 3 written" "[ $rc -eq 0 ] &&
 OBSCURA="$OBSCURA" OBSCURA_INPUT="$T/shot/g.####.exr" OBSCURA_OUTPUT="$T/ao/ao.####.exr" \
     OBSCURA_CAMERA="$DATA/room_small.camera.json" deploy/farm/obscura-chunk.sh 3 5 > "$T/chunk" 2>&1
 rc=$?
-check "a missing frame in the chunk: exit $rc (3, --strict: do not retry)" "[ $rc -eq 3 ]"
+check "a missing frame in the chunk: exit $rc (3: a frame missing, do not retry)" "[ $rc -eq 3 ]"
 echo "e2e deploy: $pass passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ]
