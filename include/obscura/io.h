@@ -18,15 +18,22 @@ extern "C" {
  * preset's.  Channels are matched by name, never by position.
  *
  *   blender: depth ViewLayer.Depth.Z; normal ViewLayer.Normal.X/Y/Z;
- *            colour ViewLayer.DiffCol.R/G/B, else ViewLayer.Combined.R/G/B/A
+ *            colour the beauty ViewLayer.Combined.R/G/B/A, else the albedo
+ *            ViewLayer.DiffCol.R/G/B
  *   generic: depth Z (or depth.Z, Depth.Z); normal N.X/Y/Z or N.R/G/B
  *            (or normal.X/Y/Z, Normal.X/Y/Z); colour R/G/B/A
+ *
+ * color[0] "beauty" or "albedo" (the others NULL) asks for the preset's
+ * beauty or diffuse albedo by name (an error when the file lacks it);
+ * with no colour named, the beauty, else the albedo.  The colour plane is
+ * what the composite multiplies by the AO (and what luminance and
+ * bleeding read).
  */
 typedef struct obs_channel_map {
     const char *preset;    /* "auto" (or NULL), "blender", "generic" */
     const char *depth;     /* explicit channel names, NULL = from preset */
     const char *normal[3];
-    const char *color[4];  /* color[3] (alpha) may be NULL */
+    const char *color[4];  /* color[3] (alpha) may be NULL; or "beauty"/"albedo" */
     const char *part;      /* a part by name or index (NULL: by view, or the first part
                             * holding the depth) */
     const char *view;      /* a view of a multi-view, multi-part file (NULL: its default

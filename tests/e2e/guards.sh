@@ -72,6 +72,25 @@ warnings "$R" --fov-y 50 -o "$T/f.png"
 check "--fov-y 50 on world-space normals: first warning names world_to_camera, no 'normals disagree'" \
     "grep 'warning' '$T/err' | head -1 | grep -q 'no world_to_camera' && ! grep -q 'normals disagree' '$T/err'"
 
+# item 4: the composite multiplies the beauty by default (Blender's Combined)
+"$OBSCURA" inspect "$R" > "$T/i.txt"
+check "inspect: colour is the beauty ViewLayer.Combined.R/G/B/A" \
+    "grep -q 'colour  ViewLayer.Combined.R, ViewLayer.Combined.G, ViewLayer.Combined.B, ViewLayer.Combined.A' '$T/i.txt'"
+DIFF="ViewLayer.DiffCol.R,ViewLayer.DiffCol.G,ViewLayer.DiffCol.B"
+"$OBSCURA" ao "$R" $CAM --output both -o "$T/cb.exr" -q
+"$OBSCURA" ao "$R" $CAM --output both --color "$DIFF" -o "$T/ca.exr" -q
+mae=$("$OBSCURA" compare "$T/ca.exr" "$T/cb.exr" --channel-a R --channel-b R --mask none --json | sed -n 's/.*"mae": \([-0-9.e+]*\).*/\1/p')
+aoe=$("$OBSCURA" compare "$T/ca.exr" "$T/cb.exr" --channel-a AO.Y --channel-b AO.Y --mask none --json | sed -n 's/.*"mae": \([-0-9.e+]*\).*/\1/p')
+check "composite on the beauty differs from the albedo's (R MAE $mae), the AO not (MAE $aoe)" \
+    "awk 'BEGIN { exit !($mae > 0.05 && $aoe == 0) }'"
+if "$OBSCURA" ao "$R" $CAM --output both --color albedo -o "$T/cw.exr" -q 2>/dev/null; then
+    "$OBSCURA" ao "$R" $CAM --output both --color beauty -o "$T/cv.exr" -q
+    check "--color albedo is the DiffCol composite, --color beauty the default" \
+        "cmp -s '$T/cw.exr' '$T/ca.exr' && cmp -s '$T/cv.exr' '$T/cb.exr'"
+else
+    echo "  skip --color beauty|albedo: the option parser (protocol/http.c, color .min 3) refuses one name"
+fi
+
 # README's examples and the shared frames with their correct flags: no warning
 clean() { # NAME ARGS...: `obscura ARGS` prints no warning
     name=$1; shift

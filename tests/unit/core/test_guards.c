@@ -214,6 +214,87 @@ static void test_cause_first(void **state)
     obs_gbuffer_free(&gf);
 }
 
+/* Item 4: the colour plane is the beauty by default; --color beauty and
+ * --color albedo ask for either by name. */
+static const char *const blender[] = {
+    "ViewLayer.Combined.A", "ViewLayer.Combined.B", "ViewLayer.Combined.G", "ViewLayer.Combined.R",
+    "ViewLayer.Depth.Z", "ViewLayer.DiffCol.B", "ViewLayer.DiffCol.G", "ViewLayer.DiffCol.R",
+    "ViewLayer.Normal.X", "ViewLayer.Normal.Y", "ViewLayer.Normal.Z"};
+#define NB ((int)(sizeof blender / sizeof blender[0]))
+
+static void test_color_roles(void **state)
+{
+    (void)state;
+    obs__channel_match m;
+    char err[OBS_ERR_LEN] = "";
+    obs_channel_map map = {0};
+    assert_int_equal(obs__channel_map_resolve(&map, blender, NB, &m, err), OBS_OK);
+    assert_int_equal(m.color[0], 3); /* ViewLayer.Combined.R */
+    assert_int_equal(m.color[3], 0); /* with its alpha */
+    map.color[0] = "beauty";
+    assert_int_equal(obs__channel_map_resolve(&map, blender, NB, &m, err), OBS_OK);
+    assert_int_equal(m.color[0], 3);
+    map.color[0] = "albedo";
+    assert_int_equal(obs__channel_map_resolve(&map, blender, NB, &m, err), OBS_OK);
+    assert_int_equal(m.color[0], 7); /* ViewLayer.DiffCol.R */
+    assert_int_equal(m.color[3], -1);
+    /* a Blender file without the beauty: the albedo by default ... */
+    map.color[0] = NULL;
+    assert_int_equal(obs__channel_map_resolve(&map, blender + 4, NB - 4, &m, err), OBS_OK);
+    assert_int_equal(m.color[0], 3); /* DiffCol.R of the shorter list */
+    /* ... but asked for by name, an error that says what was looked for */
+    map.color[0] = "beauty";
+    assert_int_equal(obs__channel_map_resolve(&map, blender + 4, NB - 4, &m, err),
+                     OBS_MISSING_CHANNEL);
+    assert_non_null(strstr(err, "--color beauty"));
+    /* a renderer row: V-Ray's beauty R,G,B,A, its albedo "diffuse" */
+    static const char *const vray[] = {"A", "B", "G", "R", "Z", "diffuse.B", "diffuse.G",
+                                       "diffuse.R", "normals.X", "normals.Y", "normals.Z"};
+    obs_channel_map vm = {.preset = "vray"};
+    assert_int_equal(obs__channel_map_resolve(&vm, vray, 11, &m, err), OBS_OK);
+    assert_int_equal(m.color[0], 3);
+    assert_int_equal(m.color[3], 0);
+    vm.color[0] = "albedo";
+    assert_int_equal(obs__channel_map_resolve(&vm, vray, 11, &m, err), OBS_OK);
+    assert_int_equal(m.color[0], 7);
+    /* generic has no albedo */
+    obs_channel_map gm = {.preset = "generic", .color = {"albedo"}};
+    assert_int_equal(obs__channel_map_resolve(&gm, vray, 11, &m, err), OBS_MISSING_CHANNEL);
+    assert_non_null(strstr(err, "--color albedo"));
+    /* a partial list is still an error, naming the keywords */
+    obs_channel_map pm = {.color = {"R", "G"}};
+    assert_int_equal(obs__channel_map_resolve(&pm, vray, 11, &m, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "beauty or albedo"));
+}
+
+/* room_small read by default: the composite's colour is the render
+ * (Combined: the sky is lit), not the albedo (DiffCol: the sky black). */
+static void test_room_beauty(void **state)
+{
+    (void)state;
+    obs_gbuffer_file gf = {0}, ga = {0};
+    char err[OBS_ERR_LEN] = "";
+    obs_channel_map albedo = {.color = {"albedo"}};
+    load_room(&gf);
+    assert_int_equal(obs_gbuffer_read_exr(ROOM, &albedo, NULL, &ga, err), OBS_OK);
+    assert_string_equal(gf.info.color[0], "ViewLayer.Combined.R");
+    assert_string_equal(ga.info.color[0], "ViewLayer.DiffCol.R");
+    double sky_beauty = 0.0, sky_albedo = 0.0;
+    long sky = 0;
+    for (int y = 0; y < gf.gb.height; y++)
+        for (int x = 0; x < gf.gb.width; x++)
+            if (*obs__plane_px(&gf.gb.depth, gf.gb.width, x, y) >= 1e9f) {
+                sky_beauty += obs__plane_px(&gf.gb.color, gf.gb.width, x, y)[1];
+                sky_albedo += obs__plane_px(&ga.gb.color, ga.gb.width, x, y)[1];
+                sky++;
+            }
+    print_message("room_small sky (%ld px): mean green %.3f beauty, %.3f albedo\n", sky,
+                  sky ? sky_beauty / sky : 0.0, sky ? sky_albedo / sky : 0.0);
+    assert_true(sky > 0 && sky_albedo / sky < 0.05 && sky_beauty / sky > 0.5);
+    obs_gbuffer_free(&gf);
+    obs_gbuffer_free(&ga);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -224,6 +305,8 @@ int main(void)
         cmocka_unit_test(test_result_near_one),
         cmocka_unit_test(test_deep_range),
         cmocka_unit_test(test_cause_first),
+        cmocka_unit_test(test_color_roles),
+        cmocka_unit_test(test_room_beauty),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
