@@ -46,6 +46,10 @@ static void print_matrix(const char *name, const float m[16])
 }
 
 static char **part_lines; /* obs_exr_describe_parts() of the file */
+/* The geometry's depth as the chain reads it (obs_gbuffer_depth_range)
+ * and the radius a user would start from (obs_radius_suggest: a tenth of
+ * the median depth, README.md "Warnings"). */
+static obs_depth_range range;
 
 static int print_json(const char *path, const obs_gbuffer *gb, const obs_exr_info *info)
 {
@@ -77,6 +81,13 @@ static int print_json(const char *path, const obs_gbuffer *gb, const obs_exr_inf
     if (gb->camera.has_projection)
         add_matrix(cam, "projection", gb->camera.projection);
     cJSON_AddItemToObject(o, "camera", cam);
+    cJSON *dr = cJSON_CreateObject();
+    cJSON_AddNumberToObject(dr, "geometry_pixels", (double)range.geometry);
+    cJSON_AddNumberToObject(dr, "min", range.min);
+    cJSON_AddNumberToObject(dr, "median", range.median);
+    cJSON_AddNumberToObject(dr, "max", range.max);
+    cJSON_AddItemToObject(o, "depth_range", dr);
+    cJSON_AddNumberToObject(o, "radius_suggested", obs_radius_suggest(&range));
     int dwin[4] = {gb->display_x, gb->display_y, gb->width, gb->height};
     int disp[2] = {gb->display_width ? gb->display_width : gb->width,
                    gb->display_height ? gb->display_height : gb->height};
@@ -125,6 +136,12 @@ static void print_text(const char *path, const obs_gbuffer *gb, const obs_exr_in
                info->position[0], info->position[1], info->position[2]);
     printf("  depth: %s\n  normals: %s space\n", depth_name(info->depth_mode),
            space_name(info->normal_space));
+    if (range.geometry > 0)
+        printf("  depth range: %.4g..%.4g, median %.4g (over %ld geometry pixels)\n"
+               "  radius to start from: %.3g (a tenth of the median depth)\n", range.min,
+               range.max, range.median, range.geometry, obs_radius_suggest(&range));
+    else
+        printf("  depth range: no geometry pixel (every depth is background)\n");
     printf("  camera: %s\n", info->camera_source[0] ? info->camera_source : "(none in the header)");
     if (info->camera_check[0])
         printf("  camera check: %s\n", info->camera_check);
@@ -239,6 +256,8 @@ static int cli_inspect_file(const char *in, int json, obs_http_request *req)
                 snprintf(gf.info.normal[k], sizeof gf.info.normal[k], "N.%c", "XYZ"[k]);
         gf.info.part = d.part;
         gf.info.part_count = 1;
+        if (obs_deep_depth_range(&d, &range) != 0)
+            memset(&range, 0, sizeof range);
         obs_deep_free(&d);
         int rc = json ? print_json(in, &gf.gb, &gf.info) : (print_text(in, &gf.gb, &gf.info), EXIT_OK);
         return rc;
@@ -253,6 +272,8 @@ static int cli_inspect_file(const char *in, int json, obs_http_request *req)
         snprintf(gf.info.warnings[gf.info.warning_count++], sizeof gf.info.warnings[0],
                  "the camera cannot be solved from the position pass: %.160s", err);
     obs_gbuffer_sanity(&gf.gb, &req->params, &gf.info);
+    if (obs_gbuffer_depth_range(&gf.gb, &req->params, &range) != 0)
+        memset(&range, 0, sizeof range);
     int rc = json ? print_json(in, &gf.gb, &gf.info) : (print_text(in, &gf.gb, &gf.info), EXIT_OK);
     obs_gbuffer_free(&gf);
     return rc;

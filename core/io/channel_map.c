@@ -57,10 +57,28 @@ static void clear_match(obs__channel_match *m)
 static const char *const XYZ[] = {".X", ".Y", ".Z"};
 static const char *const RGB[] = {".R", ".G", ".B"};
 
-/* blender: <Layer>.Depth.Z, <Layer>.Normal.X/Y/Z, <Layer>.DiffCol.R/G/B
- * else <Layer>.Combined.R/G/B/A.  The layer is the prefix of any channel
- * ending in ".Depth.Z", Blender's default layer first. */
-static void preset_blender(const char *const *names, int count, obs__channel_match *m)
+/* Which colour plane a map asks for: the beauty (the default: the
+ * composite multiplies what the renderer shows, and the albedo when the
+ * file has no beauty), the diffuse albedo, or channels by name. */
+enum { COLOR_DEFAULT, COLOR_BEAUTY, COLOR_ALBEDO, COLOR_NAMES };
+
+static int color_role(const obs_channel_map *map)
+{
+    int named = 0;
+    for (int i = 0; i < 4; i++)
+        named += map->color[i] && *map->color[i];
+    if (named == 1 && map->color[0] && !strcmp(map->color[0], "beauty"))
+        return COLOR_BEAUTY;
+    if (named == 1 && map->color[0] && !strcmp(map->color[0], "albedo"))
+        return COLOR_ALBEDO;
+    return named ? COLOR_NAMES : COLOR_DEFAULT;
+}
+
+/* blender: <Layer>.Depth.Z, <Layer>.Normal.X/Y/Z, the beauty
+ * <Layer>.Combined.R/G/B/A, the albedo <Layer>.DiffCol.R/G/B.  The layer
+ * is the prefix of any channel ending in ".Depth.Z", Blender's default
+ * layer first. */
+static void preset_blender(const char *const *names, int count, int role, obs__channel_match *m)
 {
     char layer[256] = "";
     size_t sl = strlen(BLENDER_DEPTH_SUFFIX);
@@ -86,19 +104,19 @@ static void preset_blender(const char *const *names, int count, obs__channel_mat
     char pre[300];
     snprintf(pre, sizeof pre, "%s.Normal", layer);
     find_set(names, count, pre, XYZ, 3, m->normal);
-    snprintf(pre, sizeof pre, "%s.DiffCol", layer);
-    if (!find_set(names, count, pre, RGB, 3, m->color)) {
-        snprintf(pre, sizeof pre, "%s.Combined", layer);
-        if (find_set(names, count, pre, RGB, 3, m->color)) {
-            snprintf(pre, sizeof pre, "%s.Combined.A", layer);
-            m->color[3] = find(names, count, pre);
-        }
+    snprintf(pre, sizeof pre, "%s.Combined", layer);
+    if (role != COLOR_ALBEDO && find_set(names, count, pre, RGB, 3, m->color)) {
+        snprintf(pre, sizeof pre, "%s.Combined.A", layer);
+        m->color[3] = find(names, count, pre);
     }
+    snprintf(pre, sizeof pre, "%s.DiffCol", layer);
+    if (m->color[0] < 0 && role != COLOR_BEAUTY)
+        find_set(names, count, pre, RGB, 3, m->color);
 }
 
 /* generic: Z (depth.Z, Depth.Z); N.X/Y/Z, N.R/G/B, normal.X/Y/Z,
  * Normal.X/Y/Z; R, G, B and optionally A. */
-static void preset_generic(const char *const *names, int count, obs__channel_match *m)
+static void preset_generic(const char *const *names, int count, int role, obs__channel_match *m)
 {
     static const char *const depths[] = {"Z", "depth.Z", "Depth.Z"};
     static const char *const rgb[] = {"R", "G", "B"};
@@ -110,19 +128,34 @@ static void preset_generic(const char *const *names, int count, obs__channel_mat
         !find_set(names, count, "N", RGB, 3, m->normal) &&
         !find_set(names, count, "normal", XYZ, 3, m->normal))
         find_set(names, count, "Normal", XYZ, 3, m->normal);
-    if (find_set(names, count, "", rgb, 3, m->color))
+    if (role != COLOR_ALBEDO && find_set(names, count, "", rgb, 3, m->color))
         m->color[3] = find(names, count, "A");
 }
 
 static const char *const XYZ_LOWER[] = {".x", ".y", ".z"};
 static const char *const RGB_LOWER[] = {".r", ".g", ".b"};
 
-/* A renderer's row of presets.c: its first depth name the file has, the
- * first normal and colour prefixes that are complete. */
-static void preset_row(const char *const *names, int count, const obs__preset *pr,
+/* The first of the colour prefixes `list` that is complete ("": bare
+ * R,G,B), with its alpha. */
+static void find_color(const char *const *names, int count, const char *const *list,
                        obs__channel_match *m)
 {
     static const char *const bare[] = {"R", "G", "B"};
+    for (const char *const *c = list; *c && m->color[0] < 0; c++) {
+        char alpha[300];
+        if (**c ? find_set(names, count, *c, RGB, 3, m->color)
+                : find_set(names, count, "", bare, 3, m->color)) {
+            snprintf(alpha, sizeof alpha, "%s%s", *c, **c ? ".A" : "A");
+            m->color[3] = find(names, count, alpha);
+        }
+    }
+}
+
+/* A renderer's row of presets.c: its first depth name the file has, the
+ * first normal and colour prefixes that are complete. */
+static void preset_row(const char *const *names, int count, const obs__preset *pr, int role,
+                       obs__channel_match *m)
+{
     clear_match(m);
     m->preset = pr->name;
     m->depth_mode = pr->depth_mode;
@@ -134,14 +167,10 @@ static void preset_row(const char *const *names, int count, const obs__preset *p
             !find_set(names, count, *n, RGB, 3, m->normal) &&
             !find_set(names, count, *n, XYZ_LOWER, 3, m->normal))
             find_set(names, count, *n, RGB_LOWER, 3, m->normal);
-    for (const char *const *c = pr->color; *c && m->color[0] < 0; c++) {
-        char alpha[300];
-        if (**c ? find_set(names, count, *c, RGB, 3, m->color)
-                : find_set(names, count, "", bare, 3, m->color)) {
-            snprintf(alpha, sizeof alpha, "%s%s", *c, **c ? ".A" : "A");
-            m->color[3] = find(names, count, alpha);
-        }
-    }
+    if (role != COLOR_ALBEDO)
+        find_color(names, count, pr->color, m);
+    if (role != COLOR_BEAUTY)
+        find_color(names, count, pr->albedo, m);
 }
 
 static int in_set(int idx, const int *set, int n)
@@ -245,21 +274,24 @@ obs_status obs__channel_map_resolve_for(const obs_channel_map *map, const char *
     const char *preset = map->preset && *map->preset ? map->preset : "auto";
     int is_auto = strcmp(preset, "auto") == 0;
     const obs__preset *row = obs__preset_find(is_auto ? detected : preset);
+    int role = color_role(map);
     if (row)
-        preset_row(names, count, row, &cand[ncand++]);
+        preset_row(names, count, row, role, &cand[ncand++]);
     if (is_auto || strcmp(preset, "blender") == 0)
-        preset_blender(names, count, &cand[ncand++]);
+        preset_blender(names, count, role, &cand[ncand++]);
     if (is_auto || strcmp(preset, "generic") == 0)
-        preset_generic(names, count, &cand[ncand++]);
+        preset_generic(names, count, role, &cand[ncand++]);
     if (ncand == 0)
         return obs__fail(err, OBS_INVALID_ARGUMENT,
                          "unknown channel preset '%.64s' (valid: auto, blender, generic, arnold, "
                          "vray, renderman, redshift, karma, mantra, octane, nuke)", preset);
-    int nd = count_set(&map->depth, 1), nn = count_set(map->normal, 3), nc = count_set(map->color, 3);
+    int nd = count_set(&map->depth, 1), nn = count_set(map->normal, 3);
+    int nc = role == COLOR_NAMES ? count_set(map->color, 3) : 0;
     if (nn != 0 && nn != 3)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "explicit normal needs three channel names (X, Y, Z)");
-    if (nc != 3 && (nc != 0 || (map->color[3] && *map->color[3])))
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "explicit colour needs three channel names (R, G, B) and an optional alpha");
+    if (role == COLOR_NAMES && nc != 3)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "explicit colour needs three channel names "
+                         "(R, G, B) and an optional alpha, or beauty or albedo");
 
     /* The first preset that finds its depth wins; with an explicit depth,
      * the first that finds anything supplies the other planes. */
@@ -310,6 +342,12 @@ obs_status obs__channel_map_resolve_for(const obs_channel_map *map, const char *
                              "e.g. ViewLayer.Depth.Z)"
                            : "no depth channel: looked for Z, depth.Z, Depth.Z (generic)");
 
+    if ((role == COLOR_BEAUTY || role == COLOR_ALBEDO) && m->color[0] < 0)
+        return missing(err, names, count, role == COLOR_BEAUTY
+                           ? "--color beauty: no beauty channels (Blender's <layer>.Combined, "
+                             "R,G,B[,A], or the preset's beauty layer)"
+                           : "--color albedo: no albedo channels (Blender's <layer>.DiffCol, "
+                             "or the preset's albedo layer); name them with --color R,G,B");
     /* A preset's plane that reuses an explicitly named channel gives way;
      * explicit names that clash among themselves are an error, since one
      * EXR channel decodes into one place. */

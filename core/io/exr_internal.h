@@ -29,7 +29,8 @@ typedef struct obs__preset {
     const char *name;
     const char *const *depth;
     const char *const *normal;
-    const char *const *color;
+    const char *const *color;  /* the beauty (--color beauty, the default) */
+    const char *const *albedo; /* the diffuse albedo (--color albedo) */
     obs_depth_mode depth_mode;
     obs_normal_space normal_space;
     const char *const *keys;

@@ -11,6 +11,11 @@
 #include "internal.h"
 
 #define L(...) ((const char *const[]){__VA_ARGS__, NULL})
+#define NONE ((const char *const[]){NULL})
+
+/* Each row names the beauty (the composite's colour by default; "" is
+ * bare R,G,B,A) and then the diffuse albedo (--color albedo), each a
+ * list of layer prefixes tried in order. */
 
 static const obs__preset presets[] = {
     /* Arnold (driver_exr): AOVs are channels named after the AOV: Z
@@ -22,7 +27,7 @@ static const obs__preset presets[] = {
      * ../shared/data/renderers/arnold (Arnold 4.2.16) have Z, N.X/Y/Z,
      * P.X/Y/Z; exrflatten's EXROperation_FixArnold detects Arnold by
      * arnold/version. */
-    {"arnold", L("Z", "depth.Z", "Z.Z"), L("N", "normal"), L("", "diffuse_albedo", "albedo"),
+    {"arnold", L("Z", "depth.Z", "Z.Z"), L("N", "normal"), L(""), L("diffuse_albedo", "albedo"),
      OBS_DEPTH_PLANAR, OBS_NORMALS_WORLD, L("arnold/"), L("Arnold")},
     /* V-Ray: render elements are layers named after the element:
      * "normals" (VRayNormals: camera space, Chaos docs "Normals Render
@@ -34,14 +39,15 @@ static const obs__preset presets[] = {
      * cameraTransform (camera to world) and cameraFov (horizontal,
      * degrees). */
     {"vray", L("Z", "VRayZDepthRaw.Z", "zdepth.Z"), L("normals", "VRayNormals"),
-     L("diffuse", "VRayDiffuseFilter", ""), OBS_DEPTH_PLANAR, OBS_NORMALS_CAMERA,
+     L(""), L("diffuse", "VRayDiffuseFilter"), OBS_DEPTH_PLANAR, OBS_NORMALS_CAMERA,
      L("vrayInfo/", "vray/"), L("V-Ray", "VRay")},
     /* RenderMan: display channels z (camera-space depth) and Nn (the
      * normalized shading normal, in camera space: RenderMan's AOVs are
      * in "current" space), beauty Ci; RenderMan's EXR driver writes
      * the software as "RenderMan ...".  Source: RenderMan docs, "Output
-     * Channels" / "Display Channels" (z, Nn, Ci). */
-    {"renderman", L("z", "z.Z", "Z"), L("Nn", "N"), L("Ci", ""), OBS_DEPTH_PLANAR,
+     * Channels" / "Display Channels" (z, Nn, Ci); "albedo" is the AOV its
+     * denoiser requires ("Denoising in RenderMan"). */
+    {"renderman", L("z", "z.Z", "Z"), L("Nn", "N"), L("Ci", ""), L("albedo"), OBS_DEPTH_PLANAR,
      OBS_NORMALS_CAMERA, L("renderman/", "prman/"), L("RenderMan", "PRMan")},
     /* Redshift: AOVs Z (camera depth), N (world-space normals), beauty
      * R,G,B,A, DiffuseFilter; header rs/... keys (rs/camera/transform,
@@ -49,19 +55,19 @@ static const obs__preset presets[] = {
      * MrLixm/nuke-tools-lxm metadataToCamera reads them).  Redshift does
      * not document the space of rs/camera/transform: obscura reads only
      * the standard attributes and the focal length/aperture. */
-    {"redshift", L("Z", "Z.Z", "depth.Z"), L("N", "Normals"), L("DiffuseFilter", ""),
+    {"redshift", L("Z", "Z.Z", "depth.Z"), L("N", "Normals"), L(""), L("DiffuseFilter"),
      OBS_DEPTH_PLANAR, OBS_NORMALS_WORLD, L("rs/"), L("Redshift")},
     /* Karma (Houdini Solaris): AOVs as LPE/primvar names: depth (the
      * planar camera depth, Karma's "depth" render var), N (world space),
-     * C (beauty).  Source: SideFX docs, "Karma render variables"; software
-     * attribute "Karma". */
-    {"karma", L("depth", "depth.Z", "Z"), L("N"), L("C", ""), OBS_DEPTH_PLANAR,
+     * C (beauty), albedo (the denoisers' albedo AOV).  Source: SideFX
+     * docs, "Karma render variables"; software attribute "Karma". */
+    {"karma", L("depth", "depth.Z", "Z"), L("N"), L("C", ""), L("albedo"), OBS_DEPTH_PLANAR,
      OBS_NORMALS_WORLD, L("karma/"), L("Karma")},
     /* Mantra (Houdini): image planes Pz (camera-space depth along the
      * view axis) and N (camera space: Mantra exports VEX globals in
      * camera space), beauty C.  Source: SideFX docs, "Mantra extra image
      * planes" (Pz, N); software attribute "Houdini"/"Mantra". */
-    {"mantra", L("Pz", "Pz.Z", "Pz.R"), L("N"), L("C", ""), OBS_DEPTH_PLANAR,
+    {"mantra", L("Pz", "Pz.Z", "Pz.R"), L("N"), L("C", ""), NONE, OBS_DEPTH_PLANAR,
      OBS_NORMALS_CAMERA, L("houdini/", "mantra/"), L("Mantra", "Houdini")},
     /* Octane: render passes "Z" (info pass "Z depth", raw when the max Z
      * depth is 0: camera distance along the view axis), "Normal" (the
@@ -69,14 +75,14 @@ static const obs__preset presets[] = {
      * normalized Z-depth (clamped at max depth) is not described by the
      * file; see README.  Software attribute "Octane". */
     {"octane", L("Z", "Z-depth", "Z depth", "Zdepth"), L("Normal", "Shading normal"),
-     L("Diffuse filter", "Diffuse", ""), OBS_DEPTH_PLANAR, OBS_NORMALS_WORLD, L("octane/"),
+     L(""), L("Diffuse filter", "Diffuse"), OBS_DEPTH_PLANAR, OBS_NORMALS_WORLD, L("octane/"),
      L("Octane", "OctaneRender")},
     /* Nuke (ScanlineRender, DepthGenerator, Write): depth.Z holds 1/Z
      * (Foundry's ScanlineRender2 reference: "render world space distance
      * with 1/Z"; DepthGenerator's "depth" output defaults to 1/distance),
      * normals N (world space), rgba.  Header: nuke/... keys (the Write
      * node's nuke/node_hash, nuke/full_layer_names). */
-    {"nuke", L("depth.Z", "depth.z", "Z"), L("N", "normals"), L(""), OBS_DEPTH_INVERSE,
+    {"nuke", L("depth.Z", "depth.z", "Z"), L("N", "normals"), L(""), NONE, OBS_DEPTH_INVERSE,
      OBS_NORMALS_WORLD, L("nuke/"), L("Nuke")},
 };
 

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "io/exr_internal.h"
+#include "obscura/deep.h"
 #include "internal.h"
 
 /* A G-buffer with fewer valid pixels than this is not judged. */
@@ -23,6 +24,10 @@
 #define AGREE_GOOD 0.8
 /* Neighbours farther apart than this fraction of the depth are an edge. */
 #define EDGE_FRACTION 0.05
+/* Mean AO over the geometry above which the AO is "above 0.99 almost
+ * everywhere": the Arnold frame at 20 units, radius 0.5, is 0.996; the
+ * Blender rooms at their radius 0.93..0.97. */
+#define AO_HIGH 0.99
 
 __attribute__((format(printf, 3, 4)))
 static void warn(obs_exr_info *info, int *added, const char *fmt, ...)
@@ -131,6 +136,199 @@ static const char *space_name(obs_normal_space s)
     return s == OBS_NORMALS_CAMERA ? "camera" : "world";
 }
 
+static const char *mode_name(obs_depth_mode m)
+{
+    switch (m) {
+    case OBS_DEPTH_INVERSE: return "inverse";
+    case OBS_DEPTH_NORMALIZED: return "normalized";
+    case OBS_DEPTH_NDC: return "ndc";
+    case OBS_DEPTH_RADIAL: return "radial";
+    default: return "planar";
+    }
+}
+
+/* The k-th smallest of d[0..n-1] (Hoare's selection: O(n) on average,
+ * where a sort of a 4K frame's depths would cost every frame ~0.5 s);
+ * reorders d. */
+static double select_kth(double *d, long n, long k)
+{
+    long lo = 0, hi = n - 1;
+    while (lo < hi) {
+        double pivot = d[lo + (hi - lo) / 2];
+        long i = lo, j = hi;
+        while (i <= j) {
+            while (d[i] < pivot)
+                i++;
+            while (d[j] > pivot)
+                j--;
+            if (i <= j) {
+                double t = d[i];
+                d[i++] = d[j];
+                d[j--] = t;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            break;
+    }
+    return d[k];
+}
+
+/* min, median, max of the r->geometry values at d (reordered). */
+static void fill_range(double *d, obs_depth_range *r)
+{
+    if (r->geometry <= 0)
+        return;
+    r->min = r->max = d[0];
+    for (long i = 1; i < r->geometry; i++) {
+        r->min = fmin(r->min, d[i]);
+        r->max = fmax(r->max, d[i]);
+    }
+    r->median = select_kth(d, r->geometry, r->geometry / 2);
+}
+
+/* Distance along the view axis of raw value v under p's depth mode (0:
+ * background), as the chain's linear_depth (core/chain/prep_cpu.c) reads
+ * it; radial is taken as it is (the range is for orders of magnitude). */
+static double metric(double v, const obs_params *p, const float *P)
+{
+    if (p->depth_mode == OBS_DEPTH_NDC) {
+        if (!(v >= 0.0) || v >= 1.0 || !P)
+            return !(v >= 0.0) || v >= 1.0 ? 0.0 : v;
+        double zn = 2.0 * v - 1.0, z = (P[11] - zn * P[15]) / (zn * P[14] - P[10]);
+        return -z > 0.0 && -z < OBS_BACKGROUND_DEPTH ? -z : 0.0;
+    }
+    if (p->depth_mode == OBS_DEPTH_NORMALIZED && P) {
+        double n = (P[15] + P[11]) / (P[10] + P[14]), f = (P[11] - P[15]) / (P[10] - P[14]);
+        return planar(v, OBS_DEPTH_NORMALIZED, n, f);
+    }
+    return planar(v, p->depth_mode == OBS_DEPTH_RADIAL ? OBS_DEPTH_PLANAR : p->depth_mode,
+                  0.0, 1.0);
+}
+
+int obs_gbuffer_depth_range(const obs_gbuffer *gb, const obs_params *params, obs_depth_range *r)
+{
+    obs_params p;
+    obs_camera cam;
+    char err[OBS_ERR_LEN];
+    obs__params_for_gbuffer(params, gb, &p);
+    const float *P = obs__camera_resolve(gb, &p, &cam, err) == OBS_OK ? cam.projection : NULL;
+    int unit = p.depth_mode == OBS_DEPTH_NDC || p.depth_mode == OBS_DEPTH_NORMALIZED;
+    size_t n = (size_t)gb->width * gb->height;
+    double *d = malloc((n ? n : 1) * sizeof *d);
+    memset(r, 0, sizeof *r);
+    if (!d)
+        return -1;
+    for (int y = 0; y < gb->height; y++)
+        for (int x = 0; x < gb->width; x++) {
+            double v = *obs__plane_px(&gb->depth, gb->width, x, y);
+            double m = metric(v, &p, P);
+            if (m > 0.0)
+                d[r->geometry++] = m;
+            /* over 1 and under the background marker: not a 0..1 depth */
+            else if (unit && v > 1.0 && v < OBS_BACKGROUND_DEPTH)
+                r->impossible++, r->impossible_max = fmax(r->impossible_max, v);
+        }
+    fill_range(d, r);
+    free(d);
+    return 0;
+}
+
+double obs_radius_suggest(const obs_depth_range *r)
+{
+    return r->geometry > 0 ? r->median / OBS_RADIUS_FRACTION : 0.0;
+}
+
+/* Depth that gives no AO at all, and a radius out of scale with it. */
+static void depth_guards(const obs_gbuffer *gb, const obs_params *p, obs_exr_info *info,
+                         int *added)
+{
+    obs_depth_range r;
+    if (obs_gbuffer_depth_range(gb, p, &r) != 0)
+        return;
+    if (r.impossible > 0 && r.impossible >= r.geometry)
+        warn(info, added, "depth values up to %.4g are impossible under --depth-mode %s (0..1): "
+             "%ld of %ld pixels read as background and get AO 1; the depth looks planar: give "
+             "--depth-mode planar (or inverse)", r.impossible_max, mode_name(p->depth_mode),
+             r.impossible, r.impossible + r.geometry);
+    else if (r.geometry == 0)
+        warn(info, added, "no geometry: every depth value is background (0, negative, not "
+             "finite or over %.0g) under --depth-mode %s, so the AO is 1 everywhere; check the "
+             "depth channel (--depth) and --depth-mode", (double)OBS_BACKGROUND_DEPTH,
+             mode_name(p->depth_mode));
+    if (r.geometry < MIN_PIXELS)
+        return;
+    if (p->radius < r.median / 1000.0 || p->radius > r.median)
+        warn(info, added, "radius %.4g is %s the median depth %.4g (depth %.4g..%.4g): the AO "
+             "will be %s; start from --radius %.3g (a tenth of the median depth)", p->radius,
+             p->radius > r.median ? "above" : "under 1/1000 of", r.median, r.min, r.max,
+             p->radius > r.median ? "dark everywhere" : "near 1 everywhere",
+             obs_radius_suggest(&r));
+}
+
+int obs_deep_depth_range(const obs_deep_image *d, obs_depth_range *r)
+{
+    size_t n = (size_t)d->width * d->height;
+    double *z = malloc((n ? n : 1) * sizeof *z);
+    memset(r, 0, sizeof *r);
+    if (!z)
+        return -1;
+    for (size_t i = 0; i < n; i++)
+        if (d->offset[i + 1] > d->offset[i]) { /* sorted: the first is the front */
+            double v = planar(d->samples[d->offset[i] * OBS_DEEP_CH + OBS_DEEP_Z],
+                              OBS_DEPTH_PLANAR, 0.0, 1.0);
+            if (v > 0.0)
+                z[r->geometry++] = v;
+        }
+    fill_range(z, r);
+    free(z);
+    return 0;
+}
+
+int obs_result_sanity(const obs_image *ao, const obs_gbuffer *gb, const obs_deep_image *deep,
+                      const obs_params *params, obs_exr_info *info)
+{
+    obs_params p;
+    obs_depth_range range, *r = NULL;
+    int added = 0;
+    if (!ao || !ao->data || ao->channels < 1)
+        return 0;
+    obs__params_for_gbuffer(params, gb, &p);
+    if (gb && gb->width == ao->width && gb->height == ao->height &&
+        obs_gbuffer_depth_range(gb, params, &range) == 0)
+        r = &range;
+    else if (deep && deep->width == ao->width && deep->height == ao->height &&
+             obs_deep_depth_range(deep, &range) == 0)
+        r = &range;
+    long px = (long)ao->width * ao->height, occluded = 0;
+    double lost = 0.0;
+    for (long i = 0; i < px; i++) {
+        double a = ao->data[(size_t)i * ao->channels];
+        lost += isfinite(a) ? 1.0 - a : 0.0;
+        occluded += a < 1.0 - 1e-4;
+    }
+    /* The background gets AO 1: the mean is over the geometry. */
+    long geometry = r && r->geometry > 0 && r->geometry <= px ? r->geometry : px;
+    double mean = 1.0 - lost / (double)geometry;
+    if (geometry < MIN_PIXELS || (occluded > 0 && mean <= AO_HIGH))
+        return 0;
+    char text[120] = "";
+    if (r && r->geometry > 0)
+        snprintf(text, sizeof text, "; depth %.4g..%.4g, median %.4g", r->min, r->max, r->median);
+    char hint[64] = "";
+    if (r && r->geometry > 0)
+        snprintf(hint, sizeof hint, " (start from --radius %.3g: median depth / %g)",
+                 obs_radius_suggest(r), OBS_RADIUS_FRACTION);
+    warn(info, &added, "%s (mean %.4f at radius %.4g%s): the radius is small for the scene's "
+         "units%s, or --depth-mode is wrong",
+         occluded == 0 ? "no pixel is occluded" : "AO is above 0.99 almost everywhere", mean,
+         p.radius, text, hint);
+    return added;
+}
+
 int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_info *info)
 {
     obs_params p;
@@ -151,6 +349,7 @@ int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_
             valid++;
             unit += v <= 1.0f; /* 1: a normalized depth's far plane */
         }
+    depth_guards(gb, &p, info, &added);
     if ((p.depth_mode == OBS_DEPTH_PLANAR || p.depth_mode == OBS_DEPTH_RADIAL) &&
         valid >= MIN_PIXELS && unit == valid)
         warn(info, &added, "depth looks normalized or inverted: all %ld foreground values "
@@ -179,8 +378,19 @@ int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_
         warn(info, &added, "normals are not unit length: mean | |n| - 1 | is %.3g over %.0f pixels "
              "(encoded as 0..1 colours, or not normals?)", dev / nn, (double)nn);
 
-    /* normals against the normals derived from depth */
-    if (obs__camera_resolve(gb, &p, &cam, err) != OBS_OK || cam.projection[14] != -1.0f ||
+    /* normals against the normals derived from depth.  World-space
+     * normals without a world_to_camera cannot be compared (the chain
+     * reconstructs them from depth): that cause is said, and the
+     * comparison it would make meaningless is not made. */
+    if (obs__camera_resolve(gb, &p, &cam, err) != OBS_OK)
+        return added;
+    if (p.normal_space == OBS_NORMALS_WORLD && !cam.has_world_to_camera) {
+        warn(info, &added, "normals are world-space but the camera has no world_to_camera: "
+             "they are replaced by normals derived from depth; give --camera FILE or "
+             "--world-to-camera M (or --normal-space camera if they are camera-space)");
+        return added;
+    }
+    if (cam.projection[14] != -1.0f ||
         (p.depth_mode != OBS_DEPTH_PLANAR && p.depth_mode != OBS_DEPTH_INVERSE &&
          p.depth_mode != OBS_DEPTH_NORMALIZED))
         return added;

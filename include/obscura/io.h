@@ -18,15 +18,22 @@ extern "C" {
  * preset's.  Channels are matched by name, never by position.
  *
  *   blender: depth ViewLayer.Depth.Z; normal ViewLayer.Normal.X/Y/Z;
- *            colour ViewLayer.DiffCol.R/G/B, else ViewLayer.Combined.R/G/B/A
+ *            colour the beauty ViewLayer.Combined.R/G/B/A, else the albedo
+ *            ViewLayer.DiffCol.R/G/B
  *   generic: depth Z (or depth.Z, Depth.Z); normal N.X/Y/Z or N.R/G/B
  *            (or normal.X/Y/Z, Normal.X/Y/Z); colour R/G/B/A
+ *
+ * color[0] "beauty" or "albedo" (the others NULL) asks for the preset's
+ * beauty or diffuse albedo by name (an error when the file lacks it);
+ * with no colour named, the beauty, else the albedo.  The colour plane is
+ * what the composite multiplies by the AO (and what luminance and
+ * bleeding read).
  */
 typedef struct obs_channel_map {
     const char *preset;    /* "auto" (or NULL), "blender", "generic" */
     const char *depth;     /* explicit channel names, NULL = from preset */
     const char *normal[3];
-    const char *color[4];  /* color[3] (alpha) may be NULL */
+    const char *color[4];  /* color[3] (alpha) may be NULL; or "beauty"/"albedo" */
     const char *part;      /* a part by name or index (NULL: by view, or the first part
                             * holding the depth) */
     const char *view;      /* a view of a multi-view, multi-part file (NULL: its default
@@ -133,8 +140,48 @@ obs_status obs_exr_describe_parts(const char *path, char ***lines, char err[OBS_
  * normals derived from depth only in the other space or with the depth
  * inverted, and a camera whose reprojection of the position pass (when
  * the G-buffer has one) misses the pixel centres by more than a pixel
- * (RMS).  Appends one line each to info->warnings; returns how many. */
+ * (RMS); depth values impossible for the depth mode (over 1 under ndc or
+ * normalized), no geometry pixel, a radius under 1/1000 of the median
+ * depth or above it; world-space normals without a world_to_camera
+ * (said instead of the derived-normals comparison it invalidates).
+ * Appends one line each to info->warnings; returns how many. */
 int obs_gbuffer_sanity(const obs_gbuffer *gb, const obs_params *params, obs_exr_info *info);
+
+/* The depth of a G-buffer's geometry as the chain reads it under the
+ * depth mode of `params` (NULL = defaults) or the G-buffer's convention:
+ * distance along the view axis (ndc and normalized converted with the
+ * camera's clip range when it resolves). */
+typedef struct obs_depth_range {
+    long geometry;          /* pixels with a foreground depth */
+    double min, median, max; /* over those pixels (0 when none) */
+    long impossible;        /* ndc/normalized: values over 1 (and under the
+                             * background marker) that no 0..1 depth holds */
+    double impossible_max;
+} obs_depth_range;
+/* Fills *r; -1 when out of memory. */
+int obs_gbuffer_depth_range(const obs_gbuffer *gb, const obs_params *params, obs_depth_range *r);
+
+/* The radius to start from: the median depth over OBS_RADIUS_FRACTION.
+ * At a 40-60 degree field of view a tenth of the viewing distance spans
+ * about a tenth of the frame height, the scale of the contact shadows
+ * AO is for; it also gives the default 0.5 on Blender's rooms, seen from
+ * about 5 m (README.md, "Warnings").  0 without geometry. */
+#define OBS_RADIUS_FRACTION 10.0
+double obs_radius_suggest(const obs_depth_range *r);
+
+/* The same over the front sample of each pixel of a deep image (its Z
+ * is planar). */
+struct obs_deep_image;
+int obs_deep_depth_range(const struct obs_deep_image *d, obs_depth_range *r);
+
+/* After a run: the AO of `gb` or `deep` (one may be NULL; the AO
+ * image has its size, its background is AO 1) with no pixel occluded,
+ * or a mean AO over the geometry above 0.99, is a warning that names the
+ * radius, the depth range and the radius to start from.  Appends it to
+ * info->warnings; returns 1 when it did, else 0. */
+int obs_result_sanity(const obs_image *ao, const obs_gbuffer *gb,
+                      const struct obs_deep_image *deep, const obs_params *params,
+                      obs_exr_info *info);
 
 /* Reads one named channel of an EXR (any part that holds it) as float32;
  * for comparisons and tests.  Caller frees with obs_image_free(). */

@@ -45,10 +45,10 @@ static void test_blender_auto(void **state)
     assert_int_equal(m.depth, idx_of(blender, N(blender), "ViewLayer.Depth.Z"));
     assert_int_equal(m.normal[0], idx_of(blender, N(blender), "ViewLayer.Normal.X"));
     assert_int_equal(m.normal[2], idx_of(blender, N(blender), "ViewLayer.Normal.Z"));
-    /* DiffCol wins over Combined and has no alpha */
-    assert_int_equal(m.color[0], idx_of(blender, N(blender), "ViewLayer.DiffCol.R"));
-    assert_int_equal(m.color[2], idx_of(blender, N(blender), "ViewLayer.DiffCol.B"));
-    assert_int_equal(m.color[3], -1);
+    /* the beauty (Combined, with its alpha) wins over DiffCol */
+    assert_int_equal(m.color[0], idx_of(blender, N(blender), "ViewLayer.Combined.R"));
+    assert_int_equal(m.color[2], idx_of(blender, N(blender), "ViewLayer.Combined.B"));
+    assert_int_equal(m.color[3], idx_of(blender, N(blender), "ViewLayer.Combined.A"));
 
     obs_channel_map map = {.preset = "blender"};
     assert_int_equal(obs__channel_map_resolve(&map, blender, N(blender), &m, err), OBS_OK);

@@ -213,9 +213,9 @@ static void check_blender(const char *path)
     assert_string_equal(f.info.normal[0], "ViewLayer.Normal.X");
     assert_string_equal(f.info.normal[1], "ViewLayer.Normal.Y");
     assert_string_equal(f.info.normal[2], "ViewLayer.Normal.Z");
-    assert_string_equal(f.info.color[0], "ViewLayer.DiffCol.R");
-    assert_string_equal(f.info.color[2], "ViewLayer.DiffCol.B");
-    assert_string_equal(f.info.color[3], "");
+    assert_string_equal(f.info.color[0], "ViewLayer.Combined.R"); /* the beauty */
+    assert_string_equal(f.info.color[2], "ViewLayer.Combined.B");
+    assert_string_equal(f.info.color[3], "ViewLayer.Combined.A");
     assert_string_equal(f.info.compression, "zip");
     assert_int_equal(f.info.part, 0);
     assert_int_equal(f.info.part_count, 1);
@@ -233,7 +233,7 @@ static void check_blender(const char *path)
     for (int i = 0; i < gb->width * gb->height; i++) {
         float d = gb->depth.data[i];
         const float *n = gb->normal.data + 3 * i, *c = gb->color.data + 4 * i;
-        assert_true(c[3] == 1.0f); /* DiffCol has no alpha */
+        assert_true(c[3] == 1.0f); /* Combined.A: an opaque film */
         if (d >= 1e9f) {
             assert_true(d == 1e10f); /* Blender's sky depth */
             sky++;
