@@ -96,7 +96,7 @@ static const cli_opt ao_opts[] = {
     {"solve-camera", NULL, "no camera given or in the file: solve it from the position pass"},
     {"depth", "CH", "depth channel name"},
     {"normal", "X,Y,Z", "normal channel names"},
-    {"color", "R,G,B[,A]", "colour channel names"},
+    {"color", "beauty|albedo|R,G,B[,A]", "the colour plane: the beauty (default), the albedo, or channel names"},
     {"baked", "CH|none", "a baked AO channel of the input (obscura gbuffer of a level baked by "
      "obscura bake: _AO, _AO_SHORT, _AO_LONG; default _AO when the input has it) combined with "
      "the chain's AO (--baked-combine, default product): AO.Y is the combination, "
@@ -565,6 +565,24 @@ static int cli_input_warnings(const char *in, const obs_exr_info *info, int stri
     return EXIT_OK;
 }
 
+/* The check after the run (obs_result_sanity: AO near 1 everywhere):
+ * a warning, or with --strict an error and nothing written. */
+static int cli_result_warnings(const ao_args *a, const obs_image *ao, const obs_gbuffer *gb,
+                               const obs_deep_image *deep, obs_exr_info *info)
+{
+    int k = info->warning_count;
+    if (!obs_result_sanity(ao, gb, deep, &a->req.params, info))
+        return EXIT_OK;
+    char shown[OBS_ERR_LEN];
+    cli_escape(info->warnings[k], shown, sizeof shown);
+    fprintf(stderr, "obscura: %s: %s: %s\n", a->req.strict ? "error" : "warning", a->in, shown);
+    if (!a->req.strict)
+        return EXIT_OK;
+    fprintf(stderr, "obscura: error: %s: a sanity warning on the result and --strict: not written\n",
+            a->in);
+    return EXIT_BADINPUT;
+}
+
 static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server, int argc, char **argv)
 {
     char err[OBS_ERR_LEN] = "";
@@ -613,6 +631,8 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         goto done;
     }
     double t_run = now_ms() - t0;
+    if ((rc = cli_result_warnings(a, &r.ao_front, NULL, &d, &dinfo)) != EXIT_OK)
+        goto done;
     const obs_camera *cam = d.camera.has_projection ? &d.camera : NULL;
     int want_ao = (a->req.outputs & OBS_OUTPUT_AO) != 0, want_comp = (a->req.outputs & OBS_OUTPUT_COMPOSITE) != 0;
     if (a->req.format == OBS_HTTP_EXR) {
@@ -833,6 +853,8 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
         outputs |= OBS_OUTPUT_AO; /* the combination needs the chain's AO */
     t0 = now_ms();
     if ((rc = run_frame(a, &gf, outputs, server, argc, argv, &res, &ctx, &t0, err)) != EXIT_OK)
+        goto done;
+    if (!server && (rc = cli_result_warnings(a, &res.ao, &gf.gb, NULL, &gf.info)) != EXIT_OK)
         goto done;
     if (baked.data && (rc = combine_baked(a, &res, &baked, bch, err)) != EXIT_OK)
         goto done;

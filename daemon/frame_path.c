@@ -173,6 +173,12 @@ obs_status obsd_fp_finished(obsd_fp *fp)
         obsd_stats_frame(job->deep->width, job->deep->height);
     else if (job->status == OBS_OK)
         obsd_stats_frame(job->gb->width, job->gb->height);
+    /* the result's own check (AO near 1 everywhere: a radius out of scale,
+     * a wrong depth mode), a warning beside the input's */
+    if (job->status == OBS_OK && job->deep)
+        obs_result_sanity(&fp->job.deep_result.ao_front, NULL, job->deep, job->params, &fp->gf.info);
+    else if (job->status == OBS_OK)
+        obs_result_sanity(&fp->job.result.ao, job->gb, NULL, job->params, &fp->gf.info);
     if (job->status == OBS_OK && fp->baked.data && !job->deep)
         return obs_result_combine_baked(&fp->job.result, &fp->baked, job->params, fp->job.err);
     return job->status;

@@ -120,7 +120,9 @@ obs_status obs__frame_setup_common(obs_ctx *log_ctx, const obs_gbuffer *gb, cons
     } else if (p->normal_space == OBS_NORMALS_WORLD) {
         if (!cam.has_world_to_camera) {
             f->reconstruct_normals = 1;
-            obs__log(log_ctx, OBS_LOG_WARN,
+            /* info, not a warning: the input's sanity check says the cause
+             * first (obs_gbuffer_sanity), with the flag that fixes it */
+            obs__log(log_ctx, OBS_LOG_INFO,
                      "normals are world-space but the camera has no world_to_camera "
                      "(give --camera or --world-to-camera): reconstructing normals from depth");
         } else if (normal_matrix(cam.world_to_camera, f->normal_matrix) != 0) {

@@ -48,8 +48,8 @@ check "inspect --json: depth_range and radius_suggested" \
 # after the run: only once obscura ao calls obs_result_sanity (issue 29's
 # integration step); until then said, not failed
 if grep -q obs_result_sanity clients/obscura.c 2>/dev/null; then
-    warnings "$D/arnold_sample2.exr" --radius 0.05 -o "$T/a.exr"
-    check "Arnold frame at --radius 0.05: 'AO is above 0.99 almost everywhere' with the depth" \
+    warnings "$D/arnold_sample2.exr" --radius 0.01 -o "$T/a.exr"
+    check "Arnold frame at --radius 0.01: 'AO is above 0.99 almost everywhere' with the depth" \
         "grep -q 'above 0.99 almost everywhere' '$T/err' && grep -q 'median 9.459' '$T/err'"
 else
     echo "  skip the post-run warning: clients/obscura.c does not call obs_result_sanity yet"
