@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/lod.h"
+#include "bake/closest.h"
 #include "internal.h"
 
 #define LEAF 4

@@ -319,6 +319,169 @@ static obs_status collect_edges(const obs__bake_world *w, const obs__bake_weld *
     return OBS_OK;
 }
 
+/* Each welded vertex's share of the samples (cover, b = sum w_i B_i f_i)
+ * and of the area around it (lump: a third of each face's). */
+static void gather_samples(const obs__bake_world *w, const obs__bake_weld *wd,
+                           const obs__bake_samples *s, sys *y)
+{
+    for (size_t i = 0; i < s->count; i++) {
+        if (!s->valid[i])
+            continue;
+        const uint32_t *t = w->tri + 3 * s->tri[i];
+        for (int k = 0; k < 3; k++) {
+            uint32_t v = wd->of[t[k]];
+            double wp = (double)s->weight[i] * s->bary[3 * i + k];
+            y->cover[v] += wp;
+            y->b[2 * v] += wp * s->ao[2 * i];
+            y->b[2 * v + 1] += wp * s->ao[2 * i + 1];
+        }
+    }
+    for (size_t t = 0; t < w->triangle_count; t++)
+        for (int k = 0; k < 3; k++)
+            y->lump[wd->of[w->tri[3 * t + k]]] += w->area[t] / 3.0;
+}
+
+/* Interior edges: exactly two faces on the welded edge. */
+static obs_status interior_edges(sys *y, obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    st->boundary_edges = st->nonmanifold_edges = 0;
+    if (!(y->interior = malloc((y->nedges ? y->nedges : 1) * sizeof *y->interior)))
+        return obs__fail(err, OBS_NO_MEMORY, "%zu edges", y->nedges);
+    for (size_t e = 0; e < y->nedges;) {
+        size_t f = e + 1;
+        while (f < y->nedges && y->edges[f].u == y->edges[e].u && y->edges[f].v == y->edges[e].v)
+            f++;
+        if (f - e == 1)
+            st->boundary_edges++;
+        else if (f - e == 2)
+            y->interior[y->ninterior++] = e;
+        else
+            st->nonmanifold_edges++;
+        e = f;
+    }
+    st->interior_edges = y->ninterior;
+    return OBS_OK;
+}
+
+/* Without the ridge only samples make the system definite (R is zero on
+ * linear signals): refuse rather than solve a singular system. */
+static obs_status check_definite(const obs__bake_samples *s, const obs_bake_params *p,
+                                 const obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    if (!(wsum_valid(s) > 0.0))
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "no valid sample in the level: all %zu dropped by the back-face rule "
+                         "(backface_limit %g)",
+                         s->count, (double)p->backface_limit);
+    if (p->ridge <= 0.0f && st->vertices_without_samples)
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "ridge 0 leaves the system singular: %zu vertices have no valid sample "
+                         "(a ridge above 0 gives them their neighbours' value)",
+                         st->vertices_without_samples);
+    return OBS_OK;
+}
+
+/* M, face by face: sum w_i B_i B_i^T over the face's valid samples, or
+ * the analytic mass matrix scaled by their share. */
+static void assemble_mass(const obs__bake_world *w, const obs__bake_weld *wd,
+                          const obs__bake_samples *s, const obs_bake_params *p, trip *tr)
+{
+    for (size_t t = 0; t < w->triangle_count; t++) {
+        if (!(w->area[t] > 0.0f))
+            continue;
+        uint32_t idx[3];
+        double m[9] = {0};
+        for (int k = 0; k < 3; k++)
+            idx[k] = wd->of[w->tri[3 * t + k]];
+        size_t valid = 0, n_t = s->first[t + 1] - s->first[t];
+        for (size_t i = s->first[t]; i < s->first[t + 1]; i++) {
+            if (!s->valid[i])
+                continue;
+            valid++;
+            const float *b = s->bary + 3 * i;
+            for (int a = 0; a < 3; a++)
+                for (int c = 0; c < 3; c++)
+                    m[3 * a + c] += (double)s->weight[i] * b[a] * b[c];
+        }
+        if (p->mass == OBS_BAKE_MASS_ANALYTIC) {
+            double share = n_t ? w->area[t] * (double)valid / (double)n_t / 12.0 : 0.0;
+            for (int a = 0; a < 3; a++)
+                for (int c = 0; c < 3; c++)
+                    m[3 * a + c] = share * (a == c ? 2.0 : 1.0);
+        }
+        put_local(tr, idx, 3, m);
+    }
+}
+
+/* alpha R, interior edge by interior edge. */
+static void assemble_regulariser(const obs__bake_world *w, const obs__bake_weld *wd,
+                                 const sys *y, const obs_bake_params *p, trip *tr)
+{
+    for (size_t k = 0; k < y->ninterior && p->alpha > 0.0f; k++) {
+        uint32_t idx[4];
+        double j[4], m[16];
+        double om = edge_row(w, wd, &y->edges[y->interior[k]], &y->edges[y->interior[k] + 1], idx, j);
+        if (!(om > 0.0))
+            continue;
+        for (int a = 0; a < 4; a++)
+            for (int c = 0; c < 4; c++)
+                m[4 * a + c] = p->alpha * om * j[a] * j[c];
+        put_local(tr, idx, 4, m);
+    }
+}
+
+/* The ridge D on the diagonal, and the right-hand side b + D x0 (bx: the
+ * two channels one after the other). */
+static void assemble_ridge(const sys *y, const obs_bake_params *p, trip *tr, double *bx)
+{
+    double lump_mean = 0.0;
+    for (size_t v = 0; v < y->n; v++)
+        lump_mean += y->lump[v] / (double)y->n;
+    for (size_t v = 0; v < y->n; v++) {
+        /* A vertex of no face with area (unused by the mesh, or of
+         * degenerate faces only) has no row otherwise: pinned to x0. */
+        double r = y->lump[v] > 0.0 ? p->ridge * y->lump[v] : lump_mean;
+        put(tr, (uint32_t)v, (uint32_t)v, r);
+        bx[v] = y->b[2 * v] + r * y->x0[2 * v];
+        bx[y->n + v] = y->b[2 * v + 1] + r * y->x0[2 * v + 1];
+    }
+}
+
+/* The solution copied back, two values per welded vertex. */
+static obs_status copy_back(const double *xx, size_t n, double *x, char err[OBS_ERR_LEN])
+{
+    for (size_t v = 0; v < n; v++) {
+        x[2 * v] = xx[v];
+        x[2 * v + 1] = xx[n + v];
+        /* The samples lie in [0, 1]; a fit far outside is a system too
+         * ill-conditioned to trust, not an answer. */
+        if (!(fabs(x[2 * v]) < 1e3) || !(fabs(x[2 * v + 1]) < 1e3))
+            return obs__fail(err, OBS_INVALID_ARGUMENT,
+                             "the fit is %g at welded vertex %zu: the least-squares system is "
+                             "ill-conditioned",
+                             x[2 * v], v);
+    }
+    return OBS_OK;
+}
+
+/* alpha x^T R x, edge by edge. */
+static void regulariser_energy(const obs__bake_world *w, const obs__bake_weld *wd, const sys *y,
+                               const obs_bake_params *p, const double *x, obs_bake_stats *st)
+{
+    st->regulariser_energy[0] = st->regulariser_energy[1] = 0.0;
+    for (size_t k = 0; k < y->ninterior; k++) {
+        uint32_t idx[4];
+        double j[4];
+        double om = edge_row(w, wd, &y->edges[y->interior[k]], &y->edges[y->interior[k] + 1], idx, j);
+        for (int ch = 0; ch < 2 && om > 0.0; ch++) {
+            double jump = 0.0;
+            for (int c = 0; c < 4; c++)
+                jump += j[c] * x[2 * idx[c] + ch];
+            st->regulariser_energy[ch] += p->alpha * om * jump * jump;
+        }
+    }
+}
+
 obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
                          const obs__bake_samples *s, const obs_bake_params *p, double *x,
                          double *face, double *point, obs_bake_stats *st, char err[OBS_ERR_LEN])
@@ -344,126 +507,31 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
     }
     if ((rc = collect_edges(w, wd, &y, err)) != OBS_OK)
         goto done;
-    for (size_t i = 0; i < s->count; i++) {
-        if (!s->valid[i])
-            continue;
-        const uint32_t *t = w->tri + 3 * s->tri[i];
-        for (int k = 0; k < 3; k++) {
-            uint32_t v = wd->of[t[k]];
-            double wp = (double)s->weight[i] * s->bary[3 * i + k];
-            y.cover[v] += wp;
-            y.b[2 * v] += wp * s->ao[2 * i];
-            y.b[2 * v + 1] += wp * s->ao[2 * i + 1];
-        }
-    }
-    for (size_t t = 0; t < w->triangle_count; t++)
-        for (int k = 0; k < 3; k++)
-            y.lump[wd->of[w->tri[3 * t + k]]] += w->area[t] / 3.0;
+    gather_samples(w, wd, s, &y);
     initial_values(s, &y, st);
+    if ((rc = interior_edges(&y, st, err)) != OBS_OK || (rc = check_definite(s, p, st, err)) != OBS_OK)
+        goto done;
 
-    /* Interior edges: exactly two faces on the welded edge. */
-    st->boundary_edges = st->nonmanifold_edges = 0;
-    if (!(y.interior = malloc((y.nedges ? y.nedges : 1) * sizeof *y.interior))) {
-        rc = obs__fail(err, OBS_NO_MEMORY, "%zu edges", y.nedges);
-        goto done;
-    }
-    for (size_t e = 0; e < y.nedges;) {
-        size_t f = e + 1;
-        while (f < y.nedges && y.edges[f].u == y.edges[e].u && y.edges[f].v == y.edges[e].v)
-            f++;
-        if (f - e == 1)
-            st->boundary_edges++;
-        else if (f - e == 2)
-            y.interior[y.ninterior++] = e;
-        else
-            st->nonmanifold_edges++;
-        e = f;
-    }
-    st->interior_edges = y.ninterior;
-    size_t interior = y.ninterior;
-
-    /* Without the ridge only samples make the system definite (R is zero
-     * on linear signals): refuse rather than solve a singular system. */
-    if (!(wsum_valid(s) > 0.0)) {
-        rc = obs__fail(err, OBS_INVALID_ARGUMENT,
-                       "no valid sample in the level: all %zu dropped by the back-face rule "
-                       "(backface_limit %g)",
-                       s->count, (double)p->backface_limit);
-        goto done;
-    }
-    if (p->ridge <= 0.0f && st->vertices_without_samples) {
-        rc = obs__fail(err, OBS_INVALID_ARGUMENT,
-                       "ridge 0 leaves the system singular: %zu vertices have no valid sample "
-                       "(a ridge above 0 gives them their neighbours' value)",
-                       st->vertices_without_samples);
-        goto done;
-    }
+    /* assemble (M + alpha R + D) x = b + D x0 */
     cholmod_start(&cm);
     started = 1;
     cm.print = 0;
     size_t faces = w->triangle_count - w->degenerate;
-    size_t nnz = 6 * faces + 10 * interior + y.n;
+    size_t nnz = 6 * faces + 10 * y.ninterior + y.n;
     T = cholmod_allocate_triplet(y.n, y.n, nnz, 1, CHOLMOD_REAL, &cm);
     if (!T) {
         rc = obs__fail(err, OBS_NO_MEMORY, "least-squares system: %zu entries", nnz);
         goto done;
     }
     trip tr = {T};
-    /* M */
-    for (size_t t = 0; t < w->triangle_count; t++) {
-        if (!(w->area[t] > 0.0f))
-            continue;
-        uint32_t idx[3];
-        double m[9] = {0};
-        for (int k = 0; k < 3; k++)
-            idx[k] = wd->of[w->tri[3 * t + k]];
-        size_t valid = 0, n_t = s->first[t + 1] - s->first[t];
-        for (size_t i = s->first[t]; i < s->first[t + 1]; i++) {
-            if (!s->valid[i])
-                continue;
-            valid++;
-            const float *b = s->bary + 3 * i;
-            for (int a = 0; a < 3; a++)
-                for (int c = 0; c < 3; c++)
-                    m[3 * a + c] += (double)s->weight[i] * b[a] * b[c];
-        }
-        if (p->mass == OBS_BAKE_MASS_ANALYTIC) {
-            double share = n_t ? w->area[t] * (double)valid / (double)n_t / 12.0 : 0.0;
-            for (int a = 0; a < 3; a++)
-                for (int c = 0; c < 3; c++)
-                    m[3 * a + c] = share * (a == c ? 2.0 : 1.0);
-        }
-        put_local(&tr, idx, 3, m);
-    }
-    /* alpha R */
-    for (size_t k = 0; k < y.ninterior && p->alpha > 0.0f; k++) {
-        uint32_t idx[4];
-        double j[4], m[16];
-        double om = edge_row(w, wd, &y.edges[y.interior[k]], &y.edges[y.interior[k] + 1], idx, j);
-        if (!(om > 0.0))
-            continue;
-        for (int a = 0; a < 4; a++)
-            for (int c = 0; c < 4; c++)
-                m[4 * a + c] = p->alpha * om * j[a] * j[c];
-        put_local(&tr, idx, 4, m);
-    }
-    /* ridge D, and the right-hand side */
+    assemble_mass(w, wd, s, p, &tr);
+    assemble_regulariser(w, wd, &y, p, &tr);
     B = cholmod_zeros(y.n, 2, CHOLMOD_REAL, &cm);
     if (!B) {
         rc = obs__fail(err, OBS_NO_MEMORY, "right-hand side of %zu vertices", y.n);
         goto done;
     }
-    double *bx = B->x, lump_mean = 0.0;
-    for (size_t v = 0; v < y.n; v++)
-        lump_mean += y.lump[v] / (double)y.n;
-    for (size_t v = 0; v < y.n; v++) {
-        /* A vertex of no face with area (unused by the mesh, or of
-         * degenerate faces only) has no row otherwise: pinned to x0. */
-        double r = y.lump[v] > 0.0 ? p->ridge * y.lump[v] : lump_mean;
-        put(&tr, (uint32_t)v, (uint32_t)v, r);
-        bx[v] = y.b[2 * v] + r * y.x0[2 * v];
-        bx[y.n + v] = y.b[2 * v + 1] + r * y.x0[2 * v + 1];
-    }
+    assemble_ridge(&y, p, &tr, B->x);
     A = cholmod_triplet_to_sparse(T, T->nnz, &cm);
     if (!A) {
         rc = obs__fail(err, OBS_NO_MEMORY, "sparse matrix of %zu entries", T->nnz);
@@ -472,6 +540,8 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
     cholmod_free_triplet(&T, &cm);
     t_solve = obs__bake_now();
     st->seconds[OBS_BAKE_STAGE_assemble] = t_solve - t_start;
+
+    /* solve */
     L = cholmod_analyze(A, &cm);
     if (!L || !cholmod_factorize(A, L, &cm)) {
         rc = obs__fail(err, OBS_NO_MEMORY, "CHOLMOD could not factorise (status %d)", cm.status);
@@ -488,36 +558,14 @@ obs_status obs__bake_fit(const obs__bake_world *w, const obs__bake_weld *wd,
         rc = obs__fail(err, OBS_NO_MEMORY, "CHOLMOD solve (status %d)", cm.status);
         goto done;
     }
-    const double *xx = X->x;
-    for (size_t v = 0; v < y.n; v++) {
-        x[2 * v] = xx[v];
-        x[2 * v + 1] = xx[y.n + v];
-        /* The samples lie in [0, 1]; a fit far outside is a system too
-         * ill-conditioned to trust, not an answer. */
-        if (!(fabs(x[2 * v]) < 1e3) || !(fabs(x[2 * v + 1]) < 1e3)) {
-            rc = obs__fail(err, OBS_INVALID_ARGUMENT,
-                           "the fit is %g at welded vertex %zu: the least-squares system is "
-                           "ill-conditioned",
-                           x[2 * v], v);
-            goto done;
-        }
-    }
+    if ((rc = copy_back(X->x, y.n, x, err)) != OBS_OK)
+        goto done;
     st->seconds[OBS_BAKE_STAGE_solve] = obs__bake_now() - t_solve;
+
+    /* what the report says about the fit */
     obs__bake_residual(w, wd, s, x, st->residual_fit);
     baselines(w, wd, s, &y, face, point, st);
-    /* alpha x^T R x, edge by edge */
-    st->regulariser_energy[0] = st->regulariser_energy[1] = 0.0;
-    for (size_t k = 0; k < y.ninterior; k++) {
-        uint32_t idx[4];
-        double j[4];
-        double om = edge_row(w, wd, &y.edges[y.interior[k]], &y.edges[y.interior[k] + 1], idx, j);
-        for (int ch = 0; ch < 2 && om > 0.0; ch++) {
-            double jump = 0.0;
-            for (int c = 0; c < 4; c++)
-                jump += j[c] * x[2 * idx[c] + ch];
-            st->regulariser_energy[ch] += p->alpha * om * jump * jump;
-        }
-    }
+    regulariser_energy(w, wd, &y, p, x, st);
     /* parameter values: a baseline written instead of the fit */
     if (p->values == OBS_BAKE_VALUES_FACE_MEAN || p->values == OBS_BAKE_VALUES_POINT) {
         memcpy(x, p->values == OBS_BAKE_VALUES_POINT ? point : face, 2 * y.n * sizeof *x);

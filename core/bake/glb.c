@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "io/out_file.h"
 #include "obscura/bake.h"
 
 #define GL_FLOAT 5126
@@ -230,9 +231,13 @@ static obs_status write_file(const char *path, const char *json, const bin *b,
     if (total > UINT32_MAX)
         return obs__fail(err, OBS_TOO_LARGE, "%s: %llu bytes; a .glb holds at most 4 GiB", path,
                          (unsigned long long)total);
-    FILE *f = fopen(path, "wb");
+    /* under a hidden temporary name, renamed when whole (io/out_file.h):
+     * a cancelled farm task leaves no half .glb under the final name */
+    obs__out_file file;
+    FILE *f = fopen(obs__out_begin(&file, path), "wb");
     if (!f)
-        return obs__fail(err, OBS_IO, "%s: cannot write: %s", path, strerror(errno));
+        return obs__out_end(&file, obs__fail(err, OBS_IO, "%s: cannot write: %s", path,
+                                              strerror(errno)), err);
     uint32_t head[5] = {0x46546C67u, 2u, (uint32_t)total, (uint32_t)jpad, 0x4E4F534Au};
     uint32_t bhead[2] = {(uint32_t)bpad, 0x004E4942u};
     int ok = fwrite(head, 4, 5, f) == 5 && fwrite(json, 1, jlen, f) == jlen;
@@ -243,7 +248,8 @@ static obs_status write_file(const char *path, const char *json, const bin *b,
         ok = fputc(0, f) != EOF;
     if (fclose(f) != 0)
         ok = 0;
-    return ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: write failed: %s", path, strerror(errno));
+    return obs__out_end(&file, ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: write failed: %s", path,
+                                                       strerror(errno)), err);
 }
 
 obs_status obs_bake_write_glb(const char *path, const obs_bake_scene *scene,

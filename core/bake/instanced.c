@@ -36,6 +36,7 @@
 #include <string.h>
 
 #include "bake/instanced.h"
+#include "bake/volume.h"
 #include "internal.h"
 
 /* A volume this large would take hours to trace: refused, naming the

@@ -27,7 +27,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "bake/closest.h"
 #include "bake/lod.h"
+#include "bake/simplify.h"
 #include "internal.h"
 #include "pool.h"
 

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "io/out_file.h"
 #include "obscura/bake.h"
 
 obs_status obs_bake_write_ply(const char *path, const obs_bake_scene *scene,
@@ -22,9 +23,12 @@ obs_status obs_bake_write_ply(const char *path, const obs_bake_scene *scene,
     if (nv > UINT32_MAX)
         return obs__fail(err, OBS_TOO_LARGE, "%s: %zu vertices do not fit PLY's 32-bit indices",
                          path, nv);
-    FILE *f = fopen(path, "wb");
+    /* under a hidden temporary name, renamed when whole (io/out_file.h) */
+    obs__out_file out;
+    FILE *f = fopen(obs__out_begin(&out, path), "wb");
     if (!f)
-        return obs__fail(err, OBS_IO, "%s: cannot write: %s", path, strerror(errno));
+        return obs__out_end(&out, obs__fail(err, OBS_IO, "%s: cannot write: %s", path,
+                                             strerror(errno)), err);
     int ok = fprintf(f,
                      "ply\nformat binary_little_endian 1.0\ncomment obscura bake %s\n"
                      "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n"
@@ -62,5 +66,6 @@ obs_status obs_bake_write_ply(const char *path, const obs_bake_scene *scene,
     }
     if (fclose(f) != 0)
         ok = 0;
-    return ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: write failed: %s", path, strerror(errno));
+    return obs__out_end(&out, ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: write failed: %s", path,
+                                                      strerror(errno)), err);
 }

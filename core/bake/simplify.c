@@ -23,7 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake/lod.h"
+#include "bake/simplify.h"
 #include "internal.h"
 
 /* The welded mesh: positions of each group's first vertex, the triangles

@@ -8,7 +8,7 @@
  * visibility function that represents AO at two distances using
  * quadratic spherical harmonics (SH)."
  *
- * The grid is the integer multiples of the spacing h (instanced.h); the
+ * The grid is the integer multiples of the spacing h (volume.h); the
  * top level a hash of bricks of OBS__VOL_BRICK^3 points, the second each
  * brick's table of its points.  A point's spherical obscurance is traced
  * and projected as the dynamic-object bake's points are (level/point_sh.c,
@@ -21,7 +21,7 @@
 #include <string.h>
 
 #include "level/level.h"
-#include "bake/instanced.h"
+#include "bake/volume.h"
 #include "internal.h"
 #include "pool.h"
 

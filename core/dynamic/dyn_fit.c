@@ -293,56 +293,91 @@ static obs_status copy_shape(obs_dyn_model *dst, const obs_dyn_model *src, char 
     return OBS_OK;
 }
 
-obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg,
-                            const obs_dyn_params *p, obs_dyn_result *r, char err[OBS_ERR_LEN])
+/* What the steps of obs__dyn_fit_all hand each other; every array freed
+ * by fit_work_free. */
+typedef struct fit_work {
+    size_t nr, ne;
+    size_t *first, *hfirst;   /* nr + 1: each region's fitted and held-back points */
+    uint32_t *idx, *hidx;     /* the points, region by region */
+    obs_dyn_fit *own;         /* nr: each region's own eq 4 */
+    int32_t *model_of;        /* nr: the region whose model it takes, -1 none */
+    int32_t *absorbed;        /* nr: 1 when it took a neighbour's */
+    size_t *nfirst;           /* the region adjacency (csr_build) */
+    uint32_t *nitem;
+    size_t nm;                /* models */
+    double *A;                /* nm x T x T: X^T X / n of each model's points */
+    size_t me;                /* edges between different models */
+    uint32_t *em;             /* 2 per edge: its models */
+    float *eb;                /* 3 per edge: b_ij */
+    double *ew;               /* per edge: w_ij */
+    size_t mp;                /* boundary points, boundary_points^2 per edge */
+    uint32_t *pm;
+    float *pb;
+    double *pw;
+    size_t *mfirst;           /* the models' boundary points (csr_build) */
+    uint32_t *mitem;
+    obs_dyn_fit *x, *x0;      /* nm: the regularised and the original models */
+} fit_work;
+
+static void fit_work_free(fit_work *w)
 {
-    obs_status st = OBS_OK;
-    obs_dyn_stats *ss = &r->stats;
-    size_t nr = rg->count, ne = rg->edge_count;
-    size_t *first = calloc(nr + 1, sizeof *first), *hfirst = calloc(nr + 1, sizeof *hfirst);
-    uint32_t *idx = malloc((pt->count ? pt->count : 1) * sizeof *idx);
-    uint32_t *hidx = malloc((pt->count ? pt->count : 1) * sizeof *hidx);
-    obs_dyn_fit *own = calloc(nr ? nr : 1, sizeof *own), *x = NULL, *x0 = NULL;
-    int32_t *model_of = malloc((nr ? nr : 1) * sizeof *model_of);
-    int32_t *absorbed = calloc(nr ? nr : 1, sizeof *absorbed);
-    uint32_t *em = NULL, *pm = NULL, *nitem = NULL, *mitem = NULL;
-    size_t *nfirst = NULL, *mfirst = NULL;
-    float *eb = NULL, *pb = NULL;
-    double *ew = NULL, *pw = NULL, *A = NULL;
-    obs_dyn_model *o = &r->original;
-    memset(o, 0, sizeof *o);
-    if (!first || !hfirst || !idx || !hidx || !own || !model_of || !absorbed) {
-        st = obs__fail(err, OBS_NO_MEMORY, "fit of %zu regions", nr);
-        goto done;
-    }
-    /* Each region's fitted and held-back points (counting sort). */
+    free(w->first);
+    free(w->hfirst);
+    free(w->idx);
+    free(w->hidx);
+    free(w->own);
+    free(w->model_of);
+    free(w->absorbed);
+    free(w->em);
+    free(w->eb);
+    free(w->ew);
+    free(w->pm);
+    free(w->pb);
+    free(w->pw);
+    free(w->nfirst);
+    free(w->nitem);
+    free(w->mfirst);
+    free(w->mitem);
+    free(w->A);
+    free(w->x);
+    free(w->x0);
+}
+
+/* Each region's fitted and held-back points (counting sort). */
+static obs_status group_points(const obs__dyn_points *pt, fit_work *w, char err[OBS_ERR_LEN])
+{
+    size_t nr = w->nr;
     for (size_t i = 0; i < pt->count; i++)
-        (pt->held[i] ? hfirst : first)[pt->region[i] + 1]++;
+        (pt->held[i] ? w->hfirst : w->first)[pt->region[i] + 1]++;
     for (size_t k = 0; k < nr; k++)
-        first[k + 1] += first[k], hfirst[k + 1] += hfirst[k];
-    {
-        size_t *fa = calloc(nr ? nr : 1, sizeof *fa), *fh = calloc(nr ? nr : 1, sizeof *fh);
-        if (!fa || !fh) {
-            free(fa);
-            free(fh);
-            st = obs__fail(err, OBS_NO_MEMORY, "fit");
-            goto done;
-        }
-        for (size_t i = 0; i < pt->count; i++) {
-            uint32_t g = pt->region[i];
-            if (pt->held[i])
-                hidx[hfirst[g] + fh[g]++] = (uint32_t)i;
-            else
-                idx[first[g] + fa[g]++] = (uint32_t)i;
-        }
+        w->first[k + 1] += w->first[k], w->hfirst[k + 1] += w->hfirst[k];
+    size_t *fa = calloc(nr ? nr : 1, sizeof *fa), *fh = calloc(nr ? nr : 1, sizeof *fh);
+    if (!fa || !fh) {
         free(fa);
         free(fh);
+        return obs__fail(err, OBS_NO_MEMORY, "fit");
     }
-    /* Eq 4 per region, the better of the two candidate centres. */
+    for (size_t i = 0; i < pt->count; i++) {
+        uint32_t g = pt->region[i];
+        if (pt->held[i])
+            w->hidx[w->hfirst[g] + fh[g]++] = (uint32_t)i;
+        else
+            w->idx[w->first[g] + fa[g]++] = (uint32_t)i;
+    }
+    free(fa);
+    free(fh);
+    return OBS_OK;
+}
+
+/* Eq 4 per region, the better of the two candidate centres; the
+ * held-back points' errors against eq 4, a constant and one gradient. */
+static void fit_regions(const obs__dyn_points *pt, const obs_dyn_regions *rg,
+                        const obs_dyn_params *p, fit_work *w, obs_dyn_stats *ss)
+{
     double hs[3] = {0, 0, 0};
-    for (size_t g = 0; g < nr; g++) {
-        const uint32_t *ix = idx + first[g];
-        size_t n = first[g + 1] - first[g];
+    for (size_t g = 0; g < w->nr; g++) {
+        const uint32_t *ix = w->idx + w->first[g];
+        size_t n = w->first[g + 1] - w->first[g];
         const obs_dyn_box *b = &rg->box[g];
         float cb[3], cm[3] = {0, 0, 0};
         for (int a = 0; a < 3; a++)
@@ -353,21 +388,21 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
         if (!n)
             memcpy(cm, cb, sizeof cm);
         obs_dyn_fit fb;
-        double em_ = obs__dyn_fit_centre(pt, ix, n, cm, OBS__DYN_EQ4, &own[g]);
+        double em_ = obs__dyn_fit_centre(pt, ix, n, cm, OBS__DYN_EQ4, &w->own[g]);
         double eb_ = obs__dyn_fit_centre(pt, ix, n, cb, OBS__DYN_EQ4, &fb);
         if (eb_ < em_)
-            own[g] = fb;
+            w->own[g] = fb;
         else
             ss->centre_of_mass_kept += n > 0;
-        /* Held-back points: eq 4 against a constant and one gradient. */
-        size_t nh = hfirst[g + 1] - hfirst[g];
+        size_t nh = w->hfirst[g + 1] - w->hfirst[g];
         if (nh && n >= (size_t)(p->absorb_points > 1 ? p->absorb_points : 1)) {
             obs_dyn_fit fc, fg;
-            obs__dyn_fit_centre(pt, ix, n, own[g].c, OBS__DYN_CONSTANT, &fc);
-            obs__dyn_fit_centre(pt, ix, n, own[g].c, OBS__DYN_GRADIENT, &fg);
-            hs[0] += ao_sse(pt, hidx + hfirst[g], nh, &own[g], p->blend);
-            hs[1] += ao_sse(pt, hidx + hfirst[g], nh, &fc, p->blend);
-            hs[2] += ao_sse(pt, hidx + hfirst[g], nh, &fg, p->blend);
+            const uint32_t *hx = w->hidx + w->hfirst[g];
+            obs__dyn_fit_centre(pt, ix, n, w->own[g].c, OBS__DYN_CONSTANT, &fc);
+            obs__dyn_fit_centre(pt, ix, n, w->own[g].c, OBS__DYN_GRADIENT, &fg);
+            hs[0] += ao_sse(pt, hx, nh, &w->own[g], p->blend);
+            hs[1] += ao_sse(pt, hx, nh, &fc, p->blend);
+            hs[2] += ao_sse(pt, hx, nh, &fg, p->blend);
             ss->holdout_points += nh;
         }
     }
@@ -376,17 +411,24 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
         ss->holdout_constant = sqrt(hs[1] / (6.0 * ss->holdout_points));
         ss->holdout_gradient = sqrt(hs[2] / (6.0 * ss->holdout_points));
     }
-    /* Tiny regions absorbed (section 3); passes until nothing changes, so
-     * a tiny region between tiny ones takes a model passed along. */
+}
+
+/* Tiny regions absorbed (section 3); passes until nothing changes, so a
+ * tiny region between tiny ones takes a model passed along.  A tiny
+ * region no neighbour could give a model keeps its own. */
+static obs_status absorb_tiny(const obs__dyn_points *pt, const obs_dyn_regions *rg,
+                              const obs_dyn_params *p, fit_work *w, obs_dyn_stats *ss,
+                              char err[OBS_ERR_LEN])
+{
+    size_t nr = w->nr, *first = w->first;
+    int32_t *model_of = w->model_of;
     for (size_t g = 0; g < nr; g++) {
         size_t n = first[g + 1] - first[g];
         model_of[g] = n && n >= (size_t)p->absorb_points ? (int32_t)g : -1;
         ss->regions_without_points += n == 0;
     }
-    if (!csr_build(nr, rg->edge, ne, &nfirst, &nitem)) {
-        st = obs__fail(err, OBS_NO_MEMORY, "adjacency of %zu regions", nr);
-        goto done;
-    }
+    if (!csr_build(nr, rg->edge, w->ne, &w->nfirst, &w->nitem))
+        return obs__fail(err, OBS_NO_MEMORY, "adjacency of %zu regions", nr);
     for (int changed = 1; changed;) {
         changed = 0;
         for (size_t g = 0; g < nr; g++) {
@@ -395,37 +437,44 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
             size_t n = first[g + 1] - first[g];
             int32_t best = -1;
             double be = INFINITY;
-            for (size_t q = nfirst[g]; q < nfirst[g + 1]; q++) {
-                size_t k = nitem[q];
+            for (size_t q = w->nfirst[g]; q < w->nfirst[g + 1]; q++) {
+                size_t k = w->nitem[q];
                 uint32_t a = rg->edge[2 * k], b = rg->edge[2 * k + 1];
                 uint32_t nb = a == g ? b : a;
                 if (model_of[nb] < 0)
                     continue;
-                double e = n ? sse_of(pt, idx + first[g], n, &own[model_of[nb]])
+                double e = n ? sse_of(pt, w->idx + first[g], n, &w->own[model_of[nb]])
                              : -obs__dyn_shared_face(&rg->box[g], &rg->box[nb], NULL);
                 if (e < be)
                     be = e, best = model_of[nb];
             }
             if (best >= 0) {
                 model_of[g] = best;
-                absorbed[g] = 1;
+                w->absorbed[g] = 1;
                 changed = 1;
             }
         }
     }
-    /* A tiny region no neighbour could give a model keeps its own. */
     for (size_t g = 0; g < nr; g++)
         if (model_of[g] < 0 && first[g + 1] > first[g])
             model_of[g] = (int32_t)g;
-    /* Number the models. */
+    return OBS_OK;
+}
+
+/* The models numbered, the original model o (regions, models, edges)
+ * and each model's A = X^T X / n over its region's own points (eq 4's
+ * columns). */
+static obs_status number_models(const obs__dyn_points *pt, const obs_dyn_regions *rg,
+                                const obs_dyn_params *p, fit_work *w, obs_dyn_model *o,
+                                obs_dyn_stats *ss, char err[OBS_ERR_LEN])
+{
+    size_t nr = w->nr, ne = w->ne;
     int32_t *slot = malloc((nr ? nr : 1) * sizeof *slot);
-    if (!slot) {
-        st = obs__fail(err, OBS_NO_MEMORY, "fit");
-        goto done;
-    }
+    if (!slot)
+        return obs__fail(err, OBS_NO_MEMORY, "fit");
     size_t nm = 0;
     for (size_t g = 0; g < nr; g++)
-        slot[g] = model_of[g] == (int32_t)g ? (int32_t)nm++ : -1;
+        slot[g] = w->model_of[g] == (int32_t)g ? (int32_t)nm++ : -1;
     o->region_count = nr;
     o->model_count = nm;
     o->edge_count = ne;
@@ -435,30 +484,29 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
     o->regions = calloc(nr ? nr : 1, sizeof *o->regions);
     o->models = calloc(nm ? nm : 1, sizeof *o->models);
     o->edge = malloc((ne ? 2 * ne : 1) * sizeof *o->edge);
-    A = calloc((nm ? nm : 1) * T * T, sizeof *A);
-    if (!o->regions || !o->models || !o->edge || !A) {
+    w->A = calloc((nm ? nm : 1) * T * T, sizeof *w->A);
+    if (!o->regions || !o->models || !o->edge || !w->A) {
         free(slot);
-        st = obs__fail(err, OBS_NO_MEMORY, "model of %zu regions", nr);
-        goto done;
+        return obs__fail(err, OBS_NO_MEMORY, "model of %zu regions", nr);
     }
     if (ne)
         memcpy(o->edge, rg->edge, 2 * ne * sizeof *o->edge);
     for (size_t g = 0; g < nr; g++) {
         obs_dyn_model_region *mr = &o->regions[g];
         mr->box = rg->box[g];
-        mr->model = model_of[g] >= 0 ? slot[model_of[g]] : -1;
-        mr->absorbed = absorbed[g];
-        mr->points = (uint32_t)(first[g + 1] - first[g]);
-        ss->regions_absorbed += (size_t)absorbed[g];
+        mr->model = w->model_of[g] >= 0 ? slot[w->model_of[g]] : -1;
+        mr->absorbed = w->absorbed[g];
+        mr->points = (uint32_t)(w->first[g + 1] - w->first[g]);
+        ss->regions_absorbed += (size_t)w->absorbed[g];
         if (slot[g] < 0)
             continue;
-        o->models[slot[g]] = own[g];
-        /* A = X^T X / n over the region's own points (eq 4's columns). */
-        double *Am = A + (size_t)slot[g] * T * T;
-        size_t n = first[g + 1] - first[g];
+        const obs_dyn_fit *own = &w->own[g];
+        o->models[slot[g]] = *own;
+        double *Am = w->A + (size_t)slot[g] * T * T;
+        size_t n = w->first[g + 1] - w->first[g];
         for (size_t i = 0; i < n; i++) {
-            const float *pp = pt->pos + 3 * (size_t)idx[first[g] + i];
-            float q[3] = {pp[0] - own[g].c[0], pp[1] - own[g].c[1], pp[2] - own[g].c[2]};
+            const float *pp = pt->pos + 3 * (size_t)w->idx[w->first[g] + i];
+            float q[3] = {pp[0] - own->c[0], pp[1] - own->c[1], pp[2] - own->c[2]};
             double row[T];
             obs__dyn_eq4_row(q, row);
             for (int a = 0; a < T; a++)
@@ -467,18 +515,25 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
         }
     }
     free(slot);
+    w->nm = nm;
     ss->models = nm;
+    return OBS_OK;
+}
 
-    /* The edges between different models, their weights and centres. */
-    em = malloc((ne ? 2 * ne : 1) * sizeof *em);
-    eb = malloc((ne ? 3 * ne : 1) * sizeof *eb);
-    ew = malloc((ne ? ne : 1) * sizeof *ew);
-    x = malloc((nm ? nm : 1) * sizeof *x);
-    x0 = malloc((nm ? nm : 1) * sizeof *x0);
-    if (!em || !eb || !ew || !x || !x0) {
-        st = obs__fail(err, OBS_NO_MEMORY, "regularisation");
-        goto done;
-    }
+/* The edges between different models, their weights w_ij and centres
+ * b_ij, and the points where the neighbours are compared: the paper's
+ * b_ij (boundary_points 1), or a bp x bp grid of the shared face sharing
+ * w_ij, so that the models agree over the face and not only at its
+ * centre. */
+static obs_status boundary_points(const obs_dyn_regions *rg, const obs_dyn_params *p,
+                                  const obs_dyn_model *o, fit_work *w, char err[OBS_ERR_LEN])
+{
+    size_t ne = w->ne;
+    w->em = malloc((ne ? 2 * ne : 1) * sizeof *w->em);
+    w->eb = malloc((ne ? 3 * ne : 1) * sizeof *w->eb);
+    w->ew = malloc((ne ? ne : 1) * sizeof *w->ew);
+    if (!w->em || !w->eb || !w->ew)
+        return obs__fail(err, OBS_NO_MEMORY, "regularisation");
     size_t me = 0;
     double wsum = 0.0;
     for (size_t k = 0; k < ne; k++) {
@@ -486,27 +541,24 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
         int32_t ma = o->regions[a].model, mb = o->regions[b].model;
         if (ma < 0 || mb < 0 || ma == mb)
             continue;
-        ew[me] = obs__dyn_shared_face(&rg->box[a], &rg->box[b], eb + 3 * me); /* w_ij, b_ij */
-        em[2 * me] = (uint32_t)ma;
-        em[2 * me + 1] = (uint32_t)mb;
-        wsum += ew[me];
+        w->ew[me] = obs__dyn_shared_face(&rg->box[a], &rg->box[b], w->eb + 3 * me); /* w_ij, b_ij */
+        w->em[2 * me] = (uint32_t)ma;
+        w->em[2 * me + 1] = (uint32_t)mb;
+        wsum += w->ew[me];
         me++;
     }
     for (size_t k = 0; k < me; k++)
-        ew[k] /= wsum / (double)me;
-    /* The points where the neighbours are compared: the paper's b_ij
-     * (boundary_points 1), or a bp x bp grid of the shared face sharing
-     * w_ij, so that the models agree over the face and not only at its
-     * centre. */
+        w->ew[k] /= wsum / (double)me;
+    w->me = me;
     int bp = p->boundary_points;
     size_t mp = me * (size_t)bp * (size_t)bp;
-    pm = malloc((mp ? 2 * mp : 1) * sizeof *pm);
-    pb = malloc((mp ? 3 * mp : 1) * sizeof *pb);
-    pw = malloc((mp ? mp : 1) * sizeof *pw);
-    if (!pm || !pb || !pw) {
-        st = obs__fail(err, OBS_NO_MEMORY, "regularisation");
-        goto done;
-    }
+    w->mp = mp;
+    w->pm = malloc((mp ? 2 * mp : 1) * sizeof *w->pm);
+    w->pb = malloc((mp ? 3 * mp : 1) * sizeof *w->pb);
+    w->pw = malloc((mp ? mp : 1) * sizeof *w->pw);
+    if (!w->pm || !w->pb || !w->pw)
+        return obs__fail(err, OBS_NO_MEMORY, "regularisation");
+    const float *eb = w->eb;
     for (size_t k = 0, e = 0, q = 0; k < ne; k++) {
         uint32_t a = rg->edge[2 * k], b = rg->edge[2 * k + 1];
         int32_t ma = o->regions[a].model, mb = o->regions[b].model;
@@ -523,26 +575,40 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
         int u = (ax + 1) % 3, v = (ax + 2) % 3;
         for (int i = 0; i < bp; i++)
             for (int j = 0; j < bp; j++, q++) {
-                float *pt3 = pb + 3 * q;
+                float *pt3 = w->pb + 3 * q;
                 pt3[ax] = eb[3 * e + ax];
                 pt3[u] = bp == 1 ? eb[3 * e + u] : lo[u] + (hi[u] - lo[u]) * ((float)i + 0.5f) / (float)bp;
                 pt3[v] = bp == 1 ? eb[3 * e + v] : lo[v] + (hi[v] - lo[v]) * ((float)j + 0.5f) / (float)bp;
-                pm[2 * q] = em[2 * e];
-                pm[2 * q + 1] = em[2 * e + 1];
-                pw[q] = ew[e] / (double)(bp * bp);
+                w->pm[2 * q] = w->em[2 * e];
+                w->pm[2 * q + 1] = w->em[2 * e + 1];
+                w->pw[q] = w->ew[e] / (double)(bp * bp);
             }
         e++;
     }
+    return OBS_OK;
+}
+
+/* Block coordinate descent: one model at a time, the others fixed; E
+ * (the file's comment) before and after in the stats. */
+static obs_status regularise(const obs_dyn_params *p, const obs_dyn_model *o, fit_work *w,
+                             obs_dyn_stats *ss, char err[OBS_ERR_LEN])
+{
+    size_t nm = w->nm, mp = w->mp;
+    w->x = malloc((nm ? nm : 1) * sizeof *w->x);
+    w->x0 = malloc((nm ? nm : 1) * sizeof *w->x0);
+    if (!w->x || !w->x0)
+        return obs__fail(err, OBS_NO_MEMORY, "regularisation");
+    obs_dyn_fit *x = w->x, *x0 = w->x0;
+    const uint32_t *pm = w->pm;
+    const float *pb = w->pb;
+    const double *pw = w->pw, *A = w->A;
     memcpy(x, o->models, nm * sizeof *x);
     memcpy(x0, o->models, nm * sizeof *x0);
     double beta = p->beta;
     ss->energy[0] = energy(x, x0, A, nm, pm, pb, pw, mp, beta);
-    jumps(x, em, eb, me, p->blend, &ss->jump_mean[0], &ss->jump_max[0]);
-    if (!csr_build(nm, pm, mp, &mfirst, &mitem)) {
-        st = obs__fail(err, OBS_NO_MEMORY, "regularisation");
-        goto done;
-    }
-    /* Block coordinate descent: one model at a time, the others fixed. */
+    jumps(x, w->em, w->eb, w->me, p->blend, &ss->jump_mean[0], &ss->jump_max[0]);
+    if (!csr_build(nm, pm, mp, &w->mfirst, &w->mitem))
+        return obs__fail(err, OBS_NO_MEMORY, "regularisation");
     for (int it = 0; beta > 0.0 && mp && it < p->iterations; it++)
         for (size_t m = 0; m < nm; m++) {
             double H[T * T], B[T * C] = {0};
@@ -552,8 +618,8 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
                     for (int b = 0; b < T; b++)
                         B[a * C + ch] += H[a * T + b] * x0[m].coef[ch][b];
             int any = 0;
-            for (size_t e = mfirst[m]; e < mfirst[m + 1]; e++) {
-                size_t k = mitem[e];
+            for (size_t e = w->mfirst[m]; e < w->mfirst[m + 1]; e++) {
+                size_t k = w->mitem[e];
                 uint32_t other = pm[2 * k] == m ? pm[2 * k + 1] : pm[2 * k];
                 any = 1;
                 const float *bpt = pb + 3 * k;
@@ -575,44 +641,63 @@ obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg
                     x[m].coef[ch][k] = (float)B[k * C + ch];
         }
     ss->energy[1] = energy(x, x0, A, nm, pm, pb, pw, mp, beta);
-    jumps(x, em, eb, me, p->blend, &ss->jump_mean[1], &ss->jump_max[1]);
-    if ((st = copy_shape(&r->model, o, err)) != OBS_OK)
-        goto done;
-    fits_to_model(&r->model, o, x);
-    /* The fit's residuals at the fitted points, before and after. */
+    jumps(x, w->em, w->eb, w->me, p->blend, &ss->jump_mean[1], &ss->jump_max[1]);
+    return OBS_OK;
+}
+
+/* The fit's residuals at the fitted points, before and after. */
+static void residuals(const obs__dyn_points *pt, const obs_dyn_params *p, const fit_work *w,
+                      const obs_dyn_model *o, const obs_dyn_model *reg, obs_dyn_stats *ss)
+{
     double e0 = 0.0, e1 = 0.0;
     size_t np = 0;
-    for (size_t g = 0; g < nr; g++) {
+    for (size_t g = 0; g < w->nr; g++) {
         int32_t m = o->regions[g].model;
-        size_t n = first[g + 1] - first[g];
+        size_t n = w->first[g + 1] - w->first[g];
         if (m < 0 || !n)
             continue;
-        e0 += ao_sse(pt, idx + first[g], n, &o->models[m], p->blend);
-        e1 += ao_sse(pt, idx + first[g], n, &r->model.models[m], p->blend);
+        e0 += ao_sse(pt, w->idx + w->first[g], n, &o->models[m], p->blend);
+        e1 += ao_sse(pt, w->idx + w->first[g], n, &reg->models[m], p->blend);
         np += n;
     }
     ss->fit_rms = np ? sqrt(e0 / (6.0 * np)) : 0.0;
     ss->fit_rms_regularised = np ? sqrt(e1 / (6.0 * np)) : 0.0;
+}
+
+obs_status obs__dyn_fit_all(const obs__dyn_points *pt, const obs_dyn_regions *rg,
+                            const obs_dyn_params *p, obs_dyn_result *r, char err[OBS_ERR_LEN])
+{
+    obs_status st;
+    obs_dyn_stats *ss = &r->stats;
+    size_t nr = rg->count;
+    fit_work w = {0};
+    w.nr = nr;
+    w.ne = rg->edge_count;
+    w.first = calloc(nr + 1, sizeof *w.first);
+    w.hfirst = calloc(nr + 1, sizeof *w.hfirst);
+    w.idx = malloc((pt->count ? pt->count : 1) * sizeof *w.idx);
+    w.hidx = malloc((pt->count ? pt->count : 1) * sizeof *w.hidx);
+    w.own = calloc(nr ? nr : 1, sizeof *w.own);
+    w.model_of = malloc((nr ? nr : 1) * sizeof *w.model_of);
+    w.absorbed = calloc(nr ? nr : 1, sizeof *w.absorbed);
+    obs_dyn_model *o = &r->original;
+    memset(o, 0, sizeof *o);
+    if (!w.first || !w.hfirst || !w.idx || !w.hidx || !w.own || !w.model_of || !w.absorbed) {
+        st = obs__fail(err, OBS_NO_MEMORY, "fit of %zu regions", nr);
+        goto done;
+    }
+    if ((st = group_points(pt, &w, err)) != OBS_OK)
+        goto done;
+    fit_regions(pt, rg, p, &w, ss);
+    if ((st = absorb_tiny(pt, rg, p, &w, ss, err)) != OBS_OK ||
+        (st = number_models(pt, rg, p, &w, o, ss, err)) != OBS_OK ||
+        (st = boundary_points(rg, p, o, &w, err)) != OBS_OK ||
+        (st = regularise(p, o, &w, ss, err)) != OBS_OK ||
+        (st = copy_shape(&r->model, o, err)) != OBS_OK)
+        goto done;
+    fits_to_model(&r->model, o, w.x);
+    residuals(pt, p, &w, o, &r->model, ss);
 done:
-    free(first);
-    free(hfirst);
-    free(idx);
-    free(hidx);
-    free(own);
-    free(model_of);
-    free(absorbed);
-    free(em);
-    free(eb);
-    free(ew);
-    free(pm);
-    free(pb);
-    free(pw);
-    free(nfirst);
-    free(nitem);
-    free(mfirst);
-    free(mitem);
-    free(A);
-    free(x);
-    free(x0);
+    fit_work_free(&w);
     return st;
 }

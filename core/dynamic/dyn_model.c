@@ -10,6 +10,7 @@
 
 #include "dynamic/dyn_internal.h"
 #include "internal.h"
+#include "io/out_file.h"
 
 #define FORMAT_NAME "obscura-dynamic-ao"
 #define FORMAT_VERSION 1
@@ -176,12 +177,16 @@ obs_status obs_dyn_model_write(const char *path, const obs_dyn_model *m, char er
     cJSON_Delete(d);
     if (!txt)
         return obs__fail(err, OBS_NO_MEMORY, "model JSON");
-    FILE *f = fopen(path, "w");
+    /* under a hidden temporary name, renamed when whole (io/out_file.h):
+     * a cancelled farm task leaves no half model under the final name */
+    obs__out_file out;
+    FILE *f = fopen(obs__out_begin(&out, path), "w");
     int ok = f && fputs(txt, f) >= 0 && fputc('\n', f) != EOF;
     if (f && fclose(f) != 0)
         ok = 0;
     free(txt);
-    return ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: cannot write: %s", path, strerror(errno));
+    return obs__out_end(&out, ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: cannot write: %s", path,
+                                                      strerror(errno)), err);
 }
 
 static int get_vec(const cJSON *a, float *v, int n)

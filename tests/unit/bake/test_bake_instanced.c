@@ -7,6 +7,7 @@
 #include "level/bake_testutil.h"
 #include "dynamic/dyn_internal.h"
 #include "bake/instanced.h"
+#include "bake/volume.h"
 
 static double urand(unsigned *s)
 {

@@ -6,7 +6,9 @@
 #include <unistd.h>
 
 #include "level/bake_testutil.h"
+#include "bake/closest.h"
 #include "bake/lod.h"
+#include "bake/simplify.h"
 
 static const float O[3] = {-3, 0.5f, -2}, U[3] = {0, 0.8f, 5}, V[3] = {6, 0.3f, 0};
 

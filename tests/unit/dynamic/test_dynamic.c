@@ -4,6 +4,8 @@
  * the regularisation, absorption, the region file's errors, the model
  * file and the blender, and the decorators (a tree layer above a point
  * attenuates its spherical obscurance, is not solid). */
+#include <unistd.h>
+
 #include "level/bake_testutil.h"
 #include "level/decor.h"
 #include "dynamic/dyn_internal.h"
@@ -614,6 +616,23 @@ static void test_model_file_and_blender(void **state)
     assert_int_equal(back.model_count, 2);
     const float pts[3][3] = {{0.5f, 0.5f, 0.5f}, {1.8f, 0.2f, 0.5f}, {9, 0.5f, 0.5f}};
     const float up[3] = {0, 1, 0};
+    /* written whole or not at all (io/out_file.h): no temporary after a
+     * write, and one that fails half way (the file size limit, as a full
+     * disk) leaves neither the file nor its temporary */
+    char dir[] = "/tmp/obs_dyn_write_XXXXXX", failed[64], list[256];
+    assert_non_null(mkdtemp(dir));
+    snprintf(failed, sizeof failed, "%s/model.json", dir);
+    bt_file_limit(40);
+    obs_status fst = obs_dyn_model_write(failed, &m, err);
+    bt_file_limit(0);
+    assert_int_equal(fst, OBS_IO);
+    bt_dir_list(dir, list, sizeof list);
+    assert_string_equal(list, "");
+    assert_int_equal(obs_dyn_model_write(failed, &m, err), OBS_OK);
+    bt_dir_list(dir, list, sizeof list);
+    assert_string_equal(list, "model.json/");
+    remove(failed);
+    rmdir(dir);
     for (int k = 0; k < 3; k++) {
         float a[3], b[3];
         int ra = obs_dyn_eval(&m, pts[k], up, OBS_DYN_QUADRATIC, a);

@@ -2,9 +2,13 @@
 #ifndef OBS_BAKE_TESTUTIL_H
 #define OBS_BAKE_TESTUTIL_H
 
+#include <dirent.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "obscura/bake.h"
 #include "testutil.h"
@@ -126,6 +130,44 @@ static inline void bt_copy_cut(const char *from, const char *to, long keep, long
         fputc(k == flip ? ch ^ 0x40 : ch, g);
     fclose(f);
     fclose(g);
+}
+
+/* The names in dir, one "name/" a line, sorted, "." and ".." left out:
+ * what a writer left behind, temporaries (".NAME.PID.tmp") included. */
+static inline void bt_dir_list(const char *dir, char *out, size_t cap)
+{
+    struct dirent **e;
+    int n = scandir(dir, &e, NULL, alphasort);
+    assert_true(n >= 0);
+    out[0] = '\0';
+    for (int i = 0; i < n; i++) {
+        if (strcmp(e[i]->d_name, ".") != 0 && strcmp(e[i]->d_name, "..") != 0) {
+            size_t len = strlen(out), nl = strlen(e[i]->d_name);
+            assert_true(len + nl + 2 <= cap);
+            memcpy(out + len, e[i]->d_name, nl);
+            memcpy(out + len + nl, "/", 2);
+        }
+        free(e[i]);
+    }
+    free(e);
+}
+
+/* Files may grow to `bytes` at most (RLIMIT_FSIZE; SIGXFSZ ignored, so a
+ * longer write fails with EFBIG mid-file, as on a full disk); 0: as before.
+ * Works for root, unlike a directory without write permission. */
+static inline void bt_file_limit(size_t bytes)
+{
+    static struct rlimit old;
+    static int saved;
+    if (!saved) {
+        assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
+        signal(SIGXFSZ, SIG_IGN);
+        saved = 1;
+    }
+    struct rlimit rl = old;
+    if (bytes)
+        rl.rlim_cur = bytes;
+    assert_int_equal(setrlimit(RLIMIT_FSIZE, &rl), 0);
 }
 
 #endif
