@@ -3,13 +3,15 @@
 // it.  The one C++ file of libobscura; it never throws across its C
 // interface.  What it writes, core/io/exr_deep.c reads: channels Z, ZBack,
 // A, R, G, B, N.X/N.Y/N.Z (as the image has them), the camera as
-// worldToCamera/worldToNDC (the flat writer's attributes, exr_write.c).
+// worldToCamera/worldToNDC (the flat writer's attributes, exr_write.c),
+// and obscura/version (the provenance every output carries, io.h).
 #include <ImfChannelList.h>
 #include <ImfDeepFrameBuffer.h>
 #include <ImfDeepScanLineOutputFile.h>
 #include <ImfHeader.h>
 #include <ImfMatrixAttribute.h>
 #include <ImfPartType.h>
+#include <ImfStringAttribute.h>
 #include <ImathBox.h>
 #include <ImathMatrix.h>
 #include <cstdarg>
@@ -83,6 +85,7 @@ extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image 
             if (c.present)
                 hdr.channels().insert(c.name, Channel(FLOAT));
 
+        hdr.insert("obscura/version", StringAttribute(OBS_VERSION));
         const obs_camera *cam = &d->camera;
         if (cam->has_world_to_camera) {
             float wtc[16], ndc[16];

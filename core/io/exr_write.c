@@ -7,6 +7,7 @@
 
 #include "io/exr_internal.h"
 #include "io/out_file.h"
+#include "io/provenance.h"
 #include "internal.h"
 
 /* Names longer than this need the long-name flag in the file version. */
@@ -106,12 +107,43 @@ static int has_attr(exr_const_context_t ctx, int part, const char *name)
     return has;
 }
 
+/* `skip` and the input part's obscura/... attributes, NULL-ended in
+ * out[max]: the keys of an earlier run are left out of the part that
+ * gets this run's, so no key of one run stands beside another's. */
+static const char *const *prov_skip(exr_const_context_t src, int src_part, const char *const *skip,
+                                    const char **out, int max)
+{
+    int n = 0;
+    int32_t count = 0;
+    for (; skip && *skip && n < max - 1; skip++)
+        out[n++] = *skip;
+    if (exr_get_attribute_count(src, src_part, &count) == EXR_ERR_SUCCESS)
+        for (int32_t i = 0; i < count && n < max - 1; i++) {
+            const exr_attribute_t *a = NULL;
+            if (exr_get_attribute_by_index(src, src_part, EXR_ATTR_LIST_FILE_ORDER, i, &a) == EXR_ERR_SUCCESS &&
+                a && a->name && !strncmp(a->name, "obscura/", 8))
+                out[n++] = a->name;
+        }
+    out[n] = NULL;
+    return out;
+}
+
+/* The obscura/... strings. */
+static exr_result_t write_prov(exr_context_t ctx, int part, const obs__prov *prov)
+{
+    exr_result_t rv = EXR_ERR_SUCCESS;
+    for (int i = 0; i < prov->count && rv == EXR_ERR_SUCCESS; i++)
+        rv = exr_attr_set_string(ctx, part, prov->key[i], prov->value[i]);
+    return rv;
+}
+
 /* Writes the parts' headers and pixels into ctx.  With `src`, each part
  * carries the attributes of its src_part; the camera goes on the part of
- * `cam_part` unless the input has one there. */
+ * `cam_part` unless the input has one there, the provenance on it
+ * always. */
 static exr_result_t write_parts(exr_context_t ctx, const obs__wpart *parts, int np, exr_const_context_t src,
-                                const char *const *skip, const obs_camera *cam, int cam_part,
-                                const char **what, const char **attr)
+                                const char *const *skip, const obs_camera *cam, const obs__prov *prov,
+                                int cam_part, const char **what, const char **attr)
 {
     exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
     static const exr_attr_v2f_t centre = {{{0.0f, 0.0f}}};
@@ -137,11 +169,17 @@ static exr_result_t write_parts(exr_context_t ctx, const obs__wpart *parts, int 
             if ((rv = exr_add_channel(ctx, part, p->ch[k].name, p->ch[k].type, p->ch[k].plinear, 1, 1)) !=
                 EXR_ERR_SUCCESS)
                 return rv;
-        if (src && p->src_part >= 0 && (rv = obs__exr_copy_attrs(ctx, part, src, p->src_part, skip, attr)) != EXR_ERR_SUCCESS)
+        const char *skip_prov[32];
+        if (src && p->src_part >= 0 &&
+            (rv = obs__exr_copy_attrs(ctx, part, src, p->src_part,
+                                      i == cam_part ? prov_skip(src, p->src_part, skip, skip_prov, 32) : skip,
+                                      attr)) != EXR_ERR_SUCCESS)
             return rv;
         if (i == cam_part && obs__camera_exr_attrs(cam, NULL) &&
             !(src && p->src_part >= 0 && has_attr(src, p->src_part, OBS__CAMERA_ATTR_WTC)) &&
             (rv = write_camera(ctx, part, cam)) != EXR_ERR_SUCCESS)
+            return rv;
+        if (i == cam_part && (rv = write_prov(ctx, part, prov)) != EXR_ERR_SUCCESS)
             return rv;
     }
     if ((rv = exr_write_header(ctx)) != EXR_ERR_SUCCESS)
@@ -244,6 +282,7 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
     exr_result_t rv = EXR_ERR_SUCCESS;
     obs_status st;
     obs__out_file out = {0};
+    obs__prov prov;
 
     if (!o)
         o = &zero;
@@ -303,7 +342,9 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
         for (int i = 0; o->append && i < np; i++)
             if (parts[i].src_part == o->src->part)
                 cam_part = i;
-        rv = write_parts(ctx, parts, np, src, o->append ? NULL : plain_skip, o->cam, cam_part, &what, &attr);
+        obs__prov_build(o->prov, &prov);
+        rv = write_parts(ctx, parts, np, src, o->append ? NULL : plain_skip, o->cam, &prov, cam_part, &what,
+                         &attr);
         if (rv == EXR_ERR_SUCCESS) {
             what = "finishing the file";
             rv = exr_finish(&ctx);

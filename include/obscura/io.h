@@ -239,8 +239,30 @@ typedef struct obs_exr_source {
                         * (obs_exr_info.part, obs_deep_image.part) */
 } obs_exr_source;
 
+/* What an output says about how it was made (README.md, "Output
+ * files").  Every EXR and PNG the library writes carries obscura/version
+ * (OBS_VERSION); the fields given here add the other keys, each left out
+ * when its field is NULL or empty:
+ *   obscura/method         the method of `params` (resolved)
+ *   obscura/params         its parameters that differ from the method's
+ *                          defaults, "name=value" joined by spaces ("" for
+ *                          none); `method` is among them when not vaopp
+ *   obscura/input          `input`, e.g. the input file's path
+ *   obscura/camera_source  `camera_source` (obs_exr_info.camera_source)
+ * EXR: string attributes on the part the layers go to, in place of any
+ * obscura/... the input's part carried (an earlier run's); the input's
+ * own attributes, Software and the rest, are kept beside them.  PNG:
+ * tEXt chunks (iTXt when a value is not ASCII).  The strings need only
+ * live during the call. */
+typedef struct obs_provenance {
+    const obs_params *params; /* NULL: no obscura/method, obscura/params */
+    const char *input;
+    const char *camera_source;
+} obs_provenance;
+
 /* How obs_exr_write_ex() writes.  Zeroed: half, no camera, no source,
- * the data window at the origin with the display window equal to it. */
+ * the data window at the origin with the display window equal to it,
+ * obscura/version the only provenance. */
 typedef struct obs_exr_options {
     obs_exr_pixel pixel;
     /* worldToCamera / worldToNDC, written unless the source has its own */
@@ -260,6 +282,8 @@ typedef struct obs_exr_options {
     /* Without a source: the images' place in a display window, as in
      * obs_gbuffer (display_width 0: the display window is the images). */
     int display_x, display_y, display_width, display_height;
+    /* obscura/... string attributes (NULL: obscura/version alone) */
+    const obs_provenance *prov;
 } obs_exr_options;
 
 /* obs_exr_write() with options (NULL: as zeroed). */
@@ -279,9 +303,52 @@ typedef struct obs_exr_names {
 obs_status obs_exr_layers_rename(obs_exr_layer *layers, int layer_count, const char *name,
                                  obs_exr_names *store, char err[OBS_ERR_LEN]);
 
+/* The transfer function of a PNG's values, and the tag that says so
+ * (README.md, "Output files").  Alpha is always linear. */
+typedef enum obs_png_transfer {
+    /* sRGB: the one Nuke's Read node (8- and 16-bit files are sRGB by
+     * default, whatever the chunks say) and OpenImageIO (the sRGB chunk:
+     * oiio:ColorSpace "sRGB") both read right */
+    OBS_PNG_TRANSFER_DEFAULT,
+    /* values sRGB-encoded (IEC 61966-2-1); sRGB chunk, with the gAMA
+     * 1/2.2 and cHRM chunks the PNG spec asks of an sRGB encoder */
+    OBS_PNG_TRANSFER_SRGB,
+    /* values as computed; gAMA 1.0 with Rec. 709 cHRM, and cICP (Rec. 709
+     * primaries, linear transfer, full range): OpenImageIO reads
+     * oiio:ColorSpace "linear"; Nuke needs its Read set to linear */
+    OBS_PNG_TRANSFER_LINEAR
+} obs_png_transfer;
+
+/* Valid --png-transfer names in enum order from 1 ("srgb", "linear"),
+ * NULL-terminated; obs_png_transfer_parse() maps a name to its value
+ * (OBS_PNG_TRANSFER_DEFAULT, 0, for an unknown one). */
+extern const char *const obs_png_transfers[];
+obs_png_transfer obs_png_transfer_parse(const char *name);
+
+/* How obs_png_write_ex() writes.  Zeroed: 8 bit, sRGB, obscura/version
+ * the only provenance. */
+typedef struct obs_png_options {
+    int bits;                  /* 8 or 16 (0: 8) */
+    obs_png_transfer transfer; /* of the grey or colour channels */
+    /* A colour image is display-referred: the sRGB transfer whatever
+     * `transfer` says, and values over 1 brought into range without a
+     * shift of hue (see obs_png_write_ex) */
+    int display;
+    const obs_provenance *prov; /* obscura/... text chunks (NULL: version) */
+} obs_png_options;
+
 /* Writes an 8- or 16-bit PNG: 1 channel -> grey, 3 -> RGB, 4 -> RGBA.
- * Values are clamped to [0,1]; with `srgb` colour channels are encoded with
- * the sRGB transfer function (alpha and grey AO stay linear). */
+ * Values are clamped to [0,1] (NaN to 0), then encoded with the transfer
+ * and tagged.  With `display`, an RGB(A) pixel whose largest colour
+ * channel m is over 1 is scaled by 1/m before that (its hue and
+ * saturation kept, where clamping each channel would turn an orange sky
+ * yellow); pixels with every channel at most 1 are unchanged. */
+obs_status obs_png_write_ex(const char *path, const obs_image *img, const obs_png_options *opt,
+                            char err[OBS_ERR_LEN]);
+
+/* obs_png_write_ex() with `bits`, the linear transfer (the values as
+ * they are, tagged linear) and `display` = `srgb`: with `srgb` a colour
+ * image is display-encoded, grey stays linear. */
 obs_status obs_png_write(const char *path, const obs_image *img, int bits,
                          int srgb, char err[OBS_ERR_LEN]);
 
@@ -310,6 +377,10 @@ obs_status obs_exr_write_ex_mem(const obs_exr_layer *layers, int layer_count, co
  * *out holds the PNG; caller frees with obs_bytes_free(). */
 obs_status obs_png_write_mem(const obs_image *img, int bits, int srgb,
                              obs_bytes *out, char err[OBS_ERR_LEN]);
+
+/* obs_png_write_ex() into memory: the same file, byte for byte. */
+obs_status obs_png_write_ex_mem(const obs_image *img, const obs_png_options *opt, obs_bytes *out,
+                                char err[OBS_ERR_LEN]);
 
 /* ---- camera ------------------------------------------------------------ */
 

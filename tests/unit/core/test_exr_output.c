@@ -515,6 +515,86 @@ static void test_append_refusals(void **state)
     free(img.data);
 }
 
+/* ---- provenance --------------------------------------------------------- */
+
+static const char *str_attr(exr_context_t ctx, int part, const char *name)
+{
+    const exr_attribute_t *a = NULL;
+    if (exr_get_attribute_by_name(ctx, part, name, &a) != EXR_ERR_SUCCESS || !a)
+        return NULL;
+    assert_int_equal(a->type, EXR_ATTR_STRING);
+    return a->string->str;
+}
+
+/* obscura/version, method, params (what differs from the defaults),
+ * input and camera_source on the AO's part, beside the input's own
+ * attributes (its chromaticities, its renderer's keys); a rerun over
+ * obscura's own output replaces the keys, in plain and append mode. */
+static void test_provenance(void **state)
+{
+    (void)state;
+    const char *in = tmp_path("prov_in.exr"), *out = tmp_path("prov.exr"), *again = tmp_path("prov2.exr");
+    write_input(in, &cropped, 1, 1);
+    obs_image img = {10, 8, 1, ao_pixels(10, 8)};
+    const char *names[] = {"AO.Y"};
+    obs_exr_layer l = {&img, names};
+    char err[OBS_ERR_LEN] = "";
+    obs_params p = {0};
+    assert_int_equal(obs_param_set(&p, "method", "hbao", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "hbao_steps", "8", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "fov_y", "50", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "radius", "0.5", err), OBS_OK); /* the default: not listed */
+    obs_provenance prov = {.params = &p, .input = in, .camera_source = "header worldToCamera"};
+    obs_exr_source src = {.path = in, .part = 0};
+    obs_exr_options o = {.src = &src, .prov = &prov};
+    if (obs_exr_write_ex(out, &l, 1, &o, err) != OBS_OK)
+        fail_msg("%s", err);
+    exr_context_t b = open_exr(out);
+    assert_string_equal(str_attr(b, 0, "obscura/version"), OBS_VERSION);
+    assert_string_equal(str_attr(b, 0, "obscura/method"), "hbao");
+    assert_string_equal(str_attr(b, 0, "obscura/params"), "method=hbao fov_y=50 hbao_steps=8");
+    assert_string_equal(str_attr(b, 0, "obscura/input"), in);
+    assert_string_equal(str_attr(b, 0, "obscura/camera_source"), "header worldToCamera");
+    assert_string_equal(str_attr(b, 0, "arnold/version"), "7.1.4");
+    const exr_attribute_t *chr = NULL;
+    assert_int_equal(exr_get_attribute_by_name(b, 0, "chromaticities", &chr), 0);
+    assert_int_equal(chr->type, EXR_ATTR_CHROMATICITIES);
+    assert_true(chr->chromaticities->red_x == 0.64f && chr->chromaticities->white_y == 0.329f);
+    exr_finish(&b);
+    same_from_memory(in, out, &l, &o);
+
+    /* obscura over its own output: the keys are this run's alone */
+    obs_params defaults = {0};
+    obs_provenance prov2 = {.params = &defaults, .input = out};
+    obs_exr_source src2 = {.path = out, .part = 0};
+    const char *n2[] = {"AO2.Y"};
+    obs_exr_layer l2 = {&img, n2};
+    for (int append = 0; append <= 1; append++) {
+        obs_exr_options o2 = {.src = &src2, .prov = &prov2, .append = append};
+        if (obs_exr_write_ex(again, &l2, 1, &o2, err) != OBS_OK)
+            fail_msg("%s", err);
+        b = open_exr(again);
+        assert_string_equal(str_attr(b, 0, "obscura/method"), "vaopp");
+        assert_string_equal(str_attr(b, 0, "obscura/params"), "");
+        assert_string_equal(str_attr(b, 0, "obscura/input"), out);
+        /* not given this time: the earlier run's is not kept beside this run's keys */
+        assert_null(str_attr(b, 0, "obscura/camera_source"));
+        assert_string_equal(str_attr(b, 0, "arnold/version"), "7.1.4");
+        exr_finish(&b);
+    }
+
+    /* zeroed options: obscura/version alone */
+    obs_exr_options plain = {0};
+    if (obs_exr_write_ex(again, &l, 1, &plain, err) != OBS_OK)
+        fail_msg("%s", err);
+    b = open_exr(again);
+    assert_string_equal(str_attr(b, 0, "obscura/version"), OBS_VERSION);
+    assert_null(str_attr(b, 0, "obscura/method"));
+    assert_null(str_attr(b, 0, "obscura/input"));
+    exr_finish(&b);
+    free(img.data);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -523,6 +603,7 @@ int main(void)
         cmocka_unit_test(test_layer_names),
         cmocka_unit_test(test_append_parts),
         cmocka_unit_test(test_append_refusals),
+        cmocka_unit_test(test_provenance),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,5 +1,6 @@
 /* EXR output: round trips through the reader (half and float, channels
- * by name), camera attributes in OpenEXR's conventions, and errors. */
+ * by name, obscura/version), camera attributes in OpenEXR's conventions,
+ * and errors. */
 #include "testutil.h"
 
 #include <math.h>
@@ -75,15 +76,22 @@ static void round_trip(obs_exr_pixel pixel, float tol)
     assert_null(names[5]);
     obs_strv_free(names);
 
-    /* the file says what it holds: ZIP, the pixel type asked for */
+    /* the file says what it holds: ZIP, the pixel type asked for, and
+     * which obscura wrote it (obscura/version, the one key without
+     * provenance options) */
     exr_context_t ctx;
     exr_compression_t c;
     const exr_attr_chlist_t *cl;
+    const exr_attribute_t *v = NULL, *m = NULL;
     assert_int_equal(exr_start_read(&ctx, path, NULL), EXR_ERR_SUCCESS);
     assert_int_equal(exr_get_compression(ctx, 0, &c), EXR_ERR_SUCCESS);
     assert_int_equal(c, EXR_COMPRESSION_ZIP);
     assert_int_equal(exr_get_channels(ctx, 0, &cl), EXR_ERR_SUCCESS);
     assert_int_equal(cl->entries[0].pixel_type, pixel == OBS_EXR_HALF ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT);
+    assert_int_equal(exr_get_attribute_by_name(ctx, 0, "obscura/version", &v), EXR_ERR_SUCCESS);
+    assert_int_equal(v->type, EXR_ATTR_STRING);
+    assert_string_equal(v->string->str, OBS_VERSION);
+    assert_int_not_equal(exr_get_attribute_by_name(ctx, 0, "obscura/method", &m), EXR_ERR_SUCCESS);
     exr_finish(&ctx);
     obs_image_free(&ao);
     obs_image_free(&comp);
