@@ -180,6 +180,75 @@ obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
 /* The steps; with a shard (shard.c) the trace is its step instead: one
  * shard's samples traced and written (then the bake stops there), or
  * every shard's read back. */
+/* The level in world space, its stats, the decorators (section 2.2:
+ * which nodes are shrubs, trees, small) and the large instanced ones
+ * (instanced.c: sel, their count in *inst_n) masked out of the surface
+ * samples; area_kept: the faces' areas before the mask, for the LODs
+ * (NULL when not needed). */
+static obs_status flatten_stage(const obs_bake_scene *scene, const obs_bake_desc *desc,
+                                const obs_bake_params *p, obs__bake_world *w,
+                                obs__bake_decor *dc, uint8_t **sel, size_t *inst_n,
+                                float **area_kept, obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    obs_status rc;
+    if ((rc = obs__bake_flatten_checked(scene, p->max_triangles, "bake", w, err)) != OBS_OK)
+        return rc;
+    st->instances = w->instance_count;
+    st->triangles = w->triangle_count;
+    st->vertices = w->vertex_count;
+    st->degenerate_triangles = w->degenerate;
+    st->faces_against_normals = w->against_normals;
+    for (size_t k = 0; k < w->triangle_count; k++)
+        st->two_sided_triangles += w->two_sided[k];
+    if ((rc = obs__bake_decor_classify_warn(scene, p, desc ? desc->decorators_json : NULL, dc,
+                                            st->decorator_warning, err)) != OBS_OK)
+        return rc;
+    memcpy(st->decorator_nodes, dc->counts, sizeof dc->counts);
+    /* Large instanced decorators (section 2.2, instanced.c): no surface
+     * samples of their own in the level. */
+    if (!(*sel = malloc(w->instance_count ? w->instance_count : 1)))
+        return obs__fail(err, OBS_NO_MEMORY, "%zu instances", w->instance_count);
+    if ((*inst_n = obs__bake_instanced_select(scene, w, dc, p, *sel))) {
+        /* the LODs resample the instanced faces' final values at their
+         * nearest points (lod.c), which needs their areas */
+        if (p->lods && w->triangle_count) {
+            if (!(*area_kept = malloc(w->triangle_count * sizeof **area_kept)))
+                return obs__fail(err, OBS_NO_MEMORY, "%zu triangles", w->triangle_count);
+            memcpy(*area_kept, w->area, w->triangle_count * sizeof **area_kept);
+        }
+        obs__bake_instanced_mask(w, *sel);
+    }
+    return OBS_OK;
+}
+
+/* Eq 1 at every sample (trace.c), or, for a shard or a merge, shard.c's
+ * step in its place; t: when the stage began. */
+static obs_status trace_stage(const obs_bake_desc *desc, const obs_bake_params *p,
+                              const obs__bake_decor *dc, obs__bake_shard *sh,
+                              const obs__bake_world *w, obs__bake_samples *s, double t,
+                              obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    obs_status rc;
+    obs__bake_trace_desc td = {{p->distance_short, p->distance_long}, p->rays, p->threads,
+                               p->backface_limit, (uint64_t)p->seed,
+                               desc ? desc->progress : NULL, desc ? desc->progress_user : NULL};
+    td.decor = dc;
+    td.tree_attenuation = p->tree_attenuation;
+    double bvh = 0.0;
+    if (sh) {
+        if ((rc = obs__bake_shard_step(sh, w, s, &td, st, err)) != OBS_OK)
+            return rc;
+    } else {
+        if ((rc = obs__bake_trace(w, s, &td, &bvh, err)) != OBS_OK)
+            return rc;
+        st->seconds[OBS_BAKE_STAGE_bvh] = bvh;
+        st->seconds[OBS_BAKE_STAGE_trace] = obs__bake_now() - t - bvh;
+    }
+    st->rays = s->rays;
+    st->samples_dropped_backface = s->dropped;
+    return OBS_OK;
+}
+
 obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc *desc,
                                obs__bake_shard *sh, obs_bake_result *out, char err[OBS_ERR_LEN])
 {
@@ -197,38 +266,9 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     size_t inst_n = 0;
     obs_status rc;
     double t = obs__bake_now();
-    if ((rc = obs__bake_flatten_checked(scene, p.max_triangles, "bake", &w, err)) != OBS_OK)
+    if ((rc = flatten_stage(scene, desc, &p, &w, &dc, &inst_sel, &inst_n, &area_kept, st, err)) !=
+        OBS_OK)
         goto done;
-    st->instances = w.instance_count;
-    st->triangles = w.triangle_count;
-    st->vertices = w.vertex_count;
-    st->degenerate_triangles = w.degenerate;
-    st->faces_against_normals = w.against_normals;
-    for (size_t k = 0; k < w.triangle_count; k++)
-        st->two_sided_triangles += w.two_sided[k];
-    /* Decorators (section 2.2): which nodes are shrubs, trees, small. */
-    if ((rc = obs__bake_decor_classify_warn(scene, &p, desc ? desc->decorators_json : NULL, &dc,
-                                            st->decorator_warning, err)) != OBS_OK)
-        goto done;
-    memcpy(st->decorator_nodes, dc.counts, sizeof dc.counts);
-    /* Large instanced decorators (section 2.2, instanced.c): no surface
-     * samples of their own in the level. */
-    if (!(inst_sel = malloc(w.instance_count ? w.instance_count : 1))) {
-        rc = obs__fail(err, OBS_NO_MEMORY, "%zu instances", w.instance_count);
-        goto done;
-    }
-    if ((inst_n = obs__bake_instanced_select(scene, &w, &dc, &p, inst_sel))) {
-        /* the LODs resample the instanced faces' final values at their
-         * nearest points (lod.c), which needs their areas */
-        if (p.lods && w.triangle_count) {
-            if (!(area_kept = malloc(w.triangle_count * sizeof *area_kept))) {
-                rc = obs__fail(err, OBS_NO_MEMORY, "%zu triangles", w.triangle_count);
-                goto done;
-            }
-            memcpy(area_kept, w.area, w.triangle_count * sizeof *area_kept);
-        }
-        obs__bake_instanced_mask(&w, inst_sel);
-    }
     st->seconds[OBS_BAKE_STAGE_flatten] = obs__bake_now() - t;
 
     t = obs__bake_now();
@@ -239,23 +279,8 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     st->seconds[OBS_BAKE_STAGE_samples] = obs__bake_now() - t;
 
     t = obs__bake_now();
-    obs__bake_trace_desc td = {{p.distance_short, p.distance_long}, p.rays, p.threads,
-                               p.backface_limit, (uint64_t)p.seed,
-                               desc ? desc->progress : NULL, desc ? desc->progress_user : NULL};
-    td.decor = &dc;
-    td.tree_attenuation = p.tree_attenuation;
-    double bvh = 0.0;
-    if (sh) {
-        if ((rc = obs__bake_shard_step(sh, &w, &s, &td, st, err)) != OBS_OK)
-            goto done;
-    } else {
-        if ((rc = obs__bake_trace(&w, &s, &td, &bvh, err)) != OBS_OK)
-            goto done;
-        st->seconds[OBS_BAKE_STAGE_bvh] = bvh;
-        st->seconds[OBS_BAKE_STAGE_trace] = obs__bake_now() - t - bvh;
-    }
-    st->rays = s.rays;
-    st->samples_dropped_backface = s.dropped;
+    if ((rc = trace_stage(desc, &p, &dc, sh, &w, &s, t, st, err)) != OBS_OK)
+        goto done;
     if (sh && sh->stop) /* a shard: its part is written; the merge fits */
         goto done;
 

@@ -205,6 +205,150 @@ static int stop_asked(void *user)
            c->desc->progress(c->desc->progress_user, c->samples, c->samples);
 }
 
+/* The local AO, once per distinct mesh of the selected instances (the
+ * pipeline on that mesh alone); max_v: the most vertices of one. */
+static obs_status local_aos(const obs_bake_scene *s, const obs__bake_world *w, const uint8_t *sel,
+                            const obs_bake_params *p, obs__bake_alone_fn local_ao, stop_ctx *sc,
+                            double **local, size_t *max_v, obs_bake_stats *st,
+                            char err[OBS_ERR_LEN])
+{
+    obs_status rc;
+    for (size_t i = 0; i < w->instance_count; i++) {
+        if (!sel[i])
+            continue;
+        uint32_t m = w->inst[i].mesh;
+        size_t nv = s->meshes[m].vertex_count;
+        *max_v = nv > *max_v ? nv : *max_v;
+        if (local[m])
+            continue;
+        if (stop_asked(sc))
+            return obs__fail(err, OBS_CANCELLED, "bake cancelled in the instanced trees' local AO");
+        if (!(local[m] = malloc((nv ? nv : 1) * 2 * sizeof **local)))
+            return obs__fail(err, OBS_NO_MEMORY, "local AO of %zu vertices", nv);
+        if ((rc = local_ao(s, m, p, local[m], err)) != OBS_OK) {
+            char why[OBS_ERR_LEN];
+            snprintf(why, sizeof why, "%s", err);
+            return obs__fail(err, rc, "local AO of mesh '%s': %s",
+                             s->meshes[m].name ? s->meshes[m].name : "?", why);
+        }
+        st->instanced_meshes++;
+    }
+    return OBS_OK;
+}
+
+/* The selected instances' world boxes (6 floats each: lo, hi); returns
+ * their count. */
+static size_t instance_boxes(const obs_bake_scene *s, const obs__bake_world *w, const uint8_t *sel,
+                             float *boxes)
+{
+    size_t nbox = 0;
+    for (size_t i = 0; i < w->instance_count; i++) {
+        if (!sel[i])
+            continue;
+        float *bx = boxes + 6 * nbox++;
+        size_t v0 = w->inst[i].first_vertex, nv = s->meshes[w->inst[i].mesh].vertex_count;
+        for (int a = 0; a < 3; a++)
+            bx[a] = INFINITY, bx[3 + a] = -INFINITY;
+        for (size_t v = v0; v < v0 + nv; v++)
+            for (int a = 0; a < 3; a++) {
+                bx[a] = fminf(bx[a], w->pos[3 * v + a]);
+                bx[3 + a] = fmaxf(bx[3 + a], w->pos[3 * v + a]);
+            }
+    }
+    return nbox;
+}
+
+/* Eq 3 for instance i, at each distance and for the blend: f (the
+ * volume's AO) and L (the mesh's local AO) gathered at its vertices into
+ * the scratch arrays (3 x the most vertices), the model's values written
+ * over the instance's; sq, nsq: the blend's squared residuals. */
+static obs_status eq3_instance(const obs_bake_scene *s, const obs__bake_world *w, size_t i,
+                               const obs__vol *vol, double *const *local,
+                               const obs_bake_params *p, double *f, double *L,
+                               obs_bake_result *out, double *sq, size_t *nsq,
+                               char err[OBS_ERR_LEN])
+{
+    const obs__bake_inst *in = &w->inst[i];
+    const obs_bake_mesh *m = &s->meshes[in->mesh];
+    obs_bake_instance *r = &out->instances[i];
+    obs_bake_stats *st = &out->stats;
+    size_t nv = m->vertex_count;
+    float blend = p->blend;
+    for (size_t v = 0; v < nv; v++) {
+        const float *p3 = w->pos + 3 * (in->first_vertex + v),
+                    *n3 = w->nrm + 3 * (in->first_vertex + v);
+        double ao[2];
+        int has_n = n3[0] != 0.0f || n3[1] != 0.0f || n3[2] != 0.0f;
+        if (!obs__vol_eval(vol, p3, has_n ? n3 : NULL, ao))
+            return obs__fail(err, OBS_INVALID_ARGUMENT,
+                             "volume: a vertex of instance %zu has a corner missing", i);
+        /* f: the volume's AO (eq 1 at the vertex); [c nv + v], c = 0
+         * the blend (section 2's _AO), 1 short, 2 long */
+        f[nv + v] = clamp01(ao[0]);
+        f[2 * nv + v] = clamp01(ao[1]);
+        f[v] = blend * f[nv + v] + (1.0 - blend) * f[2 * nv + v];
+        L[nv + v] = local[in->mesh][2 * v];
+        L[2 * nv + v] = local[in->mesh][2 * v + 1];
+        L[v] = blend * L[nv + v] + (1.0 - blend) * L[2 * nv + v];
+    }
+    if (p->instanced_values == OBS_BAKE_IVALUES_LINEAR)
+        for (size_t v = 0; v < 3 * nv; v++)
+            L[v] = 1.0; /* G alone: eq 3 with L = 1 */
+    free(r->ao_local);
+    r->ao_local = NULL;
+    if (p->instanced_values == OBS_BAKE_IVALUES_VOLUME) {
+        /* no model: the volume's AO itself (the comparisons' row) */
+        float *d3[3] = {r->ao, r->ao_short, r->ao_long};
+        for (int c = 0; c < 3; c++)
+            for (size_t v = 0; v < nv; v++)
+                d3[c][v] = clamp01(f[c * nv + v]);
+        st->instanced_instances++;
+        return OBS_OK;
+    }
+    if (!(r->ao_local = malloc((nv ? nv : 1) * sizeof *r->ao_local)))
+        return obs__fail(err, OBS_NO_MEMORY, "local AO of %zu vertices", nv);
+    float *dst[3] = {r->ao, r->ao_short, r->ao_long};
+    for (int c = 0; c < 3; c++) {
+        double y[4] = {1.0, 0.0, 0.0, 0.0};
+        if (p->instanced_values != OBS_BAKE_IVALUES_LOCAL)
+            obs__bake_eq3_fit(m->positions, f + c * nv, L + c * nv, nv, y); /* eq 3 */
+        for (int k = 0; k < 4; k++)
+            r->global[c][k] = (float)y[k];
+        for (size_t v = 0; v < nv; v++) {
+            /* local AO times the function (section 2.2) */
+            double g = eval_g(y, m->positions + 3 * v);
+            dst[c][v] = clamp01(L[c * nv + v] * g);
+            if (c == 0) {
+                r->ao_local[v] = (float)L[v];
+                double e = f[v] - dst[0][v];
+                *sq += e * e;
+                (*nsq)++;
+            }
+        }
+    }
+    st->instanced_instances++;
+    return OBS_OK;
+}
+
+/* The level's _AO range again, the instances' values replaced. */
+static void ao_range(const obs_bake_scene *s, obs_bake_result *out)
+{
+    double sum = 0.0, lo = INFINITY, hi = -INFINITY;
+    size_t cnt = 0;
+    for (size_t i = 0; i < out->instance_count; i++) {
+        size_t nv = s->meshes[out->instances[i].mesh].vertex_count;
+        for (size_t v = 0; v < nv; v++, cnt++) {
+            float a = out->instances[i].ao[v];
+            sum += a;
+            lo = fmin(lo, a);
+            hi = fmax(hi, a);
+        }
+    }
+    out->stats.ao_mean = cnt ? sum / (double)cnt : 0.0;
+    out->stats.ao_min = lo;
+    out->stats.ao_max = hi;
+}
+
 obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_world *w,
                                    const uint8_t *sel, const obs_bake_params *p,
                                    const obs_bake_desc *desc, size_t samples,
@@ -219,58 +363,22 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
     double *f = NULL, *L = NULL;
     obs__vol vol = {0};
     obs__bake_bvh *bvh = NULL;
-    size_t nbox = 0, max_v = 0;
+    size_t max_v = 0;
     if (!local || !boxes) {
         rc = obs__fail(err, OBS_NO_MEMORY, "instanced decorators of %zu instances",
                        w->instance_count);
         goto done;
     }
 
-    /* The local AO, once per distinct mesh. */
     double t = obs__bake_now();
-    for (size_t i = 0; i < w->instance_count; i++) {
-        if (!sel[i])
-            continue;
-        uint32_t m = w->inst[i].mesh;
-        size_t nv = s->meshes[m].vertex_count;
-        max_v = nv > max_v ? nv : max_v;
-        if (local[m])
-            continue;
-        if (stop_asked(&sc)) {
-            rc = obs__fail(err, OBS_CANCELLED, "bake cancelled in the instanced trees' local AO");
-            goto done;
-        }
-        if (!(local[m] = malloc((nv ? nv : 1) * 2 * sizeof **local))) {
-            rc = obs__fail(err, OBS_NO_MEMORY, "local AO of %zu vertices", nv);
-            goto done;
-        }
-        if ((rc = local_ao(s, m, p, local[m], err)) != OBS_OK) {
-            char why[OBS_ERR_LEN];
-            snprintf(why, sizeof why, "%s", err);
-            rc = obs__fail(err, rc, "local AO of mesh '%s': %s",
-                           s->meshes[m].name ? s->meshes[m].name : "?", why);
-            goto done;
-        }
-        st->instanced_meshes++;
-    }
+    if ((rc = local_aos(s, w, sel, p, local_ao, &sc, local, &max_v, st, err)) != OBS_OK)
+        goto done;
     st->seconds[OBS_BAKE_STAGE_local] = obs__bake_now() - t;
 
     /* The sparse volume around the instances' world boxes, traced in the
      * whole level. */
     t = obs__bake_now();
-    for (size_t i = 0; i < w->instance_count; i++) {
-        if (!sel[i])
-            continue;
-        float *bx = boxes + 6 * nbox++;
-        size_t v0 = w->inst[i].first_vertex, nv = s->meshes[w->inst[i].mesh].vertex_count;
-        for (int a = 0; a < 3; a++)
-            bx[a] = INFINITY, bx[3 + a] = -INFINITY;
-        for (size_t v = v0; v < v0 + nv; v++)
-            for (int a = 0; a < 3; a++) {
-                bx[a] = fminf(bx[a], w->pos[3 * v + a]);
-                bx[3 + a] = fmaxf(bx[3 + a], w->pos[3 * v + a]);
-            }
-    }
+    size_t nbox = instance_boxes(s, w, sel, boxes);
     if ((rc = obs__vol_build(&vol, p->volume_spacing, boxes, nbox, MAX_VOLUME_POINTS, err)) !=
         OBS_OK)
         goto done;
@@ -289,7 +397,7 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
     st->volume_rays = vol.rays;
     st->seconds[OBS_BAKE_STAGE_volume] = obs__bake_now() - t;
 
-    /* Eq 3 per instance, at each distance and for the blend. */
+    /* Eq 3 per instance. */
     t = obs__bake_now();
     f = malloc((max_v ? max_v : 1) * 3 * sizeof *f);
     L = malloc((max_v ? max_v : 1) * 3 * sizeof *L);
@@ -297,90 +405,14 @@ obs_status obs__bake_instanced_run(const obs_bake_scene *s, const obs__bake_worl
         rc = obs__fail(err, OBS_NO_MEMORY, "eq 3 of %zu vertices", max_v);
         goto done;
     }
-    float blend = p->blend;
     double sq = 0.0;
     size_t nsq = 0;
-    for (size_t i = 0; i < w->instance_count; i++) {
-        if (!sel[i])
-            continue;
-        const obs__bake_inst *in = &w->inst[i];
-        const obs_bake_mesh *m = &s->meshes[in->mesh];
-        obs_bake_instance *r = &out->instances[i];
-        size_t nv = m->vertex_count;
-        for (size_t v = 0; v < nv; v++) {
-            const float *p3 = w->pos + 3 * (in->first_vertex + v),
-                        *n3 = w->nrm + 3 * (in->first_vertex + v);
-            double ao[2];
-            int has_n = n3[0] != 0.0f || n3[1] != 0.0f || n3[2] != 0.0f;
-            if (!obs__vol_eval(&vol, p3, has_n ? n3 : NULL, ao)) {
-                rc = obs__fail(err, OBS_INVALID_ARGUMENT,
-                               "volume: a vertex of instance %zu has a corner missing", i);
-                goto done;
-            }
-            /* f: the volume's AO (eq 1 at the vertex); [c nv + v], c = 0
-             * the blend (section 2's _AO), 1 short, 2 long */
-            f[nv + v] = clamp01(ao[0]);
-            f[2 * nv + v] = clamp01(ao[1]);
-            f[v] = blend * f[nv + v] + (1.0 - blend) * f[2 * nv + v];
-            L[nv + v] = local[in->mesh][2 * v];
-            L[2 * nv + v] = local[in->mesh][2 * v + 1];
-            L[v] = blend * L[nv + v] + (1.0 - blend) * L[2 * nv + v];
-        }
-        if (p->instanced_values == OBS_BAKE_IVALUES_LINEAR)
-            for (size_t v = 0; v < 3 * nv; v++)
-                L[v] = 1.0; /* G alone: eq 3 with L = 1 */
-        free(r->ao_local);
-        r->ao_local = NULL;
-        if (p->instanced_values == OBS_BAKE_IVALUES_VOLUME) {
-            /* no model: the volume's AO itself (the comparisons' row) */
-            float *d3[3] = {r->ao, r->ao_short, r->ao_long};
-            for (int c = 0; c < 3; c++)
-                for (size_t v = 0; v < nv; v++)
-                    d3[c][v] = clamp01(f[c * nv + v]);
-            st->instanced_instances++;
-            continue;
-        }
-        if (!(r->ao_local = malloc((nv ? nv : 1) * sizeof *r->ao_local))) {
-            rc = obs__fail(err, OBS_NO_MEMORY, "local AO of %zu vertices", nv);
+    for (size_t i = 0; i < w->instance_count; i++)
+        if (sel[i] && (rc = eq3_instance(s, w, i, &vol, local, p, f, L, out, &sq, &nsq, err)) !=
+                          OBS_OK)
             goto done;
-        }
-        float *dst[3] = {r->ao, r->ao_short, r->ao_long};
-        for (int c = 0; c < 3; c++) {
-            double y[4] = {1.0, 0.0, 0.0, 0.0};
-            if (p->instanced_values != OBS_BAKE_IVALUES_LOCAL)
-                obs__bake_eq3_fit(m->positions, f + c * nv, L + c * nv, nv, y); /* eq 3 */
-            for (int k = 0; k < 4; k++)
-                r->global[c][k] = (float)y[k];
-            for (size_t v = 0; v < nv; v++) {
-                /* local AO times the function (section 2.2) */
-                double g = eval_g(y, m->positions + 3 * v);
-                dst[c][v] = clamp01(L[c * nv + v] * g);
-                if (c == 0) {
-                    r->ao_local[v] = (float)L[v];
-                    double e = f[v] - dst[0][v];
-                    sq += e * e;
-                    nsq++;
-                }
-            }
-        }
-        st->instanced_instances++;
-    }
     st->instanced_residual = nsq ? sqrt(sq / (double)nsq) : 0.0;
-    /* the level's _AO range again, the instances' values replaced */
-    double sum = 0.0, lo = INFINITY, hi = -INFINITY;
-    size_t cnt = 0;
-    for (size_t i = 0; i < out->instance_count; i++) {
-        size_t nv = s->meshes[out->instances[i].mesh].vertex_count;
-        for (size_t v = 0; v < nv; v++, cnt++) {
-            float a = out->instances[i].ao[v];
-            sum += a;
-            lo = fmin(lo, a);
-            hi = fmax(hi, a);
-        }
-    }
-    st->ao_mean = cnt ? sum / (double)cnt : 0.0;
-    st->ao_min = lo;
-    st->ao_max = hi;
+    ao_range(s, out);
     st->seconds[OBS_BAKE_STAGE_global] = obs__bake_now() - t;
 done:
     for (size_t m = 0; local && m < s->mesh_count; m++)
