@@ -372,13 +372,13 @@ static obs_status put_stdout(const obs_bytes *b, char err[OBS_ERR_LEN])
 }
 
 /* A PNG of `obscura ao` to its file, or to stdout under -o -. */
-static obs_status write_png_out(const ao_args *a, const char *path, const obs_image *img, int srgb,
-                                char err[OBS_ERR_LEN])
+static obs_status write_png_out(const ao_args *a, const char *path, const obs_image *img,
+                                const obs_png_options *po, char err[OBS_ERR_LEN])
 {
     if (!a->to_stdout)
-        return obs_png_write(path, img, a->req.png_bits, srgb, err);
+        return obs_png_write_ex(path, img, po, err);
     obs_bytes b = {0};
-    obs_status s = obs_png_write_mem(img, a->req.png_bits, srgb, &b, err);
+    obs_status s = obs_png_write_ex_mem(img, po, &b, err);
     if (s == OBS_OK)
         s = put_stdout(&b, err);
     obs_bytes_free(&b);
@@ -399,11 +399,12 @@ static obs_status one_png_for_stdout(const ao_args *a, int count, char err[OBS_E
  * kept (from part `part`, the one read), under --layer's names, the
  * input itself with the AO added under --append. */
 static obs_status write_exr_out(const ao_args *a, obs_exr_layer *layers, int n, const obs_camera *cam, int part,
-                                char err[OBS_ERR_LEN])
+                                const char *camera_source, char err[OBS_ERR_LEN])
 {
     obs_exr_source src = {.path = a->in_buf ? NULL : a->in, .buf = a->in_buf, .len = a->in_len, .part = part};
+    obs_provenance prov = {.params = &a->req.params, .input = a->in, .camera_source = camera_source};
     obs_exr_options o = {.pixel = a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam, .src = &src,
-                         .append = a->req.append};
+                         .append = a->req.append, .prov = &prov};
     obs_exr_names names;
     obs_status s = OBS_OK;
     if (a->req.layer && (s = obs_exr_layers_rename(layers, n, a->req.layer, &names, err)) != OBS_OK)
@@ -451,13 +452,14 @@ static obs_status count_scaled(const obs_image *count, obs_image *out)
 }
 
 static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs_camera *cam, int part,
-                                char err[OBS_ERR_LEN])
+                                const char *camera_source, char err[OBS_ERR_LEN])
 {
+    obs_provenance prov = {.params = &a->req.params, .input = a->in, .camera_source = camera_source};
     obs_status s = OBS_OK;
     if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[OBS_RESULT_LAYERS];
         int n = obs_result_exr_layers(r, layers);
-        s = write_exr_out(a, layers, n, cam, part, err);
+        s = write_exr_out(a, layers, n, cam, part, camera_source, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
         return s;
@@ -465,18 +467,21 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
     /* PNG: one file per output; NAME.ao.png, NAME.composite.png,
      * NAME.samples.png, NAME.cull.png, NAME.bleed.png, NAME.luminance.png,
      * NAME.screen.png, NAME.baked.png when there are several */
+    /* AO images take --png-transfer; data (counts, masks, factors) stays
+     * linear; colour is display-encoded */
+    enum { DATA, AO, DISPLAY };
     const struct {
         const obs_image *img;
         const char *suffix;
-        int srgb;
-    } files[] = {{&r->ao, "ao", 0},
-                 {&r->composite, "composite", 1},
-                 {&r->sample_count, "samples", 0},
-                 {&r->cull_mask, "cull", 0},
-                 {&r->bleed, "bleed", 1},
-                 {&r->luminance, "luminance", 0},
-                 {&r->ao_screen, "screen", 0},
-                 {&r->ao_baked, "baked", 0}};
+        int kind;
+    } files[] = {{&r->ao, "ao", AO},
+                 {&r->composite, "composite", DISPLAY},
+                 {&r->sample_count, "samples", DATA},
+                 {&r->cull_mask, "cull", DATA},
+                 {&r->bleed, "bleed", DISPLAY},
+                 {&r->luminance, "luminance", DATA},
+                 {&r->ao_screen, "screen", AO},
+                 {&r->ao_baked, "baked", AO}};
     int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data + !!r->cull_mask.data +
                 !!r->bleed.data + !!r->luminance.data + !!r->ao_screen.data + !!r->ao_baked.data;
     if ((s = one_png_for_stdout(a, count, err)) != OBS_OK)
@@ -499,7 +504,11 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
             }
             img = &scaled;
         }
-        s = write_png_out(a, path, img, files[k].srgb, err);
+        obs_png_options po = {.bits = a->req.png_bits,
+                              .transfer = files[k].kind == DATA ? OBS_PNG_TRANSFER_LINEAR
+                                                                : (obs_png_transfer)a->req.png_transfer,
+                              .display = files[k].kind == DISPLAY, .prov = &prov};
+        s = write_png_out(a, path, img, &po, err);
         obs_image_free(&scaled);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", path);
@@ -638,7 +647,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[3];
         int n = obs_deep_result_exr_layers(&r, a->req.outputs, layers);
-        s = write_exr_out(a, layers, n, cam, d.part, err);
+        s = write_exr_out(a, layers, n, cam, d.part, dinfo.camera_source, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
     } else {
@@ -655,7 +664,10 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
             if (!files[k].on)
                 continue;
             suffixed(a->out, files[k].suffix, path, sizeof path);
-            s = write_png_out(a, path, files[k].img, files[k].srgb, err);
+            obs_provenance prov = {.params = &a->req.params, .input = a->in, .camera_source = dinfo.camera_source};
+            obs_png_options po = {.bits = a->req.png_bits, .transfer = (obs_png_transfer)a->req.png_transfer,
+                                  .display = files[k].srgb, .prov = &prov};
+            s = write_png_out(a, path, files[k].img, &po, err);
             if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
                 fprintf(stderr, "obscura: wrote %s\n", path);
         }
@@ -707,6 +719,7 @@ static int prepare_camera(const ao_args *a, obs_gbuffer_file *gf, char err[OBS_E
         s = obs_camera_read_json(a->camera, &gf->gb.camera, &cw, &ch, err);
         if (s != OBS_OK)
             return cli_input_fail(s, a->camera, err);
+        snprintf(gf->info.camera_source, sizeof gf->info.camera_source, "camera JSON %s", a->camera);
         int dw = gf->gb.display_width > 0 ? gf->gb.display_width : gf->gb.width;
         int dh = gf->gb.display_height > 0 ? gf->gb.display_height : gf->gb.height;
         if (cw > 0 && ch > 0 && fabs((double)cw / ch - (double)dw / dh) > 1e-3)
@@ -860,7 +873,10 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
         goto done;
     double t_run = now_ms() - t0;
     t0 = now_ms();
-    s = write_outputs(a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part, err);
+    s = write_outputs(a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part,
+                      gf.info.camera_source[0] ? gf.info.camera_source
+                                               : gf.gb.camera.has_projection ? "parameters" : NULL,
+                      err);
     if (s != OBS_OK) {
         rc = cli_fail(s, a->out, err);
         goto done;

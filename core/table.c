@@ -104,6 +104,14 @@ obs_status obs_table_range_error(const obs_table *t, const obs_table_row *r, con
     if (r->type == OBS_TABLE_ENUM || (r->type == OBS_TABLE_INT && r->choices))
         return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s %s: '%s' is not one of %s", n,
                               r->name, value, r->choices);
+    /* a number outside the range says so; only text that is no number
+     * is called one */
+    double v;
+    int number = parse_number(value, 0, &v) == 0;
+    if (number && (r->type == OBS_TABLE_FLOAT || r->type == OBS_TABLE_INT) &&
+        (v < r->min || v > r->max))
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT, "%s %s: %s is outside [%g, %g]", n,
+                              r->name, value, r->min, r->max);
     switch (r->type) {
     case OBS_TABLE_INT:
         return obs_status_fail(err, OBS_INVALID_ARGUMENT,

@@ -260,15 +260,19 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
         obs_exr_names names;
         int n = exr_layers(im, &flat, &deep, layers);
         obs_exr_source src = {.buf = fp->src, .len = fp->src_len, .part = fp->src_part};
+        obs_provenance prov = {.params = &hr->params, .camera_source = fp->gf.info.camera_source};
         obs_exr_options o = {.pixel = hr->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam,
-                             .src = fp->src ? &src : NULL, .append = hr->append};
+                             .src = fp->src ? &src : NULL, .append = hr->append, .prov = &prov};
         if (hr->layer)
             s = obs_exr_layers_rename(layers, n, hr->layer, &names, err);
         if (s == OBS_OK)
             s = obs_exr_write_ex_mem(layers, n, &o, out, err);
     } else {
         const obs_image *img = obsd_fp_png_image(im);
-        s = obs_png_write_mem(img, hr->png_bits, img != im->ao, out, err);
+        obs_provenance prov = {.params = &hr->params, .camera_source = fp->gf.info.camera_source};
+        obs_png_options po = {.bits = hr->png_bits, .transfer = (obs_png_transfer)hr->png_transfer,
+                              .display = img != im->ao, .prov = &prov};
+        s = obs_png_write_ex_mem(img, &po, out, err);
     }
     fp->ms_encode = obsd_now_ms() - t0;
     obsd_stats_stage(OBSD_STAGE_ENCODE, fp->ms_encode);

@@ -25,6 +25,8 @@ static const obs_http_choice output_choices[] = {
 static const obs_http_choice format_choices[] = {
     {"exr", OBS_HTTP_EXR, ANY}, {"png", OBS_HTTP_PNG, ANY}, {NULL, 0, 0}};
 static const obs_http_choice png_bits_choices[] = {{"8", 8, ANY}, {"16", 16, ANY}, {NULL, 0, 0}};
+static const obs_http_choice png_transfer_choices[] = {
+    {"srgb", OBS_PNG_TRANSFER_SRGB, ANY}, {"linear", OBS_PNG_TRANSFER_LINEAR, ANY}, {NULL, 0, 0}};
 
 #define FIELD(f) offsetof(obs_http_request, f)
 #define SLOT(f) sizeof ((obs_http_request *)0)->f
@@ -40,6 +42,9 @@ const obs_http_option obs_http_options[] = {
      .doc = "EXR: 32-bit float channels instead of half"},
     {.name = "png_bits", .kind = OBS_HTTP_OPT_CHOICE, .field = FIELD(png_bits), .def = "8",
      .choices = png_bits_choices, .doc = "PNG bit depth"},
+    {.name = "png_transfer", .kind = OBS_HTTP_OPT_CHOICE, .field = FIELD(png_transfer), .def = "srgb",
+     .choices = png_transfer_choices,
+     .doc = "the AO PNG's transfer: sRGB-encoded and tagged, or linear values tagged linear"},
     {.name = "preset", .kind = OBS_HTTP_OPT_NAMES, .field = FIELD(preset), .def = "auto",
      .names = obs_channel_presets, .min = 1, .max = 1, .slot = SLOT(preset), .map = FIELD(map.preset),
      .doc = "channel-name preset of the G-buffer"},

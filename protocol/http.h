@@ -29,6 +29,7 @@ typedef struct obs_http_request {
     obs_http_format format; /* default EXR */
     int float_exr;          /* EXR: 32-bit float channels (default half) */
     int png_bits;           /* 8 (default) or 16 */
+    int png_transfer;       /* obs_png_transfer of the AO PNG: sRGB (default) or linear */
     int strict;             /* sanity warnings on the input are errors */
     int solve_camera;       /* no camera: solve it from the position pass */
     obs_channel_map map;    /* points into the buffers below */

@@ -60,15 +60,11 @@ check "the input's chromaticities carried over" \
     '[ "$(attr "$T/ao.exr" chromaticities)" = "0.708, 0.292, 0.17, 0.797, 0.131, 0.046, 0.3127, 0.329" ]'
 # method, params, input and camera_source come from the caller (the CLI's
 # and the daemon's call sites pass obs_provenance)
-if [ -n "$(attr "$T/ao.exr" obscura/method)" ]; then
-    check "obscura/method hbao" '[ "$(attr "$T/ao.exr" obscura/method)" = hbao ]'
-    check "obscura/params: the non-default parameters" \
-        'attr "$T/ao.exr" obscura/params | grep -q "^method=hbao.* hbao_steps=8"'
-    check "obscura/input names the input" '[ "$(attr "$T/ao.exr" obscura/input)" = "$T/in.exr" ]'
-    check "obscura/camera_source says where the camera came from" '[ -n "$(attr "$T/ao.exr" obscura/camera_source)" ]'
-else
-    echo "  SKIP obscura/method, params, input, camera_source: the CLI does not pass obs_provenance yet"
-fi
+check "obscura/method hbao" '[ "$(attr "$T/ao.exr" obscura/method)" = hbao ]'
+check "obscura/params: the non-default parameters" \
+    'attr "$T/ao.exr" obscura/params | grep -q "^method=hbao.* hbao_steps=8"'
+check "obscura/input names the input" '[ "$(attr "$T/ao.exr" obscura/input)" = "$T/in.exr" ]'
+check "obscura/camera_source says where the camera came from" '[ -n "$(attr "$T/ao.exr" obscura/camera_source)" ]'
 
 echo "-- PNG: provenance text, transfer tags read right by oiiotool"
 "$OBSCURA" ao "$R" --camera "$CAMJ" --float -q -o "$T/ref.exr" --output both
@@ -79,6 +75,10 @@ check "AO PNG: a transfer tag (sRGB, or gAMA and cICP for linear)" \
     'chunks "$T/p.ao.png" | grep -qx sRGB || { chunks "$T/p.ao.png" | grep -qx gAMA && chunks "$T/p.ao.png" | grep -qx cICP; }'
 check "AO PNG read by oiiotool's default (oiio:ColorSpace $(attr "$T/p.ao.png" oiio:ColorSpace)) equals the AO" \
     'reads_as "$T/p.ao.png" Y "$T/ref.exr" AO.Y'
+"$OBSCURA" ao "$R" --camera "$CAMJ" --png-transfer linear -q -o "$T/lin.png"
+check "--png-transfer linear: gAMA and cICP, read as linear, equals the AO" \
+    'chunks "$T/lin.png" | grep -qx gAMA && chunks "$T/lin.png" | grep -qx cICP && [ "$(attr "$T/lin.png" oiio:ColorSpace)" = linear ] && reads_as "$T/lin.png" Y "$T/ref.exr" AO.Y'
+check "AO PNG by default: the sRGB chunk (--png-transfer srgb)" 'chunks "$T/p.ao.png" | grep -qx sRGB'
 check "composite PNG: sRGB chunk, read as sRGB" \
     'chunks "$T/p.composite.png" | grep -qx sRGB && [ "$(attr "$T/p.composite.png" oiio:ColorSpace)" = sRGB ]'
 check "composite PNG read by oiiotool's default equals the composite" \

@@ -59,7 +59,11 @@ static void test_errors_name_the_parameter(void **state)
     assert_int_equal(obs_param_set(&p, "samples", "3.5", err), OBS_INVALID_ARGUMENT);
     assert_int_equal(obs_param_set(&p, "radius", "abc", err), OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "radius"));
+    assert_non_null(strstr(err, "'abc' is not a number"));
     assert_int_equal(obs_param_set(&p, "radius", "-1", err), OBS_INVALID_ARGUMENT);
+    /* a number out of range reads as one: "500 is outside [0, 179]" */
+    assert_int_equal(obs_param_set(&p, "fov_y", "500", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "fov_y: 500 is outside [0, 179]"));
     assert_int_equal(obs_param_set(&p, "radius", "nan", err), OBS_INVALID_ARGUMENT);
     assert_int_equal(obs_param_set(&p, "radius", "1e999", err), OBS_INVALID_ARGUMENT);
     assert_int_equal(obs_param_set(&p, "depth_mode", "linear", err), OBS_INVALID_ARGUMENT);
