@@ -395,14 +395,24 @@ static obs_status one_png_for_stdout(const ao_args *a, int count, char err[OBS_E
     return OBS_INVALID_ARGUMENT;
 }
 
+/* What every output says of its making: the version (the writers add it),
+ * the method and the non-default parameters.  The input's path and the
+ * camera's source are left out on purpose: one frame run in process or
+ * through any transport gives the same bytes, which the daemon could not
+ * keep with a path only the CLI knows. */
+static obs_provenance provenance_of(const ao_args *a)
+{
+    return (obs_provenance){.params = &a->req.params};
+}
+
 /* An EXR of `obscura ao`: the input's windows and header attributes
  * kept (from part `part`, the one read), under --layer's names, the
  * input itself with the AO added under --append. */
 static obs_status write_exr_out(const ao_args *a, obs_exr_layer *layers, int n, const obs_camera *cam, int part,
-                                const char *camera_source, char err[OBS_ERR_LEN])
+                                char err[OBS_ERR_LEN])
 {
     obs_exr_source src = {.path = a->in_buf ? NULL : a->in, .buf = a->in_buf, .len = a->in_len, .part = part};
-    obs_provenance prov = {.params = &a->req.params, .input = a->in, .camera_source = camera_source};
+    obs_provenance prov = provenance_of(a);
     obs_exr_options o = {.pixel = a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam, .src = &src,
                          .append = a->req.append, .prov = &prov};
     obs_exr_names names;
@@ -452,14 +462,14 @@ static obs_status count_scaled(const obs_image *count, obs_image *out)
 }
 
 static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs_camera *cam, int part,
-                                const char *camera_source, char err[OBS_ERR_LEN])
+                                char err[OBS_ERR_LEN])
 {
-    obs_provenance prov = {.params = &a->req.params, .input = a->in, .camera_source = camera_source};
+    obs_provenance prov = provenance_of(a);
     obs_status s = OBS_OK;
     if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[OBS_RESULT_LAYERS];
         int n = obs_result_exr_layers(r, layers);
-        s = write_exr_out(a, layers, n, cam, part, camera_source, err);
+        s = write_exr_out(a, layers, n, cam, part, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
         return s;
@@ -647,7 +657,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[3];
         int n = obs_deep_result_exr_layers(&r, a->req.outputs, layers);
-        s = write_exr_out(a, layers, n, cam, d.part, dinfo.camera_source, err);
+        s = write_exr_out(a, layers, n, cam, d.part, err);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
     } else {
@@ -664,7 +674,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
             if (!files[k].on)
                 continue;
             suffixed(a->out, files[k].suffix, path, sizeof path);
-            obs_provenance prov = {.params = &a->req.params, .input = a->in, .camera_source = dinfo.camera_source};
+            obs_provenance prov = provenance_of(a);
             obs_png_options po = {.bits = a->req.png_bits, .transfer = (obs_png_transfer)a->req.png_transfer,
                                   .display = files[k].srgb, .prov = &prov};
             s = write_png_out(a, path, files[k].img, &po, err);
@@ -719,7 +729,6 @@ static int prepare_camera(const ao_args *a, obs_gbuffer_file *gf, char err[OBS_E
         s = obs_camera_read_json(a->camera, &gf->gb.camera, &cw, &ch, err);
         if (s != OBS_OK)
             return cli_input_fail(s, a->camera, err);
-        snprintf(gf->info.camera_source, sizeof gf->info.camera_source, "camera JSON %s", a->camera);
         int dw = gf->gb.display_width > 0 ? gf->gb.display_width : gf->gb.width;
         int dh = gf->gb.display_height > 0 ? gf->gb.display_height : gf->gb.height;
         if (cw > 0 && ch > 0 && fabs((double)cw / ch - (double)dw / dh) > 1e-3)
@@ -873,10 +882,7 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
         goto done;
     double t_run = now_ms() - t0;
     t0 = now_ms();
-    s = write_outputs(a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part,
-                      gf.info.camera_source[0] ? gf.info.camera_source
-                                               : gf.gb.camera.has_projection ? "parameters" : NULL,
-                      err);
+    s = write_outputs(a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part, err);
     if (s != OBS_OK) {
         rc = cli_fail(s, a->out, err);
         goto done;

@@ -260,7 +260,7 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
         obs_exr_names names;
         int n = exr_layers(im, &flat, &deep, layers);
         obs_exr_source src = {.buf = fp->src, .len = fp->src_len, .part = fp->src_part};
-        obs_provenance prov = {.params = &hr->params, .camera_source = fp->gf.info.camera_source};
+        obs_provenance prov = {.params = &hr->params}; /* the CLI's keys: clients/obscura.c provenance_of */
         obs_exr_options o = {.pixel = hr->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam,
                              .src = fp->src ? &src : NULL, .append = hr->append, .prov = &prov};
         if (hr->layer)
@@ -269,7 +269,7 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
             s = obs_exr_write_ex_mem(layers, n, &o, out, err);
     } else {
         const obs_image *img = obsd_fp_png_image(im);
-        obs_provenance prov = {.params = &hr->params, .camera_source = fp->gf.info.camera_source};
+        obs_provenance prov = {.params = &hr->params}; /* the CLI's keys: clients/obscura.c provenance_of */
         obs_png_options po = {.bits = hr->png_bits, .transfer = (obs_png_transfer)hr->png_transfer,
                               .display = img != im->ao, .prov = &prov};
         s = obs_png_write_ex_mem(img, &po, out, err);

@@ -118,10 +118,8 @@ check "deep input with --append: refused (exit $rc): $(head -c 100 "$T/err")" \
 cp "$T/crop.exr" "$T/inplace.exr"
 "$OBSCURA" ao "$T/inplace.exr" --camera "$CAMJ" --cpu --radius 0.05 -q --append --layer occ -o "$T/inplace.exr"
 rc=$?
-# the same file but for obscura/input, which names each run's own input
-hdr() { oiiotool --info -v "$1" | grep -v 'obscura/input\|^[^ ]'; }
 check "--append onto the input itself (-o the same file): exit $rc, the same file as to another path" \
-    "[ $rc -eq 0 ] && oiiotool -q '$T/inplace.exr' '$T/app.exr' --diff --fail 0 >/dev/null 2>&1 && [ \"\$(hdr '$T/inplace.exr')\" = \"\$(hdr '$T/app.exr')\" ]"
+    "[ $rc -eq 0 ] && cmp -s '$T/inplace.exr' '$T/app.exr'"
 # a multi-part input: every part kept, the AO in the part read
 oiiotool "$T/crop.exr" --ch ViewLayer.Combined.R,ViewLayer.Combined.G,ViewLayer.Combined.B "$T/crop.exr" \
     --ch ViewLayer.Depth.Z,ViewLayer.Normal.X,ViewLayer.Normal.Y,ViewLayer.Normal.Z --siappend -o "$T/multi.exr" 2>/dev/null
