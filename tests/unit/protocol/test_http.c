@@ -123,7 +123,7 @@ static void test_option_table(void **state)
         assert_int_equal(obs_http_option_set(&r, op, op->def, OBS_HTTP_QUERY, err), OBS_OK);
         assert_memory_equal(&r, &d, sizeof r);
     }
-    assert_int_equal(rows, 15);
+    assert_int_equal(rows, 16);
     assert_ptr_equal(obs_http_option_find("png-bits"), obs_http_option_find("png_bits"));
     assert_null(obs_http_option_find("radius"));
     assert_null(obs_http_option_find(NULL));
@@ -243,6 +243,7 @@ static void test_json(void **state)
         const char *name, *type, *choices;
     } want[] = {{"output", "enum", "ao|composite|both"}, {"format", "enum", "exr|png"},
                 {"float", "bool", "0|1"},                {"png_bits", "enum", "8|16"},
+                {"png_transfer", "enum", "srgb|linear"},
                 {"preset", "enum", "auto|blender|generic|arnold|vray|renderman|redshift|karma|mantra|octane|nuke"},
                 {"depth", "string", NULL},
                 {"normal", "string", NULL},              {"color", "string", NULL},
@@ -251,8 +252,8 @@ static void test_json(void **state)
                 {"layer", "string", NULL},               {"append", "bool", "0|1"},
                 {"baked", "string", NULL}};
     cJSON *opts = cJSON_GetObjectItem(j, "options");
-    assert_int_equal(cJSON_GetArraySize(opts), 15);
-    for (int i = 0; i < 15; i++) {
+    assert_int_equal(cJSON_GetArraySize(opts), 16);
+    for (int i = 0; i < 16; i++) {
         cJSON *o = cJSON_GetArrayItem(opts, i), *c = cJSON_GetObjectItem(o, "choices"), *it;
         char got[128] = "";
         assert_string_equal(cJSON_GetObjectItem(o, "name")->valuestring, want[i].name);
