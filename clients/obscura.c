@@ -567,39 +567,40 @@ static void log_programs(const obs_ctx *ctx)
  * A-buffer.  Outputs: AO.Y, the per-node AO blended by alpha; AOFront.Y,
  * the front node's AO; R,G,B,A, the front-to-back composite times AO.Y
  * (premultiplied).  PNG: NAME.ao.png, NAME.front.png, NAME.composite.png. */
-/* Prints the reader's sanity warnings; with --strict they fail the
- * frame (exit 3). */
-static int cli_input_warnings(const char *in, const obs_exr_info *info, int strict)
+/* Prints info's sanity warnings from index `from` on (escaped); with
+ * --strict they fail the frame (exit 3) and `then` says what was not
+ * done. */
+static int cli_warnings_from(const char *in, const obs_exr_info *info, int from, int strict,
+                             const char *then)
 {
     char shown[2 * OBS_ERR_LEN];
-    for (int i = 0; i < info->warning_count; i++) {
+    for (int i = from; i < info->warning_count; i++) {
         cli_escape(info->warnings[i], shown, sizeof shown); /* a header's bytes, not the terminal's */
         fprintf(stderr, "obscura: %s: %s: %s\n", strict ? "error" : "warning", in, shown);
     }
-    if (strict && info->warning_count > 0) {
-        fprintf(stderr, "obscura: error: %s: %d sanity warning%s and --strict: not computed\n", in,
-                info->warning_count, info->warning_count == 1 ? "" : "s");
+    int n = info->warning_count - from;
+    if (strict && n > 0) {
+        fprintf(stderr, "obscura: error: %s: %d sanity warning%s and --strict: %s\n", in, n,
+                n == 1 ? "" : "s", then);
         return EXIT_BADINPUT;
     }
     return EXIT_OK;
 }
 
+static int cli_input_warnings(const char *in, const obs_exr_info *info, int strict)
+{
+    return cli_warnings_from(in, info, 0, strict, "not computed");
+}
+
 /* The check after the run (obs_result_sanity: AO near 1 everywhere):
- * a warning, or with --strict an error and nothing written. */
+ * printed as the input's are, with --strict an error and nothing
+ * written. */
 static int cli_result_warnings(const ao_args *a, const obs_image *ao, const obs_gbuffer *gb,
                                const obs_deep_image *deep, obs_exr_info *info)
 {
-    int k = info->warning_count;
-    if (!obs_result_sanity(ao, gb, deep, &a->req.params, info))
-        return EXIT_OK;
-    char shown[OBS_ERR_LEN];
-    cli_escape(info->warnings[k], shown, sizeof shown);
-    fprintf(stderr, "obscura: %s: %s: %s\n", a->req.strict ? "error" : "warning", a->in, shown);
-    if (!a->req.strict)
-        return EXIT_OK;
-    fprintf(stderr, "obscura: error: %s: a sanity warning on the result and --strict: not written\n",
-            a->in);
-    return EXIT_BADINPUT;
+    int from = info->warning_count;
+    obs_result_sanity(ao, gb, deep, &a->req.params, info);
+    return cli_warnings_from(a->in, info, from, a->req.strict, "not written");
 }
 
 static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server, int argc, char **argv)
