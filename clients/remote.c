@@ -442,8 +442,9 @@ static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs
     return ao ? exr_images(body, len, "AOFront.Y", &d->ao_front, NULL, msg, msg_len) : 0;
 }
 
-static int http_once(const server_addr *a, const char *query, const unsigned char *body, size_t body_len,
-                     unsigned outputs, answer *res, int *retry_after, char *msg, size_t msg_len)
+/* POSTs the frame to /v1/ao, or with `stream` to /v1/streams/STREAM/frames. */
+static int http_once(const server_addr *a, const char *stream, const char *query, const unsigned char *body,
+                     size_t body_len, unsigned outputs, answer *res, int *retry_after, char *msg, size_t msg_len)
 {
     int fd = connect_to(a, msg, msg_len);
     if (fd < 0)
@@ -457,8 +458,8 @@ static int http_once(const server_addr *a, const char *query, const unsigned cha
     if (!head)
         goto done;
     char path[96] = "/v1/ao";
-    if (stream_name)
-        snprintf(path, sizeof path, "/v1/streams/%s/frames", stream_name);
+    if (stream)
+        snprintf(path, sizeof path, "/v1/streams/%s/frames", stream);
     const int v6 = strchr(a->host, ':') != NULL; /* Host: [::1]:PORT */
     snprintf(head, hcap, "POST %s?%s HTTP/1.1\r\nHost: %s%s%s:%s\r\nContent-Type: image/x-exr\r\n"
              "Content-Length: %zu\r\nConnection: close\r\n%s%s%s\r\n", path, query, v6 ? "[" : "",
@@ -547,6 +548,16 @@ static void camera_params(const obs_gbuffer *gb, pairs *ps, char *buf, size_t le
 }
 
 /* ---- the run -------------------------------------------------------------- */
+
+/* A stream post's failure that POST /v1/ao of the same server may not
+ * share (no stream route or streams off: 404, 405; a daemon that keeps no
+ * deep frames: 415; no memory to keep it: 500; anything unforeseen); not
+ * the frame's own errors (400, 401, 413, 422: /v1/ao would say the same)
+ * nor busy or unreachable (503, -1: already retried). */
+static int stream_refused(int status)
+{
+    return status > 0 && status != 400 && status != 401 && status != 413 && status != 422 && status != 503;
+}
 
 static void sleep_s(int s)
 {
@@ -637,10 +648,6 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
                 "(or a comma-separated list of up to %d of them)\n", server, CLI_REMOTE_MAX_SERVERS);
         return RC_USAGE;
     }
-    if (stream_name && deep) {
-        fprintf(stderr, "obscura: error: --stream: streams keep flat frames, not deep input\n");
-        return RC_USAGE;
-    }
     if (stream_name && any_bin) {
         fprintf(stderr, "obscura: error: --stream needs http:// servers (streams are an HTTP feature)\n");
         return RC_USAGE;
@@ -713,7 +720,8 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
                 tried++;
                 answer_free(out);
                 last = addrs[k].kind == PROTO_HTTP
-                           ? http_once(&addrs[k], query, body, body_len, outputs, out, &wait, msg, sizeof msg)
+                           ? http_once(&addrs[k], stream_name, query, body, body_len, outputs, out, &wait, msg,
+                                       sizeof msg)
                            : binary_once(&addrs[k], &frame, out, &wait, msg, sizeof msg);
                 k_last = k;
                 if (last != -1 && last != 503)
@@ -733,6 +741,15 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
     }
 answered:
     rc = last;
+    if (stream_name && stream_refused(rc)) {
+        /* the stream is only a preview: the frame runs once more, on
+         * /v1/ao of the server that answered, so that its result is not lost */
+        fprintf(stderr, "obscura: warning: --stream %s: the stream post failed (%s); the result comes from "
+                "POST /v1/ao and is written, but the frame is not in the stream\n", stream_name, msg);
+        answer_free(out);
+        int wait = 0;
+        rc = http_once(&addrs[k_last], NULL, query, body, body_len, outputs, out, &wait, msg, sizeof msg);
+    }
     free(query);
     free(body);
     obs_bytes_free(&frame);

@@ -97,11 +97,12 @@ typedef struct obsd__frame_req {
     obs_http_request hr;
     obsd_fp fp;          /* the frame: its input, job, result and stage times */
     int before_drain;    /* started before SIGTERM: finished in the drain */
-    int kept;            /* a stream's frame: flat input only; its body and query are kept with it */
-    int view;            /* a kept frame's GET: exposure and output=color view it, other parameters re-run it */
+    int kept;            /* a stream's frame (flat or deep): its body and query are kept with it */
+    int view;            /* a kept frame's GET: exposure, output=color|ao_front view it, other parameters re-run it */
     char *query;         /* kept: the query as "name\0value\0" pairs */
     size_t query_len, query_cap;
     int want_color;      /* output=color */
+    int want_front;      /* output=ao_front: a deep frame's front layer's AO */
     int rerun;           /* view with parameters: run the frame again */
     double exposure;     /* stops applied to colour PNGs */
 } obsd__frame_req;
