@@ -180,6 +180,12 @@ static const char exit_codes[] =
     "\nexit codes: 0 ok, 1 failure, 2 usage, 3 bad input (batch: also a missing frame, or\n"
     "nothing written), 4 server unreachable or busy\n";
 
+/* Every command but params and samples takes --threads (main: cli_take_threads). */
+static const char threads_note[] =
+    "\n--threads N (or OBSCURA_THREADS), on every command but params and samples: the threads\n"
+    "this process may run, 1..64 (default every core): llvmpipe's (LP_NUM_THREADS, unless set)\n"
+    "and every worker pool's (the bakes' threads parameter is the same setting)\n";
+
 static void usage(FILE *f)
 {
     fprintf(f, "obscura %s: ambient occlusion for G-buffer EXRs (VAO on OpenGL)\n\nusage:\n", OBS_VERSION);
@@ -190,6 +196,7 @@ static void usage(FILE *f)
     cli_bake_usage(f);
     cli_dynamic_usage(f);
     usage_ao_options(f);
+    fputs(threads_note, f);
     fputs(exit_codes, f);
 }
 
@@ -202,7 +209,9 @@ static int usage_of(FILE *f, const char *cmd)
         if (!strcmp(cmd, usage_lines[i].cmd)) {
             fputs(usage_lines[i].text, f);
             if (!strcmp(cmd, "ao") || !strcmp(cmd, "batch"))
-                usage_ao_options(f);
+                usage_ao_options(f); /* --threads is one of them */
+            else if (strcmp(cmd, "params") && strcmp(cmd, "samples"))
+                fputs(threads_note, f);
             fputs(exit_codes, f);
             return 1;
         }
@@ -216,6 +225,7 @@ static int usage_of(FILE *f, const char *cmd)
         cli_dynamic_usage(f);
     else
         return 0;
+    fputs(threads_note, f);
     fputs(exit_codes, f);
     return 1;
 }

@@ -73,6 +73,8 @@ expect 0 "ao --threads 2, PNG" -- "$OBSCURA" ao "$R" --camera "$CAMF" -o "$T/p2.
 check "ao: the same PNG bytes" "cmp -s $T/p1.png $T/p2.png"
 expect 0 "ao --help names --threads" -- "$OBSCURA" ao --help
 said "--threads N"
+expect 0 "bake --help names --threads" -- "$OBSCURA" bake --help
+said "^--threads N (or OBSCURA_THREADS)"
 expect 2 "ao --thread 2: unknown" -- "$OBSCURA" ao "$R" -o "$T/x.exr" --thread 2
 said "did you mean --threads?"
 
