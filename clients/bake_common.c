@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "obscura/dynamic.h"
+#include "obscura/obscura.h"
 
 /* The tables' own functions take their own struct: these pass it on. */
 static obs_status bake_set(void *p, const char *name, const char *value, char err[OBS_ERR_LEN])
@@ -96,6 +97,14 @@ static int take_value(const cli_bake_cmd *c, const char *key, const char *val, c
 int cli_bake_parse(const cli_bake_cmd *c, int argc, char **argv, cli_bake_args *a)
 {
     *a = (cli_bake_args){.shard = -1};
+    /* --threads (main took it: cli_take_threads) is the table's threads
+     * parameter too, so the report says the count that ran */
+    obs_threads_info ti;
+    obs_threads_get(&ti);
+    char tv[16], terr[OBS_ERR_LEN];
+    snprintf(tv, sizeof tv, "%d", ti.limit);
+    if (ti.limit && c->table->find("threads") && c->table->set(c->params, "threads", tv, terr) != OBS_OK)
+        cli_die_usage(c->name, "%s", terr);
     int merging = 0;
     a->parts = calloc((size_t)argc + 1, sizeof *a->parts);
     if (!a->parts)

@@ -1,12 +1,16 @@
 /* What the CLI's commands share: see cli.h. */
 #include "cli.h"
 
+#include <dirent.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
 #include <string.h>
 #include <errno.h>
+
+#include "flags.h"
+#include "obscura/obscura.h"
 
 int cli_status_exit(obs_status s)
 {
@@ -186,3 +190,57 @@ obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
+
+/* A thread count as the user wrote it: digits only, in [1, 64]; else -1. */
+static int threads_value(const char *v)
+{
+    char *end;
+    errno = 0;
+    long n = strtol(v, &end, 10);
+    if (!*v || *end || errno || v[0] == '+' || v[0] == ' ' || n < 1 || n > 64)
+        return -1;
+    return (int)n;
+}
+
+int cli_take_threads(const char *cmd, int argc, char **argv)
+{
+    const char *given = NULL, *from = "--threads", *v;
+    int n = 0;
+    for (int i = 0; i < argc; i++) {
+        int k = cli_flag_value(argc, argv, &i, "threads", &v);
+        if (k < 0)
+            cli_die_usage(cmd, "option --threads needs a value (a whole number in [1, 64])");
+        if (k > 0)
+            given = v;
+        else
+            argv[n++] = argv[i];
+    }
+    if (!given) {
+        given = getenv("OBSCURA_THREADS");
+        from = "OBSCURA_THREADS";
+        if (!given || !*given) /* set empty: as unset, as OBSCURA_BACKEND */
+            return n;
+    }
+    char shown[64], err[OBS_ERR_LEN];
+    int t = threads_value(given);
+    cli_escape(given, shown, sizeof shown);
+    if (t < 0)
+        cli_die_usage(cmd, "%s: '%s' is not a whole number in [1, 64] (the threads this process may "
+                      "run: llvmpipe's and every worker pool's)", from, shown);
+    if (obs_threads_set(t, err) != OBS_OK)
+        cli_die_usage(cmd, "%s: %s", from, err);
+    return n;
+}
+
+int cli_process_threads(void)
+{
+    DIR *d = opendir("/proc/self/task");
+    struct dirent *e;
+    int n = 0;
+    if (!d)
+        return -1;
+    while ((e = readdir(d)))
+        n += e->d_name[0] != '.';
+    closedir(d);
+    return n;
+}

@@ -45,6 +45,16 @@ int cli_edit_distance(const char *a, const char *b);
  * OpenCue's progress parsers read) when N differs from *last. */
 void cli_progress_percent(int *last, long done, long total);
 
+/* --threads N (else OBSCURA_THREADS) of a command that renders, bakes or
+ * reads: taken out of argv (the new argc returned) and made the process's
+ * thread limit (obs_threads_set: every worker pool and llvmpipe's
+ * LP_NUM_THREADS, unless the user set that).  N is a whole number in
+ * [1, 64]; anything else is a usage error of cmd (exit 2). */
+int cli_take_threads(const char *cmd, int argc, char **argv);
+
+/* The threads this process runs now (/proc/self/task); -1 unknown. */
+int cli_process_threads(void);
+
 /* Seconds of CLOCK_MONOTONIC (progress, stage times). */
 double cli_now_s(void);
 /* --shard I/N of obscura bake and bake-dynamic: 0 <= I < N <= 10^6, else

@@ -106,6 +106,8 @@ static const cli_opt ao_opts[] = {
     {"cache-dir", "DIR", "program cache folder (or OBSCURA_CACHE_DIR; default "
      "$XDG_CACHE_HOME/obscura, else ~/.cache/obscura; '': none)"},
     {"cpu", NULL, "run the CPU twin instead of OpenGL (slow; for reference)"},
+    {"threads", "N", "the threads this process may run, 1..64 (or OBSCURA_THREADS; default every "
+     "core): llvmpipe's (LP_NUM_THREADS, unless set) and every worker pool's"},
     {"server", "URL[,URL...]", "run on obscurad: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT; a "
      "comma list spreads frames over several (the next one when one is busy or down)"},
     {"stream", "NAME", "with an http:// --server: post the frame to the daemon's stream NAME too "
@@ -131,7 +133,7 @@ static const struct {
     {"inspect", "  obscura inspect IN.exr [--json] [--preset P] [--depth-mode M] ...\n"
                 "                  what obscura reads: renderer, channels, camera and its source,\n"
                 "                  conventions, windows, part, sanity warnings\n"},
-    {"info", "  obscura info [--backend B]\n"},
+    {"info", "  obscura info [--backend B] [--threads N]\n"},
     {"params", "  obscura params [--markdown]\n"},
     {"samples", "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as "
                 "core/chain/sample_tables.c\n"},
@@ -178,6 +180,12 @@ static const char exit_codes[] =
     "\nexit codes: 0 ok, 1 failure, 2 usage, 3 bad input (batch: also a missing frame, or\n"
     "nothing written), 4 server unreachable or busy\n";
 
+/* Every command but params and samples takes --threads (main: cli_take_threads). */
+static const char threads_note[] =
+    "\n--threads N (or OBSCURA_THREADS), on every command but params and samples: the threads\n"
+    "this process may run, 1..64 (default every core): llvmpipe's (LP_NUM_THREADS, unless set)\n"
+    "and every worker pool's (the bakes' threads parameter is the same setting)\n";
+
 static void usage(FILE *f)
 {
     fprintf(f, "obscura %s: ambient occlusion for G-buffer EXRs (VAO on OpenGL)\n\nusage:\n", OBS_VERSION);
@@ -188,6 +196,7 @@ static void usage(FILE *f)
     cli_bake_usage(f);
     cli_dynamic_usage(f);
     usage_ao_options(f);
+    fputs(threads_note, f);
     fputs(exit_codes, f);
 }
 
@@ -200,7 +209,9 @@ static int usage_of(FILE *f, const char *cmd)
         if (!strcmp(cmd, usage_lines[i].cmd)) {
             fputs(usage_lines[i].text, f);
             if (!strcmp(cmd, "ao") || !strcmp(cmd, "batch"))
-                usage_ao_options(f);
+                usage_ao_options(f); /* --threads is one of them */
+            else if (strcmp(cmd, "params") && strcmp(cmd, "samples"))
+                fputs(threads_note, f);
             fputs(exit_codes, f);
             return 1;
         }
@@ -214,6 +225,7 @@ static int usage_of(FILE *f, const char *cmd)
         cli_dynamic_usage(f);
     else
         return 0;
+    fputs(threads_note, f);
     fputs(exit_codes, f);
     return 1;
 }
@@ -796,6 +808,9 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
         *t0 = now_ms();
         s = obs_run(*ctx, &gf->gb, &a->req.params, outputs, res, err);
         log_programs(*ctx);
+        if (verbosity >= OBS_LOG_DEBUG) /* tests/e2e/threads.sh reads it */
+            fprintf(stderr, "obscura: debug: threads: %d in this process after the frame\n",
+                    cli_process_threads());
     }
     return s == OBS_OK ? EXIT_OK : cli_fail(s, a->in, err);
 }
@@ -978,6 +993,26 @@ static void batch_finish(void)
     kept_ctx = NULL;
 }
 
+/* info's thread lines: the limit, llvmpipe's count and where it came
+ * from, and the threads running now that the context exists. */
+static void print_threads(int llvmpipe)
+{
+    obs_threads_info ti;
+    obs_threads_get(&ti);
+    if (ti.limit)
+        printf("threads: %d (--threads or OBSCURA_THREADS)\n", ti.limit);
+    else
+        printf("threads: every core (%d; --threads N or OBSCURA_THREADS bounds them)\n", ti.pool);
+    if (!llvmpipe)
+        printf("llvmpipe threads: not in use\n");
+    else if (ti.llvmpipe < 0)
+        printf("llvmpipe threads: one per core (LP_NUM_THREADS unset)\n");
+    else
+        printf("llvmpipe threads: %d (LP_NUM_THREADS %s)\n", ti.llvmpipe,
+               ti.llvmpipe_from_user ? "from the environment, kept" : "set from --threads");
+    printf("process threads: %d\n", cli_process_threads());
+}
+
 static int cmd_info(int argc, char **argv)
 {
     const char *backend = NULL, *cache = NULL, *v;
@@ -1003,6 +1038,7 @@ static int cmd_info(int argc, char **argv)
            obs_backend_name(info.backend), info.gl_version, info.gl_vendor, info.gl_renderer);
     printf("program cache: %s%s\n", info.cache_dir ? info.cache_dir : "off",
            !info.cache_dir ? "" : info.cache_writable ? "" : " (read-only)");
+    print_threads(strstr(info.gl_renderer, "llvmpipe") != NULL);
     obs_ctx_destroy(ctx);
     return EXIT_OK;
 }
@@ -1296,19 +1332,20 @@ static int cmd_batch(int argc, char **argv)
 static const struct {
     const char *name;
     int (*run)(int argc, char **argv);
+    int threads; /* takes --threads (cli_take_threads): it renders, bakes or reads images */
 } commands[] = {
-    {"ao", cmd_ao},
-    {"inspect", cli_inspect},
-    {"compare", cmd_compare},
-    {"info", cmd_info},
-    {"params", cmd_params},
-    {"samples", cmd_samples},
-    {"gbuffer", cli_gbuffer},
-    {"reference", cli_reference},
-    {"warmup", cli_warmup},
-    {"bake", cli_bake},
-    {"bake-dynamic", cli_dynamic},
-    {"batch", cmd_batch},
+    {"ao", cmd_ao, 1},
+    {"inspect", cli_inspect, 1},
+    {"compare", cmd_compare, 1},
+    {"info", cmd_info, 1},
+    {"params", cmd_params, 0},
+    {"samples", cmd_samples, 0},
+    {"gbuffer", cli_gbuffer, 1},
+    {"reference", cli_reference, 1},
+    {"warmup", cli_warmup, 1},
+    {"bake", cli_bake, 1},
+    {"bake-dynamic", cli_dynamic, 1},
+    {"batch", cmd_batch, 1},
 };
 
 int main(int argc, char **argv)
@@ -1322,8 +1359,11 @@ int main(int argc, char **argv)
         if ((!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) && usage_of(stdout, cmd))
             return EXIT_OK;
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
-        if (!strcmp(cmd, commands[i].name))
-            return commands[i].run(argc - 2, argv + 2);
+        if (!strcmp(cmd, commands[i].name)) {
+            /* before any context or thread: it may set LP_NUM_THREADS */
+            int n = commands[i].threads ? cli_take_threads(cmd, argc - 2, argv + 2) : argc - 2;
+            return commands[i].run(n, argv + 2);
+        }
     if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
         usage(stdout);
         return EXIT_OK;

@@ -22,6 +22,7 @@
 
 #include "level/occl.h"
 #include "internal.h"
+#include "pool.h"
 
 /* The ray context the callbacks see: Embree's, then the sums, one per
  * ray of a packet of 8, by the ray's id (Embree may hand a callback the
@@ -322,7 +323,8 @@ obs_status obs__bake_occl_new(const obs__bake_world *w, const obs__bake_decor *d
     if (!o)
         return obs__fail(err, OBS_NO_MEMORY, "BVH");
     o->log_keep = tree_attenuation >= 1.0f ? -INFINITY : log1p(-(double)tree_attenuation);
-    if (!(o->dev = rtcNewDevice(NULL))) {
+    char embree_cfg[32];
+    if (!(o->dev = rtcNewDevice(obs__pool_embree_config(embree_cfg)))) {
         free(o);
         return obs__fail(err, OBS_UNSUPPORTED, "Embree: no device (error %d)",
                          (int)rtcGetDeviceError(NULL));
