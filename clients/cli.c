@@ -191,13 +191,14 @@ obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN])
 }
 
 
-/* A thread count as the user wrote it: digits only, in [1, 64]; else -1. */
+/* A thread count as the user wrote it: digits only, in [0, 64] (0: every
+ * core, the bakes' threads parameter's meaning); else -1. */
 static int threads_value(const char *v)
 {
     char *end;
     errno = 0;
     long n = strtol(v, &end, 10);
-    if (!*v || *end || errno || v[0] == '+' || v[0] == ' ' || n < 1 || n > 64)
+    if (!*v || *end || errno || v[0] == '+' || v[0] == ' ' || n < 0 || n > 64)
         return -1;
     return (int)n;
 }
@@ -209,7 +210,7 @@ int cli_take_threads(const char *cmd, int argc, char **argv)
     for (int i = 0; i < argc; i++) {
         int k = cli_flag_value(argc, argv, &i, "threads", &v);
         if (k < 0)
-            cli_die_usage(cmd, "option --threads needs a value (a whole number in [1, 64])");
+            cli_die_usage(cmd, "option --threads needs a value (a whole number in [0, 64], 0: every core)");
         if (k > 0)
             given = v;
         else
@@ -225,8 +226,8 @@ int cli_take_threads(const char *cmd, int argc, char **argv)
     int t = threads_value(given);
     cli_escape(given, shown, sizeof shown);
     if (t < 0)
-        cli_die_usage(cmd, "%s: '%s' is not a whole number in [1, 64] (the threads this process may "
-                      "run: llvmpipe's and every worker pool's)", from, shown);
+        cli_die_usage(cmd, "%s: '%s' is not a whole number in [0, 64] (the threads this process may "
+                      "run: llvmpipe's and every worker pool's; 0: every core)", from, shown);
     if (obs_threads_set(t, err) != OBS_OK)
         cli_die_usage(cmd, "%s: %s", from, err);
     return n;

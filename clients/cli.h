@@ -49,7 +49,7 @@ void cli_progress_percent(int *last, long done, long total);
  * reads: taken out of argv (the new argc returned) and made the process's
  * thread limit (obs_threads_set: every worker pool and llvmpipe's
  * LP_NUM_THREADS, unless the user set that).  N is a whole number in
- * [1, 64]; anything else is a usage error of cmd (exit 2). */
+ * [0, 64] (0: every core); anything else is a usage error of cmd (exit 2). */
 int cli_take_threads(const char *cmd, int argc, char **argv);
 
 /* The threads this process runs now (/proc/self/task); -1 unknown. */
