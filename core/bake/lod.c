@@ -143,8 +143,6 @@ obs_status obs__bake_lod_resample(const obs__bake_world *full, const obs__bake_w
     return OBS_OK;
 }
 
-static float clamp01(double v) { return (float)(v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v); }
-
 /* The welded LOD solution onto each instance's LOD vertices, as bake.c's
  * copy_back does for the full detail. */
 static obs_status copy_level(const obs__bake_world *lw, const obs__bake_weld *lwd,
@@ -154,20 +152,9 @@ static obs_status copy_level(const obs__bake_world *lw, const obs__bake_weld *lw
     for (size_t i = 0; i < lw->instance_count; i++) {
         size_t end = i + 1 < lw->instance_count ? lw->inst[i + 1].first_vertex : lw->vertex_count;
         size_t n = end - lw->inst[i].first_vertex;
-        obs_bake_instance *r = &dst[i];
-        r->node = lw->inst[i].node;
-        r->mesh = lw->inst[i].mesh;
-        r->ao = malloc((n ? n : 1) * sizeof(float));
-        r->ao_short = malloc((n ? n : 1) * sizeof(float));
-        r->ao_long = malloc((n ? n : 1) * sizeof(float));
-        if (!r->ao || !r->ao_short || !r->ao_long)
+        if (obs__bake_instance_values(&dst[i], &lw->inst[i], n, lwd->of + lw->inst[i].first_vertex,
+                                      x, blend) != 0)
             return obs__fail(err, OBS_NO_MEMORY, "LOD results of %zu vertices", n);
-        for (size_t v = 0; v < n; v++) {
-            uint32_t k = lwd->of[lw->inst[i].first_vertex + v];
-            r->ao_short[v] = clamp01(x[2 * k]);
-            r->ao_long[v] = clamp01(x[2 * k + 1]);
-            r->ao[v] = clamp01(blend * r->ao_short[v] + (1.0f - blend) * r->ao_long[v]);
-        }
     }
     return OBS_OK;
 }
@@ -196,19 +183,18 @@ typedef struct lod_level {
     obs__bake_world lw;
     obs__bake_samples s, chk;
     obs__bake_weld lwd;
-    double *vx, *vert, *vw, *cnt, *face, *point, *direct;
+    double *vert;  /* 2 per LOD vertex: the resampled solution */
+    double *solve; /* one block: the arrays below, per welded vertex */
+    double *vx, *vw, *face, *point; /* 2 each: fit, vertex baseline, baselines */
+    double *cnt;                    /* 1: world vertices welded into it */
+    double *direct;                 /* 2, with lod_check: the direct bake */
     obs_bake_params fp; /* the fit's parameters */
 } lod_level;
 
 static void level_free(lod_level *v)
 {
-    free(v->vx);
     free(v->vert);
-    free(v->vw);
-    free(v->cnt);
-    free(v->face);
-    free(v->point);
-    free(v->direct);
+    free(v->solve);
     obs__bake_weld_free(&v->lwd);
     obs__bake_samples_free(&v->chk);
     obs__bake_samples_free(&v->s);
@@ -241,19 +227,19 @@ static obs_status level_resample(const obs_bake_scene *scene, const obs__bake_wo
 static obs_status level_fit(const obs_bake_params *p, int l, lod_level *v, obs_bake_stats *st,
                             char err[OBS_ERR_LEN])
 {
-    obs_status rc;
-    if ((rc = obs__bake_weld_make(&v->lw, p->weld_tolerance, p->weld_angle, &v->lwd, err)) != OBS_OK)
+    obs_status rc = obs__bake_weld_make(&v->lw, p->weld_tolerance, p->weld_angle, &v->lwd, err);
+    if (rc != OBS_OK)
         return rc;
     size_t n = v->lwd.count ? v->lwd.count : 1;
-    v->vx = malloc(2 * n * sizeof *v->vx);
-    v->vw = malloc(2 * n * sizeof *v->vw);
-    v->cnt = malloc(n * sizeof *v->cnt);
-    v->face = malloc(2 * n * sizeof *v->face);
-    v->point = malloc(2 * n * sizeof *v->point);
-    if (p->lod_check)
-        v->direct = malloc(2 * n * sizeof *v->direct);
-    if (!v->vx || !v->vw || !v->cnt || !v->face || !v->point || (p->lod_check && !v->direct))
+    v->solve = malloc((p->lod_check ? 11 : 9) * n * sizeof *v->solve);
+    if (!v->solve)
         return obs__fail(err, OBS_NO_MEMORY, "solution of %zu vertices", v->lwd.count);
+    v->vx = v->solve;
+    v->vw = v->vx + 2 * n;
+    v->face = v->vw + 2 * n;
+    v->point = v->face + 2 * n;
+    v->cnt = v->point + 2 * n;
+    v->direct = p->lod_check ? v->cnt + n : NULL;
     v->fp = *p;
     v->fp.values = OBS_BAKE_VALUES_FIT; /* the fit itself, whatever the full detail writes */
     obs_bake_stats fst = {0};
