@@ -15,6 +15,7 @@
 
 #include "internal.h"
 #include "obscura/scene.h"
+#include "ground/scene_internal.h"
 
 /* Indices are 32-bit (GL and Embree take them so). */
 #define MAX_VERTICES ((size_t)UINT32_MAX)
@@ -61,6 +62,17 @@ obs_status obs_scene_check(obs_scene *s, char err[OBS_ERR_LEN])
             return obs__fail(err, OBS_BAD_FILE, "triangle %zu refers to vertex %u of %zu", i / 3,
                              (unsigned)s->indices[i], s->vertex_count);
     return OBS_OK;
+}
+
+obs_status obs__scene_check_file(obs_scene *s, const char *path, char err[OBS_ERR_LEN])
+{
+    obs_status st = obs_scene_check(s, err);
+    if (st != OBS_OK) {
+        char msg[OBS_ERR_LEN];
+        snprintf(msg, sizeof msg, "%s", err ? err : "");
+        obs__fail(err, st, "%s: %s", path, msg);
+    }
+    return st;
 }
 
 /* The diffuse (or PBR base) colour of a material, unless it is assimp's
@@ -244,8 +256,12 @@ static obs_status copy_mesh(const char *path, const struct aiScene *sc, unsigned
 }
 
 /* The file through assimp, flattened, each mesh kept apart. */
-static const struct aiScene *import(const char *path)
+static obs_status import(const char *path, const struct aiScene **sc, char err[OBS_ERR_LEN])
 {
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
+    fclose(fp);
     const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
                            aiProcess_SortByPType | aiProcess_GenNormals |
                            aiProcess_FindInvalidData;
@@ -254,25 +270,24 @@ static const struct aiScene *import(const char *path)
     struct aiPropertyStore *props = aiCreatePropertyStore();
     if (props)
         aiSetImportPropertyInteger(props, AI_CONFIG_PP_PTV_KEEP_HIERARCHY, 1);
-    const struct aiScene *sc = aiImportFileExWithProperties(path, flags, NULL, props);
+    *sc = aiImportFileExWithProperties(path, flags, NULL, props);
     if (props)
         aiReleasePropertyStore(props);
-    return sc;
+    if (!*sc)
+        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
+                         aiGetErrorString());
+    return OBS_OK;
 }
 
 obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
-    fclose(fp);
-    const struct aiScene *sc = import(path);
-    if (!sc)
-        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
-                         aiGetErrorString());
+    const struct aiScene *sc = NULL;
+    obs_status st = import(path, &sc, err);
+    if (st != OBS_OK)
+        return st;
     scene_size z = measure(sc);
-    obs_status st = allocate(path, sc, &z, out, err);
+    st = allocate(path, sc, &z, out, err);
     size_t v0 = 0, t = 0;
     for (unsigned i = 0; st == OBS_OK && i < sc->mNumMeshes; i++)
         if (triangle_mesh(sc->mMeshes[i]))
@@ -281,12 +296,8 @@ obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN
         goto fail;
     out->vertex_count = z.nv;
     out->triangle_count = z.nt;
-    if ((st = obs_scene_check(out, err)) != OBS_OK) {
-        char msg[OBS_ERR_LEN];
-        snprintf(msg, sizeof msg, "%s", err ? err : "");
-        obs__fail(err, st, "%s: %s", path, msg);
+    if ((st = obs__scene_check_file(out, path, err)) != OBS_OK)
         goto fail;
-    }
     aiReleaseImport(sc);
     return OBS_OK;
 
