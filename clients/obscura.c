@@ -232,37 +232,21 @@ typedef struct ao_args {
     obs_http_request req;
 } ao_args;
 
-/* c (an option's name) into best when it is nearer to word than *best_d
- * edits, and fewer edits than word has letters. */
-static void nearer(const char *word, const char *c, int *best_d, char *best, size_t len)
-{
-    int d = cli_edit_distance(word, c);
-    if (d < *best_d && d < (int)strlen(word)) {
-        *best_d = d;
-        snprintf(best, len, "%s%s", c[1] ? "--" : "-", c);
-    }
-}
-
 /* An unknown option: a usage error, with the nearest of the ao options
  * and the parameter table's names when one is at most two edits away
  * ("--radiu": did you mean --radius?). */
 static void die_unknown_option(const char *arg)
 {
-    char word[64], cand[80], best[80] = "", shown[256];
-    const char *name = arg + strspn(arg, "-");
-    int best_d = 3;
-    snprintf(word, sizeof word, "%.*s", (int)strcspn(name, "="), name);
+    char shown[256];
+    cli_suggest sg;
+    cli_suggest_start(&sg, arg);
     for (const cli_opt *o = ao_opts; o->name; o++)
-        nearer(word, o->name, &best_d, best, sizeof best);
-    for (int k = 0; k < obs_param_count(); k++) {
-        snprintf(cand, sizeof cand, "%s", obs_param_at(k)->name);
-        for (char *p = cand; *p; p++)
-            *p = *p == '_' ? '-' : *p;
-        nearer(word, cand, &best_d, best, sizeof best);
-    }
+        cli_suggest_try(&sg, o->name);
+    for (int k = 0; k < obs_param_count(); k++)
+        cli_suggest_try(&sg, obs_param_at(k)->name);
     cli_escape(arg, shown, sizeof shown);
-    if (best[0])
-        die_usage("unknown option '%s'; did you mean %s?", shown, best);
+    if (sg.best[0])
+        die_usage("unknown option '%s'; did you mean %s?", shown, sg.best);
     die_usage("unknown option '%s'", shown);
 }
 
