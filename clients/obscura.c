@@ -587,6 +587,16 @@ static int cli_result_warnings(const ao_args *a, const obs_image *ao, const obs_
     return cli_warnings_from(a->in, info, from, a->req.strict, "not written");
 }
 
+/* The daemon's warnings on a remote frame (its checks of the result,
+ * and of the input where this process did not make them), printed and
+ * failed under --strict as an in-process run's own. */
+static int cli_remote_result_warnings(const ao_args *a, obs_exr_info *info)
+{
+    int from = info->warning_count;
+    cli_remote_take_warnings(info);
+    return cli_warnings_from(a->in, info, from, a->req.strict, "not written");
+}
+
 static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server, int argc, char **argv)
 {
     char err[OBS_ERR_LEN] = "";
@@ -861,7 +871,8 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
     t0 = now_ms();
     if ((rc = run_frame(a, &gf, outputs, server, argc, argv, &res, &ctx, &t0, err)) != EXIT_OK)
         goto done;
-    if (!server && (rc = cli_result_warnings(a, &res.ao, &gf.gb, NULL, &gf.info)) != EXIT_OK)
+    if ((rc = server ? cli_remote_result_warnings(a, &gf.info)
+                     : cli_result_warnings(a, &res.ao, &gf.gb, NULL, &gf.info)) != EXIT_OK)
         goto done;
     if (baked.data && (rc = combine_baked(a, &res, &baked, bch, err)) != EXIT_OK)
         goto done;
