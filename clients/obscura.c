@@ -878,7 +878,8 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
         goto done;
     double t_run = now_ms() - t0;
     t0 = now_ms();
-    s = write_outputs(a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part, err);
+    obs_camera cam; /* the parameters' over the input's, as obscurad writes it */
+    s = write_outputs(a, &res, obs_camera_of_run(&gf.gb, &a->req.params, &cam) ? &cam : NULL, gf.info.part, err);
     if (s != OBS_OK) {
         rc = cli_fail(s, a->out, err);
         goto done;
