@@ -4,6 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cli.h"
+
 int cli_flag_value(int argc, char **argv, int *i, const char *name, const char **value)
 {
     const char *a = argv[*i];
@@ -67,4 +69,25 @@ int cli_request_flag(int argc, char **argv, int *i, obs_http_request *r,
         return obs_http_option_set(r, op, v, OBS_HTTP_CLI, err) == OBS_OK ? 1 : -1;
     }
     return 0;
+}
+
+void cli_suggest_start(cli_suggest *s, const char *arg)
+{
+    const char *name = arg + strspn(arg, "-");
+    snprintf(s->word, sizeof s->word, "%.*s", (int)strcspn(name, "="), name);
+    s->best[0] = '\0';
+    s->best_d = 3;
+}
+
+void cli_suggest_try(cli_suggest *s, const char *name)
+{
+    char cand[64];
+    snprintf(cand, sizeof cand, "%s", name);
+    for (char *p = cand; *p; p++)
+        *p = *p == '_' ? '-' : *p;
+    int d = cli_edit_distance(s->word, cand);
+    if (d < s->best_d && d < (int)strlen(s->word)) {
+        s->best_d = d;
+        snprintf(s->best, sizeof s->best, "%s%s", cand[1] ? "--" : "-", cand);
+    }
 }

@@ -25,4 +25,16 @@ int cli_is_switch(const char *arg, const char *name);
 int cli_request_flag(int argc, char **argv, int *i, obs_http_request *r,
                      const obs_http_option **which, char err[OBS_ERR_LEN]);
 
+/* The "did you mean" of an unknown option: start with the argument as
+ * typed, try every option name the command knows (a table's '_' read as
+ * '-'); best is the nearest at most two edits away and fewer edits than
+ * the word has letters, spelled --name (-n for one letter), or "". */
+typedef struct cli_suggest {
+    char word[64];
+    char best[80];
+    int best_d;
+} cli_suggest;
+void cli_suggest_start(cli_suggest *s, const char *arg);
+void cli_suggest_try(cli_suggest *s, const char *name);
+
 #endif

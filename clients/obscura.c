@@ -244,37 +244,21 @@ typedef struct ao_args {
     obs_http_request req;
 } ao_args;
 
-/* c (an option's name) into best when it is nearer to word than *best_d
- * edits, and fewer edits than word has letters. */
-static void nearer(const char *word, const char *c, int *best_d, char *best, size_t len)
-{
-    int d = cli_edit_distance(word, c);
-    if (d < *best_d && d < (int)strlen(word)) {
-        *best_d = d;
-        snprintf(best, len, "%s%s", c[1] ? "--" : "-", c);
-    }
-}
-
 /* An unknown option: a usage error, with the nearest of the ao options
  * and the parameter table's names when one is at most two edits away
  * ("--radiu": did you mean --radius?). */
 static void die_unknown_option(const char *arg)
 {
-    char word[64], cand[80], best[80] = "", shown[256];
-    const char *name = arg + strspn(arg, "-");
-    int best_d = 3;
-    snprintf(word, sizeof word, "%.*s", (int)strcspn(name, "="), name);
+    char shown[256];
+    cli_suggest sg;
+    cli_suggest_start(&sg, arg);
     for (const cli_opt *o = ao_opts; o->name; o++)
-        nearer(word, o->name, &best_d, best, sizeof best);
-    for (int k = 0; k < obs_param_count(); k++) {
-        snprintf(cand, sizeof cand, "%s", obs_param_at(k)->name);
-        for (char *p = cand; *p; p++)
-            *p = *p == '_' ? '-' : *p;
-        nearer(word, cand, &best_d, best, sizeof best);
-    }
+        cli_suggest_try(&sg, o->name);
+    for (int k = 0; k < obs_param_count(); k++)
+        cli_suggest_try(&sg, obs_param_at(k)->name);
     cli_escape(arg, shown, sizeof shown);
-    if (best[0])
-        die_usage("unknown option '%s'; did you mean %s?", shown, best);
+    if (sg.best[0])
+        die_usage("unknown option '%s'; did you mean %s?", shown, sg.best);
     die_usage("unknown option '%s'", shown);
 }
 
@@ -615,6 +599,16 @@ static int cli_result_warnings(const ao_args *a, const obs_image *ao, const obs_
     return cli_warnings_from(a->in, info, from, a->req.strict, "not written");
 }
 
+/* The daemon's warnings on a remote frame (its checks of the result,
+ * and of the input where this process did not make them), printed and
+ * failed under --strict as an in-process run's own. */
+static int cli_remote_result_warnings(const ao_args *a, obs_exr_info *info)
+{
+    int from = info->warning_count;
+    cli_remote_take_warnings(info);
+    return cli_warnings_from(a->in, info, from, a->req.strict, "not written");
+}
+
 static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server, int argc, char **argv)
 {
     char err[OBS_ERR_LEN] = "";
@@ -892,13 +886,15 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
     t0 = now_ms();
     if ((rc = run_frame(a, &gf, outputs, server, argc, argv, &res, &ctx, &t0, err)) != EXIT_OK)
         goto done;
-    if (!server && (rc = cli_result_warnings(a, &res.ao, &gf.gb, NULL, &gf.info)) != EXIT_OK)
+    if ((rc = server ? cli_remote_result_warnings(a, &gf.info)
+                     : cli_result_warnings(a, &res.ao, &gf.gb, NULL, &gf.info)) != EXIT_OK)
         goto done;
     if (baked.data && (rc = combine_baked(a, &res, &baked, bch, err)) != EXIT_OK)
         goto done;
     double t_run = now_ms() - t0;
     t0 = now_ms();
-    s = write_outputs(a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part, err);
+    obs_camera cam; /* the parameters' over the input's, as obscurad writes it */
+    s = write_outputs(a, &res, obs_camera_of_run(&gf.gb, &a->req.params, &cam) ? &cam : NULL, gf.info.part, err);
     if (s != OBS_OK) {
         rc = cli_fail(s, a->out, err);
         goto done;

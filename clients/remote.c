@@ -37,6 +37,36 @@ typedef struct server_addr {
 
 static const char *stream_name; /* --stream NAME: post to /v1/streams/NAME/frames */
 
+/* The warnings of the last answer (X-Obscura-Warning over HTTP, a 200's
+ * message lines over the binary protocol), until
+ * cli_remote_take_warnings() hands them on. */
+static struct {
+    int n;
+    char text[OBS_EXR_WARNINGS][sizeof ((obs_exr_info *)0)->warnings[0]];
+} said;
+
+static void said_add(const char *text, size_t len)
+{
+    if (said.n < OBS_EXR_WARNINGS && len > 0)
+        snprintf(said.text[said.n++], sizeof said.text[0], "%.*s", (int)len, text);
+}
+
+int cli_remote_take_warnings(obs_exr_info *info)
+{
+    int added = 0;
+    for (int i = 0; i < said.n && info->warning_count < OBS_EXR_WARNINGS; i++) {
+        int known = 0;
+        for (int k = 0; k < info->warning_count && !known; k++)
+            known = !strcmp(info->warnings[k], said.text[i]);
+        if (known)
+            continue; /* the input's, which this process checked and said itself */
+        snprintf(info->warnings[info->warning_count++], sizeof info->warnings[0], "%s", said.text[i]);
+        added++;
+    }
+    said.n = 0;
+    return added;
+}
+
 static int stream_name_ok(const char *s)
 {
     size_t n = strlen(s);
@@ -344,6 +374,8 @@ static int binary_once(const server_addr *a, const obs_bytes *frame, answer *res
         rc = r.status;
         goto done;
     }
+    for (int i = 0; i < r.warning_count; i++)
+        said_add(r.warnings[i], strlen(r.warnings[i]));
     for (int i = 0; i < r.image_count; i++) {
         /* take the images over: they are ours */
         obs_image *slot = answer_slot(res, r.images[i].output);
@@ -511,6 +543,12 @@ static int http_once(const server_addr *a, const char *stream, const char *query
         rc = status;
         goto done;
     }
+    for (const unsigned char *h = ans; h < end; h++)
+        if (!strncasecmp((const char *)h, "\nX-Obscura-Warning:", 19)) {
+            const char *v = (const char *)h + 19;
+            v += strspn(v, " \t");
+            said_add(v, strcspn(v, "\r\n"));
+        }
     rc = exr_to_result(payload, plen, outputs, res, msg, msg_len) == 0 ? 0 : 500;
 done:
     free(head);
@@ -719,6 +757,7 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
                     continue;
                 tried++;
                 answer_free(out);
+                said.n = 0;
                 last = addrs[k].kind == PROTO_HTTP
                            ? http_once(&addrs[k], stream_name, query, body, body_len, outputs, out, &wait, msg,
                                        sizeof msg)

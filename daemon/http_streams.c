@@ -203,11 +203,11 @@ static enum MHD_Result get_frame(req *r, uint64_t seq)
         return obsd__answer_images(r, &color, NULL, 0, "X-Obscura-Frame", num);
     }
     if (fr->want_front && (!f->deep || !fr->rerun))
-        return answer_front(r, f->deep ? &f->ao_front : NULL, f->camera.has_projection ? &f->camera : NULL, 0,
+        return answer_front(r, f->deep ? &f->ao_front : NULL, f->written.has_projection ? &f->written : NULL, 0,
                             f->seq);
     if (!fr->rerun) {
         obsd_fp_images im = kept_images(r, f);
-        return obsd__answer_images(r, &im, f->camera.has_projection ? &f->camera : NULL, 0, "X-Obscura-Frame",
+        return obsd__answer_images(r, &im, f->written.has_projection ? &f->written : NULL, 0, "X-Obscura-Frame",
                                    num);
     }
     /* other parameters: the frame runs again (not kept) */
@@ -306,6 +306,9 @@ static int copy_color(const obs_gbuffer *gb, obs_image *out)
  * flat one's AO and composite. */
 static void take_result(obsd_fp *fp, obsd_frame *f)
 {
+    const obs_camera *written = obsd_fp_camera(fp);
+    if (written)
+        f->written = *written;
     if (fp->deep) {
         obs_deep_result *dr = &fp->job.deep_result;
         f->deep = 1;
@@ -364,7 +367,7 @@ static enum MHD_Result post_finish(req *r)
     snprintf(num, sizeof num, "%llu", (unsigned long long)seq);
     sr->frame = f; /* released when the request ends */
     obsd_fp_images im = kept_images(r, f);
-    return obsd__answer_images(r, &im, f->camera.has_projection ? &f->camera : NULL, 1, "X-Obscura-Frame", num);
+    return obsd__answer_images(r, &im, f->written.has_projection ? &f->written : NULL, 1, "X-Obscura-Frame", num);
 }
 
 enum MHD_Result obsd__streams_finish(req *r)

@@ -39,6 +39,7 @@ typedef struct obsd_frame {
     obs_image color;       /* the G-buffer's colour (RGBA); empty without one (and for deep input) */
     int deep;              /* the body is a deep EXR: it ran the multi-layer chain */
     obs_camera camera;
+    obs_camera written;    /* the camera its EXR answers carry: the one it ran with (obsd_fp_camera) */
     int part;              /* the body's part the G-buffer was read from */
     double ms_queue, ms_decode, ms_gl; /* the stages of its run */
     double posted_unix;    /* seconds since the epoch */
