@@ -60,31 +60,6 @@ void cli_escape(const char *in, char *out, size_t len)
     out[o] = '\0';
 }
 
-int cli_edit_distance(const char *a, const char *b)
-{
-    size_t la = strlen(a), lb = strlen(b);
-    int row[64];
-    if (lb >= sizeof row / sizeof row[0] || la >= 64)
-        return 1 << 20; /* no option is that long */
-    for (size_t j = 0; j <= lb; j++)
-        row[j] = (int)j;
-    for (size_t i = 1; i <= la; i++) {
-        int diag = row[0];
-        row[0] = (int)i;
-        for (size_t j = 1; j <= lb; j++) {
-            int up = row[j];
-            int best = diag + (a[i - 1] != b[j - 1]);
-            if (up + 1 < best)
-                best = up + 1;
-            if (row[j - 1] + 1 < best)
-                best = row[j - 1] + 1;
-            row[j] = best;
-            diag = up;
-        }
-    }
-    return row[lb];
-}
-
 void cli_progress_percent(int *last, long done, long total)
 {
     int pct = total > 0 ? (int)(100 * done / total) : 100;

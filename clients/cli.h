@@ -37,10 +37,6 @@ obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN]);
  * fit len: a name or message read from a file cannot drive the terminal. */
 void cli_escape(const char *in, char *out, size_t len);
 
-/* Levenshtein distance of a and b (the "did you mean" of an unknown
- * option); a large number for words of 64 bytes or more. */
-int cli_edit_distance(const char *a, const char *b);
-
 /* --progress percent: "Progress: N%" on stdout (the line Deadline's and
  * OpenCue's progress parsers read) when N differs from *last. */
 void cli_progress_percent(int *last, long done, long total);

@@ -13,6 +13,10 @@
  * is missing (NAME is the last argument). */
 int cli_flag_value(int argc, char **argv, int *i, const char *name, const char **value);
 
+/* Levenshtein distance of a and b (the "did you mean" of an unknown
+ * option); a large number for words of 64 bytes or more. */
+int cli_edit_distance(const char *a, const char *b);
+
 /* argv is exactly --NAME (a switch takes no value).  0 / 1. */
 int cli_is_switch(const char *arg, const char *name);
 
