@@ -221,6 +221,9 @@ void *obsd__conn_sweeper(void *arg)
 void obsd__req_free(req *r)
 {
     free(r->body);
+    if (r->held) /* the connection ended before the body did */
+        MHD_destroy_response(r->held);
+    free(r->held_note);
     if (r->fr) { /* the frame's state is freed here, not by a route's done: the GL worker may hold it longer */
         obsd_fp_free(&r->fr->fp);
         free(r->fr->query);

@@ -86,6 +86,8 @@ typedef enum obsd__req_state {
     REQ_QUEUED,   /* suspended; the GL worker has the job */
     REQ_REFUSED,  /* suspended and resumed at once: the queue was full */
     REQ_EVENTS,   /* answering with Server-Sent Events */
+    REQ_HELD,     /* answered while the client still sends its body: the body is
+                     discarded and the answer queued at its end (obsd__answer) */
     REQ_ANSWERED
 } obsd__req_state;
 
@@ -137,7 +139,18 @@ typedef struct obsd__req {
     unsigned char *body;
     size_t len, cap;
     int too_big;
-    size_t discarded;    /* bytes thrown away after too_big */
+    size_t discarded;    /* bytes thrown away after too_big, or under a held answer */
+    /* The client is sending a body that MHD has not all handed over: an
+     * answer queued now would close the connection with unread input,
+     * and the kernel's reset would destroy the answer at the client.  So
+     * the answer is held (REQ_HELD) until the body's end, discarding it up
+     * to hold_max bytes and within --request-timeout. */
+    int body_in;
+    size_t hold_max;
+    struct MHD_Response *held;
+    int held_status;
+    size_t held_len;
+    char *held_note;
     obsd__frame_req *fr; /* the frame it carries (http_frames.c), or NULL */
     void *own;           /* its route's own state (http_streams.c, http_bakes.c), freed by the row's done */
     /* answer */
@@ -170,9 +183,13 @@ void obsd__req_free(obsd__req *r);
 /* ---- http_reply.c: answers, each logged and counted ---- */
 
 
-/* Queues `resp` (taking it) with status; logs and counts the request. */
+/* Queues `resp` (taking it) with status; logs and counts the request.
+ * While the client still sends its body (r->body_in), the answer is held
+ * instead (REQ_HELD) and the caller goes on as if it were queued. */
 enum MHD_Result obsd__answer(obsd__req *r, int status, struct MHD_Response *resp, size_t body_len,
                              const char *note);
+/* The held answer queued, at the end of the discarded body. */
+enum MHD_Result obsd__answer_held(obsd__req *r);
 /* A body of `len` bytes that the answer frees. */
 enum MHD_Result obsd__answer_text(obsd__req *r, int status, const char *type, char *text, size_t len,
                                   const char *note);

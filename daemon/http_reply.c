@@ -26,11 +26,40 @@ static void log_request(const req *r, const char *note)
              obsd_now_ms() - r->t0, note && *note ? " " : "", note ? note : "");
 }
 
+/* An answer while the client still sends its body: kept until the
+ * body's end (obsd__answer_held), the rest of the body discarded. */
+static enum MHD_Result hold(req *r, int status, struct MHD_Response *resp, size_t body_len, const char *note)
+{
+    if (r->held) /* one answer per request: the first one stands */
+        MHD_destroy_response(resp);
+    else {
+        r->held = resp;
+        r->held_status = status;
+        r->held_len = body_len;
+        r->held_note = note && *note ? strdup(note) : NULL;
+    }
+    r->state = REQ_HELD;
+    return MHD_YES;
+}
+
+enum MHD_Result obsd__answer_held(req *r)
+{
+    struct MHD_Response *resp = r->held;
+    char *note = r->held_note;
+    r->held = NULL;
+    r->held_note = NULL;
+    enum MHD_Result rc = obsd__answer(r, r->held_status, resp, r->held_len, note);
+    free(note);
+    return rc;
+}
+
 enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size_t body_len,
                               const char *note)
 {
     if (!resp)
         return MHD_NO;
+    if (r->body_in)
+        return hold(r, status, resp, body_len, note);
     if (!obsd__req_hold(r)) { /* cut (its deadline, the drain) while we worked */
         MHD_destroy_response(resp);
         return MHD_NO;
