@@ -26,19 +26,34 @@
 
 typedef obsd__req req;
 
-static void addr_name(const struct sockaddr *sa, char *buf, size_t len)
+/* The peer as "IP:PORT" into buf, its address alone into ip. */
+static void addr_name(const struct sockaddr *sa, char *buf, size_t len, char ip[INET6_ADDRSTRLEN])
 {
-    char ip[INET6_ADDRSTRLEN];
     snprintf(buf, len, "?");
+    snprintf(ip, INET6_ADDRSTRLEN, "?");
     if (sa && sa->sa_family == AF_INET) {
         const struct sockaddr_in *in = (const struct sockaddr_in *)(const void *)sa;
-        if (inet_ntop(AF_INET, &in->sin_addr, ip, sizeof ip))
+        if (inet_ntop(AF_INET, &in->sin_addr, ip, INET6_ADDRSTRLEN))
             snprintf(buf, len, "%s:%u", ip, ntohs(in->sin_port));
     } else if (sa && sa->sa_family == AF_INET6) {
         const struct sockaddr_in6 *in6 = (const struct sockaddr_in6 *)(const void *)sa;
-        if (inet_ntop(AF_INET6, &in6->sin6_addr, ip, sizeof ip))
+        if (inet_ntop(AF_INET6, &in6->sin6_addr, ip, INET6_ADDRSTRLEN))
             snprintf(buf, len, "[%s]:%u", ip, ntohs(in6->sin6_port));
     }
+}
+
+/* Under h->lock: c is one more than --max-per-client from its address
+ * (counted here: MHD's own per-address limit resets the connection
+ * without a word). */
+static int over_client_limit(const obsd_http *h, const obsd__conn *c)
+{
+    int max = h->cfg->max_per_client, n = 0;
+    if (max <= 0)
+        return 0;
+    for (const obsd__conn *o = h->conns; o; o = o->next)
+        if (!atomic_load(&o->cut) && !o->over_client && !strcmp(o->ip, c->ip))
+            n++;
+    return n > max;
 }
 
 static double deadline_from(const obsd_http *h, double now)
@@ -134,7 +149,7 @@ void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_conte
     }
     c->mc = mc;
     c->fd = fi->connect_fd;
-    addr_name(ai ? ai->client_addr : NULL, c->peer, sizeof c->peer);
+    addr_name(ai ? ai->client_addr : NULL, c->peer, sizeof c->peer, c->ip);
     c->deadline = deadline_from(h, obsd_now_ms());
     atomic_init(&c->cut, CUT_NONE);
     pthread_mutex_lock(&h->lock);
@@ -145,6 +160,7 @@ void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_conte
         h->conns = c;
     h->conns_tail = c;
     h->open++;
+    c->over_client = over_client_limit(h, c);
     if (h->open - h->evicting > h->cfg->http_connections) {
         /* At the limit: the oldest connection that has not sent a whole
          * request (stalled in its headers, or idle between requests) makes

@@ -34,6 +34,8 @@ typedef struct obsd__conn {
     struct MHD_Connection *mc;
     int fd;
     char peer[64];
+    char ip[46];              /* the peer's address alone (INET6_ADDRSTRLEN), for --max-per-client */
+    int over_client;          /* one more than --max-per-client from its address: answered 503, closed */
     double deadline;          /* obsd_now_ms() past which it is cut; 0: none */
     struct obsd__req *r;      /* the request under way; NULL before its headers, or idle */
     int reserve;              /* opened beyond --http-connections: probes only */
@@ -196,6 +198,9 @@ enum MHD_Result obsd__answer_text(obsd__req *r, int status, const char *type, ch
 /* The JSON error; one extra header (name, value) when hname is set. */
 enum MHD_Result obsd__answer_error(obsd__req *r, int status, const char *code, const char *msg,
                                    const char *hname, const char *hvalue);
+/* 204 to a browser's OPTIONS preflight (--cors): the route's methods,
+ * the headers a page may send, how long the browser may keep it. */
+enum MHD_Result obsd__answer_preflight(obsd__req *r, const char *methods);
 /* 503 shutting_down (Retry-After: 5): the drain refuses what would start. */
 enum MHD_Result obsd__answer_shutting_down(obsd__req *r);
 /* The error of a core status (503 with Retry-After). */

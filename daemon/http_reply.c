@@ -64,14 +64,22 @@ enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size
         MHD_destroy_response(resp);
         return MHD_NO;
     }
-    /* In the drain, and on a connection beyond --http-connections, the
-     * answer is the connection's last. */
-    if (atomic_load(&r->srv->draining) || (r->cn && r->cn->reserve))
+    /* In the drain, and on a connection beyond --http-connections or
+     * --max-per-client, the answer is the connection's last. */
+    if (atomic_load(&r->srv->draining) || (r->cn && (r->cn->reserve || r->cn->over_client)))
         MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
     r->status = status;
     r->bytes_out = body_len;
     r->state = REQ_ANSWERED;
     MHD_add_response_header(resp, "Server", "obscurad/" OBS_VERSION);
+    const char *origin = r->srv->cfg->cors;
+    if (origin[0]) { /* --cors: a page from that origin may read every answer, its warnings and timings too */
+        MHD_add_response_header(resp, "Access-Control-Allow-Origin", origin);
+        MHD_add_response_header(resp, "Access-Control-Expose-Headers",
+                                "X-Obscura-Warning, Server-Timing, Retry-After, Location");
+        if (strcmp(origin, "*") != 0)
+            MHD_add_response_header(resp, "Vary", "Origin");
+    }
     enum MHD_Result rc = MHD_queue_response(r->conn, (unsigned)status, resp);
     MHD_destroy_response(resp);
     obsd_stats_request(r->slot, status, r->len + r->discarded, body_len);
@@ -112,6 +120,18 @@ enum MHD_Result obsd__answer_error(req *r, int status, const char *code, const c
     char note[OBS_ERR_LEN + 32];
     snprintf(note, sizeof note, "error=%s: %s", code, msg);
     return obsd__answer(r, status, resp, len, note);
+}
+
+enum MHD_Result obsd__answer_preflight(req *r, const char *methods)
+{
+    struct MHD_Response *resp = MHD_create_response_from_buffer(0, NULL, MHD_RESPMEM_PERSISTENT);
+    if (!resp)
+        return MHD_NO;
+    MHD_add_response_header(resp, "Access-Control-Allow-Methods",
+                            !strcmp(methods, "GET") ? "GET, HEAD" : methods);
+    MHD_add_response_header(resp, "Access-Control-Allow-Headers", "Authorization, Content-Type");
+    MHD_add_response_header(resp, "Access-Control-Max-Age", "600");
+    return obsd__answer(r, 204, resp, 0, "preflight (--cors)");
 }
 
 enum MHD_Result obsd__answer_shutting_down(req *r)

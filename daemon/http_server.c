@@ -95,6 +95,12 @@ static enum MHD_Result dispatch(req *r, const char *url, const char *method)
 {
     obsd_http *h = r->srv;
     const obsd__route *rt = r->route;
+    if (r->cn && r->cn->over_client && !(rt && (rt->flags & OBSD_ROUTE_PROBE))) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "%d connections are open from this address (--max-per-client %d); "
+                 "retry later", h->cfg->max_per_client, h->cfg->max_per_client);
+        return obsd__answer_error(r, 503, "too_many_connections", msg, MHD_HTTP_HEADER_RETRY_AFTER, "1");
+    }
     if (r->cn && r->cn->reserve && !(rt && (rt->flags & OBSD_ROUTE_PROBE))) {
         char msg[128];
         snprintf(msg, sizeof msg, "%d connections are open (--http-connections); retry later",
@@ -103,6 +109,8 @@ static enum MHD_Result dispatch(req *r, const char *url, const char *method)
     }
     if (!rt)
         return obsd__answer_error(r, 404, "not_found", "no such route (try GET /v1/params)", NULL, NULL);
+    if (h->cfg->cors[0] && !strcmp(method, "OPTIONS")) /* a preflight carries no token */
+        return obsd__answer_preflight(r, rt->methods ? rt->methods : "GET, HEAD, POST, DELETE");
     if (rt->methods && !method_ok(rt, method)) {
         char msg[64];
         snprintf(msg, sizeof msg, "%s takes %s", rt->path, rt->methods);
@@ -362,13 +370,13 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
         flags |= MHD_USE_IPv6;
     /* MHD refuses beyond its limit before anything of ours runs: the
      * reserve above --http-connections is where on_connection makes room
-     * or lets a probe in. */
+     * or lets a probe in.  --max-per-client is counted by http_conn.c,
+     * so that the connection over it is answered (MHD's would reset it). */
     h->mhd = MHD_start_daemon(flags, 0, NULL, NULL, on_request, h,
                               MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
                               MHD_OPTION_THREAD_POOL_SIZE, (unsigned)cfg->threads,
                               MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg->timeout,
                               MHD_OPTION_CONNECTION_LIMIT, (unsigned)(cfg->http_connections + OBSD_HTTP_RESERVE),
-                              MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg->max_per_client,
                               MHD_OPTION_NOTIFY_CONNECTION, obsd__conn_notify, h,
                               MHD_OPTION_NOTIFY_COMPLETED, on_completed, h,
                               MHD_OPTION_EXTERNAL_LOGGER, on_mhd_log, h,
