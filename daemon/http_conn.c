@@ -13,6 +13,7 @@
  *              suspended for the GL worker resumed (to close), their jobs
  *              left to free their requests */
 #include <arpa/inet.h>
+#include <errno.h>
 #include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -82,6 +83,7 @@ static void answer_timeout(obsd_http *h, obsd__conn *c)
     free(body);
     size_t in = r ? r->len + r->discarded : 0;
     obsd_stats_request(r ? r->slot : OBSD_STATS_OTHER, 408, in, len);
+    obsd_stats_refusal("request_timeout", c->peer, msg);
     if (r)
         obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s status=408 in=%zu out=%zu total=%.1f ms "
                  "error=request_timeout: %s", (unsigned long long)r->id, r->peer, r->method, r->path, in, len,
@@ -115,6 +117,7 @@ void obsd__conn_detach(obsd_http *h, obsd__conn *c)
 {
     pthread_mutex_lock(&h->lock);
     c->r = NULL;
+    atomic_store(&c->events, 0);
     c->deadline = deadline_from(h, obsd_now_ms()); /* the next request's, on a kept connection */
     pthread_mutex_unlock(&h->lock);
 }
@@ -152,6 +155,7 @@ void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_conte
     addr_name(ai ? ai->client_addr : NULL, c->peer, sizeof c->peer, c->ip);
     c->deadline = deadline_from(h, obsd_now_ms());
     atomic_init(&c->cut, CUT_NONE);
+    atomic_init(&c->events, 0);
     pthread_mutex_lock(&h->lock);
     c->prev = h->conns_tail;
     if (h->conns_tail)
@@ -214,8 +218,22 @@ int obsd__req_alive(req *r)
     return ok;
 }
 
+/* Under h->lock: an event stream whose client closed or reset.  Parked
+ * (suspended) it is not polled by MHD, so its departure would be seen
+ * only at its next event: the subscriber (and its gauge) would stay. */
+static int client_gone(const obsd__conn *c)
+{
+    char b;
+    if (!atomic_load(&c->events) || atomic_load(&c->cut))
+        return 0;
+    ssize_t n = recv(c->fd, &b, 1, MSG_PEEK | MSG_DONTWAIT);
+    return n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR);
+}
+
 /* Connections past their deadline, found a few times a second: the
- * ones that trickle their headers, or a body with nothing for a while. */
+ * ones that trickle their headers, or a body with nothing for a while;
+ * and event streams whose client left (shut, resumed: MHD closes them,
+ * the route's done unsubscribes). */
 void *obsd__conn_sweeper(void *arg)
 {
     obsd_http *h = arg;
@@ -228,6 +246,9 @@ void *obsd__conn_sweeper(void *arg)
             if (!atomic_load(&c->cut) && c->deadline > 0.0 && now > c->deadline) {
                 answer_timeout(h, c);
                 cut_conn(h, c, CUT_DEADLINE);
+            } else if (client_gone(c)) {
+                cut_conn(h, c, CUT_GONE);
+                MHD_resume_connection(c->mc); /* harmless when it is not suspended */
             }
         pthread_mutex_unlock(&h->lock);
     }

@@ -24,7 +24,7 @@
 #define OBSD_HTTP_RESERVE 16
 
 /* Why a connection was shut down from outside its MHD thread. */
-enum { CUT_NONE, CUT_DEADLINE, CUT_EVICTED, CUT_DRAIN };
+enum { CUT_NONE, CUT_DEADLINE, CUT_EVICTED, CUT_DRAIN, CUT_GONE /* an event stream's client left */ };
 
 /* One open connection (http_server.c keeps the list, under obsd_http's
  * lock): its deadline, for the sweeper thread, and its request, for the
@@ -39,6 +39,7 @@ typedef struct obsd__conn {
     double deadline;          /* obsd_now_ms() past which it is cut; 0: none */
     struct obsd__req *r;      /* the request under way; NULL before its headers, or idle */
     int reserve;              /* opened beyond --http-connections: probes only */
+    atomic_int events;        /* answering an event stream: the sweeper watches for the client leaving */
     atomic_int cut;           /* CUT_*: shut down, MHD closes it next */
 } obsd__conn;
 

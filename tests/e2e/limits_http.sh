@@ -97,5 +97,43 @@ check "/healthz on the 9th connection is still answered (a probe costs nothing) 
 sleep 0.3
 check "the refusal is in the log, naming the option" "grep -q 'status=503.*too_many_connections.*max-per-client' '$T/P.log'"
 
+echo "-- refusals in /metrics"
+$CURL "http://127.0.0.1:$PORT_P/metrics" > "$T/p.metrics"
+n=$(sed -n 's/^obscurad_refusals_total{reason="too_many_connections"} \([0-9]*\)$/\1/p' "$T/p.metrics")
+check "obscurad_refusals_total{reason=\"too_many_connections\"} counts the two refusals ($n)" "[ '$n' = 2 ]"
+lines=$(grep -c 'warn: refused too_many_connections' "$T/P.log")
+check "the refusals are logged, rate-limited to a line a second ($lines lines)" "[ '$lines' -ge 1 ] && [ '$lines' -le 2 ]"
+i=0
+while [ $i -lt 10 ]; do
+    $CURL -o /dev/null -H 'Content-Type: image/x-exr' -H 'Content-Length: 99999999999' -X POST \
+        "http://127.0.0.1:$PORT_P/v1/ao?fov_y=50"
+    i=$((i + 1))
+done
+sleep 1.1
+$CURL -o /dev/null -H 'Content-Type: image/x-exr' -H 'Content-Length: 99999999999' -X POST "http://127.0.0.1:$PORT_P/v1/ao"
+sleep 0.2
+n=$($CURL "http://127.0.0.1:$PORT_P/metrics" | sed -n 's/^obscurad_refusals_total{reason="body_too_large"} \([0-9]*\)$/\1/p')
+lines=$(grep -c 'warn: refused body_too_large' "$T/P.log")
+check "11 bodies over --max-body: 11 counted, at most a log line a second, the next says how many it left out ($n, $lines lines)" \
+    "[ '$n' = 11 ] && [ '$lines' -lt 11 ] && grep -q 'warn: refused body_too_large.*more since the last such line' '$T/P.log'"
+
+echo "-- the event subscribers' gauge"
+metric() { $CURL "http://127.0.0.1:$1/metrics" | sed -n "s/^$2 \([0-9]*\)$/\1/p"; }
+start V
+curl -s -N --max-time 30 "http://127.0.0.1:$PORT_V/v1/streams/s/events" > "$T/ev" &
+EV=$!
+CPIDS="$EV"
+i=0
+while [ $i -lt 50 ] && [ "$(metric "$PORT_V" obscurad_event_subscribers)" != 1 ]; do sleep 0.1; i=$((i + 1)); done
+g1=$(metric "$PORT_V" obscurad_event_subscribers)
+kill "$EV"
+t0=$(date +%s%N)
+i=0
+while [ $i -lt 30 ] && [ "$(metric "$PORT_V" obscurad_event_subscribers)" != 0 ]; do sleep 0.05; i=$((i + 1)); done
+ms=$(( ($(date +%s%N) - t0) / 1000000 ))
+g0=$(metric "$PORT_V" obscurad_event_subscribers)
+check "a subscriber that leaves is dropped from obscurad_event_subscribers within a second ($g1 -> $g0 in $ms ms)" \
+    "[ '$g1' = 1 ] && [ '$g0' = 0 ] && [ $ms -lt 1200 ]"
+
 echo "e2e HTTP limits: $pass passed, $failed failed"
 [ "$failed" -eq 0 ]
