@@ -97,6 +97,25 @@ check "/healthz on the 9th connection is still answered (a probe costs nothing) 
 sleep 0.3
 check "the refusal is in the log, naming the option" "grep -q 'status=503.*too_many_connections.*max-per-client' '$T/P.log'"
 
+echo "-- --max-per-client over the binary protocol"
+# one connection holds the Unix socket's only place; the CLI then writes
+# a whole frame (more than the socket's buffer) before it reads: it must
+# read the 503, which the daemon sends, then drains the frame for a while
+OBSCURA=${OBSCURA:-$(dirname "$OBSCURAD")/obscura}
+start B --socket "$T/b.sock" --max-per-client 1
+python3 -u -c 'import socket, sys, time
+s = socket.socket(socket.AF_UNIX); s.connect(sys.argv[1]); print("held"); time.sleep(20)' "$T/b.sock" > "$T/hold" &
+HOLD=$!
+CPIDS="$HOLD"
+i=0
+while [ $i -lt 100 ] && ! grep -q held "$T/hold"; do sleep 0.1; i=$((i + 1)); done
+sleep 0.2
+"$OBSCURA" ao "$R" --camera tests/data/room_small.camera.json -o "$T/b.exr" --server "unix:$T/b.sock" -q 2>"$T/b.err"
+rc=$?
+check "the frame over --max-per-client reads 503 too_many_connections, not EOF (exit $rc: $(head -c 160 "$T/b.err"))" \
+    "[ $rc -ne 0 ] && grep -q 'too_many_connections\|too many connections' '$T/b.err'"
+kill "$HOLD" 2>/dev/null
+
 echo "-- refusals in /metrics"
 $CURL "http://127.0.0.1:$PORT_P/metrics" > "$T/p.metrics"
 n=$(sed -n 's/^obscurad_refusals_total{reason="too_many_connections"} \([0-9]*\)$/\1/p' "$T/p.metrics")
