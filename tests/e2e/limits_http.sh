@@ -114,6 +114,8 @@ sleep 0.2
 rc=$?
 check "the frame over --max-per-client reads 503 too_many_connections, not EOF (exit $rc: $(head -c 160 "$T/b.err"))" \
     "[ $rc -ne 0 ] && grep -q 'too_many_connections\|too many connections' '$T/b.err'"
+n=$($CURL "http://127.0.0.1:$PORT_B/metrics" | sed -n 's/^obscurad_refusals_total{reason="too_many_connections"} \([0-9]*\)$/\1/p')
+check "the binary refusals are counted in obscurad_refusals_total ($n)" "[ -n '$n' ] && [ '$n' -ge 1 ]"
 kill "$HOLD" 2>/dev/null
 
 echo "-- refusals in /metrics"
