@@ -66,6 +66,11 @@
     X(token_file, STRING, 0, OBSD_STR_LEN - 1, "",                             \
       "file holding a bearer token; when set, /v1/* and /metrics need "        \
       "'Authorization: Bearer TOKEN'")                                         \
+    X(cors, STRING, 0, OBSD_STR_LEN - 1, "",                                   \
+      "allow a browser page from this origin (e.g. https://preview.example."  \
+      "com, or *) to call the API: OPTIONS preflights answered 204, "         \
+      "Access-Control-Allow-Origin on every answer (empty: off, OPTIONS is "  \
+      "405)")                                                                  \
     X(streams, INT, 0, 1024, "16",                                             \
       "streams of frames kept for the preview page (POST /v1/streams/NAME/"   \
       "frames); a new one beyond drops the least recently posted-to (0: "      \

@@ -189,6 +189,7 @@ int obsd__body_expect(req *r, size_t max, const char *what, const char *flag, in
     errno = 0;
     unsigned long long n = strtoull(v, &end, 10);
     if (errno == ERANGE || n > (unsigned long long)max) {
+        r->body_in = 0; /* not held: the client waits for 100 Continue, or sends more than we would read */
         snprintf(msg, sizeof msg, "%s of %s bytes is over the limit of %lld bytes (%s)", what, v,
                  (long long)max, flag);
         *rc = obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
@@ -223,9 +224,9 @@ enum MHD_Result obsd__discard_body(req *r, size_t n, size_t max)
 {
     r->discarded += n;
     if (r->discarded > max) {
-        obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: body over twice the limit, "
+        obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: over %zu bytes of an unread body, "
                  "connection closed", (unsigned long long)r->id, r->peer, r->method,
-                 r->label);
+                 r->label, max);
         return MHD_NO;
     }
     return MHD_YES;
