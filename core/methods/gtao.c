@@ -90,9 +90,8 @@ static const float *border_step(const obs__frame *f, const float *pos, const flo
  * steps: the largest of the tangent's cosine `low` and the samples',
  * each moved from low by its falloff weight. */
 static float side_horizon(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
-                          const float c[3],
-                          const float v[3], const float omega[2], int slice, float noise_step,
-                          float min_s, int dir, float low, int *taken)
+                          const float c[3], const float v[3], const float omega[2], int slice,
+                          float noise_step, float min_s, int dir, float low, int *taken)
 {
     const obs__gtao_state *g = obs__gtao_of(f);
     float hc = low;
