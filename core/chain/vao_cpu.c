@@ -143,6 +143,26 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
     return 1;
 }
 
+/* GLSL: the branch of vao_estimate() in vao.glsl for a sample off the
+ * planes (border_cpu.c): 1 and *zs, *nz of the surface continued past the
+ * border (*zs left as it is, open, where that is background); 0 where the
+ * sample is left out of eq 1 (behind the camera, or no estimate). */
+static int border_sample(const obs__frame *f, const float *pos, const float *nrm,
+                         const obs__disk *m, int x, int y, float sx, float sy, float *zs,
+                         float *nz)
+{
+    float sw = m->w[0] * sx + m->w[1] * sy + m->w[2];
+    if (!(sw > 0.0f))
+        return 0;
+    float fu = floorf((m->u[0] * sx + m->u[1] * sy + m->u[2]) / sw);
+    float fv = floorf((m->v[0] * sx + m->v[1] * sy + m->v[2]) / sw);
+    float pt[4];
+    int got = obs__border_point(f, pos, nrm, x, y, fu, fv, pt, nz);
+    if (got > 0)
+        *zs = pt[3];
+    return got >= 0;
+}
+
 /* GLSL: vao_estimate() in vao.glsl, without colour bleeding */
 float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         const float p[3], const float n[3], int ns, const float *xy)
@@ -195,6 +215,8 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
                     cx5 = col + 4 * k;
                 }
             }
+        } else {
+            seen = border_sample(f, pos, nrm, &disk, x, y, sx, sy, &zs, &nz);
         }
         if (bleeds) {
             /* "We use c(x) to linearly interpolate between the white
@@ -217,11 +239,10 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
             float sd = obs__range_falloff(f, front - zs, nz);
             dz = 2.0f * h * (1.0f - sd);
         }
-        /* A sample off the planes (or behind the camera) says nothing
-         * about the scene: it is left out of eq 1's sum and of F alike, so
-         * V is estimated from the part of the disk that is seen, instead
-         * of counting the unseen part as open (which lightened contact
-         * shadows near the image border). */
+        /* A sample off the planes reads the surface continued past the
+         * border (border_cpu.c derives it); one behind the camera, or
+         * without that estimate, says nothing about the scene: it is left
+         * out of eq 1's sum and of F alike. */
         if (seen) {
             open += dz;
             F += R * l; /* eq 2: F = R * sum sqrt(1 - x^2 - y^2) */
