@@ -189,6 +189,7 @@ static int send_error(frame *f, int status, const char *code, const char *msg)
 {
     obs_bin_response_desc d = {.id = f->id, .status = status, .retry_after = status == 503 ? 1 : 0,
                                 .code = code, .message = msg, .body = OBS_BIN_NONE};
+    obsd_stats_error_answer(status, code, f->c->peer, msg); /* over a limit: counted by reason */
     return send_response(f, &d);
 }
 

@@ -117,10 +117,7 @@ enum MHD_Result obsd__answer_error(req *r, int status, const char *code, const c
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "application/json");
     if (hname)
         MHD_add_response_header(resp, hname, hvalue);
-    /* over a limit (connections, queue, size, time, the drain): counted by reason, logged rate-limited */
-    if (status == 408 || status == 413 || status == 503 || !strcmp(code, "too_costly") ||
-        !strcmp(code, "deadline_exceeded"))
-        obsd_stats_refusal(code, r->peer, msg);
+    obsd_stats_error_answer(status, code, r->peer, msg); /* over a limit: counted by reason */
     char note[OBS_ERR_LEN + 32];
     snprintf(note, sizeof note, "error=%s: %s", code, msg);
     return obsd__answer(r, status, resp, len, note);

@@ -150,6 +150,13 @@ static double mono_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
+void obsd_stats_error_answer(int status, const char *code, const char *peer, const char *msg)
+{
+    if (status == 408 || status == 413 || status == 503 || !strcmp(code, "too_costly") ||
+        !strcmp(code, "deadline_exceeded"))
+        obsd_stats_refusal(code, peer, msg);
+}
+
 void obsd_stats_refusal(const char *reason, const char *peer, const char *msg)
 {
     double now = mono_ms();

@@ -38,6 +38,10 @@ void obsd_stats_frame(int64_t width, int64_t height);
  * logged at warn, at most one line per reason a second, the line saying
  * how many were not logged since the last.  peer and msg: for the line. */
 void obsd_stats_refusal(const char *reason, const char *peer, const char *msg);
+/* An error answer (either protocol): a refusal over a limit (connections,
+ * queue, size, time, the drain: 408, 413, 503, too_costly,
+ * deadline_exceeded) goes to obsd_stats_refusal; any other is not one. */
+void obsd_stats_error_answer(int status, const char *code, const char *peer, const char *msg);
 
 /* Gauges sampled when the text is made. */
 typedef struct obsd_gauges {

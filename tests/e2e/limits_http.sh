@@ -117,6 +117,13 @@ check "the frame over --max-per-client reads 503 too_many_connections, not EOF (
 n=$($CURL "http://127.0.0.1:$PORT_B/metrics" | sed -n 's/^obscurad_refusals_total{reason="too_many_connections"} \([0-9]*\)$/\1/p')
 check "the binary refusals are counted in obscurad_refusals_total ($n)" "[ -n '$n' ] && [ '$n' -ge 1 ]"
 kill "$HOLD" 2>/dev/null
+# a refusal inside a binary connection (a frame over --max-body) is counted too
+start Q --socket "$T/q.sock" --max-body 1024
+"$OBSCURA" ao "$R" --camera tests/data/room_small.camera.json -o "$T/q.exr" --server "unix:$T/q.sock" -q 2>"$T/q.err"
+rc=$?
+n=$($CURL "http://127.0.0.1:$PORT_Q/metrics" | sed -n 's/^obscurad_refusals_total{reason="body_too_large"} \([0-9]*\)$/\1/p')
+check "a binary frame over --max-body: refused (exit $rc), counted as body_too_large ($n)" \
+    "[ $rc -ne 0 ] && [ '$n' = 1 ] && grep -q 'warn: refused body_too_large' '$T/Q.log'"
 
 echo "-- refusals in /metrics"
 $CURL "http://127.0.0.1:$PORT_P/metrics" > "$T/p.metrics"
