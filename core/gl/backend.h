@@ -21,6 +21,10 @@ typedef struct obs__backend_state {
 obs_status obs__egl_create(int debug, int device, obs__backend_state *st,
                            obs__getproc_fn *getproc, char err[OBS_ERR_LEN]);
 void obs__egl_destroy(obs__backend_state *st);
+/* The EGL client extensions (eglQueryString(EGL_NO_DISPLAY,
+ * EGL_EXTENSIONS)) let the device platform enumerate devices: 1, else 0
+ * with err naming the missing extension. */
+int obs__egl_device_client_ok(const char *client, char err[OBS_ERR_LEN]);
 obs_status obs__egl_make_current(obs__backend_state *st);
 
 obs_status obs__osmesa_create(obs__backend_state *st,

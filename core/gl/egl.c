@@ -22,15 +22,28 @@ static obs__glproc egl_getproc(const char *name)
     return (obs__glproc)eglGetProcAddress(name);
 }
 
+int obs__egl_device_client_ok(const char *client, char err[OBS_ERR_LEN])
+{
+    if (!has_ext(client, "EGL_EXT_platform_device")) {
+        obs__fail(err, OBS_GL_UNAVAILABLE, "egl-device: EGL_EXT_platform_device is not available");
+        return 0;
+    }
+    /* EGL_EXT_device_base is the older name of device_enumeration plus
+     * device_query, and the only one NVIDIA's driver lists (580.159) */
+    if (!has_ext(client, "EGL_EXT_device_enumeration") && !has_ext(client, "EGL_EXT_device_base")) {
+        obs__fail(err, OBS_GL_UNAVAILABLE,
+                  "egl-device: neither EGL_EXT_device_enumeration nor EGL_EXT_device_base is available");
+        return 0;
+    }
+    return 1;
+}
+
 /* The first device that is not Mesa's software rasteriser: the device
  * backend is for real GPUs; llvmpipe is reached through surfaceless. */
 static EGLDisplay device_display(char err[OBS_ERR_LEN])
 {
-    const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-    if (!has_ext(client, "EGL_EXT_platform_device") || !has_ext(client, "EGL_EXT_device_enumeration")) {
-        obs__fail(err, OBS_GL_UNAVAILABLE, "egl-device: EGL_EXT_platform_device is not available");
+    if (!obs__egl_device_client_ok(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), err))
         return EGL_NO_DISPLAY;
-    }
     PFNEGLQUERYDEVICESEXTPROC query_devices =
         (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
     PFNEGLQUERYDEVICESTRINGEXTPROC query_string =
