@@ -88,8 +88,16 @@ void obs__exr_describe(exr_const_context_t ctx, int part, const obs__channel_mat
                        obs_gbuffer *gb, obs_exr_info *info);
 
 /* The string value of part's attribute `name`, or NULL when it has none
- * or another type (core/io/exr_parts.c). */
-const char *obs__exr_attr_string(exr_const_context_t ctx, int part, const char *name);
+ * or another type (exr_parts.c and presets.c; inline, so that presets.c
+ * links without the part reader: the binary protocol's fuzzer). */
+static inline const char *obs__exr_attr_string(exr_const_context_t ctx, int part, const char *name)
+{
+    const exr_attribute_t *a = NULL;
+    if (exr_get_attribute_by_name(ctx, part, name, &a) != EXR_ERR_SUCCESS || !a ||
+        a->type != EXR_ATTR_STRING || !a->string || !a->string->str)
+        return NULL;
+    return a->string->str;
+}
 
 /* The parts a G-buffer is read from (core/io/exr_parts.c). */
 typedef struct obs__part_set {

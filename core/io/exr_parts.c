@@ -13,15 +13,6 @@
 #include "io/exr_internal.h"
 #include "internal.h"
 
-const char *obs__exr_attr_string(exr_const_context_t ctx, int part, const char *name)
-{
-    const exr_attribute_t *a = NULL;
-    if (exr_get_attribute_by_name(ctx, part, name, &a) != EXR_ERR_SUCCESS || !a ||
-        a->type != EXR_ATTR_STRING || !a->string || !a->string->str)
-        return NULL;
-    return a->string->str;
-}
-
 /* The first entry of a multiView attribute in any part, or NULL. */
 static const char *default_view(exr_const_context_t ctx, int parts, char *buf, size_t len)
 {
