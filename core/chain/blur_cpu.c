@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "chain/bands_cpu.h"
 #include "chain/frame.h"
 
 float obs__blur_pixel(const obs__frame *f, const float *pos, const float *ao, int x, int y, int dx,
@@ -33,14 +34,29 @@ float obs__blur_pixel(const obs__frame *f, const float *pos, const float *ao, in
     return sum / wsum; /* the centre always counts: wsum > 0 */
 }
 
+typedef struct blur_job {
+    const obs__frame *f;
+    const float *pos, *src;
+    float *dst;
+    int dx, dy;
+} blur_job;
+
+static void blur_rows(void *ctx, int y0, int y1)
+{
+    const blur_job *j = ctx;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < j->f->width; x++)
+            j->dst[(size_t)y * j->f->width + x] =
+                obs__blur_pixel(j->f, j->pos, j->src, x, y, j->dx, j->dy);
+}
+
+/* The two passes in row bands on the worker pool (bands_cpu.h); the
+ * vertical one starts when every row of the horizontal one is done. */
 void obs__blur(const obs__frame *f, const float *pos, float *ao, float *tmp)
 {
     if (f->blur_radius <= 0)
         return;
-    for (int y = 0; y < f->height; y++)
-        for (int x = 0; x < f->width; x++)
-            tmp[(size_t)y * f->width + x] = obs__blur_pixel(f, pos, ao, x, y, 1, 0);
-    for (int y = 0; y < f->height; y++)
-        for (int x = 0; x < f->width; x++)
-            ao[(size_t)y * f->width + x] = obs__blur_pixel(f, pos, tmp, x, y, 0, 1);
+    blur_job h = {f, pos, ao, tmp, 1, 0}, v = {f, pos, tmp, ao, 0, 1};
+    obs__cpu_rows(f->height, 0, blur_rows, &h);
+    obs__cpu_rows(f->height, 0, blur_rows, &v);
 }
