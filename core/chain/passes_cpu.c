@@ -5,6 +5,7 @@
 
 #include "chain/bands_cpu.h"
 #include "chain/passes_cpu.h"
+#include "chain/vao_cpu.h"
 
 /* GLSL: composite.frag.glsl.  Section 5: "applied to resulting image
  * simply by multiplication by occlusion values": colour x AO, and x the
@@ -51,14 +52,14 @@ static void ao_rows(void *ctx, int y0, int y1)
                     /* section 4.1: the set of the pixel's count */
                     n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
                     const float *xy = f->adaptive ? f->sample_table + 2 * (n - 2) : f->sample_xy;
-                    ao[i] = obs__vao_estimate_bleed(f, pos, nrm, col, x, y, pos + 4 * i,
-                                                    nrm + 3 * i, n, xy, b);
+                    ao[i] = obs__vao_estimate_dnz(f, pos, c->dnz, col, x, y, pos + 4 * i,
+                                                  nrm + 3 * i, n, xy, b);
                 } else if (f->culling == 2) {
                     n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
                     n = n < OBS_CULL_CAREFUL ? n : OBS_CULL_CAREFUL;
                     const float *xy = f->sample_table + 2 * (n - 2);
-                    ao[i] = obs__vao_estimate_bleed(f, pos, nrm, col, x, y, pos + 4 * i,
-                                                    nrm + 3 * i, n, xy, b);
+                    ao[i] = obs__vao_estimate_dnz(f, pos, c->dnz, col, x, y, pos + 4 * i,
+                                                  nrm + 3 * i, n, xy, b);
                 }
             }
             if (count)
@@ -90,7 +91,12 @@ static void normal_rows(void *ctx, int y0, int y1)
     for (int y = y0; y < y1; y++)
         for (int x = 0; x < f->width; x++) {
             const float *in = gb->normal.data ? obs__plane_px(&gb->normal, f->width, x, y) : NULL;
-            obs__prep_normal(f, c->pos, in, x, y, c->nrm + 3 * ((size_t)y * f->width + x));
+            const size_t i = (size_t)y * f->width + x;
+            obs__prep_normal(f, c->pos, in, x, y, c->nrm + 3 * i);
+            if (!f->half) {
+                c->dnz[2 * i] = c->pos[4 * i + 3];
+                c->dnz[2 * i + 1] = c->nrm[3 * i + 2];
+            }
         }
 }
 
@@ -141,6 +147,8 @@ static void half_rows(void *ctx, int y0, int y1)
             const size_t h = (size_t)hy * hf->width + hx;
             memcpy(c->hpos + 4 * h, c->pos + 4 * k, 4 * sizeof(float));
             memcpy(c->hnrm + 3 * h, c->nrm + 3 * k, 3 * sizeof(float));
+            c->dnz[2 * h] = c->hpos[4 * h + 3];
+            c->dnz[2 * h + 1] = c->hnrm[3 * h + 2];
         }
 }
 
@@ -158,7 +166,7 @@ static obs_status cpu_downsample(obs__cpu_run *c, char err[OBS_ERR_LEN])
 static obs_status cpu_cull(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
     (void)err;
-    obs__cull_prepass(c->pl->af, c->apos, c->anrm, c->est);
+    obs__cull_prepass_dnz(c->pl->af, c->apos, c->anrm, c->dnz, c->est);
     return OBS_OK;
 }
 

@@ -16,6 +16,9 @@ typedef struct obs__cpu_run {
     float *pos, *nrm, *ao, *tmp, *est, *col, *bleed; /* full size; col: packed RGBA */
     float *hpos, *hnrm, *hao, *htmp, *hbleed;       /* half size */
     float *apos, *anrm, *aao, *atmp, *ableed;       /* at the AO's size */
+    /* each pixel's depth and view normal z, packed (vao_cpu.h), at the
+     * AO's size: what the AO's samples read */
+    float *dnz;
     void *block;                                    /* where the planes are */
     size_t block_size;
 } obs__cpu_run;

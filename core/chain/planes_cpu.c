@@ -49,10 +49,10 @@ obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN])
         lines(n * 4), lines(n * 3), lines(n), lines(n), lines((size_t)f->cull_w * (size_t)f->cull_h),
         lines(n * 3), col ? lines(n * 4) : 0,
         f->half ? lines(an * 4) : 0, f->half ? lines(an * 3) : 0, f->half ? lines(an) : 0,
-        f->half ? lines(an) : 0, f->half ? lines(an * 3) : 0,
+        f->half ? lines(an) : 0, f->half ? lines(an * 3) : 0, lines(an * 2),
     };
     float **planes[] = {&c->pos,  &c->nrm,  &c->ao,  &c->tmp,  &c->est,  &c->bleed,
-                        &c->col,  &c->hpos, &c->hnrm, &c->hao, &c->htmp, &c->hbleed};
+                        &c->col,  &c->hpos, &c->hnrm, &c->hao, &c->htmp, &c->hbleed, &c->dnz};
     size_t need = 0;
     for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
         need += sizes[i];

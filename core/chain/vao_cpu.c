@@ -8,6 +8,13 @@
 #include <string.h>
 
 #include "chain/frame.h"
+#include "chain/vao_cpu.h"
+
+/* fmaxf and fminf as glibc computes them (the other argument when one is
+ * NaN, the first when they are equal, so also for +0 and -0), inline:
+ * the estimator calls them per sample, and gcc calls libm for them. */
+static inline float max_f(float a, float b) { return (a >= b || b != b) ? a : b; }
+static inline float min_f(float a, float b) { return (a <= b || b != b) ? a : b; }
 
 /* GLSL: adaptive_count() in vao.frag.glsl.  Section 4.1: "double the
  * number of samples every time surface area of the sampling disc
@@ -67,11 +74,16 @@ float obs__vao_pixel(const obs__frame *f, const float *pos, const float *nrm, in
 }
 
 /* GLSL: range_falloff() in common.glsl */
-float obs__range_falloff(const obs__frame *f, float d, float nz)
+static inline float range_falloff(const obs__frame *f, float d, float nz)
 {
     if (f->range_normal)
         d *= fabsf(nz); /* the pipe's depth below the flat occluder */
-    return f->range_u / fmaxf(f->range_u, d / f->radius); /* eq 4 */
+    return f->range_u / max_f(f->range_u, d / f->radius); /* eq 4 */
+}
+
+float obs__range_falloff(const obs__frame *f, float d, float nz)
+{
+    return range_falloff(f, d, nz);
 }
 
 /* GLSL: own_plane_depth(), disk_point() in common.glsl */
@@ -129,7 +141,8 @@ void obs__disk_map(const obs__frame *f, const float c[3], float r, const float r
 }
 
 /* GLSL: disk_px() in common.glsl */
-int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx, int *qy)
+static inline int disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx,
+                          int *qy)
 {
     float sw = m->w[0] * sx + m->w[1] * sy + m->w[2];
     if (!(sw > 0.0f))
@@ -143,6 +156,11 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
     return 1;
 }
 
+int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx, int *qy)
+{
+    return disk_px(f, m, sx, sy, qx, qy);
+}
+
 /* GLSL: vao_estimate() in vao.glsl, without colour bleeding */
 float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         const float p[3], const float n[3], int ns, const float *xy)
@@ -151,10 +169,14 @@ float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm,
     return obs__vao_estimate_bleed(f, pos, nrm, NULL, x, y, p, n, ns, xy, bleed);
 }
 
-/* GLSL: vao_estimate() in vao.glsl */
-float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *nrm,
-                              const float *col, int x, int y, const float p[3], const float n[3],
-                              int ns, const float *xy, float bleed[3])
+/* GLSL: vao_estimate() in vao.glsl.  The scene at a sample's pixel k:
+ * its depth at d[ds * k], its view normal's z at nz[ns_ * k] (the prep
+ * planes, or the CPU device's packed plane of the two), its position at
+ * pos + 4 k (for bleeding only). */
+static inline float estimate(const obs__frame *f, const float *pos, const float *d_at, int ds,
+                             const float *nz_at, int nzs, const float *col, int x, int y,
+                             const float p[3], const float n[3], int ns, const float *xy,
+                             float bleed[3])
 {
     const float R = f->radius, r = 0.5f * f->radius;
     /* Centre of the tangent sphere of radius R/2, moved along the normal. */
@@ -172,7 +194,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         float c5 = 0.0f; /* eq 5's c(x); 0 (white) without a surface there */
         const float *cx5 = NULL;
         float sx = xy[2 * i], sy = xy[2 * i + 1];
-        float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
+        float l = sqrtf(max_f(0.0f, 1.0f - sx * sx - sy * sy));
         float h = r * l; /* half length of the pipe through the sphere */
         int seen = 0;    /* the sample's pixel is on the planes */
 
@@ -180,13 +202,13 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         float nz = 1.0f; /* view normal z of the surface there */
         int qx, qy;
         /* The sample on the disk through the centre, perpendicular to view Z. */
-        seen = obs__disk_px(f, &disk, sx, sy, &qx, &qy);
+        seen = disk_px(f, &disk, sx, sy, &qx, &qy);
         if (seen) {
             size_t k = (size_t)qy * (size_t)f->width + (size_t)qx;
-            float d = pos[4 * k + 3];
+            float d = d_at[(size_t)ds * k];
             if (d > 0.0f) {
                 zs = d;
-                nz = nrm[3 * k + 2];
+                nz = nz_at[(size_t)nzs * k];
                 /* a sample on the shaded pixel itself: p's tangent plane */
                 if (qx == x && qy == y)
                     zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy, zs);
@@ -206,7 +228,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         /* Unoccluded length of the pipe (cases A, B, C of section 3):
          * the pipe spans depths [-c.z - h, -c.z + h]. */
         float front = -c[2] - h;
-        float dz = fminf(fmaxf(zs - front, 0.0f), 2.0f * h);
+        float dz = min_f(max_f(zs - front, 0.0f), 2.0f * h);
         if (f->range_check && zs < front) {
             /* Case C with the depth range check, section 4.4, eq 4: the
              * pipe lies d behind the visible surface; the occluder is
@@ -214,7 +236,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
              * the pipe's weight 2h counts as occluded times s(d).  d is
              * taken from the pipe's near end, so s = 1 where case C meets
              * case A (zs = front) and the two join without a step. */
-            float sd = obs__range_falloff(f, front - zs, nz);
+            float sd = range_falloff(f, front - zs, nz);
             dz = 2.0f * h * (1.0f - sd);
         }
         /* A sample off the planes (or behind the camera) says nothing
@@ -230,4 +252,18 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
     for (int j = 0; j < 3; j++)
         bleed[j] = taken > 0.0f ? acc[j] / taken : 1.0f;
     return F > 0.0f ? open / F : 1.0f; /* eq 1: V = (1/F) sum dz_i */
+}
+
+float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *nrm,
+                              const float *col, int x, int y, const float p[3], const float n[3],
+                              int ns, const float *xy, float bleed[3])
+{
+    return estimate(f, pos, pos + 3, 4, nrm + 2, 3, col, x, y, p, n, ns, xy, bleed);
+}
+
+float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *dnz,
+                            const float *col, int x, int y, const float p[3], const float n[3],
+                            int ns, const float *xy, float bleed[3])
+{
+    return estimate(f, pos, dnz, 2, dnz + 1, 2, col, x, y, p, n, ns, xy, bleed);
 }
