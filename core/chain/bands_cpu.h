@@ -13,6 +13,14 @@
  * `rows` (0: OBS__CPU_BAND_ROWS), on obs__cpu_threads() threads. */
 void obs__cpu_rows(int height, int rows, void (*fn)(void *ctx, int y0, int y1), void *ctx);
 
+/* fn(ctx, x0, x1, y0, y1) for the tiles of tw x th pixels of a width x
+ * height frame (the last ones cut), row of tiles by row of tiles, on
+ * obs__cpu_threads() threads.  For the passes whose samples reach
+ * around the pixel: a tile's neighbourhood stays in a core's cache where
+ * a band of whole rows does not. */
+void obs__cpu_tiles(int width, int height, int tw, int th,
+                    void (*fn)(void *ctx, int x0, int x1, int y0, int y1), void *ctx);
+
 /* The thread count of the CPU chain: the pool's one rule
  * (obs__pool_threads) on the count set below, 0 by default. */
 int obs__cpu_threads(void);

@@ -23,10 +23,15 @@ static void composite_pixel(const float *color, float ao, const float *bleed, fl
     out[3] = color[3];
 }
 
+#ifndef AO_TILE_W
+#define AO_TILE_W 64
+#define AO_TILE_H 16
+#endif
+
 /* The AO pass over the rows [y0, y1) of the frame at the AO's size (GLSL:
  * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
  * and the debug planes (NULL: not wanted) of every pixel. */
-static void ao_rows(void *ctx, int y0, int y1)
+static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
 {
     const obs__cpu_run *c = ctx;
     const obs__frame *f = c->pl->af;
@@ -35,7 +40,7 @@ static void ao_rows(void *ctx, int y0, int y1)
     float *ao = c->aao, *bleed = c->ableed;
     float *count = c->out->sample_count.data, *mask = c->out->cull_mask.data;
     for (int y = y0; y < y1; y++)
-        for (int x = 0; x < f->width; x++) {
+        for (int x = x0; x < x1; x++) {
             size_t i = (size_t)y * f->width + x;
             int n = 0, culled = 0;
             float *b = bleed + 3 * i;
@@ -173,8 +178,8 @@ static obs_status cpu_cull(obs__cpu_run *c, char err[OBS_ERR_LEN])
 static obs_status cpu_ao(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
     (void)err;
-    /* bands of 2 rows: the AO's cost varies most across the frame */
-    obs__cpu_rows(c->pl->af->height, 2, ao_rows, c);
+    const obs__frame *af = c->pl->af;
+    obs__cpu_tiles(af->width, af->height, AO_TILE_W, AO_TILE_H, ao_tile, c);
     return OBS_OK;
 }
 
