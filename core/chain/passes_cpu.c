@@ -202,7 +202,7 @@ static void rays(obs__cpu_run *c)
 static obs_status cpu_blur(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
     (void)err;
-    obs__blur(c->pl->af, c->apos, c->aao, c->atmp);
+    obs__blur_dnz(c->pl->af, c->apos, c->dnz, c->aao, c->atmp);
     if (c->pl->rays_in_blur)
         rays(c);
     return OBS_OK;

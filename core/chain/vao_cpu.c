@@ -13,8 +13,8 @@
 /* fmaxf and fminf as glibc computes them (the other argument when one is
  * NaN, the first when they are equal, so also for +0 and -0), inline:
  * the estimator calls them per sample, and gcc calls libm for them. */
-static inline float max_f(float a, float b) { return (a >= b || b != b) ? a : b; }
-static inline float min_f(float a, float b) { return (a <= b || b != b) ? a : b; }
+static inline __attribute__((always_inline)) float max_f(float a, float b) { return (a >= b) | (b != b) ? a : b; }
+static inline __attribute__((always_inline)) float min_f(float a, float b) { return (a <= b) | (b != b) ? a : b; }
 
 /* GLSL: adaptive_count() in vao.frag.glsl.  Section 4.1: "double the
  * number of samples every time surface area of the sampling disc
@@ -261,9 +261,86 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
     return estimate(f, pos, pos + 3, 4, nrm + 2, 3, col, x, y, p, n, ns, xy, bleed);
 }
 
+/* floorf(v) where the caller needs only its comparisons and its int:
+ * through the int conversion, which the lanes have (floorf has no SSE2
+ * form); the same value for |v| < 2^23, v itself above (already an
+ * integer), NaN kept (it fails every comparison, as floorf's does). */
+static inline __attribute__((always_inline)) float floor_lane(float v)
+{
+    const float t = (float)(int)v; /* garbage for |v| >= 2^31: not selected */
+    const float fl = t > v ? t - 1.0f : t;
+    return fabsf(v) < 8388608.0f ? fl : v;
+}
+
+/* estimate() without colour bleeding, its samples in SIMD lanes
+ * (#pragma omp simd, gcc -fopenmp-simd): each sample's pixel, depth and
+ * pipe length computed in every lane with selects in place of branches,
+ * the same operations on the same values as estimate(), then eq 1's sums
+ * taken in the samples' order, so the result is estimate()'s, bit for
+ * bit. */
+/* always inlined: into each of the clones of its caller (OBS__LANES) */
+static inline __attribute__((always_inline)) float estimate_lanes(const obs__frame *f, const float *dnz, int x, int y,
+                                   const float p[3], const float n[3], int ns, const float *xy)
+{
+    const float R = f->radius, r = 0.5f * f->radius;
+    const float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
+    const float *rot = f->rot[obs__tile_index(f, x, y)];
+    obs__disk m;
+    obs__disk_map(f, c, r, rot, &m);
+    const float fw = (float)f->width, fh = (float)f->height;
+    const int w = f->width, range = f->range_check, by_normal = f->range_normal;
+    const float u = f->range_u;
+    /* own_plane_depth()'s terms that do not depend on the sample */
+    const int own_plane = fabsf(n[2]) > OBS_OWN_PLANE_NZ;
+    float dzs[32], ls[32];
+    int seens[32];
+#pragma omp simd
+    for (int i = 0; i < ns; i++) {
+        const float sx = xy[2 * i], sy = xy[2 * i + 1];
+        const float l = sqrtf(max_f(0.0f, 1.0f - sx * sx - sy * sy));
+        const float h = r * l;
+        /* disk_px() */
+        const float sw = m.w[0] * sx + m.w[1] * sy + m.w[2];
+        const float fu = floor_lane((m.u[0] * sx + m.u[1] * sy + m.u[2]) / sw);
+        const float fv = floor_lane((m.v[0] * sx + m.v[1] * sy + m.v[2]) / sw);
+        const int seen = (sw > 0.0f) & (fu >= 0.0f) & (fv >= 0.0f) & (fu < fw) & (fv < fh);
+        const int qx = (int)fu & -seen, qy = (int)fv & -seen; /* 0 off the planes */
+        const int k = qy * w + qx; /* < 2^28 (the frame's size limit) */
+        const float d = dnz[2 * k], nzk = dnz[2 * k + 1];
+        const int hit = seen & (d > 0.0f);
+        /* own_plane_depth() on the shaded pixel itself */
+        const float spx = c[0] + r * (rot[0] * sx - rot[1] * sy);
+        const float spy = c[1] + r * (rot[1] * sx + rot[0] * sy);
+        const float own = -p[2] + (n[0] * (spx - p[0]) + n[1] * (spy - p[1])) / n[2];
+        const int self = hit & (qx == x) & (qy == y) & own_plane;
+        const float zs = self ? own : hit ? d : INFINITY;
+        const float nz = hit ? nzk : 1.0f;
+        const float front = -c[2] - h;
+        const float dz_ab = min_f(max_f(zs - front, 0.0f), 2.0f * h);
+        /* range_falloff(), eq 4 */
+        const float dd = by_normal ? (front - zs) * fabsf(nz) : front - zs;
+        const float sd = u / max_f(u, dd / R);
+        const float dz_c = 2.0f * h * (1.0f - sd);
+        dzs[i] = range & (zs < front) ? dz_c : dz_ab;
+        ls[i] = l;
+        seens[i] = seen;
+    }
+    float open = 0.0f, F = 0.0f;
+    for (int i = 0; i < ns; i++)
+        if (seens[i]) {
+            open += dzs[i];
+            F += R * ls[i]; /* eq 2 */
+        }
+    return F > 0.0f ? open / F : 1.0f; /* eq 1 */
+}
+
+OBS__LANES
 float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *dnz,
                             const float *col, int x, int y, const float p[3], const float n[3],
                             int ns, const float *xy, float bleed[3])
 {
-    return estimate(f, pos, dnz, 2, dnz + 1, 2, col, x, y, p, n, ns, xy, bleed);
+    if (col && f->bleed_step > 0)
+        return estimate(f, pos, dnz, 2, dnz + 1, 2, col, x, y, p, n, ns, xy, bleed);
+    bleed[0] = bleed[1] = bleed[2] = 1.0f;
+    return estimate_lanes(f, dnz, x, y, p, n, ns, xy);
 }

@@ -5,6 +5,19 @@
 
 #include "chain/frame.h"
 
+/* The kernels whose samples or pixels run in SIMD lanes (#pragma omp
+ * simd) are built three times, for the baseline (SSE2), AVX2 with FMA
+ * (x86-64-v3: gathers, 8 lanes) and AVX-512 (x86-64-v4: 16 lanes), the
+ * best the processor has chosen when the library loads (gcc's
+ * target_clones, an ifunc).  The same operations in every build (no
+ * contraction into FMA: -std=c11 means -ffp-contract=off), so the same
+ * results. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define OBS__LANES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define OBS__LANES
+#endif
+
 /* obs__vao_estimate_bleed (the same arithmetic, the same result) reading
  * each sample's depth and view normal z from dnz, the two packed per
  * pixel (dnz[2 k] = pos[4 k + 3], dnz[2 k + 1] = nrm[3 k + 2]): a sample
@@ -17,5 +30,8 @@ float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *
 /* obs__cull_prepass (the same result) with the estimator above. */
 void obs__cull_prepass_dnz(const obs__frame *f, const float *pos, const float *nrm,
                            const float *dnz, float *est);
+
+/* obs__blur (the same result, bit for bit) with the depths from dnz. */
+void obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp);
 
 #endif
