@@ -108,7 +108,7 @@ typedef struct blur_job {
     const obs__frame *f;
     const float *pos, *dnz, *src; /* dnz: NULL, or the packed plane (vao_cpu.h) */
     float *dst;
-    int dx;
+    int dx, rays; /* rays: the conversion of ao_definition rays after the pass */
 } blur_job;
 
 OBS__LANES
@@ -119,13 +119,17 @@ static void blur_rows(void *ctx, int y0, int y1)
         blur_pass_rows(j->f, j->pos, j->dnz, 2, j->src, j->dst, j->dx, y0, y1);
     else
         blur_pass_rows(j->f, j->pos, j->pos + 3, 4, j->src, j->dst, j->dx, y0, y1);
+    const size_t w = (size_t)j->f->width;
+    for (size_t i = (size_t)y0 * w; j->rays && i < (size_t)y1 * w; i++)
+        j->dst[i] = obs__rays_from_volume(j->dst[i]);
 }
 
-static void blur(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp)
+static void blur(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp,
+                 int rays)
 {
     if (f->blur_radius <= 0)
         return;
-    blur_job h = {f, pos, dnz, ao, tmp, 1}, v = {f, pos, dnz, tmp, ao, 0};
+    blur_job h = {f, pos, dnz, ao, tmp, 1, 0}, v = {f, pos, dnz, tmp, ao, 0, rays};
     obs__cpu_rows(f->height, 0, blur_rows, &h);
     obs__cpu_rows(f->height, 0, blur_rows, &v);
 }
@@ -134,10 +138,11 @@ static void blur(const obs__frame *f, const float *pos, const float *dnz, float 
  * vertical one starts when every row of the horizontal one is done. */
 void obs__blur(const obs__frame *f, const float *pos, float *ao, float *tmp)
 {
-    blur(f, pos, NULL, ao, tmp);
+    blur(f, pos, NULL, ao, tmp, 0);
 }
 
-void obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp)
+void obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp,
+                   int rays)
 {
-    blur(f, pos, dnz, ao, tmp);
+    blur(f, pos, dnz, ao, tmp, rays);
 }

@@ -198,13 +198,11 @@ static void rays(obs__cpu_run *c)
 }
 
 /* Section 4.6, the low-pass filter; the conversion of ao_definition rays
- * after it, as GL's vertical pass does. */
+ * in its vertical pass's sweep, as GL's vertical pass does. */
 static obs_status cpu_blur(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
     (void)err;
-    obs__blur_dnz(c->pl->af, c->apos, c->dnz, c->aao, c->atmp);
-    if (c->pl->rays_in_blur)
-        rays(c);
+    obs__blur_dnz(c->pl->af, c->apos, c->dnz, c->aao, c->atmp, c->pl->rays_in_blur);
     return OBS_OK;
 }
 

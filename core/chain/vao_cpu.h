@@ -31,7 +31,11 @@ float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *
 void obs__cull_prepass_dnz(const obs__frame *f, const float *pos, const float *nrm,
                            const float *dnz, float *est);
 
-/* obs__blur (the same result, bit for bit) with the depths from dnz. */
-void obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp);
+/* obs__blur (the same result, bit for bit) with the depths from dnz;
+ * with rays, each row of the vertical pass then converted by
+ * obs__rays_from_volume (ao_definition rays, as GL's vertical pass does),
+ * in the same sweep. */
+void obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp,
+                   int rays);
 
 #endif

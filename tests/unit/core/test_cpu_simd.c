@@ -2,7 +2,8 @@
  * stand for: the low-pass filter (VAO++ 4.6) in SIMD lanes
  * (obs__blur_dnz, obs__blur) against obs__blur_pixel pixel by pixel, bit
  * for bit, on a synthetic frame with background, depth edges and odd
- * sizes (the rows' scalar ends), at several filter radii; the VAO
+ * sizes (the rows' scalar ends), at several filter radii, with and
+ * without ao_definition rays' conversion in its vertical sweep; the VAO
  * estimator's samples in SIMD lanes (obs__vao_estimate_dnz) against the
  * twin's obs__vao_estimate at every pixel of room_small, bit for bit, for
  * every sample set and the depth range check's forms. */
@@ -39,8 +40,8 @@ static void scene(float *pos, float *dnz, float *ao)
 
 static void test_blur_bit_for_bit(void **state)
 {
-    static float pos[4 * W * H], dnz[2 * W * H], ao[W * H], a1[W * H], a2[W * H], ref[W * H],
-        tmp[W * H];
+    static float pos[4 * W * H], dnz[2 * W * H], ao[W * H], a1[W * H], a2[W * H], a3[W * H],
+        ref[W * H], tmp[W * H];
     (void)state;
     scene(pos, dnz, ao);
     for (int radius = 1; radius <= 7; radius += 3) {
@@ -61,9 +62,15 @@ static void test_blur_bit_for_bit(void **state)
                 ref[y * W + x] = obs__blur_pixel(&f, pos, tmp, x, y, 0, 1);
         memcpy(a1, ao, sizeof ao);
         memcpy(a2, ao, sizeof ao);
-        obs__blur_dnz(&f, pos, dnz, a1, tmp);
+        obs__blur_dnz(&f, pos, dnz, a1, tmp, 0);
         obs__blur(&f, pos, a2, tmp);
+        memcpy(a3, ao, sizeof ao);
+        obs__blur_dnz(&f, pos, dnz, a3, tmp, 1); /* ao_definition rays in the vertical sweep */
         for (int i = 0; i < W * H; i++) {
+            float rays = obs__rays_from_volume(ref[i]);
+            if (memcmp(&a3[i], &rays, sizeof(float)))
+                fail_msg("radius %d, rays, pixel (%d, %d): %.9g, the twin %.9g", radius, i % W,
+                         i / W, a3[i], rays);
             if (memcmp(&a1[i], &ref[i], sizeof(float)) || memcmp(&a2[i], &ref[i], sizeof(float)))
                 fail_msg("radius %d, pixel (%d, %d): %.9g and %.9g, the twin %.9g", radius, i % W,
                          i / W, a1[i], a2[i], ref[i]);
