@@ -119,9 +119,9 @@ static void blur_rows(void *ctx, int y0, int y1)
         blur_pass_rows(j->f, j->pos, j->dnz, 2, j->src, j->dst, j->dx, y0, y1);
     else
         blur_pass_rows(j->f, j->pos, j->pos + 3, 4, j->src, j->dst, j->dx, y0, y1);
-    const size_t w = (size_t)j->f->width;
-    for (size_t i = (size_t)y0 * w; j->rays && i < (size_t)y1 * w; i++)
-        j->dst[i] = obs__rays_from_volume(j->dst[i]);
+    if (j->rays)
+        obs__rays_rows(j->dst + (size_t)y0 * (size_t)j->f->width,
+                       (size_t)(y1 - y0) * (size_t)j->f->width);
 }
 
 static void blur(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp,

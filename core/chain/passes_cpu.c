@@ -188,8 +188,7 @@ static void rays_rows(void *ctx, int y0, int y1)
 {
     const obs__cpu_run *c = ctx;
     const size_t w = (size_t)c->pl->f.width;
-    for (size_t i = (size_t)y0 * w; i < (size_t)y1 * w; i++)
-        c->ao[i] = obs__rays_from_volume(c->ao[i]);
+    obs__rays_rows(c->ao + (size_t)y0 * w, (size_t)(y1 - y0) * w);
 }
 
 static void rays(obs__cpu_run *c)

@@ -114,6 +114,16 @@ float obs__rays_from_volume(float ao)
     return 1.0f - blocked;
 }
 
+void obs__rays_rows(float *ao, size_t n)
+{
+    /* the open pixels (AO exactly 1: the background, and the blur of an
+     * open neighbourhood, whose sums are then equal) take the value the
+     * conversion gives 1, computed once: the same float */
+    const float open = obs__rays_from_volume(1.0f);
+    for (size_t i = 0; i < n; i++)
+        ao[i] = ao[i] == 1.0f ? open : obs__rays_from_volume(ao[i]);
+}
+
 /* GLSL: disk_map() in common.glsl */
 void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
                    obs__disk *m)

@@ -31,6 +31,10 @@ float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *
 void obs__cull_prepass_dnz(const obs__frame *f, const float *pos, const float *nrm,
                            const float *dnz, float *est);
 
+/* obs__rays_from_volume of each of the n values at ao, in place (the
+ * same results). */
+void obs__rays_rows(float *ao, size_t n);
+
 /* obs__blur (the same result, bit for bit) with the depths from dnz;
  * with rays, each row of the vertical pass then converted by
  * obs__rays_from_volume (ao_definition rays, as GL's vertical pass does),

@@ -152,11 +152,31 @@ static void test_vao_bit_for_bit(void **state)
     }
 }
 
+/* ao_definition rays over rows: obs__rays_from_volume of every value,
+ * 1 (the open pixels' shortcut) and values around it included. */
+static void test_rays_rows(void **state)
+{
+    enum { N = 4099 };
+    static float v[N], want[N];
+    (void)state;
+    for (int i = 0; i < N; i++) {
+        v[i] = i % 3 == 0 ? 1.0f : (float)i / (float)(N - 7) - 0.001f; /* -0.001 .. 1.0 and past */
+        want[i] = obs__rays_from_volume(v[i]);
+    }
+    v[5] = nextafterf(1.0f, 0.0f);
+    want[5] = obs__rays_from_volume(v[5]);
+    obs__rays_rows(v, N);
+    for (int i = 0; i < N; i++)
+        if (memcmp(&v[i], &want[i], sizeof(float)))
+            fail_msg("value %d: %.9g, the twin %.9g", i, v[i], want[i]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_blur_bit_for_bit),
         cmocka_unit_test(test_vao_bit_for_bit),
+        cmocka_unit_test(test_rays_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
