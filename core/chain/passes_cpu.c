@@ -28,22 +28,24 @@ static void composite_pixel(const float *color, float ao, const float *bleed, fl
 #define AO_TILE_H 16
 #endif
 
-/* The AO pass over the rows [y0, y1) of the frame at the AO's size (GLSL:
+/* The AO pass over a tile of the frame at the AO's size (GLSL:
  * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
- * and the debug planes (NULL: not wanted) of every pixel. */
+ * (when the composite or the output reads it) and the debug planes (NULL:
+ * not wanted) of every pixel. */
 static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
 {
     const obs__cpu_run *c = ctx;
     const obs__frame *f = c->pl->af;
     const obs__method *method = c->pl->method;
     const float *pos = c->apos, *nrm = c->anrm, *col = c->col, *est = c->est;
-    float *ao = c->aao, *bleed = c->ableed;
+    float *ao = c->aao, *bleed = c->ableed, unread[3];
+    const int bleed_read = c->pl->f.bleed_step || c->out->bleed.data;
     float *count = c->out->sample_count.data, *mask = c->out->cull_mask.data;
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
             size_t i = (size_t)y * f->width + x;
             int n = 0, culled = 0;
-            float *b = bleed + 3 * i;
+            float *b = bleed_read ? bleed + 3 * i : unread;
             ao[i] = 1.0f;
             b[0] = b[1] = b[2] = 1.0f;
             if (method->pixel) {
