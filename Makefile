@@ -99,7 +99,7 @@ DAEMON_BENCH := $(BUILD)/daemon_bench
 -include protocol/protocol.mk daemon/daemon.mk clients/clients.mk tests/fuzz/fuzz.mk
 E2E_DEPS += $(UPSCALE)
 
-.PHONY: all deps demo demo-run test check unit e2e loops headers readme readme-check samples bench quality bake-quality clean deep-fixture
+.PHONY: all deps demo demo-run test test-long check unit e2e loops headers readme readme-check samples bench quality bake-quality clean deep-fixture
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI) $(EXTRA_BINS)
@@ -195,10 +195,17 @@ demo-run: all
 	@echo "demo: wrote out/room_small.exr (AO.Y + R,G,B,A), out/room_small_ao.png, out/room_small_composite.png"
 
 # ---- tests --------------------------------------------------------------
-# make test = the whole suite, then the same suite under ASan/UBSan.
+# make test = the whole suite, then the same suite under ASan/UBSan but for
+# the sanitizer pass of the slowest e2e scripts (each over 20 s under ASan),
+# which make test-long runs (CI runs both).
+E2E_LONG = bake progcache dynamic run load output deploy hostile_binary bakes python_client \
+           guards hostile_http provenance remote
 test: deps
 	$(MAKE) check
-	$(MAKE) check BUILD=build/asan SAN=1
+	$(MAKE) check BUILD=build/asan SAN=1 E2E_SKIP="$(E2E_LONG)"
+
+test-long: deps
+	$(MAKE) all e2e BUILD=build/asan SAN=1 E2E_ONLY="$(E2E_LONG)"
 
 check: all headers loops unit e2e readme-check
 
@@ -228,12 +235,22 @@ loops: $(CORE_OBJ) $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
 	@tools/call_loops.py $(PROTO_OBJ) $(CLI_OBJ)
 	@tools/call_loops.py --internal $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
 
-# Every tests/e2e/*.sh runs with the binaries' paths in the environment.
+# Every tests/e2e/*.sh runs with the binaries' paths in the environment,
+# two at a time on two cores (tests/run_e2e.sh); those in E2E_ALONE time
+# the daemon and run afterwards, one at a time.  E2E_ONLY / E2E_SKIP: the
+# scripts' names (without .sh) to run, or to leave to another target.
 E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)
+E2E_ALONE = drain load output bakes hostile_http limits recover
+E2E_ALL = $(wildcard tests/e2e/*.sh)
+E2E_RUN = $(if $(E2E_ONLY),$(filter $(addprefix tests/e2e/,$(addsuffix .sh,$(E2E_ONLY))),$(E2E_ALL)),\
+            $(filter-out $(addprefix tests/e2e/,$(addsuffix .sh,$(E2E_SKIP))),$(E2E_ALL)))
+
+# the longest first, so that the two lanes end together
+E2E_FIRST = $(addprefix tests/e2e/,$(addsuffix .sh,fuzz bake progcache dynamic deploy hostile_binary run))
 
 e2e: $(CLI) $(E2E_DEPS)
-	@rc=0; for t in tests/e2e/*.sh; do s=$$(date +%s); $(E2E_ENV) $$t || rc=1; \
-	  echo "e2e: $$t took $$(( $$(date +%s) - s )) s"; done; exit $$rc
+	@$(E2E_ENV) E2E_ALONE="$(E2E_ALONE)" tests/run_e2e.sh $(filter $(E2E_FIRST),$(E2E_RUN)) \
+	  $(filter-out $(E2E_FIRST),$(E2E_RUN))
 
 # Every public header compiles alone, as C and as C++.
 headers:

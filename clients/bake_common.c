@@ -9,7 +9,9 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "flags.h"
 #include "obscura/dynamic.h"
+#include "obscura/obscura.h"
 
 /* The tables' own functions take their own struct: these pass it on. */
 static obs_status bake_set(void *p, const char *name, const char *value, char err[OBS_ERR_LEN])
@@ -93,9 +95,40 @@ static int take_value(const cli_bake_cmd *c, const char *key, const char *val, c
     return 1;
 }
 
+/* An unknown option: a usage error naming the nearest of the shared
+ * options, the command's own and its table's ("--rayz": did you mean
+ * --rays?), as obscura ao does (flags.h). */
+static void die_unknown(const cli_bake_cmd *c, const char *arg)
+{
+    static const char *const shared[] = {"o", "output", "shard", "report", "decorators", "params",
+                                         "params-markdown", "quiet", "q", "progress", "merge", NULL};
+    char shown[256];
+    cli_suggest sg;
+    cli_suggest_start(&sg, arg);
+    for (int k = 0; shared[k]; k++)
+        cli_suggest_try(&sg, shared[k]);
+    for (int k = 0; c->flags && c->flags[k]; k++)
+        cli_suggest_try(&sg, c->flags[k]);
+    for (const cli_bake_str *o = c->strs; o && o->key; o++)
+        cli_suggest_try(&sg, o->key);
+    for (int k = 0; k < c->table->count(); k++)
+        cli_suggest_try(&sg, c->table->at(k)->name);
+    cli_escape(arg, shown, sizeof shown);
+    cli_die_usage(c->name, "unknown option '%s'%s%s%s ('obscura %s --params' lists the parameters)", shown,
+                  sg.best[0] ? "; did you mean " : "", sg.best, sg.best[0] ? "?" : "", c->name);
+}
+
 int cli_bake_parse(const cli_bake_cmd *c, int argc, char **argv, cli_bake_args *a)
 {
     *a = (cli_bake_args){.shard = -1};
+    /* --threads (main took it: cli_take_threads) is the table's threads
+     * parameter too, so the report says the count that ran */
+    obs_threads_info ti;
+    obs_threads_get(&ti);
+    char tv[16], terr[OBS_ERR_LEN];
+    snprintf(tv, sizeof tv, "%d", ti.limit);
+    if (ti.limit && c->table->find("threads") && c->table->set(c->params, "threads", tv, terr) != OBS_OK)
+        cli_die_usage(c->name, "%s", terr);
     int merging = 0;
     a->parts = calloc((size_t)argc + 1, sizeof *a->parts);
     if (!a->parts)
@@ -141,8 +174,7 @@ int cli_bake_parse(const cli_bake_cmd *c, int argc, char **argv, cli_bake_args *
         } else if (!val) {
             cli_die_usage(c->name, "option --%s needs a value", key);
         } else if (!take_value(c, key, val, a)) {
-            cli_die_usage(c->name, "unknown option '%s' ('obscura %s --params' lists the parameters)",
-                          arg, c->name);
+            die_unknown(c, arg);
         }
         if (takes && !eq)
             i++;

@@ -1,12 +1,16 @@
 /* What the CLI's commands share: see cli.h. */
 #include "cli.h"
 
+#include <dirent.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
 #include <string.h>
 #include <errno.h>
+
+#include "flags.h"
+#include "obscura/obscura.h"
 
 int cli_status_exit(obs_status s)
 {
@@ -54,31 +58,6 @@ void cli_escape(const char *in, char *out, size_t len)
         out[o++] = hex[*c & 15];
     }
     out[o] = '\0';
-}
-
-int cli_edit_distance(const char *a, const char *b)
-{
-    size_t la = strlen(a), lb = strlen(b);
-    int row[64];
-    if (lb >= sizeof row / sizeof row[0] || la >= 64)
-        return 1 << 20; /* no option is that long */
-    for (size_t j = 0; j <= lb; j++)
-        row[j] = (int)j;
-    for (size_t i = 1; i <= la; i++) {
-        int diag = row[0];
-        row[0] = (int)i;
-        for (size_t j = 1; j <= lb; j++) {
-            int up = row[j];
-            int best = diag + (a[i - 1] != b[j - 1]);
-            if (up + 1 < best)
-                best = up + 1;
-            if (row[j - 1] + 1 < best)
-                best = row[j - 1] + 1;
-            row[j] = best;
-            diag = up;
-        }
-    }
-    return row[lb];
 }
 
 void cli_progress_percent(int *last, long done, long total)
@@ -186,3 +165,58 @@ obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
+
+/* A thread count as the user wrote it: digits only, in [0, 64] (0: every
+ * core, the bakes' threads parameter's meaning); else -1. */
+static int threads_value(const char *v)
+{
+    char *end;
+    errno = 0;
+    long n = strtol(v, &end, 10);
+    if (!*v || *end || errno || v[0] == '+' || v[0] == ' ' || n < 0 || n > 64)
+        return -1;
+    return (int)n;
+}
+
+int cli_take_threads(const char *cmd, int argc, char **argv)
+{
+    const char *given = NULL, *from = "--threads", *v;
+    int n = 0;
+    for (int i = 0; i < argc; i++) {
+        int k = cli_flag_value(argc, argv, &i, "threads", &v);
+        if (k < 0)
+            cli_die_usage(cmd, "option --threads needs a value (a whole number in [0, 64], 0: every core)");
+        if (k > 0)
+            given = v;
+        else
+            argv[n++] = argv[i];
+    }
+    if (!given) {
+        given = getenv("OBSCURA_THREADS");
+        from = "OBSCURA_THREADS";
+        if (!given || !*given) /* set empty: as unset, as OBSCURA_BACKEND */
+            return n;
+    }
+    char shown[64], err[OBS_ERR_LEN];
+    int t = threads_value(given);
+    cli_escape(given, shown, sizeof shown);
+    if (t < 0)
+        cli_die_usage(cmd, "%s: '%s' is not a whole number in [0, 64] (the threads this process may "
+                      "run: llvmpipe's and every worker pool's; 0: every core)", from, shown);
+    if (obs_threads_set(t, err) != OBS_OK)
+        cli_die_usage(cmd, "%s: %s", from, err);
+    return n;
+}
+
+int cli_process_threads(void)
+{
+    DIR *d = opendir("/proc/self/task");
+    struct dirent *e;
+    int n = 0;
+    if (!d)
+        return -1;
+    while ((e = readdir(d)))
+        n += e->d_name[0] != '.';
+    closedir(d);
+    return n;
+}

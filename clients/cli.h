@@ -37,13 +37,19 @@ obs_status cli_read_text(const char *path, char **out, char err[OBS_ERR_LEN]);
  * fit len: a name or message read from a file cannot drive the terminal. */
 void cli_escape(const char *in, char *out, size_t len);
 
-/* Levenshtein distance of a and b (the "did you mean" of an unknown
- * option); a large number for words of 64 bytes or more. */
-int cli_edit_distance(const char *a, const char *b);
-
 /* --progress percent: "Progress: N%" on stdout (the line Deadline's and
  * OpenCue's progress parsers read) when N differs from *last. */
 void cli_progress_percent(int *last, long done, long total);
+
+/* --threads N (else OBSCURA_THREADS) of a command that renders, bakes or
+ * reads: taken out of argv (the new argc returned) and made the process's
+ * thread limit (obs_threads_set: every worker pool and llvmpipe's
+ * LP_NUM_THREADS, unless the user set that).  N is a whole number in
+ * [0, 64] (0: every core); anything else is a usage error of cmd (exit 2). */
+int cli_take_threads(const char *cmd, int argc, char **argv);
+
+/* The threads this process runs now (/proc/self/task); -1 unknown. */
+int cli_process_threads(void);
 
 /* Seconds of CLOCK_MONOTONIC (progress, stage times). */
 double cli_now_s(void);

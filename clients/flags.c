@@ -4,6 +4,31 @@
 #include <stdio.h>
 #include <string.h>
 
+int cli_edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    int row[64];
+    if (lb >= sizeof row / sizeof row[0] || la >= 64)
+        return 1 << 20; /* no option is that long */
+    for (size_t j = 0; j <= lb; j++)
+        row[j] = (int)j;
+    for (size_t i = 1; i <= la; i++) {
+        int diag = row[0];
+        row[0] = (int)i;
+        for (size_t j = 1; j <= lb; j++) {
+            int up = row[j];
+            int best = diag + (a[i - 1] != b[j - 1]);
+            if (up + 1 < best)
+                best = up + 1;
+            if (row[j - 1] + 1 < best)
+                best = row[j - 1] + 1;
+            row[j] = best;
+            diag = up;
+        }
+    }
+    return row[lb];
+}
+
 int cli_flag_value(int argc, char **argv, int *i, const char *name, const char **value)
 {
     const char *a = argv[*i];
@@ -67,4 +92,25 @@ int cli_request_flag(int argc, char **argv, int *i, obs_http_request *r,
         return obs_http_option_set(r, op, v, OBS_HTTP_CLI, err) == OBS_OK ? 1 : -1;
     }
     return 0;
+}
+
+void cli_suggest_start(cli_suggest *s, const char *arg)
+{
+    const char *name = arg + strspn(arg, "-");
+    snprintf(s->word, sizeof s->word, "%.*s", (int)strcspn(name, "="), name);
+    s->best[0] = '\0';
+    s->best_d = 3;
+}
+
+void cli_suggest_try(cli_suggest *s, const char *name)
+{
+    char cand[64];
+    snprintf(cand, sizeof cand, "%s", name);
+    for (char *p = cand; *p; p++)
+        *p = *p == '_' ? '-' : *p;
+    int d = cli_edit_distance(s->word, cand);
+    if (d < s->best_d && d < (int)strlen(s->word)) {
+        s->best_d = d;
+        snprintf(s->best, sizeof s->best, "%s%s", cand[1] ? "--" : "-", cand);
+    }
 }

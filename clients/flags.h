@@ -13,6 +13,10 @@
  * is missing (NAME is the last argument). */
 int cli_flag_value(int argc, char **argv, int *i, const char *name, const char **value);
 
+/* Levenshtein distance of a and b (the "did you mean" of an unknown
+ * option); a large number for words of 64 bytes or more. */
+int cli_edit_distance(const char *a, const char *b);
+
 /* argv is exactly --NAME (a switch takes no value).  0 / 1. */
 int cli_is_switch(const char *arg, const char *name);
 
@@ -24,5 +28,17 @@ int cli_is_switch(const char *arg, const char *name);
  * when its value is bad or missing. */
 int cli_request_flag(int argc, char **argv, int *i, obs_http_request *r,
                      const obs_http_option **which, char err[OBS_ERR_LEN]);
+
+/* The "did you mean" of an unknown option: start with the argument as
+ * typed, try every option name the command knows (a table's '_' read as
+ * '-'); best is the nearest at most two edits away and fewer edits than
+ * the word has letters, spelled --name (-n for one letter), or "". */
+typedef struct cli_suggest {
+    char word[64];
+    char best[80];
+    int best_d;
+} cli_suggest;
+void cli_suggest_start(cli_suggest *s, const char *arg);
+void cli_suggest_try(cli_suggest *s, const char *name);
 
 #endif

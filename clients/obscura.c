@@ -107,6 +107,8 @@ static const cli_opt ao_opts[] = {
     {"cache-dir", "DIR", "program cache folder (or OBSCURA_CACHE_DIR; default "
      "$XDG_CACHE_HOME/obscura, else ~/.cache/obscura; '': none)"},
     {"cpu", NULL, "the same as --backend cpu"},
+    {"threads", "N", "the threads this process may run, 1..64 (or OBSCURA_THREADS; default every "
+     "core): llvmpipe's (LP_NUM_THREADS, unless set) and every worker pool's"},
     {"server", "URL[,URL...]", "run on obscurad: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT; a "
      "comma list spreads frames over several (the next one when one is busy or down)"},
     {"stream", "NAME", "with an http:// --server: post the frame to the daemon's stream NAME too "
@@ -132,7 +134,7 @@ static const struct {
     {"inspect", "  obscura inspect IN.exr [--json] [--preset P] [--depth-mode M] ...\n"
                 "                  what obscura reads: renderer, channels, camera and its source,\n"
                 "                  conventions, windows, part, sanity warnings\n"},
-    {"info", "  obscura info [--backend B]\n"},
+    {"info", "  obscura info [--backend B] [--threads N]\n"},
     {"params", "  obscura params [--markdown]\n"},
     {"samples", "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as "
                 "core/chain/sample_tables.c\n"},
@@ -179,6 +181,12 @@ static const char exit_codes[] =
     "\nexit codes: 0 ok, 1 failure, 2 usage, 3 bad input (batch: also a missing frame, or\n"
     "nothing written), 4 server unreachable or busy\n";
 
+/* Every command but params and samples takes --threads (main: cli_take_threads). */
+static const char threads_note[] =
+    "\n--threads N (or OBSCURA_THREADS), on every command but params and samples: the threads\n"
+    "this process may run, 1..64 (default every core): llvmpipe's (LP_NUM_THREADS, unless set)\n"
+    "and every worker pool's (the bakes' threads parameter is the same setting)\n";
+
 static void usage(FILE *f)
 {
     fprintf(f, "obscura %s: ambient occlusion for G-buffer EXRs (VAO on OpenGL)\n\nusage:\n", OBS_VERSION);
@@ -189,6 +197,7 @@ static void usage(FILE *f)
     cli_bake_usage(f);
     cli_dynamic_usage(f);
     usage_ao_options(f);
+    fputs(threads_note, f);
     fputs(exit_codes, f);
 }
 
@@ -201,7 +210,9 @@ static int usage_of(FILE *f, const char *cmd)
         if (!strcmp(cmd, usage_lines[i].cmd)) {
             fputs(usage_lines[i].text, f);
             if (!strcmp(cmd, "ao") || !strcmp(cmd, "batch"))
-                usage_ao_options(f);
+                usage_ao_options(f); /* --threads is one of them */
+            else if (strcmp(cmd, "params") && strcmp(cmd, "samples"))
+                fputs(threads_note, f);
             fputs(exit_codes, f);
             return 1;
         }
@@ -215,6 +226,7 @@ static int usage_of(FILE *f, const char *cmd)
         cli_dynamic_usage(f);
     else
         return 0;
+    fputs(threads_note, f);
     fputs(exit_codes, f);
     return 1;
 }
@@ -233,37 +245,21 @@ typedef struct ao_args {
     obs_http_request req;
 } ao_args;
 
-/* c (an option's name) into best when it is nearer to word than *best_d
- * edits, and fewer edits than word has letters. */
-static void nearer(const char *word, const char *c, int *best_d, char *best, size_t len)
-{
-    int d = cli_edit_distance(word, c);
-    if (d < *best_d && d < (int)strlen(word)) {
-        *best_d = d;
-        snprintf(best, len, "%s%s", c[1] ? "--" : "-", c);
-    }
-}
-
 /* An unknown option: a usage error, with the nearest of the ao options
  * and the parameter table's names when one is at most two edits away
  * ("--radiu": did you mean --radius?). */
 static void die_unknown_option(const char *arg)
 {
-    char word[64], cand[80], best[80] = "", shown[256];
-    const char *name = arg + strspn(arg, "-");
-    int best_d = 3;
-    snprintf(word, sizeof word, "%.*s", (int)strcspn(name, "="), name);
+    char shown[256];
+    cli_suggest sg;
+    cli_suggest_start(&sg, arg);
     for (const cli_opt *o = ao_opts; o->name; o++)
-        nearer(word, o->name, &best_d, best, sizeof best);
-    for (int k = 0; k < obs_param_count(); k++) {
-        snprintf(cand, sizeof cand, "%s", obs_param_at(k)->name);
-        for (char *p = cand; *p; p++)
-            *p = *p == '_' ? '-' : *p;
-        nearer(word, cand, &best_d, best, sizeof best);
-    }
+        cli_suggest_try(&sg, o->name);
+    for (int k = 0; k < obs_param_count(); k++)
+        cli_suggest_try(&sg, obs_param_at(k)->name);
     cli_escape(arg, shown, sizeof shown);
-    if (best[0])
-        die_usage("unknown option '%s'; did you mean %s?", shown, best);
+    if (sg.best[0])
+        die_usage("unknown option '%s'; did you mean %s?", shown, sg.best);
     die_usage("unknown option '%s'", shown);
 }
 
@@ -612,6 +608,16 @@ static int cli_result_warnings(const ao_args *a, const obs_image *ao, const obs_
     return cli_warnings_from(a->in, info, from, a->req.strict, "not written");
 }
 
+/* The daemon's warnings on a remote frame (its checks of the result,
+ * and of the input where this process did not make them), printed and
+ * failed under --strict as an in-process run's own. */
+static int cli_remote_result_warnings(const ao_args *a, obs_exr_info *info)
+{
+    int from = info->warning_count;
+    cli_remote_take_warnings(info);
+    return cli_warnings_from(a->in, info, from, a->req.strict, "not written");
+}
+
 static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *server, int argc, char **argv)
 {
     char err[OBS_ERR_LEN] = "";
@@ -805,6 +811,9 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
         *t0 = now_ms();
         s = obs_run(*ctx, &gf->gb, &a->req.params, outputs, res, err);
         log_programs(*ctx);
+        if (verbosity >= OBS_LOG_DEBUG) /* tests/e2e/threads.sh reads it */
+            fprintf(stderr, "obscura: debug: threads: %d in this process after the frame\n",
+                    cli_process_threads());
     }
     return s == OBS_OK ? EXIT_OK : cli_fail(s, a->in, err);
 }
@@ -886,13 +895,15 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
     t0 = now_ms();
     if ((rc = run_frame(a, &gf, outputs, server, argc, argv, &res, &ctx, &t0, err)) != EXIT_OK)
         goto done;
-    if (!server && (rc = cli_result_warnings(a, &res.ao, &gf.gb, NULL, &gf.info)) != EXIT_OK)
+    if ((rc = server ? cli_remote_result_warnings(a, &gf.info)
+                     : cli_result_warnings(a, &res.ao, &gf.gb, NULL, &gf.info)) != EXIT_OK)
         goto done;
     if (baked.data && (rc = combine_baked(a, &res, &baked, bch, err)) != EXIT_OK)
         goto done;
     double t_run = now_ms() - t0;
     t0 = now_ms();
-    s = write_outputs(a, &res, gf.gb.camera.has_projection ? &gf.gb.camera : NULL, gf.info.part, err);
+    obs_camera cam; /* the parameters' over the input's, as obscurad writes it */
+    s = write_outputs(a, &res, obs_camera_of_run(&gf.gb, &a->req.params, &cam) ? &cam : NULL, gf.info.part, err);
     if (s != OBS_OK) {
         rc = cli_fail(s, a->out, err);
         goto done;
@@ -989,6 +1000,26 @@ static void batch_finish(void)
     kept_ctx = NULL;
 }
 
+/* info's thread lines: the limit, llvmpipe's count and where it came
+ * from, and the threads running now that the context exists. */
+static void print_threads(int llvmpipe)
+{
+    obs_threads_info ti;
+    obs_threads_get(&ti);
+    if (ti.limit)
+        printf("threads: %d (--threads or OBSCURA_THREADS)\n", ti.limit);
+    else
+        printf("threads: every core (%d; --threads N or OBSCURA_THREADS bounds them)\n", ti.pool);
+    if (!llvmpipe)
+        printf("llvmpipe threads: not in use\n");
+    else if (ti.llvmpipe < 0)
+        printf("llvmpipe threads: one per core (LP_NUM_THREADS unset)\n");
+    else
+        printf("llvmpipe threads: %d (LP_NUM_THREADS %s)\n", ti.llvmpipe,
+               ti.llvmpipe_from_user ? "from the environment, kept" : "set from --threads");
+    printf("process threads: %d\n", cli_process_threads());
+}
+
 static int cmd_info(int argc, char **argv)
 {
     const char *backend = NULL, *cache = NULL, *v;
@@ -1019,6 +1050,7 @@ static int cmd_info(int argc, char **argv)
            obs_backend_name(info.backend), info.gl_version, info.gl_vendor, info.gl_renderer);
     printf("program cache: %s%s\n", info.cache_dir ? info.cache_dir : "off",
            !info.cache_dir ? "" : info.cache_writable ? "" : " (read-only)");
+    print_threads(strstr(info.gl_renderer, "llvmpipe") != NULL);
     obs_ctx_destroy(ctx);
     return EXIT_OK;
 }
@@ -1312,19 +1344,20 @@ static int cmd_batch(int argc, char **argv)
 static const struct {
     const char *name;
     int (*run)(int argc, char **argv);
+    int threads; /* takes --threads (cli_take_threads): it renders, bakes or reads images */
 } commands[] = {
-    {"ao", cmd_ao},
-    {"inspect", cli_inspect},
-    {"compare", cmd_compare},
-    {"info", cmd_info},
-    {"params", cmd_params},
-    {"samples", cmd_samples},
-    {"gbuffer", cli_gbuffer},
-    {"reference", cli_reference},
-    {"warmup", cli_warmup},
-    {"bake", cli_bake},
-    {"bake-dynamic", cli_dynamic},
-    {"batch", cmd_batch},
+    {"ao", cmd_ao, 1},
+    {"inspect", cli_inspect, 1},
+    {"compare", cmd_compare, 1},
+    {"info", cmd_info, 1},
+    {"params", cmd_params, 0},
+    {"samples", cmd_samples, 0},
+    {"gbuffer", cli_gbuffer, 1},
+    {"reference", cli_reference, 1},
+    {"warmup", cli_warmup, 1},
+    {"bake", cli_bake, 1},
+    {"bake-dynamic", cli_dynamic, 1},
+    {"batch", cmd_batch, 1},
 };
 
 int main(int argc, char **argv)
@@ -1338,8 +1371,11 @@ int main(int argc, char **argv)
         if ((!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) && usage_of(stdout, cmd))
             return EXIT_OK;
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
-        if (!strcmp(cmd, commands[i].name))
-            return commands[i].run(argc - 2, argv + 2);
+        if (!strcmp(cmd, commands[i].name)) {
+            /* before any context or thread: it may set LP_NUM_THREADS */
+            int n = commands[i].threads ? cli_take_threads(cmd, argc - 2, argv + 2) : argc - 2;
+            return commands[i].run(n, argv + 2);
+        }
     if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
         usage(stdout);
         return EXIT_OK;

@@ -37,6 +37,36 @@ typedef struct server_addr {
 
 static const char *stream_name; /* --stream NAME: post to /v1/streams/NAME/frames */
 
+/* The warnings of the last answer (X-Obscura-Warning over HTTP, a 200's
+ * message lines over the binary protocol), until
+ * cli_remote_take_warnings() hands them on. */
+static struct {
+    int n;
+    char text[OBS_EXR_WARNINGS][sizeof ((obs_exr_info *)0)->warnings[0]];
+} said;
+
+static void said_add(const char *text, size_t len)
+{
+    if (said.n < OBS_EXR_WARNINGS && len > 0)
+        snprintf(said.text[said.n++], sizeof said.text[0], "%.*s", (int)len, text);
+}
+
+int cli_remote_take_warnings(obs_exr_info *info)
+{
+    int added = 0;
+    for (int i = 0; i < said.n && info->warning_count < OBS_EXR_WARNINGS; i++) {
+        int known = 0;
+        for (int k = 0; k < info->warning_count && !known; k++)
+            known = !strcmp(info->warnings[k], said.text[i]);
+        if (known)
+            continue; /* the input's, which this process checked and said itself */
+        snprintf(info->warnings[info->warning_count++], sizeof info->warnings[0], "%s", said.text[i]);
+        added++;
+    }
+    said.n = 0;
+    return added;
+}
+
 static int stream_name_ok(const char *s)
 {
     size_t n = strlen(s);
@@ -344,6 +374,8 @@ static int binary_once(const server_addr *a, const obs_bytes *frame, answer *res
         rc = r.status;
         goto done;
     }
+    for (int i = 0; i < r.warning_count; i++)
+        said_add(r.warnings[i], strlen(r.warnings[i]));
     for (int i = 0; i < r.image_count; i++) {
         /* take the images over: they are ours */
         obs_image *slot = answer_slot(res, r.images[i].output);
@@ -442,8 +474,9 @@ static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs
     return ao ? exr_images(body, len, "AOFront.Y", &d->ao_front, NULL, msg, msg_len) : 0;
 }
 
-static int http_once(const server_addr *a, const char *query, const unsigned char *body, size_t body_len,
-                     unsigned outputs, answer *res, int *retry_after, char *msg, size_t msg_len)
+/* POSTs the frame to /v1/ao, or with `stream` to /v1/streams/STREAM/frames. */
+static int http_once(const server_addr *a, const char *stream, const char *query, const unsigned char *body,
+                     size_t body_len, unsigned outputs, answer *res, int *retry_after, char *msg, size_t msg_len)
 {
     int fd = connect_to(a, msg, msg_len);
     if (fd < 0)
@@ -457,8 +490,8 @@ static int http_once(const server_addr *a, const char *query, const unsigned cha
     if (!head)
         goto done;
     char path[96] = "/v1/ao";
-    if (stream_name)
-        snprintf(path, sizeof path, "/v1/streams/%s/frames", stream_name);
+    if (stream)
+        snprintf(path, sizeof path, "/v1/streams/%s/frames", stream);
     const int v6 = strchr(a->host, ':') != NULL; /* Host: [::1]:PORT */
     snprintf(head, hcap, "POST %s?%s HTTP/1.1\r\nHost: %s%s%s:%s\r\nContent-Type: image/x-exr\r\n"
              "Content-Length: %zu\r\nConnection: close\r\n%s%s%s\r\n", path, query, v6 ? "[" : "",
@@ -510,6 +543,12 @@ static int http_once(const server_addr *a, const char *query, const unsigned cha
         rc = status;
         goto done;
     }
+    for (const unsigned char *h = ans; h < end; h++)
+        if (!strncasecmp((const char *)h, "\nX-Obscura-Warning:", 19)) {
+            const char *v = (const char *)h + 19;
+            v += strspn(v, " \t");
+            said_add(v, strcspn(v, "\r\n"));
+        }
     rc = exr_to_result(payload, plen, outputs, res, msg, msg_len) == 0 ? 0 : 500;
 done:
     free(head);
@@ -547,6 +586,16 @@ static void camera_params(const obs_gbuffer *gb, pairs *ps, char *buf, size_t le
 }
 
 /* ---- the run -------------------------------------------------------------- */
+
+/* A stream post's failure that POST /v1/ao of the same server may not
+ * share (no stream route or streams off: 404, 405; a daemon that keeps no
+ * deep frames: 415; no memory to keep it: 500; anything unforeseen); not
+ * the frame's own errors (400, 401, 413, 422: /v1/ao would say the same)
+ * nor busy or unreachable (503, -1: already retried). */
+static int stream_refused(int status)
+{
+    return status > 0 && status != 400 && status != 401 && status != 413 && status != 422 && status != 503;
+}
 
 static void sleep_s(int s)
 {
@@ -637,10 +686,6 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
                 "(or a comma-separated list of up to %d of them)\n", server, CLI_REMOTE_MAX_SERVERS);
         return RC_USAGE;
     }
-    if (stream_name && deep) {
-        fprintf(stderr, "obscura: error: --stream: streams keep flat frames, not deep input\n");
-        return RC_USAGE;
-    }
     if (stream_name && any_bin) {
         fprintf(stderr, "obscura: error: --stream needs http:// servers (streams are an HTTP feature)\n");
         return RC_USAGE;
@@ -712,8 +757,10 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
                     continue;
                 tried++;
                 answer_free(out);
+                said.n = 0;
                 last = addrs[k].kind == PROTO_HTTP
-                           ? http_once(&addrs[k], query, body, body_len, outputs, out, &wait, msg, sizeof msg)
+                           ? http_once(&addrs[k], stream_name, query, body, body_len, outputs, out, &wait, msg,
+                                       sizeof msg)
                            : binary_once(&addrs[k], &frame, out, &wait, msg, sizeof msg);
                 k_last = k;
                 if (last != -1 && last != 503)
@@ -733,6 +780,15 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
     }
 answered:
     rc = last;
+    if (stream_name && stream_refused(rc)) {
+        /* the stream is only a preview: the frame runs once more, on
+         * /v1/ao of the server that answered, so that its result is not lost */
+        fprintf(stderr, "obscura: warning: --stream %s: the stream post failed (%s); the result comes from "
+                "POST /v1/ao and is written, but the frame is not in the stream\n", stream_name, msg);
+        answer_free(out);
+        int wait = 0;
+        rc = http_once(&addrs[k_last], NULL, query, body, body_len, outputs, out, &wait, msg, sizeof msg);
+    }
     free(query);
     free(body);
     obs_bytes_free(&frame);

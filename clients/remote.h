@@ -23,6 +23,7 @@
 #define OBSCURA_CLIENT_REMOTE_H
 
 #include "obscura/deep.h"
+#include "obscura/io.h"
 #include "obscura/obscura.h"
 
 #define CLI_REMOTE_MAX_SERVERS 16
@@ -51,6 +52,13 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
  * obs_deep_result_free(). */
 int cli_remote_run_deep(const char *server, int argc, char **argv, const char *in_path,
                         const obs_deep_image *deep, unsigned outputs, obs_deep_result *out);
+
+/* The warnings the last answer carried (X-Obscura-Warning over HTTP,
+ * the 200's warnings over the binary protocol: the daemon's checks of
+ * the input and of the result), appended to info, those already there
+ * (the input's, which the CLI checked itself) left out; the caller
+ * prints them as it prints its own.  Returns how many were added. */
+int cli_remote_take_warnings(obs_exr_info *info);
 
 /* Splits a comma-separated server list into urls (each < 256 bytes);
  * returns how many, or -1 when an entry is empty or too long or there

@@ -174,10 +174,15 @@ static int method_deep(const char *name)
     return !strcmp(name, "vaopp") || !strcmp(name, "vao") || !strcmp(name, "hemisphere");
 }
 
-int cli_warmup(int argc, char **argv)
+/* The command line: warmup's own options and the parameters. */
+typedef struct warm_args {
+    const char *methods, *cache, *backend;
+    obs_params p;
+} warm_args;
+
+/* -1 to go on, else the exit status (help, or a usage error said). */
+static int parse_args(int argc, char **argv, warm_args *o)
 {
-    const char *methods = NULL, *cache = NULL, *backend = getenv("OBSCURA_BACKEND");
-    obs_params p = {0};
     char err[OBS_ERR_LEN] = "";
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i], *eq = strchr(a, '=');
@@ -206,22 +211,27 @@ int cli_warmup(int argc, char **argv)
         }
         const char *v = eq ? eq + 1 : argv[++i];
         if (!strcmp(name, "methods"))
-            methods = v;
+            o->methods = v;
         else if (!strcmp(name, "cache-dir"))
-            cache = v;
+            o->cache = v;
         else if (!strcmp(name, "backend"))
-            backend = v;
-        else if (!obs_param_find(name) || obs_param_set(&p, name, v, err) != OBS_OK) {
+            o->backend = v;
+        else if (!obs_param_find(name) || obs_param_set(&o->p, name, v, err) != OBS_OK) {
             fprintf(stderr, "obscura: error: warmup: %s\n", err[0] ? err : "unknown option");
             if (!err[0])
                 fprintf(stderr, "  (--%s is not a warmup option nor a parameter)\n", name);
             return EXIT_USAGE;
         }
     }
-    /* the list of methods, checked before any context exists */
-    const char *all = obs_param_find("method")->choices;
-    char list[256];
-    snprintf(list, sizeof list, "%s", !methods ? "" : strcmp(methods, "all") ? methods : all);
+    return -1;
+}
+
+/* --methods as a comma-separated list (empty: none given), each checked
+ * before any context exists; -1 to go on, else EXIT_USAGE (said). */
+static int method_list(const warm_args *o, const char *all, char list[256])
+{
+    char err[OBS_ERR_LEN] = "";
+    snprintf(list, 256, "%s", !o->methods ? "" : strcmp(o->methods, "all") ? o->methods : all);
     for (char *c = list; *c; c++)
         if (*c == '|')
             *c = ',';
@@ -230,94 +240,129 @@ int cli_warmup(int argc, char **argv)
         size_t len = next ? (size_t)(next++ - m) : strlen(m);
         char one[32];
         snprintf(one, sizeof one, "%.*s", (int)len, m);
-        obs_params q = p;
+        obs_params q = o->p;
         if (len >= sizeof one || obs_param_set(&q, "method", one, err) != OBS_OK) {
             fprintf(stderr, "obscura: error: warmup: --methods: '%.*s' is not one of all,%s\n", (int)len, m,
                     all);
             return EXIT_USAGE;
         }
     }
+    return -1;
+}
 
-    obs_ctx_desc desc = {.log = log_cb};
-    if (backend && *backend && obs_backend_parse(backend, &desc.backend) != OBS_OK) {
-        fprintf(stderr, "obscura: error: warmup: backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa\n",
-                backend);
-        return EXIT_USAGE;
-    }
-    char dir[4096], why[OBS_ERR_LEN];
-    desc.cache_dir = obs_cache_dir_default(cache, dir, sizeof dir, why);
-    if (!desc.cache_dir[0]) {
-        fprintf(stderr, "obscura: error: warmup: %s\n", why[0] ? why : "the program cache is off (--cache-dir '')");
-        return EXIT_FAIL;
-    }
-    /* the methods to warm: the list, else the configured one */
-    char *names[OBS_METHOD_COUNT + 8];
+/* The methods to warm: the list (split in place), else the configured
+ * one (written into one); their count. */
+static int method_names(const obs_params *p, const char *all, char *list, char one[32],
+                        char **names, int cap)
+{
     int nm = 0;
-    char one[32] = "vaopp";
     if (!*list) {
         obs_params r;
-        obs_params_resolve(&p, &r);
+        obs_params_resolve(p, &r);
         /* the configured method's name: the choice at its 1-based index */
         const char *c = all;
         for (int k = 1; k < (int)r.method && c; k++)
             c = strchr(c, '|') ? strchr(c, '|') + 1 : NULL;
         if (c)
-            snprintf(one, sizeof one, "%.*s", (int)strcspn(c, "|"), c);
+            snprintf(one, 32, "%.*s", (int)strcspn(c, "|"), c);
         names[nm++] = one;
     }
-    for (char *m = list, *next; *list && m && nm < (int)(sizeof names / sizeof names[0]); m = next) {
+    for (char *m = list, *next; *list && m && nm < cap; m = next) {
         next = strchr(m, ',');
         if (next)
             *next++ = '\0';
         names[nm++] = m;
     }
+    return nm;
+}
+
+/* The program counts of the contexts, summed. */
+typedef struct warm_counts {
+    unsigned long compiled, there, rejected;
+} warm_counts;
+
+/* Every method at size k in a fresh context; the exit status. */
+static int warm_context(obs_ctx_desc *desc, const obs_params *p, char **names, int nm, size_t k,
+                        warm_counts *c)
+{
+    char err[OBS_ERR_LEN] = "";
+    obs_ctx *ctx;
+    obs_status s = obs_ctx_create(desc, &ctx, err);
+    if (s != OBS_OK)
+        return cli_fail(s, "OpenGL", err);
+    obs_ctx_info ci;
+    obs_ctx_get_info(ctx, &ci);
+    if (!ci.cache_dir || !ci.cache_writable) {
+        fprintf(stderr, "obscura: error: warmup: no writable program cache at %s (see the warning "
+                "above)\n", desc->cache_dir);
+        obs_ctx_destroy(ctx);
+        return EXIT_FAIL;
+    }
+    desc->log = NULL; /* the cache's and the context's lines once */
+    int rc = EXIT_OK;
+    for (int i = 0; i < nm && rc == EXIT_OK; i++) {
+        obs_params q = *p;
+        obs_param_set(&q, "method", names[i], err);
+        s = warm_size(ctx, &q, method_deep(names[i]), sizes[k][0], sizes[k][1], err);
+        if (s != OBS_OK)
+            rc = cli_fail(s, names[i], err);
+        else if (verbosity >= OBS_LOG_DEBUG)
+            fprintf(stderr, "obscura: debug: warmup: method %s at %dx%d done\n", names[i],
+                    sizes[k][0], sizes[k][1]);
+    }
+    obs_ctx_get_info(ctx, &ci);
+    c->compiled += ci.programs_compiled;
+    if (k == 0) /* later contexts load what the first built */
+        c->there = ci.programs_loaded;
+    c->rejected += ci.programs_rejected;
+    obs_ctx_destroy(ctx);
+    return rc;
+}
+
+int cli_warmup(int argc, char **argv)
+{
+    warm_args o = {.backend = getenv("OBSCURA_BACKEND")};
+    char err[OBS_ERR_LEN] = "";
+    int rc = parse_args(argc, argv, &o);
+    if (rc >= 0)
+        return rc;
+    const char *all = obs_param_find("method")->choices;
+    char list[256];
+    if ((rc = method_list(&o, all, list)) >= 0)
+        return rc;
+
+    obs_ctx_desc desc = {.log = log_cb};
+    if (o.backend && *o.backend && obs_backend_parse(o.backend, &desc.backend) != OBS_OK) {
+        fprintf(stderr, "obscura: error: warmup: backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa\n",
+                o.backend);
+        return EXIT_USAGE;
+    }
+    char dir[4096], why[OBS_ERR_LEN];
+    desc.cache_dir = obs_cache_dir_default(o.cache, dir, sizeof dir, why);
+    if (!desc.cache_dir[0]) {
+        fprintf(stderr, "obscura: error: warmup: %s\n", why[0] ? why : "the program cache is off (--cache-dir '')");
+        return EXIT_FAIL;
+    }
+    char *names[OBS_METHOD_COUNT + 8];
+    char one[32] = "vaopp";
+    int nm = method_names(&o.p, all, list, one, names, (int)(sizeof names / sizeof names[0]));
     /* a synthetic frame has no camera: a field of view unless one is given */
-    if (p.fov_y == 0.0f)
-        obs_param_set(&p, "fov_y", "60", err);
-    obs_param_set(&p, "normal_space", "camera", err);
+    if (o.p.fov_y == 0.0f)
+        obs_param_set(&o.p, "fov_y", "60", err);
+    obs_param_set(&o.p, "normal_space", "camera", err);
 
     /* One context per size: llvmpipe's machine code for a frame depends
      * on what the context drew before (measured: one context over every
      * size left a third of a real process's variants out of Mesa's
      * cache), and a real process draws one size from a fresh context. */
-    unsigned long compiled = 0, there = 0, rejected = 0;
-    int rc = EXIT_OK, runs = 0;
-    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0] && rc == EXIT_OK; k++) {
-        obs_ctx *ctx;
-        obs_status s = obs_ctx_create(&desc, &ctx, err);
-        if (s != OBS_OK)
-            return cli_fail(s, "OpenGL", err);
-        obs_ctx_info ci;
-        obs_ctx_get_info(ctx, &ci);
-        if (!ci.cache_dir || !ci.cache_writable) {
-            fprintf(stderr, "obscura: error: warmup: no writable program cache at %s (see the warning "
-                    "above)\n", desc.cache_dir);
-            obs_ctx_destroy(ctx);
-            return EXIT_FAIL;
-        }
-        desc.log = NULL; /* the cache's and the context's lines once */
-        for (int i = 0; i < nm && rc == EXIT_OK; i++) {
-            obs_params q = p;
-            obs_param_set(&q, "method", names[i], err);
-            s = warm_size(ctx, &q, method_deep(names[i]), sizes[k][0], sizes[k][1], err);
-            runs++;
-            if (s != OBS_OK)
-                rc = cli_fail(s, names[i], err);
-            else if (verbosity >= OBS_LOG_DEBUG)
-                fprintf(stderr, "obscura: debug: warmup: method %s at %dx%d done\n", names[i],
-                        sizes[k][0], sizes[k][1]);
-        }
-        obs_ctx_get_info(ctx, &ci);
-        compiled += ci.programs_compiled;
-        if (k == 0) /* later contexts load what the first built */
-            there = ci.programs_loaded;
-        rejected += ci.programs_rejected;
-        obs_ctx_destroy(ctx);
-    }
+    warm_counts c = {0};
+    rc = EXIT_OK;
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0] && rc == EXIT_OK; k++)
+        rc = warm_context(&desc, &o.p, names, nm, k, &c);
     if (rc == EXIT_OK && verbosity >= OBS_LOG_INFO)
         printf("warmup: %s: %lu programs built and stored, %lu already there (%lu damaged or "
                "foreign entries rebuilt), %d method%s at %d sizes\n",
-               dir, compiled, there, rejected, nm, nm == 1 ? "" : "s",
+               dir, c.compiled, c.there, c.rejected, nm, nm == 1 ? "" : "s",
                (int)(sizeof sizes / sizeof sizes[0]));
     return rc;
 }

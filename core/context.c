@@ -10,6 +10,22 @@
 
 _Static_assert(offsetof(struct obs_ctx, log) == 0, "obs__log reads the sink at the context's start");
 
+/* Where llvmpipe's thread count came from (obs_threads_set): a farm slot
+ * limit is only kept when it reached LP_NUM_THREADS. */
+static void log_llvmpipe_threads(obs_ctx *ctx)
+{
+    obs_threads_info ti;
+    obs_threads_get(&ti);
+    if (ti.llvmpipe < 0)
+        obs__log(ctx, OBS_LOG_DEBUG, "llvmpipe: a thread per core (no thread limit, LP_NUM_THREADS unset)");
+    else if (ti.llvmpipe_from_user)
+        obs__log(ctx, OBS_LOG_DEBUG, "llvmpipe: %d threads (LP_NUM_THREADS from the environment, kept%s)",
+                 ti.llvmpipe, ti.limit ? "; the thread limit bounds obscura's own pools" : "");
+    else
+        obs__log(ctx, OBS_LOG_DEBUG, "llvmpipe: %d threads (LP_NUM_THREADS set from the thread limit)",
+                 ti.llvmpipe);
+}
+
 obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out, char err[OBS_ERR_LEN])
 {
     obs_ctx_desc d = {0};
@@ -42,6 +58,8 @@ obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out, char err[OBS_
     obs__progcache_attach(&ctx->dev.cache, ctx->dev.vendor, ctx->dev.renderer, ctx->dev.version);
     obs__log(ctx, OBS_LOG_INFO, "GL context: %s, OpenGL %s, %s", obs_backend_name(ctx->dev.backend),
              ctx->dev.version, ctx->dev.renderer);
+    if (strstr(ctx->dev.renderer, "llvmpipe"))
+        log_llvmpipe_threads(ctx);
     *out = ctx;
     return OBS_OK;
 }

@@ -6,6 +6,7 @@
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
 
@@ -18,11 +19,36 @@ typedef struct run {
     size_t done;
 } run;
 
+/* Set once at the start (obs_threads_set), read by every loop: atomic,
+ * so a loop already running on another thread reads a whole value. */
+static atomic_int limit;
+
+void obs__pool_set_limit(int n)
+{
+    atomic_store(&limit, n > 0 ? n : 0);
+}
+
+int obs__pool_limit(void)
+{
+    return atomic_load(&limit);
+}
+
+const char *obs__pool_embree_config(char buf[32])
+{
+    int lim = atomic_load(&limit);
+    if (lim <= 0)
+        return NULL;
+    snprintf(buf, 32, "threads=%d", lim);
+    return buf;
+}
+
 int obs__pool_threads(int requested)
 {
-    long n = requested;
+    long n = requested, lim = atomic_load(&limit);
     if (n <= 0)
         n = sysconf(_SC_NPROCESSORS_ONLN);
+    if (lim > 0 && n > lim)
+        n = lim;
     return n < 1 ? 1 : n > OBS__POOL_MAX_THREADS ? OBS__POOL_MAX_THREADS : (int)n;
 }
 

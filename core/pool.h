@@ -11,9 +11,20 @@
 /* The most threads one loop starts. */
 #define OBS__POOL_MAX_THREADS 64
 
-/* The one rule for a thread count: the caller's (up to the maximum), else
- * (0 or less) the machine's cores (up to the maximum); at least 1. */
+/* The one rule for a thread count: the caller's, else (0 or less) the
+ * machine's cores; then no more than the process's limit (obs_threads_set:
+ * obscura --threads, obscurad --render-threads, OBSCURA_THREADS) and the
+ * maximum; at least 1. */
 int obs__pool_threads(int requested);
+
+/* The process's limit (0: none); obs_threads_set sets it. */
+void obs__pool_set_limit(int n);
+int obs__pool_limit(void);
+
+/* Embree's device configuration under the limit: "threads=N" in buf (its
+ * BVH builds run on TBB's threads, one per core unless told), NULL
+ * without a limit (Embree's defaults, as before). */
+const char *obs__pool_embree_config(char buf[32]);
 
 typedef struct obs__pool_for {
     size_t first, end; /* the items [first, end) */

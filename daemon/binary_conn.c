@@ -251,7 +251,13 @@ static int run_frame(frame *f, obs_bin_request *q)
     obs_bytes blob;
     s = obsd_fp_encode(&fp, &im, &q->hr, q->raw_out, obsd_fp_camera(&fp), &blob, err);
     f->ms_encode = fp.ms_encode;
+    /* the input's sanity warnings and the result's, as HTTP's
+     * X-Obscura-Warning headers: the 200's message, one a line */
+    const char *said[OBS_EXR_WARNINGS];
+    for (int i = 0; i < fp.gf.info.warning_count; i++)
+        said[i] = fp.gf.info.warnings[i];
     obs_bin_response_desc d = {.id = f->id, .status = 200, .code = "ok", .message = "",
+                               .warnings = said, .warning_count = fp.gf.info.warning_count,
                                .blob = blob.data, .blob_len = blob.size};
     obs_bin_image images[3];
     int n = 0;

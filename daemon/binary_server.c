@@ -87,12 +87,8 @@ static void refuse(obsd_bin *b, int fd, const conn *c, const char *why)
     obsd_stats_request(OBSD_STATS_BINARY, 503, 0, sent);
     b->refused_total++;
     double now = obsd_now_ms();
-    if (now - b->refused_logged >= 1000) {
-        /* at most a line a second, whatever a flood of clients does */
-        obsd_log(OBSD_LOG_WARN, "peer=%s binary: refusing a connection: %s (%lu refused so far)", c->peer,
-                 why, b->refused_total);
-        b->refused_logged = now;
-    }
+    /* counted by reason; at most a line a second, whatever a flood of clients does */
+    obsd_stats_refusal("too_many_connections", c->peer, msg);
     shutdown(fd, SHUT_WR);
     if (b->nrefused == REFUSED_MAX) {
         int oldest = 0;

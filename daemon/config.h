@@ -43,7 +43,13 @@
       "frames that may wait for the GL worker; more are answered 503")         \
     X(threads, INT, 1, 64, "4",                                                \
       "HTTP threads (they read, decode and encode; one GL thread runs; the "  \
-      "binary protocol has a thread per connection)")       \
+      "binary protocol has a thread per connection); the threads of the "     \
+      "frames and bakes themselves are --render-threads")                     \
+    X(render_threads, INT, 0, 64, "0",                                         \
+      "threads the frames and bakes may run, as obscura --threads: "          \
+      "llvmpipe's (LP_NUM_THREADS, unless set) and every worker pool's (EXR " \
+      "decode, bake ray tracing, a bake job's threads parameter); 0: "        \
+      "OBSCURA_THREADS, else every core")                                      \
     X(max_pixels, SIZE, 1, 1073741824, "33554432",                             \
       "largest accepted width x height of a G-buffer (413 above)")             \
     X(max_body, SIZE, 1024, 17179869184, "1g",                                 \
@@ -60,6 +66,11 @@
     X(token_file, STRING, 0, OBSD_STR_LEN - 1, "",                             \
       "file holding a bearer token; when set, /v1/* and /metrics need "        \
       "'Authorization: Bearer TOKEN'")                                         \
+    X(cors, STRING, 0, OBSD_STR_LEN - 1, "",                                   \
+      "allow a browser page from this origin (e.g. https://preview.example."  \
+      "com, or *) to call the API: OPTIONS preflights answered 204, "         \
+      "Access-Control-Allow-Origin on every answer (empty: off, OPTIONS is "  \
+      "405)")                                                                  \
     X(streams, INT, 0, 1024, "16",                                             \
       "streams of frames kept for the preview page (POST /v1/streams/NAME/"   \
       "frames); a new one beyond drops the least recently posted-to (0: "      \

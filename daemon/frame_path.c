@@ -173,6 +173,8 @@ obs_status obsd_fp_finished(obsd_fp *fp)
         obsd_stats_frame(job->deep->width, job->deep->height);
     else if (job->status == OBS_OK)
         obsd_stats_frame(job->gb->width, job->gb->height);
+    if (job->status == OBS_OK && !job->deep)
+        fp->has_cam = obs_camera_of_run(job->gb, job->params, &fp->cam);
     /* the result's own check (AO near 1 everywhere: a radius out of scale,
      * a wrong depth mode), a warning beside the input's */
     if (job->status == OBS_OK && job->deep)
@@ -211,8 +213,9 @@ void obsd_fp_images_of(const obsd_fp *fp, unsigned outputs, obsd_fp_images *im)
 
 const obs_camera *obsd_fp_camera(const obsd_fp *fp)
 {
-    const obs_camera *cam = fp->deep ? &fp->deep->camera : &fp->gb->camera;
-    return cam->has_projection ? cam : NULL;
+    if (!fp->deep)
+        return fp->has_cam ? &fp->cam : NULL;
+    return fp->deep->camera.has_projection ? &fp->deep->camera : NULL;
 }
 
 const obs_image *obsd_fp_png_image(const obsd_fp_images *im)

@@ -33,6 +33,8 @@ typedef struct obsd_fp {
     size_t src_len;
     int src_part;             /* its part the input was read from */
     obsd_job job;             /* its result is owned until obsd_fp_free() */
+    obs_camera cam;           /* flat: the camera the job ran with (obsd_fp_finished) */
+    int has_cam;
     double ms_decode, ms_queue, ms_gl, ms_encode;
     /* the way back from the GL worker */
     void (*on_done)(void *user);
@@ -90,8 +92,9 @@ void obsd_fp_wait(obsd_fp *fp);
 obs_status obsd_fp_finished(obsd_fp *fp);
 
 /* The images of the finished job for `outputs` (OBS_OUTPUT_AO and/or
- * OBS_OUTPUT_COMPOSITE), and the camera to write with them (NULL when the
- * input had no projection). */
+ * OBS_OUTPUT_COMPOSITE), and the camera to write with them: the one the
+ * job ran with, the parameters' over the input's, as obscura ao writes
+ * it (NULL when there is no projection). */
 void obsd_fp_images_of(const obsd_fp *fp, unsigned outputs, obsd_fp_images *im);
 const obs_camera *obsd_fp_camera(const obsd_fp *fp);
 /* The one image a PNG of `im` shows: the AO, else the composite. */

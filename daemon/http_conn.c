@@ -13,6 +13,7 @@
  *              suspended for the GL worker resumed (to close), their jobs
  *              left to free their requests */
 #include <arpa/inet.h>
+#include <errno.h>
 #include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,19 +27,34 @@
 
 typedef obsd__req req;
 
-static void addr_name(const struct sockaddr *sa, char *buf, size_t len)
+/* The peer as "IP:PORT" into buf, its address alone into ip. */
+static void addr_name(const struct sockaddr *sa, char *buf, size_t len, char ip[INET6_ADDRSTRLEN])
 {
-    char ip[INET6_ADDRSTRLEN];
     snprintf(buf, len, "?");
+    snprintf(ip, INET6_ADDRSTRLEN, "?");
     if (sa && sa->sa_family == AF_INET) {
         const struct sockaddr_in *in = (const struct sockaddr_in *)(const void *)sa;
-        if (inet_ntop(AF_INET, &in->sin_addr, ip, sizeof ip))
+        if (inet_ntop(AF_INET, &in->sin_addr, ip, INET6_ADDRSTRLEN))
             snprintf(buf, len, "%s:%u", ip, ntohs(in->sin_port));
     } else if (sa && sa->sa_family == AF_INET6) {
         const struct sockaddr_in6 *in6 = (const struct sockaddr_in6 *)(const void *)sa;
-        if (inet_ntop(AF_INET6, &in6->sin6_addr, ip, sizeof ip))
+        if (inet_ntop(AF_INET6, &in6->sin6_addr, ip, INET6_ADDRSTRLEN))
             snprintf(buf, len, "[%s]:%u", ip, ntohs(in6->sin6_port));
     }
+}
+
+/* Under h->lock: c is one more than --max-per-client from its address
+ * (counted here: MHD's own per-address limit resets the connection
+ * without a word). */
+static int over_client_limit(const obsd_http *h, const obsd__conn *c)
+{
+    int max = h->cfg->max_per_client, n = 0;
+    if (max <= 0)
+        return 0;
+    for (const obsd__conn *o = h->conns; o; o = o->next)
+        if (!atomic_load(&o->cut) && !o->over_client && !strcmp(o->ip, c->ip))
+            n++;
+    return n > max;
 }
 
 static double deadline_from(const obsd_http *h, double now)
@@ -67,6 +83,7 @@ static void answer_timeout(obsd_http *h, obsd__conn *c)
     free(body);
     size_t in = r ? r->len + r->discarded : 0;
     obsd_stats_request(r ? r->slot : OBSD_STATS_OTHER, 408, in, len);
+    obsd_stats_refusal("request_timeout", c->peer, msg);
     if (r)
         obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s status=408 in=%zu out=%zu total=%.1f ms "
                  "error=request_timeout: %s", (unsigned long long)r->id, r->peer, r->method, r->path, in, len,
@@ -100,6 +117,7 @@ void obsd__conn_detach(obsd_http *h, obsd__conn *c)
 {
     pthread_mutex_lock(&h->lock);
     c->r = NULL;
+    atomic_store(&c->events, 0);
     c->deadline = deadline_from(h, obsd_now_ms()); /* the next request's, on a kept connection */
     pthread_mutex_unlock(&h->lock);
 }
@@ -134,9 +152,10 @@ void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_conte
     }
     c->mc = mc;
     c->fd = fi->connect_fd;
-    addr_name(ai ? ai->client_addr : NULL, c->peer, sizeof c->peer);
+    addr_name(ai ? ai->client_addr : NULL, c->peer, sizeof c->peer, c->ip);
     c->deadline = deadline_from(h, obsd_now_ms());
     atomic_init(&c->cut, CUT_NONE);
+    atomic_init(&c->events, 0);
     pthread_mutex_lock(&h->lock);
     c->prev = h->conns_tail;
     if (h->conns_tail)
@@ -145,6 +164,7 @@ void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_conte
         h->conns = c;
     h->conns_tail = c;
     h->open++;
+    c->over_client = over_client_limit(h, c);
     if (h->open - h->evicting > h->cfg->http_connections) {
         /* At the limit: the oldest connection that has not sent a whole
          * request (stalled in its headers, or idle between requests) makes
@@ -198,8 +218,22 @@ int obsd__req_alive(req *r)
     return ok;
 }
 
+/* Under h->lock: an event stream whose client closed or reset.  Parked
+ * (suspended) it is not polled by MHD, so its departure would be seen
+ * only at its next event: the subscriber (and its gauge) would stay. */
+static int client_gone(const obsd__conn *c)
+{
+    char b;
+    if (!atomic_load(&c->events) || atomic_load(&c->cut))
+        return 0;
+    ssize_t n = recv(c->fd, &b, 1, MSG_PEEK | MSG_DONTWAIT);
+    return n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR);
+}
+
 /* Connections past their deadline, found a few times a second: the
- * ones that trickle their headers, or a body with nothing for a while. */
+ * ones that trickle their headers, or a body with nothing for a while;
+ * and event streams whose client left (shut, resumed: MHD closes them,
+ * the route's done unsubscribes). */
 void *obsd__conn_sweeper(void *arg)
 {
     obsd_http *h = arg;
@@ -212,6 +246,9 @@ void *obsd__conn_sweeper(void *arg)
             if (!atomic_load(&c->cut) && c->deadline > 0.0 && now > c->deadline) {
                 answer_timeout(h, c);
                 cut_conn(h, c, CUT_DEADLINE);
+            } else if (client_gone(c)) {
+                cut_conn(h, c, CUT_GONE);
+                MHD_resume_connection(c->mc); /* harmless when it is not suspended */
             }
         pthread_mutex_unlock(&h->lock);
     }
@@ -221,6 +258,9 @@ void *obsd__conn_sweeper(void *arg)
 void obsd__req_free(req *r)
 {
     free(r->body);
+    if (r->held) /* the connection ended before the body did */
+        MHD_destroy_response(r->held);
+    free(r->held_note);
     if (r->fr) { /* the frame's state is freed here, not by a route's done: the GL worker may hold it longer */
         obsd_fp_free(&r->fr->fp);
         free(r->fr->query);

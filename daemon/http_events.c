@@ -27,6 +27,8 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
 {
     obsd__events *ev = cls;
     (void)pos;
+    if (ev->r->cn && atomic_load(&ev->r->cn->cut))
+        return MHD_CONTENT_READER_END_WITH_ERROR; /* the client left (or the drain): MHD closes it */
     if (ev->off >= ev->len) {
         int n = ev->next(ev->r, ev->buf, sizeof ev->buf);
         if (n < 0)
@@ -54,5 +56,7 @@ enum MHD_Result obsd__events_answer(obsd__req *r, obsd__events *ev)
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
     MHD_add_response_header(resp, "X-Accel-Buffering", "no");
     r->state = REQ_EVENTS;
+    if (r->cn)
+        atomic_store(&r->cn->events, 1);
     return obsd__answer(r, 200, resp, 0, "event stream opened");
 }

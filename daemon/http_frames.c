@@ -78,12 +78,13 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
             fr->exposure = ev;
             return MHD_YES;
         }
-        if (name_is(key, "output") && !strcmp(value, "color")) {
-            fr->want_color = 1;
+        if (name_is(key, "output") && (!strcmp(value, "color") || !strcmp(value, "ao_front"))) {
+            fr->want_color = value[0] == 'c';
+            fr->want_front = value[0] == 'a';
             return MHD_YES;
         }
         if (name_is(key, "output"))
-            fr->want_color = 0;
+            fr->want_color = fr->want_front = 0;
         else if (!name_is(key, "format") && !name_is(key, "float") && !name_is(key, "png_bits") &&
                  !name_is(key, "png_transfer"))
             fr->rerun = 1;
@@ -188,6 +189,7 @@ int obsd__body_expect(req *r, size_t max, const char *what, const char *flag, in
     errno = 0;
     unsigned long long n = strtoull(v, &end, 10);
     if (errno == ERANGE || n > (unsigned long long)max) {
+        r->body_in = 0; /* not held: the client waits for 100 Continue, or sends more than we would read */
         snprintf(msg, sizeof msg, "%s of %s bytes is over the limit of %lld bytes (%s)", what, v,
                  (long long)max, flag);
         *rc = obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
@@ -222,9 +224,9 @@ enum MHD_Result obsd__discard_body(req *r, size_t n, size_t max)
 {
     r->discarded += n;
     if (r->discarded > max) {
-        obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: body over twice the limit, "
+        obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s: over %zu bytes of an unread body, "
                  "connection closed", (unsigned long long)r->id, r->peer, r->method,
-                 r->label);
+                 r->label, max);
         return MHD_NO;
     }
     return MHD_YES;
@@ -260,11 +262,7 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     obsd_http *h = r->srv;
     char err[OBS_ERR_LEN] = "";
     obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
-    /* A deep EXR runs on /v1/ao only: streams keep flat frames. */
-    obs_status s = obsd_fp_decode(&fr->fp, body, len, &fr->hr, &lim,
-                                  fr->kept ? "deep EXR input runs on POST /v1/ao, not in streams"
-                                                       : NULL,
-                                  err);
+    obs_status s = obsd_fp_decode(&fr->fp, body, len, &fr->hr, &lim, NULL, err);
     /* An EXR answer takes the body's header (its windows and attributes;
      * append=1: the body itself), which lives until the answer: r->body,
      * freed with the request, or a stream frame's, which it holds. */

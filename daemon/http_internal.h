@@ -24,7 +24,7 @@
 #define OBSD_HTTP_RESERVE 16
 
 /* Why a connection was shut down from outside its MHD thread. */
-enum { CUT_NONE, CUT_DEADLINE, CUT_EVICTED, CUT_DRAIN };
+enum { CUT_NONE, CUT_DEADLINE, CUT_EVICTED, CUT_DRAIN, CUT_GONE /* an event stream's client left */ };
 
 /* One open connection (http_server.c keeps the list, under obsd_http's
  * lock): its deadline, for the sweeper thread, and its request, for the
@@ -34,9 +34,12 @@ typedef struct obsd__conn {
     struct MHD_Connection *mc;
     int fd;
     char peer[64];
+    char ip[46];              /* the peer's address alone (INET6_ADDRSTRLEN), for --max-per-client */
+    int over_client;          /* one more than --max-per-client from its address: answered 503, closed */
     double deadline;          /* obsd_now_ms() past which it is cut; 0: none */
     struct obsd__req *r;      /* the request under way; NULL before its headers, or idle */
     int reserve;              /* opened beyond --http-connections: probes only */
+    atomic_int events;        /* answering an event stream: the sweeper watches for the client leaving */
     atomic_int cut;           /* CUT_*: shut down, MHD closes it next */
 } obsd__conn;
 
@@ -86,6 +89,8 @@ typedef enum obsd__req_state {
     REQ_QUEUED,   /* suspended; the GL worker has the job */
     REQ_REFUSED,  /* suspended and resumed at once: the queue was full */
     REQ_EVENTS,   /* answering with Server-Sent Events */
+    REQ_HELD,     /* answered while the client still sends its body: the body is
+                     discarded and the answer queued at its end (obsd__answer) */
     REQ_ANSWERED
 } obsd__req_state;
 
@@ -97,11 +102,12 @@ typedef struct obsd__frame_req {
     obs_http_request hr;
     obsd_fp fp;          /* the frame: its input, job, result and stage times */
     int before_drain;    /* started before SIGTERM: finished in the drain */
-    int kept;            /* a stream's frame: flat input only; its body and query are kept with it */
-    int view;            /* a kept frame's GET: exposure and output=color view it, other parameters re-run it */
+    int kept;            /* a stream's frame (flat or deep): its body and query are kept with it */
+    int view;            /* a kept frame's GET: exposure, output=color|ao_front view it, other parameters re-run it */
     char *query;         /* kept: the query as "name\0value\0" pairs */
     size_t query_len, query_cap;
     int want_color;      /* output=color */
+    int want_front;      /* output=ao_front: a deep frame's front layer's AO */
     int rerun;           /* view with parameters: run the frame again */
     double exposure;     /* stops applied to colour PNGs */
 } obsd__frame_req;
@@ -137,7 +143,18 @@ typedef struct obsd__req {
     unsigned char *body;
     size_t len, cap;
     int too_big;
-    size_t discarded;    /* bytes thrown away after too_big */
+    size_t discarded;    /* bytes thrown away after too_big, or under a held answer */
+    /* The client is sending a body that MHD has not all handed over: an
+     * answer queued now would close the connection with unread input,
+     * and the kernel's reset would destroy the answer at the client.  So
+     * the answer is held (REQ_HELD) until the body's end, discarding it up
+     * to hold_max bytes and within --request-timeout. */
+    int body_in;
+    size_t hold_max;
+    struct MHD_Response *held;
+    int held_status;
+    size_t held_len;
+    char *held_note;
     obsd__frame_req *fr; /* the frame it carries (http_frames.c), or NULL */
     void *own;           /* its route's own state (http_streams.c, http_bakes.c), freed by the row's done */
     /* answer */
@@ -170,15 +187,22 @@ void obsd__req_free(obsd__req *r);
 /* ---- http_reply.c: answers, each logged and counted ---- */
 
 
-/* Queues `resp` (taking it) with status; logs and counts the request. */
+/* Queues `resp` (taking it) with status; logs and counts the request.
+ * While the client still sends its body (r->body_in), the answer is held
+ * instead (REQ_HELD) and the caller goes on as if it were queued. */
 enum MHD_Result obsd__answer(obsd__req *r, int status, struct MHD_Response *resp, size_t body_len,
                              const char *note);
+/* The held answer queued, at the end of the discarded body. */
+enum MHD_Result obsd__answer_held(obsd__req *r);
 /* A body of `len` bytes that the answer frees. */
 enum MHD_Result obsd__answer_text(obsd__req *r, int status, const char *type, char *text, size_t len,
                                   const char *note);
 /* The JSON error; one extra header (name, value) when hname is set. */
 enum MHD_Result obsd__answer_error(obsd__req *r, int status, const char *code, const char *msg,
                                    const char *hname, const char *hvalue);
+/* 204 to a browser's OPTIONS preflight (--cors): the route's methods,
+ * the headers a page may send, how long the browser may keep it. */
+enum MHD_Result obsd__answer_preflight(obsd__req *r, const char *methods);
 /* 503 shutting_down (Retry-After: 5): the drain refuses what would start. */
 enum MHD_Result obsd__answer_shutting_down(obsd__req *r);
 /* The error of a core status (503 with Retry-After). */

@@ -26,23 +26,60 @@ static void log_request(const req *r, const char *note)
              obsd_now_ms() - r->t0, note && *note ? " " : "", note ? note : "");
 }
 
+/* An answer while the client still sends its body: kept until the
+ * body's end (obsd__answer_held), the rest of the body discarded. */
+static enum MHD_Result hold(req *r, int status, struct MHD_Response *resp, size_t body_len, const char *note)
+{
+    if (r->held) /* one answer per request: the first one stands */
+        MHD_destroy_response(resp);
+    else {
+        r->held = resp;
+        r->held_status = status;
+        r->held_len = body_len;
+        r->held_note = note && *note ? strdup(note) : NULL;
+    }
+    r->state = REQ_HELD;
+    return MHD_YES;
+}
+
+enum MHD_Result obsd__answer_held(req *r)
+{
+    struct MHD_Response *resp = r->held;
+    char *note = r->held_note;
+    r->held = NULL;
+    r->held_note = NULL;
+    enum MHD_Result rc = obsd__answer(r, r->held_status, resp, r->held_len, note);
+    free(note);
+    return rc;
+}
+
 enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size_t body_len,
                               const char *note)
 {
     if (!resp)
         return MHD_NO;
+    if (r->body_in)
+        return hold(r, status, resp, body_len, note);
     if (!obsd__req_hold(r)) { /* cut (its deadline, the drain) while we worked */
         MHD_destroy_response(resp);
         return MHD_NO;
     }
-    /* In the drain, and on a connection beyond --http-connections, the
-     * answer is the connection's last. */
-    if (atomic_load(&r->srv->draining) || (r->cn && r->cn->reserve))
+    /* In the drain, and on a connection beyond --http-connections or
+     * --max-per-client, the answer is the connection's last. */
+    if (atomic_load(&r->srv->draining) || (r->cn && (r->cn->reserve || r->cn->over_client)))
         MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
     r->status = status;
     r->bytes_out = body_len;
     r->state = REQ_ANSWERED;
     MHD_add_response_header(resp, "Server", "obscurad/" OBS_VERSION);
+    const char *origin = r->srv->cfg->cors;
+    if (origin[0]) { /* --cors: a page from that origin may read every answer, its warnings and timings too */
+        MHD_add_response_header(resp, "Access-Control-Allow-Origin", origin);
+        MHD_add_response_header(resp, "Access-Control-Expose-Headers",
+                                "X-Obscura-Warning, Server-Timing, Retry-After, Location");
+        if (strcmp(origin, "*") != 0)
+            MHD_add_response_header(resp, "Vary", "Origin");
+    }
     enum MHD_Result rc = MHD_queue_response(r->conn, (unsigned)status, resp);
     MHD_destroy_response(resp);
     obsd_stats_request(r->slot, status, r->len + r->discarded, body_len);
@@ -80,9 +117,25 @@ enum MHD_Result obsd__answer_error(req *r, int status, const char *code, const c
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "application/json");
     if (hname)
         MHD_add_response_header(resp, hname, hvalue);
+    /* over a limit (connections, queue, size, time, the drain): counted by reason, logged rate-limited */
+    if (status == 408 || status == 413 || status == 503 || !strcmp(code, "too_costly") ||
+        !strcmp(code, "deadline_exceeded"))
+        obsd_stats_refusal(code, r->peer, msg);
     char note[OBS_ERR_LEN + 32];
     snprintf(note, sizeof note, "error=%s: %s", code, msg);
     return obsd__answer(r, status, resp, len, note);
+}
+
+enum MHD_Result obsd__answer_preflight(req *r, const char *methods)
+{
+    struct MHD_Response *resp = MHD_create_response_from_buffer(0, NULL, MHD_RESPMEM_PERSISTENT);
+    if (!resp)
+        return MHD_NO;
+    MHD_add_response_header(resp, "Access-Control-Allow-Methods",
+                            !strcmp(methods, "GET") ? "GET, HEAD" : methods);
+    MHD_add_response_header(resp, "Access-Control-Allow-Headers", "Authorization, Content-Type");
+    MHD_add_response_header(resp, "Access-Control-Max-Age", "600");
+    return obsd__answer(r, 204, resp, 0, "preflight (--cors)");
 }
 
 enum MHD_Result obsd__answer_shutting_down(req *r)

@@ -11,6 +11,7 @@
  *   http_reply.c    the answers, logged and counted
  *   http_conn.c     the open connections: deadlines, room at the limit, the cut */
 #include <arpa/inet.h>
+#include <errno.h>
 #include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -55,13 +56,22 @@ static enum MHD_Result on_header(void *cls, enum MHD_ValueKind kind, const char 
 
 /* Headers that make the body's length ambiguous (a request smuggled
  * past a proxy that reads them the other way) or unknown: 400 before any
- * of the body is read.  *has_body: the request announces one. */
-static int framing_ok(req *r, int *has_body, enum MHD_Result *rc)
+ * of the body is read.  *has_body: the request announces one; *length:
+ * its Content-Length (-1: none, chunked; an unreadable one is huge). */
+static int framing_ok(req *r, int *has_body, unsigned long long *length, enum MHD_Result *rc)
 {
     framing f = {0};
     char msg[160];
     MHD_get_connection_values(r->conn, MHD_HEADER_KIND, on_header, &f);
     *has_body = f.n_coding > 0 || (f.n_length > 0 && strcmp(f.length, "0") != 0);
+    *length = (unsigned long long)-1;
+    if (f.n_length && !f.n_coding) {
+        char *end;
+        errno = 0;
+        unsigned long long n = strtoull(f.length, &end, 10);
+        if (!errno && end != f.length && !*end)
+            *length = n;
+    }
     if (f.n_length && f.n_coding)
         snprintf(msg, sizeof msg, "both Content-Length and Transfer-Encoding: the body's length is ambiguous");
     else if (f.lengths_differ)
@@ -85,6 +95,12 @@ static enum MHD_Result dispatch(req *r, const char *url, const char *method)
 {
     obsd_http *h = r->srv;
     const obsd__route *rt = r->route;
+    if (r->cn && r->cn->over_client && !(rt && (rt->flags & OBSD_ROUTE_PROBE))) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "%d connections are open from this address (--max-per-client %d); "
+                 "retry later", h->cfg->max_per_client, h->cfg->max_per_client);
+        return obsd__answer_error(r, 503, "too_many_connections", msg, MHD_HTTP_HEADER_RETRY_AFTER, "1");
+    }
     if (r->cn && r->cn->reserve && !(rt && (rt->flags & OBSD_ROUTE_PROBE))) {
         char msg[128];
         snprintf(msg, sizeof msg, "%d connections are open (--http-connections); retry later",
@@ -93,6 +109,8 @@ static enum MHD_Result dispatch(req *r, const char *url, const char *method)
     }
     if (!rt)
         return obsd__answer_error(r, 404, "not_found", "no such route (try GET /v1/params)", NULL, NULL);
+    if (h->cfg->cors[0] && !strcmp(method, "OPTIONS")) /* a preflight carries no token */
+        return obsd__answer_preflight(r, rt->methods ? rt->methods : "GET, HEAD, POST, DELETE");
     if (rt->methods && !method_ok(rt, method)) {
         char msg[64];
         snprintf(msg, sizeof msg, "%s takes %s", rt->path, rt->methods);
@@ -135,6 +153,31 @@ static req *req_new(obsd_http *h, struct MHD_Connection *conn, obsd__conn *c, co
     return r;
 }
 
+/* The most of a body the route reads: what a held answer discards. */
+static size_t body_max(const obsd_http *h, const obsd__route *rt)
+{
+    return (size_t)(rt && (rt->flags & OBSD_ROUTE_LEVEL_BODY) ? h->cfg->max_level : h->cfg->max_body);
+}
+
+static int expects_continue(struct MHD_Connection *conn)
+{
+    const char *v = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_EXPECT);
+    while (v && *v == ' ')
+        v++;
+    return v && !strncasecmp(v, "100-continue", 12);
+}
+
+/* A call with more of a body under a held answer: thrown away, up to
+ * the route's limit and within the request's deadline. */
+static enum MHD_Result discard_held(req *r, size_t *size)
+{
+    size_t n = *size;
+    *size = 0;
+    if (!obsd__req_alive(r))
+        return MHD_NO;
+    return obsd__discard_body(r, n, r->hold_max);
+}
+
 /* A request's first call: its record, its deadline, its framing; then
  * its start now (it reads a body, or has one), or on the next call. */
 static enum MHD_Result first_call(obsd_http *h, struct MHD_Connection *conn, const char *url,
@@ -156,19 +199,31 @@ static enum MHD_Result first_call(obsd_http *h, struct MHD_Connection *conn, con
         return obsd__answer_error(r, 408, "request_timeout", msg, NULL, NULL);
     }
     int has_body;
+    unsigned long long length;
     enum MHD_Result rc;
-    if (!framing_ok(r, &has_body, &rc))
+    if (!framing_ok(r, &has_body, &length, &rc))
         return rc;
     /* A route that reads its body starts now; anything else without one
      * is answered on the next call, once MHD holds the whole request, so
      * that the connection stays open for the next (an answer queued now
-     * closes it).  With a body it is answered now, and the body never
-     * read. */
+     * closes it).  With a body it starts now too. */
     const char *rb = r->route ? r->route->reads_body : NULL;
-    if ((rb && (!strcmp(rb, "*") || !strcmp(rb, method))) || has_body)
-        return dispatch(r, url, method);
-    r->state = REQ_DEFERRED;
-    return MHD_YES;
+    if (!(rb && (!strcmp(rb, "*") || !strcmp(rb, method))) && !has_body) {
+        r->state = REQ_DEFERRED;
+        return MHD_YES;
+    }
+    /* A client that does not wait for 100 Continue is sending its body
+     * already: an answer now (a bad parameter, 415, 503) is held until
+     * the body's end (REQ_HELD), or the connection would close with its
+     * bytes unread and the kernel's reset destroy the answer.  One that
+     * waits is answered now, as is a body over the limit (413): the
+     * client has not sent it, or we would not read it all. */
+    r->hold_max = body_max(h, r->route);
+    r->body_in = has_body && !expects_continue(conn) && (length == (unsigned long long)-1 || length <= r->hold_max);
+    rc = dispatch(r, url, method);
+    if (has_body && r->state != REQ_ANSWERED)
+        r->body_in = 1; /* from now the client sends it (after MHD's 100 Continue) */
+    return rc;
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const char *url,
@@ -183,7 +238,11 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
     int job = atomic_load(&r->job);
     if (job == JOB_CUT || job == JOB_CUT_DONE)
         return MHD_NO; /* resumed by the cut: the connection closes */
+    if (r->body_in && !*upload_data_size)
+        r->body_in = 0; /* the body's end: an answer is queued now */
     switch (r->state) {
+    case REQ_HELD:
+        return *upload_data_size ? discard_held(r, upload_data_size) : obsd__answer_held(r);
     case REQ_DEFERRED:
         if (*upload_data_size) {
             *upload_data_size = 0;
@@ -311,13 +370,13 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
         flags |= MHD_USE_IPv6;
     /* MHD refuses beyond its limit before anything of ours runs: the
      * reserve above --http-connections is where on_connection makes room
-     * or lets a probe in. */
+     * or lets a probe in.  --max-per-client is counted by http_conn.c,
+     * so that the connection over it is answered (MHD's would reset it). */
     h->mhd = MHD_start_daemon(flags, 0, NULL, NULL, on_request, h,
                               MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
                               MHD_OPTION_THREAD_POOL_SIZE, (unsigned)cfg->threads,
                               MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg->timeout,
                               MHD_OPTION_CONNECTION_LIMIT, (unsigned)(cfg->http_connections + OBSD_HTTP_RESERVE),
-                              MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg->max_per_client,
                               MHD_OPTION_NOTIFY_CONNECTION, obsd__conn_notify, h,
                               MHD_OPTION_NOTIFY_COMPLETED, on_completed, h,
                               MHD_OPTION_EXTERNAL_LOGGER, on_mhd_log, h,

@@ -4,10 +4,12 @@
  *
  *   GET  /v1/streams                    the streams (JSON)
  *   GET  /v1/streams/NAME               one stream and its kept frames (JSON)
- *   POST /v1/streams/NAME/frames        a frame, as POST /v1/ao; kept
+ *   POST /v1/streams/NAME/frames        a frame, as POST /v1/ao (flat or
+ *                                       deep); kept
  *   GET  /v1/streams/NAME/frames/N      a kept frame (N or "latest"):
- *                                       output=ao|composite|color, format,
- *                                       exposure; other parameters re-run it
+ *                                       output=ao|composite|color|ao_front,
+ *                                       format, exposure; other parameters
+ *                                       re-run it
  *   GET  /v1/streams/NAME/events        text/event-stream: `frame` events
  *
  * An event stream is http_events.c's: the store parks and wakes it. */
@@ -135,12 +137,30 @@ static void apply_stored(req *r, const obsd_frame *f)
     fr->hr.png_bits = 8;
 }
 
-/* A kept frame's images that the request asks for. */
+/* A kept frame's images that the request asks for; a deep frame's as
+ * POST /v1/ao writes them (AO.Y, AOFront.Y, R,G,B,A). */
 static obsd_fp_images kept_images(const req *r, const obsd_frame *f)
 {
     obsd__frame_req *fr = r->fr;
-    return (obsd_fp_images){.ao = (fr->hr.outputs & OBS_OUTPUT_AO) ? &f->ao : NULL,
-                            .composite = (fr->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &f->composite : NULL};
+    const int ao = (fr->hr.outputs & OBS_OUTPUT_AO) != 0;
+    return (obsd_fp_images){.ao = ao ? &f->ao : NULL, .ao_front = ao && f->deep ? &f->ao_front : NULL,
+                            .composite = (fr->hr.outputs & OBS_OUTPUT_COMPOSITE) ? &f->composite : NULL,
+                            .deep = f->deep};
+}
+
+/* output=ao_front: a deep frame's front layer's AO alone, as its AO (the
+ * preview page's AO view of deep input); 400 for a flat frame. */
+static enum MHD_Result answer_front(req *r, const obs_image *front, const obs_camera *cam, int timing,
+                                    uint64_t seq)
+{
+    char num[32];
+    snprintf(num, sizeof num, "%llu", (unsigned long long)seq);
+    if (!front || !front->data)
+        return obsd__answer_error(r, 400, "not_deep",
+                                  "output=ao_front is the front layer's AO of a deep frame; this frame is "
+                                  "flat (ask for output=ao)", NULL, NULL);
+    obsd_fp_images im = {.ao = front};
+    return obsd__answer_images(r, &im, cam, timing, "X-Obscura-Frame", num);
 }
 
 static enum MHD_Result get_frame(req *r, uint64_t seq)
@@ -174,14 +194,20 @@ static enum MHD_Result get_frame(req *r, uint64_t seq)
         obsd_fp_keep_source(&fr->fp, f->body, f->body_len, f->part);
     if (fr->want_color) {
         if (!f->color.data)
-            return obsd__answer_error(r, 404, "no_color", "the frame's G-buffer has no colour plane", NULL,
-                                      NULL);
+            return obsd__answer_error(r, 404, "no_color",
+                                      f->deep ? "a deep frame has no flat colour plane (output=composite is its "
+                                                "samples' composite, output=ao_front its front layer's AO)"
+                                              : "the frame's G-buffer has no colour plane",
+                                      NULL, NULL);
         obsd_fp_images color = {.composite = &f->color};
         return obsd__answer_images(r, &color, NULL, 0, "X-Obscura-Frame", num);
     }
+    if (fr->want_front && (!f->deep || !fr->rerun))
+        return answer_front(r, f->deep ? &f->ao_front : NULL, f->written.has_projection ? &f->written : NULL, 0,
+                            f->seq);
     if (!fr->rerun) {
         obsd_fp_images im = kept_images(r, f);
-        return obsd__answer_images(r, &im, f->camera.has_projection ? &f->camera : NULL, 0, "X-Obscura-Frame",
+        return obsd__answer_images(r, &im, f->written.has_projection ? &f->written : NULL, 0, "X-Obscura-Frame",
                                    num);
     }
     /* other parameters: the frame runs again (not kept) */
@@ -275,6 +301,37 @@ static int copy_color(const obs_gbuffer *gb, obs_image *out)
     return 0;
 }
 
+/* The finished job's images and camera into the frame (the job keeps
+ * none of them): a deep frame's blended AO, front AO and composite, a
+ * flat one's AO and composite. */
+static void take_result(obsd_fp *fp, obsd_frame *f)
+{
+    const obs_camera *written = obsd_fp_camera(fp);
+    if (written)
+        f->written = *written;
+    if (fp->deep) {
+        obs_deep_result *dr = &fp->job.deep_result;
+        f->deep = 1;
+        f->width = fp->deep->width;
+        f->height = fp->deep->height;
+        f->camera = fp->deep->camera;
+        f->ao = dr->ao_blend;
+        f->ao_front = dr->ao_front;
+        f->composite = dr->composite;
+        *dr = (obs_deep_result){0};
+        return;
+    }
+    obs_result *res = &fp->job.result;
+    f->width = fp->gb->width;
+    f->height = fp->gb->height;
+    f->camera = fp->gb->camera;
+    f->ao = res->ao;
+    f->composite = res->composite;
+    res->ao = (obs_image){0};
+    res->composite = (obs_image){0};
+    obs_result_free(res);
+}
+
 /* POST .../frames, the GL worker done: keep the frame, answer like /v1/ao. */
 static enum MHD_Result post_finish(req *r)
 {
@@ -282,14 +339,11 @@ static enum MHD_Result post_finish(req *r)
     stream_req *sr = r->own;
     obsd_http *h = r->srv;
     const obs_gbuffer *gb = &fr->fp.gf.gb;
-    obs_result *res = &fr->fp.job.result;
     obsd_frame *f = obsd_frame_new();
-    if (!f || copy_color(gb, &f->color) != 0) {
+    if (!f || (!fr->fp.deep && copy_color(gb, &f->color) != 0)) {
         obsd_frame_release(f);
         return obsd__answer_status(r, OBS_NO_MEMORY, "no memory to keep the frame");
     }
-    f->width = gb->width;
-    f->height = gb->height;
     f->body = r->body;
     f->body_len = r->len;
     r->body = NULL;
@@ -298,12 +352,7 @@ static enum MHD_Result post_finish(req *r)
     f->query_len = fr->query_len;
     fr->query = NULL;
     fr->query_len = fr->query_cap = 0;
-    f->ao = res->ao;
-    f->composite = res->composite;
-    res->ao = (obs_image){0};
-    res->composite = (obs_image){0};
-    obs_result_free(res);
-    f->camera = gb->camera;
+    take_result(&fr->fp, f);
     f->part = obsd_fp_part(&fr->fp);
     f->ms_queue = fr->fp.ms_queue;
     f->ms_decode = fr->fp.ms_decode;
@@ -318,7 +367,7 @@ static enum MHD_Result post_finish(req *r)
     snprintf(num, sizeof num, "%llu", (unsigned long long)seq);
     sr->frame = f; /* released when the request ends */
     obsd_fp_images im = kept_images(r, f);
-    return obsd__answer_images(r, &im, f->camera.has_projection ? &f->camera : NULL, 1, "X-Obscura-Frame", num);
+    return obsd__answer_images(r, &im, f->written.has_projection ? &f->written : NULL, 1, "X-Obscura-Frame", num);
 }
 
 enum MHD_Result obsd__streams_finish(req *r)
@@ -331,6 +380,8 @@ enum MHD_Result obsd__streams_finish(req *r)
     if (sr->op == STREAM_POST)
         return post_finish(r);
     /* a re-run of a kept frame */
+    if (fr->want_front)
+        return answer_front(r, &fr->fp.job.deep_result.ao_front, obsd_fp_camera(&fr->fp), 1, sr->frame->seq);
     char num[32];
     snprintf(num, sizeof num, "%llu", (unsigned long long)sr->frame->seq);
     obsd_fp_images im;

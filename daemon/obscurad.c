@@ -6,7 +6,9 @@
  *
  * Threads: main (signals, start and drain), the GL worker (the only one
  * that touches GL), libmicrohttpd's pool and the binary protocol's
- * connection threads (parse, decode, encode).
+ * connection threads (parse, decode, encode); bake jobs' threads.  The
+ * work's own threads (llvmpipe's, the worker pools') are bounded by
+ * --render-threads (obs_threads_set), the HTTP pool by --threads.
  * SIGTERM/SIGINT: stop accepting, finish every queued and running frame,
  * answer it, exit 0; a second SIGINT exits at once.
  * Exit codes: 0 ok, 1 failure (GL, listen), 2 usage. */
@@ -110,6 +112,50 @@ static int context_desc(const obsd_config *cfg, obs_ctx_desc *desc)
     return 0;
 }
 
+/* --render-threads, else OBSCURA_THREADS (as obscura's --threads), made
+ * the process's thread limit before the GL context and any thread exist
+ * (obs_threads_set may set LP_NUM_THREADS); -1 on a bad value (logged). */
+static int render_threads(const obsd_config *cfg)
+{
+    int n = cfg->render_threads;
+    const char *env = getenv("OBSCURA_THREADS");
+    char err[OBS_ERR_LEN];
+    if (!n && env && *env) {
+        obsd_config tmp;
+        obsd_config_defaults(&tmp);
+        if (obsd_config_set(&tmp, "render_threads", env, err) != OBS_OK) {
+            obsd_log(OBSD_LOG_ERROR, "OBSCURA_THREADS: %s", err);
+            return -1;
+        }
+        n = tmp.render_threads;
+    }
+    if (obs_threads_set(n, err) != OBS_OK) {
+        obsd_log(OBSD_LOG_ERROR, "render threads: %s", err);
+        return -1;
+    }
+    return 0;
+}
+
+/* The threads line: a farm slot's limit is kept only when it reached
+ * llvmpipe and the pools, so the log says where each count came from. */
+static void log_threads(const obsd_config *cfg, int llvmpipe)
+{
+    obs_threads_info ti;
+    char lp[96] = "not in use";
+    obs_threads_get(&ti);
+    if (llvmpipe && ti.llvmpipe < 0)
+        snprintf(lp, sizeof lp, "one per core (LP_NUM_THREADS unset)");
+    else if (llvmpipe)
+        snprintf(lp, sizeof lp, "%d (LP_NUM_THREADS %s)", ti.llvmpipe,
+                 ti.llvmpipe_from_user ? "from the environment, kept" : "set from the render threads");
+    if (ti.limit)
+        obsd_log(OBSD_LOG_INFO, "threads: render %d (--render-threads or OBSCURA_THREADS), llvmpipe %s, "
+                 "HTTP %d", ti.limit, lp, cfg->threads);
+    else
+        obsd_log(OBSD_LOG_INFO, "threads: render every core (%d; --render-threads bounds them), "
+                 "llvmpipe %s, HTTP %d", ti.pool, lp, cfg->threads);
+}
+
 /* The log's lines that say where obscurad listens. */
 static void log_listeners(const obsd_config *cfg, obsd_http *http, obsd_bin *bin, int token)
 {
@@ -185,7 +231,7 @@ int main(int argc, char **argv)
         return 2;
 
     obs_ctx_desc desc = {.log = obsd_log_core};
-    if (context_desc(&cfg, &desc) != 0)
+    if (context_desc(&cfg, &desc) != 0 || render_threads(&cfg) != 0)
         return 2;
     if (install_signals() != 0) {
         obsd_log(OBSD_LOG_ERROR, "cannot install signal handlers: %s", strerror(errno));
@@ -210,6 +256,7 @@ int main(int argc, char **argv)
     }
     obsd_log(OBSD_LOG_INFO, "GL context: backend %s, %s, %s (created in %.0f ms)", gl.backend,
              gl.gl_renderer, gl.gl_version, gl.create_ms);
+    log_threads(&cfg, strstr(gl.gl_renderer, "llvmpipe") != NULL);
     s = cfg.http[0] ? obsd_http_start(&cfg, token, &queue, &gl, &http, err) : OBS_OK;
     if (s == OBS_OK && (cfg.socket[0] || cfg.tcp[0]))
         s = obsd_bin_start(&cfg, token, &queue, &gl, &bin, err);

@@ -17,7 +17,7 @@ const obsd__route obsd__routes[] = {
     /* the methods of each sub-route are http_streams.c's and http_bakes.c's to check */
     {.path = "/v1/streams", .under = "/v1/streams/", .reads_body = "POST", .start = obsd__streams_start,
      .body = obsd__frame_body, .finish = obsd__streams_finish, .done = obsd__streams_done},
-    {.path = "/v1/bakes", .under = "/v1/bakes/", .reads_body = "POST", .start = obsd__bakes_start,
+    {.path = "/v1/bakes", .under = "/v1/bakes/", .reads_body = "POST", .flags = OBSD_ROUTE_LEVEL_BODY, .start = obsd__bakes_start,
      .body = obsd__bakes_body, .done = obsd__bakes_done},
     {.path = "/", .under = "/preview/", .flags = OBSD_ROUTE_OPEN, .start = obsd__page}, /* static: no token */
 };

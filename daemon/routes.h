@@ -18,7 +18,8 @@ struct obsd__req;
 enum {
     OBSD_ROUTE_OPEN = 1,       /* no bearer token needed (probes, the static page) */
     OBSD_ROUTE_PROBE = 2,      /* served on a connection beyond --http-connections */
-    OBSD_ROUTE_FRAME_TOTAL = 4 /* every answer is a frame's end: timed as the `total` stage */
+    OBSD_ROUTE_FRAME_TOTAL = 4, /* every answer is a frame's end: timed as the `total` stage */
+    OBSD_ROUTE_LEVEL_BODY = 8   /* its body is a level: --max-level bounds it, not --max-body */
 };
 
 typedef struct obsd__route {

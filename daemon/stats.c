@@ -7,6 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <time.h>
+
+#include "config.h"
+#include "log.h"
 #include "stats.h"
 
 static const char *const stage_names[OBSD_STAGE_COUNT] = {"queue", "decode", "gl", "encode", "total"};
@@ -21,8 +25,20 @@ static const char *const res_names[] = {"sd", "hd", "uhd", "larger"};
 static const int64_t res_max[] = {640 * 480, 1920 * 1080, 3840 * 2160, INT64_MAX};
 #define NRES 4
 
+/* Refusals by reason: the first NREASONS reasons seen have their own
+ * row, later ones share the last (reason "other"). */
+#define NREASONS 16
+typedef struct refusal {
+    char reason[32];
+    uint64_t n;
+    double last_line; /* monotonic ms of its last log line */
+    uint64_t unlogged; /* refusals since that line */
+} refusal;
+
 static struct {
     pthread_mutex_t lock;
+    refusal refused[NREASONS];
+    int nrefused;
     const char *labels[OBSD_STATS_SLOTS];
     uint64_t requests[OBSD_STATS_SLOTS][NCODES];
     uint64_t bytes_in, bytes_out;
@@ -41,6 +57,8 @@ void obsd_stats_init(void)
     memset(st.count, 0, sizeof st.count);
     memset(st.frames, 0, sizeof st.frames);
     st.bytes_in = st.bytes_out = 0;
+    memset(st.refused, 0, sizeof st.refused);
+    st.nrefused = 0;
     pthread_mutex_unlock(&st.lock);
 }
 
@@ -125,6 +143,48 @@ static void put(sbuf *b, const char *fmt, ...)
     }
 }
 
+static double mono_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+void obsd_stats_refusal(const char *reason, const char *peer, const char *msg)
+{
+    double now = mono_ms();
+    uint64_t unlogged = 0;
+    int line = 0;
+    pthread_mutex_lock(&st.lock);
+    refusal *f = NULL;
+    for (int i = 0; i < st.nrefused && !f; i++)
+        if (!strcmp(st.refused[i].reason, reason))
+            f = &st.refused[i];
+    if (!f && st.nrefused < NREASONS) {
+        f = &st.refused[st.nrefused++];
+        snprintf(f->reason, sizeof f->reason, "%s", st.nrefused == NREASONS ? "other" : reason);
+        f->last_line = now - 1e4;
+    }
+    if (!f)
+        f = &st.refused[NREASONS - 1];
+    f->n++;
+    if (now - f->last_line >= 1000.0) { /* a flood of refusals is one line a second */
+        line = 1;
+        unlogged = f->unlogged;
+        f->unlogged = 0;
+        f->last_line = now;
+    } else {
+        f->unlogged++;
+    }
+    pthread_mutex_unlock(&st.lock);
+    if (line) {
+        char more[64] = "";
+        if (unlogged)
+            snprintf(more, sizeof more, " (%llu more since the last such line)", (unsigned long long)unlogged);
+        obsd_log(OBSD_LOG_WARN, "refused %s, peer=%s: %s%s", reason, peer ? peer : "?", msg ? msg : "", more);
+    }
+}
+
 char *obsd_stats_text(const obsd_gauges *g, size_t *len)
 {
     sbuf b = {malloc(8192), 0, 8192, 0};
@@ -158,6 +218,12 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
         put(&b, "obscurad_stage_seconds_count{stage=\"%s\"} %llu\n", stage_names[s],
             (unsigned long long)st.count[s]);
     }
+    put(&b, "# HELP obscurad_refusals_total Clients refused over a limit (connections, queue, "
+            "body size, deadlines, the drain), by reason (the error code).\n"
+            "# TYPE obscurad_refusals_total counter\n");
+    for (int i = 0; i < st.nrefused; i++)
+        put(&b, "obscurad_refusals_total{reason=\"%s\"} %llu\n", st.refused[i].reason,
+            (unsigned long long)st.refused[i].n);
     put(&b, "# HELP obscurad_frames_total Frames computed, by resolution class "
             "(sd <= 640x480 < hd <= 1920x1080 < uhd <= 3840x2160 < larger).\n"
             "# TYPE obscurad_frames_total counter\n");

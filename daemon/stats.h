@@ -32,6 +32,13 @@ void obsd_stats_stage(obsd_stage stage, double ms);
 /* One frame computed, by its pixel count (resolution class). */
 void obsd_stats_frame(int64_t width, int64_t height);
 
+/* A client refused over a limit (reason: the error code, e.g.
+ * "too_many_connections", "queue_full", "body_too_large",
+ * "request_timeout"): counted in obscurad_refusals_total{reason} and
+ * logged at warn, at most one line per reason a second, the line saying
+ * how many were not logged since the last.  peer and msg: for the line. */
+void obsd_stats_refusal(const char *reason, const char *peer, const char *msg);
+
 /* Gauges sampled when the text is made. */
 typedef struct obsd_gauges {
     int queue_depth, queue_capacity, gl_running, in_flight, gl_alive;

@@ -1,6 +1,7 @@
 /* The stream store behind /v1/streams (see stream_store.h). */
 #include "stream_store.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,6 +54,7 @@ void obsd_frame_release(obsd_frame *f)
     free(f->body);
     free(f->query);
     obs_image_free(&f->ao);
+    obs_image_free(&f->ao_front);
     obs_image_free(&f->composite);
     obs_image_free(&f->color);
     free(f);
@@ -65,7 +67,8 @@ static size_t image_bytes(const obs_image *im)
 
 size_t obsd_frame_bytes(const obsd_frame *f)
 {
-    return sizeof *f + f->body_len + f->query_len + image_bytes(&f->ao) + image_bytes(&f->composite) +
+    return sizeof *f + f->body_len + f->query_len + image_bytes(&f->ao) + image_bytes(&f->ao_front) +
+           image_bytes(&f->composite) +
            image_bytes(&f->color);
 }
 
@@ -251,6 +254,51 @@ static void add_timings(cJSON *o, const obsd_frame *f)
     cJSON_AddNumberToObject(t, "gl", f->ms_gl);
 }
 
+/* The query the frame was posted with, keyed by the table's snake_case
+ * names ('fov-y' and 'fov_y' are one parameter; the last given wins, as
+ * the request parser reads them). */
+static void add_params(cJSON *o, const obsd_frame *f)
+{
+    cJSON *q = cJSON_AddObjectToObject(o, "params");
+    for (size_t k = 0; q && k + 1 < f->query_len;) {
+        const char *key = f->query + k, *val = key + strlen(key) + 1;
+        char name[64];
+        snprintf(name, sizeof name, "%s", key);
+        for (char *c = name; *c; c++)
+            if (*c == '-')
+                *c = '_';
+        cJSON_DeleteItemFromObjectCaseSensitive(q, name);
+        cJSON_AddStringToObject(q, name, val);
+        k = (size_t)(val - f->query) + strlen(val) + 1;
+    }
+}
+
+/* Six significant digits: what a control shows, not 49.99999809. */
+static double rounded(double v)
+{
+    char buf[32];
+    snprintf(buf, sizeof buf, "%.6g", v);
+    return strtod(buf, NULL);
+}
+
+/* fov_y (degrees), near and far of the perspective projection the frame
+ * ran with, whichever gave it (the parameters, the file's worldToNDC, a
+ * camera JSON), inverted from the OpenGL matrix as clients/remote.c
+ * does: P[5] = 1/tan(fov/2), P[10] = -(f+n)/(f-n), P[11] = -2fn/(f-n).
+ * Left out for no projection or an orthographic one (P[14] = 0). */
+static void add_camera(cJSON *o, const obs_camera *c)
+{
+    const float *p = c->projection;
+    if (!c->has_projection || p[14] != -1.0f || p[5] <= 0.0f || p[10] == 1.0f || p[10] == -1.0f)
+        return;
+    cJSON *cam = cJSON_AddObjectToObject(o, "camera");
+    if (!cam)
+        return;
+    cJSON_AddNumberToObject(cam, "fov_y", rounded(2.0 * atan(1.0 / p[5]) * 180.0 / M_PI));
+    cJSON_AddNumberToObject(cam, "near", rounded(p[11] / (p[10] - 1.0)));
+    cJSON_AddNumberToObject(cam, "far", rounded(p[11] / (p[10] + 1.0)));
+}
+
 static cJSON *stream_summary(const obsd_stream *st)
 {
     cJSON *o = cJSON_CreateObject(), *fr;
@@ -298,7 +346,7 @@ char *obsd_streams_stream_json(obsd_streams *s, const char *name, int *found)
     cJSON *o = st ? stream_summary(st) : NULL, *list = o ? cJSON_AddArrayToObject(o, "frame_info") : NULL;
     for (int i = 0; list && i < st->count; i++) {
         const obsd_frame *f = st->frames[i];
-        cJSON *fo = cJSON_CreateObject(), *q;
+        cJSON *fo = cJSON_CreateObject();
         if (!fo)
             break;
         cJSON_AddItemToArray(list, fo);
@@ -306,15 +354,11 @@ char *obsd_streams_stream_json(obsd_streams *s, const char *name, int *found)
         cJSON_AddNumberToObject(fo, "width", f->width);
         cJSON_AddNumberToObject(fo, "height", f->height);
         cJSON_AddBoolToObject(fo, "color", f->color.data != NULL);
+        cJSON_AddBoolToObject(fo, "deep", f->deep);
         cJSON_AddNumberToObject(fo, "posted", f->posted_unix);
         add_timings(fo, f);
-        if ((q = cJSON_AddObjectToObject(fo, "params")))
-            for (size_t k = 0; k + 1 < f->query_len;) {
-                const char *key = f->query + k, *val = key + strlen(key) + 1;
-                cJSON_DeleteItemFromObjectCaseSensitive(q, key); /* the last wins */
-                cJSON_AddStringToObject(q, key, val);
-                k = (size_t)(val - f->query) + strlen(val) + 1;
-            }
+        add_params(fo, f);
+        add_camera(fo, &f->camera);
     }
     pthread_mutex_unlock(&s->lock);
     if (o) {
@@ -374,10 +418,10 @@ int obsd_streams_next_event(obsd_streams *s, obsd_sub *sub, char *buf, size_t le
         sub->sent = last->seq;
         n = snprintf(buf, len,
                      "event: frame\nid: %llu\ndata: {\"stream\":\"%s\",\"frame\":%llu,\"width\":%d,"
-                     "\"height\":%d,\"color\":%s,\"timings\":{\"queue\":%.2f,\"decode\":%.2f,\"gl\":%.2f}}"
+                     "\"height\":%d,\"color\":%s,\"deep\":%s,\"timings\":{\"queue\":%.2f,\"decode\":%.2f,\"gl\":%.2f}}"
                      "\n\n",
                      (unsigned long long)last->seq, st->name, (unsigned long long)last->seq, last->width,
-                     last->height, last->color.data ? "true" : "false", last->ms_queue, last->ms_decode,
+                     last->height, last->color.data ? "true" : "false", last->deep ? "true" : "false", last->ms_queue, last->ms_decode,
                      last->ms_gl);
     } else if (sub->ended || s->ended) {
         sub->said_end = 1;

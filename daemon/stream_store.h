@@ -33,10 +33,13 @@ typedef struct obsd_frame {
     size_t body_len;
     char *query;           /* its query parameters: "name\0value\0" pairs */
     size_t query_len;      /* bytes of query */
-    obs_image ao;          /* the AO (1 channel) */
+    obs_image ao;          /* the AO (1 channel; deep input: the blended AO, AO.Y) */
+    obs_image ao_front;    /* deep input: the front layer's AO (AOFront.Y); else empty */
     obs_image composite;   /* colour x AO (RGBA) */
-    obs_image color;       /* the G-buffer's colour (RGBA); empty without one */
+    obs_image color;       /* the G-buffer's colour (RGBA); empty without one (and for deep input) */
+    int deep;              /* the body is a deep EXR: it ran the multi-layer chain */
     obs_camera camera;
+    obs_camera written;    /* the camera its EXR answers carry: the one it ran with (obsd_fp_camera) */
     int part;              /* the body's part the G-buffer was read from */
     double ms_queue, ms_decode, ms_gl; /* the stages of its run */
     double posted_unix;    /* seconds since the epoch */
@@ -89,8 +92,11 @@ obsd_frame *obsd_streams_get(obsd_streams *s, const char *name, uint64_t seq, in
 /* JSON: {"streams": [{"name", "frames": [seq...], "latest", "width",
  * "height", "updated", "subscribers"}]}.  Caller frees with free(). */
 char *obsd_streams_list_json(obsd_streams *s);
-/* JSON of one stream with each kept frame's size, timings and
- * parameters; NULL when it does not exist (or out of memory). */
+/* JSON of one stream with each kept frame's size, timings, whether it
+ * is deep, its parameters (the query it was posted with) and its camera
+ * (fov_y, near, far as the projection it ran with says, when it had one:
+ * a camera from the file shows there, not as a parameter); NULL when it
+ * does not exist (or out of memory). */
 char *obsd_streams_stream_json(obsd_streams *s, const char *name, int *found);
 
 /* Subscribes to stream `name` (created, empty, when new and there is

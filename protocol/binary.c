@@ -841,14 +841,39 @@ void obs_bin_request_free(obs_bin_request *q)
 
 /* ---- responses ------------------------------------------------------------- */
 
+/* A 200's message: its warnings, one a line, whole ones only, in
+ * out[OBS_BIN_MAX_MESSAGE + 1]. */
+static const char *warning_lines(const obs_bin_response_desc *d, char *out)
+{
+    size_t n = 0;
+    out[0] = '\0';
+    for (int i = 0; i < d->warning_count && i < OBS_BIN_MAX_WARNINGS; i++) {
+        const char *t = d->warnings[i] ? d->warnings[i] : "";
+        size_t len = strlen(t);
+        if (len == 0)
+            continue;
+        if (n + (n > 0) + len > OBS_BIN_MAX_MESSAGE)
+            break;
+        if (n > 0)
+            out[n++] = '\n';
+        for (size_t k = 0; k < len; k++)
+            out[n++] = t[k] == '\n' || t[k] == '\r' ? ' ' : t[k];
+        out[n] = '\0';
+    }
+    return out;
+}
+
 static void write_response(writer *w, const obs_bin_response_desc *d, uint64_t payload_len)
 {
     unsigned char hdr[OBS_BIN_HEADER_LEN];
+    char lines[OBS_BIN_MAX_MESSAGE + 1];
     obs_bin_header_write(hdr, OBS_BIN_RESPONSE, d->id, payload_len);
     put(w, hdr, sizeof hdr);
     size_t start = w->n;
     const char *code = d->code ? d->code : "";
-    const char *msg = d->message ? d->message : "";
+    const char *msg = d->status == 200 && d->warning_count > 0 ? warning_lines(d, lines)
+                      : d->message                            ? d->message
+                                                              : "";
     size_t cl = strnlen(code, 63), ml = strnlen(msg, OBS_BIN_MAX_MESSAGE);
     put_u16(w, (unsigned)d->status);
     put_u16(w, (unsigned)d->retry_after);
@@ -902,6 +927,20 @@ obs_status obs_bin_response_encode(const obs_bin_response_desc *d, obs_bytes *ou
     return OBS_OK;
 }
 
+/* A 200's message into its lines, the warnings (empty lines skipped). */
+static void split_warnings(obs_bin_response *out)
+{
+    memcpy(out->warning_text, out->message, sizeof out->warning_text);
+    for (char *p = out->warning_text; *p && out->warning_count < OBS_BIN_MAX_WARNINGS;) {
+        size_t len = strcspn(p, "\n");
+        char *next = p[len] ? p + len + 1 : p + len;
+        p[len] = '\0';
+        if (len > 0)
+            out->warnings[out->warning_count++] = p;
+        p = next;
+    }
+}
+
 obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, const obs_limits *lim,
                                    obs_bin_response *out, char err[OBS_ERR_LEN])
 {
@@ -927,6 +966,8 @@ obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, con
     out->status = (int)status;
     out->retry_after = (int)retry;
     out->body = (obs_bin_body)body;
+    if (status == 200)
+        split_warnings(out);
     switch (body) {
     case OBS_BIN_NONE:
         break;

@@ -8,7 +8,9 @@
  *              camera, or a deep (layered) A-buffer: per-pixel sample
  *              counts and the packed samples
  *   response = status + code + message, then nothing, an EXR/PNG file or
- *              raw float32 planes
+ *              raw float32 planes; a 200's message holds the answer's
+ *              warnings, one a line (version 1 sent "" there, so a reader
+ *              that ignores a 200's message reads both)
  *
  * Every size read from the wire is checked (overflow, the limits the
  * caller passes, the bytes actually present) before anything is
@@ -33,6 +35,7 @@ extern "C" {
 #define OBS_BIN_MAX_NAME 64
 #define OBS_BIN_MAX_VALUE 4096
 #define OBS_BIN_MAX_MESSAGE 4096
+#define OBS_BIN_MAX_WARNINGS 16
 
 typedef enum obs_bin_kind {
     OBS_BIN_REQUEST = 1,
@@ -189,7 +192,13 @@ typedef struct obs_bin_response_desc {
     int status;        /* HTTP-like: 200, 400, 401, 413, 415, 422, 500, 503 */
     int retry_after;   /* seconds, with 503; 0 otherwise */
     const char *code;  /* "ok", "bad_parameter", ... (as protocol/http.h) */
-    const char *message;
+    const char *message; /* errors: what is wrong */
+    /* status 200: the answer's warnings (X-Obscura-Warning over HTTP),
+     * sent in the message field, one a line: a line break inside one is
+     * sent as a space, and those past OBS_BIN_MAX_MESSAGE bytes (or
+     * OBS_BIN_MAX_WARNINGS) are left out whole */
+    const char *const *warnings;
+    int warning_count;
     obs_bin_body body; /* NONE, EXR, PNG or RAW */
     const void *blob;  /* EXR or PNG */
     size_t blob_len;
@@ -205,6 +214,11 @@ typedef struct obs_bin_response {
     int status, retry_after;
     char code[64];
     char message[OBS_BIN_MAX_MESSAGE + 1];
+    /* status 200: the message's lines, the answer's warnings (pointing
+     * into warning_text) */
+    int warning_count;
+    const char *warnings[OBS_BIN_MAX_WARNINGS];
+    char warning_text[OBS_BIN_MAX_MESSAGE + 1];
     obs_bin_body body;
     const unsigned char *blob; /* EXR/PNG: points into the payload */
     size_t blob_len;

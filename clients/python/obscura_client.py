@@ -22,6 +22,22 @@ an ObscuraError whose .code is the daemon's JSON error code
 ("bad_parameter", "missing_channel", "no_camera", "queue_full", ...);
 an unreachable daemon raises ObscuraError with code "unreachable".
 
+The camera JSON that `obscura ao --camera` takes (written beside a render:
+world_to_camera, projection or fov_y_deg, near, far) is sent with
+camera=Camera.from_json(path or dict), as fov_y, near, far and
+world_to_camera:
+
+    cam = oc.Camera.from_json("frame.camera.json")
+    exr = oc.ao("frame.exr", camera=cam, radius=0.5)
+
+Warnings: the daemon's warnings on an answer (a wrong camera, AO near 1
+everywhere: X-Obscura-Warning over HTTP, the answer's warnings over the
+binary protocol; what `obscura ao` prints as "obscura: warning:") are
+issued as ObscuraWarning through Python's warnings module, so a script
+sees them by default (warnings.simplefilter("error", oc.ObscuraWarning)
+makes them errors), and kept in the answer's .warnings (a list of str);
+an ObscuraError has .warnings too.
+
 Level bakes (obscura bake on the daemon, POST /v1/bakes, HTTP only):
 
     oc.bake("level.glb", out="baked.glb", rays=64, distances=(2, 300))
@@ -37,14 +53,16 @@ Works with Python 3.6 and later.
 """
 import http.client
 import json
+import math
 import os
 import socket
 import struct
 import time
 import urllib.parse
+import warnings
 
-__all__ = ["ao", "bake", "ObscuraError", "DEFAULT_SERVER"]
-__version__ = "1.1.0"
+__all__ = ["ao", "bake", "Answer", "Camera", "ObscuraError", "ObscuraWarning", "DEFAULT_SERVER"]
+__version__ = "1.2.0"
 
 DEFAULT_SERVER = "http://127.0.0.1:8420"
 CHUNK = 1 << 16
@@ -62,14 +80,126 @@ class ObscuraError(Exception):
 
     status: the HTTP status (the binary protocol uses the same numbers),
     None when the daemon was not reached; code: the JSON error code;
-    message: what is wrong; retry_after: seconds to wait (503), or 0."""
+    message: what is wrong; retry_after: seconds to wait (503), or 0;
+    warnings: the warnings the answer carried (a list of str, often
+    empty: a refusal's reason is its message)."""
 
-    def __init__(self, status, code, message, retry_after=0):
+    def __init__(self, status, code, message, retry_after=0, warnings=None):
         Exception.__init__(self, "%s%s: %s" % (code, " (%d)" % status if status else "", message))
         self.status = status
         self.code = code
         self.message = message
         self.retry_after = retry_after
+        self.warnings = list(warnings or [])
+
+
+class ObscuraWarning(UserWarning):
+    """A warning obscurad gave with its answer: the answer was computed,
+    but likely not as meant (the text names the cause and the flag or
+    parameter that fixes it)."""
+
+
+class Answer(bytes):
+    """What ao() returns: the answer's bytes (an EXR, or a PNG with
+    format="png"; b"" when out= took them), and .warnings, the daemon's
+    warnings on it (a list of str, [] when none)."""
+
+    def __new__(cls, data, warnings_=None):
+        self = bytes.__new__(cls, data)
+        self.warnings = list(warnings_ or [])
+        return self
+
+
+def _warn(texts):
+    # stacklevel 3: the line of the script that called ao()
+    for t in texts:
+        warnings.warn(t, ObscuraWarning, stacklevel=3)
+
+
+def _f32(x):
+    """x as the float32 the CLI's camera reader keeps."""
+    return struct.unpack("<f", struct.pack("<f", float(x)))[0]
+
+
+class Camera(object):
+    """A camera for ao(camera=...): a vertical field of view in degrees,
+    the clip range and the 4x4 world_to_camera (row-major, column-vector
+    convention: p_cam = M p_world, the camera looking down -Z), sent as
+    the query parameters fov_y, near, far and world_to_camera."""
+
+    def __init__(self, fov_y, world_to_camera, near=0.1, far=1000.0):
+        m = [float(v) for row in world_to_camera for v in (row if isinstance(row, (list, tuple)) else [row])]
+        if len(m) != 16:
+            raise ValueError("Camera: world_to_camera is 4 rows of 4 numbers (or 16 numbers), not %d numbers" % len(m))
+        if not 0 < fov_y < 180:
+            raise ValueError("Camera: fov_y %r is not degrees between 0 and 180" % (fov_y,))
+        if not near > 0 or not far > near:
+            raise ValueError("Camera: near %r and far %r: expected 0 < near < far" % (near, far))
+        self.fov_y, self.near, self.far = float(fov_y), float(near), float(far)
+        self.world_to_camera = m
+
+    @classmethod
+    def from_json(cls, source):
+        """The camera of a camera JSON (what `obscura ao --camera` reads,
+        core/camera/json.c): a path, or the dict json.load gives.  It has
+        world_to_camera, and projection (a symmetric perspective) or
+        fov_y_deg (with width and height); near and far default to 0.1 and
+        1000.  The values are those the CLI reads (float32), written as
+        the CLI sends them (remote.c), so that an answer is the CLI's."""
+        what = "Camera.from_json()"
+        if isinstance(source, (str, os.PathLike)):
+            what = "Camera.from_json(%r)" % os.fspath(source)
+            with open(source, "rb") as f:
+                try:
+                    source = json.loads(f.read().decode("utf-8"))
+                except ValueError as e:
+                    raise ValueError("%s: not valid JSON: %s" % (what, e))
+        if not isinstance(source, dict):
+            raise TypeError("%s takes a path or a dict, not %r" % (what, type(source)))
+
+        def number(name, default=None):
+            v = source.get(name, default)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or v != v):
+                raise ValueError("%s: %s: expected a number" % (what, name))
+            return v
+
+        def mat4(name):
+            v = source.get(name)
+            if v is None:
+                return None
+            flat = v if isinstance(v, list) and len(v) == 16 else \
+                [x for row in v for x in row] if isinstance(v, list) and len(v) == 4 and \
+                all(isinstance(r, list) and len(r) == 4 for r in v) else None
+            if flat is None or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in flat):
+                raise ValueError("%s: %s: expected 4 rows of 4 numbers" % (what, name))
+            return [_f32(x) for x in flat]
+
+        w2c, proj = mat4("world_to_camera"), mat4("projection")
+        if w2c is None:
+            raise ValueError("%s: world_to_camera: missing" % what)
+        if proj is not None:
+            p = proj
+            if p[14] != -1 or p[15] != 0 or p[1] or p[2] or p[4] or p[6] or p[3] or p[7] or p[5] <= 0:
+                raise ValueError("%s: projection: only a symmetric perspective projection can be sent "
+                                 "(as fov_y, near, far)" % what)
+            fov = 2.0 * math.atan(1.0 / p[5]) * 180.0 / math.pi
+            near, far = p[11] / (p[10] - 1.0), p[11] / (p[10] + 1.0)
+        else:
+            fov = number("fov_y_deg")
+            if fov is None or number("width") is None or number("height") is None:
+                raise ValueError("%s: projection: missing (and no fov_y_deg with width and height to "
+                                 "build one)" % what)
+            near, far = _f32(number("near", 0.1)), _f32(number("far", 1000.0))
+            fov = _f32(fov)
+        return cls(fov, w2c, near, far)
+
+    def params(self):
+        """The query parameters: fov_y, near, far, world_to_camera."""
+        return {"fov_y": "%.9g" % self.fov_y, "near": "%.9g" % self.near, "far": "%.9g" % self.far,
+                "world_to_camera": ",".join("%.9g" % v for v in self.world_to_camera)}
+
+    def __repr__(self):
+        return "Camera(fov_y=%.6g, near=%.6g, far=%.6g)" % (self.fov_y, self.near, self.far)
 
 
 def _value(v):
@@ -180,9 +310,16 @@ def _http_error(status, body):
         return "http_%d" % status, body.decode("utf-8", "replace")[:500]
 
 
+def _header_warnings(resp):
+    """The X-Obscura-Warning headers, as the daemon wrote them (UTF-8;
+    http.client reads header bytes as Latin-1)."""
+    return [v.encode("latin-1", "replace").decode("utf-8", "replace")
+            for v in (resp.msg.get_all("X-Obscura-Warning") or [])]
+
+
 def _request(server, method, path, token, timeout, body=None, headers=None, sink=None):
-    """One HTTP request; the status and the answer's body (None when it
-    was streamed into sink).  body: None or a list of bytes and _Source
+    """One HTTP request; the status, the answer's body (None when it was
+    streamed into sink) and its warnings.  body: None or a list of bytes and _Source
     pieces, sent in turn.  http.client (what urllib.request runs on)
     rather than urlopen: the daemon refuses a bad request before it reads
     the body and closes, and the answer must still be read after the send
@@ -213,26 +350,27 @@ def _request(server, method, path, token, timeout, body=None, headers=None, sink
             resp = conn.getresponse()
         except (OSError, http.client.HTTPException) as e:
             raise ObscuraError(None, "unreachable", "%s: no answer: %s" % (server, e))
+        said = _header_warnings(resp)
         if resp.status >= 300:
             code, msg = _http_error(resp.status, resp.read())
             retry = resp.getheader("Retry-After")
-            raise ObscuraError(resp.status, code, msg, int(retry) if retry and retry.isdigit() else 0)
+            raise ObscuraError(resp.status, code, msg, int(retry) if retry and retry.isdigit() else 0, said)
         if sink is None:
-            return resp.status, resp.read()
+            return resp.status, resp.read(), said
         while True:
             b = resp.read(CHUNK)
             if not b:
                 break
             sink.write(b)
-        return resp.status, None
+        return resp.status, None, said
     except socket.timeout:
         raise ObscuraError(None, "unreachable", "%s: no answer within %s s" % (server, timeout))
     finally:
         conn.close()
 
 def _ao_http(server, src, params, token, sink, timeout):
-    _request(server, "POST", "/v1/ao?" + urllib.parse.urlencode(params), token, timeout, [src],
-             {"Content-Type": "image/x-exr"}, sink)
+    return _request(server, "POST", "/v1/ao?" + urllib.parse.urlencode(params), token, timeout, [src],
+                    {"Content-Type": "image/x-exr"}, sink)[2]
 
 
 def _connect(server, timeout):
@@ -297,6 +435,9 @@ def _ao_binary(server, src, params, sink, timeout):
         _recv_exact(s, (8 - off % 8) % 8, server)
         if status != 200:
             raise ObscuraError(status, code, msg, retry)
+        # a 200's message holds the answer's warnings, one a line
+        # (PROTOCOL.md, "Response payload"); older daemons send ""
+        said = [w for w in msg.split("\n") if w]
         if body not in (BODY_EXR, BODY_PNG):
             raise ObscuraError(status, "bad_answer", "%s: answer body kind %d (ask format=exr or png)" % (server, body))
         (n,) = struct.unpack("<Q", _recv_exact(s, 8, server))
@@ -306,37 +447,47 @@ def _ao_binary(server, src, params, sink, timeout):
                 raise ObscuraError(None, "unreachable", "%s: the connection closed mid-answer" % server)
             sink.write(b)
             n -= len(b)
+        return said
     except socket.timeout:
         raise ObscuraError(None, "unreachable", "%s: no answer within %s s" % (server, timeout))
     finally:
         s.close()
 
 
-def ao(source, server=None, out=None, token=None, timeout=300, **params):
+def ao(source, server=None, out=None, token=None, timeout=300, camera=None, **params):
     """The AO of one G-buffer EXR from obscurad.
 
     source: a path (streamed from disk), bytes, or a binary file object.
     server: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT (default: the
     OBSCURA_SERVER environment variable, else http://127.0.0.1:8420).
     out: a path or a binary file object to stream the answer into (a
-    path is written whole or not at all); then None is returned.
+    path is written whole or not at all); then the Answer is b"".
     token: the bearer token (default: OBSCURA_TOKEN).
+    camera: a Camera (Camera.from_json("frame.camera.json")), sent as
+    fov_y, near, far and world_to_camera unless params give them.
     params: the daemon's query parameters.
-    Returns the answer's bytes (an EXR, or a PNG with format="png").
+    Returns an Answer: the answer's bytes (an EXR, or a PNG with
+    format="png"; b"" with out=) and .warnings, the daemon's warnings,
+    each also issued as an ObscuraWarning (Python's warnings module).
     Raises ObscuraError (with .code) when the daemon refuses or cannot
     be reached, TypeError/ValueError for arguments it cannot send."""
     server = server or os.environ.get("OBSCURA_SERVER") or DEFAULT_SERVER
     token = token if token is not None else os.environ.get("OBSCURA_TOKEN")
     if str(params.get("format", "exr")) == "raw":
         raise ValueError("ao(): format=raw is not an answer this client returns (use exr or png)")
+    if camera is not None:
+        if not isinstance(camera, Camera):
+            raise TypeError("ao(): camera is a Camera (Camera.from_json), not %r" % type(camera))
+        given = set(k.replace("-", "_") for k in params)
+        params = dict([(k, v) for k, v in camera.params().items() if k not in given] + list(params.items()))
     opened_here = isinstance(source, (str, os.PathLike))
     src = _Source(source)
     sink = _Sink(out)
     try:
         if server.startswith("http://"):
-            _ao_http(server, src, _params(params, None), token, sink, timeout)
+            said = _ao_http(server, src, _params(params, None), token, sink, timeout)
         elif server.startswith("unix:") or server.startswith("tcp://"):
-            _ao_binary(server, src, _params(params, token), sink, timeout)
+            said = _ao_binary(server, src, _params(params, token), sink, timeout)
         else:
             raise ValueError("ao(): server %r is not http://HOST:PORT, unix:/PATH or tcp://HOST:PORT" % server)
     except BaseException:
@@ -344,7 +495,9 @@ def ao(source, server=None, out=None, token=None, timeout=300, **params):
         raise
     finally:
         src.close(opened_here)
-    return sink.done()
+    data = sink.done()
+    _warn(said)
+    return Answer(data if data is not None else b"", said)
 
 
 # ---- bake jobs (POST /v1/bakes, protocol/HTTP.md "Bake jobs") ----------
@@ -392,7 +545,7 @@ def bake(level, server=None, out=None, token=None, decorators=None, timeout=60,
             body, ctype = [src], "application/octet-stream"
         else:
             body, ctype = _multipart(src, dec)
-        _, answer = _request(server, "POST", query, token, timeout, body, {"Content-Type": ctype})
+        _, answer, _ = _request(server, "POST", query, token, timeout, body, {"Content-Type": ctype})
     finally:
         src.close(level in opened)
         if dec is not None:
@@ -400,7 +553,7 @@ def bake(level, server=None, out=None, token=None, decorators=None, timeout=60,
     job = json.loads(answer.decode("utf-8"))
     jid = job["id"]
     while True:
-        _, answer = _request(server, "GET", "/v1/bakes/" + jid, token, timeout)
+        _, answer, _ = _request(server, "GET", "/v1/bakes/" + jid, token, timeout)
         job = json.loads(answer.decode("utf-8"))
         if progress is not None:
             progress(job.get("progress", 0), job.get("stage", ""))

@@ -39,8 +39,6 @@ void obs_bake_result_free(obs_bake_result *r)
     memset(r, 0, sizeof *r);
 }
 
-static float clamp01(double v) { return (float)(v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v); }
-
 /* The welded solution copied back to every instance's own vertices. */
 static obs_status copy_back(const obs_bake_scene *scene, const obs__bake_world *w,
                             const obs__bake_weld *wd, const double *x, float blend,
@@ -55,19 +53,9 @@ static obs_status copy_back(const obs_bake_scene *scene, const obs__bake_world *
         obs_bake_instance *r = &out->instances[i];
         const obs__bake_inst *in = &w->inst[i];
         size_t n = scene->meshes[in->mesh].vertex_count;
-        r->node = in->node;
-        r->mesh = in->mesh;
-        r->ao = malloc((n ? n : 1) * sizeof(float));
-        r->ao_short = malloc((n ? n : 1) * sizeof(float));
-        r->ao_long = malloc((n ? n : 1) * sizeof(float));
-        if (!r->ao || !r->ao_short || !r->ao_long)
+        if (obs__bake_instance_values(r, in, n, wd->of + in->first_vertex, x, blend) != 0)
             return obs__fail(err, OBS_NO_MEMORY, "results of %zu vertices", n);
         for (size_t v = 0; v < n; v++) {
-            uint32_t k = wd->of[in->first_vertex + v];
-            r->ao_short[v] = clamp01(x[2 * k]);
-            r->ao_long[v] = clamp01(x[2 * k + 1]);
-            /* _AO, the artists' blend (section 2) */
-            r->ao[v] = clamp01(blend * r->ao_short[v] + (1.0f - blend) * r->ao_long[v]);
             sum += r->ao[v];
             lo = fmin(lo, r->ao[v]);
             hi = fmax(hi, r->ao[v]);

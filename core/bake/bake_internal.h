@@ -57,6 +57,13 @@ typedef struct obs__bake_weld {
 obs_status obs__bake_weld_make(const obs__bake_world *w, float tolerance, float angle_deg,
                           obs__bake_weld *out, char err[OBS_ERR_LEN]);
 void obs__bake_weld_free(obs__bake_weld *wd);
+/* Instance in's values from the welded solution x (short, long per welded
+ * vertex), its n vertices welded as of[0 .. n) (wd->of from its first
+ * vertex on), into r: each distance clamped to [0, 1] and _AO, the
+ * artists' blend of the two (section 2).  The full detail (bake.c) and
+ * each LOD (lod.c) end so.  0, or -1 when out of memory. */
+int obs__bake_instance_values(obs_bake_instance *r, const obs__bake_inst *in, size_t n,
+                              const uint32_t *of, const double *x, float blend);
 
 /* The least-squares fit (fit.c): x holds 2 values (short, long) per welded
  * vertex; face and point the two baselines' values (obs_bake_stats), 2 per

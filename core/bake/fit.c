@@ -210,6 +210,13 @@ static void initial_values(const obs__bake_samples *s, sys *y, obs_bake_stats *s
     free(acc);
 }
 
+/* The welded vertex at corner k of sample i's face. */
+static uint32_t corner_vertex(const obs__bake_world *w, const obs__bake_weld *wd,
+                              const obs__bake_samples *s, size_t i, int k)
+{
+    return wd->of[w->tri[3 * (size_t)s->tri[i] + k]];
+}
+
 void obs__bake_residual(const obs__bake_world *w, const obs__bake_weld *wd,
                         const obs__bake_samples *s, const double *val, double out[2])
 {
@@ -253,9 +260,8 @@ static void baselines(const obs__bake_world *w, const obs__bake_weld *wd,
     for (size_t i = 0; i < s->count; i++) {
         if (!s->valid[i])
             continue;
-        const uint32_t *t = w->tri + 3 * s->tri[i];
         for (int k = 0; k < 3; k++) {
-            uint32_t v = wd->of[t[k]];
+            uint32_t v = corner_vertex(w, wd, s, i, k);
             mean[3 * v] += s->weight[i] * s->ao[2 * i];
             mean[3 * v + 1] += s->weight[i] * s->ao[2 * i + 1];
             mean[3 * v + 2] += s->weight[i];
@@ -327,9 +333,8 @@ static void gather_samples(const obs__bake_world *w, const obs__bake_weld *wd,
     for (size_t i = 0; i < s->count; i++) {
         if (!s->valid[i])
             continue;
-        const uint32_t *t = w->tri + 3 * s->tri[i];
         for (int k = 0; k < 3; k++) {
-            uint32_t v = wd->of[t[k]];
+            uint32_t v = corner_vertex(w, wd, s, i, k);
             double wp = (double)s->weight[i] * s->bary[3 * i + k];
             y->cover[v] += wp;
             y->b[2 * v] += wp * s->ao[2 * i];

@@ -143,8 +143,6 @@ obs_status obs__bake_lod_resample(const obs__bake_world *full, const obs__bake_w
     return OBS_OK;
 }
 
-static float clamp01(double v) { return (float)(v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v); }
-
 /* The welded LOD solution onto each instance's LOD vertices, as bake.c's
  * copy_back does for the full detail. */
 static obs_status copy_level(const obs__bake_world *lw, const obs__bake_weld *lwd,
@@ -154,20 +152,9 @@ static obs_status copy_level(const obs__bake_world *lw, const obs__bake_weld *lw
     for (size_t i = 0; i < lw->instance_count; i++) {
         size_t end = i + 1 < lw->instance_count ? lw->inst[i + 1].first_vertex : lw->vertex_count;
         size_t n = end - lw->inst[i].first_vertex;
-        obs_bake_instance *r = &dst[i];
-        r->node = lw->inst[i].node;
-        r->mesh = lw->inst[i].mesh;
-        r->ao = malloc((n ? n : 1) * sizeof(float));
-        r->ao_short = malloc((n ? n : 1) * sizeof(float));
-        r->ao_long = malloc((n ? n : 1) * sizeof(float));
-        if (!r->ao || !r->ao_short || !r->ao_long)
+        if (obs__bake_instance_values(&dst[i], &lw->inst[i], n, lwd->of + lw->inst[i].first_vertex,
+                                      x, blend) != 0)
             return obs__fail(err, OBS_NO_MEMORY, "LOD results of %zu vertices", n);
-        for (size_t v = 0; v < n; v++) {
-            uint32_t k = lwd->of[lw->inst[i].first_vertex + v];
-            r->ao_short[v] = clamp01(x[2 * k]);
-            r->ao_long[v] = clamp01(x[2 * k + 1]);
-            r->ao[v] = clamp01(blend * r->ao_short[v] + (1.0f - blend) * r->ao_long[v]);
-        }
     }
     return OBS_OK;
 }
@@ -190,138 +177,193 @@ static void weld_values(const obs__bake_world *lw, const obs__bake_weld *lwd, co
             out[2 * k] /= count[k], out[2 * k + 1] /= count[k];
 }
 
+/* One level's working state: its flattened world, samples resampled
+ * from the full detail, welded vertices and the solutions over them. */
+typedef struct lod_level {
+    obs__bake_world lw;
+    obs__bake_samples s, chk;
+    obs__bake_weld lwd;
+    double *vert;  /* 2 per LOD vertex: the resampled solution */
+    double *solve; /* one block: the arrays below, per welded vertex */
+    double *vx, *vw, *face, *point; /* 2 each: fit, vertex baseline, baselines */
+    double *cnt;                    /* 1: world vertices welded into it */
+    double *direct;                 /* 2, with lod_check: the direct bake */
+    obs_bake_params fp; /* the fit's parameters */
+} lod_level;
+
+static void level_free(lod_level *v)
+{
+    free(v->vert);
+    free(v->solve);
+    obs__bake_weld_free(&v->lwd);
+    obs__bake_samples_free(&v->chk);
+    obs__bake_samples_free(&v->s);
+    obs__bake_world_free(&v->lw);
+}
+
+/* Flatten level l, make its samples and resample the full detail's
+ * solution x onto them and onto its vertices. */
+static obs_status level_resample(const obs_bake_scene *scene, const obs__bake_world *w,
+                                 const obs__bake_weld *wd, const double *x,
+                                 const obs_bake_params *p, int l, obs_bake_result *out,
+                                 lod_level *v, char err[OBS_ERR_LEN])
+{
+    obs_bake_scene ls = *scene;
+    ls.meshes = out->lod_meshes + (size_t)(l - 1) * scene->mesh_count;
+    obs_status rc;
+    if ((rc = obs__bake_flatten(&ls, &v->lw, err)) != OBS_OK)
+        return rc;
+    if ((rc = obs__bake_samples_make(&v->lw, p->samples_per_face, p->max_samples_per_face,
+                                     (uint64_t)p->seed, &v->s, err)) != OBS_OK)
+        return rc;
+    v->vert = malloc(2 * (v->lw.vertex_count ? v->lw.vertex_count : 1) * sizeof *v->vert);
+    if (!v->vert)
+        return obs__fail(err, OBS_NO_MEMORY, "%zu vertices", v->lw.vertex_count);
+    return obs__bake_lod_resample(w, wd, x, &v->lw, &v->s, v->vert, p->threads, err);
+}
+
+/* Weld level l, fit the resampled samples (eq 2) and measure the fit and
+ * the vertex baseline against them (stats row l - 1). */
+static obs_status level_fit(const obs_bake_params *p, int l, lod_level *v, obs_bake_stats *st,
+                            char err[OBS_ERR_LEN])
+{
+    obs_status rc = obs__bake_weld_make(&v->lw, p->weld_tolerance, p->weld_angle, &v->lwd, err);
+    if (rc != OBS_OK)
+        return rc;
+    size_t n = v->lwd.count ? v->lwd.count : 1;
+    v->solve = malloc((p->lod_check ? 11 : 9) * n * sizeof *v->solve);
+    if (!v->solve)
+        return obs__fail(err, OBS_NO_MEMORY, "solution of %zu vertices", v->lwd.count);
+    v->vx = v->solve;
+    v->vw = v->vx + 2 * n;
+    v->face = v->vw + 2 * n;
+    v->point = v->face + 2 * n;
+    v->cnt = v->point + 2 * n;
+    v->direct = p->lod_check ? v->cnt + n : NULL;
+    v->fp = *p;
+    v->fp.values = OBS_BAKE_VALUES_FIT; /* the fit itself, whatever the full detail writes */
+    obs_bake_stats fst = {0};
+    if ((rc = obs__bake_fit(&v->lw, &v->lwd, &v->s, &v->fp, v->vx, v->face, v->point, &fst,
+                            err)) != OBS_OK)
+        return rc;
+    weld_values(&v->lw, &v->lwd, v->vert, v->vw, v->cnt);
+    int k = l - 1;
+    st->lod_triangles[k] = v->lw.triangle_count;
+    st->lod_vertices[k] = v->lw.vertex_count;
+    st->lod_welded[k] = v->lwd.count;
+    st->lod_samples[k] = v->s.count;
+    memcpy(st->lod_fit[k], fst.residual_fit, sizeof st->lod_fit[k]);
+    obs__bake_residual(&v->lw, &v->lwd, &v->s, v->vw, st->lod_vertex[k]);
+    return OBS_OK;
+}
+
+/* The fit and the baseline against held-out samples: other positions
+ * (the holdout's seed), resampled, never fitted. */
+static obs_status check_holdout(const obs__bake_world *w, const obs__bake_weld *wd,
+                                const double *x, const obs_bake_params *p, int k, lod_level *v,
+                                obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    obs__bake_samples h;
+    uint64_t hseed = (uint64_t)p->seed ^ 0x5bd1e995u;
+    obs_status rc = obs__bake_samples_make(&v->lw, p->samples_per_face, p->max_samples_per_face,
+                                           hseed, &h, err);
+    if (rc != OBS_OK)
+        return rc;
+    if ((rc = obs__bake_lod_resample(w, wd, x, &v->lw, &h, NULL, p->threads, err)) == OBS_OK) {
+        obs__bake_residual(&v->lw, &v->lwd, &h, v->vx, st->lod_holdout_fit[k]);
+        obs__bake_residual(&v->lw, &v->lwd, &h, v->vw, st->lod_holdout_vertex[k]);
+    }
+    obs__bake_samples_free(&h);
+    return rc;
+}
+
+/* The comparisons over the LOD's samples, against the direct bake's
+ * signal: the resampled fit, the vertex baseline, and the resampled
+ * values themselves. */
+static void check_traced(lod_level *v, int k, obs_bake_stats *st)
+{
+    obs__bake_samples *chk = &v->chk;
+    for (size_t i = 0; i < chk->count; i++) {
+        const uint32_t *tv = v->lw.tri + 3 * chk->tri[i];
+        const float *b = chk->bary + 3 * i;
+        for (int c = 0; c < 2; c++) {
+            double g = 0.0;
+            for (int j = 0; j < 3; j++)
+                g += b[j] * v->direct[2 * v->lwd.of[tv[j]] + c];
+            chk->ao[2 * i + c] = (float)g;
+        }
+        chk->valid[i] = 1;
+    }
+    obs__bake_residual(&v->lw, &v->lwd, chk, v->vx, st->lod_traced_fit[k]);
+    obs__bake_residual(&v->lw, &v->lwd, chk, v->vw, st->lod_traced_vertex[k]);
+    double e[2] = {0, 0}, ws = 0.0;
+    for (size_t i = 0; i < chk->count; i++) {
+        for (int c = 0; c < 2; c++) {
+            double r = (double)v->s.ao[2 * i + c] - chk->ao[2 * i + c];
+            e[c] += chk->weight[i] * r * r;
+        }
+        ws += chk->weight[i];
+    }
+    for (int c = 0; c < 2; c++)
+        st->lod_traced_resampled[k][c] = ws > 0.0 ? sqrt(e[c] / ws) : 0.0;
+    st->lod_traced_samples[k] = chk->count - chk->dropped;
+}
+
+/* lod_check: level l's resampled bake against held-out samples and
+ * against a bake traced directly on the LOD geometry. */
+static obs_status level_check(const obs__bake_world *w, const obs__bake_weld *wd,
+                              const double *x, const obs_bake_params *p, int l, lod_level *v,
+                              obs_bake_stats *st, char err[OBS_ERR_LEN])
+{
+    int k = l - 1;
+    obs_status rc;
+    if ((rc = check_holdout(w, wd, x, p, k, v, st, err)) != OBS_OK)
+        return rc;
+    /* the same samples (same seed), traced on the LOD geometry */
+    if ((rc = obs__bake_samples_make(&v->lw, p->samples_per_face, p->max_samples_per_face,
+                                     (uint64_t)p->seed, &v->chk, err)) != OBS_OK)
+        return rc;
+    obs__bake_trace_desc td = {{p->distance_short, p->distance_long}, p->rays, p->threads,
+                               p->backface_limit, (uint64_t)p->seed, NULL, NULL};
+    double bvh;
+    if ((rc = obs__bake_trace(&v->lw, &v->chk, &td, &bvh, err)) != OBS_OK)
+        return rc;
+    /* the direct bake: the traced samples fitted (eq 2) */
+    obs_bake_stats dst = {0};
+    if ((rc = obs__bake_fit(&v->lw, &v->lwd, &v->chk, &v->fp, v->direct, v->face, v->point, &dst,
+                            err)) != OBS_OK)
+        return rc;
+    memcpy(st->lod_direct_residual[k], dst.residual_fit, sizeof st->lod_direct_residual[k]);
+    check_traced(v, k, st);
+    return OBS_OK;
+}
+
 /* One level: flatten, samples, resample, weld, fit, (check), values. */
 static obs_status level(const obs_bake_scene *scene, const obs__bake_world *w,
                         const obs__bake_weld *wd, const double *x, const obs_bake_params *p,
                         int l, obs_bake_result *out, char err[OBS_ERR_LEN])
 {
     obs_bake_stats *st = &out->stats;
-    obs_bake_scene ls = *scene;
-    ls.meshes = out->lod_meshes + (size_t)(l - 1) * scene->mesh_count;
-    obs__bake_world lw = {0};
-    obs__bake_samples s = {0}, chk = {0};
-    obs__bake_weld lwd = {0};
-    double *vx = NULL, *vert = NULL, *vw = NULL, *cnt = NULL, *face = NULL, *point = NULL;
-    double *direct = NULL;
-    obs_status rc;
+    lod_level v = {0};
     double t = obs__bake_now();
-    if ((rc = obs__bake_flatten(&ls, &lw, err)) != OBS_OK)
-        goto done;
-    if ((rc = obs__bake_samples_make(&lw, p->samples_per_face, p->max_samples_per_face,
-                                     (uint64_t)p->seed, &s, err)) != OBS_OK)
-        goto done;
-    vert = malloc(2 * (lw.vertex_count ? lw.vertex_count : 1) * sizeof *vert);
-    if (!vert) {
-        rc = obs__fail(err, OBS_NO_MEMORY, "%zu vertices", lw.vertex_count);
-        goto done;
-    }
-    if ((rc = obs__bake_lod_resample(w, wd, x, &lw, &s, vert, p->threads, err)) != OBS_OK)
+    obs_status rc = level_resample(scene, w, wd, x, p, l, out, &v, err);
+    if (rc != OBS_OK)
         goto done;
     st->lod_seconds[1] += obs__bake_now() - t;
-
     t = obs__bake_now();
-    if ((rc = obs__bake_weld_make(&lw, p->weld_tolerance, p->weld_angle, &lwd, err)) != OBS_OK)
+    if ((rc = level_fit(p, l, &v, st, err)) != OBS_OK)
         goto done;
-    size_t n = lwd.count ? lwd.count : 1;
-    vx = malloc(2 * n * sizeof *vx);
-    vw = malloc(2 * n * sizeof *vw);
-    cnt = malloc(n * sizeof *cnt);
-    face = malloc(2 * n * sizeof *face);
-    point = malloc(2 * n * sizeof *point);
-    if (p->lod_check)
-        direct = malloc(2 * n * sizeof *direct);
-    if (!vx || !vw || !cnt || !face || !point || (p->lod_check && !direct)) {
-        rc = obs__fail(err, OBS_NO_MEMORY, "solution of %zu vertices", lwd.count);
-        goto done;
-    }
-    obs_bake_params fp = *p;
-    fp.values = OBS_BAKE_VALUES_FIT; /* the fit itself, whatever the full detail writes */
-    obs_bake_stats fst = {0};
-    if ((rc = obs__bake_fit(&lw, &lwd, &s, &fp, vx, face, point, &fst, err)) != OBS_OK)
-        goto done;
-    weld_values(&lw, &lwd, vert, vw, cnt);
-    int k = l - 1;
-    st->lod_triangles[k] = lw.triangle_count;
-    st->lod_vertices[k] = lw.vertex_count;
-    st->lod_welded[k] = lwd.count;
-    st->lod_samples[k] = s.count;
-    memcpy(st->lod_fit[k], fst.residual_fit, sizeof st->lod_fit[k]);
-    obs__bake_residual(&lw, &lwd, &s, vw, st->lod_vertex[k]);
     st->lod_seconds[2] += obs__bake_now() - t;
-
     if (p->lod_check) {
         t = obs__bake_now();
-        /* held out: other positions (the holdout's seed), resampled,
-         * never fitted */
-        obs__bake_samples h;
-        uint64_t hseed = (uint64_t)p->seed ^ 0x5bd1e995u;
-        if ((rc = obs__bake_samples_make(&lw, p->samples_per_face, p->max_samples_per_face, hseed,
-                                         &h, err)) != OBS_OK)
+        if ((rc = level_check(w, wd, x, p, l, &v, st, err)) != OBS_OK)
             goto done;
-        if ((rc = obs__bake_lod_resample(w, wd, x, &lw, &h, NULL, p->threads, err)) == OBS_OK) {
-            obs__bake_residual(&lw, &lwd, &h, vx, st->lod_holdout_fit[k]);
-            obs__bake_residual(&lw, &lwd, &h, vw, st->lod_holdout_vertex[k]);
-        }
-        obs__bake_samples_free(&h);
-        if (rc != OBS_OK)
-            goto done;
-        /* the same samples (same seed), traced on the LOD geometry */
-        if ((rc = obs__bake_samples_make(&lw, p->samples_per_face, p->max_samples_per_face,
-                                         (uint64_t)p->seed, &chk, err)) != OBS_OK)
-            goto done;
-        obs__bake_trace_desc td = {{p->distance_short, p->distance_long}, p->rays, p->threads,
-                                   p->backface_limit, (uint64_t)p->seed, NULL, NULL};
-        double bvh;
-        if ((rc = obs__bake_trace(&lw, &chk, &td, &bvh, err)) != OBS_OK)
-            goto done;
-        /* the direct bake: the traced samples fitted (eq 2) */
-        obs_bake_stats dst = {0};
-        if ((rc = obs__bake_fit(&lw, &lwd, &chk, &fp, direct, face, point, &dst, err)) != OBS_OK)
-            goto done;
-        memcpy(st->lod_direct_residual[k], dst.residual_fit, sizeof st->lod_direct_residual[k]);
-        /* the comparisons over the LOD's samples, against the direct
-         * bake's signal: the resampled fit, the vertex baseline, and the
-         * resampled values themselves */
-        for (size_t i = 0; i < chk.count; i++) {
-            const uint32_t *tv = lw.tri + 3 * chk.tri[i];
-            const float *b = chk.bary + 3 * i;
-            for (int c = 0; c < 2; c++) {
-                double g = 0.0;
-                for (int j = 0; j < 3; j++)
-                    g += b[j] * direct[2 * lwd.of[tv[j]] + c];
-                chk.ao[2 * i + c] = (float)g;
-            }
-            chk.valid[i] = 1;
-        }
-        obs__bake_residual(&lw, &lwd, &chk, vx, st->lod_traced_fit[k]);
-        obs__bake_residual(&lw, &lwd, &chk, vw, st->lod_traced_vertex[k]);
-        double e[2] = {0, 0}, ws = 0.0;
-        for (size_t i = 0; i < chk.count; i++) {
-            for (int c = 0; c < 2; c++) {
-                double r = (double)s.ao[2 * i + c] - chk.ao[2 * i + c];
-                e[c] += chk.weight[i] * r * r;
-            }
-            ws += chk.weight[i];
-        }
-        for (int c = 0; c < 2; c++)
-            st->lod_traced_resampled[k][c] = ws > 0.0 ? sqrt(e[c] / ws) : 0.0;
-        st->lod_traced_samples[k] = chk.count - chk.dropped;
         st->lod_seconds[3] += obs__bake_now() - t;
     }
-    rc = copy_level(&lw, &lwd, vx, p->blend,
+    rc = copy_level(&v.lw, &v.lwd, v.vx, p->blend,
                     out->lod_instances + (size_t)(l - 1) * out->instance_count, err);
 done:
-    free(vx);
-    free(vert);
-    free(vw);
-    free(cnt);
-    free(face);
-    free(point);
-    free(direct);
-    obs__bake_weld_free(&lwd);
-    obs__bake_samples_free(&chk);
-    obs__bake_samples_free(&s);
-    obs__bake_world_free(&lw);
+    level_free(&v);
     return rc;
 }
 

@@ -206,11 +206,9 @@ static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs
 {
     uint64_t level = traced_fingerprint(w, td);
     const obs__bake_part *p0 = &sh->parts[0];
-    if (p0->level != level)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s was traced from another level (or "
-                         "another version of it, or with other decorators): fingerprint %016llx, "
-                         "this level's %016llx",
-                         p0->path, (unsigned long long)p0->level, (unsigned long long)level);
+    obs_status rc = obs__part_check_level(p0->path, p0->level, level, err);
+    if (rc != OBS_OK)
+        return rc;
     if (p0->total != s->count)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: the parts split %llu samples; this level "
                          "and these parameters make %zu", p0->path, (unsigned long long)p0->total,
@@ -219,7 +217,7 @@ static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs
     s->rays = 0;
     s->dropped = 0;
     for (int i = 0; i < sh->count; i++) {
-        obs_status rc = read_payload(&sh->parts[i], s, err);
+        rc = read_payload(&sh->parts[i], s, err);
         if (rc != OBS_OK)
             return rc;
         s->rays += sh->parts[i].rays;

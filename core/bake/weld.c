@@ -115,3 +115,25 @@ obs_status obs__bake_weld_make(const obs__bake_world *w, float tolerance, float 
     out->count = next;
     return OBS_OK;
 }
+
+static float clamp01(double v) { return (float)(v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v); }
+
+int obs__bake_instance_values(obs_bake_instance *r, const obs__bake_inst *in, size_t n,
+                              const uint32_t *of, const double *x, float blend)
+{
+    r->node = in->node;
+    r->mesh = in->mesh;
+    r->ao = malloc((n ? n : 1) * sizeof(float));
+    r->ao_short = malloc((n ? n : 1) * sizeof(float));
+    r->ao_long = malloc((n ? n : 1) * sizeof(float));
+    if (!r->ao || !r->ao_short || !r->ao_long)
+        return -1;
+    for (size_t v = 0; v < n; v++) {
+        uint32_t k = of[v];
+        r->ao_short[v] = clamp01(x[2 * k]);
+        r->ao_long[v] = clamp01(x[2 * k + 1]);
+        /* _AO, the artists' blend (section 2) */
+        r->ao[v] = clamp01(blend * r->ao_short[v] + (1.0f - blend) * r->ao_long[v]);
+    }
+    return 0;
+}

@@ -83,3 +83,11 @@ obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p, obs_c
     *out = cam;
     return OBS_OK;
 }
+
+int obs_camera_of_run(const obs_gbuffer *gb, const obs_params *p, obs_camera *out)
+{
+    obs_params r;
+    char err[OBS_ERR_LEN];
+    obs_params_resolve(p, &r);
+    return obs__camera_resolve(gb, &r, out, err) == OBS_OK;
+}

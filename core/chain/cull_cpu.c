@@ -46,7 +46,7 @@ static void cull_rows(void *ctx, int j0, int j1)
             size_t k = (size_t)y * (size_t)f->width + (size_t)x;
             c->est[(size_t)j * (size_t)f->cull_w + (size_t)i] =
                 !(pos[4 * k + 3] > 0.0f) ? 1.0f
-                : c->dnz ? obs__vao_estimate_dnz(f, pos, c->dnz, NULL, x, y, pos + 4 * k,
+                : c->dnz ? obs__vao_estimate_dnz(f, pos, nrm, c->dnz, NULL, x, y, pos + 4 * k,
                                                  nrm + 3 * k, OBS_CULL_SAMPLES, xy, bleed)
                          : obs__vao_estimate(f, pos, nrm, x, y, pos + 4 * k, nrm + 3 * k,
                                              OBS_CULL_SAMPLES, xy);

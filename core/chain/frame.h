@@ -167,6 +167,22 @@ static inline int obs__tile_index(const obs__frame *f, int x, int y)
 /* Pixel centre (x, y) of the planes -> NDC of the display window. */
 void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2]);
 
+/* The view ray of NDC (nx, ny): the point with planar depth d is
+ * origin + d * dir, dir.z = -1 (GLSL: view_ray() in common.glsl). */
+void obs__view_ray(const float *P, const float ndc[2], float origin[3], float dir[3]);
+
+/* Samples off the planes (border_cpu.c, which derives them): the last
+ * pixel (bx, by) on the planes along the segment from pixel (x, y) to the
+ * pixel (qx, qy) off them; the point of pixel (qx, qy)'s ray on the plane
+ * through b with normal nb (1, or 0 where there is none); and the point a
+ * sample there reads for pixel (x, y): 1 and out, *nz; 0 background (open);
+ * -1 no estimate (left out). */
+void obs__border_px(const obs__frame *f, int x, int y, float qx, float qy, int *bx, int *by);
+int obs__plane_point(const obs__frame *f, float qx, float qy, const float b[3], const float nb[3],
+                     float out[4]);
+int obs__border_point(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                      float qx, float qy, float out[4], float *nz);
+
 /* View-space position of the point seen at pixel (x, y): the prep pass.
  * out = (x, y, z, d) with d the planar depth; (0,0,0,0) for background. */
 void obs__prep_position(const obs__frame *f, float raw_depth, int x, int y, float out[4]);

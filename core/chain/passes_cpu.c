@@ -59,13 +59,13 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
                     /* section 4.1: the set of the pixel's count */
                     n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
                     const float *xy = f->adaptive ? f->sample_table + 2 * (n - 2) : f->sample_xy;
-                    ao[i] = obs__vao_estimate_dnz(f, pos, c->dnz, col, x, y, pos + 4 * i,
+                    ao[i] = obs__vao_estimate_dnz(f, pos, nrm, c->dnz, col, x, y, pos + 4 * i,
                                                   nrm + 3 * i, n, xy, b);
                 } else if (f->culling == 2) {
                     n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
                     n = n < OBS_CULL_CAREFUL ? n : OBS_CULL_CAREFUL;
                     const float *xy = f->sample_table + 2 * (n - 2);
-                    ao[i] = obs__vao_estimate_dnz(f, pos, c->dnz, col, x, y, pos + 4 * i,
+                    ao[i] = obs__vao_estimate_dnz(f, pos, nrm, c->dnz, col, x, y, pos + 4 * i,
                                                   nrm + 3 * i, n, xy, b);
                 }
             }

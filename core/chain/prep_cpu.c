@@ -15,7 +15,7 @@ void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2])
 /* GLSL: view_ray() in common.glsl.  The point seen at NDC (nx, ny) with
  * planar depth d is origin + d * dir (dir.z = -1): the projection solved
  * for view x, y as a 2x2 system that is affine in view z. */
-static void view_ray(const float *P, const float ndc[2], float origin[3], float dir[3])
+void obs__view_ray(const float *P, const float ndc[2], float origin[3], float dir[3])
 {
     float nx = ndc[0], ny = ndc[1];
     float a = P[0] - nx * P[12], b = P[1] - nx * P[13];
@@ -74,7 +74,7 @@ void obs__prep_position(const obs__frame *f, float raw_depth, int x, int y, floa
 {
     float ndc[2], o[3], dir[3];
     obs__px_ndc(f, x, y, ndc);
-    view_ray(f->proj, ndc, o, dir);
+    obs__view_ray(f->proj, ndc, o, dir);
     float d = linear_depth(f, raw_depth, dir);
     if (d <= 0.0f || !isfinite(d)) {
         out[0] = out[1] = out[2] = out[3] = 0.0f;

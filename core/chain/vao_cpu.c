@@ -171,6 +171,26 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
     return disk_px(f, m, sx, sy, qx, qy);
 }
 
+/* GLSL: the branch of vao_estimate() in vao.glsl for a sample off the
+ * planes (border_cpu.c): 1 and *zs, *nz of the surface continued past the
+ * border (*zs left as it is, open, where that is background); 0 where the
+ * sample is left out of eq 1 (behind the camera, or no estimate). */
+static int border_sample(const obs__frame *f, const float *pos, const float *nrm,
+                         const obs__disk *m, int x, int y, float sx, float sy, float *zs,
+                         float *nz)
+{
+    float sw = m->w[0] * sx + m->w[1] * sy + m->w[2];
+    if (!(sw > 0.0f))
+        return 0;
+    float fu = floorf((m->u[0] * sx + m->u[1] * sy + m->u[2]) / sw);
+    float fv = floorf((m->v[0] * sx + m->v[1] * sy + m->v[2]) / sw);
+    float pt[4];
+    int got = obs__border_point(f, pos, nrm, x, y, fu, fv, pt, nz);
+    if (got > 0)
+        *zs = pt[3];
+    return got >= 0;
+}
+
 /* GLSL: vao_estimate() in vao.glsl, without colour bleeding */
 float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         const float p[3], const float n[3], int ns, const float *xy)
@@ -183,7 +203,8 @@ float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm,
  * its depth at d[ds * k], its view normal's z at nz[ns_ * k] (the prep
  * planes, or the CPU device's packed plane of the two), its position at
  * pos + 4 k (for bleeding only). */
-static inline float estimate(const obs__frame *f, const float *pos, const float *d_at, int ds,
+static inline float estimate(const obs__frame *f, const float *pos, const float *nrm,
+                             const float *d_at, int ds,
                              const float *nz_at, int nzs, const float *col, int x, int y,
                              const float p[3], const float n[3], int ns, const float *xy,
                              float bleed[3])
@@ -227,6 +248,8 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
                     cx5 = col + 4 * k;
                 }
             }
+        } else {
+            seen = border_sample(f, pos, nrm, &disk, x, y, sx, sy, &zs, &nz);
         }
         if (bleeds) {
             /* "We use c(x) to linearly interpolate between the white
@@ -249,11 +272,10 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
             float sd = range_falloff(f, front - zs, nz);
             dz = 2.0f * h * (1.0f - sd);
         }
-        /* A sample off the planes (or behind the camera) says nothing
-         * about the scene: it is left out of eq 1's sum and of F alike, so
-         * V is estimated from the part of the disk that is seen, instead
-         * of counting the unseen part as open (which lightened contact
-         * shadows near the image border). */
+        /* A sample off the planes reads the surface continued past the
+         * border (border_cpu.c derives it); one behind the camera, or
+         * without that estimate, says nothing about the scene: it is left
+         * out of eq 1's sum and of F alike. */
         if (seen) {
             open += dz;
             F += R * l; /* eq 2: F = R * sum sqrt(1 - x^2 - y^2) */
@@ -268,7 +290,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
                               const float *col, int x, int y, const float p[3], const float n[3],
                               int ns, const float *xy, float bleed[3])
 {
-    return estimate(f, pos, pos + 3, 4, nrm + 2, 3, col, x, y, p, n, ns, xy, bleed);
+    return estimate(f, pos, nrm, pos + 3, 4, nrm + 2, 3, col, x, y, p, n, ns, xy, bleed);
 }
 
 /* floorf(v) where the caller needs only its comparisons and its int:
@@ -289,7 +311,8 @@ static inline __attribute__((always_inline)) float floor_lane(float v)
  * taken in the samples' order, so the result is estimate()'s, bit for
  * bit. */
 /* always inlined: into each of the clones of its caller (OBS__LANES) */
-static inline __attribute__((always_inline)) float estimate_lanes(const obs__frame *f, const float *dnz, int x, int y,
+static inline __attribute__((always_inline)) float estimate_lanes(const obs__frame *f, const float *pos,
+                                                                  const float *nrm, const float *dnz, int x, int y,
                                    const float p[3], const float n[3], int ns, const float *xy)
 {
     const float R = f->radius, r = 0.5f * f->radius;
@@ -335,6 +358,15 @@ static inline __attribute__((always_inline)) float estimate_lanes(const obs__fra
         ls[i] = l;
         seens[i] = seen;
     }
+    /* a sample off the planes reads the surface continued past the border
+     * (border_cpu.c): the scalar estimator then takes the whole pixel */
+    int off = 0;
+    for (int i = 0; i < ns; i++)
+        off |= !seens[i];
+    if (off) {
+        float bleed[3];
+        return estimate(f, pos, nrm, dnz, 2, dnz + 1, 2, NULL, x, y, p, n, ns, xy, bleed);
+    }
     float open = 0.0f, F = 0.0f;
     for (int i = 0; i < ns; i++)
         if (seens[i]) {
@@ -345,12 +377,12 @@ static inline __attribute__((always_inline)) float estimate_lanes(const obs__fra
 }
 
 OBS__LANES
-float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *dnz,
-                            const float *col, int x, int y, const float p[3], const float n[3],
-                            int ns, const float *xy, float bleed[3])
+float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *nrm,
+                            const float *dnz, const float *col, int x, int y, const float p[3],
+                            const float n[3], int ns, const float *xy, float bleed[3])
 {
     if (col && f->bleed_step > 0)
-        return estimate(f, pos, dnz, 2, dnz + 1, 2, col, x, y, p, n, ns, xy, bleed);
+        return estimate(f, pos, nrm, dnz, 2, dnz + 1, 2, col, x, y, p, n, ns, xy, bleed);
     bleed[0] = bleed[1] = bleed[2] = 1.0f;
-    return estimate_lanes(f, dnz, x, y, p, n, ns, xy);
+    return estimate_lanes(f, pos, nrm, dnz, x, y, p, n, ns, xy);
 }

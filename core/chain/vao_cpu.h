@@ -22,10 +22,11 @@
  * each sample's depth and view normal z from dnz, the two packed per
  * pixel (dnz[2 k] = pos[4 k + 3], dnz[2 k + 1] = nrm[3 k + 2]): a sample
  * then touches one cache line instead of two, from a plane of 8 bytes a
- * pixel instead of 28.  pos is read for colour bleeding only. */
-float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *dnz,
-                            const float *col, int x, int y, const float p[3], const float n[3],
-                            int ns, const float *xy, float bleed[3]);
+ * pixel instead of 28.  pos and nrm are read for colour bleeding and for
+ * the samples off the planes (the surface continued past the border). */
+float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *nrm,
+                            const float *dnz, const float *col, int x, int y, const float p[3],
+                            const float n[3], int ns, const float *xy, float bleed[3]);
 
 /* obs__cull_prepass (the same result) with the estimator above. */
 void obs__cull_prepass_dnz(const obs__frame *f, const float *pos, const float *nrm,

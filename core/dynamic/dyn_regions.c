@@ -29,6 +29,7 @@
 #include <string.h>
 
 #include "dynamic/dyn_internal.h"
+#include "level/sweep.h"
 #include "internal.h"
 
 void obs_dyn_regions_free(obs_dyn_regions *r)
@@ -104,70 +105,75 @@ static int push_edge(obs_dyn_regions *r, size_t *cap, uint32_t i, uint32_t j)
     return 1;
 }
 
-/* The regions ordered by their lower x, so that the pairs that can
- * touch or overlap are found by a sweep: j after i with lo_x(j) <=
- * hi_x(i) + slack.  NULL when out of memory. */
-typedef struct keyed {
-    float x;
-    uint32_t i;
-} keyed;
-
-static int cmp_keyed(const void *a, const void *b)
+/* Calls visit(i, j, user) for each pair of regions that can touch or
+ * overlap, found by a sweep over them ordered by their lower x
+ * (level/sweep.h): j after i with lo_x(j) <= hi_x(i) + slack, until it
+ * returns nonzero.  Returns what it returned, 0 when no call did, -1 when
+ * out of memory. */
+static int each_near_pair(const obs_dyn_regions *r,
+                          int (*visit)(uint32_t i, uint32_t j, void *user), void *user)
 {
-    const keyed *p = a, *q = b;
-    return p->x < q->x ? -1 : p->x > q->x ? 1 : (p->i > q->i) - (p->i < q->i);
-}
-
-static uint32_t *sweep_order(const obs_dyn_regions *r, double *slack)
-{
-    uint32_t *o = malloc((r->count ? r->count : 1) * sizeof *o);
-    keyed *k = malloc((r->count ? r->count : 1) * sizeof *k);
-    if (!o || !k) {
-        free(o);
-        free(k);
-        return NULL;
-    }
     double big = 0.0;
-    for (size_t i = 0; i < r->count; i++) {
-        k[i].x = r->box[i].lo[0];
-        k[i].i = (uint32_t)i;
-        big = fmax(big, box_size(&r->box[i]));
-    }
-    qsort(k, r->count, sizeof *k, cmp_keyed);
     for (size_t i = 0; i < r->count; i++)
-        o[i] = k[i].i;
-    free(k);
-    *slack = 2e-5 * big;
-    return o;
+        big = fmax(big, box_size(&r->box[i]));
+    double slack = 2e-5 * big;
+    uint32_t *o = obs__sweep_order(r->count ? r->box[0].lo : NULL, sizeof *r->box, r->count);
+    if (!o)
+        return -1;
+    int stop = 0;
+    for (size_t a = 0; a < r->count && !stop; a++)
+        for (size_t b = a + 1; b < r->count && !stop; b++) {
+            uint32_t i = o[a], j = o[b];
+            if (r->box[j].lo[0] > r->box[i].hi[0] + slack)
+                break;
+            stop = visit(i, j, user);
+        }
+    free(o);
+    return stop;
 }
 
 static int cmp_edge(const void *a, const void *b);
+
+/* The adjacency's pairs: those sharing a face of positive area. */
+typedef struct edges {
+    obs_dyn_regions *r;
+    size_t cap;
+} edges;
+
+static int add_edge(uint32_t i, uint32_t j, void *user)
+{
+    edges *e = user;
+    return obs__dyn_shared_face(&e->r->box[i], &e->r->box[j], NULL) > 0.0 &&
+           !push_edge(e->r, &e->cap, i, j);
+}
 
 obs_status obs__dyn_adjacency(obs_dyn_regions *r, char err[OBS_ERR_LEN])
 {
     free(r->edge);
     r->edge = NULL;
     r->edge_count = 0;
-    size_t cap = 0;
-    double slack;
-    uint32_t *o = sweep_order(r, &slack);
-    if (!o)
+    edges e = {r, 0};
+    if (each_near_pair(r, add_edge, &e) != 0)
         return obs__fail(err, OBS_NO_MEMORY, "adjacency of %zu regions", r->count);
-    for (size_t a = 0; a < r->count; a++)
-        for (size_t b = a + 1; b < r->count; b++) {
-            uint32_t i = o[a], j = o[b];
-            if (r->box[j].lo[0] > r->box[i].hi[0] + slack)
-                break;
-            if (obs__dyn_shared_face(&r->box[i], &r->box[j], NULL) > 0.0 &&
-                !push_edge(r, &cap, i, j)) {
-                free(o);
-                return obs__fail(err, OBS_NO_MEMORY, "adjacency of %zu regions", r->count);
-            }
-        }
-    free(o);
     if (r->edge_count)
         qsort(r->edge, r->edge_count, 2 * sizeof *r->edge, cmp_edge);
     return OBS_OK;
+}
+
+/* The first pair of regions that overlap. */
+typedef struct overlapping {
+    const obs_dyn_regions *r;
+    uint32_t i, j;
+} overlapping;
+
+static int find_overlap(uint32_t i, uint32_t j, void *user)
+{
+    overlapping *o = user;
+    if (!overlap(&o->r->box[i], &o->r->box[j]))
+        return 0;
+    o->i = i;
+    o->j = j;
+    return 1;
 }
 
 /* Boxes non-empty and finite, no two overlapping. */
@@ -185,24 +191,14 @@ static obs_status check_boxes(const obs_dyn_regions *r, char err[OBS_ERR_LEN])
                                  "region %zu is empty: max %c %g is not above min %c %g", i,
                                  axis[ax], b->hi[ax], axis[ax], b->lo[ax]);
         }
-    double slack;
-    uint32_t *o = sweep_order(r, &slack);
-    if (!o)
+    overlapping o = {r, 0, 0};
+    int stop = each_near_pair(r, find_overlap, &o);
+    if (stop < 0)
         return obs__fail(err, OBS_NO_MEMORY, "%zu regions", r->count);
-    for (size_t a = 0; a < r->count; a++)
-        for (size_t b = a + 1; b < r->count; b++) {
-            uint32_t i = o[a], j = o[b];
-            if (r->box[j].lo[0] > r->box[i].hi[0] + slack)
-                break;
-            if (overlap(&r->box[i], &r->box[j])) {
-                free(o);
-                return obs__fail(err, OBS_INVALID_ARGUMENT,
-                                 "regions %u and %u overlap (boxes may share faces, not "
-                                 "volume)",
-                                 i < j ? i : j, i < j ? j : i);
-            }
-        }
-    free(o);
+    if (stop)
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "regions %u and %u overlap (boxes may share faces, not volume)",
+                         o.i < o.j ? o.i : o.j, o.i < o.j ? o.j : o.i);
     return OBS_OK;
 }
 

@@ -229,11 +229,9 @@ static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
 {
     const obs__dyn_part *p0 = &sh->parts[0];
-    if (p0->level != level)
-        return obs__fail(err, OBS_INVALID_ARGUMENT,
-                         "%s was traced from another level (or another version of it, or with "
-                         "other decorators): fingerprint %016llx, this level's %016llx",
-                         p0->path, (unsigned long long)p0->level, (unsigned long long)level);
+    obs_status rc = obs__part_check_level(p0->path, p0->level, level, err);
+    if (rc != OBS_OK)
+        return rc;
     if (p0->regions != rg->count || p0->total != pt->count ||
         p0->points != obs__dyn_points_fingerprint(rg, pt))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: the parts split %llu valid points of %u "
@@ -243,7 +241,7 @@ static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
     double t = obs__bake_now();
     pt->rays = 0;
     for (int i = 0; i < sh->count; i++) {
-        obs_status rc = read_payload(&sh->parts[i], pt, err);
+        rc = read_payload(&sh->parts[i], pt, err);
         if (rc != OBS_OK)
             return rc;
         pt->rays += sh->parts[i].n * (uint64_t)sh->parts[i].rays;

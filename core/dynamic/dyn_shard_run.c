@@ -14,17 +14,14 @@ obs_status obs_dyn_bake_shard(const obs_bake_scene *scene, const obs_dyn_desc *d
 {
     if (st)
         memset(st, 0, sizeof *st);
-    if (count < 1 || index < 0 || index >= count)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %d/%d: the index is 0 .. count-1 "
-                         "(count at least 1)", index, count);
-    if (!path || !*path)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %d/%d: no part file to write", index,
-                         count);
+    obs_status rc = obs__shard_check(index, count, path, err);
+    if (rc != OBS_OK)
+        return rc;
     obs__dyn_shard sh = {.index = index, .count = count, .path = path,
                          .progress = desc ? desc->progress : NULL,
                          .progress_user = desc ? desc->progress_user : NULL};
     obs_dyn_result r;
-    obs_status rc = obs__dyn_bake_run(scene, desc, &sh, &r, err);
+    rc = obs__dyn_bake_run(scene, desc, &sh, &r, err);
     if (st)
         *st = r.stats;
     obs_dyn_result_free(&r);
@@ -88,8 +85,6 @@ obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
                               char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
-    if (n == 0 || !paths)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "merge: no parts");
     void *parts = NULL;
     obs_status rc = obs__bake_parts_read(paths, n, sizeof(obs__dyn_part), read_header, key_of,
                                          &parts, err);

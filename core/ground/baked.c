@@ -19,6 +19,7 @@
 #include "internal.h"
 #include "io/glb_read.h"
 #include "obscura/scene.h"
+#include "ground/scene_internal.h"
 
 /* Depth of the node graph followed (a deeper one is refused: a cycle). */
 #define MAX_DEPTH 256
@@ -420,12 +421,8 @@ static obs_status load(const char *path, int dynamic, const char *pattern, obs_s
         goto fail;
     out->vertex_count = b2.nv;
     out->triangle_count = b2.nt;
-    if ((st = obs_scene_check(out, err)) != OBS_OK) {
-        char msg[OBS_ERR_LEN];
-        snprintf(msg, sizeof msg, "%s", err ? err : "");
-        obs__fail(err, st, "%s: %s", path, msg);
+    if ((st = obs__scene_check_file(out, path, err)) != OBS_OK)
         goto fail;
-    }
     obs__glb_free(&g);
     return OBS_OK;
 fail:

@@ -33,7 +33,10 @@ static double clamp01(float v)
     return d < 0.0 ? 0.0 : d > 1.0 ? 1.0 : d;
 }
 
-static obs_status check_pair(const obs_image *a, const obs_image *b, char err[OBS_ERR_LEN])
+/* The truth a and the candidate b: one channel each, the same size, not
+ * empty; *n their pixels. */
+static obs_status check_pair(const obs_image *a, const obs_image *b, size_t *n,
+                             char err[OBS_ERR_LEN])
 {
     if (!a || !b)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "metrics: %s image is NULL",
@@ -50,6 +53,9 @@ static obs_status check_pair(const obs_image *a, const obs_image *b, char err[OB
     if (a->width <= 0 || a->height <= 0 || !a->data || !b->data)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "metrics: empty image (%dx%d%s)",
                          a->width, a->height, !a->data || !b->data ? ", no pixels" : "");
+    if (obs__size_mul((size_t)a->width, (size_t)a->height, n) != 0)
+        return obs__fail(err, OBS_TOO_LARGE, "metrics: image %dx%d too large", a->width,
+                         a->height);
     return OBS_OK;
 }
 
@@ -219,13 +225,10 @@ obs_status obs_metrics_compute(const obs_image *a, const obs_image *b, const uns
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "metrics: no output");
     memset(out, 0, sizeof *out);
-    obs_status st = check_pair(a, b, err);
+    size_t n;
+    obs_status st = check_pair(a, b, &n, err);
     if (st != OBS_OK)
         return st;
-    size_t n;
-    if (obs__size_mul((size_t)a->width, (size_t)a->height, &n) != 0)
-        return obs__fail(err, OBS_TOO_LARGE, "metrics: image %dx%d too large", a->width,
-                         a->height);
 
     /* First pass: the differences and the means. */
     long long count = 0;
@@ -285,12 +288,11 @@ obs_status obs_metrics_diff_image(const obs_image *a, const obs_image *b, obs_im
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "metrics: no output image");
     memset(out, 0, sizeof *out);
-    obs_status st = check_pair(a, b, err);
+    size_t n, bytes;
+    obs_status st = check_pair(a, b, &n, err);
     if (st != OBS_OK)
         return st;
-    size_t n, bytes;
-    if (obs__size_mul((size_t)a->width, (size_t)a->height, &n) != 0 ||
-        obs__size_mul3(n, 3, sizeof(float), &bytes) != 0)
+    if (obs__size_mul3(n, 3, sizeof(float), &bytes) != 0)
         return obs__fail(err, OBS_TOO_LARGE, "metrics: image %dx%d too large", a->width,
                          a->height);
     float *px = malloc(bytes);

@@ -533,7 +533,8 @@ obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view
         for (int k = 0; k < 4; k++)
             j->eye[k] /= j->eye[3];
 
-    if (!(dev = rtcNewDevice(NULL))) {
+    char embree_cfg[32];
+    if (!(dev = rtcNewDevice(obs__pool_embree_config(embree_cfg)))) {
         s = obs__fail(err, OBS_UNSUPPORTED, "Embree: no device (error %d)",
                       (int)rtcGetDeviceError(NULL));
         goto fail;

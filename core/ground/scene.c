@@ -15,6 +15,7 @@
 
 #include "internal.h"
 #include "obscura/scene.h"
+#include "ground/scene_internal.h"
 
 /* Indices are 32-bit (GL and Embree take them so). */
 #define MAX_VERTICES ((size_t)UINT32_MAX)
@@ -61,6 +62,17 @@ obs_status obs_scene_check(obs_scene *s, char err[OBS_ERR_LEN])
             return obs__fail(err, OBS_BAD_FILE, "triangle %zu refers to vertex %u of %zu", i / 3,
                              (unsigned)s->indices[i], s->vertex_count);
     return OBS_OK;
+}
+
+obs_status obs__scene_check_file(obs_scene *s, const char *path, char err[OBS_ERR_LEN])
+{
+    obs_status st = obs_scene_check(s, err);
+    if (st != OBS_OK) {
+        char msg[OBS_ERR_LEN];
+        snprintf(msg, sizeof msg, "%s", err ? err : "");
+        obs__fail(err, st, "%s: %s", path, msg);
+    }
+    return st;
 }
 
 /* The diffuse (or PBR base) colour of a material, unless it is assimp's
@@ -129,14 +141,127 @@ static int triangle_mesh(const struct aiMesh *m)
            (m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE);
 }
 
-obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN])
+/* What the triangle meshes of the file hold together: the sizes of the
+ * scene's arrays, and whether any has a colour or is not opaque. */
+typedef struct scene_size {
+    size_t nv, nt, nmesh;
+    int any_albedo, any_opacity;
+} scene_size;
+
+static scene_size measure(const struct aiScene *sc)
 {
-    memset(out, 0, sizeof *out);
+    scene_size z = {0};
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[i];
+        if (!triangle_mesh(m))
+            continue;
+        z.nmesh++;
+        z.any_opacity |= m->mMaterialIndex < sc->mNumMaterials &&
+                         material_opacity(sc->mMaterials[m->mMaterialIndex]) < 1.0f;
+        z.nv += m->mNumVertices;
+        for (unsigned f = 0; f < m->mNumFaces; f++)
+            z.nt += m->mFaces[f].mNumIndices == 3;
+        float rgb[3];
+        z.any_albedo |= m->mMaterialIndex < sc->mNumMaterials &&
+                        material_albedo(sc->mMaterials[m->mMaterialIndex], rgb);
+    }
+    return z;
+}
+
+/* The scene's arrays for z's sizes, after checking them. */
+static obs_status allocate(const char *path, const struct aiScene *sc, const scene_size *z,
+                           obs_scene *out, char err[OBS_ERR_LEN])
+{
+    if (z->nt == 0)
+        return obs__fail(err, OBS_BAD_FILE, "%s: empty scene: no triangles (%u meshes)", path,
+                         sc->mNumMeshes);
+    if (z->nv > MAX_VERTICES)
+        return obs__fail(err, OBS_TOO_LARGE, "%s: %zu vertices; at most %zu", path, z->nv,
+                         MAX_VERTICES);
+    size_t vbytes, ibytes;
+    if (obs__size_mul3(z->nv, 3, sizeof(float), &vbytes) ||
+        obs__size_mul3(z->nt, 3, sizeof(uint32_t), &ibytes))
+        return obs__fail(err, OBS_TOO_LARGE, "%s: mesh too large", path);
+    out->positions = malloc(vbytes);
+    out->normals = malloc(vbytes);
+    out->albedo = z->any_albedo ? malloc(vbytes) : NULL;
+    out->indices = malloc(ibytes);
+    out->opacity = z->any_opacity ? malloc(z->nt * sizeof(float)) : NULL;
+    out->meshes = calloc(z->nmesh, sizeof *out->meshes);
+    if (!out->positions || !out->normals || !out->indices || (z->any_albedo && !out->albedo) ||
+        (z->any_opacity && !out->opacity) || !out->meshes)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %zu vertices, %zu triangles", path, z->nv,
+                         z->nt);
+    return OBS_OK;
+}
+
+/* Mesh m's vertices from v0 on: positions, unit normals, colour rgb. */
+static void copy_vertices(const struct aiMesh *m, size_t v0, const float rgb[3], obs_scene *out)
+{
+    for (unsigned v = 0; v < m->mNumVertices; v++) {
+        float *p = out->positions + 3 * (v0 + v), *n = out->normals + 3 * (v0 + v);
+        p[0] = m->mVertices[v].x;
+        p[1] = m->mVertices[v].y;
+        p[2] = m->mVertices[v].z;
+        /* GenNormals fills absent normals; FindInvalidData may still
+         * leave a zero or NaN one, which the rasteriser replaces by
+         * the triangle's own. */
+        n[0] = n[1] = n[2] = 0.0f;
+        if (m->mNormals) {
+            float x = m->mNormals[v].x, y = m->mNormals[v].y, z = m->mNormals[v].z;
+            float len = sqrtf(x * x + y * y + z * z);
+            if (isfinite(len) && len > 1e-12f) {
+                n[0] = x / len;
+                n[1] = y / len;
+                n[2] = z / len;
+            }
+        }
+        if (out->albedo)
+            memcpy(out->albedo + 3 * (v0 + v), rgb, 3 * sizeof *rgb);
+    }
+}
+
+/* The file's mesh i as the scene's next mesh: its vertices from *v0 and
+ * triangles from *t on (both advanced past it). */
+static obs_status copy_mesh(const char *path, const struct aiScene *sc, unsigned i, int any_albedo,
+                            obs_scene *out, size_t *v0, size_t *t, char err[OBS_ERR_LEN])
+{
+    const struct aiMesh *m = sc->mMeshes[i];
+    float rgb[3] = {0, 0, 0};
+    if (any_albedo && !(m->mMaterialIndex < sc->mNumMaterials &&
+                        material_albedo(sc->mMaterials[m->mMaterialIndex], rgb)))
+        rgb[0] = rgb[1] = rgb[2] = 0.8f; /* a mesh without a colour among coloured ones */
+    float opacity = m->mMaterialIndex < sc->mNumMaterials
+                        ? material_opacity(sc->mMaterials[m->mMaterialIndex])
+                        : 1.0f;
+    obs_scene_mesh *mesh = &out->meshes[out->mesh_count++];
+    const char *node = node_name_of(sc->mRootNode, i);
+    mesh->first_triangle = *t;
+    if (!(mesh->name = strdup(m->mName.data)) || !(mesh->node = strdup(node ? node : "")))
+        return obs__fail(err, OBS_NO_MEMORY, "%s: mesh names", path);
+    copy_vertices(m, *v0, rgb, out);
+    for (unsigned f = 0; f < m->mNumFaces; f++) {
+        const struct aiFace *fc = &m->mFaces[f];
+        if (fc->mNumIndices != 3)
+            continue;
+        for (int k = 0; k < 3; k++)
+            out->indices[3 * *t + k] = (uint32_t)(*v0 + fc->mIndices[k]);
+        if (out->opacity)
+            out->opacity[*t] = opacity;
+        (*t)++;
+    }
+    mesh->triangle_count = *t - mesh->first_triangle;
+    *v0 += m->mNumVertices;
+    return OBS_OK;
+}
+
+/* The file through assimp, flattened, each mesh kept apart. */
+static obs_status import(const char *path, const struct aiScene **sc, char err[OBS_ERR_LEN])
+{
     FILE *fp = fopen(path, "rb");
     if (!fp)
         return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
     fclose(fp);
-
     const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
                            aiProcess_SortByPType | aiProcess_GenNormals |
                            aiProcess_FindInvalidData;
@@ -145,119 +270,34 @@ obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN
     struct aiPropertyStore *props = aiCreatePropertyStore();
     if (props)
         aiSetImportPropertyInteger(props, AI_CONFIG_PP_PTV_KEEP_HIERARCHY, 1);
-    const struct aiScene *sc = aiImportFileExWithProperties(path, flags, NULL, props);
+    *sc = aiImportFileExWithProperties(path, flags, NULL, props);
     if (props)
         aiReleasePropertyStore(props);
-    if (!sc)
+    if (!*sc)
         return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
                          aiGetErrorString());
+    return OBS_OK;
+}
 
-    obs_status st = OBS_OK;
-    size_t nv = 0, nt = 0;
-    int any_albedo = 0, any_opacity = 0;
-    size_t nmesh = 0;
-    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
-        const struct aiMesh *m = sc->mMeshes[i];
-        if (!triangle_mesh(m))
-            continue;
-        nmesh++;
-        any_opacity |= m->mMaterialIndex < sc->mNumMaterials &&
-                       material_opacity(sc->mMaterials[m->mMaterialIndex]) < 1.0f;
-        nv += m->mNumVertices;
-        for (unsigned f = 0; f < m->mNumFaces; f++)
-            nt += m->mFaces[f].mNumIndices == 3;
-        float rgb[3];
-        any_albedo |= m->mMaterialIndex < sc->mNumMaterials &&
-                      material_albedo(sc->mMaterials[m->mMaterialIndex], rgb);
-    }
-    if (nt == 0) {
-        st = obs__fail(err, OBS_BAD_FILE, "%s: empty scene: no triangles (%u meshes)", path,
-                       sc->mNumMeshes);
-        goto fail;
-    }
-    if (nv > MAX_VERTICES) {
-        st = obs__fail(err, OBS_TOO_LARGE, "%s: %zu vertices; at most %zu", path, nv,
-                       MAX_VERTICES);
-        goto fail;
-    }
-    size_t vbytes, ibytes;
-    if (obs__size_mul3(nv, 3, sizeof(float), &vbytes) || obs__size_mul3(nt, 3, sizeof(uint32_t), &ibytes)) {
-        st = obs__fail(err, OBS_TOO_LARGE, "%s: mesh too large", path);
-        goto fail;
-    }
-    out->positions = malloc(vbytes);
-    out->normals = malloc(vbytes);
-    out->albedo = any_albedo ? malloc(vbytes) : NULL;
-    out->indices = malloc(ibytes);
-    out->opacity = any_opacity ? malloc(nt * sizeof(float)) : NULL;
-    out->meshes = calloc(nmesh, sizeof *out->meshes);
-    if (!out->positions || !out->normals || !out->indices || (any_albedo && !out->albedo) ||
-        (any_opacity && !out->opacity) || !out->meshes) {
-        st = obs__fail(err, OBS_NO_MEMORY, "%s: %zu vertices, %zu triangles", path, nv, nt);
-        goto fail;
-    }
-
+obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN])
+{
+    memset(out, 0, sizeof *out);
+    const struct aiScene *sc = NULL;
+    obs_status st = import(path, &sc, err);
+    if (st != OBS_OK)
+        return st;
+    scene_size z = measure(sc);
+    st = allocate(path, sc, &z, out, err);
     size_t v0 = 0, t = 0;
-    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
-        const struct aiMesh *m = sc->mMeshes[i];
-        if (!triangle_mesh(m))
-            continue;
-        float rgb[3] = {0, 0, 0};
-        if (any_albedo && !(m->mMaterialIndex < sc->mNumMaterials &&
-                            material_albedo(sc->mMaterials[m->mMaterialIndex], rgb)))
-            rgb[0] = rgb[1] = rgb[2] = 0.8f; /* a mesh without a colour among coloured ones */
-        float opacity = m->mMaterialIndex < sc->mNumMaterials
-                            ? material_opacity(sc->mMaterials[m->mMaterialIndex])
-                            : 1.0f;
-        obs_scene_mesh *mesh = &out->meshes[out->mesh_count++];
-        const char *node = node_name_of(sc->mRootNode, i);
-        mesh->first_triangle = t;
-        if (!(mesh->name = strdup(m->mName.data)) || !(mesh->node = strdup(node ? node : ""))) {
-            st = obs__fail(err, OBS_NO_MEMORY, "%s: mesh names", path);
-            goto fail;
-        }
-        for (unsigned v = 0; v < m->mNumVertices; v++) {
-            float *p = out->positions + 3 * (v0 + v), *n = out->normals + 3 * (v0 + v);
-            p[0] = m->mVertices[v].x;
-            p[1] = m->mVertices[v].y;
-            p[2] = m->mVertices[v].z;
-            /* GenNormals fills absent normals; FindInvalidData may still
-             * leave a zero or NaN one, which the rasteriser replaces by
-             * the triangle's own. */
-            n[0] = n[1] = n[2] = 0.0f;
-            if (m->mNormals) {
-                float x = m->mNormals[v].x, y = m->mNormals[v].y, z = m->mNormals[v].z;
-                float len = sqrtf(x * x + y * y + z * z);
-                if (isfinite(len) && len > 1e-12f) {
-                    n[0] = x / len;
-                    n[1] = y / len;
-                    n[2] = z / len;
-                }
-            }
-            if (out->albedo)
-                memcpy(out->albedo + 3 * (v0 + v), rgb, sizeof rgb);
-        }
-        for (unsigned f = 0; f < m->mNumFaces; f++) {
-            const struct aiFace *fc = &m->mFaces[f];
-            if (fc->mNumIndices != 3)
-                continue;
-            for (int k = 0; k < 3; k++)
-                out->indices[3 * t + k] = (uint32_t)(v0 + fc->mIndices[k]);
-            if (out->opacity)
-                out->opacity[t] = opacity;
-            t++;
-        }
-        mesh->triangle_count = t - mesh->first_triangle;
-        v0 += m->mNumVertices;
-    }
-    out->vertex_count = nv;
-    out->triangle_count = nt;
-    if ((st = obs_scene_check(out, err)) != OBS_OK) {
-        char msg[OBS_ERR_LEN];
-        snprintf(msg, sizeof msg, "%s", err ? err : "");
-        obs__fail(err, st, "%s: %s", path, msg);
+    for (unsigned i = 0; st == OBS_OK && i < sc->mNumMeshes; i++)
+        if (triangle_mesh(sc->mMeshes[i]))
+            st = copy_mesh(path, sc, i, z.any_albedo, out, &v0, &t, err);
+    if (st != OBS_OK)
         goto fail;
-    }
+    out->vertex_count = z.nv;
+    out->triangle_count = z.nt;
+    if ((st = obs__scene_check_file(out, path, err)) != OBS_OK)
+        goto fail;
     aiReleaseImport(sc);
     return OBS_OK;
 

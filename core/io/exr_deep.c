@@ -36,43 +36,33 @@ static int first_deep_part(exr_const_context_t ctx, int *tiled)
     return -1;
 }
 
+/* Whether the file has a deep part, into *(int *)user. */
+static obs_status deep_reader(exr_context_t ctx, int64_t size, void *user, char why[OBS_ERR_LEN])
+{
+    int tiled = 0;
+    (void)size;
+    (void)why;
+    *(int *)user = first_deep_part(ctx, &tiled) >= 0;
+    return OBS_OK;
+}
+
 obs_status obs_exr_is_deep(const char *path, int *deep, char err[OBS_ERR_LEN])
 {
-    char sub[OBS_ERR_LEN] = "";
-    exr_context_t ctx = NULL;
-    int64_t size;
-    int tiled = 0;
-    obs_status st;
-
     if (!path || !deep)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_is_deep: NULL argument");
     *deep = 0;
-    if ((st = obs__exr_open(path, NULL, &ctx, &size, sub)) != OBS_OK)
-        return obs__fail(err, st, "%s: %s", path, sub);
-    *deep = first_deep_part(ctx, &tiled) >= 0;
-    exr_finish(&ctx);
-    return OBS_OK;
+    return obs__exr_read_with(path, path, NULL, deep_reader, deep, err);
 }
 
 obs_status obs_exr_is_deep_mem(const void *buf, size_t len, int *deep, char err[OBS_ERR_LEN])
 {
-    char sub[OBS_ERR_LEN] = "";
-    exr_context_t ctx = NULL;
     mem_src mem = {buf, len};
-    int64_t size;
-    int tiled = 0;
-    obs_status st;
-
     if (!deep)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_is_deep_mem: NULL argument");
     *deep = 0;
     if (!buf || len == 0)
         return obs__fail(err, OBS_BAD_FILE, "EXR in memory: empty buffer");
-    if ((st = obs__exr_open(NULL, &mem, &ctx, &size, sub)) != OBS_OK)
-        return obs__fail(err, st, "EXR in memory: %s", sub);
-    *deep = first_deep_part(ctx, &tiled) >= 0;
-    exr_finish(&ctx);
-    return OBS_OK;
+    return obs__exr_read_with("EXR in memory", NULL, &mem, deep_reader, deep, err);
 }
 
 /* ---- channels ------------------------------------------------------------- */
@@ -438,25 +428,28 @@ fail:
     return st;
 }
 
+/* read_deep's arguments, as obs__exr_read_with passes them. */
+typedef struct image_job {
+    const obs_limits *lim;
+    obs_deep_image *out;
+} image_job;
+
+static obs_status image_reader(exr_context_t ctx, int64_t size, void *user, char why[OBS_ERR_LEN])
+{
+    const image_job *j = user;
+    return read_deep(ctx, size, j->lim, j->out, why);
+}
+
 static obs_status read_any(const char *label, const char *path, const mem_src *mem,
                            const obs_limits *lim, obs_deep_image *out, char err[OBS_ERR_LEN])
 {
-    char sub[OBS_ERR_LEN] = "";
-    exr_context_t ctx = NULL;
-    int64_t size;
-    obs_status st;
-
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
     memset(out, 0, sizeof *out);
-    if ((st = obs__exr_open(path, mem, &ctx, &size, sub)) == OBS_OK)
-        st = read_deep(ctx, size, lim, out, sub);
-    if (ctx)
-        exr_finish(&ctx);
-    if (st != OBS_OK) {
+    image_job j = {lim, out};
+    obs_status st = obs__exr_read_with(label, path, mem, image_reader, &j, err);
+    if (st != OBS_OK)
         obs_deep_free(out);
-        obs__fail(err, st, "%s: %s", label, sub);
-    }
     return st;
 }
 

@@ -8,42 +8,46 @@
 #include "io/exr_internal.h"
 #include "internal.h"
 
-obs_status obs_exr_describe_camera(const char *path, int part, obs_exr_info *info,
-                                   obs_camera *cam, char err[OBS_ERR_LEN])
+/* describe_camera's arguments and result. */
+typedef struct camera_job {
+    int part;
+    obs_exr_info *info;
+    obs_camera *cam;
+} camera_job;
+
+static obs_status camera_reader(exr_context_t ctx, int64_t size, void *user,
+                                char why[OBS_ERR_LEN])
 {
-    exr_context_t ctx = NULL;
-    int64_t size;
+    const camera_job *j = user;
     obs_gbuffer gb;
     obs__channel_match m;
-    char sub[OBS_ERR_LEN] = "";
-    obs_status st = obs__exr_open(path, NULL, &ctx, &size, sub);
-    if (st != OBS_OK)
-        return obs__fail(err, st, "%s: %s", path, sub);
+    (void)size;
+    (void)why;
     memset(&gb, 0, sizeof gb);
     memset(&m, 0, sizeof m);
-    obs__exr_describe(ctx, part, &m, &gb, info);
+    obs__exr_describe(ctx, j->part, &m, &gb, j->info);
     obs__exr_msg_reset(); /* a missing attribute is not an error */
-    *cam = gb.camera;
-    exr_finish(&ctx);
+    *j->cam = gb.camera;
     return OBS_OK;
 }
 
-obs_status obs_exr_describe_parts(const char *path, char ***lines, char err[OBS_ERR_LEN])
+obs_status obs_exr_describe_camera(const char *path, int part, obs_exr_info *info,
+                                   obs_camera *cam, char err[OBS_ERR_LEN])
 {
-    exr_context_t ctx = NULL;
-    int64_t size;
+    camera_job j = {part, info, cam};
+    return obs__exr_read_with(path, path, NULL, camera_reader, &j, err);
+}
+
+/* One line a part into *(char ***)user (obs_exr_describe_parts). */
+static obs_status parts_reader(exr_context_t ctx, int64_t size, void *user,
+                               char why[OBS_ERR_LEN])
+{
     int parts = 0;
-    char sub[OBS_ERR_LEN] = "";
     char **v = NULL;
-    obs_status st = obs__exr_open(path, NULL, &ctx, &size, sub);
-    *lines = NULL;
-    if (st != OBS_OK)
-        return obs__fail(err, st, "%s: %s", path, sub);
+    (void)size;
     if (exr_get_count(ctx, &parts) != EXR_ERR_SUCCESS || parts < 1 ||
-        !(v = calloc((size_t)parts + 1, sizeof *v))) {
-        exr_finish(&ctx);
-        return obs__fail(err, parts < 1 ? OBS_BAD_FILE : OBS_NO_MEMORY, "%s: part list", path);
-    }
+        !(v = calloc((size_t)parts + 1, sizeof *v)))
+        return obs__fail(why, parts < 1 ? OBS_BAD_FILE : OBS_NO_MEMORY, "part list");
     for (int p = 0; p < parts; p++) {
         const exr_attribute_t *n = NULL, *w = NULL;
         const exr_attr_chlist_t *cl = NULL;
@@ -63,12 +67,16 @@ obs_status obs_exr_describe_parts(const char *path, char ***lines, char err[OBS_
                  viewed ? w->string->str : "", viewed ? ")" : "", list);
         if (!(v[p] = strdup(buf))) {
             obs_strv_free(v);
-            exr_finish(&ctx);
-            return obs__fail(err, OBS_NO_MEMORY, "%s: part list", path);
+            return obs__fail(why, OBS_NO_MEMORY, "part list");
         }
     }
     obs__exr_msg_reset(); /* a missing attribute is not an error */
-    exr_finish(&ctx);
-    *lines = v;
+    *(char ***)user = v;
     return OBS_OK;
+}
+
+obs_status obs_exr_describe_parts(const char *path, char ***lines, char err[OBS_ERR_LEN])
+{
+    *lines = NULL;
+    return obs__exr_read_with(path, path, NULL, parts_reader, lines, err);
 }

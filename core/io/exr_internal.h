@@ -87,6 +87,10 @@ obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv,
 void obs__exr_describe(exr_const_context_t ctx, int part, const obs__channel_match *m,
                        obs_gbuffer *gb, obs_exr_info *info);
 
+/* The string value of part's attribute `name`, or NULL when it has none
+ * or another type (core/io/exr_parts.c). */
+const char *obs__exr_attr_string(exr_const_context_t ctx, int part, const char *name);
+
 /* The parts a G-buffer is read from (core/io/exr_parts.c). */
 typedef struct obs__part_set {
     int *part;    /* indices, in the order they are tried */
@@ -114,6 +118,14 @@ typedef struct obs__exr_mem {
  * byte count when known (else -1).  Shared by exr_read.c and exr_deep.c. */
 obs_status obs__exr_open(const char *path, const obs__exr_mem *mem, exr_context_t *ctx,
                          int64_t *size, char err[OBS_ERR_LEN]);
+/* What a reader does with an open file: read(ctx, size, user, why), its
+ * message in why. */
+typedef obs_status (*obs__exr_reader)(exr_context_t ctx, int64_t size, void *user,
+                                      char why[OBS_ERR_LEN]);
+/* Opens path (or mem, as obs__exr_open), reads it with read and closes it:
+ * every public reader's frame; a failure is "label: why" in err. */
+obs_status obs__exr_read_with(const char *label, const char *path, const obs__exr_mem *mem,
+                              obs__exr_reader read, void *user, char err[OBS_ERR_LEN]);
 
 /* ---- output parts (exr_write.c, exr_append.c, exr_header.c) ------------ */
 

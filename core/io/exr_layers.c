@@ -1,6 +1,7 @@
 /* The output's channel names: the result's layers (AO.Y, R,G,B,A, ...)
  * and --layer's renaming of them.  No OpenEXR calls: the request parser
  * (protocol/http.c) checks a layer name with them too. */
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -43,22 +44,23 @@ int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_L
     static const char *const bleed[] = {"Bleed.R", "Bleed.G", "Bleed.B"};
     static const char *const lum[] = {"Luminance.Y"};
     static const char *const screen[] = {"AOScreen.Y"}, *const baked[] = {"AOBaked.Y"};
+    /* The result's images in the file's order, each with its channels. */
+    static const struct {
+        size_t offset;
+        const char *const *names;
+    } rows[] = {{offsetof(obs_result, ao), ao},
+                {offsetof(obs_result, composite), rgba},
+                {offsetof(obs_result, sample_count), count},
+                {offsetof(obs_result, cull_mask), cull},
+                {offsetof(obs_result, bleed), bleed},
+                {offsetof(obs_result, luminance), lum},
+                {offsetof(obs_result, ao_screen), screen},
+                {offsetof(obs_result, ao_baked), baked}};
     int n = 0;
-    if (r->ao.data)
-        layers[n++] = (obs_exr_layer){&r->ao, ao};
-    if (r->composite.data)
-        layers[n++] = (obs_exr_layer){&r->composite, rgba};
-    if (r->sample_count.data)
-        layers[n++] = (obs_exr_layer){&r->sample_count, count};
-    if (r->cull_mask.data)
-        layers[n++] = (obs_exr_layer){&r->cull_mask, cull};
-    if (r->bleed.data)
-        layers[n++] = (obs_exr_layer){&r->bleed, bleed};
-    if (r->luminance.data)
-        layers[n++] = (obs_exr_layer){&r->luminance, lum};
-    if (r->ao_screen.data)
-        layers[n++] = (obs_exr_layer){&r->ao_screen, screen};
-    if (r->ao_baked.data)
-        layers[n++] = (obs_exr_layer){&r->ao_baked, baked};
+    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) {
+        const obs_image *im = (const obs_image *)((const char *)r + rows[i].offset);
+        if (im->data)
+            layers[n++] = (obs_exr_layer){im, rows[i].names};
+    }
     return n;
 }

@@ -13,7 +13,7 @@
 #include "io/exr_internal.h"
 #include "internal.h"
 
-static const char *part_string(exr_const_context_t ctx, int part, const char *name)
+const char *obs__exr_attr_string(exr_const_context_t ctx, int part, const char *name)
 {
     const exr_attribute_t *a = NULL;
     if (exr_get_attribute_by_name(ctx, part, name, &a) != EXR_ERR_SUCCESS || !a ||
@@ -43,7 +43,8 @@ static void list_parts(exr_const_context_t ctx, int parts, char *buf, size_t len
     size_t at = 0;
     buf[0] = '\0';
     for (int p = 0; p < parts && at + 80 < len; p++) {
-        const char *n = part_string(ctx, p, "name"), *v = part_string(ctx, p, "view");
+        const char *n = obs__exr_attr_string(ctx, p, "name"),
+                   *v = obs__exr_attr_string(ctx, p, "view");
         at += (size_t)snprintf(buf + at, len - at, "%s%d%s%.40s%s%s%.20s%s", p ? ", " : "", p,
                                n ? " '" : "", n ? n : "", n ? "'" : "", v ? " (" : "", v ? v : "",
                                v ? ")" : "");
@@ -67,7 +68,7 @@ obs_status obs__exr_select_parts(exr_const_context_t ctx, int parts, const obs_c
         if (digits && strlen(want_part) < 10 && atoi(want_part) < parts)
             found = atoi(want_part);
         for (int p = 0; p < parts && found < 0; p++) {
-            const char *n = part_string(ctx, p, "name");
+            const char *n = obs__exr_attr_string(ctx, p, "name");
             if (n && strcmp(n, want_part) == 0)
                 found = p;
         }
@@ -85,12 +86,12 @@ obs_status obs__exr_select_parts(exr_const_context_t ctx, int parts, const obs_c
 
     int any_view = 0;
     for (int p = 0; p < parts; p++)
-        any_view |= part_string(ctx, p, "view") != NULL;
+        any_view |= obs__exr_attr_string(ctx, p, "view") != NULL;
     const char *view = want_view;
     if (!view && any_view) {
         view = default_view(ctx, parts, dv, sizeof dv);
-        if (!view && part_string(ctx, 0, "view")) {
-            snprintf(dv, sizeof dv, "%s", part_string(ctx, 0, "view"));
+        if (!view && obs__exr_attr_string(ctx, 0, "view")) {
+            snprintf(dv, sizeof dv, "%s", obs__exr_attr_string(ctx, 0, "view"));
             view = dv;
         }
         snprintf(s->why, sizeof s->why, "the default view");
@@ -110,13 +111,13 @@ obs_status obs__exr_select_parts(exr_const_context_t ctx, int parts, const obs_c
     /* the view's parts first, then the parts of no view */
     for (int pass = 0; pass < 2; pass++)
         for (int p = 0; p < parts; p++) {
-            const char *v = part_string(ctx, p, "view");
+            const char *v = obs__exr_attr_string(ctx, p, "view");
             if (pass == 0 ? v && strcmp(v, view) == 0 : !v)
                 s->part[s->count++] = p;
         }
     int of_view = 0;
     for (int i = 0; i < s->count; i++) {
-        const char *v = part_string(ctx, s->part[i], "view");
+        const char *v = obs__exr_attr_string(ctx, s->part[i], "view");
         of_view += v != NULL;
     }
     obs__exr_msg_reset();

@@ -69,6 +69,22 @@ obs_status obs__exr_open(const char *path, const mem_src *mem, exr_context_t *ct
     return OBS_OK;
 }
 
+obs_status obs__exr_read_with(const char *label, const char *path, const obs__exr_mem *mem,
+                              obs__exr_reader read, void *user, char err[OBS_ERR_LEN])
+{
+    char why[OBS_ERR_LEN] = "";
+    exr_context_t ctx = NULL;
+    int64_t size;
+    obs_status st = obs__exr_open(path, mem, &ctx, &size, why);
+    if (st == OBS_OK)
+        st = read(ctx, size, user, why);
+    if (ctx)
+        exr_finish(&ctx);
+    if (st != OBS_OK)
+        obs__fail(err, st, "%s: %s", label, why);
+    return st;
+}
+
 /* ---- parts and channels -------------------------------------------------- */
 
 /* Channel names of one part, pointing into the context (valid until
@@ -650,29 +666,32 @@ fail:
     return st;
 }
 
+/* read_gbuffer's arguments, as obs__exr_read_with passes them. */
+typedef struct gbuffer_job {
+    const obs_channel_map *map;
+    const obs_limits *lim;
+    obs_gbuffer_file *out;
+} gbuffer_job;
+
+static obs_status gbuffer_reader(exr_context_t ctx, int64_t size, void *user,
+                                 char why[OBS_ERR_LEN])
+{
+    const gbuffer_job *j = user;
+    return read_gbuffer(ctx, size, j->map, j->lim, j->out, why);
+}
+
 /* Shared by the file and memory readers; `label` prefixes messages. */
 static obs_status read_any(const char *label, const char *path, const mem_src *mem,
                            const obs_channel_map *map, const obs_limits *lim,
                            obs_gbuffer_file *out, char err[OBS_ERR_LEN])
 {
-    char sub[OBS_ERR_LEN] = "";
-    exr_context_t ctx = NULL;
-    int64_t size;
-    obs_status st;
-
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
     memset(out, 0, sizeof *out);
-    if ((st = obs__exr_open(path, mem, &ctx, &size, sub)) != OBS_OK)
-        goto fail;
-    st = read_gbuffer(ctx, size, map, lim, out, sub);
-fail:
-    if (ctx)
-        exr_finish(&ctx);
-    if (st != OBS_OK) {
+    gbuffer_job j = {map, lim, out};
+    obs_status st = obs__exr_read_with(label, path, mem, gbuffer_reader, &j, err);
+    if (st != OBS_OK)
         obs_gbuffer_free(out);
-        obs__fail(err, st, "%s: %s", label, sub);
-    }
     return st;
 }
 
@@ -791,42 +810,41 @@ obs_status obs_exr_read_channel_mem(const void *data, size_t len, const char *ch
     return read_channel(NULL, &mem, channel, lim, out, err);
 }
 
-obs_status obs_exr_list_channels(const char *path, char ***names_out, char err[OBS_ERR_LEN])
+/* The names of part 0's channels into *(char ***)user, a NULL-ended
+ * list of copies. */
+static obs_status names_reader(exr_context_t ctx, int64_t size, void *user,
+                               char why[OBS_ERR_LEN])
 {
-    char sub[OBS_ERR_LEN] = "";
-    exr_context_t ctx = NULL;
     const char **names = NULL;
     char **v = NULL;
-    int64_t size;
     int n = 0;
-    obs_status st;
-
-    if (!path || !names_out)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_list_channels: NULL argument");
-    *names_out = NULL;
-    if ((st = obs__exr_open(path, NULL, &ctx, &size, sub)) != OBS_OK)
-        goto fail;
-    if ((st = part_names(ctx, 0, &names, &n, sub)) != OBS_OK)
+    (void)size;
+    obs_status st = part_names(ctx, 0, &names, &n, why);
+    if (st != OBS_OK)
         goto fail;
     if (!(v = calloc((size_t)n + 1, sizeof *v))) {
-        st = obs__fail(sub, OBS_NO_MEMORY, "list of %d channel names", n);
+        st = obs__fail(why, OBS_NO_MEMORY, "list of %d channel names", n);
         goto fail;
     }
     for (int i = 0; i < n; i++)
         if (!(v[i] = strdup(names[i]))) {
-            st = obs__fail(sub, OBS_NO_MEMORY, "channel name");
+            st = obs__fail(why, OBS_NO_MEMORY, "channel name");
             goto fail;
         }
-    *names_out = v;
+    *(char ***)user = v;
     v = NULL;
 fail:
     obs_strv_free(v);
     free(names);
-    if (ctx)
-        exr_finish(&ctx);
-    if (st != OBS_OK)
-        obs__fail(err, st, "%s: %s", path, sub);
     return st;
+}
+
+obs_status obs_exr_list_channels(const char *path, char ***names_out, char err[OBS_ERR_LEN])
+{
+    if (!path || !names_out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_list_channels: NULL argument");
+    *names_out = NULL;
+    return obs__exr_read_with(path, path, NULL, names_reader, names_out, err);
 }
 
 void obs_strv_free(char **v)

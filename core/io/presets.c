@@ -106,16 +106,6 @@ static int has_prefix(const char *s, const char *pre)
     return strncmp(s, pre, strlen(pre)) == 0;
 }
 
-/* The string value of attribute `name`, or NULL. */
-static const char *attr_string(exr_const_context_t ctx, int part, const char *name)
-{
-    const exr_attribute_t *a = NULL;
-    if (exr_get_attribute_by_name(ctx, part, name, &a) != EXR_ERR_SUCCESS || !a ||
-        a->type != EXR_ATTR_STRING || !a->string || !a->string->str)
-        return NULL;
-    return a->string->str;
-}
-
 const char *obs__preset_detect(exr_const_context_t ctx, int part, char *why, size_t len)
 {
     static const char *const software_keys[] = {"software", "Software", "creator",
@@ -145,7 +135,7 @@ const char *obs__preset_detect(exr_const_context_t ctx, int part, char *why, siz
                 }
     }
     for (const char *const *key = software_keys; *key && !found; key++) {
-        const char *v = attr_string(ctx, part, *key);
+        const char *v = obs__exr_attr_string(ctx, part, *key);
         for (size_t k = 0; v && k < COUNT && !found; k++)
             for (const char *const *p = presets[k].software; *p && !found; p++)
                 if (strstr(v, *p)) {

@@ -275,6 +275,119 @@ static size_t ac3d_two_sided(const char *path, obs_bake_scene *s)
     return marked;
 }
 
+/* The file's materials and meshes, in its order; at least one triangle. */
+static obs_status copy_meshes(const char *path, const struct aiScene *sc, obs_bake_scene *out,
+                              char err[OBS_ERR_LEN])
+{
+    out->meshes = calloc(sc->mNumMeshes, sizeof *out->meshes);
+    if (!out->meshes)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %u meshes", path, sc->mNumMeshes);
+    out->mesh_count = sc->mNumMeshes;
+    if (sc->mNumMaterials && !(out->materials = calloc(sc->mNumMaterials, sizeof *out->materials)))
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %u materials", path, sc->mNumMaterials);
+    for (unsigned i = 0; i < sc->mNumMaterials; i++) {
+        out->material_count = i + 1;
+        if (copy_material(sc->mMaterials[i], &out->materials[i]) != OBS_OK)
+            return obs__fail(err, OBS_NO_MEMORY, "%s: material names", path);
+    }
+    size_t stored = 0;
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        obs_status st = copy_mesh(path, sc, i, &out->meshes[i], err);
+        if (st != OBS_OK)
+            return st;
+        stored += out->meshes[i].triangle_count;
+    }
+    if (stored == 0)
+        return obs__fail(err, OBS_BAD_FILE, "%s: no triangles (%u meshes of points or lines)",
+                         path, sc->mNumMeshes);
+    return OBS_OK;
+}
+
+/* Node o, the file's nd under parent (-1: the root): its matrices, name,
+ * extras and the meshes with triangles it instances, counted into the
+ * scene's instances and flattened triangles. */
+static obs_status copy_node(const char *path, const struct aiScene *sc, const struct aiNode *nd,
+                            int parent, size_t max_triangles, obs_bake_scene *out,
+                            obs_bake_node *o, char err[OBS_ERR_LEN])
+{
+    o->parent = parent;
+    to_mat(&nd->mTransformation, o->local);
+    if (o->parent >= 0)
+        mat_mul(out->nodes[o->parent].world, o->local, o->world);
+    else
+        memcpy(o->world, o->local, sizeof o->world);
+    o->name = strdup(nd->mName.data);
+    o->extras = extras_json(nd->mMetaData);
+    o->meshes = malloc((nd->mNumMeshes ? nd->mNumMeshes : 1) * sizeof *o->meshes);
+    if (!o->name || !o->meshes)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: nodes", path);
+    for (unsigned k = 0; k < nd->mNumMeshes; k++) {
+        unsigned mi = nd->mMeshes[k];
+        if (mi >= sc->mNumMeshes)
+            return obs__fail(err, OBS_BAD_FILE, "%s: node '%s' refers to mesh %u of %u", path,
+                             nd->mName.data, mi, sc->mNumMeshes);
+        if (out->meshes[mi].triangle_count == 0)
+            continue; /* points or lines */
+        o->meshes[o->mesh_count++] = mi;
+        out->instance_count++;
+        out->world_triangles += out->meshes[mi].triangle_count;
+    }
+    if (max_triangles && out->world_triangles > max_triangles)
+        return obs__fail(err, OBS_TOO_LARGE,
+                         "%s: more than %zu triangles once instances are flattened "
+                         "(max_triangles)",
+                         path, max_triangles);
+    return OBS_OK;
+}
+
+/* The node graph, depth first, parents first. */
+static obs_status copy_nodes(const char *path, const struct aiScene *sc, size_t max_triangles,
+                             obs_bake_scene *out, char err[OBS_ERR_LEN])
+{
+    int depth_err = 0;
+    size_t nn = count_nodes(sc->mRootNode, err, &depth_err);
+    if (depth_err)
+        return OBS_UNSUPPORTED;
+    out->nodes = calloc(nn, sizeof *out->nodes);
+    if (!out->nodes)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %zu nodes", path, nn);
+    const struct aiNode *stack[MAX_DEPTH];
+    int ids[MAX_DEPTH];
+    unsigned next[MAX_DEPTH];
+    int sp = 0;
+    stack[0] = sc->mRootNode;
+    next[0] = 0;
+    ids[0] = 0;
+    size_t count = 0;
+    for (;;) {
+        const struct aiNode *nd = stack[sp];
+        if (next[sp] == 0) {
+            /* first visit */
+            obs_bake_node *o = &out->nodes[count];
+            ids[sp] = (int)count++;
+            out->node_count = count; /* what obs_bake_scene_free releases on failure */
+            obs_status st = copy_node(path, sc, nd, sp ? ids[sp - 1] : -1, max_triangles, out, o,
+                                      err);
+            if (st != OBS_OK)
+                return st;
+        }
+        if (next[sp] < nd->mNumChildren && count < nn) {
+            const struct aiNode *c = nd->mChildren[next[sp]++];
+            if (!c)
+                continue;
+            sp++;
+            stack[sp] = c;
+            next[sp] = 0;
+            continue;
+        }
+        if (sp == 0)
+            break;
+        sp--;
+    }
+    out->node_count = count;
+    return OBS_OK;
+}
+
 obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene *out,
                          char err[OBS_ERR_LEN])
 {
@@ -294,110 +407,9 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
         st = obs__fail(err, OBS_BAD_FILE, "%s: no triangles (no meshes)", path);
         goto fail;
     }
-    out->meshes = calloc(sc->mNumMeshes, sizeof *out->meshes);
-    if (!out->meshes) {
-        st = obs__fail(err, OBS_NO_MEMORY, "%s: %u meshes", path, sc->mNumMeshes);
+    if ((st = copy_meshes(path, sc, out, err)) != OBS_OK ||
+        (st = copy_nodes(path, sc, max_triangles, out, err)) != OBS_OK)
         goto fail;
-    }
-    out->mesh_count = sc->mNumMeshes;
-    if (sc->mNumMaterials && !(out->materials = calloc(sc->mNumMaterials, sizeof *out->materials))) {
-        st = obs__fail(err, OBS_NO_MEMORY, "%s: %u materials", path, sc->mNumMaterials);
-        goto fail;
-    }
-    for (unsigned i = 0; i < sc->mNumMaterials; i++) {
-        out->material_count = i + 1;
-        if (copy_material(sc->mMaterials[i], &out->materials[i]) != OBS_OK) {
-            st = obs__fail(err, OBS_NO_MEMORY, "%s: material names", path);
-            goto fail;
-        }
-    }
-    size_t stored = 0;
-    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
-        if ((st = copy_mesh(path, sc, i, &out->meshes[i], err)) != OBS_OK)
-            goto fail;
-        stored += out->meshes[i].triangle_count;
-    }
-    if (stored == 0) {
-        st = obs__fail(err, OBS_BAD_FILE, "%s: no triangles (%u meshes of points or lines)", path,
-                       sc->mNumMeshes);
-        goto fail;
-    }
-
-    int depth_err = 0;
-    size_t nn = count_nodes(sc->mRootNode, err, &depth_err);
-    if (depth_err) {
-        st = OBS_UNSUPPORTED;
-        goto fail;
-    }
-    out->nodes = calloc(nn, sizeof *out->nodes);
-    if (!out->nodes) {
-        st = obs__fail(err, OBS_NO_MEMORY, "%s: %zu nodes", path, nn);
-        goto fail;
-    }
-    /* Depth first, parents first. */
-    const struct aiNode *stack[MAX_DEPTH];
-    int ids[MAX_DEPTH];
-    unsigned next[MAX_DEPTH];
-    int sp = 0;
-    stack[0] = sc->mRootNode;
-    next[0] = 0;
-    ids[0] = 0;
-    size_t count = 0;
-    for (;;) {
-        const struct aiNode *nd = stack[sp];
-        if (next[sp] == 0) {
-            /* first visit */
-            obs_bake_node *o = &out->nodes[count];
-            ids[sp] = (int)count++;
-            out->node_count = count; /* what obs_bake_scene_free releases on failure */
-            o->parent = sp ? ids[sp - 1] : -1;
-            to_mat(&nd->mTransformation, o->local);
-            if (o->parent >= 0)
-                mat_mul(out->nodes[o->parent].world, o->local, o->world);
-            else
-                memcpy(o->world, o->local, sizeof o->world);
-            o->name = strdup(nd->mName.data);
-            o->extras = extras_json(nd->mMetaData);
-            o->meshes = malloc((nd->mNumMeshes ? nd->mNumMeshes : 1) * sizeof *o->meshes);
-            if (!o->name || !o->meshes) {
-                st = obs__fail(err, OBS_NO_MEMORY, "%s: nodes", path);
-                goto fail;
-            }
-            for (unsigned k = 0; k < nd->mNumMeshes; k++) {
-                unsigned mi = nd->mMeshes[k];
-                if (mi >= sc->mNumMeshes) {
-                    st = obs__fail(err, OBS_BAD_FILE, "%s: node '%s' refers to mesh %u of %u",
-                                   path, nd->mName.data, mi, sc->mNumMeshes);
-                    goto fail;
-                }
-                if (out->meshes[mi].triangle_count == 0)
-                    continue; /* points or lines */
-                o->meshes[o->mesh_count++] = mi;
-                out->instance_count++;
-                out->world_triangles += out->meshes[mi].triangle_count;
-            }
-            if (max_triangles && out->world_triangles > max_triangles) {
-                st = obs__fail(err, OBS_TOO_LARGE,
-                               "%s: more than %zu triangles once instances are flattened "
-                               "(max_triangles)",
-                               path, max_triangles);
-                goto fail;
-            }
-        }
-        if (next[sp] < nd->mNumChildren && count < nn) {
-            const struct aiNode *c = nd->mChildren[next[sp]++];
-            if (!c)
-                continue;
-            sp++;
-            stack[sp] = c;
-            next[sp] = 0;
-            continue;
-        }
-        if (sp == 0)
-            break;
-        sp--;
-    }
-    out->node_count = count;
     if (out->world_triangles == 0) {
         st = obs__fail(err, OBS_BAD_FILE, "%s: no triangles under the scene's nodes", path);
         goto fail;

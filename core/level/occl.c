@@ -21,7 +21,9 @@
 #include <string.h>
 
 #include "level/occl.h"
+#include "level/sweep.h"
 #include "internal.h"
+#include "pool.h"
 
 /* The ray context the callbacks see: Embree's, then the sums, one per
  * ray of a packet of 8, by the ray's id (Embree may hand a callback the
@@ -71,18 +73,7 @@ void obs__bake_occl_free(obs__bake_occl *o)
  *   density_i <- density_i * V_i / (V_i + O_i),
  * so a box lying wholly inside k - 1 others of its size (O_i = (k - 1) V)
  * keeps 1/k of its density: k coincident boxes attenuate as one.  Pairs
- * by a sweep over the boxes sorted by min x. */
-typedef struct key {
-    float x;
-    uint32_t i;
-} key;
-
-static int by_x(const void *a, const void *b)
-{
-    const key *p = a, *q = b;
-    return p->x < q->x ? -1 : p->x > q->x ? 1 : (p->i > q->i) - (p->i < q->i);
-}
-
+ * by a sweep over the boxes sorted by min x (sweep.c). */
 static double volume(const float *b)
 {
     double v = 1.0;
@@ -93,25 +84,22 @@ static double volume(const float *b)
 
 void obs__bake_fog_overlap(const float *box, size_t n, float *density)
 {
-    key *ks = malloc((n ? n : 1) * sizeof *ks);
+    uint32_t *o = obs__sweep_order(box, 6 * sizeof *box, n);
     double *ov = calloc(n ? n : 1, sizeof *ov);
-    if (!ks || !ov) { /* no memory: the densities stay as given */
-        free(ks);
+    if (!o || !ov) { /* no memory: the densities stay as given */
+        free(o);
         free(ov);
         return;
     }
-    for (size_t i = 0; i < n; i++)
-        ks[i] = (key){box[6 * i], (uint32_t)i};
-    qsort(ks, n, sizeof *ks, by_x);
     for (size_t a = 0; a < n; a++) {
-        const float *p = box + 6 * (size_t)ks[a].i;
-        for (size_t b = a + 1; b < n && ks[b].x < p[3]; b++) {
-            const float *q = box + 6 * (size_t)ks[b].i;
+        const float *p = box + 6 * (size_t)o[a];
+        for (size_t b = a + 1; b < n && box[6 * (size_t)o[b]] < p[3]; b++) {
+            const float *q = box + 6 * (size_t)o[b];
             double v = 1.0;
             for (int k = 0; k < 3; k++)
                 v *= fmax(0.0, fmin((double)p[3 + k], q[3 + k]) - fmax((double)p[k], q[k]));
-            ov[ks[a].i] += v;
-            ov[ks[b].i] += v;
+            ov[o[a]] += v;
+            ov[o[b]] += v;
         }
     }
     for (size_t i = 0; i < n; i++) {
@@ -119,7 +107,7 @@ void obs__bake_fog_overlap(const float *box, size_t n, float *density)
         if (v + ov[i] > 0.0)
             density[i] = (float)(density[i] * (v / (v + ov[i])));
     }
-    free(ks);
+    free(o);
     free(ov);
 }
 
@@ -322,7 +310,8 @@ obs_status obs__bake_occl_new(const obs__bake_world *w, const obs__bake_decor *d
     if (!o)
         return obs__fail(err, OBS_NO_MEMORY, "BVH");
     o->log_keep = tree_attenuation >= 1.0f ? -INFINITY : log1p(-(double)tree_attenuation);
-    if (!(o->dev = rtcNewDevice(NULL))) {
+    char embree_cfg[32];
+    if (!(o->dev = rtcNewDevice(obs__pool_embree_config(embree_cfg)))) {
         free(o);
         return obs__fail(err, OBS_UNSUPPORTED, "Embree: no device (error %d)",
                          (int)rtcGetDeviceError(NULL));

@@ -24,6 +24,28 @@ size_t obs__bake_shard_first(size_t total, int index, int count)
     return total / (size_t)count * (size_t)index + total % (size_t)count * (size_t)index / (size_t)count;
 }
 
+obs_status obs__shard_check(int index, int count, const char *path, char err[OBS_ERR_LEN])
+{
+    if (count < 1 || index < 0 || index >= count)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %d/%d: the index is 0 .. count-1 "
+                         "(count at least 1)", index, count);
+    if (!path || !*path)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "shard %d/%d: no part file to write", index,
+                         count);
+    return OBS_OK;
+}
+
+obs_status obs__part_check_level(const char *path, uint64_t part_level, uint64_t level,
+                                 char err[OBS_ERR_LEN])
+{
+    if (part_level != level)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s was traced from another level (or "
+                         "another version of it, or with other decorators): fingerprint %016llx, "
+                         "this level's %016llx",
+                         path, (unsigned long long)part_level, (unsigned long long)level);
+    return OBS_OK;
+}
+
 /* ---- little-endian fields and the hash (shard.h) ----------------------- */
 
 uint64_t obs__bake_fnv(uint64_t h, const void *data, size_t n)
@@ -247,6 +269,8 @@ obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
                                 char err[OBS_ERR_LEN])
 {
     *out = NULL;
+    if (n == 0 || !paths)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "merge: no parts");
     unsigned char *heads = calloc(n, elem), *ordered = NULL;
     obs__bake_part_key *keys = calloc(n, sizeof *keys);
     size_t *order = NULL;

@@ -102,16 +102,22 @@ typedef struct obs__part_format {
  * head_len + item_bytes n. */
 obs_status obs__part_range_read(const char *path, const obs__part_format *f, unsigned char *b,
                                 obs__part_range *r, char err[OBS_ERR_LEN]);
-/* The n parts at paths, their headers read by read_header into elem-byte
- * structs, checked to be every shard of one split once
- * (obs__bake_parts_order, with key's view of a header); *out the headers
- * in shard order (n of them; caller frees). */
+/* The n parts at paths (none: "merge: no parts"), their headers read by
+ * read_header into elem-byte structs, checked to be every shard of one
+ * split once (obs__bake_parts_order, with key's view of a header); *out
+ * the headers in shard order (n of them; caller frees). */
 obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
                                 obs_status (*read_header)(const char *path, void *h,
                                                           char err[OBS_ERR_LEN]),
                                 obs__bake_part_key (*key)(const void *h), void **out,
                                 char err[OBS_ERR_LEN]);
 
+/* A merge's part (at path) traced from this level: its fingerprint
+ * part_level is the level's, level (obs__bake_traced_fingerprint). */
+obs_status obs__part_check_level(const char *path, uint64_t part_level, uint64_t level,
+                                 char err[OBS_ERR_LEN]);
+/* A shard's arguments: index in 0 .. count-1, a part file to write. */
+obs_status obs__shard_check(int index, int count, const char *path, char err[OBS_ERR_LEN]);
 /* The first sample of shard index of count over total samples: shard i
  * traces [first(i), first(i + 1)); first(count) = total. */
 size_t obs__bake_shard_first(size_t total, int index, int count);

@@ -39,9 +39,13 @@
  * Hilbert-curve index, so the chain's blur averages 9 slice offsets; the
  * arc cosines are exact (XeGTAO: a polynomial approximation); depth is
  * read at full resolution (XeGTAO reads a MIP level that grows with the
- * sample's distance); a sample outside the image or on the background
- * leaves the horizon as it is (XeGTAO's clamp sampler repeats the border
- * pixel); the view vector of an orthographic camera is +z. */
+ * sample's distance); a sample on the background leaves the horizon as it
+ * is; a sample outside the image reads the surface continued past the
+ * border (chain/border_cpu.c: the tangent plane of the last pixel on the
+ * segment from the shaded pixel, exact for an open plane and for a crease
+ * through the shaded point; XeGTAO's clamp sampler repeats the border
+ * pixel instead, and counting it open lightened creases at the border);
+ * the view vector of an orthographic camera is +z. */
 #include <math.h>
 
 #include "methods/gtao.h"
@@ -67,12 +71,27 @@ void obs__gtao_noise(int tile, float out[2])
     out[1] = b - floorf(b);
 }
 
+/* GLSL: the branch of gtao_side_horizon() for a step at pixel (qx, qy)
+ * off the planes: the surface continued past the border
+ * (chain/border_cpu.c), in ext; NULL (the horizon stays) where that is
+ * background or there is no estimate.  *taken counts the steps that read
+ * the surface or background. */
+static const float *border_step(const obs__frame *f, const float *pos, const float *nrm, int x,
+                                int y, int qx, int qy, float ext[4], int *taken)
+{
+    float nz;
+    int got = obs__border_point(f, pos, nrm, x, y, (float)qx, (float)qy, ext, &nz);
+    if (got >= 0)
+        (*taken)++;
+    return got > 0 ? ext : NULL;
+}
+
 /* The horizon cosine of side `dir` (+1 or -1) of a slice after its
  * steps: the largest of the tangent's cosine `low` and the samples',
  * each moved from low by its falloff weight. */
-static float side_horizon(const obs__frame *f, const float *pos, int x, int y, const float c[3],
-                          const float v[3], const float omega[2], int slice, float noise_step,
-                          float min_s, int dir, float low, int *taken)
+static float side_horizon(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                          const float c[3], const float v[3], const float omega[2], int slice,
+                          float noise_step, float min_s, int dir, float low, int *taken)
 {
     const obs__gtao_state *g = obs__gtao_of(f);
     float hc = low;
@@ -84,10 +103,15 @@ static float side_horizon(const obs__frame *f, const float *pos, int x, int y, c
         s = s * s + min_s; /* sample distribution power 2, then off the centre pixel */
         int qx = x + dir * (int)floorf(s * omega[0] + 0.5f);
         int qy = y + dir * (int)floorf(s * omega[1] + 0.5f);
-        if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height)
-            continue;
-        (*taken)++;
-        const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+        float ext[4];
+        const float *q;
+        if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
+            if (!(q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken)))
+                continue;
+        } else {
+            (*taken)++;
+            q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+        }
         if (!(q[3] > 0.0f))
             continue;
         float d[3] = {q[0] - c[0], q[1] - c[1], q[2] - c[2]};
@@ -111,8 +135,8 @@ static float arc(float h, float gamma, float cos_gamma)
 }
 
 /* GLSL: method_ao() in gtao.glsl */
-float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                      const float n[3], int *count)
+float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                      const float p[3], const float n[3], int *count)
 {
     const obs__gtao_state *g = obs__gtao_of(f);
     const float half_pi = (float)M_PI_2;
@@ -156,8 +180,10 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const
         float cos_g = np_len > 0.0f ? saturate(dot3(np, v) / np_len) : 1.0f;
         float gamma = signf(dot3(od, np)) * acosf(cos_g);
         float low0 = cosf(gamma + half_pi), low1 = cosf(gamma - half_pi);
-        float hc0 = side_horizon(f, pos, x, y, c, v, omega, sl, noise[1], min_s, 1, low0, &taken);
-        float hc1 = side_horizon(f, pos, x, y, c, v, omega, sl, noise[1], min_s, -1, low1, &taken);
+        float hc0 =
+            side_horizon(f, pos, nrm, x, y, c, v, omega, sl, noise[1], min_s, 1, low0, &taken);
+        float hc1 =
+            side_horizon(f, pos, nrm, x, y, c, v, omega, sl, noise[1], min_s, -1, low1, &taken);
         if (g->heuristics)
             np_len += (1.0f - np_len) * GTAO_SLOPE_FUDGE;
         /* the horizons as angles from v, clamped to the hemisphere of n

@@ -26,11 +26,12 @@ static inline const obs__gtao_state *obs__gtao_of(const obs__frame *f)
 void obs__gtao_setup(const obs_params *p, obs__frame *f);
 
 /* Ground-truth-based AO (Jimenez et al., as XeGTAO implements it) of the
- * point p with normal n at pixel (x, y) (GLSL: gtao.glsl).  The count of
+ * point p with normal n at pixel (x, y) (GLSL: gtao.glsl); `nrm` is the
+ * prep pass's view normal plane (read past the border).  The count of
  * depth samples read inside the image goes to *count when count is not
  * NULL. */
-float obs__gtao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
-                      const float n[3], int *count);
+float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                      const float p[3], const float n[3], int *count);
 
 /* The noise of the 3x3 tile's pixel `tile` (obs__tile_index): XeGTAO's R2
  * sequence, fract(0.5 + k (0.754877666, 0.569840291)), k = tile;

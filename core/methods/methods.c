@@ -11,30 +11,33 @@
 #include "obs_shaders.h"
 
 /* The methods' twins behind one signature (GLSL: method_ao()). */
-static float hemisphere_ao(const obs__frame *f, const float *pos, int x, int y, const float p[4],
-                           const float n[3], int *count)
+static float hemisphere_ao(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                           const float p[4], const float n[3], int *count)
 {
+    (void)nrm;
     *count = obs__hemisphere_of(f)->count;
     return obs__hemisphere_pixel(f, pos, x, y, p, n);
 }
 
-static float angle_ao(const obs__frame *f, const float *pos, int x, int y, const float p[4],
-                      const float n[3], int *count)
+static float angle_ao(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                      const float p[4], const float n[3], int *count)
 {
+    (void)nrm;
     *count = 2 * obs__angle_of(f)->pairs;
     return obs__angle_pixel(f, pos, x, y, p, n);
 }
 
-static float hbao_ao(const obs__frame *f, const float *pos, int x, int y, const float p[4],
-                     const float n[3], int *count)
+static float hbao_ao(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                     const float p[4], const float n[3], int *count)
 {
+    (void)nrm;
     return obs__hbao_pixel(f, pos, x, y, p, n, count);
 }
 
-static float gtao_ao(const obs__frame *f, const float *pos, int x, int y, const float p[4],
-                     const float n[3], int *count)
+static float gtao_ao(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                     const float p[4], const float n[3], int *count)
 {
-    return obs__gtao_pixel(f, pos, x, y, p, n, count);
+    return obs__gtao_pixel(f, pos, nrm, x, y, p, n, count);
 }
 
 /* Samples per pixel, for obs_frame_cost. */
@@ -129,7 +132,7 @@ float obs__method_pixel(const obs__frame *f, const float *pos, const float *nrm,
     *count = 0;
     if (!(p[3] > 0.0f) || !m || !m->pixel)
         return 1.0f;
-    return m->pixel(f, pos, x, y, p, n, count);
+    return m->pixel(f, pos, nrm, x, y, p, n, count);
 }
 
 unsigned long long obs_frame_cost(const obs_params *params, int width, int height, int deep_layers)

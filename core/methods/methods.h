@@ -26,8 +26,8 @@ typedef struct obs__method {
     void (*setup)(const obs_params *p, obs__frame *f);
     /* The CPU twin of method_ao(): the AO of the point p with normal n at
      * pixel (x, y), *count the samples taken (NULL for vaopp and vao). */
-    float (*pixel)(const obs__frame *f, const float *pos, int x, int y, const float p[4],
-                   const float n[3], int *count);
+    float (*pixel)(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                   const float p[4], const float n[3], int *count);
     /* Samples a pixel takes at most, from the resolved parameters (the
      * measure of obs_frame_cost). */
     int (*samples_per_pixel)(const obs_params *p);

@@ -136,6 +136,51 @@ bool disk_px(vec3 U, vec3 V, vec3 W, float sx, float sy, ivec2 size, out ivec2 q
     return true;
 }
 
+// Samples off the planes (C twin and derivation: chain/border_cpu.c): a
+// sample at pixel q off the planes reads the tangent plane of the last
+// pixel b on the planes along the segment from the shaded pixel px to q,
+// where q's pixel-centre ray meets it.  border_px gives b: false where q
+// is too far out to be a pixel (near the camera's plane).  C twin:
+// obs__border_px.
+bool border_px(ivec2 px, vec2 q, out ivec2 b)
+{
+    b = ivec2(0);
+    if (!(abs(q.x) < OBS_BORDER_MAX_PX && abs(q.y) < OBS_BORDER_MAX_PX))
+        return false;
+    vec2 size = vec2(u_size), s = vec2(px) + 0.5, d = q + 0.5 - s;
+    float t = 1.0;
+    if (d.x > 0.0)
+        t = min(t, (size.x - s.x) / d.x);
+    else if (d.x < 0.0)
+        t = min(t, -s.x / d.x);
+    if (d.y > 0.0)
+        t = min(t, (size.y - s.y) / d.y);
+    else if (d.y < 0.0)
+        t = min(t, -s.y / d.y);
+    b = ivec2(min(max(floor(s + t * d), vec2(0.0)), size - 1.0));
+    return true;
+}
+
+// Where the view ray of pixel q meets the plane through b with normal nb:
+// true and pt (view point, planar depth in w), false where the plane does
+// not face the ray (edge-on or turned away) or meets it behind the camera.
+// C twin: obs__plane_point.
+bool plane_point(vec2 q, vec3 b, vec3 nb, out vec4 pt)
+{
+    pt = vec4(0.0);
+    vec3 o, dir;
+    view_ray(px_ndc(ivec2(q)), o, dir);
+    float den = dot(nb, dir);
+    if (!(den < 0.0))
+        return false;
+    float d = dot(nb, b - o) / den;
+    if (!(d > 0.0 && d < OBS_BACKGROUND_DEPTH))
+        return false;
+    pt = vec4(o + d * dir, d);
+    pt.z = -d;
+    return true;
+}
+
 // The planar depth under a pipe of the view-space sample point s (x, y)
 // when its pixel is the shaded pixel itself, for eq 1's dz: the tangent
 // plane at p (normal n) there, not the depth at the pixel's centre zs,

@@ -26,6 +26,22 @@ vec2 gtao_noise(ivec2 px)
     return fract(vec2(0.5) + k * vec2(0.75487766624669276, 0.56984029099805327));
 }
 
+// A step at pixel q off the planes: true and xq, the surface continued
+// past the border (chain/border_cpu.c), or xq.w = 0 where that is
+// background (the horizon stays, the step counted); false where there is
+// no estimate (the horizon stays).  C twin: border_step (methods/gtao.c).
+bool gtao_border_step(ivec2 px, ivec2 q, out vec4 xq)
+{
+    xq = vec4(0.0);
+    ivec2 b;
+    if (!border_px(px, vec2(q), b))
+        return false;
+    vec4 pb = imageLoad(u_pos, b);
+    if (!(pb.w > 0.0))
+        return true;
+    return plane_point(vec2(q), pb.xyz, imageLoad(u_vnormal, b).xyz, xq);
+}
+
 // C twin: side_horizon (methods/gtao.c)
 float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float noise_step,
                         float min_s, int dir, float low, inout int taken)
@@ -37,10 +53,14 @@ float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float n
         float s = (float(st) + sn) / float(u_gtao_steps);
         s = s * s + min_s;
         ivec2 q = px + dir * ivec2(int(floor(s * omega.x + 0.5)), int(floor(s * omega.y + 0.5)));
-        if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
-            continue;
+        vec4 xq;
+        if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y) {
+            if (!gtao_border_step(px, q, xq))
+                continue;
+        } else {
+            xq = imageLoad(u_pos, q);
+        }
         taken++;
-        vec4 xq = imageLoad(u_pos, q);
         if (!(xq.w > 0.0))
             continue;
         vec3 d = xq.xyz - c;

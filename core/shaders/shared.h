@@ -25,6 +25,11 @@
  * nearly edge-on). */
 #define OBS_OWN_PLANE_NZ 0.05f
 
+/* A sample off the planes (border_cpu.c) is continued past the border
+ * only while its pixel coordinates are below this in magnitude (farther
+ * out it lies near the camera's plane, and an int would not hold it). */
+#define OBS_BORDER_MAX_PX 1.0e6f
+
 /* The sample sets of VAO++ 4.5: n = 2, 4, 8, 16, 32, one after the other
  * in one table of OBS_SAMPLE_TABLE_LEN (x, y) pairs (the set of n at pair
  * n - 2), the layout of the shader's single uniform array (4.1). */

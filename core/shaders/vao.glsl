@@ -31,6 +31,33 @@ float bleed_weight(vec3 x, vec3 p, vec3 n, float R)
     return max(0.0, cosv) * fall * fall;
 }
 
+// A sample off the planes (chain/border_cpu.c derives it): true and zs,
+// nz of the surface continued past the border (zs left as it is, open,
+// where that is background); false where the sample is left out of eq 1
+// (behind the camera, or no estimate).  C twin: border_sample in
+// vao_cpu.c.
+bool border_sample(ivec2 px, vec3 U, vec3 V, vec3 W, float sx, float sy, inout float zs,
+                   inout float nz)
+{
+    float sw = W.x * sx + W.y * sy + W.z;
+    if (!(sw > 0.0))
+        return false;
+    vec2 q = vec2(floor((U.x * sx + U.y * sy + U.z) / sw), floor((V.x * sx + V.y * sy + V.z) / sw));
+    ivec2 b;
+    if (!border_px(px, q, b))
+        return false;
+    vec4 pb = imageLoad(u_pos, b);
+    if (!(pb.w > 0.0))
+        return true;
+    vec3 nb = imageLoad(u_vnormal, b).xyz;
+    vec4 pt;
+    if (!plane_point(q, pb.xyz, nb, pt))
+        return false;
+    zs = pt.w;
+    nz = nb.z;
+    return true;
+}
+
 // The AO of the point p (xyz; w: planar depth) with normal n at pixel px
 // from the ns samples of the set at u_samples[ns - 2].  With bleed_step >
 // 0, bleed gets the colour-bleed term of section 4.7: the mean over every
@@ -76,6 +103,8 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
                     hit = true;
                 }
             }
+        } else {
+            seen = border_sample(px, U, V, W, sx, sy, zs, nz);
         }
         if (bleeds) {
             // "We use c(x) to linearly interpolate between the white color
@@ -97,9 +126,9 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             float sd = range_falloff(front - zs, nz, R, u_range_u, u_range_normal);
             dz = 2.0 * h * (1.0 - sd);
         }
-        // A sample off the planes (or behind the camera) is left out of
-        // eq 1's sum and of F alike: V comes from the part of the disk
-        // that is seen (C twin: the same comment).
+        // A sample off the planes reads the surface continued past the
+        // border; one behind the camera, or without that estimate, is left
+        // out of eq 1's sum and of F alike (C twin: the same comment).
         if (seen) {
             open += dz;
             F += R * l;         // eq 2: F = R * sum sqrt(1 - x^2 - y^2)

@@ -1,7 +1,9 @@
 // obscura preview page: follows a stream of frames (GET /v1/streams/NAME/events),
-// shows the newest as AO, composite or split view (colour | composite),
-// re-runs it with the parameters changed here (controls generated from
-// GET /v1/params), and runs a dropped EXR once.  Plain JavaScript, no build step.
+// shows the newest as AO, composite or split view (colour | composite; a deep
+// frame's AO is its front layer's), sets the controls (generated from
+// GET /v1/params) to the parameters the frame ran with (GET /v1/streams/NAME),
+// re-runs it with those changed here, and runs a dropped EXR once.  Plain
+// JavaScript, no build step.
 'use strict';
 
 const $ = (id) => document.getElementById(id);
@@ -11,7 +13,9 @@ const state = {
   view: 'composite',
   exposure: 0,
   defs: [],        // the parameter table
-  params: {},      // name -> value, only those changed from the default
+  controls: {},    // name -> {def, control, number}: the inputs of a parameter
+  asRun: {},       // name -> value the shown frame ran with (its query, else its camera)
+  params: {},      // name -> value, only those changed here from asRun (or the default)
   token: sessionStorage.getItem('obscura-token') || '',
   seq: 0,          // guards against answers arriving out of order
   urls: [],        // object URLs shown now
@@ -61,6 +65,7 @@ function tidy(def, v) {
 function buildParams(defs) {
   const form = $('params');
   form.textContent = '';
+  state.controls = {};
   for (const def of defs) {
     if (def.type === 'mat4') continue;
     const row = document.createElement('div');
@@ -110,36 +115,113 @@ function buildParams(defs) {
     const reset = document.createElement('button');
     reset.type = 'button';
     reset.textContent = '↺';
-    reset.title = 'default: ' + def.default;
     reset.addEventListener('click', () => {
-      if (number) { number.value = def.default; control.value = scaleOf(def).to(def.default); }
-      else control.value = String(def.default);
-      setParam(def, def.default);
+      delete state.params[def.name];
+      showControl(def.name);
+      scheduleShow();
     });
     row.appendChild(reset);
     form.appendChild(row);
+    state.controls[def.name] = { def, control, number, reset };
+    showControl(def.name);
   }
 }
 
+// The value a parameter ran with on the shown frame: its query's, else
+// (fov_y, near, far) its camera's, else the table's default.
+function asRunOf(def) {
+  return def.name in state.asRun ? state.asRun[def.name] : def.default;
+}
+
+// A control shows the value changed here, else the one the frame ran with.
+function showControl(name) {
+  const c = state.controls[name];
+  if (!c) return;
+  const v = name in state.params ? state.params[name] : asRunOf(c.def);
+  if (c.number) {
+    c.number.value = v;
+    c.control.value = scaleOf(c.def).to(Number(v));
+  } else {
+    c.control.value = String(v);
+  }
+  c.reset.title = 'as the frame ran: ' + asRunOf(c.def) + ' (default: ' + c.def.default + ')';
+  $('param-' + name).classList.toggle('changed', name in state.params);
+}
+
+// The frame's own parameters, from its entry in GET /v1/streams/NAME.
+// Values changed here stay changed unless the new frame ran with them.
+async function loadAsRun(f) {
+  let info = null;
+  try {
+    const st = await (await api('/v1/streams/' + encodeURIComponent(f.stream))).json();
+    info = (st.frame_info || []).find((i) => i.frame === f.frame) || null;
+  } catch (e) {
+    status(e.message, true);
+  }
+  if (state.frame !== f) return false; // a newer frame came meanwhile
+  const given = (info && info.params) || {}, cam = (info && info.camera) || {};
+  state.asRun = {};
+  for (const def of state.defs) {
+    if (def.type === 'mat4') continue;
+    const v = def.name in given ? given[def.name] : cam[def.name];
+    if (v === undefined) continue;
+    const num = Number(v);
+    state.asRun[def.name] = def.choices || Number.isNaN(num) ? String(v) : tidy(def, num);
+  }
+  for (const name of Object.keys(state.params)) {
+    const c = state.controls[name];
+    if (c && String(state.params[name]) === String(asRunOf(c.def))) delete state.params[name];
+  }
+  for (const name of Object.keys(state.controls)) showControl(name);
+  $('info-kind').textContent = f.deep ? 'deep (AO: the front layer\'s)' : 'flat';
+  return true;
+}
+
 let rerunTimer = 0;
-function setParam(def, value) {
-  if (String(value) === String(def.default)) delete state.params[def.name];
-  else state.params[def.name] = value;
-  $('param-' + def.name).classList.toggle('changed', def.name in state.params);
+function scheduleShow() {
   clearTimeout(rerunTimer);
   rerunTimer = setTimeout(show, 150);
 }
 
+// A value set here: a change when it differs from the frame's (a re-run
+// with it; the frame's other parameters are the daemon's to apply).
+function setParam(def, value) {
+  if (String(value) === String(asRunOf(def))) delete state.params[def.name];
+  else state.params[def.name] = value;
+  $('param-' + def.name).classList.toggle('changed', def.name in state.params);
+  scheduleShow();
+}
+
+function query(obj) {
+  return Object.entries(obj).map(([k, v]) => k + '=' + encodeURIComponent(v)).join('&');
+}
+
 function paramQuery() {
-  return Object.entries(state.params).map(([k, v]) => k + '=' + encodeURIComponent(v)).join('&');
+  return query(state.params);
+}
+
+// A dropped EXR is a new frame: it runs with what the controls show
+// (where that is not the default), not only with what was changed here.
+function shownQuery() {
+  const shown = {};
+  for (const [name, c] of Object.entries(state.controls)) {
+    const v = name in state.params ? state.params[name] : asRunOf(c.def);
+    if (String(v) !== String(c.def.default)) shown[name] = v;
+  }
+  return query(shown);
 }
 
 // ---- the image -------------------------------------------------------------
 
+// The AO image of the frame: a deep frame's front layer's (output=ao_front).
+function aoOutput() {
+  return state.frame && state.frame.deep ? 'ao_front' : 'ao';
+}
+
 function frameUrl(output, format) {
   const f = state.frame;
   let q = 'output=' + output + '&format=' + format;
-  if (format === 'png' && output !== 'ao') q += '&exposure=' + state.exposure;
+  if (format === 'png' && output !== 'ao' && output !== 'ao_front') q += '&exposure=' + state.exposure;
   if (format === 'exr') q += '&float=1';
   const pq = paramQuery();
   if (pq && output !== 'color') q += '&' + pq;
@@ -160,6 +242,7 @@ function ms(v) { return v === undefined ? '-' : v.toFixed(1) + ' ms'; }
 function showInfo(f, t) {
   $('info-frame').textContent = f ? f.frame + ' (' + f.stream + ')' : '-';
   $('info-size').textContent = f ? f.width + ' × ' + f.height : '-';
+  $('info-kind').textContent = f ? (f.deep ? 'deep (AO: the front layer\'s)' : 'flat') : '-';
   $('info-queue').textContent = ms(t.queue);
   $('info-decode').textContent = ms(t.decode);
   $('info-gl').textContent = ms(t.gl);
@@ -172,7 +255,7 @@ async function show() {
   if (!f) return;
   const seq = ++state.seq;
   const split = state.view === 'split';
-  const wanted = state.view === 'ao' ? ['ao'] : split ? [f.color ? 'color' : 'ao', 'composite'] : ['composite'];
+  const wanted = state.view === 'ao' ? [aoOutput()] : split ? [f.color ? 'color' : aoOutput(), 'composite'] : ['composite'];
   try {
     const resps = await Promise.all(wanted.map((o) => api(frameUrl(o, 'png'))));
     const blobs = await Promise.all(resps.map((r) => r.blob()));
@@ -209,7 +292,7 @@ window.addEventListener('resize', fit);
 
 function updateDownloads() {
   if (!state.frame) return;
-  const main = state.view === 'ao' ? 'ao' : 'composite';
+  const main = state.view === 'ao' ? aoOutput() : 'composite';
   $('dl-exr').href = frameUrl('both', 'exr');
   $('dl-exr').download = state.frame.stream + '.' + state.frame.frame + '.exr';
   $('dl-png').href = frameUrl(main, 'png');
@@ -320,8 +403,9 @@ function onEvent(text) {
     else if (line.startsWith('data:')) data += line.slice(5).trim();
   }
   if (type === 'frame') {
-    state.frame = JSON.parse(data);
-    show();
+    const f = JSON.parse(data);
+    state.frame = f;
+    loadAsRun(f).then((current) => { if (current) show(); });
   } else if (type === 'end') {
     status('stream ended: ' + JSON.parse(data).reason);
   }
@@ -332,7 +416,7 @@ function onEvent(text) {
 async function runDropped(file) {
   status('running ' + file.name + ' …');
   const name = 'drop';
-  const q = paramQuery();
+  const q = shownQuery();
   try {
     await api('/v1/streams/' + name + '/frames?output=composite&format=png' + (q ? '&' + q : ''), {
       method: 'POST', headers: { 'Content-Type': 'image/x-exr' }, body: file,
@@ -377,7 +461,7 @@ $('token').addEventListener('change', () => {
 });
 $('reset-all').addEventListener('click', () => {
   state.params = {};
-  buildParams(state.defs);
+  for (const name of Object.keys(state.controls)) showControl(name);
   show();
 });
 

@@ -211,7 +211,8 @@ typedef enum obs_bake_ivalues {
       "surrounding AO is resampled into its one scalar (section 2.2.1)")      \
     X(seed, INT, 1, 0, 2147483647, NULL,                                       \
       "random seed; the bake depends on it alone, not on the thread count")    \
-    X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core)")      \
+    X(threads, INT, 0, 0, 64, NULL, "ray-tracing threads (0: every core); "     \
+      "obscura's --threads N sets it, obscurad's --render-threads bounds it")    \
     X(max_triangles, INT, 100000000, 1, 2147483647, NULL,                      \
       "refuse a level with more triangles than this once instances are "      \
       "flattened")                                                             \

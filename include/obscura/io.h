@@ -401,6 +401,15 @@ void obs_camera_from_fov(float fov_y_deg, float aspect, float near_z,
  * (OBS_CAMERA_PARAMS with a projection, OBS_CAMERA_NONE without). */
 void obs_camera_from_request(obs_camera *cam, int has_world_to_camera, int has_projection);
 
+/* The camera a frame of gb runs with under p: the G-buffer's, its
+ * projection and world_to_camera overridden by the parameters' (fov_y,
+ * fov_x or focal_length with aperture; world_to_camera), as the chain
+ * resolves it.  An output takes its worldToCamera/worldToNDC from it, so
+ * that the camera given as parameters (HTTP's query, obscura ao
+ * --fov-y --world-to-camera) is written as a camera JSON's is.  1 with
+ * *out when it has a projection, else 0. */
+int obs_camera_of_run(const obs_gbuffer *gb, const obs_params *p, obs_camera *out);
+
 /* Fits a centred perspective projection to an image of width x height:
  * the vertical field of view stays, the horizontal one follows the aspect
  * (x scale = y scale * height / width).  Returns 1 when it changed the

@@ -111,6 +111,25 @@ typedef struct obs_limits {
 obs_status obs_check_size(const obs_limits *lim, int64_t width, int64_t height,
                           char err[OBS_ERR_LEN]);
 
+/* ---- threads ----------------------------------------------------------- */
+
+/* The process's thread limit (obscura --threads, obscurad --render-threads,
+ * OBSCURA_THREADS): every worker pool of the library (bake and reference
+ * ray tracing, EXR decode and the rest) runs at most n threads, and
+ * llvmpipe's rasterizer n: LP_NUM_THREADS is set to n unless the
+ * environment has it already (Mesa reads it when a context is created).
+ * It may set an environment variable: call it first, before contexts and
+ * threads.  n in [1, 64]; 0 lifts the limit. */
+obs_status obs_threads_set(int n, char err[OBS_ERR_LEN]);
+
+typedef struct obs_threads_info {
+    int limit;              /* obs_threads_set's n; 0: none */
+    int pool;               /* threads a worker pool starts: the limit, else the cores (at most 64) */
+    int llvmpipe;           /* LP_NUM_THREADS as llvmpipe reads it; -1: unset (one per core) */
+    int llvmpipe_from_user; /* 1: LP_NUM_THREADS came from the environment (kept over the limit) */
+} obs_threads_info;
+void obs_threads_get(obs_threads_info *out);
+
 /* ---- GL context -------------------------------------------------------- */
 
 typedef enum obs_backend {

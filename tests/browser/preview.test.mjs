@@ -6,7 +6,9 @@
 //
 // Loads the page, posts two frames to a stream and sees the image change
 // (pixels of a screenshot), moves a slider and sees the re-run request
-// carry the parameter, switches to the split view, drops an EXR on the page.
+// carry the parameter, switches to the split view, drops an EXR on the page;
+// the controls show each frame's own parameters; a deep frame shows its
+// front layer's AO and says it is deep.
 import { chromium } from 'playwright-core';
 import { readFileSync } from 'node:fs';
 import { inflateSync } from 'node:zlib';
@@ -14,6 +16,7 @@ import { inflateSync } from 'node:zlib';
 const BASE = process.env.OBSCURAD_URL;
 const CAM = process.env.CAM || '';
 const EXR = process.env.EXR || 'tests/data/room_small.exr';
+const DEEP = process.env.DEEP || 'tests/data/deep_small.exr';
 const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
 const TIMEOUT = 20000;
 
@@ -115,6 +118,11 @@ try {
   const m2 = pngMean(await page.locator('#img-base').screenshot());
   check(`the image updated to frame 2 (mean grey ${m1.mean.toFixed(1)} -> ${m2.mean.toFixed(1)}, ${m2.width}x${m2.height})`,
     Math.abs(m1.mean - m2.mean) > 15 && m2.width > 300);
+  check('the controls show frame 2\'s own parameters (radius 3, fov_y 50, near 0.05), not the table\'s defaults',
+    await page.locator('#param-radius input[type=number]').inputValue() === '3' &&
+    await page.locator('#param-fov_y input[type=number]').inputValue() === '50' &&
+    await page.locator('#param-near input[type=number]').inputValue() === '0.05' &&
+    !(await page.locator('#param-radius').getAttribute('class')).includes('changed'));
   check('frame counter, resolution and timings shown',
     (await page.locator('#info-frame').textContent()).startsWith('2') &&
     (await page.locator('#info-size').textContent()) === '320 × 240' &&
@@ -164,6 +172,20 @@ try {
     dp.status() === 200 && new URL(dp.url()).searchParams.get('fov_y') === '50');
   await shown(page, 1, 'drop');
   check('the dropped frame is shown (stream drop selected)', (await page.locator('#stream').inputValue()) === 'drop');
+
+  // a deep frame: its front layer's AO, said to be deep; the camera of its file in the controls
+  const front = page.waitForResponse((r) => /\/v1\/streams\/drop\/frames\/2\?output=ao_front&format=png/.test(r.url()),
+    { timeout: TIMEOUT });
+  resp = await fetch(`${BASE}/v1/streams/drop/frames?deep_layers=3`, {
+    method: 'POST', headers: { 'Content-Type': 'image/x-exr' }, body: readFileSync(DEEP),
+  });
+  await resp.arrayBuffer();
+  check('deep frame posted to stream drop: ' + resp.status, resp.status === 200);
+  const fr = await front;
+  await shown(page, 2, 'drop');
+  check(`deep frame shown: its front layer's AO (${fr.status()}), said to be deep, fov_y from its file (40)`,
+    fr.status() === 200 && (await page.locator('#info-kind').textContent()).startsWith('deep') &&
+    await page.locator('#param-fov_y input[type=number]').inputValue() === '40');
 
   const shot = await page.screenshot();
   if (process.env.SCREENSHOT) (await import('node:fs')).writeFileSync(process.env.SCREENSHOT, shot);

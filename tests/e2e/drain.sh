@@ -15,14 +15,16 @@ OBSCURA=${OBSCURA:-build/obscura}
 OBSCURAD=${OBSCURAD:-build/obscurad}
 . tests/e2e/lib/common.sh
 
-# trickle PORT SECONDS: a POST /v1/ao whose body comes a byte every 0.5 s
+# trickle PORT SECONDS FILE: a POST /v1/ao whose body comes a byte every
+# 0.5 s; FILE is made once its headers and first byte are sent
 trickle() {
-    python3 - "$1" "$2" <<'PY'
+    python3 - "$1" "$2" "$3" <<'PY'
 import socket, sys, time
 port, seconds = int(sys.argv[1]), float(sys.argv[2])
 s = socket.create_connection(("127.0.0.1", port), timeout=5)
 s.sendall(b"POST /v1/ao HTTP/1.1\r\nHost: x\r\nContent-Type: image/x-exr\r\n"
-          b"Content-Length: 100000\r\n\r\n")
+          b"Content-Length: 100000\r\n\r\nv")
+open(sys.argv[3], "w").close()
 end = time.time() + seconds
 try:
     while time.time() < end:
@@ -35,9 +37,13 @@ PY
 
 echo "e2e drain: $OBSCURAD"
 start D --drain-timeout 2 --timeout 30
-trickle "$PORT_D" 30 &
+trickle "$PORT_D" 30 "$T/sent" &
 CPIDS=$!
-sleep 1
+# the request is under way (a loaded machine may take seconds to start
+# python) before the signal
+i=0
+while [ ! -f "$T/sent" ] && [ $i -lt 200 ]; do sleep 0.1; i=$((i + 1)); done
+sleep 0.5
 t0=$(date +%s)
 kill -TERM "$PID_D"
 i=0

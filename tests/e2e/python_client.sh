@@ -3,8 +3,10 @@
 # obscurad on HTTP, a Unix socket and TCP: the same answer, byte for byte,
 # as `obscura ao` writes in process, over every transport and from a path,
 # bytes or a file object; the answer streamed into a file; errors as
-# ObscuraError with the daemon's JSON code; run with `python3 -I` (no site
-# packages, no PYTHONPATH), as in the Pythons of DCC applications.
+# ObscuraError with the daemon's JSON code; the daemon's warnings as
+# ObscuraWarning and Answer.warnings over every transport; Camera.from_json
+# and the header attributes of obscura ao --camera; run with `python3 -I`
+# (no site packages, no PYTHONPATH), as in the Pythons of DCC applications.
 #
 #   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/python_client.sh
 #
@@ -65,7 +67,7 @@ try:
             data = oc.ao(f, server=server, **cam)
     elif mode == "stream":
         data = oc.ao(src, server=server, out=out, **cam)
-        assert data is None
+        assert data == b"" and data.warnings == [], (data, data.warnings)
         data = open(out, "rb").read()
     elif mode == "png":
         data = oc.ao(src, server=server, format="png", png_bits=16, **cam)
@@ -178,6 +180,89 @@ open(sys.argv[4], "wb").write(oc.ao(sys.argv[2], server=sys.argv[3], fov_y=50, n
 else
     echo "  skip pip install: no python3 with pip, setuptools and wheel (Debian python3-pip, python3-wheel)"
 fi
+
+echo "-- warnings, the camera JSON, the CLI's header attributes"
+# ObscuraWarning by default (no filter set), Answer.warnings, ObscuraError.warnings;
+# Camera.from_json; the attribute names of an EXR's (single-part) header
+cat > "$T/warn.py" <<'PYEOF'
+import os, struct, sys
+sys.path.insert(0, os.path.join(os.getcwd(), "clients", "python"))
+import obscura_client as oc
+
+def attrs(data):
+    names, i = [], 8
+    while data[i] != 0:
+        name = data[i:data.index(b"\0", i)]
+        i = data.index(b"\0", i + len(name) + 1) + 1
+        (size,) = struct.unpack("<i", data[i:i + 4])
+        i += 4 + size
+        names.append(name.decode())
+    return names
+
+mode, server, src, cam_json, out = sys.argv[1:6]
+if mode == "warn":
+    a = oc.ao(src, server=server, camera=oc.Camera.from_json(cam_json), depth_mode="ndc")
+    print("answer %s %d bytes, %d warnings: %s" % (type(a).__name__, len(a), len(a.warnings), " | ".join(a.warnings)))
+elif mode == "clean":
+    a = oc.ao(src, server=server, camera=oc.Camera.from_json(cam_json), out=out)
+    print("clean %r %r" % (bytes(a), a.warnings))
+elif mode == "error":
+    try:
+        oc.ao(src, server=server, camera=oc.Camera.from_json(cam_json), depth="NoSuchChannel")
+    except oc.ObscuraError as e:
+        print("error %s warnings %r" % (e.code, e.warnings))
+elif mode == "asdict":
+    import json
+    a = oc.ao(src, server=server, camera=oc.Camera.from_json(json.load(open(cam_json))))
+    b = oc.ao(src, server=server, camera=oc.Camera.from_json(cam_json))
+    print("dict and path: %s" % ("same" if a == b else "differ"))
+elif mode == "attrs":
+    open(out, "wb").write(oc.ao(src, server=server, camera=oc.Camera.from_json(cam_json)))
+    print(" ".join(sorted(attrs(open(out, "rb").read()))))
+elif mode == "cliattrs":
+    print(" ".join(sorted(attrs(open(src, "rb").read()))))
+elif mode == "badjson":
+    for bad in ({}, {"world_to_camera": [[1, 0, 0, 0]] * 4}, {"world_to_camera": [1] * 15, "fov_y_deg": 50}):
+        try:
+            oc.Camera.from_json(bad)
+        except ValueError as e:
+            print("ValueError: %s" % e)
+PYEOF
+pw() { python3 -I -B "$T/warn.py" "$@"; }
+RCAM="$DATA/room_small.camera.json"
+for url in "http://127.0.0.1:$HP" "unix:$SOCK" "tcp://127.0.0.1:$TP"; do
+    pw warn "$url" "$R" "$RCAM" - >"$T/out" 2>"$T/err"
+    check "${url%%:*} depth_mode=ndc: Answer.warnings name the cause and the flag ($(head -c 90 "$T/out"))" \
+        "grep -q '^answer Answer [0-9]* bytes, 2 warnings: depth values up to .* impossible under --depth-mode ndc.*give --depth-mode planar' '$T/out'"
+    check "${url%%:*}: each warning an ObscuraWarning on stderr by default, at the script's line" \
+        "[ \$(grep -c 'warn.py:[0-9]*: ObscuraWarning: ' '$T/err') -eq 2 ] && grep -q 'ObscuraWarning: no pixel is occluded' '$T/err'"
+    pw clean "$url" "$R" "$RCAM" "$T/clean.exr" >"$T/out" 2>"$T/err"
+    check "${url%%:*} the right camera: no warning; out= gives b'' and [] ($(cat "$T/out"))" \
+        "grep -qx \"clean b'' \\[\\]\" '$T/out' && [ ! -s '$T/err' ]"
+done
+pw error "http://127.0.0.1:$HP" "$R" "$RCAM" - >"$T/out" 2>&1
+check "ObscuraError.warnings: a list ($(cat "$T/out"))" "grep -qx 'error missing_channel warnings \[\]' '$T/out'"
+pw asdict "tcp://127.0.0.1:$TP" "$R" "$RCAM" - >"$T/out" 2>&1
+check "Camera.from_json of a dict: the answer of the path's" "grep -qx 'dict and path: same' '$T/out'"
+pw badjson - - - - >"$T/out" 2>&1
+check "Camera.from_json refuses a camera without world_to_camera, without projection, of 15 numbers, naming it" \
+    "grep -q 'world_to_camera: missing' '$T/out' && grep -q 'projection: missing' '$T/out' &&
+     grep -q 'world_to_camera: expected 4 rows of 4 numbers' '$T/out'"
+# the answer to a camera sent as query parameters carries the header
+# attributes obscura ao --camera writes (worldToCamera, worldToNDC);
+# obscura/params beside them names the parameters the daemon was sent
+"$OBSCURA" ao "$R" --camera "$RCAM" -o "$T/cli_cam.exr" -q 2>/dev/null
+pw cliattrs - "$T/cli_cam.exr" - - | tr ' ' '\n' | grep -vx 'obscura/params' >"$T/cli_attrs"
+for url in "http://127.0.0.1:$HP" "unix:$SOCK"; do
+    pw attrs "$url" "$R" "$RCAM" "$T/py_cam.exr" | tr ' ' '\n' | grep -vx 'obscura/params' >"$T/py_attrs"
+    check "${url%%:*} Camera.from_json: the header attributes of obscura ao --camera, worldToCamera and worldToNDC among them" \
+        "cmp -s '$T/cli_attrs' '$T/py_attrs' && grep -qx worldToNDC '$T/py_attrs' && grep -qx worldToCamera '$T/py_attrs'"
+    check "${url%%:*} Camera.from_json: the pixels of obscura ao --camera" \
+        "\"$OBSCURA\" compare '$T/cli_cam.exr' '$T/py_cam.exr' --channel-a AO.Y --channel-b AO.Y --mask none --json | grep -q '\"mae\": 0'"
+done
+pw cliattrs - "$T/cli.exr" - - >"$T/out"
+check "obscura ao --fov-y --world-to-camera (the answers above, byte for byte) writes worldToCamera and worldToNDC" \
+    "grep -q worldToCamera '$T/out' && grep -q worldToNDC '$T/out'"
 
 kill "$PID_d" 2>/dev/null
 wait "$PID_d" 2>/dev/null

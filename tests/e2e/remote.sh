@@ -69,6 +69,31 @@ done
 "$OBSCURA" ao "$R" $CAM_CLI --output composite -o "$T/rc.png" --server "unix:$SOCK" -q 2>/dev/null
 check "PNG composite over unix: same bytes as in-process" "cmp -s '$T/lc.png' '$T/rc.png'"
 
+echo "-- warnings: the daemon's, printed as in process"
+# yard_small under --method angle: the result's check (AO above 0.99);
+# room_small under depth_mode ndc: the input's (checked here, not said
+# twice) and the result's
+Y="$DATA/yard_small.exr"
+"$OBSCURA" ao "$Y" --camera "$DATA/yard_small.camera.json" --method angle -o "$T/wl.exr" -q 2>"$T/wl.err"
+"$OBSCURA" ao "$R" $CAM_CLI --depth-mode ndc -o "$T/wl.exr" -q 2>"$T/wn.err"
+"$OBSCURA" ao "$Y" --camera "$DATA/yard_small.camera.json" --method angle -o "$T/ws.exr" --strict -q 2>"$T/ws.err"
+rcs=$?
+for url in "http://127.0.0.1:$HP" "unix:$SOCK" "tcp://127.0.0.1:$TP"; do
+    tag=${url%%:*}
+    "$OBSCURA" ao "$Y" --camera "$DATA/yard_small.camera.json" --method angle -o "$T/wr.exr" --server "$url" -q 2>"$T/wr.err"
+    check "$tag: the result's warning, the in-process lines ($(grep -c 'obscura: warning:' "$T/wr.err") of $(grep -c 'obscura: warning:' "$T/wl.err"))" \
+        "grep -q 'obscura: warning: .*AO is above 0.99' '$T/wr.err' && cmp -s '$T/wl.err' '$T/wr.err'"
+    # shellcheck disable=SC2086
+    "$OBSCURA" ao "$R" $CAM_CLI --depth-mode ndc -o "$T/wr.exr" --server "$url" -q 2>"$T/wr.err"
+    check "$tag: depth_mode ndc: the input's warning once, the result's after it, as in process" \
+        "[ \$(grep -c 'obscura: warning:' '$T/wr.err') -eq 2 ] && cmp -s '$T/wn.err' '$T/wr.err'"
+    rm -f "$T/wsr.exr"
+    "$OBSCURA" ao "$Y" --camera "$DATA/yard_small.camera.json" --method angle -o "$T/wsr.exr" --server "$url" --strict -q 2>"$T/wr.err"
+    rc=$?
+    check "$tag --strict: the result's warning is an error, exit $rc ($rcs in process), nothing written" \
+        "[ $rc -eq 3 ] && [ $rcs -eq 3 ] && [ ! -e '$T/wsr.exr' ] && cmp -s '$T/ws.err' '$T/wr.err'"
+done
+
 echo "-- exit codes"
 "$OBSCURA" ao "$R" -o "$T/x.exr" --server "unix:$SOCK" --solve-camera=0 -q 2>"$T/err"
 check "no camera (--solve-camera=0 sent along): the server's 422 is exit 3, message shown" "[ $? -eq 3 ] && grep -q 'no_camera' '$T/err'"

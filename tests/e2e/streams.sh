@@ -5,6 +5,9 @@
 # announced to Server-Sent Events subscribers; bad requests get JSON
 # errors; an open event stream does not hold up the SIGTERM drain; the
 # preview page is served.  `obscura ao --stream` posts to a stream.
+# Deep frames are kept and viewed like flat ones (the front layer's AO,
+# output=ao_front); each frame's JSON carries its parameters and camera;
+# a failed stream post still writes the CLI's result.
 #
 #   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/streams.sh
 set -u
@@ -48,12 +51,45 @@ wait_for "$T/S.log" "events status=200" || true
 code=$(spost $S shot "$CAM" "$T/f1.exr")
 check "POST /v1/streams/shot/frames: 200, X-Obscura-Frame 1, Server-Timing" "[ $code = 200 ] && grep -qi '^X-Obscura-Frame: 1' $T/f1.exr.h && grep -qi '^Server-Timing: queue' $T/f1.exr.h"
 check "its answer = POST /v1/ao's (same EXR bytes as in-process)" "cmp -s $T/f1.exr $T/local.exr"
-check "subscriber told: event frame 1 with size and timings" "wait_for $T/sse 'event: frame' && grep -q '\"frame\":1,\"width\":320,\"height\":240,\"color\":true,\"timings\":{\"queue\"' $T/sse"
+check "subscriber told: event frame 1 with size, flat, timings" "wait_for $T/sse 'event: frame' && grep -q '\"frame\":1,\"width\":320,\"height\":240,\"color\":true,\"deep\":false,\"timings\":{\"queue\"' $T/sse"
 code=$(spost $S shot "$CAM&radius=1.5&output=composite&format=png" "$T/f2.png")
 check "second frame as composite PNG: 200, frame 2" "[ $code = 200 ] && grep -qi '^X-Obscura-Frame: 2' $T/f2.png.h && grep -qi 'image/png' $T/f2.png.h"
 check "subscriber told: frame 2" "wait_for $T/sse '\"frame\":2'"
 check "GET /v1/streams lists shot with frames 1, 2" "[ \$(get $S /v1/streams $T/g) = 200 ] && tr -d ' \t\n' < $T/g | grep -q '\"name\":\"shot\",\"frames\":\[1,2\],\"latest\":2'"
 check "GET /v1/streams/shot: frames with params and timings" "[ \$(get $S /v1/streams/shot $T/g) = 200 ] && grep -q '\"radius\":.*\"1.5\"' $T/g && grep -q '\"gl\"' $T/g"
+# the page's controls show these: each frame's own query (snake_case
+# names) and the camera it ran with, not the table's defaults
+tr -d ' \t\n' < "$T/g" > "$T/gj"
+check "frame 1's JSON: flat, params fov_y 50 near 0.05 far 100 (radius absent)" "grep -q '\"frame\":1,[^}]*\"deep\":false' $T/gj && grep -q '\"params\":{\"fov_y\":\"50\",\"near\":\"0.05\",\"far\":\"100\",\"world_to_camera\":\"[^\"]*\"}}' $T/gj"
+code=$($CURL -o "$T/fy.exr" -w '%{http_code}' -H 'Content-Type: image/x-exr' --data-binary @"$R" \
+    "http://127.0.0.1:$S/v1/streams/fy/frames?fov-y=40&fov-y=45&samples=4")
+check "params keyed by the table's names, the last given wins (fov-y=40&fov-y=45: fov_y 45)" "[ $code = 200 ] && [ \$(get $S /v1/streams/fy $T/g) = 200 ] && tr -d ' \t\n' < $T/g | grep -q '\"params\":{\"fov_y\":\"45\",\"samples\":\"4\"}'"
+
+echo "-- deep frames"
+DP=$DATA/deep_small.exr
+$CURL -N "http://127.0.0.1:$S/v1/streams/fy/events" > "$T/dsse" 2>/dev/null &
+CPIDS="$CPIDS $!"
+wait_for "$T/S.log" "fy/events status=200" || true
+code=$($CURL -o "$T/d1.exr" -D "$T/d1.exr.h" -w '%{http_code}' -H 'Content-Type: image/x-exr' --data-binary @"$DP" \
+    "http://127.0.0.1:$S/v1/streams/fy/frames?deep_layers=3")
+post $S "deep_layers=3" "$DP" "$T/dao.exr" >/dev/null
+check "a deep EXR posted to a stream: 200, frame 2, kept" "[ $code = 200 ] && grep -qi '^X-Obscura-Frame: 2' $T/d1.exr.h && [ \$(get $S /v1/streams/fy/frames/2?format=exr $T/dk.exr) = 200 ]"
+check "its answer and its kept EXR = POST /v1/ao's for the same deep body (AO.Y, AOFront.Y, R,G,B,A)" "cmp -s $T/d1.exr $T/dao.exr && cmp -s $T/dk.exr $T/dao.exr"
+check "subscriber told: the frame is deep" "wait_for $T/dsse '\"frame\":2,' && grep -q '\"frame\":2,\"width\":48,\"height\":32,\"color\":false,\"deep\":true' $T/dsse"
+check "GET /v1/streams/fy: frame 2 deep, its params, the camera of its file (fov_y 40, near 0.1)" "[ \$(get $S /v1/streams/fy $T/g) = 200 ] && tr -d ' \t\n' < $T/g | grep -q '\"frame\":2,[^}]*\"deep\":true,.*\"params\":{\"deep_layers\":\"3\"},\"camera\":{\"fov_y\":40,\"near\":0.1,'"
+"$OBSCURA" ao "$DP" --deep-layers 3 -o "$T/dl.png" -q 2>/dev/null
+code=$(get $S "/v1/streams/fy/frames/2?output=ao_front&format=png" "$T/df.png")
+check "output=ao_front: the front layer's AO (= obscura ao's .front.png)" "[ $code = 200 ] && cmp -s $T/df.png $T/dl.front.png"
+code=$(get $S "/v1/streams/fy/frames/2?output=composite&format=png&exposure=1" "$T/dc.png")
+check "output=composite with exposure: 200 PNG" "[ $code = 200 ] && grep -qi 'image/png' $T/dc.png.h"
+code=$(get $S "/v1/streams/fy/frames/2?output=color&format=png" "$T/g")
+check "output=color on a deep frame: 404 no_color, says it is deep" "[ $code = 404 ] && error_is $T/g no_color && grep -q 'deep frame has no flat colour' $T/g"
+"$OBSCURA" ao "$DP" --deep-layers 3 --radius 2 -o "$T/dl2.exr" -q 2>/dev/null
+code=$(get $S "/v1/streams/fy/frames/2?radius=2&format=exr" "$T/dr.exr")
+code2=$(get $S "/v1/streams/fy/frames/2?radius=2&output=ao_front&format=png" "$T/drf.png")
+check "a re-run of the deep frame (radius 2) = in-process; its front AO too" "[ $code = 200 ] && [ $code2 = 200 ] && cmp -s $T/dr.exr $T/dl2.exr && ! cmp -s $T/drf.png $T/df.png"
+code=$(get $S "/v1/streams/fy/frames/1?output=ao_front&format=png" "$T/g")
+check "output=ao_front on a flat frame: 400 not_deep" "[ $code = 400 ] && error_is $T/g not_deep"
 
 echo "-- kept frames"
 code=$(get $S "/v1/streams/shot/frames/1?format=exr" "$T/k1.exr")
@@ -104,6 +140,9 @@ check "obscura ao --stream cli --server: exit $rc, same file, frame kept" "[ $rc
 check "--stream without --server: exit 2" "[ $? -eq 2 ]"
 "$OBSCURA" ao "$R" --fov-y 50 -o "$T/x.exr" -q --stream 'b@d' --server "http://127.0.0.1:$S" 2>"$T/err"
 check "--stream with a bad name: exit 2" "[ $? -eq 2 ]"
+"$OBSCURA" ao "$DP" --deep-layers 3 -o "$T/cd.exr" -q --stream cli --server "http://127.0.0.1:$S" 2>"$T/err"
+rc=$?
+check "obscura ao DEEP --stream cli: exit $rc (0), = in-process, kept as deep frame 2" "[ $rc -eq 0 ] && cmp -s $T/cd.exr $T/dao.exr && [ \$(get $S /v1/streams/cli $T/g) = 200 ] && tr -d ' \t\n' < $T/g | grep -q '\"frame\":2,[^}]*\"deep\":true'"
 
 echo "-- SIGTERM with event streams open"
 $CURL -N "http://127.0.0.1:$S/v1/streams/c/events" > "$T/sse2" 2>/dev/null &
@@ -122,6 +161,10 @@ check "exit $rc (0) within 10 s; subscribers told 'shutting down'" "[ $rc -eq 0 
 echo "-- streams off"
 start Z --streams 0
 check "--streams 0: 404 streams_off" "[ \$(get $PORT_Z /v1/streams $T/g) = 404 ] && error_is $T/g streams_off"
+"$OBSCURA" ao "$R" --fov-y 50 --near 0.05 --far 100 --world-to-camera "$W2C" -o "$T/off.exr" -q \
+    --stream cli --server "http://127.0.0.1:$PORT_Z" 2>"$T/err"
+rc=$?
+check "--stream to a daemon with streams off: exit $rc (0), the output written (= in-process), a warning says the post failed" "[ $rc -eq 0 ] && cmp -s $T/off.exr $T/local.exr && grep -q '^obscura: warning: --stream cli: the stream post failed (HTTP 404: streams are off' $T/err"
 [ $failed -ne 0 ] && tail -5 "$T/S.log" | sed 's/^/       /'
 echo "e2e streams: $pass passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -3,6 +3,9 @@
  * command's own options and the table's rows, in both tables. */
 #include "testutil.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include "bake_common.h"
 #include "obscura/dynamic.h"
 
@@ -81,12 +84,70 @@ static void test_progress_pace(void **state)
     assert_int_equal(cli_progress_due(&p, 2, 10, &t), 1);
 }
 
+/* The usage error of an unknown option, read from a child's stderr. */
+static int unknown_message(const cli_bake_cmd *cmd, char *word, char *out, size_t len)
+{
+    int fd[2], status = 0;
+    assert_int_equal(pipe(fd), 0);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        dup2(fd[1], 2);
+        char *argv[] = {"level.glb", word, "1"};
+        cli_bake_args a;
+        cli_bake_parse(cmd, 3, argv, &a);
+        _exit(0); /* not reached: the word is unknown */
+    }
+    close(fd[1]);
+    size_t got = 0;
+    ssize_t n;
+    while (got < len - 1 && (n = read(fd[0], out + got, len - 1 - got)) > 0)
+        got += (size_t)n; /* stderr is unbuffered: the message comes in pieces */
+    out[got] = '\0';
+    close(fd[0]);
+    waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/* "did you mean" on a near miss, as obscura ao says it: a table row, a
+ * command's own option, a shared one; nothing for a word far from all. */
+static void test_did_you_mean(void **state)
+{
+    (void)state;
+    obs_bake_params params = {0};
+    obs_dyn_params dparams = {0};
+    const char *ply = NULL, *regions = NULL;
+    int color = 0;
+    static const char *const flags[] = {"color", NULL};
+    const cli_bake_str strs[] = {{"ply", &ply}, {NULL, NULL}};
+    const cli_bake_str dstrs[] = {{"regions", &regions}, {NULL, NULL}};
+    const cli_bake_cmd bake = {.name = "bake", .out_hint = "OUT.glb", .table = &cli_bake_table,
+                               .params = &params, .flags = flags, .flag_vals = &color, .strs = strs};
+    const cli_bake_cmd dyn = {.name = "bake-dynamic", .out_hint = "MODEL.json", .table = &cli_dyn_table,
+                              .params = &dparams, .strs = dstrs};
+    char msg[1024];
+    assert_int_equal(unknown_message(&bake, "--rayz", msg, sizeof msg), 2);
+    assert_non_null(strstr(msg, "unknown option '--rayz'; did you mean --rays?"));
+    assert_int_equal(unknown_message(&bake, "--distance-shrt", msg, sizeof msg), 2);
+    assert_non_null(strstr(msg, "did you mean --distance-short?"));
+    assert_int_equal(unknown_message(&bake, "--colr", msg, sizeof msg), 2);
+    assert_non_null(strstr(msg, "did you mean --color?"));
+    assert_int_equal(unknown_message(&dyn, "--regoins", msg, sizeof msg), 2);
+    assert_non_null(strstr(msg, "bake-dynamic: unknown option '--regoins'; did you mean --regions?"));
+    assert_int_equal(unknown_message(&dyn, "--decortors", msg, sizeof msg), 2);
+    assert_non_null(strstr(msg, "did you mean --decorators?"));
+    assert_int_equal(unknown_message(&bake, "--zzzzzz", msg, sizeof msg), 2);
+    assert_null(strstr(msg, "did you mean"));
+    assert_non_null(strstr(msg, "'obscura bake --params' lists the parameters"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bake_flags),
         cmocka_unit_test(test_dyn_flags),
         cmocka_unit_test(test_progress_pace),
+        cmocka_unit_test(test_did_you_mean),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

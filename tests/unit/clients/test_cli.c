@@ -1,11 +1,13 @@
 /* What the CLI's commands share (clients/cli.c): control bytes escaped
- * in messages, the edit distance of "did you mean", and the
- * "Progress: N%" lines a farm's parser reads. */
+ * in messages, the edit distance of "did you mean", the
+ * "Progress: N%" lines a farm's parser reads, and --threads taken out of
+ * a command's argv. */
 #include "testutil.h"
 
 #include <unistd.h>
 
 #include "cli.h"
+#include "obscura/obscura.h"
 
 static void test_escape(void **state)
 {
@@ -60,12 +62,38 @@ static void test_progress_percent(void **state)
     remove(path);
 }
 
+/* --threads N is taken out of argv wherever it stands (either spelling)
+ * and becomes the process's limit; a command without it keeps its argv. */
+static void test_take_threads(void **state)
+{
+    (void)state;
+    char a0[] = "in.exr", a1[] = "--threads", a2[] = "2", a3[] = "-o", a4[] = "out.exr", a5[] = "--threads=3";
+    char *argv[] = {a0, a1, a2, a3, a4, a5};
+    unsetenv("OBSCURA_THREADS");
+    int n = cli_take_threads("ao", 6, argv);
+    assert_int_equal(n, 3);
+    assert_string_equal(argv[0], "in.exr");
+    assert_string_equal(argv[1], "-o");
+    assert_string_equal(argv[2], "out.exr");
+    obs_threads_info ti;
+    obs_threads_get(&ti);
+    assert_int_equal(ti.limit, 3); /* the last one given */
+    char *plain[] = {a0, a3, a4};
+    setenv("OBSCURA_THREADS", "1", 1);
+    assert_int_equal(cli_take_threads("ao", 3, plain), 3);
+    obs_threads_get(&ti);
+    assert_int_equal(ti.limit, 1); /* the environment's, when no flag */
+    unsetenv("OBSCURA_THREADS");
+    assert_true(cli_process_threads() >= 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_escape),
         cmocka_unit_test(test_edit_distance),
         cmocka_unit_test(test_progress_percent),
+        cmocka_unit_test(test_take_threads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -270,6 +270,27 @@ static void test_other_words(void **state)
     assert_string_equal(err, "option --png-bits needs a value");
 }
 
+/* The "did you mean" of an unknown option (obscura ao, the bakes): the
+ * nearest name within two edits, '_' read as '-', "-" before one letter. */
+static void test_suggest(void **state)
+{
+    (void)state;
+    cli_suggest s;
+    cli_suggest_start(&s, "--radiu=3");
+    cli_suggest_try(&s, "rays");
+    cli_suggest_try(&s, "radius");
+    assert_string_equal(s.best, "--radius");
+    cli_suggest_start(&s, "--png_bts");
+    cli_suggest_try(&s, "png_bits");
+    assert_string_equal(s.best, "--png-bits");
+    cli_suggest_start(&s, "--qq");
+    cli_suggest_try(&s, "q");
+    assert_string_equal(s.best, "-q");
+    cli_suggest_start(&s, "--zzzzzz");
+    cli_suggest_try(&s, "radius");
+    assert_string_equal(s.best, "");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -277,6 +298,7 @@ int main(void)
         cmocka_unit_test(test_switches),
         cmocka_unit_test(test_every_row_sets_something),
         cmocka_unit_test(test_other_words),
+        cmocka_unit_test(test_suggest),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

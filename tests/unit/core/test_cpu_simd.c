@@ -134,7 +134,7 @@ static void test_vao_bit_for_bit(void **state)
                     if (!(pos[4 * i + 3] > 0.0f))
                         continue;
                     float bleed[3];
-                    float a = obs__vao_estimate_dnz(f, pos, dnz, NULL, x, y, pos + 4 * i,
+                    float a = obs__vao_estimate_dnz(f, pos, nrm, dnz, NULL, x, y, pos + 4 * i,
                                                     nrm + 3 * i, ns, xy, bleed);
                     float b = obs__vao_estimate(f, pos, nrm, x, y, pos + 4 * i, nrm + 3 * i, ns,
                                                 xy);

@@ -467,7 +467,7 @@ static void test_gtao_open_plane(void **state)
                     expect += slice_value(L, g, g - M_PI / 2, g + M_PI / 2) / gs->slices;
                 }
                 size_t i = (size_t)y * W + x;
-                float ao = obs__gtao_pixel(&f, pos, x, y, pos + 4 * i, nrm + 3 * i, NULL);
+                float ao = obs__gtao_pixel(&f, pos, nrm, x, y, pos + 4 * i, nrm + 3 * i, NULL);
                 worst = fmax(worst, fabs(ao - fmin(expect, 1.0)));
                 worst1 = fmax(worst1, fabs(ao - 1.0));
             }
@@ -567,7 +567,7 @@ static void test_gtao_crease(void **state)
                 expect += slice_value(L, g, h[1], h[0]) / gs->slices;
             }
             int count;
-            float ao = obs__gtao_pixel(&f, pos, x, y, pt, nB, &count);
+            float ao = obs__gtao_pixel(&f, pos, nrm, x, y, pt, nB, &count);
             print_message("gtao crease, tile %d: AO %.6f, derived %.6f\n", k, ao, expect);
             assert_float_equal(ao, (float)expect, 1e-5f);
             assert_int_equal(count, 2 * gs->slices);
@@ -582,7 +582,7 @@ static void test_gtao_crease(void **state)
         float *pos, *nrm;
         setup(s, &p, &f, &pos, &nrm);
         const float *pt = pos + 4 * (CY * W + CX);
-        float ao = obs__gtao_pixel(&f, pos, CX, CY, pt, nB, NULL);
+        float ao = obs__gtao_pixel(&f, pos, nrm, CX, CY, pt, nB, NULL);
         print_message("gtao crease, 32 slices x 8 steps: AO %.4f (1/2)\n", ao);
         assert_true(ao > 0.45f && ao < 0.505f);
         free(pos);

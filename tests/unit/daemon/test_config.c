@@ -151,12 +151,32 @@ static void test_help(void **state)
     free(text);
 }
 
+/* --render-threads bounds the work's threads (obscura's --threads);
+ * --threads keeps its meaning, the HTTP pool. */
+static void test_render_threads(void **state)
+{
+    (void)state;
+    obsd_config c;
+    char err[OBS_ERR_LEN];
+    int help;
+    obsd_config_defaults(&c);
+    assert_int_equal(c.render_threads, 0); /* OBSCURA_THREADS, else every core */
+    assert_int_equal(c.threads, 4);
+    char *argv[] = {"obscurad", "--render-threads", "2", "--threads=8", NULL};
+    assert_int_equal(obsd_config_args(&c, 4, argv, &help, err), OBS_OK);
+    assert_int_equal(c.render_threads, 2);
+    assert_int_equal(c.threads, 8);
+    assert_int_equal(obsd_config_set(&c, "render_threads", "65", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "render_threads"));
+    assert_int_equal(obsd_config_set(&c, "render-threads", "abc", err), OBS_INVALID_ARGUMENT);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_defaults), cmocka_unit_test(test_set),
         cmocka_unit_test(test_errors),   cmocka_unit_test(test_file_and_flags),
-        cmocka_unit_test(test_help),
+        cmocka_unit_test(test_help),     cmocka_unit_test(test_render_threads),
     };
     return cmocka_run_group_tests_name("daemon_config", tests, NULL, NULL);
 }

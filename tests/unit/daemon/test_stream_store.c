@@ -1,6 +1,8 @@
 /* The stream store of the preview page (daemon/stream_store.c): bounded
  * frames and streams, references outliving a drop, subscribers parked,
- * woken and told the end. */
+ * woken and told the end; the JSON of deep frames, params and cameras. */
+#include <math.h>
+
 #include "testutil.h"
 
 #include "stream_store.h"
@@ -169,6 +171,57 @@ static void test_names_and_json(void **state)
     obsd_streams_free(s);
 }
 
+/* A deep frame's JSON and event say so; the params are keyed by the
+ * table's names; the camera is the projection's fov_y, near and far. */
+static void test_deep_params_camera(void **state)
+{
+    (void)state;
+    obsd_streams *s = obsd_streams_new(4, 4, 1 << 30);
+    obsd_frame *f = frame(4, 2, 1);
+    size_t flat_bytes = obsd_frame_bytes(f);
+    f->deep = 1;
+    f->ao_front = (obs_image){4, 2, 1, calloc(8, sizeof(float))};
+    assert_int_equal(obsd_frame_bytes(f), flat_bytes + 8 * sizeof(float)); /* the front AO counts */
+    static const char q[] = "fov-y\0" "40\0" "fov_y\0" "45\0" "deep_layers\0" "3\0";
+    f->query = malloc(sizeof q);
+    memcpy(f->query, q, sizeof q);
+    f->query_len = sizeof q - 1;
+    /* OpenGL perspective, fov_y 50, near 0.05, far 100 (row-major) */
+    const double t = 1.0 / tan(25.0 * M_PI / 180.0), n = 0.05, fa = 100.0;
+    float *p = f->camera.projection;
+    p[0] = (float)t; /* aspect 1 */
+    p[5] = (float)t;
+    p[10] = (float)(-(fa + n) / (fa - n));
+    p[11] = (float)(-2.0 * fa * n / (fa - n));
+    p[14] = -1.0f;
+    f->camera.has_projection = 1;
+    obsd_sub sub = {.park = on_park, .wake = on_wake};
+    assert_int_equal(obsd_streams_subscribe(s, "d", &sub, 0), 0);
+    obsd_streams_add(s, "d", f);
+    char buf[512];
+    assert_true(obsd_streams_next_event(s, &sub, buf, sizeof buf, 0) > 0);
+    assert_non_null(strstr(buf, "\"color\":false,\"deep\":true,"));
+    int found;
+    char *one = obsd_streams_stream_json(s, "d", &found);
+    assert_non_null(strstr(one, "\"deep\":\ttrue"));
+    assert_non_null(strstr(one, "\"fov_y\":\t\"45\"")); /* fov-y and fov_y are one; the last wins */
+    assert_null(strstr(one, "fov-y"));
+    assert_null(strstr(one, "\"40\""));
+    assert_non_null(strstr(one, "\"camera\":\t{\n\t\t\t\t\"fov_y\":\t50,\n\t\t\t\t\"near\":\t0.05,"));
+    free(one);
+    /* orthographic (P[14] 0): no camera to show */
+    obsd_frame *o = frame(4, 2, 1);
+    o->camera.has_projection = 1;
+    o->camera.projection[0] = o->camera.projection[5] = o->camera.projection[15] = 1.0f;
+    obsd_streams_add(s, "o", o);
+    one = obsd_streams_stream_json(s, "o", &found);
+    assert_null(strstr(one, "camera"));
+    assert_non_null(strstr(one, "\"deep\":\tfalse"));
+    free(one);
+    obsd_streams_unsubscribe(s, &sub);
+    obsd_streams_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -177,6 +230,7 @@ int main(void)
         cmocka_unit_test(test_streams_bounded_and_refs),
         cmocka_unit_test(test_events),
         cmocka_unit_test(test_names_and_json),
+        cmocka_unit_test(test_deep_params_camera),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -195,6 +195,52 @@ static void test_response_round_trip(void **state)
     obs_bytes_free(&f);
 }
 
+/* A 200's warnings in the message field, one a line: decoded as a list;
+ * a line break inside one sent as a space; empty ones skipped; whole
+ * warnings only up to the message's limit; a version-1 answer (message
+ * "") has none, and an error's message is not split. */
+static void test_response_warnings(void **state)
+{
+    (void)state;
+    static char big[3000];
+    memset(big, 'x', sizeof big - 1);
+    const char *said[] = {"depth values above 1 are impossible under --depth-mode ndc", "",
+                          "two\nlines", big, big};
+    unsigned char exr[4] = {1, 2, 3, 4};
+    obs_bin_response_desc d = {.id = 5, .status = 200, .code = "ok", .message = "", .warnings = said,
+                               .warning_count = 5, .body = OBS_BIN_EXR, .blob = exr, .blob_len = 4};
+    obs_bytes f;
+    obs_bin_response r;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_bin_response_encode(&d, &f, err), OBS_OK);
+    assert_int_equal(obs_bin_response_decode(f.data + OBS_BIN_HEADER_LEN, f.size - OBS_BIN_HEADER_LEN,
+                                             NULL, &r, err), OBS_OK);
+    assert_int_equal(r.warning_count, 3);
+    assert_string_equal(r.warnings[0], said[0]);
+    assert_string_equal(r.warnings[1], "two lines");
+    assert_string_equal(r.warnings[2], big);
+    assert_true(r.blob_len == 4 && !memcmp(r.blob, exr, 4));
+    obs_bin_response_free(&r);
+    obs_bytes_free(&f);
+
+    d.warning_count = 0; /* what version 1 sent */
+    assert_int_equal(obs_bin_response_encode(&d, &f, err), OBS_OK);
+    assert_int_equal(obs_bin_response_decode(f.data + OBS_BIN_HEADER_LEN, f.size - OBS_BIN_HEADER_LEN,
+                                             NULL, &r, err), OBS_OK);
+    assert_int_equal(r.warning_count, 0);
+    assert_string_equal(r.message, "");
+    obs_bytes_free(&f);
+
+    obs_bin_response_desc e = {.id = 6, .status = 422, .code = "bad_file", .message = "a\nb",
+                               .warnings = said, .warning_count = 1};
+    assert_int_equal(obs_bin_response_encode(&e, &f, err), OBS_OK);
+    assert_int_equal(obs_bin_response_decode(f.data + OBS_BIN_HEADER_LEN, f.size - OBS_BIN_HEADER_LEN,
+                                             NULL, &r, err), OBS_OK);
+    assert_string_equal(r.message, "a\nb");
+    assert_int_equal(r.warning_count, 0);
+    obs_bytes_free(&f);
+}
+
 static void test_every_truncation(void **state)
 {
     (void)state;
@@ -865,6 +911,7 @@ int main(void)
         cmocka_unit_test(test_deep_round_trip),     cmocka_unit_test(test_deep_truncated),
         cmocka_unit_test(test_deep_bad_counts),     cmocka_unit_test(test_deep_bad_sizes),
         cmocka_unit_test(test_head),                cmocka_unit_test(test_deep_head),
+        cmocka_unit_test(test_response_warnings),
     };
     return cmocka_run_group_tests_name("protocol_binary", tests, NULL, NULL);
 }
