@@ -1,13 +1,15 @@
 #!/bin/sh
-# End-to-end tests of the CPU device's name in the CLI: --backend cpu and
-# OBSCURA_BACKEND=cpu run the chain on the CPU (no GL context), the same
-# bytes as --cpu (its older name), flat and deep input; --backend beats
-# the environment; `obscura info --backend cpu`; a backend that is none
-# names cpu among the choices.
+# End-to-end tests of the CPU device's name in the CLI and the daemon:
+# --backend cpu and OBSCURA_BACKEND=cpu run the chain on the CPU (no GL
+# context), the same bytes as --cpu (its older name), flat and deep input;
+# --backend beats the environment; `obscura info --backend cpu`; a
+# backend that is none names cpu among the choices; obscurad --backend
+# cpu answers frames with no GL context, its AO the CLI's --cpu AO.
 #
-#   OBSCURA=build/obscura tests/e2e/cpu_backend.sh
+#   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/cpu_backend.sh
 set -u
 OBSCURA=${OBSCURA:-build/obscura}
+OBSCURAD=${OBSCURAD:-build/obscurad}
 DATA=tests/data
 R="$DATA/room_small.exr"
 CAMJ="$DATA/room_small.camera.json"
@@ -45,6 +47,22 @@ check "--backend cpux: usage error (exit $rc) listing cpu" \
     "[ $rc -eq 2 ] && grep -q 'auto|cpu|egl-device' '$T/err'"
 check "help: --backend lists cpu, --cpu is its synonym" \
     "'$OBSCURA' ao --help 2>&1 | grep -q 'auto|cpu|' && '$OBSCURA' ao --help 2>&1 | grep -q 'same as --backend cpu'"
+
+echo "-- obscurad --backend cpu"
+start d --backend cpu
+check "the log names the cpu backend, no GL context" "grep -q 'backend cpu' '$T/d.log'"
+W2C=$(tr -d ' \n' < "$CAMJ" |
+    sed 's/.*"world_to_camera":\[\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\]\].*/\1,\2,\3,\4/')
+CAM="fov_y=50&near=0.05&far=100&world_to_camera=$W2C"
+code=$(post "$PORT_d" "$CAM&format=exr&float=1" "$R" "$T/d.exr")
+"$OBSCURA" ao "$R" --fov-y 50 --near 0.05 --far 100 --world-to-camera "$W2C" --cpu --float -q \
+    -o "$T/cli.exr"
+check "a frame: HTTP $code, its AO the CLI's --cpu AO" \
+    "[ '$code' = 200 ] && '$OBSCURA' compare '$T/cli.exr' '$T/d.exr' --mask none --json 2>/dev/null | grep -q '\"mae\": *0[,}]'"
+code=$(get "$PORT_d" /v1/info "$T/info.json")
+check "/v1/info: HTTP $code, backend cpu" "[ '$code' = 200 ] && grep -q '\"backend\":[[:space:]]*\"cpu\"' '$T/info.json'"
+kill "$PID_d" 2>/dev/null
+wait "$PID_d" 2>/dev/null
 
 echo "e2e cpu_backend: $pass passed, $failed failed"
 [ "$failed" -eq 0 ]
