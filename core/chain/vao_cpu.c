@@ -359,13 +359,18 @@ static inline __attribute__((always_inline)) float estimate_lanes(const obs__fra
         seens[i] = seen;
     }
     /* a sample off the planes reads the surface continued past the border
-     * (border_cpu.c): the scalar estimator then takes the whole pixel */
-    int off = 0;
-    for (int i = 0; i < ns; i++)
-        off |= !seens[i];
-    if (off) {
-        float bleed[3];
-        return estimate(f, pos, nrm, dnz, 2, dnz + 1, 2, NULL, x, y, p, n, ns, xy, bleed);
+     * (border_sample, border_cpu.c), one by one, its pipe as estimate()
+     * takes it */
+    for (int i = 0; i < ns; i++) {
+        float zs = INFINITY, nz = 1.0f;
+        if (seens[i] || !border_sample(f, pos, nrm, &m, x, y, xy[2 * i], xy[2 * i + 1], &zs, &nz))
+            continue;
+        const float h = r * ls[i], front = -c[2] - h;
+        float dz = min_f(max_f(zs - front, 0.0f), 2.0f * h);
+        if (f->range_check && zs < front)
+            dz = 2.0f * h * (1.0f - range_falloff(f, front - zs, nz));
+        dzs[i] = dz;
+        seens[i] = 1;
     }
     float open = 0.0f, F = 0.0f;
     for (int i = 0; i < ns; i++)
