@@ -50,6 +50,12 @@ CPPFLAGS += -Iinclude -I$(BUILD)/gen
 # clients/ are built without them, so `obs__` names stay internal.
 CORE_INC := -Icore
 $(BUILD)/obj/core/%.o: CPPFLAGS += $(CORE_INC)
+# The CPU device's kernels run pixels in SIMD lanes through OpenMP's simd
+# pragma (gcc -fopenmp-simd: the pragma only, no OpenMP runtime);
+# -fno-trapping-math lets gcc compute both sides of a select in the lanes
+# and -fno-math-errno sqrtf be one instruction in them (no FP exception
+# flag nor errno is read; no value changes).
+$(BUILD)/obj/core/chain/%_cpu.o: CFLAGS += -fopenmp-simd -fno-trapping-math -fno-math-errno
 ifeq ($(SAN),1)
 CFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 CXXFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined

@@ -1,16 +1,22 @@
 /* Frame timing: one context, many frames, medians.
  *
- *   frame_bench [--backend B] [--frames N] G-BUFFER.exr CAMERA.json...
+ *   frame_bench [--backend B] [--frames N] [--presets | --devices] G-BUFFER.exr CAMERA.json...
  *
  * For each G-buffer (and a 1920x1080 nearest-neighbour upscale of it):
  * the first frame (shaders compiled, targets allocated), the median of N
  * warm frames at 8/16/32 samples, and the CPU twin at 16 samples, all in
- * one run so the ratios are comparable.  Output is a Markdown table. */
+ * one run so the ratios are comparable.  Output is a Markdown table.
+ * --presets: --quality's presets at 1920x1080 and 3840x2160; --devices:
+ * every method on the CPU device (obs_run_cpu) against the GL context,
+ * at the same sizes. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "chain/bands_cpu.h"
+#include "chain/passes_cpu.h"
+#include "methods/methods.h"
 #include "obscura/io.h"
 #include "obscura/obscura.h"
 
@@ -203,10 +209,82 @@ static void bench_presets(obs_ctx *ctx, const char *name, const obs_gbuffer *gb,
     fflush(stdout);
 }
 
+/* --devices: each method's default chain on the CPU device and on the GL
+ * context, wall ms (AO out, upload and readback included), medians of
+ * `frames`, the two devices' frames interleaved so that the machine's
+ * drift hits both alike; the ratio cpu / GL from the same run.  The CPU
+ * device's median wall ms per pass go to a second table (devices_md). */
+static char devices_md[8192];
+
+static void bench_devices(obs_ctx *ctx, const char *name, const obs_gbuffer *gb, int frames,
+                          int threads)
+{
+    double t[2][64], pass[OBS_PASS_COUNT][64];
+    char err[OBS_ERR_LEN];
+    if (frames > 64)
+        frames = 64;
+    for (int m = 0; m < obs__method_count(); m++) {
+        obs_params p = {0};
+        const char *method = obs__method_at(m)->name;
+        if (obs_param_set(&p, "method", method, err) != OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            exit(1);
+        }
+        for (int i = -1; i < frames; i++) /* i = -1: warm-up, builds the programs */
+            for (int cpu = 0; cpu < 2; cpu++) {
+                obs_result r;
+                obs_pass_times pt;
+                double t0 = now_ms();
+                obs_status s = cpu ? obs__run_cpu_timed(gb, &p, OBS_OUTPUT_AO, &r, &pt, err)
+                                   : obs_run(ctx, gb, &p, OBS_OUTPUT_AO, &r, err);
+                double took = now_ms() - t0;
+                if (s != OBS_OK) {
+                    fprintf(stderr, "frame_bench: %s: %s\n", method, err);
+                    exit(1);
+                }
+                obs_result_free(&r);
+                if (i < 0)
+                    continue;
+                t[cpu][i] = took;
+                for (int q = 0; cpu && q < OBS_PASS_COUNT; q++)
+                    pass[q][i] = pt.ms[q];
+            }
+        qsort(t[0], (size_t)frames, sizeof t[0][0], cmp);
+        qsort(t[1], (size_t)frames, sizeof t[1][0], cmp);
+        double gl = t[0][frames / 2], cpu = t[1][frames / 2];
+        printf("| %s | %dx%d | %s | %d | %.1f | %.1f | %.2f |\n", name, gb->width, gb->height,
+               method, threads, gl, cpu, cpu / gl);
+        fflush(stdout);
+        size_t n = strlen(devices_md);
+        snprintf(devices_md + n, sizeof devices_md - n, "| %dx%d | %s |", gb->width, gb->height,
+                 method);
+        for (int q = 0; q < OBS_PASS_COUNT; q++) {
+            qsort(pass[q], (size_t)frames, sizeof pass[q][0], cmp);
+            double v = pass[q][frames / 2];
+            n = strlen(devices_md);
+            snprintf(devices_md + n, sizeof devices_md - n, v < 0 ? " - |" : " %.1f |", v);
+        }
+        n = strlen(devices_md);
+        snprintf(devices_md + n, sizeof devices_md - n, "\n");
+    }
+}
+
+static void devices_passes(void)
+{
+    printf("\nThe CPU device per pass, median wall ms (\"-\": the pass did not run; the "
+           "planes' allocation counts as the upload):\n\n| size | method |");
+    for (int q = 0; q < OBS_PASS_COUNT; q++)
+        printf(" %s |", obs_pass_name((obs_pass)q));
+    printf("\n|---|---|");
+    for (int q = 0; q < OBS_PASS_COUNT; q++)
+        printf("---|");
+    printf("\n%s", devices_md);
+}
+
 int main(int argc, char **argv)
 {
     obs_ctx_desc desc = {0};
-    int frames = 15, presets = 0;
+    int frames = 15, presets = 0, devices = 0;
     int i = 1;
     for (; i < argc && argv[i][0] == '-'; i++) {
         if (!strcmp(argv[i], "--backend") && i + 1 < argc)
@@ -215,9 +293,11 @@ int main(int argc, char **argv)
             frames = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--presets"))
             presets = 1;
+        else if (!strcmp(argv[i], "--devices"))
+            devices = 1;
     }
     if (argc - i < 2 || (argc - i) % 2) {
-        fprintf(stderr, "usage: frame_bench [--backend B] [--frames N] [--presets] GBUFFER.exr CAMERA.json...\n");
+        fprintf(stderr, "usage: frame_bench [--backend B] [--frames N] [--presets | --devices] GBUFFER.exr CAMERA.json...\n");
         return 2;
     }
     char err[OBS_ERR_LEN];
@@ -233,7 +313,11 @@ int main(int argc, char **argv)
     printf("backend %s, %s, %s; context created in %.1f ms; median of %d warm frames "
            "(upload + passes + readback of AO)\n\n",
            obs_backend_name(info.backend), info.gl_version, info.gl_renderer, t_ctx, frames);
-    if (presets)
+    if (devices)
+        printf("| G-buffer (upscaled) | size | method | CPU threads | %s wall ms | cpu wall ms | "
+               "cpu / %s |\n|---|---|---|---|---|---|---|\n",
+               obs_backend_name(info.backend), obs_backend_name(info.backend));
+    else if (presets)
         printf("| G-buffer (upscaled) | size | --quality | wall ms | GL ms | wall x default | GL x "
                "default |\n|---|---|---|---|---|---|---|\n");
     else
@@ -249,8 +333,9 @@ int main(int argc, char **argv)
             return 1;
         }
         const char *base = strrchr(argv[i], '/') ? strrchr(argv[i], '/') + 1 : argv[i];
-        if (presets) {
-            /* --presets: --quality's presets at 1920x1080 and 3840x2160 */
+        if (presets || devices) {
+            /* --presets: --quality's presets at 1920x1080 and 3840x2160;
+             * --devices: the methods on the two devices at those sizes */
             static const int sizes[2][2] = {{1920, 1080}, {3840, 2160}};
             for (int k = 0; k < 2; k++) {
                 int pw = sizes[k][0], ph = sizes[k][1];
@@ -264,7 +349,11 @@ int main(int argc, char **argv)
                 up.depth = (obs_plane){pd, 1, 0};
                 up.normal = (obs_plane){pn, 3, 0};
                 up.color = (obs_plane){NULL, 0, 0};
-                bench_presets(ctx, base, &up, k ? (frames < 5 ? frames : 5) : frames);
+                int nf = k ? (frames < 5 ? frames : 5) : frames;
+                if (devices)
+                    bench_devices(ctx, base, &up, nf, obs__cpu_threads());
+                else
+                    bench_presets(ctx, base, &up, nf);
                 free(pd);
                 free(pn);
             }
@@ -303,6 +392,8 @@ int main(int argc, char **argv)
         fputs(bands[b], stdout);
     if (presets)
         presets_passes();
+    if (devices)
+        devices_passes();
     obs_ctx_destroy(ctx);
     return 0;
 }

@@ -21,6 +21,11 @@ echo
 # run, then a table of each pass's GL time per preset
 "$BUILD/frame_bench" --frames 5 --presets "$1" "$2"
 echo
+# the CPU device against the GL context, every method at 1920x1080 and
+# 3840x2160 (the first scene upscaled): wall ms and the ratio cpu / GL in
+# the same run, then the CPU device's time per pass
+"$BUILD/frame_bench" --frames 5 --devices "$1" "$2"
+echo
 # cold start: one process with obscura's program cache warm and Mesa's
 # off, against Mesa's cache warm and no cache (bench/coldstart.sh)
 BUILD="$BUILD" bench/coldstart.sh

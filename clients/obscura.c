@@ -102,10 +102,11 @@ static const cli_opt ao_opts[] = {
      "the chain's AO (--baked-combine, default product): AO.Y is the combination, "
      "AOScreen.Y the chain's, AOBaked.Y the channel; none: not combined"},
     {"max-size", "N", "largest accepted width or height (default 16384)"},
-    {"backend", "B", "auto|egl-device|egl-surfaceless|osmesa (or OBSCURA_BACKEND)"},
+    {"backend", "B", "auto|cpu|egl-device|egl-surfaceless|osmesa (or OBSCURA_BACKEND); cpu: the "
+     "chain on the CPU device (every core, SIMD), no GL context; auto: a GL context"},
     {"cache-dir", "DIR", "program cache folder (or OBSCURA_CACHE_DIR; default "
      "$XDG_CACHE_HOME/obscura, else ~/.cache/obscura; '': none)"},
-    {"cpu", NULL, "run the CPU twin instead of OpenGL (slow; for reference)"},
+    {"cpu", NULL, "the same as --backend cpu"},
     {"threads", "N", "the threads this process may run, 1..64 (or OBSCURA_THREADS; default every "
      "core): llvmpipe's (LP_NUM_THREADS, unless set) and every worker pool's"},
     {"server", "URL[,URL...]", "run on obscurad: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT; a "
@@ -522,6 +523,14 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
     return s;
 }
 
+/* --backend B, else OBSCURA_BACKEND, names the CPU device. */
+static int backend_is_cpu(const char *name)
+{
+    if (!name)
+        name = getenv("OBSCURA_BACKEND");
+    return name && !strcmp(name, "cpu");
+}
+
 static obs_status backend_from_args(const char *name, obs_backend *b)
 {
     if (!name)
@@ -531,7 +540,7 @@ static obs_status backend_from_args(const char *name, obs_backend *b)
         return OBS_OK;
     }
     if (obs_backend_parse(name, b) != OBS_OK)
-        die_usage("backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", name);
+        die_usage("backend '%s' is not one of auto|cpu|egl-device|egl-surfaceless|osmesa", name);
     return OBS_OK;
 }
 
@@ -945,6 +954,8 @@ static int cmd_ao(int argc, char **argv)
     const char *server = NULL;
     argc = cli_remote_take_server(argc, argv, &server);
     parse_ao(argc, argv, &a);
+    if (!server && backend_is_cpu(a.backend)) /* with --server the backend is obscurad's */
+        a.cpu = 1;
     obs_limits lim = {0};
     if (a.max_size)
         lim.max_width = lim.max_height = (int)a.max_size;
@@ -1019,6 +1030,11 @@ static int cmd_info(int argc, char **argv)
             cache = v;
         else
             die_usage("info: unknown argument '%s'", argv[i]);
+    }
+    if (backend_is_cpu(backend)) {
+        printf("obscura %s\nbackend: cpu (the chain on the CPU device, no GL context)\n",
+               OBS_VERSION);
+        return EXIT_OK;
     }
     obs_ctx_desc desc = {.log = log_cb, .cache_dir = cache_dir_of(cache)};
     char err[OBS_ERR_LEN] = "";

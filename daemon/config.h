@@ -19,7 +19,7 @@
  * value is the 0-based index).  A new option is its row and its use:
  * parsing, the config file, the flag, --help and the README table follow
  * from the row. */
-#define OBSD_CHOICES_backend "auto|egl-device|egl-surfaceless|osmesa"
+#define OBSD_CHOICES_backend "auto|egl-device|egl-surfaceless|osmesa|cpu"
 #define OBSD_CHOICES_log_level "error|warn|info|debug"
 #define OBSD_CONFIG_TABLE(X)                                                   \
     X(http, STRING, 0, OBSD_STR_LEN - 1, "127.0.0.1:8420",                     \
@@ -119,8 +119,9 @@
       "$XDG_CACHE_HOME/obscura, else ~/.cache/obscura; given empty: none); "  \
       "read-only when it cannot be written")                                   \
     X(backend, ENUM, 0, 0, "auto",                                             \
-      "GL backend: auto|egl-device|egl-surfaceless|osmesa (default: "          \
-      "OBSCURA_BACKEND, else auto)")                                           \
+      "backend: auto|egl-device|egl-surfaceless|osmesa (a GL context) or "    \
+      "cpu (the CPU device, no GL context) (default: OBSCURA_BACKEND, else "   \
+      "auto)")                                                                 \
     X(log_level, ENUM, 0, 0, "info",                                           \
       "error|warn|info|debug; info logs one line per request")                \
     X(fail_gl_after, INT, 0, 1000000000, "0",                                  \

@@ -124,13 +124,19 @@ static void *worker_main(void *arg)
     obs_ctx *ctx = NULL;
     char err[OBS_ERR_LEN] = "";
     double t0 = obsd_now_ms();
-    obs_status s = obs_ctx_create(&w->desc, &ctx, err);
-    if (s == OBS_OK)
+    /* the CPU device (backend cpu) needs no context */
+    obs_status s = w->cpu ? OBS_OK : obs_ctx_create(&w->desc, &ctx, err);
+    if (s == OBS_OK && ctx)
         s = obs_ctx_set_deadline(ctx, w->frame_deadline, err);
 
     pthread_mutex_lock(&w->lock);
     w->start_status = s;
-    if (s == OBS_OK) {
+    if (s == OBS_OK && w->cpu) {
+        snprintf(w->backend, sizeof w->backend, "cpu");
+        snprintf(w->gl_renderer, sizeof w->gl_renderer, "the CPU device (no GL context)");
+        w->create_ms = obsd_now_ms() - t0;
+        atomic_store(&w->alive, 1);
+    } else if (s == OBS_OK) {
         obs_ctx_info info;
         obs_ctx_get_info(ctx, &info);
         snprintf(w->backend, sizeof w->backend, "%s", obs_backend_name(info.backend));
@@ -166,7 +172,7 @@ static void *worker_main(void *arg)
         frame++;
         job->t_started = obsd_now_ms();
         job->err[0] = '\0';
-        if (!ctx) {
+        if (!ctx && !w->cpu) {
             /* Stopped while the context could not be recreated. */
             job->status = OBS_GL_UNAVAILABLE;
             snprintf(job->err, OBS_ERR_LEN, "the GL context was lost and could not be recreated");
@@ -175,6 +181,10 @@ static void *worker_main(void *arg)
             snprintf(job->err, OBS_ERR_LEN, "injected GL failure on frame %ld (--fail-gl-after)", frame);
         } else if (too_costly(w, job)) {
             /* answered without running */
+        } else if (w->cpu && job->deep) {
+            job->status = obs_deep_run_cpu(job->deep, job->params, &job->deep_result, job->err);
+        } else if (w->cpu) {
+            job->status = obs_run_cpu(job->gb, job->params, job->outputs, &job->result, job->err);
         } else if (job->deep) {
             job->status = obs_deep_run(ctx, job->deep, job->params, &job->deep_result, job->err);
         } else {
@@ -204,10 +214,11 @@ static void *worker_main(void *arg)
     return NULL;
 }
 
-obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *desc,
+obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *desc, int cpu,
                          const obsd_config *cfg, char err[OBS_ERR_LEN])
 {
     memset(w, 0, sizeof *w);
+    w->cpu = cpu;
     w->queue = q;
     w->desc = *desc;
     w->fail_after = cfg->fail_gl_after;

@@ -33,6 +33,7 @@ typedef struct obsd_gl_worker {
     /* set once the first context exists (read-only afterwards; a
      * recreated context uses the same options) */
     char backend[32], gl_version[128], gl_vendor[128], gl_renderer[256];
+    int cpu;                       /* backend cpu: no context, the CPU device */
     double create_ms;
     atomic_int alive;              /* a context exists */
     atomic_ullong recreations;     /* contexts recreated after a GL failure */
@@ -51,8 +52,10 @@ typedef struct obsd_gl_worker {
  * (a frame asking more is answered OBS_TOO_COSTLY without running),
  * keep_memory (what the context may keep when the queue runs empty) and
  * fail_gl_after (testing: frame N is failed with OBS_GL_ERROR without
- * running it, as if the context were lost; 0: never). */
-obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *desc,
+ * running it, as if the context were lost; 0: never).  cpu: the jobs run
+ * on the CPU device (obs_run_cpu, obs_deep_run_cpu) and no context is
+ * made; backend reads "cpu". */
+obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *desc, int cpu,
                          const obsd_config *cfg, char err[OBS_ERR_LEN]);
 
 /* Closes the queue, lets the worker finish every queued job, joins it

@@ -88,8 +88,9 @@ static void sleep_ms(int ms)
 }
 
 /* The GL context's backend (--backend, else OBSCURA_BACKEND, else auto)
- * and program cache (an explicit --cache-dir, even empty, wins); -1 on a
- * backend that is none (logged). */
+ * and program cache (an explicit --cache-dir, even empty, wins); 1 for
+ * the CPU device (backend cpu: no context), -1 on a backend that is none
+ * (logged). */
 static int context_desc(const obsd_config *cfg, obs_ctx_desc *desc)
 {
     const obsd_opt_info *bo = obsd_opt_find("backend");
@@ -98,8 +99,9 @@ static int context_desc(const obsd_config *cfg, obs_ctx_desc *desc)
     obsd_config_format(cfg, bo, bname, sizeof bname);
     if (!cfg->set[bo - obsd_opt_at(0)] && env && *env)
         snprintf(bname, sizeof bname, "%s", env);
-    if (obs_backend_parse(bname, &desc->backend) != OBS_OK) {
-        obsd_log(OBSD_LOG_ERROR, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
+    int cpu = !strcmp(bname, "cpu");
+    if (!cpu && obs_backend_parse(bname, &desc->backend) != OBS_OK) {
+        obsd_log(OBSD_LOG_ERROR, "backend '%s' is not one of " OBSD_CHOICES_backend, bname);
         return -1;
     }
     const obsd_opt_info *co = obsd_opt_find("cache_dir");
@@ -109,7 +111,7 @@ static int context_desc(const obsd_config *cfg, obs_ctx_desc *desc)
                                            sizeof cache, why);
     if (why[0])
         obsd_log(OBSD_LOG_WARN, "%s", why);
-    return 0;
+    return cpu;
 }
 
 /* --render-threads, else OBSCURA_THREADS (as obscura's --threads), made
@@ -231,7 +233,8 @@ int main(int argc, char **argv)
         return 2;
 
     obs_ctx_desc desc = {.log = obsd_log_core};
-    if (context_desc(&cfg, &desc) != 0 || render_threads(&cfg) != 0)
+    int cpu = context_desc(&cfg, &desc);
+    if (cpu < 0 || render_threads(&cfg) != 0)
         return 2;
     if (install_signals() != 0) {
         obsd_log(OBSD_LOG_ERROR, "cannot install signal handlers: %s", strerror(errno));
@@ -248,7 +251,7 @@ int main(int argc, char **argv)
     }
     obsd_stats_init();
     mask_signals(SIG_BLOCK);
-    s = obsd_gl_start(&gl, &queue, &desc, &cfg, err);
+    s = obsd_gl_start(&gl, &queue, &desc, cpu, &cfg, err);
     if (s != OBS_OK) {
         obsd_log(OBSD_LOG_ERROR, "OpenGL: %s (%s)", err, obs_status_name(s));
         obsd_queue_destroy(&queue);

@@ -19,24 +19,51 @@
  * so for 8-bit formats; this R32F texture it filters in float). */
 #include <math.h>
 
+#include "chain/bands_cpu.h"
 #include "chain/frame.h"
+#include "chain/vao_cpu.h"
 
-void obs__cull_prepass(const obs__frame *f, const float *pos, const float *nrm, float *est)
+typedef struct cull_job {
+    const obs__frame *f;
+    const float *pos, *nrm, *dnz; /* dnz: NULL, or the packed plane (vao_cpu.h) */
+    float *est;
+} cull_job;
+
+/* The texel rows [j0, j1) of the pre-pass. */
+static void cull_rows(void *ctx, int j0, int j1)
 {
+    const cull_job *c = ctx;
+    const obs__frame *f = c->f;
+    const float *pos = c->pos, *nrm = c->nrm;
     const float *xy = f->sample_table + 2 * (OBS_CULL_SAMPLES - 2);
-    for (int j = 0; j < f->cull_h; j++)
+    float bleed[3];
+    for (int j = j0; j < j1; j++)
         for (int i = 0; i < f->cull_w; i++) {
             int x = OBS_CULL_BLOCK * i + OBS_CULL_BLOCK / 2;
             int y = OBS_CULL_BLOCK * j + OBS_CULL_BLOCK / 2;
             x = x < f->width ? x : f->width - 1;
             y = y < f->height ? y : f->height - 1;
             size_t k = (size_t)y * (size_t)f->width + (size_t)x;
-            est[(size_t)j * (size_t)f->cull_w + (size_t)i] =
-                pos[4 * k + 3] > 0.0f
-                    ? obs__vao_estimate(f, pos, nrm, x, y, pos + 4 * k, nrm + 3 * k,
-                                        OBS_CULL_SAMPLES, xy)
-                    : 1.0f;
+            c->est[(size_t)j * (size_t)f->cull_w + (size_t)i] =
+                !(pos[4 * k + 3] > 0.0f) ? 1.0f
+                : c->dnz ? obs__vao_estimate_dnz(f, pos, nrm, c->dnz, NULL, x, y, pos + 4 * k,
+                                                 nrm + 3 * k, OBS_CULL_SAMPLES, xy, bleed)
+                         : obs__vao_estimate(f, pos, nrm, x, y, pos + 4 * k, nrm + 3 * k,
+                                             OBS_CULL_SAMPLES, xy);
         }
+}
+
+void obs__cull_prepass(const obs__frame *f, const float *pos, const float *nrm, float *est)
+{
+    cull_job c = {f, pos, nrm, NULL, est};
+    obs__cpu_rows(f->cull_h, 1, cull_rows, &c); /* a texel row: 8 rows of pixels */
+}
+
+void obs__cull_prepass_dnz(const obs__frame *f, const float *pos, const float *nrm,
+                           const float *dnz, float *est)
+{
+    cull_job c = {f, pos, nrm, dnz, est};
+    obs__cpu_rows(f->cull_h, 1, cull_rows, &c);
 }
 
 static int clampi(int v, int hi) { return v < 0 ? 0 : v > hi ? hi : v; }

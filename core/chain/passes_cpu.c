@@ -3,7 +3,9 @@
  * the table's (passes.c); the driver is run_cpu.c. */
 #include <string.h>
 
+#include "chain/bands_cpu.h"
 #include "chain/passes_cpu.h"
+#include "chain/vao_cpu.h"
 
 /* GLSL: composite.frag.glsl.  Section 5: "applied to resulting image
  * simply by multiplication by occlusion values": colour x AO, and x the
@@ -21,18 +23,29 @@ static void composite_pixel(const float *color, float ao, const float *bleed, fl
     out[3] = color[3];
 }
 
-/* The AO pass over frame f's planes (GLSL: vao.frag.glsl, or the method's
- * method.frag.glsl): ao, the bleed term and the debug planes (NULL: not
- * wanted) of every pixel. */
-static void ao_pass(const obs__frame *f, const obs__method *method, const float *pos,
-                    const float *nrm, const float *col, const float *est, float *ao, float *bleed,
-                    float *count, float *mask)
+#ifndef AO_TILE_W
+#define AO_TILE_W 64
+#define AO_TILE_H 16
+#endif
+
+/* The AO pass over a tile of the frame at the AO's size (GLSL:
+ * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
+ * (when the composite or the output reads it) and the debug planes (NULL:
+ * not wanted) of every pixel. */
+static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
 {
-    for (int y = 0; y < f->height; y++)
-        for (int x = 0; x < f->width; x++) {
+    const obs__cpu_run *c = ctx;
+    const obs__frame *f = c->pl->af;
+    const obs__method *method = c->pl->method;
+    const float *pos = c->apos, *nrm = c->anrm, *col = c->col, *est = c->est;
+    float *ao = c->aao, *bleed = c->ableed, unread[3];
+    const int bleed_read = c->pl->f.bleed_step || c->out->bleed.data;
+    float *count = c->out->sample_count.data, *mask = c->out->cull_mask.data;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
             size_t i = (size_t)y * f->width + x;
             int n = 0, culled = 0;
-            float *b = bleed + 3 * i;
+            float *b = bleed_read ? bleed + 3 * i : unread;
             ao[i] = 1.0f;
             b[0] = b[1] = b[2] = 1.0f;
             if (method->pixel) {
@@ -46,14 +59,14 @@ static void ao_pass(const obs__frame *f, const obs__method *method, const float 
                     /* section 4.1: the set of the pixel's count */
                     n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
                     const float *xy = f->adaptive ? f->sample_table + 2 * (n - 2) : f->sample_xy;
-                    ao[i] = obs__vao_estimate_bleed(f, pos, nrm, col, x, y, pos + 4 * i,
-                                                    nrm + 3 * i, n, xy, b);
+                    ao[i] = obs__vao_estimate_dnz(f, pos, nrm, c->dnz, col, x, y, pos + 4 * i,
+                                                  nrm + 3 * i, n, xy, b);
                 } else if (f->culling == 2) {
                     n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
                     n = n < OBS_CULL_CAREFUL ? n : OBS_CULL_CAREFUL;
                     const float *xy = f->sample_table + 2 * (n - 2);
-                    ao[i] = obs__vao_estimate_bleed(f, pos, nrm, col, x, y, pos + 4 * i,
-                                                    nrm + 3 * i, n, xy, b);
+                    ao[i] = obs__vao_estimate_dnz(f, pos, nrm, c->dnz, col, x, y, pos + 4 * i,
+                                                  nrm + 3 * i, n, xy, b);
                 }
             }
             if (count)
@@ -63,33 +76,59 @@ static void ao_pass(const obs__frame *f, const obs__method *method, const float 
         }
 }
 
-/* The prep pass at full size: view positions, then normals (from the
- * input or derived from the positions). */
-static void prep_full(obs__cpu_run *c)
+/* The prep pass at full size, in two sweeps: view positions, then
+ * normals (from the input, or derived from the positions of the
+ * neighbours, which the first sweep has finished). */
+static void position_rows(void *ctx, int y0, int y1)
 {
+    const obs__cpu_run *c = ctx;
     const obs__frame *f = &c->pl->f;
     const obs_gbuffer *gb = c->pl->gb;
-    for (int y = 0; y < f->height; y++)
+    for (int y = y0; y < y1; y++)
         for (int x = 0; x < f->width; x++)
             obs__prep_position(f, *obs__plane_px(&gb->depth, f->width, x, y), x, y,
                                c->pos + 4 * ((size_t)y * f->width + x));
-    for (int y = 0; y < f->height; y++)
+}
+
+static void normal_rows(void *ctx, int y0, int y1)
+{
+    const obs__cpu_run *c = ctx;
+    const obs__frame *f = &c->pl->f;
+    const obs_gbuffer *gb = c->pl->gb;
+    for (int y = y0; y < y1; y++)
         for (int x = 0; x < f->width; x++) {
             const float *in = gb->normal.data ? obs__plane_px(&gb->normal, f->width, x, y) : NULL;
-            obs__prep_normal(f, c->pos, in, x, y, c->nrm + 3 * ((size_t)y * f->width + x));
+            const size_t i = (size_t)y * f->width + x;
+            obs__prep_normal(f, c->pos, in, x, y, c->nrm + 3 * i);
+            if (!f->half) {
+                c->dnz[2 * i] = c->pos[4 * i + 3];
+                c->dnz[2 * i + 1] = c->nrm[3 * i + 2];
+            }
         }
 }
 
+static void prep_full(obs__cpu_run *c)
+{
+    obs__cpu_rows(c->pl->f.height, 0, position_rows, c);
+    obs__cpu_rows(c->pl->f.height, 0, normal_rows, c);
+}
+
 /* The colour, packed, for sections 4.3 and 4.7. */
+static void color_rows(void *ctx, int y0, int y1)
+{
+    const obs__cpu_run *c = ctx;
+    const obs__frame *f = &c->pl->f;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < f->width; x++)
+            memcpy(c->col + 4 * ((size_t)y * f->width + x),
+                   obs__plane_px(&c->pl->gb->color, f->width, x, y), 4 * sizeof(float));
+}
+
 static obs_status cpu_upload(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
-    const obs__frame *f = &c->pl->f;
     (void)err;
     if (c->col)
-        for (int y = 0; y < f->height; y++)
-            for (int x = 0; x < f->width; x++)
-                memcpy(c->col + 4 * ((size_t)y * f->width + x),
-                       obs__plane_px(&c->pl->gb->color, f->width, x, y), 4 * sizeof(float));
+        obs__cpu_rows(c->pl->f.height, 0, color_rows, c);
     return OBS_OK;
 }
 
@@ -100,15 +139,14 @@ static obs_status cpu_prep(obs__cpu_run *c, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
-/* ao_resolution half: the full prep (the upsample reads it), then each
- * half pixel takes the planes of the pixel obs__half_source picks (GLSL:
- * prep.frag.glsl with OBS_HALF, straight from the raw planes). */
-static obs_status cpu_downsample(obs__cpu_run *c, char err[OBS_ERR_LEN])
+/* ao_resolution half: each half pixel takes the planes of the pixel
+ * obs__half_source picks (GLSL: prep.frag.glsl with OBS_HALF, straight
+ * from the raw planes). */
+static void half_rows(void *ctx, int y0, int y1)
 {
+    const obs__cpu_run *c = ctx;
     const obs__frame *f = &c->pl->f, *hf = c->pl->af;
-    (void)err;
-    prep_full(c);
-    for (int hy = 0; hy < hf->height; hy++)
+    for (int hy = y0; hy < y1; hy++)
         for (int hx = 0; hx < hf->width; hx++) {
             long k = obs__half_source(f, c->pos, hx, hy);
             if (k < 0) /* all background: the block's first pixel, background too */
@@ -116,7 +154,18 @@ static obs_status cpu_downsample(obs__cpu_run *c, char err[OBS_ERR_LEN])
             const size_t h = (size_t)hy * hf->width + hx;
             memcpy(c->hpos + 4 * h, c->pos + 4 * k, 4 * sizeof(float));
             memcpy(c->hnrm + 3 * h, c->nrm + 3 * k, 3 * sizeof(float));
+            c->dnz[2 * h] = c->hpos[4 * h + 3];
+            c->dnz[2 * h + 1] = c->hnrm[3 * h + 2];
         }
+}
+
+/* ao_resolution half: the full prep (the upsample reads it), then the
+ * half planes. */
+static obs_status cpu_downsample(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    (void)err;
+    prep_full(c);
+    obs__cpu_rows(c->pl->af->height, 0, half_rows, c);
     return OBS_OK;
 }
 
@@ -124,49 +173,73 @@ static obs_status cpu_downsample(obs__cpu_run *c, char err[OBS_ERR_LEN])
 static obs_status cpu_cull(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
     (void)err;
-    obs__cull_prepass(c->pl->af, c->apos, c->anrm, c->est);
+    obs__cull_prepass_dnz(c->pl->af, c->apos, c->anrm, c->dnz, c->est);
     return OBS_OK;
 }
 
 static obs_status cpu_ao(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
     (void)err;
-    ao_pass(c->pl->af, c->pl->method, c->apos, c->anrm, c->col, c->est, c->aao, c->ableed,
-            c->out->sample_count.data, c->out->cull_mask.data);
+    const obs__frame *af = c->pl->af;
+    obs__cpu_tiles(af->width, af->height, AO_TILE_W, AO_TILE_H, ao_tile, c);
     return OBS_OK;
 }
 
 /* ao_definition rays (not linear: applied to the filtered estimate). */
-static void rays(float *ao, size_t n)
+static void rays_rows(void *ctx, int y0, int y1)
 {
-    for (size_t i = 0; i < n; i++)
-        ao[i] = obs__rays_from_volume(ao[i]);
+    const obs__cpu_run *c = ctx;
+    const size_t w = (size_t)c->pl->f.width;
+    obs__rays_rows(c->ao + (size_t)y0 * w, (size_t)(y1 - y0) * w);
+}
+
+static void rays(obs__cpu_run *c)
+{
+    obs__cpu_rows(c->pl->f.height, 0, rays_rows, c);
 }
 
 /* Section 4.6, the low-pass filter; the conversion of ao_definition rays
- * after it, as GL's vertical pass does. */
+ * in its vertical pass's sweep, as GL's vertical pass does. */
 static obs_status cpu_blur(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
     (void)err;
-    obs__blur(c->pl->af, c->apos, c->aao, c->atmp);
-    if (c->pl->rays_in_blur)
-        rays(c->ao, c->npx);
+    obs__blur_dnz(c->pl->af, c->apos, c->dnz, c->aao, c->atmp, c->pl->rays_in_blur);
     return OBS_OK;
 }
 
-/* ao_resolution half: the joint bilateral upsample, then ao_definition
- * rays' conversion (GLSL: up.frag.glsl). */
-static obs_status cpu_up(obs__cpu_run *c, char err[OBS_ERR_LEN])
+/* ao_resolution half: the joint bilateral upsample (GLSL: up.frag.glsl). */
+static void up_rows(void *ctx, int y0, int y1)
 {
+    const obs__cpu_run *c = ctx;
     const obs__frame *f = &c->pl->f, *hf = c->pl->af;
-    (void)err;
-    for (int y = 0; y < f->height; y++)
+    for (int y = y0; y < y1; y++)
         for (int x = 0; x < f->width; x++)
             c->ao[(size_t)y * f->width + x] =
                 obs__half_upsample(f, hf, c->pos, c->nrm, c->hpos, c->hnrm, c->hao, x, y);
-    if (f->rays)
-        rays(c->ao, c->npx);
+}
+
+/* ao_resolution half: the upsample, then ao_definition rays' conversion. */
+static obs_status cpu_up(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    (void)err;
+    obs__cpu_rows(c->pl->f.height, 0, up_rows, c);
+    if (c->pl->f.rays)
+        rays(c);
     return OBS_OK;
+}
+
+/* Luminance sensitivity (section 4.3, eq 3) of the rows. */
+static void luminance_rows(void *ctx, int y0, int y1)
+{
+    const obs__cpu_run *c = ctx;
+    const obs__frame *f = &c->pl->f;
+    const size_t w = (size_t)f->width;
+    float *lum = c->out->luminance.data;
+    for (size_t i = (size_t)y0 * w; i < (size_t)y1 * w; i++) {
+        if (lum)
+            lum[i] = obs__luminance_factor(f, c->col + 4 * i);
+        c->ao[i] = obs__luminance_ao(f, c->ao[i], c->col + 4 * i);
+    }
 }
 
 /* The finishing pass (luminance.frag.glsl), after the blur: the
@@ -176,31 +249,32 @@ static obs_status cpu_up(obs__cpu_run *c, char err[OBS_ERR_LEN])
  * occlusion onto it). */
 static obs_status cpu_finish(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
-    const obs__frame *f = &c->pl->f;
     (void)err;
     if (c->pl->rays_in_finish)
-        rays(c->ao, c->npx);
-    if (!f->luminance)
-        return OBS_OK;
-    for (size_t i = 0; c->out->luminance.data && i < c->npx; i++)
-        c->out->luminance.data[i] = obs__luminance_factor(f, c->col + 4 * i);
-    for (size_t i = 0; i < c->npx; i++)
-        c->ao[i] = obs__luminance_ao(f, c->ao[i], c->col + 4 * i);
+        rays(c);
+    if (c->pl->f.luminance)
+        obs__cpu_rows(c->pl->f.height, 0, luminance_rows, c);
     return OBS_OK;
 }
 
-static obs_status cpu_composite(obs__cpu_run *c, char err[OBS_ERR_LEN])
+static void composite_rows(void *ctx, int y0, int y1)
 {
+    const obs__cpu_run *c = ctx;
     const obs__frame *f = &c->pl->f;
     const obs_gbuffer *gb = c->pl->gb;
-    (void)err;
-    for (int y = 0; y < f->height; y++)
+    for (int y = y0; y < y1; y++)
         for (int x = 0; x < f->width; x++) {
             size_t i = (size_t)y * f->width + x;
             composite_pixel(gb->color.data ? obs__plane_px(&gb->color, f->width, x, y) : NULL,
                             c->ao[i], f->bleed_step ? c->bleed + 3 * i : NULL,
                             c->out->composite.data + 4 * i);
         }
+}
+
+static obs_status cpu_composite(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    (void)err;
+    obs__cpu_rows(c->pl->f.height, 0, composite_rows, c);
     return OBS_OK;
 }
 

@@ -16,11 +16,29 @@ typedef struct obs__cpu_run {
     float *pos, *nrm, *ao, *tmp, *est, *col, *bleed; /* full size; col: packed RGBA */
     float *hpos, *hnrm, *hao, *htmp, *hbleed;       /* half size */
     float *apos, *anrm, *aao, *atmp, *ableed;       /* at the AO's size */
+    /* each pixel's depth and view normal z, packed (vao_cpu.h), at the
+     * AO's size: what the AO's samples read */
+    float *dnz;
+    void *block;                                    /* where the planes are */
+    size_t block_size;
 } obs__cpu_run;
+
+/* The planes of c's plan, in one block: the one the last frame gave back
+ * when it fits, else a new one (planes_cpu.c). */
+obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN]);
+
+/* Gives the block back, to be kept for the next frame (the larger of it
+ * and the one kept is kept, the other freed). */
+void obs__cpu_planes_give(obs__cpu_run *c);
 
 typedef obs_status (*obs__cpu_kernel)(obs__cpu_run *c, char err[OBS_ERR_LEN]);
 
 /* By obs_pass: the kernel of each row of obs__passes. */
 extern const obs__cpu_kernel obs__cpu_kernels[OBS_PASS_COUNT];
+
+/* obs_run_cpu with, when times is not NULL, each pass's wall time (the
+ * planes' allocation in the upload's); -1 for a pass that did not run. */
+obs_status obs__run_cpu_timed(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                              obs_result *out, obs_pass_times *times, char err[OBS_ERR_LEN]);
 
 #endif

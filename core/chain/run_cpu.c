@@ -4,65 +4,44 @@
  * libraries. */
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "chain/passes_cpu.h"
 
-static obs_status alloc_planes(obs__cpu_run *c, char err[OBS_ERR_LEN])
+static double now_ms(void)
 {
-    const obs__frame *f = &c->pl->f, *af = c->pl->af;
-    const size_t n = c->npx, an = (size_t)af->width * (size_t)af->height;
-    c->pos = malloc(n * 4 * sizeof(float));
-    c->nrm = malloc(n * 3 * sizeof(float));
-    c->ao = malloc(n * sizeof(float));
-    c->tmp = malloc(n * sizeof(float));
-    c->est = malloc((size_t)f->cull_w * (size_t)f->cull_h * sizeof(float));
-    c->bleed = malloc(n * 3 * sizeof(float));
-    /* colour, packed RGBA, for sections 4.3 and 4.7 */
-    int col = f->luminance || f->bleed_step;
-    if (col)
-        c->col = malloc(n * 4 * sizeof(float));
-    if (f->half) {
-        c->hpos = malloc(an * 4 * sizeof(float));
-        c->hnrm = malloc(an * 3 * sizeof(float));
-        c->hao = malloc(an * sizeof(float));
-        c->htmp = malloc(an * sizeof(float));
-        c->hbleed = malloc(an * 3 * sizeof(float));
-    }
-    c->apos = f->half ? c->hpos : c->pos;
-    c->anrm = f->half ? c->hnrm : c->nrm;
-    c->aao = f->half ? c->hao : c->ao;
-    c->atmp = f->half ? c->htmp : c->tmp;
-    c->ableed = f->half ? c->hbleed : c->bleed;
-    if (!c->pos || !c->nrm || !c->ao || !c->tmp || !c->est || !c->bleed || (col && !c->col) ||
-        !c->apos || !c->anrm || !c->aao || !c->atmp || !c->ableed)
-        return obs__fail(err, OBS_NO_MEMORY, "out of memory for a %dx%d frame", f->width,
-                         f->height);
-    return OBS_OK;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
-static void free_planes(obs__cpu_run *c)
-{
-    float *all[] = {c->pos, c->nrm,  c->ao,  c->tmp,  c->est,  c->col,
-                    c->bleed, c->hpos, c->hnrm, c->hao, c->htmp, c->hbleed};
-    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
-        free(all[i]);
-}
-
-/* Every pass that runs, in the table's order. */
-static obs_status walk(obs__cpu_run *c, char err[OBS_ERR_LEN])
+/* Every pass that runs, in the table's order; with t, each one's wall
+ * time. */
+static obs_status walk(obs__cpu_run *c, obs_pass_times *t, char err[OBS_ERR_LEN])
 {
     for (int i = 0; i < OBS_PASS_COUNT; i++) {
         if (!obs__passes[i].when(c->pl))
             continue;
+        double t0 = t ? now_ms() : 0.0;
         obs_status s = obs__cpu_kernels[i](c, err);
         if (s != OBS_OK)
             return s;
+        if (t) {
+            t->ms[i] += now_ms() - t0;
+            t->total_ms += now_ms() - t0;
+        }
     }
     return OBS_OK;
 }
 
 obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                        obs_result *out, char err[OBS_ERR_LEN])
+{
+    return obs__run_cpu_timed(gb, params, outputs, out, NULL, err);
+}
+
+obs_status obs__run_cpu_timed(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                              obs_result *out, obs_pass_times *times, char err[OBS_ERR_LEN])
 {
     obs__plan pl;
     obs__cpu_run c = {0};
@@ -74,12 +53,23 @@ obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned
     c.pl = &pl;
     c.out = out;
     c.npx = (size_t)pl.f.width * (size_t)pl.f.height;
-    s = alloc_planes(&c, err);
+    if (times) {
+        for (int i = 0; i < OBS_PASS_COUNT; i++)
+            times->ms[i] = obs__passes[i].when(&pl) ? 0.0 : -1.0;
+        times->total_ms = 0.0;
+    }
+    /* the planes' allocation counts as the upload, as GL's textures do */
+    double t0 = times ? now_ms() : 0.0;
+    s = obs__cpu_planes_take(&c, err);
     if (s == OBS_OK)
         s = obs__alloc_result(out, pl.f.width, pl.f.height, outputs, err);
+    if (times) {
+        times->ms[OBS_PASS_UPLOAD] += now_ms() - t0;
+        times->total_ms += now_ms() - t0;
+    }
     if (s == OBS_OK)
-        s = walk(&c, err);
-    free_planes(&c);
+        s = walk(&c, times, err);
+    obs__cpu_planes_give(&c);
     if (s != OBS_OK)
         obs_result_free(out);
     return s;

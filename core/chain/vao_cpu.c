@@ -8,6 +8,13 @@
 #include <string.h>
 
 #include "chain/frame.h"
+#include "chain/vao_cpu.h"
+
+/* fmaxf and fminf as glibc computes them (the other argument when one is
+ * NaN, the first when they are equal, so also for +0 and -0), inline:
+ * the estimator calls them per sample, and gcc calls libm for them. */
+static inline __attribute__((always_inline)) float max_f(float a, float b) { return (a >= b) | (b != b) ? a : b; }
+static inline __attribute__((always_inline)) float min_f(float a, float b) { return (a <= b) | (b != b) ? a : b; }
 
 /* GLSL: adaptive_count() in vao.frag.glsl.  Section 4.1: "double the
  * number of samples every time surface area of the sampling disc
@@ -67,11 +74,16 @@ float obs__vao_pixel(const obs__frame *f, const float *pos, const float *nrm, in
 }
 
 /* GLSL: range_falloff() in common.glsl */
-float obs__range_falloff(const obs__frame *f, float d, float nz)
+static inline float range_falloff(const obs__frame *f, float d, float nz)
 {
     if (f->range_normal)
         d *= fabsf(nz); /* the pipe's depth below the flat occluder */
-    return f->range_u / fmaxf(f->range_u, d / f->radius); /* eq 4 */
+    return f->range_u / max_f(f->range_u, d / f->radius); /* eq 4 */
+}
+
+float obs__range_falloff(const obs__frame *f, float d, float nz)
+{
+    return range_falloff(f, d, nz);
 }
 
 /* GLSL: own_plane_depth(), disk_point() in common.glsl */
@@ -102,6 +114,16 @@ float obs__rays_from_volume(float ao)
     return 1.0f - blocked;
 }
 
+void obs__rays_rows(float *ao, size_t n)
+{
+    /* the open pixels (AO exactly 1: the background, and the blur of an
+     * open neighbourhood, whose sums are then equal) take the value the
+     * conversion gives 1, computed once: the same float */
+    const float open = obs__rays_from_volume(1.0f);
+    for (size_t i = 0; i < n; i++)
+        ao[i] = ao[i] == 1.0f ? open : obs__rays_from_volume(ao[i]);
+}
+
 /* GLSL: disk_map() in common.glsl */
 void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
                    obs__disk *m)
@@ -129,7 +151,8 @@ void obs__disk_map(const obs__frame *f, const float c[3], float r, const float r
 }
 
 /* GLSL: disk_px() in common.glsl */
-int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx, int *qy)
+static inline int disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx,
+                          int *qy)
 {
     float sw = m->w[0] * sx + m->w[1] * sy + m->w[2];
     if (!(sw > 0.0f))
@@ -141,6 +164,11 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
     *qx = (int)fu;
     *qy = (int)fv;
     return 1;
+}
+
+int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx, int *qy)
+{
+    return disk_px(f, m, sx, sy, qx, qy);
 }
 
 /* GLSL: the branch of vao_estimate() in vao.glsl for a sample off the
@@ -171,10 +199,15 @@ float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm,
     return obs__vao_estimate_bleed(f, pos, nrm, NULL, x, y, p, n, ns, xy, bleed);
 }
 
-/* GLSL: vao_estimate() in vao.glsl */
-float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *nrm,
-                              const float *col, int x, int y, const float p[3], const float n[3],
-                              int ns, const float *xy, float bleed[3])
+/* GLSL: vao_estimate() in vao.glsl.  The scene at a sample's pixel k:
+ * its depth at d[ds * k], its view normal's z at nz[ns_ * k] (the prep
+ * planes, or the CPU device's packed plane of the two), its position at
+ * pos + 4 k (for bleeding only). */
+static inline float estimate(const obs__frame *f, const float *pos, const float *nrm,
+                             const float *d_at, int ds,
+                             const float *nz_at, int nzs, const float *col, int x, int y,
+                             const float p[3], const float n[3], int ns, const float *xy,
+                             float bleed[3])
 {
     const float R = f->radius, r = 0.5f * f->radius;
     /* Centre of the tangent sphere of radius R/2, moved along the normal. */
@@ -192,7 +225,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         float c5 = 0.0f; /* eq 5's c(x); 0 (white) without a surface there */
         const float *cx5 = NULL;
         float sx = xy[2 * i], sy = xy[2 * i + 1];
-        float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
+        float l = sqrtf(max_f(0.0f, 1.0f - sx * sx - sy * sy));
         float h = r * l; /* half length of the pipe through the sphere */
         int seen = 0;    /* the sample's pixel is on the planes */
 
@@ -200,13 +233,13 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         float nz = 1.0f; /* view normal z of the surface there */
         int qx, qy;
         /* The sample on the disk through the centre, perpendicular to view Z. */
-        seen = obs__disk_px(f, &disk, sx, sy, &qx, &qy);
+        seen = disk_px(f, &disk, sx, sy, &qx, &qy);
         if (seen) {
             size_t k = (size_t)qy * (size_t)f->width + (size_t)qx;
-            float d = pos[4 * k + 3];
+            float d = d_at[(size_t)ds * k];
             if (d > 0.0f) {
                 zs = d;
-                nz = nrm[3 * k + 2];
+                nz = nz_at[(size_t)nzs * k];
                 /* a sample on the shaded pixel itself: p's tangent plane */
                 if (qx == x && qy == y)
                     zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy, zs);
@@ -228,7 +261,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
         /* Unoccluded length of the pipe (cases A, B, C of section 3):
          * the pipe spans depths [-c.z - h, -c.z + h]. */
         float front = -c[2] - h;
-        float dz = fminf(fmaxf(zs - front, 0.0f), 2.0f * h);
+        float dz = min_f(max_f(zs - front, 0.0f), 2.0f * h);
         if (f->range_check && zs < front) {
             /* Case C with the depth range check, section 4.4, eq 4: the
              * pipe lies d behind the visible surface; the occluder is
@@ -236,7 +269,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
              * the pipe's weight 2h counts as occluded times s(d).  d is
              * taken from the pipe's near end, so s = 1 where case C meets
              * case A (zs = front) and the two join without a step. */
-            float sd = obs__range_falloff(f, front - zs, nz);
+            float sd = range_falloff(f, front - zs, nz);
             dz = 2.0f * h * (1.0f - sd);
         }
         /* A sample off the planes reads the surface continued past the
@@ -251,4 +284,110 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
     for (int j = 0; j < 3; j++)
         bleed[j] = taken > 0.0f ? acc[j] / taken : 1.0f;
     return F > 0.0f ? open / F : 1.0f; /* eq 1: V = (1/F) sum dz_i */
+}
+
+float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *nrm,
+                              const float *col, int x, int y, const float p[3], const float n[3],
+                              int ns, const float *xy, float bleed[3])
+{
+    return estimate(f, pos, nrm, pos + 3, 4, nrm + 2, 3, col, x, y, p, n, ns, xy, bleed);
+}
+
+/* floorf(v) where the caller needs only its comparisons and its int:
+ * through the int conversion, which the lanes have (floorf has no SSE2
+ * form); the same value for |v| < 2^23, v itself above (already an
+ * integer), NaN kept (it fails every comparison, as floorf's does). */
+static inline __attribute__((always_inline)) float floor_lane(float v)
+{
+    const float t = (float)(int)v; /* garbage for |v| >= 2^31: not selected */
+    const float fl = t > v ? t - 1.0f : t;
+    return fabsf(v) < 8388608.0f ? fl : v;
+}
+
+/* estimate() without colour bleeding, its samples in SIMD lanes
+ * (#pragma omp simd, gcc -fopenmp-simd): each sample's pixel, depth and
+ * pipe length computed in every lane with selects in place of branches,
+ * the same operations on the same values as estimate(), then eq 1's sums
+ * taken in the samples' order, so the result is estimate()'s, bit for
+ * bit. */
+/* always inlined: into each of the clones of its caller (OBS__LANES) */
+static inline __attribute__((always_inline)) float estimate_lanes(const obs__frame *f, const float *pos,
+                                                                  const float *nrm, const float *dnz, int x, int y,
+                                   const float p[3], const float n[3], int ns, const float *xy)
+{
+    const float R = f->radius, r = 0.5f * f->radius;
+    const float c[3] = {p[0] + n[0] * r, p[1] + n[1] * r, p[2] + n[2] * r};
+    const float *rot = f->rot[obs__tile_index(f, x, y)];
+    obs__disk m;
+    obs__disk_map(f, c, r, rot, &m);
+    const float fw = (float)f->width, fh = (float)f->height;
+    const int w = f->width, range = f->range_check, by_normal = f->range_normal;
+    const float u = f->range_u;
+    /* own_plane_depth()'s terms that do not depend on the sample */
+    const int own_plane = fabsf(n[2]) > OBS_OWN_PLANE_NZ;
+    float dzs[32], ls[32];
+    int seens[32];
+#pragma omp simd
+    for (int i = 0; i < ns; i++) {
+        const float sx = xy[2 * i], sy = xy[2 * i + 1];
+        const float l = sqrtf(max_f(0.0f, 1.0f - sx * sx - sy * sy));
+        const float h = r * l;
+        /* disk_px() */
+        const float sw = m.w[0] * sx + m.w[1] * sy + m.w[2];
+        const float fu = floor_lane((m.u[0] * sx + m.u[1] * sy + m.u[2]) / sw);
+        const float fv = floor_lane((m.v[0] * sx + m.v[1] * sy + m.v[2]) / sw);
+        const int seen = (sw > 0.0f) & (fu >= 0.0f) & (fv >= 0.0f) & (fu < fw) & (fv < fh);
+        const int qx = (int)fu & -seen, qy = (int)fv & -seen; /* 0 off the planes */
+        const int k = qy * w + qx; /* < 2^28 (the frame's size limit) */
+        const float d = dnz[2 * k], nzk = dnz[2 * k + 1];
+        const int hit = seen & (d > 0.0f);
+        /* own_plane_depth() on the shaded pixel itself */
+        const float spx = c[0] + r * (rot[0] * sx - rot[1] * sy);
+        const float spy = c[1] + r * (rot[1] * sx + rot[0] * sy);
+        const float own = -p[2] + (n[0] * (spx - p[0]) + n[1] * (spy - p[1])) / n[2];
+        const int self = hit & (qx == x) & (qy == y) & own_plane;
+        const float zs = self ? own : hit ? d : INFINITY;
+        const float nz = hit ? nzk : 1.0f;
+        const float front = -c[2] - h;
+        const float dz_ab = min_f(max_f(zs - front, 0.0f), 2.0f * h);
+        /* range_falloff(), eq 4 */
+        const float dd = by_normal ? (front - zs) * fabsf(nz) : front - zs;
+        const float sd = u / max_f(u, dd / R);
+        const float dz_c = 2.0f * h * (1.0f - sd);
+        dzs[i] = range & (zs < front) ? dz_c : dz_ab;
+        ls[i] = l;
+        seens[i] = seen;
+    }
+    /* a sample off the planes reads the surface continued past the border
+     * (border_sample, border_cpu.c), one by one, its pipe as estimate()
+     * takes it */
+    for (int i = 0; i < ns; i++) {
+        float zs = INFINITY, nz = 1.0f;
+        if (seens[i] || !border_sample(f, pos, nrm, &m, x, y, xy[2 * i], xy[2 * i + 1], &zs, &nz))
+            continue;
+        const float h = r * ls[i], front = -c[2] - h;
+        float dz = min_f(max_f(zs - front, 0.0f), 2.0f * h);
+        if (f->range_check && zs < front)
+            dz = 2.0f * h * (1.0f - range_falloff(f, front - zs, nz));
+        dzs[i] = dz;
+        seens[i] = 1;
+    }
+    float open = 0.0f, F = 0.0f;
+    for (int i = 0; i < ns; i++)
+        if (seens[i]) {
+            open += dzs[i];
+            F += R * ls[i]; /* eq 2 */
+        }
+    return F > 0.0f ? open / F : 1.0f; /* eq 1 */
+}
+
+OBS__LANES
+float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *nrm,
+                            const float *dnz, const float *col, int x, int y, const float p[3],
+                            const float n[3], int ns, const float *xy, float bleed[3])
+{
+    if (col && f->bleed_step > 0)
+        return estimate(f, pos, nrm, dnz, 2, dnz + 1, 2, col, x, y, p, n, ns, xy, bleed);
+    bleed[0] = bleed[1] = bleed[2] = 1.0f;
+    return estimate_lanes(f, pos, nrm, dnz, x, y, p, n, ns, xy);
 }

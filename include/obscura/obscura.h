@@ -229,8 +229,10 @@ typedef struct obs_result {
 obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params,
                    unsigned outputs, obs_result *out, char err[OBS_ERR_LEN]);
 
-/* The same computation on the CPU (the "twin" of the GL passes), used by
- * tests and as a reference.  Same ownership as obs_run(). */
+/* The same computation on the CPU device (`--backend cpu`): the CPU
+ * twins of the GL passes, each pass in bands or tiles on the worker pool
+ * (every core), the AO and the blur in SIMD lanes; the same bytes for
+ * any thread count.  No GL context.  Same ownership as obs_run(). */
 obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params,
                        unsigned outputs, obs_result *out, char err[OBS_ERR_LEN]);
 

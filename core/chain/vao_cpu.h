@@ -1,0 +1,46 @@
+/* The CPU device's form of the VAO estimator (vao_cpu.c).  No GL.  Not
+ * installed. */
+#ifndef OBSCURA_VAO_CPU_H
+#define OBSCURA_VAO_CPU_H
+
+#include "chain/frame.h"
+
+/* The kernels whose samples or pixels run in SIMD lanes (#pragma omp
+ * simd) are built three times, for the baseline (SSE2), AVX2 with FMA
+ * (x86-64-v3: gathers, 8 lanes) and AVX-512 (x86-64-v4: 16 lanes), the
+ * best the processor has chosen when the library loads (gcc's
+ * target_clones, an ifunc).  The same operations in every build (no
+ * contraction into FMA: -std=c11 means -ffp-contract=off), so the same
+ * results. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define OBS__LANES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define OBS__LANES
+#endif
+
+/* obs__vao_estimate_bleed (the same arithmetic, the same result) reading
+ * each sample's depth and view normal z from dnz, the two packed per
+ * pixel (dnz[2 k] = pos[4 k + 3], dnz[2 k + 1] = nrm[3 k + 2]): a sample
+ * then touches one cache line instead of two, from a plane of 8 bytes a
+ * pixel instead of 28.  pos and nrm are read for colour bleeding and for
+ * the samples off the planes (the surface continued past the border). */
+float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *nrm,
+                            const float *dnz, const float *col, int x, int y, const float p[3],
+                            const float n[3], int ns, const float *xy, float bleed[3]);
+
+/* obs__cull_prepass (the same result) with the estimator above. */
+void obs__cull_prepass_dnz(const obs__frame *f, const float *pos, const float *nrm,
+                           const float *dnz, float *est);
+
+/* obs__rays_from_volume of each of the n values at ao, in place (the
+ * same results). */
+void obs__rays_rows(float *ao, size_t n);
+
+/* obs__blur (the same result, bit for bit) with the depths from dnz;
+ * with rays, each row of the vertical pass then converted by
+ * obs__rays_from_volume (ao_definition rays, as GL's vertical pass does),
+ * in the same sweep. */
+void obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp,
+                   int rays);
+
+#endif

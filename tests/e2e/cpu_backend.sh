@@ -1,0 +1,68 @@
+#!/bin/sh
+# End-to-end tests of the CPU device's name in the CLI and the daemon:
+# --backend cpu and OBSCURA_BACKEND=cpu run the chain on the CPU (no GL
+# context), the same bytes as --cpu (its older name), flat and deep input;
+# --backend beats the environment; `obscura info --backend cpu`; a
+# backend that is none names cpu among the choices; obscurad --backend
+# cpu answers frames with no GL context, its AO the CLI's --cpu AO.
+#
+#   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/cpu_backend.sh
+set -u
+OBSCURA=${OBSCURA:-build/obscura}
+OBSCURAD=${OBSCURAD:-build/obscurad}
+DATA=tests/data
+R="$DATA/room_small.exr"
+CAMJ="$DATA/room_small.camera.json"
+. tests/e2e/lib/common.sh
+
+echo "e2e cpu_backend: $OBSCURA"
+unset OBSCURA_BACKEND
+"$OBSCURA" ao "$R" --camera "$CAMJ" --cpu -q -o "$T/twin.exr"
+"$OBSCURA" ao "$R" --camera "$CAMJ" --backend cpu -v -o "$T/flag.exr" 2>"$T/flag.log"
+rc=$?
+check "--backend cpu: exit $rc, the bytes of --cpu" "[ $rc -eq 0 ] && cmp -s '$T/twin.exr' '$T/flag.exr'"
+check "--backend cpu: the run line names the cpu device" "grep -q 'samples, cpu: ' '$T/flag.log'"
+OBSCURA_BACKEND=cpu "$OBSCURA" ao "$R" --camera "$CAMJ" -v -o "$T/env.exr" 2>"$T/env.log"
+rc=$?
+check "OBSCURA_BACKEND=cpu: exit $rc, the bytes of --cpu, no GL context" \
+    "[ $rc -eq 0 ] && cmp -s '$T/twin.exr' '$T/env.exr' && grep -q 'samples, cpu: ' '$T/env.log'"
+OBSCURA_BACKEND=cpu "$OBSCURA" ao "$R" --camera "$CAMJ" --backend auto -v -o "$T/gl.exr" 2>"$T/gl.log"
+rc=$?
+check "--backend auto beats OBSCURA_BACKEND=cpu: exit $rc, a GL context" \
+    "[ $rc -eq 0 ] && ! grep -q 'samples, cpu: ' '$T/gl.log' && grep -q 'samples, ' '$T/gl.log'"
+
+"$OBSCURA" ao "$DATA/deep_small.exr" --radius 0.6 --cpu -q -o "$T/deep_twin.exr"
+"$OBSCURA" ao "$DATA/deep_small.exr" --radius 0.6 --backend cpu -q -o "$T/deep_flag.exr"
+rc=$?
+check "deep input, --backend cpu: exit $rc, the bytes of --cpu" \
+    "[ $rc -eq 0 ] && cmp -s '$T/deep_twin.exr' '$T/deep_flag.exr'"
+
+out=$("$OBSCURA" info --backend cpu 2>&1)
+rc=$?
+check "info --backend cpu: exit $rc, 'backend: cpu'" \
+    "[ $rc -eq 0 ] && echo \"\$out\" | grep -q '^backend: cpu'"
+"$OBSCURA" ao "$R" --camera "$CAMJ" --backend cpux -o "$T/x.exr" 2>"$T/err"
+rc=$?
+check "--backend cpux: usage error (exit $rc) listing cpu" \
+    "[ $rc -eq 2 ] && grep -q 'auto|cpu|egl-device' '$T/err'"
+check "help: --backend lists cpu, --cpu is its synonym" \
+    "'$OBSCURA' ao --help 2>&1 | grep -q 'auto|cpu|' && '$OBSCURA' ao --help 2>&1 | grep -q 'same as --backend cpu'"
+
+echo "-- obscurad --backend cpu"
+start d --backend cpu
+check "the log names the cpu backend, no GL context" "grep -q 'backend cpu' '$T/d.log'"
+W2C=$(tr -d ' \n' < "$CAMJ" |
+    sed 's/.*"world_to_camera":\[\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\],\[\([^]]*\)\]\].*/\1,\2,\3,\4/')
+CAM="fov_y=50&near=0.05&far=100&world_to_camera=$W2C"
+code=$(post "$PORT_d" "$CAM&format=exr&float=1" "$R" "$T/d.exr")
+"$OBSCURA" ao "$R" --fov-y 50 --near 0.05 --far 100 --world-to-camera "$W2C" --cpu --float -q \
+    -o "$T/cli.exr"
+check "a frame: HTTP $code, its AO the CLI's --cpu AO" \
+    "[ '$code' = 200 ] && '$OBSCURA' compare '$T/cli.exr' '$T/d.exr' --mask none --json 2>/dev/null | grep -q '\"mae\": *0[,}]'"
+code=$(get "$PORT_d" /v1/info "$T/info.json")
+check "/v1/info: HTTP $code, backend cpu" "[ '$code' = 200 ] && grep -q '\"backend\":[[:space:]]*\"cpu\"' '$T/info.json'"
+kill "$PID_d" 2>/dev/null
+wait "$PID_d" 2>/dev/null
+
+echo "e2e cpu_backend: $pass passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,182 @@
+/* The CPU device's vectorised kernels against the scalar twins they
+ * stand for: the low-pass filter (VAO++ 4.6) in SIMD lanes
+ * (obs__blur_dnz, obs__blur) against obs__blur_pixel pixel by pixel, bit
+ * for bit, on a synthetic frame with background, depth edges and odd
+ * sizes (the rows' scalar ends), at several filter radii, with and
+ * without ao_definition rays' conversion in its vertical sweep; the VAO
+ * estimator's samples in SIMD lanes (obs__vao_estimate_dnz) against the
+ * twin's obs__vao_estimate at every pixel of room_small, bit for bit, for
+ * every sample set and the depth range check's forms. */
+#include <math.h>
+
+#include "testutil.h"
+#include "chain/frame.h"
+#include "chain/passes.h"
+#include "chain/vao_cpu.h"
+#include "obscura/io.h"
+
+enum { W = 301, H = 77 };
+
+/* Depths in steps (edges over the threshold), holes of background. */
+static void scene(float *pos, float *dnz, float *ao)
+{
+    unsigned s = 12345u;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            size_t i = (size_t)y * W + x;
+            s = s * 1103515245u + 12345u;
+            float d = 2.0f + (float)((x / 17 + y / 11) % 4) * 0.7f + (float)(s >> 16) * 1e-6f;
+            if ((x * 7 + y * 3) % 23 == 0)
+                d = 0.0f; /* background */
+            pos[4 * i] = (float)x * 0.01f;
+            pos[4 * i + 1] = (float)y * 0.01f;
+            pos[4 * i + 2] = -d;
+            pos[4 * i + 3] = d;
+            dnz[2 * i] = d;
+            dnz[2 * i + 1] = 1.0f;
+            ao[i] = (float)((s >> 8) & 0xffff) / 65535.0f;
+        }
+}
+
+static void test_blur_bit_for_bit(void **state)
+{
+    static float pos[4 * W * H], dnz[2 * W * H], ao[W * H], a1[W * H], a2[W * H], a3[W * H],
+        ref[W * H], tmp[W * H];
+    (void)state;
+    scene(pos, dnz, ao);
+    for (int radius = 1; radius <= 7; radius += 3) {
+        obs__frame f;
+        memset(&f, 0, sizeof f);
+        f.width = W;
+        f.height = H;
+        f.radius = 0.5f;
+        f.blur_radius = radius;
+        for (int k = 0; k <= radius; k++)
+            f.blur_w[k] = expf(-0.5f * (float)(k * k) / 2.0f);
+        /* the scalar twin, pixel by pixel */
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++)
+                tmp[y * W + x] = obs__blur_pixel(&f, pos, ao, x, y, 1, 0);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++)
+                ref[y * W + x] = obs__blur_pixel(&f, pos, tmp, x, y, 0, 1);
+        memcpy(a1, ao, sizeof ao);
+        memcpy(a2, ao, sizeof ao);
+        obs__blur_dnz(&f, pos, dnz, a1, tmp, 0);
+        obs__blur(&f, pos, a2, tmp);
+        memcpy(a3, ao, sizeof ao);
+        obs__blur_dnz(&f, pos, dnz, a3, tmp, 1); /* ao_definition rays in the vertical sweep */
+        for (int i = 0; i < W * H; i++) {
+            float rays = obs__rays_from_volume(ref[i]);
+            if (memcmp(&a3[i], &rays, sizeof(float)))
+                fail_msg("radius %d, rays, pixel (%d, %d): %.9g, the twin %.9g", radius, i % W,
+                         i / W, a3[i], rays);
+            if (memcmp(&a1[i], &ref[i], sizeof(float)) || memcmp(&a2[i], &ref[i], sizeof(float)))
+                fail_msg("radius %d, pixel (%d, %d): %.9g and %.9g, the twin %.9g", radius, i % W,
+                         i / W, a1[i], a2[i], ref[i]);
+        }
+    }
+}
+
+/* room_small's prep planes by the twins, and the packed plane. */
+static void room_planes(obs__plan *pl, obs_gbuffer_file *gf, const char *const *set, float **pos,
+                        float **nrm, float **dnz)
+{
+    char err[OBS_ERR_LEN] = "";
+    obs_params p = {0};
+    if (obs_gbuffer_read_exr(TESTDATA "/room_small.exr", NULL, NULL, gf, err) != OBS_OK ||
+        obs_camera_read_json(TESTDATA "/room_small.camera.json", &gf->gb.camera, NULL, NULL,
+                             err) != OBS_OK)
+        fail_msg("room_small: %s", err);
+    for (int k = 0; set[k]; k += 2)
+        assert_int_equal(obs_param_set(&p, set[k], set[k + 1], err), OBS_OK);
+    if (obs__plan_init(pl, NULL, &gf->gb, &p, OBS_OUTPUT_AO, err) != OBS_OK)
+        fail_msg("%s", err);
+    const obs__frame *f = &pl->f;
+    const size_t n = (size_t)f->width * (size_t)f->height;
+    *pos = malloc(n * 4 * sizeof(float));
+    *nrm = malloc(n * 3 * sizeof(float));
+    *dnz = malloc(n * 2 * sizeof(float));
+    assert_true(*pos && *nrm && *dnz);
+    for (int y = 0; y < f->height; y++)
+        for (int x = 0; x < f->width; x++)
+            obs__prep_position(f, *obs__plane_px(&gf->gb.depth, f->width, x, y), x, y,
+                               *pos + 4 * ((size_t)y * f->width + x));
+    for (size_t i = 0; i < n; i++) {
+        int x = (int)(i % (size_t)f->width), y = (int)(i / (size_t)f->width);
+        obs__prep_normal(f, *pos, obs__plane_px(&gf->gb.normal, f->width, x, y), x, y,
+                         *nrm + 3 * i);
+        (*dnz)[2 * i] = (*pos)[4 * i + 3];
+        (*dnz)[2 * i + 1] = (*nrm)[3 * i + 2];
+    }
+}
+
+static void test_vao_bit_for_bit(void **state)
+{
+    static const char *const sets[][5] = {
+        {"range_check", "on", NULL},
+        {"range_check", "off", NULL},
+        {"range_distance", "normal", NULL},
+    };
+    (void)state;
+    for (size_t s = 0; s < sizeof sets / sizeof sets[0]; s++) {
+        obs__plan pl;
+        obs_gbuffer_file gf = {0};
+        float *pos, *nrm, *dnz;
+        room_planes(&pl, &gf, sets[s], &pos, &nrm, &dnz);
+        const obs__frame *f = &pl.f;
+        long compared = 0;
+        for (int ns = 2; ns <= 32; ns *= 2) {
+            const float *xy = f->sample_table + 2 * (ns - 2);
+            for (int y = 0; y < f->height; y++)
+                for (int x = 0; x < f->width; x++) {
+                    size_t i = (size_t)y * f->width + x;
+                    if (!(pos[4 * i + 3] > 0.0f))
+                        continue;
+                    float bleed[3];
+                    float a = obs__vao_estimate_dnz(f, pos, nrm, dnz, NULL, x, y, pos + 4 * i,
+                                                    nrm + 3 * i, ns, xy, bleed);
+                    float b = obs__vao_estimate(f, pos, nrm, x, y, pos + 4 * i, nrm + 3 * i, ns,
+                                                xy);
+                    if (memcmp(&a, &b, sizeof a))
+                        fail_msg("%s %s, %d samples, pixel (%d, %d): %.9g, the twin %.9g",
+                                 sets[s][0], sets[s][1], ns, x, y, a, b);
+                    compared++;
+                }
+        }
+        assert_true(compared > 1000);
+        free(pos);
+        free(nrm);
+        free(dnz);
+        obs_gbuffer_free(&gf);
+    }
+}
+
+/* ao_definition rays over rows: obs__rays_from_volume of every value,
+ * 1 (the open pixels' shortcut) and values around it included. */
+static void test_rays_rows(void **state)
+{
+    enum { N = 4099 };
+    static float v[N], want[N];
+    (void)state;
+    for (int i = 0; i < N; i++) {
+        v[i] = i % 3 == 0 ? 1.0f : (float)i / (float)(N - 7) - 0.001f; /* -0.001 .. 1.0 and past */
+        want[i] = obs__rays_from_volume(v[i]);
+    }
+    v[5] = nextafterf(1.0f, 0.0f);
+    want[5] = obs__rays_from_volume(v[5]);
+    obs__rays_rows(v, N);
+    for (int i = 0; i < N; i++)
+        if (memcmp(&v[i], &want[i], sizeof(float)))
+            fail_msg("value %d: %.9g, the twin %.9g", i, v[i], want[i]);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_blur_bit_for_bit),
+        cmocka_unit_test(test_vao_bit_for_bit),
+        cmocka_unit_test(test_rays_rows),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

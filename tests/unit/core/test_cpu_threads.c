@@ -1,0 +1,184 @@
+/* The CPU device's output does not depend on its thread count: every
+ * method, the chain's variants (half resolution, culling off and greedy,
+ * ao_definition volume, luminance and bleeding with colour, every
+ * output) and the deep chain, on room_small and deep_small, the same
+ * bytes with 1 thread and with several (bands_cpu.h). */
+#include "testutil.h"
+#include "chain/bands_cpu.h"
+#include "methods/methods.h"
+#include "obscura/deep.h"
+#include "obscura/io.h"
+#include "obscura/obscura.h"
+
+static obs_gbuffer_file room;
+
+static int setup(void **state)
+{
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    if (obs_gbuffer_read_exr(TESTDATA "/room_small.exr", NULL, NULL, &room, err) != OBS_OK ||
+        obs_camera_read_json(TESTDATA "/room_small.camera.json", &room.gb.camera, NULL, NULL,
+                             err) != OBS_OK)
+        fail_msg("room_small: %s", err);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    obs_gbuffer_free(&room);
+    return 0;
+}
+
+static const unsigned all_outputs = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE |
+                                    OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |
+                                    OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE;
+
+static void same_image(const obs_image *a, const obs_image *b, const char *what)
+{
+    assert_int_equal(a->data != NULL, b->data != NULL);
+    if (!a->data)
+        return;
+    size_t n = (size_t)a->width * (size_t)a->height * (size_t)a->channels * sizeof(float);
+    if (memcmp(a->data, b->data, n) != 0)
+        fail_msg("%s: the output differs between thread counts", what);
+}
+
+/* The frame with the parameters "name=value,..." (NULL: defaults) and
+ * `outputs` on 1 thread and on 2, 3 and 7, compared byte for byte. */
+static void check(const char *method, const char *const *set, unsigned outputs)
+{
+    obs_params p = {0};
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_param_set(&p, "method", method, err), OBS_OK);
+    for (int k = 0; set && set[k]; k += 2)
+        if (obs_param_set(&p, set[k], set[k + 1], err) != OBS_OK)
+            fail_msg("%s=%s: %s", set[k], set[k + 1], err);
+    obs_result one, many;
+    int before = obs__cpu_set_threads(1);
+    if (obs_run_cpu(&room.gb, &p, outputs, &one, err) != OBS_OK)
+        fail_msg("%s: %s", method, err);
+    static const int counts[] = {2, 3, 7};
+    for (int t = 0; t < 3; t++) {
+        obs__cpu_set_threads(counts[t]);
+        assert_true(obs__cpu_threads() >= 1); /* the process's limit may cap it */
+        if (obs_run_cpu(&room.gb, &p, outputs, &many, err) != OBS_OK)
+            fail_msg("%s: %s", method, err);
+        same_image(&one.ao, &many.ao, method);
+        same_image(&one.composite, &many.composite, method);
+        same_image(&one.sample_count, &many.sample_count, method);
+        same_image(&one.cull_mask, &many.cull_mask, method);
+        same_image(&one.bleed, &many.bleed, method);
+        same_image(&one.luminance, &many.luminance, method);
+        obs_result_free(&many);
+    }
+    obs__cpu_set_threads(before);
+    obs_result_free(&one);
+}
+
+static void test_every_method(void **state)
+{
+    (void)state;
+    for (int m = 0; m < obs__method_count(); m++)
+        check(obs__method_at(m)->name, NULL, OBS_OUTPUT_AO | OBS_OUTPUT_SAMPLE_COUNT);
+}
+
+static void test_chain_variants(void **state)
+{
+    static const char *const half[] = {"ao_resolution", "half", NULL};
+    static const char *const greedy[] = {"culling", "greedy", "ao_definition", "volume", NULL};
+    static const char *const off[] = {"culling", "off", "adaptive", "off", "blur", "off", NULL};
+    static const char *const colour[] = {"luminance", "lum", "bleeding", "half", NULL};
+    static const char *const value[] = {"luminance", "value", NULL};
+    (void)state;
+    check("vaopp", half, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE);
+    check("vaopp", greedy, all_outputs);
+    check("vaopp", off, all_outputs);
+    check("vaopp", colour, all_outputs);
+    check("hbao", value, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_LUMINANCE);
+}
+
+static void test_deep_chain(void **state)
+{
+    obs_deep_image d;
+    obs_deep_result one, many;
+    obs_params p = {0};
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    if (obs_deep_read_exr(TESTDATA "/deep_small.exr", NULL, &d, err) != OBS_OK)
+        fail_msg("deep_small: %s", err);
+    int before = obs__cpu_set_threads(1);
+    assert_int_equal(obs_deep_run_cpu(&d, &p, &one, err), OBS_OK);
+    obs__cpu_set_threads(3);
+    assert_int_equal(obs_deep_run_cpu(&d, &p, &many, err), OBS_OK);
+    obs__cpu_set_threads(before);
+    same_image(&one.ao_blend, &many.ao_blend, "deep ao");
+    same_image(&one.ao_front, &many.ao_front, "deep front ao");
+    same_image(&one.composite, &many.composite, "deep composite");
+    obs_deep_result_free(&one);
+    obs_deep_result_free(&many);
+    obs_deep_free(&d);
+}
+
+/* Every row in exactly one band, bands no taller than asked. */
+static void count_rows(void *ctx, int y0, int y1)
+{
+    int *seen = ctx;
+    assert_true(y0 < y1 && y1 - y0 <= 5);
+    for (int y = y0; y < y1; y++)
+        __atomic_add_fetch(&seen[y], 1, __ATOMIC_RELAXED);
+}
+
+static void test_bands(void **state)
+{
+    int seen[103] = {0};
+    (void)state;
+    int before = obs__cpu_set_threads(4);
+    obs__cpu_rows(103, 5, count_rows, seen);
+    obs__cpu_set_threads(before);
+    for (int y = 0; y < 103; y++)
+        assert_int_equal(seen[y], 1);
+}
+
+/* The planes kept from one frame for the next (planes_cpu.c) carry
+ * nothing over: a frame after frames of other parameters and sizes is the
+ * same bytes as the first. */
+static void test_kept_planes(void **state)
+{
+    static const char *const half[] = {"ao_resolution", "half", "luminance", "lum", NULL};
+    obs_params p = {0}, q = {0};
+    obs_result first, other, again;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    for (int k = 0; half[k]; k += 2)
+        assert_int_equal(obs_param_set(&q, half[k], half[k + 1], err), OBS_OK);
+    assert_int_equal(obs_run_cpu(&room.gb, &p, all_outputs, &first, err), OBS_OK);
+    assert_int_equal(obs_run_cpu(&room.gb, &q, OBS_OUTPUT_AO, &other, err), OBS_OK);
+    obs_result_free(&other);
+    obs_gbuffer small = room.gb;
+    small.width /= 2; /* the left half, rows at their stride */
+    small.depth.row_stride = (size_t)room.gb.width * sizeof(float);
+    small.normal.row_stride = (size_t)room.gb.width * 3 * sizeof(float);
+    small.color.row_stride = (size_t)room.gb.width * 4 * sizeof(float);
+    assert_int_equal(obs_run_cpu(&small, &p, OBS_OUTPUT_AO, &other, err), OBS_OK);
+    obs_result_free(&other);
+    assert_int_equal(obs_run_cpu(&room.gb, &p, all_outputs, &again, err), OBS_OK);
+    same_image(&first.ao, &again.ao, "ao");
+    same_image(&first.composite, &again.composite, "composite");
+    same_image(&first.bleed, &again.bleed, "bleed");
+    same_image(&first.sample_count, &again.sample_count, "sample count");
+    obs_result_free(&first);
+    obs_result_free(&again);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bands),
+        cmocka_unit_test(test_every_method),
+        cmocka_unit_test(test_chain_variants),
+        cmocka_unit_test(test_deep_chain),
+        cmocka_unit_test(test_kept_planes),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
