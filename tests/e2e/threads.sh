@@ -17,17 +17,6 @@ CAMF=tests/data/room_small.camera.json
 FIX=tests/data/levels/aalborg_cut.acc
 . tests/e2e/lib/common.sh
 
-expect() {
-    code=$1; what=$2; shift 3
-    "$@" >"$T/out" 2>"$T/err"
-    rc=$?
-    if [ "$rc" -eq "$code" ]; then ok "$what"; else
-        bad "$what (exit $rc, expected $code)"; sed 's/^/       /' "$T/err" | tail -5; fi
-}
-said() {
-    if grep -q -- "$1" "$T/err" "$T/out"; then ok "message: $1"; else
-        bad "message '$1' missing"; sed 's/^/       /' "$T/err" "$T/out" | tail -5; fi
-}
 # info_threads ARGS...: the process's threads once obscura info made its context
 info_threads() { "$OBSCURA" info "$@" 2>/dev/null | sed -n 's/^process threads: //p'; }
 

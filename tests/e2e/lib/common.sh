@@ -70,3 +70,17 @@ get() {
 }
 # error_is FILE CODE: the body is our JSON error with that code
 error_is() { grep -q "\"code\":\"$2\"" "$1"; }
+
+# expect CODE WHAT -- CMD...: runs CMD (stdout and stderr into $T/out and
+# $T/err), passes when it exits CODE; said TEXT: the last CMD printed it
+expect() {
+    code=$1; what=$2; shift 3
+    "$@" >"$T/out" 2>"$T/err"
+    rc=$?
+    if [ "$rc" -eq "$code" ]; then ok "$what"; else
+        bad "$what (exit $rc, expected $code)"; sed 's/^/       /' "$T/err" | tail -5; fi
+}
+said() {
+    if grep -q -- "$1" "$T/err" "$T/out"; then ok "message: $1"; else
+        bad "message '$1' missing"; sed 's/^/       /' "$T/err" "$T/out" | tail -5; fi
+}
