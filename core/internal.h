@@ -27,6 +27,13 @@ double obs__now_ms(void);
 int obs__size_mul(size_t a, size_t b, size_t *out);
 int obs__size_mul3(size_t a, size_t b, size_t c, size_t *out);
 
+/* One allocation for n arrays made and freed together: array i has
+ * bytes[i] bytes (0 counts as 1), each starts aligned for any type, all
+ * are zero-filled; arr[i] gets array i's start.  arr[0] is the block
+ * itself: free() it alone frees them all.  NULL (arr untouched) when
+ * the sizes overflow or memory runs out. */
+void *obs__alloc_arrays(size_t n, const size_t *bytes, void **arr);
+
 /* Bytes of one plane's row (stride or packed) and pointer to pixel (x, y). */
 size_t obs__plane_stride(const obs_plane *p, int width);
 const float *obs__plane_px(const obs_plane *p, int width, int x, int y);

@@ -30,6 +30,27 @@ int obs__size_mul3(size_t a, size_t b, size_t c, size_t *out)
     return obs__size_mul(ab, c, out);
 }
 
+/* Array i's bytes rounded up to the alignment of any type. */
+static size_t padded(size_t bytes)
+{
+    const size_t align = _Alignof(max_align_t);
+    return ((bytes ? bytes : 1) + align - 1) / align * align;
+}
+
+void *obs__alloc_arrays(size_t n, const size_t *bytes, void **arr)
+{
+    size_t total = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (bytes[i] > SIZE_MAX - _Alignof(max_align_t) - total)
+            return NULL;
+        total += padded(bytes[i]);
+    }
+    unsigned char *block = calloc(1, total ? total : 1);
+    for (size_t i = 0, at = 0; block && i < n; at += padded(bytes[i]), i++)
+        arr[i] = block + at;
+    return block;
+}
+
 obs_status obs_check_size(const obs_limits *lim, int64_t width, int64_t height,
                           char err[OBS_ERR_LEN])
 {

@@ -12,7 +12,7 @@
 /* Surface samples (samples.c); ao and valid are filled by the trace. */
 typedef struct obs__bake_samples {
     size_t count;
-    uint32_t *tri;  /* the face */
+    uint32_t *tri;  /* the face; the one allocation holding all six arrays */
     float *bary;    /* 3 per sample: barycentric weights of its corners */
     float *weight;  /* w = A_t / n_t */
     float *ao;      /* 2 per sample: eq 1 at the short and long distance */

@@ -20,12 +20,7 @@ void obs__bake_samples_free(obs__bake_samples *s)
 {
     if (!s)
         return;
-    free(s->tri);
-    free(s->bary);
-    free(s->weight);
-    free(s->ao);
-    free(s->valid);
-    free(s->first);
+    free(s->tri); /* the block of all six arrays (obs__alloc_arrays) */
     memset(s, 0, sizeof *s);
 }
 
@@ -80,16 +75,17 @@ obs_status obs__bake_samples_make(const obs__bake_world *w, double per_face, int
     size_t n = total(w, hi, max_face);
     if (n > UINT32_MAX)
         return obs__fail(err, OBS_TOO_LARGE, "%zu samples; at most %u", n, (unsigned)UINT32_MAX);
-    s->tri = malloc(n * sizeof *s->tri);
-    s->bary = malloc(n * 3 * sizeof *s->bary);
-    s->weight = malloc(n * sizeof *s->weight);
-    s->ao = calloc(n * 2, sizeof *s->ao);
-    s->valid = calloc(n, 1);
-    s->first = malloc((w->triangle_count + 1) * sizeof *s->first);
-    if (!s->tri || !s->bary || !s->weight || !s->ao || !s->valid || !s->first) {
-        obs__bake_samples_free(s);
+    const size_t bytes[] = {n * sizeof *s->tri, n * 3 * sizeof *s->bary, n * sizeof *s->weight,
+                            n * 2 * sizeof *s->ao, n, (w->triangle_count + 1) * sizeof *s->first};
+    void *a[6];
+    if (!obs__alloc_arrays(6, bytes, a))
         return obs__fail(err, OBS_NO_MEMORY, "%zu samples", n);
-    }
+    s->tri = a[0];
+    s->bary = a[1];
+    s->weight = a[2];
+    s->ao = a[3];
+    s->valid = a[4];
+    s->first = a[5];
     size_t i = 0;
     for (size_t t = 0; t < w->triangle_count; t++) {
         size_t nt = face_count(hi, w->area[t], max_face);

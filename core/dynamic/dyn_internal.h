@@ -36,7 +36,7 @@ int obs__dyn_inside(const obs__bake_bvh *bvh, const float p[3], int rays, float 
  * rays met back faces more often than the limit (2: no memory). */
 typedef struct obs__dyn_points {
     size_t count;
-    float *pos;
+    float *pos; /* the one allocation holding all six arrays */
     double *sh;
     uint32_t *region;
     uint8_t *held;
@@ -63,6 +63,9 @@ obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *b
                                 obs__dyn_points *out, double *valid_seconds,
                                 void (*progress)(void *, size_t, size_t), void *user,
                                 char err[OBS_ERR_LEN]);
+/* The six arrays of n points, zeroed, in one allocation (count is the
+ * caller's to set); free them with obs__dyn_points_free. */
+obs_status obs__dyn_points_alloc(obs__dyn_points *pt, size_t n, char err[OBS_ERR_LEN]);
 void obs__dyn_points_free(obs__dyn_points *pt);
 
 /* Eq 1 at point o for the unit normal n by `rays` cosine-weighted rays

@@ -53,14 +53,25 @@ int obs__dyn_inside(const obs__bake_bvh *bvh, const float p[3], int rays, float 
     return (double)nb > (double)limit * rays;
 }
 
+obs_status obs__dyn_points_alloc(obs__dyn_points *pt, size_t n, char err[OBS_ERR_LEN])
+{
+    const size_t bytes[] = {n * 3 * sizeof *pt->pos, n * OBS_DYN_CHANNELS * sizeof *pt->sh,
+                            n * sizeof *pt->region, n, n * sizeof *pt->id, n};
+    void *a[6];
+    if (!obs__alloc_arrays(6, bytes, a))
+        return obs__fail(err, OBS_NO_MEMORY, "%zu valid points", n);
+    pt->pos = a[0];
+    pt->sh = a[1];
+    pt->region = a[2];
+    pt->held = a[3];
+    pt->id = a[4];
+    pt->dropped = a[5];
+    return OBS_OK;
+}
+
 void obs__dyn_points_free(obs__dyn_points *pt)
 {
-    free(pt->pos);
-    free(pt->sh);
-    free(pt->region);
-    free(pt->held);
-    free(pt->id);
-    free(pt->dropped);
+    free(pt->pos); /* the block of all six arrays (obs__dyn_points_alloc) */
     memset(pt, 0, sizeof *pt);
 }
 
@@ -163,16 +174,10 @@ obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions 
         out->hidden += state[k] == 2;
         nv += state[k] == 0;
     }
-    out->pos = malloc((nv ? nv : 1) * 3 * sizeof *out->pos);
-    out->sh = calloc((nv ? nv : 1) * OBS_DYN_CHANNELS, sizeof *out->sh);
-    out->region = malloc((nv ? nv : 1) * sizeof *out->region);
-    out->held = malloc(nv ? nv : 1);
-    out->id = malloc((nv ? nv : 1) * sizeof *out->id);
-    out->dropped = calloc(nv ? nv : 1, 1);
-    if (!out->pos || !out->sh || !out->region || !out->held || !out->id || !out->dropped) {
+    obs_status rc = obs__dyn_points_alloc(out, nv, err);
+    if (rc != OBS_OK) {
         free(state);
-        obs__dyn_points_free(out);
-        return obs__fail(err, OBS_NO_MEMORY, "%zu valid points", nv);
+        return rc;
     }
     size_t i = 0;
     for (size_t k = 0; k < total; k++) {

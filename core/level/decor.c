@@ -69,8 +69,7 @@ void obs__bake_decor_free(obs__bake_decor *d)
 {
     if (!d)
         return;
-    free(d->node_class);
-    free(d->density);
+    free(d->node_class); /* the block of both arrays (obs__alloc_arrays) */
     memset(d, 0, sizeof *d);
 }
 
@@ -276,12 +275,11 @@ obs_status obs__bake_decor_classify(const obs_bake_scene *s, const obs_bake_para
     obs_bake_params rp;
     obs_bake_params_resolve(p, &rp);
     size_t nn = s ? s->node_count : 0;
-    out->node_class = calloc(nn ? nn : 1, 1);
-    out->density = calloc(nn ? nn : 1, sizeof *out->density);
-    if (!out->node_class || !out->density) {
-        obs__bake_decor_free(out);
+    void *a[2];
+    if (!obs__alloc_arrays(2, (const size_t[]){nn, nn * sizeof *out->density}, a))
         return obs__fail(err, OBS_NO_MEMORY, "decorator classes of %zu nodes", nn);
-    }
+    out->node_class = a[0];
+    out->density = a[1];
     out->node_count = nn;
     if (rp.decorator_source == OBS_BAKE_DECOR_OFF) {
         out->counts[OBS__DECOR_NONE] = nn;

@@ -20,7 +20,7 @@ enum {
 
 typedef struct obs__bake_decor {
     size_t node_count;
-    uint8_t *node_class; /* OBS__DECOR_* per scene node */
+    uint8_t *node_class; /* OBS__DECOR_* per scene node; one allocation with density */
     float *density;      /* per node, fog density for shrubs (1/m), 0 otherwise */
     size_t counts[4];    /* nodes per class */
 } obs__bake_decor;

@@ -12,13 +12,7 @@ void obs__bake_world_free(obs__bake_world *w)
 {
     if (!w)
         return;
-    free(w->pos);
-    free(w->nrm);
-    free(w->tri);
-    free(w->area);
-    free(w->fn);
-    free(w->two_sided);
-    free(w->inst);
+    free(w->pos); /* the block of all seven arrays (obs__alloc_arrays) */
     memset(w, 0, sizeof *w);
 }
 
@@ -102,17 +96,18 @@ obs_status obs__bake_flatten(const obs_bake_scene *s, obs__bake_world *w, char e
     size_t b3;
     if (obs__size_mul(nv, 3 * sizeof(float), &b3) || obs__size_mul(nt, 3 * sizeof(float), &b3))
         return obs__fail(err, OBS_TOO_LARGE, "%zu vertices, %zu triangles", nv, nt);
-    w->pos = malloc(nv * 3 * sizeof(float));
-    w->nrm = malloc(nv * 3 * sizeof(float));
-    w->tri = malloc(nt * 3 * sizeof(uint32_t));
-    w->area = malloc(nt * sizeof(float));
-    w->fn = malloc(nt * 3 * sizeof(float));
-    w->two_sided = malloc(nt);
-    w->inst = malloc(ni * sizeof *w->inst);
-    if (!w->pos || !w->nrm || !w->tri || !w->area || !w->fn || !w->two_sided || !w->inst) {
-        obs__bake_world_free(w);
+    const size_t bytes[] = {nv * 3 * sizeof(float), nv * 3 * sizeof(float), nt * 3 * sizeof(uint32_t),
+                            nt * sizeof(float), nt * 3 * sizeof(float), nt, ni * sizeof *w->inst};
+    void *arr[7];
+    if (!obs__alloc_arrays(7, bytes, arr))
         return obs__fail(err, OBS_NO_MEMORY, "world copy of %zu vertices, %zu triangles", nv, nt);
-    }
+    w->pos = arr[0];
+    w->nrm = arr[1];
+    w->tri = arr[2];
+    w->area = arr[3];
+    w->fn = arr[4];
+    w->two_sided = arr[5];
+    w->inst = arr[6];
     for (size_t n = 0; n < s->node_count; n++) {
         const obs_bake_node *node = &s->nodes[n];
         float nm[9];

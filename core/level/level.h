@@ -33,7 +33,7 @@ typedef struct obs__bake_inst {
 
 typedef struct obs__bake_world {
     size_t vertex_count, triangle_count, instance_count;
-    float *pos;         /* 3 per vertex */
+    float *pos;         /* 3 per vertex; the one allocation holding all seven arrays */
     float *nrm;         /* 3 per vertex, unit; zero where the mesh has none */
     uint32_t *tri;      /* 3 per triangle, world vertex indices */
     float *area;        /* per triangle; 0 for a degenerate one */

@@ -329,10 +329,8 @@ static obs__dyn_points field_points(const obs_dyn_box *b, int g, const obs_dyn_f
     obs__dyn_points pt = {0};
     size_t n = (size_t)g * g * g;
     pt.count = n;
-    pt.pos = malloc(n * 3 * sizeof *pt.pos);
-    pt.sh = malloc(n * OBS_DYN_CHANNELS * sizeof *pt.sh);
-    pt.region = malloc(n * sizeof *pt.region);
-    pt.held = calloc(n, 1);
+    char err[OBS_ERR_LEN];
+    assert_int_equal(obs__dyn_points_alloc(&pt, n, err), OBS_OK);
     for (size_t k = 0; k < n; k++) {
         size_t ix[3] = {k % g, k / g % g, k / ((size_t)g * g)};
         float *q = pt.pos + 3 * k;
@@ -398,10 +396,8 @@ static obs__dyn_points merge_points(obs__dyn_points *a, obs__dyn_points *b)
 {
     obs__dyn_points m = {0};
     m.count = a->count + b->count;
-    m.pos = malloc(m.count * 3 * sizeof *m.pos);
-    m.sh = malloc(m.count * OBS_DYN_CHANNELS * sizeof *m.sh);
-    m.region = malloc(m.count * sizeof *m.region);
-    m.held = calloc(m.count, 1);
+    char err[OBS_ERR_LEN];
+    assert_int_equal(obs__dyn_points_alloc(&m, m.count, err), OBS_OK);
     memcpy(m.pos, a->pos, a->count * 3 * sizeof *m.pos);
     memcpy(m.pos + 3 * a->count, b->pos, b->count * 3 * sizeof *m.pos);
     memcpy(m.sh, a->sh, a->count * OBS_DYN_CHANNELS * sizeof *m.sh);
