@@ -80,12 +80,8 @@ obs_status obs__bake_samples_make(const obs__bake_world *w, double per_face, int
     void *a[6];
     if (!obs__alloc_arrays(6, bytes, a))
         return obs__fail(err, OBS_NO_MEMORY, "%zu samples", n);
-    s->tri = a[0];
-    s->bary = a[1];
-    s->weight = a[2];
-    s->ao = a[3];
-    s->valid = a[4];
-    s->first = a[5];
+    *s = (obs__bake_samples){.tri = a[0], .bary = a[1], .weight = a[2], .ao = a[3], .valid = a[4],
+                             .first = a[5]};
     size_t i = 0;
     for (size_t t = 0; t < w->triangle_count; t++) {
         size_t nt = face_count(hi, w->area[t], max_face);

@@ -63,8 +63,8 @@ obs_status obs__dyn_points_make(const obs__bake_world *w, const obs__bake_bvh *b
                                 obs__dyn_points *out, double *valid_seconds,
                                 void (*progress)(void *, size_t, size_t), void *user,
                                 char err[OBS_ERR_LEN]);
-/* The six arrays of n points, zeroed, in one allocation (count is the
- * caller's to set); free them with obs__dyn_points_free. */
+/* *pt: n points (count n), their six arrays zeroed in one allocation,
+ * every other field 0; free them with obs__dyn_points_free. */
 obs_status obs__dyn_points_alloc(obs__dyn_points *pt, size_t n, char err[OBS_ERR_LEN]);
 void obs__dyn_points_free(obs__dyn_points *pt);
 

@@ -60,12 +60,8 @@ obs_status obs__dyn_points_alloc(obs__dyn_points *pt, size_t n, char err[OBS_ERR
     void *a[6];
     if (!obs__alloc_arrays(6, bytes, a))
         return obs__fail(err, OBS_NO_MEMORY, "%zu valid points", n);
-    pt->pos = a[0];
-    pt->sh = a[1];
-    pt->region = a[2];
-    pt->held = a[3];
-    pt->id = a[4];
-    pt->dropped = a[5];
+    *pt = (obs__dyn_points){.count = n, .pos = a[0], .sh = a[1], .region = a[2], .held = a[3],
+                            .id = a[4], .dropped = a[5]};
     return OBS_OK;
 }
 
@@ -168,10 +164,10 @@ obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions 
         return obs__fail(err, OBS_NO_MEMORY, "valid flags of %zu points", total);
     flag_job fj = {bvh, rg, p, state};
     obs__pool_each(rg->count, 1, p->threads, flag_region, &fj);
-    out->grid = total;
+    size_t inside = 0, hidden = 0;
     for (size_t k = 0; k < total; k++) {
-        out->inside += state[k] == 1;
-        out->hidden += state[k] == 2;
+        inside += state[k] == 1;
+        hidden += state[k] == 2;
         nv += state[k] == 0;
     }
     obs_status rc = obs__dyn_points_alloc(out, nv, err);
@@ -179,6 +175,9 @@ obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions 
         free(state);
         return rc;
     }
+    out->grid = total;
+    out->inside = inside;
+    out->hidden = hidden;
     size_t i = 0;
     for (size_t k = 0; k < total; k++) {
         if (state[k])
@@ -190,7 +189,6 @@ obs_status obs__dyn_points_flag(const obs__bake_bvh *bvh, const obs_dyn_regions 
         out->held[i] = obs__bake_rng_unit(&r) < p->holdout;
         i++;
     }
-    out->count = nv;
     free(state);
     return OBS_OK;
 }

@@ -101,13 +101,8 @@ obs_status obs__bake_flatten(const obs_bake_scene *s, obs__bake_world *w, char e
     void *arr[7];
     if (!obs__alloc_arrays(7, bytes, arr))
         return obs__fail(err, OBS_NO_MEMORY, "world copy of %zu vertices, %zu triangles", nv, nt);
-    w->pos = arr[0];
-    w->nrm = arr[1];
-    w->tri = arr[2];
-    w->area = arr[3];
-    w->fn = arr[4];
-    w->two_sided = arr[5];
-    w->inst = arr[6];
+    *w = (obs__bake_world){.pos = arr[0], .nrm = arr[1], .tri = arr[2], .area = arr[3], .fn = arr[4],
+                           .two_sided = arr[5], .inst = arr[6]};
     for (size_t n = 0; n < s->node_count; n++) {
         const obs_bake_node *node = &s->nodes[n];
         float nm[9];

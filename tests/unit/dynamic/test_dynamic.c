@@ -328,7 +328,6 @@ static obs__dyn_points field_points(const obs_dyn_box *b, int g, const obs_dyn_f
 {
     obs__dyn_points pt = {0};
     size_t n = (size_t)g * g * g;
-    pt.count = n;
     char err[OBS_ERR_LEN];
     assert_int_equal(obs__dyn_points_alloc(&pt, n, err), OBS_OK);
     for (size_t k = 0; k < n; k++) {
@@ -395,9 +394,8 @@ static void test_eq4_recovers_field(void **state)
 static obs__dyn_points merge_points(obs__dyn_points *a, obs__dyn_points *b)
 {
     obs__dyn_points m = {0};
-    m.count = a->count + b->count;
     char err[OBS_ERR_LEN];
-    assert_int_equal(obs__dyn_points_alloc(&m, m.count, err), OBS_OK);
+    assert_int_equal(obs__dyn_points_alloc(&m, a->count + b->count, err), OBS_OK);
     memcpy(m.pos, a->pos, a->count * 3 * sizeof *m.pos);
     memcpy(m.pos + 3 * a->count, b->pos, b->count * 3 * sizeof *m.pos);
     memcpy(m.sh, a->sh, a->count * OBS_DYN_CHANNELS * sizeof *m.sh);
