@@ -462,9 +462,54 @@ static obs_status take_half_planes(reader *r, uint64_t px, uint64_t channels, ob
     return OBS_OK;
 }
 
+/* The fields both G-buffer headers open with: the data window's size,
+ * the display window, the flags. */
+typedef struct window_fields {
+    uint32_t width, height, dx, dy, dw, dh, flags;
+} window_fields;
+
+/* 0 when the payload is shorter than the header's header_len bytes. */
+static int get_window(reader *r, uint64_t header_len, window_fields *w)
+{
+    if (!have(r, header_len))
+        return 0;
+    get_u32(r, &w->width);
+    get_u32(r, &w->height);
+    get_u32(r, &w->dx);
+    get_u32(r, &w->dy);
+    get_u32(r, &w->dw);
+    get_u32(r, &w->dh);
+    get_u32(r, &w->flags);
+    return 1;
+}
+
+/* The two matrices after a header's fields (have() counted them in),
+ * each the camera's where the flags say it is given. */
+static void get_camera(reader *r, uint32_t flags, obs_camera *cam)
+{
+    get(r, cam->world_to_camera, sizeof cam->world_to_camera);
+    get(r, cam->projection, sizeof cam->projection);
+    obs_camera_from_request(cam, flags & OBS_BIN_HAS_WORLD_TO_CAMERA, flags & OBS_BIN_HAS_PROJECTION);
+}
+
+/* The window's size against the limits, the display window's a size
+ * (what: the header's name for the messages). */
+static obs_status check_window(const window_fields *w, const obs_limits *lim, const char *what,
+                               char err[OBS_ERR_LEN])
+{
+    obs_status s = obs_check_size(lim, w->width, w->height, err);
+    if (s != OBS_OK)
+        return s;
+    if ((int32_t)w->dw < 0 || (int32_t)w->dh < 0 || w->dw > (1u << 20) || w->dh > (1u << 20))
+        return fail(err, OBS_BAD_FILE, "%s: display window %u x %u is not a size", what, w->dw,
+                    w->dh);
+    return OBS_OK;
+}
+
 /* The fixed fields of a raw G-buffer, before its planes. */
 typedef struct raw_fields {
-    uint32_t width, height, dx, dy, dw, dh, flags, type;
+    window_fields w;
+    uint32_t type;
     uint64_t px, channels, bytes; /* the planes: pixels, channels, bytes */
 } raw_fields;
 
@@ -473,36 +518,26 @@ typedef struct raw_fields {
  * of the payload (`rest` bytes after the header), exactly. */
 static obs_status get_raw_fields(reader *r, const obs_limits *lim, raw_fields *f, char err[OBS_ERR_LEN])
 {
-    if (!have(r, RAW_HEADER_LEN))
+    if (!get_window(r, RAW_HEADER_LEN, &f->w))
         return truncated(r, "raw G-buffer header", err);
-    get_u32(r, &f->width);
-    get_u32(r, &f->height);
-    get_u32(r, &f->dx);
-    get_u32(r, &f->dy);
-    get_u32(r, &f->dw);
-    get_u32(r, &f->dh);
-    get_u32(r, &f->flags);
     get_u32(r, &f->type);
-    if (f->flags & ~0xfu)
-        return fail(err, OBS_BAD_FILE, "raw G-buffer: unknown flags 0x%x", f->flags);
+    if (f->w.flags & ~0xfu)
+        return fail(err, OBS_BAD_FILE, "raw G-buffer: unknown flags 0x%x", f->w.flags);
     if (f->type != OBS_BIN_F32 && f->type != OBS_BIN_F16)
         return fail(err, OBS_BAD_FILE, "raw G-buffer: plane type %u is neither float32 (0) nor "
                     "float16 (1)", f->type);
-    obs_status s = obs_check_size(lim, f->width, f->height, err);
+    obs_status s = check_window(&f->w, lim, "raw G-buffer", err);
     if (s != OBS_OK)
         return s;
-    if ((int32_t)f->dw < 0 || (int32_t)f->dh < 0 || f->dw > (1u << 20) || f->dh > (1u << 20))
-        return fail(err, OBS_BAD_FILE, "raw G-buffer: display window %u x %u is not a size", f->dw,
-                    f->dh);
     /* Exactly the planes the flags announce, and nothing after them. */
     size_t full = r->full > r->n ? r->full : r->n, rest = full - r->off - 128;
     uint64_t value_size = f->type == OBS_BIN_F16 ? 2 : sizeof(float);
-    f->px = (uint64_t)f->width * f->height;
-    f->channels = 1 + ((f->flags & OBS_BIN_HAS_NORMAL) ? 3 : 0) + ((f->flags & OBS_BIN_HAS_COLOR) ? 4 : 0);
+    f->px = (uint64_t)f->w.width * f->w.height;
+    f->channels = 1 + ((f->w.flags & OBS_BIN_HAS_NORMAL) ? 3 : 0) + ((f->w.flags & OBS_BIN_HAS_COLOR) ? 4 : 0);
     f->bytes = 0;
     if (!mul3(f->px, f->channels, value_size, &f->bytes) || f->bytes != rest)
         return fail(err, OBS_BAD_FILE, "raw G-buffer: %u x %u with %llu %s channels needs %llu bytes "
-                    "of planes, the frame holds %zu", f->width, f->height, (unsigned long long)f->channels,
+                    "of planes, the frame holds %zu", f->w.width, f->w.height, (unsigned long long)f->channels,
                     f->type == OBS_BIN_F16 ? "float16" : "float32", (unsigned long long)f->bytes, rest);
     return OBS_OK;
 }
@@ -513,13 +548,10 @@ static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *
     obs_status s = get_raw_fields(r, lim, &rf, err);
     if (s != OBS_OK)
         return s;
-    uint32_t width = rf.width, height = rf.height, dx = rf.dx, dy = rf.dy, dw = rf.dw, dh = rf.dh;
-    uint32_t flags = rf.flags, type = rf.type;
+    uint32_t width = rf.w.width, height = rf.w.height, dx = rf.w.dx, dy = rf.w.dy, dw = rf.w.dw;
+    uint32_t dh = rf.w.dh, flags = rf.w.flags, type = rf.type;
     obs_gbuffer *gb = &q->gf.gb;
-    obs_camera *cam = &gb->camera;
-    get(r, cam->world_to_camera, sizeof cam->world_to_camera);
-    get(r, cam->projection, sizeof cam->projection);
-    obs_camera_from_request(cam, flags & OBS_BIN_HAS_WORLD_TO_CAMERA, flags & OBS_BIN_HAS_PROJECTION);
+    get_camera(r, flags, &gb->camera);
     uint64_t px = rf.px, channels = rf.channels, bytes = rf.bytes;
     gb->width = (int)width;
     gb->height = (int)height;
@@ -560,7 +592,8 @@ static float sort_key(float z) { return z != z ? INFINITY : z; }
  * OBS_DEEP_MAX_PER_PIXEL and their sum against the total. */
 /* The fixed fields of a deep G-buffer, before its counts. */
 typedef struct deep_fields {
-    uint32_t width, height, dx, dy, dw, dh, flags, values, type, reserved;
+    window_fields w;
+    uint32_t values, type, reserved;
     uint64_t total, npx, sample_bytes;
 } deep_fields;
 
@@ -569,43 +602,33 @@ typedef struct deep_fields {
  * are the rest of the payload, exactly. */
 static obs_status get_deep_fields(reader *r, const obs_limits *lim, deep_fields *f, char err[OBS_ERR_LEN])
 {
-    if (!have(r, DEEP_HEADER_LEN))
+    if (!get_window(r, DEEP_HEADER_LEN, &f->w))
         return truncated(r, "deep G-buffer header", err);
-    get_u32(r, &f->width);
-    get_u32(r, &f->height);
-    get_u32(r, &f->dx);
-    get_u32(r, &f->dy);
-    get_u32(r, &f->dw);
-    get_u32(r, &f->dh);
-    get_u32(r, &f->flags);
     get_u32(r, &f->values);
     get_u32(r, &f->type);
     get_u32(r, &f->reserved);
     get_u64(r, &f->total);
-    if (f->flags & ~(uint32_t)DEEP_FLAGS)
-        return fail(err, OBS_BAD_FILE, "deep G-buffer: unknown flags 0x%x", f->flags);
+    if (f->w.flags & ~(uint32_t)DEEP_FLAGS)
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: unknown flags 0x%x", f->w.flags);
     if (f->values != OBS_DEEP_CH)
         return fail(err, OBS_BAD_FILE, "deep G-buffer: %u values per sample; the layout has %d "
                     "(Z, ZBack, R, G, B, A, N.X, N.Y, N.Z)", f->values, OBS_DEEP_CH);
     if (f->type != OBS_BIN_F32 || f->reserved != 0)
         return fail(err, OBS_BAD_FILE, "deep G-buffer: sample type %u (only float32, 0) or reserved "
                     "field %u (0)", f->type, f->reserved);
-    obs_status s = obs_check_size(lim, f->width, f->height, err);
+    obs_status s = check_window(&f->w, lim, "deep G-buffer", err);
     if (s != OBS_OK)
         return s;
-    if ((int32_t)f->dw < 0 || (int32_t)f->dh < 0 || f->dw > (1u << 20) || f->dh > (1u << 20))
-        return fail(err, OBS_BAD_FILE, "deep G-buffer: display window %u x %u is not a size", f->dw,
-                    f->dh);
     if (f->total > OBS_DEEP_MAX_SAMPLES)
         return fail(err, OBS_TOO_LARGE, "deep G-buffer: %llu samples, over the limit of %llu",
                     (unsigned long long)f->total, (unsigned long long)OBS_DEEP_MAX_SAMPLES);
     /* width x height within the limits, total < 2^25: no overflow below */
     size_t full = r->full > r->n ? r->full : r->n, rest = full - r->off - 128;
-    f->npx = (uint64_t)f->width * f->height;
+    f->npx = (uint64_t)f->w.width * f->w.height;
     f->sample_bytes = f->total * OBS_DEEP_CH * sizeof(float);
     if (f->npx * 4 + f->sample_bytes != rest)
         return fail(err, OBS_BAD_FILE, "deep G-buffer: %u x %u counts and %llu samples need %llu bytes, "
-                    "the frame holds %zu", f->width, f->height, (unsigned long long)f->total,
+                    "the frame holds %zu", f->w.width, f->w.height, (unsigned long long)f->total,
                     (unsigned long long)(f->npx * 4 + f->sample_bytes), rest);
     return OBS_OK;
 }
@@ -616,12 +639,10 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
     obs_status s = get_deep_fields(r, lim, &f, err);
     if (s != OBS_OK)
         return s;
-    uint32_t width = f.width, height = f.height, dx = f.dx, dy = f.dy, dw = f.dw, dh = f.dh;
-    uint32_t flags = f.flags;
+    uint32_t width = f.w.width, height = f.w.height, dx = f.w.dx, dy = f.w.dy, dw = f.w.dw;
+    uint32_t dh = f.w.dh, flags = f.w.flags;
     uint64_t total = f.total, npx = f.npx, sample_bytes = f.sample_bytes;
-    obs_camera *cam = &q->deep.camera;
-    get(r, cam->world_to_camera, sizeof cam->world_to_camera);
-    get(r, cam->projection, sizeof cam->projection);
+    get_camera(r, flags, &q->deep.camera);
     const unsigned char *cp = r->p + r->off;
     uint64_t sum = 0;
     for (uint64_t i = 0; i < npx; i++) {
@@ -672,7 +693,6 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
     d->has_alpha = !!(flags & OBS_BIN_DEEP_ALPHA);
     d->has_color = !!(flags & OBS_BIN_DEEP_COLOR);
     d->has_normal = !!(flags & OBS_BIN_DEEP_NORMAL);
-    obs_camera_from_request(cam, flags & OBS_BIN_HAS_WORLD_TO_CAMERA, flags & OBS_BIN_HAS_PROJECTION);
     return OBS_OK;
 }
 
@@ -794,15 +814,15 @@ static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, 
         if ((s = get_deep_fields(r, lim, &f, err)) != OBS_OK)
             return s;
         r->off += 128; /* the matrices: have() counted them in */
-        h->width = f.width;
-        h->height = f.height;
+        h->width = f.w.width;
+        h->height = f.w.height;
     } else if (body == OBS_BIN_RAW) {
         raw_fields f;
         if ((s = get_raw_fields(r, lim, &f, err)) != OBS_OK)
             return s;
         r->off += 128;
-        h->width = f.width;
-        h->height = f.height;
+        h->width = f.w.width;
+        h->height = f.w.height;
     } else {
         return fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is not EXR (1), raw (2) "
                     "or deep (4)", body);
