@@ -21,6 +21,7 @@ typedef struct node {
     uint32_t count; /* 0 for an inner node */
 } node;
 
+/* One allocation holds the struct, its items and its nodes. */
 struct obs__bake_closest {
     const obs__bake_world *w;
     uint32_t *items; /* world triangle indices */
@@ -165,18 +166,16 @@ obs_status obs__bake_closest_new(const obs__bake_world *w, size_t first, size_t 
                                  obs__bake_closest **out, char err[OBS_ERR_LEN])
 {
     *out = NULL;
-    obs__bake_closest *c = calloc(1, sizeof *c);
-    if (!c)
-        return obs__fail(err, OBS_NO_MEMORY, "nearest-point search");
-    c->w = w;
-    c->items = malloc((count ? count : 1) * sizeof *c->items);
-    c->cen = malloc(3 * (count ? count : 1) * sizeof *c->cen);
+    obs__bake_closest *c;
     /* a binary tree over n leaves of >= 1 item: fewer than 2n nodes */
-    c->nodes = malloc(2 * (count ? count : 1) * sizeof *c->nodes);
-    if (!c->items || !c->cen || !c->nodes) {
-        obs__bake_closest_free(c);
+    const size_t bytes[] = {sizeof *c, count * sizeof *c->items, 2 * count * sizeof *c->nodes};
+    void *a[3];
+    float *cen = malloc(3 * (count ? count : 1) * sizeof *cen);
+    if (!cen || !(c = obs__alloc_arrays(3, bytes, a))) {
+        free(cen);
         return obs__fail(err, OBS_NO_MEMORY, "nearest-point search over %zu triangles", count);
     }
+    *c = (obs__bake_closest){.w = w, .items = a[1], .nodes = a[2], .cen = cen};
     for (size_t t = first; t < first + count; t++) {
         if (!(w->area[t] > 0.0f))
             continue;
@@ -199,12 +198,7 @@ obs_status obs__bake_closest_new(const obs__bake_world *w, size_t first, size_t 
 
 void obs__bake_closest_free(obs__bake_closest *c)
 {
-    if (!c)
-        return;
-    free(c->items);
-    free(c->nodes);
-    free(c->cen);
-    free(c);
+    free(c); /* with its items and nodes; cen went with the build */
 }
 
 static double box_dist2(const node *n, const float p[3])
