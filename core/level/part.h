@@ -60,8 +60,25 @@ obs_status obs__bake_part_payload(const char *path, size_t offset, size_t len, u
  * carry the same value, bit for bit.  TAKE: the merge's p->name is part
  * a's unless row `row` of p's table was given (p->set), when the two
  * must agree. */
-#define OBS__PART_SAME(a, b, name, field)                                           if (memcmp(&(a)->field, &(b)->field, sizeof(a)->field) != 0)                       return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced with different "                          #name " (%g and %g): they are not parts of one bake", (a)->path,                             (b)->path, (double)(a)->field, (double)(b)->field);
-#define OBS__PART_TAKE(p, a, row, name, field)                                      {                                                                                   int row_ = (row);                                                               if (row_ >= 0 && ((p)->set >> row_ & 1)) {                                          if ((p)->name != (a)->field)                                                        return obs__fail(err, OBS_INVALID_ARGUMENT, "the parts were traced with " #name                                  " %g; this merge asks for %g (leave it out to take the parts')",                                  (double)(a)->field, (double)(p)->name);                } else {                                                                            (p)->name = (a)->field;                                                         if (row_ >= 0)                                                                      (p)->set |= (uint64_t)1 << row_;                                        }                                                                           }
+#define OBS__PART_SAME(a, b, name, field)                                                \
+    if (memcmp(&(a)->field, &(b)->field, sizeof(a)->field) != 0)                         \
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced with different " \
+                         #name " (%g and %g): they are not parts of one bake", (a)->path, \
+                         (b)->path, (double)(a)->field, (double)(b)->field);
+#define OBS__PART_TAKE(p, a, row, name, field)                                           \
+    {                                                                                    \
+        int row_ = (row);                                                                \
+        if (row_ >= 0 && ((p)->set >> row_ & 1)) {                                       \
+            if ((p)->name != (a)->field)                                                 \
+                return obs__fail(err, OBS_INVALID_ARGUMENT, "the parts were traced with " #name \
+                                 " %g; this merge asks for %g (leave it out to take the parts')", \
+                                 (double)(a)->field, (double)(p)->name);                 \
+        } else {                                                                         \
+            (p)->name = (a)->field;                                                      \
+            if (row_ >= 0)                                                               \
+                (p)->set |= (uint64_t)1 << row_;                                         \
+        }                                                                                \
+    }
 
 /* What identifies a part among the parts of a split. */
 typedef struct obs__bake_part_key {
