@@ -146,6 +146,27 @@ static const struct {
               "                -q: no line per frame\n"},
 };
 
+/* A parameter's flag: --name with '-' for '_'. */
+static void param_flag(const obs_param_info *pi, char *flag, size_t len)
+{
+    snprintf(flag, len, "--%s", pi->name);
+    for (char *c = flag; *c; c++)
+        if (*c == '_')
+            *c = '-';
+}
+
+/* A parameter's range, its choices or its bounds, as --help writes it
+ * (" {CHOICES}", " [LO..HI]") or as the parameter table does (table:
+ * "CHOICES", "LO .. HI"); "" when it has none. */
+static void param_range(const obs_param_info *pi, int table, char *range, size_t len)
+{
+    range[0] = 0;
+    if ((pi->type == OBS_PARAM_INT && pi->choices) || pi->type == OBS_PARAM_ENUM)
+        snprintf(range, len, table ? "%s" : " {%s}", pi->choices);
+    else if (pi->type == OBS_PARAM_FLOAT || pi->type == OBS_PARAM_INT)
+        snprintf(range, len, table ? "%g .. %g" : " [%g..%g]", pi->min, pi->max);
+}
+
 /* The ao options and the parameter table; the left column widens to
  * the longest entry's line of its own, so no entry is cut. */
 static void usage_ao_options(FILE *f)
@@ -162,17 +183,9 @@ static void usage_ao_options(FILE *f)
     fprintf(f, "\nparameters (the one parameter table; 'obscura params' for details):\n");
     for (int i = 0; i < obs_param_count(); i++) {
         const obs_param_info *pi = obs_param_at(i);
-        char flag[80], range[256] = "";
-        snprintf(flag, sizeof flag, "--%s", pi->name);
-        for (char *c = flag; *c; c++)
-            if (*c == '_')
-                *c = '-';
-        if (pi->type == OBS_PARAM_INT && pi->choices)
-            snprintf(range, sizeof range, " {%s}", pi->choices);
-        else if (pi->type == OBS_PARAM_FLOAT || pi->type == OBS_PARAM_INT)
-            snprintf(range, sizeof range, " [%g..%g]", pi->min, pi->max);
-        else if (pi->type == OBS_PARAM_ENUM)
-            snprintf(range, sizeof range, " {%s}", pi->choices);
+        char flag[80], range[256];
+        param_flag(pi, flag, sizeof flag);
+        param_range(pi, 0, range, sizeof range);
         fprintf(f, "  %-30s %s (default %s%s)\n", flag, pi->doc, pi->def, range);
     }
 }
@@ -1063,22 +1076,14 @@ static int cmd_params(int argc, char **argv)
     for (int i = 0; i < obs_param_count(); i++) {
         const obs_param_info *pi = obs_param_at(i);
         static const char *const types[] = {"float", "int", "enum", "16 floats"};
-        char range[96] = "";
-        if (pi->type == OBS_PARAM_INT && pi->choices)
-            snprintf(range, sizeof range, "%s", pi->choices);
-        else if (pi->type == OBS_PARAM_FLOAT || pi->type == OBS_PARAM_INT)
-            snprintf(range, sizeof range, "%g .. %g", pi->min, pi->max);
-        else if (pi->type == OBS_PARAM_ENUM)
-            snprintf(range, sizeof range, "%s", pi->choices);
+        char range[96];
+        param_range(pi, 1, range, sizeof range);
         if (markdown) /* '|' would end a Markdown table cell */
             for (char *c = range; *c; c++)
                 if (*c == '|')
                     *c = '/';
         char flag[48];
-        snprintf(flag, sizeof flag, "--%s", pi->name);
-        for (char *c = flag; *c; c++)
-            if (*c == '_')
-                *c = '-';
+        param_flag(pi, flag, sizeof flag);
         if (markdown) {
             printf("| `%s` | %s | %s | %s | ", flag, types[pi->type], pi->def, range);
             for (const char *c = pi->doc; *c; c++) { /* a bare '|' would end the cell */

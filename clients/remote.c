@@ -9,6 +9,7 @@
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -189,31 +190,28 @@ static int connect_to(const server_addr *a, char *why, size_t why_len)
     return fd;
 }
 
-static int send_all(int fd, const void *buf, size_t len)
+/* All len bytes sent (sending) or received, through interruptions; -1
+ * on an error or a closed connection. */
+static int transfer_all(int fd, char *buf, size_t len, int sending)
 {
-    for (size_t put = 0; put < len;) {
-        ssize_t n = send(fd, (const char *)buf + put, len - put, MSG_NOSIGNAL);
+    for (size_t done = 0; done < len;) {
+        ssize_t n = sending ? send(fd, buf + done, len - done, MSG_NOSIGNAL)
+                            : recv(fd, buf + done, len - done, 0);
         if (n < 0 && errno == EINTR)
             continue;
         if (n <= 0)
             return -1;
-        put += (size_t)n;
+        done += (size_t)n;
     }
     return 0;
 }
 
-static int recv_all(int fd, void *buf, size_t len)
+static int send_all(int fd, const void *buf, size_t len)
 {
-    for (size_t got = 0; got < len;) {
-        ssize_t n = recv(fd, (char *)buf + got, len - got, 0);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0)
-            return -1;
-        got += (size_t)n;
-    }
-    return 0;
+    return transfer_all(fd, (char *)(uintptr_t)buf, len, 1); /* send only reads it */
 }
+
+static int recv_all(int fd, void *buf, size_t len) { return transfer_all(fd, buf, len, 0); }
 
 /* ---- the parameters to forward ------------------------------------------- */
 

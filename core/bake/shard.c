@@ -70,8 +70,7 @@ static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_tra
 
 static void header_bytes(const obs__bake_part *h, unsigned char b[HEADER])
 {
-    obs__part_range r = {VERSION, h->index, h->count, h->level, h->total, h->first, h->n};
-    obs__part_range_put(b, HEADER, MAGIC, &r);
+    obs__part_range_put(b, HEADER, MAGIC, &h->r);
     obs__le_put64(b + 56, h->rays);
     obs__le_put64(b + 64, h->dropped);
     obs__le_put32(b + 72, (uint32_t)h->rays_per_sample);
@@ -117,22 +116,18 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
                               const obs__bake_trace_desc *td, const obs_bake_params *p,
                               obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
-    obs__bake_part h = {0};
-    h.level = traced_fingerprint(w, td);
-    h.index = (uint32_t)sh->index;
-    h.count = (uint32_t)sh->count;
-    h.total = s->count;
-    h.first = obs__bake_shard_first(s->count, sh->index, sh->count);
-    h.n = obs__bake_shard_first(s->count, sh->index + 1, sh->count) - h.first;
+    obs__bake_part h = {
+        .r = obs__part_range_of(VERSION, traced_fingerprint(w, td), sh->index, sh->count, s->count)};
     part_params(&h, td, p);
     double t = obs__bake_now(), bvh = 0.0;
     obs_status rc = OBS_OK;
     s->rays = 0;
     s->dropped = 0;
-    if (h.n) { /* an empty shard builds no BVH */
+    size_t n = (size_t)h.r.n, first = (size_t)h.r.first;
+    if (n) { /* an empty shard builds no BVH */
         obs__bake_trace_desc d = *td;
-        d.first = (size_t)h.first;
-        d.end = (size_t)(h.first + h.n);
+        d.first = first;
+        d.end = first + n;
         if ((rc = obs__bake_trace(w, s, &d, &bvh, err)) != OBS_OK)
             return rc;
     }
@@ -140,17 +135,17 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
     h.trace_seconds = obs__bake_now() - t - bvh;
     h.rays = s->rays;
     h.dropped = s->dropped;
-    unsigned char *payload = payload_bytes(s, (size_t)h.first, (size_t)h.n);
+    unsigned char *payload = payload_bytes(s, first, n);
     if (!payload)
-        return obs__fail(err, OBS_NO_MEMORY, "the part of %llu samples", (unsigned long long)h.n);
-    h.checksum = obs__bake_fnv(FNV_OFFSET, payload, (size_t)h.n * 9);
+        return obs__fail(err, OBS_NO_MEMORY, "the part of %zu samples", n);
+    h.checksum = obs__bake_fnv(FNV_OFFSET, payload, n * 9);
     unsigned char head[HEADER];
     header_bytes(&h, head);
-    rc = obs__bake_part_write(sh->path, head, HEADER, payload, (size_t)h.n * 9, err);
+    rc = obs__bake_part_write(sh->path, head, HEADER, payload, n * 9, err);
     free(payload);
     st->seconds[OBS_BAKE_STAGE_bvh] = h.bvh_seconds;
     st->seconds[OBS_BAKE_STAGE_trace] = h.trace_seconds;
-    st->samples = (size_t)h.n;
+    st->samples = n;
     sh->stop = 1;
     return rc;
 }
@@ -163,10 +158,8 @@ static const obs__part_format format = {MAGIC, "bake part", "obscura bake --shar
 obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN])
 {
     unsigned char b[HEADER];
-    obs__part_range r = {0};
-    obs_status rc = obs__part_range_read(path, &format, b, &r, err);
-    *h = (obs__bake_part){.path = path, .version = r.version, .index = r.index, .count = r.count,
-                          .level = r.level, .total = r.total, .first = r.first, .n = r.n};
+    *h = (obs__bake_part){0};
+    obs_status rc = obs__part_range_read(path, &format, b, &h->r, err);
     if (rc != OBS_OK)
         return rc;
     h->rays = obs__le_get64(b + 56);
@@ -186,9 +179,9 @@ obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char 
 
 static obs_status read_payload(const obs__bake_part *h, obs__bake_samples *s, char err[OBS_ERR_LEN])
 {
-    size_t n = (size_t)h->n, first = (size_t)h->first;
+    size_t n = (size_t)h->r.n, first = (size_t)h->r.first;
     unsigned char *p;
-    obs_status rc = obs__bake_part_payload(h->path, HEADER, 9 * n, h->checksum, &p, err);
+    obs_status rc = obs__bake_part_payload(h->r.path, HEADER, 9 * n, h->checksum, &p, err);
     if (rc != OBS_OK)
         return rc;
     for (size_t i = 0; i < n; i++) {
@@ -205,7 +198,7 @@ static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs
                               char err[OBS_ERR_LEN])
 {
     uint64_t level = traced_fingerprint(w, td);
-    const obs__bake_part *p0 = &sh->parts[0];
+    const obs__part_range *p0 = &sh->parts[0].r;
     obs_status rc = obs__part_check_level(p0->path, p0->level, level, err);
     if (rc != OBS_OK)
         return rc;

@@ -8,10 +8,7 @@
 
 /* A part's header as read (shard.c documents the layout). */
 typedef struct obs__bake_part {
-    const char *path;
-    uint32_t version, index, count;
-    uint64_t level;             /* fingerprint of the flattened level */
-    uint64_t total, first, n;   /* the level's samples; this part's range */
+    obs__part_range r;          /* level: the traced fingerprint; items: the level's samples */
     uint64_t rays, dropped;
     int32_t rays_per_sample, seed, max_samples_per_face;
     float samples_per_face, distance_short, distance_long, backface_limit;

@@ -60,16 +60,10 @@ static obs_status adopt(obs_bake_params *p, const obs__bake_part *parts, size_t 
     return OBS_OK;
 }
 
-/* A part's header and its key among the parts (level/part.h). */
+/* A part's header (level/part.h reads every part through it). */
 static obs_status read_header(const char *path, void *h, char err[OBS_ERR_LEN])
 {
     return obs__bake_part_read_header(path, h, err);
-}
-
-static obs__bake_part_key key_of(const void *p)
-{
-    const obs__bake_part *h = p;
-    return (obs__bake_part_key){h->path, h->index, h->count, h->level};
 }
 
 obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
@@ -78,8 +72,8 @@ obs_status obs_bake_merge(const obs_bake_scene *scene, obs_bake_desc *desc,
 {
     memset(out, 0, sizeof *out);
     void *parts = NULL;
-    obs_status rc = obs__bake_parts_read(paths, n, sizeof(obs__bake_part), read_header, key_of,
-                                         &parts, err);
+    obs_status rc = obs__bake_parts_read(paths, n, sizeof(obs__bake_part), read_header, &parts,
+                                         err);
     obs__bake_part *ordered = parts;
     obs_bake_desc d = desc ? *desc : (obs_bake_desc){0};
     if (rc == OBS_OK)

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "level/level.h"
+#include "level/part.h"
 #include "obscura/dynamic.h"
 
 /* ---- dyn_regions.c ---------------------------------------------------------- */
@@ -104,10 +105,8 @@ double obs__dyn_blend_ao(const double *sh, const float n[3], float blend, int or
 
 /* A part's header as read (dyn_shard.c documents the layout). */
 typedef struct obs__dyn_part {
-    const char *path;
-    uint32_t version, index, count, regions;
-    uint64_t level;           /* fingerprint of the flattened level */
-    uint64_t total, first, n; /* the valid points; this part's range */
+    obs__part_range r;        /* level: the traced fingerprint; items: the valid points */
+    uint32_t regions;
     uint64_t points;          /* fingerprint of the regions and their valid points */
     int32_t rays, seed, grid, max_regions;
     float distance_short, distance_long, backface_limit, min_region_size;

@@ -95,8 +95,7 @@ uint64_t obs__dyn_points_fingerprint(const obs_dyn_regions *rg, const obs__dyn_p
 
 static void header_bytes(const obs__dyn_part *h, unsigned char b[HEADER])
 {
-    obs__part_range r = {VERSION, h->index, h->count, h->level, h->total, h->first, h->n};
-    obs__part_range_put(b, HEADER, MAGIC, &r);
+    obs__part_range_put(b, HEADER, MAGIC, &h->r);
     obs__le_put64(b + 56, h->points);
     obs__le_put32(b + 64, (uint32_t)h->rays);
     obs__le_put32(b + 68, (uint32_t)h->seed);
@@ -117,11 +116,7 @@ static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
 {
     obs__dyn_part h = {
-        .level = level,
-        .index = (uint32_t)sh->index,
-        .count = (uint32_t)sh->count,
-        .total = pt->count,
-        .first = obs__bake_shard_first(pt->count, sh->index, sh->count),
+        .r = obs__part_range_of(VERSION, level, sh->index, sh->count, pt->count),
         .points = obs__dyn_points_fingerprint(rg, pt),
         .rays = p->rays,
         .seed = p->seed,
@@ -133,15 +128,13 @@ static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
         .min_region_size = p->min_region_size,
         .regions = (uint32_t)rg->count,
     };
-    h.n = obs__bake_shard_first(pt->count, sh->index + 1, sh->count) - h.first;
     for (int k = 0; k < OBS_DYN_STAGE_trace; k++)
         h.prep_seconds += st->seconds[k];
     double t = obs__bake_now();
     pt->rays = 0;
-    obs__dyn_points_trace(bvh, p, pt, (size_t)h.first, (size_t)(h.first + h.n), sh->progress,
-                          sh->progress_user);
+    size_t n = (size_t)h.r.n, first = (size_t)h.r.first, dropped = 0;
+    obs__dyn_points_trace(bvh, p, pt, first, first + n, sh->progress, sh->progress_user);
     h.trace_seconds = obs__bake_now() - t;
-    size_t n = (size_t)h.n, first = (size_t)h.first, dropped = 0;
     unsigned char *payload = malloc(n * (POINT_BYTES + 1) + 1);
     if (!payload)
         return obs__fail(err, OBS_NO_MEMORY, "the part of %zu points", n);
@@ -182,11 +175,9 @@ static const obs__part_format format = {MAGIC, "bake-dynamic part",
 obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char err[OBS_ERR_LEN])
 {
     unsigned char b[HEADER];
-    obs__part_range r = {0};
+    *h = (obs__dyn_part){0};
     /* total at most 2^40: a size the payload's bytes cannot overflow */
-    obs_status rc = obs__part_range_read(path, &format, b, &r, err);
-    *h = (obs__dyn_part){.path = path, .version = r.version, .index = r.index, .count = r.count,
-                         .level = r.level, .total = r.total, .first = r.first, .n = r.n};
+    obs_status rc = obs__part_range_read(path, &format, b, &h->r, err);
     if (rc != OBS_OK)
         return rc;
     h->points = obs__le_get64(b + 56);
@@ -207,9 +198,9 @@ obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char er
 
 static obs_status read_payload(const obs__dyn_part *h, obs__dyn_points *pt, char err[OBS_ERR_LEN])
 {
-    size_t n = (size_t)h->n, first = (size_t)h->first;
+    size_t n = (size_t)h->r.n, first = (size_t)h->r.first;
     unsigned char *p;
-    obs_status rc = obs__bake_part_payload(h->path, HEADER, n * (POINT_BYTES + 1), h->checksum, &p, err);
+    obs_status rc = obs__bake_part_payload(h->r.path, HEADER, n * (POINT_BYTES + 1), h->checksum, &p, err);
     if (rc != OBS_OK)
         return rc;
     for (size_t i = 0; rc == OBS_OK && i < n; i++) {
@@ -219,7 +210,7 @@ static obs_status read_payload(const obs__dyn_part *h, obs__dyn_points *pt, char
         pt->dropped[first + i] = p[POINT_BYTES * n + i];
         if (p[POINT_BYTES * n + i] > 1)
             rc = obs__fail(err, OBS_BAD_FILE, "%s: damaged: point %zu's back-face flag is %u",
-                           h->path, first + i, p[POINT_BYTES * n + i]);
+                           h->r.path, first + i, p[POINT_BYTES * n + i]);
     }
     free(p);
     return rc;
@@ -229,22 +220,22 @@ static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
 {
     const obs__dyn_part *p0 = &sh->parts[0];
-    obs_status rc = obs__part_check_level(p0->path, p0->level, level, err);
+    obs_status rc = obs__part_check_level(p0->r.path, p0->r.level, level, err);
     if (rc != OBS_OK)
         return rc;
-    if (p0->regions != rg->count || p0->total != pt->count ||
+    if (p0->regions != rg->count || p0->r.total != pt->count ||
         p0->points != obs__dyn_points_fingerprint(rg, pt))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: the parts split %llu valid points of %u "
                          "regions; this level, these regions and parameters make %zu of %zu "
-                         "(or other ones): give the merge the shards' --regions", p0->path,
-                         (unsigned long long)p0->total, p0->regions, pt->count, rg->count);
+                         "(or other ones): give the merge the shards' --regions", p0->r.path,
+                         (unsigned long long)p0->r.total, p0->regions, pt->count, rg->count);
     double t = obs__bake_now();
     pt->rays = 0;
     for (int i = 0; i < sh->count; i++) {
         rc = read_payload(&sh->parts[i], pt, err);
         if (rc != OBS_OK)
             return rc;
-        pt->rays += sh->parts[i].n * (uint64_t)sh->parts[i].rays;
+        pt->rays += sh->parts[i].r.n * (uint64_t)sh->parts[i].rays;
         /* the parts' times, summed: the farm's machine time */
         st->seconds[OBS_DYN_STAGE_trace] += sh->parts[i].trace_seconds;
     }

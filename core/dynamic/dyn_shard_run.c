@@ -56,11 +56,11 @@ static obs_status adopt(obs_dyn_params *p, const obs__dyn_part *parts, size_t n,
 #define SAME(name, field) OBS__PART_SAME(a, b, name, field)
         PART_PARAMS(SAME)
 #undef SAME
-        if (a->points != b->points || a->total != b->total)
+        if (a->points != b->points || a->r.total != b->r.total)
             return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced over different "
                              "regions or valid points (%llu and %llu points): they are not parts "
-                             "of one bake", a->path, b->path, (unsigned long long)a->total,
-                             (unsigned long long)b->total);
+                             "of one bake", a->r.path, b->r.path, (unsigned long long)a->r.total,
+                             (unsigned long long)b->r.total);
     }
 #define TAKE(name, field) OBS__PART_TAKE(p, a, row_of(#name), name, field)
     PART_PARAMS(TAKE)
@@ -68,16 +68,10 @@ static obs_status adopt(obs_dyn_params *p, const obs__dyn_part *parts, size_t n,
     return OBS_OK;
 }
 
-/* A part's header and its key among the parts (level/part.h). */
+/* A part's header (level/part.h reads every part through it). */
 static obs_status read_header(const char *path, void *h, char err[OBS_ERR_LEN])
 {
     return obs__dyn_part_read_header(path, h, err);
-}
-
-static obs__bake_part_key key_of(const void *p)
-{
-    const obs__dyn_part *h = p;
-    return (obs__bake_part_key){h->path, h->index, h->count, h->level};
 }
 
 obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
@@ -86,8 +80,8 @@ obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
 {
     memset(out, 0, sizeof *out);
     void *parts = NULL;
-    obs_status rc = obs__bake_parts_read(paths, n, sizeof(obs__dyn_part), read_header, key_of,
-                                         &parts, err);
+    obs_status rc = obs__bake_parts_read(paths, n, sizeof(obs__dyn_part), read_header, &parts,
+                                         err);
     obs__dyn_part *ordered = parts;
     obs_dyn_desc d = desc ? *desc : (obs_dyn_desc){0};
     if (rc == OBS_OK)

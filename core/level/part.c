@@ -211,6 +211,15 @@ obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t 
 
 /* ---- the range every header starts with --------------------------------- */
 
+obs__part_range obs__part_range_of(uint32_t version, uint64_t level, int index, int count,
+                                   size_t total)
+{
+    size_t first = obs__bake_shard_first(total, index, count);
+    return (obs__part_range){.version = version, .index = (uint32_t)index, .count = (uint32_t)count,
+                             .level = level, .total = total, .first = first,
+                             .n = obs__bake_shard_first(total, index + 1, count) - first};
+}
+
 void obs__part_range_put(unsigned char *b, size_t head_len, const char *magic,
                          const obs__part_range *r)
 {
@@ -230,6 +239,7 @@ obs_status obs__part_range_read(const char *path, const obs__part_format *f, uns
                                 obs__part_range *r, char err[OBS_ERR_LEN])
 {
     uint64_t size;
+    r->path = path;
     obs_status rc = obs__bake_part_head(path, f->magic, f->what, f->writer, b, f->head_len, &size,
                                         err);
     if (rc != OBS_OK)
@@ -265,8 +275,7 @@ obs_status obs__part_range_read(const char *path, const obs__part_format *f, uns
 obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
                                 obs_status (*read_header)(const char *path, void *h,
                                                           char err[OBS_ERR_LEN]),
-                                obs__bake_part_key (*key)(const void *h), void **out,
-                                char err[OBS_ERR_LEN])
+                                void **out, char err[OBS_ERR_LEN])
 {
     *out = NULL;
     if (n == 0 || !paths)
@@ -276,8 +285,10 @@ obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
     size_t *order = NULL;
     obs_status rc = heads && keys ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
     for (size_t i = 0; rc == OBS_OK && i < n; i++)
-        if ((rc = read_header(paths[i], heads + i * elem, err)) == OBS_OK)
-            keys[i] = key(heads + i * elem);
+        if ((rc = read_header(paths[i], heads + i * elem, err)) == OBS_OK) {
+            const obs__part_range *r = (const void *)(heads + i * elem);
+            keys[i] = (obs__bake_part_key){r->path, r->index, r->count, r->level};
+        }
     if (rc == OBS_OK && (!(ordered = calloc(keys[0].count, elem)) ||
                          !(order = calloc(keys[0].count, sizeof *order))))
         rc = obs__fail(err, OBS_NO_MEMORY, "%u parts", keys[0].count);

@@ -63,8 +63,8 @@ obs_status obs__bake_part_payload(const char *path, size_t offset, size_t len, u
 #define OBS__PART_SAME(a, b, name, field)                                                \
     if (memcmp(&(a)->field, &(b)->field, sizeof(a)->field) != 0)                         \
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced with different " \
-                         #name " (%g and %g): they are not parts of one bake", (a)->path, \
-                         (b)->path, (double)(a)->field, (double)(b)->field);
+                         #name " (%g and %g): they are not parts of one bake", (a)->r.path, \
+                         (b)->r.path, (double)(a)->field, (double)(b)->field);
 #define OBS__PART_TAKE(p, a, row, name, field)                                           \
     {                                                                                    \
         int row_ = (row);                                                                \
@@ -95,11 +95,19 @@ obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t 
 /* The fields every part's header starts with (bytes 0 .. 56, each bake's
  * layout in its own file): magic, u32 version, u32 header size, u64 level
  * fingerprint, u32 shard index, u32 shard count, u64 items of the whole
- * level, u64 first item of this part, u64 items of this part. */
+ * level, u64 first item of this part, u64 items of this part; and the
+ * part's file, as read (NULL in one being written).  Each bake's part
+ * struct starts with one (member r), so that the merge sees every part
+ * through it. */
 typedef struct obs__part_range {
     uint32_t version, index, count;
     uint64_t level, total, first, n;
+    const char *path;
 } obs__part_range;
+/* Shard index of count over total items, traced from the level with
+ * fingerprint level, in a part of the given version. */
+obs__part_range obs__part_range_of(uint32_t version, uint64_t level, int index, int count,
+                                   size_t total);
 /* Zeroes the head_len bytes of b and writes magic, head_len and r. */
 void obs__part_range_put(unsigned char *b, size_t head_len, const char *magic,
                          const obs__part_range *r);
@@ -120,14 +128,14 @@ typedef struct obs__part_format {
 obs_status obs__part_range_read(const char *path, const obs__part_format *f, unsigned char *b,
                                 obs__part_range *r, char err[OBS_ERR_LEN]);
 /* The n parts at paths (none: "merge: no parts"), their headers read by
- * read_header into elem-byte structs, checked to be every shard of one
- * split once (obs__bake_parts_order, with key's view of a header); *out
- * the headers in shard order (n of them; caller frees). */
+ * read_header into elem-byte structs that start with their
+ * obs__part_range, checked to be every shard of one split once
+ * (obs__bake_parts_order); *out the headers in shard order (n of them;
+ * caller frees). */
 obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
                                 obs_status (*read_header)(const char *path, void *h,
                                                           char err[OBS_ERR_LEN]),
-                                obs__bake_part_key (*key)(const void *h), void **out,
-                                char err[OBS_ERR_LEN]);
+                                void **out, char err[OBS_ERR_LEN]);
 
 /* A merge's part (at path) traced from this level: its fingerprint
  * part_level is the level's, level (obs__bake_traced_fingerprint). */

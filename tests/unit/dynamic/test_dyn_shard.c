@@ -70,9 +70,9 @@ static void shard_all(const obs_bake_scene *sc, const char *name, int n, const c
         fclose(f);
         obs__dyn_part h;
         assert_int_equal(obs__dyn_part_read_header(p, &h, err), OBS_OK);
-        assert_int_equal(h.index, i);
-        assert_int_equal(h.count, n);
-        assert_int_equal(h.first, sum);
+        assert_int_equal(h.r.index, i);
+        assert_int_equal(h.r.count, n);
+        assert_int_equal(h.r.first, sum);
         assert_int_equal(h.rays, atoi(rays));
         sum += np;
     }
