@@ -10,6 +10,7 @@
 #include <math.h>
 
 #include "gl_testutil.h"
+#include "synth_planes.h"
 
 #include "chain/frame.h"
 
@@ -20,9 +21,7 @@
 #define MAXW (W + 2 * G)
 #define MAXH (H + 2 * G)
 
-typedef struct plane {
-    float n[3], c; /* n . p = c, n towards the camera */
-} plane;
+typedef sp_plane plane;
 
 typedef struct scene {
     float depth[MAXW * MAXH];
@@ -30,68 +29,19 @@ typedef struct scene {
     obs_gbuffer gb;
 } scene;
 
-static void ortho(float P[16])
-{
-    const float n = 0.1f, f = 100.0f;
-    memset(P, 0, 16 * sizeof(float));
-    P[0] = 1.0f / (0.5f * W * PX);
-    P[5] = 1.0f / (0.5f * H * PX);
-    P[10] = -2.0f / (f - n);
-    P[11] = -(f + n) / (f - n);
-    P[15] = 1.0f;
-}
+static void ortho(float P[16]) { sp_ortho(P, 0.5f * W * PX, 0.5f * H * PX); }
 
-static void perspective(float P[16])
-{
-    const float n = 0.1f, f = 100.0f, t = 1.0f / tanf(25.0f * (float)M_PI / 180.0f);
-    memset(P, 0, 16 * sizeof(float));
-    P[0] = t * H / W;
-    P[5] = t;
-    P[10] = -(f + n) / (f - n);
-    P[11] = -2.0f * f * n / (f - n);
-    P[14] = -1.0f;
-}
+static void perspective(float P[16]) { sp_perspective(P, 50.0f, W, H); }
 
 /* The W x H display window of camera P, with a guard band of g pixels
  * on every side in the planes; each pixel sees the nearest plane. */
 static void render(scene *s, const float P[16], const plane *pl, int count, int g)
 {
-    int w = W + 2 * g, h = H + 2 * g;
-    memset(s, 0, sizeof *s);
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            float nx = (x - g + 0.5f) / W * 2 - 1, ny = 1 - (y - g + 0.5f) / H * 2;
-            float o[3] = {0, 0, 0}, d[3] = {0, 0, -1}, best = 1e10f;
-            if (P[14] == 0.0f) {
-                o[0] = nx / P[0];
-                o[1] = ny / P[5];
-            } else {
-                d[0] = nx / P[0];
-                d[1] = ny / P[5];
-            }
-            for (int k = 0; k < count; k++) {
-                const float *n = pl[k].n;
-                float t = (pl[k].c - (n[0] * o[0] + n[1] * o[1] + n[2] * o[2])) /
-                          (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
-                if (t > 0 && t < best) {
-                    best = t;
-                    memcpy(&s->normal[3 * (y * w + x)], n, 3 * sizeof(float));
-                }
-            }
-            s->depth[y * w + x] = best; /* d.z = -1: t is the planar depth */
-        }
-    s->gb.width = w;
-    s->gb.height = h;
+    sp_render(s->depth, s->normal, &s->gb, W, H, g, P, pl, count);
     s->gb.display_x = -g;
     s->gb.display_y = -g;
     s->gb.display_width = W;
     s->gb.display_height = H;
-    s->gb.depth = (obs_plane){s->depth, 1, 0};
-    s->gb.normal = (obs_plane){s->normal, 3, 0};
-    memcpy(s->gb.camera.projection, P, 16 * sizeof(float));
-    obs__mat4_identity(s->gb.camera.world_to_camera);
-    s->gb.camera.has_projection = 1;
-    s->gb.camera.has_world_to_camera = 1;
 }
 
 /* The estimator itself: camera-space normals, no blur; VAO++ as the

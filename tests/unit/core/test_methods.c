@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "gl_testutil.h"
+#include "synth_planes.h"
 
 #include "methods/angle.h"
 #include "methods/gtao.h"
@@ -28,71 +29,15 @@ typedef struct scene {
     obs_gbuffer gb;
 } scene;
 
-static void ortho(float P[16])
-{
-    const float n = 0.1f, f = 100.0f;
-    memset(P, 0, 16 * sizeof(float));
-    P[0] = 1.0f / (0.5f * W * PX);
-    P[5] = 1.0f / (0.5f * H * PX);
-    P[10] = -2.0f / (f - n);
-    P[11] = -(f + n) / (f - n);
-    P[15] = 1.0f;
-}
+static void ortho(float P[16]) { sp_ortho(P, 0.5f * W * PX, 0.5f * H * PX); }
 
-static void perspective(float P[16], float fov_y_deg)
-{
-    const float n = 0.1f, f = 100.0f, t = 1.0f / tanf(fov_y_deg * (float)M_PI / 360.0f);
-    memset(P, 0, 16 * sizeof(float));
-    P[0] = t * H / W;
-    P[5] = t;
-    P[10] = -(f + n) / (f - n);
-    P[11] = -2.0f * f * n / (f - n);
-    P[14] = -1.0f;
-}
+static void perspective(float P[16], float fov_y_deg) { sp_perspective(P, fov_y_deg, W, H); }
 
-typedef struct plane {
-    float n[3], c; /* n . p = c */
-} plane;
+typedef sp_plane plane;
 
-/* Each pixel sees the nearest plane (the first one on a tie). */
 static void render(scene *s, const float P[16], const plane *pl, int count)
 {
-    memset(s, 0, sizeof *s);
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            float nx = (x + 0.5f) / W * 2 - 1, ny = 1 - (y + 0.5f) / H * 2;
-            float o[3] = {0, 0, 0}, d[3] = {0, 0, -1}, best = 1e10f;
-            if (P[14] == 0.0f) {
-                o[0] = nx / P[0];
-                o[1] = ny / P[5];
-            } else {
-                d[0] = nx / P[0];
-                d[1] = ny / P[5];
-            }
-            const float *bn = NULL;
-            for (int k = 0; k < count; k++) {
-                float den = pl[k].n[0] * d[0] + pl[k].n[1] * d[1] + pl[k].n[2] * d[2];
-                if (fabsf(den) < 1e-9f)
-                    continue;
-                float t = (pl[k].c - (pl[k].n[0] * o[0] + pl[k].n[1] * o[1] + pl[k].n[2] * o[2])) /
-                          den;
-                if (t > 0 && t < best) {
-                    best = t;
-                    bn = pl[k].n;
-                }
-            }
-            s->depth[y * W + x] = best; /* d.z = -1: t is the planar depth */
-            if (bn)
-                memcpy(&s->normal[3 * (y * W + x)], bn, 3 * sizeof(float));
-        }
-    s->gb.width = W;
-    s->gb.height = H;
-    s->gb.depth = (obs_plane){s->depth, 1, 0};
-    s->gb.normal = (obs_plane){s->normal, 3, 0};
-    memcpy(s->gb.camera.projection, P, 16 * sizeof(float));
-    obs__mat4_identity(s->gb.camera.world_to_camera);
-    s->gb.camera.has_projection = 1;
-    s->gb.camera.has_world_to_camera = 1;
+    sp_render(s->depth, s->normal, &s->gb, W, H, 0, P, pl, count);
 }
 
 /* Parameters of one method on camera-space normals, without the blur

@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "gl_testutil.h"
+#include "synth_planes.h"
 
 #include "methods/methods.h"
 
@@ -19,27 +20,9 @@ typedef struct scene {
     obs_gbuffer gb;
 } scene;
 
-static void ortho(float P[16], float half_w, float half_h)
-{
-    const float n = 0.1f, f = 100.0f;
-    memset(P, 0, 16 * sizeof(float));
-    P[0] = 1.0f / half_w;
-    P[5] = 1.0f / half_h;
-    P[10] = -2.0f / (f - n);
-    P[11] = -(f + n) / (f - n);
-    P[15] = 1.0f;
-}
+static void ortho(float P[16], float half_w, float half_h) { sp_ortho(P, half_w, half_h); }
 
-static void perspective(float P[16], float fov_y_deg)
-{
-    const float n = 0.1f, f = 100.0f, t = 1.0f / tanf(fov_y_deg * (float)M_PI / 360.0f);
-    memset(P, 0, 16 * sizeof(float));
-    P[0] = t * H / W;
-    P[5] = t;
-    P[10] = -(f + n) / (f - n);
-    P[11] = -2.0f * f * n / (f - n);
-    P[14] = -1.0f;
-}
+static void perspective(float P[16], float fov_y_deg) { sp_perspective(P, fov_y_deg, W, H); }
 
 /* Ray of pixel (x, y): origin o, direction d with d.z = -1. */
 static void pixel_ray(const float P[16], int x, int y, float o[3], float d[3])
@@ -58,41 +41,12 @@ static void pixel_ray(const float P[16], int x, int y, float o[3], float d[3])
     d[2] = -1;
 }
 
-/* A scene of planes {n . p = c}; each pixel sees the nearest one. */
-typedef struct plane {
-    float n[3], c;
-} plane;
+typedef sp_plane plane;
 
+/* A scene of planes; each pixel sees the nearest one. */
 static void render(scene *s, const float P[16], const plane *pl, int count)
 {
-    memset(s, 0, sizeof *s);
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            float o[3], d[3], best = 1e10f;
-            const float *bn = NULL;
-            pixel_ray(P, x, y, o, d);
-            for (int k = 0; k < count; k++) {
-                float den = pl[k].n[0] * d[0] + pl[k].n[1] * d[1] + pl[k].n[2] * d[2];
-                if (fabsf(den) < 1e-9f)
-                    continue;
-                float t = (pl[k].c - (pl[k].n[0] * o[0] + pl[k].n[1] * o[1] + pl[k].n[2] * o[2])) / den;
-                if (t > 0 && t < best) {
-                    best = t;
-                    bn = pl[k].n;
-                }
-            }
-            s->depth[y * W + x] = best; /* planar depth: d.z = -1, so t is the depth */
-            if (bn)
-                memcpy(&s->normal[3 * (y * W + x)], bn, 3 * sizeof(float));
-        }
-    s->gb.width = W;
-    s->gb.height = H;
-    s->gb.depth = (obs_plane){s->depth, 1, 0};
-    s->gb.normal = (obs_plane){s->normal, 3, 0};
-    memcpy(s->gb.camera.projection, P, 16 * sizeof(float));
-    obs__mat4_identity(s->gb.camera.world_to_camera);
-    s->gb.camera.has_projection = 1;
-    s->gb.camera.has_world_to_camera = 1;
+    sp_render(s->depth, s->normal, &s->gb, W, H, 0, P, pl, count);
 }
 
 static obs_params camera_normals(int samples)
