@@ -17,19 +17,7 @@
 set -u
 OBSCURA=${OBSCURA:-build/obscura}
 . tests/e2e/lib/common.sh
-
-expect() {
-    code=$1; what=$2; shift 3
-    "$@" >"$T/out" 2>"$T/err"
-    rc=$?
-    if [ "$rc" -eq "$code" ]; then ok "$what"; else
-        bad "$what (exit $rc, expected $code)"; sed 's/^/       /' "$T/err" | tail -5; fi
-}
-said() {
-    if grep -q -- "$1" "$T/err" "$T/out"; then ok "message: $1"; else
-        bad "message '$1' missing"; sed 's/^/       /' "$T/err" | tail -5; fi
-}
-field() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval('d'+sys.argv[2]))" "$@"; }
+SAID_ERR_ONLY=1
 
 echo "e2e bake-dynamic: $OBSCURA"
 FIX=tests/data/levels/aalborg_cut.acc

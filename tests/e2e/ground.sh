@@ -11,19 +11,7 @@ set -u
 OBSCURA=${OBSCURA:-build/obscura}
 SHARED=${OBSCURA_SHARED_DATA:-../shared/data}
 . tests/e2e/lib/common.sh
-
-# expect CODE DESCRIPTION -- command...: runs it, checks the exit code
-expect() {
-    code=$1; what=$2; shift 3
-    "$@" >"$T/out" 2>"$T/err"
-    rc=$?
-    if [ "$rc" -eq "$code" ]; then ok "$what"; else
-        bad "$what (exit $rc, expected $code)"; sed 's/^/       /' "$T/err" | tail -5; fi
-}
-said() {
-    if grep -q -- "$1" "$T/err" "$T/out"; then ok "message: $1"; else
-        bad "message '$1' missing"; sed 's/^/       /' "$T/err" | tail -5; fi
-}
+SAID_ERR_ONLY=1
 json() { sed -n "s/.*\"$1\": \([-0-9.e+]*\).*/\1/p" "$T/out"; }
 
 echo "e2e ground: $OBSCURA"

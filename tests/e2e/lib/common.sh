@@ -73,6 +73,8 @@ error_is() { grep -q "\"code\":\"$2\"" "$1"; }
 
 # expect CODE WHAT -- CMD...: runs CMD (stdout and stderr into $T/out and
 # $T/err), passes when it exits CODE; said TEXT: the last CMD printed it
+# (on a miss, the last lines of $T/err and $T/out; of $T/err alone when
+# the script sets SAID_ERR_ONLY=1)
 expect() {
     code=$1; what=$2; shift 3
     "$@" >"$T/out" 2>"$T/err"
@@ -82,5 +84,8 @@ expect() {
 }
 said() {
     if grep -q -- "$1" "$T/err" "$T/out"; then ok "message: $1"; else
-        bad "message '$1' missing"; sed 's/^/       /' "$T/err" "$T/out" | tail -5; fi
+        shown="$T/err"; [ -n "${SAID_ERR_ONLY:-}" ] || shown="$T/err $T/out"
+        bad "message '$1' missing"; sed 's/^/       /' $shown | tail -5; fi
 }
+# field FILE EXPR: the value at EXPR (e.g. "['counts']['rays']") of a JSON file
+field() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval('d'+sys.argv[2]))" "$@"; }
