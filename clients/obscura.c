@@ -473,7 +473,8 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
     }
     /* PNG: one file per output; NAME.ao.png, NAME.composite.png,
      * NAME.samples.png, NAME.cull.png, NAME.bleed.png, NAME.luminance.png,
-     * NAME.screen.png, NAME.baked.png when there are several */
+     * NAME.screen.png, NAME.baked.png, NAME.multibounce.png when there are
+     * several */
     /* AO images take --png-transfer; data (counts, masks, factors) stays
      * linear; colour is display-encoded */
     enum { DATA, AO, DISPLAY };
@@ -488,9 +489,11 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
                  {&r->bleed, "bleed", DISPLAY},
                  {&r->luminance, "luminance", DATA},
                  {&r->ao_screen, "screen", AO},
-                 {&r->ao_baked, "baked", AO}};
+                 {&r->ao_baked, "baked", AO},
+                 {&r->multibounce, "multibounce", AO}};
     int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data + !!r->cull_mask.data +
-                !!r->bleed.data + !!r->luminance.data + !!r->ao_screen.data + !!r->ao_baked.data;
+                !!r->bleed.data + !!r->luminance.data + !!r->ao_screen.data + !!r->ao_baked.data +
+                !!r->multibounce.data;
     if ((s = one_png_for_stdout(a, count, err)) != OBS_OK)
         return s;
     for (size_t k = 0; k < sizeof files / sizeof files[0] && s == OBS_OK; k++) {

@@ -58,6 +58,7 @@ void obs_result_free(obs_result *r)
     obs_image_free(&r->cull_mask);
     obs_image_free(&r->luminance);
     obs_image_free(&r->bleed);
+    obs_image_free(&r->multibounce);
     obs_image_free(&r->ao_screen);
     obs_image_free(&r->ao_baked);
 }

@@ -11,8 +11,9 @@
 
 enum { Q = OBS_HTTP_QUERY, CLI = OBS_HTTP_CLI, ANY = Q | CLI };
 
-/* The debug outputs are the CLI's only: obscurad answers AO and the
- * composite (clients/remote.c refuses the others with --server). */
+/* The debug outputs are the CLI's only: obscurad answers AO, the
+ * composite, the multi-bounce AO and the AOVs (clients/remote.c refuses
+ * the others with --server). */
 static const obs_http_choice output_choices[] = {
     {"ao", OBS_OUTPUT_AO, ANY},
     {"composite", OBS_OUTPUT_COMPOSITE, ANY},
@@ -21,6 +22,9 @@ static const obs_http_choice output_choices[] = {
     {"cull", OBS_OUTPUT_CULL_MASK, CLI},
     {"bleed", OBS_OUTPUT_BLEED, CLI},
     {"luminance", OBS_OUTPUT_LUMINANCE, CLI},
+    {"multibounce", OBS_OUTPUT_MULTIBOUNCE, ANY},
+    /* a compositor's set in one EXR (README's "AOVs" table) */
+    {"aovs", OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT, ANY},
     {NULL, 0, 0}};
 static const obs_http_choice format_choices[] = {
     {"exr", OBS_HTTP_EXR, ANY}, {"png", OBS_HTTP_PNG, ANY}, {NULL, 0, 0}};

@@ -12,7 +12,7 @@
 /* Every OBS_OUTPUT_* bit. */
 #define OBS__OUTPUTS_ALL                                                                           \
     (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |        \
-     OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE)
+     OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE | OBS_OUTPUT_MULTIBOUNCE)
 
 /* k of R = k * D: the paper's kernel width R (hemisphere radius; the
  * tangent sphere has radius R/2) for the ray-traced AO distance D that the
@@ -289,6 +289,10 @@ float obs__bleed_weight(const float x[3], const float p[3], const float n[3], fl
  * non-zero. */
 float obs__luminance_factor(const obs__frame *f, const float rgb[3]);
 float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3]);
+/* Jimenez et al. 2016 eq 10, the multi-bounce fit of the AO for an albedo
+ * in [0, 1] per channel (multibounce.c; GLSL: obs_multibounce in
+ * composite.frag.glsl). */
+void obs__multibounce(float ao, const float albedo[3], float out[3]);
 
 /* Low-pass filter, VAO++ section 4.6 (GLSL: blur.frag.glsl): one pass of
  * the depth-aware cross-bilateral Gaussian along (dx, dy) at pixel (x, y)

@@ -19,7 +19,10 @@ obs_status obs__plan_init(obs__plan *pl, obs_ctx *log_ctx, const obs_gbuffer *gb
         return s;
     const obs__frame *f = &pl->f;
     pl->gb = gb;
-    pl->outputs = outputs;
+    pl->asked = outputs;
+    pl->multibounce = obs__multibounce_wanted(gb, &p, outputs);
+    /* the fit reads the AO: read back whenever it is made */
+    pl->outputs = pl->multibounce ? outputs | OBS_OUTPUT_AO : outputs & ~OBS_OUTPUT_MULTIBOUNCE;
     pl->method = obs__method_get(f->method);
     /* ao_resolution half: the culling pre-pass, AO and blur run on the
      * half frame, between the downsample and the upsample; everything

@@ -10,16 +10,25 @@
 /* GLSL: composite.frag.glsl.  Section 5: "applied to resulting image
  * simply by multiplication by occlusion values": colour x AO, and x the
  * bleed term (section 4.7) when bleeding is on; grey AO when there is no
- * colour. */
-static void composite_pixel(const float *color, float ao, const float *bleed, float out[4])
+ * colour; with multibounce, the AO of each channel through the fit of
+ * the colour as albedo (obs__multibounce). */
+static void composite_pixel(const float *color, float ao, const float *bleed, int multibounce,
+                            float out[4])
 {
     if (!color) {
         out[0] = out[1] = out[2] = ao;
         out[3] = 1.0f;
         return;
     }
+    float occ[3] = {ao, ao, ao};
+    if (multibounce) {
+        float rho[3];
+        for (int k = 0; k < 3; k++)
+            rho[k] = color[k] > 0.0f ? (color[k] < 1.0f ? color[k] : 1.0f) : 0.0f;
+        obs__multibounce(ao, rho, occ);
+    }
     for (int k = 0; k < 3; k++)
-        out[k] = bleed ? color[k] * ao * bleed[k] : color[k] * ao;
+        out[k] = bleed ? color[k] * occ[k] * bleed[k] : color[k] * occ[k];
     out[3] = color[3];
 }
 
@@ -267,7 +276,7 @@ static void composite_rows(void *ctx, int y0, int y1)
             size_t i = (size_t)y * f->width + x;
             composite_pixel(gb->color.data ? obs__plane_px(&gb->color, f->width, x, y) : NULL,
                             c->ao[i], f->bleed_step ? c->bleed + 3 * i : NULL,
-                            c->out->composite.data + 4 * i);
+                            c->pl->multibounce, c->out->composite.data + 4 * i);
         }
 }
 

@@ -255,6 +255,7 @@ static obs_status run_composite(obs__gl_run *r, char err[OBS_ERR_LEN])
     bind_tex(prog, "u_bleed", 2, t->tex_bleed);
     glUniform1i(glGetUniformLocation(prog, "u_has_color"), r->pl->has_color);
     glUniform1i(glGetUniformLocation(prog, "u_has_bleed"), r->pl->f.bleed_step > 0);
+    glUniform1i(glGetUniformLocation(prog, "u_multibounce"), r->pl->multibounce);
     draw(r->ctx, t->fbo_composite, r->pl->f.width, r->pl->f.height);
     return OBS_OK;
 }

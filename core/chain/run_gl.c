@@ -119,6 +119,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         s = walk(&r, &ran, err);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
+    if (s == OBS_OK)
+        s = obs__multibounce_finish(&pl, out, err);
     if (s != OBS_OK) {
         ctx->times_valid = 0; /* no times for a frame cut short */
         obs_result_free(out);
