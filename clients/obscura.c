@@ -79,8 +79,11 @@ typedef struct cli_opt {
 
 static const cli_opt ao_opts[] = {
     {"o", "FILE", "output file; .exr or .png (also --output-file)"},
-    {"output", "ao|composite|both|samples|cull|bleed|luminance",
-     "what to write (default ao); a comma list combines them; samples: the sample count "
+    {"output", "ao|composite|both|samples|cull|bleed|luminance|multibounce|aovs",
+     "what to write (default ao); a comma list combines them; aovs: the AO, the multi-bounce "
+     "AO and the sample count in one EXR, the layers of README's AOV table (with --append, in "
+     "the input's own file); multibounce: the AO through the albedo-driven multi-bounce fit "
+     "(Jimenez et al. 2016, --multibounce; EXR channels AOMultiBounce.R/G/B); samples: the sample count "
      "of each pixel (adaptive sampling, VAO++ 4.1; EXR channel Samples.Y, PNG count/32); "
      "cull: 1 where the culling pre-pass culled the pixel (VAO++ 4.2; EXR channel Cull.Y); "
      "bleed: the colour-bleed term (VAO++ 4.7, --bleeding; EXR channels Bleed.R/G/B); "
