@@ -79,8 +79,9 @@ typedef struct cli_opt {
 
 static const cli_opt ao_opts[] = {
     {"o", "FILE", "output file; .exr or .png (also --output-file)"},
-    {"output", "ao|composite|both|samples|cull|bleed|luminance|multibounce|aovs",
-     "what to write (default ao); a comma list combines them; aovs: the AO, the multi-bounce "
+    {"output", "ao|composite|both|samples|cull|bleed|luminance|multibounce|aovs|deep",
+     "what to write (default ao); a comma list combines them; deep (deep input, EXR, alone): "
+     "the AO of every kept node as a deep EXR with the flat AO beside it; aovs: the AO, the multi-bounce "
      "AO and the sample count in one EXR, the layers of README's AOV table (with --append, in "
      "the input's own file); multibounce: the AO through the albedo-driven multi-bounce fit "
      "(Jimenez et al. 2016, --multibounce; EXR channels AOMultiBounce.R/G/B); samples: the sample count "
@@ -640,6 +641,13 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
                  "supported (write the AO on its own, without --append)");
         return cli_fail(OBS_UNSUPPORTED, a->in, err);
     }
+    if ((a->req.outputs & OBS_OUTPUT_DEEP) &&
+        (a->req.outputs != OBS_OUTPUT_DEEP || a->req.format != OBS_HTTP_EXR || server ||
+         !strcmp(a->out, "-"))) {
+        snprintf(err, OBS_ERR_LEN, "--output deep writes one deep EXR file in-process: not with other "
+                 "outputs, PNG, --server or stdout");
+        return cli_fail(OBS_INVALID_ARGUMENT, a->in, err);
+    }
     double t0 = now_ms();
     s = a->in_buf ? obs_deep_read_exr_mem(a->in_buf, a->in_len, lim, &d, err) : obs_deep_read_exr(a->in, lim, &d, err);
     if (s != OBS_OK)
@@ -676,7 +684,17 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         goto done;
     const obs_camera *cam = d.camera.has_projection ? &d.camera : NULL;
     int want_ao = (a->req.outputs & OBS_OUTPUT_AO) != 0, want_comp = (a->req.outputs & OBS_OUTPUT_COMPOSITE) != 0;
-    if (a->req.format == OBS_HTTP_EXR) {
+    if (a->req.outputs & OBS_OUTPUT_DEEP) {
+        /* every kept node's AO (the CPU twin of the per-node pass), the
+         * run's flat AO and front AO beside it */
+        obs_deep_ao nodes;
+        s = obs_deep_ao_nodes(&d, &a->req.params, &nodes, err);
+        if (s == OBS_OK)
+            s = obs_deep_ao_write_exr(a->out, &nodes, &r.ao_blend, &r.ao_front, err);
+        obs_deep_ao_free(&nodes);
+        if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
+            fprintf(stderr, "obscura: wrote %s\n", a->out);
+    } else if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[3];
         int n = obs_deep_result_exr_layers(&r, a->req.outputs, layers);
         s = write_exr_out(a, layers, n, cam, d.part, err);
@@ -978,6 +996,9 @@ static int cmd_ao(int argc, char **argv)
             die_usage("ao: --baked: the input is a deep EXR; a baked channel is combined with "
                       "flat input only");
         rc = cmd_ao_deep(&a, &lim, server, argc, argv);
+    } else if (s == OBS_OK && (a.req.outputs & OBS_OUTPUT_DEEP)) {
+        rc = cli_fail(OBS_INVALID_ARGUMENT, a.in,
+                      "--output deep: the input is not a deep EXR (the deep AO is of deep input's nodes)");
     } else {
         rc = ao_flat(&a, &lim, server, argc, argv);
     }

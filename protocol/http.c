@@ -25,6 +25,7 @@ static const obs_http_choice output_choices[] = {
     {"multibounce", OBS_OUTPUT_MULTIBOUNCE, ANY},
     /* a compositor's set in one EXR (README's "AOVs" table) */
     {"aovs", OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT, ANY},
+    {"deep", OBS_OUTPUT_DEEP, CLI},
     {NULL, 0, 0}};
 static const obs_http_choice format_choices[] = {
     {"exr", OBS_HTTP_EXR, ANY}, {"png", OBS_HTTP_PNG, ANY}, {NULL, 0, 0}};

@@ -208,10 +208,14 @@ enum {
                                     sensitivity factor of VAO++ eq 3 (4.3):
                                     1 keeps the pixel's occlusion, 0 removes
                                     it; 1 everywhere when it is off */
-    OBS_OUTPUT_MULTIBOUNCE = 64  /* RGB: the AO through the multi-bounce fit
+    OBS_OUTPUT_MULTIBOUNCE = 64, /* RGB: the AO through the multi-bounce fit
                                     of the colour plane's albedo (parameter
                                     multibounce); not filled without a
                                     colour plane */
+    OBS_OUTPUT_DEEP = 128        /* deep input only, a request option of
+                                    obscura ao: the AO of every kept node as
+                                    a deep EXR (obs_deep_ao_nodes, deep.h);
+                                    obs_run ignores it */
 };
 
 typedef struct obs_result {
