@@ -97,6 +97,7 @@ extern "C" obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao 
         deep.setName("deep");
         deep.setType(DEEPSCANLINE);
         deep.compression() = ZIPS_COMPRESSION;
+        deep.setVersion(1); // the deep data version the C API (and Nuke) require
         // planar per channel: A, A x AO, Z, ZBack of every node in order
         static const char *const names[] = {"A", "AO.Y", "Z", "ZBack"};
         for (const char *n : names)
@@ -105,6 +106,7 @@ extern "C" obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao 
         flt.setName("flat");
         flt.setType(SCANLINEIMAGE);
         flt.compression() = ZIP_COMPRESSION;
+        flt.setVersion(1); // OpenEXR's C API wants it on every part of a file with deep data
         if (flat)
             flt.channels().insert("AO.Y", Channel(FLOAT));
         if (front)
