@@ -286,10 +286,11 @@ obs_status obs_http_request_set_n(obs_http_request *r, const char *name, size_t 
 
 obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LEN])
 {
-    if (r->format == OBS_HTTP_PNG && r->outputs == (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE))
+    if (r->format == OBS_HTTP_PNG && (r->outputs & (r->outputs - 1))) /* more than one */
         return obs_status_fail(err, OBS_INVALID_ARGUMENT,
-                              "format=png holds one image: ask for one output (output=ao or "
-                              "output=composite), or use format=exr for both");
+                              "format=png holds one image: ask for one output (output=ao, "
+                              "output=composite or output=multibounce), or use format=exr for "
+                              "both or aovs");
     if (r->append && r->format != OBS_HTTP_EXR)
         return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "append=1 writes the input EXR back with the AO added: it needs "
