@@ -79,9 +79,10 @@ typedef struct cli_opt {
 
 static const cli_opt ao_opts[] = {
     {"o", "FILE", "output file; .exr or .png (also --output-file)"},
-    {"output", "ao|composite|both|samples|cull|bleed|luminance|multibounce|aovs|deep",
+    {"output", "ao|composite|both|samples|cull|bleed|luminance|multibounce|bent|aovs|deep",
      "what to write (default ao); a comma list combines them; deep (deep input, EXR, alone): "
-     "the AO of every kept node as a deep EXR with the flat AO beside it; aovs: the AO, the multi-bounce "
+     "the AO of every kept node as a deep EXR with the flat AO beside it; bent: the bent normal "
+     "in the normals' space (method gtao; EXR channels BentNormal.X/Y/Z, PNG 0.5 + 0.5 n); aovs: the AO, the multi-bounce "
      "AO and the sample count in one EXR, the layers of README's AOV table (with --append, in "
      "the input's own file); multibounce: the AO through the albedo-driven multi-bounce fit "
      "(Jimenez et al. 2016, --multibounce; EXR channels AOMultiBounce.R/G/B); samples: the sample count "
@@ -447,18 +448,19 @@ static void suffixed(const char *path, const char *suffix, char *buf, size_t len
         snprintf(buf, len, "%.*s.%s%s", (int)(dot - path), path, suffix, dot);
 }
 
-/* The sample count as an image of count / 32 (PNG holds [0, 1]). */
-static obs_status count_scaled(const obs_image *count, obs_image *out)
+/* An image into [0, 1] for PNG: the sample count as count / 32, the bent
+ * normal as 0.5 + 0.5 n. */
+static obs_status png_scaled(const obs_image *img, float scale, float offset, obs_image *out)
 {
-    size_t n = (size_t)count->width * count->height;
+    size_t n = (size_t)img->width * img->height * img->channels;
     out->data = malloc(n * sizeof(float));
     if (!out->data)
         return OBS_NO_MEMORY;
-    out->width = count->width;
-    out->height = count->height;
-    out->channels = 1;
+    out->width = img->width;
+    out->height = img->height;
+    out->channels = img->channels;
     for (size_t i = 0; i < n; i++)
-        out->data[i] = count->data[i] / 32.0f;
+        out->data[i] = offset + scale * img->data[i];
     return OBS_OK;
 }
 
@@ -477,8 +479,8 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
     }
     /* PNG: one file per output; NAME.ao.png, NAME.composite.png,
      * NAME.samples.png, NAME.cull.png, NAME.bleed.png, NAME.luminance.png,
-     * NAME.screen.png, NAME.baked.png, NAME.multibounce.png when there are
-     * several */
+     * NAME.screen.png, NAME.baked.png, NAME.multibounce.png, NAME.bent.png
+     * when there are several */
     /* AO images take --png-transfer; data (counts, masks, factors) stays
      * linear; colour is display-encoded */
     enum { DATA, AO, DISPLAY };
@@ -494,10 +496,11 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
                  {&r->luminance, "luminance", DATA},
                  {&r->ao_screen, "screen", AO},
                  {&r->ao_baked, "baked", AO},
-                 {&r->multibounce, "multibounce", AO}};
+                 {&r->multibounce, "multibounce", AO},
+                 {&r->bent, "bent", DATA}};
     int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data + !!r->cull_mask.data +
                 !!r->bleed.data + !!r->luminance.data + !!r->ao_screen.data + !!r->ao_baked.data +
-                !!r->multibounce.data;
+                !!r->multibounce.data + !!r->bent.data;
     if ((s = one_png_for_stdout(a, count, err)) != OBS_OK)
         return s;
     for (size_t k = 0; k < sizeof files / sizeof files[0] && s == OBS_OK; k++) {
@@ -510,8 +513,9 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
             suffixed(a->out, files[k].suffix, path, sizeof path);
         else
             snprintf(path, sizeof path, "%s", a->out);
-        if (img == &r->sample_count) {
-            s = count_scaled(img, &scaled);
+        if (img == &r->sample_count || img == &r->bent) {
+            s = img == &r->bent ? png_scaled(img, 0.5f, 0.5f, &scaled)
+                                : png_scaled(img, 1.0f / 32.0f, 0.0f, &scaled);
             if (s != OBS_OK) {
                 snprintf(err, OBS_ERR_LEN, "out of memory for the sample-count image");
                 return s;

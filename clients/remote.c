@@ -284,7 +284,8 @@ static const char *outputs_name(unsigned outputs)
     case OBS_OUTPUT_COMPOSITE: return "composite";
     case OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE: return "both";
     case OBS_OUTPUT_MULTIBOUNCE: return "multibounce";
-    case OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT: return "aovs";
+    case OBS_OUTPUT_BENT: return "bent";
+    case OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_BENT: return "aovs";
     default: return NULL;
     }
 }
@@ -335,7 +336,8 @@ static obs_image *answer_slot(answer *a, unsigned output)
     return output == OBS_OUTPUT_AO ? &a->flat->ao
            : output == OBS_OUTPUT_COMPOSITE ? &a->flat->composite
            : output == OBS_OUTPUT_MULTIBOUNCE ? &a->flat->multibounce
-           : output == OBS_OUTPUT_SAMPLE_COUNT ? &a->flat->sample_count : NULL;
+           : output == OBS_OUTPUT_SAMPLE_COUNT ? &a->flat->sample_count
+           : output == OBS_OUTPUT_BENT ? &a->flat->bent : NULL;
 }
 
 /* ---- binary protocol ------------------------------------------------------ */
@@ -438,7 +440,7 @@ static int exr_images(const unsigned char *body, size_t len, const char *ao, obs
                       const char *const *color, int color_ch, obs_image *color_out, char *msg,
                       size_t msg_len)
 {
-    obs_channel_map map = {.preset = "generic", .depth = ao ? ao : "R"};
+    obs_channel_map map = {.preset = "generic", .depth = ao ? ao : color_out ? color[0] : "R"};
     if (color_out)
         for (int c = 0; c < color_ch; c++)
             map.color[c] = color[c];
@@ -478,6 +480,7 @@ static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs
 {
     static const char *const rgba[] = {"R", "G", "B", "A"};
     static const char *const mb[] = {"AOMultiBounce.R", "AOMultiBounce.G", "AOMultiBounce.B"};
+    static const char *const bent[] = {"BentNormal.X", "BentNormal.Y", "BentNormal.Z"};
     int ao = (outputs & OBS_OUTPUT_AO) != 0, comp = (outputs & OBS_OUTPUT_COMPOSITE) != 0;
     if (!res->deep) {
         obs_result *r = res->flat;
@@ -490,6 +493,10 @@ static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs
             exr_images(body, len, count ? "Samples.Y" : NULL, &r->sample_count, mb, 3, &r->multibounce,
                        msg, msg_len))
             return -1;
+        /* the bent normal is left out by methods without one: read when there */
+        if ((outputs & OBS_OUTPUT_BENT) &&
+            exr_images(body, len, NULL, NULL, bent, 3, &r->bent, msg, msg_len))
+            msg[0] = '\0';
         return 0;
     }
     obs_deep_result *d = res->deep;
@@ -716,7 +723,7 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
         return RC_USAGE;
     }
     if (!oname) {
-        fprintf(stderr, "obscura: error: --server: the daemon answers ao, composite, both, multibounce or aovs, not this --output\n");
+        fprintf(stderr, "obscura: error: --server: the daemon answers ao, composite, both, multibounce, bent or aovs, not this --output\n");
         return RC_USAGE;
     }
 

@@ -53,6 +53,7 @@ typedef struct obsd_fp_images {
     const obs_image *composite;
     const obs_image *ao_screen, *ao_baked; /* with a baked channel: AOScreen.Y, AOBaked.Y */
     const obs_image *multibounce, *samples; /* AOMultiBounce.R,G,B; Samples.Y (output aovs) */
+    const obs_image *bent;                  /* BentNormal.X,Y,Z */
     int deep;
 } obsd_fp_images;
 

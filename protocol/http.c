@@ -24,7 +24,8 @@ static const obs_http_choice output_choices[] = {
     {"luminance", OBS_OUTPUT_LUMINANCE, CLI},
     {"multibounce", OBS_OUTPUT_MULTIBOUNCE, ANY},
     /* a compositor's set in one EXR (README's "AOVs" table) */
-    {"aovs", OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT, ANY},
+    {"bent", OBS_OUTPUT_BENT, ANY},
+    {"aovs", OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_BENT, ANY},
     {"deep", OBS_OUTPUT_DEEP, CLI},
     {NULL, 0, 0}};
 static const obs_http_choice format_choices[] = {

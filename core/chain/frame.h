@@ -12,7 +12,7 @@
 /* Every OBS_OUTPUT_* bit. */
 #define OBS__OUTPUTS_ALL                                                                           \
     (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |        \
-     OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE | OBS_OUTPUT_MULTIBOUNCE)
+     OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_BENT)
 
 /* k of R = k * D: the paper's kernel width R (hemisphere radius; the
  * tangent sphere has radius R/2) for the ray-traced AO distance D that the

@@ -24,6 +24,17 @@ obs_status obs__plan_init(obs__plan *pl, obs_ctx *log_ctx, const obs_gbuffer *gb
     /* the fit reads the AO: read back whenever it is made */
     pl->outputs = pl->multibounce ? outputs | OBS_OUTPUT_AO : outputs & ~OBS_OUTPUT_MULTIBOUNCE;
     pl->method = obs__method_get(f->method);
+    /* the bent normal: of the methods that have one (in aovs: when
+     * available), of full-resolution frames */
+    if ((outputs & OBS_OUTPUT_BENT) && !(pl->method && pl->method->pixel_bent)) {
+        pl->outputs &= ~OBS_OUTPUT_BENT;
+        if (!pl->outputs)
+            return obs__fail(err, OBS_INVALID_ARGUMENT,
+                             "method %s has no bent normal (method gtao has one)", obs__method_get(f->method)->name);
+    }
+    if ((pl->outputs & OBS_OUTPUT_BENT) && f->half)
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "ao_resolution half has no bent normal output (use ao_resolution full)");
     /* ao_resolution half: the culling pre-pass, AO and blur run on the
      * half frame, between the downsample and the upsample; everything
      * else at full size */

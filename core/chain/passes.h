@@ -43,6 +43,10 @@ obs_status obs__plan_init(obs__plan *pl, obs_ctx *log_ctx, const obs_gbuffer *gb
 int obs__multibounce_wanted(const obs_gbuffer *gb, const obs_params *p, unsigned outputs);
 void obs__multibounce_image(const obs_gbuffer *gb, const obs_image *ao, obs_image *out);
 obs_status obs__multibounce_finish(const obs__plan *pl, obs_result *out, char err[OBS_ERR_LEN]);
+/* The bent normal (bent_out.c): the method's view-space sums in
+ * out->bent, normalised and turned into the normals' space, after the
+ * readback by every device's driver. */
+void obs__bent_finish(const obs__plan *pl, obs_result *out);
 
 typedef struct obs__pass {
     obs_pass id;      /* its place in the order, its timing slot (obs_pass_times) */

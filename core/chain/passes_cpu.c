@@ -59,7 +59,9 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
             b[0] = b[1] = b[2] = 1.0f;
             if (method->pixel) {
                 /* a comparison method in place of the VAO estimator */
-                ao[i] = obs__method_pixel(f, pos, nrm, x, y, &n);
+                ao[i] = c->out->bent.data
+                            ? obs__method_pixel_bent(f, pos, nrm, x, y, &n, c->out->bent.data + 3 * i)
+                            : obs__method_pixel(f, pos, nrm, x, y, &n);
             } else if (pos[4 * i + 3] > 0.0f) {
                 /* Section 4.2: a culling candidate gets AO 1 (greedy) or
                  * at most the 4-sample set (careful). */

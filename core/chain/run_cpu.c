@@ -71,6 +71,8 @@ obs_status obs__run_cpu_timed(const obs_gbuffer *gb, const obs_params *params, u
         s = walk(&c, times, err);
     if (s == OBS_OK)
         s = obs__multibounce_finish(&pl, out, err);
+    if (s == OBS_OK)
+        obs__bent_finish(&pl, out);
     obs__cpu_planes_give(&c);
     if (s != OBS_OK)
         obs_result_free(out);

@@ -121,6 +121,8 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
     glUseProgram(0);
     if (s == OBS_OK)
         s = obs__multibounce_finish(&pl, out, err);
+    if (s == OBS_OK)
+        obs__bent_finish(&pl, out);
     if (s != OBS_OK) {
         ctx->times_valid = 0; /* no times for a frame cut short */
         obs_result_free(out);

@@ -38,4 +38,17 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
  * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
 void obs__gtao_noise(int tile, float out[2]);
 
+/* obs__gtao_pixel that also sums the bent normal of every slice into
+ * bent[3] (NULL: not wanted): Jimenez et al.'s Algorithm 2 extension as
+ * XeGTAO computes it (obs__gtao_bent_slice, methods/bent.c). */
+float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                           const float p[3], const float n[3], int *count, float bent[3]);
+
+/* The bent normal of one slice, added to acc (GLSL: gtao_bent_slice in
+ * method.glsl): XeGTAO's t0 (along the slice's screen direction od, unit,
+ * orthogonal to v) and t1 (along v) of the horizon angles h0, h1 and the
+ * projected normal's angle gamma, times |n_p|. */
+void obs__gtao_bent_slice(float h0, float h1, float gamma, float np_len, const float od[3],
+                          const float v[3], float acc[3]);
+
 #endif

@@ -219,9 +219,9 @@ typedef struct obs_exr_layer {
  * AO.Y; R,G,B,A (composite); Samples.Y (sample count); Cull.Y (culling
  * mask); Bleed.R,G,B; Luminance.Y; AOScreen.Y and AOBaked.Y (after
  * obs_result_combine_baked: the chain's AO and the baked channel; AO.Y
- * is then their combination); AOMultiBounce.R,G,B.  Fills `layers` with the images the result
+ * is then their combination); AOMultiBounce.R,G,B; BentNormal.X,Y,Z.  Fills `layers` with the images the result
  * holds; returns how many. */
-#define OBS_RESULT_LAYERS 9
+#define OBS_RESULT_LAYERS 10
 int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_LAYERS]);
 
 /* Writes a scanline EXR (ZIP compression) holding every layer's channels;
