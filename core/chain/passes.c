@@ -26,11 +26,13 @@ obs_status obs__plan_init(obs__plan *pl, obs_ctx *log_ctx, const obs_gbuffer *gb
     pl->method = obs__method_get(f->method);
     /* the bent normal: of the methods that have one (in aovs: when
      * available), of full-resolution frames */
-    if ((outputs & OBS_OUTPUT_BENT) && !(pl->method && pl->method->pixel_bent)) {
+    /* vaopp and vao (no pixel function): the chain's estimator has one */
+    if ((outputs & OBS_OUTPUT_BENT) && pl->method && pl->method->pixel && !pl->method->pixel_bent) {
         pl->outputs &= ~OBS_OUTPUT_BENT;
         if (!pl->outputs)
             return obs__fail(err, OBS_INVALID_ARGUMENT,
-                             "method %s has no bent normal (method gtao has one)", obs__method_get(f->method)->name);
+                             "method %s has no bent normal (methods vaopp, vao and gtao have one)",
+                             pl->method->name);
     }
     if ((pl->outputs & OBS_OUTPUT_BENT) && f->half)
         return obs__fail(err, OBS_INVALID_ARGUMENT,

@@ -37,6 +37,27 @@ static void composite_pixel(const float *color, float ao, const float *bleed, in
 #define AO_TILE_H 16
 #endif
 
+/* OBS_OUTPUT_BENT of the VAO estimator at pixel i, which took n samples
+ * (0: culled greedily or background): the scalar estimator's sum of the
+ * same samples (obs__vao_estimate_bent), the view normal where nothing is
+ * open or nothing was sampled on the geometry, 0 on the background.  The
+ * AO stays the SIMD form's. */
+static void vao_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y, int n,
+                     int culled, float bent[3])
+{
+    size_t i = (size_t)y * f->width + x;
+    bent[0] = bent[1] = bent[2] = 0.0f;
+    if (!(pos[4 * i + 3] > 0.0f))
+        return;
+    if (n > 0) {
+        const float *xy = f->adaptive || culled ? f->sample_table + 2 * (n - 2) : f->sample_xy;
+        obs__vao_estimate_bent(f, pos, nrm, x, y, pos + 4 * i, nrm + 3 * i, n, xy, bent);
+    }
+    if (bent[0] == 0.0f && bent[1] == 0.0f && bent[2] == 0.0f)
+        for (int k = 0; k < 3; k++)
+            bent[k] = nrm[3 * i + k];
+}
+
 /* The AO pass over a tile of the frame at the AO's size (GLSL:
  * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
  * (when the composite or the output reads it) and the debug planes (NULL:
@@ -80,6 +101,8 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
                                                   nrm + 3 * i, n, xy, b);
                 }
             }
+            if (c->out->bent.data && !method->pixel)
+                vao_bent(f, pos, nrm, x, y, n, culled, c->out->bent.data + 3 * i);
             if (count)
                 count[i] = (float)n;
             if (mask)

@@ -1,5 +1,7 @@
-/* The bent normal (OBS_OUTPUT_BENT, method gtao: Jimenez et al. 2016,
- * Algorithm 2, as XeGTAO computes it; methods/bent.c): an open floor's
+/* The bent normal (OBS_OUTPUT_BENT; method gtao: Jimenez et al. 2016,
+ * Algorithm 2, as XeGTAO computes it, methods/bent.c; vaopp: the
+ * centroid of the tangent sphere's open volume, chain/vao_bent_cpu.c),
+ * for both methods: an open floor's
  * bent normal is its normal; at a floor-wall crease each side's tilts
  * away from the other, and the two sides' together point along the
  * bisector (by symmetry: the crease's cosine-weighted open directions
@@ -13,11 +15,12 @@
 #include "chain/frame.h"
 #include "synth_corner.h"
 
-static void run(obs_ctx *ctx, const obs_gbuffer *gb, int camera_normals, unsigned out, obs_result *r)
+static void run(obs_ctx *ctx, const char *method, const obs_gbuffer *gb, int camera_normals, unsigned out,
+                obs_result *r)
 {
     obs_params p = {0};
     char err[OBS_ERR_LEN] = "";
-    assert_int_equal(obs_param_set(&p, "method", "gtao", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "method", method, err), OBS_OK);
     if (camera_normals)
         assert_int_equal(obs_param_set(&p, "normal_space", "camera", err), OBS_OK);
     obs_status s = ctx ? obs_run(ctx, gb, &p, out, r, err) : obs_run_cpu(gb, &p, out, r, err);
@@ -54,16 +57,14 @@ static void crease_means(const sc_scene *s, const obs_result *r, double m[3][3])
     }
 }
 
-static void test_crease(void **state)
+static void crease(obs_ctx *ctx, const char *method)
 {
     static sc_scene s;
-    obs_ctx *ctx = make_ctx(OBS_BACKEND_AUTO);
     obs_result cpu, gl;
     double m[3][3], g[3][3];
-    (void)state;
     sc_render(&s);
-    run(NULL, &s.gb, 1, OBS_OUTPUT_AO | OBS_OUTPUT_BENT, &cpu);
-    run(ctx, &s.gb, 1, OBS_OUTPUT_AO | OBS_OUTPUT_BENT, &gl);
+    run(NULL, method, &s.gb, 1, OBS_OUTPUT_AO | OBS_OUTPUT_BENT, &cpu);
+    run(ctx, method, &s.gb, 1, OBS_OUTPUT_AO | OBS_OUTPUT_BENT, &gl);
     crease_means(&s, &cpu, m);
     crease_means(&s, &gl, g);
     /* floor normal (0, 1, 0), wall normal (0, 0, 1); the crease runs along x */
@@ -72,11 +73,11 @@ static void test_crease(void **state)
     double bl = sqrt(both[0] * both[0] + both[1] * both[1] + both[2] * both[2]);
     double off_bisector = deg(acos((both[1] + both[2]) / (bl * sqrt(2.0))));
     double open = deg(acos(m[2][1]));
-    print_message("crease (CPU): floor's bent normal tilted %.1f deg away from the wall, the wall's "
+    print_message("crease, %s (CPU): floor's bent normal tilted %.1f deg away from the wall, the wall's "
                   "%.1f deg away from the floor (a cosine-weighted quarter space at the crease "
                   "line: 32.5 deg), together %.2f deg off the bisector; open floor %.2f deg off its "
                   "normal; x components %.3f %.3f\n",
-                  tilt_floor, tilt_wall, off_bisector, open, m[0][0], m[1][0]);
+                  method, tilt_floor, tilt_wall, off_bisector, open, m[0][0], m[1][0]);
     assert_true(tilt_floor > 10.0 && tilt_floor < 50.0);
     assert_true(tilt_wall > 10.0 && tilt_wall < 50.0);
     assert_true(off_bisector < 5.0);
@@ -93,13 +94,22 @@ static void test_crease(void **state)
         worst = fmax(worst, a);
         sum += a;
     }
-    print_message("crease: GL vs CPU bent normal: mean %.3f deg, worst %.3f deg\n", sum / n, worst);
+    print_message("crease, %s: GL vs CPU bent normal: mean %.3f deg, worst %.3f deg\n", method,
+                  sum / n, worst);
     assert_true(sum / n < 0.05);
     for (int k = 0; k < 3; k++)
         for (int c = 0; c < 3; c++)
             assert_float_equal(g[k][c], m[k][c], 1e-3);
     obs_result_free(&cpu);
     obs_result_free(&gl);
+}
+
+static void test_crease(void **state)
+{
+    obs_ctx *ctx = make_ctx(OBS_BACKEND_AUTO);
+    (void)state;
+    crease(ctx, "vaopp");
+    crease(ctx, "gtao");
     obs_ctx_destroy(ctx);
 }
 
@@ -107,15 +117,14 @@ static void test_crease(void **state)
  * geometry and 0 on the background, and its angle to the normal grows
  * with the occlusion (Pearson correlation of the angle with 1 - AO over
  * the geometry, AO unblurred to match the bent normal). */
-static void test_room_correlation(void **state)
+static void room(const char *method)
 {
     obs_gbuffer_file gf = {0};
     obs_result r;
     obs_params p = {0};
     char err[OBS_ERR_LEN] = "";
-    (void)state;
     load(scenes[0], &gf);
-    assert_int_equal(obs_param_set(&p, "method", "gtao", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "method", method, err), OBS_OK);
     assert_int_equal(obs_param_set(&p, "blur", "off", err), OBS_OK);
     assert_int_equal(obs_run_cpu(&gf.gb, &p, OBS_OUTPUT_AO | OBS_OUTPUT_BENT, &r, err), OBS_OK);
     const obs_gbuffer *gb = &gf.gb;
@@ -138,16 +147,23 @@ static void test_room_correlation(void **state)
         }
     double cov = sxy / cnt - sx / cnt * sy / cnt;
     double rho = cov / sqrt((sxx / cnt - sx * sx / cnt / cnt) * (syy / cnt - sy * sy / cnt / cnt));
-    print_message("room_small, gtao: correlation of the bent normal's angle to the normal with "
+    print_message("room_small, %s: correlation of the bent normal's angle to the normal with "
                   "the occlusion 1 - AO over %.0f pixels: r = %.3f; mean angle for occlusion "
                   "< 0.1: %.1f deg (%.0f px), 0.1-0.3: %.1f (%.0f), 0.3-0.5: %.1f (%.0f), "
                   ">= 0.5: %.1f (%.0f)\n",
-                  cnt, rho, bins[0] / fmax(nb[0], 1), nb[0], bins[1] / fmax(nb[1], 1), nb[1],
+                  method, cnt, rho, bins[0] / fmax(nb[0], 1), nb[0], bins[1] / fmax(nb[1], 1), nb[1],
                   bins[2] / fmax(nb[2], 1), nb[2], bins[3] / fmax(nb[3], 1), nb[3]);
     assert_true(rho > 0.3);
     assert_true(bins[0] / nb[0] < bins[1] / nb[1] && bins[1] / nb[1] < bins[2] / nb[2]);
     obs_result_free(&r);
     obs_gbuffer_free(&gf);
+}
+
+static void test_room_correlation(void **state)
+{
+    (void)state;
+    room("vaopp");
+    room("gtao");
 }
 
 /* Methods without a bent normal: alone it is refused, naming the method;
@@ -160,8 +176,9 @@ static void test_methods_without(void **state)
     char err[OBS_ERR_LEN] = "";
     (void)state;
     sc_render(&s);
+    assert_int_equal(obs_param_set(&p, "method", "hbao", err), OBS_OK);
     assert_int_equal(obs_run_cpu(&s.gb, &p, OBS_OUTPUT_BENT, &r, err), OBS_INVALID_ARGUMENT);
-    assert_non_null(strstr(err, "method vaopp has no bent normal"));
+    assert_non_null(strstr(err, "method hbao has no bent normal"));
     assert_int_equal(obs_run_cpu(&s.gb, &p, OBS_OUTPUT_AO | OBS_OUTPUT_BENT, &r, err), OBS_OK);
     assert_null(r.bent.data);
     assert_non_null(r.ao.data);
