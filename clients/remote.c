@@ -472,6 +472,42 @@ static int exr_images(const unsigned char *body, size_t len, const char *ao, obs
     return rc ? -1 : 0;
 }
 
+/* The three channels `names` of the answer's EXR as one RGB image; none
+ * of them there: no image (0), one missing or another error: -1. */
+static int exr_vector(const unsigned char *body, size_t len, const char *const names[3], obs_image *out,
+                      char *msg, size_t msg_len)
+{
+    obs_image ch[3] = {{0}};
+    char err[OBS_ERR_LEN];
+    int rc = 0, got = 0;
+    for (int k = 0; k < 3 && !rc; k++) {
+        obs_status s = obs_exr_read_channel_mem(body, len, names[k], NULL, &ch[k], err);
+        got += s == OBS_OK;
+        rc = s != OBS_OK && s != OBS_MISSING_CHANNEL;
+    }
+    if (!rc && got == 3) {
+        size_t n = (size_t)ch[0].width * ch[0].height;
+        if (ch[1].width != ch[0].width || ch[2].width != ch[0].width || ch[1].height != ch[0].height ||
+            ch[2].height != ch[0].height || !(out->data = malloc(3 * n * sizeof(float)))) {
+            rc = 1;
+        } else {
+            out->width = ch[0].width;
+            out->height = ch[0].height;
+            out->channels = 3;
+            for (size_t i = 0; i < n; i++)
+                for (int k = 0; k < 3; k++)
+                    out->data[3 * i + k] = ch[k].data[i];
+        }
+    } else if (!rc && got) {
+        rc = 1;
+    }
+    if (rc)
+        snprintf(msg, msg_len, "cannot read the answer's %s: %s", names[0], got ? "incomplete" : err);
+    for (int k = 0; k < 3; k++)
+        obs_image_free(&ch[k]);
+    return rc ? -1 : 0;
+}
+
 /* The answer's EXR (float; AO.Y, deep input's AOFront.Y, R,G,B,A; with
  * aovs or multibounce, AOMultiBounce.R,G,B and Samples.Y) back into
  * images. */
@@ -494,10 +530,7 @@ static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs
                        msg, msg_len))
             return -1;
         /* the bent normal is left out by methods without one: read when there */
-        if ((outputs & OBS_OUTPUT_BENT) &&
-            exr_images(body, len, NULL, NULL, bent, 3, &r->bent, msg, msg_len))
-            msg[0] = '\0';
-        return 0;
+        return (outputs & OBS_OUTPUT_BENT) ? exr_vector(body, len, bent, &r->bent, msg, msg_len) : 0;
     }
     obs_deep_result *d = res->deep;
     if (exr_images(body, len, ao ? "AO.Y" : NULL, &d->ao_blend, rgba, 4, comp ? &d->composite : NULL, msg,
