@@ -6,6 +6,7 @@
 #
 #   docs/aovs_strip.png         albedo | AO.Y | AOMultiBounce | Samples.Y / 32
 #   docs/multibounce_strip.png  albedo x AO | albedo x multi-bounce AO
+#   docs/bent_strip.png         normals | vaopp's bent normal | gtao's (0.5 + 0.5 n)
 #   docs/deep_strip.png         deep fixture, 6x: front node's AO | flat AO |
 #                               oiiotool's flatten of the deep AO (+ 1 - A)
 set -eu
@@ -30,6 +31,12 @@ srgb "$T/c1.exr" "$T/c1.png"
 srgb "$T/c2.exr" "$T/c2.png"
 oiiotool "$T/c1.png" "$T/c2.png" --mosaic:pad=4 2x1 -o docs/multibounce_strip.png
 
+oiiotool "$R" --ch R=ViewLayer.Normal.X,G=ViewLayer.Normal.Y,B=ViewLayer.Normal.Z --mulc 0.5 --addc 0.5 -d uint8 -o "$T/nrm.png"
+for m in vaopp gtao; do
+    "$OBSCURA" ao "$R" --method "$m" --output bent -o "$T/bent_$m.png" -q
+done
+oiiotool "$T/nrm.png" "$T/bent_vaopp.png" "$T/bent_gtao.png" --mosaic:pad=4 3x1 -o docs/bent_strip.png
+
 "$OBSCURA" ao tests/data/deep_small.exr --output deep --blur off --radius 2 --backend cpu -o "$T/deep.exr" -q
 oiiotool "$T/deep.exr" --subimage 1 --ch AOFront.Y,AOFront.Y,AOFront.Y --chnames R,G,B -o "$T/front.exr"
 oiiotool "$T/deep.exr" --subimage 1 --ch AO.Y,AO.Y,AO.Y --chnames R,G,B -o "$T/flat.exr"
@@ -40,4 +47,4 @@ for f in front flat fl; do
     oiiotool "$T/$f.exr" --resize:filter=box 288x192 --colorconvert linear sRGB -d uint8 -o "$T/$f.png"
 done
 oiiotool "$T/front.png" "$T/flat.png" "$T/fl.png" --mosaic:pad=4 3x1 -o docs/deep_strip.png
-echo "wrote docs/aovs_strip.png docs/multibounce_strip.png docs/deep_strip.png"
+echo "wrote docs/aovs_strip.png docs/multibounce_strip.png docs/bent_strip.png docs/deep_strip.png"

@@ -2,8 +2,10 @@
  * and vao).  VAO's tangent sphere of radius R/2 touching p stands for
  * the cosine-weighted hemisphere (its chord from p along a direction at
  * angle theta to n has length R cos theta); the mean unoccluded direction
- * is then the direction from p to the centroid of the sphere's open
- * volume.  Each line sample's pipe (eq 1) has its open part at the near
+ * is taken as the direction from p to the centroid of the sphere's open
+ * volume (the estimator's own measure: a direction's cone of the sphere
+ * moves the centroid by cos^4 theta, not cos theta, so grazing openings
+ * count less than in a ray tracer's cosine-weighted bent normal).  Each line sample's pipe (eq 1) has its open part at the near
  * end, dz long, so its centroid is the sample's disk point moved along
  * view Z to the middle of that part; the volume centroid is the
  * dz-weighted mean of those, and the bent normal is
