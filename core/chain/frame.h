@@ -299,10 +299,6 @@ float obs__bleed_weight(const float x[3], const float p[3], const float n[3], fl
  * non-zero. */
 float obs__luminance_factor(const obs__frame *f, const float rgb[3]);
 float obs__luminance_ao(const obs__frame *f, float ao, const float rgb[3]);
-/* Jimenez et al. 2016 eq 10, the multi-bounce fit of the AO for an albedo
- * in [0, 1] per channel (multibounce.c; GLSL: obs_multibounce in
- * composite.frag.glsl). */
-void obs__multibounce(float ao, const float albedo[3], float out[3]);
 
 /* Low-pass filter, VAO++ section 4.6 (GLSL: blur.frag.glsl): one pass of
  * the depth-aware cross-bilateral Gaussian along (dx, dy) at pixel (x, y)

@@ -17,7 +17,7 @@
  * obs_multibounce in composite.frag.glsl. */
 #include <string.h>
 
-#include "chain/passes.h"
+#include "chain/multibounce.h"
 
 void obs__multibounce(float ao, const float albedo[3], float out[3])
 {
@@ -58,16 +58,17 @@ int obs__multibounce_wanted(const obs_gbuffer *gb, const obs_params *p, unsigned
            (p->multibounce == OBS_ON && (outputs & (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE)));
 }
 
-obs_status obs__multibounce_finish(const obs__plan *pl, obs_result *out, char err[OBS_ERR_LEN])
+obs_status obs__multibounce_finish(const obs_gbuffer *gb, int made, unsigned asked, obs_result *out,
+                                   char err[OBS_ERR_LEN])
 {
-    if (!pl->multibounce)
+    if (!made)
         return OBS_OK;
     obs_status s = obs__image_alloc(&out->multibounce, out->ao.width, out->ao.height, 3, err);
     if (s != OBS_OK)
         return s;
-    obs__multibounce_image(pl->gb, &out->ao, &out->multibounce);
+    obs__multibounce_image(gb, &out->ao, &out->multibounce);
     /* the AO was read back for the fit only */
-    if (!(pl->asked & OBS_OUTPUT_AO))
+    if (!(asked & OBS_OUTPUT_AO))
         obs_image_free(&out->ao);
     return OBS_OK;
 }

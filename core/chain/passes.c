@@ -2,6 +2,7 @@
  * walks it with. */
 #include <string.h>
 
+#include "chain/multibounce.h"
 #include "chain/passes.h"
 
 obs_status obs__plan_init(obs__plan *pl, obs_ctx *log_ctx, const obs_gbuffer *gb,

@@ -35,14 +35,6 @@ typedef struct obs__plan {
 obs_status obs__plan_init(obs__plan *pl, obs_ctx *log_ctx, const obs_gbuffer *gb,
                           const obs_params *params, unsigned outputs, char err[OBS_ERR_LEN]);
 
-/* Multi-bounce AO (multibounce.c, Jimenez et al. 2016 eq 10): whether the
- * frame makes it (a colour plane, and OBS_OUTPUT_MULTIBOUNCE asked or
- * parameter multibounce on with the AO or the composite); the result's
- * image from its AO and the colour plane, made after the readback by
- * every device's driver (the AO read back for it alone is freed). */
-int obs__multibounce_wanted(const obs_gbuffer *gb, const obs_params *p, unsigned outputs);
-void obs__multibounce_image(const obs_gbuffer *gb, const obs_image *ao, obs_image *out);
-obs_status obs__multibounce_finish(const obs__plan *pl, obs_result *out, char err[OBS_ERR_LEN]);
 /* The bent normal (bent_out.c): the method's view-space sums in
  * out->bent, normalised and turned into the normals' space, after the
  * readback by every device's driver. */

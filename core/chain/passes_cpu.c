@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "chain/bands_cpu.h"
+#include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
 #include "chain/vao_cpu.h"
 

@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
 
 static double now_ms(void)
@@ -70,7 +71,7 @@ obs_status obs__run_cpu_timed(const obs_gbuffer *gb, const obs_params *params, u
     if (s == OBS_OK)
         s = walk(&c, times, err);
     if (s == OBS_OK)
-        s = obs__multibounce_finish(&pl, out, err);
+        s = obs__multibounce_finish(pl.gb, pl.multibounce, pl.asked, out, err);
     if (s == OBS_OK)
         obs__bent_finish(&pl, out);
     obs__cpu_planes_give(&c);

@@ -18,7 +18,7 @@
  * normalised by the caller.  GLSL twin: gtao_bent_slice in method.glsl. */
 #include <math.h>
 
-#include "methods/gtao.h"
+#include "methods/bent.h"
 
 void obs__gtao_bent_slice(float h0, float h1, float gamma, float np_len, const float od[3],
                           const float v[3], float acc[3])

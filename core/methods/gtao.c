@@ -48,6 +48,7 @@
  * the view vector of an orthographic camera is +z. */
 #include <math.h>
 
+#include "methods/bent.h"
 #include "methods/gtao.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */

@@ -44,11 +44,4 @@ void obs__gtao_noise(int tile, float out[2]);
 float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                            const float p[3], const float n[3], int *count, float bent[3]);
 
-/* The bent normal of one slice, added to acc (GLSL: gtao_bent_slice in
- * method.glsl): XeGTAO's t0 (along the slice's screen direction od, unit,
- * orthogonal to v) and t1 (along v) of the horizon angles h0, h1 and the
- * projected normal's angle gamma, times |n_p|. */
-void obs__gtao_bent_slice(float h0, float h1, float gamma, float np_len, const float od[3],
-                          const float v[3], float acc[3]);
-
 #endif

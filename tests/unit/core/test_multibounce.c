@@ -6,7 +6,7 @@
 
 #include "gl_testutil.h"
 
-#include "chain/frame.h"
+#include "chain/multibounce.h"
 #include "obscura/io.h"
 
 /* The fit's published coefficients (the paper's eq 10, XeGTAO's and
