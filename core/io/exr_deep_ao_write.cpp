@@ -11,38 +11,16 @@
 #include <ImfDeepFrameBuffer.h>
 #include <ImfDeepScanLineOutputPart.h>
 #include <ImfFrameBuffer.h>
-#include <ImfHeader.h>
-#include <ImfMatrixAttribute.h>
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputPart.h>
 #include <ImfPartType.h>
-#include <ImfStringAttribute.h>
 #include <ImathBox.h>
-#include <ImathMatrix.h>
-#include <cstdarg>
-#include <cstdio>
-#include <exception>
-#include <new>
 #include <vector>
 
-#include "io/out_file.h"
+#include "io/exr_deep_cpp.h"
 #include "obscura/deep.h"
 
-// exr_internal.h (a C header that includes openexr.h) declares it too.
-extern "C" void obs__exr_camera_matrices(const obs_camera *cam, float wtc[16], float ndc[16]);
-
 using namespace OPENEXR_IMF_NAMESPACE;
-
-static obs_status fail(char *err, obs_status s, const char *fmt, ...)
-{
-    if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        std::vsnprintf(err, OBS_ERR_LEN, fmt, ap);
-        va_end(ap);
-    }
-    return s;
-}
 
 // The header both parts share: the windows, the camera, the version.
 static Header base_header(const obs_deep_ao *a)
@@ -54,21 +32,7 @@ static Header base_header(const obs_deep_ao *a)
     IMATH_NAMESPACE::Box2i data(IMATH_NAMESPACE::V2i(a->display_x, a->display_y),
                                 IMATH_NAMESPACE::V2i(a->display_x + w - 1, a->display_y + h - 1));
     Header hdr(display, data);
-    hdr.insert("obscura/version", StringAttribute(OBS_VERSION));
-    const obs_camera *cam = &a->camera;
-    if (cam->has_world_to_camera) {
-        float wtc[16], ndc[16];
-        obs__exr_camera_matrices(cam, wtc, ndc);
-        IMATH_NAMESPACE::M44f mw, mn;
-        for (int r = 0; r < 4; r++)
-            for (int c = 0; c < 4; c++) {
-                mw[r][c] = wtc[4 * r + c];
-                mn[r][c] = ndc[4 * r + c];
-            }
-        hdr.insert("worldToCamera", M44fAttribute(mw));
-        if (cam->has_projection)
-            hdr.insert("worldToNDC", M44fAttribute(mn));
-    }
+    obs__deep_header_attrs(hdr, &a->camera);
     return hdr;
 }
 
@@ -77,22 +41,19 @@ extern "C" obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao 
                                             char err[OBS_ERR_LEN])
 {
     if (!path || !*path || !a || !a->offset || a->width <= 0 || a->height <= 0)
-        return fail(err, OBS_INVALID_ARGUMENT, "obs_deep_ao_write_exr: no path or no deep AO");
+        return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "obs_deep_ao_write_exr: no path or no deep AO");
     const int w = a->width, h = a->height;
     const size_t npx = (size_t)w * (size_t)h;
     const obs_image *flats[2] = {flat, front};
     for (const obs_image *im : flats)
         if (im && (!im->data || im->width != w || im->height != h || im->channels != 1))
-            return fail(err, OBS_INVALID_ARGUMENT, "%s: the flat AO is %dx%d, the deep AO %dx%d", path,
+            return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "%s: the flat AO is %dx%d, the deep AO %dx%d", path,
                         im->width, im->height, w, h);
     for (size_t i = 0; i < npx; i++)
         if (a->offset[i + 1] < a->offset[i] || a->offset[i + 1] - a->offset[i] > OBS_DEEP_MAX_LAYERS)
-            return fail(err, OBS_INVALID_ARGUMENT, "%s: pixel %zu holds %llu nodes; at most %d", path, i,
+            return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "%s: pixel %zu holds %llu nodes; at most %d", path, i,
                         (unsigned long long)(a->offset[i + 1] - a->offset[i]), OBS_DEEP_MAX_LAYERS);
-    obs__out_file out;
-    const char *tmp = obs__out_begin(&out, path);
-    obs_status st = OBS_OK;
-    try {
+    return obs__deep_write_file(path, "deep AO", err, [&](const char *tmp) {
         Header deep = base_header(a);
         deep.setName("deep");
         deep.setType(DEEPSCANLINE);
@@ -158,17 +119,5 @@ extern "C" obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao 
             fp.setFrameBuffer(ff);
             fp.writePixels(h);
         }
-    } catch (const std::bad_alloc &) {
-        st = fail(err, OBS_NO_MEMORY, "%s: out of memory writing the deep AO", path);
-    } catch (const std::exception &e) {
-        st = fail(err, OBS_IO, "%s: %s", path, e.what());
-    } catch (...) {
-        st = fail(err, OBS_IO, "%s: cannot write the deep AO", path);
-    }
-    if (st != OBS_OK)
-        return obs__out_end(&out, st, NULL);
-    char sub[OBS_ERR_LEN] = "";
-    if ((st = obs__out_end(&out, st, sub)) != OBS_OK)
-        return fail(err, st, "%s: %s", path, sub);
-    return OBS_OK;
+    });
 }
