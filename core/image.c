@@ -27,24 +27,36 @@ void obs_image_free(obs_image *img)
     memset(img, 0, sizeof *img);
 }
 
+/* Every image of a result, its place and channels: those with an output
+ * are the ones obs__alloc_result makes when it is asked for (in this
+ * order), the others (0) are made by their passes; obs_result_free frees
+ * them all. */
+static const struct {
+    unsigned output;
+    size_t at;
+    int channels;
+} result_images[] = {
+    {OBS_OUTPUT_AO, offsetof(obs_result, ao), 1},
+    {OBS_OUTPUT_COMPOSITE, offsetof(obs_result, composite), 4},
+    {OBS_OUTPUT_SAMPLE_COUNT, offsetof(obs_result, sample_count), 1},
+    {OBS_OUTPUT_CULL_MASK, offsetof(obs_result, cull_mask), 1},
+    {OBS_OUTPUT_LUMINANCE, offsetof(obs_result, luminance), 1},
+    {OBS_OUTPUT_BLEED, offsetof(obs_result, bleed), 3},
+    {OBS_OUTPUT_BENT, offsetof(obs_result, bent), 3},
+    {0, offsetof(obs_result, multibounce), 3},
+    {0, offsetof(obs_result, ao_screen), 1},
+    {0, offsetof(obs_result, ao_baked), 1},
+};
+#define RESULT_IMAGES (sizeof result_images / sizeof result_images[0])
+
 obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
     obs_status s = OBS_OK;
-    if (outputs & OBS_OUTPUT_AO)
-        s = obs__image_alloc(&out->ao, w, h, 1, err);
-    if (s == OBS_OK && (outputs & OBS_OUTPUT_COMPOSITE))
-        s = obs__image_alloc(&out->composite, w, h, 4, err);
-    if (s == OBS_OK && (outputs & OBS_OUTPUT_SAMPLE_COUNT))
-        s = obs__image_alloc(&out->sample_count, w, h, 1, err);
-    if (s == OBS_OK && (outputs & OBS_OUTPUT_CULL_MASK))
-        s = obs__image_alloc(&out->cull_mask, w, h, 1, err);
-    if (s == OBS_OK && (outputs & OBS_OUTPUT_LUMINANCE))
-        s = obs__image_alloc(&out->luminance, w, h, 1, err);
-    if (s == OBS_OK && (outputs & OBS_OUTPUT_BLEED))
-        s = obs__image_alloc(&out->bleed, w, h, 3, err);
-    if (s == OBS_OK && (outputs & OBS_OUTPUT_BENT))
-        s = obs__image_alloc(&out->bent, w, h, 3, err);
+    for (size_t i = 0; s == OBS_OK && i < RESULT_IMAGES; i++)
+        if (outputs & result_images[i].output)
+            s = obs__image_alloc((obs_image *)((char *)out + result_images[i].at), w, h,
+                                 result_images[i].channels, err);
     if (s != OBS_OK)
         obs_result_free(out);
     return s;
@@ -52,16 +64,6 @@ obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs, ch
 
 void obs_result_free(obs_result *r)
 {
-    if (!r)
-        return;
-    obs_image_free(&r->ao);
-    obs_image_free(&r->composite);
-    obs_image_free(&r->sample_count);
-    obs_image_free(&r->cull_mask);
-    obs_image_free(&r->luminance);
-    obs_image_free(&r->bleed);
-    obs_image_free(&r->multibounce);
-    obs_image_free(&r->bent);
-    obs_image_free(&r->ao_screen);
-    obs_image_free(&r->ao_baked);
+    for (size_t i = 0; r && i < RESULT_IMAGES; i++)
+        obs_image_free((obs_image *)((char *)r + result_images[i].at));
 }

@@ -260,21 +260,22 @@ static int run_frame(frame *f, obs_bin_request *q)
     obs_bin_response_desc d = {.id = f->id, .status = 200, .code = "ok", .message = "",
                                .warnings = said, .warning_count = fp.gf.info.warning_count,
                                .blob = blob.data, .blob_len = blob.size};
-    obs_bin_image images[6];
+    /* the raw images, in the order the answer carries them */
+    const struct {
+        unsigned output;
+        const obs_image *image;
+    } raw[] = {{OBS_OUTPUT_AO, im.ao},
+               {OBS_BIN_OUTPUT_AO_FRONT, im.ao_front},
+               {OBS_OUTPUT_COMPOSITE, im.composite},
+               {OBS_OUTPUT_MULTIBOUNCE, im.multibounce},
+               {OBS_OUTPUT_SAMPLE_COUNT, im.samples},
+               {OBS_OUTPUT_BENT, im.bent}};
+    obs_bin_image images[sizeof raw / sizeof raw[0]];
     int n = 0;
     if (q->raw_out) {
-        if (im.ao)
-            images[n++] = (obs_bin_image){OBS_OUTPUT_AO, *im.ao};
-        if (im.ao_front)
-            images[n++] = (obs_bin_image){OBS_BIN_OUTPUT_AO_FRONT, *im.ao_front};
-        if (im.composite)
-            images[n++] = (obs_bin_image){OBS_OUTPUT_COMPOSITE, *im.composite};
-        if (im.multibounce)
-            images[n++] = (obs_bin_image){OBS_OUTPUT_MULTIBOUNCE, *im.multibounce};
-        if (im.samples)
-            images[n++] = (obs_bin_image){OBS_OUTPUT_SAMPLE_COUNT, *im.samples};
-        if (im.bent)
-            images[n++] = (obs_bin_image){OBS_OUTPUT_BENT, *im.bent};
+        for (size_t i = 0; i < sizeof raw / sizeof raw[0]; i++)
+            if (raw[i].image)
+                images[n++] = (obs_bin_image){raw[i].output, *raw[i].image};
         d.body = OBS_BIN_RAW;
         d.images = images;
         d.image_count = n;
