@@ -17,7 +17,8 @@
 #define RAW_HEADER_LEN 160  /* width .. projection, see PROTOCOL.md */
 #define DEEP_HEADER_LEN 176 /* width .. projection of a deep G-buffer */
 #define DEEP_FLAGS (OBS_BIN_DEEP_ZBACK | OBS_BIN_DEEP_ALPHA | OBS_BIN_HAS_WORLD_TO_CAMERA | \
-                    OBS_BIN_HAS_PROJECTION | OBS_BIN_DEEP_COLOR | OBS_BIN_DEEP_NORMAL)
+                    OBS_BIN_HAS_PROJECTION | OBS_BIN_DEEP_COLOR | OBS_BIN_DEEP_NORMAL | \
+                    OBS_BIN_DEEP_FACING)
 
 /* The message into err (when set), and s.  This file's own: the protocol
  * is built against the public headers, not core's internal ones. */
@@ -258,7 +259,8 @@ static void write_deep(writer *w, const obs_deep_image *d)
     uint32_t flags = (d->has_zback ? OBS_BIN_DEEP_ZBACK : 0) | (d->has_alpha ? OBS_BIN_DEEP_ALPHA : 0) |
                      (cam->has_world_to_camera ? OBS_BIN_HAS_WORLD_TO_CAMERA : 0) |
                      (cam->has_projection ? OBS_BIN_HAS_PROJECTION : 0) |
-                     (d->has_color ? OBS_BIN_DEEP_COLOR : 0) | (d->has_normal ? OBS_BIN_DEEP_NORMAL : 0);
+                     (d->has_color ? OBS_BIN_DEEP_COLOR : 0) | (d->has_normal ? OBS_BIN_DEEP_NORMAL : 0) |
+                     (d->has_facing ? OBS_BIN_DEEP_FACING : 0);
     put_u32(w, (uint32_t)d->width);
     put_u32(w, (uint32_t)d->height);
     put_u32(w, (uint32_t)d->display_x);
@@ -586,7 +588,7 @@ static obs_status get_deep_fields(reader *r, const obs_limits *lim, deep_fields 
         return fail(err, OBS_BAD_FILE, "deep G-buffer: unknown flags 0x%x", f->flags);
     if (f->values != OBS_DEEP_CH)
         return fail(err, OBS_BAD_FILE, "deep G-buffer: %u values per sample; the layout has %d "
-                    "(Z, ZBack, R, G, B, A, N.X, N.Y, N.Z)", f->values, OBS_DEEP_CH);
+                    "(Z, ZBack, R, G, B, A, N.X, N.Y, N.Z, Facing)", f->values, OBS_DEEP_CH);
     if (f->type != OBS_BIN_F32 || f->reserved != 0)
         return fail(err, OBS_BAD_FILE, "deep G-buffer: sample type %u (only float32, 0) or reserved "
                     "field %u (0)", f->type, f->reserved);
@@ -672,6 +674,7 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
     d->has_alpha = !!(flags & OBS_BIN_DEEP_ALPHA);
     d->has_color = !!(flags & OBS_BIN_DEEP_COLOR);
     d->has_normal = !!(flags & OBS_BIN_DEEP_NORMAL);
+    d->has_facing = !!(flags & OBS_BIN_DEEP_FACING);
     obs_camera_from_request(cam, flags & OBS_BIN_HAS_WORLD_TO_CAMERA, flags & OBS_BIN_HAS_PROJECTION);
     return OBS_OK;
 }

@@ -66,7 +66,8 @@ enum {
     OBS_BIN_DEEP_ZBACK = 1,
     OBS_BIN_DEEP_ALPHA = 2,
     OBS_BIN_DEEP_COLOR = 16,
-    OBS_BIN_DEEP_NORMAL = 32
+    OBS_BIN_DEEP_NORMAL = 32,
+    OBS_BIN_DEEP_FACING = 64
 };
 
 /* The `output` of a raw response image that holds the front node's AO of

@@ -33,6 +33,13 @@ enum {
     OBS_DEEP_NX,    /* normal (0 when the file has none) */
     OBS_DEEP_NY,
     OBS_DEEP_NZ,
+    OBS_DEEP_FACING, /* +1: a front face (entering a solid along the view
+                      * ray: its outward side faces the camera), -1: a back
+                      * face (leaving it), 0: not known.  Channel "Facing";
+                      * `obscura gbuffer --deep` writes it from the
+                      * triangle's winding.  With it the multi-layer chain
+                      * takes the solid between a front face and its
+                      * matching back face as an interval (deep_intervals) */
     OBS_DEEP_CH     /* floats per sample */
 };
 
@@ -50,7 +57,7 @@ typedef struct obs_deep_image {
     int display_width, display_height;
     uint64_t *offset;                  /* width * height + 1 entries */
     float *samples;                    /* offset[width * height] samples */
-    int has_zback, has_alpha, has_color, has_normal;
+    int has_zback, has_alpha, has_color, has_normal, has_facing;
     obs_camera camera;                 /* from worldToCamera/worldToNDC, if any */
     int part;                          /* the part read */
 } obs_deep_image;
@@ -65,7 +72,7 @@ obs_status obs_exr_is_deep_mem(const void *buf, size_t len, int *deep, char err[
  * count tables (checked: non-negative, cumulative per scanline, within
  * OBS_DEEP_MAX_* and the chunk's size) before any sample memory is
  * allocated, then the samples.  Channels by name: Z (required), ZBack,
- * A, R, G, B, and N.X/N.Y/N.Z (or N.R/N.G/N.B).  Caller frees with
+ * A, R, G, B, N.X/N.Y/N.Z (or N.R/N.G/N.B) and Facing.  Caller frees with
  * obs_deep_free(). */
 obs_status obs_deep_read_exr(const char *path, const obs_limits *lim, obs_deep_image *out,
                              char err[OBS_ERR_LEN]);
@@ -76,7 +83,7 @@ obs_status obs_deep_read_exr_mem(const void *buf, size_t len, const obs_limits *
 void obs_deep_free(obs_deep_image *d);
 
 /* Writes a deep scanline EXR (ZIPS, float channels): Z always, ZBack, A,
- * R, G, B and N.X/N.Y/N.Z as d->has_* say (the names obs_deep_read_exr()
+ * R, G, B, N.X/N.Y/N.Z and Facing as d->has_* say (the names obs_deep_read_exr()
  * reads), the camera as worldToCamera/worldToNDC when d->camera has one.
  * Samples are written in their order (front to back).  Through OpenEXR's
  * C++ library (core/io/exr_deep_write.cpp).  Fails with OBS_IO when the
@@ -97,7 +104,8 @@ typedef struct obs_deep_layers {
     int width, height, m;
     float *node;   /* m planes, node k of pixel i at (k * width * height + i) * OBS_DEEP_CH */
     int *count;    /* valid nodes per pixel, front to back from node 0 */
-    float zmin, zmax; /* the depth range normalised depth is taken over */
+    float zmin, zmax; /* the depth range eq 5's z is normalised over: the
+                       * camera's clip range (near, far) */
 } obs_deep_layers;
 
 /* Compresses one list (OITAO section III-B): the n samples (OBS_DEEP_CH
@@ -105,7 +113,8 @@ typedef struct obs_deep_layers {
  * m nodes; once more than m were inserted the node j minimising
  * a[j].alpha * (1 - a[j].z) (eq 5) is dropped, searched over every node or,
  * with front_half, over the back half only (j >= m / 2).  z is the depth
- * normalised to [0, 1] over zmin..zmax (see deep_compress.c).  Writes the
+ * normalised to [0, 1] over zmin..zmax, the camera's clip range (see
+ * deep_compress.c).  Writes the
  * kept nodes front to back to out (m * OBS_DEEP_CH floats) and returns
  * their count. */
 int obs_deep_compress_list(const float *samples, int n, int m, int front_half, float zmin,
@@ -114,7 +123,9 @@ int obs_deep_compress_list(const float *samples, int n, int m, int front_half, f
 /* Compresses every pixel of a deep image to m nodes (1 <= m <=
  * OBS_DEEP_MAX_LAYERS); m = 0 keeps up to OBS_DEEP_MAX_LAYERS front
  * nodes unchanged when they fit (no eq 5 needed), i.e. the uncompressed
- * reference for lists up to that length.  Caller frees with
+ * reference for lists up to that length.  Eq 5's z is normalised over the
+ * clip range (near, far) of d->camera's projection, or without one over
+ * the default clip range of parameters near and far.  Caller frees with
  * obs_deep_layers_free(). */
 obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs_deep_layers *out,
                              char err[OBS_ERR_LEN]);

@@ -239,22 +239,51 @@ static void test_compress_eq5(void **state)
     for (int k = 0; k < 4; k++)
         assert_float_equal(out[k * OBS_DEEP_CH + OBS_DEEP_Z], want[k], 0);
 
-    /* the fixture's pixel (0, 0): ten samples of alpha 0.3 at Z 1 .. 1.9
-     * and the opaque wall at 8, the image's farthest depth: z = 1 there,
-     * so eq 5 gives the wall 0 and drops it whatever its alpha; of the
-     * others, a (1 - z) falls with depth: m = 4 keeps Z 1 .. 1.3 */
+    /* the paper's criterion (OITAO III-B) over the view frustum: the
+     * fixture's pixel (0, 0) holds ten samples of alpha 0.3 at Z 1 .. 1.9
+     * and the opaque wall at 8, the image's farthest depth.  Its camera has
+     * the default clip range 0.1 .. 1000, so z = (Z - 0.1) / 999.9: the
+     * wall scores 1 - 0.0079 = 0.992, each transparent sample about 0.3
+     * (falling with depth).  The opaque wall is kept, and of the
+     * transparent samples the nearest: m = 4 keeps Z 1, 1.1, 1.2 and 8.
+     * (Normalised over the image's own range, 1 .. 8, the wall would
+     * score 0 and be dropped first.) */
     obs_deep_image d;
     obs_deep_layers l;
     char err[OBS_ERR_LEN] = "";
     assert_int_equal(obs_deep_read_exr(FIXTURE, NULL, &d, err), OBS_OK);
     assert_int_equal(obs_deep_compress(&d, 4, 0, &l, err), OBS_OK);
-    assert_float_equal(l.zmin, 1.0f, 1e-6);
-    assert_float_equal(l.zmax, 8.0f, 1e-6);
+    assert_float_equal(l.zmin, 0.1f, 1e-4);
+    assert_float_equal(l.zmax, 1000.0f, 1.0);
     assert_int_equal(l.count[0], 4);
     size_t npx = 48 * 32;
-    const float keep[4] = {1.0f, 1.1f, 1.2f, 1.3f};
+    const float keep[4] = {1.0f, 1.1f, 1.2f, 8.0f};
     for (int k = 0; k < 4; k++)
         assert_float_equal(l.node[(size_t)k * npx * OBS_DEEP_CH + OBS_DEEP_Z], keep[k], 1e-5);
+    obs_deep_layers_free(&l);
+
+    /* the farthest sample of a list is not dropped for being the farthest:
+     * near 1, far 10, z = (Z - 1) / 9:
+     *   Z 2 a .2 -> .2 (1 - 1/9) = .178, Z 4 a .3 -> .3 (1 - 3/9) = .2,
+     *   Z 6 a 1 -> 1 - 5/9 = .444: m = 2 drops Z 2, keeps [4, 6]
+     * (over the list's own range 2 .. 6 the wall would score 0 and go);
+     * at the far plane itself, the paper's initial depth of 1, a node
+     * scores 0 whatever its opacity and goes first: [2, 4] */
+    float lst[3 * OBS_DEEP_CH];
+    sample(lst, 2.0f, 0.2f);
+    sample(lst + OBS_DEEP_CH, 4.0f, 0.3f);
+    sample(lst + 2 * OBS_DEEP_CH, 6.0f, 1.0f);
+    assert_int_equal(obs_deep_compress_list(lst, 3, 2, 0, 1.0f, 10.0f, out), 2);
+    assert_float_equal(out[OBS_DEEP_Z], 4.0f, 0);
+    assert_float_equal(out[OBS_DEEP_CH + OBS_DEEP_Z], 6.0f, 0);
+    sample(lst + 2 * OBS_DEEP_CH, 10.0f, 1.0f);
+    assert_int_equal(obs_deep_compress_list(lst, 3, 2, 0, 1.0f, 10.0f, out), 2);
+    assert_float_equal(out[OBS_DEEP_Z], 2.0f, 0);
+    assert_float_equal(out[OBS_DEEP_CH + OBS_DEEP_Z], 4.0f, 0);
+    d.camera.has_projection = 0; /* no projection: the parameters' default 0.1 .. 1000 */
+    assert_int_equal(obs_deep_compress(&d, 4, 0, &l, err), OBS_OK);
+    assert_float_equal(l.zmin, 0.1f, 1e-6);
+    assert_float_equal(l.zmax, 1000.0f, 1e-3);
     obs_deep_layers_free(&l);
     obs_deep_free(&d);
 }
@@ -363,6 +392,106 @@ static void test_hidden_occluder(void **state)
     float half = ao_at(&d, &multi, 15, 16, NULL);
     print_message("alpha 0.5 box: AO %.4f\n", half);
     assert_float_equal(1.0f - half, 0.5f * (1.0f - m), 0.02f);
+    obs_deep_free(&d);
+}
+
+/* ---- intervals from facing flags (deep_intervals) ---------------------------- */
+
+static void synth_face(obs_deep_image *d, int x, int y, float z, float facing)
+{
+    synth_add(d, x, y, z, 1.0f);
+    size_t i = (size_t)y * d->width + x;
+    d->samples[(d->offset[i + 1] - 1) * OBS_DEEP_CH + OBS_DEEP_FACING] = facing;
+}
+
+/* A wall at depth 10 seen from its front (a room's wall: no back face)
+ * and, right of column 16, a closed slab from depth zf (front face) to zb
+ * (back face), opaque. */
+static void slab_scene(obs_deep_image *d, float zf, float zb)
+{
+    synth_init(d, 32, 32);
+    d->has_facing = 1;
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++) {
+            synth_next(d, x, y);
+            if (x >= 16) {
+                synth_face(d, x, y, zf, 1.0f);
+                synth_face(d, x, y, zb, -1.0f);
+            }
+            synth_face(d, x, y, 10.0f, 1.0f);
+        }
+}
+
+/* The wall pixel beside the slab: its tangent sphere (radius 0.5) spans
+ * depths 9 .. 10.  A thin plate 8.5 .. 8.6 lies wholly in front of it:
+ * with intervals nothing of the pipes is solid and the wall stays as open
+ * as far from the plate (no halo); every node solid behind it (intervals
+ * off, or deep_mode single, the flat buffer's view) lets the range check
+ * count the plate far behind itself, the halo.  A plate 9.4 .. 9.5 that
+ * reaches into the sphere occludes its own thickness only: between the
+ * two.  A closed box 9.4 .. 10, flush with the wall, is solid over the
+ * whole depth the flat buffer assumes: the same AO with intervals,
+ * without, and on the flat chain. */
+static void test_intervals(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    obs_params on = deep_params(OBS_DEEP_MULTI), off = deep_params(OBS_DEEP_MULTI);
+    obs_params single = deep_params(OBS_DEEP_SINGLE);
+    assert_int_equal(obs_param_set(&off, "deep_intervals", "off", err), OBS_OK);
+    for (int i = 0; i < 3; i++) /* the AO itself, not the low-pass filter's spread */
+        assert_int_equal(obs_param_set(i == 0 ? &on : i == 1 ? &off : &single, "blur", "off", err),
+                         OBS_OK);
+
+    slab_scene(&d, 8.5f, 8.6f);
+    float open = ao_at(&d, &on, 4, 16, NULL);
+    float with = ao_at(&d, &on, 15, 16, NULL), without = ao_at(&d, &off, 15, 16, NULL);
+    float flat = ao_at(&d, &single, 15, 16, NULL);
+    print_message("thin plate in front: AO open %.4f, intervals %.4f, off %.4f, single %.4f\n",
+                  open, with, without, flat);
+    assert_float_equal(open, 1.0f, 1e-4);
+    assert_float_equal(with, open, 1e-4);
+    assert_true(without < open - 0.02f);
+    assert_true(flat < open - 0.02f);
+    /* the same image without facing flags: every node solid behind */
+    d.has_facing = 0;
+    assert_float_equal(ao_at(&d, &on, 15, 16, NULL), without, 1e-6);
+    obs_deep_free(&d);
+
+    slab_scene(&d, 9.4f, 9.5f);
+    float thin_on = ao_at(&d, &on, 15, 16, NULL), thin_off = ao_at(&d, &off, 15, 16, NULL);
+    print_message("plate reaching the sphere: AO intervals %.4f, off %.4f\n", thin_on, thin_off);
+    assert_true(thin_on < 1.0f - 1e-3);
+    assert_true(thin_on > thin_off + 0.02f);
+    obs_deep_free(&d);
+
+    /* the closed box: every pixel as without intervals, and as the flat
+     * chain on the front nodes' depth */
+    slab_scene(&d, 9.4f, 10.0f);
+    obs_deep_result a, b;
+    assert_int_equal(obs_deep_run_cpu(&d, &on, &a, err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(&d, &single, &b, err), OBS_OK);
+    float depth[32 * 32];
+    for (int i = 0; i < 32 * 32; i++)
+        depth[i] = d.samples[d.offset[i] * OBS_DEEP_CH + OBS_DEEP_Z];
+    obs_gbuffer gb = {0};
+    gb.width = gb.height = 32;
+    gb.depth = (obs_plane){depth, 1, 0};
+    obs_result fr;
+    assert_int_equal(obs_run_cpu(&gb, &single, OBS_OUTPUT_AO, &fr, err), OBS_OK);
+    double worst = 0.0, worst_flat = 0.0;
+    for (int i = 0; i < 32 * 32; i++) {
+        worst = fmax(worst, fabs(a.ao_front.data[i] - b.ao_front.data[i]));
+        worst_flat = fmax(worst_flat, fabs(a.ao_front.data[i] - fr.ao.data[i]));
+    }
+    print_message("closed box: max |intervals - single| %.2e, |intervals - flat chain| %.2e\n",
+                  worst, worst_flat);
+    assert_true(worst < 1e-5);
+    assert_true(worst_flat < 1e-3);
+    obs_deep_result_free(&a);
+    obs_deep_result_free(&b);
+    obs_result_free(&fr);
     obs_deep_free(&d);
 }
 
@@ -648,9 +777,9 @@ static void test_gl_resources_reused(void **state)
     unsigned long before = ctx->gl_objects_created;
     assert_int_equal(obs_deep_run(ctx, &d, &p, &a, err), OBS_OK);
     unsigned long first = ctx->gl_objects_created - before;
-    /* two node arrays, three RG planes (front, blend, the blur's
+    /* three node arrays (positions, normals, interval ends), three RG planes (front, blend, the blur's
      * intermediate), the pass's framebuffer and one per plane */
-    assert_int_equal(first, 9);
+    assert_int_equal(first, 10);
     assert_int_equal(obs_deep_run(ctx, &d, &p, &b, err), OBS_OK);
     assert_int_equal(ctx->gl_objects_created - before, first);
     size_t n = (size_t)d.width * d.height * sizeof(float);
@@ -807,6 +936,7 @@ int main(void)
         cmocka_unit_test(test_read_damaged_files),
         cmocka_unit_test(test_compress_eq5),
         cmocka_unit_test(test_hidden_occluder),
+        cmocka_unit_test(test_intervals),
         cmocka_unit_test(test_subpixel_sphere),
         cmocka_unit_test(test_hidden_occluder_hemisphere),
         cmocka_unit_test(test_methods_refused),
