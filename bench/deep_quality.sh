@@ -7,10 +7,13 @@
 #                                      with its facing flag)
 #   obscura gbuffer SCENE.obj          the flat G-buffer, the same camera
 # then `obscura ao` at --radius ao_distance: the flat chain on the flat
-# G-buffer and the deep chain (deep_mode multi and single, m = 2, 4, 8,
-# deep_intervals on and off) for every method that takes deep input (vaopp,
-# hemisphere), each scored against the scene's Cycles AO by
-# shared/tools/aometrics.py (the referee).  Writes the tables to
+# G-buffer and the deep chain for every method that takes deep input
+# (vaopp, hemisphere): deep_mode multi at m = 2, 4, 8 (deep_intervals off,
+# the default), deep_mode single at m = 4 (the front node alone: m does not
+# change it), and for vaopp deep_intervals on at m = 4 (it changes only the
+# VAO line samples), each scored against the scene's Cycles AO by
+# shared/tools/aometrics.py (the referee).  DEEP_SCENES (names) limits the
+# scenes; DEEP_APPEND=1 adds to the last run's scores.  Writes the tables to
 # bench/QUALITY.md between the "BEGIN make quality-deep" / "END make
 # quality-deep" markers (appended the first time) and to stdout.
 #
@@ -33,7 +36,7 @@ LAYERS=${DEEP_LAYERS:-2 4 8}
 [ -x "$AOMETRICS" ] || { echo "quality-deep: no $AOMETRICS (the referee)" >&2; exit 1; }
 mkdir -p "$OUT"
 SCORES=$OUT/scores.tsv # scene method variant mse ssim bias
-: >"$SCORES"
+[ "${DEEP_APPEND:-0}" = 1 ] || : >"$SCORES"
 
 json() { sed -n "s/.*\"$1\": \([-0-9.e+]*\).*/\1/p" "$2"; }
 
@@ -56,16 +59,20 @@ for exr in "$DATA"/*.exr; do
     n=$(basename "$s")
     D=$(sed -n 's/.*"ao_distance": *\([0-9.e+-]*\).*/\1/p' "$s.json" 2>/dev/null | head -n 1)
     [ -n "$D" ] && [ -f "$s.obj" ] && [ -f "$s.camera.json" ] || continue
+    if [ -n "${DEEP_SCENES:-}" ]; then
+        case " $DEEP_SCENES " in *" $n "*) ;; *) continue ;; esac
+    fi
     echo "quality-deep: $n (AO distance $D)" >&2
     "$OBSCURA" gbuffer "$s.obj" --camera "$s.camera.json" -o "$OUT/$n.flat.exr" -q
     "$OBSCURA" gbuffer "$s.obj" --camera "$s.camera.json" --deep -o "$OUT/$n.deep.exr" -q
     for meth in $METHODS; do
         run "$n" "$meth" flat "$OUT/$n.flat.exr"
         for m in $LAYERS; do
-            run "$n" "$meth" "multi-m$m" "$OUT/$n.deep.exr" --deep-layers "$m"
-            run "$n" "$meth" "multi-m$m-nointervals" "$OUT/$n.deep.exr" --deep-layers "$m" --deep-intervals off
-            run "$n" "$meth" "single-m$m" "$OUT/$n.deep.exr" --deep-layers "$m" --deep-mode single
+            run "$n" "$meth" "multi-m$m" "$OUT/$n.deep.exr" --deep-layers "$m" --deep-intervals off
         done
+        run "$n" "$meth" single-m4 "$OUT/$n.deep.exr" --deep-layers 4 --deep-mode single
+        [ "$meth" = hemisphere ] ||
+            run "$n" "$meth" multi-m4-intervals "$OUT/$n.deep.exr" --deep-layers 4 --deep-intervals on
     done
 done
 
@@ -78,9 +85,9 @@ awk -v methods="$METHODS" -v layers="$LAYERS" '
     END {
         nm = split(methods, M, " "); nl = split(layers, L, " ")
         nv = 0
-        for (i = 1; i <= nl; i++) {
-            V[++nv] = "multi-m" L[i]; V[++nv] = "multi-m" L[i] "-nointervals"; V[++nv] = "single-m" L[i]
-        }
+        for (i = 1; i <= nl; i++)
+            V[++nv] = "multi-m" L[i]
+        V[++nv] = "single-m4"; V[++nv] = "multi-m4-intervals"
         for (k = 1; k <= nm; k++) {
             m = M[k]
             printf "#### %s: MSE against Cycles (ratio to the flat chain)\n\n| scene | flat |", m

@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "deep/deep_internal.h"
+#include "methods/gtao.h"
 #include "methods/hemisphere.h"
 #include "methods/methods.h"
 
@@ -45,6 +46,7 @@ void obs__deep_frame_free(obs__deep_frame *df)
     free(df->pos);
     free(df->nrm);
     free(df->end);
+    free(df->nrm3);
     obs_deep_layers_free(&df->layers);
     memset(df, 0, sizeof *df);
 }
@@ -155,6 +157,15 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
                 nrm[4 * i + 2] = v[2];
                 nrm[4 * i + 3] = pos[4 * i + 3] > 0.0f ? fminf(fmaxf(nd[OBS_DEEP_A], 0.0f), 1.0f) : 0.0f;
             }
+    }
+    /* Method gtao's border steps read the front nodes' normals. */
+    if (df->f.method == OBS_METHOD_GTAO) {
+        if (!(df->nrm3 = malloc(npx * 3 * sizeof *df->nrm3))) {
+            s = obs__fail(err, OBS_NO_MEMORY, "deep frame of %dx%d", d->width, d->height);
+            goto fail;
+        }
+        for (size_t i = 0; i < npx; i++)
+            memcpy(df->nrm3 + 3 * i, df->nrm + 4 * i, 3 * sizeof *df->nrm3);
     }
     /* The nodes' extents from their facing flags (deep_intervals). */
     if (df->intervals)
@@ -310,14 +321,18 @@ static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float 
     return obs__hemisphere_estimate(f, &nodes, x, y, p, n);
 }
 
-/* The per-sample estimator of the frame's method: VAO++'s line samples or
- * method hemisphere's point samples, each against every node (Algorithm
- * 1). */
+/* The per-sample estimator of the frame's method: VAO++'s line samples,
+ * method hemisphere's point samples or method gtao's horizon steps, each
+ * against every node (Algorithm 1; for gtao the largest horizon over the
+ * nodes at a step's pixel, OITAO's multi-layer HBAO, Fig. 9). */
 static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3], const float n[3],
                        int interior, int self)
 {
     if (df->f.method == OBS_METHOD_HEMISPHERE)
         return hemisphere_ao(df, x, y, p, n, interior);
+    if (df->f.method == OBS_METHOD_GTAO) /* the horizon over every node */
+        return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, x, y, p,
+                                     n, NULL);
     float v = sphere_ao(df, x, y, p, n, interior, self);
     return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */
 }

@@ -86,7 +86,7 @@ static const obs__method methods[] = {
       {"u_gtao_falloff", OBS__U_VEC2, GT(falloff), 0, 0},
       {"u_gtao_thin_power", OBS__U_VEC2, GT(thin_power), 0, 0},
       {NULL}},
-     0},
+     1},
 };
 #undef GT
 #undef HB
