@@ -22,6 +22,7 @@
 
 #include "deep/deep_internal.h"
 #include "methods/gtao.h"
+#include "methods/hbao.h"
 #include "methods/hemisphere.h"
 #include "methods/methods.h"
 
@@ -322,9 +323,9 @@ static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float 
 }
 
 /* The per-sample estimator of the frame's method: VAO++'s line samples,
- * method hemisphere's point samples or method gtao's horizon steps, each
- * against every node (Algorithm 1; for gtao the largest horizon over the
- * nodes at a step's pixel, OITAO's multi-layer HBAO, Fig. 9). */
+ * method hemisphere's point samples or methods gtao's and hbao's horizon
+ * steps, each against every node (Algorithm 1; for the horizon methods
+ * every node at a step's pixel, OITAO's multi-layer HBAO, Fig. 9). */
 static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3], const float n[3],
                        int interior, int self)
 {
@@ -333,6 +334,8 @@ static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3]
     if (df->f.method == OBS_METHOD_GTAO) /* the horizon over every node */
         return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, x, y, p,
                                      n, NULL);
+    if (df->f.method == OBS_METHOD_HBAO)
+        return obs__hbao_pixel_nodes(&df->f, df->pos, df->multi ? df->m : 1, x, y, p, n, NULL);
     float v = sphere_ao(df, x, y, p, n, interior, self);
     return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */
 }

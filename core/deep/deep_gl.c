@@ -68,7 +68,8 @@ enum {
     DEEP_RANGE = 4,      /* OBS_RANGE_CHECK: VAO++ 4.4, eq 4 */
     DEEP_RAYS = 8,       /* OBS_RAYS: ao_definition rays' conversion of the VAO nodes */
     DEEP_INTERVALS = 16, /* OBS_DEEP_INTERVALS: the nodes' intervals (deep_intervals) */
-    DEEP_GTAO = 32       /* OBS_DEEP_GTAO: method gtao's horizon search */
+    DEEP_GTAO = 32,      /* OBS_DEEP_HORIZON with gtao.glsl: method gtao's horizon search */
+    DEEP_HBAO = 64       /* OBS_DEEP_HORIZON with hbao.glsl: method hbao's */
 };
 
 static unsigned deep_variant(const obs__deep_frame *df)
@@ -76,7 +77,8 @@ static unsigned deep_variant(const obs__deep_frame *df)
     return (df->f.method == OBS_METHOD_HEMISPHERE ? DEEP_HEMISPHERE : 0u) |
            (df->thin ? DEEP_THIN : 0u) | (df->f.range_check ? DEEP_RANGE : 0u) |
            (df->f.rays ? DEEP_RAYS : 0u) | (df->intervals ? DEEP_INTERVALS : 0u) |
-           (df->f.method == OBS_METHOD_GTAO ? DEEP_GTAO : 0u);
+           (df->f.method == OBS_METHOD_GTAO ? DEEP_GTAO : 0u) |
+           (df->f.method == OBS_METHOD_HBAO ? DEEP_HBAO : 0u);
 }
 
 /* A framebuffer writing the n textures; OBS_GL_ERROR when incomplete. */
@@ -125,18 +127,21 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
         snprintf(defs, sizeof defs,
                  "#define OBS_DEEP_HEMISPHERE %d\n#define OBS_DEEP_THIN %d\n"
                  "#define OBS_RANGE_CHECK %d\n#define OBS_RAYS %d\n#define OBS_DEEP_INTERVALS %d\n"
-                 "#define OBS_DEEP_GTAO %d\n",
+                 "#define OBS_DEEP_HORIZON %d\n",
                  (v & DEEP_HEMISPHERE) != 0, (v & DEEP_THIN) != 0, (v & DEEP_RANGE) != 0,
-                 (v & DEEP_RAYS) != 0, (v & DEEP_INTERVALS) != 0, (v & DEEP_GTAO) != 0);
+                 (v & DEEP_RAYS) != 0, (v & DEEP_INTERVALS) != 0,
+                 (v & (DEEP_GTAO | DEEP_HBAO)) != 0);
         /* method hemisphere's estimator, or method.glsl (radius_px) and
-         * gtao's, come after the pass, which defines how they read the
-         * nodes (HS_NODE, GT_NODE in deep.frag.glsl) */
+         * gtao's or hbao's, come after the pass, which defines how they
+         * read the nodes (HS_NODE, GT_NODE, HB_NODE in deep.frag.glsl) */
+        const int horizon = (v & (DEEP_GTAO | DEEP_HBAO)) != 0;
         const char *hs[] = {glsl_version, defs, obs__shader_common, obs__shader_deep_frag,
                             obs__shader_hemisphere};
-        const char *gt[] = {glsl_version,          defs, obs__shader_common, obs__shader_method,
-                            obs__shader_deep_frag, obs__shader_gtao};
-        const char *const *src = (v & DEEP_GTAO) ? gt : hs;
-        const int parts = (v & DEEP_GTAO) ? 6 : (v & DEEP_HEMISPHERE) ? 5 : 4;
+        const char *hz[] = {glsl_version,          defs, obs__shader_common, obs__shader_method,
+                            obs__shader_deep_frag, (v & DEEP_GTAO) ? obs__shader_gtao
+                                                                   : obs__shader_hbao};
+        const char *const *src = horizon ? hz : hs;
+        const int parts = horizon ? 6 : (v & DEEP_HEMISPHERE) ? 5 : 4;
         if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, parts, &t->prog[v], err)) !=
             OBS_OK) {
             t->prog[v] = 0;

@@ -6,7 +6,7 @@
 
 #include "gl/gl.h"
 
-#define OBS__DEEP_VARIANTS 64 /* 6 switches of the deep pass (deep_gl.c: DEEP_*) */
+#define OBS__DEEP_VARIANTS 128 /* 7 switches of the deep pass (deep_gl.c: DEEP_*) */
 
 /* The deep pass's programs, and the node planes and the output target of
  * one size and node count. */

@@ -7,8 +7,8 @@
 // to back by alpha (section III, the separated scheme).  With
 // OBS_DEEP_HEMISPHERE the per-node occlusion is method hemisphere's point samples
 // (the normal-oriented hemisphere kernel), each against every node, the
-// largest counting (Algorithm 1); with OBS_DEEP_GTAO method gtao's horizon
-// search, each step's horizon the largest over the nodes at its pixel (as
+// largest counting (Algorithm 1); with OBS_DEEP_HORIZON method gtao's or
+// hbao's horizon search, each step reading every node at its pixel (as
 // OITAO's multi-layer HBAO, Fig. 9).  C twin: core/deep/deep_cpu.c (same
 // function names).
 
@@ -30,19 +30,22 @@ uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node
 // samples); OBS_DEEP_THIN, thin hulls (eqs 2-4; else solid volumes, eq 1);
 // OBS_RANGE_CHECK, the depth range check (VAO++ 4.4, eq 4);
 // OBS_DEEP_INTERVALS, the nodes' intervals from their facing flags;
-// OBS_DEEP_GTAO, method gtao's horizon search over the nodes.
+// OBS_DEEP_HORIZON, method gtao's or hbao's horizon search over the nodes.
 // Method hemisphere's estimator (hemisphere.glsl, appended after this file
 // in the OBS_DEEP_HEMISPHERE programs) reads the nodes through these.
 #define HS_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
 #define HS_ALPHA(q, k) imageLoad(u_lnrm, ivec3(q, k)).w
 float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
-// Method gtao's horizon search (gtao.glsl, after this file in the
-// OBS_DEEP_GTAO programs, with method.glsl's radius_px) reads every node
-// at a step's pixel through these, the front nodes past the border.
+// Methods gtao's and hbao's horizon searches (gtao.glsl, hbao.glsl,
+// after this file in the OBS_DEEP_HORIZON programs, with method.glsl's
+// radius_px) read every node at a step's pixel through these (gtao: the
+// front nodes past the border); method_ao(px, vec4 p, n, count) is theirs.
 #define GT_LAYERS (u_multi != 0 ? u_m : 1)
 #define GT_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
 #define GT_FRONT(b) imageLoad(u_lpos, ivec3(b, 0))
 #define GT_FRONT_NORMAL(b) imageLoad(u_lnrm, ivec3(b, 0))
+#define HB_LAYERS (u_multi != 0 ? u_m : 1)
+#define HB_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count);
 
 // the front node's AO and the blended AO, each beside the front node's
@@ -133,9 +136,9 @@ float method_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
 {
 #if OBS_DEEP_HEMISPHERE
     return hemisphere_estimate(px, p, n, u_multi != 0 ? u_m : 1, interior);
-#elif OBS_DEEP_GTAO
+#elif OBS_DEEP_HORIZON
     int count;
-    return method_ao(px, vec4(p, 0.0), n, count);   // gtao.glsl, over the nodes
+    return method_ao(px, vec4(p, 0.0), n, count);   // gtao.glsl or hbao.glsl, over the nodes
 #else
 #if OBS_RAYS
     return rays_from_volume(sphere_ao(px, p, n, interior, self)); // common.glsl

@@ -497,31 +497,30 @@ static void test_intervals(void **state)
     obs_deep_free(&d);
 }
 
-/* Method gtao on deep input: its horizon search reads every node at a
- * step's pixel (OITAO's multi-layer HBAO, Fig. 9).  In scene() the wall
+/* Methods gtao and hbao on deep input: their horizon search reads every
+ * node at a step's pixel (OITAO's multi-layer HBAO, Fig. 9).  In scene() the wall
  * pixel beside the near object (depth 3, 7 in front of the wall: beyond
  * the falloff) finds its horizon raised by the box face at 9.3 hidden
  * behind that object only in multi mode; single mode (the front nodes
- * alone) is the flat gtao on the front depth, pixel for pixel, and
+ * alone) is the flat method on the front depth, pixel for pixel, and
  * without the hidden box multi equals single. */
-static void test_gtao_deep(void **state)
+static void horizon_deep(const char *method)
 {
-    (void)state;
     obs_deep_image d;
     char err[OBS_ERR_LEN] = "";
     obs_params multi = deep_params(OBS_DEEP_MULTI), single = deep_params(OBS_DEEP_SINGLE);
     for (int i = 0; i < 2; i++) {
         obs_params *p = i ? &single : &multi;
-        assert_int_equal(obs_param_set(p, "method", "gtao", err), OBS_OK);
+        assert_int_equal(obs_param_set(p, "method", method, err), OBS_OK);
         assert_int_equal(obs_param_set(p, "blur", "off", err), OBS_OK);
     }
     scene(&d, 9.3f, 1.0f);
     float s = ao_at(&d, &single, 15, 16, NULL), m = ao_at(&d, &multi, 15, 16, NULL);
-    print_message("gtao, hidden occluder: AO single %.4f, multi %.4f\n", s, m);
+    print_message("%s, hidden occluder: AO single %.4f, multi %.4f\n", method, s, m);
     assert_true(m < s - 0.05f);
     assert_float_equal(ao_at(&d, &multi, 4, 16, NULL), ao_at(&d, &single, 4, 16, NULL), 1e-6);
 
-    /* single = the flat chain's gtao (CPU) on the front nodes' depth */
+    /* single = the flat chain's method (CPU) on the front nodes' depth */
     obs_deep_result a;
     assert_int_equal(obs_deep_run_cpu(&d, &single, &a, err), OBS_OK);
     float depth[32 * 32];
@@ -535,7 +534,7 @@ static void test_gtao_deep(void **state)
     double worst = 0.0;
     for (int i = 0; i < 32 * 32; i++)
         worst = fmax(worst, fabs(a.ao_front.data[i] - fr.ao.data[i]));
-    print_message("gtao, single vs the flat chain: max |diff| %.2e\n", worst);
+    print_message("%s, single vs the flat chain: max |diff| %.2e\n", method, worst);
     assert_true(worst < 1e-4);
     obs_deep_result_free(&a);
     obs_result_free(&fr);
@@ -544,6 +543,18 @@ static void test_gtao_deep(void **state)
     scene(&d, 0.0f, 0.0f);
     assert_float_equal(ao_at(&d, &multi, 15, 16, NULL), ao_at(&d, &single, 15, 16, NULL), 1e-6);
     obs_deep_free(&d);
+}
+
+static void test_gtao_deep(void **state)
+{
+    (void)state;
+    horizon_deep("gtao");
+}
+
+static void test_hbao_deep(void **state)
+{
+    (void)state;
+    horizon_deep("hbao");
 }
 
 /* A floor seen at a grazing angle (view plane 2y + z = -6, one opaque
@@ -650,11 +661,11 @@ static void test_hidden_occluder_hemisphere(void **state)
 static void test_methods_refused(void **state)
 {
     (void)state;
-    static const char *const refused[] = {"hbao", "angle"};
+    static const char *const refused[] = {"angle"};
     obs_deep_image d;
     obs_deep_result r;
     scene(&d, 9.3f, 1.0f);
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 1; k++) {
         obs_params p = deep_params(OBS_DEEP_MULTI);
         char err[OBS_ERR_LEN] = "", want[64];
         assert_int_equal(obs_param_set(&p, "method", refused[k], err), OBS_OK);
@@ -821,6 +832,9 @@ static void test_gl_twin(void **state)
     p = deep_params(OBS_DEEP_SINGLE);
     assert_int_equal(obs_param_set(&p, "method", "gtao", err), OBS_OK);
     compare_gl(ctx, &d, &p, "hidden occluder, gtao, single");
+    p = deep_params(OBS_DEEP_MULTI);
+    assert_int_equal(obs_param_set(&p, "method", "hbao", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "hidden occluder, hbao, multi");
     obs_deep_free(&d);
     obs_ctx_destroy(ctx);
 }
@@ -1008,6 +1022,7 @@ int main(void)
         cmocka_unit_test(test_hidden_occluder),
         cmocka_unit_test(test_intervals),
         cmocka_unit_test(test_gtao_deep),
+        cmocka_unit_test(test_hbao_deep),
         cmocka_unit_test(test_subpixel_sphere),
         cmocka_unit_test(test_hidden_occluder_hemisphere),
         cmocka_unit_test(test_methods_refused),
