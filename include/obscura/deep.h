@@ -8,7 +8,8 @@
  * compressed layers (OITAO Algorithm 1, eqs 1-4) with VAO++'s volumetric
  * estimator (section 3, depth range check of 4.4) as the per-sample
  * occlusion, or with method hemisphere the normal-oriented hemisphere
- * kernel's point samples.  See README.md, "Deep input". */
+ * kernel's point samples, or with methods gtao and hbao their horizon
+ * search over every node.  See README.md, "Deep input". */
 #ifndef OBSCURA_DEEP_H
 #define OBSCURA_DEEP_H
 
@@ -151,11 +152,14 @@ int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_e
 
 /* Multi-layer AO of the deep image on the CPU: compression to the
  * parameters' deep_layers nodes, then OITAO Algorithm 1 with VAO++'s
- * per-sample occlusion (methods vaopp, vao) or the hemisphere kernel's
- * (method hemisphere) against every node (or the front one alone with
- * deep_mode single), opacity-weighted (eq 1, or eqs 2-4 with deep_hull
- * thin).  Other methods are refused (OBS_INVALID_ARGUMENT, naming the
- * method).  The camera is the image's unless the parameters carry one. */
+ * per-sample occlusion (methods vaopp, vao), the hemisphere kernel's
+ * (method hemisphere) or the horizon search of methods gtao and hbao
+ * (every node at a step's pixel, OITAO's multi-layer HBAO) against every
+ * node (or the front one alone with deep_mode single), opacity-weighted
+ * (eq 1, or eqs 2-4 with deep_hull thin); with deep_intervals on and
+ * facing flags, VAO's line samples take the solid between a front face
+ * and its back face as an interval.  Method angle is refused
+ * (OBS_INVALID_ARGUMENT, naming the method).  The camera is the image's unless the parameters carry one. */
 obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
                             obs_deep_result *out, char err[OBS_ERR_LEN]);
 
