@@ -193,22 +193,34 @@ fail:
 
 void obs__deep_intervals(const float *z, const float *facing, int count, float *end)
 {
-    int open = -1, depth = 0; /* the node that opened the interval, the facing count */
-    for (int k = 0; k < count; k++) {
+    int k0 = 0;
+    for (int k = 0; k < count; k++)
         end[k] = 0.0f;
-        if (!(z[k] > 0.0f))
-            continue;
-        if (depth == 0) {
-            if (facing[k] > 0.0f) { /* a front face: the solid starts */
-                open = k;
-                depth = 1;
+    while (k0 < count) {
+        int open = -1, depth = 0; /* the node that opened the interval, the facing count */
+        for (int k = k0; k < count; k++) {
+            if (!(z[k] > 0.0f))
+                continue;
+            if (depth == 0) {
+                if (facing[k] > 0.0f) { /* a front face: the solid starts */
+                    open = k;
+                    depth = 1;
+                }
+                continue; /* else a surface seen from one side: solid behind */
             }
-            continue; /* else a surface seen from one side: solid behind */
+            end[k] = -1.0f; /* inside the interval node `open` opened */
+            depth += facing[k] > 0.0f ? 1 : facing[k] < 0.0f ? -1 : 0;
+            if (depth == 0)
+                end[open] = fmaxf(z[k], z[open]); /* its matching back face */
         }
-        end[k] = -1.0f; /* inside the interval node `open` opened */
-        depth += facing[k] > 0.0f ? 1 : facing[k] < 0.0f ? -1 : 0;
         if (depth == 0)
-            end[open] = fmaxf(z[k], z[open]); /* its matching back face */
+            return;
+        /* node `open` has no back face in the list: a surface seen from one
+         * side, solid behind it as without intervals; the nodes behind it
+         * are scanned again on their own */
+        for (int k = open; k < count; k++)
+            end[k] = 0.0f;
+        k0 = open + 1;
     }
 }
 

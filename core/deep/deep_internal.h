@@ -40,8 +40,10 @@ void obs__deep_frame_free(obs__deep_frame *df);
  * face's depth; every node inside is -1.  A node outside every interval
  * that is not a front face (a back face seen with nothing open: a surface
  * seen from behind; facing unknown) and a front face whose back face the
- * list does not hold keep end 0: solid behind them, the range check (eq 4)
- * applying, as without intervals.  z, facing: the count nodes' planar
+ * list does not hold (an open mesh, or the back face dropped by eq 5)
+ * keep end 0: solid behind them, the range check (eq 4) applying, as
+ * without intervals; the nodes behind such a front face are taken on
+ * their own, as if it were not there.  z, facing: the count nodes' planar
  * depths and OBS_DEEP_FACING values, front to back; writes end[0 ..
  * count - 1]. */
 void obs__deep_intervals(const float *z, const float *facing, int count, float *end);
