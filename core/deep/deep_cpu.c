@@ -345,7 +345,7 @@ static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         return hemisphere_ao(df, x, y, p, n, interior);
     if (df->f.method == OBS_METHOD_GTAO) /* the horizon over every node */
         return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, x, y, p,
-                                     n, NULL);
+                                     n, NULL, NULL);
     if (df->f.method == OBS_METHOD_HBAO)
         return obs__hbao_pixel_nodes(&df->f, df->pos, df->multi ? df->m : 1, x, y, p, n, NULL);
     float v = sphere_ao(df, x, y, p, n, interior, self);
