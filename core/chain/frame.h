@@ -235,16 +235,6 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
  * common.glsl). */
 float obs__range_falloff(const obs__frame *f, float d, float nz);
 
-/* The thickness along view Z of the occluder seen at pixel (qx, qy) of
- * the planes pos (view point, planar depth in w) and nrm (view normal):
- * the chord 2 rho |n.z| of the sphere of its largest curvature 1/rho
- * there, from its neighbours' normals; INFINITY where the surface is
- * flat.  A pipe hidden behind that occluder is open past its far side
- * (the range check, eq 4, bounded).  GLSL: occluder_thickness() in
- * vao.glsl, which derives it. */
-float obs__occluder_thickness(const obs__frame *f, const float *pos, const float *nrm, int qx,
-                              int qy);
-
 /* The planar depth of the tangent plane at p (normal n) under the pipe of
  * the disk's sample (sx, sy), for eq 1's dz: what a sample on the shaded
  * pixel itself reads instead of the depth at the pixel's centre zs, which

@@ -191,64 +191,6 @@ static int border_sample(const obs__frame *f, const float *pos, const float *nrm
     return got >= 0;
 }
 
-/* GLSL: occluder_thickness() in vao.glsl, which derives it.  The
- * thickness along view Z of the occluder seen at pixel (qx, qy): the
- * chord 2 rho |n_q.z| of the sphere of its largest curvature 1/rho there,
- * the curvature from the turn of the normal to a neighbour on each axis
- * (|n_b - n_q| / |x_b - x_q|, exact on a circle), the neighbour of the
- * two nearer q's depth; INFINITY where the normal does not turn (a flat
- * occluder: eq 4 alone). */
-float obs__occluder_thickness(const obs__frame *f, const float *pos, const float *nrm, int qx,
-                              int qy)
-{
-    const size_t kq = (size_t)qy * (size_t)f->width + (size_t)qx;
-    const float *xq = pos + 4 * kq, *nq = nrm + 3 * kq;
-    float k = 0.0f; /* the largest curvature found, 1/rho */
-    for (int a = 0; a < 2; a++) {
-        float best = INFINITY;
-        size_t kb = 0;
-        int found = 0;
-        for (int s = -1; s <= 1; s += 2) {
-            int tx = qx + (a == 0 ? s : 0), ty = qy + (a == 1 ? s : 0);
-            if (tx < 0 || ty < 0 || tx >= f->width || ty >= f->height)
-                continue;
-            size_t kt = (size_t)ty * (size_t)f->width + (size_t)tx;
-            float wt = pos[4 * kt + 3];
-            if (wt > 0.0f && fabsf(wt - xq[3]) < best) {
-                best = fabsf(wt - xq[3]);
-                kb = kt;
-                found = 1;
-            }
-        }
-        if (!found)
-            continue;
-        const float *xb = pos + 4 * kb, *nb = nrm + 3 * kb;
-        float dx[3] = {xb[0] - xq[0], xb[1] - xq[1], xb[2] - xq[2]};
-        float dn[3] = {nb[0] - nq[0], nb[1] - nq[1], nb[2] - nq[2]};
-        float chord = sqrtf(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
-        if (chord > 0.0f)
-            k = max_f(k, sqrtf(dn[0] * dn[0] + dn[1] * dn[1] + dn[2] * dn[2]) / chord);
-    }
-    return k > 0.0f ? 2.0f * fabsf(nq[2]) / k : INFINITY;
-}
-
-/* GLSL: the range check's case C in vao_estimate(): eq 4's open length
- * dz of a pipe of half length h whose near end lies at depth `front`,
- * behind the surface at depth zs of pixel (qx, qy) (qx < 0: a sample
- * off the planes, whose occluder's thickness is unknown), no less than
- * what is left of the pipe behind the occluder's far side,
- * zs + obs__occluder_thickness. */
-static float range_open(const obs__frame *f, const float *pos, const float *nrm, int qx, int qy,
-                        float h, float front, float zs, float nz)
-{
-    float dz = 2.0f * h * (1.0f - range_falloff(f, front - zs, nz));
-    if (qx >= 0) {
-        float t = obs__occluder_thickness(f, pos, nrm, qx, qy);
-        dz = max_f(dz, 2.0f * h - max_f(zs + t - front, 0.0f));
-    }
-    return dz;
-}
-
 /* GLSL: vao_estimate() in vao.glsl, without colour bleeding */
 float obs__vao_estimate(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         const float p[3], const float n[3], int ns, const float *xy)
@@ -290,7 +232,6 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
         float zs = INFINITY; /* scene depth at the sample's pixel */
         float nz = 1.0f; /* view normal z of the surface there */
         int qx, qy;
-        int on_q = 0; /* zs is the surface at pixel (qx, qy) */
         /* The sample on the disk through the centre, perpendicular to view Z. */
         seen = disk_px(f, &disk, sx, sy, &qx, &qy);
         if (seen) {
@@ -299,7 +240,6 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
             if (d > 0.0f) {
                 zs = d;
                 nz = nz_at[(size_t)nzs * k];
-                on_q = qx != x || qy != y;
                 /* a sample on the shaded pixel itself: p's tangent plane */
                 if (qx == x && qy == y)
                     zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy, zs);
@@ -329,7 +269,8 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
              * the pipe's weight 2h counts as occluded times s(d).  d is
              * taken from the pipe's near end, so s = 1 where case C meets
              * case A (zs = front) and the two join without a step. */
-            dz = range_open(f, pos, nrm, on_q ? qx : -1, on_q ? qy : -1, h, front, zs, nz);
+            float sd = range_falloff(f, front - zs, nz);
+            dz = 2.0f * h * (1.0f - sd);
         }
         /* A sample off the planes reads the surface continued past the
          * border (border_cpu.c derives it); one behind the camera, or
@@ -385,7 +326,7 @@ static inline __attribute__((always_inline)) float estimate_lanes(const obs__fra
     /* own_plane_depth()'s terms that do not depend on the sample */
     const int own_plane = fabsf(n[2]) > OBS_OWN_PLANE_NZ;
     float dzs[32], ls[32];
-    int seens[32], thick[32], qxs[32], qys[32];
+    int seens[32];
 #pragma omp simd
     for (int i = 0; i < ns; i++) {
         const float sx = xy[2 * i], sy = xy[2 * i + 1];
@@ -416,19 +357,6 @@ static inline __attribute__((always_inline)) float estimate_lanes(const obs__fra
         dzs[i] = range & (zs < front) ? dz_c : dz_ab;
         ls[i] = l;
         seens[i] = seen;
-        thick[i] = range & (zs < front) & hit & !((qx == x) & (qy == y));
-        qxs[i] = qx;
-        qys[i] = qy;
-    }
-    /* case C on the planes: bounded by the occluder's far side
-     * (range_open), one by one */
-    for (int i = 0; i < ns; i++) {
-        if (!thick[i])
-            continue;
-        const float h = r * ls[i], front = -c[2] - h;
-        const size_t k = (size_t)qys[i] * (size_t)w + (size_t)qxs[i];
-        const float t = obs__occluder_thickness(f, pos, nrm, qxs[i], qys[i]);
-        dzs[i] = max_f(dzs[i], 2.0f * h - max_f(dnz[2 * k] + t - front, 0.0f));
     }
     /* a sample off the planes reads the surface continued past the border
      * (border_sample, border_cpu.c), one by one, its pipe as estimate()
@@ -440,7 +368,7 @@ static inline __attribute__((always_inline)) float estimate_lanes(const obs__fra
         const float h = r * ls[i], front = -c[2] - h;
         float dz = min_f(max_f(zs - front, 0.0f), 2.0f * h);
         if (f->range_check && zs < front)
-            dz = range_open(f, pos, nrm, -1, -1, h, front, zs, nz);
+            dz = 2.0f * h * (1.0f - range_falloff(f, front - zs, nz));
         dzs[i] = dz;
         seens[i] = 1;
     }

@@ -58,49 +58,6 @@ bool border_sample(ivec2 px, vec3 U, vec3 V, vec3 W, float sx, float sy, inout f
     return true;
 }
 
-// The thickness along view Z of the occluder seen at pixel q (view point
-// xq, planar depth in xq.w, view normal nq), for the range check of a
-// pipe hidden behind it.  One depth layer does not show how far an
-// occluder reaches behind its visible surface; what it shows is the
-// surface's curvature, from its neighbours' normals: across the pixel
-// step from q to a neighbour b on the same surface, the normal turns by
-// |n_b - n_q| over the chord |x_b - x_q|, which for a circle of radius rho
-// is exactly 1/rho.  The occluder is taken as the sphere of its largest
-// curvature at q, tangent there (a tube of radius rho, a rail, a chair's
-// frame, a sphere: exact), whose chord along view Z from xq is
-// 2 rho |n_q.z|.  On each axis the neighbour of the two whose depth is
-// nearer q's is taken (the other may be across the occluder's own
-// silhouette).  A flat occluder (no turn of the normal) has no such
-// bound: FAR_AWAY, and eq 4 alone applies, as for a surface whose
-// thickness the buffer cannot show.  C twin: obs__occluder_thickness.
-float occluder_thickness(ivec2 q, vec4 xq, vec3 nq)
-{
-    float k = 0.0;              // the largest curvature found, 1/rho
-    for (int a = 0; a < 2; a++) {
-        ivec2 e = a == 0 ? ivec2(1, 0) : ivec2(0, 1);
-        float best = FAR_AWAY;
-        ivec2 b = ivec2(-1);
-        for (int s = -1; s <= 1; s += 2) {
-            ivec2 t = q + s * e;
-            if (t.x < 0 || t.y < 0 || t.x >= u_size.x || t.y >= u_size.y)
-                continue;
-            float wt = imageLoad(u_dz, t).x;
-            if (wt > 0.0 && abs(wt - xq.w) < best) {
-                best = abs(wt - xq.w);
-                b = t;
-            }
-        }
-        if (b.x < 0)
-            continue;
-        vec3 dx = imageLoad(u_pos, b).xyz - xq.xyz;
-        vec3 dn = imageLoad(u_vnormal, b).xyz - nq;
-        float chord = sqrt(dot(dx, dx));
-        if (chord > 0.0)
-            k = max(k, sqrt(dot(dn, dn)) / chord);
-    }
-    return k > 0.0 ? 2.0 * abs(nq.z) / k : FAR_AWAY;
-}
-
 // The AO of the point p (xyz; w: planar depth) with normal n at pixel px
 // from the ns samples of the set at u_samples[ns - 2].  With bleed_step >
 // 0, bleed gets the colour-bleed term of section 4.7: the mean over every
@@ -129,7 +86,6 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
         float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
         float h = r * l;        // half length of the pipe through the sphere
         bool seen = false;      // the sample's pixel is on the planes
-        bool on_q = false;      // zs is the surface at pixel q
 
         float zs = FAR_AWAY;    // scene depth at the sample's pixel
         float nz = 1.0;         // view normal z there
@@ -139,7 +95,6 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             if (dq.x > 0.0) {
                 zs = dq.x;
                 nz = dq.y;
-                on_q = q != px;
                 // a sample on the shaded pixel itself: p's tangent plane
                 if (q == px)
                     zs = own_plane_depth(p.xyz, n, disk_point(c, r, rot, sx, sy), zs);
@@ -168,14 +123,8 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             // s(d) = u / max(u, d / radius), d behind the visible surface,
             // measured from the pipe's near end (s = 1 where case C meets
             // case A); the occluded weight 2h is multiplied by s(d).
-            // The occluder ends zs + t behind (occluder_thickness): the
-            // pipe is occluded no further than it reaches.
             float sd = range_falloff(front - zs, nz, R, u_range_u, u_range_normal);
             dz = 2.0 * h * (1.0 - sd);
-            if (on_q) {
-                float t = occluder_thickness(q, imageLoad(u_pos, q), imageLoad(u_vnormal, q).xyz);
-                dz = max(dz, 2.0 * h - max(zs + t - front, 0.0));
-            }
         }
         // A sample off the planes reads the surface continued past the
         // border; one behind the camera, or without that estimate, is left
