@@ -16,11 +16,18 @@
  * pixels each, R_px the radius projected at p (at most R_px steps). */
 #include <math.h>
 
+#include "methods/bent.h"
 #include "methods/hbao.h"
 
 /* GLSL: hbao_ao() in hbao.glsl */
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count)
+{
+    return obs__hbao_pixel_bent(f, pos, x, y, p, n, count, NULL);
+}
+
+float obs__hbao_pixel_bent(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                           const float n[3], int *count, float bent[3])
 {
     const obs__hbao_state *hb = obs__hbao_of(f);
     const float R = f->radius, R2 = R * R;
@@ -46,6 +53,8 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
         float sin_h = st * hb->bias_cs[0] + ct * hb->bias_cs[1];
         if (ct * hb->bias_cs[0] - st * hb->bias_cs[1] < 0.0f)
             sin_h = 1.0f;
+        if (bent) /* OBS_OUTPUT_BENT: open from the tangent up to the view axis */
+            obs__hbao_bent_span(dx, dy, sin_h, 1.0f, 1.0f, bent);
         for (int j = 1; j <= ns; j++) {
             /* screen y runs down, view y up */
             int qx = x + (int)floorf(dx * step * (float)j + 0.5f);
@@ -63,6 +72,8 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
             float sin_s = v[2] / sqrtf(r2); /* elevation of the sample: view +z faces the camera */
             if (sin_s > sin_h) {
                 ao += (1.0f - r2 / R2) * (sin_s - sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
+                if (bent) /* less the step's occluded span */
+                    obs__hbao_bent_span(dx, dy, sin_h, sin_s, -(1.0f - r2 / R2), bent);
                 sin_h = sin_s;
             }
         }

@@ -9,6 +9,17 @@ uniform int u_hbao_steps;        // Ns
 uniform vec2 u_hbao_dir[OBS_MAX_DIRECTIONS];     // unit directions over 2 pi (view xy)
 uniform vec2 u_hbao_bias_cs;     // cos, sin of the angle bias
 
+// OBS_OUTPUT_BENT (method.glsl's g_bent): the solid-angle sum of the
+// directions cos a e + sin a z over the elevations asin(sin0)..asin(sin1)
+// along e = (dx, dy), times w.  C twin: obs__hbao_bent_span
+// (methods/bent.c), which derives it.
+void hbao_bent_span(float dx, float dy, float sin0, float sin1, float w)
+{
+    float a0 = asin(clamp(sin0, -1.0, 1.0)), a1 = asin(clamp(sin1, -1.0, 1.0));
+    float along = (a1 - a0) * 0.5 + (sin(2.0 * a1) - sin(2.0 * a0)) * 0.25;
+    g_bent += w * vec3(along * dx, along * dy, (sin1 * sin1 - sin0 * sin0) * 0.5);
+}
+
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
 {
     float R = u_radius, R2 = R * R;
@@ -30,6 +41,7 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
         float sin_h = st * u_hbao_bias_cs.x + ct * u_hbao_bias_cs.y;
         if (ct * u_hbao_bias_cs.x - st * u_hbao_bias_cs.y < 0.0)
             sin_h = 1.0;
+        hbao_bent_span(dx, dy, sin_h, 1.0, 1.0);   // open from the tangent up to the view axis
         for (int j = 1; j <= ns; j++) {
             ivec2 q = px + ivec2(int(floor(dx * stp * float(j) + 0.5)),
                                  int(floor(-dy * stp * float(j) + 0.5)));
@@ -46,6 +58,7 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
             float sin_s = v.z / sqrt(r2);
             if (sin_s > sin_h) {
                 ao += (1.0 - r2 / R2) * (sin_s - sin_h);   // W(r_i) (sin h_i - sin h_(i-1))
+                hbao_bent_span(dx, dy, sin_h, sin_s, -(1.0 - r2 / R2)); // less the occluded step
                 sin_h = sin_s;
             }
         }
