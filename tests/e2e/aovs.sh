@@ -35,6 +35,8 @@ check "aovs: GL and CPU agree (AO, multi-bounce, bent normal)" \
     'oiiotool "$T/gl.exr" "$T/cpu.exr" --fail 0.01 --failpercent 1 --diff >/dev/null 2>&1'
 check "aovs: the multi-bounce AO is at least the AO" \
     'oiiotool "$T/cpu.exr" --ch AOMultiBounce.G "$T/cpu.exr" --ch AO.Y --sub --printstats 2>&1 | grep "Stats Min" | awk "{exit !(\$3 >= -0.001)}"'
+expect 0 "aovs of hbao on the CPU device" -- "$OBSCURA" ao "$R" --method hbao --output aovs --backend cpu -o "$T/hbao.exr"
+check "aovs of hbao: the bent normal layer too" '[ "$(chans "$T/hbao.exr")" = "$AOVS" ]'
 expect 0 "aovs --append" -- "$OBSCURA" ao "$R" --output aovs --append --backend cpu -o "$T/app.exr"
 check "aovs --append: the input's channels and the AOVs" \
     'c=$(chans "$T/app.exr"); for n in AO.Y AOMultiBounce.R Samples.Y ViewLayer.Depth.Z ViewLayer.DiffCol.R; do echo "$c" | grep -q "$n" || exit 1; done'
