@@ -550,7 +550,7 @@ static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs
             exr_images(body, len, count ? "Samples.Y" : NULL, &r->sample_count, mb, 3, &r->multibounce,
                        msg, msg_len))
             return -1;
-        /* the bent normal is left out by methods without one: read when there */
+        /* the bent normal (every method has one): read when there */
         return (outputs & OBS_OUTPUT_BENT) ? exr_vector(body, len, bent, &r->bent, msg, msg_len) : 0;
     }
     obs_deep_result *d = res->deep;

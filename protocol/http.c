@@ -12,7 +12,8 @@
 enum { Q = OBS_HTTP_QUERY, CLI = OBS_HTTP_CLI, ANY = Q | CLI };
 
 /* The debug outputs are the CLI's only: obscurad answers AO, the
- * composite, the multi-bounce AO and the AOVs (clients/remote.c refuses
+ * composite, the multi-bounce AO, the AOVs and a deep frame's deep EXR
+ * (clients/remote.c refuses
  * the others with --server). */
 static const obs_http_choice output_choices[] = {
     {"ao", OBS_OUTPUT_AO, ANY},
