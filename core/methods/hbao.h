@@ -31,4 +31,11 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
 float obs__hbao_pixel_bent(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                            const float n[3], int *count, float bent[3]);
 
+/* The same over `layers` planes of positions (pos, then pos + 4 w h, ...:
+ * deep input's nodes, core/deep): at each step every node at its pixel,
+ * front to back, raises the horizon where it lies above it (OITAO's
+ * multi-layer HBAO, Fig. 9). */
+float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, int layers, int x, int y,
+                            const float p[3], const float n[3], int *count);
+
 #endif
