@@ -386,6 +386,20 @@ static obs_status put_stdout(const obs_bytes *b, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
+/* A whole file as it is (the daemon's deep EXR answer). */
+static obs_status put_file(const char *path, const obs_bytes *b, char err[OBS_ERR_LEN])
+{
+    FILE *fp = fopen(path, "wb");
+    int ok = fp && fwrite(b->data, 1, b->size, fp) == b->size;
+    if (fp && fclose(fp) != 0)
+        ok = 0;
+    if (!ok) {
+        snprintf(err, OBS_ERR_LEN, "cannot write it: %s", strerror(errno));
+        return OBS_IO;
+    }
+    return OBS_OK;
+}
+
 /* A PNG of `obscura ao` to its file, or to stdout under -o -. */
 static obs_status write_png_out(const ao_args *a, const char *path, const obs_image *img,
                                 const obs_png_options *po, char err[OBS_ERR_LEN])
@@ -659,10 +673,9 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         return cli_fail(OBS_UNSUPPORTED, a->in, err);
     }
     if ((a->req.outputs & OBS_OUTPUT_DEEP) &&
-        (a->req.outputs != OBS_OUTPUT_DEEP || a->req.format != OBS_HTTP_EXR || server ||
-         !strcmp(a->out, "-"))) {
-        snprintf(err, OBS_ERR_LEN, "--output deep writes one deep EXR file in-process: not with other "
-                 "outputs, PNG, --server or stdout");
+        (a->req.outputs != OBS_OUTPUT_DEEP || a->req.format != OBS_HTTP_EXR || !strcmp(a->out, "-"))) {
+        snprintf(err, OBS_ERR_LEN, "--output deep writes one deep EXR file: not with other outputs, PNG "
+                 "or stdout");
         return cli_fail(OBS_INVALID_ARGUMENT, a->in, err);
     }
     double t0 = now_ms();
@@ -677,7 +690,19 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         (rc = cli_input_warnings(a->in, &dinfo, a->req.strict)) != EXIT_OK)
         goto done;
     t0 = now_ms();
-    if (a->cpu) {
+    if (server && (a->req.outputs & OBS_OUTPUT_DEEP)) {
+        /* the daemon answers the deep EXR itself: written as it came */
+        obs_bytes file = {0};
+        if ((rc = cli_remote_run_deep_file(server, argc, argv, a->in, &d, &file)) == EXIT_OK &&
+            (rc = cli_remote_result_warnings(a, &dinfo)) == EXIT_OK) {
+            if ((s = put_file(a->out, &file, err)) != OBS_OK)
+                rc = cli_fail(s, a->out, err);
+            else if (verbosity >= OBS_LOG_INFO)
+                fprintf(stderr, "obscura: wrote %s\n", a->out);
+        }
+        obs_bytes_free(&file);
+        goto done;
+    } else if (a->cpu) {
         s = obs_deep_run_cpu(&d, &a->req.params, &r, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         if ((rc = cli_remote_run_deep(server, argc, argv, a->in, &d, a->req.outputs, &r)) != EXIT_OK)
@@ -746,14 +771,24 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     if (verbosity >= OBS_LOG_INFO) {
         obs_params p;
         obs_params_resolve(&a->req.params, &p);
+        char kernel[64]; /* the method's samples */
+        if (p.method == OBS_METHOD_GTAO)
+            snprintf(kernel, sizeof kernel, "gtao %d slices x %d steps", p.gtao_slices,
+                     p.gtao_steps);
+        else if (p.method == OBS_METHOD_HBAO)
+            snprintf(kernel, sizeof kernel, "hbao %d directions x %d steps", p.hbao_directions,
+                     p.hbao_steps);
+        else if (p.method == OBS_METHOD_HEMISPHERE)
+            snprintf(kernel, sizeof kernel, "%d hemisphere samples", p.hemisphere_samples);
+        else
+            snprintf(kernel, sizeof kernel, "%d samples%s", p.samples,
+                     p.deep_intervals == OBS_ON && d.has_facing ? ", intervals" : "");
         fprintf(stderr, "obscura: info: deep %dx%d, %llu samples, %s, %d nodes%s, %s hulls, "
-                "radius %g, %d %ssamples: read %.1f ms, AO %.1f ms\n",
+                "radius %g, %s: read %.1f ms, AO %.1f ms\n",
                 d.width, d.height, (unsigned long long)d.offset[(size_t)d.width * d.height],
                 p.deep_mode == OBS_DEEP_SINGLE ? "single-layer" : "multi-layer", p.deep_layers,
                 p.deep_front_half == OBS_ON ? " (front half kept)" : "",
-                p.deep_hull == OBS_DEEP_THIN ? "thin" : "solid", p.radius,
-                p.method == OBS_METHOD_HEMISPHERE ? p.hemisphere_samples : p.samples,
-                p.method == OBS_METHOD_HEMISPHERE ? "hemisphere " : "", t_read, t_run);
+                p.deep_hull == OBS_DEEP_THIN ? "thin" : "solid", p.radius, kernel, t_read, t_run);
     }
 done:
     obs_deep_result_free(&r);
