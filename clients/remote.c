@@ -333,12 +333,10 @@ static int answer_file(answer *res, const unsigned char *body, size_t len, char 
 
 static void answer_free(answer *a)
 {
-    if (a->flat)
-        obs_result_free(a->flat);
-    if (a->deep)
-        obs_deep_result_free(a->deep);
-    if (a->file)
-        obs_bytes_free(a->file);
+    /* each takes NULL */
+    obs_result_free(a->flat);
+    obs_deep_result_free(a->deep);
+    obs_bytes_free(a->file);
 }
 
 /* Where a raw image of the answer goes (NULL: not one asked for). */
