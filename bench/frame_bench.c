@@ -1,6 +1,7 @@
 /* Frame timing: one context, many frames, medians.
  *
- *   frame_bench [--backend B] [--frames N] [--presets | --devices] G-BUFFER.exr CAMERA.json...
+ *   frame_bench [--backend B] [--frames N] [--presets | --devices | --cpu-only WxH]
+ *               G-BUFFER.exr CAMERA.json...
  *
  * For each G-buffer (and a 1920x1080 nearest-neighbour upscale of it):
  * the first frame (shaders compiled, targets allocated), the median of N
@@ -8,7 +9,8 @@
  * one run so the ratios are comparable.  Output is a Markdown table.
  * --presets: --quality's presets at 1920x1080 and 3840x2160; --devices:
  * every method on the CPU device (obs_run_cpu) against the GL context,
- * at the same sizes. */
+ * at the same sizes; --cpu-only WxH: the CPU device alone (no GL context:
+ * for a profiler), every method at that size, per pass. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -281,10 +283,64 @@ static void devices_passes(void)
     printf("\n%s", devices_md);
 }
 
+/* --cpu-only: each method's default chain on the CPU device alone at
+ * one size, median wall ms per pass (no GL context: what a profiler such
+ * as perf or callgrind sees is the CPU device's own). */
+static void bench_cpu_only(const char *name, const obs_gbuffer *gb, int frames)
+{
+    char err[OBS_ERR_LEN];
+    if (frames > 64)
+        frames = 64;
+    if (frames < 1)
+        frames = 1;
+    printf("| G-buffer (upscaled) | size | method | CPU threads | wall ms |");
+    for (int q = 0; q < OBS_PASS_COUNT; q++)
+        printf(" %s |", obs_pass_name((obs_pass)q));
+    printf("\n|---|---|---|---|---|");
+    for (int q = 0; q < OBS_PASS_COUNT; q++)
+        printf("---|");
+    printf("\n");
+    const char *only = getenv("FRAME_BENCH_METHOD"); /* one method (profiling) */
+    for (int m = 0; m < obs__method_count(); m++) {
+        obs_params p = {0};
+        const char *method = obs__method_at(m)->name;
+        if (only && strcmp(only, method))
+            continue;
+        double t[64], pass[OBS_PASS_COUNT][64];
+        if (obs_param_set(&p, "method", method, err) != OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            exit(1);
+        }
+        for (int i = 0; i < frames; i++) {
+            obs_result r;
+            obs_pass_times pt;
+            double t0 = now_ms();
+            if (obs__run_cpu_timed(gb, &p, OBS_OUTPUT_AO, &r, &pt, err) != OBS_OK) {
+                fprintf(stderr, "frame_bench: %s: %s\n", method, err);
+                exit(1);
+            }
+            t[i] = now_ms() - t0;
+            obs_result_free(&r);
+            for (int q = 0; q < OBS_PASS_COUNT; q++)
+                pass[q][i] = pt.ms[q];
+        }
+        qsort(t, (size_t)frames, sizeof t[0], cmp);
+        printf("| %s | %dx%d | %s | %d | %.1f |", name, gb->width, gb->height, method,
+               obs__cpu_threads(), t[frames / 2]);
+        for (int q = 0; q < OBS_PASS_COUNT; q++) {
+            qsort(pass[q], (size_t)frames, sizeof pass[q][0], cmp);
+            double v = pass[q][frames / 2];
+            printf(v < 0 ? " - |" : " %.1f |", v);
+        }
+        printf("\n");
+        fflush(stdout);
+    }
+}
+
 int main(int argc, char **argv)
 {
     obs_ctx_desc desc = {0};
-    int frames = 15, presets = 0, devices = 0;
+    int frames = 15, presets = 0, devices = 0, cpu_w = 0, cpu_h = 0;
     int i = 1;
     for (; i < argc && argv[i][0] == '-'; i++) {
         if (!strcmp(argv[i], "--backend") && i + 1 < argc)
@@ -295,12 +351,41 @@ int main(int argc, char **argv)
             presets = 1;
         else if (!strcmp(argv[i], "--devices"))
             devices = 1;
+        else if (!strcmp(argv[i], "--cpu-only") && i + 1 < argc &&
+                 sscanf(argv[++i], "%dx%d", &cpu_w, &cpu_h) != 2) {
+            fprintf(stderr, "frame_bench: --cpu-only takes WxH\n");
+            return 2;
+        }
     }
     if (argc - i < 2 || (argc - i) % 2) {
-        fprintf(stderr, "usage: frame_bench [--backend B] [--frames N] [--presets | --devices] GBUFFER.exr CAMERA.json...\n");
+        fprintf(stderr, "usage: frame_bench [--backend B] [--frames N] [--presets | --devices | --cpu-only WxH] GBUFFER.exr CAMERA.json...\n");
         return 2;
     }
     char err[OBS_ERR_LEN];
+    if (cpu_w > 0 && cpu_h > 0) { /* the CPU device alone: no context */
+        obs_gbuffer_file gf = {0};
+        if (obs_gbuffer_read_exr(argv[i], NULL, NULL, &gf, err) != OBS_OK ||
+            obs_camera_read_json(argv[i + 1], &gf.gb.camera, NULL, NULL, err) != OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            return 1;
+        }
+        float *pd = upscale(&gf.gb.depth, gf.gb.width, gf.gb.height, cpu_w, cpu_h);
+        float *pn = upscale(&gf.gb.normal, gf.gb.width, gf.gb.height, cpu_w, cpu_h);
+        obs_gbuffer up = gf.gb;
+        up.width = cpu_w;
+        up.height = cpu_h;
+        up.display_width = up.display_height = 0;
+        up.display_x = up.display_y = 0;
+        up.depth = (obs_plane){pd, 1, 0};
+        up.normal = (obs_plane){pn, 3, 0};
+        up.color = (obs_plane){NULL, 0, 0};
+        const char *base = strrchr(argv[i], '/') ? strrchr(argv[i], '/') + 1 : argv[i];
+        bench_cpu_only(base, &up, frames);
+        free(pd);
+        free(pn);
+        obs_gbuffer_free(&gf);
+        return 0;
+    }
     obs_ctx *ctx;
     double t0 = now_ms();
     if (obs_ctx_create(&desc, &ctx, err) != OBS_OK) {

@@ -41,6 +41,9 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
     float *ao = c->aao, *bleed = c->ableed, unread[3];
     const int bleed_read = c->pl->f.bleed_step || c->out->bleed.data;
     float *count = c->out->sample_count.data, *mask = c->out->cull_mask.data;
+    unsigned char cand[AO_TILE_W * AO_TILE_H]; /* section 4.2's test, the tile at once */
+    if (f->culling && !method->pixel)
+        obs__cull_candidates(f, est, x0, x1, y0, y1, cand);
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
             size_t i = (size_t)y * f->width + x;
@@ -54,7 +57,7 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
             } else if (pos[4 * i + 3] > 0.0f) {
                 /* Section 4.2: a culling candidate gets AO 1 (greedy) or
                  * at most the 4-sample set (careful). */
-                culled = f->culling && obs__cull_candidate(f, est, x, y);
+                culled = f->culling && cand[(size_t)(y - y0) * (size_t)(x1 - x0) + (size_t)(x - x0)];
                 if (!culled) {
                     /* section 4.1: the set of the pixel's count */
                     n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
@@ -203,7 +206,18 @@ static void rays(obs__cpu_run *c)
 static obs_status cpu_blur(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
     (void)err;
-    obs__blur_dnz(c->pl->af, c->apos, c->dnz, c->aao, c->atmp, c->pl->rays_in_blur);
+    float *res = obs__blur_dnz(c->pl->af, c->apos, c->dnz, c->aao, c->atmp, c->pl->rays_in_blur);
+    if (res != c->aao) { /* the result in the other plane: the two swap roles */
+        c->atmp = c->aao;
+        c->aao = res;
+        if (c->pl->f.half) {
+            c->htmp = c->atmp;
+            c->hao = res;
+        } else {
+            c->tmp = c->atmp;
+            c->ao = res;
+        }
+    }
     return OBS_OK;
 }
 
