@@ -120,8 +120,9 @@
       "read-only when it cannot be written")                                   \
     X(backend, ENUM, 0, 0, "auto",                                             \
       "backend: auto|egl-device|egl-surfaceless|osmesa (a GL context) or "    \
-      "cpu (the CPU device, no GL context) (default: OBSCURA_BACKEND, else "   \
-      "auto)")                                                                 \
+      "cpu (the CPU device, no GL context); auto named: a GPU, else the "     \
+      "faster of cpu and llvmpipe, measured once and kept in the cache "      \
+      "folder (default: OBSCURA_BACKEND, else auto)")                          \
     X(log_level, ENUM, 0, 0, "info",                                           \
       "error|warn|info|debug; info logs one line per request")                \
     X(fail_gl_after, INT, 0, 1000000000, "0",                                  \
