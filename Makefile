@@ -240,6 +240,12 @@ loops: $(CORE_OBJ) $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
 # the daemon and run afterwards, one at a time.  E2E_ONLY / E2E_SKIP: the
 # scripts' names (without .sh) to run, or to leave to another target.
 E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)
+# `make e2e OBSCURA_BACKEND=cpu`: every script on the CPU device (obscura
+# and obscurad read the variable where no --backend is given; gbuffer and
+# the bakes rasterise on a GL context still).
+ifneq ($(OBSCURA_BACKEND),)
+E2E_ENV += OBSCURA_BACKEND=$(OBSCURA_BACKEND)
+endif
 E2E_ALONE = drain load output bakes hostile_http limits recover
 E2E_ALL = $(wildcard tests/e2e/*.sh)
 E2E_RUN = $(if $(E2E_ONLY),$(filter $(addprefix tests/e2e/,$(addsuffix .sh,$(E2E_ONLY))),$(E2E_ALL)),\

@@ -48,6 +48,16 @@ rc=$?
 check "deep input, --backend cpu: exit $rc, the bytes of --cpu" \
     "[ $rc -eq 0 ] && cmp -s '$T/deep_twin.exr' '$T/deep_flag.exr'"
 
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$T/tri.obj"
+"$OBSCURA" gbuffer "$T/tri.obj" --camera "$CAMJ" --backend cpu -o "$T/g.exr" 2>"$T/g.err"
+rc=$?
+check "gbuffer --backend cpu: usage error (exit $rc): it rasterises, GL needed" \
+    "[ $rc -eq 2 ] && grep -q 'rasterises a mesh, which needs a GL context' '$T/g.err'"
+"$OBSCURA" warmup --backend cpu --cache-dir "$T/wc" 2>"$T/w.err"
+rc=$?
+check "warmup --backend cpu: exit $rc, nothing to warm up" \
+    "[ $rc -eq 0 ] && grep -q 'compiles no programs' '$T/w.err'"
+
 out=$("$OBSCURA" info --backend cpu 2>&1)
 rc=$?
 check "info --backend cpu: exit $rc, 'backend: cpu'" \
