@@ -87,10 +87,13 @@ static void position_rows(void *ctx, int y0, int y1)
     const obs__cpu_run *c = ctx;
     const obs__frame *f = &c->pl->f;
     const obs_gbuffer *gb = c->pl->gb;
-    for (int y = y0; y < y1; y++)
+    for (int y = y0; y < y1; y++) {
+        const float *depth = obs__plane_px(&gb->depth, f->width, 0, y); /* the row, once */
+        const size_t dc = (size_t)gb->depth.channels;
         for (int x = 0; x < f->width; x++)
-            obs__prep_position(f, *obs__plane_px(&gb->depth, f->width, x, y), x, y,
+            obs__prep_position(f, depth[dc * (size_t)x], x, y,
                                c->pos + 4 * ((size_t)y * f->width + x));
+    }
 }
 
 static void normal_rows(void *ctx, int y0, int y1)
@@ -98,9 +101,10 @@ static void normal_rows(void *ctx, int y0, int y1)
     const obs__cpu_run *c = ctx;
     const obs__frame *f = &c->pl->f;
     const obs_gbuffer *gb = c->pl->gb;
-    for (int y = y0; y < y1; y++)
+    for (int y = y0; y < y1; y++) {
+        const float *row = gb->normal.data ? obs__plane_px(&gb->normal, f->width, 0, y) : NULL;
         for (int x = 0; x < f->width; x++) {
-            const float *in = gb->normal.data ? obs__plane_px(&gb->normal, f->width, x, y) : NULL;
+            const float *in = row ? row + (size_t)gb->normal.channels * (size_t)x : NULL;
             const size_t i = (size_t)y * f->width + x;
             obs__prep_normal(f, c->pos, in, x, y, c->nrm + 3 * i);
             if (!f->half) {
@@ -108,6 +112,7 @@ static void normal_rows(void *ctx, int y0, int y1)
                 c->dnz[2 * i + 1] = c->nrm[3 * i + 2];
             }
         }
+    }
 }
 
 static void prep_full(obs__cpu_run *c)
