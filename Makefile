@@ -143,6 +143,12 @@ $(UPSCALE): tools/exr_upscale.c $(LIB)
 
 # Deep input: OITAO Table I structure (bench/RESULTS.md, "Deep input").
 DEEP_BENCH := $(BUILD)/deep_bench
+# The blur kernel in Google's Highway (libhwy-dev) against the library's
+# OpenMP simd form (bench/blur_hwy.cc); built by make bench only, the
+# library does not link Highway.
+HWY_BENCH := $(BUILD)/blur_hwy_bench
+$(HWY_BENCH): bench/blur_hwy.cc $(LIB)
+	$(CXX) -I. $(CPPFLAGS) $(CORE_INC) $(CXXFLAGS) -std=c++17 -ffp-contract=off $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS) -lhwy
 $(DEEP_BENCH): bench/deep_bench.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CORE_INC) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
@@ -270,7 +276,8 @@ headers:
 	@echo "headers: each public header compiles alone as C and C++"
 
 bench: deps
-	@$(MAKE) --no-print-directory all $(BENCH) $(EXT_BENCH) $(UPSCALE) $(DAEMON_BENCH) $(DEEP_BENCH)
+	@$(MAKE) --no-print-directory all $(BENCH) $(EXT_BENCH) $(UPSCALE) $(DAEMON_BENCH) $(DEEP_BENCH) \
+	  $(if $(wildcard /usr/include/hwy/highway.h),$(HWY_BENCH))
 	@BUILD=$(BUILD) bench/run.sh
 
 # Quality against ground truth (bench/QUALITY.md, bench/quality/*.png): every
