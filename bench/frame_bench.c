@@ -10,7 +10,10 @@
  * --presets: --quality's presets at 1920x1080 and 3840x2160; --devices:
  * every method on the CPU device (obs_run_cpu) against the GL context,
  * at the same sizes; --cpu-only WxH: the CPU device alone (no GL context:
- * for a profiler), every method at that size, per pass. */
+ * for a profiler), every method at that size, per pass (FRAME_BENCH_METHOD:
+ * one method), then the AO pass against a plain gather loop over the same
+ * samples; with FRAME_BENCH_TABLE1=D[,D...] instead VAO++ Table 1's
+ * structure on the CPU device at 16 samples, at each adaptive_diameter D. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -413,6 +416,63 @@ static void bench_gather_limit(const obs_gbuffer *gb)
     free(rpx);
 }
 
+/* VAO++ Table 1's structure on the CPU device at 16 samples: VAO,
+ * + adaptive sampling (4.1), + culling pre-pass (4.2), VAO++ (both), the
+ * effect's wall ms (culling pre-pass + AO pass, what Table 1 counts),
+ * medians of `frames` interleaved, at adaptive_diameter `diameter`; the
+ * ratio to VAO and the mean samples per pixel with geometry. */
+static void bench_cpu_table1(const obs_gbuffer *gb, int frames, const char *diameter)
+{
+    char err[OBS_ERR_LEN];
+    obs_params p[4];
+    double t[4][64], mean[4] = {0};
+    if (frames > 64)
+        frames = 64;
+    for (int v = 0; v < 4; v++) {
+        memset(&p[v], 0, sizeof p[v]);
+        if (obs_param_set(&p[v], "samples", "16", err) != OBS_OK ||
+            obs_param_set(&p[v], "adaptive", v & 1 ? "on" : "off", err) != OBS_OK ||
+            obs_param_set(&p[v], "culling", v & 2 ? "careful" : "off", err) != OBS_OK ||
+            obs_param_set(&p[v], "adaptive_diameter", diameter, err) != OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            exit(1);
+        }
+    }
+    for (int i = -1; i < frames; i++) /* -1: the planes allocated, the counts read */
+        for (int v = 0; v < 4; v++) {
+            obs_result r;
+            obs_pass_times pt;
+            unsigned out = OBS_OUTPUT_AO | (i < 0 ? OBS_OUTPUT_SAMPLE_COUNT : 0);
+            if (obs__run_cpu_timed(gb, &p[v], out, &r, &pt, err) != OBS_OK) {
+                fprintf(stderr, "frame_bench: %s\n", err);
+                exit(1);
+            }
+            if (i < 0) {
+                double sum = 0.0;
+                size_t n = 0;
+                for (size_t k = 0; k < (size_t)gb->width * gb->height; k++)
+                    if (r.sample_count.data[k] > 0.0f) {
+                        sum += r.sample_count.data[k];
+                        n++;
+                    }
+                mean[v] = n ? sum / (double)n : 0.0;
+            } else {
+                t[v][i] = pt.ms[OBS_PASS_AO] + (pt.ms[OBS_PASS_CULL] > 0 ? pt.ms[OBS_PASS_CULL] : 0);
+            }
+            obs_result_free(&r);
+        }
+    double m[4];
+    for (int v = 0; v < 4; v++) {
+        qsort(t[v], (size_t)frames, sizeof t[v][0], cmp);
+        m[v] = t[v][frames / 2];
+    }
+    printf("| %dx%d | %s |", gb->width, gb->height, diameter);
+    for (int v = 0; v < 4; v++)
+        printf(v ? " %.1f (%.0f %%) |" : " %.1f |", m[v], 100.0 * m[v] / m[0]);
+    printf(" %.1f, %.1f, %.1f, %.1f |\n", mean[0], mean[1], mean[2], mean[3]);
+    fflush(stdout);
+}
+
 int main(int argc, char **argv)
 {
     obs_ctx_desc desc = {0};
@@ -456,6 +516,21 @@ int main(int argc, char **argv)
         up.normal = (obs_plane){pn, 3, 0};
         up.color = (obs_plane){NULL, 0, 0};
         const char *base = strrchr(argv[i], '/') ? strrchr(argv[i], '/') + 1 : argv[i];
+        const char *t1 = getenv("FRAME_BENCH_TABLE1"); /* diameters, comma-separated */
+        if (t1) {
+            printf("VAO++ Table 1 on the CPU device, 16 samples: effect wall ms (culling pre-pass "
+                   "+ AO pass), %% of VAO; mean samples per pixel with geometry\n\n"
+                   "| size | adaptive_diameter | VAO | +adaptive | +culling | VAO++ | samples/px "
+                   "VAO, +adaptive, +culling, VAO++ |\n|---|---|---|---|---|---|---|\n");
+            char list[256];
+            snprintf(list, sizeof list, "%s", t1);
+            for (char *d = strtok(list, ","); d; d = strtok(NULL, ","))
+                bench_cpu_table1(&up, frames, d);
+            free(pd);
+            free(pn);
+            obs_gbuffer_free(&gf);
+            return 0;
+        }
         bench_cpu_only(base, &up, frames);
         printf("\nThe AO pass (vaopp, default chain, 1 thread, fastest of 3) against a plain gather "
                "loop fetching the same samples (each one 8-byte load of depth and normal z at the "
