@@ -78,6 +78,21 @@ static float *upscale(const obs_plane *p, int sw, int sh, int w, int h)
     return out;
 }
 
+/* gb's depth and normals upscaled to w x h (no colour), the same camera;
+ * the caller frees up->depth.data and up->normal.data. */
+static obs_gbuffer upscaled(const obs_gbuffer *gb, int w, int h)
+{
+    obs_gbuffer up = *gb;
+    up.width = w;
+    up.height = h;
+    up.display_width = up.display_height = 0;
+    up.display_x = up.display_y = 0;
+    up.depth = (obs_plane){upscale(&gb->depth, gb->width, gb->height, w, h), 1, 0};
+    up.normal = (obs_plane){upscale(&gb->normal, gb->width, gb->height, w, h), 3, 0};
+    up.color = (obs_plane){NULL, 0, 0};
+    return up;
+}
+
 static void bench(obs_ctx *ctx, const char *name, const obs_gbuffer *gb, int frames, int with_cpu)
 {
     char err[OBS_ERR_LEN];
@@ -505,16 +520,8 @@ int main(int argc, char **argv)
             fprintf(stderr, "frame_bench: %s\n", err);
             return 1;
         }
-        float *pd = upscale(&gf.gb.depth, gf.gb.width, gf.gb.height, cpu_w, cpu_h);
-        float *pn = upscale(&gf.gb.normal, gf.gb.width, gf.gb.height, cpu_w, cpu_h);
-        obs_gbuffer up = gf.gb;
-        up.width = cpu_w;
-        up.height = cpu_h;
-        up.display_width = up.display_height = 0;
-        up.display_x = up.display_y = 0;
-        up.depth = (obs_plane){pd, 1, 0};
-        up.normal = (obs_plane){pn, 3, 0};
-        up.color = (obs_plane){NULL, 0, 0};
+        obs_gbuffer up = upscaled(&gf.gb, cpu_w, cpu_h);
+        float *pd = (float *)up.depth.data, *pn = (float *)up.normal.data;
         const char *base = strrchr(argv[i], '/') ? strrchr(argv[i], '/') + 1 : argv[i];
         const char *t1 = getenv("FRAME_BENCH_TABLE1"); /* diameters, comma-separated */
         if (t1) {
@@ -580,16 +587,8 @@ int main(int argc, char **argv)
             static const int sizes[2][2] = {{1920, 1080}, {3840, 2160}};
             for (int k = 0; k < 2; k++) {
                 int pw = sizes[k][0], ph = sizes[k][1];
-                float *pd = upscale(&gf.gb.depth, gf.gb.width, gf.gb.height, pw, ph);
-                float *pn = upscale(&gf.gb.normal, gf.gb.width, gf.gb.height, pw, ph);
-                obs_gbuffer up = gf.gb;
-                up.width = pw;
-                up.height = ph;
-                up.display_width = up.display_height = 0;
-                up.display_x = up.display_y = 0;
-                up.depth = (obs_plane){pd, 1, 0};
-                up.normal = (obs_plane){pn, 3, 0};
-                up.color = (obs_plane){NULL, 0, 0};
+                obs_gbuffer up = upscaled(&gf.gb, pw, ph);
+                float *pd = (float *)up.depth.data, *pn = (float *)up.normal.data;
                 int nf = k ? (frames < 5 ? frames : 5) : frames;
                 if (devices)
                     bench_devices(ctx, base, &up, nf, obs__cpu_threads());

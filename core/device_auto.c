@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "obscura/obscura.h"
+#include "internal.h"
 #include "obscura/params.h"
 #include "pool.h"
 
@@ -28,9 +29,7 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
-/* The key of a measurement: this machine, this version, the method and
- * the thread count (a farm slot of fewer cores may choose otherwise). */
-static void key_of(const char *method, char *buf, size_t n)
+void obs__device_key(const char *method, char *buf, size_t n)
 {
     char host[128] = "?";
     if (gethostname(host, sizeof host - 1) != 0)
@@ -159,7 +158,7 @@ obs_status obs_device_choose(const char *cache_dir, const obs_params *params, in
     out->cpu_ms = out->gl_ms = -1.0;
     obs_params_resolve(params, &resolved); /* the method by name, the default's too */
     obs_param_format(&resolved, obs_param_find("method"), method, sizeof method);
-    key_of(method, key, sizeof key);
+    obs__device_key(method, key, sizeof key);
     snprintf(path, sizeof path, "%s/devices.txt", dir);
     if (measure_now) { /* a GPU first: it wins over both */
         obs_ctx_desc gpu = {.backend = OBS_BACKEND_EGL_DEVICE};

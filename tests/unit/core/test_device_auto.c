@@ -8,20 +8,8 @@
 
 #include <unistd.h>
 
+#include "internal.h"
 #include "obscura/obscura.h"
-#include "pool.h"
-
-static void key(char *buf, size_t n, const char *method)
-{
-    char host[128] = "?";
-    if (gethostname(host, sizeof host - 1) != 0)
-        snprintf(host, sizeof host, "?");
-    host[sizeof host - 1] = '\0';
-    for (char *c = host; *c; c++)
-        if (*c == ' ' || *c == '\t' || *c == '\n')
-            *c = '_';
-    snprintf(buf, n, "%s %s %s %d", host, OBS_VERSION, method, obs__pool_threads(0));
-}
 
 static void write_lines(const char *path, const char *lines)
 {
@@ -46,8 +34,8 @@ static void test_kept_choice(void **state)
     assert_int_equal(ch.backend, OBS_BACKEND_AUTO);
     assert_false(ch.cached || ch.measured);
     /* the default method's line: the CPU device */
-    key(k, sizeof k, "vaopp");
-    key(k2, sizeof k2, "gtao");
+    obs__device_key("vaopp", k, sizeof k);
+    obs__device_key("gtao", k2, sizeof k2);
     snprintf(lines, sizeof lines, "%s cpu 10.0 20.0\n%s gl 30.0 20.0\n", k, k2);
     write_lines(path, lines);
     assert_int_equal(obs_device_choose(dir, NULL, 0, &ch, err), OBS_OK);
