@@ -822,7 +822,7 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
 {
     obs_status s;
     if (a->cpu) {
-        s = obs_run_cpu(&gf->gb, &a->req.params, outputs, res, err);
+        s = obs_run_cpu_logged(&gf->gb, &a->req.params, outputs, res, log_cb, NULL, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, res);
     } else {

@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "chain/passes_cpu.h"
+#include "log.h"
 
 static double now_ms(void)
 {
@@ -34,20 +35,39 @@ static obs_status walk(obs__cpu_run *c, obs_pass_times *t, char err[OBS_ERR_LEN]
     return OBS_OK;
 }
 
+static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                      obs_result *out, obs_pass_times *times, obs_log_fn log, void *log_user,
+                      char err[OBS_ERR_LEN]);
+
 obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                        obs_result *out, char err[OBS_ERR_LEN])
 {
-    return obs__run_cpu_timed(gb, params, outputs, out, NULL, err);
+    return run(gb, params, outputs, out, NULL, NULL, NULL, err);
+}
+
+obs_status obs_run_cpu_logged(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                              obs_result *out, obs_log_fn log, void *log_user,
+                              char err[OBS_ERR_LEN])
+{
+    return run(gb, params, outputs, out, NULL, log, log_user, err);
 }
 
 obs_status obs__run_cpu_timed(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                               obs_result *out, obs_pass_times *times, char err[OBS_ERR_LEN])
 {
+    return run(gb, params, outputs, out, times, NULL, NULL, err);
+}
+
+static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                      obs_result *out, obs_pass_times *times, obs_log_fn log, void *log_user,
+                      char err[OBS_ERR_LEN])
+{
     obs__plan pl;
     obs__cpu_run c = {0};
+    obs__log_sink sink = {log, log_user}; /* the frame setup's messages */
 
     memset(out, 0, sizeof *out);
-    obs_status s = obs__plan_init(&pl, NULL, gb, params, outputs, err);
+    obs_status s = obs__plan_init(&pl, log ? obs__log_only_ctx(&sink) : NULL, gb, params, outputs, err);
     if (s != OBS_OK)
         return s;
     c.pl = &pl;

@@ -256,6 +256,13 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
 obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params,
                        unsigned outputs, obs_result *out, char err[OBS_ERR_LEN]);
 
+/* obs_run_cpu with the frame's messages (the channel and camera notes a
+ * GL context's log gets, such as "reconstructing normals from depth")
+ * handed to log (NULL: dropped, as obs_run_cpu does). */
+obs_status obs_run_cpu_logged(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                              obs_result *out, obs_log_fn log, void *log_user,
+                              char err[OBS_ERR_LEN]);
+
 void obs_result_free(obs_result *r);
 
 /* Baked and screen-space AO in one frame: r->ao (the chain's, 1 channel)

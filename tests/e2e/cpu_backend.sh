@@ -2,7 +2,7 @@
 # End-to-end tests of the CPU device's name in the CLI and the daemon:
 # --backend cpu and OBSCURA_BACKEND=cpu run the chain on the CPU (no GL
 # context), the same bytes as --cpu (its older name), flat and deep input;
-# --backend beats the environment; --backend auto measures the two
+# the frame's notes logged; --backend beats the environment; --backend auto measures the two
 # devices once and keeps the faster (a run naming no backend reads it);
 # `obscura info --backend cpu`; a
 # backend that is none names cpu among the choices; obscurad --backend
@@ -41,6 +41,11 @@ check "--backend auto beats OBSCURA_BACKEND=cpu: exit $rc, measured ($kept kept)
 rc=$?
 check "no backend named: exit $rc, the kept choice ($kept), not measured again" \
     "[ $rc -eq 0 ] && grep -q 'device: .*measured before' '$T/auto2.log' && grep -q '$ran' '$T/auto2.log' && [ \$(wc -l < '$T/cache/devices.txt') -eq 1 ]"
+
+"$OBSCURA" ao "$R" --preset blender --fov-y 50 --backend cpu -o "$T/fov.exr" 2>"$T/fov.log"
+rc=$?
+check "--backend cpu logs the frame's notes as a GL context does (exit $rc)" \
+    "[ $rc -eq 0 ] && grep -q 'reconstructing normals from depth' '$T/fov.log'"
 
 "$OBSCURA" ao "$DATA/deep_small.exr" --radius 0.6 --cpu -q -o "$T/deep_twin.exr"
 "$OBSCURA" ao "$DATA/deep_small.exr" --radius 0.6 --backend cpu -q -o "$T/deep_flag.exr"
