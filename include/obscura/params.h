@@ -184,7 +184,9 @@ typedef enum obs_baked_combine {
     X(deep_mode, OBS_DEEP_MODE_LIST)                                           \
     X(deep_front_half, OBS_SWITCH_LIST)                                        \
     X(deep_hull, OBS_DEEP_HULL_LIST)                                           \
-    X(baked_combine, OBS_BAKED_COMBINE_LIST)
+    X(deep_intervals, OBS_SWITCH_LIST)                                         \
+    X(baked_combine, OBS_BAKED_COMBINE_LIST)                                   \
+    X(multibounce, OBS_SWITCH_LIST)
 
 /* X(name, type, default, min, max, choices, doc)
  * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4.
@@ -388,7 +390,7 @@ typedef enum obs_baked_combine {
     X(deep_layers, INT, 4, 1, 8, NULL,                                         \
       "deep input: nodes m kept per pixel by the list compression of OITAO "   \
       "III-B (eq 5 drops the node of least alpha (1 - z), z the depth "        \
-      "normalised over the image)")                                           \
+      "normalised over the camera's clip range)")                              \
     X(deep_front_half, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),                            \
       "deep input: eq 5 searches the back half of the list only, keeping the " \
       "m/2 front nodes (OITAO V-A, Fig. 6 column C)")                          \
@@ -397,12 +399,28 @@ typedef enum obs_baked_combine {
       "occluders and receivers weighted by alpha) or thin hulls (eqs 2-4: "    \
       "exterior and interior AO mixed by W(p), alpha or 1 - alpha on back "    \
       "faces)")                                                                \
+    X(deep_intervals, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),         \
+      "deep input with facing flags (channel Facing, as obscura gbuffer "      \
+      "--deep writes), deep_mode multi, methods vaopp and vao: on, the solid " \
+      "between a front face and its matching back face is an interval, free "  \
+      "behind it, and the depth range check applies only to a surface with "   \
+      "no back face in the list (the obscured volume as it is); off, every "   \
+      "node is solid behind it, as ao_definition rays' conversion assumes "    \
+      "(bench/QUALITY.md, \"Deep input against Cycles\")")                     \
     X(baked_combine, ENUM, "product", 0, 0, OBS_CHOICES(OBS_BAKED_COMBINE_LIST), \
       "--baked CH (HTTP: baked=CH): how the G-buffer's baked AO channel "      \
       "(obscura bake's _AO, rasterised by obscura gbuffer) is combined with "  \
       "the chain's AO: product (two visibility factors of separate scales, "   \
       "the baked distant obscurance times the screen-space detail) or min "    \
-      "(the darker of the two: an occluder both see darkens once)")
+      "(the darker of the two: an occluder both see darkens once)")           \
+    X(multibounce, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),             \
+      "multi-bounce AO (Jimenez et al. 2016, the cubic fit): the AO's albedo-driven "  \
+      "cubic fit of the light that bounces back into the occluded cone, "      \
+      "max(A, ((a A + b) A + c) A), a, b, c linear in the albedo, per "        \
+      "channel of the colour plane (name the albedo with --color albedo); "    \
+      "on: the composite takes it and the AOMultiBounce.R,G,B layer is "       \
+      "written beside the AO; a warning and the plain AO without a colour "    \
+      "plane")
 
 #define OBS__PDECL_FLOAT(n) float n;
 #define OBS__PDECL_INT(n) int n;
