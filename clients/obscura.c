@@ -860,7 +860,8 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
 {
     obs_status s;
     if (a->cpu) {
-        s = obs_run_cpu_logged(&gf->gb, &a->req.params, outputs, res, log_cb, NULL, err);
+        obs_cpu_options o = {.log = log_cb};
+        s = obs_run_cpu_opts(&gf->gb, &a->req.params, outputs, res, &o, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, res);
     } else {

@@ -2,6 +2,7 @@
  * (passes_gl.c), pixel by pixel.  The order and whether a pass runs are
  * the table's (passes.c); the driver is run_cpu.c. */
 #include <string.h>
+#include <time.h>
 
 #include "chain/bands_cpu.h"
 #include "chain/multibounce.h"
@@ -63,9 +64,28 @@ static void vao_bent(const obs__frame *f, const float *pos, const float *nrm, in
  * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
  * (when the composite or the output reads it) and the debug planes (NULL:
  * not wanted) of every pixel. */
+/* The clock against the run's deadline, read between the AO pass's
+ * tiles: past it, the rest of the pass's tiles are skipped (the run then
+ * fails with OBS_DEADLINE, run_cpu.c). */
+static int past_deadline(obs__cpu_run *c)
+{
+    if (atomic_load_explicit(&c->stopped, memory_order_relaxed))
+        return 1;
+    if (c->deadline_ms <= 0.0)
+        return 0;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    if ((double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6 <= c->deadline_ms)
+        return 0;
+    atomic_store(&c->stopped, 1);
+    return 1;
+}
+
 static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
 {
-    const obs__cpu_run *c = ctx;
+    obs__cpu_run *c = ctx;
+    if (past_deadline(c))
+        return;
     const obs__frame *f = c->pl->af;
     const obs__method *method = c->pl->method;
     const float *pos = c->apos, *nrm = c->anrm, *col = c->col, *est = c->est;

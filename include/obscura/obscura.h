@@ -274,12 +274,21 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
 obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params,
                        unsigned outputs, obs_result *out, char err[OBS_ERR_LEN]);
 
-/* obs_run_cpu with the frame's messages (the channel and camera notes a
- * GL context's log gets, such as "reconstructing normals from depth")
- * handed to log (NULL: dropped, as obs_run_cpu does). */
-obs_status obs_run_cpu_logged(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
-                              obs_result *out, obs_log_fn log, void *log_user,
-                              char err[OBS_ERR_LEN]);
+/* What obs_run_cpu_opts takes besides the frame (zeroed: obs_run_cpu). */
+typedef struct obs_cpu_options {
+    /* the frame's messages (the channel and camera notes a GL context's
+     * log gets, such as "reconstructing normals from depth"); NULL:
+     * dropped */
+    obs_log_fn log;
+    void *log_user;
+    /* seconds: the run stops with OBS_DEADLINE once the chain has taken
+     * longer (the clock read between passes and between the AO pass's
+     * tiles, so at most one tile past it); 0: no deadline */
+    double deadline;
+} obs_cpu_options;
+
+obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                            obs_result *out, const obs_cpu_options *opt, char err[OBS_ERR_LEN]);
 
 void obs_result_free(obs_result *r);
 
