@@ -38,6 +38,10 @@ void *obs__alloc_arrays(size_t n, const size_t *bytes, void **arr);
 size_t obs__plane_stride(const obs_plane *p, int width);
 const float *obs__plane_px(const obs_plane *p, int width, int x, int y);
 
+/* The key of --backend auto's kept measurement (device_auto.c): "HOST
+ * VERSION METHOD THREADS", the host's blanks as '_'. */
+void obs__device_key(const char *method, char *buf, size_t n);
+
 /* Checks a G-buffer's sizes and planes before anything runs; the message
  * names the offending plane. */
 obs_status obs__gbuffer_validate(const obs_gbuffer *gb, char err[OBS_ERR_LEN]);
