@@ -29,6 +29,7 @@
 #include "dynamic.h"
 #include "ground.h"
 #include "obscura/io.h"
+#include "obscura/mask.h"
 #include "obscura/metrics.h"
 #include "obscura/obscura.h"
 #include "remote.h"
@@ -636,8 +637,13 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     }
     double t0 = now_ms();
     s = a->in_buf ? obs_deep_read_exr_mem(a->in_buf, a->in_len, lim, &d, err) : obs_deep_read_exr(a->in, lim, &d, err);
-    if (s != OBS_OK)
+    if (s == OBS_OK) /* object masks: receivers at the front samples */
+        s = obs_deep_read_masks(&d, a->in_buf ? NULL : a->in, a->in_buf, a->in_len,
+                                &a->req.params, lim, err);
+    if (s != OBS_OK) {
+        obs_deep_free(&d);
         return cli_input_fail(s, a->in, err);
+    }
     double t_read = now_ms() - t0;
     /* the camera's cross-checks (the deep reader keeps the camera only) */
     obs_exr_info dinfo = {0};
@@ -880,8 +886,14 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
     double t0 = now_ms();
     obs_status s = a->in_buf ? obs_gbuffer_read_exr_mem(a->in_buf, a->in_len, &a->req.map, lim, &gf, err)
                              : obs_gbuffer_read_exr(a->in, &a->req.map, lim, &gf, err);
-    if (s != OBS_OK)
+    /* object masks (receivers, occluders, self_only); a daemon reads its own */
+    if (s == OBS_OK && !server)
+        s = obs_gbuffer_read_masks(&gf, a->in_buf ? NULL : a->in, a->in_buf, a->in_len,
+                                   &a->req.params, lim, err);
+    if (s != OBS_OK) {
+        obs_gbuffer_free(&gf);
         return cli_input_fail(s, a->in, err);
+    }
     double t_read = now_ms() - t0;
     print_input_info(a->in, &gf.info, &gf.gb);
     int rc = prepare_camera(a, &gf, err);
@@ -1062,7 +1074,7 @@ static int cmd_params(int argc, char **argv)
         printf("| parameter | type | default | range | meaning |\n|---|---|---|---|---|\n");
     for (int i = 0; i < obs_param_count(); i++) {
         const obs_param_info *pi = obs_param_at(i);
-        static const char *const types[] = {"float", "int", "enum", "16 floats"};
+        static const char *const types[] = {"float", "int", "enum", "16 floats", "text"};
         char range[96] = "";
         if (pi->type == OBS_PARAM_INT && pi->choices)
             snprintf(range, sizeof range, "%s", pi->choices);

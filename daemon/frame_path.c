@@ -6,6 +6,7 @@
 
 #include "frame_path.h"
 #include "obscura/deep.h"
+#include "obscura/mask.h"
 #include "stats.h"
 
 static obs_status fail_strict(char err[OBS_ERR_LEN], const obs_exr_info *info)
@@ -75,6 +76,10 @@ obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
         s = obs_deep_read_exr_mem(body, len, lim, &fp->deep_exr, err);
     else if (s == OBS_OK)
         s = obs_gbuffer_read_exr_mem(body, len, map, lim, &fp->gf, err);
+    /* object masks (receivers, occluders, self_only) from the same body */
+    if (s == OBS_OK)
+        s = deep ? obs_deep_read_masks(&fp->deep_exr, NULL, body, len, &hr->params, lim, err)
+                 : obs_gbuffer_read_masks(&fp->gf, NULL, body, len, &hr->params, lim, err);
     if (s == OBS_OK && !deep)
         s = read_baked(fp, body, len, hr, lim, err);
     if (s == OBS_OK && !deep && hr->solve_camera && fp->gf.gb.position.data)

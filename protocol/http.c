@@ -409,7 +409,7 @@ static cJSON *choices_array(const char *choices)
 
 char *obs_http_params_json(void)
 {
-    static const char *const types[] = {"float", "int", "enum", "mat4"};
+    static const char *const types[] = {"float", "int", "enum", "mat4", "string"};
     cJSON *root = cJSON_CreateObject(), *params, *opts;
     char *out = NULL;
     if (!root)

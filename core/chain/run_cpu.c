@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "chain/passes_cpu.h"
+#include "mask_apply.h"
 
 static double now_ms(void)
 {
@@ -72,5 +73,7 @@ obs_status obs__run_cpu_timed(const obs_gbuffer *gb, const obs_params *params, u
     obs__cpu_planes_give(&c);
     if (s != OBS_OK)
         obs_result_free(out);
+    else
+        obs__receivers_apply(gb, out); /* object masks: receivers */
     return s;
 }

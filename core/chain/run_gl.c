@@ -6,6 +6,7 @@
 
 #include "chain/frame_gl.h"
 #include "chain/passes_gl.h"
+#include "mask_apply.h"
 
 /* ---- per-pass timings (GL_TIME_ELAPSED queries) ------------------------ */
 
@@ -125,5 +126,6 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         return s;
     }
     collect_times(ctx, ran);
+    obs__receivers_apply(gb, out); /* object masks: receivers */
     return OBS_OK;
 }

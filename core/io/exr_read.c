@@ -719,6 +719,7 @@ void obs_gbuffer_free(obs_gbuffer_file *f)
     if (!f)
         return;
     free(f->storage);
+    free(f->mask_storage);
     memset(f, 0, sizeof *f);
 }
 

@@ -15,6 +15,7 @@
  * one far, 0 with both far; the result is the weighted mean. */
 #include <math.h>
 
+#include "chain/mask_weight.h"
 #include "methods/angle.h"
 
 /* Radical inverse of i in base 2. */
@@ -94,6 +95,8 @@ float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, cons
                 v[k][j] = q[j] - p[j];
             /* "too far away": a depth difference over R, fully so from 2R */
             far[k] = fminf(1.0f, fmaxf(0.0f, fabsf(q[3] - p[3]) / R - 1.0f));
+            /* object masks: a surface that may not occlude counts as far */
+            far[k] = 1.0f - (1.0f - far[k]) * obs__occluder_weight(f, x, y, qx, qy);
         }
         /* Pair weight 1 / 0.5 / 0 for none / one / both far (continuous
          * in between); the weights renormalise the mean. */

@@ -48,6 +48,7 @@
  * the view vector of an orthographic camera is +z. */
 #include <math.h>
 
+#include "chain/mask_weight.h"
 #include "methods/gtao.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
@@ -121,7 +122,8 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         float shc = dot3(d, v) / dist;
         float dz = d[2] * (1.0f + g->thin_power[0]); /* thin-occluder compensation */
         float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
-        float w = saturate(fb * g->falloff[0] + g->falloff[1]);
+        float w = saturate(fb * g->falloff[0] + g->falloff[1]) *
+                  obs__occluder_weight(f, x, y, qx, qy); /* object masks */
         shc = low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
         hc = fmaxf(hc, shc);
     }

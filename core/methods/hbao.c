@@ -16,6 +16,7 @@
  * pixels each, R_px the radius projected at p (at most R_px steps). */
 #include <math.h>
 
+#include "chain/mask_weight.h"
 #include "methods/hbao.h"
 
 /* GLSL: hbao_ao() in hbao.glsl */
@@ -60,9 +61,11 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
             float r2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
             if (!(r2 < R2) || !(r2 > 0.0f))
                 continue;
+            /* object masks: a surface that may not occlude raises no horizon */
+            float om = obs__occluder_weight(f, x, y, qx, qy);
             float sin_s = v[2] / sqrtf(r2); /* elevation of the sample: view +z faces the camera */
-            if (sin_s > sin_h) {
-                ao += (1.0f - r2 / R2) * (sin_s - sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
+            if (sin_s > sin_h && om > 0.0f) {
+                ao += om * (1.0f - r2 / R2) * (sin_s - sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
                 sin_h = sin_s;
             }
         }

@@ -9,6 +9,7 @@
 #include <math.h>
 
 #include "methods/hemisphere.h"
+#include "chain/mask_weight.h"
 
 /* Radical inverse of i in base b: the van der Corput sequence. */
 static double radical_inverse(unsigned i, unsigned b)
@@ -104,7 +105,7 @@ float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes 
             float an = nodes->nrm ? nodes->nrm[((size_t)k * nodes->layer_px + q) * 4 + 3] : 1.0f;
             best = fmaxf(best, an * r * r * (3.0f - 2.0f * r));
         }
-        occ += best;
+        occ += best * obs__occluder_weight(f, x, y, qx, qy); /* object masks */
     }
     return hs->count > 0 ? 1.0f - occ / (float)hs->count : 1.0f;
 }

@@ -78,6 +78,7 @@ typedef struct obs_gbuffer_file {
     obs_gbuffer gb;    /* planes point into `storage` */
     float *storage;
     obs_exr_info info;
+    float *mask_storage; /* the planes of obs_gbuffer_read_masks (obscura/mask.h) */
 } obs_gbuffer_file;
 
 /* Reads a G-buffer EXR (scanline or tiled, single or multipart, any
