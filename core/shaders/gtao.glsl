@@ -69,7 +69,8 @@ float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float n
             continue;
         float shc = dot(d, v) / dist;
         float fb = length(vec3(d.xy, d.z * (1.0 + u_gtao_thin_power.x)));
-        float w = clamp(fb * u_gtao_falloff.x + u_gtao_falloff.y, 0.0, 1.0);
+        float w = clamp(fb * u_gtao_falloff.x + u_gtao_falloff.y, 0.0, 1.0) *
+                  occluder_weight(px, q); // object masks
         shc = low + (shc - low) * w;
         hc = max(hc, shc);
     }

@@ -43,9 +43,11 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
             float r2 = v.x * v.x + v.y * v.y + v.z * v.z;
             if (!(r2 < R2) || !(r2 > 0.0))
                 continue;
+            // object masks: a surface that may not occlude raises no horizon
+            float om = occluder_weight(px, q);
             float sin_s = v.z / sqrt(r2);
-            if (sin_s > sin_h) {
-                ao += (1.0 - r2 / R2) * (sin_s - sin_h);   // W(r_i) (sin h_i - sin h_(i-1))
+            if (sin_s > sin_h && om > 0.0) {
+                ao += om * (1.0 - r2 / R2) * (sin_s - sin_h);   // W(r_i) (sin h_i - sin h_(i-1))
                 sin_h = sin_s;
             }
         }

@@ -57,7 +57,7 @@ float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior)
             float r = dz > R ? R / dz : 1.0;
             best = max(best, HS_ALPHA(q, j) * r * r * (3.0 - 2.0 * r));
         }
-        occ += best;
+        occ += best * occluder_weight(px, q); // object masks
     }
     return u_hs_count > 0 ? 1.0 - occ / float(u_hs_count) : 1.0;
 }
