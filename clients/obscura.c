@@ -1082,6 +1082,8 @@ static int cmd_params(int argc, char **argv)
             snprintf(range, sizeof range, "%g .. %g", pi->min, pi->max);
         else if (pi->type == OBS_PARAM_ENUM)
             snprintf(range, sizeof range, "%s", pi->choices);
+        else if (pi->type == OBS_PARAM_STRING)
+            snprintf(range, sizeof range, "at most %g bytes", pi->max);
         if (markdown) /* '|' would end a Markdown table cell */
             for (char *c = range; *c; c++)
                 if (*c == '|')
