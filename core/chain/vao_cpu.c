@@ -274,7 +274,7 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
             float sd = range_falloff(f, front - zs, nz);
             dz = 2.0f * h * (1.0f - sd);
         }
-        dz = 2.0f * h - (2.0f * h - dz) * om; /* the occluded length times the mask */
+        dz += (2.0f * h - dz) * (1.0f - om); /* the occluded length times the mask (om 1: dz) */
         /* A sample off the planes reads the surface continued past the
          * border (border_cpu.c derives it); one behind the camera, or
          * without that estimate, says nothing about the scene: it is left

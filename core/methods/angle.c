@@ -96,7 +96,7 @@ float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, cons
             /* "too far away": a depth difference over R, fully so from 2R */
             far[k] = fminf(1.0f, fmaxf(0.0f, fabsf(q[3] - p[3]) / R - 1.0f));
             /* object masks: a surface that may not occlude counts as far */
-            far[k] = 1.0f - (1.0f - far[k]) * obs__occluder_weight(f, x, y, qx, qy);
+            far[k] += (1.0f - far[k]) * (1.0f - obs__occluder_weight(f, x, y, qx, qy));
         }
         /* Pair weight 1 / 0.5 / 0 for none / one / both far (continuous
          * in between); the weights renormalise the mean. */

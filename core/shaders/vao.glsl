@@ -128,7 +128,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             float sd = range_falloff(front - zs, nz, R, u_range_u, u_range_normal);
             dz = 2.0 * h * (1.0 - sd);
         }
-        dz = 2.0 * h - (2.0 * h - dz) * om; // the occluded length times the mask
+        dz += (2.0 * h - dz) * (1.0 - om); // the occluded length times the mask (om 1: dz)
         // A sample off the planes reads the surface continued past the
         // border; one behind the camera, or without that estimate, is left
         // out of eq 1's sum and of F alike (C twin: the same comment).

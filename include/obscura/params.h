@@ -184,10 +184,12 @@ typedef enum obs_baked_combine {
     X(deep_mode, OBS_DEEP_MODE_LIST)                                           \
     X(deep_front_half, OBS_SWITCH_LIST)                                        \
     X(deep_hull, OBS_DEEP_HULL_LIST)                                           \
-    X(baked_combine, OBS_BAKED_COMBINE_LIST)
+    X(baked_combine, OBS_BAKED_COMBINE_LIST)                                   \
+    X(self_only, OBS_SWITCH_LIST)
 
 /* X(name, type, default, min, max, choices, doc)
- * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4.
+ * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4,
+ * STRING (char[max + 1], at most max bytes; default "").
  * An INT with choices takes only the listed numbers (within min..max). 
  * For ENUM the default is the choice's name; for MAT4 it is unused. */
 /* The longest object-mask selector (receivers, occluders), in bytes. */
