@@ -22,6 +22,7 @@ typedef enum { SEL_CRYPTO, SEL_ID, SEL_MATTE } sel_kind;
 
 typedef struct {
     sel_kind kind;
+    int negate;              /* "!SELECTOR": 1 - its weight */
     char layer[128];         /* SEL_CRYPTO: "@LAYER:" ("": every layer) */
     int npat;
     char pat[MAX_PATTERNS][256]; /* unescaped; wild marks which bytes are wildcards */
@@ -120,6 +121,10 @@ bad:
 static obs_status parse_selector(const char *s, selector *sel, char err[OBS_ERR_LEN])
 {
     memset(sel, 0, sizeof *sel);
+    if (s && s[0] == '!') { /* everything but: Arnold's trace_set, inclusive off */
+        sel->negate = 1;
+        s++;
+    }
     if (!s || !*s)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "selector: empty");
     if (!strncmp(s, "id:", 3)) {
@@ -431,6 +436,9 @@ static obs_status plane_of(const source *src, const char *text, obs_image *weigh
         else
             st = matte_plane(src, sel, weight, err);
     }
+    if (st == OBS_OK && sel->negate)
+        for (size_t i = 0; i < (size_t)weight->width * (size_t)weight->height; i++)
+            weight->data[i] = 1.0f - weight->data[i];
     free(sel);
     if (st != OBS_OK) {
         obs_image_free(weight);
@@ -489,6 +497,7 @@ static obs_status default_source(const source *src, char *out, size_t len, char 
 
 static int sel_has_objects(const char *s)
 {
+    s += s[0] == '!';
     return s[0] && strncmp(s, "matte:", 6) != 0;
 }
 

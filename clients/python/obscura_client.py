@@ -212,7 +212,7 @@ class Camera(object):
 
 def selector(*names, literal=True, layer=None):
     """A receivers/occluders selector of Cryptomatte names: joined with
-    ',', each name's ',', '*', '?', '\\' (and a leading '@') escaped when
+    ',', each name's ',', '*', '?', '\\' (and a leading '@' or '!') escaped when
     literal, else * and ? kept as wildcards; layer: "@LAYER:" first (one
     Cryptomatte layer of the file instead of all)."""
     out = []
@@ -222,7 +222,7 @@ def selector(*names, literal=True, layer=None):
             n = "".join("\\" + c if c in ",*?\\" else c for c in n)
         else:
             n = n.replace("\\", "\\\\").replace(",", "\\,")
-        if n.startswith("@"):
+        if n.startswith("@") or n.startswith("!"):
             n = "\\" + n
         out.append(n)
     return ("@%s:" % layer if layer else "") + ",".join(out)

@@ -193,10 +193,10 @@ function scheduleShow() {
   rerunTimer = setTimeout(show, 150);
 }
 
-// A selector's escapes: ',', '*', '?', '\\' and a leading '@' are literal
+// A selector's escapes: ',', '*', '?', '\\' and a leading '@' or '!' are literal
 // with a backslash before them (README: Object masks).
 function escapeName(n) {
-  return n.replace(/[\\,*?]/g, (c) => '\\' + c).replace(/^@/, '\\@');
+  return n.replace(/[\\,*?]/g, (c) => '\\' + c).replace(/^[@!]/, (c) => '\\' + c);
 }
 
 // The suggestions of the selector controls: every Cryptomatte name of the

@@ -72,6 +72,8 @@ uint32_t obs_crypto_name_id(const char *name);
  *                       "@LAYER:" first restricts them to one layer
  *   id:CHANNEL=LIST     integer IDs of a channel, LIST of N or N-M by ','
  *   matte:CHANNEL       a coverage matte channel, clamped to [0, 1]
+ *   !SELECTOR           everything but: 1 - the selector's weight (a name
+ *                       that starts with '!' is written "\!")
  * *dominant (NULL: not wanted) receives, per pixel, the object the
  * selector's source says is there: the rank-0 ID's float of the
  * Cryptomatte layer (the first one matched), or the ID channel's value;

@@ -157,6 +157,14 @@ static void test_cornell_selectors(void **state)
     expect_mask("@uCryptoWildcard:rect_[_top,rect_][_bot", rects, 2);
     char err[OBS_ERR_LEN];
     obs_image w = {0};
+    /* "!": everything but */
+    int W = 0, H = 0;
+    float *m = decode(CORNELL, rects, 2, &W, &H);
+    assert_int_equal(obs_mask_plane(CORNELL, NULL, 0, "!rect_*", NULL, &w, NULL, err), OBS_OK);
+    for (int i = 0; i < W * H; i++)
+        assert_true(fabsf(w.data[i] - (1.0f - m[i])) < 1e-6f);
+    free(m);
+    obs_image_free(&w);
     assert_int_equal(obs_mask_plane(CORNELL, NULL, 0, "@nolayer:x", NULL, &w, NULL, err),
                      OBS_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "uCryptoWildcard"));
@@ -244,8 +252,8 @@ static void test_bad_selectors(void **state)
     (void)state;
     char err[OBS_ERR_LEN];
     obs_image w = {0};
-    const char *bad[] = {"", "id:id", "id:id=", "id:id=3-1", "id:id=a", "a,,b", "x\\", "matte:",
-                         "@:x"};
+    const char *bad[] = {"", "!", "id:id", "id:id=", "id:id=3-1", "id:id=a", "a,,b", "x\\",
+                         "matte:", "@:x"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
         assert_int_equal(obs_mask_plane(CORNELL, NULL, 0, bad[i], NULL, &w, NULL, err),
                          OBS_INVALID_ARGUMENT);
