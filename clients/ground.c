@@ -30,6 +30,8 @@ void cli_ground_usage(FILE *f)
             "                  [--baked]        a level baked by obscura bake (.glb, found by\n"
             "                  its attributes; --baked: required) adds _AO, _AO_SHORT, _AO_LONG,\n"
             "                  the vertex values interpolated\n"
+            "                  [--ids]          adds id: 1 + the mesh's index at each pixel (0: none),\n"
+            "                  an object mask's id:id=N; prints each ID's mesh and node names\n"
             "                  [--dynamic MODEL.json [--dynamic-nodes PATTERN] [--dynamic-sh S]]\n"
             "                  dynamic objects in the baked level (nodes whose name matches the\n"
             "                  pattern, or with glTF extras \"obscura_dynamic\": true, and their\n"
@@ -61,7 +63,7 @@ typedef struct ground_args {
     long width, height, spp, threads;
     unsigned long long seed;
     double distance;
-    int quiet, verbose, deep, baked;
+    int quiet, verbose, deep, baked, ids;
     /* --obscurance and --blend, through the bake's table (its ranges and
      * its default blend) */
     int obscurance, blend_given, decor_given;
@@ -146,6 +148,8 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
             a->deep = 1;
         else if (!reference && !strcmp(argv[i], "--baked"))
             a->baked = 1;
+        else if (!reference && !strcmp(argv[i], "--ids"))
+            a->ids = 1;
         else if (!reference && (v = opt_value(a, argc, argv, &i, "dynamic")))
             a->dynamic = v;
         else if (!reference && (v = opt_value(a, argc, argv, &i, "dynamic-nodes")))
@@ -391,9 +395,10 @@ static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene
 /* The G-buffer's EXR: depth, normals (world and camera), positions, the
  * colour (its coverage alone without albedo) and the baked channels. */
 static int write_gbuffer(const ground_args *a, const obs_raster *r, const obs_image *baked,
-                         int has_baked, const obs_camera *cam, int w, int h,
+                         int has_baked, const obs_image *ids, const obs_camera *cam, int w, int h,
                          char err[OBS_ERR_LEN])
 {
+    static const char *const n_id[] = {"id"};
     static const char *const n_baked[] = {"_AO", "_AO_SHORT", "_AO_LONG"};
     static const char *const n_z[] = {"Z"}, *const n_n[] = {"N.X", "N.Y", "N.Z"},
                              *const n_nc[] = {"Ncam.X", "Ncam.Y", "Ncam.Z"},
@@ -414,9 +419,12 @@ static int write_gbuffer(const ground_args *a, const obs_raster *r, const obs_im
                                     {&r->normal_cam, n_nc}, {&r->position, n_p},
                                     r->has_albedo ? (obs_exr_layer){&r->color, n_c}
                                                   : (obs_exr_layer){&alpha, n_a},
-                                    {baked, n_baked}};
+                                    has_baked ? (obs_exr_layer){baked, n_baked}
+                                              : (obs_exr_layer){ids, n_id},
+                                    {ids, n_id}};
+    int nl = 5 + has_baked + (ids->data != NULL);
     /* Float: the sky depth (1e10) and world positions do not fit a half. */
-    obs_status s = obs_exr_write(a->out, layers, has_baked ? 6 : 5, OBS_EXR_FLOAT, cam, err);
+    obs_status s = obs_exr_write(a->out, layers, nl, OBS_EXR_FLOAT, cam, err);
     obs_image_free(&alpha);
     return s == OBS_OK ? EXIT_OK : cli_fail(s, a->out, err);
 }
@@ -432,7 +440,7 @@ int cli_gbuffer(int argc, char **argv)
     obs_scene scene = {0};
     obs_raster r = {0};
     obs_ctx *ctx = NULL;
-    obs_image baked = {0};
+    obs_image baked = {0}, ids = {0};
     obs_dyn_model model = {0};
     char err[OBS_ERR_LEN] = "";
     int w, h, rc;
@@ -488,10 +496,18 @@ int cli_gbuffer(int argc, char **argv)
             baked.data[i] = baked.data[3 * i];
         baked.channels = 1;
     }
+    if (a.ids && (s = obs_raster_ids(ctx, &scene, &cam, w, h, &ids, err)) != OBS_OK) {
+        rc = cli_input_fail(s, a.scene, err);
+        goto done;
+    }
     double t_raster = cli_now_s() - t0;
 
-    if ((rc = write_gbuffer(&a, &r, &baked, scene.baked != NULL, &cam, w, h, err)) != EXIT_OK)
+    if ((rc = write_gbuffer(&a, &r, &baked, scene.baked != NULL, &ids, &cam, w, h, err)) != EXIT_OK)
         goto done;
+    for (size_t m = 0; a.ids && !a.quiet && m < scene.mesh_count; m++)
+        fprintf(stderr, "obscura: info: id %zu: mesh '%s', node '%s'\n", m + 1,
+                scene.meshes[m].name ? scene.meshes[m].name : "",
+                scene.meshes[m].node ? scene.meshes[m].node : "");
     if (!a.quiet) {
         obs_ctx_info ci;
         obs_ctx_get_info(ctx, &ci);
@@ -504,6 +520,7 @@ int cli_gbuffer(int argc, char **argv)
 
 done:
     obs_image_free(&baked);
+    obs_image_free(&ids);
     obs_raster_free(&r);
     obs_ctx_destroy(ctx);
     obs_scene_free(&scene);
