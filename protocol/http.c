@@ -438,6 +438,8 @@ char *obs_http_params_json(void)
             cJSON_AddNumberToObject(o, "max", pi->max);
         } else {
             cJSON_AddStringToObject(o, "default", pi->def);
+            if (pi->type == OBS_PARAM_STRING) /* its length in bytes */
+                cJSON_AddNumberToObject(o, "max", pi->max);
         }
         /* an int with choices takes only those numbers (samples: 2|4|8|16|32) */
         if ((pi->type == OBS_PARAM_ENUM || pi->type == OBS_PARAM_INT) && pi->choices)
