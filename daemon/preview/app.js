@@ -84,6 +84,7 @@ function buildParams(defs) {
       control.type = 'text';
       control.setAttribute('list', 'objects');
       control.placeholder = 'names, id:CHANNEL=N or matte:CHANNEL';
+      if (def.max) control.maxLength = def.max;
       control.style.gridColumn = '1 / 3';
       control.addEventListener('change', () => setParam(def, control.value));
     } else if (def.choices) {

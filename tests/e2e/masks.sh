@@ -90,6 +90,10 @@ expect 0 "obscura ao and HTTP: the same AO" -- "$OBSCURA" compare "$T/cli.exr" "
 said '"mse": 0,'
 expect 0 "obscura ao and the binary protocol: the same AO" -- "$OBSCURA" compare "$T/cli.exr" "$T/bin.exr" --mask none --json
 said '"mse": 0,'
+check "a stream's frame lists its ID channels (the preview's suggestions)" \
+    "[ \"\$($CURL -o /dev/null -w '%{http_code}' -H 'Content-Type: image/x-exr' --data-binary @$A \
+        'http://127.0.0.1:$PORT_d/v1/streams/m/frames?receivers=id%3Aid%3D2')\" = 200 ] &&
+     $CURL http://127.0.0.1:$PORT_d/v1/streams/m | tr -d ' \n\t' | grep -q '\"id_channels\":\[\"id\"\]'"
 check "HTTP: a missing side-car manifest is a 4xx" "[ \"\$(post $PORT_d 'receivers=leftAsset' $DATA/crypto_sidecar/sidecar_manifest.exr $T/sc.json)\" -ge 400 ]"
 [ $failed -ne 0 ] && tail -20 "$T/d.log" | sed 's/^/       /'
 echo "e2e masks: $pass passed, $failed failed"
