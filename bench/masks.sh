@@ -10,7 +10,10 @@
 # compare, geometry pixels): the mask should bring every method closer to
 # the hidden-table reference.  The issue asked for a Cycles render with a
 # Cryptomatte layer; the Embree reference with the table transparent to
-# rays is the same question (Arnold's trace_set) without Blender.
+# rays is the same question (Arnold's trace_set) without Blender.  Draws
+# docs/masks.png (build/quality_strip): the two references and gtao
+# without a mask; gtao with the mask, with --receivers on the table only,
+# and with --self-only.
 #
 #   BUILD=build bench/masks.sh [SPP]     (SPP: reference samples, 256)
 set -eu
@@ -38,4 +41,14 @@ for m in vaopp hemisphere angle hbao gtao; do
     "$O" ao "$T/g.exr" --method "$m" --radius 0.5 --occluders "!id:id=$ids" -o "$T/m.exr" 2>/dev/null
     printf '| %s | %.5f | %.5f | %.5f | %.5f |\n' "$m" "$(mse "$T/hidden.exr" "$T/a.exr")" \
         "$(mse "$T/hidden.exr" "$T/m.exr")" "$(mse "$T/full.exr" "$T/a.exr")" "$(mse "$T/full.exr" "$T/m.exr")"
+    [ "$m" = gtao ] && cp "$T/a.exr" "$T/gtao.exr" && cp "$T/m.exr" "$T/gtao_m.exr"
 done
+"$O" ao "$T/g.exr" --method gtao --radius 0.5 --receivers "id:id=$ids" -o "$T/gtao_r.exr" 2>/dev/null
+"$O" ao "$T/g.exr" --method gtao --radius 0.5 --self-only on --occluders 'id:id=1-999' -o "$T/gtao_s.exr" 2>/dev/null
+[ -x "$BUILD/quality_strip" ] || make -s "$BUILD/quality_strip" BUILD="$BUILD"
+"$BUILD/quality_strip" docs/masks.png --scale 1 --cols 3 --sky "$T/g.exr" Z \
+    --grey "$T/full.exr" AO.Y --grey "$T/hidden.exr" AO.Y --grey "$T/gtao.exr" AO.Y \
+    --grey "$T/gtao_m.exr" AO.Y --grey "$T/gtao_r.exr" AO.Y --grey "$T/gtao_s.exr" AO.Y
+echo
+echo "docs/masks.png: Embree AO (every mesh; the table transparent to rays); gtao without a mask;"
+echo "gtao with --occluders '!id:id=$ids'; with --receivers 'id:id=$ids'; with --self-only on"
