@@ -340,13 +340,18 @@ char *obsd_streams_list_json(obsd_streams *s)
 
 /* What the object-mask selectors of a frame can name (the preview page's
  * receivers/occluders control): each Cryptomatte layer's names and the ID
- * channels, from the body's header (no pixel is decoded). */
+ * channels, from the body's header (no pixel is decoded); neither key
+ * when the frame has none. */
 static void add_objects(cJSON *fo, const obsd_frame *f)
 {
     obs_crypto_info ci;
     char err[OBS_ERR_LEN];
     if (!f->body || obs_crypto_describe(NULL, f->body, f->body_len, &ci, err) != OBS_OK)
         return;
+    if (!ci.layer_count && !ci.id_count) { /* nothing to name: no keys */
+        obs_crypto_info_free(&ci);
+        return;
+    }
     cJSON *layers = cJSON_AddArrayToObject(fo, "cryptomatte");
     for (int i = 0; layers && i < ci.layer_count; i++) {
         cJSON *l = cJSON_CreateObject(), *names = cJSON_CreateArray();
