@@ -235,55 +235,78 @@ static obs_status same_size(const obs_image *a, const obs_image *b, const char *
                      b->height, a->width, a->height);
 }
 
+/* The 4 channels of every rank set of L (ID, coverage, ID, coverage), into
+ * ch[4 * rank_sets]: in one pass over a flat file's chunks, else (deep)
+ * one by one at the front samples. */
+static obs_status read_ranks(const source *src, const obs_crypto_layer *L, obs_image *ch,
+                             char err[OBS_ERR_LEN])
+{
+    char names[4 * OBS_CRYPTO_MAX_RANK_SETS][160];
+    const char *np[4 * OBS_CRYPTO_MAX_RANK_SETS];
+    const int n = 4 * L->rank_sets;
+    for (int k = 0; k < n; k++) {
+        obs__crypto_channel(L, k / 4, k % 4, names[k], sizeof names[k]);
+        np[k] = names[k];
+    }
+    if (!src->deep) {
+        const obs__exr_mem mem = {src->buf, src->len};
+        return obs__exr_read_channels(src->path, src->buf ? &mem : NULL, np, n, src->lim, ch, err);
+    }
+    obs_status st = OBS_OK;
+    for (int k = 0; k < n && st == OBS_OK; k++)
+        st = read_ch(src, np[k], &ch[k], err);
+    for (int k = 0; k < n && st != OBS_OK; k++)
+        obs_image_free(&ch[k]);
+    return st;
+}
+
 /* w = max(w, min(1, the sum of the coverage of L's ranks whose ID is in
- * ids)), w allocated (zero) at the first plane read; the rank-0 ID into
- * *dom when dom is not NULL and has no data yet. */
+ * ids)), w allocated (zero) at the first layer; the rank-0 ID into *dom
+ * when dom is not NULL and has no data yet. */
 static obs_status crypto_layer_weight(const source *src, const obs_crypto_layer *L,
                                       const uint32_t *ids, int nids, obs_image *w,
                                       obs_image *dom, char err[OBS_ERR_LEN])
 {
-    obs_image id = {0}, cov = {0}, sum = {0};
-    obs_status st = OBS_OK;
+    obs_image ch[4 * OBS_CRYPTO_MAX_RANK_SETS], sum = {0};
+    obs_status st;
     if (L->rank_sets == 0)
         return obs__fail(err, OBS_MISSING_CHANNEL,
                          "Cryptomatte layer '%.100s': no rank channels %.100s00.R/G/B/A (or "
                          ".red/.green/.blue/.alpha)",
                          L->name, L->name);
-    for (int r = 0; r < 2 * L->rank_sets; r++) {
-        char chi[160], chc[160];
-        obs__crypto_channel(L, r / 2, 2 * (r % 2), chi, sizeof chi);
-        obs__crypto_channel(L, r / 2, 2 * (r % 2) + 1, chc, sizeof chc);
-        if ((st = read_ch(src, chi, &id, err)) != OBS_OK ||
-            (st = read_ch(src, chc, &cov, err)) != OBS_OK)
+    const int n = 4 * L->rank_sets;
+    memset(ch, 0, sizeof ch);
+    if ((st = read_ranks(src, L, ch, err)) != OBS_OK)
+        return st;
+    if ((st = alloc_like(&ch[0], &sum, 0.0f, err)) != OBS_OK)
+        goto fail;
+    for (int k = 1; k < n && st == OBS_OK; k++)
+        st = same_size(&ch[0], &ch[k], L->name, err);
+    if (st != OBS_OK)
+        goto fail;
+    const size_t np = (size_t)sum.width * (size_t)sum.height;
+    if (dom && !dom->data) {
+        if ((st = alloc_like(&ch[0], dom, 0.0f, err)) != OBS_OK)
             goto fail;
-        if (!sum.data && (st = alloc_like(&id, &sum, 0.0f, err)) != OBS_OK)
-            goto fail;
-        if ((st = same_size(&sum, &id, chi, err)) != OBS_OK ||
-            (st = same_size(&sum, &cov, chc, err)) != OBS_OK)
-            goto fail;
-        size_t n = (size_t)id.width * (size_t)id.height;
-        if (dom && !dom->data && r == 0) {
-            if ((st = alloc_like(&id, dom, 0.0f, err)) != OBS_OK)
-                goto fail;
-            memcpy(dom->data, id.data, n * sizeof(float));
-        }
-        for (size_t i = 0; i < n; i++) {
-            uint32_t b = bits_of(id.data[i]);
+        memcpy(dom->data, ch[0].data, np * sizeof(float));
+    }
+    for (int r = 0; r < n / 2; r++) { /* rank r: its ID in ch[2r], coverage in ch[2r + 1] */
+        const float *id = ch[2 * r].data, *cov = ch[2 * r + 1].data;
+        for (size_t i = 0; i < np; i++) {
+            uint32_t b = bits_of(id[i]);
             if (bsearch(&b, ids, (size_t)nids, sizeof b, cmp_u32))
-                sum.data[i] += cov.data[i];
+                sum.data[i] += cov[i];
         }
-        obs_image_free(&id);
-        obs_image_free(&cov);
     }
     if (!w->data && (st = alloc_like(&sum, w, 0.0f, err)) != OBS_OK)
         goto fail;
     if ((st = same_size(w, &sum, L->name, err)) != OBS_OK)
         goto fail;
-    for (size_t i = 0; i < (size_t)sum.width * (size_t)sum.height; i++)
+    for (size_t i = 0; i < np; i++)
         w->data[i] = fmaxf(w->data[i], fminf(1.0f, fmaxf(0.0f, sum.data[i])));
 fail:
-    obs_image_free(&id);
-    obs_image_free(&cov);
+    for (int k = 0; k < n; k++)
+        obs_image_free(&ch[k]);
     obs_image_free(&sum);
     return st;
 }
