@@ -196,10 +196,18 @@ int obs__crypto_is_id_channel(const char *name)
 {
     static const char *const ids[] = {"id", "ID", "IndexOB", "IndexMA", "object_id",
                                       "objectId", "ObjectID", "RenderID", NULL};
-    const char *dot = strrchr(name, '.');
-    const char *last = dot ? dot + 1 : name;
+    /* the last component, or the one before a one-letter channel (Blender's
+     * ViewLayer.IndexOB.X) */
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", name);
+    char *dot = strrchr(buf, '.');
+    if (dot && strlen(dot + 1) == 1 && dot != buf) {
+        *dot = 0;
+        dot = strrchr(buf, '.');
+    }
+    const char *last = dot ? dot + 1 : buf;
     for (int i = 0; ids[i]; i++)
-        if (!strcmp(last, ids[i]) || !strcmp(name, ids[i]))
+        if (!strcmp(last, ids[i]))
             return 1;
     return 0;
 }

@@ -7,7 +7,8 @@
 #include "obscura/mask.h"
 
 /* 1 when a channel's name says it holds integer object or material IDs
- * (id, IndexOB, IndexMA, object_id, RenderID, ..., or LAYER.<one of them>). */
+ * (id, IndexOB, IndexMA, object_id, RenderID, ..., also LAYER.<one of
+ * them> and <that>.X: Blender's ViewLayer.IndexOB.X). */
 int obs__crypto_is_id_channel(const char *name);
 /* The name of channel c (0 R .. 3 A) of rank set s (<name>NN) of L. */
 void obs__crypto_channel(const obs_crypto_layer *L, int s, int c, char *buf, size_t len);

@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "io/crypto.h"
 #include "obscura/deep.h"
 #include "obscura/mask.h"
 
@@ -247,6 +248,20 @@ static void test_arnold_id(void **state)
                      OBS_MISSING_CHANNEL);
 }
 
+/* Integer ID channels by name: Arnold's id, Blender's IndexOB under its
+ * view layer with its one-letter channel; not depth or normals. */
+static void test_id_channel_names(void **state)
+{
+    (void)state;
+    assert_true(obs__crypto_is_id_channel("id"));
+    assert_true(obs__crypto_is_id_channel("ViewLayer.IndexOB.X"));
+    assert_true(obs__crypto_is_id_channel("ViewLayer.IndexOB"));
+    assert_true(obs__crypto_is_id_channel("IndexMA.V"));
+    assert_false(obs__crypto_is_id_channel("ViewLayer.Depth.Z"));
+    assert_false(obs__crypto_is_id_channel("N.X"));
+    assert_false(obs__crypto_is_id_channel("R"));
+}
+
 static void test_bad_selectors(void **state)
 {
     (void)state;
@@ -267,6 +282,7 @@ int main(void)
         cmocka_unit_test(test_cornell_selectors),
         cmocka_unit_test(test_sidecar),
         cmocka_unit_test(test_arnold_id),
+        cmocka_unit_test(test_id_channel_names),
         cmocka_unit_test(test_bad_selectors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
