@@ -312,6 +312,19 @@ int obs_result_sanity(const obs_image *ao, const obs_gbuffer *gb, const obs_deep
     }
     /* The background gets AO 1: the mean is over the geometry. */
     long geometry = r && r->geometry > 0 && r->geometry <= px ? r->geometry : px;
+    /* receivers (object masks): the pixels left at 1 by request count by
+     * their weight, so the mean is over what was asked for */
+    const float *w = gb && gb->width == ao->width && gb->height == ao->height
+                         ? gb->receivers.data
+                         : deep && deep->width == ao->width && deep->height == ao->height
+                               ? deep->receivers
+                               : NULL;
+    if (w) {
+        double sw = 0.0;
+        for (long i = 0; i < px; i++)
+            sw += w[i];
+        geometry = (long)(sw + 0.5);
+    }
     double mean = 1.0 - lost / (double)geometry;
     if (geometry < MIN_PIXELS || (occluded > 0 && mean <= AO_HIGH))
         return 0;
