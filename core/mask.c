@@ -145,28 +145,40 @@ static obs_status parse_selector(const char *s, selector *sel, char err[OBS_ERR_
 /* ---- matching ----------------------------------------------------------- */
 
 /* Glob match of name against pattern p (wild[i]: p[i] is * or ?); '?'
- * takes one UTF-8 character. */
+ * takes one UTF-8 character.  Iterative, with one backtrack point (the
+ * last '*'): time at most |p| |name|, whatever the pattern (a request's
+ * selector is untrusted). */
 static int glob(const char *p, const char *wild, const char *name)
 {
-    if (!*p)
-        return !*name;
-    if (wild[0] && p[0] == '*') {
-        for (const char *n = name;; n++) {
-            if (glob(p + 1, wild + 1, n))
-                return 1;
-            if (!*n)
-                return 0;
+    const char *star_p = NULL, *star_w = NULL, *star_n = NULL;
+    while (*name) {
+        if (*p && *wild && *p == '*') { /* remember it; first match nothing */
+            star_p = ++p;
+            star_w = ++wild;
+            star_n = name;
+        } else if (*p && *wild && *p == '?') {
+            p++;
+            wild++;
+            name++;
+            while ((*name & 0xC0) == 0x80)
+                name++;
+        } else if (*p && *p == *name) {
+            p++;
+            wild++;
+            name++;
+        } else if (star_p) { /* the last '*' takes one more character */
+            p = star_p;
+            wild = star_w;
+            while ((*++star_n & 0xC0) == 0x80)
+                ;
+            name = star_n;
+        } else {
+            return 0;
         }
     }
-    if (!*name)
-        return 0;
-    if (wild[0] && p[0] == '?') {
-        const char *n = name + 1;
-        while ((*n & 0xC0) == 0x80)
-            n++;
-        return glob(p + 1, wild + 1, n);
-    }
-    return p[0] == name[0] && glob(p + 1, wild + 1, name + 1);
+    while (*p && *wild && *p == '*')
+        p++, wild++;
+    return !*p;
 }
 
 static int cmp_u32(const void *a, const void *b)

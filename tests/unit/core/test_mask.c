@@ -73,6 +73,21 @@ static void test_special_chars(void **state)
         sum += w.data[i];
     assert_true(sum > 1.0);
     obs_image_free(&w);
+    /* '?' takes one character, two bytes here; '*' runs over them */
+    assert_int_equal(obs_mask_plane(SPECIAL, NULL, 0, "?\xd0\xb0\xd0\xb2\xd0\xbd\xd0\xb8\xd0\xbd\xd0\xb0", NULL, &w,
+                                    NULL, err),
+                     OBS_OK);
+    obs_image_free(&w);
+    assert_int_equal(obs_mask_plane(SPECIAL, NULL, 0, "*\xd0\xbd?", NULL, &w, NULL, err), OBS_OK);
+    obs_image_free(&w);
+    /* a pattern of many stars against every name: no match, and an
+     * answer (the matcher backtracks to the last star only) */
+    char many[128] = "";
+    for (int k = 0; k < 40; k++)
+        strcat(many, "*a");
+    strcat(many, "*q");
+    assert_int_equal(obs_mask_plane(SPECIAL, NULL, 0, many, NULL, &w, NULL, err),
+                     OBS_INVALID_ARGUMENT);
     /* a name not in the manifest is an error that lists the names */
     assert_int_equal(obs_mask_plane(SPECIAL, NULL, 0, "no_such_name", NULL, &w, NULL, err),
                      OBS_INVALID_ARGUMENT);
