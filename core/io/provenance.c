@@ -74,4 +74,9 @@ void obs__prov_build(const obs_provenance *p, obs__prov *out)
         out->key[out->count] = "obscura/camera_source";
         out->value[out->count++] = p->camera_source;
     }
+    for (int k = 0; p->attrs && p->attrs[k] && p->attrs[k + 1] && out->count < OBS__PROV_KEYS;
+         k += 2) {
+        out->key[out->count] = p->attrs[k];
+        out->value[out->count++] = p->attrs[k + 1];
+    }
 }

@@ -259,6 +259,9 @@ typedef struct obs_provenance {
     const obs_params *params; /* NULL: no obscura/method, obscura/params */
     const char *input;
     const char *camera_source;
+    /* More string attributes, key, value, ..., NULL (at most 8 pairs; NULL:
+     * none): obscura gbuffer --ids writes its Cryptomatte layer's here. */
+    const char *const *attrs;
 } obs_provenance;
 
 /* How obs_exr_write_ex() writes.  Zeroed: half, no camera, no source,

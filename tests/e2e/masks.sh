@@ -54,6 +54,14 @@ if [ -f "$S/room.obj" ]; then
     SZ="--width 160 --height 120"
     expect 0 "gbuffer --ids" -- "$OBSCURA" gbuffer "$S/room.obj" --camera "$S/room.camera.json" $SZ --ids -o "$T/g.exr"
     said "id 13: mesh 'Table.001_Untitled.000'"
+    expect 0 "inspect: gbuffer --ids's Cryptomatte layer" -- "$OBSCURA" inspect "$T/g.exr"
+    said 'Cryptomatte layer CryptoObject (key 3ae39a5, 2 ranks, manifest in the header): 43 names'
+    # the same table by Cryptomatte names and by IDs: the same AO
+    "$OBSCURA" ao "$T/g.exr" --backend cpu --method gtao --radius 0.5 --occluders '!Table*' -o "$T/by_name.exr" 2>/dev/null
+    "$OBSCURA" ao "$T/g.exr" --backend cpu --method gtao --radius 0.5 --occluders '!id:id=13-29' -o "$T/by_id.exr" 2>/dev/null
+    expect 0 "occluders by Cryptomatte name = by ID" -- "$OBSCURA" compare "$T/by_id.exr" "$T/by_name.exr" --mask none --json
+    said '"mse": 0,'
+    expect 0 "self_only on the CryptoObject layer" -- "$OBSCURA" ao "$T/g.exr" --backend cpu --self-only on -o "$T/self.exr"
     "$OBSCURA" reference "$S/room.obj" --camera "$S/room.camera.json" $SZ --gbuffer "$T/g.exr" \
         --distance 0.5 --spp 64 --alpha 'Table*=0' -o "$T/hidden.exr" 2>/dev/null
     mse() { "$OBSCURA" compare "$1" "$2" --json | sed -n 's/.*"mse": \([^,]*\),.*/\1/p'; }
