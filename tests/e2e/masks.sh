@@ -89,6 +89,10 @@ import os, sys
 sys.path.insert(0, os.path.join(os.getcwd(), "clients", "python"))
 import obscura_client as oc
 server, src, out, w2c = sys.argv[1:5]
+# selector(): names escaped as the selectors read them
+assert oc.selector("name, with, comma", "has_*_asterisk") == "name\\, with\\, comma,has_\\*_asterisk"
+assert oc.selector("floor*", literal=False, layer="CryptoObject") == "@CryptoObject:floor*"
+assert oc.selector("!bang", "@at") == "\\!bang,\\@at"
 sel = "id:ViewLayer.DiffCol.R=0.15-0.25"
 oc.ao(src, server=server, out=out, receivers=sel, fov_y=50, near=0.05, far=100,
       world_to_camera=[float(x) for x in w2c.split(",")])
