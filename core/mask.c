@@ -195,6 +195,8 @@ typedef struct {
     size_t len;
     const obs_limits *lim;
     int deep; /* 1: a deep file, read at each pixel's front sample */
+    int part;         /* the part to prefer (the G-buffer's); -1: none */
+    const char *view; /* the view whose parts come first (the G-buffer's); NULL: none */
 } source;
 
 static obs_status read_ch(const source *src, const char *ch, obs_image *img,
@@ -204,14 +206,16 @@ static obs_status read_ch(const source *src, const char *ch, obs_image *img,
         const obs__exr_mem mem = {src->buf, src->len};
         return obs__deep_read_front(src->path, src->buf ? &mem : NULL, ch, src->lim, img, err);
     }
-    return src->buf ? obs_exr_read_channel_mem(src->buf, src->len, ch, src->lim, img, err)
-                    : obs_exr_read_channel(src->path, ch, src->lim, img, err);
+    const obs__exr_mem mem = {src->buf, src->len};
+    const char *const one[1] = {ch};
+    return obs__exr_read_channels(src->path, src->buf ? &mem : NULL, src->part, src->view, one, 1,
+                                  src->lim, img, err);
 }
 
 static obs_status source_init(source *src, const char *path, const void *buf, size_t len,
                               const obs_limits *lim, char err[OBS_ERR_LEN])
 {
-    *src = (source){path, buf, len, lim, 0};
+    *src = (source){path, buf, len, lim, 0, -1, NULL};
     return buf ? obs_exr_is_deep_mem(buf, len, &src->deep, err)
                : obs_exr_is_deep(path, &src->deep, err);
 }
@@ -262,7 +266,8 @@ static obs_status read_ranks(const source *src, const obs_crypto_layer *L, obs_i
     }
     if (!src->deep) {
         const obs__exr_mem mem = {src->buf, src->len};
-        return obs__exr_read_channels(src->path, src->buf ? &mem : NULL, np, n, src->lim, ch, err);
+        return obs__exr_read_channels(src->path, src->buf ? &mem : NULL, src->part, src->view, np,
+                                      n, src->lim, ch, err);
     }
     obs_status st = OBS_OK;
     for (int k = 0; k < n && st == OBS_OK; k++)
@@ -550,6 +555,8 @@ obs_status obs_gbuffer_read_masks(obs_gbuffer_file *f, const char *path, const v
     obs_status st = source_init(&src, path, buf, len, lim, err);
     if (st != OBS_OK)
         return st;
+    src.part = f->info.part; /* the G-buffer's part and view first (--part, --view) */
+    src.view = f->info.view;
     char self_sel[200];
     const int W = f->gb.width, H = f->gb.height;
     if (p->receivers[0] &&

@@ -727,18 +727,19 @@ void obs_gbuffer_free(obs_gbuffer_file *f)
 
 /* obs_exr_read_channel(_mem) and obs__exr_read_channels: n channels of
  * the file at path, or of the buffer mem (path then names it in
- * messages), from the first part that holds channels[0] (every other one
- * must be in that part too), decoded in one pass over its chunks. */
-obs_status obs__exr_read_channels(const char *path, const obs__exr_mem *mem,
-                                  const char *const *channels, int n, const obs_limits *lim,
-                                  obs_image *out, char err[OBS_ERR_LEN])
+ * messages), all from one part that holds channels[0]: one of `view`
+ * (its "view" attribute; NULL or "": none wanted), else part `prefer`,
+ * else the first; decoded in one pass over its chunks. */
+obs_status obs__exr_read_channels(const char *path, const obs__exr_mem *mem, int prefer,
+                                  const char *view, const char *const *channels, int n,
+                                  const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN])
 {
     char sub[OBS_ERR_LEN] = "";
     exr_context_t ctx = NULL;
-    const char **names = NULL, **first = NULL; /* first: part 0's, for the message */
+    const char **names = NULL;
     target *t = NULL;
     int64_t size;
-    int parts = 0, nn = 0, nfirst = 0, found = -1, missing = -1;
+    int parts = 0, nn = 0, found = -1, score = -1, missing = -1;
     part_geom g;
     exr_result_t rv;
     obs_status st;
@@ -752,35 +753,36 @@ obs_status obs__exr_read_channels(const char *path, const obs__exr_mem *mem,
         st = obs__exr_fail(sub, rv, "part count");
         goto fail;
     }
-    for (int p = 0; p < parts && found < 0; p++) {
+    for (int p = 0; p < parts && score < 2; p++) {
         if ((st = part_names(ctx, p, &names, &nn, sub)) != OBS_OK)
             goto fail;
-        for (int i = 0; i < nn; i++)
-            if (strcmp(names[i], channels[0]) == 0)
-                found = p;
-        if (found >= 0) /* the others in the same part */
-            for (int k = 1; k < n && missing < 0; k++) {
-                int has = 0;
-                for (int i = 0; i < nn && !has; i++)
-                    has = strcmp(names[i], channels[k]) == 0;
-                if (!has)
-                    missing = k;
-            }
-        if (p == 0) {
-            first = names;
-            nfirst = nn;
-        } else if (found >= 0) {
-            free(first);
-            first = names;
-            nfirst = nn;
-        } else {
-            free(names);
-        }
+        int has = 0;
+        for (int i = 0; i < nn && !has; i++)
+            has = strcmp(names[i], channels[0]) == 0;
+        free(names);
         names = NULL;
+        if (!has)
+            continue;
+        const char *v = obs__exr_attr_string(ctx, p, "view");
+        int sc = view && *view && v && !strcmp(v, view) ? 2 : p == prefer ? 1 : 0;
+        if (sc > score) {
+            score = sc;
+            found = p;
+        }
+    }
+    /* the part chosen, or part 0 for the message */
+    if ((st = part_names(ctx, found < 0 ? 0 : found, &names, &nn, sub)) != OBS_OK)
+        goto fail;
+    for (int k = 1; found >= 0 && k < n && missing < 0; k++) {
+        int has = 0;
+        for (int i = 0; i < nn && !has; i++)
+            has = strcmp(names[i], channels[k]) == 0;
+        if (!has)
+            missing = k;
     }
     if (found < 0 || missing >= 0) {
         char list[OBS__LIST_CHARS + 32];
-        obs__list_names(first, nfirst, list, sizeof list);
+        obs__list_names(names, nn, list, sizeof list);
         st = obs__fail(sub, OBS_MISSING_CHANNEL, "channel '%.256s' not found; the %s has: %s",
                        channels[found < 0 ? 0 : missing], found < 0 ? "file" : "part", list);
         goto fail;
@@ -806,7 +808,6 @@ obs_status obs__exr_read_channels(const char *path, const obs__exr_mem *mem,
 fail:
     free(t);
     free(names);
-    free(first);
     if (ctx)
         exr_finish(&ctx);
     if (st != OBS_OK) {
@@ -823,7 +824,7 @@ static obs_status read_channel(const char *path, const obs__exr_mem *mem, const 
     const char *const one[1] = {channel};
     if (!channel)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_read_channel: NULL argument");
-    return obs__exr_read_channels(path, mem, one, 1, lim, out, err);
+    return obs__exr_read_channels(path, mem, -1, NULL, one, 1, lim, out, err);
 }
 
 obs_status obs_exr_read_channel(const char *path, const char *channel, const obs_limits *lim,
