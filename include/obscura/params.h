@@ -185,6 +185,7 @@ typedef enum obs_baked_combine {
     X(deep_front_half, OBS_SWITCH_LIST)                                        \
     X(deep_hull, OBS_DEEP_HULL_LIST)                                           \
     X(baked_combine, OBS_BAKED_COMBINE_LIST)                                   \
+    X(multibounce, OBS_SWITCH_LIST)                                            \
     X(self_only, OBS_SWITCH_LIST)
 
 /* X(name, type, default, min, max, choices, doc)
@@ -407,7 +408,15 @@ typedef enum obs_baked_combine {
       "(obscura bake's _AO, rasterised by obscura gbuffer) is combined with "  \
       "the chain's AO: product (two visibility factors of separate scales, "   \
       "the baked distant obscurance times the screen-space detail) or min "    \
-      "(the darker of the two: an occluder both see darkens once)")          \
+      "(the darker of the two: an occluder both see darkens once)")           \
+    X(multibounce, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),             \
+      "multi-bounce AO (Jimenez et al. 2016, the cubic fit): the AO's albedo-driven "  \
+      "cubic fit of the light that bounces back into the occluded cone, "      \
+      "max(A, ((a A + b) A + c) A), a, b, c linear in the albedo, per "        \
+      "channel of the colour plane (name the albedo with --color albedo); "    \
+      "on: the composite takes it and the AOMultiBounce.R,G,B layer is "       \
+      "written beside the AO; a warning and the plain AO without a colour "    \
+      "plane")                                                                 \
     X(receivers, STRING, "", 0, OBS_SELECTOR_MAX, NULL,                          \
       "object mask: the pixels that get AO, a selector (README: Object "       \
       "masks): Cryptomatte names with * and ? (any layer of the file; "        \
