@@ -20,6 +20,10 @@ void obs__receivers_apply(const obs_gbuffer *gb, obs_result *r)
     const size_t n = (size_t)gb->width * (size_t)gb->height;
     if (r->ao.data)
         apply(w, n, r->ao.data);
+    /* the multi-bounce AO (R, G, B) the same way, channel by channel */
+    for (size_t i = 0; r->multibounce.data && i < n; i++)
+        for (int k = 0; k < 3; k++)
+            r->multibounce.data[3 * i + k] = 1.0f - w[i] * (1.0f - r->multibounce.data[3 * i + k]);
     if (!r->composite.data)
         return;
     for (int y = 0; y < gb->height; y++)

@@ -6,8 +6,9 @@
 #include "obscura/deep.h"
 #include "obscura/obscura.h"
 
-/* AO' = 1 - w (1 - AO) with w = gb->receivers (nothing without it), and
- * the composite made again from it: (1 - w) colour + w composite, the
+/* AO' = 1 - w (1 - AO) with w = gb->receivers (nothing without it), the
+ * multi-bounce AO's channels alike (the bent normal is left as it is),
+ * and the composite made again from it: (1 - w) colour + w composite, the
  * colour's own value where w is 0 (exact without colour bleeding; with
  * it the unselected part of a pixel gets no bleed). */
 void obs__receivers_apply(const obs_gbuffer *gb, obs_result *r);

@@ -79,12 +79,16 @@ static void test_receivers_flat(void **state)
     assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE, &all, err), OBS_OK);
     set(&p, "receivers", OBJECT);
     assert_int_equal(obs_gbuffer_read_masks(&f, ROOM, NULL, 0, &p, NULL, err), OBS_OK);
+    set(&p, "multibounce", "on");
     assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE, &sel, err), OBS_OK);
+    assert_non_null(sel.multibounce.data);
     const float *w = f.gb.receivers.data;
     int ones = 0, kept = 0;
     for (int i = 0; i < f.gb.width * f.gb.height; i++) {
         if (w[i] == 0.0f) {
             assert_true(sel.ao.data[i] == 1.0f);
+            for (int k = 0; k < 3; k++) /* the multi-bounce AO too */
+                assert_true(sel.multibounce.data[3 * i + k] == 1.0f);
             ones++;
         } else {
             assert_true(sel.ao.data[i] == all.ao.data[i]);
