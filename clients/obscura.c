@@ -653,6 +653,11 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
                  "outputs, PNG, --server or stdout");
         return cli_fail(OBS_INVALID_ARGUMENT, a->in, err);
     }
+    if ((a->req.outputs & OBS_OUTPUT_DEEP) && a->req.params.receivers[0]) {
+        snprintf(err, OBS_ERR_LEN, "--output deep writes every node's AO, which --receivers (a mask "
+                 "of each pixel's front sample) does not reach: not together");
+        return cli_fail(OBS_INVALID_ARGUMENT, a->in, err);
+    }
     double t0 = now_ms();
     s = a->in_buf ? obs_deep_read_exr_mem(a->in_buf, a->in_len, lim, &d, err) : obs_deep_read_exr(a->in, lim, &d, err);
     if (s == OBS_OK) /* object masks: receivers at the front samples */

@@ -42,6 +42,8 @@ said 'need ao_resolution full'
 
 # deep: receivers at the front sample; occluders refused
 expect 0 "ao --receivers id:id=2 (deep)" -- "$OBSCURA" ao "$A" --backend cpu --receivers 'id:id=2' -o "$T/deep.exr"
+expect 3 "ao --receivers with --output deep" -- "$OBSCURA" ao "$A" --backend cpu --receivers 'id:id=2' --output deep -o "$T/x.exr"
+said 'not together'
 expect 3 "ao --occluders on deep input" -- "$OBSCURA" ao "$A" --backend cpu --occluders 'id:id=1' -o "$T/x.exr"
 said 'not available on deep input'
 
