@@ -19,10 +19,37 @@
 #include "chain/mask_weight.h"
 #include "methods/hbao.h"
 
+/* One sample point q (view xyz, planar depth w; w 0: background) of a
+ * direction from p: where it rises above the horizon sin_h, W(r) times
+ * the rise into *ao and the horizon raised, times om, the object masks'
+ * weight of its pixel (GLSL: hbao_sample()). */
+static void hbao_sample(const float q[4], const float p[3], float R2, float om, float *sin_h,
+                        float *ao)
+{
+    if (!(q[3] > 0.0f))
+        return;
+    float v[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+    float r2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if (!(r2 < R2) || !(r2 > 0.0f))
+        return;
+    float sin_s = v[2] / sqrtf(r2); /* elevation of the sample: view +z faces the camera */
+    if (sin_s > *sin_h && om > 0.0f) { /* om 0 (object masks): it raises no horizon */
+        *ao += om * (1.0f - r2 / R2) * (sin_s - *sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
+        *sin_h = sin_s;
+    }
+}
+
 /* GLSL: hbao_ao() in hbao.glsl */
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count)
 {
+    return obs__hbao_pixel_nodes(f, pos, 1, x, y, p, n, count);
+}
+
+float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, int layers, int x, int y,
+                            const float p[3], const float n[3], int *count)
+{
+    const size_t plane = (size_t)f->width * (size_t)f->height * 4;
     const obs__hbao_state *hb = obs__hbao_of(f);
     const float R = f->radius, R2 = R * R;
     const float *rot = f->rot[obs__tile_index(f, x, y)];
@@ -55,19 +82,10 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
                 break;
             taken++;
             const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
-            if (!(q[3] > 0.0f))
-                continue;
-            float v[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-            float r2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-            if (!(r2 < R2) || !(r2 > 0.0f))
-                continue;
-            /* object masks: a surface that may not occlude raises no horizon */
-            float om = obs__occluder_weight(f, x, y, qx, qy);
-            float sin_s = v[2] / sqrtf(r2); /* elevation of the sample: view +z faces the camera */
-            if (sin_s > sin_h && om > 0.0f) {
-                ao += om * (1.0f - r2 / R2) * (sin_s - sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
-                sin_h = sin_s;
-            }
+            /* object masks: the weight of the surface at the step's pixel */
+            const float om = obs__occluder_weight(f, x, y, qx, qy);
+            for (int k = 0; k < layers; k++) /* deep input: every node, front to back */
+                hbao_sample(q + (size_t)k * plane, p, R2, om, &sin_h, &ao);
         }
     }
     if (count)
