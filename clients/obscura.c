@@ -374,6 +374,20 @@ static obs_status put_stdout(const obs_bytes *b, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
+/* A whole file as it is (the daemon's deep EXR answer). */
+static obs_status put_file(const char *path, const obs_bytes *b, char err[OBS_ERR_LEN])
+{
+    FILE *fp = fopen(path, "wb");
+    int ok = fp && fwrite(b->data, 1, b->size, fp) == b->size;
+    if (fp && fclose(fp) != 0)
+        ok = 0;
+    if (!ok) {
+        snprintf(err, OBS_ERR_LEN, "cannot write it: %s", strerror(errno));
+        return OBS_IO;
+    }
+    return OBS_OK;
+}
+
 /* A PNG of `obscura ao` to its file, or to stdout under -o -. */
 static obs_status write_png_out(const ao_args *a, const char *path, const obs_image *img,
                                 const obs_png_options *po, char err[OBS_ERR_LEN])
@@ -647,10 +661,9 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         return cli_fail(OBS_UNSUPPORTED, a->in, err);
     }
     if ((a->req.outputs & OBS_OUTPUT_DEEP) &&
-        (a->req.outputs != OBS_OUTPUT_DEEP || a->req.format != OBS_HTTP_EXR || server ||
-         !strcmp(a->out, "-"))) {
-        snprintf(err, OBS_ERR_LEN, "--output deep writes one deep EXR file in-process: not with other "
-                 "outputs, PNG, --server or stdout");
+        (a->req.outputs != OBS_OUTPUT_DEEP || a->req.format != OBS_HTTP_EXR || !strcmp(a->out, "-"))) {
+        snprintf(err, OBS_ERR_LEN, "--output deep writes one deep EXR file: not with other outputs, PNG "
+                 "or stdout");
         return cli_fail(OBS_INVALID_ARGUMENT, a->in, err);
     }
     if ((a->req.outputs & OBS_OUTPUT_DEEP) && a->req.params.receivers[0]) {
@@ -675,7 +688,19 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         (rc = cli_input_warnings(a->in, &dinfo, a->req.strict)) != EXIT_OK)
         goto done;
     t0 = now_ms();
-    if (a->cpu) {
+    if (server && (a->req.outputs & OBS_OUTPUT_DEEP)) {
+        /* the daemon answers the deep EXR itself: written as it came */
+        obs_bytes file = {0};
+        if ((rc = cli_remote_run_deep_file(server, argc, argv, a->in, &d, &file)) == EXIT_OK &&
+            (rc = cli_remote_result_warnings(a, &dinfo)) == EXIT_OK) {
+            if ((s = put_file(a->out, &file, err)) != OBS_OK)
+                rc = cli_fail(s, a->out, err);
+            else if (verbosity >= OBS_LOG_INFO)
+                fprintf(stderr, "obscura: wrote %s\n", a->out);
+        }
+        obs_bytes_free(&file);
+        goto done;
+    } else if (a->cpu) {
         s = obs_deep_run_cpu(&d, &a->req.params, &r, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         if ((rc = cli_remote_run_deep(server, argc, argv, a->in, &d, a->req.outputs, &r)) != EXIT_OK)
