@@ -109,7 +109,8 @@ static const cli_opt ao_opts[] = {
      "AOScreen.Y the chain's, AOBaked.Y the channel; none: not combined"},
     {"max-size", "N", "largest accepted width or height (default 16384)"},
     {"backend", "B", "auto|cpu|egl-device|egl-surfaceless|osmesa (or OBSCURA_BACKEND); cpu: the "
-     "chain on the CPU device (every core, SIMD), no GL context; auto: a GL context"},
+     "chain on the CPU device (every core, SIMD), no GL context; auto: a GPU, else the faster of cpu "
+     "and llvmpipe, measured once and kept in the cache folder"},
     {"cache-dir", "DIR", "program cache folder (or OBSCURA_CACHE_DIR; default "
      "$XDG_CACHE_HOME/obscura, else ~/.cache/obscura; '': none)"},
     {"cpu", NULL, "the same as --backend cpu"},
@@ -583,6 +584,30 @@ static const char *cache_dir_of(const char *flag)
     return d;
 }
 
+/* --backend auto (or OBSCURA_BACKEND=auto): a GPU, else the faster of
+ * the CPU device and llvmpipe, measured once and kept in the cache
+ * folder (obs_device_choose); no backend named: the kept choice when
+ * there is one, else a GL context as the backend order has it. */
+static void choose_device(ao_args *a)
+{
+    const char *name = a->backend ? a->backend : getenv("OBSCURA_BACKEND");
+    int named_auto = name && !strcmp(name, "auto");
+    if (name && *name && !named_auto)
+        return; /* a GL backend named: that one */
+    obs_device_choice ch;
+    char err[OBS_ERR_LEN] = "";
+    if (obs_device_choose(cache_dir_of(a->cache_dir), &a->req.params, named_auto, &ch, err) != OBS_OK) {
+        log_cb(NULL, OBS_LOG_WARN, err); /* measuring failed: a GL context, as before */
+        return;
+    }
+    if (verbosity >= OBS_LOG_DEBUG || (named_auto && ch.measured && verbosity >= OBS_LOG_INFO))
+        fprintf(stderr, "obscura: device: %s\n", ch.why);
+    if (ch.cpu)
+        a->cpu = 1;
+    else if (ch.backend == OBS_BACKEND_EGL_DEVICE)
+        a->backend = "egl-device";
+}
+
 /* -v: what the context built and what it loaded from the cache. */
 static void log_programs(const obs_ctx *ctx)
 {
@@ -871,7 +896,8 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
 {
     obs_status s;
     if (a->cpu) {
-        s = obs_run_cpu(&gf->gb, &a->req.params, outputs, res, err);
+        obs_cpu_options o = {.log = log_cb};
+        s = obs_run_cpu_opts(&gf->gb, &a->req.params, outputs, res, &o, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, res);
     } else {
@@ -1036,6 +1062,8 @@ static int cmd_ao(int argc, char **argv)
     parse_ao(argc, argv, &a);
     if (!server && backend_is_cpu(a.backend)) /* with --server the backend is obscurad's */
         a.cpu = 1;
+    if (!server && !a.cpu)
+        choose_device(&a);
     obs_limits lim = {0};
     if (a.max_size)
         lim.max_width = lim.max_height = (int)a.max_size;
