@@ -85,7 +85,8 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
         }
         if (name_is(key, "output"))
             fr->want_color = fr->want_front = 0;
-        else if (!name_is(key, "format") && !name_is(key, "float") && !name_is(key, "png_bits") &&
+        else if (!name_is(key, "format") && !name_is(key, "float") && !name_is(key, "compression") &&
+                 !name_is(key, "png_bits") &&
                  !name_is(key, "png_transfer"))
             fr->rerun = 1;
     }
