@@ -300,6 +300,8 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
 static enum MHD_Result queue_body(req *r)
 {
     obsd__frame_req *fr = r->fr;
+    fr->fp.ms_receive = obsd_now_ms() - r->t0;
+    obsd_stats_stage(OBSD_STAGE_RECEIVE, fr->fp.ms_receive);
     if (r->len == 0) {
         char msg[128];
         snprintf(msg, sizeof msg, "%s %s needs a G-buffer EXR as its body", r->method,
