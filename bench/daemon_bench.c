@@ -3,8 +3,8 @@
  * concurrent clients.  bench/daemon_bench.sh starts the daemon and runs
  * this; see there.
  *
- *   daemon_bench [--frames N] [--per-client M] [--cpu] [--concurrency-only]
- *                G-BUFFER.exr URL...
+ *   daemon_bench [--frames N] [--per-client M] [--max-clients C] [--cpu]
+ *                [--concurrency-only] G-BUFFER.exr URL...
  *
  * The G-buffer must carry its camera in the header (tools/exr_upscale
  * with a camera JSON).  In-process is obs_run on a warm context (what
@@ -19,9 +19,10 @@
  * clients/remote.c.  Medians of N, all in one run.  Then 1, 2, 4 and 8
  * client processes send M frames each, over the first http:// URL (the
  * default answer) and over the last URL: frames per second over the wall
- * time.  Last, for the first http:// URL, small frames over one
- * keep-alive connection and on a new connection each, and the daemon's
- * stage means from GET /metrics. */
+ * time (up to C clients, default 8).  Then, for the first http:// URL,
+ * the daemon's stage means from GET /metrics (the big frames so far),
+ * and small frames over one keep-alive connection and on a new
+ * connection each. */
 #include <math.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -279,6 +280,8 @@ static void client_frames(const char *url, const char *path, const obs_gbuffer *
         remote_frame(url, path, gb);
 }
 
+static int max_clients = 8;
+
 static void concurrency(const char *url, const char *what, const char *path, const obs_gbuffer *gb,
                         const obs_bytes *file, int per_client)
 {
@@ -286,7 +289,7 @@ static void concurrency(const char *url, const char *what, const char *path, con
     printf("| clients | frames | wall s | frames/s | x one client |\n|---|---|---|---|---|\n");
     fflush(stdout);
     double one = 0;
-    for (int n = 1; n <= 8; n *= 2) {
+    for (int n = 1; n <= max_clients; n *= 2) {
         double t0 = now_ms();
         pid_t pids[8];
         for (int c = 0; c < n; c++) {
@@ -415,8 +418,9 @@ static void metrics_means(const char *url)
         die("metrics", "no memory");
     buf[got] = '\0';
     static const char *const stages[] = {"receive", "decode", "queue", "gl", "encode", "send", "total"};
-    printf("\nDaemon's stages over the whole run (GET /metrics obscurad_stage_seconds: mean ms, every frame "
-           "and protocol, warm-ups and concurrent clients included; receive and send: HTTP only):\n\n|");
+    printf("\nDaemon's stages of the 1080p frames above (GET /metrics obscurad_stage_seconds: mean ms over "
+           "every protocol, warm-ups included; receive and send: HTTP only; total: HTTP's, the request's "
+           "headers to its answer queued):\n\n|");
     for (int s = 0; s < 7; s++)
         printf(" %s |", stages[s]);
     printf("\n|");
@@ -463,11 +467,13 @@ int main(int argc, char **argv)
             frames = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--per-client") && i + 1 < argc)
             per_client = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--max-clients") && i + 1 < argc)
+            max_clients = atoi(argv[++i]);
         else
             break;
     }
-    if (argc - i < 2 || frames < 1 || frames > 64 || per_client < 1) {
-        fprintf(stderr, "usage: daemon_bench [--frames N] [--per-client M] [--cpu] [--concurrency-only] "
+    if (argc - i < 2 || frames < 1 || frames > 64 || per_client < 1 || max_clients < 1 || max_clients > 8) {
+        fprintf(stderr, "usage: daemon_bench [--frames N] [--per-client M] [--max-clients 1..8] [--cpu] [--concurrency-only] "
                         "G-BUFFER.exr URL...\n");
         return 2;
     }
@@ -562,6 +568,8 @@ int main(int argc, char **argv)
         fflush(stdout);
     }
 
+    if (http)
+        metrics_means(http);
     codec_bench(&kept.ao, &file, frames < 5 ? 5 : frames > 16 ? 16 : frames);
     obs_result_free(&kept);
 
@@ -569,10 +577,8 @@ int main(int argc, char **argv)
         concurrency(http, "HTTP, default answer", path, &gf.gb, &file, per_client);
     if (argv[argc - 1] != http)
         concurrency(argv[argc - 1], "binary protocol, raw planes", path, &gf.gb, &file, per_client);
-    if (http) {
+    if (http)
         keepalive_bench(http, &gf.gb, 200);
-        metrics_means(http);
-    }
     obs_gbuffer_free(&gf);
     obs_bytes_free(&file);
     return 0;

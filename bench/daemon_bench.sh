@@ -5,8 +5,9 @@
 # the binary protocol over TCP and over a Unix socket (raw planes), against
 # the decode + run in process, medians in one run; the EXR encode per
 # compression and the decode per thread count; frames per second with 1,
-# 2, 4 and 8 concurrent clients, on the GL backend and on the CPU device
-# (a second daemon, --backend cpu); each stage of a frame in the daemon
+# 2, 4 and 8 concurrent clients, on the GL backend, on the CPU device
+# (a second daemon, --backend cpu) and with the chain on one core (a
+# third, --render-threads 1: the decode beside the chain); each stage of a frame in the daemon
 # (its log and /metrics); a one-shot `obscura ao` of the same file, and of
 # BASELINE_OBSCURA (another build's obscura, e.g. main's) when set.
 #
@@ -66,13 +67,13 @@ stop_daemon() {
 # the median of the stages in the daemon's log lines (one per frame)
 stage_table() {
     echo
-    echo "Daemon's stages, median ms per frame (from its log; every frame of the protocol, warm-ups and"
+    echo "Daemon's stages, median ms per 1080p frame (from its log: frames of over 1 MB, warm-ups and"
     echo "concurrent clients included; receive: HTTP only):"
     echo
     echo "| protocol | frames | receive | decode | queue | gl | encode | total in daemon |"
     echo "|---|---|---|---|---|---|---|---|"
     for p in "POST /v1/ao" "BINARY"; do
-        grep "status=200" "$1" | grep "$p" | tr ' ' '\n' |
+        grep "status=200" "$1" | grep "$p" | grep -E ' in=[0-9]{7,} ' | tr ' ' '\n' |
             awk -v p="$p" -F= '$1 ~ /^(receive|queue|decode|gl|encode|total)$/ { v[$1, n[$1]++] = $2 }
                 function med(k,   m, i, j, a, t) { m = n[k]; for (i = 0; i < m; i++) a[i] = v[k, i]
                     for (i = 1; i < m; i++) { t = a[i]; for (j = i - 1; j >= 0 && a[j] > t; j--) a[j + 1] = a[j]; a[j + 1] = t }
@@ -106,9 +107,19 @@ stop_daemon
 echo
 echo "#### the same daemon on the CPU device (obscurad --backend cpu)"
 start_daemon "$T/c.log" --backend cpu
-"$BUILD/daemon_bench" --cpu --concurrency-only --per-client "$PER_CLIENT" "$T/big.exr" \
-    "http://127.0.0.1:$HP" "unix:$SOCK"
+"$BUILD/daemon_bench" --cpu --concurrency-only --max-clients 4 --per-client "$PER_CLIENT" "$T/big.exr" \
+    "http://127.0.0.1:$HP"
 stage_table "$T/c.log"
+stop_daemon
+
+# the chain held to one core: does the next frame's decode (an HTTP
+# thread) run beside the current frame's chain (the worker)?
+echo
+echo "#### the chain held to one core (obscurad --render-threads 1): the decode beside the chain"
+start_daemon "$T/r.log" --render-threads 1
+"$BUILD/daemon_bench" --concurrency-only --max-clients 4 --per-client "$PER_CLIENT" "$T/big.exr" \
+    "http://127.0.0.1:$HP"
+stage_table "$T/r.log"
 stop_daemon
 
 # one-shot obscura ao: a whole process, read and write included
