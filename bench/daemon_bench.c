@@ -3,8 +3,8 @@
  * concurrent clients.  bench/daemon_bench.sh starts the daemon and runs
  * this; see there.
  *
- *   daemon_bench [--frames N] [--per-client M] [--max-clients C] [--cpu]
- *                [--concurrency-only] G-BUFFER.exr URL...
+ *   daemon_bench [--frames N] [--per-client M] [--max-clients C] [--daemon-pid PID]
+ *                [--cpu] [--concurrency-only] G-BUFFER.exr URL...
  *
  * The G-buffer must carry its camera in the header (tools/exr_upscale
  * with a camera JSON).  In-process is obs_run on a warm context (what
@@ -19,7 +19,8 @@
  * clients/remote.c.  Medians of N, all in one run.  Then 1, 2, 4 and 8
  * client processes send M frames each, over the first http:// URL (the
  * default answer) and over the last URL: frames per second over the wall
- * time (up to C clients, default 8).  Then, for the first http:// URL,
+ * time (up to C clients, default 8), and the cores the daemon (its CPU
+ * time from /proc, given its pid) and the clients kept busy.  Then, for the first http:// URL,
  * the daemon's stage means from GET /metrics (the big frames so far),
  * and small frames over one keep-alive connection and on a new
  * connection each. */
@@ -30,6 +31,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <sys/stat.h>
@@ -281,15 +283,44 @@ static void client_frames(const char *url, const char *path, const obs_gbuffer *
 }
 
 static int max_clients = 8;
+static long daemon_pid; /* --daemon-pid: its CPU time, from /proc */
+
+/* CPU seconds (user + system) the daemon used so far; -1 unknown. */
+static double daemon_cpu_s(void)
+{
+    char path[64], buf[1024];
+    snprintf(path, sizeof path, "/proc/%ld/stat", daemon_pid);
+    FILE *f = daemon_pid > 0 ? fopen(path, "r") : NULL;
+    if (!f)
+        return -1;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    const char *p = strrchr(buf, ')'); /* the name may hold spaces */
+    unsigned long long ut = 0, st = 0;
+    if (!p || sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &ut, &st) != 2)
+        return -1;
+    return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
+}
+
+/* CPU seconds the finished client processes used so far. */
+static double children_cpu_s(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_CHILDREN, &ru);
+    return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) / 1e6;
+}
 
 static void concurrency(const char *url, const char *what, const char *path, const obs_gbuffer *gb,
                         const obs_bytes *file, int per_client)
 {
     printf("\nConcurrent clients (%s, %s, %d frames per client, one process each):\n\n", url, what, per_client);
-    printf("| clients | frames | wall s | frames/s | x one client |\n|---|---|---|---|---|\n");
+    printf("| clients | frames | wall s | frames/s | x one client | cores busy: daemon + clients |\n"
+           "|---|---|---|---|---|---|\n");
     fflush(stdout);
     double one = 0;
     for (int n = 1; n <= max_clients; n *= 2) {
+        double d0 = daemon_cpu_s(), c0 = children_cpu_s();
         double t0 = now_ms();
         pid_t pids[8];
         for (int c = 0; c < n; c++) {
@@ -310,10 +341,13 @@ static void concurrency(const char *url, const char *what, const char *path, con
         double sec = (now_ms() - t0) / 1e3;
         if (bad)
             die("concurrent clients", "a client failed");
-        double fps = n * per_client / sec;
+        double fps = n * per_client / sec, d1 = daemon_cpu_s(), c1 = children_cpu_s();
         if (n == 1)
             one = fps;
-        printf("| %d | %d | %.2f | %.2f | %.2f |\n", n, n * per_client, sec, fps, fps / one);
+        char busy[64] = "-";
+        if (d0 >= 0 && d1 >= 0)
+            snprintf(busy, sizeof busy, "%.2f + %.2f", (d1 - d0) / sec, (c1 - c0) / sec);
+        printf("| %d | %d | %.2f | %.2f | %.2f | %s |\n", n, n * per_client, sec, fps, fps / one, busy);
         fflush(stdout);
     }
 }
@@ -469,11 +503,14 @@ int main(int argc, char **argv)
             per_client = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--max-clients") && i + 1 < argc)
             max_clients = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--daemon-pid") && i + 1 < argc)
+            daemon_pid = atol(argv[++i]);
         else
             break;
     }
     if (argc - i < 2 || frames < 1 || frames > 64 || per_client < 1 || max_clients < 1 || max_clients > 8) {
-        fprintf(stderr, "usage: daemon_bench [--frames N] [--per-client M] [--max-clients 1..8] [--cpu] [--concurrency-only] "
+        fprintf(stderr, "usage: daemon_bench [--frames N] [--per-client M] [--max-clients 1..8] [--daemon-pid PID] [--cpu] "
+                        "[--concurrency-only] "
                         "G-BUFFER.exr URL...\n");
         return 2;
     }

@@ -99,7 +99,7 @@ echo "command: BUILD=$BUILD bench/daemon_bench.sh ($BUILD/daemon_bench --frames 
     "obscurad --backend cpu)"
 echo
 start_daemon "$T/d.log"
-"$BUILD/daemon_bench" --frames "$FRAMES" --per-client "$PER_CLIENT" "$T/big.exr" \
+"$BUILD/daemon_bench" --daemon-pid "$PID" --frames "$FRAMES" --per-client "$PER_CLIENT" "$T/big.exr" \
     "http://127.0.0.1:$HP" "tcp://127.0.0.1:$TP" "unix:$SOCK"
 stage_table "$T/d.log"
 stop_daemon
@@ -107,7 +107,7 @@ stop_daemon
 echo
 echo "#### the same daemon on the CPU device (obscurad --backend cpu)"
 start_daemon "$T/c.log" --backend cpu
-"$BUILD/daemon_bench" --cpu --concurrency-only --max-clients 4 --per-client "$PER_CLIENT" "$T/big.exr" \
+"$BUILD/daemon_bench" --daemon-pid "$PID" --cpu --concurrency-only --max-clients 4 --per-client "$PER_CLIENT" "$T/big.exr" \
     "http://127.0.0.1:$HP"
 stage_table "$T/c.log"
 stop_daemon
@@ -117,7 +117,7 @@ stop_daemon
 echo
 echo "#### the chain held to one core (obscurad --render-threads 1): the decode beside the chain"
 start_daemon "$T/r.log" --render-threads 1
-"$BUILD/daemon_bench" --concurrency-only --max-clients 4 --per-client "$PER_CLIENT" "$T/big.exr" \
+"$BUILD/daemon_bench" --daemon-pid "$PID" --concurrency-only --max-clients 4 --per-client "$PER_CLIENT" "$T/big.exr" \
     "http://127.0.0.1:$HP"
 stage_table "$T/r.log"
 stop_daemon
