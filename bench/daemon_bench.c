@@ -16,7 +16,8 @@
  * answer before compression existed); then clients/remote.c, the code of
  * `obscura ao --server` (it asks for a float answer).  For unix: and
  * tcp:// URLs, the binary protocol's raw float32 planes through
- * clients/remote.c.  Medians of N, all in one run.  Then 1, 2, 4 and 8
+ * clients/remote.c.  Medians of N rounds, each round every path once (a
+ * load from outside falls on every path alike), all in one run.  Then 1, 2, 4 and 8
  * client processes send M frames each, over the first http:// URL (the
  * default answer) and over the last URL: frames per second over the wall
  * time (up to C clients, default 8), and the cores the daemon (its CPU
@@ -243,25 +244,6 @@ static void http_big_frame(int fd, const char *query, const obs_bytes *file, ans
     if (obs_exr_read_channel_mem(a->data, a->size, "AO.Y", NULL, &ao, err) != OBS_OK)
         die("the answer", err);
     obs_image_free(&ao);
-}
-
-/* Median ms of `frames` frames over one keep-alive connection, after a warm-up. */
-static double http_big_median(const char *url, const char *query, const obs_bytes *file, int frames,
-                              size_t *bytes)
-{
-    double t[64];
-    answer a = {0};
-    int fd = http_connect(url);
-    http_big_frame(fd, query, file, &a);
-    for (int k = 0; k < frames; k++) {
-        double t0 = now_ms();
-        http_big_frame(fd, query, file, &a);
-        t[k] = now_ms() - t0;
-    }
-    close(fd);
-    *bytes = a.size;
-    free(a.data);
-    return median(t, frames);
 }
 
 /* One frame of a concurrent client: over HTTP (this program's client,
@@ -544,11 +526,45 @@ int main(int argc, char **argv)
     if (!cpu && obs_ctx_create(&desc, &ctx, err) != OBS_OK)
         die("context", err);
     obs_result r;
-    double t[64], t_dec[64];
     if ((cpu ? obs_run_cpu(&gf.gb, NULL, OBS_OUTPUT_AO, &r, err) /* warm-up (GL: compiles the shaders) */
              : obs_run(ctx, &gf.gb, NULL, OBS_OUTPUT_AO, &r, err)) != OBS_OK)
         die("obs_run", err);
     obs_result kept = r; /* its AO for the encode table */
+
+    /* The paths, measured in rounds: each round runs every path once, so
+     * that load from outside falls on all of them alike. */
+    enum { MAX_PATHS = 16 };
+    struct path {
+        const char *url, *query, *what;
+        int kind; /* 0: this client over fd, 1: clients/remote.c */
+        int fd;
+        answer a;
+        double t[64];
+    } paths[MAX_PATHS];
+    int np = 0;
+    for (int u = i; u < argc && np + 3 <= MAX_PATHS; u++) {
+        const char *url = argv[u];
+        if (!strncmp(url, "http://", 7)) {
+            paths[np++] = (struct path){url, "",
+                "HTTP, EXR body, default answer (half, compression auto = rle), answer decoded, keep-alive", 0};
+            paths[np++] = (struct path){url, "float=1&compression=zip",
+                "HTTP, EXR body, float ZIP answer (the answer before compression=), answer decoded", 0};
+        }
+        paths[np++] = (struct path){url, NULL,
+            !strncmp(url, "http", 4) ? "HTTP through obscura ao --server's client (file read, float answer)"
+            : !strncmp(url, "unix:", 5) ? "binary protocol, raw planes, Unix socket"
+                                        : "binary protocol, raw planes, TCP loopback", 1};
+    }
+    for (int q = 0; q < np; q++) { /* warm-ups: the daemon's shaders, textures */
+        if (paths[q].kind == 0) {
+            paths[q].fd = http_connect(paths[q].url);
+            paths[q].a = (answer){0};
+            http_big_frame(paths[q].fd, paths[q].query, &file, &paths[q].a);
+        } else {
+            remote_frame(paths[q].url, path, &gf.gb);
+        }
+    }
+    double t[64], t_dec[64];
     for (int k = 0; k < frames; k++) {
         obs_gbuffer_file g2 = {0};
         double t0 = now_ms();
@@ -563,47 +579,39 @@ int main(int argc, char **argv)
         obs_gbuffer_free(&g2);
         t[k] = t2 - t1;
         t_dec[k] = t2 - t0;
+        for (int q = 0; q < np; q++) {
+            t0 = now_ms();
+            if (paths[q].kind == 0)
+                http_big_frame(paths[q].fd, paths[q].query, &file, &paths[q].a);
+            else
+                remote_frame(paths[q].url, path, &gf.gb);
+            paths[q].t[k] = now_ms() - t0;
+        }
     }
     if (ctx)
         obs_ctx_destroy(ctx);
     double in_proc = median(t, frames), in_proc_dec = median(t_dec, frames);
-    printf("G-buffer %s: %dx%d; median of %d frames each, after one warm-up\n\n", path, gf.gb.width,
-           gf.gb.height, frames);
+    printf("G-buffer %s: %dx%d; median of %d rounds, each path once a round (in-process first), after one "
+           "warm-up each\n\n", path, gf.gb.width, gf.gb.height, frames);
     printf("| path | round trip ms | answer bytes | x in-process run | x in-process decode + run |\n"
            "|---|---|---|---|---|\n");
     printf("| in-process: %s, warm (%s) | %.1f | | 1.00 | |\n", cpu ? "obs_run_cpu" : "obs_run",
            cpu ? "the CPU device" : "upload + passes + readback", in_proc);
     printf("| in-process: EXR decode (in memory) + run | %.1f | | %.2f | 1.00 |\n", in_proc_dec,
            in_proc_dec / in_proc);
-    fflush(stdout);
-
-    for (int u = i; u < argc; u++) {
-        const char *url = argv[u];
-        size_t bytes = 0;
-        double m;
-        if (!strncmp(url, "http://", 7)) {
-            m = http_big_median(url, "", &file, frames, &bytes);
-            printf("| HTTP, EXR body, default answer (half, compression auto = rle), answer decoded, keep-alive "
-                   "| %.1f | %zu | %.2f | %.2f |\n", m, bytes, m / in_proc, m / in_proc_dec);
-            fflush(stdout);
-            m = http_big_median(url, "float=1&compression=zip", &file, frames, &bytes);
-            printf("| HTTP, EXR body, float ZIP answer (the answer before compression=), answer decoded | %.1f | "
-                   "%zu | %.2f | %.2f |\n", m, bytes, m / in_proc, m / in_proc_dec);
-            fflush(stdout);
+    for (int q = 0; q < np; q++) {
+        double m = median(paths[q].t, frames);
+        if (paths[q].kind == 0)
+            printf("| %s | %.1f | %zu | %.2f | %.2f |\n", paths[q].what, m, paths[q].a.size, m / in_proc,
+                   m / in_proc_dec);
+        else
+            printf("| %s | %.1f | | %.2f | %.2f |\n", paths[q].what, m, m / in_proc, m / in_proc_dec);
+        if (paths[q].kind == 0) {
+            close(paths[q].fd);
+            free(paths[q].a.data);
         }
-        remote_frame(url, path, &gf.gb); /* warm-up */
-        for (int k = 0; k < frames; k++) {
-            double t0 = now_ms();
-            remote_frame(url, path, &gf.gb);
-            t[k] = now_ms() - t0;
-        }
-        m = median(t, frames);
-        const char *what = !strncmp(url, "http", 4) ? "HTTP through obscura ao --server's client (file read, float answer)"
-                           : !strncmp(url, "unix:", 5) ? "binary protocol, raw planes, Unix socket"
-                                                       : "binary protocol, raw planes, TCP loopback";
-        printf("| %s | %.1f | | %.2f | %.2f |\n", what, m, m / in_proc, m / in_proc_dec);
-        fflush(stdout);
     }
+    fflush(stdout);
 
     if (http)
         metrics_means(http);
