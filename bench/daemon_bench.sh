@@ -82,14 +82,15 @@ stage_table() {
     done
 }
 
-# ms of one command's wall time, the median of 3
+# ms of one command's wall time
 wall_ms() {
-    for k in 1 2 3; do
-        s=$(date +%s%N)
-        "$@" >/dev/null 2>&1
-        echo $(( ($(date +%s%N) - s) / 1000000 ))
-    done | sort -n | sed -n 2p
+    s=$(date +%s%N)
+    "$@" >/dev/null 2>&1
+    echo $(( ($(date +%s%N) - s) / 1000000 ))
 }
+
+# the median of the numbers on stdin
+median() { sort -n | awk '{ v[n++] = $1 } END { print n % 2 ? v[int(n / 2)] : (v[n / 2 - 1] + v[n / 2]) / 2 }'; }
 
 "$BUILD/exr_upscale" "$IN" 1920x1080 "$T/big.exr" "$CAM"
 echo "### daemon round trip: $(basename "$IN") upscaled to 1920x1080"
@@ -122,16 +123,22 @@ start_daemon "$T/r.log" --render-threads 1
 stage_table "$T/r.log"
 stop_daemon
 
-# one-shot obscura ao: a whole process, read and write included
+# one-shot obscura ao: a whole process, read and write included; this
+# build and the baseline in turns (a load from outside falls on both)
 echo
 echo "One-shot \`obscura ao big.exr -o out.exr\` (a whole process: EXR read, context, chain, EXR write),"
-echo "median wall ms of 3:"
+echo "median wall ms of 5, the builds in turns:"
 echo
-echo "| obscura | backend | wall ms |"
-echo "|---|---|---|"
+echo "| backend | $BUILD/obscura ms | ${BASELINE_OBSCURA:-(no BASELINE_OBSCURA)} ms | ratio |"
+echo "|---|---|---|---|"
 for b in auto cpu; do
-    echo "| $BUILD/obscura | $b | $(wall_ms "$BUILD/obscura" ao "$T/big.exr" -o "$T/out.exr" --backend $b) |"
-    if [ -n "${BASELINE_OBSCURA:-}" ]; then
-        echo "| $BASELINE_OBSCURA | $b | $(wall_ms "$BASELINE_OBSCURA" ao "$T/big.exr" -o "$T/out.exr" --backend $b) |"
-    fi
+    : >"$T/a" ; : >"$T/b"
+    for k in 1 2 3 4 5; do
+        wall_ms "$BUILD/obscura" ao "$T/big.exr" -o "$T/out.exr" --backend $b >>"$T/a"
+        [ -n "${BASELINE_OBSCURA:-}" ] &&
+            wall_ms "$BASELINE_OBSCURA" ao "$T/big.exr" -o "$T/out.exr" --backend $b >>"$T/b"
+    done
+    ma=$(median <"$T/a")
+    mb=$([ -s "$T/b" ] && median <"$T/b" || echo "")
+    echo "| $b | $ma | ${mb:--} | $([ -n "$mb" ] && awk "BEGIN { printf \"%.2f\", $ma / $mb }" || echo -) |"
 done

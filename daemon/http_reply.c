@@ -19,11 +19,11 @@ static void log_request(const req *r, const char *note)
         return;
     const obsd_fp *fp = r->fr ? &r->fr->fp : &none;
     obsd_log(OBSD_LOG_INFO,
-             "req=%llu peer=%s %s %s status=%d in=%zu out=%zu receive=%.1f queue=%.1f decode=%.1f gl=%.1f "
-             "encode=%.1f total=%.1f ms%s%s",
+             "req=%llu peer=%s %s %s status=%d in=%zu out=%zu queue=%.1f decode=%.1f gl=%.1f "
+             "encode=%.1f receive=%.1f total=%.1f ms%s%s",
              (unsigned long long)r->id, r->peer, r->method, r->path, r->status,
-             r->len + r->discarded, r->bytes_out, fp->ms_receive, fp->ms_queue, fp->ms_decode, fp->ms_gl,
-             fp->ms_encode,
+             r->len + r->discarded, r->bytes_out, fp->ms_queue, fp->ms_decode, fp->ms_gl, fp->ms_encode,
+             fp->ms_receive,
              obsd_now_ms() - r->t0, note && *note ? " " : "", note ? note : "");
 }
 

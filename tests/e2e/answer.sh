@@ -73,6 +73,6 @@ check "Server-Timing: queue, decode, gl, encode, receive" \
 get $A /metrics "$T/m" >/dev/null
 check "/metrics: receive and send stages counted" \
     "grep -q 'obscurad_stage_seconds_count{stage=\"receive\"} [1-9]' $T/m && grep -q 'obscurad_stage_seconds_count{stage=\"send\"} [1-9]' $T/m"
-check "the request log has receive=" "grep -q 'POST /v1/ao status=200 .* receive=[0-9.]* queue=' $T/A.log"
+check "the request log has receive=" "grep -q 'POST /v1/ao status=200 .* encode=[0-9.]* receive=[0-9.]* total=' $T/A.log"
 echo "e2e answer: $pass passed, $failed failed"
 [ "$failed" -eq 0 ]
