@@ -79,8 +79,13 @@ typedef struct cli_opt {
 
 static const cli_opt ao_opts[] = {
     {"o", "FILE", "output file; .exr or .png (also --output-file)"},
-    {"output", "ao|composite|both|samples|cull|bleed|luminance",
-     "what to write (default ao); a comma list combines them; samples: the sample count "
+    {"output", "ao|composite|both|samples|cull|bleed|luminance|multibounce|bent|aovs|deep",
+     "what to write (default ao); a comma list combines them; deep (deep input, EXR, alone): "
+     "the AO of every kept node as a deep EXR with the flat AO beside it; bent: the bent normal "
+     "in the normals' space (method gtao; EXR channels BentNormal.X/Y/Z, PNG 0.5 + 0.5 n); aovs: the AO, the multi-bounce "
+     "AO and the sample count in one EXR, the layers of README's AOV table (with --append, in "
+     "the input's own file); multibounce: the AO through the albedo-driven multi-bounce fit "
+     "(Jimenez et al. 2016, --multibounce; EXR channels AOMultiBounce.R/G/B); samples: the sample count "
      "of each pixel (adaptive sampling, VAO++ 4.1; EXR channel Samples.Y, PNG count/32); "
      "cull: 1 where the culling pre-pass culled the pixel (VAO++ 4.2; EXR channel Cull.Y); "
      "bleed: the colour-bleed term (VAO++ 4.7, --bleeding; EXR channels Bleed.R/G/B); "
@@ -446,18 +451,19 @@ static void suffixed(const char *path, const char *suffix, char *buf, size_t len
         snprintf(buf, len, "%.*s.%s%s", (int)(dot - path), path, suffix, dot);
 }
 
-/* The sample count as an image of count / 32 (PNG holds [0, 1]). */
-static obs_status count_scaled(const obs_image *count, obs_image *out)
+/* An image into [0, 1] for PNG: the sample count as count / 32, the bent
+ * normal as 0.5 + 0.5 n. */
+static obs_status png_scaled(const obs_image *img, float scale, float offset, obs_image *out)
 {
-    size_t n = (size_t)count->width * count->height;
+    size_t n = (size_t)img->width * img->height * img->channels;
     out->data = malloc(n * sizeof(float));
     if (!out->data)
         return OBS_NO_MEMORY;
-    out->width = count->width;
-    out->height = count->height;
-    out->channels = 1;
+    out->width = img->width;
+    out->height = img->height;
+    out->channels = img->channels;
     for (size_t i = 0; i < n; i++)
-        out->data[i] = count->data[i] / 32.0f;
+        out->data[i] = offset + scale * img->data[i];
     return OBS_OK;
 }
 
@@ -476,7 +482,8 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
     }
     /* PNG: one file per output; NAME.ao.png, NAME.composite.png,
      * NAME.samples.png, NAME.cull.png, NAME.bleed.png, NAME.luminance.png,
-     * NAME.screen.png, NAME.baked.png when there are several */
+     * NAME.screen.png, NAME.baked.png, NAME.multibounce.png, NAME.bent.png
+     * when there are several */
     /* AO images take --png-transfer; data (counts, masks, factors) stays
      * linear; colour is display-encoded */
     enum { DATA, AO, DISPLAY };
@@ -491,9 +498,12 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
                  {&r->bleed, "bleed", DISPLAY},
                  {&r->luminance, "luminance", DATA},
                  {&r->ao_screen, "screen", AO},
-                 {&r->ao_baked, "baked", AO}};
+                 {&r->ao_baked, "baked", AO},
+                 {&r->multibounce, "multibounce", AO},
+                 {&r->bent, "bent", DATA}};
     int count = !!r->ao.data + !!r->composite.data + !!r->sample_count.data + !!r->cull_mask.data +
-                !!r->bleed.data + !!r->luminance.data + !!r->ao_screen.data + !!r->ao_baked.data;
+                !!r->bleed.data + !!r->luminance.data + !!r->ao_screen.data + !!r->ao_baked.data +
+                !!r->multibounce.data + !!r->bent.data;
     if ((s = one_png_for_stdout(a, count, err)) != OBS_OK)
         return s;
     for (size_t k = 0; k < sizeof files / sizeof files[0] && s == OBS_OK; k++) {
@@ -506,8 +516,9 @@ static obs_status write_outputs(const ao_args *a, const obs_result *r, const obs
             suffixed(a->out, files[k].suffix, path, sizeof path);
         else
             snprintf(path, sizeof path, "%s", a->out);
-        if (img == &r->sample_count) {
-            s = count_scaled(img, &scaled);
+        if (img == &r->sample_count || img == &r->bent) {
+            s = img == &r->bent ? png_scaled(img, 0.5f, 0.5f, &scaled)
+                                : png_scaled(img, 1.0f / 32.0f, 0.0f, &scaled);
             if (s != OBS_OK) {
                 snprintf(err, OBS_ERR_LEN, "out of memory for the sample-count image");
                 return s;
@@ -637,6 +648,13 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
                  "supported (write the AO on its own, without --append)");
         return cli_fail(OBS_UNSUPPORTED, a->in, err);
     }
+    if ((a->req.outputs & OBS_OUTPUT_DEEP) &&
+        (a->req.outputs != OBS_OUTPUT_DEEP || a->req.format != OBS_HTTP_EXR || server ||
+         !strcmp(a->out, "-"))) {
+        snprintf(err, OBS_ERR_LEN, "--output deep writes one deep EXR file in-process: not with other "
+                 "outputs, PNG, --server or stdout");
+        return cli_fail(OBS_INVALID_ARGUMENT, a->in, err);
+    }
     double t0 = now_ms();
     s = a->in_buf ? obs_deep_read_exr_mem(a->in_buf, a->in_len, lim, &d, err) : obs_deep_read_exr(a->in, lim, &d, err);
     if (s != OBS_OK)
@@ -673,7 +691,17 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         goto done;
     const obs_camera *cam = d.camera.has_projection ? &d.camera : NULL;
     int want_ao = (a->req.outputs & OBS_OUTPUT_AO) != 0, want_comp = (a->req.outputs & OBS_OUTPUT_COMPOSITE) != 0;
-    if (a->req.format == OBS_HTTP_EXR) {
+    if (a->req.outputs & OBS_OUTPUT_DEEP) {
+        /* every kept node's AO (the CPU twin of the per-node pass), the
+         * run's flat AO and front AO beside it */
+        obs_deep_ao nodes;
+        s = obs_deep_ao_nodes(&d, &a->req.params, &nodes, err);
+        if (s == OBS_OK)
+            s = obs_deep_ao_write_exr(a->out, &nodes, &r.ao_blend, &r.ao_front, err);
+        obs_deep_ao_free(&nodes);
+        if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
+            fprintf(stderr, "obscura: wrote %s\n", a->out);
+    } else if (a->req.format == OBS_HTTP_EXR) {
         obs_exr_layer layers[3];
         int n = obs_deep_result_exr_layers(&r, a->req.outputs, layers);
         s = write_exr_out(a, layers, n, cam, d.part, err);
@@ -975,6 +1003,9 @@ static int cmd_ao(int argc, char **argv)
             die_usage("ao: --baked: the input is a deep EXR; a baked channel is combined with "
                       "flat input only");
         rc = cmd_ao_deep(&a, &lim, server, argc, argv);
+    } else if (s == OBS_OK && (a.req.outputs & OBS_OUTPUT_DEEP)) {
+        rc = cli_fail(OBS_INVALID_ARGUMENT, a.in,
+                      "--output deep: the input is not a deep EXR (the deep AO is of deep input's nodes)");
     } else {
         rc = ao_flat(&a, &lim, server, argc, argv);
     }

@@ -283,6 +283,9 @@ static const char *outputs_name(unsigned outputs)
     case OBS_OUTPUT_AO: return "ao";
     case OBS_OUTPUT_COMPOSITE: return "composite";
     case OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE: return "both";
+    case OBS_OUTPUT_MULTIBOUNCE: return "multibounce";
+    case OBS_OUTPUT_BENT: return "bent";
+    case OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_BENT: return "aovs";
     default: return NULL;
     }
 }
@@ -331,7 +334,10 @@ static obs_image *answer_slot(answer *a, unsigned output)
                : output == OBS_BIN_OUTPUT_AO_FRONT ? &a->deep->ao_front
                : output == OBS_OUTPUT_COMPOSITE ? &a->deep->composite : NULL;
     return output == OBS_OUTPUT_AO ? &a->flat->ao
-           : output == OBS_OUTPUT_COMPOSITE ? &a->flat->composite : NULL;
+           : output == OBS_OUTPUT_COMPOSITE ? &a->flat->composite
+           : output == OBS_OUTPUT_MULTIBOUNCE ? &a->flat->multibounce
+           : output == OBS_OUTPUT_SAMPLE_COUNT ? &a->flat->sample_count
+           : output == OBS_OUTPUT_BENT ? &a->flat->bent : NULL;
 }
 
 /* ---- binary protocol ------------------------------------------------------ */
@@ -431,14 +437,13 @@ static unsigned char *read_file(const char *path, size_t *len)
 /* One channel (`ao`, read as the depth) and/or R,G,B,A of the answer's
  * float EXR into images. */
 static int exr_images(const unsigned char *body, size_t len, const char *ao, obs_image *ao_out,
-                      obs_image *rgba_out, char *msg, size_t msg_len)
+                      const char *const *color, int color_ch, obs_image *color_out, char *msg,
+                      size_t msg_len)
 {
-    obs_channel_map map = {.preset = "generic", .depth = ao ? ao : "R"};
-    if (rgba_out) {
-        static const char *const rgba[] = {"R", "G", "B", "A"};
-        for (int c = 0; c < 4; c++)
-            map.color[c] = rgba[c];
-    }
+    obs_channel_map map = {.preset = "generic", .depth = ao ? ao : color_out ? color[0] : "R"};
+    if (color_out)
+        for (int c = 0; c < color_ch; c++)
+            map.color[c] = color[c];
     obs_gbuffer_file gf = {0};
     char err[OBS_ERR_LEN];
     if (obs_gbuffer_read_exr_mem(body, len, &map, NULL, &gf, err) != OBS_OK) {
@@ -450,28 +455,88 @@ static int exr_images(const unsigned char *body, size_t len, const char *ao, obs
     if (ao)
         rc |= copy_image(g->depth.data, g->depth.row_stride ? g->depth.row_stride / 4 : (size_t)g->width,
                          g->width, g->height, 1, ao_out);
-    if (rgba_out)
-        rc |= copy_image(g->color.data, g->color.row_stride ? g->color.row_stride / 4 : (size_t)g->width * 4,
-                         g->width, g->height, 4, rgba_out);
+    if (color_out && !(rc |= copy_image(g->color.data, g->color.row_stride ? g->color.row_stride / 4
+                                                                             : (size_t)g->width * 4,
+                                         g->width, g->height, 4, color_out)) &&
+        color_ch < 4) {
+        /* the colour plane has 4 channels: keep the first color_ch */
+        size_t n = (size_t)g->width * g->height;
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < color_ch; c++)
+                color_out->data[i * color_ch + c] = color_out->data[i * 4 + c];
+        color_out->channels = color_ch;
+    }
     obs_gbuffer_free(&gf);
     if (rc)
         snprintf(msg, msg_len, "out of memory");
     return rc ? -1 : 0;
 }
 
-/* The answer's EXR (float; AO.Y, deep input's AOFront.Y, R,G,B,A) back
- * into images. */
+/* The three channels `names` of the answer's EXR as one RGB image; none
+ * of them there: no image (0), one missing or another error: -1. */
+static int exr_vector(const unsigned char *body, size_t len, const char *const names[3], obs_image *out,
+                      char *msg, size_t msg_len)
+{
+    obs_image ch[3] = {{0}};
+    char err[OBS_ERR_LEN];
+    int rc = 0, got = 0;
+    for (int k = 0; k < 3 && !rc; k++) {
+        obs_status s = obs_exr_read_channel_mem(body, len, names[k], NULL, &ch[k], err);
+        got += s == OBS_OK;
+        rc = s != OBS_OK && s != OBS_MISSING_CHANNEL;
+    }
+    if (!rc && got == 3) {
+        size_t n = (size_t)ch[0].width * ch[0].height;
+        if (ch[1].width != ch[0].width || ch[2].width != ch[0].width || ch[1].height != ch[0].height ||
+            ch[2].height != ch[0].height || !(out->data = malloc(3 * n * sizeof(float)))) {
+            rc = 1;
+        } else {
+            out->width = ch[0].width;
+            out->height = ch[0].height;
+            out->channels = 3;
+            for (size_t i = 0; i < n; i++)
+                for (int k = 0; k < 3; k++)
+                    out->data[3 * i + k] = ch[k].data[i];
+        }
+    } else if (!rc && got) {
+        rc = 1;
+    }
+    if (rc)
+        snprintf(msg, msg_len, "cannot read the answer's %s: %s", names[0], got ? "incomplete" : err);
+    for (int k = 0; k < 3; k++)
+        obs_image_free(&ch[k]);
+    return rc ? -1 : 0;
+}
+
+/* The answer's EXR (float; AO.Y, deep input's AOFront.Y, R,G,B,A; with
+ * aovs or multibounce, AOMultiBounce.R,G,B and Samples.Y) back into
+ * images. */
 static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs, answer *res,
                          char *msg, size_t msg_len)
 {
+    static const char *const rgba[] = {"R", "G", "B", "A"};
+    static const char *const mb[] = {"AOMultiBounce.R", "AOMultiBounce.G", "AOMultiBounce.B"};
+    static const char *const bent[] = {"BentNormal.X", "BentNormal.Y", "BentNormal.Z"};
     int ao = (outputs & OBS_OUTPUT_AO) != 0, comp = (outputs & OBS_OUTPUT_COMPOSITE) != 0;
-    if (!res->deep)
-        return exr_images(body, len, ao ? "AO.Y" : NULL, &res->flat->ao, comp ? &res->flat->composite : NULL,
-                          msg, msg_len);
+    if (!res->deep) {
+        obs_result *r = res->flat;
+        if ((ao || comp) && exr_images(body, len, ao ? "AO.Y" : NULL, &r->ao, rgba, 4,
+                                       comp ? &r->composite : NULL, msg, msg_len))
+            return -1;
+        /* the multi-bounce AO is left out of an answer without a colour plane */
+        int count = (outputs & OBS_OUTPUT_SAMPLE_COUNT) != 0;
+        if ((outputs & OBS_OUTPUT_MULTIBOUNCE) &&
+            exr_images(body, len, count ? "Samples.Y" : NULL, &r->sample_count, mb, 3, &r->multibounce,
+                       msg, msg_len))
+            return -1;
+        /* the bent normal is left out by methods without one: read when there */
+        return (outputs & OBS_OUTPUT_BENT) ? exr_vector(body, len, bent, &r->bent, msg, msg_len) : 0;
+    }
     obs_deep_result *d = res->deep;
-    if (exr_images(body, len, ao ? "AO.Y" : NULL, &d->ao_blend, comp ? &d->composite : NULL, msg, msg_len))
+    if (exr_images(body, len, ao ? "AO.Y" : NULL, &d->ao_blend, rgba, 4, comp ? &d->composite : NULL, msg,
+                   msg_len))
         return -1;
-    return ao ? exr_images(body, len, "AOFront.Y", &d->ao_front, NULL, msg, msg_len) : 0;
+    return ao ? exr_images(body, len, "AOFront.Y", &d->ao_front, NULL, 0, NULL, msg, msg_len) : 0;
 }
 
 /* POSTs the frame to /v1/ao, or with `stream` to /v1/streams/STREAM/frames. */
@@ -691,7 +756,7 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
         return RC_USAGE;
     }
     if (!oname) {
-        fprintf(stderr, "obscura: error: --server: the daemon answers ao, composite or both, not this --output\n");
+        fprintf(stderr, "obscura: error: --server: the daemon answers ao, composite, both, multibounce, bent or aovs, not this --output\n");
         return RC_USAGE;
     }
 

@@ -43,6 +43,8 @@ obs_status obs__alloc_result(obs_result *out, int w, int h, unsigned outputs, ch
         s = obs__image_alloc(&out->luminance, w, h, 1, err);
     if (s == OBS_OK && (outputs & OBS_OUTPUT_BLEED))
         s = obs__image_alloc(&out->bleed, w, h, 3, err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_BENT))
+        s = obs__image_alloc(&out->bent, w, h, 3, err);
     if (s != OBS_OK)
         obs_result_free(out);
     return s;
@@ -58,6 +60,8 @@ void obs_result_free(obs_result *r)
     obs_image_free(&r->cull_mask);
     obs_image_free(&r->luminance);
     obs_image_free(&r->bleed);
+    obs_image_free(&r->multibounce);
+    obs_image_free(&r->bent);
     obs_image_free(&r->ao_screen);
     obs_image_free(&r->ao_baked);
 }

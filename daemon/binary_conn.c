@@ -260,7 +260,7 @@ static int run_frame(frame *f, obs_bin_request *q)
     obs_bin_response_desc d = {.id = f->id, .status = 200, .code = "ok", .message = "",
                                .warnings = said, .warning_count = fp.gf.info.warning_count,
                                .blob = blob.data, .blob_len = blob.size};
-    obs_bin_image images[3];
+    obs_bin_image images[6];
     int n = 0;
     if (q->raw_out) {
         if (im.ao)
@@ -269,6 +269,12 @@ static int run_frame(frame *f, obs_bin_request *q)
             images[n++] = (obs_bin_image){OBS_BIN_OUTPUT_AO_FRONT, *im.ao_front};
         if (im.composite)
             images[n++] = (obs_bin_image){OBS_OUTPUT_COMPOSITE, *im.composite};
+        if (im.multibounce)
+            images[n++] = (obs_bin_image){OBS_OUTPUT_MULTIBOUNCE, *im.multibounce};
+        if (im.samples)
+            images[n++] = (obs_bin_image){OBS_OUTPUT_SAMPLE_COUNT, *im.samples};
+        if (im.bent)
+            images[n++] = (obs_bin_image){OBS_OUTPUT_BENT, *im.bent};
         d.body = OBS_BIN_RAW;
         d.images = images;
         d.image_count = n;

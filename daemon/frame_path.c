@@ -214,6 +214,9 @@ void obsd_fp_images_of(const obsd_fp *fp, unsigned outputs, obsd_fp_images *im)
     im->ao_screen = ao && res->ao_screen.data ? &res->ao_screen : NULL;
     im->ao_baked = ao && res->ao_baked.data ? &res->ao_baked : NULL;
     im->composite = res->composite.data ? &res->composite : NULL;
+    im->multibounce = res->multibounce.data ? &res->multibounce : NULL;
+    im->samples = res->sample_count.data ? &res->sample_count : NULL;
+    im->bent = res->bent.data ? &res->bent : NULL;
 }
 
 const obs_camera *obsd_fp_camera(const obsd_fp *fp)
@@ -225,7 +228,7 @@ const obs_camera *obsd_fp_camera(const obsd_fp *fp)
 
 const obs_image *obsd_fp_png_image(const obsd_fp_images *im)
 {
-    return im->ao ? im->ao : im->composite;
+    return im->ao ? im->ao : im->composite ? im->composite : im->multibounce ? im->multibounce : im->bent;
 }
 
 /* The EXR layers of `im`, named by core's own tables. */
@@ -249,6 +252,12 @@ static int exr_layers(const obsd_fp_images *im, obs_result *flat, obs_deep_resul
         flat->ao_screen = *im->ao_screen;
     if (im->ao_baked)
         flat->ao_baked = *im->ao_baked;
+    if (im->multibounce)
+        flat->multibounce = *im->multibounce;
+    if (im->samples)
+        flat->sample_count = *im->samples;
+    if (im->bent)
+        flat->bent = *im->bent;
     return obs_result_exr_layers(flat, layers);
 }
 

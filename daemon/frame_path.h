@@ -53,6 +53,8 @@ typedef struct obsd_fp_images {
     const obs_image *ao_front; /* deep: AOFront.Y */
     const obs_image *composite;
     const obs_image *ao_screen, *ao_baked; /* with a baked channel: AOScreen.Y, AOBaked.Y */
+    const obs_image *multibounce, *samples; /* AOMultiBounce.R,G,B; Samples.Y (output aovs) */
+    const obs_image *bent;                  /* BentNormal.X,Y,Z */
     int deep;
 } obsd_fp_images;
 
@@ -98,7 +100,8 @@ obs_status obsd_fp_finished(obsd_fp *fp);
  * it (NULL when there is no projection). */
 void obsd_fp_images_of(const obsd_fp *fp, unsigned outputs, obsd_fp_images *im);
 const obs_camera *obsd_fp_camera(const obsd_fp *fp);
-/* The one image a PNG of `im` shows: the AO, else the composite. */
+/* The one image a PNG of `im` shows: the AO, else the composite, else the
+ * multi-bounce AO. */
 const obs_image *obsd_fp_png_image(const obsd_fp_images *im);
 
 /* Writes `im` as hr asks (format exr|png, float, png_bits, layer,

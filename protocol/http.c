@@ -11,8 +11,9 @@
 
 enum { Q = OBS_HTTP_QUERY, CLI = OBS_HTTP_CLI, ANY = Q | CLI };
 
-/* The debug outputs are the CLI's only: obscurad answers AO and the
- * composite (clients/remote.c refuses the others with --server). */
+/* The debug outputs are the CLI's only: obscurad answers AO, the
+ * composite, the multi-bounce AO and the AOVs (clients/remote.c refuses
+ * the others with --server). */
 static const obs_http_choice output_choices[] = {
     {"ao", OBS_OUTPUT_AO, ANY},
     {"composite", OBS_OUTPUT_COMPOSITE, ANY},
@@ -21,6 +22,11 @@ static const obs_http_choice output_choices[] = {
     {"cull", OBS_OUTPUT_CULL_MASK, CLI},
     {"bleed", OBS_OUTPUT_BLEED, CLI},
     {"luminance", OBS_OUTPUT_LUMINANCE, CLI},
+    {"multibounce", OBS_OUTPUT_MULTIBOUNCE, ANY},
+    /* a compositor's set in one EXR (README's "AOVs" table) */
+    {"bent", OBS_OUTPUT_BENT, ANY},
+    {"aovs", OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_BENT, ANY},
+    {"deep", OBS_OUTPUT_DEEP, CLI},
     {NULL, 0, 0}};
 static const obs_http_choice format_choices[] = {
     {"exr", OBS_HTTP_EXR, ANY}, {"png", OBS_HTTP_PNG, ANY}, {NULL, 0, 0}};
@@ -291,10 +297,11 @@ obs_status obs_http_request_set_n(obs_http_request *r, const char *name, size_t 
 
 obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LEN])
 {
-    if (r->format == OBS_HTTP_PNG && r->outputs == (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE))
+    if (r->format == OBS_HTTP_PNG && (r->outputs & (r->outputs - 1))) /* more than one */
         return obs_status_fail(err, OBS_INVALID_ARGUMENT,
-                              "format=png holds one image: ask for one output (output=ao or "
-                              "output=composite), or use format=exr for both");
+                              "format=png holds one image: ask for one output (output=ao, "
+                              "output=composite or output=multibounce), or use format=exr for "
+                              "both or aovs");
     if (r->append && r->format != OBS_HTTP_EXR)
         return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "append=1 writes the input EXR back with the AO added: it needs "

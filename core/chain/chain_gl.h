@@ -40,9 +40,10 @@ typedef struct obs__targets {
     GLuint tex_cullmask;                      /* debug: culling candidates (4.2) */
     GLuint tex_bleed;                         /* colour-bleed term (4.7), RGBA */
     GLuint tex_lumfactor;                     /* debug: factor of eq 3 (4.3) */
+    GLuint tex_bent;                          /* bent normal sums (view space), RGBA */
     GLuint fbo_prep, fbo_ao, fbo_composite;  /* fbo_prep: viewpos + vnormal + dz */
     GLuint fbo_blur;                          /* tex_blur + tex_lumfactor */
-    GLuint fbo_vao;                           /* AO pass: tex_ao + tex_count + tex_cullmask + tex_bleed */
+    GLuint fbo_vao;                           /* AO pass: tex_ao + tex_count + tex_cullmask + tex_bleed + tex_bent */
     GLuint fbo_cull;                          /* culling pre-pass: tex_cull */
 } obs__targets;
 

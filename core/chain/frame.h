@@ -12,7 +12,7 @@
 /* Every OBS_OUTPUT_* bit. */
 #define OBS__OUTPUTS_ALL                                                                           \
     (OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |        \
-     OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE)
+     OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_BENT)
 
 /* k of R = k * D: the paper's kernel width R (hemisphere radius; the
  * tangent sphere has radius R/2) for the ray-traced AO distance D that the
@@ -273,6 +273,16 @@ int obs__cull_candidate(const obs__frame *f, const float *est, int x, int y);
  * f->bleed_step > 0, bleed gets the mean over every bleed_step-th sample
  * of white mixed towards the colour at the sample's pixel by c(x); else
  * (1, 1, 1).  col: 4 floats (RGBA) per pixel; NULL: no bleeding. */
+/* The VAO estimator's bent normal (OBS_OUTPUT_BENT; vao_bent_cpu.c): the
+ * centroid of the tangent sphere's open volume seen from p, summed over
+ * the samples into bent[3] (not normalised; 0 when every pipe is closed);
+ * returns the AO as obs__vao_estimate.  GLSL: vao_bent_sample() in
+ * vao.glsl, in vao_estimate(). */
+float obs__vao_estimate_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                             const float p[3], const float n[3], int ns, const float *xy,
+                             float bent[3]);
+void obs__vao_bent_sample(const float c[3], float r, const float rot[2], float sx, float sy, float h,
+                          float dz, const float p[3], float bent[3]);
 float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float *nrm,
                               const float *col, int x, int y, const float p[3], const float n[3],
                               int ns, const float *xy, float bleed[3]);

@@ -13,7 +13,9 @@
  * the outputs asked for and what the passes' tests read. */
 typedef struct obs__plan {
     const obs_gbuffer *gb;
-    unsigned outputs;    /* OBS_OUTPUT_* bits */
+    unsigned outputs;    /* OBS_OUTPUT_* bits the passes fill */
+    unsigned asked;      /* the caller's: outputs less what a post step needs */
+    int multibounce;     /* 1: the multi-bounce image is made (multibounce.c) */
     obs__frame f;        /* the full-resolution frame */
     obs__frame hf;       /* ao_resolution half: the frame at half size */
     const obs__frame *af; /* the frame the culling pre-pass, AO and blur run at: &f or &hf */
@@ -32,6 +34,11 @@ typedef struct obs__plan {
  * into itself: it is not copied. */
 obs_status obs__plan_init(obs__plan *pl, obs_ctx *log_ctx, const obs_gbuffer *gb,
                           const obs_params *params, unsigned outputs, char err[OBS_ERR_LEN]);
+
+/* The bent normal (bent_out.c): the method's view-space sums in
+ * out->bent, normalised and turned into the normals' space, after the
+ * readback by every device's driver. */
+void obs__bent_finish(const obs__plan *pl, obs_result *out);
 
 typedef struct obs__pass {
     obs_pass id;      /* its place in the order, its timing slot (obs_pass_times) */

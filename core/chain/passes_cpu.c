@@ -4,22 +4,32 @@
 #include <string.h>
 
 #include "chain/bands_cpu.h"
+#include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
 #include "chain/vao_cpu.h"
 
 /* GLSL: composite.frag.glsl.  Section 5: "applied to resulting image
  * simply by multiplication by occlusion values": colour x AO, and x the
  * bleed term (section 4.7) when bleeding is on; grey AO when there is no
- * colour. */
-static void composite_pixel(const float *color, float ao, const float *bleed, float out[4])
+ * colour; with multibounce, the AO of each channel through the fit of
+ * the colour as albedo (obs__multibounce). */
+static void composite_pixel(const float *color, float ao, const float *bleed, int multibounce,
+                            float out[4])
 {
     if (!color) {
         out[0] = out[1] = out[2] = ao;
         out[3] = 1.0f;
         return;
     }
+    float occ[3] = {ao, ao, ao};
+    if (multibounce) {
+        float rho[3];
+        for (int k = 0; k < 3; k++)
+            rho[k] = color[k] > 0.0f ? (color[k] < 1.0f ? color[k] : 1.0f) : 0.0f;
+        obs__multibounce(ao, rho, occ);
+    }
     for (int k = 0; k < 3; k++)
-        out[k] = bleed ? color[k] * ao * bleed[k] : color[k] * ao;
+        out[k] = bleed ? color[k] * occ[k] * bleed[k] : color[k] * occ[k];
     out[3] = color[3];
 }
 
@@ -27,6 +37,27 @@ static void composite_pixel(const float *color, float ao, const float *bleed, fl
 #define AO_TILE_W 64
 #define AO_TILE_H 16
 #endif
+
+/* OBS_OUTPUT_BENT of the VAO estimator at pixel i, which took n samples
+ * (0: culled greedily or background): the scalar estimator's sum of the
+ * same samples (obs__vao_estimate_bent), the view normal where nothing is
+ * open or nothing was sampled on the geometry, 0 on the background.  The
+ * AO stays the SIMD form's. */
+static void vao_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y, int n,
+                     int culled, float bent[3])
+{
+    size_t i = (size_t)y * f->width + x;
+    bent[0] = bent[1] = bent[2] = 0.0f;
+    if (!(pos[4 * i + 3] > 0.0f))
+        return;
+    if (n > 0) {
+        const float *xy = f->adaptive || culled ? f->sample_table + 2 * (n - 2) : f->sample_xy;
+        obs__vao_estimate_bent(f, pos, nrm, x, y, pos + 4 * i, nrm + 3 * i, n, xy, bent);
+    }
+    if (bent[0] == 0.0f && bent[1] == 0.0f && bent[2] == 0.0f)
+        for (int k = 0; k < 3; k++)
+            bent[k] = nrm[3 * i + k];
+}
 
 /* The AO pass over a tile of the frame at the AO's size (GLSL:
  * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
@@ -50,7 +81,9 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
             b[0] = b[1] = b[2] = 1.0f;
             if (method->pixel) {
                 /* a comparison method in place of the VAO estimator */
-                ao[i] = obs__method_pixel(f, pos, nrm, x, y, &n);
+                ao[i] = c->out->bent.data
+                            ? obs__method_pixel_bent(f, pos, nrm, x, y, &n, c->out->bent.data + 3 * i)
+                            : obs__method_pixel(f, pos, nrm, x, y, &n);
             } else if (pos[4 * i + 3] > 0.0f) {
                 /* Section 4.2: a culling candidate gets AO 1 (greedy) or
                  * at most the 4-sample set (careful). */
@@ -69,6 +102,8 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
                                                   nrm + 3 * i, n, xy, b);
                 }
             }
+            if (c->out->bent.data && !method->pixel)
+                vao_bent(f, pos, nrm, x, y, n, culled, c->out->bent.data + 3 * i);
             if (count)
                 count[i] = (float)n;
             if (mask)
@@ -267,7 +302,7 @@ static void composite_rows(void *ctx, int y0, int y1)
             size_t i = (size_t)y * f->width + x;
             composite_pixel(gb->color.data ? obs__plane_px(&gb->color, f->width, x, y) : NULL,
                             c->ao[i], f->bleed_step ? c->bleed + 3 * i : NULL,
-                            c->out->composite.data + 4 * i);
+                            c->pl->multibounce, c->out->composite.data + 4 * i);
         }
 }
 

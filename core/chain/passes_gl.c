@@ -171,9 +171,10 @@ static obs_status run_ao(obs__gl_run *r, char err[OBS_ERR_LEN])
         GL_COLOR_ATTACHMENT0,
         (pl->outputs & OBS_OUTPUT_SAMPLE_COUNT) ? GL_COLOR_ATTACHMENT1 : GL_NONE,
         (pl->outputs & OBS_OUTPUT_CULL_MASK) ? GL_COLOR_ATTACHMENT2 : GL_NONE,
-        pl->f.bleed_step ? GL_COLOR_ATTACHMENT3 : GL_NONE};
+        pl->f.bleed_step ? GL_COLOR_ATTACHMENT3 : GL_NONE,
+        (pl->outputs & OBS_OUTPUT_BENT) ? GL_COLOR_ATTACHMENT4 : GL_NONE};
     glBindFramebuffer(GL_FRAMEBUFFER, at->fbo_vao);
-    glDrawBuffers(4, vao_bufs);
+    glDrawBuffers(5, vao_bufs);
     /* the pass whose cost grows with the samples: in bands against the
      * deadline (obs_ctx_set_deadline) */
     return obs__gl_draw_banded(r->ctx->dev.vao, pl->af->width, pl->af->height, r->t_run,
@@ -255,6 +256,7 @@ static obs_status run_composite(obs__gl_run *r, char err[OBS_ERR_LEN])
     bind_tex(prog, "u_bleed", 2, t->tex_bleed);
     glUniform1i(glGetUniformLocation(prog, "u_has_color"), r->pl->has_color);
     glUniform1i(glGetUniformLocation(prog, "u_has_bleed"), r->pl->f.bleed_step > 0);
+    glUniform1i(glGetUniformLocation(prog, "u_multibounce"), r->pl->multibounce);
     draw(r->ctx, t->fbo_composite, r->pl->f.width, r->pl->f.height);
     return OBS_OK;
 }
@@ -286,6 +288,8 @@ static obs_status run_readback(obs__gl_run *r, char err[OBS_ERR_LEN])
         read_back(t->fbo_vao, GL_COLOR_ATTACHMENT3, w, h, GL_RGB, out->bleed.data);
     else if (outputs & OBS_OUTPUT_BLEED) /* bleeding off: the neutral term */
         fill_ones(out->bleed.data, (size_t)w * h * 3);
+    if (outputs & OBS_OUTPUT_BENT)
+        read_back(t->fbo_vao, GL_COLOR_ATTACHMENT4, w, h, GL_RGB, out->bent.data);
     if ((outputs & OBS_OUTPUT_LUMINANCE) && f->luminance)
         read_back(t->fbo_blur, GL_COLOR_ATTACHMENT1, w, h, GL_RED, out->luminance.data);
     else if (outputs & OBS_OUTPUT_LUMINANCE) /* off: the factor is 1 */

@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
 
 static double now_ms(void)
@@ -62,13 +63,17 @@ obs_status obs__run_cpu_timed(const obs_gbuffer *gb, const obs_params *params, u
     double t0 = times ? now_ms() : 0.0;
     s = obs__cpu_planes_take(&c, err);
     if (s == OBS_OK)
-        s = obs__alloc_result(out, pl.f.width, pl.f.height, outputs, err);
+        s = obs__alloc_result(out, pl.f.width, pl.f.height, pl.outputs, err);
     if (times) {
         times->ms[OBS_PASS_UPLOAD] += now_ms() - t0;
         times->total_ms += now_ms() - t0;
     }
     if (s == OBS_OK)
         s = walk(&c, times, err);
+    if (s == OBS_OK)
+        s = obs__multibounce_finish(pl.gb, pl.multibounce, pl.asked, out, err);
+    if (s == OBS_OK)
+        obs__bent_finish(&pl, out);
     obs__cpu_planes_give(&c);
     if (s != OBS_OK)
         obs_result_free(out);

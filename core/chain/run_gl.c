@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "chain/frame_gl.h"
+#include "chain/multibounce.h"
 #include "chain/passes_gl.h"
 
 /* ---- per-pass timings (GL_TIME_ELAPSED queries) ------------------------ */
@@ -119,6 +120,10 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         s = walk(&r, &ran, err);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
+    if (s == OBS_OK)
+        s = obs__multibounce_finish(pl.gb, pl.multibounce, pl.asked, out, err);
+    if (s == OBS_OK)
+        obs__bent_finish(&pl, out);
     if (s != OBS_OK) {
         ctx->times_valid = 0; /* no times for a frame cut short */
         obs_result_free(out);

@@ -42,7 +42,7 @@ void obs__chain_release(obs__programs *g, obs__targets *t)
 {
     GLuint tex[] = {t->tex_depth,   t->tex_normal, t->tex_color,     t->tex_viewpos, t->tex_vnormal,
                     t->tex_dz,      t->tex_ao,     t->tex_composite, t->tex_blur,    t->tex_count,
-                    t->tex_cull,    t->tex_cullmask, t->tex_bleed,   t->tex_lumfactor};
+                    t->tex_cull,    t->tex_cullmask, t->tex_bleed,   t->tex_lumfactor, t->tex_bent};
     GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao, t->fbo_cull};
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
@@ -148,6 +148,8 @@ obs_status obs__targets_need(unsigned long *created, const obs__frame *f, obs__t
     if (s == OBS_OK && f->bleed_step)
         s = need_texture(created, at, &at->tex_bleed, GL_RGBA32F, at->fbo_vao, GL_COLOR_ATTACHMENT3,
                          err);
+    if (s == OBS_OK && (outputs & OBS_OUTPUT_BENT))
+        s = need_texture(created, at, &at->tex_bent, GL_RGBA32F, at->fbo_vao, GL_COLOR_ATTACHMENT4, err);
     if (s == OBS_OK && f->luminance && (outputs & OBS_OUTPUT_LUMINANCE))
         s = need_texture(created, t, &t->tex_lumfactor, GL_R32F, t->fbo_blur, GL_COLOR_ATTACHMENT1,
                          err);

@@ -207,7 +207,7 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
                              const float *d_at, int ds,
                              const float *nz_at, int nzs, const float *col, int x, int y,
                              const float p[3], const float n[3], int ns, const float *xy,
-                             float bleed[3])
+                             float bleed[3], float bent[3])
 {
     const float R = f->radius, r = 0.5f * f->radius;
     /* Centre of the tangent sphere of radius R/2, moved along the normal. */
@@ -279,6 +279,8 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
         if (seen) {
             open += dz;
             F += R * l; /* eq 2: F = R * sum sqrt(1 - x^2 - y^2) */
+            if (bent) /* OBS_OUTPUT_BENT: the open part's centroid (obs__vao_estimate_bent) */
+                obs__vao_bent_sample(c, r, rot, sx, sy, h, dz, p, bent);
         }
     }
     for (int j = 0; j < 3; j++)
@@ -290,7 +292,7 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
                               const float *col, int x, int y, const float p[3], const float n[3],
                               int ns, const float *xy, float bleed[3])
 {
-    return estimate(f, pos, nrm, pos + 3, 4, nrm + 2, 3, col, x, y, p, n, ns, xy, bleed);
+    return estimate(f, pos, nrm, pos + 3, 4, nrm + 2, 3, col, x, y, p, n, ns, xy, bleed, NULL);
 }
 
 /* floorf(v) where the caller needs only its comparisons and its int:
@@ -387,7 +389,16 @@ float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *
                             const float n[3], int ns, const float *xy, float bleed[3])
 {
     if (col && f->bleed_step > 0)
-        return estimate(f, pos, nrm, dnz, 2, dnz + 1, 2, col, x, y, p, n, ns, xy, bleed);
+        return estimate(f, pos, nrm, dnz, 2, dnz + 1, 2, col, x, y, p, n, ns, xy, bleed, NULL);
     bleed[0] = bleed[1] = bleed[2] = 1.0f;
     return estimate_lanes(f, pos, nrm, dnz, x, y, p, n, ns, xy);
+}
+
+float obs__vao_estimate_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                             const float p[3], const float n[3], int ns, const float *xy,
+                             float bent[3])
+{
+    float bleed[3];
+    bent[0] = bent[1] = bent[2] = 0.0f;
+    return estimate(f, pos, nrm, pos + 3, 4, nrm + 2, 3, NULL, x, y, p, n, ns, xy, bleed, bent);
 }

@@ -44,6 +44,8 @@ int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_L
     static const char *const bleed[] = {"Bleed.R", "Bleed.G", "Bleed.B"};
     static const char *const lum[] = {"Luminance.Y"};
     static const char *const screen[] = {"AOScreen.Y"}, *const baked[] = {"AOBaked.Y"};
+    static const char *const mb[] = {"AOMultiBounce.R", "AOMultiBounce.G", "AOMultiBounce.B"};
+    static const char *const bent[] = {"BentNormal.X", "BentNormal.Y", "BentNormal.Z"};
     /* The result's images in the file's order, each with its channels. */
     static const struct {
         size_t offset;
@@ -55,7 +57,9 @@ int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_L
                 {offsetof(obs_result, bleed), bleed},
                 {offsetof(obs_result, luminance), lum},
                 {offsetof(obs_result, ao_screen), screen},
-                {offsetof(obs_result, ao_baked), baked}};
+                {offsetof(obs_result, ao_baked), baked},
+                {offsetof(obs_result, multibounce), mb},
+                {offsetof(obs_result, bent), bent}};
     int n = 0;
     for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) {
         const obs_image *im = (const obs_image *)((const char *)r + rows[i].offset);

@@ -291,9 +291,12 @@ int obs_result_sanity(const obs_image *ao, const obs_gbuffer *gb, const obs_deep
     obs_params p;
     obs_depth_range range, *r = NULL;
     int added = 0;
-    if (!ao || !ao->data || ao->channels < 1)
-        return 0;
     obs__params_for_gbuffer(params, gb, &p);
+    if (p.multibounce == OBS_ON && (deep || (gb && !gb->color.data)))
+        warn(info, &added, "multibounce on needs a colour plane (the albedo: --color albedo)%s; "
+             "the AO is single-bounce", deep ? " of flat input" : " and the input has none");
+    if (!ao || !ao->data || ao->channels < 1)
+        return added;
     if (gb && gb->width == ao->width && gb->height == ao->height &&
         obs_gbuffer_depth_range(gb, params, &range) == 0)
         r = &range;
@@ -311,7 +314,7 @@ int obs_result_sanity(const obs_image *ao, const obs_gbuffer *gb, const obs_deep
     long geometry = r && r->geometry > 0 && r->geometry <= px ? r->geometry : px;
     double mean = 1.0 - lost / (double)geometry;
     if (geometry < MIN_PIXELS || (occluded > 0 && mean <= AO_HIGH))
-        return 0;
+        return added;
     char text[120] = "";
     if (r && r->geometry > 0)
         snprintf(text, sizeof text, "; depth %.4g..%.4g, median %.4g", r->min, r->max, r->median);

@@ -48,6 +48,7 @@
  * the view vector of an orthographic camera is +z. */
 #include <math.h>
 
+#include "methods/bent.h"
 #include "methods/gtao.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
@@ -138,6 +139,12 @@ static float arc(float h, float gamma, float cos_gamma)
 float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                       const float p[3], const float n[3], int *count)
 {
+    return obs__gtao_pixel_bent(f, pos, nrm, x, y, p, n, count, NULL);
+}
+
+float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                           const float p[3], const float n[3], int *count, float bent[3])
+{
     const obs__gtao_state *g = obs__gtao_of(f);
     const float half_pi = (float)M_PI_2;
     int taken = 0;
@@ -193,6 +200,8 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
         h0 = gamma + fmaxf(h0 - gamma, -half_pi);
         h1 = gamma + fminf(h1 - gamma, half_pi);
         vis += np_len * (arc(h0, gamma, cos_g) + arc(h1, gamma, cos_g));
+        if (bent)
+            obs__gtao_bent_slice(h0, h1, gamma, np_len, od, v, bent);
     }
     vis /= (float)g->slices;
     vis = powf(fmaxf(vis, 0.0f), g->thin_power[1]);

@@ -38,4 +38,10 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
  * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
 void obs__gtao_noise(int tile, float out[2]);
 
+/* obs__gtao_pixel that also sums the bent normal of every slice into
+ * bent[3] (NULL: not wanted): Jimenez et al.'s Algorithm 2 extension as
+ * XeGTAO computes it (obs__gtao_bent_slice, methods/bent.c). */
+float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                           const float p[3], const float n[3], int *count, float bent[3]);
+
 #endif

@@ -40,6 +40,12 @@ static float gtao_ao(const obs__frame *f, const float *pos, const float *nrm, in
     return obs__gtao_pixel(f, pos, nrm, x, y, p, n, count);
 }
 
+static float gtao_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                       const float p[4], const float n[3], int *count, float bent[3])
+{
+    return obs__gtao_pixel_bent(f, pos, nrm, x, y, p, n, count, bent);
+}
+
 /* Samples per pixel, for obs_frame_cost. */
 static int vao_samples(const obs_params *p) { return p->samples; }
 static int hemisphere_samples(const obs_params *p) { return p->hemisphere_samples; }
@@ -86,7 +92,7 @@ static const obs__method methods[] = {
       {"u_gtao_falloff", OBS__U_VEC2, GT(falloff), 0, 0},
       {"u_gtao_thin_power", OBS__U_VEC2, GT(thin_power), 0, 0},
       {NULL}},
-     0},
+     0, gtao_bent},
 };
 #undef GT
 #undef HB
@@ -133,6 +139,19 @@ float obs__method_pixel(const obs__frame *f, const float *pos, const float *nrm,
     if (!(p[3] > 0.0f) || !m || !m->pixel)
         return 1.0f;
     return m->pixel(f, pos, nrm, x, y, p, n, count);
+}
+
+float obs__method_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                             int *count, float bent[3])
+{
+    size_t i = (size_t)y * (size_t)f->width + (size_t)x;
+    const float *p = pos + 4 * i, *n = nrm + 3 * i;
+    const obs__method *m = obs__method_get(f->method);
+    bent[0] = bent[1] = bent[2] = 0.0f;
+    if (!m || !m->pixel_bent || !(p[3] > 0.0f))
+        return obs__method_pixel(f, pos, nrm, x, y, count);
+    *count = 0;
+    return m->pixel_bent(f, pos, nrm, x, y, p, n, count, bent);
 }
 
 unsigned long long obs_frame_cost(const obs_params *params, int width, int height, int deep_layers)

@@ -33,6 +33,11 @@ typedef struct obs__method {
     int (*samples_per_pixel)(const obs_params *p);
     obs__uniform uniforms[OBS__METHOD_MAX_UNIFORMS]; /* ends at a NULL name */
     int deep; /* 1: runs on deep input too (core/deep: OITAO's GetAO) */
+    /* The method's bent normal (OBS_OUTPUT_BENT): pixel's twin that also
+     * sums the view-space bent normal of its samples into bent[3] (not
+     * normalised); NULL: the method has none (its GLSL leaves g_bent 0). */
+    float (*pixel_bent)(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                        const float p[4], const float n[3], int *count, float bent[3]);
 } obs__method;
 
 /* Resolves one frame (obs__frame_setup_common, frame.c) and fills the
@@ -45,6 +50,11 @@ obs_status obs__frame_setup(obs_ctx *log_ctx, const obs_gbuffer *gb, const obs_p
  * main() of method.frag.glsl). */
 float obs__method_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         int *count);
+
+/* obs__method_pixel with the bent normal summed into bent[3] (left 0 for
+ * the background and methods without one). */
+float obs__method_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                             int *count, float bent[3]);
 
 /* The row of method id (resolved, 1 .. OBS_METHOD_COUNT - 1); NULL for
  * any other value. */

@@ -120,6 +120,7 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
         h0 = gamma + max(h0 - gamma, -GTAO_HALF_PI);   // Algorithm 1: clamped to n's hemisphere
         h1 = gamma + min(h1 - gamma, GTAO_HALF_PI);
         vis += np_len * (gtao_arc(h0, gamma, cos_g) + gtao_arc(h1, gamma, cos_g));
+        gtao_bent_slice(h0, h1, gamma, np_len, od, v); // OBS_OUTPUT_BENT (method.glsl)
     }
     vis /= float(u_gtao_slices);
     vis = pow(max(vis, 0.0), u_gtao_thin_power.y);

@@ -5,6 +5,24 @@
 layout(rgba32f) readonly uniform image2D u_pos;     // prep: view position, planar depth in w
 layout(rgba32f) readonly uniform image2D u_vnormal; // prep: view normal
 layout(rg32f) readonly uniform image2D u_dz;        // prep: planar depth (x), view normal z (y)
+
+// The bent normal's view-space sum of the methods that have one (gtao),
+// written by method.frag.glsl (OBS_OUTPUT_BENT); 0 for the others.
+vec3 g_bent;
+
+// One gtao slice's bent normal, added to g_bent: Jimenez et al. 2016,
+// Algorithm 2, as XeGTAO computes it (t0 along the slice's direction od
+// orthogonal to v, t1 along v).  C twin: obs__gtao_bent_slice
+// (methods/bent.c).
+void gtao_bent_slice(float h0, float h1, float g, float np_len, vec3 od, vec3 v)
+{
+    float t0 = (6.0 * sin(h0 - g) - sin(3.0 * h0 - g) + 6.0 * sin(h1 - g) - sin(3.0 * h1 - g) +
+                16.0 * sin(g) - 3.0 * (sin(h0 + g) + sin(h1 + g))) / 12.0;
+    float t1 = (-cos(3.0 * h0 - g) - cos(3.0 * h1 - g) + 8.0 * cos(g) -
+                3.0 * (cos(h0 + g) + cos(h1 + g))) / 12.0;
+    float l = length(od);
+    g_bent += np_len * (t0 * (l > 0.0 ? od / l : vec3(0.0)) + t1 * v);
+}
 // u_size, u_radius (the AO distance D, in depth units), u_rot: the Frame
 // block (common.glsl)
 

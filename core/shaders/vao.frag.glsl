@@ -13,6 +13,7 @@ layout(location = 0) out vec2 o_ao;    // AO, planar depth (for the blur)
 layout(location = 1) out float o_count; // samples taken (debug output)
 layout(location = 2) out float o_cull;  // 1: culling candidate (debug output)
 layout(location = 3) out vec4 o_bleed;  // section 4.7: the colour-bleed term
+layout(location = 4) out vec4 o_bent;   // the bent normal's sum (vao.glsl's g_bent)
 
 // Adaptive sampling, section 4.1: "double the number of samples every time
 // surface area of the sampling disc doubles", 2 samples for a disk of
@@ -85,6 +86,8 @@ void main()
     vec4 p = imageLoad(u_pos, px);
     o_cull = 0.0;
     o_bleed = vec4(1.0);
+    o_bent = vec4(0.0);
+    g_bent = vec3(0.0);
     if (p.w <= 0.0) {
         o_ao = vec2(1.0, 0.0);
         o_count = 0.0;
@@ -110,4 +113,6 @@ void main()
     vec3 bleed = vec3(1.0);
     o_ao = vec2(ns > 0 ? vao_estimate(px, p, n, ns, u_bleed_step, bleed) : 1.0, p.w);
     o_bleed = vec4(bleed, 1.0);
+    // nothing open or nothing sampled: the normal (C twin: vao_bent in passes_cpu.c)
+    o_bent = vec4(g_bent == vec3(0.0) ? n : g_bent, 0.0);
 }

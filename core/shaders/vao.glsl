@@ -58,6 +58,15 @@ bool border_sample(ivec2 px, vec3 U, vec3 V, vec3 W, float sx, float sy, inout f
     return true;
 }
 
+// OBS_OUTPUT_BENT: the sum of the open pipes' centroids seen from p,
+// written by vao.frag.glsl.  C twin: obs__vao_bent_sample
+// (chain/vao_bent_cpu.c, where the definition is).
+vec3 g_bent;
+void vao_bent_sample(vec3 c, float r, vec2 rot, float sx, float sy, float h, float dz, vec3 p)
+{
+    g_bent += dz * (vec3(disk_point(c, r, rot, sx, sy), c.z + h - 0.5 * dz) - p);
+}
+
 // The AO of the point p (xyz; w: planar depth) with normal n at pixel px
 // from the ns samples of the set at u_samples[ns - 2].  With bleed_step >
 // 0, bleed gets the colour-bleed term of section 4.7: the mean over every
@@ -132,6 +141,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
         if (seen) {
             open += dz;
             F += R * l;         // eq 2: F = R * sum sqrt(1 - x^2 - y^2)
+            vao_bent_sample(c, r, rot, sx, sy, h, dz, p.xyz); // OBS_OUTPUT_BENT
         }
     }
     bleed = taken > 0.0 ? acc / taken : vec3(1.0);

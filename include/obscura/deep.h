@@ -154,6 +154,44 @@ obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
 obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
                         obs_deep_result *out, char err[OBS_ERR_LEN]);
 
+/* ---- deep AO out (obscura ao --output deep) ------------------------------ */
+
+/* The values of one node of a deep AO, in this order. */
+enum { OBS_DEEP_AO_Z, OBS_DEEP_AO_ZBACK, OBS_DEEP_AO_A, OBS_DEEP_AO_AO, OBS_DEEP_AO_CH };
+
+/* The AO of every node the list compression kept (OITAO III-B), as a deep
+ * image: pixel i holds the nodes offset[i] .. offset[i + 1] - 1 front to
+ * back, each OBS_DEEP_AO_CH floats: the node's Z and ZBack as the input
+ * has them, its alpha, and its AO (1 = open, not premultiplied).
+ * Flattened front to back, sum of T_k A_k AO_k plus the T left (open),
+ * it is obs_deep_result's ao_blend before the blur. */
+typedef struct obs_deep_ao {
+    int width, height;                 /* the input's data window */
+    int display_x, display_y, display_width, display_height;
+    uint64_t *offset;                  /* width * height + 1 entries */
+    float *node;                       /* offset[width * height] nodes */
+    obs_camera camera;                 /* the input's */
+} obs_deep_ao;
+
+/* The per-node AO of the deep image on the CPU (the twin of obs_deep_run's
+ * per-node pass, core/deep/deep_nodes.c), the parameters as
+ * obs_deep_run_cpu takes them.  Caller frees with obs_deep_ao_free(). */
+obs_status obs_deep_ao_nodes(const obs_deep_image *d, const obs_params *params, obs_deep_ao *out,
+                             char err[OBS_ERR_LEN]);
+void obs_deep_ao_free(obs_deep_ao *a);
+
+/* Writes the deep AO as a two-part EXR through OpenEXR's C++ deep API
+ * (core/io/exr_deep_ao_write.cpp): part "deep", deep scanline (ZIPS,
+ * float), channels A, AO.Y (premultiplied by A, as deep colour is in
+ * OpenEXR: Nuke's DeepRead, DeepToImage and oiiotool --flatten give the
+ * AO over black with alpha), Z and ZBack; part "flat", scanline (ZIP,
+ * float), AO.Y (the flat AO: `flat`, e.g. ao_blend) and AOFront.Y (the
+ * front node's, `front`); either image may be NULL.  Both parts carry
+ * the windows, the camera as worldToCamera/worldToNDC and
+ * obscura/version. */
+obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao *a, const obs_image *flat,
+                                 const obs_image *front, char err[OBS_ERR_LEN]);
+
 #ifdef __cplusplus
 }
 #endif

@@ -177,8 +177,9 @@ int obs_deep_depth_range(const struct obs_deep_image *d, obs_depth_range *r);
 /* After a run: the AO of `gb` or `deep` (one may be NULL; the AO
  * image has its size, its background is AO 1) with no pixel occluded,
  * or a mean AO over the geometry above 0.99, is a warning that names the
- * radius, the depth range and the radius to start from.  Appends it to
- * info->warnings; returns 1 when it did, else 0. */
+ * radius, the depth range and the radius to start from; multibounce on
+ * with no colour plane (or deep input) is a warning too (ao may then be
+ * NULL).  Appends them to info->warnings; returns how many. */
 int obs_result_sanity(const obs_image *ao, const obs_gbuffer *gb,
                       const struct obs_deep_image *deep, const obs_params *params,
                       obs_exr_info *info);
@@ -241,9 +242,9 @@ typedef struct obs_exr_layer {
  * AO.Y; R,G,B,A (composite); Samples.Y (sample count); Cull.Y (culling
  * mask); Bleed.R,G,B; Luminance.Y; AOScreen.Y and AOBaked.Y (after
  * obs_result_combine_baked: the chain's AO and the baked channel; AO.Y
- * is then their combination).  Fills `layers` with the images the result
+ * is then their combination); AOMultiBounce.R,G,B; BentNormal.X,Y,Z.  Fills `layers` with the images the result
  * holds; returns how many. */
-#define OBS_RESULT_LAYERS 8
+#define OBS_RESULT_LAYERS 10
 int obs_result_exr_layers(const obs_result *r, obs_exr_layer layers[OBS_RESULT_LAYERS]);
 
 /* Writes a scanline EXR (ZIP compression) holding every layer's channels;

@@ -204,10 +204,23 @@ enum {
     OBS_OUTPUT_BLEED = 16,       /* RGB: the colour-bleed term (VAO++ 4.7),
                                     (1,1,1) where there is none or bleeding
                                     is off */
-    OBS_OUTPUT_LUMINANCE = 32    /* debug: one channel, the luminance-
+    OBS_OUTPUT_LUMINANCE = 32,   /* debug: one channel, the luminance-
                                     sensitivity factor of VAO++ eq 3 (4.3):
                                     1 keeps the pixel's occlusion, 0 removes
                                     it; 1 everywhere when it is off */
+    OBS_OUTPUT_MULTIBOUNCE = 64, /* RGB: the AO through the multi-bounce fit
+                                    of the colour plane's albedo (parameter
+                                    multibounce); not filled without a
+                                    colour plane */
+    OBS_OUTPUT_DEEP = 128,       /* deep input only, a request option of
+                                    obscura ao: the AO of every kept node as
+                                    a deep EXR (obs_deep_ao_nodes, deep.h);
+                                    obs_run ignores it */
+    OBS_OUTPUT_BENT = 512        /* RGB: the bent normal (the mean unoccluded
+                                    direction, cosine-weighted) in the
+                                    normals' space, unit length, 0 on the
+                                    background; methods with one (gtao);
+                                    others leave it out */
 };
 
 typedef struct obs_result {
@@ -217,6 +230,11 @@ typedef struct obs_result {
     obs_image cull_mask;    /* filled when OBS_OUTPUT_CULL_MASK was asked */
     obs_image bleed;        /* filled when OBS_OUTPUT_BLEED was asked */
     obs_image luminance;    /* filled when OBS_OUTPUT_LUMINANCE was asked */
+    obs_image bent;         /* RGB; filled when OBS_OUTPUT_BENT was asked and
+                               the method has one */
+    obs_image multibounce;  /* RGB; filled when OBS_OUTPUT_MULTIBOUNCE was asked,
+                               or multibounce is on with the AO, and the
+                               G-buffer has a colour plane */
     /* After obs_result_combine_baked: the chain's own AO (ao is then the
      * combination) and the baked channel it was combined with. */
     obs_image ao_screen, ao_baked;

@@ -184,7 +184,8 @@ typedef enum obs_baked_combine {
     X(deep_mode, OBS_DEEP_MODE_LIST)                                           \
     X(deep_front_half, OBS_SWITCH_LIST)                                        \
     X(deep_hull, OBS_DEEP_HULL_LIST)                                           \
-    X(baked_combine, OBS_BAKED_COMBINE_LIST)
+    X(baked_combine, OBS_BAKED_COMBINE_LIST)                                   \
+    X(multibounce, OBS_SWITCH_LIST)
 
 /* X(name, type, default, min, max, choices, doc)
  * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4.
@@ -402,7 +403,15 @@ typedef enum obs_baked_combine {
       "(obscura bake's _AO, rasterised by obscura gbuffer) is combined with "  \
       "the chain's AO: product (two visibility factors of separate scales, "   \
       "the baked distant obscurance times the screen-space detail) or min "    \
-      "(the darker of the two: an occluder both see darkens once)")
+      "(the darker of the two: an occluder both see darkens once)")           \
+    X(multibounce, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),             \
+      "multi-bounce AO (Jimenez et al. 2016, the cubic fit): the AO's albedo-driven "  \
+      "cubic fit of the light that bounces back into the occluded cone, "      \
+      "max(A, ((a A + b) A + c) A), a, b, c linear in the albedo, per "        \
+      "channel of the colour plane (name the albedo with --color albedo); "    \
+      "on: the composite takes it and the AOMultiBounce.R,G,B layer is "       \
+      "written beside the AO; a warning and the plain AO without a colour "    \
+      "plane")
 
 #define OBS__PDECL_FLOAT(n) float n;
 #define OBS__PDECL_INT(n) int n;

@@ -54,7 +54,7 @@ for cmd in ao batch compare inspect bake bake-dynamic gbuffer warmup; do
     check "obscura $cmd --help: exit $rc (0), its usage on stdout" "[ $rc -eq 0 ] && grep -q 'obscura $cmd' '$T/out'"
 done
 "$OBSCURA" help >"$T/out"
-check "help: the --output line whole (...|bleed|luminance)" "grep -q -- '--output ao|composite|both|samples|cull|bleed|luminance\$' '$T/out'"
+check "help: the --output line whole (...|aovs|deep)" "grep -q -- '--output ao|composite|both|samples|cull|bleed|luminance|multibounce|bent|aovs|deep\$' '$T/out'"
 "$OBSCURA" ao "$R" -o "$T/x.exr" --radiu 0.4 2>"$T/err"
 rc=$?
 check "--radiu: exit $rc (2), did you mean --radius?" "[ $rc -eq 2 ] && grep -q \"error: unknown option '--radiu'; did you mean --radius?\" '$T/err'"

@@ -189,11 +189,11 @@ static void test_option_from(void **state)
     assert_int_equal(r.outputs, OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE);
     assert_int_equal(obs_http_option_set(&r, out, "ao,depth", OBS_HTTP_CLI, err), OBS_INVALID_ARGUMENT);
     assert_string_equal(err, "parameter output: 'depth' is not one of "
-                             "ao|composite|both|samples|cull|bleed|luminance");
+                             "ao|composite|both|samples|cull|bleed|luminance|multibounce|bent|aovs|deep");
     assert_int_equal(obs_http_option_set(&r, out, ",", OBS_HTTP_CLI, err), OBS_INVALID_ARGUMENT);
     assert_int_equal(r.outputs, OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE); /* unchanged */
     assert_int_equal(obs_http_request_set(&r, "output", "samples", err), OBS_INVALID_ARGUMENT);
-    assert_string_equal(err, "parameter output: 'samples' is not one of ao|composite|both");
+    assert_string_equal(err, "parameter output: 'samples' is not one of ao|composite|both|multibounce|bent|aovs");
     assert_int_equal(obs_http_request_set(&r, "output", "ao,composite", err), OBS_INVALID_ARGUMENT);
     /* a refused list of names leaves the earlier one */
     assert_int_equal(obs_http_request_set(&r, "normal", "A,B,C", err), OBS_OK);
@@ -259,7 +259,7 @@ static void test_json(void **state)
     /* the options as the table's rows say: type, choices of a query */
     static const struct {
         const char *name, *type, *choices;
-    } want[] = {{"output", "enum", "ao|composite|both"}, {"format", "enum", "exr|png"},
+    } want[] = {{"output", "enum", "ao|composite|both|multibounce|bent|aovs"}, {"format", "enum", "exr|png"},
                 {"float", "bool", "0|1"},
                 {"compression", "enum", "auto|none|rle|zips|zip|piz|dwaa"},
                 {"png_bits", "enum", "8|16"},

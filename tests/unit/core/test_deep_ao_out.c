@@ -1,0 +1,98 @@
+/* The deep AO out (obs_deep_ao_nodes, obs_deep_ao_write_exr; obscura ao
+ * --output deep) on the deep fixture: every kept node's AO in [0, 1],
+ * its flattening front to back by the nodes' alpha equal to
+ * obs_deep_run_cpu's flat AO (blur off), and the file read back through
+ * OpenEXR's C API (obs_deep_read_exr: the deep part's counts, Z, ZBack
+ * and A; obs_exr_read_channel: the flat part's AOFront.Y). */
+#include "testutil.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <unistd.h>
+
+#include "obscura/deep.h"
+
+#define FIXTURE TESTDATA "/deep_small.exr"
+
+static void params(obs_params *p)
+{
+    char err[OBS_ERR_LEN] = "";
+    memset(p, 0, sizeof *p);
+    assert_int_equal(obs_param_set(p, "blur", "off", err), OBS_OK);
+    assert_int_equal(obs_param_set(p, "radius", "2", err), OBS_OK);
+}
+
+static void test_nodes_flatten_to_flat_ao(void **state)
+{
+    obs_deep_image d;
+    obs_deep_ao a;
+    obs_deep_result r;
+    obs_params p;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    params(&p);
+    if (obs_deep_read_exr(FIXTURE, NULL, &d, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_int_equal(obs_deep_ao_nodes(&d, &p, &a, err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(&d, &p, &r, err), OBS_OK);
+    size_t npx = (size_t)d.width * d.height, occluded = 0;
+    double worst = 0.0;
+    for (size_t i = 0; i < npx; i++) {
+        float T = 1.0f, acc = 0.0f, zprev = -INFINITY;
+        assert_true(a.offset[i + 1] - a.offset[i] <= 4); /* deep_layers 4 */
+        for (uint64_t s = a.offset[i]; s < a.offset[i + 1]; s++) {
+            const float *v = a.node + s * OBS_DEEP_AO_CH;
+            assert_true(v[OBS_DEEP_AO_AO] >= 0.0f && v[OBS_DEEP_AO_AO] <= 1.0f);
+            assert_true(v[OBS_DEEP_AO_Z] >= zprev); /* front to back */
+            zprev = v[OBS_DEEP_AO_Z];
+            occluded += v[OBS_DEEP_AO_AO] < 0.9f;
+            acc += T * v[OBS_DEEP_AO_A] * v[OBS_DEEP_AO_AO];
+            T *= 1.0f - v[OBS_DEEP_AO_A];
+        }
+        if (a.offset[i + 1] > a.offset[i])
+            assert_true(a.node[a.offset[i] * OBS_DEEP_AO_CH + OBS_DEEP_AO_AO] == r.ao_front.data[i]);
+        worst = fmax(worst, fabs(acc + T - r.ao_blend.data[i]));
+    }
+    print_message("deep_small: %llu nodes, %zu with AO < 0.9; worst |flattened - flat AO| %.2e\n",
+                  (unsigned long long)a.offset[npx], occluded, worst);
+    assert_true(occluded > 50);
+    assert_true(worst < 1e-6);
+
+    /* written and read back */
+    char path[] = "/tmp/obs_deep_ao_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    if (obs_deep_ao_write_exr(path, &a, &r.ao_blend, &r.ao_front, err) != OBS_OK)
+        fail_msg("%s", err);
+    obs_deep_image back;
+    if (obs_deep_read_exr(path, NULL, &back, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_int_equal(back.width, d.width);
+    assert_true(back.has_zback && back.has_alpha && !back.has_color);
+    assert_true(back.camera.has_projection);
+    for (size_t i = 0; i <= npx; i++)
+        assert_true(back.offset[i] == a.offset[i]);
+    for (uint64_t s = 0; s < a.offset[npx]; s++) {
+        assert_true(back.samples[s * OBS_DEEP_CH + OBS_DEEP_Z] == a.node[s * OBS_DEEP_AO_CH + OBS_DEEP_AO_Z]);
+        assert_true(back.samples[s * OBS_DEEP_CH + OBS_DEEP_A] == a.node[s * OBS_DEEP_AO_CH + OBS_DEEP_AO_A]);
+    }
+    obs_image front;
+    if (obs_exr_read_channel(path, "AOFront.Y", NULL, &front, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_memory_equal(front.data, r.ao_front.data, npx * sizeof(float));
+    obs_image_free(&front);
+    obs_deep_free(&back);
+    unlink(path);
+    obs_deep_ao_free(&a);
+    obs_deep_result_free(&r);
+    obs_deep_free(&d);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_nodes_flatten_to_flat_ao),
+    };
+    return cmocka_run_group_tests_name("deep AO out", tests, NULL, NULL);
+}
