@@ -240,13 +240,13 @@ static exr_result_t write_pixels(exr_context_t ctx, int part, const obs__wpart *
     if (lines < 1)
         return EXR_ERR_INVALID_ARGUMENT;
     int64_t chunks = ((int64_t)p->dw.max.y - p->dw.min.y + lines) / lines;
-    enc_job j = {.ctx = ctx, .part = part, .p = p, .failed = chunks, .rv = EXR_ERR_SUCCESS};
-    j.ci = calloc((size_t)chunks, sizeof *j.ci);
+    exr_chunk_info_t *ci = calloc((size_t)chunks, sizeof *ci);
+    enc_job j = {.ctx = ctx, .part = part, .p = p, .ci = ci, .failed = chunks, .rv = EXR_ERR_SUCCESS};
     j.slot = calloc((size_t)chunks, sizeof *j.slot);
-    if (!j.ci || !j.slot)
+    if (!ci || !j.slot)
         rv = EXR_ERR_OUT_OF_MEMORY;
     for (int64_t c = 0; c < chunks && rv == EXR_ERR_SUCCESS; c++)
-        rv = exr_write_scanline_chunk_info(ctx, part, (int)(p->dw.min.y + c * lines), (exr_chunk_info_t *)&j.ci[c]);
+        rv = exr_write_scanline_chunk_info(ctx, part, (int)(p->dw.min.y + c * lines), &ci[c]);
     if (rv == EXR_ERR_SUCCESS) {
         obs__pool_for f = {.end = (size_t)chunks, .chunk = 1, .threads = encode_threads(threads, chunks),
                            .range = enc_one, .ctx = &j, .local_size = sizeof(enc_local),
@@ -261,7 +261,7 @@ static exr_result_t write_pixels(exr_context_t ctx, int part, const obs__wpart *
     for (int64_t c = 0; j.slot && c < chunks; c++)
         free(j.slot[c].data);
     free(j.slot);
-    free((void *)j.ci);
+    free(ci);
     return rv;
 }
 
