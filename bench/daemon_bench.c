@@ -435,8 +435,8 @@ static void metrics_means(const char *url)
     buf[got] = '\0';
     static const char *const stages[] = {"receive", "decode", "queue", "gl", "encode", "send", "total"};
     printf("\nDaemon's stages of the 1080p frames above (GET /metrics obscurad_stage_seconds: mean ms over "
-           "every protocol, warm-ups included; receive and send: HTTP only; total: HTTP's, the request's "
-           "headers to its answer queued):\n\n|");
+           "every protocol, warm-ups included; receive and send: HTTP only; total: a request's arrival to its "
+           "answer queued, every protocol):\n\n|");
     for (int s = 0; s < 7; s++)
         printf(" %s |", stages[s]);
     printf("\n|");
