@@ -42,6 +42,7 @@ start_daemon() {
     shift
     SOCK="$T/obscurad.sock"
     rm -f "$SOCK"
+    : >"$log" # before the daemon's shell opens it: the loop below reads it at once
     "$BUILD/obscurad" --http 127.0.0.1:0 --socket "$SOCK" --tcp 127.0.0.1:0 --queue 16 "$@" 2>"$log" &
     PID=$!
     i=0 HP="" TP=""
