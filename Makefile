@@ -99,7 +99,7 @@ DAEMON_BENCH := $(BUILD)/daemon_bench
 -include protocol/protocol.mk daemon/daemon.mk clients/clients.mk tests/fuzz/fuzz.mk
 E2E_DEPS += $(UPSCALE)
 
-.PHONY: all deps demo demo-run test test-long check unit e2e loops headers readme readme-check samples bench quality bake-quality clean deep-fixture
+.PHONY: all deps demo demo-run test test-long check unit e2e loops headers readme readme-check samples bench quality quality-deep bake-quality clean deep-fixture
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI) $(EXTRA_BINS)
@@ -273,6 +273,12 @@ bench: deps
 quality: deps
 	@$(MAKE) --no-print-directory all $(QSTRIP)
 	@BUILD=$(BUILD) bench/quality.sh
+
+# The multi-layer chain on rasterised deep G-buffers against Cycles, beside
+# the flat chain (bench/QUALITY.md, "Deep input against Cycles").
+quality-deep: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bench/deep_quality.sh
 
 # The baked vertices against the per-pixel obscurance reference
 # (bench/BAKE.md, "Against a per-pixel reference"): the levels of

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """The error against Cycles split by where it is: per scene and per method,
 the MSE of four bands of pixels, each band's share of the pixels and of the
-total squared error, EEVEE's beside.
+total squared error, EEVEE's beside; and each band's bias (mean signed
+error), which tells a halo (too dark) from missed occlusion (too light).
 
   bench/error_split.py OUTDIR [METHOD...]
 
@@ -166,15 +167,20 @@ NAMES = ['halo', 'border', 'crease', 'open']
 
 
 def split(truth, cand, band):
-    """Per band: (pixel share, MSE, share of the squared error); and the MSE."""
-    e = (np.clip(cand, 0, 1) - np.clip(truth, 0, 1)) ** 2
+    """Per band: (pixel share, MSE, share of the squared error, bias); and
+    the MSE.  The bias is the band's mean signed error, candidate minus
+    truth: > 0 too light (occlusion missed), < 0 too dark (a halo)."""
+    d = np.clip(cand, 0, 1) - np.clip(truth, 0, 1)
+    e = d ** 2
     m = band >= 0
     total = e[m].sum()
     rows = []
     for k in range(4):
         b = band == k
         n = b.sum()
-        rows.append((n / m.sum(), e[b].mean() if n else float('nan'), e[b].sum() / total))
+        nan = float('nan')
+        rows.append((n / m.sum(), e[b].mean() if n else nan, e[b].sum() / total,
+                     d[b].mean() if n else nan))
     return rows, total / m.sum()
 
 
@@ -224,7 +230,7 @@ def main():
             rows, mse = res[n, m]
             ev = res.get((n, 'EEVEE'))
             cells = []
-            for k, (_, bm, sh) in enumerate(rows):
+            for k, (_, bm, sh, _) in enumerate(rows):
                 if bm != bm:
                     cells.append('-')
                     continue
@@ -235,6 +241,20 @@ def main():
             top = max(range(4), key=lambda k: rows[k][2])
             print('| %s | %.5f | %s | %s |' % (n, mse, ' | '.join(cells), NAMES[top]))
         print()
+    # the sign of each band's error: a halo (too dark) and missed
+    # occlusion (too light) both raise a band's MSE, and a change that
+    # removes one adds to the other
+    print('#### Bias by band\n')
+    print('Each band\'s mean signed error against Cycles (candidate minus truth):'
+          ' > 0 too light, < 0 too dark.\n')
+    print('| scene | method | ' + ' | '.join(NAMES) + ' |')
+    print('|---|---|' + '---|' * 4)
+    for n in shares:
+        for m in ['EEVEE'] + list(methods):
+            if (n, m) in res:
+                print('| %s | %s | %s |' % (n, m, ' | '.join(
+                    '-' if r[3] != r[3] else '%+.3f' % r[3] for r in res[n, m][0])))
+    print()
 
 
 main()

@@ -736,14 +736,24 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     if (verbosity >= OBS_LOG_INFO) {
         obs_params p;
         obs_params_resolve(&a->req.params, &p);
+        char kernel[64]; /* the method's samples */
+        if (p.method == OBS_METHOD_GTAO)
+            snprintf(kernel, sizeof kernel, "gtao %d slices x %d steps", p.gtao_slices,
+                     p.gtao_steps);
+        else if (p.method == OBS_METHOD_HBAO)
+            snprintf(kernel, sizeof kernel, "hbao %d directions x %d steps", p.hbao_directions,
+                     p.hbao_steps);
+        else if (p.method == OBS_METHOD_HEMISPHERE)
+            snprintf(kernel, sizeof kernel, "%d hemisphere samples", p.hemisphere_samples);
+        else
+            snprintf(kernel, sizeof kernel, "%d samples%s", p.samples,
+                     p.deep_intervals == OBS_ON && d.has_facing ? ", intervals" : "");
         fprintf(stderr, "obscura: info: deep %dx%d, %llu samples, %s, %d nodes%s, %s hulls, "
-                "radius %g, %d %ssamples: read %.1f ms, AO %.1f ms\n",
+                "radius %g, %s: read %.1f ms, AO %.1f ms\n",
                 d.width, d.height, (unsigned long long)d.offset[(size_t)d.width * d.height],
                 p.deep_mode == OBS_DEEP_SINGLE ? "single-layer" : "multi-layer", p.deep_layers,
                 p.deep_front_half == OBS_ON ? " (front half kept)" : "",
-                p.deep_hull == OBS_DEEP_THIN ? "thin" : "solid", p.radius,
-                p.method == OBS_METHOD_HEMISPHERE ? p.hemisphere_samples : p.samples,
-                p.method == OBS_METHOD_HEMISPHERE ? "hemisphere " : "", t_read, t_run);
+                p.deep_hull == OBS_DEEP_THIN ? "thin" : "solid", p.radius, kernel, t_read, t_run);
     }
 done:
     obs_deep_result_free(&r);

@@ -17,7 +17,8 @@
 #define RAW_HEADER_LEN 160  /* width .. projection, see PROTOCOL.md */
 #define DEEP_HEADER_LEN 176 /* width .. projection of a deep G-buffer */
 #define DEEP_FLAGS (OBS_BIN_DEEP_ZBACK | OBS_BIN_DEEP_ALPHA | OBS_BIN_HAS_WORLD_TO_CAMERA | \
-                    OBS_BIN_HAS_PROJECTION | OBS_BIN_DEEP_COLOR | OBS_BIN_DEEP_NORMAL)
+                    OBS_BIN_HAS_PROJECTION | OBS_BIN_DEEP_COLOR | OBS_BIN_DEEP_NORMAL | \
+                    OBS_BIN_DEEP_FACING)
 
 /* The message into err (when set), and s.  This file's own: the protocol
  * is built against the public headers, not core's internal ones. */
@@ -258,7 +259,8 @@ static void write_deep(writer *w, const obs_deep_image *d)
     uint32_t flags = (d->has_zback ? OBS_BIN_DEEP_ZBACK : 0) | (d->has_alpha ? OBS_BIN_DEEP_ALPHA : 0) |
                      (cam->has_world_to_camera ? OBS_BIN_HAS_WORLD_TO_CAMERA : 0) |
                      (cam->has_projection ? OBS_BIN_HAS_PROJECTION : 0) |
-                     (d->has_color ? OBS_BIN_DEEP_COLOR : 0) | (d->has_normal ? OBS_BIN_DEEP_NORMAL : 0);
+                     (d->has_color ? OBS_BIN_DEEP_COLOR : 0) | (d->has_normal ? OBS_BIN_DEEP_NORMAL : 0) |
+                     (d->has_facing ? OBS_BIN_DEEP_FACING : 0);
     put_u32(w, (uint32_t)d->width);
     put_u32(w, (uint32_t)d->height);
     put_u32(w, (uint32_t)d->display_x);
@@ -584,9 +586,13 @@ static obs_status get_deep_fields(reader *r, const obs_limits *lim, deep_fields 
     get_u64(r, &f->total);
     if (f->flags & ~(uint32_t)DEEP_FLAGS)
         return fail(err, OBS_BAD_FILE, "deep G-buffer: unknown flags 0x%x", f->flags);
-    if (f->values != OBS_DEEP_CH)
+    if (f->values != OBS_DEEP_CH && f->values != OBS_DEEP_CH - 1)
         return fail(err, OBS_BAD_FILE, "deep G-buffer: %u values per sample; the layout has %d "
-                    "(Z, ZBack, R, G, B, A, N.X, N.Y, N.Z)", f->values, OBS_DEEP_CH);
+                    "(Z, ZBack, R, G, B, A, N.X, N.Y, N.Z, Facing) or %d (without Facing)",
+                    f->values, OBS_DEEP_CH, OBS_DEEP_CH - 1);
+    if (f->values != OBS_DEEP_CH && (f->flags & OBS_BIN_DEEP_FACING))
+        return fail(err, OBS_BAD_FILE, "deep G-buffer: flag 64 (facing written) with %u values "
+                    "per sample, which have no Facing", f->values);
     if (f->type != OBS_BIN_F32 || f->reserved != 0)
         return fail(err, OBS_BAD_FILE, "deep G-buffer: sample type %u (only float32, 0) or reserved "
                     "field %u (0)", f->type, f->reserved);
@@ -602,7 +608,7 @@ static obs_status get_deep_fields(reader *r, const obs_limits *lim, deep_fields 
     /* width x height within the limits, total < 2^25: no overflow below */
     size_t full = r->full > r->n ? r->full : r->n, rest = full - r->off - 128;
     f->npx = (uint64_t)f->width * f->height;
-    f->sample_bytes = f->total * OBS_DEEP_CH * sizeof(float);
+    f->sample_bytes = f->total * f->values * sizeof(float);
     if (f->npx * 4 + f->sample_bytes != rest)
         return fail(err, OBS_BAD_FILE, "deep G-buffer: %u x %u counts and %llu samples need %llu bytes, "
                     "the frame holds %zu", f->width, f->height, (unsigned long long)f->total,
@@ -644,7 +650,15 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
         d->offset[i + 1] = d->offset[i] + ((uint32_t)cp[4 * i] | (uint32_t)cp[4 * i + 1] << 8 |
                                            (uint32_t)cp[4 * i + 2] << 16 | (uint32_t)cp[4 * i + 3] << 24);
     r->off += (size_t)npx * 4;
-    if (total && ((uintptr_t)(r->p + r->off) & 3u) != 0) {
+    if (total && f.values != OBS_DEEP_CH) {
+        /* the layout without Facing: widened, facing 0 (not known) */
+        if (!(q->gf.storage = calloc((size_t)total, OBS_DEEP_CH * sizeof(float))))
+            return fail(err, OBS_NO_MEMORY, "no memory for %llu deep samples", (unsigned long long)total);
+        for (uint64_t k = 0; k < total; k++)
+            memcpy(q->gf.storage + k * OBS_DEEP_CH, r->p + r->off + k * f.values * sizeof(float),
+                   f.values * sizeof(float));
+        d->samples = q->gf.storage;
+    } else if (total && ((uintptr_t)(r->p + r->off) & 3u) != 0) {
         if (!(q->gf.storage = malloc((size_t)sample_bytes)))
             return fail(err, OBS_NO_MEMORY, "no memory for %llu deep samples", (unsigned long long)total);
         memcpy(q->gf.storage, r->p + r->off, (size_t)sample_bytes);
@@ -672,6 +686,7 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
     d->has_alpha = !!(flags & OBS_BIN_DEEP_ALPHA);
     d->has_color = !!(flags & OBS_BIN_DEEP_COLOR);
     d->has_normal = !!(flags & OBS_BIN_DEEP_NORMAL);
+    d->has_facing = !!(flags & OBS_BIN_DEEP_FACING);
     obs_camera_from_request(cam, flags & OBS_BIN_HAS_WORLD_TO_CAMERA, flags & OBS_BIN_HAS_PROJECTION);
     return OBS_OK;
 }

@@ -66,7 +66,8 @@ enum {
     OBS_BIN_DEEP_ZBACK = 1,
     OBS_BIN_DEEP_ALPHA = 2,
     OBS_BIN_DEEP_COLOR = 16,
-    OBS_BIN_DEEP_NORMAL = 32
+    OBS_BIN_DEEP_NORMAL = 32,
+    OBS_BIN_DEEP_FACING = 64
 };
 
 /* The `output` of a raw response image that holds the front node's AO of
@@ -132,7 +133,8 @@ obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out,
  * float16 planes are converted into gf.storage; with
  * EXR, exr/exr_len point into the payload; with DEEP, deep.offset is
  * owned and deep.samples points into the payload when it is 4-byte
- * aligned (else into gf.storage, a copy).  The deep image is read-only
+ * aligned (else into gf.storage, a copy; samples of 9 values, without
+ * Facing, are widened into gf.storage).  The deep image is read-only
  * (never pass it to obs_deep_free).  Either way the payload must outlive
  * the request.  Free with obs_bin_request_free(). */
 typedef struct obs_bin_request {

@@ -8,21 +8,33 @@
  * the array only, preserving the front nodes (section V-A, Fig. 6 column
  * C).
  *
- * z in eq 5 is a normalised depth: the paper's array "is initialized with
- * depth values of 1", the far end of a [0, 1] depth buffer.  A deep EXR
- * has no near and far planes, so z here is the planar depth normalised
- * over the image's own range, z = (Z - zmin) / (zmax - zmin) with zmin,
- * zmax the nearest and farthest sample: 0 at the nearest fragment of the
- * image, 1 at the farthest (linear in depth, where a perspective depth
- * buffer would crowd distant fragments towards 1). */
+ * z in eq 5 is a normalised depth, and the paper says over what: its
+ * array "is initialized with depth values of 1" (III-B), the far end of
+ * the camera's [0, 1] depth range, the far clip plane, and eq 5 prefers
+ * "fragments with low depth ... opposed to those resident in greater
+ * distance", fragments close to the camera; the depth it stores is
+ * linear (III-A: "it is usually enough to store solely the linear depth
+ * value of the fragment").  So z is the planar depth normalised over the
+ * view frustum, z = (Z - near) / (far - near) with the camera's clip
+ * range, not over the image's own depths nor the pixel's own list: over
+ * those the farthest fragment (the image's, or each pixel's) would score
+ * a (1 - z) = 0 and go first whatever its opacity, where the paper drops
+ * it only for being transparent or distant.  The clip range is that of
+ * the camera's projection (perspective or orthographic), as the chain
+ * resolves it (a deep EXR without clip attributes: 0.1 .. 1000, the
+ * reader's default; parameters near and far with a field of view); a
+ * camera without a projection falls back to the default clip range of
+ * those parameters. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "obscura/deep.h"
+#include "deep/deep_internal.h"
 #include "internal.h"
 
-/* Normalised depth of eq 5 (see above); 0 for a degenerate range. */
+/* Normalised depth of eq 5 (see above), clamped to [0, 1]; 0 for a
+ * degenerate range. */
 static float norm_z(float z, float zmin, float zmax)
 {
     if (!(zmax > zmin) || !isfinite(z))
@@ -83,11 +95,36 @@ void obs_deep_layers_free(obs_deep_layers *l)
     memset(l, 0, sizeof *l);
 }
 
+void obs__deep_clip_range(const obs_camera *cam, float *near_z, float *far_z)
+{
+    obs_params p;
+    obs_params_resolve(NULL, &p);
+    *near_z = p.near;
+    *far_z = p.far;
+    if (!cam || !cam->has_projection)
+        return;
+    const float *P = cam->projection;
+    double n, f;
+    if (P[14] != 0.0f) { /* perspective: P10 = -(f + n) / (f - n), P11 = -2 f n / (f - n) */
+        n = P[11] / (P[10] - 1.0);
+        f = P[11] / (P[10] + 1.0);
+    } else { /* orthographic: P10 = -2 / (f - n), P11 = -(f + n) / (f - n) */
+        if (P[10] == 0.0f)
+            return;
+        n = (P[11] + 1.0) / P[10];
+        f = (P[11] - 1.0) / P[10];
+    }
+    if (isfinite(n) && isfinite(f) && f > n && n >= 0.0) {
+        *near_z = (float)n;
+        *far_z = (float)f;
+    }
+}
+
 obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs_deep_layers *out,
                              char err[OBS_ERR_LEN])
 {
     size_t npx, bytes;
-    float zmin = INFINITY, zmax = -INFINITY;
+    float zmin, zmax;
 
     memset(out, 0, sizeof *out);
     if (!d || !d->offset || d->width <= 0 || d->height <= 0)
@@ -107,15 +144,7 @@ obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs
         obs_deep_layers_free(out);
         return obs__fail(err, OBS_NO_MEMORY, "deep layers of %dx%dx%d", d->width, d->height, m);
     }
-    for (uint64_t s = 0; s < d->offset[npx]; s++) {
-        float z = d->samples[s * OBS_DEEP_CH + OBS_DEEP_Z];
-        if (z > 0.0f && isfinite(z)) {
-            zmin = z < zmin ? z : zmin;
-            zmax = z > zmax ? z : zmax;
-        }
-    }
-    if (!(zmax >= zmin))
-        zmin = zmax = 0.0f;
+    obs__deep_clip_range(&d->camera, &zmin, &zmax);
     out->width = d->width;
     out->height = d->height;
     out->m = m;

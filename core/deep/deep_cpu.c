@@ -21,6 +21,8 @@
 #include <string.h>
 
 #include "deep/deep_internal.h"
+#include "methods/gtao.h"
+#include "methods/hbao.h"
 #include "methods/hemisphere.h"
 #include "methods/methods.h"
 
@@ -44,6 +46,8 @@ void obs__deep_frame_free(obs__deep_frame *df)
         return;
     free(df->pos);
     free(df->nrm);
+    free(df->end);
+    free(df->nrm3);
     obs_deep_layers_free(&df->layers);
     memset(df, 0, sizeof *df);
 }
@@ -84,17 +88,11 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
                          "methods %s",
                          name, list);
     }
-    s = obs_deep_compress(d, p.deep_layers, p.deep_front_half == OBS_ON, &df->layers, err);
-    if (s != OBS_OK)
-        return s;
     size_t npx = (size_t)d->width * (size_t)d->height;
-    int m = df->layers.m;
     depth = calloc(npx, sizeof *depth);
     in_n = d->has_normal ? calloc(npx * 3, sizeof *in_n) : NULL;
-    df->pos = malloc(npx * (size_t)m * 4 * sizeof *df->pos);
-    df->nrm = malloc(npx * (size_t)m * 4 * sizeof *df->nrm);
-    if (!depth || !df->pos || !df->nrm || (d->has_normal && !in_n)) {
-        s = obs__fail(err, OBS_NO_MEMORY, "deep frame of %dx%dx%d", d->width, d->height, m);
+    if (!depth || (d->has_normal && !in_n)) {
+        s = obs__fail(err, OBS_NO_MEMORY, "deep frame of %dx%d", d->width, d->height);
         goto fail;
     }
     /* The frame (camera, R, samples) as for a flat G-buffer of the front
@@ -117,9 +115,26 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
                       "resolution (use ao_resolution full or a quality other than preview)");
         goto fail;
     }
+    /* eq 5 over the clip range of the camera the frame resolved (the
+     * image's, or the parameters' field of view and near, far) */
+    obs_deep_image dc = *d;
+    memcpy(dc.camera.projection, df->f.proj, sizeof dc.camera.projection);
+    dc.camera.has_projection = 1;
+    if ((s = obs_deep_compress(&dc, p.deep_layers, p.deep_front_half == OBS_ON, &df->layers,
+                               err)) != OBS_OK)
+        goto fail;
+    int m = df->layers.m;
+    df->pos = malloc(npx * (size_t)m * 4 * sizeof *df->pos);
+    df->nrm = malloc(npx * (size_t)m * 4 * sizeof *df->nrm);
+    df->end = calloc(npx * (size_t)m, sizeof *df->end);
+    if (!df->pos || !df->nrm || !df->end) {
+        s = obs__fail(err, OBS_NO_MEMORY, "deep frame of %dx%dx%d", d->width, d->height, m);
+        goto fail;
+    }
     df->m = m;
     df->multi = p.deep_mode != OBS_DEEP_SINGLE;
     df->thin = p.deep_hull == OBS_DEEP_THIN;
+    df->intervals = p.deep_intervals == OBS_ON && d->has_facing && df->multi;
 
     /* The prep pass of every node plane. */
     for (int k = 0; k < m; k++) {
@@ -144,6 +159,28 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
                 nrm[4 * i + 3] = pos[4 * i + 3] > 0.0f ? fminf(fmaxf(nd[OBS_DEEP_A], 0.0f), 1.0f) : 0.0f;
             }
     }
+    /* Method gtao's border steps read the front nodes' normals. */
+    if (df->f.method == OBS_METHOD_GTAO) {
+        if (!(df->nrm3 = malloc(npx * 3 * sizeof *df->nrm3))) {
+            s = obs__fail(err, OBS_NO_MEMORY, "deep frame of %dx%d", d->width, d->height);
+            goto fail;
+        }
+        for (size_t i = 0; i < npx; i++)
+            memcpy(df->nrm3 + 3 * i, df->nrm + 4 * i, 3 * sizeof *df->nrm3);
+    }
+    /* The nodes' extents from their facing flags (deep_intervals). */
+    if (df->intervals)
+        for (size_t i = 0; i < npx; i++) {
+            float z[OBS_DEEP_MAX_LAYERS], fc[OBS_DEEP_MAX_LAYERS], e[OBS_DEEP_MAX_LAYERS];
+            int c = df->layers.count[i];
+            for (int k = 0; k < c; k++) {
+                z[k] = df->pos[((size_t)k * npx + i) * 4 + 3];
+                fc[k] = df->layers.node[((size_t)k * npx + i) * OBS_DEEP_CH + OBS_DEEP_FACING];
+            }
+            obs__deep_intervals(z, fc, c, e);
+            for (int k = 0; k < c; k++)
+                df->end[(size_t)k * npx + i] = e[k];
+        }
     free(depth);
     free(in_n);
     return OBS_OK;
@@ -152,6 +189,48 @@ fail:
     free(in_n);
     obs__deep_frame_free(df);
     return s;
+}
+
+void obs__deep_intervals(const float *z, const float *facing, int count, float *end)
+{
+    int k0 = 0;
+    for (int k = 0; k < count; k++)
+        end[k] = 0.0f;
+    while (k0 < count) {
+        int open = -1, depth = 0; /* the node that opened the interval, the facing count */
+        for (int k = k0; k < count; k++) {
+            if (!(z[k] > 0.0f))
+                continue;
+            if (depth == 0) {
+                if (facing[k] > 0.0f) { /* a front face: the solid starts */
+                    open = k;
+                    depth = 1;
+                }
+                continue; /* else a surface seen from one side: solid behind */
+            }
+            end[k] = -1.0f; /* inside the interval node `open` opened */
+            depth += facing[k] > 0.0f ? 1 : facing[k] < 0.0f ? -1 : 0;
+            if (depth == 0)
+                end[open] = fmaxf(z[k], z[open]); /* its matching back face */
+        }
+        if (depth == 0)
+            return;
+        /* node `open` has no back face in the list: a surface seen from one
+         * side, solid behind it as without intervals; the nodes behind it
+         * are scanned again on their own */
+        for (int k = open; k < count; k++)
+            end[k] = 0.0f;
+        k0 = open + 1;
+    }
+}
+
+/* GLSL: interval_occlusion() in deep.frag.glsl.  The length of the pipe
+ * [front, front + 2h] inside the solid interval [zs, e] of a node whose
+ * back face the list holds: their overlap, no range check (the buffer
+ * shows where the solid ends). */
+static float interval_occlusion(float zs, float e, float front, float h)
+{
+    return fmaxf(0.0f, fminf(e, front + 2.0f * h) - fmaxf(zs, front));
 }
 
 /* GLSL: node_occlusion() in deep.frag.glsl.  The length of the pipe
@@ -205,15 +284,24 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         if (!obs__disk_px(f, &disk, sx, sy, &qx, &qy))
             continue; /* off the planes: left out of eq 1's sum and F */
         size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
-        float front = -c[2] - h, occ = 0.0f;
+        float front = -c[2] - h, occ = 0.0f, solid = 0.0f;
         for (int k = 0; k < layers; k++) {
             const float *pk = df->pos + ((size_t)k * npx + q) * 4;
             const float *nk = df->nrm + ((size_t)k * npx + q) * 4; /* normal, alpha */
+            const float e = df->end[(size_t)k * npx + q];
             float zs = pk[3];
+            if (e < 0.0f)
+                continue; /* inside a nearer node's interval */
             if (k == self && qx == x && qy == y)
                 zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy, zs);
-            occ = fmaxf(occ, nk[3] * node_occlusion(f, zs, nk[2], front, h, interior));
+            if (e > 0.0f && zs > 0.0f && !interior) /* a closed interval */
+                solid += nk[3] * interval_occlusion(zs, e, front, h);
+            else
+                occ = fmaxf(occ, nk[3] * node_occlusion(f, zs, nk[2], front, h, interior));
         }
+        /* the intervals are disjoint: their lengths add; the nodes solid
+         * behind them count as Algorithm 1's largest */
+        occ = fminf(2.0f * h, occ + solid);
         open += 2.0f * h - occ;
         F += R * l; /* VAO++ eq 2 */
     }
@@ -246,14 +334,20 @@ static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float 
     return obs__hemisphere_estimate(f, &nodes, x, y, p, n);
 }
 
-/* The per-sample estimator of the frame's method: VAO++'s line samples or
- * method hemisphere's point samples, each against every node (Algorithm
- * 1). */
+/* The per-sample estimator of the frame's method: VAO++'s line samples,
+ * method hemisphere's point samples or methods gtao's and hbao's horizon
+ * steps, each against every node (Algorithm 1; for the horizon methods
+ * every node at a step's pixel, OITAO's multi-layer HBAO, Fig. 9). */
 static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3], const float n[3],
                        int interior, int self)
 {
     if (df->f.method == OBS_METHOD_HEMISPHERE)
         return hemisphere_ao(df, x, y, p, n, interior);
+    if (df->f.method == OBS_METHOD_GTAO) /* the horizon over every node */
+        return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, x, y, p,
+                                     n, NULL, NULL);
+    if (df->f.method == OBS_METHOD_HBAO)
+        return obs__hbao_pixel_nodes(&df->f, df->pos, df->multi ? df->m : 1, x, y, p, n, NULL);
     float v = sphere_ao(df, x, y, p, n, interior, self);
     return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */
 }

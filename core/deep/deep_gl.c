@@ -1,8 +1,9 @@
 /* obs_deep_run: the multi-layer AO of deep input on the GL context.  The
  * compressed nodes (OITAO III-B) are prepared as for the CPU twin
- * (deep_cpu.c: view position, normal, alpha), uploaded as two 2D array
- * textures of m layers (RGBA32F: position + planar depth, normal +
- * alpha) and one fragment pass (core/shaders/deep.frag.glsl) writes the
+ * (deep_cpu.c: view position, normal, alpha, interval end), uploaded as
+ * 2D array textures of m layers (RGBA32F: position + planar depth, normal
+ * + alpha; R32F: the interval ends, with deep_intervals) and one fragment
+ * pass (core/shaders/deep.frag.glsl) writes the
  * front node's AO and the blended AO, each beside the front node's
  * planar depth; with the blur on (VAO++ 4.6, as the flat chain: --blur,
  * --blur-radius) both are blurred by the flat chain's program
@@ -36,13 +37,13 @@
 #include "methods/methods.h"
 #include "obs_shaders.h"
 
-static GLuint array_texture(obs_ctx *ctx, int w, int h, int m)
+static GLuint array_texture(obs_ctx *ctx, int w, int h, int m, GLenum format)
 {
     GLuint t;
     glGenTextures(1, &t);
     ctx->gl_objects_created++;
     glBindTexture(GL_TEXTURE_2D_ARRAY, t);
-    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, w, h, m);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, format, w, h, m);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -50,12 +51,12 @@ static GLuint array_texture(obs_ctx *ctx, int w, int h, int m)
     return t;
 }
 
-static void upload_layers(GLuint tex, int w, int h, int m, const float *data)
+static void upload_layers(GLuint tex, int w, int h, int m, GLenum format, const float *data)
 {
     glBindTexture(GL_TEXTURE_2D_ARRAY, tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, m, GL_RGBA, GL_FLOAT, data);
+    glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, m, format, GL_FLOAT, data);
 }
 
 /* Switches of the deep pass compiled in or out by defines (a SIMD
@@ -65,14 +66,19 @@ enum {
     DEEP_HEMISPHERE = 1, /* OBS_DEEP_HEMISPHERE: method hemisphere's samples */
     DEEP_THIN = 2,       /* OBS_DEEP_THIN: thin hulls, OITAO eqs 2-4 */
     DEEP_RANGE = 4,      /* OBS_RANGE_CHECK: VAO++ 4.4, eq 4 */
-    DEEP_RAYS = 8        /* OBS_RAYS: ao_definition rays' conversion of the VAO nodes */
+    DEEP_RAYS = 8,       /* OBS_RAYS: ao_definition rays' conversion of the VAO nodes */
+    DEEP_INTERVALS = 16, /* OBS_DEEP_INTERVALS: the nodes' intervals (deep_intervals) */
+    DEEP_GTAO = 32,      /* OBS_DEEP_HORIZON with gtao.glsl: method gtao's horizon search */
+    DEEP_HBAO = 64       /* OBS_DEEP_HORIZON with hbao.glsl: method hbao's */
 };
 
 static unsigned deep_variant(const obs__deep_frame *df)
 {
     return (df->f.method == OBS_METHOD_HEMISPHERE ? DEEP_HEMISPHERE : 0u) |
            (df->thin ? DEEP_THIN : 0u) | (df->f.range_check ? DEEP_RANGE : 0u) |
-           (df->f.rays ? DEEP_RAYS : 0u);
+           (df->f.rays ? DEEP_RAYS : 0u) | (df->intervals ? DEEP_INTERVALS : 0u) |
+           (df->f.method == OBS_METHOD_GTAO ? DEEP_GTAO : 0u) |
+           (df->f.method == OBS_METHOD_HBAO ? DEEP_HBAO : 0u);
 }
 
 /* A framebuffer writing the n textures; OBS_GL_ERROR when incomplete. */
@@ -117,17 +123,25 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     obs__deep_targets *t = &ctx->deep;
     obs_status s;
     if (!t->prog[v]) {
-        char defs[128];
+        char defs[224];
         snprintf(defs, sizeof defs,
                  "#define OBS_DEEP_HEMISPHERE %d\n#define OBS_DEEP_THIN %d\n"
-                 "#define OBS_RANGE_CHECK %d\n#define OBS_RAYS %d\n",
+                 "#define OBS_RANGE_CHECK %d\n#define OBS_RAYS %d\n#define OBS_DEEP_INTERVALS %d\n"
+                 "#define OBS_DEEP_HORIZON %d\n",
                  (v & DEEP_HEMISPHERE) != 0, (v & DEEP_THIN) != 0, (v & DEEP_RANGE) != 0,
-                 (v & DEEP_RAYS) != 0);
-        /* method hemisphere's estimator comes after the pass, which
-         * defines how it reads the nodes (HS_NODE in deep.frag.glsl) */
-        const char *src[] = {glsl_version, defs, obs__shader_common, obs__shader_deep_frag,
-                             obs__shader_hemisphere};
-        const int parts = (v & DEEP_HEMISPHERE) ? 5 : 4;
+                 (v & DEEP_RAYS) != 0, (v & DEEP_INTERVALS) != 0,
+                 (v & (DEEP_GTAO | DEEP_HBAO)) != 0);
+        /* method hemisphere's estimator, or method.glsl (radius_px) and
+         * gtao's or hbao's, come after the pass, which defines how they
+         * read the nodes (HS_NODE, GT_NODE, HB_NODE in deep.frag.glsl) */
+        const int horizon = (v & (DEEP_GTAO | DEEP_HBAO)) != 0;
+        const char *hs[] = {glsl_version, defs, obs__shader_common, obs__shader_deep_frag,
+                            obs__shader_hemisphere};
+        const char *hz[] = {glsl_version,          defs, obs__shader_common, obs__shader_method,
+                            obs__shader_deep_frag, (v & DEEP_GTAO) ? obs__shader_gtao
+                                                                   : obs__shader_hbao};
+        const char *const *src = horizon ? hz : hs;
+        const int parts = horizon ? 6 : (v & DEEP_HEMISPHERE) ? 5 : 4;
         if ((s = obs__gl_program("deep", obs__shader_fullscreen_vert, src, parts, &t->prog[v], err)) !=
             OBS_OK) {
             t->prog[v] = 0;
@@ -137,10 +151,12 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     if (t->width == w && t->height == h && t->m == m)
         return OBS_OK;
     obs__deep_release(&ctx->deep, 0);
-    t->tex_pos = array_texture(ctx, w, h, m);
-    t->tex_nrm = array_texture(ctx, w, h, m);
-    /* two RGBA32F arrays of m layers and three RG32F planes */
-    t->bytes = (unsigned long long)w * (unsigned long long)h * (16ull * 2ull * (unsigned)m + 3ull * 8ull);
+    t->tex_pos = array_texture(ctx, w, h, m, GL_RGBA32F);
+    t->tex_nrm = array_texture(ctx, w, h, m, GL_RGBA32F);
+    t->tex_end = array_texture(ctx, w, h, m, GL_R32F);
+    /* two RGBA32F arrays and one R32F array of m layers and three RG32F planes */
+    t->bytes = (unsigned long long)w * (unsigned long long)h *
+               ((16ull * 2ull + 4ull) * (unsigned)m + 3ull * 8ull);
     GLuint *planes[] = {&t->tex_front, &t->tex_blend, &t->tex_tmp};
     for (int i = 0; i < 3; i++) {
         glGenTextures(1, planes[i]);
@@ -222,8 +238,10 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
         times.ms[p] = -1.0;
 
     stage_begin(ctx, &t0);
-    upload_layers(t->tex_pos, w, h, df.m, df.pos);
-    upload_layers(t->tex_nrm, w, h, df.m, df.nrm);
+    upload_layers(t->tex_pos, w, h, df.m, GL_RGBA, df.pos);
+    upload_layers(t->tex_nrm, w, h, df.m, GL_RGBA, df.nrm);
+    if (df.intervals)
+        upload_layers(t->tex_end, w, h, df.m, GL_RED, df.end);
     stage_end(ctx, OBS_PASS_UPLOAD, t0, &times);
 
     stage_begin(ctx, &t0);
@@ -239,6 +257,10 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glUniform1i(glGetUniformLocation(prog, "u_lpos"), 0);
     glBindImageTexture(1, t->tex_nrm, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glUniform1i(glGetUniformLocation(prog, "u_lnrm"), 1);
+    if (df.intervals) {
+        glBindImageTexture(2, t->tex_end, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
+        glUniform1i(glGetUniformLocation(prog, "u_lend"), 2);
+    }
     s = obs__gl_draw_banded(ctx->dev.vao, w, h, t_run, ctx->deadline_ms, "deep AO", err);
     stage_end(ctx, OBS_PASS_AO, t0, &times);
     if (s != OBS_OK) {

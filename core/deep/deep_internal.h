@@ -12,8 +12,17 @@ typedef struct obs__deep_frame {
     int m;          /* nodes per pixel */
     int multi;      /* 1: OITAO Algorithm 1 over every node; 0: front node only */
     int thin;       /* 1: thin hulls (eqs 2-4); 0: solid volumes (eq 1) */
+    int intervals;  /* 1: end holds the nodes' intervals (deep_intervals on,
+                     * the image has facing flags, deep_mode multi) */
     float *pos;     /* m planes of 4 floats: view position xyz, planar depth w (0: empty) */
     float *nrm;     /* m planes of 4 floats: view normal xyz, alpha */
+    float *nrm3;    /* method gtao: the front nodes' view normals, 3 floats a
+                     * pixel, the surface a step past the border continues */
+    float *end;     /* m planes of 1 float, the node's extent along its pixel's
+                     * ray (obs__deep_intervals): 0 solid behind it (no back
+                     * face known), e > 0 solid from its depth to e (a front
+                     * face and its matching back face), -1 inside an
+                     * interval a nearer node opened (adds nothing) */
     obs_deep_layers layers;
 } obs__deep_frame;
 
@@ -23,6 +32,21 @@ typedef struct obs__deep_frame {
 obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *params,
                                  obs__deep_frame *df, char err[OBS_ERR_LEN]);
 void obs__deep_frame_free(obs__deep_frame *df);
+
+/* The facing flags of pixel i's kept nodes as intervals (the
+ * deep_intervals parameter): front to back, a node met outside every
+ * interval opens one if it is a front face (facing +1), which its
+ * matching back face closes (the facing count back to 0): end = that back
+ * face's depth; every node inside is -1.  A node outside every interval
+ * that is not a front face (a back face seen with nothing open: a surface
+ * seen from behind; facing unknown) and a front face whose back face the
+ * list does not hold (an open mesh, or the back face dropped by eq 5)
+ * keep end 0: solid behind them, the range check (eq 4) applying, as
+ * without intervals; the nodes behind such a front face are taken on
+ * their own, as if it were not there.  z, facing: the count nodes' planar
+ * depths and OBS_DEEP_FACING values, front to back; writes end[0 ..
+ * count - 1]. */
+void obs__deep_intervals(const float *z, const float *facing, int count, float *end);
 
 /* The AO (1 = open) of node k at pixel (x, y): OITAO Algorithm 1 with
  * VAO++'s pipe through the tangent sphere as GetAO (with f.method
@@ -39,6 +63,12 @@ float obs__deep_pixel(const obs__deep_frame *df, int x, int y, float *front);
 /* Fills out's composite: the front-to-back "over" of every sample's
  * (premultiplied) colour, times ao_blend; out->ao_blend must be filled. */
 void obs__deep_composite(const obs_deep_image *d, obs_deep_result *out);
+
+/* The clip range (near, far) of the camera's projection, over which eq 5
+ * normalises depth (deep_compress.c); the default clip range of
+ * parameters near and far when the camera has no projection or one
+ * without a usable range. */
+void obs__deep_clip_range(const obs_camera *cam, float *near_z, float *far_z);
 
 obs_status obs__deep_result_alloc(obs_deep_result *out, int w, int h, char err[OBS_ERR_LEN]);
 

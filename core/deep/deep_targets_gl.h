@@ -6,7 +6,7 @@
 
 #include "gl/gl.h"
 
-#define OBS__DEEP_VARIANTS 16 /* 4 switches of the deep pass (deep_gl.c: DEEP_*) */
+#define OBS__DEEP_VARIANTS 128 /* 7 switches of the deep pass (deep_gl.c: DEEP_*) */
 
 /* The deep pass's programs, and the node planes and the output target of
  * one size and node count. */
@@ -15,6 +15,7 @@ typedef struct obs__deep_targets {
     int width, height, m;        /* 0: none allocated yet */
     unsigned long long bytes;    /* the textures' storage (obs_ctx_kept_bytes) */
     GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
+    GLuint tex_end;              /* 2D array of m layers (R32F): the nodes' intervals */
     /* RG32F (AO, the front node's planar depth, for the blur): the front
      * node's AO, the blend, and the blur's intermediate; fbo writes the
      * first two (the deep pass), the others one each (the blur) */

@@ -12,7 +12,7 @@
 #include "ground/raster_internal.h"
 
 /* Words of one node; raster_deep.frag.glsl's NODE_WORDS. */
-enum { W_DEPTH, W_ALPHA, W_R, W_G, W_B, W_NX, W_NY, W_NZ, W_NEXT, W_PRIM, NODE_WORDS };
+enum { W_DEPTH, W_ALPHA, W_R, W_G, W_B, W_NX, W_NY, W_NZ, W_NEXT, W_PRIM, W_FACING, NODE_WORDS };
 #define NIL 0xffffffffu
 
 typedef struct deep_gl {
@@ -159,12 +159,13 @@ static obs_status build_image(const uint32_t *heads, const uint32_t *nodes, uint
                 o[OBS_DEEP_NX] = v[W_NX];
                 o[OBS_DEEP_NY] = v[W_NY];
                 o[OBS_DEEP_NZ] = v[W_NZ];
+                o[OBS_DEEP_FACING] = v[W_FACING];
             }
         }
     free(keys);
     d->width = d->display_width = width;
     d->height = d->display_height = height;
-    d->has_alpha = d->has_normal = 1;
+    d->has_alpha = d->has_normal = d->has_facing = 1;
     d->has_color = has_albedo;
     return OBS_OK;
 }

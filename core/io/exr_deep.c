@@ -99,6 +99,7 @@ static obs_status map_channels(const exr_attr_chlist_t *cl, deep_map *m, char er
             m->ch[OBS_DEEP_NZ] = c;
         }
     }
+    m->ch[OBS_DEEP_FACING] = find_channel(cl, "Facing");
     if (m->ch[OBS_DEEP_Z] < 0) {
         const char *list[64];
         char buf[OBS__LIST_CHARS + 32];
@@ -419,6 +420,7 @@ static obs_status read_deep(exr_context_t ctx, int64_t file_size, const obs_limi
     d->has_alpha = j.map.ch[OBS_DEEP_A] >= 0;
     d->has_color = j.map.ch[OBS_DEEP_R] >= 0 && j.map.ch[OBS_DEEP_G] >= 0 && j.map.ch[OBS_DEEP_B] >= 0;
     d->has_normal = j.map.ch[OBS_DEEP_NX] >= 0;
+    d->has_facing = j.map.ch[OBS_DEEP_FACING] >= 0;
     d->part = j.part;
     obs__exr_read_camera(ctx, j.part, &d->camera);
     obs__exr_msg_reset(); /* a missing attribute is not an error */

@@ -2,7 +2,7 @@
 // C++ deep API: the C API of OpenEXR 3.1 reads deep data but cannot write
 // it.  With exr_deep_ao_write.cpp the C++ of libobscura (what the two
 // share: exr_deep_cpp.h); it never throws across its C interface.  What it writes, core/io/exr_deep.c reads: channels Z, ZBack,
-// A, R, G, B, N.X/N.Y/N.Z (as the image has them), the camera as
+// A, R, G, B, N.X/N.Y/N.Z, Facing (as the image has them), the camera as
 // worldToCamera/worldToNDC (the flat writer's attributes, exr_write.c),
 // and obscura/version (the provenance every output carries, io.h).
 #include <ImfChannelList.h>
@@ -54,7 +54,7 @@ extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image 
             {"A", OBS_DEEP_A, d->has_alpha != 0}, {"R", OBS_DEEP_R, d->has_color != 0},
             {"G", OBS_DEEP_G, d->has_color != 0}, {"B", OBS_DEEP_B, d->has_color != 0},
             {"N.X", OBS_DEEP_NX, d->has_normal != 0}, {"N.Y", OBS_DEEP_NY, d->has_normal != 0},
-            {"N.Z", OBS_DEEP_NZ, d->has_normal != 0},
+            {"N.Z", OBS_DEEP_NZ, d->has_normal != 0}, {"Facing", OBS_DEEP_FACING, d->has_facing != 0},
         };
         for (const ch &c : chans)
             if (c.present)

@@ -87,14 +87,38 @@ static const float *border_step(const obs__frame *f, const float *pos, const flo
     return got > 0 ? ext : NULL;
 }
 
+/* The horizon cosine of one sample point q (view xyz, planar depth w; w
+ * 0: background) for the centre c: its cosine to v moved from the
+ * tangent's `low` by its falloff weight; low where it adds nothing. */
+static float sample_cos(const obs__gtao_state *g, const float q[4], const float c[3],
+                        const float v[3], float low)
+{
+    if (!(q[3] > 0.0f))
+        return low;
+    float d[3] = {q[0] - c[0], q[1] - c[1], q[2] - c[2]};
+    float dist = sqrtf(dot3(d, d));
+    if (!(dist > 0.0f))
+        return low;
+    float shc = dot3(d, v) / dist;
+    float dz = d[2] * (1.0f + g->thin_power[0]); /* thin-occluder compensation */
+    float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
+    float w = saturate(fb * g->falloff[0] + g->falloff[1]);
+    return low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
+}
+
 /* The horizon cosine of side `dir` (+1 or -1) of a slice after its
  * steps: the largest of the tangent's cosine `low` and the samples',
- * each moved from low by its falloff weight. */
-static float side_horizon(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
-                          const float c[3], const float v[3], const float omega[2], int slice,
-                          float noise_step, float min_s, int dir, float low, int *taken)
+ * each moved from low by its falloff weight.  A step inside the image
+ * reads every one of the `layers` planes of pos (deep input's nodes,
+ * OITAO Algorithm 1: the largest counts); past the border, the front
+ * plane's surface continued. */
+static float side_horizon(const obs__frame *f, const float *pos, const float *nrm, int layers,
+                          int x, int y, const float c[3], const float v[3], const float omega[2],
+                          int slice, float noise_step, float min_s, int dir, float low,
+                          int *taken)
 {
     const obs__gtao_state *g = obs__gtao_of(f);
+    const size_t plane = (size_t)f->width * (size_t)f->height * 4;
     float hc = low;
     for (int st = 0; st < g->steps; st++) {
         float base = (float)(slice + st * g->steps) * GTAO_R1;
@@ -109,22 +133,13 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
             if (!(q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken)))
                 continue;
-        } else {
-            (*taken)++;
-            q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+            hc = fmaxf(hc, sample_cos(g, q, c, v, low));
+            continue;
         }
-        if (!(q[3] > 0.0f))
-            continue;
-        float d[3] = {q[0] - c[0], q[1] - c[1], q[2] - c[2]};
-        float dist = sqrtf(dot3(d, d));
-        if (!(dist > 0.0f))
-            continue;
-        float shc = dot3(d, v) / dist;
-        float dz = d[2] * (1.0f + g->thin_power[0]); /* thin-occluder compensation */
-        float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
-        float w = saturate(fb * g->falloff[0] + g->falloff[1]);
-        shc = low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
-        hc = fmaxf(hc, shc);
+        (*taken)++;
+        q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+        for (int k = 0; k < layers; k++)
+            hc = fmaxf(hc, sample_cos(g, q + (size_t)k * plane, c, v, low));
     }
     return hc;
 }
@@ -144,6 +159,13 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
 
 float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                            const float p[3], const float n[3], int *count, float bent[3])
+{
+    return obs__gtao_pixel_nodes(f, pos, nrm, 1, x, y, p, n, count, bent);
+}
+
+float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
+                            int x, int y, const float p[3], const float n[3], int *count,
+                            float bent[3])
 {
     const obs__gtao_state *g = obs__gtao_of(f);
     const float half_pi = (float)M_PI_2;
@@ -187,10 +209,10 @@ float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *n
         float cos_g = np_len > 0.0f ? saturate(dot3(np, v) / np_len) : 1.0f;
         float gamma = signf(dot3(od, np)) * acosf(cos_g);
         float low0 = cosf(gamma + half_pi), low1 = cosf(gamma - half_pi);
-        float hc0 =
-            side_horizon(f, pos, nrm, x, y, c, v, omega, sl, noise[1], min_s, 1, low0, &taken);
-        float hc1 =
-            side_horizon(f, pos, nrm, x, y, c, v, omega, sl, noise[1], min_s, -1, low1, &taken);
+        float hc0 = side_horizon(f, pos, nrm, layers, x, y, c, v, omega, sl, noise[1], min_s, 1,
+                                 low0, &taken);
+        float hc1 = side_horizon(f, pos, nrm, layers, x, y, c, v, omega, sl, noise[1], min_s, -1,
+                                 low1, &taken);
         if (g->heuristics)
             np_len += (1.0f - np_len) * GTAO_SLOPE_FUDGE;
         /* the horizons as angles from v, clamped to the hemisphere of n

@@ -33,6 +33,15 @@ void obs__gtao_setup(const obs_params *p, obs__frame *f);
 float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                       const float p[3], const float n[3], int *count);
 
+/* obs__gtao_pixel_bent over `layers` planes of positions (pos, then
+ * pos + 4 w h, ...: deep input's nodes, core/deep): each step's horizon
+ * is the largest over the nodes at its pixel (OITAO Algorithm 1, as its
+ * multi-layer HBAO, Fig. 9); a step past the border reads the first
+ * plane's surface continued, with nrm its normals (3 floats a pixel). */
+float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
+                            int x, int y, const float p[3], const float n[3], int *count,
+                            float bent[3]);
+
 /* The noise of the 3x3 tile's pixel `tile` (obs__tile_index): XeGTAO's R2
  * sequence, fract(0.5 + k (0.754877666, 0.569840291)), k = tile;
  * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */

@@ -18,10 +18,35 @@
 
 #include "methods/hbao.h"
 
+/* One sample point q (view xyz, planar depth w; w 0: background) of a
+ * direction from p: where it rises above the horizon sin_h, W(r) times
+ * the rise into *ao and the horizon raised (GLSL: hbao_sample()). */
+static void hbao_sample(const float q[4], const float p[3], float R2, float *sin_h, float *ao)
+{
+    if (!(q[3] > 0.0f))
+        return;
+    float v[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+    float r2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if (!(r2 < R2) || !(r2 > 0.0f))
+        return;
+    float sin_s = v[2] / sqrtf(r2); /* elevation of the sample: view +z faces the camera */
+    if (sin_s > *sin_h) {
+        *ao += (1.0f - r2 / R2) * (sin_s - *sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
+        *sin_h = sin_s;
+    }
+}
+
 /* GLSL: hbao_ao() in hbao.glsl */
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count)
 {
+    return obs__hbao_pixel_nodes(f, pos, 1, x, y, p, n, count);
+}
+
+float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, int layers, int x, int y,
+                            const float p[3], const float n[3], int *count)
+{
+    const size_t plane = (size_t)f->width * (size_t)f->height * 4;
     const obs__hbao_state *hb = obs__hbao_of(f);
     const float R = f->radius, R2 = R * R;
     const float *rot = f->rot[obs__tile_index(f, x, y)];
@@ -54,17 +79,8 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
                 break;
             taken++;
             const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
-            if (!(q[3] > 0.0f))
-                continue;
-            float v[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-            float r2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-            if (!(r2 < R2) || !(r2 > 0.0f))
-                continue;
-            float sin_s = v[2] / sqrtf(r2); /* elevation of the sample: view +z faces the camera */
-            if (sin_s > sin_h) {
-                ao += (1.0f - r2 / R2) * (sin_s - sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
-                sin_h = sin_s;
-            }
+            for (int k = 0; k < layers; k++) /* deep input: every node, front to back */
+                hbao_sample(q + (size_t)k * plane, p, R2, &sin_h, &ao);
         }
     }
     if (count)

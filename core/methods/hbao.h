@@ -27,4 +27,11 @@ void obs__hbao_setup(const obs_params *p, obs__frame *f);
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count);
 
+/* The same over `layers` planes of positions (pos, then pos + 4 w h, ...:
+ * deep input's nodes, core/deep): at each step every node at its pixel,
+ * front to back, raises the horizon where it lies above it (OITAO's
+ * multi-layer HBAO, Fig. 9). */
+float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, int layers, int x, int y,
+                            const float p[3], const float n[3], int *count);
+
 #endif

@@ -83,7 +83,7 @@ static const obs__method methods[] = {
       {"u_hbao_dir", OBS__U_VEC2, HB(dir), HB(dirs), 1},
       {"u_hbao_bias_cs", OBS__U_VEC2, HB(bias_cs), 0, 0},
       {NULL}},
-     0},
+     1},
     {OBS_METHOD_GTAO, "gtao", obs__shader_gtao, obs__gtao_setup, gtao_ao, gtao_samples,
      {{"u_gtao_slices", OBS__U_INT, GT(slices), 0, 0},
       {"u_gtao_steps", OBS__U_INT, GT(steps), 0, 0},
@@ -92,7 +92,7 @@ static const obs__method methods[] = {
       {"u_gtao_falloff", OBS__U_VEC2, GT(falloff), 0, 0},
       {"u_gtao_thin_power", OBS__U_VEC2, GT(thin_power), 0, 0},
       {NULL}},
-     0, gtao_bent},
+     1, gtao_bent},
 };
 #undef GT
 #undef HB

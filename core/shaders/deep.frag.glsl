@@ -7,11 +7,18 @@
 // to back by alpha (section III, the separated scheme).  With
 // OBS_DEEP_HEMISPHERE the per-node occlusion is method hemisphere's point samples
 // (the normal-oriented hemisphere kernel), each against every node, the
-// largest counting (Algorithm 1).  C twin: core/deep/deep_cpu.c (same function
-// names).
+// largest counting (Algorithm 1); with OBS_DEEP_HORIZON method gtao's or
+// hbao's horizon search, each step reading every node at its pixel (as
+// OITAO's multi-layer HBAO, Fig. 9).  C twin: core/deep/deep_cpu.c (same
+// function names).
 
 layout(rgba32f) readonly uniform image2DArray u_lpos; // node view position xyz, planar depth w (0: empty)
 layout(rgba32f) readonly uniform image2DArray u_lnrm; // node view normal xyz, alpha w
+#if OBS_DEEP_INTERVALS
+// the node's interval end (obs__deep_intervals): 0 solid behind it, e > 0
+// solid from its depth to e, -1 inside a nearer node's interval
+layout(r32f) readonly uniform image2DArray u_lend;
+#endif
 uniform int u_m;                // nodes per pixel
 uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node 0 only
 // u_size, u_radius (R), u_count (the line samples, the set of section 4.5
@@ -21,12 +28,25 @@ uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node
 // does not run the unused side of a uniform branch for every node:
 // OBS_DEEP_HEMISPHERE, method hemisphere's point samples (else VAO's line
 // samples); OBS_DEEP_THIN, thin hulls (eqs 2-4; else solid volumes, eq 1);
-// OBS_RANGE_CHECK, the depth range check (VAO++ 4.4, eq 4).
+// OBS_RANGE_CHECK, the depth range check (VAO++ 4.4, eq 4);
+// OBS_DEEP_INTERVALS, the nodes' intervals from their facing flags;
+// OBS_DEEP_HORIZON, method gtao's or hbao's horizon search over the nodes.
 // Method hemisphere's estimator (hemisphere.glsl, appended after this file
 // in the OBS_DEEP_HEMISPHERE programs) reads the nodes through these.
 #define HS_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
 #define HS_ALPHA(q, k) imageLoad(u_lnrm, ivec3(q, k)).w
 float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
+// Methods gtao's and hbao's horizon searches (gtao.glsl, hbao.glsl,
+// after this file in the OBS_DEEP_HORIZON programs, with method.glsl's
+// radius_px) read every node at a step's pixel through these (gtao: the
+// front nodes past the border); method_ao(px, vec4 p, n, count) is theirs.
+#define GT_LAYERS (u_multi != 0 ? u_m : 1)
+#define GT_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
+#define GT_FRONT(b) imageLoad(u_lpos, ivec3(b, 0))
+#define GT_FRONT_NORMAL(b) imageLoad(u_lnrm, ivec3(b, 0))
+#define HB_LAYERS (u_multi != 0 ? u_m : 1)
+#define HB_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
+float method_ao(ivec2 px, vec4 p, vec3 n, out int count);
 
 // the front node's AO and the blended AO, each beside the front node's
 // planar depth (0: empty), as the blur reads them (blur.frag.glsl)
@@ -54,6 +74,13 @@ float node_occlusion(float zs, float nz, float front, float h, bool interior)
     return 2.0 * h - dz;
 }
 
+// The length of the pipe [front, front + 2h] inside a node's closed
+// interval [zs, e]: their overlap, no range check.
+float interval_occlusion(float zs, float e, float front, float h)
+{
+    return max(0.0, min(e, front + 2.0 * h) - max(zs, front));
+}
+
 // VAO++ eqs 1-2 for the tangent sphere at p along n; each sample's
 // occlusion is the largest over the nodes at its pixel (Algorithm 1, line
 // 9), each node's weighted by its alpha (eq 1's alpha_omega).  self: the
@@ -76,14 +103,26 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
         ivec2 q;
         if (!disk_px(U, V, W, sx, sy, u_size, q))
             continue;               // off the planes: left out
-        float front = -c.z - h, occ = 0.0;
+        float front = -c.z - h, occ = 0.0, solid = 0.0;
         for (int k = 0; k < layers; k++) {
+#if OBS_DEEP_INTERVALS
+            float e = imageLoad(u_lend, ivec3(q, k)).x;
+            if (e < 0.0)
+                continue;               // inside a nearer node's interval
+#endif
             float zs = imageLoad(u_lpos, ivec3(q, k)).w;
             vec4 nk = imageLoad(u_lnrm, ivec3(q, k));   // normal, alpha
             if (k == self && q == px)
                 zs = own_plane_depth(p, n, disk_point(c, r, rot, sx, sy), zs);
-            occ = max(occ, nk.w * node_occlusion(zs, nk.z, front, h, interior));
+#if OBS_DEEP_INTERVALS
+            if (e > 0.0 && zs > 0.0 && !interior)       // a closed interval
+                solid += nk.w * interval_occlusion(zs, e, front, h);
+            else
+#endif
+                occ = max(occ, nk.w * node_occlusion(zs, nk.z, front, h, interior));
         }
+        // disjoint intervals add; the nodes solid behind them, the largest
+        occ = min(2.0 * h, occ + solid);
         open += 2.0 * h - occ;
         F += R * l;
     }
@@ -97,6 +136,9 @@ float method_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
 {
 #if OBS_DEEP_HEMISPHERE
     return hemisphere_estimate(px, p, n, u_multi != 0 ? u_m : 1, interior);
+#elif OBS_DEEP_HORIZON
+    int count;
+    return method_ao(px, vec4(p, 0.0), n, count);   // gtao.glsl or hbao.glsl, over the nodes
 #else
 #if OBS_RAYS
     return rays_from_volume(sphere_ao(px, p, n, interior, self)); // common.glsl

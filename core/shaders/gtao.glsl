@@ -5,6 +5,18 @@
 // horizons from the depth samples weighted by the falloff.  C twin:
 // obs__gtao_pixel (methods/gtao.c), which documents the method.
 
+// The planes the horizon search reads: the flat chain's (method.glsl);
+// the deep pass (deep.frag.glsl) defines them for its nodes: GT_LAYERS
+// nodes at a pixel, GT_NODE(q, k) the view position and planar depth of
+// node k at q, GT_FRONT and GT_FRONT_NORMAL the front surface that a step
+// past the border continues.
+#ifndef GT_LAYERS
+#define GT_LAYERS 1
+#define GT_NODE(q, k) imageLoad(u_pos, q)
+#define GT_FRONT(b) imageLoad(u_pos, b)
+#define GT_FRONT_NORMAL(b) imageLoad(u_vnormal, b)
+#endif
+
 uniform int u_gtao_slices;
 uniform int u_gtao_steps;
 uniform int u_gtao_heuristics;     // 1: XeGTAO's three empirical corrections
@@ -36,13 +48,30 @@ bool gtao_border_step(ivec2 px, ivec2 q, out vec4 xq)
     ivec2 b;
     if (!border_px(px, vec2(q), b))
         return false;
-    vec4 pb = imageLoad(u_pos, b);
+    vec4 pb = GT_FRONT(b);
     if (!(pb.w > 0.0))
         return true;
-    return plane_point(vec2(q), pb.xyz, imageLoad(u_vnormal, b).xyz, xq);
+    return plane_point(vec2(q), pb.xyz, GT_FRONT_NORMAL(b).xyz, xq);
 }
 
-// C twin: side_horizon (methods/gtao.c)
+// The horizon cosine of one sample point xq for the centre c: low where
+// it adds nothing.  C twin: sample_cos (methods/gtao.c)
+float gtao_sample_cos(vec4 xq, vec3 c, vec3 v, float low)
+{
+    if (!(xq.w > 0.0))
+        return low;
+    vec3 d = xq.xyz - c;
+    float dist = length(d);
+    if (!(dist > 0.0))
+        return low;
+    float shc = dot(d, v) / dist;
+    float fb = length(vec3(d.xy, d.z * (1.0 + u_gtao_thin_power.x)));
+    float w = clamp(fb * u_gtao_falloff.x + u_gtao_falloff.y, 0.0, 1.0);
+    return low + (shc - low) * w;
+}
+
+// C twin: side_horizon (methods/gtao.c); a step inside the image reads
+// every node at its pixel (GT_LAYERS), the largest counting
 float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float noise_step,
                         float min_s, int dir, float low, inout int taken)
 {
@@ -53,25 +82,17 @@ float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float n
         float s = (float(st) + sn) / float(u_gtao_steps);
         s = s * s + min_s;
         ivec2 q = px + dir * ivec2(int(floor(s * omega.x + 0.5)), int(floor(s * omega.y + 0.5)));
-        vec4 xq;
         if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y) {
+            vec4 xq;
             if (!gtao_border_step(px, q, xq))
                 continue;
-        } else {
-            xq = imageLoad(u_pos, q);
+            taken++;
+            hc = max(hc, gtao_sample_cos(xq, c, v, low));
+            continue;
         }
         taken++;
-        if (!(xq.w > 0.0))
-            continue;
-        vec3 d = xq.xyz - c;
-        float dist = length(d);
-        if (!(dist > 0.0))
-            continue;
-        float shc = dot(d, v) / dist;
-        float fb = length(vec3(d.xy, d.z * (1.0 + u_gtao_thin_power.x)));
-        float w = clamp(fb * u_gtao_falloff.x + u_gtao_falloff.y, 0.0, 1.0);
-        shc = low + (shc - low) * w;
-        hc = max(hc, shc);
+        for (int k = 0; k < GT_LAYERS; k++)
+            hc = max(hc, gtao_sample_cos(GT_NODE(q, k), c, v, low));
     }
     return hc;
 }

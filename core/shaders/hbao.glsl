@@ -9,6 +9,31 @@ uniform int u_hbao_steps;        // Ns
 uniform vec2 u_hbao_dir[OBS_MAX_DIRECTIONS];     // unit directions over 2 pi (view xy)
 uniform vec2 u_hbao_bias_cs;     // cos, sin of the angle bias
 
+// The planes the horizon search reads: the flat chain's (method.glsl);
+// the deep pass (deep.frag.glsl) defines them for its nodes: HB_LAYERS
+// nodes at a pixel, HB_NODE(q, k) node k's view position, planar depth.
+#ifndef HB_LAYERS
+#define HB_LAYERS 1
+#define HB_NODE(q, k) imageLoad(u_pos, q)
+#endif
+
+// One sample point xq of a direction from p: where it rises above the
+// horizon sin_h, W(r) times the rise into ao.  C twin: hbao_sample.
+void hbao_sample(vec4 xq, vec3 p, float R2, inout float sin_h, inout float ao)
+{
+    if (!(xq.w > 0.0))
+        return;
+    vec3 v = xq.xyz - p;
+    float r2 = v.x * v.x + v.y * v.y + v.z * v.z;
+    if (!(r2 < R2) || !(r2 > 0.0))
+        return;
+    float sin_s = v.z / sqrt(r2);
+    if (sin_s > sin_h) {
+        ao += (1.0 - r2 / R2) * (sin_s - sin_h);   // W(r_i) (sin h_i - sin h_(i-1))
+        sin_h = sin_s;
+    }
+}
+
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
 {
     float R = u_radius, R2 = R * R;
@@ -36,18 +61,8 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
             if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
                 break;
             count++;
-            vec4 xq = imageLoad(u_pos, q);
-            if (!(xq.w > 0.0))
-                continue;
-            vec3 v = xq.xyz - p.xyz;
-            float r2 = v.x * v.x + v.y * v.y + v.z * v.z;
-            if (!(r2 < R2) || !(r2 > 0.0))
-                continue;
-            float sin_s = v.z / sqrt(r2);
-            if (sin_s > sin_h) {
-                ao += (1.0 - r2 / R2) * (sin_s - sin_h);   // W(r_i) (sin h_i - sin h_(i-1))
-                sin_h = sin_s;
-            }
+            for (int k = 0; k < HB_LAYERS; k++)   // deep input: every node
+                hbao_sample(HB_NODE(q, k), p.xyz, R2, sin_h, ao);
         }
     }
     return max(0.0, 1.0 - ao / float(u_hbao_dirs));

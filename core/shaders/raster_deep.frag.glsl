@@ -13,8 +13,8 @@ uniform int u_capacity;    // nodes the pool holds
 uniform int u_has_opacity;
 
 // Words of one node (raster_deep_gl.c reads them back): depth, alpha,
-// colour rgb (premultiplied), world normal xyz, next, triangle.
-const uint NODE_WORDS = 10u;
+// colour rgb (premultiplied), world normal xyz, next, triangle, facing.
+const uint NODE_WORDS = 11u;
 
 void main()
 {
@@ -41,4 +41,8 @@ void main()
     node[b + 7u] = floatBitsToUint(n.z);
     node[b + 8u] = next;
     node[b + 9u] = uint(gl_PrimitiveID);
+    // Facing (OBS_DEEP_FACING): +1 where the triangle is seen from its
+    // front, i.e. its outward side by the mesh's counter-clockwise winding
+    // (OBJ's and glTF's convention), entering the solid; -1 from its back.
+    node[b + 10u] = floatBitsToUint(gl_FrontFacing ? 1.0 : -1.0);
 }

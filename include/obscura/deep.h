@@ -8,7 +8,8 @@
  * compressed layers (OITAO Algorithm 1, eqs 1-4) with VAO++'s volumetric
  * estimator (section 3, depth range check of 4.4) as the per-sample
  * occlusion, or with method hemisphere the normal-oriented hemisphere
- * kernel's point samples.  See README.md, "Deep input". */
+ * kernel's point samples, or with methods gtao and hbao their horizon
+ * search over every node.  See README.md, "Deep input". */
 #ifndef OBSCURA_DEEP_H
 #define OBSCURA_DEEP_H
 
@@ -33,6 +34,13 @@ enum {
     OBS_DEEP_NX,    /* normal (0 when the file has none) */
     OBS_DEEP_NY,
     OBS_DEEP_NZ,
+    OBS_DEEP_FACING, /* +1: a front face (entering a solid along the view
+                      * ray: its outward side faces the camera), -1: a back
+                      * face (leaving it), 0: not known.  Channel "Facing";
+                      * `obscura gbuffer --deep` writes it from the
+                      * triangle's winding.  With it the multi-layer chain
+                      * takes the solid between a front face and its
+                      * matching back face as an interval (deep_intervals) */
     OBS_DEEP_CH     /* floats per sample */
 };
 
@@ -50,7 +58,7 @@ typedef struct obs_deep_image {
     int display_width, display_height;
     uint64_t *offset;                  /* width * height + 1 entries */
     float *samples;                    /* offset[width * height] samples */
-    int has_zback, has_alpha, has_color, has_normal;
+    int has_zback, has_alpha, has_color, has_normal, has_facing;
     obs_camera camera;                 /* from worldToCamera/worldToNDC, if any */
     int part;                          /* the part read */
 } obs_deep_image;
@@ -65,7 +73,7 @@ obs_status obs_exr_is_deep_mem(const void *buf, size_t len, int *deep, char err[
  * count tables (checked: non-negative, cumulative per scanline, within
  * OBS_DEEP_MAX_* and the chunk's size) before any sample memory is
  * allocated, then the samples.  Channels by name: Z (required), ZBack,
- * A, R, G, B, and N.X/N.Y/N.Z (or N.R/N.G/N.B).  Caller frees with
+ * A, R, G, B, N.X/N.Y/N.Z (or N.R/N.G/N.B) and Facing.  Caller frees with
  * obs_deep_free(). */
 obs_status obs_deep_read_exr(const char *path, const obs_limits *lim, obs_deep_image *out,
                              char err[OBS_ERR_LEN]);
@@ -76,7 +84,7 @@ obs_status obs_deep_read_exr_mem(const void *buf, size_t len, const obs_limits *
 void obs_deep_free(obs_deep_image *d);
 
 /* Writes a deep scanline EXR (ZIPS, float channels): Z always, ZBack, A,
- * R, G, B and N.X/N.Y/N.Z as d->has_* say (the names obs_deep_read_exr()
+ * R, G, B, N.X/N.Y/N.Z and Facing as d->has_* say (the names obs_deep_read_exr()
  * reads), the camera as worldToCamera/worldToNDC when d->camera has one.
  * Samples are written in their order (front to back).  Through OpenEXR's
  * C++ library (core/io/exr_deep_write.cpp).  Fails with OBS_IO when the
@@ -97,7 +105,8 @@ typedef struct obs_deep_layers {
     int width, height, m;
     float *node;   /* m planes, node k of pixel i at (k * width * height + i) * OBS_DEEP_CH */
     int *count;    /* valid nodes per pixel, front to back from node 0 */
-    float zmin, zmax; /* the depth range normalised depth is taken over */
+    float zmin, zmax; /* the depth range eq 5's z is normalised over: the
+                       * camera's clip range (near, far) */
 } obs_deep_layers;
 
 /* Compresses one list (OITAO section III-B): the n samples (OBS_DEEP_CH
@@ -105,7 +114,8 @@ typedef struct obs_deep_layers {
  * m nodes; once more than m were inserted the node j minimising
  * a[j].alpha * (1 - a[j].z) (eq 5) is dropped, searched over every node or,
  * with front_half, over the back half only (j >= m / 2).  z is the depth
- * normalised to [0, 1] over zmin..zmax (see deep_compress.c).  Writes the
+ * normalised to [0, 1] over zmin..zmax, the camera's clip range (see
+ * deep_compress.c).  Writes the
  * kept nodes front to back to out (m * OBS_DEEP_CH floats) and returns
  * their count. */
 int obs_deep_compress_list(const float *samples, int n, int m, int front_half, float zmin,
@@ -114,7 +124,9 @@ int obs_deep_compress_list(const float *samples, int n, int m, int front_half, f
 /* Compresses every pixel of a deep image to m nodes (1 <= m <=
  * OBS_DEEP_MAX_LAYERS); m = 0 keeps up to OBS_DEEP_MAX_LAYERS front
  * nodes unchanged when they fit (no eq 5 needed), i.e. the uncompressed
- * reference for lists up to that length.  Caller frees with
+ * reference for lists up to that length.  Eq 5's z is normalised over the
+ * clip range (near, far) of d->camera's projection, or without one over
+ * the default clip range of parameters near and far.  Caller frees with
  * obs_deep_layers_free(). */
 obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs_deep_layers *out,
                              char err[OBS_ERR_LEN]);
@@ -140,11 +152,14 @@ int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_e
 
 /* Multi-layer AO of the deep image on the CPU: compression to the
  * parameters' deep_layers nodes, then OITAO Algorithm 1 with VAO++'s
- * per-sample occlusion (methods vaopp, vao) or the hemisphere kernel's
- * (method hemisphere) against every node (or the front one alone with
- * deep_mode single), opacity-weighted (eq 1, or eqs 2-4 with deep_hull
- * thin).  Other methods are refused (OBS_INVALID_ARGUMENT, naming the
- * method).  The camera is the image's unless the parameters carry one. */
+ * per-sample occlusion (methods vaopp, vao), the hemisphere kernel's
+ * (method hemisphere) or the horizon search of methods gtao and hbao
+ * (every node at a step's pixel, OITAO's multi-layer HBAO) against every
+ * node (or the front one alone with deep_mode single), opacity-weighted
+ * (eq 1, or eqs 2-4 with deep_hull thin); with deep_intervals on and
+ * facing flags, VAO's line samples take the solid between a front face
+ * and its back face as an interval.  Method angle is refused
+ * (OBS_INVALID_ARGUMENT, naming the method).  The camera is the image's unless the parameters carry one. */
 obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
                             obs_deep_result *out, char err[OBS_ERR_LEN]);
 

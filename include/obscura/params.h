@@ -184,6 +184,7 @@ typedef enum obs_baked_combine {
     X(deep_mode, OBS_DEEP_MODE_LIST)                                           \
     X(deep_front_half, OBS_SWITCH_LIST)                                        \
     X(deep_hull, OBS_DEEP_HULL_LIST)                                           \
+    X(deep_intervals, OBS_SWITCH_LIST)                                         \
     X(baked_combine, OBS_BAKED_COMBINE_LIST)                                   \
     X(multibounce, OBS_SWITCH_LIST)
 
@@ -389,7 +390,7 @@ typedef enum obs_baked_combine {
     X(deep_layers, INT, 4, 1, 8, NULL,                                         \
       "deep input: nodes m kept per pixel by the list compression of OITAO "   \
       "III-B (eq 5 drops the node of least alpha (1 - z), z the depth "        \
-      "normalised over the image)")                                           \
+      "normalised over the camera's clip range)")                              \
     X(deep_front_half, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),                            \
       "deep input: eq 5 searches the back half of the list only, keeping the " \
       "m/2 front nodes (OITAO V-A, Fig. 6 column C)")                          \
@@ -398,6 +399,14 @@ typedef enum obs_baked_combine {
       "occluders and receivers weighted by alpha) or thin hulls (eqs 2-4: "    \
       "exterior and interior AO mixed by W(p), alpha or 1 - alpha on back "    \
       "faces)")                                                                \
+    X(deep_intervals, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),         \
+      "deep input with facing flags (channel Facing, as obscura gbuffer "      \
+      "--deep writes), deep_mode multi, methods vaopp and vao: on, the solid " \
+      "between a front face and its matching back face is an interval, free "  \
+      "behind it, and the depth range check applies only to a surface with "   \
+      "no back face in the list (the obscured volume as it is); off, every "   \
+      "node is solid behind it, as ao_definition rays' conversion assumes "    \
+      "(bench/QUALITY.md, \"Deep input against Cycles\")")                     \
     X(baked_combine, ENUM, "product", 0, 0, OBS_CHOICES(OBS_BAKED_COMBINE_LIST), \
       "--baked CH (HTTP: baked=CH): how the G-buffer's baked AO channel "      \
       "(obscura bake's _AO, rasterised by obscura gbuffer) is combined with "  \

@@ -239,22 +239,51 @@ static void test_compress_eq5(void **state)
     for (int k = 0; k < 4; k++)
         assert_float_equal(out[k * OBS_DEEP_CH + OBS_DEEP_Z], want[k], 0);
 
-    /* the fixture's pixel (0, 0): ten samples of alpha 0.3 at Z 1 .. 1.9
-     * and the opaque wall at 8, the image's farthest depth: z = 1 there,
-     * so eq 5 gives the wall 0 and drops it whatever its alpha; of the
-     * others, a (1 - z) falls with depth: m = 4 keeps Z 1 .. 1.3 */
+    /* the paper's criterion (OITAO III-B) over the view frustum: the
+     * fixture's pixel (0, 0) holds ten samples of alpha 0.3 at Z 1 .. 1.9
+     * and the opaque wall at 8, the image's farthest depth.  Its camera has
+     * the default clip range 0.1 .. 1000, so z = (Z - 0.1) / 999.9: the
+     * wall scores 1 - 0.0079 = 0.992, each transparent sample about 0.3
+     * (falling with depth).  The opaque wall is kept, and of the
+     * transparent samples the nearest: m = 4 keeps Z 1, 1.1, 1.2 and 8.
+     * (Normalised over the image's own range, 1 .. 8, the wall would
+     * score 0 and be dropped first.) */
     obs_deep_image d;
     obs_deep_layers l;
     char err[OBS_ERR_LEN] = "";
     assert_int_equal(obs_deep_read_exr(FIXTURE, NULL, &d, err), OBS_OK);
     assert_int_equal(obs_deep_compress(&d, 4, 0, &l, err), OBS_OK);
-    assert_float_equal(l.zmin, 1.0f, 1e-6);
-    assert_float_equal(l.zmax, 8.0f, 1e-6);
+    assert_float_equal(l.zmin, 0.1f, 1e-4);
+    assert_float_equal(l.zmax, 1000.0f, 1.0);
     assert_int_equal(l.count[0], 4);
     size_t npx = 48 * 32;
-    const float keep[4] = {1.0f, 1.1f, 1.2f, 1.3f};
+    const float keep[4] = {1.0f, 1.1f, 1.2f, 8.0f};
     for (int k = 0; k < 4; k++)
         assert_float_equal(l.node[(size_t)k * npx * OBS_DEEP_CH + OBS_DEEP_Z], keep[k], 1e-5);
+    obs_deep_layers_free(&l);
+
+    /* the farthest sample of a list is not dropped for being the farthest:
+     * near 1, far 10, z = (Z - 1) / 9:
+     *   Z 2 a .2 -> .2 (1 - 1/9) = .178, Z 4 a .3 -> .3 (1 - 3/9) = .2,
+     *   Z 6 a 1 -> 1 - 5/9 = .444: m = 2 drops Z 2, keeps [4, 6]
+     * (over the list's own range 2 .. 6 the wall would score 0 and go);
+     * at the far plane itself, the paper's initial depth of 1, a node
+     * scores 0 whatever its opacity and goes first: [2, 4] */
+    float lst[3 * OBS_DEEP_CH];
+    sample(lst, 2.0f, 0.2f);
+    sample(lst + OBS_DEEP_CH, 4.0f, 0.3f);
+    sample(lst + 2 * OBS_DEEP_CH, 6.0f, 1.0f);
+    assert_int_equal(obs_deep_compress_list(lst, 3, 2, 0, 1.0f, 10.0f, out), 2);
+    assert_float_equal(out[OBS_DEEP_Z], 4.0f, 0);
+    assert_float_equal(out[OBS_DEEP_CH + OBS_DEEP_Z], 6.0f, 0);
+    sample(lst + 2 * OBS_DEEP_CH, 10.0f, 1.0f);
+    assert_int_equal(obs_deep_compress_list(lst, 3, 2, 0, 1.0f, 10.0f, out), 2);
+    assert_float_equal(out[OBS_DEEP_Z], 2.0f, 0);
+    assert_float_equal(out[OBS_DEEP_CH + OBS_DEEP_Z], 4.0f, 0);
+    d.camera.has_projection = 0; /* no projection: the parameters' default 0.1 .. 1000 */
+    assert_int_equal(obs_deep_compress(&d, 4, 0, &l, err), OBS_OK);
+    assert_float_equal(l.zmin, 0.1f, 1e-6);
+    assert_float_equal(l.zmax, 1000.0f, 1e-3);
     obs_deep_layers_free(&l);
     obs_deep_free(&d);
 }
@@ -366,6 +395,194 @@ static void test_hidden_occluder(void **state)
     obs_deep_free(&d);
 }
 
+/* ---- intervals from facing flags (deep_intervals) ---------------------------- */
+
+static void synth_face(obs_deep_image *d, int x, int y, float z, float facing)
+{
+    synth_add(d, x, y, z, 1.0f);
+    size_t i = (size_t)y * d->width + x;
+    d->samples[(d->offset[i + 1] - 1) * OBS_DEEP_CH + OBS_DEEP_FACING] = facing;
+}
+
+/* A wall at depth 10 seen from its front (a room's wall: no back face)
+ * and, right of column 16, a closed slab from depth zf (front face) to zb
+ * (back face), opaque. */
+static void slab_scene(obs_deep_image *d, float zf, float zb)
+{
+    synth_init(d, 32, 32);
+    d->has_facing = 1;
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++) {
+            synth_next(d, x, y);
+            if (x >= 16) {
+                synth_face(d, x, y, zf, 1.0f);
+                synth_face(d, x, y, zb, -1.0f);
+            }
+            synth_face(d, x, y, 10.0f, 1.0f);
+        }
+}
+
+static void slab_scene_free_and(obs_deep_image *d, float zf, float zb)
+{
+    obs_deep_free(d);
+    slab_scene(d, zf, zb);
+}
+
+/* obs__deep_intervals on lists: a closed slab before a one-sided wall; a
+ * box inside a box (nested); an open front face (a pane, no back face)
+ * before a closed slab, which then stands on its own; a back face seen
+ * first (from behind) and unknown facing: solid behind, as without. */
+static void test_interval_lists(void **state)
+{
+    (void)state;
+    static const struct {
+        int n;
+        float z[6], f[6], want[6];
+    } c[] = {
+        {3, {2, 3, 10}, {1, -1, 1}, {3, -1, 0}},
+        {5, {2, 3, 4, 5, 10}, {1, 1, -1, -1, 1}, {5, -1, -1, -1, 0}},
+        {4, {1, 2, 3, 10}, {1, 1, -1, 1}, {0, 3, -1, 0}},
+        {4, {1, 2, 3, 4}, {-1, 0, 1, -1}, {0, 0, 4, -1}},
+        {2, {1, 0, 0, 0}, {1, 0, 0, 0}, {0, 0, 0, 0}},
+    };
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        float e[6];
+        obs__deep_intervals(c[i].z, c[i].f, c[i].n, e);
+        for (int k = 0; k < c[i].n; k++)
+            if (e[k] != c[i].want[k])
+                fail_msg("list %zu node %d: end %g, want %g", i, k, e[k], c[i].want[k]);
+    }
+}
+
+/* The wall pixel beside the slab: its tangent sphere (R = 1 at depth 10
+ * in this frame: the pipes span depths 8 .. 10).  A thin plate 7.5 .. 7.6
+ * lies wholly in front of it:
+ * with intervals nothing of the pipes is solid and the wall stays as open
+ * as far from the plate (no halo); every node solid behind it (intervals
+ * off, or deep_mode single, the flat buffer's view) lets the range check
+ * count the plate far behind itself, the halo.  A plate 8.6 .. 8.7 that
+ * reaches into the sphere occludes its own thickness only: between the
+ * two.  A closed box 8.6 .. 10, flush with the wall, is solid over the
+ * whole depth the flat buffer assumes: the same AO with intervals,
+ * without, and on the flat chain. */
+static void test_intervals(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    obs_params on = deep_params(OBS_DEEP_MULTI), off = deep_params(OBS_DEEP_MULTI);
+    obs_params single = deep_params(OBS_DEEP_SINGLE);
+    assert_int_equal(obs_param_set(&on, "deep_intervals", "on", err), OBS_OK);
+    assert_int_equal(obs_param_set(&off, "deep_intervals", "off", err), OBS_OK);
+    for (int i = 0; i < 3; i++) /* the AO itself, not the low-pass filter's spread */
+        assert_int_equal(obs_param_set(i == 0 ? &on : i == 1 ? &off : &single, "blur", "off", err),
+                         OBS_OK);
+
+    slab_scene(&d, 7.5f, 7.6f);
+    float open = ao_at(&d, &on, 4, 16, NULL);
+    float with = ao_at(&d, &on, 15, 16, NULL), without = ao_at(&d, &off, 15, 16, NULL);
+    float flat = ao_at(&d, &single, 15, 16, NULL);
+    print_message("thin plate in front: AO open %.4f, intervals %.4f, off %.4f, single %.4f\n",
+                  open, with, without, flat);
+    assert_float_equal(open, 1.0f, 1e-4);
+    assert_float_equal(with, open, 1e-4);
+    assert_true(without < open - 0.02f);
+    assert_true(flat < open - 0.02f);
+    /* the same image without facing flags: every node solid behind */
+    d.has_facing = 0;
+    assert_float_equal(ao_at(&d, &on, 15, 16, NULL), without, 1e-6);
+    obs_deep_free(&d);
+
+    slab_scene(&d, 8.6f, 8.7f);
+    float thin_on = ao_at(&d, &on, 15, 16, NULL), thin_off = ao_at(&d, &off, 15, 16, NULL);
+    print_message("plate reaching the sphere: AO intervals %.4f, off %.4f\n", thin_on, thin_off);
+    assert_true(thin_on < 1.0f - 1e-3);
+    assert_true(thin_on > thin_off + 0.02f);
+    obs_deep_free(&d);
+
+    /* the closed box: every pixel as without intervals and as deep_mode
+     * single (the front nodes alone, a flat depth buffer) */
+    slab_scene(&d, 8.6f, 10.0f);
+    obs_deep_result a, b, c;
+    assert_int_equal(obs_deep_run_cpu(&d, &on, &a, err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(&d, &single, &b, err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(&d, &off, &c, err), OBS_OK);
+    double worst = 0.0, lowest = 1.0;
+    for (int i = 0; i < 32 * 32; i++) {
+        worst = fmax(worst, fabs(a.ao_front.data[i] - b.ao_front.data[i]));
+        worst = fmax(worst, fabs(a.ao_front.data[i] - c.ao_front.data[i]));
+        lowest = fmin(lowest, a.ao_front.data[i]);
+    }
+    print_message("closed box: max |intervals - single, off| %.2e (lowest AO %.3f)\n", worst,
+                  lowest);
+    assert_true(worst < 1e-5);
+    assert_true(lowest < 0.8); /* the crease is there */
+    obs_deep_result_free(&a);
+    obs_deep_result_free(&b);
+    obs_deep_result_free(&c);
+    obs_deep_free(&d);
+}
+
+/* Methods gtao and hbao on deep input: their horizon search reads every
+ * node at a step's pixel (OITAO's multi-layer HBAO, Fig. 9).  In scene() the wall
+ * pixel beside the near object (depth 3, 7 in front of the wall: beyond
+ * the falloff) finds its horizon raised by the box face at 9.3 hidden
+ * behind that object only in multi mode; single mode (the front nodes
+ * alone) is the flat method on the front depth, pixel for pixel, and
+ * without the hidden box multi equals single. */
+static void horizon_deep(const char *method)
+{
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    obs_params multi = deep_params(OBS_DEEP_MULTI), single = deep_params(OBS_DEEP_SINGLE);
+    for (int i = 0; i < 2; i++) {
+        obs_params *p = i ? &single : &multi;
+        assert_int_equal(obs_param_set(p, "method", method, err), OBS_OK);
+        assert_int_equal(obs_param_set(p, "blur", "off", err), OBS_OK);
+    }
+    scene(&d, 9.3f, 1.0f);
+    float s = ao_at(&d, &single, 15, 16, NULL), m = ao_at(&d, &multi, 15, 16, NULL);
+    print_message("%s, hidden occluder: AO single %.4f, multi %.4f\n", method, s, m);
+    assert_true(m < s - 0.05f);
+    assert_float_equal(ao_at(&d, &multi, 4, 16, NULL), ao_at(&d, &single, 4, 16, NULL), 1e-6);
+
+    /* single = the flat chain's method (CPU) on the front nodes' depth */
+    obs_deep_result a;
+    assert_int_equal(obs_deep_run_cpu(&d, &single, &a, err), OBS_OK);
+    float depth[32 * 32];
+    for (int i = 0; i < 32 * 32; i++)
+        depth[i] = d.samples[d.offset[i] * OBS_DEEP_CH + OBS_DEEP_Z];
+    obs_gbuffer gb = {0};
+    gb.width = gb.height = 32;
+    gb.depth = (obs_plane){depth, 1, 0};
+    obs_result fr;
+    assert_int_equal(obs_run_cpu(&gb, &single, OBS_OUTPUT_AO, &fr, err), OBS_OK);
+    double worst = 0.0;
+    for (int i = 0; i < 32 * 32; i++)
+        worst = fmax(worst, fabs(a.ao_front.data[i] - fr.ao.data[i]));
+    print_message("%s, single vs the flat chain: max |diff| %.2e\n", method, worst);
+    assert_true(worst < 1e-4);
+    obs_deep_result_free(&a);
+    obs_result_free(&fr);
+    obs_deep_free(&d);
+
+    scene(&d, 0.0f, 0.0f);
+    assert_float_equal(ao_at(&d, &multi, 15, 16, NULL), ao_at(&d, &single, 15, 16, NULL), 1e-6);
+    obs_deep_free(&d);
+}
+
+static void test_gtao_deep(void **state)
+{
+    (void)state;
+    horizon_deep("gtao");
+}
+
+static void test_hbao_deep(void **state)
+{
+    (void)state;
+    horizon_deep("hbao");
+}
+
 /* A floor seen at a grazing angle (view plane 2y + z = -6, one opaque
  * node per pixel, normals derived from depth) with a tangent sphere
  * smaller than a pixel (radius 0.002): a sample on the shaded pixel reads
@@ -470,11 +687,11 @@ static void test_hidden_occluder_hemisphere(void **state)
 static void test_methods_refused(void **state)
 {
     (void)state;
-    static const char *const refused[] = {"hbao", "angle", "gtao"};
+    static const char *const refused[] = {"angle"};
     obs_deep_image d;
     obs_deep_result r;
     scene(&d, 9.3f, 1.0f);
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 1; k++) {
         obs_params p = deep_params(OBS_DEEP_MULTI);
         char err[OBS_ERR_LEN] = "", want[64];
         assert_int_equal(obs_param_set(&p, "method", refused[k], err), OBS_OK);
@@ -590,6 +807,18 @@ static void test_gl_twin(void **state)
     assert_int_equal(obs_param_set(&p, "range_check", "off", err), OBS_OK);
     compare_gl(ctx, &d, &p, "hidden occluder, multi, range check off");
     obs_deep_free(&d);
+    /* intervals from facing flags (the pass's OBS_DEEP_INTERVALS variant) */
+    slab_scene(&d, 8.6f, 8.7f);
+    p = deep_params(OBS_DEEP_MULTI);
+    assert_int_equal(obs_param_set(&p, "deep_intervals", "on", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "thin plate, intervals");
+    slab_scene_free_and(&d, 7.5f, 7.6f);
+    compare_gl(ctx, &d, &p, "plate in front, intervals");
+    assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "plate in front, intervals, m = 2");
+    obs_deep_free(&d);
+    scene(&d, 9.8f, 0.7f);
+    obs_deep_free(&d);
     /* the receiver's own tangent plane (spheres under a pixel) */
     grazing_floor(&d);
     p = subpixel_params(0);
@@ -622,6 +851,16 @@ static void test_gl_twin(void **state)
     p = deep_params(OBS_DEEP_SINGLE);
     assert_int_equal(obs_param_set(&p, "method", "hemisphere", err), OBS_OK);
     compare_gl(ctx, &d, &p, "hidden occluder, hemisphere, single");
+    /* method gtao: the program with gtao.glsl over the nodes */
+    p = deep_params(OBS_DEEP_MULTI);
+    assert_int_equal(obs_param_set(&p, "method", "gtao", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "hidden occluder, gtao, multi");
+    p = deep_params(OBS_DEEP_SINGLE);
+    assert_int_equal(obs_param_set(&p, "method", "gtao", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "hidden occluder, gtao, single");
+    p = deep_params(OBS_DEEP_MULTI);
+    assert_int_equal(obs_param_set(&p, "method", "hbao", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "hidden occluder, hbao, multi");
     obs_deep_free(&d);
     obs_ctx_destroy(ctx);
 }
@@ -648,9 +887,9 @@ static void test_gl_resources_reused(void **state)
     unsigned long before = ctx->gl_objects_created;
     assert_int_equal(obs_deep_run(ctx, &d, &p, &a, err), OBS_OK);
     unsigned long first = ctx->gl_objects_created - before;
-    /* two node arrays, three RG planes (front, blend, the blur's
+    /* three node arrays (positions, normals, interval ends), three RG planes (front, blend, the blur's
      * intermediate), the pass's framebuffer and one per plane */
-    assert_int_equal(first, 9);
+    assert_int_equal(first, 10);
     assert_int_equal(obs_deep_run(ctx, &d, &p, &b, err), OBS_OK);
     assert_int_equal(ctx->gl_objects_created - before, first);
     size_t n = (size_t)d.width * d.height * sizeof(float);
@@ -807,6 +1046,10 @@ int main(void)
         cmocka_unit_test(test_read_damaged_files),
         cmocka_unit_test(test_compress_eq5),
         cmocka_unit_test(test_hidden_occluder),
+        cmocka_unit_test(test_interval_lists),
+        cmocka_unit_test(test_intervals),
+        cmocka_unit_test(test_gtao_deep),
+        cmocka_unit_test(test_hbao_deep),
         cmocka_unit_test(test_subpixel_sphere),
         cmocka_unit_test(test_hidden_occluder_hemisphere),
         cmocka_unit_test(test_methods_refused),

@@ -66,10 +66,13 @@ static void test_rows_are_whole(void **state)
             assert_true(u->count_of < sizeof(obs__frame));
         }
     }
-    /* the deep chain runs the VAO methods and hemisphere (OITAO's GetAO) */
+    /* the deep chain runs the VAO methods, hemisphere (OITAO's GetAO) and
+     * the horizon searches of hbao and gtao over the nodes; not angle */
     assert_true(obs__method_get(OBS_METHOD_VAOPP)->deep);
     assert_true(obs__method_get(OBS_METHOD_HEMISPHERE)->deep);
-    assert_false(obs__method_get(OBS_METHOD_HBAO)->deep);
+    assert_true(obs__method_get(OBS_METHOD_HBAO)->deep);
+    assert_true(obs__method_get(OBS_METHOD_GTAO)->deep);
+    assert_false(obs__method_get(OBS_METHOD_ANGLE)->deep);
 }
 
 int main(void)

@@ -246,6 +246,8 @@ static void test_stacked_quads(void **state)
                 assert_float_equal(f[k * OBS_DEEP_CH + OBS_DEEP_Z], z[q], 1e-4);
                 assert_float_equal(f[k * OBS_DEEP_CH + OBS_DEEP_A], alpha[q], 0);
                 assert_float_equal(f[k * OBS_DEEP_CH + OBS_DEEP_NZ], 1.0f, 1e-5); /* facing the camera */
+                /* counter-clockwise seen from the camera: a front face */
+                assert_float_equal(f[k * OBS_DEEP_CH + OBS_DEEP_FACING], 1.0f, 0);
                 k++;
             }
         }
@@ -292,7 +294,7 @@ static void test_write_roundtrip(void **state)
     assert_int_equal(e.width, W);
     assert_int_equal(e.height, H);
     assert_int_equal(e.display_width, W);
-    assert_true(e.has_alpha && e.has_color && e.has_normal && !e.has_zback);
+    assert_true(e.has_alpha && e.has_color && e.has_normal && e.has_facing && !e.has_zback);
     assert_memory_equal(e.offset, d.offset, ((size_t)W * H + 1) * sizeof *d.offset);
     assert_true(d.offset[(size_t)W * H] > (uint64_t)W * H / 2);
     int pane_px = 0;

@@ -678,7 +678,7 @@ static void fill_deep(obs_deep_image *d)
     d->display_height = 4;
     d->offset = (uint64_t *)deep_offset;
     d->samples = deep_samples;
-    d->has_zback = d->has_alpha = d->has_color = 1;
+    d->has_zback = d->has_alpha = d->has_color = d->has_facing = 1;
     for (int k = 0; k < 16; k++)
         d->camera.projection[k] = (float)k / 3.0f;
     d->camera.has_projection = 1;
@@ -742,6 +742,7 @@ static void test_deep_round_trip(void **state)
         assert_int_equal(d->display_width, 8);
         assert_int_equal(d->display_height, 4);
         assert_true(d->has_zback && d->has_alpha && d->has_color && !d->has_normal);
+        assert_true(d->has_facing); /* flag 64, the tenth value */
         assert_true(d->camera.has_projection && !d->camera.has_world_to_camera);
         for (int k = 0; k < 16; k++)
             assert_true(d->camera.projection[k] == (float)k / 3.0f);
