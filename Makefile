@@ -143,6 +143,12 @@ $(UPSCALE): tools/exr_upscale.c $(LIB)
 
 # Deep input: OITAO Table I structure (bench/RESULTS.md, "Deep input").
 DEEP_BENCH := $(BUILD)/deep_bench
+# The blur kernel in Google's Highway (libhwy-dev) against the library's
+# OpenMP simd form (bench/blur_hwy.cc); built by make bench only, the
+# library does not link Highway.
+HWY_BENCH := $(BUILD)/blur_hwy_bench
+$(HWY_BENCH): bench/blur_hwy.cc $(LIB)
+	$(CXX) -I. $(CPPFLAGS) $(CORE_INC) $(CXXFLAGS) -std=c++17 -ffp-contract=off $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS) -lhwy
 $(DEEP_BENCH): bench/deep_bench.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CORE_INC) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
@@ -240,6 +246,12 @@ loops: $(CORE_OBJ) $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
 # the daemon and run afterwards, one at a time.  E2E_ONLY / E2E_SKIP: the
 # scripts' names (without .sh) to run, or to leave to another target.
 E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)
+# `make e2e OBSCURA_BACKEND=cpu`: every script on the CPU device (obscura
+# and obscurad read the variable where no --backend is given; gbuffer and
+# the bakes rasterise on a GL context still).
+ifneq ($(OBSCURA_BACKEND),)
+E2E_ENV += OBSCURA_BACKEND=$(OBSCURA_BACKEND)
+endif
 E2E_ALONE = drain load output bakes hostile_http limits recover
 E2E_ALL = $(wildcard tests/e2e/*.sh)
 E2E_RUN = $(if $(E2E_ONLY),$(filter $(addprefix tests/e2e/,$(addsuffix .sh,$(E2E_ONLY))),$(E2E_ALL)),\
@@ -264,7 +276,8 @@ headers:
 	@echo "headers: each public header compiles alone as C and C++"
 
 bench: deps
-	@$(MAKE) --no-print-directory all $(BENCH) $(EXT_BENCH) $(UPSCALE) $(DAEMON_BENCH) $(DEEP_BENCH)
+	@$(MAKE) --no-print-directory all $(BENCH) $(EXT_BENCH) $(UPSCALE) $(DAEMON_BENCH) $(DEEP_BENCH) \
+	  $(if $(wildcard /usr/include/hwy/highway.h),$(HWY_BENCH))
 	@BUILD=$(BUILD) bench/run.sh
 
 # Quality against ground truth (bench/QUALITY.md, bench/quality/*.png): every

@@ -1,6 +1,7 @@
 /* Frame timing: one context, many frames, medians.
  *
- *   frame_bench [--backend B] [--frames N] [--presets | --devices] G-BUFFER.exr CAMERA.json...
+ *   frame_bench [--backend B] [--frames N] [--presets | --devices | --cpu-only WxH]
+ *               G-BUFFER.exr CAMERA.json...
  *
  * For each G-buffer (and a 1920x1080 nearest-neighbour upscale of it):
  * the first frame (shaders compiled, targets allocated), the median of N
@@ -8,7 +9,11 @@
  * one run so the ratios are comparable.  Output is a Markdown table.
  * --presets: --quality's presets at 1920x1080 and 3840x2160; --devices:
  * every method on the CPU device (obs_run_cpu) against the GL context,
- * at the same sizes. */
+ * at the same sizes; --cpu-only WxH: the CPU device alone (no GL context:
+ * for a profiler), every method at that size, per pass (FRAME_BENCH_METHOD:
+ * one method), then the AO pass against a plain gather loop over the same
+ * samples; with FRAME_BENCH_TABLE1=D[,D...] instead VAO++ Table 1's
+ * structure on the CPU device at 16 samples, at each adaptive_diameter D. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -71,6 +76,21 @@ static float *upscale(const obs_plane *p, int sw, int sh, int w, int h)
             memcpy(out + ((size_t)y * w + x) * p->channels, src, sizeof(float) * p->channels);
         }
     return out;
+}
+
+/* gb's depth and normals upscaled to w x h (no colour), the same camera;
+ * the caller frees up->depth.data and up->normal.data. */
+static obs_gbuffer upscaled(const obs_gbuffer *gb, int w, int h)
+{
+    obs_gbuffer up = *gb;
+    up.width = w;
+    up.height = h;
+    up.display_width = up.display_height = 0;
+    up.display_x = up.display_y = 0;
+    up.depth = (obs_plane){upscale(&gb->depth, gb->width, gb->height, w, h), 1, 0};
+    up.normal = (obs_plane){upscale(&gb->normal, gb->width, gb->height, w, h), 3, 0};
+    up.color = (obs_plane){NULL, 0, 0};
+    return up;
 }
 
 static void bench(obs_ctx *ctx, const char *name, const obs_gbuffer *gb, int frames, int with_cpu)
@@ -281,10 +301,197 @@ static void devices_passes(void)
     printf("\n%s", devices_md);
 }
 
+/* --cpu-only: each method's default chain on the CPU device alone at
+ * one size, median wall ms per pass (no GL context: what a profiler such
+ * as perf or callgrind sees is the CPU device's own). */
+static void bench_cpu_only(const char *name, const obs_gbuffer *gb, int frames)
+{
+    char err[OBS_ERR_LEN];
+    if (frames > 64)
+        frames = 64;
+    if (frames < 1)
+        frames = 1;
+    printf("| G-buffer (upscaled) | size | method | CPU threads | wall ms |");
+    for (int q = 0; q < OBS_PASS_COUNT; q++)
+        printf(" %s |", obs_pass_name((obs_pass)q));
+    printf("\n|---|---|---|---|---|");
+    for (int q = 0; q < OBS_PASS_COUNT; q++)
+        printf("---|");
+    printf("\n");
+    const char *only = getenv("FRAME_BENCH_METHOD"); /* one method (profiling) */
+    for (int m = 0; m < obs__method_count(); m++) {
+        obs_params p = {0};
+        const char *method = obs__method_at(m)->name;
+        if (only && strcmp(only, method))
+            continue;
+        double t[64], pass[OBS_PASS_COUNT][64];
+        if (obs_param_set(&p, "method", method, err) != OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            exit(1);
+        }
+        for (int i = 0; i < frames; i++) {
+            obs_result r;
+            obs_pass_times pt;
+            double t0 = now_ms();
+            if (obs__run_cpu_timed(gb, &p, OBS_OUTPUT_AO, &r, &pt, err) != OBS_OK) {
+                fprintf(stderr, "frame_bench: %s: %s\n", method, err);
+                exit(1);
+            }
+            t[i] = now_ms() - t0;
+            obs_result_free(&r);
+            for (int q = 0; q < OBS_PASS_COUNT; q++)
+                pass[q][i] = pt.ms[q];
+        }
+        qsort(t, (size_t)frames, sizeof t[0], cmp);
+        printf("| %s | %dx%d | %s | %d | %.1f |", name, gb->width, gb->height, method,
+               obs__cpu_threads(), t[frames / 2]);
+        for (int q = 0; q < OBS_PASS_COUNT; q++) {
+            qsort(pass[q], (size_t)frames, sizeof pass[q][0], cmp);
+            double v = pass[q][frames / 2];
+            printf(v < 0 ? " - |" : " %.1f |", v);
+        }
+        printf("\n");
+        fflush(stdout);
+    }
+}
+
+/* The AO pass against the limit of its memory reads: the default chain
+ * (vaopp) at one thread, its AO pass's time and sample count (each
+ * sample one 8-byte fetch of the packed depth and normal z), then a plain
+ * gather loop over a plane of the same size that fetches the same number
+ * of samples per pixel at the same pixel offsets (the sample set scaled
+ * by the pixel's projected radius) and sums them.  Fetches per second of
+ * both: the distance of the AO pass to the gather limit. */
+static void bench_gather_limit(const obs_gbuffer *gb)
+{
+    char err[OBS_ERR_LEN];
+    obs_params p = {0}, rp;
+    obs_result r;
+    obs_pass_times pt;
+    int before = obs__cpu_set_threads(1);
+    double ao_ms = 1e30;
+    for (int i = 0; i < 3; i++) { /* the fastest of 3: the least disturbed by the load */
+        if (obs__run_cpu_timed(gb, &p, OBS_OUTPUT_AO | OBS_OUTPUT_SAMPLE_COUNT, &r, &pt, err) !=
+            OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            exit(1);
+        }
+        if (pt.ms[OBS_PASS_AO] < ao_ms)
+            ao_ms = pt.ms[OBS_PASS_AO];
+        if (i < 2)
+            obs_result_free(&r);
+    }
+    obs__frame f;
+    obs_params_resolve(&p, &rp);
+    if (obs__frame_setup(NULL, gb, &rp, &f, err) != OBS_OK) {
+        fprintf(stderr, "frame_bench: %s\n", err);
+        exit(1);
+    }
+    const int w = gb->width, h = gb->height;
+    const size_t npx = (size_t)w * (size_t)h;
+    float *dnz = malloc(sizeof(float) * 2 * npx), *rpx = malloc(sizeof(float) * npx);
+    double fetches = 0.0;
+    for (int y = 0; y < h; y++) /* each pixel's projected radius (the setup, not timed) */
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            float q[4];
+            obs__prep_position(&f, *obs__plane_px(&gb->depth, w, x, y), x, y, q);
+            dnz[2 * i] = q[3];
+            dnz[2 * i + 1] = 0.5f;
+            rpx[i] = q[3] > 0.0f ? obs__radius_px(&f, q, 0.5f * f.radius) : 0.0f;
+            fetches += r.sample_count.data[i];
+        }
+    double best = 1e30, sink = 0.0;
+    for (int rep = 0; rep < 3; rep++) {
+        double t0 = now_ms();
+        float total = 0.0f;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                size_t i = (size_t)y * w + x;
+                int n = (int)r.sample_count.data[i];
+                const float *xy = f.adaptive && n >= 2 ? f.sample_table + 2 * (n - 2) : f.sample_xy;
+                for (int k = 0; k < n; k++) {
+                    int qx = x + (int)(xy[2 * k] * rpx[i]), qy = y + (int)(xy[2 * k + 1] * rpx[i]);
+                    qx = qx < 0 ? 0 : qx >= w ? w - 1 : qx;
+                    qy = qy < 0 ? 0 : qy >= h ? h - 1 : qy;
+                    const float *d = dnz + 2 * ((size_t)qy * w + qx);
+                    total += d[0] * d[1];
+                }
+            }
+        double t = now_ms() - t0;
+        sink += total;
+        if (t < best)
+            best = t;
+    }
+    printf("| %dx%d | %.0f | %.1f | %.0f | %.1f | %.0f | %.1f |%s\n", w, h, fetches, ao_ms,
+           fetches / ao_ms / 1e3, best, fetches / best / 1e3, ao_ms / best, sink == 0.5 ? " " : "");
+    obs__cpu_set_threads(before);
+    obs_result_free(&r);
+    free(dnz);
+    free(rpx);
+}
+
+/* VAO++ Table 1's structure on the CPU device at 16 samples: VAO,
+ * + adaptive sampling (4.1), + culling pre-pass (4.2), VAO++ (both), the
+ * effect's wall ms (culling pre-pass + AO pass, what Table 1 counts),
+ * medians of `frames` interleaved, at adaptive_diameter `diameter`; the
+ * ratio to VAO and the mean samples per pixel with geometry. */
+static void bench_cpu_table1(const obs_gbuffer *gb, int frames, const char *diameter)
+{
+    char err[OBS_ERR_LEN];
+    obs_params p[4];
+    double t[4][64], mean[4] = {0};
+    if (frames > 64)
+        frames = 64;
+    for (int v = 0; v < 4; v++) {
+        memset(&p[v], 0, sizeof p[v]);
+        if (obs_param_set(&p[v], "samples", "16", err) != OBS_OK ||
+            obs_param_set(&p[v], "adaptive", v & 1 ? "on" : "off", err) != OBS_OK ||
+            obs_param_set(&p[v], "culling", v & 2 ? "careful" : "off", err) != OBS_OK ||
+            obs_param_set(&p[v], "adaptive_diameter", diameter, err) != OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            exit(1);
+        }
+    }
+    for (int i = -1; i < frames; i++) /* -1: the planes allocated, the counts read */
+        for (int v = 0; v < 4; v++) {
+            obs_result r;
+            obs_pass_times pt;
+            unsigned out = OBS_OUTPUT_AO | (i < 0 ? OBS_OUTPUT_SAMPLE_COUNT : 0);
+            if (obs__run_cpu_timed(gb, &p[v], out, &r, &pt, err) != OBS_OK) {
+                fprintf(stderr, "frame_bench: %s\n", err);
+                exit(1);
+            }
+            if (i < 0) {
+                double sum = 0.0;
+                size_t n = 0;
+                for (size_t k = 0; k < (size_t)gb->width * gb->height; k++)
+                    if (r.sample_count.data[k] > 0.0f) {
+                        sum += r.sample_count.data[k];
+                        n++;
+                    }
+                mean[v] = n ? sum / (double)n : 0.0;
+            } else {
+                t[v][i] = pt.ms[OBS_PASS_AO] + (pt.ms[OBS_PASS_CULL] > 0 ? pt.ms[OBS_PASS_CULL] : 0);
+            }
+            obs_result_free(&r);
+        }
+    double m[4];
+    for (int v = 0; v < 4; v++) {
+        qsort(t[v], (size_t)frames, sizeof t[v][0], cmp);
+        m[v] = t[v][frames / 2];
+    }
+    printf("| %dx%d | %s |", gb->width, gb->height, diameter);
+    for (int v = 0; v < 4; v++)
+        printf(v ? " %.1f (%.0f %%) |" : " %.1f |", m[v], 100.0 * m[v] / m[0]);
+    printf(" %.1f, %.1f, %.1f, %.1f |\n", mean[0], mean[1], mean[2], mean[3]);
+    fflush(stdout);
+}
+
 int main(int argc, char **argv)
 {
     obs_ctx_desc desc = {0};
-    int frames = 15, presets = 0, devices = 0;
+    int frames = 15, presets = 0, devices = 0, cpu_w = 0, cpu_h = 0;
     int i = 1;
     for (; i < argc && argv[i][0] == '-'; i++) {
         if (!strcmp(argv[i], "--backend") && i + 1 < argc)
@@ -295,12 +502,53 @@ int main(int argc, char **argv)
             presets = 1;
         else if (!strcmp(argv[i], "--devices"))
             devices = 1;
+        else if (!strcmp(argv[i], "--cpu-only") && i + 1 < argc &&
+                 sscanf(argv[++i], "%dx%d", &cpu_w, &cpu_h) != 2) {
+            fprintf(stderr, "frame_bench: --cpu-only takes WxH\n");
+            return 2;
+        }
     }
     if (argc - i < 2 || (argc - i) % 2) {
-        fprintf(stderr, "usage: frame_bench [--backend B] [--frames N] [--presets | --devices] GBUFFER.exr CAMERA.json...\n");
+        fprintf(stderr, "usage: frame_bench [--backend B] [--frames N] [--presets | --devices | --cpu-only WxH] GBUFFER.exr CAMERA.json...\n");
         return 2;
     }
     char err[OBS_ERR_LEN];
+    if (cpu_w > 0 && cpu_h > 0) { /* the CPU device alone: no context */
+        obs_gbuffer_file gf = {0};
+        if (obs_gbuffer_read_exr(argv[i], NULL, NULL, &gf, err) != OBS_OK ||
+            obs_camera_read_json(argv[i + 1], &gf.gb.camera, NULL, NULL, err) != OBS_OK) {
+            fprintf(stderr, "frame_bench: %s\n", err);
+            return 1;
+        }
+        obs_gbuffer up = upscaled(&gf.gb, cpu_w, cpu_h);
+        float *pd = (float *)up.depth.data, *pn = (float *)up.normal.data;
+        const char *base = strrchr(argv[i], '/') ? strrchr(argv[i], '/') + 1 : argv[i];
+        const char *t1 = getenv("FRAME_BENCH_TABLE1"); /* diameters, comma-separated */
+        if (t1) {
+            printf("VAO++ Table 1 on the CPU device, 16 samples: effect wall ms (culling pre-pass "
+                   "+ AO pass), %% of VAO; mean samples per pixel with geometry\n\n"
+                   "| size | adaptive_diameter | VAO | +adaptive | +culling | VAO++ | samples/px "
+                   "VAO, +adaptive, +culling, VAO++ |\n|---|---|---|---|---|---|---|\n");
+            char list[256];
+            snprintf(list, sizeof list, "%s", t1);
+            for (char *d = strtok(list, ","); d; d = strtok(NULL, ","))
+                bench_cpu_table1(&up, frames, d);
+            free(pd);
+            free(pn);
+            obs_gbuffer_free(&gf);
+            return 0;
+        }
+        bench_cpu_only(base, &up, frames);
+        printf("\nThe AO pass (vaopp, default chain, 1 thread, fastest of 3) against a plain gather "
+               "loop fetching the same samples (each one 8-byte load of depth and normal z at the "
+               "sample's pixel):\n\n| size | samples | AO pass ms | AO Mfetch/s | gather ms | "
+               "gather Mfetch/s | AO / gather |\n|---|---|---|---|---|---|---|\n");
+        bench_gather_limit(&up);
+        free(pd);
+        free(pn);
+        obs_gbuffer_free(&gf);
+        return 0;
+    }
     obs_ctx *ctx;
     double t0 = now_ms();
     if (obs_ctx_create(&desc, &ctx, err) != OBS_OK) {
@@ -339,16 +587,8 @@ int main(int argc, char **argv)
             static const int sizes[2][2] = {{1920, 1080}, {3840, 2160}};
             for (int k = 0; k < 2; k++) {
                 int pw = sizes[k][0], ph = sizes[k][1];
-                float *pd = upscale(&gf.gb.depth, gf.gb.width, gf.gb.height, pw, ph);
-                float *pn = upscale(&gf.gb.normal, gf.gb.width, gf.gb.height, pw, ph);
-                obs_gbuffer up = gf.gb;
-                up.width = pw;
-                up.height = ph;
-                up.display_width = up.display_height = 0;
-                up.display_x = up.display_y = 0;
-                up.depth = (obs_plane){pd, 1, 0};
-                up.normal = (obs_plane){pn, 3, 0};
-                up.color = (obs_plane){NULL, 0, 0};
+                obs_gbuffer up = upscaled(&gf.gb, pw, ph);
+                float *pd = (float *)up.depth.data, *pn = (float *)up.normal.data;
                 int nf = k ? (frames < 5 ? frames : 5) : frames;
                 if (devices)
                     bench_devices(ctx, base, &up, nf, obs__cpu_threads());

@@ -26,6 +26,12 @@ echo
 # the same run, then the CPU device's time per pass
 "$BUILD/frame_bench" --frames 5 --devices "$1" "$2"
 echo
+# the blur kernel in Highway against the library's OpenMP simd form, one
+# thread (bench/blur_hwy.cc; when libhwy-dev is installed)
+if [ -x "$BUILD/blur_hwy_bench" ]; then
+    "$BUILD/blur_hwy_bench"
+    echo
+fi
 # cold start: one process with obscura's program cache warm and Mesa's
 # off, against Mesa's cache warm and no cache (bench/coldstart.sh)
 BUILD="$BUILD" bench/coldstart.sh

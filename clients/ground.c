@@ -456,6 +456,13 @@ int cli_gbuffer(int argc, char **argv)
 
     obs_ctx_desc desc = {.log = log_cb, .log_user = &a};
     const char *bname = a.backend ? a.backend : getenv("OBSCURA_BACKEND");
+    if (bname && !strcmp(bname, "cpu")) {
+        if (a.backend)
+            cli_die_usage(a.cmd, "--backend cpu: %s rasterises a mesh, which needs a GL context "
+                                 "(auto|egl-device|egl-surfaceless|osmesa); the CPU device runs "
+                                 "the AO chain only", a.cmd);
+        bname = NULL; /* OBSCURA_BACKEND=cpu names the AO chain's device: a GL context rasterises */
+    }
     if (bname && *bname && obs_backend_parse(bname, &desc.backend) != OBS_OK)
         cli_die_usage(a.cmd, "backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa", bname);
     double t0 = cli_now_s();

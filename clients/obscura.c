@@ -108,7 +108,8 @@ static const cli_opt ao_opts[] = {
      "AOScreen.Y the chain's, AOBaked.Y the channel; none: not combined"},
     {"max-size", "N", "largest accepted width or height (default 16384)"},
     {"backend", "B", "auto|cpu|egl-device|egl-surfaceless|osmesa (or OBSCURA_BACKEND); cpu: the "
-     "chain on the CPU device (every core, SIMD), no GL context; auto: a GL context"},
+     "chain on the CPU device (every core, SIMD), no GL context; auto: a GPU, else the faster of cpu "
+     "and llvmpipe, measured once and kept in the cache folder"},
     {"cache-dir", "DIR", "program cache folder (or OBSCURA_CACHE_DIR; default "
      "$XDG_CACHE_HOME/obscura, else ~/.cache/obscura; '': none)"},
     {"cpu", NULL, "the same as --backend cpu"},
@@ -375,6 +376,20 @@ static obs_status put_stdout(const obs_bytes *b, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
+/* A whole file as it is (the daemon's deep EXR answer). */
+static obs_status put_file(const char *path, const obs_bytes *b, char err[OBS_ERR_LEN])
+{
+    FILE *fp = fopen(path, "wb");
+    int ok = fp && fwrite(b->data, 1, b->size, fp) == b->size;
+    if (fp && fclose(fp) != 0)
+        ok = 0;
+    if (!ok) {
+        snprintf(err, OBS_ERR_LEN, "cannot write it: %s", strerror(errno));
+        return OBS_IO;
+    }
+    return OBS_OK;
+}
+
 /* A PNG of `obscura ao` to its file, or to stdout under -o -. */
 static obs_status write_png_out(const ao_args *a, const char *path, const obs_image *img,
                                 const obs_png_options *po, char err[OBS_ERR_LEN])
@@ -571,6 +586,30 @@ static const char *cache_dir_of(const char *flag)
     return d;
 }
 
+/* --backend auto (or OBSCURA_BACKEND=auto): a GPU, else the faster of
+ * the CPU device and llvmpipe, measured once and kept in the cache
+ * folder (obs_device_choose); no backend named: the kept choice when
+ * there is one, else a GL context as the backend order has it. */
+static void choose_device(ao_args *a)
+{
+    const char *name = a->backend ? a->backend : getenv("OBSCURA_BACKEND");
+    int named_auto = name && !strcmp(name, "auto");
+    if (name && *name && !named_auto)
+        return; /* a GL backend named: that one */
+    obs_device_choice ch;
+    char err[OBS_ERR_LEN] = "";
+    if (obs_device_choose(cache_dir_of(a->cache_dir), &a->req.params, named_auto, &ch, err) != OBS_OK) {
+        log_cb(NULL, OBS_LOG_WARN, err); /* measuring failed: a GL context, as before */
+        return;
+    }
+    if (verbosity >= OBS_LOG_DEBUG || (named_auto && ch.measured && verbosity >= OBS_LOG_INFO))
+        fprintf(stderr, "obscura: device: %s\n", ch.why);
+    if (ch.cpu)
+        a->cpu = 1;
+    else if (ch.backend == OBS_BACKEND_EGL_DEVICE)
+        a->backend = "egl-device";
+}
+
 /* -v: what the context built and what it loaded from the cache. */
 static void log_programs(const obs_ctx *ctx)
 {
@@ -649,10 +688,9 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         return cli_fail(OBS_UNSUPPORTED, a->in, err);
     }
     if ((a->req.outputs & OBS_OUTPUT_DEEP) &&
-        (a->req.outputs != OBS_OUTPUT_DEEP || a->req.format != OBS_HTTP_EXR || server ||
-         !strcmp(a->out, "-"))) {
-        snprintf(err, OBS_ERR_LEN, "--output deep writes one deep EXR file in-process: not with other "
-                 "outputs, PNG, --server or stdout");
+        (a->req.outputs != OBS_OUTPUT_DEEP || a->req.format != OBS_HTTP_EXR || !strcmp(a->out, "-"))) {
+        snprintf(err, OBS_ERR_LEN, "--output deep writes one deep EXR file: not with other outputs, PNG "
+                 "or stdout");
         return cli_fail(OBS_INVALID_ARGUMENT, a->in, err);
     }
     double t0 = now_ms();
@@ -667,7 +705,19 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         (rc = cli_input_warnings(a->in, &dinfo, a->req.strict)) != EXIT_OK)
         goto done;
     t0 = now_ms();
-    if (a->cpu) {
+    if (server && (a->req.outputs & OBS_OUTPUT_DEEP)) {
+        /* the daemon answers the deep EXR itself: written as it came */
+        obs_bytes file = {0};
+        if ((rc = cli_remote_run_deep_file(server, argc, argv, a->in, &d, &file)) == EXIT_OK &&
+            (rc = cli_remote_result_warnings(a, &dinfo)) == EXIT_OK) {
+            if ((s = put_file(a->out, &file, err)) != OBS_OK)
+                rc = cli_fail(s, a->out, err);
+            else if (verbosity >= OBS_LOG_INFO)
+                fprintf(stderr, "obscura: wrote %s\n", a->out);
+        }
+        obs_bytes_free(&file);
+        goto done;
+    } else if (a->cpu) {
         s = obs_deep_run_cpu(&d, &a->req.params, &r, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         if ((rc = cli_remote_run_deep(server, argc, argv, a->in, &d, a->req.outputs, &r)) != EXIT_OK)
@@ -838,7 +888,8 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
 {
     obs_status s;
     if (a->cpu) {
-        s = obs_run_cpu(&gf->gb, &a->req.params, outputs, res, err);
+        obs_cpu_options o = {.log = log_cb};
+        s = obs_run_cpu_opts(&gf->gb, &a->req.params, outputs, res, &o, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, res);
     } else {
@@ -997,6 +1048,8 @@ static int cmd_ao(int argc, char **argv)
     parse_ao(argc, argv, &a);
     if (!server && backend_is_cpu(a.backend)) /* with --server the backend is obscurad's */
         a.cpu = 1;
+    if (!server && !a.cpu)
+        choose_device(&a);
     obs_limits lim = {0};
     if (a.max_size)
         lim.max_width = lim.max_height = (int)a.max_size;

@@ -286,6 +286,7 @@ static const char *outputs_name(unsigned outputs)
     case OBS_OUTPUT_MULTIBOUNCE: return "multibounce";
     case OBS_OUTPUT_BENT: return "bent";
     case OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_BENT: return "aovs";
+    case OBS_OUTPUT_DEEP: return "deep";
     default: return NULL;
     }
 }
@@ -312,11 +313,25 @@ static int copy_image(const float *src, size_t stride_floats, int w, int h, int 
     return 0;
 }
 
-/* What an answer fills: a flat frame's result, or deep input's. */
+/* What an answer fills: a flat frame's result, or deep input's; with
+ * output deep, the answer's deep EXR as it came (`file`). */
 typedef struct answer {
     obs_result *flat;
     obs_deep_result *deep;
+    obs_bytes *file;
 } answer;
+
+/* Keeps a copy of the answer's EXR in res->file.  0, or -1 out of memory. */
+static int answer_file(answer *res, const unsigned char *body, size_t len, char *msg, size_t msg_len)
+{
+    if (!(res->file->data = malloc(len ? len : 1))) {
+        snprintf(msg, msg_len, "out of memory for the answer");
+        return -1;
+    }
+    memcpy(res->file->data, body, len);
+    res->file->size = len;
+    return 0;
+}
 
 static void answer_free(answer *a)
 {
@@ -324,6 +339,8 @@ static void answer_free(answer *a)
         obs_result_free(a->flat);
     if (a->deep)
         obs_deep_result_free(a->deep);
+    if (a->file)
+        obs_bytes_free(a->file);
 }
 
 /* Where a raw image of the answer goes (NULL: not one asked for). */
@@ -382,6 +399,10 @@ static int binary_once(const server_addr *a, const obs_bytes *frame, answer *res
     }
     for (int i = 0; i < r.warning_count; i++)
         said_add(r.warnings[i], strlen(r.warnings[i]));
+    if (res->file) {
+        rc = r.body == OBS_BIN_EXR && answer_file(res, r.blob, r.blob_len, msg, msg_len) == 0 ? 0 : 500;
+        goto done;
+    }
     for (int i = 0; i < r.image_count; i++) {
         /* take the images over: they are ours */
         obs_image *slot = answer_slot(res, r.images[i].output);
@@ -529,7 +550,7 @@ static int exr_to_result(const unsigned char *body, size_t len, unsigned outputs
             exr_images(body, len, count ? "Samples.Y" : NULL, &r->sample_count, mb, 3, &r->multibounce,
                        msg, msg_len))
             return -1;
-        /* the bent normal is left out by methods without one: read when there */
+        /* the bent normal (every method has one): read when there */
         return (outputs & OBS_OUTPUT_BENT) ? exr_vector(body, len, bent, &r->bent, msg, msg_len) : 0;
     }
     obs_deep_result *d = res->deep;
@@ -614,7 +635,10 @@ static int http_once(const server_addr *a, const char *stream, const char *query
             v += strspn(v, " \t");
             said_add(v, strcspn(v, "\r\n"));
         }
-    rc = exr_to_result(payload, plen, outputs, res, msg, msg_len) == 0 ? 0 : 500;
+    if (res->file)
+        rc = answer_file(res, payload, plen, msg, msg_len) == 0 ? 0 : 500;
+    else
+        rc = exr_to_result(payload, plen, outputs, res, msg, msg_len) == 0 ? 0 : 500;
 done:
     free(head);
     free(ans);
@@ -737,6 +761,8 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
         memset(out->flat, 0, sizeof *out->flat);
     if (out->deep)
         memset(out->deep, 0, sizeof *out->deep);
+    if (out->file)
+        *out->file = (obs_bytes){0};
     ps.n = pb.n = 0;
     for (int k = 0; k < nserv; k++) {
         if (parse_server(urls[k], &addrs[k]) != 0) {
@@ -756,7 +782,7 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
         return RC_USAGE;
     }
     if (!oname) {
-        fprintf(stderr, "obscura: error: --server: the daemon answers ao, composite, both, multibounce, bent or aovs, not this --output\n");
+        fprintf(stderr, "obscura: error: --server: the daemon answers ao, composite, both, multibounce, bent, aovs or deep, not this --output\n");
         return RC_USAGE;
     }
 
@@ -795,7 +821,7 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
     if (any_bin) {
         collect(argc, argv, 0, &pb, names_b);
         add(&pb, "output", oname);
-        add(&pb, "format", "raw");
+        add(&pb, "format", out->file ? "exr" : "raw"); /* deep: the file as it is */
         if (token && *token)
             add(&pb, "token", token);
         obs_bin_request_desc d = {.id = 1, .params = pb.p, .param_count = pb.n, .gb = gb, .deep = deep};
@@ -876,13 +902,20 @@ fail:
 int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
                    const obs_gbuffer *gb, unsigned outputs, obs_result *out)
 {
-    answer a = {out, NULL};
+    answer a = {out, NULL, NULL};
     return run_remote(server, argc, argv, in_path, gb, NULL, outputs, &a);
 }
 
 int cli_remote_run_deep(const char *server, int argc, char **argv, const char *in_path,
                         const obs_deep_image *deep, unsigned outputs, obs_deep_result *out)
 {
-    answer a = {NULL, out};
+    answer a = {NULL, out, NULL};
     return run_remote(server, argc, argv, in_path, NULL, deep, outputs, &a);
+}
+
+int cli_remote_run_deep_file(const char *server, int argc, char **argv, const char *in_path,
+                             const obs_deep_image *deep, obs_bytes *file)
+{
+    answer a = {NULL, NULL, file};
+    return run_remote(server, argc, argv, in_path, NULL, deep, OBS_OUTPUT_DEEP, &a);
 }

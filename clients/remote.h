@@ -52,6 +52,10 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
  * obs_deep_result_free(). */
 int cli_remote_run_deep(const char *server, int argc, char **argv, const char *in_path,
                         const obs_deep_image *deep, unsigned outputs, obs_deep_result *out);
+/* --output deep: the daemon's answer, the two-part deep EXR, as it came
+ * into *file (the caller frees it with obs_bytes_free()). */
+int cli_remote_run_deep_file(const char *server, int argc, char **argv, const char *in_path,
+                             const obs_deep_image *deep, obs_bytes *file);
 
 /* The warnings the last answer carried (X-Obscura-Warning over HTTP,
  * the 200's warnings over the binary protocol: the daemon's checks of

@@ -332,6 +332,11 @@ int cli_warmup(int argc, char **argv)
         return rc;
 
     obs_ctx_desc desc = {.log = log_cb};
+    if (o.backend && !strcmp(o.backend, "cpu")) { /* --backend cpu or OBSCURA_BACKEND=cpu */
+        fprintf(stderr, "obscura: warmup: the CPU device compiles no programs: nothing to warm "
+                        "up (the program cache is for the GL backends)\n");
+        return EXIT_OK;
+    }
     if (o.backend && *o.backend && obs_backend_parse(o.backend, &desc.backend) != OBS_OK) {
         fprintf(stderr, "obscura: error: warmup: backend '%s' is not one of auto|egl-device|egl-surfaceless|osmesa\n",
                 o.backend);

@@ -31,6 +31,10 @@ int obs__size_mul3(size_t a, size_t b, size_t c, size_t *out);
 size_t obs__plane_stride(const obs_plane *p, int width);
 const float *obs__plane_px(const obs_plane *p, int width, int x, int y);
 
+/* The key of --backend auto's kept measurement (device_auto.c): "HOST
+ * VERSION METHOD THREADS", the host's blanks as '_'. */
+void obs__device_key(const char *method, char *buf, size_t n);
+
 /* Checks a G-buffer's sizes and planes before anything runs; the message
  * names the offending plane. */
 obs_status obs__gbuffer_validate(const obs_gbuffer *gb, char err[OBS_ERR_LEN]);

@@ -107,7 +107,8 @@
     X(frame_deadline, INT, 0, 86400, "60",                                   \
       "seconds of GL work one frame may take; past it the frame is stopped "  \
       "(the AO pass runs in 16 bands of rows, the clock read between "        \
-      "them) and answered 422 deadline_exceeded, and the GL worker takes "    \
+      "them; on the CPU device between passes and the AO pass's tiles) "      \
+      "and answered 422 deadline_exceeded, and the GL worker takes "          \
       "the next frame (0: no deadline, the AO pass drawn at once)")           \
     X(keep_memory, SIZE, 0, 1099511627776, "512m",                             \
       "texture memory the GL worker keeps for the next frame of the same "     \
@@ -120,8 +121,9 @@
       "read-only when it cannot be written")                                   \
     X(backend, ENUM, 0, 0, "auto",                                             \
       "backend: auto|egl-device|egl-surfaceless|osmesa (a GL context) or "    \
-      "cpu (the CPU device, no GL context) (default: OBSCURA_BACKEND, else "   \
-      "auto)")                                                                 \
+      "cpu (the CPU device, no GL context); auto named: a GPU, else the "     \
+      "faster of cpu and llvmpipe, measured once and kept in the cache "      \
+      "folder (default: OBSCURA_BACKEND, else auto)")                          \
     X(log_level, ENUM, 0, 0, "info",                                           \
       "error|warn|info|debug; info logs one line per request")                \
     X(fail_gl_after, INT, 0, 1000000000, "0",                                  \

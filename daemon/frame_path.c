@@ -109,6 +109,10 @@ int obsd_fp_part(const obsd_fp *fp)
 
 obs_status obsd_fp_check_output(const obsd_fp *fp, const obs_http_request *hr, char err[OBS_ERR_LEN])
 {
+    if ((hr->outputs & OBS_OUTPUT_DEEP) && !fp->deep) {
+        snprintf(err, OBS_ERR_LEN, "output=deep: the input is not a deep EXR (the deep AO is of deep input's nodes)");
+        return OBS_INVALID_ARGUMENT;
+    }
     if (!hr->append)
         return OBS_OK;
     if (!fp->src) {
@@ -269,6 +273,14 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
     *out = (obs_bytes){0};
     if (raw) {
         /* nothing to write: the protocol sends the planes */
+    } else if (hr->outputs & OBS_OUTPUT_DEEP) {
+        /* every kept node's AO (the CPU twin, as obscura ao --output deep) */
+        obs_deep_ao nodes;
+        s = obs_deep_ao_nodes(fp->deep, fp->job.params, &nodes, err);
+        if (s == OBS_OK)
+            s = obs_deep_ao_write_exr_mem(&nodes, &fp->job.deep_result.ao_blend,
+                                          &fp->job.deep_result.ao_front, out, err);
+        obs_deep_ao_free(&nodes);
     } else if (hr->format == OBS_HTTP_EXR) {
         /* copies of the image headers only: the pixels stay where they are */
         obs_result flat = {0};

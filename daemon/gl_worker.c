@@ -184,7 +184,9 @@ static void *worker_main(void *arg)
         } else if (w->cpu && job->deep) {
             job->status = obs_deep_run_cpu(job->deep, job->params, &job->deep_result, job->err);
         } else if (w->cpu) {
-            job->status = obs_run_cpu(job->gb, job->params, job->outputs, &job->result, job->err);
+            obs_cpu_options o = {.deadline = w->frame_deadline}; /* as the GL context's */
+            job->status = obs_run_cpu_opts(job->gb, job->params, job->outputs, &job->result, &o,
+                                           job->err);
         } else if (job->deep) {
             job->status = obs_deep_run(ctx, job->deep, job->params, &job->deep_result, job->err);
         } else {

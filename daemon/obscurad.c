@@ -97,8 +97,11 @@ static int context_desc(const obsd_config *cfg, obs_ctx_desc *desc)
     const char *env = getenv("OBSCURA_BACKEND");
     char bname[32];
     obsd_config_format(cfg, bo, bname, sizeof bname);
-    if (!cfg->set[bo - obsd_opt_at(0)] && env && *env)
+    int named = cfg->set[bo - obsd_opt_at(0)];
+    if (!named && env && *env) {
         snprintf(bname, sizeof bname, "%s", env);
+        named = 1;
+    }
     int cpu = !strcmp(bname, "cpu");
     if (!cpu && obs_backend_parse(bname, &desc->backend) != OBS_OK) {
         obsd_log(OBSD_LOG_ERROR, "backend '%s' is not one of " OBSD_CHOICES_backend, bname);
@@ -111,6 +114,20 @@ static int context_desc(const obsd_config *cfg, obs_ctx_desc *desc)
                                            sizeof cache, why);
     if (why[0])
         obsd_log(OBSD_LOG_WARN, "%s", why);
+    if (!cpu && desc->backend == OBS_BACKEND_AUTO) {
+        /* auto: a GPU, else the faster device for the default chain,
+         * measured when auto was named and kept in the cache folder */
+        obs_device_choice ch;
+        char err[OBS_ERR_LEN] = "";
+        if (obs_device_choose(desc->cache_dir, NULL, named, &ch, err) != OBS_OK) {
+            obsd_log(OBSD_LOG_WARN, "backend auto: %s; a GL context", err);
+        } else {
+            obsd_log(named ? OBSD_LOG_INFO : OBSD_LOG_DEBUG, "backend auto: %s", ch.why);
+            cpu = ch.cpu;
+            if (ch.backend == OBS_BACKEND_EGL_DEVICE)
+                desc->backend = OBS_BACKEND_EGL_DEVICE;
+        }
+    }
     return cpu;
 }
 

@@ -716,6 +716,8 @@ obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, cons
         return s;
     if (out->raw_out && out->hr.format != OBS_HTTP_EXR)
         return fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
+    if (out->raw_out && (out->hr.outputs & OBS_OUTPUT_DEEP))
+        return fail(err, OBS_INVALID_ARGUMENT, "output=deep answers a deep EXR: it needs format=exr, not raw");
     if (out->raw_out && out->hr.append)
         return fail(err, OBS_INVALID_ARGUMENT, "append=1 writes an EXR: it needs format=exr, not raw");
     if (!get_u8(&r, &body))
@@ -788,6 +790,8 @@ static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, 
         return s;
     if (q->raw_out && q->hr.format != OBS_HTTP_EXR)
         return fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
+    if (q->raw_out && (q->hr.outputs & OBS_OUTPUT_DEEP))
+        return fail(err, OBS_INVALID_ARGUMENT, "output=deep answers a deep EXR: it needs format=exr, not raw");
     if (q->raw_out && q->hr.append)
         return fail(err, OBS_INVALID_ARGUMENT, "append=1 writes an EXR: it needs format=exr, not raw");
     if (!get_u8(r, &body))

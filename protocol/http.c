@@ -12,7 +12,8 @@
 enum { Q = OBS_HTTP_QUERY, CLI = OBS_HTTP_CLI, ANY = Q | CLI };
 
 /* The debug outputs are the CLI's only: obscurad answers AO, the
- * composite, the multi-bounce AO and the AOVs (clients/remote.c refuses
+ * composite, the multi-bounce AO, the AOVs and a deep frame's deep EXR
+ * (clients/remote.c refuses
  * the others with --server). */
 static const obs_http_choice output_choices[] = {
     {"ao", OBS_OUTPUT_AO, ANY},
@@ -26,7 +27,7 @@ static const obs_http_choice output_choices[] = {
     /* a compositor's set in one EXR (README's "AOVs" table) */
     {"bent", OBS_OUTPUT_BENT, ANY},
     {"aovs", OBS_OUTPUT_AO | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_BENT, ANY},
-    {"deep", OBS_OUTPUT_DEEP, CLI},
+    {"deep", OBS_OUTPUT_DEEP, ANY}, /* deep input: the two-part deep EXR alone */
     {NULL, 0, 0}};
 static const obs_http_choice format_choices[] = {
     {"exr", OBS_HTTP_EXR, ANY}, {"png", OBS_HTTP_PNG, ANY}, {NULL, 0, 0}};
@@ -302,6 +303,11 @@ obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LE
                               "format=png holds one image: ask for one output (output=ao, "
                               "output=composite or output=multibounce), or use format=exr for "
                               "both or aovs");
+    if ((r->outputs & OBS_OUTPUT_DEEP) &&
+        (r->outputs != OBS_OUTPUT_DEEP || r->format != OBS_HTTP_EXR || r->append || r->layer))
+        return obs_status_fail(err, OBS_INVALID_ARGUMENT,
+                              "output=deep answers one deep EXR (deep input): not with other "
+                              "outputs, format=png, append or layer");
     if (r->append && r->format != OBS_HTTP_EXR)
         return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "append=1 writes the input EXR back with the AO added: it needs "

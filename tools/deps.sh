@@ -11,10 +11,11 @@ libassimp-dev libembree-dev nettle-dev libsuitesparse-dev libmeshoptimizer-dev"
 # PyYAML), make quality's referee (shared/tools/aometrics.py: numpy,
 # OpenImageIO), oiiotool (tests/e2e/output.sh reads obscura's EXRs back with
 # OpenImageIO), python3 with pip and wheel (the Python client's tests,
-# pip install clients/python offline).  `deps.sh --build` leaves them out
-# (deploy/container).
+# pip install clients/python offline), Highway (make bench's blur kernel
+# in Highway against the library's OpenMP simd form, bench/blur_hwy.cc).
+# `deps.sh --build` leaves them out (deploy/container).
 if [ "${1:-}" != "--build" ]; then
-    PKGS="$PKGS chromium nodejs python3-yaml systemd python3-numpy python3-openimageio openimageio-tools python3 python3-pip python3-wheel"
+    PKGS="$PKGS libhwy-dev chromium nodejs python3-yaml systemd python3-numpy python3-openimageio openimageio-tools python3 python3-pip python3-wheel"
     command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
 fi
 

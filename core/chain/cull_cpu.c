@@ -66,12 +66,13 @@ void obs__cull_prepass_dnz(const obs__frame *f, const float *pos, const float *n
     obs__cpu_rows(f->cull_h, 1, cull_rows, &c);
 }
 
-static int clampi(int v, int hi) { return v < 0 ? 0 : v > hi ? hi : v; }
+static inline int clampi(int v, int hi) { return v < 0 ? 0 : v > hi ? hi : v; }
 
 /* GL_LINEAR with GL_CLAMP_TO_EDGE at the pixel corner (px, py), texel
  * coordinate (px / 8 - 0.5, py / 8 - 0.5) (exact in float), as
  * cull_candidate() in vao.frag.glsl computes it from four image loads. */
-float obs__cull_fetch(const obs__frame *f, const float *est, int px, int py)
+static inline __attribute__((always_inline)) float fetch(const obs__frame *f, const float *est,
+                                                         int px, int py)
 {
     float u = (float)px * 0.125f - 0.5f;
     float v = (float)py * 0.125f - 0.5f;
@@ -91,13 +92,49 @@ float obs__cull_fetch(const obs__frame *f, const float *est, int px, int py)
     return fmaf(b, bottom - top, top);
 }
 
+float obs__cull_fetch(const obs__frame *f, const float *est, int px, int py)
+{
+    return fetch(f, est, px, py);
+}
+
 int obs__cull_candidate(const obs__frame *f, const float *est, int x, int y)
 {
     /* Section 4.2: "When at least one of these pixels exhibits occlusion,
      * we calculate full AO - otherwise the pixel is a candidate for
      * culling." */
     for (int k = 0; k < 4; k++)
-        if (obs__cull_fetch(f, est, x + (k & 1), y + (k >> 1)) < f->cull_threshold)
+        if (fetch(f, est, x + (k & 1), y + (k >> 1)) < f->cull_threshold)
             return 0;
     return 1;
+}
+
+/* obs__cull_candidate of a tile's pixels: a pixel corner is shared by
+ * four pixels, so each corner's fetch is computed once, row of corners by
+ * row of corners (the same fetch, the same comparison: the same answer).
+ * In the clones of OBS__LANES, fmaf and floorf are instructions. */
+OBS__LANES
+void obs__cull_candidates(const obs__frame *f, const float *est, int x0, int x1, int y0, int y1,
+                          unsigned char *cand)
+{
+    const int n = x1 - x0;
+    const float thr = f->cull_threshold;
+    unsigned char row[2][OBS__CULL_TILE_MAX + 1]; /* corner row y, y + 1: "shows occlusion" */
+    if (n <= 0 || n > OBS__CULL_TILE_MAX) { /* not a tile this form takes */
+        for (int y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++)
+                cand[(size_t)(y - y0) * (size_t)n + (size_t)(x - x0)] =
+                    (unsigned char)obs__cull_candidate(f, est, x, y);
+        return;
+    }
+    for (int i = 0; i <= n; i++)
+        row[0][i] = fetch(f, est, x0 + i, y0) < thr;
+    for (int y = y0; y < y1; y++) {
+        const unsigned char *top = row[(y - y0) & 1];
+        unsigned char *bottom = row[(y - y0 + 1) & 1];
+        for (int i = 0; i <= n; i++)
+            bottom[i] = fetch(f, est, x0 + i, y + 1) < thr;
+        unsigned char *out = cand + (size_t)(y - y0) * (size_t)n;
+        for (int i = 0; i < n; i++)
+            out[i] = !(top[i] | top[i + 1] | bottom[i] | bottom[i + 1]);
+    }
 }

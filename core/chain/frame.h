@@ -268,6 +268,15 @@ float obs__cull_fetch(const obs__frame *f, const float *est, int px, int py);
  * pixel is a culling candidate (GLSL: cull_candidate() in vao.frag.glsl). */
 int obs__cull_candidate(const obs__frame *f, const float *est, int x, int y);
 
+/* obs__cull_candidate for every pixel of the tile [x0, x1) x [y0, y1),
+ * 1 or 0 at cand[(y - y0) * (x1 - x0) + x - x0]; each pixel corner's
+ * fetch once (a corner is shared by four pixels).  Tiles up to
+ * OBS__CULL_TILE_MAX pixels wide take that form, wider ones the test
+ * pixel by pixel. */
+#define OBS__CULL_TILE_MAX 256
+void obs__cull_candidates(const obs__frame *f, const float *est, int x0, int x1, int y0, int y1,
+                          unsigned char *cand);
+
 /* The estimator of obs__vao_estimate that also gathers colour bleeding
  * (VAO++ section 4.7, eq 5; GLSL: vao_estimate() in vao.glsl): with
  * f->bleed_step > 0, bleed gets the mean over every bleed_step-th sample

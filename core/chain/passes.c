@@ -25,16 +25,8 @@ obs_status obs__plan_init(obs__plan *pl, obs_ctx *log_ctx, const obs_gbuffer *gb
     /* the fit reads the AO: read back whenever it is made */
     pl->outputs = pl->multibounce ? outputs | OBS_OUTPUT_AO : outputs & ~OBS_OUTPUT_MULTIBOUNCE;
     pl->method = obs__method_get(f->method);
-    /* the bent normal: of the methods that have one (in aovs: when
-     * available), of full-resolution frames */
-    /* vaopp and vao (no pixel function): the chain's estimator has one */
-    if ((outputs & OBS_OUTPUT_BENT) && pl->method && pl->method->pixel && !pl->method->pixel_bent) {
-        pl->outputs &= ~OBS_OUTPUT_BENT;
-        if (!pl->outputs)
-            return obs__fail(err, OBS_INVALID_ARGUMENT,
-                             "method %s has no bent normal (methods vaopp, vao and gtao have one)",
-                             pl->method->name);
-    }
+    /* the bent normal: every method has one (vaopp and vao: the chain's
+     * estimator; the others: pixel_bent), of full-resolution frames */
     if ((pl->outputs & OBS_OUTPUT_BENT) && f->half)
         return obs__fail(err, OBS_INVALID_ARGUMENT,
                          "ao_resolution half has no bent normal output (use ao_resolution full)");

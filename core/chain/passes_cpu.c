@@ -2,6 +2,7 @@
  * (passes_gl.c), pixel by pixel.  The order and whether a pass runs are
  * the table's (passes.c); the driver is run_cpu.c. */
 #include <string.h>
+#include <time.h>
 
 #include "chain/bands_cpu.h"
 #include "chain/multibounce.h"
@@ -63,15 +64,37 @@ static void vao_bent(const obs__frame *f, const float *pos, const float *nrm, in
  * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
  * (when the composite or the output reads it) and the debug planes (NULL:
  * not wanted) of every pixel. */
+/* The clock against the run's deadline, read between the AO pass's
+ * tiles: past it, the rest of the pass's tiles are skipped (the run then
+ * fails with OBS_DEADLINE, run_cpu.c). */
+static int past_deadline(obs__cpu_run *c)
+{
+    if (atomic_load_explicit(&c->stopped, memory_order_relaxed))
+        return 1;
+    if (c->deadline_ms <= 0.0)
+        return 0;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    if ((double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6 <= c->deadline_ms)
+        return 0;
+    atomic_store(&c->stopped, 1);
+    return 1;
+}
+
 static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
 {
-    const obs__cpu_run *c = ctx;
+    obs__cpu_run *c = ctx;
+    if (past_deadline(c))
+        return;
     const obs__frame *f = c->pl->af;
     const obs__method *method = c->pl->method;
     const float *pos = c->apos, *nrm = c->anrm, *col = c->col, *est = c->est;
     float *ao = c->aao, *bleed = c->ableed, unread[3];
     const int bleed_read = c->pl->f.bleed_step || c->out->bleed.data;
     float *count = c->out->sample_count.data, *mask = c->out->cull_mask.data;
+    unsigned char cand[AO_TILE_W * AO_TILE_H]; /* section 4.2's test, the tile at once */
+    if (f->culling && !method->pixel)
+        obs__cull_candidates(f, est, x0, x1, y0, y1, cand);
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
             size_t i = (size_t)y * f->width + x;
@@ -87,7 +110,7 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
             } else if (pos[4 * i + 3] > 0.0f) {
                 /* Section 4.2: a culling candidate gets AO 1 (greedy) or
                  * at most the 4-sample set (careful). */
-                culled = f->culling && obs__cull_candidate(f, est, x, y);
+                culled = f->culling && cand[(size_t)(y - y0) * (size_t)(x1 - x0) + (size_t)(x - x0)];
                 if (!culled) {
                     /* section 4.1: the set of the pixel's count */
                     n = obs__vao_count(f, pos + 4 * i, nrm + 3 * i);
@@ -119,10 +142,13 @@ static void position_rows(void *ctx, int y0, int y1)
     const obs__cpu_run *c = ctx;
     const obs__frame *f = &c->pl->f;
     const obs_gbuffer *gb = c->pl->gb;
-    for (int y = y0; y < y1; y++)
+    for (int y = y0; y < y1; y++) {
+        const float *depth = obs__plane_px(&gb->depth, f->width, 0, y); /* the row, once */
+        const size_t dc = (size_t)gb->depth.channels;
         for (int x = 0; x < f->width; x++)
-            obs__prep_position(f, *obs__plane_px(&gb->depth, f->width, x, y), x, y,
+            obs__prep_position(f, depth[dc * (size_t)x], x, y,
                                c->pos + 4 * ((size_t)y * f->width + x));
+    }
 }
 
 static void normal_rows(void *ctx, int y0, int y1)
@@ -130,9 +156,10 @@ static void normal_rows(void *ctx, int y0, int y1)
     const obs__cpu_run *c = ctx;
     const obs__frame *f = &c->pl->f;
     const obs_gbuffer *gb = c->pl->gb;
-    for (int y = y0; y < y1; y++)
+    for (int y = y0; y < y1; y++) {
+        const float *row = gb->normal.data ? obs__plane_px(&gb->normal, f->width, 0, y) : NULL;
         for (int x = 0; x < f->width; x++) {
-            const float *in = gb->normal.data ? obs__plane_px(&gb->normal, f->width, x, y) : NULL;
+            const float *in = row ? row + (size_t)gb->normal.channels * (size_t)x : NULL;
             const size_t i = (size_t)y * f->width + x;
             obs__prep_normal(f, c->pos, in, x, y, c->nrm + 3 * i);
             if (!f->half) {
@@ -140,6 +167,7 @@ static void normal_rows(void *ctx, int y0, int y1)
                 c->dnz[2 * i + 1] = c->nrm[3 * i + 2];
             }
         }
+    }
 }
 
 static void prep_full(obs__cpu_run *c)
@@ -238,7 +266,18 @@ static void rays(obs__cpu_run *c)
 static obs_status cpu_blur(obs__cpu_run *c, char err[OBS_ERR_LEN])
 {
     (void)err;
-    obs__blur_dnz(c->pl->af, c->apos, c->dnz, c->aao, c->atmp, c->pl->rays_in_blur);
+    float *res = obs__blur_dnz(c->pl->af, c->apos, c->dnz, c->aao, c->atmp, c->pl->rays_in_blur);
+    if (res != c->aao) { /* the result in the other plane: the two swap roles */
+        c->atmp = c->aao;
+        c->aao = res;
+        if (c->pl->f.half) {
+            c->htmp = c->atmp;
+            c->hao = res;
+        } else {
+            c->tmp = c->atmp;
+            c->ao = res;
+        }
+    }
     return OBS_OK;
 }
 

@@ -4,6 +4,8 @@
 #ifndef OBSCURA_PASSES_CPU_H
 #define OBSCURA_PASSES_CPU_H
 
+#include <stdatomic.h>
+
 #include "chain/passes.h"
 
 /* One frame's planes on the CPU: the full-size ones and, with
@@ -21,6 +23,10 @@ typedef struct obs__cpu_run {
     float *dnz;
     void *block;                                    /* where the planes are */
     size_t block_size;
+    /* the deadline (CLOCK_MONOTONIC ms; 0: none); stopped: a tile found
+     * it past and the rest of the pass was skipped */
+    double deadline_ms;
+    atomic_int stopped;
 } obs__cpu_run;
 
 /* The planes of c's plan, in one block: the one the last frame gave back

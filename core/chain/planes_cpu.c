@@ -45,11 +45,14 @@ obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN])
     const size_t n = c->npx, an = (size_t)af->width * (size_t)af->height;
     /* colour, packed RGBA, for sections 4.3 and 4.7 */
     const int col = f->luminance || f->bleed_step;
+    /* the bleed term (4.7) only where the composite or the output reads
+     * it (the AO pass writes it nowhere else): 12 bytes a pixel */
+    const int bleed = f->bleed_step || (c->pl->outputs & OBS_OUTPUT_BLEED);
     const size_t sizes[] = {
         lines(n * 4), lines(n * 3), lines(n), lines(n), lines((size_t)f->cull_w * (size_t)f->cull_h),
-        lines(n * 3), col ? lines(n * 4) : 0,
+        bleed ? lines(n * 3) : 0, col ? lines(n * 4) : 0,
         f->half ? lines(an * 4) : 0, f->half ? lines(an * 3) : 0, f->half ? lines(an) : 0,
-        f->half ? lines(an) : 0, f->half ? lines(an * 3) : 0, lines(an * 2),
+        f->half ? lines(an) : 0, f->half && bleed ? lines(an * 3) : 0, lines(an * 2),
     };
     float **planes[] = {&c->pos,  &c->nrm,  &c->ao,  &c->tmp,  &c->est,  &c->bleed,
                         &c->col,  &c->hpos, &c->hnrm, &c->hao, &c->htmp, &c->hbleed, &c->dnz};

@@ -8,6 +8,7 @@
 
 #include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
+#include "log.h"
 
 static double now_ms(void)
 {
@@ -23,10 +24,18 @@ static obs_status walk(obs__cpu_run *c, obs_pass_times *t, char err[OBS_ERR_LEN]
     for (int i = 0; i < OBS_PASS_COUNT; i++) {
         if (!obs__passes[i].when(c->pl))
             continue;
+        if (c->deadline_ms > 0.0 && now_ms() > c->deadline_ms)
+            atomic_store(&c->stopped, 1);
+        if (atomic_load(&c->stopped))
+            return obs__fail(err, OBS_DEADLINE, "the frame ran past its deadline (before the %s pass)",
+                             obs_pass_name((obs_pass)i));
         double t0 = t ? now_ms() : 0.0;
         obs_status s = obs__cpu_kernels[i](c, err);
         if (s != OBS_OK)
             return s;
+        if (atomic_load(&c->stopped)) /* a pass cut short: its output is not whole */
+            return obs__fail(err, OBS_DEADLINE, "the frame ran past its deadline (in the %s pass)",
+                             obs_pass_name((obs_pass)i));
         if (t) {
             t->ms[i] += now_ms() - t0;
             t->total_ms += now_ms() - t0;
@@ -35,20 +44,42 @@ static obs_status walk(obs__cpu_run *c, obs_pass_times *t, char err[OBS_ERR_LEN]
     return OBS_OK;
 }
 
+static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                      obs_result *out, obs_pass_times *times, const obs_cpu_options *opt,
+                      char err[OBS_ERR_LEN]);
+
 obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                        obs_result *out, char err[OBS_ERR_LEN])
 {
-    return obs__run_cpu_timed(gb, params, outputs, out, NULL, err);
+    return run(gb, params, outputs, out, NULL, NULL, err);
+}
+
+obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                            obs_result *out, const obs_cpu_options *opt, char err[OBS_ERR_LEN])
+{
+    return run(gb, params, outputs, out, NULL, opt, err);
 }
 
 obs_status obs__run_cpu_timed(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                               obs_result *out, obs_pass_times *times, char err[OBS_ERR_LEN])
 {
+    return run(gb, params, outputs, out, times, NULL, err);
+}
+
+static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                      obs_result *out, obs_pass_times *times, const obs_cpu_options *opt,
+                      char err[OBS_ERR_LEN])
+{
     obs__plan pl;
     obs__cpu_run c = {0};
+    obs_log_fn log = opt ? opt->log : NULL;
+    obs__log_sink sink = {log, opt ? opt->log_user : NULL}; /* the frame setup's messages */
 
     memset(out, 0, sizeof *out);
-    obs_status s = obs__plan_init(&pl, NULL, gb, params, outputs, err);
+    if (opt && opt->deadline > 0.0)
+        c.deadline_ms = now_ms() + opt->deadline * 1e3;
+    atomic_init(&c.stopped, 0);
+    obs_status s = obs__plan_init(&pl, log ? obs__log_only_ctx(&sink) : NULL, gb, params, outputs, err);
     if (s != OBS_OK)
         return s;
     c.pl = &pl;

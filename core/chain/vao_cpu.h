@@ -39,8 +39,10 @@ void obs__rays_rows(float *ao, size_t n);
 /* obs__blur (the same result, bit for bit) with the depths from dnz;
  * with rays, each row of the vertical pass then converted by
  * obs__rays_from_volume (ao_definition rays, as GL's vertical pass does),
- * in the same sweep. */
-void obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, float *ao, float *tmp,
-                   int rays);
+ * in the same sweep.  The two passes fused in bands (blur_cpu.c): the
+ * result goes to tmp, not in place; returns the plane that holds it (tmp,
+ * or ao where there was no memory for the bands' scratch). */
+float *obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, float *ao,
+                     float *tmp, int rays);
 
 #endif

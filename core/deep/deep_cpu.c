@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "chain/bands_cpu.h"
 #include "deep/deep_internal.h"
 #include "methods/gtao.h"
 #include "methods/hbao.h"
@@ -50,6 +51,49 @@ void obs__deep_frame_free(obs__deep_frame *df)
     free(df->nrm3);
     obs_deep_layers_free(&df->layers);
     memset(df, 0, sizeof *df);
+}
+
+typedef struct prep_job {
+    obs__deep_frame *df;
+    const obs_deep_image *d;
+    int k; /* the node plane */
+} prep_job;
+
+static void prep_position_rows(void *ctx, int y0, int y1)
+{
+    const prep_job *j = ctx;
+    const obs__deep_frame *df = j->df;
+    const size_t npx = (size_t)j->d->width * (size_t)j->d->height;
+    const float *node = df->layers.node + (size_t)j->k * npx * OBS_DEEP_CH;
+    float *pos = df->pos + (size_t)j->k * npx * 4;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < j->d->width; x++) {
+            size_t i = (size_t)y * j->d->width + x;
+            /* an empty node is background (raw depth 0) */
+            float z = j->k < df->layers.count[i] ? node[i * OBS_DEEP_CH + OBS_DEEP_Z] : 0.0f;
+            obs__prep_position(&df->f, z, x, y, pos + 4 * i);
+        }
+}
+
+static void prep_normal_rows(void *ctx, int y0, int y1)
+{
+    const prep_job *j = ctx;
+    const obs__deep_frame *df = j->df;
+    const size_t npx = (size_t)j->d->width * (size_t)j->d->height;
+    const float *node = df->layers.node + (size_t)j->k * npx * OBS_DEEP_CH;
+    const float *pos = df->pos + (size_t)j->k * npx * 4;
+    float *nrm = df->nrm + (size_t)j->k * npx * 4;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < j->d->width; x++) {
+            size_t i = (size_t)y * j->d->width + x;
+            const float *nd = node + i * OBS_DEEP_CH;
+            float v[3];
+            obs__prep_normal(&df->f, pos, nd + OBS_DEEP_NX, x, y, v);
+            nrm[4 * i] = v[0];
+            nrm[4 * i + 1] = v[1];
+            nrm[4 * i + 2] = v[2];
+            nrm[4 * i + 3] = pos[4 * i + 3] > 0.0f ? fminf(fmaxf(nd[OBS_DEEP_A], 0.0f), 1.0f) : 0.0f;
+        }
 }
 
 obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *params,
@@ -136,28 +180,12 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
     df->thin = p.deep_hull == OBS_DEEP_THIN;
     df->intervals = p.deep_intervals == OBS_ON && d->has_facing && df->multi;
 
-    /* The prep pass of every node plane. */
+    /* The prep pass of every node plane, in row bands on the worker pool:
+     * positions, then normals (which read the neighbours' positions). */
     for (int k = 0; k < m; k++) {
-        const float *node = df->layers.node + (size_t)k * npx * OBS_DEEP_CH;
-        float *pos = df->pos + (size_t)k * npx * 4, *nrm = df->nrm + (size_t)k * npx * 4;
-        for (int y = 0; y < d->height; y++)
-            for (int x = 0; x < d->width; x++) {
-                size_t i = (size_t)y * d->width + x;
-                /* an empty node is background (raw depth 0) */
-                float z = (int)k < df->layers.count[i] ? node[i * OBS_DEEP_CH + OBS_DEEP_Z] : 0.0f;
-                obs__prep_position(&df->f, z, x, y, pos + 4 * i);
-            }
-        for (int y = 0; y < d->height; y++)
-            for (int x = 0; x < d->width; x++) {
-                size_t i = (size_t)y * d->width + x;
-                const float *nd = node + i * OBS_DEEP_CH;
-                float v[3];
-                obs__prep_normal(&df->f, pos, nd + OBS_DEEP_NX, x, y, v);
-                nrm[4 * i] = v[0];
-                nrm[4 * i + 1] = v[1];
-                nrm[4 * i + 2] = v[2];
-                nrm[4 * i + 3] = pos[4 * i + 3] > 0.0f ? fminf(fmaxf(nd[OBS_DEEP_A], 0.0f), 1.0f) : 0.0f;
-            }
+        prep_job j = {df, d, k};
+        obs__cpu_rows(d->height, 0, prep_position_rows, &j);
+        obs__cpu_rows(d->height, 0, prep_normal_rows, &j);
     }
     /* Method gtao's border steps read the front nodes' normals. */
     if (df->f.method == OBS_METHOD_GTAO) {
@@ -411,6 +439,22 @@ void obs__deep_composite(const obs_deep_image *d, obs_deep_result *out)
     }
 }
 
+typedef struct deep_job {
+    const obs__deep_frame *df;
+    obs_deep_result *out;
+} deep_job;
+
+static void deep_rows(void *ctx, int y0, int y1)
+{
+    const deep_job *j = ctx;
+    const int w = j->df->f.width;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * (size_t)w + (size_t)x;
+            j->out->ao_blend.data[i] = obs__deep_pixel(j->df, x, y, &j->out->ao_front.data[i]);
+        }
+}
+
 obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
                             obs_deep_result *out, char err[OBS_ERR_LEN])
 {
@@ -426,11 +470,11 @@ obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
         obs__deep_frame_free(&df);
         return s;
     }
-    for (int y = 0; y < d->height; y++)
-        for (int x = 0; x < d->width; x++) {
-            size_t i = (size_t)y * d->width + x;
-            out->ao_blend.data[i] = obs__deep_pixel(&df, x, y, &out->ao_front.data[i]);
-        }
+    /* every pixel on its own (obs__deep_pixel reads the frame, writes its
+     * pixel): in row bands on the worker pool, the same bytes for any
+     * thread count */
+    deep_job j = {&df, out};
+    obs__cpu_rows(d->height, 0, deep_rows, &j);
     /* the low-pass filter (VAO++ 4.6) of both, the flat chain's twin with
      * the front node's plane as its positions (GLSL: deep_gl.c) */
     if (df.f.blur_radius > 0) {

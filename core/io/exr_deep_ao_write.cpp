@@ -11,10 +11,13 @@
 #include <ImfDeepFrameBuffer.h>
 #include <ImfDeepScanLineOutputPart.h>
 #include <ImfFrameBuffer.h>
+#include <ImfIO.h>
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputPart.h>
 #include <ImfPartType.h>
 #include <ImathBox.h>
+#include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include "io/exr_deep_cpp.h"
@@ -36,9 +39,10 @@ static Header base_header(const obs_deep_ao *a)
     return hdr;
 }
 
-extern "C" obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao *a,
-                                            const obs_image *flat, const obs_image *front,
-                                            char err[OBS_ERR_LEN])
+// The deep AO and the flat images are consistent (`path` names the
+// output in the message).
+static obs_status check_args(const char *path, const obs_deep_ao *a, const obs_image *flat,
+                             const obs_image *front, char err[OBS_ERR_LEN])
 {
     if (!path || !*path || !a || !a->offset || a->width <= 0 || a->height <= 0)
         return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "obs_deep_ao_write_exr: no path or no deep AO");
@@ -53,71 +57,144 @@ extern "C" obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao 
         if (a->offset[i + 1] < a->offset[i] || a->offset[i + 1] - a->offset[i] > OBS_DEEP_MAX_LAYERS)
             return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "%s: pixel %zu holds %llu nodes; at most %d", path, i,
                         (unsigned long long)(a->offset[i + 1] - a->offset[i]), OBS_DEEP_MAX_LAYERS);
-    return obs__deep_write_file(path, "deep AO", err, [&](const char *tmp) {
-        Header deep = base_header(a);
-        deep.setName("deep");
-        deep.setType(DEEPSCANLINE);
-        deep.compression() = ZIPS_COMPRESSION;
-        deep.setVersion(1); // the deep data version the C API (and Nuke) require
-        // planar per channel: A, A x AO, Z, ZBack of every node in order
-        static const char *const names[] = {"A", "AO.Y", "Z", "ZBack"};
-        for (const char *n : names)
-            deep.channels().insert(n, Channel(FLOAT));
-        Header flt = base_header(a);
-        flt.setName("flat");
-        flt.setType(SCANLINEIMAGE);
-        flt.compression() = ZIP_COMPRESSION;
-        flt.setVersion(1); // OpenEXR's C API wants it on every part of a file with deep data
-        if (flat)
-            flt.channels().insert("AO.Y", Channel(FLOAT));
-        if (front)
-            flt.channels().insert("AOFront.Y", Channel(FLOAT));
-        const bool has_flat = flat || front;
+    return OBS_OK;
+}
 
-        const uint64_t total = a->offset[npx];
-        std::vector<float> plane[4];
-        for (std::vector<float> &p : plane)
-            p.resize(total ? total : 1);
-        for (uint64_t s = 0; s < total; s++) {
-            const float *v = a->node + s * OBS_DEEP_AO_CH;
-            plane[0][s] = v[OBS_DEEP_AO_A];
-            plane[1][s] = v[OBS_DEEP_AO_A] * v[OBS_DEEP_AO_AO];
-            plane[2][s] = v[OBS_DEEP_AO_Z];
-            plane[3][s] = v[OBS_DEEP_AO_ZBACK];
-        }
-        std::vector<unsigned int> count(npx);
-        std::vector<float *> ptr[4];
+// Writes the two parts into dest: a file name or an OStream.
+template <class Dest>
+static void write_parts(Dest &dest, const obs_deep_ao *a, const obs_image *flat, const obs_image *front)
+{
+    const int w = a->width, h = a->height;
+    const size_t npx = (size_t)w * (size_t)h;
+    const obs_image *flats[2] = {flat, front};
+    Header deep = base_header(a);
+    deep.setName("deep");
+    deep.setType(DEEPSCANLINE);
+    deep.compression() = ZIPS_COMPRESSION;
+    deep.setVersion(1); // the deep data version the C API (and Nuke) require
+    // planar per channel: A, A x AO, Z, ZBack of every node in order
+    static const char *const names[] = {"A", "AO.Y", "Z", "ZBack"};
+    for (const char *n : names)
+        deep.channels().insert(n, Channel(FLOAT));
+    Header flt = base_header(a);
+    flt.setName("flat");
+    flt.setType(SCANLINEIMAGE);
+    flt.compression() = ZIP_COMPRESSION;
+    flt.setVersion(1); // OpenEXR's C API wants it on every part of a file with deep data
+    if (flat)
+        flt.channels().insert("AO.Y", Channel(FLOAT));
+    if (front)
+        flt.channels().insert("AOFront.Y", Channel(FLOAT));
+    const bool has_flat = flat || front;
+
+    const uint64_t total = a->offset[npx];
+    std::vector<float> plane[4];
+    for (std::vector<float> &p : plane)
+        p.resize(total ? total : 1);
+    for (uint64_t s = 0; s < total; s++) {
+        const float *v = a->node + s * OBS_DEEP_AO_CH;
+        plane[0][s] = v[OBS_DEEP_AO_A];
+        plane[1][s] = v[OBS_DEEP_AO_A] * v[OBS_DEEP_AO_AO];
+        plane[2][s] = v[OBS_DEEP_AO_Z];
+        plane[3][s] = v[OBS_DEEP_AO_ZBACK];
+    }
+    std::vector<unsigned int> count(npx);
+    std::vector<float *> ptr[4];
+    for (size_t i = 0; i < npx; i++)
+        count[i] = (unsigned int)(a->offset[i + 1] - a->offset[i]);
+    // Slices address pixel (x, y) of the data window at base + x xs + y ys.
+    const ptrdiff_t origin = (ptrdiff_t)a->display_y * w + a->display_x;
+    DeepFrameBuffer fb;
+    fb.insertSampleCountSlice(Slice(UINT, (char *)(count.data() - origin), sizeof(unsigned int),
+                                    sizeof(unsigned int) * (size_t)w));
+    for (int c = 0; c < 4; c++) {
+        ptr[c].resize(npx);
         for (size_t i = 0; i < npx; i++)
-            count[i] = (unsigned int)(a->offset[i + 1] - a->offset[i]);
-        // Slices address pixel (x, y) of the data window at base + x xs + y ys.
-        const ptrdiff_t origin = (ptrdiff_t)a->display_y * w + a->display_x;
-        DeepFrameBuffer fb;
-        fb.insertSampleCountSlice(Slice(UINT, (char *)(count.data() - origin), sizeof(unsigned int),
-                                        sizeof(unsigned int) * (size_t)w));
-        for (int c = 0; c < 4; c++) {
-            ptr[c].resize(npx);
-            for (size_t i = 0; i < npx; i++)
-                ptr[c][i] = plane[c].data() + a->offset[i];
-            fb.insert(names[c], DeepSlice(FLOAT, (char *)(ptr[c].data() - origin), sizeof(float *),
-                                          sizeof(float *) * (size_t)w, sizeof(float)));
+            ptr[c][i] = plane[c].data() + a->offset[i];
+        fb.insert(names[c], DeepSlice(FLOAT, (char *)(ptr[c].data() - origin), sizeof(float *),
+                                      sizeof(float *) * (size_t)w, sizeof(float)));
+    }
+    std::vector<Header> headers{deep};
+    if (has_flat)
+        headers.push_back(flt);
+    MultiPartOutputFile file(dest, headers.data(), (int)headers.size());
+    DeepScanLineOutputPart dp(file, 0);
+    dp.setFrameBuffer(fb);
+    dp.writePixels(h);
+    if (has_flat) {
+        FrameBuffer ff;
+        const char *const fnames[2] = {"AO.Y", "AOFront.Y"};
+        for (int k = 0; k < 2; k++)
+            if (flats[k])
+                ff.insert(fnames[k], Slice(FLOAT, (char *)(flats[k]->data - origin), sizeof(float),
+                                           sizeof(float) * (size_t)w));
+        OutputPart fp(file, 1);
+        fp.setFrameBuffer(ff);
+        fp.writePixels(h);
+    }
+}
+
+extern "C" obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao *a,
+                                            const obs_image *flat, const obs_image *front,
+                                            char err[OBS_ERR_LEN])
+{
+    obs_status s = check_args(path, a, flat, front, err);
+    if (s != OBS_OK)
+        return s;
+    return obs__deep_write_file(path, "deep AO", err,
+                                [&](const char *tmp) { write_parts(tmp, a, flat, front); });
+}
+
+// An OStream into memory (malloc'd, grown by doubling), for the daemon's
+// answer.
+class MemOStream : public OStream {
+  public:
+    MemOStream() : OStream("memory") {}
+    ~MemOStream() override { std::free(buf); }
+    void write(const char c[], int n) override
+    {
+        if (pos + (uint64_t)n > cap) {
+            uint64_t want = cap ? cap : 65536;
+            while (want < pos + (uint64_t)n)
+                want *= 2;
+            char *nb = (char *)std::realloc(buf, want);
+            if (!nb)
+                throw std::bad_alloc();
+            buf = nb, cap = want;
         }
-        std::vector<Header> headers{deep};
-        if (has_flat)
-            headers.push_back(flt);
-        MultiPartOutputFile file(tmp, headers.data(), (int)headers.size());
-        DeepScanLineOutputPart dp(file, 0);
-        dp.setFrameBuffer(fb);
-        dp.writePixels(h);
-        if (has_flat) {
-            FrameBuffer ff;
-            const char *const fnames[2] = {"AO.Y", "AOFront.Y"};
-            for (int k = 0; k < 2; k++)
-                if (flats[k])
-                    ff.insert(fnames[k], Slice(FLOAT, (char *)(flats[k]->data - origin), sizeof(float),
-                                               sizeof(float) * (size_t)w));
-            OutputPart fp(file, 1);
-            fp.setFrameBuffer(ff);
-            fp.writePixels(h);
-        }
-    });
+        std::memcpy(buf + pos, c, (size_t)n);
+        pos += (uint64_t)n;
+        if (pos > len)
+            len = pos;
+    }
+    uint64_t tellp() override { return pos; }
+    void seekp(uint64_t p) override { pos = p; }
+    char *buf = nullptr;
+    uint64_t cap = 0, pos = 0, len = 0;
+};
+
+extern "C" obs_status obs_deep_ao_write_exr_mem(const obs_deep_ao *a, const obs_image *flat,
+                                                const obs_image *front, obs_bytes *out,
+                                                char err[OBS_ERR_LEN])
+{
+    if (!out)
+        return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "obs_deep_ao_write_exr_mem: no output");
+    *out = obs_bytes{nullptr, 0};
+    obs_status s = check_args("deep AO", a, flat, front, err);
+    if (s != OBS_OK)
+        return s;
+    try {
+        MemOStream os;
+        write_parts(os, a, flat, front);
+        out->data = (unsigned char *)os.buf;
+        out->size = (size_t)os.len;
+        os.buf = nullptr;
+    } catch (const std::bad_alloc &) {
+        return obs__deep_fail(err, OBS_NO_MEMORY, "out of memory writing the deep AO");
+    } catch (const std::exception &e) {
+        return obs__deep_fail(err, OBS_IO, "deep AO: %s", e.what());
+    } catch (...) {
+        return obs__deep_fail(err, OBS_IO, "cannot write the deep AO");
+    }
+    return OBS_OK;
 }

@@ -16,6 +16,7 @@
 #include <math.h>
 
 #include "methods/angle.h"
+#include "methods/bent.h"
 
 /* Radical inverse of i in base 2. */
 static double radical_inverse2(unsigned i)
@@ -67,6 +68,12 @@ static float angle_to_normal(const obs__frame *f, const float n[3], const float 
 float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[4],
                        const float n[3])
 {
+    return obs__angle_pixel_bent(f, pos, x, y, p, n, NULL);
+}
+
+float obs__angle_pixel_bent(const obs__frame *f, const float *pos, int x, int y, const float p[4],
+                            const float n[3], float bent[3])
+{
     const obs__angle_state *an = obs__angle_of(f);
     const float R = f->radius;
     const float *rot = f->rot[obs__tile_index(f, x, y)];
@@ -107,7 +114,10 @@ float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, cons
             float u[3];
             for (int j = 0; j < 3; j++)
                 u[j] = v[k][j] + far[k] * (-v[1 - k][j] - v[k][j]);
-            th += angle_to_normal(f, n, u);
+            float thk = angle_to_normal(f, n, u);
+            th += thk;
+            if (bent) /* OBS_OUTPUT_BENT: the open arc on u's side */
+                obs__angle_bent_side(n, u, thk, w, bent);
         }
         sum += w * fminf(th / (float)M_PI, 1.0f); /* min((theta_l + theta_r) / pi, 1) */
         wsum += w;

@@ -34,5 +34,9 @@ float obs__acos_mode(int mode, float x);
  * depth) with normal n at pixel (x, y) (GLSL: angle.glsl). */
 float obs__angle_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[4],
                        const float n[3]);
+/* obs__angle_pixel that also sums the bent normal of its pairs into
+ * bent[3] (NULL: not wanted; obs__angle_bent_side, bent.c). */
+float obs__angle_pixel_bent(const obs__frame *f, const float *pos, int x, int y, const float p[4],
+                            const float n[3], float bent[3]);
 
 #endif

@@ -16,12 +16,15 @@
  * pixels each, R_px the radius projected at p (at most R_px steps). */
 #include <math.h>
 
+#include "methods/bent.h"
 #include "methods/hbao.h"
 
 /* One sample point q (view xyz, planar depth w; w 0: background) of a
  * direction from p: where it rises above the horizon sin_h, W(r) times
- * the rise into *ao and the horizon raised (GLSL: hbao_sample()). */
-static void hbao_sample(const float q[4], const float p[3], float R2, float *sin_h, float *ao)
+ * the rise into *ao and the horizon raised (GLSL: hbao_sample()); with
+ * bent, the occluded span taken from the bent normal (direction dx, dy). */
+static void hbao_sample(const float q[4], const float p[3], float R2, float *sin_h, float *ao,
+                        float dx, float dy, float *bent)
 {
     if (!(q[3] > 0.0f))
         return;
@@ -32,9 +35,14 @@ static void hbao_sample(const float q[4], const float p[3], float R2, float *sin
     float sin_s = v[2] / sqrtf(r2); /* elevation of the sample: view +z faces the camera */
     if (sin_s > *sin_h) {
         *ao += (1.0f - r2 / R2) * (sin_s - *sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
+        if (bent) /* OBS_OUTPUT_BENT: less the step's occluded span */
+            obs__hbao_bent_span(dx, dy, *sin_h, sin_s, -(1.0f - r2 / R2), bent);
         *sin_h = sin_s;
     }
 }
+
+static float hbao_estimate(const obs__frame *f, const float *pos, int layers, int x, int y,
+                           const float p[3], const float n[3], int *count, float bent[3]);
 
 /* GLSL: hbao_ao() in hbao.glsl */
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
@@ -43,8 +51,22 @@ float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const
     return obs__hbao_pixel_nodes(f, pos, 1, x, y, p, n, count);
 }
 
+float obs__hbao_pixel_bent(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                           const float n[3], int *count, float bent[3])
+{
+    return hbao_estimate(f, pos, 1, x, y, p, n, count, bent);
+}
+
 float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, int layers, int x, int y,
                             const float p[3], const float n[3], int *count)
+{
+    return hbao_estimate(f, pos, layers, x, y, p, n, count, NULL);
+}
+
+/* obs__hbao_pixel_nodes that also sums the bent normal into bent[3]
+ * (NULL: not wanted; obs__hbao_bent_span, bent.c). */
+static float hbao_estimate(const obs__frame *f, const float *pos, int layers, int x, int y,
+                           const float p[3], const float n[3], int *count, float bent[3])
 {
     const size_t plane = (size_t)f->width * (size_t)f->height * 4;
     const obs__hbao_state *hb = obs__hbao_of(f);
@@ -71,6 +93,8 @@ float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, int layers, i
         float sin_h = st * hb->bias_cs[0] + ct * hb->bias_cs[1];
         if (ct * hb->bias_cs[0] - st * hb->bias_cs[1] < 0.0f)
             sin_h = 1.0f;
+        if (bent) /* OBS_OUTPUT_BENT: open from the tangent up to the view axis */
+            obs__hbao_bent_span(dx, dy, sin_h, 1.0f, 1.0f, bent);
         for (int j = 1; j <= ns; j++) {
             /* screen y runs down, view y up */
             int qx = x + (int)floorf(dx * step * (float)j + 0.5f);
@@ -80,7 +104,7 @@ float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, int layers, i
             taken++;
             const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
             for (int k = 0; k < layers; k++) /* deep input: every node, front to back */
-                hbao_sample(q + (size_t)k * plane, p, R2, &sin_h, &ao);
+                hbao_sample(q + (size_t)k * plane, p, R2, &sin_h, &ao, dx, dy, bent);
         }
     }
     if (count)

@@ -26,6 +26,10 @@ void obs__hbao_setup(const obs_params *p, obs__frame *f);
  * goes to *count when count is not NULL. */
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count);
+/* obs__hbao_pixel that also sums the bent normal of its directions into
+ * bent[3] (NULL: not wanted; obs__hbao_bent_span, bent.c). */
+float obs__hbao_pixel_bent(const obs__frame *f, const float *pos, int x, int y, const float p[3],
+                           const float n[3], int *count, float bent[3]);
 
 /* The same over `layers` planes of positions (pos, then pos + 4 w h, ...:
  * deep input's nodes, core/deep): at each step every node at its pixel,

@@ -8,6 +8,7 @@
  * surface far in front does not count.  The CPU twin of hemisphere.glsl. */
 #include <math.h>
 
+#include "methods/bent.h"
 #include "methods/hemisphere.h"
 
 /* Radical inverse of i in base b: the van der Corput sequence. */
@@ -76,6 +77,12 @@ void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3],
 float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes *nodes, int x,
                                int y, const float p[3], const float n[3])
 {
+    return obs__hemisphere_estimate_bent(f, nodes, x, y, p, n, NULL);
+}
+
+float obs__hemisphere_estimate_bent(const obs__frame *f, const obs__hemisphere_nodes *nodes, int x,
+                                    int y, const float p[3], const float n[3], float bent[3])
+{
     const obs__hemisphere_state *hs = obs__hemisphere_of(f);
     const float R = f->radius;
     float t1[3], t2[3];
@@ -85,8 +92,11 @@ float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes 
         float s[3];
         obs__hemisphere_sample(f, x, y, p, n, t1, t2, i, s);
         int qx, qy;
-        if (!obs__view_to_px(f, s, &qx, &qy))
+        if (!obs__view_to_px(f, s, &qx, &qy)) {
+            if (bent) /* left out of the AO's sum: open */
+                obs__hemisphere_bent_sample(p, s, 1.0f, bent);
             continue;
+        }
         size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
         float best = 0.0f;
         for (int k = 0; k < nodes->layers; k++) {
@@ -105,6 +115,8 @@ float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes 
             best = fmaxf(best, an * r * r * (3.0f - 2.0f * r));
         }
         occ += best;
+        if (bent) /* OBS_OUTPUT_BENT: the sample's direction times its open part */
+            obs__hemisphere_bent_sample(p, s, 1.0f - best, bent);
     }
     return hs->count > 0 ? 1.0f - occ / (float)hs->count : 1.0f;
 }
@@ -113,8 +125,14 @@ float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes 
 float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                             const float n[3])
 {
+    return obs__hemisphere_pixel_bent(f, pos, x, y, p, n, NULL);
+}
+
+float obs__hemisphere_pixel_bent(const obs__frame *f, const float *pos, int x, int y,
+                                 const float p[3], const float n[3], float bent[3])
+{
     const obs__hemisphere_nodes flat = {pos, NULL, 1, 0, 0};
-    return obs__hemisphere_estimate(f, &flat, x, y, p, n);
+    return obs__hemisphere_estimate_bent(f, &flat, x, y, p, n, bent);
 }
 
 void obs__hemisphere_setup(const obs_params *p, obs__frame *f)

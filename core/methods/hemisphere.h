@@ -50,11 +50,17 @@ typedef struct obs__hemisphere_nodes {
 /* Method hemisphere's estimator, for the flat and the deep chain alike. */
 float obs__hemisphere_estimate(const obs__frame *f, const obs__hemisphere_nodes *nodes, int x,
                                int y, const float p[3], const float n[3]);
+/* obs__hemisphere_estimate that also sums the bent normal of its samples
+ * into bent[3] (NULL: not wanted; obs__hemisphere_bent_sample, bent.c). */
+float obs__hemisphere_estimate_bent(const obs__frame *f, const obs__hemisphere_nodes *nodes, int x,
+                                    int y, const float p[3], const float n[3], float bent[3]);
 
 /* Normal-oriented hemisphere SSAO of the point p (xyz; planar depth in
  * p[3] is not needed) with normal n at pixel (x, y); `pos` is the prep
  * pass's position plane (GLSL: hemisphere.glsl). */
 float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                             const float n[3]);
+float obs__hemisphere_pixel_bent(const obs__frame *f, const float *pos, int x, int y,
+                                 const float p[3], const float n[3], float bent[3]);
 
 #endif

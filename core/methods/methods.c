@@ -40,6 +40,29 @@ static float gtao_ao(const obs__frame *f, const float *pos, const float *nrm, in
     return obs__gtao_pixel(f, pos, nrm, x, y, p, n, count);
 }
 
+static float hemisphere_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                             const float p[4], const float n[3], int *count, float bent[3])
+{
+    (void)nrm;
+    *count = obs__hemisphere_of(f)->count;
+    return obs__hemisphere_pixel_bent(f, pos, x, y, p, n, bent);
+}
+
+static float angle_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                        const float p[4], const float n[3], int *count, float bent[3])
+{
+    (void)nrm;
+    *count = 2 * obs__angle_of(f)->pairs;
+    return obs__angle_pixel_bent(f, pos, x, y, p, n, bent);
+}
+
+static float hbao_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                       const float p[4], const float n[3], int *count, float bent[3])
+{
+    (void)nrm;
+    return obs__hbao_pixel_bent(f, pos, x, y, p, n, count, bent);
+}
+
 static float gtao_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                        const float p[4], const float n[3], int *count, float bent[3])
 {
@@ -70,20 +93,20 @@ static const obs__method methods[] = {
       {"u_hs_bias", OBS__U_FLOAT, HS(bias), 0, 0},
       {"u_hs_kernel", OBS__U_FLOAT, HS(kernel), HS(count), 3},
       {NULL}},
-     1},
+     1, hemisphere_bent},
     {OBS_METHOD_ANGLE, "angle", obs__shader_angle, obs__angle_setup, angle_ao, angle_samples,
      {{"u_angle_pairs", OBS__U_INT, AN(pairs), 0, 0},
       {"u_angle_xy", OBS__U_VEC2, AN(xy), AN(pairs), 1},
       {"u_angle_acos", OBS__U_INT, AN(acos), 0, 0},
       {NULL}},
-     0},
+     0, angle_bent},
     {OBS_METHOD_HBAO, "hbao", obs__shader_hbao, obs__hbao_setup, hbao_ao, hbao_samples,
      {{"u_hbao_dirs", OBS__U_INT, HB(dirs), 0, 0},
       {"u_hbao_steps", OBS__U_INT, HB(steps), 0, 0},
       {"u_hbao_dir", OBS__U_VEC2, HB(dir), HB(dirs), 1},
       {"u_hbao_bias_cs", OBS__U_VEC2, HB(bias_cs), 0, 0},
       {NULL}},
-     1},
+     1, hbao_bent},
     {OBS_METHOD_GTAO, "gtao", obs__shader_gtao, obs__gtao_setup, gtao_ao, gtao_samples,
      {{"u_gtao_slices", OBS__U_INT, GT(slices), 0, 0},
       {"u_gtao_steps", OBS__U_INT, GT(steps), 0, 0},
@@ -151,7 +174,11 @@ float obs__method_pixel_bent(const obs__frame *f, const float *pos, const float 
     if (!m || !m->pixel_bent || !(p[3] > 0.0f))
         return obs__method_pixel(f, pos, nrm, x, y, count);
     *count = 0;
-    return m->pixel_bent(f, pos, nrm, x, y, p, n, count, bent);
+    float ao = m->pixel_bent(f, pos, nrm, x, y, p, n, count, bent);
+    if (bent[0] == 0.0f && bent[1] == 0.0f && bent[2] == 0.0f) /* nothing open: the normal */
+        for (int k = 0; k < 3; k++)
+            bent[k] = n[k];
+    return ao;
 }
 
 unsigned long long obs_frame_cost(const obs_params *params, int width, int height, int deep_layers)

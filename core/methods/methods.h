@@ -35,7 +35,8 @@ typedef struct obs__method {
     int deep; /* 1: runs on deep input too (core/deep: OITAO's GetAO) */
     /* The method's bent normal (OBS_OUTPUT_BENT): pixel's twin that also
      * sums the view-space bent normal of its samples into bent[3] (not
-     * normalised); NULL: the method has none (its GLSL leaves g_bent 0). */
+     * normalised; every comparison method has one, its GLSL twin sums
+     * g_bent in method.glsl). */
     float (*pixel_bent)(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                         const float p[4], const float n[3], int *count, float bent[3]);
 } obs__method;

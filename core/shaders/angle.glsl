@@ -28,6 +28,17 @@ float angle_to_normal(vec3 n, vec3 v)
     return acos_mode(u_angle_acos, c);
 }
 
+// OBS_OUTPUT_BENT (method.glsl's g_bent): one side of a pair, the open
+// arc from n to u's side, theta long, weighted alike in angle:
+// sin theta n + (1 - cos theta) t, times the pair's weight.  C twin:
+// obs__angle_bent_side (methods/bent.c), which derives it.
+void angle_bent_side(vec3 n, vec3 u, float theta, float w)
+{
+    vec3 t = u - dot(u, n) * n;
+    float l = length(t);
+    g_bent += w * (sin(theta) * n + (l > 0.0 ? (1.0 - cos(theta)) / l : 0.0) * t);
+}
+
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
 {
     float R = u_radius;
@@ -62,7 +73,10 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
         // a far sample moves towards the coplanar point 2p - x_other
         vec3 u0 = v[0] + far[0] * (-v[1] - v[0]);
         vec3 u1 = v[1] + far[1] * (-v[0] - v[1]);
-        float th = angle_to_normal(n, u0) + angle_to_normal(n, u1);
+        float th0 = angle_to_normal(n, u0), th1 = angle_to_normal(n, u1);
+        float th = th0 + th1;
+        angle_bent_side(n, u0, th0, w);
+        angle_bent_side(n, u1, th1, w);
         sum += w * min(th / PI, 1.0);     // min((theta_l + theta_r) / pi, 1)
         wsum += w;
     }

@@ -15,11 +15,26 @@ uniform vec2 u_hbao_bias_cs;     // cos, sin of the angle bias
 #ifndef HB_LAYERS
 #define HB_LAYERS 1
 #define HB_NODE(q, k) imageLoad(u_pos, q)
+#define HB_BENT 1 // the flat chain's bent normal (method.glsl's g_bent); not the deep pass's
 #endif
 
-// One sample point xq of a direction from p: where it rises above the
-// horizon sin_h, W(r) times the rise into ao.  C twin: hbao_sample.
-void hbao_sample(vec4 xq, vec3 p, float R2, inout float sin_h, inout float ao)
+// OBS_OUTPUT_BENT (method.glsl's g_bent): the solid-angle sum of the
+// directions cos a e + sin a z over the elevations asin(sin0)..asin(sin1)
+// along e = (dx, dy), times w.  C twin: obs__hbao_bent_span
+// (methods/bent.c), which derives it.
+void hbao_bent_span(float dx, float dy, float sin0, float sin1, float w)
+{
+#ifdef HB_BENT
+    float a0 = asin(clamp(sin0, -1.0, 1.0)), a1 = asin(clamp(sin1, -1.0, 1.0));
+    float along = (a1 - a0) * 0.5 + (sin(2.0 * a1) - sin(2.0 * a0)) * 0.25;
+    g_bent += w * vec3(along * dx, along * dy, (sin1 * sin1 - sin0 * sin0) * 0.5);
+#endif
+}
+
+// One sample point xq of a direction e = (dx, dy) from p: where it rises
+// above the horizon sin_h, W(r) times the rise into ao, and the occluded
+// span taken from the bent normal.  C twin: hbao_sample.
+void hbao_sample(vec4 xq, vec3 p, float R2, inout float sin_h, inout float ao, float dx, float dy)
 {
     if (!(xq.w > 0.0))
         return;
@@ -30,6 +45,7 @@ void hbao_sample(vec4 xq, vec3 p, float R2, inout float sin_h, inout float ao)
     float sin_s = v.z / sqrt(r2);
     if (sin_s > sin_h) {
         ao += (1.0 - r2 / R2) * (sin_s - sin_h);   // W(r_i) (sin h_i - sin h_(i-1))
+        hbao_bent_span(dx, dy, sin_h, sin_s, -(1.0 - r2 / R2)); // less the occluded step
         sin_h = sin_s;
     }
 }
@@ -55,6 +71,7 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
         float sin_h = st * u_hbao_bias_cs.x + ct * u_hbao_bias_cs.y;
         if (ct * u_hbao_bias_cs.x - st * u_hbao_bias_cs.y < 0.0)
             sin_h = 1.0;
+        hbao_bent_span(dx, dy, sin_h, 1.0, 1.0);   // open from the tangent up to the view axis
         for (int j = 1; j <= ns; j++) {
             ivec2 q = px + ivec2(int(floor(dx * stp * float(j) + 0.5)),
                                  int(floor(-dy * stp * float(j) + 0.5)));
@@ -62,7 +79,7 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
                 break;
             count++;
             for (int k = 0; k < HB_LAYERS; k++)   // deep input: every node
-                hbao_sample(HB_NODE(q, k), p.xyz, R2, sin_h, ao);
+                hbao_sample(HB_NODE(q, k), p.xyz, R2, sin_h, ao, dx, dy);
         }
     }
     return max(0.0, 1.0 - ao / float(u_hbao_dirs));

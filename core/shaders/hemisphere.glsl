@@ -14,6 +14,13 @@
 #define HS_NODE(q, k) vec4(0.0, 0.0, 0.0, imageLoad(u_dz, q).x) // the depth plane: one RG texel
 #define HS_ALPHA(q, k) 1.0
 #define HS_FLAT 1
+// OBS_OUTPUT_BENT (method.glsl's g_bent): each sample's unit direction
+// times its open part.  The deep pass leaves it out.  C twin:
+// obs__hemisphere_bent_sample (methods/bent.c), which derives it.
+#define HS_BENT(s, open) g_bent += (open) * normalize((s) - p)
+#endif
+#ifndef HS_BENT
+#define HS_BENT(s, open)
 #endif
 
 uniform int u_hs_count;          // samples
@@ -42,8 +49,10 @@ float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior)
                       p.y + R * (kx * t1.y + ky * t2.y + k.z * n.y),
                       p.z + R * (kx * t1.z + ky * t2.z + k.z * n.z));
         ivec2 q;
-        if (!view_to_px(s, u_size, q))
+        if (!view_to_px(s, u_size, q)) {
+            HS_BENT(s, 1.0);        // left out of the AO's sum: open
             continue;               // off the planes: left out
+        }
         float best = 0.0;
         for (int j = 0; j < layers; j++) {
             vec4 pk = HS_NODE(q, j);
@@ -58,6 +67,7 @@ float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior)
             best = max(best, HS_ALPHA(q, j) * r * r * (3.0 - 2.0 * r));
         }
         occ += best;
+        HS_BENT(s, 1.0 - best);
     }
     return u_hs_count > 0 ? 1.0 - occ / float(u_hs_count) : 1.0;
 }

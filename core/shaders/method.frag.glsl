@@ -25,5 +25,5 @@ void main()
     int count = 0;
     o_ao = vec2(method_ao(px, p, n, count), p.w);
     o_count = float(count);
-    o_bent = vec4(g_bent, 0.0);
+    o_bent = vec4(g_bent == vec3(0.0) ? n : g_bent, 0.0); // nothing open: the normal
 }

@@ -6,8 +6,8 @@ layout(rgba32f) readonly uniform image2D u_pos;     // prep: view position, plan
 layout(rgba32f) readonly uniform image2D u_vnormal; // prep: view normal
 layout(rg32f) readonly uniform image2D u_dz;        // prep: planar depth (x), view normal z (y)
 
-// The bent normal's view-space sum of the methods that have one (gtao),
-// written by method.frag.glsl (OBS_OUTPUT_BENT); 0 for the others.
+// The bent normal's view-space sum of the method's samples, written by
+// method.frag.glsl (OBS_OUTPUT_BENT; the view normal where it is 0).
 vec3 g_bent;
 
 // One gtao slice's bent normal, added to g_bent: Jimenez et al. 2016,

@@ -206,6 +206,10 @@ void obs_deep_ao_free(obs_deep_ao *a);
  * obscura/version. */
 obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao *a, const obs_image *flat,
                                  const obs_image *front, char err[OBS_ERR_LEN]);
+/* The same file into memory (obscurad's answer to output=deep); caller
+ * frees *out with obs_bytes_free(). */
+obs_status obs_deep_ao_write_exr_mem(const obs_deep_ao *a, const obs_image *flat, const obs_image *front,
+                                     obs_bytes *out, char err[OBS_ERR_LEN]);
 
 #ifdef __cplusplus
 }

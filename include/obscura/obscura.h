@@ -190,6 +190,26 @@ obs_status obs_ctx_create(const obs_ctx_desc *desc, obs_ctx **out,
 void obs_ctx_destroy(obs_ctx *ctx);
 void obs_ctx_get_info(const obs_ctx *ctx, obs_ctx_info *info);
 
+/* --backend auto's choice of device (README, Backends). */
+typedef struct obs_device_choice {
+    int cpu;             /* 1: the CPU device (obs_run_cpu), 0: a GL context */
+    obs_backend backend; /* with cpu 0: EGL_DEVICE (a GPU was found) or AUTO */
+    int measured, cached;
+    double cpu_ms, gl_ms; /* the measurement's medians; -1: none */
+    char why[256];        /* one line saying what was chosen and why */
+} obs_device_choice;
+
+/* With measure_now: an EGL GPU device when there is one; else the
+ * device kept for this machine, version, method (params' method, NULL:
+ * the defaults) and thread count in cache_dir/devices.txt; else the
+ * faster of the CPU device and the software GL context on a synthetic
+ * 960x540 frame of the chain, measured now (about a second) and kept
+ * there; the CPU device when no GL context can be created.  Without
+ * measure_now only the kept choice is read (no context is created): a
+ * GL context (AUTO) when none is kept. */
+obs_status obs_device_choose(const char *cache_dir, const obs_params *params, int measure_now,
+                             obs_device_choice *out, char err[OBS_ERR_LEN]);
+
 /* ---- running the AO chain ---------------------------------------------- */
 
 enum {
@@ -253,6 +273,22 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
  * any thread count.  No GL context.  Same ownership as obs_run(). */
 obs_status obs_run_cpu(const obs_gbuffer *gb, const obs_params *params,
                        unsigned outputs, obs_result *out, char err[OBS_ERR_LEN]);
+
+/* What obs_run_cpu_opts takes besides the frame (zeroed: obs_run_cpu). */
+typedef struct obs_cpu_options {
+    /* the frame's messages (the channel and camera notes a GL context's
+     * log gets, such as "reconstructing normals from depth"); NULL:
+     * dropped */
+    obs_log_fn log;
+    void *log_user;
+    /* seconds: the run stops with OBS_DEADLINE once the chain has taken
+     * longer (the clock read between passes and between the AO pass's
+     * tiles, so at most one tile past it); 0: no deadline */
+    double deadline;
+} obs_cpu_options;
+
+obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
+                            obs_result *out, const obs_cpu_options *opt, char err[OBS_ERR_LEN]);
 
 void obs_result_free(obs_result *r);
 

@@ -3,7 +3,7 @@
 # AOMultiBounce.R/G/B, BentNormal.X/Y/Z, Samples.Y in one EXR; --append puts them into the
 # input's own file) on GL, the CPU device, over HTTP and the binary
 # protocol, the same channels everywhere; --multibounce on; --output deep
-# (deep input): read back with oiiotool, every node's AO (AO.Y / A, the
+# (deep input; in-process, over HTTP and the binary protocol): read back with oiiotool, every node's AO (AO.Y / A, the
 # channel being premultiplied) in [0, 1], and its flattening (oiiotool
 # --flatten, plus the transmittance left, 1 - A) equal to the flat AO
 # written beside it.
@@ -35,6 +35,8 @@ check "aovs: GL and CPU agree (AO, multi-bounce, bent normal)" \
     'oiiotool "$T/gl.exr" "$T/cpu.exr" --fail 0.01 --failpercent 1 --diff >/dev/null 2>&1'
 check "aovs: the multi-bounce AO is at least the AO" \
     'oiiotool "$T/cpu.exr" --ch AOMultiBounce.G "$T/cpu.exr" --ch AO.Y --sub --printstats 2>&1 | grep "Stats Min" | awk "{exit !(\$3 >= -0.001)}"'
+expect 0 "aovs of hbao on the CPU device" -- "$OBSCURA" ao "$R" --method hbao --output aovs --backend cpu -o "$T/hbao.exr"
+check "aovs of hbao: the bent normal layer too" '[ "$(chans "$T/hbao.exr")" = "$AOVS" ]'
 expect 0 "aovs --append" -- "$OBSCURA" ao "$R" --output aovs --append --backend cpu -o "$T/app.exr"
 check "aovs --append: the input's channels and the AOVs" \
     'c=$(chans "$T/app.exr"); for n in AO.Y AOMultiBounce.R Samples.Y ViewLayer.Depth.Z ViewLayer.DiffCol.R; do echo "$c" | grep -q "$n" || exit 1; done'
@@ -50,6 +52,9 @@ check "aovs over the binary protocol: the same channels" '[ "$(chans "$T/bin.exr
 check "aovs: HTTP gives GL's pixels" 'oiiotool "$T/http.exr" "$T/gl.exr" --diff >/dev/null 2>&1'
 expect 0 "bent normal of gtao over the binary protocol" -- "$OBSCURA" ao "$R" --method gtao --output bent --server "tcp://127.0.0.1:$TCP_d" -o "$T/bent.exr"
 check "bent over the binary protocol: BentNormal.X/Y/Z" '[ "$(chans "$T/bent.exr")" = "BentNormal.X, BentNormal.Y, BentNormal.Z" ]'
+expect 0 "--output deep over HTTP" -- "$OBSCURA" ao "$D" --output deep --blur off --radius 2 --server "http://127.0.0.1:$PORT_d" -o "$T/deephttp.exr"
+expect 0 "--output deep over the binary protocol" -- "$OBSCURA" ao "$D" --output deep --blur off --radius 2 --server "unix:$SOCK_d" -o "$T/deepbin.exr"
+check "output=deep of flat input over HTTP: 400" '[ "$(post "$PORT_d" output=deep "$R" "$T/deepflat")" = 400 ]'
 kill "$PID_d" 2>/dev/null
 
 # deep: the nodes' AO against the flat AO written beside it (blur off:
@@ -82,6 +87,8 @@ expect 0 "--output deep on GL" -- "$OBSCURA" ao "$D" --output deep --blur off --
 flatten "$T/deepgl.exr" "$T/fg.exr"
 check "deep, GL: flattened within 1e-3 of GL's flat AO" \
     'oiiotool "$T/fg.exr" "$T/fg.exr.flat.exr" --fail 1e-3 --failpercent 0 --diff >/dev/null 2>&1'
+check "deep over HTTP and the binary protocol: the in-process GL file's nodes and flat part" \
+    'for f in deephttp deepbin; do for i in 0 1; do oiiotool "$T/$f.exr" --subimage $i "$T/deepgl.exr" --subimage $i --diff >/dev/null 2>&1 || exit 1; done; done'
 expect 3 "--output deep of flat input is refused" -- "$OBSCURA" ao "$R" --output deep -o "$T/no.exr"
 said "the input is not a deep EXR"
 expect 3 "--output deep with another output is refused" -- "$OBSCURA" ao "$D" --output deep,ao -o "$T/no.exr"

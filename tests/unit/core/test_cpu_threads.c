@@ -120,6 +120,34 @@ static void test_deep_chain(void **state)
     obs_deep_free(&d);
 }
 
+/* A deadline already past stops the run with OBS_DEADLINE and nothing
+ * allocated; none (0) runs it whole; the log gets the frame's notes. */
+static void note(void *user, obs_log_level level, const char *msg)
+{
+    (void)level;
+    (void)msg;
+    (*(int *)user)++;
+}
+
+static void test_deadline_and_log(void **state)
+{
+    obs_result r;
+    char err[OBS_ERR_LEN] = "";
+    int lines = 0;
+    (void)state;
+    obs_cpu_options past = {.deadline = 1e-9};
+    assert_int_equal(obs_run_cpu_opts(&room.gb, NULL, OBS_OUTPUT_AO, &r, &past, err), OBS_DEADLINE);
+    assert_non_null(strstr(err, "deadline"));
+    assert_null(r.ao.data);
+    obs_gbuffer no_normals = room.gb; /* normals derived from depth: a note */
+    no_normals.normal = (obs_plane){NULL, 0, 0};
+    obs_cpu_options none = {.log = note, .log_user = &lines};
+    assert_int_equal(obs_run_cpu_opts(&no_normals, NULL, OBS_OUTPUT_AO, &r, &none, err), OBS_OK);
+    assert_non_null(r.ao.data);
+    assert_true(lines > 0);
+    obs_result_free(&r);
+}
+
 /* Every row in exactly one band, bands no taller than asked. */
 static void count_rows(void *ctx, int y0, int y1)
 {
@@ -175,6 +203,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bands),
+        cmocka_unit_test(test_deadline_and_log),
         cmocka_unit_test(test_every_method),
         cmocka_unit_test(test_chain_variants),
         cmocka_unit_test(test_deep_chain),

@@ -186,10 +186,47 @@ static void test_fetch(void **state)
     assert_int_equal(obs__cull_candidate(&f, est, 0, 11), 1);
 }
 
+/* The tile form (obs__cull_candidates, each corner fetched once) gives
+ * the per-pixel test's answer at every pixel, on tiles inside the frame,
+ * at its edges and past the texture, and on one wider than the form takes. */
+static void test_tile_candidates(void **state)
+{
+    obs__frame f;
+    (void)state;
+    memset(&f, 0, sizeof f);
+    f.width = 300;
+    f.height = 37;
+    f.cull_w = (f.width + 7) / 8;
+    f.cull_h = (f.height + 7) / 8;
+    f.cull_threshold = 0.9f;
+    float est[38 * 5];
+    unsigned seed = 7;
+    for (int i = 0; i < f.cull_w * f.cull_h; i++) { /* about a third of the texels occluded */
+        seed = seed * 1103515245u + 12345u;
+        est[i] = (seed >> 16) % 3 ? 1.0f : 0.5f;
+    }
+    static const int tiles[][4] = {{0, 64, 0, 16}, {13, 77, 5, 21}, {256, 300, 32, 37},
+                                   {0, 300, 0, 37}};
+    unsigned char cand[300 * 37];
+    int seen[2] = {0, 0};
+    for (size_t t = 0; t < sizeof tiles / sizeof tiles[0]; t++) {
+        const int *r = tiles[t];
+        obs__cull_candidates(&f, est, r[0], r[1], r[2], r[3], cand);
+        for (int y = r[2]; y < r[3]; y++)
+            for (int x = r[0]; x < r[1]; x++) {
+                int want = obs__cull_candidate(&f, est, x, y);
+                assert_int_equal(cand[(y - r[2]) * (r[1] - r[0]) + (x - r[0])], want);
+                seen[want]++;
+            }
+    }
+    assert_true(seen[0] > 0 && seen[1] > 0); /* both answers occur */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_fetch),
+        cmocka_unit_test(test_tile_candidates),
         cmocka_unit_test(test_real_scenes),
     };
     return cmocka_run_group_tests_name("culling", tests, NULL, NULL);

@@ -1,4 +1,5 @@
-/* The deep AO out (obs_deep_ao_nodes, obs_deep_ao_write_exr; obscura ao
+/* The deep AO out (obs_deep_ao_nodes, obs_deep_ao_write_exr and its
+ * in-memory twin, byte for byte the file; obscura ao
  * --output deep) on the deep fixture: every kept node's AO in [0, 1],
  * its flattening front to back by the nodes' alpha equal to
  * obs_deep_run_cpu's flat AO (blur off), and the file read back through
@@ -83,6 +84,20 @@ static void test_nodes_flatten_to_flat_ao(void **state)
     assert_memory_equal(front.data, r.ao_front.data, npx * sizeof(float));
     obs_image_free(&front);
     obs_deep_free(&back);
+    /* into memory (obscurad's answer): the file's bytes */
+    obs_bytes mem;
+    if (obs_deep_ao_write_exr_mem(&a, &r.ao_blend, &r.ao_front, &mem, err) != OBS_OK)
+        fail_msg("%s", err);
+    FILE *fp = fopen(path, "rb");
+    assert_non_null(fp);
+    unsigned char *file = malloc(mem.size + 1);
+    assert_non_null(file);
+    assert_int_equal(fread(file, 1, mem.size + 1, fp), mem.size);
+    fclose(fp);
+    assert_memory_equal(file, mem.data, mem.size);
+    free(file);
+    obs_bytes_free(&mem);
+    assert_int_equal(obs_deep_ao_write_exr_mem(NULL, NULL, NULL, &mem, err), OBS_INVALID_ARGUMENT);
     unlink(path);
     obs_deep_ao_free(&a);
     obs_deep_result_free(&r);

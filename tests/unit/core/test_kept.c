@@ -87,8 +87,9 @@ static void test_deep(void **state)
     obs_deep_result r;
     assert_int_equal(obs_deep_run(ctx, &d, &p, &r, err), OBS_OK);
     /* the nodes' positions and normals (two RGBA32F arrays of 3 layers),
-     * the front and blend AO and the blur's plane between its passes (RG32F) */
-    const unsigned long long want = (unsigned long long)d.width * d.height * (16 * 2 * 3 + 3 * 8);
+     * the intervals' ends (an R32F array of 3 layers), the front and blend
+     * AO and the blur's plane between its passes (RG32F) */
+    const unsigned long long want = (unsigned long long)d.width * d.height * (16 * 2 * 3 + 4 * 3 + 3 * 8);
     assert_int_equal(obs_ctx_kept_bytes(ctx), want);
     assert_int_equal(obs_ctx_trim(ctx, 0, err), OBS_OK);
     assert_int_equal(obs_ctx_kept_bytes(ctx), 0);

@@ -172,6 +172,16 @@ static void test_output_options(void **state)
     assert_non_null(strstr(err, "layer name 'a.'"));
     assert_int_equal(obs_http_request_set(&r, "layer", "", err), OBS_INVALID_ARGUMENT);
     assert_int_equal(obs_http_request_set(&r, "append", "2", err), OBS_INVALID_ARGUMENT);
+    /* output=deep: the deep EXR alone (the query takes one output) */
+    obs_http_request_init(&r);
+    assert_int_equal(obs_http_request_set(&r, "output", "deep", err), OBS_OK);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "format", "png", err), OBS_OK);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "output=deep answers one deep EXR"));
+    assert_int_equal(obs_http_request_set(&r, "format", "exr", err), OBS_OK);
+    assert_int_equal(obs_http_request_set(&r, "append", "1", err), OBS_OK);
+    assert_int_equal(obs_http_request_check(&r, err), OBS_INVALID_ARGUMENT);
 }
 
 /* The CLI takes the debug outputs and a comma list of outputs; a query
@@ -193,7 +203,7 @@ static void test_option_from(void **state)
     assert_int_equal(obs_http_option_set(&r, out, ",", OBS_HTTP_CLI, err), OBS_INVALID_ARGUMENT);
     assert_int_equal(r.outputs, OBS_OUTPUT_BLEED | OBS_OUTPUT_LUMINANCE); /* unchanged */
     assert_int_equal(obs_http_request_set(&r, "output", "samples", err), OBS_INVALID_ARGUMENT);
-    assert_string_equal(err, "parameter output: 'samples' is not one of ao|composite|both|multibounce|bent|aovs");
+    assert_string_equal(err, "parameter output: 'samples' is not one of ao|composite|both|multibounce|bent|aovs|deep");
     assert_int_equal(obs_http_request_set(&r, "output", "ao,composite", err), OBS_INVALID_ARGUMENT);
     /* a refused list of names leaves the earlier one */
     assert_int_equal(obs_http_request_set(&r, "normal", "A,B,C", err), OBS_OK);
@@ -259,7 +269,7 @@ static void test_json(void **state)
     /* the options as the table's rows say: type, choices of a query */
     static const struct {
         const char *name, *type, *choices;
-    } want[] = {{"output", "enum", "ao|composite|both|multibounce|bent|aovs"}, {"format", "enum", "exr|png"},
+    } want[] = {{"output", "enum", "ao|composite|both|multibounce|bent|aovs|deep"}, {"format", "enum", "exr|png"},
                 {"float", "bool", "0|1"},
                 {"compression", "enum", "auto|none|rle|zips|zip|piz|dwaa"},
                 {"png_bits", "enum", "8|16"},
