@@ -363,6 +363,8 @@ static void parse_ao(int argc, char **argv, ao_args *a)
     obs_exr_names names;
     if (a->req.layer && obs_exr_layers_rename(NULL, 0, a->req.layer, &names, err) != OBS_OK)
         die_usage("--layer: %s", err);
+    if (obs_exr_compression_check((obs_exr_compression)a->req.compression, err) != OBS_OK)
+        die_usage("--compression: %s", err);
 }
 
 /* -o -: a whole file to stdout (oiiotool's convention). */
@@ -432,7 +434,8 @@ static obs_status write_exr_out(const ao_args *a, obs_exr_layer *layers, int n, 
     obs_exr_source src = {.path = a->in_buf ? NULL : a->in, .buf = a->in_buf, .len = a->in_len, .part = part};
     obs_provenance prov = provenance_of(a);
     obs_exr_options o = {.pixel = a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam, .src = &src,
-                         .append = a->req.append, .prov = &prov};
+                         .append = a->req.append, .prov = &prov,
+                         .compression = (obs_exr_compression)a->req.compression};
     obs_exr_names names;
     obs_status s = OBS_OK;
     if (a->req.layer && (s = obs_exr_layers_rename(layers, n, a->req.layer, &names, err)) != OBS_OK)

@@ -9,6 +9,11 @@
 #include "obscura/mask.h"
 #include "stats.h"
 
+/* An EXR answer's compression when the request names none (compression
+ * auto): chosen for the round trip's time, not the bytes (bench/RESULTS.md,
+ * "daemon round trip": the encode of a 1080p half AO per compression). */
+#define OBSD_ANSWER_COMPRESSION OBS_EXR_RLE
+
 static obs_status fail_strict(char err[OBS_ERR_LEN], const obs_exr_info *info)
 {
     snprintf(err, OBS_ERR_LEN, "strict: %d sanity warning%s: %s", info->warning_count,
@@ -291,7 +296,9 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
         obs_exr_source src = {.buf = fp->src, .len = fp->src_len, .part = fp->src_part};
         obs_provenance prov = {.params = &hr->params}; /* the CLI's keys: clients/obscura.c provenance_of */
         obs_exr_options o = {.pixel = hr->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam,
-                             .src = fp->src ? &src : NULL, .append = hr->append, .prov = &prov};
+                             .src = fp->src ? &src : NULL, .append = hr->append, .prov = &prov,
+                             .compression = hr->compression ? (obs_exr_compression)hr->compression
+                                                            : OBSD_ANSWER_COMPRESSION};
         if (hr->layer)
             s = obs_exr_layers_rename(layers, n, hr->layer, &names, err);
         if (s == OBS_OK)
