@@ -15,7 +15,10 @@
 #include "obscura/bake.h"
 #include "obscura/deep.h"
 #include "ground.h"
+#include <cjson/cJSON.h>
+
 #include "obscura/io.h"
+#include "obscura/mask.h"
 #include "obscura/obscura.h"
 #include "obscura/reference.h"
 #include "obscura/scene.h"
@@ -30,6 +33,9 @@ void cli_ground_usage(FILE *f)
             "                  [--baked]        a level baked by obscura bake (.glb, found by\n"
             "                  its attributes; --baked: required) adds _AO, _AO_SHORT, _AO_LONG,\n"
             "                  the vertex values interpolated\n"
+            "                  [--ids]          adds id: 1 + the mesh's index at each pixel (0: none),\n"
+            "                  an object mask's id:id=N (prints each ID's mesh and node names),\n"
+            "                  and a Cryptomatte layer CryptoObject of the node names\n"
             "                  [--dynamic MODEL.json [--dynamic-nodes PATTERN] [--dynamic-sh S]]\n"
             "                  dynamic objects in the baked level (nodes whose name matches the\n"
             "                  pattern, or with glTF extras \"obscura_dynamic\": true, and their\n"
@@ -61,7 +67,7 @@ typedef struct ground_args {
     long width, height, spp, threads;
     unsigned long long seed;
     double distance;
-    int quiet, verbose, deep, baked;
+    int quiet, verbose, deep, baked, ids;
     /* --obscurance and --blend, through the bake's table (its ranges and
      * its default blend) */
     int obscurance, blend_given, decor_given;
@@ -146,6 +152,8 @@ static void parse(ground_args *a, int argc, char **argv, int reference)
             a->deep = 1;
         else if (!reference && !strcmp(argv[i], "--baked"))
             a->baked = 1;
+        else if (!reference && !strcmp(argv[i], "--ids"))
+            a->ids = 1;
         else if (!reference && (v = opt_value(a, argc, argv, &i, "dynamic")))
             a->dynamic = v;
         else if (!reference && (v = opt_value(a, argc, argv, &i, "dynamic-nodes")))
@@ -388,12 +396,79 @@ static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene
     return EXIT_OK;
 }
 
+/* gbuffer --ids: a Cryptomatte layer "CryptoObject" of the meshes (each
+ * named by its node, else its mesh name) as the specification writes one:
+ * one rank set, rank 0 the ID of the name's MurmurHash3 (obs_crypto_name_id)
+ * with coverage 1 (one sample per pixel), rank 1 empty; the manifest JSON
+ * and the layer's attributes into attrs (key, value, ..., NULL; the strings
+ * in *store, freed by the caller).  0, or -1 out of memory. */
+#define CRYPTO_LAYER "CryptoObject"
+static int crypto_layer(const obs_scene *scene, const obs_image *ids, obs_image *out,
+                        const char *attrs[9], char **store)
+{
+    static char keys[4][64];
+    char key[9];
+    snprintf(key, sizeof key, "%08x", (unsigned)obs_murmur3_32(CRYPTO_LAYER, strlen(CRYPTO_LAYER), 0));
+    key[7] = '\0';
+    static const char *const field[4] = {"name", "hash", "conversion", "manifest"};
+    for (int k = 0; k < 4; k++)
+        snprintf(keys[k], sizeof keys[k], "cryptomatte/%s/%s", key, field[k]);
+    cJSON *man = cJSON_CreateObject();
+    size_t n = (size_t)ids->width * ids->height;
+    if (!man || !(out->data = calloc(n * 4, sizeof(float)))) {
+        cJSON_Delete(man);
+        return -1;
+    }
+    out->width = ids->width;
+    out->height = ids->height;
+    out->channels = 4;
+    for (size_t m = 0; m < scene->mesh_count; m++) {
+        const obs_scene_mesh *sm = &scene->meshes[m];
+        const char *name = sm->node && *sm->node ? sm->node : sm->name ? sm->name : "";
+        char hex[9];
+        snprintf(hex, sizeof hex, "%08x", (unsigned)obs_crypto_name_id(name));
+        if (!cJSON_GetObjectItemCaseSensitive(man, name))
+            cJSON_AddStringToObject(man, name, hex);
+    }
+    for (size_t i = 0; i < n; i++) {
+        size_t m = (size_t)ids->data[i];
+        if (m < 1 || m > scene->mesh_count)
+            continue;
+        const obs_scene_mesh *sm = &scene->meshes[m - 1];
+        uint32_t h = obs_crypto_name_id(sm->node && *sm->node ? sm->node : sm->name ? sm->name : "");
+        memcpy(&out->data[4 * i], &h, sizeof h);
+        out->data[4 * i + 1] = 1.0f;
+    }
+    *store = cJSON_PrintUnformatted(man);
+    cJSON_Delete(man);
+    if (!*store)
+        return -1;
+    const char *v[4] = {CRYPTO_LAYER, "MurmurHash3_32", "uint32_to_float32", *store};
+    for (int k = 0; k < 4; k++) {
+        attrs[2 * k] = keys[k];
+        attrs[2 * k + 1] = v[k];
+    }
+    attrs[8] = NULL;
+    return 0;
+}
+
 /* The G-buffer's EXR: depth, normals (world and camera), positions, the
  * colour (its coverage alone without albedo) and the baked channels. */
-static int write_gbuffer(const ground_args *a, const obs_raster *r, const obs_image *baked,
-                         int has_baked, const obs_camera *cam, int w, int h,
-                         char err[OBS_ERR_LEN])
+static int write_gbuffer(const ground_args *a, const obs_scene *scene, const obs_raster *r,
+                         const obs_image *baked, int has_baked, const obs_image *ids,
+                         const obs_camera *cam, int w, int h, char err[OBS_ERR_LEN])
 {
+    static const char *const n_id[] = {"id"};
+    static const char *const n_crypto[] = {CRYPTO_LAYER "00.R", CRYPTO_LAYER "00.G",
+                                           CRYPTO_LAYER "00.B", CRYPTO_LAYER "00.A"};
+    obs_image crypto = {0};
+    const char *attrs[9] = {NULL};
+    char *manifest = NULL;
+    if (ids->data && crypto_layer(scene, ids, &crypto, attrs, &manifest) != 0) {
+        obs_image_free(&crypto);
+        free(manifest);
+        return cli_fail(OBS_NO_MEMORY, a->out, NULL);
+    }
     static const char *const n_baked[] = {"_AO", "_AO_SHORT", "_AO_LONG"};
     static const char *const n_z[] = {"Z"}, *const n_n[] = {"N.X", "N.Y", "N.Z"},
                              *const n_nc[] = {"Ncam.X", "Ncam.Y", "Ncam.Z"},
@@ -414,9 +489,19 @@ static int write_gbuffer(const ground_args *a, const obs_raster *r, const obs_im
                                     {&r->normal_cam, n_nc}, {&r->position, n_p},
                                     r->has_albedo ? (obs_exr_layer){&r->color, n_c}
                                                   : (obs_exr_layer){&alpha, n_a},
-                                    {baked, n_baked}};
-    /* Float: the sky depth (1e10) and world positions do not fit a half. */
-    obs_status s = obs_exr_write(a->out, layers, has_baked ? 6 : 5, OBS_EXR_FLOAT, cam, err);
+                                    has_baked ? (obs_exr_layer){baked, n_baked}
+                                              : (obs_exr_layer){ids, n_id},
+                                    has_baked ? (obs_exr_layer){ids, n_id}
+                                              : (obs_exr_layer){&crypto, n_crypto},
+                                    {&crypto, n_crypto}};
+    int nl = 5 + has_baked + 2 * (ids->data != NULL);
+    /* Float: the sky depth (1e10) and world positions do not fit a half
+     * (and a Cryptomatte ID is a float's bits). */
+    obs_provenance prov = {.attrs = ids->data ? attrs : NULL};
+    obs_exr_options o = {.pixel = OBS_EXR_FLOAT, .cam = cam, .prov = &prov};
+    obs_status s = obs_exr_write_ex(a->out, layers, nl, &o, err);
+    obs_image_free(&crypto);
+    free(manifest);
     obs_image_free(&alpha);
     return s == OBS_OK ? EXIT_OK : cli_fail(s, a->out, err);
 }
@@ -432,7 +517,7 @@ int cli_gbuffer(int argc, char **argv)
     obs_scene scene = {0};
     obs_raster r = {0};
     obs_ctx *ctx = NULL;
-    obs_image baked = {0};
+    obs_image baked = {0}, ids = {0};
     obs_dyn_model model = {0};
     char err[OBS_ERR_LEN] = "";
     int w, h, rc;
@@ -495,10 +580,18 @@ int cli_gbuffer(int argc, char **argv)
             baked.data[i] = baked.data[3 * i];
         baked.channels = 1;
     }
+    if (a.ids && (s = obs_raster_ids(ctx, &scene, &cam, w, h, &ids, err)) != OBS_OK) {
+        rc = cli_input_fail(s, a.scene, err);
+        goto done;
+    }
     double t_raster = cli_now_s() - t0;
 
-    if ((rc = write_gbuffer(&a, &r, &baked, scene.baked != NULL, &cam, w, h, err)) != EXIT_OK)
+    if ((rc = write_gbuffer(&a, &scene, &r, &baked, scene.baked != NULL, &ids, &cam, w, h, err)) != EXIT_OK)
         goto done;
+    for (size_t m = 0; a.ids && !a.quiet && m < scene.mesh_count; m++)
+        fprintf(stderr, "obscura: info: id %zu: mesh '%s', node '%s'\n", m + 1,
+                scene.meshes[m].name ? scene.meshes[m].name : "",
+                scene.meshes[m].node ? scene.meshes[m].node : "");
     if (!a.quiet) {
         obs_ctx_info ci;
         obs_ctx_get_info(ctx, &ci);
@@ -511,6 +604,7 @@ int cli_gbuffer(int argc, char **argv)
 
 done:
     obs_image_free(&baked);
+    obs_image_free(&ids);
     obs_raster_free(&r);
     obs_ctx_destroy(ctx);
     obs_scene_free(&scene);

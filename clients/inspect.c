@@ -16,6 +16,7 @@
 #include "inspect.h"
 #include "obscura/deep.h"
 #include "obscura/io.h"
+#include "obscura/mask.h"
 
 static const char *depth_name(int m)
 {
@@ -50,6 +51,58 @@ static char **part_lines; /* obs_exr_describe_parts() of the file */
  * and the radius a user would start from (obs_radius_suggest: a tenth of
  * the median depth, README.md "Warnings"). */
 static obs_depth_range range;
+/* The Cryptomatte layers and ID channels (obs_crypto_describe): what the
+ * object-mask selectors can name. */
+static obs_crypto_info crypto;
+
+static void json_masks(cJSON *o)
+{
+    cJSON *layers = cJSON_AddArrayToObject(o, "cryptomatte"), *ids;
+    for (int i = 0; i < crypto.layer_count; i++) {
+        const obs_crypto_layer *L = &crypto.layers[i];
+        cJSON *l = cJSON_CreateObject(), *names = cJSON_CreateArray();
+        cJSON_AddItemToArray(layers, l);
+        cJSON_AddStringToObject(l, "name", L->name);
+        cJSON_AddStringToObject(l, "key", L->key);
+        cJSON_AddStringToObject(l, "hash", L->hash);
+        cJSON_AddNumberToObject(l, "ranks", 2 * L->rank_sets);
+        cJSON_AddStringToObject(l, "manifest", L->manif_file[0] ? L->manif_file : "header");
+        cJSON_AddStringToObject(l, "manifest_error", L->manifest_error);
+        for (int k = 0; k < L->entry_count; k++) {
+            char hex[9];
+            cJSON *e = cJSON_CreateObject();
+            snprintf(hex, sizeof hex, "%08x", L->ids[k]);
+            cJSON_AddStringToObject(e, "name", L->names[k]);
+            cJSON_AddStringToObject(e, "id", hex);
+            cJSON_AddItemToArray(names, e);
+        }
+        cJSON_AddItemToObject(l, "names", names);
+    }
+    ids = cJSON_AddArrayToObject(o, "id_channels");
+    for (int i = 0; i < crypto.id_count; i++)
+        cJSON_AddItemToArray(ids, cJSON_CreateString(crypto.id_channels[i]));
+}
+
+static void print_masks(void)
+{
+    if (!crypto.layer_count && !crypto.id_count) {
+        printf("  object masks: no Cryptomatte layer, no ID channel (matte:CHANNEL still works)\n");
+        return;
+    }
+    printf("  object masks (--receivers, --occluders, --self-only):\n");
+    for (int i = 0; i < crypto.layer_count; i++) {
+        const obs_crypto_layer *L = &crypto.layers[i];
+        printf("    Cryptomatte layer %s (key %s, %d ranks, manifest %s%s): %d names\n", L->name,
+               L->key, 2 * L->rank_sets, L->manif_file[0] ? "in " : "in the header",
+               L->manif_file, L->entry_count);
+        if (L->manifest_error[0])
+            printf("      error: %s\n", L->manifest_error);
+        for (int k = 0; k < L->entry_count; k++)
+            printf("      %08x  %s\n", L->ids[k], L->names[k]);
+    }
+    for (int i = 0; i < crypto.id_count; i++)
+        printf("    ID channel %s (id:%s=N)\n", crypto.id_channels[i], crypto.id_channels[i]);
+}
 
 static int print_json(const char *path, const obs_gbuffer *gb, const obs_exr_info *info)
 {
@@ -106,6 +159,7 @@ static int print_json(const char *path, const obs_gbuffer *gb, const obs_exr_inf
     for (int i = 0; i < info->warning_count; i++)
         cJSON_AddItemToArray(w, cJSON_CreateString(info->warnings[i]));
     cJSON_AddItemToObject(o, "warnings", w);
+    json_masks(o);
     char *s = cJSON_Print(o);
     int ok = s != NULL;
     if (s)
@@ -161,6 +215,7 @@ static void print_text(const char *path, const obs_gbuffer *gb, const obs_exr_in
     if (part_lines && part_lines[0] && part_lines[1])
         for (char **l = part_lines; *l; l++)
             printf("    part %s\n", *l);
+    print_masks();
     for (int i = 0; i < info->warning_count; i++)
         printf("  warning: %s\n", info->warnings[i]);
     if (!info->warning_count)
@@ -225,7 +280,35 @@ int cli_inspect(int argc, char **argv)
     return rc;
 }
 
+static int inspect_file(const char *in, int json, obs_http_request *req);
+
+/* inspect_file with the object masks described first; a file that is no
+ * G-buffer (a Cryptomatte-only frame) still has its layers listed. */
 static int cli_inspect_file(const char *in, int json, obs_http_request *req)
+{
+    char err[OBS_ERR_LEN] = "";
+    if (obs_crypto_describe(in, NULL, 0, &crypto, err) != OBS_OK)
+        memset(&crypto, 0, sizeof crypto);
+    int rc = inspect_file(in, json, req);
+    if (rc != EXIT_OK && (crypto.layer_count || crypto.id_count) && !json) {
+        printf("%s (not read as a G-buffer)\n", in);
+        print_masks();
+    } else if (rc != EXIT_OK && (crypto.layer_count || crypto.id_count)) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "file", in);
+        cJSON_AddBoolToObject(o, "gbuffer", 0);
+        json_masks(o);
+        char *s = cJSON_Print(o);
+        if (s)
+            printf("%s\n", s);
+        free(s);
+        cJSON_Delete(o);
+    }
+    obs_crypto_info_free(&crypto);
+    return rc;
+}
+
+static int inspect_file(const char *in, int json, obs_http_request *req)
 {
     obs_gbuffer_file gf = {0};
     char err[OBS_ERR_LEN] = "";

@@ -29,6 +29,7 @@
 #include "dynamic.h"
 #include "ground.h"
 #include "obscura/io.h"
+#include "obscura/mask.h"
 #include "obscura/metrics.h"
 #include "obscura/obscura.h"
 #include "remote.h"
@@ -163,7 +164,8 @@ static void param_flag(const obs_param_info *pi, char *flag, size_t len)
 
 /* A parameter's range, its choices or its bounds, as --help writes it
  * (" {CHOICES}", " [LO..HI]") or as the parameter table does (table:
- * "CHOICES", "LO .. HI"); "" when it has none. */
+ * "CHOICES", "LO .. HI", a text's "at most MAX bytes"); "" when it has
+ * none. */
 static void param_range(const obs_param_info *pi, int table, char *range, size_t len)
 {
     range[0] = 0;
@@ -171,6 +173,8 @@ static void param_range(const obs_param_info *pi, int table, char *range, size_t
         snprintf(range, len, table ? "%s" : " {%s}", pi->choices);
     else if (pi->type == OBS_PARAM_FLOAT || pi->type == OBS_PARAM_INT)
         snprintf(range, len, table ? "%g .. %g" : " [%g..%g]", pi->min, pi->max);
+    else if (pi->type == OBS_PARAM_STRING && table)
+        snprintf(range, len, "at most %g bytes", pi->max);
 }
 
 /* The ao options and the parameter table; the left column widens to
@@ -375,6 +379,8 @@ static void parse_ao(int argc, char **argv, ao_args *a)
     obs_exr_names names;
     if (a->req.layer && obs_exr_layers_rename(NULL, 0, a->req.layer, &names, err) != OBS_OK)
         die_usage("--layer: %s", err);
+    if (obs_exr_compression_check((obs_exr_compression)a->req.compression, err) != OBS_OK)
+        die_usage("--compression: %s", err);
 }
 
 /* -o -: a whole file to stdout (oiiotool's convention). */
@@ -444,7 +450,8 @@ static obs_status write_exr_out(const ao_args *a, obs_exr_layer *layers, int n, 
     obs_exr_source src = {.path = a->in_buf ? NULL : a->in, .buf = a->in_buf, .len = a->in_len, .part = part};
     obs_provenance prov = provenance_of(a);
     obs_exr_options o = {.pixel = a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam, .src = &src,
-                         .append = a->req.append, .prov = &prov};
+                         .append = a->req.append, .prov = &prov,
+                         .compression = (obs_exr_compression)a->req.compression};
     obs_exr_names names;
     obs_status s = OBS_OK;
     if (a->req.layer && (s = obs_exr_layers_rename(layers, n, a->req.layer, &names, err)) != OBS_OK)
@@ -703,10 +710,20 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
                  "or stdout");
         return cli_fail(OBS_INVALID_ARGUMENT, a->in, err);
     }
+    if ((a->req.outputs & OBS_OUTPUT_DEEP) && a->req.params.receivers[0]) {
+        snprintf(err, OBS_ERR_LEN, "--output deep writes every node's AO, which --receivers (a mask "
+                 "of each pixel's front sample) does not reach: not together");
+        return cli_fail(OBS_INVALID_ARGUMENT, a->in, err);
+    }
     double t0 = now_ms();
     s = a->in_buf ? obs_deep_read_exr_mem(a->in_buf, a->in_len, lim, &d, err) : obs_deep_read_exr(a->in, lim, &d, err);
-    if (s != OBS_OK)
+    if (s == OBS_OK) /* object masks: receivers at the front samples */
+        s = obs_deep_read_masks(&d, a->in_buf ? NULL : a->in, a->in_buf, a->in_len,
+                                &a->req.params, lim, err);
+    if (s != OBS_OK) {
+        obs_deep_free(&d);
         return cli_input_fail(s, a->in, err);
+    }
     double t_read = now_ms() - t0;
     /* the camera's cross-checks (the deep reader keeps the camera only) */
     obs_exr_info dinfo = {0};
@@ -982,8 +999,14 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
     double t0 = now_ms();
     obs_status s = a->in_buf ? obs_gbuffer_read_exr_mem(a->in_buf, a->in_len, &a->req.map, lim, &gf, err)
                              : obs_gbuffer_read_exr(a->in, &a->req.map, lim, &gf, err);
-    if (s != OBS_OK)
+    /* object masks (receivers, occluders, self_only); a daemon reads its own */
+    if (s == OBS_OK && !server)
+        s = obs_gbuffer_read_masks(&gf, a->in_buf ? NULL : a->in, a->in_buf, a->in_len,
+                                   &a->req.params, lim, err);
+    if (s != OBS_OK) {
+        obs_gbuffer_free(&gf);
         return cli_input_fail(s, a->in, err);
+    }
     double t_read = now_ms() - t0;
     print_input_info(a->in, &gf.info, &gf.gb);
     int rc = prepare_camera(a, &gf, err);
@@ -1169,7 +1192,7 @@ static int cmd_params(int argc, char **argv)
         printf("| parameter | type | default | range | meaning |\n|---|---|---|---|---|\n");
     for (int i = 0; i < obs_param_count(); i++) {
         const obs_param_info *pi = obs_param_at(i);
-        static const char *const types[] = {"float", "int", "enum", "16 floats"};
+        static const char *const types[] = {"float", "int", "enum", "16 floats", "text"};
         char range[96];
         param_range(pi, 1, range, sizeof range);
         if (markdown) /* '|' would end a Markdown table cell */

@@ -10,6 +10,7 @@
 #define OBS__DEF_INT(d) OBS__STR(d)
 #define OBS__DEF_ENUM(d) d
 #define OBS__DEF_MAT4(d) "unset"
+#define OBS__DEF_STRING(d) d
 
 static const obs_table_row rows[] = {
 #define X(name, type, def, lo, hi, choices, doc)                                   \

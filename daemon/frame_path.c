@@ -6,7 +6,13 @@
 
 #include "frame_path.h"
 #include "obscura/deep.h"
+#include "obscura/mask.h"
 #include "stats.h"
+
+/* An EXR answer's compression when the request names none (compression
+ * auto): chosen for the round trip's time, not the bytes (bench/RESULTS.md,
+ * "daemon round trip": the encode of a 1080p half AO per compression). */
+#define OBSD_ANSWER_COMPRESSION OBS_EXR_RLE
 
 static obs_status fail_strict(char err[OBS_ERR_LEN], const obs_exr_info *info)
 {
@@ -75,6 +81,10 @@ obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
         s = obs_deep_read_exr_mem(body, len, lim, &fp->deep_exr, err);
     else if (s == OBS_OK)
         s = obs_gbuffer_read_exr_mem(body, len, map, lim, &fp->gf, err);
+    /* object masks (receivers, occluders, self_only) from the same body */
+    if (s == OBS_OK)
+        s = deep ? obs_deep_read_masks(&fp->deep_exr, NULL, body, len, &hr->params, lim, err)
+                 : obs_gbuffer_read_masks(&fp->gf, NULL, body, len, &hr->params, lim, err);
     if (s == OBS_OK && !deep)
         s = read_baked(fp, body, len, hr, lim, err);
     if (s == OBS_OK && !deep && hr->solve_camera && fp->gf.gb.position.data)
@@ -286,7 +296,9 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
         obs_exr_source src = {.buf = fp->src, .len = fp->src_len, .part = fp->src_part};
         obs_provenance prov = {.params = &hr->params}; /* the CLI's keys: clients/obscura.c provenance_of */
         obs_exr_options o = {.pixel = hr->float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = cam,
-                             .src = fp->src ? &src : NULL, .append = hr->append, .prov = &prov};
+                             .src = fp->src ? &src : NULL, .append = hr->append, .prov = &prov,
+                             .compression = hr->compression ? (obs_exr_compression)hr->compression
+                                                            : OBSD_ANSWER_COMPRESSION};
         if (hr->layer)
             s = obs_exr_layers_rename(layers, n, hr->layer, &names, err);
         if (s == OBS_OK)

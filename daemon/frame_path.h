@@ -36,6 +36,7 @@ typedef struct obsd_fp {
     obs_camera cam;           /* flat: the camera the job ran with (obsd_fp_finished) */
     int has_cam;
     double ms_decode, ms_queue, ms_gl, ms_encode;
+    double ms_receive;        /* the transport's: the body's arrival (HTTP), else 0 */
     /* the way back from the GL worker */
     void (*on_done)(void *user);
     void *user;

@@ -85,7 +85,8 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
         }
         if (name_is(key, "output"))
             fr->want_color = fr->want_front = 0;
-        else if (!name_is(key, "format") && !name_is(key, "float") && !name_is(key, "png_bits") &&
+        else if (!name_is(key, "format") && !name_is(key, "float") && !name_is(key, "compression") &&
+                 !name_is(key, "png_bits") &&
                  !name_is(key, "png_transfer"))
             fr->rerun = 1;
     }
@@ -299,6 +300,8 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
 static enum MHD_Result queue_body(req *r)
 {
     obsd__frame_req *fr = r->fr;
+    fr->fp.ms_receive = obsd_now_ms() - r->t0;
+    obsd_stats_stage(OBSD_STAGE_RECEIVE, fr->fp.ms_receive);
     if (r->len == 0) {
         char msg[128];
         snprintf(msg, sizeof msg, "%s %s needs a G-buffer EXR as its body", r->method,

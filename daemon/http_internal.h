@@ -139,6 +139,7 @@ typedef struct obsd__req {
     char peer[64];
     char path[128];      /* the URL's path, for the log */
     double t0;
+    double t_answered;   /* its answer queued (obsd_now_ms()), for the `send` stage */
     /* its body (a frame's, a level's) */
     unsigned char *body;
     size_t len, cap;

@@ -20,9 +20,10 @@ static void log_request(const req *r, const char *note)
     const obsd_fp *fp = r->fr ? &r->fr->fp : &none;
     obsd_log(OBSD_LOG_INFO,
              "req=%llu peer=%s %s %s status=%d in=%zu out=%zu queue=%.1f decode=%.1f gl=%.1f "
-             "encode=%.1f total=%.1f ms%s%s",
+             "encode=%.1f receive=%.1f total=%.1f ms%s%s",
              (unsigned long long)r->id, r->peer, r->method, r->path, r->status,
              r->len + r->discarded, r->bytes_out, fp->ms_queue, fp->ms_decode, fp->ms_gl, fp->ms_encode,
+             fp->ms_receive,
              obsd_now_ms() - r->t0, note && *note ? " " : "", note ? note : "");
 }
 
@@ -83,8 +84,9 @@ enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size
     enum MHD_Result rc = MHD_queue_response(r->conn, (unsigned)status, resp);
     MHD_destroy_response(resp);
     obsd_stats_request(r->slot, status, r->len + r->discarded, body_len);
+    r->t_answered = obsd_now_ms();
     if (r->frame_total)
-        obsd_stats_stage(OBSD_STAGE_TOTAL, obsd_now_ms() - r->t0);
+        obsd_stats_stage(OBSD_STAGE_TOTAL, r->t_answered - r->t0);
     log_request(r, rc == MHD_YES ? note : "(could not queue the answer)");
     return rc;
 }
@@ -175,9 +177,10 @@ static enum MHD_Result answer_bytes(req *r, obs_bytes *out, const char *type, in
     }
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, type);
     if (timing) {
-        char t[192];
-        snprintf(t, sizeof t, "queue;dur=%.2f, decode;dur=%.2f, gl;dur=%.2f, encode;dur=%.2f",
-                 fr->fp.ms_queue, fr->fp.ms_decode, fr->fp.ms_gl, fr->fp.ms_encode);
+        /* send is not known yet: it is in /metrics (obscurad_stage_seconds) */
+        char t[224];
+        snprintf(t, sizeof t, "queue;dur=%.2f, decode;dur=%.2f, gl;dur=%.2f, encode;dur=%.2f, receive;dur=%.2f",
+                 fr->fp.ms_queue, fr->fp.ms_decode, fr->fp.ms_gl, fr->fp.ms_encode, fr->fp.ms_receive);
         MHD_add_response_header(resp, "Server-Timing", t);
     }
     if (extra_name)

@@ -277,6 +277,10 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
         obsd_log(OBSD_LOG_INFO, "req=%llu peer=%s %s %s ended without an answer (reason %d%s)",
                  (unsigned long long)r->id, r->peer, r->method, r->label, (int)why,
                  cut == CUT_DRAIN ? ", cut by the drain" : cut == CUT_EVICTED ? ", evicted" : "");
+    /* the answer of a frame is out: the send stage (its bytes handed to
+     * the kernel; the client may still be reading them) */
+    if (why == MHD_REQUEST_TERMINATED_COMPLETED_OK && r->frame_total && r->status == 200 && r->t_answered > 0)
+        obsd_stats_stage(OBSD_STAGE_SEND, obsd_now_ms() - r->t_answered);
     if (c)
         obsd__conn_detach(h, c);
     if (r->route && r->route->done)

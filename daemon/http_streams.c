@@ -134,6 +134,7 @@ static void apply_stored(req *r, const obsd_frame *f)
     fr->hr.outputs = OBS_OUTPUT_AO;
     fr->hr.format = OBS_HTTP_EXR;
     fr->hr.float_exr = 0;
+    fr->hr.compression = 0;
     fr->hr.png_bits = 8;
 }
 

@@ -13,7 +13,8 @@
 #include "log.h"
 #include "stats.h"
 
-static const char *const stage_names[OBSD_STAGE_COUNT] = {"queue", "decode", "gl", "encode", "total"};
+static const char *const stage_names[OBSD_STAGE_COUNT] = {"queue", "decode", "gl", "encode", "receive",
+                                                                 "send", "total"};
 /* The statuses the daemon answers; anything else counts as the last. */
 static const int codes[] = {200, 202, 400, 401, 404, 405, 408, 409, 413, 415, 422, 500, 503, 0};
 #define NCODES ((int)(sizeof codes / sizeof codes[0]))
@@ -208,7 +209,7 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
                     codes[c] ? "" : "other", codes[c] ? codes[c] : 0,
                     (unsigned long long)st.requests[r][c]);
     put(&b, "# HELP obscurad_stage_seconds Latency of each stage of a frame "
-            "(queue wait, EXR decode, GL run, encode, total).\n"
+            "(queue wait, EXR decode, GL run, encode; HTTP: receive, send; total).\n"
             "# TYPE obscurad_stage_seconds histogram\n");
     for (int s = 0; s < OBSD_STAGE_COUNT; s++) {
         uint64_t cum = 0;

@@ -11,6 +11,7 @@
 #include <cjson/cJSON.h>
 
 #include "list.h"
+#include "obscura/mask.h"
 
 typedef struct obsd_stream obsd_stream;
 struct obsd_stream {
@@ -337,6 +338,36 @@ char *obsd_streams_list_json(obsd_streams *s)
     return out;
 }
 
+/* What the object-mask selectors of a frame can name (the preview page's
+ * receivers/occluders control): each Cryptomatte layer's names and the ID
+ * channels, from the body's header (no pixel is decoded); neither key
+ * when the frame has none. */
+static void add_objects(cJSON *fo, const obsd_frame *f)
+{
+    obs_crypto_info ci;
+    char err[OBS_ERR_LEN];
+    if (!f->body || obs_crypto_describe(NULL, f->body, f->body_len, &ci, err) != OBS_OK)
+        return;
+    if (!ci.layer_count && !ci.id_count) { /* nothing to name: no keys */
+        obs_crypto_info_free(&ci);
+        return;
+    }
+    cJSON *layers = cJSON_AddArrayToObject(fo, "cryptomatte");
+    for (int i = 0; layers && i < ci.layer_count; i++) {
+        cJSON *l = cJSON_CreateObject(), *names = cJSON_CreateArray();
+        cJSON_AddItemToArray(layers, l);
+        cJSON_AddStringToObject(l, "name", ci.layers[i].name);
+        cJSON_AddStringToObject(l, "manifest_error", ci.layers[i].manifest_error);
+        for (int k = 0; k < ci.layers[i].entry_count; k++)
+            cJSON_AddItemToArray(names, cJSON_CreateString(ci.layers[i].names[k]));
+        cJSON_AddItemToObject(l, "names", names);
+    }
+    cJSON *ids = cJSON_AddArrayToObject(fo, "id_channels");
+    for (int i = 0; ids && i < ci.id_count; i++)
+        cJSON_AddItemToArray(ids, cJSON_CreateString(ci.id_channels[i]));
+    obs_crypto_info_free(&ci);
+}
+
 char *obsd_streams_stream_json(obsd_streams *s, const char *name, int *found)
 {
     char *out = NULL;
@@ -359,6 +390,7 @@ char *obsd_streams_stream_json(obsd_streams *s, const char *name, int *found)
         add_timings(fo, f);
         add_params(fo, f);
         add_camera(fo, &f->camera);
+        add_objects(fo, f);
     }
     pthread_mutex_unlock(&s->lock);
     if (o) {

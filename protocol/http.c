@@ -32,6 +32,12 @@ static const obs_http_choice output_choices[] = {
 static const obs_http_choice format_choices[] = {
     {"exr", OBS_HTTP_EXR, ANY}, {"png", OBS_HTTP_PNG, ANY}, {NULL, 0, 0}};
 static const obs_http_choice png_bits_choices[] = {{"8", 8, ANY}, {"16", 16, ANY}, {NULL, 0, 0}};
+/* auto (0): ZIP for a file `obscura ao` writes, the daemon's fast
+ * default for an answer (daemon/frame_path.c); the rest by OpenEXR's names */
+static const obs_http_choice compression_choices[] = {
+    {"auto", OBS_EXR_ZIP_DEFAULT, ANY}, {"none", OBS_EXR_NONE, ANY}, {"rle", OBS_EXR_RLE, ANY},
+    {"zips", OBS_EXR_ZIPS, ANY},        {"zip", OBS_EXR_ZIP, ANY},   {"piz", OBS_EXR_PIZ, ANY},
+    {"dwaa", OBS_EXR_DWAA, ANY},        {NULL, 0, 0}};
 static const obs_http_choice png_transfer_choices[] = {
     {"srgb", OBS_PNG_TRANSFER_SRGB, ANY}, {"linear", OBS_PNG_TRANSFER_LINEAR, ANY}, {NULL, 0, 0}};
 
@@ -47,6 +53,10 @@ const obs_http_option obs_http_options[] = {
      .choices = format_choices, .doc = "image format of the response"},
     {.name = "float", .kind = OBS_HTTP_OPT_BOOL, .field = FIELD(float_exr), .def = "0",
      .doc = "EXR: 32-bit float channels instead of half"},
+    {.name = "compression", .kind = OBS_HTTP_OPT_CHOICE, .field = FIELD(compression), .def = "auto",
+     .choices = compression_choices,
+     .doc = "EXR: the output's compression; auto: zip for a file obscura ao writes, rle for "
+            "obscurad's answer (fast to write; dwaa, lossy, needs OpenEXR 3.2)"},
     {.name = "png_bits", .kind = OBS_HTTP_OPT_CHOICE, .field = FIELD(png_bits), .def = "8",
      .choices = png_bits_choices, .doc = "PNG bit depth"},
     {.name = "png_transfer", .kind = OBS_HTTP_OPT_CHOICE, .field = FIELD(png_transfer), .def = "srgb",
@@ -302,6 +312,8 @@ obs_status obs_http_request_check(const obs_http_request *r, char err[OBS_ERR_LE
         return obs_status_fail(err, OBS_INVALID_ARGUMENT,
                               "append=1 writes the input EXR back with the AO added: it needs "
                               "format=exr");
+    if (r->compression == OBS_EXR_DWAA && obs_exr_compression_check(OBS_EXR_DWAA, err) != OBS_OK)
+        return OBS_INVALID_ARGUMENT; /* this build cannot: the request's fault to fix (400) */
     if (r->layer) {
         obs_exr_names names;
         obs_status s = obs_exr_layers_rename(NULL, 0, r->layer, &names, err);
@@ -422,7 +434,7 @@ static cJSON *choices_array(const char *choices)
 
 char *obs_http_params_json(void)
 {
-    static const char *const types[] = {"float", "int", "enum", "mat4"};
+    static const char *const types[] = {"float", "int", "enum", "mat4", "string"};
     cJSON *root = cJSON_CreateObject(), *params, *opts;
     char *out = NULL;
     if (!root)
@@ -451,6 +463,8 @@ char *obs_http_params_json(void)
             cJSON_AddNumberToObject(o, "max", pi->max);
         } else {
             cJSON_AddStringToObject(o, "default", pi->def);
+            if (pi->type == OBS_PARAM_STRING) /* its length in bytes */
+                cJSON_AddNumberToObject(o, "max", pi->max);
         }
         /* an int with choices takes only those numbers (samples: 2|4|8|16|32) */
         if ((pi->type == OBS_PARAM_ENUM || pi->type == OBS_PARAM_INT) && pi->choices)

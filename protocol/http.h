@@ -28,6 +28,7 @@ typedef struct obs_http_request {
     unsigned outputs;       /* OBS_OUTPUT_* bits; default AO */
     obs_http_format format; /* default EXR */
     int float_exr;          /* EXR: 32-bit float channels (default half) */
+    int compression;        /* EXR: obs_exr_compression; 0 (auto): the writer's default */
     int png_bits;           /* 8 (default) or 16 */
     int png_transfer;       /* obs_png_transfer of the AO PNG: sRGB (default) or linear */
     int strict;             /* sanity warnings on the input are errors */

@@ -38,6 +38,14 @@ sees them by default (warnings.simplefilter("error", oc.ObscuraWarning)
 makes them errors), and kept in the answer's .warnings (a list of str);
 an ObscuraError has .warnings too.
 
+Object masks (README: Object masks): receivers, occluders and self_only,
+with selectors of Cryptomatte names (wildcards * and ?), integer IDs of a
+channel or a coverage matte; selector() escapes names that hold ',', '*',
+'?' or '\\' themselves:
+
+    oc.ao("shot.exr", receivers=oc.selector("hero", "floor*", literal=False),
+          occluders="id:IndexOB=3,5-7", self_only="on")
+
 Level bakes (obscura bake on the daemon, POST /v1/bakes, HTTP only):
 
     oc.bake("level.glb", out="baked.glb", rays=64, distances=(2, 300))
@@ -61,7 +69,7 @@ import time
 import urllib.parse
 import warnings
 
-__all__ = ["ao", "bake", "Answer", "Camera", "ObscuraError", "ObscuraWarning", "DEFAULT_SERVER"]
+__all__ = ["ao", "bake", "selector", "Answer", "Camera", "ObscuraError", "ObscuraWarning", "DEFAULT_SERVER"]
 __version__ = "1.2.0"
 
 DEFAULT_SERVER = "http://127.0.0.1:8420"
@@ -200,6 +208,24 @@ class Camera(object):
 
     def __repr__(self):
         return "Camera(fov_y=%.6g, near=%.6g, far=%.6g)" % (self.fov_y, self.near, self.far)
+
+
+def selector(*names, literal=True, layer=None):
+    """A receivers/occluders selector of Cryptomatte names: joined with
+    ',', each name's ',', '*', '?', '\\' (and a leading '@' or '!') escaped when
+    literal, else * and ? kept as wildcards; layer: "@LAYER:" first (one
+    Cryptomatte layer of the file instead of all)."""
+    out = []
+    for n in names:
+        n = str(n)
+        if literal:
+            n = "".join("\\" + c if c in ",*?\\" else c for c in n)
+        else:
+            n = n.replace("\\", "\\\\").replace(",", "\\,")
+        if n.startswith("@") or n.startswith("!"):
+            n = "\\" + n
+        out.append(n)
+    return ("@%s:" % layer if layer else "") + ",".join(out)
 
 
 def _value(v):

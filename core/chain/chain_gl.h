@@ -40,6 +40,7 @@ typedef struct obs__targets {
     GLuint tex_cullmask;                      /* debug: culling candidates (4.2) */
     GLuint tex_bleed;                         /* colour-bleed term (4.7), RGBA */
     GLuint tex_lumfactor;                     /* debug: factor of eq 3 (4.3) */
+    GLuint tex_mask_w, tex_mask_id;           /* object masks: occluders weight, object ID */
     GLuint tex_bent;                          /* bent normal sums (view space), RGBA */
     GLuint fbo_prep, fbo_ao, fbo_composite;  /* fbo_prep: viewpos + vnormal + dz */
     GLuint fbo_blur;                          /* tex_blur + tex_lumfactor */

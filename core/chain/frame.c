@@ -81,6 +81,14 @@ obs_status obs__frame_setup_common(obs_ctx *log_ctx, const obs_gbuffer *gb, cons
     f->cull_h = (f->height + OBS_CULL_BLOCK - 1) / OBS_CULL_BLOCK;
     f->blur_radius = p->blur == OBS_ON ? p->blur_radius : 0;
     f->half = p->ao_resolution == OBS_RESOLUTION_HALF;
+    /* object masks (core/mask.c): full-size planes, read at the samples */
+    f->mask_occl = gb->occluders.data;
+    f->mask_id = gb->object_id.data;
+    f->mask_on = f->mask_occl || f->mask_id;
+    if (f->mask_on && f->half)
+        return obs__fail(err, OBS_INVALID_ARGUMENT,
+                         "occluders and self_only need ao_resolution full (the masks are "
+                         "per pixel of the full frame)");
     for (int k = 0; k <= f->blur_radius; k++) /* section 4.6: Gaussian kernel */
         f->blur_w[k] = expf(-(float)(k * k) / (2.0f * p->blur_sigma * p->blur_sigma));
     for (int k = 0; k < 9; k++)

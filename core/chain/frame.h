@@ -75,6 +75,11 @@ typedef struct obs__frame {
     float lum_threshold, lum_width, lum_sigma; /* threshold, width, sigma of eq 3 */
     int bleed_step;         /* section 4.7, eq 5: 0 off, else every bleed_step-th sample */
     int method;             /* OBS_METHOD_*: which estimator the AO pass runs */
+    /* Object masks (core/mask.c, obs_gbuffer.occluders and object_id,
+     * packed, width x height; NULL: none): read at each method's sample
+     * site through obs__occluder_weight (chain/mask_weight.h) */
+    const float *mask_occl, *mask_id;
+    int mask_on;            /* 1: either is set */
     /* the method's own values, read by its functions only: their types
      * are in core/methods/<method>.h (obs__gtao_of(f), ...), so the chain
      * needs none of them; in place, so that a frame copies whole

@@ -122,6 +122,10 @@ static obs_status run_upload(obs__gl_run *r, char err[OBS_ERR_LEN])
         upload(r->t->tex_normal, &gb->normal, f->width, f->height, GL_RGB);
     if (r->pl->has_color)
         upload(r->t->tex_color, &gb->color, f->width, f->height, GL_RGBA);
+    if (f->mask_occl) /* object masks */
+        upload(r->t->tex_mask_w, &gb->occluders, f->width, f->height, GL_RED);
+    if (f->mask_id)
+        upload(r->t->tex_mask_id, &gb->object_id, f->width, f->height, GL_RED);
     return OBS_OK;
 }
 
@@ -166,6 +170,13 @@ static obs_status run_ao(obs__gl_run *r, char err[OBS_ERR_LEN])
         /* section 4.7: colour bleeding reads the colour at the samples */
         bind_img(prog, "u_color", 3, r->t->tex_color, GL_RGBA32F);
     }
+    /* object masks: occluder_weight() in common.glsl */
+    glUniform1i(glGetUniformLocation(prog, "u_mask_on"),
+                (pl->f.mask_occl ? 1 : 0) | (pl->f.mask_id ? 2 : 0));
+    if (pl->f.mask_occl)
+        bind_img(prog, "u_mask_w", 5, r->t->tex_mask_w, GL_R32F);
+    if (pl->f.mask_id)
+        bind_img(prog, "u_mask_id", 6, r->t->tex_mask_id, GL_R32F);
     /* the debug outputs go to their textures only when asked for */
     const GLenum vao_bufs[] = {
         GL_COLOR_ATTACHMENT0,

@@ -9,6 +9,7 @@
 #include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
 #include "log.h"
+#include "mask_apply.h"
 
 static double now_ms(void)
 {
@@ -108,5 +109,7 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
     obs__cpu_planes_give(&c);
     if (s != OBS_OK)
         obs_result_free(out);
+    else
+        obs__receivers_apply(gb, out); /* object masks: receivers */
     return s;
 }

@@ -7,6 +7,7 @@
 #include "chain/frame_gl.h"
 #include "chain/multibounce.h"
 #include "chain/passes_gl.h"
+#include "mask_apply.h"
 
 /* ---- per-pass timings (GL_TIME_ELAPSED queries) ------------------------ */
 
@@ -130,5 +131,6 @@ obs_status obs_run(obs_ctx *ctx, const obs_gbuffer *gb, const obs_params *params
         return s;
     }
     collect_times(ctx, ran);
+    obs__receivers_apply(gb, out); /* object masks: receivers */
     return OBS_OK;
 }

@@ -42,7 +42,8 @@ void obs__chain_release(obs__programs *g, obs__targets *t)
 {
     GLuint tex[] = {t->tex_depth,   t->tex_normal, t->tex_color,     t->tex_viewpos, t->tex_vnormal,
                     t->tex_dz,      t->tex_ao,     t->tex_composite, t->tex_blur,    t->tex_count,
-                    t->tex_cull,    t->tex_cullmask, t->tex_bleed,   t->tex_lumfactor, t->tex_bent};
+                    t->tex_cull,    t->tex_cullmask, t->tex_bleed,   t->tex_lumfactor, t->tex_bent,
+                    t->tex_mask_w,  t->tex_mask_id};
     GLuint fbo[] = {t->fbo_prep, t->fbo_ao, t->fbo_blur, t->fbo_composite, t->fbo_vao, t->fbo_cull};
     glDeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     glDeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
@@ -153,6 +154,10 @@ obs_status obs__targets_need(unsigned long *created, const obs__frame *f, obs__t
     if (s == OBS_OK && f->luminance && (outputs & OBS_OUTPUT_LUMINANCE))
         s = need_texture(created, t, &t->tex_lumfactor, GL_R32F, t->fbo_blur, GL_COLOR_ATTACHMENT1,
                          err);
+    if (s == OBS_OK && f->mask_occl) /* object masks (core/mask.c) */
+        s = need_texture(created, t, &t->tex_mask_w, GL_R32F, 0, 0, err);
+    if (s == OBS_OK && f->mask_id)
+        s = need_texture(created, t, &t->tex_mask_id, GL_R32F, 0, 0, err);
     if (s == OBS_OK && (outputs & OBS_OUTPUT_COMPOSITE) && !t->fbo_composite) {
         s = need_texture(created, t, &t->tex_composite, GL_RGBA32F, 0, 0, err);
         if (s == OBS_OK)

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "chain/frame.h"
+#include "chain/mask_weight.h"
 #include "chain/vao_cpu.h"
 
 /* fmaxf and fminf as glibc computes them (the other argument when one is
@@ -231,7 +232,7 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
 
         float zs = INFINITY; /* scene depth at the sample's pixel */
         float nz = 1.0f; /* view normal z of the surface there */
-        int qx, qy;
+        int qx = x, qy = y;
         /* The sample on the disk through the centre, perpendicular to view Z. */
         seen = disk_px(f, &disk, sx, sy, &qx, &qy);
         if (seen) {
@@ -262,6 +263,7 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
          * the pipe spans depths [-c.z - h, -c.z + h]. */
         float front = -c[2] - h;
         float dz = min_f(max_f(zs - front, 0.0f), 2.0f * h);
+        const float om = obs__occluder_weight(f, x, y, qx, qy); /* object masks */
         if (f->range_check && zs < front) {
             /* Case C with the depth range check, section 4.4, eq 4: the
              * pipe lies d behind the visible surface; the occluder is
@@ -272,6 +274,7 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
             float sd = range_falloff(f, front - zs, nz);
             dz = 2.0f * h * (1.0f - sd);
         }
+        dz += (2.0f * h - dz) * (1.0f - om); /* the occluded length times the mask (om 1: dz) */
         /* A sample off the planes reads the surface continued past the
          * border (border_cpu.c derives it); one behind the camera, or
          * without that estimate, says nothing about the scene: it is left
@@ -388,7 +391,8 @@ float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *
                             const float *dnz, const float *col, int x, int y, const float p[3],
                             const float n[3], int ns, const float *xy, float bleed[3])
 {
-    if (col && f->bleed_step > 0)
+    /* bleeding, and object masks (not in the lanes): the reference loop */
+    if ((col && f->bleed_step > 0) || f->mask_on)
         return estimate(f, pos, nrm, dnz, 2, dnz + 1, 2, col, x, y, p, n, ns, xy, bleed, NULL);
     bleed[0] = bleed[1] = bleed[2] = 1.0f;
     return estimate_lanes(f, pos, nrm, dnz, x, y, p, n, ns, xy);

@@ -25,6 +25,7 @@
 #include "methods/gtao.h"
 #include "methods/hbao.h"
 #include "methods/hemisphere.h"
+#include "mask_apply.h"
 #include "methods/methods.h"
 
 int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_exr_layer layers[3])
@@ -488,6 +489,7 @@ obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
         obs__blur(&df.f, df.pos, out->ao_blend.data, tmp);
         free(tmp);
     }
+    obs__receivers_apply_deep(d, out); /* object masks: receivers */
     obs__deep_composite(d, out);
     obs__deep_frame_free(&df);
     return OBS_OK;

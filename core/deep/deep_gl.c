@@ -32,6 +32,7 @@
 #include "chain/chain_gl.h"
 #include "chain/frame_gl.h"
 #include "context.h"
+#include "mask_apply.h"
 #include "deep/deep_internal.h"
 #include "gl/draw.h"
 #include "methods/methods.h"
@@ -297,6 +298,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
         ctx->times = times;
         ctx->times_valid = 1;
     }
+    obs__receivers_apply_deep(d, out); /* object masks: receivers */
     obs__deep_composite(d, out);
 fail:
     obs__deep_frame_free(&df);

@@ -321,8 +321,10 @@ static obs_status sample_pass(const deep_job *j, const uint32_t *counts, obs_dee
     return st;
 }
 
+/* extra: a channel read in the place of R (obs__deep_read_front); NULL:
+ * none. */
 static obs_status read_deep(exr_context_t ctx, int64_t file_size, const obs_limits *lim,
-                            obs_deep_image *d, char err[OBS_ERR_LEN])
+                            const char *extra, obs_deep_image *d, char err[OBS_ERR_LEN])
 {
     deep_job j;
     const exr_attr_chlist_t *cl = NULL;
@@ -350,6 +352,8 @@ static obs_status read_deep(exr_context_t ctx, int64_t file_size, const obs_limi
         return obs__exr_fail(err, rv ? rv : EXR_ERR_MISSING_REQ_ATTR, "channel list");
     if ((st = map_channels(cl, &j.map, err)) != OBS_OK)
         return st;
+    if (extra && (j.map.ch[OBS_DEEP_R] = find_channel(cl, extra)) < 0)
+        return obs__fail(err, OBS_MISSING_CHANNEL, "deep part has no channel '%.200s'", extra);
     for (int i = 0; i < cl->num_channels; i++) {
         exr_pixel_type_t t = cl->entries[i].pixel_type;
         if (t != EXR_PIXEL_HALF && t != EXR_PIXEL_FLOAT && t != EXR_PIXEL_UINT)
@@ -434,12 +438,13 @@ fail:
 typedef struct image_job {
     const obs_limits *lim;
     obs_deep_image *out;
+    const char *extra;
 } image_job;
 
 static obs_status image_reader(exr_context_t ctx, int64_t size, void *user, char why[OBS_ERR_LEN])
 {
     const image_job *j = user;
-    return read_deep(ctx, size, j->lim, j->out, why);
+    return read_deep(ctx, size, j->lim, j->extra, j->out, why);
 }
 
 static obs_status read_any(const char *label, const char *path, const mem_src *mem,
@@ -448,10 +453,36 @@ static obs_status read_any(const char *label, const char *path, const mem_src *m
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
     memset(out, 0, sizeof *out);
-    image_job j = {lim, out};
+    image_job j = {lim, out, NULL};
     obs_status st = obs__exr_read_with(label, path, mem, image_reader, &j, err);
     if (st != OBS_OK)
         obs_deep_free(out);
+    return st;
+}
+
+obs_status obs__deep_read_front(const char *path, const obs__exr_mem *mem, const char *channel,
+                                const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN])
+{
+    obs_deep_image d;
+    memset(&d, 0, sizeof d);
+    memset(out, 0, sizeof *out);
+    image_job j = {lim, &d, channel};
+    obs_status st = obs__exr_read_with(path ? path : "EXR in memory", mem ? NULL : path, mem,
+                                       image_reader, &j, err);
+    size_t n = (size_t)d.width * (size_t)d.height;
+    if (st == OBS_OK && !(out->data = malloc((n ? n : 1) * sizeof(float))))
+        st = obs__fail(err, OBS_NO_MEMORY, "channel of %dx%d", d.width, d.height);
+    if (st == OBS_OK) {
+        out->width = d.width;
+        out->height = d.height;
+        out->channels = 1;
+        /* the lists are sorted front to back: the first is the surface seen */
+        for (size_t i = 0; i < n; i++)
+            out->data[i] = d.offset[i + 1] > d.offset[i]
+                               ? d.samples[d.offset[i] * OBS_DEEP_CH + OBS_DEEP_R]
+                               : 0.0f;
+    }
+    obs_deep_free(&d);
     return st;
 }
 
@@ -478,5 +509,6 @@ void obs_deep_free(obs_deep_image *d)
         return;
     free(d->offset);
     free(d->samples);
+    free(d->receivers);
     memset(d, 0, sizeof *d);
 }

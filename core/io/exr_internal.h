@@ -135,6 +135,24 @@ typedef obs_status (*obs__exr_reader)(exr_context_t ctx, int64_t size, void *use
 obs_status obs__exr_read_with(const char *label, const char *path, const obs__exr_mem *mem,
                               obs__exr_reader read, void *user, char err[OBS_ERR_LEN]);
 
+/* n channels (float32, one image each), all from one part that holds
+ * channels[0]: one whose "view" attribute is `view` (NULL or "": none),
+ * else part `prefer` (-1: none), else the first; in one pass over its
+ * chunks; the file
+ * at path or len bytes at mem (path then names it).  out: n images, freed
+ * by the caller with obs_image_free (none left on failure).  For the
+ * object masks' rank channels (core/mask.c); obs_exr_read_channel is n 1. */
+obs_status obs__exr_read_channels(const char *path, const obs__exr_mem *mem, int prefer,
+                                  const char *view, const char *const *channels, int n, const obs_limits *lim,
+                                  obs_image *out, char err[OBS_ERR_LEN]);
+
+/* The value of `channel` at the front sample (least Z) of each pixel of
+ * the first deep part (0 where a pixel has none), float32 (core/io/exr_deep.c:
+ * the deep reader's checks, the channel read in the place of R); for
+ * object masks on deep input (core/mask.c). */
+obs_status obs__deep_read_front(const char *path, const obs__exr_mem *mem, const char *channel,
+                                const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN]);
+
 /* ---- output parts (exr_write.c, exr_append.c, exr_header.c) ------------ */
 
 /* One channel an output part writes: `base` is its value at the data

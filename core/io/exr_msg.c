@@ -1,7 +1,9 @@
 /* OpenEXR's messages and statuses, for every EXR file of core/io: the
  * library reports through a callback (obs__exr_error_handler) into a
- * per-thread buffer, which the failing call's message then quotes.  Below
- * the readers and writers, so that each can use it. */
+ * per-thread buffer, which the failing call's message then quotes; and
+ * the output compressions by name, with what this build's library can
+ * code (the request parser checks them without the writer).  Below the
+ * readers and writers, so that each can use it. */
 #include <stdio.h>
 #include <string.h>
 
@@ -53,3 +55,37 @@ obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv, const char *wha
     return obs__fail(err, obs__exr_status(rv), "%s: %s", what, msg);
 }
 
+/* ---- output compressions ------------------------------------------------ */
+
+static const char *const compression_names[] = {"zip", "none", "rle", "zips", "zip", "piz", "dwaa"};
+#define COMPRESSIONS ((int)(sizeof compression_names / sizeof compression_names[0]))
+
+const char *obs_exr_compression_name(obs_exr_compression c)
+{
+    return (int)c >= 0 && (int)c < COMPRESSIONS ? compression_names[c] : "?";
+}
+
+int obs_exr_compression_parse(const char *name)
+{
+    for (int c = 1; name && c < COMPRESSIONS; c++)
+        if (!strcmp(name, compression_names[c]))
+            return c;
+    return -1;
+}
+
+obs_status obs_exr_compression_check(obs_exr_compression c, char err[OBS_ERR_LEN])
+{
+    if ((int)c < 0 || (int)c >= COMPRESSIONS)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "unknown EXR compression %d", (int)c);
+    if (c != OBS_EXR_DWAA)
+        return OBS_OK;
+    /* OpenEXR's C API codes DWAA from 3.2 on; 3.1's says "not yet
+     * implemented in C" for both directions. */
+    int maj = 0, min = 0, patch = 0;
+    exr_get_library_version(&maj, &min, &patch, NULL);
+    if (maj > 3 || (maj == 3 && min >= 2))
+        return OBS_OK;
+    return obs__fail(err, OBS_UNSUPPORTED,
+                     "compression dwaa needs OpenEXR 3.2 or later (this build has %d.%d.%d, whose C API neither "
+                     "writes nor reads DWAA); use none, rle, zips, zip or piz", maj, min, patch);
+}

@@ -719,78 +719,112 @@ void obs_gbuffer_free(obs_gbuffer_file *f)
     if (!f)
         return;
     free(f->storage);
+    free(f->mask_storage);
     memset(f, 0, sizeof *f);
 }
 
 /* ---- single channels and channel lists ---------------------------------- */
 
-/* obs_exr_read_channel and obs_exr_read_channel_mem: the file at path,
- * or the buffer mem (path then names it in messages). */
-static obs_status read_channel(const char *path, const obs__exr_mem *mem, const char *channel,
-                               const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN])
+/* obs_exr_read_channel(_mem) and obs__exr_read_channels: n channels of
+ * the file at path, or of the buffer mem (path then names it in
+ * messages), all from one part that holds channels[0]: one of `view`
+ * (its "view" attribute; NULL or "": none wanted), else part `prefer`,
+ * else the first; decoded in one pass over its chunks. */
+obs_status obs__exr_read_channels(const char *path, const obs__exr_mem *mem, int prefer,
+                                  const char *view, const char *const *channels, int n,
+                                  const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN])
 {
     char sub[OBS_ERR_LEN] = "";
     exr_context_t ctx = NULL;
-    const char **names = NULL, **first = NULL; /* first: part 0's, for the message */
+    const char **names = NULL;
+    target *t = NULL;
     int64_t size;
-    int parts = 0, n = 0, nfirst = 0, found = -1;
+    int parts = 0, nn = 0, found = -1, score = -1, missing = -1;
     part_geom g;
     exr_result_t rv;
     obs_status st;
 
-    if ((!path && !mem) || !channel || !out)
+    if ((!path && !mem) || !channels || n < 1 || !out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_read_channel: NULL argument");
-    memset(out, 0, sizeof *out);
+    memset(out, 0, (size_t)n * sizeof *out);
     if ((st = obs__exr_open(mem ? NULL : path, mem, &ctx, &size, sub)) != OBS_OK)
         goto fail;
     if ((rv = exr_get_count(ctx, &parts)) != EXR_ERR_SUCCESS) {
         st = obs__exr_fail(sub, rv, "part count");
         goto fail;
     }
-    for (int p = 0; p < parts && found < 0; p++) {
-        if ((st = part_names(ctx, p, &names, &n, sub)) != OBS_OK)
+    for (int p = 0; p < parts && score < 2; p++) {
+        if ((st = part_names(ctx, p, &names, &nn, sub)) != OBS_OK)
             goto fail;
-        for (int i = 0; i < n; i++)
-            if (strcmp(names[i], channel) == 0)
-                found = p;
-        if (p == 0) {
-            first = names;
-            nfirst = n;
-        } else {
-            free(names);
-        }
+        int has = 0;
+        for (int i = 0; i < nn && !has; i++)
+            has = strcmp(names[i], channels[0]) == 0;
+        free(names);
         names = NULL;
+        if (!has)
+            continue;
+        const char *v = obs__exr_attr_string(ctx, p, "view");
+        int sc = view && *view && v && !strcmp(v, view) ? 2 : p == prefer ? 1 : 0;
+        if (sc > score) {
+            score = sc;
+            found = p;
+        }
     }
-    if (found < 0) {
+    /* the part chosen, or part 0 for the message */
+    if ((st = part_names(ctx, found < 0 ? 0 : found, &names, &nn, sub)) != OBS_OK)
+        goto fail;
+    for (int k = 1; found >= 0 && k < n && missing < 0; k++) {
+        int has = 0;
+        for (int i = 0; i < nn && !has; i++)
+            has = strcmp(names[i], channels[k]) == 0;
+        if (!has)
+            missing = k;
+    }
+    if (found < 0 || missing >= 0) {
         char list[OBS__LIST_CHARS + 32];
-        obs__list_names(first, nfirst, list, sizeof list);
-        st = obs__fail(sub, OBS_MISSING_CHANNEL, "channel '%.256s' not found; the file has: %s",
-                       channel, list);
+        obs__list_names(names, nn, list, sizeof list);
+        st = obs__fail(sub, OBS_MISSING_CHANNEL, "channel '%.256s' not found; the %s has: %s",
+                       channels[found < 0 ? 0 : missing], found < 0 ? "file" : "part", list);
         goto fail;
     }
     if ((st = check_part(ctx, found, size, lim, &g, sub)) != OBS_OK)
         goto fail;
-    /* check_part() bounded width x height by the limits. */
-    if (!(out->data = malloc((size_t)g.width * (size_t)g.height * sizeof(float)))) {
-        st = obs__fail(sub, OBS_NO_MEMORY, "channel of %dx%d", g.width, g.height);
+    if (!(t = calloc((size_t)n, sizeof *t))) {
+        st = obs__fail(sub, OBS_NO_MEMORY, "%d channels", n);
         goto fail;
     }
-    target t = {channel, out->data, 1};
-    if ((st = decode_part(ctx, found, &g, &t, 1, lim, sub)) != OBS_OK)
-        goto fail;
-    out->width = g.width;
-    out->height = g.height;
-    out->channels = 1;
+    /* check_part() bounded width x height by the limits. */
+    for (int k = 0; k < n; k++) {
+        if (!(out[k].data = malloc((size_t)g.width * (size_t)g.height * sizeof(float)))) {
+            st = obs__fail(sub, OBS_NO_MEMORY, "channel of %dx%d", g.width, g.height);
+            goto fail;
+        }
+        out[k].width = g.width;
+        out[k].height = g.height;
+        out[k].channels = 1;
+        t[k] = (target){channels[k], out[k].data, 1};
+    }
+    st = decode_part(ctx, found, &g, t, n, lim, sub);
 fail:
+    free(t);
     free(names);
-    free(first);
     if (ctx)
         exr_finish(&ctx);
     if (st != OBS_OK) {
-        obs_image_free(out);
+        for (int k = 0; k < n; k++)
+            obs_image_free(&out[k]);
         obs__fail(err, st, "%s: %s", path ? path : "EXR", sub);
     }
     return st;
+}
+
+static obs_status read_channel(const char *path, const obs__exr_mem *mem, const char *channel,
+                               const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN])
+{
+    const char *const one[1] = {channel};
+    if (!channel)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_exr_read_channel: NULL argument");
+    return obs__exr_read_channels(path, mem, -1, NULL, one, 1, lim, out, err);
 }
 
 obs_status obs_exr_read_channel(const char *path, const char *channel, const obs_limits *lim,

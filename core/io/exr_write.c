@@ -1,5 +1,6 @@
-/* EXR output through OpenEXR's C API: one scanline part, ZIP, half or
- * float, each layer's channels under the names the caller gives. */
+/* EXR output through OpenEXR's C API: one scanline part, ZIP (or the
+ * compression asked for), half or float, each layer's channels under the
+ * names the caller gives; chunks compressed by a few threads. */
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,10 +10,25 @@
 #include "io/out_file.h"
 #include "io/provenance.h"
 #include "internal.h"
+#include "pool.h"
 
 /* Names longer than this need the long-name flag in the file version. */
 #define SHORT_NAME_MAX 31
 #define NAME_MAX_LEN 255
+
+/* ---- compression (the names: exr_msg.c) -------------------------------- */
+
+static exr_compression_t exr_compression_of(obs_exr_compression c)
+{
+    switch (c) {
+    case OBS_EXR_NONE: return EXR_COMPRESSION_NONE;
+    case OBS_EXR_RLE: return EXR_COMPRESSION_RLE;
+    case OBS_EXR_ZIPS: return EXR_COMPRESSION_ZIPS;
+    case OBS_EXR_PIZ: return EXR_COMPRESSION_PIZ;
+    case OBS_EXR_DWAA: return EXR_COMPRESSION_DWAA;
+    default: return EXR_COMPRESSION_ZIP;
+    }
+}
 
 /* Checks layers before the file is created; the message names the layer
  * or channel at fault. */
@@ -107,6 +123,148 @@ static int has_attr(exr_const_context_t ctx, int part, const char *name)
     return has;
 }
 
+/* ---- pixels: chunks compressed by a few threads ---------------------------
+ *
+ * OpenEXR's C API writes a scanline part's chunks in order, but packing
+ * and compressing a chunk (exr_encoding_run up to its write step) touches
+ * only that chunk's pipeline.  So each thread runs its own pipeline over
+ * chunks handed out in order (pool.h), with the write step replaced by a
+ * copy of the compressed bytes into the chunk's slot; then this thread
+ * writes the slots in order with exr_write_scanline_chunk.  The bytes are
+ * those one thread writes, whatever the thread count.  On failure the
+ * lowest failing chunk's error (and the library's message, which is per
+ * thread) is kept. */
+
+typedef struct enc_slot {
+    void *data;
+    uint64_t size;
+} enc_slot;
+
+typedef struct enc_job {
+    exr_context_t ctx;
+    int part;
+    const obs__wpart *p;
+    const exr_chunk_info_t *ci;
+    enc_slot *slot;
+    int64_t failed;     /* lowest failing chunk (chunks: none); under the pool's lock */
+    exr_result_t rv;
+    char msg[384];
+} enc_job;
+
+typedef struct enc_local {
+    exr_encode_pipeline_t enc;
+    int started;
+    int64_t failed;
+    exr_result_t rv;
+    char msg[384];
+} enc_local;
+
+/* The write step of a thread's pipeline: keep the chunk's bytes. */
+static exr_result_t stash_chunk(exr_encode_pipeline_t *enc)
+{
+    enc_slot *s = enc->encoding_user_data;
+    if (!(s->data = malloc(enc->compressed_bytes ? (size_t)enc->compressed_bytes : 1)))
+        return EXR_ERR_OUT_OF_MEMORY;
+    memcpy(s->data, enc->compressed_buffer, (size_t)enc->compressed_bytes);
+    s->size = enc->compressed_bytes;
+    return EXR_ERR_SUCCESS;
+}
+
+static void enc_begin(void *ctx, void *local)
+{
+    (void)ctx;
+    enc_local *l = local;
+    l->enc = (exr_encode_pipeline_t)EXR_ENCODE_PIPELINE_INITIALIZER;
+    l->rv = EXR_ERR_SUCCESS;
+    obs__exr_msg_reset();
+}
+
+static int enc_one(void *ctx, void *local, size_t i, size_t i1)
+{
+    (void)i1; /* ranges of one chunk */
+    enc_job *j = ctx;
+    enc_local *l = local;
+    const exr_chunk_info_t *ci = &j->ci[i];
+    exr_result_t rv = l->started ? exr_encoding_update(j->ctx, j->part, ci, &l->enc)
+                                 : exr_encoding_initialize(j->ctx, j->part, ci, &l->enc);
+    l->started |= rv == EXR_ERR_SUCCESS;
+    if (rv == EXR_ERR_SUCCESS) {
+        bind_channels(&l->enc, j->p, ci);
+        rv = exr_encoding_choose_default_routines(j->ctx, j->part, &l->enc);
+    }
+    if (rv == EXR_ERR_SUCCESS) {
+        l->enc.encoding_user_data = &j->slot[i];
+        l->enc.yield_until_ready_fn = NULL; /* the order is this file's: written after */
+        l->enc.write_fn = stash_chunk;
+        rv = exr_encoding_run(j->ctx, j->part, &l->enc);
+    }
+    if (rv == EXR_ERR_SUCCESS)
+        return 0;
+    l->failed = (int64_t)i;
+    l->rv = rv;
+    snprintf(l->msg, sizeof l->msg, "%s", obs__exr_msg());
+    return 1;
+}
+
+/* Under the pool's lock. */
+static void enc_end(void *ctx, void *local)
+{
+    enc_job *j = ctx;
+    enc_local *l = local;
+    if (l->rv != EXR_ERR_SUCCESS && l->failed < j->failed) {
+        j->failed = l->failed;
+        j->rv = l->rv;
+        memcpy(j->msg, l->msg, sizeof j->msg);
+    }
+    if (l->started)
+        exr_encoding_destroy(j->ctx, &l->enc);
+}
+
+/* Compression threads for `chunks` chunks: the caller's count (0: the
+ * machine's cores, pool.h), no more than one for every 4 chunks. */
+static int encode_threads(int threads, int64_t chunks)
+{
+    int n = obs__pool_threads(threads);
+    if (n > chunks / 4)
+        n = (int)(chunks / 4);
+    return n < 1 ? 1 : n;
+}
+
+/* Part `part`'s pixels, every chunk, in order. */
+static exr_result_t write_pixels(exr_context_t ctx, int part, const obs__wpart *p, int threads)
+{
+    int32_t lines = 0;
+    exr_result_t rv = exr_get_scanlines_per_chunk(ctx, part, &lines);
+    if (rv != EXR_ERR_SUCCESS)
+        return rv;
+    if (lines < 1)
+        return EXR_ERR_INVALID_ARGUMENT;
+    int64_t chunks = ((int64_t)p->dw.max.y - p->dw.min.y + lines) / lines;
+    exr_chunk_info_t *ci = calloc((size_t)chunks, sizeof *ci);
+    enc_job j = {.ctx = ctx, .part = part, .p = p, .ci = ci, .failed = chunks, .rv = EXR_ERR_SUCCESS};
+    j.slot = calloc((size_t)chunks, sizeof *j.slot);
+    if (!ci || !j.slot)
+        rv = EXR_ERR_OUT_OF_MEMORY;
+    for (int64_t c = 0; c < chunks && rv == EXR_ERR_SUCCESS; c++)
+        rv = exr_write_scanline_chunk_info(ctx, part, (int)(p->dw.min.y + c * lines), &ci[c]);
+    if (rv == EXR_ERR_SUCCESS) {
+        obs__pool_for f = {.end = (size_t)chunks, .chunk = 1, .threads = encode_threads(threads, chunks),
+                           .range = enc_one, .ctx = &j, .local_size = sizeof(enc_local),
+                           .begin = enc_begin, .end_thread = enc_end};
+        if (obs__pool_run(&f, NULL) < 0)
+            rv = EXR_ERR_OUT_OF_MEMORY;
+        else if ((rv = j.rv) != EXR_ERR_SUCCESS && j.msg[0])
+            obs__exr_error_handler(ctx, rv, j.msg); /* the worker's message, on this thread */
+    }
+    for (int64_t c = 0; c < chunks && rv == EXR_ERR_SUCCESS; c++)
+        rv = exr_write_scanline_chunk(ctx, part, j.ci[c].start_y, j.slot[c].data, j.slot[c].size);
+    for (int64_t c = 0; j.slot && c < chunks; c++)
+        free(j.slot[c].data);
+    free(j.slot);
+    free(ci);
+    return rv;
+}
+
 /* `skip` and the input part's obscura/... attributes, NULL-ended in
  * out[max]: the keys of an earlier run are left out of the part that
  * gets this run's, so no key of one run stands beside another's. */
@@ -143,11 +301,10 @@ static exr_result_t write_prov(exr_context_t ctx, int part, const obs__prov *pro
  * always. */
 static exr_result_t write_parts(exr_context_t ctx, const obs__wpart *parts, int np, exr_const_context_t src,
                                 const char *const *skip, const obs_camera *cam, const obs__prov *prov,
-                                int cam_part, const char **what, const char **attr)
+                                int cam_part, int threads, const char **what, const char **attr)
 {
-    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
     static const exr_attr_v2f_t centre = {{{0.0f, 0.0f}}};
-    int longnames = 0, started = 0, enc_part = 0;
+    int longnames = 0;
     exr_result_t rv = EXR_ERR_SUCCESS;
 
     *what = "writing the header";
@@ -186,29 +343,8 @@ static exr_result_t write_parts(exr_context_t ctx, const obs__wpart *parts, int 
         return rv;
 
     *what = "writing pixels";
-    for (int i = 0; i < np && rv == EXR_ERR_SUCCESS; i++) {
-        const obs__wpart *p = &parts[i];
-        int32_t lines = 0;
-        if ((rv = exr_get_scanlines_per_chunk(ctx, i, &lines)) != EXR_ERR_SUCCESS)
-            break;
-        for (int64_t y = p->dw.min.y; y <= p->dw.max.y && rv == EXR_ERR_SUCCESS; y += lines) {
-            exr_chunk_info_t ci;
-            if ((rv = exr_write_scanline_chunk_info(ctx, i, (int)y, &ci)) != EXR_ERR_SUCCESS)
-                break;
-            rv = started && enc_part == i ? exr_encoding_update(ctx, i, &ci, &enc)
-                                          : exr_encoding_initialize(ctx, i, &ci, &enc);
-            started = 1;
-            enc_part = i;
-            if (rv != EXR_ERR_SUCCESS)
-                break;
-            bind_channels(&enc, p, &ci);
-            if ((rv = exr_encoding_choose_default_routines(ctx, i, &enc)) == EXR_ERR_SUCCESS)
-                rv = exr_encoding_run(ctx, i, &enc);
-        }
-        if (started)
-            exr_encoding_destroy(ctx, &enc);
-        started = 0;
-    }
+    for (int i = 0; i < np && rv == EXR_ERR_SUCCESS; i++)
+        rv = write_pixels(ctx, i, &parts[i], threads);
     return rv;
 }
 
@@ -292,6 +428,8 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: unknown pixel type %d", path, (int)o->pixel);
     if ((st = check_layers(layers, layer_count, &longnames, err)) != OBS_OK)
         return st;
+    if (!o->append && (st = obs_exr_compression_check(o->compression, sub)) != OBS_OK)
+        return obs__fail(err, st, "%s: %s", path, sub);
     if (o->append && !o->src)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: appending needs the input file", path);
     exr_pixel_type_t type = o->pixel == OBS_EXR_FLOAT ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
@@ -321,7 +459,7 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
         }
     } else {
         one.src_part = src ? o->src->part : -1;
-        one.compression = EXR_COMPRESSION_ZIP;
+        one.compression = exr_compression_of(o->compression);
         if ((st = layers_part(layers, layer_count, type, &one, sub)) != OBS_OK ||
             (st = plain_windows(o, src, w, h, &one, sub)) != OBS_OK)
             goto fail;
@@ -343,8 +481,8 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
             if (parts[i].src_part == o->src->part)
                 cam_part = i;
         obs__prov_build(o->prov, &prov);
-        rv = write_parts(ctx, parts, np, src, o->append ? NULL : plain_skip, o->cam, &prov, cam_part, &what,
-                         &attr);
+        rv = write_parts(ctx, parts, np, src, o->append ? NULL : plain_skip, o->cam, &prov, cam_part,
+                         o->threads, &what, &attr);
         if (rv == EXR_ERR_SUCCESS) {
             what = "finishing the file";
             rv = exr_finish(&ctx);

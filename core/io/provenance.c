@@ -17,12 +17,27 @@ static void non_defaults(const obs_params *r, const obs_params *d, const obs_par
     buf[0] = '\0';
     for (int i = 0; i < obs_param_count(); i++) {
         const obs_param_info *pi = obs_param_at(i);
-        char v[512], dv[512];
+        char v[OBS_SELECTOR_MAX + 32], dv[OBS_SELECTOR_MAX + 32], q[2 * OBS_SELECTOR_MAX + 64];
         obs_param_format(r, pi, v, sizeof v);
         obs_param_format(strcmp(pi->name, "method") ? d : d0, pi, dv, sizeof dv);
         if (!strcmp(v, dv))
             continue;
-        int n = snprintf(buf + off, len - off, "%s%s=%s", off ? " " : "", pi->name, v);
+        /* a text value with a space or quote (a selector's names) in
+         * double quotes, '"' and '\' escaped, so that the list splits */
+        if (strpbrk(v, " \"\\")) {
+            size_t k = 0;
+            q[k++] = '"';
+            for (const char *c = v; *c && k + 3 < sizeof q; c++) {
+                if (*c == '"' || *c == '\\')
+                    q[k++] = '\\';
+                q[k++] = *c;
+            }
+            q[k++] = '"';
+            q[k] = '\0';
+        } else {
+            snprintf(q, sizeof q, "%s", v);
+        }
+        int n = snprintf(buf + off, len - off, "%s%s=%s", off ? " " : "", pi->name, q);
         if (n < 0 || (size_t)n >= len - off) {
             buf[off] = '\0'; /* a whole entry or none */
             return;
@@ -58,5 +73,10 @@ void obs__prov_build(const obs_provenance *p, obs__prov *out)
     if (p->camera_source && *p->camera_source) {
         out->key[out->count] = "obscura/camera_source";
         out->value[out->count++] = p->camera_source;
+    }
+    for (int k = 0; p->attrs && p->attrs[k] && p->attrs[k + 1] && out->count < OBS__PROV_KEYS;
+         k += 2) {
+        out->key[out->count] = p->attrs[k];
+        out->value[out->count++] = p->attrs[k + 1];
     }
 }

@@ -5,7 +5,7 @@
 
 #include "obscura/io.h"
 
-#define OBS__PROV_KEYS 5
+#define OBS__PROV_KEYS 13 /* 5 of obscura/ and 8 of obs_provenance.attrs */
 
 typedef struct obs__prov {
     int count;

@@ -15,6 +15,7 @@
  * one far, 0 with both far; the result is the weighted mean. */
 #include <math.h>
 
+#include "chain/mask_weight.h"
 #include "methods/angle.h"
 #include "methods/bent.h"
 
@@ -101,6 +102,8 @@ float obs__angle_pixel_bent(const obs__frame *f, const float *pos, int x, int y,
                 v[k][j] = q[j] - p[j];
             /* "too far away": a depth difference over R, fully so from 2R */
             far[k] = fminf(1.0f, fmaxf(0.0f, fabsf(q[3] - p[3]) / R - 1.0f));
+            /* object masks: a surface that may not occlude counts as far */
+            far[k] += (1.0f - far[k]) * (1.0f - obs__occluder_weight(f, x, y, qx, qy));
         }
         /* Pair weight 1 / 0.5 / 0 for none / one / both far (continuous
          * in between); the weights renormalise the mean. */

@@ -49,6 +49,7 @@
 #include <math.h>
 
 #include "methods/bent.h"
+#include "chain/mask_weight.h"
 #include "methods/gtao.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
@@ -89,9 +90,10 @@ static const float *border_step(const obs__frame *f, const float *pos, const flo
 
 /* The horizon cosine of one sample point q (view xyz, planar depth w; w
  * 0: background) for the centre c: its cosine to v moved from the
- * tangent's `low` by its falloff weight; low where it adds nothing. */
+ * tangent's `low` by its falloff weight times om, the object masks'
+ * weight of its pixel (obs__occluder_weight); low where it adds nothing. */
 static float sample_cos(const obs__gtao_state *g, const float q[4], const float c[3],
-                        const float v[3], float low)
+                        const float v[3], float low, float om)
 {
     if (!(q[3] > 0.0f))
         return low;
@@ -102,7 +104,7 @@ static float sample_cos(const obs__gtao_state *g, const float q[4], const float 
     float shc = dot3(d, v) / dist;
     float dz = d[2] * (1.0f + g->thin_power[0]); /* thin-occluder compensation */
     float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
-    float w = saturate(fb * g->falloff[0] + g->falloff[1]);
+    float w = saturate(fb * g->falloff[0] + g->falloff[1]) * om; /* om: object masks */
     return low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
 }
 
@@ -130,16 +132,18 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         int qy = y + dir * (int)floorf(s * omega[1] + 0.5f);
         float ext[4];
         const float *q;
+        /* object masks: the weight of the surface at the step's pixel */
+        const float om = obs__occluder_weight(f, x, y, qx, qy);
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
             if (!(q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken)))
                 continue;
-            hc = fmaxf(hc, sample_cos(g, q, c, v, low));
+            hc = fmaxf(hc, sample_cos(g, q, c, v, low, om));
             continue;
         }
         (*taken)++;
         q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
         for (int k = 0; k < layers; k++)
-            hc = fmaxf(hc, sample_cos(g, q + (size_t)k * plane, c, v, low));
+            hc = fmaxf(hc, sample_cos(g, q + (size_t)k * plane, c, v, low, om));
     }
     return hc;
 }

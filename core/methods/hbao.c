@@ -17,14 +17,17 @@
 #include <math.h>
 
 #include "methods/bent.h"
+#include "chain/mask_weight.h"
 #include "methods/hbao.h"
 
 /* One sample point q (view xyz, planar depth w; w 0: background) of a
  * direction from p: where it rises above the horizon sin_h, W(r) times
  * the rise into *ao and the horizon raised (GLSL: hbao_sample()); with
- * bent, the occluded span taken from the bent normal (direction dx, dy). */
-static void hbao_sample(const float q[4], const float p[3], float R2, float *sin_h, float *ao,
-                        float dx, float dy, float *bent)
+ * bent, the occluded span taken from the bent normal (direction dx, dy);
+ * all times om, the object masks' weight of its pixel (0: no horizon
+ * raised). */
+static void hbao_sample(const float q[4], const float p[3], float R2, float om, float *sin_h,
+                        float *ao, float dx, float dy, float *bent)
 {
     if (!(q[3] > 0.0f))
         return;
@@ -33,10 +36,10 @@ static void hbao_sample(const float q[4], const float p[3], float R2, float *sin
     if (!(r2 < R2) || !(r2 > 0.0f))
         return;
     float sin_s = v[2] / sqrtf(r2); /* elevation of the sample: view +z faces the camera */
-    if (sin_s > *sin_h) {
-        *ao += (1.0f - r2 / R2) * (sin_s - *sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
+    if (sin_s > *sin_h && om > 0.0f) { /* om 0 (object masks): it raises no horizon */
+        *ao += om * (1.0f - r2 / R2) * (sin_s - *sin_h); /* W(r_i) (sin h_i - sin h_(i-1)) */
         if (bent) /* OBS_OUTPUT_BENT: less the step's occluded span */
-            obs__hbao_bent_span(dx, dy, *sin_h, sin_s, -(1.0f - r2 / R2), bent);
+            obs__hbao_bent_span(dx, dy, *sin_h, sin_s, -om * (1.0f - r2 / R2), bent);
         *sin_h = sin_s;
     }
 }
@@ -103,8 +106,10 @@ static float hbao_estimate(const obs__frame *f, const float *pos, int layers, in
                 break;
             taken++;
             const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+            /* object masks: the weight of the surface at the step's pixel */
+            const float om = obs__occluder_weight(f, x, y, qx, qy);
             for (int k = 0; k < layers; k++) /* deep input: every node, front to back */
-                hbao_sample(q + (size_t)k * plane, p, R2, &sin_h, &ao, dx, dy, bent);
+                hbao_sample(q + (size_t)k * plane, p, R2, om, &sin_h, &ao, dx, dy, bent);
         }
     }
     if (count)

@@ -10,6 +10,7 @@
 
 #include "methods/bent.h"
 #include "methods/hemisphere.h"
+#include "chain/mask_weight.h"
 
 /* Radical inverse of i in base b: the van der Corput sequence. */
 static double radical_inverse(unsigned i, unsigned b)
@@ -114,6 +115,7 @@ float obs__hemisphere_estimate_bent(const obs__frame *f, const obs__hemisphere_n
             float an = nodes->nrm ? nodes->nrm[((size_t)k * nodes->layer_px + q) * 4 + 3] : 1.0f;
             best = fmaxf(best, an * r * r * (3.0f - 2.0f * r));
         }
+        best *= obs__occluder_weight(f, x, y, qx, qy); /* object masks */
         occ += best;
         if (bent) /* OBS_OUTPUT_BENT: the sample's direction times its open part */
             obs__hemisphere_bent_sample(p, s, 1.0f - best, bent);

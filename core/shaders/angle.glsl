@@ -65,6 +65,8 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
             v[k] = xq.xyz - p.xyz;
             // "too far away": a depth difference over R, fully from 2R
             far[k] = min(1.0, max(0.0, abs(xq.w - p.w) / R - 1.0));
+            // object masks: a surface that may not occlude counts as far
+            far[k] += (1.0 - far[k]) * (1.0 - occluder_weight(px, q));
         }
         // pair weight 1 / 0.5 / 0 for none / one / both far
         float w = 1.0 - 0.5 * (far[0] + far[1]);

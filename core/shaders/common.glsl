@@ -246,3 +246,24 @@ void tangent_basis(vec3 n, out vec3 t1, out vec3 t2)
     t1 = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x);
     t2 = vec3(b, sg + n.y * n.y * a, -n.y);
 }
+
+// Object masks (parameters occluders and self_only, core/mask.c): the
+// weight of the surface seen at pixel s as an occluder of pixel c, its
+// occluders coverage times 0 where self_only's object there is not c's;
+// a pixel off the image reads the nearest one on it.  Bound by the AO pass
+// only (u_mask_on: 1 occluders, 2 self_only; 0 elsewhere, the default).
+// C twin: obs__occluder_weight (chain/mask_weight.h).
+layout(r32f) readonly uniform image2D u_mask_w;  // occluders weight
+layout(r32f) readonly uniform image2D u_mask_id; // object ID (compared as bits)
+uniform int u_mask_on;
+float occluder_weight(ivec2 c, ivec2 s)
+{
+    if (u_mask_on == 0)
+        return 1.0;
+    s = clamp(s, ivec2(0), u_size - 1);
+    float w = (u_mask_on & 1) != 0 ? imageLoad(u_mask_w, s).x : 1.0;
+    if ((u_mask_on & 2) != 0 &&
+        floatBitsToUint(imageLoad(u_mask_id, s).x) != floatBitsToUint(imageLoad(u_mask_id, c).x))
+        w = 0.0;
+    return w;
+}

@@ -54,9 +54,10 @@ bool gtao_border_step(ivec2 px, ivec2 q, out vec4 xq)
     return plane_point(vec2(q), pb.xyz, GT_FRONT_NORMAL(b).xyz, xq);
 }
 
-// The horizon cosine of one sample point xq for the centre c: low where
-// it adds nothing.  C twin: sample_cos (methods/gtao.c)
-float gtao_sample_cos(vec4 xq, vec3 c, vec3 v, float low)
+// The horizon cosine of one sample point xq for the centre c, its falloff
+// weight times om (the object masks' weight of its pixel): low where it
+// adds nothing.  C twin: sample_cos (methods/gtao.c)
+float gtao_sample_cos(vec4 xq, vec3 c, vec3 v, float low, float om)
 {
     if (!(xq.w > 0.0))
         return low;
@@ -66,7 +67,7 @@ float gtao_sample_cos(vec4 xq, vec3 c, vec3 v, float low)
         return low;
     float shc = dot(d, v) / dist;
     float fb = length(vec3(d.xy, d.z * (1.0 + u_gtao_thin_power.x)));
-    float w = clamp(fb * u_gtao_falloff.x + u_gtao_falloff.y, 0.0, 1.0);
+    float w = clamp(fb * u_gtao_falloff.x + u_gtao_falloff.y, 0.0, 1.0) * om;
     return low + (shc - low) * w;
 }
 
@@ -82,17 +83,18 @@ float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float n
         float s = (float(st) + sn) / float(u_gtao_steps);
         s = s * s + min_s;
         ivec2 q = px + dir * ivec2(int(floor(s * omega.x + 0.5)), int(floor(s * omega.y + 0.5)));
+        float om = occluder_weight(px, q); // object masks
         if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y) {
             vec4 xq;
             if (!gtao_border_step(px, q, xq))
                 continue;
             taken++;
-            hc = max(hc, gtao_sample_cos(xq, c, v, low));
+            hc = max(hc, gtao_sample_cos(xq, c, v, low, om));
             continue;
         }
         taken++;
         for (int k = 0; k < GT_LAYERS; k++)
-            hc = max(hc, gtao_sample_cos(GT_NODE(q, k), c, v, low));
+            hc = max(hc, gtao_sample_cos(GT_NODE(q, k), c, v, low, om));
     }
     return hc;
 }

@@ -33,8 +33,10 @@ void hbao_bent_span(float dx, float dy, float sin0, float sin1, float w)
 
 // One sample point xq of a direction e = (dx, dy) from p: where it rises
 // above the horizon sin_h, W(r) times the rise into ao, and the occluded
-// span taken from the bent normal.  C twin: hbao_sample.
-void hbao_sample(vec4 xq, vec3 p, float R2, inout float sin_h, inout float ao, float dx, float dy)
+// span taken from the bent normal; all times om, the object masks' weight
+// of its pixel (0: no horizon raised).  C twin: hbao_sample.
+void hbao_sample(vec4 xq, vec3 p, float R2, float om, inout float sin_h, inout float ao, float dx,
+                 float dy)
 {
     if (!(xq.w > 0.0))
         return;
@@ -43,9 +45,9 @@ void hbao_sample(vec4 xq, vec3 p, float R2, inout float sin_h, inout float ao, f
     if (!(r2 < R2) || !(r2 > 0.0))
         return;
     float sin_s = v.z / sqrt(r2);
-    if (sin_s > sin_h) {
-        ao += (1.0 - r2 / R2) * (sin_s - sin_h);   // W(r_i) (sin h_i - sin h_(i-1))
-        hbao_bent_span(dx, dy, sin_h, sin_s, -(1.0 - r2 / R2)); // less the occluded step
+    if (sin_s > sin_h && om > 0.0) {
+        ao += om * (1.0 - r2 / R2) * (sin_s - sin_h);   // W(r_i) (sin h_i - sin h_(i-1))
+        hbao_bent_span(dx, dy, sin_h, sin_s, -om * (1.0 - r2 / R2)); // less the occluded step
         sin_h = sin_s;
     }
 }
@@ -78,8 +80,9 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
             if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
                 break;
             count++;
+            float om = occluder_weight(px, q);   // object masks
             for (int k = 0; k < HB_LAYERS; k++)   // deep input: every node
-                hbao_sample(HB_NODE(q, k), p.xyz, R2, sin_h, ao, dx, dy);
+                hbao_sample(HB_NODE(q, k), p.xyz, R2, om, sin_h, ao, dx, dy);
         }
     }
     return max(0.0, 1.0 - ao / float(u_hbao_dirs));

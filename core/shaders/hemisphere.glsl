@@ -66,6 +66,7 @@ float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior)
             float r = dz > R ? R / dz : 1.0;
             best = max(best, HS_ALPHA(q, j) * r * r * (3.0 - 2.0 * r));
         }
+        best *= occluder_weight(px, q); // object masks
         occ += best;
         HS_BENT(s, 1.0 - best);
     }

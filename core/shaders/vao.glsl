@@ -99,6 +99,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
         float zs = FAR_AWAY;    // scene depth at the sample's pixel
         float nz = 1.0;         // view normal z there
         seen = disk_px(U, V, W, sx, sy, u_size, q);
+        ivec2 qm = seen ? q : px; // object masks: off the planes, the shaded pixel's
         if (seen) {
             vec2 dq = imageLoad(u_dz, q).xy;
             if (dq.x > 0.0) {
@@ -127,6 +128,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
         // Unoccluded length of the pipe (cases A, B, C of section 3).
         float front = -c.z - h;
         float dz = min(max(zs - front, 0.0), 2.0 * h);
+        float om = occluder_weight(px, qm); // object masks
         if (OBS_RANGE_CHECK != 0 && zs < front) {
             // Case C with the depth range check, section 4.4, eq 4:
             // s(d) = u / max(u, d / radius), d behind the visible surface,
@@ -135,6 +137,7 @@ float vao_estimate(ivec2 px, vec4 p, vec3 n, int ns, int bleed_step, out vec3 bl
             float sd = range_falloff(front - zs, nz, R, u_range_u, u_range_normal);
             dz = 2.0 * h * (1.0 - sd);
         }
+        dz += (2.0 * h - dz) * (1.0 - om); // the occluded length times the mask (om 1: dz)
         // A sample off the planes reads the surface continued past the
         // border; one behind the camera, or without that estimate, is left
         // out of eq 1's sum and of F alike (C twin: the same comment).

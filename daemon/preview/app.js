@@ -77,7 +77,17 @@ function buildParams(defs) {
     name.textContent = def.name;
     row.appendChild(name);
     let control, number = null;
-    if (def.choices) {
+    if (def.type === 'string') {
+      // an object-mask selector: free text, suggesting the frame's
+      // Cryptomatte names and ID channels (fillObjects)
+      control = document.createElement('input');
+      control.type = 'text';
+      control.setAttribute('list', 'objects');
+      control.placeholder = 'names, id:CHANNEL=N or matte:CHANNEL';
+      if (def.max) control.maxLength = def.max;
+      control.style.gridColumn = '1 / 3';
+      control.addEventListener('change', () => setParam(def, control.value));
+    } else if (def.choices) {
       control = document.createElement('select');
       for (const c of def.choices) control.add(new Option(c, c));
       control.value = String(def.default);
@@ -159,6 +169,7 @@ async function loadAsRun(f) {
     status(e.message, true);
   }
   if (state.frame !== f) return false; // a newer frame came meanwhile
+  fillObjects(info);
   const given = (info && info.params) || {}, cam = (info && info.camera) || {};
   state.asRun = {};
   for (const def of state.defs) {
@@ -166,7 +177,7 @@ async function loadAsRun(f) {
     const v = def.name in given ? given[def.name] : cam[def.name];
     if (v === undefined) continue;
     const num = Number(v);
-    state.asRun[def.name] = def.choices || Number.isNaN(num) ? String(v) : tidy(def, num);
+    state.asRun[def.name] = def.choices || def.type === 'string' || Number.isNaN(num) ? String(v) : tidy(def, num);
   }
   for (const name of Object.keys(state.params)) {
     const c = state.controls[name];
@@ -181,6 +192,24 @@ let rerunTimer = 0;
 function scheduleShow() {
   clearTimeout(rerunTimer);
   rerunTimer = setTimeout(show, 150);
+}
+
+// A selector's escapes: ',', '*', '?', '\\' and a leading '@' or '!' are literal
+// with a backslash before them (README: Object masks).
+function escapeName(n) {
+  return n.replace(/[\\,*?]/g, (c) => '\\' + c).replace(/^[@!]/, (c) => '\\' + c);
+}
+
+// The suggestions of the selector controls: every Cryptomatte name of the
+// shown frame (each layer also as @LAYER:*), and id:CHANNEL= per ID channel.
+function fillObjects(info) {
+  const list = $('objects');
+  list.textContent = '';
+  for (const l of (info && info.cryptomatte) || []) {
+    list.appendChild(new Option('@' + l.name + ':*', '@' + l.name + ':*'));
+    for (const n of l.names) list.appendChild(new Option(l.name + ': ' + n, escapeName(n)));
+  }
+  for (const c of (info && info.id_channels) || []) list.appendChild(new Option('ID channel', 'id:' + c + '='));
 }
 
 // A value set here: a change when it differs from the frame's (a re-run

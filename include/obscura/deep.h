@@ -61,6 +61,9 @@ typedef struct obs_deep_image {
     int has_zback, has_alpha, has_color, has_normal, has_facing;
     obs_camera camera;                 /* from worldToCamera/worldToNDC, if any */
     int part;                          /* the part read */
+    /* Object mask (obscura/mask.h, obs_deep_read_masks; NULL: none): the
+     * receivers weight of each pixel's front sample, width x height, owned. */
+    float *receivers;
 } obs_deep_image;
 
 /* 1 when the file's first deep part is deep data (scanline or tiled),

@@ -78,6 +78,7 @@ typedef struct obs_gbuffer_file {
     obs_gbuffer gb;    /* planes point into `storage` */
     float *storage;
     obs_exr_info info;
+    float *mask_storage; /* the planes of obs_gbuffer_read_masks (obscura/mask.h) */
 } obs_gbuffer_file;
 
 /* Reads a G-buffer EXR (scanline or tiled, single or multipart, any
@@ -208,6 +209,29 @@ typedef enum obs_exr_pixel {
     OBS_EXR_FLOAT
 } obs_exr_pixel;
 
+/* An output EXR's compression (OpenEXR's names).  OBS_EXR_ZIP_DEFAULT
+ * (zeroed options) is ZIP, the file default; the others are asked for by
+ * name (obs_exr_compression_parse).  DWAA is lossy; it needs OpenEXR's C
+ * API of 3.2 or later (obs_exr_compression_check). */
+typedef enum obs_exr_compression {
+    OBS_EXR_ZIP_DEFAULT,
+    OBS_EXR_NONE,
+    OBS_EXR_RLE,
+    OBS_EXR_ZIPS,
+    OBS_EXR_ZIP,
+    OBS_EXR_PIZ,
+    OBS_EXR_DWAA
+} obs_exr_compression;
+
+/* "none", "rle", "zips", "zip", "piz", "dwaa" (the default: "zip"). */
+const char *obs_exr_compression_name(obs_exr_compression c);
+/* The compression of that name; -1 when there is none. */
+int obs_exr_compression_parse(const char *name);
+/* OBS_OK when this build's OpenEXR writes and reads `c`; else
+ * OBS_UNSUPPORTED and a message naming the compression and the library's
+ * version. */
+obs_status obs_exr_compression_check(obs_exr_compression c, char err[OBS_ERR_LEN]);
+
 /* One image to store in an EXR under the given channel names
  * (names[c] for channel c of the image). */
 typedef struct obs_exr_layer {
@@ -259,6 +283,9 @@ typedef struct obs_provenance {
     const obs_params *params; /* NULL: no obscura/method, obscura/params */
     const char *input;
     const char *camera_source;
+    /* More string attributes, key, value, ..., NULL (at most 8 pairs; NULL:
+     * none): obscura gbuffer --ids writes its Cryptomatte layer's here. */
+    const char *const *attrs;
 } obs_provenance;
 
 /* How obs_exr_write_ex() writes.  Zeroed: half, no camera, no source,
@@ -285,6 +312,12 @@ typedef struct obs_exr_options {
     int display_x, display_y, display_width, display_height;
     /* obscura/... string attributes (NULL: obscura/version alone) */
     const obs_provenance *prov;
+    /* The plain output's compression (zeroed: ZIP); append keeps the
+     * input parts' own (above). */
+    obs_exr_compression compression;
+    /* Threads compressing chunks (0: the machine's cores, under the
+     * process's limit); the bytes are the same for any count. */
+    int threads;
 } obs_exr_options;
 
 /* obs_exr_write() with options (NULL: as zeroed). */

@@ -85,6 +85,16 @@ typedef struct obs_gbuffer {
     /* Optional world-space position pass (3 channels, data NULL when
      * absent): only to solve or check the camera, never drawn. */
     obs_plane position;
+    /* Object masks (obscura/mask.h, obs_gbuffer_read_masks; data NULL when
+     * not asked for), one float per pixel: receivers, the weight in [0, 1]
+     * of a pixel's AO (1 - w (1 - AO) is returned; 0 leaves it at 1);
+     * occluders, the weight of the surface at a pixel as an occluder of
+     * the others; object_id, the object seen at a pixel (any float; with
+     * it a sample counts only where it equals the shaded pixel's:
+     * self_only). */
+    obs_plane receivers;
+    obs_plane occluders;
+    obs_plane object_id;
 } obs_gbuffer;
 
 /* An image owned by the library: `channels` interleaved float32 values

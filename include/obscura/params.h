@@ -186,12 +186,17 @@ typedef enum obs_baked_combine {
     X(deep_hull, OBS_DEEP_HULL_LIST)                                           \
     X(deep_intervals, OBS_SWITCH_LIST)                                         \
     X(baked_combine, OBS_BAKED_COMBINE_LIST)                                   \
-    X(multibounce, OBS_SWITCH_LIST)
+    X(multibounce, OBS_SWITCH_LIST)                                            \
+    X(self_only, OBS_SWITCH_LIST)
 
 /* X(name, type, default, min, max, choices, doc)
- * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4.
+ * type: FLOAT, INT, ENUM (choices '|'-separated, stored 1-based), MAT4,
+ * STRING (char[max + 1], at most max bytes; default "").
  * An INT with choices takes only the listed numbers (within min..max). 
  * For ENUM the default is the choice's name; for MAT4 it is unused. */
+/* The longest object-mask selector (receivers, occluders), in bytes. */
+#define OBS_SELECTOR_MAX 1023
+
 #define OBS_PARAM_TABLE(X)                                                     \
     X(method, ENUM, "vaopp", 0, 0, OBS_CHOICES(OBS_METHOD_LIST),          \
       "AO method: vaopp (the VAO++ chain), vao (plain VAO, VAO++ section 3: "  \
@@ -420,15 +425,34 @@ typedef enum obs_baked_combine {
       "channel of the colour plane (name the albedo with --color albedo); "    \
       "on: the composite takes it and the AOMultiBounce.R,G,B layer is "       \
       "written beside the AO; a warning and the plain AO without a colour "    \
-      "plane")
+      "plane")                                                                 \
+    X(receivers, STRING, "", 0, OBS_SELECTOR_MAX, NULL,                          \
+      "object mask: the pixels that get AO, a selector (README: Object "       \
+      "masks): Cryptomatte names with * and ? (any layer of the file; "        \
+      "@LAYER: first for one), id:CHANNEL=N,N-M (integer ID channel) or "      \
+      "matte:CHANNEL (coverage); a pixel of weight w gets 1 - w (1 - AO), "    \
+      "anti-aliased edges by their Cryptomatte coverage; the rest stays 1 "    \
+      "(Arnold's aiAmbientOcclusion on the selected shapes only); empty: all")\
+    X(occluders, STRING, "", 0, OBS_SELECTOR_MAX, NULL,                          \
+      "object mask: what may occlude, a selector as for receivers; a sample "  \
+      "counts as occluding in proportion to the selected coverage of the "     \
+      "surface it meets, an unselected one not at all (Arnold's trace_set "    \
+      "with inclusive on); empty: everything")                                \
+    X(self_only, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),              \
+      "object mask: an object occludes only itself (Arnold's self_only): a "  \
+      "sample counts only where the object seen at its pixel (the dominant "   \
+      "Cryptomatte rank, or the ID channel, of the receivers or occluders "    \
+      "selector, else the first Cryptomatte layer named *object*) is the "     \
+      "shaded pixel's")
 
-#define OBS__PDECL_FLOAT(n) float n;
-#define OBS__PDECL_INT(n) int n;
-#define OBS__PDECL_ENUM(n) int n;
-#define OBS__PDECL_MAT4(n) float n[16];
+#define OBS__PDECL_FLOAT(n, hi) float n;
+#define OBS__PDECL_INT(n, hi) int n;
+#define OBS__PDECL_ENUM(n, hi) int n;
+#define OBS__PDECL_MAT4(n, hi) float n[16];
+#define OBS__PDECL_STRING(n, hi) char n[(hi) + 1];
 
 typedef struct obs_params {
-#define OBS__PDECL(name, type, def, lo, hi, choices, doc) OBS__PDECL_##type(name)
+#define OBS__PDECL(name, type, def, lo, hi, choices, doc) OBS__PDECL_##type(name, hi)
     OBS_PARAM_TABLE(OBS__PDECL)
 #undef OBS__PDECL
     int has_world_to_camera; /* set by obs_param_set for world_to_camera */
@@ -448,6 +472,7 @@ typedef obs_table_type obs_param_type;
 #define OBS_PARAM_INT OBS_TABLE_INT
 #define OBS_PARAM_ENUM OBS_TABLE_ENUM
 #define OBS_PARAM_MAT4 OBS_TABLE_MAT4
+#define OBS_PARAM_STRING OBS_TABLE_STRING
 typedef obs_table_row obs_param_info;
 
 int obs_param_count(void);

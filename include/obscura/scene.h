@@ -129,6 +129,14 @@ obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_ca
 /* Frees the images and zeroes *r; NULL-safe. */
 void obs_raster_free(obs_raster *r);
 
+/* The object at each pixel as obs_raster_gbuffer rasterises the scene:
+ * 1 + the index of its mesh in scene->meshes, 0 where no geometry is
+ * (one channel, an integer per pixel: the `id` channel of obscura gbuffer
+ * --ids, an object-mask selector's id:id=N).  Caller frees with
+ * obs_image_free(). */
+obs_status obs_raster_ids(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam, int width,
+                          int height, obs_image *out, char err[OBS_ERR_LEN]);
+
 /* The scene's baked values (obs_scene.baked) rasterised as
  * obs_raster_gbuffer rasterises the albedo: the same triangles and
  * pixels, each value interpolated across its triangle with perspective

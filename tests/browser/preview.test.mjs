@@ -123,6 +123,10 @@ try {
     await page.locator('#param-fov_y input[type=number]').inputValue() === '50' &&
     await page.locator('#param-near input[type=number]').inputValue() === '0.05' &&
     !(await page.locator('#param-radius').getAttribute('class')).includes('changed'));
+  check('the object-mask selectors are text fields suggesting the frame\'s names (datalist objects)',
+    await page.locator('#param-receivers input[type=text]').getAttribute('list') === 'objects' &&
+    await page.locator('#param-occluders input[type=text]').getAttribute('maxlength') === '1023' &&
+    await page.locator('#param-self_only select option').count() === 2);
   check('frame counter, resolution and timings shown',
     (await page.locator('#info-frame').textContent()).startsWith('2') &&
     (await page.locator('#info-size').textContent()) === '320 × 240' &&

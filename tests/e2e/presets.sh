@@ -27,7 +27,7 @@ check "in process: preview differs from default, and --ao-resolution full wins o
     "! cmp -s '$T/p.exr' '$T/d.exr' && oiiotool -q '$T/pf.exr' '$T/d.exr' --diff --fail 0 >/dev/null 2>&1"
 
 start A --socket "$T/a.sock"
-st=$(post "$PORT_A" "$Q&quality=preview&float=1" "$R" "$T/h.exr")
+st=$(post "$PORT_A" "$Q&quality=preview&float=1&compression=zip" "$R" "$T/h.exr") # zip: the CLI file's
 check "HTTP quality=preview: the in-process bytes ($st)" "[ '$st' = 200 ] && cmp -s '$T/h.exr' '$T/p.exr'"
 "$OBSCURA" ao "$R" $CAMF --quality preview --float -o "$T/b.exr" --server "unix:$T/a.sock" -q
 mae=$("$OBSCURA" compare "$T/p.exr" "$T/b.exr" --mask none --json | sed -n 's/.*"mae": \([-0-9.e+]*\).*/\1/p')

@@ -91,7 +91,8 @@ py() { python3 -I -B "$T/run.py" "$@"; }
 
 echo "-- the same bytes as the CLI, over every transport"
 # shellcheck disable=SC2086
-"$OBSCURA" ao "$R" $CAM_CLI -o "$T/cli.exr" -q 2>/dev/null
+# --compression rle: the daemon's answer's auto (the CLI's file default is zip)
+"$OBSCURA" ao "$R" $CAM_CLI --compression rle -o "$T/cli.exr" -q 2>/dev/null
 for url in "http://127.0.0.1:$HP" "unix:$SOCK" "tcp://127.0.0.1:$TP"; do
     for mode in path bytes file stream; do
         py "$mode" "$url" "$R" "$T/py.exr" "$W2C" >"$T/out" 2>&1

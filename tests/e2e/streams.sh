@@ -48,9 +48,11 @@ $CURL -N "http://127.0.0.1:$S/v1/streams/shot/events" > "$T/sse" 2>/dev/null &
 CPIDS="$CPIDS $!"
 wait_for "$T/S.log" "events status=200" || true
 "$OBSCURA" ao "$R" --fov-y 50 --near 0.05 --far 100 --world-to-camera "$W2C" -o "$T/local.exr" -q
+# the daemon answers RLE unless asked (compression auto): obscura ao writes those bytes with --compression rle
+"$OBSCURA" ao "$R" --fov-y 50 --near 0.05 --far 100 --world-to-camera "$W2C" --compression rle -o "$T/local_rle.exr" -q
 code=$(spost $S shot "$CAM" "$T/f1.exr")
 check "POST /v1/streams/shot/frames: 200, X-Obscura-Frame 1, Server-Timing" "[ $code = 200 ] && grep -qi '^X-Obscura-Frame: 1' $T/f1.exr.h && grep -qi '^Server-Timing: queue' $T/f1.exr.h"
-check "its answer = POST /v1/ao's (same EXR bytes as in-process)" "cmp -s $T/f1.exr $T/local.exr"
+check "its answer = POST /v1/ao's (same EXR bytes as in-process)" "cmp -s $T/f1.exr $T/local_rle.exr"
 check "subscriber told: event frame 1 with size, flat, timings" "wait_for $T/sse 'event: frame' && grep -q '\"frame\":1,\"width\":320,\"height\":240,\"color\":true,\"deep\":false,\"timings\":{\"queue\"' $T/sse"
 code=$(spost $S shot "$CAM&radius=1.5&output=composite&format=png" "$T/f2.png")
 check "second frame as composite PNG: 200, frame 2" "[ $code = 200 ] && grep -qi '^X-Obscura-Frame: 2' $T/f2.png.h && grep -qi 'image/png' $T/f2.png.h"
@@ -84,7 +86,7 @@ code=$(get $S "/v1/streams/fy/frames/2?output=composite&format=png&exposure=1" "
 check "output=composite with exposure: 200 PNG" "[ $code = 200 ] && grep -qi 'image/png' $T/dc.png.h"
 code=$(get $S "/v1/streams/fy/frames/2?output=color&format=png" "$T/g")
 check "output=color on a deep frame: 404 no_color, says it is deep" "[ $code = 404 ] && error_is $T/g no_color && grep -q 'deep frame has no flat colour' $T/g"
-"$OBSCURA" ao "$DP" --deep-layers 3 --radius 2 -o "$T/dl2.exr" -q 2>/dev/null
+"$OBSCURA" ao "$DP" --deep-layers 3 --radius 2 --compression rle -o "$T/dl2.exr" -q 2>/dev/null
 code=$(get $S "/v1/streams/fy/frames/2?radius=2&format=exr" "$T/dr.exr")
 code2=$(get $S "/v1/streams/fy/frames/2?radius=2&output=ao_front&format=png" "$T/drf.png")
 check "a re-run of the deep frame (radius 2) = in-process; its front AO too" "[ $code = 200 ] && [ $code2 = 200 ] && cmp -s $T/dr.exr $T/dl2.exr && ! cmp -s $T/drf.png $T/df.png"
@@ -100,7 +102,7 @@ code=$(get $S "/v1/streams/shot/frames/2?output=color&format=png" "$T/c0.png")
 code2=$(get $S "/v1/streams/shot/frames/2?output=color&format=png&exposure=2" "$T/c2.png")
 check "output=color: the G-buffer's colour; exposure changes it" "[ $code = 200 ] && [ $code2 = 200 ] && ! cmp -s $T/c0.png $T/c2.png"
 code=$(get $S "/v1/streams/shot/frames/1?radius=1.5&format=exr" "$T/r1.exr")
-"$OBSCURA" ao "$R" --fov-y 50 --near 0.05 --far 100 --world-to-camera "$W2C" --radius 1.5 -o "$T/local15.exr" -q
+"$OBSCURA" ao "$R" --fov-y 50 --near 0.05 --far 100 --world-to-camera "$W2C" --radius 1.5 --compression rle -o "$T/local15.exr" -q
 check "a parameter re-runs frame 1 with it (= in-process radius 1.5), Server-Timing" "[ $code = 200 ] && cmp -s $T/r1.exr $T/local15.exr && grep -qi '^Server-Timing: queue' $T/r1.exr.h"
 code=$(get $S "/v1/streams/shot/frames/1?format=exr" "$T/k1b.exr")
 check "the re-run is not kept: frame 1 unchanged" "[ $code = 200 ] && cmp -s $T/k1b.exr $T/f1.exr"
@@ -140,7 +142,7 @@ check "obscura ao --stream cli --server: exit $rc, same file, frame kept" "[ $rc
 check "--stream without --server: exit 2" "[ $? -eq 2 ]"
 "$OBSCURA" ao "$R" --fov-y 50 -o "$T/x.exr" -q --stream 'b@d' --server "http://127.0.0.1:$S" 2>"$T/err"
 check "--stream with a bad name: exit 2" "[ $? -eq 2 ]"
-"$OBSCURA" ao "$DP" --deep-layers 3 -o "$T/cd.exr" -q --stream cli --server "http://127.0.0.1:$S" 2>"$T/err"
+"$OBSCURA" ao "$DP" --deep-layers 3 --compression rle -o "$T/cd.exr" -q --stream cli --server "http://127.0.0.1:$S" 2>"$T/err"
 rc=$?
 check "obscura ao DEEP --stream cli: exit $rc (0), = in-process, kept as deep frame 2" "[ $rc -eq 0 ] && cmp -s $T/cd.exr $T/dao.exr && [ \$(get $S /v1/streams/cli $T/g) = 200 ] && tr -d ' \t\n' < $T/g | grep -q '\"frame\":2,[^}]*\"deep\":true'"
 

@@ -16,12 +16,13 @@ FUZZ_CFLAGS := -O1 -g -std=c11 -D_DEFAULT_SOURCE -Wall -Wextra -Wno-missing-fiel
 FUZZ_CPPFLAGS := -Iinclude -Icore -Iprotocol $(shell pkg-config --cflags libcjson OpenEXR 2>/dev/null)
 FUZZ_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libcjson 2>/dev/null) -lz -lm -lpthread
 FUZZ_SRC := protocol/binary.c protocol/http.c core/status.c core/util.c core/image.c core/params.c \
-            core/io/bytes.c core/io/channel_map.c core/io/presets.c core/io/exr_layers.c core/camera/request.c core/table.c
+            core/io/bytes.c core/io/channel_map.c core/io/presets.c core/io/exr_layers.c core/camera/request.c core/table.c \
+            core/io/exr_msg.c
 FUZZ_HDR := $(wildcard protocol/*.h include/obscura/*.h core/*.h core/*/*.h)
 # The EXR readers (flat and deep) against OpenEXR's C library.
 FUZZ_EXR_SRC := core/io/exr_read.c core/io/exr_deep.c core/io/exr_msg.c core/io/exr_parts.c core/io/exr_describe.c \
                 core/io/exr_info.c core/camera/exr.c core/io/presets.c core/camera/request.c core/status.c core/util.c core/image.c core/io/channel_map.c \
-                core/io/bytes.c core/params.c core/table.c core/pool.c
+                core/io/bytes.c core/params.c core/table.c core/pool.c core/io/crypto.c
 FUZZ_EXR_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libcjson 2>/dev/null) -lz -lm -lpthread
 
 .PHONY: fuzz fuzz-check

@@ -1,5 +1,6 @@
-/* libFuzzer target for the EXR readers (core/io/exr_read.c, core/io/exr_deep.c):
- * every input is read from memory as a flat G-buffer and as a deep image,
+/* libFuzzer target for the EXR readers (core/io/exr_read.c, core/io/exr_deep.c,
+ * core/io/crypto.c): every input is read from memory as a flat G-buffer and
+ * as a deep image, its Cryptomatte layers (manifest JSON) described,
  * with small size limits so that a valid-looking header cannot ask for
  * much memory; whatever a reader returns is touched and freed (ASan and
  * LeakSanitizer check).  Seeds: the EXRs of tests/data and tests/data/damaged.
@@ -10,6 +11,7 @@
 
 #include "obscura/deep.h"
 #include "obscura/io.h"
+#include "obscura/mask.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -35,6 +37,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 sink += d.samples[k * OBS_DEEP_CH];
             obs_deep_free(&d);
         }
+    }
+    obs_crypto_info ci;
+    if (obs_crypto_describe(NULL, data, size, &ci, err) == OBS_OK) {
+        for (int l = 0; l < ci.layer_count; l++)
+            for (int k = 0; k < ci.layers[l].entry_count; k++)
+                sink += (float)ci.layers[l].ids[k] + (float)ci.layers[l].names[k][0];
+        obs_crypto_info_free(&ci);
     }
     (void)sink;
     return 0;

@@ -553,6 +553,20 @@ static void test_provenance(void **state)
     assert_string_equal(str_attr(b, 0, "obscura/version"), OBS_VERSION);
     assert_string_equal(str_attr(b, 0, "obscura/method"), "hbao");
     assert_string_equal(str_attr(b, 0, "obscura/params"), "method=hbao fov_y=50 hbao_steps=8");
+    exr_finish(&b);
+    /* a selector with spaces and quotes: in double quotes, escaped */
+    assert_int_equal(obs_param_set(&p, "receivers", "name containing a \"quote\",b\\,c", err), OBS_OK);
+    if (obs_exr_write_ex(out, &l, 1, &o, err) != OBS_OK)
+        fail_msg("%s", err);
+    b = open_exr(out);
+    assert_string_equal(str_attr(b, 0, "obscura/params"),
+                        "method=hbao fov_y=50 hbao_steps=8 "
+                        "receivers=\"name containing a \\\"quote\\\",b\\\\,c\"");
+    exr_finish(&b);
+    assert_int_equal(obs_param_set(&p, "receivers", "", err), OBS_OK);
+    if (obs_exr_write_ex(out, &l, 1, &o, err) != OBS_OK) /* as before, for what follows */
+        fail_msg("%s", err);
+    b = open_exr(out);
     assert_string_equal(str_attr(b, 0, "obscura/input"), in);
     assert_string_equal(str_attr(b, 0, "obscura/camera_source"), "header worldToCamera");
     assert_string_equal(str_attr(b, 0, "arnold/version"), "7.1.4");
