@@ -1,4 +1,4 @@
-/* What the CLI's commands share (clients/cli.c): control bytes escaped
+/* What the CLI's commands share (clients/cli.c, clients/flags.c): control bytes escaped
  * in messages, the edit distance of "did you mean", the
  * "Progress: N%" lines a farm's parser reads, and --threads taken out of
  * a command's argv. */
@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "flags.h"
 #include "obscura/obscura.h"
 
 static void test_escape(void **state)
