@@ -160,15 +160,21 @@ void obs__prep_normal(const obs__frame *f, const float *pos, const float *in_nor
     normalize3(out);
 }
 
+/* The clip-space x, y and w of view-space point p (row-major projection
+ * P); returns w. */
+static float clip_xyw(const float *P, const float p[3], float *x, float *y)
+{
+    *x = P[0] * p[0] + P[1] * p[1] + P[2] * p[2] + P[3];
+    *y = P[4] * p[0] + P[5] * p[1] + P[6] * p[2] + P[7];
+    return P[12] * p[0] + P[13] * p[1] + P[14] * p[2] + P[15];
+}
+
 /* GLSL: view_to_px() in common.glsl. */
 int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy)
 {
-    const float *P = f->proj;
-    float cw = P[12] * s[0] + P[13] * s[1] + P[14] * s[2] + P[15];
+    float cx, cy, cw = clip_xyw(f->proj, s, &cx, &cy);
     if (!(cw > 0.0f))
         return 0;
-    float cx = P[0] * s[0] + P[1] * s[1] + P[2] * s[2] + P[3];
-    float cy = P[4] * s[0] + P[5] * s[1] + P[6] * s[2] + P[7];
     float u = (cx / cw * 0.5f + 0.5f) * f->viewport[2] - f->viewport[0];
     float v = (0.5f - cy / cw * 0.5f) * f->viewport[3] - f->viewport[1];
     float fu = floorf(u), fv = floorf(v);
@@ -183,11 +189,9 @@ int obs__view_to_px(const obs__frame *f, const float s[3], int *qx, int *qy)
 float obs__radius_px(const obs__frame *f, const float p[3], float r)
 {
     const float *P = f->proj;
-    float w = P[12] * p[0] + P[13] * p[1] + P[14] * p[2] + P[15];
+    float X, Y, w = clip_xyw(P, p, &X, &Y);
     if (!(w > 0.0f))
         return 0.0f;
-    float X = P[0] * p[0] + P[1] * p[1] + P[2] * p[2] + P[3];
-    float Y = P[4] * p[0] + P[5] * p[1] + P[6] * p[2] + P[7];
     float w2 = w * w;
     float j00 = (P[0] * w - X * P[12]) / w2, j01 = (P[1] * w - X * P[13]) / w2;
     float j10 = (P[4] * w - Y * P[12]) / w2, j11 = (P[5] * w - Y * P[13]) / w2;

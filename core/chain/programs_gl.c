@@ -82,10 +82,16 @@ int obs__prep_index(const obs__frame *f)
     return OBS__DEPTH_MODES * (f->reconstruct_normals != 0) + mode - OBS_DEPTH_PLANAR;
 }
 
-static void prep_defines(int k, char *defs, size_t size)
+/* A program of the prep family (prep.glsl with frag): variant k's
+ * defines, then `flag` (OBS_HALF or OBS_RAYS), built into *prog. */
+static obs_status prep_family(const char *name, int k, const char *flag, const char *frag,
+                              GLuint *prog, char err[OBS_ERR_LEN])
 {
-    snprintf(defs, size, "#define OBS_RECONSTRUCT %d\n#define OBS_DEPTH_MODE %d\n",
+    char defs[80];
+    snprintf(defs, sizeof defs, "#define OBS_RECONSTRUCT %d\n#define OBS_DEPTH_MODE %d\n",
              k / OBS__DEPTH_MODES, k % OBS__DEPTH_MODES + OBS_DEPTH_PLANAR);
+    const char *src[] = {glsl_version, defs, flag, obs__shader_common, obs__shader_prep, frag};
+    return obs__gl_program(name, obs__shader_fullscreen_vert, src, 6, prog, err);
 }
 
 obs_status obs__prog_prep(obs__programs *g, const obs__frame *f, char err[OBS_ERR_LEN])
@@ -93,15 +99,11 @@ obs_status obs__prog_prep(obs__programs *g, const obs__frame *f, char err[OBS_ER
     int k = obs__prep_index(f), half = f->half != 0;
     if (g->prep[half][k])
         return OBS_OK;
-    char defs[80];
-    prep_defines(k, defs, sizeof defs);
-    const char *src[] = {glsl_version, defs, half ? "#define OBS_HALF 1\n" : "#define OBS_HALF 0\n",
-                         obs__shader_common, obs__shader_prep, obs__shader_prep_frag};
     const char *name = half ? (k / OBS__DEPTH_MODES ? "prep to half size (normals from depth)"
                                                     : "prep to half size")
                             : (k / OBS__DEPTH_MODES ? "prep (normals from depth)" : "prep");
-    return obs__gl_program(name, obs__shader_fullscreen_vert, src, 6, &g->prep[half][k],
-                           err);
+    return prep_family(name, k, half ? "#define OBS_HALF 1\n" : "#define OBS_HALF 0\n",
+                       obs__shader_prep_frag, &g->prep[half][k], err);
 }
 
 /* The blur of half-width radius (section 4.6), built on its first use:
@@ -139,10 +141,6 @@ obs_status obs__prog_up(obs__programs *g, const obs__frame *f, char err[OBS_ERR_
     int k = obs__prep_index(f), rays = f->rays != 0;
     if (g->up[rays][k])
         return OBS_OK;
-    char defs[80];
-    prep_defines(k, defs, sizeof defs);
-    const char *src[] = {glsl_version, defs, rays ? "#define OBS_RAYS 1\n" : "#define OBS_RAYS 0\n",
-                         obs__shader_common, obs__shader_prep, obs__shader_up_frag};
-    return obs__gl_program("upsample", obs__shader_fullscreen_vert, src, 6, &g->up[rays][k],
-                           err);
+    return prep_family("upsample", k, rays ? "#define OBS_RAYS 1\n" : "#define OBS_RAYS 0\n",
+                       obs__shader_up_frag, &g->up[rays][k], err);
 }

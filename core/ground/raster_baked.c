@@ -1,11 +1,11 @@
 /* The baked values of a level rasterised (scene.h, obs_raster_baked):
  * the G-buffer rasteriser run with the baked triple in the place of the
- * albedo, whose vertex attribute it interpolates and writes unchanged
- * (raster.frag.glsl), so that depth, normals and the baked channels come
+ * albedo (obs__raster_values), so that depth, normals and the baked channels come
  * from the same triangles at the same pixels. */
 #include <string.h>
 
 #include "internal.h"
+#include "ground/raster_internal.h"
 #include "obscura/scene.h"
 
 obs_status obs_raster_baked(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
@@ -15,10 +15,8 @@ obs_status obs_raster_baked(obs_ctx *ctx, const obs_scene *scene, const obs_came
     if (!scene || !scene->baked)
         return obs__fail(err, OBS_MISSING_CHANNEL,
                          "the scene has no baked _AO values (load a baked level)");
-    obs_scene as_albedo = *scene;
-    as_albedo.albedo = scene->baked;
     obs_raster r;
-    obs_status s = obs_raster_gbuffer(ctx, &as_albedo, cam, width, height, &r, err);
+    obs_status s = obs__raster_values(ctx, scene, scene->baked, cam, width, height, &r, err);
     if (s != OBS_OK)
         return s;
     if ((s = obs__image_alloc(out, width, height, 3, err)) == OBS_OK) {

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "ground/raster_internal.h"
 #include "obscura/scene.h"
 
 #define DYNAMIC_MARK -1.0f
@@ -87,10 +88,8 @@ obs_status obs_raster_baked_dynamic(obs_ctx *ctx, const obs_scene *scene, const 
                 for (int a = 0; a < 3; a++)
                     mark[3 * (size_t)scene->indices[3 * t + c] + a] = DYNAMIC_MARK;
     }
-    obs_scene as_albedo = *scene;
-    as_albedo.albedo = mark;
     obs_raster r;
-    obs_status s = obs_raster_gbuffer(ctx, &as_albedo, cam, width, height, &r, err);
+    obs_status s = obs__raster_values(ctx, scene, mark, cam, width, height, &r, err);
     free(mark);
     if (s != OBS_OK)
         return s;

@@ -155,6 +155,15 @@ obs_status obs__raster_check(obs_ctx *ctx, const obs_scene *scene, const obs_cam
     return OBS_OK;
 }
 
+obs_status obs__raster_values(obs_ctx *ctx, const obs_scene *scene, float *values,
+                              const obs_camera *cam, int width, int height, obs_raster *out,
+                              char err[OBS_ERR_LEN])
+{
+    obs_scene as_albedo = *scene;
+    as_albedo.albedo = values;
+    return obs_raster_gbuffer(ctx, &as_albedo, cam, width, height, out, err);
+}
+
 obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
                               int width, int height, obs_raster *out, char err[OBS_ERR_LEN])
 {

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "ground/raster_internal.h"
 #include "obscura/scene.h"
 
 obs_status obs_raster_ids(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam, int width,
@@ -29,10 +30,8 @@ obs_status obs_raster_ids(obs_ctx *ctx, const obs_scene *scene, const obs_camera
             for (int k = 0; k < 3; k++)
                 ids[3 * (size_t)scene->indices[3 * t + k]] = (float)(m + 1);
     }
-    obs_scene as_albedo = *scene;
-    as_albedo.albedo = ids;
     obs_raster r;
-    obs_status s = obs_raster_gbuffer(ctx, &as_albedo, cam, width, height, &r, err);
+    obs_status s = obs__raster_values(ctx, scene, ids, cam, width, height, &r, err);
     free(ids);
     if (s != OBS_OK)
         return s;

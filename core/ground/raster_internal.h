@@ -1,6 +1,7 @@
 /* Internal to the rasterisers (raster_gl.c: the flat G-buffer,
- * raster_deep_gl.c: the A-buffer): what both set up the same way.  Call
- * on the context's GL thread.  Not installed. */
+ * raster_deep_gl.c: the A-buffer): what both set up the same way, and the
+ * G-buffer run with other per-vertex values (raster_baked.c, raster_ids.c,
+ * raster_dynamic.c).  Call on the context's GL thread.  Not installed. */
 #ifndef OBSCURA_RASTER_INTERNAL_H
 #define OBSCURA_RASTER_INTERNAL_H
 
@@ -27,5 +28,13 @@ void obs__raster_set_scene(GLuint prog, const obs_scene *scene);
  * (attributes 0, 1, 2, where present) and its index buffer, left bound.
  * The caller deletes the objects. */
 void obs__raster_upload_mesh(const obs_scene *scene, GLuint *vao, GLuint vbo[3], GLuint *ibo);
+
+/* obs_raster_gbuffer with values (3 floats a vertex) in the place of the
+ * scene's albedo, whose vertex attribute raster.frag.glsl interpolates and
+ * writes unchanged: out->color holds the values at each pixel (alpha: the
+ * coverage, 0 where no geometry is).  Caller frees with obs_raster_free. */
+obs_status obs__raster_values(obs_ctx *ctx, const obs_scene *scene, float *values,
+                              const obs_camera *cam, int width, int height, obs_raster *out,
+                              char err[OBS_ERR_LEN]);
 
 #endif
