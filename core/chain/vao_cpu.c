@@ -151,15 +151,25 @@ void obs__disk_map(const obs__frame *f, const float c[3], float r, const float r
     m->w[2] = k0[3];
 }
 
-/* GLSL: disk_px() in common.glsl */
-static inline int disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx,
-                          int *qy)
+/* The pixel coordinates (floored) the disk map sends sample (sx, sy) to;
+ * 0 behind the camera (w <= 0). */
+static inline int disk_uv(const obs__disk *m, float sx, float sy, float *fu, float *fv)
 {
     float sw = m->w[0] * sx + m->w[1] * sy + m->w[2];
     if (!(sw > 0.0f))
         return 0;
-    float fu = floorf((m->u[0] * sx + m->u[1] * sy + m->u[2]) / sw);
-    float fv = floorf((m->v[0] * sx + m->v[1] * sy + m->v[2]) / sw);
+    *fu = floorf((m->u[0] * sx + m->u[1] * sy + m->u[2]) / sw);
+    *fv = floorf((m->v[0] * sx + m->v[1] * sy + m->v[2]) / sw);
+    return 1;
+}
+
+/* GLSL: disk_px() in common.glsl */
+static inline int disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx,
+                          int *qy)
+{
+    float fu, fv;
+    if (!disk_uv(m, sx, sy, &fu, &fv))
+        return 0;
     if (!(fu >= 0.0f && fv >= 0.0f && fu < (float)f->width && fv < (float)f->height))
         return 0;
     *qx = (int)fu;
@@ -180,11 +190,9 @@ static int border_sample(const obs__frame *f, const float *pos, const float *nrm
                          const obs__disk *m, int x, int y, float sx, float sy, float *zs,
                          float *nz)
 {
-    float sw = m->w[0] * sx + m->w[1] * sy + m->w[2];
-    if (!(sw > 0.0f))
+    float fu, fv;
+    if (!disk_uv(m, sx, sy, &fu, &fv))
         return 0;
-    float fu = floorf((m->u[0] * sx + m->u[1] * sy + m->u[2]) / sw);
-    float fv = floorf((m->v[0] * sx + m->v[1] * sy + m->v[2]) / sw);
     float pt[4];
     int got = obs__border_point(f, pos, nrm, x, y, fu, fv, pt, nz);
     if (got > 0)

@@ -16,17 +16,16 @@ obs_status obs_raster_baked(obs_ctx *ctx, const obs_scene *scene, const obs_came
         return obs__fail(err, OBS_MISSING_CHANNEL,
                          "the scene has no baked _AO values (load a baked level)");
     obs_raster r;
-    obs_status s = obs__raster_values(ctx, scene, scene->baked, cam, width, height, &r, err);
+    obs_status s = obs__raster_values(ctx, scene, scene->baked, cam, width, height, 3, &r, out,
+                                      err);
     if (s != OBS_OK)
         return s;
-    if ((s = obs__image_alloc(out, width, height, 3, err)) == OBS_OK) {
-        size_t n = (size_t)width * height;
-        for (size_t i = 0; i < n; i++) {
-            const float *c = r.color.data + 4 * i;
-            for (int k = 0; k < 3; k++)
-                out->data[3 * i + k] = c[3] > 0.0f ? c[k] : 1.0f; /* coverage 0: open */
-        }
+    size_t n = (size_t)width * height;
+    for (size_t i = 0; i < n; i++) {
+        const float *c = r.color.data + 4 * i;
+        for (int k = 0; k < 3; k++)
+            out->data[3 * i + k] = c[3] > 0.0f ? c[k] : 1.0f; /* coverage 0: open */
     }
     obs_raster_free(&r);
-    return s;
+    return OBS_OK;
 }

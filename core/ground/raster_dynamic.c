@@ -89,30 +89,28 @@ obs_status obs_raster_baked_dynamic(obs_ctx *ctx, const obs_scene *scene, const 
                     mark[3 * (size_t)scene->indices[3 * t + c] + a] = DYNAMIC_MARK;
     }
     obs_raster r;
-    obs_status s = obs__raster_values(ctx, scene, mark, cam, width, height, &r, err);
+    obs_status s = obs__raster_values(ctx, scene, mark, cam, width, height, 3, &r, out, err);
     free(mark);
     if (s != OBS_OK)
         return s;
-    if ((s = obs__image_alloc(out, width, height, 3, err)) == OBS_OK) {
-        size_t n = (size_t)width * height, dyn = 0;
-        obs_dyn_sh_order order = quadratic ? OBS_DYN_QUADRATIC : OBS_DYN_LINEAR;
-        for (size_t i = 0; i < n; i++) {
-            const float *c = r.color.data + 4 * i;
-            float *o = out->data + 3 * i;
-            if (!(c[3] > 0.0f)) { /* coverage 0: open */
-                o[0] = o[1] = o[2] = 1.0f;
-            } else if (c[0] < 0.5f * DYNAMIC_MARK) {
-                float ao[3]; /* short, long, blended */
-                obs_dyn_eval(m, g->position.data + 3 * i, g->normal.data + 3 * i, order, ao);
-                o[0] = ao[2], o[1] = ao[0], o[2] = ao[1];
-                dyn++;
-            } else {
-                memcpy(o, c, 3 * sizeof *o);
-            }
+    size_t n = (size_t)width * height, dyn = 0;
+    obs_dyn_sh_order order = quadratic ? OBS_DYN_QUADRATIC : OBS_DYN_LINEAR;
+    for (size_t i = 0; i < n; i++) {
+        const float *c = r.color.data + 4 * i;
+        float *o = out->data + 3 * i;
+        if (!(c[3] > 0.0f)) { /* coverage 0: open */
+            o[0] = o[1] = o[2] = 1.0f;
+        } else if (c[0] < 0.5f * DYNAMIC_MARK) {
+            float ao[3]; /* short, long, blended */
+            obs_dyn_eval(m, g->position.data + 3 * i, g->normal.data + 3 * i, order, ao);
+            o[0] = ao[2], o[1] = ao[0], o[2] = ao[1];
+            dyn++;
+        } else {
+            memcpy(o, c, 3 * sizeof *o);
         }
-        if (dynamic_pixels)
-            *dynamic_pixels = dyn;
     }
+    if (dynamic_pixels)
+        *dynamic_pixels = dyn;
     obs_raster_free(&r);
-    return s;
+    return OBS_OK;
 }

@@ -156,12 +156,15 @@ obs_status obs__raster_check(obs_ctx *ctx, const obs_scene *scene, const obs_cam
 }
 
 obs_status obs__raster_values(obs_ctx *ctx, const obs_scene *scene, float *values,
-                              const obs_camera *cam, int width, int height, obs_raster *out,
-                              char err[OBS_ERR_LEN])
+                              const obs_camera *cam, int width, int height, int channels,
+                              obs_raster *r, obs_image *out, char err[OBS_ERR_LEN])
 {
     obs_scene as_albedo = *scene;
     as_albedo.albedo = values;
-    return obs_raster_gbuffer(ctx, &as_albedo, cam, width, height, out, err);
+    obs_status s = obs_raster_gbuffer(ctx, &as_albedo, cam, width, height, r, err);
+    if (s == OBS_OK && (s = obs__image_alloc(out, width, height, channels, err)) != OBS_OK)
+        obs_raster_free(r);
+    return s;
 }
 
 obs_status obs_raster_gbuffer(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,

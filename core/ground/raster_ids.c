@@ -31,16 +31,14 @@ obs_status obs_raster_ids(obs_ctx *ctx, const obs_scene *scene, const obs_camera
                 ids[3 * (size_t)scene->indices[3 * t + k]] = (float)(m + 1);
     }
     obs_raster r;
-    obs_status s = obs__raster_values(ctx, scene, ids, cam, width, height, &r, err);
+    obs_status s = obs__raster_values(ctx, scene, ids, cam, width, height, 1, &r, out, err);
     free(ids);
     if (s != OBS_OK)
         return s;
-    if ((s = obs__image_alloc(out, width, height, 1, err)) == OBS_OK) {
-        size_t n = (size_t)width * height;
-        /* the interpolated constant, rounded back to its integer; 0: no geometry */
-        for (size_t i = 0; i < n; i++)
-            out->data[i] = r.color.data[4 * i + 3] > 0.0f ? floorf(r.color.data[4 * i] + 0.5f) : 0.0f;
-    }
+    size_t n = (size_t)width * height;
+    /* the interpolated constant, rounded back to its integer; 0: no geometry */
+    for (size_t i = 0; i < n; i++)
+        out->data[i] = r.color.data[4 * i + 3] > 0.0f ? floorf(r.color.data[4 * i] + 0.5f) : 0.0f;
     obs_raster_free(&r);
-    return s;
+    return OBS_OK;
 }

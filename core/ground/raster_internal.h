@@ -31,10 +31,13 @@ void obs__raster_upload_mesh(const obs_scene *scene, GLuint *vao, GLuint vbo[3],
 
 /* obs_raster_gbuffer with values (3 floats a vertex) in the place of the
  * scene's albedo, whose vertex attribute raster.frag.glsl interpolates and
- * writes unchanged: out->color holds the values at each pixel (alpha: the
- * coverage, 0 where no geometry is).  Caller frees with obs_raster_free. */
+ * writes unchanged: r->color holds the values at each pixel (alpha: the
+ * coverage, 0 where no geometry is); then out, width x height x channels,
+ * for the caller to fill from it.  On failure nothing is left to free;
+ * else the caller frees r with obs_raster_free and out with
+ * obs_image_free. */
 obs_status obs__raster_values(obs_ctx *ctx, const obs_scene *scene, float *values,
-                              const obs_camera *cam, int width, int height, obs_raster *out,
-                              char err[OBS_ERR_LEN]);
+                              const obs_camera *cam, int width, int height, int channels,
+                              obs_raster *r, obs_image *out, char err[OBS_ERR_LEN]);
 
 #endif
