@@ -20,6 +20,7 @@
 
 #include "config.h"
 #include "job.h"
+#include "list.h"
 #include "log.h"
 
 #define MAX_WORKERS 16
@@ -624,8 +625,7 @@ int obsd_bakes_subscribe(obsd_bakes *b, const char *id, obsd_bake_sub *s)
         s->job = j;
         s->seen = UINT64_MAX; /* its state is the first event */
         s->parked = s->ended = s->final_sent = s->keepalive = 0;
-        s->next = j->subs;
-        j->subs = s;
+        OBSD_LIST_PUSH(j->subs, s);
         j->refs++;
     }
     pthread_mutex_unlock(&b->lock);
@@ -672,11 +672,7 @@ void obsd_bakes_unsubscribe(obsd_bakes *b, obsd_bake_sub *s)
     pthread_mutex_lock(&b->lock);
     job *j = s->job;
     if (j) {
-        for (obsd_bake_sub **p = &j->subs; *p; p = &(*p)->next)
-            if (*p == s) {
-                *p = s->next;
-                break;
-            }
+        OBSD_LIST_UNLINK(j->subs, s);
         s->job = NULL;
         unref(j);
     }

@@ -28,7 +28,7 @@ typedef struct obsd_bakes obsd_bakes;
  * under the store's lock when the job's version moves, and when the
  * waiter must end (shutdown, the job removed). */
 typedef struct obsd_bake_sub {
-    struct obsd_bake_sub *next;
+    struct obsd_bake_sub *prev, *next; /* the job's subscribers (list.h) */
     void (*park)(void *arg); /* called under the lock when there is nothing to send */
     void (*wake)(void *arg);
     void *arg;
