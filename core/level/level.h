@@ -59,7 +59,8 @@ obs_status obs__bake_flatten_checked(const obs_bake_scene *scene, int max_triang
  * obs_bake_scene_free). */
 obs_status obs__bake_lod_file_read(const char *path, obs_bake_scene *s, char err[OBS_ERR_LEN]);
 void obs__bake_lod_file_free(obs_bake_scene *s);
-/* Frees a mesh's arrays and name and zeroes it (the LODs' meshes). */
+/* Frees a mesh's arrays and name and zeroes it (the scene's meshes and the
+ * LODs'). */
 void obs__bake_mesh_free(obs_bake_mesh *m);
 
 /* The level's BVH on its own, for points in space (bvh.c; the

@@ -28,12 +28,8 @@ void obs_bake_scene_free(obs_bake_scene *s)
 {
     if (!s)
         return;
-    for (size_t m = 0; m < s->mesh_count && s->meshes; m++) {
-        free(s->meshes[m].name);
-        free(s->meshes[m].positions);
-        free(s->meshes[m].normals);
-        free(s->meshes[m].indices);
-    }
+    for (size_t m = 0; m < s->mesh_count && s->meshes; m++)
+        obs__bake_mesh_free(&s->meshes[m]);
     for (size_t n = 0; n < s->node_count && s->nodes; n++) {
         free(s->nodes[n].name);
         free(s->nodes[n].meshes);
