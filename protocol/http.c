@@ -189,13 +189,15 @@ static obs_status set_bool(obs_http_request *r, const obs_http_option *op, const
                            char err[OBS_ERR_LEN])
 {
     int v;
-    if (!strcmp(value, "1") || !strcmp(value, "true") || !*value)
+    /* on/off too: the words of the parameter table's switches, so one
+     * spelling serves both (the Python client sends it for True/False) */
+    if (!strcmp(value, "1") || !strcmp(value, "true") || !strcmp(value, "on") || !*value)
         v = 1;
-    else if (!strcmp(value, "0") || !strcmp(value, "false"))
+    else if (!strcmp(value, "0") || !strcmp(value, "false") || !strcmp(value, "off"))
         v = 0;
     else
         return obs_status_fail(err, OBS_INVALID_ARGUMENT, "parameter %s: '%s' is not one of %s",
-                              op->name, value, "0|1|true|false");
+                              op->name, value, "0|1|true|false|on|off");
     memcpy((char *)r + op->field, &v, sizeof v);
     return OBS_OK;
 }

@@ -228,22 +228,29 @@ def selector(*names, literal=True, layer=None):
     return ("@%s:" % layer if layer else "") + ",".join(out)
 
 
-def _value(v):
+# How True and False are spelt: a frame's switches (blur, self_only, ...)
+# take on/off, as do its request options (float, append, ...); the bake's
+# switches (lod_lock_border, ...) are integers 0/1.
+_FRAME_BOOL = ("on", "off")
+_BAKE_BOOL = ("1", "0")
+
+
+def _value(v, words=_FRAME_BOOL):
     if isinstance(v, bool):
-        return "1" if v else "0"
+        return words[0] if v else words[1]
     if isinstance(v, (list, tuple)):
-        return ",".join(_value(x) for x in v)
+        return ",".join(_value(x, words) for x in v)
     if isinstance(v, float):
         return repr(v)
     return str(v)
 
 
-def _params(params, token):
+def _params(params, token, words=_FRAME_BOOL):
     out = []
     for k, v in params.items():
         if v is None:
             continue
-        out.append((str(k), _value(v)))
+        out.append((str(k), _value(v, words)))
     if token:
         out.append(("token", token))
     return out
@@ -491,7 +498,8 @@ def ao(source, server=None, out=None, token=None, timeout=300, camera=None, **pa
     token: the bearer token (default: OBSCURA_TOKEN).
     camera: a Camera (Camera.from_json("frame.camera.json")), sent as
     fov_y, near, far and world_to_camera unless params give them.
-    params: the daemon's query parameters.
+    params: the daemon's query parameters (True/False are sent as on/off,
+    which switches like blur and options like float both take).
     Returns an Answer: the answer's bytes (an EXR, or a PNG with
     format="png"; b"" with out=) and .warnings, the daemon's warnings,
     each also issued as an ObscuraWarning (Python's warnings module).
@@ -565,7 +573,7 @@ def bake(level, server=None, out=None, token=None, decorators=None, timeout=60,
     opened = [x for x in (level, decorators) if isinstance(x, (str, os.PathLike))]
     src = _Source(level, "bake(): the level")
     dec = _Source(decorators, "bake(): the decorators file") if decorators is not None else None
-    query = "/v1/bakes?" + urllib.parse.urlencode(_params(params, None))
+    query = "/v1/bakes?" + urllib.parse.urlencode(_params(params, None, _BAKE_BOOL))
     try:
         if dec is None:
             body, ctype = [src], "application/octet-stream"

@@ -69,6 +69,8 @@ try:
         data = oc.ao(src, server=server, out=out, **cam)
         assert data == b"" and data.warnings == [], (data, data.warnings)
         data = open(out, "rb").read()
+    elif mode == "switches":  # True/False: a parameter's switch and a request option
+        data = oc.ao(src, server=server, blur=False, float=True, **cam)
     elif mode == "png":
         data = oc.ao(src, server=server, format="png", png_bits=16, **cam)
     elif mode == "missing":
@@ -106,6 +108,15 @@ done
 "$OBSCURA" ao "$R" $CAM_CLI --png-bits 16 -o "$T/cli.png" -q 2>/dev/null
 py png "tcp://127.0.0.1:$TP" "$R" "$T/py.png" "$W2C" >/dev/null 2>&1
 check "tcp format=png png_bits=16: the CLI's PNG" "cmp -s '$T/cli.png' '$T/py.png'"
+
+# shellcheck disable=SC2086
+"$OBSCURA" ao "$R" $CAM_CLI --blur off --float --compression rle -o "$T/cli_sw.exr" -q 2>/dev/null
+for url in "http://127.0.0.1:$HP" "tcp://127.0.0.1:$TP"; do
+    py switches "$url" "$R" "$T/py_sw.exr" "$W2C" >"$T/out" 2>&1
+    check "${url%%:*} blur=False float=True: the CLI's --blur off --float bytes ($(head -c 80 "$T/out"))" \
+        "cmp -s '$T/cli_sw.exr' '$T/py_sw.exr'"
+    rm -f "$T/py_sw.exr"
+done
 
 echo "-- errors carry the daemon's code"
 for url in "http://127.0.0.1:$HP" "unix:$SOCK"; do

@@ -84,6 +84,13 @@ static void test_options(void **state)
     assert_int_equal(r.png_bits, 16);
     assert_int_equal(obs_http_request_set(&r, "float", "1", err), OBS_OK);
     assert_int_equal(r.float_exr, 1);
+    /* a switch's words too (the Python client's True/False) */
+    assert_int_equal(obs_http_request_set(&r, "float", "off", err), OBS_OK);
+    assert_int_equal(r.float_exr, 0);
+    assert_int_equal(obs_http_request_set(&r, "float", "on", err), OBS_OK);
+    assert_int_equal(r.float_exr, 1);
+    assert_int_equal(obs_http_request_set(&r, "float", "yes", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "0|1|true|false|on|off"));
     /* compression: auto (0) by default, each name, a bad one named */
     assert_int_equal(r.compression, OBS_EXR_ZIP_DEFAULT);
     static const char *const comp[] = {"none", "rle", "zips", "zip", "piz"};
