@@ -80,6 +80,9 @@ typedef struct obs__frame {
      * site through obs__occluder_weight (chain/mask_weight.h) */
     const float *mask_occl, *mask_id;
     int mask_on;            /* 1: either is set */
+    /* 0: one plane (the flat chain); deep input: the planes are per node,
+     * node k's at k * mask_plane (width x height each, core/deep) */
+    size_t mask_plane;
     /* the method's own values, read by its functions only: their types
      * are in core/methods/<method>.h (obs__gtao_of(f), ...), so the chain
      * needs none of them; in place, so that a frame copies whole

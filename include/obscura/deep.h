@@ -61,9 +61,13 @@ typedef struct obs_deep_image {
     int has_zback, has_alpha, has_color, has_normal, has_facing;
     obs_camera camera;                 /* from worldToCamera/worldToNDC, if any */
     int part;                          /* the part read */
-    /* Object mask (obscura/mask.h, obs_deep_read_masks; NULL: none): the
-     * receivers weight of each pixel's front sample, width x height, owned. */
+    /* Object masks (obscura/mask.h, obs_deep_read_masks; NULL: none),
+     * owned: the receivers weight of each pixel's front sample, width x
+     * height; the occluders weight and the object ID (self_only; compared
+     * as the float's bits) of every sample, offset[width * height] each,
+     * in the samples' order. */
     float *receivers;
+    float *occluders, *object_id;
 } obs_deep_image;
 
 /* 1 when the file's first deep part is deep data (scanline or tiled),
@@ -110,6 +114,11 @@ typedef struct obs_deep_layers {
     int *count;    /* valid nodes per pixel, front to back from node 0 */
     float zmin, zmax; /* the depth range eq 5's z is normalised over: the
                        * camera's clip range (near, far) */
+    /* the object masks of the image's samples (obs_deep_image.occluders,
+     * object_id) carried to the nodes they became: m planes of width x
+     * height floats each, node k of pixel i at k * width * height + i
+     * (an empty node: weight 1, ID 0); NULL where the image has none */
+    float *occluders, *object_id;
 } obs_deep_layers;
 
 /* Compresses one list (OITAO section III-B): the n samples (OBS_DEEP_CH
