@@ -148,6 +148,12 @@ void obs__frame_half(const obs__frame *f, obs__frame *hf);
  * pixel, straight from the raw planes). */
 long obs__half_source(const obs__frame *f, const float *pos, int hx, int hy);
 
+/* The object masks of half pixel h (occluders weight into hw[h], object
+ * into hid[h]; NULL, or the full frame without that mask: not written):
+ * those of full pixel k, the one obs__half_source picked for it.  The
+ * half frame's mask_occl and mask_id then point at hw and hid. */
+void obs__half_masks(const obs__frame *f, long k, size_t h, float *hw, float *hid);
+
 /* The AO of full pixel (x, y) from the half-resolution AO `hao`: the
  * joint bilateral upsample, up.frag.glsl.  The
  * four half pixels around the pixel's centre, each weighted by its

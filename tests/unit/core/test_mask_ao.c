@@ -54,10 +54,16 @@ static void test_receivers_deep_arnold(void **state)
     assert_true(ones > 1000 && kept > 1000 && darker > 100);
     obs_deep_result_free(&all);
     obs_deep_result_free(&sel);
-    /* occluders and self_only are refused on deep input */
-    obs_params q = {0};
+    /* occluders and self_only on deep input: read at every sample
+     * (test_mask_deep.c), the receivers kept */
+    obs_params q = p;
     set(&q, "occluders", "id:id=1");
-    assert_int_equal(obs_deep_read_masks(&d, ARNOLD, NULL, 0, &q, NULL, err), OBS_UNSUPPORTED);
+    set(&q, "self_only", "on");
+    if (obs_deep_read_masks(&d, ARNOLD, NULL, 0, &q, NULL, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_non_null(d.receivers);
+    assert_non_null(d.occluders);
+    assert_non_null(d.object_id);
     obs_deep_free(&d);
 }
 
