@@ -35,7 +35,8 @@ void cli_ground_usage(FILE *f)
             "                  the vertex values interpolated\n"
             "                  [--ids]          adds id: 1 + the mesh's index at each pixel (0: none),\n"
             "                  an object mask's id:id=N (prints each ID's mesh and node names),\n"
-            "                  and a Cryptomatte layer CryptoObject of the node names\n"
+            "                  and a Cryptomatte layer CryptoObject of the node names;\n"
+            "                  with --deep, id per sample (the deep object masks' IDs)\n"
             "                  [--dynamic MODEL.json [--dynamic-nodes PATTERN] [--dynamic-sh S]]\n"
             "                  dynamic objects in the baked level (nodes whose name matches the\n"
             "                  pattern, or with glTF extras \"obscura_dynamic\": true, and their\n"
@@ -368,15 +369,24 @@ static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene
                       const obs_camera *cam, int w, int h, double t0)
 {
     obs_deep_image d;
+    float *ids = NULL;
     char err[OBS_ERR_LEN] = "";
-    obs_status s = obs_raster_deep(ctx, scene, cam, w, h, &d, err);
+    /* --ids: each sample's object as the per-sample channel id, what the
+     * object masks read at every deep sample (README: Object masks) */
+    obs_status s = obs_raster_deep_ids(ctx, scene, cam, w, h, &d, a->ids ? &ids : NULL, err);
     if (s != OBS_OK)
         return cli_input_fail(s, a->scene, err);
     double t_raster = cli_now_s() - t0;
-    if ((s = obs_deep_write_exr(a->out, &d, err)) != OBS_OK) {
+    if ((s = obs_deep_write_exr_extra(a->out, &d, ids ? "id" : NULL, ids, err)) != OBS_OK) {
         obs_deep_free(&d);
+        free(ids);
         return cli_fail(s, a->out, err);
     }
+    free(ids);
+    for (size_t m = 0; a->ids && !a->quiet && m < scene->mesh_count; m++)
+        fprintf(stderr, "obscura: info: id %zu: mesh '%s', node '%s'\n", m + 1,
+                scene->meshes[m].name ? scene->meshes[m].name : "",
+                scene->meshes[m].node ? scene->meshes[m].node : "");
     if (!a->quiet) {
         size_t npx = (size_t)w * h, covered = 0;
         uint64_t most = 0;

@@ -20,8 +20,17 @@ using namespace OPENEXR_IMF_NAMESPACE;
 extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image *d,
                                          char err[OBS_ERR_LEN])
 {
+    return obs_deep_write_exr_extra(path, d, NULL, NULL, err);
+}
+
+extern "C" obs_status obs_deep_write_exr_extra(const char *path, const obs_deep_image *d,
+                                               const char *extra, const float *values,
+                                               char err[OBS_ERR_LEN])
+{
     if (!path || !*path || !d || !d->offset || !d->samples || d->width <= 0 || d->height <= 0)
         return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "obs_deep_write_exr: no path or no deep image");
+    if (extra && (!*extra || !values))
+        return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "obs_deep_write_exr_extra: no channel name or no values");
     const int w = d->width, h = d->height;
     const size_t npx = (size_t)w * (size_t)h;
     for (size_t i = 0; i < npx; i++)
@@ -59,6 +68,8 @@ extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image 
         for (const ch &c : chans)
             if (c.present)
                 hdr.channels().insert(c.name, Channel(FLOAT));
+        if (extra) // one value a sample, beside the others
+            hdr.channels().insert(extra, Channel(FLOAT));
 
         obs__deep_header_attrs(hdr, &d->camera);
 
@@ -86,6 +97,12 @@ extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image 
             fb.insert(c.name, DeepSlice(FLOAT, (char *)(p.data() - origin), sizeof(float *),
                                         sizeof(float *) * (size_t)w, OBS_DEEP_CH * sizeof(float)));
         }
+        std::vector<const float *> pe(extra ? npx : 0);
+        for (size_t i = 0; extra && i < npx; i++)
+            pe[i] = values + d->offset[i];
+        if (extra)
+            fb.insert(extra, DeepSlice(FLOAT, (char *)(pe.data() - origin), sizeof(float *),
+                                       sizeof(float *) * (size_t)w, sizeof(float)));
         DeepScanLineOutputFile file(tmp, hdr);
         file.setFrameBuffer(fb);
         file.writePixels(h);

@@ -97,6 +97,11 @@ void obs_deep_free(obs_deep_image *d);
  * C++ library (core/io/exr_deep_write.cpp).  Fails with OBS_IO when the
  * file cannot be written. */
 obs_status obs_deep_write_exr(const char *path, const obs_deep_image *d, char err[OBS_ERR_LEN]);
+/* The same with one more float channel named `extra`, one value a sample
+ * (values[k] for sample k, offset[width * height] of them): the per-sample
+ * object ID `obscura gbuffer --deep --ids` writes as "id". */
+obs_status obs_deep_write_exr_extra(const char *path, const obs_deep_image *d, const char *extra,
+                                    const float *values, char err[OBS_ERR_LEN]);
 
 /* The values of the parameters deep_mode and deep_hull, OBS_DEEP_MULTI
  * and so on, are in obscura/params.h with the others. */
