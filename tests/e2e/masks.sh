@@ -107,11 +107,20 @@ if [ -f "$S/room.obj" ]; then
     else
         echo "  skip GL: no context"
     fi
-    start dm --backend cpu --max-body 8m
+    start_all dm --backend cpu --max-body 8m
     check "HTTP occluders= on a deep body answers 200" \
         "[ \"\$(post $PORT_dm 'occluders=!id%3Aid%3D13-29&self_only=on&method=gtao&radius=0.5' $T/dg.exr $T/dg_http.exr)\" = 200 ]"
     "$OBSCURA" ao "$T/dg.exr" --backend cpu $DO --occluders '!id:id=13-29' --self-only on -o "$T/dg_ms.exr" 2>/dev/null
     expect 0 "deep masks: obscura ao and HTTP, the same AO" -- "$OBSCURA" compare "$T/dg_ms.exr" "$T/dg_http.exr" --mask none --json
+    said '"mse": 0,'
+    # the binary protocol: with masks the client sends the file, whose
+    # channels the selectors name, not the planes
+    expect 0 "deep masks: obscura ao --server tcp://" -- "$OBSCURA" ao "$T/dg.exr" --server "tcp://127.0.0.1:$TCP_dm" $DO --occluders '!id:id=13-29' --self-only on -o "$T/dg_tcp.exr"
+    expect 0 "deep masks: obscura ao and the binary protocol, the same AO" -- "$OBSCURA" compare "$T/dg_ms.exr" "$T/dg_tcp.exr" --mask none --json
+    said '"mse": 0,'
+    "$OBSCURA" ao "$R" $CAM --occluders 'id:ViewLayer.DiffCol.R=0.7-0.9' --ao-resolution half -o "$T/half_c.exr" 2>/dev/null
+    expect 0 "half-resolution occluders: obscura ao --server tcp://" -- "$OBSCURA" ao "$R" --camera "$DATA/room_small.camera.json" --server "tcp://127.0.0.1:$TCP_dm" --occluders 'id:ViewLayer.DiffCol.R=0.7-0.9' --ao-resolution half -o "$T/half_tcp.exr"
+    expect 0 "half-resolution occluders: obscura ao and the binary protocol, the same AO" -- "$OBSCURA" compare "$T/half_c.exr" "$T/half_tcp.exr" --mask none --json
     said '"mse": 0,'
 fi
 
