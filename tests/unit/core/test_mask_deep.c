@@ -1,5 +1,5 @@
-/* Object masks on deep input and at half resolution (core/mask.c,
- * core/deep, chain/half_cpu.c): a plate in front of a wall, as deep
+/* Object masks on deep input (core/mask.c, core/deep): a plate in front
+ * of a wall, as deep
  * samples with an object ID each: leaving the plate out of the occluders
  * gives the wall's nodes exactly the AO of the wall alone, and self_only
  * gives each object's nodes the AO of that object alone, every method of
@@ -9,7 +9,9 @@
  * the deep part lacks named in the error; at half resolution the masked
  * AO equals the unmasked one away from what is excluded and rises near
  * it, GL against the CPU twin. */
-#include "gl_testutil.h"
+#include "testutil.h"
+
+#include <math.h>
 
 #include <stdlib.h>
 #include <string.h>
@@ -18,9 +20,6 @@
 #include "obscura/mask.h"
 
 #define ARNOLD TESTDATA "/arnold_sample2.exr"
-#define ROOM TESTDATA "/room_small.exr"
-/* the room's albedo as object IDs: 0.8 walls and floor, 0.2 one object */
-#define WALLS "id:ViewLayer.DiffCol.R=0.7-0.9"
 
 enum { N = 32, PLATE_LO = 10, PLATE_HI = 22 };
 enum { WALL = 1, PLATE = 2 };
@@ -294,118 +293,11 @@ static void test_deep_arnold(void **state)
     obs_deep_free(&d);
 }
 
-/* ---- half resolution ----------------------------------------------------- */
-
-static void read_room(obs_gbuffer_file *f, const obs_params *p)
-{
-    char err[OBS_ERR_LEN];
-    load(scenes[0], f);
-    assert_int_equal(obs_gbuffer_read_masks(f, ROOM, NULL, 0, p, NULL, err), OBS_OK);
-}
-
-/* At half resolution, the walls and floor as the only occluders: the AO
- * equals the unmasked half-resolution AO bit for bit at every pixel
- * farther than the radius (and the half grid's reach) from an excluded
- * surface, and rises or stays near one, rising at many. */
-static void test_half_occluders(void **state)
-{
-    (void)state;
-    char err[OBS_ERR_LEN];
-    obs_params p = {0};
-    obs_gbuffer_file f = {0};
-    obs_result all, sel;
-    set(&p, "method", "hemisphere");
-    set(&p, "blur", "off");
-    set(&p, "ao_resolution", "half");
-    read_room(&f, &p);
-    assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &all, err), OBS_OK);
-    set(&p, "occluders", WALLS);
-    assert_int_equal(obs_gbuffer_read_masks(&f, ROOM, NULL, 0, &p, NULL, err), OBS_OK);
-    if (obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &sel, err) != OBS_OK)
-        fail_msg("%s", err);
-    const float *occl = f.gb.occluders.data;
-    const int W = f.gb.width, H = f.gb.height;
-    const float fpx = f.gb.camera.projection[5] * 0.5f * (float)H, D = 0.5f;
-    int changed = 0, same_far = 0;
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            size_t i = (size_t)y * W + x;
-            assert_true(sel.ao.data[i] >= all.ao.data[i] - 1e-6f);
-            /* the radius in pixels at depth z, plus the 2x2 blocks the
-             * half pixels and the upsample reach */
-            float z = f.gb.depth.data[i];
-            int r = (int)ceilf(z > D ? D * fpx / (z - D) : (float)W) + 4, near = 0;
-            for (int v = y - r; v <= y + r && !near; v++)
-                for (int u = x - r; u <= x + r && !near; u++)
-                    near = u >= 0 && v >= 0 && u < W && v < H && occl[(size_t)v * W + u] < 1.0f;
-            if (!near) {
-                assert_true(sel.ao.data[i] == all.ao.data[i]);
-                same_far++;
-            }
-            changed += sel.ao.data[i] > all.ao.data[i] + 1e-4f;
-        }
-    print_message("half: %d pixels rose, %d far from the excluded surfaces unchanged\n", changed,
-                  same_far);
-    assert_true(changed > 100 && same_far > 100);
-    obs_result_free(&all);
-    obs_result_free(&sel);
-    obs_gbuffer_free(&f);
-}
-
-/* GL against the CPU twins at half resolution with masks, every method:
- * the flat chain's masked tolerance. */
-static void test_half_gl_twin(void **state)
-{
-    (void)state;
-    char err[OBS_ERR_LEN];
-    obs_ctx *ctx = make_ctx(OBS_BACKEND_AUTO);
-    static const char *const all[] = {"vaopp", "hemisphere", "angle", "hbao", "gtao"};
-    for (int m = 0; m < 5; m++)
-        for (int self = 0; self < 2; self++) {
-            obs_params p = {0};
-            obs_gbuffer_file f = {0};
-            obs_result g, c, plain;
-            set(&p, "method", all[m]);
-            set(&p, "ao_resolution", "half");
-            set(&p, "occluders", self ? "id:ViewLayer.DiffCol.R=0-1" : WALLS);
-            if (self)
-                set(&p, "self_only", "on");
-            read_room(&f, &p);
-            if (obs_run(ctx, &f.gb, &p, OBS_OUTPUT_AO, &g, err) != OBS_OK)
-                fail_msg("GL: %s", err);
-            assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &c, err), OBS_OK);
-            obs_gbuffer_free(&f);
-            obs_params q = p; /* the same without masks: the masks do something */
-            q.occluders[0] = 0;
-            q.self_only = OBS_OFF;
-            read_room(&f, &q);
-            assert_int_equal(obs_run_cpu(&f.gb, &q, OBS_OUTPUT_AO, &plain, err), OBS_OK);
-            double mae = 0.0, moved = 0.0;
-            for (int i = 0; i < f.gb.width * f.gb.height; i++) {
-                mae += fabs(g.ao.data[i] - c.ao.data[i]);
-                moved += fabs(plain.ao.data[i] - c.ao.data[i]);
-            }
-            mae /= f.gb.width * f.gb.height;
-            moved /= f.gb.width * f.gb.height;
-            print_message("half, %s, %s: GL vs CPU mean |diff| %.2e; the masks move the AO by "
-                          "%.2e\n",
-                          all[m], self ? "self_only" : "occluders", mae, moved);
-            assert_true(mae < 2e-3);
-            assert_true(moved > 5 * mae);
-            obs_result_free(&g);
-            obs_result_free(&c);
-            obs_result_free(&plain);
-            obs_gbuffer_free(&f);
-        }
-    obs_ctx_destroy(ctx);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_deep_occluders_plate), cmocka_unit_test(test_deep_self_only),
         cmocka_unit_test(test_deep_gl_twin),         cmocka_unit_test(test_deep_arnold),
-        cmocka_unit_test(test_half_occluders),       cmocka_unit_test(test_half_gl_twin),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
