@@ -129,7 +129,7 @@ static obs_status build_image(const uint32_t *heads, const uint32_t *nodes, uint
         }
     if (!(d->samples = malloc((size_t)(stored ? stored : 1) * OBS_DEEP_CH * sizeof(float))))
         return obs__fail(err, OBS_NO_MEMORY, "%llu deep samples", (unsigned long long)stored);
-    if (ids && !(*ids = malloc((size_t)(stored ? stored : 1) * sizeof **ids)))
+    if (ids && !(*ids = calloc((size_t)(stored ? stored : 1), sizeof **ids)))
         return obs__fail(err, OBS_NO_MEMORY, "IDs of %llu deep samples", (unsigned long long)stored);
     for (int y = 0; y < height; y++)
         for (int x = 0; x < width; x++) {

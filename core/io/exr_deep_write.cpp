@@ -20,17 +20,19 @@ using namespace OPENEXR_IMF_NAMESPACE;
 extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image *d,
                                          char err[OBS_ERR_LEN])
 {
-    return obs_deep_write_exr_extra(path, d, NULL, NULL, err);
+    return obs_deep_write_exr_extra(path, d, NULL, 0, NULL, err);
 }
 
 extern "C" obs_status obs_deep_write_exr_extra(const char *path, const obs_deep_image *d,
-                                               const char *extra, const float *values,
-                                               char err[OBS_ERR_LEN])
+                                               const obs_deep_channel *extra, int n_extra,
+                                               const char *const *attrs, char err[OBS_ERR_LEN])
 {
     if (!path || !*path || !d || !d->offset || !d->samples || d->width <= 0 || d->height <= 0)
         return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "obs_deep_write_exr: no path or no deep image");
-    if (extra && (!*extra || !values))
-        return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "obs_deep_write_exr_extra: no channel name or no values");
+    for (int k = 0; k < n_extra; k++)
+        if (!extra[k].name || !*extra[k].name || !extra[k].values || extra[k].stride < 1)
+            return obs__deep_fail(err, OBS_INVALID_ARGUMENT,
+                                  "obs_deep_write_exr_extra: channel %d has no name, values or stride", k);
     const int w = d->width, h = d->height;
     const size_t npx = (size_t)w * (size_t)h;
     for (size_t i = 0; i < npx; i++)
@@ -68,8 +70,10 @@ extern "C" obs_status obs_deep_write_exr_extra(const char *path, const obs_deep_
         for (const ch &c : chans)
             if (c.present)
                 hdr.channels().insert(c.name, Channel(FLOAT));
-        if (extra) // one value a sample, beside the others
-            hdr.channels().insert(extra, Channel(FLOAT));
+        for (int k = 0; k < n_extra; k++) // one value a sample, beside the others
+            hdr.channels().insert(extra[k].name, Channel(FLOAT));
+        for (int k = 0; attrs && attrs[k] && attrs[k + 1]; k += 2)
+            hdr.insert(attrs[k], StringAttribute(attrs[k + 1]));
 
         obs__deep_header_attrs(hdr, &d->camera);
 
@@ -97,12 +101,15 @@ extern "C" obs_status obs_deep_write_exr_extra(const char *path, const obs_deep_
             fb.insert(c.name, DeepSlice(FLOAT, (char *)(p.data() - origin), sizeof(float *),
                                         sizeof(float *) * (size_t)w, OBS_DEEP_CH * sizeof(float)));
         }
-        std::vector<const float *> pe(extra ? npx : 0);
-        for (size_t i = 0; extra && i < npx; i++)
-            pe[i] = values + d->offset[i];
-        if (extra)
-            fb.insert(extra, DeepSlice(FLOAT, (char *)(pe.data() - origin), sizeof(float *),
-                                       sizeof(float *) * (size_t)w, sizeof(float)));
+        std::vector<std::vector<const float *>> pe((size_t)n_extra);
+        for (int k = 0; k < n_extra; k++) {
+            pe[k].resize(npx);
+            for (size_t i = 0; i < npx; i++)
+                pe[k][i] = extra[k].values + d->offset[i] * (size_t)extra[k].stride;
+            fb.insert(extra[k].name,
+                      DeepSlice(FLOAT, (char *)(pe[k].data() - origin), sizeof(float *),
+                                sizeof(float *) * (size_t)w, (size_t)extra[k].stride * sizeof(float)));
+        }
         DeepScanLineOutputFile file(tmp, hdr);
         file.setFrameBuffer(fb);
         file.writePixels(h);

@@ -97,11 +97,22 @@ void obs_deep_free(obs_deep_image *d);
  * C++ library (core/io/exr_deep_write.cpp).  Fails with OBS_IO when the
  * file cannot be written. */
 obs_status obs_deep_write_exr(const char *path, const obs_deep_image *d, char err[OBS_ERR_LEN]);
-/* The same with one more float channel named `extra`, one value a sample
- * (values[k] for sample k, offset[width * height] of them): the per-sample
- * object ID `obscura gbuffer --deep --ids` writes as "id". */
-obs_status obs_deep_write_exr_extra(const char *path, const obs_deep_image *d, const char *extra,
-                                    const float *values, char err[OBS_ERR_LEN]);
+/* One more float channel of a deep EXR: its name, and sample k's value
+ * at values[k * stride] (offset[width * height] samples). */
+typedef struct obs_deep_channel {
+    const char *name;
+    const float *values;
+    int stride;
+} obs_deep_channel;
+
+/* obs_deep_write_exr with n more float channels, one value a sample
+ * (written as they are, bits and all: a Cryptomatte ID stays its hash),
+ * and string attributes in the header (attrs: name, value, ..., NULL;
+ * NULL: none): what `obscura gbuffer --deep --ids` writes, the object ID
+ * "id" of each sample and a Cryptomatte layer per sample. */
+obs_status obs_deep_write_exr_extra(const char *path, const obs_deep_image *d,
+                                    const obs_deep_channel *extra, int n,
+                                    const char *const *attrs, char err[OBS_ERR_LEN]);
 
 /* The values of the parameters deep_mode and deep_hull, OBS_DEEP_MULTI
  * and so on, are in obscura/params.h with the others. */
