@@ -260,6 +260,19 @@ static void test_stacked_quads(void **state)
 
 /* ---- the deep EXR writer ------------------------------------------------------ */
 
+/* A floor (two triangles, opaque) and a pane standing on it (two, alpha
+ * 0.5), seen from above one side, w x h. */
+static obs_scene floor_and_pane(builder *b, int w, int h, obs_camera *cam)
+{
+    const float floor_[4][3] = {{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}};
+    const float pane[4][3] = {{-1, -0.5f, 0}, {1, -0.5f, 0}, {1, -0.5f, 1}, {-1, -0.5f, 1}};
+    quad(b, floor_, 1);
+    quad(b, pane, 0.5f);
+    const float eye[3] = {0.5f, -3.0f, 1.5f}, at[3] = {0, 0, 0.3f};
+    look_at(eye, at, 50, w, h, cam);
+    return as_scene(b);
+}
+
 /* What obs_deep_write_exr() writes, obs_deep_read_exr() reads: every
  * sample exactly (float channels), the flags, the camera. */
 static void test_write_roundtrip(void **state)
@@ -267,19 +280,13 @@ static void test_write_roundtrip(void **state)
     (void)state;
     enum { W = 40, H = 30 };
     builder b = {0};
-    const float floor_[4][3] = {{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}};
-    const float pane[4][3] = {{-1, -0.5f, 0}, {1, -0.5f, 0}, {1, -0.5f, 1}, {-1, -0.5f, 1}};
-    quad(&b, floor_, 1);
-    quad(&b, pane, 0.5f);
-    obs_scene s = as_scene(&b);
+    obs_camera cam;
+    obs_scene s = floor_and_pane(&b, W, H, &cam);
     float albedo[3 * 8];
     for (int v = 0; v < 8; v++)
         for (int k = 0; k < 3; k++)
             albedo[3 * v + k] = v < 4 ? 0.8f : (k == 0 ? 0.9f : 0.1f);
     s.albedo = albedo;
-    obs_camera cam;
-    const float eye[3] = {0.5f, -3.0f, 1.5f}, at[3] = {0, 0, 0.3f};
-    look_at(eye, at, 50, W, H, &cam);
     obs_deep_image d, e;
     char err[OBS_ERR_LEN] = "", path[512];
     if (obs_raster_deep(ctx, &s, &cam, W, H, &d, err) != OBS_OK)
@@ -333,18 +340,12 @@ static void test_deep_ids(void **state)
     (void)state;
     enum { W = 40, H = 30 };
     builder b = {0};
-    const float floor_[4][3] = {{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}};
-    const float pane[4][3] = {{-1, -0.5f, 0}, {1, -0.5f, 0}, {1, -0.5f, 1}, {-1, -0.5f, 1}};
-    quad(&b, floor_, 1);
-    quad(&b, pane, 0.5f);
-    obs_scene s = as_scene(&b);
+    obs_camera cam;
+    obs_scene s = floor_and_pane(&b, W, H, &cam);
     obs_scene_mesh meshes[2] = {{.name = "floor", .first_triangle = 0, .triangle_count = 2},
                                 {.name = "pane", .first_triangle = 2, .triangle_count = 2}};
     s.meshes = meshes;
     s.mesh_count = 2;
-    obs_camera cam;
-    const float eye[3] = {0.5f, -3.0f, 1.5f}, at[3] = {0, 0, 0.3f};
-    look_at(eye, at, 50, W, H, &cam);
     obs_deep_image d, e;
     float *ids = NULL;
     char err[OBS_ERR_LEN] = "", path[512];
