@@ -150,7 +150,8 @@ json.dump({
         spec["ao_distance"], a.samples),
     "id_channels": "ViewLayer.IndexOB.X: pass_index (%s); Cryptomatte layer ViewLayer.CryptoObject (object names)" % (
         ", ".join("%s=%d" % (l, bpy.data.objects[l].pass_index) for l in labels)),
-    "hidden": "%s_hidden.exr: the same frame with '%s' hidden from rendering" % (os.path.basename(a.out), a.hide),
+    "hidden": "%s_hidden.exr: the same frame with '%s' hidden from rendering; %s_ref.exr: its AO pass, with Depth.Z "
+              "1e10 where this frame shows '%s'" % (os.path.basename(a.out), a.hide, os.path.basename(a.out), a.hide),
     "ao_distance": spec["ao_distance"], "engine": "cycles",
 }, open(a.out + ".camera.json", "w"), indent=1)
 
