@@ -54,7 +54,7 @@ if [ "${1:-}" = cycles ]; then
     mse() { "$O" compare "$1" "$2" --json | sed -n 's/.*"mse": \([^,]*\),.*/\1/p'; }
     echo
     echo "Cycles $SPP spp, distance 0.5, 320x240; MSE against the AO with '$HIDE' hidden, over the pixels both frames show"
-    echo "(the two Cycles AO passes differ by MSE $(mse "$REF" "$R" 2>/dev/null || true) there: the table's shadow and both renders' noise)"
+    echo "(the two Cycles AO passes differ by MSE $(mse "$REF" "$R" 2>/dev/null || true) there: $HIDE's shadow and both renders' noise)"
     echo
     echo "| method | no mask | --occluders '!$HIDE' | --occluders '!id:ViewLayer.IndexOB.X=$n' |"
     echo "|---|---|---|---|"
