@@ -31,7 +31,7 @@ typedef struct obs_crypto_layer {
     char conversion[32];   /* "uint32_to_float32" */
     char manif_file[512];  /* side-car manifest as the header names it ("": in the header) */
     int rank_sets;         /* <name>NN channel sets found (two ranks each) */
-    int red_style;         /* 1: .red/.green/.blue/.alpha; 0: .R/.G/.B/.A */
+    int red_style;         /* 0: .R/.G/.B/.A; 1: .red/.green/.blue/.alpha; 2: .r/.g/.b/.a */
     int entry_count;       /* names in the manifest */
     char **names;          /* entry_count names, UTF-8 as the manifest has them */
     uint32_t *ids;         /* their IDs (the float's bits) */
