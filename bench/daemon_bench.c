@@ -14,7 +14,7 @@
  * EXR bytes and decoding the answer's AO.Y, with the daemon's default
  * answer (half, compression auto) and with a float ZIP answer (the
  * answer before compression existed); then clients/remote.c, the code of
- * `obscura ao --server` (it asks for a float answer).  For unix: and
+ * `obscura ao --server` (it asks for a half answer, as obscura ao writes half).  For unix: and
  * tcp:// URLs, the binary protocol's raw float32 planes through
  * clients/remote.c.  Medians of N rounds, each round every path once (a
  * load from outside falls on every path alike), all in one run.  Then 1, 2, 4 and 8
@@ -73,7 +73,7 @@ static void remote_frame(const char *url, const char *path, const obs_gbuffer *g
 {
     char *argv[] = {NULL};
     obs_result r;
-    if (cli_remote_run(url, 0, argv, path, gb, OBS_OUTPUT_AO, &r) != 0)
+    if (cli_remote_run(url, 0, argv, path, gb, OBS_OUTPUT_AO, 1, &r) != 0)
         die(url, "frame failed");
     obs_result_free(&r);
 }
@@ -551,7 +551,7 @@ int main(int argc, char **argv)
                 "HTTP, EXR body, float ZIP answer (the answer before compression=), answer decoded", 0};
         }
         paths[np++] = (struct path){url, NULL,
-            !strncmp(url, "http", 4) ? "HTTP through obscura ao --server's client (file read, float answer)"
+            !strncmp(url, "http", 4) ? "HTTP through obscura ao --server's client (file read, half answer)"
             : !strncmp(url, "unix:", 5) ? "binary protocol, raw planes, Unix socket"
                                         : "binary protocol, raw planes, TCP loopback", 1};
     }

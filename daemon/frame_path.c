@@ -279,12 +279,14 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
     if (raw) {
         /* nothing to write: the protocol sends the planes */
     } else if (hr->outputs & OBS_OUTPUT_DEEP) {
-        /* every kept node's AO (the CPU twin, as obscura ao --output deep) */
+        /* every kept node's AO (the CPU twin, as obscura ao --output deep);
+         * a file written as it comes (obscura ao --server --output deep),
+         * so auto keeps the file's compressions, as obscura ao writes them */
         obs_deep_ao nodes;
         s = obs_deep_ao_nodes(fp->deep, fp->job.params, &nodes, err);
         if (s == OBS_OK)
-            s = obs_deep_ao_write_exr_mem(&nodes, &fp->job.deep_result.ao_blend,
-                                          &fp->job.deep_result.ao_front, out, err);
+            s = obs_deep_ao_write_exr_mem(&nodes, &fp->job.deep_result.ao_blend, &fp->job.deep_result.ao_front,
+                                          (obs_exr_compression)hr->compression, out, err);
         obs_deep_ao_free(&nodes);
     } else if (hr->format == OBS_HTTP_EXR) {
         /* copies of the image headers only: the pixels stay where they are */
