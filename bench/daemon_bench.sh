@@ -69,17 +69,17 @@ stop_daemon() {
 stage_table() {
     echo
     echo "Daemon's stages, median ms per 1080p frame (from its log: frames of over 1 MB, warm-ups and"
-    echo "concurrent clients included; receive: HTTP only):"
+    echo "concurrent clients included; send: binary only, HTTP's is in /metrics):"
     echo
-    echo "| protocol | frames | receive | decode | queue | gl | encode | total in daemon |"
-    echo "|---|---|---|---|---|---|---|---|"
+    echo "| protocol | frames | receive | decode | queue | gl | encode | send | total in daemon |"
+    echo "|---|---|---|---|---|---|---|---|---|"
     for p in "POST /v1/ao" "BINARY"; do
         grep "status=200" "$1" | grep "$p" | grep -E ' in=[0-9]{7,} ' | tr ' ' '\n' |
-            awk -v p="$p" -F= '$1 ~ /^(receive|queue|decode|gl|encode|total)$/ { v[$1, n[$1]++] = $2 }
+            awk -v p="$p" -F= '$1 ~ /^(receive|queue|decode|gl|encode|send|total)$/ { v[$1, n[$1]++] = $2 }
                 function med(k,   m, i, j, a, t) { m = n[k]; for (i = 0; i < m; i++) a[i] = v[k, i]
                     for (i = 1; i < m; i++) { t = a[i]; for (j = i - 1; j >= 0 && a[j] > t; j--) a[j + 1] = a[j]; a[j + 1] = t }
                     return m ? a[int(m / 2)] : 0 }
-                END { printf "| %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f |\n", p, n["gl"], med("receive"), med("decode"), med("queue"), med("gl"), med("encode"), med("total") }'
+                END { printf "| %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f |\n", p, n["gl"], med("receive"), med("decode"), med("queue"), med("gl"), med("encode"), med("send"), med("total") }'
     done
 }
 
