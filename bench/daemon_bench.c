@@ -306,8 +306,8 @@ static void concurrency(const char *url, const char *what, const char *path, con
     double ms0[4][STAGES], mc0[4][STAGES], ms1[4][STAGES], mc1[4][STAGES];
     int rows = 0;
     printf("\nConcurrent clients (%s, %s, %d frames per client, one process each):\n\n", url, what, per_client);
-    printf("| clients | frames | wall s | frames/s | x one client | cores busy: daemon + clients |\n"
-           "|---|---|---|---|---|---|\n");
+    printf("| clients | frames | wall s | frames/s | x one client | cores busy: daemon + clients "
+           "| frames per daemon core-second |\n|---|---|---|---|---|---|---|\n");
     fflush(stdout);
     double one = 0;
     for (int n = 1; n <= max_clients; n *= 2) {
@@ -337,10 +337,16 @@ static void concurrency(const char *url, const char *what, const char *path, con
         double fps = n * per_client / sec, d1 = daemon_cpu_s(), c1 = children_cpu_s();
         if (n == 1)
             one = fps;
-        char busy[64] = "-";
-        if (d0 >= 0 && d1 >= 0)
+        /* frames per CPU-second of the daemon: the work a frame costs it,
+         * whatever share of the cores a loaded machine leaves it */
+        char busy[64] = "-", per_core[32] = "-";
+        if (d0 >= 0 && d1 >= 0) {
             snprintf(busy, sizeof busy, "%.2f + %.2f", (d1 - d0) / sec, (c1 - c0) / sec);
-        printf("| %d | %d | %.2f | %.2f | %.2f | %s |\n", n, n * per_client, sec, fps, fps / one, busy);
+            if (d1 > d0)
+                snprintf(per_core, sizeof per_core, "%.2f", n * per_client / (d1 - d0));
+        }
+        printf("| %d | %d | %.2f | %.2f | %.2f | %s | %s |\n", n, n * per_client, sec, fps, fps / one, busy,
+               per_core);
         fflush(stdout);
         if (metrics)
             metrics_read(metrics, ms1[rows], mc1[rows]);
