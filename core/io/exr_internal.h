@@ -134,6 +134,13 @@ typedef obs_status (*obs__exr_reader)(exr_context_t ctx, int64_t size, void *use
  * every public reader's frame; a failure is "label: why" in err. */
 obs_status obs__exr_read_with(const char *label, const char *path, const obs__exr_mem *mem,
                               obs__exr_reader read, void *user, char err[OBS_ERR_LEN]);
+/* A public reader that fills a struct: out (out_size bytes) checked and
+ * zeroed, then obs__exr_read_with, and *out released with release (the
+ * struct's free function) when that fails.  exr_read.c's G-buffer and
+ * exr_deep.c's deep image. */
+obs_status obs__exr_read_out(const char *label, const char *path, const obs__exr_mem *mem,
+                             obs__exr_reader read, void *user, void *out, size_t out_size,
+                             void (*release)(void *out), char err[OBS_ERR_LEN]);
 
 /* n channels (float32, one image each), all from one part that holds
  * channels[0]: one whose "view" attribute is `view` (NULL or "": none),

@@ -85,6 +85,19 @@ obs_status obs__exr_read_with(const char *label, const char *path, const obs__ex
     return st;
 }
 
+obs_status obs__exr_read_out(const char *label, const char *path, const obs__exr_mem *mem,
+                             obs__exr_reader read, void *user, void *out, size_t out_size,
+                             void (*release)(void *out), char err[OBS_ERR_LEN])
+{
+    if (!out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
+    memset(out, 0, out_size);
+    obs_status st = obs__exr_read_with(label, path, mem, read, user, err);
+    if (st != OBS_OK)
+        release(out);
+    return st;
+}
+
 /* ---- parts and channels -------------------------------------------------- */
 
 /* Channel names of one part, pointing into the context (valid until
@@ -680,19 +693,19 @@ static obs_status gbuffer_reader(exr_context_t ctx, int64_t size, void *user,
     return read_gbuffer(ctx, size, j->map, j->lim, j->out, why);
 }
 
+static void gbuffer_release(void *out)
+{
+    obs_gbuffer_free(out);
+}
+
 /* Shared by the file and memory readers; `label` prefixes messages. */
 static obs_status read_any(const char *label, const char *path, const mem_src *mem,
                            const obs_channel_map *map, const obs_limits *lim,
                            obs_gbuffer_file *out, char err[OBS_ERR_LEN])
 {
-    if (!out)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
-    memset(out, 0, sizeof *out);
     gbuffer_job j = {map, lim, out};
-    obs_status st = obs__exr_read_with(label, path, mem, gbuffer_reader, &j, err);
-    if (st != OBS_OK)
-        obs_gbuffer_free(out);
-    return st;
+    return obs__exr_read_out(label, path, mem, gbuffer_reader, &j, out, sizeof *out,
+                             gbuffer_release, err);
 }
 
 obs_status obs_gbuffer_read_exr(const char *path, const obs_channel_map *map,
