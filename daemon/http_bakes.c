@@ -229,14 +229,14 @@ static enum MHD_Result post_start(req *r)
         /* the parts are copied out as the body comes: nothing is held twice */
         if (!(bk->parts = calloc(1, sizeof *bk->parts)))
             return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the parts");
-        bk->parts->max = (size_t)h->cfg->max_level;
+        bk->parts->max = (size_t)h->front.cfg->max_level;
         bk->pp = MHD_create_post_processor(r->conn, 1 << 16, on_part, bk->parts);
         if (!bk->pp)
             return obsd__answer_error(r, 400, "bad_multipart",
                                       "a multipart/form-data body without a boundary", NULL, NULL);
     }
     enum MHD_Result rc;
-    if (!obsd__body_expect(r, (size_t)h->cfg->max_level, "level", "--max-level", !multipart, &rc))
+    if (!obsd__body_expect(r, (size_t)h->front.cfg->max_level, "level", "--max-level", !multipart, &rc))
         return rc;
     r->state = REQ_BODY;
     return MHD_YES;
@@ -281,11 +281,11 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
         return MHD_YES;
     }
     if (*size)
-        return obsd__append_body(r, data, size, (size_t)h->cfg->max_level);
+        return obsd__append_body(r, data, size, (size_t)h->front.cfg->max_level);
     char msg[320];
     if (r->too_big) {
         snprintf(msg, sizeof msg, "level is over the limit of %lld bytes (--max-level)",
-                 (long long)h->cfg->max_level);
+                 (long long)h->front.cfg->max_level);
         return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
     }
     if (pt) {
@@ -327,7 +327,7 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
     int rc = obsd_bakes_submit(h->bakes, level, len, ext, decor, rules, &bk->params, id);
     if (rc == -1) {
         snprintf(msg, sizeof msg, "%d bake jobs are queued or running (--max-bakes); retry later",
-                 h->cfg->max_bakes);
+                 h->front.cfg->max_bakes);
         return obsd__answer_error(r, 503, "bake_queue_full", msg, MHD_HTTP_HEADER_RETRY_AFTER, "10");
     }
     if (rc == -2)
@@ -436,7 +436,7 @@ enum MHD_Result obsd__bakes_start(req *r, const char *url)
     if (!bk)
         return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the request");
     int ok = parse_path(r, url);
-    if (h->cfg->max_bakes < 1)
+    if (h->front.cfg->max_bakes < 1)
         return obsd__answer_error(r, 404, "bakes_off", "bake jobs are off (--max-bakes 0)", NULL, NULL);
     if (ok < 0)
         return obsd__answer_error(r, 404, "not_found", "a bake job's id is 16 hex digits, as POST /v1/bakes "

@@ -169,11 +169,11 @@ enum MHD_Result obsd__frame_start(req *r, const char *url)
     if (v && strncmp(v, "image/x-exr", 11) != 0 && strncmp(v, "application/octet-stream", 24) != 0)
         return obsd__answer_error(r, 415, "unsupported_media_type",
                             "the body must be a G-buffer EXR (Content-Type: image/x-exr)", NULL, NULL);
-    if (!obsd__body_expect(r, (size_t)h->cfg->max_body, "body", "--max-body", 1, &rc))
+    if (!obsd__body_expect(r, (size_t)h->front.cfg->max_body, "body", "--max-body", 1, &rc))
         return rc;
     /* Refuse early when the queue is already full: no need for the body. */
     int full;
-    obsd_queue_stats(h->queue, NULL, NULL, &full);
+    obsd_queue_stats(h->front.queue, NULL, NULL, &full);
     if (full)
         return obsd__answer_error(r, 503, "queue_full", "the frame queue is full; retry later",
                             MHD_HTTP_HEADER_RETRY_AFTER, "1");
@@ -262,7 +262,7 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     obsd__frame_req *fr = r->fr;
     obsd_http *h = r->srv;
     char err[OBS_ERR_LEN] = "";
-    obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
+    obs_limits lim = {.max_pixels = (uint64_t)h->front.cfg->max_pixels};
     obs_status s = obsd_fp_decode(&fr->fp, body, len, &fr->hr, &lim, NULL, err);
     /* An EXR answer takes the body's header (its windows and attributes;
      * append=1: the body itself), which lives until the answer: r->body,
@@ -285,7 +285,7 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     MHD_suspend_connection(r->conn);
     atomic_store(&r->job, JOB_PENDING);
     if ((r->cn && atomic_load(&r->cn->cut)) || (atomic_load(&h->draining) && !fr->before_drain) ||
-        obsd_fp_queue(&fr->fp, h->queue, &fr->hr.params, outputs, job_done, r) != 0) {
+        obsd_fp_queue(&fr->fp, h->front.queue, &fr->hr.params, outputs, job_done, r) != 0) {
         int pending = JOB_PENDING;
         if (atomic_compare_exchange_strong(&r->job, &pending, JOB_NONE)) {
             r->state = REQ_REFUSED;
@@ -324,11 +324,11 @@ enum MHD_Result obsd__frame_body(req *r, const char *data, size_t *size)
     if (!obsd__req_alive(r))
         return MHD_NO;
     if (*size)
-        return obsd__append_body(r, data, size, (size_t)r->srv->cfg->max_body);
+        return obsd__append_body(r, data, size, (size_t)r->srv->front.cfg->max_body);
     if (r->too_big) {
         char msg[160];
         snprintf(msg, sizeof msg, "body is over the limit of %lld bytes (--max-body)",
-                 (long long)r->srv->cfg->max_body);
+                 (long long)r->srv->front.cfg->max_body);
         return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
     }
     return queue_body(r);

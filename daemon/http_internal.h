@@ -14,8 +14,7 @@
 #include "bake_jobs.h"
 #include "frame_path.h"
 #include "http.h"
-#include "config.h"
-#include "gl_worker.h"
+#include "front.h"
 #include "obscura/io.h"
 #include "stats.h"
 #include "stream_store.h"
@@ -49,10 +48,7 @@ typedef struct obsd__conn {
 typedef struct obsd_http obsd_http;
 struct obsd_http {
     struct MHD_Daemon *mhd;
-    const obsd_config *cfg;
-    const char *token;
-    obsd_queue *queue;
-    obsd_gl_worker *gl;
+    obsd_front front;
     obsd_streams *streams;
     obsd_bakes *bakes;
     int port;

@@ -216,7 +216,7 @@ static enum MHD_Result get_frame(req *r, uint64_t seq)
     if (!fr->before_drain)
         return obsd__answer_shutting_down(r);
     int full;
-    obsd_queue_stats(h->queue, NULL, NULL, &full);
+    obsd_queue_stats(h->front.queue, NULL, NULL, &full);
     if (full)
         return obsd__answer_error(r, 503, "queue_full", "the frame queue is full; retry later",
                                   MHD_HTTP_HEADER_RETRY_AFTER, "1");
@@ -239,7 +239,7 @@ enum MHD_Result obsd__streams_start(req *r, const char *url)
         return obsd__answer_error(r, 404, "not_found",
                                   "no such route (GET /v1/streams, GET|POST /v1/streams/NAME/frames[/N], "
                                   "GET /v1/streams/NAME/events)", NULL, NULL);
-    if (h->cfg->streams < 1)
+    if (h->front.cfg->streams < 1)
         return obsd__answer_error(r, 404, "streams_off", "streams are off (--streams 0)", NULL, NULL);
     const char *allowed = sr->op == STREAM_POST ? "POST" : "GET";
     if (strcmp(r->method, allowed) != 0 && !(sr->op != STREAM_POST && !strcmp(r->method, "HEAD"))) {

@@ -35,7 +35,8 @@ static obsd_bin *start(obsd_config *cfg, obsd_queue *q, const char *token)
     snprintf(cfg->socket, sizeof cfg->socket, "%s", sock_path);
     cfg->http[0] = '\0';
     assert_int_equal(obsd_queue_init(q, 1), 0);
-    assert_int_equal(obsd_bin_start(cfg, token, q, NULL, &b, err), OBS_OK);
+    const obsd_front front = obsd_front_make(cfg, token, q, NULL);
+    assert_int_equal(obsd_bin_start(&front, &b, err), OBS_OK);
     return b;
 }
 
