@@ -36,8 +36,9 @@ obs_status obs__bake_shard_step(obs__bake_shard *sh, const obs__bake_world *w,
                                 obs__bake_samples *s, const obs__bake_trace_desc *td,
                                 obs_bake_stats *st, char err[OBS_ERR_LEN]);
 
-/* Reads and checks a part's header (magic, version, sizes, the file's
- * length against its count). */
-obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN]);
+/* The part file's layout (shard.c): its header's fields, the bake
+ * parameters they carry (obs__part_header_read reads one, with its
+ * checks: magic, version, sizes, the file's length against its count). */
+extern const obs__part_format obs__bake_part_format;
 
 #endif

@@ -151,9 +151,10 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
 obs_status obs__dyn_shard_step(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
                                const obs_dyn_params *p, const obs__bake_bvh *bvh,
                                obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN]);
-/* Reads and checks a part's header (magic, version, sizes, the file's
- * length against its count). */
-obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char err[OBS_ERR_LEN]);
+/* The part file's layout (dyn_shard.c): its header's fields, the
+ * parameters they carry (obs__part_header_read reads one, with its
+ * checks: magic, version, sizes, the file's length against its count). */
+extern const obs__part_format obs__dyn_part_format;
 /* FNV-1a 64 of the regions' boxes and the valid points' grid indices,
  * independent of the host's byte order. */
 uint64_t obs__dyn_points_fingerprint(const obs_dyn_regions *rg, const obs__dyn_points *pt);
