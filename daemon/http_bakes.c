@@ -86,63 +86,40 @@ static enum MHD_Result unknown(req *r)
 
 /* ---- POST: the query, then the body ------------------------------------ */
 
-typedef struct arg_ctx {
-    req *r;
-    int bad;
-    char err[OBS_ERR_LEN];
-} arg_ctx;
-
-static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *key, size_t key_size,
-                              const char *value, size_t value_size)
+/* One query argument of POST /v1/bakes (obsd__query_args). */
+static obs_status bake_arg(req *r, const char *key, const char *value, char err[OBS_ERR_LEN])
 {
-    arg_ctx *a = cls;
-    req *r = a->r;
     bake_req *bk = r->own;
-    (void)kind;
-    if (a->bad)
-        return MHD_NO;
-    if (obs_http_value_check(key, key_size, value, value_size, a->err) != OBS_OK) {
-        a->bad = 1;
-        return MHD_NO;
-    }
-    if (!value)
-        value = "";
     if (!strcmp(key, "format")) {
         size_t n = strlen(value);
         int ok = n > 0 && n < sizeof bk->ext;
         for (size_t i = 0; ok && i < n; i++)
             ok = (value[i] >= 'a' && value[i] <= 'z') || (value[i] >= '0' && value[i] <= '9');
         if (!ok) {
-            snprintf(a->err, OBS_ERR_LEN, "format '%.40s' is not a file extension (glb, gltf, ac, obj, ...)",
+            snprintf(err, OBS_ERR_LEN, "format '%.40s' is not a file extension (glb, gltf, ac, obj, ...)",
                      value);
-            a->bad = 1;
-            return MHD_NO;
+            return OBS_INVALID_ARGUMENT;
         }
         snprintf(bk->ext, sizeof bk->ext, "%s", value);
-        return MHD_YES;
+        return OBS_OK;
     }
     if (!strcmp(key, "distances")) {
         char s[64], l[64];
         const char *comma = strchr(value, ',');
         if (!comma || strchr(comma + 1, ',') || (size_t)(comma - value) >= sizeof s || strlen(comma + 1) >= sizeof l) {
-            snprintf(a->err, OBS_ERR_LEN, "distances '%.40s': expected SHORT,LONG (e.g. 2,300)", value);
-            a->bad = 1;
-            return MHD_NO;
+            snprintf(err, OBS_ERR_LEN, "distances '%.40s': expected SHORT,LONG (e.g. 2,300)", value);
+            return OBS_INVALID_ARGUMENT;
         }
         snprintf(s, sizeof s, "%.*s", (int)(comma - value), value);
         snprintf(l, sizeof l, "%s", comma + 1);
-        a->bad = obs_bake_param_set(&bk->params, "distance_short", s, a->err) != OBS_OK ||
-                 obs_bake_param_set(&bk->params, "distance_long", l, a->err) != OBS_OK;
-        return a->bad ? MHD_NO : MHD_YES;
+        obs_status st = obs_bake_param_set(&bk->params, "distance_short", s, err);
+        return st != OBS_OK ? st : obs_bake_param_set(&bk->params, "distance_long", l, err);
     }
-    if (obs_bake_param_set(&bk->params, key, value, a->err) != OBS_OK) {
-        if (!obs_bake_param_find(key))
-            snprintf(a->err, OBS_ERR_LEN, "unknown bake parameter '%.60s' (GET /v1/bakes lists none; "
-                     "'obscura bake --params' lists them; also format=EXT, distances=S,L)", key);
-        a->bad = 1;
-        return MHD_NO;
-    }
-    return MHD_YES;
+    obs_status st = obs_bake_param_set(&bk->params, key, value, err);
+    if (st != OBS_OK && !obs_bake_param_find(key))
+        snprintf(err, OBS_ERR_LEN, "unknown bake parameter '%.60s' (GET /v1/bakes lists none; "
+                 "'obscura bake --params' lists them; also format=EXT, distances=S,L)", key);
+    return st;
 }
 
 /* ---- a multipart/form-data body: the parts `level` and `decorators` ---- */
@@ -219,10 +196,9 @@ static enum MHD_Result post_start(req *r)
     obsd_http *h = r->srv;
     if (atomic_load(&h->draining))
         return obsd__answer_shutting_down(r);
-    arg_ctx a = {r, 0, ""};
-    MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
-    if (a.bad)
-        return obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL);
+    char err[OBS_ERR_LEN];
+    if (obsd__query_args(r, bake_arg, err) != OBS_OK)
+        return obsd__answer_error(r, 400, "bad_parameter", err, NULL, NULL);
     const char *ct = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
     int multipart = ct && !strncasecmp(ct, "multipart/form-data", strlen("multipart/form-data"));
     if (multipart) {

@@ -209,6 +209,17 @@ enum MHD_Result obsd__answer_status(obsd__req *r, obs_status s, const char *msg)
 enum MHD_Result obsd__answer_images(obsd__req *r, const obsd_fp_images *im, const obs_camera *cam, int timing,
                                     const char *extra_name, const char *extra_value);
 
+/* ---- http_query.c: a request's query arguments ------------------------ */
+
+/* A route's reader of one query argument (value "" when it has none):
+ * OBS_OK, or an error with its message in err. */
+typedef obs_status (*obsd__arg_fn)(obsd__req *r, const char *key, const char *value,
+                                   char err[OBS_ERR_LEN]);
+/* Every query argument of r through fn, in order, up to the first error
+ * (one with a NUL byte is an error before fn sees it): OBS_OK or that
+ * error, its message in err. */
+obs_status obsd__query_args(obsd__req *r, obsd__arg_fn fn, char err[OBS_ERR_LEN]);
+
 /* ---- http_frames.c: a frame's query, body and trip to the GL worker ---- */
 
 /* The start of a frame's request: query, Content-Type, Content-Length,
