@@ -212,7 +212,7 @@ static obs_status flatten_stage(const obs_bake_scene *scene, const obs_bake_desc
 /* Eq 1 at every sample (trace.c), or, for a shard or a merge, shard.c's
  * step in its place; t: when the stage began. */
 static obs_status trace_stage(const obs_bake_desc *desc, const obs_bake_params *p,
-                              const obs__bake_decor *dc, obs__bake_shard *sh,
+                              const obs__bake_decor *dc, obs__part_job *sh,
                               const obs__bake_world *w, obs__bake_samples *s, double t,
                               obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
@@ -224,7 +224,7 @@ static obs_status trace_stage(const obs_bake_desc *desc, const obs_bake_params *
     td.tree_attenuation = p->tree_attenuation;
     double bvh = 0.0;
     if (sh) {
-        if ((rc = obs__bake_shard_step(sh, w, s, &td, st, err)) != OBS_OK)
+        if ((rc = obs__bake_shard_step(sh, w, s, &td, p, st, err)) != OBS_OK)
             return rc;
     } else {
         if ((rc = obs__bake_trace(w, s, &td, &bvh, err)) != OBS_OK)
@@ -238,7 +238,7 @@ static obs_status trace_stage(const obs_bake_desc *desc, const obs_bake_params *
 }
 
 obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc *desc,
-                               obs__bake_shard *sh, obs_bake_result *out, char err[OBS_ERR_LEN])
+                               obs__part_job *sh, obs_bake_result *out, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
     obs_bake_params p;

@@ -123,7 +123,7 @@ static void part_params(obs__bake_part *h, const obs__bake_trace_desc *td, const
     }
 }
 
-static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs__bake_samples *s,
+static obs_status trace_shard(obs__part_job *sh, const obs__bake_world *w, obs__bake_samples *s,
                               const obs__bake_trace_desc *td, const obs_bake_params *p,
                               obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
@@ -177,12 +177,13 @@ static obs_status read_payload(const obs__bake_part *h, obs__bake_samples *s, ch
     return OBS_OK;
 }
 
-static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs__bake_samples *s,
+static obs_status read_shards(obs__part_job *sh, const obs__bake_world *w, obs__bake_samples *s,
                               const obs__bake_trace_desc *td, obs_bake_stats *st,
                               char err[OBS_ERR_LEN])
 {
     uint64_t level = traced_fingerprint(w, td);
-    const obs__part_range *p0 = &sh->parts[0].r;
+    const obs__bake_part *parts = sh->parts;
+    const obs__part_range *p0 = &parts[0].r;
     obs_status rc = obs__part_check_level(p0->path, p0->level, level, err);
     if (rc != OBS_OK)
         return rc;
@@ -194,23 +195,24 @@ static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs
     s->rays = 0;
     s->dropped = 0;
     for (int i = 0; i < sh->count; i++) {
-        rc = read_payload(&sh->parts[i], s, err);
+        rc = read_payload(&parts[i], s, err);
         if (rc != OBS_OK)
             return rc;
-        s->rays += sh->parts[i].rays;
-        s->dropped += (size_t)sh->parts[i].dropped;
+        s->rays += parts[i].rays;
+        s->dropped += (size_t)parts[i].dropped;
         /* the parts' times, summed: the farm's machine time */
-        st->seconds[OBS_BAKE_STAGE_bvh] += sh->parts[i].bvh_seconds;
-        st->seconds[OBS_BAKE_STAGE_trace] += sh->parts[i].trace_seconds;
+        st->seconds[OBS_BAKE_STAGE_bvh] += parts[i].bvh_seconds;
+        st->seconds[OBS_BAKE_STAGE_trace] += parts[i].trace_seconds;
     }
     st->seconds[OBS_BAKE_STAGE_trace] += obs__bake_now() - t;
     return OBS_OK;
 }
 
-obs_status obs__bake_shard_step(obs__bake_shard *sh, const obs__bake_world *w,
+obs_status obs__bake_shard_step(obs__part_job *sh, const obs__bake_world *w,
                                 obs__bake_samples *s, const obs__bake_trace_desc *td,
-                                obs_bake_stats *st, char err[OBS_ERR_LEN])
+                                const obs_bake_params *p, obs_bake_stats *st,
+                                char err[OBS_ERR_LEN])
 {
-    return sh->parts ? read_shards(sh, w, s, td, st, err) : trace_shard(sh, w, s, td, &sh->params, st, err);
+    return sh->parts ? read_shards(sh, w, s, td, st, err) : trace_shard(sh, w, s, td, p, st, err);
 }
 

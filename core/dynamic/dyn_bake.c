@@ -88,7 +88,7 @@ obs_status obs_dyn_bake(const obs_bake_scene *scene, const obs_dyn_desc *desc,
  * place: one shard's points traced and written (the bake stops there),
  * or every shard's read back. */
 obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *desc,
-                             obs__dyn_shard *sh, obs_dyn_result *out, char err[OBS_ERR_LEN])
+                             obs__part_job *sh, obs_dyn_result *out, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
     obs_dyn_params p;
@@ -126,7 +126,8 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     st->seconds[OBS_DYN_STAGE_valid] = obs__bake_now() - t;
     t = obs__bake_now();
     if (sh) {
-        if ((rc = obs__dyn_shard_step(sh, obs__bake_traced_fingerprint(&w, &dc, p.tree_attenuation),
+        if ((rc = obs__dyn_shard_step(sh, desc,
+                                      obs__bake_traced_fingerprint(&w, &dc, p.tree_attenuation),
                                       rg, &p, bvh, &pt, st, err)) != OBS_OK || sh->stop)
             goto done;
     } else {

@@ -124,9 +124,10 @@ uint64_t obs__dyn_points_fingerprint(const obs_dyn_regions *rg, const obs__dyn_p
 
 /* ---- writing a part ------------------------------------------------------ */
 
-static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
-                              const obs_dyn_params *p, const obs__bake_bvh *bvh,
-                              obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
+static obs_status trace_shard(obs__part_job *sh, const obs_dyn_desc *desc, uint64_t level,
+                              const obs_dyn_regions *rg, const obs_dyn_params *p,
+                              const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
+                              char err[OBS_ERR_LEN])
 {
     obs__dyn_part h = {
         .r = obs__part_range_of(VERSION, level, sh->index, sh->count, pt->count),
@@ -146,7 +147,8 @@ static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
     double t = obs__bake_now();
     pt->rays = 0;
     size_t n = (size_t)h.r.n, first = (size_t)h.r.first, dropped = 0;
-    obs__dyn_points_trace(bvh, p, pt, first, first + n, sh->progress, sh->progress_user);
+    obs__dyn_points_trace(bvh, p, pt, first, first + n, desc ? desc->progress : NULL,
+                          desc ? desc->progress_user : NULL);
     h.trace_seconds = obs__bake_now() - t;
     unsigned char *payload = malloc(n * (POINT_BYTES + 1) + 1);
     if (!payload)
@@ -199,10 +201,10 @@ static obs_status read_payload(const obs__dyn_part *h, obs__dyn_points *pt, char
     return rc;
 }
 
-static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
+static obs_status read_shards(obs__part_job *sh, uint64_t level, const obs_dyn_regions *rg,
                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
 {
-    const obs__dyn_part *p0 = &sh->parts[0];
+    const obs__dyn_part *parts = sh->parts, *p0 = &parts[0];
     obs_status rc = obs__part_check_level(p0->r.path, p0->r.level, level, err);
     if (rc != OBS_OK)
         return rc;
@@ -215,21 +217,22 @@ static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
     double t = obs__bake_now();
     pt->rays = 0;
     for (int i = 0; i < sh->count; i++) {
-        rc = read_payload(&sh->parts[i], pt, err);
+        rc = read_payload(&parts[i], pt, err);
         if (rc != OBS_OK)
             return rc;
-        pt->rays += sh->parts[i].r.n * (uint64_t)sh->parts[i].rays;
+        pt->rays += parts[i].r.n * (uint64_t)parts[i].rays;
         /* the parts' times, summed: the farm's machine time */
-        st->seconds[OBS_DYN_STAGE_trace] += sh->parts[i].trace_seconds;
+        st->seconds[OBS_DYN_STAGE_trace] += parts[i].trace_seconds;
     }
     st->seconds[OBS_DYN_STAGE_trace] += obs__bake_now() - t;
     return OBS_OK;
 }
 
-obs_status obs__dyn_shard_step(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
-                               const obs_dyn_params *p, const obs__bake_bvh *bvh,
-                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
+obs_status obs__dyn_shard_step(obs__part_job *sh, const obs_dyn_desc *desc, uint64_t level,
+                               const obs_dyn_regions *rg, const obs_dyn_params *p,
+                               const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
+                               char err[OBS_ERR_LEN])
 {
     return sh->parts ? read_shards(sh, level, rg, pt, st, err)
-                     : trace_shard(sh, level, rg, p, bvh, pt, st, err);
+                     : trace_shard(sh, desc, level, rg, p, bvh, pt, st, err);
 }

@@ -1,32 +1,14 @@
-/* obs_dyn_bake_shard and obs_dyn_bake_merge (obscura/dynamic.h): the
- * checks of a merge's parts against each other and its parameters, then
- * dynamic.c's steps with dyn_shard.c's step in place of the trace. */
+/* obs_dyn_bake_shard and obs_dyn_bake_merge (obscura/dynamic.h):
+ * level/part.h's drivers over dyn_bake.c's steps with dyn_shard.c's step
+ * in place of the trace and dyn_shard.c's part format; a merge takes the
+ * parts' parameters, all alike, unless given, when they must agree, and
+ * its parts must split the same valid points. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "dynamic/dyn_internal.h"
 #include "level/part.h"
 #include "internal.h"
-
-obs_status obs_dyn_bake_shard(const obs_bake_scene *scene, const obs_dyn_desc *desc, int index,
-                              int count, const char *path, obs_dyn_stats *st,
-                              char err[OBS_ERR_LEN])
-{
-    if (st)
-        memset(st, 0, sizeof *st);
-    obs_status rc = obs__shard_check(index, count, path, err);
-    if (rc != OBS_OK)
-        return rc;
-    obs__dyn_shard sh = {.index = index, .count = count, .path = path,
-                         .progress = desc ? desc->progress : NULL,
-                         .progress_user = desc ? desc->progress_user : NULL};
-    obs_dyn_result r;
-    rc = obs__dyn_bake_run(scene, desc, &sh, &r, err);
-    if (st)
-        *st = r.stats;
-    obs_dyn_result_free(&r);
-    return rc;
-}
 
 /* Parts of one bake also split the same valid points of the same regions. */
 static obs_status same_points(const void *pa, const void *pb, char err[OBS_ERR_LEN])
@@ -40,24 +22,6 @@ static obs_status same_points(const void *pa, const void *pb, char err[OBS_ERR_L
     return OBS_OK;
 }
 
-obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
-                              const char *const *paths, size_t n, obs_dyn_result *out,
-                              char err[OBS_ERR_LEN])
-{
-    memset(out, 0, sizeof *out);
-    void *parts = NULL;
-    obs_status rc = obs__bake_parts_read(paths, n, &obs__dyn_part_format, &parts, err);
-    obs__dyn_part *ordered = parts;
-    obs_dyn_desc d = desc ? *desc : (obs_dyn_desc){0};
-    /* the parameters: the parts' (all alike), unless given, when they must agree */
-    if (rc == OBS_OK)
-        rc = obs__part_adopt(&obs__dyn_part_format, ordered, n, &d.params, same_points, err);
-    if (rc == OBS_OK) {
-        obs__dyn_shard sh = {.index = 0, .count = (int)n, .parts = ordered};
-        rc = obs__dyn_bake_run(scene, &d, &sh, out, err);
-        if (desc)
-            desc->params = d.params;
-    }
-    free(ordered);
-    return rc;
-}
+OBS__PART_DRIVERS(obs_dyn_bake_shard, obs_dyn_bake_merge, obs_dyn_desc, obs_dyn_result,
+                  obs_dyn_stats, obs__dyn_bake_run, obs_dyn_result_free, obs__dyn_part_format,
+                  same_points)

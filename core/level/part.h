@@ -90,6 +90,18 @@ typedef struct obs__part_field {
     size_t member;
     const char *param;
 } obs__part_field;
+/* What a bake does in place of its trace (bake/shard.c's step,
+ * dynamic/dyn_shard.c's): with path, trace shard index of count and
+ * write it there (stop is set: the bake ends after the step); with parts
+ * (count of them: the bake's part structs, in shard order), read every
+ * shard back and go on. */
+typedef struct obs__part_job {
+    int index, count;
+    const char *path;
+    const void *parts;
+    int stop;
+} obs__part_job;
+
 /* The longest header of a part format. */
 #define OBS__PART_HEAD_MAX 128u
 /* A bake's part file: its magic, the names for the messages (`what` and
@@ -142,6 +154,56 @@ obs_status obs__bake_parts_read(const char *const *paths, size_t n, const obs__p
 obs_status obs__part_adopt(const obs__part_format *f, const void *parts, size_t n, void *p,
                            obs_status (*same)(const void *a, const void *b, char err[OBS_ERR_LEN]),
                            char err[OBS_ERR_LEN]);
+
+/* The public shard and merge of a bake that shards, written once for
+ * both (bake/shard_run.c, dynamic/dyn_shard_run.c; the file needs
+ * stdlib.h and string.h):
+ *   SHARD(scene, desc, index, count, path, stats, err): the arguments
+ *   checked (obs__shard_check), then the bake's steps RUN(scene, desc,
+ *   job, result, err) with the job of tracing shard index of count into
+ *   path; *stats (when not NULL) the result's stats, the result freed
+ *   (RESULT_FREE);
+ *   MERGE(scene, desc, paths, n, result, err): the parts read (FORMAT,
+ *   obs__bake_parts_read), their parameters taken into a copy of *desc
+ *   (obs__part_adopt, with SAME), then RUN with the job of reading them
+ *   back; *desc (when not NULL) gets the parameters taken.
+ * DESC, RESULT and STATS are the bake's types; DESC has `params`, RESULT
+ * `stats`. */
+#define OBS__PART_DRIVERS(SHARD, MERGE, DESC, RESULT, STATS, RUN, RESULT_FREE, FORMAT, SAME)  \
+    obs_status SHARD(const obs_bake_scene *scene, const DESC *desc, int index, int count,      \
+                     const char *path, STATS *st, char err[OBS_ERR_LEN])                       \
+    {                                                                                           \
+        if (st)                                                                                 \
+            memset(st, 0, sizeof *st);                                                          \
+        obs_status rc = obs__shard_check(index, count, path, err);                              \
+        if (rc != OBS_OK)                                                                       \
+            return rc;                                                                          \
+        obs__part_job job = {.index = index, .count = count, .path = path};                     \
+        RESULT r;                                                                               \
+        rc = RUN(scene, desc, &job, &r, err);                                                   \
+        if (st)                                                                                 \
+            *st = r.stats;                                                                      \
+        RESULT_FREE(&r);                                                                        \
+        return rc;                                                                              \
+    }                                                                                           \
+    obs_status MERGE(const obs_bake_scene *scene, DESC *desc, const char *const *paths,        \
+                     size_t n, RESULT *out, char err[OBS_ERR_LEN])                              \
+    {                                                                                           \
+        memset(out, 0, sizeof *out);                                                            \
+        void *parts = NULL;                                                                     \
+        obs_status rc = obs__bake_parts_read(paths, n, &(FORMAT), &parts, err);                 \
+        DESC d = desc ? *desc : (DESC){0};                                                      \
+        if (rc == OBS_OK)                                                                       \
+            rc = obs__part_adopt(&(FORMAT), parts, n, &d.params, SAME, err);                    \
+        if (rc == OBS_OK) {                                                                     \
+            obs__part_job job = {.index = 0, .count = (int)n, .parts = parts};                  \
+            rc = RUN(scene, &d, &job, out, err);                                                \
+            if (desc)                                                                           \
+                desc->params = d.params;                                                        \
+        }                                                                                       \
+        free(parts);                                                                            \
+        return rc;                                                                              \
+    }
 
 /* A merge's part (at path) traced from this level: its fingerprint
  * part_level is the level's, level (obs__bake_traced_fingerprint). */
