@@ -17,9 +17,10 @@ typedef struct obs__bake_part {
 } obs__bake_part;
 
 /* bake.c: obs_bake_run's steps with a shard's or a merge's job in place
- * of the trace (sh NULL: obs_bake_run); sh->parts are obs__bake_parts. */
-obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc *desc,
-                               obs__part_job *sh, obs_bake_result *out, char err[OBS_ERR_LEN]);
+ * of the trace (sh NULL: obs_bake_run); sh->parts are obs__bake_parts.
+ * level/part.h's OBS__BAKE_ENTRY. */
+obs_status obs__bake_run_job(const obs_bake_scene *scene, const obs_bake_desc *desc,
+                             obs__part_job *sh, obs_bake_result *out, char err[OBS_ERR_LEN]);
 /* shard.c: the step (p: the bake's resolved parameters); fills st's
  * trace rows (times, rays, samples). */
 obs_status obs__bake_shard_step(obs__part_job *sh, const obs__bake_world *w,

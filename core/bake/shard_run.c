@@ -10,4 +10,4 @@
 #include "internal.h"
 
 OBS__PART_DRIVERS(obs_bake_shard, obs_bake_merge, obs_bake_desc, obs_bake_result, obs_bake_stats,
-                  obs__bake_run_shard, obs_bake_result_free, obs__bake_part_format, NULL)
+                  obs__bake_run_job, obs_bake_result_free, obs__bake_part_format, NULL)

@@ -128,11 +128,11 @@ obs_status obs__dyn_occluders(const obs_bake_scene *scene, const obs__bake_world
                               struct obs__bake_decor *dc, obs__bake_bvh **bvh,
                               char warning[OBS_ERR_LEN], char err[OBS_ERR_LEN]);
 
-/* dynamic.c: obs_dyn_bake's steps with a shard's or a merge's job in
+/* dyn_bake.c: obs_dyn_bake's steps with a shard's or a merge's job in
  * place of the trace of the valid points (sh NULL: obs_dyn_bake);
- * sh->parts are obs__dyn_parts. */
-obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *desc,
-                             obs__part_job *sh, obs_dyn_result *out, char err[OBS_ERR_LEN]);
+ * sh->parts are obs__dyn_parts.  level/part.h's OBS__BAKE_ENTRY. */
+obs_status obs__dyn_run_job(const obs_bake_scene *scene, const obs_dyn_desc *desc,
+                            obs__part_job *sh, obs_dyn_result *out, char err[OBS_ERR_LEN]);
 /* dyn_shard.c: the step, after the points are flagged (pt->count listed,
  * not traced) and before the dropped ones are removed; fills st's trace
  * row.  level: the traced fingerprint (obs__bake_traced_fingerprint),

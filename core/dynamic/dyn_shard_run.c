@@ -23,5 +23,5 @@ static obs_status same_points(const void *pa, const void *pb, char err[OBS_ERR_L
 }
 
 OBS__PART_DRIVERS(obs_dyn_bake_shard, obs_dyn_bake_merge, obs_dyn_desc, obs_dyn_result,
-                  obs_dyn_stats, obs__dyn_bake_run, obs_dyn_result_free, obs__dyn_part_format,
+                  obs_dyn_stats, obs__dyn_run_job, obs_dyn_result_free, obs__dyn_part_format,
                   same_points)

@@ -155,14 +155,55 @@ obs_status obs__part_adopt(const obs__part_format *f, const void *parts, size_t 
                            obs_status (*same)(const void *a, const void *b, char err[OBS_ERR_LEN]),
                            char err[OBS_ERR_LEN]);
 
+/* A bake's entry points, written once for both (bake/bake.c with P bake,
+ * U BAKE; dynamic/dyn_bake.c with P dyn, U DYN; after their STEPS; the
+ * file needs string.h), over its public types obs_P_desc (with
+ * `params`), obs_P_params, obs_P_result (with `stats`), obs_P_stats:
+ *   obs_P_stage_name(stage): the stage's name in OBS_U_STAGE_LIST (rows
+ *   X(name, doc)), "?" out of range;
+ *   obs__P_run_job(scene, desc, job, result, err): the result zeroed,
+ *   desc's parameters resolved (obs_P_params_resolve), then STEPS(scene,
+ *   desc, params, job, result, err), job (NULL: none) in place of the
+ *   trace; a failed result freed (obs_P_result_free) but for its stats
+ *   (what ran, how long);
+ *   RUN(scene, desc, result, err): the public bake, obs__P_run_job
+ *   without a job. */
+#define OBS__BAKE_ENTRY(P, U, RUN, STEPS)                                                       \
+    const char *obs_##P##_stage_name(int stage)                                                 \
+    {                                                                                           \
+        static const char *const names[] = {OBS_##U##_STAGE_LIST(OBS__STAGE_NAME_ROW)};         \
+        return stage >= 0 && stage < OBS_##U##_STAGE_COUNT ? names[stage] : "?";                \
+    }                                                                                           \
+    obs_status obs__##P##_run_job(const obs_bake_scene *scene, const obs_##P##_desc *desc,     \
+                                  obs__part_job *job, obs_##P##_result *out,                    \
+                                  char err[OBS_ERR_LEN])                                        \
+    {                                                                                           \
+        obs_##P##_params p;                                                                     \
+        memset(out, 0, sizeof *out);                                                            \
+        obs_##P##_params_resolve(desc ? &desc->params : NULL, &p);                              \
+        obs_status rc = STEPS(scene, desc, &p, job, out, err);                                  \
+        if (rc != OBS_OK) {                                                                     \
+            obs_##P##_stats keep = out->stats;                                                  \
+            obs_##P##_result_free(out);                                                         \
+            out->stats = keep;                                                                  \
+        }                                                                                       \
+        return rc;                                                                              \
+    }                                                                                           \
+    obs_status RUN(const obs_bake_scene *scene, const obs_##P##_desc *desc,                    \
+                   obs_##P##_result *out, char err[OBS_ERR_LEN])                                \
+    {                                                                                           \
+        return obs__##P##_run_job(scene, desc, NULL, out, err);                                 \
+    }
+#define OBS__STAGE_NAME_ROW(name, doc) #name,
+
 /* The public shard and merge of a bake that shards, written once for
  * both (bake/shard_run.c, dynamic/dyn_shard_run.c; the file needs
  * stdlib.h and string.h):
  *   SHARD(scene, desc, index, count, path, stats, err): the arguments
  *   checked (obs__shard_check), then the bake's steps RUN(scene, desc,
- *   job, result, err) with the job of tracing shard index of count into
- *   path; *stats (when not NULL) the result's stats, the result freed
- *   (RESULT_FREE);
+ *   job, result, err) (its OBS__BAKE_ENTRY's RUN_JOB) with the job of
+ *   tracing shard index of count into path; *stats (when not NULL) the
+ *   result's stats, the result freed (RESULT_FREE);
  *   MERGE(scene, desc, paths, n, result, err): the parts read (FORMAT,
  *   obs__bake_parts_read), their parameters taken into a copy of *desc
  *   (obs__part_adopt, with SAME), then RUN with the job of reading them
