@@ -37,7 +37,6 @@ typedef struct bake_req {
     char ext[16];                 /* format=EXT */
     obs_bake_params params;
     obsd_bake_sub sub;            /* GET .../events */
-    int subscribed;
     obsd__events events;
     struct MHD_PostProcessor *pp; /* a multipart body, split as it comes */
     parts *parts;                 /* its parts */
@@ -339,21 +338,22 @@ static int next_event(req *r, char *buf, size_t len)
     return obsd_bakes_next_event(r->srv->bakes, &bk->sub, buf, len);
 }
 
-static enum MHD_Result events(req *r)
+/* The job's subscriber (obsd__events_open): an unknown job is 404, one
+ * the daemon is dropping (shutting down) 503. */
+static int join(req *r, enum MHD_Result *rc)
 {
     bake_req *bk = r->own;
-    obsd_http *h = r->srv;
-    if (atomic_load(&h->draining))
-        return obsd__answer_shutting_down(r);
     bk->sub = (obsd_bake_sub){.park = obsd__events_park, .wake = obsd__events_wake, .arg = r};
-    int rc = obsd_bakes_subscribe(h->bakes, bk->id, &bk->sub);
-    if (rc == -1)
-        return unknown(r);
-    if (rc != 0)
-        return obsd__answer_shutting_down(r);
-    bk->subscribed = 1;
-    bk->events.next = next_event;
-    return obsd__events_answer(r, &bk->events);
+    int s = obsd_bakes_subscribe(r->srv->bakes, bk->id, &bk->sub);
+    if (s != 0)
+        *rc = s == -1 ? unknown(r) : obsd__answer_shutting_down(r);
+    return s == 0;
+}
+
+static void leave(req *r)
+{
+    bake_req *bk = r->own;
+    obsd_bakes_unsubscribe(r->srv->bakes, &bk->sub);
 }
 
 /* ---- the routes ------------------------------------------------------------- */
@@ -443,7 +443,7 @@ enum MHD_Result obsd__bakes_start(req *r, const char *url)
     case OP_RESULT:
         return result(r);
     default:
-        return events(r);
+        return obsd__events_open(r, &bk->events, join, next_event, leave);
     }
 }
 
@@ -452,8 +452,7 @@ void obsd__bakes_done(req *r)
     bake_req *bk = r->own;
     if (!bk)
         return;
-    if (bk->subscribed)
-        obsd_bakes_unsubscribe(r->srv->bakes, &bk->sub);
+    obsd__events_close(r, &bk->events);
     if (bk->pp)
         MHD_destroy_post_processor(bk->pp);
     if (bk->parts) {

@@ -110,9 +110,12 @@ typedef struct obsd__frame_req {
 
 /* An event stream's answer (http_events.c): `next` writes the source's
  * next event into buf and returns its length; 0: none yet (the source
- * parked the connection, obsd__events_park, and wakes it); -1: the end. */
+ * parked the connection, obsd__events_park, and wakes it); -1: the end.
+ * `leave` unsubscribes the request from its source (set while it is
+ * subscribed). */
 typedef struct obsd__events {
     int (*next)(struct obsd__req *r, char *buf, size_t len);
+    void (*leave)(struct obsd__req *r);
     struct obsd__req *r;
     char buf[512];
     int len, off;
@@ -279,9 +282,17 @@ void obsd__bakes_done(obsd__req *r);
  * resume its connection. */
 void obsd__events_park(void *arg);
 void obsd__events_wake(void *arg);
-/* Answers 200 text/event-stream with the events of ev->next (ev, which
- * must live as long as the request, is set up by the caller); REQ_EVENTS. */
-enum MHD_Result obsd__events_answer(obsd__req *r, obsd__events *ev);
+/* An event route's answer (ev lives as long as the request): 503 while
+ * the daemon drains; else join subscribes the request to its source
+ * (with obsd__events_park and _wake; 0 and its own answer in *rc when it
+ * cannot), and the answer is 200 text/event-stream with the events of
+ * next (REQ_EVENTS), until obsd__events_close calls leave. */
+enum MHD_Result obsd__events_open(obsd__req *r, obsd__events *ev,
+                                  int (*join)(obsd__req *r, enum MHD_Result *rc),
+                                  int (*next)(obsd__req *r, char *buf, size_t len),
+                                  void (*leave)(obsd__req *r));
+/* The request's subscription ended, when it has one (its route's done). */
+void obsd__events_close(obsd__req *r, obsd__events *ev);
 
 /* ---- http_info.c, http_page.c ---- */
 
