@@ -15,7 +15,7 @@
 #include "binary.h"
 #include "binary_server.h"
 #include "job.h"
-#include "log.h"
+#include "../../../daemon/log.h" /* core/log.h shadows it: -Icore comes first */
 
 static char dir[64], sock_path[96];
 
