@@ -125,6 +125,7 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
 {
     const obs__gtao_state *g = obs__gtao_of(f);
     const size_t plane = (size_t)f->width * (size_t)f->height * 4;
+    const float fw[3] = {g->falloff[0], g->falloff[1], g->thin_power[0]}; /* intervals */
     float hc = low;
     for (int st = 0; st < g->steps; st++) {
         float base = (float)(slice + st * g->steps) * GTAO_R1;
@@ -141,7 +142,7 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
             q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
             if (end) /* intervals: the surface continued, solid behind it */
-                obs__gtao_column(f, side, q, NULL, 0, q ? 1 : 0, x, y, self, qx, qy, c, v, low);
+                obs__gtao_column(f, fw, side, q, NULL, 0, q ? 1 : 0, x, y, self, qx, qy, c, v, low);
             if (!q)
                 continue;
             hc = fmaxf(hc, sample_cos(g, q, c, v, low,
@@ -151,8 +152,8 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         (*taken)++;
         q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
         if (end) { /* intervals: the step's column (gtao_deep.c) */
-            hc = fmaxf(hc, obs__gtao_column(f, side, q, end + (size_t)qy * f->width + qx, plane,
-                                            layers, x, y, self, qx, qy, c, v, low));
+            hc = fmaxf(hc, obs__gtao_column(f, fw, side, q, end + (size_t)qy * f->width + qx,
+                                            plane, layers, x, y, self, qx, qy, c, v, low));
             continue;
         }
         for (int k = 0; k < layers; k++)

@@ -56,7 +56,6 @@
 #include <math.h>
 
 #include "chain/mask_weight.h"
-#include "methods/gtao.h"
 #include "methods/gtao_deep.h"
 
 static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
@@ -65,16 +64,16 @@ static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1
 /* The horizon cosine of the point c + d moved from the tangent's `low`
  * by its falloff weight times om, as sample_cos in gtao.c; low where d
  * is 0. */
-static float weighted_cos(const obs__gtao_state *g, const float d[3], const float v[3], float low,
+static float weighted_cos(const float fw[3], const float d[3], const float v[3], float low,
                           float om)
 {
     float dist = sqrtf(dot3(d, d));
     if (!(dist > 0.0f))
         return low;
     float shc = dot3(d, v) / dist;
-    float dz = d[2] * (1.0f + g->thin_power[0]); /* thin-occluder compensation */
+    float dz = d[2] * (1.0f + fw[2]); /* thin-occluder compensation */
     float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
-    float w = clampf(fb * g->falloff[0] + g->falloff[1], 0.0f, 1.0f) * om;
+    float w = clampf(fb * fw[0] + fw[1], 0.0f, 1.0f) * om;
     return low + (shc - low) * w;
 }
 
@@ -115,11 +114,10 @@ void obs__gtao_side_start(obs__gtao_side *s, const float c[3])
     s->t[0][1] = s->m[0][1] = (float)M_PI;
 }
 
-float obs__gtao_column(const obs__frame *f, obs__gtao_side *s, const float *q, const float *end,
-                       size_t plane, int layers, int x, int y, int self, int qx, int qy,
-                       const float c[3], const float v[3], float low)
+float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s, const float *q,
+                       const float *end, size_t plane, int layers, int x, int y, int self, int qx,
+                       int qy, const float c[3], const float v[3], float low)
 {
-    const obs__gtao_state *g = obs__gtao_of(f);
     float gz[OBS__GTAO_MAX_GAPS][2], gt[OBS__GTAO_MAX_GAPS][2], gm[OBS__GTAO_MAX_GAPS][2];
     float hc = low, cz = 0.0f, ct = 0.0f, cm = 0.0f; /* the free range open from depth cz */
     int ng = 0, open = 1, last = -1;
@@ -135,7 +133,7 @@ float obs__gtao_column(const obs__frame *f, obs__gtao_side *s, const float *q, c
             continue; /* empty, or inside a nearer node's interval */
         const float om = obs__occluder_weight_node(f, x, y, self, qx, qy, k);
         const float d[3] = {qk[0] - c[0], qk[1] - c[1], qk[2] - c[2]};
-        const float cf = weighted_cos(g, d, v, low, om);
+        const float cf = weighted_cos(fw, d, v, low, om);
         if (e == 0.0f)
             hc = fmaxf(hc, cf); /* solid behind: the horizon form */
         if (!open)
@@ -157,7 +155,7 @@ float obs__gtao_column(const obs__frame *f, obs__gtao_side *s, const float *q, c
         obs__px_ndc(f, qx, qy, ndc);
         obs__view_ray(f->proj, ndc, o, dir);
         const float db[3] = {o[0] + e * dir[0] - c[0], o[1] + e * dir[1] - c[1], -e - c[2]};
-        const float mb = acosf(clampf(weighted_cos(g, db, v, low, om), -1.0f, 1.0f));
+        const float mb = acosf(clampf(weighted_cos(fw, db, v, low, om), -1.0f, 1.0f));
         add_arc(s, fminf(mf, mb), fmaxf(mf, mb));
         cz = e;
         ct = true_angle(db, v, low);

@@ -33,7 +33,8 @@ typedef struct obs__gtao_side {
  * leaving c starts. */
 void obs__gtao_side_start(obs__gtao_side *s, const float c[3]);
 
-/* The column of one step at pixel (qx, qy) ((x, y, self): the
+/* The column of one step at pixel (qx, qy) (fw: method gtao's falloff
+ * mul and add and gtao_thin, obs__gtao_state's; (x, y, self): the
  * receiver's pixel and node, for the object masks): `layers` nodes at q,
  * q + plane floats, ... (view xyz, planar depth w; w 0 empty) with their
  * interval ends at end[0], end[plane / 4], ... (obs__deep_intervals; end
@@ -44,9 +45,9 @@ void obs__gtao_side_start(obs__gtao_side *s, const float c[3]);
  * none), as side_horizon in gtao.c takes it.  layers 0: a column with no
  * surface (background, or off the image with no estimate).  GLSL:
  * gtao_column in gtao.glsl. */
-float obs__gtao_column(const obs__frame *f, obs__gtao_side *s, const float *q, const float *end,
-                       size_t plane, int layers, int x, int y, int self, int qx, int qy,
-                       const float c[3], const float v[3], float low);
+float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s, const float *q,
+                       const float *end, size_t plane, int layers, int x, int y, int self, int qx,
+                       int qy, const float c[3], const float v[3], float low);
 
 /* A_slice / |n_p| over the free arcs: the inner integral of Jimenez et
  * al. (the closed form gtao.c cites) over the part of [h0, h1] (the
