@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "chain/bands_run.h"
 #include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
 #include "log.h"
@@ -93,7 +94,8 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
     }
     /* the planes' allocation counts as the upload, as GL's textures do */
     double t0 = times ? now_ms() : 0.0;
-    s = obs__cpu_planes_take(&c, err);
+    const int bands = obs__bands_rows(&c, opt); /* 0: the whole frame; else bands_run.c */
+    s = bands ? OBS_OK : obs__cpu_planes_take(&c, err);
     if (s == OBS_OK)
         s = obs__alloc_result(out, pl.f.width, pl.f.height, pl.outputs, err);
     if (times) {
@@ -101,7 +103,7 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
         times->total_ms += now_ms() - t0;
     }
     if (s == OBS_OK)
-        s = walk(&c, times, err);
+        s = bands ? obs__bands_run(&c, bands, opt, times, err) : walk(&c, times, err);
     if (s == OBS_OK)
         s = obs__multibounce_finish(pl.gb, pl.multibounce, pl.asked, out, err);
     if (s == OBS_OK)

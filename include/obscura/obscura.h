@@ -295,6 +295,14 @@ typedef struct obs_cpu_options {
      * longer (the clock read between passes and between the AO pass's
      * tiles, so at most one tile past it); 0: no deadline */
     double deadline;
+    /* bytes the chain's planes may take (about 56 a pixel at the default
+     * parameters): a frame that needs more runs in bands of rows, each
+     * holding its rows and the halo its samples reach (the same result,
+     * the input and the result still whole); 0: a quarter of the
+     * machine's physical memory */
+    size_t max_memory;
+    /* > 0: bands of this many rows whatever the frame's size (tests) */
+    int band_rows;
 } obs_cpu_options;
 
 obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
