@@ -907,6 +907,31 @@ static int read_baked(const ao_args *a, const obs_limits *lim, const obs_gbuffer
     return EXIT_OK;
 }
 
+/* The CPU device's memory budget for the chain's planes, from
+ * OBSCURA_MAX_MEMORY (MiB; over it the frame runs in bands of rows), and
+ * OBSCURA_BAND_ROWS (bands of that many rows whatever the size: tests,
+ * benchmarks); a value that is not a positive count is said and left
+ * out (the default: a quarter of the machine's memory, whole frames). */
+static void cpu_bands_from_env(obs_cpu_options *o)
+{
+    static const char *const names[] = {"OBSCURA_MAX_MEMORY", "OBSCURA_BAND_ROWS"};
+    for (int k = 0; k < 2; k++) {
+        const char *v = getenv(names[k]);
+        if (!v || !*v)
+            continue;
+        char *end;
+        long n = strtol(v, &end, 10);
+        if (*end || n <= 0 || n > (k == 0 ? 1L << 30 : 1L << 20)) {
+            fprintf(stderr, "obscura: warning: %s=%s is not a positive count; left out\n", names[k], v);
+            continue;
+        }
+        if (k == 0)
+            o->max_memory = (size_t)n << 20;
+        else
+            o->band_rows = (int)n;
+    }
+}
+
 /* The chain on the CPU twin, on obscurad (--server) or on a GL context
  * (kept across a batch's frames); *t0 restarts once the context exists. */
 static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, const char *server,
@@ -916,6 +941,7 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
     obs_status s;
     if (a->cpu) {
         obs_cpu_options o = {.log = log_cb};
+        cpu_bands_from_env(&o);
         s = obs_run_cpu_opts(&gf->gb, &a->req.params, outputs, res, &o, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, res);
