@@ -252,18 +252,24 @@ static void band_readback(obs__cpu_run *c, const band *b)
         memcpy(out->bleed.data + 3 * o, c->bleed + 3 * o, 3 * n * sizeof(float));
 }
 
+/* The rows band b's planes hold (passes_cpu.h). */
+static void band_rows_of(obs__cpu_run *c, const band *b)
+{
+    c->row0 = b->a0;
+    c->row1 = b->a1;
+    c->hrow0 = b->a0 / 2;
+    c->hrow1 = clampi((b->a1 + 1) / 2, 0, c->pl->af->height);
+    c->crow0 = b->t0;
+    c->crow1 = b->t1;
+}
+
 /* One band: its planes, then every pass of the table that runs, each
  * on its window. */
 static obs_status band_run(obs__cpu_run *c, const band *b, obs_pass_times *t,
                            char err[OBS_ERR_LEN])
 {
     const obs__plan *pl = c->pl;
-    c->row0 = b->a0;
-    c->row1 = b->a1;
-    c->hrow0 = b->a0 / 2;
-    c->hrow1 = clampi((b->a1 + 1) / 2, 0, pl->af->height);
-    c->crow0 = b->t0;
-    c->crow1 = b->t1;
+    band_rows_of(c, b);
     double t0 = t ? now_ms() : 0.0;
     obs_status s = obs__cpu_planes_take(c, err);
     if (t) {
@@ -324,10 +330,10 @@ int obs__bands_rows(obs__cpu_run *c, const obs_cpu_options *opt)
     size_t need = obs__cpu_planes_need(c), budget = obs__bands_budget(opt);
     if (need <= budget)
         return 0;
-    /* the first try: the budget's rows less a halo either side as large
-     * as the band (band_plan's shrinking corrects it) */
+    /* the first try: half the budget's rows (obs__bands_run fits each
+     * band to the budget from its halo) */
     size_t per_row = need / (size_t)pl->f.height + 1;
-    int rows = (int)(budget / per_row / 3);
+    int rows = (int)(budget / per_row / 2);
     return rows > OBS__BANDS_MIN_ROWS ? rows : OBS__BANDS_MIN_ROWS;
 }
 
@@ -355,19 +361,42 @@ obs_status obs__bands_run(obs__cpu_run *c, int rows, const obs_cpu_options *opt,
     const int forced = opt && opt->band_rows > 0;
     const size_t budget = obs__bands_budget(opt);
     obs_status s = OBS_OK;
+    int warned = 0;
     for (int c0 = 0, k = 1; s == OBS_OK && c0 < H; k++) {
         int n = rows;
         band b;
-        for (;;) { /* shrink the band until its planes fit the budget */
+        for (int tries = 0;; tries++) { /* the band's rows until its planes fit the budget */
             band_plan(pl, reach, c0, c0 + n < H ? c0 + n : H, &b);
-            c->row0 = b.a0;
-            c->row1 = b.a1;
-            c->hrow0 = b.a0 / 2;
-            c->hrow1 = clampi((b.a1 + 1) / 2, 0, pl->af->height);
-            c->crow0 = b.t0;
-            c->crow1 = b.t1;
-            if (forced || n <= OBS__BANDS_MIN_ROWS || obs__cpu_planes_need(c) <= budget)
+            band_rows_of(c, &b);
+            size_t need = obs__cpu_planes_need(c);
+            if (forced || need <= budget || n <= OBS__BANDS_MIN_ROWS || tries > 32)
                 break;
+            /* the rows the budget holds, less the halo the band reads */
+            const int held = b.a1 - b.a0, halo = (held - (b.c1 - b.c0) + 1) / 2;
+            const int fit = (int)((double)budget / (double)need * held) - 2 * halo;
+            if (fit >= OBS__BANDS_MIN_ROWS && fit < n) {
+                n = fit;
+                continue;
+            }
+            if (fit < OBS__BANDS_MIN_ROWS) {
+                /* the halo alone is over the budget: bands as tall as the
+                 * halo, so each band's prep runs over at most three times
+                 * its rows */
+                if (!warned++ && opt && opt->log) {
+                    char msg[224];
+                    snprintf(msg, sizeof msg, "the AO's samples reach %d rows either side: a band "
+                             "holds more than the memory budget (%.0f MiB)", halo,
+                             (double)budget / 1048576.0);
+                    opt->log(opt->log_user, OBS_LOG_WARN, msg);
+                }
+                int m = halo > OBS__BANDS_MIN_ROWS ? halo : OBS__BANDS_MIN_ROWS;
+                if (m < n) {
+                    n = m;
+                    band_plan(pl, reach, c0, c0 + n < H ? c0 + n : H, &b);
+                    band_rows_of(c, &b);
+                }
+                break;
+            }
             n /= 2;
         }
         band_log(opt, k, &b, H, obs__cpu_planes_need(c));
