@@ -102,6 +102,28 @@ obs_status obs_gbuffer_read_exr_mem(const void *buf, size_t len,
 /* Frees storage and zeroes *f; NULL-safe. */
 void obs_gbuffer_free(obs_gbuffer_file *f);
 
+/* A G-buffer EXR read by rows, for a frame that is never whole in memory
+ * (obs_run_cpu_rows).  obs_gbuffer_rows_open reads the header and
+ * resolves the channels as obs_gbuffer_read_exr does, no pixels: meta->gb
+ * is the frame (size, windows, camera, conventions) with its planes' data
+ * NULL and their channels set (1, 3 for normals, 4 for colour when the
+ * file has them; no position pass), meta->info as the reader fills it.
+ * A view whose channels lie in several parts is refused
+ * (OBS_UNSUPPORTED).  Close with obs_gbuffer_rows_close(). */
+typedef struct obs_gbuffer_rows obs_gbuffer_rows;
+obs_status obs_gbuffer_rows_open(const char *path, const obs_channel_map *map, const obs_limits *lim,
+                                 obs_gbuffer_rows **rows, obs_gbuffer_file *meta, char err[OBS_ERR_LEN]);
+
+/* Rows [y0, y1) of the data window: *out is the frame with its planes'
+ * data at row y0 (packed rows; rows outside the range are not there),
+ * valid until the next read or the close.  Only the chunks holding those
+ * rows are decoded (lim->threads threads). */
+obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *rows, int y0, int y1, obs_gbuffer *out,
+                                 char err[OBS_ERR_LEN]);
+
+/* NULL-safe. */
+void obs_gbuffer_rows_close(obs_gbuffer_rows *rows);
+
 /* The renderer, camera (and its source, cross-check and warnings) of part
  * `part` of an EXR, flat or deep, as the readers find them: fills those
  * fields of *info and *cam. */
