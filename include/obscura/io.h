@@ -342,6 +342,24 @@ typedef struct obs_exr_options {
     int threads;
 } obs_exr_options;
 
+/* A plain EXR output written by rows, for a frame never whole in memory
+ * (obs_run_cpu_rows): obs_exr_rows_open writes the header of an image of
+ * layers' width and `height` rows, layers' channels and names (the
+ * images' rows are not written here; the names must live until the
+ * close), as obs_exr_write_ex with `opt` (a source given by path, no
+ * append; OBS_UNSUPPORTED otherwise); obs_exr_rows_write takes the next
+ * rows, every layer's image holding the same count (written a batch of
+ * chunks at a time, the same bytes as obs_exr_write_ex of the whole
+ * image); obs_exr_rows_close finishes the file when st is OBS_OK and
+ * every row came (else the file is removed, as a failed write's is) and
+ * frees the writer; it returns the status. */
+typedef struct obs_exr_rows obs_exr_rows;
+obs_status obs_exr_rows_open(const char *path, const obs_exr_layer *layers, int layer_count, int height,
+                             const obs_exr_options *opt, obs_exr_rows **out, char err[OBS_ERR_LEN]);
+obs_status obs_exr_rows_write(obs_exr_rows *w, const obs_exr_layer *layers, int layer_count,
+                              char err[OBS_ERR_LEN]);
+obs_status obs_exr_rows_close(obs_exr_rows *w, obs_status st, char err[OBS_ERR_LEN]);
+
 /* obs_exr_write() with options (NULL: as zeroed). */
 obs_status obs_exr_write_ex(const char *path, const obs_exr_layer *layers, int layer_count,
                             const obs_exr_options *opt, char err[OBS_ERR_LEN]);
