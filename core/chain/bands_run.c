@@ -33,6 +33,7 @@
 
 #include "chain/bands_cpu.h"
 #include "chain/bands_run.h"
+#include "chain/multibounce.h"
 #include "chain/vao_cpu.h"
 #include "log.h"
 #include "methods/gtao.h"
@@ -102,6 +103,7 @@ static int sample_reach(const obs__frame *af, const float p[3], int all)
 
 typedef struct reach_job {
     const obs__plan *pl;
+    const obs_gbuffer *gb; /* its depth read by the frame's rows */
     int *reach; /* per full row, in rows at the AO's size */
 } reach_job;
 
@@ -109,7 +111,7 @@ static void reach_rows(void *ctx, int y0, int y1)
 {
     const reach_job *j = ctx;
     const obs__frame *f = &j->pl->f, *af = j->pl->af;
-    const obs_gbuffer *gb = j->pl->gb;
+    const obs_gbuffer *gb = j->gb;
     for (int y = y0; y < y1; y++) {
         const float *depth = obs__plane_px(&gb->depth, f->width, 0, y);
         const size_t dc = (size_t)gb->depth.channels;
@@ -127,11 +129,10 @@ static void reach_rows(void *ctx, int y0, int y1)
 }
 
 /* The reach of each row at the AO's size (the larger of a half row's two
- * full rows with ao_resolution half), into reach[af->height]. */
-static void row_reach(const obs__plan *pl, int *full, int *reach)
+ * full rows with ao_resolution half), into reach[af->height], from each
+ * full row's in full[] (reach_rows). */
+static void row_reach(const obs__plan *pl, const int *full, int *reach)
 {
-    reach_job j = {pl, full};
-    obs__cpu_rows(pl->f.height, 0, reach_rows, &j);
     for (int y = 0; y < pl->af->height; y++) {
         int r = full[pl->f.half ? 2 * y : y];
         if (pl->f.half && 2 * y + 1 < pl->f.height && full[2 * y + 1] > r)
@@ -347,17 +348,21 @@ static void band_log(const obs_cpu_options *opt, int k, const band *b, int H, si
     opt->log(opt->log_user, OBS_LOG_INFO, msg);
 }
 
-obs_status obs__bands_run(obs__cpu_run *c, int rows, const obs_cpu_options *opt,
-                          obs_pass_times *t, char err[OBS_ERR_LEN])
+/* What a band does before and after its passes: nothing for a frame in
+ * memory (obs__bands_run); the rows read and the result's rows handed
+ * on for a frame by rows (obs_run_cpu_rows). */
+typedef struct band_io {
+    obs_status (*in)(struct band_io *io, obs__cpu_run *c, const band *b, char err[OBS_ERR_LEN]);
+    obs_status (*out)(struct band_io *io, obs__cpu_run *c, const band *b, char err[OBS_ERR_LEN]);
+} band_io;
+
+/* Every band of c's plan, from the rows' reach (reach[], at the AO's
+ * size). */
+static obs_status bands_loop(obs__cpu_run *c, int rows, const int *reach, const obs_cpu_options *opt,
+                             obs_pass_times *t, band_io *io, char err[OBS_ERR_LEN])
 {
     const obs__plan *pl = c->pl;
     const int H = pl->f.height;
-    int *full = malloc(sizeof(int) * ((size_t)H + (size_t)pl->af->height));
-    if (!full)
-        return obs__fail(err, OBS_NO_MEMORY, "out of memory for the bands of a %dx%d frame",
-                         pl->f.width, H);
-    int *reach = full + H;
-    row_reach(pl, full, reach);
     const int forced = opt && opt->band_rows > 0;
     const size_t budget = obs__bands_budget(opt);
     obs_status s = OBS_OK;
@@ -400,20 +405,209 @@ obs_status obs__bands_run(obs__cpu_run *c, int rows, const obs_cpu_options *opt,
             n /= 2;
         }
         band_log(opt, k, &b, H, obs__cpu_planes_need(c));
-        s = band_run(c, &b, t, err);
+        if (io)
+            s = io->in(io, c, &b, err);
+        if (s == OBS_OK)
+            s = band_run(c, &b, t, err);
+        if (s == OBS_OK && io)
+            s = io->out(io, c, &b, err);
         c0 = b.c1;
     }
-    free(full);
     c->row0 = c->row1 = 0;
-    if (s != OBS_OK)
-        return s;
-    /* the readback's neutral planes (cpu_readback, passes_cpu.c) */
-    obs_result *out = c->out;
+    return s;
+}
+
+/* The readback's neutral planes (cpu_readback, passes_cpu.c) of an
+ * image of n pixels. */
+static void neutral_planes(const obs__plan *pl, obs_result *out, size_t n)
+{
     if (out->bleed.data && pl->f.half)
-        for (size_t i = 0; i < c->npx * 3; i++)
+        for (size_t i = 0; i < n * 3; i++)
             out->bleed.data[i] = 1.0f;
     if (out->luminance.data && !pl->f.luminance)
-        for (size_t i = 0; i < c->npx; i++)
+        for (size_t i = 0; i < n; i++)
             out->luminance.data[i] = 1.0f;
+}
+
+obs_status obs__bands_run(obs__cpu_run *c, int rows, const obs_cpu_options *opt,
+                          obs_pass_times *t, char err[OBS_ERR_LEN])
+{
+    const obs__plan *pl = c->pl;
+    const int H = pl->f.height;
+    int *full = malloc(sizeof(int) * ((size_t)H + (size_t)pl->af->height));
+    if (!full)
+        return obs__fail(err, OBS_NO_MEMORY, "out of memory for the bands of a %dx%d frame",
+                         pl->f.width, H);
+    reach_job j = {pl, pl->gb, full};
+    obs__cpu_rows(H, 0, reach_rows, &j);
+    row_reach(pl, full, full + H);
+    obs_status s = bands_loop(c, rows, full + H, opt, t, NULL, err);
+    free(full);
+    if (s == OBS_OK)
+        neutral_planes(pl, c->out, c->npx);
+    return s;
+}
+
+/* ---- a frame by rows (obs_run_cpu_rows) ------------------------------------ */
+
+/* The images a band's result can hold. */
+#define BAND_IMAGES 8
+static void result_images(obs_result *r, obs_image *img[BAND_IMAGES])
+{
+    obs_image *list[BAND_IMAGES] = {&r->ao,   &r->composite, &r->sample_count, &r->cull_mask,
+                                    &r->bleed, &r->luminance, &r->bent,        &r->multibounce};
+    memcpy(img, list, sizeof list);
+}
+
+typedef struct rows_io {
+    band_io io;
+    obs__plan *pl;
+    obs_rows_in_fn in;
+    obs_rows_out_fn out;
+    void *user;
+    obs_gbuffer gb;   /* the band's rows, its planes' data at the frame's row 0 */
+    obs_result held;  /* the band's result over the rows it holds (allocated) */
+    obs_result at0;   /* the same images, data at the frame's row 0 */
+} rows_io;
+
+/* A gbuffer of rows [y0, ...) as the source gives it, with its planes'
+ * data at the frame's row 0. */
+static void rows_at0(obs_gbuffer *gb, int y0)
+{
+    obs_plane *planes[] = {&gb->depth, &gb->normal, &gb->color};
+    for (int i = 0; i < 3; i++)
+        if (planes[i]->data) {
+            size_t row = planes[i]->row_stride ? planes[i]->row_stride
+                                               : (size_t)gb->width * (size_t)planes[i]->channels * sizeof(float);
+            planes[i]->data = (const float *)(const void *)((const char *)planes[i]->data - (size_t)y0 * row);
+        }
+}
+
+static obs_status rows_fetch(rows_io *r, int y0, int y1, char err[OBS_ERR_LEN])
+{
+    obs_gbuffer g;
+    memset(&g, 0, sizeof g);
+    obs_status s = r->in(r->user, y0, y1, &g, err);
+    if (s != OBS_OK)
+        return s;
+    if (g.width != r->pl->f.width || g.height != r->pl->f.height || !g.depth.data ||
+        !g.normal.data != !r->gb.normal.data || !g.color.data != !r->gb.color.data)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "rows %d-%d are not the frame's (%dx%d, the same planes)",
+                         y0, y1, r->pl->f.width, r->pl->f.height);
+    rows_at0(&g, y0);
+    r->gb = g;
     return OBS_OK;
+}
+
+static obs_status rows_in(band_io *io, obs__cpu_run *c, const band *b, char err[OBS_ERR_LEN])
+{
+    rows_io *r = (rows_io *)io;
+    obs_status s = rows_fetch(r, b->a0, b->a1, err);
+    if (s != OBS_OK)
+        return s;
+    r->pl->gb = &r->gb;
+    /* the result of the rows held, its images' data at the frame's row 0 */
+    s = obs__alloc_result(&r->held, r->pl->f.width, b->a1 - b->a0, r->pl->outputs, err);
+    if (s != OBS_OK)
+        return s;
+    r->at0 = r->held;
+    obs_image *img[BAND_IMAGES];
+    result_images(&r->at0, img);
+    for (int i = 0; i < BAND_IMAGES; i++)
+        if (img[i]->data)
+            img[i]->data -= (size_t)b->a0 * (size_t)img[i]->width * (size_t)img[i]->channels;
+    c->out = &r->at0;
+    return OBS_OK;
+}
+
+/* The band's own rows: copied out of the rows held, finished as the
+ * whole frame's result is (multi-bounce, bent normals, neutral planes),
+ * handed on. */
+static obs_status rows_out(band_io *io, obs__cpu_run *c, const band *b, char err[OBS_ERR_LEN])
+{
+    rows_io *r = (rows_io *)io;
+    const obs__plan *pl = r->pl;
+    const int n = b->c1 - b->c0;
+    obs_result part;
+    obs_status s = obs__alloc_result(&part, pl->f.width, n, pl->outputs, err);
+    obs_image *from[BAND_IMAGES], *to[BAND_IMAGES];
+    result_images(&r->held, from);
+    result_images(&part, to);
+    for (int i = 0; s == OBS_OK && i < BAND_IMAGES; i++)
+        if (to[i]->data)
+            memcpy(to[i]->data,
+                   from[i]->data + (size_t)(b->c0 - b->a0) * (size_t)from[i]->width * (size_t)from[i]->channels,
+                   (size_t)n * (size_t)to[i]->width * (size_t)to[i]->channels * sizeof(float));
+    obs_result_free(&r->held);
+    c->out = NULL;
+    obs_gbuffer view = r->gb; /* the band's rows, for the multi-bounce fit's colour */
+    view.height = n;
+    rows_at0(&view, -b->c0);
+    if (s == OBS_OK)
+        s = obs__multibounce_finish(&view, pl->multibounce, pl->asked, &part, err);
+    if (s == OBS_OK) {
+        obs__bent_finish(pl, &part);
+        neutral_planes(pl, &part, (size_t)n * (size_t)pl->f.width);
+        s = r->out(r->user, b->c0, b->c1, &part, err);
+    }
+    obs_result_free(&part);
+    return s;
+}
+
+obs_status obs_run_cpu_rows(const obs_gbuffer *frame, obs_rows_in_fn in, obs_rows_out_fn out, void *user,
+                            const obs_params *params, unsigned outputs, const obs_cpu_options *opt,
+                            char err[OBS_ERR_LEN])
+{
+    static const float present = 0.0f; /* a plane the frame has, for the plan: never read */
+    obs__plan pl;
+    obs__cpu_run c = {0};
+    obs_log_fn log = opt ? opt->log : NULL;
+    obs__log_sink sink = {log, opt ? opt->log_user : NULL};
+    if (!frame || !in || !out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_run_cpu_rows: no frame, source or sink");
+    if (frame->receivers.data || frame->occluders.data || frame->object_id.data)
+        return obs__fail(err, OBS_UNSUPPORTED, "object masks need the frame in memory (obs_run_cpu)");
+    obs_gbuffer head = *frame;
+    head.depth.data = &present;
+    head.normal.data = frame->normal.channels > 0 ? &present : NULL;
+    head.color.data = frame->color.channels > 0 ? &present : NULL;
+    head.position = (obs_plane){NULL, 0, 0};
+    head.depth.row_stride = head.normal.row_stride = head.color.row_stride = 0;
+    if (opt && opt->deadline > 0.0)
+        c.deadline_ms = now_ms() + opt->deadline * 1e3;
+    atomic_init(&c.stopped, 0);
+    obs_status s = obs__plan_init(&pl, log ? obs__log_only_ctx(&sink) : NULL, &head, params, outputs, err);
+    if (s != OBS_OK)
+        return s;
+    c.pl = &pl;
+    c.npx = (size_t)pl.f.width * (size_t)pl.f.height;
+    const int H = pl.f.height;
+    int rows = H < OBS__BANDS_MIN_HEIGHT ? H : obs__bands_rows(&c, opt);
+    if (rows <= 0) /* whole, as one band */
+        rows = H;
+    rows_io r = {{rows_in, rows_out}, &pl, in, out, user};
+    r.gb = head;
+    int *full = malloc(sizeof(int) * ((size_t)H + (size_t)pl.af->height));
+    if (!full)
+        return obs__fail(err, OBS_NO_MEMORY, "out of memory for the bands of a %dx%d frame", pl.f.width, H);
+    /* the rows' reach, from the depth, a few rows at a time */
+    const int step = OBS__BANDS_REACH_ROWS;
+    for (int y0 = 0; s == OBS_OK && y0 < H; y0 += step) {
+        const int y1 = y0 + step < H ? y0 + step : H;
+        s = rows_fetch(&r, y0, y1, err);
+        if (s != OBS_OK)
+            break;
+        obs__cpu_window w = {{H}, {y0}, {y1}};
+        const obs__cpu_window *old = obs__cpu_window_set(&w);
+        reach_job j = {&pl, &r.gb, full};
+        obs__cpu_rows(H, 0, reach_rows, &j);
+        obs__cpu_window_set(old);
+    }
+    if (s == OBS_OK) {
+        row_reach(&pl, full, full + H);
+        s = bands_loop(&c, rows, full + H, opt, NULL, &r.io, err);
+    }
+    obs_result_free(&r.held);
+    free(full);
+    return s;
 }

@@ -10,6 +10,9 @@
 /* Frames under this many rows run whole; bands are not cut smaller. */
 #define OBS__BANDS_MIN_HEIGHT 64
 #define OBS__BANDS_MIN_ROWS 16
+/* obs_run_cpu_rows reads the depth this many rows at a time for the
+ * rows' reach, before the bands. */
+#define OBS__BANDS_REACH_ROWS 256
 
 /* The bytes the chain's planes may take: opt->max_memory, else a quarter
  * of the machine's physical memory. */

@@ -169,6 +169,121 @@ static void test_whole_when_small(void **state)
     obs_result_free(&r);
 }
 
+/* ---- a frame by rows (obs_run_cpu_rows) ---------------------------------- */
+
+typedef struct rows_job {
+    const obs_gbuffer *gb; /* the source's frame */
+    obs_result whole;      /* the rows handed out, gathered */
+    int next;              /* the row the next hand-out must start at */
+    int asked;             /* the source's calls */
+} rows_job;
+
+static obs_status give_rows(void *user, int y0, int y1, obs_gbuffer *rows, char err[OBS_ERR_LEN])
+{
+    rows_job *j = user;
+    (void)err;
+    assert_true(0 <= y0 && y0 < y1 && y1 <= j->gb->height);
+    j->asked++;
+    *rows = *j->gb;
+    const size_t w = (size_t)rows->width;
+    rows->depth.data += (size_t)y0 * w * (size_t)rows->depth.channels;
+    if (rows->normal.data)
+        rows->normal.data += (size_t)y0 * w * 3;
+    if (rows->color.data)
+        rows->color.data += (size_t)y0 * w * 4;
+    return OBS_OK;
+}
+
+static obs_status take_rows(void *user, int y0, int y1, const obs_result *rows, char err[OBS_ERR_LEN])
+{
+    rows_job *j = user;
+    (void)err;
+    assert_int_equal(y0, j->next);
+    j->next = y1;
+    const obs_image *from[] = {&rows->ao, &rows->composite, &rows->bent, &rows->multibounce, &rows->luminance};
+    obs_image *to[] = {&j->whole.ao, &j->whole.composite, &j->whole.bent, &j->whole.multibounce,
+                       &j->whole.luminance};
+    for (int i = 0; i < 5; i++) {
+        if (!from[i]->data)
+            continue;
+        assert_int_equal(from[i]->height, y1 - y0);
+        size_t row = (size_t)from[i]->width * (size_t)from[i]->channels;
+        if (!to[i]->data) {
+            *to[i] = *from[i];
+            to[i]->height = j->gb->height;
+            to[i]->data = calloc(row * (size_t)j->gb->height, sizeof(float));
+        }
+        memcpy(to[i]->data + (size_t)y0 * row, from[i]->data, (size_t)(y1 - y0) * row * sizeof(float));
+    }
+    return OBS_OK;
+}
+
+/* The frame by rows from memory: the whole frame's bytes, in bands of 16
+ * and 37 rows and in a budget, the source asked band by band. */
+static void check_rows(const char *method, const char *const *set, unsigned outputs)
+{
+    obs_params p = {0};
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_param_set(&p, "method", method, err), OBS_OK);
+    for (int k = 0; set && set[k]; k += 2)
+        assert_int_equal(obs_param_set(&p, set[k], set[k + 1], err), OBS_OK);
+    obs_result whole;
+    assert_int_equal(obs_run_cpu(&room.gb, &p, outputs, &whole, err), OBS_OK);
+    obs_gbuffer frame = room.gb;
+    frame.depth.data = frame.normal.data = frame.color.data = NULL; /* the header only */
+    const size_t third = (size_t)room.gb.width * (size_t)room.gb.height * 56 / 3;
+    const obs_cpu_options opts[] = {{.band_rows = 16}, {.band_rows = 37}, {.max_memory = third}};
+    for (int k = 0; k < 3; k++) {
+        rows_job j = {&room.gb};
+        if (obs_run_cpu_rows(&frame, give_rows, take_rows, &j, &p, outputs, &opts[k], err) != OBS_OK)
+            fail_msg("%s by rows: %s", method, err);
+        assert_int_equal(j.next, room.gb.height);
+        assert_true(j.asked >= 3); /* the depth once, then band by band */
+        same_image(&j.whole.ao, &whole.ao, method, "by rows");
+        same_image(&j.whole.composite, &whole.composite, method, "by rows");
+        same_image(&j.whole.bent, &whole.bent, method, "by rows");
+        same_image(&j.whole.multibounce, &whole.multibounce, method, "by rows");
+        same_image(&j.whole.luminance, &whole.luminance, method, "by rows");
+        obs_result_free(&j.whole);
+    }
+    obs_result_free(&whole);
+}
+
+static void test_by_rows(void **state)
+{
+    static const char *const half[] = {"ao_resolution", "half", "luminance", "lum", NULL};
+    static const char *const mb[] = {"multibounce", "on", NULL};
+    (void)state;
+    for (int m = 0; m < obs__method_count(); m++)
+        check_rows(obs__method_at(m)->name, NULL, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_BENT);
+    check_rows("vaopp", half, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_LUMINANCE);
+    check_rows("vaopp", mb, OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_MULTIBOUNCE);
+}
+
+/* A failing source or sink stops the run with its status; masks are
+ * refused. */
+static obs_status no_rows(void *user, int y0, int y1, obs_gbuffer *rows, char err[OBS_ERR_LEN])
+{
+    (void)user, (void)y0, (void)y1, (void)rows;
+    return obs_status_fail(err, OBS_IO, "the disk went away");
+}
+
+static void test_by_rows_failures(void **state)
+{
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    obs_gbuffer frame = room.gb;
+    frame.depth.data = frame.normal.data = frame.color.data = NULL;
+    rows_job j = {&room.gb};
+    obs_cpu_options o = {.band_rows = 32};
+    assert_int_equal(obs_run_cpu_rows(&frame, no_rows, take_rows, &j, NULL, OBS_OUTPUT_AO, &o, err), OBS_IO);
+    assert_non_null(strstr(err, "went away"));
+    float w = 1.0f;
+    frame.receivers = (obs_plane){&w, 1, 0};
+    assert_int_equal(obs_run_cpu_rows(&frame, give_rows, take_rows, &j, NULL, OBS_OUTPUT_AO, &o, err),
+                     OBS_UNSUPPORTED);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -176,6 +291,8 @@ int main(void)
         cmocka_unit_test(test_chain_variants),
         cmocka_unit_test(test_near_camera),
         cmocka_unit_test(test_whole_when_small),
+        cmocka_unit_test(test_by_rows),
+        cmocka_unit_test(test_by_rows_failures),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
