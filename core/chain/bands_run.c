@@ -310,6 +310,8 @@ static obs_status band_run(obs__cpu_run *c, const band *b, obs_pass_times *t,
     return s;
 }
 
+size_t obs_cpu_memory_budget(const obs_cpu_options *opt) { return obs__bands_budget(opt); }
+
 size_t obs__bands_budget(const obs_cpu_options *opt)
 {
     if (opt && opt->max_memory > 0)

@@ -308,6 +308,10 @@ typedef struct obs_cpu_options {
 obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                             obs_result *out, const obs_cpu_options *opt, char err[OBS_ERR_LEN]);
 
+/* The memory budget of opt (NULL: the default): opt->max_memory, else a
+ * quarter of the machine's physical memory. */
+size_t obs_cpu_memory_budget(const obs_cpu_options *opt);
+
 /* A frame that is never whole in memory, on the CPU device: run in bands
  * of rows as obs_run_cpu_opts runs a frame over its memory budget (the
  * same result, byte for byte), each band's rows of the G-buffer asked of
