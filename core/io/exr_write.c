@@ -409,6 +409,24 @@ static obs_status plain_windows(const obs_exr_options *o, exr_const_context_t sr
     return OBS_OK;
 }
 
+/* The path, the pixel type, the layers and the compression of a write
+ * (the compression unless appending, which keeps the input's). */
+static obs_status check_write(const char *path, const obs_exr_options *o, const obs_exr_layer *layers,
+                              int layer_count, int *longnames, char err[OBS_ERR_LEN])
+{
+    char sub[OBS_ERR_LEN] = "";
+    obs_status st;
+    if (!path || !*path)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no EXR path given");
+    if (o->pixel != OBS_EXR_HALF && o->pixel != OBS_EXR_FLOAT)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: unknown pixel type %d", path, (int)o->pixel);
+    if ((st = check_layers(layers, layer_count, longnames, err)) != OBS_OK)
+        return st;
+    if (!o->append && (st = obs_exr_compression_check(o->compression, sub)) != OBS_OK)
+        return obs__fail(err, st, "%s: %s", path, sub);
+    return OBS_OK;
+}
+
 /* The status of the library's rv while `what` (the input's attribute
  * attr, when not NULL), its message into sub. */
 static obs_status write_status(exr_result_t rv, const char *what, const char *attr, char sub[OBS_ERR_LEN])
@@ -449,14 +467,8 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
 
     if (!o)
         o = &zero;
-    if (!path || !*path)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "no EXR path given");
-    if (o->pixel != OBS_EXR_HALF && o->pixel != OBS_EXR_FLOAT)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: unknown pixel type %d", path, (int)o->pixel);
-    if ((st = check_layers(layers, layer_count, &longnames, err)) != OBS_OK)
+    if ((st = check_write(path, o, layers, layer_count, &longnames, err)) != OBS_OK)
         return st;
-    if (!o->append && (st = obs_exr_compression_check(o->compression, sub)) != OBS_OK)
-        return obs__fail(err, st, "%s: %s", path, sub);
     if (o->append && !o->src)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: appending needs the input file", path);
     exr_pixel_type_t type = o->pixel == OBS_EXR_FLOAT ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
@@ -619,16 +631,10 @@ obs_status obs_exr_rows_open(const char *path, const obs_exr_layer *layers, int 
     obs__prov prov;
 
     *out = NULL;
-    if (!path || !*path)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "no EXR path given");
-    if (o->pixel != OBS_EXR_HALF && o->pixel != OBS_EXR_FLOAT)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: unknown pixel type %d", path, (int)o->pixel);
-    if ((st = check_layers(layers, layer_count, &longnames, err)) != OBS_OK)
+    if ((st = check_write(path, o, layers, layer_count, &longnames, err)) != OBS_OK)
         return st;
     if (layer_count > OBS_RESULT_LAYERS + 4 || o->append || (o->src && !o->src->path) || height <= 0)
         return obs__fail(err, OBS_UNSUPPORTED, "%s: written by rows: a plain output of a file's rows only", path);
-    if ((st = obs_exr_compression_check(o->compression, sub)) != OBS_OK)
-        return obs__fail(err, st, "%s: %s", path, sub);
     obs_exr_rows *w = calloc(1, sizeof *w);
     if (!w)
         return obs__fail(err, OBS_NO_MEMORY, "%s: a writer", path);
