@@ -622,8 +622,9 @@ struct obs_gbuffer_rows {
     obs__channel_match m;
     const char **names; /* point into ctx */
     obs_gbuffer gb;     /* the frame; planes NULL */
-    float *buf;         /* the rows last read */
-    size_t cap;         /* floats buf holds */
+    float *buf;         /* the rows last read: each plane cap_rows rows */
+    int cap_rows;
+    int h0, h1;         /* the data window's rows buf holds (chunk rows) */
 };
 
 /* With rows: the header, part and channels into *rows, no pixels (a view
@@ -823,6 +824,29 @@ obs_status obs_gbuffer_rows_open(const char *path, const obs_channel_map *map, c
     return OBS_OK;
 }
 
+/* Decodes rows [y0, y1) (chunk rows) into the reader's buffer, whose row
+ * 0 is the data window's row h0. */
+static obs_status rows_decode(obs_gbuffer_rows *r, int h0, int y0, int y1, char err[OBS_ERR_LEN])
+{
+    const part_geom *g = &r->g;
+    if (y0 >= y1)
+        return OBS_OK;
+    const size_t plane = (size_t)g->width * (size_t)r->cap_rows, w = (size_t)g->width;
+    const int has_n = r->gb.normal.channels > 0, has_c = r->gb.color.channels > 0;
+    float *depth = r->buf, *normal = has_n ? depth + plane : NULL;
+    float *color = has_c ? depth + plane * (size_t)(1 + 3 * has_n) : NULL;
+    if (has_c && r->m.color[3] < 0) /* colour without alpha is opaque */
+        for (size_t i = (size_t)(y0 - h0) * w; i < (size_t)(y1 - h0) * w; i++)
+            color[i * 4 + 3] = 1.0f;
+    /* the targets' row 0 is the data window's: h0 rows before the buffer */
+    const size_t back = (size_t)h0 * w;
+    target t[11];
+    int idx[11];
+    int nt = gbuffer_targets(r->names, &r->m, depth - back, normal ? normal - 3 * back : NULL,
+                             color ? color - 4 * back : NULL, NULL, t, idx);
+    return decode_rows(r->ctx, r->part, g, t, nt, &r->lim, y0, y1, err);
+}
+
 obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *r, int y0, int y1, obs_gbuffer *out,
                                  char err[OBS_ERR_LEN])
 {
@@ -835,39 +859,55 @@ obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *r, int y0, int y1, obs_gbuffe
     obs_status st = chunk_lines(r->ctx, r->part, g, &lines, &tw, err);
     if (st != OBS_OK)
         return st;
-    /* the rows of the chunks holding [y0, y1): the targets hold them all */
-    const int c0 = y0 / lines * lines;
-    const int c1 = (int)((((int64_t)y1 + lines - 1) / lines) * lines < g->height
-                             ? (((int64_t)y1 + lines - 1) / lines) * lines
-                             : g->height);
+    /* the rows of the chunks holding [y0, y1) */
+    const int n0 = y0 / lines * lines;
+    const int64_t up = ((int64_t)y1 + lines - 1) / lines * lines;
+    const int n1 = up < g->height ? (int)up : g->height;
     const int has_n = r->gb.normal.channels > 0, has_c = r->gb.color.channels > 0;
-    const size_t px = (size_t)g->width * (size_t)(c1 - c0), need = px * (size_t)(1 + 3 * has_n + 4 * has_c);
-    if (need > r->cap) {
+    const int per_px = 1 + 3 * has_n + 4 * has_c;
+    const size_t w = (size_t)g->width;
+    /* the rows held before that are asked again (the bands go down the
+     * frame, each with a halo over the last one's): kept, not decoded */
+    int k0 = r->h1 > r->h0 && n0 >= r->h0 && n0 < r->h1 ? n0 : n1;
+    int k1 = k0 < n1 ? (r->h1 < n1 ? r->h1 : n1) : n1;
+    if (n1 - n0 > r->cap_rows) { /* a larger buffer: the kept rows copied over */
+        float *nb = calloc((size_t)(n1 - n0) * w * (size_t)per_px, sizeof(float));
+        if (!nb)
+            return obs__fail(err, OBS_NO_MEMORY, "%d rows of a %dx%d G-buffer", n1 - n0, g->width,
+                             g->height);
+        const size_t oplane = w * (size_t)r->cap_rows, nplane = w * (size_t)(n1 - n0);
+        for (int c = 0, at = 0; k1 > k0 && c < 3; c++) {
+            const int ch = c == 0 ? 1 : c == 1 ? 3 * has_n : 4 * has_c;
+            if (ch)
+                memcpy(nb + nplane * (size_t)at + (size_t)(k0 - n0) * w * (size_t)ch,
+                       r->buf + oplane * (size_t)at + (size_t)(k0 - r->h0) * w * (size_t)ch,
+                       (size_t)(k1 - k0) * w * (size_t)ch * sizeof(float));
+            at += ch;
+        }
         free(r->buf);
-        r->cap = 0;
-        if (!(r->buf = calloc(need, sizeof(float))))
-            return obs__fail(err, OBS_NO_MEMORY, "%zu rows of a %dx%d G-buffer", (size_t)(c1 - c0),
-                             g->width, g->height);
-        r->cap = need;
+        r->buf = nb;
+        r->cap_rows = n1 - n0;
+    } else if (k1 > k0 && k0 != r->h0) { /* in place, towards the start */
+        const size_t plane = w * (size_t)r->cap_rows;
+        for (int c = 0, at = 0; c < 3; c++) {
+            const int ch = c == 0 ? 1 : c == 1 ? 3 * has_n : 4 * has_c;
+            if (ch)
+                memmove(r->buf + plane * (size_t)at + (size_t)(k0 - n0) * w * (size_t)ch,
+                        r->buf + plane * (size_t)at + (size_t)(k0 - r->h0) * w * (size_t)ch,
+                        (size_t)(k1 - k0) * w * (size_t)ch * sizeof(float));
+            at += ch;
+        }
     }
-    float *depth = r->buf, *normal = has_n ? depth + px : NULL;
-    float *color = has_c ? depth + px * (size_t)(1 + 3 * has_n) : NULL;
-    if (has_c && r->m.color[3] < 0) /* colour without alpha is opaque */
-        for (size_t i = 0; i < px; i++)
-            color[i * 4 + 3] = 1.0f;
-    /* the targets' row 0 is the data window's: c0 rows before the buffer */
-    const size_t back = (size_t)c0 * (size_t)g->width;
-    target t[11];
-    int idx[11];
-    int nt = gbuffer_targets(r->names, &r->m, depth - back, normal ? normal - 3 * back : NULL,
-                             color ? color - 4 * back : NULL, NULL, t, idx);
-    if ((st = decode_rows(r->ctx, r->part, g, t, nt, &r->lim, y0, y1, err)) != OBS_OK)
+    r->h0 = r->h1 = 0;
+    if ((st = rows_decode(r, n0, n0, k0, err)) != OBS_OK || (st = rows_decode(r, n0, k1, n1, err)) != OBS_OK)
         return st;
-    const size_t skip = (size_t)(y0 - c0) * (size_t)g->width;
+    r->h0 = n0;
+    r->h1 = n1;
+    const size_t plane = w * (size_t)r->cap_rows, skip = (size_t)(y0 - n0) * w;
     *out = r->gb;
-    out->depth.data = depth + skip;
-    out->normal.data = normal ? normal + 3 * skip : NULL;
-    out->color.data = color ? color + 4 * skip : NULL;
+    out->depth.data = r->buf + skip;
+    out->normal.data = has_n ? r->buf + plane + 3 * skip : NULL;
+    out->color.data = has_c ? r->buf + plane * (size_t)(1 + 3 * has_n) + 4 * skip : NULL;
     return OBS_OK;
 }
 
