@@ -870,33 +870,31 @@ obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *r, int y0, int y1, obs_gbuffe
      * frame, each with a halo over the last one's): kept, not decoded */
     int k0 = r->h1 > r->h0 && n0 >= r->h0 && n0 < r->h1 ? n0 : n1;
     int k1 = k0 < n1 ? (r->h1 < n1 ? r->h1 : n1) : n1;
-    if (n1 - n0 > r->cap_rows) { /* a larger buffer: the kept rows copied over */
-        float *nb = calloc((size_t)(n1 - n0) * w * (size_t)per_px, sizeof(float));
+    if (n1 - n0 > r->cap_rows) {
+        /* a larger buffer (grown in place where the allocator can: the
+         * old and the new are not held at once), each plane's kept rows
+         * moved to its new place, the last plane first */
+        float *nb = realloc(r->buf, (size_t)(n1 - n0) * w * (size_t)per_px * sizeof(float));
         if (!nb)
             return obs__fail(err, OBS_NO_MEMORY, "%d rows of a %dx%d G-buffer", n1 - n0, g->width,
                              g->height);
-        const size_t oplane = w * (size_t)r->cap_rows, nplane = w * (size_t)(n1 - n0);
-        for (int c = 0, at = 0; k1 > k0 && c < 3; c++) {
-            const int ch = c == 0 ? 1 : c == 1 ? 3 * has_n : 4 * has_c;
-            if (ch)
-                memcpy(nb + nplane * (size_t)at + (size_t)(k0 - n0) * w * (size_t)ch,
-                       r->buf + oplane * (size_t)at + (size_t)(k0 - r->h0) * w * (size_t)ch,
-                       (size_t)(k1 - k0) * w * (size_t)ch * sizeof(float));
-            at += ch;
-        }
-        free(r->buf);
         r->buf = nb;
+        const size_t oplane = w * (size_t)r->cap_rows, nplane = w * (size_t)(n1 - n0);
+        const int chs[3] = {1, 3 * has_n, 4 * has_c}, at[3] = {0, 1, 1 + 3 * has_n};
+        for (int c = 2; k1 > k0 && c >= 0; c--)
+            if (chs[c])
+                memmove(nb + nplane * (size_t)at[c] + (size_t)(k0 - n0) * w * (size_t)chs[c],
+                        nb + oplane * (size_t)at[c] + (size_t)(k0 - r->h0) * w * (size_t)chs[c],
+                        (size_t)(k1 - k0) * w * (size_t)chs[c] * sizeof(float));
         r->cap_rows = n1 - n0;
     } else if (k1 > k0 && k0 != r->h0) { /* in place, towards the start */
         const size_t plane = w * (size_t)r->cap_rows;
-        for (int c = 0, at = 0; c < 3; c++) {
-            const int ch = c == 0 ? 1 : c == 1 ? 3 * has_n : 4 * has_c;
-            if (ch)
-                memmove(r->buf + plane * (size_t)at + (size_t)(k0 - n0) * w * (size_t)ch,
-                        r->buf + plane * (size_t)at + (size_t)(k0 - r->h0) * w * (size_t)ch,
-                        (size_t)(k1 - k0) * w * (size_t)ch * sizeof(float));
-            at += ch;
-        }
+        const int chs[3] = {1, 3 * has_n, 4 * has_c}, at[3] = {0, 1, 1 + 3 * has_n};
+        for (int c = 0; c < 3; c++)
+            if (chs[c])
+                memmove(r->buf + plane * (size_t)at[c] + (size_t)(k0 - n0) * w * (size_t)chs[c],
+                        r->buf + plane * (size_t)at[c] + (size_t)(k0 - r->h0) * w * (size_t)chs[c],
+                        (size_t)(k1 - k0) * w * (size_t)chs[c] * sizeof(float));
     }
     r->h0 = r->h1 = 0;
     if ((st = rows_decode(r, n0, n0, k0, err)) != OBS_OK || (st = rows_decode(r, n0, k1, n1, err)) != OBS_OK)
