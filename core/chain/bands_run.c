@@ -266,13 +266,15 @@ static void band_rows_of(obs__cpu_run *c, const band *b)
 
 /* One band: its planes, then every pass of the table that runs, each
  * on its window. */
-static obs_status band_run(obs__cpu_run *c, const band *b, obs_pass_times *t,
+static obs_status band_run(obs__cpu_run *c, obs__plan *pl, const band *b, obs_pass_times *t,
                            char err[OBS_ERR_LEN])
 {
-    const obs__plan *pl = c->pl;
     band_rows_of(c, b);
     double t0 = t ? now_ms() : 0.0;
     obs_status s = obs__cpu_planes_take(c, err);
+    /* object masks at half resolution: the band's half planes */
+    pl->hf.mask_occl = c->hmask_w;
+    pl->hf.mask_id = c->hmask_id;
     if (t) {
         t->ms[OBS_PASS_UPLOAD] += now_ms() - t0;
         t->total_ms += now_ms() - t0;
@@ -360,10 +362,10 @@ typedef struct band_io {
 
 /* Every band of c's plan, from the rows' reach (reach[], at the AO's
  * size). */
-static obs_status bands_loop(obs__cpu_run *c, int rows, const int *reach, const obs_cpu_options *opt,
-                             obs_pass_times *t, band_io *io, char err[OBS_ERR_LEN])
+static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int *reach,
+                             const obs_cpu_options *opt, obs_pass_times *t, band_io *io,
+                             char err[OBS_ERR_LEN])
 {
-    const obs__plan *pl = c->pl;
     const int H = pl->f.height;
     const int forced = opt && opt->band_rows > 0;
     const size_t budget = obs__bands_budget(opt);
@@ -410,7 +412,7 @@ static obs_status bands_loop(obs__cpu_run *c, int rows, const int *reach, const 
         if (io)
             s = io->in(io, c, &b, err);
         if (s == OBS_OK)
-            s = band_run(c, &b, t, err);
+            s = band_run(c, pl, &b, t, err);
         if (s == OBS_OK && io)
             s = io->out(io, c, &b, err);
         c0 = b.c1;
@@ -431,10 +433,9 @@ static void neutral_planes(const obs__plan *pl, obs_result *out, size_t n)
             out->luminance.data[i] = 1.0f;
 }
 
-obs_status obs__bands_run(obs__cpu_run *c, int rows, const obs_cpu_options *opt,
+obs_status obs__bands_run(obs__cpu_run *c, obs__plan *pl, int rows, const obs_cpu_options *opt,
                           obs_pass_times *t, char err[OBS_ERR_LEN])
 {
-    const obs__plan *pl = c->pl;
     const int H = pl->f.height;
     int *full = malloc(sizeof(int) * ((size_t)H + (size_t)pl->af->height));
     if (!full)
@@ -443,7 +444,7 @@ obs_status obs__bands_run(obs__cpu_run *c, int rows, const obs_cpu_options *opt,
     reach_job j = {pl, pl->gb, full};
     obs__cpu_rows(H, 0, reach_rows, &j);
     row_reach(pl, full, full + H);
-    obs_status s = bands_loop(c, rows, full + H, opt, t, NULL, err);
+    obs_status s = bands_loop(c, pl, rows, full + H, opt, t, NULL, err);
     free(full);
     if (s == OBS_OK)
         neutral_planes(pl, c->out, c->npx);
@@ -607,7 +608,7 @@ obs_status obs_run_cpu_rows(const obs_gbuffer *frame, obs_rows_in_fn in, obs_row
     }
     if (s == OBS_OK) {
         row_reach(&pl, full, full + H);
-        s = bands_loop(&c, rows, full + H, opt, NULL, &r.io, err);
+        s = bands_loop(&c, &pl, rows, full + H, opt, NULL, &r.io, err);
     }
     obs_result_free(&r.held);
     free(full);

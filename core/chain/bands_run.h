@@ -23,11 +23,12 @@ size_t obs__bands_budget(const obs_cpu_options *opt);
  * fit the budget, else a count from the budget. */
 int obs__bands_rows(obs__cpu_run *c, const obs_cpu_options *opt);
 
-/* Runs c's plan band by band into c->out (allocated, whole): bands of
+/* Runs c's plan (pl, which each band's half-size mask planes are set
+ * in) band by band into c->out (allocated, whole): bands of
  * `rows` rows, each shrunk (halved, down to OBS__BANDS_MIN_ROWS) until
  * its planes fit the budget unless opt->band_rows forces the count;
  * each band said through opt->log.  With t, the passes' times summed. */
-obs_status obs__bands_run(obs__cpu_run *c, int rows, const obs_cpu_options *opt,
+obs_status obs__bands_run(obs__cpu_run *c, obs__plan *pl, int rows, const obs_cpu_options *opt,
                           obs_pass_times *t, char err[OBS_ERR_LEN]);
 
 #endif

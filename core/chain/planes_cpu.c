@@ -40,7 +40,7 @@ static void *take(size_t need, size_t *size)
 }
 
 /* The bytes of each plane of c's frame (or band), in planes' order. */
-#define PLANES 13
+#define PLANES 15
 static size_t plane_sizes(const obs__cpu_run *c, size_t sizes[PLANES])
 {
     const obs__frame *f = &c->pl->f, *af = c->pl->af;
@@ -59,6 +59,7 @@ static size_t plane_sizes(const obs__cpu_run *c, size_t sizes[PLANES])
         bleed ? lines(n * 3) : 0, col ? lines(n * 4) : 0,
         f->half ? lines(an * 4) : 0, f->half ? lines(an * 3) : 0, f->half ? lines(an) : 0,
         f->half ? lines(an) : 0, f->half && bleed ? lines(an * 3) : 0, lines(an * 2),
+        f->half && f->mask_occl ? lines(an) : 0, f->half && f->mask_id ? lines(an) : 0,
     };
     size_t need = 0;
     for (int i = 0; i < PLANES; i++)
@@ -77,8 +78,9 @@ obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN])
     const obs__frame *f = &c->pl->f, *af = c->pl->af;
     size_t sizes[PLANES];
     const size_t need = plane_sizes(c, sizes);
-    float **planes[PLANES] = {&c->pos,  &c->nrm,  &c->ao,  &c->tmp,  &c->est,  &c->bleed,
-                              &c->col,  &c->hpos, &c->hnrm, &c->hao, &c->htmp, &c->hbleed, &c->dnz};
+    float **planes[PLANES] = {&c->pos,  &c->nrm,  &c->ao,   &c->tmp,  &c->est,    &c->bleed,
+                              &c->col,  &c->hpos, &c->hnrm, &c->hao,  &c->htmp,   &c->hbleed,
+                              &c->dnz,  &c->hmask_w, &c->hmask_id};
     unsigned char *b = take(need, &c->block_size);
     if (!b)
         return obs__fail(err, OBS_NO_MEMORY, "out of memory for a %dx%d frame", f->width,
@@ -90,7 +92,7 @@ obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN])
     }
     if (c->row1 > 0) { /* a band: each plane's pointer at the frame's row 0 */
         const size_t fw = (size_t)f->width * (size_t)c->row0, hw = (size_t)af->width * (size_t)c->hrow0;
-        const int per_px[PLANES] = {4, 3, 1, 1, 0, 3, 4, 4, 3, 1, 1, 3, 2};
+        const int per_px[PLANES] = {4, 3, 1, 1, 0, 3, 4, 4, 3, 1, 1, 3, 2, 1, 1};
         for (int i = 0; i < PLANES; i++)
             if (*planes[i] && i != 4) /* the half-size planes, and dnz at half size */
                 *planes[i] -= (size_t)per_px[i] * (i >= 7 && (f->half || i != 12) ? hw : fw);

@@ -149,6 +149,34 @@ static void test_near_camera(void **state)
     free(depth);
 }
 
+/* Object masks (receivers, occluders, self_only's object IDs) read at the
+ * samples, full and half resolution: the whole frame's bytes in bands. */
+static void test_masks(void **state)
+{
+    static const char *const self[] = {"self_only", "on", NULL};
+    static const char *const half[] = {"self_only", "on", "ao_resolution", "half", NULL};
+    (void)state;
+    const int w = room.gb.width, h = room.gb.height;
+    float *planes = malloc(sizeof(float) * 3 * (size_t)w * (size_t)h);
+    assert_non_null(planes);
+    float *recv = planes, *occl = planes + (size_t)w * h, *id = planes + 2 * (size_t)w * h;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            recv[i] = x < w / 2 ? 1.0f : 0.5f;
+            occl[i] = (x / 16 + y / 16) % 2 ? 1.0f : 0.25f;
+            id[i] = (float)(x / 40 + 10 * (y / 50));
+        }
+    obs_gbuffer masked = room.gb;
+    masked.receivers = (obs_plane){recv, 1, 0};
+    masked.occluders = (obs_plane){occl, 1, 0};
+    masked.object_id = (obs_plane){id, 1, 0};
+    check_gb(&masked, "vaopp", self, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE);
+    check_gb(&masked, "vaopp", half, OBS_OUTPUT_AO);
+    check_gb(&masked, "hbao", NULL, OBS_OUTPUT_AO);
+    free(planes);
+}
+
 /* A frame under OBS__BANDS_MIN_HEIGHT rows, or bands as tall as the
  * frame, run whole (no band said). */
 static void test_whole_when_small(void **state)
@@ -290,6 +318,7 @@ int main(void)
         cmocka_unit_test(test_every_method),
         cmocka_unit_test(test_chain_variants),
         cmocka_unit_test(test_near_camera),
+        cmocka_unit_test(test_masks),
         cmocka_unit_test(test_whole_when_small),
         cmocka_unit_test(test_by_rows),
         cmocka_unit_test(test_by_rows_failures),
