@@ -867,9 +867,11 @@ obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *r, int y0, int y1, obs_gbuffe
     const int per_px = 1 + 3 * has_n + 4 * has_c;
     const size_t w = (size_t)g->width;
     /* the rows held before that are asked again (the bands go down the
-     * frame, each with a halo over the last one's): kept, not decoded */
-    int k0 = r->h1 > r->h0 && n0 >= r->h0 && n0 < r->h1 ? n0 : n1;
-    int k1 = k0 < n1 ? (r->h1 < n1 ? r->h1 : n1) : n1;
+     * frame, each with a halo over the last one's): kept, not decoded;
+     * the rows before and after them decoded */
+    int k0 = n0 > r->h0 ? n0 : r->h0, k1 = n1 < r->h1 ? n1 : r->h1;
+    if (!(r->h1 > r->h0 && k0 < k1))
+        k0 = k1 = n1; /* nothing kept */
     if (n1 - n0 > r->cap_rows) {
         /* a larger buffer (grown in place where the allocator can: the
          * old and the new are not held at once), each plane's kept rows
@@ -887,7 +889,7 @@ obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *r, int y0, int y1, obs_gbuffe
                         nb + oplane * (size_t)at[c] + (size_t)(k0 - r->h0) * w * (size_t)chs[c],
                         (size_t)(k1 - k0) * w * (size_t)chs[c] * sizeof(float));
         r->cap_rows = n1 - n0;
-    } else if (k1 > k0 && k0 != r->h0) { /* in place, towards the start */
+    } else if (k1 > k0 && n0 != r->h0) { /* in place (memmove: either way within a plane) */
         const size_t plane = w * (size_t)r->cap_rows;
         const int chs[3] = {1, 3 * has_n, 4 * has_c}, at[3] = {0, 1, 1 + 3 * has_n};
         for (int c = 0; c < 3; c++)
