@@ -1170,6 +1170,16 @@ static int ao_rows(ao_args *a, const obs_limits *lim)
         return -1;
     }
     print_input_info(a->in, &meta.info, &meta.gb);
+    /* the colour only where the chain reads it: the rows half the size
+     * with RGBA otherwise */
+    obs_params rp;
+    obs_params_resolve(p, &rp);
+    if (!(a->req.outputs & (OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_LUMINANCE |
+                            OBS_OUTPUT_BLEED)) &&
+        rp.luminance == OBS_LUMINANCE_OFF && rp.bleeding == OBS_BLEEDING_OFF && rp.multibounce != OBS_ON) {
+        obs_gbuffer_rows_no_color(j.rows);
+        meta.gb.color = (obs_plane){NULL, 0, 0};
+    }
     if (verbosity >= OBS_LOG_INFO)
         fprintf(stderr, "obscura: info: %dx%d needs about %.0f MiB read whole: read, run and written by "
                         "rows (the input's sanity checks, which read the whole frame, are left out)\n",

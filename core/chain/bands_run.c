@@ -262,6 +262,12 @@ static void band_rows_of(obs__cpu_run *c, const band *b)
     c->hrow1 = clampi((b->a1 + 1) / 2, 0, c->pl->af->height);
     c->crow0 = b->t0;
     c->crow1 = b->t1;
+    /* the AO's planes: the rows the AO and the blur compute; at half
+     * resolution the full-size AO only the upsample's rows (the band's) */
+    c->arow0 = c->pl->f.half ? b->c0 : b->b0;
+    c->arow1 = c->pl->f.half ? b->c1 : b->b1;
+    c->harow0 = b->b0;
+    c->harow1 = b->b1;
 }
 
 /* One band: its planes, then every pass of the table that runs, each

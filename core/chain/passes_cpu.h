@@ -29,6 +29,10 @@ typedef struct obs__cpu_run {
      * passes index the planes by the frame's coordinates.  row1 0: the
      * whole frame */
     int row0, row1, hrow0, hrow1, crow0, crow1;
+    /* ... of those, the rows the AO's planes hold (ao, tmp, bleed at full
+     * size; hao, htmp, hbleed at half size): the rows the AO, the blur
+     * and the passes after them compute, not the halo */
+    int arow0, arow1, harow0, harow1;
     void *block;                                    /* where the planes are */
     size_t block_size;
     /* the deadline (CLOCK_MONOTONIC ms; 0: none); stopped: a tile found

@@ -911,6 +911,16 @@ obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *r, int y0, int y1, obs_gbuffe
     return OBS_OK;
 }
 
+void obs_gbuffer_rows_no_color(obs_gbuffer_rows *r)
+{
+    r->gb.color = (obs_plane){NULL, 0, 0};
+    for (int i = 0; i < 4; i++)
+        r->m.color[i] = -1;
+    free(r->buf); /* the rows' layout changes: nothing held */
+    r->buf = NULL;
+    r->cap_rows = r->h0 = r->h1 = 0;
+}
+
 void obs_gbuffer_rows_close(obs_gbuffer_rows *r)
 {
     if (!r)

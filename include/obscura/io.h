@@ -121,6 +121,12 @@ obs_status obs_gbuffer_rows_open(const char *path, const obs_channel_map *map, c
 obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *rows, int y0, int y1, obs_gbuffer *out,
                                  char err[OBS_ERR_LEN]);
 
+/* Leaves the colour out of the reads from now on (a chain that reads no
+ * colour: no composite, luminance, bleeding or multi-bounce), which
+ * halves the bytes of a row with RGBA; the frame given to the chain must
+ * then have no colour plane either. */
+void obs_gbuffer_rows_no_color(obs_gbuffer_rows *rows);
+
 /* NULL-safe. */
 void obs_gbuffer_rows_close(obs_gbuffer_rows *rows);
 
