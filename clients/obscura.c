@@ -1076,7 +1076,8 @@ done:
  * On the CPU device, a flat EXR input whose working set (the input's
  * planes, the chain's, the result's) is over the memory budget
  * (OBSCURA_MAX_MEMORY MiB, else a quarter of the machine's memory; or
- * any size with OBSCURA_BAND_ROWS) is read by rows, run in bands and
+ * any size with OBSCURA_BAND_ROWS) is read by rows (the chain's planes
+ * get the budget's share they have in the whole frame's working set), run in bands and
  * written by rows (obs_run_cpu_rows, obs_gbuffer_rows_*, obs_exr_rows_*):
  * the same file as the whole frame's.  Only a plain EXR output of a file
  * input, with the camera at hand and no object masks, baked channel,
@@ -1191,8 +1192,9 @@ static int ao_rows(ao_args *a, const obs_limits *lim)
     j.height = meta.gb.height;
     obs_cpu_options o = {.log = log_cb};
     cpu_bands_from_env(&o);
-    if (o.band_rows <= 0 && o.max_memory == 0) /* the chain's share of the budget */
-        o.max_memory = (size_t)(memory_budget() * 56.0 / whole_bytes_per_px(&meta.gb, a->req.outputs));
+    /* the budget is the frame's: the chain's planes get their share of it
+     * (the rows of the input and of the result the rest) */
+    o.max_memory = (size_t)(memory_budget() * 56.0 / whole_bytes_per_px(&meta.gb, a->req.outputs));
     double t0 = now_ms();
     obs_status s = obs_run_cpu_rows(&meta.gb, ao_rows_in, ao_rows_out, &j, p, a->req.outputs, &o, err);
     double t_all = now_ms() - t0;
