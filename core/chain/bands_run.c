@@ -389,18 +389,19 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
             /* the rows the budget holds, less the halo the band reads */
             const int held = b.a1 - b.a0, halo = (held - (b.c1 - b.c0) + 1) / 2;
             const int fit = (int)((double)budget / (double)need * held) - 2 * halo;
-            if (fit >= OBS__BANDS_MIN_ROWS && fit < n) {
+            if (fit >= halo && fit >= OBS__BANDS_MIN_ROWS && fit < n) {
                 n = fit;
                 continue;
             }
-            if (fit < OBS__BANDS_MIN_ROWS) {
-                /* the halo alone is over the budget: bands as tall as the
-                 * halo, so each band's prep runs over at most three times
-                 * its rows */
+            if (fit < halo || fit < OBS__BANDS_MIN_ROWS) {
+                /* the budget holds less than three halos: bands as tall
+                 * as the halo (over the budget), so that each band's prep
+                 * runs over at most three times its rows, not over a
+                 * halo many times a thin band's rows */
                 if (!warned++ && opt && opt->log) {
                     char msg[224];
                     snprintf(msg, sizeof msg, "the AO's samples reach %d rows either side: a band "
-                             "holds more than the memory budget (%.0f MiB)", halo,
+                             "holds more than the memory budget (%.0f MiB of planes)", halo,
                              (double)budget / 1048576.0);
                     opt->log(opt->log_user, OBS_LOG_WARN, msg);
                 }
