@@ -4,7 +4,7 @@
 # SIZE (default 3840x2160), whole, then by rows under OBSCURA_MAX_MEMORY
 # MiB (default 256): peak RSS (/usr/bin/time -v), wall time and their
 # ratios in one run, the bands, and whether the two files are the same
-# bytes.  bench/RESULTS.md, "An 8K frame ... by rows", has the 8K run.
+# bytes.  bench/RESULTS.md, "An 8K frame by rows", has the 8K run.
 #
 #   BUILD=build bench/bands.sh SCENE.exr CAMERA.json [SIZE [MIB]]
 set -eu
