@@ -85,6 +85,19 @@ obs_status obs__exr_read_with(const char *label, const char *path, const obs__ex
     return st;
 }
 
+obs_status obs__exr_read_out(const char *label, const char *path, const obs__exr_mem *mem,
+                             obs__exr_reader read, void *user, void *out, size_t out_size,
+                             void (*release)(void *out), char err[OBS_ERR_LEN])
+{
+    if (!out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
+    memset(out, 0, out_size);
+    obs_status st = obs__exr_read_with(label, path, mem, read, user, err);
+    if (st != OBS_OK)
+        release(out);
+    return st;
+}
+
 /* ---- parts and channels -------------------------------------------------- */
 
 /* Channel names of one part, pointing into the context (valid until
@@ -329,9 +342,7 @@ typedef struct part_job {
     uint32_t tw, th;      /* tile size (tiled parts) */
     int64_t ntx, chunks;  /* tiles across; chunks to decode */
     int64_t first;        /* the first of them (a range of rows: obs_gbuffer_rows) */
-    int64_t failed;       /* lowest failing chunk (chunks = none); under the pool's lock */
-    obs_status st;
-    char err[OBS_ERR_LEN];
+    obs__exr_chunk_fail fail; /* under the pool's lock */
 } part_job;
 
 static obs_status decode_nth(part_job *j, int64_t i, decoder *d, char err[OBS_ERR_LEN])
@@ -357,9 +368,7 @@ static obs_status decode_nth(part_job *j, int64_t i, decoder *d, char err[OBS_ER
 /* One decoder per thread; a failure is kept until the thread ends. */
 typedef struct decode_local {
     decoder d;
-    int64_t failed;
-    obs_status st;
-    char err[OBS_ERR_LEN];
+    obs__exr_chunk_fail fail;
 } decode_local;
 
 static void decode_begin(void *ctx, void *local)
@@ -367,7 +376,7 @@ static void decode_begin(void *ctx, void *local)
     (void)ctx;
     decode_local *l = local;
     l->d = (decoder){EXR_DECODE_PIPELINE_INITIALIZER};
-    l->st = OBS_OK;
+    l->fail.code = OBS_OK;
     obs__exr_msg_reset(); /* the library's messages are per thread */
 }
 
@@ -376,37 +385,23 @@ static int decode_one(void *ctx, void *local, size_t i, size_t i1)
 {
     (void)i1; /* ranges of one chunk */
     decode_local *l = local;
-    obs_status st = decode_nth(ctx, (int64_t)i, &l->d, l->err);
+    obs_status st = decode_nth(ctx, (int64_t)i, &l->d, l->fail.msg);
     if (st == OBS_OK)
         return 0;
-    l->failed = (int64_t)i;
-    l->st = st;
+    l->fail.chunk = (int64_t)i;
+    l->fail.code = st;
     return 1;
 }
 
-/* Under the pool's lock: the lowest failing chunk's error wins. */
+/* Under the pool's lock. */
 static void decode_end(void *ctx, void *local)
 {
     part_job *j = ctx;
     decode_local *l = local;
-    if (l->st != OBS_OK && l->failed < j->failed) {
-        j->failed = l->failed;
-        j->st = l->st;
-        memcpy(j->err, l->err, sizeof l->err);
-    }
+    obs__exr_chunk_fail_keep(&j->fail, &l->fail);
     if (l->d.started)
         exr_decoding_destroy(j->ctx, &l->d.dec);
     free(l->d.scratch);
-}
-
-/* Decode threads for a part of `chunks` chunks: the configured count
- * (0 = CPUs online; pool.h), but no more than one for every 4 chunks. */
-static int decode_threads(const obs_limits *lim, int64_t chunks)
-{
-    int n = obs__pool_threads(lim ? lim->threads : 0);
-    if (n > chunks / 4)
-        n = (int)(chunks / 4);
-    return n < 1 ? 1 : n;
 }
 
 /* Decodes the chunks of level 0 of a part that hold rows [y0, y1) of its
@@ -448,7 +443,7 @@ static obs_status decode_rows(exr_const_context_t ctx, int part, const part_geom
                               const target *t, int nt, const obs_limits *lim, int y0, int y1,
                               char err[OBS_ERR_LEN])
 {
-    part_job j = {.ctx = ctx, .part = part, .g = g, .t = t, .nt = nt, .st = OBS_OK};
+    part_job j = {.ctx = ctx, .part = part, .g = g, .t = t, .nt = nt, .fail = {.chunk = INT64_MAX}};
     int32_t lines = 0;
     uint32_t tw = 0;
     obs_status cs = chunk_lines(ctx, part, g, &lines, &tw, err);
@@ -467,15 +462,15 @@ static obs_status decode_rows(exr_const_context_t ctx, int part, const part_geom
         j.first = r0 * j.ntx;
         j.chunks = j.ntx * (r1 - r0);
     }
-    j.failed = j.chunks;
-    obs__pool_for f = {.end = (size_t)j.chunks, .chunk = 1, .threads = decode_threads(lim, j.chunks),
+    obs__pool_for f = {.end = (size_t)j.chunks, .chunk = 1,
+                       .threads = obs__exr_chunk_threads(lim ? lim->threads : 0, j.chunks),
                        .range = decode_one, .ctx = &j, .local_size = sizeof(decode_local),
                        .begin = decode_begin, .end_thread = decode_end};
     if (obs__pool_run(&f, NULL) < 0)
         return obs__fail(err, OBS_NO_MEMORY, "decode threads");
-    if (j.st != OBS_OK)
-        memcpy(err, j.err, OBS_ERR_LEN);
-    return j.st;
+    if (j.fail.code != OBS_OK)
+        memcpy(err, j.fail.msg, OBS_ERR_LEN);
+    return (obs_status)j.fail.code;
 }
 
 /* ---- G-buffer ----------------------------------------------------------- */
@@ -764,19 +759,19 @@ static obs_status gbuffer_reader(exr_context_t ctx, int64_t size, void *user,
     return read_gbuffer(ctx, size, j->map, j->lim, j->out, NULL, why);
 }
 
+static void gbuffer_release(void *out)
+{
+    obs_gbuffer_free(out);
+}
+
 /* Shared by the file and memory readers; `label` prefixes messages. */
 static obs_status read_any(const char *label, const char *path, const mem_src *mem,
                            const obs_channel_map *map, const obs_limits *lim,
                            obs_gbuffer_file *out, char err[OBS_ERR_LEN])
 {
-    if (!out)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
-    memset(out, 0, sizeof *out);
     gbuffer_job j = {map, lim, out};
-    obs_status st = obs__exr_read_with(label, path, mem, gbuffer_reader, &j, err);
-    if (st != OBS_OK)
-        obs_gbuffer_free(out);
-    return st;
+    return obs__exr_read_out(label, path, mem, gbuffer_reader, &j, out, sizeof *out,
+                             gbuffer_release, err);
 }
 
 obs_status obs_gbuffer_read_exr(const char *path, const obs_channel_map *map,

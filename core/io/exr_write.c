@@ -146,17 +146,13 @@ typedef struct enc_job {
     const obs__wpart *p;
     const exr_chunk_info_t *ci;
     enc_slot *slot;
-    int64_t failed;     /* lowest failing chunk (chunks: none); under the pool's lock */
-    exr_result_t rv;
-    char msg[384];
+    obs__exr_chunk_fail fail; /* under the pool's lock */
 } enc_job;
 
 typedef struct enc_local {
     exr_encode_pipeline_t enc;
     int started;
-    int64_t failed;
-    exr_result_t rv;
-    char msg[384];
+    obs__exr_chunk_fail fail;
 } enc_local;
 
 /* The write step of a thread's pipeline: keep the chunk's bytes. */
@@ -175,7 +171,7 @@ static void enc_begin(void *ctx, void *local)
     (void)ctx;
     enc_local *l = local;
     l->enc = (exr_encode_pipeline_t)EXR_ENCODE_PIPELINE_INITIALIZER;
-    l->rv = EXR_ERR_SUCCESS;
+    l->fail.code = EXR_ERR_SUCCESS;
     obs__exr_msg_reset();
 }
 
@@ -200,9 +196,9 @@ static int enc_one(void *ctx, void *local, size_t i, size_t i1)
     }
     if (rv == EXR_ERR_SUCCESS)
         return 0;
-    l->failed = (int64_t)i;
-    l->rv = rv;
-    snprintf(l->msg, sizeof l->msg, "%s", obs__exr_msg());
+    l->fail.chunk = (int64_t)i;
+    l->fail.code = rv;
+    snprintf(l->fail.msg, sizeof l->fail.msg, "%s", obs__exr_msg());
     return 1;
 }
 
@@ -211,23 +207,9 @@ static void enc_end(void *ctx, void *local)
 {
     enc_job *j = ctx;
     enc_local *l = local;
-    if (l->rv != EXR_ERR_SUCCESS && l->failed < j->failed) {
-        j->failed = l->failed;
-        j->rv = l->rv;
-        memcpy(j->msg, l->msg, sizeof j->msg);
-    }
+    obs__exr_chunk_fail_keep(&j->fail, &l->fail);
     if (l->started)
         exr_encoding_destroy(j->ctx, &l->enc);
-}
-
-/* Compression threads for `chunks` chunks: the caller's count (0: the
- * machine's cores, pool.h), no more than one for every 4 chunks. */
-static int encode_threads(int threads, int64_t chunks)
-{
-    int n = obs__pool_threads(threads);
-    if (n > chunks / 4)
-        n = (int)(chunks / 4);
-    return n < 1 ? 1 : n;
 }
 
 /* Part `part`'s pixels: the chunks [first, first + chunks) (the rows of
@@ -237,20 +219,21 @@ static exr_result_t write_chunks(exr_context_t ctx, int part, const obs__wpart *
 {
     exr_result_t rv = EXR_ERR_SUCCESS;
     exr_chunk_info_t *ci = calloc((size_t)chunks, sizeof *ci);
-    enc_job j = {.ctx = ctx, .part = part, .p = p, .ci = ci, .failed = chunks, .rv = EXR_ERR_SUCCESS};
+    enc_job j = {.ctx = ctx, .part = part, .p = p, .ci = ci, .fail = {.chunk = INT64_MAX}};
     j.slot = calloc((size_t)chunks, sizeof *j.slot);
     if (!ci || !j.slot)
         rv = EXR_ERR_OUT_OF_MEMORY;
     for (int64_t c = 0; c < chunks && rv == EXR_ERR_SUCCESS; c++)
         rv = exr_write_scanline_chunk_info(ctx, part, (int)(p->dw.min.y + (first + c) * lines), &ci[c]);
     if (rv == EXR_ERR_SUCCESS) {
-        obs__pool_for f = {.end = (size_t)chunks, .chunk = 1, .threads = encode_threads(threads, chunks),
+        obs__pool_for f = {.end = (size_t)chunks, .chunk = 1,
+                           .threads = obs__exr_chunk_threads(threads, chunks),
                            .range = enc_one, .ctx = &j, .local_size = sizeof(enc_local),
                            .begin = enc_begin, .end_thread = enc_end};
         if (obs__pool_run(&f, NULL) < 0)
             rv = EXR_ERR_OUT_OF_MEMORY;
-        else if ((rv = j.rv) != EXR_ERR_SUCCESS && j.msg[0])
-            obs__exr_error_handler(ctx, rv, j.msg); /* the worker's message, on this thread */
+        else if ((rv = (exr_result_t)j.fail.code) != EXR_ERR_SUCCESS && j.fail.msg[0])
+            obs__exr_error_handler(ctx, rv, j.fail.msg); /* the worker's message, on this thread */
     }
     for (int64_t c = 0; c < chunks && rv == EXR_ERR_SUCCESS; c++)
         rv = exr_write_scanline_chunk(ctx, part, j.ci[c].start_y, j.slot[c].data, j.slot[c].size);
