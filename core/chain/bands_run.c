@@ -87,17 +87,13 @@ static int sample_reach(const obs__frame *af, const float p[3], int all)
     double g = sqrt((a[0] - ndc * b[0]) * (a[0] - ndc * b[0]) + (a[1] - ndc * b[1]) * (a[1] - ndc * b[1]) +
                     (a[2] - ndc * b[2]) * (a[2] - ndc * b[2]));
     double bl = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]), bxy = sqrt(b[0] * b[0] + b[1] * b[1]);
-    double R = af->radius, reach, wmin;
-    if (af->method == OBS_METHOD_VAOPP || af->method == OBS_METHOD_VAO) {
-        reach = g * R;
-        wmin = w - 0.5 * R * (bl + bxy);
-    } else {
-        reach = g * R;
-        wmin = w - R * bl;
-    }
+    const double R = af->radius; /* |d| <= R for every one of these methods */
+    const double wmin = af->method == OBS_METHOD_VAOPP || af->method == OBS_METHOD_VAO
+                            ? w - 0.5 * R * (bl + bxy)
+                            : w - R * bl;
     if (!(w > 0.0) || !(wmin > 0.0))
         return all;
-    double rows = 0.5 * af->viewport[3] * reach / wmin;
+    double rows = 0.5 * af->viewport[3] * g * R / wmin;
     return isfinite(rows) && rows < (double)all ? (int)ceil(rows) + 2 : all;
 }
 
