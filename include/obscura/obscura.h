@@ -295,6 +295,12 @@ typedef struct obs_cpu_options {
      * longer (the clock read between passes and between the AO pass's
      * tiles, so at most one tile past it); 0: no deadline */
     double deadline;
+    /* polled where the deadline is read, from the worker pool's threads
+     * (possibly several at once); a nonzero return stops the run with
+     * OBS_CANCELLED (obscurad's drain: a frame nobody waits for any
+     * more); NULL: never */
+    int (*cancel)(void *user);
+    void *cancel_user;
 } obs_cpu_options;
 
 obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,

@@ -15,8 +15,6 @@ OBSCURA=${OBSCURA:-build/obscura}
 OBSCURAD=${OBSCURAD:-build/obscurad}
 DATA=tests/data
 . tests/e2e/lib/common.sh
-skipped=0
-skip() { skipped=$((skipped + 1)); echo "  skip $*"; }
 
 echo "e2e deploy: deploy/"
 echo "-- systemd"
@@ -27,7 +25,9 @@ check "unit: CacheDirectory=obscura, passed as --cache-dir /var/cache/obscura" \
     "grep -q '^CacheDirectory=obscura\$' $U && grep -q '^ExecStart=.* --cache-dir /var/cache/obscura' $U"
 if command -v systemd-analyze >/dev/null 2>&1; then
     # verify wants the ExecStart binary to exist: point it at this build
-    sed "s|/usr/local/bin/obscurad|$(pwd)/$OBSCURAD|" "$U" > "$T/obscurad.service"
+    # (OBSCURAD relative to here, or absolute)
+    case "$OBSCURAD" in /*) abs=$OBSCURAD ;; *) abs=$(pwd)/$OBSCURAD ;; esac
+    sed "s|/usr/local/bin/obscurad|$abs|" "$U" > "$T/obscurad.service"
     systemd-analyze verify --man=no "$T/obscurad.service" > "$T/verify" 2>&1
     rc=$?
     if [ $rc -ne 0 ] && grep -qi 'system has not been booted\|failed to connect\|permission denied' "$T/verify"; then

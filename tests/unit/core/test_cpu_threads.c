@@ -148,6 +148,46 @@ static void test_deadline_and_log(void **state)
     obs_result_free(&r);
 }
 
+/* obs_cpu_options.cancel: polled while the frame runs (between passes
+ * and tiles, from the pool's threads); a nonzero return stops the run
+ * with OBS_CANCELLED and nothing allocated, and the cancel is not asked
+ * again; one that never says stop leaves the frame's bytes as they are. */
+static int cancel_after(void *user)
+{
+    int *calls = user; /* calls[0]: calls so far, calls[1]: the call that says stop */
+    return __atomic_add_fetch(&calls[0], 1, __ATOMIC_RELAXED) >= calls[1];
+}
+
+static void test_cancel(void **state)
+{
+    obs_result r, plain;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    int calls[2] = {0, 1};
+    obs_cpu_options now = {.cancel = cancel_after, .cancel_user = calls};
+    assert_int_equal(obs_run_cpu_opts(&room.gb, NULL, OBS_OUTPUT_AO, &r, &now, err), OBS_CANCELLED);
+    assert_non_null(strstr(err, "cancelled (before the"));
+    assert_null(r.ao.data);
+    assert_int_equal(calls[0], 1);
+    int never[2] = {0, 1 << 30};
+    obs_cpu_options polled = {.cancel = cancel_after, .cancel_user = never};
+    assert_int_equal(obs_run_cpu(&room.gb, NULL, OBS_OUTPUT_AO, &plain, err), OBS_OK);
+    assert_int_equal(obs_run_cpu_opts(&room.gb, NULL, OBS_OUTPUT_AO, &r, &polled, err), OBS_OK);
+    assert_memory_equal(r.ao.data, plain.ao.data, (size_t)r.ao.width * r.ao.height * sizeof(float));
+    obs_result_free(&r);
+    /* asked before each pass (OBS_PASS_COUNT at most) and between the AO
+     * pass's tiles: halfway through the calls is inside the AO pass */
+    assert_true(never[0] > OBS_PASS_COUNT);
+    int mid[2] = {0, never[0] / 2};
+    obs_cpu_options midway = {.cancel = cancel_after, .cancel_user = mid};
+    assert_int_equal(obs_run_cpu_opts(&room.gb, NULL, OBS_OUTPUT_AO, &r, &midway, err), OBS_CANCELLED);
+    assert_non_null(strstr(err, "cancelled"));
+    assert_null(r.ao.data);
+    /* each thread that was in a tile asks at most once more */
+    assert_true(mid[0] <= mid[1] + 64);
+    obs_result_free(&plain);
+}
+
 /* Every row in exactly one band, bands no taller than asked. */
 static void count_rows(void *ctx, int y0, int y1)
 {
@@ -204,6 +244,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bands),
         cmocka_unit_test(test_deadline_and_log),
+        cmocka_unit_test(test_cancel),
         cmocka_unit_test(test_every_method),
         cmocka_unit_test(test_chain_variants),
         cmocka_unit_test(test_deep_chain),
