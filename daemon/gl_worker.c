@@ -121,7 +121,9 @@ static void idle(obsd_gl_worker *w, obs_ctx *ctx)
     char err[OBS_ERR_LEN] = "";
     if (ctx && obs_ctx_trim(ctx, w->keep_memory, err) != OBS_OK)
         obsd_log(OBSD_LOG_WARN, "releasing frame targets: %s", err);
-    atomic_store(&w->kept_bytes, ctx ? obs_ctx_kept_bytes(ctx) : 0);
+    if (w->cpu) /* the CPU device's planes, as a context's targets */
+        obs_cpu_trim(w->keep_memory);
+    atomic_store(&w->kept_bytes, ctx ? obs_ctx_kept_bytes(ctx) : w->cpu ? obs_cpu_kept_bytes() : 0);
 }
 
 static void *worker_main(void *arg)
@@ -214,6 +216,8 @@ static void *worker_main(void *arg)
         if (ctx) {
             atomic_store(&w->kept_bytes, obs_ctx_kept_bytes(ctx));
             count_programs(w, ctx, 0);
+        } else if (w->cpu) {
+            atomic_store(&w->kept_bytes, obs_cpu_kept_bytes());
         }
         obsd_queue_done(w->queue);
         job->done(job, job->user); /* the job is not ours after this */

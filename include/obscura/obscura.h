@@ -344,6 +344,12 @@ unsigned long long obs_ctx_kept_bytes(const obs_ctx *ctx);
  * on the context's thread, e.g. when idle. */
 obs_status obs_ctx_trim(obs_ctx *ctx, unsigned long long budget, char err[OBS_ERR_LEN]);
 
+/* The CPU device's twins of these: the bytes of the one block of planes
+ * it keeps for the next frame (process-wide), and their release when
+ * more than budget (0: always).  Any thread. */
+unsigned long long obs_cpu_kept_bytes(void);
+void obs_cpu_trim(unsigned long long budget);
+
 /* ---- a deadline on each frame's GL work -------------------------------- */
 
 /* Each following obs_run and obs_deep_run stops with OBS_DEADLINE when

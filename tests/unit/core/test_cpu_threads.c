@@ -188,6 +188,29 @@ static void test_cancel(void **state)
     obs_result_free(&plain);
 }
 
+/* The planes kept for the next frame: counted, kept under a budget
+ * above them, released under one below them or 0. */
+static void test_kept_trim(void **state)
+{
+    obs_result r;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    assert_int_equal(obs_run_cpu(&room.gb, NULL, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    obs_result_free(&r);
+    unsigned long long kept = obs_cpu_kept_bytes();
+    size_t px = (size_t)room.gb.width * room.gb.height;
+    assert_true(kept >= px * 9 * sizeof(float)); /* position, normal, AO, blur */
+    obs_cpu_trim(kept);
+    assert_int_equal(obs_cpu_kept_bytes(), kept);
+    obs_cpu_trim(kept - 1);
+    assert_int_equal(obs_cpu_kept_bytes(), 0);
+    assert_int_equal(obs_run_cpu(&room.gb, NULL, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    obs_result_free(&r);
+    assert_int_equal(obs_cpu_kept_bytes(), kept);
+    obs_cpu_trim(0);
+    assert_int_equal(obs_cpu_kept_bytes(), 0);
+}
+
 /* Every row in exactly one band, bands no taller than asked. */
 static void count_rows(void *ctx, int y0, int y1)
 {
@@ -245,6 +268,7 @@ int main(void)
         cmocka_unit_test(test_bands),
         cmocka_unit_test(test_deadline_and_log),
         cmocka_unit_test(test_cancel),
+        cmocka_unit_test(test_kept_trim),
         cmocka_unit_test(test_every_method),
         cmocka_unit_test(test_chain_variants),
         cmocka_unit_test(test_deep_chain),
