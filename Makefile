@@ -24,8 +24,11 @@ PKGS := OpenEXR egl osmesa libpng libcjson
 # only writes deep files (core/io/exr_deep_write.cpp, see below).
 EXR_CFLAGS := $(shell pkg-config --cflags OpenEXR 2>/dev/null)
 PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson nettle 2>/dev/null) $(EXR_CFLAGS)
-# nettle: SHA-256 of the program cache's keys (core/gl/progcache.c)
-PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson nettle 2>/dev/null) -lz -lm -lpthread
+# nettle: SHA-256 of the program cache's keys (core/gl/progcache.c).
+# EGL and OSMesa: their headers only; the libraries are opened at run time
+# when a GL backend is chosen (core/gl/libs.c), so that nothing linked
+# needs GL and the CPU device runs on a node without it.
+PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libpng libcjson nettle 2>/dev/null) -lz -lm -lpthread -ldl
 # Scene loading (core/ground/scene.c: assimp) and the ray-traced reference
 # (core/ground/reference.c: Embree 3, no .pc file) and the bake's least-squares
 # solve (core/bake/fit.c: SuiteSparse CHOLMOD) and its LODs (core/bake/simplify.c:

@@ -2,7 +2,8 @@
 # Checks of deploy/: the systemd unit (systemd-analyze verify), the
 # example config (obscurad reads it), the Dockerfile (its run-time
 # packages cover every library obscurad and obscura link; hadolint when
-# installed), the Kubernetes manifests and farm job templates
+# installed; nothing links GL, and the CPU device runs with the GL
+# libraries hidden), the Kubernetes manifests and farm job templates
 # (tests/deploy/check_manifests.py, PyYAML; the bake templates' commands
 # and bake-dynamic templates' commands run on the fixture level, merged =
 # unsharded), and the plain farm script
@@ -81,6 +82,27 @@ for bin in "$OBSCURAD" "$OBSCURA"; do
     done
 done
 check "run-time stage installs the package of every linked library${missing:+ (missing:$missing)}" "[ -z '$missing' ]"
+# a node without GL (the image's BACKEND=cpu): nothing links a GL library,
+# and with libEGL and libOSMesa hidden (bound over by /dev/null in a mount
+# namespace of this process's own) the CPU device still answers, and a GL
+# backend says what to install
+gl_linked=$(readelf -d "$OBSCURAD" "$OBSCURA" | grep -E 'NEEDED.*lib(EGL|OSMesa|GL|OpenGL|GLX)\b')
+check "Dockerfile: BACKEND=cpu leaves the GL packages out; obscura and obscurad link no GL library${gl_linked:+ ($gl_linked)}" \
+    "[ -z '$gl_linked' ] && grep -q 'if \[ \"\$BACKEND\" = cpu \]; then gl=\"\"' $D && grep -q 'OBSCURA_BACKEND=\$BACKEND' $D"
+egl=$(ldconfig -p | sed -n 's/^[[:space:]]*libEGL\.so\.1 (libc6,x86-64) => //p' | head -1)
+osm=$(ldconfig -p | sed -n 's/^[[:space:]]*libOSMesa\.so\.8 (libc6,x86-64) => //p' | head -1)
+if [ "$(id -u)" = 0 ] && [ -n "$egl" ] && [ -n "$osm" ] && unshare -m true 2>/dev/null; then
+    unshare -m sh -c 'mount --bind /dev/null "$(readlink -f "$1")" && mount --bind /dev/null "$(readlink -f "$2")" &&
+        "$3" ao tests/data/room_small.exr --camera tests/data/room_small.camera.json --backend cpu -o "$4/nogl.exr" -q &&
+        { "$3" info --backend egl-surfaceless > "$4/nogl.info" 2>&1; echo $? > "$4/nogl.rc"; }' \
+        - "$egl" "$osm" "$OBSCURA" "$T" > "$T/nogl.err" 2>&1
+    rc=$?
+    check "without libEGL and libOSMesa: the CPU device runs (exit $rc); a GL backend exits 1 naming libegl1" \
+        "[ $rc -eq 0 ] && [ -s '$T/nogl.exr' ] && [ \"\$(cat '$T/nogl.rc')\" = 1 ] && grep -q 'install libegl1' '$T/nogl.info'"
+    [ $rc -eq 0 ] || sed 's/^/       /' "$T/nogl.err" | tail -3
+else
+    skip "a node without GL libraries: needs root and unshare -m (a mount namespace to hide them)"
+fi
 if command -v hadolint >/dev/null 2>&1; then
     hadolint "$D" > "$T/hadolint" 2>&1
     check "hadolint" "[ $? -eq 0 ]"
