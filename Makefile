@@ -206,7 +206,9 @@ demo-run: all
 # ---- tests --------------------------------------------------------------
 # make test = the whole suite, then the same suite under ASan/UBSan but for
 # the sanitizer pass of the slowest e2e scripts (each over 20 s under ASan),
-# which make test-long runs (CI runs both).
+# which make test-long runs, and then the e2e suite once more on the CPU
+# device (plain build; fuzz.sh left out: it fuzzes decoders, whatever the
+# device) (CI runs both).
 E2E_LONG = bake progcache dynamic run load output deploy hostile_binary bakes python_client \
            guards hostile_http provenance remote
 test: deps
@@ -215,6 +217,7 @@ test: deps
 
 test-long: deps
 	$(MAKE) all e2e BUILD=build/asan SAN=1 E2E_ONLY="$(E2E_LONG)"
+	$(MAKE) all e2e OBSCURA_BACKEND=cpu E2E_SKIP=fuzz
 
 check: all headers loops unit e2e readme-check
 

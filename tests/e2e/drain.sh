@@ -67,7 +67,10 @@ echo "-- frames still queued when the deadline passes are not run"
 # on the CPU device): one runs, two wait in the queue when the signal
 # comes; past the 1 s deadline the queued ones are skipped, and on the
 # CPU device the one under way stops at its next tile
-"$BUILD/exr_upscale" tests/data/room_small.exr 640x480 "$T/mid.exr" 2>/dev/null
+if ! "$BUILD/exr_upscale" tests/data/room_small.exr 640x480 "$T/mid.exr" 2>"$T/up.err"; then
+    bad "exr_upscale 640x480 (make e2e builds it): $(cat "$T/up.err")"
+    exit 1
+fi
 start F --drain-timeout 1
 Q="fov_y=50&near=0.05&far=100&method=hbao&hbao_directions=32&hbao_steps=32&blur_radius=16"
 for i in 1 2 3; do post "$PORT_F" "$Q" "$T/mid.exr" "$T/f$i.out" > /dev/null & CPIDS="$CPIDS $!"; done

@@ -61,9 +61,33 @@ if [ $LLVMPIPE = 1 ]; then
         "[ -n '$a1' ] && [ $a1 -lt $a2 ] && [ $a1 -eq $t1 ]"
 elif [ "$CPU_DEVICE" = 1 ]; then
     # the CPU device's pool threads run a pass and are joined: none is
-    # left once the frame is done, whatever --threads
+    # left once the frame is done, whatever --threads; while the frame
+    # runs (a 640x480 HBAO frame: about a second) the process's threads,
+    # read every few milliseconds, never pass --threads, and reach it or
+    # the cores, whichever is fewer
     check "ao on the CPU device: its threads end with the frame (1 thread left after it: $a1, $a2)" \
         "[ '$a1' = 1 ] && [ '$a2' = 1 ]"
+    # peak N: the most threads obscura ao --threads N had at once
+    peak() {
+        "$OBSCURA" ao "$T/mid.exr" --camera "$CAMF" --method hbao --hbao-directions 16 --hbao-steps 16 \
+            -o "$T/peak$1.exr" --threads "$1" -q &
+        p=$! most=0
+        while kill -0 $p 2>/dev/null; do
+            n=$(ls /proc/$p/task 2>/dev/null | wc -l)
+            [ "$n" -gt "$most" ] && most=$n
+            sleep 0.01
+        done
+        wait $p
+        echo "$most"
+    }
+    if "${BUILD:-build}/exr_upscale" "$R" 640x480 "$T/mid.exr" 2>"$T/up.err"; then
+        m1=$(peak 1); m3=$(peak 3)
+        cores=$(nproc); [ "$cores" -gt 3 ] && cores=3
+        check "ao on the CPU device: min(--threads, cores) threads while the frame runs (1: $m1, 3: $m3 of $cores)" \
+            "[ '$m1' = 1 ] && [ '$m3' = $cores ] && cmp -s $T/peak1.exr $T/peak3.exr"
+    else
+        bad "exr_upscale 640x480 (make e2e builds it): $(cat "$T/up.err")"
+    fi
 fi
 expect 0 "ao --threads 1, PNG" -- "$OBSCURA" ao "$R" --camera "$CAMF" -o "$T/p1.png" --threads 1 -q
 expect 0 "ao --threads 2, PNG" -- "$OBSCURA" ao "$R" --camera "$CAMF" -o "$T/p2.png" --threads 2 -q
