@@ -115,7 +115,7 @@ static float sample_cos(const obs__gtao_state *g, const float q[4], const float 
  * OITAO Algorithm 1: the largest counts); past the border, the front
  * plane's surface continued. */
 static float side_horizon(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                          int x, int y, const float c[3], const float v[3], const float omega[2],
+                          int self, int x, int y, const float c[3], const float v[3], const float omega[2],
                           int slice, float noise_step, float min_s, int dir, float low,
                           int *taken)
 {
@@ -132,18 +132,20 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         int qy = y + dir * (int)floorf(s * omega[1] + 0.5f);
         float ext[4];
         const float *q;
-        /* object masks: the weight of the surface at the step's pixel */
-        const float om = obs__occluder_weight(f, x, y, qx, qy);
+        /* object masks: the weight of the surface at the step's pixel
+         * (of each node there; past the border, of the front one) */
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
             if (!(q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken)))
                 continue;
-            hc = fmaxf(hc, sample_cos(g, q, c, v, low, om));
+            hc = fmaxf(hc, sample_cos(g, q, c, v, low,
+                                      obs__occluder_weight_node(f, x, y, self, qx, qy, 0)));
             continue;
         }
         (*taken)++;
         q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
         for (int k = 0; k < layers; k++)
-            hc = fmaxf(hc, sample_cos(g, q + (size_t)k * plane, c, v, low, om));
+            hc = fmaxf(hc, sample_cos(g, q + (size_t)k * plane, c, v, low,
+                                      obs__occluder_weight_node(f, x, y, self, qx, qy, k)));
     }
     return hc;
 }
@@ -164,11 +166,11 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
 float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                            const float p[3], const float n[3], int *count, float bent[3])
 {
-    return obs__gtao_pixel_nodes(f, pos, nrm, 1, x, y, p, n, count, bent);
+    return obs__gtao_pixel_nodes(f, pos, nrm, 1, 0, x, y, p, n, count, bent);
 }
 
 float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                            int x, int y, const float p[3], const float n[3], int *count,
+                            int self, int x, int y, const float p[3], const float n[3], int *count,
                             float bent[3])
 {
     const obs__gtao_state *g = obs__gtao_of(f);
@@ -213,9 +215,9 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
         float cos_g = np_len > 0.0f ? saturate(dot3(np, v) / np_len) : 1.0f;
         float gamma = signf(dot3(od, np)) * acosf(cos_g);
         float low0 = cosf(gamma + half_pi), low1 = cosf(gamma - half_pi);
-        float hc0 = side_horizon(f, pos, nrm, layers, x, y, c, v, omega, sl, noise[1], min_s, 1,
+        float hc0 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, omega, sl, noise[1], min_s, 1,
                                  low0, &taken);
-        float hc1 = side_horizon(f, pos, nrm, layers, x, y, c, v, omega, sl, noise[1], min_s, -1,
+        float hc1 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, omega, sl, noise[1], min_s, -1,
                                  low1, &taken);
         if (g->heuristics)
             np_len += (1.0f - np_len) * GTAO_SLOPE_FUDGE;

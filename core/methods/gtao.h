@@ -37,9 +37,11 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
  * pos + 4 w h, ...: deep input's nodes, core/deep): each step's horizon
  * is the largest over the nodes at its pixel (OITAO Algorithm 1, as its
  * multi-layer HBAO, Fig. 9); a step past the border reads the first
- * plane's surface continued, with nrm its normals (3 floats a pixel). */
+ * plane's surface continued, with nrm its normals (3 floats a pixel).
+ * self: the receiver's node at (x, y), whose object self_only compares
+ * (object masks, obs__occluder_weight_node; the flat chain's: 0). */
 float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                            int x, int y, const float p[3], const float n[3], int *count,
+                            int self, int x, int y, const float p[3], const float n[3], int *count,
                             float bent[3]);
 
 /* The noise of the 3x3 tile's pixel `tile` (obs__tile_index): XeGTAO's R2
