@@ -252,7 +252,11 @@ loops: $(CORE_OBJ) $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
 # two at a time on two cores (tests/run_e2e.sh); those in E2E_ALONE time
 # the daemon and run afterwards, one at a time.  E2E_ONLY / E2E_SKIP: the
 # scripts' names (without .sh) to run, or to leave to another target.
-E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)
+# The program cache (and auto's kept choice, devices.txt) in a folder of
+# the build's own, not the user's ~/.cache: a choice kept there by a run
+# of `--backend auto` would move every GL check onto the CPU device.
+E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD) \
+          OBSCURA_CACHE_DIR=$(abspath $(BUILD))/e2e-cache
 # `make e2e OBSCURA_BACKEND=cpu`: every script on the CPU device (obscura
 # and obscurad read the variable where no --backend is given; gbuffer and
 # the bakes rasterise on a GL context still).
