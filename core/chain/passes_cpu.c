@@ -83,6 +83,15 @@ int obs__cpu_stop_now(obs__cpu_run *c)
     return 1;
 }
 
+obs_status obs__cpu_stopped_fail(obs__cpu_run *c, const char *where, obs_pass p, char err[OBS_ERR_LEN])
+{
+    if (atomic_load(&c->stopped) == OBS__CPU_CANCELLED)
+        return obs__fail(err, OBS_CANCELLED, "the frame was cancelled (%s the %s pass)", where,
+                         obs_pass_name(p));
+    return obs__fail(err, OBS_DEADLINE, "the frame ran past its deadline (%s the %s pass)", where,
+                     obs_pass_name(p));
+}
+
 /* The AO pass over a tile of the frame at the AO's size (GLSL:
  * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
  * (when the composite or the output reads it) and the debug planes (NULL:

@@ -22,6 +22,17 @@ typedef struct obs__cpu_run {
     /* each pixel's depth and view normal z, packed (vao_cpu.h), at the
      * AO's size: what the AO's samples read */
     float *dnz;
+    /* a frame run in bands (bands_run.c): the full-size rows [row0,
+     * row1) the planes hold, the half-size ones [hrow0, hrow1), the
+     * culling texels' [crow0, crow1); each plane pointer is then that of
+     * the frame's row 0 (its rows outside those never touched), so the
+     * passes index the planes by the frame's coordinates.  row1 0: the
+     * whole frame */
+    int row0, row1, hrow0, hrow1, crow0, crow1;
+    /* ... of those, the rows the AO's planes hold (ao, tmp, bleed at full
+     * size; hao, htmp, hbleed at half size): the rows the AO, the blur
+     * and the passes after them compute, not the halo */
+    int arow0, arow1, harow0, harow1;
     void *block;                                    /* where the planes are */
     size_t block_size;
     /* the deadline (CLOCK_MONOTONIC ms; 0: none) and the caller's cancel
@@ -37,12 +48,18 @@ typedef struct obs__cpu_run {
 enum { OBS__CPU_PAST_DEADLINE = 1, OBS__CPU_CANCELLED = 2 };
 
 /* Whether c's run is to stop (a tile's test, from any thread): the
- * deadline passed or the cancel said so; sets c->stopped (run_cpu.c). */
+ * deadline passed or the cancel said so; sets c->stopped (passes_cpu.c). */
 int obs__cpu_stop_now(obs__cpu_run *c);
+/* The failure of a run stopped (c->stopped) before or in (`where`) pass
+ * p: OBS_CANCELLED or OBS_DEADLINE, named. */
+obs_status obs__cpu_stopped_fail(obs__cpu_run *c, const char *where, obs_pass p, char err[OBS_ERR_LEN]);
 
 /* The planes of c's plan, in one block: the one the last frame gave back
  * when it fits, else a new one (planes_cpu.c). */
 obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN]);
+
+/* The bytes obs__cpu_planes_take would take for c (its rows, when set). */
+size_t obs__cpu_planes_need(const obs__cpu_run *c);
 
 /* Gives the block back, to be kept for the next frame (the larger of it
  * and the one kept is kept, the other freed). */

@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "chain/bands_run.h"
 #include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
 #include "log.h"
@@ -18,16 +19,6 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
-/* The failure of a run stopped (c->stopped) before or in pass p. */
-static obs_status stopped(obs__cpu_run *c, const char *where, obs_pass p, char err[OBS_ERR_LEN])
-{
-    if (atomic_load(&c->stopped) == OBS__CPU_CANCELLED)
-        return obs__fail(err, OBS_CANCELLED, "the frame was cancelled (%s the %s pass)", where,
-                         obs_pass_name(p));
-    return obs__fail(err, OBS_DEADLINE, "the frame ran past its deadline (%s the %s pass)", where,
-                     obs_pass_name(p));
-}
-
 /* Every pass that runs, in the table's order; with t, each one's wall
  * time. */
 static obs_status walk(obs__cpu_run *c, obs_pass_times *t, char err[OBS_ERR_LEN])
@@ -36,13 +27,13 @@ static obs_status walk(obs__cpu_run *c, obs_pass_times *t, char err[OBS_ERR_LEN]
         if (!obs__passes[i].when(c->pl))
             continue;
         if (obs__cpu_stop_now(c))
-            return stopped(c, "before", (obs_pass)i, err);
+            return obs__cpu_stopped_fail(c, "before", (obs_pass)i, err);
         double t0 = t ? now_ms() : 0.0;
         obs_status s = obs__cpu_kernels[i](c, err);
         if (s != OBS_OK)
             return s;
         if (atomic_load(&c->stopped)) /* a pass cut short: its output is not whole */
-            return stopped(c, "in", (obs_pass)i, err);
+            return obs__cpu_stopped_fail(c, "in", (obs_pass)i, err);
         if (t) {
             t->ms[i] += now_ms() - t0;
             t->total_ms += now_ms() - t0;
@@ -103,8 +94,10 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
     }
     /* the planes' allocation counts as the upload, as GL's textures do */
     double t0 = times ? now_ms() : 0.0;
-    s = obs__cpu_planes_take(&c, err);
-    /* object masks at half resolution: the downsample's half planes */
+    const int bands = obs__bands_rows(&c, opt); /* 0: the whole frame; else bands_run.c */
+    s = bands ? OBS_OK : obs__cpu_planes_take(&c, err);
+    /* object masks at half resolution: the downsample's half planes (a
+     * band's: set by bands_run.c) */
     pl.hf.mask_occl = c.hmask_w;
     pl.hf.mask_id = c.hmask_id;
     if (s == OBS_OK)
@@ -114,7 +107,7 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
         times->total_ms += now_ms() - t0;
     }
     if (s == OBS_OK)
-        s = walk(&c, times, err);
+        s = bands ? obs__bands_run(&c, &pl, bands, opt, times, err) : walk(&c, times, err);
     if (s == OBS_OK)
         s = obs__multibounce_finish(pl.gb, pl.multibounce, pl.asked, out, err);
     if (s == OBS_OK)

@@ -51,6 +51,7 @@
 #include "methods/bent.h"
 #include "chain/mask_weight.h"
 #include "methods/gtao.h"
+#include "methods/gtao_deep.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
 #define GTAO_TOO_CLOSE 1.3f       /* pixelTooCloseThreshold: first sample this far, in pixels */
@@ -113,14 +114,18 @@ static float sample_cos(const obs__gtao_state *g, const float q[4], const float 
  * each moved from low by its falloff weight.  A step inside the image
  * reads every one of the `layers` planes of pos (deep input's nodes,
  * OITAO Algorithm 1: the largest counts); past the border, the front
- * plane's surface continued. */
+ * plane's surface continued.  end (NULL: none): deep input's interval
+ * ends (obs__deep_intervals); each step is then a column of the side's
+ * free arcs (obs__gtao_column, gtao_deep.c), the nodes solid behind them
+ * giving the horizon as here. */
 static float side_horizon(const obs__frame *f, const float *pos, const float *nrm, int layers,
                           int self, int x, int y, const float c[3], const float v[3], const float omega[2],
                           int slice, float noise_step, float min_s, int dir, float low,
-                          int *taken)
+                          int *taken, const float *end, obs__gtao_side *side)
 {
     const obs__gtao_state *g = obs__gtao_of(f);
     const size_t plane = (size_t)f->width * (size_t)f->height * 4;
+    const float fw[3] = {g->falloff[0], g->falloff[1], g->thin_power[0]}; /* intervals */
     float hc = low;
     for (int st = 0; st < g->steps; st++) {
         float base = (float)(slice + st * g->steps) * GTAO_R1;
@@ -135,7 +140,10 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         /* object masks: the weight of the surface at the step's pixel
          * (of each node there; past the border, of the front one) */
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
-            if (!(q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken)))
+            q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
+            if (end) /* intervals: the surface continued, solid behind it */
+                obs__gtao_column(f, fw, side, q, NULL, 0, q ? 1 : 0, x, y, self, qx, qy, c, v, low);
+            if (!q)
                 continue;
             hc = fmaxf(hc, sample_cos(g, q, c, v, low,
                                       obs__occluder_weight_node(f, x, y, self, qx, qy, 0)));
@@ -143,6 +151,11 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         }
         (*taken)++;
         q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+        if (end) { /* intervals: the step's column (gtao_deep.c) */
+            hc = fmaxf(hc, obs__gtao_column(f, fw, side, q, end + (size_t)qy * f->width + qx,
+                                            plane, layers, x, y, self, qx, qy, c, v, low));
+            continue;
+        }
         for (int k = 0; k < layers; k++)
             hc = fmaxf(hc, sample_cos(g, q + (size_t)k * plane, c, v, low,
                                       obs__occluder_weight_node(f, x, y, self, qx, qy, k)));
@@ -166,12 +179,12 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
 float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                            const float p[3], const float n[3], int *count, float bent[3])
 {
-    return obs__gtao_pixel_nodes(f, pos, nrm, 1, 0, x, y, p, n, count, bent);
+    return obs__gtao_pixel_nodes(f, pos, nrm, 1, 0, NULL, x, y, p, n, count, bent);
 }
 
 float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                            int self, int x, int y, const float p[3], const float n[3], int *count,
-                            float bent[3])
+                            int self, const float *end, int x, int y, const float p[3],
+                            const float n[3], int *count, float bent[3])
 {
     const obs__gtao_state *g = obs__gtao_of(f);
     const float half_pi = (float)M_PI_2;
@@ -215,10 +228,15 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
         float cos_g = np_len > 0.0f ? saturate(dot3(np, v) / np_len) : 1.0f;
         float gamma = signf(dot3(od, np)) * acosf(cos_g);
         float low0 = cosf(gamma + half_pi), low1 = cosf(gamma - half_pi);
+        obs__gtao_side sides[2]; /* deep input's intervals: the sides' occupied arcs */
+        if (end) {
+            obs__gtao_side_start(&sides[0], c);
+            obs__gtao_side_start(&sides[1], c);
+        }
         float hc0 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, omega, sl, noise[1], min_s, 1,
-                                 low0, &taken);
+                                 low0, &taken, end, &sides[0]);
         float hc1 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, omega, sl, noise[1], min_s, -1,
-                                 low1, &taken);
+                                 low1, &taken, end, &sides[1]);
         if (g->heuristics)
             np_len += (1.0f - np_len) * GTAO_SLOPE_FUDGE;
         /* the horizons as angles from v, clamped to the hemisphere of n
@@ -227,7 +245,10 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
         float h1 = acosf(clampf(hc0, -1.0f, 1.0f));
         h0 = gamma + fmaxf(h0 - gamma, -half_pi);
         h1 = gamma + fminf(h1 - gamma, half_pi);
-        vis += np_len * (arc(h0, gamma, cos_g) + arc(h1, gamma, cos_g));
+        if (end) /* the free arcs between the horizons (gtao_deep.c) */
+            vis += np_len * obs__gtao_slice_free(&sides[0], &sides[1], h0, h1, gamma, cos_g);
+        else
+            vis += np_len * (arc(h0, gamma, cos_g) + arc(h1, gamma, cos_g));
         if (bent)
             obs__gtao_bent_slice(h0, h1, gamma, np_len, od, v, bent);
     }

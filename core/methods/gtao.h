@@ -39,10 +39,13 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
  * multi-layer HBAO, Fig. 9); a step past the border reads the first
  * plane's surface continued, with nrm its normals (3 floats a pixel).
  * self: the receiver's node at (x, y), whose object self_only compares
- * (object masks, obs__occluder_weight_node; the flat chain's: 0). */
+ * (object masks, obs__occluder_weight_node; the flat chain's: 0).  end
+ * (NULL: every node solid behind it): `layers` planes of the nodes'
+ * interval ends (obs__deep_intervals, deep_intervals on): each slice's
+ * visibility is then that of its free arcs (methods/gtao_deep.c). */
 float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                            int self, int x, int y, const float p[3], const float n[3], int *count,
-                            float bent[3]);
+                            int self, const float *end, int x, int y, const float p[3],
+                            const float n[3], int *count, float bent[3]);
 
 /* The noise of the 3x3 tile's pixel `tile` (obs__tile_index): XeGTAO's R2
  * sequence, fract(0.5 + k (0.754877666, 0.569840291)), k = tile;

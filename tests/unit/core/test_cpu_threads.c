@@ -185,6 +185,12 @@ static void test_cancel(void **state)
     assert_null(r.ao.data);
     /* each thread that was in a tile asks at most once more */
     assert_true(mid[0] <= mid[1] + 64);
+    /* a frame in bands of rows (bands_run.c) asks too */
+    int banded[2] = {0, never[0] / 2};
+    obs_cpu_options bands = {.cancel = cancel_after, .cancel_user = banded, .band_rows = 32};
+    assert_int_equal(obs_run_cpu_opts(&room.gb, NULL, OBS_OUTPUT_AO, &r, &bands, err), OBS_CANCELLED);
+    assert_non_null(strstr(err, "cancelled"));
+    assert_null(r.ao.data);
     obs_result_free(&plain);
 }
 
