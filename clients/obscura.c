@@ -964,10 +964,10 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
         *t0 = now_ms();
         s = obs_run(*ctx, &gf->gb, &a->req.params, outputs, res, err);
         log_programs(*ctx);
-        if (verbosity >= OBS_LOG_DEBUG) /* tests/e2e/threads.sh reads it */
-            fprintf(stderr, "obscura: debug: threads: %d in this process after the frame\n",
-                    cli_process_threads());
     }
+    if (verbosity >= OBS_LOG_DEBUG) /* tests/e2e/threads.sh reads it */
+        fprintf(stderr, "obscura: debug: threads: %d in this process after the frame\n",
+                cli_process_threads());
     return s == OBS_OK ? EXIT_OK : cli_fail(s, a->in, err);
 }
 
@@ -1342,6 +1342,7 @@ static int cmd_info(int argc, char **argv)
     if (backend_is_cpu(backend)) {
         printf("obscura %s\nbackend: cpu (the chain on the CPU device, no GL context)\n",
                OBS_VERSION);
+        print_threads(0);
         return EXIT_OK;
     }
     obs_ctx_desc desc = {.log = log_cb, .cache_dir = cache_dir_of(cache)};
