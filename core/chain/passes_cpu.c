@@ -81,6 +81,86 @@ static int past_deadline(obs__cpu_run *c)
     return 1;
 }
 
+/* ao_tile() for the VAO estimator without colour bleeding and without
+ * object masks: the tile's pixels sorted by the sample set they take,
+ * each set's pixels run in SIMD lanes (obs__vao_estimate_pixels), the
+ * same results as pixel by pixel. */
+static void ao_tile_lanes(obs__cpu_run *c, const unsigned char *cand, int x0, int x1, int y0,
+                          int y1)
+{
+    const obs__frame *f = c->pl->af;
+    const float *pos = c->apos, *nrm = c->anrm;
+    float *ao = c->aao, *bleed = c->ableed;
+    const int bleed_read = c->pl->f.bleed_step || c->out->bleed.data;
+    float *count = c->out->sample_count.data, *mask = c->out->cull_mask.data;
+    int px[AO_TILE_W * AO_TILE_H], ns[AO_TILE_W * AO_TILE_H], set[AO_TILE_W * AO_TILE_H];
+    unsigned char culled[AO_TILE_W * AO_TILE_H];
+    int m = 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            const size_t i = (size_t)y * f->width + x;
+            const size_t t = (size_t)(y - y0) * (size_t)(x1 - x0) + (size_t)(x - x0);
+            ao[i] = 1.0f;
+            if (bleed_read)
+                bleed[3 * i] = bleed[3 * i + 1] = bleed[3 * i + 2] = 1.0f;
+            if (count)
+                count[i] = 0.0f;
+            if (mask)
+                mask[i] = 0.0f;
+            if (!(pos[4 * i + 3] > 0.0f))
+                continue;
+            /* Section 4.2: a culling candidate gets AO 1 (greedy) or at
+             * most the 4-sample set (careful). */
+            const int cull = f->culling && cand[t];
+            if (mask)
+                mask[i] = (float)cull;
+            if (cull && f->culling != 2)
+                continue;
+            culled[m] = (unsigned char)cull;
+            px[m++] = (int)i;
+        }
+    if (m > 0) /* section 4.1: the set of each pixel's count */
+        obs__vao_counts(f, pos, nrm, px, m, ns);
+    for (int j = 0; j < m; j++) {
+        ns[j] = culled[j] && ns[j] > OBS_CULL_CAREFUL ? OBS_CULL_CAREFUL : ns[j];
+        if (count)
+            count[px[j]] = (float)ns[j];
+    }
+    /* each set (the count's set of the table, or the samples parameter's
+     * own set), its pixels in lanes */
+    int done = 0;
+    unsigned char taken[AO_TILE_W * AO_TILE_H];
+    memset(taken, 0, (size_t)m);
+    while (done < m) {
+        int first = 0;
+        while (taken[first])
+            first++;
+        const int n = ns[first];
+        const int table = f->adaptive || culled[first];
+        int k = 0;
+        for (int j = first; j < m; j++)
+            if (!taken[j] && ns[j] == n && (f->adaptive || culled[j]) == table) {
+                taken[j] = 1;
+                set[k++] = px[j];
+            }
+        done += k;
+        const float *xy = table ? f->sample_table + 2 * (n - 2) : f->sample_xy;
+        obs__vao_estimate_pixels(f, pos, nrm, c->dnz, set, k, n, xy, ao);
+    }
+    if (c->out->bent.data)
+        for (int j = 0, y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++) {
+                const size_t i = (size_t)y * f->width + x;
+                int n = 0, cull = 0;
+                if (j < m && px[j] == (int)i) {
+                    n = ns[j];
+                    cull = culled[j];
+                    j++;
+                }
+                vao_bent(f, pos, nrm, x, y, n, cull, c->out->bent.data + 3 * i);
+            }
+}
+
 static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
 {
     obs__cpu_run *c = ctx;
@@ -95,6 +175,10 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
     unsigned char cand[AO_TILE_W * AO_TILE_H]; /* section 4.2's test, the tile at once */
     if (f->culling && !method->pixel)
         obs__cull_candidates(f, est, x0, x1, y0, y1, cand);
+    if (!method->pixel && !f->mask_on && !(col && f->bleed_step > 0)) {
+        ao_tile_lanes(c, cand, x0, x1, y0, y1);
+        return;
+    }
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
             size_t i = (size_t)y * f->width + x;

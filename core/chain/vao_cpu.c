@@ -33,23 +33,36 @@ static inline __attribute__((always_inline)) float min_f(float a, float b) { ret
  * q = D^2 / D0^2 = r^2 |det J| * adaptive_k.  The count is 2 for q < 2,
  * 4 for 2 <= q < 4, ..., capped at the samples parameter; a centre
  * behind the camera takes the maximum. */
-int obs__adaptive_count(const obs__frame *f, const float c[3])
+/* the area ratio q and the centre's clip w */
+static inline __attribute__((always_inline)) float adaptive_q(const obs__frame *f, float c0,
+                                                              float c1, float c2, float *wc)
 {
     const float *P = f->proj;
-    float w = P[12] * c[0] + P[13] * c[1] + P[14] * c[2] + P[15];
-    if (!(w > 0.0f))
-        return f->samples;
-    float X = P[0] * c[0] + P[1] * c[1] + P[2] * c[2] + P[3];
-    float Y = P[4] * c[0] + P[5] * c[1] + P[6] * c[2] + P[7];
+    float w = P[12] * c0 + P[13] * c1 + P[14] * c2 + P[15];
+    float X = P[0] * c0 + P[1] * c1 + P[2] * c2 + P[3];
+    float Y = P[4] * c0 + P[5] * c1 + P[6] * c2 + P[7];
     float w2 = w * w;
     float j00 = (P[0] * w - X * P[12]) / w2, j01 = (P[1] * w - X * P[13]) / w2;
     float j10 = (P[4] * w - Y * P[12]) / w2, j11 = (P[5] * w - Y * P[13]) / w2;
     float r = 0.5f * f->radius;
-    float q = r * r * fabsf(j00 * j11 - j01 * j10) * f->adaptive_k;
+    *wc = w;
+    return r * r * fabsf(j00 * j11 - j01 * j10) * f->adaptive_k;
+}
+
+static inline int count_of_q(const obs__frame *f, float q, float w)
+{
+    if (!(w > 0.0f))
+        return f->samples;
     int n = 2;
     while (n < f->samples && q >= (float)n)
         n *= 2;
     return n;
+}
+
+int obs__adaptive_count(const obs__frame *f, const float c[3])
+{
+    float w, q = adaptive_q(f, c[0], c[1], c[2], &w);
+    return count_of_q(f, q, w);
 }
 
 /* GLSL: the count in main() of vao.frag.glsl */
@@ -125,30 +138,42 @@ void obs__rays_rows(float *ao, size_t n)
         ao[i] = ao[i] == 1.0f ? open : obs__rays_from_volume(ao[i]);
 }
 
-/* GLSL: disk_map() in common.glsl */
-void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
-                   obs__disk *m)
+/* GLSL: disk_map() in common.glsl; m[0..8] = u, v, w (obs__disk) */
+static inline __attribute__((always_inline)) void disk_map(const obs__frame *f, float c0, float c1,
+                                                           float c2, float r, float rot0,
+                                                           float rot1, float m[9])
 {
     const float *P = f->proj, *vp = f->viewport;
+    const float c[3] = {c0, c1, c2};
     float k0[4], A[4], B[4];
     for (int i = 0; i < 4; i++) {
         const float *row = P + 4 * i;
         k0[i] = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + row[3];
         float ex = row[0] * r, ey = row[1] * r; /* a step r along view x, y */
-        A[i] = rot[0] * ex + rot[1] * ey;
-        B[i] = rot[0] * ey - rot[1] * ex;
+        A[i] = rot0 * ex + rot1 * ey;
+        B[i] = rot0 * ey - rot1 * ex;
     }
     float hx = 0.5f * vp[2], hy = 0.5f * vp[3];
     float ox = hx - vp[0], oy = hy - vp[1];
-    m->u[0] = hx * A[0] + ox * A[3];
-    m->u[1] = hx * B[0] + ox * B[3];
-    m->u[2] = hx * k0[0] + ox * k0[3];
-    m->v[0] = -hy * A[1] + oy * A[3];
-    m->v[1] = -hy * B[1] + oy * B[3];
-    m->v[2] = -hy * k0[1] + oy * k0[3];
-    m->w[0] = A[3];
-    m->w[1] = B[3];
-    m->w[2] = k0[3];
+    m[0] = hx * A[0] + ox * A[3];
+    m[1] = hx * B[0] + ox * B[3];
+    m[2] = hx * k0[0] + ox * k0[3];
+    m[3] = -hy * A[1] + oy * A[3];
+    m[4] = -hy * B[1] + oy * B[3];
+    m[5] = -hy * k0[1] + oy * k0[3];
+    m[6] = A[3];
+    m[7] = B[3];
+    m[8] = k0[3];
+}
+
+void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
+                   obs__disk *m)
+{
+    float t[9];
+    disk_map(f, c[0], c[1], c[2], r, rot[0], rot[1], t);
+    memcpy(m->u, t, 3 * sizeof(float));
+    memcpy(m->v, t + 3, 3 * sizeof(float));
+    memcpy(m->w, t + 6, 3 * sizeof(float));
 }
 
 /* The pixel coordinates (floored) the disk map sends sample (sx, sy) to;
@@ -413,4 +438,133 @@ float obs__vao_estimate_bent(const obs__frame *f, const float *pos, const float 
     float bleed[3];
     bent[0] = bent[1] = bent[2] = 0.0f;
     return estimate(f, pos, nrm, pos + 3, 4, nrm + 2, 3, NULL, x, y, p, n, ns, xy, bleed, bent);
+}
+
+/* Section 4.1's count of each of the m pixels px[] (obs__vao_count), the
+ * pixels in SIMD lanes. */
+OBS__LANES
+void obs__vao_counts(const obs__frame *f, const float *pos, const float *nrm, const int *px, int m,
+                     int *n)
+{
+    const float r = 0.5f * f->radius;
+    if (!f->adaptive) {
+        for (int j = 0; j < m; j++)
+            n[j] = f->samples;
+        return;
+    }
+    for (int j0 = 0; j0 < m; j0 += 64) {
+        const int cnt = m - j0 < 64 ? m - j0 : 64;
+        float q[64], w[64];
+#pragma omp simd
+        for (int j = 0; j < cnt; j++) {
+            const int k = px[j0 + j]; /* < 2^28 (the frame's size limit): 4 k fits */
+            const float c0 = pos[4 * k] + nrm[3 * k] * r, c1 = pos[4 * k + 1] + nrm[3 * k + 1] * r;
+            const float c2 = pos[4 * k + 2] + nrm[3 * k + 2] * r;
+            q[j] = adaptive_q(f, c0, c1, c2, &w[j]);
+        }
+        for (int j = 0; j < cnt; j++)
+            n[j0 + j] = count_of_q(f, q[j], w[j]);
+    }
+}
+
+/* The pixels of obs__vao_estimate_pixels in one chunk of lanes: one
+ * vector of AVX-512, two of AVX2. */
+#define PX_LANES 16
+
+/* estimate_lanes() of m pixels at once: a chunk of PX_LANES pixels in the
+ * lanes, each sample's arithmetic for all of them, eq 1's sums per lane
+ * in the samples' order (so each pixel's result is estimate_lanes()'s,
+ * bit for bit).  What a pixel's samples share is computed once: the
+ * pipes' half lengths and, for a pixel all of whose samples fall on the
+ * planes, eq 2's F.  A pixel with a sample off the planes (the surface
+ * continued past the border, border_cpu.c) is redone by estimate_lanes(). */
+OBS__LANES
+void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float *nrm,
+                              const float *dnz, const int *px, int m, int ns, const float *xy,
+                              float *ao)
+{
+    const float R = f->radius, r = 0.5f * f->radius;
+    const float fw = (float)f->width, fh = (float)f->height;
+    const int w = f->width, range = f->range_check, by_normal = f->range_normal;
+    const float u = f->range_u;
+    float hs[32], F = 0.0f;
+    for (int i = 0; i < ns; i++) {
+        const float sx = xy[2 * i], sy = xy[2 * i + 1];
+        const float l = sqrtf(max_f(0.0f, 1.0f - sx * sx - sy * sy));
+        hs[i] = r * l;
+        F += R * l; /* eq 2: F = R * sum sqrt(1 - x^2 - y^2) */
+    }
+    for (int j0 = 0; j0 < m; j0 += PX_LANES) {
+        const int cnt = m - j0 < PX_LANES ? m - j0 : PX_LANES;
+        float p0[PX_LANES], p1[PX_LANES], p2[PX_LANES], n0[PX_LANES], n1[PX_LANES],
+            n2[PX_LANES], c0[PX_LANES], c1[PX_LANES], c2[PX_LANES], ro0[PX_LANES],
+            ro1[PX_LANES], dm[9][PX_LANES], open[PX_LANES];
+        int xs[PX_LANES], ys[PX_LANES], ownp[PX_LANES], miss[PX_LANES];
+        /* the pixels' own terms; lanes past the m pixels repeat the first */
+        for (int j = 0; j < PX_LANES; j++) {
+            const int k = px[j0 + (j < cnt ? j : 0)];
+            const int x = k % w, y = k / w;
+            const float *p = pos + 4 * (size_t)k, *nv = nrm + 3 * (size_t)k;
+            const float *rot = f->rot[obs__tile_index(f, x, y)];
+            xs[j] = x;
+            ys[j] = y;
+            p0[j] = p[0];
+            p1[j] = p[1];
+            p2[j] = p[2];
+            n0[j] = nv[0];
+            n1[j] = nv[1];
+            n2[j] = nv[2];
+            c0[j] = p[0] + nv[0] * r;
+            c1[j] = p[1] + nv[1] * r;
+            c2[j] = p[2] + nv[2] * r;
+            ro0[j] = rot[0];
+            ro1[j] = rot[1];
+            float t[9];
+            disk_map(f, c0[j], c1[j], c2[j], r, rot[0], rot[1], t);
+            for (int q = 0; q < 9; q++)
+                dm[q][j] = t[q];
+            ownp[j] = fabsf(nv[2]) > OBS_OWN_PLANE_NZ;
+            open[j] = 0.0f;
+            miss[j] = 0;
+        }
+        for (int i = 0; i < ns; i++) {
+            const float sx = xy[2 * i], sy = xy[2 * i + 1], h = hs[i];
+#pragma omp simd
+            for (int j = 0; j < PX_LANES; j++) {
+                /* disk_px() */
+                const float sw = dm[6][j] * sx + dm[7][j] * sy + dm[8][j];
+                const float fu = floor_lane((dm[0][j] * sx + dm[1][j] * sy + dm[2][j]) / sw);
+                const float fv = floor_lane((dm[3][j] * sx + dm[4][j] * sy + dm[5][j]) / sw);
+                const int seen =
+                    (sw > 0.0f) & (fu >= 0.0f) & (fv >= 0.0f) & (fu < fw) & (fv < fh);
+                const int qx = (int)fu & -seen, qy = (int)fv & -seen; /* 0 off the planes */
+                const int k = qy * w + qx;
+                const float d = dnz[2 * k], nzk = dnz[2 * k + 1];
+                const int hit = seen & (d > 0.0f);
+                /* own_plane_depth() on the shaded pixel itself */
+                const float spx = c0[j] + r * (ro0[j] * sx - ro1[j] * sy);
+                const float spy = c1[j] + r * (ro1[j] * sx + ro0[j] * sy);
+                const float own =
+                    -p2[j] + (n0[j] * (spx - p0[j]) + n1[j] * (spy - p1[j])) / n2[j];
+                const int self = hit & (qx == xs[j]) & (qy == ys[j]) & ownp[j];
+                const float zs = self ? own : hit ? d : INFINITY;
+                const float nz = hit ? nzk : 1.0f;
+                const float front = -c2[j] - h;
+                const float dz_ab = min_f(max_f(zs - front, 0.0f), 2.0f * h);
+                /* range_falloff(), eq 4 */
+                const float dd = by_normal ? (front - zs) * fabsf(nz) : front - zs;
+                const float sd = u / max_f(u, dd / R);
+                const float dz_c = 2.0f * h * (1.0f - sd);
+                open[j] += range & (zs < front) ? dz_c : dz_ab;
+                miss[j] |= !seen;
+            }
+        }
+        for (int j = 0; j < cnt; j++) {
+            const int k = px[j0 + j];
+            ao[k] = miss[j] ? estimate_lanes(f, pos, nrm, dnz, xs[j], ys[j], pos + 4 * (size_t)k,
+                                             nrm + 3 * (size_t)k, ns, xy)
+                  : F > 0.0f ? open[j] / F
+                             : 1.0f; /* eq 1 */
+        }
+    }
 }

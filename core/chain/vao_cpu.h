@@ -28,6 +28,20 @@ float obs__vao_estimate_dnz(const obs__frame *f, const float *pos, const float *
                             const float *dnz, const float *col, int x, int y, const float p[3],
                             const float n[3], int ns, const float *xy, float bleed[3]);
 
+/* obs__vao_count of each of the m pixels px[] (indices into the planes)
+ * into n[], the pixels in SIMD lanes (the same counts). */
+void obs__vao_counts(const obs__frame *f, const float *pos, const float *nrm, const int *px, int m,
+                     int *n);
+
+/* ao[px[j]] = obs__vao_estimate_dnz's AO of each of the m pixels px[]
+ * (indices into the planes), all taking the ns samples at xy, without
+ * colour bleeding and without object masks (the caller's to rule out):
+ * the same results, bit for bit, the pixels in SIMD lanes over the
+ * sample set (a tile's pixels at once). */
+void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float *nrm,
+                              const float *dnz, const int *px, int m, int ns, const float *xy,
+                              float *ao);
+
 /* obs__cull_prepass (the same result) with the estimator above. */
 void obs__cull_prepass_dnz(const obs__frame *f, const float *pos, const float *nrm,
                            const float *dnz, float *est);

@@ -153,6 +153,74 @@ static void test_vao_bit_for_bit(void **state)
     }
 }
 
+/* A tile's pixels in lanes over the sample set (obs__vao_estimate_pixels)
+ * and their counts in lanes (obs__vao_counts): the twin's results bit for
+ * bit, for every set size, on lists of pixels in an order of their own (a
+ * stride through the frame, so chunks mix rows and the image's border)
+ * and of lengths that leave a partial chunk. */
+static void test_vao_pixels_bit_for_bit(void **state)
+{
+    static const char *const sets[][5] = {
+        {"range_check", "on", NULL},
+        {"range_check", "off", NULL},
+        {"range_distance", "normal", NULL},
+        {"adaptive_diameter", "0.2", NULL},
+    };
+    (void)state;
+    for (size_t s = 0; s < sizeof sets / sizeof sets[0]; s++) {
+        obs__plan pl;
+        obs_gbuffer_file gf = {0};
+        float *pos, *nrm, *dnz;
+        room_planes(&pl, &gf, sets[s], &pos, &nrm, &dnz);
+        const obs__frame *f = &pl.f;
+        const size_t npx = (size_t)f->width * (size_t)f->height;
+        int *px = malloc(npx * sizeof(int)), *cnt = malloc(npx * sizeof(int));
+        float *ao = malloc(npx * sizeof(float));
+        assert_true(px && cnt && ao);
+        int m = 0;
+        for (size_t k = 0, i = 0; k < npx; k++, i = (i + 7919) % npx) /* 7919: prime */
+            if (pos[4 * i + 3] > 0.0f)
+                px[m++] = (int)i;
+        assert_true(m > 1000);
+        int counts_seen = 0;
+        obs__vao_counts(f, pos, nrm, px, m, cnt);
+        for (int j = 0; j < m; j++) {
+            if (cnt[j] != obs__vao_count(f, pos + 4 * (size_t)px[j], nrm + 3 * (size_t)px[j]))
+                fail_msg("%s %s, pixel %d: count %d, the twin's %d", sets[s][0], sets[s][1],
+                         px[j], cnt[j],
+                         obs__vao_count(f, pos + 4 * (size_t)px[j], nrm + 3 * (size_t)px[j]));
+            counts_seen |= cnt[j];
+        }
+        if (s == 3)
+            assert_true(counts_seen & 2); /* a diameter that gives some pixels 2 samples */
+        for (int ns = 2; ns <= 32; ns *= 2) {
+            const float *xy = f->sample_table + 2 * (ns - 2);
+            for (int len = m - 5; len <= m; len += 5) { /* a partial last chunk, then m */
+                for (size_t i = 0; i < npx; i++)
+                    ao[i] = -1.0f;
+                obs__vao_estimate_pixels(f, pos, nrm, dnz, px, len, ns, xy, ao);
+                for (int j = 0; j < len; j++) {
+                    const int i = px[j], x = i % f->width, y = i / f->width;
+                    float b = obs__vao_estimate(f, pos, nrm, x, y, pos + 4 * (size_t)i,
+                                                nrm + 3 * (size_t)i, ns, xy);
+                    if (memcmp(&ao[i], &b, sizeof b))
+                        fail_msg("%s %s, %d samples, pixel (%d, %d): %.9g, the twin %.9g",
+                                 sets[s][0], sets[s][1], ns, x, y, ao[i], b);
+                }
+                for (int j = len; j < m; j++) /* only the listed pixels written */
+                    assert_true(ao[px[j]] == -1.0f);
+            }
+        }
+        free(px);
+        free(cnt);
+        free(ao);
+        free(pos);
+        free(nrm);
+        free(dnz);
+        obs_gbuffer_free(&gf);
+    }
+}
+
 /* ao_definition rays over rows: obs__rays_from_volume of every value,
  * 1 (the open pixels' shortcut) and values around it included. */
 static void test_rays_rows(void **state)
@@ -177,6 +245,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_blur_bit_for_bit),
         cmocka_unit_test(test_vao_bit_for_bit),
+        cmocka_unit_test(test_vao_pixels_bit_for_bit),
         cmocka_unit_test(test_rays_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
