@@ -128,14 +128,57 @@ float obs__rays_from_volume(float ao)
     return 1.0f - blocked;
 }
 
+/* asin(x) for x in [-1, 1], in lanes: Cephes' asinf (S. L. Moshier), its
+ * polynomial on [0, 1/2] and asin(x) = pi/2 - 2 asin(sqrt((1 - x) / 2))
+ * above; relative error about 2.5e-7 (Cephes' bound).  libm's asinf and
+ * acosf are calls, which the lanes cannot make. */
+static inline __attribute__((always_inline)) float asin_lane(float x)
+{
+    const float a = fabsf(x);
+    const int big = a > 0.5f;
+    const float z = big ? 0.5f * (1.0f - a) : a * a;
+    const float s = big ? sqrtf(z) : a;
+    const float P = (((4.2163199048e-2f * z + 2.4181311049e-2f) * z + 4.5470025998e-2f) * z +
+                     7.4953002686e-2f) * z + 1.6666752422e-1f;
+    const float t = s + s * z * P;
+    const float r = big ? 1.57079632679489662f - 2.0f * t : t;
+    return x < 0.0f ? -r : r;
+}
+
+/* obs__rays_from_volume in lanes (no libm call): b = 2 cos((acos(1 - 2o)
+ * + pi) / 3) is 2 sin(asin(1 - 2o) / 3) (pi/2 - acos y = asin y), and
+ * acos(b) = pi/2 - asin(b); sin on [0, pi/6] by its Taylor polynomial to
+ * d^7 (the next term is below 1e-8 there).  Not the twin's libm
+ * acosf / cosf, so not its bits: within RAYS_LANE_TOL of it for every
+ * input (tests/unit/core/test_cpu_simd.c sweeps [0, 1]). */
+static inline __attribute__((always_inline)) float rays_lane(float ao)
+{
+    const float pi = 3.14159265358979f;
+    const float o = 1.0f - min_f(max_f(ao, 0.0f), 1.0f);
+    const float d = asin_lane(1.0f - 2.0f * o) / 3.0f; /* in (0, pi/6] for o < 1/2 */
+    const float d2 = d * d;
+    const float sn = d + d * d2 * (-1.6666666667e-1f + d2 * (8.3333333333e-3f + d2 * -1.9841269841e-4f));
+    /* b is a number (o is, by the clamp above): plain clamps, and
+     * 1 - b^2 >= 0 without one */
+    const float b0 = 2.0f * sn, b1 = b0 > 0.0f ? b0 : 0.0f, b = b1 < 1.0f ? b1 : 1.0f;
+    const float blocked = (1.57079632679489662f - asin_lane(b) - b * sqrtf(1.0f - b * b)) / pi;
+    return o >= 0.5f ? ao : 1.0f - blocked;
+}
+
+OBS__LANES
 void obs__rays_rows(float *ao, size_t n)
 {
     /* the open pixels (AO exactly 1: the background, and the blur of an
-     * open neighbourhood, whose sums are then equal) take the value the
-     * conversion gives 1, computed once: the same float */
+     * open neighbourhood, whose sums are then equal) take the twin's value
+     * of 1, computed once */
     const float open = obs__rays_from_volume(1.0f);
-    for (size_t i = 0; i < n; i++)
-        ao[i] = ao[i] == 1.0f ? open : obs__rays_from_volume(ao[i]);
+    for (size_t i0 = 0; i0 < n; i0 += 4096) {
+        float *a = ao + i0;
+        const int m = n - i0 < 4096 ? (int)(n - i0) : 4096;
+#pragma omp simd
+        for (int i = 0; i < m; i++)
+            a[i] = a[i] == 1.0f ? open : rays_lane(a[i]);
+    }
 }
 
 /* GLSL: disk_map() in common.glsl; m[0..8] = u, v, w (obs__disk) */
