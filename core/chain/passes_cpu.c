@@ -228,10 +228,8 @@ static void position_rows(void *ctx, int y0, int y1)
     const obs_gbuffer *gb = c->pl->gb;
     for (int y = y0; y < y1; y++) {
         const float *depth = obs__plane_px(&gb->depth, f->width, 0, y); /* the row, once */
-        const size_t dc = (size_t)gb->depth.channels;
-        for (int x = 0; x < f->width; x++)
-            obs__prep_position(f, depth[dc * (size_t)x], x, y,
-                               c->pos + 4 * ((size_t)y * f->width + x));
+        obs__prep_position_row(f, depth, (size_t)gb->depth.channels, y,
+                               c->pos + 4 * (size_t)y * f->width);
     }
 }
 
@@ -242,6 +240,12 @@ static void normal_rows(void *ctx, int y0, int y1)
     const obs_gbuffer *gb = c->pl->gb;
     for (int y = y0; y < y1; y++) {
         const float *row = gb->normal.data ? obs__plane_px(&gb->normal, f->width, 0, y) : NULL;
+        const size_t r0 = (size_t)y * f->width;
+        if (row && !f->reconstruct_normals) { /* the input's normals: the row in lanes */
+            obs__prep_normal_row(f, c->pos + 4 * r0, row, (size_t)gb->normal.channels,
+                                 c->nrm + 3 * r0, f->half ? NULL : c->dnz + 2 * r0);
+            continue;
+        }
         for (int x = 0; x < f->width; x++) {
             const float *in = row ? row + (size_t)gb->normal.channels * (size_t)x : NULL;
             const size_t i = (size_t)y * f->width + x;

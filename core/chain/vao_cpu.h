@@ -1,5 +1,5 @@
-/* The CPU device's form of the VAO estimator (vao_cpu.c).  No GL.  Not
- * installed. */
+/* The CPU device's kernels in SIMD lanes: the VAO estimator (vao_cpu.c)
+ * and the prep pass's rows (prep_cpu.c).  No GL.  Not installed. */
 #ifndef OBSCURA_VAO_CPU_H
 #define OBSCURA_VAO_CPU_H
 
@@ -16,6 +16,16 @@
 #define OBS__LANES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define OBS__LANES
+/* The prep pass's rows in lanes (prep_cpu.c), the twins' floats:
+ * obs__prep_position of row y's pixels, their raw depths at depth[dc x],
+ * into out[4 x]; obs__prep_normal of a row's pixels from the input
+ * normals in[nc x] (not for reconstruct_normals) into out[3 x], and,
+ * where dnz is not NULL, the packed plane's row from pos (the row's
+ * positions) and those normals. */
+void obs__prep_position_row(const obs__frame *f, const float *depth, size_t dc, int y, float *out);
+void obs__prep_normal_row(const obs__frame *f, const float *pos, const float *in, size_t nc,
+                          float *out, float *dnz);
+
 #endif
 
 /* obs__vao_estimate_bleed (the same arithmetic, the same result) reading
@@ -58,5 +68,15 @@ void obs__rays_rows(float *ao, size_t n);
  * or ao where there was no memory for the bands' scratch). */
 float *obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, float *ao,
                      float *tmp, int rays);
+
+/* The prep pass's rows in lanes (prep_cpu.c), the twins' floats:
+ * obs__prep_position of row y's pixels, their raw depths at depth[dc x],
+ * into out[4 x]; obs__prep_normal of a row's pixels from the input
+ * normals in[nc x] (not for reconstruct_normals) into out[3 x], and,
+ * where dnz is not NULL, the packed plane's row from pos (the row's
+ * positions) and those normals. */
+void obs__prep_position_row(const obs__frame *f, const float *depth, size_t dc, int y, float *out);
+void obs__prep_normal_row(const obs__frame *f, const float *pos, const float *in, size_t nc,
+                          float *out, float *dnz);
 
 #endif

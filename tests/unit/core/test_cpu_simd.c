@@ -224,6 +224,74 @@ static void test_vao_pixels_bit_for_bit(void **state)
     }
 }
 
+/* The prep pass's rows in lanes (obs__prep_position_row,
+ * obs__prep_normal_row) against obs__prep_position and obs__prep_normal,
+ * bit for bit, in every depth mode, on room_small's rows with raw values
+ * of every kind put in (background, 0, negative, NaN, infinities, 1 and
+ * past, tiny) and a zero normal. */
+static void test_prep_rows(void **state)
+{
+    static const char *const modes[] = {"planar", "radial", "ndc", "inverse", "normalized"};
+    static const float odd[] = {0.0f, -1.0f, NAN, INFINITY, -INFINITY, 1.0f, 1.5f, 1e-30f,
+                                0.999f, 1e30f, 0.5f};
+    (void)state;
+    for (size_t md = 0; md < sizeof modes / sizeof modes[0]; md++) {
+        const char *set[] = {"depth_mode", modes[md], NULL};
+        obs__plan pl;
+        obs_gbuffer_file gf = {0};
+        float *pos, *nrm, *dnz;
+        room_planes(&pl, &gf, set, &pos, &nrm, &dnz);
+        const obs__frame *f = &pl.f;
+        const int w = f->width;
+        float *depth = malloc((size_t)w * 3 * sizeof(float)), *in = malloc((size_t)w * 4 * sizeof(float));
+        float *p1 = malloc((size_t)w * 4 * sizeof(float)), *n1 = malloc((size_t)w * 3 * sizeof(float));
+        float *d1 = malloc((size_t)w * 2 * sizeof(float));
+        assert_true(depth && in && p1 && n1 && d1);
+        for (int y = 0; y < f->height; y += 7) {
+            for (int x = 0; x < w; x++) { /* 3 channels, the depth in the first */
+                float raw = *obs__plane_px(&gf.gb.depth, w, x, y);
+                depth[3 * x] = x % 5 == 0 ? odd[(x / 5 + y) % (sizeof odd / sizeof odd[0])] : raw;
+                depth[3 * x + 1] = depth[3 * x + 2] = -7.0f;
+                const float *nv = obs__plane_px(&gf.gb.normal, w, x, y);
+                for (int k = 0; k < 3; k++)
+                    in[4 * x + k] = x == 3 ? 0.0f : nv[k];
+                in[4 * x + 3] = -7.0f;
+            }
+            obs__prep_position_row(f, depth, 3, y, p1);
+            for (int x = 0; x < w; x++) {
+                float want[4];
+                obs__prep_position(f, depth[3 * x], x, y, want);
+                if (memcmp(want, p1 + 4 * x, sizeof want))
+                    fail_msg("depth %s, pixel (%d, %d), raw %g: (%g %g %g %g), the twin (%g %g "
+                             "%g %g)", modes[md], x, y, depth[3 * x], p1[4 * x], p1[4 * x + 1],
+                             p1[4 * x + 2], p1[4 * x + 3], want[0], want[1], want[2], want[3]);
+            }
+            if (!f->reconstruct_normals) {
+                obs__prep_normal_row(f, p1, in, 4, n1, d1);
+                for (int x = 0; x < w; x++) {
+                    float want[3];
+                    obs__prep_normal(f, pos, in + 4 * x, x, y, want); /* pos: not read */
+                    if (memcmp(want, n1 + 3 * x, sizeof want) || d1[2 * x] != p1[4 * x + 3] ||
+                        memcmp(&d1[2 * x + 1], &want[2], sizeof(float)))
+                        fail_msg("depth %s, pixel (%d, %d): normal (%g %g %g), the twin (%g %g "
+                                 "%g)", modes[md], x, y, n1[3 * x], n1[3 * x + 1], n1[3 * x + 2],
+                                 want[0], want[1], want[2]);
+                }
+            }
+        }
+        assert_false(f->reconstruct_normals);
+        free(depth);
+        free(in);
+        free(p1);
+        free(n1);
+        free(d1);
+        free(pos);
+        free(nrm);
+        free(dnz);
+        obs_gbuffer_free(&gf);
+    }
+}
+
 /* ao_definition rays over rows (obs__rays_rows, the conversion in lanes
  * by polynomials): within RAYS_TOL of obs__rays_from_volume (libm's acosf
  * and cosf) at every value of a sweep of [0, 1] (2^20 + 1 values; the
@@ -268,6 +336,7 @@ int main(void)
         cmocka_unit_test(test_vao_bit_for_bit),
         cmocka_unit_test(test_vao_pixels_bit_for_bit),
         cmocka_unit_test(test_rays_rows),
+        cmocka_unit_test(test_prep_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
