@@ -181,39 +181,40 @@ void obs__rays_rows(float *ao, size_t n)
     }
 }
 
-/* GLSL: disk_map() in common.glsl; m[0..8] = u, v, w (obs__disk) */
+/* GLSL: disk_map() in common.glsl; m[0], m[s], ..., m[8 s] = u, v, w
+ * (obs__disk).  The rows 0, 1 and 3 of the projection (row 2, z, is not in
+ * the map), written out so that the lanes can take it. */
 static inline __attribute__((always_inline)) void disk_map(const obs__frame *f, float c0, float c1,
                                                            float c2, float r, float rot0,
-                                                           float rot1, float m[9])
+                                                           float rot1, float *m, int s)
 {
     const float *P = f->proj, *vp = f->viewport;
-    const float c[3] = {c0, c1, c2};
-    float k0[4], A[4], B[4];
-    for (int i = 0; i < 4; i++) {
-        const float *row = P + 4 * i;
-        k0[i] = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + row[3];
-        float ex = row[0] * r, ey = row[1] * r; /* a step r along view x, y */
-        A[i] = rot0 * ex + rot1 * ey;
-        B[i] = rot0 * ey - rot1 * ex;
-    }
-    float hx = 0.5f * vp[2], hy = 0.5f * vp[3];
-    float ox = hx - vp[0], oy = hy - vp[1];
-    m[0] = hx * A[0] + ox * A[3];
-    m[1] = hx * B[0] + ox * B[3];
-    m[2] = hx * k0[0] + ox * k0[3];
-    m[3] = -hy * A[1] + oy * A[3];
-    m[4] = -hy * B[1] + oy * B[3];
-    m[5] = -hy * k0[1] + oy * k0[3];
-    m[6] = A[3];
-    m[7] = B[3];
-    m[8] = k0[3];
+#define DISK_ROW(i, k0, A, B)                                                                 \
+    const float k0 = P[4 * i] * c0 + P[4 * i + 1] * c1 + P[4 * i + 2] * c2 + P[4 * i + 3]; \
+    const float A = rot0 * (P[4 * i] * r) + rot1 * (P[4 * i + 1] * r);                     \
+    const float B = rot0 * (P[4 * i + 1] * r) - rot1 * (P[4 * i] * r)
+    DISK_ROW(0, k00, A0, B0); /* A, B: a step r along the rotated view x, y */
+    DISK_ROW(1, k01, A1, B1);
+    DISK_ROW(3, k03, A3, B3);
+#undef DISK_ROW
+    const float hx = 0.5f * vp[2], hy = 0.5f * vp[3];
+    const float ox = hx - vp[0], oy = hy - vp[1];
+    m[0] = hx * A0 + ox * A3;
+    m[1 * s] = hx * B0 + ox * B3;
+    m[2 * s] = hx * k00 + ox * k03;
+    m[3 * s] = -hy * A1 + oy * A3;
+    m[4 * s] = -hy * B1 + oy * B3;
+    m[5 * s] = -hy * k01 + oy * k03;
+    m[6 * s] = A3;
+    m[7 * s] = B3;
+    m[8 * s] = k03;
 }
 
 void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
                    obs__disk *m)
 {
     float t[9];
-    disk_map(f, c[0], c[1], c[2], r, rot[0], rot[1], t);
+    disk_map(f, c[0], c[1], c[2], r, rot[0], rot[1], t, 1);
     memcpy(m->u, t, 3 * sizeof(float));
     memcpy(m->v, t + 3, 3 * sizeof(float));
     memcpy(m->w, t + 6, 3 * sizeof(float));
@@ -385,6 +386,23 @@ static inline __attribute__((always_inline)) float floor_lane(float v)
     return fabsf(v) < 8388608.0f ? fl : v;
 }
 
+/* The unoccluded length *dz of the pipe of half length h (centre depth
+ * -c2) of a sample off the planes (border_sample), as estimate() takes it;
+ * 0 where the sample is left out of eq 1. */
+static int border_dz(const obs__frame *f, const float *pos, const float *nrm, const obs__disk *m,
+                     int x, int y, float sx, float sy, float c2, float h, float *dz)
+{
+    float zs = INFINITY, nz = 1.0f;
+    if (!border_sample(f, pos, nrm, m, x, y, sx, sy, &zs, &nz))
+        return 0;
+    const float front = -c2 - h;
+    float d = min_f(max_f(zs - front, 0.0f), 2.0f * h);
+    if (f->range_check && zs < front)
+        d = 2.0f * h * (1.0f - range_falloff(f, front - zs, nz));
+    *dz = d;
+    return 1;
+}
+
 /* estimate() without colour bleeding, its samples in SIMD lanes
  * (#pragma omp simd, gcc -fopenmp-simd): each sample's pixel, depth and
  * pipe length computed in every lane with selects in place of branches,
@@ -442,17 +460,10 @@ static inline __attribute__((always_inline)) float estimate_lanes(const obs__fra
     /* a sample off the planes reads the surface continued past the border
      * (border_sample, border_cpu.c), one by one, its pipe as estimate()
      * takes it */
-    for (int i = 0; i < ns; i++) {
-        float zs = INFINITY, nz = 1.0f;
-        if (seens[i] || !border_sample(f, pos, nrm, &m, x, y, xy[2 * i], xy[2 * i + 1], &zs, &nz))
-            continue;
-        const float h = r * ls[i], front = -c[2] - h;
-        float dz = min_f(max_f(zs - front, 0.0f), 2.0f * h);
-        if (f->range_check && zs < front)
-            dz = 2.0f * h * (1.0f - range_falloff(f, front - zs, nz));
-        dzs[i] = dz;
-        seens[i] = 1;
-    }
+    for (int i = 0; i < ns; i++)
+        if (!seens[i])
+            seens[i] = border_dz(f, pos, nrm, &m, x, y, xy[2 * i], xy[2 * i + 1], c[2], r * ls[i],
+                                 &dzs[i]);
     float open = 0.0f, F = 0.0f;
     for (int i = 0; i < ns; i++)
         if (seens[i]) {
@@ -513,14 +524,17 @@ void obs__vao_counts(const obs__frame *f, const float *pos, const float *nrm, co
 /* The pixels of obs__vao_estimate_pixels in one chunk of lanes: one
  * vector of AVX-512, two of AVX2. */
 #define PX_LANES 16
+#define DM(q) dm[(q) * PX_LANES + j] /* term q of lane j's disk map */
 
 /* estimate_lanes() of m pixels at once: a chunk of PX_LANES pixels in the
- * lanes, each sample's arithmetic for all of them, eq 1's sums per lane
- * in the samples' order (so each pixel's result is estimate_lanes()'s,
- * bit for bit).  What a pixel's samples share is computed once: the
- * pipes' half lengths and, for a pixel all of whose samples fall on the
- * planes, eq 2's F.  A pixel with a sample off the planes (the surface
- * continued past the border, border_cpu.c) is redone by estimate_lanes(). */
+ * lanes, each sample's arithmetic for all of them (the pixels' own terms,
+ * the disk map among them, in lanes too), eq 1's sums per lane in the
+ * samples' order, so each pixel's result is estimate_lanes()'s, bit for
+ * bit.  What a pixel's samples share is computed once: the pipes' half
+ * lengths and, for a pixel all of whose samples fall on the planes, eq 2's
+ * F.  A sample off the planes (the surface continued past the border,
+ * border_cpu.c) is taken afterwards, one by one, and its pixel's sums
+ * redone in the samples' order. */
 OBS__LANES
 void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float *nrm,
                               const float *dnz, const int *px, int m, int ns, const float *xy,
@@ -530,10 +544,12 @@ void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float
     const float fw = (float)f->width, fh = (float)f->height;
     const int w = f->width, range = f->range_check, by_normal = f->range_normal;
     const float u = f->range_u;
-    float hs[32], F = 0.0f;
+    float ls[32], hs[32], F = 0.0f, rots[18];
+    memcpy(rots, f->rot, sizeof rots);
     for (int i = 0; i < ns; i++) {
         const float sx = xy[2 * i], sy = xy[2 * i + 1];
         const float l = sqrtf(max_f(0.0f, 1.0f - sx * sx - sy * sy));
+        ls[i] = l;
         hs[i] = r * l;
         F += R * l; /* eq 2: F = R * sum sqrt(1 - x^2 - y^2) */
     }
@@ -541,32 +557,33 @@ void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float
         const int cnt = m - j0 < PX_LANES ? m - j0 : PX_LANES;
         float p0[PX_LANES], p1[PX_LANES], p2[PX_LANES], n0[PX_LANES], n1[PX_LANES],
             n2[PX_LANES], c0[PX_LANES], c1[PX_LANES], c2[PX_LANES], ro0[PX_LANES],
-            ro1[PX_LANES], dm[9][PX_LANES], open[PX_LANES];
-        int xs[PX_LANES], ys[PX_LANES], ownp[PX_LANES], miss[PX_LANES];
-        /* the pixels' own terms; lanes past the m pixels repeat the first */
+            ro1[PX_LANES], dm[9 * PX_LANES], open[PX_LANES], dzs[32][PX_LANES];
+        int kk[PX_LANES], ti[PX_LANES], xs[PX_LANES], ys[PX_LANES], ownp[PX_LANES],
+            miss[PX_LANES], seen_at[32][PX_LANES];
+        /* lanes past the m pixels repeat the first */
         for (int j = 0; j < PX_LANES; j++) {
-            const int k = px[j0 + (j < cnt ? j : 0)];
-            const int x = k % w, y = k / w;
-            const float *p = pos + 4 * (size_t)k, *nv = nrm + 3 * (size_t)k;
-            const float *rot = f->rot[obs__tile_index(f, x, y)];
-            xs[j] = x;
-            ys[j] = y;
-            p0[j] = p[0];
-            p1[j] = p[1];
-            p2[j] = p[2];
-            n0[j] = nv[0];
-            n1[j] = nv[1];
-            n2[j] = nv[2];
-            c0[j] = p[0] + nv[0] * r;
-            c1[j] = p[1] + nv[1] * r;
-            c2[j] = p[2] + nv[2] * r;
-            ro0[j] = rot[0];
-            ro1[j] = rot[1];
-            float t[9];
-            disk_map(f, c0[j], c1[j], c2[j], r, rot[0], rot[1], t);
-            for (int q = 0; q < 9; q++)
-                dm[q][j] = t[q];
-            ownp[j] = fabsf(nv[2]) > OBS_OWN_PLANE_NZ;
+            kk[j] = px[j0 + (j < cnt ? j : 0)];
+            xs[j] = kk[j] % w;
+            ys[j] = kk[j] / w;
+            ti[j] = obs__tile_index(f, xs[j], ys[j]);
+        }
+        /* the pixels' own terms */
+#pragma omp simd
+        for (int j = 0; j < PX_LANES; j++) {
+            const int k = kk[j]; /* < 2^28 (the frame's size limit): 4 k fits */
+            p0[j] = pos[4 * k];
+            p1[j] = pos[4 * k + 1];
+            p2[j] = pos[4 * k + 2];
+            n0[j] = nrm[3 * k];
+            n1[j] = nrm[3 * k + 1];
+            n2[j] = nrm[3 * k + 2];
+            c0[j] = p0[j] + n0[j] * r;
+            c1[j] = p1[j] + n1[j] * r;
+            c2[j] = p2[j] + n2[j] * r;
+            ro0[j] = rots[2 * ti[j]];
+            ro1[j] = rots[2 * ti[j] + 1];
+            disk_map(f, c0[j], c1[j], c2[j], r, ro0[j], ro1[j], dm + j, PX_LANES);
+            ownp[j] = fabsf(n2[j]) > OBS_OWN_PLANE_NZ;
             open[j] = 0.0f;
             miss[j] = 0;
         }
@@ -575,9 +592,9 @@ void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float
 #pragma omp simd
             for (int j = 0; j < PX_LANES; j++) {
                 /* disk_px() */
-                const float sw = dm[6][j] * sx + dm[7][j] * sy + dm[8][j];
-                const float fu = floor_lane((dm[0][j] * sx + dm[1][j] * sy + dm[2][j]) / sw);
-                const float fv = floor_lane((dm[3][j] * sx + dm[4][j] * sy + dm[5][j]) / sw);
+                const float sw = DM(6) * sx + DM(7) * sy + DM(8);
+                const float fu = floor_lane((DM(0) * sx + DM(1) * sy + DM(2)) / sw);
+                const float fv = floor_lane((DM(3) * sx + DM(4) * sy + DM(5)) / sw);
                 const int seen =
                     (sw > 0.0f) & (fu >= 0.0f) & (fv >= 0.0f) & (fu < fw) & (fv < fh);
                 const int qx = (int)fu & -seen, qy = (int)fv & -seen; /* 0 off the planes */
@@ -598,16 +615,32 @@ void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float
                 const float dd = by_normal ? (front - zs) * fabsf(nz) : front - zs;
                 const float sd = u / max_f(u, dd / R);
                 const float dz_c = 2.0f * h * (1.0f - sd);
-                open[j] += range & (zs < front) ? dz_c : dz_ab;
+                const float dz = range & (zs < front) ? dz_c : dz_ab;
+                open[j] += dz;
+                dzs[i][j] = dz;
+                seen_at[i][j] = seen;
                 miss[j] |= !seen;
             }
         }
         for (int j = 0; j < cnt; j++) {
-            const int k = px[j0 + j];
-            ao[k] = miss[j] ? estimate_lanes(f, pos, nrm, dnz, xs[j], ys[j], pos + 4 * (size_t)k,
-                                             nrm + 3 * (size_t)k, ns, xy)
-                  : F > 0.0f ? open[j] / F
-                             : 1.0f; /* eq 1 */
+            if (!miss[j]) {
+                ao[kk[j]] = F > 0.0f ? open[j] / F : 1.0f; /* eq 1 */
+                continue;
+            }
+            /* the samples off the planes, then the sums in the samples' order */
+            const obs__disk dk = {{DM(0), DM(1), DM(2)},
+                                  {DM(3), DM(4), DM(5)},
+                                  {DM(6), DM(7), DM(8)}};
+            float o = 0.0f, Fp = 0.0f;
+            for (int i = 0; i < ns; i++) {
+                float dz = dzs[i][j];
+                if (!seen_at[i][j] && !border_dz(f, pos, nrm, &dk, xs[j], ys[j], xy[2 * i],
+                                                 xy[2 * i + 1], c2[j], hs[i], &dz))
+                    continue;
+                o += dz;
+                Fp += R * ls[i]; /* eq 2 */
+            }
+            ao[kk[j]] = Fp > 0.0f ? o / Fp : 1.0f; /* eq 1 */
         }
     }
 }
