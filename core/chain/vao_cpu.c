@@ -11,11 +11,6 @@
 #include "chain/mask_weight.h"
 #include "chain/vao_cpu.h"
 
-/* fmaxf and fminf as glibc computes them (the other argument when one is
- * NaN, the first when they are equal, so also for +0 and -0), inline:
- * the estimator calls them per sample, and gcc calls libm for them. */
-static inline __attribute__((always_inline)) float max_f(float a, float b) { return (a >= b) | (b != b) ? a : b; }
-static inline __attribute__((always_inline)) float min_f(float a, float b) { return (a <= b) | (b != b) ? a : b; }
 
 /* GLSL: adaptive_count() in vao.frag.glsl.  Section 4.1: "double the
  * number of samples every time surface area of the sampling disc
@@ -373,17 +368,6 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
                               int ns, const float *xy, float bleed[3])
 {
     return estimate(f, pos, nrm, pos + 3, 4, nrm + 2, 3, col, x, y, p, n, ns, xy, bleed, NULL);
-}
-
-/* floorf(v) where the caller needs only its comparisons and its int:
- * through the int conversion, which the lanes have (floorf has no SSE2
- * form); the same value for |v| < 2^23, v itself above (already an
- * integer), NaN kept (it fails every comparison, as floorf's does). */
-static inline __attribute__((always_inline)) float floor_lane(float v)
-{
-    const float t = (float)(int)v; /* garbage for |v| >= 2^31: not selected */
-    const float fl = t > v ? t - 1.0f : t;
-    return fabsf(v) < 8388608.0f ? fl : v;
 }
 
 /* The unoccluded length *dz of the pipe of half length h (centre depth
