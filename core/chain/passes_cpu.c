@@ -161,6 +161,41 @@ static void ao_tile_lanes(obs__cpu_run *c, const unsigned char *cand, int x0, in
             }
 }
 
+/* ao_tile() for a comparison method without the bent normal: the
+ * tile's pixels with geometry in SIMD lanes (obs__method_pixels); 0 (the
+ * tile untouched) where the method has no lanes. */
+static int ao_tile_method(obs__cpu_run *c, int x0, int x1, int y0, int y1)
+{
+    const obs__frame *f = c->pl->af;
+    const float *pos = c->apos, *nrm = c->anrm;
+    float *count = c->out->sample_count.data;
+    int px[AO_TILE_W * AO_TILE_H], m = 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            const size_t i = (size_t)y * f->width + x;
+            if (pos[4 * i + 3] > 0.0f)
+                px[m++] = (int)i;
+        }
+    if (m > 0 && !obs__method_pixels(f, pos, nrm, px, m, c->aao, count))
+        return 0;
+    const int bleed_read = c->pl->f.bleed_step || c->out->bleed.data;
+    float *mask = c->out->cull_mask.data;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            const size_t i = (size_t)y * f->width + x;
+            if (bleed_read)
+                c->ableed[3 * i] = c->ableed[3 * i + 1] = c->ableed[3 * i + 2] = 1.0f;
+            if (mask)
+                mask[i] = 0.0f;
+            if (pos[4 * i + 3] > 0.0f)
+                continue;
+            c->aao[i] = 1.0f; /* background */
+            if (count)
+                count[i] = 0.0f;
+        }
+    return 1;
+}
+
 static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
 {
     obs__cpu_run *c = ctx;
@@ -179,6 +214,8 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
         ao_tile_lanes(c, cand, x0, x1, y0, y1);
         return;
     }
+    if (method->pixel && !c->out->bent.data && ao_tile_method(c, x0, x1, y0, y1))
+        return;
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
             size_t i = (size_t)y * f->width + x;

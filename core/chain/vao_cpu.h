@@ -1,5 +1,6 @@
-/* The CPU device's kernels in SIMD lanes: the VAO estimator (vao_cpu.c)
- * and the prep pass's rows (prep_cpu.c).  No GL.  Not installed. */
+/* The CPU device's kernels in SIMD lanes: the VAO estimator (vao_cpu.c),
+ * the prep pass's rows (prep_cpu.c) and the comparison methods
+ * (methods_cpu.c).  No GL.  Not installed. */
 #ifndef OBSCURA_VAO_CPU_H
 #define OBSCURA_VAO_CPU_H
 
@@ -88,5 +89,14 @@ float *obs__blur_dnz(const obs__frame *f, const float *pos, const float *dnz, fl
 void obs__prep_position_row(const obs__frame *f, const float *depth, size_t dc, int y, float *out);
 void obs__prep_normal_row(const obs__frame *f, const float *pos, const float *in, size_t nc,
                           float *out, float *dnz);
+
+/* The comparison method's AO (obs__method_pixel) of each of the m pixels
+ * px[] (indices into the planes, each with geometry) into ao[px[j]], and
+ * its sample count into count[px[j]] (count NULL: not wanted), the pixels
+ * in SIMD lanes (methods_cpu.c), the same results bit for bit; the flat
+ * chain without object masks.  0 (nothing written) where the method has
+ * no lanes: the caller then takes obs__method_pixel. */
+int obs__method_pixels(const obs__frame *f, const float *pos, const float *nrm, const int *px,
+                       int m, float *ao, float *count);
 
 #endif

@@ -13,6 +13,7 @@
 #include "chain/frame.h"
 #include "chain/passes.h"
 #include "chain/vao_cpu.h"
+#include "methods/methods.h"
 #include "obscura/io.h"
 
 enum { W = 301, H = 77 };
@@ -292,6 +293,63 @@ static void test_prep_rows(void **state)
     }
 }
 
+/* The comparison methods in lanes (obs__method_pixels) against their
+ * twins (obs__method_pixel) at every pixel with geometry of room_small,
+ * bit for bit, AO and sample count, with default and non-default
+ * parameters, on a list of pixels in an order of its own with a partial
+ * last chunk; methods without lanes (and object masks) leave it to the
+ * twin. */
+static void test_method_pixels(void **state)
+{
+    static const char *const sets[][9] = {
+        {"method", "hemisphere", NULL},
+        {"method", "hemisphere", "hemisphere_samples", "3", "hemisphere_bias", "0.2", NULL},
+        {"method", "hbao", NULL},
+        {"method", "hbao", "hbao_directions", "5", "hbao_steps", "13", "radius", "2.5", NULL},
+        {"method", "hbao", "radius", "0.02", NULL}, /* a kernel within a pixel: AO 1 */
+        {"method", "gtao", NULL},
+        {"method", "angle", NULL},
+    };
+    (void)state;
+    for (size_t s = 0; s < sizeof sets / sizeof sets[0]; s++) {
+        obs__plan pl;
+        obs_gbuffer_file gf = {0};
+        float *pos, *nrm, *dnz;
+        room_planes(&pl, &gf, sets[s], &pos, &nrm, &dnz);
+        const obs__frame *f = &pl.f;
+        const size_t npx = (size_t)f->width * (size_t)f->height;
+        int *px = malloc(npx * sizeof(int));
+        float *ao = malloc(npx * sizeof(float)), *cnt = malloc(npx * sizeof(float));
+        assert_true(px && ao && cnt);
+        int m = 0;
+        for (size_t k = 0, i = 0; k < npx; k++, i = (i + 7919) % npx)
+            if (pos[4 * i + 3] > 0.0f)
+                px[m++] = (int)i;
+        m -= 3; /* a partial last chunk */
+        for (size_t i = 0; i < npx; i++)
+            ao[i] = cnt[i] = -1.0f;
+        const int lanes = obs__method_pixels(f, pos, nrm, px, m, ao, cnt);
+        assert_int_equal(lanes, s < 5); /* gtao, angle: none yet */
+        for (int j = 0; lanes && j < m; j++) {
+            const int i = px[j], x = i % f->width, y = i / f->width;
+            int n = -1;
+            const float want = obs__method_pixel(f, pos, nrm, x, y, &n);
+            if (memcmp(&ao[i], &want, sizeof want) || cnt[i] != (float)n)
+                fail_msg("%s (set %zu), pixel (%d, %d): %.9g, %g samples; the twin %.9g, %d",
+                         sets[s][1], s, x, y, ao[i], cnt[i], want, n);
+        }
+        for (int j = m; j < m + 3; j++) /* only the listed pixels written */
+            assert_true(ao[px[j]] == -1.0f && cnt[px[j]] == -1.0f);
+        free(px);
+        free(ao);
+        free(cnt);
+        free(pos);
+        free(nrm);
+        free(dnz);
+        obs_gbuffer_free(&gf);
+    }
+}
+
 /* ao_definition rays over rows (obs__rays_rows, the conversion in lanes
  * by polynomials): within RAYS_TOL of obs__rays_from_volume (libm's acosf
  * and cosf) at every value of a sweep of [0, 1] (2^20 + 1 values; the
@@ -337,6 +395,7 @@ int main(void)
         cmocka_unit_test(test_vao_pixels_bit_for_bit),
         cmocka_unit_test(test_rays_rows),
         cmocka_unit_test(test_prep_rows),
+        cmocka_unit_test(test_method_pixels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,235 @@
+/* Two of the comparison methods' CPU twins (core/methods/: hemisphere.c,
+ * hbao.c) over a tile's pixels in SIMD lanes: a chunk of
+ * METHOD_LANES pixels, each sample's arithmetic for all of them, every
+ * pixel's sums in the twin's order, so each result is the twin's, bit for
+ * bit (tests/unit/core/test_cpu_simd.c).  The flat chain only (one node a
+ * pixel), without object masks and without the bent normal: the callers
+ * take the twins pixel by pixel for those. */
+#include <string.h>
+
+#include "chain/vao_cpu.h"
+#include "methods/hbao.h"
+#include "methods/hemisphere.h"
+
+#define METHOD_LANES 16
+
+/* The pixels' indices, coordinates and tile rotations of one chunk; lanes
+ * past the cnt pixels repeat the first. */
+typedef struct chunk {
+    int cnt, k[METHOD_LANES], x[METHOD_LANES], y[METHOD_LANES];
+    float ro0[METHOD_LANES], ro1[METHOD_LANES];
+} chunk;
+
+static void chunk_at(const obs__frame *f, const int *px, int m, int j0, chunk *c)
+{
+    c->cnt = m - j0 < METHOD_LANES ? m - j0 : METHOD_LANES;
+    for (int j = 0; j < METHOD_LANES; j++) {
+        const int k = px[j0 + (j < c->cnt ? j : 0)];
+        c->k[j] = k;
+        c->x[j] = k % f->width;
+        c->y[j] = k / f->width;
+        const float *rot = f->rot[obs__tile_index(f, c->x[j], c->y[j])];
+        c->ro0[j] = rot[0];
+        c->ro1[j] = rot[1];
+    }
+}
+
+/* GLSL: view_to_px() in common.glsl (obs__view_to_px): 1 and the pixel of
+ * view point s on the planes, else 0 (and pixel 0, 0). */
+static inline __attribute__((always_inline)) int view_px_lane(const float *P, const float *vp,
+                                                              float fw, float fh, float s0,
+                                                              float s1, float s2, int *qx,
+                                                              int *qy)
+{
+    const float cx = P[0] * s0 + P[1] * s1 + P[2] * s2 + P[3];
+    const float cy = P[4] * s0 + P[5] * s1 + P[6] * s2 + P[7];
+    const float cw = P[12] * s0 + P[13] * s1 + P[14] * s2 + P[15];
+    const float u = (cx / cw * 0.5f + 0.5f) * vp[2] - vp[0];
+    const float v = (0.5f - cy / cw * 0.5f) * vp[3] - vp[1];
+    const float fu = floor_lane(u), fv = floor_lane(v);
+    const int ok = (cw > 0.0f) & (fu >= 0.0f) & (fv >= 0.0f) & (fu < fw) & (fv < fh);
+    *qx = (int)fu & -ok;
+    *qy = (int)fv & -ok;
+    return ok;
+}
+
+/* The pixels' positions and normals of a chunk, in lanes. */
+typedef struct lanes_pn {
+    float p0[METHOD_LANES], p1[METHOD_LANES], p2[METHOD_LANES];
+    float n0[METHOD_LANES], n1[METHOD_LANES], n2[METHOD_LANES];
+} lanes_pn;
+
+static inline __attribute__((always_inline)) void lanes_load(const float *pos, const float *nrm,
+                                                             const chunk *c, lanes_pn *v)
+{
+#pragma omp simd
+    for (int j = 0; j < METHOD_LANES; j++) {
+        const int k = c->k[j]; /* < 2^28 (the frame's size limit): 4 k fits */
+        v->p0[j] = pos[4 * k];
+        v->p1[j] = pos[4 * k + 1];
+        v->p2[j] = pos[4 * k + 2];
+        v->n0[j] = nrm[3 * k];
+        v->n1[j] = nrm[3 * k + 1];
+        v->n2[j] = nrm[3 * k + 2];
+    }
+}
+
+/* hemisphere: obs__hemisphere_pixel */
+OBS__LANES
+static void hemisphere_pixels(const obs__frame *f, const float *pos, const float *nrm,
+                              const int *px, int m, float *ao)
+{
+    const obs__hemisphere_state *hs = obs__hemisphere_of(f);
+    const float R = f->radius, bias = hs->bias, fw = (float)f->width, fh = (float)f->height;
+    const int w = f->width, ns = hs->count;
+    float P[16], vp[4];
+    memcpy(P, f->proj, sizeof P);
+    memcpy(vp, f->viewport, sizeof vp);
+    for (int j0 = 0; j0 < m; j0 += METHOD_LANES) {
+        chunk c;
+        lanes_pn v;
+        float t10[METHOD_LANES], t11[METHOD_LANES], t12[METHOD_LANES], t20[METHOD_LANES],
+            t21[METHOD_LANES], t22[METHOD_LANES], occ[METHOD_LANES];
+        chunk_at(f, px, m, j0, &c);
+        lanes_load(pos, nrm, &c, &v);
+#pragma omp simd
+        for (int j = 0; j < METHOD_LANES; j++) {
+            /* obs__hemisphere_basis() */
+            const float n0 = v.n0[j], n1 = v.n1[j], n2 = v.n2[j];
+            const float sg = n2 >= 0.0f ? 1.0f : -1.0f;
+            const float a = -1.0f / (sg + n2), b = n0 * n1 * a;
+            t10[j] = 1.0f + sg * n0 * n0 * a;
+            t11[j] = sg * b;
+            t12[j] = -sg * n0;
+            t20[j] = b;
+            t21[j] = sg + n1 * n1 * a;
+            t22[j] = -n1;
+            occ[j] = 0.0f;
+        }
+        for (int i = 0; i < ns; i++) {
+            const float k0 = hs->kernel[i][0], k1 = hs->kernel[i][1], k2 = hs->kernel[i][2];
+#pragma omp simd
+            for (int j = 0; j < METHOD_LANES; j++) {
+                /* obs__hemisphere_sample() */
+                const float kx = c.ro0[j] * k0 - c.ro1[j] * k1;
+                const float ky = c.ro1[j] * k0 + c.ro0[j] * k1;
+                const float s0 = v.p0[j] + R * (kx * t10[j] + ky * t20[j] + k2 * v.n0[j]);
+                const float s1 = v.p1[j] + R * (kx * t11[j] + ky * t21[j] + k2 * v.n1[j]);
+                const float s2 = v.p2[j] + R * (kx * t12[j] + ky * t22[j] + k2 * v.n2[j]);
+                int qx, qy;
+                const int ok = view_px_lane(P, vp, fw, fh, s0, s1, s2, &qx, &qy);
+                const float zn = pos[4 * (qy * w + qx) + 3];
+                const float dz = fabsf(-v.p2[j] - zn);
+                const float r = dz > R ? R / dz : 1.0f;
+                /* an = 1 (one opaque node), so an * r = r; fmaxf(0, x) = x
+                 * for x >= 0; the object masks' weight 1 */
+                const float x = r * r * (3.0f - 2.0f * r);
+                occ[j] += ok & (zn > 0.0f) & (zn <= -s2 - bias) ? x : 0.0f;
+            }
+        }
+        for (int j = 0; j < c.cnt; j++)
+            ao[c.k[j]] = ns > 0 ? 1.0f - occ[j] / (float)ns : 1.0f;
+    }
+}
+
+/* hbao: obs__hbao_pixel */
+OBS__LANES
+static void hbao_pixels(const obs__frame *f, const float *pos, const float *nrm, const int *px,
+                        int m, float *ao, float *count)
+{
+    const obs__hbao_state *hb = obs__hbao_of(f);
+    const float R = f->radius, R2 = R * R;
+    const int w = f->width, h = f->height, dirs = hb->dirs, steps = hb->steps;
+    const float bc = hb->bias_cs[0], bs = hb->bias_cs[1];
+    float P[16], vp[4];
+    memcpy(P, f->proj, sizeof P);
+    memcpy(vp, f->viewport, sizeof vp);
+    for (int j0 = 0; j0 < m; j0 += METHOD_LANES) {
+        chunk c;
+        lanes_pn v;
+        float step[METHOD_LANES], o[METHOD_LANES], sin_h[METHOD_LANES], dx[METHOD_LANES],
+            dy[METHOD_LANES];
+        int ns[METHOD_LANES], reach[METHOD_LANES], taken[METHOD_LANES], alive[METHOD_LANES];
+        chunk_at(f, px, m, j0, &c);
+        lanes_load(pos, nrm, &c, &v);
+#pragma omp simd
+        for (int j = 0; j < METHOD_LANES; j++) {
+            /* obs__radius_px() */
+            const float p0 = v.p0[j], p1 = v.p1[j], p2 = v.p2[j];
+            const float X = P[0] * p0 + P[1] * p1 + P[2] * p2 + P[3];
+            const float Y = P[4] * p0 + P[5] * p1 + P[6] * p2 + P[7];
+            const float cw = P[12] * p0 + P[13] * p1 + P[14] * p2 + P[15];
+            const float w2 = cw * cw;
+            const float j00 = (P[0] * cw - X * P[12]) / w2, j01 = (P[1] * cw - X * P[13]) / w2;
+            const float j10 = (P[4] * cw - Y * P[12]) / w2, j11 = (P[5] * cw - Y * P[13]) / w2;
+            const float rj = R * sqrtf(fabsf(j00 * j11 - j01 * j10) * vp[2] * vp[3] * 0.25f);
+            const float rpx = cw > 0.0f ? rj : 0.0f;
+            reach[j] = rpx >= 1.0f; /* else the kernel reaches no other pixel: AO 1 */
+            const int ri = reach[j] ? (int)rpx : 0;
+            ns[j] = steps < ri ? steps : ri;
+            step[j] = rpx / (float)(ns[j] + 1);
+            o[j] = 0.0f;
+            taken[j] = 0;
+        }
+        for (int d = 0; d < dirs; d++) {
+            const float e0 = hb->dir[d][0], e1 = hb->dir[d][1];
+#pragma omp simd
+            for (int j = 0; j < METHOD_LANES; j++) {
+                dx[j] = c.ro0[j] * e0 - c.ro1[j] * e1;
+                dy[j] = c.ro1[j] * e0 + c.ro0[j] * e1;
+                /* t(theta) + bias (hbao.c) */
+                const float nd = v.n0[j] * dx[j] + v.n1[j] * dy[j], nz = max_f(v.n2[j], 0.0f);
+                const float l = sqrtf(nd * nd + nz * nz);
+                const float st = l > 0.0f ? -nd / l : 0.0f, ct = l > 0.0f ? nz / l : 1.0f;
+                sin_h[j] = ct * bc - st * bs < 0.0f ? 1.0f : st * bc + ct * bs;
+                alive[j] = 1;
+            }
+            for (int s = 1; s <= steps; s++) {
+#pragma omp simd
+                for (int j = 0; j < METHOD_LANES; j++) {
+                    const int qx = c.x[j] + (int)floor_lane(dx[j] * step[j] * (float)s + 0.5f);
+                    const int qy = c.y[j] + (int)floor_lane(-dy[j] * step[j] * (float)s + 0.5f);
+                    const int in = (qx >= 0) & (qy >= 0) & (qx < w) & (qy < h);
+                    /* the twin's loop ends after ns steps, or on leaving the planes */
+                    const int live = alive[j] & (s <= ns[j]) & in;
+                    alive[j] = live;
+                    taken[j] += live;
+                    const int q = live ? qy * w + qx : c.k[j];
+                    const float v0 = pos[4 * q] - v.p0[j], v1 = pos[4 * q + 1] - v.p1[j];
+                    const float v2 = pos[4 * q + 2] - v.p2[j], q3 = pos[4 * q + 3];
+                    /* hbao_sample() with the object masks' weight 1 */
+                    const float r2 = v0 * v0 + v1 * v1 + v2 * v2;
+                    const float sin_s = v2 / sqrtf(r2);
+                    const int rise =
+                        live & (q3 > 0.0f) & (r2 < R2) & (r2 > 0.0f) & (sin_s > sin_h[j]);
+                    o[j] += rise ? 1.0f * (1.0f - r2 / R2) * (sin_s - sin_h[j]) : 0.0f;
+                    sin_h[j] = rise ? sin_s : sin_h[j];
+                }
+            }
+        }
+        for (int j = 0; j < c.cnt; j++) {
+            ao[c.k[j]] = reach[j] ? max_f(0.0f, 1.0f - o[j] / (float)dirs) : 1.0f;
+            if (count)
+                count[c.k[j]] = (float)(reach[j] ? taken[j] : 0);
+        }
+    }
+}
+
+int obs__method_pixels(const obs__frame *f, const float *pos, const float *nrm, const int *px,
+                       int m, float *ao, float *count)
+{
+    if (f->mask_on)
+        return 0;
+    switch (f->method) {
+    case OBS_METHOD_HEMISPHERE:
+        hemisphere_pixels(f, pos, nrm, px, m, ao);
+        for (int j = 0; count && j < m; j++)
+            count[px[j]] = (float)obs__hemisphere_of(f)->count;
+        return 1;
+    case OBS_METHOD_HBAO:
+        hbao_pixels(f, pos, nrm, px, m, ao, count);
+        return 1;
+    default:
+        return 0;
+    }
+}
