@@ -1,13 +1,15 @@
-/* Two of the comparison methods' CPU twins (core/methods/: hemisphere.c,
- * hbao.c) over a tile's pixels in SIMD lanes: a chunk of
+/* The comparison methods' CPU twins (core/methods/: hemisphere.c,
+ * angle.c, hbao.c) over a tile's pixels in SIMD lanes: a chunk of
  * METHOD_LANES pixels, each sample's arithmetic for all of them, every
  * pixel's sums in the twin's order, so each result is the twin's, bit for
  * bit (tests/unit/core/test_cpu_simd.c).  The flat chain only (one node a
- * pixel), without object masks and without the bent normal: the callers
- * take the twins pixel by pixel for those. */
+ * pixel), without object masks and without the bent normal, and angle
+ * with its linear or quadratic arc cosine (exact is libm's acosf, a call):
+ * the callers take the twins pixel by pixel for the rest, and for gtao. */
 #include <string.h>
 
 #include "chain/vao_cpu.h"
+#include "methods/angle.h"
 #include "methods/hbao.h"
 #include "methods/hemisphere.h"
 
@@ -55,7 +57,7 @@ static inline __attribute__((always_inline)) int view_px_lane(const float *P, co
 
 /* The pixels' positions and normals of a chunk, in lanes. */
 typedef struct lanes_pn {
-    float p0[METHOD_LANES], p1[METHOD_LANES], p2[METHOD_LANES];
+    float p0[METHOD_LANES], p1[METHOD_LANES], p2[METHOD_LANES], p3[METHOD_LANES];
     float n0[METHOD_LANES], n1[METHOD_LANES], n2[METHOD_LANES];
 } lanes_pn;
 
@@ -68,6 +70,7 @@ static inline __attribute__((always_inline)) void lanes_load(const float *pos, c
         v->p0[j] = pos[4 * k];
         v->p1[j] = pos[4 * k + 1];
         v->p2[j] = pos[4 * k + 2];
+        v->p3[j] = pos[4 * k + 3];
         v->n0[j] = nrm[3 * k];
         v->n1[j] = nrm[3 * k + 1];
         v->n2[j] = nrm[3 * k + 2];
@@ -130,6 +133,106 @@ static void hemisphere_pixels(const obs__frame *f, const float *pos, const float
         for (int j = 0; j < c.cnt; j++)
             ao[c.k[j]] = ns > 0 ? 1.0f - occ[j] / (float)ns : 1.0f;
     }
+}
+
+/* c ? v : +0, by the bits: v computed in every lane (a select lets gcc
+ * move v's loads under the condition, masked gathers the lanes lack) */
+static inline __attribute__((always_inline)) float keep_if(int c, float v)
+{
+    union {
+        float f;
+        unsigned u;
+    } b = {v};
+    b.u &= -(unsigned)c;
+    return b.f;
+}
+
+/* One sample of angle_pixels at view (sx, sy, p2): the vector u0..u2
+ * towards it and its far weight fr (off the image or background: far, no
+ * point; the object masks' term adds (1 - far) * 0 = +0; the clamp of a
+ * number, without NaN's case).  A macro: the lanes take no struct nor
+ * pointer to a lane's value. */
+#define ANGLE_SIDE(sx, sy, u0, u1, u2, fr)                                                   \
+    int qx_##fr, qy_##fr;                                                                    \
+    const int ok_##fr = view_px_lane(P, vp, fw, fh, sx, sy, p2, &qx_##fr, &qy_##fr);        \
+    const int k_##fr = 4 * (qy_##fr * w + qx_##fr);                                          \
+    const float qa_##fr = pos[k_##fr], qb_##fr = pos[k_##fr + 1]; /* loaded in every lane: */ \
+    const float qc_##fr = pos[k_##fr + 2], qd_##fr = pos[k_##fr + 3]; /* no masked gathers */ \
+    const int got_##fr = ok_##fr & (qd_##fr > 0.0f);                                         \
+    const float u0 = keep_if(got_##fr, qa_##fr - p0);                                        \
+    const float u1 = keep_if(got_##fr, qb_##fr - p1);                                        \
+    const float u2 = keep_if(got_##fr, qc_##fr - p2);                                        \
+    const float t_##fr = fabsf(qd_##fr - p3) / R - 1.0f;                                     \
+    const float fr = got_##fr ? (t_##fr < 0.0f ? 0.0f : t_##fr > 1.0f ? 1.0f : t_##fr) : 1.0f
+
+/* angle_to_normal(), obs__acos_mode()'s linear and quadratic forms */
+static inline __attribute__((always_inline)) float angle_of(float n0, float n1, float n2, int quad,
+                                                            float u0, float u1, float u2)
+{
+    const float pi = (float)M_PI;
+    const float l = sqrtf(u0 * u0 + u1 * u1 + u2 * u2);
+    const float cs = l > 0.0f ? (n0 * u0 + n1 * u1 + n2 * u2) / l : 0.0f;
+    const float x = cs < -1.0f ? -1.0f : cs > 1.0f ? 1.0f : cs; /* a number, as t above */
+    return quad ? pi * (1.0f - (x >= 0.0f ? x * x : -x * x)) * 0.5f : pi * (1.0f - x) * 0.5f;
+}
+
+/* angle: obs__angle_pixel, with obs__acos_mode's quadratic form (quad 1,
+ * a constant where this is inlined) or its linear one */
+static inline __attribute__((always_inline)) void angle_body(const obs__frame *f, const float *pos,
+                                                             const float *nrm, const int *px,
+                                                             int m, float *ao, const int quad)
+{
+    const obs__angle_state *an = obs__angle_of(f);
+    const float R = f->radius, fw = (float)f->width, fh = (float)f->height;
+    const int w = f->width, pairs = an->pairs;
+    float P[16], vp[4];
+    memcpy(P, f->proj, sizeof P);
+    memcpy(vp, f->viewport, sizeof vp);
+    for (int j0 = 0; j0 < m; j0 += METHOD_LANES) {
+        chunk c;
+        lanes_pn v;
+        float sum[METHOD_LANES], wsum[METHOD_LANES];
+        chunk_at(f, px, m, j0, &c);
+        lanes_load(pos, nrm, &c, &v);
+        for (int j = 0; j < METHOD_LANES; j++)
+            sum[j] = wsum[j] = 0.0f;
+        for (int i = 0; i < pairs; i++) {
+            const float a0 = an->xy[i][0], a1 = an->xy[i][1];
+#pragma omp simd
+            for (int j = 0; j < METHOD_LANES; j++) {
+                const float ox = R * (c.ro0[j] * a0 - c.ro1[j] * a1);
+                const float oy = R * (c.ro1[j] * a0 + c.ro0[j] * a1);
+                const float p0 = v.p0[j], p1 = v.p1[j], p2 = v.p2[j], p3 = v.p3[j];
+                const float n0 = v.n0[j], n1 = v.n1[j], n2 = v.n2[j];
+                ANGLE_SIDE(p0 + 1.0f * ox, p1 + 1.0f * oy, a00, a01, a02, fa);
+                ANGLE_SIDE(p0 + -1.0f * ox, p1 + -1.0f * oy, b00, b01, b02, fb);
+                const float wt = 1.0f - 0.5f * (fa + fb);
+                /* a far sample moves towards the coplanar point: -v_other */
+                float th = 0.0f;
+                th += angle_of(n0, n1, n2, quad, a00 + fa * (-b00 - a00), a01 + fa * (-b01 - a01),
+                               a02 + fa * (-b02 - a02));
+                th += angle_of(n0, n1, n2, quad, b00 + fb * (-a00 - b00), b01 + fb * (-a01 - b01),
+                               b02 + fb * (-a02 - b02));
+                const int take = wt > 0.0f;
+                const float tp = th / (float)M_PI;
+                sum[j] += take ? wt * (tp <= 1.0f ? tp : 1.0f) : 0.0f;
+                wsum[j] += take ? wt : 0.0f;
+            }
+        }
+        for (int j = 0; j < c.cnt; j++)
+            ao[c.k[j]] = wsum[j] > 0.0f ? sum[j] / wsum[j] : 1.0f;
+    }
+}
+#undef ANGLE_SIDE
+
+OBS__LANES
+static void angle_pixels(const obs__frame *f, const float *pos, const float *nrm, const int *px,
+                         int m, float *ao)
+{
+    if (obs__angle_of(f)->acos == OBS_ACOS_QUADRATIC)
+        angle_body(f, pos, nrm, px, m, ao, 1);
+    else
+        angle_body(f, pos, nrm, px, m, ao, 0);
 }
 
 /* hbao: obs__hbao_pixel */
@@ -225,6 +328,13 @@ int obs__method_pixels(const obs__frame *f, const float *pos, const float *nrm, 
         hemisphere_pixels(f, pos, nrm, px, m, ao);
         for (int j = 0; count && j < m; j++)
             count[px[j]] = (float)obs__hemisphere_of(f)->count;
+        return 1;
+    case OBS_METHOD_ANGLE:
+        if (obs__angle_of(f)->acos == OBS_ACOS_EXACT)
+            return 0; /* acosf: a libm call, not in the lanes */
+        angle_pixels(f, pos, nrm, px, m, ao);
+        for (int j = 0; count && j < m; j++)
+            count[px[j]] = (float)(2 * obs__angle_of(f)->pairs);
         return 1;
     case OBS_METHOD_HBAO:
         hbao_pixels(f, pos, nrm, px, m, ao, count);

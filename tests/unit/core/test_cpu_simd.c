@@ -307,8 +307,10 @@ static void test_method_pixels(void **state)
         {"method", "hbao", NULL},
         {"method", "hbao", "hbao_directions", "5", "hbao_steps", "13", "radius", "2.5", NULL},
         {"method", "hbao", "radius", "0.02", NULL}, /* a kernel within a pixel: AO 1 */
-        {"method", "gtao", NULL},
         {"method", "angle", NULL},
+        {"method", "angle", "angle_acos", "linear", "angle_pairs", "11", "radius", "1.5", NULL},
+        {"method", "gtao", NULL},
+        {"method", "angle", "angle_acos", "exact", NULL}, /* acosf: no lanes */
     };
     (void)state;
     for (size_t s = 0; s < sizeof sets / sizeof sets[0]; s++) {
@@ -329,7 +331,7 @@ static void test_method_pixels(void **state)
         for (size_t i = 0; i < npx; i++)
             ao[i] = cnt[i] = -1.0f;
         const int lanes = obs__method_pixels(f, pos, nrm, px, m, ao, cnt);
-        assert_int_equal(lanes, s < 5); /* gtao, angle: none yet */
+        assert_int_equal(lanes, s < 7); /* gtao and angle's exact acos: none */
         for (int j = 0; lanes && j < m; j++) {
             const int i = px[j], x = i % f->width, y = i / f->width;
             int n = -1;
