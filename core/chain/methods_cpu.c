@@ -10,6 +10,7 @@
 
 #include "chain/vao_cpu.h"
 #include "methods/angle.h"
+#include "methods/gtao.h"
 #include "methods/hbao.h"
 #include "methods/hemisphere.h"
 
@@ -318,6 +319,121 @@ static void hbao_pixels(const obs__frame *f, const float *pos, const float *nrm,
     }
 }
 
+/* gtao: obs__gtao_pixel.  The slices' set-up and the visibility's sums
+ * (libm's cosf, sinf, acosf and powf: calls) pixel by pixel through
+ * gtao.c's own functions, the horizon steps in lanes (their largest cosine
+ * per lane in the steps' order); a pixel with a step off the planes (the
+ * surface continued past the border, border_cpu.c) is left to the twin. */
+OBS__LANES
+static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm, const int *px,
+                        int m, float *ao, float *count)
+{
+    const obs__gtao_state *g = obs__gtao_of(f);
+    const int w = f->width, h = f->height, steps = g->steps, slices = g->slices;
+    const float thin1 = 1.0f + g->thin_power[0], fmul = g->falloff[0], fadd = g->falloff[1];
+    float noise[9][2];
+    for (int t = 0; t < 9; t++)
+        obs__gtao_noise(t, noise[t]);
+    for (int j0 = 0; j0 < m; j0 += METHOD_LANES) {
+        chunk c;
+        lanes_pn v;
+        float c0[METHOD_LANES], c1[METHOD_LANES], c2[METHOD_LANES], v0[METHOD_LANES],
+            v1[METHOD_LANES], v2[METHOD_LANES], rpx[METHOD_LANES], min_s[METHOD_LANES],
+            nz0[METHOD_LANES], nz1[METHOD_LANES], vis[METHOD_LANES], om0[METHOD_LANES],
+            om1[METHOD_LANES], hc[2][METHOD_LANES];
+        int ok[METHOD_LANES], miss[METHOD_LANES], taken[METHOD_LANES];
+        obs__gtao_slice sl_of[METHOD_LANES];
+        chunk_at(f, px, m, j0, &c);
+        lanes_load(pos, nrm, &c, &v);
+        for (int j = 0; j < METHOD_LANES; j++) {
+            const float p[3] = {v.p0[j], v.p1[j], v.p2[j]};
+            rpx[j] = obs__radius_px(f, p, g->radius);
+            ok[j] = rpx[j] > 0.0f; /* else behind the camera: 1 */
+            c0[j] = p[0] * GTAO_CENTRE_SCALE;
+            c1[j] = p[1] * GTAO_CENTRE_SCALE;
+            c2[j] = p[2] * GTAO_CENTRE_SCALE;
+            v0[j] = v1[j] = 0.0f; /* towards the camera; orthographic: +z */
+            v2[j] = 1.0f;
+            if (f->proj[14] != 0.0f) {
+                const float l = sqrtf(c0[j] * c0[j] + c1[j] * c1[j] + c2[j] * c2[j]);
+                ok[j] &= l > 0.0f;
+                v0[j] = -c0[j] / l;
+                v1[j] = -c1[j] / l;
+                v2[j] = -c2[j] / l;
+            }
+            const float *nz = noise[obs__tile_index(f, c.x[j], c.y[j])];
+            nz0[j] = nz[0];
+            nz1[j] = nz[1];
+            min_s[j] = GTAO_TOO_CLOSE / rpx[j];
+            vis[j] = obs__gtao_vis0(g, rpx[j]);
+            miss[j] = !ok[j];
+            taken[j] = 0;
+        }
+        for (int sl = 0; sl < slices; sl++) {
+            for (int j = 0; j < METHOD_LANES; j++) {
+                const float vv[3] = {v0[j], v1[j], v2[j]}, n[3] = {v.n0[j], v.n1[j], v.n2[j]};
+                obs__gtao_slice_setup(g, sl, nz0[j], rpx[j], vv, n, &sl_of[j]);
+                om0[j] = sl_of[j].omega[0];
+                om1[j] = sl_of[j].omega[1];
+                hc[0][j] = sl_of[j].low[0];
+                hc[1][j] = sl_of[j].low[1];
+            }
+            for (int side = 0; side < 2; side++) {
+                const int dir = side ? -1 : 1;
+                float *hs = hc[side];
+                for (int st = 0; st < steps; st++) {
+                    const float base = (float)(sl + st * steps) * GTAO_R1;
+#pragma omp simd
+                    for (int j = 0; j < METHOD_LANES; j++) {
+                        float sn = nz1[j] + base;
+                        sn -= floor_lane(sn);
+                        float s = ((float)st + sn) / (float)steps;
+                        s = s * s + min_s[j]; /* power 2, then off the centre pixel */
+                        const int qx = c.x[j] + dir * (int)floor_lane(s * om0[j] + 0.5f);
+                        const int qy = c.y[j] + dir * (int)floor_lane(s * om1[j] + 0.5f);
+                        const int in = (qx >= 0) & (qy >= 0) & (qx < w) & (qy < h);
+                        miss[j] |= !in;
+                        taken[j] += in;
+                        const int k = 4 * (in ? qy * w + qx : c.k[j]);
+                        const float q0 = pos[k], q1 = pos[k + 1], q2 = pos[k + 2];
+                        const float q3 = pos[k + 3];
+                        /* sample_cos() with the object masks' weight 1 */
+                        const float d0 = q0 - c0[j], d1 = q1 - c1[j], d2 = q2 - c2[j];
+                        const float dist = sqrtf(d0 * d0 + d1 * d1 + d2 * d2);
+                        const float shc = (d0 * v0[j] + d1 * v1[j] + d2 * v2[j]) / dist;
+                        const float dz = d2 * thin1;
+                        const float fb = sqrtf(d0 * d0 + d1 * d1 + dz * dz);
+                        const float t = fb * fmul + fadd; /* a number: the clamp without NaN */
+                        const float wt = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+                        const float low = sl_of[j].low[side];
+                        const float val =
+                            (q3 > 0.0f) & (dist > 0.0f) ? low + (shc - low) * wt : low;
+                        hs[j] = in ? max_f(hs[j], val) : hs[j];
+                    }
+                }
+            }
+            for (int j = 0; j < METHOD_LANES; j++) {
+                float hh[2];
+                vis[j] += obs__gtao_slice_vis(g, &sl_of[j], hc[0][j], hc[1][j], hh);
+            }
+        }
+        for (int j = 0; j < c.cnt; j++) {
+            const int k = c.k[j];
+            int n = 0;
+            if (!ok[j] || miss[j]) { /* the twin (AO 1 behind the camera) */
+                const float p[3] = {v.p0[j], v.p1[j], v.p2[j]};
+                const float nv[3] = {v.n0[j], v.n1[j], v.n2[j]};
+                ao[k] = obs__gtao_pixel(f, pos, nrm, c.x[j], c.y[j], p, nv, &n);
+            } else {
+                ao[k] = obs__gtao_finish(g, vis[j]);
+                n = taken[j];
+            }
+            if (count)
+                count[k] = (float)n;
+        }
+    }
+}
+
 int obs__method_pixels(const obs__frame *f, const float *pos, const float *nrm, const int *px,
                        int m, float *ao, float *count)
 {
@@ -338,6 +454,9 @@ int obs__method_pixels(const obs__frame *f, const float *pos, const float *nrm, 
         return 1;
     case OBS_METHOD_HBAO:
         hbao_pixels(f, pos, nrm, px, m, ao, count);
+        return 1;
+    case OBS_METHOD_GTAO:
+        gtao_pixels(f, pos, nrm, px, m, ao, count);
         return 1;
     default:
         return 0;

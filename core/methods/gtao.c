@@ -53,11 +53,8 @@
 #include "methods/gtao.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
-#define GTAO_TOO_CLOSE 1.3f       /* pixelTooCloseThreshold: first sample this far, in pixels */
-#define GTAO_CENTRE_SCALE 0.99999f /* viewspaceZ *= 0.99999 (FP32 depths) */
 #define GTAO_SLOPE_FUDGE 0.05f    /* projectedNormalVecLength = lerp(len, 1, 0.05) */
 #define GTAO_MIN_VISIBILITY 0.03f /* visibility = max(0.03, visibility) */
-#define GTAO_R1 0.6180339887498948482f /* the steps' R1 sequence */
 
 static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
 static float saturate(float v) { return clampf(v, 0.0f, 1.0f); }
@@ -167,12 +164,64 @@ float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *n
     return obs__gtao_pixel_nodes(f, pos, nrm, 1, x, y, p, n, count, bent);
 }
 
+void obs__gtao_slice_setup(const obs__gtao_state *g, int sl, float noise0, float rpx,
+                           const float v[3], const float n[3], obs__gtao_slice *s)
+{
+    float phi = ((float)sl + noise0) / (float)g->slices * (float)M_PI;
+    float cp = cosf(phi), sp = sinf(phi);
+    s->omega[0] = cp * rpx; /* screen pixels: y runs down, view y up */
+    s->omega[1] = -sp * rpx;
+    float d[3] = {cp, sp, 0.0f};
+    float dv = dot3(d, v);
+    float *od = s->od;
+    od[0] = d[0] - dv * v[0];
+    od[1] = d[1] - dv * v[1];
+    od[2] = d[2] - dv * v[2];
+    /* the slice plane's normal: normalize(cross(od, v)) */
+    float ax[3] = {od[1] * v[2] - od[2] * v[1], od[2] * v[0] - od[0] * v[2],
+                   od[0] * v[1] - od[1] * v[0]};
+    float al = sqrtf(dot3(ax, ax));
+    ax[0] /= al;
+    ax[1] /= al;
+    ax[2] /= al;
+    float na = dot3(n, ax);
+    float np[3] = {n[0] - ax[0] * na, n[1] - ax[1] * na, n[2] - ax[2] * na};
+    s->np_len = sqrtf(dot3(np, np));
+    s->cos_g = s->np_len > 0.0f ? saturate(dot3(np, v) / s->np_len) : 1.0f;
+    s->gamma = signf(dot3(od, np)) * acosf(s->cos_g);
+    s->low[0] = cosf(s->gamma + (float)M_PI_2);
+    s->low[1] = cosf(s->gamma - (float)M_PI_2);
+}
+
+float obs__gtao_slice_vis(const obs__gtao_state *g, obs__gtao_slice *s, float hc0, float hc1,
+                          float h[2])
+{
+    const float half_pi = (float)M_PI_2, gamma = s->gamma;
+    if (g->heuristics)
+        s->np_len += (1.0f - s->np_len) * GTAO_SLOPE_FUDGE;
+    /* the horizons as angles from v, clamped to the hemisphere of n
+     * (Algorithm 1's h1 = n + max(h1 - n, -pi/2), h2 = n + min(h2 - n, pi/2)) */
+    float h0 = -acosf(clampf(hc1, -1.0f, 1.0f));
+    float h1 = acosf(clampf(hc0, -1.0f, 1.0f));
+    h[0] = gamma + fmaxf(h0 - gamma, -half_pi);
+    h[1] = gamma + fminf(h1 - gamma, half_pi);
+    return s->np_len * (arc(h[0], gamma, s->cos_g) + arc(h[1], gamma, s->cos_g));
+}
+
+float obs__gtao_finish(const obs__gtao_state *g, float vis)
+{
+    vis /= (float)g->slices;
+    vis = powf(fmaxf(vis, 0.0f), g->thin_power[1]);
+    if (g->heuristics)
+        vis = fmaxf(vis, GTAO_MIN_VISIBILITY);
+    return saturate(vis);
+}
+
 float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
                             int x, int y, const float p[3], const float n[3], int *count,
                             float bent[3])
 {
     const obs__gtao_state *g = obs__gtao_of(f);
-    const float half_pi = (float)M_PI_2;
     int taken = 0;
     if (count)
         *count = 0;
@@ -192,50 +241,27 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
     float noise[2];
     obs__gtao_noise(obs__tile_index(f, x, y), noise);
     const float min_s = GTAO_TOO_CLOSE / rpx;
-    float vis = g->heuristics ? saturate((10.0f - rpx) / 100.0f) * 0.5f : 0.0f;
+    float vis = obs__gtao_vis0(g, rpx);
     for (int sl = 0; sl < g->slices; sl++) {
-        float phi = ((float)sl + noise[0]) / (float)g->slices * (float)M_PI;
-        float cp = cosf(phi), sp = sinf(phi);
-        float omega[2] = {cp * rpx, -sp * rpx}; /* screen pixels: y runs down, view y up */
-        float d[3] = {cp, sp, 0.0f};
-        float dv = dot3(d, v);
-        float od[3] = {d[0] - dv * v[0], d[1] - dv * v[1], d[2] - dv * v[2]};
-        /* the slice plane's normal: normalize(cross(od, v)) */
-        float ax[3] = {od[1] * v[2] - od[2] * v[1], od[2] * v[0] - od[0] * v[2],
-                       od[0] * v[1] - od[1] * v[0]};
-        float al = sqrtf(dot3(ax, ax));
-        ax[0] /= al;
-        ax[1] /= al;
-        ax[2] /= al;
-        float na = dot3(n, ax);
-        float np[3] = {n[0] - ax[0] * na, n[1] - ax[1] * na, n[2] - ax[2] * na};
-        float np_len = sqrtf(dot3(np, np));
-        float cos_g = np_len > 0.0f ? saturate(dot3(np, v) / np_len) : 1.0f;
-        float gamma = signf(dot3(od, np)) * acosf(cos_g);
-        float low0 = cosf(gamma + half_pi), low1 = cosf(gamma - half_pi);
-        float hc0 = side_horizon(f, pos, nrm, layers, x, y, c, v, omega, sl, noise[1], min_s, 1,
-                                 low0, &taken);
-        float hc1 = side_horizon(f, pos, nrm, layers, x, y, c, v, omega, sl, noise[1], min_s, -1,
-                                 low1, &taken);
-        if (g->heuristics)
-            np_len += (1.0f - np_len) * GTAO_SLOPE_FUDGE;
-        /* the horizons as angles from v, clamped to the hemisphere of n
-         * (Algorithm 1's h1 = n + max(h1 - n, -pi/2), h2 = n + min(h2 - n, pi/2)) */
-        float h0 = -acosf(clampf(hc1, -1.0f, 1.0f));
-        float h1 = acosf(clampf(hc0, -1.0f, 1.0f));
-        h0 = gamma + fmaxf(h0 - gamma, -half_pi);
-        h1 = gamma + fminf(h1 - gamma, half_pi);
-        vis += np_len * (arc(h0, gamma, cos_g) + arc(h1, gamma, cos_g));
+        obs__gtao_slice s;
+        obs__gtao_slice_setup(g, sl, noise[0], rpx, v, n, &s);
+        float hc0 = side_horizon(f, pos, nrm, layers, x, y, c, v, s.omega, sl, noise[1], min_s, 1,
+                                 s.low[0], &taken);
+        float hc1 = side_horizon(f, pos, nrm, layers, x, y, c, v, s.omega, sl, noise[1], min_s,
+                                 -1, s.low[1], &taken);
+        float h[2];
+        vis += obs__gtao_slice_vis(g, &s, hc0, hc1, h);
         if (bent)
-            obs__gtao_bent_slice(h0, h1, gamma, np_len, od, v, bent);
+            obs__gtao_bent_slice(h[0], h[1], s.gamma, s.np_len, s.od, v, bent);
     }
-    vis /= (float)g->slices;
-    vis = powf(fmaxf(vis, 0.0f), g->thin_power[1]);
-    if (g->heuristics)
-        vis = fmaxf(vis, GTAO_MIN_VISIBILITY);
     if (count)
         *count = taken;
-    return saturate(vis);
+    return obs__gtao_finish(g, vis);
+}
+
+float obs__gtao_vis0(const obs__gtao_state *g, float rpx)
+{
+    return g->heuristics ? saturate((10.0f - rpx) / 100.0f) * 0.5f : 0.0f;
 }
 
 void obs__gtao_setup(const obs_params *p, obs__frame *f)

@@ -5,6 +5,12 @@
 
 #include "chain/frame.h"
 
+/* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) that the CPU
+ * device's lanes share (methods_cpu.c); the others are in gtao.c */
+#define GTAO_TOO_CLOSE 1.3f        /* pixelTooCloseThreshold: first sample this far, in pixels */
+#define GTAO_CENTRE_SCALE 0.99999f /* viewspaceZ *= 0.99999 (FP32 depths) */
+#define GTAO_R1 0.6180339887498948482f /* the steps' R1 sequence */
+
 /* Slices, steps per side, XeGTAO's heuristics (1: on); the search radius
  * gtao_multiplier * D in depth units; the falloff's weight =
  * saturate(r * mul + add); the thin-occluder compensation and the final
@@ -46,6 +52,25 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
  * sequence, fract(0.5 + k (0.754877666, 0.569840291)), k = tile;
  * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
 void obs__gtao_noise(int tile, float out[2]);
+
+/* One slice of a pixel (obs__gtao_pixel_nodes' loop, in parts that the
+ * CPU device's lanes share, methods_cpu.c): its direction in screen
+ * pixels (omega, the search radius's length), the direction in view
+ * space od, the projected normal's length, cos and angle gamma, and the
+ * horizon cosines' starts low[side] (side 0: +omega, 1: -omega). */
+typedef struct obs__gtao_slice {
+    float omega[2], od[3], np_len, cos_g, gamma, low[2];
+} obs__gtao_slice;
+void obs__gtao_slice_setup(const obs__gtao_state *g, int sl, float noise0, float rpx,
+                           const float v[3], const float n[3], obs__gtao_slice *s);
+/* The slice's visibility from its horizon cosines hc0 (+omega) and hc1
+ * (-omega); h[] the horizon angles (for the bent normal). */
+float obs__gtao_slice_vis(const obs__gtao_state *g, obs__gtao_slice *s, float hc0, float hc1,
+                          float h[2]);
+/* The visibility's start (XeGTAO's heuristic for a small radius in pixels)
+ * and its end from the slices' sum. */
+float obs__gtao_vis0(const obs__gtao_state *g, float rpx);
+float obs__gtao_finish(const obs__gtao_state *g, float vis);
 
 /* obs__gtao_pixel that also sums the bent normal of every slice into
  * bent[3] (NULL: not wanted): Jimenez et al.'s Algorithm 2 extension as
