@@ -322,8 +322,9 @@ static void hbao_pixels(const obs__frame *f, const float *pos, const float *nrm,
 /* gtao: obs__gtao_pixel.  The slices' set-up and the visibility's sums
  * (libm's cosf, sinf, acosf and powf: calls) pixel by pixel through
  * gtao.c's own functions, the horizon steps in lanes (their largest cosine
- * per lane in the steps' order); a pixel with a step off the planes (the
- * surface continued past the border, border_cpu.c) is left to the twin. */
+ * per lane in the steps' order); a side with a step off the planes (the
+ * surface continued past the border, border_cpu.c) is taken again step by
+ * step in order, those steps through gtao.c. */
 OBS__LANES
 static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm, const int *px,
                         int m, float *ao, float *count)
@@ -341,7 +342,9 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
             v1[METHOD_LANES], v2[METHOD_LANES], rpx[METHOD_LANES], min_s[METHOD_LANES],
             nz0[METHOD_LANES], nz1[METHOD_LANES], vis[METHOD_LANES], om0[METHOD_LANES],
             om1[METHOD_LANES], hc[2][METHOD_LANES];
-        int ok[METHOD_LANES], miss[METHOD_LANES], taken[METHOD_LANES];
+        float sval[32][METHOD_LANES]; /* a side's steps' cosines (steps <= 32) */
+        int ok[METHOD_LANES], taken[METHOD_LANES], out[METHOD_LANES], sqx[32][METHOD_LANES],
+            sqy[32][METHOD_LANES];
         obs__gtao_slice sl_of[METHOD_LANES];
         chunk_at(f, px, m, j0, &c);
         lanes_load(pos, nrm, &c, &v);
@@ -366,7 +369,6 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
             nz1[j] = nz[1];
             min_s[j] = GTAO_TOO_CLOSE / rpx[j];
             vis[j] = obs__gtao_vis0(g, rpx[j]);
-            miss[j] = !ok[j];
             taken[j] = 0;
         }
         for (int sl = 0; sl < slices; sl++) {
@@ -381,6 +383,8 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
             for (int side = 0; side < 2; side++) {
                 const int dir = side ? -1 : 1;
                 float *hs = hc[side];
+                for (int j = 0; j < METHOD_LANES; j++)
+                    out[j] = 0;
                 for (int st = 0; st < steps; st++) {
                     const float base = (float)(sl + st * steps) * GTAO_R1;
 #pragma omp simd
@@ -392,8 +396,10 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
                         const int qx = c.x[j] + dir * (int)floor_lane(s * om0[j] + 0.5f);
                         const int qy = c.y[j] + dir * (int)floor_lane(s * om1[j] + 0.5f);
                         const int in = (qx >= 0) & (qy >= 0) & (qx < w) & (qy < h);
-                        miss[j] |= !in;
+                        out[j] |= !in;
                         taken[j] += in;
+                        sqx[st][j] = qx;
+                        sqy[st][j] = qy;
                         const int k = 4 * (in ? qy * w + qx : c.k[j]);
                         const float q0 = pos[k], q1 = pos[k + 1], q2 = pos[k + 2];
                         const float q3 = pos[k + 3];
@@ -408,8 +414,28 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
                         const float low = sl_of[j].low[side];
                         const float val =
                             (q3 > 0.0f) & (dist > 0.0f) ? low + (shc - low) * wt : low;
+                        sval[st][j] = val;
                         hs[j] = in ? max_f(hs[j], val) : hs[j];
                     }
+                }
+                /* a side with a step off the planes: its largest cosine
+                 * again in the steps' order, those steps read past the
+                 * border (gtao.c) */
+                for (int j = 0; j < METHOD_LANES; j++) {
+                    if (!out[j] || !ok[j])
+                        continue;
+                    const float cc[3] = {c0[j], c1[j], c2[j]}, vv[3] = {v0[j], v1[j], v2[j]};
+                    const int x = c.x[j], y = c.y[j];
+                    float hm = sl_of[j].low[side];
+                    for (int st = 0; st < steps; st++) {
+                        const int qx = sqx[st][j], qy = sqy[st][j];
+                        if (qx >= 0 && qy >= 0 && qx < w && qy < h)
+                            hm = max_f(hm, sval[st][j]);
+                        else
+                            obs__gtao_border_step(f, pos, nrm, x, y, qx, qy, cc, vv,
+                                                  sl_of[j].low[side], &hm, &taken[j]);
+                    }
+                    hs[j] = hm;
                 }
             }
             for (int j = 0; j < METHOD_LANES; j++) {
@@ -419,17 +445,9 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
         }
         for (int j = 0; j < c.cnt; j++) {
             const int k = c.k[j];
-            int n = 0;
-            if (!ok[j] || miss[j]) { /* the twin (AO 1 behind the camera) */
-                const float p[3] = {v.p0[j], v.p1[j], v.p2[j]};
-                const float nv[3] = {v.n0[j], v.n1[j], v.n2[j]};
-                ao[k] = obs__gtao_pixel(f, pos, nrm, c.x[j], c.y[j], p, nv, &n);
-            } else {
-                ao[k] = obs__gtao_finish(g, vis[j]);
-                n = taken[j];
-            }
+            ao[k] = ok[j] ? obs__gtao_finish(g, vis[j]) : 1.0f; /* 1: behind the camera */
             if (count)
-                count[k] = (float)n;
+                count[k] = (float)(ok[j] ? taken[j] : 0);
         }
     }
 }

@@ -105,6 +105,17 @@ static float sample_cos(const obs__gtao_state *g, const float q[4], const float 
     return low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
 }
 
+void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                           int qx, int qy, const float c[3], const float v[3], float low,
+                           float *hc, int *taken)
+{
+    float ext[4];
+    const float om = obs__occluder_weight(f, x, y, qx, qy); /* object masks */
+    const float *q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
+    if (q)
+        *hc = fmaxf(*hc, sample_cos(obs__gtao_of(f), q, c, v, low, om));
+}
+
 /* The horizon cosine of side `dir` (+1 or -1) of a slice after its
  * steps: the largest of the tangent's cosine `low` and the samples',
  * each moved from low by its falloff weight.  A step inside the image
@@ -127,18 +138,14 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         s = s * s + min_s; /* sample distribution power 2, then off the centre pixel */
         int qx = x + dir * (int)floorf(s * omega[0] + 0.5f);
         int qy = y + dir * (int)floorf(s * omega[1] + 0.5f);
-        float ext[4];
-        const float *q;
         /* object masks: the weight of the surface at the step's pixel */
         const float om = obs__occluder_weight(f, x, y, qx, qy);
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
-            if (!(q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken)))
-                continue;
-            hc = fmaxf(hc, sample_cos(g, q, c, v, low, om));
+            obs__gtao_border_step(f, pos, nrm, x, y, qx, qy, c, v, low, &hc, taken);
             continue;
         }
         (*taken)++;
-        q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+        const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
         for (int k = 0; k < layers; k++)
             hc = fmaxf(hc, sample_cos(g, q + (size_t)k * plane, c, v, low, om));
     }

@@ -67,6 +67,13 @@ void obs__gtao_slice_setup(const obs__gtao_state *g, int sl, float noise0, float
  * (-omega); h[] the horizon angles (for the bent normal). */
 float obs__gtao_slice_vis(const obs__gtao_state *g, obs__gtao_slice *s, float hc0, float hc1,
                           float h[2]);
+/* A step of a slice's side at pixel (qx, qy) off the planes, for the
+ * pixel (x, y) (centre c, view direction v, the side's start low): the
+ * surface continued past the border (border_cpu.c), its horizon cosine
+ * into *hc (the larger), *taken counted where it reads a point. */
+void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
+                           int qx, int qy, const float c[3], const float v[3], float low,
+                           float *hc, int *taken);
 /* The visibility's start (XeGTAO's heuristic for a small radius in pixels)
  * and its end from the slices' sum. */
 float obs__gtao_vis0(const obs__gtao_state *g, float rpx);
