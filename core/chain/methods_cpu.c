@@ -332,18 +332,21 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
     const obs__gtao_state *g = obs__gtao_of(f);
     const int w = f->width, h = f->height, steps = g->steps, slices = g->slices;
     const float thin1 = 1.0f + g->thin_power[0], fmul = g->falloff[0], fadd = g->falloff[1];
-    float noise[9][2];
-    for (int t = 0; t < 9; t++)
+    float noise[9][2], cs[9][32][2]; /* each tile's noise and slices' directions (<= 32) */
+    for (int t = 0; t < 9; t++) {
         obs__gtao_noise(t, noise[t]);
+        for (int sl = 0; sl < slices; sl++)
+            obs__gtao_slice_dir(g, sl, noise[t][0], cs[t][sl]);
+    }
     for (int j0 = 0; j0 < m; j0 += METHOD_LANES) {
         chunk c;
         lanes_pn v;
         float c0[METHOD_LANES], c1[METHOD_LANES], c2[METHOD_LANES], v0[METHOD_LANES],
             v1[METHOD_LANES], v2[METHOD_LANES], rpx[METHOD_LANES], min_s[METHOD_LANES],
-            nz0[METHOD_LANES], nz1[METHOD_LANES], vis[METHOD_LANES], om0[METHOD_LANES],
+            nz1[METHOD_LANES], vis[METHOD_LANES], om0[METHOD_LANES],
             om1[METHOD_LANES], hc[2][METHOD_LANES];
         float sval[32][METHOD_LANES]; /* a side's steps' cosines (steps <= 32) */
-        int ok[METHOD_LANES], taken[METHOD_LANES], out[METHOD_LANES], sqx[32][METHOD_LANES],
+        int ok[METHOD_LANES], taken[METHOD_LANES], out[METHOD_LANES], ti[METHOD_LANES], sqx[32][METHOD_LANES],
             sqy[32][METHOD_LANES];
         obs__gtao_slice sl_of[METHOD_LANES];
         chunk_at(f, px, m, j0, &c);
@@ -364,9 +367,8 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
                 v1[j] = -c1[j] / l;
                 v2[j] = -c2[j] / l;
             }
-            const float *nz = noise[obs__tile_index(f, c.x[j], c.y[j])];
-            nz0[j] = nz[0];
-            nz1[j] = nz[1];
+            ti[j] = obs__tile_index(f, c.x[j], c.y[j]);
+            nz1[j] = noise[ti[j]][1];
             min_s[j] = GTAO_TOO_CLOSE / rpx[j];
             vis[j] = obs__gtao_vis0(g, rpx[j]);
             taken[j] = 0;
@@ -374,7 +376,7 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
         for (int sl = 0; sl < slices; sl++) {
             for (int j = 0; j < METHOD_LANES; j++) {
                 const float vv[3] = {v0[j], v1[j], v2[j]}, n[3] = {v.n0[j], v.n1[j], v.n2[j]};
-                obs__gtao_slice_setup(g, sl, nz0[j], rpx[j], vv, n, &sl_of[j]);
+                obs__gtao_slice_setup(cs[ti[j]][sl], rpx[j], vv, n, &sl_of[j]);
                 om0[j] = sl_of[j].omega[0];
                 om1[j] = sl_of[j].omega[1];
                 hc[0][j] = sl_of[j].low[0];

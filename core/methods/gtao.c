@@ -51,12 +51,14 @@
 #include "methods/bent.h"
 #include "chain/mask_weight.h"
 #include "methods/gtao.h"
+#include "chain/vao_cpu.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
 #define GTAO_SLOPE_FUDGE 0.05f    /* projectedNormalVecLength = lerp(len, 1, 0.05) */
 #define GTAO_MIN_VISIBILITY 0.03f /* visibility = max(0.03, visibility) */
 
-static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
+/* fminf and fmaxf as glibc computes them, inline (chain/vao_cpu.h) */
+static float clampf(float v, float lo, float hi) { return min_f(max_f(v, lo), hi); }
 static float saturate(float v) { return clampf(v, 0.0f, 1.0f); }
 static float signf(float v) { return (float)((v > 0.0f) - (v < 0.0f)); }
 static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -113,7 +115,7 @@ void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *n
     const float om = obs__occluder_weight(f, x, y, qx, qy); /* object masks */
     const float *q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
     if (q)
-        *hc = fmaxf(*hc, sample_cos(obs__gtao_of(f), q, c, v, low, om));
+        *hc = max_f(*hc, sample_cos(obs__gtao_of(f), q, c, v, low, om));
 }
 
 /* The horizon cosine of side `dir` (+1 or -1) of a slice after its
@@ -147,15 +149,15 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         (*taken)++;
         const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
         for (int k = 0; k < layers; k++)
-            hc = fmaxf(hc, sample_cos(g, q + (size_t)k * plane, c, v, low, om));
+            hc = max_f(hc, sample_cos(g, q + (size_t)k * plane, c, v, low, om));
     }
     return hc;
 }
 
 /* a(h) of the header: the inner integral's closed form */
-static float arc(float h, float gamma, float cos_gamma)
+static float arc(float h, float gamma, float cos_gamma, float sin_gamma)
 {
-    return (cos_gamma + 2.0f * h * sinf(gamma) - cosf(2.0f * h - gamma)) / 4.0f;
+    return (cos_gamma + 2.0f * h * sin_gamma - cosf(2.0f * h - gamma)) / 4.0f;
 }
 
 /* GLSL: method_ao() in gtao.glsl */
@@ -171,11 +173,17 @@ float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *n
     return obs__gtao_pixel_nodes(f, pos, nrm, 1, x, y, p, n, count, bent);
 }
 
-void obs__gtao_slice_setup(const obs__gtao_state *g, int sl, float noise0, float rpx,
-                           const float v[3], const float n[3], obs__gtao_slice *s)
+void obs__gtao_slice_dir(const obs__gtao_state *g, int sl, float noise0, float cs[2])
 {
     float phi = ((float)sl + noise0) / (float)g->slices * (float)M_PI;
-    float cp = cosf(phi), sp = sinf(phi);
+    cs[0] = cosf(phi);
+    cs[1] = sinf(phi);
+}
+
+void obs__gtao_slice_setup(const float cs[2], float rpx, const float v[3], const float n[3],
+                           obs__gtao_slice *s)
+{
+    const float cp = cs[0], sp = cs[1];
     s->omega[0] = cp * rpx; /* screen pixels: y runs down, view y up */
     s->omega[1] = -sp * rpx;
     float d[3] = {cp, sp, 0.0f};
@@ -210,17 +218,18 @@ float obs__gtao_slice_vis(const obs__gtao_state *g, obs__gtao_slice *s, float hc
      * (Algorithm 1's h1 = n + max(h1 - n, -pi/2), h2 = n + min(h2 - n, pi/2)) */
     float h0 = -acosf(clampf(hc1, -1.0f, 1.0f));
     float h1 = acosf(clampf(hc0, -1.0f, 1.0f));
-    h[0] = gamma + fmaxf(h0 - gamma, -half_pi);
-    h[1] = gamma + fminf(h1 - gamma, half_pi);
-    return s->np_len * (arc(h[0], gamma, s->cos_g) + arc(h[1], gamma, s->cos_g));
+    h[0] = gamma + max_f(h0 - gamma, -half_pi);
+    h[1] = gamma + min_f(h1 - gamma, half_pi);
+    const float sg = sinf(gamma); /* once for both arcs */
+    return s->np_len * (arc(h[0], gamma, s->cos_g, sg) + arc(h[1], gamma, s->cos_g, sg));
 }
 
 float obs__gtao_finish(const obs__gtao_state *g, float vis)
 {
     vis /= (float)g->slices;
-    vis = powf(fmaxf(vis, 0.0f), g->thin_power[1]);
+    vis = powf(max_f(vis, 0.0f), g->thin_power[1]);
     if (g->heuristics)
-        vis = fmaxf(vis, GTAO_MIN_VISIBILITY);
+        vis = max_f(vis, GTAO_MIN_VISIBILITY);
     return saturate(vis);
 }
 
@@ -251,7 +260,9 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
     float vis = obs__gtao_vis0(g, rpx);
     for (int sl = 0; sl < g->slices; sl++) {
         obs__gtao_slice s;
-        obs__gtao_slice_setup(g, sl, noise[0], rpx, v, n, &s);
+        float cs[2];
+        obs__gtao_slice_dir(g, sl, noise[0], cs);
+        obs__gtao_slice_setup(cs, rpx, v, n, &s);
         float hc0 = side_horizon(f, pos, nrm, layers, x, y, c, v, s.omega, sl, noise[1], min_s, 1,
                                  s.low[0], &taken);
         float hc1 = side_horizon(f, pos, nrm, layers, x, y, c, v, s.omega, sl, noise[1], min_s,

@@ -61,8 +61,11 @@ void obs__gtao_noise(int tile, float out[2]);
 typedef struct obs__gtao_slice {
     float omega[2], od[3], np_len, cos_g, gamma, low[2];
 } obs__gtao_slice;
-void obs__gtao_slice_setup(const obs__gtao_state *g, int sl, float noise0, float rpx,
-                           const float v[3], const float n[3], obs__gtao_slice *s);
+/* The slice's screen direction (cos, sin of its angle) from its index and
+ * the pixel's noise out[0] (obs__gtao_noise) */
+void obs__gtao_slice_dir(const obs__gtao_state *g, int sl, float noise0, float cs[2]);
+void obs__gtao_slice_setup(const float cs[2], float rpx, const float v[3], const float n[3],
+                           obs__gtao_slice *s);
 /* The slice's visibility from its horizon cosines hc0 (+omega) and hc1
  * (-omega); h[] the horizon angles (for the bent normal). */
 float obs__gtao_slice_vis(const obs__gtao_state *g, obs__gtao_slice *s, float hc0, float hc1,
