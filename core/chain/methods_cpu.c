@@ -319,10 +319,12 @@ static void hbao_pixels(const obs__frame *f, const float *pos, const float *nrm,
     }
 }
 
-/* gtao: obs__gtao_pixel.  The slices' set-up and the visibility's sums
- * (libm's cosf, sinf, acosf and powf: calls) pixel by pixel through
- * gtao.c's own functions, the horizon steps in lanes (their largest cosine
- * per lane in the steps' order); a side with a step off the planes (the
+/* gtao: obs__gtao_pixel, the one method here that is not the twin's bits:
+ * the slices' set-up and visibility in lanes with acosf, sinf and cosf by
+ * polynomials (acos_lane, sincos_lane: about 3e-7 and 1e-7 absolute),
+ * within 1e-5 of the twin (test_cpu_simd); the slices' directions and
+ * the final powf are libm's, as the twin's.  The horizon steps in lanes
+ * (their largest cosine per lane in the steps' order); a side with a step off the planes (the
  * surface continued past the border, border_cpu.c) is taken again step by
  * step in order, those steps through gtao.c. */
 OBS__LANES
@@ -332,6 +334,7 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
     const obs__gtao_state *g = obs__gtao_of(f);
     const int w = f->width, h = f->height, steps = g->steps, slices = g->slices;
     const float thin1 = 1.0f + g->thin_power[0], fmul = g->falloff[0], fadd = g->falloff[1];
+    const int heur = g->heuristics;
     float noise[9][2], cs[9][32][2]; /* each tile's noise and slices' directions (<= 32) */
     for (int t = 0; t < 9; t++) {
         obs__gtao_noise(t, noise[t]);
@@ -346,9 +349,9 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
             nz1[METHOD_LANES], vis[METHOD_LANES], om0[METHOD_LANES],
             om1[METHOD_LANES], hc[2][METHOD_LANES];
         float sval[32][METHOD_LANES]; /* a side's steps' cosines (steps <= 32) */
+        float np_len[METHOD_LANES], cosg[METHOD_LANES], gam[METHOD_LANES], lo[2][METHOD_LANES];
         int ok[METHOD_LANES], taken[METHOD_LANES], out[METHOD_LANES], ti[METHOD_LANES], sqx[32][METHOD_LANES],
             sqy[32][METHOD_LANES];
-        obs__gtao_slice sl_of[METHOD_LANES];
         chunk_at(f, px, m, j0, &c);
         lanes_load(pos, nrm, &c, &v);
         for (int j = 0; j < METHOD_LANES; j++) {
@@ -374,13 +377,40 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
             taken[j] = 0;
         }
         for (int sl = 0; sl < slices; sl++) {
+            float cpl[METHOD_LANES], spl[METHOD_LANES];
             for (int j = 0; j < METHOD_LANES; j++) {
-                const float vv[3] = {v0[j], v1[j], v2[j]}, n[3] = {v.n0[j], v.n1[j], v.n2[j]};
-                obs__gtao_slice_setup(cs[ti[j]][sl], rpx[j], vv, n, &sl_of[j]);
-                om0[j] = sl_of[j].omega[0];
-                om1[j] = sl_of[j].omega[1];
-                hc[0][j] = sl_of[j].low[0];
-                hc[1][j] = sl_of[j].low[1];
+                cpl[j] = cs[ti[j]][sl][0];
+                spl[j] = cs[ti[j]][sl][1];
+            }
+            /* obs__gtao_slice_setup(), its acosf and cosf by polynomials */
+#pragma omp simd
+            for (int j = 0; j < METHOD_LANES; j++) {
+                const float cp = cpl[j], sp = spl[j];
+                const float a0 = v0[j], a1 = v1[j], a2 = v2[j];
+                const float n0 = v.n0[j], n1 = v.n1[j], n2 = v.n2[j];
+                om0[j] = cp * rpx[j];
+                om1[j] = -sp * rpx[j];
+                const float dv = cp * a0 + sp * a1 + 0.0f * a2;
+                const float od0 = cp - dv * a0, od1 = sp - dv * a1, od2 = 0.0f - dv * a2;
+                float ax0 = od1 * a2 - od2 * a1, ax1 = od2 * a0 - od0 * a2;
+                float ax2 = od0 * a1 - od1 * a0;
+                const float al = sqrtf(ax0 * ax0 + ax1 * ax1 + ax2 * ax2);
+                ax0 /= al;
+                ax1 /= al;
+                ax2 /= al;
+                const float na = n0 * ax0 + n1 * ax1 + n2 * ax2;
+                const float np0 = n0 - ax0 * na, np1 = n1 - ax1 * na, np2 = n2 - ax2 * na;
+                const float npl = sqrtf(np0 * np0 + np1 * np1 + np2 * np2);
+                const float cg = (np0 * a0 + np1 * a1 + np2 * a2) / npl;
+                const float cgs = cg < 0.0f ? 0.0f : cg > 1.0f ? 1.0f : cg; /* saturate */
+                const float cos_g = npl > 0.0f ? cgs : 1.0f;
+                const float on = od0 * np0 + od1 * np1 + od2 * np2;
+                const float gamma = (float)((on > 0.0f) - (on < 0.0f)) * acos_lane(cos_g);
+                np_len[j] = npl;
+                cosg[j] = cos_g;
+                gam[j] = gamma;
+                hc[0][j] = lo[0][j] = sincos_lane(gamma + (float)M_PI_2, 1);
+                hc[1][j] = lo[1][j] = sincos_lane(gamma - (float)M_PI_2, 1);
             }
             for (int side = 0; side < 2; side++) {
                 const int dir = side ? -1 : 1;
@@ -413,7 +443,7 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
                         const float fb = sqrtf(d0 * d0 + d1 * d1 + dz * dz);
                         const float t = fb * fmul + fadd; /* a number: the clamp without NaN */
                         const float wt = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
-                        const float low = sl_of[j].low[side];
+                        const float low = lo[side][j];
                         const float val =
                             (q3 > 0.0f) & (dist > 0.0f) ? low + (shc - low) * wt : low;
                         sval[st][j] = val;
@@ -428,21 +458,34 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
                         continue;
                     const float cc[3] = {c0[j], c1[j], c2[j]}, vv[3] = {v0[j], v1[j], v2[j]};
                     const int x = c.x[j], y = c.y[j];
-                    float hm = sl_of[j].low[side];
+                    float hm = lo[side][j];
                     for (int st = 0; st < steps; st++) {
                         const int qx = sqx[st][j], qy = sqy[st][j];
                         if (qx >= 0 && qy >= 0 && qx < w && qy < h)
                             hm = max_f(hm, sval[st][j]);
                         else
                             obs__gtao_border_step(f, pos, nrm, x, y, qx, qy, cc, vv,
-                                                  sl_of[j].low[side], &hm, &taken[j]);
+                                                  lo[side][j], &hm, &taken[j]);
                     }
                     hs[j] = hm;
                 }
             }
+            /* obs__gtao_slice_vis(), its acosf, sinf and cosf by polynomials */
+#pragma omp simd
             for (int j = 0; j < METHOD_LANES; j++) {
-                float hh[2];
-                vis[j] += obs__gtao_slice_vis(g, &sl_of[j], hc[0][j], hc[1][j], hh);
+                const float half_pi = (float)M_PI_2, gamma = gam[j], cg = cosg[j];
+                const float npl = heur ? np_len[j] + (1.0f - np_len[j]) * GTAO_SLOPE_FUDGE
+                                       : np_len[j];
+                const float k1 = hc[1][j] < -1.0f ? -1.0f : hc[1][j] > 1.0f ? 1.0f : hc[1][j];
+                const float k0 = hc[0][j] < -1.0f ? -1.0f : hc[0][j] > 1.0f ? 1.0f : hc[0][j];
+                const float e0 = -acos_lane(k1) - gamma, e1 = acos_lane(k0) - gamma;
+                const float h0 = gamma + (e0 > -half_pi ? e0 : -half_pi);
+                const float h1 = gamma + (e1 < half_pi ? e1 : half_pi);
+                const float sg = sincos_lane(gamma, 0);
+                /* arc(): (cos g + 2 h sin g - cos(2 h - g)) / 4 */
+                const float a0 = (cg + 2.0f * h0 * sg - sincos_lane(2.0f * h0 - gamma, 1)) / 4.0f;
+                const float a1 = (cg + 2.0f * h1 * sg - sincos_lane(2.0f * h1 - gamma, 1)) / 4.0f;
+                vis[j] += npl * (a0 + a1);
             }
         }
         for (int j = 0; j < c.cnt; j++) {

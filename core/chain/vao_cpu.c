@@ -123,23 +123,6 @@ float obs__rays_from_volume(float ao)
     return 1.0f - blocked;
 }
 
-/* asin(x) for x in [-1, 1], in lanes: Cephes' asinf (S. L. Moshier), its
- * polynomial on [0, 1/2] and asin(x) = pi/2 - 2 asin(sqrt((1 - x) / 2))
- * above; relative error about 2.5e-7 (Cephes' bound).  libm's asinf and
- * acosf are calls, which the lanes cannot make. */
-static inline __attribute__((always_inline)) float asin_lane(float x)
-{
-    const float a = fabsf(x);
-    const int big = a > 0.5f;
-    const float z = big ? 0.5f * (1.0f - a) : a * a;
-    const float s = big ? sqrtf(z) : a;
-    const float P = (((4.2163199048e-2f * z + 2.4181311049e-2f) * z + 4.5470025998e-2f) * z +
-                     7.4953002686e-2f) * z + 1.6666752422e-1f;
-    const float t = s + s * z * P;
-    const float r = big ? 1.57079632679489662f - 2.0f * t : t;
-    return x < 0.0f ? -r : r;
-}
-
 /* obs__rays_from_volume in lanes (no libm call): b = 2 cos((acos(1 - 2o)
  * + pi) / 3) is 2 sin(asin(1 - 2o) / 3) (pi/2 - acos y = asin y), and
  * acos(b) = pi/2 - asin(b); sin on [0, pi/6] by its Taylor polynomial to

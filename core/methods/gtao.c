@@ -54,7 +54,6 @@
 #include "chain/vao_cpu.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
-#define GTAO_SLOPE_FUDGE 0.05f    /* projectedNormalVecLength = lerp(len, 1, 0.05) */
 #define GTAO_MIN_VISIBILITY 0.03f /* visibility = max(0.03, visibility) */
 
 /* fminf and fmaxf as glibc computes them, inline (chain/vao_cpu.h) */

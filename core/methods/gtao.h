@@ -10,6 +10,7 @@
 #define GTAO_TOO_CLOSE 1.3f        /* pixelTooCloseThreshold: first sample this far, in pixels */
 #define GTAO_CENTRE_SCALE 0.99999f /* viewspaceZ *= 0.99999 (FP32 depths) */
 #define GTAO_R1 0.6180339887498948482f /* the steps' R1 sequence */
+#define GTAO_SLOPE_FUDGE 0.05f     /* projectedNormalVecLength = lerp(len, 1, 0.05) */
 
 /* Slices, steps per side, XeGTAO's heuristics (1: on); the search radius
  * gtao_multiplier * D in depth units; the falloff's weight =
@@ -53,8 +54,9 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
  * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
 void obs__gtao_noise(int tile, float out[2]);
 
-/* One slice of a pixel (obs__gtao_pixel_nodes' loop, in parts that the
- * CPU device's lanes share, methods_cpu.c): its direction in screen
+/* One slice of a pixel (obs__gtao_pixel_nodes' loop in parts; the CPU
+ * device's lanes, methods_cpu.c, share the direction, the steps past the
+ * border, the visibility's start and end): its direction in screen
  * pixels (omega, the search radius's length), the direction in view
  * space od, the projected normal's length, cos and angle gamma, and the
  * horizon cosines' starts low[side] (side 0: +omega, 1: -omega). */

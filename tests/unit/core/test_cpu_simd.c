@@ -295,7 +295,8 @@ static void test_prep_rows(void **state)
 
 /* The comparison methods in lanes (obs__method_pixels) against their
  * twins (obs__method_pixel) at every pixel with geometry of room_small,
- * bit for bit, AO and sample count, with default and non-default
+ * bit for bit (gtao within 1e-5, with the largest difference printed), AO
+ * and sample count exactly, with default and non-default
  * parameters, on a list of pixels in an order of its own with a partial
  * last chunk; methods without lanes (and object masks) leave it to the
  * twin. */
@@ -334,14 +335,21 @@ static void test_method_pixels(void **state)
             ao[i] = cnt[i] = -1.0f;
         const int lanes = obs__method_pixels(f, pos, nrm, px, m, ao, cnt);
         assert_int_equal(lanes, s < 10); /* angle's exact acos: none */
+        float worst = 0.0f;
         for (int j = 0; lanes && j < m; j++) {
             const int i = px[j], x = i % f->width, y = i / f->width;
             int n = -1;
             const float want = obs__method_pixel(f, pos, nrm, x, y, &n);
-            if (memcmp(&ao[i], &want, sizeof want) || cnt[i] != (float)n)
+            /* gtao's lanes take acos, sin and cos by polynomials: within
+             * 1e-5; the others bit for bit */
+            const int gtao = !strcmp(sets[s][1], "gtao");
+            if ((gtao ? !(fabsf(ao[i] - want) <= 1e-5f) : memcmp(&ao[i], &want, sizeof want)) ||
+                cnt[i] != (float)n)
                 fail_msg("%s (set %zu), pixel (%d, %d): %.9g, %g samples; the twin %.9g, %d",
                          sets[s][1], s, x, y, ao[i], cnt[i], want, n);
+            worst = fmaxf(worst, fabsf(ao[i] - want));
         }
+        print_message("%s (set %zu): largest |lanes - twin| %.3g\n", sets[s][1], s, worst);
         for (int j = m; j < m + 3; j++) /* only the listed pixels written */
             assert_true(ao[px[j]] == -1.0f && cnt[px[j]] == -1.0f);
         free(px);
