@@ -6,6 +6,7 @@
 #   make test     unit + end-to-end tests, then the same under ASan/UBSan
 #   make bench    benchmarks (bench/RESULTS.md)
 #   make quality  AO against ray-traced ground truth (bench/QUALITY.md)
+#   make quality-masks  the object masks against a hidden-object Cycles render (needs blender)
 #   make bake-quality  baked vertices against the per-pixel reference (bench/BAKE.md)
 #   make fuzz     libFuzzer targets: binary protocol, EXR readers (clang; tests/fuzz/fuzz.mk)
 #   make readme   regenerate README.md's parameter and daemon option tables
@@ -99,7 +100,7 @@ DAEMON_BENCH := $(BUILD)/daemon_bench
 -include protocol/protocol.mk daemon/daemon.mk clients/clients.mk tests/fuzz/fuzz.mk
 E2E_DEPS += $(UPSCALE)
 
-.PHONY: all deps demo demo-run test test-long check unit e2e loops headers readme readme-check samples bench quality quality-deep bake-quality clean deep-fixture
+.PHONY: all deps demo demo-run test test-long check unit e2e loops headers readme readme-check samples bench quality quality-masks quality-deep bake-quality clean deep-fixture
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI) $(EXTRA_BINS)
@@ -286,6 +287,15 @@ bench: deps
 quality: deps
 	@$(MAKE) --no-print-directory all $(QSTRIP)
 	@BUILD=$(BUILD) bench/quality.sh
+
+# The object masks against Cycles: the Blender room rendered twice with
+# tools/blender_masks.py (one object hidden), each method with and without
+# --occluders '!table' (bench/QUALITY.md, "Masks against a hidden-object
+# Cycles render"); says it skipped where Debian's blender is not installed
+# (tools/deps.sh --quality installs it; make test never needs it).
+quality-masks: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bench/masks.sh cycles
 
 # The multi-layer chain on rasterised deep G-buffers against Cycles, beside
 # the flat chain (bench/QUALITY.md, "Deep input against Cycles").

@@ -16,10 +16,70 @@
 # and with --self-only.
 #
 #   BUILD=build bench/masks.sh [SPP]     (SPP: reference samples, 256)
+#
+# With "cycles" (make quality-masks): the same question against Cycles
+# itself, when Debian's blender (and sweethome3d-furniture, whose meshes
+# the room is made of) are installed, else it says it skipped.
+# tools/blender_masks.py renders the room of $S/room.json at 320x240 twice
+# (every object, with IndexOB and a Cryptomatte object layer; HIDE, the
+# table by default, hidden from rendering); each method's AO of the first
+# without a mask, with --occluders '!HIDE' (Cryptomatte, coverage-weighted)
+# and with --occluders '!id:ViewLayer.IndexOB.X=N', MSE (obscura compare)
+# against the second's AO pass on the pixels both frames show (the
+# referee's figures too where ../shared/tools/aometrics.py can run); and
+# --receivers HIDE / --receivers id:... leave every pixel the selector
+# does not touch exactly 1.  Renders are kept in $BUILD/masks_cycles.
+#
+#   BUILD=build bench/masks.sh cycles [SPP [HIDE]]   (SPP: Cycles samples, 512)
 set -eu
 BUILD=${BUILD:-build}
 O=$BUILD/obscura
 S=${OBSCURA_SHARED_DATA:-../shared/data}/blender
+if [ "${1:-}" = cycles ]; then
+    SPP=${2:-512} HIDE=${3:-table}
+    FURN=/usr/share/sweethome3d/furniture/BlendSwap-CC-0.sh3f
+    if ! command -v blender >/dev/null 2>&1 || [ ! -f "$FURN" ] || [ ! -f "$S/room.json" ]; then
+        echo "quality-masks: SKIPPED: needs Debian's blender and sweethome3d-furniture" \
+            "(tools/deps.sh --quality) and $S/room.json"
+        exit 0
+    fi
+    D=$BUILD/masks_cycles
+    mkdir -p "$D"
+    blender -b --factory-startup --python tools/blender_masks.py -- "$S/room.json" "$D/room" "$HIDE" \
+        --res 320 240 --samples "$SPP" >"$D/blender.log" 2>&1 ||
+        { tail -20 "$D/blender.log"; exit 1; }
+    grep -E '^(OBJECTS|RENDER_SECONDS|REFERENCE)' "$D/blender.log"
+    n=$(sed -n "s/^OBJECTS.* $HIDE=\([0-9]*\).*/\1/p" "$D/blender.log")
+    R="$D/room.exr" REF="$D/room_ref.exr" CAM="--camera $D/room.camera.json --radius 0.5"
+    mse() { "$O" compare "$1" "$2" --json | sed -n 's/.*"mse": \([^,]*\),.*/\1/p'; }
+    echo
+    echo "Cycles $SPP spp, distance 0.5, 320x240; MSE against the AO with '$HIDE' hidden, over the pixels both frames show"
+    echo "(the two Cycles AO passes differ by MSE $(mse "$REF" "$R" 2>/dev/null || true) there: $HIDE's shadow and both renders' noise)"
+    echo
+    echo "| method | no mask | --occluders '!$HIDE' | --occluders '!id:ViewLayer.IndexOB.X=$n' |"
+    echo "|---|---|---|---|"
+    for m in vaopp hemisphere angle hbao gtao; do
+        "$O" ao "$R" $CAM --method "$m" -o "$D/$m.exr" 2>/dev/null
+        "$O" ao "$R" $CAM --method "$m" --occluders "!$HIDE" -o "$D/${m}_name.exr" 2>/dev/null
+        "$O" ao "$R" $CAM --method "$m" --occluders "!id:ViewLayer.IndexOB.X=$n" -o "$D/${m}_id.exr" 2>/dev/null
+        printf '| %s | %.5f | %.5f | %.5f |\n' "$m" "$(mse "$REF" "$D/$m.exr")" \
+            "$(mse "$REF" "$D/${m}_name.exr")" "$(mse "$REF" "$D/${m}_id.exr")"
+    done
+    if /usr/bin/python3 -c 'import OpenImageIO, numpy' 2>/dev/null; then
+        AOM=${OBSCURA_SHARED_DATA:-../shared/data}/../tools/aometrics.py
+        for f in vaopp vaopp_name gtao gtao_name; do
+            echo "aometrics.py $f: $(/usr/bin/python3 "$AOM" "$REF" "$D/$f.exr")"
+        done
+    fi
+    # --receivers: every pixel the selector gives weight 0 stays exactly 1
+    "$O" ao "$R" $CAM --method gtao --receivers "id:ViewLayer.IndexOB.X=$n" -o "$D/recv_id.exr" 2>/dev/null
+    "$O" ao "$R" $CAM --method gtao --receivers "$HIDE" -o "$D/recv_name.exr" 2>/dev/null
+    echo "--receivers 'id:ViewLayer.IndexOB.X=$n': max |AO - 1| over the unselected pixels:" \
+        "$(tools/unselected_max.sh "$O" "$R" "$D/recv_id.exr" id ViewLayer.IndexOB.X "$n")"
+    echo "--receivers '$HIDE': max |AO - 1| over the unselected pixels:" \
+        "$(tools/unselected_max.sh "$O" "$R" "$D/recv_name.exr" name ViewLayer.CryptoObject "$HIDE")"
+    exit 0
+fi
 SPP=${1:-256}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -35,7 +35,8 @@ void cli_ground_usage(FILE *f)
             "                  the vertex values interpolated\n"
             "                  [--ids]          adds id: 1 + the mesh's index at each pixel (0: none),\n"
             "                  an object mask's id:id=N (prints each ID's mesh and node names),\n"
-            "                  and a Cryptomatte layer CryptoObject of the node names\n"
+            "                  and a Cryptomatte layer CryptoObject of the node names;\n"
+            "                  with --deep, both per sample (the deep object masks' IDs)\n"
             "                  [--dynamic MODEL.json [--dynamic-nodes PATTERN] [--dynamic-sh S]]\n"
             "                  dynamic objects in the baked level (nodes whose name matches the\n"
             "                  pattern, or with glTF extras \"obscura_dynamic\": true, and their\n"
@@ -363,39 +364,6 @@ static int load_scene(const ground_args *a, obs_scene *scene)
 
 /* ---- obscura gbuffer ------------------------------------------------------ */
 
-/* gbuffer --deep: the A-buffer (obs_raster_deep) as a deep EXR. */
-static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene,
-                      const obs_camera *cam, int w, int h, double t0)
-{
-    obs_deep_image d;
-    char err[OBS_ERR_LEN] = "";
-    obs_status s = obs_raster_deep(ctx, scene, cam, w, h, &d, err);
-    if (s != OBS_OK)
-        return cli_input_fail(s, a->scene, err);
-    double t_raster = cli_now_s() - t0;
-    if ((s = obs_deep_write_exr(a->out, &d, err)) != OBS_OK) {
-        obs_deep_free(&d);
-        return cli_fail(s, a->out, err);
-    }
-    if (!a->quiet) {
-        size_t npx = (size_t)w * h, covered = 0;
-        uint64_t most = 0;
-        for (size_t i = 0; i < npx; i++) {
-            uint64_t n = d.offset[i + 1] - d.offset[i];
-            covered += n > 0;
-            most = n > most ? n : most;
-        }
-        obs_ctx_info ci;
-        obs_ctx_get_info(ctx, &ci);
-        fprintf(stderr, "obscura: info: wrote %s: %dx%d deep, %llu samples (%zu pixels covered, "
-                        "at most %llu per pixel), %s, rasterised in %.2f s\n",
-                a->out, w, h, (unsigned long long)d.offset[npx], covered,
-                (unsigned long long)most, obs_backend_name(ci.backend), t_raster);
-    }
-    obs_deep_free(&d);
-    return EXIT_OK;
-}
-
 /* gbuffer --ids: a Cryptomatte layer "CryptoObject" of the meshes (each
  * named by its node, else its mesh name) as the specification writes one:
  * one rank set, rank 0 the ID of the name's MurmurHash3 (obs_crypto_name_id)
@@ -450,6 +418,71 @@ static int crypto_layer(const obs_scene *scene, const obs_image *ids, obs_image 
     }
     attrs[8] = NULL;
     return 0;
+}
+
+/* gbuffer --deep: the A-buffer (obs_raster_deep) as a deep EXR. */
+static int write_deep(const ground_args *a, obs_ctx *ctx, const obs_scene *scene,
+                      const obs_camera *cam, int w, int h, double t0)
+{
+    obs_deep_image d;
+    float *ids = NULL;
+    char err[OBS_ERR_LEN] = "";
+    /* --ids: each sample's object as the per-sample channel id and a
+     * Cryptomatte layer of one rank per sample (coverage 1: a sample is one
+     * object's), what the object masks read at every deep sample (README:
+     * Object masks) */
+    obs_status s = obs_raster_deep_ids(ctx, scene, cam, w, h, &d, a->ids ? &ids : NULL, err);
+    if (s != OBS_OK)
+        return cli_input_fail(s, a->scene, err);
+    double t_raster = cli_now_s() - t0;
+    const uint64_t samples = d.offset[(size_t)w * h];
+    obs_image sid = {.data = ids, .width = samples ? (int)samples : 1, .height = 1, .channels = 1};
+    obs_image crypto = {0};
+    const char *attrs[9] = {NULL};
+    char *manifest = NULL;
+    if (ids && crypto_layer(scene, &sid, &crypto, attrs, &manifest) != 0) {
+        obs_deep_free(&d);
+        free(ids);
+        obs_image_free(&crypto);
+        free(manifest);
+        return cli_fail(OBS_NO_MEMORY, a->out, NULL);
+    }
+    const obs_deep_channel extra[] = {
+        {"id", ids, 1},
+        {CRYPTO_LAYER "00.R", crypto.data, 4},
+        {CRYPTO_LAYER "00.G", crypto.data + 1, 4},
+        {CRYPTO_LAYER "00.B", crypto.data + 2, 4},
+        {CRYPTO_LAYER "00.A", crypto.data + 3, 4},
+    };
+    s = obs_deep_write_exr_extra(a->out, &d, extra, ids ? 5 : 0, ids ? attrs : NULL, err);
+    free(ids);
+    obs_image_free(&crypto);
+    free(manifest);
+    if (s != OBS_OK) {
+        obs_deep_free(&d);
+        return cli_fail(s, a->out, err);
+    }
+    for (size_t m = 0; a->ids && !a->quiet && m < scene->mesh_count; m++)
+        fprintf(stderr, "obscura: info: id %zu: mesh '%s', node '%s'\n", m + 1,
+                scene->meshes[m].name ? scene->meshes[m].name : "",
+                scene->meshes[m].node ? scene->meshes[m].node : "");
+    if (!a->quiet) {
+        size_t npx = (size_t)w * h, covered = 0;
+        uint64_t most = 0;
+        for (size_t i = 0; i < npx; i++) {
+            uint64_t n = d.offset[i + 1] - d.offset[i];
+            covered += n > 0;
+            most = n > most ? n : most;
+        }
+        obs_ctx_info ci;
+        obs_ctx_get_info(ctx, &ci);
+        fprintf(stderr, "obscura: info: wrote %s: %dx%d deep, %llu samples (%zu pixels covered, "
+                        "at most %llu per pixel), %s, rasterised in %.2f s\n",
+                a->out, w, h, (unsigned long long)d.offset[npx], covered,
+                (unsigned long long)most, obs_backend_name(ci.backend), t_raster);
+    }
+    obs_deep_free(&d);
+    return EXIT_OK;
 }
 
 /* The G-buffer's EXR: depth, normals (world and camera), positions, the

@@ -717,7 +717,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     }
     double t0 = now_ms();
     s = a->in_buf ? obs_deep_read_exr_mem(a->in_buf, a->in_len, lim, &d, err) : obs_deep_read_exr(a->in, lim, &d, err);
-    if (s == OBS_OK) /* object masks: receivers at the front samples */
+    if (s == OBS_OK) /* object masks: receivers at the front samples, the rest at every sample */
         s = obs_deep_read_masks(&d, a->in_buf ? NULL : a->in, a->in_buf, a->in_len,
                                 &a->req.params, lim, err);
     if (s != OBS_OK) {

@@ -814,13 +814,42 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
             o += (size_t)snprintf(query + o, qcap - o, "%s%s=%s", i ? "&" : "", ps.p[i].name, v);
         }
     }
+    /* Object masks are read by the daemon from the EXR itself (its
+     * selectors name the file's channels, per sample on deep input): with
+     * a mask the binary request carries the file, with the parameters an
+     * HTTP request sends, instead of the planes, which have no place for
+     * them */
+    int masks = 0;
+    char cam_b[1024];
     if (any_bin) {
         collect(argc, argv, 0, &pb, names_b);
+        static const char *const mask_rows[] = {"receivers", "occluders", "self_only", "self-only"};
+        for (int k = 0; k < 4; k++)
+            masks |= has(&pb, mask_rows[k]);
+        if (masks) { /* again, with the channel map's rows, as for HTTP */
+            pb.n = 0;
+            collect(argc, argv, 1, &pb, names_b);
+        }
         add(&pb, "output", oname);
         add(&pb, "format", out->file ? "exr" : "raw"); /* deep: the file as it is */
         if (token && *token)
             add(&pb, "token", token);
-        obs_bin_request_desc d = {.id = 1, .params = pb.p, .param_count = pb.n, .gb = gb, .deep = deep};
+        if (masks) {
+            add(&pb, "baked", "none"); /* as for HTTP: this client combines it */
+            camera_params(gb, &pb, cam_b, sizeof cam_b);
+            if (!body && !(body = read_file(in_path, &body_len))) {
+                fprintf(stderr, "obscura: error: %s: cannot read it to send\n", in_path);
+                free(query);
+                return RC_BADINPUT;
+            }
+        }
+        obs_bin_request_desc d = {.id = 1,
+                                  .params = pb.p,
+                                  .param_count = pb.n,
+                                  .gb = masks ? NULL : gb,
+                                  .exr = masks ? body : NULL,
+                                  .exr_len = masks ? body_len : 0,
+                                  .deep = masks ? NULL : deep};
         if (obs_bin_request_encode(&d, &frame, err) != OBS_OK) {
             fprintf(stderr, "obscura: error: cannot encode the request: %s\n", err);
             goto fail;

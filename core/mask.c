@@ -194,7 +194,8 @@ typedef struct {
     const void *buf;
     size_t len;
     const obs_limits *lim;
-    int deep; /* 1: a deep file, read at each pixel's front sample */
+    int deep; /* 1: a deep file, read at each pixel's front sample; 2: at
+               * every sample (an image of the samples x 1) */
     int part;         /* the part to prefer (the G-buffer's); -1: none */
     const char *view; /* the view whose parts come first (the G-buffer's); NULL: none */
 } source;
@@ -202,6 +203,17 @@ typedef struct {
 static obs_status read_ch(const source *src, const char *ch, obs_image *img,
                           char err[OBS_ERR_LEN])
 {
+    if (src->deep == 2) {
+        const obs__exr_mem mem = {src->buf, src->len};
+        obs_status st =
+            obs__deep_read_samples(src->path, src->buf ? &mem : NULL, ch, src->lim, img, err);
+        if (st == OBS_MISSING_CHANNEL) /* what the selector needs, said */
+            st = obs__fail(err, st,
+                           "the deep part has no per-sample channel '%.200s': the selector reads "
+                           "it at every deep sample (README: Object masks, deep input)",
+                           ch);
+        return st;
+    }
     if (src->deep) {
         const obs__exr_mem mem = {src->buf, src->len};
         return obs__deep_read_front(src->path, src->buf ? &mem : NULL, ch, src->lim, img, err);
@@ -617,30 +629,92 @@ fail:
     return st;
 }
 
+/* The occluders weight (when occl is not NULL) and self_only's object
+ * (when id is not NULL) of every sample of a deep file: the selectors
+ * read at every sample (src->deep 2), the objects from the same source as
+ * the flat chain's (obs_gbuffer_read_masks): the receivers or occluders
+ * selector's Cryptomatte layer or ID channel, else default_source. */
+static obs_status deep_sample_masks(source *src, const obs_params *p, uint64_t samples,
+                                    obs_image *occl, obs_image *id, char err[OBS_ERR_LEN])
+{
+    obs_image skip = {0};
+    obs_status st = OBS_OK;
+    char self_sel[200];
+    src->deep = 2;
+    if (id && p->receivers[0] && sel_has_objects(p->receivers))
+        st = plane_of(src, p->receivers, &skip, id, err);
+    obs_image_free(&skip);
+    if (st == OBS_OK && (occl || (id && !id->data && p->occluders[0] &&
+                                  sel_has_objects(p->occluders))))
+        st = plane_of(src, p->occluders, occl ? occl : &skip,
+                      id && !id->data && sel_has_objects(p->occluders) ? id : NULL, err);
+    obs_image_free(&skip);
+    if (st == OBS_OK && id && !id->data &&
+        (st = default_source(src, self_sel, sizeof self_sel, err)) == OBS_OK)
+        st = plane_of(src, self_sel, &skip, id, err);
+    obs_image_free(&skip);
+    const obs_image *pl[2] = {occl, id};
+    for (int k = 0; k < 2 && st == OBS_OK; k++)
+        if (pl[k] && pl[k]->data && (uint64_t)pl[k]->width * (uint64_t)pl[k]->height !=
+                                        (samples ? samples : 1))
+            st = obs__fail(err, OBS_BAD_FILE,
+                           "%s: the mask covers %llu deep samples, the deep image has %llu",
+                           k ? "self_only" : "occluders",
+                           (unsigned long long)pl[k]->width * (unsigned long long)pl[k]->height,
+                           (unsigned long long)samples);
+    return st;
+}
+
 obs_status obs_deep_read_masks(obs_deep_image *d, const char *path, const void *buf, size_t len,
                                const obs_params *p, const obs_limits *lim, char err[OBS_ERR_LEN])
 {
     if (!d || !p || (!path && !buf))
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_read_masks: NULL argument");
-    if (p->occluders[0] || p->self_only == OBS_ON)
-        return obs__fail(err, OBS_UNSUPPORTED,
-                         "occluders and self_only are not available on deep input (receivers "
-                         "is: the front sample's weight)");
-    if (!p->receivers[0])
+    const int self = p->self_only == OBS_ON;
+    if (!p->receivers[0] && !p->occluders[0] && !self)
         return OBS_OK;
     source src;
-    obs_image w = {0};
+    obs_image w = {0}, occl = {0}, id = {0};
     obs_status st = source_init(&src, path, buf, len, lim, err);
-    if (st == OBS_OK)
+    /* receivers: at each pixel's front sample (what the flat AO shades) */
+    if (st == OBS_OK && p->receivers[0])
         st = plane_of(&src, p->receivers, &w, NULL, err);
-    if (st == OBS_OK && (w.width != d->width || w.height != d->height))
+    if (st == OBS_OK && w.data && (w.width != d->width || w.height != d->height))
         st = obs__fail(err, OBS_BAD_FILE, "receivers: the mask covers %dx%d pixels, the deep "
                        "image %dx%d", w.width, w.height, d->width, d->height);
+    /* occluders and self_only: at every sample, carried to the nodes the
+     * list compression keeps (obs_deep_compress) */
+    const uint64_t samples = d->offset ? d->offset[(size_t)d->width * (size_t)d->height] : 0;
+    if (st == OBS_OK && (p->occluders[0] || self)) {
+        st = deep_sample_masks(&src, p, samples, p->occluders[0] ? &occl : NULL,
+                               self ? &id : NULL, err);
+        if (st != OBS_OK) { /* which parameter asked, before the reason */
+            char why[OBS_ERR_LEN];
+            snprintf(why, sizeof why, "%s", err);
+            st = obs__fail(err, st, "%s on deep input: %.400s",
+                           p->occluders[0] && self ? "occluders, self_only"
+                           : self                  ? "self_only"
+                                                   : "occluders",
+                           why);
+        }
+    }
     if (st != OBS_OK) {
         obs_image_free(&w);
+        obs_image_free(&occl);
+        obs_image_free(&id);
         return st;
     }
-    free(d->receivers);
-    d->receivers = w.data; /* taken over */
+    if (w.data) {
+        free(d->receivers);
+        d->receivers = w.data; /* taken over */
+    }
+    free(d->occluders);
+    free(d->object_id);
+    d->occluders = samples ? occl.data : NULL; /* taken over */
+    d->object_id = samples ? id.data : NULL;
+    if (!samples) {
+        obs_image_free(&occl);
+        obs_image_free(&id);
+    }
     return OBS_OK;
 }

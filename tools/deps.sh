@@ -14,6 +14,13 @@ libassimp-dev libembree-dev nettle-dev libsuitesparse-dev libmeshoptimizer-dev"
 # pip install clients/python offline), Highway (make bench's blur kernel
 # in Highway against the library's OpenMP simd form, bench/blur_hwy.cc).
 # `deps.sh --build` leaves them out (deploy/container).
+# `deps.sh --quality` adds what only make quality-masks needs: Blender
+# (Cycles renders the hidden-object reference, tools/blender_masks.py) and
+# sweethome3d-furniture (the CC0 meshes of the Blender room).  Neither the
+# build, make demo nor make test needs them.
+if [ "${1:-}" = "--quality" ]; then
+    PKGS="$PKGS blender sweethome3d-furniture"
+fi
 if [ "${1:-}" != "--build" ]; then
     PKGS="$PKGS libhwy-dev chromium nodejs python3-yaml systemd python3-numpy python3-openimageio openimageio-tools python3 python3-pip python3-wheel"
     command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"

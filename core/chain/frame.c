@@ -85,10 +85,10 @@ obs_status obs__frame_setup_common(obs_ctx *log_ctx, const obs_gbuffer *gb, cons
     f->mask_occl = gb->occluders.data;
     f->mask_id = gb->object_id.data;
     f->mask_on = f->mask_occl || f->mask_id;
-    if (f->mask_on && f->half)
-        return obs__fail(err, OBS_INVALID_ARGUMENT,
-                         "occluders and self_only need ao_resolution full (the masks are "
-                         "per pixel of the full frame)");
+    f->mask_plane = 0;
+    /* ao_resolution half: the half frame reads half-size planes, each
+     * half pixel the masks of the full pixel whose depth it keeps
+     * (obs__frame_half, obs__half_source) */
     for (int k = 0; k <= f->blur_radius; k++) /* section 4.6: Gaussian kernel */
         f->blur_w[k] = expf(-(float)(k * k) / (2.0f * p->blur_sigma * p->blur_sigma));
     for (int k = 0; k < 9; k++)

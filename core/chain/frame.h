@@ -80,6 +80,9 @@ typedef struct obs__frame {
      * site through obs__occluder_weight (chain/mask_weight.h) */
     const float *mask_occl, *mask_id;
     int mask_on;            /* 1: either is set */
+    /* 0: one plane (the flat chain); deep input: the planes are per node,
+     * node k's at k * mask_plane (width x height each, core/deep) */
+    size_t mask_plane;
     /* the method's own values, read by its functions only: their types
      * are in core/methods/<method>.h (obs__gtao_of(f), ...), so the chain
      * needs none of them; in place, so that a frame copies whole
@@ -144,6 +147,12 @@ void obs__frame_half(const obs__frame *f, obs__frame *hf);
  * depth).  GLSL: prep.frag.glsl with OBS_HALF (the prep of the chosen
  * pixel, straight from the raw planes). */
 long obs__half_source(const obs__frame *f, const float *pos, int hx, int hy);
+
+/* The object masks of half pixel h (occluders weight into hw[h], object
+ * into hid[h]; NULL, or the full frame without that mask: not written):
+ * those of full pixel k, the one obs__half_source picked for it.  The
+ * half frame's mask_occl and mask_id then point at hw and hid. */
+void obs__half_masks(const obs__frame *f, long k, size_t h, float *hw, float *hid);
 
 /* The AO of full pixel (x, y) from the half-resolution AO `hao`: the
  * joint bilateral upsample, up.frag.glsl.  The

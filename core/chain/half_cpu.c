@@ -17,6 +17,9 @@
 void obs__frame_half(const obs__frame *f, obs__frame *hf)
 {
     *hf = *f;
+    /* object masks: the driver points these at its half-size planes,
+     * filled by the downsample (obs__half_masks) */
+    hf->mask_occl = hf->mask_id = NULL;
     hf->width = (f->width + 1) / 2;
     hf->height = (f->height + 1) / 2;
     for (int k = 0; k < 4; k++)
@@ -45,6 +48,17 @@ long obs__half_source(const obs__frame *f, const float *pos, int hx, int hy)
             }
         }
     return best;
+}
+
+void obs__half_masks(const obs__frame *f, long k, size_t h, float *hw, float *hid)
+{
+    /* k is the pixel obs__half_source kept the depth, position and normal
+     * of: the weight and the self_only test then read the surface the
+     * half pixel's depth came from, never a neighbour's across an edge */
+    if (hw && f->mask_occl)
+        hw[h] = f->mask_occl[k];
+    if (hid && f->mask_id)
+        hid[h] = f->mask_id[k];
 }
 
 /* The first of the two half pixels around coordinate c (half grid), both

@@ -464,7 +464,7 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
                         if (qx >= 0 && qy >= 0 && qx < w && qy < h)
                             hm = max_f(hm, sval[st][j]);
                         else
-                            obs__gtao_border_step(f, pos, nrm, x, y, qx, qy, cc, vv,
+                            obs__gtao_border_step(f, pos, nrm, 0, x, y, qx, qy, cc, vv,
                                                   lo[side][j], &hm, &taken[j]);
                     }
                     hs[j] = hm;

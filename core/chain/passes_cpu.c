@@ -342,6 +342,7 @@ static void half_rows(void *ctx, int y0, int y1)
             const size_t h = (size_t)hy * hf->width + hx;
             memcpy(c->hpos + 4 * h, c->pos + 4 * k, 4 * sizeof(float));
             memcpy(c->hnrm + 3 * h, c->nrm + 3 * k, 3 * sizeof(float));
+            obs__half_masks(f, k, h, c->hmask_w, c->hmask_id); /* object masks */
             c->dnz[2 * h] = c->hpos[4 * h + 3];
             c->dnz[2 * h + 1] = c->hnrm[3 * h + 2];
         }

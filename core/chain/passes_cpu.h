@@ -17,6 +17,7 @@ typedef struct obs__cpu_run {
     size_t npx;
     float *pos, *nrm, *ao, *tmp, *est, *col, *bleed; /* full size; col: packed RGBA */
     float *hpos, *hnrm, *hao, *htmp, *hbleed;       /* half size */
+    float *hmask_w, *hmask_id; /* half size: the object masks (NULL: none) */
     float *apos, *anrm, *aao, *atmp, *ableed;       /* at the AO's size */
     /* each pixel's depth and view normal z, packed (vao_cpu.h), at the
      * AO's size: what the AO's samples read */

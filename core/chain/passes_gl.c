@@ -139,7 +139,23 @@ static obs_status run_prep(obs__gl_run *r, char err[OBS_ERR_LEN])
     glUseProgram(prog);
     bind_img(prog, "u_depth", 0, r->t->tex_depth, GL_R32F);
     bind_img(prog, "u_normal", 1, r->t->tex_normal, GL_RGBA32F);
+    if (f->half) { /* object masks: the half pixels' from their full pixels' */
+        glUniform1i(glGetUniformLocation(prog, "u_mask_on"),
+                    (f->mask_occl ? 1 : 0) | (f->mask_id ? 2 : 0));
+        if (f->mask_occl) {
+            bind_img(prog, "u_mask_w", 5, r->t->tex_mask_w, GL_R32F);
+            glBindImageTexture(2, r->at->tex_mask_w, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+            glUniform1i(glGetUniformLocation(prog, "u_hmask_w"), 2);
+        }
+        if (f->mask_id) {
+            bind_img(prog, "u_mask_id", 6, r->t->tex_mask_id, GL_R32F);
+            glBindImageTexture(3, r->at->tex_mask_id, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+            glUniform1i(glGetUniformLocation(prog, "u_hmask_id"), 3);
+        }
+    }
     draw(r->ctx, r->at->fbo_prep, af->width, af->height);
+    if (f->half && f->mask_on) /* the AO pass reads what the images got */
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     return f->half ? obs__frame_block_bind(r->ctx, af, err) : OBS_OK;
 }
 
@@ -173,10 +189,10 @@ static obs_status run_ao(obs__gl_run *r, char err[OBS_ERR_LEN])
     /* object masks: occluder_weight() in common.glsl */
     glUniform1i(glGetUniformLocation(prog, "u_mask_on"),
                 (pl->f.mask_occl ? 1 : 0) | (pl->f.mask_id ? 2 : 0));
-    if (pl->f.mask_occl)
-        bind_img(prog, "u_mask_w", 5, r->t->tex_mask_w, GL_R32F);
+    if (pl->f.mask_occl) /* at the AO's size (half: the downsample's) */
+        bind_img(prog, "u_mask_w", 5, at->tex_mask_w, GL_R32F);
     if (pl->f.mask_id)
-        bind_img(prog, "u_mask_id", 6, r->t->tex_mask_id, GL_R32F);
+        bind_img(prog, "u_mask_id", 6, at->tex_mask_id, GL_R32F);
     /* the debug outputs go to their textures only when asked for */
     const GLenum vao_bufs[] = {
         GL_COLOR_ATTACHMENT0,

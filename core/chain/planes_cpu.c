@@ -53,9 +53,11 @@ obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN])
         bleed ? lines(n * 3) : 0, col ? lines(n * 4) : 0,
         f->half ? lines(an * 4) : 0, f->half ? lines(an * 3) : 0, f->half ? lines(an) : 0,
         f->half ? lines(an) : 0, f->half && bleed ? lines(an * 3) : 0, lines(an * 2),
+        f->half && f->mask_occl ? lines(an) : 0, f->half && f->mask_id ? lines(an) : 0,
     };
-    float **planes[] = {&c->pos,  &c->nrm,  &c->ao,  &c->tmp,  &c->est,  &c->bleed,
-                        &c->col,  &c->hpos, &c->hnrm, &c->hao, &c->htmp, &c->hbleed, &c->dnz};
+    float **planes[] = {&c->pos,  &c->nrm,  &c->ao,   &c->tmp,  &c->est,    &c->bleed,
+                        &c->col,  &c->hpos, &c->hnrm, &c->hao,  &c->htmp,   &c->hbleed,
+                        &c->dnz,  &c->hmask_w, &c->hmask_id};
     size_t need = 0;
     for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
         need += sizes[i];

@@ -94,6 +94,9 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
     /* the planes' allocation counts as the upload, as GL's textures do */
     double t0 = times ? now_ms() : 0.0;
     s = obs__cpu_planes_take(&c, err);
+    /* object masks at half resolution: the downsample's half planes */
+    pl.hf.mask_occl = c.hmask_w;
+    pl.hf.mask_id = c.hmask_id;
     if (s == OBS_OK)
         s = obs__alloc_result(out, pl.f.width, pl.f.height, pl.outputs, err);
     if (times) {

@@ -158,6 +158,11 @@ obs_status obs__targets_need(unsigned long *created, const obs__frame *f, obs__t
         s = need_texture(created, t, &t->tex_mask_w, GL_R32F, 0, 0, err);
     if (s == OBS_OK && f->mask_id)
         s = need_texture(created, t, &t->tex_mask_id, GL_R32F, 0, 0, err);
+    /* ao_resolution half: the half-size masks the downsample writes */
+    if (s == OBS_OK && f->half && f->mask_occl)
+        s = need_texture(created, at, &at->tex_mask_w, GL_R32F, 0, 0, err);
+    if (s == OBS_OK && f->half && f->mask_id)
+        s = need_texture(created, at, &at->tex_mask_id, GL_R32F, 0, 0, err);
     if (s == OBS_OK && (outputs & OBS_OUTPUT_COMPOSITE) && !t->fbo_composite) {
         s = need_texture(created, t, &t->tex_composite, GL_RGBA32F, 0, 0, err);
         if (s == OBS_OK)

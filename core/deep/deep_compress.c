@@ -43,12 +43,17 @@ static float norm_z(float z, float zmin, float zmax)
     return t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
 }
 
-int obs_deep_compress_list(const float *samples, int n, int m, int front_half, float zmin,
-                           float zmax, float *out)
+/* obs_deep_compress_list that also writes, when src is not NULL, the
+ * index (0 .. n - 1) of the sample each kept node came from: the nodes
+ * move with their index, so the object masks of a sample reach the node
+ * it became (obs_deep_layers.occluders, object_id). */
+static int compress_list(const float *samples, int n, int m, int front_half, float zmin,
+                         float zmax, float *out, int *src)
 {
     /* m + 1 slots: the insertion that overflows is followed at once by
      * the elimination of eq 5 over the m + 1 candidates. */
     float a[(OBS_DEEP_MAX_LAYERS + 1) * OBS_DEEP_CH];
+    int ix[OBS_DEEP_MAX_LAYERS + 1];
     int count = 0;
     if (m < 1)
         m = 1;
@@ -64,6 +69,8 @@ int obs_deep_compress_list(const float *samples, int n, int m, int front_half, f
         memmove(a + (i + 1) * OBS_DEEP_CH, a + i * OBS_DEEP_CH,
                 (size_t)(count - i) * OBS_DEEP_CH * sizeof(float));
         memcpy(a + i * OBS_DEEP_CH, f, OBS_DEEP_CH * sizeof(float));
+        memmove(ix + i + 1, ix + i, (size_t)(count - i) * sizeof *ix);
+        ix[i] = s;
         count++;
         if (count <= m)
             continue;
@@ -80,10 +87,19 @@ int obs_deep_compress_list(const float *samples, int n, int m, int front_half, f
         }
         memmove(a + drop * OBS_DEEP_CH, a + (drop + 1) * OBS_DEEP_CH,
                 (size_t)(count - drop - 1) * OBS_DEEP_CH * sizeof(float));
+        memmove(ix + drop, ix + drop + 1, (size_t)(count - drop - 1) * sizeof *ix);
         count--;
     }
     memcpy(out, a, (size_t)count * OBS_DEEP_CH * sizeof(float));
+    if (src)
+        memcpy(src, ix, (size_t)count * sizeof *src);
     return count;
+}
+
+int obs_deep_compress_list(const float *samples, int n, int m, int front_half, float zmin,
+                           float zmax, float *out)
+{
+    return compress_list(samples, n, m, front_half, zmin, zmax, out, NULL);
 }
 
 void obs_deep_layers_free(obs_deep_layers *l)
@@ -92,6 +108,8 @@ void obs_deep_layers_free(obs_deep_layers *l)
         return;
     free(l->node);
     free(l->count);
+    free(l->occluders);
+    free(l->object_id);
     memset(l, 0, sizeof *l);
 }
 
@@ -140,7 +158,13 @@ obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs
         return obs__fail(err, OBS_TOO_LARGE, "deep layers of %dx%dx%d", d->width, d->height, m);
     out->node = calloc(1, bytes);
     out->count = calloc(npx, sizeof *out->count);
-    if (!out->node || !out->count) {
+    /* the object masks' planes: node k of pixel i at k * npx + i */
+    if (d->occluders)
+        out->occluders = malloc(npx * (size_t)m * sizeof *out->occluders);
+    if (d->object_id)
+        out->object_id = calloc(npx * (size_t)m, sizeof *out->object_id);
+    if (!out->node || !out->count || (d->occluders && !out->occluders) ||
+        (d->object_id && !out->object_id)) {
         obs_deep_layers_free(out);
         return obs__fail(err, OBS_NO_MEMORY, "deep layers of %dx%dx%d", d->width, d->height, m);
     }
@@ -150,7 +174,10 @@ obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs
     out->m = m;
     out->zmin = zmin;
     out->zmax = zmax;
+    for (size_t k = 0; out->occluders && k < npx * (size_t)m; k++)
+        out->occluders[k] = 1.0f; /* empty nodes: as without the mask */
     float list[OBS_DEEP_MAX_LAYERS * OBS_DEEP_CH];
+    int src[OBS_DEEP_MAX_LAYERS];
     for (size_t i = 0; i < npx; i++) {
         const float *s = d->samples + d->offset[i] * OBS_DEEP_CH;
         uint64_t n64 = d->offset[i + 1] - d->offset[i];
@@ -159,13 +186,21 @@ obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs
         if (keep_all) { /* the front OBS_DEEP_MAX_LAYERS as they are */
             c = n < m ? n : m;
             memcpy(list, s, (size_t)c * OBS_DEEP_CH * sizeof(float));
+            for (int k = 0; k < c; k++)
+                src[k] = k;
         } else {
-            c = obs_deep_compress_list(s, n, m, front_half, zmin, zmax, list);
+            c = compress_list(s, n, m, front_half, zmin, zmax, list, src);
         }
         out->count[i] = c;
-        for (int k = 0; k < c; k++)
-            memcpy(out->node + ((size_t)k * npx + i) * OBS_DEEP_CH, list + k * OBS_DEEP_CH,
+        for (int k = 0; k < c; k++) {
+            const size_t at = (size_t)k * npx + i;
+            memcpy(out->node + at * OBS_DEEP_CH, list + k * OBS_DEEP_CH,
                    OBS_DEEP_CH * sizeof(float));
+            if (out->occluders)
+                out->occluders[at] = d->occluders[d->offset[i] + (uint64_t)src[k]];
+            if (out->object_id)
+                out->object_id[at] = d->object_id[d->offset[i] + (uint64_t)src[k]];
+        }
     }
     return OBS_OK;
 }

@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "chain/bands_cpu.h"
+#include "chain/mask_weight.h"
 #include "deep/deep_internal.h"
 #include "methods/gtao.h"
 #include "methods/hbao.h"
@@ -169,6 +170,13 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
                                err)) != OBS_OK)
         goto fail;
     int m = df->layers.m;
+    /* object masks (obs_deep_read_masks): the weight and the object of
+     * every node, read at each method's sample site by
+     * obs__occluder_weight_node, one plane per node */
+    df->f.mask_occl = df->layers.occluders;
+    df->f.mask_id = df->layers.object_id;
+    df->f.mask_on = df->f.mask_occl || df->f.mask_id;
+    df->f.mask_plane = npx;
     df->pos = malloc(npx * (size_t)m * 4 * sizeof *df->pos);
     df->nrm = malloc(npx * (size_t)m * 4 * sizeof *df->nrm);
     df->end = calloc(npx * (size_t)m, sizeof *df->end);
@@ -323,10 +331,13 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
                 continue; /* inside a nearer node's interval */
             if (k == self && qx == x && qy == y)
                 zs = obs__own_plane_depth(p, n, c, r, rot, sx, sy, zs);
+            /* the node's alpha times the object masks' weight of its
+             * surface (1 without masks) */
+            const float a = nk[3] * obs__occluder_weight_node(f, x, y, self, qx, qy, k);
             if (e > 0.0f && zs > 0.0f && !interior) /* a closed interval */
-                solid += nk[3] * interval_occlusion(zs, e, front, h);
+                solid += a * interval_occlusion(zs, e, front, h);
             else
-                occ = fmaxf(occ, nk[3] * node_occlusion(f, zs, nk[2], front, h, interior));
+                occ = fmaxf(occ, a * node_occlusion(f, zs, nk[2], front, h, interior));
         }
         /* the intervals are disjoint: their lengths add; the nodes solid
          * behind them count as Algorithm 1's largest */
@@ -355,11 +366,11 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
  * the bias along n from p) hides nothing, as node_occlusion's node in
  * front of the pipe. */
 static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float p[3],
-                           const float n[3], int interior)
+                           const float n[3], int interior, int self)
 {
     const obs__frame *f = &df->f;
-    const obs__hemisphere_nodes nodes = {df->pos, df->nrm, df->multi ? df->m : 1,
-                                         (size_t)f->width * (size_t)f->height, interior};
+    const obs__hemisphere_nodes nodes = {df->pos,  df->nrm, df->multi ? df->m : 1,
+                                         (size_t)f->width * (size_t)f->height, interior, self};
     return obs__hemisphere_estimate(f, &nodes, x, y, p, n);
 }
 
@@ -371,12 +382,13 @@ static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3]
                        int interior, int self)
 {
     if (df->f.method == OBS_METHOD_HEMISPHERE)
-        return hemisphere_ao(df, x, y, p, n, interior);
+        return hemisphere_ao(df, x, y, p, n, interior, self);
     if (df->f.method == OBS_METHOD_GTAO) /* the horizon over every node */
-        return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, x, y, p,
-                                     n, NULL, NULL);
+        return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, self, x,
+                                     y, p, n, NULL, NULL);
     if (df->f.method == OBS_METHOD_HBAO)
-        return obs__hbao_pixel_nodes(&df->f, df->pos, df->multi ? df->m : 1, x, y, p, n, NULL);
+        return obs__hbao_pixel_nodes(&df->f, df->pos, df->multi ? df->m : 1, self, x, y, p, n,
+                                     NULL);
     float v = sphere_ao(df, x, y, p, n, interior, self);
     return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */
 }

@@ -155,7 +155,9 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     t->tex_pos = array_texture(ctx, w, h, m, GL_RGBA32F);
     t->tex_nrm = array_texture(ctx, w, h, m, GL_RGBA32F);
     t->tex_end = array_texture(ctx, w, h, m, GL_R32F);
-    /* two RGBA32F arrays and one R32F array of m layers and three RG32F planes */
+    /* two RGBA32F arrays and one R32F array of m layers and three RG32F
+     * planes (the object masks' array is made by the first frame with
+     * masks) */
     t->bytes = (unsigned long long)w * (unsigned long long)h *
                ((16ull * 2ull + 4ull) * (unsigned)m + 3ull * 8ull);
     GLuint *planes[] = {&t->tex_front, &t->tex_blend, &t->tex_tmp};
@@ -243,6 +245,27 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     upload_layers(t->tex_nrm, w, h, df.m, GL_RGBA, df.nrm);
     if (df.intervals)
         upload_layers(t->tex_end, w, h, df.m, GL_RED, df.end);
+    /* object masks: each node's weight and object, interleaved, in an
+     * RG32F array made on the first frame with masks and kept with the
+     * others */
+    if (f->mask_on && !t->tex_mask) {
+        ctx->deep.tex_mask = array_texture(ctx, w, h, df.m, GL_RG32F);
+        ctx->deep.bytes += (unsigned long long)w * (unsigned long long)h * 8ull * (unsigned)df.m;
+    }
+    if (f->mask_on) {
+        const size_t nn = (size_t)w * (size_t)h * (size_t)df.m;
+        float *rg = malloc(nn * 2 * sizeof *rg);
+        if (!rg) {
+            s = obs__fail(err, OBS_NO_MEMORY, "deep object masks of %dx%dx%d", w, h, df.m);
+            goto fail;
+        }
+        for (size_t i = 0; i < nn; i++) {
+            rg[2 * i] = f->mask_occl ? f->mask_occl[i] : 1.0f;
+            rg[2 * i + 1] = f->mask_id ? f->mask_id[i] : 0.0f;
+        }
+        upload_layers(t->tex_mask, w, h, df.m, GL_RG, rg);
+        free(rg);
+    }
     stage_end(ctx, OBS_PASS_UPLOAD, t0, &times);
 
     stage_begin(ctx, &t0);
@@ -261,6 +284,13 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     if (df.intervals) {
         glBindImageTexture(2, t->tex_end, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
         glUniform1i(glGetUniformLocation(prog, "u_lend"), 2);
+    }
+    /* object masks: node_weight() in deep.frag.glsl */
+    glUniform1i(glGetUniformLocation(prog, "u_deep_mask"),
+                (f->mask_occl ? 1 : 0) | (f->mask_id ? 2 : 0));
+    if (f->mask_on) {
+        glBindImageTexture(3, t->tex_mask, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32F);
+        glUniform1i(glGetUniformLocation(prog, "u_lmask"), 3);
     }
     s = obs__gl_draw_banded(ctx->dev.vao, w, h, t_run, ctx->deadline_ms, "deep AO", err);
     stage_end(ctx, OBS_PASS_AO, t0, &times);

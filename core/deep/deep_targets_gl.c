@@ -9,8 +9,9 @@
 /* Drops the size-dependent objects; the program stays unless `all`. */
 void obs__deep_release(obs__deep_targets *t, int all)
 {
-    GLuint tex[] = {t->tex_pos, t->tex_nrm, t->tex_end, t->tex_front, t->tex_blend, t->tex_tmp};
-    glDeleteTextures(6, tex);
+    GLuint tex[] = {t->tex_pos,   t->tex_nrm,   t->tex_end, t->tex_mask,
+                    t->tex_front, t->tex_blend, t->tex_tmp};
+    glDeleteTextures(7, tex);
     GLuint fbo[] = {t->fbo, t->fbo_front, t->fbo_blend, t->fbo_tmp};
     for (int i = 0; i < 4; i++)
         if (fbo[i])

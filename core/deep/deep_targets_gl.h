@@ -16,6 +16,7 @@ typedef struct obs__deep_targets {
     unsigned long long bytes;    /* the textures' storage (obs_ctx_kept_bytes) */
     GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
     GLuint tex_end;              /* 2D array of m layers (R32F): the nodes' intervals */
+    GLuint tex_mask;             /* 2D array of m layers (RG32F): the nodes' object masks */
     /* RG32F (AO, the front node's planar depth, for the blur): the front
      * node's AO, the blend, and the blur's intermediate; fbo writes the
      * first two (the deep pass), the others one each (the blur) */

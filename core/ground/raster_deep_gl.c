@@ -100,7 +100,8 @@ static int cmp_key(const void *pa, const void *pb)
  * the pool and the per-pixel limit), then filled top row first and
  * sorted. */
 static obs_status build_image(const uint32_t *heads, const uint32_t *nodes, uint64_t stored,
-                              int width, int height, int has_albedo, obs_deep_image *d,
+                              int width, int height, int has_albedo, const float *tri_id,
+                              size_t triangles, obs_deep_image *d, float **ids,
                               char err[OBS_ERR_LEN])
 {
     const size_t npx = (size_t)width * (size_t)height;
@@ -128,6 +129,8 @@ static obs_status build_image(const uint32_t *heads, const uint32_t *nodes, uint
         }
     if (!(d->samples = malloc((size_t)(stored ? stored : 1) * OBS_DEEP_CH * sizeof(float))))
         return obs__fail(err, OBS_NO_MEMORY, "%llu deep samples", (unsigned long long)stored);
+    if (ids && !(*ids = calloc((size_t)(stored ? stored : 1), sizeof **ids)))
+        return obs__fail(err, OBS_NO_MEMORY, "IDs of %llu deep samples", (unsigned long long)stored);
     for (int y = 0; y < height; y++)
         for (int x = 0; x < width; x++) {
             size_t i = (size_t)y * width + x, n = (size_t)(d->offset[i + 1] - d->offset[i]), c = 0;
@@ -160,6 +163,8 @@ static obs_status build_image(const uint32_t *heads, const uint32_t *nodes, uint
                 o[OBS_DEEP_NY] = v[W_NY];
                 o[OBS_DEEP_NZ] = v[W_NZ];
                 o[OBS_DEEP_FACING] = v[W_FACING];
+                if (ids) /* the object of the sample's triangle; 0: none known */
+                    (*ids)[d->offset[i] + j] = keys[j].prim < triangles ? tri_id[keys[j].prim] : 0.0f;
             }
         }
     free(keys);
@@ -173,12 +178,22 @@ static obs_status build_image(const uint32_t *heads, const uint32_t *nodes, uint
 obs_status obs_raster_deep(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam, int width,
                            int height, obs_deep_image *out, char err[OBS_ERR_LEN])
 {
+    return obs_raster_deep_ids(ctx, scene, cam, width, height, out, NULL, err);
+}
+
+obs_status obs_raster_deep_ids(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
+                               int width, int height, obs_deep_image *out, float **ids,
+                               char err[OBS_ERR_LEN])
+{
+    float *tri_id = NULL;
     static const char *const frag[] = {"#version 430 core\n", obs__shader_raster_common,
                                        obs__shader_raster_deep_frag};
     deep_gl g = {0};
     uint32_t *heads = NULL, *nodes = NULL;
     obs_status s;
 
+    if (ids)
+        *ids = NULL;
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_raster_deep: no output");
     memset(out, 0, sizeof *out);
@@ -276,8 +291,21 @@ obs_status obs_raster_deep(obs_ctx *ctx, const obs_scene *scene, const obs_camer
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     if ((s = obs__gl_check("reading the A-buffer", err)) != OBS_OK)
         goto fail;
-    if ((s = build_image(heads, nodes, fragments, width, height, scene->albedo != NULL, out,
-                         err)) != OBS_OK)
+    /* --ids: each triangle's object, 1 + its mesh's index (gl_PrimitiveID
+     * is the triangle's index in the one draw of every triangle) */
+    if (ids && !(tri_id = calloc(scene->triangle_count ? scene->triangle_count : 1,
+                                 sizeof *tri_id))) {
+        s = obs__fail(err, OBS_NO_MEMORY, "IDs of %zu triangles", scene->triangle_count);
+        goto fail;
+    }
+    for (size_t m = 0; ids && m < scene->mesh_count; m++) {
+        const obs_scene_mesh *sm = &scene->meshes[m];
+        for (size_t t = sm->first_triangle;
+             t < sm->first_triangle + sm->triangle_count && t < scene->triangle_count; t++)
+            tri_id[t] = (float)(m + 1);
+    }
+    if ((s = build_image(heads, nodes, fragments, width, height, scene->albedo != NULL, tri_id,
+                         scene->triangle_count, out, ids, err)) != OBS_OK)
         goto fail;
     out->camera = *cam;
     obs__log(ctx, OBS_LOG_DEBUG, "A-buffer: %zu triangles at %dx%d, %llu fragments",
@@ -286,8 +314,14 @@ obs_status obs_raster_deep(obs_ctx *ctx, const obs_scene *scene, const obs_camer
 fail:
     free(heads);
     free(nodes);
+    free(tri_id);
     release(&g, ctx);
-    if (s != OBS_OK)
+    if (s != OBS_OK) {
         obs_deep_free(out);
+        if (ids) {
+            free(*ids);
+            *ids = NULL;
+        }
+    }
     return s;
 }

@@ -212,12 +212,16 @@ int obs__crypto_is_id_channel(const char *name)
     return 0;
 }
 
-/* The channel name of rank set s, component c (0 R .. 3 A) of L. */
+/* The channel name of rank set s, component c (0 R .. 3 A) of L: .R/.G/.B/.A
+ * as the specification names them, .red/.green/.blue/.alpha (Nuke), or
+ * .r/.g/.b/.a (Blender's multilayer EXR writes its Cryptomatte passes in
+ * lower case, e.g. ViewLayer.CryptoObject00.r). */
 void obs__crypto_channel(const obs_crypto_layer *L, int s, int c, char *buf, size_t len)
 {
-    static const char *const rgba[] = {"R", "G", "B", "A"};
-    static const char *const red[] = {"red", "green", "blue", "alpha"};
-    snprintf(buf, len, "%s%02d.%s", L->name, s, L->red_style ? red[c] : rgba[c]);
+    static const char *const styles[3][4] = {
+        {"R", "G", "B", "A"}, {"red", "green", "blue", "alpha"}, {"r", "g", "b", "a"}};
+    int k = L->red_style >= 0 && L->red_style < 3 ? L->red_style : 0;
+    snprintf(buf, len, "%s%02d.%s", L->name, s, styles[k][c]);
 }
 
 static int has_channel(const exr_attr_chlist_t *cl, const char *name)
@@ -272,12 +276,12 @@ static obs_status describe_part(exr_context_t ctx, int part, describe_job *j, ch
     for (int i = 0; i < info->layer_count; i++) {
         obs_crypto_layer *L = &info->layers[i];
         char ch[160];
-        for (L->red_style = 0; L->red_style < 2; L->red_style++) {
+        for (L->red_style = 0; L->red_style < 3; L->red_style++) {
             obs__crypto_channel(L, 0, 0, ch, sizeof ch);
             if (has_channel(cl, ch))
                 break;
         }
-        if (L->red_style == 2)
+        if (L->red_style == 3)
             L->red_style = 0;
         for (L->rank_sets = 0; L->rank_sets < OBS_CRYPTO_MAX_RANK_SETS; L->rank_sets++) {
             int all = 1;

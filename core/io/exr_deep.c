@@ -460,15 +460,24 @@ static obs_status read_any(const char *label, const char *path, const mem_src *m
     return st;
 }
 
+/* The deep image of path (or mem) with `channel` read in the place of R,
+ * for the object masks' two readers below. */
+static obs_status read_with_channel(const char *path, const obs__exr_mem *mem,
+                                    const char *channel, const obs_limits *lim,
+                                    obs_deep_image *d, char err[OBS_ERR_LEN])
+{
+    memset(d, 0, sizeof *d);
+    image_job j = {lim, d, channel};
+    return obs__exr_read_with(path ? path : "EXR in memory", mem ? NULL : path, mem, image_reader,
+                              &j, err);
+}
+
 obs_status obs__deep_read_front(const char *path, const obs__exr_mem *mem, const char *channel,
                                 const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN])
 {
     obs_deep_image d;
-    memset(&d, 0, sizeof d);
     memset(out, 0, sizeof *out);
-    image_job j = {lim, &d, channel};
-    obs_status st = obs__exr_read_with(path ? path : "EXR in memory", mem ? NULL : path, mem,
-                                       image_reader, &j, err);
+    obs_status st = read_with_channel(path, mem, channel, lim, &d, err);
     size_t n = (size_t)d.width * (size_t)d.height;
     if (st == OBS_OK && !(out->data = malloc((n ? n : 1) * sizeof(float))))
         st = obs__fail(err, OBS_NO_MEMORY, "channel of %dx%d", d.width, d.height);
@@ -481,6 +490,26 @@ obs_status obs__deep_read_front(const char *path, const obs__exr_mem *mem, const
             out->data[i] = d.offset[i + 1] > d.offset[i]
                                ? d.samples[d.offset[i] * OBS_DEEP_CH + OBS_DEEP_R]
                                : 0.0f;
+    }
+    obs_deep_free(&d);
+    return st;
+}
+
+obs_status obs__deep_read_samples(const char *path, const obs__exr_mem *mem, const char *channel,
+                                  const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN])
+{
+    obs_deep_image d;
+    memset(out, 0, sizeof *out);
+    obs_status st = read_with_channel(path, mem, channel, lim, &d, err);
+    const size_t n = st == OBS_OK ? (size_t)d.offset[(size_t)d.width * (size_t)d.height] : 0;
+    if (st == OBS_OK && !(out->data = calloc(n ? n : 1, sizeof(float))))
+        st = obs__fail(err, OBS_NO_MEMORY, "channel of %zu deep samples", n);
+    if (st == OBS_OK) {
+        out->width = n ? (int)n : 1; /* n <= OBS_DEEP_MAX_SAMPLES */
+        out->height = 1;
+        out->channels = 1;
+        for (size_t i = 0; i < n; i++) /* in the reader's order: sorted front to back */
+            out->data[i] = d.samples[i * OBS_DEEP_CH + OBS_DEEP_R];
     }
     obs_deep_free(&d);
     return st;
@@ -510,5 +539,7 @@ void obs_deep_free(obs_deep_image *d)
     free(d->offset);
     free(d->samples);
     free(d->receivers);
+    free(d->occluders);
+    free(d->object_id);
     memset(d, 0, sizeof *d);
 }

@@ -20,8 +20,19 @@ using namespace OPENEXR_IMF_NAMESPACE;
 extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image *d,
                                          char err[OBS_ERR_LEN])
 {
+    return obs_deep_write_exr_extra(path, d, NULL, 0, NULL, err);
+}
+
+extern "C" obs_status obs_deep_write_exr_extra(const char *path, const obs_deep_image *d,
+                                               const obs_deep_channel *extra, int n_extra,
+                                               const char *const *attrs, char err[OBS_ERR_LEN])
+{
     if (!path || !*path || !d || !d->offset || !d->samples || d->width <= 0 || d->height <= 0)
         return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "obs_deep_write_exr: no path or no deep image");
+    for (int k = 0; k < n_extra; k++)
+        if (!extra[k].name || !*extra[k].name || !extra[k].values || extra[k].stride < 1)
+            return obs__deep_fail(err, OBS_INVALID_ARGUMENT,
+                                  "obs_deep_write_exr_extra: channel %d has no name, values or stride", k);
     const int w = d->width, h = d->height;
     const size_t npx = (size_t)w * (size_t)h;
     for (size_t i = 0; i < npx; i++)
@@ -59,6 +70,10 @@ extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image 
         for (const ch &c : chans)
             if (c.present)
                 hdr.channels().insert(c.name, Channel(FLOAT));
+        for (int k = 0; k < n_extra; k++) // one value a sample, beside the others
+            hdr.channels().insert(extra[k].name, Channel(FLOAT));
+        for (int k = 0; attrs && attrs[k] && attrs[k + 1]; k += 2)
+            hdr.insert(attrs[k], StringAttribute(attrs[k + 1]));
 
         obs__deep_header_attrs(hdr, &d->camera);
 
@@ -85,6 +100,15 @@ extern "C" obs_status obs_deep_write_exr(const char *path, const obs_deep_image 
                 p[i] = base[i] + c.index;
             fb.insert(c.name, DeepSlice(FLOAT, (char *)(p.data() - origin), sizeof(float *),
                                         sizeof(float *) * (size_t)w, OBS_DEEP_CH * sizeof(float)));
+        }
+        std::vector<std::vector<const float *>> pe((size_t)n_extra);
+        for (int k = 0; k < n_extra; k++) {
+            pe[k].resize(npx);
+            for (size_t i = 0; i < npx; i++)
+                pe[k][i] = extra[k].values + d->offset[i] * (size_t)extra[k].stride;
+            fb.insert(extra[k].name,
+                      DeepSlice(FLOAT, (char *)(pe[k].data() - origin), sizeof(float *),
+                                sizeof(float *) * (size_t)w, (size_t)extra[k].stride * sizeof(float)));
         }
         DeepScanLineOutputFile file(tmp, hdr);
         file.setFrameBuffer(fb);

@@ -152,6 +152,13 @@ obs_status obs__exr_read_channels(const char *path, const obs__exr_mem *mem, int
  * object masks on deep input (core/mask.c). */
 obs_status obs__deep_read_front(const char *path, const obs__exr_mem *mem, const char *channel,
                                 const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN]);
+/* The same for every sample: `channel` of each sample of the first deep
+ * part, in the order obs_deep_read_exr() gives the samples (pixel by
+ * pixel, front to back), as an image of offset[width * height] x 1 (a
+ * file without samples: 1 x 1, its value 0); for the occluders and
+ * self_only masks of deep input (core/mask.c). */
+obs_status obs__deep_read_samples(const char *path, const obs__exr_mem *mem, const char *channel,
+                                  const obs_limits *lim, obs_image *out, char err[OBS_ERR_LEN]);
 
 /* ---- output parts (exr_write.c, exr_append.c, exr_header.c) ------------ */
 

@@ -106,12 +106,12 @@ static float sample_cos(const obs__gtao_state *g, const float q[4], const float 
     return low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
 }
 
-void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
-                           int qx, int qy, const float c[3], const float v[3], float low,
-                           float *hc, int *taken)
+void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int self,
+                           int x, int y, int qx, int qy, const float c[3], const float v[3],
+                           float low, float *hc, int *taken)
 {
     float ext[4];
-    const float om = obs__occluder_weight(f, x, y, qx, qy); /* object masks */
+    const float om = obs__occluder_weight_node(f, x, y, self, qx, qy, 0); /* object masks */
     const float *q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
     if (q)
         *hc = max_f(*hc, sample_cos(obs__gtao_of(f), q, c, v, low, om));
@@ -124,7 +124,7 @@ void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *n
  * OITAO Algorithm 1: the largest counts); past the border, the front
  * plane's surface continued. */
 static float side_horizon(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                          int x, int y, const float c[3], const float v[3], const float omega[2],
+                          int self, int x, int y, const float c[3], const float v[3], const float omega[2],
                           int slice, float noise_step, float min_s, int dir, float low,
                           int *taken)
 {
@@ -139,16 +139,17 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         s = s * s + min_s; /* sample distribution power 2, then off the centre pixel */
         int qx = x + dir * (int)floorf(s * omega[0] + 0.5f);
         int qy = y + dir * (int)floorf(s * omega[1] + 0.5f);
-        /* object masks: the weight of the surface at the step's pixel */
-        const float om = obs__occluder_weight(f, x, y, qx, qy);
+        /* object masks: the weight of the surface at the step's pixel
+         * (of each node there; past the border, of the front one) */
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
-            obs__gtao_border_step(f, pos, nrm, x, y, qx, qy, c, v, low, &hc, taken);
+            obs__gtao_border_step(f, pos, nrm, self, x, y, qx, qy, c, v, low, &hc, taken);
             continue;
         }
         (*taken)++;
         const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
         for (int k = 0; k < layers; k++)
-            hc = max_f(hc, sample_cos(g, q + (size_t)k * plane, c, v, low, om));
+            hc = max_f(hc, sample_cos(g, q + (size_t)k * plane, c, v, low,
+                                      obs__occluder_weight_node(f, x, y, self, qx, qy, k)));
     }
     return hc;
 }
@@ -169,7 +170,7 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
 float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                            const float p[3], const float n[3], int *count, float bent[3])
 {
-    return obs__gtao_pixel_nodes(f, pos, nrm, 1, x, y, p, n, count, bent);
+    return obs__gtao_pixel_nodes(f, pos, nrm, 1, 0, x, y, p, n, count, bent);
 }
 
 void obs__gtao_slice_dir(const obs__gtao_state *g, int sl, float noise0, float cs[2])
@@ -233,7 +234,7 @@ float obs__gtao_finish(const obs__gtao_state *g, float vis)
 }
 
 float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                            int x, int y, const float p[3], const float n[3], int *count,
+                            int self, int x, int y, const float p[3], const float n[3], int *count,
                             float bent[3])
 {
     const obs__gtao_state *g = obs__gtao_of(f);
@@ -262,10 +263,10 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
         float cs[2];
         obs__gtao_slice_dir(g, sl, noise[0], cs);
         obs__gtao_slice_setup(cs, rpx, v, n, &s);
-        float hc0 = side_horizon(f, pos, nrm, layers, x, y, c, v, s.omega, sl, noise[1], min_s, 1,
-                                 s.low[0], &taken);
-        float hc1 = side_horizon(f, pos, nrm, layers, x, y, c, v, s.omega, sl, noise[1], min_s,
-                                 -1, s.low[1], &taken);
+        float hc0 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, s.omega, sl, noise[1],
+                                 min_s, 1, s.low[0], &taken);
+        float hc1 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, s.omega, sl, noise[1],
+                                 min_s, -1, s.low[1], &taken);
         float h[2];
         vis += obs__gtao_slice_vis(g, &s, hc0, hc1, h);
         if (bent)

@@ -44,9 +44,11 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
  * pos + 4 w h, ...: deep input's nodes, core/deep): each step's horizon
  * is the largest over the nodes at its pixel (OITAO Algorithm 1, as its
  * multi-layer HBAO, Fig. 9); a step past the border reads the first
- * plane's surface continued, with nrm its normals (3 floats a pixel). */
+ * plane's surface continued, with nrm its normals (3 floats a pixel).
+ * self: the receiver's node at (x, y), whose object self_only compares
+ * (object masks, obs__occluder_weight_node; the flat chain's: 0). */
 float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                            int x, int y, const float p[3], const float n[3], int *count,
+                            int self, int x, int y, const float p[3], const float n[3], int *count,
                             float bent[3]);
 
 /* The noise of the 3x3 tile's pixel `tile` (obs__tile_index): XeGTAO's R2
@@ -73,12 +75,13 @@ void obs__gtao_slice_setup(const float cs[2], float rpx, const float v[3], const
 float obs__gtao_slice_vis(const obs__gtao_state *g, obs__gtao_slice *s, float hc0, float hc1,
                           float h[2]);
 /* A step of a slice's side at pixel (qx, qy) off the planes, for the
- * pixel (x, y) (centre c, view direction v, the side's start low): the
+ * pixel (x, y) (its node self on deep input, else 0; centre c, view
+ * direction v, the side's start low): the
  * surface continued past the border (border_cpu.c), its horizon cosine
  * into *hc (the larger), *taken counted where it reads a point. */
-void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
-                           int qx, int qy, const float c[3], const float v[3], float low,
-                           float *hc, int *taken);
+void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int self,
+                           int x, int y, int qx, int qy, const float c[3], const float v[3],
+                           float low, float *hc, int *taken);
 /* The visibility's start (XeGTAO's heuristic for a small radius in pixels)
  * and its end from the slices' sum. */
 float obs__gtao_vis0(const obs__gtao_state *g, float rpx);

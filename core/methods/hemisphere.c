@@ -113,9 +113,10 @@ float obs__hemisphere_estimate_bent(const obs__frame *f, const obs__hemisphere_n
             float dz = fabsf(-p[2] - zn);
             float r = dz > R ? R / dz : 1.0f;
             float an = nodes->nrm ? nodes->nrm[((size_t)k * nodes->layer_px + q) * 4 + 3] : 1.0f;
-            best = fmaxf(best, an * r * r * (3.0f - 2.0f * r));
+            /* object masks: the weight of the node's surface */
+            best = fmaxf(best, an * r * r * (3.0f - 2.0f * r) *
+                                   obs__occluder_weight_node(f, x, y, nodes->self, qx, qy, k));
         }
-        best *= obs__occluder_weight(f, x, y, qx, qy); /* object masks */
         occ += best;
         if (bent) /* OBS_OUTPUT_BENT: the sample's direction times its open part */
             obs__hemisphere_bent_sample(p, s, 1.0f - best, bent);
@@ -133,7 +134,7 @@ float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y,
 float obs__hemisphere_pixel_bent(const obs__frame *f, const float *pos, int x, int y,
                                  const float p[3], const float n[3], float bent[3])
 {
-    const obs__hemisphere_nodes flat = {pos, NULL, 1, 0, 0};
+    const obs__hemisphere_nodes flat = {pos, NULL, 1, 0, 0, 0};
     return obs__hemisphere_estimate_bent(f, &flat, x, y, p, n, bent);
 }
 

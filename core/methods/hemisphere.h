@@ -38,13 +38,15 @@ void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3],
  * planes of layer_px pixels, 4 floats each (view xyz, planar depth w; 0:
  * empty), one after the other; nrm: the same layout with alpha in w (NULL:
  * opaque); interior: OITAO eqs 2-4's back side, where a node on the
- * exterior side of p's tangent plane hides nothing.  The flat chain's
- * prep plane is one layer. */
+ * exterior side of p's tangent plane hides nothing; self: the receiver's
+ * node at (x, y), whose object self_only compares (object masks,
+ * obs__occluder_weight_node).  The flat chain's prep plane is one layer. */
 typedef struct obs__hemisphere_nodes {
     const float *pos, *nrm;
     int layers;
     size_t layer_px;
     int interior;
+    int self;
 } obs__hemisphere_nodes;
 
 /* Method hemisphere's estimator, for the flat and the deep chain alike. */

@@ -19,6 +19,12 @@ layout(rgba32f) readonly uniform image2DArray u_lnrm; // node view normal xyz, a
 // solid from its depth to e, -1 inside a nearer node's interval
 layout(r32f) readonly uniform image2DArray u_lend;
 #endif
+// Object masks (occluders, self_only; obs_deep_read_masks): each node's
+// occluders weight (x) and object ID (y, compared as bits), bound when
+// u_deep_mask is not 0 (1: the weights, 2: self_only, 3: both).
+layout(rg32f) readonly uniform image2DArray u_lmask;
+uniform int u_deep_mask;
+int g_self = 0;                 // the receiver's node, set by node_ao()
 uniform int u_m;                // nodes per pixel
 uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node 0 only
 // u_size, u_radius (R), u_count (the line samples, the set of section 4.5
@@ -33,7 +39,25 @@ uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node
 // OBS_DEEP_HORIZON, method gtao's or hbao's horizon search over the nodes.
 // Method hemisphere's estimator (hemisphere.glsl, appended after this file
 // in the OBS_DEEP_HEMISPHERE programs) reads the nodes through these.
+// The object masks' weight of node k at pixel s as an occluder of node
+// g_self at pixel c: its occluders weight, times 0 where self_only's
+// object there is not the receiver's; a pixel off the image reads the
+// nearest one on it.  1 without masks.  C twin: obs__occluder_weight_node
+// (chain/mask_weight.h), with the deep frame's per-node planes.
+float node_weight(ivec2 c, ivec2 s, int k)
+{
+    if (u_deep_mask == 0)
+        return 1.0;
+    s = clamp(s, ivec2(0), u_size - 1);
+    vec2 ms = imageLoad(u_lmask, ivec3(s, k)).xy;
+    float w = (u_deep_mask & 1) != 0 ? ms.x : 1.0;
+    if ((u_deep_mask & 2) != 0 &&
+        floatBitsToUint(ms.y) != floatBitsToUint(imageLoad(u_lmask, ivec3(c, g_self)).y))
+        w = 0.0;
+    return w;
+}
 #define HS_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
+#define HS_WEIGHT(c, q, k) node_weight(c, q, k)
 #define HS_ALPHA(q, k) imageLoad(u_lnrm, ivec3(q, k)).w
 float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
 // Methods gtao's and hbao's horizon searches (gtao.glsl, hbao.glsl,
@@ -44,8 +68,10 @@ float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
 #define GT_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
 #define GT_FRONT(b) imageLoad(u_lpos, ivec3(b, 0))
 #define GT_FRONT_NORMAL(b) imageLoad(u_lnrm, ivec3(b, 0))
+#define GT_WEIGHT(c, q, k) node_weight(c, q, k)
 #define HB_LAYERS (u_multi != 0 ? u_m : 1)
 #define HB_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
+#define HB_WEIGHT(c, q, k) node_weight(c, q, k)
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count);
 
 // the front node's AO and the blended AO, each beside the front node's
@@ -114,12 +140,14 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
             vec4 nk = imageLoad(u_lnrm, ivec3(q, k));   // normal, alpha
             if (k == self && q == px)
                 zs = own_plane_depth(p, n, disk_point(c, r, rot, sx, sy), zs);
+            // alpha times the object masks' weight of the node's surface
+            float a = nk.w * node_weight(px, q, k);
 #if OBS_DEEP_INTERVALS
             if (e > 0.0 && zs > 0.0 && !interior)       // a closed interval
-                solid += nk.w * interval_occlusion(zs, e, front, h);
+                solid += a * interval_occlusion(zs, e, front, h);
             else
 #endif
-                occ = max(occ, nk.w * node_occlusion(zs, nk.z, front, h, interior));
+                occ = max(occ, a * node_occlusion(zs, nk.z, front, h, interior));
         }
         // disjoint intervals add; the nodes solid behind them, the largest
         occ = min(2.0 * h, occ + solid);
@@ -155,6 +183,7 @@ float node_ao(ivec2 px, int k)
     vec4 n = imageLoad(u_lnrm, ivec3(px, k));
     if (!(p.w > 0.0))
         return 1.0;
+    g_self = k;                                     // node_weight()'s receiver
     float ve = method_ao(px, p.xyz, n.xyz, false, k);
 #if OBS_DEEP_THIN == 0
     return 1.0 - n.w * (1.0 - ve);                  // eq 1: alpha_p

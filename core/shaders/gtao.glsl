@@ -16,6 +16,11 @@
 #define GT_FRONT(b) imageLoad(u_pos, b)
 #define GT_FRONT_NORMAL(b) imageLoad(u_vnormal, b)
 #endif
+// The object masks' weight of node k at q for the receiver at px (the
+// flat chain: occluder_weight, common.glsl; the deep pass defines it).
+#ifndef GT_WEIGHT
+#define GT_WEIGHT(c, q, k) occluder_weight(c, q)
+#endif
 
 uniform int u_gtao_slices;
 uniform int u_gtao_steps;
@@ -83,18 +88,19 @@ float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float n
         float s = (float(st) + sn) / float(u_gtao_steps);
         s = s * s + min_s;
         ivec2 q = px + dir * ivec2(int(floor(s * omega.x + 0.5)), int(floor(s * omega.y + 0.5)));
-        float om = occluder_weight(px, q); // object masks
+        // object masks: the weight of each node's surface at q (past the
+        // border, the front one's)
         if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y) {
             vec4 xq;
             if (!gtao_border_step(px, q, xq))
                 continue;
             taken++;
-            hc = max(hc, gtao_sample_cos(xq, c, v, low, om));
+            hc = max(hc, gtao_sample_cos(xq, c, v, low, GT_WEIGHT(px, q, 0)));
             continue;
         }
         taken++;
         for (int k = 0; k < GT_LAYERS; k++)
-            hc = max(hc, gtao_sample_cos(GT_NODE(q, k), c, v, low, om));
+            hc = max(hc, gtao_sample_cos(GT_NODE(q, k), c, v, low, GT_WEIGHT(px, q, k)));
     }
     return hc;
 }

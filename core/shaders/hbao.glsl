@@ -17,6 +17,11 @@ uniform vec2 u_hbao_bias_cs;     // cos, sin of the angle bias
 #define HB_NODE(q, k) imageLoad(u_pos, q)
 #define HB_BENT 1 // the flat chain's bent normal (method.glsl's g_bent); not the deep pass's
 #endif
+// The object masks' weight of node k at q for the receiver at px (the
+// flat chain: occluder_weight, common.glsl; the deep pass defines it).
+#ifndef HB_WEIGHT
+#define HB_WEIGHT(c, q, k) occluder_weight(c, q)
+#endif
 
 // OBS_OUTPUT_BENT (method.glsl's g_bent): the solid-angle sum of the
 // directions cos a e + sin a z over the elevations asin(sin0)..asin(sin1)
@@ -80,9 +85,8 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
             if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y)
                 break;
             count++;
-            float om = occluder_weight(px, q);   // object masks
             for (int k = 0; k < HB_LAYERS; k++)   // deep input: every node
-                hbao_sample(HB_NODE(q, k), p.xyz, R2, om, sin_h, ao, dx, dy);
+                hbao_sample(HB_NODE(q, k), p.xyz, R2, HB_WEIGHT(px, q, k), sin_h, ao, dx, dy);
         }
     }
     return max(0.0, 1.0 - ao / float(u_hbao_dirs));

@@ -5,7 +5,8 @@
 //
 // One estimator for the flat and the deep chain: a sample is tested
 // against the nodes at its pixel, read through HS_NODE(q, k) (view xyz,
-// planar depth w; w 0: empty) and HS_ALPHA(q, k).  The deep pass
+// planar depth w; w 0: empty), HS_ALPHA(q, k) and HS_WEIGHT(px, q, k)
+// (the object masks' weight of node k at q for the receiver at px).  The deep pass
 // (deep.frag.glsl) defines them for its node arrays; without them this
 // file is the flat method's AO pass, one opaque node per pixel from the
 // depth plane, and defines method_ao().
@@ -13,6 +14,7 @@
 #ifndef HS_NODE
 #define HS_NODE(q, k) vec4(0.0, 0.0, 0.0, imageLoad(u_dz, q).x) // the depth plane: one RG texel
 #define HS_ALPHA(q, k) 1.0
+#define HS_WEIGHT(c, q, k) occluder_weight(c, q) // object masks (common.glsl)
 #define HS_FLAT 1
 // OBS_OUTPUT_BENT (method.glsl's g_bent): each sample's unit direction
 // times its open part.  The deep pass leaves it out.  C twin:
@@ -64,9 +66,9 @@ float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior)
                 continue;           // on the hull's exterior side
             float dz = abs(-p.z - pk.w);
             float r = dz > R ? R / dz : 1.0;
-            best = max(best, HS_ALPHA(q, j) * r * r * (3.0 - 2.0 * r));
+            // times the object masks' weight of the node's surface
+            best = max(best, HS_ALPHA(q, j) * r * r * (3.0 - 2.0 * r) * HS_WEIGHT(px, q, j));
         }
-        best *= occluder_weight(px, q); // object masks
         occ += best;
         HS_BENT(s, 1.0 - best);
     }

@@ -8,6 +8,15 @@
 // That is the full prep planes' downsample, without computing the full
 // planes.  C twin: obs__half_source in half_cpu.c.
 
+#if OBS_HALF
+// Object masks at half resolution (u_mask_on, u_mask_w, u_mask_id of
+// common.glsl: the full frame's): each half pixel gets those of the pixel
+// whose prep it takes, for the AO pass at half size.  C twin:
+// obs__half_masks in half_cpu.c.
+layout(r32f) writeonly uniform image2D u_hmask_w;
+layout(r32f) writeonly uniform image2D u_hmask_id;
+#endif
+
 layout(location = 0) out vec4 o_pos;
 layout(location = 1) out vec4 o_normal;
 layout(location = 2) out vec2 o_dz;     // planar depth and n.z: what the samples read
@@ -36,6 +45,12 @@ void main()
                 best_z = z;
             }
         }
+    // the weight and the self_only test read the surface whose depth this
+    // half pixel keeps (p), never a neighbour's across an edge
+    if ((u_mask_on & 1) != 0)
+        imageStore(u_hmask_w, hp, imageLoad(u_mask_w, p));
+    if ((u_mask_on & 2) != 0)
+        imageStore(u_hmask_id, hp, imageLoad(u_mask_id, p));
 #endif
     vec4 c;
     vec3 n;

@@ -61,9 +61,13 @@ typedef struct obs_deep_image {
     int has_zback, has_alpha, has_color, has_normal, has_facing;
     obs_camera camera;                 /* from worldToCamera/worldToNDC, if any */
     int part;                          /* the part read */
-    /* Object mask (obscura/mask.h, obs_deep_read_masks; NULL: none): the
-     * receivers weight of each pixel's front sample, width x height, owned. */
+    /* Object masks (obscura/mask.h, obs_deep_read_masks; NULL: none),
+     * owned: the receivers weight of each pixel's front sample, width x
+     * height; the occluders weight and the object ID (self_only; compared
+     * as the float's bits) of every sample, offset[width * height] each,
+     * in the samples' order. */
     float *receivers;
+    float *occluders, *object_id;
 } obs_deep_image;
 
 /* 1 when the file's first deep part is deep data (scanline or tiled),
@@ -93,6 +97,22 @@ void obs_deep_free(obs_deep_image *d);
  * C++ library (core/io/exr_deep_write.cpp).  Fails with OBS_IO when the
  * file cannot be written. */
 obs_status obs_deep_write_exr(const char *path, const obs_deep_image *d, char err[OBS_ERR_LEN]);
+/* One more float channel of a deep EXR: its name, and sample k's value
+ * at values[k * stride] (offset[width * height] samples). */
+typedef struct obs_deep_channel {
+    const char *name;
+    const float *values;
+    int stride;
+} obs_deep_channel;
+
+/* obs_deep_write_exr with n more float channels, one value a sample
+ * (written as they are, bits and all: a Cryptomatte ID stays its hash),
+ * and string attributes in the header (attrs: name, value, ..., NULL;
+ * NULL: none): what `obscura gbuffer --deep --ids` writes, the object ID
+ * "id" of each sample and a Cryptomatte layer per sample. */
+obs_status obs_deep_write_exr_extra(const char *path, const obs_deep_image *d,
+                                    const obs_deep_channel *extra, int n,
+                                    const char *const *attrs, char err[OBS_ERR_LEN]);
 
 /* The values of the parameters deep_mode and deep_hull, OBS_DEEP_MULTI
  * and so on, are in obscura/params.h with the others. */
@@ -110,6 +130,11 @@ typedef struct obs_deep_layers {
     int *count;    /* valid nodes per pixel, front to back from node 0 */
     float zmin, zmax; /* the depth range eq 5's z is normalised over: the
                        * camera's clip range (near, far) */
+    /* the object masks of the image's samples (obs_deep_image.occluders,
+     * object_id) carried to the nodes they became: m planes of width x
+     * height floats each, node k of pixel i at k * width * height + i
+     * (an empty node: weight 1, ID 0); NULL where the image has none */
+    float *occluders, *object_id;
 } obs_deep_layers;
 
 /* Compresses one list (OITAO section III-B): the n samples (OBS_DEEP_CH

@@ -31,7 +31,7 @@ typedef struct obs_crypto_layer {
     char conversion[32];   /* "uint32_to_float32" */
     char manif_file[512];  /* side-car manifest as the header names it ("": in the header) */
     int rank_sets;         /* <name>NN channel sets found (two ranks each) */
-    int red_style;         /* 1: .red/.green/.blue/.alpha; 0: .R/.G/.B/.A */
+    int red_style;         /* 0: .R/.G/.B/.A; 1: .red/.green/.blue/.alpha; 2: .r/.g/.b/.a */
     int entry_count;       /* names in the manifest */
     char **names;          /* entry_count names, UTF-8 as the manifest has them */
     uint32_t *ids;         /* their IDs (the float's bits) */
@@ -92,8 +92,12 @@ obs_status obs_gbuffer_read_masks(obs_gbuffer_file *f, const char *path, const v
                                   char err[OBS_ERR_LEN]);
 
 /* The same for deep input (d read from path, or len bytes at buf):
- * receivers only, read at each pixel's front sample, into d->receivers;
- * occluders and self_only are refused on deep input. */
+ * receivers read at each pixel's front sample, into d->receivers;
+ * occluders and self_only's objects read at every sample (the selector's
+ * channels per sample), into d->occluders and d->object_id, which the
+ * list compression carries to the nodes it keeps.  A selector naming a
+ * channel the deep part lacks is OBS_MISSING_CHANNEL, the message naming
+ * it. */
 obs_status obs_deep_read_masks(struct obs_deep_image *d, const char *path, const void *buf,
                                size_t len, const obs_params *params, const obs_limits *lim,
                                char err[OBS_ERR_LEN]);

@@ -185,6 +185,13 @@ struct obs_deep_image; /* deep.h */
  * camera is copied into out->camera.  Caller frees with obs_deep_free(). */
 obs_status obs_raster_deep(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam, int width,
                            int height, struct obs_deep_image *out, char err[OBS_ERR_LEN]);
+/* obs_raster_deep that also gives each sample's object ID, 1 + the index
+ * of the mesh its triangle belongs to (obs_raster_ids' numbering), in
+ * *ids: out->offset[width * height] floats in the samples' order, freed
+ * by the caller (NULL on failure). */
+obs_status obs_raster_deep_ids(obs_ctx *ctx, const obs_scene *scene, const obs_camera *cam,
+                               int width, int height, struct obs_deep_image *out, float **ids,
+                               char err[OBS_ERR_LEN]);
 
 #ifdef __cplusplus
 }

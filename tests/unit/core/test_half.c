@@ -202,6 +202,47 @@ static void test_refused(void **state)
     obs_gbuffer_free(&gf);
 }
 
+/* Object masks at half resolution: each half pixel carries the occluders
+ * weight and the object of the full pixel whose depth it keeps, here a
+ * weight and an ID told apart by the surface (0.25 and 7 on the near
+ * side, 1 and 3 on the far one), so that a half pixel at a 2-vs-10 edge
+ * whose block holds both has the ones of its own depth's surface. */
+static void test_masks_follow_depth(void **state)
+{
+    (void)state;
+    obs__frame f, hf;
+    memset(&f, 0, sizeof f);
+    f.width = W;
+    f.height = H;
+    static float pos[4 * W * H], nrm[3 * W * H], occl[W * H], ids[W * H];
+    static float hw[W * H], hid[W * H];
+    edge_planes(edge_at_5, pos, nrm);
+    for (int i = 0; i < W * H; i++) {
+        occl[i] = pos[4 * i + 3] < 5.0f ? 0.25f : 1.0f;
+        ids[i] = pos[4 * i + 3] < 5.0f ? 7.0f : 3.0f;
+    }
+    f.mask_occl = occl;
+    f.mask_id = ids;
+    f.mask_on = 1;
+    obs__frame_half(&f, &hf);
+    /* the driver's to set: a half frame reads no full-size plane */
+    assert_null(hf.mask_occl);
+    assert_null(hf.mask_id);
+    int picks[2] = {0, 0}; /* in the block of columns 4, 5: the far, the near side */
+    for (int hy = 0; hy < hf.height; hy++)
+        for (int hx = 0; hx < hf.width; hx++) {
+            long k = obs__half_source(&f, pos, hx, hy);
+            size_t h = (size_t)hy * hf.width + hx;
+            assert_true(k >= 0);
+            obs__half_masks(&f, k, h, hw, hid);
+            int near = pos[4 * k + 3] < 5.0f;
+            assert_true(hw[h] == (near ? 0.25f : 1.0f));
+            assert_true(hid[h] == (near ? 7.0f : 3.0f));
+            picks[near] += hx == 2;
+        }
+    assert_true(picks[0] > 0 && picks[1] > 0); /* the checkerboard keeps both */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -209,6 +250,7 @@ int main(void)
         cmocka_unit_test(test_checkerboard),
         cmocka_unit_test(test_twin),
         cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_masks_follow_depth),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -19,6 +19,7 @@
 #define SPECIAL TESTDATA "/crypto_special_chars.exr"
 #define SIDECAR TESTDATA "/crypto_sidecar/sidecar_manifest.exr"
 #define ARNOLD TESTDATA "/arnold_sample2.exr"
+#define BLENDER TESTDATA "/small/room_masks.exr"
 
 /* MurmurHash3_x86_32's published vectors (seed 0 unless given), and
  * names against the IDs the files' manifests hold. */
@@ -101,17 +102,19 @@ static uint32_t bits(float f)
     return u;
 }
 
-/* The matte of ids, decoded here: the sum over the six ranks of the
- * coverage where the rank's ID is one of them. */
-static float *decode(const char *path, const uint32_t *ids, int nids, int *w, int *h)
+/* The matte of ids in layer (channels layerNN.RGBA, or .rgba where lower),
+ * decoded here: the sum over the six ranks of the coverage where the rank's
+ * ID is one of them. */
+static float *decode_layer(const char *path, const char *layer, int lower, const uint32_t *ids,
+                           int nids, int *w, int *h)
 {
     char err[OBS_ERR_LEN];
     float *m = NULL;
     for (int s = 0; s < 3; s++)
         for (int r = 0; r < 2; r++) {
-            char chi[64], chc[64];
-            snprintf(chi, sizeof chi, "uCryptoWildcard%02d.%s", s, r ? "B" : "R");
-            snprintf(chc, sizeof chc, "uCryptoWildcard%02d.%s", s, r ? "A" : "G");
+            char chi[96], chc[96];
+            snprintf(chi, sizeof chi, "%s%02d.%s", layer, s, r ? (lower ? "b" : "B") : (lower ? "r" : "R"));
+            snprintf(chc, sizeof chc, "%s%02d.%s", layer, s, r ? (lower ? "a" : "A") : (lower ? "g" : "G"));
             obs_image id = {0}, cov = {0};
             assert_int_equal(obs_exr_read_channel(path, chi, NULL, &id, err), OBS_OK);
             assert_int_equal(obs_exr_read_channel(path, chc, NULL, &cov, err), OBS_OK);
@@ -130,6 +133,45 @@ static float *decode(const char *path, const uint32_t *ids, int nids, int *w, in
     for (int i = 0; i < *w * *h; i++)
         m[i] = m[i] > 1.0f ? 1.0f : m[i];
     return m;
+}
+
+static float *decode(const char *path, const uint32_t *ids, int nids, int *w, int *h)
+{
+    return decode_layer(path, "uCryptoWildcard", 0, ids, nids, w, h);
+}
+
+/* Blender's Cryptomatte object layer (tests/data/small/README.md): ranks in
+ * lower case (ViewLayer.CryptoObject00.r/g/b/a), the table's matte as
+ * decoded here, with anti-aliased edges. */
+static void test_blender_lower_case(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN];
+    obs_crypto_info ci;
+    assert_int_equal(obs_crypto_describe(BLENDER, NULL, 0, &ci, err), OBS_OK);
+    assert_int_equal(ci.layer_count, 1);
+    const obs_crypto_layer *L = &ci.layers[0];
+    assert_string_equal(L->name, "ViewLayer.CryptoObject");
+    assert_int_equal(L->rank_sets, 3);
+    assert_int_equal(L->red_style, 2);
+    assert_int_equal(L->entry_count, 7);
+    obs_crypto_info_free(&ci);
+    const uint32_t table = obs_crypto_name_id("table");
+    obs_image w = {0};
+    int W = 0, H = 0, covered = 0, partial = 0;
+    assert_int_equal(obs_mask_plane(BLENDER, NULL, 0, "table", NULL, &w, NULL, err), OBS_OK);
+    float *m = decode_layer(BLENDER, "ViewLayer.CryptoObject", 1, &table, 1, &W, &H);
+    assert_int_equal(w.width, W);
+    assert_int_equal(w.height, H);
+    for (int i = 0; i < W * H; i++) {
+        assert_true(fabsf(w.data[i] - m[i]) < 1e-6f);
+        covered += m[i] > 0.0f;
+        partial += m[i] > 0.0f && m[i] < 1.0f;
+    }
+    assert_true(covered > 100);
+    assert_true(partial > 10);
+    free(m);
+    obs_image_free(&w);
 }
 
 static void expect_mask(const char *selector, const uint32_t *ids, int nids)
@@ -295,6 +337,7 @@ int main(void)
         cmocka_unit_test(test_murmur3),
         cmocka_unit_test(test_special_chars),
         cmocka_unit_test(test_cornell_selectors),
+        cmocka_unit_test(test_blender_lower_case),
         cmocka_unit_test(test_sidecar),
         cmocka_unit_test(test_arnold_id),
         cmocka_unit_test(test_id_channel_names),

@@ -2,7 +2,9 @@
  * exactly 1 and the selected ones at the chain's AO (the Arnold sample's
  * deep id channel, and a flat Blender frame); occluders excluding a
  * surface changes the AO only where that surface could occlude, and only
- * upwards; GL and the CPU twins agree with masks on every method. */
+ * upwards, at full and at half resolution; GL and the CPU twins agree
+ * with masks on every method at both.  Deep input's occluders and
+ * self_only: test_mask_deep.c. */
 #include "testutil.h"
 
 #include <math.h>
@@ -54,10 +56,16 @@ static void test_receivers_deep_arnold(void **state)
     assert_true(ones > 1000 && kept > 1000 && darker > 100);
     obs_deep_result_free(&all);
     obs_deep_result_free(&sel);
-    /* occluders and self_only are refused on deep input */
-    obs_params q = {0};
+    /* occluders and self_only on deep input: read at every sample
+     * (test_mask_deep.c), the receivers kept */
+    obs_params q = p;
     set(&q, "occluders", "id:id=1");
-    assert_int_equal(obs_deep_read_masks(&d, ARNOLD, NULL, 0, &q, NULL, err), OBS_UNSUPPORTED);
+    set(&q, "self_only", "on");
+    if (obs_deep_read_masks(&d, ARNOLD, NULL, 0, &q, NULL, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_non_null(d.receivers);
+    assert_non_null(d.occluders);
+    assert_non_null(d.object_id);
     obs_deep_free(&d);
 }
 
@@ -105,82 +113,118 @@ static void test_receivers_flat(void **state)
     obs_gbuffer_free(&f);
 }
 
-/* Only the walls and floor as occluders: the AO rises or stays, and
- * changes only at pixels within the sampling radius of an excluded
- * surface (method hemisphere: point samples within D). */
-static void test_occluders_local(void **state)
+/* The AO `sel` with the occluders mask f->gb.occluders against `all`
+ * without it: it rises or stays everywhere, and changes only at pixels
+ * within the sampling radius D (method hemisphere: point samples within
+ * D), plus `margin` pixels, of an excluded surface; the number of pixels
+ * that changed. */
+static int check_local(const obs_gbuffer_file *f, const obs_result *all, const obs_result *sel,
+                       int margin)
 {
-    (void)state;
-    char err[OBS_ERR_LEN];
-    obs_params p = {0};
-    obs_gbuffer_file f = {0};
-    obs_result all, sel;
-    set(&p, "method", "hemisphere");
-    set(&p, "blur", "off");
-    read_room(&f, &p);
-    assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &all, err), OBS_OK);
-    set(&p, "occluders", WALLS);
-    assert_int_equal(obs_gbuffer_read_masks(&f, ROOM, NULL, 0, &p, NULL, err), OBS_OK);
-    assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &sel, err), OBS_OK);
-    /* what was excluded: every surface not of the walls' albedo (the
-     * object, the black ones, the edges between) */
-    const float *occl = f.gb.occluders.data;
-    const int W = f.gb.width, H = f.gb.height;
+    const float *occl = f->gb.occluders.data;
+    const int W = f->gb.width, H = f->gb.height;
     /* the radius in pixels at depth z: D f_px / (z - D), f_px from the
      * projection's [1][1] */
-    const float fpx = f.gb.camera.projection[5] * 0.5f * (float)H, D = 0.5f;
+    const float fpx = f->gb.camera.projection[5] * 0.5f * (float)H, D = 0.5f;
     int changed = 0;
     for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++) {
             size_t i = (size_t)y * W + x;
-            assert_true(sel.ao.data[i] >= all.ao.data[i] - 1e-6f);
-            if (sel.ao.data[i] == all.ao.data[i])
+            assert_true(sel->ao.data[i] >= all->ao.data[i] - 1e-6f);
+            if (sel->ao.data[i] == all->ao.data[i])
                 continue;
             changed++;
-            float z = f.gb.depth.data[i];
-            int r = (int)ceilf(z > D ? D * fpx / (z - D) : (float)W) + 2, near = 0;
+            float z = f->gb.depth.data[i];
+            int r = (int)ceilf(z > D ? D * fpx / (z - D) : (float)W) + margin, near = 0;
             for (int v = y - r; v <= y + r && !near; v++)
                 for (int u = x - r; u <= x + r && !near; u++)
                     near = u >= 0 && v >= 0 && u < W && v < H && occl[(size_t)v * W + u] < 1.0f;
             assert_true(near);
         }
-    assert_true(changed > 100);
-    obs_result_free(&all);
-    obs_result_free(&sel);
-    obs_gbuffer_free(&f);
+    return changed;
 }
 
-/* GL against the CPU twins with masks, every method: the mean absolute
- * difference stays small (a weight is per pixel, so a sample whose
- * position rounds to the next pixel in one of them reads another
- * weight: not bit for bit). */
+/* Only the walls and floor as occluders: the AO rises or stays, and
+ * changes only at pixels within the sampling radius of an excluded
+ * surface (what was excluded: every surface not of the walls' albedo,
+ * the object, the black ones, the edges between).  The same at half
+ * resolution (each half pixel the masks of the pixel whose depth it
+ * keeps): equal to the unmasked half-resolution AO bit for bit away from
+ * the excluded surfaces (a margin of the 2x2 blocks the half pixels and
+ * the upsample reach), rising near them. */
+static void test_occluders_local(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN];
+    for (int half = 0; half < 2; half++) {
+        obs_params p = {0};
+        obs_gbuffer_file f = {0};
+        obs_result all, sel;
+        set(&p, "method", "hemisphere");
+        set(&p, "blur", "off");
+        set(&p, "ao_resolution", half ? "half" : "full");
+        read_room(&f, &p);
+        assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &all, err), OBS_OK);
+        set(&p, "occluders", WALLS);
+        assert_int_equal(obs_gbuffer_read_masks(&f, ROOM, NULL, 0, &p, NULL, err), OBS_OK);
+        if (obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &sel, err) != OBS_OK)
+            fail_msg("%s", err);
+        int changed = check_local(&f, &all, &sel, half ? 4 : 2);
+        print_message("%s resolution: %d of %d pixels rose\n", half ? "half" : "full", changed,
+                      f.gb.width * f.gb.height);
+        assert_true(changed > 100 && changed < f.gb.width * f.gb.height * 3 / 4);
+        obs_result_free(&all);
+        obs_result_free(&sel);
+        obs_gbuffer_free(&f);
+    }
+}
+
+/* GL against the CPU twins with masks, every method, at both
+ * resolutions: the mean absolute difference stays small (a weight is per
+ * pixel, so a sample whose position rounds to the next pixel in one of
+ * them reads another weight: not bit for bit), far below what the masks
+ * move. */
 static void test_gl_twin_masks(void **state)
 {
     (void)state;
     char err[OBS_ERR_LEN];
     obs_ctx *ctx = make_ctx(OBS_BACKEND_AUTO);
     static const char *const methods[] = {"vaopp", "hemisphere", "angle", "hbao", "gtao"};
-    for (int m = 0; m < 5; m++)
-        for (int self = 0; self < 2; self++) {
-            obs_params p = {0};
-            obs_gbuffer_file f = {0};
-            obs_result g, c;
-            set(&p, "method", methods[m]);
-            set(&p, "occluders", self ? "id:ViewLayer.DiffCol.R=0-1" : WALLS);
-            if (self)
-                set(&p, "self_only", "on");
-            read_room(&f, &p);
-            assert_int_equal(obs_run(ctx, &f.gb, &p, OBS_OUTPUT_AO, &g, err), OBS_OK);
-            assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &c, err), OBS_OK);
-            double mae = 0.0;
-            for (int i = 0; i < f.gb.width * f.gb.height; i++)
-                mae += fabs(g.ao.data[i] - c.ao.data[i]);
-            mae /= f.gb.width * f.gb.height;
-            assert_true(mae < 2e-3);
-            obs_result_free(&g);
-            obs_result_free(&c);
-            obs_gbuffer_free(&f);
-        }
+    for (int half = 0; half < 2; half++)
+        for (int m = 0; m < 5; m++)
+            for (int self = 0; self < 2; self++) {
+                obs_params p = {0};
+                obs_gbuffer_file f = {0};
+                obs_result g, c, plain;
+                set(&p, "method", methods[m]);
+                set(&p, "ao_resolution", half ? "half" : "full");
+                read_room(&f, &p);
+                assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &plain, err), OBS_OK);
+                set(&p, "occluders", self ? "id:ViewLayer.DiffCol.R=0-1" : WALLS);
+                if (self)
+                    set(&p, "self_only", "on");
+                assert_int_equal(obs_gbuffer_read_masks(&f, ROOM, NULL, 0, &p, NULL, err), OBS_OK);
+                if (obs_run(ctx, &f.gb, &p, OBS_OUTPUT_AO, &g, err) != OBS_OK)
+                    fail_msg("GL: %s", err);
+                assert_int_equal(obs_run_cpu(&f.gb, &p, OBS_OUTPUT_AO, &c, err), OBS_OK);
+                double mae = 0.0, moved = 0.0;
+                for (int i = 0; i < f.gb.width * f.gb.height; i++) {
+                    mae += fabs(g.ao.data[i] - c.ao.data[i]);
+                    moved += fabs(plain.ao.data[i] - c.ao.data[i]);
+                }
+                mae /= f.gb.width * f.gb.height;
+                moved /= f.gb.width * f.gb.height;
+                print_message("%s, %s, %s: GL vs CPU mean |diff| %.2e; the masks move the AO by "
+                              "%.2e\n",
+                              half ? "half" : "full", methods[m], self ? "self_only" : "occluders",
+                              mae, moved);
+                assert_true(mae < 2e-3);
+                assert_true(moved > 5 * mae);
+                obs_result_free(&g);
+                obs_result_free(&c);
+                obs_result_free(&plain);
+                obs_gbuffer_free(&f);
+            }
     obs_ctx_destroy(ctx);
 }
 

@@ -1,6 +1,7 @@
 /* The A-buffer rasteriser (obs_raster_deep: per-pixel linked lists, OITAO
  * section IV-A) against the flat one, node counts of stacked quads, the
- * deep EXR writer read back by core/io/exr_deep.c, opacity specs and
+ * deep EXR writer read back by core/io/exr_deep.c, the per-sample object
+ * IDs (--ids) read back by the deep object masks, opacity specs and
  * materials, the ray-traced reference with transparency on an analytic
  * case, and multi-layer against single-layer AO on a scene with a
  * transparent pane (built here; the Blender room when ../shared is
@@ -11,6 +12,7 @@
 
 #include "obscura/deep.h"
 #include "obscura/io.h"
+#include "obscura/mask.h"
 #include "obscura/metrics.h"
 #include "obscura/reference.h"
 #include "obscura/scene.h"
@@ -258,6 +260,19 @@ static void test_stacked_quads(void **state)
 
 /* ---- the deep EXR writer ------------------------------------------------------ */
 
+/* A floor (two triangles, opaque) and a pane standing on it (two, alpha
+ * 0.5), seen from above one side, w x h. */
+static obs_scene floor_and_pane(builder *b, int w, int h, obs_camera *cam)
+{
+    const float floor_[4][3] = {{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}};
+    const float pane[4][3] = {{-1, -0.5f, 0}, {1, -0.5f, 0}, {1, -0.5f, 1}, {-1, -0.5f, 1}};
+    quad(b, floor_, 1);
+    quad(b, pane, 0.5f);
+    const float eye[3] = {0.5f, -3.0f, 1.5f}, at[3] = {0, 0, 0.3f};
+    look_at(eye, at, 50, w, h, cam);
+    return as_scene(b);
+}
+
 /* What obs_deep_write_exr() writes, obs_deep_read_exr() reads: every
  * sample exactly (float channels), the flags, the camera. */
 static void test_write_roundtrip(void **state)
@@ -265,19 +280,13 @@ static void test_write_roundtrip(void **state)
     (void)state;
     enum { W = 40, H = 30 };
     builder b = {0};
-    const float floor_[4][3] = {{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}};
-    const float pane[4][3] = {{-1, -0.5f, 0}, {1, -0.5f, 0}, {1, -0.5f, 1}, {-1, -0.5f, 1}};
-    quad(&b, floor_, 1);
-    quad(&b, pane, 0.5f);
-    obs_scene s = as_scene(&b);
+    obs_camera cam;
+    obs_scene s = floor_and_pane(&b, W, H, &cam);
     float albedo[3 * 8];
     for (int v = 0; v < 8; v++)
         for (int k = 0; k < 3; k++)
             albedo[3 * v + k] = v < 4 ? 0.8f : (k == 0 ? 0.9f : 0.1f);
     s.albedo = albedo;
-    obs_camera cam;
-    const float eye[3] = {0.5f, -3.0f, 1.5f}, at[3] = {0, 0, 0.3f};
-    look_at(eye, at, 50, W, H, &cam);
     obs_deep_image d, e;
     char err[OBS_ERR_LEN] = "", path[512];
     if (obs_raster_deep(ctx, &s, &cam, W, H, &d, err) != OBS_OK)
@@ -318,6 +327,51 @@ static void test_write_roundtrip(void **state)
     assert_int_equal(obs_deep_write_exr(path, NULL, err), OBS_INVALID_ARGUMENT);
     assert_int_equal(obs_deep_write_exr("/nonexistent-dir/x.exr", &d, err), OBS_IO);
     assert_non_null(strstr(err, "/nonexistent-dir/x.exr"));
+    obs_deep_free(&d);
+    obs_deep_free(&e);
+}
+
+/* gbuffer --deep --ids: every sample's object (1 + its mesh's index),
+ * written as a per-sample channel by obs_deep_write_exr_extra and read
+ * back by the deep object masks at every sample: the pane left out of
+ * the occluders weighs exactly its own samples 0. */
+static void test_deep_ids(void **state)
+{
+    (void)state;
+    enum { W = 40, H = 30 };
+    builder b = {0};
+    obs_camera cam;
+    obs_scene s = floor_and_pane(&b, W, H, &cam);
+    obs_scene_mesh meshes[2] = {{.name = "floor", .first_triangle = 0, .triangle_count = 2},
+                                {.name = "pane", .first_triangle = 2, .triangle_count = 2}};
+    s.meshes = meshes;
+    s.mesh_count = 2;
+    obs_deep_image d, e;
+    float *ids = NULL;
+    char err[OBS_ERR_LEN] = "", path[512];
+    if (obs_raster_deep_ids(ctx, &s, &cam, W, H, &d, &ids, err) != OBS_OK)
+        fail_msg("%s", err);
+    const uint64_t n = d.offset[(size_t)W * H];
+    int panes = 0;
+    for (uint64_t k = 0; k < n; k++) { /* the pane is the one of alpha 0.5 */
+        assert_true(ids[k] == (d.samples[k * OBS_DEEP_CH + OBS_DEEP_A] == 0.5f ? 2.0f : 1.0f));
+        panes += ids[k] == 2.0f;
+    }
+    assert_true(panes > 50 && (uint64_t)panes < n);
+    snprintf(path, sizeof path, "%s/deep_ids.exr", obs_test_tmp());
+    const obs_deep_channel id = {"id", ids, 1};
+    if (obs_deep_write_exr_extra(path, &d, &id, 1, NULL, err) != OBS_OK)
+        fail_msg("%s", err);
+    if (obs_deep_read_exr(path, NULL, &e, err) != OBS_OK)
+        fail_msg("%s", err);
+    obs_params p = {0};
+    assert_int_equal(obs_param_set(&p, "occluders", "!id:id=2", err), OBS_OK);
+    if (obs_deep_read_masks(&e, path, NULL, 0, &p, NULL, err) != OBS_OK)
+        fail_msg("%s", err);
+    assert_non_null(e.occluders);
+    for (uint64_t k = 0; k < n; k++)
+        assert_true(e.occluders[k] == (ids[k] == 2.0f ? 0.0f : 1.0f));
+    free(ids);
     obs_deep_free(&d);
     obs_deep_free(&e);
 }
@@ -593,6 +647,7 @@ int main(void)
         cmocka_unit_test(test_front_equals_flat),
         cmocka_unit_test(test_stacked_quads),
         cmocka_unit_test(test_write_roundtrip),
+        cmocka_unit_test(test_deep_ids),
         cmocka_unit_test(test_opacity_specs),
         cmocka_unit_test(test_reference_slab),
         cmocka_unit_test(test_pane_multi_beats_single),
