@@ -116,6 +116,27 @@ static void room_planes(obs__plan *pl, obs_gbuffer_file *gf, const char *const *
     }
 }
 
+static void free_planes(obs_gbuffer_file *gf, float *pos, float *nrm, float *dnz)
+{
+    free(pos);
+    free(nrm);
+    free(dnz);
+    obs_gbuffer_free(gf);
+}
+
+/* The pixels with geometry, in an order of their own: a stride of 7919 (a
+ * prime) through the frame, so chunks of lanes mix rows and the border;
+ * returns how many. */
+static int stride_list(const obs__frame *f, const float *pos, int *px)
+{
+    const size_t npx = (size_t)f->width * (size_t)f->height;
+    int m = 0;
+    for (size_t k = 0, i = 0; k < npx; k++, i = (i + 7919) % npx)
+        if (pos[4 * i + 3] > 0.0f)
+            px[m++] = (int)i;
+    return m;
+}
+
 static void test_vao_bit_for_bit(void **state)
 {
     static const char *const sets[][5] = {
@@ -150,10 +171,7 @@ static void test_vao_bit_for_bit(void **state)
                 }
         }
         assert_true(compared > 1000);
-        free(pos);
-        free(nrm);
-        free(dnz);
-        obs_gbuffer_free(&gf);
+        free_planes(&gf, pos, nrm, dnz);
     }
 }
 
@@ -181,10 +199,7 @@ static void test_vao_pixels_bit_for_bit(void **state)
         int *px = malloc(npx * sizeof(int)), *cnt = malloc(npx * sizeof(int));
         float *ao = malloc(npx * sizeof(float));
         assert_true(px && cnt && ao);
-        int m = 0;
-        for (size_t k = 0, i = 0; k < npx; k++, i = (i + 7919) % npx) /* 7919: prime */
-            if (pos[4 * i + 3] > 0.0f)
-                px[m++] = (int)i;
+        const int m = stride_list(f, pos, px);
         assert_true(m > 1000);
         int counts_seen = 0;
         obs__vao_counts(f, pos, nrm, px, m, cnt);
@@ -218,10 +233,7 @@ static void test_vao_pixels_bit_for_bit(void **state)
         free(px);
         free(cnt);
         free(ao);
-        free(pos);
-        free(nrm);
-        free(dnz);
-        obs_gbuffer_free(&gf);
+        free_planes(&gf, pos, nrm, dnz);
     }
 }
 
@@ -286,10 +298,7 @@ static void test_prep_rows(void **state)
         free(p1);
         free(n1);
         free(d1);
-        free(pos);
-        free(nrm);
-        free(dnz);
-        obs_gbuffer_free(&gf);
+        free_planes(&gf, pos, nrm, dnz);
     }
 }
 
@@ -326,11 +335,7 @@ static void test_method_pixels(void **state)
         int *px = malloc(npx * sizeof(int));
         float *ao = malloc(npx * sizeof(float)), *cnt = malloc(npx * sizeof(float));
         assert_true(px && ao && cnt);
-        int m = 0;
-        for (size_t k = 0, i = 0; k < npx; k++, i = (i + 7919) % npx)
-            if (pos[4 * i + 3] > 0.0f)
-                px[m++] = (int)i;
-        m -= 3; /* a partial last chunk */
+        const int m = stride_list(f, pos, px) - 3; /* a partial last chunk */
         for (size_t i = 0; i < npx; i++)
             ao[i] = cnt[i] = -1.0f;
         const int lanes = obs__method_pixels(f, pos, nrm, px, m, ao, cnt);
@@ -355,10 +360,7 @@ static void test_method_pixels(void **state)
         free(px);
         free(ao);
         free(cnt);
-        free(pos);
-        free(nrm);
-        free(dnz);
-        obs_gbuffer_free(&gf);
+        free_planes(&gf, pos, nrm, dnz);
     }
 }
 
