@@ -7,6 +7,7 @@
 #include "chain/bands_cpu.h"
 #include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
+#include "chain/prep_cpu.h"
 #include "chain/vao_cpu.h"
 
 /* GLSL: composite.frag.glsl.  Section 5: "applied to resulting image

@@ -5,7 +5,8 @@
 #include <string.h>
 
 #include "chain/frame.h"
-#include "chain/vao_cpu.h"
+#include "chain/lanes.h"
+#include "chain/prep_cpu.h"
 
 /* GLSL: px_ndc() in common.glsl */
 void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2])

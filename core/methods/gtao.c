@@ -51,12 +51,12 @@
 #include "methods/bent.h"
 #include "chain/mask_weight.h"
 #include "methods/gtao.h"
-#include "chain/vao_cpu.h"
+#include "chain/lanes.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
 #define GTAO_MIN_VISIBILITY 0.03f /* visibility = max(0.03, visibility) */
 
-/* fminf and fmaxf as glibc computes them, inline (chain/vao_cpu.h) */
+/* fminf and fmaxf as glibc computes them, inline (chain/lanes.h) */
 static float clampf(float v, float lo, float hi) { return min_f(max_f(v, lo), hi); }
 static float saturate(float v) { return clampf(v, 0.0f, 1.0f); }
 static float signf(float v) { return (float)((v > 0.0f) - (v < 0.0f)); }

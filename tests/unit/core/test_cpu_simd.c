@@ -12,6 +12,7 @@
 #include "testutil.h"
 #include "chain/frame.h"
 #include "chain/passes.h"
+#include "chain/prep_cpu.h"
 #include "chain/vao_cpu.h"
 #include "methods/methods.h"
 #include "obscura/io.h"
