@@ -131,7 +131,7 @@ static void ao_tile_lanes(obs__cpu_run *c, const unsigned char *cand, int x0, in
      * own set), its pixels in lanes */
     int done = 0;
     unsigned char taken[AO_TILE_W * AO_TILE_H];
-    memset(taken, 0, (size_t)m);
+    memset(taken, 0, sizeof taken);
     while (done < m) {
         int first = 0;
         while (taken[first])
