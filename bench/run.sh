@@ -63,6 +63,10 @@ else
     "$BUILD/extensions_bench" --methods --sizes 1920x1080 "$1" "$2"
 fi
 echo
+# a frame by rows against the frame whole on the CPU device: peak RSS
+# and wall time (bench/bands.sh; 3840x2160, a 256 MiB budget)
+BUILD="$BUILD" bench/bands.sh "$1" "$2"
+echo
 # the daemon: round trip vs in-process, concurrent clients (1920x1080)
 BUILD="$BUILD" bench/daemon_bench.sh "$1" "$2"
 echo

@@ -907,6 +907,31 @@ static int read_baked(const ao_args *a, const obs_limits *lim, const obs_gbuffer
     return EXIT_OK;
 }
 
+/* The CPU device's memory budget for the chain's planes, from
+ * OBSCURA_MAX_MEMORY (MiB; over it the frame runs in bands of rows), and
+ * OBSCURA_BAND_ROWS (bands of that many rows whatever the size: tests,
+ * benchmarks); a value that is not a positive count is said and left
+ * out (the default: a quarter of the machine's memory, whole frames). */
+static void cpu_bands_from_env(obs_cpu_options *o)
+{
+    static const char *const names[] = {"OBSCURA_MAX_MEMORY", "OBSCURA_BAND_ROWS"};
+    for (int k = 0; k < 2; k++) {
+        const char *v = getenv(names[k]);
+        if (!v || !*v)
+            continue;
+        char *end;
+        long n = strtol(v, &end, 10);
+        if (*end || n <= 0 || n > (k == 0 ? 1L << 30 : 1L << 20)) {
+            fprintf(stderr, "obscura: warning: %s=%s is not a positive count; left out\n", names[k], v);
+            continue;
+        }
+        if (k == 0)
+            o->max_memory = (size_t)n << 20;
+        else
+            o->band_rows = (int)n;
+    }
+}
+
 /* The chain on the CPU twin, on obscurad (--server) or on a GL context
  * (kept across a batch's frames); *t0 restarts once the context exists. */
 static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, const char *server,
@@ -916,6 +941,7 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
     obs_status s;
     if (a->cpu) {
         obs_cpu_options o = {.log = log_cb};
+        cpu_bands_from_env(&o);
         s = obs_run_cpu_opts(&gf->gb, &a->req.params, outputs, res, &o, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, res);
@@ -1045,6 +1071,147 @@ done:
     return rc;
 }
 
+/* ---- a frame by rows: neither the G-buffer nor the result whole in memory ----
+ *
+ * On the CPU device, a flat EXR input whose working set (the input's
+ * planes, the chain's, the result's) is over the memory budget
+ * (OBSCURA_MAX_MEMORY MiB, else a quarter of the machine's memory; or
+ * any size with OBSCURA_BAND_ROWS) is read by rows (the chain's planes
+ * get the budget's share they have in the whole frame's working set), run in bands and
+ * written by rows (obs_run_cpu_rows, obs_gbuffer_rows_*, obs_exr_rows_*):
+ * the same file as the whole frame's.  Only a plain EXR output of a file
+ * input, with the camera at hand and no object masks, baked channel,
+ * --layer or --append; otherwise the frame is read whole. */
+
+typedef struct ao_rows_job {
+    const ao_args *a;
+    obs_gbuffer_rows *rows;
+    obs_exr_rows *w;
+    obs_exr_options o;
+    int height;
+    double t_in, t_out; /* ms reading and writing */
+} ao_rows_job;
+
+static obs_status ao_rows_in(void *user, int y0, int y1, obs_gbuffer *rows, char err[OBS_ERR_LEN])
+{
+    ao_rows_job *j = user;
+    double t0 = now_ms();
+    obs_status s = obs_gbuffer_rows_read(j->rows, y0, y1, rows, err);
+    j->t_in += now_ms() - t0;
+    return s;
+}
+
+static obs_status ao_rows_out(void *user, int y0, int y1, const obs_result *res, char err[OBS_ERR_LEN])
+{
+    ao_rows_job *j = user;
+    obs_exr_layer layers[OBS_RESULT_LAYERS];
+    int n = obs_result_exr_layers(res, layers);
+    double t0 = now_ms();
+    (void)y0, (void)y1; /* in order: the writer counts them */
+    obs_status s = j->w ? OBS_OK : obs_exr_rows_open(j->a->out, layers, n, j->height, &j->o, &j->w, err);
+    if (s == OBS_OK)
+        s = obs_exr_rows_write(j->w, layers, n, err);
+    j->t_out += now_ms() - t0;
+    return s;
+}
+
+/* The bytes a pixel of the frame takes read whole: its planes, the CPU
+ * chain's (about 56 at the default parameters) and the result's. */
+static double whole_bytes_per_px(const obs_gbuffer *gb, unsigned outputs)
+{
+    double in = 4.0 * (1 + gb->normal.channels + gb->color.channels);
+    double out = 4.0 * (!!(outputs & OBS_OUTPUT_AO) + 4 * !!(outputs & OBS_OUTPUT_COMPOSITE) +
+                        3 * !!(outputs & OBS_OUTPUT_BENT) + 3 * !!(outputs & OBS_OUTPUT_BLEED) + 3);
+    return in + 56.0 + out;
+}
+
+/* OBSCURA_MAX_MEMORY's budget, else the library's default. */
+static double memory_budget(void)
+{
+    obs_cpu_options o = {0};
+    cpu_bands_from_env(&o);
+    return (double)obs_cpu_memory_budget(&o);
+}
+
+/* -1: the frame is to be read whole (ao_flat); else the exit code. */
+static int ao_rows(ao_args *a, const obs_limits *lim)
+{
+    const obs_params *p = &a->req.params;
+    const char *forced = getenv("OBSCURA_BAND_ROWS");
+    if (!a->cpu || a->in_buf || a->to_stdout || a->req.format != OBS_HTTP_EXR || a->req.append ||
+        a->req.layer || p->receivers[0] || p->occluders[0] || p->self_only == OBS_ON)
+        return -1;
+    char err[OBS_ERR_LEN] = "";
+    obs_gbuffer_file meta;
+    ao_rows_job j = {.a = a};
+    if (obs_gbuffer_rows_open(a->in, &a->req.map, lim, &j.rows, &meta, err) != OBS_OK)
+        return -1; /* the whole reader says why, or reads what this one does not */
+    double need = whole_bytes_per_px(&meta.gb, a->req.outputs) * meta.gb.width * meta.gb.height;
+    int whole = !(forced && *forced) && need <= memory_budget();
+    /* a baked channel to combine (--baked, or the input's _AO) needs the
+     * frame whole (obs_result_combine_baked) */
+    char **names = NULL;
+    const char *bch = a->req.baked ? a->req.baked : "_AO";
+    if (!whole && strcmp(bch, "none") != 0 && obs_exr_list_channels(a->in, &names, err) == OBS_OK)
+        for (char **nm = names; *nm && !whole; nm++)
+            whole = !strcmp(*nm, bch);
+    obs_strv_free(names);
+    if (!whole && a->camera) {
+        obs_status s = obs_camera_read_json(a->camera, &meta.gb.camera, NULL, NULL, err);
+        if (s != OBS_OK) {
+            obs_gbuffer_rows_close(j.rows);
+            return cli_input_fail(s, a->camera, err);
+        }
+    }
+    obs_camera cam;
+    if (!whole && !obs_camera_of_run(&meta.gb, p, &cam))
+        whole = 1; /* no camera: the whole reader solves it from the positions, or says so */
+    if (whole) {
+        obs_gbuffer_rows_close(j.rows);
+        return -1;
+    }
+    print_input_info(a->in, &meta.info, &meta.gb);
+    /* the colour only where the chain reads it: the rows half the size
+     * with RGBA otherwise */
+    obs_params rp;
+    obs_params_resolve(p, &rp);
+    if (!(a->req.outputs & (OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_MULTIBOUNCE | OBS_OUTPUT_LUMINANCE |
+                            OBS_OUTPUT_BLEED)) &&
+        rp.luminance == OBS_LUMINANCE_OFF && rp.bleeding == OBS_BLEEDING_OFF && rp.multibounce != OBS_ON) {
+        obs_gbuffer_rows_no_color(j.rows);
+        meta.gb.color = (obs_plane){NULL, 0, 0};
+    }
+    if (verbosity >= OBS_LOG_INFO)
+        fprintf(stderr, "obscura: info: %dx%d needs about %.0f MiB read whole: read, run and written by "
+                        "rows (the input's sanity checks, which read the whole frame, are left out)\n",
+                meta.gb.width, meta.gb.height, need / 1048576.0);
+    obs_exr_source src = {.path = a->in, .part = meta.info.part};
+    obs_provenance prov = provenance_of(a);
+    j.o = (obs_exr_options){.pixel = a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = &cam, .src = &src,
+                            .prov = &prov, .compression = (obs_exr_compression)a->req.compression};
+    j.height = meta.gb.height;
+    obs_cpu_options o = {.log = log_cb};
+    cpu_bands_from_env(&o);
+    /* the budget is the frame's: the chain's planes get their share of it
+     * (the rows of the input and of the result the rest) */
+    o.max_memory = (size_t)(memory_budget() * 56.0 / whole_bytes_per_px(&meta.gb, a->req.outputs));
+    double t0 = now_ms();
+    obs_status s = obs_run_cpu_rows(&meta.gb, ao_rows_in, ao_rows_out, &j, p, a->req.outputs, &o, err);
+    double t_all = now_ms() - t0;
+    char werr[OBS_ERR_LEN] = "";
+    obs_status ws = j.w ? obs_exr_rows_close(j.w, s, werr) : s;
+    obs_gbuffer_rows_close(j.rows);
+    if (s != OBS_OK)
+        return cli_fail(s, a->in, err);
+    if (ws != OBS_OK)
+        return cli_fail(ws, a->out, werr);
+    if (verbosity >= OBS_LOG_INFO) {
+        fprintf(stderr, "obscura: wrote %s\n", a->out);
+        print_run_info(a, &meta.gb, NULL, j.t_in, t_all - j.t_in - j.t_out, j.t_out);
+    }
+    return EXIT_OK;
+}
+
 /* IN '-': stdin's whole EXR in memory (the readers take it from there,
  * as the daemon's do a request body); 4 GiB at most. */
 static int read_stdin(ao_args *a)
@@ -1098,11 +1265,14 @@ static int cmd_ao(int argc, char **argv)
         if (a.req.baked && strcmp(a.req.baked, "none") != 0)
             die_usage("ao: --baked: the input is a deep EXR; a baked channel is combined with "
                       "flat input only");
+        if (a.cpu && getenv("OBSCURA_BAND_ROWS") && verbosity >= OBS_LOG_INFO)
+            fprintf(stderr, "obscura: info: deep input is read and run whole (bands of rows are for "
+                            "flat frames: a deep pixel's node lists have no fixed size a row)\n");
         rc = cmd_ao_deep(&a, &lim, server, argc, argv);
     } else if (s == OBS_OK && (a.req.outputs & OBS_OUTPUT_DEEP)) {
         rc = cli_fail(OBS_INVALID_ARGUMENT, a.in,
                       "--output deep: the input is not a deep EXR (the deep AO is of deep input's nodes)");
-    } else {
+    } else if (server || (rc = ao_rows(&a, &lim)) < 0) {
         rc = ao_flat(&a, &lim, server, argc, argv);
     }
     free(a.in_buf);

@@ -55,7 +55,7 @@ static int wait_fd(obsd_bin *b, int fd, short events, double deadline, int idle)
  * when `idle`), -1 error, timeout or EOF in the middle. */
 static int read_all(obsd_bin *b, int fd, void *buf, size_t len, int idle)
 {
-    const int timeout = b->cfg->timeout;
+    const int timeout = b->front.cfg->timeout;
     double deadline = timeout ? obsd_now_ms() + timeout * 1000.0 : 0;
     size_t got = 0;
     while (got < len) {
@@ -79,7 +79,7 @@ static int read_all(obsd_bin *b, int fd, void *buf, size_t len, int idle)
  * byte went for --timeout seconds (a client that does not read). */
 static int write_all(obsd_bin *b, int fd, const void *buf, size_t len)
 {
-    const int timeout = b->cfg->timeout;
+    const int timeout = b->front.cfg->timeout;
     double deadline = timeout ? obsd_now_ms() + timeout * 1000.0 : 0;
     size_t put = 0;
     while (put < len) {
@@ -177,7 +177,7 @@ static int send_response(frame *f, const obs_bin_response_desc *d)
     if (rc == -2)
         snprintf(f->note + strlen(f->note), sizeof f->note - strlen(f->note),
                  "%s(no byte of the answer went for %d s: the client does not read; gave up, closed)",
-                 f->note[0] ? " " : "", f->c->srv->cfg->timeout);
+                 f->note[0] ? " " : "", f->c->srv->front.cfg->timeout);
     else if (rc != 0)
         snprintf(f->note + strlen(f->note), sizeof f->note - strlen(f->note),
                  "%s(client gone before the answer)", f->note[0] ? " " : "");
@@ -204,7 +204,7 @@ static int send_status(frame *f, obs_status s, const char *msg)
 static int run_frame(frame *f, obs_bin_request *q)
 {
     obsd_bin *b = f->c->srv;
-    obs_limits lim = {.max_pixels = (uint64_t)b->cfg->max_pixels};
+    obs_limits lim = {.max_pixels = (uint64_t)b->front.cfg->max_pixels};
     char err[OBS_ERR_LEN] = "";
     obsd_fp fp;
     int rc;
@@ -229,7 +229,7 @@ static int run_frame(frame *f, obs_bin_request *q)
         goto done;
     }
     if (atomic_load(&b->draining) ||
-        obsd_fp_queue(&fp, b->queue, &q->hr.params, q->hr.outputs, NULL, NULL) != 0) {
+        obsd_fp_queue(&fp, b->front.queue, &q->hr.params, q->hr.outputs, NULL, NULL) != 0) {
         f->close_after = atomic_load(&b->draining);
         rc = f->close_after ? send_error(f, 503, "shutting_down", "the daemon is shutting down")
                             : send_error(f, 503, "queue_full", "the frame queue is full; retry later");
@@ -342,7 +342,7 @@ static int token_ok(const obsd_bin *b, const char *token)
 {
     char auth[sizeof ((obs_bin_head *)0)->token + 8];
     snprintf(auth, sizeof auth, "Bearer %s", token);
-    return obs_http_bearer_ok(auth, b->token);
+    return obs_http_bearer_ok(auth, b->front.token);
 }
 
 /* Reads and answers one frame: the header, the head, the checks that
@@ -362,7 +362,7 @@ static int serve_one(conn *c)
     frame f = {.c = c, .rid = atomic_fetch_add(&b->next_id, 1) + 1, .t0 = obsd_now_ms(),
                .bytes_in = sizeof hdr};
     obs_bin_header h;
-    obs_status s = obs_bin_header_parse(hdr, &h, (uint64_t)b->cfg->max_body, err);
+    obs_status s = obs_bin_header_parse(hdr, &h, (uint64_t)b->front.cfg->max_body, err);
     f.id = h.id;
     if (s == OBS_OK && h.kind != OBS_BIN_REQUEST)
         s = OBS_BAD_FILE, snprintf(err, sizeof err, "a client sends requests (kind 1), not responses");
@@ -380,7 +380,7 @@ static int serve_one(conn *c)
     }
 
     /* The head: nothing of the G-buffer is read before it is allowed. */
-    obs_limits lim = {.max_pixels = (uint64_t)b->cfg->max_pixels};
+    obs_limits lim = {.max_pixels = (uint64_t)b->front.cfg->max_pixels};
     obs_bin_head hd;
     unsigned char *payload = NULL;
     size_t got = 0;
@@ -393,7 +393,7 @@ static int serve_one(conn *c)
     }
     f.bytes_in += got;
     int rc = 0;
-    if (b->token && (!hd.params_done || !token_ok(b, hd.token)))
+    if (b->front.token && (!hd.params_done || !token_ok(b, hd.token)))
         rc = 1, send_error(&f, 401, "unauthorized", "missing or wrong token parameter");
     else if (s == OBS_TOO_LARGE || s == OBS_NO_MEMORY)
         rc = 1, send_status(&f, s, err);
@@ -414,7 +414,7 @@ static int serve_one(conn *c)
         rc = 1, send_error(&f, 503, "shutting_down", "the daemon is shutting down");
     else {
         int full = 0;
-        obsd_queue_stats(b->queue, NULL, NULL, &full);
+        obsd_queue_stats(b->front.queue, NULL, NULL, &full);
         if (full)
             rc = 1, send_error(&f, 503, "queue_full", "the frame queue is full; retry later");
     }

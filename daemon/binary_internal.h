@@ -10,8 +10,7 @@
 #include <stdatomic.h>
 #include <stddef.h>
 
-#include "config.h"
-#include "gl_worker.h"
+#include "front.h"
 
 #define TICK_MS 200
 /* Before closing a connection that was answered without reading all it
@@ -42,10 +41,7 @@ typedef struct refused {
 
 typedef struct obsd_bin obsd_bin; /* as binary_server.h, which only the listeners include */
 struct obsd_bin {
-    const obsd_config *cfg;
-    const char *token;
-    obsd_queue *queue;
-    obsd_gl_worker *gl;
+    obsd_front front;
     int unix_fd, tcp_fd, tcp_port;
     pthread_t acceptor;
     int accepting;

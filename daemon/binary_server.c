@@ -150,9 +150,9 @@ static void accept_one(obsd_bin *b, int lfd)
         open_now++;
         same += !strcmp(o->addr, c->addr);
     }
-    if (open_now >= b->cfg->bin_connections)
+    if (open_now >= b->front.cfg->bin_connections)
         snprintf(why, sizeof why, "%d open (bin_connections)", open_now);
-    else if (b->cfg->max_per_client > 0 && same >= b->cfg->max_per_client)
+    else if (b->front.cfg->max_per_client > 0 && same >= b->front.cfg->max_per_client)
         snprintf(why, sizeof why, "%d open from %s (max_per_client)", same, c->addr);
     else {
         OBSD_LIST_PUSH(b->conns, c);
@@ -286,16 +286,13 @@ bad:
     return -1;
 }
 
-obs_status obsd_bin_start(const obsd_config *cfg, const char *token, obsd_queue *q,
-                          obsd_gl_worker *gl, obsd_bin **out, char err[OBS_ERR_LEN])
+obs_status obsd_bin_start(const obsd_front *f, obsd_bin **out, char err[OBS_ERR_LEN])
 {
+    const obsd_config *cfg = f->cfg;
     obsd_bin *b = calloc(1, sizeof *b);
     if (!b)
         return OBS_NO_MEMORY;
-    b->cfg = cfg;
-    b->token = token && *token ? token : NULL;
-    b->queue = q;
-    b->gl = gl;
+    b->front = *f;
     b->unix_fd = b->tcp_fd = -1;
     atomic_init(&b->draining, 0);
     atomic_init(&b->connections, 0);
@@ -337,7 +334,7 @@ void obsd_bin_quiesce(obsd_bin *b)
     }
     if (b->unix_fd >= 0) {
         close(b->unix_fd);
-        unlink(b->cfg->socket);
+        unlink(b->front.cfg->socket);
         b->unix_fd = -1;
     }
     if (b->tcp_fd >= 0) {

@@ -4,15 +4,12 @@
 #ifndef OBSD_BINARY_SERVER_H
 #define OBSD_BINARY_SERVER_H
 
-#include "config.h"
-#include "gl_worker.h"
+#include "front.h"
 
 typedef struct obsd_bin obsd_bin;
 
-/* Listens on cfg->socket and/or cfg->tcp (whichever is set).  `token`
- * may be NULL or "" (no token required). */
-obs_status obsd_bin_start(const obsd_config *cfg, const char *token, obsd_queue *q,
-                          obsd_gl_worker *gl, obsd_bin **out, char err[OBS_ERR_LEN]);
+/* Listens on f->cfg->socket and/or f->cfg->tcp (whichever is set). */
+obs_status obsd_bin_start(const obsd_front *f, obsd_bin **out, char err[OBS_ERR_LEN]);
 
 /* The bound TCP port (useful with port 0); 0 when there is no TCP. */
 int obsd_bin_tcp_port(const obsd_bin *b);

@@ -240,33 +240,39 @@ const obs_image *obsd_fp_png_image(const obsd_fp_images *im)
     return im->ao ? im->ao : im->composite ? im->composite : im->multibounce ? im->multibounce : im->bent;
 }
 
+/* An image of the answer and its place in the result whose EXR layers
+ * name it. */
+typedef struct image_into {
+    const obs_image *from;
+    obs_image *to;
+} image_into;
+
+/* The images present copied into their places (the others stay empty). */
+static void copy_present(const image_into *c, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (c[i].from)
+            *c[i].to = *c[i].from;
+}
+
 /* The EXR layers of `im`, named by core's own tables. */
 static int exr_layers(const obsd_fp_images *im, obs_result *flat, obs_deep_result *deep,
                       obs_exr_layer layers[OBS_RESULT_LAYERS])
 {
     if (im->deep) {
-        if (im->ao)
-            deep->ao_blend = *im->ao;
-        if (im->ao_front)
-            deep->ao_front = *im->ao_front;
-        if (im->composite)
-            deep->composite = *im->composite;
+        const image_into c[] = {{im->ao, &deep->ao_blend}, {im->ao_front, &deep->ao_front},
+                                {im->composite, &deep->composite}};
+        copy_present(c, sizeof c / sizeof c[0]);
         return obs_deep_result_exr_layers(deep, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE, layers);
     }
-    if (im->ao)
-        flat->ao = *im->ao;
-    if (im->composite)
-        flat->composite = *im->composite;
-    if (im->ao_screen)
-        flat->ao_screen = *im->ao_screen;
-    if (im->ao_baked)
-        flat->ao_baked = *im->ao_baked;
-    if (im->multibounce)
-        flat->multibounce = *im->multibounce;
-    if (im->samples)
-        flat->sample_count = *im->samples;
-    if (im->bent)
-        flat->bent = *im->bent;
+    const image_into c[] = {{im->ao, &flat->ao},
+                            {im->composite, &flat->composite},
+                            {im->ao_screen, &flat->ao_screen},
+                            {im->ao_baked, &flat->ao_baked},
+                            {im->multibounce, &flat->multibounce},
+                            {im->samples, &flat->sample_count},
+                            {im->bent, &flat->bent}};
+    copy_present(c, sizeof c / sizeof c[0]);
     return obs_result_exr_layers(flat, layers);
 }
 

@@ -37,7 +37,6 @@ typedef struct bake_req {
     char ext[16];                 /* format=EXT */
     obs_bake_params params;
     obsd_bake_sub sub;            /* GET .../events */
-    int subscribed;
     obsd__events events;
     struct MHD_PostProcessor *pp; /* a multipart body, split as it comes */
     parts *parts;                 /* its parts */
@@ -86,63 +85,40 @@ static enum MHD_Result unknown(req *r)
 
 /* ---- POST: the query, then the body ------------------------------------ */
 
-typedef struct arg_ctx {
-    req *r;
-    int bad;
-    char err[OBS_ERR_LEN];
-} arg_ctx;
-
-static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *key, size_t key_size,
-                              const char *value, size_t value_size)
+/* One query argument of POST /v1/bakes (obsd__query_args). */
+static obs_status bake_arg(req *r, const char *key, const char *value, char err[OBS_ERR_LEN])
 {
-    arg_ctx *a = cls;
-    req *r = a->r;
     bake_req *bk = r->own;
-    (void)kind;
-    if (a->bad)
-        return MHD_NO;
-    if (obs_http_value_check(key, key_size, value, value_size, a->err) != OBS_OK) {
-        a->bad = 1;
-        return MHD_NO;
-    }
-    if (!value)
-        value = "";
     if (!strcmp(key, "format")) {
         size_t n = strlen(value);
         int ok = n > 0 && n < sizeof bk->ext;
         for (size_t i = 0; ok && i < n; i++)
             ok = (value[i] >= 'a' && value[i] <= 'z') || (value[i] >= '0' && value[i] <= '9');
         if (!ok) {
-            snprintf(a->err, OBS_ERR_LEN, "format '%.40s' is not a file extension (glb, gltf, ac, obj, ...)",
+            snprintf(err, OBS_ERR_LEN, "format '%.40s' is not a file extension (glb, gltf, ac, obj, ...)",
                      value);
-            a->bad = 1;
-            return MHD_NO;
+            return OBS_INVALID_ARGUMENT;
         }
         snprintf(bk->ext, sizeof bk->ext, "%s", value);
-        return MHD_YES;
+        return OBS_OK;
     }
     if (!strcmp(key, "distances")) {
         char s[64], l[64];
         const char *comma = strchr(value, ',');
         if (!comma || strchr(comma + 1, ',') || (size_t)(comma - value) >= sizeof s || strlen(comma + 1) >= sizeof l) {
-            snprintf(a->err, OBS_ERR_LEN, "distances '%.40s': expected SHORT,LONG (e.g. 2,300)", value);
-            a->bad = 1;
-            return MHD_NO;
+            snprintf(err, OBS_ERR_LEN, "distances '%.40s': expected SHORT,LONG (e.g. 2,300)", value);
+            return OBS_INVALID_ARGUMENT;
         }
         snprintf(s, sizeof s, "%.*s", (int)(comma - value), value);
         snprintf(l, sizeof l, "%s", comma + 1);
-        a->bad = obs_bake_param_set(&bk->params, "distance_short", s, a->err) != OBS_OK ||
-                 obs_bake_param_set(&bk->params, "distance_long", l, a->err) != OBS_OK;
-        return a->bad ? MHD_NO : MHD_YES;
+        obs_status st = obs_bake_param_set(&bk->params, "distance_short", s, err);
+        return st != OBS_OK ? st : obs_bake_param_set(&bk->params, "distance_long", l, err);
     }
-    if (obs_bake_param_set(&bk->params, key, value, a->err) != OBS_OK) {
-        if (!obs_bake_param_find(key))
-            snprintf(a->err, OBS_ERR_LEN, "unknown bake parameter '%.60s' (GET /v1/bakes lists none; "
-                     "'obscura bake --params' lists them; also format=EXT, distances=S,L)", key);
-        a->bad = 1;
-        return MHD_NO;
-    }
-    return MHD_YES;
+    obs_status st = obs_bake_param_set(&bk->params, key, value, err);
+    if (st != OBS_OK && !obs_bake_param_find(key))
+        snprintf(err, OBS_ERR_LEN, "unknown bake parameter '%.60s' (GET /v1/bakes lists none; "
+                 "'obscura bake --params' lists them; also format=EXT, distances=S,L)", key);
+    return st;
 }
 
 /* ---- a multipart/form-data body: the parts `level` and `decorators` ---- */
@@ -219,24 +195,23 @@ static enum MHD_Result post_start(req *r)
     obsd_http *h = r->srv;
     if (atomic_load(&h->draining))
         return obsd__answer_shutting_down(r);
-    arg_ctx a = {r, 0, ""};
-    MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
-    if (a.bad)
-        return obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL);
+    char err[OBS_ERR_LEN];
+    if (obsd__query_args(r, bake_arg, err) != OBS_OK)
+        return obsd__answer_error(r, 400, "bad_parameter", err, NULL, NULL);
     const char *ct = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
     int multipart = ct && !strncasecmp(ct, "multipart/form-data", strlen("multipart/form-data"));
     if (multipart) {
         /* the parts are copied out as the body comes: nothing is held twice */
         if (!(bk->parts = calloc(1, sizeof *bk->parts)))
             return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the parts");
-        bk->parts->max = (size_t)h->cfg->max_level;
+        bk->parts->max = (size_t)h->front.cfg->max_level;
         bk->pp = MHD_create_post_processor(r->conn, 1 << 16, on_part, bk->parts);
         if (!bk->pp)
             return obsd__answer_error(r, 400, "bad_multipart",
                                       "a multipart/form-data body without a boundary", NULL, NULL);
     }
     enum MHD_Result rc;
-    if (!obsd__body_expect(r, (size_t)h->cfg->max_level, "level", "--max-level", !multipart, &rc))
+    if (!obsd__body_expect(r, (size_t)h->front.cfg->max_level, "level", "--max-level", !multipart, &rc))
         return rc;
     r->state = REQ_BODY;
     return MHD_YES;
@@ -281,11 +256,11 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
         return MHD_YES;
     }
     if (*size)
-        return obsd__append_body(r, data, size, (size_t)h->cfg->max_level);
+        return obsd__append_body(r, data, size, (size_t)h->front.cfg->max_level);
     char msg[320];
     if (r->too_big) {
         snprintf(msg, sizeof msg, "level is over the limit of %lld bytes (--max-level)",
-                 (long long)h->cfg->max_level);
+                 (long long)h->front.cfg->max_level);
         return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
     }
     if (pt) {
@@ -327,7 +302,7 @@ enum MHD_Result obsd__bakes_body(req *r, const char *data, size_t *size)
     int rc = obsd_bakes_submit(h->bakes, level, len, ext, decor, rules, &bk->params, id);
     if (rc == -1) {
         snprintf(msg, sizeof msg, "%d bake jobs are queued or running (--max-bakes); retry later",
-                 h->cfg->max_bakes);
+                 h->front.cfg->max_bakes);
         return obsd__answer_error(r, 503, "bake_queue_full", msg, MHD_HTTP_HEADER_RETRY_AFTER, "10");
     }
     if (rc == -2)
@@ -363,21 +338,22 @@ static int next_event(req *r, char *buf, size_t len)
     return obsd_bakes_next_event(r->srv->bakes, &bk->sub, buf, len);
 }
 
-static enum MHD_Result events(req *r)
+/* The job's subscriber (obsd__events_open): an unknown job is 404, one
+ * the daemon is dropping (shutting down) 503. */
+static int join(req *r, enum MHD_Result *rc)
 {
     bake_req *bk = r->own;
-    obsd_http *h = r->srv;
-    if (atomic_load(&h->draining))
-        return obsd__answer_shutting_down(r);
     bk->sub = (obsd_bake_sub){.park = obsd__events_park, .wake = obsd__events_wake, .arg = r};
-    int rc = obsd_bakes_subscribe(h->bakes, bk->id, &bk->sub);
-    if (rc == -1)
-        return unknown(r);
-    if (rc != 0)
-        return obsd__answer_shutting_down(r);
-    bk->subscribed = 1;
-    bk->events.next = next_event;
-    return obsd__events_answer(r, &bk->events);
+    int s = obsd_bakes_subscribe(r->srv->bakes, bk->id, &bk->sub);
+    if (s != 0)
+        *rc = s == -1 ? unknown(r) : obsd__answer_shutting_down(r);
+    return s == 0;
+}
+
+static void leave(req *r)
+{
+    bake_req *bk = r->own;
+    obsd_bakes_unsubscribe(r->srv->bakes, &bk->sub);
 }
 
 /* ---- the routes ------------------------------------------------------------- */
@@ -436,7 +412,7 @@ enum MHD_Result obsd__bakes_start(req *r, const char *url)
     if (!bk)
         return obsd__answer_status(r, OBS_NO_MEMORY, "no memory for the request");
     int ok = parse_path(r, url);
-    if (h->cfg->max_bakes < 1)
+    if (h->front.cfg->max_bakes < 1)
         return obsd__answer_error(r, 404, "bakes_off", "bake jobs are off (--max-bakes 0)", NULL, NULL);
     if (ok < 0)
         return obsd__answer_error(r, 404, "not_found", "a bake job's id is 16 hex digits, as POST /v1/bakes "
@@ -467,7 +443,7 @@ enum MHD_Result obsd__bakes_start(req *r, const char *url)
     case OP_RESULT:
         return result(r);
     default:
-        return events(r);
+        return obsd__events_open(r, &bk->events, join, next_event, leave);
     }
 }
 
@@ -476,8 +452,7 @@ void obsd__bakes_done(req *r)
     bake_req *bk = r->own;
     if (!bk)
         return;
-    if (bk->subscribed)
-        obsd_bakes_unsubscribe(r->srv->bakes, &bk->sub);
+    obsd__events_close(r, &bk->events);
     if (bk->pp)
         MHD_destroy_post_processor(bk->pp);
     if (bk->parts) {

@@ -48,7 +48,7 @@ static void addr_name(const struct sockaddr *sa, char *buf, size_t len, char ip[
  * without a word). */
 static int over_client_limit(const obsd_http *h, const obsd__conn *c)
 {
-    int max = h->cfg->max_per_client, n = 0;
+    int max = h->front.cfg->max_per_client, n = 0;
     if (max <= 0)
         return 0;
     for (const obsd__conn *o = h->conns; o; o = o->next)
@@ -59,7 +59,7 @@ static int over_client_limit(const obsd_http *h, const obsd__conn *c)
 
 static double deadline_from(const obsd_http *h, double now)
 {
-    return h->cfg->request_timeout > 0 ? now + h->cfg->request_timeout * 1000.0 : 0.0;
+    return h->front.cfg->request_timeout > 0 ? now + h->front.cfg->request_timeout * 1000.0 : 0.0;
 }
 
 /* Past its deadline: a 408 written straight to the socket (libmicrohttpd
@@ -71,7 +71,7 @@ static void answer_timeout(obsd_http *h, obsd__conn *c)
     const obsd__req *r = c->r;
     char msg[160], head[256];
     snprintf(msg, sizeof msg, "the request took over %d s (--request-timeout) to send its %s",
-             h->cfg->request_timeout, r ? "body" : "headers");
+             h->front.cfg->request_timeout, r ? "body" : "headers");
     char *body = obs_http_error_json("request_timeout", msg);
     size_t len = body ? strlen(body) : 0;
     int n = snprintf(head, sizeof head,
@@ -165,7 +165,7 @@ void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_conte
     h->conns_tail = c;
     h->open++;
     c->over_client = over_client_limit(h, c);
-    if (h->open - h->evicting > h->cfg->http_connections) {
+    if (h->open - h->evicting > h->front.cfg->http_connections) {
         /* At the limit: the oldest connection that has not sent a whole
          * request (stalled in its headers, or idle between requests) makes
          * room; when every one is inside a request, this one may ask the
@@ -175,7 +175,7 @@ void obsd__conn_notify(void *cls, struct MHD_Connection *mc, void **socket_conte
             o = o->next;
         if (o) {
             obsd_log(OBSD_LOG_INFO, "peer=%s: connection closed to make room (--http-connections %d open, "
-                     "it had sent no whole request)", o->peer, h->cfg->http_connections);
+                     "it had sent no whole request)", o->peer, h->front.cfg->http_connections);
             cut_conn(h, o, CUT_EVICTED);
         } else {
             c->reserve = 1;

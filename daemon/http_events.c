@@ -46,7 +46,7 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
     return (ssize_t)k;
 }
 
-enum MHD_Result obsd__events_answer(obsd__req *r, obsd__events *ev)
+static enum MHD_Result answer(obsd__req *r, obsd__events *ev)
 {
     ev->r = r;
     struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 1024, reader, ev, NULL);
@@ -59,4 +59,26 @@ enum MHD_Result obsd__events_answer(obsd__req *r, obsd__events *ev)
     if (r->cn)
         atomic_store(&r->cn->events, 1);
     return obsd__answer(r, 200, resp, 0, "event stream opened");
+}
+
+enum MHD_Result obsd__events_open(obsd__req *r, obsd__events *ev,
+                                  int (*join)(obsd__req *r, enum MHD_Result *rc),
+                                  int (*next)(obsd__req *r, char *buf, size_t len),
+                                  void (*leave)(obsd__req *r))
+{
+    enum MHD_Result rc;
+    if (atomic_load(&r->srv->draining))
+        return obsd__answer_shutting_down(r);
+    if (!join(r, &rc))
+        return rc;
+    ev->leave = leave;
+    ev->next = next;
+    return answer(r, ev);
+}
+
+void obsd__events_close(obsd__req *r, obsd__events *ev)
+{
+    if (ev->leave)
+        ev->leave(r);
+    ev->leave = NULL;
 }

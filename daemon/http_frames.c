@@ -18,12 +18,6 @@
 
 typedef obsd__req req;
 
-typedef struct arg_ctx {
-    req *r;
-    obs_status status;
-    char err[OBS_ERR_LEN];
-} arg_ctx;
-
 static int record_pair(req *r, const char *key, const char *value)
 {
     obsd__frame_req *fr = r->fr;
@@ -50,38 +44,27 @@ static int name_is(const char *name, const char *want)
     return *name == *want;
 }
 
-static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *key, size_t key_size,
-                              const char *value, size_t value_size)
+/* One query argument of a frame's request (obsd__query_args). */
+static obs_status frame_arg(req *r, const char *key, const char *value, char err[OBS_ERR_LEN])
 {
-    arg_ctx *a = cls;
-    req *r = a->r;
     obsd__frame_req *fr = r->fr;
-    (void)kind;
-    if (a->status != OBS_OK)
-        return MHD_NO;
-    /* %00 would end the C string: 'radius=0.5%00x' would read 0.5 */
-    if ((a->status = obs_http_value_check(key, key_size, value, value_size, a->err)) != OBS_OK)
-        return MHD_NO;
-    if (!value)
-        value = "";
     if (fr->view) {
         /* a stored frame: the view options, and anything else re-runs it */
         if (name_is(key, "exposure")) {
             char *end;
             double ev = strtod(value, &end);
             if (end == value || *end || !(ev >= -20.0 && ev <= 20.0)) {
-                snprintf(a->err, OBS_ERR_LEN, "parameter exposure: '%.100s' is not a number in [-20, 20] "
+                snprintf(err, OBS_ERR_LEN, "parameter exposure: '%.100s' is not a number in [-20, 20] "
                          "(stops)", value);
-                a->status = OBS_INVALID_ARGUMENT;
-                return MHD_NO;
+                return OBS_INVALID_ARGUMENT;
             }
             fr->exposure = ev;
-            return MHD_YES;
+            return OBS_OK;
         }
         if (name_is(key, "output") && (!strcmp(value, "color") || !strcmp(value, "ao_front"))) {
             fr->want_color = value[0] == 'c';
             fr->want_front = value[0] == 'a';
-            return MHD_YES;
+            return OBS_OK;
         }
         if (name_is(key, "output"))
             fr->want_color = fr->want_front = 0;
@@ -90,25 +73,25 @@ static enum MHD_Result on_arg(void *cls, enum MHD_ValueKind kind, const char *ke
                  !name_is(key, "png_transfer"))
             fr->rerun = 1;
     }
-    a->status = obs_http_request_set(&fr->hr, key, value, a->err);
-    if (a->status == OBS_OK && fr->kept && record_pair(r, key, value) != 0) {
-        snprintf(a->err, OBS_ERR_LEN, "no memory for the query");
-        a->status = OBS_NO_MEMORY;
+    obs_status s = obs_http_request_set(&fr->hr, key, value, err);
+    if (s == OBS_OK && fr->kept && record_pair(r, key, value) != 0) {
+        snprintf(err, OBS_ERR_LEN, "no memory for the query");
+        s = OBS_NO_MEMORY;
     }
-    return a->status == OBS_OK ? MHD_YES : MHD_NO;
+    return s;
 }
 
 int obsd__parse_query(req *r, enum MHD_Result *rc)
 {
     obsd__frame_req *fr = r->fr;
-    arg_ctx a = {r, OBS_OK, ""};
-    MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, on_arg, &a);
-    if (a.status == OBS_OK)
-        a.status = obs_http_request_check(&fr->hr, a.err);
-    if (a.status == OBS_OK)
+    char err[OBS_ERR_LEN];
+    obs_status s = obsd__query_args(r, frame_arg, err);
+    if (s == OBS_OK)
+        s = obs_http_request_check(&fr->hr, err);
+    if (s == OBS_OK)
         return 1;
-    *rc = a.status == OBS_INVALID_ARGUMENT ? obsd__answer_error(r, 400, "bad_parameter", a.err, NULL, NULL)
-                                           : obsd__answer_status(r, a.status, a.err);
+    *rc = s == OBS_INVALID_ARGUMENT ? obsd__answer_error(r, 400, "bad_parameter", err, NULL, NULL)
+                                    : obsd__answer_status(r, s, err);
     return 0;
 }
 
@@ -169,11 +152,11 @@ enum MHD_Result obsd__frame_start(req *r, const char *url)
     if (v && strncmp(v, "image/x-exr", 11) != 0 && strncmp(v, "application/octet-stream", 24) != 0)
         return obsd__answer_error(r, 415, "unsupported_media_type",
                             "the body must be a G-buffer EXR (Content-Type: image/x-exr)", NULL, NULL);
-    if (!obsd__body_expect(r, (size_t)h->cfg->max_body, "body", "--max-body", 1, &rc))
+    if (!obsd__body_expect(r, (size_t)h->front.cfg->max_body, "body", "--max-body", 1, &rc))
         return rc;
     /* Refuse early when the queue is already full: no need for the body. */
     int full;
-    obsd_queue_stats(h->queue, NULL, NULL, &full);
+    obsd_queue_stats(h->front.queue, NULL, NULL, &full);
     if (full)
         return obsd__answer_error(r, 503, "queue_full", "the frame queue is full; retry later",
                             MHD_HTTP_HEADER_RETRY_AFTER, "1");
@@ -262,7 +245,7 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     obsd__frame_req *fr = r->fr;
     obsd_http *h = r->srv;
     char err[OBS_ERR_LEN] = "";
-    obs_limits lim = {.max_pixels = (uint64_t)h->cfg->max_pixels};
+    obs_limits lim = {.max_pixels = (uint64_t)h->front.cfg->max_pixels};
     obs_status s = obsd_fp_decode(&fr->fp, body, len, &fr->hr, &lim, NULL, err);
     /* An EXR answer takes the body's header (its windows and attributes;
      * append=1: the body itself), which lives until the answer: r->body,
@@ -285,7 +268,7 @@ enum MHD_Result obsd__queue_frame(req *r, const unsigned char *body, size_t len,
     MHD_suspend_connection(r->conn);
     atomic_store(&r->job, JOB_PENDING);
     if ((r->cn && atomic_load(&r->cn->cut)) || (atomic_load(&h->draining) && !fr->before_drain) ||
-        obsd_fp_queue(&fr->fp, h->queue, &fr->hr.params, outputs, job_done, r) != 0) {
+        obsd_fp_queue(&fr->fp, h->front.queue, &fr->hr.params, outputs, job_done, r) != 0) {
         int pending = JOB_PENDING;
         if (atomic_compare_exchange_strong(&r->job, &pending, JOB_NONE)) {
             r->state = REQ_REFUSED;
@@ -324,11 +307,11 @@ enum MHD_Result obsd__frame_body(req *r, const char *data, size_t *size)
     if (!obsd__req_alive(r))
         return MHD_NO;
     if (*size)
-        return obsd__append_body(r, data, size, (size_t)r->srv->cfg->max_body);
+        return obsd__append_body(r, data, size, (size_t)r->srv->front.cfg->max_body);
     if (r->too_big) {
         char msg[160];
         snprintf(msg, sizeof msg, "body is over the limit of %lld bytes (--max-body)",
-                 (long long)r->srv->cfg->max_body);
+                 (long long)r->srv->front.cfg->max_body);
         return obsd__answer_error(r, 413, "body_too_large", msg, NULL, NULL);
     }
     return queue_body(r);

@@ -13,18 +13,18 @@ typedef obsd__req req;
 static void gauges(obsd_http *h, obsd_gauges *g)
 {
     int waiting, running, full;
-    obsd_queue_stats(h->queue, &waiting, &running, &full);
+    obsd_queue_stats(h->front.queue, &waiting, &running, &full);
     g->queue_depth = waiting;
-    g->queue_capacity = h->cfg->queue;
+    g->queue_capacity = h->front.cfg->queue;
     g->gl_running = running;
     g->in_flight = atomic_load(&h->in_flight);
-    g->gl_alive = atomic_load(&h->gl->alive);
-    g->gl_recreations = (unsigned long long)atomic_load(&h->gl->recreations);
-    g->gl_kept_bytes = (unsigned long long)atomic_load(&h->gl->kept_bytes);
-    g->heap_trims = (unsigned long long)atomic_load(&h->gl->heap_trims);
-    g->programs_compiled = (unsigned long long)atomic_load(&h->gl->programs_compiled);
-    g->programs_loaded = (unsigned long long)atomic_load(&h->gl->programs_loaded);
-    g->programs_rejected = (unsigned long long)atomic_load(&h->gl->programs_rejected);
+    g->gl_alive = atomic_load(&h->front.gl->alive);
+    g->gl_recreations = (unsigned long long)atomic_load(&h->front.gl->recreations);
+    g->gl_kept_bytes = (unsigned long long)atomic_load(&h->front.gl->kept_bytes);
+    g->heap_trims = (unsigned long long)atomic_load(&h->front.gl->heap_trims);
+    g->programs_compiled = (unsigned long long)atomic_load(&h->front.gl->programs_compiled);
+    g->programs_loaded = (unsigned long long)atomic_load(&h->front.gl->programs_loaded);
+    g->programs_rejected = (unsigned long long)atomic_load(&h->front.gl->programs_rejected);
     obsd_streams_gauges(h->streams, &g->streams, &g->stream_frames, &g->stream_bytes, &g->sse_subscribers);
 }
 
@@ -37,23 +37,23 @@ enum MHD_Result obsd__info_get(req *r, const char *url)
         return MHD_NO;
     cJSON_AddStringToObject(o, "name", "obscurad");
     cJSON_AddStringToObject(o, "version", OBS_VERSION);
-    cJSON_AddStringToObject(o, "backend", h->gl->backend);
-    cJSON_AddStringToObject(o, "gl_version", h->gl->gl_version);
-    cJSON_AddStringToObject(o, "gl_vendor", h->gl->gl_vendor);
-    cJSON_AddStringToObject(o, "gl_renderer", h->gl->gl_renderer);
-    cJSON_AddNumberToObject(o, "queue", h->cfg->queue);
-    cJSON_AddNumberToObject(o, "max_pixels", (double)h->cfg->max_pixels);
-    cJSON_AddNumberToObject(o, "max_body", (double)h->cfg->max_body);
+    cJSON_AddStringToObject(o, "backend", h->front.gl->backend);
+    cJSON_AddStringToObject(o, "gl_version", h->front.gl->gl_version);
+    cJSON_AddStringToObject(o, "gl_vendor", h->front.gl->gl_vendor);
+    cJSON_AddStringToObject(o, "gl_renderer", h->front.gl->gl_renderer);
+    cJSON_AddNumberToObject(o, "queue", h->front.cfg->queue);
+    cJSON_AddNumberToObject(o, "max_pixels", (double)h->front.cfg->max_pixels);
+    cJSON_AddNumberToObject(o, "max_body", (double)h->front.cfg->max_body);
     cJSON *pc = cJSON_AddObjectToObject(o, "program_cache");
     if (pc) {
-        if (h->gl->cache_dir[0])
-            cJSON_AddStringToObject(pc, "dir", h->gl->cache_dir);
+        if (h->front.gl->cache_dir[0])
+            cJSON_AddStringToObject(pc, "dir", h->front.gl->cache_dir);
         else
             cJSON_AddNullToObject(pc, "dir");
-        cJSON_AddBoolToObject(pc, "writable", h->gl->cache_dir[0] && h->gl->cache_writable);
-        cJSON_AddNumberToObject(pc, "compiled", (double)atomic_load(&h->gl->programs_compiled));
-        cJSON_AddNumberToObject(pc, "loaded", (double)atomic_load(&h->gl->programs_loaded));
-        cJSON_AddNumberToObject(pc, "rejected", (double)atomic_load(&h->gl->programs_rejected));
+        cJSON_AddBoolToObject(pc, "writable", h->front.gl->cache_dir[0] && h->front.gl->cache_writable);
+        cJSON_AddNumberToObject(pc, "compiled", (double)atomic_load(&h->front.gl->programs_compiled));
+        cJSON_AddNumberToObject(pc, "loaded", (double)atomic_load(&h->front.gl->programs_loaded));
+        cJSON_AddNumberToObject(pc, "rejected", (double)atomic_load(&h->front.gl->programs_rejected));
     }
     char *text = cJSON_Print(o);
     cJSON_Delete(o);
@@ -81,7 +81,7 @@ enum MHD_Result obsd__readyz_get(req *r, const char *url)
     int full;
     (void)url;
     gauges(h, &g);
-    obsd_queue_stats(h->queue, NULL, NULL, &full);
+    obsd_queue_stats(h->front.queue, NULL, NULL, &full);
     const char *why = !g.gl_alive ? "GL context not alive"
                       : atomic_load(&h->draining) ? "shutting down"
                       : full ? "queue full" : NULL;

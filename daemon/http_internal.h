@@ -14,8 +14,7 @@
 #include "bake_jobs.h"
 #include "frame_path.h"
 #include "http.h"
-#include "config.h"
-#include "gl_worker.h"
+#include "front.h"
 #include "obscura/io.h"
 #include "stats.h"
 #include "stream_store.h"
@@ -49,10 +48,7 @@ typedef struct obsd__conn {
 typedef struct obsd_http obsd_http;
 struct obsd_http {
     struct MHD_Daemon *mhd;
-    const obsd_config *cfg;
-    const char *token;
-    obsd_queue *queue;
-    obsd_gl_worker *gl;
+    obsd_front front;
     obsd_streams *streams;
     obsd_bakes *bakes;
     int port;
@@ -114,9 +110,12 @@ typedef struct obsd__frame_req {
 
 /* An event stream's answer (http_events.c): `next` writes the source's
  * next event into buf and returns its length; 0: none yet (the source
- * parked the connection, obsd__events_park, and wakes it); -1: the end. */
+ * parked the connection, obsd__events_park, and wakes it); -1: the end.
+ * `leave` unsubscribes the request from its source (set while it is
+ * subscribed). */
 typedef struct obsd__events {
     int (*next)(struct obsd__req *r, char *buf, size_t len);
+    void (*leave)(struct obsd__req *r);
     struct obsd__req *r;
     char buf[512];
     int len, off;
@@ -213,6 +212,17 @@ enum MHD_Result obsd__answer_status(obsd__req *r, obs_status s, const char *msg)
 enum MHD_Result obsd__answer_images(obsd__req *r, const obsd_fp_images *im, const obs_camera *cam, int timing,
                                     const char *extra_name, const char *extra_value);
 
+/* ---- http_query.c: a request's query arguments ------------------------ */
+
+/* A route's reader of one query argument (value "" when it has none):
+ * OBS_OK, or an error with its message in err. */
+typedef obs_status (*obsd__arg_fn)(obsd__req *r, const char *key, const char *value,
+                                   char err[OBS_ERR_LEN]);
+/* Every query argument of r through fn, in order, up to the first error
+ * (one with a NUL byte is an error before fn sees it): OBS_OK or that
+ * error, its message in err. */
+obs_status obsd__query_args(obsd__req *r, obsd__arg_fn fn, char err[OBS_ERR_LEN]);
+
 /* ---- http_frames.c: a frame's query, body and trip to the GL worker ---- */
 
 /* The start of a frame's request: query, Content-Type, Content-Length,
@@ -272,9 +282,17 @@ void obsd__bakes_done(obsd__req *r);
  * resume its connection. */
 void obsd__events_park(void *arg);
 void obsd__events_wake(void *arg);
-/* Answers 200 text/event-stream with the events of ev->next (ev, which
- * must live as long as the request, is set up by the caller); REQ_EVENTS. */
-enum MHD_Result obsd__events_answer(obsd__req *r, obsd__events *ev);
+/* An event route's answer (ev lives as long as the request): 503 while
+ * the daemon drains; else join subscribes the request to its source
+ * (with obsd__events_park and _wake; 0 and its own answer in *rc when it
+ * cannot), and the answer is 200 text/event-stream with the events of
+ * next (REQ_EVENTS), until obsd__events_close calls leave. */
+enum MHD_Result obsd__events_open(obsd__req *r, obsd__events *ev,
+                                  int (*join)(obsd__req *r, enum MHD_Result *rc),
+                                  int (*next)(obsd__req *r, char *buf, size_t len),
+                                  void (*leave)(obsd__req *r));
+/* The request's subscription ended, when it has one (its route's done). */
+void obsd__events_close(obsd__req *r, obsd__events *ev);
 
 /* ---- http_info.c, http_page.c ---- */
 

@@ -73,7 +73,7 @@ enum MHD_Result obsd__answer(req *r, int status, struct MHD_Response *resp, size
     r->bytes_out = body_len;
     r->state = REQ_ANSWERED;
     MHD_add_response_header(resp, "Server", "obscurad/" OBS_VERSION);
-    const char *origin = r->srv->cfg->cors;
+    const char *origin = r->srv->front.cfg->cors;
     if (origin[0]) { /* --cors: a page from that origin may read every answer, its warnings and timings too */
         MHD_add_response_header(resp, "Access-Control-Allow-Origin", origin);
         MHD_add_response_header(resp, "Access-Control-Expose-Headers",

@@ -98,18 +98,18 @@ static enum MHD_Result dispatch(req *r, const char *url, const char *method)
     if (r->cn && r->cn->over_client && !(rt && (rt->flags & OBSD_ROUTE_PROBE))) {
         char msg[160];
         snprintf(msg, sizeof msg, "%d connections are open from this address (--max-per-client %d); "
-                 "retry later", h->cfg->max_per_client, h->cfg->max_per_client);
+                 "retry later", h->front.cfg->max_per_client, h->front.cfg->max_per_client);
         return obsd__answer_error(r, 503, "too_many_connections", msg, MHD_HTTP_HEADER_RETRY_AFTER, "1");
     }
     if (r->cn && r->cn->reserve && !(rt && (rt->flags & OBSD_ROUTE_PROBE))) {
         char msg[128];
         snprintf(msg, sizeof msg, "%d connections are open (--http-connections); retry later",
-                 h->cfg->http_connections);
+                 h->front.cfg->http_connections);
         return obsd__answer_error(r, 503, "too_many_connections", msg, MHD_HTTP_HEADER_RETRY_AFTER, "1");
     }
     if (!rt)
         return obsd__answer_error(r, 404, "not_found", "no such route (try GET /v1/params)", NULL, NULL);
-    if (h->cfg->cors[0] && !strcmp(method, "OPTIONS")) /* a preflight carries no token */
+    if (h->front.cfg->cors[0] && !strcmp(method, "OPTIONS")) /* a preflight carries no token */
         return obsd__answer_preflight(r, rt->methods ? rt->methods : "GET, HEAD, POST, DELETE");
     if (rt->methods && !method_ok(rt, method)) {
         char msg[64];
@@ -117,10 +117,10 @@ static enum MHD_Result dispatch(req *r, const char *url, const char *method)
         return obsd__answer_error(r, 405, "method_not_allowed", msg, MHD_HTTP_HEADER_ALLOW, rt->methods);
     }
     /* Probes and the static page stay open; the API and the metrics need the token. */
-    if (h->token && !(rt->flags & OBSD_ROUTE_OPEN) &&
+    if (h->front.token && !(rt->flags & OBSD_ROUTE_OPEN) &&
         !obs_http_bearer_ok(MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND,
                                                         MHD_HTTP_HEADER_AUTHORIZATION),
-                            h->token))
+                            h->front.token))
         return obsd__answer_error(r, 401, "unauthorized", "missing or wrong bearer token",
                                   MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"obscurad\"");
     return rt->start(r, url);
@@ -156,7 +156,8 @@ static req *req_new(obsd_http *h, struct MHD_Connection *conn, obsd__conn *c, co
 /* The most of a body the route reads: what a held answer discards. */
 static size_t body_max(const obsd_http *h, const obsd__route *rt)
 {
-    return (size_t)(rt && (rt->flags & OBSD_ROUTE_LEVEL_BODY) ? h->cfg->max_level : h->cfg->max_body);
+    const obsd_config *cfg = h->front.cfg;
+    return (size_t)(rt && (rt->flags & OBSD_ROUTE_LEVEL_BODY) ? cfg->max_level : cfg->max_body);
 }
 
 static int expects_continue(struct MHD_Connection *conn)
@@ -195,7 +196,7 @@ static enum MHD_Result first_call(obsd_http *h, struct MHD_Connection *conn, con
     if (c && obsd__conn_attach(h, c, r, r->t0)) { /* its headers came too late */
         char msg[128];
         snprintf(msg, sizeof msg, "the request took over %d s (--request-timeout) to send its headers",
-                 h->cfg->request_timeout);
+                 h->front.cfg->request_timeout);
         return obsd__answer_error(r, 408, "request_timeout", msg, NULL, NULL);
     }
     int has_body;
@@ -333,9 +334,9 @@ static int parse_addr(const char *s, struct sockaddr_storage *addr, socklen_t *a
     return 0;
 }
 
-obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue *q,
-                           obsd_gl_worker *gl, obsd_http **out, char err[OBS_ERR_LEN])
+obs_status obsd_http_start(const obsd_front *f, obsd_http **out, char err[OBS_ERR_LEN])
 {
+    const obsd_config *cfg = f->cfg;
     struct sockaddr_storage addr;
     socklen_t alen;
     char host[OBSD_STR_LEN];
@@ -344,10 +345,7 @@ obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue
     obsd_http *h = calloc(1, sizeof *h);
     if (!h)
         return OBS_NO_MEMORY;
-    h->cfg = cfg;
-    h->token = token && *token ? token : NULL;
-    h->queue = q;
-    h->gl = gl;
+    h->front = *f;
     h->listen_fd = MHD_INVALID_SOCKET;
     h->family = addr.ss_family;
     snprintf(h->host, sizeof h->host, "%s", host);

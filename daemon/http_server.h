@@ -4,15 +4,12 @@
 #ifndef OBSD_HTTP_SERVER_H
 #define OBSD_HTTP_SERVER_H
 
-#include "config.h"
-#include "gl_worker.h"
+#include "front.h"
 
 typedef struct obsd_http obsd_http;
 
-/* Starts listening on cfg->http.  `token` (may be NULL) is the bearer
- * token; cfg, q and gl must outlive the server. */
-obs_status obsd_http_start(const obsd_config *cfg, const char *token, obsd_queue *q,
-                           obsd_gl_worker *gl, obsd_http **out, char err[OBS_ERR_LEN]);
+/* Starts listening on f->cfg->http. */
+obs_status obsd_http_start(const obsd_front *f, obsd_http **out, char err[OBS_ERR_LEN]);
 /* The port it listens on (useful with port 0). */
 int obsd_http_port(const obsd_http *h);
 /* "http://HOST:PORT" as --http named the host ("[::1]" for IPv6), with

@@ -39,7 +39,6 @@ typedef struct stream_req {
     char name[OBSD_STREAM_NAME_LEN + 1];
     obsd_frame *frame;   /* GET .../frames/N, or the posted frame once kept: a reference */
     obsd_sub sub;        /* GET .../events */
-    int subscribed;
     obsd__events events;
 } stream_req;
 
@@ -99,22 +98,25 @@ static int next_event(req *r, char *buf, size_t len)
     return obsd_streams_next_event(r->srv->streams, &sr->sub, buf, len, obsd_now_ms());
 }
 
-static enum MHD_Result events(req *r)
+/* The stream's subscriber (obsd__events_open; the stream made when it
+ * is not there yet). */
+static int join(req *r, enum MHD_Result *rc)
 {
     stream_req *sr = r->own;
-    obsd_http *h = r->srv;
-    if (atomic_load(&h->draining))
-        return obsd__answer_shutting_down(r);
     sr->sub = (obsd_sub){.park = obsd__events_park, .wake = obsd__events_wake, .arg = r};
-    if (obsd_streams_subscribe(h->streams, sr->name, &sr->sub, obsd_now_ms()) != 0) {
-        char msg[192];
-        snprintf(msg, sizeof msg, "too many event subscribers (at most %d), or no stream '%s' and no room "
-                 "for a new one (--streams)", OBSD_STREAM_MAX_SUBS, sr->name);
-        return obsd__answer_error(r, 503, "too_many_subscribers", msg, MHD_HTTP_HEADER_RETRY_AFTER, "5");
-    }
-    sr->subscribed = 1;
-    sr->events.next = next_event;
-    return obsd__events_answer(r, &sr->events);
+    if (obsd_streams_subscribe(r->srv->streams, sr->name, &sr->sub, obsd_now_ms()) == 0)
+        return 1;
+    char msg[192];
+    snprintf(msg, sizeof msg, "too many event subscribers (at most %d), or no stream '%s' and no room "
+             "for a new one (--streams)", OBSD_STREAM_MAX_SUBS, sr->name);
+    *rc = obsd__answer_error(r, 503, "too_many_subscribers", msg, MHD_HTTP_HEADER_RETRY_AFTER, "5");
+    return 0;
+}
+
+static void leave(req *r)
+{
+    stream_req *sr = r->own;
+    obsd_streams_unsubscribe(r->srv->streams, &sr->sub);
 }
 
 /* ---- frames ------------------------------------------------------------ */
@@ -216,7 +218,7 @@ static enum MHD_Result get_frame(req *r, uint64_t seq)
     if (!fr->before_drain)
         return obsd__answer_shutting_down(r);
     int full;
-    obsd_queue_stats(h->queue, NULL, NULL, &full);
+    obsd_queue_stats(h->front.queue, NULL, NULL, &full);
     if (full)
         return obsd__answer_error(r, 503, "queue_full", "the frame queue is full; retry later",
                                   MHD_HTTP_HEADER_RETRY_AFTER, "1");
@@ -239,7 +241,7 @@ enum MHD_Result obsd__streams_start(req *r, const char *url)
         return obsd__answer_error(r, 404, "not_found",
                                   "no such route (GET /v1/streams, GET|POST /v1/streams/NAME/frames[/N], "
                                   "GET /v1/streams/NAME/events)", NULL, NULL);
-    if (h->cfg->streams < 1)
+    if (h->front.cfg->streams < 1)
         return obsd__answer_error(r, 404, "streams_off", "streams are off (--streams 0)", NULL, NULL);
     const char *allowed = sr->op == STREAM_POST ? "POST" : "GET";
     if (strcmp(r->method, allowed) != 0 && !(sr->op != STREAM_POST && !strcmp(r->method, "HEAD"))) {
@@ -271,7 +273,7 @@ enum MHD_Result obsd__streams_start(req *r, const char *url)
     case STREAM_FRAME:
         return get_frame(r, latest ? 0 : seq);
     case STREAM_EVENTS:
-        return events(r);
+        return obsd__events_open(r, &sr->events, join, next_event, leave);
     default:
         return obsd__answer_error(r, 404, "not_found", "no such route", NULL, NULL);
     }
@@ -395,8 +397,7 @@ void obsd__streams_done(req *r)
     stream_req *sr = r->own;
     if (!sr)
         return;
-    if (sr->subscribed)
-        obsd_streams_unsubscribe(r->srv->streams, &sr->sub);
+    obsd__events_close(r, &sr->events);
     obsd_frame_release(sr->frame);
     free(sr);
     r->own = NULL;

@@ -277,9 +277,10 @@ int main(int argc, char **argv)
     obsd_log(OBSD_LOG_INFO, "GL context: backend %s, %s, %s (created in %.0f ms)", gl.backend,
              gl.gl_renderer, gl.gl_version, gl.create_ms);
     log_threads(&cfg, strstr(gl.gl_renderer, "llvmpipe") != NULL);
-    s = cfg.http[0] ? obsd_http_start(&cfg, token, &queue, &gl, &http, err) : OBS_OK;
+    const obsd_front front = obsd_front_make(&cfg, token, &queue, &gl);
+    s = cfg.http[0] ? obsd_http_start(&front, &http, err) : OBS_OK;
     if (s == OBS_OK && (cfg.socket[0] || cfg.tcp[0]))
-        s = obsd_bin_start(&cfg, token, &queue, &gl, &bin, err);
+        s = obsd_bin_start(&front, &bin, err);
     mask_signals(SIG_UNBLOCK);
     if (s != OBS_OK) {
         obsd_log(OBSD_LOG_ERROR, "%s", err);

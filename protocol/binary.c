@@ -33,6 +33,12 @@ static int mul3(uint64_t a, uint64_t b, uint64_t c, uint64_t *out)
     return 1;
 }
 
+/* The fields both G-buffer headers open with: the data window's size,
+ * the display window, the flags. */
+typedef struct window_fields {
+    uint32_t width, height, dx, dy, dw, dh, flags;
+} window_fields;
+
 /* ---- writer: counts when p is NULL ---------------------------------------- */
 
 typedef struct writer {
@@ -47,32 +53,28 @@ static void put(writer *w, const void *src, size_t len)
     w->n += len;
 }
 
-static void put_u8(writer *w, unsigned v)
-{
-    unsigned char b = (unsigned char)v;
-    put(w, &b, 1);
-}
-
-static void put_u16(writer *w, unsigned v)
-{
-    unsigned char b[2] = {(unsigned char)v, (unsigned char)(v >> 8)};
-    put(w, b, 2);
-}
-
-static void put_u32(writer *w, uint32_t v)
-{
-    unsigned char b[4];
-    for (int i = 0; i < 4; i++)
-        b[i] = (unsigned char)(v >> (8 * i));
-    put(w, b, 4);
-}
-
-static void put_u64(writer *w, uint64_t v)
+/* v as an n-byte little-endian unsigned (n 1 to 8). */
+static void put_le(writer *w, uint64_t v, size_t n)
 {
     unsigned char b[8];
-    for (int i = 0; i < 8; i++)
+    for (size_t i = 0; i < n; i++)
         b[i] = (unsigned char)(v >> (8 * i));
-    put(w, b, 8);
+    put(w, b, n);
+}
+#define put_u8(w, v) put_le(w, v, 1)
+#define put_u16(w, v) put_le(w, v, 2)
+#define put_u32(w, v) put_le(w, v, 4)
+#define put_u64(w, v) put_le(w, v, 8)
+
+static void put_window(writer *w, const window_fields *f)
+{
+    put_u32(w, f->width);
+    put_u32(w, f->height);
+    put_u32(w, f->dx);
+    put_u32(w, f->dy);
+    put_u32(w, f->dw);
+    put_u32(w, f->dh);
+    put_u32(w, f->flags);
 }
 
 /* Zero bytes up to the next multiple of 8 of the payload offset. */
@@ -97,6 +99,24 @@ static void put_plane(writer *w, const obs_plane *pl, int width, int height, int
     }
     for (int y = 0; y < height; y++)
         put(w, (const unsigned char *)pl->data + (size_t)y * stride, row);
+}
+
+/* A frame (header and payload) that write(w, desc, payload length) writes:
+ * counted first, then written into one allocation of its exact size. */
+static obs_status write_frame(void (*write)(writer *w, const void *desc, uint64_t payload_len),
+                              const void *desc, const char *what, obs_bytes *out,
+                              char err[OBS_ERR_LEN])
+{
+    writer w = {NULL, 0};
+    write(&w, desc, 0);
+    if (!(w.p = malloc(w.n)))
+        return fail(err, OBS_NO_MEMORY, "no memory for a %zu-byte %s", w.n, what);
+    size_t total = w.n;
+    w.n = 0;
+    write(&w, desc, total - OBS_BIN_HEADER_LEN);
+    out->data = w.p;
+    out->size = total;
+    return OBS_OK;
 }
 
 /* ---- reader ---------------------------------------------------------------- */
@@ -130,43 +150,38 @@ static int get(reader *r, void *dst, size_t len)
     return 1;
 }
 
-static int get_u8(reader *r, unsigned *v)
+/* The n-byte little-endian unsigned at b (n 1 to 8): every field the
+ * reader takes, and the deep counts and float16 values read in place. */
+static uint64_t le_bytes(const unsigned char *b, size_t n)
 {
-    unsigned char b;
-    if (!get(r, &b, 1))
-        return 0;
-    *v = b;
-    return 1;
+    uint64_t v = 0;
+    while (n--)
+        v = v << 8 | b[n];
+    return v;
 }
 
-static int get_u16(reader *r, unsigned *v)
-{
-    unsigned char b[2];
-    if (!get(r, b, 2))
-        return 0;
-    *v = (unsigned)b[0] | (unsigned)b[1] << 8;
-    return 1;
-}
-
-static int get_u32(reader *r, uint32_t *v)
-{
-    unsigned char b[4];
-    if (!get(r, b, 4))
-        return 0;
-    *v = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
-    return 1;
-}
-
-static int get_u64(reader *r, uint64_t *v)
+static int get_le(reader *r, size_t n, uint64_t *v)
 {
     unsigned char b[8];
-    if (!get(r, b, 8))
+    if (!get(r, b, n))
         return 0;
-    *v = 0;
-    for (int i = 7; i >= 0; i--)
-        *v = *v << 8 | b[i];
+    *v = le_bytes(b, n);
     return 1;
 }
+
+/* A field of 1, 2 or 4 bytes. */
+static int get_le32(reader *r, size_t n, uint32_t *v)
+{
+    uint64_t x;
+    if (!get_le(r, n, &x))
+        return 0;
+    *v = (uint32_t)x;
+    return 1;
+}
+#define get_u8(r, v) get_le32(r, 1, v)
+#define get_u16(r, v) get_le32(r, 2, v)
+#define get_u32(r, v) get_le32(r, 4, v)
+#define get_u64(r, v) get_le(r, 8, v)
 
 static int get_pad8(reader *r)
 {
@@ -202,7 +217,7 @@ obs_status obs_bin_header_parse(const unsigned char *in, obs_bin_header *h, uint
                                 char err[OBS_ERR_LEN])
 {
     reader r = {in, OBS_BIN_HEADER_LEN, 4, "header"};
-    unsigned version = 0, kind = 0;
+    uint32_t version = 0, kind = 0;
     memset(h, 0, sizeof *h);
     if (memcmp(in, OBS_BIN_MAGIC, 4) != 0)
         return fail(err, OBS_BAD_FILE, "not an obscura binary-protocol frame (magic is not '%s')",
@@ -261,13 +276,9 @@ static void write_deep(writer *w, const obs_deep_image *d)
                      (cam->has_projection ? OBS_BIN_HAS_PROJECTION : 0) |
                      (d->has_color ? OBS_BIN_DEEP_COLOR : 0) | (d->has_normal ? OBS_BIN_DEEP_NORMAL : 0) |
                      (d->has_facing ? OBS_BIN_DEEP_FACING : 0);
-    put_u32(w, (uint32_t)d->width);
-    put_u32(w, (uint32_t)d->height);
-    put_u32(w, (uint32_t)d->display_x);
-    put_u32(w, (uint32_t)d->display_y);
-    put_u32(w, (uint32_t)d->display_width);
-    put_u32(w, (uint32_t)d->display_height);
-    put_u32(w, flags);
+    put_window(w, &(window_fields){(uint32_t)d->width, (uint32_t)d->height, (uint32_t)d->display_x,
+                                   (uint32_t)d->display_y, (uint32_t)d->display_width,
+                                   (uint32_t)d->display_height, flags});
     put_u32(w, OBS_DEEP_CH);
     put_u32(w, OBS_BIN_F32);
     put_u32(w, 0);
@@ -283,8 +294,9 @@ static void write_deep(writer *w, const obs_deep_image *d)
     put(w, d->samples, (size_t)d->offset[npx] * OBS_DEEP_CH * sizeof(float));
 }
 
-static void write_request(writer *w, const obs_bin_request_desc *d, uint64_t payload_len)
+static void write_request(writer *w, const void *desc, uint64_t payload_len)
 {
+    const obs_bin_request_desc *d = desc;
     unsigned char hdr[OBS_BIN_HEADER_LEN];
     obs_bin_header_write(hdr, OBS_BIN_REQUEST, d->id, payload_len);
     put(w, hdr, sizeof hdr);
@@ -317,13 +329,9 @@ static void write_request(writer *w, const obs_bin_request_desc *d, uint64_t pay
                      (cam->has_projection ? OBS_BIN_HAS_PROJECTION : 0);
     put_u8(w, OBS_BIN_RAW);
     put_pad8(w, start);
-    put_u32(w, (uint32_t)gb->width);
-    put_u32(w, (uint32_t)gb->height);
-    put_u32(w, (uint32_t)gb->display_x);
-    put_u32(w, (uint32_t)gb->display_y);
-    put_u32(w, (uint32_t)gb->display_width);
-    put_u32(w, (uint32_t)gb->display_height);
-    put_u32(w, flags);
+    put_window(w, &(window_fields){(uint32_t)gb->width, (uint32_t)gb->height, (uint32_t)gb->display_x,
+                                   (uint32_t)gb->display_y, (uint32_t)gb->display_width,
+                                   (uint32_t)gb->display_height, flags});
     put_u32(w, 0);
     put(w, cam->world_to_camera, sizeof cam->world_to_camera);
     put(w, cam->projection, sizeof cam->projection);
@@ -351,16 +359,7 @@ obs_status obs_bin_request_encode(const obs_bin_request_desc *d, obs_bytes *out,
     obs_status s = d->gb ? check_gbuffer(d->gb, err) : d->deep ? check_deep(d->deep, err) : OBS_OK;
     if (s != OBS_OK)
         return s;
-    writer w = {NULL, 0};
-    write_request(&w, d, 0);
-    if (!(w.p = malloc(w.n)))
-        return fail(err, OBS_NO_MEMORY, "no memory for a %zu-byte request", w.n);
-    size_t total = w.n;
-    w.n = 0;
-    write_request(&w, d, total - OBS_BIN_HEADER_LEN);
-    out->data = w.p;
-    out->size = total;
-    return OBS_OK;
+    return write_frame(write_request, d, "request", out, err);
 }
 
 /* Sets one name=value pair of a request. */
@@ -388,8 +387,7 @@ static obs_status request_param(obs_bin_request *q, const char *name, const char
 static obs_status get_param(reader *r, uint32_t i, char name[OBS_BIN_MAX_NAME + 1],
                             char value[OBS_BIN_MAX_VALUE + 1], char err[OBS_ERR_LEN])
 {
-    unsigned nl;
-    uint32_t vl;
+    uint32_t nl, vl;
     if (!get_u16(r, &nl))
         return truncated(r, "parameter name length", err);
     if (nl == 0 || nl > OBS_BIN_MAX_NAME)
@@ -459,16 +457,10 @@ static obs_status take_half_planes(reader *r, uint64_t px, uint64_t channels, ob
         return fail(err, OBS_NO_MEMORY, "no memory for %zu float16 values", n);
     const unsigned char *src = r->p + r->off;
     for (size_t i = 0; i < n; i++)
-        q->gf.storage[i] = obs_bin_half_to_float((uint16_t)(src[2 * i] | src[2 * i + 1] << 8));
+        q->gf.storage[i] = obs_bin_half_to_float((uint16_t)le_bytes(src + 2 * i, 2));
     r->off += n * 2;
     return OBS_OK;
 }
-
-/* The fields both G-buffer headers open with: the data window's size,
- * the display window, the flags. */
-typedef struct window_fields {
-    uint32_t width, height, dx, dy, dw, dh, flags;
-} window_fields;
 
 /* 0 when the payload is shorter than the header's header_len bytes. */
 static int get_window(reader *r, uint64_t header_len, window_fields *w)
@@ -544,17 +536,15 @@ static obs_status get_raw_fields(reader *r, const obs_limits *lim, raw_fields *f
     return OBS_OK;
 }
 
-static obs_status decode_raw(reader *r, const obs_limits *lim, obs_bin_request *q, char err[OBS_ERR_LEN])
+/* A raw G-buffer after its fixed fields (get_raw_fields): the matrices
+ * and the planes. */
+static obs_status decode_raw(reader *r, const raw_fields *rf, obs_bin_request *q, char err[OBS_ERR_LEN])
 {
-    raw_fields rf;
-    obs_status s = get_raw_fields(r, lim, &rf, err);
-    if (s != OBS_OK)
-        return s;
-    uint32_t width = rf.w.width, height = rf.w.height, dx = rf.w.dx, dy = rf.w.dy, dw = rf.w.dw;
-    uint32_t dh = rf.w.dh, flags = rf.w.flags, type = rf.type;
+    uint32_t width = rf->w.width, height = rf->w.height, dx = rf->w.dx, dy = rf->w.dy, dw = rf->w.dw;
+    uint32_t dh = rf->w.dh, flags = rf->w.flags, type = rf->type;
     obs_gbuffer *gb = &q->gf.gb;
     get_camera(r, flags, &gb->camera);
-    uint64_t px = rf.px, channels = rf.channels, bytes = rf.bytes;
+    uint64_t px = rf->px, channels = rf->channels, bytes = rf->bytes;
     gb->width = (int)width;
     gb->height = (int)height;
     gb->display_x = (int32_t)dx;
@@ -639,21 +629,18 @@ static obs_status get_deep_fields(reader *r, const obs_limits *lim, deep_fields 
     return OBS_OK;
 }
 
-static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request *q, char err[OBS_ERR_LEN])
+/* A deep G-buffer after its fixed fields (get_deep_fields): the
+ * matrices, the counts and the samples. */
+static obs_status decode_deep(reader *r, const deep_fields *f, obs_bin_request *q, char err[OBS_ERR_LEN])
 {
-    deep_fields f;
-    obs_status s = get_deep_fields(r, lim, &f, err);
-    if (s != OBS_OK)
-        return s;
-    uint32_t width = f.w.width, height = f.w.height, dx = f.w.dx, dy = f.w.dy, dw = f.w.dw;
-    uint32_t dh = f.w.dh, flags = f.w.flags;
-    uint64_t total = f.total, npx = f.npx, sample_bytes = f.sample_bytes;
+    uint32_t width = f->w.width, height = f->w.height, dx = f->w.dx, dy = f->w.dy, dw = f->w.dw;
+    uint32_t dh = f->w.dh, flags = f->w.flags, values = f->values;
+    uint64_t total = f->total, npx = f->npx, sample_bytes = f->sample_bytes;
     get_camera(r, flags, &q->deep.camera);
     const unsigned char *cp = r->p + r->off;
     uint64_t sum = 0;
     for (uint64_t i = 0; i < npx; i++) {
-        uint32_t c = (uint32_t)cp[4 * i] | (uint32_t)cp[4 * i + 1] << 8 | (uint32_t)cp[4 * i + 2] << 16 |
-                     (uint32_t)cp[4 * i + 3] << 24;
+        uint32_t c = (uint32_t)le_bytes(cp + 4 * i, 4);
         if (c > OBS_DEEP_MAX_PER_PIXEL)
             return fail(err, OBS_TOO_LARGE, "deep G-buffer: pixel (%llu, %llu) holds %u samples, over the "
                         "limit of %d", (unsigned long long)(i % width), (unsigned long long)(i / width), c,
@@ -668,16 +655,15 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
         return fail(err, OBS_NO_MEMORY, "no memory for the offsets of %u x %u pixels", width, height);
     d->offset[0] = 0;
     for (uint64_t i = 0; i < npx; i++)
-        d->offset[i + 1] = d->offset[i] + ((uint32_t)cp[4 * i] | (uint32_t)cp[4 * i + 1] << 8 |
-                                           (uint32_t)cp[4 * i + 2] << 16 | (uint32_t)cp[4 * i + 3] << 24);
+        d->offset[i + 1] = d->offset[i] + le_bytes(cp + 4 * i, 4);
     r->off += (size_t)npx * 4;
-    if (total && f.values != OBS_DEEP_CH) {
+    if (total && values != OBS_DEEP_CH) {
         /* the layout without Facing: widened, facing 0 (not known) */
         if (!(q->gf.storage = calloc((size_t)total, OBS_DEEP_CH * sizeof(float))))
             return fail(err, OBS_NO_MEMORY, "no memory for %llu deep samples", (unsigned long long)total);
         for (uint64_t k = 0; k < total; k++)
-            memcpy(q->gf.storage + k * OBS_DEEP_CH, r->p + r->off + k * f.values * sizeof(float),
-                   f.values * sizeof(float));
+            memcpy(q->gf.storage + k * OBS_DEEP_CH, r->p + r->off + k * values * sizeof(float),
+                   values * sizeof(float));
         d->samples = q->gf.storage;
     } else if (total && ((uintptr_t)(r->p + r->off) & 3u) != 0) {
         if (!(q->gf.storage = malloc((size_t)sample_bytes)))
@@ -711,77 +697,22 @@ static obs_status decode_deep(reader *r, const obs_limits *lim, obs_bin_request 
     return OBS_OK;
 }
 
-obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, const obs_limits *lim,
-                                  obs_bin_request *out, char err[OBS_ERR_LEN])
-{
-    reader r = {payload, len, 0, "request"};
-    uint32_t count;
-    unsigned body;
-    obs_status s;
-    memset(out, 0, sizeof *out);
-    obs_http_request_init(&out->hr);
-    if (!get_u32(&r, &count))
-        return truncated(&r, "parameter count", err);
-    if (count > OBS_BIN_MAX_PARAMS)
-        return fail(err, OBS_BAD_FILE, "malformed request: %u parameters (at most %d)", count,
-                    OBS_BIN_MAX_PARAMS);
-    for (uint32_t i = 0; i < count; i++) {
-        char name[OBS_BIN_MAX_NAME + 1], value[OBS_BIN_MAX_VALUE + 1];
-        if ((s = get_param(&r, i, name, value, err)) != OBS_OK)
-            return s;
-        if ((s = request_param(out, name, value, err)) != OBS_OK)
-            return s;
-    }
-    if ((s = obs_http_request_check(&out->hr, err)) != OBS_OK)
-        return s;
-    if (out->raw_out && out->hr.format != OBS_HTTP_EXR)
-        return fail(err, OBS_INVALID_ARGUMENT, "format: raw and png at once");
-    if (out->raw_out && (out->hr.outputs & OBS_OUTPUT_DEEP))
-        return fail(err, OBS_INVALID_ARGUMENT, "output=deep answers a deep EXR: it needs format=exr, not raw");
-    if (out->raw_out && out->hr.append)
-        return fail(err, OBS_INVALID_ARGUMENT, "append=1 writes an EXR: it needs format=exr, not raw");
-    if (!get_u8(&r, &body))
-        return truncated(&r, "G-buffer kind", err);
-    if (!get_pad8(&r))
-        return truncated(&r, "padding", err);
-    if (body == OBS_BIN_EXR) {
-        uint64_t n;
-        if (!get_u64(&r, &n))
-            return truncated(&r, "EXR length", err);
-        if (n != r.n - r.off)
-            return fail(err, OBS_BAD_FILE, "malformed request: EXR of %llu bytes, the frame holds %zu",
-                        (unsigned long long)n, r.n - r.off);
-        if (n == 0)
-            return fail(err, OBS_BAD_FILE, "malformed request: empty EXR");
-        out->body = OBS_BIN_EXR;
-        out->exr = r.p + r.off;
-        out->exr_len = (size_t)n;
-        return OBS_OK;
-    }
-    if (body == OBS_BIN_DEEP) {
-        out->body = OBS_BIN_DEEP;
-        s = decode_deep(&r, lim, out, err);
-        if (s != OBS_OK)
-            obs_bin_request_free(out);
-        return s;
-    }
-    if (body != OBS_BIN_RAW)
-        return fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is not EXR (1), raw (2) "
-                    "or deep (4)", body);
-    out->body = OBS_BIN_RAW;
-    s = decode_raw(&r, lim, out, err);
-    if (s != OBS_OK)
-        obs_bin_request_free(out);
-    return s;
-}
+/* A G-buffer's fixed fields, as parse_head leaves them for the body. */
+typedef union body_fields {
+    raw_fields raw;
+    deep_fields deep;
+} body_fields;
 
-/* The head, read and checked as obs_bin_request_decode() does, in the
- * same order (so the first error is the same); q is scratch. */
+/* A request's head, read and checked: the parameters into q (their
+ * framing first: the token is known even when a value is bad), their
+ * checks, the G-buffer's kind, an EXR's length or a raw or deep
+ * G-buffer's fixed fields into *bf (the reader left before its
+ * matrices).  obs_bin_request_head() and obs_bin_request_decode() both
+ * read requests through it, so the first error is the same. */
 static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, obs_bin_request *q,
-                             char err[OBS_ERR_LEN])
+                             body_fields *bf, char err[OBS_ERR_LEN])
 {
-    uint32_t count;
-    unsigned body;
+    uint32_t count, body;
     obs_status s = OBS_OK;
     memset(q, 0, sizeof *q);
     obs_http_request_init(&q->hr);
@@ -790,8 +721,7 @@ static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, 
     if (count > OBS_BIN_MAX_PARAMS)
         return fail(err, OBS_BAD_FILE, "malformed request: %u parameters (at most %d)", count,
                     OBS_BIN_MAX_PARAMS);
-    /* every parameter's framing first: the token is known even when a
-     * value is bad (the value's error is the answer, after the token) */
+    /* a bad value's error is the answer, after the token */
     obs_status bad_value = OBS_OK;
     char bad_err[OBS_ERR_LEN] = "";
     for (uint32_t i = 0; i < count; i++) {
@@ -828,27 +758,44 @@ static obs_status parse_head(reader *r, const obs_limits *lim, obs_bin_head *h, 
                         (unsigned long long)n, full - r->off);
         if (n == 0)
             return fail(err, OBS_BAD_FILE, "malformed request: empty EXR");
-    } else if (body == OBS_BIN_DEEP) {
-        deep_fields f;
-        if ((s = get_deep_fields(r, lim, &f, err)) != OBS_OK)
+    } else if (body == OBS_BIN_DEEP || body == OBS_BIN_RAW) {
+        q->body = (obs_bin_body)body;
+        s = body == OBS_BIN_DEEP ? get_deep_fields(r, lim, &bf->deep, err)
+                                 : get_raw_fields(r, lim, &bf->raw, err);
+        if (s != OBS_OK)
             return s;
-        r->off += 128; /* the matrices: have() counted them in */
-        h->width = f.w.width;
-        h->height = f.w.height;
-    } else if (body == OBS_BIN_RAW) {
-        raw_fields f;
-        if ((s = get_raw_fields(r, lim, &f, err)) != OBS_OK)
-            return s;
-        r->off += 128;
-        h->width = f.w.width;
-        h->height = f.w.height;
+        const window_fields *w = body == OBS_BIN_DEEP ? &bf->deep.w : &bf->raw.w;
+        h->width = w->width;
+        h->height = w->height;
     } else {
         return fail(err, OBS_BAD_FILE, "malformed request: G-buffer kind %u is not EXR (1), raw (2) "
                     "or deep (4)", body);
     }
     h->body = (obs_bin_body)body;
-    h->len = r->off;
     return OBS_OK;
+}
+
+obs_status obs_bin_request_decode(const unsigned char *payload, size_t len, const obs_limits *lim,
+                                  obs_bin_request *out, char err[OBS_ERR_LEN])
+{
+    reader r = {payload, len, 0, "request"};
+    obs_bin_head h;
+    body_fields bf;
+    memset(&h, 0, sizeof h);
+    obs_status s = parse_head(&r, lim, &h, out, &bf, err);
+    if (s != OBS_OK)
+        return s;
+    if (h.body == OBS_BIN_EXR) {
+        out->body = OBS_BIN_EXR;
+        out->exr = r.p + r.off;
+        out->exr_len = r.n - r.off; /* the EXR's length, checked */
+        return OBS_OK;
+    }
+    s = h.body == OBS_BIN_DEEP ? decode_deep(&r, &bf.deep, out, err)
+                               : decode_raw(&r, &bf.raw, out, err);
+    if (s != OBS_OK)
+        obs_bin_request_free(out);
+    return s;
 }
 
 obs_status obs_bin_request_head(const unsigned char *p, size_t have_len, size_t len, const obs_limits *lim,
@@ -856,13 +803,17 @@ obs_status obs_bin_request_head(const unsigned char *p, size_t have_len, size_t 
 {
     reader r = {p, have_len < len ? have_len : len, 0, "request", len, 0};
     obs_bin_request scratch;
+    body_fields bf;
     memset(h, 0, sizeof *h);
-    obs_status s = parse_head(&r, lim, h, &scratch, err);
+    obs_status s = parse_head(&r, lim, h, &scratch, &bf, err);
     *need = r.want;
     if (r.want) {
         h->len = 0;
         return OBS_OK;
     }
+    if (s == OBS_OK && h->body != OBS_BIN_EXR)
+        r.off += 128; /* the matrices: have() counted them in */
+    h->len = s == OBS_OK ? r.off : 0;
     return s;
 }
 
@@ -902,8 +853,9 @@ static const char *warning_lines(const obs_bin_response_desc *d, char *out)
     return out;
 }
 
-static void write_response(writer *w, const obs_bin_response_desc *d, uint64_t payload_len)
+static void write_response(writer *w, const void *desc, uint64_t payload_len)
 {
+    const obs_bin_response_desc *d = desc;
     unsigned char hdr[OBS_BIN_HEADER_LEN];
     char lines[OBS_BIN_MAX_MESSAGE + 1];
     obs_bin_header_write(hdr, OBS_BIN_RESPONSE, d->id, payload_len);
@@ -954,16 +906,7 @@ obs_status obs_bin_response_encode(const obs_bin_response_desc *d, obs_bytes *ou
                             im->channels);
         }
     }
-    writer w = {NULL, 0};
-    write_response(&w, d, 0);
-    if (!(w.p = malloc(w.n)))
-        return fail(err, OBS_NO_MEMORY, "no memory for a %zu-byte response", w.n);
-    size_t total = w.n;
-    w.n = 0;
-    write_response(&w, d, total - OBS_BIN_HEADER_LEN);
-    out->data = w.p;
-    out->size = total;
-    return OBS_OK;
+    return write_frame(write_response, d, "response", out, err);
 }
 
 /* A 200's message into its lines, the warnings (empty lines skipped). */
@@ -984,8 +927,7 @@ obs_status obs_bin_response_decode(const unsigned char *payload, size_t len, con
                                    obs_bin_response *out, char err[OBS_ERR_LEN])
 {
     reader r = {payload, len, 0, "response"};
-    unsigned status, retry, cl, body;
-    uint32_t ml;
+    uint32_t status, retry, cl, body, ml;
     obs_status s = OBS_OK;
     memset(out, 0, sizeof *out);
     if (!get_u16(&r, &status) || !get_u16(&r, &retry) || !get_u16(&r, &cl))

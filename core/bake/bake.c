@@ -12,17 +12,6 @@
 #include "bake/shard.h"
 #include "internal.h"
 
-static const char *const stage_names[] = {
-#define X(n, d) #n,
-    OBS_BAKE_STAGE_LIST(X)
-#undef X
-};
-
-const char *obs_bake_stage_name(int stage)
-{
-    return stage >= 0 && stage < OBS_BAKE_STAGE_COUNT ? stage_names[stage] : "?";
-}
-
 void obs_bake_result_free(obs_bake_result *r)
 {
     if (!r)
@@ -159,12 +148,6 @@ static obs_status holdout(const obs__bake_world *w, const obs__bake_weld *wd,
     return rc;
 }
 
-obs_status obs_bake_run(const obs_bake_scene *scene, const obs_bake_desc *desc,
-                        obs_bake_result *out, char err[OBS_ERR_LEN])
-{
-    return obs__bake_run_shard(scene, desc, NULL, out, err);
-}
-
 /* The steps; with a shard (shard.c) the trace is its step instead: one
  * shard's samples traced and written (then the bake stops there), or
  * every shard's read back. */
@@ -212,7 +195,7 @@ static obs_status flatten_stage(const obs_bake_scene *scene, const obs_bake_desc
 /* Eq 1 at every sample (trace.c), or, for a shard or a merge, shard.c's
  * step in its place; t: when the stage began. */
 static obs_status trace_stage(const obs_bake_desc *desc, const obs_bake_params *p,
-                              const obs__bake_decor *dc, obs__bake_shard *sh,
+                              const obs__bake_decor *dc, obs__part_job *sh,
                               const obs__bake_world *w, obs__bake_samples *s, double t,
                               obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
@@ -224,7 +207,7 @@ static obs_status trace_stage(const obs_bake_desc *desc, const obs_bake_params *
     td.tree_attenuation = p->tree_attenuation;
     double bvh = 0.0;
     if (sh) {
-        if ((rc = obs__bake_shard_step(sh, w, s, &td, st, err)) != OBS_OK)
+        if ((rc = obs__bake_shard_step(sh, w, s, &td, p, st, err)) != OBS_OK)
             return rc;
     } else {
         if ((rc = obs__bake_trace(w, s, &td, &bvh, err)) != OBS_OK)
@@ -237,12 +220,10 @@ static obs_status trace_stage(const obs_bake_desc *desc, const obs_bake_params *
     return OBS_OK;
 }
 
-obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc *desc,
-                               obs__bake_shard *sh, obs_bake_result *out, char err[OBS_ERR_LEN])
+static obs_status steps(const obs_bake_scene *scene, const obs_bake_desc *desc,
+                        const obs_bake_params *p, obs__part_job *sh, obs_bake_result *out,
+                        char err[OBS_ERR_LEN])
 {
-    memset(out, 0, sizeof *out);
-    obs_bake_params p;
-    obs_bake_params_resolve(desc ? &desc->params : NULL, &p);
     obs_bake_stats *st = &out->stats;
     obs__bake_world w = {0};
     obs__bake_samples s = {0};
@@ -254,26 +235,26 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
     size_t inst_n = 0;
     obs_status rc;
     double t = obs__bake_now();
-    if ((rc = flatten_stage(scene, desc, &p, &w, &dc, &inst_sel, &inst_n, &area_kept, st, err)) !=
+    if ((rc = flatten_stage(scene, desc, p, &w, &dc, &inst_sel, &inst_n, &area_kept, st, err)) !=
         OBS_OK)
         goto done;
     st->seconds[OBS_BAKE_STAGE_flatten] = obs__bake_now() - t;
 
     t = obs__bake_now();
-    if ((rc = obs__bake_samples_make(&w, p.samples_per_face, p.max_samples_per_face,
-                                     (uint64_t)p.seed, &s, err)) != OBS_OK)
+    if ((rc = obs__bake_samples_make(&w, p->samples_per_face, p->max_samples_per_face,
+                                     (uint64_t)p->seed, &s, err)) != OBS_OK)
         goto done;
     st->samples = s.count;
     st->seconds[OBS_BAKE_STAGE_samples] = obs__bake_now() - t;
 
     t = obs__bake_now();
-    if ((rc = trace_stage(desc, &p, &dc, sh, &w, &s, t, st, err)) != OBS_OK)
+    if ((rc = trace_stage(desc, p, &dc, sh, &w, &s, t, st, err)) != OBS_OK)
         goto done;
     if (sh && sh->stop) /* a shard: its part is written; the merge fits */
         goto done;
 
     t = obs__bake_now();
-    if ((rc = obs__bake_weld_make(&w, p.weld_tolerance, p.weld_angle, &wd, err)) != OBS_OK)
+    if ((rc = obs__bake_weld_make(&w, p->weld_tolerance, p->weld_angle, &wd, err)) != OBS_OK)
         goto done;
     st->welded_vertices = wd.count;
     st->seconds[OBS_BAKE_STAGE_weld] = obs__bake_now() - t;
@@ -286,16 +267,16 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
         rc = obs__fail(err, OBS_NO_MEMORY, "solution of %zu vertices", wd.count);
         goto done;
     }
-    if ((rc = obs__bake_fit(&w, &wd, &s, &p, x, face, point, st, err)) != OBS_OK)
+    if ((rc = obs__bake_fit(&w, &wd, &s, p, x, face, point, st, err)) != OBS_OK)
         goto done;
     if (inst_n)
         obs__bake_instanced_uncount(&w, &wd, inst_sel, st);
-    if (p.holdout > 0.0f && (rc = holdout(&w, &wd, &dc, &p, x, face, point, st, err)) != OBS_OK)
+    if (p->holdout > 0.0f && (rc = holdout(&w, &wd, &dc, p, x, face, point, st, err)) != OBS_OK)
         goto done;
-    if ((rc = copy_back(scene, &w, &wd, x, p.blend, out, err)) != OBS_OK)
+    if ((rc = copy_back(scene, &w, &wd, x, p->blend, out, err)) != OBS_OK)
         goto done;
     if (inst_n) {
-        rc = obs__bake_instanced_run(scene, &w, inst_sel, &p, desc, s.count, &dc, local_ao, out,
+        rc = obs__bake_instanced_run(scene, &w, inst_sel, p, desc, s.count, &dc, local_ao, out,
                                      err);
         if (rc == OBS_OK)
             results_into_solution(scene, &w, &wd, inst_sel, out, x);
@@ -304,14 +285,14 @@ obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc 
         if (rc != OBS_OK)
             goto done;
     }
-    if ((rc = obs__bake_small(scene, &w, wd.of, &dc, x, &p, out, err)) != OBS_OK)
+    if ((rc = obs__bake_small(scene, &w, wd.of, &dc, x, p, out, err)) != OBS_OK)
         goto done;
-    if (out->node_ao && p.lods) { /* the small decorators' scalars, for the LODs too */
+    if (out->node_ao && p->lods) { /* the small decorators' scalars, for the LODs too */
         for (size_t i = 0; i < w.instance_count; i++) /* NaN: not one, or unresolved */
             inst_sel[i] = !isnan(out->node_ao[3 * w.inst[i].node]);
         results_into_solution(scene, &w, &wd, inst_sel, out, x);
     }
-    rc = obs__bake_lods(scene, &w, &wd, x, &p, out, err); /* lod.c, paper 2.2.1 */
+    rc = obs__bake_lods(scene, &w, &wd, x, p, out, err); /* lod.c, paper 2.2.1 */
 done:
     free(area_kept);
     free(inst_sel);
@@ -322,10 +303,9 @@ done:
     obs__bake_decor_free(&dc);
     obs__bake_samples_free(&s);
     obs__bake_world_free(&w);
-    if (rc != OBS_OK) {
-        obs_bake_stats keep = out->stats;
-        obs_bake_result_free(out);
-        out->stats = keep;
-    }
     return rc;
 }
+
+/* obs_bake_stage_name, obs_bake_run and obs__bake_run_job (the steps
+ * with a shard's or a merge's job, shard_run.c's), level/part.h's. */
+OBS__BAKE_ENTRY(bake, BAKE, obs_bake_run, steps)

@@ -43,6 +43,7 @@
  * other.  A shard writes its part under PATH.tmp and renames it, so a
  * killed shard leaves no part that looks whole. */
 #include <errno.h>
+#include <stddef.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -60,6 +61,33 @@
 #define FNV_OFFSET OBS__BAKE_FNV_OFFSET
 #define FNV_PRIME 0x100000001b3ULL
 
+/* The header's fields after the range: offset, type, member, and the
+ * bake parameter it carries (shard_run.c's merge checks those). */
+#define FIELD(at, type, member, param) {at, OBS__PART_##type, offsetof(obs__bake_part, member), param}
+static const obs__part_field fields[] = {
+    FIELD(56, U64, rays, NULL),
+    FIELD(64, U64, dropped, NULL),
+    FIELD(72, I32, rays_per_sample, "rays"),
+    FIELD(76, I32, seed, "seed"),
+    FIELD(80, I32, max_samples_per_face, "max_samples_per_face"),
+    FIELD(84, F32, samples_per_face, "samples_per_face"),
+    FIELD(88, F32, distance_short, "distance_short"),
+    FIELD(92, F32, distance_long, "distance_long"),
+    FIELD(96, F32, backface_limit, "backface_limit"),
+    FIELD(104, F64, bvh_seconds, NULL),
+    FIELD(112, F64, trace_seconds, NULL),
+    FIELD(120, U64, checksum, NULL),
+};
+#undef FIELD
+_Static_assert(HEADER <= OBS__PART_HEAD_MAX, "a part's header fits obs__part_write's buffer");
+
+const obs__part_format obs__bake_part_format = {
+    .magic = MAGIC, .what = "bake part", .writer = "obscura bake --shard I/N", .kind = "part",
+    .items = "samples", .version = VERSION, .head_len = HEADER, .max_total = UINT32_MAX,
+    .item_bytes = 9, .part_size = sizeof(obs__bake_part), .fields = fields,
+    .field_count = sizeof fields / sizeof fields[0], .param_find = obs_bake_param_find,
+    .param_at = obs_bake_param_at, .params_given = offsetof(obs_bake_params, set)};
+
 static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_trace_desc *td)
 {
     return td ? obs__bake_traced_fingerprint(w, td->decor, td->tree_attenuation)
@@ -67,23 +95,6 @@ static uint64_t traced_fingerprint(const obs__bake_world *w, const obs__bake_tra
 }
 
 /* ---- writing a part ----------------------------------------------------- */
-
-static void header_bytes(const obs__bake_part *h, unsigned char b[HEADER])
-{
-    obs__part_range_put(b, HEADER, MAGIC, &h->r);
-    obs__le_put64(b + 56, h->rays);
-    obs__le_put64(b + 64, h->dropped);
-    obs__le_put32(b + 72, (uint32_t)h->rays_per_sample);
-    obs__le_put32(b + 76, (uint32_t)h->seed);
-    obs__le_put32(b + 80, (uint32_t)h->max_samples_per_face);
-    obs__le_put32(b + 84, obs__le_fbits(h->samples_per_face));
-    obs__le_put32(b + 88, obs__le_fbits(h->distance_short));
-    obs__le_put32(b + 92, obs__le_fbits(h->distance_long));
-    obs__le_put32(b + 96, obs__le_fbits(h->backface_limit));
-    obs__le_put64(b + 104, obs__le_dbits(h->bvh_seconds));
-    obs__le_put64(b + 112, obs__le_dbits(h->trace_seconds));
-    obs__le_put64(b + 120, h->checksum);
-}
 
 /* The payload of samples [first, first + n) as the file holds it. */
 static unsigned char *payload_bytes(const obs__bake_samples *s, size_t first, size_t n)
@@ -112,7 +123,7 @@ static void part_params(obs__bake_part *h, const obs__bake_trace_desc *td, const
     }
 }
 
-static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs__bake_samples *s,
+static obs_status trace_shard(obs__part_job *sh, const obs__bake_world *w, obs__bake_samples *s,
                               const obs__bake_trace_desc *td, const obs_bake_params *p,
                               obs_bake_stats *st, char err[OBS_ERR_LEN])
 {
@@ -139,9 +150,7 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
     if (!payload)
         return obs__fail(err, OBS_NO_MEMORY, "the part of %zu samples", n);
     h.checksum = obs__bake_fnv(FNV_OFFSET, payload, n * 9);
-    unsigned char head[HEADER];
-    header_bytes(&h, head);
-    rc = obs__bake_part_write(sh->path, head, HEADER, payload, n * 9, err);
+    rc = obs__part_write(sh->path, &obs__bake_part_format, &h, payload, n * 9, err);
     free(payload);
     st->seconds[OBS_BAKE_STAGE_bvh] = h.bvh_seconds;
     st->seconds[OBS_BAKE_STAGE_trace] = h.trace_seconds;
@@ -151,31 +160,6 @@ static obs_status trace_shard(obs__bake_shard *sh, const obs__bake_world *w, obs
 }
 
 /* ---- reading parts ------------------------------------------------------- */
-
-static const obs__part_format format = {MAGIC, "bake part", "obscura bake --shard I/N", "part",
-                                       "samples", VERSION, HEADER, UINT32_MAX, 9};
-
-obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN])
-{
-    unsigned char b[HEADER];
-    *h = (obs__bake_part){0};
-    obs_status rc = obs__part_range_read(path, &format, b, &h->r, err);
-    if (rc != OBS_OK)
-        return rc;
-    h->rays = obs__le_get64(b + 56);
-    h->dropped = obs__le_get64(b + 64);
-    h->rays_per_sample = (int32_t)obs__le_get32(b + 72);
-    h->seed = (int32_t)obs__le_get32(b + 76);
-    h->max_samples_per_face = (int32_t)obs__le_get32(b + 80);
-    h->samples_per_face = obs__le_bitsf(obs__le_get32(b + 84));
-    h->distance_short = obs__le_bitsf(obs__le_get32(b + 88));
-    h->distance_long = obs__le_bitsf(obs__le_get32(b + 92));
-    h->backface_limit = obs__le_bitsf(obs__le_get32(b + 96));
-    h->bvh_seconds = obs__le_bitsd(obs__le_get64(b + 104));
-    h->trace_seconds = obs__le_bitsd(obs__le_get64(b + 112));
-    h->checksum = obs__le_get64(b + 120);
-    return OBS_OK;
-}
 
 static obs_status read_payload(const obs__bake_part *h, obs__bake_samples *s, char err[OBS_ERR_LEN])
 {
@@ -193,12 +177,13 @@ static obs_status read_payload(const obs__bake_part *h, obs__bake_samples *s, ch
     return OBS_OK;
 }
 
-static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs__bake_samples *s,
+static obs_status read_shards(obs__part_job *sh, const obs__bake_world *w, obs__bake_samples *s,
                               const obs__bake_trace_desc *td, obs_bake_stats *st,
                               char err[OBS_ERR_LEN])
 {
     uint64_t level = traced_fingerprint(w, td);
-    const obs__part_range *p0 = &sh->parts[0].r;
+    const obs__bake_part *parts = sh->parts;
+    const obs__part_range *p0 = &parts[0].r;
     obs_status rc = obs__part_check_level(p0->path, p0->level, level, err);
     if (rc != OBS_OK)
         return rc;
@@ -210,23 +195,24 @@ static obs_status read_shards(obs__bake_shard *sh, const obs__bake_world *w, obs
     s->rays = 0;
     s->dropped = 0;
     for (int i = 0; i < sh->count; i++) {
-        rc = read_payload(&sh->parts[i], s, err);
+        rc = read_payload(&parts[i], s, err);
         if (rc != OBS_OK)
             return rc;
-        s->rays += sh->parts[i].rays;
-        s->dropped += (size_t)sh->parts[i].dropped;
+        s->rays += parts[i].rays;
+        s->dropped += (size_t)parts[i].dropped;
         /* the parts' times, summed: the farm's machine time */
-        st->seconds[OBS_BAKE_STAGE_bvh] += sh->parts[i].bvh_seconds;
-        st->seconds[OBS_BAKE_STAGE_trace] += sh->parts[i].trace_seconds;
+        st->seconds[OBS_BAKE_STAGE_bvh] += parts[i].bvh_seconds;
+        st->seconds[OBS_BAKE_STAGE_trace] += parts[i].trace_seconds;
     }
     st->seconds[OBS_BAKE_STAGE_trace] += obs__bake_now() - t;
     return OBS_OK;
 }
 
-obs_status obs__bake_shard_step(obs__bake_shard *sh, const obs__bake_world *w,
+obs_status obs__bake_shard_step(obs__part_job *sh, const obs__bake_world *w,
                                 obs__bake_samples *s, const obs__bake_trace_desc *td,
-                                obs_bake_stats *st, char err[OBS_ERR_LEN])
+                                const obs_bake_params *p, obs_bake_stats *st,
+                                char err[OBS_ERR_LEN])
 {
-    return sh->parts ? read_shards(sh, w, s, td, st, err) : trace_shard(sh, w, s, td, &sh->params, st, err);
+    return sh->parts ? read_shards(sh, w, s, td, st, err) : trace_shard(sh, w, s, td, p, st, err);
 }
 

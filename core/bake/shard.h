@@ -16,28 +16,21 @@ typedef struct obs__bake_part {
     uint64_t checksum;          /* FNV-1a 64 of the payload */
 } obs__bake_part;
 
-/* What the bake does instead of its trace: with path, trace shard
- * index/count and write it there (stop is set: the bake ends after the
- * step); with parts (count of them, shard order), read every shard's
- * samples back and go on to the fit. */
-typedef struct obs__bake_shard {
-    obs_bake_params params; /* resolved */
-    int index, count;
-    const char *path;
-    const obs__bake_part *parts;
-    int stop;
-} obs__bake_shard;
-
-/* bake.c: obs_bake_run's steps with the hook (sh NULL: obs_bake_run). */
-obs_status obs__bake_run_shard(const obs_bake_scene *scene, const obs_bake_desc *desc,
-                               obs__bake_shard *sh, obs_bake_result *out, char err[OBS_ERR_LEN]);
-/* shard.c: the step; fills st's trace rows (times, rays, samples). */
-obs_status obs__bake_shard_step(obs__bake_shard *sh, const obs__bake_world *w,
+/* bake.c: obs_bake_run's steps with a shard's or a merge's job in place
+ * of the trace (sh NULL: obs_bake_run); sh->parts are obs__bake_parts.
+ * level/part.h's OBS__BAKE_ENTRY. */
+obs_status obs__bake_run_job(const obs_bake_scene *scene, const obs_bake_desc *desc,
+                             obs__part_job *sh, obs_bake_result *out, char err[OBS_ERR_LEN]);
+/* shard.c: the step (p: the bake's resolved parameters); fills st's
+ * trace rows (times, rays, samples). */
+obs_status obs__bake_shard_step(obs__part_job *sh, const obs__bake_world *w,
                                 obs__bake_samples *s, const obs__bake_trace_desc *td,
-                                obs_bake_stats *st, char err[OBS_ERR_LEN]);
+                                const obs_bake_params *p, obs_bake_stats *st,
+                                char err[OBS_ERR_LEN]);
 
-/* Reads and checks a part's header (magic, version, sizes, the file's
- * length against its count). */
-obs_status obs__bake_part_read_header(const char *path, obs__bake_part *h, char err[OBS_ERR_LEN]);
+/* The part file's layout (shard.c): its header's fields, the bake
+ * parameters they carry (obs__part_header_read reads one, with its
+ * checks: magic, version, sizes, the file's length against its count). */
+extern const obs__part_format obs__bake_part_format;
 
 #endif

@@ -21,6 +21,20 @@ void obs__cpu_rows(int height, int rows, void (*fn)(void *ctx, int y0, int y1), 
 void obs__cpu_tiles(int width, int height, int tw, int th,
                     void (*fn)(void *ctx, int x0, int x1, int y0, int y1), void *ctx);
 
+/* A frame run in bands (bands_run.c): the rows each pass computes.  While
+ * a window is set on the calling thread, obs__cpu_rows and obs__cpu_tiles
+ * over a height the window names run only its rows [lo, hi) of that
+ * height (every pixel's arithmetic unchanged: the frame keeps its whole
+ * size and coordinates).  Heights it does not name run whole. */
+#define OBS__CPU_WINDOWS 3
+typedef struct obs__cpu_window {
+    int height[OBS__CPU_WINDOWS]; /* 0: an unused entry */
+    int lo[OBS__CPU_WINDOWS], hi[OBS__CPU_WINDOWS];
+} obs__cpu_window;
+
+/* Sets the calling thread's window (NULL: none); returns the previous. */
+const obs__cpu_window *obs__cpu_window_set(const obs__cpu_window *w);
+
 /* The thread count of the CPU chain: the pool's one rule
  * (obs__pool_threads) on the count set below, 0 by default. */
 int obs__cpu_threads(void);

@@ -22,6 +22,17 @@ typedef struct obs__cpu_run {
     /* each pixel's depth and view normal z, packed (vao_cpu.h), at the
      * AO's size: what the AO's samples read */
     float *dnz;
+    /* a frame run in bands (bands_run.c): the full-size rows [row0,
+     * row1) the planes hold, the half-size ones [hrow0, hrow1), the
+     * culling texels' [crow0, crow1); each plane pointer is then that of
+     * the frame's row 0 (its rows outside those never touched), so the
+     * passes index the planes by the frame's coordinates.  row1 0: the
+     * whole frame */
+    int row0, row1, hrow0, hrow1, crow0, crow1;
+    /* ... of those, the rows the AO's planes hold (ao, tmp, bleed at full
+     * size; hao, htmp, hbleed at half size): the rows the AO, the blur
+     * and the passes after them compute, not the halo */
+    int arow0, arow1, harow0, harow1;
     void *block;                                    /* where the planes are */
     size_t block_size;
     /* the deadline (CLOCK_MONOTONIC ms; 0: none); stopped: a tile found
@@ -33,6 +44,9 @@ typedef struct obs__cpu_run {
 /* The planes of c's plan, in one block: the one the last frame gave back
  * when it fits, else a new one (planes_cpu.c). */
 obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN]);
+
+/* The bytes obs__cpu_planes_take would take for c (its rows, when set). */
+size_t obs__cpu_planes_need(const obs__cpu_run *c);
 
 /* Gives the block back, to be kept for the next frame (the larger of it
  * and the one kept is kept, the other freed). */

@@ -39,36 +39,74 @@ static void *take(size_t need, size_t *size)
     return b;
 }
 
-obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN])
+/* The bytes of each plane of c's frame (or band), in planes' order. */
+#define PLANES 15
+static size_t plane_sizes(const obs__cpu_run *c, size_t sizes[PLANES])
 {
     const obs__frame *f = &c->pl->f, *af = c->pl->af;
-    const size_t n = c->npx, an = (size_t)af->width * (size_t)af->height;
+    const int banded = c->row1 > 0; /* the rows of a band (passes_cpu.h) */
+    const size_t n = banded ? (size_t)f->width * (size_t)(c->row1 - c->row0) : c->npx;
+    const size_t an = (size_t)af->width *
+                      (size_t)(!banded ? af->height : f->half ? c->hrow1 - c->hrow0 : c->row1 - c->row0);
+    const size_t cn = (size_t)f->cull_w * (size_t)(banded ? c->crow1 - c->crow0 : f->cull_h);
+    /* the AO's planes: a band's AO rows only */
+    const size_t nao = banded ? (size_t)f->width * (size_t)(c->arow1 - c->arow0) : n;
+    const size_t anao = banded && f->half ? (size_t)af->width * (size_t)(c->harow1 - c->harow0) : an;
     /* colour, packed RGBA, for sections 4.3 and 4.7 */
     const int col = f->luminance || f->bleed_step;
     /* the bleed term (4.7) only where the composite or the output reads
      * it (the AO pass writes it nowhere else): 12 bytes a pixel */
     const int bleed = f->bleed_step || (c->pl->outputs & OBS_OUTPUT_BLEED);
-    const size_t sizes[] = {
-        lines(n * 4), lines(n * 3), lines(n), lines(n), lines((size_t)f->cull_w * (size_t)f->cull_h),
-        bleed ? lines(n * 3) : 0, col ? lines(n * 4) : 0,
-        f->half ? lines(an * 4) : 0, f->half ? lines(an * 3) : 0, f->half ? lines(an) : 0,
-        f->half ? lines(an) : 0, f->half && bleed ? lines(an * 3) : 0, lines(an * 2),
+    const size_t s[PLANES] = {
+        lines(n * 4), lines(n * 3), lines(nao), lines(nao), lines(cn),
+        bleed ? lines(nao * 3) : 0, col ? lines(n * 4) : 0,
+        f->half ? lines(an * 4) : 0, f->half ? lines(an * 3) : 0, f->half ? lines(anao) : 0,
+        f->half ? lines(anao) : 0, f->half && bleed ? lines(anao * 3) : 0, lines(an * 2),
         f->half && f->mask_occl ? lines(an) : 0, f->half && f->mask_id ? lines(an) : 0,
     };
-    float **planes[] = {&c->pos,  &c->nrm,  &c->ao,   &c->tmp,  &c->est,    &c->bleed,
-                        &c->col,  &c->hpos, &c->hnrm, &c->hao,  &c->htmp,   &c->hbleed,
-                        &c->dnz,  &c->hmask_w, &c->hmask_id};
     size_t need = 0;
-    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
-        need += sizes[i];
+    for (int i = 0; i < PLANES; i++)
+        need += sizes[i] = s[i];
+    return need;
+}
+
+size_t obs__cpu_planes_need(const obs__cpu_run *c)
+{
+    size_t sizes[PLANES];
+    return plane_sizes(c, sizes);
+}
+
+obs_status obs__cpu_planes_take(obs__cpu_run *c, char err[OBS_ERR_LEN])
+{
+    const obs__frame *f = &c->pl->f, *af = c->pl->af;
+    size_t sizes[PLANES];
+    const size_t need = plane_sizes(c, sizes);
+    float **planes[PLANES] = {&c->pos,  &c->nrm,  &c->ao,   &c->tmp,  &c->est,    &c->bleed,
+                              &c->col,  &c->hpos, &c->hnrm, &c->hao,  &c->htmp,   &c->hbleed,
+                              &c->dnz,  &c->hmask_w, &c->hmask_id};
     unsigned char *b = take(need, &c->block_size);
     if (!b)
         return obs__fail(err, OBS_NO_MEMORY, "out of memory for a %dx%d frame", f->width,
                          f->height);
     c->block = b;
-    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
+    for (int i = 0; i < PLANES; i++) {
         *planes[i] = sizes[i] ? (float *)(void *)b : NULL;
         b += sizes[i];
+    }
+    if (c->row1 > 0) { /* a band: each plane's pointer at the frame's row 0 */
+        const size_t fw = (size_t)f->width * (size_t)c->row0, hw = (size_t)af->width * (size_t)c->hrow0;
+        const size_t faw = (size_t)f->width * (size_t)c->arow0, haw = (size_t)af->width * (size_t)c->harow0;
+        const int per_px[PLANES] = {4, 3, 1, 1, 0, 3, 4, 4, 3, 1, 1, 3, 2, 1, 1};
+        /* the first row each plane holds: 0 its band's rows, 1 its AO rows; full or half size */
+        const int ao_rows[PLANES] = {0, 0, 1, 1, 0, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0};
+        for (int i = 0; i < PLANES; i++) {
+            if (!*planes[i] || i == 4)
+                continue;
+            const int half = i >= 7 && (f->half || i != 12); /* dnz (12) at the AO's size */
+            *planes[i] -= (size_t)per_px[i] * (half ? (ao_rows[i] ? haw : hw) : ao_rows[i] ? faw : fw);
+        }
+        if (c->est)
+            c->est -= (size_t)f->cull_w * (size_t)c->crow0;
     }
     c->apos = f->half ? c->hpos : c->pos;
     c->anrm = f->half ? c->hnrm : c->nrm;

@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "chain/bands_run.h"
 #include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
 #include "log.h"
@@ -93,8 +94,10 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
     }
     /* the planes' allocation counts as the upload, as GL's textures do */
     double t0 = times ? now_ms() : 0.0;
-    s = obs__cpu_planes_take(&c, err);
-    /* object masks at half resolution: the downsample's half planes */
+    const int bands = obs__bands_rows(&c, opt); /* 0: the whole frame; else bands_run.c */
+    s = bands ? OBS_OK : obs__cpu_planes_take(&c, err);
+    /* object masks at half resolution: the downsample's half planes (a
+     * band's: set by bands_run.c) */
     pl.hf.mask_occl = c.hmask_w;
     pl.hf.mask_id = c.hmask_id;
     if (s == OBS_OK)
@@ -104,7 +107,7 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
         times->total_ms += now_ms() - t0;
     }
     if (s == OBS_OK)
-        s = walk(&c, times, err);
+        s = bands ? obs__bands_run(&c, &pl, bands, opt, times, err) : walk(&c, times, err);
     if (s == OBS_OK)
         s = obs__multibounce_finish(pl.gb, pl.multibounce, pl.asked, out, err);
     if (s == OBS_OK)

@@ -403,7 +403,9 @@ static inline __attribute__((always_inline)) float estimate_lanes(const obs__fra
         const float fu = floor_lane((m.u[0] * sx + m.u[1] * sy + m.u[2]) / sw);
         const float fv = floor_lane((m.v[0] * sx + m.v[1] * sy + m.v[2]) / sw);
         const int seen = (sw > 0.0f) & (fu >= 0.0f) & (fv >= 0.0f) & (fu < fw) & (fv < fh);
-        const int qx = (int)fu & -seen, qy = (int)fv & -seen; /* 0 off the planes */
+        /* off the planes: the shaded pixel's own (read, then left out), a
+         * pixel a band of rows holds (bands_run.c) */
+        const int qx = seen ? (int)fu : x, qy = seen ? (int)fv : y;
         const int k = qy * w + qx; /* < 2^28 (the frame's size limit) */
         const float d = dnz[2 * k], nzk = dnz[2 * k + 1];
         const int hit = seen & (d > 0.0f);

@@ -384,8 +384,8 @@ static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3]
     if (df->f.method == OBS_METHOD_HEMISPHERE)
         return hemisphere_ao(df, x, y, p, n, interior, self);
     if (df->f.method == OBS_METHOD_GTAO) /* the horizon over every node */
-        return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, self, x,
-                                     y, p, n, NULL, NULL);
+        return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, self,
+                                     df->intervals ? df->end : NULL, x, y, p, n, NULL, NULL);
     if (df->f.method == OBS_METHOD_HBAO)
         return obs__hbao_pixel_nodes(&df->f, df->pos, df->multi ? df->m : 1, self, x, y, p, n,
                                      NULL);

@@ -28,17 +28,6 @@
 #include "level/part.h"
 #include "internal.h"
 
-static const char *const stage_names[] = {
-#define X(n, d) #n,
-    OBS_DYN_STAGE_LIST(X)
-#undef X
-};
-
-const char *obs_dyn_stage_name(int stage)
-{
-    return stage >= 0 && stage < OBS_DYN_STAGE_COUNT ? stage_names[stage] : "?";
-}
-
 void obs_dyn_result_free(obs_dyn_result *r)
 {
     if (!r)
@@ -78,21 +67,13 @@ obs_status obs__dyn_occluders(const obs_bake_scene *scene, const obs__bake_world
     return obs__bake_bvh_new_decor(w, dc, p->tree_attenuation, bvh, err);
 }
 
-obs_status obs_dyn_bake(const obs_bake_scene *scene, const obs_dyn_desc *desc,
-                        obs_dyn_result *out, char err[OBS_ERR_LEN])
-{
-    return obs__dyn_bake_run(scene, desc, NULL, out, err);
-}
-
 /* The steps; with a shard (dyn_shard.c) its step takes the trace's
  * place: one shard's points traced and written (the bake stops there),
  * or every shard's read back. */
-obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *desc,
-                             obs__dyn_shard *sh, obs_dyn_result *out, char err[OBS_ERR_LEN])
+static obs_status steps(const obs_bake_scene *scene, const obs_dyn_desc *desc,
+                        const obs_dyn_params *p, obs__part_job *sh, obs_dyn_result *out,
+                        char err[OBS_ERR_LEN])
 {
-    memset(out, 0, sizeof *out);
-    obs_dyn_params p;
-    obs_dyn_params_resolve(desc ? &desc->params : NULL, &p);
     obs_dyn_stats *st = &out->stats;
     obs__bake_world w = {0};
     obs__bake_bvh *bvh = NULL;
@@ -102,18 +83,18 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     obs__dyn_points pt = {0};
     obs_status rc;
     double t = obs__bake_now();
-    if ((rc = obs__bake_flatten_checked(scene, p.max_triangles, "bake-dynamic", &w, err)) != OBS_OK)
+    if ((rc = obs__bake_flatten_checked(scene, p->max_triangles, "bake-dynamic", &w, err)) != OBS_OK)
         goto done;
     st->seconds[OBS_DYN_STAGE_flatten] = obs__bake_now() - t;
     t = obs__bake_now();
-    if ((rc = obs__dyn_occluders(scene, &w, &p, desc ? desc->decorators_json : NULL, &dc, &bvh,
+    if ((rc = obs__dyn_occluders(scene, &w, p, desc ? desc->decorators_json : NULL, &dc, &bvh,
                                  st->decorator_warning, err)) != OBS_OK)
         goto done;
     memcpy(st->decorator_nodes, dc.counts, sizeof dc.counts);
     st->seconds[OBS_DYN_STAGE_bvh] = obs__bake_now() - t;
     t = obs__bake_now();
     if (!rg) {
-        if ((rc = obs__dyn_regions_build(&w, bvh, &p, &own, err)) != OBS_OK)
+        if ((rc = obs__dyn_regions_build(&w, bvh, p, &own, err)) != OBS_OK)
             goto done;
         rg = &own;
     }
@@ -121,16 +102,17 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     st->edges = rg->edge_count;
     st->seconds[OBS_DYN_STAGE_regions] = obs__bake_now() - t;
     t = obs__bake_now();
-    if ((rc = obs__dyn_points_flag(bvh, rg, &p, &pt, err)) != OBS_OK)
+    if ((rc = obs__dyn_points_flag(bvh, rg, p, &pt, err)) != OBS_OK)
         goto done;
     st->seconds[OBS_DYN_STAGE_valid] = obs__bake_now() - t;
     t = obs__bake_now();
     if (sh) {
-        if ((rc = obs__dyn_shard_step(sh, obs__bake_traced_fingerprint(&w, &dc, p.tree_attenuation),
-                                      rg, &p, bvh, &pt, st, err)) != OBS_OK || sh->stop)
+        if ((rc = obs__dyn_shard_step(sh, desc,
+                                      obs__bake_traced_fingerprint(&w, &dc, p->tree_attenuation),
+                                      rg, p, bvh, &pt, st, err)) != OBS_OK || sh->stop)
             goto done;
     } else {
-        obs__dyn_points_trace(bvh, &p, &pt, 0, pt.count, desc ? desc->progress : NULL,
+        obs__dyn_points_trace(bvh, p, &pt, 0, pt.count, desc ? desc->progress : NULL,
                               desc ? desc->progress_user : NULL);
         st->seconds[OBS_DYN_STAGE_trace] = obs__bake_now() - t;
     }
@@ -143,7 +125,7 @@ obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *de
     st->points_valid = pt.count;
     st->rays = pt.rays;
     t = obs__bake_now();
-    if ((rc = obs__dyn_fit_all(&pt, rg, &p, out, err)) != OBS_OK)
+    if ((rc = obs__dyn_fit_all(&pt, rg, p, out, err)) != OBS_OK)
         goto done;
     st->seconds[OBS_DYN_STAGE_fit] = obs__bake_now() - t;
     out->model.level = out->original.level = obs__dyn_level_of(&w);
@@ -153,10 +135,9 @@ done:
     obs__bake_bvh_free(bvh);
     obs__bake_decor_free(&dc);
     obs__bake_world_free(&w);
-    if (rc != OBS_OK) {
-        obs_dyn_stats keep = out->stats;
-        obs_dyn_result_free(out);
-        out->stats = keep;
-    }
     return rc;
 }
+
+/* obs_dyn_stage_name, obs_dyn_bake and obs__dyn_run_job (the steps with
+ * a shard's or a merge's job, dyn_shard_run.c's), level/part.h's. */
+OBS__BAKE_ENTRY(dyn, DYN, obs_dyn_bake, steps)

@@ -114,19 +114,6 @@ typedef struct obs__dyn_part {
     uint64_t checksum; /* FNV-1a 64 of the payload */
 } obs__dyn_part;
 
-/* What the bake does in place of its trace: with path, trace shard
- * index/count of the valid points and write it there (stop is set: the
- * bake ends after the step); with parts (count of them, in shard
- * order), read every shard's points back and go on to the fit. */
-typedef struct obs__dyn_shard {
-    int index, count;
-    const char *path;
-    const obs__dyn_part *parts;
-    int stop;
-    void (*progress)(void *user, size_t done, size_t total); /* the shard's trace */
-    void *progress_user;
-} obs__dyn_shard;
-
 /* dynamic.c: the level's decorators classified as obscura bake does
  * (obs__bake_decor_classify, from p's decorator_source and
  * shrub_density and decorators_json, the text of a decorators file or
@@ -141,19 +128,24 @@ obs_status obs__dyn_occluders(const obs_bake_scene *scene, const obs__bake_world
                               struct obs__bake_decor *dc, obs__bake_bvh **bvh,
                               char warning[OBS_ERR_LEN], char err[OBS_ERR_LEN]);
 
-/* dynamic.c: obs_dyn_bake's steps with the hook (sh NULL: obs_dyn_bake). */
-obs_status obs__dyn_bake_run(const obs_bake_scene *scene, const obs_dyn_desc *desc,
-                             obs__dyn_shard *sh, obs_dyn_result *out, char err[OBS_ERR_LEN]);
+/* dyn_bake.c: obs_dyn_bake's steps with a shard's or a merge's job in
+ * place of the trace of the valid points (sh NULL: obs_dyn_bake);
+ * sh->parts are obs__dyn_parts.  level/part.h's OBS__BAKE_ENTRY. */
+obs_status obs__dyn_run_job(const obs_bake_scene *scene, const obs_dyn_desc *desc,
+                            obs__part_job *sh, obs_dyn_result *out, char err[OBS_ERR_LEN]);
 /* dyn_shard.c: the step, after the points are flagged (pt->count listed,
  * not traced) and before the dropped ones are removed; fills st's trace
  * row.  level: the traced fingerprint (obs__bake_traced_fingerprint),
- * written into a part, checked against the parts read. */
-obs_status obs__dyn_shard_step(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
-                               const obs_dyn_params *p, const obs__bake_bvh *bvh,
-                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN]);
-/* Reads and checks a part's header (magic, version, sizes, the file's
- * length against its count). */
-obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char err[OBS_ERR_LEN]);
+ * written into a part, checked against the parts read; desc's progress
+ * callback follows a shard's trace. */
+obs_status obs__dyn_shard_step(obs__part_job *sh, const obs_dyn_desc *desc, uint64_t level,
+                               const obs_dyn_regions *rg, const obs_dyn_params *p,
+                               const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
+                               char err[OBS_ERR_LEN]);
+/* The part file's layout (dyn_shard.c): its header's fields, the
+ * parameters they carry (obs__part_header_read reads one, with its
+ * checks: magic, version, sizes, the file's length against its count). */
+extern const obs__part_format obs__dyn_part_format;
 /* FNV-1a 64 of the regions' boxes and the valid points' grid indices,
  * independent of the host's byte order. */
 uint64_t obs__dyn_points_fingerprint(const obs_dyn_regions *rg, const obs__dyn_points *pt);

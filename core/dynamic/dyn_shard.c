@@ -44,6 +44,7 @@
  * given from the parts and refuses parts that disagree with it or each
  * other (dyn_shard_run.c). */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -56,6 +57,36 @@
 #define VERSION 1u
 #define HEADER 128u
 #define POINT_BYTES (8u * OBS_DYN_CHANNELS)
+
+/* The header's fields after the range: offset, type, member, and the
+ * parameter it carries (dyn_shard_run.c's merge checks those). */
+#define FIELD(at, type, member, param) {at, OBS__PART_##type, offsetof(obs__dyn_part, member), param}
+static const obs__part_field fields[] = {
+    FIELD(56, U64, points, NULL),
+    FIELD(64, I32, rays, "rays"),
+    FIELD(68, I32, seed, "seed"),
+    FIELD(72, I32, grid, "grid"),
+    FIELD(76, I32, max_regions, "max_regions"),
+    FIELD(80, F32, distance_short, "distance_short"),
+    FIELD(84, F32, distance_long, "distance_long"),
+    FIELD(88, F32, backface_limit, "backface_limit"),
+    FIELD(92, F32, min_region_size, "min_region_size"),
+    FIELD(96, U32, regions, NULL),
+    FIELD(104, F64, prep_seconds, NULL),
+    FIELD(112, F64, trace_seconds, NULL),
+    FIELD(120, U64, checksum, NULL),
+};
+#undef FIELD
+_Static_assert(HEADER <= OBS__PART_HEAD_MAX, "a part's header fits obs__part_write's buffer");
+
+/* total at most 2^40: a size the payload's bytes cannot overflow */
+const obs__part_format obs__dyn_part_format = {
+    .magic = MAGIC, .what = "bake-dynamic part", .writer = "obscura bake-dynamic --shard I/N",
+    .kind = "bake-dynamic part", .items = "points", .version = VERSION, .head_len = HEADER,
+    .max_total = (uint64_t)1 << 40, .item_bytes = POINT_BYTES + 1,
+    .part_size = sizeof(obs__dyn_part), .fields = fields,
+    .field_count = sizeof fields / sizeof fields[0], .param_find = obs_dyn_param_find,
+    .param_at = obs_dyn_param_at, .params_given = offsetof(obs_dyn_params, set)};
 
 obs_dyn_level obs__dyn_level_of(const obs__bake_world *w)
 {
@@ -93,27 +124,10 @@ uint64_t obs__dyn_points_fingerprint(const obs_dyn_regions *rg, const obs__dyn_p
 
 /* ---- writing a part ------------------------------------------------------ */
 
-static void header_bytes(const obs__dyn_part *h, unsigned char b[HEADER])
-{
-    obs__part_range_put(b, HEADER, MAGIC, &h->r);
-    obs__le_put64(b + 56, h->points);
-    obs__le_put32(b + 64, (uint32_t)h->rays);
-    obs__le_put32(b + 68, (uint32_t)h->seed);
-    obs__le_put32(b + 72, (uint32_t)h->grid);
-    obs__le_put32(b + 76, (uint32_t)h->max_regions);
-    obs__le_put32(b + 80, obs__le_fbits(h->distance_short));
-    obs__le_put32(b + 84, obs__le_fbits(h->distance_long));
-    obs__le_put32(b + 88, obs__le_fbits(h->backface_limit));
-    obs__le_put32(b + 92, obs__le_fbits(h->min_region_size));
-    obs__le_put32(b + 96, h->regions);
-    obs__le_put64(b + 104, obs__le_dbits(h->prep_seconds));
-    obs__le_put64(b + 112, obs__le_dbits(h->trace_seconds));
-    obs__le_put64(b + 120, h->checksum);
-}
-
-static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
-                              const obs_dyn_params *p, const obs__bake_bvh *bvh,
-                              obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
+static obs_status trace_shard(obs__part_job *sh, const obs_dyn_desc *desc, uint64_t level,
+                              const obs_dyn_regions *rg, const obs_dyn_params *p,
+                              const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
+                              char err[OBS_ERR_LEN])
 {
     obs__dyn_part h = {
         .r = obs__part_range_of(VERSION, level, sh->index, sh->count, pt->count),
@@ -133,7 +147,8 @@ static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
     double t = obs__bake_now();
     pt->rays = 0;
     size_t n = (size_t)h.r.n, first = (size_t)h.r.first, dropped = 0;
-    obs__dyn_points_trace(bvh, p, pt, first, first + n, sh->progress, sh->progress_user);
+    obs__dyn_points_trace(bvh, p, pt, first, first + n, desc ? desc->progress : NULL,
+                          desc ? desc->progress_user : NULL);
     h.trace_seconds = obs__bake_now() - t;
     unsigned char *payload = malloc(n * (POINT_BYTES + 1) + 1);
     if (!payload)
@@ -150,9 +165,8 @@ static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
         dropped += pt->dropped[first + i];
     }
     h.checksum = obs__bake_fnv(OBS__BAKE_FNV_OFFSET, payload, n * (POINT_BYTES + 1));
-    unsigned char head[HEADER];
-    header_bytes(&h, head);
-    obs_status rc = obs__bake_part_write(sh->path, head, HEADER, payload, n * (POINT_BYTES + 1), err);
+    obs_status rc = obs__part_write(sh->path, &obs__dyn_part_format, &h, payload,
+                                    n * (POINT_BYTES + 1), err);
     free(payload);
     st->seconds[OBS_DYN_STAGE_trace] = h.trace_seconds;
     st->grid_points = pt->grid;
@@ -166,35 +180,6 @@ static obs_status trace_shard(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
 }
 
 /* ---- reading parts ------------------------------------------------------- */
-
-static const obs__part_format format = {MAGIC, "bake-dynamic part",
-                                       "obscura bake-dynamic --shard I/N", "bake-dynamic part",
-                                       "points", VERSION, HEADER, (uint64_t)1 << 40,
-                                       POINT_BYTES + 1};
-
-obs_status obs__dyn_part_read_header(const char *path, obs__dyn_part *h, char err[OBS_ERR_LEN])
-{
-    unsigned char b[HEADER];
-    *h = (obs__dyn_part){0};
-    /* total at most 2^40: a size the payload's bytes cannot overflow */
-    obs_status rc = obs__part_range_read(path, &format, b, &h->r, err);
-    if (rc != OBS_OK)
-        return rc;
-    h->points = obs__le_get64(b + 56);
-    h->rays = (int32_t)obs__le_get32(b + 64);
-    h->seed = (int32_t)obs__le_get32(b + 68);
-    h->grid = (int32_t)obs__le_get32(b + 72);
-    h->max_regions = (int32_t)obs__le_get32(b + 76);
-    h->distance_short = obs__le_bitsf(obs__le_get32(b + 80));
-    h->distance_long = obs__le_bitsf(obs__le_get32(b + 84));
-    h->backface_limit = obs__le_bitsf(obs__le_get32(b + 88));
-    h->min_region_size = obs__le_bitsf(obs__le_get32(b + 92));
-    h->regions = obs__le_get32(b + 96);
-    h->prep_seconds = obs__le_bitsd(obs__le_get64(b + 104));
-    h->trace_seconds = obs__le_bitsd(obs__le_get64(b + 112));
-    h->checksum = obs__le_get64(b + 120);
-    return OBS_OK;
-}
 
 static obs_status read_payload(const obs__dyn_part *h, obs__dyn_points *pt, char err[OBS_ERR_LEN])
 {
@@ -216,10 +201,10 @@ static obs_status read_payload(const obs__dyn_part *h, obs__dyn_points *pt, char
     return rc;
 }
 
-static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
+static obs_status read_shards(obs__part_job *sh, uint64_t level, const obs_dyn_regions *rg,
                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
 {
-    const obs__dyn_part *p0 = &sh->parts[0];
+    const obs__dyn_part *parts = sh->parts, *p0 = &parts[0];
     obs_status rc = obs__part_check_level(p0->r.path, p0->r.level, level, err);
     if (rc != OBS_OK)
         return rc;
@@ -232,21 +217,22 @@ static obs_status read_shards(obs__dyn_shard *sh, uint64_t level, const obs_dyn_
     double t = obs__bake_now();
     pt->rays = 0;
     for (int i = 0; i < sh->count; i++) {
-        rc = read_payload(&sh->parts[i], pt, err);
+        rc = read_payload(&parts[i], pt, err);
         if (rc != OBS_OK)
             return rc;
-        pt->rays += sh->parts[i].r.n * (uint64_t)sh->parts[i].rays;
+        pt->rays += parts[i].r.n * (uint64_t)parts[i].rays;
         /* the parts' times, summed: the farm's machine time */
-        st->seconds[OBS_DYN_STAGE_trace] += sh->parts[i].trace_seconds;
+        st->seconds[OBS_DYN_STAGE_trace] += parts[i].trace_seconds;
     }
     st->seconds[OBS_DYN_STAGE_trace] += obs__bake_now() - t;
     return OBS_OK;
 }
 
-obs_status obs__dyn_shard_step(obs__dyn_shard *sh, uint64_t level, const obs_dyn_regions *rg,
-                               const obs_dyn_params *p, const obs__bake_bvh *bvh,
-                               obs__dyn_points *pt, obs_dyn_stats *st, char err[OBS_ERR_LEN])
+obs_status obs__dyn_shard_step(obs__part_job *sh, const obs_dyn_desc *desc, uint64_t level,
+                               const obs_dyn_regions *rg, const obs_dyn_params *p,
+                               const obs__bake_bvh *bvh, obs__dyn_points *pt, obs_dyn_stats *st,
+                               char err[OBS_ERR_LEN])
 {
     return sh->parts ? read_shards(sh, level, rg, pt, st, err)
-                     : trace_shard(sh, level, rg, p, bvh, pt, st, err);
+                     : trace_shard(sh, desc, level, rg, p, bvh, pt, st, err);
 }

@@ -1,6 +1,8 @@
-/* obs_dyn_bake_shard and obs_dyn_bake_merge (obscura/dynamic.h): the
- * checks of a merge's parts against each other and its parameters, then
- * dynamic.c's steps with dyn_shard.c's step in place of the trace. */
+/* obs_dyn_bake_shard and obs_dyn_bake_merge (obscura/dynamic.h):
+ * level/part.h's drivers over dyn_bake.c's steps with dyn_shard.c's step
+ * in place of the trace and dyn_shard.c's part format; a merge takes the
+ * parts' parameters, all alike, unless given, when they must agree, and
+ * its parts must split the same valid points. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -8,90 +10,18 @@
 #include "level/part.h"
 #include "internal.h"
 
-obs_status obs_dyn_bake_shard(const obs_bake_scene *scene, const obs_dyn_desc *desc, int index,
-                              int count, const char *path, obs_dyn_stats *st,
-                              char err[OBS_ERR_LEN])
+/* Parts of one bake also split the same valid points of the same regions. */
+static obs_status same_points(const void *pa, const void *pb, char err[OBS_ERR_LEN])
 {
-    if (st)
-        memset(st, 0, sizeof *st);
-    obs_status rc = obs__shard_check(index, count, path, err);
-    if (rc != OBS_OK)
-        return rc;
-    obs__dyn_shard sh = {.index = index, .count = count, .path = path,
-                         .progress = desc ? desc->progress : NULL,
-                         .progress_user = desc ? desc->progress_user : NULL};
-    obs_dyn_result r;
-    rc = obs__dyn_bake_run(scene, desc, &sh, &r, err);
-    if (st)
-        *st = r.stats;
-    obs_dyn_result_free(&r);
-    return rc;
-}
-
-/* The parameters a part carries: its row's name and its header field. */
-#define PART_PARAMS(X)                                                          \
-    X(rays, rays)                                                               \
-    X(seed, seed)                                                               \
-    X(grid, grid)                                                               \
-    X(max_regions, max_regions)                                                 \
-    X(distance_short, distance_short)                                           \
-    X(distance_long, distance_long)                                             \
-    X(backface_limit, backface_limit)                                           \
-    X(min_region_size, min_region_size)
-
-static int row_of(const char *name)
-{
-    const obs_bake_param_info *pi = obs_dyn_param_find(name);
-    return pi ? (int)(pi - obs_dyn_param_at(0)) : -1;
-}
-
-/* The merge's parameters: the parts' (all alike), unless given, when
- * they must agree. */
-static obs_status adopt(obs_dyn_params *p, const obs__dyn_part *parts, size_t n,
-                        char err[OBS_ERR_LEN])
-{
-    const obs__dyn_part *a = &parts[0];
-    for (size_t i = 1; i < n; i++) {
-        const obs__dyn_part *b = &parts[i];
-#define SAME(name, field) OBS__PART_SAME(a, b, name, field)
-        PART_PARAMS(SAME)
-#undef SAME
-        if (a->points != b->points || a->r.total != b->r.total)
-            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced over different "
-                             "regions or valid points (%llu and %llu points): they are not parts "
-                             "of one bake", a->r.path, b->r.path, (unsigned long long)a->r.total,
-                             (unsigned long long)b->r.total);
-    }
-#define TAKE(name, field) OBS__PART_TAKE(p, a, row_of(#name), name, field)
-    PART_PARAMS(TAKE)
-#undef TAKE
+    const obs__dyn_part *a = pa, *b = pb;
+    if (a->points != b->points || a->r.total != b->r.total)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced over different "
+                         "regions or valid points (%llu and %llu points): they are not parts "
+                         "of one bake", a->r.path, b->r.path, (unsigned long long)a->r.total,
+                         (unsigned long long)b->r.total);
     return OBS_OK;
 }
 
-/* A part's header (level/part.h reads every part through it). */
-static obs_status read_header(const char *path, void *h, char err[OBS_ERR_LEN])
-{
-    return obs__dyn_part_read_header(path, h, err);
-}
-
-obs_status obs_dyn_bake_merge(const obs_bake_scene *scene, obs_dyn_desc *desc,
-                              const char *const *paths, size_t n, obs_dyn_result *out,
-                              char err[OBS_ERR_LEN])
-{
-    memset(out, 0, sizeof *out);
-    void *parts = NULL;
-    obs_status rc = obs__bake_parts_read(paths, n, sizeof(obs__dyn_part), read_header, &parts,
-                                         err);
-    obs__dyn_part *ordered = parts;
-    obs_dyn_desc d = desc ? *desc : (obs_dyn_desc){0};
-    if (rc == OBS_OK)
-        rc = adopt(&d.params, ordered, n, err);
-    if (rc == OBS_OK) {
-        obs__dyn_shard sh = {.index = 0, .count = (int)n, .parts = ordered};
-        rc = obs__dyn_bake_run(scene, &d, &sh, out, err);
-        if (desc)
-            desc->params = d.params;
-    }
-    free(ordered);
-    return rc;
-}
+OBS__PART_DRIVERS(obs_dyn_bake_shard, obs_dyn_bake_merge, obs_dyn_desc, obs_dyn_result,
+                  obs_dyn_stats, obs__dyn_run_job, obs_dyn_result_free, obs__dyn_part_format,
+                  same_points)

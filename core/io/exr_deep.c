@@ -447,17 +447,17 @@ static obs_status image_reader(exr_context_t ctx, int64_t size, void *user, char
     return read_deep(ctx, size, j->lim, j->extra, j->out, why);
 }
 
+static void image_release(void *out)
+{
+    obs_deep_free(out);
+}
+
 static obs_status read_any(const char *label, const char *path, const mem_src *mem,
                            const obs_limits *lim, obs_deep_image *out, char err[OBS_ERR_LEN])
 {
-    if (!out)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
-    memset(out, 0, sizeof *out);
     image_job j = {lim, out, NULL};
-    obs_status st = obs__exr_read_with(label, path, mem, image_reader, &j, err);
-    if (st != OBS_OK)
-        obs_deep_free(out);
-    return st;
+    return obs__exr_read_out(label, path, mem, image_reader, &j, out, sizeof *out,
+                             image_release, err);
 }
 
 /* The deep image of path (or mem) with `channel` read in the place of R,

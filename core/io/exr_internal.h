@@ -77,6 +77,21 @@ void obs__exr_error_handler(exr_const_context_t ctxt, exr_result_t code,
 /* The status class of an OpenEXR result code. */
 obs_status obs__exr_status(exr_result_t rv);
 
+/* A loop over a part's chunks on the pool (exr_read.c decodes them,
+ * exr_write.c encodes them).  Its threads: the caller's count through
+ * obs__pool_threads, but no more than one for every 4 chunks, at least
+ * one.  Its failure: each thread keeps its own, and the lowest failing
+ * chunk's is the part's, whatever the threads' order. */
+int obs__exr_chunk_threads(int threads, int64_t chunks);
+typedef struct obs__exr_chunk_fail {
+    int64_t chunk; /* the failing chunk; INT64_MAX: none yet */
+    int code;      /* 0: none; the reader's obs_status, the writer's exr_result_t */
+    char msg[OBS_ERR_LEN];
+} obs__exr_chunk_fail;
+/* At a thread's end, under the pool's lock: its failure into the part's
+ * when it is at a lower chunk. */
+void obs__exr_chunk_fail_keep(obs__exr_chunk_fail *part, const obs__exr_chunk_fail *thread);
+
 /* Fails with the status of `rv`: "<what>: <library message>". */
 obs_status obs__exr_fail(char err[OBS_ERR_LEN], exr_result_t rv,
                          const char *what);
@@ -134,6 +149,13 @@ typedef obs_status (*obs__exr_reader)(exr_context_t ctx, int64_t size, void *use
  * every public reader's frame; a failure is "label: why" in err. */
 obs_status obs__exr_read_with(const char *label, const char *path, const obs__exr_mem *mem,
                               obs__exr_reader read, void *user, char err[OBS_ERR_LEN]);
+/* A public reader that fills a struct: out (out_size bytes) checked and
+ * zeroed, then obs__exr_read_with, and *out released with release (the
+ * struct's free function) when that fails.  exr_read.c's G-buffer and
+ * exr_deep.c's deep image. */
+obs_status obs__exr_read_out(const char *label, const char *path, const obs__exr_mem *mem,
+                             obs__exr_reader read, void *user, void *out, size_t out_size,
+                             void (*release)(void *out), char err[OBS_ERR_LEN]);
 
 /* n channels (float32, one image each), all from one part that holds
  * channels[0]: one whose "view" attribute is `view` (NULL or "": none),

@@ -1,6 +1,7 @@
 /* OpenEXR's messages and statuses, for every EXR file of core/io: the
  * library reports through a callback (obs__exr_error_handler) into a
- * per-thread buffer, which the failing call's message then quotes; and
+ * per-thread buffer, which the failing call's message then quotes; the
+ * threads and the failure of a loop over a part's chunks; and
  * the output compressions by name, with what this build's library can
  * code (the request parser checks them without the writer).  Below the
  * readers and writers, so that each can use it. */
@@ -9,6 +10,7 @@
 
 #include "io/exr_internal.h"
 #include "internal.h"
+#include "pool.h"
 
 static _Thread_local char exr_msg[384];
 
@@ -88,4 +90,18 @@ obs_status obs_exr_compression_check(obs_exr_compression c, char err[OBS_ERR_LEN
     return obs__fail(err, OBS_UNSUPPORTED,
                      "compression dwaa needs OpenEXR 3.2 or later (this build has %d.%d.%d, whose C API neither "
                      "writes nor reads DWAA); use none, rle, zips, zip or piz", maj, min, patch);
+}
+
+int obs__exr_chunk_threads(int threads, int64_t chunks)
+{
+    int n = obs__pool_threads(threads);
+    if (n > chunks / 4)
+        n = (int)(chunks / 4);
+    return n < 1 ? 1 : n;
+}
+
+void obs__exr_chunk_fail_keep(obs__exr_chunk_fail *part, const obs__exr_chunk_fail *thread)
+{
+    if (thread->code != 0 && thread->chunk < part->chunk)
+        *part = *thread;
 }

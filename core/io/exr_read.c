@@ -85,6 +85,19 @@ obs_status obs__exr_read_with(const char *label, const char *path, const obs__ex
     return st;
 }
 
+obs_status obs__exr_read_out(const char *label, const char *path, const obs__exr_mem *mem,
+                             obs__exr_reader read, void *user, void *out, size_t out_size,
+                             void (*release)(void *out), char err[OBS_ERR_LEN])
+{
+    if (!out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
+    memset(out, 0, out_size);
+    obs_status st = obs__exr_read_with(label, path, mem, read, user, err);
+    if (st != OBS_OK)
+        release(out);
+    return st;
+}
+
 /* ---- parts and channels -------------------------------------------------- */
 
 /* Channel names of one part, pointing into the context (valid until
@@ -327,15 +340,15 @@ typedef struct part_job {
     int nt;
     int32_t lines;        /* scanlines per chunk (scanline parts) */
     uint32_t tw, th;      /* tile size (tiled parts) */
-    int64_t ntx, chunks;  /* tiles across; chunks in all */
-    int64_t failed;       /* lowest failing chunk (chunks = none); under the pool's lock */
-    obs_status st;
-    char err[OBS_ERR_LEN];
+    int64_t ntx, chunks;  /* tiles across; chunks to decode */
+    int64_t first;        /* the first of them (a range of rows: obs_gbuffer_rows) */
+    obs__exr_chunk_fail fail; /* under the pool's lock */
 } part_job;
 
 static obs_status decode_nth(part_job *j, int64_t i, decoder *d, char err[OBS_ERR_LEN])
 {
     const part_geom *g = j->g;
+    i += j->first;
     exr_chunk_info_t ci;
     exr_result_t rv;
 
@@ -355,9 +368,7 @@ static obs_status decode_nth(part_job *j, int64_t i, decoder *d, char err[OBS_ER
 /* One decoder per thread; a failure is kept until the thread ends. */
 typedef struct decode_local {
     decoder d;
-    int64_t failed;
-    obs_status st;
-    char err[OBS_ERR_LEN];
+    obs__exr_chunk_fail fail;
 } decode_local;
 
 static void decode_begin(void *ctx, void *local)
@@ -365,7 +376,7 @@ static void decode_begin(void *ctx, void *local)
     (void)ctx;
     decode_local *l = local;
     l->d = (decoder){EXR_DECODE_PIPELINE_INITIALIZER};
-    l->st = OBS_OK;
+    l->fail.code = OBS_OK;
     obs__exr_msg_reset(); /* the library's messages are per thread */
 }
 
@@ -374,69 +385,92 @@ static int decode_one(void *ctx, void *local, size_t i, size_t i1)
 {
     (void)i1; /* ranges of one chunk */
     decode_local *l = local;
-    obs_status st = decode_nth(ctx, (int64_t)i, &l->d, l->err);
+    obs_status st = decode_nth(ctx, (int64_t)i, &l->d, l->fail.msg);
     if (st == OBS_OK)
         return 0;
-    l->failed = (int64_t)i;
-    l->st = st;
+    l->fail.chunk = (int64_t)i;
+    l->fail.code = st;
     return 1;
 }
 
-/* Under the pool's lock: the lowest failing chunk's error wins. */
+/* Under the pool's lock. */
 static void decode_end(void *ctx, void *local)
 {
     part_job *j = ctx;
     decode_local *l = local;
-    if (l->st != OBS_OK && l->failed < j->failed) {
-        j->failed = l->failed;
-        j->st = l->st;
-        memcpy(j->err, l->err, sizeof l->err);
-    }
+    obs__exr_chunk_fail_keep(&j->fail, &l->fail);
     if (l->d.started)
         exr_decoding_destroy(j->ctx, &l->d.dec);
     free(l->d.scratch);
 }
 
-/* Decode threads for a part of `chunks` chunks: the configured count
- * (0 = CPUs online; pool.h), but no more than one for every 4 chunks. */
-static int decode_threads(const obs_limits *lim, int64_t chunks)
-{
-    int n = obs__pool_threads(lim ? lim->threads : 0);
-    if (n > chunks / 4)
-        n = (int)(chunks / 4);
-    return n < 1 ? 1 : n;
-}
+/* Decodes the chunks of level 0 of a part that hold rows [y0, y1) of its
+ * data window into the targets (a chunk's rows outside the range too:
+ * obs__exr_chunk_rows gives the rows the targets must hold). */
+static obs_status decode_rows(exr_const_context_t ctx, int part, const part_geom *g,
+                              const target *t, int nt, const obs_limits *lim, int y0, int y1,
+                              char err[OBS_ERR_LEN]);
 
 /* Decodes level 0 of a part into the targets. */
 static obs_status decode_part(exr_const_context_t ctx, int part, const part_geom *g,
                               const target *t, int nt, const obs_limits *lim,
                               char err[OBS_ERR_LEN])
 {
-    part_job j = {.ctx = ctx, .part = part, .g = g, .t = t, .nt = nt, .st = OBS_OK};
-    exr_result_t rv;
+    return decode_rows(ctx, part, g, t, nt, lim, 0, g->height, err);
+}
 
+/* Scanlines (or tile rows) per chunk of a part. */
+static obs_status chunk_lines(exr_const_context_t ctx, int part, const part_geom *g, int32_t *lines,
+                              uint32_t *tw, char err[OBS_ERR_LEN])
+{
+    exr_result_t rv;
     if (!g->tiled) {
-        if ((rv = exr_get_scanlines_per_chunk(ctx, part, &j.lines)) != EXR_ERR_SUCCESS || j.lines < 1)
+        if ((rv = exr_get_scanlines_per_chunk(ctx, part, lines)) != EXR_ERR_SUCCESS || *lines < 1)
             return obs__exr_fail(err, rv ? rv : EXR_ERR_INVALID_ATTR, "scanlines per chunk");
-        j.chunks = ((int64_t)g->height + j.lines - 1) / j.lines;
-    } else {
-        exr_tile_level_mode_t level;
-        exr_tile_round_mode_t round;
-        rv = exr_get_tile_descriptor(ctx, part, &j.tw, &j.th, &level, &round);
-        if (rv != EXR_ERR_SUCCESS || j.tw == 0 || j.th == 0)
-            return obs__exr_fail(err, rv ? rv : EXR_ERR_INVALID_ATTR, "tile description");
-        j.ntx = ((int64_t)g->width + j.tw - 1) / j.tw;
-        j.chunks = j.ntx * (((int64_t)g->height + j.th - 1) / j.th);
+        return OBS_OK;
     }
-    j.failed = j.chunks;
-    obs__pool_for f = {.end = (size_t)j.chunks, .chunk = 1, .threads = decode_threads(lim, j.chunks),
+    exr_tile_level_mode_t level;
+    exr_tile_round_mode_t round;
+    uint32_t th = 0;
+    rv = exr_get_tile_descriptor(ctx, part, tw, &th, &level, &round);
+    if (rv != EXR_ERR_SUCCESS || *tw == 0 || th == 0 || th > INT32_MAX)
+        return obs__exr_fail(err, rv ? rv : EXR_ERR_INVALID_ATTR, "tile description");
+    *lines = (int32_t)th;
+    return OBS_OK;
+}
+
+static obs_status decode_rows(exr_const_context_t ctx, int part, const part_geom *g,
+                              const target *t, int nt, const obs_limits *lim, int y0, int y1,
+                              char err[OBS_ERR_LEN])
+{
+    part_job j = {.ctx = ctx, .part = part, .g = g, .t = t, .nt = nt, .fail = {.chunk = INT64_MAX}};
+    int32_t lines = 0;
+    uint32_t tw = 0;
+    obs_status cs = chunk_lines(ctx, part, g, &lines, &tw, err);
+    if (cs != OBS_OK)
+        return cs;
+    /* the chunk rows holding [y0, y1) */
+    const int64_t r0 = y0 / lines, r1 = ((int64_t)y1 + lines - 1) / lines;
+    if (!g->tiled) {
+        j.lines = lines;
+        j.first = r0;
+        j.chunks = r1 - r0;
+    } else {
+        j.tw = tw;
+        j.th = (uint32_t)lines;
+        j.ntx = ((int64_t)g->width + j.tw - 1) / j.tw;
+        j.first = r0 * j.ntx;
+        j.chunks = j.ntx * (r1 - r0);
+    }
+    obs__pool_for f = {.end = (size_t)j.chunks, .chunk = 1,
+                       .threads = obs__exr_chunk_threads(lim ? lim->threads : 0, j.chunks),
                        .range = decode_one, .ctx = &j, .local_size = sizeof(decode_local),
                        .begin = decode_begin, .end_thread = decode_end};
     if (obs__pool_run(&f, NULL) < 0)
         return obs__fail(err, OBS_NO_MEMORY, "decode threads");
-    if (j.st != OBS_OK)
-        memcpy(err, j.err, OBS_ERR_LEN);
-    return j.st;
+    if (j.fail.code != OBS_OK)
+        memcpy(err, j.fail.msg, OBS_ERR_LEN);
+    return (obs_status)j.fail.code;
 }
 
 /* ---- G-buffer ----------------------------------------------------------- */
@@ -554,9 +588,45 @@ static void copy_name(char *dst, size_t len, const char *const *names, int idx)
     snprintf(dst, len, "%s", idx >= 0 ? names[idx] : "");
 }
 
+/* The targets of the channels m maps, planes at depth (1 float a pixel),
+ * normal (3), color (4), position (3) (NULL: not read); idx[i]: the
+ * channel of target i.  Returns how many. */
+static int gbuffer_targets(const char *const *names, const obs__channel_match *m, float *depth,
+                           float *normal, float *color, float *position, target t[11], int idx[11])
+{
+    int nt = 0;
+    idx[nt] = m->depth;
+    t[nt++] = (target){names[m->depth], depth, 1};
+    for (int i = 0; normal && i < 3; i++)
+        idx[nt] = m->normal[i], t[nt++] = (target){names[m->normal[i]], normal + i, 3};
+    for (int i = 0; color && i < 4; i++)
+        if (m->color[i] >= 0)
+            idx[nt] = m->color[i], t[nt++] = (target){names[m->color[i]], color + i, 4};
+    for (int i = 0; position && i < 3; i++)
+        idx[nt] = m->position[i], t[nt++] = (target){names[m->position[i]], position + i, 3};
+    return nt;
+}
+
+/* A G-buffer read by rows (obs_gbuffer_rows_open): the open file, its
+ * part, geometry and channels, and the rows last read. */
+struct obs_gbuffer_rows {
+    exr_context_t ctx;
+    obs_limits lim;
+    int part;
+    part_geom g;
+    obs__channel_match m;
+    const char **names; /* point into ctx */
+    obs_gbuffer gb;     /* the frame; planes NULL */
+    float *buf;         /* the rows last read: each plane cap_rows rows */
+    int cap_rows;
+    int h0, h1;         /* the data window's rows buf holds (chunk rows) */
+};
+
+/* With rows: the header, part and channels into *rows, no pixels (a view
+ * whose channels lie in several parts is refused). */
 static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_channel_map *map,
                                const obs_limits *lim, obs_gbuffer_file *out,
-                               char err[OBS_ERR_LEN])
+                               obs_gbuffer_rows *rows, char err[OBS_ERR_LEN])
 {
     const char **names = NULL;
     int *owner = NULL;
@@ -581,45 +651,46 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     /* Planes: depth (1), normal (3), colour (4), position (3), in one
      * allocation. */
     int has_n = m.normal[0] >= 0, has_c = m.color[0] >= 0, has_p = m.position[0] >= 0;
-    size_t px = (size_t)g.width * (size_t)g.height, bytes;
-    if (obs__size_mul3((size_t)g.width, (size_t)g.height,
-                       (size_t)(1 + 3 * has_n + 4 * has_c + 3 * has_p) * sizeof(float), &bytes) != 0) {
-        st = obs__fail(err, OBS_TOO_LARGE, "G-buffer of %dx%d does not fit in memory", g.width, g.height);
-        goto fail;
-    }
-    if (!(out->storage = calloc(1, bytes))) {
-        st = obs__fail(err, OBS_NO_MEMORY, "G-buffer of %dx%d", g.width, g.height);
-        goto fail;
-    }
-    float *depth = out->storage, *normal = has_n ? depth + px : NULL;
-    float *color = has_c ? depth + px * (1 + 3 * has_n) : NULL;
-    float *position = has_p ? depth + px * (1 + 3 * has_n + 4 * has_c) : NULL;
+    float *depth = NULL, *normal = NULL, *color = NULL, *position = NULL;
     target t[11];
     int nt = 0, tpart[11], idx[11];
-    idx[nt] = m.depth;
-    t[nt++] = (target){names[m.depth], depth, 1};
-    for (int i = 0; has_n && i < 3; i++)
-        idx[nt] = m.normal[i], t[nt++] = (target){names[m.normal[i]], normal + i, 3};
-    for (int i = 0; has_c && i < 4; i++)
-        if (m.color[i] >= 0)
-            idx[nt] = m.color[i], t[nt++] = (target){names[m.color[i]], color + i, 4};
-    for (int i = 0; has_p && i < 3; i++)
-        idx[nt] = m.position[i], t[nt++] = (target){names[m.position[i]], position + i, 3};
-    /* a view's channels may lie in several parts: the depth part's here,
-     * the others' by decode_other_parts() */
-    target here[11];
-    int nt_here = 0;
-    for (int i = 0; i < nt; i++) {
-        tpart[i] = owner ? owner[idx[i]] : part;
-        if (tpart[i] == part)
-            here[nt_here++] = t[i];
-    }
-    if (has_c && m.color[3] < 0) /* colour without alpha is opaque */
-        for (size_t i = 0; i < px; i++)
-            color[i * 4 + 3] = 1.0f;
-    if ((st = decode_part(ctx, part, &g, here, nt_here, lim, err)) != OBS_OK ||
-        (st = decode_other_parts(ctx, file_size, part, &g, t, tpart, nt, lim, err)) != OBS_OK)
+    if (rows && owner) {
+        st = obs__fail(err, OBS_UNSUPPORTED, "the channels lie in several parts of the view: "
+                       "read by rows from one part only");
         goto fail;
+    }
+    if (!rows) {
+        size_t px = (size_t)g.width * (size_t)g.height, bytes;
+        if (obs__size_mul3((size_t)g.width, (size_t)g.height,
+                           (size_t)(1 + 3 * has_n + 4 * has_c + 3 * has_p) * sizeof(float), &bytes) != 0) {
+            st = obs__fail(err, OBS_TOO_LARGE, "G-buffer of %dx%d does not fit in memory", g.width, g.height);
+            goto fail;
+        }
+        if (!(out->storage = calloc(1, bytes))) {
+            st = obs__fail(err, OBS_NO_MEMORY, "G-buffer of %dx%d", g.width, g.height);
+            goto fail;
+        }
+        depth = out->storage;
+        normal = has_n ? depth + px : NULL;
+        color = has_c ? depth + px * (1 + 3 * has_n) : NULL;
+        position = has_p ? depth + px * (1 + 3 * has_n + 4 * has_c) : NULL;
+        nt = gbuffer_targets(names, &m, depth, normal, color, position, t, idx);
+        /* a view's channels may lie in several parts: the depth part's here,
+         * the others' by decode_other_parts() */
+        target here[11];
+        int nt_here = 0;
+        for (int i = 0; i < nt; i++) {
+            tpart[i] = owner ? owner[idx[i]] : part;
+            if (tpart[i] == part)
+                here[nt_here++] = t[i];
+        }
+        if (has_c && m.color[3] < 0) /* colour without alpha is opaque */
+            for (size_t i = 0; i < px; i++)
+                color[i * 4 + 3] = 1.0f;
+        if ((st = decode_part(ctx, part, &g, here, nt_here, lim, err)) != OBS_OK ||
+            (st = decode_other_parts(ctx, file_size, part, &g, t, tpart, nt, lim, err)) != OBS_OK)
+            goto fail;
+    }
 
     obs_gbuffer *gb = &out->gb;
     gb->width = g.width;
@@ -631,7 +702,7 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     gb->depth = (obs_plane){depth, 1, 0};
     gb->normal = (obs_plane){normal, has_n ? 3 : 0, 0};
     gb->color = (obs_plane){color, has_c ? 4 : 0, 0};
-    gb->position = (obs_plane){position, has_p ? 3 : 0, 0};
+    gb->position = (obs_plane){position, has_p && !rows ? 3 : 0, 0};
     gb->depth_mode = m.depth_mode;
     gb->normal_space = m.normal_space;
 
@@ -652,6 +723,14 @@ static obs_status read_gbuffer(exr_context_t ctx, int64_t file_size, const obs_c
     snprintf(info->preset, sizeof info->preset, "%s", m.preset);
     snprintf(info->view, sizeof info->view, "%s", ps.view);
     info->parts_read = 1;
+    if (rows) { /* the rows' reader keeps the part and the names */
+        rows->part = part;
+        rows->g = g;
+        rows->m = m;
+        rows->names = names;
+        rows->gb = *gb;
+        names = NULL;
+    }
     for (int i = 1; i < nt; i++) {
         int seen = 0;
         for (int k = 0; k < i; k++)
@@ -677,7 +756,12 @@ static obs_status gbuffer_reader(exr_context_t ctx, int64_t size, void *user,
                                  char why[OBS_ERR_LEN])
 {
     const gbuffer_job *j = user;
-    return read_gbuffer(ctx, size, j->map, j->lim, j->out, why);
+    return read_gbuffer(ctx, size, j->map, j->lim, j->out, NULL, why);
+}
+
+static void gbuffer_release(void *out)
+{
+    obs_gbuffer_free(out);
 }
 
 /* Shared by the file and memory readers; `label` prefixes messages. */
@@ -685,14 +769,9 @@ static obs_status read_any(const char *label, const char *path, const mem_src *m
                            const obs_channel_map *map, const obs_limits *lim,
                            obs_gbuffer_file *out, char err[OBS_ERR_LEN])
 {
-    if (!out)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: no output", label);
-    memset(out, 0, sizeof *out);
     gbuffer_job j = {map, lim, out};
-    obs_status st = obs__exr_read_with(label, path, mem, gbuffer_reader, &j, err);
-    if (st != OBS_OK)
-        obs_gbuffer_free(out);
-    return st;
+    return obs__exr_read_out(label, path, mem, gbuffer_reader, &j, out, sizeof *out,
+                             gbuffer_release, err);
 }
 
 obs_status obs_gbuffer_read_exr(const char *path, const obs_channel_map *map,
@@ -712,6 +791,140 @@ obs_status obs_gbuffer_read_exr_mem(const void *buf, size_t len, const obs_chann
     if (!buf || len == 0)
         return obs__fail(err, OBS_BAD_FILE, "EXR in memory: empty buffer");
     return read_any("EXR in memory", NULL, &mem, map, lim, out, err);
+}
+
+obs_status obs_gbuffer_rows_open(const char *path, const obs_channel_map *map, const obs_limits *lim,
+                                 obs_gbuffer_rows **rows, obs_gbuffer_file *meta, char err[OBS_ERR_LEN])
+{
+    char why[OBS_ERR_LEN] = "";
+    int64_t size;
+    *rows = NULL;
+    memset(meta, 0, sizeof *meta);
+    if (!path || !*path)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no EXR path given");
+    obs_gbuffer_rows *r = calloc(1, sizeof *r);
+    if (!r)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: a reader", path);
+    if (lim)
+        r->lim = *lim;
+    obs_status st = obs__exr_open(path, NULL, &r->ctx, &size, why);
+    if (st == OBS_OK)
+        st = read_gbuffer(r->ctx, size, map, lim, meta, r, why);
+    if (st != OBS_OK) {
+        obs_gbuffer_rows_close(r);
+        obs_gbuffer_free(meta);
+        return obs__fail(err, st, "%s: %s", path, why);
+    }
+    *rows = r;
+    return OBS_OK;
+}
+
+/* Decodes rows [y0, y1) (chunk rows) into the reader's buffer, whose row
+ * 0 is the data window's row h0. */
+static obs_status rows_decode(obs_gbuffer_rows *r, int h0, int y0, int y1, char err[OBS_ERR_LEN])
+{
+    const part_geom *g = &r->g;
+    if (y0 >= y1)
+        return OBS_OK;
+    const size_t plane = (size_t)g->width * (size_t)r->cap_rows, w = (size_t)g->width;
+    const int has_n = r->gb.normal.channels > 0, has_c = r->gb.color.channels > 0;
+    float *depth = r->buf, *normal = has_n ? depth + plane : NULL;
+    float *color = has_c ? depth + plane * (size_t)(1 + 3 * has_n) : NULL;
+    if (has_c && r->m.color[3] < 0) /* colour without alpha is opaque */
+        for (size_t i = (size_t)(y0 - h0) * w; i < (size_t)(y1 - h0) * w; i++)
+            color[i * 4 + 3] = 1.0f;
+    /* the targets' row 0 is the data window's: h0 rows before the buffer */
+    const size_t back = (size_t)h0 * w;
+    target t[11];
+    int idx[11];
+    int nt = gbuffer_targets(r->names, &r->m, depth - back, normal ? normal - 3 * back : NULL,
+                             color ? color - 4 * back : NULL, NULL, t, idx);
+    return decode_rows(r->ctx, r->part, g, t, nt, &r->lim, y0, y1, err);
+}
+
+obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *r, int y0, int y1, obs_gbuffer *out,
+                                 char err[OBS_ERR_LEN])
+{
+    const part_geom *g = &r->g;
+    int32_t lines = 0;
+    uint32_t tw = 0;
+    if (y0 < 0 || y1 > g->height || y0 >= y1)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "rows %d-%d of a G-buffer of %d rows", y0, y1,
+                         g->height);
+    obs_status st = chunk_lines(r->ctx, r->part, g, &lines, &tw, err);
+    if (st != OBS_OK)
+        return st;
+    /* the rows of the chunks holding [y0, y1) */
+    const int n0 = y0 / lines * lines;
+    const int64_t up = ((int64_t)y1 + lines - 1) / lines * lines;
+    const int n1 = up < g->height ? (int)up : g->height;
+    const int has_n = r->gb.normal.channels > 0, has_c = r->gb.color.channels > 0;
+    const int per_px = 1 + 3 * has_n + 4 * has_c;
+    const size_t w = (size_t)g->width;
+    /* the rows held before that are asked again (the bands go down the
+     * frame, each with a halo over the last one's): kept, not decoded;
+     * the rows before and after them decoded */
+    int k0 = n0 > r->h0 ? n0 : r->h0, k1 = n1 < r->h1 ? n1 : r->h1;
+    if (!(r->h1 > r->h0 && k0 < k1))
+        k0 = k1 = n1; /* nothing kept */
+    if (n1 - n0 > r->cap_rows) {
+        /* a larger buffer (grown in place where the allocator can: the
+         * old and the new are not held at once), each plane's kept rows
+         * moved to its new place, the last plane first */
+        float *nb = realloc(r->buf, (size_t)(n1 - n0) * w * (size_t)per_px * sizeof(float));
+        if (!nb)
+            return obs__fail(err, OBS_NO_MEMORY, "%d rows of a %dx%d G-buffer", n1 - n0, g->width,
+                             g->height);
+        r->buf = nb;
+        const size_t oplane = w * (size_t)r->cap_rows, nplane = w * (size_t)(n1 - n0);
+        const int chs[3] = {1, 3 * has_n, 4 * has_c}, at[3] = {0, 1, 1 + 3 * has_n};
+        for (int c = 2; k1 > k0 && c >= 0; c--)
+            if (chs[c])
+                memmove(nb + nplane * (size_t)at[c] + (size_t)(k0 - n0) * w * (size_t)chs[c],
+                        nb + oplane * (size_t)at[c] + (size_t)(k0 - r->h0) * w * (size_t)chs[c],
+                        (size_t)(k1 - k0) * w * (size_t)chs[c] * sizeof(float));
+        r->cap_rows = n1 - n0;
+    } else if (k1 > k0 && n0 != r->h0) { /* in place (memmove: either way within a plane) */
+        const size_t plane = w * (size_t)r->cap_rows;
+        const int chs[3] = {1, 3 * has_n, 4 * has_c}, at[3] = {0, 1, 1 + 3 * has_n};
+        for (int c = 0; c < 3; c++)
+            if (chs[c])
+                memmove(r->buf + plane * (size_t)at[c] + (size_t)(k0 - n0) * w * (size_t)chs[c],
+                        r->buf + plane * (size_t)at[c] + (size_t)(k0 - r->h0) * w * (size_t)chs[c],
+                        (size_t)(k1 - k0) * w * (size_t)chs[c] * sizeof(float));
+    }
+    r->h0 = r->h1 = 0;
+    if ((st = rows_decode(r, n0, n0, k0, err)) != OBS_OK || (st = rows_decode(r, n0, k1, n1, err)) != OBS_OK)
+        return st;
+    r->h0 = n0;
+    r->h1 = n1;
+    const size_t plane = w * (size_t)r->cap_rows, skip = (size_t)(y0 - n0) * w;
+    *out = r->gb;
+    out->depth.data = r->buf + skip;
+    out->normal.data = has_n ? r->buf + plane + 3 * skip : NULL;
+    out->color.data = has_c ? r->buf + plane * (size_t)(1 + 3 * has_n) + 4 * skip : NULL;
+    return OBS_OK;
+}
+
+void obs_gbuffer_rows_no_color(obs_gbuffer_rows *r)
+{
+    r->gb.color = (obs_plane){NULL, 0, 0};
+    for (int i = 0; i < 4; i++)
+        r->m.color[i] = -1;
+    free(r->buf); /* the rows' layout changes: nothing held */
+    r->buf = NULL;
+    r->cap_rows = r->h0 = r->h1 = 0;
+}
+
+void obs_gbuffer_rows_close(obs_gbuffer_rows *r)
+{
+    if (!r)
+        return;
+    free(r->names);
+    if (r->ctx)
+        exr_finish(&r->ctx);
+    free(r->buf);
+    free(r);
 }
 
 void obs_gbuffer_free(obs_gbuffer_file *f)

@@ -146,17 +146,13 @@ typedef struct enc_job {
     const obs__wpart *p;
     const exr_chunk_info_t *ci;
     enc_slot *slot;
-    int64_t failed;     /* lowest failing chunk (chunks: none); under the pool's lock */
-    exr_result_t rv;
-    char msg[384];
+    obs__exr_chunk_fail fail; /* under the pool's lock */
 } enc_job;
 
 typedef struct enc_local {
     exr_encode_pipeline_t enc;
     int started;
-    int64_t failed;
-    exr_result_t rv;
-    char msg[384];
+    obs__exr_chunk_fail fail;
 } enc_local;
 
 /* The write step of a thread's pipeline: keep the chunk's bytes. */
@@ -175,7 +171,7 @@ static void enc_begin(void *ctx, void *local)
     (void)ctx;
     enc_local *l = local;
     l->enc = (exr_encode_pipeline_t)EXR_ENCODE_PIPELINE_INITIALIZER;
-    l->rv = EXR_ERR_SUCCESS;
+    l->fail.code = EXR_ERR_SUCCESS;
     obs__exr_msg_reset();
 }
 
@@ -200,9 +196,9 @@ static int enc_one(void *ctx, void *local, size_t i, size_t i1)
     }
     if (rv == EXR_ERR_SUCCESS)
         return 0;
-    l->failed = (int64_t)i;
-    l->rv = rv;
-    snprintf(l->msg, sizeof l->msg, "%s", obs__exr_msg());
+    l->fail.chunk = (int64_t)i;
+    l->fail.code = rv;
+    snprintf(l->fail.msg, sizeof l->fail.msg, "%s", obs__exr_msg());
     return 1;
 }
 
@@ -211,23 +207,41 @@ static void enc_end(void *ctx, void *local)
 {
     enc_job *j = ctx;
     enc_local *l = local;
-    if (l->rv != EXR_ERR_SUCCESS && l->failed < j->failed) {
-        j->failed = l->failed;
-        j->rv = l->rv;
-        memcpy(j->msg, l->msg, sizeof j->msg);
-    }
+    obs__exr_chunk_fail_keep(&j->fail, &l->fail);
     if (l->started)
         exr_encoding_destroy(j->ctx, &l->enc);
 }
 
-/* Compression threads for `chunks` chunks: the caller's count (0: the
- * machine's cores, pool.h), no more than one for every 4 chunks. */
-static int encode_threads(int threads, int64_t chunks)
+/* Part `part`'s pixels: the chunks [first, first + chunks) (the rows of
+ * p's channels from the data window's first), in order. */
+static exr_result_t write_chunks(exr_context_t ctx, int part, const obs__wpart *p, int threads,
+                                 int64_t first, int64_t chunks, int32_t lines)
 {
-    int n = obs__pool_threads(threads);
-    if (n > chunks / 4)
-        n = (int)(chunks / 4);
-    return n < 1 ? 1 : n;
+    exr_result_t rv = EXR_ERR_SUCCESS;
+    exr_chunk_info_t *ci = calloc((size_t)chunks, sizeof *ci);
+    enc_job j = {.ctx = ctx, .part = part, .p = p, .ci = ci, .fail = {.chunk = INT64_MAX}};
+    j.slot = calloc((size_t)chunks, sizeof *j.slot);
+    if (!ci || !j.slot)
+        rv = EXR_ERR_OUT_OF_MEMORY;
+    for (int64_t c = 0; c < chunks && rv == EXR_ERR_SUCCESS; c++)
+        rv = exr_write_scanline_chunk_info(ctx, part, (int)(p->dw.min.y + (first + c) * lines), &ci[c]);
+    if (rv == EXR_ERR_SUCCESS) {
+        obs__pool_for f = {.end = (size_t)chunks, .chunk = 1,
+                           .threads = obs__exr_chunk_threads(threads, chunks),
+                           .range = enc_one, .ctx = &j, .local_size = sizeof(enc_local),
+                           .begin = enc_begin, .end_thread = enc_end};
+        if (obs__pool_run(&f, NULL) < 0)
+            rv = EXR_ERR_OUT_OF_MEMORY;
+        else if ((rv = (exr_result_t)j.fail.code) != EXR_ERR_SUCCESS && j.fail.msg[0])
+            obs__exr_error_handler(ctx, rv, j.fail.msg); /* the worker's message, on this thread */
+    }
+    for (int64_t c = 0; c < chunks && rv == EXR_ERR_SUCCESS; c++)
+        rv = exr_write_scanline_chunk(ctx, part, j.ci[c].start_y, j.slot[c].data, j.slot[c].size);
+    for (int64_t c = 0; j.slot && c < chunks; c++)
+        free(j.slot[c].data);
+    free(j.slot);
+    free(ci);
+    return rv;
 }
 
 /* Part `part`'s pixels, every chunk, in order. */
@@ -239,30 +253,8 @@ static exr_result_t write_pixels(exr_context_t ctx, int part, const obs__wpart *
         return rv;
     if (lines < 1)
         return EXR_ERR_INVALID_ARGUMENT;
-    int64_t chunks = ((int64_t)p->dw.max.y - p->dw.min.y + lines) / lines;
-    exr_chunk_info_t *ci = calloc((size_t)chunks, sizeof *ci);
-    enc_job j = {.ctx = ctx, .part = part, .p = p, .ci = ci, .failed = chunks, .rv = EXR_ERR_SUCCESS};
-    j.slot = calloc((size_t)chunks, sizeof *j.slot);
-    if (!ci || !j.slot)
-        rv = EXR_ERR_OUT_OF_MEMORY;
-    for (int64_t c = 0; c < chunks && rv == EXR_ERR_SUCCESS; c++)
-        rv = exr_write_scanline_chunk_info(ctx, part, (int)(p->dw.min.y + c * lines), &ci[c]);
-    if (rv == EXR_ERR_SUCCESS) {
-        obs__pool_for f = {.end = (size_t)chunks, .chunk = 1, .threads = encode_threads(threads, chunks),
-                           .range = enc_one, .ctx = &j, .local_size = sizeof(enc_local),
-                           .begin = enc_begin, .end_thread = enc_end};
-        if (obs__pool_run(&f, NULL) < 0)
-            rv = EXR_ERR_OUT_OF_MEMORY;
-        else if ((rv = j.rv) != EXR_ERR_SUCCESS && j.msg[0])
-            obs__exr_error_handler(ctx, rv, j.msg); /* the worker's message, on this thread */
-    }
-    for (int64_t c = 0; c < chunks && rv == EXR_ERR_SUCCESS; c++)
-        rv = exr_write_scanline_chunk(ctx, part, j.ci[c].start_y, j.slot[c].data, j.slot[c].size);
-    for (int64_t c = 0; j.slot && c < chunks; c++)
-        free(j.slot[c].data);
-    free(j.slot);
-    free(ci);
-    return rv;
+    return write_chunks(ctx, part, p, threads, 0, ((int64_t)p->dw.max.y - p->dw.min.y + lines) / lines,
+                        lines);
 }
 
 /* `skip` and the input part's obscura/... attributes, NULL-ended in
@@ -301,7 +293,7 @@ static exr_result_t write_prov(exr_context_t ctx, int part, const obs__prov *pro
  * always. */
 static exr_result_t write_parts(exr_context_t ctx, const obs__wpart *parts, int np, exr_const_context_t src,
                                 const char *const *skip, const obs_camera *cam, const obs__prov *prov,
-                                int cam_part, int threads, const char **what, const char **attr)
+                                int cam_part, int threads, int pixels, const char **what, const char **attr)
 {
     static const exr_attr_v2f_t centre = {{{0.0f, 0.0f}}};
     int longnames = 0;
@@ -343,7 +335,7 @@ static exr_result_t write_parts(exr_context_t ctx, const obs__wpart *parts, int 
         return rv;
 
     *what = "writing pixels";
-    for (int i = 0; i < np && rv == EXR_ERR_SUCCESS; i++)
+    for (int i = 0; pixels && i < np && rv == EXR_ERR_SUCCESS; i++)
         rv = write_pixels(ctx, i, &parts[i], threads);
     return rv;
 }
@@ -400,6 +392,42 @@ static obs_status plain_windows(const obs_exr_options *o, exr_const_context_t sr
     return OBS_OK;
 }
 
+/* The path, the pixel type, the layers and the compression of a write
+ * (the compression unless appending, which keeps the input's). */
+static obs_status check_write(const char *path, const obs_exr_options *o, const obs_exr_layer *layers,
+                              int layer_count, int *longnames, char err[OBS_ERR_LEN])
+{
+    char sub[OBS_ERR_LEN] = "";
+    obs_status st;
+    if (!path || !*path)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "no EXR path given");
+    if (o->pixel != OBS_EXR_HALF && o->pixel != OBS_EXR_FLOAT)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: unknown pixel type %d", path, (int)o->pixel);
+    if ((st = check_layers(layers, layer_count, longnames, err)) != OBS_OK)
+        return st;
+    if (!o->append && (st = obs_exr_compression_check(o->compression, sub)) != OBS_OK)
+        return obs__fail(err, st, "%s: %s", path, sub);
+    return OBS_OK;
+}
+
+/* The status of the library's rv while `what` (the input's attribute
+ * attr, when not NULL), its message into sub. */
+static obs_status write_status(exr_result_t rv, const char *what, const char *attr, char sub[OBS_ERR_LEN])
+{
+    if (rv == EXR_ERR_SUCCESS)
+        return OBS_OK;
+    obs_status st = obs__exr_status(rv);
+    /* Here a bad argument or attribute is ours, not the file's. */
+    if (st == OBS_BAD_FILE)
+        st = rv == EXR_ERR_INVALID_ARGUMENT || rv == EXR_ERR_NAME_TOO_LONG ? OBS_INVALID_ARGUMENT : OBS_IO;
+    const char *msg = obs__exr_msg()[0] ? obs__exr_msg() : exr_get_default_error_message(rv);
+    if (attr)
+        obs__fail(sub, st, "%s: the input's attribute '%.100s': %s", what, attr, msg);
+    else
+        obs__fail(sub, st, "%s: %s", what, msg);
+    return st;
+}
+
 /* Writes to `path`, or into `mem` when it is non-NULL (`path` then only
  * names the output in messages). */
 static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_layer *layers,
@@ -422,14 +450,8 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
 
     if (!o)
         o = &zero;
-    if (!path || !*path)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "no EXR path given");
-    if (o->pixel != OBS_EXR_HALF && o->pixel != OBS_EXR_FLOAT)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: unknown pixel type %d", path, (int)o->pixel);
-    if ((st = check_layers(layers, layer_count, &longnames, err)) != OBS_OK)
+    if ((st = check_write(path, o, layers, layer_count, &longnames, err)) != OBS_OK)
         return st;
-    if (!o->append && (st = obs_exr_compression_check(o->compression, sub)) != OBS_OK)
-        return obs__fail(err, st, "%s: %s", path, sub);
     if (o->append && !o->src)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: appending needs the input file", path);
     exr_pixel_type_t type = o->pixel == OBS_EXR_FLOAT ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
@@ -482,24 +504,13 @@ static obs_status write_exr(const char *path, obs__membuf *mem, const obs_exr_la
                 cam_part = i;
         obs__prov_build(o->prov, &prov);
         rv = write_parts(ctx, parts, np, src, o->append ? NULL : plain_skip, o->cam, &prov, cam_part,
-                         o->threads, &what, &attr);
+                         o->threads, 1, &what, &attr);
         if (rv == EXR_ERR_SUCCESS) {
             what = "finishing the file";
             rv = exr_finish(&ctx);
         }
     }
-    st = OBS_OK;
-    if (rv != EXR_ERR_SUCCESS) {
-        st = obs__exr_status(rv);
-        /* Here a bad argument or attribute is ours, not the file's. */
-        if (st == OBS_BAD_FILE)
-            st = rv == EXR_ERR_INVALID_ARGUMENT || rv == EXR_ERR_NAME_TOO_LONG ? OBS_INVALID_ARGUMENT : OBS_IO;
-        const char *msg = obs__exr_msg()[0] ? obs__exr_msg() : exr_get_default_error_message(rv);
-        if (attr)
-            obs__fail(sub, st, "%s: the input's attribute '%.100s': %s", what, attr, msg);
-        else
-            obs__fail(sub, st, "%s: %s", what, msg);
-    }
+    st = write_status(rv, what, attr, sub);
 fail:
     if (ctx)
         exr_finish(&ctx);
@@ -550,3 +561,192 @@ obs_status obs_exr_write_mem(const obs_exr_layer *layers, int layer_count, obs_e
     return obs_exr_write_ex_mem(layers, layer_count, &o, out, err);
 }
 
+
+/* ---- by rows: a frame never whole in memory --------------------------------
+ *
+ * The header goes out at the open; rows come in order, are kept until
+ * BATCH_CHUNKS chunks are complete, and those are compressed (by a few
+ * threads, write_chunks) and written: the writer holds a batch of rows,
+ * never the image. */
+#define BATCH_CHUNKS 8
+
+struct obs_exr_rows {
+    exr_context_t ctx;
+    obs__out_file out;
+    obs__wpart part;
+    const uint8_t **base; /* each channel's place in buf */
+    float *buf;           /* a batch of rows of every layer, layer after layer */
+    int nl, lch[OBS_RESULT_LAYERS + 4];
+    int width, height, lines, batch, threads;
+    int next;             /* the rows received */
+    int first;            /* the first row in buf */
+    char path[4096];
+};
+
+/* Compresses and writes the rows in buf ([first, next)). */
+static obs_status rows_flush(obs_exr_rows *w, char sub[OBS_ERR_LEN])
+{
+    if (w->next <= w->first)
+        return OBS_OK;
+    for (int k = 0; k < w->part.nch; k++) /* the channels from the data window's first row */
+        w->part.ch[k].base = w->base[k] - (size_t)w->first * (size_t)w->part.ch[k].line_stride;
+    int64_t c0 = w->first / w->lines, c1 = ((int64_t)w->next + w->lines - 1) / w->lines;
+    exr_result_t rv = write_chunks(w->ctx, 0, &w->part, w->threads, c0, c1 - c0, w->lines);
+    w->first = w->next;
+    return write_status(rv, "writing pixels", NULL, sub);
+}
+
+static obs_status rows_free(obs_exr_rows *w, obs_status st, char sub[OBS_ERR_LEN]);
+
+obs_status obs_exr_rows_open(const char *path, const obs_exr_layer *layers, int layer_count, int height,
+                             const obs_exr_options *opt, obs_exr_rows **out, char err[OBS_ERR_LEN])
+{
+    static const char *const plain_skip[] = {"multiView", NULL};
+    static const obs_exr_options zero = {0};
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    exr_context_t src = NULL;
+    int64_t src_size = -1;
+    int longnames = 0;
+    const char *what = "reading the input's header", *attr = NULL;
+    char sub[OBS_ERR_LEN] = "";
+    obs_status st;
+    const obs_exr_options *o = opt ? opt : &zero;
+    obs__prov prov;
+
+    *out = NULL;
+    if ((st = check_write(path, o, layers, layer_count, &longnames, err)) != OBS_OK)
+        return st;
+    if (layer_count > OBS_RESULT_LAYERS + 4 || o->append || (o->src && !o->src->path) || height <= 0)
+        return obs__fail(err, OBS_UNSUPPORTED, "%s: written by rows: a plain output of a file's rows only", path);
+    obs_exr_rows *w = calloc(1, sizeof *w);
+    if (!w)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: a writer", path);
+    snprintf(w->path, sizeof w->path, "%s", path);
+    w->width = layers[0].image->width;
+    w->height = height;
+    w->threads = o->threads;
+    w->nl = layer_count;
+    exr_pixel_type_t type = o->pixel == OBS_EXR_FLOAT ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
+    /* the batch's images: the layers' channels over the batch's rows */
+    int per_px = 0;
+    for (int l = 0; l < layer_count; l++)
+        per_px += w->lch[l] = layers[l].image->channels;
+    w->part.src_part = o->src ? o->src->part : -1;
+    w->part.compression = exr_compression_of(o->compression);
+    obs_image imgs[OBS_RESULT_LAYERS + 4];
+    obs_exr_layer batch[OBS_RESULT_LAYERS + 4];
+    if (o->src && (st = obs__exr_open(o->src->path, NULL, &src, &src_size, sub)) != OBS_OK)
+        goto fail;
+    init.error_handler_fn = obs__exr_error_handler;
+    obs__exr_msg_reset();
+    what = "creating the file";
+    exr_result_t rv = exr_start_write(&w->ctx, obs__out_begin(&w->out, w->path), EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv == EXR_ERR_SUCCESS) {
+        obs__prov_build(o->prov, &prov);
+        /* the windows first: the chunk size follows the compression */
+        for (int l = 0; l < layer_count; l++) {
+            imgs[l] = (obs_image){w->width, height, layers[l].image->channels, layers[l].image->data};
+            batch[l] = (obs_exr_layer){&imgs[l], layers[l].names};
+        }
+        if ((st = layers_part(batch, layer_count, type, &w->part, sub)) != OBS_OK ||
+            (st = plain_windows(o, src, w->width, height, &w->part, sub)) != OBS_OK)
+            goto fail;
+        rv = write_parts(w->ctx, &w->part, 1, src, plain_skip, o->cam, &prov, 0, o->threads, 0, &what, &attr);
+    }
+    if (rv == EXR_ERR_SUCCESS && (rv = exr_get_scanlines_per_chunk(w->ctx, 0, &w->lines)) == EXR_ERR_SUCCESS &&
+        w->lines < 1)
+        rv = EXR_ERR_INVALID_ARGUMENT;
+    if ((st = write_status(rv, what, attr, sub)) != OBS_OK)
+        goto fail;
+    w->batch = w->lines * BATCH_CHUNKS;
+    size_t n = (size_t)w->width * (size_t)w->batch * (size_t)per_px;
+    if (!(w->buf = malloc(n * sizeof(float))) || !(w->base = calloc((size_t)w->part.nch, sizeof *w->base))) {
+        st = obs__fail(sub, OBS_NO_MEMORY, "%d rows of %d pixels", w->batch, w->width);
+        goto fail;
+    }
+    /* each channel at its place in the batch: layer l's rows after the
+     * layers before it */
+    float *at = w->buf;
+    for (int l = 0, k = 0; l < layer_count; l++) {
+        for (int c = 0; c < w->lch[l]; c++, k++)
+            w->base[k] = (const uint8_t *)(at + c);
+        at += (size_t)w->width * (size_t)w->batch * (size_t)w->lch[l];
+    }
+    if (src)
+        exr_finish(&src);
+    *out = w;
+    return OBS_OK;
+fail:
+    if (src)
+        exr_finish(&src);
+    char ignored[OBS_ERR_LEN];
+    rows_free(w, st, ignored);
+    return obs__fail(err, st, "%s: %s", path, sub);
+}
+
+obs_status obs_exr_rows_write(obs_exr_rows *w, const obs_exr_layer *layers, int layer_count,
+                              char err[OBS_ERR_LEN])
+{
+    char sub[OBS_ERR_LEN] = "";
+    if (layer_count != w->nl)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: %d layers, the file has %d", w->path, layer_count, w->nl);
+    const int rows = layers[0].image->height;
+    for (int l = 0; l < layer_count; l++)
+        if (layers[l].image->width != w->width || layers[l].image->height != rows ||
+            layers[l].image->channels != w->lch[l])
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: layer %d is not the file's", w->path, l);
+    if (rows <= 0 || rows > w->height - w->next)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s: %d rows more than the %d of the image", w->path, rows,
+                         w->height);
+    for (int y = 0; y < rows;) {
+        /* into the batch: the rows it has room for */
+        int take = w->first + w->batch - w->next < rows - y ? w->first + w->batch - w->next : rows - y;
+        float *at = w->buf;
+        for (int l = 0; l < layer_count; l++) {
+            const size_t row = (size_t)w->width * (size_t)w->lch[l];
+            memcpy(at + (size_t)(w->next - w->first) * row, layers[l].image->data + (size_t)y * row,
+                   (size_t)take * row * sizeof(float));
+            at += (size_t)w->batch * row;
+        }
+        w->next += take;
+        y += take;
+        obs_status st = OBS_OK;
+        if (w->next - w->first == w->batch || w->next == w->height)
+            st = rows_flush(w, sub);
+        if (st != OBS_OK)
+            return obs__fail(err, st, "%s: %s", w->path, sub);
+    }
+    return OBS_OK;
+}
+
+/* Finishes (st OBS_OK) or removes the file, frees w; the message of a
+ * failure here into sub. */
+static obs_status rows_free(obs_exr_rows *w, obs_status st, char sub[OBS_ERR_LEN])
+{
+    if (w->ctx) {
+        exr_result_t rv = exr_finish(&w->ctx);
+        if (st == OBS_OK)
+            st = write_status(rv, "finishing the file", NULL, sub);
+    }
+    if (w->out.path)
+        st = obs__out_end(&w->out, st, sub);
+    free(w->part.ch);
+    free(w->base);
+    free(w->buf);
+    free(w);
+    return st;
+}
+
+obs_status obs_exr_rows_close(obs_exr_rows *w, obs_status st, char err[OBS_ERR_LEN])
+{
+    char sub[OBS_ERR_LEN] = "", path[4096];
+    if (!w)
+        return st;
+    snprintf(path, sizeof path, "%s", w->path);
+    if (st == OBS_OK && w->next != w->height)
+        st = obs__fail(sub, OBS_INVALID_ARGUMENT, "%d of its %d rows were written", w->next, w->height);
+    st = rows_free(w, st, sub);
+    if (st != OBS_OK && sub[0])
+        obs__fail(err, st, "%s: %s", path, sub);
+    return st;
+}

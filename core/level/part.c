@@ -93,9 +93,9 @@ uint64_t obs__bake_traced_fingerprint(const obs__bake_world *w, const obs__bake_
 
 /* ---- writing and reading a part ----------------------------------------- */
 
-obs_status obs__bake_part_write(const char *path, const unsigned char *head, size_t head_len,
-                                const unsigned char *payload, size_t payload_len,
-                                char err[OBS_ERR_LEN])
+/* Writes head then payload to path.tmp and renames it to path. */
+static obs_status write_file(const char *path, const unsigned char *head, size_t head_len,
+                             const unsigned char *payload, size_t payload_len, char err[OBS_ERR_LEN])
 {
     size_t len = strlen(path);
     char *tmp = malloc(len + 5);
@@ -117,10 +117,14 @@ obs_status obs__bake_part_write(const char *path, const unsigned char *head, siz
     return ok ? OBS_OK : obs__fail(err, OBS_IO, "%s: cannot write the part: %s", path, strerror(e));
 }
 
-obs_status obs__bake_part_head(const char *path, const char *magic, const char *what, const char *writer,
-                               unsigned char *head, size_t head_len, uint64_t *size,
-                               char err[OBS_ERR_LEN])
+/* Reads a part's first f->head_len bytes and checks its 8-byte magic and
+ * that the header is whole; *size is the file's size (UINT64_MAX when
+ * unknown). */
+static obs_status read_head(const char *path, const obs__part_format *fm, unsigned char *head,
+                            uint64_t *size, char err[OBS_ERR_LEN])
 {
+    size_t head_len = fm->head_len;
+    *size = UINT64_MAX;
     FILE *f = fopen(path, "rb");
     if (!f)
         return obs__fail(err, OBS_IO, "%s: cannot open the part: %s", path, strerror(errno));
@@ -129,9 +133,9 @@ obs_status obs__bake_part_head(const char *path, const char *magic, const char *
     int have_size = fstat(fileno(f), &sb) == 0;
     fclose(f);
     *size = have_size ? (uint64_t)sb.st_size : UINT64_MAX;
-    if (got >= 8 && memcmp(head, magic, 8) != 0)
+    if (got >= 8 && memcmp(head, fm->magic, 8) != 0)
         return obs__fail(err, OBS_BAD_FILE, "%s: not a %s (no '%.8s' magic; '%s' writes "
-                         "them)", path, what, magic, writer);
+                         "them)", path, fm->what, fm->magic, fm->writer);
     if (got < head_len)
         return obs__fail(err, OBS_BAD_FILE, "%s: truncated: %zu bytes, shorter than a part's "
                          "header (%zu)", path, got, head_len);
@@ -220,8 +224,8 @@ obs__part_range obs__part_range_of(uint32_t version, uint64_t level, int index, 
                              .n = obs__bake_shard_first(total, index + 1, count) - first};
 }
 
-void obs__part_range_put(unsigned char *b, size_t head_len, const char *magic,
-                         const obs__part_range *r)
+/* Zeroes the head_len bytes of b and writes magic, head_len and r. */
+static void range_put(unsigned char *b, size_t head_len, const char *magic, const obs__part_range *r)
 {
     memset(b, 0, head_len);
     memcpy(b, magic, 8);
@@ -235,13 +239,14 @@ void obs__part_range_put(unsigned char *b, size_t head_len, const char *magic,
     obs__le_put64(b + 48, r->n);
 }
 
-obs_status obs__part_range_read(const char *path, const obs__part_format *f, unsigned char *b,
-                                obs__part_range *r, char err[OBS_ERR_LEN])
+/* Reads the part's header into b (head_len bytes) and its range into r,
+ * with obs__part_header_read's checks. */
+static obs_status range_read(const char *path, const obs__part_format *f, unsigned char *b,
+                             obs__part_range *r, char err[OBS_ERR_LEN])
 {
     uint64_t size;
     r->path = path;
-    obs_status rc = obs__bake_part_head(path, f->magic, f->what, f->writer, b, f->head_len, &size,
-                                        err);
+    obs_status rc = read_head(path, f, b, &size, err);
     if (rc != OBS_OK)
         return rc;
     r->version = obs__le_get32(b + 8);
@@ -272,11 +277,90 @@ obs_status obs__part_range_read(const char *path, const obs__part_format *f, uns
     return OBS_OK;
 }
 
-obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
-                                obs_status (*read_header)(const char *path, void *h,
-                                                          char err[OBS_ERR_LEN]),
+/* ---- the fields after the range, and the merge's parameters ------------- */
+
+/* The field's member in part, as a double (exact for every type but
+ * the 64-bit integers, which are no parameters). */
+static double member_value(const void *part, const obs__part_field *fd)
+{
+    const unsigned char *m = (const unsigned char *)part + fd->member;
+    uint32_t u32;
+    int32_t i32;
+    float f32;
+    uint64_t u64;
+    double f64;
+    switch (fd->type) {
+    case OBS__PART_U32: memcpy(&u32, m, 4); return u32;
+    case OBS__PART_I32: memcpy(&i32, m, 4); return i32;
+    case OBS__PART_F32: memcpy(&f32, m, 4); return f32;
+    case OBS__PART_U64: memcpy(&u64, m, 8); return (double)u64;
+    default: memcpy(&f64, m, 8); return f64;
+    }
+}
+
+static size_t type_size(obs__part_type t)
+{
+    return t == OBS__PART_U64 || t == OBS__PART_F64 ? 8 : 4;
+}
+
+/* The header's fields after the range, between the part's members and b. */
+static void fields_put(unsigned char *b, const obs__part_format *f, const void *part)
+{
+    for (size_t i = 0; i < f->field_count; i++) {
+        const obs__part_field *fd = &f->fields[i];
+        const unsigned char *m = (const unsigned char *)part + fd->member;
+        uint32_t u32;
+        uint64_t u64;
+        if (type_size(fd->type) == 4) {
+            memcpy(&u32, m, 4); /* the bits of a float, or the integer */
+            obs__le_put32(b + fd->at, u32);
+        } else {
+            memcpy(&u64, m, 8);
+            obs__le_put64(b + fd->at, u64);
+        }
+    }
+}
+
+static void fields_get(const unsigned char *b, const obs__part_format *f, void *part)
+{
+    for (size_t i = 0; i < f->field_count; i++) {
+        const obs__part_field *fd = &f->fields[i];
+        unsigned char *m = (unsigned char *)part + fd->member;
+        if (type_size(fd->type) == 4) {
+            uint32_t u32 = obs__le_get32(b + fd->at);
+            memcpy(m, &u32, 4);
+        } else {
+            uint64_t u64 = obs__le_get64(b + fd->at);
+            memcpy(m, &u64, 8);
+        }
+    }
+}
+
+obs_status obs__part_write(const char *path, const obs__part_format *f, const void *part,
+                           const unsigned char *payload, size_t payload_len,
+                           char err[OBS_ERR_LEN])
+{
+    unsigned char head[OBS__PART_HEAD_MAX];
+    range_put(head, f->head_len, f->magic, part);
+    fields_put(head, f, part);
+    return write_file(path, head, f->head_len, payload, payload_len, err);
+}
+
+obs_status obs__part_header_read(const char *path, const obs__part_format *f, void *part,
+                                 char err[OBS_ERR_LEN])
+{
+    unsigned char b[OBS__PART_HEAD_MAX];
+    memset(part, 0, f->part_size);
+    obs_status rc = range_read(path, f, b, part, err);
+    if (rc == OBS_OK)
+        fields_get(b, f, part);
+    return rc;
+}
+
+obs_status obs__bake_parts_read(const char *const *paths, size_t n, const obs__part_format *f,
                                 void **out, char err[OBS_ERR_LEN])
 {
+    size_t elem = f->part_size;
     *out = NULL;
     if (n == 0 || !paths)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "merge: no parts");
@@ -285,7 +369,7 @@ obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
     size_t *order = NULL;
     obs_status rc = heads && keys ? OBS_OK : obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
     for (size_t i = 0; rc == OBS_OK && i < n; i++)
-        if ((rc = read_header(paths[i], heads + i * elem, err)) == OBS_OK) {
+        if ((rc = obs__part_header_read(paths[i], f, heads + i * elem, err)) == OBS_OK) {
             const obs__part_range *r = (const void *)(heads + i * elem);
             keys[i] = (obs__bake_part_key){r->path, r->index, r->count, r->level};
         }
@@ -304,4 +388,76 @@ obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
     else
         free(ordered);
     return rc;
+}
+
+/* The merge's value of a parameter row in p, and v into it (the parts'
+ * parameters are rows of an int or a float). */
+static int int_row(const obs_table_row *row)
+{
+    return row->type == OBS_TABLE_INT || row->type == OBS_TABLE_WHOLE;
+}
+
+static double param_value(const void *p, const obs_table_row *row)
+{
+    const unsigned char *m = (const unsigned char *)p + row->offset;
+    int i;
+    float x;
+    if (int_row(row)) {
+        memcpy(&i, m, sizeof i);
+        return i;
+    }
+    memcpy(&x, m, sizeof x);
+    return x;
+}
+
+static void param_store(void *p, const obs_table_row *row, double v)
+{
+    unsigned char *m = (unsigned char *)p + row->offset;
+    int i = (int)v;
+    float x = (float)v;
+    if (int_row(row))
+        memcpy(m, &i, sizeof i);
+    else
+        memcpy(m, &x, sizeof x);
+}
+
+obs_status obs__part_adopt(const obs__part_format *f, const void *parts, size_t n, void *p,
+                           obs_status (*same)(const void *a, const void *b, char err[OBS_ERR_LEN]),
+                           char err[OBS_ERR_LEN])
+{
+    const unsigned char *a = parts;
+    const obs__part_range *ra = parts;
+    for (size_t i = 1; i < n; i++) {
+        const unsigned char *b = a + i * f->part_size;
+        const obs__part_range *rb = (const void *)b;
+        for (size_t k = 0; k < f->field_count; k++) {
+            const obs__part_field *fd = &f->fields[k];
+            if (fd->param && memcmp(a + fd->member, b + fd->member, type_size(fd->type)) != 0)
+                return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced with different "
+                                 "%s (%g and %g): they are not parts of one bake", ra->path,
+                                 rb->path, fd->param, member_value(a, fd), member_value(b, fd));
+        }
+        obs_status rc = same ? same(a, b, err) : OBS_OK;
+        if (rc != OBS_OK)
+            return rc;
+    }
+    uint64_t *given = (uint64_t *)(void *)((unsigned char *)p + f->params_given);
+    for (size_t k = 0; k < f->field_count; k++) {
+        const obs__part_field *fd = &f->fields[k];
+        const obs_table_row *row = fd->param ? f->param_find(fd->param) : NULL;
+        if (!row)
+            continue;
+        int bit = (int)(row - f->param_at(0));
+        double v = member_value(a, fd);
+        if (*given >> bit & 1) {
+            if (param_value(p, row) != v)
+                return obs__fail(err, OBS_INVALID_ARGUMENT, "the parts were traced with %s %g; "
+                                 "this merge asks for %g (leave it out to take the parts')",
+                                 fd->param, v, param_value(p, row));
+        } else {
+            param_store(p, row, v);
+            *given |= (uint64_t)1 << bit;
+        }
+    }
+    return OBS_OK;
 }

@@ -38,47 +38,10 @@ static inline double obs__le_bitsd(uint64_t u) { double d; memcpy(&d, &u, 8); re
 #define OBS__BAKE_FNV_OFFSET 0xcbf29ce484222325ULL
 uint64_t obs__bake_fnv(uint64_t h, const void *data, size_t n);
 
-/* Writes head then payload to path.tmp and renames it to path, so that a
- * killed writer leaves no part that looks whole. */
-obs_status obs__bake_part_write(const char *path, const unsigned char *head, size_t head_len,
-                                const unsigned char *payload, size_t payload_len,
-                                char err[OBS_ERR_LEN]);
-/* Reads a part's first head_len bytes and checks its 8-byte magic (the
- * message names `what` and the command that writes them) and that the
- * header is whole; *size is the file's size (UINT64_MAX when unknown). */
-obs_status obs__bake_part_head(const char *path, const char *magic, const char *what,
-                               const char *writer, unsigned char *head, size_t head_len,
-                               uint64_t *size, char err[OBS_ERR_LEN]);
 /* The len bytes at offset, checked against the header's FNV-1a 64;
  * caller frees *out. */
 obs_status obs__bake_part_payload(const char *path, size_t offset, size_t len, uint64_t checksum,
                                   unsigned char **out, char err[OBS_ERR_LEN]);
-
-/* The merges' checks of the parameters parts carry (bake/shard_run.c,
- * dynamic/dyn_shard_run.c), one row of a list X(name, field) each, inside a
- * function with `err` that returns obs_status.  SAME: parts a and b
- * carry the same value, bit for bit.  TAKE: the merge's p->name is part
- * a's unless row `row` of p's table was given (p->set), when the two
- * must agree. */
-#define OBS__PART_SAME(a, b, name, field)                                                \
-    if (memcmp(&(a)->field, &(b)->field, sizeof(a)->field) != 0)                         \
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced with different " \
-                         #name " (%g and %g): they are not parts of one bake", (a)->r.path, \
-                         (b)->r.path, (double)(a)->field, (double)(b)->field);
-#define OBS__PART_TAKE(p, a, row, name, field)                                           \
-    {                                                                                    \
-        int row_ = (row);                                                                \
-        if (row_ >= 0 && ((p)->set >> row_ & 1)) {                                       \
-            if ((p)->name != (a)->field)                                                 \
-                return obs__fail(err, OBS_INVALID_ARGUMENT, "the parts were traced with " #name \
-                                 " %g; this merge asks for %g (leave it out to take the parts')", \
-                                 (double)(a)->field, (double)(p)->name);                 \
-        } else {                                                                         \
-            (p)->name = (a)->field;                                                      \
-            if (row_ >= 0)                                                               \
-                (p)->set |= (uint64_t)1 << row_;                                         \
-        }                                                                                \
-    }
 
 /* What identifies a part among the parts of a split. */
 typedef struct obs__bake_part_key {
@@ -108,34 +71,180 @@ typedef struct obs__part_range {
  * fingerprint level, in a part of the given version. */
 obs__part_range obs__part_range_of(uint32_t version, uint64_t level, int index, int count,
                                    size_t total);
-/* Zeroes the head_len bytes of b and writes magic, head_len and r. */
-void obs__part_range_put(unsigned char *b, size_t head_len, const char *magic,
-                         const obs__part_range *r);
-/* What a reader expects of a part: its magic, the names for the messages
- * (`what` and the command that writes it; `kind` before "version";
- * `items` its items), its version and header size, the most items a level
- * has, each item's bytes in the payload. */
+/* The type of a header field after the range (little-endian on the
+ * file) and of the part struct's member that holds it. */
+typedef enum obs__part_type {
+    OBS__PART_U32, /* uint32_t */
+    OBS__PART_I32, /* int32_t */
+    OBS__PART_F32, /* float, its bits */
+    OBS__PART_U64, /* uint64_t */
+    OBS__PART_F64  /* double, its bits */
+} obs__part_type;
+/* A field of a part's header after its range: its byte offset, its type,
+ * the offset of its member in the part's struct, and for a parameter the
+ * name of its row in the bake's parameter table (else NULL): the merge
+ * checks those (obs__part_adopt), in the order of the fields. */
+typedef struct obs__part_field {
+    uint32_t at;
+    obs__part_type type;
+    size_t member;
+    const char *param;
+} obs__part_field;
+/* What a bake does in place of its trace (bake/shard.c's step,
+ * dynamic/dyn_shard.c's): with path, trace shard index of count and
+ * write it there (stop is set: the bake ends after the step); with parts
+ * (count of them: the bake's part structs, in shard order), read every
+ * shard back and go on. */
+typedef struct obs__part_job {
+    int index, count;
+    const char *path;
+    const void *parts;
+    int stop;
+} obs__part_job;
+
+/* The longest header of a part format. */
+#define OBS__PART_HEAD_MAX 128u
+/* A bake's part file: its magic, the names for the messages (`what` and
+ * the command that writes it; `kind` before "version"; `items` its
+ * items), its version and header size, the most items a level has, each
+ * item's bytes in the payload; its part struct's size (a struct that
+ * starts with its obs__part_range) and the header's fields after the
+ * range; the bake's parameter table (the rows the fields' `param` name,
+ * find and at as obs_bake_param_find and _at) and the offset of its
+ * uint64_t mask of the rows given in the parameters' struct. */
 typedef struct obs__part_format {
     const char *magic, *what, *writer, *kind, *items;
     uint32_t version;
     size_t head_len;
     uint64_t max_total, item_bytes;
+    size_t part_size;
+    const obs__part_field *fields;
+    size_t field_count;
+    const obs_table_row *(*param_find)(const char *name);
+    const obs_table_row *(*param_at)(int i);
+    size_t params_given;
 } obs__part_format;
-/* Reads the part's header into b (head_len bytes) and its range into r,
- * checking the magic, version and header size, the range against the
- * split (obs__bake_shard_first) and the file's length against
- * head_len + item_bytes n. */
-obs_status obs__part_range_read(const char *path, const obs__part_format *f, unsigned char *b,
-                                obs__part_range *r, char err[OBS_ERR_LEN]);
-/* The n parts at paths (none: "merge: no parts"), their headers read by
- * read_header into elem-byte structs that start with their
- * obs__part_range, checked to be every shard of one split once
- * (obs__bake_parts_order); *out the headers in shard order (n of them;
- * caller frees). */
-obs_status obs__bake_parts_read(const char *const *paths, size_t n, size_t elem,
-                                obs_status (*read_header)(const char *path, void *h,
-                                                          char err[OBS_ERR_LEN]),
+/* Writes the part (f->part_size bytes) to path as f lays it out: the
+ * header (zeroes, the magic, the header size, the range, f's fields),
+ * then the payload; under path.tmp, renamed to path, so that a killed
+ * writer leaves no part that looks whole. */
+obs_status obs__part_write(const char *path, const obs__part_format *f, const void *part,
+                           const unsigned char *payload, size_t payload_len,
+                           char err[OBS_ERR_LEN]);
+/* Zeroes part (f->part_size bytes) and reads the header of the part at
+ * path into it, checking the magic (the message names f->what and
+ * f->writer) and that the header is whole, the version and header size,
+ * the range
+ * against the split (obs__bake_shard_first) and the file's length
+ * against head_len + item_bytes n. */
+obs_status obs__part_header_read(const char *path, const obs__part_format *f, void *part,
+                                 char err[OBS_ERR_LEN]);
+/* The n parts at paths (none: "merge: no parts"), their headers read
+ * (obs__part_header_read) and checked to be every shard of one split
+ * once (obs__bake_parts_order); *out the parts in shard order (n of
+ * them; caller frees). */
+obs_status obs__bake_parts_read(const char *const *paths, size_t n, const obs__part_format *f,
                                 void **out, char err[OBS_ERR_LEN]);
+/* A merge's parameters p (the bake's parameters struct) from its n parts
+ * (shard order), f's parameter fields in order: every part carries part
+ * 0's value, bit for bit (then same(a, b, err), when given, holds for
+ * part 0 and each other); a parameter given to the merge (its row's bit
+ * in p's mask) equals the parts', one not given takes theirs and is
+ * marked given. */
+obs_status obs__part_adopt(const obs__part_format *f, const void *parts, size_t n, void *p,
+                           obs_status (*same)(const void *a, const void *b, char err[OBS_ERR_LEN]),
+                           char err[OBS_ERR_LEN]);
+
+/* A bake's entry points, written once for both (bake/bake.c with P bake,
+ * U BAKE; dynamic/dyn_bake.c with P dyn, U DYN; after their STEPS; the
+ * file needs string.h), over its public types obs_P_desc (with
+ * `params`), obs_P_params, obs_P_result (with `stats`), obs_P_stats:
+ *   obs_P_stage_name(stage): the stage's name in OBS_U_STAGE_LIST (rows
+ *   X(name, doc)), "?" out of range;
+ *   obs__P_run_job(scene, desc, job, result, err): the result zeroed,
+ *   desc's parameters resolved (obs_P_params_resolve), then STEPS(scene,
+ *   desc, params, job, result, err), job (NULL: none) in place of the
+ *   trace; a failed result freed (obs_P_result_free) but for its stats
+ *   (what ran, how long);
+ *   RUN(scene, desc, result, err): the public bake, obs__P_run_job
+ *   without a job. */
+#define OBS__BAKE_ENTRY(P, U, RUN, STEPS)                                                       \
+    const char *obs_##P##_stage_name(int stage)                                                 \
+    {                                                                                           \
+        static const char *const names[] = {OBS_##U##_STAGE_LIST(OBS__STAGE_NAME_ROW)};         \
+        return stage >= 0 && stage < OBS_##U##_STAGE_COUNT ? names[stage] : "?";                \
+    }                                                                                           \
+    obs_status obs__##P##_run_job(const obs_bake_scene *scene, const obs_##P##_desc *desc,     \
+                                  obs__part_job *job, obs_##P##_result *out,                    \
+                                  char err[OBS_ERR_LEN])                                        \
+    {                                                                                           \
+        obs_##P##_params p;                                                                     \
+        memset(out, 0, sizeof *out);                                                            \
+        obs_##P##_params_resolve(desc ? &desc->params : NULL, &p);                              \
+        obs_status rc = STEPS(scene, desc, &p, job, out, err);                                  \
+        if (rc != OBS_OK) {                                                                     \
+            obs_##P##_stats keep = out->stats;                                                  \
+            obs_##P##_result_free(out);                                                         \
+            out->stats = keep;                                                                  \
+        }                                                                                       \
+        return rc;                                                                              \
+    }                                                                                           \
+    obs_status RUN(const obs_bake_scene *scene, const obs_##P##_desc *desc,                    \
+                   obs_##P##_result *out, char err[OBS_ERR_LEN])                                \
+    {                                                                                           \
+        return obs__##P##_run_job(scene, desc, NULL, out, err);                                 \
+    }
+#define OBS__STAGE_NAME_ROW(name, doc) #name,
+
+/* The public shard and merge of a bake that shards, written once for
+ * both (bake/shard_run.c, dynamic/dyn_shard_run.c; the file needs
+ * stdlib.h and string.h):
+ *   SHARD(scene, desc, index, count, path, stats, err): the arguments
+ *   checked (obs__shard_check), then the bake's steps RUN(scene, desc,
+ *   job, result, err) (its OBS__BAKE_ENTRY's RUN_JOB) with the job of
+ *   tracing shard index of count into path; *stats (when not NULL) the
+ *   result's stats, the result freed (RESULT_FREE);
+ *   MERGE(scene, desc, paths, n, result, err): the parts read (FORMAT,
+ *   obs__bake_parts_read), their parameters taken into a copy of *desc
+ *   (obs__part_adopt, with SAME), then RUN with the job of reading them
+ *   back; *desc (when not NULL) gets the parameters taken.
+ * DESC, RESULT and STATS are the bake's types; DESC has `params`, RESULT
+ * `stats`. */
+#define OBS__PART_DRIVERS(SHARD, MERGE, DESC, RESULT, STATS, RUN, RESULT_FREE, FORMAT, SAME)  \
+    obs_status SHARD(const obs_bake_scene *scene, const DESC *desc, int index, int count,      \
+                     const char *path, STATS *st, char err[OBS_ERR_LEN])                       \
+    {                                                                                           \
+        if (st)                                                                                 \
+            memset(st, 0, sizeof *st);                                                          \
+        obs_status rc = obs__shard_check(index, count, path, err);                              \
+        if (rc != OBS_OK)                                                                       \
+            return rc;                                                                          \
+        obs__part_job job = {.index = index, .count = count, .path = path};                     \
+        RESULT r;                                                                               \
+        rc = RUN(scene, desc, &job, &r, err);                                                   \
+        if (st)                                                                                 \
+            *st = r.stats;                                                                      \
+        RESULT_FREE(&r);                                                                        \
+        return rc;                                                                              \
+    }                                                                                           \
+    obs_status MERGE(const obs_bake_scene *scene, DESC *desc, const char *const *paths,        \
+                     size_t n, RESULT *out, char err[OBS_ERR_LEN])                              \
+    {                                                                                           \
+        memset(out, 0, sizeof *out);                                                            \
+        void *parts = NULL;                                                                     \
+        obs_status rc = obs__bake_parts_read(paths, n, &(FORMAT), &parts, err);                 \
+        DESC d = desc ? *desc : (DESC){0};                                                      \
+        if (rc == OBS_OK)                                                                       \
+            rc = obs__part_adopt(&(FORMAT), parts, n, &d.params, SAME, err);                    \
+        if (rc == OBS_OK) {                                                                     \
+            obs__part_job job = {.index = 0, .count = (int)n, .parts = parts};                  \
+            rc = RUN(scene, &d, &job, out, err);                                                \
+            if (desc)                                                                           \
+                desc->params = d.params;                                                        \
+        }                                                                                       \
+        free(parts);                                                                            \
+        return rc;                                                                              \
+    }
 
 /* A merge's part (at path) traced from this level: its fingerprint
  * part_level is the level's, level (obs__bake_traced_fingerprint). */

@@ -51,13 +51,12 @@
 #include "methods/bent.h"
 #include "chain/mask_weight.h"
 #include "methods/gtao.h"
-#include "chain/lanes.h"
+#include "methods/gtao_deep.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
 #define GTAO_MIN_VISIBILITY 0.03f /* visibility = max(0.03, visibility) */
 
-/* fminf and fmaxf as glibc computes them, inline (chain/lanes.h) */
-static float clampf(float v, float lo, float hi) { return min_f(max_f(v, lo), hi); }
+static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
 static float saturate(float v) { return clampf(v, 0.0f, 1.0f); }
 static float signf(float v) { return (float)((v > 0.0f) - (v < 0.0f)); }
 static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -111,10 +110,10 @@ void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *n
                            float low, float *hc, int *taken)
 {
     float ext[4];
-    const float om = obs__occluder_weight_node(f, x, y, self, qx, qy, 0); /* object masks */
     const float *q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
     if (q)
-        *hc = max_f(*hc, sample_cos(obs__gtao_of(f), q, c, v, low, om));
+        *hc = fmaxf(*hc, sample_cos(obs__gtao_of(f), q, c, v, low,
+                                    obs__occluder_weight_node(f, x, y, self, qx, qy, 0)));
 }
 
 /* The horizon cosine of side `dir` (+1 or -1) of a slice after its
@@ -122,14 +121,18 @@ void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *n
  * each moved from low by its falloff weight.  A step inside the image
  * reads every one of the `layers` planes of pos (deep input's nodes,
  * OITAO Algorithm 1: the largest counts); past the border, the front
- * plane's surface continued. */
+ * plane's surface continued.  end (NULL: none): deep input's interval
+ * ends (obs__deep_intervals); each step is then a column of the side's
+ * free arcs (obs__gtao_column, gtao_deep.c), the nodes solid behind them
+ * giving the horizon as here. */
 static float side_horizon(const obs__frame *f, const float *pos, const float *nrm, int layers,
                           int self, int x, int y, const float c[3], const float v[3], const float omega[2],
                           int slice, float noise_step, float min_s, int dir, float low,
-                          int *taken)
+                          int *taken, const float *end, obs__gtao_side *side)
 {
     const obs__gtao_state *g = obs__gtao_of(f);
     const size_t plane = (size_t)f->width * (size_t)f->height * 4;
+    const float fw[3] = {g->falloff[0], g->falloff[1], g->thin_power[0]}; /* intervals */
     float hc = low;
     for (int st = 0; st < g->steps; st++) {
         float base = (float)(slice + st * g->steps) * GTAO_R1;
@@ -139,25 +142,42 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         s = s * s + min_s; /* sample distribution power 2, then off the centre pixel */
         int qx = x + dir * (int)floorf(s * omega[0] + 0.5f);
         int qy = y + dir * (int)floorf(s * omega[1] + 0.5f);
+        float ext[4];
+        const float *q;
         /* object masks: the weight of the surface at the step's pixel
          * (of each node there; past the border, of the front one) */
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
-            obs__gtao_border_step(f, pos, nrm, self, x, y, qx, qy, c, v, low, &hc, taken);
+            if (!end) {
+                obs__gtao_border_step(f, pos, nrm, self, x, y, qx, qy, c, v, low, &hc, taken);
+                continue;
+            }
+            q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
+            /* intervals: the surface continued, solid behind it */
+            obs__gtao_column(f, fw, side, q, NULL, 0, q ? 1 : 0, x, y, self, qx, qy, c, v, low);
+            if (!q)
+                continue;
+            hc = fmaxf(hc, sample_cos(g, q, c, v, low,
+                                      obs__occluder_weight_node(f, x, y, self, qx, qy, 0)));
             continue;
         }
         (*taken)++;
-        const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+        q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
+        if (end) { /* intervals: the step's column (gtao_deep.c) */
+            hc = fmaxf(hc, obs__gtao_column(f, fw, side, q, end + (size_t)qy * f->width + qx,
+                                            plane, layers, x, y, self, qx, qy, c, v, low));
+            continue;
+        }
         for (int k = 0; k < layers; k++)
-            hc = max_f(hc, sample_cos(g, q + (size_t)k * plane, c, v, low,
+            hc = fmaxf(hc, sample_cos(g, q + (size_t)k * plane, c, v, low,
                                       obs__occluder_weight_node(f, x, y, self, qx, qy, k)));
     }
     return hc;
 }
 
 /* a(h) of the header: the inner integral's closed form */
-static float arc(float h, float gamma, float cos_gamma, float sin_gamma)
+static float arc(float h, float gamma, float cos_gamma)
 {
-    return (cos_gamma + 2.0f * h * sin_gamma - cosf(2.0f * h - gamma)) / 4.0f;
+    return (cos_gamma + 2.0f * h * sinf(gamma) - cosf(2.0f * h - gamma)) / 4.0f;
 }
 
 /* GLSL: method_ao() in gtao.glsl */
@@ -170,74 +190,15 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
 float obs__gtao_pixel_bent(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
                            const float p[3], const float n[3], int *count, float bent[3])
 {
-    return obs__gtao_pixel_nodes(f, pos, nrm, 1, 0, x, y, p, n, count, bent);
-}
-
-void obs__gtao_slice_dir(const obs__gtao_state *g, int sl, float noise0, float cs[2])
-{
-    float phi = ((float)sl + noise0) / (float)g->slices * (float)M_PI;
-    cs[0] = cosf(phi);
-    cs[1] = sinf(phi);
-}
-
-void obs__gtao_slice_setup(const float cs[2], float rpx, const float v[3], const float n[3],
-                           obs__gtao_slice *s)
-{
-    const float cp = cs[0], sp = cs[1];
-    s->omega[0] = cp * rpx; /* screen pixels: y runs down, view y up */
-    s->omega[1] = -sp * rpx;
-    float d[3] = {cp, sp, 0.0f};
-    float dv = dot3(d, v);
-    float *od = s->od;
-    od[0] = d[0] - dv * v[0];
-    od[1] = d[1] - dv * v[1];
-    od[2] = d[2] - dv * v[2];
-    /* the slice plane's normal: normalize(cross(od, v)) */
-    float ax[3] = {od[1] * v[2] - od[2] * v[1], od[2] * v[0] - od[0] * v[2],
-                   od[0] * v[1] - od[1] * v[0]};
-    float al = sqrtf(dot3(ax, ax));
-    ax[0] /= al;
-    ax[1] /= al;
-    ax[2] /= al;
-    float na = dot3(n, ax);
-    float np[3] = {n[0] - ax[0] * na, n[1] - ax[1] * na, n[2] - ax[2] * na};
-    s->np_len = sqrtf(dot3(np, np));
-    s->cos_g = s->np_len > 0.0f ? saturate(dot3(np, v) / s->np_len) : 1.0f;
-    s->gamma = signf(dot3(od, np)) * acosf(s->cos_g);
-    s->low[0] = cosf(s->gamma + (float)M_PI_2);
-    s->low[1] = cosf(s->gamma - (float)M_PI_2);
-}
-
-float obs__gtao_slice_vis(const obs__gtao_state *g, obs__gtao_slice *s, float hc0, float hc1,
-                          float h[2])
-{
-    const float half_pi = (float)M_PI_2, gamma = s->gamma;
-    if (g->heuristics)
-        s->np_len += (1.0f - s->np_len) * GTAO_SLOPE_FUDGE;
-    /* the horizons as angles from v, clamped to the hemisphere of n
-     * (Algorithm 1's h1 = n + max(h1 - n, -pi/2), h2 = n + min(h2 - n, pi/2)) */
-    float h0 = -acosf(clampf(hc1, -1.0f, 1.0f));
-    float h1 = acosf(clampf(hc0, -1.0f, 1.0f));
-    h[0] = gamma + max_f(h0 - gamma, -half_pi);
-    h[1] = gamma + min_f(h1 - gamma, half_pi);
-    const float sg = sinf(gamma); /* once for both arcs */
-    return s->np_len * (arc(h[0], gamma, s->cos_g, sg) + arc(h[1], gamma, s->cos_g, sg));
-}
-
-float obs__gtao_finish(const obs__gtao_state *g, float vis)
-{
-    vis /= (float)g->slices;
-    vis = powf(max_f(vis, 0.0f), g->thin_power[1]);
-    if (g->heuristics)
-        vis = max_f(vis, GTAO_MIN_VISIBILITY);
-    return saturate(vis);
+    return obs__gtao_pixel_nodes(f, pos, nrm, 1, 0, NULL, x, y, p, n, count, bent);
 }
 
 float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                            int self, int x, int y, const float p[3], const float n[3], int *count,
-                            float bent[3])
+                            int self, const float *end, int x, int y, const float p[3],
+                            const float n[3], int *count, float bent[3])
 {
     const obs__gtao_state *g = obs__gtao_of(f);
+    const float half_pi = (float)M_PI_2;
     int taken = 0;
     if (count)
         *count = 0;
@@ -259,27 +220,74 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
     const float min_s = GTAO_TOO_CLOSE / rpx;
     float vis = obs__gtao_vis0(g, rpx);
     for (int sl = 0; sl < g->slices; sl++) {
-        obs__gtao_slice s;
         float cs[2];
         obs__gtao_slice_dir(g, sl, noise[0], cs);
-        obs__gtao_slice_setup(cs, rpx, v, n, &s);
-        float hc0 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, s.omega, sl, noise[1],
-                                 min_s, 1, s.low[0], &taken);
-        float hc1 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, s.omega, sl, noise[1],
-                                 min_s, -1, s.low[1], &taken);
-        float h[2];
-        vis += obs__gtao_slice_vis(g, &s, hc0, hc1, h);
+        const float cp = cs[0], sp = cs[1];
+        float omega[2] = {cp * rpx, -sp * rpx}; /* screen pixels: y runs down, view y up */
+        float d[3] = {cp, sp, 0.0f};
+        float dv = dot3(d, v);
+        float od[3] = {d[0] - dv * v[0], d[1] - dv * v[1], d[2] - dv * v[2]};
+        /* the slice plane's normal: normalize(cross(od, v)) */
+        float ax[3] = {od[1] * v[2] - od[2] * v[1], od[2] * v[0] - od[0] * v[2],
+                       od[0] * v[1] - od[1] * v[0]};
+        float al = sqrtf(dot3(ax, ax));
+        ax[0] /= al;
+        ax[1] /= al;
+        ax[2] /= al;
+        float na = dot3(n, ax);
+        float np[3] = {n[0] - ax[0] * na, n[1] - ax[1] * na, n[2] - ax[2] * na};
+        float np_len = sqrtf(dot3(np, np));
+        float cos_g = np_len > 0.0f ? saturate(dot3(np, v) / np_len) : 1.0f;
+        float gamma = signf(dot3(od, np)) * acosf(cos_g);
+        float low0 = cosf(gamma + half_pi), low1 = cosf(gamma - half_pi);
+        obs__gtao_side sides[2]; /* deep input's intervals: the sides' occupied arcs */
+        if (end) {
+            obs__gtao_side_start(&sides[0], c);
+            obs__gtao_side_start(&sides[1], c);
+        }
+        float hc0 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, omega, sl, noise[1], min_s, 1,
+                                 low0, &taken, end, &sides[0]);
+        float hc1 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, omega, sl, noise[1], min_s, -1,
+                                 low1, &taken, end, &sides[1]);
+        if (g->heuristics)
+            np_len += (1.0f - np_len) * GTAO_SLOPE_FUDGE;
+        /* the horizons as angles from v, clamped to the hemisphere of n
+         * (Algorithm 1's h1 = n + max(h1 - n, -pi/2), h2 = n + min(h2 - n, pi/2)) */
+        float h0 = -acosf(clampf(hc1, -1.0f, 1.0f));
+        float h1 = acosf(clampf(hc0, -1.0f, 1.0f));
+        h0 = gamma + fmaxf(h0 - gamma, -half_pi);
+        h1 = gamma + fminf(h1 - gamma, half_pi);
+        if (end) /* the free arcs between the horizons (gtao_deep.c) */
+            vis += np_len * obs__gtao_slice_free(&sides[0], &sides[1], h0, h1, gamma, cos_g);
+        else
+            vis += np_len * (arc(h0, gamma, cos_g) + arc(h1, gamma, cos_g));
         if (bent)
-            obs__gtao_bent_slice(h[0], h[1], s.gamma, s.np_len, s.od, v, bent);
+            obs__gtao_bent_slice(h0, h1, gamma, np_len, od, v, bent);
     }
     if (count)
         *count = taken;
     return obs__gtao_finish(g, vis);
 }
 
+void obs__gtao_slice_dir(const obs__gtao_state *g, int sl, float noise0, float cs[2])
+{
+    float phi = ((float)sl + noise0) / (float)g->slices * (float)M_PI;
+    cs[0] = cosf(phi);
+    cs[1] = sinf(phi);
+}
+
 float obs__gtao_vis0(const obs__gtao_state *g, float rpx)
 {
     return g->heuristics ? saturate((10.0f - rpx) / 100.0f) * 0.5f : 0.0f;
+}
+
+float obs__gtao_finish(const obs__gtao_state *g, float vis)
+{
+    vis /= (float)g->slices;
+    vis = powf(fmaxf(vis, 0.0f), g->thin_power[1]);
+    if (g->heuristics)
+        vis = fmaxf(vis, GTAO_MIN_VISIBILITY);
+    return saturate(vis);
 }
 
 void obs__gtao_setup(const obs_params *p, obs__frame *f)

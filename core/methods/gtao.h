@@ -46,34 +46,23 @@ float obs__gtao_pixel(const obs__frame *f, const float *pos, const float *nrm, i
  * multi-layer HBAO, Fig. 9); a step past the border reads the first
  * plane's surface continued, with nrm its normals (3 floats a pixel).
  * self: the receiver's node at (x, y), whose object self_only compares
- * (object masks, obs__occluder_weight_node; the flat chain's: 0). */
+ * (object masks, obs__occluder_weight_node; the flat chain's: 0).  end
+ * (NULL: every node solid behind it): `layers` planes of the nodes'
+ * interval ends (obs__deep_intervals, deep_intervals on): each slice's
+ * visibility is then that of its free arcs (methods/gtao_deep.c). */
 float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *nrm, int layers,
-                            int self, int x, int y, const float p[3], const float n[3], int *count,
-                            float bent[3]);
+                            int self, const float *end, int x, int y, const float p[3],
+                            const float n[3], int *count, float bent[3]);
 
 /* The noise of the 3x3 tile's pixel `tile` (obs__tile_index): XeGTAO's R2
  * sequence, fract(0.5 + k (0.754877666, 0.569840291)), k = tile;
  * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
 void obs__gtao_noise(int tile, float out[2]);
 
-/* One slice of a pixel (obs__gtao_pixel_nodes' loop in parts; the CPU
- * device's lanes, methods_cpu.c, share the direction, the steps past the
- * border, the visibility's start and end): its direction in screen
- * pixels (omega, the search radius's length), the direction in view
- * space od, the projected normal's length, cos and angle gamma, and the
- * horizon cosines' starts low[side] (side 0: +omega, 1: -omega). */
-typedef struct obs__gtao_slice {
-    float omega[2], od[3], np_len, cos_g, gamma, low[2];
-} obs__gtao_slice;
-/* The slice's screen direction (cos, sin of its angle) from its index and
- * the pixel's noise out[0] (obs__gtao_noise) */
+/* Parts of obs__gtao_pixel_nodes that the CPU device's lanes share
+ * (methods_cpu.c): the slice's screen direction (cos, sin of its angle)
+ * from its index and the pixel's noise out[0] (obs__gtao_noise). */
 void obs__gtao_slice_dir(const obs__gtao_state *g, int sl, float noise0, float cs[2]);
-void obs__gtao_slice_setup(const float cs[2], float rpx, const float v[3], const float n[3],
-                           obs__gtao_slice *s);
-/* The slice's visibility from its horizon cosines hc0 (+omega) and hc1
- * (-omega); h[] the horizon angles (for the bent normal). */
-float obs__gtao_slice_vis(const obs__gtao_state *g, obs__gtao_slice *s, float hc0, float hc1,
-                          float h[2]);
 /* A step of a slice's side at pixel (qx, qy) off the planes, for the
  * pixel (x, y) (its node self on deep input, else 0; centre c, view
  * direction v, the side's start low): the

@@ -69,6 +69,10 @@ float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
 #define GT_FRONT(b) imageLoad(u_lpos, ivec3(b, 0))
 #define GT_FRONT_NORMAL(b) imageLoad(u_lnrm, ivec3(b, 0))
 #define GT_WEIGHT(c, q, k) node_weight(c, q, k)
+#if OBS_DEEP_INTERVALS
+#define GT_INTERVALS 1      // gtao: each slice's free arcs (gtao.glsl)
+#define GT_END(q, k) imageLoad(u_lend, ivec3(q, k)).x
+#endif
 #define HB_LAYERS (u_multi != 0 ? u_m : 1)
 #define HB_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
 #define HB_WEIGHT(c, q, k) node_weight(c, q, k)

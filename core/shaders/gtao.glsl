@@ -21,6 +21,12 @@
 #ifndef GT_WEIGHT
 #define GT_WEIGHT(c, q, k) occluder_weight(c, q)
 #endif
+// Deep input with intervals (deep.frag.glsl): GT_INTERVALS 1 and
+// GT_END(q, k) node k's interval end (obs__deep_intervals): each slice's
+// visibility over its free arcs (C twin: methods/gtao_deep.c).
+#ifndef GT_INTERVALS
+#define GT_INTERVALS 0
+#endif
 
 uniform int u_gtao_slices;
 uniform int u_gtao_steps;
@@ -76,6 +82,161 @@ float gtao_sample_cos(vec4 xq, vec3 c, vec3 v, float low, float om)
     return low + (shc - low) * w;
 }
 
+float gtao_arc(float h, float gamma, float cos_gamma)
+{
+    return (cos_gamma + 2.0 * h * sin(gamma) - cos(2.0 * h - gamma)) / 4.0;
+}
+
+#if GT_INTERVALS
+// The sides of the slice (side 0: dir +1): their occupied arcs, angles
+// from v sorted by their near end, and the free depth ranges of the last
+// column read with their ends' angles, true (t) and falloff-mapped (m).
+// C twin: obs__gtao_side (methods/gtao_deep.h); GT_MAX_GAPS and
+// GT_MAX_ARCS are OBS__GTAO_MAX_GAPS and OBS__GTAO_MAX_ARCS for 8 nodes
+// and 32 steps.
+const int GT_MAX_GAPS = 5;
+const int GT_MAX_ARCS = 32 * 13;
+float gt_lo[2 * GT_MAX_ARCS], gt_hi[2 * GT_MAX_ARCS];
+int gt_n[2], gt_gaps[2];
+vec2 gt_z[2 * GT_MAX_GAPS], gt_t[2 * GT_MAX_GAPS], gt_m[2 * GT_MAX_GAPS];
+
+// C twin: obs__gtao_side_start
+void gtao_side_start(int side, vec3 c)
+{
+    gt_n[side] = 0;
+    gt_gaps[side] = 1;
+    gt_z[side * GT_MAX_GAPS] = vec2(0.0, -c.z);
+    gt_t[side * GT_MAX_GAPS] = vec2(0.0, 3.14159265358979);
+    gt_m[side * GT_MAX_GAPS] = vec2(0.0, 3.14159265358979);
+}
+
+// C twin: true_angle (methods/gtao_deep.c)
+float gtao_true_angle(vec3 d, vec3 v, float low)
+{
+    float dist = length(d);
+    return acos(clamp(dist > 0.0 ? dot(d, v) / dist : low, -1.0, 1.0));
+}
+
+// C twin: add_arc (methods/gtao_deep.c)
+void gtao_add_arc(int side, float lo, float hi)
+{
+    if (!(hi > lo))
+        return;
+    int base = side * GT_MAX_ARCS, i = gt_n[side];
+    if (i == GT_MAX_ARCS) {
+        gt_lo[base + i - 1] = min(gt_lo[base + i - 1], lo);
+        gt_hi[base + i - 1] = max(gt_hi[base + i - 1], hi);
+        return;
+    }
+    for (; i > 0 && gt_lo[base + i - 1] > lo; i--) {
+        gt_lo[base + i] = gt_lo[base + i - 1];
+        gt_hi[base + i] = gt_hi[base + i - 1];
+    }
+    gt_lo[base + i] = lo;
+    gt_hi[base + i] = hi;
+    gt_n[side]++;
+}
+
+// The column of the step at q (border: the one point xq past the image
+// instead, solid behind it).  C twin: obs__gtao_column (methods/gtao_deep.c)
+float gtao_column(int side, ivec2 px, ivec2 q, bool border, vec4 xq, vec3 c, vec3 v, float low)
+{
+    vec2 gz[GT_MAX_GAPS], gt[GT_MAX_GAPS], gm[GT_MAX_GAPS];
+    float hc = low, cz = 0.0, ct = 0.0, cm = 0.0;
+    int ng = 0, last = -1, layers = border ? 1 : GT_LAYERS;
+    bool open = true;
+    for (int k = 0; k < layers; k++) {
+        vec4 qk = border ? xq : GT_NODE(q, k);
+        if (qk.w > 0.0 && !(!border && GT_END(q, k) < 0.0))
+            last = k;
+    }
+    for (int k = 0; k < layers; k++) {
+        vec4 qk = border ? xq : GT_NODE(q, k);
+        float e = border || k == last ? 0.0 : GT_END(q, k);
+        if (!(qk.w > 0.0) || e < 0.0)
+            continue;
+        float om = GT_WEIGHT(px, q, border ? 0 : k);
+        vec3 d = qk.xyz - c;
+        float cf = gtao_sample_cos(qk, c, v, low, om);
+        if (e == 0.0)
+            hc = max(hc, cf);
+        if (!open)
+            continue;
+        float tf = gtao_true_angle(d, v, low), mf = acos(clamp(cf, -1.0, 1.0));
+        if (qk.w > cz && ng < GT_MAX_GAPS) {
+            gz[ng] = vec2(cz, qk.w);
+            gt[ng] = vec2(ct, tf);
+            gm[ng] = vec2(cm, mf);
+            ng++;
+        }
+        if (e == 0.0) {
+            open = false;
+            continue;
+        }
+        vec3 o, dir;
+        view_ray(px_ndc(q), o, dir);
+        vec4 b = vec4(o.xy + e * dir.xy, -e, e);
+        float mb = acos(clamp(gtao_sample_cos(b, c, v, low, om), -1.0, 1.0));
+        gtao_add_arc(side, min(mf, mb), max(mf, mb));
+        cz = e;
+        ct = gtao_true_angle(b.xyz - c, v, low);
+        cm = mb;
+    }
+    if (open && ng < GT_MAX_GAPS) {
+        gz[ng] = vec2(cz, uintBitsToFloat(0x7f800000u)); // no surface from cz on
+        gt[ng] = vec2(ct, 3.14159265358979);
+        gm[ng] = vec2(cm, 3.14159265358979);
+        ng++;
+    }
+    int base = side * GT_MAX_GAPS;
+    for (int a = 0; a < gt_gaps[side]; a++) {
+        vec2 za = gt_z[base + a], ta = gt_t[base + a], ma = gt_m[base + a];
+        for (int b = 0; b < ng; b++) {
+            if (za.x < gz[b].y && gz[b].x < za.y)
+                continue;
+            float lo = max(ta.x, gt[b].x), hi = min(ta.y, gt[b].y);
+            if (!(hi > lo))
+                continue;
+            float ml = ta.x >= gt[b].x ? ma.x : gm[b].x;
+            float mh = ta.y <= gt[b].y ? ma.y : gm[b].y;
+            gtao_add_arc(side, min(ml, mh), max(ml, mh));
+        }
+    }
+    gt_gaps[side] = ng;
+    for (int b = 0; b < ng; b++) {
+        gt_z[base + b] = gz[b];
+        gt_t[base + b] = gt[b];
+        gt_m[base + b] = gm[b];
+    }
+    return hc;
+}
+
+// C twin: side_free (methods/gtao_deep.c)
+float gtao_side_free(int side, float h, float s, float gamma, float cos_g)
+{
+    int n = gt_n[side], base = side * GT_MAX_ARCS;
+    if (n == 0)
+        return gtao_arc(h, gamma, cos_g);
+    float end = s * h, cur = 0.0, sum = 0.0;
+    for (int i = 0; i <= n; i++) {
+        float lo = end, hi = end;
+        if (i < n) {
+            float a = gt_lo[base + i], b = gt_hi[base + i];
+            lo = s > 0.0 ? gamma + min(a - gamma, GTAO_HALF_PI) : gamma + max(-a - gamma, -GTAO_HALF_PI);
+            hi = s > 0.0 ? gamma + min(b - gamma, GTAO_HALF_PI) : gamma + max(-b - gamma, -GTAO_HALF_PI);
+            lo = min(s * lo, end);
+            hi = s * hi;
+        }
+        if (lo > cur)
+            sum += gtao_arc(s * lo, gamma, cos_g) - (cur > 0.0 ? gtao_arc(s * cur, gamma, cos_g) : 0.0);
+        cur = max(cur, hi);
+        if (cur >= end)
+            break;
+    }
+    return sum;
+}
+#endif
+
 // C twin: side_horizon (methods/gtao.c); a step inside the image reads
 // every node at its pixel (GT_LAYERS), the largest counting
 float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float noise_step,
@@ -92,23 +253,30 @@ float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float n
         // border, the front one's)
         if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y) {
             vec4 xq;
-            if (!gtao_border_step(px, q, xq))
+            bool got = gtao_border_step(px, q, xq);
+#if GT_INTERVALS
+            // intervals: the surface continued, solid behind it (xq.w 0:
+            // a column with no surface)
+            gtao_column(dir > 0 ? 0 : 1, px, q, true, got ? xq : vec4(0.0), c, v, low);
+#endif
+            if (!got)
                 continue;
             taken++;
             hc = max(hc, gtao_sample_cos(xq, c, v, low, GT_WEIGHT(px, q, 0)));
             continue;
         }
         taken++;
+#if GT_INTERVALS
+        // intervals: the step's column (C twin: obs__gtao_column)
+        hc = max(hc, gtao_column(dir > 0 ? 0 : 1, px, q, false, vec4(0.0), c, v, low));
+        continue;
+#endif
         for (int k = 0; k < GT_LAYERS; k++)
             hc = max(hc, gtao_sample_cos(GT_NODE(q, k), c, v, low, GT_WEIGHT(px, q, k)));
     }
     return hc;
 }
 
-float gtao_arc(float h, float gamma, float cos_gamma)
-{
-    return (cos_gamma + 2.0 * h * sin(gamma) - cos(2.0 * h - gamma)) / 4.0;
-}
 
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
 {
@@ -140,6 +308,10 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
         float cos_g = np_len > 0.0 ? clamp(dot(np, v) / np_len, 0.0, 1.0) : 1.0;
         float gamma = sign(dot(od, np)) * acos(cos_g);
         float low0 = cos(gamma + GTAO_HALF_PI), low1 = cos(gamma - GTAO_HALF_PI);
+#if GT_INTERVALS
+        gtao_side_start(0, c);
+        gtao_side_start(1, c);
+#endif
         float hc0 = gtao_side_horizon(px, c, v, omega, sl, noise.y, min_s, 1, low0, taken);
         float hc1 = gtao_side_horizon(px, c, v, omega, sl, noise.y, min_s, -1, low1, taken);
         if (u_gtao_heuristics != 0)
@@ -148,7 +320,11 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
         float h1 = acos(clamp(hc0, -1.0, 1.0));
         h0 = gamma + max(h0 - gamma, -GTAO_HALF_PI);   // Algorithm 1: clamped to n's hemisphere
         h1 = gamma + min(h1 - gamma, GTAO_HALF_PI);
+#if GT_INTERVALS
+        vis += np_len * (gtao_side_free(1, h0, -1.0, gamma, cos_g) + gtao_side_free(0, h1, 1.0, gamma, cos_g));
+#else
         vis += np_len * (gtao_arc(h0, gamma, cos_g) + gtao_arc(h1, gamma, cos_g));
+#endif
         gtao_bent_slice(h0, h1, gamma, np_len, od, v); // OBS_OUTPUT_BENT (method.glsl)
     }
     vis /= float(u_gtao_slices);

@@ -102,6 +102,34 @@ obs_status obs_gbuffer_read_exr_mem(const void *buf, size_t len,
 /* Frees storage and zeroes *f; NULL-safe. */
 void obs_gbuffer_free(obs_gbuffer_file *f);
 
+/* A G-buffer EXR read by rows, for a frame that is never whole in memory
+ * (obs_run_cpu_rows).  obs_gbuffer_rows_open reads the header and
+ * resolves the channels as obs_gbuffer_read_exr does, no pixels: meta->gb
+ * is the frame (size, windows, camera, conventions) with its planes' data
+ * NULL and their channels set (1, 3 for normals, 4 for colour when the
+ * file has them; no position pass), meta->info as the reader fills it.
+ * A view whose channels lie in several parts is refused
+ * (OBS_UNSUPPORTED).  Close with obs_gbuffer_rows_close(). */
+typedef struct obs_gbuffer_rows obs_gbuffer_rows;
+obs_status obs_gbuffer_rows_open(const char *path, const obs_channel_map *map, const obs_limits *lim,
+                                 obs_gbuffer_rows **rows, obs_gbuffer_file *meta, char err[OBS_ERR_LEN]);
+
+/* Rows [y0, y1) of the data window: *out is the frame with its planes'
+ * data at row y0 (packed rows; rows outside the range are not there),
+ * valid until the next read or the close.  Only the chunks holding those
+ * rows are decoded (lim->threads threads). */
+obs_status obs_gbuffer_rows_read(obs_gbuffer_rows *rows, int y0, int y1, obs_gbuffer *out,
+                                 char err[OBS_ERR_LEN]);
+
+/* Leaves the colour out of the reads from now on (a chain that reads no
+ * colour: no composite, luminance, bleeding or multi-bounce), which
+ * halves the bytes of a row with RGBA; the frame given to the chain must
+ * then have no colour plane either. */
+void obs_gbuffer_rows_no_color(obs_gbuffer_rows *rows);
+
+/* NULL-safe. */
+void obs_gbuffer_rows_close(obs_gbuffer_rows *rows);
+
 /* The renderer, camera (and its source, cross-check and warnings) of part
  * `part` of an EXR, flat or deep, as the readers find them: fills those
  * fields of *info and *cam. */
@@ -319,6 +347,24 @@ typedef struct obs_exr_options {
      * process's limit); the bytes are the same for any count. */
     int threads;
 } obs_exr_options;
+
+/* A plain EXR output written by rows, for a frame never whole in memory
+ * (obs_run_cpu_rows): obs_exr_rows_open writes the header of an image of
+ * layers' width and `height` rows, layers' channels and names (the
+ * images' rows are not written here; the names must live until the
+ * close), as obs_exr_write_ex with `opt` (a source given by path, no
+ * append; OBS_UNSUPPORTED otherwise); obs_exr_rows_write takes the next
+ * rows, every layer's image holding the same count (written a batch of
+ * chunks at a time, the same bytes as obs_exr_write_ex of the whole
+ * image); obs_exr_rows_close finishes the file when st is OBS_OK and
+ * every row came (else the file is removed, as a failed write's is) and
+ * frees the writer; it returns the status. */
+typedef struct obs_exr_rows obs_exr_rows;
+obs_status obs_exr_rows_open(const char *path, const obs_exr_layer *layers, int layer_count, int height,
+                             const obs_exr_options *opt, obs_exr_rows **out, char err[OBS_ERR_LEN]);
+obs_status obs_exr_rows_write(obs_exr_rows *w, const obs_exr_layer *layers, int layer_count,
+                              char err[OBS_ERR_LEN]);
+obs_status obs_exr_rows_close(obs_exr_rows *w, obs_status st, char err[OBS_ERR_LEN]);
 
 /* obs_exr_write() with options (NULL: as zeroed). */
 obs_status obs_exr_write_ex(const char *path, const obs_exr_layer *layers, int layer_count,

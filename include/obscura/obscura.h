@@ -295,10 +295,44 @@ typedef struct obs_cpu_options {
      * longer (the clock read between passes and between the AO pass's
      * tiles, so at most one tile past it); 0: no deadline */
     double deadline;
+    /* bytes the chain's planes may take (about 56 a pixel at the default
+     * parameters): a frame that needs more runs in bands of rows, each
+     * holding its rows and the halo its samples reach (the same result,
+     * the input and the result still whole); 0: a quarter of the
+     * machine's physical memory */
+    size_t max_memory;
+    /* > 0: bands of this many rows whatever the frame's size (tests) */
+    int band_rows;
 } obs_cpu_options;
 
 obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                             obs_result *out, const obs_cpu_options *opt, char err[OBS_ERR_LEN]);
+
+/* The memory budget of opt (NULL: the default): opt->max_memory, else a
+ * quarter of the machine's physical memory. */
+size_t obs_cpu_memory_budget(const obs_cpu_options *opt);
+
+/* A frame that is never whole in memory, on the CPU device: run in bands
+ * of rows as obs_run_cpu_opts runs a frame over its memory budget (the
+ * same result, byte for byte), each band's rows of the G-buffer asked of
+ * `in`, the result's rows handed to `out` in order.
+ *   frame: the frame's size, windows, camera and conventions, its planes'
+ *     data NULL and their channels set (1, 3 for normals, 4 for colour
+ *     when it has them: obs_gbuffer_rows_open's meta->gb); no object masks
+ *     (OBS_UNSUPPORTED).
+ *   in(user, y0, y1, rows, err): *rows is the frame with its planes' data
+ *     at row y0, holding rows [y0, y1) (valid until the next call).  The
+ *     depth is read once ahead of the bands (the samples' reach, a few
+ *     hundred rows at a time), then each band's rows with its halo.
+ *   out(user, y0, y1, res, err): rows [y0, y1) of the result, images of
+ *     y1 - y0 rows (valid during the call).
+ * A status other than OBS_OK from either stops the run and is returned. */
+typedef obs_status (*obs_rows_in_fn)(void *user, int y0, int y1, obs_gbuffer *rows, char err[OBS_ERR_LEN]);
+typedef obs_status (*obs_rows_out_fn)(void *user, int y0, int y1, const obs_result *rows,
+                                      char err[OBS_ERR_LEN]);
+obs_status obs_run_cpu_rows(const obs_gbuffer *frame, obs_rows_in_fn in, obs_rows_out_fn out, void *user,
+                            const obs_params *params, unsigned outputs, const obs_cpu_options *opt,
+                            char err[OBS_ERR_LEN]);
 
 void obs_result_free(obs_result *r);
 

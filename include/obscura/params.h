@@ -406,12 +406,13 @@ typedef enum obs_baked_combine {
       "faces)")                                                                \
     X(deep_intervals, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),         \
       "deep input with facing flags (channel Facing, as obscura gbuffer "      \
-      "--deep writes), deep_mode multi, methods vaopp and vao: on, the solid " \
-      "between a front face and its matching back face is an interval, free "  \
-      "behind it, and the depth range check applies only to a surface with "   \
-      "no back face in the list (the obscured volume as it is); off, every "   \
-      "node is solid behind it, as ao_definition rays' conversion assumes "    \
-      "(bench/QUALITY.md, \"Deep input against Cycles\")")                     \
+      "--deep writes), deep_mode multi, methods vaopp, vao and gtao: on, the " \
+      "solid between a front face and its matching back face is an "           \
+      "interval, free behind it, and the depth range check applies only to a " \
+      "surface with no back face in the list (the obscured volume as it is; "  \
+      "gtao: each slice's visibility over its free arcs); off, every node is " \
+      "solid behind it, as ao_definition rays' conversion and gtao's horizon " \
+      "assume (bench/QUALITY.md, \"Deep input against Cycles\")")              \
     X(baked_combine, ENUM, "product", 0, 0, OBS_CHOICES(OBS_BAKED_COMBINE_LIST), \
       "--baked CH (HTTP: baked=CH): how the G-buffer's baked AO channel "      \
       "(obscura bake's _AO, rasterised by obscura gbuffer) is combined with "  \

@@ -17,7 +17,7 @@ FUZZ_CPPFLAGS := -Iinclude -Icore -Iprotocol $(shell pkg-config --cflags libcjso
 FUZZ_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libcjson 2>/dev/null) -lz -lm -lpthread
 FUZZ_SRC := protocol/binary.c protocol/http.c core/status.c core/util.c core/image.c core/params.c \
             core/io/bytes.c core/io/channel_map.c core/io/presets.c core/io/exr_layers.c core/camera/request.c core/table.c \
-            core/io/exr_msg.c
+            core/io/exr_msg.c core/pool.c
 FUZZ_HDR := $(wildcard protocol/*.h include/obscura/*.h core/*.h core/*/*.h)
 # The EXR readers (flat and deep) against OpenEXR's C library.
 FUZZ_EXR_SRC := core/io/exr_read.c core/io/exr_deep.c core/io/exr_msg.c core/io/exr_parts.c core/io/exr_describe.c \

@@ -422,6 +422,22 @@ static void slab_scene(obs_deep_image *d, float zf, float zb)
         }
 }
 
+/* slab_scene with the slab over columns x0 .. x1 - 1 only (a strip) */
+static void strip_scene(obs_deep_image *d, float zf, float zb, int x0, int x1)
+{
+    synth_init(d, 32, 32);
+    d->has_facing = 1;
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++) {
+            synth_next(d, x, y);
+            if (x >= x0 && x < x1) {
+                synth_face(d, x, y, zf, 1.0f);
+                synth_face(d, x, y, zb, -1.0f);
+            }
+            synth_face(d, x, y, 10.0f, 1.0f);
+        }
+}
+
 static void slab_scene_free_and(obs_deep_image *d, float zf, float zb)
 {
     obs_deep_free(d);
@@ -581,6 +597,88 @@ static void test_hbao_deep(void **state)
 {
     (void)state;
     horizon_deep("hbao");
+}
+
+/* Method gtao with intervals (methods/gtao_deep.c): each slice's
+ * visibility over its free arcs.  The wall pixel beside a thin plate
+ * (0.1 thick, two pixels wide) 0.7 in front of the wall (well within
+ * gtao's search radius, 1.457 R): every node solid behind it (intervals
+ * off, deep_mode single: the flat buffer's view) puts the plate's horizon
+ * over everything under it, the halo; with the plate's back face known
+ * the rays passing behind it to the wall are free, and the plate occupies
+ * only the angles where it is (a plate as wide as the image blocks most
+ * rays rising from the wall beside it: that is occlusion, not a halo).  A list whose
+ * front faces have no back face (one-sided surfaces: every node solid
+ * behind) gives the horizon form to the bit, and a closed box flush with
+ * the wall (its back face on the wall) the flat buffer's AO. */
+static obs_params gtao_params(int mode, const char *intervals)
+{
+    char err[OBS_ERR_LEN] = "";
+    obs_params p = deep_params(mode);
+    assert_int_equal(obs_param_set(&p, "method", "gtao", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "blur", "off", err), OBS_OK);
+    assert_int_equal(obs_param_set(&p, "deep_intervals", intervals, err), OBS_OK);
+    return p;
+}
+
+/* the largest |a - b| over the front AO of every pixel */
+static double ao_diff(const obs_deep_image *d, const obs_params *a, const obs_params *b)
+{
+    obs_deep_result ra, rb;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_deep_run_cpu(d, a, &ra, err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(d, b, &rb, err), OBS_OK);
+    double worst = 0.0;
+    for (int i = 0; i < d->width * d->height; i++)
+        worst = fmax(worst, fabs(ra.ao_front.data[i] - rb.ao_front.data[i]));
+    obs_deep_result_free(&ra);
+    obs_deep_result_free(&rb);
+    return worst;
+}
+
+static void test_gtao_intervals(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    obs_params on = gtao_params(OBS_DEEP_MULTI, "on"), off = gtao_params(OBS_DEEP_MULTI, "off");
+    obs_params single = gtao_params(OBS_DEEP_SINGLE, "off");
+
+    strip_scene(&d, 9.3f, 9.4f, 16, 18);
+    float open = ao_at(&d, &on, 4, 16, NULL);
+    float with = ao_at(&d, &on, 15, 16, NULL), without = ao_at(&d, &off, 15, 16, NULL);
+    float flat = ao_at(&d, &single, 15, 16, NULL);
+    print_message("gtao, thin plate in front: AO open %.4f, intervals %.4f, off %.4f, single %.4f\n",
+                  open, with, without, flat);
+    assert_true(without < open - 0.05f); /* the halo */
+    assert_true(flat < open - 0.05f);
+    assert_true(with <= open + 1e-6f); /* the plate's thickness still occupies its arc */
+    assert_true(open - with < 0.5f * (open - without));
+    obs_deep_free(&d);
+
+    /* front faces only (no back face in any list): the horizon form */
+    synth_init(&d, 32, 32);
+    d.has_facing = 1;
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++) {
+            synth_next(&d, x, y);
+            if (x >= 16)
+                synth_face(&d, x, y, 9.3f, 1.0f);
+            synth_face(&d, x, y, 10.0f, 1.0f);
+        }
+    double same = ao_diff(&d, &on, &off);
+    print_message("gtao, one-sided surfaces: max |intervals - off| %.2e\n", same);
+    assert_true(same == 0.0);
+    obs_deep_free(&d);
+
+    /* the closed box flush with the wall: as the flat buffer */
+    slab_scene(&d, 9.3f, 10.0f);
+    double box = fmax(ao_diff(&d, &on, &off), ao_diff(&d, &on, &single));
+    float crease = ao_at(&d, &on, 15, 16, NULL);
+    print_message("gtao, closed box: max |intervals - off, single| %.2e (AO beside it %.3f)\n", box,
+                  crease);
+    assert_true(box < 1e-5);
+    assert_true(crease < 0.95f); /* the crease is there */
+    obs_deep_free(&d);
 }
 
 /* A floor seen at a grazing angle (view plane 2y + z = -6, one opaque
@@ -862,6 +960,16 @@ static void test_gl_twin(void **state)
     assert_int_equal(obs_param_set(&p, "method", "hbao", err), OBS_OK);
     compare_gl(ctx, &d, &p, "hidden occluder, hbao, multi");
     obs_deep_free(&d);
+    /* method gtao with intervals (gtao.glsl's GT_INTERVALS) */
+    slab_scene(&d, 9.3f, 9.4f);
+    p = gtao_params(OBS_DEEP_MULTI, "on");
+    compare_gl(ctx, &d, &p, "thin plate, gtao, intervals");
+    slab_scene_free_and(&d, 9.3f, 10.0f);
+    compare_gl(ctx, &d, &p, "closed box, gtao, intervals");
+    slab_scene_free_and(&d, 8.6f, 8.7f);
+    assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "thin plate, gtao, intervals, m = 2");
+    obs_deep_free(&d);
     obs_ctx_destroy(ctx);
 }
 
@@ -1050,6 +1158,7 @@ int main(void)
         cmocka_unit_test(test_intervals),
         cmocka_unit_test(test_gtao_deep),
         cmocka_unit_test(test_hbao_deep),
+        cmocka_unit_test(test_gtao_intervals),
         cmocka_unit_test(test_subpixel_sphere),
         cmocka_unit_test(test_hidden_occluder_hemisphere),
         cmocka_unit_test(test_methods_refused),

@@ -805,6 +805,70 @@ static void test_threads_synth(void **state)
     obs_image_free(&img);
 }
 
+/* ---- by rows (obs_gbuffer_rows_*) ---------------------------------------- */
+
+static void same_rows(const obs_plane *a, const obs_plane *whole, int width, int y0, int y1)
+{
+    if (!whole->data) {
+        assert_null(a->data);
+        return;
+    }
+    const size_t row = (size_t)width * (size_t)whole->channels;
+    if (memcmp(a->data, whole->data + (size_t)y0 * row, (size_t)(y1 - y0) * row * sizeof(float)) != 0)
+        fail_msg("rows %d-%d differ from the whole read's", y0, y1);
+}
+
+/* Ranges down the frame overlapping the last (rows kept), one larger
+ * than any before, one back up: each the whole read's rows. */
+static void check_rows(const char *path)
+{
+    obs_gbuffer_file whole, meta;
+    obs_gbuffer_rows *r;
+    obs_gbuffer g;
+    char err[OBS_ERR_LEN] = "";
+    if (obs_gbuffer_read_exr(path, NULL, NULL, &whole, err) != OBS_OK ||
+        obs_gbuffer_rows_open(path, NULL, NULL, &r, &meta, err) != OBS_OK)
+        fail_msg("%s: %s", path, err);
+    const int H = whole.gb.height;
+    assert_int_equal(meta.gb.width, whole.gb.width);
+    assert_int_equal(H, meta.gb.height);
+    assert_null(meta.gb.depth.data);
+    assert_int_equal(meta.gb.color.channels, whole.gb.color.data ? 4 : 0);
+    assert_string_equal(meta.info.preset, whole.info.preset);
+    const int ranges[][2] = {{0, H / 3}, {H / 5, H / 2}, {H / 3, H}, {1, H}, {H / 2, H / 2 + 3}, {0, 1}};
+    for (size_t k = 0; k < sizeof ranges / sizeof ranges[0]; k++) {
+        const int y0 = ranges[k][0], y1 = ranges[k][1];
+        if (obs_gbuffer_rows_read(r, y0, y1, &g, err) != OBS_OK)
+            fail_msg("%s rows %d-%d: %s", path, y0, y1, err);
+        same_rows(&g.depth, &whole.gb.depth, g.width, y0, y1);
+        same_rows(&g.normal, &whole.gb.normal, g.width, y0, y1);
+        same_rows(&g.color, &whole.gb.color, g.width, y0, y1);
+    }
+    assert_int_equal(obs_gbuffer_rows_read(r, 3, 2, &g, err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_gbuffer_rows_read(r, 0, H + 1, &g, err), OBS_INVALID_ARGUMENT);
+    obs_gbuffer_rows_close(r);
+    obs_gbuffer_free(&meta);
+    obs_gbuffer_free(&whole);
+}
+
+static void test_rows(void **state)
+{
+    (void)state;
+    check_rows(TESTDATA "/room_small.exr");
+    const char *path = tmp_path("rows_tiled.exr");
+    tpart p = simple_part(50, 37, EXR_COMPRESSION_ZIP);
+    p.tiled = 1;
+    p.tw = 16;
+    p.th = 8;
+    add_ch(&p, "B", EXR_PIXEL_FLOAT);
+    add_ch(&p, "G", EXR_PIXEL_HALF);
+    add_ch(&p, "R", EXR_PIXEL_FLOAT);
+    add_ch(&p, "Z", EXR_PIXEL_FLOAT);
+    write_synth(path, &p, 1, NULL, NULL);
+    check_rows(path);
+    remove(path);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -826,6 +890,7 @@ int main(void)
         cmocka_unit_test(test_beachball),
         cmocka_unit_test(test_threads_blender),
         cmocka_unit_test(test_threads_synth),
+        cmocka_unit_test(test_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

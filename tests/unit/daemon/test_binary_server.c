@@ -15,7 +15,7 @@
 #include "binary.h"
 #include "binary_server.h"
 #include "job.h"
-#include "log.h"
+#include "../../../daemon/log.h" /* core/log.h shadows it: -Icore comes first */
 
 static char dir[64], sock_path[96];
 
@@ -35,7 +35,8 @@ static obsd_bin *start(obsd_config *cfg, obsd_queue *q, const char *token)
     snprintf(cfg->socket, sizeof cfg->socket, "%s", sock_path);
     cfg->http[0] = '\0';
     assert_int_equal(obsd_queue_init(q, 1), 0);
-    assert_int_equal(obsd_bin_start(cfg, token, q, NULL, &b, err), OBS_OK);
+    const obsd_front front = obsd_front_make(cfg, token, q, NULL);
+    assert_int_equal(obsd_bin_start(&front, &b, err), OBS_OK);
     return b;
 }
 

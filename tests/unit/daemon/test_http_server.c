@@ -77,7 +77,8 @@ static void run(int cut_first)
     obsd_gl_worker gl;
     memset(&gl, 0, sizeof gl);
     obsd_http *h = NULL;
-    assert_int_equal(obsd_http_start(&cfg, NULL, &q, &gl, &h, err), OBS_OK);
+    const obsd_front front = obsd_front_make(&cfg, NULL, &q, &gl);
+    assert_int_equal(obsd_http_start(&front, &h, err), OBS_OK);
 
     client c = {.port = obsd_http_port(h)};
     c.body = obs_test_slurp(TESTDATA "/room_small.exr", &c.len);

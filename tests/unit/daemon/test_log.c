@@ -3,7 +3,7 @@
  * query or a binary parameter) stays one line. */
 #include "testutil.h"
 
-#include "log.h"
+#include "../../../daemon/log.h" /* core/log.h shadows it: -Icore comes first */
 
 static void test_escape(void **state)
 {

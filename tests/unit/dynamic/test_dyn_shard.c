@@ -69,7 +69,7 @@ static void shard_all(const obs_bake_scene *sc, const char *name, int n, const c
         assert_int_equal(ftell(f), 128 + 145 * (long)np);
         fclose(f);
         obs__dyn_part h;
-        assert_int_equal(obs__dyn_part_read_header(p, &h, err), OBS_OK);
+        assert_int_equal(obs__part_header_read(p, &obs__dyn_part_format, &h, err), OBS_OK);
         assert_int_equal(h.r.index, i);
         assert_int_equal(h.r.count, n);
         assert_int_equal(h.r.first, sum);

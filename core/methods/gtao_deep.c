@@ -1,0 +1,232 @@
+/* Method gtao on deep input with intervals (deep_intervals on, facing
+ * flags known): each slice's visibility from its set of free angles
+ * instead of one horizon per side.  The CPU twin of gtao.glsl's
+ * GT_INTERVALS branch.
+ *
+ * GTAO's slice visibility (methods/gtao.c; Jimenez et al. 2016, Algorithm
+ * 1, the inner integral) is the cosine-weighted measure of the visible
+ * directions of the slice,
+ *   A_slice / |n_p| = Int_visible cos(theta - gamma) |sin theta| dtheta,
+ * theta the angle from v in the slice plane, with the antiderivative
+ * a(h) = (cos gamma + 2 h sin gamma - cos(2 h - gamma)) / 4 (a(0) = 0,
+ * Int_0^h for h > 0, Int_h^0 for h < 0).  The horizon form takes the
+ * visible set of a side as [0, h]: every sample is solid behind it, so
+ * everything below the highest one is blocked.  With a node's interval
+ * known (its front face at depth w and its matching back face at depth e
+ * along the pixel's ray, obs__deep_intervals) the solid it puts in the
+ * slice is the segment from q to q + (e - w) dir, which the slice sees
+ * as the arc between the angles of its two ends (the angle from v is
+ * monotonic along a ray that does not pass through the centre): occupied,
+ * the idea of Therrien et al. 2023 ("Screen Space Indirect Lighting with
+ * Visibility Bitmask"), but with exact arcs and each occluder's thickness
+ * taken from its back face (no thickness constant).
+ *
+ * The steps sample the slice at a few columns (their pixels' rays), and
+ * a surface between two columns blocks rays there too: a wall seen face
+ * on from the floor shows each column only a sliver of its thickness.
+ * The horizon form covers this by taking each sample solid behind (the
+ * depth buffer as a height field, continuous between samples).  Here a
+ * column's free depth ranges (before its first interval, between two)
+ * are matched with the previous column's, starting at the centre's (the
+ * range in front of it, where every ray leaving c starts): two ranges
+ * with depths in common are one free space, the surfaces bounding them
+ * being taken continuous between the columns; a ray passing from a free
+ * range of one column to one of the next with no depth in common has
+ * crossed a surface, and the angles where it does (the overlap of the two
+ * ranges' arcs) are occupied.  The space behind a column's last surface
+ * is outside the scene as the list shows it (the far side of a room's
+ * wall): a ray cannot reach it from the centre's range without crossing
+ * that surface, so a closed interval with no node behind it is solid
+ * behind it, as is a node without back face (facing unknown, unmatched).
+ * The visible set is what no arc occupies: the sum over the free arcs
+ * [t0, t1] of a(t1) - a(t0).  The nodes solid behind them bound the side
+ * by their highest horizon as before, and as every free range then starts
+ * at the camera no crossing is found: with no closed interval the result
+ * is a(h0) + a(h1) exactly.
+ *
+ * XeGTAO's falloff (gtao.c) moves a point's horizon cosine towards the
+ * tangent's `low` by the weight w(r) of its distance r: a sample solid
+ * behind occupies [low, low + (shc - low) w].  Each end of an interval is
+ * a point and is mapped the same way by its own weight, so that a point
+ * has one mapped angle whichever node it belongs to (a back face on the
+ * wall behind it meets the wall's horizon: a closed box flush with a wall
+ * is the flat buffer's box), and a back face beyond the falloff radius
+ * maps to the tangent: the interval is then the sample solid behind.
+ * The arc is taken between its two mapped ends. */
+#include <math.h>
+
+#include "chain/mask_weight.h"
+#include "methods/gtao_deep.h"
+
+static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
+static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* The horizon cosine of the point c + d moved from the tangent's `low`
+ * by its falloff weight times om, as sample_cos in gtao.c; low where d
+ * is 0. */
+static float weighted_cos(const float fw[3], const float d[3], const float v[3], float low,
+                          float om)
+{
+    float dist = sqrtf(dot3(d, d));
+    if (!(dist > 0.0f))
+        return low;
+    float shc = dot3(d, v) / dist;
+    float dz = d[2] * (1.0f + fw[2]); /* thin-occluder compensation */
+    float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
+    float w = clampf(fb * fw[0] + fw[1], 0.0f, 1.0f) * om;
+    return low + (shc - low) * w;
+}
+
+/* the angle of d from v (no falloff); acos(low) where d is 0 */
+static float true_angle(const float d[3], const float v[3], float low)
+{
+    float dist = sqrtf(dot3(d, d));
+    return acosf(clampf(dist > 0.0f ? dot3(d, v) / dist : low, -1.0f, 1.0f));
+}
+
+/* adds the occupied arc [lo, hi] to the side, sorted by lo */
+static void add_arc(obs__gtao_side *s, float lo, float hi)
+{
+    if (!(hi > lo))
+        return;
+    int i = s->n;
+    if (i == OBS__GTAO_MAX_ARCS) { /* not reached (the bound's comment): widen the last arc */
+        s->lo[i - 1] = fminf(s->lo[i - 1], lo);
+        s->hi[i - 1] = fmaxf(s->hi[i - 1], hi);
+        return;
+    }
+    for (; i > 0 && s->lo[i - 1] > lo; i--) {
+        s->lo[i] = s->lo[i - 1];
+        s->hi[i] = s->hi[i - 1];
+    }
+    s->lo[i] = lo;
+    s->hi[i] = hi;
+    s->n++;
+}
+
+void obs__gtao_side_start(obs__gtao_side *s, const float c[3])
+{
+    s->n = 0;
+    s->gaps = 1;
+    s->z[0][0] = 0.0f;
+    s->z[0][1] = -c[2];
+    s->t[0][0] = s->m[0][0] = 0.0f;
+    s->t[0][1] = s->m[0][1] = (float)M_PI;
+}
+
+float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s, const float *q,
+                       const float *end, size_t plane, int layers, int x, int y, int self, int qx,
+                       int qy, const float c[3], const float v[3], float low)
+{
+    float gz[OBS__GTAO_MAX_GAPS][2], gt[OBS__GTAO_MAX_GAPS][2], gm[OBS__GTAO_MAX_GAPS][2];
+    float hc = low, cz = 0.0f, ct = 0.0f, cm = 0.0f; /* the free range open from depth cz */
+    int ng = 0, open = 1, last = -1;
+    /* the last node met outside every interval: if it closes an interval,
+     * nothing lies behind that (solid behind it, the header) */
+    for (int k = 0; k < layers; k++)
+        if (q[(size_t)k * plane + 3] > 0.0f && !(end && end[(size_t)k * (plane / 4)] < 0.0f))
+            last = k;
+    for (int k = 0; k < layers; k++) {
+        const float *qk = q + (size_t)k * plane;
+        const float e = end && k != last ? end[(size_t)k * (plane / 4)] : 0.0f;
+        if (!(qk[3] > 0.0f) || e < 0.0f)
+            continue; /* empty, or inside a nearer node's interval */
+        const float om = obs__occluder_weight_node(f, x, y, self, qx, qy, k);
+        const float d[3] = {qk[0] - c[0], qk[1] - c[1], qk[2] - c[2]};
+        const float cf = weighted_cos(fw, d, v, low, om);
+        if (e == 0.0f)
+            hc = fmaxf(hc, cf); /* solid behind: the horizon form */
+        if (!open)
+            continue; /* behind a node solid behind it: no free range */
+        const float tf = true_angle(d, v, low), mf = acosf(clampf(cf, -1.0f, 1.0f));
+        if (qk[3] > cz && ng < OBS__GTAO_MAX_GAPS) { /* the free range in front of it */
+            gz[ng][0] = cz, gz[ng][1] = qk[3];
+            gt[ng][0] = ct, gt[ng][1] = tf;
+            gm[ng][0] = cm, gm[ng][1] = mf;
+            ng++;
+        }
+        if (e == 0.0f) {
+            open = 0;
+            continue;
+        }
+        /* a closed interval: its back face on the pixel's ray, q = o + w
+         * dir (obs__prep_position), and the arc between its ends */
+        float ndc[2], o[3], dir[3];
+        obs__px_ndc(f, qx, qy, ndc);
+        obs__view_ray(f->proj, ndc, o, dir);
+        const float db[3] = {o[0] + e * dir[0] - c[0], o[1] + e * dir[1] - c[1], -e - c[2]};
+        const float mb = acosf(clampf(weighted_cos(fw, db, v, low, om), -1.0f, 1.0f));
+        add_arc(s, fminf(mf, mb), fmaxf(mf, mb));
+        cz = e;
+        ct = true_angle(db, v, low);
+        cm = mb;
+    }
+    if (open && ng < OBS__GTAO_MAX_GAPS) { /* no surface from cz on */
+        gz[ng][0] = cz, gz[ng][1] = INFINITY;
+        gt[ng][0] = ct, gt[ng][1] = (float)M_PI;
+        gm[ng][0] = cm, gm[ng][1] = (float)M_PI;
+        ng++;
+    }
+    /* a ray from a free range of the previous column to one of this
+     * column with no depth in common crosses a surface between them */
+    for (int a = 0; a < s->gaps; a++)
+        for (int b = 0; b < ng; b++) {
+            if (s->z[a][0] < gz[b][1] && gz[b][0] < s->z[a][1])
+                continue; /* one free space */
+            float lo = fmaxf(s->t[a][0], gt[b][0]), hi = fminf(s->t[a][1], gt[b][1]);
+            if (!(hi > lo))
+                continue;
+            /* the crossing's ends as the falloff maps them */
+            float ml = s->t[a][0] >= gt[b][0] ? s->m[a][0] : gm[b][0];
+            float mh = s->t[a][1] <= gt[b][1] ? s->m[a][1] : gm[b][1];
+            add_arc(s, fminf(ml, mh), fmaxf(ml, mh));
+        }
+    s->gaps = ng;
+    for (int b = 0; b < ng; b++)
+        for (int i = 0; i < 2; i++) {
+            s->z[b][i] = gz[b][i];
+            s->t[b][i] = gt[b][i];
+            s->m[b][i] = gm[b][i];
+        }
+    return hc;
+}
+
+/* a(h) of gtao.c (its arc()): the inner integral's closed form */
+static float arc(float h, float gamma, float cos_gamma)
+{
+    return (cos_gamma + 2.0f * h * sinf(gamma) - cosf(2.0f * h - gamma)) / 4.0f;
+}
+
+/* The free part of one side (s = +1: angles 0 .. h, s = -1: h .. 0):
+ * the sweep over its arcs, sorted by their near end, each end clamped to
+ * n's hemisphere as gtao.c clamps a horizon. */
+static float side_free(const obs__gtao_side *a, float h, float s, float gamma, float cos_g)
+{
+    const float half_pi = (float)M_PI_2;
+    if (a->n == 0)
+        return arc(h, gamma, cos_g);
+    float end = s * h, cur = 0.0f, sum = 0.0f; /* |angles| on the side */
+    for (int i = 0; i <= a->n; i++) {
+        float lo = end, hi = end;
+        if (i < a->n) {
+            lo = s > 0.0f ? gamma + fminf(a->lo[i] - gamma, half_pi)
+                          : gamma + fmaxf(-a->lo[i] - gamma, -half_pi);
+            hi = s > 0.0f ? gamma + fminf(a->hi[i] - gamma, half_pi)
+                          : gamma + fmaxf(-a->hi[i] - gamma, -half_pi);
+            lo = fminf(s * lo, end);
+            hi = s * hi;
+        }
+        if (lo > cur) /* free from cur to lo */
+            sum += arc(s * lo, gamma, cos_g) - (cur > 0.0f ? arc(s * cur, gamma, cos_g) : 0.0f);
+        cur = fmaxf(cur, hi);
+        if (cur >= end)
+            break;
+    }
+    return sum;
+}
+
+float obs__gtao_slice_free(const obs__gtao_side *s0, const obs__gtao_side *s1, float h0, float h1,
+                           float gamma, float cos_g)
+{
+    return side_free(s1, h0, -1.0f, gamma, cos_g) + side_free(s0, h1, 1.0f, gamma, cos_g);
+}
