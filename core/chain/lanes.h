@@ -27,6 +27,17 @@
 static inline __attribute__((always_inline)) float max_f(float a, float b) { return (a >= b) | (b != b) ? a : b; }
 static inline __attribute__((always_inline)) float min_f(float a, float b) { return (a <= b) | (b != b) ? a : b; }
 
+/* min_f and max_f of two numbers (neither NaN): the same value, without
+ * the NaN test, which nested in a clamp can keep gcc from vectorising */
+static inline __attribute__((always_inline)) float min_num(float a, float b)
+{
+    return a <= b ? a : b;
+}
+static inline __attribute__((always_inline)) float max_num(float a, float b)
+{
+    return a >= b ? a : b;
+}
+
 /* floorf(v) where the caller needs only its comparisons and its int:
  * through the int conversion, which the lanes have (floorf has no SSE2
  * form); the same value for |v| < 2^23, v itself above (already an

@@ -350,8 +350,8 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
             om1[METHOD_LANES], hc[2][METHOD_LANES];
         float sval[32][METHOD_LANES]; /* a side's steps' cosines (steps <= 32) */
         float np_len[METHOD_LANES], cosg[METHOD_LANES], gam[METHOD_LANES], lo[2][METHOD_LANES];
-        int ok[METHOD_LANES], taken[METHOD_LANES], out[METHOD_LANES], ti[METHOD_LANES], sqx[32][METHOD_LANES],
-            sqy[32][METHOD_LANES];
+        int ok[METHOD_LANES], taken[METHOD_LANES], out[METHOD_LANES], ti[METHOD_LANES];
+        int sqx[32][METHOD_LANES], sqy[32][METHOD_LANES];
         chunk_at(f, px, m, j0, &c);
         lanes_load(pos, nrm, &c, &v);
         for (int j = 0; j < METHOD_LANES; j++) {

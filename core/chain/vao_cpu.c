@@ -495,15 +495,80 @@ void obs__vao_counts(const obs__frame *f, const float *pos, const float *nrm, co
 #define PX_LANES 16
 #define DM(q) dm[(q) * PX_LANES + j] /* term q of lane j's disk map */
 
+/* border_dz() of n samples off the planes in lanes, entry e the sample
+ * mi[e] of chunk lane ml[e] (disk map dm, pixel xs, ys, centre depth c2):
+ * obs__border_point, obs__border_px and obs__plane_point (border_cpu.c)
+ * as selects, the same floats; seen[e] 0 where the sample is left out of
+ * eq 1, else its unoccluded length in dz[e]. */
+OBS__LANES __attribute__((noinline)) static void border_lanes(
+    const obs__frame *f, const float *pos, const float *nrm, const float *P, const float *vp,
+    const float *dm, const int *xs, const int *ys, const float *c2, const float *hs,
+    const float *xy, const int *ml, const int *mi, int n, float *dz, int *seen)
+{
+    const float fw = (float)f->width, fh = (float)f->height, R = f->radius, u = f->range_u;
+    const int w = f->width, range = f->range_check, by_normal = f->range_normal;
+#pragma omp simd
+    for (int e = 0; e < n; e++) {
+        const int j = ml[e], i = mi[e];
+        const float sx = xy[2 * i], sy = xy[2 * i + 1], h = hs[i];
+        /* disk_uv() */
+        const float sw =
+            dm[6 * PX_LANES + j] * sx + dm[7 * PX_LANES + j] * sy + dm[8 * PX_LANES + j];
+        const float fu =
+            floor_lane((dm[j] * sx + dm[PX_LANES + j] * sy + dm[2 * PX_LANES + j]) / sw);
+        const float fv = floor_lane(
+            (dm[3 * PX_LANES + j] * sx + dm[4 * PX_LANES + j] * sy + dm[5 * PX_LANES + j]) / sw);
+        const int near = (fabsf(fu) < OBS_BORDER_MAX_PX) & (fabsf(fv) < OBS_BORDER_MAX_PX);
+        /* obs__border_px() */
+        const float px0 = (float)xs[j] + 0.5f, py0 = (float)ys[j] + 0.5f;
+        const float du = fu + 0.5f - px0, dv = fv + 0.5f - py0;
+        const float tu = du > 0.0f ? (fw - px0) / du : du < 0.0f ? -px0 / du : 1.0f;
+        const float t1 = min_num(1.0f, tu); /* tu, tv: numbers */
+        const float tv = dv > 0.0f ? (fh - py0) / dv : dv < 0.0f ? -py0 / dv : t1;
+        const float t = min_num(t1, tv);
+        const int bx = (int)min_num(max_num(floor_lane(px0 + t * du), 0.0f), fw - 1.0f);
+        const int by = (int)min_num(max_num(floor_lane(py0 + t * dv), 0.0f), fh - 1.0f);
+        const int k = (by * w + bx) & -near; /* not a select: gcc gathers by pointers */
+        const float b0 = pos[4 * k], b1 = pos[4 * k + 1], b2 = pos[4 * k + 2];
+        const float b3 = pos[4 * k + 3];
+        const float nb0 = nrm[3 * k], nb1 = nrm[3 * k + 1], nb2 = nrm[3 * k + 2];
+        /* obs__plane_point(): obs__px_ndc() of the sample's pixel, obs__view_ray() */
+        /* (float)(int)fu is fu: an integer under OBS_BORDER_MAX_PX where used */
+        const float nx = (fu + 0.5f + vp[0]) / vp[2] * 2.0f - 1.0f;
+        const float ny = 1.0f - (fv + 0.5f + vp[1]) / vp[3] * 2.0f;
+        const float a = P[0] - nx * P[12], b = P[1] - nx * P[13];
+        const float c = P[4] - ny * P[12], d = P[5] - ny * P[13];
+        const float b0x = nx * P[15] - P[3], b0y = ny * P[15] - P[7];
+        const float b1x = nx * P[14] - P[2], b1y = ny * P[14] - P[6];
+        const float inv = 1.0f / (a * d - b * c);
+        const float o0 = (d * b0x - b * b0y) * inv, o1 = (a * b0y - c * b0x) * inv;
+        const float dir0 = -(d * b1x - b * b1y) * inv, dir1 = -(a * b1y - c * b1x) * inv;
+        const float den = nb0 * dir0 + nb1 * dir1 + nb2 * -1.0f;
+        const float dp = (nb0 * (b0 - o0) + nb1 * (b1 - o1) + nb2 * (b2 - 0.0f)) / den;
+        const int fg = b3 > 0.0f; /* else background: the sample is open */
+        const int got = (den < 0.0f) & (dp > 0.0f) & (dp < OBS_BACKGROUND_DEPTH);
+        const float zs = fg ? dp : INFINITY;
+        const float nz = fg ? nb2 : 1.0f;
+        seen[e] = (sw > 0.0f) & near & ((fg == 0) | got);
+        /* the pipe, as estimate() takes it */
+        const float front = -c2[j] - h;
+        const float dz_ab = min_f(max_f(zs - front, 0.0f), 2.0f * h);
+        const float dd = by_normal ? (front - zs) * fabsf(nz) : front - zs;
+        const float sd = u / max_f(u, dd / R);
+        const float dz_c = 2.0f * h * (1.0f - sd);
+        dz[e] = range & (zs < front) ? dz_c : dz_ab;
+    }
+}
+
 /* estimate_lanes() of m pixels at once: a chunk of PX_LANES pixels in the
  * lanes, each sample's arithmetic for all of them (the pixels' own terms,
  * the disk map among them, in lanes too), eq 1's sums per lane in the
  * samples' order, so each pixel's result is estimate_lanes()'s, bit for
  * bit.  What a pixel's samples share is computed once: the pipes' half
  * lengths and, for a pixel all of whose samples fall on the planes, eq 2's
- * F.  A sample off the planes (the surface continued past the border,
- * border_cpu.c) is taken afterwards, one by one, and its pixel's sums
- * redone in the samples' order. */
+ * F.  The samples off the planes (the surface continued past the border,
+ * border_cpu.c) are taken afterwards, in lanes over a list of them
+ * (border_lanes), and their pixels' sums redone in the samples' order. */
 OBS__LANES
 void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float *nrm,
                               const float *dnz, const int *px, int m, int ns, const float *xy,
@@ -513,8 +578,10 @@ void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float
     const float fw = (float)f->width, fh = (float)f->height;
     const int w = f->width, range = f->range_check, by_normal = f->range_normal;
     const float u = f->range_u;
-    float ls[32], hs[32], F = 0.0f, rots[18];
+    float ls[32], hs[32], F = 0.0f, rots[18], P[16], vp[4];
     memcpy(rots, f->rot, sizeof rots);
+    memcpy(P, f->proj, sizeof P);
+    memcpy(vp, f->viewport, sizeof vp);
     for (int i = 0; i < ns; i++) {
         const float sx = xy[2 * i], sy = xy[2 * i + 1];
         const float l = sqrtf(max_f(0.0f, 1.0f - sx * sx - sy * sy));
@@ -529,6 +596,8 @@ void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float
             ro1[PX_LANES], dm[9 * PX_LANES], open[PX_LANES], dzs[32][PX_LANES];
         int kk[PX_LANES], ti[PX_LANES], xs[PX_LANES], ys[PX_LANES], ownp[PX_LANES],
             miss[PX_LANES], seen_at[32][PX_LANES];
+        int ml[32 * PX_LANES], mi[32 * PX_LANES], bseen[32 * PX_LANES]; /* off the planes */
+        float bdz[32 * PX_LANES];
         /* lanes past the m pixels repeat the first */
         for (int j = 0; j < PX_LANES; j++) {
             kk[j] = px[j0 + (j < cnt ? j : 0)];
@@ -591,22 +660,32 @@ void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float
                 miss[j] |= !seen;
             }
         }
+        /* the samples off the planes (the surface continued past the
+         * border), in lanes over a list of them */
+        int nb = 0;
+        for (int i = 0; i < ns; i++)
+            for (int j = 0; j < cnt; j++)
+                if (!seen_at[i][j]) {
+                    ml[nb] = j;
+                    mi[nb++] = i;
+                }
+        if (nb > 0)
+            border_lanes(f, pos, nrm, P, vp, dm, xs, ys, c2, hs, xy, ml, mi, nb, bdz, bseen);
+        for (int e = 0; e < nb; e++) {
+            dzs[mi[e]][ml[e]] = bdz[e];
+            seen_at[mi[e]][ml[e]] = bseen[e];
+        }
         for (int j = 0; j < cnt; j++) {
             if (!miss[j]) {
                 ao[kk[j]] = F > 0.0f ? open[j] / F : 1.0f; /* eq 1 */
                 continue;
             }
-            /* the samples off the planes, then the sums in the samples' order */
-            const obs__disk dk = {{DM(0), DM(1), DM(2)},
-                                  {DM(3), DM(4), DM(5)},
-                                  {DM(6), DM(7), DM(8)}};
+            /* the sums again in the samples' order, the ones left out skipped */
             float o = 0.0f, Fp = 0.0f;
             for (int i = 0; i < ns; i++) {
-                float dz = dzs[i][j];
-                if (!seen_at[i][j] && !border_dz(f, pos, nrm, &dk, xs[j], ys[j], xy[2 * i],
-                                                 xy[2 * i + 1], c2[j], hs[i], &dz))
+                if (!seen_at[i][j])
                     continue;
-                o += dz;
+                o += dzs[i][j];
                 Fp += R * ls[i]; /* eq 2 */
             }
             ao[kk[j]] = Fp > 0.0f ? o / Fp : 1.0f; /* eq 1 */
