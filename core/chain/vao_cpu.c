@@ -663,8 +663,8 @@ void obs__vao_estimate_pixels(const obs__frame *f, const float *pos, const float
         /* the samples off the planes (the surface continued past the
          * border), in lanes over a list of them */
         int nb = 0;
-        for (int i = 0; i < ns; i++)
-            for (int j = 0; j < cnt; j++)
+        for (int j = 0; j < cnt; j++)
+            for (int i = 0; miss[j] && i < ns; i++)
                 if (!seen_at[i][j]) {
                     ml[nb] = j;
                     mi[nb++] = i;
