@@ -25,8 +25,11 @@ PKGS := OpenEXR egl osmesa libpng libcjson
 # only writes deep files (core/io/exr_deep_write.cpp, see below).
 EXR_CFLAGS := $(shell pkg-config --cflags OpenEXR 2>/dev/null)
 PKG_CFLAGS := $(shell pkg-config --cflags egl osmesa libpng libcjson nettle 2>/dev/null) $(EXR_CFLAGS)
-# nettle: SHA-256 of the program cache's keys (core/gl/progcache.c)
-PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs egl osmesa libpng libcjson nettle 2>/dev/null) -lz -lm -lpthread
+# nettle: SHA-256 of the program cache's keys (core/gl/progcache.c).
+# EGL and OSMesa: their headers only; the libraries are opened at run time
+# when a GL backend is chosen (core/gl/libs.c), so that nothing linked
+# needs GL and the CPU device runs on a node without it.
+PKG_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libpng libcjson nettle 2>/dev/null) -lz -lm -lpthread -ldl
 # Scene loading (core/ground/scene.c: assimp) and the ray-traced reference
 # (core/ground/reference.c: Embree 3, no .pc file) and the bake's least-squares
 # solve (core/bake/fit.c: SuiteSparse CHOLMOD) and its LODs (core/bake/simplify.c:
@@ -208,7 +211,9 @@ demo-run: all
 # ---- tests --------------------------------------------------------------
 # make test = the whole suite, then the same suite under ASan/UBSan but for
 # the sanitizer pass of the slowest e2e scripts (each over 20 s under ASan),
-# which make test-long runs (CI runs both).
+# which make test-long runs, and then the e2e suite once more on the CPU
+# device (plain build; fuzz.sh left out: it fuzzes decoders, whatever the
+# device) (CI runs both).
 E2E_LONG = bake progcache dynamic run load output deploy hostile_binary bakes python_client \
            guards hostile_http provenance remote
 test: deps
@@ -217,6 +222,7 @@ test: deps
 
 test-long: deps
 	$(MAKE) all e2e BUILD=build/asan SAN=1 E2E_ONLY="$(E2E_LONG)"
+	$(MAKE) all e2e OBSCURA_BACKEND=cpu E2E_SKIP=fuzz
 
 check: all headers loops unit e2e readme-check
 
@@ -250,7 +256,11 @@ loops: $(CORE_OBJ) $(DAEMON_OBJ) $(PROTO_OBJ) $(CLI_OBJ)
 # two at a time on two cores (tests/run_e2e.sh); those in E2E_ALONE time
 # the daemon and run afterwards, one at a time.  E2E_ONLY / E2E_SKIP: the
 # scripts' names (without .sh) to run, or to leave to another target.
-E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD)
+# The program cache (and auto's kept choice, devices.txt) in a folder of
+# the build's own, not the user's ~/.cache: a choice kept there by a run
+# of `--backend auto` would move every GL check onto the CPU device.
+E2E_ENV = OBSCURA=$(CLI) OBSCURAD=$(BUILD)/obscurad BUILD=$(BUILD) \
+          OBSCURA_CACHE_DIR=$(abspath $(BUILD))/e2e-cache
 # `make e2e OBSCURA_BACKEND=cpu`: every script on the CPU device (obscura
 # and obscurad read the variable where no --backend is given; gbuffer and
 # the bakes rasterise on a GL context still).

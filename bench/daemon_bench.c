@@ -14,7 +14,7 @@
  * EXR bytes and decoding the answer's AO.Y, with the daemon's default
  * answer (half, compression auto) and with a float ZIP answer (the
  * answer before compression existed); then clients/remote.c, the code of
- * `obscura ao --server` (it asks for a float answer).  For unix: and
+ * `obscura ao --server` (it asks for a half answer, as obscura ao writes half).  For unix: and
  * tcp:// URLs, the binary protocol's raw float32 planes through
  * clients/remote.c.  Medians of N rounds, each round every path once (a
  * load from outside falls on every path alike), all in one run.  Then 1, 2, 4 and 8
@@ -73,7 +73,7 @@ static void remote_frame(const char *url, const char *path, const obs_gbuffer *g
 {
     char *argv[] = {NULL};
     obs_result r;
-    if (cli_remote_run(url, 0, argv, path, gb, OBS_OUTPUT_AO, &r) != 0)
+    if (cli_remote_run(url, 0, argv, path, gb, OBS_OUTPUT_AO, 1, &r) != 0)
         die(url, "frame failed");
     obs_result_free(&r);
 }
@@ -265,6 +265,11 @@ static void client_frames(const char *url, const char *path, const obs_gbuffer *
 }
 
 static int max_clients = 8;
+#define STAGES 7
+static void metrics_read(const char *url, double sum[STAGES], double count[STAGES]);
+static void stage_header(const char *first);
+static void stage_row(const char *first, const double s0[STAGES], const double c0[STAGES],
+                      const double s1[STAGES], const double c1[STAGES]);
 static long daemon_pid; /* --daemon-pid: its CPU time, from /proc */
 
 /* CPU seconds (user + system) the daemon used so far; -1 unknown. */
@@ -293,15 +298,21 @@ static double children_cpu_s(void)
     return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) / 1e6;
 }
 
+/* `metrics`: the daemon's http:// URL, for each client count's stage
+ * means (NULL: none). */
 static void concurrency(const char *url, const char *what, const char *path, const obs_gbuffer *gb,
-                        const obs_bytes *file, int per_client)
+                        const obs_bytes *file, int per_client, const char *metrics)
 {
+    double ms0[4][STAGES], mc0[4][STAGES], ms1[4][STAGES], mc1[4][STAGES];
+    int rows = 0;
     printf("\nConcurrent clients (%s, %s, %d frames per client, one process each):\n\n", url, what, per_client);
-    printf("| clients | frames | wall s | frames/s | x one client | cores busy: daemon + clients |\n"
-           "|---|---|---|---|---|---|\n");
+    printf("| clients | frames | wall s | frames/s | x one client | cores busy: daemon + clients "
+           "| frames per daemon core-second |\n|---|---|---|---|---|---|---|\n");
     fflush(stdout);
     double one = 0;
     for (int n = 1; n <= max_clients; n *= 2) {
+        if (metrics)
+            metrics_read(metrics, ms0[rows], mc0[rows]);
         double d0 = daemon_cpu_s(), c0 = children_cpu_s();
         double t0 = now_ms();
         pid_t pids[8];
@@ -326,12 +337,32 @@ static void concurrency(const char *url, const char *what, const char *path, con
         double fps = n * per_client / sec, d1 = daemon_cpu_s(), c1 = children_cpu_s();
         if (n == 1)
             one = fps;
-        char busy[64] = "-";
-        if (d0 >= 0 && d1 >= 0)
+        /* frames per CPU-second of the daemon: the work a frame costs it,
+         * whatever share of the cores a loaded machine leaves it */
+        char busy[64] = "-", per_core[32] = "-";
+        if (d0 >= 0 && d1 >= 0) {
             snprintf(busy, sizeof busy, "%.2f + %.2f", (d1 - d0) / sec, (c1 - c0) / sec);
-        printf("| %d | %d | %.2f | %.2f | %.2f | %s |\n", n, n * per_client, sec, fps, fps / one, busy);
+            if (d1 > d0)
+                snprintf(per_core, sizeof per_core, "%.2f", n * per_client / (d1 - d0));
+        }
+        printf("| %d | %d | %.2f | %.2f | %.2f | %s | %s |\n", n, n * per_client, sec, fps, fps / one, busy,
+               per_core);
         fflush(stdout);
+        if (metrics)
+            metrics_read(metrics, ms1[rows], mc1[rows]);
+        rows++;
     }
+    if (!metrics)
+        return;
+    printf("\nThe daemon's stages per client count (GET /metrics before and after: mean ms of those frames; "
+           "decode: the EXR's, on the connection's thread; gl: the chain, on the worker):\n\n");
+    stage_header("clients");
+    for (int r = 0, n = 1; r < rows; r++, n *= 2) {
+        char c[16];
+        snprintf(c, sizeof c, "%d", n);
+        stage_row(c, ms0[r], mc0[r], ms1[r], mc1[r]);
+    }
+    fflush(stdout);
 }
 
 /* ---- the EXR encode and decode, in process ---- */
@@ -416,8 +447,11 @@ static void codec_bench(const obs_image *ao, const obs_bytes *file, int reps)
     fflush(stdout);
 }
 
-/* The daemon's stage means from GET /metrics (obscurad_stage_seconds). */
-static void metrics_means(const char *url)
+/* The daemon's stages, GET /metrics obscurad_stage_seconds: each one's
+ * sum (s) and count so far, in the order of `stages`. */
+static const char *const stages[STAGES] = {"receive", "decode", "queue", "gl", "encode", "send", "total"};
+
+static void metrics_read(const char *url, double sum[STAGES], double count[STAGES])
 {
     int fd = http_connect(url);
     const char *req = "GET /metrics HTTP/1.1\r\nHost: bench\r\nConnection: close\r\n\r\n";
@@ -433,30 +467,53 @@ static void metrics_means(const char *url)
     if (!buf)
         die("metrics", "no memory");
     buf[got] = '\0';
-    static const char *const stages[] = {"receive", "decode", "queue", "gl", "encode", "send", "total"};
-    printf("\nDaemon's stages of the 1080p frames above (GET /metrics obscurad_stage_seconds: mean ms over "
-           "every protocol, warm-ups included; receive and send: HTTP only; total: a request's arrival to its "
-           "answer queued, every protocol):\n\n|");
-    for (int s = 0; s < 7; s++)
-        printf(" %s |", stages[s]);
-    printf("\n|");
-    for (int s = 0; s < 7; s++)
-        printf("---|");
-    printf("\n|");
-    for (int s = 0; s < 7; s++) {
+    for (int s = 0; s < STAGES; s++) {
         char key[96];
-        double sum = 0, count = 0;
+        sum[s] = count[s] = 0;
         snprintf(key, sizeof key, "obscurad_stage_seconds_sum{stage=\"%s\"} ", stages[s]);
         const char *p = strstr(buf, key);
         if (p)
-            sum = strtod(p + strlen(key), NULL);
+            sum[s] = strtod(p + strlen(key), NULL);
         snprintf(key, sizeof key, "obscurad_stage_seconds_count{stage=\"%s\"} ", stages[s]);
         if ((p = strstr(buf, key)))
-            count = strtod(p + strlen(key), NULL);
-        printf(" %.1f |", count > 0 ? sum / count * 1e3 : 0.0);
+            count[s] = strtod(p + strlen(key), NULL);
     }
-    printf("\n");
     free(buf);
+}
+
+static void stage_header(const char *first)
+{
+    printf("| %s |", first);
+    for (int s = 0; s < STAGES; s++)
+        printf(" %s |", stages[s]);
+    printf("\n|---|");
+    for (int s = 0; s < STAGES; s++)
+        printf("---|");
+    printf("\n");
+}
+
+/* One row: the mean ms of each stage between two reads. */
+static void stage_row(const char *first, const double s0[STAGES], const double c0[STAGES],
+                      const double s1[STAGES], const double c1[STAGES])
+{
+    printf("| %s |", first);
+    for (int s = 0; s < STAGES; s++)
+        printf(" %.1f |", c1[s] > c0[s] ? (s1[s] - s0[s]) / (c1[s] - c0[s]) * 1e3 : 0.0);
+    printf("\n");
+}
+
+/* The daemon's stage means so far (the big frames above). */
+static void metrics_means(const char *url)
+{
+    double sum[STAGES], count[STAGES], zero[STAGES] = {0};
+    metrics_read(url, sum, count);
+    printf("\nDaemon's stages of the 1080p frames above (GET /metrics obscurad_stage_seconds: mean ms over "
+           "every protocol, warm-ups included; total: a request's arrival to its answer queued, every "
+           "protocol):\n\n");
+    stage_header("frames");
+    char n[32];
+    snprintf(n, sizeof n, "%.0f", count[STAGES - 1]);
+    stage_row(n, zero, zero, sum, count);
     fflush(stdout);
 }
 
@@ -512,9 +569,9 @@ int main(int argc, char **argv)
             http = argv[u];
     if (only_conc) {
         if (http)
-            concurrency(http, "HTTP, default answer", path, &gf.gb, &file, per_client);
+            concurrency(http, "HTTP, default answer", path, &gf.gb, &file, per_client, http);
         if (argv[argc - 1] != http)
-            concurrency(argv[argc - 1], "binary protocol, raw planes", path, &gf.gb, &file, per_client);
+            concurrency(argv[argc - 1], "binary protocol, raw planes", path, &gf.gb, &file, per_client, http);
         obs_gbuffer_free(&gf);
         obs_bytes_free(&file);
         return 0;
@@ -551,7 +608,7 @@ int main(int argc, char **argv)
                 "HTTP, EXR body, float ZIP answer (the answer before compression=), answer decoded", 0};
         }
         paths[np++] = (struct path){url, NULL,
-            !strncmp(url, "http", 4) ? "HTTP through obscura ao --server's client (file read, float answer)"
+            !strncmp(url, "http", 4) ? "HTTP through obscura ao --server's client (file read, half answer)"
             : !strncmp(url, "unix:", 5) ? "binary protocol, raw planes, Unix socket"
                                         : "binary protocol, raw planes, TCP loopback", 1};
     }
@@ -619,9 +676,9 @@ int main(int argc, char **argv)
     obs_result_free(&kept);
 
     if (http)
-        concurrency(http, "HTTP, default answer", path, &gf.gb, &file, per_client);
+        concurrency(http, "HTTP, default answer", path, &gf.gb, &file, per_client, http);
     if (argv[argc - 1] != http)
-        concurrency(argv[argc - 1], "binary protocol, raw planes", path, &gf.gb, &file, per_client);
+        concurrency(argv[argc - 1], "binary protocol, raw planes", path, &gf.gb, &file, per_client, http);
     if (http)
         keepalive_bench(http, &gf.gb, 200);
     obs_gbuffer_free(&gf);

@@ -11,7 +11,10 @@
 # (its log and /metrics); a one-shot `obscura ao` of the same file, and of
 # BASELINE_OBSCURA (another build's obscura, e.g. main's) when set.
 #
-#   BUILD=build [BASELINE_OBSCURA=PATH] bench/daemon_bench.sh [G-BUFFER.exr CAMERA.json]
+# With BASELINE_OBSCURAD (another build's obscurad), its HTTP concurrency
+# and stages per client count against this build's, in turns.
+#
+#   BUILD=build [BASELINE_OBSCURA=PATH] [BASELINE_OBSCURAD=PATH] bench/daemon_bench.sh [G-BUFFER.exr CAMERA.json]
 #
 # Loopback only; the daemons are killed on exit; every wait is bounded.
 set -eu
@@ -43,7 +46,7 @@ start_daemon() {
     SOCK="$T/obscurad.sock"
     rm -f "$SOCK"
     : >"$log" # before the daemon's shell opens it: the loop below reads it at once
-    "$BUILD/obscurad" --http 127.0.0.1:0 --socket "$SOCK" --tcp 127.0.0.1:0 --queue 16 "$@" 2>"$log" &
+    "${DAEMON_BIN:-$BUILD/obscurad}" --http 127.0.0.1:0 --socket "$SOCK" --tcp 127.0.0.1:0 --queue 16 "$@" 2>"$log" &
     PID=$!
     i=0 HP="" TP=""
     while [ $i -lt 300 ] && { [ -z "$HP" ] || [ -z "$TP" ] || [ ! -S "$SOCK" ]; }; do
@@ -69,17 +72,17 @@ stop_daemon() {
 stage_table() {
     echo
     echo "Daemon's stages, median ms per 1080p frame (from its log: frames of over 1 MB, warm-ups and"
-    echo "concurrent clients included; receive: HTTP only):"
+    echo "concurrent clients included; send: binary only, HTTP's is in /metrics):"
     echo
-    echo "| protocol | frames | receive | decode | queue | gl | encode | total in daemon |"
-    echo "|---|---|---|---|---|---|---|---|"
+    echo "| protocol | frames | receive | decode | queue | gl | encode | send | total in daemon |"
+    echo "|---|---|---|---|---|---|---|---|---|"
     for p in "POST /v1/ao" "BINARY"; do
         grep "status=200" "$1" | grep "$p" | grep -E ' in=[0-9]{7,} ' | tr ' ' '\n' |
-            awk -v p="$p" -F= '$1 ~ /^(receive|queue|decode|gl|encode|total)$/ { v[$1, n[$1]++] = $2 }
+            awk -v p="$p" -F= '$1 ~ /^(receive|queue|decode|gl|encode|send|total)$/ { v[$1, n[$1]++] = $2 }
                 function med(k,   m, i, j, a, t) { m = n[k]; for (i = 0; i < m; i++) a[i] = v[k, i]
                     for (i = 1; i < m; i++) { t = a[i]; for (j = i - 1; j >= 0 && a[j] > t; j--) a[j + 1] = a[j]; a[j + 1] = t }
                     return m ? a[int(m / 2)] : 0 }
-                END { printf "| %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f |\n", p, n["gl"], med("receive"), med("decode"), med("queue"), med("gl"), med("encode"), med("total") }'
+                END { printf "| %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f |\n", p, n["gl"], med("receive"), med("decode"), med("queue"), med("gl"), med("encode"), med("send"), med("total") }'
     done
 }
 
@@ -123,6 +126,26 @@ start_daemon "$T/r.log" --render-threads 1
     "http://127.0.0.1:$HP"
 stage_table "$T/r.log"
 stop_daemon
+
+# BASELINE_OBSCURAD (another build's obscurad, e.g. main's): its
+# concurrency and stages per client count against this build's, the two
+# daemons in turns, twice (a load from outside falls on both)
+if [ -n "${BASELINE_OBSCURAD:-}" ]; then
+    echo
+    echo "#### this build's obscurad and BASELINE_OBSCURAD's, in turns (HTTP, 1, 2, 4 clients)"
+    for round in 1 2; do
+        for d in "$BUILD/obscurad" "$BASELINE_OBSCURAD"; do
+            echo
+            echo "##### $d (round $round, load $(cut -d' ' -f1-3 /proc/loadavg))"
+            DAEMON_BIN=$d
+            start_daemon "$T/b.log"
+            DAEMON_BIN=""
+            "$BUILD/daemon_bench" --daemon-pid "$PID" --concurrency-only --max-clients 4 --per-client "$PER_CLIENT" \
+                "$T/big.exr" "http://127.0.0.1:$HP"
+            stop_daemon
+        done
+    done
+fi
 
 # one-shot obscura ao: a whole process, read and write included; this
 # build and the baseline in turns (a load from outside falls on both)

@@ -465,6 +465,13 @@ static obs_status write_exr_out(const ao_args *a, obs_exr_layer *layers, int n, 
     return s;
 }
 
+/* 1 when the outputs are written as a half EXR as the chain gives them:
+ * a daemon's half answer then writes the same file (--server). */
+static int half_answer(const ao_args *a)
+{
+    return a->req.format == OBS_HTTP_EXR && !a->req.float_exr;
+}
+
 /* "dir/out.png" + "ao" -> "dir/out.ao.png"; a frame number stays last,
  * where sequence readers look for it: "comp.0001.png" -> "comp.ao.0001.png". */
 static void suffixed(const char *path, const char *suffix, char *buf, size_t len)
@@ -747,7 +754,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     } else if (a->cpu) {
         s = obs_deep_run_cpu(&d, &a->req.params, &r, err);
     } else if (server) { /* clients/remote.c prints its own errors */
-        if ((rc = cli_remote_run_deep(server, argc, argv, a->in, &d, a->req.outputs, &r)) != EXIT_OK)
+        if ((rc = cli_remote_run_deep(server, argc, argv, a->in, &d, a->req.outputs, half_answer(a), &r)) != EXIT_OK)
             goto done;
     } else {
         obs_ctx_desc desc = {.debug = a->debug_gl, .log = log_cb, .cache_dir = cache_dir_of(a->cache_dir)};
@@ -774,7 +781,8 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
         obs_deep_ao nodes;
         s = obs_deep_ao_nodes(&d, &a->req.params, &nodes, err);
         if (s == OBS_OK)
-            s = obs_deep_ao_write_exr(a->out, &nodes, &r.ao_blend, &r.ao_front, err);
+            s = obs_deep_ao_write_exr(a->out, &nodes, &r.ao_blend, &r.ao_front,
+                                      (obs_exr_compression)a->req.compression, err);
         obs_deep_ao_free(&nodes);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
@@ -935,7 +943,7 @@ static void cpu_bands_from_env(obs_cpu_options *o)
 /* The chain on the CPU twin, on obscurad (--server) or on a GL context
  * (kept across a batch's frames); *t0 restarts once the context exists. */
 static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, const char *server,
-                     int argc, char **argv, obs_result *res, obs_ctx **ctx, double *t0,
+                     int combined, int argc, char **argv, obs_result *res, obs_ctx **ctx, double *t0,
                      char err[OBS_ERR_LEN])
 {
     obs_status s;
@@ -944,7 +952,7 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
         cpu_bands_from_env(&o);
         s = obs_run_cpu_opts(&gf->gb, &a->req.params, outputs, res, &o, err);
     } else if (server) { /* clients/remote.c prints its own errors */
-        return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, res);
+        return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, half_answer(a) && !combined, res);
     } else {
         obs_ctx_desc desc = {.debug = a->debug_gl, .log = log_cb, .cache_dir = cache_dir_of(a->cache_dir)};
         backend_from_args(a->backend, &desc.backend);
@@ -956,10 +964,10 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
         *t0 = now_ms();
         s = obs_run(*ctx, &gf->gb, &a->req.params, outputs, res, err);
         log_programs(*ctx);
-        if (verbosity >= OBS_LOG_DEBUG) /* tests/e2e/threads.sh reads it */
-            fprintf(stderr, "obscura: debug: threads: %d in this process after the frame\n",
-                    cli_process_threads());
     }
+    if (verbosity >= OBS_LOG_DEBUG) /* tests/e2e/threads.sh reads it */
+        fprintf(stderr, "obscura: debug: threads: %d in this process after the frame\n",
+                cli_process_threads());
     return s == OBS_OK ? EXIT_OK : cli_fail(s, a->in, err);
 }
 
@@ -1044,7 +1052,7 @@ static int ao_flat(ao_args *a, const obs_limits *lim, const char *server, int ar
     if (baked.data)
         outputs |= OBS_OUTPUT_AO; /* the combination needs the chain's AO */
     t0 = now_ms();
-    if ((rc = run_frame(a, &gf, outputs, server, argc, argv, &res, &ctx, &t0, err)) != EXIT_OK)
+    if ((rc = run_frame(a, &gf, outputs, server, baked.data != NULL, argc, argv, &res, &ctx, &t0, err)) != EXIT_OK)
         goto done;
     if ((rc = server ? cli_remote_result_warnings(a, &gf.info)
                      : cli_result_warnings(a, &res.ao, &gf.gb, NULL, &gf.info)) != EXIT_OK)
@@ -1334,6 +1342,7 @@ static int cmd_info(int argc, char **argv)
     if (backend_is_cpu(backend)) {
         printf("obscura %s\nbackend: cpu (the chain on the CPU device, no GL context)\n",
                OBS_VERSION);
+        print_threads(0);
         return EXIT_OK;
     }
     obs_ctx_desc desc = {.log = log_cb, .cache_dir = cache_dir_of(cache)};

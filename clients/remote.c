@@ -275,6 +275,21 @@ static void collect(int argc, char **argv, int map_too, pairs *ps, char names[][
     }
 }
 
+/* --compression's value, which the deep answer's file is written with
+ * (the daemon writes --output deep's file, which this client keeps as
+ * it comes); NULL when not given (auto: the file's default, as obscura
+ * ao writes it). */
+static const char *deep_compression(int argc, char **argv)
+{
+    for (int i = 0; i < argc; i++) {
+        if (!strncmp(argv[i], "--compression=", 14))
+            return argv[i] + 14;
+        if (!strcmp(argv[i], "--compression") && i + 1 < argc)
+            return argv[i + 1];
+    }
+    return NULL;
+}
+
 static const char *outputs_name(unsigned outputs)
 {
     switch (outputs) {
@@ -744,7 +759,7 @@ int cli_remote_split(const char *list, char urls[][256], int max)
 
 /* The frame (gb or deep) on the servers; the answer into `out`. */
 static int run_remote(const char *server, int argc, char **argv, const char *in_path, const obs_gbuffer *gb,
-                      const obs_deep_image *deep, unsigned outputs, answer *out)
+                      const obs_deep_image *deep, unsigned outputs, int half, answer *out)
 {
     static server_addr addrs[CLI_REMOTE_MAX_SERVERS];
     static char urls[CLI_REMOTE_MAX_SERVERS][256];
@@ -793,7 +808,13 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
         collect(argc, argv, 1, &ps, names);
         add(&ps, "output", oname);
         add(&ps, "format", "exr");
-        add(&ps, "float", "1");
+        /* half when the caller writes half (obscura ao's default EXR):
+         * half -> float -> half is exact, so the file is the same bytes
+         * as the float answer would give, at a quarter of the answer's
+         * size and encode; float for PNG, --float and a combination */
+        add(&ps, "float", half ? "0" : "1");
+        if (out->file && deep_compression(argc, argv))
+            add(&ps, "compression", deep_compression(argc, argv));
         /* the baked channel: this client combines it (obscura.c), so the
          * daemon does not do it a second time */
         add(&ps, "baked", "none");
@@ -832,6 +853,8 @@ static int run_remote(const char *server, int argc, char **argv, const char *in_
         }
         add(&pb, "output", oname);
         add(&pb, "format", out->file ? "exr" : "raw"); /* deep: the file as it is */
+        if (out->file && deep_compression(argc, argv))
+            add(&pb, "compression", deep_compression(argc, argv));
         if (token && *token)
             add(&pb, "token", token);
         if (masks) {
@@ -925,22 +948,22 @@ fail:
 }
 
 int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
-                   const obs_gbuffer *gb, unsigned outputs, obs_result *out)
+                   const obs_gbuffer *gb, unsigned outputs, int half, obs_result *out)
 {
     answer a = {out, NULL, NULL};
-    return run_remote(server, argc, argv, in_path, gb, NULL, outputs, &a);
+    return run_remote(server, argc, argv, in_path, gb, NULL, outputs, half, &a);
 }
 
 int cli_remote_run_deep(const char *server, int argc, char **argv, const char *in_path,
-                        const obs_deep_image *deep, unsigned outputs, obs_deep_result *out)
+                        const obs_deep_image *deep, unsigned outputs, int half, obs_deep_result *out)
 {
     answer a = {NULL, out, NULL};
-    return run_remote(server, argc, argv, in_path, NULL, deep, outputs, &a);
+    return run_remote(server, argc, argv, in_path, NULL, deep, outputs, half, &a);
 }
 
 int cli_remote_run_deep_file(const char *server, int argc, char **argv, const char *in_path,
                              const obs_deep_image *deep, obs_bytes *file)
 {
     answer a = {NULL, NULL, file};
-    return run_remote(server, argc, argv, in_path, NULL, deep, OBS_OUTPUT_DEEP, &a);
+    return run_remote(server, argc, argv, in_path, NULL, deep, OBS_OUTPUT_DEEP, 0, &a);
 }

@@ -41,9 +41,12 @@ int cli_remote_take_server(int argc, char **argv, const char **server);
  * Prints its own message on failure.  Returns an exit code: 0 ok, 1
  * failure, 2 usage, 3 bad input (the server said 4xx other than 503), 4
  * server unreachable or busy (after bounded retries with Retry-After).
+ * `half`: the caller writes the images as a half EXR as they come (no
+ * combination first), so an HTTP answer in half is enough and gives the
+ * same file; 0 asks for float (PNG, --float).  Raw planes are float.
  * On 0 the caller frees *out with obs_result_free(). */
 int cli_remote_run(const char *server, int argc, char **argv, const char *in_path,
-                   const obs_gbuffer *gb, unsigned outputs, obs_result *out);
+                   const obs_gbuffer *gb, unsigned outputs, int half, obs_result *out);
 
 /* The same for deep input: over the binary protocol the A-buffer goes as
  * a deep G-buffer (per-pixel counts and samples), over HTTP the deep EXR
@@ -51,7 +54,7 @@ int cli_remote_run(const char *server, int argc, char **argv, const char *in_pat
  * composite, as `outputs` asks).  On 0 the caller frees *out with
  * obs_deep_result_free(). */
 int cli_remote_run_deep(const char *server, int argc, char **argv, const char *in_path,
-                        const obs_deep_image *deep, unsigned outputs, obs_deep_result *out);
+                        const obs_deep_image *deep, unsigned outputs, int half, obs_deep_result *out);
 /* --output deep: the daemon's answer, the two-part deep EXR, as it came
  * into *file (the caller frees it with obs_bytes_free()). */
 int cli_remote_run_deep_file(const char *server, int argc, char **argv, const char *in_path,

@@ -137,6 +137,7 @@ typedef struct frame {
     double t0;
     size_t bytes_in, bytes_out;
     double ms_decode, ms_queue, ms_gl, ms_encode;
+    double ms_receive, ms_send; /* the payload's arrival after its header; the answer's write */
     int status;
     int close_after; /* answered shutting_down: no frame follows */
     char note[OBS_ERR_LEN + 96];
@@ -145,16 +146,19 @@ typedef struct frame {
 static void log_frame(const frame *f)
 {
     obsd_stats_request(OBSD_STATS_BINARY, f->status, f->bytes_in, f->bytes_out);
-    if (f->status == 200)
+    if (f->status == 200) {
         obsd_stats_stage(OBSD_STAGE_TOTAL, obsd_now_ms() - f->t0);
+        obsd_stats_stage(OBSD_STAGE_SEND, f->ms_send);
+    }
     if (!obsd_log_enabled(OBSD_LOG_INFO))
         return;
+    /* receive= and send= after encode=, as HTTP's line has receive= */
     obsd_log(OBSD_LOG_INFO,
              "req=b%llu peer=%s BINARY id=%llu status=%d in=%zu out=%zu queue=%.1f decode=%.1f "
-             "gl=%.1f encode=%.1f total=%.1f ms%s%s", (unsigned long long)f->rid, f->c->peer,
-             (unsigned long long)f->id, f->status, f->bytes_in, f->bytes_out, f->ms_queue,
-             f->ms_decode, f->ms_gl, f->ms_encode, obsd_now_ms() - f->t0, f->note[0] ? " " : "",
-             f->note);
+             "gl=%.1f encode=%.1f receive=%.1f send=%.1f total=%.1f ms%s%s", (unsigned long long)f->rid,
+             f->c->peer, (unsigned long long)f->id, f->status, f->bytes_in, f->bytes_out, f->ms_queue,
+             f->ms_decode, f->ms_gl, f->ms_encode, f->ms_receive, f->ms_send, obsd_now_ms() - f->t0,
+             f->note[0] ? " " : "", f->note);
 }
 
 /* Sends a response; -1 when the connection is gone. */
@@ -170,7 +174,9 @@ static int send_response(frame *f, const obs_bin_response_desc *d)
     }
     f->status = d->status;
     f->bytes_out = out.size;
+    double t0 = obsd_now_ms();
     int rc = write_all(f->c->srv, f->c->fd, out.data, out.size);
+    f->ms_send = obsd_now_ms() - t0;
     obs_bytes_free(&out);
     if (d->status != 200)
         snprintf(f->note, sizeof f->note, "error=%s: %s", d->code, d->message);
@@ -442,6 +448,8 @@ static int serve_one(conn *c)
         }
     }
     f.bytes_in = sizeof hdr + (size_t)h.length;
+    f.ms_receive = obsd_now_ms() - f.t0;
+    obsd_stats_stage(OBSD_STAGE_RECEIVE, f.ms_receive);
     obs_bin_request q;
     double t0 = obsd_now_ms();
     s = obs_bin_request_decode(payload, (size_t)h.length, &lim, &q, err);

@@ -112,7 +112,8 @@
       "the next frame (0: no deadline, the AO pass drawn at once)")           \
     X(keep_memory, SIZE, 0, 1099511627776, "512m",                             \
       "texture memory the GL worker keeps for the next frame of the same "     \
-      "size; above it, whenever the queue runs empty, it is released; "       \
+      "size (on the CPU device, its planes); above it, whenever the queue "  \
+      "runs empty, it is released; "                                           \
       "freed heap memory is returned to the system (malloc_trim) once the "    \
       "queue has stayed empty for a second")                                   \
     X(cache_dir, STRING, 0, OBSD_STR_LEN - 1, "",                              \

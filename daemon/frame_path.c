@@ -89,10 +89,13 @@ obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
         s = read_baked(fp, body, len, hr, lim, err);
     if (s == OBS_OK && !deep && hr->solve_camera && fp->gf.gb.position.data)
         s = obs_gbuffer_solve_camera(&fp->gf, &hr->params, err);
-    /* strict: a sanity warning on the input fails the frame (HTTP 422) */
-    if (s == OBS_OK && !deep && obs_gbuffer_sanity(&fp->gf.gb, &hr->params, &fp->gf.info) > 0 &&
-        hr->strict)
+    /* strict: a sanity warning on the input fails the frame (HTTP 422),
+     * so it is checked before the frame runs; else the check only adds
+     * warnings to the answer, and runs while the chain does (obsd_fp_queue) */
+    if (s == OBS_OK && !deep && hr->strict && obs_gbuffer_sanity(&fp->gf.gb, &hr->params, &fp->gf.info) > 0)
         s = fail_strict(err, &fp->gf.info);
+    else if (s == OBS_OK && !deep)
+        fp->sanity_params = &hr->params;
     fp->ms_decode = obsd_now_ms() - t0;
     obsd_stats_stage(OBSD_STAGE_DECODE, fp->ms_decode);
     if (s == OBS_OK)
@@ -165,7 +168,20 @@ int obsd_fp_queue(obsd_fp *fp, obsd_queue *q, const obs_params *params, unsigned
     fp->on_done = on_done;
     fp->user = user;
     fp->done = 0;
-    return obsd_queue_push(q, &fp->job);
+    if (obsd_queue_push(q, &fp->job) != 0)
+        return -1;
+    /* The input's sanity check beside the chain: both only read the
+     * G-buffer, the check writes fp->gf.info, which the worker leaves
+     * alone, and the caller reads the result only after this returns
+     * (HTTP resumes the connection on this thread, once this callback has
+     * returned; the binary server waits after). */
+    if (fp->sanity_params) {
+        double t0 = obsd_now_ms();
+        obs_gbuffer_sanity(&fp->gf.gb, fp->sanity_params, &fp->gf.info);
+        fp->ms_sanity = obsd_now_ms() - t0;
+        fp->sanity_params = NULL;
+    }
+    return 0;
 }
 
 void obsd_fp_wait(obsd_fp *fp)
@@ -285,12 +301,14 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
     if (raw) {
         /* nothing to write: the protocol sends the planes */
     } else if (hr->outputs & OBS_OUTPUT_DEEP) {
-        /* every kept node's AO (the CPU twin, as obscura ao --output deep) */
+        /* every kept node's AO (the CPU twin, as obscura ao --output deep);
+         * a file written as it comes (obscura ao --server --output deep),
+         * so auto keeps the file's compressions, as obscura ao writes them */
         obs_deep_ao nodes;
         s = obs_deep_ao_nodes(fp->deep, fp->job.params, &nodes, err);
         if (s == OBS_OK)
-            s = obs_deep_ao_write_exr_mem(&nodes, &fp->job.deep_result.ao_blend,
-                                          &fp->job.deep_result.ao_front, out, err);
+            s = obs_deep_ao_write_exr_mem(&nodes, &fp->job.deep_result.ao_blend, &fp->job.deep_result.ao_front,
+                                          (obs_exr_compression)hr->compression, out, err);
         obs_deep_ao_free(&nodes);
     } else if (hr->format == OBS_HTTP_EXR) {
         /* copies of the image headers only: the pixels stay where they are */

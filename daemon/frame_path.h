@@ -3,7 +3,9 @@
  *
  *   decode     an EXR body (flat or deep) into the frame's G-buffer, on
  *              the network thread; or planes the protocol decoded itself
- *   queue      the job to the GL worker (a full queue is refused)
+ *   queue      the job to the GL worker (a full queue is refused); the
+ *              input's sanity check then runs on the network thread while
+ *              the worker runs the chain (before it, under strict)
  *   wait       obsd_fp_wait(), or a callback on the GL worker thread for a
  *              caller that must not block (HTTP resumes its connection)
  *   finished   the job's queue and GL times, the frame's size class
@@ -37,6 +39,10 @@ typedef struct obsd_fp {
     int has_cam;
     double ms_decode, ms_queue, ms_gl, ms_encode;
     double ms_receive;        /* the transport's: the body's arrival (HTTP), else 0 */
+    /* the input's sanity check, run beside the chain once queued (not
+     * strict: its warnings go with the answer), and its time */
+    const obs_params *sanity_params;
+    double ms_sanity;
     /* the way back from the GL worker */
     void (*on_done)(void *user);
     void *user;
@@ -65,8 +71,10 @@ void obsd_fp_free(obsd_fp *fp);
 
 /* Reads an EXR body: a deep one into fp->deep_exr (refused with OBS_UNSUPPORTED
  * and the message `no_deep` when that is set), else a G-buffer with
- * hr->map, checked for sanity under hr->params (with hr->strict a warning
- * fails it: OBS_BAD_FILE).  Sizes are checked against lim.  Sets ms_decode either way. */
+ * hr->map, checked for sanity under hr->params: here with hr->strict (a
+ * warning fails it: OBS_BAD_FILE), else in obsd_fp_queue, beside the
+ * chain (hr must live until then).  Sizes are checked against lim.  Sets
+ * ms_decode either way. */
 obs_status obsd_fp_decode(obsd_fp *fp, const unsigned char *body, size_t len,
                           const obs_http_request *hr, const obs_limits *lim, const char *no_deep,
                           char err[OBS_ERR_LEN]);

@@ -71,6 +71,12 @@ static obs_ctx *recreate(obsd_gl_worker *w, obs_ctx *ctx, obs_status why, const 
     }
 }
 
+/* The CPU device's cancel: the drain cut the requests. */
+static int cut_asked(void *user)
+{
+    return atomic_load(&((obsd_gl_worker *)user)->cut);
+}
+
 /* 1 (and the job answered OBS_TOO_COSTLY) when the frame asks for more
  * work than --max-cost. */
 static int too_costly(const obsd_gl_worker *w, obsd_job *job)
@@ -115,7 +121,9 @@ static void idle(obsd_gl_worker *w, obs_ctx *ctx)
     char err[OBS_ERR_LEN] = "";
     if (ctx && obs_ctx_trim(ctx, w->keep_memory, err) != OBS_OK)
         obsd_log(OBSD_LOG_WARN, "releasing frame targets: %s", err);
-    atomic_store(&w->kept_bytes, ctx ? obs_ctx_kept_bytes(ctx) : 0);
+    if (w->cpu) /* the CPU device's planes, as a context's targets */
+        obs_cpu_trim(w->keep_memory);
+    atomic_store(&w->kept_bytes, ctx ? obs_ctx_kept_bytes(ctx) : w->cpu ? obs_cpu_kept_bytes() : 0);
 }
 
 static void *worker_main(void *arg)
@@ -179,12 +187,16 @@ static void *worker_main(void *arg)
         } else if (w->fail_after > 0 && frame == w->fail_after) {
             job->status = OBS_GL_ERROR;
             snprintf(job->err, OBS_ERR_LEN, "injected GL failure on frame %ld (--fail-gl-after)", frame);
+        } else if (atomic_load(&w->cut)) {
+            job->status = OBS_CANCELLED;
+            snprintf(job->err, OBS_ERR_LEN, "not run: the drain's deadline passed");
         } else if (too_costly(w, job)) {
             /* answered without running */
         } else if (w->cpu && job->deep) {
             job->status = obs_deep_run_cpu(job->deep, job->params, &job->deep_result, job->err);
         } else if (w->cpu) {
-            obs_cpu_options o = {.deadline = w->frame_deadline}; /* as the GL context's */
+            obs_cpu_options o = {.deadline = w->frame_deadline, /* as the GL context's */
+                                 .cancel = cut_asked, .cancel_user = w};
             job->status = obs_run_cpu_opts(job->gb, job->params, job->outputs, &job->result, &o,
                                            job->err);
         } else if (job->deep) {
@@ -196,12 +208,16 @@ static void *worker_main(void *arg)
         if (job->status == OBS_DEADLINE) /* name the option that set it */
             snprintf(job->err + strlen(job->err), OBS_ERR_LEN - strlen(job->err),
                      " (--frame-deadline)");
+        if (job->status == OBS_CANCELLED) /* by the drain's cut: its request is gone */
+            obsd_log(OBSD_LOG_INFO, "frame %ld: %s", frame, job->err);
         obs_status st = job->status;
         char msg[OBS_ERR_LEN];
         snprintf(msg, sizeof msg, "%s", job->err);
         if (ctx) {
             atomic_store(&w->kept_bytes, obs_ctx_kept_bytes(ctx));
             count_programs(w, ctx, 0);
+        } else if (w->cpu) {
+            atomic_store(&w->kept_bytes, obs_cpu_kept_bytes());
         }
         obsd_queue_done(w->queue);
         job->done(job, job->user); /* the job is not ours after this */
@@ -231,6 +247,7 @@ obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *d
     atomic_init(&w->recreations, 0);
     atomic_init(&w->heap_trims, 0);
     atomic_init(&w->stopping, 0);
+    atomic_init(&w->cut, 0);
     pthread_mutex_init(&w->lock, NULL);
     pthread_cond_init(&w->ready, NULL);
     if (pthread_create(&w->thread, NULL, worker_main, w) != 0) {
@@ -259,4 +276,9 @@ void obsd_gl_stop(obsd_gl_worker *w)
     obsd_queue_close(w->queue);
     pthread_join(w->thread, NULL);
     w->running = 0;
+}
+
+void obsd_gl_cut(obsd_gl_worker *w)
+{
+    atomic_store(&w->cut, 1);
 }

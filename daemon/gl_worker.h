@@ -38,6 +38,7 @@ typedef struct obsd_gl_worker {
     atomic_int alive;              /* a context exists */
     atomic_ullong recreations;     /* contexts recreated after a GL failure */
     atomic_int stopping;           /* obsd_gl_stop() was called */
+    atomic_int cut;                /* obsd_gl_cut() was called */
     int running;                   /* the thread runs (main thread only) */
     /* start-up handshake */
     pthread_mutex_t lock;
@@ -61,5 +62,11 @@ obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *d
 /* Closes the queue, lets the worker finish every queued job, joins it
  * (the context is destroyed on the worker thread). */
 void obsd_gl_stop(obsd_gl_worker *w);
+
+/* The drain's cut (its deadline passed, the requests cut): the frame
+ * running on the CPU device stops at its next tile, and every job still
+ * queued is answered OBS_CANCELLED without running, so that the stop
+ * that follows does not wait for frames nobody waits for. */
+void obsd_gl_cut(obsd_gl_worker *w);
 
 #endif

@@ -198,8 +198,10 @@ static void log_listeners(const obsd_config *cfg, obsd_http *http, obsd_bin *bin
 
 /* Drain: no new connections; every frame taken is finished and answered
  * before the server stops, within --drain-timeout: past it what is left
- * is cut (logged), so the drain ends whatever the clients do. */
-static void drain(const obsd_config *cfg, obsd_http *http, obsd_bin *bin)
+ * is cut (logged), and the worker skips the frames still queued and stops
+ * the CPU device's frame under way, so the drain ends whatever the clients
+ * do. */
+static void drain(const obsd_config *cfg, obsd_http *http, obsd_bin *bin, obsd_gl_worker *gl)
 {
     obsd_log(OBSD_LOG_INFO, "stopping: finishing %d request(s) and %d binary connection(s) under way "
              "(SIGINT again to quit now)", http ? obsd_http_in_flight(http) : 0, obsd_bin_in_flight(bin));
@@ -216,6 +218,7 @@ static void drain(const obsd_config *cfg, obsd_http *http, obsd_bin *bin)
             int requests = http ? obsd_http_in_flight(http) : 0, conns = obsd_bin_in_flight(bin);
             obsd_log(OBSD_LOG_WARN, "drain deadline (%d s) passed: cutting %d request(s) and %d "
                      "binary connection(s)", cfg->drain_timeout, requests, conns);
+            obsd_gl_cut(gl);
             if (http)
                 obsd_http_cut(http);
             obsd_bin_cut(bin);
@@ -299,7 +302,7 @@ int main(int argc, char **argv)
         obsd_http_tick(http); /* event streams' keep-alives */
     }
 
-    drain(&cfg, http, bin);
+    drain(&cfg, http, bin, &gl);
     obsd_http_stop(http);
     obsd_bin_stop(bin);
     obsd_gl_stop(&gl);

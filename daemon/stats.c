@@ -264,7 +264,7 @@ char *obsd_stats_text(const obsd_gauges *g, size_t *len)
             "# TYPE obscurad_gl_context_recreations_total counter\n"
             "obscurad_gl_context_recreations_total %llu\n"
             "# HELP obscurad_gl_kept_bytes Texture memory the GL worker keeps for the next frame "
-            "(--keep-memory).\n"
+            "(on the CPU device its planes; --keep-memory).\n"
             "# TYPE obscurad_gl_kept_bytes gauge\n"
             "obscurad_gl_kept_bytes %llu\n"
             "# HELP obscurad_heap_trims_total Times freed heap memory was returned to the "

@@ -11,8 +11,8 @@ typedef enum obsd_stage {
     OBSD_STAGE_DECODE,
     OBSD_STAGE_GL,
     OBSD_STAGE_ENCODE,
-    OBSD_STAGE_RECEIVE, /* HTTP: the request's headers to its body's end */
-    OBSD_STAGE_SEND,    /* HTTP: the answer queued to its last byte handed to the kernel */
+    OBSD_STAGE_RECEIVE, /* HTTP: the request's headers to its body's end; binary: the payload after its header */
+    OBSD_STAGE_SEND,    /* the answer queued (binary: written) to its last byte handed to the kernel */
     OBSD_STAGE_TOTAL,
     OBSD_STAGE_COUNT
 } obsd_stage;

@@ -284,11 +284,8 @@ static obs_status band_run(obs__cpu_run *c, obs__plan *pl, const band *b, obs_pa
     for (int i = 0; s == OBS_OK && i < OBS_PASS_COUNT; i++) {
         if (!obs__passes[i].when(pl))
             continue;
-        if (c->deadline_ms > 0.0 && now_ms() > c->deadline_ms)
-            atomic_store(&c->stopped, 1);
-        if (atomic_load(&c->stopped)) {
-            s = obs__fail(err, OBS_DEADLINE, "the frame ran past its deadline (before the %s pass)",
-                          obs_pass_name((obs_pass)i));
+        if (obs__cpu_stop_now(c)) {
+            s = obs__cpu_stopped_fail(c, "before", (obs_pass)i, err);
             break;
         }
         t0 = t ? now_ms() : 0.0;
@@ -303,8 +300,7 @@ static obs_status band_run(obs__cpu_run *c, obs__plan *pl, const band *b, obs_pa
             s = obs__cpu_kernels[i](c, err);
         obs__cpu_window_set(old);
         if (s == OBS_OK && atomic_load(&c->stopped))
-            s = obs__fail(err, OBS_DEADLINE, "the frame ran past its deadline (in the %s pass)",
-                          obs_pass_name((obs_pass)i));
+            s = obs__cpu_stopped_fail(c, "in", (obs_pass)i, err);
         if (t) {
             t->ms[i] += now_ms() - t0;
             t->total_ms += now_ms() - t0;
@@ -581,6 +577,10 @@ obs_status obs_run_cpu_rows(const obs_gbuffer *frame, obs_rows_in_fn in, obs_row
     head.depth.row_stride = head.normal.row_stride = head.color.row_stride = 0;
     if (opt && opt->deadline > 0.0)
         c.deadline_ms = now_ms() + opt->deadline * 1e3;
+    if (opt) {
+        c.cancel = opt->cancel;
+        c.cancel_user = opt->cancel_user;
+    }
     atomic_init(&c.stopped, 0);
     obs_status s = obs__plan_init(&pl, log ? obs__log_only_ctx(&sink) : NULL, &head, params, outputs, err);
     if (s != OBS_OK)

@@ -61,25 +61,36 @@ static void vao_bent(const obs__frame *f, const float *pos, const float *nrm, in
             bent[k] = nrm[3 * i + k];
 }
 
-/* The AO pass over a tile of the frame at the AO's size (GLSL:
- * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
- * (when the composite or the output reads it) and the debug planes (NULL:
- * not wanted) of every pixel. */
-/* The clock against the run's deadline, read between the AO pass's
- * tiles: past it, the rest of the pass's tiles are skipped (the run then
- * fails with OBS_DEADLINE, run_cpu.c). */
-static int past_deadline(obs__cpu_run *c)
+/* The clock against the run's deadline, and the caller's cancel, read
+ * between the passes and the AO pass's tiles: past it (or cancelled), the
+ * rest of the pass's tiles are skipped (the run then fails with
+ * OBS_DEADLINE or OBS_CANCELLED, run_cpu.c). */
+int obs__cpu_stop_now(obs__cpu_run *c)
 {
     if (atomic_load_explicit(&c->stopped, memory_order_relaxed))
         return 1;
-    if (c->deadline_ms <= 0.0)
+    int why = 0, none = 0;
+    if (c->cancel && c->cancel(c->cancel_user)) {
+        why = OBS__CPU_CANCELLED;
+    } else if (c->deadline_ms > 0.0) {
+        struct timespec ts;
+        clock_gettime(CLOCK_MONOTONIC, &ts);
+        if ((double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6 > c->deadline_ms)
+            why = OBS__CPU_PAST_DEADLINE;
+    }
+    if (!why)
         return 0;
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    if ((double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6 <= c->deadline_ms)
-        return 0;
-    atomic_store(&c->stopped, 1);
+    atomic_compare_exchange_strong(&c->stopped, &none, why); /* the first reason stays */
     return 1;
+}
+
+obs_status obs__cpu_stopped_fail(obs__cpu_run *c, const char *where, obs_pass p, char err[OBS_ERR_LEN])
+{
+    if (atomic_load(&c->stopped) == OBS__CPU_CANCELLED)
+        return obs__fail(err, OBS_CANCELLED, "the frame was cancelled (%s the %s pass)", where,
+                         obs_pass_name(p));
+    return obs__fail(err, OBS_DEADLINE, "the frame ran past its deadline (%s the %s pass)", where,
+                     obs_pass_name(p));
 }
 
 /* ao_tile() for the VAO estimator without colour bleeding and without
@@ -197,10 +208,14 @@ static int ao_tile_method(obs__cpu_run *c, int x0, int x1, int y0, int y1)
     return 1;
 }
 
+/* The AO pass over a tile of the frame at the AO's size (GLSL:
+ * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
+ * (when the composite or the output reads it) and the debug planes (NULL:
+ * not wanted) of every pixel. */
 static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
 {
     obs__cpu_run *c = ctx;
-    if (past_deadline(c))
+    if (obs__cpu_stop_now(c))
         return;
     const obs__frame *f = c->pl->af;
     const obs__method *method = c->pl->method;

@@ -35,11 +35,24 @@ typedef struct obs__cpu_run {
     int arow0, arow1, harow0, harow1;
     void *block;                                    /* where the planes are */
     size_t block_size;
-    /* the deadline (CLOCK_MONOTONIC ms; 0: none); stopped: a tile found
-     * it past and the rest of the pass was skipped */
+    /* the deadline (CLOCK_MONOTONIC ms; 0: none) and the caller's cancel
+     * (obs_cpu_options; NULL: none); stopped: a tile found the deadline
+     * past (OBS__CPU_PAST_DEADLINE) or the run cancelled
+     * (OBS__CPU_CANCELLED), and the rest of the pass was skipped */
     double deadline_ms;
+    int (*cancel)(void *user);
+    void *cancel_user;
     atomic_int stopped;
 } obs__cpu_run;
+
+enum { OBS__CPU_PAST_DEADLINE = 1, OBS__CPU_CANCELLED = 2 };
+
+/* Whether c's run is to stop (a tile's test, from any thread): the
+ * deadline passed or the cancel said so; sets c->stopped (passes_cpu.c). */
+int obs__cpu_stop_now(obs__cpu_run *c);
+/* The failure of a run stopped (c->stopped) before or in (`where`) pass
+ * p: OBS_CANCELLED or OBS_DEADLINE, named. */
+obs_status obs__cpu_stopped_fail(obs__cpu_run *c, const char *where, obs_pass p, char err[OBS_ERR_LEN]);
 
 /* The planes of c's plan, in one block: the one the last frame gave back
  * when it fits, else a new one (planes_cpu.c). */

@@ -132,3 +132,24 @@ void obs__cpu_planes_give(obs__cpu_run *c)
     free(drop);
     c->block = NULL;
 }
+
+unsigned long long obs_cpu_kept_bytes(void)
+{
+    pthread_mutex_lock(&kept_lock);
+    unsigned long long n = kept ? kept_size : 0;
+    pthread_mutex_unlock(&kept_lock);
+    return n;
+}
+
+void obs_cpu_trim(unsigned long long budget)
+{
+    void *drop = NULL;
+    pthread_mutex_lock(&kept_lock);
+    if (kept && (budget == 0 || kept_size > budget)) {
+        drop = kept;
+        kept = NULL;
+        kept_size = 0;
+    }
+    pthread_mutex_unlock(&kept_lock);
+    free(drop);
+}

@@ -26,18 +26,14 @@ static obs_status walk(obs__cpu_run *c, obs_pass_times *t, char err[OBS_ERR_LEN]
     for (int i = 0; i < OBS_PASS_COUNT; i++) {
         if (!obs__passes[i].when(c->pl))
             continue;
-        if (c->deadline_ms > 0.0 && now_ms() > c->deadline_ms)
-            atomic_store(&c->stopped, 1);
-        if (atomic_load(&c->stopped))
-            return obs__fail(err, OBS_DEADLINE, "the frame ran past its deadline (before the %s pass)",
-                             obs_pass_name((obs_pass)i));
+        if (obs__cpu_stop_now(c))
+            return obs__cpu_stopped_fail(c, "before", (obs_pass)i, err);
         double t0 = t ? now_ms() : 0.0;
         obs_status s = obs__cpu_kernels[i](c, err);
         if (s != OBS_OK)
             return s;
         if (atomic_load(&c->stopped)) /* a pass cut short: its output is not whole */
-            return obs__fail(err, OBS_DEADLINE, "the frame ran past its deadline (in the %s pass)",
-                             obs_pass_name((obs_pass)i));
+            return obs__cpu_stopped_fail(c, "in", (obs_pass)i, err);
         if (t) {
             t->ms[i] += now_ms() - t0;
             t->total_ms += now_ms() - t0;
@@ -80,6 +76,10 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
     memset(out, 0, sizeof *out);
     if (opt && opt->deadline > 0.0)
         c.deadline_ms = now_ms() + opt->deadline * 1e3;
+    if (opt) {
+        c.cancel = opt->cancel;
+        c.cancel_user = opt->cancel_user;
+    }
     atomic_init(&c.stopped, 0);
     obs_status s = obs__plan_init(&pl, log ? obs__log_only_ctx(&sink) : NULL, gb, params, outputs, err);
     if (s != OBS_OK)

@@ -9,6 +9,14 @@
 typedef void (*obs__glproc)(void);
 typedef obs__glproc (*obs__getproc_fn)(const char *name);
 
+/* ---- their libraries (libs.c) ------------------------------------------ */
+
+/* dlopen(soname): the handle, else NULL with err naming the library, the
+ * Debian package that has it, and the CPU device. */
+void *obs__gl_lib_open(const char *soname, const char *package, char err[OBS_ERR_LEN]);
+/* dlsym(h, name), else NULL with err naming what is missing. */
+void *obs__gl_lib_sym(void *h, const char *soname, const char *name, char err[OBS_ERR_LEN]);
+
 /* ---- backends ---------------------------------------------------------- */
 
 typedef struct obs__backend_state {

@@ -1,12 +1,48 @@
 /* EGL backends: the device platform (a real GPU, EGL_EXT_platform_device)
  * and Mesa's surfaceless platform (EGL_MESA_platform_surfaceless).  Both
  * make an OpenGL 4.3+ core context current with no surface. */
+#include <pthread.h>
 #include <string.h>
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 
 #include "gl/backend.h"
+
+/* The EGL entry points, from libEGL.so.1 opened at the first EGL context
+ * (libs.c): nothing of EGL is linked. */
+#define EGL_FNS(X)                                                                         \
+    X(eglBindAPI) X(eglChooseConfig) X(eglCreateContext) X(eglDestroyContext)              \
+    X(eglGetCurrentContext) X(eglGetError) X(eglGetProcAddress) X(eglInitialize)           \
+    X(eglMakeCurrent) X(eglQueryString) X(eglReleaseThread)
+static struct {
+#define EGL_FIELD(f) __typeof__(f) *f;
+    EGL_FNS(EGL_FIELD)
+#undef EGL_FIELD
+} E;
+static pthread_once_t egl_once = PTHREAD_ONCE_INIT;
+static obs_status egl_loaded = OBS_GL_UNAVAILABLE;
+static char egl_err[OBS_ERR_LEN];
+
+static void egl_load(void)
+{
+    void *h = obs__gl_lib_open("libEGL.so.1", "libegl1", egl_err);
+    if (!h)
+        return;
+#define EGL_SYM(f)                                                                         \
+    if (!(E.f = (__typeof__(E.f))obs__gl_lib_sym(h, "libEGL.so.1", #f, egl_err)))          \
+        return;
+    EGL_FNS(EGL_SYM)
+#undef EGL_SYM
+    egl_loaded = OBS_OK;
+}
+
+/* libEGL loaded (once, by any thread), else why not, for backend `who` */
+static obs_status egl_lib(const char *who, char err[OBS_ERR_LEN])
+{
+    pthread_once(&egl_once, egl_load);
+    return egl_loaded == OBS_OK ? OBS_OK : obs__fail(err, egl_loaded, "%s: %s", who, egl_err);
+}
 
 static int has_ext(const char *exts, const char *name)
 {
@@ -19,7 +55,7 @@ static int has_ext(const char *exts, const char *name)
 
 static obs__glproc egl_getproc(const char *name)
 {
-    return (obs__glproc)eglGetProcAddress(name);
+    return (obs__glproc)E.eglGetProcAddress(name);
 }
 
 int obs__egl_device_client_ok(const char *client, char err[OBS_ERR_LEN])
@@ -42,14 +78,14 @@ int obs__egl_device_client_ok(const char *client, char err[OBS_ERR_LEN])
  * backend is for real GPUs; llvmpipe is reached through surfaceless. */
 static EGLDisplay device_display(char err[OBS_ERR_LEN])
 {
-    if (!obs__egl_device_client_ok(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), err))
+    if (!obs__egl_device_client_ok(E.eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), err))
         return EGL_NO_DISPLAY;
     PFNEGLQUERYDEVICESEXTPROC query_devices =
-        (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
+        (PFNEGLQUERYDEVICESEXTPROC)E.eglGetProcAddress("eglQueryDevicesEXT");
     PFNEGLQUERYDEVICESTRINGEXTPROC query_string =
-        (PFNEGLQUERYDEVICESTRINGEXTPROC)eglGetProcAddress("eglQueryDeviceStringEXT");
+        (PFNEGLQUERYDEVICESTRINGEXTPROC)E.eglGetProcAddress("eglQueryDeviceStringEXT");
     PFNEGLGETPLATFORMDISPLAYEXTPROC get_display =
-        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+        (PFNEGLGETPLATFORMDISPLAYEXTPROC)E.eglGetProcAddress("eglGetPlatformDisplayEXT");
     if (!query_devices || !query_string || !get_display) {
         obs__fail(err, OBS_GL_UNAVAILABLE, "egl-device: device enumeration entry points missing");
         return EGL_NO_DISPLAY;
@@ -74,19 +110,19 @@ static EGLDisplay device_display(char err[OBS_ERR_LEN])
 
 static EGLDisplay surfaceless_display(char err[OBS_ERR_LEN])
 {
-    const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    const char *client = E.eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (!has_ext(client, "EGL_MESA_platform_surfaceless")) {
         obs__fail(err, OBS_GL_UNAVAILABLE,
                   "egl-surfaceless: EGL_MESA_platform_surfaceless is not available");
         return EGL_NO_DISPLAY;
     }
     PFNEGLGETPLATFORMDISPLAYEXTPROC get_display =
-        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+        (PFNEGLGETPLATFORMDISPLAYEXTPROC)E.eglGetProcAddress("eglGetPlatformDisplayEXT");
     EGLDisplay d = get_display ? get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL)
                                : EGL_NO_DISPLAY;
     if (d == EGL_NO_DISPLAY)
         obs__fail(err, OBS_GL_UNAVAILABLE, "egl-surfaceless: no display (EGL error 0x%x)",
-                  (unsigned)eglGetError());
+                  (unsigned)E.eglGetError());
     return d;
 }
 
@@ -94,24 +130,26 @@ obs_status obs__egl_create(int debug, int device, obs__backend_state *st,
                            obs__getproc_fn *getproc, char err[OBS_ERR_LEN])
 {
     const char *who = device ? "egl-device" : "egl-surfaceless";
+    obs_status s = egl_lib(who, err);
+    if (s != OBS_OK)
+        return s;
     EGLDisplay dpy = device ? device_display(err) : surfaceless_display(err);
     EGLContext gc = EGL_NO_CONTEXT;
     EGLint major = 0, minor = 0;
-    obs_status s;
 
     if (dpy == EGL_NO_DISPLAY)
         return OBS_GL_UNAVAILABLE;
-    if (!eglInitialize(dpy, &major, &minor)) {
+    if (!E.eglInitialize(dpy, &major, &minor)) {
         s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: eglInitialize failed (0x%x)", who,
-                      (unsigned)eglGetError());
+                      (unsigned)E.eglGetError());
         goto fail;
     }
-    const char *exts = eglQueryString(dpy, EGL_EXTENSIONS);
+    const char *exts = E.eglQueryString(dpy, EGL_EXTENSIONS);
     if (!has_ext(exts, "EGL_KHR_surfaceless_context")) {
         s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: EGL_KHR_surfaceless_context missing", who);
         goto fail;
     }
-    if (!eglBindAPI(EGL_OPENGL_API)) {
+    if (!E.eglBindAPI(EGL_OPENGL_API)) {
         s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: desktop OpenGL is not supported", who);
         goto fail;
     }
@@ -119,7 +157,7 @@ obs_status obs__egl_create(int debug, int device, obs__backend_state *st,
     if (!has_ext(exts, "EGL_KHR_no_config_context")) {
         const EGLint cattr[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
         EGLint ncfg = 0;
-        if (!eglChooseConfig(dpy, cattr, &cfg, 1, &ncfg) || ncfg < 1) {
+        if (!E.eglChooseConfig(dpy, cattr, &cfg, 1, &ncfg) || ncfg < 1) {
             s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: no OpenGL config", who);
             goto fail;
         }
@@ -130,15 +168,15 @@ obs_status obs__egl_create(int debug, int device, obs__backend_state *st,
         EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
         EGL_CONTEXT_OPENGL_DEBUG, debug ? EGL_TRUE : EGL_FALSE,
         EGL_NONE};
-    gc = eglCreateContext(dpy, cfg ? cfg : (EGLConfig)0, EGL_NO_CONTEXT, attr);
+    gc = E.eglCreateContext(dpy, cfg ? cfg : (EGLConfig)0, EGL_NO_CONTEXT, attr);
     if (gc == EGL_NO_CONTEXT) {
         s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: no OpenGL 4.3 core context (0x%x)", who,
-                      (unsigned)eglGetError());
+                      (unsigned)E.eglGetError());
         goto fail;
     }
-    if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, gc)) {
+    if (!E.eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, gc)) {
         s = obs__fail(err, OBS_GL_UNAVAILABLE, "%s: eglMakeCurrent failed (0x%x)", who,
-                      (unsigned)eglGetError());
+                      (unsigned)E.eglGetError());
         goto fail;
     }
     st->egl_display = dpy;
@@ -148,15 +186,15 @@ obs_status obs__egl_create(int debug, int device, obs__backend_state *st,
 
 fail:
     if (gc != EGL_NO_CONTEXT)
-        eglDestroyContext(dpy, gc);
+        E.eglDestroyContext(dpy, gc);
     return s;
 }
 
 obs_status obs__egl_make_current(obs__backend_state *st)
 {
-    if (eglGetCurrentContext() == (EGLContext)st->egl_context)
+    if (E.eglGetCurrentContext() == (EGLContext)st->egl_context)
         return OBS_OK;
-    return eglMakeCurrent(st->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, st->egl_context)
+    return E.eglMakeCurrent(st->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, st->egl_context)
                ? OBS_OK
                : OBS_GL_ERROR;
 }
@@ -165,12 +203,12 @@ void obs__egl_destroy(obs__backend_state *st)
 {
     if (!st->egl_display)
         return;
-    eglMakeCurrent(st->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    E.eglMakeCurrent(st->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (st->egl_context)
-        eglDestroyContext(st->egl_display, st->egl_context);
+        E.eglDestroyContext(st->egl_display, st->egl_context);
     /* No eglTerminate: the display is per process and cheap to keep, and
      * terminating it unloads Mesa's driver, which leaks its JIT state on
      * every unload.  A context created later reuses the display. */
-    eglReleaseThread();
+    E.eglReleaseThread();
     st->egl_display = st->egl_context = NULL;
 }

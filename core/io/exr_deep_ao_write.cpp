@@ -60,9 +60,30 @@ static obs_status check_args(const char *path, const obs_deep_ao *a, const obs_i
     return OBS_OK;
 }
 
+// The parts' compressions for `c`: `c` for both, but zip (and the
+// default, zip) is ZIPS in the deep part: OpenEXR's deep data takes
+// none, rle or zips (one scanline a chunk), and no other.
+static obs_status compressions(obs_exr_compression c, Compression *deep, Compression *flat, char err[OBS_ERR_LEN])
+{
+    static const Compression of[] = {ZIP_COMPRESSION, NO_COMPRESSION,   RLE_COMPRESSION, ZIPS_COMPRESSION,
+                                     ZIP_COMPRESSION, PIZ_COMPRESSION,  DWAA_COMPRESSION};
+    if ((int)c < 0 || (size_t)c >= sizeof of / sizeof of[0])
+        return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "deep AO: unknown compression %d", (int)c);
+    obs_status s = obs_exr_compression_check(c, err); // dwaa: OpenEXR 3.2's C API reads it
+    if (s != OBS_OK)
+        return s;
+    *deep = of[c] == ZIP_COMPRESSION ? ZIPS_COMPRESSION : of[c];
+    *flat = of[c];
+    if (*deep != NO_COMPRESSION && *deep != RLE_COMPRESSION && *deep != ZIPS_COMPRESSION)
+        return obs__deep_fail(err, OBS_UNSUPPORTED, "compression %s: the deep AO's deep part takes none, rle, zips "
+                              "or zip (OpenEXR codes no other for deep data)", obs_exr_compression_name(c));
+    return OBS_OK;
+}
+
 // Writes the two parts into dest: a file name or an OStream.
 template <class Dest>
-static void write_parts(Dest &dest, const obs_deep_ao *a, const obs_image *flat, const obs_image *front)
+static void write_parts(Dest &dest, const obs_deep_ao *a, const obs_image *flat, const obs_image *front,
+                        Compression deep_c, Compression flat_c)
 {
     const int w = a->width, h = a->height;
     const size_t npx = (size_t)w * (size_t)h;
@@ -70,7 +91,7 @@ static void write_parts(Dest &dest, const obs_deep_ao *a, const obs_image *flat,
     Header deep = base_header(a);
     deep.setName("deep");
     deep.setType(DEEPSCANLINE);
-    deep.compression() = ZIPS_COMPRESSION;
+    deep.compression() = deep_c;
     deep.setVersion(1); // the deep data version the C API (and Nuke) require
     // planar per channel: A, A x AO, Z, ZBack of every node in order
     static const char *const names[] = {"A", "AO.Y", "Z", "ZBack"};
@@ -79,7 +100,7 @@ static void write_parts(Dest &dest, const obs_deep_ao *a, const obs_image *flat,
     Header flt = base_header(a);
     flt.setName("flat");
     flt.setType(SCANLINEIMAGE);
-    flt.compression() = ZIP_COMPRESSION;
+    flt.compression() = flat_c;
     flt.setVersion(1); // OpenEXR's C API wants it on every part of a file with deep data
     if (flat)
         flt.channels().insert("AO.Y", Channel(FLOAT));
@@ -136,13 +157,16 @@ static void write_parts(Dest &dest, const obs_deep_ao *a, const obs_image *flat,
 
 extern "C" obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao *a,
                                             const obs_image *flat, const obs_image *front,
-                                            char err[OBS_ERR_LEN])
+                                            obs_exr_compression compression, char err[OBS_ERR_LEN])
 {
+    Compression dc, fc;
     obs_status s = check_args(path, a, flat, front, err);
+    if (s == OBS_OK)
+        s = compressions(compression, &dc, &fc, err);
     if (s != OBS_OK)
         return s;
     return obs__deep_write_file(path, "deep AO", err,
-                                [&](const char *tmp) { write_parts(tmp, a, flat, front); });
+                                [&](const char *tmp) { write_parts(tmp, a, flat, front, dc, fc); });
 }
 
 // An OStream into memory (malloc'd, grown by doubling), for the daemon's
@@ -174,18 +198,21 @@ class MemOStream : public OStream {
 };
 
 extern "C" obs_status obs_deep_ao_write_exr_mem(const obs_deep_ao *a, const obs_image *flat,
-                                                const obs_image *front, obs_bytes *out,
-                                                char err[OBS_ERR_LEN])
+                                                const obs_image *front, obs_exr_compression compression,
+                                                obs_bytes *out, char err[OBS_ERR_LEN])
 {
     if (!out)
         return obs__deep_fail(err, OBS_INVALID_ARGUMENT, "obs_deep_ao_write_exr_mem: no output");
     *out = obs_bytes{nullptr, 0};
+    Compression dc, fc;
     obs_status s = check_args("deep AO", a, flat, front, err);
+    if (s == OBS_OK)
+        s = compressions(compression, &dc, &fc, err);
     if (s != OBS_OK)
         return s;
     try {
         MemOStream os;
-        write_parts(os, a, flat, front);
+        write_parts(os, a, flat, front, dc, fc);
         out->data = (unsigned char *)os.buf;
         out->size = (size_t)os.len;
         os.buf = nullptr;

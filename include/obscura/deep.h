@@ -231,13 +231,15 @@ void obs_deep_ao_free(obs_deep_ao *a);
  * float), AO.Y (the flat AO: `flat`, e.g. ao_blend) and AOFront.Y (the
  * front node's, `front`); either image may be NULL.  Both parts carry
  * the windows, the camera as worldToCamera/worldToNDC and
- * obscura/version. */
+ * obscura/version.  Those compressions are OBS_EXR_ZIP_DEFAULT's (zip);
+ * any other names both parts' (zip is ZIPS in the deep part: deep data
+ * takes none, rle or zips; piz and dwaa are OBS_UNSUPPORTED). */
 obs_status obs_deep_ao_write_exr(const char *path, const obs_deep_ao *a, const obs_image *flat,
-                                 const obs_image *front, char err[OBS_ERR_LEN]);
+                                 const obs_image *front, obs_exr_compression compression, char err[OBS_ERR_LEN]);
 /* The same file into memory (obscurad's answer to output=deep); caller
  * frees *out with obs_bytes_free(). */
 obs_status obs_deep_ao_write_exr_mem(const obs_deep_ao *a, const obs_image *flat, const obs_image *front,
-                                     obs_bytes *out, char err[OBS_ERR_LEN]);
+                                     obs_exr_compression compression, obs_bytes *out, char err[OBS_ERR_LEN]);
 
 #ifdef __cplusplus
 }

@@ -295,6 +295,12 @@ typedef struct obs_cpu_options {
      * longer (the clock read between passes and between the AO pass's
      * tiles, so at most one tile past it); 0: no deadline */
     double deadline;
+    /* polled where the deadline is read, from the worker pool's threads
+     * (possibly several at once); a nonzero return stops the run with
+     * OBS_CANCELLED (obscurad's drain: a frame nobody waits for any
+     * more); NULL: never */
+    int (*cancel)(void *user);
+    void *cancel_user;
     /* bytes the chain's planes may take (about 56 a pixel at the default
      * parameters): a frame that needs more runs in bands of rows, each
      * holding its rows and the halo its samples reach (the same result,
@@ -371,6 +377,12 @@ unsigned long long obs_ctx_kept_bytes(const obs_ctx *ctx);
  * always); the next frame allocates them again.  Programs stay.  Call
  * on the context's thread, e.g. when idle. */
 obs_status obs_ctx_trim(obs_ctx *ctx, unsigned long long budget, char err[OBS_ERR_LEN]);
+
+/* The CPU device's twins of these: the bytes of the one block of planes
+ * it keeps for the next frame (process-wide), and their release when
+ * more than budget (0: always).  Any thread. */
+unsigned long long obs_cpu_kept_bytes(void);
+void obs_cpu_trim(unsigned long long budget);
 
 /* ---- a deadline on each frame's GL work -------------------------------- */
 

@@ -16,8 +16,9 @@ CAMF="$DATA/room_small.camera.json"
 
 # the compression byte of an EXR's header: the value after the second
 # "compression" (the attribute's type name) and its 4-byte size
+# (of part $2 of a multi-part file, default 0)
 comp_of() {
-    off=$(grep -abo compression "$1" | sed -n 2p | cut -d: -f1)
+    off=$(grep -abo compression "$1" | sed -n $((2 * ${2:-0} + 2))p | cut -d: -f1)
     [ -n "$off" ] && od -An -tu1 -j $((off + 16)) -N1 "$1" | tr -d ' '
 }
 mae() { "$OBSCURA" compare "$1" "$2" --mask none --json 2>/dev/null | sed -n 's/.*"mae": \([-0-9.e+]*\).*/\1/p'; }
@@ -66,6 +67,31 @@ check "float=1: the float AO (MAE ${m:-?} < 1e-6)" "[ $code = 200 ] && under '$m
 code=$(post $A "float=1&compression=none" "$R" "$T/fn.exr")
 check "  uncompressed, about twice the half answer's bytes" \
     "[ $code = 200 ] && [ \$(wc -c < $T/fn.exr) -gt \$((19 * \$(wc -c < $T/none.exr) / 10)) ]"
+
+echo "-- obscura ao --server: the answer the file needs"
+"$OBSCURA" ao "$R" --camera "$CAMF" -o "$T/sv_h.exr" --server "http://127.0.0.1:$A" -q 2>/dev/null
+"$OBSCURA" ao "$R" --camera "$CAMF" --float -o "$T/sv_f.exr" --server "http://127.0.0.1:$A" -q 2>/dev/null
+outs=$(grep 'POST /v1/ao status=200' "$T/A.log" | tail -2 | sed -n 's/.* out=\([0-9]*\) .*/\1/p' | tr '\n' ' ')
+check "the half file asks for a half answer, --float for a float one (answer bytes: $outs)" \
+    "echo '$outs' | awk '{ exit !(NF == 2 && 2 * \$1 < \$2) }'"
+check "  each file the same bytes as obscura ao's own" \
+    "cmp -s $T/local_h.exr $T/sv_h.exr && cmp -s $T/local_f.exr $T/sv_f.exr"
+
+echo "-- the deep answer's compression"
+D=$DATA/deep_small.exr
+code=$(post $A "output=deep" "$D" "$T/deep_auto.exr")
+check "output=deep: 200, the file's compressions (ZIPS deep part, ZIP flat part) as obscura ao writes them" \
+    "[ $code = 200 ] && [ \"\$(comp_of $T/deep_auto.exr 0)\" = 2 ] && [ \"\$(comp_of $T/deep_auto.exr 1)\" = 3 ]"
+code=$(post $A "output=deep&compression=rle" "$D" "$T/deep_rle.exr")
+check "output=deep&compression=rle: both parts RLE" \
+    "[ $code = 200 ] && [ \"\$(comp_of $T/deep_rle.exr 0)\" = 1 ] && [ \"\$(comp_of $T/deep_rle.exr 1)\" = 1 ]"
+code=$(post $A "output=deep&compression=piz" "$D" "$T/deep_piz")
+check "output=deep&compression=piz: refused ($code), naming what deep data takes" \
+    "[ $code != 200 ] && grep -q 'deep part takes none, rle, zips' $T/deep_piz"
+"$OBSCURA" ao "$D" --output deep --compression rle -o "$T/deep_cli.exr" -q 2>/dev/null
+"$OBSCURA" ao "$D" --output deep --compression rle -o "$T/deep_sv.exr" --server "http://127.0.0.1:$A" -q 2>/dev/null
+check "obscura ao --output deep --compression rle: RLE, and --server's file the same bytes" \
+    "[ \"\$(comp_of $T/deep_cli.exr 0)\" = 1 ] && cmp -s $T/deep_cli.exr $T/deep_sv.exr"
 
 echo "-- stages"
 check "Server-Timing: queue, decode, gl, encode, receive" \

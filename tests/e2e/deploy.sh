@@ -2,7 +2,8 @@
 # Checks of deploy/: the systemd unit (systemd-analyze verify), the
 # example config (obscurad reads it), the Dockerfile (its run-time
 # packages cover every library obscurad and obscura link; hadolint when
-# installed), the Kubernetes manifests and farm job templates
+# installed; nothing links GL, and the CPU device runs with the GL
+# libraries hidden), the Kubernetes manifests and farm job templates
 # (tests/deploy/check_manifests.py, PyYAML; the bake templates' commands
 # and bake-dynamic templates' commands run on the fixture level, merged =
 # unsharded), and the plain farm script
@@ -15,8 +16,6 @@ OBSCURA=${OBSCURA:-build/obscura}
 OBSCURAD=${OBSCURAD:-build/obscurad}
 DATA=tests/data
 . tests/e2e/lib/common.sh
-skipped=0
-skip() { skipped=$((skipped + 1)); echo "  skip $*"; }
 
 echo "e2e deploy: deploy/"
 echo "-- systemd"
@@ -27,7 +26,9 @@ check "unit: CacheDirectory=obscura, passed as --cache-dir /var/cache/obscura" \
     "grep -q '^CacheDirectory=obscura\$' $U && grep -q '^ExecStart=.* --cache-dir /var/cache/obscura' $U"
 if command -v systemd-analyze >/dev/null 2>&1; then
     # verify wants the ExecStart binary to exist: point it at this build
-    sed "s|/usr/local/bin/obscurad|$(pwd)/$OBSCURAD|" "$U" > "$T/obscurad.service"
+    # (OBSCURAD relative to here, or absolute)
+    case "$OBSCURAD" in /*) abs=$OBSCURAD ;; *) abs=$(pwd)/$OBSCURAD ;; esac
+    sed "s|/usr/local/bin/obscurad|$abs|" "$U" > "$T/obscurad.service"
     systemd-analyze verify --man=no "$T/obscurad.service" > "$T/verify" 2>&1
     rc=$?
     if [ $rc -ne 0 ] && grep -qi 'system has not been booted\|failed to connect\|permission denied' "$T/verify"; then
@@ -81,6 +82,27 @@ for bin in "$OBSCURAD" "$OBSCURA"; do
     done
 done
 check "run-time stage installs the package of every linked library${missing:+ (missing:$missing)}" "[ -z '$missing' ]"
+# a node without GL (the image's BACKEND=cpu): nothing links a GL library,
+# and with libEGL and libOSMesa hidden (bound over by /dev/null in a mount
+# namespace of this process's own) the CPU device still answers, and a GL
+# backend says what to install
+gl_linked=$(readelf -d "$OBSCURAD" "$OBSCURA" | grep -E 'NEEDED.*lib(EGL|OSMesa|GL|OpenGL|GLX)\b')
+check "Dockerfile: BACKEND=cpu leaves the GL packages out; obscura and obscurad link no GL library${gl_linked:+ ($gl_linked)}" \
+    "[ -z '$gl_linked' ] && grep -q 'if \[ \"\$BACKEND\" = cpu \]; then gl=\"\"' $D && grep -q 'OBSCURA_BACKEND=\$BACKEND' $D"
+egl=$(ldconfig -p | sed -n 's/^[[:space:]]*libEGL\.so\.1 (libc6,x86-64) => //p' | head -1)
+osm=$(ldconfig -p | sed -n 's/^[[:space:]]*libOSMesa\.so\.8 (libc6,x86-64) => //p' | head -1)
+if [ "$(id -u)" = 0 ] && [ -n "$egl" ] && [ -n "$osm" ] && unshare -m true 2>/dev/null; then
+    unshare -m sh -c 'mount --bind /dev/null "$(readlink -f "$1")" && mount --bind /dev/null "$(readlink -f "$2")" &&
+        "$3" ao tests/data/room_small.exr --camera tests/data/room_small.camera.json --backend cpu -o "$4/nogl.exr" -q &&
+        { "$3" info --backend egl-surfaceless > "$4/nogl.info" 2>&1; echo $? > "$4/nogl.rc"; }' \
+        - "$egl" "$osm" "$OBSCURA" "$T" > "$T/nogl.err" 2>&1
+    rc=$?
+    check "without libEGL and libOSMesa: the CPU device runs (exit $rc); a GL backend exits 1 naming libegl1" \
+        "[ $rc -eq 0 ] && [ -s '$T/nogl.exr' ] && [ \"\$(cat '$T/nogl.rc')\" = 1 ] && grep -q 'install libegl1' '$T/nogl.info'"
+    [ $rc -eq 0 ] || sed 's/^/       /' "$T/nogl.err" | tail -3
+else
+    skip "a node without GL libraries: needs root and unshare -m (a mount namespace to hide them)"
+fi
 if command -v hadolint >/dev/null 2>&1; then
     hadolint "$D" > "$T/hadolint" 2>&1
     check "hadolint" "[ $? -eq 0 ]"

@@ -4,7 +4,9 @@
 # is left, logs what it cut and exits 0.  The client that holds the drain
 # sends its body a byte every half second (each gap shorter than
 # --timeout, the whole request shorter than --request-timeout), so only
-# the drain deadline ends it.
+# the drain deadline ends it.  Frames still queued at the deadline are
+# not run, and on the CPU device the frame under way stops at its next
+# tile.
 #
 #   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/drain.sh
 #
@@ -13,6 +15,7 @@
 set -u
 OBSCURA=${OBSCURA:-build/obscura}
 OBSCURAD=${OBSCURAD:-build/obscurad}
+BUILD=${BUILD:-build}
 . tests/e2e/lib/common.sh
 
 # trickle PORT SECONDS FILE: a POST /v1/ao whose body comes a byte every
@@ -59,5 +62,42 @@ else
 fi
 check "the log names what the deadline cut" "grep -q 'drain deadline (2 s) passed: cutting 1 request' '$T/D.log'"
 
-echo "e2e drain: $pass passed, $failed failed"
+echo "-- frames still queued when the deadline passes are not run"
+# three heavy frames (640x480, HBAO 32 x 32: seconds each on llvmpipe and
+# on the CPU device): one runs, two wait in the queue when the signal
+# comes; past the 1 s deadline the queued ones are skipped, and on the
+# CPU device the one under way stops at its next tile
+if ! "$BUILD/exr_upscale" tests/data/room_small.exr 640x480 "$T/mid.exr" 2>"$T/up.err"; then
+    bad "exr_upscale 640x480 (make e2e builds it): $(cat "$T/up.err")"
+    exit 1
+fi
+start F --drain-timeout 1
+Q="fov_y=50&near=0.05&far=100&method=hbao&hbao_directions=32&hbao_steps=32&blur_radius=16"
+for i in 1 2 3; do post "$PORT_F" "$Q" "$T/mid.exr" "$T/f$i.out" > /dev/null & CPIDS="$CPIDS $!"; done
+i=0
+while [ $i -lt 300 ]; do
+    get "$PORT_F" /metrics "$T/fm" > /dev/null
+    q=$(sed -n 's/^obscurad_queue_depth //p' "$T/fm")
+    [ "${q:-0}" -ge 2 ] && break
+    sleep 0.1
+    i=$((i + 1))
+done
+t0=$(date +%s)
+kill -TERM "$PID_F"
+i=0
+while kill -0 "$PID_F" 2>/dev/null && [ $i -lt 600 ]; do sleep 0.1; i=$((i + 1)); done
+t1=$(date +%s)
+wait "$PID_F"
+rc=$?
+skipped_frames=$(grep -c "not run: the drain's deadline passed" "$T/F.log")
+check "SIGTERM with ${q:-?} frames queued: exit $rc, the queued ones not run ($skipped_frames)" \
+    "[ $rc -eq 0 ] && [ $skipped_frames -ge 1 ]"
+if [ "$CPU_DEVICE" = 1 ]; then
+    check "the CPU device's frame under way stopped: exit within the 1 s deadline (+2 s), $((t1 - t0)) s" \
+        "[ $((t1 - t0)) -le 3 ] && grep -q 'the frame was cancelled (in the ao pass)' '$T/F.log'"
+else
+    skip "the frame under way: a GL draw is not stopped (it ends, $((t1 - t0)) s after the signal)"
+fi
+
+echo "e2e drain: $pass passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ]

@@ -48,11 +48,19 @@ check "the refused frames were not computed: one frame in obscurad_frames_total 
 # The kept targets of a 320x240 AO frame with normals derived from depth:
 # 4612800 bytes, 60 a pixel and the culling pre-pass's 1/8-size plane
 # (test_kept.c counts the same textures)
+# (on the CPU device, its one block of planes: a size of its own, at
+# least the 36 bytes a pixel of the position, normal, AO and blur planes,
+# and above the 1m below)
 start K
 st=$(post "$PORT_K" "$Q" "$R" "$T/k1.out")
 kept=$(metric "$PORT_K" obscurad_gl_kept_bytes)
-check "default --keep-memory: a frame's targets are kept for the next ($kept bytes)" \
-    "[ '$st' = 200 ] && [ '$kept' = 4612800 ]"
+if [ "$CPU_DEVICE" = 1 ]; then
+    check "default --keep-memory: the CPU device's planes are kept for the next frame ($kept bytes)" \
+        "[ '$st' = 200 ] && [ '${kept:-0}' -ge $((320 * 240 * 36)) ] && [ '${kept:-0}' -lt $((16 * 1048576)) ]"
+else
+    check "default --keep-memory: a frame's targets are kept for the next ($kept bytes)" \
+        "[ '$st' = 200 ] && [ '$kept' = 4612800 ]"
+fi
 start M --keep-memory 1m
 st=$(post "$PORT_M" "$Q" "$R" "$T/m1.out")
 kept=$(metric "$PORT_M" obscurad_gl_kept_bytes)
@@ -99,5 +107,5 @@ else
     bad "exr_upscale 1280x720: $(cat "$T/up.err")"
 fi
 
-echo "e2e limits: $pass passed, $failed failed"
+echo "e2e limits: $pass passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ]

@@ -7,7 +7,8 @@
 # (ours and Mesa's) are rebuilt with the same output; a folder that
 # cannot be made costs one log line; obscura warmup --methods all leaves
 # nothing to compile for any method; obscurad counts the programs in
-# /v1/info and /metrics.  Counters, not timings.
+# /v1/info and /metrics.  Counters, not timings.  On the CPU device
+# (OBSCURA_BACKEND=cpu): that it compiles nothing and makes no folder.
 #
 #   OBSCURA=build/obscura OBSCURAD=build/obscurad tests/e2e/progcache.sh
 set -u
@@ -33,6 +34,33 @@ run() {
 }
 
 echo "e2e progcache: the program cache"
+# The CPU device (OBSCURA_BACKEND=cpu) compiles nothing: what it has of
+# the cache is that it uses none, makes no folder and counts nothing.
+if [ "$CPU_DEVICE" = 1 ]; then
+    C="$T/cache"
+    run cpu --cache-dir "$C"
+    check "the CPU device: exit 0, no programs line, no cache folder made" \
+        "[ $RC -eq 0 ] && [ -z '$COMPILED' ] && ! grep -q 'programs: ' '$T/cpu.err' && [ ! -e '$C' ]"
+    "$OBSCURA" warmup --methods all --cache-dir "$C" > "$T/warmup.out" 2>&1
+    rc=$?
+    check "warmup --methods all on the CPU device: exit $rc (0), nothing to warm up, no folder made" \
+        "[ $rc -eq 0 ] && grep -q 'nothing to warm up' '$T/warmup.out' && [ ! -e '$C' ]"
+    "$OBSCURA" warmup --methods bogus --cache-dir "$C" > "$T/bogus" 2>&1
+    rc=$?
+    check "warmup --methods bogus: exit 2 naming it ($rc)" "[ $rc -eq 2 ] && grep -q \"'bogus' is not one of\" '$T/bogus'"
+    start d --cache-dir "$C"
+    code=$(post "$PORT_d" "fov_y=50&output=ao&format=exr" "$DATA/room_small.exr" "$T/d.exr")
+    get "$PORT_d" /v1/info "$T/info.json" > /dev/null
+    get "$PORT_d" /metrics "$T/metrics" > /dev/null
+    check "obscurad on the CPU device: a frame ($code), /v1/info's program_cache: no folder, nothing counted" \
+        "[ '$code' = 200 ] && python3 -c 'import json,sys; p=json.load(open(sys.argv[1]))[\"program_cache\"]; sys.exit(not (p[\"dir\"] is None and p[\"compiled\"]==0 and p[\"loaded\"]==0))' '$T/info.json' && grep -q '^obscurad_programs_compiled_total 0\$' '$T/metrics' && [ ! -e '$C' ]"
+    kill "$PID_d"; wait "$PID_d" 2>/dev/null
+    gl_only "the program cache's entries, damaged entries, folders, warmup's programs and a recreated context's loads" \
+        "the CPU device compiles no programs"
+    echo "e2e progcache: $pass passed, $failed failed, $skipped skipped"
+    [ "$failed" -eq 0 ]
+    exit
+fi
 C="$T/cache"
 run nocache --cache-dir ''
 check "no cache: exit 0, programs compiled ($COMPILED), none loaded" \

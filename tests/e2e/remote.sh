@@ -185,6 +185,8 @@ wait "$PID"; rc=$?
 PID=""
 check "SIGTERM: exit $rc (0), socket file removed" "[ $rc -eq 0 ] && [ ! -e '$SOCK' ]"
 check "log: one line per binary frame" "grep -q 'BINARY id=1 status=200 in=[0-9]* out=[0-9]* queue=' '$T/d.log'"
+check "  with its receive and send stages, as HTTP's" \
+    "grep -q 'BINARY id=1 status=200 .* encode=[0-9.]* receive=[0-9.]* send=[0-9.]* total=' '$T/d.log'"
 [ $failed -ne 0 ] && tail -20 "$T/d.log" | sed 's/^/       /'
 echo "e2e remote: $pass passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -10,28 +10,7 @@ set -u
 OBSCURA=${OBSCURA:-build/obscura}
 SHARED=${OBSCURA_SHARED_DATA:-../shared/data}
 DATA=tests/data
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-pass=0
-failed=0
-
-ok() { pass=$((pass + 1)); echo "  ok   $*"; }
-bad() { failed=$((failed + 1)); echo "  FAIL $*"; }
-
-# expect CODE DESCRIPTION -- command...: runs it, checks the exit code.
-expect() {
-    code=$1; what=$2; shift 3
-    "$@" >"$T/out" 2>"$T/err"
-    rc=$?
-    if [ "$rc" -eq "$code" ]; then ok "$what"; else
-        bad "$what (exit $rc, expected $code)"; sed 's/^/       /' "$T/err" | tail -5; fi
-}
-
-# stderr of the last command contains TEXT
-said() {
-    if grep -q -- "$1" "$T/err" "$T/out"; then ok "message: $1"; else
-        bad "message '$1' missing"; sed 's/^/       /' "$T/err" | tail -5; fi
-}
+. tests/e2e/lib/common.sh
 
 # value of KEY in the JSON line of the last compare
 json() { sed -n "s/.*\"$1\": \([-0-9.e+]*\).*/\1/p" "$T/out"; }
@@ -59,7 +38,12 @@ echo "e2e: $OBSCURA"
 
 echo "-- info and usage"
 expect 0 "info" -- "$OBSCURA" info
-said "GL renderer"
+if [ "$CPU_DEVICE" = 1 ]; then
+    said "backend: cpu (the chain on the CPU device"
+    said "^threads: "
+else
+    said "GL renderer"
+fi
 for b in egl-surfaceless osmesa; do
     expect 0 "info --backend $b" -- "$OBSCURA" info --backend $b
     said "backend: $b"
@@ -112,8 +96,13 @@ expect 0 "AO and sample count to EXR" -- "$OBSCURA" ao "$R" --camera "$C" --outp
 expect 0 "EXR has AO.Y and Samples.Y" -- "$OBSCURA" compare "$T/count.exr" "$T/count.exr" --channel-a AO.Y --channel-b Samples.Y --mask none
 expect 0 "sample count to PNG with the AO" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,samples -o "$T/count.png"
 if [ -s "$T/count.ao.png" ] && [ -s "$T/count.samples.png" ]; then ok "ao,samples to PNG wrote two files"; else bad "ao,samples PNG files missing"; fi
+# the GL frames against the CPU twin: on the CPU device (OBSCURA_BACKEND=cpu)
+# a GL backend named, so that GL is still what is compared
+GLB=""
+[ "$CPU_DEVICE" = 1 ] && GLB="--backend egl-surfaceless"
 # the culling mask (VAO++ 4.2) and the colour-bleed term (4.7), GL and CPU twin
-expect 0 "culling mask and bleed to EXR" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,cull,bleed --bleeding full -o "$T/cb.exr" --float
+# shellcheck disable=SC2086
+expect 0 "culling mask and bleed to EXR" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,cull,bleed --bleeding full -o "$T/cb.exr" --float $GLB
 expect 0 "culling mask and bleed, CPU twin" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,cull,bleed --bleeding full -o "$T/cb_cpu.exr" --float --cpu
 for ch in Cull.Y Bleed.G; do
     expect 0 "$ch: GL vs CPU twin" -- "$OBSCURA" compare "$T/cb_cpu.exr" "$T/cb.exr" --channel-a $ch --channel-b $ch --mask none --json
@@ -125,7 +114,8 @@ if [ -s "$T/cm.ao.png" ] && [ -s "$T/cm.cull.png" ]; then ok "ao,cull to PNG wro
 expect 2 "unknown output" -- "$OBSCURA" ao "$R" --camera "$C" --output ao,depth -o "$T/x.exr"
 said "not one of ao|composite|both|samples"
 expect 0 "CPU twin" -- "$OBSCURA" ao "$R" --camera "$C" --cpu -o "$T/cpu.exr" --float
-expect 0 "GL float" -- "$OBSCURA" ao "$R" --camera "$C" -o "$T/gl.exr" --float
+# shellcheck disable=SC2086
+expect 0 "GL float${GLB:+ ($GLB)}" -- "$OBSCURA" ao "$R" --camera "$C" -o "$T/gl.exr" --float $GLB
 expect 0 "compare GL with CPU twin" -- "$OBSCURA" compare "$T/cpu.exr" "$T/gl.exr" --mask none --json
 mae=$(json mae)
 if awk "BEGIN { exit !($mae < 0.001) }"; then ok "GL vs CPU MAE $mae < 1e-3"; else bad "GL vs CPU MAE $mae"; fi

@@ -1,8 +1,9 @@
 # Shared by the e2e scripts (sourced, not run: the Makefile runs only
 # tests/e2e/*.sh).  Gives: a temp dir $T, removed on exit; every pid in
 # $PIDS (and $PID, $CPIDS when a script sets them) killed on exit; the
-# ok/bad/check counters; $CURL; and the daemon helpers start, post, get,
-# error_is.  Scripts end with `finish NAME`.
+# ok/bad/check counters, skip and gl_only; $CURL; and the daemon helpers
+# start, post, get, error_is.  Each script ends with its own "passed,
+# failed" line and exits 1 when a check failed.
 T=$(mktemp -d)
 PIDS=""
 cleanup() {
@@ -16,6 +17,20 @@ failed=0
 ok() { pass=$((pass + 1)); echo "  ok   $*"; }
 bad() { failed=$((failed + 1)); echo "  FAIL $*"; }
 check() { if eval "$2"; then ok "$1"; else bad "$1"; fi; }
+skipped=0
+skip() { skipped=$((skipped + 1)); echo "  skip $*"; }
+# CPU_DEVICE: 1 when the run is on the CPU device (OBSCURA_BACKEND=cpu,
+# `make e2e OBSCURA_BACKEND=cpu`), which has no GL context.
+CPU_DEVICE=0
+[ "${OBSCURA_BACKEND:-}" = cpu ] && CPU_DEVICE=1
+# gl_only WHAT WHY: true on a GL backend; on the CPU device false, with a
+# skip line naming WHAT and WHY it does not apply there, e.g.
+#   if gl_only "the program cache" "the CPU device compiles no programs"; then ...
+gl_only() {
+    [ "$CPU_DEVICE" = 1 ] || return 0
+    skip "$1: GL only ($2)"
+    return 1
+}
 CURL="curl -s --max-time 60"
 
 # start NAME ARGS...: starts obscurad on a free port (port 0; the port is

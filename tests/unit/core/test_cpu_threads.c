@@ -148,6 +148,75 @@ static void test_deadline_and_log(void **state)
     obs_result_free(&r);
 }
 
+/* obs_cpu_options.cancel: polled while the frame runs (between passes
+ * and tiles, from the pool's threads); a nonzero return stops the run
+ * with OBS_CANCELLED and nothing allocated, and the cancel is not asked
+ * again; one that never says stop leaves the frame's bytes as they are. */
+static int cancel_after(void *user)
+{
+    int *calls = user; /* calls[0]: calls so far, calls[1]: the call that says stop */
+    return __atomic_add_fetch(&calls[0], 1, __ATOMIC_RELAXED) >= calls[1];
+}
+
+static void test_cancel(void **state)
+{
+    obs_result r, plain;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    int calls[2] = {0, 1};
+    obs_cpu_options now = {.cancel = cancel_after, .cancel_user = calls};
+    assert_int_equal(obs_run_cpu_opts(&room.gb, NULL, OBS_OUTPUT_AO, &r, &now, err), OBS_CANCELLED);
+    assert_non_null(strstr(err, "cancelled (before the"));
+    assert_null(r.ao.data);
+    assert_int_equal(calls[0], 1);
+    int never[2] = {0, 1 << 30};
+    obs_cpu_options polled = {.cancel = cancel_after, .cancel_user = never};
+    assert_int_equal(obs_run_cpu(&room.gb, NULL, OBS_OUTPUT_AO, &plain, err), OBS_OK);
+    assert_int_equal(obs_run_cpu_opts(&room.gb, NULL, OBS_OUTPUT_AO, &r, &polled, err), OBS_OK);
+    assert_memory_equal(r.ao.data, plain.ao.data, (size_t)r.ao.width * r.ao.height * sizeof(float));
+    obs_result_free(&r);
+    /* asked before each pass (OBS_PASS_COUNT at most) and between the AO
+     * pass's tiles: halfway through the calls is inside the AO pass */
+    assert_true(never[0] > OBS_PASS_COUNT);
+    int mid[2] = {0, never[0] / 2};
+    obs_cpu_options midway = {.cancel = cancel_after, .cancel_user = mid};
+    assert_int_equal(obs_run_cpu_opts(&room.gb, NULL, OBS_OUTPUT_AO, &r, &midway, err), OBS_CANCELLED);
+    assert_non_null(strstr(err, "cancelled"));
+    assert_null(r.ao.data);
+    /* each thread that was in a tile asks at most once more */
+    assert_true(mid[0] <= mid[1] + 64);
+    /* a frame in bands of rows (bands_run.c) asks too */
+    int banded[2] = {0, never[0] / 2};
+    obs_cpu_options bands = {.cancel = cancel_after, .cancel_user = banded, .band_rows = 32};
+    assert_int_equal(obs_run_cpu_opts(&room.gb, NULL, OBS_OUTPUT_AO, &r, &bands, err), OBS_CANCELLED);
+    assert_non_null(strstr(err, "cancelled"));
+    assert_null(r.ao.data);
+    obs_result_free(&plain);
+}
+
+/* The planes kept for the next frame: counted, kept under a budget
+ * above them, released under one below them or 0. */
+static void test_kept_trim(void **state)
+{
+    obs_result r;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    assert_int_equal(obs_run_cpu(&room.gb, NULL, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    obs_result_free(&r);
+    unsigned long long kept = obs_cpu_kept_bytes();
+    size_t px = (size_t)room.gb.width * room.gb.height;
+    assert_true(kept >= px * 9 * sizeof(float)); /* position, normal, AO, blur */
+    obs_cpu_trim(kept);
+    assert_int_equal(obs_cpu_kept_bytes(), kept);
+    obs_cpu_trim(kept - 1);
+    assert_int_equal(obs_cpu_kept_bytes(), 0);
+    assert_int_equal(obs_run_cpu(&room.gb, NULL, OBS_OUTPUT_AO, &r, err), OBS_OK);
+    obs_result_free(&r);
+    assert_int_equal(obs_cpu_kept_bytes(), kept);
+    obs_cpu_trim(0);
+    assert_int_equal(obs_cpu_kept_bytes(), 0);
+}
+
 /* Every row in exactly one band, bands no taller than asked. */
 static void count_rows(void *ctx, int y0, int y1)
 {
@@ -204,6 +273,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bands),
         cmocka_unit_test(test_deadline_and_log),
+        cmocka_unit_test(test_cancel),
+        cmocka_unit_test(test_kept_trim),
         cmocka_unit_test(test_every_method),
         cmocka_unit_test(test_chain_variants),
         cmocka_unit_test(test_deep_chain),

@@ -8,6 +8,7 @@
 #include "testutil.h"
 
 #include <math.h>
+#include <openexr.h>
 #include <stdio.h>
 #include <unistd.h>
 
@@ -64,7 +65,7 @@ static void test_nodes_flatten_to_flat_ao(void **state)
     int fd = mkstemp(path);
     assert_true(fd >= 0);
     close(fd);
-    if (obs_deep_ao_write_exr(path, &a, &r.ao_blend, &r.ao_front, err) != OBS_OK)
+    if (obs_deep_ao_write_exr(path, &a, &r.ao_blend, &r.ao_front, OBS_EXR_ZIP_DEFAULT, err) != OBS_OK)
         fail_msg("%s", err);
     obs_deep_image back;
     if (obs_deep_read_exr(path, NULL, &back, err) != OBS_OK)
@@ -86,7 +87,7 @@ static void test_nodes_flatten_to_flat_ao(void **state)
     obs_deep_free(&back);
     /* into memory (obscurad's answer): the file's bytes */
     obs_bytes mem;
-    if (obs_deep_ao_write_exr_mem(&a, &r.ao_blend, &r.ao_front, &mem, err) != OBS_OK)
+    if (obs_deep_ao_write_exr_mem(&a, &r.ao_blend, &r.ao_front, OBS_EXR_ZIP_DEFAULT, &mem, err) != OBS_OK)
         fail_msg("%s", err);
     FILE *fp = fopen(path, "rb");
     assert_non_null(fp);
@@ -97,7 +98,35 @@ static void test_nodes_flatten_to_flat_ao(void **state)
     assert_memory_equal(file, mem.data, mem.size);
     free(file);
     obs_bytes_free(&mem);
-    assert_int_equal(obs_deep_ao_write_exr_mem(NULL, NULL, NULL, &mem, err), OBS_INVALID_ARGUMENT);
+    assert_int_equal(obs_deep_ao_write_exr_mem(NULL, NULL, NULL, OBS_EXR_ZIP_DEFAULT, &mem, err), OBS_INVALID_ARGUMENT);
+    /* a compression named: both parts' (zip: ZIPS in the deep part, as
+     * the default), the AO the same; one deep data has no codec for
+     * refused, naming it */
+    static const obs_exr_compression named[] = {OBS_EXR_NONE, OBS_EXR_RLE, OBS_EXR_ZIPS, OBS_EXR_ZIP};
+    for (size_t k = 0; k < sizeof named / sizeof named[0]; k++) {
+        if (obs_deep_ao_write_exr(path, &a, &r.ao_blend, &r.ao_front, named[k], err) != OBS_OK)
+            fail_msg("%s: %s", obs_exr_compression_name(named[k]), err);
+        static const exr_compression_t want[][2] = {{EXR_COMPRESSION_NONE, EXR_COMPRESSION_NONE},
+                                                    {EXR_COMPRESSION_RLE, EXR_COMPRESSION_RLE},
+                                                    {EXR_COMPRESSION_ZIPS, EXR_COMPRESSION_ZIPS},
+                                                    {EXR_COMPRESSION_ZIPS, EXR_COMPRESSION_ZIP}};
+        exr_context_t ctx;
+        exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+        assert_int_equal(exr_start_read(&ctx, path, &init), EXR_ERR_SUCCESS);
+        for (int part = 0; part < 2; part++) { /* deep, flat */
+            exr_compression_t c;
+            assert_int_equal(exr_get_compression(ctx, part, &c), EXR_ERR_SUCCESS);
+            assert_int_equal(c, want[k][part]);
+        }
+        exr_finish(&ctx);
+        if (obs_exr_read_channel(path, "AOFront.Y", NULL, &front, err) != OBS_OK)
+            fail_msg("%s", err);
+        assert_memory_equal(front.data, r.ao_front.data, npx * sizeof(float));
+        obs_image_free(&front);
+    }
+    assert_int_equal(obs_deep_ao_write_exr_mem(&a, &r.ao_blend, &r.ao_front, OBS_EXR_PIZ, &mem, err),
+                     OBS_UNSUPPORTED);
+    assert_non_null(strstr(err, "piz"));
     unlink(path);
     obs_deep_ao_free(&a);
     obs_deep_result_free(&r);

@@ -8,6 +8,8 @@
 
 #include "frame_path.h"
 
+static void *worker(void *arg);
+
 static void test_decode(void **state)
 {
     (void)state;
@@ -26,12 +28,26 @@ static void test_decode(void **state)
     obsd_fp_free(&fp);
 
     /* strict=1: a sanity warning on the input fails the frame (world
-     * normals read as camera-space disagree with the depth's) */
+     * normals read as camera-space disagree with the depth's); without
+     * it the check waits for the queue, where it runs beside the chain */
     obsd_fp_init(&fp);
     assert_int_equal(obs_http_request_set(&hr, "normal_space", "camera", err), OBS_OK);
     assert_int_equal(obs_http_request_set(&hr, "fov_y", "50", err), OBS_OK);
     assert_int_equal(obsd_fp_decode(&fp, flat, len, &hr, NULL, NULL, err), OBS_OK);
-    assert_true(fp.gf.info.warning_count >= 1);
+    assert_int_equal(fp.gf.info.warning_count, 0);
+    assert_ptr_equal(fp.sanity_params, &hr.params);
+    obsd_queue q;
+    pthread_t t;
+    assert_int_equal(obsd_queue_init(&q, 1), 0);
+    assert_int_equal(obsd_fp_queue(&fp, &q, &hr.params, OBS_OUTPUT_AO, NULL, NULL), 0);
+    assert_true(fp.gf.info.warning_count >= 1); /* checked once queued */
+    assert_null(fp.sanity_params);
+    assert_int_equal(pthread_create(&t, NULL, worker, &q), 0);
+    obsd_fp_wait(&fp);
+    pthread_join(t, NULL);
+    assert_int_equal(obsd_fp_finished(&fp), OBS_OK);
+    assert_true(fp.gf.info.warning_count >= 1); /* the input's, with the answer */
+    obsd_queue_destroy(&q);
     obsd_fp_free(&fp);
     obsd_fp_init(&fp);
     assert_int_equal(obs_http_request_set(&hr, "strict", "1", err), OBS_OK);
