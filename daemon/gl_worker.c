@@ -85,13 +85,9 @@ static int too_costly(const obsd_gl_worker *w, obsd_job *job)
         return 0;
     int width = job->deep ? job->deep->width : job->gb->width;
     int height = job->deep ? job->deep->height : job->gb->height;
-    int layers = 0;
-    if (job->deep) {
-        obs_params p;
-        obs_params_resolve(job->params, &p);
-        layers = p.deep_layers;
-    }
-    unsigned long long cost = obs_frame_cost(job->params, width, height, layers);
+    /* deep: the nodes' pass, and with output=deep the per-node AO too */
+    unsigned long long cost = job->deep ? obs_deep_frame_cost(job->deep, job->params, job->outputs)
+                                        : obs_frame_cost(job->params, width, height, 0);
     if (cost <= w->max_cost)
         return 0;
     job->status = OBS_TOO_COSTLY;

@@ -1,11 +1,39 @@
 /* The deep AO out (obs_deep_ao_nodes, obscura ao --output deep): the AO of
  * every node the list compression kept, the per-node AO of OITAO
  * Algorithm 1 (obs__deep_node_ao) that obs__deep_pixel blends into the
- * flat AO, kept per node instead. */
+ * flat AO, kept per node instead; and the work it adds to a frame
+ * (obs_deep_frame_cost). */
 #include <stdlib.h>
 #include <string.h>
 
 #include "deep/deep_internal.h"
+
+unsigned long long obs_deep_frame_cost(const obs_deep_image *d, const obs_params *params,
+                                       unsigned outputs)
+{
+    if (!d || !d->offset || d->width <= 0 || d->height <= 0)
+        return 0;
+    obs_params p;
+    obs_params_resolve(params, &p);
+    const int m = p.deep_layers;
+    unsigned long long n = obs_frame_cost(&p, d->width, d->height, m);
+    if (!(outputs & OBS_OUTPUT_DEEP))
+        return n;
+    /* obs_deep_ao_nodes beside the pass, on either device: each kept
+     * node (min(samples, m) a pixel, obs_deep_compress) with the
+     * method's samples against the m nodes at their pixels, the unit
+     * of the pass's m^2 a pixel */
+    const unsigned long long per_node = obs_frame_cost(&p, 1, 1, 0) * (unsigned long long)m;
+    const size_t npx = (size_t)d->width * (size_t)d->height;
+    unsigned long long kept = 0;
+    for (size_t i = 0; i < npx; i++) {
+        uint64_t c = d->offset[i + 1] - d->offset[i];
+        if (c > OBS_DEEP_MAX_PER_PIXEL)
+            c = OBS_DEEP_MAX_PER_PIXEL;
+        kept += c < (uint64_t)m ? c : (uint64_t)m;
+    }
+    return n + kept * per_node;
+}
 
 void obs_deep_ao_free(obs_deep_ao *a)
 {

@@ -223,6 +223,17 @@ obs_status obs_deep_ao_nodes(const obs_deep_image *d, const obs_params *params, 
                              char err[OBS_ERR_LEN]);
 void obs_deep_ao_free(obs_deep_ao *a);
 
+/* The work a deep frame asks for, in samples, for obsd --max-cost and
+ * other admission checks: obs_frame_cost's (width x height x the method's
+ * samples per pixel x deep_layers^2), plus with OBS_OUTPUT_DEEP in
+ * `outputs` the per-node AO (obs_deep_ao_nodes, which runs on the CPU
+ * beside the GL or CPU pass): every kept node, min(its pixel's samples,
+ * deep_layers), times the method's samples per pixel x deep_layers, the
+ * pass's own unit per node.  Parameters as obs_deep_run takes them (NULL:
+ * defaults); 0 without an image. */
+unsigned long long obs_deep_frame_cost(const obs_deep_image *d, const obs_params *params,
+                                       unsigned outputs);
+
 /* Writes the deep AO as a two-part EXR through OpenEXR's C++ deep API
  * (core/io/exr_deep_ao_write.cpp): part "deep", deep scanline (ZIPS,
  * float), channels A, AO.Y (premultiplied by A, as deep colour is in

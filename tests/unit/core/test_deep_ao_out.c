@@ -4,7 +4,9 @@
  * its flattening front to back by the nodes' alpha equal to
  * obs_deep_run_cpu's flat AO (blur off), and the file read back through
  * OpenEXR's C API (obs_deep_read_exr: the deep part's counts, Z, ZBack
- * and A; obs_exr_read_channel: the flat part's AOFront.Y). */
+ * and A; obs_exr_read_channel: the flat part's AOFront.Y); the work it
+ * adds to the frame's cost (obs_deep_frame_cost), by the nodes
+ * obs_deep_ao_nodes keeps. */
 #include "testutil.h"
 
 #include <math.h>
@@ -133,10 +135,58 @@ static void test_nodes_flatten_to_flat_ao(void **state)
     obs_deep_free(&d);
 }
 
+/* obs_deep_frame_cost: the pass's obs_frame_cost without output deep;
+ * with it, more by the method's samples x deep_layers for every node
+ * obs_deep_ao_nodes keeps (counted here from its output, at two node
+ * counts and two methods, so the extra follows the kept nodes). */
+static void test_frame_cost_counts_nodes(void **state)
+{
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    (void)state;
+    if (obs_deep_read_exr(FIXTURE, NULL, &d, err) != OBS_OK)
+        fail_msg("%s", err);
+    const size_t npx = (size_t)d.width * d.height;
+    static const char *const method[] = {"vao", "gtao"};
+    for (int mi = 0; mi < 2; mi++) {
+        unsigned long long extra_of[2] = {0, 0}, kept_of[2] = {0, 0};
+        for (int li = 0; li < 2; li++) {
+            const int m = li ? 4 : 2;
+            char v[8];
+            obs_params p;
+            params(&p);
+            snprintf(v, sizeof v, "%d", m);
+            assert_int_equal(obs_param_set(&p, "deep_layers", v, err), OBS_OK);
+            assert_int_equal(obs_param_set(&p, "method", method[mi], err), OBS_OK);
+            unsigned long long flat = obs_deep_frame_cost(&d, &p, OBS_OUTPUT_AO);
+            unsigned long long deep = obs_deep_frame_cost(&d, &p, OBS_OUTPUT_AO | OBS_OUTPUT_DEEP);
+            assert_true(flat == obs_frame_cost(&p, d.width, d.height, m));
+            assert_true(deep > flat);
+            obs_deep_ao a;
+            if (obs_deep_ao_nodes(&d, &p, &a, err) != OBS_OK)
+                fail_msg("%s", err);
+            kept_of[li] = a.offset[npx];
+            extra_of[li] = deep - flat;
+            unsigned long long spp = obs_frame_cost(&p, 1, 1, 0);
+            assert_true(spp > 0);
+            assert_true(extra_of[li] == kept_of[li] * spp * (unsigned long long)m);
+            obs_deep_ao_free(&a);
+        }
+        /* the fixture has pixels of more than 2 samples: more nodes kept at 4 */
+        assert_true(kept_of[1] > kept_of[0]);
+        assert_true(extra_of[1] * kept_of[0] * 2 == extra_of[0] * kept_of[1] * 4);
+        print_message("deep_small %s: kept nodes %llu (m 2), %llu (m 4)\n", method[mi], kept_of[0],
+                      kept_of[1]);
+    }
+    assert_true(obs_deep_frame_cost(NULL, NULL, OBS_OUTPUT_DEEP) == 0);
+    obs_deep_free(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_nodes_flatten_to_flat_ao),
+        cmocka_unit_test(test_frame_cost_counts_nodes),
     };
     return cmocka_run_group_tests_name("deep AO out", tests, NULL, NULL);
 }
