@@ -44,23 +44,16 @@ void obs_deep_ao_free(obs_deep_ao *a)
     memset(a, 0, sizeof *a);
 }
 
-obs_status obs_deep_ao_nodes(const obs_deep_image *d, const obs_params *params, obs_deep_ao *out,
-                             char err[OBS_ERR_LEN])
+obs_status obs__deep_ao_pack(const obs_deep_image *d, const obs__deep_frame *df,
+                             const float *node_ao, obs_deep_ao *out, char err[OBS_ERR_LEN])
 {
-    obs__deep_frame df;
-    if (!out)
-        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_ao_nodes: no output");
     memset(out, 0, sizeof *out);
-    obs_status s = obs__deep_frame_setup(d, params, &df, err);
-    if (s != OBS_OK)
-        return s;
     const size_t npx = (size_t)d->width * (size_t)d->height;
     /* at most m nodes a pixel: npx * m * OBS_DEEP_AO_CH floats, the
      * sizes the setup's node planes already took */
     out->offset = malloc((npx + 1) * sizeof *out->offset);
-    out->node = malloc(npx * (size_t)df.m * OBS_DEEP_AO_CH * sizeof *out->node);
+    out->node = malloc(npx * (size_t)df->m * OBS_DEEP_AO_CH * sizeof *out->node);
     if (!out->offset || !out->node) {
-        obs__deep_frame_free(&df);
         obs_deep_ao_free(out);
         return obs__fail(err, OBS_NO_MEMORY, "deep AO nodes of %dx%d", d->width, d->height);
     }
@@ -77,16 +70,31 @@ obs_status obs_deep_ao_nodes(const obs_deep_image *d, const obs_params *params, 
             size_t i = (size_t)y * d->width + x;
             out->offset[i] = n;
             /* nodes are packed front to back (obs__deep_pixel's walk) */
-            for (int k = 0; k < df.m && df.pos[((size_t)k * npx + i) * 4 + 3] > 0.0f; k++) {
-                const float *src = df.layers.node + ((size_t)k * npx + i) * OBS_DEEP_CH;
+            for (int k = 0; k < df->m && df->pos[((size_t)k * npx + i) * 4 + 3] > 0.0f; k++) {
+                const size_t at = (size_t)k * npx + i;
+                const float *src = df->layers.node + at * OBS_DEEP_CH;
                 float *o = out->node + n++ * OBS_DEEP_AO_CH;
                 o[OBS_DEEP_AO_Z] = src[OBS_DEEP_Z];
                 o[OBS_DEEP_AO_ZBACK] = src[OBS_DEEP_ZBACK];
-                o[OBS_DEEP_AO_A] = df.nrm[((size_t)k * npx + i) * 4 + 3];
-                o[OBS_DEEP_AO_AO] = obs__deep_node_ao(&df, x, y, k);
+                o[OBS_DEEP_AO_A] = df->nrm[at * 4 + 3];
+                o[OBS_DEEP_AO_AO] = node_ao ? node_ao[at] : obs__deep_node_ao(df, x, y, k);
             }
         }
     out->offset[npx] = n;
-    obs__deep_frame_free(&df);
     return OBS_OK;
+}
+
+obs_status obs_deep_ao_nodes(const obs_deep_image *d, const obs_params *params, obs_deep_ao *out,
+                             char err[OBS_ERR_LEN])
+{
+    obs__deep_frame df;
+    if (!out)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_ao_nodes: no output");
+    memset(out, 0, sizeof *out);
+    obs_status s = obs__deep_frame_setup(d, params, &df, err);
+    if (s != OBS_OK)
+        return s;
+    s = obs__deep_ao_pack(d, &df, NULL, out, err);
+    obs__deep_frame_free(&df);
+    return s;
 }
