@@ -9,7 +9,7 @@
 #include "deep/deep_internal.h"
 
 unsigned long long obs_deep_frame_cost(const obs_deep_image *d, const obs_params *params,
-                                       unsigned outputs)
+                                       unsigned outputs, int cpu)
 {
     if (!d || !d->offset || d->width <= 0 || d->height <= 0)
         return 0;
@@ -17,9 +17,9 @@ unsigned long long obs_deep_frame_cost(const obs_deep_image *d, const obs_params
     obs_params_resolve(params, &p);
     const int m = p.deep_layers;
     unsigned long long n = obs_frame_cost(&p, d->width, d->height, m);
-    if (!(outputs & OBS_OUTPUT_DEEP))
-        return n;
-    /* obs_deep_ao_nodes beside the pass, on either device: each kept
+    if (!(outputs & OBS_OUTPUT_DEEP) || !cpu)
+        return n; /* GL: the pass keeps the nodes' AO (obs_deep_run_nodes) */
+    /* obs_deep_ao_nodes apart from obs_deep_run_cpu: each kept
      * node (min(samples, m) a pixel, obs_deep_compress) with the
      * method's samples against the m nodes at their pixels, the unit
      * of the pass's m^2 a pixel */

@@ -234,14 +234,16 @@ void obs_deep_ao_free(obs_deep_ao *a);
 
 /* The work a deep frame asks for, in samples, for obsd --max-cost and
  * other admission checks: obs_frame_cost's (width x height x the method's
- * samples per pixel x deep_layers^2), plus with OBS_OUTPUT_DEEP in
- * `outputs` the per-node AO (obs_deep_ao_nodes, which runs on the CPU
- * beside the GL or CPU pass): every kept node, min(its pixel's samples,
- * deep_layers), times the method's samples per pixel x deep_layers, the
- * pass's own unit per node.  Parameters as obs_deep_run takes them (NULL:
- * defaults); 0 without an image. */
+ * samples per pixel x deep_layers^2), plus on the CPU device (cpu 1) with
+ * OBS_OUTPUT_DEEP in `outputs` the per-node AO that obs_deep_ao_nodes
+ * computes apart from obs_deep_run_cpu: every kept node, min(its pixel's
+ * samples, deep_layers), times the method's samples per pixel x
+ * deep_layers, the pass's own unit per node.  On GL (cpu 0)
+ * obs_deep_run_nodes keeps the nodes' AO from the pass: nothing added.
+ * Parameters as obs_deep_run takes them (NULL: defaults); 0 without an
+ * image. */
 unsigned long long obs_deep_frame_cost(const obs_deep_image *d, const obs_params *params,
-                                       unsigned outputs);
+                                       unsigned outputs, int cpu);
 
 /* Writes the deep AO as a two-part EXR through OpenEXR's C++ deep API
  * (core/io/exr_deep_ao_write.cpp): part "deep", deep scanline (ZIPS,

@@ -136,9 +136,9 @@ static void test_nodes_flatten_to_flat_ao(void **state)
     obs_deep_free(&d);
 }
 
-/* obs_deep_frame_cost: the pass's obs_frame_cost without output deep;
- * with it, more by the method's samples x deep_layers for every node
- * obs_deep_ao_nodes keeps (counted here from its output, at two node
+/* obs_deep_frame_cost: the pass's obs_frame_cost without output deep and
+ * on GL; with it on the CPU device, more by the method's samples x
+ * deep_layers for every node obs_deep_ao_nodes keeps (counted here from its output, at two node
  * counts and two methods, so the extra follows the kept nodes). */
 static void test_frame_cost_counts_nodes(void **state)
 {
@@ -159,9 +159,12 @@ static void test_frame_cost_counts_nodes(void **state)
             snprintf(v, sizeof v, "%d", m);
             assert_int_equal(obs_param_set(&p, "deep_layers", v, err), OBS_OK);
             assert_int_equal(obs_param_set(&p, "method", method[mi], err), OBS_OK);
-            unsigned long long flat = obs_deep_frame_cost(&d, &p, OBS_OUTPUT_AO);
-            unsigned long long deep = obs_deep_frame_cost(&d, &p, OBS_OUTPUT_AO | OBS_OUTPUT_DEEP);
+            unsigned long long flat = obs_deep_frame_cost(&d, &p, OBS_OUTPUT_AO, 1);
+            unsigned long long deep = obs_deep_frame_cost(&d, &p, OBS_OUTPUT_AO | OBS_OUTPUT_DEEP, 1);
             assert_true(flat == obs_frame_cost(&p, d.width, d.height, m));
+            assert_true(obs_deep_frame_cost(&d, &p, OBS_OUTPUT_AO, 0) == flat);
+            /* GL: the pass keeps the nodes (obs_deep_run_nodes), nothing apart */
+            assert_true(obs_deep_frame_cost(&d, &p, OBS_OUTPUT_AO | OBS_OUTPUT_DEEP, 0) == flat);
             assert_true(deep > flat);
             obs_deep_ao a;
             if (obs_deep_ao_nodes(&d, &p, &a, err) != OBS_OK)
@@ -179,7 +182,7 @@ static void test_frame_cost_counts_nodes(void **state)
         print_message("deep_small %s: kept nodes %llu (m 2), %llu (m 4)\n", method[mi], kept_of[0],
                       kept_of[1]);
     }
-    assert_true(obs_deep_frame_cost(NULL, NULL, OBS_OUTPUT_DEEP) == 0);
+    assert_true(obs_deep_frame_cost(NULL, NULL, OBS_OUTPUT_DEEP, 1) == 0);
     obs_deep_free(&d);
 }
 
