@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <unistd.h>
 
+#include "gl_testutil.h"
 #include "obscura/deep.h"
 
 #define FIXTURE TESTDATA "/deep_small.exr"
@@ -267,12 +268,8 @@ static void test_nodes_gl_twin(void **state)
 {
     (void)state;
     obs_ctx *ctx = NULL;
-    obs_ctx_desc desc = {0};
     char err[OBS_ERR_LEN] = "";
-    if (obs_ctx_create(&desc, &ctx, err) != OBS_OK) {
-        print_message("no GL context (%s): skipped\n", err);
-        skip();
-    }
+    CTX_OR_SKIP(ctx);
     obs_deep_image d;
     if (obs_deep_read_exr(FIXTURE, NULL, &d, err) != OBS_OK)
         fail_msg("%s", err);
