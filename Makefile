@@ -153,6 +153,10 @@ DEEP_BENCH := $(BUILD)/deep_bench
 HWY_BENCH := $(BUILD)/blur_hwy_bench
 $(HWY_BENCH): bench/blur_hwy.cc $(LIB)
 	$(CXX) -I. $(CPPFLAGS) $(CORE_INC) $(CXXFLAGS) -std=c++17 -ffp-contract=off $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS) -lhwy
+# The same for ao_definition rays' conversion (bench/rays_hwy.cc).
+RAYS_HWY_BENCH := $(BUILD)/rays_hwy_bench
+$(RAYS_HWY_BENCH): bench/rays_hwy.cc $(LIB)
+	$(CXX) -I. $(CPPFLAGS) $(CORE_INC) $(CXXFLAGS) -std=c++17 -ffp-contract=off $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS) -lhwy
 $(DEEP_BENCH): bench/deep_bench.c $(LIB)
 	$(CC) $(CPPFLAGS) $(CORE_INC) $(CFLAGS) $(PKG_CFLAGS) $< -o $@ $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
@@ -288,7 +292,7 @@ headers:
 
 bench: deps
 	@$(MAKE) --no-print-directory all $(BENCH) $(EXT_BENCH) $(UPSCALE) $(DAEMON_BENCH) $(DEEP_BENCH) \
-	  $(if $(wildcard /usr/include/hwy/highway.h),$(HWY_BENCH))
+	  $(if $(wildcard /usr/include/hwy/highway.h),$(HWY_BENCH) $(RAYS_HWY_BENCH))
 	@BUILD=$(BUILD) bench/run.sh
 
 # Quality against ground truth (bench/QUALITY.md, bench/quality/*.png): every

@@ -11,7 +11,8 @@
  * every method on the CPU device (obs_run_cpu) against the GL context,
  * at the same sizes; --cpu-only WxH: the CPU device alone (no GL context:
  * for a profiler), every method at that size, per pass (FRAME_BENCH_METHOD:
- * one method), then the AO pass against a plain gather loop over the same
+ * one method, here and with --devices; FRAME_BENCH_MAX_WIDTH=1920: --devices
+ * and --presets at 1920x1080 only), then the AO pass against a plain gather loop over the same
  * samples; with FRAME_BENCH_TABLE1=D[,D...] instead VAO++ Table 1's
  * structure on the CPU device at 16 samples, at each adaptive_diameter D. */
 #include <stdio.h>
@@ -243,9 +244,12 @@ static void bench_devices(obs_ctx *ctx, const char *name, const obs_gbuffer *gb,
     char err[OBS_ERR_LEN];
     if (frames > 64)
         frames = 64;
+    const char *only = getenv("FRAME_BENCH_METHOD"); /* one method */
     for (int m = 0; m < obs__method_count(); m++) {
         obs_params p = {0};
         const char *method = obs__method_at(m)->name;
+        if (only && strcmp(only, method))
+            continue;
         if (obs_param_set(&p, "method", method, err) != OBS_OK) {
             fprintf(stderr, "frame_bench: %s\n", err);
             exit(1);
@@ -585,8 +589,11 @@ int main(int argc, char **argv)
             /* --presets: --quality's presets at 1920x1080 and 3840x2160;
              * --devices: the methods on the two devices at those sizes */
             static const int sizes[2][2] = {{1920, 1080}, {3840, 2160}};
+            const char *maxw = getenv("FRAME_BENCH_MAX_WIDTH"); /* e.g. 1920: 1080p only */
             for (int k = 0; k < 2; k++) {
                 int pw = sizes[k][0], ph = sizes[k][1];
+                if (maxw && pw > atoi(maxw))
+                    continue;
                 obs_gbuffer up = upscaled(&gf.gb, pw, ph);
                 float *pd = (float *)up.depth.data, *pn = (float *)up.normal.data;
                 int nf = k ? (frames < 5 ? frames : 5) : frames;

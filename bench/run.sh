@@ -32,6 +32,11 @@ if [ -x "$BUILD/blur_hwy_bench" ]; then
     "$BUILD/blur_hwy_bench"
     echo
 fi
+# the same for ao_definition rays' conversion (bench/rays_hwy.cc)
+if [ -x "$BUILD/rays_hwy_bench" ]; then
+    "$BUILD/rays_hwy_bench"
+    echo
+fi
 # cold start: one process with obscura's program cache warm and Mesa's
 # off, against Mesa's cache warm and no cache (bench/coldstart.sh)
 BUILD="$BUILD" bench/coldstart.sh

@@ -16,6 +16,7 @@
 #include "internal.h"
 #include "obscura/params.h"
 #include "pool.h"
+#include "gl/backend.h"
 
 /* The measurement's frame: 960x540 (a quarter of 1080p: the passes'
  * costs per pixel, not a fixed cost, decide), 1 warm-up and 3 timed
@@ -27,6 +28,19 @@ static double now_ms(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+/* Whether a GL backend's library loads (libEGL for the EGL backends,
+ * libOSMesa for osmesa; each is opened once and kept).  When neither
+ * does, `why` names the CPU device and the EGL library's failure. */
+static int gl_loadable(char *why, size_t n)
+{
+    char egl_err[OBS_ERR_LEN], osm_err[OBS_ERR_LEN];
+    if (obs__gl_lib_open("libEGL.so.1", "libegl1", egl_err) ||
+        obs__gl_lib_open("libOSMesa.so.8", "libosmesa6", osm_err))
+        return 1;
+    snprintf(why, n, "the CPU device (no GL library: %.200s)", egl_err);
+    return 0;
 }
 
 void obs__device_key(const char *method, char *buf, size_t n)
@@ -180,6 +194,10 @@ obs_status obs_device_choose(const char *cache_dir, const obs_params *params, in
         return OBS_OK;
     }
     if (!measure_now) {
+        if (!gl_loadable(out->why, sizeof out->why)) { /* a node without GL: no choice to make */
+            out->cpu = 1;
+            return OBS_OK;
+        }
         snprintf(out->why, sizeof out->why, "a GL context (no measurement kept in %.120s)",
                  dir[0] ? path : "a cache folder");
         return OBS_OK;

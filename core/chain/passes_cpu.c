@@ -7,6 +7,7 @@
 #include "chain/bands_cpu.h"
 #include "chain/multibounce.h"
 #include "chain/passes_cpu.h"
+#include "chain/prep_cpu.h"
 #include "chain/vao_cpu.h"
 
 /* GLSL: composite.frag.glsl.  Section 5: "applied to resulting image
@@ -92,6 +93,121 @@ obs_status obs__cpu_stopped_fail(obs__cpu_run *c, const char *where, obs_pass p,
                      obs_pass_name(p));
 }
 
+/* ao_tile() for the VAO estimator without colour bleeding and without
+ * object masks: the tile's pixels sorted by the sample set they take,
+ * each set's pixels run in SIMD lanes (obs__vao_estimate_pixels), the
+ * same results as pixel by pixel. */
+static void ao_tile_lanes(obs__cpu_run *c, const unsigned char *cand, int x0, int x1, int y0,
+                          int y1)
+{
+    const obs__frame *f = c->pl->af;
+    const float *pos = c->apos, *nrm = c->anrm;
+    float *ao = c->aao, *bleed = c->ableed;
+    const int bleed_read = c->pl->f.bleed_step || c->out->bleed.data;
+    float *count = c->out->sample_count.data, *mask = c->out->cull_mask.data;
+    int px[AO_TILE_W * AO_TILE_H], ns[AO_TILE_W * AO_TILE_H], set[AO_TILE_W * AO_TILE_H];
+    unsigned char culled[AO_TILE_W * AO_TILE_H];
+    int m = 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            const size_t i = (size_t)y * f->width + x;
+            const size_t t = (size_t)(y - y0) * (size_t)(x1 - x0) + (size_t)(x - x0);
+            ao[i] = 1.0f;
+            if (bleed_read)
+                bleed[3 * i] = bleed[3 * i + 1] = bleed[3 * i + 2] = 1.0f;
+            if (count)
+                count[i] = 0.0f;
+            if (mask)
+                mask[i] = 0.0f;
+            if (!(pos[4 * i + 3] > 0.0f))
+                continue;
+            /* Section 4.2: a culling candidate gets AO 1 (greedy) or at
+             * most the 4-sample set (careful). */
+            const int cull = f->culling && cand[t];
+            if (mask)
+                mask[i] = (float)cull;
+            if (cull && f->culling != 2)
+                continue;
+            culled[m] = (unsigned char)cull;
+            px[m++] = (int)i;
+        }
+    if (m > 0) /* section 4.1: the set of each pixel's count */
+        obs__vao_counts(f, pos, nrm, px, m, ns);
+    for (int j = 0; j < m; j++) {
+        ns[j] = culled[j] && ns[j] > OBS_CULL_CAREFUL ? OBS_CULL_CAREFUL : ns[j];
+        if (count)
+            count[px[j]] = (float)ns[j];
+    }
+    /* each set (the count's set of the table, or the samples parameter's
+     * own set), its pixels in lanes */
+    int done = 0;
+    unsigned char taken[AO_TILE_W * AO_TILE_H];
+    memset(taken, 0, sizeof taken);
+    while (done < m) {
+        int first = 0;
+        while (taken[first])
+            first++;
+        const int n = ns[first];
+        const int table = f->adaptive || culled[first];
+        int k = 0;
+        for (int j = first; j < m; j++)
+            if (!taken[j] && ns[j] == n && (f->adaptive || culled[j]) == table) {
+                taken[j] = 1;
+                set[k++] = px[j];
+            }
+        done += k;
+        const float *xy = table ? f->sample_table + 2 * (n - 2) : f->sample_xy;
+        obs__vao_estimate_pixels(f, pos, nrm, c->dnz, set, k, n, xy, ao);
+    }
+    if (c->out->bent.data)
+        for (int j = 0, y = y0; y < y1; y++)
+            for (int x = x0; x < x1; x++) {
+                const size_t i = (size_t)y * f->width + x;
+                int n = 0, cull = 0;
+                if (j < m && px[j] == (int)i) {
+                    n = ns[j];
+                    cull = culled[j];
+                    j++;
+                }
+                vao_bent(f, pos, nrm, x, y, n, cull, c->out->bent.data + 3 * i);
+            }
+}
+
+/* ao_tile() for a comparison method without the bent normal: the
+ * tile's pixels with geometry in SIMD lanes (obs__method_pixels); 0 (the
+ * tile untouched) where the method has no lanes. */
+static int ao_tile_method(obs__cpu_run *c, int x0, int x1, int y0, int y1)
+{
+    const obs__frame *f = c->pl->af;
+    const float *pos = c->apos, *nrm = c->anrm;
+    float *count = c->out->sample_count.data;
+    int px[AO_TILE_W * AO_TILE_H], m = 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            const size_t i = (size_t)y * f->width + x;
+            if (pos[4 * i + 3] > 0.0f)
+                px[m++] = (int)i;
+        }
+    if (m > 0 && !obs__method_pixels(f, pos, nrm, px, m, c->aao, count))
+        return 0;
+    const int bleed_read = c->pl->f.bleed_step || c->out->bleed.data;
+    float *mask = c->out->cull_mask.data;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            const size_t i = (size_t)y * f->width + x;
+            if (bleed_read)
+                c->ableed[3 * i] = c->ableed[3 * i + 1] = c->ableed[3 * i + 2] = 1.0f;
+            if (mask)
+                mask[i] = 0.0f;
+            if (pos[4 * i + 3] > 0.0f)
+                continue;
+            c->aao[i] = 1.0f; /* background */
+            if (count)
+                count[i] = 0.0f;
+        }
+    return 1;
+}
+
 /* The AO pass over a tile of the frame at the AO's size (GLSL:
  * vao.frag.glsl, or the method's method.frag.glsl): ao, the bleed term
  * (when the composite or the output reads it) and the debug planes (NULL:
@@ -110,6 +226,12 @@ static void ao_tile(void *ctx, int x0, int x1, int y0, int y1)
     unsigned char cand[AO_TILE_W * AO_TILE_H]; /* section 4.2's test, the tile at once */
     if (f->culling && !method->pixel)
         obs__cull_candidates(f, est, x0, x1, y0, y1, cand);
+    if (!method->pixel && !f->mask_on && !(col && f->bleed_step > 0)) {
+        ao_tile_lanes(c, cand, x0, x1, y0, y1);
+        return;
+    }
+    if (method->pixel && !c->out->bent.data && ao_tile_method(c, x0, x1, y0, y1))
+        return;
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
             size_t i = (size_t)y * f->width + x;
@@ -159,10 +281,8 @@ static void position_rows(void *ctx, int y0, int y1)
     const obs_gbuffer *gb = c->pl->gb;
     for (int y = y0; y < y1; y++) {
         const float *depth = obs__plane_px(&gb->depth, f->width, 0, y); /* the row, once */
-        const size_t dc = (size_t)gb->depth.channels;
-        for (int x = 0; x < f->width; x++)
-            obs__prep_position(f, depth[dc * (size_t)x], x, y,
-                               c->pos + 4 * ((size_t)y * f->width + x));
+        obs__prep_position_row(f, depth, (size_t)gb->depth.channels, y,
+                               c->pos + 4 * (size_t)y * f->width);
     }
 }
 
@@ -173,6 +293,12 @@ static void normal_rows(void *ctx, int y0, int y1)
     const obs_gbuffer *gb = c->pl->gb;
     for (int y = y0; y < y1; y++) {
         const float *row = gb->normal.data ? obs__plane_px(&gb->normal, f->width, 0, y) : NULL;
+        const size_t r0 = (size_t)y * f->width;
+        if (row && !f->reconstruct_normals) { /* the input's normals: the row in lanes */
+            obs__prep_normal_row(f, c->pos + 4 * r0, row, (size_t)gb->normal.channels,
+                                 c->nrm + 3 * r0, f->half ? NULL : c->dnz + 2 * r0);
+            continue;
+        }
         for (int x = 0; x < f->width; x++) {
             const float *in = row ? row + (size_t)gb->normal.channels * (size_t)x : NULL;
             const size_t i = (size_t)y * f->width + x;

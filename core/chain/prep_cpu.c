@@ -2,8 +2,11 @@
  * pixel's view-space position and normal, and the maps between pixels and
  * view space that every pass shares (obs__px_ndc, obs__view_to_px). */
 #include <math.h>
+#include <string.h>
 
 #include "chain/frame.h"
+#include "chain/lanes.h"
+#include "chain/prep_cpu.h"
 
 /* GLSL: px_ndc() in common.glsl */
 void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2])
@@ -196,4 +199,123 @@ float obs__radius_px(const obs__frame *f, const float p[3], float r)
     float j00 = (P[0] * w - X * P[12]) / w2, j01 = (P[1] * w - X * P[13]) / w2;
     float j10 = (P[4] * w - Y * P[12]) / w2, j11 = (P[5] * w - Y * P[13]) / w2;
     return r * sqrtf(fabsf(j00 * j11 - j01 * j10) * f->viewport[2] * f->viewport[3] * 0.25f);
+}
+
+/* linear_depth() as selects, for the lanes: the same value in every mode
+ * (nf: clip_range() of the projection, computed once; mode a constant
+ * where this is inlined, so only its own terms remain) */
+static inline __attribute__((always_inline)) float linear_depth_lane(const float *P, int mode,
+                                                                     float raw, float dl,
+                                                                     const float nf[2])
+{
+    if (mode == OBS_DEPTH_INVERSE) {
+        const float inv = 1.0f / raw;
+        return (raw > 0.0f) & (inv < OBS_BACKGROUND_DEPTH) ? inv : 0.0f;
+    }
+    if (mode == OBS_DEPTH_NORMALIZED)
+        return (raw >= 0.0f) & (raw < 1.0f) ? nf[0] + raw * (nf[1] - nf[0]) : 0.0f;
+    const int fg = (raw > 0.0f) & (raw < OBS_BACKGROUND_DEPTH);
+    if (mode == OBS_DEPTH_RADIAL)
+        return fg ? raw / dl : 0.0f;
+    if (mode == OBS_DEPTH_NDC) {
+        const float zn = 2.0f * raw - 1.0f;
+        const float z = (P[11] - zn * P[15]) / (zn * P[14] - P[10]);
+        return fg & (raw < 1.0f) & (-z > 0.0f) ? -z : 0.0f;
+    }
+    return fg ? raw : 0.0f;
+}
+
+static inline __attribute__((always_inline)) void position_row(const obs__frame *f,
+                                                               const float *depth, size_t dc,
+                                                               int y, float *out, const int mode)
+{
+    float P[16], nf[2]; /* copies: the row's stores cannot alias them */
+    memcpy(P, f->proj, sizeof P);
+    clip_range(P, nf);
+    const float vx = f->viewport[0], vw = f->viewport[2];
+    const int w = f->width;
+    const float ny = 1.0f - ((float)y + 0.5f + f->viewport[1]) / f->viewport[3] * 2.0f;
+    const float c = P[4] - ny * P[12], d = P[5] - ny * P[13];
+    const float b0y = ny * P[15] - P[7], b1y = ny * P[14] - P[6];
+#pragma omp simd
+    for (int x = 0; x < w; x++) {
+        /* obs__px_ndc(), obs__view_ray() */
+        const float nx = ((float)x + 0.5f + vx) / vw * 2.0f - 1.0f;
+        const float a = P[0] - nx * P[12], b = P[1] - nx * P[13];
+        const float b0x = nx * P[15] - P[3], b1x = nx * P[14] - P[2];
+        const float inv = 1.0f / (a * d - b * c);
+        const float o0 = (d * b0x - b * b0y) * inv, o1 = (a * b0y - c * b0x) * inv;
+        const float dir0 = -(d * b1x - b * b1y) * inv, dir1 = -(a * b1y - c * b1x) * inv;
+        const float dl = sqrtf(dir0 * dir0 + dir1 * dir1 + -1.0f * -1.0f);
+        const float z = linear_depth_lane(P, mode, depth[dc * (size_t)x], dl, nf);
+        const int keep = (z > 0.0f) & (fabsf(z) < INFINITY); /* not (z <= 0 or not finite) */
+        out[4 * x] = keep ? o0 + z * dir0 : 0.0f;
+        out[4 * x + 1] = keep ? o1 + z * dir1 : 0.0f;
+        out[4 * x + 2] = keep ? -z : 0.0f;
+        out[4 * x + 3] = keep ? z : 0.0f;
+    }
+}
+
+/* obs__prep_position of the pixels of row y, their depths at depth[dc x],
+ * into out[4 x], the pixels in SIMD lanes: the same arithmetic, the same
+ * floats. */
+OBS__LANES
+void obs__prep_position_row(const obs__frame *f, const float *depth, size_t dc, int y, float *out)
+{
+    switch (f->depth_mode) {
+    case OBS_DEPTH_RADIAL:
+        position_row(f, depth, dc, y, out, OBS_DEPTH_RADIAL);
+        break;
+    case OBS_DEPTH_NDC:
+        position_row(f, depth, dc, y, out, OBS_DEPTH_NDC);
+        break;
+    case OBS_DEPTH_INVERSE:
+        position_row(f, depth, dc, y, out, OBS_DEPTH_INVERSE);
+        break;
+    case OBS_DEPTH_NORMALIZED:
+        position_row(f, depth, dc, y, out, OBS_DEPTH_NORMALIZED);
+        break;
+    default:
+        position_row(f, depth, dc, y, out, OBS_DEPTH_PLANAR);
+    }
+}
+
+static inline __attribute__((always_inline)) void normal_row(const obs__frame *f,
+                                                             const float *pos, const float *in,
+                                                             size_t nc, float *out, float *dnz,
+                                                             const int packed)
+{
+    float m[9];
+    memcpy(m, f->normal_matrix, sizeof m);
+    const int w = f->width;
+#pragma omp simd
+    for (int x = 0; x < w; x++) {
+        const float *v = in + nc * (size_t)x;
+        const float o0 = m[0] * v[0] + m[1] * v[1] + m[2] * v[2];
+        const float o1 = m[3] * v[0] + m[4] * v[1] + m[5] * v[2];
+        const float o2 = m[6] * v[0] + m[7] * v[1] + m[8] * v[2];
+        const float l = sqrtf(o0 * o0 + o1 * o1 + o2 * o2); /* normalize3() */
+        const int sc = l > 0.0f;
+        out[3 * x] = sc ? o0 / l : o0;
+        out[3 * x + 1] = sc ? o1 / l : o1;
+        out[3 * x + 2] = sc ? o2 / l : o2;
+        if (packed) {
+            dnz[2 * x] = pos[4 * x + 3];
+            dnz[2 * x + 1] = sc ? o2 / l : o2;
+        }
+    }
+}
+
+/* obs__prep_normal of the pixels of a row from the input normals
+ * in[nc x] (not reconstruct_normals) into out[3 x], and (dnz not NULL)
+ * the packed plane's dnz[2 x] = pos[4 x + 3], dnz[2 x + 1] = out[3 x + 2]:
+ * the pixels in SIMD lanes, the same floats. */
+OBS__LANES
+void obs__prep_normal_row(const obs__frame *f, const float *pos, const float *in, size_t nc,
+                          float *out, float *dnz)
+{
+    if (dnz)
+        normal_row(f, pos, in, nc, out, dnz, 1);
+    else
+        normal_row(f, pos, in, nc, out, NULL, 0);
 }

@@ -54,11 +54,7 @@
 #include "methods/gtao_deep.h"
 
 /* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) */
-#define GTAO_TOO_CLOSE 1.3f       /* pixelTooCloseThreshold: first sample this far, in pixels */
-#define GTAO_CENTRE_SCALE 0.99999f /* viewspaceZ *= 0.99999 (FP32 depths) */
-#define GTAO_SLOPE_FUDGE 0.05f    /* projectedNormalVecLength = lerp(len, 1, 0.05) */
 #define GTAO_MIN_VISIBILITY 0.03f /* visibility = max(0.03, visibility) */
-#define GTAO_R1 0.6180339887498948482f /* the steps' R1 sequence */
 
 static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
 static float saturate(float v) { return clampf(v, 0.0f, 1.0f); }
@@ -109,6 +105,17 @@ static float sample_cos(const obs__gtao_state *g, const float q[4], const float 
     return low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
 }
 
+void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int self,
+                           int x, int y, int qx, int qy, const float c[3], const float v[3],
+                           float low, float *hc, int *taken)
+{
+    float ext[4];
+    const float *q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
+    if (q)
+        *hc = fmaxf(*hc, sample_cos(obs__gtao_of(f), q, c, v, low,
+                                    obs__occluder_weight_node(f, x, y, self, qx, qy, 0)));
+}
+
 /* The horizon cosine of side `dir` (+1 or -1) of a slice after its
  * steps: the largest of the tangent's cosine `low` and the samples',
  * each moved from low by its falloff weight.  A step inside the image
@@ -140,9 +147,13 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         /* object masks: the weight of the surface at the step's pixel
          * (of each node there; past the border, of the front one) */
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
+            if (!end) {
+                obs__gtao_border_step(f, pos, nrm, self, x, y, qx, qy, c, v, low, &hc, taken);
+                continue;
+            }
             q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
-            if (end) /* intervals: the surface continued, solid behind it */
-                obs__gtao_column(f, fw, side, q, NULL, 0, q ? 1 : 0, x, y, self, qx, qy, c, v, low);
+            /* intervals: the surface continued, solid behind it */
+            obs__gtao_column(f, fw, side, q, NULL, 0, q ? 1 : 0, x, y, self, qx, qy, c, v, low);
             if (!q)
                 continue;
             hc = fmaxf(hc, sample_cos(g, q, c, v, low,
@@ -207,10 +218,11 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
     float noise[2];
     obs__gtao_noise(obs__tile_index(f, x, y), noise);
     const float min_s = GTAO_TOO_CLOSE / rpx;
-    float vis = g->heuristics ? saturate((10.0f - rpx) / 100.0f) * 0.5f : 0.0f;
+    float vis = obs__gtao_vis0(g, rpx);
     for (int sl = 0; sl < g->slices; sl++) {
-        float phi = ((float)sl + noise[0]) / (float)g->slices * (float)M_PI;
-        float cp = cosf(phi), sp = sinf(phi);
+        float cs[2];
+        obs__gtao_slice_dir(g, sl, noise[0], cs);
+        const float cp = cs[0], sp = cs[1];
         float omega[2] = {cp * rpx, -sp * rpx}; /* screen pixels: y runs down, view y up */
         float d[3] = {cp, sp, 0.0f};
         float dv = dot3(d, v);
@@ -252,12 +264,29 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
         if (bent)
             obs__gtao_bent_slice(h0, h1, gamma, np_len, od, v, bent);
     }
+    if (count)
+        *count = taken;
+    return obs__gtao_finish(g, vis);
+}
+
+void obs__gtao_slice_dir(const obs__gtao_state *g, int sl, float noise0, float cs[2])
+{
+    float phi = ((float)sl + noise0) / (float)g->slices * (float)M_PI;
+    cs[0] = cosf(phi);
+    cs[1] = sinf(phi);
+}
+
+float obs__gtao_vis0(const obs__gtao_state *g, float rpx)
+{
+    return g->heuristics ? saturate((10.0f - rpx) / 100.0f) * 0.5f : 0.0f;
+}
+
+float obs__gtao_finish(const obs__gtao_state *g, float vis)
+{
     vis /= (float)g->slices;
     vis = powf(fmaxf(vis, 0.0f), g->thin_power[1]);
     if (g->heuristics)
         vis = fmaxf(vis, GTAO_MIN_VISIBILITY);
-    if (count)
-        *count = taken;
     return saturate(vis);
 }
 

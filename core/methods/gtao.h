@@ -5,6 +5,13 @@
 
 #include "chain/frame.h"
 
+/* XeGTAO_MainPass's constants (XeGTAO.hlsli, XeGTAO.h) that the CPU
+ * device's lanes share (methods_cpu.c); the others are in gtao.c */
+#define GTAO_TOO_CLOSE 1.3f        /* pixelTooCloseThreshold: first sample this far, in pixels */
+#define GTAO_CENTRE_SCALE 0.99999f /* viewspaceZ *= 0.99999 (FP32 depths) */
+#define GTAO_R1 0.6180339887498948482f /* the steps' R1 sequence */
+#define GTAO_SLOPE_FUDGE 0.05f     /* projectedNormalVecLength = lerp(len, 1, 0.05) */
+
 /* Slices, steps per side, XeGTAO's heuristics (1: on); the search radius
  * gtao_multiplier * D in depth units; the falloff's weight =
  * saturate(r * mul + add); the thin-occluder compensation and the final
@@ -51,6 +58,23 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
  * sequence, fract(0.5 + k (0.754877666, 0.569840291)), k = tile;
  * out[0] offsets the slices, out[1] the steps (GLSL: gtao_noise()). */
 void obs__gtao_noise(int tile, float out[2]);
+
+/* Parts of obs__gtao_pixel_nodes that the CPU device's lanes share
+ * (methods_cpu.c): the slice's screen direction (cos, sin of its angle)
+ * from its index and the pixel's noise out[0] (obs__gtao_noise). */
+void obs__gtao_slice_dir(const obs__gtao_state *g, int sl, float noise0, float cs[2]);
+/* A step of a slice's side at pixel (qx, qy) off the planes, for the
+ * pixel (x, y) (its node self on deep input, else 0; centre c, view
+ * direction v, the side's start low): the
+ * surface continued past the border (border_cpu.c), its horizon cosine
+ * into *hc (the larger), *taken counted where it reads a point. */
+void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int self,
+                           int x, int y, int qx, int qy, const float c[3], const float v[3],
+                           float low, float *hc, int *taken);
+/* The visibility's start (XeGTAO's heuristic for a small radius in pixels)
+ * and its end from the slices' sum. */
+float obs__gtao_vis0(const obs__gtao_state *g, float rpx);
+float obs__gtao_finish(const obs__gtao_state *g, float vis);
 
 /* obs__gtao_pixel that also sums the bent normal of every slice into
  * bent[3] (NULL: not wanted): Jimenez et al.'s Algorithm 2 extension as

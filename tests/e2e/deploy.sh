@@ -94,11 +94,15 @@ osm=$(ldconfig -p | sed -n 's/^[[:space:]]*libOSMesa\.so\.8 (libc6,x86-64) => //
 if [ "$(id -u)" = 0 ] && [ -n "$egl" ] && [ -n "$osm" ] && unshare -m true 2>/dev/null; then
     unshare -m sh -c 'mount --bind /dev/null "$(readlink -f "$1")" && mount --bind /dev/null "$(readlink -f "$2")" &&
         "$3" ao tests/data/room_small.exr --camera tests/data/room_small.camera.json --backend cpu -o "$4/nogl.exr" -q &&
+        env -u OBSCURA_BACKEND OBSCURA_CACHE_DIR="$4/nogl-cache" "$3" ao tests/data/room_small.exr \
+            --camera tests/data/room_small.camera.json -o "$4/nogl-default.exr" -q &&
         { "$3" info --backend egl-surfaceless > "$4/nogl.info" 2>&1; echo $? > "$4/nogl.rc"; }' \
         - "$egl" "$osm" "$OBSCURA" "$T" > "$T/nogl.err" 2>&1
     rc=$?
     check "without libEGL and libOSMesa: the CPU device runs (exit $rc); a GL backend exits 1 naming libegl1" \
         "[ $rc -eq 0 ] && [ -s '$T/nogl.exr' ] && [ \"\$(cat '$T/nogl.rc')\" = 1 ] && grep -q 'install libegl1' '$T/nogl.info'"
+    check "without libEGL and libOSMesa, no backend named and nothing kept: the CPU device's frame, the same bytes" \
+        "[ $rc -eq 0 ] && cmp -s '$T/nogl.exr' '$T/nogl-default.exr'"
     [ $rc -eq 0 ] || sed 's/^/       /' "$T/nogl.err" | tail -3
 else
     skip "a node without GL libraries: needs root and unshare -m (a mount namespace to hide them)"
