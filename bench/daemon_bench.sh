@@ -103,7 +103,11 @@ echo "command: BUILD=$BUILD bench/daemon_bench.sh ($BUILD/daemon_bench --frames 
     "big.exr http://127.0.0.1:PORT tcp://127.0.0.1:PORT unix:SOCK; then --cpu --concurrency-only against" \
     "obscurad --backend cpu)"
 echo
-start_daemon "$T/d.log"
+# the daemon on the GL context the in-process frames run on (a daemon
+# naming no backend takes the CPU device where there is no GPU)
+GL_BACKEND=egl-surfaceless
+"$BUILD/obscura" info --backend egl-device >/dev/null 2>&1 && GL_BACKEND=egl-device
+start_daemon "$T/d.log" --backend "$GL_BACKEND"
 "$BUILD/daemon_bench" --daemon-pid "$PID" --frames "$FRAMES" --per-client "$PER_CLIENT" "$T/big.exr" \
     "http://127.0.0.1:$HP" "tcp://127.0.0.1:$TP" "unix:$SOCK"
 stage_table "$T/d.log"
@@ -138,7 +142,7 @@ if [ -n "${BASELINE_OBSCURAD:-}" ]; then
             echo
             echo "##### $d (round $round, load $(cut -d' ' -f1-3 /proc/loadavg))"
             DAEMON_BIN=$d
-            start_daemon "$T/b.log"
+            start_daemon "$T/b.log" --backend "$GL_BACKEND"
             DAEMON_BIN=""
             "$BUILD/daemon_bench" --daemon-pid "$PID" --concurrency-only --max-clients 4 --per-client "$PER_CLIENT" \
                 "$T/big.exr" "http://127.0.0.1:$HP"

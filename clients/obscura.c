@@ -613,8 +613,7 @@ static const char *cache_dir_of(const char *flag)
 /* --backend auto (or OBSCURA_BACKEND=auto): a GPU, else the faster of
  * the CPU device and llvmpipe, measured once and kept in the cache
  * folder (obs_device_choose); no backend named: the kept choice when
- * there is one, else a GL context as the backend order has it, or the
- * CPU device where no GL library loads. */
+ * there is one, else an EGL GPU device, else the CPU device. */
 static void choose_device(ao_args *a)
 {
     const char *name = a->backend ? a->backend : getenv("OBSCURA_BACKEND");

@@ -16,7 +16,6 @@
 #include "internal.h"
 #include "obscura/params.h"
 #include "pool.h"
-#include "gl/backend.h"
 
 /* The measurement's frame: 960x540 (a quarter of 1080p: the passes'
  * costs per pixel, not a fixed cost, decide), 1 warm-up and 3 timed
@@ -30,17 +29,19 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
-/* Whether a GL backend's library loads (libEGL for the EGL backends,
- * libOSMesa for osmesa; each is opened once and kept).  When neither
- * does, `why` names the CPU device and the EGL library's failure. */
-static int gl_loadable(char *why, size_t n)
+/* An EGL GPU device, found by creating a context on it (then released):
+ * the backend every other choice gives way to. */
+static int gpu_found(obs_device_choice *out)
 {
-    char egl_err[OBS_ERR_LEN], osm_err[OBS_ERR_LEN];
-    if (obs__gl_lib_open("libEGL.so.1", "libegl1", egl_err) ||
-        obs__gl_lib_open("libOSMesa.so.8", "libosmesa6", osm_err))
-        return 1;
-    snprintf(why, n, "the CPU device (no GL library: %.200s)", egl_err);
-    return 0;
+    obs_ctx_desc gpu = {.backend = OBS_BACKEND_EGL_DEVICE};
+    obs_ctx *ctx;
+    char why[OBS_ERR_LEN];
+    if (obs_ctx_create(&gpu, &ctx, why) != OBS_OK)
+        return 0;
+    obs_ctx_destroy(ctx);
+    out->backend = OBS_BACKEND_EGL_DEVICE;
+    snprintf(out->why, sizeof out->why, "an EGL GPU device");
+    return 1;
 }
 
 void obs__device_key(const char *method, char *buf, size_t n)
@@ -174,17 +175,8 @@ obs_status obs_device_choose(const char *cache_dir, const obs_params *params, in
     obs_param_format(&resolved, obs_param_find("method"), method, sizeof method);
     obs__device_key(method, key, sizeof key);
     snprintf(path, sizeof path, "%s/devices.txt", dir);
-    if (measure_now) { /* a GPU first: it wins over both */
-        obs_ctx_desc gpu = {.backend = OBS_BACKEND_EGL_DEVICE};
-        obs_ctx *ctx;
-        char why[OBS_ERR_LEN];
-        if (obs_ctx_create(&gpu, &ctx, why) == OBS_OK) {
-            obs_ctx_destroy(ctx);
-            out->backend = OBS_BACKEND_EGL_DEVICE;
-            snprintf(out->why, sizeof out->why, "an EGL GPU device");
-            return OBS_OK;
-        }
-    }
+    if (measure_now && gpu_found(out))
+        return OBS_OK; /* a GPU first: it wins over both */
     int c = dir[0] ? cached(path, key, &out->cpu_ms, &out->gl_ms) : -1;
     if (c >= 0) {
         out->cpu = c;
@@ -193,13 +185,13 @@ obs_status obs_device_choose(const char *cache_dir, const obs_params *params, in
                  c ? "the CPU device" : "the software GL context", out->cpu_ms, out->gl_ms, path);
         return OBS_OK;
     }
-    if (!measure_now) {
-        if (!gl_loadable(out->why, sizeof out->why)) { /* a node without GL: no choice to make */
-            out->cpu = 1;
+    if (!measure_now) { /* nothing kept: a GPU, else the CPU device */
+        if (gpu_found(out))
             return OBS_OK;
-        }
-        snprintf(out->why, sizeof out->why, "a GL context (no measurement kept in %.120s)",
-                 dir[0] ? path : "a cache folder");
+        out->cpu = 1;
+        snprintf(out->why, sizeof out->why,
+                 "the CPU device (no EGL GPU device; faster than llvmpipe on every method, "
+                 "bench/RESULTS.md; --backend auto measures this machine)");
         return OBS_OK;
     }
     obs_ctx_desc sw = {.backend = OBS_BACKEND_AUTO, .cache_dir = cache_dir};

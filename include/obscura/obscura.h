@@ -215,8 +215,9 @@ typedef struct obs_device_choice {
  * faster of the CPU device and the software GL context on a synthetic
  * 960x540 frame of the chain, measured now (about a second) and kept
  * there; the CPU device when no GL context can be created.  Without
- * measure_now only the kept choice is read (no context is created): a
- * GL context (AUTO) when none is kept. */
+ * measure_now the kept choice is read; when none is kept, an EGL GPU
+ * device when there is one, else the CPU device (faster than llvmpipe on
+ * every method: bench/RESULTS.md), nothing measured. */
 obs_status obs_device_choose(const char *cache_dir, const obs_params *params, int measure_now,
                              obs_device_choice *out, char err[OBS_ERR_LEN]);
 

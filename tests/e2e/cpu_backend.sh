@@ -37,6 +37,10 @@ kept=$(awk 'NF == 7 && ($5 == "cpu" || $5 == "gl") { print $5 }' "$T/cache/devic
 if [ "$kept" = cpu ]; then ran='samples, cpu: '; else ran='samples, egl-'; fi
 check "--backend auto beats OBSCURA_BACKEND=cpu: exit $rc, measured ($kept kept), run there" \
     "[ $rc -eq 0 ] && [ -n '$kept' ] && grep -q 'device: .*measured now' '$T/auto.log' && grep -q '$ran' '$T/auto.log'"
+"$OBSCURA" ao "$R" --camera "$CAMJ" --cache-dir "$T/fresh" -v -o "$T/plain.exr" 2>"$T/plain.log"
+rc=$?
+check "no backend named, nothing kept, no GPU: the CPU device, not llvmpipe (exit $rc, the bytes of --cpu)" \
+    "[ $rc -eq 0 ] && grep -q 'device: the CPU device (no EGL GPU device' '$T/plain.log' && cmp -s '$T/plain.exr' '$T/env.exr'"
 "$OBSCURA" ao "$R" --camera "$CAMJ" --cache-dir "$T/cache" -v -o "$T/auto2.exr" 2>"$T/auto2.log"
 rc=$?
 check "no backend named: exit $rc, the kept choice ($kept), not measured again" \

@@ -23,6 +23,9 @@ skip() { skipped=$((skipped + 1)); echo "  skip $*"; }
 # `make e2e OBSCURA_BACKEND=cpu`), which has no GL context.
 CPU_DEVICE=0
 [ "${OBSCURA_BACKEND:-}" = cpu ] && CPU_DEVICE=1
+# Nothing named: the GL path (llvmpipe here), which the GL checks need; a
+# run naming no backend would take the CPU device where no GPU is found.
+[ -n "${OBSCURA_BACKEND:-}" ] || { OBSCURA_BACKEND=egl-surfaceless; export OBSCURA_BACKEND; }
 # gl_only WHAT WHY: true on a GL backend; on the CPU device false, with a
 # skip line naming WHAT and WHY it does not apply there, e.g.
 #   if gl_only "the program cache" "the CPU device compiles no programs"; then ...
