@@ -700,6 +700,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     char err[OBS_ERR_LEN] = "";
     obs_deep_image d;
     obs_deep_result r = {0};
+    obs_deep_ao gl_nodes = {0}; /* output=deep on GL: the pass's per-node AO */
     obs_ctx *ctx = NULL;
     obs_status s;
     int rc = EXIT_OK;
@@ -763,7 +764,9 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
             rc = cli_fail(s, "OpenGL", err);
             goto done;
         }
-        s = obs_deep_run(ctx, &d, &a->req.params, &r, err);
+        /* output=deep: every node's AO from the pass itself */
+        s = (a->req.outputs & OBS_OUTPUT_DEEP) ? obs_deep_run_nodes(ctx, &d, &a->req.params, &r, &gl_nodes, err)
+                                               : obs_deep_run(ctx, &d, &a->req.params, &r, err);
         log_programs(ctx);
     }
     if (s != OBS_OK) {
@@ -776,14 +779,18 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     const obs_camera *cam = d.camera.has_projection ? &d.camera : NULL;
     int want_ao = (a->req.outputs & OBS_OUTPUT_AO) != 0, want_comp = (a->req.outputs & OBS_OUTPUT_COMPOSITE) != 0;
     if (a->req.outputs & OBS_OUTPUT_DEEP) {
-        /* every kept node's AO (the CPU twin of the per-node pass), the
-         * run's flat AO and front AO beside it */
-        obs_deep_ao nodes;
-        s = obs_deep_ao_nodes(&d, &a->req.params, &nodes, err);
+        /* every kept node's AO (the GL pass's; with --cpu the CPU twin's,
+         * computed here), the run's flat AO and front AO beside it */
+        obs_deep_ao computed = {0};
+        const obs_deep_ao *nodes = &gl_nodes;
+        if (!gl_nodes.offset) {
+            s = obs_deep_ao_nodes(&d, &a->req.params, &computed, err);
+            nodes = &computed;
+        }
         if (s == OBS_OK)
-            s = obs_deep_ao_write_exr(a->out, &nodes, &r.ao_blend, &r.ao_front,
+            s = obs_deep_ao_write_exr(a->out, nodes, &r.ao_blend, &r.ao_front,
                                       (obs_exr_compression)a->req.compression, err);
-        obs_deep_ao_free(&nodes);
+        obs_deep_ao_free(&computed);
         if (s == OBS_OK && verbosity >= OBS_LOG_INFO)
             fprintf(stderr, "obscura: wrote %s\n", a->out);
     } else if (a->req.format == OBS_HTTP_EXR) {
@@ -842,6 +849,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     }
 done:
     obs_deep_result_free(&r);
+    obs_deep_ao_free(&gl_nodes);
     obs_ctx_destroy(ctx);
     obs_deep_free(&d);
     return rc;

@@ -101,7 +101,8 @@
       "exits 0 (0: wait for them)")                                            \
     X(max_cost, SIZE, 0, 1099511627776, "768m",                                \
       "largest work one frame may ask for, in samples: width x height x "      \
-      "the method's samples per pixel (x nodes^2 for deep input); 422 "        \
+      "the method's samples per pixel (x nodes^2 for deep input, plus "       \
+      "kept nodes x samples x nodes for output=deep on backend cpu); 422 "    \
       "too_costly above, before it runs (0: no limit; the default takes the "  \
       "default chain at the largest accepted frame, max_pixels x 16)")         \
     X(frame_deadline, INT, 0, 86400, "60",                                   \

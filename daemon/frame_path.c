@@ -32,6 +32,7 @@ void obsd_fp_free(obsd_fp *fp)
 {
     obs_result_free(&fp->job.result);
     obs_deep_result_free(&fp->job.deep_result);
+    obs_deep_ao_free(&fp->job.deep_nodes);
     obs_gbuffer_free(&fp->gf);
     obs_deep_free(&fp->deep_exr);
     obs_image_free(&fp->baked);
@@ -301,15 +302,20 @@ obs_status obsd_fp_encode(obsd_fp *fp, const obsd_fp_images *im, const obs_http_
     if (raw) {
         /* nothing to write: the protocol sends the planes */
     } else if (hr->outputs & OBS_OUTPUT_DEEP) {
-        /* every kept node's AO (the CPU twin, as obscura ao --output deep);
-         * a file written as it comes (obscura ao --server --output deep),
-         * so auto keeps the file's compressions, as obscura ao writes them */
-        obs_deep_ao nodes;
-        s = obs_deep_ao_nodes(fp->deep, fp->job.params, &nodes, err);
+        /* every kept node's AO: the GL pass's (obs_deep_run_nodes), or on
+         * the CPU device the CPU twin's, computed here; a file written as
+         * it comes (obscura ao --server --output deep), so auto keeps the
+         * file's compressions, as obscura ao writes them */
+        obs_deep_ao computed = {0};
+        const obs_deep_ao *nodes = &fp->job.deep_nodes;
+        if (!nodes->offset) {
+            s = obs_deep_ao_nodes(fp->deep, fp->job.params, &computed, err);
+            nodes = &computed;
+        }
         if (s == OBS_OK)
-            s = obs_deep_ao_write_exr_mem(&nodes, &fp->job.deep_result.ao_blend, &fp->job.deep_result.ao_front,
+            s = obs_deep_ao_write_exr_mem(nodes, &fp->job.deep_result.ao_blend, &fp->job.deep_result.ao_front,
                                           (obs_exr_compression)hr->compression, out, err);
-        obs_deep_ao_free(&nodes);
+        obs_deep_ao_free(&computed);
     } else if (hr->format == OBS_HTTP_EXR) {
         /* copies of the image headers only: the pixels stay where they are */
         obs_result flat = {0};

@@ -85,13 +85,10 @@ static int too_costly(const obsd_gl_worker *w, obsd_job *job)
         return 0;
     int width = job->deep ? job->deep->width : job->gb->width;
     int height = job->deep ? job->deep->height : job->gb->height;
-    int layers = 0;
-    if (job->deep) {
-        obs_params p;
-        obs_params_resolve(job->params, &p);
-        layers = p.deep_layers;
-    }
-    unsigned long long cost = obs_frame_cost(job->params, width, height, layers);
+    /* deep: the nodes' pass, and with output=deep on the CPU device the
+     * per-node AO the encoder computes apart */
+    unsigned long long cost = job->deep ? obs_deep_frame_cost(job->deep, job->params, job->outputs, w->cpu)
+                                        : obs_frame_cost(job->params, width, height, 0);
     if (cost <= w->max_cost)
         return 0;
     job->status = OBS_TOO_COSTLY;
@@ -200,7 +197,10 @@ static void *worker_main(void *arg)
             job->status = obs_run_cpu_opts(job->gb, job->params, job->outputs, &job->result, &o,
                                            job->err);
         } else if (job->deep) {
-            job->status = obs_deep_run(ctx, job->deep, job->params, &job->deep_result, job->err);
+            job->status = (job->outputs & OBS_OUTPUT_DEEP)
+                              ? obs_deep_run_nodes(ctx, job->deep, job->params, &job->deep_result,
+                                                   &job->deep_nodes, job->err)
+                              : obs_deep_run(ctx, job->deep, job->params, &job->deep_result, job->err);
         } else {
             job->status = obs_run(ctx, job->gb, job->params, job->outputs, &job->result, job->err);
         }

@@ -21,6 +21,10 @@ struct obsd_job {
      * deep_result for deep) */
     obs_result result;
     obs_deep_result deep_result;
+    /* output=deep on GL: every kept node's AO from the pass
+     * (obs_deep_run_nodes); empty on the CPU device, where the encoder
+     * computes them (obs_deep_ao_nodes) */
+    obs_deep_ao deep_nodes;
     obs_status status;
     char err[OBS_ERR_LEN];
     double t_queued, t_started, t_finished; /* obsd_now_ms() */

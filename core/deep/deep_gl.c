@@ -70,7 +70,8 @@ enum {
     DEEP_RAYS = 8,       /* OBS_RAYS: ao_definition rays' conversion of the VAO nodes */
     DEEP_INTERVALS = 16, /* OBS_DEEP_INTERVALS: the nodes' intervals (deep_intervals) */
     DEEP_GTAO = 32,      /* OBS_DEEP_HORIZON with gtao.glsl: method gtao's horizon search */
-    DEEP_HBAO = 64       /* OBS_DEEP_HORIZON with hbao.glsl: method hbao's */
+    DEEP_HBAO = 64,      /* OBS_DEEP_HORIZON with hbao.glsl: method hbao's */
+    DEEP_NODES = 128     /* OBS_DEEP_NODES: every node's AO stored (obs_deep_run_nodes) */
 };
 
 static unsigned deep_variant(const obs__deep_frame *df)
@@ -124,14 +125,14 @@ static obs_status ensure_deep(obs_ctx *ctx, unsigned v, int w, int h, int m,
     obs__deep_targets *t = &ctx->deep;
     obs_status s;
     if (!t->prog[v]) {
-        char defs[224];
+        char defs[256];
         snprintf(defs, sizeof defs,
                  "#define OBS_DEEP_HEMISPHERE %d\n#define OBS_DEEP_THIN %d\n"
                  "#define OBS_RANGE_CHECK %d\n#define OBS_RAYS %d\n#define OBS_DEEP_INTERVALS %d\n"
-                 "#define OBS_DEEP_HORIZON %d\n",
+                 "#define OBS_DEEP_HORIZON %d\n#define OBS_DEEP_NODES %d\n",
                  (v & DEEP_HEMISPHERE) != 0, (v & DEEP_THIN) != 0, (v & DEEP_RANGE) != 0,
                  (v & DEEP_RAYS) != 0, (v & DEEP_INTERVALS) != 0,
-                 (v & (DEEP_GTAO | DEEP_HBAO)) != 0);
+                 (v & (DEEP_GTAO | DEEP_HBAO)) != 0, (v & DEEP_NODES) != 0);
         /* method hemisphere's estimator, or method.glsl (radius_px) and
          * gtao's or hbao's, come after the pass, which defines how they
          * read the nodes (HS_NODE, GT_NODE, HB_NODE in deep.frag.glsl) */
@@ -206,18 +207,22 @@ static void stage_end(obs_ctx *ctx, obs_pass p, double t0, obs_pass_times *t)
     t->ms[p] = obs__now_ms() - t0;
 }
 
-obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
-                        obs_deep_result *out, char err[OBS_ERR_LEN])
+/* obs_deep_run, and with nodes not NULL obs_deep_run_nodes. */
+static obs_status deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
+                           obs_deep_result *out, obs_deep_ao *nodes, char err[OBS_ERR_LEN])
 {
     obs__deep_frame df;
     obs_pass_times times;
     double t0 = 0.0;
     const double t_run = obs__now_ms(); /* obs_ctx_set_deadline counts from here */
+    float *node_ao = NULL;               /* nodes: the pass's per-node planes */
     obs_status s;
 
     if (!ctx || !out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_run: NULL argument");
     memset(out, 0, sizeof *out);
+    if (nodes)
+        memset(nodes, 0, sizeof *nodes);
     if ((s = obs__gl_device_bind(&ctx->dev, err)) != OBS_OK)
         return s;
     ctx->times_valid = 0;
@@ -227,7 +232,7 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     const int w = f->width, h = f->height;
     if ((s = obs__deep_result_alloc(out, w, h, err)) != OBS_OK)
         goto fail;
-    const unsigned variant = deep_variant(&df);
+    const unsigned variant = deep_variant(&df) | (nodes ? DEEP_NODES : 0u);
     if ((s = ensure_deep(ctx, variant, w, h, df.m, err)) != OBS_OK)
         goto fail;
     if ((s = obs__blur_program(&ctx->prog, 0, f->blur_radius, err)) != OBS_OK)
@@ -266,6 +271,11 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
         upload_layers(t->tex_mask, w, h, df.m, GL_RG, rg);
         free(rg);
     }
+    /* the deep AO out: an R32F array made on the first frame that asks */
+    if (nodes && !t->tex_nodes) {
+        ctx->deep.tex_nodes = array_texture(ctx, w, h, df.m, GL_R32F);
+        ctx->deep.bytes += (unsigned long long)w * (unsigned long long)h * 4ull * (unsigned)df.m;
+    }
     stage_end(ctx, OBS_PASS_UPLOAD, t0, &times);
 
     stage_begin(ctx, &t0);
@@ -292,6 +302,10 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
         glBindImageTexture(3, t->tex_mask, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RG32F);
         glUniform1i(glGetUniformLocation(prog, "u_lmask"), 3);
     }
+    if (nodes) {
+        glBindImageTexture(4, t->tex_nodes, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+        glUniform1i(glGetUniformLocation(prog, "u_lao"), 4);
+    }
     s = obs__gl_draw_banded(ctx->dev.vao, w, h, t_run, ctx->deadline_ms, "deep AO", err);
     stage_end(ctx, OBS_PASS_AO, t0, &times);
     if (s != OBS_OK) {
@@ -316,10 +330,25 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo_blend);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, out->ao_blend.data);
+    if (nodes) {
+        /* every node's AO, the m planes as the frame's (k * npx + i); the
+         * layers past a pixel's last node are not read */
+        node_ao = malloc((size_t)w * (size_t)h * (size_t)df.m * sizeof *node_ao);
+        if (!node_ao) {
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            s = obs__fail(err, OBS_NO_MEMORY, "deep AO nodes of %dx%dx%d", w, h, df.m);
+            goto fail;
+        }
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, t->tex_nodes);
+        glGetTexImage(GL_TEXTURE_2D_ARRAY, 0, GL_RED, GL_FLOAT, node_ao);
+    }
     stage_end(ctx, OBS_PASS_READBACK, t0, &times);
     glActiveTexture(GL_TEXTURE0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if ((s = obs__gl_check("deep AO pass", err)) != OBS_OK)
+        goto fail;
+    if (nodes && (s = obs__deep_ao_pack(d, &df, node_ao, nodes, err)) != OBS_OK)
         goto fail;
     if (ctx->timing) {
         times.total_ms = times.ms[OBS_PASS_UPLOAD] + times.ms[OBS_PASS_AO] +
@@ -331,8 +360,23 @@ obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params 
     obs__receivers_apply_deep(d, out); /* object masks: receivers */
     obs__deep_composite(d, out);
 fail:
+    free(node_ao);
     obs__deep_frame_free(&df);
     if (s != OBS_OK)
         obs_deep_result_free(out);
     return s;
+}
+
+obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
+                        obs_deep_result *out, char err[OBS_ERR_LEN])
+{
+    return deep_run(ctx, d, params, out, NULL, err);
+}
+
+obs_status obs_deep_run_nodes(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
+                              obs_deep_result *out, obs_deep_ao *nodes, char err[OBS_ERR_LEN])
+{
+    if (!nodes)
+        return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_run_nodes: no nodes output");
+    return deep_run(ctx, d, params, out, nodes, err);
 }

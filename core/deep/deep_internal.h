@@ -33,6 +33,13 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
                                  obs__deep_frame *df, char err[OBS_ERR_LEN]);
 void obs__deep_frame_free(obs__deep_frame *df);
 
+/* The deep AO out of the frame d was set up from (deep_nodes.c): every
+ * kept node's AO into out, from node_ao (m planes of width x height, node
+ * k of pixel i at k * npx + i: the GL pass's read-back) or, with node_ao
+ * NULL, computed here (obs__deep_node_ao, the CPU twin). */
+obs_status obs__deep_ao_pack(const obs_deep_image *d, const obs__deep_frame *df,
+                             const float *node_ao, obs_deep_ao *out, char err[OBS_ERR_LEN]);
+
 /* The facing flags of pixel i's kept nodes as intervals (the
  * deep_intervals parameter): front to back, a node met outside every
  * interval opens one if it is a front face (facing +1), which its

@@ -10,8 +10,8 @@
 void obs__deep_release(obs__deep_targets *t, int all)
 {
     GLuint tex[] = {t->tex_pos,   t->tex_nrm,   t->tex_end, t->tex_mask,
-                    t->tex_front, t->tex_blend, t->tex_tmp};
-    glDeleteTextures(7, tex);
+                    t->tex_front, t->tex_blend, t->tex_tmp, t->tex_nodes};
+    glDeleteTextures(8, tex);
     GLuint fbo[] = {t->fbo, t->fbo_front, t->fbo_blend, t->fbo_tmp};
     for (int i = 0; i < 4; i++)
         if (fbo[i])

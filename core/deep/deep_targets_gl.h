@@ -6,7 +6,7 @@
 
 #include "gl/gl.h"
 
-#define OBS__DEEP_VARIANTS 128 /* 7 switches of the deep pass (deep_gl.c: DEEP_*) */
+#define OBS__DEEP_VARIANTS 256 /* 8 switches of the deep pass (deep_gl.c: DEEP_*) */
 
 /* The deep pass's programs, and the node planes and the output target of
  * one size and node count. */
@@ -17,6 +17,7 @@ typedef struct obs__deep_targets {
     GLuint tex_pos, tex_nrm;     /* 2D arrays of m layers (RGBA32F) */
     GLuint tex_end;              /* 2D array of m layers (R32F): the nodes' intervals */
     GLuint tex_mask;             /* 2D array of m layers (RG32F): the nodes' object masks */
+    GLuint tex_nodes;            /* 2D array of m layers (R32F): every node's AO (deep AO out) */
     /* RG32F (AO, the front node's planar depth, for the blur): the front
      * node's AO, the blend, and the blur's intermediate; fbo writes the
      * first two (the deep pass), the others one each (the blur) */

@@ -86,6 +86,7 @@
     X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                                 \
     X(PFNGLGETBUFFERSUBDATAPROC, GetBufferSubData)                             \
     X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                   \
+    X(PFNGLGETTEXIMAGEPROC, GetTexImage)                                       \
     X(PFNGLBINDIMAGETEXTUREPROC, BindImageTexture)                             \
     /* the frame's uniform block, its layout as the tests read it */           \
     X(PFNGLGETPROGRAMRESOURCEINDEXPROC, GetProgramResourceIndex)               \
@@ -177,6 +178,7 @@ extern _Thread_local const obs__gl *obs__glp;
 #define glBindBufferBase obs__glp->BindBufferBase
 #define glGetBufferSubData obs__glp->GetBufferSubData
 #define glMemoryBarrier obs__glp->MemoryBarrier
+#define glGetTexImage obs__glp->GetTexImage
 #define glBindImageTexture obs__glp->BindImageTexture
 #define glGetProgramResourceIndex obs__glp->GetProgramResourceIndex
 #define glGetProgramResourceiv obs__glp->GetProgramResourceiv

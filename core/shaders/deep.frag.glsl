@@ -23,6 +23,11 @@ layout(r32f) readonly uniform image2DArray u_lend;
 // occluders weight (x) and object ID (y, compared as bits), bound when
 // u_deep_mask is not 0 (1: the weights, 2: self_only, 3: both).
 layout(rg32f) readonly uniform image2DArray u_lmask;
+#if OBS_DEEP_NODES
+// every node's AO, node k in layer k (the deep AO out, obs_deep_run_nodes;
+// C twin: obs_deep_ao_nodes); layers past the pixel's last node untouched
+layout(r32f) writeonly uniform image2DArray u_lao;
+#endif
 uniform int u_deep_mask;
 int g_self = 0;                 // the receiver's node, set by node_ao()
 uniform int u_m;                // nodes per pixel
@@ -36,7 +41,8 @@ uniform int u_multi;            // 1: every node occludes (Algorithm 1); 0: node
 // samples); OBS_DEEP_THIN, thin hulls (eqs 2-4; else solid volumes, eq 1);
 // OBS_RANGE_CHECK, the depth range check (VAO++ 4.4, eq 4);
 // OBS_DEEP_INTERVALS, the nodes' intervals from their facing flags;
-// OBS_DEEP_HORIZON, method gtao's or hbao's horizon search over the nodes.
+// OBS_DEEP_HORIZON, method gtao's or hbao's horizon search over the nodes;
+// OBS_DEEP_NODES, every node's AO stored (u_lao).
 // Method hemisphere's estimator (hemisphere.glsl, appended after this file
 // in the OBS_DEEP_HEMISPHERE programs) reads the nodes through these.
 // The object masks' weight of node k at pixel s as an occluder of node
@@ -211,6 +217,9 @@ void main()
         float ao = node_ao(px, k);
         if (k == 0)
             front = ao;
+#if OBS_DEEP_NODES
+        imageStore(u_lao, ivec3(px, k), vec4(ao));
+#endif
         acc += T * a * ao;   // "over", front to back
         T *= 1.0 - a;
     }

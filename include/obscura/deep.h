@@ -197,6 +197,15 @@ obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
 obs_status obs_deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
                         obs_deep_result *out, char err[OBS_ERR_LEN]);
 
+/* obs_deep_run that also fills `nodes` with every kept node's AO, as
+ * obs_deep_ao_nodes (below, its CPU twin) gives it: the pass stores each
+ * node's AO in a layer of an R32F array read back with the planes, so the
+ * per-node AO costs no second computation.  Caller frees nodes with
+ * obs_deep_ao_free() (cleared on failure). */
+typedef struct obs_deep_ao obs_deep_ao;
+obs_status obs_deep_run_nodes(obs_ctx *ctx, const obs_deep_image *d, const obs_params *params,
+                              obs_deep_result *out, obs_deep_ao *nodes, char err[OBS_ERR_LEN]);
+
 /* ---- deep AO out (obscura ao --output deep) ------------------------------ */
 
 /* The values of one node of a deep AO, in this order. */
@@ -208,13 +217,13 @@ enum { OBS_DEEP_AO_Z, OBS_DEEP_AO_ZBACK, OBS_DEEP_AO_A, OBS_DEEP_AO_AO, OBS_DEEP
  * has them, its alpha, and its AO (1 = open, not premultiplied).
  * Flattened front to back, sum of T_k A_k AO_k plus the T left (open),
  * it is obs_deep_result's ao_blend before the blur. */
-typedef struct obs_deep_ao {
+struct obs_deep_ao {
     int width, height;                 /* the input's data window */
     int display_x, display_y, display_width, display_height;
     uint64_t *offset;                  /* width * height + 1 entries */
     float *node;                       /* offset[width * height] nodes */
     obs_camera camera;                 /* the input's */
-} obs_deep_ao;
+};
 
 /* The per-node AO of the deep image on the CPU (the twin of obs_deep_run's
  * per-node pass, core/deep/deep_nodes.c), the parameters as
@@ -222,6 +231,19 @@ typedef struct obs_deep_ao {
 obs_status obs_deep_ao_nodes(const obs_deep_image *d, const obs_params *params, obs_deep_ao *out,
                              char err[OBS_ERR_LEN]);
 void obs_deep_ao_free(obs_deep_ao *a);
+
+/* The work a deep frame asks for, in samples, for obsd --max-cost and
+ * other admission checks: obs_frame_cost's (width x height x the method's
+ * samples per pixel x deep_layers^2), plus on the CPU device (cpu 1) with
+ * OBS_OUTPUT_DEEP in `outputs` the per-node AO that obs_deep_ao_nodes
+ * computes apart from obs_deep_run_cpu: every kept node, min(its pixel's
+ * samples, deep_layers), times the method's samples per pixel x
+ * deep_layers, the pass's own unit per node.  On GL (cpu 0)
+ * obs_deep_run_nodes keeps the nodes' AO from the pass: nothing added.
+ * Parameters as obs_deep_run takes them (NULL: defaults); 0 without an
+ * image. */
+unsigned long long obs_deep_frame_cost(const obs_deep_image *d, const obs_params *params,
+                                       unsigned outputs, int cpu);
 
 /* Writes the deep AO as a two-part EXR through OpenEXR's C++ deep API
  * (core/io/exr_deep_ao_write.cpp): part "deep", deep scanline (ZIPS,

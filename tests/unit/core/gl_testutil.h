@@ -32,6 +32,18 @@ static inline obs_ctx *make_ctx(obs_backend b)
     return ctx;
 }
 
+/* A context of the default backend, or the test skipped (said why) when
+ * none can be made. */
+#define CTX_OR_SKIP(ctx)                                                       \
+    do {                                                                       \
+        obs_ctx_desc desc_ = {0};                                              \
+        char err_[OBS_ERR_LEN] = "";                                           \
+        if (obs_ctx_create(&desc_, &(ctx), err_) != OBS_OK) {                  \
+            print_message("no GL context (%s): skipped\n", err_);              \
+            skip();                                                            \
+        }                                                                      \
+    } while (0)
+
 /* Mean |a - b| and the fraction of pixels differing by more than 1e-3. */
 static inline void diff(const obs_image *a, const obs_image *b, double *mean, double *frac)
 {
