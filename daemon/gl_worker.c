@@ -189,13 +189,13 @@ static void *worker_main(void *arg)
             snprintf(job->err, OBS_ERR_LEN, "not run: the drain's deadline passed");
         } else if (too_costly(w, job)) {
             /* answered without running */
-        } else if (w->cpu && job->deep) {
-            job->status = obs_deep_run_cpu(job->deep, job->params, &job->deep_result, job->err);
         } else if (w->cpu) {
             obs_cpu_options o = {.deadline = w->frame_deadline, /* as the GL context's */
                                  .cancel = cut_asked, .cancel_user = w};
-            job->status = obs_run_cpu_opts(job->gb, job->params, job->outputs, &job->result, &o,
-                                           job->err);
+            job->status = job->deep ? obs_deep_run_cpu_opts(job->deep, job->params, &o,
+                                                            &job->deep_result, job->err)
+                                    : obs_run_cpu_opts(job->gb, job->params, job->outputs,
+                                                       &job->result, &o, job->err);
         } else if (job->deep) {
             job->status = (job->outputs & OBS_OUTPUT_DEEP)
                               ? obs_deep_run_nodes(ctx, job->deep, job->params, &job->deep_result,

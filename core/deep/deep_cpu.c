@@ -19,9 +19,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "chain/bands_cpu.h"
 #include "chain/mask_weight.h"
+#include "chain/passes_cpu.h"
 #include "deep/deep_internal.h"
 #include "methods/gtao.h"
 #include "methods/hbao.h"
@@ -455,28 +457,50 @@ void obs__deep_composite(const obs_deep_image *d, obs_deep_result *out)
 typedef struct deep_job {
     const obs__deep_frame *df;
     obs_deep_result *out;
+    obs__cpu_run *stop; /* its deadline, cancel and stopped fields only */
 } deep_job;
 
 static void deep_rows(void *ctx, int y0, int y1)
 {
     const deep_job *j = ctx;
     const int w = j->df->f.width;
-    for (int y = y0; y < y1; y++)
+    for (int y = y0; y < y1; y++) {
+        if (obs__cpu_stop_now(j->stop)) /* read between rows: at most a row past it */
+            return;
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * (size_t)w + (size_t)x;
             j->out->ao_blend.data[i] = obs__deep_pixel(j->df, x, y, &j->out->ao_front.data[i]);
         }
+    }
 }
 
 obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
                             obs_deep_result *out, char err[OBS_ERR_LEN])
 {
+    return obs_deep_run_cpu_opts(d, params, NULL, out, err);
+}
+
+obs_status obs_deep_run_cpu_opts(const obs_deep_image *d, const obs_params *params,
+                                 const obs_cpu_options *opt, obs_deep_result *out,
+                                 char err[OBS_ERR_LEN])
+{
     obs__deep_frame df;
+    obs__cpu_run stop = {0};
     obs_status s;
     if (out)
         memset(out, 0, sizeof *out);
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_run_cpu: no output");
+    if (opt && opt->deadline > 0.0) {
+        struct timespec ts;
+        clock_gettime(CLOCK_MONOTONIC, &ts);
+        stop.deadline_ms = (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6 + opt->deadline * 1e3;
+    }
+    if (opt) {
+        stop.cancel = opt->cancel;
+        stop.cancel_user = opt->cancel_user;
+    }
+    atomic_init(&stop.stopped, 0);
     if ((s = obs__deep_frame_setup(d, params, &df, err)) != OBS_OK)
         return s;
     if ((s = obs__deep_result_alloc(out, d->width, d->height, err)) != OBS_OK) {
@@ -486,8 +510,14 @@ obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
     /* every pixel on its own (obs__deep_pixel reads the frame, writes its
      * pixel): in row bands on the worker pool, the same bytes for any
      * thread count */
-    deep_job j = {&df, out};
+    deep_job j = {&df, out, &stop};
     obs__cpu_rows(d->height, 0, deep_rows, &j);
+    if (atomic_load(&stop.stopped)) { /* some rows not run: no result */
+        s = obs__cpu_stopped_fail(&stop, "in", OBS_PASS_AO, err);
+        obs__deep_frame_free(&df);
+        obs_deep_result_free(out);
+        return s;
+    }
     /* the low-pass filter (VAO++ 4.6) of both, the flat chain's twin with
      * the front node's plane as its positions (GLSL: deep_gl.c) */
     if (df.f.blur_radius > 0) {

@@ -191,6 +191,15 @@ int obs_deep_result_exr_layers(const obs_deep_result *r, unsigned outputs, obs_e
 obs_status obs_deep_run_cpu(const obs_deep_image *d, const obs_params *params,
                             obs_deep_result *out, char err[OBS_ERR_LEN]);
 
+/* obs_deep_run_cpu with the CPU device's options (obscura.h): their
+ * deadline (OBS_DEADLINE) and cancel (OBS_CANCELLED), read between rows
+ * of the AO, as obs_run_cpu_opts reads them between tiles; log, the
+ * memory budget and bands are not used (a deep frame runs whole).  NULL:
+ * obs_deep_run_cpu. */
+obs_status obs_deep_run_cpu_opts(const obs_deep_image *d, const obs_params *params,
+                                 const obs_cpu_options *opt, obs_deep_result *out,
+                                 char err[OBS_ERR_LEN]);
+
 /* The same on the GL context: the nodes go to 2D array textures and one
  * fragment pass (core/shaders/deep.frag.glsl) computes the AO; the CPU
  * functions above are its twin. */

@@ -98,6 +98,12 @@ static void test_chain_variants(void **state)
     check("hbao", value, OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE | OBS_OUTPUT_LUMINANCE);
 }
 
+static int cancel_after(void *user)
+{
+    int *calls = user; /* calls[0]: calls so far, calls[1]: the call that says stop */
+    return __atomic_add_fetch(&calls[0], 1, __ATOMIC_RELAXED) >= calls[1];
+}
+
 static void test_deep_chain(void **state)
 {
     obs_deep_image d;
@@ -115,8 +121,26 @@ static void test_deep_chain(void **state)
     same_image(&one.ao_blend, &many.ao_blend, "deep ao");
     same_image(&one.ao_front, &many.ao_front, "deep front ao");
     same_image(&one.composite, &many.composite, "deep composite");
-    obs_deep_result_free(&one);
     obs_deep_result_free(&many);
+    /* the deadline and the cancel, read between the AO's rows: a cancel
+     * that never fires gives the same bytes; one that fires midway and a
+     * deadline already past give no result */
+    int never[2] = {0, 1 << 30};
+    obs_cpu_options polled = {.cancel = cancel_after, .cancel_user = never};
+    assert_int_equal(obs_deep_run_cpu_opts(&d, &p, &polled, &many, err), OBS_OK);
+    same_image(&one.ao_blend, &many.ao_blend, "deep ao, cancel polled");
+    obs_deep_result_free(&many);
+    assert_true(never[0] >= d.height); /* once a row at least */
+    int mid[2] = {0, never[0] / 2};
+    obs_cpu_options midway = {.cancel = cancel_after, .cancel_user = mid};
+    assert_int_equal(obs_deep_run_cpu_opts(&d, &p, &midway, &many, err), OBS_CANCELLED);
+    assert_non_null(strstr(err, "cancelled (in the ao pass)"));
+    assert_null(many.ao_blend.data);
+    obs_cpu_options past = {.deadline = 1e-9};
+    assert_int_equal(obs_deep_run_cpu_opts(&d, &p, &past, &many, err), OBS_DEADLINE);
+    assert_non_null(strstr(err, "past its deadline"));
+    assert_null(many.ao_blend.data);
+    obs_deep_result_free(&one);
     obs_deep_free(&d);
 }
 
@@ -152,11 +176,6 @@ static void test_deadline_and_log(void **state)
  * and tiles, from the pool's threads); a nonzero return stops the run
  * with OBS_CANCELLED and nothing allocated, and the cancel is not asked
  * again; one that never says stop leaves the frame's bytes as they are. */
-static int cancel_after(void *user)
-{
-    int *calls = user; /* calls[0]: calls so far, calls[1]: the call that says stop */
-    return __atomic_add_fetch(&calls[0], 1, __ATOMIC_RELAXED) >= calls[1];
-}
 
 static void test_cancel(void **state)
 {
