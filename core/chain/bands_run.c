@@ -575,13 +575,7 @@ obs_status obs_run_cpu_rows(const obs_gbuffer *frame, obs_rows_in_fn in, obs_row
     head.color.data = frame->color.channels > 0 ? &present : NULL;
     head.position = (obs_plane){NULL, 0, 0};
     head.depth.row_stride = head.normal.row_stride = head.color.row_stride = 0;
-    if (opt && opt->deadline > 0.0)
-        c.deadline_ms = now_ms() + opt->deadline * 1e3;
-    if (opt) {
-        c.cancel = opt->cancel;
-        c.cancel_user = opt->cancel_user;
-    }
-    atomic_init(&c.stopped, 0);
+    obs__cpu_arm(&c, opt);
     obs_status s = obs__plan_init(&pl, log ? obs__log_only_ctx(&sink) : NULL, &head, params, outputs, err);
     if (s != OBS_OK)
         return s;

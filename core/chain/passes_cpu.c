@@ -65,6 +65,23 @@ static void vao_bent(const obs__frame *f, const float *pos, const float *nrm, in
  * between the passes and the AO pass's tiles: past it (or cancelled), the
  * rest of the pass's tiles are skipped (the run then fails with
  * OBS_DEADLINE or OBS_CANCELLED, run_cpu.c). */
+void obs__cpu_arm(obs__cpu_run *c, const obs_cpu_options *opt)
+{
+    c->deadline_ms = 0.0;
+    c->cancel = NULL;
+    c->cancel_user = NULL;
+    if (opt && opt->deadline > 0.0) {
+        struct timespec ts;
+        clock_gettime(CLOCK_MONOTONIC, &ts);
+        c->deadline_ms = (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6 + opt->deadline * 1e3;
+    }
+    if (opt) {
+        c->cancel = opt->cancel;
+        c->cancel_user = opt->cancel_user;
+    }
+    atomic_init(&c->stopped, 0);
+}
+
 int obs__cpu_stop_now(obs__cpu_run *c)
 {
     if (atomic_load_explicit(&c->stopped, memory_order_relaxed))

@@ -47,6 +47,9 @@ typedef struct obs__cpu_run {
 
 enum { OBS__CPU_PAST_DEADLINE = 1, OBS__CPU_CANCELLED = 2 };
 
+/* c's deadline (from now), cancel and stopped, from the caller's options
+ * (NULL: neither): the start of every CPU run, flat, banded or deep. */
+void obs__cpu_arm(obs__cpu_run *c, const obs_cpu_options *opt);
 /* Whether c's run is to stop (a tile's test, from any thread): the
  * deadline passed or the cancel said so; sets c->stopped (passes_cpu.c). */
 int obs__cpu_stop_now(obs__cpu_run *c);

@@ -74,13 +74,7 @@ static obs_status run(const obs_gbuffer *gb, const obs_params *params, unsigned 
     obs__log_sink sink = {log, opt ? opt->log_user : NULL}; /* the frame setup's messages */
 
     memset(out, 0, sizeof *out);
-    if (opt && opt->deadline > 0.0)
-        c.deadline_ms = now_ms() + opt->deadline * 1e3;
-    if (opt) {
-        c.cancel = opt->cancel;
-        c.cancel_user = opt->cancel_user;
-    }
-    atomic_init(&c.stopped, 0);
+    obs__cpu_arm(&c, opt);
     obs_status s = obs__plan_init(&pl, log ? obs__log_only_ctx(&sink) : NULL, gb, params, outputs, err);
     if (s != OBS_OK)
         return s;

@@ -19,7 +19,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "chain/bands_cpu.h"
 #include "chain/mask_weight.h"
@@ -491,16 +490,7 @@ obs_status obs_deep_run_cpu_opts(const obs_deep_image *d, const obs_params *para
         memset(out, 0, sizeof *out);
     if (!out)
         return obs__fail(err, OBS_INVALID_ARGUMENT, "obs_deep_run_cpu: no output");
-    if (opt && opt->deadline > 0.0) {
-        struct timespec ts;
-        clock_gettime(CLOCK_MONOTONIC, &ts);
-        stop.deadline_ms = (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6 + opt->deadline * 1e3;
-    }
-    if (opt) {
-        stop.cancel = opt->cancel;
-        stop.cancel_user = opt->cancel_user;
-    }
-    atomic_init(&stop.stopped, 0);
+    obs__cpu_arm(&stop, opt);
     if ((s = obs__deep_frame_setup(d, params, &df, err)) != OBS_OK)
         return s;
     if ((s = obs__deep_result_alloc(out, d->width, d->height, err)) != OBS_OK) {
