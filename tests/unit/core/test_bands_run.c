@@ -8,26 +8,8 @@
 #include "methods/methods.h"
 #include "obscura/io.h"
 #include "obscura/obscura.h"
+#include "room_fixture.h"
 
-static obs_gbuffer_file room;
-
-static int setup(void **state)
-{
-    char err[OBS_ERR_LEN] = "";
-    (void)state;
-    if (obs_gbuffer_read_exr(TESTDATA "/room_small.exr", NULL, NULL, &room, err) != OBS_OK ||
-        obs_camera_read_json(TESTDATA "/room_small.camera.json", &room.gb.camera, NULL, NULL,
-                             err) != OBS_OK)
-        fail_msg("room_small: %s", err);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    obs_gbuffer_free(&room);
-    return 0;
-}
 
 static const unsigned all_outputs = OBS_OUTPUT_AO | OBS_OUTPUT_COMPOSITE |
                                     OBS_OUTPUT_SAMPLE_COUNT | OBS_OUTPUT_CULL_MASK |
