@@ -827,7 +827,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     }
     if (verbosity >= OBS_LOG_INFO) {
         obs_params p;
-        obs_params_resolve(&a->req.params, &p);
+        obs_deep_params_resolve(&d, &a->req.params, &p);
         char kernel[64]; /* the method's samples */
         if (p.method == OBS_METHOD_GTAO)
             snprintf(kernel, sizeof kernel, "gtao %d slices x %d steps", p.gtao_slices,
@@ -839,7 +839,7 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
             snprintf(kernel, sizeof kernel, "%d hemisphere samples", p.hemisphere_samples);
         else
             snprintf(kernel, sizeof kernel, "%d samples%s", p.samples,
-                     p.deep_intervals == OBS_ON && d.has_facing ? ", intervals" : "");
+                     obs_deep_intervals_in_effect(&d, &p) ? ", intervals" : "");
         fprintf(stderr, "obscura: info: deep %dx%d, %llu samples, %s, %d nodes%s, %s hulls, "
                 "radius %g, %s: read %.1f ms, AO %.1f ms\n",
                 d.width, d.height, (unsigned long long)d.offset[(size_t)d.width * d.height],

@@ -57,6 +57,11 @@ void obs__mat4_apply(const float m[16], const float v[4], float out[4]);
 /* The camera a frame is computed with: the G-buffer's camera, overridden
  * by parameters (fov_y, world_to_camera) where they are set.  Fails with
  * NO_CAMERA when neither gives a projection. */
+/* Sets parameter `name` of r to `value` (text, as obs_param_set) when r
+ * leaves it unset (0): a preset's row, a parameter given explicitly
+ * wins (--quality's presets, OBS_DEEP_GTAO_EXACT). */
+void obs__params_fill(obs_params *r, const char *name, const char *value);
+
 /* obs_params_resolve() of `in` with depth_mode and normal_space, where
  * `in` leaves them at 0, taken from the G-buffer's convention. */
 void obs__params_for_gbuffer(const obs_params *in, const obs_gbuffer *gb, obs_params *out);

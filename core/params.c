@@ -132,6 +132,20 @@ static const char *method_why(size_t offset)
     return "";
 }
 
+void obs__params_fill(obs_params *r, const char *name, const char *value)
+{
+    const obs_param_info *pi = obs_param_find(name);
+    obs_params set;
+    memset(&set, 0, sizeof set);
+    /* the rows are checked by test_params.c: each value parses */
+    if (!pi || obs_param_set(&set, name, value, NULL) != OBS_OK)
+        return;
+    char *field = (char *)r + pi->offset;
+    const char *v = (const char *)&set + pi->offset;
+    if (pi->type == OBS_PARAM_FLOAT ? *(float *)field == 0.0f : *(int *)field == 0)
+        memcpy(field, v, pi->type == OBS_PARAM_FLOAT ? sizeof(float) : sizeof(int));
+}
+
 /* The rows of --quality's preset: each parameter the request left unset
  * (0) takes the preset's value; an explicit one keeps its own. */
 static void apply_quality(obs_params *r)
@@ -144,20 +158,9 @@ static void apply_quality(obs_params *r)
         OBS_QUALITY_PRESETS(OBS__PRESET_ROW)
 #undef OBS__PRESET_ROW
     };
-    for (size_t k = 0; k < sizeof presets / sizeof presets[0]; k++) {
-        if (presets[k].quality != r->quality)
-            continue;
-        const obs_param_info *pi = obs_param_find(presets[k].name);
-        obs_params set;
-        memset(&set, 0, sizeof set);
-        /* the rows are checked by test_params.c: each value parses */
-        if (!pi || obs_param_set(&set, presets[k].name, presets[k].value, NULL) != OBS_OK)
-            continue;
-        char *field = (char *)r + pi->offset;
-        const char *value = (const char *)&set + pi->offset;
-        if (pi->type == OBS_PARAM_FLOAT ? *(float *)field == 0.0f : *(int *)field == 0)
-            memcpy(field, value, pi->type == OBS_PARAM_FLOAT ? sizeof(float) : sizeof(int));
-    }
+    for (size_t k = 0; k < sizeof presets / sizeof presets[0]; k++)
+        if (presets[k].quality == r->quality)
+            obs__params_fill(r, presets[k].name, presets[k].value);
 }
 
 void obs_params_resolve(const obs_params *in, obs_params *out)

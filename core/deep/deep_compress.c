@@ -24,7 +24,23 @@
  * resolves it (a deep EXR without clip attributes: 0.1 .. 1000, the
  * reader's default; parameters near and far with a field of view); a
  * camera without a projection falls back to the default clip range of
- * those parameters. */
+ * those parameters.
+ *
+ * With intervals (deep_intervals, obs__deep_intervals) a front face and
+ * its matching back face bound a solid: the chain reads the depth between
+ * them as occupied and the depth behind the back face as free, and a
+ * front face whose back face the list lacks as solid behind it to
+ * infinity.  Eq 5 scores single nodes, so on its own it can keep a front
+ * face and drop its back face (opaque nodes: the farther one), turning a
+ * thin object into an infinitely deep one.  The unit eq 5 eliminates is
+ * then a closed interval's two ends: when the node it chooses is one end
+ * of a matched pair (facing +1 and -1 matched as parentheses, front to
+ * back, as obs__deep_intervals matches them), its partner goes with it.
+ * Removing a matched pair leaves every other pair matched (and makes no
+ * unmatched node matched), so no kept front face loses its back face to
+ * compression; a node of no pair (a surface seen from one side, facing
+ * unknown) is dropped alone, as without intervals.  The partner may lie
+ * in the front half that front_half preserves: the pair goes whole. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,12 +59,68 @@ static float norm_z(float z, float zmin, float zmax)
     return t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
 }
 
+/* The intervals of a whole list (n samples): pair[s] = the sample matched
+ * with sample s by the facing flags, front to back by depth (ties in
+ * insertion order) as parentheses: a front face (+1) opens, the next back
+ * face (-1) closes the innermost open one, as obs__deep_intervals matches
+ * a kept list; -1 for a sample in no pair (facing 0, a back face with
+ * nothing open, a front face whose back face the list lacks).  scratch:
+ * 2 n ints. */
+static void match_list(const float *samples, int n, int *pair, int *scratch)
+{
+    int *order = scratch, *tmp = scratch + n;
+    for (int s = 0; s < n; s++) {
+        order[s] = s;
+        pair[s] = -1;
+    }
+    /* stable bottom-up merge sort of the indices by depth */
+    for (int w = 1; w < n; w *= 2) {
+        for (int lo = 0; lo < n; lo += 2 * w) {
+            int mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
+            int i = lo, j = mid, k = lo;
+            while (i < mid && j < hi)
+                tmp[k++] = samples[(size_t)order[j] * OBS_DEEP_CH + OBS_DEEP_Z] <
+                                   samples[(size_t)order[i] * OBS_DEEP_CH + OBS_DEEP_Z]
+                               ? order[j++]
+                               : order[i++];
+            while (i < mid)
+                tmp[k++] = order[i++];
+            while (j < hi)
+                tmp[k++] = order[j++];
+        }
+        memcpy(order, tmp, (size_t)n * sizeof *order);
+    }
+    int *open = tmp, depth = 0; /* the open front faces, innermost last */
+    for (int k = 0; k < n; k++) {
+        int s = order[k];
+        float fc = samples[(size_t)s * OBS_DEEP_CH + OBS_DEEP_FACING];
+        if (fc > 0.0f) {
+            open[depth++] = s;
+        } else if (fc < 0.0f && depth > 0) {
+            int o = open[--depth];
+            pair[o] = s;
+            pair[s] = o;
+        }
+    }
+}
+
+/* Removes node j of the count nodes of a and ix; returns count - 1. */
+static int remove_node(float *a, int *ix, int count, int j)
+{
+    memmove(a + j * OBS_DEEP_CH, a + (j + 1) * OBS_DEEP_CH,
+            (size_t)(count - j - 1) * OBS_DEEP_CH * sizeof(float));
+    memmove(ix + j, ix + j + 1, (size_t)(count - j - 1) * sizeof *ix);
+    return count - 1;
+}
+
 /* obs_deep_compress_list that also writes, when src is not NULL, the
  * index (0 .. n - 1) of the sample each kept node came from: the nodes
  * move with their index, so the object masks of a sample reach the node
- * it became (obs_deep_layers.occluders, object_id). */
-static int compress_list(const float *samples, int n, int m, int front_half, float zmin,
-                         float zmax, float *out, int *src)
+ * it became (obs_deep_layers.occluders, object_id).  pair: NULL, or the
+ * list's intervals (match_list), which eq 5 then drops whole; it marks a
+ * sample whose partner went -2 (the sample goes on arrival). */
+static int compress_list(const float *samples, int n, int m, int front_half, int *pair,
+                         float zmin, float zmax, float *out, int *src)
 {
     /* m + 1 slots: the insertion that overflows is followed at once by
      * the elimination of eq 5 over the m + 1 candidates. */
@@ -60,6 +132,8 @@ static int compress_list(const float *samples, int n, int m, int front_half, flo
     if (m > OBS_DEEP_MAX_LAYERS)
         m = OBS_DEEP_MAX_LAYERS;
     for (int s = 0; s < n; s++) {
+        if (pair && pair[s] == -2)
+            continue; /* its interval was eliminated before it arrived */
         const float *f = samples + (size_t)s * OBS_DEEP_CH;
         float fz = f[OBS_DEEP_Z];
         /* "looking up the index i of a where a[i]z < fz < a[i+1]z" */
@@ -85,10 +159,19 @@ static int compress_list(const float *samples, int n, int m, int front_half, flo
                 drop = j;
             }
         }
-        memmove(a + drop * OBS_DEEP_CH, a + (drop + 1) * OBS_DEEP_CH,
-                (size_t)(count - drop - 1) * OBS_DEEP_CH * sizeof(float));
-        memmove(ix + drop, ix + drop + 1, (size_t)(count - drop - 1) * sizeof *ix);
-        count--;
+        /* with intervals, a closed interval's two ends go together: the
+         * partner now if it is in the array, on arrival if it is to come */
+        int partner = pair ? pair[ix[drop]] : -1;
+        count = remove_node(a, ix, count, drop);
+        if (partner >= 0) {
+            int k = 0;
+            while (k < count && ix[k] != partner)
+                k++;
+            if (k < count)
+                count = remove_node(a, ix, count, k);
+            else
+                pair[partner] = -2;
+        }
     }
     memcpy(out, a, (size_t)count * OBS_DEEP_CH * sizeof(float));
     if (src)
@@ -99,7 +182,21 @@ static int compress_list(const float *samples, int n, int m, int front_half, flo
 int obs_deep_compress_list(const float *samples, int n, int m, int front_half, float zmin,
                            float zmax, float *out)
 {
-    return compress_list(samples, n, m, front_half, zmin, zmax, out, NULL);
+    return compress_list(samples, n, m, front_half, NULL, zmin, zmax, out, NULL);
+}
+
+int obs__deep_compress_list(const float *samples, int n, int m, int front_half, int intervals,
+                            float zmin, float zmax, float *out)
+{
+    int *pair = NULL;
+    if (intervals && n > 0) {
+        if (!(pair = malloc((size_t)n * 3 * sizeof *pair)))
+            return -1;
+        match_list(samples, n, pair, pair + n);
+    }
+    int c = compress_list(samples, n, m, front_half, pair, zmin, zmax, out, NULL);
+    free(pair);
+    return c;
 }
 
 void obs_deep_layers_free(obs_deep_layers *l)
@@ -141,6 +238,12 @@ void obs__deep_clip_range(const obs_camera *cam, float *near_z, float *far_z)
 obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs_deep_layers *out,
                              char err[OBS_ERR_LEN])
 {
+    return obs__deep_compress(d, m, front_half, 0, out, err);
+}
+
+obs_status obs__deep_compress(const obs_deep_image *d, int m, int front_half, int intervals,
+                              obs_deep_layers *out, char err[OBS_ERR_LEN])
+{
     size_t npx, bytes;
     float zmin, zmax;
 
@@ -168,6 +271,20 @@ obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs
         obs_deep_layers_free(out);
         return obs__fail(err, OBS_NO_MEMORY, "deep layers of %dx%dx%d", d->width, d->height, m);
     }
+    /* with intervals: the pairs of the longest list and their scratch */
+    int *pair = NULL;
+    if (intervals && !keep_all) {
+        size_t most = 0;
+        for (size_t i = 0; i < npx; i++)
+            if (d->offset[i + 1] - d->offset[i] > most)
+                most = (size_t)(d->offset[i + 1] - d->offset[i]);
+        if (most > OBS_DEEP_MAX_PER_PIXEL)
+            most = OBS_DEEP_MAX_PER_PIXEL;
+        if (most && !(pair = malloc(most * 3 * sizeof *pair))) {
+            obs_deep_layers_free(out);
+            return obs__fail(err, OBS_NO_MEMORY, "deep intervals of %zu samples", most);
+        }
+    }
     obs__deep_clip_range(&d->camera, &zmin, &zmax);
     out->width = d->width;
     out->height = d->height;
@@ -189,7 +306,9 @@ obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs
             for (int k = 0; k < c; k++)
                 src[k] = k;
         } else {
-            c = compress_list(s, n, m, front_half, zmin, zmax, list, src);
+            if (pair)
+                match_list(s, n, pair, pair + n);
+            c = compress_list(s, n, m, front_half, pair, zmin, zmax, list, src);
         }
         out->count[i] = c;
         for (int k = 0; k < c; k++) {
@@ -202,5 +321,6 @@ obs_status obs_deep_compress(const obs_deep_image *d, int m, int front_half, obs
                 out->object_id[at] = d->object_id[d->offset[i] + (uint64_t)src[k]];
         }
     }
+    free(pair);
     return OBS_OK;
 }

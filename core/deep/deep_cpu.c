@@ -99,6 +99,36 @@ static void prep_normal_rows(void *ctx, int y0, int y1)
         }
 }
 
+int obs_deep_intervals_in_effect(const obs_deep_image *d, const obs_params *p)
+{
+    /* on, or auto with method gtao (whose free arcs measured closer to the
+     * ray tracer; the VAO methods' intervals measured farther,
+     * bench/QUALITY.md), where the image has facing flags and every node
+     * counts (deep_mode multi) */
+    return d && p &&
+           (p->deep_intervals == OBS_DEEP_INTERVALS_ON ||
+            (p->deep_intervals == OBS_DEEP_INTERVALS_AUTO && p->method == OBS_METHOD_GTAO)) &&
+           d->has_facing && p->deep_mode != OBS_DEEP_SINGLE;
+}
+
+void obs_deep_params_resolve(const obs_deep_image *d, const obs_params *in, obs_params *out)
+{
+    obs_params_resolve(in, out);
+    if (!obs_deep_intervals_in_effect(d, out) || out->method != OBS_METHOD_GTAO)
+        return;
+    /* gtao with intervals computes the slice integral as written
+     * (OBS_DEEP_GTAO_EXACT): its rows fill what the request left unset */
+    obs_params q;
+    if (in)
+        q = *in;
+    else
+        memset(&q, 0, sizeof q);
+#define OBS__EXACT_ROW(name, value) obs__params_fill(&q, #name, value);
+    OBS_DEEP_GTAO_EXACT(OBS__EXACT_ROW)
+#undef OBS__EXACT_ROW
+    obs_params_resolve(&q, out);
+}
+
 obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *params,
                                  obs__deep_frame *df, char err[OBS_ERR_LEN])
 {
@@ -135,6 +165,12 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
                          "methods %s",
                          name, list);
     }
+    /* the parameters as the chain runs them on this image (intervals:
+     * gtao's exact rows) */
+    obs_deep_params_resolve(d, params, &p);
+    df->multi = p.deep_mode != OBS_DEEP_SINGLE;
+    df->thin = p.deep_hull == OBS_DEEP_THIN;
+    df->intervals = obs_deep_intervals_in_effect(d, &p);
     size_t npx = (size_t)d->width * (size_t)d->height;
     depth = calloc(npx, sizeof *depth);
     in_n = d->has_normal ? calloc(npx * 3, sizeof *in_n) : NULL;
@@ -163,12 +199,13 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
         goto fail;
     }
     /* eq 5 over the clip range of the camera the frame resolved (the
-     * image's, or the parameters' field of view and near, far) */
+     * image's, or the parameters' field of view and near, far); with
+     * intervals it never splits one (deep_compress.c) */
     obs_deep_image dc = *d;
     memcpy(dc.camera.projection, df->f.proj, sizeof dc.camera.projection);
     dc.camera.has_projection = 1;
-    if ((s = obs_deep_compress(&dc, p.deep_layers, p.deep_front_half == OBS_ON, &df->layers,
-                               err)) != OBS_OK)
+    if ((s = obs__deep_compress(&dc, p.deep_layers, p.deep_front_half == OBS_ON, df->intervals,
+                                &df->layers, err)) != OBS_OK)
         goto fail;
     int m = df->layers.m;
     /* object masks (obs_deep_read_masks): the weight and the object of
@@ -186,9 +223,6 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
         goto fail;
     }
     df->m = m;
-    df->multi = p.deep_mode != OBS_DEEP_SINGLE;
-    df->thin = p.deep_hull == OBS_DEEP_THIN;
-    df->intervals = p.deep_intervals == OBS_ON && d->has_facing && df->multi;
 
     /* The prep pass of every node plane, in row bands on the worker pool:
      * positions, then normals (which read the neighbours' positions). */

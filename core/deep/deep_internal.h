@@ -26,6 +26,16 @@ typedef struct obs__deep_frame {
     obs_deep_layers layers;
 } obs__deep_frame;
 
+/* obs_deep_compress_list and obs_deep_compress with intervals (non-zero:
+ * deep_intervals in effect): eq 5's node and, when it is one end of a
+ * front face / back face pair matched by the facing flags, its partner
+ * are dropped together, so compression never splits an interval
+ * (deep_compress.c); intervals 0 is the public functions' behaviour. */
+int obs__deep_compress_list(const float *samples, int n, int m, int front_half, int intervals,
+                            float zmin, float zmax, float *out);
+obs_status obs__deep_compress(const obs_deep_image *d, int m, int front_half, int intervals,
+                              obs_deep_layers *out, char err[OBS_ERR_LEN]);
+
 /* Compresses the image and prepares the node planes (the prep pass of
  * every node: view position, then normal from the file or reconstructed
  * from the node plane's positions).  Frees with obs__deep_frame_free(). */

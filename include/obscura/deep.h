@@ -162,6 +162,17 @@ void obs_deep_layers_free(obs_deep_layers *l);
 
 /* ---- multi-layer AO -------------------------------------------------------- */
 
+/* Whether the multi-layer chain reads d's front and back faces as
+ * intervals with the resolved parameters p: deep_intervals on, or auto
+ * with method gtao; d has facing flags; deep_mode multi. */
+int obs_deep_intervals_in_effect(const obs_deep_image *d, const obs_params *p);
+
+/* obs_params_resolve() of `in` as the multi-layer chain runs it on d:
+ * with intervals in effect, method gtao's parameters that `in` leaves
+ * unset take the rows of OBS_DEEP_GTAO_EXACT (the slice integral as
+ * written, converged in steps). */
+void obs_deep_params_resolve(const obs_deep_image *d, const obs_params *in, obs_params *out);
+
 typedef struct obs_deep_result {
     obs_image ao_front;  /* 1 channel: AO of the front node of each pixel */
     obs_image ao_blend;  /* 1 channel: per-node AO blended front to back by

@@ -118,6 +118,32 @@ typedef enum obs_quality { OBS_QUALITY_UNSET, OBS_QUALITY_LIST(OBS__ENUM_VALUE) 
     X(OBS_QUALITY_REFERENCE, adaptive, "off")                                  \
     X(OBS_QUALITY_REFERENCE, culling, "off")
 
+/* Whether deep input's front and back faces bound intervals (parameter
+ * `deep_intervals`); on and off keep the values of OBS_SWITCH_LIST. */
+#define OBS_DEEP_INTERVALS_LIST(X)                                             \
+    X(OBS_DEEP_INTERVALS_ON, on)                                               \
+    X(OBS_DEEP_INTERVALS_OFF, off)                                             \
+    X(OBS_DEEP_INTERVALS_AUTO, auto) /* on for method gtao, off for the VAO methods */
+typedef enum obs_deep_intervals {
+    OBS_DEEP_INTERVALS_DEFAULT,
+    OBS_DEEP_INTERVALS_LIST(OBS__ENUM_VALUE)
+} obs_deep_intervals;
+
+/* X(parameter, value): method gtao on deep input with intervals in
+ * effect (deep_intervals, facing flags, deep_mode multi) computes the
+ * slice integral of Jimenez et al. as written, over the free arcs to the
+ * AO distance D: the search radius D, a hard cut at it, no power, no
+ * heuristics (XeGTAO's defaults compensate for one depth layer of unknown
+ * thickness and 2 to 3 steps, which the intervals replace), with the steps
+ * at which the free-arc sum has converged.  Each parameter the request
+ * left unset takes its value here; an explicit one keeps its own. */
+#define OBS_DEEP_GTAO_EXACT(X)                                                 \
+    X(gtao_radius_multiplier, "1")                                             \
+    X(gtao_falloff, "1e-6")                                                    \
+    X(gtao_power, "1")                                                         \
+    X(gtao_heuristics, "off")                                                  \
+    X(gtao_steps, "16")
+
 /* What the VAO methods' AO measures (parameter `ao_definition`). */
 #define OBS_AO_DEFINITION_LIST(X)                                              \
     X(OBS_AO_RAYS, rays)     /* a ray tracer's AO within radius: R = 2 radius, eq 1's V converted */ \
@@ -184,7 +210,7 @@ typedef enum obs_baked_combine {
     X(deep_mode, OBS_DEEP_MODE_LIST)                                           \
     X(deep_front_half, OBS_SWITCH_LIST)                                        \
     X(deep_hull, OBS_DEEP_HULL_LIST)                                           \
-    X(deep_intervals, OBS_SWITCH_LIST)                                         \
+    X(deep_intervals, OBS_DEEP_INTERVALS_LIST)                                 \
     X(baked_combine, OBS_BAKED_COMBINE_LIST)                                   \
     X(multibounce, OBS_SWITCH_LIST)                                            \
     X(self_only, OBS_SWITCH_LIST)
@@ -404,7 +430,7 @@ typedef enum obs_baked_combine {
       "occluders and receivers weighted by alpha) or thin hulls (eqs 2-4: "    \
       "exterior and interior AO mixed by W(p), alpha or 1 - alpha on back "    \
       "faces)")                                                                \
-    X(deep_intervals, ENUM, "off", 0, 0, OBS_CHOICES(OBS_SWITCH_LIST),         \
+    X(deep_intervals, ENUM, "off", 0, 0, OBS_CHOICES(OBS_DEEP_INTERVALS_LIST), \
       "deep input with facing flags (channel Facing, as obscura gbuffer "      \
       "--deep writes), deep_mode multi, methods vaopp, vao and gtao: on, the " \
       "solid between a front face and its matching back face is an "           \

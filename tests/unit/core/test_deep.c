@@ -470,6 +470,101 @@ static void test_interval_lists(void **state)
     }
 }
 
+static void face_sample(float *s, float z, float facing, float tag)
+{
+    sample(s, z, 1.0f);
+    s[OBS_DEEP_FACING] = facing;
+    s[OBS_DEEP_R] = tag; /* which sample a kept node came from */
+}
+
+/* Eq 5 with intervals never splits one.  A plate (front face 1, back face
+ * 1.1), a box (3 .. 3.5) and a wall seen from its front (6, no back face),
+ * opaque, m = 3: eq 5 drops the farthest node; without intervals the box's
+ * back face goes and its front face stays with nothing behind it closed,
+ * solid to infinity ([1, 1.1, 3]); with intervals the box goes whole
+ * ([1, 1.1, 6]: the plate and the wall, as obs__deep_intervals reads
+ * them).  Lists without facing flags: the same as without intervals.
+ * Random lists (nested and disjoint boxes, one-sided faces, random alpha
+ * and insertion order): every kept node that has a partner in the whole
+ * list keeps it. */
+static void test_compress_intervals(void **state)
+{
+    (void)state;
+    float in[32 * OBS_DEEP_CH], out[OBS_DEEP_MAX_LAYERS * OBS_DEEP_CH], ref[OBS_DEEP_MAX_LAYERS * OBS_DEEP_CH];
+    const float z[5] = {1, 1.1f, 3, 3.5f, 6}, f[5] = {1, -1, 1, -1, 1};
+    for (int k = 0; k < 5; k++)
+        face_sample(in + k * OBS_DEEP_CH, z[k], f[k], (float)k);
+    const float without[3] = {1, 1.1f, 3}, with[3] = {1, 1.1f, 6};
+    assert_int_equal(obs__deep_compress_list(in, 5, 3, 0, 0, 0.1f, 1000.0f, out), 3);
+    for (int k = 0; k < 3; k++)
+        assert_float_equal(out[k * OBS_DEEP_CH + OBS_DEEP_Z], without[k], 0);
+    assert_int_equal(obs__deep_compress_list(in, 5, 3, 0, 1, 0.1f, 1000.0f, out), 3);
+    for (int k = 0; k < 3; k++)
+        assert_float_equal(out[k * OBS_DEEP_CH + OBS_DEEP_Z], with[k], 0);
+    float zk[3], fk[3], e[3];
+    for (int k = 0; k < 3; k++) {
+        zk[k] = out[k * OBS_DEEP_CH + OBS_DEEP_Z];
+        fk[k] = out[k * OBS_DEEP_CH + OBS_DEEP_FACING];
+    }
+    obs__deep_intervals(zk, fk, 3, e);
+    assert_float_equal(e[0], 1.1f, 0); /* the plate closed */
+    assert_float_equal(e[2], 0.0f, 0); /* the wall solid behind */
+    /* no facing flags: bit for bit the list without intervals */
+    for (int k = 0; k < 5; k++)
+        in[k * OBS_DEEP_CH + OBS_DEEP_FACING] = 0.0f;
+    assert_int_equal(obs__deep_compress_list(in, 5, 3, 0, 1, 0.1f, 1000.0f, out), 3);
+    assert_int_equal(obs_deep_compress_list(in, 5, 3, 0, 0.1f, 1000.0f, ref), 3);
+    assert_memory_equal(out, ref, 3 * OBS_DEEP_CH * sizeof(float));
+
+    unsigned rng = 12345u;
+#define RND() ((rng = rng * 1103515245u + 12345u) >> 16 & 0x7fff)
+    for (int trial = 0; trial < 500; trial++) {
+        int n = 0, partner[32];
+        float depth = 1.0f;
+        while (n < 24) { /* a box, a box in a box, or a one-sided face */
+            int kind = RND() % 4;
+            if (kind == 0) {
+                face_sample(in + n * OBS_DEEP_CH, depth, RND() % 2 ? 1.0f : -1.0f, (float)n);
+                partner[n++] = -1;
+            } else if (kind == 1 && n + 4 <= 32) {
+                face_sample(in + n * OBS_DEEP_CH, depth, 1, (float)n);
+                face_sample(in + (n + 1) * OBS_DEEP_CH, depth + 0.1f, 1, (float)(n + 1));
+                face_sample(in + (n + 2) * OBS_DEEP_CH, depth + 0.2f, -1, (float)(n + 2));
+                face_sample(in + (n + 3) * OBS_DEEP_CH, depth + 0.3f, -1, (float)(n + 3));
+                partner[n] = n + 3, partner[n + 3] = n, partner[n + 1] = n + 2, partner[n + 2] = n + 1;
+                n += 4;
+            } else {
+                face_sample(in + n * OBS_DEEP_CH, depth, 1, (float)n);
+                face_sample(in + (n + 1) * OBS_DEEP_CH, depth + 0.2f, -1, (float)(n + 1));
+                partner[n] = n + 1, partner[n + 1] = n;
+                n += 2;
+            }
+            depth += 0.5f + (float)(RND() % 100) / 50.0f;
+        }
+        for (int k = 0; k < n; k++)
+            in[k * OBS_DEEP_CH + OBS_DEEP_A] = (float)(1 + RND() % 100) / 100.0f;
+        for (int k = n - 1; k > 0; k--) { /* shuffle the insertion order */
+            int j = (int)(RND() % (unsigned)(k + 1));
+            float t[OBS_DEEP_CH];
+            memcpy(t, in + k * OBS_DEEP_CH, sizeof t);
+            memcpy(in + k * OBS_DEEP_CH, in + j * OBS_DEEP_CH, sizeof t);
+            memcpy(in + j * OBS_DEEP_CH, t, sizeof t);
+        }
+        int m = 1 + (int)(RND() % 8), c = obs__deep_compress_list(in, n, m, (int)(RND() % 2), 1,
+                                                                   0.1f, 100.0f, out);
+        assert_true(c >= 0 && c <= m);
+        for (int k = 0; k < c; k++) {
+            int tag = (int)out[k * OBS_DEEP_CH + OBS_DEEP_R], found = partner[tag] < 0;
+            for (int j = 0; j < c && !found; j++)
+                found = (int)out[j * OBS_DEEP_CH + OBS_DEEP_R] == partner[tag];
+            if (!found)
+                fail_msg("trial %d, m %d: node %d (z %g) kept without its partner", trial, m,
+                         tag, out[k * OBS_DEEP_CH + OBS_DEEP_Z]);
+        }
+    }
+#undef RND
+}
+
 /* The wall pixel beside the slab: its tangent sphere (R = 1 at depth 10
  * in this frame: the pipes span depths 8 .. 10).  A thin plate 7.5 .. 7.6
  * lies wholly in front of it:
@@ -621,6 +716,17 @@ static obs_params gtao_params(int mode, const char *intervals)
     return p;
 }
 
+/* p with the rows gtao on deep input takes with intervals
+ * (OBS_DEEP_GTAO_EXACT) given explicitly */
+static obs_params gtao_exact(obs_params p)
+{
+    char err[OBS_ERR_LEN] = "";
+#define SET_ROW(name, value) assert_int_equal(obs_param_set(&p, #name, value, err), OBS_OK);
+    OBS_DEEP_GTAO_EXACT(SET_ROW)
+#undef SET_ROW
+    return p;
+}
+
 /* the largest |a - b| over the front AO of every pixel */
 static double ao_diff(const obs_deep_image *d, const obs_params *a, const obs_params *b)
 {
@@ -665,19 +771,39 @@ static void test_gtao_intervals(void **state)
                 synth_face(&d, x, y, 9.3f, 1.0f);
             synth_face(&d, x, y, 10.0f, 1.0f);
         }
-    double same = ao_diff(&d, &on, &off);
+    /* with intervals gtao takes the exact rows where unset; off, single
+     * keep XeGTAO's defaults: compared with the same parameters */
+    obs_params off_x = gtao_exact(off), single_x = gtao_exact(single);
+    double same = ao_diff(&d, &on, &off_x);
     print_message("gtao, one-sided surfaces: max |intervals - off| %.2e\n", same);
     assert_true(same == 0.0);
     obs_deep_free(&d);
 
-    /* the closed box flush with the wall: as the flat buffer */
+    /* the closed box flush with the wall: as the flat buffer with the
+     * same parameters (single: the flat chain to the bit, test_gtao_deep) */
     slab_scene(&d, 9.3f, 10.0f);
-    double box = fmax(ao_diff(&d, &on, &off), ao_diff(&d, &on, &single));
+    double box = fmax(ao_diff(&d, &on, &off_x), ao_diff(&d, &on, &single_x));
     float crease = ao_at(&d, &on, 15, 16, NULL);
     print_message("gtao, closed box: max |intervals - off, single| %.2e (AO beside it %.3f)\n", box,
                   crease);
     assert_true(box < 1e-5);
     assert_true(crease < 0.95f); /* the crease is there */
+
+    /* the defaults with intervals are the exact rows, bit for bit; a
+     * parameter given explicitly wins; auto is on for gtao */
+    obs_params on_x = gtao_exact(on), on_p = on, aut = gtao_params(OBS_DEEP_MULTI, "auto");
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_param_set(&on_p, "gtao_power", "2.2", err), OBS_OK);
+    assert_true(ao_diff(&d, &on, &on_x) == 0.0);
+    assert_true(ao_diff(&d, &on, &aut) == 0.0);
+    assert_true(ao_diff(&d, &on, &on_p) > 1e-3);
+    obs_params r;
+    obs_deep_params_resolve(&d, &on_p, &r);
+    assert_float_equal(r.gtao_power, 2.2f, 0);
+    assert_float_equal(r.gtao_radius_multiplier, 1.0f, 0);
+    assert_int_equal(r.gtao_heuristics, OBS_OFF);
+    obs_deep_params_resolve(&d, &off, &r); /* off: XeGTAO's defaults */
+    assert_float_equal(r.gtao_radius_multiplier, 1.457f, 1e-6);
     obs_deep_free(&d);
 }
 
@@ -1155,6 +1281,7 @@ int main(void)
         cmocka_unit_test(test_compress_eq5),
         cmocka_unit_test(test_hidden_occluder),
         cmocka_unit_test(test_interval_lists),
+        cmocka_unit_test(test_compress_intervals),
         cmocka_unit_test(test_intervals),
         cmocka_unit_test(test_gtao_deep),
         cmocka_unit_test(test_hbao_deep),

@@ -169,6 +169,9 @@ static void test_quality_presets(void **state)
         assert_int_equal(obs_param_set(&t, #name, value, err), OBS_OK);        \
     }
     OBS_QUALITY_PRESETS(ROW_PARSES)
+#define EXACT_PARSES(name, value) ROW_PARSES(0, name, value)
+    OBS_DEEP_GTAO_EXACT(EXACT_PARSES) /* the rows of deep gtao with intervals */
+#undef EXACT_PARSES
 #undef ROW_PARSES
     obs_params p = {0}, r, d;
     obs_params_resolve(NULL, &d);
