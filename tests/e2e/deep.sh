@@ -125,6 +125,31 @@ fi
 "$OBSCURA" ao "$D" --output both --deep-layers 3 -o "$T/again.exr" --server "unix:$SOCK" -q 2>/dev/null
 check "still serving after the bad deep frames: same bytes" "cmp -s '$T/local.exr' '$T/again.exr' && kill -0 $PID"
 
+echo "-- gtao on a deep G-buffer with facing flags: the exact slice integral by default"
+# a wall and a thin plate in front of it, closed boxes (front and back faces)
+box() { # x0 x1 y0 y1 z0 z1 first-vertex-index
+    for x in $1 $2; do for y in $3 $4; do for z in $5 $6; do echo "v $x $y $z"; done; done; done
+    b=$7
+    echo "f $b $((b + 1)) $((b + 3)) $((b + 2))"; echo "f $((b + 4)) $((b + 6)) $((b + 7)) $((b + 5))"
+    echo "f $b $((b + 4)) $((b + 5)) $((b + 1))"; echo "f $((b + 2)) $((b + 3)) $((b + 7)) $((b + 6))"
+    echo "f $b $((b + 2)) $((b + 6)) $((b + 4))"; echo "f $((b + 1)) $((b + 5)) $((b + 7)) $((b + 3))"
+}
+{ box -3 3 -2 2 -5.1 -5 1; box -0.5 0.5 -0.5 0.5 -4.72 -4.7 9; } >"$T/plate.obj"
+echo '{"width": 64, "height": 48, "fov_y_deg": 55, "near": 0.05, "far": 100,
+ "world_to_camera": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}' >"$T/plate.camera.json"
+if "$OBSCURA" gbuffer "$T/plate.obj" --camera "$T/plate.camera.json" --deep -o "$T/plate.exr" -q 2>"$T/err"; then
+    "$OBSCURA" ao "$T/plate.exr" --method gtao --radius 0.5 -o "$T/g.exr" 2>"$T/err"
+    check "deep gtao, deep_intervals auto: the exact integral's 32 steps" "grep -q 'gtao 3 slices x 32 steps' '$T/err'"
+    "$OBSCURA" ao "$T/plate.exr" --method gtao --radius 0.5 --gtao-steps 5 -o "$T/g5.exr" 2>"$T/err"
+    check "an explicit --gtao-steps wins" "grep -q 'gtao 3 slices x 5 steps' '$T/err'"
+    "$OBSCURA" ao "$T/plate.exr" --method gtao --radius 0.5 --deep-intervals off -o "$T/g0.exr" 2>"$T/err"
+    check "--deep-intervals off: XeGTAO's defaults" "grep -q 'gtao 3 slices x 3 steps' '$T/err'"
+    "$OBSCURA" ao "$T/plate.exr" --method gtao --radius 0.5 -o "$T/gr.exr" --server "unix:$SOCK" -q 2>/dev/null
+    check "the daemon resolves the same defaults: same bytes" "cmp -s '$T/g.exr' '$T/gr.exr' && ! cmp -s '$T/g.exr' '$T/g0.exr'"
+else
+    skip "gbuffer --deep: $(tail -n 1 "$T/err")"
+fi
+
 kill -TERM "$PID"
 k=0
 while [ $k -lt 100 ] && kill -0 "$PID" 2>/dev/null; do sleep 0.1; k=$((k + 1)); done

@@ -797,6 +797,20 @@ static void test_gtao_intervals(void **state)
     assert_true(ao_diff(&d, &on, &on_x) == 0.0);
     assert_true(ao_diff(&d, &on, &aut) == 0.0);
     assert_true(ao_diff(&d, &on, &on_p) > 1e-3);
+    obs_deep_free(&d);
+
+    /* a strip 1.2 in front of the wall (D = 1): no ray from the wall
+     * beside it meets it within D.  With the defaults the search stops at
+     * D: the wall beside it is open, AO 1 (no halo); XeGTAO's defaults
+     * (without intervals) search 1.457 D with a soft falloff and darken
+     * it. */
+    strip_scene(&d, 8.7f, 8.8f, 16, 18);
+    float far_open = ao_at(&d, &on, 4, 16, NULL), far_on = ao_at(&d, &on, 15, 16, NULL);
+    float far_off = ao_at(&d, &off_x, 15, 16, NULL), far_xe = ao_at(&d, &off, 15, 16, NULL);
+    print_message("gtao, strip beyond D: AO open %.4f, defaults %.4f, no intervals %.4f, XeGTAO's "
+                  "defaults %.4f\n", far_open, far_on, far_off, far_xe);
+    assert_true(far_on > 1.0f - 1e-5f && far_on >= far_open);
+    assert_true(far_xe < far_on - 0.03f);
     obs_params r;
     obs_deep_params_resolve(&d, &on_p, &r);
     assert_float_equal(r.gtao_power, 2.2f, 0);
@@ -1095,6 +1109,16 @@ static void test_gl_twin(void **state)
     slab_scene_free_and(&d, 8.6f, 8.7f);
     assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
     compare_gl(ctx, &d, &p, "thin plate, gtao, intervals, m = 2");
+    obs_deep_free(&d);
+    /* the defaults (deep_intervals auto: intervals and the exact rows) on
+     * a strip before the wall, lists longer than m = 2: the compression
+     * drops whole intervals on both paths */
+    strip_scene(&d, 9.3f, 9.4f, 12, 15);
+    p = deep_params(OBS_DEEP_MULTI);
+    assert_int_equal(obs_param_set(&p, "method", "gtao", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "thin strip, gtao, defaults");
+    assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "thin strip, gtao, defaults, m = 2");
     obs_deep_free(&d);
     obs_ctx_destroy(ctx);
 }
