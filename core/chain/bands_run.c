@@ -312,14 +312,18 @@ static obs_status band_run(obs__cpu_run *c, obs__plan *pl, const band *b, obs_pa
 
 size_t obs_cpu_memory_budget(const obs_cpu_options *opt) { return obs__bands_budget(opt); }
 
+size_t obs_cpu_memory_physical(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    return pages > 0 && page > 0 ? (size_t)pages * (size_t)page : 0;
+}
+
 size_t obs__bands_budget(const obs_cpu_options *opt)
 {
     if (opt && opt->max_memory > 0)
         return opt->max_memory;
-    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-    if (pages <= 0 || page <= 0)
-        return (size_t)1 << 31; /* not known: 2 GiB */
-    return (size_t)pages / 4 * (size_t)page; /* a quarter of the memory */
+    size_t phys = obs_cpu_memory_physical();
+    return phys ? phys / 4 : (size_t)1 << 31; /* a quarter of the memory; not known: 2 GiB */
 }
 
 int obs__bands_rows(obs__cpu_run *c, const obs_cpu_options *opt)
@@ -348,6 +352,20 @@ static void band_log(const obs_cpu_options *opt, int k, const band *b, int H, si
     snprintf(msg, sizeof msg, "band %d: rows %d-%d of %d (holds rows %d-%d, %.1f MiB of planes)", k,
              b->c0, b->c1, H, b->a0, b->a1, (double)bytes / 1048576.0);
     opt->log(opt->log_user, OBS_LOG_INFO, msg);
+}
+
+/* Said once a frame: a band as tall as its halo is over the budget (the
+ * budget's name as the caller gave it). */
+static void over_budget_log(const obs_cpu_options *opt, int halo, size_t need, size_t budget)
+{
+    if (!opt || !opt->log)
+        return;
+    char msg[320];
+    snprintf(msg, sizeof msg, "%s: the AO's samples reach %d rows either side at this depth: a band "
+             "holds %.1f MiB of planes, over the %.1f MiB the budget leaves them",
+             opt->max_memory_name ? opt->max_memory_name : "the memory budget", halo,
+             (double)need / 1048576.0, (double)budget / 1048576.0);
+    opt->log(opt->log_user, OBS_LOG_WARN, msg);
 }
 
 /* What a band does before and after its passes: nothing for a frame in
@@ -390,19 +408,14 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
                  * as the halo (over the budget), so that each band's prep
                  * runs over at most three times its rows, not over a
                  * halo many times a thin band's rows */
-                if (!warned++ && opt && opt->log) {
-                    char msg[224];
-                    snprintf(msg, sizeof msg, "the AO's samples reach %d rows either side: a band "
-                             "holds more than the memory budget (%.0f MiB of planes)", halo,
-                             (double)budget / 1048576.0);
-                    opt->log(opt->log_user, OBS_LOG_WARN, msg);
-                }
                 int m = halo > OBS__BANDS_MIN_ROWS ? halo : OBS__BANDS_MIN_ROWS;
                 if (m < n) {
                     n = m;
                     band_plan(pl, reach, c0, c0 + n < H ? c0 + n : H, &b);
                     band_rows_of(c, &b);
                 }
+                if (!warned++)
+                    over_budget_log(opt, halo, obs__cpu_planes_need(c), budget);
                 break;
             }
             n /= 2;

@@ -310,6 +310,10 @@ typedef struct obs_cpu_options {
     size_t max_memory;
     /* > 0: bands of this many rows whatever the frame's size (tests) */
     int band_rows;
+    /* what set max_memory, as the warning of a band over the budget
+     * (through log) names it, e.g. "--max-memory 256 MiB"; NULL: "the
+     * memory budget" */
+    const char *max_memory_name;
 } obs_cpu_options;
 
 obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
@@ -318,6 +322,10 @@ obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, uns
 /* The memory budget of opt (NULL: the default): opt->max_memory, else a
  * quarter of the machine's physical memory. */
 size_t obs_cpu_memory_budget(const obs_cpu_options *opt);
+
+/* The machine's physical memory in bytes (what the default budget is a
+ * quarter of); 0 when not known. */
+size_t obs_cpu_memory_physical(void);
 
 /* A frame that is never whole in memory, on the CPU device: run in bands
  * of rows as obs_run_cpu_opts runs a frame over its memory budget (the
