@@ -267,6 +267,8 @@ void cli_max_memory(obs_cpu_options *o)
                                                               "machine's; --max-memory MIB sets it)";
 }
 
+int cli_max_memory_given(void) { return max_memory.name[0] == '-'; }
+
 const char *cli_max_memory_text(void)
 {
     size_t phys = obs_cpu_memory_physical();

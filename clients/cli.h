@@ -67,6 +67,9 @@ void cli_max_memory(obs_cpu_options *o);
  * "6038 MiB (default: a quarter of 23.6 GiB; --max-memory MIB sets it)". */
 const char *cli_max_memory_text(void);
 
+/* 1 when the budget came from --max-memory (not the environment). */
+int cli_max_memory_given(void);
+
 /* The threads this process runs now (/proc/self/task); -1 unknown. */
 int cli_process_threads(void);
 

@@ -1269,6 +1269,11 @@ static int cmd_ao(int argc, char **argv)
         a.cpu = 1;
     if (!server && !a.cpu)
         choose_device(&a);
+    static int said_budget; /* once a batch */
+    if ((server || !a.cpu) && cli_max_memory_given() && !said_budget++ && verbosity >= OBS_LOG_INFO)
+        fprintf(stderr, "obscura: info: --max-memory is the CPU device's budget: %s\n",
+                server ? "the frame runs on obscurad, whose own --max-memory applies"
+                       : "the frame runs on a GL context, whole");
     obs_limits lim = {0};
     if (a.max_size)
         lim.max_width = lim.max_height = (int)a.max_size;

@@ -354,15 +354,16 @@ static void band_log(const obs_cpu_options *opt, int k, const band *b, int H, si
     opt->log(opt->log_user, OBS_LOG_INFO, msg);
 }
 
-/* Said once a frame: a band as tall as its halo is over the budget (the
- * budget's name as the caller gave it). */
+/* Said once a frame, after its bands: bands as tall as their halo were
+ * over the budget; the largest halo and band (the budget's name as the
+ * caller gave it). */
 static void over_budget_log(const obs_cpu_options *opt, int halo, size_t need, size_t budget)
 {
     if (!opt || !opt->log)
         return;
     char msg[320];
-    snprintf(msg, sizeof msg, "%s: the AO's samples reach %d rows either side at this depth: a band "
-             "holds %.1f MiB of planes, over the %.1f MiB the budget leaves them",
+    snprintf(msg, sizeof msg, "%s: the AO's samples reach up to %d rows either side at this depth: "
+             "bands hold up to %.1f MiB of planes, over the %.1f MiB the budget leaves them",
              opt->max_memory_name ? opt->max_memory_name : "the memory budget", halo,
              (double)need / 1048576.0, (double)budget / 1048576.0);
     opt->log(opt->log_user, OBS_LOG_WARN, msg);
@@ -386,7 +387,8 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
     const int forced = opt && opt->band_rows > 0;
     const size_t budget = obs__bands_budget(opt);
     obs_status s = OBS_OK;
-    int warned = 0;
+    int over = 0, over_halo = 0; /* bands over the budget, their largest halo: said at the end */
+    size_t over_need = 0;
     for (int c0 = 0, k = 1; s == OBS_OK && c0 < H; k++) {
         int n = rows;
         band b;
@@ -414,13 +416,18 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
                     band_plan(pl, reach, c0, c0 + n < H ? c0 + n : H, &b);
                     band_rows_of(c, &b);
                 }
-                if (!warned++)
-                    over_budget_log(opt, halo, obs__cpu_planes_need(c), budget);
                 break;
             }
             n /= 2;
         }
-        band_log(opt, k, &b, H, obs__cpu_planes_need(c));
+        const size_t need = obs__cpu_planes_need(c);
+        if (!forced && need > budget) { /* its halo alone is too much */
+            const int halo = (b.a1 - b.a0 - (b.c1 - b.c0) + 1) / 2;
+            over++;
+            over_halo = halo > over_halo ? halo : over_halo;
+            over_need = need > over_need ? need : over_need;
+        }
+        band_log(opt, k, &b, H, need);
         if (io)
             s = io->in(io, c, &b, err);
         if (s == OBS_OK)
@@ -430,6 +437,8 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
         c0 = b.c1;
     }
     c->row0 = c->row1 = 0;
+    if (over)
+        over_budget_log(opt, over_halo, over_need, budget);
     return s;
 }
 

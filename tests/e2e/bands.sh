@@ -53,7 +53,7 @@ check "--max-memory 1: exit $rc, by rows, the whole frame's file" \
 check "--max-memory 1: the log names the budget and the option" \
     "grep -q 'over the memory budget of 1 MiB (--max-memory)' '$T/opt.log'"
 check "--max-memory 1, no -v: a warning names the option and the halo's rows" \
-    "grep -q \"^obscura: warning: --max-memory 1 MiB: the AO's samples reach [0-9]* rows either side\" '$T/opt.log'"
+    "grep -q \"^obscura: warning: --max-memory 1 MiB: the AO's samples reach up to [0-9]* rows either side\" '$T/opt.log'"
 OBSCURA_MAX_MEMORY=1 "$OBSCURA" ao "$R" --camera "$CAMJ" --backend cpu --max-memory 1000 -v -o "$T/over.exr" 2>"$T/over.log"
 rc=$?
 check "--max-memory 1000 over OBSCURA_MAX_MEMORY=1: exit $rc, the frame whole, the budget said with -v" \
@@ -95,6 +95,9 @@ check "obscurad: the band over the budget is a warning naming the option" \
     "grep -q \"warn: --max-memory 1 MiB: the AO's samples reach\" '$T/tiny.log'"
 check "obscurad without a budget: the start log says the default" \
     "grep -q 'memory budget: [0-9]* MiB a frame on the CPU device (default: a quarter of' '$T/whole.log'"
+expect 0 "obscura ao --server with --max-memory: the frame on obscurad" -- "$OBSCURA" ao "$R" --camera "$CAMJ" \
+    --server "http://127.0.0.1:$PORT_whole" --max-memory 1 -o "$T/remote.exr"
+said "the frame runs on obscurad, whose own --max-memory applies"
 kill "$PID_whole" "$PID_tiny" 2>/dev/null
 wait "$PID_whole" "$PID_tiny" 2>/dev/null
 expect 2 "obscurad --max-memory abc: refused" -- "$OBSCURAD" --http 127.0.0.1:0 --backend cpu --max-memory abc
