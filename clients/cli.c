@@ -240,7 +240,7 @@ int cli_take_max_memory(const char *cmd, int argc, char **argv)
         if (!given || !*given) /* set empty: as unset, as OBSCURA_THREADS */
             return n;
     }
-    const size_t phys_mib = obs_cpu_memory_physical() >> 20;
+    const size_t phys_mib = obs_cpu_memory_usable() >> 20;
     const long hi = phys_mib ? (long)phys_mib : 1L << 30;
     char shown[64], *end;
     cli_escape(given, shown, sizeof shown);
@@ -250,7 +250,7 @@ int cli_take_max_memory(const char *cmd, int argc, char **argv)
         cli_die_usage(cmd, "%s: '%s' is not a whole number of MiB from 1 to %ld (the memory the CPU "
                       "device's frames may hold; over it a frame runs in bands of rows)", from, shown, hi);
     if (mib > hi)
-        cli_die_usage(cmd, "%s: %s MiB is more than this machine's memory (%ld MiB)", from, shown, hi);
+        cli_die_usage(cmd, "%s: %s MiB is more than the usable memory (%ld MiB)", from, shown, hi);
     max_memory.bytes = (size_t)mib << 20;
     if (from[0] == '-')
         snprintf(max_memory.name, sizeof max_memory.name, "--max-memory %ld MiB", mib);
@@ -271,12 +271,12 @@ int cli_max_memory_given(void) { return max_memory.name[0] == '-'; }
 
 const char *cli_max_memory_text(void)
 {
-    size_t phys = obs_cpu_memory_physical();
+    size_t phys = obs_cpu_memory_usable();
     if (!max_memory.bytes && phys)
         snprintf(max_memory.text, sizeof max_memory.text, "%zu MiB (default: a quarter of %.1f GiB; "
                  "--max-memory MIB sets it)", obs_cpu_memory_budget(NULL) >> 20, (double)phys / 1073741824.0);
     else if (!max_memory.bytes)
-        snprintf(max_memory.text, sizeof max_memory.text, "%zu MiB (default: the machine's memory is not "
+        snprintf(max_memory.text, sizeof max_memory.text, "%zu MiB (default: the usable memory is not "
                  "known; --max-memory MIB sets it)", obs_cpu_memory_budget(NULL) >> 20);
     return max_memory.text;
 }

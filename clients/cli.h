@@ -53,9 +53,9 @@ int cli_take_threads(const char *cmd, int argc, char **argv);
  * may run on the CPU device, taken out of argv as cli_take_threads takes
  * --threads (the new argc returned): the budget of every such frame
  * (obs_cpu_options.max_memory; over it a frame runs in bands of rows).
- * MIB is a whole number from 1 to the machine's memory in MiB; anything
+ * MIB is a whole number from 1 to the usable memory in MiB; anything
  * else is a usage error of cmd naming the option (exit 2).  Neither
- * given: the library's default, a quarter of the machine's memory. */
+ * given: the library's default, a quarter of the usable memory. */
 int cli_take_max_memory(const char *cmd, int argc, char **argv);
 
 /* The budget taken (0: the default) and its name in o (max_memory,

@@ -1091,7 +1091,7 @@ done:
  *
  * On the CPU device, a flat EXR input whose working set (the input's
  * planes, the chain's, the result's) is over the memory budget
- * (OBSCURA_MAX_MEMORY MiB, else a quarter of the machine's memory; or
+ * (OBSCURA_MAX_MEMORY MiB, else a quarter of the usable memory; or
  * any size with OBSCURA_BAND_ROWS) is read by rows (the chain's planes
  * get the budget's share they have in the whole frame's working set), run in bands and
  * written by rows (obs_run_cpu_rows, obs_gbuffer_rows_*, obs_exr_rows_*):

@@ -255,7 +255,7 @@ obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *d
     const obsd_opt_info *mo = obsd_opt_find("max_memory");
     if (!cfg->max_memory)
         snprintf(w->max_memory_name, sizeof w->max_memory_name,
-                 "the memory budget (a quarter of the machine's; --max-memory MIB sets it)");
+                 "the memory budget (a quarter of the usable memory; --max-memory MIB sets it)");
     else
         snprintf(w->max_memory_name, sizeof w->max_memory_name, cfg->set[mo - obsd_opt_at(0)]
                  ? "--max-memory %d MiB" : "OBSCURA_MAX_MEMORY=%d MiB", cfg->max_memory);

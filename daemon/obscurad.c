@@ -170,14 +170,14 @@ static int max_memory(obsd_config *cfg)
         obs_status st = obsd_config_set(&tmp, "max_memory", env, err);
         if (st != OBS_OK || !tmp.max_memory) {
             obsd_log(OBSD_LOG_ERROR, "OBSCURA_MAX_MEMORY: %s", st != OBS_OK ? err :
-                     "'0' is not a budget (MiB from 1 to the machine's memory)");
+                     "'0' is not a budget (MiB from 1 to the usable memory)");
             return -1;
         }
         cfg->max_memory = tmp.max_memory;
     }
-    const long long phys = (long long)(obs_cpu_memory_physical() >> 20);
+    const long long phys = (long long)(obs_cpu_memory_usable() >> 20);
     if (phys && cfg->max_memory > phys) {
-        obsd_log(OBSD_LOG_ERROR, "%s: %d MiB is more than this machine's memory (%lld MiB)", from,
+        obsd_log(OBSD_LOG_ERROR, "%s: %d MiB is more than the usable memory (%lld MiB)", from,
                  cfg->max_memory, phys);
         return -1;
     }
@@ -194,7 +194,7 @@ static void log_max_memory(const obsd_config *cfg)
     else
         obsd_log(OBSD_LOG_INFO, "memory budget: %zu MiB a frame on the CPU device (default: a quarter "
                  "of %.1f GiB; --max-memory MIB sets it)", obs_cpu_memory_budget(NULL) >> 20,
-                 (double)obs_cpu_memory_physical() / 1073741824.0);
+                 (double)obs_cpu_memory_usable() / 1073741824.0);
 }
 
 /* The threads line: a farm slot's limit is kept only when it reached

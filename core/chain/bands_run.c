@@ -312,18 +312,13 @@ static obs_status band_run(obs__cpu_run *c, obs__plan *pl, const band *b, obs_pa
 
 size_t obs_cpu_memory_budget(const obs_cpu_options *opt) { return obs__bands_budget(opt); }
 
-size_t obs_cpu_memory_physical(void)
-{
-    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-    return pages > 0 && page > 0 ? (size_t)pages * (size_t)page : 0;
-}
 
 size_t obs__bands_budget(const obs_cpu_options *opt)
 {
     if (opt && opt->max_memory > 0)
         return opt->max_memory;
-    size_t phys = obs_cpu_memory_physical();
-    return phys ? phys / 4 : (size_t)1 << 31; /* a quarter of the memory; not known: 2 GiB */
+    size_t phys = obs_cpu_memory_usable();
+    return phys ? phys / 4 : (size_t)1 << 31; /* a quarter of the usable memory; not known: 2 GiB */
 }
 
 int obs__bands_rows(obs__cpu_run *c, const obs_cpu_options *opt)

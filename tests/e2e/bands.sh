@@ -59,14 +59,14 @@ rc=$?
 check "--max-memory 1000 over OBSCURA_MAX_MEMORY=1: exit $rc, the frame whole, the budget said with -v" \
     "[ $rc -eq 0 ] && ! grep -q 'by rows' '$T/over.log' && grep -q 'memory budget: 1000 MiB (--max-memory)' '$T/over.log'"
 "$OBSCURA" ao "$R" --camera "$CAMJ" --backend cpu -v -o "$T/def.exr" 2>"$T/def.log"
-check "no budget given: -v says the default, a quarter of the machine's memory" \
+check "no budget given: -v says the default, a quarter of the usable memory" \
     "grep -q 'memory budget: [0-9]* MiB (default: a quarter of' '$T/def.log'"
 expect 2 "--max-memory 0: usage error" -- "$OBSCURA" ao "$R" --backend cpu --max-memory 0 -o "$T/x.exr"
 said "ao: --max-memory: '0' is not a whole number of MiB from 1 to"
 expect 2 "--max-memory 12abc: usage error" -- "$OBSCURA" ao "$R" --backend cpu --max-memory 12abc -o "$T/x.exr"
 said "ao: --max-memory: '12abc' is not a whole number of MiB"
-expect 2 "--max-memory over the machine's memory: usage error" -- "$OBSCURA" ao "$R" --backend cpu --max-memory 999999999 -o "$T/x.exr"
-said "ao: --max-memory: 999999999 MiB is more than this machine's memory"
+expect 2 "--max-memory over the usable memory: usage error" -- "$OBSCURA" ao "$R" --backend cpu --max-memory 999999999 -o "$T/x.exr"
+said "ao: --max-memory: 999999999 MiB is more than the usable memory"
 expect 2 "OBSCURA_MAX_MEMORY=-5: usage error naming the variable" -- env OBSCURA_MAX_MEMORY=-5 "$OBSCURA" ao "$R" --backend cpu -o "$T/x.exr"
 said "ao: OBSCURA_MAX_MEMORY: '-5' is not a whole number of MiB"
 ln -s "$PWD/$R" "$T/in.0001.exr"
@@ -102,8 +102,8 @@ kill "$PID_whole" "$PID_tiny" 2>/dev/null
 wait "$PID_whole" "$PID_tiny" 2>/dev/null
 expect 2 "obscurad --max-memory abc: refused" -- "$OBSCURAD" --http 127.0.0.1:0 --backend cpu --max-memory abc
 said "option max_memory: 'abc' is not a number"
-expect 2 "obscurad --max-memory over the machine's memory: refused" -- "$OBSCURAD" --http 127.0.0.1:0 --backend cpu --max-memory 999999999
-said "max_memory: 999999999 MiB is more than this machine's memory"
+expect 2 "obscurad --max-memory over the usable memory: refused" -- "$OBSCURAD" --http 127.0.0.1:0 --backend cpu --max-memory 999999999
+said "max_memory: 999999999 MiB is more than the usable memory"
 expect 2 "obscurad OBSCURA_MAX_MEMORY=0: refused" -- env OBSCURA_MAX_MEMORY=0 "$OBSCURAD" --http 127.0.0.1:0 --backend cpu
 said "OBSCURA_MAX_MEMORY: '0' is not a budget"
 

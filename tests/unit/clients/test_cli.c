@@ -117,7 +117,7 @@ static void test_take_max_memory(void **state)
     cli_max_memory(&o);
     assert_true(o.max_memory == 0); /* the default */
     assert_non_null(strstr(cli_max_memory_text(), "default: a quarter of"));
-    assert_true(obs_cpu_memory_budget(&o) == obs_cpu_memory_physical() / 4);
+    assert_true(obs_cpu_memory_budget(&o) == obs_cpu_memory_usable() / 4);
 }
 
 int main(void)
