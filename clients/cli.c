@@ -178,19 +178,31 @@ static int threads_value(const char *v)
     return (int)n;
 }
 
-int cli_take_threads(const char *cmd, int argc, char **argv)
+/* Takes every --NAME VALUE (or --NAME=VALUE) out of argv, the last
+ * value in *given (NULL: none); a missing value is a usage error of cmd
+ * saying what the value is.  The new argc. */
+static int take_flag(const char *cmd, int argc, char **argv, const char *name, const char *what,
+                     const char **given)
 {
-    const char *given = NULL, *from = "--threads", *v;
+    const char *v;
     int n = 0;
+    *given = NULL;
     for (int i = 0; i < argc; i++) {
-        int k = cli_flag_value(argc, argv, &i, "threads", &v);
+        int k = cli_flag_value(argc, argv, &i, name, &v);
         if (k < 0)
-            cli_die_usage(cmd, "option --threads needs a value (a whole number in [0, 64], 0: every core)");
+            cli_die_usage(cmd, "option --%s needs a value (%s)", name, what);
         if (k > 0)
-            given = v;
+            *given = v;
         else
             argv[n++] = argv[i];
     }
+    return n;
+}
+
+int cli_take_threads(const char *cmd, int argc, char **argv)
+{
+    const char *given, *from = "--threads";
+    int n = take_flag(cmd, argc, argv, "threads", "a whole number in [0, 64], 0: every core", &given);
     if (!given) {
         given = getenv("OBSCURA_THREADS");
         from = "OBSCURA_THREADS";
@@ -206,6 +218,67 @@ int cli_take_threads(const char *cmd, int argc, char **argv)
     if (obs_threads_set(t, err) != OBS_OK)
         cli_die_usage(cmd, "%s: %s", from, err);
     return n;
+}
+
+/* The budget of this process's CPU frames: bytes (0: the default), the
+ * name the band warning gives it, the -v text. */
+static struct {
+    size_t bytes;
+    char name[96], text[160];
+} max_memory;
+
+int cli_take_max_memory(const char *cmd, int argc, char **argv)
+{
+    const char *given, *from = "--max-memory";
+    int n = take_flag(cmd, argc, argv, "max-memory", "MiB the CPU device's frames may hold", &given);
+    max_memory.bytes = 0;
+    max_memory.name[0] = 0;
+    max_memory.text[0] = 0;
+    if (!given) {
+        given = getenv("OBSCURA_MAX_MEMORY");
+        from = "OBSCURA_MAX_MEMORY";
+        if (!given || !*given) /* set empty: as unset, as OBSCURA_THREADS */
+            return n;
+    }
+    const size_t phys_mib = obs_cpu_memory_usable() >> 20;
+    const long hi = phys_mib ? (long)phys_mib : 1L << 30;
+    char shown[64], *end;
+    cli_escape(given, shown, sizeof shown);
+    errno = 0;
+    long mib = strtol(given, &end, 10);
+    if (!*given || *end || errno || given[0] == '+' || given[0] == ' ' || mib < 1)
+        cli_die_usage(cmd, "%s: '%s' is not a whole number of MiB from 1 to %ld (the memory the CPU "
+                      "device's frames may hold; over it a frame runs in bands of rows)", from, shown, hi);
+    if (mib > hi)
+        cli_die_usage(cmd, "%s: %s MiB is more than the usable memory (%ld MiB)", from, shown, hi);
+    max_memory.bytes = (size_t)mib << 20;
+    if (from[0] == '-')
+        snprintf(max_memory.name, sizeof max_memory.name, "--max-memory %ld MiB", mib);
+    else
+        snprintf(max_memory.name, sizeof max_memory.name, "OBSCURA_MAX_MEMORY=%ld MiB", mib);
+    snprintf(max_memory.text, sizeof max_memory.text, "%ld MiB (%s)", mib, from);
+    return n;
+}
+
+void cli_max_memory(obs_cpu_options *o)
+{
+    o->max_memory = max_memory.bytes;
+    o->max_memory_name = max_memory.bytes ? max_memory.name : "the memory budget (a quarter of the "
+                                                              "machine's; --max-memory MIB sets it)";
+}
+
+int cli_max_memory_given(void) { return max_memory.name[0] == '-'; }
+
+const char *cli_max_memory_text(void)
+{
+    size_t phys = obs_cpu_memory_usable();
+    if (!max_memory.bytes && phys)
+        snprintf(max_memory.text, sizeof max_memory.text, "%zu MiB (default: a quarter of %.1f GiB; "
+                 "--max-memory MIB sets it)", obs_cpu_memory_budget(NULL) >> 20, (double)phys / 1073741824.0);
+    else if (!max_memory.bytes)
+        snprintf(max_memory.text, sizeof max_memory.text, "%zu MiB (default: the usable memory is not "
+                 "known; --max-memory MIB sets it)", obs_cpu_memory_budget(NULL) >> 20);
+    return max_memory.text;
 }
 
 int cli_process_threads(void)

@@ -4,6 +4,7 @@
 #define OBSCURA_CLIENT_CLI_H
 
 #include "obscura/bake.h"
+#include "obscura/obscura.h"
 #include "obscura/status.h"
 
 /* Process exit codes of every command: 3 is bad input (retrying will not
@@ -47,6 +48,27 @@ void cli_progress_percent(int *last, long done, long total);
  * LP_NUM_THREADS, unless the user set that).  N is a whole number in
  * [0, 64] (0: every core); anything else is a usage error of cmd (exit 2). */
 int cli_take_threads(const char *cmd, int argc, char **argv);
+
+/* --max-memory MIB (else OBSCURA_MAX_MEMORY) of a command whose frames
+ * may run on the CPU device, taken out of argv as cli_take_threads takes
+ * --threads (the new argc returned): the budget of every such frame
+ * (obs_cpu_options.max_memory; over it a frame runs in bands of rows).
+ * MIB is a whole number from 1 to the usable memory in MiB; anything
+ * else is a usage error of cmd naming the option (exit 2).  Neither
+ * given: the library's default, a quarter of the usable memory. */
+int cli_take_max_memory(const char *cmd, int argc, char **argv);
+
+/* The budget taken (0: the default) and its name in o (max_memory,
+ * max_memory_name: the band warning says what set it). */
+void cli_max_memory(obs_cpu_options *o);
+
+/* The budget in use and where it came from, for -v and obscura info:
+ * "256 MiB (--max-memory)", "... (OBSCURA_MAX_MEMORY)", or the default's
+ * "6038 MiB (default: a quarter of 23.6 GiB; --max-memory MIB sets it)". */
+const char *cli_max_memory_text(void);
+
+/* 1 when the budget came from --max-memory (not the environment). */
+int cli_max_memory_given(void);
 
 /* The threads this process runs now (/proc/self/task); -1 unknown. */
 int cli_process_threads(void);

@@ -116,6 +116,9 @@ static const cli_opt ao_opts[] = {
     {"cpu", NULL, "the same as --backend cpu"},
     {"threads", "N", "the threads this process may run, 1..64 (or OBSCURA_THREADS; default every "
      "core): llvmpipe's (LP_NUM_THREADS, unless set) and every worker pool's"},
+    {"max-memory", "MIB", "the memory a frame on the CPU device may hold, in MiB (or "
+     "OBSCURA_MAX_MEMORY; default a quarter of the machine's): over it the frame runs in bands of "
+     "rows, the same result (README \"Frames larger than memory\")"},
     {"server", "URL[,URL...]", "run on obscurad: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT; a "
      "comma list spreads frames over several (the next one when one is busy or down)"},
     {"stream", "NAME", "with an http:// --server: post the frame to the daemon's stream NAME too "
@@ -141,7 +144,7 @@ static const struct {
     {"inspect", "  obscura inspect IN.exr [--json] [--preset P] [--depth-mode M] ...\n"
                 "                  what obscura reads: renderer, channels, camera and its source,\n"
                 "                  conventions, windows, part, sanity warnings\n"},
-    {"info", "  obscura info [--backend B] [--threads N]\n"},
+    {"info", "  obscura info [--backend B] [--threads N] [--max-memory MIB]\n"},
     {"params", "  obscura params [--markdown]\n"},
     {"samples", "  obscura samples [--c]            the sample sets (VAO++ 4.5); --c: as "
                 "core/chain/sample_tables.c\n"},
@@ -923,29 +926,26 @@ static int read_baked(const ao_args *a, const obs_limits *lim, const obs_gbuffer
     return EXIT_OK;
 }
 
-/* The CPU device's memory budget for the chain's planes, from
- * OBSCURA_MAX_MEMORY (MiB; over it the frame runs in bands of rows), and
- * OBSCURA_BAND_ROWS (bands of that many rows whatever the size: tests,
- * benchmarks); a value that is not a positive count is said and left
- * out (the default: a quarter of the machine's memory, whole frames). */
-static void cpu_bands_from_env(obs_cpu_options *o)
+/* The CPU device's memory budget for the chain's planes: --max-memory
+ * (else OBSCURA_MAX_MEMORY; main took it: cli_take_max_memory; over it
+ * the frame runs in bands of rows), and OBSCURA_BAND_ROWS (bands of that
+ * many rows whatever the size: tests, benchmarks), which is left out,
+ * said, when it is not a positive count.  Said with -v once a process. */
+static void cpu_bands_opts(obs_cpu_options *o)
 {
-    static const char *const names[] = {"OBSCURA_MAX_MEMORY", "OBSCURA_BAND_ROWS"};
-    for (int k = 0; k < 2; k++) {
-        const char *v = getenv(names[k]);
-        if (!v || !*v)
-            continue;
-        char *end;
-        long n = strtol(v, &end, 10);
-        if (*end || n <= 0 || n > (k == 0 ? 1L << 30 : 1L << 20)) {
-            fprintf(stderr, "obscura: warning: %s=%s is not a positive count; left out\n", names[k], v);
-            continue;
-        }
-        if (k == 0)
-            o->max_memory = (size_t)n << 20;
-        else
-            o->band_rows = (int)n;
-    }
+    static int said;
+    cli_max_memory(o);
+    if (!said++ && verbosity >= OBS_LOG_DEBUG)
+        fprintf(stderr, "obscura: debug: memory budget: %s\n", cli_max_memory_text());
+    const char *v = getenv("OBSCURA_BAND_ROWS");
+    if (!v || !*v)
+        return;
+    char *end;
+    long n = strtol(v, &end, 10);
+    if (*end || n <= 0 || n > 1L << 20)
+        fprintf(stderr, "obscura: warning: OBSCURA_BAND_ROWS=%s is not a positive count; left out\n", v);
+    else
+        o->band_rows = (int)n;
 }
 
 /* The chain on the CPU twin, on obscurad (--server) or on a GL context
@@ -957,7 +957,7 @@ static int run_frame(const ao_args *a, obs_gbuffer_file *gf, unsigned outputs, c
     obs_status s;
     if (a->cpu) {
         obs_cpu_options o = {.log = log_cb};
-        cpu_bands_from_env(&o);
+        cpu_bands_opts(&o);
         s = obs_run_cpu_opts(&gf->gb, &a->req.params, outputs, res, &o, err);
     } else if (server) { /* clients/remote.c prints its own errors */
         return cli_remote_run(server, argc, argv, a->in, &gf->gb, outputs, half_answer(a) && !combined, res);
@@ -1091,7 +1091,7 @@ done:
  *
  * On the CPU device, a flat EXR input whose working set (the input's
  * planes, the chain's, the result's) is over the memory budget
- * (OBSCURA_MAX_MEMORY MiB, else a quarter of the machine's memory; or
+ * (OBSCURA_MAX_MEMORY MiB, else a quarter of the usable memory; or
  * any size with OBSCURA_BAND_ROWS) is read by rows (the chain's planes
  * get the budget's share they have in the whole frame's working set), run in bands and
  * written by rows (obs_run_cpu_rows, obs_gbuffer_rows_*, obs_exr_rows_*):
@@ -1141,11 +1141,12 @@ static double whole_bytes_per_px(const obs_gbuffer *gb, unsigned outputs)
     return in + 56.0 + out;
 }
 
-/* OBSCURA_MAX_MEMORY's budget, else the library's default. */
+/* --max-memory's budget (or OBSCURA_MAX_MEMORY's), else the library's
+ * default. */
 static double memory_budget(void)
 {
     obs_cpu_options o = {0};
-    cpu_bands_from_env(&o);
+    cli_max_memory(&o);
     return (double)obs_cpu_memory_budget(&o);
 }
 
@@ -1198,16 +1199,18 @@ static int ao_rows(ao_args *a, const obs_limits *lim)
         meta.gb.color = (obs_plane){NULL, 0, 0};
     }
     if (verbosity >= OBS_LOG_INFO)
-        fprintf(stderr, "obscura: info: %dx%d needs about %.0f MiB read whole: read, run and written by "
-                        "rows (the input's sanity checks, which read the whole frame, are left out)\n",
-                meta.gb.width, meta.gb.height, need / 1048576.0);
+        fprintf(stderr, "obscura: info: %dx%d needs about %.0f MiB read whole, %s %s: read, run and "
+                        "written by rows (the input's sanity checks, which read the whole frame, are left "
+                        "out)\n", meta.gb.width, meta.gb.height, need / 1048576.0,
+                forced && *forced ? "bands asked by" : "over the memory budget of",
+                forced && *forced ? "OBSCURA_BAND_ROWS" : cli_max_memory_text());
     obs_exr_source src = {.path = a->in, .part = meta.info.part};
     obs_provenance prov = provenance_of(a);
     j.o = (obs_exr_options){.pixel = a->req.float_exr ? OBS_EXR_FLOAT : OBS_EXR_HALF, .cam = &cam, .src = &src,
                             .prov = &prov, .compression = (obs_exr_compression)a->req.compression};
     j.height = meta.gb.height;
     obs_cpu_options o = {.log = log_cb};
-    cpu_bands_from_env(&o);
+    cpu_bands_opts(&o);
     /* the budget is the frame's: the chain's planes get their share of it
      * (the rows of the input and of the result the rest) */
     o.max_memory = (size_t)(memory_budget() * 56.0 / whole_bytes_per_px(&meta.gb, a->req.outputs));
@@ -1266,6 +1269,11 @@ static int cmd_ao(int argc, char **argv)
         a.cpu = 1;
     if (!server && !a.cpu)
         choose_device(&a);
+    static int said_budget; /* once a batch */
+    if ((server || !a.cpu) && cli_max_memory_given() && !said_budget++ && verbosity >= OBS_LOG_INFO)
+        fprintf(stderr, "obscura: info: --max-memory is the CPU device's budget: %s\n",
+                server ? "the frame runs on obscurad, whose own --max-memory applies"
+                       : "the frame runs on a GL context, whole");
     obs_limits lim = {0};
     if (a.max_size)
         lim.max_width = lim.max_height = (int)a.max_size;
@@ -1317,7 +1325,8 @@ static void batch_finish(void)
 }
 
 /* info's thread lines: the limit, llvmpipe's count and where it came
- * from, and the threads running now that the context exists. */
+ * from, and the threads running now that the context exists; then the
+ * CPU device's memory budget and where it came from. */
 static void print_threads(int llvmpipe)
 {
     obs_threads_info ti;
@@ -1334,6 +1343,7 @@ static void print_threads(int llvmpipe)
         printf("llvmpipe threads: %d (LP_NUM_THREADS %s)\n", ti.llvmpipe,
                ti.llvmpipe_from_user ? "from the environment, kept" : "set from --threads");
     printf("process threads: %d\n", cli_process_threads());
+    printf("memory budget (CPU device): %s\n", cli_max_memory_text());
 }
 
 static int cmd_info(int argc, char **argv)
@@ -1654,19 +1664,20 @@ static const struct {
     const char *name;
     int (*run)(int argc, char **argv);
     int threads; /* takes --threads (cli_take_threads): it renders, bakes or reads images */
+    int memory;  /* takes --max-memory (cli_take_max_memory): its frames may run on the CPU device */
 } commands[] = {
-    {"ao", cmd_ao, 1},
-    {"inspect", cli_inspect, 1},
-    {"compare", cmd_compare, 1},
-    {"info", cmd_info, 1},
-    {"params", cmd_params, 0},
-    {"samples", cmd_samples, 0},
-    {"gbuffer", cli_gbuffer, 1},
-    {"reference", cli_reference, 1},
-    {"warmup", cli_warmup, 1},
-    {"bake", cli_bake, 1},
-    {"bake-dynamic", cli_dynamic, 1},
-    {"batch", cmd_batch, 1},
+    {"ao", cmd_ao, 1, 1},
+    {"inspect", cli_inspect, 1, 0},
+    {"compare", cmd_compare, 1, 0},
+    {"info", cmd_info, 1, 1}, /* says the budget */
+    {"params", cmd_params, 0, 0},
+    {"samples", cmd_samples, 0, 0},
+    {"gbuffer", cli_gbuffer, 1, 0},
+    {"reference", cli_reference, 1, 0},
+    {"warmup", cli_warmup, 1, 0},
+    {"bake", cli_bake, 1, 0},
+    {"bake-dynamic", cli_dynamic, 1, 0},
+    {"batch", cmd_batch, 1, 1},
 };
 
 int main(int argc, char **argv)
@@ -1683,6 +1694,8 @@ int main(int argc, char **argv)
         if (!strcmp(cmd, commands[i].name)) {
             /* before any context or thread: it may set LP_NUM_THREADS */
             int n = commands[i].threads ? cli_take_threads(cmd, argc - 2, argv + 2) : argc - 2;
+            if (commands[i].memory)
+                n = cli_take_max_memory(cmd, n, argv + 2);
             return commands[i].run(n, argv + 2);
         }
     if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {

@@ -22,6 +22,11 @@
 /* Milliseconds of CLOCK_MONOTONIC (for deadlines and stage times). */
 double obs__now_ms(void);
 
+/* The smallest memory limit (bytes) of this process's control groups,
+ * read from PROC_CGROUP (/proc/self/cgroup) under SYS_CGROUP
+ * (/sys/fs/cgroup), v1 and v2; 0 when none (core/memory.c). */
+size_t obs__memory_cgroup_limit(const char *proc_cgroup, const char *sys_cgroup);
+
 /* Overflow-checked size arithmetic: 0 on success, -1 when the product does
  * not fit in size_t (then *out is left alone). */
 int obs__size_mul(size_t a, size_t b, size_t *out);

@@ -50,6 +50,11 @@
       "llvmpipe's (LP_NUM_THREADS, unless set) and every worker pool's (EXR " \
       "decode, bake ray tracing, a bake job's threads parameter); 0: "        \
       "OBSCURA_THREADS, else every core")                                      \
+    X(max_memory, INT, 0, 1073741824, "0",                                     \
+      "MiB a frame on the CPU device may hold, as obscura --max-memory: over " \
+      "it the frame runs in bands of rows, the same result; at most the "     \
+      "usable memory (the machine's, or its cgroup limit when lower); 0: "    \
+      "OBSCURA_MAX_MEMORY, else a quarter of the usable memory")              \
     X(max_pixels, SIZE, 1, 1073741824, "33554432",                             \
       "largest accepted width x height of a G-buffer (413 above)")             \
     X(max_body, SIZE, 1024, 17179869184, "1g",                                 \

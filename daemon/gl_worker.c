@@ -71,6 +71,13 @@ static obs_ctx *recreate(obsd_gl_worker *w, obs_ctx *ctx, obs_status why, const 
     }
 }
 
+/* The CPU device's messages: warnings and errors as they are (a band
+ * over --max-memory), the rest (each band's rows) at debug. */
+static void cpu_log(void *user, obs_log_level level, const char *msg)
+{
+    obsd_log_core(user, level <= OBS_LOG_WARN ? level : OBS_LOG_DEBUG, msg);
+}
+
 /* The CPU device's cancel: the drain cut the requests. */
 static int cut_asked(void *user)
 {
@@ -191,7 +198,8 @@ static void *worker_main(void *arg)
             /* answered without running */
         } else if (w->cpu) {
             obs_cpu_options o = {.deadline = w->frame_deadline, /* as the GL context's */
-                                 .cancel = cut_asked, .cancel_user = w};
+                                 .cancel = cut_asked, .cancel_user = w, .log = cpu_log,
+                                 .max_memory = w->max_memory, .max_memory_name = w->max_memory_name};
             job->status = job->deep ? obs_deep_run_cpu_opts(job->deep, job->params, &o,
                                                             &job->deep_result, job->err)
                                     : obs_run_cpu_opts(job->gb, job->params, job->outputs,
@@ -243,6 +251,14 @@ obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *d
     w->max_cost = (unsigned long long)cfg->max_cost;
     w->keep_memory = (unsigned long long)cfg->keep_memory;
     w->frame_deadline = cfg->frame_deadline;
+    w->max_memory = (size_t)cfg->max_memory << 20;
+    const obsd_opt_info *mo = obsd_opt_find("max_memory");
+    if (!cfg->max_memory)
+        snprintf(w->max_memory_name, sizeof w->max_memory_name,
+                 "the memory budget (a quarter of the usable memory; --max-memory MIB sets it)");
+    else
+        snprintf(w->max_memory_name, sizeof w->max_memory_name, cfg->set[mo - obsd_opt_at(0)]
+                 ? "--max-memory %d MiB" : "OBSCURA_MAX_MEMORY=%d MiB", cfg->max_memory);
     atomic_init(&w->alive, 0);
     atomic_init(&w->recreations, 0);
     atomic_init(&w->heap_trims, 0);

@@ -22,6 +22,8 @@ typedef struct obsd_gl_worker {
     unsigned long long max_cost;    /* --max-cost (0: none) */
     unsigned long long keep_memory; /* --keep-memory */
     int frame_deadline;             /* --frame-deadline, seconds (0: none) */
+    size_t max_memory;              /* --max-memory in bytes (0: the library's default) */
+    char max_memory_name[96];       /* what set it, as the band warning names it */
     atomic_ullong kept_bytes;       /* obs_ctx_kept_bytes after the last frame */
     atomic_ullong heap_trims;       /* malloc_trim calls, once idle after frames */
     /* programs built from source, loaded from the program cache, cache
@@ -51,7 +53,8 @@ typedef struct obsd_gl_worker {
 /* Starts the thread and waits until it has created the context; on
  * failure the thread has ended and err says why.  From cfg: max_cost
  * (a frame asking more is answered OBS_TOO_COSTLY without running),
- * keep_memory (what the context may keep when the queue runs empty) and
+ * keep_memory (what the context may keep when the queue runs empty),
+ * max_memory (the CPU device's budget, resolved: obscurad.c) and
  * fail_gl_after (testing: frame N is failed with OBS_GL_ERROR without
  * running it, as if the context were lost; 0: never).  cpu: the jobs run
  * on the CPU device (obs_run_cpu, obs_deep_run_cpu) and no context is

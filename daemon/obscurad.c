@@ -155,6 +155,48 @@ static int render_threads(const obsd_config *cfg)
     return 0;
 }
 
+/* --max-memory, else OBSCURA_MAX_MEMORY (as obscura's --max-memory),
+ * into cfg->max_memory (MiB; 0: the library's default): at most the
+ * machine's memory.  -1 on a bad value (logged, naming where it came
+ * from). */
+static int max_memory(obsd_config *cfg)
+{
+    const char *env = getenv("OBSCURA_MAX_MEMORY"), *from = "max_memory";
+    char err[OBS_ERR_LEN];
+    if (!cfg->max_memory && env && *env) {
+        obsd_config tmp;
+        obsd_config_defaults(&tmp);
+        from = "OBSCURA_MAX_MEMORY";
+        obs_status st = obsd_config_set(&tmp, "max_memory", env, err);
+        if (st != OBS_OK || !tmp.max_memory) {
+            obsd_log(OBSD_LOG_ERROR, "OBSCURA_MAX_MEMORY: %s", st != OBS_OK ? err :
+                     "'0' is not a budget (MiB from 1 to the usable memory)");
+            return -1;
+        }
+        cfg->max_memory = tmp.max_memory;
+    }
+    const long long phys = (long long)(obs_cpu_memory_usable() >> 20);
+    if (phys && cfg->max_memory > phys) {
+        obsd_log(OBSD_LOG_ERROR, "%s: %d MiB is more than the usable memory (%lld MiB)", from,
+                 cfg->max_memory, phys);
+        return -1;
+    }
+    return 0;
+}
+
+/* The CPU device's budget and where it came from. */
+static void log_max_memory(const obsd_config *cfg)
+{
+    const obsd_opt_info *o = obsd_opt_find("max_memory");
+    if (cfg->max_memory)
+        obsd_log(OBSD_LOG_INFO, "memory budget: %d MiB a frame on the CPU device (%s)", cfg->max_memory,
+                 cfg->set[o - obsd_opt_at(0)] ? "--max-memory" : "OBSCURA_MAX_MEMORY");
+    else
+        obsd_log(OBSD_LOG_INFO, "memory budget: %zu MiB a frame on the CPU device (default: a quarter "
+                 "of %.1f GiB; --max-memory MIB sets it)", obs_cpu_memory_budget(NULL) >> 20,
+                 (double)obs_cpu_memory_usable() / 1073741824.0);
+}
+
 /* The threads line: a farm slot's limit is kept only when it reached
  * llvmpipe and the pools, so the log says where each count came from. */
 static void log_threads(const obsd_config *cfg, int llvmpipe)
@@ -254,7 +296,7 @@ int main(int argc, char **argv)
 
     obs_ctx_desc desc = {.log = obsd_log_core};
     int cpu = context_desc(&cfg, &desc);
-    if (cpu < 0 || render_threads(&cfg) != 0)
+    if (cpu < 0 || render_threads(&cfg) != 0 || max_memory(&cfg) != 0)
         return 2;
     if (install_signals() != 0) {
         obsd_log(OBSD_LOG_ERROR, "cannot install signal handlers: %s", strerror(errno));
@@ -280,6 +322,8 @@ int main(int argc, char **argv)
     obsd_log(OBSD_LOG_INFO, "GL context: backend %s, %s, %s (created in %.0f ms)", gl.backend,
              gl.gl_renderer, gl.gl_version, gl.create_ms);
     log_threads(&cfg, strstr(gl.gl_renderer, "llvmpipe") != NULL);
+    if (cpu)
+        log_max_memory(&cfg);
     const obsd_front front = obsd_front_make(&cfg, token, &queue, &gl);
     s = cfg.http[0] ? obsd_http_start(&front, &http, err) : OBS_OK;
     if (s == OBS_OK && (cfg.socket[0] || cfg.tcp[0]))

@@ -312,14 +312,13 @@ static obs_status band_run(obs__cpu_run *c, obs__plan *pl, const band *b, obs_pa
 
 size_t obs_cpu_memory_budget(const obs_cpu_options *opt) { return obs__bands_budget(opt); }
 
+
 size_t obs__bands_budget(const obs_cpu_options *opt)
 {
     if (opt && opt->max_memory > 0)
         return opt->max_memory;
-    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-    if (pages <= 0 || page <= 0)
-        return (size_t)1 << 31; /* not known: 2 GiB */
-    return (size_t)pages / 4 * (size_t)page; /* a quarter of the memory */
+    size_t phys = obs_cpu_memory_usable();
+    return phys ? phys / 4 : (size_t)1 << 31; /* a quarter of the usable memory; not known: 2 GiB */
 }
 
 int obs__bands_rows(obs__cpu_run *c, const obs_cpu_options *opt)
@@ -350,6 +349,21 @@ static void band_log(const obs_cpu_options *opt, int k, const band *b, int H, si
     opt->log(opt->log_user, OBS_LOG_INFO, msg);
 }
 
+/* Said once a frame, after its bands: bands as tall as their halo were
+ * over the budget; the largest halo and band (the budget's name as the
+ * caller gave it). */
+static void over_budget_log(const obs_cpu_options *opt, int halo, size_t need, size_t budget)
+{
+    if (!opt || !opt->log)
+        return;
+    char msg[320];
+    snprintf(msg, sizeof msg, "%s: the AO's samples reach up to %d rows either side at this depth: "
+             "bands hold up to %.1f MiB of planes, over the %.1f MiB the budget leaves them",
+             opt->max_memory_name ? opt->max_memory_name : "the memory budget", halo,
+             (double)need / 1048576.0, (double)budget / 1048576.0);
+    opt->log(opt->log_user, OBS_LOG_WARN, msg);
+}
+
 /* What a band does before and after its passes: nothing for a frame in
  * memory (obs__bands_run); the rows read and the result's rows handed
  * on for a frame by rows (obs_run_cpu_rows). */
@@ -368,7 +382,8 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
     const int forced = opt && opt->band_rows > 0;
     const size_t budget = obs__bands_budget(opt);
     obs_status s = OBS_OK;
-    int warned = 0;
+    int over = 0, over_halo = 0; /* bands over the budget, their largest halo: said at the end */
+    size_t over_need = 0;
     for (int c0 = 0, k = 1; s == OBS_OK && c0 < H; k++) {
         int n = rows;
         band b;
@@ -390,13 +405,6 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
                  * as the halo (over the budget), so that each band's prep
                  * runs over at most three times its rows, not over a
                  * halo many times a thin band's rows */
-                if (!warned++ && opt && opt->log) {
-                    char msg[224];
-                    snprintf(msg, sizeof msg, "the AO's samples reach %d rows either side: a band "
-                             "holds more than the memory budget (%.0f MiB of planes)", halo,
-                             (double)budget / 1048576.0);
-                    opt->log(opt->log_user, OBS_LOG_WARN, msg);
-                }
                 int m = halo > OBS__BANDS_MIN_ROWS ? halo : OBS__BANDS_MIN_ROWS;
                 if (m < n) {
                     n = m;
@@ -407,7 +415,14 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
             }
             n /= 2;
         }
-        band_log(opt, k, &b, H, obs__cpu_planes_need(c));
+        const size_t need = obs__cpu_planes_need(c);
+        if (!forced && need > budget) { /* its halo alone is too much */
+            const int halo = (b.a1 - b.a0 - (b.c1 - b.c0) + 1) / 2;
+            over++;
+            over_halo = halo > over_halo ? halo : over_halo;
+            over_need = need > over_need ? need : over_need;
+        }
+        band_log(opt, k, &b, H, need);
         if (io)
             s = io->in(io, c, &b, err);
         if (s == OBS_OK)
@@ -417,6 +432,8 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
         c0 = b.c1;
     }
     c->row0 = c->row1 = 0;
+    if (over)
+        over_budget_log(opt, over_halo, over_need, budget);
     return s;
 }
 

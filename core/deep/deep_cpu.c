@@ -464,6 +464,8 @@ float obs__deep_pixel(const obs__deep_frame *df, int x, int y, float *front)
             *front = ao;
         acc += T * a * ao; /* "over", front to back */
         T *= 1.0f - a;
+        if (T == 0.0f)
+            break; /* an opaque node: every node behind it adds T a ao = 0 */
     }
     return acc + T; /* what shows through is open (AO 1) */
 }

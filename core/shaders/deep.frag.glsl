@@ -222,6 +222,10 @@ void main()
 #endif
         acc += T * a * ao;   // "over", front to back
         T *= 1.0 - a;
+#if !OBS_DEEP_NODES
+        if (T == 0.0)
+            break;           // an opaque node: every node behind it adds T a ao = 0
+#endif
     }
     float z0 = max(imageLoad(u_lpos, ivec3(px, 0)).w, 0.0);
     o_front = vec2(front, z0);

@@ -306,18 +306,29 @@ typedef struct obs_cpu_options {
      * parameters): a frame that needs more runs in bands of rows, each
      * holding its rows and the halo its samples reach (the same result,
      * the input and the result still whole); 0: a quarter of the
-     * machine's physical memory */
+     * usable memory (obs_cpu_memory_usable) */
     size_t max_memory;
     /* > 0: bands of this many rows whatever the frame's size (tests) */
     int band_rows;
+    /* what set max_memory, as the warning of a band over the budget
+     * (through log) names it, e.g. "--max-memory 256 MiB"; NULL: "the
+     * memory budget" */
+    const char *max_memory_name;
 } obs_cpu_options;
 
 obs_status obs_run_cpu_opts(const obs_gbuffer *gb, const obs_params *params, unsigned outputs,
                             obs_result *out, const obs_cpu_options *opt, char err[OBS_ERR_LEN]);
 
 /* The memory budget of opt (NULL: the default): opt->max_memory, else a
- * quarter of the machine's physical memory. */
+ * quarter of obs_cpu_memory_usable(). */
 size_t obs_cpu_memory_budget(const obs_cpu_options *opt);
+
+/* The memory this process may use, in bytes (what the default budget is a
+ * quarter of): the usable memory (obs_cpu_memory_usable), or its control group's
+ * memory limit when lower (cgroup v2 memory.max, v1
+ * memory.limit_in_bytes: a Slurm job, a container, a systemd unit with
+ * MemoryMax); 0 when not known. */
+size_t obs_cpu_memory_usable(void);
 
 /* A frame that is never whole in memory, on the CPU device: run in bands
  * of rows as obs_run_cpu_opts runs a frame over its memory budget (the

@@ -1,7 +1,7 @@
 /* What the CLI's commands share (clients/cli.c, clients/flags.c): control bytes escaped
  * in messages, the edit distance of "did you mean", the
- * "Progress: N%" lines a farm's parser reads, and --threads taken out of
- * a command's argv. */
+ * "Progress: N%" lines a farm's parser reads, and --threads and
+ * --max-memory taken out of a command's argv. */
 #include "testutil.h"
 
 #include <unistd.h>
@@ -88,6 +88,38 @@ static void test_take_threads(void **state)
     assert_true(cli_process_threads() >= 1);
 }
 
+/* --max-memory MIB is taken out of argv as --threads is (either
+ * spelling, the last one given), over OBSCURA_MAX_MEMORY; neither: the
+ * library's default, said as such. */
+static void test_take_max_memory(void **state)
+{
+    (void)state;
+    char a0[] = "in.exr", a1[] = "--max-memory", a2[] = "64", a3[] = "-o", a4[] = "out.exr",
+         a5[] = "--max-memory=3";
+    char *argv[] = {a0, a1, a2, a3, a4, a5};
+    obs_cpu_options o = {0};
+    setenv("OBSCURA_MAX_MEMORY", "7", 1);
+    assert_int_equal(cli_take_max_memory("ao", 6, argv), 3);
+    assert_string_equal(argv[0], "in.exr");
+    assert_string_equal(argv[1], "-o");
+    assert_string_equal(argv[2], "out.exr");
+    cli_max_memory(&o);
+    assert_true(o.max_memory == (size_t)3 << 20); /* the option's, the last one */
+    assert_string_equal(o.max_memory_name, "--max-memory 3 MiB");
+    assert_string_equal(cli_max_memory_text(), "3 MiB (--max-memory)");
+    char *plain[] = {a0, a3, a4};
+    assert_int_equal(cli_take_max_memory("ao", 3, plain), 3);
+    cli_max_memory(&o);
+    assert_true(o.max_memory == (size_t)7 << 20); /* the environment's, when no option */
+    assert_string_equal(o.max_memory_name, "OBSCURA_MAX_MEMORY=7 MiB");
+    unsetenv("OBSCURA_MAX_MEMORY");
+    assert_int_equal(cli_take_max_memory("ao", 3, plain), 3);
+    cli_max_memory(&o);
+    assert_true(o.max_memory == 0); /* the default */
+    assert_non_null(strstr(cli_max_memory_text(), "default: a quarter of"));
+    assert_true(obs_cpu_memory_budget(&o) == obs_cpu_memory_usable() / 4);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -95,6 +127,7 @@ int main(void)
         cmocka_unit_test(test_edit_distance),
         cmocka_unit_test(test_progress_percent),
         cmocka_unit_test(test_take_threads),
+        cmocka_unit_test(test_take_max_memory),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

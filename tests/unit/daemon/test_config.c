@@ -171,12 +171,36 @@ static void test_render_threads(void **state)
     assert_int_equal(obsd_config_set(&c, "render-threads", "abc", err), OBS_INVALID_ARGUMENT);
 }
 
+/* --max-memory: MiB of the CPU device's budget (obscura's --max-memory),
+ * 0 by default (OBSCURA_MAX_MEMORY, else the library's default); a flag
+ * or a config line sets it and marks it given; not a number or negative
+ * refused, naming it. */
+static void test_max_memory(void **state)
+{
+    (void)state;
+    obsd_config c;
+    char err[OBS_ERR_LEN];
+    int help;
+    obsd_config_defaults(&c);
+    assert_int_equal(c.max_memory, 0);
+    char *argv[] = {"obscurad", "--max-memory", "256", NULL};
+    assert_int_equal(obsd_config_args(&c, 3, argv, &help, err), OBS_OK);
+    assert_int_equal(c.max_memory, 256);
+    assert_true(c.set[obsd_opt_find("max-memory") - obsd_opt_at(0)]);
+    assert_int_equal(obsd_config_set(&c, "max_memory", "-1", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "max_memory"));
+    assert_int_equal(obsd_config_set(&c, "max-memory", "1g", err), OBS_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "max_memory"));
+    assert_int_equal(c.max_memory, 256);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_defaults), cmocka_unit_test(test_set),
         cmocka_unit_test(test_errors),   cmocka_unit_test(test_file_and_flags),
         cmocka_unit_test(test_help),     cmocka_unit_test(test_render_threads),
+        cmocka_unit_test(test_max_memory),
     };
     return cmocka_run_group_tests_name("daemon_config", tests, NULL, NULL);
 }
