@@ -831,10 +831,11 @@ static int cmd_ao_deep(const ao_args *a, const obs_limits *lim, const char *serv
     if (verbosity >= OBS_LOG_INFO) {
         obs_params p;
         obs_deep_params_resolve(&d, &a->req.params, &p);
-        char kernel[64]; /* the method's samples */
+        char kernel[96]; /* the method's samples */
         if (p.method == OBS_METHOD_GTAO)
-            snprintf(kernel, sizeof kernel, "gtao %d slices x %d steps", p.gtao_slices,
-                     p.gtao_steps);
+            snprintf(kernel, sizeof kernel, "gtao %d slices x %d steps%s", p.gtao_slices,
+                     p.gtao_steps, obs_deep_intervals_in_effect(&d, &p)
+                                       ? ", intervals (free arcs, the exact integral)" : "");
         else if (p.method == OBS_METHOD_HBAO)
             snprintf(kernel, sizeof kernel, "hbao %d directions x %d steps", p.hbao_directions,
                      p.hbao_steps);
