@@ -241,9 +241,12 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
         float gamma = signf(dot3(od, np)) * acosf(cos_g);
         float low0 = cosf(gamma + half_pi), low1 = cosf(gamma - half_pi);
         obs__gtao_side sides[2]; /* deep input's intervals: the sides' occupied arcs */
-        if (end) {
-            obs__gtao_side_start(&sides[0], c);
-            obs__gtao_side_start(&sides[1], c);
+        if (end) { /* the receiver's column: free from the surface in front of it */
+            const size_t px = (size_t)y * (size_t)f->width + (size_t)x;
+            const float z0 = obs__gtao_centre_start(pos + 4 * px, end + px,
+                                                    (size_t)f->width * (size_t)f->height * 4, self);
+            obs__gtao_side_start(&sides[0], c, z0);
+            obs__gtao_side_start(&sides[1], c, z0);
         }
         float hc0 = side_horizon(f, pos, nrm, layers, self, x, y, c, v, omega, sl, noise[1], min_s, 1,
                                  low0, &taken, end, &sides[0]);

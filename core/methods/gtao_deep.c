@@ -44,15 +44,31 @@
  * at the camera no crossing is found: with no closed interval the result
  * is a(h0) + a(h1) exactly.
  *
- * XeGTAO's falloff (gtao.c) moves a point's horizon cosine towards the
- * tangent's `low` by the weight w(r) of its distance r: a sample solid
- * behind occupies [low, low + (shc - low) w].  Each end of an interval is
- * a point and is mapped the same way by its own weight, so that a point
- * has one mapped angle whichever node it belongs to (a back face on the
- * wall behind it meets the wall's horizon: a closed box flush with a wall
- * is the flat buffer's box), and a back face beyond the falloff radius
- * maps to the tangent: the interval is then the sample solid behind.
- * The arc is taken between its two mapped ends. */
+ * The search radius.  XeGTAO's falloff (gtao.c) moves a point's horizon
+ * cosine towards the tangent's `low` by the weight w(r) of its distance
+ * r: a node solid behind occupies [low, low + (shc - low) w], the
+ * horizon form, kept for those nodes.  An arc is not a horizon: mapping
+ * its end beyond the radius to the tangent (w = 0) turns [front, back]
+ * into [back, tangent], the directions *under* the solid (the ground
+ * under an animal's belly, whose back is beyond D and belly within it:
+ * measured on zoo, the whole gap occupied).  The arcs take the true
+ * angles instead, and a solid counts where a ray can meet it within the
+ * radius R where the weight reaches 0 (the hard cut of the exact rows:
+ * the ray tracer's distance).  A solid met between two columns (an
+ * interval seen in the later one, or a crossing) is entered after the
+ * ray left the earlier column and at the depths it occupies there (its
+ * bounding surfaces continued between the columns at the depths they
+ * have in the later one): the arc counts where the ray left the
+ * earlier column within R (the angles of that column's chord of the
+ * ball; the centre's: all) and reaches the solid's depths within R
+ * (|cz - z| / |u_z| for the depth z of its near face and the ray's
+ * direction u).  Both are lower bounds of the distance at which the ray
+ * meets the surface, exact for a face at one depth (a slab parallel to
+ * the image plane: test_deep.c, the wall under a raised slab), and they
+ * converge to it as the columns get dense.  The receiver's own column
+ * is free from the nearest surface in front of it (0 for the front
+ * node; a hidden node's free range starts at the back face or node
+ * before it). */
 #include <math.h>
 
 #include "chain/mask_weight.h"
@@ -63,7 +79,7 @@ static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1
 
 /* The horizon cosine of the point c + d moved from the tangent's `low`
  * by its falloff weight times om, as sample_cos in gtao.c; low where d
- * is 0. */
+ * is 0: the horizon form of a node solid behind it. */
 static float weighted_cos(const float fw[3], const float d[3], const float v[3], float low,
                           float om)
 {
@@ -82,6 +98,37 @@ static float true_angle(const float d[3], const float v[3], float low)
 {
     float dist = sqrtf(dot3(d, d));
     return acosf(clampf(dist > 0.0f ? dot3(d, v) / dist : low, -1.0f, 1.0f));
+}
+
+/* The part of the column's ray o + s dir (s the planar depth) where the
+ * falloff weight is not 0: the distance from c, measured as the weight
+ * measures it (z scaled by 1 + gtao_thin), at most the radius where
+ * the weight reaches 0, R = -fw[1] / fw[0] (gtao_setup: R at any
+ * falloff range).  Writes the depths [s0, s1]; 0 where the ray passes
+ * outside. */
+static int chord(const float fw[3], const float o[3], const float dir[3], const float c[3],
+                 float s[2])
+{
+    const float k = 1.0f + fw[2], r = -fw[1] / fw[0];
+    const float a3[3] = {o[0] - c[0], o[1] - c[1], (o[2] - c[2]) * k};
+    const float d3[3] = {dir[0], dir[1], dir[2] * k};
+    const float a = dot3(d3, d3), b = dot3(a3, d3), cc = dot3(a3, a3) - r * r;
+    const float disc = b * b - a * cc;
+    if (!(disc > 0.0f) || !(a > 0.0f))
+        return 0;
+    const float sq = sqrtf(disc);
+    s[0] = (-b - sq) / a;
+    s[1] = (-b + sq) / a;
+    return 1;
+}
+
+/* the angle from v of the column's point at depth z, seen from c */
+static float depth_angle(const float o[3], const float dir[3], float z, const float c[3],
+                         const float v[3], float low)
+{
+    const float d[3] = {o[0] + z * dir[0] - c[0], o[1] + z * dir[1] - c[1],
+                        o[2] + z * dir[2] - c[2]};
+    return true_angle(d, v, low);
 }
 
 /* adds the occupied arc [lo, hi] to the side, sorted by lo */
@@ -104,23 +151,75 @@ static void add_arc(obs__gtao_side *s, float lo, float hi)
     s->n++;
 }
 
-void obs__gtao_side_start(obs__gtao_side *s, const float c[3])
+/* Adds the arc [lo, hi] of a solid met between the previous column and
+ * this one, where it can lie within the radius r: where the ray left the
+ * previous column within r (the side's window) and reaches the solid's
+ * depths [zlo, zhi] within r.  The solid lies at those depths (the
+ * surfaces bounding it continued between the columns at the depths
+ * they have here), so a ray from c (planar depth cz) meets it no nearer
+ * than where it reaches the band: at |cz - z| / |u_z| for the band's
+ * near edge z, u the ray's direction; in the slice u_z(t) = A cos(t -
+ * p0) (uz: A and p0).  Both are lower bounds of the distance of the
+ * surface crossed, exact for a face at one depth. */
+static void add_reach(obs__gtao_side *s, float lo, float hi, float zlo, float zhi, float cz,
+                      float r, const float uz[2])
+{
+    const float pi = (float)M_PI;
+    lo = fmaxf(lo, s->win[0]);
+    hi = fminf(hi, s->win[1]);
+    if (!(hi > lo))
+        return;
+    const float dz = cz < zlo ? zlo - cz : cz > zhi ? cz - zhi : 0.0f;
+    if (!(dz > 0.0f)) { /* c at the band's depths */
+        add_arc(s, lo, hi);
+        return;
+    }
+    if (!(uz[0] * r > dz))
+        return; /* no ray of the slice reaches the band within r */
+    const float half = acosf(dz / (r * uz[0]));
+    const float mid = cz > zhi ? uz[1] : uz[1] + pi; /* towards the camera: u_z > 0 */
+    for (int i = -1; i <= 1; i++)
+        add_arc(s, fmaxf(lo, mid + 2.0f * pi * (float)i - half),
+                fminf(hi, mid + 2.0f * pi * (float)i + half));
+}
+
+void obs__gtao_side_start(obs__gtao_side *s, const float c[3], float z0)
 {
     s->n = 0;
     s->gaps = 1;
-    s->z[0][0] = 0.0f;
+    s->z[0][0] = fminf(z0, -c[2]);
     s->z[0][1] = -c[2];
-    s->t[0][0] = s->m[0][0] = 0.0f;
-    s->t[0][1] = s->m[0][1] = (float)M_PI;
+    s->t[0][0] = s->win[0] = 0.0f;
+    s->t[0][1] = s->win[1] = (float)M_PI;
 }
 
 float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s, const float *q,
                        const float *end, size_t plane, int layers, int x, int y, int self, int qx,
                        int qy, const float c[3], const float v[3], float low)
 {
-    float gz[OBS__GTAO_MAX_GAPS][2], gt[OBS__GTAO_MAX_GAPS][2], gm[OBS__GTAO_MAX_GAPS][2];
-    float hc = low, cz = 0.0f, ct = 0.0f, cm = 0.0f; /* the free range open from depth cz */
+    float gz[OBS__GTAO_MAX_GAPS][2], gt[OBS__GTAO_MAX_GAPS][2];
+    float hc = low, cz = 0.0f, ct = 0.0f; /* the free range open from depth cz */
     int ng = 0, open = 1, last = -1;
+    /* the column's ray and the depths [cs0, cs1] of it within the
+     * radius: the window of the solids met after it (the header) */
+    float ndc[2], o[3], dir[3], cs[2];
+    obs__px_ndc(f, qx, qy, ndc);
+    obs__view_ray(f->proj, ndc, o, dir);
+    const int near = chord(fw, o, dir, c, cs);
+    /* the slice's direction on this side (from the column's ray): u_z */
+    const float r = -fw[1] / fw[0], cz0 = -c[2];
+    float uz[2] = {0.0f, 0.0f};
+    {
+        const float pc[3] = {o[0] + cz0 * dir[0] - c[0], o[1] + cz0 * dir[1] - c[1],
+                             o[2] + cz0 * dir[2] - c[2]};
+        const float pv = dot3(pc, v);
+        const float od[3] = {pc[0] - pv * v[0], pc[1] - pv * v[1], pc[2] - pv * v[2]};
+        const float ol = sqrtf(dot3(od, od));
+        if (ol > 0.0f) {
+            uz[0] = sqrtf(v[2] * v[2] + od[2] * od[2] / (ol * ol));
+            uz[1] = atan2f(od[2] / ol, v[2]);
+        }
+    }
     /* the last node met outside every interval: if it closes an interval,
      * nothing lies behind that (solid behind it, the header) */
     for (int k = 0; k < layers; k++)
@@ -131,64 +230,71 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
         const float e = end && k != last ? end[(size_t)k * (plane / 4)] : 0.0f;
         if (!(qk[3] > 0.0f) || e < 0.0f)
             continue; /* empty, or inside a nearer node's interval */
-        const float om = obs__occluder_weight_node(f, x, y, self, qx, qy, k);
         const float d[3] = {qk[0] - c[0], qk[1] - c[1], qk[2] - c[2]};
-        const float cf = weighted_cos(fw, d, v, low, om);
-        if (e == 0.0f)
-            hc = fmaxf(hc, cf); /* solid behind: the horizon form */
+        if (e == 0.0f) /* solid behind: the horizon form */
+            hc = fmaxf(hc, weighted_cos(fw, d, v, low,
+                                        obs__occluder_weight_node(f, x, y, self, qx, qy, k)));
         if (!open)
             continue; /* behind a node solid behind it: no free range */
-        const float tf = true_angle(d, v, low), mf = acosf(clampf(cf, -1.0f, 1.0f));
+        const float tf = true_angle(d, v, low);
         if (qk[3] > cz && ng < OBS__GTAO_MAX_GAPS) { /* the free range in front of it */
             gz[ng][0] = cz, gz[ng][1] = qk[3];
             gt[ng][0] = ct, gt[ng][1] = tf;
-            gm[ng][0] = cm, gm[ng][1] = mf;
             ng++;
         }
         if (e == 0.0f) {
             open = 0;
             continue;
         }
-        /* a closed interval: its back face on the pixel's ray, q = o + w
-         * dir (obs__prep_position), and the arc between its ends */
-        float ndc[2], o[3], dir[3];
-        obs__px_ndc(f, qx, qy, ndc);
-        obs__view_ray(f->proj, ndc, o, dir);
-        const float db[3] = {o[0] + e * dir[0] - c[0], o[1] + e * dir[1] - c[1], -e - c[2]};
-        const float mb = acosf(clampf(weighted_cos(fw, db, v, low, om), -1.0f, 1.0f));
-        add_arc(s, fminf(mf, mb), fmaxf(mf, mb));
+        /* a closed interval: the solid from its front face to its back
+         * face on the pixel's ray (q = o + w dir, obs__prep_position),
+         * the arc between their angles where a ray meets it within the
+         * radius (add_reach) */
         cz = e;
-        ct = true_angle(db, v, low);
-        cm = mb;
+        ct = depth_angle(o, dir, e, c, v, low);
+        if (obs__occluder_weight_node(f, x, y, self, qx, qy, k) > 0.0f)
+            add_reach(s, tf, ct, qk[3], e, cz0, r, uz);
     }
     if (open && ng < OBS__GTAO_MAX_GAPS) { /* no surface from cz on */
         gz[ng][0] = cz, gz[ng][1] = INFINITY;
         gt[ng][0] = ct, gt[ng][1] = (float)M_PI;
-        gm[ng][0] = cm, gm[ng][1] = (float)M_PI;
         ng++;
     }
     /* a ray from a free range of the previous column to one of this
-     * column with no depth in common crosses a surface between them */
+     * column with no depth in common crosses a surface between them,
+     * counted where it can do so within the radius (add_reach) */
     for (int a = 0; a < s->gaps; a++)
         for (int b = 0; b < ng; b++) {
             if (s->z[a][0] < gz[b][1] && gz[b][0] < s->z[a][1])
                 continue; /* one free space */
-            float lo = fmaxf(s->t[a][0], gt[b][0]), hi = fminf(s->t[a][1], gt[b][1]);
-            if (!(hi > lo))
-                continue;
-            /* the crossing's ends as the falloff maps them */
-            float ml = s->t[a][0] >= gt[b][0] ? s->m[a][0] : gm[b][0];
-            float mh = s->t[a][1] <= gt[b][1] ? s->m[a][1] : gm[b][1];
-            add_arc(s, fminf(ml, mh), fmaxf(ml, mh));
+            /* the surface crossed lies at the depths between the two */
+            const int before = s->z[a][1] <= gz[b][0];
+            add_reach(s, fmaxf(s->t[a][0], gt[b][0]), fminf(s->t[a][1], gt[b][1]),
+                      before ? s->z[a][1] : gz[b][1], before ? gz[b][0] : s->z[a][0], cz0, r, uz);
         }
+    s->win[0] = s->win[1] = 0.0f; /* this column's window, for the next */
+    if (near && cs[1] > 0.0f) {
+        s->win[0] = depth_angle(o, dir, fmaxf(cs[0], 0.0f), c, v, low);
+        s->win[1] = depth_angle(o, dir, cs[1], c, v, low);
+    }
     s->gaps = ng;
     for (int b = 0; b < ng; b++)
         for (int i = 0; i < 2; i++) {
             s->z[b][i] = gz[b][i];
             s->t[b][i] = gt[b][i];
-            s->m[b][i] = gm[b][i];
         }
     return hc;
+}
+
+float obs__gtao_centre_start(const float *q, const float *end, size_t plane, int self)
+{
+    float z0 = 0.0f;
+    for (int k = 0; k < self; k++) {
+        const float w = q[(size_t)k * plane + 3], e = end[(size_t)k * (plane / 4)];
+        if (w > 0.0f && e >= 0.0f)
+            z0 = fmaxf(z0, e > 0.0f ? e : w);
+    }
+    return z0;
 }
 
 /* a(h) of gtao.c (its arc()): the inner integral's closed form */

@@ -20,18 +20,25 @@
 /* One side of a slice: its occupied arcs as angles from the view vector
  * v (0 .. pi, the side's own sign left out), sorted by their near end;
  * the free depth ranges z of the last column read, each with the angles
- * of its ends, t without the falloff (where rays cross) and m with it
- * (the arcs). */
+ * of its ends (true angles: where rays cross). */
 typedef struct obs__gtao_side {
     int n, gaps;
     float lo[OBS__GTAO_MAX_ARCS], hi[OBS__GTAO_MAX_ARCS];
-    float z[OBS__GTAO_MAX_GAPS][2], t[OBS__GTAO_MAX_GAPS][2], m[OBS__GTAO_MAX_GAPS][2];
+    float z[OBS__GTAO_MAX_GAPS][2], t[OBS__GTAO_MAX_GAPS][2];
+    float win[2]; /* the angles where the last column's ray lies within the radius */
 } obs__gtao_side;
 
 /* Starts a side at the centre c: no arcs; the centre's column is the
- * free range in front of it (planar depths 0 .. -c z), where every ray
+ * free range in front of it (planar depths z0 .. -c z), where every ray
  * leaving c starts. */
-void obs__gtao_side_start(obs__gtao_side *s, const float c[3]);
+void obs__gtao_side_start(obs__gtao_side *s, const float c[3], float z0);
+
+/* Where the free range in front of the receiver node `self` starts in
+ * its own column (q, end: its pixel's nodes and interval ends, plane
+ * floats apart, as obs__gtao_column reads them): the depth of the
+ * nearest surface in front of it, the back face of an interval or a
+ * node solid behind it; 0 for the front node. */
+float obs__gtao_centre_start(const float *q, const float *end, size_t plane, int self);
 
 /* The column of one step at pixel (qx, qy) (fw: method gtao's falloff
  * mul and add and gtao_thin, obs__gtao_state's; (x, y, self): the

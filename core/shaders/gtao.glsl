@@ -90,7 +90,7 @@ float gtao_arc(float h, float gamma, float cos_gamma)
 #if GT_INTERVALS
 // The sides of the slice (side 0: dir +1): their occupied arcs, angles
 // from v sorted by their near end, and the free depth ranges of the last
-// column read with their ends' angles, true (t) and falloff-mapped (m).
+// column read with their ends' angles (t).
 // C twin: obs__gtao_side (methods/gtao_deep.h); GT_MAX_GAPS and
 // GT_MAX_ARCS are OBS__GTAO_MAX_GAPS and OBS__GTAO_MAX_ARCS for 8 nodes
 // and 32 steps.
@@ -98,16 +98,17 @@ const int GT_MAX_GAPS = 5;
 const int GT_MAX_ARCS = 32 * 13;
 float gt_lo[2 * GT_MAX_ARCS], gt_hi[2 * GT_MAX_ARCS];
 int gt_n[2], gt_gaps[2];
-vec2 gt_z[2 * GT_MAX_GAPS], gt_t[2 * GT_MAX_GAPS], gt_m[2 * GT_MAX_GAPS];
+vec2 gt_win[2]; // the angles where the last column's ray lies within the radius
+vec2 gt_z[2 * GT_MAX_GAPS], gt_t[2 * GT_MAX_GAPS];
 
 // C twin: obs__gtao_side_start
-void gtao_side_start(int side, vec3 c)
+void gtao_side_start(int side, vec3 c, float z0)
 {
     gt_n[side] = 0;
     gt_gaps[side] = 1;
-    gt_z[side * GT_MAX_GAPS] = vec2(0.0, -c.z);
+    gt_win[side] = vec2(0.0, 3.14159265358979);
+    gt_z[side * GT_MAX_GAPS] = vec2(min(z0, -c.z), -c.z);
     gt_t[side * GT_MAX_GAPS] = vec2(0.0, 3.14159265358979);
-    gt_m[side * GT_MAX_GAPS] = vec2(0.0, 3.14159265358979);
 }
 
 // C twin: true_angle (methods/gtao_deep.c)
@@ -115,6 +116,22 @@ float gtao_true_angle(vec3 d, vec3 v, float low)
 {
     float dist = length(d);
     return acos(clamp(dist > 0.0 ? dot(d, v) / dist : low, -1.0, 1.0));
+}
+
+// The depths of the ray o + s dir where the falloff weight is not 0
+// (within R = -u_gtao_falloff.y / u_gtao_falloff.x of c, z scaled by
+// 1 + gtao_thin); false where it passes outside.  C twin: chord
+// (methods/gtao_deep.c)
+bool gtao_chord(vec3 o, vec3 dir, vec3 c, out vec2 s)
+{
+    float k = 1.0 + u_gtao_thin_power.x, r = -u_gtao_falloff.y / u_gtao_falloff.x;
+    vec3 a3 = vec3((o - c).xy, (o.z - c.z) * k), d3 = vec3(dir.xy, dir.z * k);
+    float a = dot(d3, d3), b = dot(a3, d3), disc = b * b - a * (dot(a3, a3) - r * r);
+    s = vec2(0.0);
+    if (!(disc > 0.0) || !(a > 0.0))
+        return false;
+    s = (vec2(-b) + vec2(-1.0, 1.0) * sqrt(disc)) / a;
+    return true;
 }
 
 // C twin: add_arc (methods/gtao_deep.c)
@@ -137,14 +154,59 @@ void gtao_add_arc(int side, float lo, float hi)
     gt_n[side]++;
 }
 
+// C twin: add_reach (methods/gtao_deep.c)
+void gtao_add_reach(int side, float lo, float hi, float zlo, float zhi, float cz, float r, vec2 uz)
+{
+    lo = max(lo, gt_win[side].x);
+    hi = min(hi, gt_win[side].y);
+    if (!(hi > lo))
+        return;
+    float dz = cz < zlo ? zlo - cz : cz > zhi ? cz - zhi : 0.0;
+    if (!(dz > 0.0)) {
+        gtao_add_arc(side, lo, hi);
+        return;
+    }
+    if (!(uz.x * r > dz))
+        return;
+    float half_w = acos(dz / (r * uz.x));
+    float mid = cz > zhi ? uz.y : uz.y + 3.14159265358979;
+    for (int i = -1; i <= 1; i++)
+        gtao_add_arc(side, max(lo, mid + 6.28318530717959 * float(i) - half_w),
+                     min(hi, mid + 6.28318530717959 * float(i) + half_w));
+}
+
+// C twin: obs__gtao_centre_start (methods/gtao_deep.c), for the receiver
+// node g_self (deep.frag.glsl)
+float gtao_centre_start(ivec2 px)
+{
+    float z0 = 0.0;
+    for (int k = 0; k < g_self; k++) {
+        float w = GT_NODE(px, k).w, e = GT_END(px, k);
+        if (w > 0.0 && e >= 0.0)
+            z0 = max(z0, e > 0.0 ? e : w);
+    }
+    return z0;
+}
+
 // The column of the step at q (border: the one point xq past the image
 // instead, solid behind it).  C twin: obs__gtao_column (methods/gtao_deep.c)
 float gtao_column(int side, ivec2 px, ivec2 q, bool border, vec4 xq, vec3 c, vec3 v, float low)
 {
-    vec2 gz[GT_MAX_GAPS], gt[GT_MAX_GAPS], gm[GT_MAX_GAPS];
-    float hc = low, cz = 0.0, ct = 0.0, cm = 0.0;
+    vec2 gz[GT_MAX_GAPS], gt[GT_MAX_GAPS];
+    float hc = low, cz = 0.0, ct = 0.0;
     int ng = 0, last = -1, layers = border ? 1 : GT_LAYERS;
     bool open = true;
+    vec3 o, dir;
+    vec2 cs;
+    view_ray(px_ndc(q), o, dir);
+    bool near = gtao_chord(o, dir, c, cs);
+    float r = -u_gtao_falloff.y / u_gtao_falloff.x, cz0 = -c.z;
+    vec2 uz = vec2(0.0);
+    vec3 pc = o + cz0 * dir - c;
+    vec3 od = pc - dot(pc, v) * v;
+    float ol = length(od);
+    if (ol > 0.0)
+        uz = vec2(sqrt(v.z * v.z + od.z * od.z / (ol * ol)), atan(od.z / ol, v.z));
     for (int k = 0; k < layers; k++) {
         vec4 qk = border ? xq : GT_NODE(q, k);
         if (qk.w > 0.0 && !(!border && GT_END(q, k) < 0.0))
@@ -155,58 +217,50 @@ float gtao_column(int side, ivec2 px, ivec2 q, bool border, vec4 xq, vec3 c, vec
         float e = border || k == last ? 0.0 : GT_END(q, k);
         if (!(qk.w > 0.0) || e < 0.0)
             continue;
-        float om = GT_WEIGHT(px, q, border ? 0 : k);
         vec3 d = qk.xyz - c;
-        float cf = gtao_sample_cos(qk, c, v, low, om);
         if (e == 0.0)
-            hc = max(hc, cf);
+            hc = max(hc, gtao_sample_cos(qk, c, v, low, GT_WEIGHT(px, q, border ? 0 : k)));
         if (!open)
             continue;
-        float tf = gtao_true_angle(d, v, low), mf = acos(clamp(cf, -1.0, 1.0));
+        float tf = gtao_true_angle(d, v, low);
         if (qk.w > cz && ng < GT_MAX_GAPS) {
             gz[ng] = vec2(cz, qk.w);
             gt[ng] = vec2(ct, tf);
-            gm[ng] = vec2(cm, mf);
             ng++;
         }
         if (e == 0.0) {
             open = false;
             continue;
         }
-        vec3 o, dir;
-        view_ray(px_ndc(q), o, dir);
-        vec4 b = vec4(o.xy + e * dir.xy, -e, e);
-        float mb = acos(clamp(gtao_sample_cos(b, c, v, low, om), -1.0, 1.0));
-        gtao_add_arc(side, min(mf, mb), max(mf, mb));
         cz = e;
-        ct = gtao_true_angle(b.xyz - c, v, low);
-        cm = mb;
+        ct = gtao_true_angle(o + e * dir - c, v, low);
+        if (GT_WEIGHT(px, q, k) > 0.0)
+            gtao_add_reach(side, tf, ct, qk.w, e, cz0, r, uz);
     }
     if (open && ng < GT_MAX_GAPS) {
         gz[ng] = vec2(cz, uintBitsToFloat(0x7f800000u)); // no surface from cz on
         gt[ng] = vec2(ct, 3.14159265358979);
-        gm[ng] = vec2(cm, 3.14159265358979);
         ng++;
     }
     int base = side * GT_MAX_GAPS;
     for (int a = 0; a < gt_gaps[side]; a++) {
-        vec2 za = gt_z[base + a], ta = gt_t[base + a], ma = gt_m[base + a];
+        vec2 za = gt_z[base + a], ta = gt_t[base + a];
         for (int b = 0; b < ng; b++) {
             if (za.x < gz[b].y && gz[b].x < za.y)
                 continue;
-            float lo = max(ta.x, gt[b].x), hi = min(ta.y, gt[b].y);
-            if (!(hi > lo))
-                continue;
-            float ml = ta.x >= gt[b].x ? ma.x : gm[b].x;
-            float mh = ta.y <= gt[b].y ? ma.y : gm[b].y;
-            gtao_add_arc(side, min(ml, mh), max(ml, mh));
+            bool before = za.y <= gz[b].x;
+            gtao_add_reach(side, max(ta.x, gt[b].x), min(ta.y, gt[b].y), before ? za.y : gz[b].y,
+                           before ? gz[b].x : za.x, cz0, r, uz);
         }
     }
+    gt_win[side] = vec2(0.0);
+    if (near && cs.y > 0.0)
+        gt_win[side] = vec2(gtao_true_angle(o + max(cs.x, 0.0) * dir - c, v, low),
+                            gtao_true_angle(o + cs.y * dir - c, v, low));
     gt_gaps[side] = ng;
     for (int b = 0; b < ng; b++) {
         gt_z[base + b] = gz[b];
         gt_t[base + b] = gt[b];
-        gt_m[base + b] = gm[b];
     }
     return hc;
 }
@@ -309,8 +363,9 @@ float method_ao(ivec2 px, vec4 p, vec3 n, out int count)
         float gamma = sign(dot(od, np)) * acos(cos_g);
         float low0 = cos(gamma + GTAO_HALF_PI), low1 = cos(gamma - GTAO_HALF_PI);
 #if GT_INTERVALS
-        gtao_side_start(0, c);
-        gtao_side_start(1, c);
+        float z0 = gtao_centre_start(px);
+        gtao_side_start(0, c, z0);
+        gtao_side_start(1, c, z0);
 #endif
         float hc0 = gtao_side_horizon(px, c, v, omega, sl, noise.y, min_s, 1, low0, taken);
         float hc1 = gtao_side_horizon(px, c, v, omega, sl, noise.y, min_s, -1, low1, taken);

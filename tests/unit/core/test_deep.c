@@ -779,14 +779,36 @@ static void test_gtao_intervals(void **state)
     assert_true(same == 0.0);
     obs_deep_free(&d);
 
-    /* the closed box flush with the wall: as the flat buffer with the
-     * same parameters (single: the flat chain to the bit, test_gtao_deep) */
+    /* the closed box flush with the wall (0.7 deep, D = 1): as the flat
+     * buffer with the same parameters (single: the flat chain to the bit,
+     * test_gtao_deep) on the box and in the crease beside it (x >= 15);
+     * further off the flat buffer drops a box column whose front lies
+     * beyond D though the box's side still reaches into D (a ray that
+     * left the previous column within D meets it): there the intervals
+     * are darker, never lighter */
     slab_scene(&d, 9.3f, 10.0f);
-    double box = fmax(ao_diff(&d, &on, &off_x), ao_diff(&d, &on, &single_x));
+    double box = 0.0, far = 0.0;
+    {
+        obs_deep_result ra, rb;
+        char e2[OBS_ERR_LEN] = "";
+        assert_int_equal(obs_deep_run_cpu(&d, &on, &ra, e2), OBS_OK);
+        assert_int_equal(obs_deep_run_cpu(&d, &single_x, &rb, e2), OBS_OK);
+        for (int i = 0; i < d.width * d.height; i++) {
+            double diff = ra.ao_front.data[i] - rb.ao_front.data[i];
+            if (i % d.width >= 15)
+                box = fmax(box, fabs(diff));
+            else
+                far = fmax(far, diff);
+        }
+        obs_deep_result_free(&ra);
+        obs_deep_result_free(&rb);
+    }
     float crease = ao_at(&d, &on, 15, 16, NULL);
-    print_message("gtao, closed box: max |intervals - off, single| %.2e (AO beside it %.3f)\n", box,
-                  crease);
+    print_message("gtao, closed box: max |intervals - single| %.2e on it and within D, intervals - "
+                  "single further %.2e (AO beside it %.3f)\n", box, far, crease);
     assert_true(box < 1e-5);
+    assert_true(far < 1e-6);
+    assert_true(ao_diff(&d, &off_x, &single_x) < 1e-5); /* off = single */
     assert_true(crease < 0.95f); /* the crease is there */
 
     /* the defaults with intervals are the exact rows, bit for bit; a
@@ -819,6 +841,51 @@ static void test_gtao_intervals(void **state)
     obs_deep_params_resolve(&d, &off, &r); /* off: XeGTAO's defaults */
     assert_float_equal(r.gtao_radius_multiplier, 1.457f, 1e-6);
     obs_deep_free(&d);
+}
+
+/* The AO of the last node of pixel (x, y) (obs_deep_ao_nodes) */
+static float last_node_ao(const obs_deep_image *d, const obs_params *p, int x, int y)
+{
+    obs_deep_ao a;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_deep_ao_nodes(d, p, &a, err), OBS_OK);
+    size_t i = (size_t)y * (size_t)d->width + (size_t)x;
+    assert_true(a.offset[i + 1] > a.offset[i]);
+    float v = a.node[(a.offset[i + 1] - 1) * OBS_DEEP_AO_CH + OBS_DEEP_AO_AO];
+    obs_deep_ao_free(&a);
+    return v;
+}
+
+/* The wall under a closed slab raised off it (the ground under an
+ * animal's belly): the slab's back face at height h = 0.6 over the wall,
+ * D = 1, the slab covering the whole image.  With the hard cut a ray
+ * from the wall at angle t from the normal meets the slab within D where
+ * h / cos t <= D: the cosine-weighted open part is the rays with cos t <
+ * h / D, exactly (h / D)^2 = 0.36, whatever the slab's thickness (the
+ * solid beyond D does not count).  A slab whose front face lies beyond D
+ * (8.8, 1.2 over the wall) must give the thin slab's AO (front within D
+ * for the near columns): mapping that front face's angle to the tangent
+ * (XeGTAO's falloff for a horizon point beyond the radius) occupied
+ * every angle from the back face down to the tangent, the open gap under
+ * the slab (AO near 0).  The slab's faces lie at one depth each, where
+ * the distance at which a ray meets them is exact (gtao_deep.c,
+ * add_reach). */
+static void test_gtao_raised_slab(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    obs_params on = gtao_params(OBS_DEEP_MULTI, "on");
+    strip_scene(&d, 9.3f, 9.4f, 0, 32);
+    float thin = last_node_ao(&d, &on, 16, 16);
+    obs_deep_free(&d);
+    strip_scene(&d, 8.8f, 9.4f, 0, 32);
+    float thick = last_node_ao(&d, &on, 16, 16);
+    obs_deep_free(&d);
+    const float exact = 0.6f * 0.6f;
+    print_message("gtao, wall under a raised slab: AO thin %.4f, front beyond D %.4f, exact %.4f\n",
+                  thin, thick, exact);
+    assert_true(fabsf(thick - thin) < 1e-3f);
+    assert_true(fabsf(thick - exact) < 0.01f && fabsf(thin - exact) < 0.01f);
 }
 
 /* A floor seen at a grazing angle (view plane 2y + z = -6, one opaque
@@ -1024,6 +1091,29 @@ static void compare_gl(obs_ctx *ctx, const obs_deep_image *d, const obs_params *
     obs_deep_result_free(&c);
 }
 
+/* compare_gl for the AO of every kept node (obs_deep_run_nodes against
+ * obs_deep_ao_nodes): the hidden receivers */
+static void compare_gl_nodes(obs_ctx *ctx, const obs_deep_image *d, const obs_params *p,
+                             const char *what)
+{
+    obs_deep_result g;
+    obs_deep_ao gn, cn;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_deep_run_nodes(ctx, d, p, &g, &gn, err), OBS_OK);
+    assert_int_equal(obs_deep_ao_nodes(d, p, &cn, err), OBS_OK);
+    size_t npx = (size_t)d->width * (size_t)d->height;
+    assert_true(gn.offset[npx] == cn.offset[npx]);
+    double worst = 0.0;
+    for (uint64_t k = 0; k < cn.offset[npx]; k++)
+        worst = fmax(worst, fabs(gn.node[k * OBS_DEEP_AO_CH + OBS_DEEP_AO_AO] -
+                                 cn.node[k * OBS_DEEP_AO_CH + OBS_DEEP_AO_AO]));
+    print_message("%s: GL vs CPU, every node, max |diff| %.2e\n", what, worst);
+    assert_true(worst < 2e-3);
+    obs_deep_result_free(&g);
+    obs_deep_ao_free(&gn);
+    obs_deep_ao_free(&cn);
+}
+
 static void test_gl_twin(void **state)
 {
     (void)state;
@@ -1119,6 +1209,12 @@ static void test_gl_twin(void **state)
     compare_gl(ctx, &d, &p, "thin strip, gtao, defaults");
     assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
     compare_gl(ctx, &d, &p, "thin strip, gtao, defaults, m = 2");
+    obs_deep_free(&d);
+    /* the wall under a slab raised off it (test_gtao_raised_slab): the
+     * hidden receiver's own column, solids reached within D */
+    strip_scene(&d, 8.8f, 9.4f, 0, 32);
+    p = gtao_params(OBS_DEEP_MULTI, "on");
+    compare_gl_nodes(ctx, &d, &p, "raised slab, gtao, defaults");
     obs_deep_free(&d);
     obs_ctx_destroy(ctx);
 }
@@ -1310,6 +1406,7 @@ int main(void)
         cmocka_unit_test(test_gtao_deep),
         cmocka_unit_test(test_hbao_deep),
         cmocka_unit_test(test_gtao_intervals),
+        cmocka_unit_test(test_gtao_raised_slab),
         cmocka_unit_test(test_subpixel_sphere),
         cmocka_unit_test(test_hidden_occluder_hemisphere),
         cmocka_unit_test(test_methods_refused),
