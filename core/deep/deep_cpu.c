@@ -250,6 +250,14 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
                 fc[k] = df->layers.node[((size_t)k * npx + i) * OBS_DEEP_CH + OBS_DEEP_FACING];
             }
             obs__deep_intervals(z, fc, c, e);
+            /* a list eq 5 cut behind its last kept node, that one a back
+             * face: OBS__DEEP_END_CUT (what lies behind it is not known) */
+            if (c > 0 && e[c - 1] < 0.0f) {
+                const float zl = df->layers.node[((size_t)(c - 1) * npx + i) * OBS_DEEP_CH + OBS_DEEP_Z];
+                for (uint64_t k = d->offset[i]; k < d->offset[i + 1]; k++)
+                    if (d->samples[k * OBS_DEEP_CH + OBS_DEEP_Z] > zl)
+                        e[c - 1] = OBS__DEEP_END_CUT;
+            }
             for (int k = 0; k < c; k++)
                 df->end[(size_t)k * npx + i] = e[k];
         }

@@ -7,6 +7,10 @@
 #include "obscura/deep.h"
 #include "chain/frame.h"
 
+/* end of a list's last kept node, a back face, where eq 5 dropped nodes
+ * behind it: inside an interval (< 0) like -1, and the list goes on */
+#define OBS__DEEP_END_CUT (-2.0f)
+
 typedef struct obs__deep_frame {
     obs__frame f;   /* camera, R, the sample set, the depth range check */
     int m;          /* nodes per pixel */
@@ -22,7 +26,9 @@ typedef struct obs__deep_frame {
                      * ray (obs__deep_intervals): 0 solid behind it (no back
                      * face known), e > 0 solid from its depth to e (a front
                      * face and its matching back face), -1 inside an
-                     * interval a nearer node opened (adds nothing) */
+                     * interval a nearer node opened (adds nothing),
+                     * OBS__DEEP_END_CUT the same for a list's last node
+                     * where eq 5 dropped nodes behind it */
     obs_deep_layers layers;
 } obs__deep_frame;
 

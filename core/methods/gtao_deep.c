@@ -221,10 +221,18 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
         }
     }
     /* the last node met outside every interval: if it closes an interval,
-     * nothing lies behind that (solid behind it, the header) */
+     * nothing lies behind that (solid behind it, the header), unless the
+     * list was cut behind it (its last node's end OBS__DEEP_END_CUT,
+     * deep_internal.h: -2) */
+    int tail = -1;
     for (int k = 0; k < layers; k++)
-        if (q[(size_t)k * plane + 3] > 0.0f && !(end && end[(size_t)k * (plane / 4)] < 0.0f))
-            last = k;
+        if (q[(size_t)k * plane + 3] > 0.0f) {
+            tail = k;
+            if (!(end && end[(size_t)k * (plane / 4)] < 0.0f))
+                last = k;
+        }
+    if (end && tail >= 0 && end[(size_t)tail * (plane / 4)] < -1.5f)
+        last = -1;
     for (int k = 0; k < layers; k++) {
         const float *qk = q + (size_t)k * plane;
         const float e = end && k != last ? end[(size_t)k * (plane / 4)] : 0.0f;

@@ -207,11 +207,17 @@ float gtao_column(int side, ivec2 px, ivec2 q, bool border, vec4 xq, vec3 c, vec
     float ol = length(od);
     if (ol > 0.0)
         uz = vec2(sqrt(v.z * v.z + od.z * od.z / (ol * ol)), atan(od.z / ol, v.z));
+    int tail = -1;
     for (int k = 0; k < layers; k++) {
         vec4 qk = border ? xq : GT_NODE(q, k);
-        if (qk.w > 0.0 && !(!border && GT_END(q, k) < 0.0))
-            last = k;
+        if (qk.w > 0.0) {
+            tail = k;
+            if (!(!border && GT_END(q, k) < 0.0))
+                last = k;
+        }
     }
+    if (!border && tail >= 0 && GT_END(q, tail) < -1.5) // the list was cut behind it
+        last = -1;
     for (int k = 0; k < layers; k++) {
         vec4 qk = border ? xq : GT_NODE(q, k);
         float e = border || k == last ? 0.0 : GT_END(q, k);

@@ -888,6 +888,39 @@ static void test_gtao_raised_slab(void **state)
     assert_true(fabsf(thick - exact) < 0.01f && fabsf(thin - exact) < 0.01f);
 }
 
+/* A list cut by eq 5 behind a closed interval (deep_layers 2: the strip's
+ * front and back face kept, the wall behind dropped) does not say what
+ * lies behind the strip: it stays open there (OBS__DEEP_END_CUT), so the
+ * wall beside the strip gets the AO it has with the whole lists (m = 4);
+ * taking the strip as solid behind (the rule for a list that ends there)
+ * put the halo back (before: 0.598 at m = 2 against 0.780 at m = 4). */
+static void test_gtao_cut_list(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    char err[OBS_ERR_LEN] = "";
+    obs_params m4 = gtao_params(OBS_DEEP_MULTI, "on"), m2 = m4;
+    assert_int_equal(obs_param_set(&m2, "deep_layers", "2", err), OBS_OK);
+    strip_scene(&d, 9.3f, 9.4f, 16, 18);
+    float beside4 = ao_at(&d, &m4, 15, 16, NULL), beside2 = ao_at(&d, &m2, 15, 16, NULL);
+    double worst = 0.0; /* over the wall (the strip's own lists lose the wall behind it) */
+    obs_deep_result r4, r2;
+    assert_int_equal(obs_deep_run_cpu(&d, &m4, &r4, err), OBS_OK);
+    assert_int_equal(obs_deep_run_cpu(&d, &m2, &r2, err), OBS_OK);
+    for (int i = 0; i < d.width * d.height; i++)
+        if (i % d.width < 16 || i % d.width >= 18)
+            worst = fmax(worst, fabs(r4.ao_front.data[i] - r2.ao_front.data[i]));
+    obs_deep_result_free(&r4);
+    obs_deep_result_free(&r2);
+    print_message("gtao, list cut behind a strip: AO beside it m = 4 %.4f, m = 2 %.4f, max |diff| "
+                  "over the wall %.2e\n", beside4, beside2, worst);
+    /* m = 2 also drops the wall's own node at the strip's columns, whose
+     * horizon (c is scaled by 0.99999 off the wall) adds a trace */
+    assert_true(worst < 5e-3);
+    assert_true(fabsf(beside4 - beside2) < 1e-3);
+    obs_deep_free(&d);
+}
+
 /* A floor seen at a grazing angle (view plane 2y + z = -6, one opaque
  * node per pixel, normals derived from depth) with a tangent sphere
  * smaller than a pixel (radius 0.002): a sample on the shaded pixel reads
@@ -1216,6 +1249,11 @@ static void test_gl_twin(void **state)
     p = gtao_params(OBS_DEEP_MULTI, "on");
     compare_gl_nodes(ctx, &d, &p, "raised slab, gtao, defaults");
     obs_deep_free(&d);
+    /* lists cut behind a strip (test_gtao_cut_list): OBS__DEEP_END_CUT */
+    strip_scene(&d, 9.3f, 9.4f, 16, 18);
+    assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "strip, lists cut, gtao, defaults, m = 2");
+    obs_deep_free(&d);
     obs_ctx_destroy(ctx);
 }
 
@@ -1407,6 +1445,7 @@ int main(void)
         cmocka_unit_test(test_hbao_deep),
         cmocka_unit_test(test_gtao_intervals),
         cmocka_unit_test(test_gtao_raised_slab),
+        cmocka_unit_test(test_gtao_cut_list),
         cmocka_unit_test(test_subpixel_sphere),
         cmocka_unit_test(test_hidden_occluder_hemisphere),
         cmocka_unit_test(test_methods_refused),
