@@ -258,6 +258,8 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
                     if (d->samples[k * OBS_DEEP_CH + OBS_DEEP_Z] > zl)
                         e[c - 1] = OBS__DEEP_END_CUT;
             }
+            if (df->f.method == OBS_METHOD_GTAO)
+                obs__deep_sheets(z, fc, c, e);
             for (int k = 0; k < c; k++)
                 df->end[(size_t)k * npx + i] = e[k];
         }
@@ -302,6 +304,13 @@ void obs__deep_intervals(const float *z, const float *facing, int count, float *
             end[k] = 0.0f;
         k0 = open + 1;
     }
+}
+
+void obs__deep_sheets(const float *z, const float *facing, int count, float *end)
+{
+    for (int k = 0; k + 1 < count; k++) /* not the last: a node behind it */
+        if (end[k] == 0.0f && facing[k] != 0.0f && z[k] > 0.0f)
+            end[k] = z[k];
 }
 
 /* GLSL: interval_occlusion() in deep.frag.glsl.  The length of the pipe

@@ -28,7 +28,8 @@ typedef struct obs__deep_frame {
                      * face and its matching back face), -1 inside an
                      * interval a nearer node opened (adds nothing),
                      * OBS__DEEP_END_CUT the same for a list's last node
-                     * where eq 5 dropped nodes behind it */
+                     * where eq 5 dropped nodes behind it; method gtao:
+                     * e = the node's depth for a sheet (obs__deep_sheets) */
     obs_deep_layers layers;
 } obs__deep_frame;
 
@@ -70,6 +71,20 @@ obs_status obs__deep_ao_pack(const obs_deep_image *d, const obs__deep_frame *df,
  * depths and OBS_DEEP_FACING values, front to back; writes end[0 ..
  * count - 1]. */
 void obs__deep_intervals(const float *z, const float *facing, int count, float *end);
+
+/* Method gtao's ends (gtao_deep.c): a node obs__deep_intervals left solid
+ * behind (end 0) whose facing is known and that has a node behind it in
+ * the list is a one-sided surface of an open mesh, a sheet: end = its own
+ * depth, an interval of no thickness.  The facing flags say the space
+ * behind it is not inside a solid: a back face's outside is behind it, and
+ * the node after an unmatched front face is a front face (a back face
+ * would have matched it), whose outside, in front of it, is free; the
+ * list then shows the surfaces behind, so the sheet is what the ray tracer
+ * takes every triangle to be: a surface of no thickness.  The list's last
+ * node stays solid behind (nothing behind it is known: a room's
+ * one-sided wall).  z, facing, count, end: as obs__deep_intervals, end
+ * its output. */
+void obs__deep_sheets(const float *z, const float *facing, int count, float *end);
 
 /* The AO (1 = open) of node k at pixel (x, y): OITAO Algorithm 1 with
  * VAO++'s pipe through the tangent sphere as GetAO (with f.method
