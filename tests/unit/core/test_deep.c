@@ -955,15 +955,21 @@ static void test_gtao_sheet(void **state)
     const float closed = ao_at(&d, &on, 15, 16, NULL), open = ao_at(&d, &on, 4, 16, NULL);
     obs_deep_free(&d);
     float sheet[2];
+    /* the strip solid behind (the previous rule): every node solid
+     * behind, the horizon form, as without intervals at the same rows */
+    const obs_params off = gtao_exact(gtao_params(OBS_DEEP_MULTI, "off"));
+    float solid = 0.0f;
     for (int i = 0; i < 2; i++) {
         sheet_scene(&d, 9.3f, i ? 1.0f : -1.0f, 16, 18);
         sheet[i] = ao_at(&d, &on, 15, 16, NULL);
+        solid = ao_at(&d, &off, 15, 16, NULL);
         obs_deep_free(&d);
     }
     print_message("gtao, one-sided strip before the wall: AO beside it seen from behind %.4f, "
-                  "from the front %.4f, closed strip of no thickness %.4f, open wall %.4f\n",
-                  sheet[0], sheet[1], closed, open);
+                  "from the front %.4f, closed strip of no thickness %.4f, open wall %.4f, "
+                  "strip solid behind %.4f\n", sheet[0], sheet[1], closed, open, solid);
     assert_true(closed < open - 0.01f); /* the strip occludes the wall beside it */
+    assert_true(solid < closed - 0.05f); /* a horizon over the gap behind it */
     assert_float_equal(sheet[0], closed, 1e-6);
     assert_float_equal(sheet[1], closed, 1e-6);
 }
