@@ -422,20 +422,26 @@ static void slab_scene(obs_deep_image *d, float zf, float zb)
         }
 }
 
-/* slab_scene with the slab over columns x0 .. x1 - 1 only (a strip) */
-static void strip_scene(obs_deep_image *d, float zf, float zb, int x0, int x1)
+/* the wall at depth 10 (its list's last node) and over columns x0 .. x1 -
+ * 1 the n faces at depths z with facing f in front of it */
+static void faces_scene(obs_deep_image *d, int x0, int x1, int n, const float *z, const float *f)
 {
     synth_init(d, 32, 32);
     d->has_facing = 1;
     for (int y = 0; y < 32; y++)
         for (int x = 0; x < 32; x++) {
             synth_next(d, x, y);
-            if (x >= x0 && x < x1) {
-                synth_face(d, x, y, zf, 1.0f);
-                synth_face(d, x, y, zb, -1.0f);
-            }
+            for (int k = 0; x >= x0 && x < x1 && k < n; k++)
+                synth_face(d, x, y, z[k], f[k]);
             synth_face(d, x, y, 10.0f, 1.0f);
         }
+}
+
+/* slab_scene with the slab over columns x0 .. x1 - 1 only (a strip) */
+static void strip_scene(obs_deep_image *d, float zf, float zb, int x0, int x1)
+{
+    const float z[2] = {zf, zb}, f[2] = {1.0f, -1.0f};
+    faces_scene(d, x0, x1, 2, z, f);
 }
 
 static void slab_scene_free_and(obs_deep_image *d, float zf, float zb)
@@ -481,20 +487,11 @@ static void test_interval_lists(void **state)
     }
 }
 
-/* a wall at depth 10 (its list's last node) and over columns x0 .. x1 - 1
- * a one-sided surface at depth z with facing `facing` (-1: seen from
- * behind) in front of it, with no back face */
+/* a one-sided surface at depth z (facing -1: seen from behind) over
+ * columns x0 .. x1 - 1 before the wall, no back face */
 static void sheet_scene(obs_deep_image *d, float z, float facing, int x0, int x1)
 {
-    synth_init(d, 32, 32);
-    d->has_facing = 1;
-    for (int y = 0; y < 32; y++)
-        for (int x = 0; x < 32; x++) {
-            synth_next(d, x, y);
-            if (x >= x0 && x < x1)
-                synth_face(d, x, y, z, facing);
-            synth_face(d, x, y, 10.0f, 1.0f);
-        }
+    faces_scene(d, x0, x1, 1, &z, &facing);
 }
 
 static void face_sample(float *s, float z, float facing, float tag)
