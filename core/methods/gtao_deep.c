@@ -44,7 +44,7 @@
  * behind (a horizon over the whole gap behind it) blocked every ray past
  * it: measured on the street scene, the darkening that grew with the
  * steps (each denser step a new chance to meet such a column; the
- * horizon is a maximum) was mostly away from the ray tracer's AO.
+ * horizon is a maximum) was half of it away from the ray tracer's AO.
  * The visible set is what no arc occupies: the sum over the free arcs
  * [t0, t1] of a(t1) - a(t0).  The nodes solid behind them bound the side
  * by their highest horizon as before, and as every free range then starts
