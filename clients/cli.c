@@ -264,20 +264,15 @@ void cli_max_memory(obs_cpu_options *o)
 {
     o->max_memory = max_memory.bytes;
     o->max_memory_name = max_memory.bytes ? max_memory.name : "the memory budget (a quarter of the "
-                                                              "machine's; --max-memory MIB sets it)";
+                                                              "usable memory; --max-memory MIB sets it)";
 }
 
 int cli_max_memory_given(void) { return max_memory.name[0] == '-'; }
 
 const char *cli_max_memory_text(void)
 {
-    size_t phys = obs_cpu_memory_usable();
-    if (!max_memory.bytes && phys)
-        snprintf(max_memory.text, sizeof max_memory.text, "%zu MiB (default: a quarter of %.1f GiB; "
-                 "--max-memory MIB sets it)", obs_cpu_memory_budget(NULL) >> 20, (double)phys / 1073741824.0);
-    else if (!max_memory.bytes)
-        snprintf(max_memory.text, sizeof max_memory.text, "%zu MiB (default: the usable memory is not "
-                 "known; --max-memory MIB sets it)", obs_cpu_memory_budget(NULL) >> 20);
+    if (!max_memory.bytes)
+        obs_cpu_memory_default_text(max_memory.text, sizeof max_memory.text);
     return max_memory.text;
 }
 

@@ -117,7 +117,7 @@ static const cli_opt ao_opts[] = {
     {"threads", "N", "the threads this process may run, 1..64 (or OBSCURA_THREADS; default every "
      "core): llvmpipe's (LP_NUM_THREADS, unless set) and every worker pool's"},
     {"max-memory", "MIB", "the memory a frame on the CPU device may hold, in MiB (or "
-     "OBSCURA_MAX_MEMORY; default a quarter of the machine's): over it the frame runs in bands of "
+     "OBSCURA_MAX_MEMORY; default a quarter of the usable memory): over it the frame runs in bands of "
      "rows, the same result (README \"Frames larger than memory\")"},
     {"server", "URL[,URL...]", "run on obscurad: http://HOST:PORT, unix:/PATH or tcp://HOST:PORT; a "
      "comma list spreads frames over several (the next one when one is busy or down)"},

@@ -188,13 +188,13 @@ static int max_memory(obsd_config *cfg)
 static void log_max_memory(const obsd_config *cfg)
 {
     const obsd_opt_info *o = obsd_opt_find("max_memory");
+    char text[160];
     if (cfg->max_memory)
-        obsd_log(OBSD_LOG_INFO, "memory budget: %d MiB a frame on the CPU device (%s)", cfg->max_memory,
+        snprintf(text, sizeof text, "%d MiB (%s)", cfg->max_memory,
                  cfg->set[o - obsd_opt_at(0)] ? "--max-memory" : "OBSCURA_MAX_MEMORY");
     else
-        obsd_log(OBSD_LOG_INFO, "memory budget: %zu MiB a frame on the CPU device (default: a quarter "
-                 "of %.1f GiB; --max-memory MIB sets it)", obs_cpu_memory_budget(NULL) >> 20,
-                 (double)obs_cpu_memory_usable() / 1073741824.0);
+        obs_cpu_memory_default_text(text, sizeof text);
+    obsd_log(OBSD_LOG_INFO, "memory budget of a frame on the CPU device: %s", text);
 }
 
 /* The threads line: a farm slot's limit is kept only when it reached

@@ -310,17 +310,6 @@ static obs_status band_run(obs__cpu_run *c, obs__plan *pl, const band *b, obs_pa
     return s;
 }
 
-size_t obs_cpu_memory_budget(const obs_cpu_options *opt) { return obs__bands_budget(opt); }
-
-
-size_t obs__bands_budget(const obs_cpu_options *opt)
-{
-    if (opt && opt->max_memory > 0)
-        return opt->max_memory;
-    size_t phys = obs_cpu_memory_usable();
-    return phys ? phys / 4 : (size_t)1 << 31; /* a quarter of the usable memory; not known: 2 GiB */
-}
-
 int obs__bands_rows(obs__cpu_run *c, const obs_cpu_options *opt)
 {
     const obs__plan *pl = c->pl;
@@ -329,7 +318,7 @@ int obs__bands_rows(obs__cpu_run *c, const obs_cpu_options *opt)
         return 0;
     if (opt && opt->band_rows > 0)
         return opt->band_rows < pl->f.height ? opt->band_rows : 0;
-    size_t need = obs__cpu_planes_need(c), budget = obs__bands_budget(opt);
+    size_t need = obs__cpu_planes_need(c), budget = obs_cpu_memory_budget(opt);
     if (need <= budget)
         return 0;
     /* the first try: half the budget's rows (obs__bands_run fits each
@@ -380,7 +369,7 @@ static obs_status bands_loop(obs__cpu_run *c, obs__plan *pl, int rows, const int
 {
     const int H = pl->f.height;
     const int forced = opt && opt->band_rows > 0;
-    const size_t budget = obs__bands_budget(opt);
+    const size_t budget = obs_cpu_memory_budget(opt);
     obs_status s = OBS_OK;
     int over = 0, over_halo = 0; /* bands over the budget, their largest halo: said at the end */
     size_t over_need = 0;

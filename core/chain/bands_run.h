@@ -14,9 +14,6 @@
  * rows' reach, before the bands. */
 #define OBS__BANDS_REACH_ROWS 256
 
-/* The bytes the chain's planes may take: opt->max_memory, else a quarter
- * of the usable memory (obs_cpu_memory_usable). */
-size_t obs__bands_budget(const obs_cpu_options *opt);
 
 /* The rows of the first try at a band for c's plan (c->pl set, its rows
  * not): opt->band_rows when set, else 0 (the whole frame) when its planes

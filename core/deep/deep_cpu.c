@@ -255,8 +255,10 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
             if (c > 0 && e[c - 1] < 0.0f) {
                 const float zl = df->layers.node[((size_t)(c - 1) * npx + i) * OBS_DEEP_CH + OBS_DEEP_Z];
                 for (uint64_t k = d->offset[i]; k < d->offset[i + 1]; k++)
-                    if (d->samples[k * OBS_DEEP_CH + OBS_DEEP_Z] > zl)
+                    if (d->samples[k * OBS_DEEP_CH + OBS_DEEP_Z] > zl) {
                         e[c - 1] = OBS__DEEP_END_CUT;
+                        break;
+                    }
             }
             if (df->f.method == OBS_METHOD_GTAO)
                 obs__deep_sheets(z, fc, c, e);

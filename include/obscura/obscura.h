@@ -330,6 +330,10 @@ size_t obs_cpu_memory_budget(const obs_cpu_options *opt);
  * MemoryMax); 0 when not known. */
 size_t obs_cpu_memory_usable(void);
 
+/* The default budget as the CLI and the daemon say it: "N MiB (default:
+ * a quarter of G GiB usable; --max-memory MIB sets it)". */
+void obs_cpu_memory_default_text(char *buf, size_t n);
+
 /* A frame that is never whole in memory, on the CPU device: run in bands
  * of rows as obs_run_cpu_opts runs a frame over its memory budget (the
  * same result, byte for byte), each band's rows of the G-buffer asked of

@@ -90,11 +90,11 @@ c1=$(post "$PORT_tiny" "$CAM" "$R" "$T/d_tiny.exr")
 check "obscurad --max-memory 1: HTTP $c1, the AO bytes of a daemon without a budget (HTTP $c0)" \
     "[ '$c0' = 200 ] && [ '$c1' = 200 ] && cmp -s '$T/d_whole.exr' '$T/d_tiny.exr'"
 check "obscurad --max-memory 1 over OBSCURA_MAX_MEMORY: the start log says it, the frame ran in bands" \
-    "grep -q 'memory budget: 1 MiB a frame on the CPU device (--max-memory)' '$T/tiny.log' && grep -q 'band 3: rows' '$T/tiny.log'"
+    "grep -q 'memory budget of a frame on the CPU device: 1 MiB (--max-memory)' '$T/tiny.log' && grep -q 'band 3: rows' '$T/tiny.log'"
 check "obscurad: the band over the budget is a warning naming the option" \
     "grep -q \"warn: --max-memory 1 MiB: the AO's samples reach\" '$T/tiny.log'"
 check "obscurad without a budget: the start log says the default" \
-    "grep -q 'memory budget: [0-9]* MiB a frame on the CPU device (default: a quarter of' '$T/whole.log'"
+    "grep -q 'memory budget of a frame on the CPU device: [0-9]* MiB (default: a quarter of' '$T/whole.log'"
 expect 0 "obscura ao --server with --max-memory: the frame on obscurad" -- "$OBSCURA" ao "$R" --camera "$CAMJ" \
     --server "http://127.0.0.1:$PORT_whole" --max-memory 1 -o "$T/remote.exr"
 said "the frame runs on obscurad, whose own --max-memory applies"
