@@ -78,19 +78,34 @@
  * before it). */
 #include <math.h>
 
+#include "chain/lanes.h"
 #include "chain/mask_weight.h"
 #include "methods/gtao_deep.h"
 
-static float clampf(float v, float lo, float hi) { return fminf(fmaxf(v, lo), hi); }
+/* fminf and fmaxf as glibc computes them, inline (lanes.h): gcc calls
+ * libm for them, several times per node */
+static float clampf(float v, float lo, float hi) { return min_f(max_f(v, lo), hi); }
 static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/* The horizon cosine of the point c + d moved from the tangent's `low`
- * by its falloff weight times om, as sample_cos in gtao.c; low where d
- * is 0: the horizon form of a node solid behind it. */
-static float weighted_cos(const float fw[3], const float d[3], const float v[3], float low,
-                          float om)
+/* The angles from v of the columns' points are kept as their cosines
+ * until an arc is added: acos is decreasing, so the larger of two angles
+ * is the arc cosine of the smaller cosine, and a clip that leaves an arc
+ * empty is seen on the cosines, without the arc cosines (most clips:
+ * most columns add no arc).  The same arcs as taking the angles first. */
+
+/* the cosine of the angle of d from v, clamped to [-1, 1] (dist: |d|);
+ * low where d is 0 */
+static float true_cos(const float d[3], float dist, const float v[3], float low)
 {
-    float dist = sqrtf(dot3(d, d));
+    return clampf(dist > 0.0f ? dot3(d, v) / dist : low, -1.0f, 1.0f);
+}
+
+/* The horizon cosine of the point c + d (dist: |d|) moved from the
+ * tangent's `low` by its falloff weight times om, as sample_cos in
+ * gtao.c; low where d is 0: the horizon form of a node solid behind it. */
+static float weighted_cos(const float fw[3], const float d[3], float dist, const float v[3],
+                          float low, float om)
+{
     if (!(dist > 0.0f))
         return low;
     float shc = dot3(d, v) / dist;
@@ -98,13 +113,6 @@ static float weighted_cos(const float fw[3], const float d[3], const float v[3],
     float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
     float w = clampf(fb * fw[0] + fw[1], 0.0f, 1.0f) * om;
     return low + (shc - low) * w;
-}
-
-/* the angle of d from v (no falloff); acos(low) where d is 0 */
-static float true_angle(const float d[3], const float v[3], float low)
-{
-    float dist = sqrtf(dot3(d, d));
-    return acosf(clampf(dist > 0.0f ? dot3(d, v) / dist : low, -1.0f, 1.0f));
 }
 
 /* The part of the column's ray o + s dir (s the planar depth) where the
@@ -129,13 +137,14 @@ static int chord(const float fw[3], const float o[3], const float dir[3], const 
     return 1;
 }
 
-/* the angle from v of the column's point at depth z, seen from c */
-static float depth_angle(const float o[3], const float dir[3], float z, const float c[3],
-                         const float v[3], float low)
+/* the cosine of the angle from v of the column's point at depth z, seen
+ * from c */
+static float depth_cos(const float o[3], const float dir[3], float z, const float c[3],
+                       const float v[3], float low)
 {
     const float d[3] = {o[0] + z * dir[0] - c[0], o[1] + z * dir[1] - c[1],
                         o[2] + z * dir[2] - c[2]};
-    return true_angle(d, v, low);
+    return true_cos(d, sqrtf(dot3(d, d)), v, low);
 }
 
 /* adds the occupied arc [lo, hi] to the side, sorted by lo */
@@ -145,8 +154,8 @@ static void add_arc(obs__gtao_side *s, float lo, float hi)
         return;
     int i = s->n;
     if (i == OBS__GTAO_MAX_ARCS) { /* not reached (the bound's comment): widen the last arc */
-        s->lo[i - 1] = fminf(s->lo[i - 1], lo);
-        s->hi[i - 1] = fmaxf(s->hi[i - 1], hi);
+        s->lo[i - 1] = min_f(s->lo[i - 1], lo);
+        s->hi[i - 1] = max_f(s->hi[i - 1], hi);
         return;
     }
     for (; i > 0 && s->lo[i - 1] > lo; i--) {
@@ -158,75 +167,94 @@ static void add_arc(obs__gtao_side *s, float lo, float hi)
     s->n++;
 }
 
-/* Adds the arc [lo, hi] of a solid met between the previous column and
- * this one, where it can lie within the radius r: where the ray left the
- * previous column within r (the side's window) and reaches the solid's
- * depths [zlo, zhi] within r.  The solid lies at those depths (the
- * surfaces bounding it continued between the columns at the depths
- * they have here), so a ray from c (planar depth cz) meets it no nearer
- * than where it reaches the band: at |cz - z| / |u_z| for the band's
- * near edge z, u the ray's direction; in the slice u_z(t) = A cos(t -
- * p0) (uz: A and p0).  Both are lower bounds of the distance of the
- * surface crossed, exact for a face at one depth. */
-static void add_reach(obs__gtao_side *s, float lo, float hi, float zlo, float zhi, float cz,
-                      float r, const float uz[2])
+/* The column's ray and what add_reach reads of it: the slice's direction
+ * on this side, u_z(t) = uz[0] cos(t - uz[1]), taken from the ray where
+ * first needed (have_uz); pc: the ray's point at the centre's depth,
+ * less c. */
+typedef struct column_ray {
+    const float *v;
+    float pc[3], r, cz0, uz[2];
+    int have_uz;
+} column_ray;
+
+static void ray_uz(column_ray *cr)
 {
-    const float pi = (float)M_PI;
-    lo = fmaxf(lo, s->win[0]);
-    hi = fminf(hi, s->win[1]);
-    if (!(hi > lo))
+    const float *v = cr->v;
+    const float pv = dot3(cr->pc, v);
+    const float od[3] = {cr->pc[0] - pv * v[0], cr->pc[1] - pv * v[1], cr->pc[2] - pv * v[2]};
+    const float ol = sqrtf(dot3(od, od));
+    cr->uz[0] = cr->uz[1] = 0.0f;
+    if (ol > 0.0f) {
+        cr->uz[0] = sqrtf(v[2] * v[2] + od[2] * od[2] / (ol * ol));
+        cr->uz[1] = atan2f(od[2] / ol, v[2]);
+    }
+    cr->have_uz = 1;
+}
+
+/* Adds the arc of a solid met between the previous column and this one,
+ * the angles whose cosines are [clo, chi] (clo >= chi), where it can lie
+ * within the radius r: where the ray left the previous column within r
+ * (the side's window) and reaches the solid's depths [zlo, zhi] within
+ * r.  The solid lies at those depths (the surfaces bounding it continued
+ * between the columns at the depths they have here), so a ray from c
+ * (planar depth cz) meets it no nearer than where it reaches the band:
+ * at |cz - z| / |u_z| for the band's near edge z, u the ray's direction;
+ * in the slice u_z(t) = A cos(t - p0) (cr's uz: A and p0).  Both are
+ * lower bounds of the distance of the surface crossed, exact for a face
+ * at one depth. */
+static void add_reach(obs__gtao_side *s, float clo, float chi, float zlo, float zhi,
+                      column_ray *cr)
+{
+    const float pi = (float)M_PI, cz = cr->cz0, r = cr->r;
+    /* the window's clip on the cosines: empty there where it is empty on
+     * the angles (acos decreasing) */
+    clo = min_f(clo, s->win[0]);
+    chi = max_f(chi, s->win[1]);
+    if (!(chi < clo))
         return;
     const float dz = cz < zlo ? zlo - cz : cz > zhi ? cz - zhi : 0.0f;
     if (!(dz > 0.0f)) { /* c at the band's depths */
-        add_arc(s, lo, hi);
+        add_arc(s, acosf(clo), acosf(chi));
         return;
     }
-    if (!(uz[0] * r > dz))
+    if (!cr->have_uz)
+        ray_uz(cr);
+    if (!(cr->uz[0] * r > dz))
         return; /* no ray of the slice reaches the band within r */
-    const float half = acosf(dz / (r * uz[0]));
-    const float mid = cz > zhi ? uz[1] : uz[1] + pi; /* towards the camera: u_z > 0 */
+    const float lo = acosf(clo), hi = acosf(chi);
+    const float half = acosf(dz / (r * cr->uz[0]));
+    const float mid = cz > zhi ? cr->uz[1] : cr->uz[1] + pi; /* towards the camera: u_z > 0 */
     for (int i = -1; i <= 1; i++)
-        add_arc(s, fmaxf(lo, mid + 2.0f * pi * (float)i - half),
-                fminf(hi, mid + 2.0f * pi * (float)i + half));
+        add_arc(s, max_f(lo, mid + 2.0f * pi * (float)i - half),
+                min_f(hi, mid + 2.0f * pi * (float)i + half));
 }
 
 void obs__gtao_side_start(obs__gtao_side *s, const float c[3], float z0)
 {
     s->n = 0;
     s->gaps = 1;
-    s->z[0][0] = fminf(z0, -c[2]);
+    s->z[0][0] = min_f(z0, -c[2]);
     s->z[0][1] = -c[2];
-    s->t[0][0] = s->win[0] = 0.0f;
-    s->t[0][1] = s->win[1] = (float)M_PI;
+    s->t[0][0] = s->win[0] = 1.0f; /* the angles 0 and pi */
+    s->t[0][1] = s->win[1] = -1.0f;
 }
 
 float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s, const float *q,
                        const float *end, size_t plane, int layers, int x, int y, int self, int qx,
                        int qy, const float c[3], const float v[3], float low)
 {
-    float gz[OBS__GTAO_MAX_GAPS][2], gt[OBS__GTAO_MAX_GAPS][2];
-    float hc = low, cz = 0.0f, ct = 0.0f; /* the free range open from depth cz */
+    float gz[OBS__GTAO_MAX_GAPS][2], gt[OBS__GTAO_MAX_GAPS][2]; /* gt: cosines */
+    float hc = low, cz = 0.0f, ct = 1.0f; /* the free range open from depth cz (angle 0) */
     int ng = 0, open = 1, last = -1;
     /* the column's ray and the depths [cs0, cs1] of it within the
      * radius: the window of the solids met after it (the header) */
-    float ndc[2], o[3], dir[3], cs[2];
+    float ndc[2], o[3], dir[3], cs[2] = {0.0f, 0.0f};
     obs__px_ndc(f, qx, qy, ndc);
     obs__view_ray(f->proj, ndc, o, dir);
     const int near = chord(fw, o, dir, c, cs);
-    /* the slice's direction on this side (from the column's ray): u_z */
-    const float r = -fw[1] / fw[0], cz0 = -c[2];
-    float uz[2] = {0.0f, 0.0f};
-    {
-        const float pc[3] = {o[0] + cz0 * dir[0] - c[0], o[1] + cz0 * dir[1] - c[1],
-                             o[2] + cz0 * dir[2] - c[2]};
-        const float pv = dot3(pc, v);
-        const float od[3] = {pc[0] - pv * v[0], pc[1] - pv * v[1], pc[2] - pv * v[2]};
-        const float ol = sqrtf(dot3(od, od));
-        if (ol > 0.0f) {
-            uz[0] = sqrtf(v[2] * v[2] + od[2] * od[2] / (ol * ol));
-            uz[1] = atan2f(od[2] / ol, v[2]);
-        }
-    }
+    column_ray cr = {v, {0.0f, 0.0f, 0.0f}, -fw[1] / fw[0], -c[2], {0.0f, 0.0f}, 0};
+    for (int i = 0; i < 3; i++)
+        cr.pc[i] = o[i] + cr.cz0 * dir[i] - c[i];
     /* the last node met outside every interval: if it closes an interval,
      * nothing lies behind that (solid behind it, the header), unless the
      * list was cut behind it (its last node's end OBS__DEEP_END_CUT,
@@ -246,12 +274,13 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
         if (!(qk[3] > 0.0f) || e < 0.0f)
             continue; /* empty, or inside a nearer node's interval */
         const float d[3] = {qk[0] - c[0], qk[1] - c[1], qk[2] - c[2]};
+        const float dist = sqrtf(dot3(d, d));
         if (e == 0.0f) /* solid behind: the horizon form */
-            hc = fmaxf(hc, weighted_cos(fw, d, v, low,
+            hc = max_f(hc, weighted_cos(fw, d, dist, v, low,
                                         obs__occluder_weight_node(f, x, y, self, qx, qy, k)));
         if (!open)
             continue; /* behind a node solid behind it: no free range */
-        const float tf = true_angle(d, v, low);
+        const float tf = true_cos(d, dist, v, low);
         if (qk[3] > cz && ng < OBS__GTAO_MAX_GAPS) { /* the free range in front of it */
             gz[ng][0] = cz, gz[ng][1] = qk[3];
             gt[ng][0] = ct, gt[ng][1] = tf;
@@ -266,13 +295,13 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
          * the arc between their angles where a ray meets it within the
          * radius (add_reach) */
         cz = e;
-        ct = depth_angle(o, dir, e, c, v, low);
+        ct = depth_cos(o, dir, e, c, v, low);
         if (obs__occluder_weight_node(f, x, y, self, qx, qy, k) > 0.0f)
-            add_reach(s, tf, ct, qk[3], e, cz0, r, uz);
+            add_reach(s, tf, ct, qk[3], e, &cr);
     }
     if (open && ng < OBS__GTAO_MAX_GAPS) { /* no surface from cz on */
         gz[ng][0] = cz, gz[ng][1] = INFINITY;
-        gt[ng][0] = ct, gt[ng][1] = (float)M_PI;
+        gt[ng][0] = ct, gt[ng][1] = -1.0f; /* the angle pi */
         ng++;
     }
     /* a ray from a free range of the previous column to one of this
@@ -282,15 +311,18 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
         for (int b = 0; b < ng; b++) {
             if (s->z[a][0] < gz[b][1] && gz[b][0] < s->z[a][1])
                 continue; /* one free space */
-            /* the surface crossed lies at the depths between the two */
+            /* the surface crossed lies at the depths between the two,
+             * at the angles both ranges' arcs hold (the larger start,
+             * the smaller end: on the cosines, the smaller and the
+             * larger) */
             const int before = s->z[a][1] <= gz[b][0];
-            add_reach(s, fmaxf(s->t[a][0], gt[b][0]), fminf(s->t[a][1], gt[b][1]),
-                      before ? s->z[a][1] : gz[b][1], before ? gz[b][0] : s->z[a][0], cz0, r, uz);
+            add_reach(s, min_f(s->t[a][0], gt[b][0]), max_f(s->t[a][1], gt[b][1]),
+                      before ? s->z[a][1] : gz[b][1], before ? gz[b][0] : s->z[a][0], &cr);
         }
-    s->win[0] = s->win[1] = 0.0f; /* this column's window, for the next */
+    s->win[0] = s->win[1] = 1.0f; /* this column's window, for the next: empty */
     if (near && cs[1] > 0.0f) {
-        s->win[0] = depth_angle(o, dir, fmaxf(cs[0], 0.0f), c, v, low);
-        s->win[1] = depth_angle(o, dir, cs[1], c, v, low);
+        s->win[0] = depth_cos(o, dir, max_f(cs[0], 0.0f), c, v, low);
+        s->win[1] = depth_cos(o, dir, cs[1], c, v, low);
     }
     s->gaps = ng;
     for (int b = 0; b < ng; b++)
@@ -307,7 +339,7 @@ float obs__gtao_centre_start(const float *q, const float *end, size_t plane, int
     for (int k = 0; k < self; k++) {
         const float w = q[(size_t)k * plane + 3], e = end[(size_t)k * (plane / 4)];
         if (w > 0.0f && e >= 0.0f)
-            z0 = fmaxf(z0, e > 0.0f ? e : w);
+            z0 = max_f(z0, e > 0.0f ? e : w);
     }
     return z0;
 }
@@ -330,16 +362,16 @@ static float side_free(const obs__gtao_side *a, float h, float s, float gamma, f
     for (int i = 0; i <= a->n; i++) {
         float lo = end, hi = end;
         if (i < a->n) {
-            lo = s > 0.0f ? gamma + fminf(a->lo[i] - gamma, half_pi)
-                          : gamma + fmaxf(-a->lo[i] - gamma, -half_pi);
-            hi = s > 0.0f ? gamma + fminf(a->hi[i] - gamma, half_pi)
-                          : gamma + fmaxf(-a->hi[i] - gamma, -half_pi);
-            lo = fminf(s * lo, end);
+            lo = s > 0.0f ? gamma + min_f(a->lo[i] - gamma, half_pi)
+                          : gamma + max_f(-a->lo[i] - gamma, -half_pi);
+            hi = s > 0.0f ? gamma + min_f(a->hi[i] - gamma, half_pi)
+                          : gamma + max_f(-a->hi[i] - gamma, -half_pi);
+            lo = min_f(s * lo, end);
             hi = s * hi;
         }
         if (lo > cur) /* free from cur to lo */
             sum += arc(s * lo, gamma, cos_g) - (cur > 0.0f ? arc(s * cur, gamma, cos_g) : 0.0f);
-        cur = fmaxf(cur, hi);
+        cur = max_f(cur, hi);
         if (cur >= end)
             break;
     }

@@ -19,13 +19,14 @@
 
 /* One side of a slice: its occupied arcs as angles from the view vector
  * v (0 .. pi, the side's own sign left out), sorted by their near end;
- * the free depth ranges z of the last column read, each with the angles
- * of its ends (true angles: where rays cross). */
+ * the free depth ranges z of the last column read, each with the cosines
+ * of its ends' angles (true angles: where rays cross; cosines until an
+ * arc needs them, gtao_deep.c). */
 typedef struct obs__gtao_side {
     int n, gaps;
     float lo[OBS__GTAO_MAX_ARCS], hi[OBS__GTAO_MAX_ARCS];
     float z[OBS__GTAO_MAX_GAPS][2], t[OBS__GTAO_MAX_GAPS][2];
-    float win[2]; /* the angles where the last column's ray lies within the radius */
+    float win[2]; /* the cosines of the angles where the last column's ray lies within the radius */
 } obs__gtao_side;
 
 /* Starts a side at the centre c: no arcs; the centre's column is the
