@@ -178,12 +178,34 @@ static inline int obs__tile_index(const obs__frame *f, int x, int y)
     return 3 * tx + ty;
 }
 
-/* Pixel centre (x, y) of the planes -> NDC of the display window. */
-void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2]);
+/* Pixel centre (x, y) of the planes -> NDC of the display window (GLSL:
+ * px_ndc() in common.glsl).  Inline: method gtao on deep intervals takes
+ * it, with obs__view_ray, for every step's column (methods/gtao_deep.c). */
+static inline void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2])
+{
+    ndc[0] = ((float)x + 0.5f + f->viewport[0]) / f->viewport[2] * 2.0f - 1.0f;
+    ndc[1] = 1.0f - ((float)y + 0.5f + f->viewport[1]) / f->viewport[3] * 2.0f;
+}
 
 /* The view ray of NDC (nx, ny): the point with planar depth d is
- * origin + d * dir, dir.z = -1 (GLSL: view_ray() in common.glsl). */
-void obs__view_ray(const float *P, const float ndc[2], float origin[3], float dir[3]);
+ * origin + d * dir, dir.z = -1 (GLSL: view_ray() in common.glsl): the
+ * projection solved for view x, y as a 2x2 system that is affine in view
+ * z. */
+static inline void obs__view_ray(const float *P, const float ndc[2], float origin[3], float dir[3])
+{
+    float nx = ndc[0], ny = ndc[1];
+    float a = P[0] - nx * P[12], b = P[1] - nx * P[13];
+    float c = P[4] - ny * P[12], d = P[5] - ny * P[13];
+    float b0x = nx * P[15] - P[3], b0y = ny * P[15] - P[7];
+    float b1x = nx * P[14] - P[2], b1y = ny * P[14] - P[6];
+    float inv = 1.0f / (a * d - b * c);
+    origin[0] = (d * b0x - b * b0y) * inv;
+    origin[1] = (a * b0y - c * b0x) * inv;
+    origin[2] = 0.0f;
+    dir[0] = -(d * b1x - b * b1y) * inv;
+    dir[1] = -(a * b1y - c * b1x) * inv;
+    dir[2] = -1.0f;
+}
 
 /* Samples off the planes (border_cpu.c, which derives them): the last
  * pixel (bx, by) on the planes along the segment from pixel (x, y) to the

@@ -1,38 +1,13 @@
 /* CPU twin of the prep pass (GLSL: prep.frag.glsl, common.glsl): each
  * pixel's view-space position and normal, and the maps between pixels and
- * view space that every pass shares (obs__px_ndc, obs__view_to_px). */
+ * view space that every pass shares (obs__view_to_px; obs__px_ndc and
+ * obs__view_ray are inline in frame.h). */
 #include <math.h>
 #include <string.h>
 
 #include "chain/frame.h"
 #include "chain/lanes.h"
 #include "chain/prep_cpu.h"
-
-/* GLSL: px_ndc() in common.glsl */
-void obs__px_ndc(const obs__frame *f, int x, int y, float ndc[2])
-{
-    ndc[0] = ((float)x + 0.5f + f->viewport[0]) / f->viewport[2] * 2.0f - 1.0f;
-    ndc[1] = 1.0f - ((float)y + 0.5f + f->viewport[1]) / f->viewport[3] * 2.0f;
-}
-
-/* GLSL: view_ray() in common.glsl.  The point seen at NDC (nx, ny) with
- * planar depth d is origin + d * dir (dir.z = -1): the projection solved
- * for view x, y as a 2x2 system that is affine in view z. */
-void obs__view_ray(const float *P, const float ndc[2], float origin[3], float dir[3])
-{
-    float nx = ndc[0], ny = ndc[1];
-    float a = P[0] - nx * P[12], b = P[1] - nx * P[13];
-    float c = P[4] - ny * P[12], d = P[5] - ny * P[13];
-    float b0x = nx * P[15] - P[3], b0y = ny * P[15] - P[7];
-    float b1x = nx * P[14] - P[2], b1y = ny * P[14] - P[6];
-    float inv = 1.0f / (a * d - b * c);
-    origin[0] = (d * b0x - b * b0y) * inv;
-    origin[1] = (a * b0y - c * b0x) * inv;
-    origin[2] = 0.0f;
-    dir[0] = -(d * b1x - b * b1y) * inv;
-    dir[1] = -(a * b1y - c * b1x) * inv;
-    dir[2] = -1.0f;
-}
 
 /* GLSL: clip_range() in prep.frag.glsl.  The clip range (near, far) of
  * the projection's z row, z_ndc = (a z + b) / (c z + d): the planar depths
