@@ -172,8 +172,8 @@ static void add_arc(obs__gtao_side *s, float lo, float hi)
  * first needed (have_uz); pc: the ray's point at the centre's depth,
  * less c. */
 typedef struct column_ray {
-    const float *v;
-    float pc[3], r, cz0, uz[2];
+    const float *c, *v;
+    float low, pc[3], r, cz0, uz[2];
     int have_uz;
 } column_ray;
 
@@ -206,6 +206,11 @@ static void add_reach(obs__gtao_side *s, float clo, float chi, float zlo, float 
                       column_ray *cr)
 {
     const float pi = (float)M_PI, cz = cr->cz0, r = cr->r;
+    if (s->win_at) { /* the previous column's window, first needed */
+        s->win[0] = depth_cos(s->wo, s->wd, s->win[0], cr->c, cr->v, cr->low);
+        s->win[1] = depth_cos(s->wo, s->wd, s->win[1], cr->c, cr->v, cr->low);
+        s->win_at = 0;
+    }
     /* the window's clip on the cosines: empty there where it is empty on
      * the angles (acos decreasing) */
     clo = min_f(clo, s->win[0]);
@@ -237,6 +242,7 @@ void obs__gtao_side_start(obs__gtao_side *s, const float c[3], float z0)
     s->z[0][1] = -c[2];
     s->t[0][0] = s->win[0] = 1.0f; /* the angles 0 and pi */
     s->t[0][1] = s->win[1] = -1.0f;
+    s->win_at = 0;
 }
 
 float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s, const float *q,
@@ -252,7 +258,7 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
     obs__px_ndc(f, qx, qy, ndc);
     obs__view_ray(f->proj, ndc, o, dir);
     const int near = chord(fw, o, dir, c, cs);
-    column_ray cr = {v, {0.0f, 0.0f, 0.0f}, -fw[1] / fw[0], -c[2], {0.0f, 0.0f}, 0};
+    column_ray cr = {c, v, low, {0.0f, 0.0f, 0.0f}, -fw[1] / fw[0], -c[2], {0.0f, 0.0f}, 0};
     for (int i = 0; i < 3; i++)
         cr.pc[i] = o[i] + cr.cz0 * dir[i] - c[i];
     /* the last node met outside every interval: if it closes an interval,
@@ -319,10 +325,19 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
             add_reach(s, min_f(s->t[a][0], gt[b][0]), max_f(s->t[a][1], gt[b][1]),
                       before ? s->z[a][1] : gz[b][1], before ? gz[b][0] : s->z[a][0], &cr);
         }
-    s->win[0] = s->win[1] = 1.0f; /* this column's window, for the next: empty */
+    /* this column's window, for the next: empty (the cosines of angle 0),
+     * or its depths, their cosines taken where an arc needs them (most
+     * columns add none) */
+    s->win[0] = s->win[1] = 1.0f;
+    s->win_at = 0;
     if (near && cs[1] > 0.0f) {
-        s->win[0] = depth_cos(o, dir, max_f(cs[0], 0.0f), c, v, low);
-        s->win[1] = depth_cos(o, dir, cs[1], c, v, low);
+        s->win[0] = max_f(cs[0], 0.0f);
+        s->win[1] = cs[1];
+        for (int i = 0; i < 3; i++) {
+            s->wo[i] = o[i];
+            s->wd[i] = dir[i];
+        }
+        s->win_at = 1;
     }
     s->gaps = ng;
     for (int b = 0; b < ng; b++)

@@ -26,7 +26,11 @@ typedef struct obs__gtao_side {
     int n, gaps;
     float lo[OBS__GTAO_MAX_ARCS], hi[OBS__GTAO_MAX_ARCS];
     float z[OBS__GTAO_MAX_GAPS][2], t[OBS__GTAO_MAX_GAPS][2];
-    float win[2]; /* the cosines of the angles where the last column's ray lies within the radius */
+    /* the cosines of the angles where the last column's ray lies within
+     * the radius; until an arc needs them (win_at 1) the depths there on
+     * its ray wo + s wd */
+    float win[2], wo[3], wd[3];
+    int win_at;
 } obs__gtao_side;
 
 /* Starts a side at the centre c: no arcs; the centre's column is the
