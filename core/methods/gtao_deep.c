@@ -167,21 +167,37 @@ static void add_arc(obs__gtao_side *s, float lo, float hi)
     s->n++;
 }
 
-/* The column's ray and what add_reach reads of it: the slice's direction
- * on this side, u_z(t) = uz[0] cos(t - uz[1]), taken from the ray where
- * first needed (have_uz); pc: the ray's point at the centre's depth,
- * less c. */
+/* A column's pixel and, taken where first needed (most columns need
+ * neither), its ray o + s dir (have_ray) and the slice's direction on
+ * this side, u_z(t) = uz[0] cos(t - uz[1]) (have_uz); with what they
+ * are measured against: the centre c (planar depth cz0), v, the side's
+ * low, the falloff (fw) and its radius r. */
 typedef struct column_ray {
-    const float *c, *v;
-    float low, pc[3], r, cz0, uz[2];
-    int have_uz;
+    const obs__frame *f;
+    const float *fw, *c, *v;
+    float low, r, cz0;
+    int qx, qy, have_ray, have_uz;
+    float o[3], dir[3], uz[2];
 } column_ray;
+
+static void ray_of(column_ray *cr)
+{
+    float ndc[2];
+    obs__px_ndc(cr->f, cr->qx, cr->qy, ndc);
+    obs__view_ray(cr->f->proj, ndc, cr->o, cr->dir);
+    cr->have_ray = 1;
+}
 
 static void ray_uz(column_ray *cr)
 {
-    const float *v = cr->v;
-    const float pv = dot3(cr->pc, v);
-    const float od[3] = {cr->pc[0] - pv * v[0], cr->pc[1] - pv * v[1], cr->pc[2] - pv * v[2]};
+    if (!cr->have_ray)
+        ray_of(cr);
+    const float *v = cr->v, *o = cr->o, *dir = cr->dir, *c = cr->c;
+    /* the ray's point at the centre's depth, less c */
+    const float pc[3] = {o[0] + cr->cz0 * dir[0] - c[0], o[1] + cr->cz0 * dir[1] - c[1],
+                         o[2] + cr->cz0 * dir[2] - c[2]};
+    const float pv = dot3(pc, v);
+    const float od[3] = {pc[0] - pv * v[0], pc[1] - pv * v[1], pc[2] - pv * v[2]};
     const float ol = sqrtf(dot3(od, od));
     cr->uz[0] = cr->uz[1] = 0.0f;
     if (ol > 0.0f) {
@@ -189,6 +205,25 @@ static void ray_uz(column_ray *cr)
         cr->uz[1] = atan2f(od[2] / ol, v[2]);
     }
     cr->have_uz = 1;
+}
+
+/* The window of the side's last column (pixel s->wq): the cosines of the
+ * angles where its ray lies within the radius, the depths [cs0, cs1] of
+ * its chord of the ball; empty (the cosines of angle 0) where it passes
+ * outside. */
+static void side_window(obs__gtao_side *s, const column_ray *cr)
+{
+    column_ray w = *cr;
+    float cs[2] = {0.0f, 0.0f};
+    w.qx = s->wq[0];
+    w.qy = s->wq[1];
+    ray_of(&w);
+    s->win[0] = s->win[1] = 1.0f;
+    if (chord(cr->fw, w.o, w.dir, cr->c, cs) && cs[1] > 0.0f) {
+        s->win[0] = depth_cos(w.o, w.dir, max_f(cs[0], 0.0f), cr->c, cr->v, cr->low);
+        s->win[1] = depth_cos(w.o, w.dir, cs[1], cr->c, cr->v, cr->low);
+    }
+    s->win_at = 0;
 }
 
 /* Adds the arc of a solid met between the previous column and this one,
@@ -206,11 +241,8 @@ static void add_reach(obs__gtao_side *s, float clo, float chi, float zlo, float 
                       column_ray *cr)
 {
     const float pi = (float)M_PI, cz = cr->cz0, r = cr->r;
-    if (s->win_at) { /* the previous column's window, first needed */
-        s->win[0] = depth_cos(s->wo, s->wd, s->win[0], cr->c, cr->v, cr->low);
-        s->win[1] = depth_cos(s->wo, s->wd, s->win[1], cr->c, cr->v, cr->low);
-        s->win_at = 0;
-    }
+    if (s->win_at) /* the previous column's window, first needed */
+        side_window(s, cr);
     /* the window's clip on the cosines: empty there where it is empty on
      * the angles (acos decreasing) */
     clo = min_f(clo, s->win[0]);
@@ -252,15 +284,8 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
     float gz[OBS__GTAO_MAX_GAPS][2], gt[OBS__GTAO_MAX_GAPS][2]; /* gt: cosines */
     float hc = low, cz = 0.0f, ct = 1.0f; /* the free range open from depth cz (angle 0) */
     int ng = 0, open = 1, last = -1;
-    /* the column's ray and the depths [cs0, cs1] of it within the
-     * radius: the window of the solids met after it (the header) */
-    float ndc[2], o[3], dir[3], cs[2] = {0.0f, 0.0f};
-    obs__px_ndc(f, qx, qy, ndc);
-    obs__view_ray(f->proj, ndc, o, dir);
-    const int near = chord(fw, o, dir, c, cs);
-    column_ray cr = {c, v, low, {0.0f, 0.0f, 0.0f}, -fw[1] / fw[0], -c[2], {0.0f, 0.0f}, 0};
-    for (int i = 0; i < 3; i++)
-        cr.pc[i] = o[i] + cr.cz0 * dir[i] - c[i];
+    column_ray cr = {f, fw, c, v, low, -fw[1] / fw[0], -c[2], qx, qy, 0, 0,
+                     {0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, {0.0f, 0.0f}};
     /* the last node met outside every interval: if it closes an interval,
      * nothing lies behind that (solid behind it, the header), unless the
      * list was cut behind it (its last node's end OBS__DEEP_END_CUT,
@@ -301,7 +326,9 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
          * the arc between their angles where a ray meets it within the
          * radius (add_reach) */
         cz = e;
-        ct = depth_cos(o, dir, e, c, v, low);
+        if (!cr.have_ray)
+            ray_of(&cr);
+        ct = depth_cos(cr.o, cr.dir, e, c, v, low);
         if (obs__occluder_weight_node(f, x, y, self, qx, qy, k) > 0.0f)
             add_reach(s, tf, ct, qk[3], e, &cr);
     }
@@ -325,20 +352,12 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
             add_reach(s, min_f(s->t[a][0], gt[b][0]), max_f(s->t[a][1], gt[b][1]),
                       before ? s->z[a][1] : gz[b][1], before ? gz[b][0] : s->z[a][0], &cr);
         }
-    /* this column's window, for the next: empty (the cosines of angle 0),
-     * or its depths, their cosines taken where an arc needs them (most
+    /* this column's window, for the next: the depths of its ray within
+     * the radius (the header), taken where an arc needs them (most
      * columns add none) */
-    s->win[0] = s->win[1] = 1.0f;
-    s->win_at = 0;
-    if (near && cs[1] > 0.0f) {
-        s->win[0] = max_f(cs[0], 0.0f);
-        s->win[1] = cs[1];
-        for (int i = 0; i < 3; i++) {
-            s->wo[i] = o[i];
-            s->wd[i] = dir[i];
-        }
-        s->win_at = 1;
-    }
+    s->wq[0] = qx;
+    s->wq[1] = qy;
+    s->win_at = 1;
     s->gaps = ng;
     for (int b = 0; b < ng; b++)
         for (int i = 0; i < 2; i++) {

@@ -27,10 +27,10 @@ typedef struct obs__gtao_side {
     float lo[OBS__GTAO_MAX_ARCS], hi[OBS__GTAO_MAX_ARCS];
     float z[OBS__GTAO_MAX_GAPS][2], t[OBS__GTAO_MAX_GAPS][2];
     /* the cosines of the angles where the last column's ray lies within
-     * the radius; until an arc needs them (win_at 1) the depths there on
-     * its ray wo + s wd */
-    float win[2], wo[3], wd[3];
-    int win_at;
+     * the radius; until an arc needs them (win_at 1) that column's pixel
+     * wq */
+    float win[2];
+    int win_at, wq[2];
 } obs__gtao_side;
 
 /* Starts a side at the centre c: no arcs; the centre's column is the
