@@ -48,6 +48,7 @@
  * the view vector of an orthographic camera is +z. */
 #include <math.h>
 
+#include "chain/lanes.h"
 #include "methods/bent.h"
 #include "chain/mask_weight.h"
 #include "methods/gtao.h"
@@ -170,11 +171,11 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
     for (int st = 0; st < g->steps; st++) {
         float base = (float)(slice + st * g->steps) * GTAO_R1;
         float sn = noise_step + base;
-        sn -= floorf(sn);
+        sn -= floor_lane(sn); /* floorf's value, inline (lanes.h) */
         float s = ((float)st + sn) / (float)g->steps;
         s = s * s + min_s; /* sample distribution power 2, then off the centre pixel */
-        sq[st][0] = x + dir * (int)floorf(s * omega[0] + 0.5f);
-        sq[st][1] = y + dir * (int)floorf(s * omega[1] + 0.5f);
+        sq[st][0] = x + dir * (int)floor_lane(s * omega[0] + 0.5f);
+        sq[st][1] = y + dir * (int)floor_lane(s * omega[1] + 0.5f);
     }
     for (int st = 0; end && st < GTAO_PREFETCH && st < g->steps; st++)
         prefetch_column(f, pos, end, layers, sq[st]);
