@@ -241,6 +241,8 @@ static void add_reach(obs__gtao_side *s, float clo, float chi, float zlo, float 
                       column_ray *cr)
 {
     const float pi = (float)M_PI, cz = cr->cz0, r = cr->r;
+    if (!(chi < clo))
+        return; /* empty before the window's clip */
     if (s->win_at) /* the previous column's window, first needed */
         side_window(s, cr);
     /* the window's clip on the cosines: empty there where it is empty on
