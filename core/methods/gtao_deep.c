@@ -207,7 +207,8 @@ static void ray_uz(column_ray *cr)
     cr->have_uz = 1;
 }
 
-/* The window of the side's last column (pixel s->wq): the cosines of the
+/* The window of the side's last column (pixel s->wq, its ray wo + s wd
+ * where it took it: win_at 2): the cosines of the
  * angles where its ray lies within the radius, the depths [cs0, cs1] of
  * its chord of the ball; empty (the cosines of angle 0) where it passes
  * outside. */
@@ -217,7 +218,13 @@ static void side_window(obs__gtao_side *s, const column_ray *cr)
     float cs[2] = {0.0f, 0.0f};
     w.qx = s->wq[0];
     w.qy = s->wq[1];
-    ray_of(&w);
+    if (s->win_at == 2) /* that column took its ray */
+        for (int i = 0; i < 3; i++) {
+            w.o[i] = s->wo[i];
+            w.dir[i] = s->wd[i];
+        }
+    else
+        ray_of(&w);
     s->win[0] = s->win[1] = 1.0f;
     if (chord(cr->fw, w.o, w.dir, cr->c, cs) && cs[1] > 0.0f) {
         s->win[0] = depth_cos(w.o, w.dir, max_f(cs[0], 0.0f), cr->c, cr->v, cr->low);
@@ -360,6 +367,13 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
     s->wq[0] = qx;
     s->wq[1] = qy;
     s->win_at = 1;
+    if (cr.have_ray) { /* kept: most windows taken follow a column that took its ray */
+        for (int i = 0; i < 3; i++) {
+            s->wo[i] = cr.o[i];
+            s->wd[i] = cr.dir[i];
+        }
+        s->win_at = 2;
+    }
     s->gaps = ng;
     for (int b = 0; b < ng; b++)
         for (int i = 0; i < 2; i++) {

@@ -27,9 +27,9 @@ typedef struct obs__gtao_side {
     float lo[OBS__GTAO_MAX_ARCS], hi[OBS__GTAO_MAX_ARCS];
     float z[OBS__GTAO_MAX_GAPS][2], t[OBS__GTAO_MAX_GAPS][2];
     /* the cosines of the angles where the last column's ray lies within
-     * the radius; until an arc needs them (win_at 1) that column's pixel
-     * wq */
-    float win[2];
+     * the radius; until an arc needs them (win_at 1 or 2) that column's
+     * pixel wq and (win_at 2) its ray wo + s wd */
+    float win[2], wo[3], wd[3];
     int win_at, wq[2];
 } obs__gtao_side;
 
