@@ -110,7 +110,8 @@ static float weighted_cos(const float fw[3], const float d[3], float dist, const
         return low;
     float shc = dot3(d, v) / dist;
     float dz = d[2] * (1.0f + fw[2]); /* thin-occluder compensation */
-    float fb = sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
+    /* gtao_thin 0 (its default): dz is d[2] and fb the distance */
+    float fb = fw[2] == 0.0f ? dist : sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
     float w = clampf(fb * fw[0] + fw[1], 0.0f, 1.0f) * om;
     return low + (shc - low) * w;
 }
