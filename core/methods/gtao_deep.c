@@ -89,15 +89,15 @@ static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1
 
 /* The cost (a pixel reads 2 x slices x 32 columns): most columns add no
  * arc (dining: 32 % of them call add_reach, 61 % of its calls have an
- * arc empty before the window), so what only an arc
- * reads is taken where it is first needed.  The angles from v of the
- * columns' points are kept as their cosines until an arc is added: acos
- * is decreasing, so the larger of two angles is the arc cosine of the
- * smaller cosine, and a clip that leaves an arc empty is seen on the
- * cosines.  A column's ray (its pixel's projection solved), its u_z and
- * its window (the chord of the ball and two cosines, read by the next
- * column) wait for their first reader.  The same arcs, bit for bit, as
- * taking each angle first (GLSL does: gtao.glsl). */
+ * arc empty before the window), so what only an arc reads is taken where
+ * it is first needed.  The angles from v of the columns' points are kept
+ * as their cosines until an arc is added: acos is decreasing, so the
+ * larger of two angles is the arc cosine of the smaller cosine, and a
+ * clip that leaves an arc empty is seen on the cosines.  A column's ray
+ * (its pixel's projection solved), its u_z and its window (the chord of
+ * the ball and two cosines, read by the next column) wait for their
+ * first reader.  The same arcs, bit for bit, as taking each angle first
+ * (GLSL does: gtao.glsl). */
 
 /* the cosine of the angle of d from v, clamped to [-1, 1] (dist: |d|);
  * low where d is 0 */
