@@ -178,11 +178,11 @@ static void add_arc(obs__gtao_side *s, float lo, float hi)
  * neither), its ray o + s dir (have_ray) and the slice's direction on
  * this side, u_z(t) = uz[0] cos(t - uz[1]) (have_uz); with what they
  * are measured against: the centre c (planar depth cz0), v, the side's
- * low, the falloff (fw) and its radius r. */
+ * low and the falloff (fw). */
 typedef struct column_ray {
     const obs__frame *f;
     const float *fw, *c, *v;
-    float low, r, cz0;
+    float low, cz0;
     int qx, qy, have_ray, have_uz;
     float o[3], dir[3], uz[2];
 } column_ray;
@@ -254,7 +254,7 @@ static void side_window(obs__gtao_side *s, const column_ray *cr)
 static void add_reach(obs__gtao_side *s, float clo, float chi, float zlo, float zhi,
                       column_ray *cr)
 {
-    const float pi = (float)M_PI, cz = cr->cz0, r = cr->r;
+    const float pi = (float)M_PI, cz = cr->cz0;
     if (!(chi < clo))
         return; /* empty before the window's clip */
     if (s->win_at) /* the previous column's window, first needed */
@@ -272,6 +272,7 @@ static void add_reach(obs__gtao_side *s, float clo, float chi, float zlo, float 
     }
     if (!cr->have_uz)
         ray_uz(cr);
+    const float r = -cr->fw[1] / cr->fw[0];
     if (!(cr->uz[0] * r > dz))
         return; /* no ray of the slice reaches the band within r */
     const float lo = acosf(clo), hi = acosf(chi);
@@ -300,7 +301,7 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
     float gz[OBS__GTAO_MAX_GAPS][2], gt[OBS__GTAO_MAX_GAPS][2]; /* gt: cosines */
     float hc = low, cz = 0.0f, ct = 1.0f; /* the free range open from depth cz (angle 0) */
     int ng = 0, open = 1, last = -1;
-    column_ray cr = {f, fw, c, v, low, -fw[1] / fw[0], -c[2], qx, qy, 0, 0,
+    column_ray cr = {f, fw, c, v, low, -c[2], qx, qy, 0, 0,
                      {0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, {0.0f, 0.0f}};
     /* the last node met outside every interval: if it closes an interval,
      * nothing lies behind that (solid behind it, the header), unless the
