@@ -231,8 +231,9 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
         obs__cpu_rows(d->height, 0, prep_position_rows, &j);
         obs__cpu_rows(d->height, 0, prep_normal_rows, &j);
     }
-    /* Method gtao's border steps read the front nodes' normals. */
-    if (df->f.method == OBS_METHOD_GTAO) {
+    /* The border steps of method gtao and the samples off the planes of
+     * VAO's line samples read the front nodes' normals. */
+    if (df->f.method != OBS_METHOD_HEMISPHERE && df->f.method != OBS_METHOD_HBAO) {
         if (!(df->nrm3 = malloc(npx * 3 * sizeof *df->nrm3))) {
             s = obs__fail(err, OBS_NO_MEMORY, "deep frame of %dx%d", d->width, d->height);
             goto fail;
@@ -372,10 +373,25 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
         float h = r * l;
         int qx, qy;
-        if (!obs__disk_px(f, &disk, sx, sy, &qx, &qy))
-            continue; /* off the planes: left out of eq 1's sum and F */
-        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
         float front = -c[2] - h, occ = 0.0f, solid = 0.0f;
+        if (!obs__disk_px(f, &disk, sx, sy, &qx, &qy)) {
+            /* off the planes: the front nodes' surface continued past the
+             * border, as the flat chain reads its planes there
+             * (border_cpu.c), with the alpha and masks' weight of the
+             * front node it continues; left out of eq 1's sum and F where
+             * there is no estimate */
+            float zs = 0.0f, nz = 1.0f; /* 0: an empty node, where b is background */
+            size_t b = 0;
+            if (!obs__disk_border(f, df->pos, df->nrm3, &disk, x, y, sx, sy, &zs, &nz, &b))
+                continue;
+            const float a = df->nrm[4 * b + 3] *
+                            obs__occluder_weight_node(f, x, y, self, (int)(b % (size_t)f->width),
+                                                      (int)(b / (size_t)f->width), 0);
+            open += 2.0f * h - a * node_occlusion(f, zs, nz, front, h, interior);
+            F += R * l;
+            continue;
+        }
+        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
         for (int k = 0; k < layers; k++) {
             const float *pk = df->pos + ((size_t)k * npx + q) * 4;
             const float *nk = df->nrm + ((size_t)k * npx + q) * 4; /* normal, alpha */

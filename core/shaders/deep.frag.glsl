@@ -117,6 +117,38 @@ float interval_occlusion(float zs, float e, float front, float h)
     return max(0.0, min(e, front + 2.0 * h) - max(zs, front));
 }
 
+// A line sample off the planes: true and the surface continued past the
+// border (chain/border_cpu.c) from the front node of the last pixel b on
+// the planes, zs (0, an empty node, open, where b is background), nz, and a, b's
+// front node's alpha times the masks' weight; false where there is no
+// estimate (the sample is left out).  As vao.glsl's border_sample reads
+// the flat planes.  C twin: obs__disk_border in sphere_ao (deep_cpu.c).
+bool deep_border(ivec2 px, vec3 U, vec3 V, vec3 W, float sx, float sy, out float zs,
+                 out float nz, out float a)
+{
+    zs = 0.0;
+    nz = 1.0;
+    a = 0.0;
+    float sw = W.x * sx + W.y * sy + W.z;
+    if (!(sw > 0.0))
+        return false;
+    vec2 q = vec2(floor((U.x * sx + U.y * sy + U.z) / sw), floor((V.x * sx + V.y * sy + V.z) / sw));
+    ivec2 b;
+    if (!border_px(px, q, b))
+        return false;
+    vec4 pb = imageLoad(u_lpos, ivec3(b, 0));
+    vec4 nb = imageLoad(u_lnrm, ivec3(b, 0));
+    a = nb.w * node_weight(px, b, 0);
+    if (!(pb.w > 0.0))
+        return true;
+    vec4 pt;
+    if (!plane_point(q, pb.xyz, nb.xyz, pt))
+        return false;
+    zs = pt.w;
+    nz = nb.z;
+    return true;
+}
+
 // VAO++ eqs 1-2 for the tangent sphere at p along n; each sample's
 // occlusion is the largest over the nodes at its pixel (Algorithm 1, line
 // 9), each node's weighted by its alpha (eq 1's alpha_omega).  self: the
@@ -137,9 +169,17 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
         float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
         float h = r * l;
         ivec2 q;
-        if (!disk_px(U, V, W, sx, sy, u_size, q))
-            continue;               // off the planes: left out
         float front = -c.z - h, occ = 0.0, solid = 0.0;
+        if (!disk_px(U, V, W, sx, sy, u_size, q)) {
+            // off the planes: the front nodes' surface continued past the
+            // border (deep_border), or left out where there is no estimate
+            float zs, nz, a;
+            if (!deep_border(px, U, V, W, sx, sy, zs, nz, a))
+                continue;
+            open += 2.0 * h - a * node_occlusion(zs, nz, front, h, interior);
+            F += R * l;
+            continue;
+        }
         for (int k = 0; k < layers; k++) {
 #if OBS_DEEP_INTERVALS
             float e = imageLoad(u_lend, ivec3(q, k)).x;
