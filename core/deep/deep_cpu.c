@@ -171,6 +171,16 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
     df->multi = p.deep_mode != OBS_DEEP_SINGLE;
     df->thin = p.deep_hull == OBS_DEEP_THIN;
     df->intervals = obs_deep_intervals_in_effect(d, &p);
+    /* Without intervals every node is the visible surface of a solid
+     * behind it (eq 4's range check, ao_definition rays' conversion).  A
+     * node the facing flags put inside a nearer node's interval (a back
+     * face closing it, a face within it) is not: it lies inside the solid
+     * the nearer front face already stands for, and taken as the front of
+     * one more solid behind it, nearer the samples' pipes than that front
+     * face, it thickened the occluder the range check thins (a halo behind
+     * every back face).  VAO's line samples leave such nodes out. */
+    df->inside = !df->intervals && d->has_facing && df->multi &&
+                 (p.method == OBS_METHOD_VAOPP || p.method == OBS_METHOD_VAO);
     size_t npx = (size_t)d->width * (size_t)d->height;
     depth = calloc(npx, sizeof *depth);
     in_n = d->has_normal ? calloc(npx * 3, sizeof *in_n) : NULL;
@@ -241,8 +251,9 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
         for (size_t i = 0; i < npx; i++)
             memcpy(df->nrm3 + 3 * i, df->nrm + 4 * i, 3 * sizeof *df->nrm3);
     }
-    /* The nodes' extents from their facing flags (deep_intervals). */
-    if (df->intervals)
+    /* The nodes' extents from their facing flags (deep_intervals; without
+     * them only whether a node lies inside an interval, df->inside). */
+    if (df->intervals || df->inside)
         for (size_t i = 0; i < npx; i++) {
             float z[OBS_DEEP_MAX_LAYERS], fc[OBS_DEEP_MAX_LAYERS], e[OBS_DEEP_MAX_LAYERS];
             int c = df->layers.count[i];
@@ -264,7 +275,7 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
             if (df->f.method == OBS_METHOD_GTAO)
                 obs__deep_sheets(z, fc, c, e);
             for (int k = 0; k < c; k++)
-                df->end[(size_t)k * npx + i] = e[k];
+                df->end[(size_t)k * npx + i] = df->inside && e[k] > 0.0f ? 0.0f : e[k];
         }
     free(depth);
     free(in_n);

@@ -18,6 +18,11 @@ typedef struct obs__deep_frame {
     int thin;       /* 1: thin hulls (eqs 2-4); 0: solid volumes (eq 1) */
     int intervals;  /* 1: end holds the nodes' intervals (deep_intervals on,
                      * the image has facing flags, deep_mode multi) */
+    int inside;     /* 1: intervals off, but the facing flags mark the nodes
+                     * inside a nearer node's interval (end -1 or
+                     * OBS__DEEP_END_CUT, the rest 0), which are no
+                     * occluders (VAO's line samples; the image has facing
+                     * flags, deep_mode multi) */
     float *pos;     /* m planes of 4 floats: view position xyz, planar depth w (0: empty) */
     float *nrm;     /* m planes of 4 floats: view normal xyz, alpha */
     float *nrm3;    /* methods gtao and VAO: the front nodes' view normals,
