@@ -178,9 +178,10 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
      * the nearer front face already stands for, and taken as the front of
      * one more solid behind it, nearer the samples' pipes than that front
      * face, it thickened the occluder the range check thins (a halo behind
-     * every back face).  VAO's line samples leave such nodes out. */
-    df->inside = !df->intervals && d->has_facing && df->multi &&
-                 (p.method == OBS_METHOD_VAOPP || p.method == OBS_METHOD_VAO);
+     * every back face).  The methods leave such nodes out: VAO's line
+     * samples, hemisphere's point samples, hbao's horizon (gtao: with its
+     * intervals, on by default, or every node solid behind). */
+    df->inside = !df->intervals && d->has_facing && df->multi && p.method != OBS_METHOD_GTAO;
     size_t npx = (size_t)d->width * (size_t)d->height;
     depth = calloc(npx, sizeof *depth);
     in_n = d->has_normal ? calloc(npx * 3, sizeof *in_n) : NULL;
@@ -450,8 +451,13 @@ static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float 
                            const float n[3], int interior, int self)
 {
     const obs__frame *f = &df->f;
-    const obs__hemisphere_nodes nodes = {df->pos,  df->nrm, df->multi ? df->m : 1,
-                                         (size_t)f->width * (size_t)f->height, interior, self};
+    const obs__hemisphere_nodes nodes = {df->pos,
+                                         df->nrm,
+                                         df->end,
+                                         df->multi ? df->m : 1,
+                                         (size_t)f->width * (size_t)f->height,
+                                         interior,
+                                         self};
     return obs__hemisphere_estimate(f, &nodes, x, y, p, n);
 }
 
@@ -468,7 +474,8 @@ static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, self,
                                      df->intervals ? df->end : NULL, x, y, p, n, NULL, NULL);
     if (df->f.method == OBS_METHOD_HBAO)
-        return obs__hbao_pixel_nodes(&df->f, df->pos, df->multi ? df->m : 1, self, x, y, p, n,
+        return obs__hbao_pixel_nodes(&df->f, df->pos, df->end,
+                                     df->multi ? df->m : 1, self, x, y, p, n,
                                      NULL);
     float v = sphere_ao(df, x, y, p, n, interior, self);
     return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */

@@ -635,6 +635,24 @@ static void test_intervals(void **state)
     print_message("thin plate in front, facing unknown: AO %.4f\n", unknown);
     assert_float_equal(ao_at(&d, &off, 15, 16, NULL), unknown, 1e-6);
     assert_true(unknown < without - 1e-3);
+    /* method hemisphere alike: the back face adds nothing.  (hbao: a
+     * back face behind its front face in a column never rises above the
+     * front face's horizon from a receiver behind both; the rule reaches
+     * it through hidden receivers only.) */
+    d.has_facing = 1;
+    {
+        obs_params mo = off, ms = single;
+        assert_int_equal(obs_param_set(&mo, "method", "hemisphere", err), OBS_OK);
+        assert_int_equal(obs_param_set(&ms, "method", "hemisphere", err), OBS_OK);
+        float a = ao_at(&d, &mo, 15, 16, NULL), b = ao_at(&d, &ms, 15, 16, NULL);
+        d.has_facing = 0;
+        float u = ao_at(&d, &mo, 15, 16, NULL);
+        print_message("thin plate in front, hemisphere: AO off %.4f, single %.4f, facing "
+                      "unknown %.4f\n",
+                      a, b, u);
+        assert_float_equal(a, b, 1e-6);
+        assert_true(u < a - 1e-3);
+    }
     obs_deep_free(&d);
 
     slab_scene(&d, 8.6f, 8.7f);
@@ -1332,6 +1350,10 @@ static void test_gl_twin(void **state)
     /* intervals off, facing flags known: the nodes inside an interval left out */
     assert_int_equal(obs_param_set(&p, "deep_intervals", "off", err), OBS_OK);
     compare_gl(ctx, &d, &p, "plate in front, intervals off, m = 2");
+    assert_int_equal(obs_param_set(&p, "method", "hemisphere", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "plate in front, hemisphere, m = 2");
+    assert_int_equal(obs_param_set(&p, "method", "hbao", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "plate in front, hbao, m = 2");
     obs_deep_free(&d);
     scene(&d, 9.8f, 0.7f);
     obs_deep_free(&d);
