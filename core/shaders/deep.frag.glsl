@@ -142,12 +142,9 @@ bool deep_border(ivec2 px, vec3 U, vec3 V, vec3 W, float sx, float sy, out float
     zs = 0.0;
     nz = 1.0;
     a = 0.0;
-    float sw = W.x * sx + W.y * sy + W.z;
-    if (!(sw > 0.0))
-        return false;
-    vec2 q = vec2(floor((U.x * sx + U.y * sy + U.z) / sw), floor((V.x * sx + V.y * sy + V.z) / sw));
+    vec2 q;
     ivec2 b;
-    if (!border_px(px, q, b))
+    if (!disk_uv(U, V, W, sx, sy, q) || !border_px(px, q, b))
         return false;
     vec4 pb = imageLoad(u_lpos, ivec3(b, 0));
     vec4 nb = imageLoad(u_lnrm, ivec3(b, 0));
