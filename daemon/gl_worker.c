@@ -75,7 +75,17 @@ static obs_ctx *recreate(obsd_gl_worker *w, obs_ctx *ctx, obs_status why, const 
  * over --max-memory), the rest (each band's rows) at debug. */
 static void cpu_log(void *user, obs_log_level level, const char *msg)
 {
-    obsd_log_core(user, level <= OBS_LOG_WARN ? level : OBS_LOG_DEBUG, msg);
+    obsd_gl_worker *w = user;
+    if (level == OBS_LOG_WARN) {
+        /* the same warning for every frame alike (a budget too small for
+         * the frames a client sends) is said once, then at debug level */
+        if (strcmp(msg, w->last_warn) == 0) {
+            obsd_log(OBSD_LOG_DEBUG, "%s (again)", msg);
+            return;
+        }
+        snprintf(w->last_warn, sizeof w->last_warn, "%s", msg);
+    }
+    obsd_log_core(NULL, level <= OBS_LOG_WARN ? level : OBS_LOG_DEBUG, msg);
 }
 
 /* The CPU device's cancel: the drain cut the requests. */
@@ -198,7 +208,7 @@ static void *worker_main(void *arg)
             /* answered without running */
         } else if (w->cpu) {
             obs_cpu_options o = {.deadline = w->frame_deadline, /* as the GL context's */
-                                 .cancel = cut_asked, .cancel_user = w, .log = cpu_log,
+                                 .cancel = cut_asked, .cancel_user = w, .log = cpu_log, .log_user = w,
                                  .max_memory = w->max_memory, .max_memory_name = w->max_memory_name};
             job->status = job->deep ? obs_deep_run_cpu_opts(job->deep, job->params, &o,
                                                             &job->deep_result, job->err)

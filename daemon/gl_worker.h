@@ -24,6 +24,8 @@ typedef struct obsd_gl_worker {
     int frame_deadline;             /* --frame-deadline, seconds (0: none) */
     size_t max_memory;              /* --max-memory in bytes (0: the library's default) */
     char max_memory_name[96];       /* what set it, as the band warning names it */
+    char last_warn[320];            /* the CPU device's last warning (worker only): a
+                                     * frame repeating it logs it at debug level */
     atomic_ullong kept_bytes;       /* obs_ctx_kept_bytes after the last frame */
     atomic_ullong heap_trims;       /* malloc_trim calls, once idle after frames */
     /* programs built from source, loaded from the program cache, cache

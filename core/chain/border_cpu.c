@@ -89,15 +89,18 @@ int obs__plane_point(const obs__frame *f, float qx, float qy, const float b[3], 
 /* The point a sample at pixel (qx, qy) off the planes reads for the pixel
  * (x, y) (the header above): 1 and out (view point, planar depth), *nz the
  * view normal's z there; 0 where b is background (the sample is open);
- * -1 where there is no estimate (the sample is left out). */
+ * -1 where there is no estimate (the sample is left out).  *bk (when not
+ * NULL): b's pixel index, where the result is not -1. */
 int obs__border_point(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
-                      float qx, float qy, float out[4], float *nz)
+                      float qx, float qy, float out[4], float *nz, size_t *bk)
 {
     int bx, by;
     if (!(fabsf(qx) < OBS_BORDER_MAX_PX && fabsf(qy) < OBS_BORDER_MAX_PX))
         return -1; /* a sample near the camera's plane: no pixel to speak of */
     obs__border_px(f, x, y, qx, qy, &bx, &by);
     size_t k = (size_t)by * (size_t)f->width + (size_t)bx;
+    if (bk)
+        *bk = k;
     const float *b = pos + 4 * k, *nb = nrm + 3 * k;
     if (!(b[3] > 0.0f))
         return 0;

@@ -217,7 +217,7 @@ void obs__border_px(const obs__frame *f, int x, int y, float qx, float qy, int *
 int obs__plane_point(const obs__frame *f, float qx, float qy, const float b[3], const float nb[3],
                      float out[4]);
 int obs__border_point(const obs__frame *f, const float *pos, const float *nrm, int x, int y,
-                      float qx, float qy, float out[4], float *nz);
+                      float qx, float qy, float out[4], float *nz, size_t *bk);
 
 /* View-space position of the point seen at pixel (x, y): the prep pass.
  * out = (x, y, z, d) with d the planar depth; (0,0,0,0) for background. */
@@ -263,6 +263,13 @@ typedef struct obs__disk {
 void obs__disk_map(const obs__frame *f, const float c[3], float r, const float rot[2],
                    obs__disk *m);
 int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, int *qx, int *qy);
+/* A sample (sx, sy) of the disk off the planes: the surface of the planes
+ * pos, nrm (stride 4 and 3) continued past the border (border_cpu.c):
+ * 1 and *zs, *nz there (*zs left as it is, open, where that is
+ * background), *bk (when not NULL) the index of the pixel continued; 0:
+ * left out (behind the camera, or no estimate). */
+int obs__disk_border(const obs__frame *f, const float *pos, const float *nrm, const obs__disk *m,
+                     int x, int y, float sx, float sy, float *zs, float *nz, size_t *bk);
 
 /* The depth range check's falloff (VAO++ 4.4, eq 4): s(d) = u / max(u,
  * d / R) for a pipe d behind its occluder along view Z; with

@@ -230,18 +230,19 @@ int obs__disk_px(const obs__frame *f, const obs__disk *m, float sx, float sy, in
 }
 
 /* GLSL: the branch of vao_estimate() in vao.glsl for a sample off the
- * planes (border_cpu.c): 1 and *zs, *nz of the surface continued past the
- * border (*zs left as it is, open, where that is background); 0 where the
- * sample is left out of eq 1 (behind the camera, or no estimate). */
-static int border_sample(const obs__frame *f, const float *pos, const float *nrm,
-                         const obs__disk *m, int x, int y, float sx, float sy, float *zs,
-                         float *nz)
+ * planes (border_cpu.c), and deep_border() in deep.frag.glsl: 1 and *zs,
+ * *nz of the surface continued past the border (*zs left as it is, open,
+ * where that is background), *bk (when not NULL) the pixel index of the
+ * pixel b continued; 0 where the sample is left out of eq 1 (behind the
+ * camera, or no estimate). */
+int obs__disk_border(const obs__frame *f, const float *pos, const float *nrm, const obs__disk *m,
+                     int x, int y, float sx, float sy, float *zs, float *nz, size_t *bk)
 {
     float fu, fv;
     if (!disk_uv(m, sx, sy, &fu, &fv))
         return 0;
     float pt[4];
-    int got = obs__border_point(f, pos, nrm, x, y, fu, fv, pt, nz);
+    int got = obs__border_point(f, pos, nrm, x, y, fu, fv, pt, nz, bk);
     if (got > 0)
         *zs = pt[3];
     return got >= 0;
@@ -305,7 +306,7 @@ static inline float estimate(const obs__frame *f, const float *pos, const float 
                 }
             }
         } else {
-            seen = border_sample(f, pos, nrm, &disk, x, y, sx, sy, &zs, &nz);
+            seen = obs__disk_border(f, pos, nrm, &disk, x, y, sx, sy, &zs, &nz, NULL);
         }
         if (bleeds) {
             /* "We use c(x) to linearly interpolate between the white
@@ -354,13 +355,13 @@ float obs__vao_estimate_bleed(const obs__frame *f, const float *pos, const float
 }
 
 /* The unoccluded length *dz of the pipe of half length h (centre depth
- * -c2) of a sample off the planes (border_sample), as estimate() takes it;
+ * -c2) of a sample off the planes (obs__disk_border), as estimate() takes it;
  * 0 where the sample is left out of eq 1. */
 static int border_dz(const obs__frame *f, const float *pos, const float *nrm, const obs__disk *m,
                      int x, int y, float sx, float sy, float c2, float h, float *dz)
 {
     float zs = INFINITY, nz = 1.0f;
-    if (!border_sample(f, pos, nrm, m, x, y, sx, sy, &zs, &nz))
+    if (!obs__disk_border(f, pos, nrm, m, x, y, sx, sy, &zs, &nz, NULL))
         return 0;
     const float front = -c2 - h;
     float d = min_f(max_f(zs - front, 0.0f), 2.0f * h);
@@ -427,7 +428,7 @@ static inline __attribute__((always_inline)) float estimate_lanes(const obs__fra
         seens[i] = seen;
     }
     /* a sample off the planes reads the surface continued past the border
-     * (border_sample, border_cpu.c), one by one, its pipe as estimate()
+     * (obs__disk_border, border_cpu.c), one by one, its pipe as estimate()
      * takes it */
     for (int i = 0; i < ns; i++)
         if (!seens[i])

@@ -171,6 +171,17 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
     df->multi = p.deep_mode != OBS_DEEP_SINGLE;
     df->thin = p.deep_hull == OBS_DEEP_THIN;
     df->intervals = obs_deep_intervals_in_effect(d, &p);
+    /* Without intervals every node is the visible surface of a solid
+     * behind it (eq 4's range check, ao_definition rays' conversion).  A
+     * node the facing flags put inside a nearer node's interval (a back
+     * face closing it, a face within it) is not: it lies inside the solid
+     * the nearer front face already stands for, and taken as the front of
+     * one more solid behind it, nearer the samples' pipes than that front
+     * face, it thickened the occluder the range check thins (a halo behind
+     * every back face).  The methods leave such nodes out: VAO's line
+     * samples, hemisphere's point samples, hbao's horizon (gtao: with its
+     * intervals, on by default, or every node solid behind). */
+    df->inside = !df->intervals && d->has_facing && df->multi && p.method != OBS_METHOD_GTAO;
     size_t npx = (size_t)d->width * (size_t)d->height;
     depth = calloc(npx, sizeof *depth);
     in_n = d->has_normal ? calloc(npx * 3, sizeof *in_n) : NULL;
@@ -231,8 +242,9 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
         obs__cpu_rows(d->height, 0, prep_position_rows, &j);
         obs__cpu_rows(d->height, 0, prep_normal_rows, &j);
     }
-    /* Method gtao's border steps read the front nodes' normals. */
-    if (df->f.method == OBS_METHOD_GTAO) {
+    /* The border steps of method gtao and the samples off the planes of
+     * VAO's line samples read the front nodes' normals. */
+    if (df->f.method != OBS_METHOD_HEMISPHERE && df->f.method != OBS_METHOD_HBAO) {
         if (!(df->nrm3 = malloc(npx * 3 * sizeof *df->nrm3))) {
             s = obs__fail(err, OBS_NO_MEMORY, "deep frame of %dx%d", d->width, d->height);
             goto fail;
@@ -240,8 +252,9 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
         for (size_t i = 0; i < npx; i++)
             memcpy(df->nrm3 + 3 * i, df->nrm + 4 * i, 3 * sizeof *df->nrm3);
     }
-    /* The nodes' extents from their facing flags (deep_intervals). */
-    if (df->intervals)
+    /* The nodes' extents from their facing flags (deep_intervals; without
+     * them only whether a node lies inside an interval, df->inside). */
+    if (df->intervals || df->inside)
         for (size_t i = 0; i < npx; i++) {
             float z[OBS_DEEP_MAX_LAYERS], fc[OBS_DEEP_MAX_LAYERS], e[OBS_DEEP_MAX_LAYERS];
             int c = df->layers.count[i];
@@ -263,7 +276,7 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
             if (df->f.method == OBS_METHOD_GTAO)
                 obs__deep_sheets(z, fc, c, e);
             for (int k = 0; k < c; k++)
-                df->end[(size_t)k * npx + i] = e[k];
+                df->end[(size_t)k * npx + i] = df->inside && e[k] > 0.0f ? 0.0f : e[k];
         }
     free(depth);
     free(in_n);
@@ -372,10 +385,25 @@ static float sphere_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         float l = sqrtf(fmaxf(0.0f, 1.0f - sx * sx - sy * sy));
         float h = r * l;
         int qx, qy;
-        if (!obs__disk_px(f, &disk, sx, sy, &qx, &qy))
-            continue; /* off the planes: left out of eq 1's sum and F */
-        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
         float front = -c[2] - h, occ = 0.0f, solid = 0.0f;
+        if (!obs__disk_px(f, &disk, sx, sy, &qx, &qy)) {
+            /* off the planes: the front nodes' surface continued past the
+             * border, as the flat chain reads its planes there
+             * (border_cpu.c), with the alpha and masks' weight of the
+             * front node it continues; left out of eq 1's sum and F where
+             * there is no estimate */
+            float zs = 0.0f, nz = 1.0f; /* 0: an empty node, where b is background */
+            size_t b = 0;
+            if (!obs__disk_border(f, df->pos, df->nrm3, &disk, x, y, sx, sy, &zs, &nz, &b))
+                continue;
+            const float a = df->nrm[4 * b + 3] *
+                            obs__occluder_weight_node(f, x, y, self, (int)(b % (size_t)f->width),
+                                                      (int)(b / (size_t)f->width), 0);
+            open += 2.0f * h - a * node_occlusion(f, zs, nz, front, h, interior);
+            F += R * l;
+            continue;
+        }
+        size_t q = (size_t)qy * (size_t)f->width + (size_t)qx;
         for (int k = 0; k < layers; k++) {
             const float *pk = df->pos + ((size_t)k * npx + q) * 4;
             const float *nk = df->nrm + ((size_t)k * npx + q) * 4; /* normal, alpha */
@@ -423,8 +451,13 @@ static float hemisphere_ao(const obs__deep_frame *df, int x, int y, const float 
                            const float n[3], int interior, int self)
 {
     const obs__frame *f = &df->f;
-    const obs__hemisphere_nodes nodes = {df->pos,  df->nrm, df->multi ? df->m : 1,
-                                         (size_t)f->width * (size_t)f->height, interior, self};
+    const obs__hemisphere_nodes nodes = {df->pos,
+                                         df->nrm,
+                                         df->end,
+                                         df->multi ? df->m : 1,
+                                         (size_t)f->width * (size_t)f->height,
+                                         interior,
+                                         self};
     return obs__hemisphere_estimate(f, &nodes, x, y, p, n);
 }
 
@@ -441,7 +474,8 @@ static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, self,
                                      df->intervals ? df->end : NULL, x, y, p, n, NULL, NULL);
     if (df->f.method == OBS_METHOD_HBAO)
-        return obs__hbao_pixel_nodes(&df->f, df->pos, df->multi ? df->m : 1, self, x, y, p, n,
+        return obs__hbao_pixel_nodes(&df->f, df->pos, df->end,
+                                     df->multi ? df->m : 1, self, x, y, p, n,
                                      NULL);
     float v = sphere_ao(df, x, y, p, n, interior, self);
     return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */

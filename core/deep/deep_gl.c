@@ -78,7 +78,7 @@ static unsigned deep_variant(const obs__deep_frame *df)
 {
     return (df->f.method == OBS_METHOD_HEMISPHERE ? DEEP_HEMISPHERE : 0u) |
            (df->thin ? DEEP_THIN : 0u) | (df->f.range_check ? DEEP_RANGE : 0u) |
-           (df->f.rays ? DEEP_RAYS : 0u) | (df->intervals ? DEEP_INTERVALS : 0u) |
+           (df->f.rays ? DEEP_RAYS : 0u) | (df->intervals || df->inside ? DEEP_INTERVALS : 0u) |
            (df->f.method == OBS_METHOD_GTAO ? DEEP_GTAO : 0u) |
            (df->f.method == OBS_METHOD_HBAO ? DEEP_HBAO : 0u);
 }
@@ -248,7 +248,7 @@ static obs_status deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_para
     stage_begin(ctx, &t0);
     upload_layers(t->tex_pos, w, h, df.m, GL_RGBA, df.pos);
     upload_layers(t->tex_nrm, w, h, df.m, GL_RGBA, df.nrm);
-    if (df.intervals)
+    if (df.intervals || df.inside)
         upload_layers(t->tex_end, w, h, df.m, GL_RED, df.end);
     /* object masks: each node's weight and object, interleaved, in an
      * RG32F array made on the first frame with masks and kept with the
@@ -291,7 +291,7 @@ static obs_status deep_run(obs_ctx *ctx, const obs_deep_image *d, const obs_para
     glUniform1i(glGetUniformLocation(prog, "u_lpos"), 0);
     glBindImageTexture(1, t->tex_nrm, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
     glUniform1i(glGetUniformLocation(prog, "u_lnrm"), 1);
-    if (df.intervals) {
+    if (df.intervals || df.inside) {
         glBindImageTexture(2, t->tex_end, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32F);
         glUniform1i(glGetUniformLocation(prog, "u_lend"), 2);
     }

@@ -18,10 +18,16 @@ typedef struct obs__deep_frame {
     int thin;       /* 1: thin hulls (eqs 2-4); 0: solid volumes (eq 1) */
     int intervals;  /* 1: end holds the nodes' intervals (deep_intervals on,
                      * the image has facing flags, deep_mode multi) */
+    int inside;     /* 1: intervals off, but the facing flags mark the nodes
+                     * inside a nearer node's interval (end -1 or
+                     * OBS__DEEP_END_CUT, the rest 0), which are no
+                     * occluders (methods vaopp, vao, hemisphere, hbao; the
+                     * image has facing flags, deep_mode multi) */
     float *pos;     /* m planes of 4 floats: view position xyz, planar depth w (0: empty) */
     float *nrm;     /* m planes of 4 floats: view normal xyz, alpha */
-    float *nrm3;    /* method gtao: the front nodes' view normals, 3 floats a
-                     * pixel, the surface a step past the border continues */
+    float *nrm3;    /* methods gtao and VAO: the front nodes' view normals,
+                     * 3 floats a pixel, the surface that a step or a line
+                     * sample past the border continues (border_cpu.c) */
     float *end;     /* m planes of 1 float, the node's extent along its pixel's
                      * ray (obs__deep_intervals): 0 solid behind it (no back
                      * face known), e > 0 solid from its depth to e (a front

@@ -80,7 +80,7 @@ static const float *border_step(const obs__frame *f, const float *pos, const flo
                                 int y, int qx, int qy, float ext[4], int *taken)
 {
     float nz;
-    int got = obs__border_point(f, pos, nrm, x, y, (float)qx, (float)qy, ext, &nz);
+    int got = obs__border_point(f, pos, nrm, x, y, (float)qx, (float)qy, ext, &nz, NULL);
     if (got >= 0)
         (*taken)++;
     return got > 0 ? ext : NULL;

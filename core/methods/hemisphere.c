@@ -105,6 +105,8 @@ float obs__hemisphere_estimate_bent(const obs__frame *f, const obs__hemisphere_n
             float zn = pk[3];
             if (!(zn > 0.0f))
                 continue; /* empty node: background never occludes */
+            if (nodes->end && nodes->end[(size_t)k * nodes->layer_px + q] < 0.0f)
+                continue; /* inside a nearer node's interval */
             if (!(zn <= -s[2] - hs->bias))
                 continue; /* s is not behind the node */
             if (nodes->interior &&
@@ -134,7 +136,7 @@ float obs__hemisphere_pixel(const obs__frame *f, const float *pos, int x, int y,
 float obs__hemisphere_pixel_bent(const obs__frame *f, const float *pos, int x, int y,
                                  const float p[3], const float n[3], float bent[3])
 {
-    const obs__hemisphere_nodes flat = {pos, NULL, 1, 0, 0, 0};
+    const obs__hemisphere_nodes flat = {pos, NULL, NULL, 1, 0, 0, 0};
     return obs__hemisphere_estimate_bent(f, &flat, x, y, p, n, bent);
 }
 

@@ -43,6 +43,9 @@ void obs__hemisphere_sample(const obs__frame *f, int x, int y, const float p[3],
  * obs__occluder_weight_node).  The flat chain's prep plane is one layer. */
 typedef struct obs__hemisphere_nodes {
     const float *pos, *nrm;
+    const float *end; /* NULL, or the nodes' ends (deep_internal.h): a node
+                       * with end < 0 (inside a nearer node's interval)
+                       * occludes nothing */
     int layers;
     size_t layer_px;
     int interior;

@@ -120,19 +120,30 @@ void disk_map(vec3 c, float r, vec2 rot, out vec3 U, out vec3 V, out vec3 W)
     W = vec3(A.w, B.w, k0.w);
 }
 
+// The pixel coordinates (floored, on the planes or not) of the sample
+// (sx, sy) under disk_map's U, V, W; false when it is behind the camera.
+// C twin: disk_uv in vao_cpu.c.
+bool disk_uv(vec3 U, vec3 V, vec3 W, float sx, float sy, out vec2 q)
+{
+    q = vec2(0.0);
+    float sw = W.x * sx + W.y * sy + W.z;
+    if (!(sw > 0.0))
+        return false;
+    q = vec2(floor((U.x * sx + U.y * sy + U.z) / sw), floor((V.x * sx + V.y * sy + V.z) / sw));
+    return true;
+}
+
 // The pixel q of the sample (sx, sy) under disk_map's U, V, W on planes of
 // the given size; false when it is behind the camera or off the planes.
 bool disk_px(vec3 U, vec3 V, vec3 W, float sx, float sy, ivec2 size, out ivec2 q)
 {
     q = ivec2(0);
-    float sw = W.x * sx + W.y * sy + W.z;
-    if (!(sw > 0.0))
+    vec2 f;
+    if (!disk_uv(U, V, W, sx, sy, f))
         return false;
-    float fu = floor((U.x * sx + U.y * sy + U.z) / sw);
-    float fv = floor((V.x * sx + V.y * sy + V.z) / sw);
-    if (!(fu >= 0.0 && fv >= 0.0 && fu < float(size.x) && fv < float(size.y)))
+    if (!(f.x >= 0.0 && f.y >= 0.0 && f.x < float(size.x) && f.y < float(size.y)))
         return false;
-    q = ivec2(int(fu), int(fv));
+    q = ivec2(int(f.x), int(f.y));
     return true;
 }
 

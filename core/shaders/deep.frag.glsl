@@ -62,8 +62,21 @@ float node_weight(ivec2 c, ivec2 s, int k)
         w = 0.0;
     return w;
 }
+// Whether node k at q can occlude: not where the facing flags put it
+// inside a nearer node's interval (end < 0, deep_internal.h), as a back
+// face closing it; method hemisphere's samples and hbao's horizon take
+// such a node's weight as 0, which adds nothing (C: the ends passed to
+// obs__hemisphere_estimate and obs__hbao_pixel_nodes).
+bool node_occludes(ivec2 q, int k)
+{
+#if OBS_DEEP_INTERVALS
+    return imageLoad(u_lend, ivec3(q, k)).x >= 0.0;
+#else
+    return true;
+#endif
+}
 #define HS_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
-#define HS_WEIGHT(c, q, k) node_weight(c, q, k)
+#define HS_WEIGHT(c, q, k) (node_occludes(q, k) ? node_weight(c, q, k) : 0.0)
 #define HS_ALPHA(q, k) imageLoad(u_lnrm, ivec3(q, k)).w
 float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
 // Methods gtao's and hbao's horizon searches (gtao.glsl, hbao.glsl,
@@ -81,7 +94,7 @@ float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
 #endif
 #define HB_LAYERS (u_multi != 0 ? u_m : 1)
 #define HB_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
-#define HB_WEIGHT(c, q, k) node_weight(c, q, k)
+#define HB_WEIGHT(c, q, k) (node_occludes(q, k) ? node_weight(c, q, k) : 0.0)
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count);
 
 // the front node's AO and the blended AO, each beside the front node's
@@ -117,6 +130,35 @@ float interval_occlusion(float zs, float e, float front, float h)
     return max(0.0, min(e, front + 2.0 * h) - max(zs, front));
 }
 
+// A line sample off the planes: true and the surface continued past the
+// border (chain/border_cpu.c) from the front node of the last pixel b on
+// the planes, zs (0, an empty node, open, where b is background), nz, and a, b's
+// front node's alpha times the masks' weight; false where there is no
+// estimate (the sample is left out).  As vao.glsl's border_sample reads
+// the flat planes.  C twin: obs__disk_border in sphere_ao (deep_cpu.c).
+bool deep_border(ivec2 px, vec3 U, vec3 V, vec3 W, float sx, float sy, out float zs,
+                 out float nz, out float a)
+{
+    zs = 0.0;
+    nz = 1.0;
+    a = 0.0;
+    vec2 q;
+    ivec2 b;
+    if (!disk_uv(U, V, W, sx, sy, q) || !border_px(px, q, b))
+        return false;
+    vec4 pb = imageLoad(u_lpos, ivec3(b, 0));
+    vec4 nb = imageLoad(u_lnrm, ivec3(b, 0));
+    a = nb.w * node_weight(px, b, 0);
+    if (!(pb.w > 0.0))
+        return true;
+    vec4 pt;
+    if (!plane_point(q, pb.xyz, nb.xyz, pt))
+        return false;
+    zs = pt.w;
+    nz = nb.z;
+    return true;
+}
+
 // VAO++ eqs 1-2 for the tangent sphere at p along n; each sample's
 // occlusion is the largest over the nodes at its pixel (Algorithm 1, line
 // 9), each node's weighted by its alpha (eq 1's alpha_omega).  self: the
@@ -137,9 +179,17 @@ float sphere_ao(ivec2 px, vec3 p, vec3 n, bool interior, int self)
         float l = sqrt(max(0.0, 1.0 - sx * sx - sy * sy));
         float h = r * l;
         ivec2 q;
-        if (!disk_px(U, V, W, sx, sy, u_size, q))
-            continue;               // off the planes: left out
         float front = -c.z - h, occ = 0.0, solid = 0.0;
+        if (!disk_px(U, V, W, sx, sy, u_size, q)) {
+            // off the planes: the front nodes' surface continued past the
+            // border (deep_border), or left out where there is no estimate
+            float zs, nz, a;
+            if (!deep_border(px, U, V, W, sx, sy, zs, nz, a))
+                continue;
+            open += 2.0 * h - a * node_occlusion(zs, nz, front, h, interior);
+            F += R * l;
+            continue;
+        }
         for (int k = 0; k < layers; k++) {
 #if OBS_DEEP_INTERVALS
             float e = imageLoad(u_lend, ivec3(q, k)).x;

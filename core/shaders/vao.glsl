@@ -39,12 +39,9 @@ float bleed_weight(vec3 x, vec3 p, vec3 n, float R)
 bool border_sample(ivec2 px, vec3 U, vec3 V, vec3 W, float sx, float sy, inout float zs,
                    inout float nz)
 {
-    float sw = W.x * sx + W.y * sy + W.z;
-    if (!(sw > 0.0))
-        return false;
-    vec2 q = vec2(floor((U.x * sx + U.y * sy + U.z) / sw), floor((V.x * sx + V.y * sy + V.z) / sw));
+    vec2 q;
     ivec2 b;
-    if (!border_px(px, q, b))
+    if (!disk_uv(U, V, W, sx, sy, q) || !border_px(px, q, b))
         return false;
     vec4 pb = imageLoad(u_pos, b);
     if (!(pb.w > 0.0))

@@ -93,6 +93,9 @@ check "obscurad --max-memory 1 over OBSCURA_MAX_MEMORY: the start log says it, t
     "grep -q 'memory budget of a frame on the CPU device: 1 MiB (--max-memory)' '$T/tiny.log' && grep -q 'band 3: rows' '$T/tiny.log'"
 check "obscurad: the band over the budget is a warning naming the option" \
     "grep -q \"warn: --max-memory 1 MiB: the AO's samples reach\" '$T/tiny.log'"
+c2=$(post "$PORT_tiny" "$CAM" "$R" "$T/d_tiny2.exr")
+check "obscurad: the same frame again (HTTP $c2): the warning once, then at debug level" \
+    "[ \$(grep -c \"warn: --max-memory 1 MiB: the AO's samples reach\" '$T/tiny.log') = 1 ] && grep -q 'debug: --max-memory 1 MiB: .*(again)' '$T/tiny.log'"
 check "obscurad without a budget: the start log says the default" \
     "grep -q 'memory budget of a frame on the CPU device: [0-9]* MiB (default: a quarter of' '$T/whole.log'"
 expect 0 "obscura ao --server with --max-memory: the frame on obscurad" -- "$OBSCURA" ao "$R" --camera "$CAMJ" \

@@ -623,9 +623,36 @@ static void test_intervals(void **state)
     assert_float_equal(with, open, 1e-4);
     assert_true(without < open - 0.02f);
     assert_true(flat < open - 0.02f);
-    /* the same image without facing flags: every node solid behind */
+    /* intervals off: the plate's back face, inside its interval, is no
+     * occluder (df->inside): the front face alone, solid behind it, as a
+     * flat depth buffer has it */
+    assert_float_equal(without, flat, 1e-6);
+    /* the same image without facing flags: every node solid behind, the
+     * back face too, 0.1 nearer the wall than the front face: eq 4 thins
+     * it less, a darker halo */
     d.has_facing = 0;
-    assert_float_equal(ao_at(&d, &on, 15, 16, NULL), without, 1e-6);
+    float unknown = ao_at(&d, &on, 15, 16, NULL);
+    print_message("thin plate in front, facing unknown: AO %.4f\n", unknown);
+    assert_float_equal(ao_at(&d, &off, 15, 16, NULL), unknown, 1e-6);
+    assert_true(unknown < without - 1e-3);
+    /* method hemisphere alike: the back face adds nothing.  (hbao: a
+     * back face behind its front face in a column never rises above the
+     * front face's horizon from a receiver behind both; the rule reaches
+     * it through hidden receivers only.) */
+    d.has_facing = 1;
+    {
+        obs_params mo = off, ms = single;
+        assert_int_equal(obs_param_set(&mo, "method", "hemisphere", err), OBS_OK);
+        assert_int_equal(obs_param_set(&ms, "method", "hemisphere", err), OBS_OK);
+        float a = ao_at(&d, &mo, 15, 16, NULL), b = ao_at(&d, &ms, 15, 16, NULL);
+        d.has_facing = 0;
+        float u = ao_at(&d, &mo, 15, 16, NULL);
+        print_message("thin plate in front, hemisphere: AO off %.4f, single %.4f, facing "
+                      "unknown %.4f\n",
+                      a, b, u);
+        assert_float_equal(a, b, 1e-6);
+        assert_true(u < a - 1e-3);
+    }
     obs_deep_free(&d);
 
     slab_scene(&d, 8.6f, 8.7f);
@@ -1032,6 +1059,88 @@ static void test_subpixel_sphere(void **state)
     obs_deep_free(&d);
 }
 
+/* A valley whose crease runs down the middle of the image, from the top
+ * border to the bottom one: two walls at 45 degrees meeting at planar
+ * depth 6, their camera-space normals given (a crease pixel's is its own
+ * wall's, not one reconstructed across the crease). */
+static void valley_scene(obs_deep_image *d)
+{
+    synth_init(d, 64, 64);
+    const float t = tanf(20.0f * (float)M_PI / 180.0f); /* fov_y 40, square */
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            synth_next(d, x, y);
+            float dx = (2.0f * (x + 0.5f) / 64.0f - 1.0f) * t; /* view ray (dx, ., -1) */
+            synth_add(d, x, y, 6.0f / (1.0f + fabsf(dx)), 1.0f);
+            float *n = d->samples + (d->offset[y * 64 + x + 1] - 1) * OBS_DEEP_CH;
+            n[OBS_DEEP_NX] = (dx < 0.0f ? 1.0f : -1.0f) * sqrtf(0.5f);
+            n[OBS_DEEP_NY] = 0.0f;
+            n[OBS_DEEP_NZ] = sqrtf(0.5f);
+        }
+    d->has_normal = 1;
+}
+
+/* One layer of deep input is a flat G-buffer: deep_mode single on the
+ * valley gives the flat chain's AO on the same depth and normals, at the
+ * border too, where the spheres' line samples fall off the image and
+ * both read the surface continued past it (border_cpu.c).  (Left out of
+ * eq 1 there, as the deep chain's were, the AO within 8 pixels of the
+ * border differed from the flat chain's by up to 0.17, and by 0.008
+ * farther in, where the spheres still reach past it.)  The flat chain runs without
+ * adaptive sampling and culling, which the deep chain does not have. */
+static void test_single_is_flat(void **state)
+{
+    (void)state;
+    obs_deep_image d;
+    valley_scene(&d);
+    const size_t npx = 64 * 64;
+    float *depth = malloc(npx * sizeof *depth), *nrm = malloc(npx * 3 * sizeof *nrm);
+    for (size_t i = 0; i < npx; i++) {
+        const float *sp = d.samples + d.offset[i] * OBS_DEEP_CH;
+        depth[i] = sp[OBS_DEEP_Z];
+        for (int c = 0; c < 3; c++)
+            nrm[3 * i + c] = sp[OBS_DEEP_NX + c];
+    }
+    obs_gbuffer gb = {0};
+    gb.width = gb.display_width = 64;
+    gb.height = gb.display_height = 64;
+    gb.depth = (obs_plane){depth, 1, 0};
+    gb.normal = (obs_plane){nrm, 3, 0};
+    const char *const defs[] = {"volume", "rays"};
+    for (int v = 0; v < 2; v++) {
+        obs_params p = deep_params(OBS_DEEP_SINGLE);
+        char err[OBS_ERR_LEN];
+        assert_int_equal(obs_param_set(&p, "blur", "off", err), OBS_OK);
+        assert_int_equal(obs_param_set(&p, "normal_space", "camera", err), OBS_OK);
+        assert_int_equal(obs_param_set(&p, "ao_definition", defs[v], err), OBS_OK);
+        assert_int_equal(obs_param_set(&p, "adaptive", "off", err), OBS_OK);
+        assert_int_equal(obs_param_set(&p, "culling", "off", err), OBS_OK);
+        obs_deep_result r;
+        obs_result f;
+        if (obs_deep_run_cpu(&d, &p, &r, err) != OBS_OK)
+            fail_msg("%s", err);
+        assert_int_equal(obs_run_cpu(&gb, &p, OBS_OUTPUT_AO, &f, err), OBS_OK);
+        double border = 0.0, inside = 0.0;
+        for (size_t i = 0; i < npx; i++) {
+            double e = fabs(r.ao_front.data[i] - f.ao.data[i]);
+            if (i < 8 * 64 || i >= 56 * 64 || i % 64 < 8 || i % 64 >= 56)
+                border = fmax(border, e);
+            else
+                inside = fmax(inside, e);
+        }
+        print_message("valley, %s: deep single against the flat chain, max |diff| within 8 "
+                      "pixels of the border %.2e, inside %.2e\n",
+                      defs[v], border, inside);
+        assert_true(inside < 1e-4);
+        assert_true(border < 1e-4);
+        obs_deep_result_free(&r);
+        obs_result_free(&f);
+    }
+    free(depth);
+    free(nrm);
+    obs_deep_free(&d);
+}
+
 /* Method hemisphere on deep input: the same hidden box occludes the wall
  * pixel beside the near object in multi-layer mode and not in single
  * mode; the near object, 7 in front of the receiver, fades out by the
@@ -1238,6 +1347,13 @@ static void test_gl_twin(void **state)
     compare_gl(ctx, &d, &p, "plate in front, intervals");
     assert_int_equal(obs_param_set(&p, "deep_layers", "2", err), OBS_OK);
     compare_gl(ctx, &d, &p, "plate in front, intervals, m = 2");
+    /* intervals off, facing flags known: the nodes inside an interval left out */
+    assert_int_equal(obs_param_set(&p, "deep_intervals", "off", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "plate in front, intervals off, m = 2");
+    assert_int_equal(obs_param_set(&p, "method", "hemisphere", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "plate in front, hemisphere, m = 2");
+    assert_int_equal(obs_param_set(&p, "method", "hbao", err), OBS_OK);
+    compare_gl(ctx, &d, &p, "plate in front, hbao, m = 2");
     obs_deep_free(&d);
     scene(&d, 9.8f, 0.7f);
     obs_deep_free(&d);
@@ -1514,6 +1630,7 @@ int main(void)
         cmocka_unit_test(test_gtao_sheet),
         cmocka_unit_test(test_gtao_cut_list),
         cmocka_unit_test(test_subpixel_sphere),
+        cmocka_unit_test(test_single_is_flat),
         cmocka_unit_test(test_hidden_occluder_hemisphere),
         cmocka_unit_test(test_methods_refused),
         cmocka_unit_test(test_blend_and_hull),
