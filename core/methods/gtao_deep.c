@@ -99,22 +99,21 @@ static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1
  * first reader.  The same arcs, bit for bit, as taking each angle first
  * (GLSL does: gtao.glsl). */
 
-/* the cosine of the angle of d from v, clamped to [-1, 1] (dist: |d|);
- * low where d is 0 */
-static float true_cos(const float d[3], float dist, const float v[3], float low)
+/* the cosine of the angle of d from v (dist: |d|); low where d is 0 */
+static float cos_v(const float d[3], float dist, const float v[3], float low)
 {
-    return clampf(dist > 0.0f ? dot3(d, v) / dist : low, -1.0f, 1.0f);
+    return dist > 0.0f ? dot3(d, v) / dist : low;
 }
 
-/* The horizon cosine of the point c + d (dist: |d|) moved from the
- * tangent's `low` by its falloff weight times om, as sample_cos in
- * gtao.c; low where d is 0: the horizon form of a node solid behind it. */
-static float weighted_cos(const float fw[3], const float d[3], float dist, const float v[3],
-                          float low, float om)
+/* The horizon cosine of the point c + d (dist: |d|, shc: cos_v) moved
+ * from the tangent's `low` by its falloff weight times om, as sample_cos
+ * in gtao.c; low where d is 0: the horizon form of a node solid behind
+ * it. */
+static float weighted_cos(const float fw[3], const float d[3], float dist, float shc, float low,
+                          float om)
 {
     if (!(dist > 0.0f))
         return low;
-    float shc = dot3(d, v) / dist;
     float dz = d[2] * (1.0f + fw[2]); /* thin-occluder compensation */
     /* gtao_thin 0 (its default): dz is d[2] and fb the distance */
     float fb = fw[2] == 0.0f ? dist : sqrtf(d[0] * d[0] + d[1] * d[1] + dz * dz);
@@ -151,7 +150,7 @@ static float depth_cos(const float o[3], const float dir[3], float z, const floa
 {
     const float d[3] = {o[0] + z * dir[0] - c[0], o[1] + z * dir[1] - c[1],
                         o[2] + z * dir[2] - c[2]};
-    return true_cos(d, sqrtf(dot3(d, d)), v, low);
+    return clampf(cos_v(d, sqrtf(dot3(d, d)), v, low), -1.0f, 1.0f);
 }
 
 /* adds the occupied arc [lo, hi] to the side, sorted by lo */
@@ -322,13 +321,13 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
         if (!(qk[3] > 0.0f) || e < 0.0f)
             continue; /* empty, or inside a nearer node's interval */
         const float d[3] = {qk[0] - c[0], qk[1] - c[1], qk[2] - c[2]};
-        const float dist = sqrtf(dot3(d, d));
+        const float dist = sqrtf(dot3(d, d)), shc = cos_v(d, dist, v, low);
         if (e == 0.0f) /* solid behind: the horizon form */
-            hc = max_f(hc, weighted_cos(fw, d, dist, v, low,
+            hc = max_f(hc, weighted_cos(fw, d, dist, shc, low,
                                         obs__occluder_weight_node(f, x, y, self, qx, qy, k)));
         if (!open)
             continue; /* behind a node solid behind it: no free range */
-        const float tf = true_cos(d, dist, v, low);
+        const float tf = clampf(shc, -1.0f, 1.0f); /* its true angle's cosine */
         if (qk[3] > cz && ng < OBS__GTAO_MAX_GAPS) { /* the free range in front of it */
             gz[ng][0] = cz, gz[ng][1] = qk[3];
             gt[ng][0] = ct, gt[ng][1] = tf;

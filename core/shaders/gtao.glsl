@@ -111,7 +111,7 @@ void gtao_side_start(int side, vec3 c, float z0)
     gt_t[side * GT_MAX_GAPS] = vec2(0.0, 3.14159265358979);
 }
 
-// C twin: true_cos (methods/gtao_deep.c) and its arc cosine; the C twin
+// C twin: cos_v (methods/gtao_deep.c), clamped, and its arc cosine; the C twin
 // keeps the cosines until an arc is added (the same arcs: acos is
 // decreasing) and takes a column's ray and window where first needed
 float gtao_true_angle(vec3 d, vec3 v, float low)
