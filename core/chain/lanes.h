@@ -1,7 +1,9 @@
 /* What the CPU device's SIMD kernels share (vao_cpu.c, prep_cpu.c,
  * methods_cpu.c, blur_cpu.c, cull_cpu.c): the build of each kernel for
  * three instruction sets, and the lanes' forms of fminf, fmaxf, floorf and
- * of the arc sine, arc cosine, sine and cosine.  Macros and inline
+ * of the arc sine, arc cosine, sine and cosine (fminf, fmaxf and floorf
+ * also for gtao's scalar steps and free arcs, methods/gtao.c and
+ * gtao_deep.c, where gcc calls libm for them).  Macros and inline
  * functions only.  No GL.  Not installed. */
 #ifndef OBSCURA_LANES_H
 #define OBSCURA_LANES_H
