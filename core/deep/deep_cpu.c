@@ -178,10 +178,15 @@ obs_status obs__deep_frame_setup(const obs_deep_image *d, const obs_params *para
      * the nearer front face already stands for, and taken as the front of
      * one more solid behind it, nearer the samples' pipes than that front
      * face, it thickened the occluder the range check thins (a halo behind
-     * every back face).  The methods leave such nodes out: VAO's line
-     * samples, hemisphere's point samples, hbao's horizon (gtao: with its
-     * intervals, on by default, or every node solid behind). */
-    df->inside = !df->intervals && d->has_facing && df->multi && p.method != OBS_METHOD_GTAO;
+     * every back face).  The methods whose occluder is solid behind a
+     * node leave such nodes out: VAO's line samples, hemisphere's point
+     * samples.  The horizon methods keep them: a node raises a horizon by
+     * its own position, and a back face is a point of the occluder, the
+     * one nearest a receiver behind it (hbao; gtao: with its intervals,
+     * on by default, or every node as it is). */
+    df->inside = !df->intervals && d->has_facing && df->multi &&
+                 (p.method == OBS_METHOD_VAOPP || p.method == OBS_METHOD_VAO ||
+                  p.method == OBS_METHOD_HEMISPHERE);
     size_t npx = (size_t)d->width * (size_t)d->height;
     depth = calloc(npx, sizeof *depth);
     in_n = d->has_normal ? calloc(npx * 3, sizeof *in_n) : NULL;
@@ -474,8 +479,7 @@ static float method_ao(const obs__deep_frame *df, int x, int y, const float p[3]
         return obs__gtao_pixel_nodes(&df->f, df->pos, df->nrm3, df->multi ? df->m : 1, self,
                                      df->intervals ? df->end : NULL, x, y, p, n, NULL, NULL);
     if (df->f.method == OBS_METHOD_HBAO)
-        return obs__hbao_pixel_nodes(&df->f, df->pos, df->end,
-                                     df->multi ? df->m : 1, self, x, y, p, n,
+        return obs__hbao_pixel_nodes(&df->f, df->pos, df->multi ? df->m : 1, self, x, y, p, n,
                                      NULL);
     float v = sphere_ao(df, x, y, p, n, interior, self);
     return df->f.rays ? obs__rays_from_volume(v) : v; /* ao_definition rays */

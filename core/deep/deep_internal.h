@@ -21,7 +21,7 @@ typedef struct obs__deep_frame {
     int inside;     /* 1: intervals off, but the facing flags mark the nodes
                      * inside a nearer node's interval (end -1 or
                      * OBS__DEEP_END_CUT, the rest 0), which are no
-                     * occluders (methods vaopp, vao, hemisphere, hbao; the
+                     * occluders (methods vaopp, vao, hemisphere; the
                      * image has facing flags, deep_mode multi) */
     float *pos;     /* m planes of 4 floats: view position xyz, planar depth w (0: empty) */
     float *nrm;     /* m planes of 4 floats: view normal xyz, alpha */

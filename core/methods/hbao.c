@@ -44,34 +44,32 @@ static void hbao_sample(const float q[4], const float p[3], float R2, float om, 
     }
 }
 
-static float hbao_estimate(const obs__frame *f, const float *pos, const float *end, int layers,
-                           int self, int x, int y, const float p[3], const float n[3], int *count,
-                           float bent[3]);
+static float hbao_estimate(const obs__frame *f, const float *pos, int layers, int self, int x,
+                           int y, const float p[3], const float n[3], int *count, float bent[3]);
 
 /* GLSL: hbao_ao() in hbao.glsl */
 float obs__hbao_pixel(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                       const float n[3], int *count)
 {
-    return obs__hbao_pixel_nodes(f, pos, NULL, 1, 0, x, y, p, n, count);
+    return obs__hbao_pixel_nodes(f, pos, 1, 0, x, y, p, n, count);
 }
 
 float obs__hbao_pixel_bent(const obs__frame *f, const float *pos, int x, int y, const float p[3],
                            const float n[3], int *count, float bent[3])
 {
-    return hbao_estimate(f, pos, NULL, 1, 0, x, y, p, n, count, bent);
+    return hbao_estimate(f, pos, 1, 0, x, y, p, n, count, bent);
 }
 
-float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, const float *end, int layers,
-                            int self, int x, int y, const float p[3], const float n[3], int *count)
+float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, int layers, int self, int x,
+                            int y, const float p[3], const float n[3], int *count)
 {
-    return hbao_estimate(f, pos, end, layers, self, x, y, p, n, count, NULL);
+    return hbao_estimate(f, pos, layers, self, x, y, p, n, count, NULL);
 }
 
 /* obs__hbao_pixel_nodes that also sums the bent normal into bent[3]
  * (NULL: not wanted; obs__hbao_bent_span, bent.c). */
-static float hbao_estimate(const obs__frame *f, const float *pos, const float *end, int layers,
-                           int self, int x, int y, const float p[3], const float n[3], int *count,
-                           float bent[3])
+static float hbao_estimate(const obs__frame *f, const float *pos, int layers, int self, int x,
+                           int y, const float p[3], const float n[3], int *count, float bent[3])
 {
     const size_t plane = (size_t)f->width * (size_t)f->height * 4;
     const obs__hbao_state *hb = obs__hbao_of(f);
@@ -110,14 +108,10 @@ static float hbao_estimate(const obs__frame *f, const float *pos, const float *e
             const float *q = pos + 4 * ((size_t)qy * (size_t)f->width + (size_t)qx);
             /* deep input: every node, front to back, each times the
              * object masks' weight of its surface */
-            for (int k = 0; k < layers; k++) {
-                const size_t qi = (size_t)qy * (size_t)f->width + (size_t)qx;
-                if (end && end[(size_t)k * (plane / 4) + qi] < 0.0f)
-                    continue; /* inside a nearer node's interval */
+            for (int k = 0; k < layers; k++)
                 hbao_sample(q + (size_t)k * plane, p, R2,
                             obs__occluder_weight_node(f, x, y, self, qx, qy, k), &sin_h, &ao, dx,
                             dy, bent);
-            }
         }
     }
     if (count)

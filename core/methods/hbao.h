@@ -35,10 +35,8 @@ float obs__hbao_pixel_bent(const obs__frame *f, const float *pos, int x, int y, 
  * deep input's nodes, core/deep): at each step every node at its pixel,
  * front to back, raises the horizon where it lies above it (OITAO's
  * multi-layer HBAO, Fig. 9).  self: the receiver's node at (x, y), whose
- * object self_only compares (object masks, obs__occluder_weight_node);
- * end (NULL: none): the nodes' ends (deep_internal.h), a node with end < 0
- * (inside a nearer node's interval) raising no horizon. */
-float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, const float *end, int layers,
-                            int self, int x, int y, const float p[3], const float n[3], int *count);
+ * object self_only compares (object masks, obs__occluder_weight_node). */
+float obs__hbao_pixel_nodes(const obs__frame *f, const float *pos, int layers, int self, int x,
+                            int y, const float p[3], const float n[3], int *count);
 
 #endif

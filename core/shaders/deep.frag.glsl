@@ -64,9 +64,8 @@ float node_weight(ivec2 c, ivec2 s, int k)
 }
 // Whether node k at q can occlude: not where the facing flags put it
 // inside a nearer node's interval (end < 0, deep_internal.h), as a back
-// face closing it; method hemisphere's samples and hbao's horizon take
-// such a node's weight as 0, which adds nothing (C: the ends passed to
-// obs__hemisphere_estimate and obs__hbao_pixel_nodes).
+// face closing it; method hemisphere's samples take such a node's weight
+// as 0, which adds nothing (C: the ends passed to obs__hemisphere_estimate).
 bool node_occludes(ivec2 q, int k)
 {
 #if OBS_DEEP_INTERVALS
@@ -94,7 +93,7 @@ float hemisphere_estimate(ivec2 px, vec3 p, vec3 n, int layers, bool interior);
 #endif
 #define HB_LAYERS (u_multi != 0 ? u_m : 1)
 #define HB_NODE(q, k) imageLoad(u_lpos, ivec3(q, k))
-#define HB_WEIGHT(c, q, k) (node_occludes(q, k) ? node_weight(c, q, k) : 0.0)
+#define HB_WEIGHT(c, q, k) node_weight(c, q, k)
 float method_ao(ivec2 px, vec4 p, vec3 n, out int count);
 
 // the front node's AO and the blended AO, each beside the front node's

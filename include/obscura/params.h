@@ -449,7 +449,7 @@ typedef enum obs_baked_combine {
       "gtao_radius_multiplier 1, gtao_falloff 1e-6, gtao_power 1, "            \
       "gtao_heuristics off, gtao_steps 32); off, every node is solid behind "  \
       "it, as ao_definition rays' conversion and gtao's horizon assume "     \
-      "(vaopp, vao, hemisphere, hbao: but a node inside a nearer node's "     \
+      "(vaopp, vao, hemisphere: but a node inside a nearer node's "           \
       "interval, such as a back face, which adds nothing); auto "             \
       "(default): on for gtao, off for vaopp and vao, whose intervals "        \
       "measured farther from the ray tracer (bench/QUALITY.md, \"Deep input " \

@@ -635,10 +635,7 @@ static void test_intervals(void **state)
     print_message("thin plate in front, facing unknown: AO %.4f\n", unknown);
     assert_float_equal(ao_at(&d, &off, 15, 16, NULL), unknown, 1e-6);
     assert_true(unknown < without - 1e-3);
-    /* method hemisphere alike: the back face adds nothing.  (hbao: a
-     * back face behind its front face in a column never rises above the
-     * front face's horizon from a receiver behind both; the rule reaches
-     * it through hidden receivers only.) */
+    /* method hemisphere alike: the back face adds nothing */
     d.has_facing = 1;
     {
         obs_params mo = off, ms = single;
