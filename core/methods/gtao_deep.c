@@ -213,11 +213,10 @@ static void ray_uz(column_ray *cr)
     cr->have_uz = 1;
 }
 
-/* The window of the side's last column (pixel s->wq, its ray wo + s wd
- * where it took it: win_at 2): the cosines of the
- * angles where its ray lies within the radius, the depths [cs0, cs1] of
- * its chord of the ball; empty (the cosines of angle 0) where it passes
- * outside. */
+/* The window of the side's last column (pixel s->wq; its ray wo + s wd
+ * where it took it, win_at 2): the cosines of the angles where its ray
+ * lies within the radius, the depths [cs0, cs1] of its chord of the
+ * ball; empty (the cosines of angle 0) where it passes outside. */
 static void side_window(obs__gtao_side *s, const column_ray *cr)
 {
     column_ray w = *cr;
