@@ -188,17 +188,13 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         /* object masks: the weight of the surface at the step's pixel
          * (of each node there; past the border, of the front one) */
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
-            if (!end) {
-                obs__gtao_border_step(f, pos, nrm, self, x, y, qx, qy, c, v, low, &hc, taken);
-                continue;
-            }
             q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
-            /* intervals: the surface continued, solid behind it */
-            obs__gtao_column(f, fw, side, q, NULL, 0, q ? 1 : 0, x, y, self, qx, qy, c, v, low);
-            if (!q)
-                continue;
-            hc = fmaxf(hc, sample_cos(g, q, c, v, low,
-                                      obs__occluder_weight_node(f, x, y, self, qx, qy, 0)));
+            if (end) /* intervals: the surface continued, solid behind it */
+                obs__gtao_column(f, fw, side, q, NULL, 0, q ? 1 : 0, x, y, self, qx, qy, c, v,
+                                 low);
+            if (q)
+                hc = fmaxf(hc, sample_cos(g, q, c, v, low,
+                                          obs__occluder_weight_node(f, x, y, self, qx, qy, 0)));
             continue;
         }
         (*taken)++;
