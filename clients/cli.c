@@ -263,8 +263,7 @@ int cli_take_max_memory(const char *cmd, int argc, char **argv)
 void cli_max_memory(obs_cpu_options *o)
 {
     o->max_memory = max_memory.bytes;
-    o->max_memory_name = max_memory.bytes ? max_memory.name : "the memory budget (a quarter of the "
-                                                              "usable memory; --max-memory MIB sets it)";
+    o->max_memory_name = max_memory.bytes ? max_memory.name : NULL; /* the default's: bands_run.c */
 }
 
 int cli_max_memory_given(void) { return max_memory.name[0] == '-'; }

@@ -59,9 +59,6 @@ void obs__mat4_transpose(const float m[16], float out[16]);
 /* out = m * (x, y, z, w) */
 void obs__mat4_apply(const float m[16], const float v[4], float out[4]);
 
-/* The camera a frame is computed with: the G-buffer's camera, overridden
- * by parameters (fov_y, world_to_camera) where they are set.  Fails with
- * NO_CAMERA when neither gives a projection. */
 /* Sets parameter `name` of r to `value` (text, as obs_param_set) when r
  * leaves it unset (0): a preset's row, a parameter given explicitly
  * wins (--quality's presets, OBS_DEEP_GTAO_EXACT). */
@@ -71,6 +68,9 @@ void obs__params_fill(obs_params *r, const char *name, const char *value);
  * `in` leaves them at 0, taken from the G-buffer's convention. */
 void obs__params_for_gbuffer(const obs_params *in, const obs_gbuffer *gb, obs_params *out);
 
+/* The camera a frame is computed with: the G-buffer's camera, overridden
+ * by parameters (fov_y, world_to_camera) where they are set.  Fails with
+ * NO_CAMERA when neither gives a projection. */
 obs_status obs__camera_resolve(const obs_gbuffer *gb, const obs_params *p,
                                obs_camera *out, char err[OBS_ERR_LEN]);
 

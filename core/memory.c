@@ -92,17 +92,22 @@ size_t obs__memory_cgroup_limit(const char *proc_cgroup, const char *sys_cgroup)
     return best;
 }
 
+/* the default budget of `usable` bytes of usable memory */
+static size_t default_budget(size_t usable)
+{
+    return usable ? usable / 4 : (size_t)1 << 31; /* a quarter of the usable memory; not known: 2 GiB */
+}
+
 size_t obs_cpu_memory_budget(const obs_cpu_options *opt)
 {
     if (opt && opt->max_memory > 0)
         return opt->max_memory;
-    size_t usable = obs_cpu_memory_usable();
-    return usable ? usable / 4 : (size_t)1 << 31; /* a quarter of the usable memory; not known: 2 GiB */
+    return default_budget(obs_cpu_memory_usable());
 }
 
 void obs_cpu_memory_default_text(char *buf, size_t n)
 {
-    size_t usable = obs_cpu_memory_usable(), mib = obs_cpu_memory_budget(NULL) >> 20;
+    size_t usable = obs_cpu_memory_usable(), mib = default_budget(usable) >> 20;
     if (usable)
         snprintf(buf, n, "%zu MiB (default: a quarter of %.1f GiB usable; --max-memory MIB sets it)", mib,
                  (double)usable / 1073741824.0);

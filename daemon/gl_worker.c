@@ -209,7 +209,8 @@ static void *worker_main(void *arg)
         } else if (w->cpu) {
             obs_cpu_options o = {.deadline = w->frame_deadline, /* as the GL context's */
                                  .cancel = cut_asked, .cancel_user = w, .log = cpu_log, .log_user = w,
-                                 .max_memory = w->max_memory, .max_memory_name = w->max_memory_name};
+                                 .max_memory = w->max_memory,
+                                 .max_memory_name = w->max_memory_name[0] ? w->max_memory_name : NULL};
             job->status = job->deep ? obs_deep_run_cpu_opts(job->deep, job->params, &o,
                                                             &job->deep_result, job->err)
                                     : obs_run_cpu_opts(job->gb, job->params, job->outputs,
@@ -263,10 +264,8 @@ obs_status obsd_gl_start(obsd_gl_worker *w, obsd_queue *q, const obs_ctx_desc *d
     w->frame_deadline = cfg->frame_deadline;
     w->max_memory = (size_t)cfg->max_memory << 20;
     const obsd_opt_info *mo = obsd_opt_find("max_memory");
-    if (!cfg->max_memory)
-        snprintf(w->max_memory_name, sizeof w->max_memory_name,
-                 "the memory budget (a quarter of the usable memory; --max-memory MIB sets it)");
-    else
+    w->max_memory_name[0] = 0; /* the default's name: the library's (bands_run.c) */
+    if (cfg->max_memory)
         snprintf(w->max_memory_name, sizeof w->max_memory_name, cfg->set[mo - obsd_opt_at(0)]
                  ? "--max-memory %d MiB" : "OBSCURA_MAX_MEMORY=%d MiB", cfg->max_memory);
     atomic_init(&w->alive, 0);

@@ -345,11 +345,15 @@ static void over_budget_log(const obs_cpu_options *opt, int halo, size_t need, s
 {
     if (!opt || !opt->log)
         return;
+    const char *name = opt->max_memory_name;
+    if (!name)
+        name = opt->max_memory ? "the memory budget"
+                               : "the memory budget (a quarter of the usable memory; --max-memory MIB "
+                                 "sets it)";
     char msg[320];
     snprintf(msg, sizeof msg, "%s: the AO's samples reach up to %d rows either side at this depth: "
              "bands hold up to %.1f MiB of planes, over the %.1f MiB the budget leaves them",
-             opt->max_memory_name ? opt->max_memory_name : "the memory budget", halo,
-             (double)need / 1048576.0, (double)budget / 1048576.0);
+             name, halo, (double)need / 1048576.0, (double)budget / 1048576.0);
     opt->log(opt->log_user, OBS_LOG_WARN, msg);
 }
 

@@ -312,7 +312,8 @@ typedef struct obs_cpu_options {
     int band_rows;
     /* what set max_memory, as the warning of a band over the budget
      * (through log) names it, e.g. "--max-memory 256 MiB"; NULL: "the
-     * memory budget" */
+     * memory budget", with the default's description where max_memory
+     * is 0 */
     const char *max_memory_name;
 } obs_cpu_options;
 
