@@ -458,14 +458,14 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
                         continue;
                     const float cc[3] = {c0[j], c1[j], c2[j]}, vv[3] = {v0[j], v1[j], v2[j]};
                     const int x = c.x[j], y = c.y[j];
-                    float hm = lo[side][j];
+                    float hm = lo[side][j], ext[4];
                     for (int st = 0; st < steps; st++) {
                         const int qx = sqx[st][j], qy = sqy[st][j];
                         if (qx >= 0 && qy >= 0 && qx < w && qy < h)
                             hm = max_f(hm, sval[st][j]);
                         else
                             obs__gtao_border_step(f, pos, nrm, 0, x, y, qx, qy, cc, vv,
-                                                  lo[side][j], &hm, &taken[j]);
+                                                  lo[side][j], &hm, &taken[j], ext);
                     }
                     hs[j] = hm;
                 }
@@ -482,7 +482,7 @@ static void gtao_pixels(const obs__frame *f, const float *pos, const float *nrm,
                 const float h0 = gamma + (e0 > -half_pi ? e0 : -half_pi);
                 const float h1 = gamma + (e1 < half_pi ? e1 : half_pi);
                 const float sg = sincos_lane(gamma, 0);
-                /* arc(): (cos g + 2 h sin g - cos(2 h - g)) / 4 */
+                /* obs__gtao_arc(): (cos g + 2 h sin g - cos(2 h - g)) / 4 */
                 const float a0 = (cg + 2.0f * h0 * sg - sincos_lane(2.0f * h0 - gamma, 1)) / 4.0f;
                 const float a1 = (cg + 2.0f * h1 * sg - sincos_lane(2.0f * h1 - gamma, 1)) / 4.0f;
                 vis[j] += npl * (a0 + a1);

@@ -106,15 +106,16 @@ static float sample_cos(const obs__gtao_state *g, const float q[4], const float 
     return low + (shc - low) * w; /* lerp(lowHorizonCos, shc, weight) */
 }
 
-void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int self,
-                           int x, int y, int qx, int qy, const float c[3], const float v[3],
-                           float low, float *hc, int *taken)
+const float *obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm,
+                                   int self, int x, int y, int qx, int qy, const float c[3],
+                                   const float v[3], float low, float *hc, int *taken,
+                                   float ext[4])
 {
-    float ext[4];
     const float *q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
     if (q)
         *hc = fmaxf(*hc, sample_cos(obs__gtao_of(f), q, c, v, low,
                                     obs__occluder_weight_node(f, x, y, self, qx, qy, 0)));
+    return q;
 }
 
 /* Deep input with intervals: a step's column reads its pixel's node in
@@ -188,13 +189,11 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
         /* object masks: the weight of the surface at the step's pixel
          * (of each node there; past the border, of the front one) */
         if (qx < 0 || qy < 0 || qx >= f->width || qy >= f->height) {
-            q = border_step(f, pos, nrm, x, y, qx, qy, ext, taken);
+            q = obs__gtao_border_step(f, pos, nrm, self, x, y, qx, qy, c, v, low, &hc, taken,
+                                      ext);
             if (end) /* intervals: the surface continued, solid behind it */
                 obs__gtao_column(f, fw, side, q, NULL, 0, q ? 1 : 0, x, y, self, qx, qy, c, v,
                                  low);
-            if (q)
-                hc = fmaxf(hc, sample_cos(g, q, c, v, low,
-                                          obs__occluder_weight_node(f, x, y, self, qx, qy, 0)));
             continue;
         }
         (*taken)++;
@@ -209,12 +208,6 @@ static float side_horizon(const obs__frame *f, const float *pos, const float *nr
                                       obs__occluder_weight_node(f, x, y, self, qx, qy, k)));
     }
     return hc;
-}
-
-/* a(h) of the header: the inner integral's closed form */
-static float arc(float h, float gamma, float cos_gamma)
-{
-    return (cos_gamma + 2.0f * h * sinf(gamma) - cosf(2.0f * h - gamma)) / 4.0f;
 }
 
 /* GLSL: method_ao() in gtao.glsl */
@@ -300,7 +293,7 @@ float obs__gtao_pixel_nodes(const obs__frame *f, const float *pos, const float *
         if (end) /* the free arcs between the horizons (gtao_deep.c) */
             vis += np_len * obs__gtao_slice_free(&sides[0], &sides[1], h0, h1, gamma, cos_g);
         else
-            vis += np_len * (arc(h0, gamma, cos_g) + arc(h1, gamma, cos_g));
+            vis += np_len * (obs__gtao_arc(h0, gamma, cos_g) + obs__gtao_arc(h1, gamma, cos_g));
         if (bent)
             obs__gtao_bent_slice(h0, h1, gamma, np_len, od, v, bent);
     }

@@ -67,10 +67,14 @@ void obs__gtao_slice_dir(const obs__gtao_state *g, int sl, float noise0, float c
  * pixel (x, y) (its node self on deep input, else 0; centre c, view
  * direction v, the side's start low): the
  * surface continued past the border (border_cpu.c), its horizon cosine
- * into *hc (the larger), *taken counted where it reads a point. */
-void obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm, int self,
-                           int x, int y, int qx, int qy, const float c[3], const float v[3],
-                           float low, float *hc, int *taken);
+ * into *hc (the larger), *taken counted where it reads a point.  The
+ * point (view xyz, planar depth) in ext, returned; NULL where it is
+ * background or there is no estimate. */
+const float *obs__gtao_border_step(const obs__frame *f, const float *pos, const float *nrm,
+                                   int self, int x, int y, int qx, int qy, const float c[3],
+                                   const float v[3], float low, float *hc, int *taken,
+                                   float ext[4]);
+
 /* The visibility's start (XeGTAO's heuristic for a small radius in pixels)
  * and its end from the slices' sum. */
 float obs__gtao_vis0(const obs__gtao_state *g, float rpx);

@@ -400,12 +400,6 @@ float obs__gtao_centre_start(const float *q, const float *end, size_t plane, int
     return z0;
 }
 
-/* a(h) of gtao.c (its arc()): the inner integral's closed form */
-static float arc(float h, float gamma, float cos_gamma)
-{
-    return (cos_gamma + 2.0f * h * sinf(gamma) - cosf(2.0f * h - gamma)) / 4.0f;
-}
-
 /* The free part of one side (s = +1: angles 0 .. h, s = -1: h .. 0):
  * the sweep over its arcs, sorted by their near end, each end clamped to
  * n's hemisphere as gtao.c clamps a horizon. */
@@ -413,7 +407,7 @@ static float side_free(const obs__gtao_side *a, float h, float s, float gamma, f
 {
     const float half_pi = (float)M_PI_2;
     if (a->n == 0)
-        return arc(h, gamma, cos_g);
+        return obs__gtao_arc(h, gamma, cos_g);
     float end = s * h, cur = 0.0f, sum = 0.0f; /* |angles| on the side */
     for (int i = 0; i <= a->n; i++) {
         float lo = end, hi = end;
@@ -426,7 +420,8 @@ static float side_free(const obs__gtao_side *a, float h, float s, float gamma, f
             hi = s * hi;
         }
         if (lo > cur) /* free from cur to lo */
-            sum += arc(s * lo, gamma, cos_g) - (cur > 0.0f ? arc(s * cur, gamma, cos_g) : 0.0f);
+            sum += obs__gtao_arc(s * lo, gamma, cos_g) -
+                   (cur > 0.0f ? obs__gtao_arc(s * cur, gamma, cos_g) : 0.0f);
         cur = max_f(cur, hi);
         if (cur >= end)
             break;

@@ -3,6 +3,8 @@
 #ifndef OBSCURA_METHODS_GTAO_DEEP_H
 #define OBSCURA_METHODS_GTAO_DEEP_H
 
+#include <math.h>
+
 #include "chain/frame.h"
 #include "obscura/deep.h"
 
@@ -69,5 +71,14 @@ float obs__gtao_column(const obs__frame *f, const float fw[3], obs__gtao_side *s
  * in gtao.glsl). */
 float obs__gtao_slice_free(const obs__gtao_side *s0, const obs__gtao_side *s1, float h0, float h1,
                            float gamma, float cos_g);
+
+/* a(h): the closed form of a slice side's inner integral from the view
+ * vector to the angle h (Jimenez et al. 2016, Algorithm 1; the header of
+ * gtao.c), gamma the projected normal's angle, cos_gamma its cosine.
+ * GLSL: gtao_arc() in gtao.glsl. */
+static inline float obs__gtao_arc(float h, float gamma, float cos_gamma)
+{
+    return (cos_gamma + 2.0f * h * sinf(gamma) - cosf(2.0f * h - gamma)) / 4.0f;
+}
 
 #endif
