@@ -59,40 +59,37 @@ static float norm_z(float z, float zmin, float zmax)
     return t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
 }
 
+/* A sample's depth and index, sorted by depth, ties by index (a NaN
+ * depth last, as the deep reader sorts them). */
+typedef struct depth_ix {
+    float z;
+    int s;
+} depth_ix;
+
+static int by_depth(const void *a, const void *b)
+{
+    const depth_ix *p = a, *q = b;
+    return p->z < q->z ? -1 : p->z > q->z ? 1 : p->s - q->s;
+}
+
 /* The intervals of a whole list (n samples): pair[s] = the sample matched
  * with sample s by the facing flags, front to back by depth (ties in
  * insertion order) as parentheses: a front face (+1) opens, the next back
  * face (-1) closes the innermost open one, as obs__deep_intervals matches
  * a kept list; -1 for a sample in no pair (facing 0, a back face with
- * nothing open, a front face whose back face the list lacks).  scratch:
- * 2 n ints. */
-static void match_list(const float *samples, int n, int *pair, int *scratch)
+ * nothing open, a front face whose back face the list lacks).  order, open:
+ * scratch of n each. */
+static void match_list(const float *samples, int n, int *pair, depth_ix *order, int *open)
 {
-    int *order = scratch, *tmp = scratch + n;
     for (int s = 0; s < n; s++) {
-        order[s] = s;
+        const float z = samples[(size_t)s * OBS_DEEP_CH + OBS_DEEP_Z];
+        order[s] = (depth_ix){isnan(z) ? INFINITY : z, s};
         pair[s] = -1;
     }
-    /* stable bottom-up merge sort of the indices by depth */
-    for (int w = 1; w < n; w *= 2) {
-        for (int lo = 0; lo < n; lo += 2 * w) {
-            int mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
-            int i = lo, j = mid, k = lo;
-            while (i < mid && j < hi)
-                tmp[k++] = samples[(size_t)order[j] * OBS_DEEP_CH + OBS_DEEP_Z] <
-                                   samples[(size_t)order[i] * OBS_DEEP_CH + OBS_DEEP_Z]
-                               ? order[j++]
-                               : order[i++];
-            while (i < mid)
-                tmp[k++] = order[i++];
-            while (j < hi)
-                tmp[k++] = order[j++];
-        }
-        memcpy(order, tmp, (size_t)n * sizeof *order);
-    }
-    int *open = tmp, depth = 0; /* the open front faces, innermost last */
+    qsort(order, (size_t)n, sizeof *order, by_depth);
+    int depth = 0; /* the open front faces, innermost last */
     for (int k = 0; k < n; k++) {
-        int s = order[k];
+        int s = order[k].s;
         float fc = samples[(size_t)s * OBS_DEEP_CH + OBS_DEEP_FACING];
         if (fc > 0.0f) {
             open[depth++] = s;
@@ -185,14 +182,24 @@ int obs_deep_compress_list(const float *samples, int n, int m, int front_half, f
     return compress_list(samples, n, m, front_half, NULL, zmin, zmax, out, NULL);
 }
 
+/* The scratch of match_list for lists of up to n samples: pair and open
+ * (n ints each), order (n depth_ix); NULL when out of memory. */
+static int *match_alloc(size_t n, depth_ix **order)
+{
+    int *pair = malloc(n * (2 * sizeof(int) + sizeof(depth_ix)));
+    *order = pair ? (depth_ix *)(void *)(pair + 2 * n) : NULL;
+    return pair;
+}
+
 int obs__deep_compress_list(const float *samples, int n, int m, int front_half, int intervals,
                             float zmin, float zmax, float *out)
 {
     int *pair = NULL;
+    depth_ix *order = NULL;
     if (intervals && n > 0) {
-        if (!(pair = malloc((size_t)n * 3 * sizeof *pair)))
+        if (!(pair = match_alloc((size_t)n, &order)))
             return -1;
-        match_list(samples, n, pair, pair + n);
+        match_list(samples, n, pair, order, pair + n);
     }
     int c = compress_list(samples, n, m, front_half, pair, zmin, zmax, out, NULL);
     free(pair);
@@ -273,6 +280,7 @@ obs_status obs__deep_compress(const obs_deep_image *d, int m, int front_half, in
     }
     /* with intervals: the pairs of the longest list and their scratch */
     int *pair = NULL;
+    depth_ix *order = NULL;
     if (intervals && !keep_all) {
         size_t most = 0;
         for (size_t i = 0; i < npx; i++)
@@ -280,7 +288,7 @@ obs_status obs__deep_compress(const obs_deep_image *d, int m, int front_half, in
                 most = (size_t)(d->offset[i + 1] - d->offset[i]);
         if (most > OBS_DEEP_MAX_PER_PIXEL)
             most = OBS_DEEP_MAX_PER_PIXEL;
-        if (most && !(pair = malloc(most * 3 * sizeof *pair))) {
+        if (most && !(pair = match_alloc(most, &order))) {
             obs_deep_layers_free(out);
             return obs__fail(err, OBS_NO_MEMORY, "deep intervals of %zu samples", most);
         }
@@ -307,7 +315,7 @@ obs_status obs__deep_compress(const obs_deep_image *d, int m, int front_half, in
                 src[k] = k;
         } else {
             if (pair)
-                match_list(s, n, pair, pair + n);
+                match_list(s, n, pair, order, pair + n);
             c = compress_list(s, n, m, front_half, pair, zmin, zmax, list, src);
         }
         out->count[i] = c;
