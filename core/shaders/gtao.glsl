@@ -95,7 +95,7 @@ float gtao_arc(float h, float gamma, float cos_gamma)
 // GT_MAX_ARCS are OBS__GTAO_MAX_GAPS and OBS__GTAO_MAX_ARCS for 8 nodes
 // and 32 steps.
 //
-// The cost.  Most columns add no arc (the C twin's header), and the
+// The cost.  Most columns add no arc (gtao_deep.c's cost comment), and the
 // arcs, as the C twin's, wait for a column that adds one: its angles are
 // kept as cosines until then (gtao_cos_v).  A GL implementation without
 // branches (llvmpipe runs the pixels of a block together, each branch
