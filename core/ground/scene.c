@@ -255,6 +255,72 @@ static obs_status copy_mesh(const char *path, const struct aiScene *sc, unsigned
     return OBS_OK;
 }
 
+/* Every mesh under some node: PreTransformVertices, keeping the
+ * hierarchy, takes each mesh's transform from the node that holds it and
+ * reads a null one for a mesh no node holds (a damaged file: an AC3D
+ * object with vertices and no surface count). */
+static obs_status meshes_placed(const char *path, const struct aiScene *sc,
+                                char err[OBS_ERR_LEN])
+{
+    if (!sc->mRootNode)
+        return obs__fail(err, OBS_BAD_FILE, "%s: no node graph", path);
+    unsigned char *held = calloc(sc->mNumMeshes ? sc->mNumMeshes : 1, 1);
+    size_t cap = 64, sp = 0;
+    const struct aiNode **stack = malloc(cap * sizeof *stack);
+    if (!held || !stack) {
+        free(held);
+        free(stack);
+        return obs__fail(err, OBS_NO_MEMORY, "%s: node graph", path);
+    }
+    stack[sp++] = sc->mRootNode;
+    obs_status st = OBS_OK;
+    while (sp > 0 && st == OBS_OK) {
+        const struct aiNode *n = stack[--sp];
+        for (unsigned k = 0; k < n->mNumMeshes; k++)
+            if (n->mMeshes[k] < sc->mNumMeshes)
+                held[n->mMeshes[k]] = 1;
+        for (unsigned c = 0; c < n->mNumChildren && st == OBS_OK; c++) {
+            if (!n->mChildren[c])
+                continue;
+            if (sp == cap) {
+                const struct aiNode **more = realloc(stack, 2 * cap * sizeof *stack);
+                if (!more)
+                    st = obs__fail(err, OBS_NO_MEMORY, "%s: node graph", path);
+                else
+                    stack = more, cap *= 2;
+            }
+            if (st == OBS_OK)
+                stack[sp++] = n->mChildren[c];
+        }
+    }
+    for (unsigned i = 0; i < sc->mNumMeshes && st == OBS_OK; i++)
+        if (!held[i])
+            st = obs__fail(err, OBS_BAD_FILE, "%s: mesh %u '%s' is under no node of the file "
+                                              "(a damaged file?)",
+                           path, i, sc->mMeshes[i]->mName.data);
+    free(held);
+    free(stack);
+    return st;
+}
+
+/* Every vertex in world space (the file's nodes applied), finite. */
+static obs_status finite_vertices(const char *path, const struct aiScene *sc,
+                                  char err[OBS_ERR_LEN])
+{
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[i];
+        for (unsigned v = 0; v < m->mNumVertices; v++) {
+            const struct aiVector3D p = m->mVertices[v];
+            if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+                return obs__fail(err, OBS_BAD_FILE,
+                                 "%s: mesh %u '%s': vertex %u is (%g, %g, %g) in world space, "
+                                 "not finite (in the file, or its node's transform overflows)",
+                                 path, i, m->mName.data, v, (double)p.x, (double)p.y, (double)p.z);
+        }
+    }
+    return OBS_OK;
+}
+
 /* The file through assimp, flattened, each mesh kept apart. */
 static obs_status import(const char *path, const struct aiScene **sc, char err[OBS_ERR_LEN])
 {
@@ -262,18 +328,47 @@ static obs_status import(const char *path, const struct aiScene **sc, char err[O
     if (!fp)
         return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
     fclose(fp);
-    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                           aiProcess_SortByPType | aiProcess_GenNormals |
-                           aiProcess_FindInvalidData;
+    /* Read and validated first, nothing else: ValidateDataStructure
+     * refuses an importer's inconsistent output (a face without indices,
+     * an index past its mesh's vertices, a node naming a mesh that is not
+     * there) before assimp's own preprocessing or copy_mesh reads it out
+     * of bounds.  Then the steps in two calls, in assimp's own order (its
+     * step list runs PreTransformVertices, Triangulate and SortByPType
+     * before FindInvalidData and GenNormals): the world-space vertices are
+     * checked in between, as FindInvalidData would drop a mesh with a NaN
+     * or infinite vertex (the file's, or its node's transform overflowing)
+     * without a word. */
+    const unsigned place = aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                           aiProcess_SortByPType;
+    const unsigned clean = aiProcess_FindInvalidData | aiProcess_GenNormals;
     /* Keep the meshes apart (PreTransformVertices otherwise joins those
      * of one material): their names select opacities. */
     struct aiPropertyStore *props = aiCreatePropertyStore();
     if (props)
         aiSetImportPropertyInteger(props, AI_CONFIG_PP_PTV_KEEP_HIERARCHY, 1);
-    *sc = aiImportFileExWithProperties(path, flags, NULL, props);
+    *sc = aiImportFileExWithProperties(path, aiProcess_ValidateDataStructure, NULL, props);
     if (props)
         aiReleasePropertyStore(props);
     if (!*sc)
+        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
+                         aiGetErrorString());
+    obs_status st = meshes_placed(path, *sc, err);
+    if (st != OBS_OK) {
+        aiReleaseImport(*sc);
+        *sc = NULL;
+        return st;
+    }
+    /* aiApplyPostProcessing releases the scene when a step fails. */
+    if (!(*sc = aiApplyPostProcessing(*sc, place)))
+        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
+                         aiGetErrorString());
+    st = finite_vertices(path, *sc, err);
+    if (st != OBS_OK) {
+        aiReleaseImport(*sc);
+        *sc = NULL;
+        return st;
+    }
+    if (!(*sc = aiApplyPostProcessing(*sc, clean)))
         return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
                          aiGetErrorString());
     return OBS_OK;

@@ -393,8 +393,11 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
         return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
     fclose(fp);
     /* No joining, no pre-transform: the soup, the graph and the mesh
-     * order stay the file's. */
-    const struct aiScene *sc = aiImportFile(path, aiProcess_Triangulate);
+     * order stay the file's.  ValidateDataStructure refuses what an
+     * importer left inconsistent (a face without indices, a mesh index
+     * out of range) before assimp's own preprocessing reads it. */
+    const struct aiScene *sc =
+        aiImportFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate);
     if (!sc)
         return obs__fail(err, OBS_BAD_FILE, "%s: not a level assimp can read: %s", path,
                          aiGetErrorString());

@@ -49,3 +49,18 @@ $(FUZZ_DIR)/corpus.stamp: $(FUZZ_DIR)/gen_corpus
 	@mkdir -p tests/fuzz/corpus/binary
 	$(FUZZ_DIR)/gen_corpus tests/fuzz/corpus/binary
 	@touch $@
+
+# ---- fuzz_scene: the mesh and level loaders through assimp ---------------
+#   $(BUILD)/fuzz/fuzz_scene -max_len=65536 NEW_DIR tests/fuzz/corpus/scene
+# (tests/fuzz/fuzz_scene.c: obs_scene_load, obs_scene_load_baked,
+# obs_bake_load, obs__bake_flatten).  assimp is not built with the
+# sanitizers; its own leaks are suppressed (tests/fuzz/scene.supp).
+FUZZ_SCENE_SRC := core/ground/scene.c core/ground/baked.c core/io/glb_read.c core/level/load.c \
+                  core/level/lod_file.c core/level/flatten.c core/status.c core/util.c
+FUZZ_SCENE_LIBS := -lassimp $(shell pkg-config --libs libcjson 2>/dev/null) -lstdc++ -lm -lpthread
+
+fuzz: $(FUZZ_DIR)/fuzz_scene
+
+$(FUZZ_DIR)/fuzz_scene: tests/fuzz/fuzz_scene.c $(FUZZ_SCENE_SRC) $(FUZZ_HDR) | fuzz-check
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SCENE_SRC) -o $@ $(FUZZ_SCENE_LIBS)
