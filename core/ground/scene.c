@@ -2,7 +2,6 @@
  * world space, as one indexed mesh. */
 #include <assimp/GltfMaterial.h>
 #include <assimp/cimport.h>
-#include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -15,6 +14,7 @@
 
 #include "internal.h"
 #include "obscura/scene.h"
+#include "ground/assimp_read.h"
 #include "ground/scene_internal.h"
 
 /* Indices are 32-bit (GL and Embree take them so). */
@@ -322,7 +322,8 @@ static obs_status finite_vertices(const char *path, const struct aiScene *sc,
 }
 
 /* The file through assimp, flattened, each mesh kept apart. */
-static obs_status import(const char *path, const struct aiScene **sc, char err[OBS_ERR_LEN])
+static obs_status import(const char *path, obs__assimp **imp, const struct aiScene **sc,
+                         char err[OBS_ERR_LEN])
 {
     FILE *fp = fopen(path, "rb");
     if (!fp)
@@ -341,44 +342,33 @@ static obs_status import(const char *path, const struct aiScene **sc, char err[O
     const unsigned place = aiProcess_Triangulate | aiProcess_PreTransformVertices |
                            aiProcess_SortByPType;
     const unsigned clean = aiProcess_FindInvalidData | aiProcess_GenNormals;
+    char msg[OBS_ERR_LEN] = "";
     /* Keep the meshes apart (PreTransformVertices otherwise joins those
      * of one material): their names select opacities. */
-    struct aiPropertyStore *props = aiCreatePropertyStore();
-    if (props)
-        aiSetImportPropertyInteger(props, AI_CONFIG_PP_PTV_KEEP_HIERARCHY, 1);
-    *sc = aiImportFileExWithProperties(path, aiProcess_ValidateDataStructure, NULL, props);
-    if (props)
-        aiReleasePropertyStore(props);
-    if (!*sc)
-        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
-                         aiGetErrorString());
-    obs_status st = meshes_placed(path, *sc, err);
+    *sc = NULL;
+    if (!(*imp = obs__assimp_read(path, 1, msg)))
+        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path, msg);
+    obs_status st = meshes_placed(path, obs__assimp_scene(*imp), err);
+    if (st == OBS_OK && !obs__assimp_apply(*imp, place, msg))
+        st = obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path, msg);
+    if (st == OBS_OK)
+        st = finite_vertices(path, obs__assimp_scene(*imp), err);
+    if (st == OBS_OK && !(*sc = obs__assimp_apply(*imp, clean, msg)))
+        st = obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path, msg);
     if (st != OBS_OK) {
-        aiReleaseImport(*sc);
+        obs__assimp_free(*imp);
+        *imp = NULL;
         *sc = NULL;
-        return st;
     }
-    /* aiApplyPostProcessing releases the scene when a step fails. */
-    if (!(*sc = aiApplyPostProcessing(*sc, place)))
-        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
-                         aiGetErrorString());
-    st = finite_vertices(path, *sc, err);
-    if (st != OBS_OK) {
-        aiReleaseImport(*sc);
-        *sc = NULL;
-        return st;
-    }
-    if (!(*sc = aiApplyPostProcessing(*sc, clean)))
-        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path,
-                         aiGetErrorString());
-    return OBS_OK;
+    return st;
 }
 
 obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
+    obs__assimp *imp = NULL;
     const struct aiScene *sc = NULL;
-    obs_status st = import(path, &sc, err);
+    obs_status st = import(path, &imp, &sc, err);
     if (st != OBS_OK)
         return st;
     scene_size z = measure(sc);
@@ -393,11 +383,11 @@ obs_status obs_scene_load(const char *path, obs_scene *out, char err[OBS_ERR_LEN
     out->triangle_count = z.nt;
     if ((st = obs__scene_check_file(out, path, err)) != OBS_OK)
         goto fail;
-    aiReleaseImport(sc);
+    obs__assimp_free(imp);
     return OBS_OK;
 
 fail:
-    aiReleaseImport(sc);
+    obs__assimp_free(imp);
     obs_scene_free(out);
     return st;
 }

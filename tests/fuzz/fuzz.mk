@@ -57,10 +57,12 @@ $(FUZZ_DIR)/corpus.stamp: $(FUZZ_DIR)/gen_corpus
 # sanitizers; its own leaks are suppressed (tests/fuzz/scene.supp).
 FUZZ_SCENE_SRC := core/ground/scene.c core/ground/baked.c core/io/glb_read.c core/level/load.c \
                   core/level/lod_file.c core/level/flatten.c core/status.c core/util.c
+FUZZ_SCENE_CXX_SRC := core/ground/assimp_read.cpp
 FUZZ_SCENE_LIBS := -lassimp $(shell pkg-config --libs libcjson 2>/dev/null) -lstdc++ -lm -lpthread
 
 fuzz: $(FUZZ_DIR)/fuzz_scene
 
-$(FUZZ_DIR)/fuzz_scene: tests/fuzz/fuzz_scene.c $(FUZZ_SCENE_SRC) $(FUZZ_HDR) | fuzz-check
-	@mkdir -p $(dir $@)
-	$(FUZZ_CC) $(FUZZ_CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SCENE_SRC) -o $@ $(FUZZ_SCENE_LIBS)
+$(FUZZ_DIR)/fuzz_scene: tests/fuzz/fuzz_scene.c $(FUZZ_SCENE_SRC) $(FUZZ_SCENE_CXX_SRC) $(FUZZ_HDR) | fuzz-check
+	@mkdir -p $(FUZZ_DIR)/scene
+	$(FUZZ_CC)++ $(FUZZ_CPPFLAGS) $(filter-out -std=c11,$(FUZZ_CFLAGS)) -std=c++14 -fno-sanitize=vptr -c $(FUZZ_SCENE_CXX_SRC) -o $(FUZZ_DIR)/scene/assimp_read.o
+	$(FUZZ_CC) $(FUZZ_CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_SCENE_SRC) $(FUZZ_DIR)/scene/assimp_read.o -o $@ $(FUZZ_SCENE_LIBS)

@@ -1,0 +1,36 @@
+/* assimp's importer through its C++ API (assimp_read.cpp), for
+ * scene.c: read with validation only, then post-processing steps
+ * applied in calls of their own, so that the scene can be checked in
+ * between.  assimp 5.2's C aiApplyPostProcessing releases a scene that a
+ * failing step has already deleted (a crash); Importer::ApplyPostProcessing
+ * only returns NULL. */
+#ifndef OBSCURA_GROUND_ASSIMP_READ_H
+#define OBSCURA_GROUND_ASSIMP_READ_H
+
+#include <stddef.h>
+
+#include "obscura/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct aiScene;
+typedef struct obs__assimp obs__assimp;
+
+/* The file read with aiProcess_ValidateDataStructure and no other step
+ * (keep_hierarchy: AI_CONFIG_PP_PTV_KEEP_HIERARCHY for a later
+ * PreTransformVertices); NULL with assimp's message in msg when it cannot
+ * be read, or out of memory. */
+obs__assimp *obs__assimp_read(const char *path, int keep_hierarchy, char msg[OBS_ERR_LEN]);
+const struct aiScene *obs__assimp_scene(const obs__assimp *a);
+/* The steps (aiProcess_* flags) applied to the scene; NULL with assimp's
+ * message in msg when one fails (the scene is then gone). */
+const struct aiScene *obs__assimp_apply(obs__assimp *a, unsigned steps, char msg[OBS_ERR_LEN]);
+void obs__assimp_free(obs__assimp *a);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
