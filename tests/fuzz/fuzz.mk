@@ -30,12 +30,14 @@ FUZZ_EXR_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libcjson 2>/dev/nul
 # The other files a user or a farm hands obscura (fuzz_files.c): camera
 # JSON, object-mask selectors (against an EXR: the EXR readers), a .glb's
 # own LODs (the scene they match loaded with assimp: level/load.c), the
-# dynamic-AO model, the bake and bake-dynamic parts.  shard.c and
+# dynamic-AO model, the bake and bake-dynamic parts, bake-dynamic's
+# regions file, the bakes' decorators file.  shard.c and
 # dyn_shard.c are compiled for their part formats; their trace steps
 # (never called) are dropped at link time (--gc-sections; start-stop-gc
 # so that the coverage tables do not keep them).
 FUZZ_FILES_SRC := core/camera/json.c core/mask.c core/level/lod_file.c core/level/load.c core/io/glb_read.c \
-                  core/dynamic/dyn_model.c core/dynamic/dyn_fit.c core/level/part.c core/level/sh.c \
+                  core/dynamic/dyn_model.c core/dynamic/dyn_fit.c core/dynamic/dyn_regions.c core/level/decor.c \
+                  core/level/part.c core/level/sh.c core/level/sweep.c \
                   core/bake/shard.c core/dynamic/dyn_shard.c core/bake/params.c core/dynamic/dyn_params.c \
                   core/io/out_file.c $(FUZZ_EXR_SRC)
 FUZZ_FILES_FLAGS := -ffunction-sections -fdata-sections -Wl,--gc-sections -Wl,-z,start-stop-gc

@@ -14,8 +14,12 @@
  *   4  bake part               core/level/part.c with bake/shard.c's format: header,
  *                                                    merge parameters, payload
  *   5  bake-dynamic part       the same with dynamic/dyn_shard.c's format
+ *   6  regions file            core/dynamic/dyn_regions.c obs_dyn_regions_parse
+ *                                                    (bake-dynamic --regions)
+ *   7  decorators file         core/level/decor.c    obs__bake_decor_classify against
+ *                                                    the LOD parser's scene (bake --decorators)
  *
- * (the byte is taken modulo 6; OBS_FUZZ_ONLY=N in the environment: parser
+ * (the byte is taken modulo 8; OBS_FUZZ_ONLY=N in the environment: parser
  * N whatever the byte, OBS_FUZZ_VERBOSE: each parser's status and message
  * on stderr).  Whatever a parser returns is touched and
  * freed (ASan and LeakSanitizer check).  Seeds: tests/fuzz/corpus/files
@@ -31,6 +35,7 @@
 
 #include "bake/shard.h"
 #include "dynamic/dyn_internal.h"
+#include "level/decor.h"
 #include "obscura/bake.h"
 #include "obscura/dynamic.h"
 #include "obscura/io.h"
@@ -39,7 +44,7 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 
-enum { P_CAMERA, P_MASK, P_LOD, P_DYN_MODEL, P_BAKE_PART, P_DYN_PART, P_COUNT };
+enum { P_CAMERA, P_MASK, P_LOD, P_DYN_MODEL, P_BAKE_PART, P_DYN_PART, P_REGIONS, P_DECOR, P_COUNT };
 
 static char dir[64];
 static char file[96];
@@ -134,16 +139,11 @@ static void camera(void)
             sink += cam.world_to_camera[i] + cam.projection[i] + (float)(w + h);
 }
 
-static void mask(const uint8_t *data, size_t size)
+static void mask(const char *sel)
 {
     char err[OBS_ERR_LEN];
     if (!mask_exr)
         return;
-    char *sel = malloc(size + 1);
-    if (!sel)
-        return;
-    memcpy(sel, data, size);
-    sel[size] = '\0';
     const obs_limits lim = {.threads = 1};
     obs_image w, dom;
     if (told("mask selector", obs_mask_plane(NULL, mask_exr, mask_exr_len, sel, &lim, &w, &dom, err), err) ==
@@ -153,7 +153,6 @@ static void mask(const uint8_t *data, size_t size)
         obs_image_free(&w);
         obs_image_free(&dom);
     }
-    free(sel);
 }
 
 static void lod(void)
@@ -229,14 +228,61 @@ static void part(const obs__part_format *f, int bake)
     free(parts);
 }
 
+static void regions(const char *text)
+{
+    char err[OBS_ERR_LEN];
+    obs_dyn_regions rg;
+    if (told("regions file", obs_dyn_regions_parse(text, &rg, err), err) != OBS_OK)
+        return;
+    for (size_t r = 0; r < rg.count; r++)
+        sink += rg.box[r].lo[0] + rg.box[r].hi[2];
+    for (size_t e = 0; e < 2 * rg.edge_count; e++)
+        sink += (float)rg.edge[e];
+    obs_dyn_regions_free(&rg);
+}
+
+static void decorators(const char *text)
+{
+    char err[OBS_ERR_LEN];
+    if (!lod_scene_ok)
+        return;
+    obs_bake_params p;
+    obs_bake_params_resolve(NULL, &p);
+    obs__bake_decor d;
+    if (told("decorators file", obs__bake_decor_classify(&lod_scene, &p, text, &d, err), err) !=
+        OBS_OK)
+        return;
+    for (size_t n = 0; n < d.node_count; n++)
+        sink += (float)d.node_class[n] + d.density[n];
+    obs__bake_decor_free(&d);
+}
+
+/* The input as a NUL-terminated string (caller frees). */
+static char *text_of(const uint8_t *data, size_t size)
+{
+    char *t = malloc(size + 1);
+    if (t) {
+        memcpy(t, data, size);
+        t[size] = '\0';
+    }
+    return t;
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size < 1)
         return 0;
     int which = only >= 0 ? only : data[0] % P_COUNT;
     data++, size--;
-    if (which == P_MASK) {
-        mask(data, size);
+    if (which == P_MASK || which == P_REGIONS || which == P_DECOR) {
+        char *text = text_of(data, size);
+        if (text && which == P_MASK)
+            mask(text);
+        else if (text && which == P_REGIONS)
+            regions(text);
+        else if (text)
+            decorators(text);
+        free(text);
         return 0;
     }
     if (!write_input(data, size))

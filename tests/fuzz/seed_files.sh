@@ -65,4 +65,13 @@ for s in 0/1 0/2 1/2; do
     "$OBSCURA" bake-dynamic "$T/box.obj" --shard $s -o "$T/d$n" --rays 8 --max-regions 2 --grid 3 -q
     seed '\005' "dyn_part_$n" "$T/d$n"
 done
+# bake-dynamic --regions files (README's layout) and --decorators files
+# (tests/data's trees.json; rules naming the seed scene's node)
+printf '{"regions": [{"min": [-2,0,-2], "max": [0,2,2]}, {"min": [0,0,-2], "max": [2,2,2]}], "adjacency": [[0,1]]}' >"$T/r"
+seed '\006' regions_2 "$T/r"
+printf '{"regions": [{"min": [-2,0,-2], "max": [2,2,2]}]}' >"$T/r"
+seed '\006' regions_1 "$T/r"
+seed '\007' decor_trees tests/data/levels/aalborg_cut.trees.json
+printf '{"decorators": [{"name": "defaultobject", "class": "shrub", "density": 2}, {"match": "box*", "class": "tree"}]}' >"$T/d"
+seed '\007' decor_rules "$T/d"
 echo "seeds in $OUT: $(ls "$OUT" | wc -l)"
