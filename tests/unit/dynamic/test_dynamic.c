@@ -697,7 +697,7 @@ static obs_status read_model_text(const char *blend, const char *region, const c
     return st;
 }
 
-/* Damaged model files found by fuzzing (tests/fuzz/fuzz_files.c): each
+/* Damaged model files (tests/fuzz/fuzz_files.c fuzzes the reader): each
  * refused with a message naming the piece, none read as a model that
  * evaluates to garbage (a point count past 32 bits was a float-to-integer
  * overflow; a coefficient past a float's range an infinity, a blend out
