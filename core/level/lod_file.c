@@ -222,7 +222,7 @@ static int match_nodes(const obs__glb *f, const obs_bake_scene *s, long *of)
     int ok = 1;
     for (int r = 0; r < nroots && ok; r++) {
         int sp = 0;
-        stack[0] = (long)cJSON_GetNumberValue(cJSON_GetArrayItem(roots, r));
+        stack[0] = obs__glb_index_value(cJSON_GetArrayItem(roots, r));
         stack[1] = 0;
         if (count >= s->node_count || !at(f->doc, "nodes", stack[0])) {
             ok = 0;
@@ -237,7 +237,7 @@ static int match_nodes(const obs__glb *f, const obs_bake_scene *s, long *of)
                 sp--;
                 continue;
             }
-            long c = (long)cJSON_GetNumberValue(cJSON_GetArrayItem(ch, (int)k));
+            long c = obs__glb_index_value(cJSON_GetArrayItem(ch, (int)k));
             if (sp + 1 >= DEPTH || count >= s->node_count || !at(f->doc, "nodes", c)) {
                 ok = 0;
                 break;
@@ -317,7 +317,7 @@ obs_status obs__bake_lod_file_read(const char *path, obs_bake_scene *s, char err
         const cJSON *prims = cJSON_GetObjectItemCaseSensitive(
             at(f.doc, "meshes", num(jn, "mesh", -1)), "primitives");
         for (int l = 1; l <= levels && l <= cJSON_GetArraySize(ids); l++) {
-            long li = (long)cJSON_GetNumberValue(cJSON_GetArrayItem(ids, l - 1));
+            long li = obs__glb_index_value(cJSON_GetArrayItem(ids, l - 1));
             const cJSON *ln = at(f.doc, "nodes", li);
             long lj = ln ? num(ln, "mesh", -1) : -1;
             const cJSON *lprims =

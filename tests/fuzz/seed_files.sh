@@ -74,4 +74,40 @@ seed '\006' regions_1 "$T/r"
 seed '\007' decor_trees tests/data/levels/aalborg_cut.trees.json
 printf '{"decorators": [{"name": "defaultobject", "class": "shrub", "density": 2}, {"match": "box*", "class": "tree"}]}' >"$T/d"
 seed '\007' decor_rules "$T/d"
+# Regressions: the inputs that crashed a parser (or asked for gigabytes),
+# rebuilt from the seeds above; each run of the target replays them.
+python3 - "$OUT" <<'PY'
+import struct, sys
+out = sys.argv[1]
+def put(name, byte, data):
+    open(out + "/regress_" + name, "wb").write(bytes([byte]) + data)
+# a .glb whose JSON is edited, its lengths kept true
+glb = open(out + "/lod", "rb").read()[1:]
+magic, ver, total, jlen, jtype = struct.unpack("<5I", glb[:20])
+js, rest = glb[20:20 + jlen], glb[20 + jlen:]
+def glb_with(old, new):
+    assert old in js
+    j = js.replace(old, new)
+    j += b" " * (-len(j) % 4)
+    return struct.pack("<5I", magic, ver, 20 + len(j) + len(rest), len(j), jtype) + j + rest
+# node indices that are no integers (a float-to-long conversion out of range)
+put("lod_root_string", 2, glb_with(b'"scenes":[{"nodes":[0]}]', b'"scenes":[{"nodes":["x"]}]'))
+put("lod_child_1e300", 2, glb_with(b'"children":[1]', b'"children":[1e300]'))
+put("lod_id_true", 2, glb_with(b'"ids":[2,3]', b'"ids":[2,true]'))
+# a header giving almost 4 GiB for a file of a few hundred bytes
+put("lod_length", 2, struct.pack("<5I", magic, ver, 0xfffffff0, jlen, jtype) + js + rest[:64])
+# a bake part of shard 0 of 2^31 - 1 over as many samples (one sample):
+# the merge sized its tables by that count
+part = bytearray(open(out + "/bake_part_0_1", "rb").read()[1:])
+struct.pack_into("<I", part, 28, 0x7fffffff)
+struct.pack_into("<QQQ", part, 32, 0x7fffffff, 0, 1)
+put("bake_part_count", 4, bytes(part[:128 + 9]))
+# a model whose region has 1e12 points (a float-to-uint32 conversion out of range)
+model = open(out + "/dyn_model", "rb").read()[1:]
+i = model.index(b'"points":')
+j = i + 9
+while model[j:j + 1].isdigit():
+    j += 1
+put("dyn_model_points", 3, model[:i] + b'"points":1e12' + model[j:])
+PY
 echo "seeds in $OUT: $(ls "$OUT" | wc -l)"
