@@ -436,12 +436,13 @@ static double param_value(const void *p, const obs_table_row *row)
 static void param_store(void *p, const obs_table_row *row, double v)
 {
     unsigned char *m = (unsigned char *)p + row->offset;
-    int i = (int)v;
-    float x = (float)v;
-    if (int_row(row))
+    if (int_row(row)) { /* converted as the row's type only: v is in its range */
+        int i = (int)v;
         memcpy(m, &i, sizeof i);
-    else
+    } else {
+        float x = (float)v;
         memcpy(m, &x, sizeof x);
+    }
 }
 
 obs_status obs__part_adopt(const obs__part_format *f, const void *parts, size_t n, void *p,

@@ -76,6 +76,8 @@ printf '{"decorators": [{"name": "defaultobject", "class": "shrub", "density": 2
 seed '\007' decor_rules "$T/d"
 # Regressions: the inputs that crashed a parser (or asked for gigabytes),
 # rebuilt from the seeds above; each run of the target replays them.
+# (regress_bake_part_param and regress_dyn_part_param are libFuzzer's own
+# finds, kept as found: a parameter of the header past an int's range.)
 python3 - "$OUT" <<'PY'
 import struct, sys
 out = sys.argv[1]
