@@ -96,8 +96,9 @@ static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1
  * clip that leaves an arc empty is seen on the cosines.  A column's ray
  * (its pixel's projection solved), its u_z and its window (the chord of
  * the ball and two cosines, read by the next column) wait for their
- * first reader.  The same arcs, bit for bit, as taking each angle first
- * (GLSL does: gtao.glsl). */
+ * first reader.  The same arcs, bit for bit, as taking each angle first.
+ * gtao.glsl keeps the cosines too, but computes the ray and window of
+ * every column (llvmpipe runs both sides of a branch). */
 
 /* the cosine of the angle of d from v (dist: |d|); low where d is 0 */
 static float cos_v(const float d[3], float dist, const float v[3], float low)

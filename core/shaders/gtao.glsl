@@ -90,15 +90,28 @@ float gtao_arc(float h, float gamma, float cos_gamma)
 #if GT_INTERVALS
 // The sides of the slice (side 0: dir +1): their occupied arcs, angles
 // from v sorted by their near end, and the free depth ranges of the last
-// column read with their ends' angles (t).
+// column read with the cosines of their ends' angles (gt_t).
 // C twin: obs__gtao_side (methods/gtao_deep.h); GT_MAX_GAPS and
 // GT_MAX_ARCS are OBS__GTAO_MAX_GAPS and OBS__GTAO_MAX_ARCS for 8 nodes
 // and 32 steps.
+//
+// The cost.  Most columns add no arc (gtao_deep.c's cost comment), and the
+// arcs, as the C twin's, wait for a column that adds one: its angles are
+// kept as cosines until then (gtao_cos_v).  A GL implementation without
+// branches (llvmpipe runs the pixels of a block together, each branch
+// for all of them under a mask) pays for every line a pixel could run,
+// so what the C twin takes where first needed (a column's ray, u_z,
+// window) stays taken once a column here, and the work of an added arc
+// (three acos, the sorted insertion) is done once, at the column's end
+// (gtao_add_reached), rather than at each of its call sites; a step past
+// the border reads the same gtao_column call as one inside
+// (gtao_side_horizon).  Measured on llvmpipe: bench/RESULTS.md, "gtao on
+// deep intervals on llvmpipe".
 const int GT_MAX_GAPS = 5;
 const int GT_MAX_ARCS = 32 * 13;
 float gt_lo[2 * GT_MAX_ARCS], gt_hi[2 * GT_MAX_ARCS];
 int gt_n[2], gt_gaps[2];
-vec2 gt_win[2]; // the angles where the last column's ray lies within the radius
+vec2 gt_win[2]; // the cosines of the angles where the last column's ray lies within the radius
 vec2 gt_z[2 * GT_MAX_GAPS], gt_t[2 * GT_MAX_GAPS];
 
 // C twin: obs__gtao_side_start
@@ -106,18 +119,21 @@ void gtao_side_start(int side, vec3 c, float z0)
 {
     gt_n[side] = 0;
     gt_gaps[side] = 1;
-    gt_win[side] = vec2(0.0, 3.14159265358979);
+    gt_win[side] = vec2(1.0, -1.0); // the angles 0 and pi
     gt_z[side * GT_MAX_GAPS] = vec2(min(z0, -c.z), -c.z);
-    gt_t[side * GT_MAX_GAPS] = vec2(0.0, 3.14159265358979);
+    gt_t[side * GT_MAX_GAPS] = vec2(1.0, -1.0);
 }
 
-// C twin: cos_v (methods/gtao_deep.c), clamped, and its arc cosine; the C twin
-// keeps the cosines until an arc is added (the same arcs: acos is
-// decreasing) and takes a column's ray and window where first needed
-float gtao_true_angle(vec3 d, vec3 v, float low)
+// The cosine of the angle of d from v, clamped; low where d is 0.  C
+// twin: cos_v (methods/gtao_deep.c) and its clamp.  A column's angles
+// are kept as these cosines until an arc is added, as the C twin keeps
+// them: acos is decreasing, so the larger of two angles is the arc
+// cosine of the smaller cosine, and a clip that leaves an arc empty is
+// seen on the cosines.
+float gtao_cos_v(vec3 d, vec3 v, float low)
 {
     float dist = length(d);
-    return acos(clamp(dist > 0.0 ? dot(d, v) / dist : low, -1.0, 1.0));
+    return clamp(dist > 0.0 ? dot(d, v) / dist : low, -1.0, 1.0);
 }
 
 // The depths of the ray o + s dir where the falloff weight is not 0
@@ -156,25 +172,54 @@ void gtao_add_arc(int side, float lo, float hi)
     gt_n[side]++;
 }
 
-// C twin: add_reach (methods/gtao_deep.c)
-void gtao_add_reach(int side, float lo, float hi, float zlo, float zhi, float cz, float r, vec2 uz)
+// A column's arcs, found by gtao_reach and added at its end in the order
+// found (gtao_add_reached): the arc cosines [x, y] clipped to the window,
+// z the cosine of the half width of the band's reach (-1: c at the
+// band's depths, no reach clip), w its middle.  At most a call per node
+// and per pair of free ranges.
+const int GT_MAX_REACHED = 8 + GT_MAX_GAPS * GT_MAX_GAPS;
+vec4 gt_reached[GT_MAX_REACHED];
+int gt_nreached;
+
+// The arc of a solid met between the previous column and this one, the
+// angles whose cosines are [clo, chi] (clo >= chi), where it can lie
+// within the radius r: the window's clip, then the depths [zlo, zhi]
+// reached from the centre's depth cz (uz: u_z(t) = uz.x cos(t - uz.y)).
+// C twin: add_reach (methods/gtao_deep.c), which adds it at once; here
+// it waits in gt_reached for gtao_add_reached (the cost, above).
+void gtao_reach(int side, float clo, float chi, float zlo, float zhi, float cz, float r, vec2 uz)
 {
-    lo = max(lo, gt_win[side].x);
-    hi = min(hi, gt_win[side].y);
-    if (!(hi > lo))
+    clo = min(clo, gt_win[side].x);
+    chi = max(chi, gt_win[side].y);
+    if (!(chi < clo))
         return;
     float dz = cz < zlo ? zlo - cz : cz > zhi ? cz - zhi : 0.0;
-    if (!(dz > 0.0)) {
-        gtao_add_arc(side, lo, hi);
-        return;
+    vec4 a = vec4(clo, chi, -1.0, 0.0);
+    if (dz > 0.0) {
+        if (!(uz.x * r > dz))
+            return;
+        a.zw = vec2(dz / (r * uz.x), cz > zhi ? uz.y : uz.y + 3.14159265358979);
     }
-    if (!(uz.x * r > dz))
-        return;
-    float half_w = acos(dz / (r * uz.x));
-    float mid = cz > zhi ? uz.y : uz.y + 3.14159265358979;
-    for (int i = -1; i <= 1; i++)
-        gtao_add_arc(side, max(lo, mid + 6.28318530717959 * float(i) - half_w),
-                     min(hi, mid + 6.28318530717959 * float(i) + half_w));
+    gt_reached[gt_nreached++] = a;
+}
+
+// Adds the column's arcs (gtao_reach) in the order found, as the C twin
+// adds them: the same sorted arcs
+void gtao_add_reached(int side)
+{
+    for (int j = 0; j < gt_nreached; j++) {
+        vec4 a = gt_reached[j];
+        float lo = acos(a.x), hi = acos(a.y);
+        bool reach = a.z >= 0.0;
+        float half_w = reach ? acos(a.z) : 0.0;
+        for (int i = -1; i <= 1; i++) {
+            float m = a.w + 6.28318530717959 * float(i);
+            if (reach)
+                gtao_add_arc(side, max(lo, m - half_w), min(hi, m + half_w));
+            else if (i == 0)
+                gtao_add_arc(side, lo, hi);
+        }
+    }
 }
 
 // C twin: obs__gtao_centre_start (methods/gtao_deep.c), for the receiver
@@ -194,8 +239,8 @@ float gtao_centre_start(ivec2 px)
 // instead, solid behind it).  C twin: obs__gtao_column (methods/gtao_deep.c)
 float gtao_column(int side, ivec2 px, ivec2 q, bool border, vec4 xq, vec3 c, vec3 v, float low)
 {
-    vec2 gz[GT_MAX_GAPS], gt[GT_MAX_GAPS];
-    float hc = low, cz = 0.0, ct = 0.0;
+    vec2 gz[GT_MAX_GAPS], gt[GT_MAX_GAPS]; // gt: cosines
+    float hc = low, cz = 0.0, ct = 1.0; // the free range open from depth cz (angle 0)
     int ng = 0, last = -1, layers = border ? 1 : GT_LAYERS;
     bool open = true;
     vec3 o, dir;
@@ -209,6 +254,7 @@ float gtao_column(int side, ivec2 px, ivec2 q, bool border, vec4 xq, vec3 c, vec
     float ol = length(od);
     if (ol > 0.0)
         uz = vec2(sqrt(v.z * v.z + od.z * od.z / (ol * ol)), atan(od.z / ol, v.z));
+    gt_nreached = 0;
     int tail = -1;
     for (int k = 0; k < layers; k++) {
         vec4 qk = border ? xq : GT_NODE(q, k);
@@ -230,7 +276,7 @@ float gtao_column(int side, ivec2 px, ivec2 q, bool border, vec4 xq, vec3 c, vec
             hc = max(hc, gtao_sample_cos(qk, c, v, low, GT_WEIGHT(px, q, border ? 0 : k)));
         if (!open)
             continue;
-        float tf = gtao_true_angle(d, v, low);
+        float tf = gtao_cos_v(d, v, low);
         if (qk.w > cz && ng < GT_MAX_GAPS) {
             gz[ng] = vec2(cz, qk.w);
             gt[ng] = vec2(ct, tf);
@@ -241,13 +287,13 @@ float gtao_column(int side, ivec2 px, ivec2 q, bool border, vec4 xq, vec3 c, vec
             continue;
         }
         cz = e;
-        ct = gtao_true_angle(o + e * dir - c, v, low);
+        ct = gtao_cos_v(o + e * dir - c, v, low);
         if (GT_WEIGHT(px, q, k) > 0.0)
-            gtao_add_reach(side, tf, ct, qk.w, e, cz0, r, uz);
+            gtao_reach(side, tf, ct, qk.w, e, cz0, r, uz);
     }
     if (open && ng < GT_MAX_GAPS) {
         gz[ng] = vec2(cz, uintBitsToFloat(0x7f800000u)); // no surface from cz on
-        gt[ng] = vec2(ct, 3.14159265358979);
+        gt[ng] = vec2(ct, -1.0); // the angle pi
         ng++;
     }
     int base = side * GT_MAX_GAPS;
@@ -257,14 +303,17 @@ float gtao_column(int side, ivec2 px, ivec2 q, bool border, vec4 xq, vec3 c, vec
             if (za.x < gz[b].y && gz[b].x < za.y)
                 continue;
             bool before = za.y <= gz[b].x;
-            gtao_add_reach(side, max(ta.x, gt[b].x), min(ta.y, gt[b].y), before ? za.y : gz[b].y,
-                           before ? gz[b].x : za.x, cz0, r, uz);
+            // the angles both ranges' arcs hold: on the cosines, the
+            // smaller start and the larger end
+            gtao_reach(side, min(ta.x, gt[b].x), max(ta.y, gt[b].y), before ? za.y : gz[b].y,
+                       before ? gz[b].x : za.x, cz0, r, uz);
         }
     }
-    gt_win[side] = vec2(0.0);
+    gtao_add_reached(side);
+    gt_win[side] = vec2(1.0);
     if (near && cs.y > 0.0)
-        gt_win[side] = vec2(gtao_true_angle(o + max(cs.x, 0.0) * dir - c, v, low),
-                            gtao_true_angle(o + cs.y * dir - c, v, low));
+        gt_win[side] = vec2(gtao_cos_v(o + max(cs.x, 0.0) * dir - c, v, low),
+                            gtao_cos_v(o + cs.y * dir - c, v, low));
     gt_gaps[side] = ng;
     for (int b = 0; b < ng; b++) {
         gt_z[base + b] = gz[b];
@@ -313,14 +362,16 @@ float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float n
         ivec2 q = px + dir * ivec2(int(floor(s * omega.x + 0.5)), int(floor(s * omega.y + 0.5)));
         // object masks: the weight of each node's surface at q (past the
         // border, the front one's)
-        if (q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y) {
-            vec4 xq;
-            bool got = gtao_border_step(px, q, xq);
+        bool off = q.x < 0 || q.y < 0 || q.x >= u_size.x || q.y >= u_size.y;
 #if GT_INTERVALS
-            // intervals: the surface continued, solid behind it (xq.w 0:
-            // a column with no surface)
-            gtao_column(dir > 0 ? 0 : 1, px, q, true, got ? xq : vec4(0.0), c, v, low);
-#endif
+        // intervals: the step's column (C twin: obs__gtao_column); past
+        // the border the surface continued, solid behind it (xq.w 0: a
+        // column with no surface).  One call for both (the cost, at
+        // GT_INTERVALS' sides above).
+        vec4 xq = vec4(0.0);
+        bool got = off && gtao_border_step(px, q, xq);
+        float hq = gtao_column(dir > 0 ? 0 : 1, px, q, off, got ? xq : vec4(0.0), c, v, low);
+        if (off) {
             if (!got)
                 continue;
             taken++;
@@ -328,13 +379,20 @@ float gtao_side_horizon(ivec2 px, vec3 c, vec3 v, vec2 omega, int slice, float n
             continue;
         }
         taken++;
-#if GT_INTERVALS
-        // intervals: the step's column (C twin: obs__gtao_column)
-        hc = max(hc, gtao_column(dir > 0 ? 0 : 1, px, q, false, vec4(0.0), c, v, low));
-        continue;
-#endif
+        hc = max(hc, hq);
+#else
+        if (off) {
+            vec4 xq;
+            if (!gtao_border_step(px, q, xq))
+                continue;
+            taken++;
+            hc = max(hc, gtao_sample_cos(xq, c, v, low, GT_WEIGHT(px, q, 0)));
+            continue;
+        }
+        taken++;
         for (int k = 0; k < GT_LAYERS; k++)
             hc = max(hc, gtao_sample_cos(GT_NODE(q, k), c, v, low, GT_WEIGHT(px, q, k)));
+#endif
     }
     return hc;
 }
