@@ -8,7 +8,7 @@
 #   make quality  AO against ray-traced ground truth (bench/QUALITY.md)
 #   make quality-masks  the object masks against a hidden-object Cycles render (needs blender)
 #   make bake-quality  baked vertices against the per-pixel reference (bench/BAKE.md)
-#   make fuzz     libFuzzer targets: binary protocol, EXR readers (clang; tests/fuzz/fuzz.mk)
+#   make fuzz     libFuzzer targets: binary protocol, EXR readers, other input files (clang; tests/fuzz/fuzz.mk)
 #   make readme   regenerate README.md's parameter and daemon option tables
 #   make samples  regenerate core/chain/sample_tables.c (VAO++ 4.5 sample sets)
 #

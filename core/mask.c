@@ -98,6 +98,8 @@ static obs_status parse_ids(const char *s, selector *sel, char err[OBS_ERR_LEN])
             if (end == c || hi < lo)
                 goto bad;
         }
+        if (!isfinite(lo) || !isfinite(hi)) /* strtod's "nan" and "inf" */
+            goto bad;
         if (sel->nrange == MAX_ID_RANGES)
             return obs__fail(err, OBS_INVALID_ARGUMENT, "selector: at most %d IDs or ranges",
                              MAX_ID_RANGES);

@@ -3,6 +3,7 @@
  * core/camera/request.c. */
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -60,6 +61,13 @@ static obs_status get_number(const cJSON *root, const char *field, double *out, 
     return OBS_OK;
 }
 
+/* A number the camera's floats hold: finite as a float (a double past
+ * FLT_MAX would become an infinity). */
+static int float_number(const cJSON *v)
+{
+    return cJSON_IsNumber(v) && fabs(v->valuedouble) <= FLT_MAX;
+}
+
 /* An optional 4x4 matrix: four rows of four numbers (or 16 numbers),
  * row-major. */
 static obs_status get_mat4(const cJSON *root, const char *field, float m[16], int *present,
@@ -78,7 +86,7 @@ static obs_status get_mat4(const cJSON *root, const char *field, float m[16], in
     const cJSON *row, *x;
     cJSON_ArrayForEach(row, v) {
         if (flat) {
-            if (!cJSON_IsNumber(row) || !isfinite(row->valuedouble))
+            if (!float_number(row))
                 goto bad;
             m[n++] = (float)row->valuedouble;
             continue;
@@ -86,7 +94,7 @@ static obs_status get_mat4(const cJSON *root, const char *field, float m[16], in
         if (!cJSON_IsArray(row) || cJSON_GetArraySize(row) != 4)
             goto bad;
         cJSON_ArrayForEach(x, row) {
-            if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble))
+            if (!float_number(x))
                 goto bad;
             m[n++] = (float)x->valuedouble;
         }
@@ -132,10 +140,10 @@ static obs_status parse_camera(const char *text, size_t len, obs_camera *cam, in
         bad = "height: expected a positive integer";
     else if (has_fov && !(fov > 0 && fov < 180))
         bad = "fov_y_deg: expected degrees between 0 and 180";
-    else if (!(near_z > 0))
+    else if (!((float)near_z > 0))
         bad = "near: expected a positive distance";
-    else if (!(far_z > near_z))
-        bad = "far: expected a distance beyond near";
+    else if (!((float)far_z > (float)near_z) || !(far_z <= FLT_MAX))
+        bad = "far: expected a distance beyond near"; /* as floats: the projection's */
     else if (!has_wtc)
         bad = "world_to_camera: missing";
     else if (obs__mat4_invert(cam->world_to_camera, inv) != 0)

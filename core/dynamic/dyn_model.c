@@ -3,6 +3,7 @@
  * temporal blender, and the JSON file an engine loads. */
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -189,16 +190,28 @@ obs_status obs_dyn_model_write(const char *path, const obs_dyn_model *m, char er
                                                       strerror(errno)), err);
 }
 
+/* n numbers of a JSON array, each finite as a float (a double past
+ * FLT_MAX would be read as an infinity). */
 static int get_vec(const cJSON *a, float *v, int n)
 {
     if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != n)
         return 0;
     for (int i = 0; i < n; i++) {
         const cJSON *e = cJSON_GetArrayItem(a, i);
-        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble))
+        if (!cJSON_IsNumber(e) || !(fabs(e->valuedouble) <= FLT_MAX))
             return 0;
         v[i] = (float)e->valuedouble;
     }
+    return 1;
+}
+
+/* A JSON number that is an integer in lo .. hi, into *out. */
+static int get_int(const cJSON *v, double lo, double hi, double *out)
+{
+    if (!cJSON_IsNumber(v) || !(v->valuedouble >= lo && v->valuedouble <= hi) ||
+        v->valuedouble != floor(v->valuedouble))
+        return 0;
+    *out = v->valuedouble;
     return 1;
 }
 
@@ -230,6 +243,13 @@ obs_status obs_dyn_model_read(const char *path, obs_dyn_model *out, char err[OBS
         !get_vec(cJSON_GetObjectItemCaseSensitive(d, "distances"), out->distance, 2)) {
         st = obs__fail(err, OBS_BAD_FILE, "%s: not an %s model (format, distances, blend, "
                                           "regions, models)", path, FORMAT_NAME);
+        goto done;
+    }
+    if (!(bl->valuedouble >= 0.0 && bl->valuedouble <= 1.0) ||
+        !(out->distance[0] > 0.0f && out->distance[1] > 0.0f)) {
+        st = obs__fail(err, OBS_BAD_FILE, "%s: blend %g (a weight in 0 .. 1), distances %g, %g "
+                       "(positive)", path, bl->valuedouble, (double)out->distance[0],
+                       (double)out->distance[1]);
         goto done;
     }
     out->blend = (float)bl->valuedouble;
@@ -265,19 +285,23 @@ obs_status obs_dyn_model_read(const char *path, obs_dyn_model *out, char err[OBS
     cJSON_ArrayForEach(it, regs)
     {
         obs_dyn_model_region *r = &out->regions[i];
-        const cJSON *mi = cJSON_GetObjectItemCaseSensitive(it, "model");
+        const cJSON *pn = cJSON_GetObjectItemCaseSensitive(it, "points");
+        double mi, points = 0;
         if (!get_vec(cJSON_GetObjectItemCaseSensitive(it, "min"), r->box.lo, 3) ||
             !get_vec(cJSON_GetObjectItemCaseSensitive(it, "max"), r->box.hi, 3) ||
-            !cJSON_IsNumber(mi) || mi->valuedouble < -1 ||
-            mi->valuedouble >= (double)out->model_count) {
-            st = obs__fail(err, OBS_BAD_FILE, "%s: region %zu: min, max and a model index in "
-                                              "-1..%zu", path, i, out->model_count - 1);
+            !(r->box.lo[0] <= r->box.hi[0] && r->box.lo[1] <= r->box.hi[1] &&
+              r->box.lo[2] <= r->box.hi[2]) ||
+            !get_int(cJSON_GetObjectItemCaseSensitive(it, "model"), -1,
+                     (double)out->model_count - 1, &mi) ||
+            (pn && !get_int(pn, 0, UINT32_MAX, &points))) {
+            st = obs__fail(err, OBS_BAD_FILE, "%s: region %zu: min <= max, a model index in "
+                                              "-1 .. %lld and a count of points", path, i,
+                           (long long)out->model_count - 1);
             goto done;
         }
-        r->model = (int32_t)mi->valuedouble;
+        r->model = (int32_t)mi;
         r->absorbed = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(it, "absorbed"));
-        const cJSON *pn = cJSON_GetObjectItemCaseSensitive(it, "points");
-        r->points = cJSON_IsNumber(pn) && pn->valuedouble >= 0 ? (uint32_t)pn->valuedouble : 0;
+        r->points = (uint32_t)points;
         i++;
     }
     i = 0;
@@ -299,10 +323,13 @@ obs_status obs_dyn_model_read(const char *path, obs_dyn_model *out, char err[OBS
     i = 0;
     cJSON_ArrayForEach(it, adj)
     {
-        float e[2];
-        if (!get_vec(it, e, 2) || e[0] < 0 || e[1] < 0 || e[0] >= (float)out->region_count ||
-            e[1] >= (float)out->region_count) {
-            st = obs__fail(err, OBS_BAD_FILE, "%s: adjacency %zu", path, i);
+        double e[2];
+        double last = (double)out->region_count - 1;
+        if (!cJSON_IsArray(it) || cJSON_GetArraySize(it) != 2 ||
+            !get_int(cJSON_GetArrayItem(it, 0), 0, last, &e[0]) ||
+            !get_int(cJSON_GetArrayItem(it, 1), 0, last, &e[1])) {
+            st = obs__fail(err, OBS_BAD_FILE, "%s: adjacency %zu: two region indices in 0 .. "
+                           "%lld", path, i, (long long)last);
             goto done;
         }
         out->edge[2 * i] = (uint32_t)e[0];

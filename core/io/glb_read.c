@@ -41,7 +41,11 @@ static const cJSON *item(const cJSON *o, const char *name)
 /* A non-negative integer member, or -1. */
 long obs__glb_index_of(const cJSON *o, const char *name)
 {
-    const cJSON *v = item(o, name);
+    return obs__glb_index_value(item(o, name));
+}
+
+long obs__glb_index_value(const cJSON *v)
+{
     if (!cJSON_IsNumber(v) || !(v->valuedouble >= 0.0) || v->valuedouble > 2147483647.0 ||
         v->valuedouble != floor(v->valuedouble))
         return -1;

@@ -39,6 +39,8 @@ void obs__glb_free(obs__glb *g);
 obs_status obs__glb_find_bin(obs__glb *g, size_t jlen, char err[OBS_ERR_LEN]);
 /* A non-negative integer member of o, or -1. */
 long obs__glb_index_of(const cJSON *o, const char *name);
+/* The same of a value (an array's element; NULL: -1). */
+long obs__glb_index_value(const cJSON *v);
 
 /* One accessor's elements in the binary chunk. */
 typedef struct obs__glb_acc {

@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "level/level.h"
 #include "internal.h"
@@ -47,14 +48,23 @@ static int file_open(const char *path, obs__glb *f, char err[OBS_ERR_LEN])
         return 0;
     }
     uint32_t total = obs__glb_u32(head + 8), jlen = obs__glb_u32(head + 12);
-    if (total < 20 || obs__glb_u32(head + 16) != OBS__GLB_CHUNK_JSON || jlen > total - 20 ||
-        !(f->file = malloc(total))) {
+    if (total < 20 || obs__glb_u32(head + 16) != OBS__GLB_CHUNK_JSON || jlen > total - 20) {
         fclose(fp);
         return obs__fail(err, OBS_BAD_FILE, "%s: glTF binary of %u bytes without its JSON chunk",
                          path, total), -1;
     }
+    /* the file's length, not the header's, sizes the buffer: a damaged
+     * header claiming up to 4 GiB allocates no more than the file */
+    struct stat sb;
+    size_t have = total;
+    if (fstat(fileno(fp), &sb) == 0 && sb.st_size >= 20 && (uint64_t)sb.st_size < total)
+        have = (size_t)sb.st_size;
+    if (!(f->file = malloc(have))) {
+        fclose(fp);
+        return obs__fail(err, OBS_NO_MEMORY, "%s: glTF binary of %zu bytes", path, have), -1;
+    }
     memcpy(f->file, head, 20);
-    size_t got = fread(f->file + 20, 1, jlen, fp);
+    size_t got = jlen <= have - 20 ? fread(f->file + 20, 1, jlen, fp) : 0;
     if (got == jlen && !(f->doc = cJSON_ParseWithLength((const char *)f->file + 20, jlen))) {
         fclose(fp);
         return obs__fail(err, OBS_BAD_FILE, "%s: the JSON chunk does not parse", path), -1;
@@ -63,7 +73,8 @@ static int file_open(const char *path, obs__glb *f, char err[OBS_ERR_LEN])
         fclose(fp);
         return 0;
     }
-    got += fread(f->file + 20 + got, 1, total - 20 - got, fp);
+    if (got == jlen)
+        got += fread(f->file + 20 + got, 1, have - 20 - got, fp);
     fclose(fp);
     if (got != total - 20)
         return obs__fail(err, OBS_BAD_FILE, "%s: truncated: %zu of %u bytes", path, got + 20,
@@ -211,7 +222,7 @@ static int match_nodes(const obs__glb *f, const obs_bake_scene *s, long *of)
     int ok = 1;
     for (int r = 0; r < nroots && ok; r++) {
         int sp = 0;
-        stack[0] = (long)cJSON_GetNumberValue(cJSON_GetArrayItem(roots, r));
+        stack[0] = obs__glb_index_value(cJSON_GetArrayItem(roots, r));
         stack[1] = 0;
         if (count >= s->node_count || !at(f->doc, "nodes", stack[0])) {
             ok = 0;
@@ -226,7 +237,7 @@ static int match_nodes(const obs__glb *f, const obs_bake_scene *s, long *of)
                 sp--;
                 continue;
             }
-            long c = (long)cJSON_GetNumberValue(cJSON_GetArrayItem(ch, (int)k));
+            long c = obs__glb_index_value(cJSON_GetArrayItem(ch, (int)k));
             if (sp + 1 >= DEPTH || count >= s->node_count || !at(f->doc, "nodes", c)) {
                 ok = 0;
                 break;
@@ -306,7 +317,7 @@ obs_status obs__bake_lod_file_read(const char *path, obs_bake_scene *s, char err
         const cJSON *prims = cJSON_GetObjectItemCaseSensitive(
             at(f.doc, "meshes", num(jn, "mesh", -1)), "primitives");
         for (int l = 1; l <= levels && l <= cJSON_GetArraySize(ids); l++) {
-            long li = (long)cJSON_GetNumberValue(cJSON_GetArrayItem(ids, l - 1));
+            long li = obs__glb_index_value(cJSON_GetArrayItem(ids, l - 1));
             const cJSON *ln = at(f.doc, "nodes", li);
             long lj = ln ? num(ln, "mesh", -1) : -1;
             const cJSON *lprims =

@@ -168,6 +168,21 @@ obs_status obs__bake_part_payload(const char *path, size_t offset, size_t len, u
 
 /* ---- the parts of one split ----------------------------------------------- */
 
+/* A part's shard index and its position among the parts given, sorted by
+ * index then position. */
+typedef struct shard_at {
+    uint32_t index;
+    size_t pos;
+} shard_at;
+
+static int shard_at_cmp(const void *a, const void *b)
+{
+    const shard_at *x = a, *y = b;
+    if (x->index != y->index)
+        return x->index < y->index ? -1 : 1;
+    return (x->pos > y->pos) - (x->pos < y->pos);
+}
+
 obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t *order,
                                  char err[OBS_ERR_LEN])
 {
@@ -176,40 +191,48 @@ obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t 
         return obs__fail(err, OBS_INVALID_ARGUMENT, "%zu parts given for a split into %u shards "
                          "(%s): one is given twice, or belongs to another split", n, count,
                          in[0].path);
-    unsigned char *seen = calloc(count, 1);
-    if (!seen)
-        return obs__fail(err, OBS_NO_MEMORY, "%u shards", count);
-    obs_status rc = OBS_OK;
-    for (size_t i = 0; rc == OBS_OK && i < n; i++) {
+    for (size_t i = 1; i < n; i++) {
         if (in[i].count != count)
-            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%s is shard %u/%u, %s shard %u/%u: parts "
-                           "of different splits", in[0].path, in[0].index, count, in[i].path,
-                           in[i].index, in[i].count);
-        else if (in[i].level != in[0].level)
-            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced from different levels "
-                           "(fingerprints %016llx and %016llx)", in[0].path, in[i].path,
-                           (unsigned long long)in[0].level, (unsigned long long)in[i].level);
-        else if (seen[in[i].index])
-            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "shard %u/%u given twice: %s and %s",
-                           in[i].index, count, in[order[in[i].index]].path, in[i].path);
-        else
-            seen[in[i].index] = 1, order[in[i].index] = i;
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s is shard %u/%u, %s shard %u/%u: "
+                             "parts of different splits", in[0].path, in[0].index, count,
+                             in[i].path, in[i].index, in[i].count);
+        if (in[i].level != in[0].level)
+            return obs__fail(err, OBS_INVALID_ARGUMENT, "%s and %s were traced from different "
+                             "levels (fingerprints %016llx and %016llx)", in[0].path, in[i].path,
+                             (unsigned long long)in[0].level, (unsigned long long)in[i].level);
     }
+    /* the n parts sorted by index: a shard given twice is two neighbours,
+     * the missing ones the gaps (n entries, whatever count a damaged
+     * header claims) */
+    shard_at *by = malloc(n * sizeof *by);
+    if (!by)
+        return obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
+    for (size_t i = 0; i < n; i++)
+        by[i] = (shard_at){in[i].index, i};
+    qsort(by, n, sizeof *by, shard_at_cmp);
+    obs_status rc = OBS_OK;
+    for (size_t k = 1; rc == OBS_OK && k < n; k++)
+        if (by[k].index == by[k - 1].index)
+            rc = obs__fail(err, OBS_INVALID_ARGUMENT, "shard %u/%u given twice: %s and %s",
+                           by[k].index, count, in[by[k - 1].pos].path, in[by[k].pos].path);
     if (rc == OBS_OK && n < count) {
         char list[256] = "";
-        size_t len = 0, missing = 0;
-        for (uint32_t k = 0; k < count; k++) {
-            if (seen[k])
-                continue;
-            if (len + 16 < sizeof list)
-                len += (size_t)snprintf(list + len, sizeof list - len, "%s%u", missing ? ", " : "", k);
-            missing++;
+        size_t len = 0, shown = 0, missing = (size_t)count - n;
+        uint32_t next = 0; /* the first index not yet looked at */
+        for (size_t k = 0; k <= n && len + 16 < sizeof list; k++) {
+            uint32_t upto = k < n ? by[k].index : count;
+            for (; next < upto && len + 16 < sizeof list; next++, shown++)
+                len += (size_t)snprintf(list + len, sizeof list - len, "%s%u", shown ? ", " : "",
+                                        next);
+            next = upto + (k < n);
         }
         rc = obs__fail(err, OBS_INVALID_ARGUMENT, "%zu of %u shards missing (%s%s): a merge needs "
                        "every shard of the split once", missing, count, list,
-                       missing * 4 > sizeof list ? ", ..." : "");
+                       shown < missing ? ", ..." : "");
     }
-    free(seen);
+    for (size_t k = 0; rc == OBS_OK && k < n; k++)
+        order[by[k].index] = by[k].pos;
+    free(by);
     return rc;
 }
 
@@ -373,9 +396,9 @@ obs_status obs__bake_parts_read(const char *const *paths, size_t n, const obs__p
             const obs__part_range *r = (const void *)(heads + i * elem);
             keys[i] = (obs__bake_part_key){r->path, r->index, r->count, r->level};
         }
-    if (rc == OBS_OK && (!(ordered = calloc(keys[0].count, elem)) ||
-                         !(order = calloc(keys[0].count, sizeof *order))))
-        rc = obs__fail(err, OBS_NO_MEMORY, "%u parts", keys[0].count);
+    /* n entries: the order checks that the parts are the count shards */
+    if (rc == OBS_OK && (!(ordered = calloc(n, elem)) || !(order = calloc(n, sizeof *order))))
+        rc = obs__fail(err, OBS_NO_MEMORY, "%zu parts", n);
     if (rc == OBS_OK)
         rc = obs__bake_parts_order(keys, n, order, err);
     for (size_t k = 0; rc == OBS_OK && k < n; k++)
@@ -413,12 +436,13 @@ static double param_value(const void *p, const obs_table_row *row)
 static void param_store(void *p, const obs_table_row *row, double v)
 {
     unsigned char *m = (unsigned char *)p + row->offset;
-    int i = (int)v;
-    float x = (float)v;
-    if (int_row(row))
+    if (int_row(row)) { /* converted as the row's type only: v is in its range */
+        int i = (int)v;
         memcpy(m, &i, sizeof i);
-    else
+    } else {
+        float x = (float)v;
         memcpy(m, &x, sizeof x);
+    }
 }
 
 obs_status obs__part_adopt(const obs__part_format *f, const void *parts, size_t n, void *p,
@@ -449,6 +473,10 @@ obs_status obs__part_adopt(const obs__part_format *f, const void *parts, size_t 
             continue;
         int bit = (int)(row - f->param_at(0));
         double v = member_value(a, fd);
+        /* the header has no checksum: a value its row refuses is damage */
+        if (!(v >= row->min && v <= row->max))
+            return obs__fail(err, OBS_BAD_FILE, "%s: damaged header: %s %g, outside %g .. %g",
+                             ra->path, fd->param, v, row->min, row->max);
         if (*given >> bit & 1) {
             if (param_value(p, row) != v)
                 return obs__fail(err, OBS_INVALID_ARGUMENT, "the parts were traced with %s %g; "

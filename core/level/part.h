@@ -51,7 +51,8 @@ typedef struct obs__bake_part_key {
 } obs__bake_part_key;
 /* Checks that the n parts are every shard of one split of one level,
  * once each (the messages name the parts, the shards missing); fills
- * order[k] with the position in `in` of shard k (count entries). */
+ * order[k] with the position in `in` of shard k (n = count entries, on
+ * success only: nothing is sized by a header's count). */
 obs_status obs__bake_parts_order(const obs__bake_part_key *in, size_t n, size_t *order,
                                  char err[OBS_ERR_LEN]);
 
@@ -150,7 +151,8 @@ obs_status obs__bake_parts_read(const char *const *paths, size_t n, const obs__p
  * 0's value, bit for bit (then same(a, b, err), when given, holds for
  * part 0 and each other); a parameter given to the merge (its row's bit
  * in p's mask) equals the parts', one not given takes theirs and is
- * marked given. */
+ * marked given; a value outside its row's range is a damaged header
+ * (OBS_BAD_FILE: the header has no checksum). */
 obs_status obs__part_adopt(const obs__part_format *f, const void *parts, size_t n, void *p,
                            obs_status (*same)(const void *a, const void *b, char err[OBS_ERR_LEN]),
                            char err[OBS_ERR_LEN]);

@@ -1,8 +1,12 @@
 #!/bin/sh
 # Short, bounded libFuzzer runs of the binary protocol's decoders
-# (tests/fuzz/fuzz_binary.c) and of the EXR readers, flat and deep
-# (tests/fuzz/fuzz_exr.c), on their seeds: fails on a crash, a read
-# past the buffer, undefined behaviour or a leak.  Needs clang (libFuzzer);
+# (tests/fuzz/fuzz_binary.c), of the EXR readers, flat and deep
+# (tests/fuzz/fuzz_exr.c), and of the other files a user or a farm hands
+# obscura (tests/fuzz/fuzz_files.c: camera JSON, mask selectors, a .glb's
+# LODs, the dynamic model, bake and bake-dynamic parts, regions and
+# decorators files; its seeds replay the inputs that crashed it), on their
+# seeds: fails on a crash, a read past the buffer, undefined behaviour, a
+# leak or an allocation past the limit.  Needs clang (libFuzzer);
 # without it, prints "skip".  The fuzzer carries its own sanitizers, so it
 # runs once, in the plain build (BUILD without "asan").
 #
@@ -51,4 +55,6 @@ fuzz() {
 fuzz fuzz_binary "binary protocol decoders" tests/fuzz/corpus/binary
 mkdir -p "$T/exr_seeds" && cp tests/data/*.exr "$T/exr_seeds/"
 fuzz fuzz_exr "EXR readers (flat and deep)" tests/data/damaged "$T/exr_seeds"
+fuzz fuzz_files "file parsers (camera, masks, LODs, dynamic model, parts, regions, decorators)" \
+    tests/fuzz/corpus/files
 exit $rc

@@ -1,10 +1,13 @@
 # tests/fuzz/: libFuzzer targets, built with clang (-fsanitize=fuzzer,
 # address,undefined).  Included by the top Makefile; not part of `all`.
 #
-#   make fuzz        build $(BUILD)/fuzz/fuzz_binary and $(BUILD)/fuzz/fuzz_exr
-#                    and refresh the seed corpus tests/fuzz/corpus/binary
+#   make fuzz        build $(BUILD)/fuzz/fuzz_binary, $(BUILD)/fuzz/fuzz_exr and
+#                    $(BUILD)/fuzz/fuzz_files and refresh the seed corpus
+#                    tests/fuzz/corpus/binary
 #   $(BUILD)/fuzz/fuzz_binary -max_total_time=60 NEW_DIR tests/fuzz/corpus/binary
 #   $(BUILD)/fuzz/fuzz_exr -max_total_time=60 NEW_DIR tests/data/damaged
+#   $(BUILD)/fuzz/fuzz_files -max_total_time=60 NEW_DIR tests/fuzz/corpus/files
+#                    (from the repository root; seeds: tests/fuzz/seed_files.sh)
 #
 # The protocol sources and the few core files they need are compiled here,
 # with clang and the fuzzer's sanitizers, not taken from $(BUILD)/obj.
@@ -24,9 +27,24 @@ FUZZ_EXR_SRC := core/io/exr_read.c core/io/exr_deep.c core/io/exr_msg.c core/io/
                 core/io/exr_info.c core/camera/exr.c core/io/presets.c core/camera/request.c core/status.c core/util.c core/image.c core/io/channel_map.c \
                 core/io/bytes.c core/params.c core/table.c core/pool.c core/io/crypto.c
 FUZZ_EXR_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libcjson 2>/dev/null) -lz -lm -lpthread
+# The other files a user or a farm hands obscura (fuzz_files.c): camera
+# JSON, object-mask selectors (against an EXR: the EXR readers), a .glb's
+# own LODs (the scene they match loaded with assimp: level/load.c), the
+# dynamic-AO model, the bake and bake-dynamic parts, bake-dynamic's
+# regions file, the bakes' decorators file.  shard.c and
+# dyn_shard.c are compiled for their part formats; their trace steps
+# (never called) are dropped at link time (--gc-sections; start-stop-gc
+# so that the coverage tables do not keep them).
+FUZZ_FILES_SRC := core/camera/json.c core/mask.c core/level/lod_file.c core/level/load.c core/io/glb_read.c \
+                  core/dynamic/dyn_model.c core/dynamic/dyn_fit.c core/dynamic/dyn_regions.c core/level/decor.c \
+                  core/level/part.c core/level/sh.c core/level/sweep.c \
+                  core/bake/shard.c core/dynamic/dyn_shard.c core/bake/params.c core/dynamic/dyn_params.c \
+                  core/io/out_file.c $(FUZZ_EXR_SRC)
+FUZZ_FILES_FLAGS := -ffunction-sections -fdata-sections -Wl,--gc-sections -Wl,-z,start-stop-gc
+FUZZ_FILES_LIBS := $(FUZZ_EXR_LIBS) $(shell pkg-config --libs assimp 2>/dev/null)
 
 .PHONY: fuzz fuzz-check
-fuzz: fuzz-check $(FUZZ_DIR)/fuzz_binary $(FUZZ_DIR)/fuzz_exr $(FUZZ_DIR)/corpus.stamp
+fuzz: fuzz-check $(FUZZ_DIR)/fuzz_binary $(FUZZ_DIR)/fuzz_exr $(FUZZ_DIR)/fuzz_files $(FUZZ_DIR)/corpus.stamp
 
 fuzz-check:
 	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { \
@@ -40,6 +58,10 @@ $(FUZZ_DIR)/fuzz_binary: tests/fuzz/fuzz_binary.c $(FUZZ_SRC) $(FUZZ_HDR) | fuzz
 $(FUZZ_DIR)/fuzz_exr: tests/fuzz/fuzz_exr.c $(FUZZ_EXR_SRC) $(FUZZ_HDR) | fuzz-check
 	@mkdir -p $(dir $@)
 	$(FUZZ_CC) $(FUZZ_CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_EXR_SRC) -o $@ $(FUZZ_EXR_LIBS)
+
+$(FUZZ_DIR)/fuzz_files: tests/fuzz/fuzz_files.c $(FUZZ_FILES_SRC) $(FUZZ_HDR) | fuzz-check
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CPPFLAGS) $(FUZZ_CFLAGS) $(FUZZ_FILES_FLAGS) -fsanitize=fuzzer $< $(FUZZ_FILES_SRC) -o $@ $(FUZZ_FILES_LIBS)
 
 $(FUZZ_DIR)/gen_corpus: tests/fuzz/gen_corpus.c $(FUZZ_SRC) $(FUZZ_HDR) | fuzz-check
 	@mkdir -p $(dir $@)

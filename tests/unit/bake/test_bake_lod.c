@@ -3,6 +3,8 @@
  * onto the LOD's vertices, the whole stage through obs_bake_run, a file's
  * own LODs, bad parameters. */
 #include <stdio.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "level/bake_testutil.h"
@@ -559,6 +561,62 @@ static void test_file_lods(void **state)
     obs_bake_scene_free(&sc);
 }
 
+
+/* A .glb with MSFT_lod whose header gives a length of almost 4 GiB, the
+ * file 200 bytes (tests/fuzz/fuzz_files.c found it): refused as
+ * truncated, the buffer sized by the file.  Read in a child whose address
+ * space has 256 MiB to spare, where a buffer sized by the header cannot
+ * be had (without the limit, under the sanitizers, it only checks the
+ * message). */
+static void test_file_lods_damaged(void **state)
+{
+    (void)state;
+    const char json[] = "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"MSFT_lod\"],"
+                        "\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"name\":\"a\"}]} ";
+    unsigned char head[20];
+    const uint32_t words[5] = {0x46546C67u, 2, 0xfffffff0u, (uint32_t)(sizeof json - 1),
+                               0x4E4F534Au};
+    for (int w = 0; w < 5; w++)
+        for (int b = 0; b < 4; b++)
+            head[4 * w + b] = (unsigned char)(words[w] >> (8 * b));
+    char path[] = "/tmp/obs_lodbad_XXXXXX.glb";
+    int fd = mkstemps(path, 4);
+    assert_true(fd >= 0);
+    FILE *f = fdopen(fd, "wb");
+    assert_non_null(f);
+    fwrite(head, 1, 20, f);
+    fwrite(json, 1, sizeof json - 1, f);
+    for (int k = 0; k < 50; k++)
+        fputc(0, f);
+    fclose(f);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+#if !defined(__SANITIZE_ADDRESS__)
+        long pages = 0;
+        FILE *st = fopen("/proc/self/statm", "r");
+        if (st && fscanf(st, "%ld", &pages) == 1) {
+            rlim_t cap = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + ((rlim_t)256 << 20);
+            struct rlimit rl = {cap, cap};
+            setrlimit(RLIMIT_AS, &rl);
+        }
+        if (st)
+            fclose(st);
+#endif
+        obs_bake_scene sc = {0};
+        char err[OBS_ERR_LEN] = "";
+        obs_status rc = obs__bake_lod_file_read(path, &sc, err);
+        if (rc != OBS_BAD_FILE || !strstr(err, "truncated"))
+            fprintf(stderr, "got %s: %s\n", obs_status_name(rc), err);
+        _exit(rc == OBS_BAD_FILE && strstr(err, "truncated") ? 0 : 1);
+    }
+    int status = 0;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    unlink(path);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 0);
+}
+
 /* Bad parameters: each refused with the row's name; the simplifier's own
  * checks. */
 static void test_bad_params(void **state)
@@ -604,6 +662,7 @@ int main(void)
         cmocka_unit_test(test_fit_linear),
         cmocka_unit_test(test_bake_run),
         cmocka_unit_test(test_file_lods),
+        cmocka_unit_test(test_file_lods_damaged),
         cmocka_unit_test(test_bad_params),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

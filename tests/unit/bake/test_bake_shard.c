@@ -195,6 +195,66 @@ static void test_bad_parts(void **state)
     obs_bake_scene_free(&other);
 }
 
+/* A copy of the part at from in to, its first keep bytes (-1: all) with
+ * the 4 bytes at `at` set to v (little-endian). */
+static void patch32(const char *from, const char *to, long keep, uint32_t at, uint32_t v)
+{
+    unsigned char b[4096];
+    FILE *f = fopen(from, "rb");
+    assert_non_null(f);
+    size_t len = fread(b, 1, sizeof b, f);
+    fclose(f);
+    assert_true(len > at + 4 && len < sizeof b);
+    obs__le_put32(b + at, v);
+    FILE *g = fopen(to, "wb");
+    assert_non_null(g);
+    assert_int_equal(fwrite(b, 1, keep < 0 ? len : (size_t)keep, g), keep < 0 ? len : (size_t)keep);
+    fclose(g);
+}
+
+/* Damaged headers (tests/fuzz/fuzz_files.c fuzzes the part reader): a
+ * shard count near 2^31 with a level of as many samples (so the range
+ * checks hold) is a missing shard, not an allocation of count parts;
+ * trace parameters out of their rows' ranges (the header carries no
+ * checksum) are refused, naming the parameter, not taken by the merge. */
+static void test_damaged_headers(void **state)
+{
+    (void)state;
+    obs_bake_scene sc;
+    level(&sc, 0.0f);
+    shard_all(&sc, "h", 1, "8");
+    char p[128], bad[128];
+    path_of(p, sizeof p, "h", 0);
+    path_of(bad, sizeof bad, "hbad", 0);
+    /* shard 0 of 2^31 - 1 over 2^31 - 1 samples: one sample, 128 + 9 bytes */
+    patch32(p, bad, -1, 28, 0x7fffffffu);
+    unsigned char b[4096];
+    FILE *f = fopen(bad, "rb");
+    size_t len = fread(b, 1, sizeof b, f);
+    fclose(f);
+    obs__le_put64(b + 32, 0x7fffffffu);
+    obs__le_put64(b + 48, 1);
+    f = fopen(bad, "wb");
+    assert_int_equal(fwrite(b, 1, 128 + 9, f), 128 + 9);
+    fclose(f);
+    assert_true(len > 128 + 9);
+    const char *one[] = {bad};
+    expect_refused(&sc, one, 1, OBS_INVALID_ARGUMENT, "2147483646 of 2147483647 shards missing");
+    /* parameters the merge takes from the parts: rays -5, a sample
+     * budget that is NaN, a back-face limit of 2 */
+    const struct {
+        uint32_t at, v;
+        const char *says;
+    } fields[] = {{72, (uint32_t)-5, "rays"},
+                  {84, 0x7fc00000u, "samples_per_face"},
+                  {96, 0x40000000u, "backface_limit"}};
+    for (size_t k = 0; k < sizeof fields / sizeof fields[0]; k++) {
+        patch32(p, bad, -1, fields[k].at, fields[k].v);
+        expect_refused(&sc, one, 1, OBS_BAD_FILE, fields[k].says);
+    }
+    obs_bake_scene_free(&sc);
+}
+
 static int stop_at;
 static int cancel_cb(void *user, size_t done, size_t total)
 {
@@ -244,6 +304,7 @@ int main(void)
         cmocka_unit_test(test_split),
         cmocka_unit_test(test_merged_is_unsharded),
         cmocka_unit_test(test_bad_parts),
+        cmocka_unit_test(test_damaged_headers),
         cmocka_unit_test(test_cancel),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

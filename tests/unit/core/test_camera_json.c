@@ -109,6 +109,18 @@ static void test_malformed(void **state)
     expect_bad("this is not JSON", "not valid JSON");
     expect_bad("[1, 2, 3]", "not a JSON object");
     expect_bad("", "not valid JSON");
+    /* numbers a double holds and a float does not: an infinity in the
+     * camera's matrices, a zero near plane, a far plane on the near one */
+    expect_bad("{\"world_to_camera\": [1e39,0,0,0, 0,1,0,0, 0,0,1,-5, 0,0,0,1], " PROJ "}",
+               "world_to_camera");
+    expect_bad("{" WTC ", \"projection\": [[1,0,0,0],[0,1,0,0],[0,0,-1,-1e300],[0,0,-1,0]]}",
+               "projection");
+    expect_bad("{\"near\": 1e-50, \"width\": 320, \"height\": 240, \"fov_y_deg\": 50, " WTC "}",
+               "near");
+    expect_bad("{\"near\": 1, \"far\": 1.00000001, \"width\": 320, \"height\": 240, "
+               "\"fov_y_deg\": 50, " WTC "}", "far");
+    expect_bad("{\"far\": 1e39, \"width\": 320, \"height\": 240, \"fov_y_deg\": 50, " WTC "}",
+               "far");
 }
 
 static void test_fov_only_and_flat(void **state)

@@ -324,8 +324,11 @@ static void test_bad_selectors(void **state)
     (void)state;
     char err[OBS_ERR_LEN];
     obs_image w = {0};
+    /* strtod reads "nan", "inf" and "nan-5" as numbers: no IDs (a NaN
+     * range matched no pixel, silently) */
     const char *bad[] = {"", "!", "id:id", "id:id=", "id:id=3-1", "id:id=a", "a,,b", "x\\",
-                         "matte:", "@:x"};
+                         "matte:", "@:x", "id:id=nan", "id:id=1,inf", "id:id=nan-5",
+                         "id:id=1-infinity"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
         assert_int_equal(obs_mask_plane(CORNELL, NULL, 0, bad[i], NULL, &w, NULL, err),
                          OBS_INVALID_ARGUMENT);

@@ -662,6 +662,83 @@ static void test_model_file_and_blender(void **state)
 
 /* ---- decorators (section 2.1) --------------------------------------------- */
 
+
+/* A model file with two regions and one model, the given pieces in it
+ * (a blend, the first region's members, one coefficient, the adjacency),
+ * read back: its status, the message in err. */
+static obs_status read_model_text(const char *blend, const char *region, const char *coef,
+                                  const char *adjacency, char err[OBS_ERR_LEN])
+{
+    char co[4096] = "", *c = co;
+    for (int k = 0; k < OBS_DYN_CHANNELS; k++) {
+        c += sprintf(c, "%s[%s", k ? "," : "", k ? "0.5" : coef);
+        for (int t = 1; t < OBS_DYN_TERMS; t++)
+            c += sprintf(c, ",0");
+        c += sprintf(c, "]");
+    }
+    char text[8192];
+    snprintf(text, sizeof text,
+             "{\"format\":\"obscura-dynamic-ao\",\"distances\":[2,300],\"blend\":%s,"
+             "\"regions\":[{%s},"
+             "{\"min\":[1,0,0],\"max\":[2,1,1],\"model\":-1}],\"adjacency\":[%s],"
+             "\"models\":[{\"center\":[0.5,0.5,0.5],\"coefficients\":[%s]}]}",
+             blend, region, adjacency, co);
+    const char *path = obs_test_tmp_file("dyn_damaged.json", text);
+    obs_dyn_model m;
+    obs_status st = obs_dyn_model_read(path, &m, err);
+    if (st == OBS_OK) {
+        float ao[3];
+        const float p[3] = {0.5f, 0.5f, 0.5f}, n[3] = {0, 1, 0};
+        assert_int_equal(obs_dyn_eval(&m, p, n, OBS_DYN_QUADRATIC, ao), 0);
+        for (int k = 0; k < 3; k++) /* a model read is one that evaluates */
+            assert_true(ao[k] >= 0.0f && ao[k] <= 1.0f);
+        obs_dyn_model_free(&m);
+    }
+    return st;
+}
+
+/* Damaged model files (tests/fuzz/fuzz_files.c fuzzes the reader): each
+ * refused with a message naming the piece, none read as a model that
+ * evaluates to garbage (a point count past 32 bits was a float-to-integer
+ * overflow; a coefficient past a float's range an infinity, a blend out
+ * of 0 .. 1 an AO out of it, a fractional index truncated). */
+#define BOX "\"min\":[0,0,0],\"max\":[1,1,1],"
+static void test_model_file_damaged(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(read_model_text("0.03", BOX "\"model\":0,\"points\":40", "0.7", "[0,1]", err),
+                     OBS_OK);
+    assert_int_equal(read_model_text("0.03", BOX "\"model\":0,\"points\":1e12", "0.7", "", err),
+                     OBS_BAD_FILE);
+    assert_non_null(strstr(err, "region 0"));
+    assert_int_equal(read_model_text("0.03", BOX "\"model\":0,\"points\":-3", "0.7", "", err),
+                     OBS_BAD_FILE);
+    assert_int_equal(read_model_text("0.03", BOX "\"model\":0.5", "0.7", "", err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "model index in -1 .. 0"));
+    assert_int_equal(read_model_text("0.03", BOX "\"model\":0", "1e39", "", err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "model 0"));
+    assert_int_equal(read_model_text("1e999", BOX "\"model\":0", "0.7", "", err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "blend"));
+    assert_int_equal(read_model_text("-0.5", BOX "\"model\":0", "0.7", "", err), OBS_BAD_FILE);
+    assert_int_equal(read_model_text("0.03", BOX "\"model\":0", "0.7", "[0.5,1]", err),
+                     OBS_BAD_FILE);
+    assert_non_null(strstr(err, "adjacency 0"));
+    assert_int_equal(read_model_text("0.03", BOX "\"model\":0", "0.7", "[0,2]", err), OBS_BAD_FILE);
+    /* a box whose min is past its max */
+    assert_int_equal(read_model_text("0.03", "\"min\":[0,3,0],\"max\":[1,1,1],\"model\":0", "0.7",
+                                     "", err),
+                     OBS_BAD_FILE);
+    /* no model at all: the message's range is -1 .. -1, not a wrapped count */
+    const char *none = obs_test_tmp_file("dyn_none.json",
+        "{\"format\":\"obscura-dynamic-ao\",\"distances\":[2,300],\"blend\":0.03,"
+        "\"regions\":[{\"min\":[0,0,0],\"max\":[1,1,1],\"model\":0}],\"models\":[]}");
+    obs_dyn_model m;
+    assert_int_equal(obs_dyn_model_read(none, &m, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "-1 .. -1"));
+}
+#undef BOX
+
 /* A point under a wide horizontal layer 1 above it (a 200 x 200 grid
  * facing down), nothing else within reach (an opaque ground far below,
  * beyond the rays' length).  The layer is a node named tree: semi-
@@ -753,6 +830,7 @@ int main(void)
         cmocka_unit_test(test_regions_file),
         cmocka_unit_test(test_built_regions_outside),
         cmocka_unit_test(test_model_file_and_blender),
+        cmocka_unit_test(test_model_file_damaged),
         cmocka_unit_test(test_tree_layer_attenuates),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
