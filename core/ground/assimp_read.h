@@ -29,6 +29,13 @@ const struct aiScene *obs__assimp_scene(const obs__assimp *a);
 const struct aiScene *obs__assimp_apply(obs__assimp *a, unsigned steps, char msg[OBS_ERR_LEN]);
 void obs__assimp_free(obs__assimp *a);
 
+/* The failure of assimp on path as a status and message: OBS_TOO_LARGE
+ * when assimp ran out of memory (an allocation sized by a count in the
+ * file), else OBS_BAD_FILE; `what` names what was expected ("a mesh", "a
+ * level"), msg is assimp's message. */
+obs_status obs__assimp_fail(const char *path, const char *what, const char *msg,
+                            char err[OBS_ERR_LEN]);
+
 #ifdef __cplusplus
 }
 #endif

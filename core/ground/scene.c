@@ -347,14 +347,19 @@ static obs_status import(const char *path, obs__assimp **imp, const struct aiSce
      * of one material): their names select opacities. */
     *sc = NULL;
     if (!(*imp = obs__assimp_read(path, 1, msg)))
-        return obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path, msg);
+        return obs__assimp_fail(path, "a mesh", msg, err);
     obs_status st = meshes_placed(path, obs__assimp_scene(*imp), err);
     if (st == OBS_OK && !obs__assimp_apply(*imp, place, msg))
-        st = obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path, msg);
+        st = obs__assimp_fail(path, "a mesh", msg, err);
     if (st == OBS_OK)
         st = finite_vertices(path, obs__assimp_scene(*imp), err);
+    /* FindInvalidData also drops a mesh whose vertices all coincide. */
     if (st == OBS_OK && !(*sc = obs__assimp_apply(*imp, clean, msg)))
-        st = obs__fail(err, OBS_BAD_FILE, "%s: not a mesh assimp can read: %s", path, msg);
+        st = strstr(msg, "No meshes remaining")
+                 ? obs__fail(err, OBS_BAD_FILE, "%s: no mesh left once assimp drops the invalid "
+                                                "ones (each mesh's vertices all at one point?)",
+                             path)
+                 : obs__assimp_fail(path, "a mesh", msg, err);
     if (st != OBS_OK) {
         obs__assimp_free(*imp);
         *imp = NULL;

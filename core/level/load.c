@@ -17,6 +17,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "ground/assimp_read.h"
 #include "level/level.h"
 #include "internal.h"
 #include "obscura/bake.h"
@@ -399,8 +400,7 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
     const struct aiScene *sc =
         aiImportFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate);
     if (!sc)
-        return obs__fail(err, OBS_BAD_FILE, "%s: not a level assimp can read: %s", path,
-                         aiGetErrorString());
+        return obs__assimp_fail(path, "a level", aiGetErrorString(), err);
     obs_status st = OBS_OK;
     if (!sc->mRootNode || sc->mNumMeshes == 0) {
         st = obs__fail(err, OBS_BAD_FILE, "%s: no triangles (no meshes)", path);

@@ -1,0 +1,202 @@
+/* Damaged and hostile mesh files (tests/data/levels/bad) through both
+ * assimp loaders: obs_scene_load (gbuffer, reference: core/ground/scene.c)
+ * and obs_bake_load (bake: core/level/load.c), then the bake's flattening.
+ * Each case is one fuzz_scene found or the CLI check made by hand; before
+ * the fixes they crashed (SEGV) or lost a mesh without a word. */
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "level/bake_testutil.h"
+#include "level/level.h"
+#include "obscura/scene.h"
+
+#define BAD TESTDATA "/levels/bad/"
+
+static void scene_fails(const char *file, obs_status want, const char *words)
+{
+    obs_scene s;
+    char err[OBS_ERR_LEN] = "";
+    obs_status st = obs_scene_load(file, &s, err);
+    print_message("scene %s: %s\n", file, err);
+    assert_int_equal(st, want);
+    assert_non_null(strstr(err, file));
+    assert_non_null(strstr(err, words));
+    assert_null(s.positions);
+}
+
+static void level_fails(const char *file, obs_status want, const char *words)
+{
+    obs_bake_scene b;
+    char err[OBS_ERR_LEN] = "";
+    obs_status st = obs_bake_load(file, 0, &b, err);
+    print_message("level %s: %s\n", file, err);
+    assert_int_equal(st, want);
+    assert_non_null(strstr(err, file));
+    assert_non_null(strstr(err, words));
+    assert_null(b.nodes);
+}
+
+/* An OFF file whose face list runs into other text: assimp's OFF reader
+ * leaves a face without indices, which its own scene preprocessing then
+ * read (SEGV).  Validated first, it is refused. */
+static void test_face_without_indices(void **state)
+{
+    (void)state;
+    scene_fails(BAD "face_without_indices.off", OBS_BAD_FILE, "mIndices is nullptr");
+    level_fails(BAD "face_without_indices.off", OBS_BAD_FILE, "mIndices is nullptr");
+}
+
+/* A NaN vertex: FindInvalidData dropped its mesh (the only one: "No
+ * meshes remaining"; the second of two: the scene loaded without it).
+ * Both loaders name the mesh and the vertex. */
+static void test_nan_vertex(void **state)
+{
+    (void)state;
+    scene_fails(BAD "nan_vertex.obj", OBS_BAD_FILE, "vertex 1 is (nan, 0, 0)");
+    scene_fails(BAD "nan_second_mesh.obj", OBS_BAD_FILE, "mesh 1 'bad': vertex 0");
+    level_fails(BAD "nan_second_mesh.obj", OBS_BAD_FILE, "mesh 1 'bad': vertex 0");
+}
+
+/* Node transforms whose product overflows (scale 1e30 under 1e30): the
+ * pre-transformed mesh is infinite, and was dropped as the NaN one.  The
+ * level keeps each mesh in its own space; its flattening refuses. */
+static void test_transform_overflow(void **state)
+{
+    (void)state;
+    const char *f = BAD "transform_overflow.gltf";
+    scene_fails(f, OBS_BAD_FILE, "not finite (in the file, or its node's transform overflows)");
+    obs_bake_scene b;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_bake_load(f, 0, &b, err), OBS_OK);
+    obs__bake_world w;
+    assert_int_equal(obs__bake_flatten(&b, &w, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "node 'a', mesh 'box'"));
+    assert_non_null(strstr(err, "transform overflows"));
+    obs_bake_scene_free(&b);
+}
+
+/* An AC3D object with vertices and no surface count: assimp keeps its
+ * points as a mesh under no node, and PreTransformVertices (hierarchy
+ * kept) read a null transform for it (SEGV).  The scene refuses it by
+ * name; the level bakes the meshes under its nodes (4 of the 5). */
+static void test_mesh_under_no_node(void **state)
+{
+    (void)state;
+    const char *f = BAD "no_numsurf.ac";
+    scene_fails(f, OBS_BAD_FILE, "mesh 3 '' is under no node");
+    obs_bake_scene b;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_bake_load(f, 0, &b, err), OBS_OK);
+    assert_int_equal(b.mesh_count, 5);
+    assert_int_equal(b.instance_count, 4);
+    assert_int_equal(b.world_triangles, 4);
+    obs_bake_scene_free(&b);
+}
+
+/* Each mesh's vertices at one point: FindInvalidData drops them all;
+ * said so, rather than assimp's bare "No meshes remaining". */
+static void test_all_at_one_point(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/obs_onepoint_XXXXXX.obj";
+    int fd = mkstemps(path, 4);
+    assert_true(fd >= 0);
+    static const char obj[] = "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n";
+    assert_int_equal(write(fd, obj, sizeof obj - 1), (ssize_t)(sizeof obj - 1));
+    close(fd);
+    scene_fails(path, OBS_BAD_FILE, "vertices all at one point");
+    unlink(path);
+}
+
+/* A PLY header declaring 2^31 vertices in a file of 178 bytes: assimp
+ * sizes its arrays by the count and runs out of memory; both loaders say
+ * so (OBS_TOO_LARGE).  Run in a child whose address space is capped, so
+ * the answer does not depend on the machine's memory; not under ASan
+ * (its shadow memory needs the address space, and its allocator aborts
+ * rather than throw). */
+static void test_huge_declared_count(void **state)
+{
+    (void)state;
+#if defined(__SANITIZE_ADDRESS__)
+    skip();
+#else
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        long pages = 0;
+        FILE *st = fopen("/proc/self/statm", "r");
+        if (st && fscanf(st, "%ld", &pages) == 1) {
+            rlim_t cap = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + ((rlim_t)1 << 30);
+            struct rlimit rl = {cap, cap};
+            setrlimit(RLIMIT_AS, &rl);
+        }
+        if (st)
+            fclose(st);
+        const char *f = BAD "huge_vertex_count.ply";
+        char err[OBS_ERR_LEN] = "";
+        obs_scene s;
+        obs_bake_scene b;
+        int ok = obs_scene_load(f, &s, err) == OBS_TOO_LARGE && strstr(err, "out of memory");
+        if (!ok)
+            fprintf(stderr, "scene: %s\n", err);
+        int ok2 = obs_bake_load(f, 0, &b, err) == OBS_TOO_LARGE && strstr(err, "out of memory");
+        if (!ok2)
+            fprintf(stderr, "level: %s\n", err);
+        _exit(ok && ok2 ? 0 : 1);
+    }
+    int status = 0;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 0);
+#endif
+}
+
+/* The fuzz_scene seeds that are whole files: each loads in both loaders
+ * and flattens (a seed that stopped loading would fuzz only the errors). */
+static void test_valid_seeds_load(void **state)
+{
+    (void)state;
+    static const char *const good[] = {"cube_obj", "cube_ply_ascii", "cube_ply_bin",
+                                       "cube_off", "cube_stl_ascii", "cube_stl_bin",
+                                       "cube_gltf", "cube_glb", "quads_ac"};
+    static const char *const exts[] = {"obj", "ply", "off", "stl", "glb", "gltf", "ac"};
+    for (size_t i = 0; i < sizeof good / sizeof *good; i++) {
+        char src[256], path[64];
+        snprintf(src, sizeof src, "tests/fuzz/corpus/scene/%s", good[i]);
+        size_t len = 0;
+        unsigned char *d = obs_test_slurp(src, &len);
+        assert_non_null(d);
+        assert_true(len > 1 && d[0] < sizeof exts / sizeof *exts);
+        snprintf(path, sizeof path, "/tmp/obs_seed_%d.%s", (int)getpid(), exts[d[0]]);
+        FILE *f = fopen(path, "wb");
+        assert_non_null(f);
+        assert_int_equal(fwrite(d + 1, 1, len - 1, f), len - 1);
+        fclose(f);
+        free(d);
+        obs_scene s;
+        obs_bake_scene b;
+        obs__bake_world w;
+        char err[OBS_ERR_LEN] = "";
+        if (obs_scene_load(path, &s, err) != OBS_OK)
+            fail_msg("%s: %s", good[i], err);
+        assert_true(s.triangle_count >= 3);
+        obs_scene_free(&s);
+        if (obs_bake_load(path, 0, &b, err) != OBS_OK || obs__bake_flatten(&b, &w, err) != OBS_OK)
+            fail_msg("%s: %s", good[i], err);
+        obs__bake_world_free(&w);
+        obs_bake_scene_free(&b);
+        unlink(path);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_face_without_indices), cmocka_unit_test(test_nan_vertex),
+        cmocka_unit_test(test_transform_overflow),   cmocka_unit_test(test_mesh_under_no_node),
+        cmocka_unit_test(test_all_at_one_point),     cmocka_unit_test(test_huge_declared_count),
+        cmocka_unit_test(test_valid_seeds_load),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
