@@ -7,7 +7,6 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <cstdio>
-#include <cstring>
 #include <exception>
 #include <new>
 
@@ -66,19 +65,4 @@ void obs__assimp_free(obs__assimp *a)
         delete a;
     } catch (...) {
     }
-}
-
-obs_status obs__assimp_fail(const char *path, const char *what, const char *msg,
-                            char err[OBS_ERR_LEN])
-{
-    if (msg && std::strstr(msg, "bad_alloc")) {
-        if (err)
-            std::snprintf(err, OBS_ERR_LEN, "%s: assimp ran out of memory reading it (a count in "
-                                            "the file larger than the file holds?)", path);
-        return OBS_TOO_LARGE;
-    }
-    if (err)
-        std::snprintf(err, OBS_ERR_LEN, "%s: not %s assimp can read: %s", path, what,
-                      msg && *msg ? msg : "unknown error");
-    return OBS_BAD_FILE;
 }
