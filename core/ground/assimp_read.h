@@ -29,6 +29,11 @@ const struct aiScene *obs__assimp_scene(const obs__assimp *a);
 const struct aiScene *obs__assimp_apply(obs__assimp *a, unsigned steps, char msg[OBS_ERR_LEN]);
 void obs__assimp_free(obs__assimp *a);
 
+/* What path must be before assimp reads it (assimp_check.c): a PLY
+ * header ends with end_header.  OBS_OK, or the error (OBS_BAD_FILE,
+ * OBS_IO). */
+obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN]);
+
 /* The failure of assimp on path as a status and message: OBS_TOO_LARGE
  * when assimp ran out of memory (an allocation sized by a count in the
  * file), else OBS_BAD_FILE; `what` names what was expected ("a mesh", "a

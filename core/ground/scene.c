@@ -325,10 +325,9 @@ static obs_status finite_vertices(const char *path, const struct aiScene *sc,
 static obs_status import(const char *path, obs__assimp **imp, const struct aiScene **sc,
                          char err[OBS_ERR_LEN])
 {
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
-    fclose(fp);
+    obs_status st = obs__assimp_precheck(path, err);
+    if (st != OBS_OK)
+        return st;
     /* Read and validated first, nothing else: ValidateDataStructure
      * refuses an importer's inconsistent output (a face without indices,
      * an index past its mesh's vertices, a node naming a mesh that is not
@@ -348,7 +347,7 @@ static obs_status import(const char *path, obs__assimp **imp, const struct aiSce
     *sc = NULL;
     if (!(*imp = obs__assimp_read(path, 1, msg)))
         return obs__assimp_fail(path, "a mesh", msg, err);
-    obs_status st = meshes_placed(path, obs__assimp_scene(*imp), err);
+    st = meshes_placed(path, obs__assimp_scene(*imp), err);
     if (st == OBS_OK && !obs__assimp_apply(*imp, place, msg))
         st = obs__assimp_fail(path, "a mesh", msg, err);
     if (st == OBS_OK)

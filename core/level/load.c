@@ -389,10 +389,9 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
                          char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
-    fclose(fp);
+    obs_status pre = obs__assimp_precheck(path, err);
+    if (pre != OBS_OK)
+        return pre;
     /* No joining, no pre-transform: the soup, the graph and the mesh
      * order stay the file's.  ValidateDataStructure refuses what an
      * importer left inconsistent (a face without indices, a mesh index

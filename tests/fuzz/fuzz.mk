@@ -35,7 +35,7 @@ FUZZ_EXR_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libcjson 2>/dev/nul
 # dyn_shard.c are compiled for their part formats; their trace steps
 # (never called) are dropped at link time (--gc-sections; start-stop-gc
 # so that the coverage tables do not keep them).
-FUZZ_FILES_SRC := core/camera/json.c core/mask.c core/level/lod_file.c core/level/load.c core/ground/assimp_fail.c core/io/glb_read.c \
+FUZZ_FILES_SRC := core/camera/json.c core/mask.c core/level/lod_file.c core/level/load.c core/ground/assimp_check.c core/io/glb_read.c \
                   core/dynamic/dyn_model.c core/dynamic/dyn_fit.c core/dynamic/dyn_regions.c core/level/decor.c \
                   core/level/part.c core/level/sh.c core/level/sweep.c \
                   core/bake/shard.c core/dynamic/dyn_shard.c core/bake/params.c core/dynamic/dyn_params.c \
@@ -82,7 +82,7 @@ $(FUZZ_DIR)/corpus.stamp: $(FUZZ_DIR)/gen_corpus
 # is then replayed to see whose code it stops in.
 #   ASAN_OPTIONS=fast_unwind_on_malloc=0 LSAN_OPTIONS=suppressions=$PWD/tests/fuzz/scene.supp \
 #     $(BUILD)/fuzz/fuzz_scene -max_len=65536 NEW_DIR tests/fuzz/corpus/scene
-FUZZ_SCENE_SRC := core/ground/scene.c core/ground/assimp_fail.c core/ground/baked.c core/io/glb_read.c core/level/load.c \
+FUZZ_SCENE_SRC := core/ground/scene.c core/ground/assimp_check.c core/ground/baked.c core/io/glb_read.c core/level/load.c \
                   core/level/lod_file.c core/level/flatten.c core/status.c core/util.c
 FUZZ_SCENE_CXX_SRC := core/ground/assimp_read.cpp
 FUZZ_SCENE_LIBS := -lassimp $(shell pkg-config --libs libcjson 2>/dev/null) -lstdc++ -lm -lpthread

@@ -47,6 +47,18 @@ static void test_face_without_indices(void **state)
     level_fails(BAD "face_without_indices.off", OBS_BAD_FILE, "mIndices is nullptr");
 }
 
+/* A PLY header without its end_header line: assimp's PLY reader read
+ * past its buffer (binary: SEGV) or never returned (ASCII).  Refused
+ * before assimp sees it. */
+static void test_ply_without_end_header(void **state)
+{
+    (void)state;
+    scene_fails(BAD "ply_no_end_header.ply", OBS_BAD_FILE, "without its end_header line");
+    level_fails(BAD "ply_no_end_header.ply", OBS_BAD_FILE, "without its end_header line");
+    scene_fails(BAD "ply_no_end_header_ascii.ply", OBS_BAD_FILE, "without its end_header line");
+    level_fails(BAD "ply_no_end_header_ascii.ply", OBS_BAD_FILE, "without its end_header line");
+}
+
 /* A NaN vertex: FindInvalidData dropped its mesh (the only one: "No
  * meshes remaining"; the second of two: the scene loaded without it).
  * Both loaders name the mesh and the vertex. */
@@ -193,7 +205,8 @@ static void test_valid_seeds_load(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_face_without_indices), cmocka_unit_test(test_nan_vertex),
+        cmocka_unit_test(test_face_without_indices), cmocka_unit_test(test_ply_without_end_header),
+        cmocka_unit_test(test_nan_vertex),
         cmocka_unit_test(test_transform_overflow),   cmocka_unit_test(test_mesh_under_no_node),
         cmocka_unit_test(test_all_at_one_point),     cmocka_unit_test(test_huge_declared_count),
         cmocka_unit_test(test_valid_seeds_load),
