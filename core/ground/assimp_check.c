@@ -1,13 +1,16 @@
 /* What obscura checks around assimp (assimp_read.h): a file before it is
  * handed over, assimp's failure as a status and message.  C, so that
  * core/level/load.c, which reads through assimp's C API, needs no C++. */
+#include <cjson/cJSON.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "ground/assimp_read.h"
 #include "internal.h"
+#include "io/glb_read.h"
 
 obs_status obs__assimp_fail(const char *path, const char *what, const char *msg,
                             char err[OBS_ERR_LEN])
@@ -27,17 +30,10 @@ obs_status obs__assimp_fail(const char *path, const char *what, const char *msg,
 /* How much of a PLY file is searched for the end of its header. */
 #define PLY_HEADER_MAX ((size_t)1 << 20)
 
-obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
+/* A PLY file (f after its first line) whose header ends. */
+static obs_status ply_header(const char *path, FILE *f, char err[OBS_ERR_LEN])
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
-    char head[5] = "";
-    size_t n = fread(head, 1, 4, f);
-    if (n < 4 || memcmp(head, "ply", 3) != 0 || (head[3] != '\n' && head[3] != '\r')) {
-        fclose(f);
-        return OBS_OK; /* not PLY */
-    }
+    size_t n;
     /* assimp 5.2's PLY reader, given a header without its end_header
      * line, reads past its buffer (binary) or never returns (ASCII). */
     char *buf = malloc(PLY_HEADER_MAX + 1);
@@ -46,7 +42,6 @@ obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
         return obs__fail(err, OBS_NO_MEMORY, "%s: PLY header", path);
     }
     n = fread(buf, 1, PLY_HEADER_MAX, f);
-    fclose(f);
     buf[n] = '\0';
     int found = 0;
     for (char *line = buf; !found && line < buf + n;) {
@@ -65,4 +60,110 @@ obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
                                             "(damaged or truncated)",
                          path, n == PLY_HEADER_MAX ? " in its first MiB" : "");
     return OBS_OK;
+}
+
+static const cJSON *item(const cJSON *o, const char *name)
+{
+    return cJSON_GetObjectItemCaseSensitive(o, name);
+}
+
+/* glTF's node graph a forest, as the specification asks: no node the
+ * child of two nodes (or twice of one), no scene root a child.  assimp
+ * 5.2's glTF importer copies a node once per path to it (a DAG of 40
+ * levels asks for 2^40 nodes) and recurses around a cycle without end.
+ * Child indices out of range are assimp's to refuse. */
+static obs_status gltf_forest(const char *path, const cJSON *doc, char err[OBS_ERR_LEN])
+{
+    const cJSON *nodes = item(doc, "nodes"), *nd, *c, *sc;
+    int n = cJSON_GetArraySize(nodes);
+    if (n <= 0)
+        return OBS_OK;
+    unsigned char *parent = calloc((size_t)n, 1);
+    if (!parent)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %d nodes", path, n);
+    obs_status st = OBS_OK;
+    cJSON_ArrayForEach(nd, nodes)
+    {
+        cJSON_ArrayForEach(c, item(nd, "children"))
+        {
+            long k = obs__glb_index_value(c);
+            if (k < 0 || k >= n)
+                continue;
+            if (parent[k]++) {
+                st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is the child of more than "
+                                                  "one node (the node graph must be a forest)",
+                               path, k);
+                goto done;
+            }
+        }
+    }
+    cJSON_ArrayForEach(sc, item(doc, "scenes"))
+    {
+        cJSON_ArrayForEach(c, item(sc, "nodes"))
+        {
+            long k = obs__glb_index_value(c);
+            if (k >= 0 && k < n && parent[k]) {
+                st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is a scene's root and a "
+                                                  "child (a cycle?)",
+                               path, k);
+                goto done;
+            }
+        }
+    }
+done:
+    free(parent);
+    return st;
+}
+
+/* The JSON of a .glb (f after its first 4 bytes) or a .gltf (whole), of
+ * size bytes, checked by gltf_forest; what does not parse is assimp's to
+ * refuse. */
+static obs_status gltf_json(const char *path, FILE *f, int glb, size_t size,
+                            char err[OBS_ERR_LEN])
+{
+    size_t off = 0, len = size;
+    if (glb) {
+        unsigned char h[16];
+        if (fread(h, 1, 16, f) != 16)
+            return OBS_OK;
+        len = obs__glb_u32(h + 8);
+        off = 20;
+        if (obs__glb_u32(h + 12) != OBS__GLB_CHUNK_JSON || len > size - 20)
+            return OBS_OK;
+    }
+    char *txt = malloc(len ? len : 1);
+    if (!txt)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %zu bytes of glTF JSON", path, len);
+    obs_status st = OBS_OK;
+    if (fseek(f, (long)off, SEEK_SET) == 0 && fread(txt, 1, len, f) == len) {
+        cJSON *doc = cJSON_ParseWithLength(txt, len);
+        if (doc)
+            st = gltf_forest(path, doc, err);
+        cJSON_Delete(doc);
+    }
+    free(txt);
+    return st;
+}
+
+obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return obs__fail(err, OBS_IO, "%s: cannot open: %s", path, strerror(errno));
+    unsigned char head[4] = {0};
+    size_t n = fread(head, 1, 4, f);
+    obs_status st = OBS_OK;
+    size_t plen = strlen(path);
+    if (n == 4 && !memcmp(head, "ply", 3) && (head[3] == '\n' || head[3] == '\r')) {
+        st = ply_header(path, f, err);
+    } else if ((n == 4 && obs__glb_u32(head) == OBS__GLB_MAGIC) ||
+               (plen >= 5 && !strcasecmp(path + plen - 5, ".gltf"))) {
+        long size = -1;
+        if (fseek(f, 0, SEEK_END) == 0)
+            size = ftell(f);
+        if (size >= 20 && fseek(f, 4, SEEK_SET) == 0)
+            st = gltf_json(path, f, obs__glb_u32(head) == OBS__GLB_MAGIC, (size_t)size, err);
+    }
+    fclose(f);
+    return st;
 }

@@ -147,6 +147,11 @@ typedef struct build {
     int dynamic;
     const char *pattern;
     size_t marked;
+    /* the nodes reached so far in this walk (glTF's node graph is a
+     * forest: a node reached twice, through a DAG or a cycle, is refused,
+     * as a walk that followed every path would take exponential time) */
+    unsigned char *seen;
+    size_t node_count;
 } build;
 
 static obs_status primitive(build *b, const cJSON *prim, const char *mname, const char *nname,
@@ -279,11 +284,21 @@ static obs_status walk(build *b, long n, const float parent[16], int depth, int 
                        char err[OBS_ERR_LEN])
 {
     const cJSON *node = cJSON_GetArrayItem(item(b->g->doc, "nodes"), (int)n);
-    if (n < 0 || !cJSON_IsObject(node))
+    if (n < 0)
+        return obs__fail(err, OBS_BAD_FILE, "%s: a node index that is not a whole number from 0 "
+                                            "to 2^31-1", b->g->path);
+    if (!cJSON_IsObject(node))
         return obs__fail(err, OBS_BAD_FILE, "%s: node %ld does not exist", b->g->path, n);
     if (depth > MAX_DEPTH)
         return obs__fail(err, OBS_BAD_FILE, "%s: the node graph is deeper than %d (a cycle?)",
                          b->g->path, MAX_DEPTH);
+    if ((size_t)n < b->node_count) {
+        if (b->seen[n])
+            return obs__fail(err, OBS_BAD_FILE, "%s: node %ld is reached twice from the scene's "
+                                                "roots (glTF's node graph is a forest)",
+                             b->g->path, n);
+        b->seen[n] = 1;
+    }
     float local[16], world[16];
     local_matrix(node, local);
     obs__mat4_mul(parent, local, world);
@@ -306,8 +321,7 @@ static obs_status walk(build *b, long n, const float parent[16], int depth, int 
     }
     const cJSON *c;
     cJSON_ArrayForEach(c, item(node, "children"))
-        if ((st = walk(b, cJSON_IsNumber(c) ? (long)c->valuedouble : -1, world, depth + 1, dyn,
-                       err)) != OBS_OK)
+        if ((st = walk(b, obs__glb_index_value(c), world, depth + 1, dyn, err)) != OBS_OK)
             return st;
     return OBS_OK;
 }
@@ -318,11 +332,16 @@ static obs_status walk_scene(build *b, char err[OBS_ERR_LEN])
     const cJSON *sc = cJSON_GetArrayItem(item(b->g->doc, "scenes"), (int)(si < 0 ? 0 : si)), *r;
     float id[16];
     obs__mat4_identity(id);
-    obs_status st;
+    b->node_count = (size_t)cJSON_GetArraySize(item(b->g->doc, "nodes"));
+    if (!(b->seen = calloc(b->node_count ? b->node_count : 1, 1)))
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %zu nodes", b->g->path, b->node_count);
+    obs_status st = OBS_OK;
     cJSON_ArrayForEach(r, item(sc, "nodes"))
-        if ((st = walk(b, cJSON_IsNumber(r) ? (long)r->valuedouble : -1, id, 0, 0, err)) != OBS_OK)
-            return st;
-    return OBS_OK;
+        if ((st = walk(b, obs__glb_index_value(r), id, 0, 0, err)) != OBS_OK)
+            break;
+    free(b->seen);
+    b->seen = NULL;
+    return st;
 }
 
 int obs_scene_file_is_baked(const char *path)

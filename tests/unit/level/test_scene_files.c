@@ -59,6 +59,33 @@ static void test_ply_without_end_header(void **state)
     level_fails(BAD "ply_no_end_header_ascii.ply", OBS_BAD_FILE, "without its end_header line");
 }
 
+/* A .glb whose node graph is a DAG of 40 levels, each node twice the
+ * child of the one above: the baked reader walked every path (2^40,
+ * a hang), assimp's glTF importer copies each (out of memory).  The
+ * graph must be a forest: refused by both (baked.c, assimp_check.c). */
+static void test_node_dag(void **state)
+{
+    (void)state;
+    const char *f = BAD "node_dag.glb";
+    obs_scene s;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_scene_load_baked(f, &s, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "node 40 is reached twice"));
+    scene_fails(f, OBS_BAD_FILE, "glTF node 1 is the child of more than one node");
+    level_fails(f, OBS_BAD_FILE, "glTF node 1 is the child of more than one node");
+}
+
+/* A child index of 1e300: converted to long, undefined behaviour
+ * (UBSan in fuzz_scene); now read as a glTF index, refused. */
+static void test_node_index_not_integer(void **state)
+{
+    (void)state;
+    obs_scene s;
+    char err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_scene_load_baked(BAD "node_index_1e300.glb", &s, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "a node index that is not a whole number"));
+}
+
 /* A NaN vertex: FindInvalidData dropped its mesh (the only one: "No
  * meshes remaining"; the second of two: the scene loaded without it).
  * Both loaders name the mesh and the vertex. */
@@ -206,6 +233,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_face_without_indices), cmocka_unit_test(test_ply_without_end_header),
+        cmocka_unit_test(test_node_dag),             cmocka_unit_test(test_node_index_not_integer),
         cmocka_unit_test(test_nan_vertex),
         cmocka_unit_test(test_transform_overflow),   cmocka_unit_test(test_mesh_under_no_node),
         cmocka_unit_test(test_all_at_one_point),     cmocka_unit_test(test_huge_declared_count),
