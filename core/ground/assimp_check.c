@@ -30,7 +30,7 @@ obs_status obs__assimp_fail(const char *path, const char *what, const char *msg,
 /* How much of a PLY file is searched for the end of its header. */
 #define PLY_HEADER_MAX ((size_t)1 << 20)
 
-/* A PLY file (f after its first line) whose header ends. */
+/* A PLY file (f after its first 4 bytes) whose header ends. */
 static obs_status ply_header(const char *path, FILE *f, char err[OBS_ERR_LEN])
 {
     size_t n;
@@ -154,7 +154,9 @@ obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
     size_t n = fread(head, 1, 4, f);
     obs_status st = OBS_OK;
     size_t plen = strlen(path);
-    if (n == 4 && !memcmp(head, "ply", 3) && (head[3] == '\n' || head[3] == '\r')) {
+    /* assimp takes any file that starts "ply" (either case) for PLY when
+     * its extension's reader refuses it. */
+    if (n >= 3 && !strncasecmp((const char *)head, "ply", 3)) {
         st = ply_header(path, f, err);
     } else if ((n == 4 && obs__glb_u32(head) == OBS__GLB_MAGIC) ||
                (plen >= 5 && !strcasecmp(path + plen - 5, ".gltf"))) {

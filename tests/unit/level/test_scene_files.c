@@ -57,6 +57,17 @@ static void test_ply_without_end_header(void **state)
     level_fails(BAD "ply_no_end_header.ply", OBS_BAD_FILE, "without its end_header line");
     scene_fails(BAD "ply_no_end_header_ascii.ply", OBS_BAD_FILE, "without its end_header line");
     level_fails(BAD "ply_no_end_header_ascii.ply", OBS_BAD_FILE, "without its end_header line");
+    /* assimp reads any file that starts "ply" as PLY when its extension's
+     * reader refuses it (found as a .glb by fuzz_scene) */
+    char path[] = "/tmp/obs_plyglb_XXXXXX.glb";
+    int fd = mkstemps(path, 4);
+    assert_true(fd >= 0);
+    static const char ply[] = "plyF\nformat binary_little_endian 1.0\nelement vertex 3\n";
+    assert_int_equal(write(fd, ply, sizeof ply - 1), (ssize_t)(sizeof ply - 1));
+    close(fd);
+    scene_fails(path, OBS_BAD_FILE, "without its end_header line");
+    level_fails(path, OBS_BAD_FILE, "without its end_header line");
+    unlink(path);
 }
 
 /* A .glb whose node graph is a DAG of 40 levels, each node twice the
