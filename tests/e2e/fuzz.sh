@@ -1,7 +1,7 @@
 #!/bin/sh
 # Short, bounded libFuzzer runs of the binary protocol's decoders
-# (tests/fuzz/fuzz_binary.c), of the EXR readers, flat and deep
-# (tests/fuzz/fuzz_exr.c), and of the other files a user or a farm hands
+# (tests/fuzz/fuzz_binary.c), of the EXR readers, flat and deep, with
+# their object masks (tests/fuzz/fuzz_exr.c), and of the other files a user or a farm hands
 # obscura (tests/fuzz/fuzz_files.c: camera JSON, mask selectors, a .glb's
 # LODs, the dynamic model, bake and bake-dynamic parts, regions and
 # decorators files; its seeds replay the inputs that crashed it), on their
@@ -54,8 +54,9 @@ fuzz() {
     done
 }
 fuzz fuzz_binary "binary protocol decoders" tests/fuzz/corpus/binary
-mkdir -p "$T/exr_seeds" && cp tests/data/*.exr "$T/exr_seeds/"
-fuzz fuzz_exr "EXR readers (flat and deep)" tests/data/damaged "$T/exr_seeds"
+mkdir -p "$T/exr_seeds" && cp tests/data/*.exr tests/data/small/*.exr tests/data/crypto_sidecar/*.exr \
+    "$T/exr_seeds/"
+fuzz fuzz_exr "EXR readers (flat and deep) and their object masks" tests/data/damaged "$T/exr_seeds"
 fuzz fuzz_files "file parsers (camera, masks, LODs, dynamic model, parts, regions, decorators)" \
     tests/fuzz/corpus/files
 # The mesh and level loaders (tests/fuzz/fuzz_scene.c: assimp, then

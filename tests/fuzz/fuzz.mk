@@ -25,7 +25,7 @@ FUZZ_HDR := $(wildcard protocol/*.h include/obscura/*.h core/*.h core/*/*.h)
 # The EXR readers (flat and deep) against OpenEXR's C library.
 FUZZ_EXR_SRC := core/io/exr_read.c core/io/exr_deep.c core/io/exr_msg.c core/io/exr_parts.c core/io/exr_describe.c \
                 core/io/exr_info.c core/camera/exr.c core/io/presets.c core/camera/request.c core/status.c core/util.c core/image.c core/io/channel_map.c \
-                core/io/bytes.c core/params.c core/table.c core/pool.c core/io/crypto.c
+                core/io/bytes.c core/params.c core/table.c core/pool.c core/io/crypto.c core/mask.c
 FUZZ_EXR_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libcjson 2>/dev/null) -lz -lm -lpthread
 # The other files a user or a farm hands obscura (fuzz_files.c): camera
 # JSON, object-mask selectors (against an EXR: the EXR readers), a .glb's
@@ -35,7 +35,7 @@ FUZZ_EXR_LIBS := -lOpenEXRCore-3_1 $(shell pkg-config --libs libcjson 2>/dev/nul
 # dyn_shard.c are compiled for their part formats; their trace steps
 # (never called) are dropped at link time (--gc-sections; start-stop-gc
 # so that the coverage tables do not keep them).
-FUZZ_FILES_SRC := core/camera/json.c core/mask.c core/level/lod_file.c core/level/load.c core/ground/assimp_check.c core/io/glb_read.c \
+FUZZ_FILES_SRC := core/camera/json.c core/level/lod_file.c core/level/load.c core/ground/assimp_check.c core/io/glb_read.c \
                   core/dynamic/dyn_model.c core/dynamic/dyn_fit.c core/dynamic/dyn_regions.c core/level/decor.c \
                   core/level/part.c core/level/sh.c core/level/sweep.c \
                   core/bake/shard.c core/dynamic/dyn_shard.c core/bake/params.c core/dynamic/dyn_params.c \
