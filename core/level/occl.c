@@ -438,7 +438,9 @@ obs_status obs_bake_occluders_new(const obs_bake_scene *s, const obs_bake_params
         obs__bake_decor_free(&d);
         return obs__fail(err, OBS_NO_MEMORY, "occluders");
     }
-    if ((st = obs__bake_flatten(s, &o->w, err)) == OBS_OK)
+    /* the level is read with no limit (obs_bake_load's 0): the
+     * parameter bounds what its instances flatten to */
+    if ((st = obs__bake_flatten_checked(s, p.max_triangles, "occluders", &o->w, err)) == OBS_OK)
         st = obs__bake_occl_new(&o->w, &d, p.tree_attenuation, &o->occl, err);
     obs__bake_decor_free(&d);
     if (st != OBS_OK) {

@@ -513,7 +513,8 @@ obs_status obs_bake_decorators_check(const char *text, size_t *rules, char err[O
  * the opaque triangles, the shrubs' fog boxes and the trees'
  * semi-transparent triangles (section 2.1), from the decorators of s
  * (params: decorator_source, shrub_density, tree_attenuation;
- * decorators_json: the text of a decorators file or NULL).  *out is NULL
+ * max_triangles, OBS_TOO_LARGE past it once flattened; decorators_json:
+ * the text of a decorators file or NULL).  *out is NULL
  * when the level has no shrub, tree or small decorator: every surface is
  * then opaque, as the scene itself.  warning (may be NULL) receives the
  * classification's warning, "" when none.  Free with

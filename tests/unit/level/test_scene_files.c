@@ -150,6 +150,33 @@ static void test_mesh_under_no_node(void **state)
     obs_bake_scene_free(&b);
 }
 
+/* reference --obscurance reads the level with no limit (as the bake
+ * does before its own check) and flattened it for the occluders without
+ * one: a small file instancing a mesh many times asked for memory sized
+ * by the product.  max_triangles now bounds that flattening too. */
+static void test_occluders_bounded(void **state)
+{
+    (void)state;
+    obs_bake_scene b;
+    level_loads(TESTDATA "/levels/aalborg_cut.acc", &b);
+    size_t len = 0;
+    char *trees = (char *)obs_test_slurp(TESTDATA "/levels/aalborg_cut.trees.json", &len);
+    assert_non_null(trees);
+    obs_bake_params bp = {0};
+    bt_set(&bp, "max-triangles", "100");
+    obs_bake_occluders *o = NULL;
+    char warning[OBS_ERR_LEN], err[OBS_ERR_LEN] = "";
+    assert_int_equal(obs_bake_occluders_new(&b, &bp, trees, &o, warning, err), OBS_TOO_LARGE);
+    assert_non_null(strstr(err, "811 triangles once flattened; max_triangles is 100"));
+    assert_null(o);
+    bt_set(&bp, "max-triangles", "811");
+    assert_int_equal(obs_bake_occluders_new(&b, &bp, trees, &o, warning, err), OBS_OK);
+    assert_non_null(o);
+    obs_bake_occluders_free(o);
+    free(trees);
+    obs_bake_scene_free(&b);
+}
+
 /* Each mesh's vertices at one point: FindInvalidData drops them all;
  * said so, rather than assimp's bare "No meshes remaining". */
 static void test_all_at_one_point(void **state)
@@ -253,7 +280,7 @@ int main(void)
         cmocka_unit_test(test_node_dag),             cmocka_unit_test(test_node_index_not_integer),
         cmocka_unit_test(test_nan_vertex),
         cmocka_unit_test(test_transform_overflow),   cmocka_unit_test(test_mesh_under_no_node),
-        cmocka_unit_test(test_all_at_one_point),     cmocka_unit_test(test_huge_declared_count),
+        cmocka_unit_test(test_occluders_bounded),    cmocka_unit_test(test_all_at_one_point),     cmocka_unit_test(test_huge_declared_count),
         cmocka_unit_test(test_valid_seeds_load),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
