@@ -1,6 +1,7 @@
 /* What obscura checks around assimp (assimp_read.h): a file before it is
  * handed over, assimp's failure as a status and message.  C, so that
  * core/level/load.c, which reads through assimp's C API, needs no C++. */
+#include <assimp/scene.h>
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <stdio.h>
@@ -168,4 +169,16 @@ obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
     }
     fclose(f);
     return st;
+}
+
+obs_status obs__assimp_faces(const char *path, const struct aiScene *sc, char err[OBS_ERR_LEN])
+{
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[i];
+        for (unsigned f = 0; f < m->mNumFaces; f++)
+            if (m->mFaces[f].mNumIndices == 0)
+                return obs__fail(err, OBS_BAD_FILE, "%s: mesh %u '%s': face %u has no vertices",
+                                 path, i, m->mName.data, f);
+    }
+    return OBS_OK;
 }

@@ -34,6 +34,11 @@ void obs__assimp_free(obs__assimp *a);
  * OBS_IO). */
 obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN]);
 
+/* Every face of the validated scene with at least one vertex (assimp
+ * 5.2's Triangulate aborts on one without: ValidateDataStructure lets it
+ * through). */
+obs_status obs__assimp_faces(const char *path, const struct aiScene *sc, char err[OBS_ERR_LEN]);
+
 /* The failure of assimp on path as a status and message: OBS_TOO_LARGE
  * when assimp ran out of memory (an allocation sized by a count in the
  * file), else OBS_BAD_FILE; `what` names what was expected ("a mesh", "a

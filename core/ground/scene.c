@@ -348,6 +348,8 @@ static obs_status import(const char *path, obs__assimp **imp, const struct aiSce
     if (!(*imp = obs__assimp_read(path, 1, msg)))
         return obs__assimp_fail(path, "a mesh", msg, err);
     st = meshes_placed(path, obs__assimp_scene(*imp), err);
+    if (st == OBS_OK)
+        st = obs__assimp_faces(path, obs__assimp_scene(*imp), err);
     if (st == OBS_OK && !obs__assimp_apply(*imp, place, msg))
         st = obs__assimp_fail(path, "a mesh", msg, err);
     if (st == OBS_OK)

@@ -393,14 +393,21 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
     if (pre != OBS_OK)
         return pre;
     /* No joining, no pre-transform: the soup, the graph and the mesh
-     * order stay the file's.  ValidateDataStructure refuses what an
-     * importer left inconsistent (a face without indices, a mesh index
-     * out of range) before assimp's own preprocessing reads it. */
-    const struct aiScene *sc =
-        aiImportFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate);
-    if (!sc)
-        return obs__assimp_fail(path, "a level", aiGetErrorString(), err);
-    obs_status st = OBS_OK;
+     * order stay the file's.  Read and validated first (an importer's
+     * inconsistent output refused before assimp's own preprocessing
+     * reads it), the faces checked, then triangulated (assimp_read.h). */
+    char msg[OBS_ERR_LEN] = "";
+    obs__assimp *imp = obs__assimp_read(path, 0, msg);
+    if (!imp)
+        return obs__assimp_fail(path, "a level", msg, err);
+    const struct aiScene *sc = obs__assimp_scene(imp);
+    obs_status st = obs__assimp_faces(path, sc, err);
+    if (st == OBS_OK && !(sc = obs__assimp_apply(imp, aiProcess_Triangulate, msg)))
+        st = obs__assimp_fail(path, "a level", msg, err);
+    if (st != OBS_OK) {
+        obs__assimp_free(imp);
+        return st;
+    }
     if (!sc->mRootNode || sc->mNumMeshes == 0) {
         st = obs__fail(err, OBS_BAD_FILE, "%s: no triangles (no meshes)", path);
         goto fail;
@@ -414,7 +421,7 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
     }
     if (has_suffix(path, ".ac") || has_suffix(path, ".acc"))
         ac3d_two_sided(path, out);
-    aiReleaseImport(sc);
+    obs__assimp_free(imp);
     /* The file's own LODs (lod_file.c); a reason they cannot be read is
      * kept for the bake to name if it is asked for LODs. */
     char lerr[OBS_ERR_LEN] = "";
@@ -424,7 +431,7 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
     }
     return OBS_OK;
 fail:
-    aiReleaseImport(sc);
+    obs__assimp_free(imp);
     obs_bake_scene_free(out);
     return st;
 }

@@ -54,6 +54,16 @@ static void test_face_without_indices(void **state)
     level_fails(BAD "face_without_indices.off", OBS_BAD_FILE, "mIndices is nullptr");
 }
 
+/* A binary PLY whose faces list no vertices: ValidateDataStructure lets
+ * them through, assimp's Triangulate then aborts (an assertion in
+ * Debian's build).  Checked between the read and the steps. */
+static void test_face_no_vertices(void **state)
+{
+    (void)state;
+    scene_fails(BAD "face_no_vertices.ply", OBS_BAD_FILE, "face 0 has no vertices");
+    level_fails(BAD "face_no_vertices.ply", OBS_BAD_FILE, "face 0 has no vertices");
+}
+
 /* A PLY header without its end_header line: assimp's PLY reader read
  * past its buffer (binary: SEGV) or never returned (ASCII).  Refused
  * before assimp sees it. */
@@ -276,7 +286,8 @@ static void test_valid_seeds_load(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_face_without_indices), cmocka_unit_test(test_ply_without_end_header),
+        cmocka_unit_test(test_face_without_indices), cmocka_unit_test(test_face_no_vertices),
+        cmocka_unit_test(test_ply_without_end_header),
         cmocka_unit_test(test_node_dag),             cmocka_unit_test(test_node_index_not_integer),
         cmocka_unit_test(test_nan_vertex),
         cmocka_unit_test(test_transform_overflow),   cmocka_unit_test(test_mesh_under_no_node),
