@@ -124,12 +124,26 @@ static obs_status gltf_json(const char *path, FILE *f, int glb, size_t size,
 {
     size_t off = 0, len = size;
     if (glb) {
-        unsigned char h[16];
+        /* assimp 5.2 allocates a chunk's length before it compares it
+         * with the file (4 GiB asked by a damaged 1 KiB file) */
+        unsigned char h[24];
         if (fread(h, 1, 16, f) != 16)
             return OBS_OK;
+        size_t total = obs__glb_u32(h + 4);
         len = obs__glb_u32(h + 8);
         off = 20;
-        if (obs__glb_u32(h + 12) != OBS__GLB_CHUNK_JSON || len > size - 20)
+        if (total > size || len > size - 20)
+            return obs__fail(err, OBS_BAD_FILE, "%s: glTF binary of %zu bytes whose header says "
+                                                "%zu and its JSON chunk %zu (truncated or "
+                                                "damaged)",
+                             path, size, total, len);
+        size_t at = 20 + ((len + 3) & ~(size_t)3);
+        if (at + 8 <= size && fseek(f, (long)at, SEEK_SET) == 0 && fread(h + 16, 1, 8, f) == 8 &&
+            obs__glb_u32(h + 16) > size - at - 8)
+            return obs__fail(err, OBS_BAD_FILE, "%s: glTF binary chunk of %u bytes past the end "
+                                                "of the file (%zu bytes)",
+                             path, (unsigned)obs__glb_u32(h + 16), size);
+        if (obs__glb_u32(h + 12) != OBS__GLB_CHUNK_JSON)
             return OBS_OK;
     }
     char *txt = malloc(len ? len : 1);

@@ -64,6 +64,16 @@ static void test_face_no_vertices(void **state)
     level_fails(BAD "face_no_vertices.ply", OBS_BAD_FILE, "face 0 has no vertices");
 }
 
+/* A .glb of 1 KiB whose JSON chunk claims 4 GiB: assimp's glTF reader
+ * allocated the claimed length first (out of memory under the fuzzer's
+ * limit).  Its chunks are now checked against the file before. */
+static void test_glb_chunk_past_end(void **state)
+{
+    (void)state;
+    scene_fails(BAD "glb_json_past_end.glb", OBS_BAD_FILE, "its JSON chunk 4294902660");
+    level_fails(BAD "glb_json_past_end.glb", OBS_BAD_FILE, "(truncated or damaged)");
+}
+
 /* A PLY header without its end_header line: assimp's PLY reader read
  * past its buffer (binary: SEGV) or never returned (ASCII).  Refused
  * before assimp sees it. */
@@ -287,7 +297,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_face_without_indices), cmocka_unit_test(test_face_no_vertices),
-        cmocka_unit_test(test_ply_without_end_header),
+        cmocka_unit_test(test_ply_without_end_header), cmocka_unit_test(test_glb_chunk_past_end),
         cmocka_unit_test(test_node_dag),             cmocka_unit_test(test_node_index_not_integer),
         cmocka_unit_test(test_nan_vertex),
         cmocka_unit_test(test_transform_overflow),   cmocka_unit_test(test_mesh_under_no_node),
