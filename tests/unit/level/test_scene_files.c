@@ -182,6 +182,7 @@ static void test_occluders_bounded(void **state)
     size_t len = 0;
     char *trees = (char *)obs_test_slurp(TESTDATA "/levels/aalborg_cut.trees.json", &len);
     assert_non_null(trees);
+    trees[len] = '\0'; /* obs_test_slurp leaves room for it */
     obs_bake_params bp = {0};
     bt_set(&bp, "max-triangles", "100");
     obs_bake_occluders *o = NULL;
