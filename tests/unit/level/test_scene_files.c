@@ -37,6 +37,13 @@ static void level_fails(const char *file, obs_status want, const char *words)
     assert_null(b.nodes);
 }
 
+/* Both loaders refuse file as OBS_BAD_FILE, with words in the message. */
+static void both_fail(const char *file, const char *words)
+{
+    scene_fails(file, OBS_BAD_FILE, words);
+    level_fails(file, OBS_BAD_FILE, words);
+}
+
 static void level_loads(const char *file, obs_bake_scene *b)
 {
     char err[OBS_ERR_LEN] = "";
@@ -50,8 +57,7 @@ static void level_loads(const char *file, obs_bake_scene *b)
 static void test_face_without_indices(void **state)
 {
     (void)state;
-    scene_fails(BAD "face_without_indices.off", OBS_BAD_FILE, "mIndices is nullptr");
-    level_fails(BAD "face_without_indices.off", OBS_BAD_FILE, "mIndices is nullptr");
+    both_fail(BAD "face_without_indices.off", "mIndices is nullptr");
 }
 
 /* A binary PLY whose faces list no vertices: ValidateDataStructure lets
@@ -60,8 +66,7 @@ static void test_face_without_indices(void **state)
 static void test_face_no_vertices(void **state)
 {
     (void)state;
-    scene_fails(BAD "face_no_vertices.ply", OBS_BAD_FILE, "face 0 has no vertices");
-    level_fails(BAD "face_no_vertices.ply", OBS_BAD_FILE, "face 0 has no vertices");
+    both_fail(BAD "face_no_vertices.ply", "face 0 has no vertices");
 }
 
 /* A .glb of 1 KiB whose JSON chunk claims 4 GiB: assimp's glTF reader
@@ -80,10 +85,8 @@ static void test_glb_chunk_past_end(void **state)
 static void test_ply_without_end_header(void **state)
 {
     (void)state;
-    scene_fails(BAD "ply_no_end_header.ply", OBS_BAD_FILE, "without its end_header line");
-    level_fails(BAD "ply_no_end_header.ply", OBS_BAD_FILE, "without its end_header line");
-    scene_fails(BAD "ply_no_end_header_ascii.ply", OBS_BAD_FILE, "without its end_header line");
-    level_fails(BAD "ply_no_end_header_ascii.ply", OBS_BAD_FILE, "without its end_header line");
+    both_fail(BAD "ply_no_end_header.ply", "without its end_header line");
+    both_fail(BAD "ply_no_end_header_ascii.ply", "without its end_header line");
     /* assimp reads any file that starts "ply" as PLY when its extension's
      * reader refuses it (found as a .glb by fuzz_scene) */
     char path[] = "/tmp/obs_plyglb_XXXXXX.glb";
@@ -92,8 +95,7 @@ static void test_ply_without_end_header(void **state)
     static const char ply[] = "plyF\nformat binary_little_endian 1.0\nelement vertex 3\n";
     assert_int_equal(write(fd, ply, sizeof ply - 1), (ssize_t)(sizeof ply - 1));
     close(fd);
-    scene_fails(path, OBS_BAD_FILE, "without its end_header line");
-    level_fails(path, OBS_BAD_FILE, "without its end_header line");
+    both_fail(path, "without its end_header line");
     unlink(path);
 }
 
@@ -109,8 +111,7 @@ static void test_node_dag(void **state)
     char err[OBS_ERR_LEN] = "";
     assert_int_equal(obs_scene_load_baked(f, &s, err), OBS_BAD_FILE);
     assert_non_null(strstr(err, "node 40 is reached twice"));
-    scene_fails(f, OBS_BAD_FILE, "glTF node 1 is the child of more than one node");
-    level_fails(f, OBS_BAD_FILE, "glTF node 1 is the child of more than one node");
+    both_fail(f, "glTF node 1 is the child of more than one node");
 }
 
 /* A child index of 1e300: converted to long, undefined behaviour
@@ -131,8 +132,7 @@ static void test_nan_vertex(void **state)
 {
     (void)state;
     scene_fails(BAD "nan_vertex.obj", OBS_BAD_FILE, "vertex 1 is (nan, 0, 0)");
-    scene_fails(BAD "nan_second_mesh.obj", OBS_BAD_FILE, "mesh 1 'bad': vertex 0");
-    level_fails(BAD "nan_second_mesh.obj", OBS_BAD_FILE, "mesh 1 'bad': vertex 0");
+    both_fail(BAD "nan_second_mesh.obj", "mesh 1 'bad': vertex 0");
 }
 
 /* Node transforms whose product overflows (scale 1e30 under 1e30): the
