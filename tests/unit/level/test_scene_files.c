@@ -44,6 +44,17 @@ static void both_fail(const char *file, const char *words)
     level_fails(file, OBS_BAD_FILE, words);
 }
 
+/* text in a new file named from path (a mkstemps template whose last 4
+ * characters are the extension), path filled in. */
+static void temp_file(char *path, const char *text)
+{
+    int fd = mkstemps(path, 4);
+    assert_true(fd >= 0);
+    size_t n = strlen(text);
+    assert_int_equal(write(fd, text, n), (ssize_t)n);
+    close(fd);
+}
+
 static void level_loads(const char *file, obs_bake_scene *b)
 {
     char err[OBS_ERR_LEN] = "";
@@ -90,11 +101,7 @@ static void test_ply_without_end_header(void **state)
     /* assimp reads any file that starts "ply" as PLY when its extension's
      * reader refuses it (found as a .glb by fuzz_scene) */
     char path[] = "/tmp/obs_plyglb_XXXXXX.glb";
-    int fd = mkstemps(path, 4);
-    assert_true(fd >= 0);
-    static const char ply[] = "plyF\nformat binary_little_endian 1.0\nelement vertex 3\n";
-    assert_int_equal(write(fd, ply, sizeof ply - 1), (ssize_t)(sizeof ply - 1));
-    close(fd);
+    temp_file(path, "plyF\nformat binary_little_endian 1.0\nelement vertex 3\n");
     both_fail(path, "without its end_header line");
     unlink(path);
 }
@@ -204,11 +211,7 @@ static void test_all_at_one_point(void **state)
 {
     (void)state;
     char path[] = "/tmp/obs_onepoint_XXXXXX.obj";
-    int fd = mkstemps(path, 4);
-    assert_true(fd >= 0);
-    static const char obj[] = "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n";
-    assert_int_equal(write(fd, obj, sizeof obj - 1), (ssize_t)(sizeof obj - 1));
-    close(fd);
+    temp_file(path, "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n");
     scene_fails(path, OBS_BAD_FILE, "vertices all at one point");
     unlink(path);
 }
