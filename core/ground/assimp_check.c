@@ -1,6 +1,7 @@
-/* What obscura checks around assimp (assimp_read.h): a file before it is
- * handed over, assimp's failure as a status and message.  C, so that
- * core/level/load.c, which reads through assimp's C API, needs no C++. */
+/* What obscura checks around assimp (assimp_read.h), for both loaders
+ * (ground/scene.c, level/load.c): a file before it is handed over, the
+ * validated scene's faces, assimp's failure as a status and message.  In
+ * C: only the importer itself (assimp_read.cpp) is C++. */
 #include <assimp/scene.h>
 #include <cjson/cJSON.h>
 #include <errno.h>
@@ -63,61 +64,8 @@ static obs_status ply_header(const char *path, FILE *f, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
-static const cJSON *item(const cJSON *o, const char *name)
-{
-    return cJSON_GetObjectItemCaseSensitive(o, name);
-}
-
-/* glTF's node graph a forest, as the specification asks: no node the
- * child of two nodes (or twice of one), no scene root a child.  assimp
- * 5.2's glTF importer copies a node once per path to it (a DAG of 40
- * levels asks for 2^40 nodes) and recurses around a cycle without end.
- * Child indices out of range are assimp's to refuse. */
-static obs_status gltf_forest(const char *path, const cJSON *doc, char err[OBS_ERR_LEN])
-{
-    const cJSON *nodes = item(doc, "nodes"), *nd, *c, *sc;
-    int n = cJSON_GetArraySize(nodes);
-    if (n <= 0)
-        return OBS_OK;
-    unsigned char *parent = calloc((size_t)n, 1);
-    if (!parent)
-        return obs__fail(err, OBS_NO_MEMORY, "%s: %d nodes", path, n);
-    obs_status st = OBS_OK;
-    cJSON_ArrayForEach(nd, nodes)
-    {
-        cJSON_ArrayForEach(c, item(nd, "children"))
-        {
-            long k = obs__glb_index_value(c);
-            if (k < 0 || k >= n)
-                continue;
-            if (parent[k]++) {
-                st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is the child of more than "
-                                                  "one node (the node graph must be a forest)",
-                               path, k);
-                goto done;
-            }
-        }
-    }
-    cJSON_ArrayForEach(sc, item(doc, "scenes"))
-    {
-        cJSON_ArrayForEach(c, item(sc, "nodes"))
-        {
-            long k = obs__glb_index_value(c);
-            if (k >= 0 && k < n && parent[k]) {
-                st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is a scene's root and a "
-                                                  "child (a cycle?)",
-                               path, k);
-                goto done;
-            }
-        }
-    }
-done:
-    free(parent);
-    return st;
-}
-
 /* The JSON of a .glb (f after its first 4 bytes) or a .gltf (whole), of
- * size bytes, checked by gltf_forest; what does not parse is assimp's to
+ * size bytes, checked by obs__glb_forest; what does not parse is assimp's to
  * refuse. */
 static obs_status gltf_json(const char *path, FILE *f, int glb, size_t size,
                             char err[OBS_ERR_LEN])
@@ -153,7 +101,7 @@ static obs_status gltf_json(const char *path, FILE *f, int glb, size_t size,
     if (fseek(f, (long)off, SEEK_SET) == 0 && fread(txt, 1, len, f) == len) {
         cJSON *doc = cJSON_ParseWithLength(txt, len);
         if (doc)
-            st = gltf_forest(path, doc, err);
+            st = obs__glb_forest(path, doc, err);
         cJSON_Delete(doc);
     }
     free(txt);

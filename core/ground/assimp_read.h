@@ -1,5 +1,5 @@
-/* assimp's importer through its C++ API (assimp_read.cpp), for
- * scene.c: read with validation only, then post-processing steps
+/* assimp's importer through its C++ API (assimp_read.cpp), for both
+ * loaders (ground/scene.c, level/load.c): read with validation only, then post-processing steps
  * applied in calls of their own, so that the scene can be checked in
  * between.  assimp 5.2's C aiApplyPostProcessing releases a scene that a
  * failing step has already deleted (a crash); Importer::ApplyPostProcessing
@@ -30,8 +30,9 @@ const struct aiScene *obs__assimp_apply(obs__assimp *a, unsigned steps, char msg
 void obs__assimp_free(obs__assimp *a);
 
 /* What path must be before assimp reads it (assimp_check.c): a PLY
- * header ends with end_header.  OBS_OK, or the error (OBS_BAD_FILE,
- * OBS_IO). */
+ * header ends with end_header; a .glb's chunks lie within the file; a
+ * glTF's node graph is a forest (obs__glb_forest).  OBS_OK, or the error
+ * (OBS_BAD_FILE, OBS_IO, OBS_NO_MEMORY). */
 obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN]);
 
 /* Every face of the validated scene with at least one vertex (assimp

@@ -147,11 +147,6 @@ typedef struct build {
     int dynamic;
     const char *pattern;
     size_t marked;
-    /* the nodes reached so far in this walk (glTF's node graph is a
-     * forest: a node reached twice, through a DAG or a cycle, is refused,
-     * as a walk that followed every path would take exponential time) */
-    unsigned char *seen;
-    size_t node_count;
 } build;
 
 static obs_status primitive(build *b, const cJSON *prim, const char *mname, const char *nname,
@@ -292,13 +287,6 @@ static obs_status walk(build *b, long n, const float parent[16], int depth, int 
     if (depth > MAX_DEPTH)
         return obs__fail(err, OBS_BAD_FILE, "%s: the node graph is deeper than %d (a cycle?)",
                          b->g->path, MAX_DEPTH);
-    if ((size_t)n < b->node_count) {
-        if (b->seen[n])
-            return obs__fail(err, OBS_BAD_FILE, "%s: node %ld is reached twice from the scene's "
-                                                "roots (glTF's node graph is a forest)",
-                             b->g->path, n);
-        b->seen[n] = 1;
-    }
     float local[16], world[16];
     local_matrix(node, local);
     obs__mat4_mul(parent, local, world);
@@ -332,15 +320,12 @@ static obs_status walk_scene(build *b, char err[OBS_ERR_LEN])
     const cJSON *sc = cJSON_GetArrayItem(item(b->g->doc, "scenes"), (int)(si < 0 ? 0 : si)), *r;
     float id[16];
     obs__mat4_identity(id);
-    b->node_count = (size_t)cJSON_GetArraySize(item(b->g->doc, "nodes"));
-    if (!(b->seen = calloc(b->node_count ? b->node_count : 1, 1)))
-        return obs__fail(err, OBS_NO_MEMORY, "%s: %zu nodes", b->g->path, b->node_count);
-    obs_status st = OBS_OK;
+    /* a forest, so that the walk visits each node once (a DAG's paths
+     * are exponential in its depth) */
+    obs_status st = obs__glb_forest(b->g->path, b->g->doc, err);
     cJSON_ArrayForEach(r, item(sc, "nodes"))
-        if ((st = walk(b, obs__glb_index_value(r), id, 0, 0, err)) != OBS_OK)
-            break;
-    free(b->seen);
-    b->seen = NULL;
+        if (st == OBS_OK)
+            st = walk(b, obs__glb_index_value(r), id, 0, 0, err);
     return st;
 }
 

@@ -122,3 +122,52 @@ uint32_t obs__glb_index(const obs__glb_acc *a, size_t i)
         return (uint32_t)p[0] | (uint32_t)p[1] << 8;
     return obs__glb_u32(p);
 }
+
+/* glTF's node graph a forest, as the specification asks: no node the
+ * child of two nodes (or twice of one), no scene root a child.  assimp
+ * 5.2's glTF importer copies a node once per path to it (a DAG of 40
+ * levels asks for 2^40 nodes) and recurses around a cycle without end,
+ * and a walk of the graph (baked.c) would visit every path.
+ * Child indices out of range are the reader's to refuse. */
+obs_status obs__glb_forest(const char *path, const cJSON *doc, char err[OBS_ERR_LEN])
+{
+    const cJSON *nodes = item(doc, "nodes"), *nd, *c, *sc;
+    int n = cJSON_GetArraySize(nodes);
+    if (n <= 0)
+        return OBS_OK;
+    unsigned char *parent = calloc((size_t)n, 1);
+    if (!parent)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %d nodes", path, n);
+    obs_status st = OBS_OK;
+    cJSON_ArrayForEach(nd, nodes)
+    {
+        cJSON_ArrayForEach(c, item(nd, "children"))
+        {
+            long k = obs__glb_index_value(c);
+            if (k < 0 || k >= n)
+                continue;
+            if (parent[k]++) {
+                st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is the child of more than "
+                                                  "one node (the node graph must be a forest)",
+                               path, k);
+                goto done;
+            }
+        }
+    }
+    cJSON_ArrayForEach(sc, item(doc, "scenes"))
+    {
+        cJSON_ArrayForEach(c, item(sc, "nodes"))
+        {
+            long k = obs__glb_index_value(c);
+            if (k >= 0 && k < n && parent[k]) {
+                st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is a scene's root and a "
+                                                  "child (a cycle?)",
+                               path, k);
+                goto done;
+            }
+        }
+    }
+done:
+    free(parent);
+    return st;
+}
