@@ -377,10 +377,12 @@ static obs_status ac_objects(const char *path, const char *buf, size_t size,
             } else if (ac_is(&w, "kids")) {
                 long long n = ac_count(&w, "kids");
                 /* each child is at least a line "OBJECT" */
-                if (n < 0 || (unsigned long long)n > (size_t)(w.end - w.p) / 7)
-                    return AC_FAIL("%s: line %lu: kids %s: more children than the %zu bytes "
-                                   "after it could hold (AC3D)", path, w.no,
-                                   n < 0 ? "without a count" : "says", (size_t)(w.end - w.p));
+                if (n < 0)
+                    return AC_FAIL("%s: line %lu: kids without its count (AC3D)", path, w.no);
+                if ((unsigned long long)n > (size_t)(w.end - w.p) / 7)
+                    return AC_FAIL("%s: line %lu: kids %lld: more children than the %zu bytes "
+                                   "after it could hold (AC3D)", path, w.no, n,
+                                   (size_t)(w.end - w.p));
                 kids = 1;
                 more = ac_next(&w);
                 if (n > 0 && more && !ac_is(&w, "OBJECT"))
@@ -411,6 +413,87 @@ static obs_status ac3d_structure(const char *path, FILE *f, size_t size, char er
                         : obs__fail(err, OBS_IO, "%s: cannot read it", path);
     free(buf);
     return st;
+}
+
+/* ---- OFF: the counts in its header against the file's size ---------------
+ * An OFF file starts with an optional keyword ([ST][C][N][4][n]OFF, 'n'
+ * followed by the dimension), then the vertex, face and edge counts, then
+ * the vertices and the faces, each at least a number and a separator.
+ * assimp 5.2's OFF reader allocates what the counts say before it reads
+ * anything (45 GB asked by a damaged file of 258 bytes). */
+
+/* Past blanks, line ends and '#' comments from buf[*at] (size bytes). */
+static void off_skip(const char *buf, size_t size, size_t *at)
+{
+    size_t i = *at;
+    for (;;) {
+        while (i < size && (buf[i] == ' ' || buf[i] == '\t' || buf[i] == '\r' || buf[i] == '\n'))
+            i++;
+        if (i >= size || buf[i] != '#')
+            break;
+        while (i < size && buf[i] != '\n')
+            i++;
+    }
+    *at = i;
+}
+
+/* The decimal digits at buf[*at] as assimp reads a count (0 when there are
+ * none), *at moved past them; -1 past 2^32 - 1. */
+static long long off_uint(const char *buf, size_t size, size_t *at)
+{
+    unsigned long long v = 0;
+    int over = 0;
+    for (; *at < size && buf[*at] >= '0' && buf[*at] <= '9'; ++*at)
+        if (!over && (v = v * 10 + (unsigned)(buf[*at] - '0')) > 0xffffffffull)
+            over = 1;
+    return over ? -1 : (long long)v;
+}
+
+/* The header read as assimp 5.2 reads it: the keyword's letters one by
+ * one (they may run into the counts), then the counts. */
+static obs_status off_counts(const char *path, FILE *f, char err[OBS_ERR_LEN])
+{
+    long end = -1;
+    if (fseek(f, 0, SEEK_END) == 0)
+        end = ftell(f);
+    if (end < 0 || fseek(f, 0, SEEK_SET) != 0)
+        return OBS_OK; /* assimp's to refuse */
+    char buf[4096];
+    size_t size = fread(buf, 1, sizeof buf, f), at = 0;
+    off_skip(buf, size, &at);
+    if (at + 2 <= size && buf[at] == 'S' && buf[at + 1] == 'T')
+        at += 2;
+    at += at < size && buf[at] == 'C';
+    at += at < size && buf[at] == 'N';
+    at += at < size && buf[at] == '4';
+    int dim = at < size && buf[at] == 'n';
+    at += dim;
+    if (at + 3 <= size && memcmp(buf + at, "OFF", 3) == 0) {
+        at += 3;
+        off_skip(buf, size, &at);
+        if (dim) {
+            (void)off_uint(buf, size, &at);
+            off_skip(buf, size, &at);
+        }
+    }
+    off_skip(buf, size, &at);
+    long long nv = off_uint(buf, size, &at);
+    off_skip(buf, size, &at);
+    long long nf = off_uint(buf, size, &at);
+    off_skip(buf, size, &at);
+    (void)off_uint(buf, size, &at); /* the edge count */
+    if (at == size && size == sizeof buf)
+        return obs__fail(err, OBS_BAD_FILE, "%s: an OFF header longer than %zu bytes", path,
+                         sizeof buf);
+    unsigned long long rest = (unsigned long long)end - at;
+    if (nv < 0 || nf < 0)
+        return obs__fail(err, OBS_BAD_FILE, "%s: an OFF header count past 2^32 - 1", path);
+    if ((unsigned long long)nv + (unsigned long long)nf > rest / 2)
+        return obs__fail(err, OBS_BAD_FILE, "%s: OFF header of %lld vertices and %lld faces, "
+                                            "more than the %llu bytes after it hold (each is "
+                                            "at least a number and a separator)",
+                         path, nv, nf, rest);
+    return OBS_OK;
 }
 
 obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
@@ -445,6 +528,8 @@ obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
             size = ftell(f);
         if (size >= 0)
             st = ac3d_structure(path, f, (size_t)size, err);
+    } else if (ext && !strcasecmp(ext, ".off")) {
+        st = off_counts(path, f, err);
     }
     fclose(f);
     return st;

@@ -44,11 +44,11 @@ static void both_fail(const char *file, const char *words)
     level_fails(file, OBS_BAD_FILE, words);
 }
 
-/* text in a new file named from path (a mkstemps template whose last 4
- * characters are the extension), path filled in. */
+/* text in a new file named from path (a mkstemps template ending in XXXXXX
+ * and the extension), path filled in. */
 static void temp_file(char *path, const char *text)
 {
-    int fd = mkstemps(path, 4);
+    int fd = mkstemps(path, (int)strlen(strrchr(path, '.')));
     assert_true(fd >= 0);
     size_t n = strlen(text);
     assert_int_equal(write(fd, text, n), (ssize_t)n);
@@ -259,6 +259,75 @@ static void test_huge_declared_count(void **state)
 #endif
 }
 
+/* An AC3D triangle strip (SURF type 4) of no references among polygons:
+ * assimp 5.2's AC3D reader counts it as -2 faces and reads its empty list
+ * from entry 0 on (SEGV, fuzz_scene).  The structure is walked first. */
+static void test_ac3d_strip_without_refs(void **state)
+{
+    (void)state;
+    both_fail(BAD "strip_no_refs.ac", "a triangle strip of 0 vertex references");
+}
+
+/* Counts an AC3D file does not hold: each walked before assimp reserves
+ * what they say or reads the next lines as more of the same. */
+static void test_ac3d_counts(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *text, *words;
+    } bad[] = {
+        {"AC3Db\nOBJECT poly\nnumvert 4\n0 0 0\n1 0 0\n0 1 0\nkids 0\n", "line 7 is not a vertex"},
+        {"AC3Db\nOBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 2\nSURF 0x0\nmat 0\n"
+         "refs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", "surface 1 does not start with SURF"},
+        {"AC3Db\nOBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 1\nSURF 0x0\nmat 0\n"
+         "refs 3\n0 0 0\n1 0 0\n3 0 0\nkids 0\n", "refers to vertex 3 of an object of 3"},
+        {"AC3Db\nOBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 1\nSURF 0x0\nmat 1\n"
+         "refs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", "material 1 of the file's 0"},
+        {"AC3Db\nOBJECT world\nkids 4000000000\nOBJECT poly\nkids 0\n", "more children than"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        char path[] = "/tmp/obs_ac3d_XXXXXX.acc";
+        temp_file(path, bad[i].text);
+        both_fail(path, bad[i].words);
+        unlink(path);
+    }
+}
+
+/* A file named .glb that is no glTF binary (its first bytes name an
+ * OpenGEX structure): assimp's two glTF readers refuse it, assimp then
+ * offers it to its every reader by content, and its OpenGEX reader read
+ * past its buffer (ASan) or never returned.  A .glb must start "glTF", a
+ * .gltf be glTF 2.0 JSON. */
+static void test_gltf_not_gltf(void **state)
+{
+    (void)state;
+    both_fail(BAD "not_glb_opengex.glb", "a .glb starts with the magic");
+    static const struct {
+        const char *text, *words;
+    } bad[] = {
+        {"{\"asset\": {\"version\": \"2.0\"}} Metric IndexArray", "text after its JSON value"},
+        {"{\"asset\": {\"version\": \"1.0\"}, \"IndexArray\": 1}", "\"version\" 2.x"},
+        {"{\"scenes\": [], \"IndexArray\": {}}", "no \"asset\" object"},
+        {"Metric {float {1.0}} IndexArray {}", "is not JSON"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        char path[] = "/tmp/obs_gltf_XXXXXX.gltf";
+        temp_file(path, bad[i].text);
+        both_fail(path, bad[i].words);
+        unlink(path);
+    }
+}
+
+/* OFF header counts past 32 bits, or past what the file could hold:
+ * assimp 5.2 allocates what they say before reading (45 GB asked by a
+ * 258-byte file, fuzz_scene under ASan). */
+static void test_off_counts(void **state)
+{
+    (void)state;
+    both_fail(BAD "off_count_past_32_bits.off", "count past 2^32 - 1");
+    both_fail(BAD "off_counts_past_file.off", "more than the 27 bytes after it hold");
+}
+
 /* The fuzz_scene seeds that are whole files: each loads in both loaders
  * and flattens (a seed that stopped loading would fuzz only the errors). */
 static void test_valid_seeds_load(void **state)
@@ -306,6 +375,8 @@ int main(void)
         cmocka_unit_test(test_nan_vertex),
         cmocka_unit_test(test_transform_overflow),   cmocka_unit_test(test_mesh_under_no_node),
         cmocka_unit_test(test_occluders_bounded),    cmocka_unit_test(test_all_at_one_point),     cmocka_unit_test(test_huge_declared_count),
+        cmocka_unit_test(test_ac3d_strip_without_refs), cmocka_unit_test(test_ac3d_counts),
+        cmocka_unit_test(test_gltf_not_gltf),          cmocka_unit_test(test_off_counts),
         cmocka_unit_test(test_valid_seeds_load),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
