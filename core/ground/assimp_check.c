@@ -29,6 +29,14 @@ obs_status obs__assimp_fail(const char *path, const char *what, const char *msg,
     return OBS_BAD_FILE;
 }
 
+/* How deep a file's hierarchy (glTF nodes, AC3D objects) may be.  assimp
+ * 5.2 reads, converts and post-processes the node tree recursively on the
+ * caller's stack: with 8 MiB of stack it crashed (SEGV) between 5000 and
+ * 8000 nested AC3D objects and between 8000 and 20000 nested glTF nodes.
+ * A quarter of the smallest leaves room for smaller thread stacks; real
+ * scenes nest a few levels. */
+#define HIERARCHY_MAX 1024
+
 /* How much of a PLY file is searched for the end of its header. */
 #define PLY_HEADER_MAX ((size_t)1 << 20)
 
@@ -121,6 +129,51 @@ static obs_status glb_header(const char *path, const unsigned char *head, size_t
     return OBS_OK;
 }
 
+/* The depth of a glTF document's node tree (nodes' "children"), walked
+ * up from each node with the depths found so far kept: at most
+ * HIERARCHY_MAX levels (a cycle never ends, so it is refused too). */
+static obs_status gltf_depth(const char *path, const cJSON *doc, char err[OBS_ERR_LEN])
+{
+    const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(doc, "nodes");
+    int n = cJSON_IsArray(nodes) ? cJSON_GetArraySize(nodes) : 0;
+    if (n <= 0)
+        return OBS_OK;
+    long *parent = malloc(2 * (size_t)n * sizeof *parent);
+    if (!parent)
+        return obs__fail(err, OBS_NO_MEMORY, "%s: %d glTF nodes", path, n);
+    long *depth = parent + n;
+    for (int i = 0; i < n; i++)
+        parent[i] = depth[i] = -1;
+    int i = 0;
+    for (const cJSON *node = nodes->child; node; node = node->next, i++) {
+        const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node, "children"), *c;
+        cJSON_ArrayForEach(c, kids)
+        {
+            if (cJSON_IsNumber(c) && c->valuedouble >= 0 && c->valuedouble < n)
+                parent[(long)c->valuedouble] = i;
+        }
+    }
+    obs_status st = OBS_OK;
+    for (long k = 0; k < n && st == OBS_OK; k++) {
+        long j = k, steps = 0;
+        while (j >= 0 && depth[j] < 0 && steps <= HIERARCHY_MAX) {
+            j = parent[j];
+            steps++;
+        }
+        long d = (j >= 0 ? depth[j] : -1) + steps;
+        if (steps > HIERARCHY_MAX || d > HIERARCHY_MAX) {
+            st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is deeper than %d levels in "
+                                              "the node tree (or in a cycle)",
+                           path, k, HIERARCHY_MAX);
+            break;
+        }
+        for (j = k; j >= 0 && depth[j] < 0; j = parent[j])
+            depth[j] = d--;
+    }
+    free(parent);
+    return st;
+}
+
 /* The JSON of a .glb (f after its first 4 bytes) or a .gltf (whole), of
  * size bytes, checked by obs__glb_forest; what does not parse is assimp's to
  * refuse. */
@@ -161,6 +214,8 @@ static obs_status gltf_json(const char *path, FILE *f, int glb, size_t size,
         st = gltf_document(path, glb, txt, len, &doc, err);
         if (st == OBS_OK)
             st = obs__glb_forest(path, doc, err);
+        if (st == OBS_OK)
+            st = gltf_depth(path, doc, err);
         cJSON_Delete(doc);
     }
     free(txt);
@@ -327,6 +382,8 @@ static obs_status ac_objects(const char *path, const char *buf, size_t size,
     if (!ac_next(&w) || w.len < 4 || memcmp(w.s, "AC3D", 4) != 0)
         return AC_FAIL("%s: not an AC3D file (its first line is not AC3D and a version)", path);
     long long materials = 0, max_mat = -1;
+    long long pending[HIERARCHY_MAX + 1]; /* children still to come, per level */
+    int levels = 0;
     int more = ac_next(&w);
     while (more) {
         if (ac_is(&w, "MATERIAL")) {
@@ -338,7 +395,12 @@ static obs_status ac_objects(const char *path, const char *buf, size_t size,
             more = ac_next(&w); /* assimp skips what it does not know */
             continue;
         }
-        /* One object, the current line its OBJECT. */
+        /* One object, the current line its OBJECT: a child of the
+         * innermost object still owed children, if any. */
+        while (levels > 0 && pending[levels - 1] == 0)
+            levels--;
+        if (levels > 0)
+            pending[levels - 1]--;
         unsigned long at = w.no;
         long long nvert = 0, max_ref = -1;
         int kids = 0;
@@ -383,6 +445,11 @@ static obs_status ac_objects(const char *path, const char *buf, size_t size,
                     return AC_FAIL("%s: line %lu: kids %lld: more children than the %zu bytes "
                                    "after it could hold (AC3D)", path, w.no, n,
                                    (size_t)(w.end - w.p));
+                if (n > 0 && levels == HIERARCHY_MAX)
+                    return AC_FAIL("%s: line %lu: objects nested deeper than %d levels (AC3D)",
+                                   path, w.no, HIERARCHY_MAX);
+                if (n > 0)
+                    pending[levels++] = n;
                 kids = 1;
                 more = ac_next(&w);
                 if (n > 0 && more && !ac_is(&w, "OBJECT"))

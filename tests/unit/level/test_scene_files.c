@@ -328,6 +328,38 @@ static void test_off_counts(void **state)
     both_fail(BAD "off_counts_past_file.off", "more than the 27 bytes after it hold");
 }
 
+/* A hierarchy 1100 levels deep, as AC3D objects and as glTF nodes: assimp
+ * 5.2 walks it recursively and crashed (stack overflow) some thousands of
+ * levels down; both are refused past 1024 levels. */
+static void test_deep_hierarchy(void **state)
+{
+    (void)state;
+    enum { LEVELS = 1100 };
+    static const char quad[] = "OBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 1\n"
+                               "SURF 0x0\nmat 0\nrefs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n";
+    char *text = malloc(LEVELS * 32 + 4096);
+    assert_non_null(text);
+    size_t n = (size_t)sprintf(text, "AC3Db\n");
+    for (int i = 0; i < LEVELS; i++)
+        n += (size_t)sprintf(text + n, "OBJECT group\nkids 1\n");
+    sprintf(text + n, "%s", quad);
+    char ac[] = "/tmp/obs_deep_XXXXXX.ac3d";
+    temp_file(ac, text);
+    both_fail(ac, "nested deeper than 1024 levels");
+    unlink(ac);
+
+    n = (size_t)sprintf(text, "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], "
+                              "\"nodes\": [");
+    for (int i = 0; i < LEVELS; i++)
+        n += (size_t)sprintf(text + n, "{\"children\": [%d]}, ", i + 1);
+    sprintf(text + n, "{}]}");
+    char gltf[] = "/tmp/obs_deep_XXXXXX.gltf";
+    temp_file(gltf, text);
+    both_fail(gltf, "deeper than 1024 levels");
+    unlink(gltf);
+    free(text);
+}
+
 /* The fuzz_scene seeds that are whole files: each loads in both loaders
  * and flattens (a seed that stopped loading would fuzz only the errors). */
 static void test_valid_seeds_load(void **state)
@@ -377,6 +409,7 @@ int main(void)
         cmocka_unit_test(test_occluders_bounded),    cmocka_unit_test(test_all_at_one_point),     cmocka_unit_test(test_huge_declared_count),
         cmocka_unit_test(test_ac3d_strip_without_refs), cmocka_unit_test(test_ac3d_counts),
         cmocka_unit_test(test_gltf_not_gltf),          cmocka_unit_test(test_off_counts),
+        cmocka_unit_test(test_deep_hierarchy),
         cmocka_unit_test(test_valid_seeds_load),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
