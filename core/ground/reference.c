@@ -170,12 +170,21 @@ static int hit_point(const job *j, const float o[3], const float d[3], const str
     if (s->normals) {
         const uint32_t *tri = s->indices + 3 * (size_t)rh->hit.primID;
         float w[3] = {1.0f - rh->hit.u - rh->hit.v, rh->hit.u, rh->hit.v}, sn[3] = {0, 0, 0};
-        for (int c = 0; c < 3; c++)
+        int against = 0;
+        for (int c = 0; c < 3; c++) {
+            const float *vn = s->normals + 3 * (size_t)tri[c];
+            against += dot3(vn, ng) * flip < 0.0f;
             for (int k = 0; k < 3; k++)
-                sn[k] += w[c] * s->normals[3 * (size_t)tri[c] + k];
+                sn[k] += w[c] * vn[k];
+        }
+        /* A triangle whose three normals all lie on the other side of it
+         * than the one seen (normals that disagree with the winding) has
+         * them turned to face the viewer, as the --gbuffer points' are:
+         * around them every cosine ray would lie below the surface, AO 0. */
+        float side = against == 3 ? -flip : flip;
         if (normalize3(sn) == 0)
             for (int k = 0; k < 3; k++)
-                n[k] = flip * sn[k];
+                n[k] = side * sn[k];
     }
     return 1;
 }

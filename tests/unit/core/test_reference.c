@@ -159,6 +159,44 @@ static void test_deterministic(void **state)
     obs_scene_free(&s);
 }
 
+/* Normals against the winding (every vertex normal pointing into the side
+ * the camera does not see): the AO is that of the geometric normals, as
+ * the --gbuffer points' (turned to face the viewer).  It was 0 wherever
+ * such a triangle was seen: every cosine ray around the normal lay below
+ * the surface. */
+static void test_normals_against_winding(void **state)
+{
+    (void)state;
+    const float box[2][4][3] = {{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}},
+                                {{0.2f, -0.5f, 0}, {0.2f, -0.5f, 0.4f}, {0.2f, 0.5f, 0.4f}, {0.2f, 0.5f, 0}}};
+    obs_scene s;
+    obs_camera cam;
+    obs_image plain = {0}, against = {0};
+    char err[OBS_ERR_LEN] = "";
+    quads(&s, box, 2);
+    top_camera(&cam, 1.5f);
+    obs_reference_view v = {.camera = &cam, .width = 48, .height = 32};
+    obs_reference_desc d = {.distance = 0.5f, .spp = 16, .seed = 1, .threads = 1};
+    assert_int_equal(obs_reference_render(&s, &v, &d, &plain, NULL, err), OBS_OK);
+    /* the floor's normals -Z (its winding faces +Z, the camera), the
+     * wall's +X (its winding faces -X, the camera at x = 0) */
+    s.normals = calloc(3 * s.vertex_count, sizeof(float));
+    assert_non_null(s.normals);
+    for (int i = 0; i < 4; i++) {
+        s.normals[3 * i + 2] = -1.0f;
+        s.normals[3 * (4 + i)] = 1.0f;
+    }
+    assert_int_equal(obs_reference_render(&s, &v, &d, &against, NULL, err), OBS_OK);
+    float mean = 0.0f;
+    for (int i = 0; i < 48 * 32; i++)
+        mean += against.data[i] / (48 * 32);
+    print_message("AO mean %.3f with the normals against the winding\n", (double)mean);
+    assert_memory_equal(plain.data, against.data, 48 * 32 * sizeof(float));
+    obs_image_free(&plain);
+    obs_image_free(&against);
+    obs_scene_free(&s);
+}
+
 static void test_errors(void **state)
 {
     (void)state;
@@ -273,6 +311,7 @@ int main(void)
         cmocka_unit_test(test_closed_forms),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_normals_against_winding),
         cmocka_unit_test(test_blender_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
