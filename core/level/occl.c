@@ -245,6 +245,72 @@ static obs_status add_triangles(obs__bake_occl *o, RTCScene sc, const obs__bake_
     return OBS_OK;
 }
 
+/* FNV-1a of a triangle's three positions, in order, and its sidedness. */
+static uint64_t tri_hash(const obs__bake_world *w, uint32_t t)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (int c = 0; c < 3; c++) {
+        const unsigned char *b = (const unsigned char *)(w->pos + 3 * (size_t)w->tri[3 * t + c]);
+        for (size_t k = 0; k < 3 * sizeof(float); k++)
+            h = (h ^ b[k]) * 0x100000001b3ULL;
+    }
+    return (h ^ w->two_sided[t]) * 0x100000001b3ULL;
+}
+
+static int tri_same(const obs__bake_world *w, uint32_t a, uint32_t b)
+{
+    if (w->two_sided[a] != w->two_sided[b])
+        return 0;
+    for (int c = 0; c < 3; c++)
+        if (memcmp(w->pos + 3 * (size_t)w->tri[3 * a + c], w->pos + 3 * (size_t)w->tri[3 * b + c],
+                   3 * sizeof(float)))
+            return 0;
+    return 1;
+}
+
+/* The opaque triangles (list, or every one when NULL; *n of them) without
+ * the exact copies of one before them: the same three positions in the
+ * same order and the same sidedness, whose every hit is that one's (the
+ * same distance, face normal and side).  A BVH cannot split coincident
+ * triangles, so each ray that reaches them tested every copy: thousands
+ * of copies of one quad made bake-dynamic's probes take minutes.  *list
+ * becomes a new list when some were dropped (freed by the caller), else
+ * is left as it is. */
+static obs_status drop_copies(const obs__bake_world *w, uint32_t **list, size_t *n,
+                              char err[OBS_ERR_LEN])
+{
+    size_t cap = 16;
+    while (cap < 2 * *n)
+        cap *= 2;
+    uint32_t *slot = malloc(cap * sizeof *slot), *keep = malloc((*n ? *n : 1) * sizeof *keep);
+    if (!slot || !keep) {
+        free(slot);
+        free(keep);
+        return obs__fail(err, OBS_NO_MEMORY, "the copies among %zu triangles", *n);
+    }
+    memset(slot, 0xff, cap * sizeof *slot);
+    size_t kept = 0;
+    for (size_t i = 0; i < *n; i++) {
+        uint32_t t = *list ? (*list)[i] : (uint32_t)i;
+        size_t s = (size_t)tri_hash(w, t) & (cap - 1);
+        while (slot[s] != UINT32_MAX && !tri_same(w, slot[s], t))
+            s = (s + 1) & (cap - 1);
+        if (slot[s] != UINT32_MAX)
+            continue; /* a copy */
+        slot[s] = t;
+        keep[kept++] = t;
+    }
+    free(slot);
+    if (kept == *n) {
+        free(keep);
+        return OBS_OK;
+    }
+    free(*list);
+    *list = keep;
+    *n = kept;
+    return OBS_OK;
+}
+
 /* The world boxes of the shrub nodes (one per node: the union of its
  * instances), their densities through the overlap pre-pass. */
 static obs_status shrub_boxes(obs__bake_occl *o, const obs__bake_world *w,
@@ -341,6 +407,8 @@ obs_status obs__bake_occl_new(const obs__bake_world *w, const obs__bake_decor *d
             }
         }
     }
+    if ((st = drop_copies(w, &o->opaque_tri, &nopaque, err)) != OBS_OK)
+        goto done;
     o->opaque_count = nopaque;
     o->tree_count = ntree;
     o->opaque = rtcNewScene(o->dev);
