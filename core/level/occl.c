@@ -268,47 +268,28 @@ static int tri_same(const obs__bake_world *w, uint32_t a, uint32_t b)
     return 1;
 }
 
-/* The opaque triangles (list, or every one when NULL; *n of them) without
- * the exact copies of one before them: the same three positions in the
- * same order and the same sidedness, whose every hit is that one's (the
- * same distance, face normal and side).  A BVH cannot split coincident
- * triangles, so each ray that reaches them tested every copy: thousands
- * of copies of one quad made bake-dynamic's probes take minutes.  *list
- * becomes a new list when some were dropped (freed by the caller), else
- * is left as it is. */
-static obs_status drop_copies(const obs__bake_world *w, uint32_t **list, size_t *n,
-                              char err[OBS_ERR_LEN])
+size_t obs__bake_drop_copies(const obs__bake_world *w, uint32_t *list, size_t n)
 {
     size_t cap = 16;
-    while (cap < 2 * *n)
+    while (cap < 2 * n)
         cap *= 2;
-    uint32_t *slot = malloc(cap * sizeof *slot), *keep = malloc((*n ? *n : 1) * sizeof *keep);
-    if (!slot || !keep) {
-        free(slot);
-        free(keep);
-        return obs__fail(err, OBS_NO_MEMORY, "the copies among %zu triangles", *n);
-    }
+    uint32_t *slot = malloc(cap * sizeof *slot);
+    if (!slot)
+        return SIZE_MAX;
     memset(slot, 0xff, cap * sizeof *slot);
     size_t kept = 0;
-    for (size_t i = 0; i < *n; i++) {
-        uint32_t t = *list ? (*list)[i] : (uint32_t)i;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t t = list[i];
         size_t s = (size_t)tri_hash(w, t) & (cap - 1);
         while (slot[s] != UINT32_MAX && !tri_same(w, slot[s], t))
             s = (s + 1) & (cap - 1);
         if (slot[s] != UINT32_MAX)
             continue; /* a copy */
         slot[s] = t;
-        keep[kept++] = t;
+        list[kept++] = t;
     }
     free(slot);
-    if (kept == *n) {
-        free(keep);
-        return OBS_OK;
-    }
-    free(*list);
-    *list = keep;
-    *n = kept;
-    return OBS_OK;
+    return kept;
 }
 
 /* The world boxes of the shrub nodes (one per node: the union of its
@@ -407,8 +388,28 @@ obs_status obs__bake_occl_new(const obs__bake_world *w, const obs__bake_decor *d
             }
         }
     }
-    if ((st = drop_copies(w, &o->opaque_tri, &nopaque, err)) != OBS_OK)
+    /* Exact copies left out (obs__bake_drop_copies): a level without any
+     * keeps every triangle and no list. */
+    uint32_t *all = o->opaque_tri;
+    if (!all && !(all = malloc((nt ? nt : 1) * sizeof *all))) {
+        st = obs__fail(err, OBS_NO_MEMORY, "the copies among %zu triangles", nt);
         goto done;
+    }
+    if (!o->opaque_tri)
+        for (size_t t = 0; t < nt; t++)
+            all[t] = (uint32_t)t;
+    size_t kept = obs__bake_drop_copies(w, all, nopaque);
+    if (kept == SIZE_MAX) {
+        if (all != o->opaque_tri)
+            free(all);
+        st = obs__fail(err, OBS_NO_MEMORY, "the copies among %zu triangles", nopaque);
+        goto done;
+    }
+    if (kept == nopaque && all != o->opaque_tri)
+        free(all);
+    else
+        o->opaque_tri = all;
+    nopaque = kept;
     o->opaque_count = nopaque;
     o->tree_count = ntree;
     o->opaque = rtcNewScene(o->dev);
