@@ -108,7 +108,7 @@ DAEMON_BENCH := $(BUILD)/daemon_bench
 -include protocol/protocol.mk daemon/daemon.mk clients/clients.mk tests/fuzz/fuzz.mk
 E2E_DEPS += $(UPSCALE)
 
-.PHONY: all deps demo demo-run test test-long check unit e2e loops headers readme readme-check samples bench quality quality-masks quality-deep bake-quality clean deep-fixture
+.PHONY: all deps demo demo-run test test-long fuzz-replay check unit e2e loops headers readme readme-check samples bench quality quality-masks quality-deep quality-heldout bake-quality clean deep-fixture
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI) $(EXTRA_BINS)
@@ -218,7 +218,8 @@ demo-run: all
 # the sanitizer pass of the slowest e2e scripts (each over 20 s under ASan),
 # which make test-long runs, and then the e2e suite once more on the CPU
 # device (plain build; fuzz.sh left out: it fuzzes decoders, whatever the
-# device) (CI runs both).
+# device), and then every fuzz target's seeds replayed with clang, which it
+# installs (CI runs both).
 E2E_LONG = bake progcache dynamic run load output deploy hostile_binary bakes python_client \
            guards hostile_http provenance remote
 test: deps
@@ -228,6 +229,13 @@ test: deps
 test-long: deps
 	$(MAKE) all e2e BUILD=build/asan SAN=1 E2E_ONLY="$(E2E_LONG)"
 	$(MAKE) all e2e OBSCURA_BACKEND=cpu E2E_SKIP=fuzz
+	$(MAKE) fuzz-replay
+
+# Every fuzz target's seeds and regression inputs replayed, no mutation
+# (the same inputs on every run), with clang installed first (as root).
+fuzz-replay:
+	tools/deps.sh --fuzz
+	FUZZ_SECONDS=0 BUILD=$(BUILD) tests/e2e/fuzz.sh
 
 check: all headers loops unit e2e readme-check
 
@@ -321,6 +329,13 @@ quality-masks: deps
 quality-deep: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bench/deep_quality.sh
+
+# The Blender scenes from cameras and at AO distances no other figure was
+# measured on (four views a scene, fixed in the script), flat and deep,
+# against obscura's Embree reference (bench/QUALITY.md, "Held-out views").
+quality-heldout: deps
+	@$(MAKE) --no-print-directory all
+	@bench/heldout.py --obscura $(CLI) --shared $(or $(OBSCURA_SHARED_DATA),../shared/data)
 
 # The baked vertices against the per-pixel obscurance reference
 # (bench/BAKE.md, "Against a per-pixel reference"): the levels of

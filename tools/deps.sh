@@ -18,8 +18,14 @@ libassimp-dev libembree-dev nettle-dev libsuitesparse-dev libmeshoptimizer-dev"
 # (Cycles renders the hidden-object reference, tools/blender_masks.py) and
 # sweethome3d-furniture (the CC0 meshes of the Blender room).  Neither the
 # build, make demo nor make test needs them.
+# `deps.sh --fuzz` adds clang and its runtime libraries (libFuzzer, the
+# sanitizers): make test-long replays the fuzz targets' seeds with them
+# (tests/e2e/fuzz.sh; make test's run of it skips without clang).
 if [ "${1:-}" = "--quality" ]; then
     PKGS="$PKGS blender sweethome3d-furniture"
+fi
+if [ "${1:-}" = "--fuzz" ]; then
+    PKGS="$PKGS clang libclang-rt-dev"
 fi
 if [ "${1:-}" != "--build" ]; then
     PKGS="$PKGS libhwy-dev chromium nodejs python3-yaml systemd python3-numpy python3-openimageio openimageio-tools python3 python3-pip python3-wheel"
