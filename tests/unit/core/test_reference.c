@@ -233,6 +233,40 @@ static void test_errors(void **state)
     obs_scene_free(&s);
 }
 
+/* A camera 1e30 above the floor: Embree aborted the process on its rays
+ * (ray.valid: an origin past 1.844e18).  Refused by the scenes' bound,
+ * naming the camera's position; one at 1e9 is taken.  G-buffer points
+ * beyond the bound are background (AO 1), as non-finite ones are; the
+ * point at 1e30 aborted the same way. */
+static void test_far_camera_and_points(void **state)
+{
+    (void)state;
+    const float floor_q[1][4][3] = {{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}};
+    obs_scene s;
+    obs_camera cam;
+    obs_image ao = {0};
+    char err[OBS_ERR_LEN] = "";
+    quads(&s, floor_q, 1);
+    top_camera(&cam, 1.0f);
+    cam.world_to_camera[11] = -1e30f;
+    obs_reference_view v = {.camera = &cam, .width = 8, .height = 8};
+    obs_reference_desc d = {.distance = 0.5f, .spp = 4, .threads = 1};
+    assert_int_equal(obs_reference_render(&s, &v, &d, &ao, NULL, err), OBS_NO_CAMERA);
+    print_message("%s\n", err);
+    assert_non_null(strstr(err, "the camera at (0, 0, 1e+30): a coordinate beyond +-1e9"));
+    assert_null(ao.data);
+    cam.world_to_camera[11] = -1e9f;
+    assert_int_equal(obs_reference_render(&s, &v, &d, &ao, NULL, err), OBS_OK);
+    obs_image_free(&ao);
+
+    const float xs[3] = {0.0f, 1e30f, 3e38f};
+    float out[3];
+    ao_at_points(&s, xs, 3, 0.0f, 4, out);
+    for (int i = 0; i < 3; i++)
+        assert_true(out[i] == 1.0f); /* open floor; background */
+    obs_scene_free(&s);
+}
+
 /* Our reference (camera rays through pixel centres, SPP rays) against
  * Cycles' AO pass of room.exr (128 samples, distance 0.5 m), over the
  * pixels both see geometry at.
@@ -312,6 +346,7 @@ int main(void)
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_normals_against_winding),
+        cmocka_unit_test(test_far_camera_and_points),
         cmocka_unit_test(test_blender_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
