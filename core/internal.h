@@ -59,6 +59,13 @@ void obs__mat4_transpose(const float m[16], float out[16]);
 /* out = m * (x, y, z, w) */
 void obs__mat4_apply(const float m[16], const float v[4], float out[4]);
 
+/* A triangle's normal n = (p1 - p0) x (p2 - p0), unnormalised, and its
+ * length |n| (twice the area); 0 (n zeroed) for a degenerate triangle:
+ * zero area, a sliver whose normal float rounding decides
+ * (|n| <= 1e-7 |e|^2), or a product beyond float.  The bake's flatten and
+ * obs_scene_check take their degenerate faces from here. */
+double obs__tri_normal(const float p0[3], const float p1[3], const float p2[3], float n[3]);
+
 /* Sets parameter `name` of r to `value` (text, as obs_param_set) when r
  * leaves it unset (0): a preset's row, a parameter given explicitly
  * wins (--quality's presets, OBS_DEEP_GTAO_EXACT). */

@@ -122,6 +122,26 @@ void obs__mat4_apply(const float m[16], const float v[4], float out[4])
     memcpy(out, r, sizeof r);
 }
 
+double obs__tri_normal(const float p0[3], const float p1[3], const float p2[3], float n[3])
+{
+    float e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = p1[k] - p0[k];
+        e2[k] = p2[k] - p0[k];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+    double scale = (double)e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2] + e2[0] * e2[0] +
+                   e2[1] * e2[1] + e2[2] * e2[2];
+    if (!(len > 1e-7 * scale) || !isfinite(len)) {
+        n[0] = n[1] = n[2] = 0.0f;
+        return 0.0;
+    }
+    return len;
+}
+
 /* Gauss-Jordan elimination with partial pivoting, in double. */
 int obs__mat4_invert(const float m[16], float out[16])
 {

@@ -176,15 +176,23 @@ obs_status obs__bake_closest_new(const obs__bake_world *w, size_t first, size_t 
         return obs__fail(err, OBS_NO_MEMORY, "nearest-point search over %zu triangles", count);
     }
     *c = (obs__bake_closest){.w = w, .items = a[1], .nodes = a[2], .cen = cen};
-    for (size_t t = first; t < first + count; t++) {
-        if (!(w->area[t] > 0.0f))
-            continue;
-        const uint32_t *v = w->tri + 3 * t;
-        float *ce = c->cen + 3 * c->nitems;
+    for (size_t t = first; t < first + count; t++)
+        if (w->area[t] > 0.0f)
+            c->items[c->nitems++] = (uint32_t)t;
+    /* exact copies left out: each query near them measured every copy */
+    size_t kept = obs__bake_drop_copies(w, c->items, c->nitems);
+    if (kept == SIZE_MAX) {
+        free(cen);
+        free(c);
+        return obs__fail(err, OBS_NO_MEMORY, "nearest-point search over %zu triangles", count);
+    }
+    c->nitems = kept;
+    for (size_t i = 0; i < c->nitems; i++) {
+        const uint32_t *v = w->tri + 3 * (size_t)c->items[i];
+        float *ce = c->cen + 3 * i;
         for (int k = 0; k < 3; k++)
             ce[k] = (w->pos[3 * (size_t)v[0] + k] + w->pos[3 * (size_t)v[1] + k] +
                      w->pos[3 * (size_t)v[2] + k]) / 3.0f;
-        c->items[c->nitems++] = (uint32_t)t;
     }
     if (c->nitems) {
         c->nnodes = 1;

@@ -98,6 +98,26 @@ static int flat(const float *pos, const uint32_t t[3])
     return !(len > 1e-7 * scale);
 }
 
+/* The mesh copied whole into out (its name already set): a level the
+ * weld cannot simplify. */
+static int copy_whole(const obs_bake_mesh *m, obs_bake_mesh *out)
+{
+    size_t nv = m->vertex_count, ni = 3 * m->triangle_count;
+    out->positions = malloc(3 * nv * sizeof *out->positions);
+    out->indices = malloc(ni * sizeof *out->indices);
+    if (m->normals)
+        out->normals = malloc(3 * nv * sizeof *out->normals);
+    if (!out->positions || !out->indices || (m->normals && !out->normals))
+        return 0;
+    memcpy(out->positions, m->positions, 3 * nv * sizeof *out->positions);
+    memcpy(out->indices, m->indices, ni * sizeof *out->indices);
+    if (m->normals)
+        memcpy(out->normals, m->normals, 3 * nv * sizeof *out->normals);
+    out->vertex_count = nv;
+    out->triangle_count = m->triangle_count;
+    return 1;
+}
+
 obs_status obs__bake_simplify(const obs_bake_mesh *m, int level, float ratio, float error,
                               int lock_border, float weld_tolerance, float weld_angle,
                               obs_bake_mesh *out, char err[OBS_ERR_LEN])
@@ -123,8 +143,20 @@ obs_status obs__bake_simplify(const obs_bake_mesh *m, int level, float ratio, fl
         return OBS_OK;
     if ((rc = weld(m, weld_tolerance, weld_angle, &k, err)) != OBS_OK)
         goto done;
-    if (k.ni == 0) /* every triangle collapsed: an empty level */
+    if (k.ni == 0) {
+        /* Every triangle collapsed: an empty level for a mesh without
+         * area; a mesh with some (faces much smaller than the weld's
+         * tolerance, a fraction of its box: a small part beside long
+         * slivers) is kept whole, as the bake keeps it, rather than left
+         * empty (a level of such meshes alone had no triangle at all). */
+        for (size_t t = 0; t < m->triangle_count; t++)
+            if (!flat(m->positions, m->indices + 3 * t)) {
+                if (!copy_whole(m, out))
+                    goto nomem;
+                break;
+            }
         goto done;
+    }
     if (!(dst = malloc(k.ni * sizeof *dst)))
         goto nomem;
     size_t tris = k.ni / 3;

@@ -120,6 +120,12 @@ obs_status obs__raster_set_camera(GLuint prog, const obs_camera *cam, char err[O
         for (int k = 0; k < 3; k++)
             eye[k] /= eye[3];
         eye[3] = 1.0f;
+        /* the scenes' bound (scene.h): a camera beyond it drew nothing,
+         * and its header lost the camera, without a word */
+        if (!isfinite(eye[0]) || !isfinite(eye[1]) || !isfinite(eye[2]) ||
+            obs_scene_coord_beyond(eye))
+            return obs__fail(err, OBS_NO_CAMERA, "the camera at (%g, %g, %g): " OBS_SCENE_COORD_RULE,
+                             (double)eye[0], (double)eye[1], (double)eye[2]);
     }
     glUseProgram(prog);
     glUniformMatrix4fv(glGetUniformLocation(prog, "u_world_to_clip"), 1, GL_TRUE, clip);

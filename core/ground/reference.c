@@ -132,6 +132,16 @@ static void init_ray(struct RTCRay *r, const float o[3], const float d[3], float
     r->flags = 0;
 }
 
+/* A ray Embree takes (it asserts so): finite, its origin within the
+ * scenes' bound (far within Embree's 1.844e18). */
+static int ray_ok(const float o[3], const float d[3])
+{
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(o[k]) || !isfinite(d[k]))
+            return 0;
+    return !obs_scene_coord_beyond(o) && (d[0] != 0.0f || d[1] != 0.0f || d[2] != 0.0f);
+}
+
 /* The world-space ray through the centre of pixel (x, y): the points at
  * NDC z = -1 and z = 1 unprojected (valid for any projection). */
 static void camera_ray(const job *j, int x, int y, float o[3], float d[3])
@@ -170,12 +180,21 @@ static int hit_point(const job *j, const float o[3], const float d[3], const str
     if (s->normals) {
         const uint32_t *tri = s->indices + 3 * (size_t)rh->hit.primID;
         float w[3] = {1.0f - rh->hit.u - rh->hit.v, rh->hit.u, rh->hit.v}, sn[3] = {0, 0, 0};
-        for (int c = 0; c < 3; c++)
+        int against = 0;
+        for (int c = 0; c < 3; c++) {
+            const float *vn = s->normals + 3 * (size_t)tri[c];
+            against += dot3(vn, ng) * flip < 0.0f;
             for (int k = 0; k < 3; k++)
-                sn[k] += w[c] * s->normals[3 * (size_t)tri[c] + k];
+                sn[k] += w[c] * vn[k];
+        }
+        /* A triangle whose three normals all lie on the other side of it
+         * than the one seen (normals that disagree with the winding) has
+         * them turned to face the viewer, as the --gbuffer points' are:
+         * around them every cosine ray would lie below the surface, AO 0. */
+        float side = against == 3 ? -flip : flip;
         if (normalize3(sn) == 0)
             for (int k = 0; k < 3; k++)
-                n[k] = flip * sn[k];
+                n[k] = side * sn[k];
     }
     return 1;
 }
@@ -206,7 +225,10 @@ static int surface_point(const job *j, struct RTCIntersectContext *ictx, int x, 
             p[k] = pp[k];
             n[k] = nn[k];
         }
-        if (!isfinite(p[0] + p[1] + p[2]) || normalize3(n) != 0)
+        /* background: a non-finite point, one beyond the scenes' bound
+         * (no ray can start there), a zero normal */
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]) ||
+            obs_scene_coord_beyond(p) || normalize3(n) != 0)
             return 0;
         for (int k = 0; k < 3; k++)
             to_eye[k] = j->eye[3] != 0.0f ? j->eye[k] - p[k] : j->eye[k];
@@ -219,6 +241,8 @@ static int surface_point(const job *j, struct RTCIntersectContext *ictx, int x, 
 
     float o[3], d[3];
     camera_ray(j, x, y, o, d);
+    if (!ray_ok(o, d)) /* the corners' were checked: rounding between them */
+        return 0;
     struct RTCRayHit rh;
     if (!intersect(j, ictx, o, d, 0.0f, INFINITY, &rh))
         return 0;
@@ -304,6 +328,8 @@ static float layered_ao(const job *j, struct RTCIntersectContext *ictx, pcg32 *r
     float o[3], d[3], T = 1.0f, acc = 0.0f, tnear = 0.0f;
     camera_ray(j, x, y, o, d);
     *depth = OBS_SKY_DEPTH;
+    if (!ray_ok(o, d))
+        return 1.0f;
     for (int k = 0; k < MAX_CROSSINGS && T > 0.0f; k++) {
         struct RTCRayHit rh;
         float p[3], n[3], ng[3];
@@ -532,6 +558,29 @@ obs_status obs_reference_render(const obs_scene *scene, const obs_reference_view
     if (persp)
         for (int k = 0; k < 4; k++)
             j->eye[k] /= j->eye[3];
+    /* The camera rays start there (Embree aborts on an origin past
+     * 1.844e18 or a non-finite one): the scenes' bound, and every corner
+     * ray finite. */
+    if (persp && (!isfinite(j->eye[0]) || !isfinite(j->eye[1]) || !isfinite(j->eye[2]) ||
+                  obs_scene_coord_beyond(j->eye))) {
+        s = obs__fail(err, OBS_NO_CAMERA, "the camera at (%g, %g, %g): " OBS_SCENE_COORD_RULE,
+                      (double)j->eye[0], (double)j->eye[1], (double)j->eye[2]);
+        goto fail;
+    }
+    j->width = w;
+    j->height = h;
+    for (int c = 0; c < 4; c++) {
+        float o[3], dir[3];
+        camera_ray(j, c & 1 ? w - 1 : 0, c & 2 ? h - 1 : 0, o, dir);
+        if (!ray_ok(o, dir)) {
+            s = obs__fail(err, OBS_NO_CAMERA,
+                          "the camera's ray through pixel (%d, %d) starts at (%g, %g, %g) "
+                          "towards (%g, %g, %g): its matrices overflow float, or " OBS_SCENE_COORD_RULE,
+                          c & 1 ? w - 1 : 0, c & 2 ? h - 1 : 0, (double)o[0], (double)o[1],
+                          (double)o[2], (double)dir[0], (double)dir[1], (double)dir[2]);
+            goto fail;
+        }
+    }
 
     char embree_cfg[32];
     if (!(dev = rtcNewDevice(obs__pool_embree_config(embree_cfg)))) {

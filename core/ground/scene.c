@@ -38,30 +38,75 @@ void obs_scene_free(obs_scene *s)
     memset(s, 0, sizeof *s);
 }
 
+/* " (mesh 'NAME', node 'NODE')" of the mesh that holds triangle t, or "". */
+static void mesh_of_triangle(const obs_scene *s, size_t t, char *buf, size_t n)
+{
+    buf[0] = '\0';
+    for (size_t m = 0; m < s->mesh_count && s->meshes; m++)
+        if (t >= s->meshes[m].first_triangle &&
+            t - s->meshes[m].first_triangle < s->meshes[m].triangle_count) {
+            snprintf(buf, n, " (mesh '%s', node '%s')", s->meshes[m].name ? s->meshes[m].name : "",
+                     s->meshes[m].node ? s->meshes[m].node : "");
+            return;
+        }
+}
+
+/* mesh_of_triangle of the first triangle that uses vertex v. */
+static void mesh_of_vertex(const obs_scene *s, size_t v, char *buf, size_t n)
+{
+    buf[0] = '\0';
+    for (size_t i = 0; i < 3 * s->triangle_count; i++)
+        if (s->indices[i] == v) {
+            mesh_of_triangle(s, i / 3, buf, n);
+            return;
+        }
+}
+
 obs_status obs_scene_check(obs_scene *s, char err[OBS_ERR_LEN])
 {
+    char where[160];
     if (!s->positions || !s->indices || s->vertex_count == 0 || s->triangle_count == 0)
         return obs__fail(err, OBS_BAD_FILE, "empty scene: no triangles");
     if (s->vertex_count > MAX_VERTICES)
         return obs__fail(err, OBS_TOO_LARGE, "%zu vertices; at most %zu", s->vertex_count,
                          MAX_VERTICES);
-    for (int k = 0; k < 3; k++) {
-        s->bounds_min[k] = INFINITY;
-        s->bounds_max[k] = -INFINITY;
-    }
-    for (size_t v = 0; v < s->vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            float x = s->positions[3 * v + k];
-            if (!isfinite(x))
-                return obs__fail(err, OBS_BAD_FILE, "vertex %zu has a non-finite coordinate", v);
-            s->bounds_min[k] = fminf(s->bounds_min[k], x);
-            s->bounds_max[k] = fmaxf(s->bounds_max[k], x);
-        }
     for (size_t i = 0; i < 3 * s->triangle_count; i++)
         if (s->indices[i] >= s->vertex_count)
             return obs__fail(err, OBS_BAD_FILE, "triangle %zu refers to vertex %u of %zu", i / 3,
                              (unsigned)s->indices[i], s->vertex_count);
-    return OBS_OK;
+    for (int k = 0; k < 3; k++) {
+        s->bounds_min[k] = INFINITY;
+        s->bounds_max[k] = -INFINITY;
+    }
+    for (size_t v = 0; v < s->vertex_count; v++) {
+        const float *p = s->positions + 3 * v;
+        for (int k = 0; k < 3; k++)
+            if (!isfinite(p[k])) {
+                mesh_of_vertex(s, v, where, sizeof where);
+                return obs__fail(err, OBS_BAD_FILE, "vertex %zu%s has a non-finite coordinate", v,
+                                 where);
+            }
+        if (obs_scene_coord_beyond(p)) {
+            mesh_of_vertex(s, v, where, sizeof where);
+            return obs__fail(err, OBS_BAD_FILE, "vertex %zu%s at (%g, %g, %g): " OBS_SCENE_COORD_RULE,
+                             v, where, p[0], p[1], p[2]);
+        }
+        for (int k = 0; k < 3; k++) {
+            s->bounds_min[k] = fminf(s->bounds_min[k], p[k]);
+            s->bounds_max[k] = fmaxf(s->bounds_max[k], p[k]);
+        }
+    }
+    /* the bake's rule (level/flatten.c): a scene of degenerate triangles
+     * only has no surface to draw or trace */
+    for (size_t t = 0; t < s->triangle_count; t++) {
+        const uint32_t *i = s->indices + 3 * t;
+        float n[3];
+        if (obs__tri_normal(s->positions + 3 * (size_t)i[0], s->positions + 3 * (size_t)i[1],
+                            s->positions + 3 * (size_t)i[2], n) > 0.0)
+            return OBS_OK;
+    }
+    return obs__fail(err, OBS_BAD_FILE, "all %zu triangles are degenerate (zero area)",
+                     s->triangle_count);
 }
 
 obs_status obs__scene_check_file(obs_scene *s, const char *path, char err[OBS_ERR_LEN])

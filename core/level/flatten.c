@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "level/level.h"
+#include "obscura/scene.h"
 #include "internal.h"
 
 void obs__bake_world_free(obs__bake_world *w)
@@ -40,28 +41,13 @@ static float normal_matrix(const float m[16], float c[9])
     return a * c[0] + b * c[1] + cc * c[2];
 }
 
-static void cross3(const float a[3], const float b[3], float c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static void face(obs__bake_world *w, size_t t)
 {
     const uint32_t *v = w->tri + 3 * t;
     const float *p0 = w->pos + 3 * v[0], *p1 = w->pos + 3 * v[1], *p2 = w->pos + 3 * v[2];
-    float e1[3], e2[3], n[3];
-    for (int k = 0; k < 3; k++) {
-        e1[k] = p1[k] - p0[k];
-        e2[k] = p2[k] - p0[k];
-    }
-    cross3(e1, e2, n);
-    double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-    double scale = (double)e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2] + e2[0] * e2[0] +
-                   e2[1] * e2[1] + e2[2] * e2[2];
-    /* Zero area, or a sliver whose normal float rounding decides. */
-    if (!(len > 1e-7 * scale) || !isfinite(len)) {
+    float n[3];
+    double len = obs__tri_normal(p0, p1, p2, n);
+    if (len == 0.0) {
         w->area[t] = 0.0f;
         memset(w->fn + 3 * t, 0, 3 * sizeof(float));
         w->degenerate++;
@@ -117,12 +103,21 @@ obs_status obs__bake_flatten(const obs_bake_scene *s, obs__bake_world *w, char e
             for (size_t v = 0; v < m->vertex_count; v++) {
                 float *p = w->pos + 3 * (w->vertex_count + v), *q = w->nrm + 3 * (w->vertex_count + v);
                 xform_point(node->world, m->positions + 3 * v, p);
-                if (!isfinite(p[0] + p[1] + p[2])) {
+                /* each coordinate: their sum overflows where they do not */
+                if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
                     obs__bake_world_free(w);
                     return obs__fail(err, OBS_BAD_FILE,
                                      "node '%s', mesh '%s': vertex %zu is not finite in world "
                                      "space (the node's transform overflows)",
                                      node->name, m->name, v);
+                }
+                if (obs_scene_coord_beyond(p)) {
+                    obs__fail(err, OBS_BAD_FILE,
+                              "node '%s', mesh '%s': vertex %zu at (%g, %g, %g) in world "
+                              "space: " OBS_SCENE_COORD_RULE,
+                              node->name, m->name, v, p[0], p[1], p[2]);
+                    obs__bake_world_free(w); /* p was in it */
+                    return OBS_BAD_FILE;
                 }
                 memset(q, 0, 3 * sizeof(float));
                 if (m->normals) {

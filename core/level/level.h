@@ -63,6 +63,16 @@ void obs__bake_lod_file_free(obs_bake_scene *s);
  * LODs'). */
 void obs__bake_mesh_free(obs_bake_mesh *m);
 
+/* list[0 .. n) compacted in place to the triangles that are no exact copy
+ * of one before them: the same three positions in the same order and the
+ * same sidedness, whose every hit (distance, face normal, side) and
+ * nearest point are that one's.  A BVH cannot split coincident triangles,
+ * so each ray or query that reached them tested every copy (bake-dynamic's
+ * probes on 2000 copies of one quad: 90 s, the quad alone 1 s).  Returns
+ * the count kept, SIZE_MAX when out of memory.  occl.c's; the opaque BVH and
+ * the LODs' nearest-point search (bake/closest.c) leave copies out. */
+size_t obs__bake_drop_copies(const obs__bake_world *w, uint32_t *list, size_t n);
+
 /* The level's BVH on its own, for points in space (bvh.c; the
  * dynamic-object bake).  w must outlive it. */
 typedef struct obs__bake_bvh obs__bake_bvh;

@@ -245,6 +245,53 @@ static obs_status add_triangles(obs__bake_occl *o, RTCScene sc, const obs__bake_
     return OBS_OK;
 }
 
+/* FNV-1a of a triangle's three positions, in order, and its sidedness. */
+static uint64_t tri_hash(const obs__bake_world *w, uint32_t t)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (int c = 0; c < 3; c++) {
+        const unsigned char *b = (const unsigned char *)(w->pos + 3 * (size_t)w->tri[3 * t + c]);
+        for (size_t k = 0; k < 3 * sizeof(float); k++)
+            h = (h ^ b[k]) * 0x100000001b3ULL;
+    }
+    return (h ^ w->two_sided[t]) * 0x100000001b3ULL;
+}
+
+static int tri_same(const obs__bake_world *w, uint32_t a, uint32_t b)
+{
+    if (w->two_sided[a] != w->two_sided[b])
+        return 0;
+    for (int c = 0; c < 3; c++)
+        if (memcmp(w->pos + 3 * (size_t)w->tri[3 * a + c], w->pos + 3 * (size_t)w->tri[3 * b + c],
+                   3 * sizeof(float)))
+            return 0;
+    return 1;
+}
+
+size_t obs__bake_drop_copies(const obs__bake_world *w, uint32_t *list, size_t n)
+{
+    size_t cap = 16;
+    while (cap < 2 * n)
+        cap *= 2;
+    uint32_t *slot = malloc(cap * sizeof *slot);
+    if (!slot)
+        return SIZE_MAX;
+    memset(slot, 0xff, cap * sizeof *slot);
+    size_t kept = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t t = list[i];
+        size_t s = (size_t)tri_hash(w, t) & (cap - 1);
+        while (slot[s] != UINT32_MAX && !tri_same(w, slot[s], t))
+            s = (s + 1) & (cap - 1);
+        if (slot[s] != UINT32_MAX)
+            continue; /* a copy */
+        slot[s] = t;
+        list[kept++] = t;
+    }
+    free(slot);
+    return kept;
+}
+
 /* The world boxes of the shrub nodes (one per node: the union of its
  * instances), their densities through the overlap pre-pass. */
 static obs_status shrub_boxes(obs__bake_occl *o, const obs__bake_world *w,
@@ -341,6 +388,28 @@ obs_status obs__bake_occl_new(const obs__bake_world *w, const obs__bake_decor *d
             }
         }
     }
+    /* Exact copies left out (obs__bake_drop_copies): a level without any
+     * keeps every triangle and no list. */
+    uint32_t *all = o->opaque_tri;
+    if (!all && !(all = malloc((nt ? nt : 1) * sizeof *all))) {
+        st = obs__fail(err, OBS_NO_MEMORY, "the copies among %zu triangles", nt);
+        goto done;
+    }
+    if (!o->opaque_tri)
+        for (size_t t = 0; t < nt; t++)
+            all[t] = (uint32_t)t;
+    size_t kept = obs__bake_drop_copies(w, all, nopaque);
+    if (kept == SIZE_MAX) {
+        if (all != o->opaque_tri)
+            free(all);
+        st = obs__fail(err, OBS_NO_MEMORY, "the copies among %zu triangles", nopaque);
+        goto done;
+    }
+    if (kept == nopaque && all != o->opaque_tri)
+        free(all);
+    else
+        o->opaque_tri = all;
+    nopaque = kept;
     o->opaque_count = nopaque;
     o->tree_count = ntree;
     o->opaque = rtcNewScene(o->dev);

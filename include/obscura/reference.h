@@ -82,8 +82,10 @@ typedef struct obs_reference_desc {
  * camera through each pixel centre, or, with `position` set, the points of
  * a G-buffer (3 channels, world space) with their normals (3 channels,
  * world space, flipped to face the camera when they do not); a pixel with
- * a non-finite position or a zero normal is background.  The camera is
- * required in both cases (it gives the depth and the view direction). */
+ * a non-finite position, one beyond OBS_SCENE_MAX_COORD or a zero normal
+ * is background.  The camera is required in both cases (it gives the
+ * depth and the view direction); one placed beyond OBS_SCENE_MAX_COORD,
+ * or whose corner rays overflow float, is OBS_NO_CAMERA. */
 typedef struct obs_reference_view {
     const obs_camera *camera;  /* world_to_camera + projection */
     int width, height;         /* image size (camera rays) */

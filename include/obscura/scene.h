@@ -22,6 +22,28 @@ extern "C" {
  * chain takes depth >= 1e9 as sky). */
 #define OBS_SKY_DEPTH 1e10f
 
+/* The largest coordinate (world space, in magnitude) of a scene that
+ * gbuffer, reference and both bakes take: a planar depth of 1e9 and beyond
+ * is sky to the AO chain, float spacing there is 64 units, and the
+ * products of coordinates the stages compute overflow float or lose
+ * their digits not far above (measured: the rasteriser's normals are NaN
+ * from 1e11, Embree finds no hit at 1e10 and aborts on a ray origin past
+ * 1.844e18).  obs_scene_check and the bake's flatten refuse a vertex
+ * beyond it, with OBS_SCENE_COORD_RULE in the message. */
+#define OBS_SCENE_MAX_COORD 1e9f
+#define OBS_SCENE_COORD_RULE                                                                   \
+    "a coordinate beyond +-1e9 (the bound of obscura's scenes: depth 1e9 is sky, float "        \
+    "spacing there is 64 units and products of coordinates overflow; scale the scene down or "  \
+    "move it towards the origin)"
+
+/* 1 when a coordinate of p lies beyond OBS_SCENE_MAX_COORD. */
+static inline int obs_scene_coord_beyond(const float p[3])
+{
+    return p[0] > OBS_SCENE_MAX_COORD || p[0] < -OBS_SCENE_MAX_COORD ||
+           p[1] > OBS_SCENE_MAX_COORD || p[1] < -OBS_SCENE_MAX_COORD ||
+           p[2] > OBS_SCENE_MAX_COORD || p[2] < -OBS_SCENE_MAX_COORD;
+}
+
 /* One mesh of a scene file: its names (assimp's mesh name, and the name
  * of the first node that holds it; either may be "") and its run of
  * triangles. */
@@ -93,7 +115,9 @@ obs_status obs_scene_load_baked_dynamic(const char *path, const char *dynamic_no
 int obs_scene_file_is_baked(const char *path);
 
 /* Checks a scene built in memory (counts, indices in range, finite
- * positions) and computes its bounds.  obs_scene_load() calls it. */
+ * positions within OBS_SCENE_MAX_COORD, some triangle not degenerate) and
+ * computes its bounds; the message names the vertex or triangle and its
+ * mesh.  obs_scene_load() calls it. */
 obs_status obs_scene_check(obs_scene *s, char err[OBS_ERR_LEN]);
 
 /* Frees the arrays and zeroes *s; NULL-safe. */

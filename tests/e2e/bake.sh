@@ -456,7 +456,8 @@ said "instanced"
 
 echo "-- bad input"
 for f in no_triangles.obj:"no triangles" nan_vertex.obj:"not finite" \
-         huge_index_count.glb:"out of range" degenerate.obj:"degenerate"; do
+         huge_index_count.glb:"out of range" degenerate.obj:"degenerate" \
+         coords_3e38.obj:"in world space: a coordinate beyond +-1e9"; do
     expect 3 "refuses ${f%%:*}" -- "$OBSCURA" bake "tests/data/levels/bad/${f%%:*}" -o "$T/x.glb" -q
     said "${f#*:}"
 done

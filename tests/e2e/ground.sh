@@ -172,6 +172,22 @@ said "junk.ply"
 printf 'v 0 0 0\nv 1 0 0\nl 1 2\n' >"$T/lines.obj"
 expect 3 "empty scene" -- "$OBSCURA" gbuffer "$T/lines.obj" --camera "$C" -o "$T/x.exr"
 said "no triangles"
+# hostile but loadable: finite coordinates of 3e38 (an empty image, exit 0,
+# before), every triangle degenerate (the same)
+expect 3 "coordinates beyond the bound" -- "$OBSCURA" gbuffer tests/data/levels/bad/coords_3e38.obj \
+    --camera "$C" -o "$T/x.exr"
+said "vertex 0 (mesh 'defaultobject', node 'defaultobject') at (-3e+38, -3e+38, 0): a coordinate beyond +-1e9"
+expect 3 "every triangle degenerate" -- "$OBSCURA" reference tests/data/levels/bad/degenerate.obj \
+    --camera "$C" -o "$T/x.exr"
+said "all 2 triangles are degenerate"
+# a camera 1e30 away: gbuffer drew an empty image, reference aborted in Embree
+sed 's/-4.4376016/-4.4376016e30/' "$C" >"$T/far.camera.json"
+expect 3 "gbuffer: a camera beyond the bound" -- "$OBSCURA" gbuffer "$T/corner.obj" \
+    --camera "$T/far.camera.json" -o "$T/x.exr"
+said "the camera at (0, -3.69"
+expect 3 "reference: a camera beyond the bound" -- "$OBSCURA" reference "$T/corner.obj" \
+    --camera "$T/far.camera.json" -o "$T/x.exr" --spp 4
+said "a coordinate beyond +-1e9"
 printf '{"fov_y_deg": 500}' >"$T/bad.json"
 expect 3 "bad camera" -- "$OBSCURA" gbuffer "$T/corner.obj" --camera "$T/bad.json" -o "$T/x.exr"
 said "fov_y_deg"

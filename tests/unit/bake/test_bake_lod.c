@@ -82,6 +82,34 @@ static void test_simplify_plane(void **state)
     obs__bake_mesh_free(&soup);
 }
 
+/* A mesh whose faces are all far smaller than the weld's tolerance (a
+ * fraction of its box): a small quad beside slivers 2e7 long and 1e-6
+ * wide.  The weld collapses every triangle; the level was left empty, and
+ * a level of such meshes alone failed the bake's --lods ("no triangles
+ * under the scene's nodes") where the plain bake takes it.  The mesh is
+ * kept whole; a mesh without area (slivers alone) stays empty. */
+static void test_simplify_all_collapsed(void **state)
+{
+    (void)state;
+    char err[OBS_ERR_LEN] = "";
+    float pos[] = {-1e7f, 0, 0, 1e7f, 0, 0, 1e7f, 1e-6f, 0,       /* a sliver */
+                   -1e7f, 1, 0, 1e7f, 1, 0, 1e7f, 1 + 1e-6f, 0,   /* another */
+                   0, 0.5f, 0, 0.6f, 0.5f, 0, 0.6f, 0.5f, 0.5f, 0, 0.5f, 0.5f}; /* a quad */
+    uint32_t idx[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 6, 8, 9};
+    obs_bake_mesh m = {.name = "slivers", .vertex_count = 10, .triangle_count = 4,
+                       .positions = pos, .indices = idx, .material = -1};
+    obs_bake_mesh l1;
+    assert_int_equal(obs__bake_simplify(&m, 1, 0.5f, 0.02f, 0, 1e-5f, 120.0f, &l1, err), OBS_OK);
+    assert_int_equal(l1.triangle_count, 4);
+    assert_memory_equal(l1.indices, idx, sizeof idx);
+    assert_memory_equal(l1.positions, pos, sizeof pos);
+    obs__bake_mesh_free(&l1);
+    m.triangle_count = 2; /* the slivers alone: no area */
+    assert_int_equal(obs__bake_simplify(&m, 1, 0.5f, 0.02f, 0, 1e-5f, 120.0f, &l1, err), OBS_OK);
+    assert_int_equal(l1.triangle_count, 0);
+    obs__bake_mesh_free(&l1);
+}
+
 /* A curved height field: with the error bound 0 the simplifier may only
  * take collapses that move nothing, so it stays near the full count;
  * with a loose bound it reaches its ratio.  Never empty either way. */
@@ -655,6 +683,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_simplify_plane),
         cmocka_unit_test(test_simplify_error_bound),
+        cmocka_unit_test(test_simplify_all_collapsed),
         cmocka_unit_test(test_simplify_lock_border),
         cmocka_unit_test(test_closest_tri),
         cmocka_unit_test(test_closest_bvh),

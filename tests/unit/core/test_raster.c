@@ -310,6 +310,12 @@ static void test_errors(void **state)
     /* the in-memory triangle without normals renders (geometric normal) */
     assert_int_equal(obs_raster_gbuffer(ctx, &m, &cam, W, H, &r, err), OBS_OK);
     obs_raster_free(&r);
+    /* a camera 1e30 away (its translation): it drew nothing, with exit 0,
+     * and gbuffer's header lost the camera; refused by the scenes' bound */
+    cam.world_to_camera[11] -= 1e30f;
+    assert_int_equal(obs_raster_gbuffer(ctx, &m, &cam, W, H, &r, err), OBS_NO_CAMERA);
+    assert_non_null(strstr(err, "a coordinate beyond +-1e9"));
+    assert_null(r.depth.data);
 }
 
 /* Depth and normals of room.obj rasterised with room.camera.json against

@@ -159,6 +159,44 @@ static void test_deterministic(void **state)
     obs_scene_free(&s);
 }
 
+/* Normals against the winding (every vertex normal pointing into the side
+ * the camera does not see): the AO is that of the geometric normals, as
+ * the --gbuffer points' (turned to face the viewer).  It was 0 wherever
+ * such a triangle was seen: every cosine ray around the normal lay below
+ * the surface. */
+static void test_normals_against_winding(void **state)
+{
+    (void)state;
+    const float box[2][4][3] = {{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}},
+                                {{0.2f, -0.5f, 0}, {0.2f, -0.5f, 0.4f}, {0.2f, 0.5f, 0.4f}, {0.2f, 0.5f, 0}}};
+    obs_scene s;
+    obs_camera cam;
+    obs_image plain = {0}, against = {0};
+    char err[OBS_ERR_LEN] = "";
+    quads(&s, box, 2);
+    top_camera(&cam, 1.5f);
+    obs_reference_view v = {.camera = &cam, .width = 48, .height = 32};
+    obs_reference_desc d = {.distance = 0.5f, .spp = 16, .seed = 1, .threads = 1};
+    assert_int_equal(obs_reference_render(&s, &v, &d, &plain, NULL, err), OBS_OK);
+    /* the floor's normals -Z (its winding faces +Z, the camera), the
+     * wall's +X (its winding faces -X, the camera at x = 0) */
+    s.normals = calloc(3 * s.vertex_count, sizeof(float));
+    assert_non_null(s.normals);
+    for (int i = 0; i < 4; i++) {
+        s.normals[3 * i + 2] = -1.0f;
+        s.normals[3 * (4 + i)] = 1.0f;
+    }
+    assert_int_equal(obs_reference_render(&s, &v, &d, &against, NULL, err), OBS_OK);
+    float mean = 0.0f;
+    for (int i = 0; i < 48 * 32; i++)
+        mean += against.data[i] / (48 * 32);
+    print_message("AO mean %.3f with the normals against the winding\n", (double)mean);
+    assert_memory_equal(plain.data, against.data, 48 * 32 * sizeof(float));
+    obs_image_free(&plain);
+    obs_image_free(&against);
+    obs_scene_free(&s);
+}
+
 static void test_errors(void **state)
 {
     (void)state;
@@ -192,6 +230,40 @@ static void test_errors(void **state)
     v.position = &pos; /* without normals */
     assert_int_equal(obs_reference_render(&s, &v, &d, &ao, NULL, err), OBS_INVALID_ARGUMENT);
     assert_null(ao.data);
+    obs_scene_free(&s);
+}
+
+/* A camera 1e30 above the floor: Embree aborted the process on its rays
+ * (ray.valid: an origin past 1.844e18).  Refused by the scenes' bound,
+ * naming the camera's position; one at 1e9 is taken.  G-buffer points
+ * beyond the bound are background (AO 1), as non-finite ones are; the
+ * point at 1e30 aborted the same way. */
+static void test_far_camera_and_points(void **state)
+{
+    (void)state;
+    const float floor_q[1][4][3] = {{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}};
+    obs_scene s;
+    obs_camera cam;
+    obs_image ao = {0};
+    char err[OBS_ERR_LEN] = "";
+    quads(&s, floor_q, 1);
+    top_camera(&cam, 1.0f);
+    cam.world_to_camera[11] = -1e30f;
+    obs_reference_view v = {.camera = &cam, .width = 8, .height = 8};
+    obs_reference_desc d = {.distance = 0.5f, .spp = 4, .threads = 1};
+    assert_int_equal(obs_reference_render(&s, &v, &d, &ao, NULL, err), OBS_NO_CAMERA);
+    print_message("%s\n", err);
+    assert_non_null(strstr(err, "the camera at (0, 0, 1e+30): a coordinate beyond +-1e9"));
+    assert_null(ao.data);
+    cam.world_to_camera[11] = -1e9f;
+    assert_int_equal(obs_reference_render(&s, &v, &d, &ao, NULL, err), OBS_OK);
+    obs_image_free(&ao);
+
+    const float xs[3] = {0.0f, 1e30f, 3e38f};
+    float out[3];
+    ao_at_points(&s, xs, 3, 0.0f, 4, out);
+    for (int i = 0; i < 3; i++)
+        assert_true(out[i] == 1.0f); /* open floor; background */
     obs_scene_free(&s);
 }
 
@@ -273,6 +345,8 @@ int main(void)
         cmocka_unit_test(test_closed_forms),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_normals_against_winding),
+        cmocka_unit_test(test_far_camera_and_points),
         cmocka_unit_test(test_blender_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -160,6 +160,57 @@ static void test_transform_overflow(void **state)
     obs_bake_scene_free(&b);
 }
 
+/* Finite coordinates of +-3e38 (hostile but loadable): each is a float,
+ * their sums and products are not.  Both loaders refuse them by the
+ * bound of obscura's scenes (OBS_SCENE_MAX_COORD), naming the vertex;
+ * before, gbuffer and reference drew and traced nothing without a word,
+ * and the flattening called the identity transform an overflow (it
+ * tested the sum of the coordinates). */
+static void test_coordinates_beyond_bound(void **state)
+{
+    (void)state;
+    const char *f = BAD "coords_3e38.obj";
+    scene_fails(f, OBS_BAD_FILE, "vertex 0 (mesh 'defaultobject', node 'defaultobject') at "
+                                 "(-3e+38, -3e+38, 0): a coordinate beyond +-1e9");
+    obs_bake_scene b;
+    char err[OBS_ERR_LEN] = "";
+    level_loads(f, &b);
+    obs__bake_world w;
+    assert_int_equal(obs__bake_flatten(&b, &w, err), OBS_BAD_FILE);
+    print_message("flatten: %s\n", err);
+    assert_non_null(strstr(err, "vertex 0 at (-3e+38, -3e+38, 0) in world space: a coordinate "
+                                "beyond +-1e9"));
+    assert_null(strstr(err, "transform overflows"));
+    obs_bake_scene_free(&b);
+
+    /* the bound itself is taken, a step beyond it is not */
+    float pos[9] = {-1e9f, 0, 0, 1e9f, 0, 0, 0, 1e9f, -1e9f};
+    uint32_t idx[3] = {0, 1, 2};
+    obs_scene m = {.vertex_count = 3, .positions = pos, .triangle_count = 1, .indices = idx};
+    assert_int_equal(obs_scene_check(&m, err), OBS_OK);
+    pos[8] = nextafterf(-1e9f, -INFINITY);
+    assert_int_equal(obs_scene_check(&m, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "vertex 2 at"));
+}
+
+/* Every triangle degenerate (collinear points): the bake refused such a
+ * scene, gbuffer and reference drew an empty image without a word;
+ * obs_scene_check refuses it as the bake does (level/flatten.c's rule,
+ * obs__tri_normal). */
+static void test_all_degenerate(void **state)
+{
+    (void)state;
+    scene_fails(BAD "degenerate.obj", OBS_BAD_FILE, "all 2 triangles are degenerate");
+    float pos[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2};
+    uint32_t idx[3] = {0, 1, 2};
+    char err[OBS_ERR_LEN] = "";
+    obs_scene m = {.vertex_count = 3, .positions = pos, .triangle_count = 1, .indices = idx};
+    assert_int_equal(obs_scene_check(&m, err), OBS_BAD_FILE);
+    assert_non_null(strstr(err, "degenerate"));
+    pos[8] = 3; /* off the line */
+    assert_int_equal(obs_scene_check(&m, err), OBS_OK);
+}
+
 /* An AC3D object with vertices and no surface count: assimp keeps its
  * points as a mesh under no node, and PreTransformVertices (hierarchy
  * kept) read a null transform for it (SEGV).  The scene refuses it by
@@ -406,6 +457,7 @@ int main(void)
         cmocka_unit_test(test_node_dag),             cmocka_unit_test(test_node_index_not_integer),
         cmocka_unit_test(test_nan_vertex),
         cmocka_unit_test(test_transform_overflow),   cmocka_unit_test(test_mesh_under_no_node),
+        cmocka_unit_test(test_coordinates_beyond_bound), cmocka_unit_test(test_all_degenerate),
         cmocka_unit_test(test_occluders_bounded),    cmocka_unit_test(test_all_at_one_point),     cmocka_unit_test(test_huge_declared_count),
         cmocka_unit_test(test_ac3d_strip_without_refs), cmocka_unit_test(test_ac3d_counts),
         cmocka_unit_test(test_gltf_not_gltf),          cmocka_unit_test(test_off_counts),
