@@ -319,14 +319,29 @@ static void test_ac3d_strip_without_refs(void **state)
     both_fail(BAD "strip_no_refs.ac", "a triangle strip of 0 vertex references");
 }
 
+/* Files of the given texts (each with the words its error must hold),
+ * named by template (as temp_file's), each refused by both loaders. */
+struct bad_text {
+    const char *text, *words;
+};
+
+static void texts_fail(const char *template, const struct bad_text *bad, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        char path[64];
+        snprintf(path, sizeof path, "%s", template);
+        temp_file(path, bad[i].text);
+        both_fail(path, bad[i].words);
+        unlink(path);
+    }
+}
+
 /* Counts an AC3D file does not hold: each walked before assimp reserves
  * what they say or reads the next lines as more of the same. */
 static void test_ac3d_counts(void **state)
 {
     (void)state;
-    static const struct {
-        const char *text, *words;
-    } bad[] = {
+    static const struct bad_text bad[] = {
         {"AC3Db\nOBJECT poly\nnumvert 4\n0 0 0\n1 0 0\n0 1 0\nkids 0\n", "line 7 is not a vertex"},
         {"AC3Db\nOBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 2\nSURF 0x0\nmat 0\n"
          "refs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", "surface 1 does not start with SURF"},
@@ -336,12 +351,7 @@ static void test_ac3d_counts(void **state)
          "refs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", "material 1 of the file's 0"},
         {"AC3Db\nOBJECT world\nkids 4000000000\nOBJECT poly\nkids 0\n", "more children than"},
     };
-    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
-        char path[] = "/tmp/obs_ac3d_XXXXXX.acc";
-        temp_file(path, bad[i].text);
-        both_fail(path, bad[i].words);
-        unlink(path);
-    }
+    texts_fail("/tmp/obs_ac3d_XXXXXX.acc", bad, sizeof bad / sizeof *bad);
 }
 
 /* A file named .glb that is no glTF binary (its first bytes name an
@@ -353,20 +363,13 @@ static void test_gltf_not_gltf(void **state)
 {
     (void)state;
     both_fail(BAD "not_glb_opengex.glb", "a .glb starts with the magic");
-    static const struct {
-        const char *text, *words;
-    } bad[] = {
+    static const struct bad_text bad[] = {
         {"{\"asset\": {\"version\": \"2.0\"}} Metric IndexArray", "text after its JSON value"},
         {"{\"asset\": {\"version\": \"1.0\"}, \"IndexArray\": 1}", "\"version\" 2.x"},
         {"{\"scenes\": [], \"IndexArray\": {}}", "no \"asset\" object"},
         {"Metric {float {1.0}} IndexArray {}", "is not JSON"},
     };
-    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
-        char path[] = "/tmp/obs_gltf_XXXXXX.gltf";
-        temp_file(path, bad[i].text);
-        both_fail(path, bad[i].words);
-        unlink(path);
-    }
+    texts_fail("/tmp/obs_gltf_XXXXXX.gltf", bad, sizeof bad / sizeof *bad);
 }
 
 /* OFF header counts past 32 bits, or past what the file could hold:
