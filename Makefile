@@ -61,9 +61,9 @@ $(BUILD)/obj/core/%.o: CPPFLAGS += $(CORE_INC)
 # flag nor errno is read; no value changes).
 $(BUILD)/obj/core/chain/%_cpu.o: CFLAGS += -fopenmp-simd -fno-trapping-math -fno-math-errno
 ifeq ($(SAN),1)
-CFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
-CXXFLAGS += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
-LDFLAGS += -fsanitize=address,undefined
+CFLAGS += -fsanitize=address,undefined,float-cast-overflow -fno-omit-frame-pointer -fno-sanitize-recover=undefined,float-cast-overflow
+CXXFLAGS += -fsanitize=address,undefined,float-cast-overflow -fno-omit-frame-pointer -fno-sanitize-recover=undefined,float-cast-overflow
+LDFLAGS += -fsanitize=address,undefined,float-cast-overflow
 # intercept_tls_get_addr=0: gcc 12's LeakSanitizer reads a dynamic TLS block
 # of a library opened with dlopen (Mesa's, core/gl/libs.c) at a bogus address
 # and its tracer dies at exit ("Tracer caught signal 11", after "DTLS ... at
