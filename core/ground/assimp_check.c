@@ -5,6 +5,8 @@
 #include <assimp/scene.h>
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -323,7 +325,8 @@ static int ac_numbers(const struct ac_walk *w, int k)
  * max_ref) and material (max_mat).  Leaves w on the line after it; *more is
  * 0 at the end of the file. */
 static obs_status ac_surface(const char *path, struct ac_walk *w, long long *max_ref,
-                             long long *max_mat, int *more, char err[OBS_ERR_LEN])
+                             long long *max_mat, long long *corners, int *more,
+                             char err[OBS_ERR_LEN])
 {
     static const char *const type_name[] = {"polygon", "closed line", "line", "", "triangle strip"};
     static const int min_refs[] = {1, 2, 2, 0, 3};
@@ -370,14 +373,16 @@ static obs_status ac_surface(const char *path, struct ac_walk *w, long long *max
     if (refs < min_refs[type])
         return AC_FAIL("%s: line %lu: a %s of %lld vertex references (AC3D needs at least %d)",
                        path, at, type_name[type], refs, min_refs[type]);
+    *corners += refs;
     return OBS_OK;
 }
 
 /* The file's objects and their counts; buf holds the whole file (size
  * bytes). */
 static obs_status ac_objects(const char *path, const char *buf, size_t size,
-                             char err[OBS_ERR_LEN])
+                             uint64_t max_faces, char err[OBS_ERR_LEN])
 {
+    double total = 0.0; /* triangles of the objects walked, subdivided */
     struct ac_walk w = {buf, buf + size, NULL, 0, 0};
     if (!ac_next(&w) || w.len < 4 || memcmp(w.s, "AC3D", 4) != 0)
         return AC_FAIL("%s: not an AC3D file (its first line is not AC3D and a version)", path);
@@ -402,7 +407,7 @@ static obs_status ac_objects(const char *path, const char *buf, size_t size,
         if (levels > 0)
             pending[levels - 1]--;
         unsigned long at = w.no;
-        long long nvert = 0, max_ref = -1;
+        long long nvert = 0, max_ref = -1, nsurf = 0, corners = 0, subdiv = 0;
         int kids = 0;
         more = ac_next(&w);
         while (more && !kids) {
@@ -432,10 +437,16 @@ static obs_status ac_objects(const char *path, const char *buf, size_t size,
                         return AC_FAIL("%s: line %lu: numsurf %lld, but surface %lld %s (AC3D)",
                                        path, line, n, i,
                                        more ? "does not start with SURF" : "is past the end");
-                    obs_status st = ac_surface(path, &w, &max_ref, &max_mat, &more, err);
+                    obs_status st = ac_surface(path, &w, &max_ref, &max_mat, &corners, &more, err);
                     if (st != OBS_OK)
                         return st;
                 }
+                nsurf += n;
+            } else if (ac_is(&w, "subdiv")) {
+                subdiv = ac_count(&w, "subdiv");
+                if (subdiv < 0)
+                    return AC_FAIL("%s: line %lu: subdiv without its level (AC3D)", path, w.no);
+                more = ac_next(&w);
             } else if (ac_is(&w, "kids")) {
                 long long n = ac_count(&w, "kids");
                 /* each child is at least a line "OBJECT" */
@@ -462,6 +473,19 @@ static obs_status ac_objects(const char *path, const char *buf, size_t size,
         if (max_ref >= nvert)
             return AC_FAIL("%s: line %lu: a surface refers to vertex %lld of an object of %lld "
                            "vertices (AC3D)", path, at, max_ref, nvert);
+        /* assimp subdivides the object subdiv times (Catmull-Clark): the
+         * first level turns each n-gon into n quads, each further level
+         * each quad into 4, and a quad is 2 triangles */
+        double tris = subdiv > 0 ? 2.0 * (double)corners * pow(4.0, (double)(subdiv - 1))
+                                 : (double)nsurf;
+        total += tris;
+        if (subdiv > 0 && total > (double)max_faces)
+            return obs__fail(err, OBS_TOO_LARGE,
+                             "%s: line %lu: subdiv %lld of an object of %lld surfaces makes "
+                             "%.4g triangles; with the objects before it more than the %llu "
+                             "allowed (a bake's max_triangles, else assimp's 32-bit face "
+                             "count; AC3D: assimp subdivides while it reads the file)", path, at, subdiv, nsurf, total,
+                             (unsigned long long)max_faces);
     }
     if (max_mat >= (materials ? materials : 1))
         return AC_FAIL("%s: a surface uses material %lld of the file's %lld MATERIAL lines "
@@ -470,13 +494,14 @@ static obs_status ac_objects(const char *path, const char *buf, size_t size,
 }
 
 /* An AC3D file (f at its start, size bytes) walked by ac_objects. */
-static obs_status ac3d_structure(const char *path, FILE *f, size_t size, char err[OBS_ERR_LEN])
+static obs_status ac3d_structure(const char *path, FILE *f, size_t size, uint64_t max_faces,
+                                 char err[OBS_ERR_LEN])
 {
     char *buf = malloc(size ? size : 1);
     if (!buf)
         return obs__fail(err, OBS_NO_MEMORY, "%s: %zu bytes of AC3D", path, size);
     obs_status st = fseek(f, 0, SEEK_SET) == 0 && fread(buf, 1, size, f) == size
-                        ? ac_objects(path, buf, size, err)
+                        ? ac_objects(path, buf, size, max_faces, err)
                         : obs__fail(err, OBS_IO, "%s: cannot read it", path);
     free(buf);
     return st;
@@ -563,7 +588,7 @@ static obs_status off_counts(const char *path, FILE *f, char err[OBS_ERR_LEN])
     return OBS_OK;
 }
 
-obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
+obs_status obs__assimp_precheck(const char *path, uint64_t max_faces, char err[OBS_ERR_LEN])
 {
     FILE *f = fopen(path, "rb");
     if (!f)
@@ -594,7 +619,7 @@ obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN])
         if (fseek(f, 0, SEEK_END) == 0)
             size = ftell(f);
         if (size >= 0)
-            st = ac3d_structure(path, f, (size_t)size, err);
+            st = ac3d_structure(path, f, (size_t)size, max_faces, err);
     } else if (ext && !strcasecmp(ext, ".off")) {
         st = off_counts(path, f, err);
     }

@@ -7,6 +7,7 @@
 #ifndef OBSCURA_GROUND_ASSIMP_READ_H
 #define OBSCURA_GROUND_ASSIMP_READ_H
 
+#include <stdint.h>
 #include <stddef.h>
 
 #include "obscura/status.h"
@@ -31,9 +32,11 @@ void obs__assimp_free(obs__assimp *a);
 
 /* What path must be before assimp reads it (assimp_check.c): a PLY
  * header ends with end_header; a .glb's chunks lie within the file; a
- * glTF's node graph is a forest (obs__glb_forest).  OBS_OK, or the error
- * (OBS_BAD_FILE, OBS_IO, OBS_NO_MEMORY). */
-obs_status obs__assimp_precheck(const char *path, char err[OBS_ERR_LEN]);
+ * glTF's node graph is a forest (obs__glb_forest); an AC3D file's
+ * structure, and its subdivided objects (assimp subdivides while it
+ * reads) at most max_faces triangles.  OBS_OK, or the error
+ * (OBS_BAD_FILE, OBS_TOO_LARGE, OBS_IO, OBS_NO_MEMORY). */
+obs_status obs__assimp_precheck(const char *path, uint64_t max_faces, char err[OBS_ERR_LEN]);
 
 /* Every face of the validated scene with at least one vertex (assimp
  * 5.2's Triangulate aborts on one without: ValidateDataStructure lets it

@@ -370,7 +370,8 @@ static obs_status finite_vertices(const char *path, const struct aiScene *sc,
 static obs_status import(const char *path, obs__assimp **imp, const struct aiScene **sc,
                          char err[OBS_ERR_LEN])
 {
-    obs_status st = obs__assimp_precheck(path, err);
+    /* no triangle limit here: what assimp's 32-bit face counts hold */
+    obs_status st = obs__assimp_precheck(path, UINT32_MAX, err);
     if (st != OBS_OK)
         return st;
     /* Read and validated first, nothing else: ValidateDataStructure

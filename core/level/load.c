@@ -389,7 +389,9 @@ obs_status obs_bake_load(const char *path, size_t max_triangles, obs_bake_scene 
                          char err[OBS_ERR_LEN])
 {
     memset(out, 0, sizeof *out);
-    obs_status pre = obs__assimp_precheck(path, err);
+    /* max_triangles 0: no limit but assimp's own (32-bit face counts) */
+    uint64_t most = max_triangles ? (uint64_t)max_triangles : UINT32_MAX;
+    obs_status pre = obs__assimp_precheck(path, most, err);
     if (pre != OBS_OK)
         return pre;
     /* No joining, no pre-transform: the soup, the graph and the mesh

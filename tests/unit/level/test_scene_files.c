@@ -319,6 +319,40 @@ static void test_ac3d_strip_without_refs(void **state)
     both_fail(BAD "strip_no_refs.ac", "a triangle strip of 0 vertex references");
 }
 
+/* An AC3D object subdivided k times (Catmull-Clark, while assimp reads
+ * the file): its quad makes 2 * 4 * 4^(k - 1) triangles.  subdiv 12 made
+ * assimp take 7.2 GB, past 60 s, before the bake's max_triangles could
+ * refuse the level; now the precheck counts them first: subdiv 8 (131072
+ * triangles) loads under max_triangles 131072 and is refused under 131071
+ * (OBS_TOO_LARGE, without assimp reading it), and subdiv 20 (2.2e12) is
+ * refused by the scene loader too (past 32-bit face counts). */
+static void test_ac3d_subdiv(void **state)
+{
+    (void)state;
+    static const char fmt[] = "AC3Db\nMATERIAL \"m\" rgb 1 1 1 amb 0.2 0.2 0.2 emis 0 0 0 spec 0 0 0 "
+                              "shi 1 trans 0\nOBJECT poly\nsubdiv %d\nnumvert 4\n0 0 0\n1 0 0\n"
+                              "1 1 0\n0 1 0\nnumsurf 1\nSURF 0x10\nmat 0\nrefs 4\n0 0 0\n1 0 0\n"
+                              "2 0 0\n3 0 0\nkids 0\n";
+    char text[512], path[64], err[OBS_ERR_LEN] = "";
+    obs_bake_scene b;
+    snprintf(text, sizeof text, fmt, 8);
+    snprintf(path, sizeof path, "%s", "/tmp/obs_subdivXXXXXX.ac");
+    temp_file(path, text);
+    assert_int_equal(obs_bake_load(path, 131071, &b, err), OBS_TOO_LARGE);
+    print_message("%s\n", err);
+    assert_non_null(strstr(err, "subdiv 8"));
+    assert_non_null(strstr(err, "1.311e+05 triangles"));
+    assert_int_equal(obs_bake_load(path, 131072, &b, err), OBS_OK);
+    obs_bake_scene_free(&b);
+    unlink(path);
+    snprintf(text, sizeof text, fmt, 20);
+    snprintf(path, sizeof path, "%s", "/tmp/obs_subdivXXXXXX.ac");
+    temp_file(path, text);
+    scene_fails(path, OBS_TOO_LARGE, "subdiv 20");
+    level_fails(path, OBS_TOO_LARGE, "subdiv 20");
+    unlink(path);
+}
+
 /* Files of the given texts (each with the words its error must hold),
  * named by template (as temp_file's), each refused by both loaders. */
 struct bad_text {
@@ -464,7 +498,7 @@ int main(void)
         cmocka_unit_test(test_occluders_bounded),    cmocka_unit_test(test_all_at_one_point),     cmocka_unit_test(test_huge_declared_count),
         cmocka_unit_test(test_ac3d_strip_without_refs), cmocka_unit_test(test_ac3d_counts),
         cmocka_unit_test(test_gltf_not_gltf),          cmocka_unit_test(test_off_counts),
-        cmocka_unit_test(test_deep_hierarchy),
+        cmocka_unit_test(test_deep_hierarchy),         cmocka_unit_test(test_ac3d_subdiv),
         cmocka_unit_test(test_valid_seeds_load),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
