@@ -78,24 +78,13 @@ static obs_status weld(const obs_bake_mesh *m, float tolerance, float angle, wel
     return OBS_OK;
 }
 
-/* flatten.c's degenerate face: zero area, or a sliver whose normal
- * float rounding decides. */
+/* flatten.c's degenerate face (obs__tri_normal): zero area, or a sliver
+ * whose normal float rounding decides. */
 static int flat(const float *pos, const uint32_t t[3])
 {
-    const float *p0 = pos + 3 * (size_t)t[0], *p1 = pos + 3 * (size_t)t[1],
-                *p2 = pos + 3 * (size_t)t[2];
-    double e1[3], e2[3], n[3];
-    for (int k = 0; k < 3; k++) {
-        e1[k] = (double)p1[k] - p0[k];
-        e2[k] = (double)p2[k] - p0[k];
-    }
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    double scale = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2] + e2[0] * e2[0] +
-                   e2[1] * e2[1] + e2[2] * e2[2];
-    return !(len > 1e-7 * scale);
+    float n[3];
+    return obs__tri_normal(pos + 3 * (size_t)t[0], pos + 3 * (size_t)t[1], pos + 3 * (size_t)t[2],
+                           n) == 0.0;
 }
 
 /* The mesh copied whole into out (its name already set): a level the

@@ -49,10 +49,8 @@ static obs_status ply_header(const char *path, FILE *f, char err[OBS_ERR_LEN])
     /* assimp 5.2's PLY reader, given a header without its end_header
      * line, reads past its buffer (binary) or never returns (ASCII). */
     char *buf = malloc(PLY_HEADER_MAX + 1);
-    if (!buf) {
-        fclose(f);
+    if (!buf) /* f is the caller's to close */
         return obs__fail(err, OBS_NO_MEMORY, "%s: PLY header", path);
-    }
     n = fread(buf, 1, PLY_HEADER_MAX, f);
     buf[n] = '\0';
     int found = 0;
@@ -131,51 +129,6 @@ static obs_status glb_header(const char *path, const unsigned char *head, size_t
     return OBS_OK;
 }
 
-/* The depth of a glTF document's node tree (nodes' "children"), walked
- * up from each node with the depths found so far kept: at most
- * HIERARCHY_MAX levels (a cycle never ends, so it is refused too). */
-static obs_status gltf_depth(const char *path, const cJSON *doc, char err[OBS_ERR_LEN])
-{
-    const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(doc, "nodes");
-    int n = cJSON_IsArray(nodes) ? cJSON_GetArraySize(nodes) : 0;
-    if (n <= 0)
-        return OBS_OK;
-    long *parent = malloc(2 * (size_t)n * sizeof *parent);
-    if (!parent)
-        return obs__fail(err, OBS_NO_MEMORY, "%s: %d glTF nodes", path, n);
-    long *depth = parent + n;
-    for (int i = 0; i < n; i++)
-        parent[i] = depth[i] = -1;
-    int i = 0;
-    for (const cJSON *node = nodes->child; node; node = node->next, i++) {
-        const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node, "children"), *c;
-        cJSON_ArrayForEach(c, kids)
-        {
-            if (cJSON_IsNumber(c) && c->valuedouble >= 0 && c->valuedouble < n)
-                parent[(long)c->valuedouble] = i;
-        }
-    }
-    obs_status st = OBS_OK;
-    for (long k = 0; k < n && st == OBS_OK; k++) {
-        long j = k, steps = 0;
-        while (j >= 0 && depth[j] < 0 && steps <= HIERARCHY_MAX) {
-            j = parent[j];
-            steps++;
-        }
-        long d = (j >= 0 ? depth[j] : -1) + steps;
-        if (steps > HIERARCHY_MAX || d > HIERARCHY_MAX) {
-            st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is deeper than %d levels in "
-                                              "the node tree (or in a cycle)",
-                           path, k, HIERARCHY_MAX);
-            break;
-        }
-        for (j = k; j >= 0 && depth[j] < 0; j = parent[j])
-            depth[j] = d--;
-    }
-    free(parent);
-    return st;
-}
-
 /* The JSON of a .glb (f after its first 4 bytes) or a .gltf (whole), of
  * size bytes, checked by obs__glb_forest; what does not parse is assimp's to
  * refuse. */
@@ -214,10 +167,8 @@ static obs_status gltf_json(const char *path, FILE *f, int glb, size_t size,
     if (fseek(f, (long)off, SEEK_SET) == 0 && fread(txt, 1, len, f) == len) {
         cJSON *doc = NULL;
         st = gltf_document(path, glb, txt, len, &doc, err);
-        if (st == OBS_OK)
-            st = obs__glb_forest(path, doc, err);
-        if (st == OBS_OK)
-            st = gltf_depth(path, doc, err);
+        if (st == OBS_OK) /* assimp walks the node tree recursively */
+            st = obs__glb_forest(path, doc, HIERARCHY_MAX, err);
         cJSON_Delete(doc);
     }
     free(txt);

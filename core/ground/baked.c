@@ -322,7 +322,7 @@ static obs_status walk_scene(build *b, char err[OBS_ERR_LEN])
     obs__mat4_identity(id);
     /* a forest, so that the walk visits each node once (a DAG's paths
      * are exponential in its depth) */
-    obs_status st = obs__glb_forest(b->g->path, b->g->doc, err);
+    obs_status st = obs__glb_forest(b->g->path, b->g->doc, 0, err); /* walk() bounds the depth */
     cJSON_ArrayForEach(r, item(sc, "nodes"))
         if (st == OBS_OK)
             st = walk(b, obs__glb_index_value(r), id, 0, 0, err);

@@ -127,18 +127,25 @@ uint32_t obs__glb_index(const obs__glb_acc *a, size_t i)
  * child of two nodes (or twice of one), no scene root a child.  assimp
  * 5.2's glTF importer copies a node once per path to it (a DAG of 40
  * levels asks for 2^40 nodes) and recurses around a cycle without end,
- * and a walk of the graph (baked.c) would visit every path.
- * Child indices out of range are the reader's to refuse. */
-obs_status obs__glb_forest(const char *path, const cJSON *doc, char err[OBS_ERR_LEN])
+ * and a walk of the graph (baked.c) would visit every path.  With
+ * max_depth > 0 also no node deeper than max_depth levels, walked up from
+ * each node with the depths found so far kept (a cycle never ends, so it
+ * is refused too).  Child indices out of range are the reader's to
+ * refuse. */
+obs_status obs__glb_forest(const char *path, const cJSON *doc, int max_depth,
+                           char err[OBS_ERR_LEN])
 {
     const cJSON *nodes = item(doc, "nodes"), *nd, *c, *sc;
     int n = cJSON_GetArraySize(nodes);
     if (n <= 0)
         return OBS_OK;
-    unsigned char *parent = calloc((size_t)n, 1);
+    long *parent = malloc(2 * (size_t)n * sizeof *parent), *depth = parent + n;
     if (!parent)
         return obs__fail(err, OBS_NO_MEMORY, "%s: %d nodes", path, n);
+    for (int i = 0; i < n; i++)
+        parent[i] = depth[i] = -1;
     obs_status st = OBS_OK;
+    long i = 0;
     cJSON_ArrayForEach(nd, nodes)
     {
         cJSON_ArrayForEach(c, item(nd, "children"))
@@ -146,26 +153,44 @@ obs_status obs__glb_forest(const char *path, const cJSON *doc, char err[OBS_ERR_
             long k = obs__glb_index_value(c);
             if (k < 0 || k >= n)
                 continue;
-            if (parent[k]++) {
+            if (parent[k] >= 0) {
                 st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is the child of more than "
                                                   "one node (the node graph must be a forest)",
                                path, k);
                 goto done;
             }
+            parent[k] = i;
         }
+        i++;
     }
     cJSON_ArrayForEach(sc, item(doc, "scenes"))
     {
         cJSON_ArrayForEach(c, item(sc, "nodes"))
         {
             long k = obs__glb_index_value(c);
-            if (k >= 0 && k < n && parent[k]) {
+            if (k >= 0 && k < n && parent[k] >= 0) {
                 st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is a scene's root and a "
                                                   "child (a cycle?)",
                                path, k);
                 goto done;
             }
         }
+    }
+    for (long k = 0; max_depth > 0 && k < n; k++) {
+        long j = k, steps = 0;
+        while (j >= 0 && depth[j] < 0 && steps <= max_depth) {
+            j = parent[j];
+            steps++;
+        }
+        long d = (j >= 0 ? depth[j] : -1) + steps;
+        if (steps > max_depth || d > max_depth) {
+            st = obs__fail(err, OBS_BAD_FILE, "%s: glTF node %ld is deeper than %d levels in "
+                                              "the node tree (or in a cycle)",
+                           path, k, max_depth);
+            goto done;
+        }
+        for (j = k; j >= 0 && depth[j] < 0; j = parent[j])
+            depth[j] = d--;
     }
 done:
     free(parent);

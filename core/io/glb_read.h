@@ -42,9 +42,11 @@ long obs__glb_index_of(const cJSON *o, const char *name);
 /* The same of a value (an array's element; NULL: -1). */
 long obs__glb_index_value(const cJSON *v);
 /* OBS_OK when the glTF document's node graph is a forest (no node the
- * child of two nodes, no scene root a child); else OBS_BAD_FILE naming
- * the node (path: the file, for the message). */
-obs_status obs__glb_forest(const char *path, const cJSON *doc, char err[OBS_ERR_LEN]);
+ * child of two nodes, no scene root a child) and, with max_depth > 0, no
+ * node deeper than max_depth levels (nor in a cycle); else OBS_BAD_FILE
+ * naming the node (path: the file, for the message). */
+obs_status obs__glb_forest(const char *path, const cJSON *doc, int max_depth,
+                           char err[OBS_ERR_LEN]);
 
 /* One accessor's elements in the binary chunk. */
 typedef struct obs__glb_acc {
